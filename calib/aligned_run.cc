@@ -1,0 +1,46 @@
+#include "calib/aligned_run.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace fitcal {
+
+AlignedRun AlignRun(const RunLog& run) {
+  const std::vector<double>& t = run.encoders.t_s;
+  const GroundTruthTrack& gt = run.ground_truth;
+  AlignedRun out;
+  out.id = run.id;
+  out.trajectory = run.trajectory;
+  out.repetition = run.repetition;
+  if (run.start_pose) {
+    out.t_start_s = t.front();
+    out.start = *run.start_pose;
+  } else {
+    out.t_start_s = std::max(t.front(), gt.t_s.front());
+    out.start = InterpolateGroundTruth(gt, out.t_start_s);
+  }
+  out.t_final_s = std::min(t.back(), gt.t_s.back());
+  if (!(out.t_final_s > out.t_start_s)) {
+    throw std::invalid_argument("run " + run.id + ": encoders and ground truth share no time");
+  }
+  out.final_ground_truth = InterpolateGroundTruth(gt, out.t_final_s);
+  out.samples.reserve(run.encoders.samples.size());
+  for (std::size_t k = 0; k < run.encoders.samples.size(); ++k) {
+    const double begin = std::max(t[k], out.t_start_s);
+    const double end = std::min(t[k + 1], out.t_final_s);
+    if (end <= begin) continue;
+    WheelSample sample = run.encoders.samples[k];
+    sample.dt_s = end - begin;
+    out.samples.push_back(sample);
+  }
+  return out;
+}
+
+std::vector<AlignedRun> AlignRuns(const std::vector<RunLog>& runs) {
+  std::vector<AlignedRun> out;
+  out.reserve(runs.size());
+  for (const RunLog& run : runs) out.push_back(AlignRun(run));
+  return out;
+}
+
+}  // namespace fitcal

@@ -1,0 +1,33 @@
+#pragma once
+// A run prepared for the final-pose cost: encoder samples clipped to the time window that both
+// clocks cover, the start pose at the window's start and the ground-truth pose at its end.
+//
+// Window: [t_start, t_final] with t_start = the first encoder time when the run declares its
+// start_pose, else max(first encoder time, first ground-truth time) with the start pose
+// interpolated from the ground truth there; t_final = min(last encoder time, last ground-truth
+// time). Intervals cut by the window keep their mean rate over the shortened length, so the
+// replay covers exactly the span the ground truth measured.
+
+#include <string>
+#include <vector>
+
+#include "odometry/run_log.h"
+
+namespace fitcal {
+
+struct AlignedRun {
+  std::string id;
+  std::string trajectory;
+  int repetition = 0;
+  double t_start_s = 0.0;
+  double t_final_s = 0.0;
+  Pose2d start;               // world_T_robot at t_start
+  Pose2d final_ground_truth;  // world_T_robot at t_final, from the ground truth
+  WheelSamples samples;       // clipped to the window
+};
+
+// Throws std::invalid_argument if the two clocks share no time.
+AlignedRun AlignRun(const RunLog& run);
+std::vector<AlignedRun> AlignRuns(const std::vector<RunLog>& runs);
+
+}  // namespace fitcal

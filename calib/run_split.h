@@ -1,0 +1,25 @@
+#pragma once
+// Training / validation split by repetition (Palacin Sec. 3: repetitions 1-5 fit, 6-10 validate).
+
+#include <string>
+#include <vector>
+
+#include "calib/aligned_run.h"
+
+namespace fitcal {
+
+// Parses "1-5", "1,3,5" or "1-3,7": sorted, unique; throws std::invalid_argument otherwise.
+std::vector<int> ParseRepetitionList(const std::string& text);
+// "1-5" style text of a sorted list.
+std::string FormatRepetitionList(const std::vector<int>& repetitions);
+
+struct RunSplit {
+  std::vector<AlignedRun> training;
+  std::vector<AlignedRun> validation;
+  std::vector<int> training_repetitions;    // present in the data
+  std::vector<int> validation_repetitions;  // present in the data
+};
+
+RunSplit SplitByRepetition(std::vector<AlignedRun> runs, const std::vector<int>& training_reps);
+
+}  // namespace fitcal

@@ -1,0 +1,171 @@
+#include "io/dataset.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <set>
+#include <sstream>
+
+#include "io/input_error.h"
+#include "io/log_files.h"
+#include "io/yaml_reader.h"
+#include "odometry/parallel_for.h"
+
+namespace fitcal::io {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+int LineOf(const YAML::Node& node) { return node.Mark().line + 1; }
+
+// Resolves a path from dataset.yaml against the data set directory, refusing absolute paths and
+// '..' escapes unless allowed: a data set is a self-contained directory.
+std::string ResolvePath(const std::string& directory, const std::string& relative,
+                        const DatasetOptions& options, const std::string& yaml_path,
+                        const YAML::Node& node) {
+  const fs::path p(relative);
+  if (!options.allow_paths_outside) {
+    if (p.is_absolute()) {
+      throw InputError(InputErrorKind::kBadPath, yaml_path, LineOf(node),
+                       "path '" + relative + "' is absolute; paths are relative to the data set "
+                       "directory (--allow-outside-paths to permit)");
+    }
+    for (const auto& part : p) {
+      if (part == "..") {
+        throw InputError(InputErrorKind::kBadPath, yaml_path, LineOf(node),
+                         "path '" + relative + "' leaves the data set directory "
+                         "(--allow-outside-paths to permit)");
+      }
+    }
+  }
+  return p.is_absolute() ? p.string() : (fs::path(directory) / p).string();
+}
+
+}  // namespace
+
+Dataset LoadDataset(const std::string& directory, const DatasetOptions& options) {
+  const std::string yaml_path = (fs::path(directory) / "dataset.yaml").string();
+  if (!fs::is_directory(directory)) {
+    throw InputError(InputErrorKind::kMissingFile, directory, 0, "not a directory");
+  }
+  const YAML::Node root = LoadYamlFile(yaml_path);
+  YamlMap top(root, yaml_path, "dataset");
+  Dataset dataset;
+  dataset.directory = directory;
+  const YAML::Node robot_node = top.Required("robot");
+  dataset.robot_path = ResolvePath(directory, YamlString(robot_node, yaml_path, "dataset.robot"),
+                                   options, yaml_path, robot_node);
+  if (!fs::exists(dataset.robot_path)) {
+    throw InputError(InputErrorKind::kMissingFile, yaml_path, LineOf(robot_node),
+                     "robot file '" + dataset.robot_path + "' does not exist");
+  }
+  top.Optional("name");
+  top.Optional("description");
+  const YAML::Node runs = top.Required("runs");
+  ExpectYamlType(runs, YAML::NodeType::Sequence, yaml_path, "dataset.runs");
+  if (runs.size() == 0) {
+    throw InputError(InputErrorKind::kTooFewSamples, yaml_path, LineOf(runs), "no runs listed");
+  }
+  top.RejectUnread();
+
+  struct Pending {
+    std::string encoders, ground_truth;
+    int line = 0;
+  };
+  std::vector<Pending> pending(runs.size());
+  dataset.runs.resize(runs.size());
+  std::set<std::string> ids;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const YAML::Node node = runs[i];
+    YamlMap run(node, yaml_path, "run " + std::to_string(i + 1));
+    RunLog& log = dataset.runs[i];
+    log.id = run.String("id");
+    if (!ids.insert(log.id).second) {
+      throw InputError(InputErrorKind::kDuplicateRunId, yaml_path, LineOf(node),
+                       "run id '" + log.id + "' is used twice");
+    }
+    log.trajectory = run.String("trajectory");
+    log.repetition = run.Int("repetition");
+    pending[i].encoders =
+        ResolvePath(directory, run.String("encoders"), options, yaml_path, node["encoders"]);
+    pending[i].ground_truth = ResolvePath(directory, run.String("ground_truth"), options,
+                                          yaml_path, node["ground_truth"]);
+    pending[i].line = LineOf(node);
+    const YAML::Node start = run.Optional("start_pose");
+    if (start) {
+      ExpectYamlType(start, YAML::NodeType::Sequence, yaml_path, "start_pose");
+      if (start.size() != 3) {
+        throw InputError(InputErrorKind::kBadValue, yaml_path, LineOf(start),
+                         "start_pose must be [x, y, theta] (m, m, rad)");
+      }
+      log.start_pose = Pose2d{YamlDouble(start[0], yaml_path, "start_pose x"),
+                              YamlDouble(start[1], yaml_path, "start_pose y"),
+                              YamlDouble(start[2], yaml_path, "start_pose theta")};
+    }
+    run.RejectUnread();
+  }
+
+  ParallelFor(dataset.runs.size(), options.num_threads, [&](std::size_t i) {
+    RunLog& log = dataset.runs[i];
+    log.encoders = ReadEncoderCsv(pending[i].encoders);
+    log.ground_truth = ReadGroundTruth(pending[i].ground_truth);
+    const double enc_begin = log.encoders.t_s.front(), enc_end = log.encoders.t_s.back();
+    const double gt_begin = log.ground_truth.t_s.front(), gt_end = log.ground_truth.t_s.back();
+    if (gt_end <= enc_begin || gt_begin >= enc_end) {
+      std::ostringstream msg;
+      msg << "ground truth [" << gt_begin << ", " << gt_end << "] s does not overlap the encoder "
+          << "span [" << enc_begin << ", " << enc_end << "] s (different clocks or wrong file?)";
+      throw InputError(InputErrorKind::kNoOverlap, pending[i].ground_truth, 0, msg.str());
+    }
+  });
+  return dataset;
+}
+
+std::string DatasetYaml(const std::string& robot_path, const std::vector<DatasetEntry>& runs) {
+  YAML::Emitter out;
+  out << YAML::BeginMap;
+  out << YAML::Key << "robot" << YAML::Value << robot_path;
+  out << YAML::Key << "runs" << YAML::Value << YAML::BeginSeq;
+  for (const DatasetEntry& run : runs) {
+    out << YAML::Flow << YAML::BeginMap;
+    out << YAML::Key << "id" << YAML::Value << run.id;
+    out << YAML::Key << "trajectory" << YAML::Value << run.trajectory;
+    out << YAML::Key << "repetition" << YAML::Value << run.repetition;
+    out << YAML::Key << "encoders" << YAML::Value << run.encoders;
+    out << YAML::Key << "ground_truth" << YAML::Value << run.ground_truth;
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+std::string EncoderCsv(const EncoderLog& log) {
+  std::string out = "t,w_a,w_b,w_c\n";
+  out.reserve(log.t_s.size() * 40);
+  char line[160];
+  for (std::size_t k = 0; k < log.t_s.size(); ++k) {
+    const double* w = k == 0 ? nullptr : log.samples[k - 1].rate_rad_s;
+    const int n = w == nullptr
+                      ? std::snprintf(line, sizeof line, "%.6f,0,0,0\n", log.t_s[k])
+                      : std::snprintf(line, sizeof line, "%.6f,%.9g,%.9g,%.9g\n", log.t_s[k],
+                                      w[0], w[1], w[2]);
+    out.append(line, static_cast<std::size_t>(n));
+  }
+  return out;
+}
+
+std::string GroundTruthCsv(const GroundTruthTrack& track) {
+  std::string out = "t,x,y,theta\n";
+  char line[160];
+  for (std::size_t k = 0; k < track.t_s.size(); ++k) {
+    const Pose2d& p = track.world_T_robot[k];
+    const int n = std::snprintf(line, sizeof line, "%.6f,%.6f,%.6f,%.7f\n", track.t_s[k], p.x,
+                                p.y, p.theta);
+    out.append(line, static_cast<std::size_t>(n));
+  }
+  return out;
+}
+
+}  // namespace fitcal::io

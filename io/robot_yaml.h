@@ -1,0 +1,47 @@
+#pragma once
+// The robot YAML (docs/data_format.md): nominal geometry and bounds in, calibrated geometry out.
+// The calibrated file has the same schema plus a `calibration:` block, so it can be read back as
+// the robot of a new fit.
+
+#include <Eigen/Core>
+#include <array>
+#include <string>
+#include <vector>
+
+#include "odometry/robot_description.h"
+
+namespace fitcal::io {
+
+// The `model:` of a robot YAML ("omni3", ...); throws for a file that is not a robot YAML.
+std::string ReadRobotModel(const std::string& path);
+
+// Reads an omni3 robot; throws InputError on anything malformed or physically impossible
+// (non-positive radius, bounds with lo > hi, nominal outside its bounds, ...).
+Omni3Robot ReadOmni3Robot(const std::string& path);
+
+// What a calibration did, stored beside the calibrated parameters.
+struct CalibrationRecord {
+  std::string method;
+  std::string objective;
+  std::string dataset;
+  std::string tool_version;
+  std::string termination;
+  std::vector<int> training_repetitions;
+  std::vector<int> validation_repetitions;
+  int training_runs = 0;
+  int validation_runs = 0;
+  double cf_training_before = 0.0;
+  double cf_training_after = 0.0;
+  double cf_validation_before = 0.0;
+  double cf_validation_after = 0.0;
+  bool has_uncertainty = false;
+  std::array<double, omni3::kNumParameters> sigma{};  // one sigma, flat order, SI + rad
+  Eigen::Matrix<double, omni3::kNumParameters, omni3::kNumParameters> correlation =
+      Eigen::Matrix<double, omni3::kNumParameters, omni3::kNumParameters>::Identity();
+  Eigen::Matrix3d inverse_kinematic_matrix = Eigen::Matrix3d::Zero();
+};
+
+// The YAML text of a calibrated robot (same schema as the input robot + `calibration:`).
+std::string Omni3RobotYaml(const Omni3Robot& robot, const CalibrationRecord* calibration);
+
+}  // namespace fitcal::io

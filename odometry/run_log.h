@@ -1,0 +1,40 @@
+#pragma once
+// The recorded data of one calibration run, as the loaders hand it over: encoder wheel rates and
+// the ground-truth track on the same clock. No file knowledge here (io/ fills these).
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "odometry/pose2.h"
+#include "odometry/wheel_samples.h"
+
+namespace fitcal {
+
+// Encoder log: t_s[0] only sets the start time; samples[k] covers (t_s[k], t_s[k+1]] with
+// dt_s = t_s[k+1] - t_s[k] and the mean wheel rates over that interval.
+struct EncoderLog {
+  std::vector<double> t_s;
+  WheelSamples samples;
+};
+
+// Ground truth (SLAM, motion capture): poses in the world frame at strictly increasing times.
+struct GroundTruthTrack {
+  std::vector<double> t_s;
+  std::vector<Pose2d> world_T_robot;
+};
+
+struct RunLog {
+  std::string id;
+  std::string trajectory;  // e.g. "R1", "G12": repetitions of a trajectory share this label
+  int repetition = 0;
+  EncoderLog encoders;
+  GroundTruthTrack ground_truth;
+  std::optional<Pose2d> start_pose;  // the pose at the first encoder time, when the user knows it
+};
+
+// Ground truth at time t_s by linear interpolation (heading along the shorter arc); clamps to the
+// first/last sample outside the track. The track must hold at least one sample.
+Pose2d InterpolateGroundTruth(const GroundTruthTrack& track, double t_s);
+
+}  // namespace fitcal

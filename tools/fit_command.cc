@@ -1,0 +1,165 @@
+#include "tools/fit_command.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <stdexcept>
+
+#include "calib/final_pose_cost.h"
+#include "calib/omni3_ceres_fit.h"
+#include "calib/run_split.h"
+#include "fitcal/version.h"
+#include "io/atomic_file.h"
+#include "io/dataset.h"
+#include "io/input_error.h"
+#include "io/robot_yaml.h"
+
+namespace fitcal::tools {
+
+namespace {
+
+double Seconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+double ChangePercent(double before, double after) {
+  return before > 0.0 ? 100.0 * (after - before) / before : 0.0;
+}
+
+void PrintParameters(const Omni3Robot& robot, const Omni3FitResult& fit) {
+  const auto nominal = robot.nominal.ToArray();
+  static const char* kSymbol[] = {"R", "r", "delta"};
+  static const char* kUnit[] = {"m", "m", "deg"};
+  std::printf("\n  %-12s %12s %12s %12s %10s\n", "parameter", "nominal", "calibrated", "+-1 sigma",
+              "change");
+  for (int k = 0; k < omni3::kNumParameters; ++k) {
+    const int group = k / omni3::kNumWheels;
+    const double scale = group == 2 ? 180.0 / M_PI : 1.0;
+    char name[48];
+    std::snprintf(name, sizeof name, "%s_%s [%s]", kSymbol[group],
+                  robot.wheel_names[k % omni3::kNumWheels].c_str(), kUnit[group]);
+    char sigma[32] = "-";
+    if (fit.has_covariance) std::snprintf(sigma, sizeof sigma, "%.2g", fit.sigma[k] * scale);
+    const int digits = group == 2 ? 4 : 6;
+    std::printf("  %-12s %12.*f %12.*f %12s %+9.2f%%%s\n", name, digits, nominal[k] * scale, digits,
+                fit.parameters[k] * scale, sigma, ChangePercent(nominal[k], fit.parameters[k]),
+                fit.at_bound[k] ? "  AT BOUND" : "");
+  }
+}
+
+}  // namespace
+
+int RunFitCommand(const FitCommandOptions& options) {
+  const auto t_total = std::chrono::steady_clock::now();
+  if (options.method != "ceres") {
+    std::cerr << "fitcal: unknown --method '" << options.method << "' (available: ceres)\n";
+    return 2;
+  }
+  try {
+    const auto t_load = std::chrono::steady_clock::now();
+    io::DatasetOptions dataset_options;
+    dataset_options.allow_paths_outside = options.allow_outside_paths;
+    dataset_options.num_threads = options.threads;
+    const io::Dataset dataset = io::LoadDataset(options.logs, dataset_options);
+    const std::string model = io::ReadRobotModel(dataset.robot_path);
+    if (model != "omni3") {
+      throw io::InputError(io::InputErrorKind::kUnknownModel, dataset.robot_path, 0,
+                           "model '" + model + "' is not supported by 'fit' (known: omni3)");
+    }
+    const Omni3Robot robot = io::ReadOmni3Robot(dataset.robot_path);
+    const std::vector<int> train_reps = ParseRepetitionList(options.train_reps);
+    RunSplit split = SplitByRepetition(AlignRuns(dataset.runs), train_reps);
+    const double load_s = Seconds(t_load);
+    if (split.training.empty()) {
+      std::cerr << "fitcal: no run of " << options.logs << " has a training repetition ("
+                << options.train_reps << ")\n";
+      return 2;
+    }
+
+    CeresFitOptions fit_options;
+    fit_options.num_threads = options.threads;
+    fit_options.weights.position_sigma_m = options.position_sigma_m;
+    fit_options.weights.heading_sigma_rad = options.heading_sigma_deg * M_PI / 180.0;
+    const Omni3FitResult fit = FitOmni3Ceres(split.training, robot, fit_options);
+
+    const auto nominal = robot.nominal.ToArray();
+    const FinalPoseErrors train_before = EvaluateFinalPoseErrors(nominal, split.training, options.threads);
+    const FinalPoseErrors train_after = EvaluateFinalPoseErrors(fit.parameters, split.training, options.threads);
+    const FinalPoseErrors val_before = EvaluateFinalPoseErrors(nominal, split.validation, options.threads);
+    const FinalPoseErrors val_after = EvaluateFinalPoseErrors(fit.parameters, split.validation, options.threads);
+
+    std::printf("fitcal %s  omni3 robot '%s'  data set %s\n", kVersion, robot.name.c_str(),
+                options.logs.c_str());
+    std::printf("runs: %zu training (repetitions %s), %zu validation (repetitions %s)\n\n",
+                split.training.size(), FormatRepetitionList(split.training_repetitions).c_str(),
+                split.validation.size(), FormatRepetitionList(split.validation_repetitions).c_str());
+    std::printf("  %-30s %10s %10s %9s\n", "CF (Eq. 14, m and rad)", "nominal", "calibrated", "change");
+    std::printf("  %-30s %10.4f %10.4f %+8.1f%%\n", "training", train_before.cf, train_after.cf,
+                ChangePercent(train_before.cf, train_after.cf));
+    if (!split.validation.empty()) {
+      std::printf("  %-30s %10.4f %10.4f %+8.1f%%\n", "validation", val_before.cf, val_after.cf,
+                  ChangePercent(val_before.cf, val_after.cf));
+      std::printf("  %-30s %10.4f %10.4f\n", "  mean final position error [m]",
+                  val_before.mean_position_error_m, val_after.mean_position_error_m);
+      std::printf("  %-30s %10.3f %10.3f\n", "  mean final heading error [deg]",
+                  val_before.mean_abs_heading_error_rad * 180.0 / M_PI,
+                  val_after.mean_abs_heading_error_rad * 180.0 / M_PI);
+    } else {
+      std::printf("  validation: no held-out repetitions; the result is not validated\n");
+    }
+    PrintParameters(robot, fit);
+    std::printf("\nsolver: Ceres Levenberg-Marquardt, %s after %d iterations, %.3f s (%s)\n",
+                fit.termination.c_str(), fit.iterations, fit.solve_time_s, fit.message.c_str());
+    if (!fit.has_covariance) std::printf("uncertainty: %s\n", fit.covariance_message.c_str());
+    for (int k = 0; k < omni3::kNumParameters; ++k) {
+      if (fit.at_bound[k]) {
+        std::printf("warning: a parameter stopped on its bound; the model may be absorbing an "
+                    "effect it does not contain, or the bounds are too tight\n");
+        break;
+      }
+    }
+    if (!fit.usable) {
+      std::cerr << "fitcal: the fit did not converge (" << fit.termination << ": " << fit.message
+                << "); nothing written\n";
+      return 3;
+    }
+
+    if (!options.no_output) {
+      Omni3Robot calibrated = robot;
+      calibrated.nominal = omni3::Parameters::FromArray(fit.parameters.data());
+      io::CalibrationRecord record;
+      record.method = "ceres";
+      record.objective = "sum of squared final-pose residuals (sigma_xy " +
+                         std::to_string(options.position_sigma_m) + " m, sigma_theta " +
+                         std::to_string(options.heading_sigma_deg) + " deg)";
+      record.dataset = options.logs;
+      record.tool_version = kVersion;
+      record.termination = fit.termination;
+      record.training_repetitions = split.training_repetitions;
+      record.validation_repetitions = split.validation_repetitions;
+      record.training_runs = static_cast<int>(split.training.size());
+      record.validation_runs = static_cast<int>(split.validation.size());
+      record.cf_training_before = train_before.cf;
+      record.cf_training_after = train_after.cf;
+      record.cf_validation_before = val_before.cf;
+      record.cf_validation_after = val_after.cf;
+      record.has_uncertainty = fit.has_covariance;
+      record.sigma = fit.sigma;
+      record.correlation = fit.correlation;
+      record.inverse_kinematic_matrix = omni3::InverseKinematicMatrix(fit.parameters.data());
+      io::WriteFileAtomically(options.out, io::Omni3RobotYaml(calibrated, &record));
+      std::printf("wrote %s\n", options.out.c_str());
+    }
+    std::printf("time: load %.3f s, total %.3f s\n", load_s, Seconds(t_total));
+    return 0;
+  } catch (const io::InputError& e) {
+    std::cerr << "fitcal: " << e.what() << "\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "fitcal: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace fitcal::tools

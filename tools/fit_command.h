@@ -1,0 +1,24 @@
+#pragma once
+// `fitcal fit` (and plain `fitcal --logs ... --method ceres`): load a data set, fit on the
+// training repetitions, validate on the rest, print the table and write the calibrated YAML.
+
+#include <string>
+
+namespace fitcal::tools {
+
+struct FitCommandOptions {
+  std::string logs;
+  std::string method = "ceres";
+  std::string train_reps = "1-5";
+  std::string out = "calibrated.yaml";
+  bool no_output = false;
+  bool allow_outside_paths = false;
+  int threads = 0;
+  double position_sigma_m = 1.0;
+  double heading_sigma_deg = 180.0 / 3.14159265358979323846;  // 1 rad: Eq. 14's weighting
+};
+
+// Returns the process exit code; prints results to stdout and errors (one line) to stderr.
+int RunFitCommand(const FitCommandOptions& options);
+
+}  // namespace fitcal::tools
