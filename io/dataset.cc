@@ -45,21 +45,22 @@ std::string ResolvePath(const std::string& directory, const std::string& relativ
 
 }  // namespace
 
-Dataset LoadDataset(const std::string& directory, const DatasetOptions& options) {
-  const std::string yaml_path = (fs::path(directory) / "dataset.yaml").string();
+DatasetIndex ReadDatasetIndex(const std::string& directory, const DatasetOptions& options) {
+  DatasetIndex index;
+  index.directory = directory;
+  index.yaml_path = (fs::path(directory) / "dataset.yaml").string();
+  const std::string& yaml_path = index.yaml_path;
   if (!fs::is_directory(directory)) {
     throw InputError(InputErrorKind::kMissingFile, directory, 0, "not a directory");
   }
   const YAML::Node root = LoadYamlFile(yaml_path);
   YamlMap top(root, yaml_path, "dataset");
-  Dataset dataset;
-  dataset.directory = directory;
   const YAML::Node robot_node = top.Required("robot");
-  dataset.robot_path = ResolvePath(directory, YamlString(robot_node, yaml_path, "dataset.robot"),
-                                   options, yaml_path, robot_node);
-  if (!fs::exists(dataset.robot_path)) {
+  index.robot_path = ResolvePath(directory, YamlString(robot_node, yaml_path, "dataset.robot"),
+                                 options, yaml_path, robot_node);
+  if (!fs::exists(index.robot_path)) {
     throw InputError(InputErrorKind::kMissingFile, yaml_path, LineOf(robot_node),
-                     "robot file '" + dataset.robot_path + "' does not exist");
+                     "robot file '" + index.robot_path + "' does not exist");
   }
   top.Optional("name");
   top.Optional("description");
@@ -70,29 +71,23 @@ Dataset LoadDataset(const std::string& directory, const DatasetOptions& options)
   }
   top.RejectUnread();
 
-  struct Pending {
-    std::string encoders, ground_truth;
-    int line = 0;
-  };
-  std::vector<Pending> pending(runs.size());
-  dataset.runs.resize(runs.size());
+  index.runs.resize(runs.size());
   std::set<std::string> ids;
   for (std::size_t i = 0; i < runs.size(); ++i) {
     const YAML::Node node = runs[i];
     YamlMap run(node, yaml_path, "run " + std::to_string(i + 1));
-    RunLog& log = dataset.runs[i];
-    log.id = run.String("id");
-    if (!ids.insert(log.id).second) {
+    DatasetIndexEntry& entry = index.runs[i];
+    entry.id = run.String("id");
+    if (!ids.insert(entry.id).second) {
       throw InputError(InputErrorKind::kDuplicateRunId, yaml_path, LineOf(node),
-                       "run id '" + log.id + "' is used twice");
+                       "run id '" + entry.id + "' is used twice");
     }
-    log.trajectory = run.String("trajectory");
-    log.repetition = run.Int("repetition");
-    pending[i].encoders =
+    entry.trajectory = run.String("trajectory");
+    entry.repetition = run.Int("repetition");
+    entry.encoders_path =
         ResolvePath(directory, run.String("encoders"), options, yaml_path, node["encoders"]);
-    pending[i].ground_truth = ResolvePath(directory, run.String("ground_truth"), options,
+    entry.ground_truth_path = ResolvePath(directory, run.String("ground_truth"), options,
                                           yaml_path, node["ground_truth"]);
-    pending[i].line = LineOf(node);
     const YAML::Node start = run.Optional("start_pose");
     if (start) {
       ExpectYamlType(start, YAML::NodeType::Sequence, yaml_path, "start_pose");
@@ -100,25 +95,43 @@ Dataset LoadDataset(const std::string& directory, const DatasetOptions& options)
         throw InputError(InputErrorKind::kBadValue, yaml_path, LineOf(start),
                          "start_pose must be [x, y, theta] (m, m, rad)");
       }
-      log.start_pose = Pose2d{YamlDouble(start[0], yaml_path, "start_pose x"),
-                              YamlDouble(start[1], yaml_path, "start_pose y"),
-                              YamlDouble(start[2], yaml_path, "start_pose theta")};
+      entry.start_pose = Pose2d{YamlDouble(start[0], yaml_path, "start_pose x"),
+                                YamlDouble(start[1], yaml_path, "start_pose y"),
+                                YamlDouble(start[2], yaml_path, "start_pose theta")};
     }
     run.RejectUnread();
   }
+  return index;
+}
 
-  ParallelFor(dataset.runs.size(), options.num_threads, [&](std::size_t i) {
+void CheckGroundTruthOverlap(const GroundTruthTrack& ground_truth, double enc_begin_s,
+                             double enc_end_s, const std::string& ground_truth_path) {
+  const double gt_begin = ground_truth.t_s.front(), gt_end = ground_truth.t_s.back();
+  if (gt_end <= enc_begin_s || gt_begin >= enc_end_s) {
+    std::ostringstream msg;
+    msg << "ground truth [" << gt_begin << ", " << gt_end << "] s does not overlap the encoder "
+        << "span [" << enc_begin_s << ", " << enc_end_s << "] s (different clocks or wrong file?)";
+    throw InputError(InputErrorKind::kNoOverlap, ground_truth_path, 0, msg.str());
+  }
+}
+
+Dataset LoadDataset(const std::string& directory, const DatasetOptions& options) {
+  const DatasetIndex index = ReadDatasetIndex(directory, options);
+  Dataset dataset;
+  dataset.directory = index.directory;
+  dataset.robot_path = index.robot_path;
+  dataset.runs.resize(index.runs.size());
+  ParallelFor(index.runs.size(), options.num_threads, [&](std::size_t i) {
+    const DatasetIndexEntry& entry = index.runs[i];
     RunLog& log = dataset.runs[i];
-    log.encoders = ReadEncoderCsv(pending[i].encoders);
-    log.ground_truth = ReadGroundTruth(pending[i].ground_truth);
-    const double enc_begin = log.encoders.t_s.front(), enc_end = log.encoders.t_s.back();
-    const double gt_begin = log.ground_truth.t_s.front(), gt_end = log.ground_truth.t_s.back();
-    if (gt_end <= enc_begin || gt_begin >= enc_end) {
-      std::ostringstream msg;
-      msg << "ground truth [" << gt_begin << ", " << gt_end << "] s does not overlap the encoder "
-          << "span [" << enc_begin << ", " << enc_end << "] s (different clocks or wrong file?)";
-      throw InputError(InputErrorKind::kNoOverlap, pending[i].ground_truth, 0, msg.str());
-    }
+    log.id = entry.id;
+    log.trajectory = entry.trajectory;
+    log.repetition = entry.repetition;
+    log.start_pose = entry.start_pose;
+    log.encoders = ReadEncoderCsv(entry.encoders_path);
+    log.ground_truth = ReadGroundTruth(entry.ground_truth_path);
+    CheckGroundTruthOverlap(log.ground_truth, log.encoders.t_s.front(), log.encoders.t_s.back(),
+                            entry.ground_truth_path);
   });
   return dataset;
 }

@@ -2,6 +2,7 @@
 // A data set directory: dataset.yaml naming the robot and the runs, and one encoder CSV and one
 // ground-truth file per run (docs/data_format.md). Loading checks everything a fit relies on.
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,13 +17,38 @@ struct DatasetOptions {
   int num_threads = 0;
 };
 
+// dataset.yaml alone, paths resolved and checked; the log files are not read yet. Models whose
+// encoder files differ from omni3's (e.g. ASOC) load their logs from this index.
+struct DatasetIndexEntry {
+  std::string id;
+  std::string trajectory;
+  int repetition = 0;
+  std::string encoders_path;
+  std::string ground_truth_path;
+  std::optional<Pose2d> start_pose;
+};
+
+struct DatasetIndex {
+  std::string directory;
+  std::string yaml_path;
+  std::string robot_path;  // resolved path of the robot YAML
+  std::vector<DatasetIndexEntry> runs;
+};
+
+DatasetIndex ReadDatasetIndex(const std::string& directory, const DatasetOptions& options = {});
+
+// Throws kNoOverlap when the ground truth does not share time with [enc_begin_s, enc_end_s].
+void CheckGroundTruthOverlap(const GroundTruthTrack& ground_truth, double enc_begin_s,
+                             double enc_end_s, const std::string& ground_truth_path);
+
 struct Dataset {
   std::string directory;
   std::string robot_path;  // resolved path of the robot YAML
   std::vector<RunLog> runs;
 };
 
-// Loads dataset.yaml and every run it lists; throws InputError naming the file and line.
+// Loads dataset.yaml and every run it lists (omni3 encoder CSVs); throws InputError naming the
+// file and line.
 Dataset LoadDataset(const std::string& directory, const DatasetOptions& options = {});
 
 // One run as dataset.yaml lists it; used by writers (the simulator, importers).
