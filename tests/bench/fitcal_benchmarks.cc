@@ -1,0 +1,98 @@
+// Speed of the core: the replay (Palacin Eq. 4) in double and in Jets, loading the shipped flower
+// data set, the 180-run Ceres fit, and the whole `fitcal` process. Run with
+//   build/tests/fitcal_benchmarks --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+// from the repository root (the data set is data/flower).
+
+#include <benchmark/benchmark.h>
+#include <ceres/jet.h>
+
+#include <cstdlib>
+#include <random>
+
+#include "calib/omni3_ceres_fit.h"
+#include "calib/run_split.h"
+#include "io/dataset.h"
+#include "io/robot_yaml.h"
+#include "odometry/omni3_replay.h"
+#include "tools/sim/omni3_simulator.h"
+
+namespace fitcal {
+namespace {
+
+const std::string kData = std::string(FITCAL_SOURCE_DIR) + "/data/flower";
+
+WheelSamples RandomLog(std::size_t n) {
+  std::mt19937_64 rng(1);
+  std::uniform_real_distribution<double> rate(-3.0, 3.0), dt(0.009, 0.011);
+  WheelSamples samples(n);
+  for (auto& s : samples) {
+    s.dt_s = dt(rng);
+    for (double& w : s.rate_rad_s) w = rate(rng);
+  }
+  return samples;
+}
+
+void BM_ReplayDouble(benchmark::State& state) {
+  const WheelSamples samples = RandomLog(static_cast<std::size_t>(state.range(0)));
+  const auto p = sim::PalacinTable5Parameters().ToArray();
+  for (auto _ : state) {
+    const Pose2d end = omni3::ReplayFinalPose(p.data(), samples, Pose2d{});
+    benchmark::DoNotOptimize(end);
+  }
+  // One item = one encoder sample (the three wheel rates of one interval).
+  state.SetItemsProcessed(state.iterations() * state.range(0));
+}
+BENCHMARK(BM_ReplayDouble)->Arg(400)->Arg(1 << 20);
+
+void BM_ReplayJet9(benchmark::State& state) {
+  using Jet = ceres::Jet<double, omni3::kNumParameters>;
+  const WheelSamples samples = RandomLog(static_cast<std::size_t>(state.range(0)));
+  const auto p = sim::PalacinTable5Parameters().ToArray();
+  std::array<Jet, omni3::kNumParameters> pj;
+  for (int k = 0; k < omni3::kNumParameters; ++k) pj[k] = Jet(p[k], k);
+  for (auto _ : state) {
+    const Pose2<Jet> end = omni3::ReplayFinalPose(pj.data(), samples, Pose2<Jet>{});
+    benchmark::DoNotOptimize(end);
+  }
+  state.SetItemsProcessed(state.iterations() * state.range(0));
+}
+BENCHMARK(BM_ReplayJet9)->Arg(400);
+
+void BM_LoadFlowerDataset(benchmark::State& state) {
+  for (auto _ : state) {
+    const io::Dataset dataset = io::LoadDataset(kData);
+    benchmark::DoNotOptimize(AlignRuns(dataset.runs));
+  }
+  state.SetLabel("360 runs, load + align");
+}
+BENCHMARK(BM_LoadFlowerDataset)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_CeresFitFlower180Runs(benchmark::State& state) {
+  const io::Dataset dataset = io::LoadDataset(kData);
+  const Omni3Robot robot = io::ReadOmni3Robot(dataset.robot_path);
+  const RunSplit split = SplitByRepetition(AlignRuns(dataset.runs), {1, 2, 3, 4, 5});
+  CeresFitOptions options;
+  options.compute_covariance = state.range(0) != 0;
+  for (auto _ : state) {
+    const Omni3FitResult fit = FitOmni3Ceres(split.training, robot, options);
+    if (!fit.usable) state.SkipWithError("fit not usable");
+    benchmark::DoNotOptimize(fit);
+  }
+  state.SetLabel(options.compute_covariance ? "fit + covariance" : "fit only");
+}
+BENCHMARK(BM_CeresFitFlower180Runs)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_FitcalProcessEndToEnd(benchmark::State& state) {
+  const std::string command = std::string(FITCAL_BINARY_DIR) + "/tools/fitcal --logs " + kData +
+                              " --method ceres --no-output > /dev/null";
+  for (auto _ : state) {
+    if (std::system(command.c_str()) != 0) state.SkipWithError("fitcal failed");
+  }
+  state.SetLabel("process start, load 360 runs, fit, covariance, validate, print");
+}
+BENCHMARK(BM_FitcalProcessEndToEnd)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+}  // namespace fitcal
+
+BENCHMARK_MAIN();

@@ -1,0 +1,126 @@
+// The fitcal command line end to end: simulate a data set, fit it, read the calibrated YAML back;
+// and on bad input: a non-zero exit, one line on stderr naming the file and line, nothing written.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "io/robot_yaml.h"
+#include "tests/test_files.h"
+
+namespace fitcal {
+namespace {
+
+using fitcal::testing::TempDir;
+
+const std::string kFitcal = std::string(FITCAL_BINARY_DIR) + "/tools/fitcal";
+const std::string kRobot = std::string(FITCAL_SOURCE_DIR) + "/data/robots/apr02.yaml";
+
+struct Result {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+std::string Slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+Result RunFitcal(const TempDir& dir, const std::string& args) {
+  const std::string out = dir.Path("stdout.txt"), err = dir.Path("stderr.txt");
+  const int status = std::system((kFitcal + " " + args + " >" + out + " 2>" + err).c_str());
+  Result r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = Slurp(out);
+  r.err = Slurp(err);
+  return r;
+}
+
+int CountLines(const std::string& s) {
+  int n = 0;
+  for (char c : s) n += c == '\n';
+  return n;
+}
+
+// A small simulated data set (2 repetitions of the 36 trajectories), made once per test.
+std::string MakeDataset(const TempDir& dir) {
+  const std::string data = dir.Path("flower");
+  const Result r =
+      RunFitcal(dir, "simulate --out " + data + " --robot " + kRobot + " --repetitions 2 --seed 5");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  return data;
+}
+
+TEST(FitcalCli, FitsWritesAndReadsBackTheCalibration) {
+  TempDir dir;
+  const std::string data = MakeDataset(dir);
+  const std::string out = dir.Path("calibrated.yaml");
+  const Result r = RunFitcal(dir, "--logs " + data + " --method ceres --train-reps 1 --out " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("validation"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("CONVERGENCE"), std::string::npos) << r.out;
+  const Omni3Robot calibrated = io::ReadOmni3Robot(out);  // the output is a valid robot file
+  // Table 5 (the simulated truth) has R_a = 0.2186 m, far from the nominal 0.195 m.
+  EXPECT_NEAR(calibrated.nominal.distance_m[0], 0.2186, 0.003);
+  const std::string yaml = Slurp(out);
+  for (const char* key : {"calibration:", "cf_validation:", "sigma:", "inverse_kinematic_matrix:",
+                          "tool_version:", "training_repetitions: [1]"}) {
+    EXPECT_NE(yaml.find(key), std::string::npos) << key;
+  }
+  // `fitcal fit` is the same command.
+  const Result again = RunFitcal(dir, "fit --logs " + data + " --no-output");
+  EXPECT_EQ(again.exit_code, 0) << again.err;
+}
+
+TEST(FitcalCli, BadInputGivesOneLineAndWritesNothing) {
+  TempDir dir;
+  const std::string data = MakeDataset(dir);
+  const std::string out = dir.Path("calibrated.yaml");
+  const std::string previous = "# a previous calibration that must survive\n";
+  dir.Write("calibrated.yaml", previous);
+
+  // A non-numeric field on line 5 of one encoder file.
+  const std::string enc = data + "/runs/G3-rep02_encoders.csv";
+  const std::string original = Slurp(enc);
+  std::string text = original;
+  std::size_t line_start = 0;
+  for (int i = 0; i < 4; ++i) line_start = text.find('\n', line_start) + 1;
+  text.replace(line_start, text.find(',', line_start) - line_start, "0.04x");
+  std::ofstream(enc, std::ios::binary) << text;
+
+  const Result r = RunFitcal(dir, "--logs " + data + " --method ceres --out " + out);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_EQ(CountLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(enc + ":5:"), std::string::npos) << r.err;
+  EXPECT_EQ(Slurp(out), previous);
+
+  // Unknown model (the encoder file repaired first).
+  std::ofstream(enc, std::ios::binary) << original;
+  std::string robot = Slurp(data + "/robot.yaml");
+  robot.replace(robot.find("omni3"), 5, "omni4");
+  dir.Write("flower/robot.yaml", robot);
+  const Result m = RunFitcal(dir, "--logs " + data + " --out " + out);
+  EXPECT_NE(m.exit_code, 0);
+  EXPECT_EQ(CountLines(m.err), 1) << m.err;
+  EXPECT_NE(m.err.find("omni4"), std::string::npos) << m.err;
+  EXPECT_EQ(Slurp(out), previous);
+}
+
+TEST(FitcalCli, UsageErrors) {
+  TempDir dir;
+  EXPECT_NE(RunFitcal(dir, "--method ceres").exit_code, 0);  // no --logs
+  EXPECT_NE(RunFitcal(dir, "--logs " + dir.Path("") + " --method magic").exit_code, 0);
+  const Result help = RunFitcal(dir, "--help");
+  EXPECT_EQ(help.exit_code, 0);
+  for (const char* flag : {"--logs", "--method", "--train-reps", "--out"}) {
+    EXPECT_NE(help.out.find(flag), std::string::npos) << flag;
+  }
+}
+
+}  // namespace
+}  // namespace fitcal

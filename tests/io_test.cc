@@ -1,0 +1,232 @@
+// Loaders and writers of io/: the data set format round trip, TUM ground truth, and every bad
+// input case of the core issue with its error kind, file and line.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "io/dataset.h"
+#include "io/input_error.h"
+#include "io/log_files.h"
+#include "io/robot_yaml.h"
+#include "tests/test_files.h"
+
+namespace fitcal::io {
+namespace {
+
+using fitcal::testing::TempDir;
+
+const char* kRobot = R"(model: omni3
+name: test
+wheels:
+  - {name: a, distance_m: 0.195, radius_m: 0.148, angle_deg: 60.0}
+  - {name: b, distance_m: 0.195, radius_m: 0.148, angle_deg: 180.0}
+  - {name: c, distance_m: 0.195, radius_m: 0.148, angle_deg: 300.0}
+bounds:
+  distance_m: [0.170, 0.220]
+  radius_m: [0.138, 0.158]
+  angle_offset_deg: [-2.0, 2.0]
+)";
+
+const char* kEncoders = "t,w_a,w_b,w_c\n0,0,0,0\n0.01,1,2,3\n0.02,1,2,3\n";
+const char* kGroundTruth = "t,x,y,theta\n0,0,0,0\n0.02,0.1,0.2,0.3\n";
+
+// Expects `fn` to throw an InputError of `kind` naming `file` at `line`.
+template <typename Fn>
+void ExpectInputError(Fn fn, InputErrorKind kind, const std::string& file, int line) {
+  try {
+    fn();
+    ADD_FAILURE() << "no error; expected " << ToString(kind);
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.kind(), kind) << e.what();
+    EXPECT_EQ(e.file(), file) << e.what();
+    EXPECT_EQ(e.line(), line) << e.what();
+    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << "one line: " << e.what();
+  }
+}
+
+TEST(EncoderCsv, ReadsRatesAndIntervals) {
+  TempDir dir;
+  const EncoderLog log =
+      ReadEncoderCsv(dir.Write("e.csv", "t,w_a,w_b,w_c\n1.0,9,9,9\n1.01,1,-2,3.5\n1.03,4,5,6\n"));
+  ASSERT_EQ(log.t_s.size(), 3u);
+  ASSERT_EQ(log.samples.size(), 2u);
+  EXPECT_NEAR(log.samples[0].dt_s, 0.01, 1e-15);  // row 0 only sets the start time
+  EXPECT_EQ(log.samples[0].rate_rad_s[1], -2.0);
+  EXPECT_NEAR(log.samples[1].dt_s, 0.02, 1e-15);
+  EXPECT_EQ(log.samples[1].rate_rad_s[2], 6.0);
+}
+
+TEST(EncoderCsv, BadInputs) {
+  TempDir dir;
+  const auto check = [&](const std::string& text, InputErrorKind kind, int line) {
+    const std::string path = dir.Write("bad.csv", text);
+    ExpectInputError([&] { ReadEncoderCsv(path); }, kind, path, line);
+  };
+  ExpectInputError([&] { ReadEncoderCsv(dir.Path("missing.csv")); }, InputErrorKind::kMissingFile,
+                   dir.Path("missing.csv"), 0);
+  check("", InputErrorKind::kEmptyFile, 1);
+  check("t,w_a,w_b\n0,1,2\n", InputErrorKind::kBadHeader, 1);
+  check("time,w_a,w_b,w_c\n0,1,2,3\n", InputErrorKind::kBadHeader, 1);
+  check("t,w_a,w_b,w_c\n0,0,0,0\n0.01,1,x,3\n", InputErrorKind::kNonNumeric, 3);
+  check("t,w_a,w_b,w_c\n0,0,0,0\n0.01,1,nan,3\n", InputErrorKind::kNonFinite, 3);
+  check("t,w_a,w_b,w_c\n0,0,0,0\n0.01,1,2,inf\n", InputErrorKind::kNonFinite, 3);
+  check("t,w_a,w_b,w_c\n0,0,0,0\n0.01,1,2,1e999\n", InputErrorKind::kNonFinite, 3);
+  check("t,w_a,w_b,w_c\n0,0,0,0\n0.01,1,2\n", InputErrorKind::kWrongColumnCount, 3);
+  check("t,w_a,w_b,w_c\n0,0,0,0\n0.01,1,2,3,4\n", InputErrorKind::kWrongColumnCount, 3);
+  check("t,w_a,w_b,w_c\n0,0,0,0\n0.01,1,2,3\n0.01,1,2,3\n", InputErrorKind::kNonIncreasingTime, 4);
+  check("t,w_a,w_b,w_c\n0,0,0,0\n0.02,1,2,3\n0.01,1,2,3\n", InputErrorKind::kNonIncreasingTime, 4);
+  check("t,w_a,w_b,w_c\n0,0,0,0\n", InputErrorKind::kTooFewSamples, 0);
+}
+
+TEST(GroundTruth, ReadsCsvAndTum) {
+  TempDir dir;
+  const GroundTruthTrack csv = ReadGroundTruth(dir.Write("gt.csv", kGroundTruth));
+  ASSERT_EQ(csv.t_s.size(), 2u);
+  EXPECT_EQ(csv.world_T_robot[1].theta, 0.3);
+  // TUM: yaw from the quaternion of a rotation of 2 rad about z.
+  const double yaw = 2.0;
+  const std::string tum = "# t x y z qx qy qz qw\n0 1 2 0 0 0 " +
+                          std::to_string(std::sin(yaw / 2)) + " " +
+                          std::to_string(std::cos(yaw / 2)) + "\n0.2 1.5 2 0.1 0 0 0 1\n";
+  const GroundTruthTrack t = ReadGroundTruth(dir.Write("gt.tum", tum));
+  ASSERT_EQ(t.t_s.size(), 2u);
+  EXPECT_NEAR(t.world_T_robot[0].theta, yaw, 1e-6);  // printed with 6 decimals
+  EXPECT_EQ(t.world_T_robot[0].x, 1.0);
+  EXPECT_EQ(t.world_T_robot[1].theta, 0.0);
+}
+
+TEST(GroundTruth, BadInputs) {
+  TempDir dir;
+  const auto check = [&](const std::string& text, InputErrorKind kind, int line) {
+    const std::string path = dir.Write("bad_gt.csv", text);
+    ExpectInputError([&] { ReadGroundTruth(path); }, kind, path, line);
+  };
+  check("t,x,y\n0,0,0\n", InputErrorKind::kBadHeader, 1);
+  check("t,x,y,theta\n0,0,0,0\n1,0,abc,0\n", InputErrorKind::kNonNumeric, 3);
+  check("t,x,y,theta\n0,0,0,0\n1,0,0,NaN\n", InputErrorKind::kNonFinite, 3);
+  check("t,x,y,theta\n0,0,0,0\n0,0,0,0\n", InputErrorKind::kNonIncreasingTime, 3);
+  check("t,x,y,theta\n0,0,0,0\n", InputErrorKind::kTooFewSamples, 0);
+  check("0 1 2 0 0 0 0 1\n1 1 2 0 0 0\n", InputErrorKind::kWrongColumnCount, 2);
+}
+
+TEST(RobotYaml, RoundTripsThroughTheCalibratedSchema) {
+  TempDir dir;
+  const Omni3Robot robot = ReadOmni3Robot(dir.Write("robot.yaml", kRobot));
+  EXPECT_EQ(robot.name, "test");
+  EXPECT_NEAR(robot.nominal.angle_rad[1], M_PI, 1e-15);
+  CalibrationRecord record;
+  record.method = "ceres";
+  record.has_uncertainty = true;
+  record.sigma.fill(1e-4);
+  const Omni3Robot back =
+      ReadOmni3Robot(dir.Write("calibrated.yaml", Omni3RobotYaml(robot, &record)));
+  EXPECT_EQ(back.name, robot.name);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(back.nominal.distance_m[i], robot.nominal.distance_m[i], 1e-10);
+    EXPECT_NEAR(back.nominal.angle_rad[i], robot.nominal.angle_rad[i], 1e-9);
+  }
+  EXPECT_NEAR(back.bounds.angle_offset_rad.lo, robot.bounds.angle_offset_rad.lo, 1e-12);
+}
+
+TEST(RobotYaml, BadInputs) {
+  TempDir dir;
+  const auto check = [&](const std::string& text, InputErrorKind kind, int line) {
+    const std::string path = dir.Write("bad_robot.yaml", text);
+    ExpectInputError([&] { ReadOmni3Robot(path); }, kind, path, line);
+  };
+  std::string robot = kRobot;
+  const auto replace = [&](const std::string& from, const std::string& to) {
+    std::string s = robot;
+    s.replace(s.find(from), from.size(), to);
+    return s;
+  };
+  check(replace("model: omni3", "model: tricycle"), InputErrorKind::kUnknownModel, 1);
+  check(replace("name: test", "name: [a, b]"), InputErrorKind::kWrongYamlType, 2);
+  check(replace("wheels:\n", "wheels: 3\nx:\n"), InputErrorKind::kWrongYamlType, 3);
+  check(replace("radius_m: 0.148, angle_deg: 180.0", "radius_m: abc, angle_deg: 180.0"),
+        InputErrorKind::kNonNumeric, 5);
+  check(replace("distance_m: [0.170, 0.220]", "distance_m: [0.220, 0.170]"),
+        InputErrorKind::kBadValue, 8);
+  // The nominal is the fit's start and must lie inside the bounds (angle bounds are relative).
+  check(replace("radius_m: 0.148, angle_deg: 300.0", "radius_m: 0.160, angle_deg: 300.0"),
+        InputErrorKind::kBadValue, 6);
+  check(replace("name: test", "name: test\ncolour: red"), InputErrorKind::kUnknownKey, 3);
+  check(replace("name: test\n", ""), InputErrorKind::kMissingKey, 1);
+  check("model: omni3\nwheels: [\n", InputErrorKind::kYamlSyntax, 3);
+}
+
+// A one-run data set in `dir`, with `dataset_yaml` as its index.
+void WriteDataset(const TempDir& dir, const std::string& dataset_yaml) {
+  dir.Write("robot.yaml", kRobot);
+  dir.Write("runs/e.csv", kEncoders);
+  dir.Write("runs/g.csv", kGroundTruth);
+  dir.Write("dataset.yaml", dataset_yaml);
+}
+
+const char* kDatasetYaml = R"(robot: robot.yaml
+runs:
+  - {id: r1, trajectory: R1, repetition: 1, encoders: runs/e.csv, ground_truth: runs/g.csv}
+)";
+
+TEST(Dataset, LoadsRunsAndStartPose) {
+  TempDir dir;
+  WriteDataset(dir, std::string(kDatasetYaml) +
+                        "  - {id: r2, trajectory: R1, repetition: 2, encoders: runs/e.csv, "
+                        "ground_truth: runs/g.csv, start_pose: [1, 2, 0.5]}\n");
+  const Dataset d = LoadDataset(dir.path().string());
+  ASSERT_EQ(d.runs.size(), 2u);
+  EXPECT_EQ(d.runs[1].repetition, 2);
+  ASSERT_TRUE(d.runs[1].start_pose.has_value());
+  EXPECT_EQ(d.runs[1].start_pose->theta, 0.5);
+  EXPECT_FALSE(d.runs[0].start_pose.has_value());
+  EXPECT_EQ(d.runs[0].encoders.samples.size(), 2u);
+}
+
+TEST(Dataset, BadInputs) {
+  const auto check = [](const std::string& yaml, InputErrorKind kind, int line,
+                        const std::string& bad_file = "dataset.yaml") {
+    TempDir dir;
+    WriteDataset(dir, yaml);
+    if (bad_file == "runs/g_late.csv") dir.Write(bad_file, "t,x,y,theta\n5,0,0,0\n6,0,0,0\n");
+    ExpectInputError([&] { LoadDataset(dir.path().string()); }, kind, dir.Path(bad_file), line);
+  };
+  const std::string run =
+      "  - {id: r1, trajectory: R1, repetition: 1, encoders: runs/e.csv, ground_truth: "
+      "runs/g.csv}\n";
+  check("robot: robot.yaml\nruns:\n" + run + run, InputErrorKind::kDuplicateRunId, 4);
+  check("robot: robot.yaml\nruns: {a: 1}\n", InputErrorKind::kWrongYamlType, 2);
+  check("- a\n- b\n", InputErrorKind::kWrongYamlType, 1);
+  check(
+      "robot: robot.yaml\nruns:\n  - {id: r1, trajectory: R1, repetition: 1.5, encoders: "
+      "runs/e.csv, ground_truth: runs/g.csv}\n",
+      InputErrorKind::kBadValue, 3);
+  check(
+      "robot: robot.yaml\nruns:\n  - {id: r1, trajectory: R1, repetition: 1, encoders: "
+      "runs/e.csv}\n",
+      InputErrorKind::kMissingKey, 3);
+  check(
+      "robot: robot.yaml\nruns:\n  - {id: r1, trajectory: R1, repetition: 1, encoders: ../e.csv, "
+      "ground_truth: runs/g.csv}\n",
+      InputErrorKind::kBadPath, 3);
+  check("robot: /etc/robot.yaml\nruns:\n" + run, InputErrorKind::kBadPath, 1);
+  check("robot: nothere.yaml\nruns:\n" + run, InputErrorKind::kMissingFile, 1);
+  check(
+      "robot: robot.yaml\nruns:\n  - {id: r1, trajectory: R1, repetition: 1, encoders: runs/e.csv, "
+      "ground_truth: runs/g_late.csv}\n",
+      InputErrorKind::kNoOverlap, 0, "runs/g_late.csv");
+  check(
+      "robot: robot.yaml\nruns:\n  - {id: r1, trajectory: R1, repetition: 1, encoders: runs/e.csv, "
+      "ground_truth: runs/g.csv, start_pose: [1, 2]}\n",
+      InputErrorKind::kBadValue, 3);
+  {
+    TempDir dir;
+    WriteDataset(dir, std::string(kDatasetYaml)
+                          .replace(std::string(kDatasetYaml).find("runs/e.csv"), 10, "runs/x.csv"));
+    ExpectInputError([&] { LoadDataset(dir.path().string()); }, InputErrorKind::kMissingFile,
+                     dir.Path("runs/x.csv"), 0);
+  }
+}
+
+}  // namespace
+}  // namespace fitcal::io
