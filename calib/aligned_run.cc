@@ -5,6 +5,12 @@
 
 namespace fitcal {
 
+namespace {
+bool IsRest(const WheelSample& s) {
+  return s.rate_rad_s[0] == 0.0 && s.rate_rad_s[1] == 0.0 && s.rate_rad_s[2] == 0.0;
+}
+}  // namespace
+
 AlignedRun AlignRun(const RunLog& run) {
   const std::vector<double>& t = run.encoders.t_s;
   const GroundTruthTrack& gt = run.ground_truth;
@@ -31,6 +37,13 @@ AlignedRun AlignRun(const RunLog& run) {
     if (end <= begin) continue;
     WheelSample sample = run.encoders.samples[k];
     sample.dt_s = end - begin;
+    // Consecutive intervals with all wheels at rest move nothing under any model: one interval
+    // of their summed length keeps the time line and saves the replay the work (robots log
+    // long rests before and after each run).
+    if (IsRest(sample) && !out.samples.empty() && IsRest(out.samples.back())) {
+      out.samples.back().dt_s += sample.dt_s;
+      continue;
+    }
     out.samples.push_back(sample);
   }
   return out;

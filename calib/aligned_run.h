@@ -6,7 +6,8 @@
 // start_pose, else max(first encoder time, first ground-truth time) with the start pose
 // interpolated from the ground truth there; t_final = min(last encoder time, last ground-truth
 // time). Intervals cut by the window keep their mean rate over the shortened length, so the
-// replay covers exactly the span the ground truth measured.
+// replay covers exactly the span the ground truth measured. Consecutive intervals in which all
+// wheels are at rest are merged into one (they move nothing; the time line is kept).
 
 #include <string>
 #include <vector>

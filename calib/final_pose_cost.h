@@ -13,7 +13,7 @@
 namespace fitcal {
 
 struct FinalPoseErrors {
-  double cf = 0.0;                   // mean per-run CF (Eq. 14)
+  double cf = 0.0;  // mean per-run CF (Eq. 14)
   double mean_position_error_m = 0.0;
   double mean_abs_heading_error_rad = 0.0;
   std::vector<double> per_run_cf;

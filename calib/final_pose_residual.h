@@ -3,7 +3,8 @@
 // the ground truth's, heading difference wrapped to [-pi, pi). Written once, templated: Ceres
 // differentiates it with autodiff; the CF evaluation and the NLopt back end call it on double.
 //
-//   r = [ (x_f - x_gt_f) / sigma_xy,  (y_f - y_gt_f) / sigma_xy,  wrap(theta_f - theta_gt_f) / sigma_theta ]
+//   r = [ (x_f - x_gt_f) / sigma_xy,  (y_f - y_gt_f) / sigma_xy,  wrap(theta_f - theta_gt_f) /
+//   sigma_theta ]
 //
 // With the default sigmas of 1 (m and rad) |r| is the paper's per-run CF.
 

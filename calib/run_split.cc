@@ -9,7 +9,8 @@ namespace fitcal {
 namespace {
 int ParseInt(const std::string& s, const std::string& whole) {
   if (s.empty() || s.size() > 6 || s.find_first_not_of("0123456789") != std::string::npos) {
-    throw std::invalid_argument("repetition list '" + whole + "': '" + s + "' is not a whole number");
+    throw std::invalid_argument("repetition list '" + whole + "': '" + s +
+                                "' is not a whole number");
   }
   return std::stoi(s);
 }
@@ -28,7 +29,9 @@ std::vector<int> ParseRepetitionList(const std::string& text) {
     } else {
       const int lo = ParseInt(item.substr(0, dash), text);
       const int hi = ParseInt(item.substr(dash + 1), text);
-      if (lo > hi) throw std::invalid_argument("repetition list '" + text + "': range " + item + " is reversed");
+      if (lo > hi)
+        throw std::invalid_argument("repetition list '" + text + "': range " + item +
+                                    " is reversed");
       for (int r = lo; r <= hi; ++r) out.insert(r);
     }
     pos = end + 1;

@@ -9,6 +9,7 @@
 
 #include "io/input_error.h"
 #include "io/log_files.h"
+#include "io/robot_yaml.h"
 #include "io/yaml_reader.h"
 #include "odometry/parallel_for.h"
 
@@ -29,14 +30,16 @@ std::string ResolvePath(const std::string& directory, const std::string& relativ
   if (!options.allow_paths_outside) {
     if (p.is_absolute()) {
       throw InputError(InputErrorKind::kBadPath, yaml_path, LineOf(node),
-                       "path '" + relative + "' is absolute; paths are relative to the data set "
-                       "directory (--allow-outside-paths to permit)");
+                       "path '" + relative +
+                           "' is absolute; paths are relative to the data set "
+                           "directory (--allow-outside-paths to permit)");
     }
     for (const auto& part : p) {
       if (part == "..") {
         throw InputError(InputErrorKind::kBadPath, yaml_path, LineOf(node),
-                         "path '" + relative + "' leaves the data set directory "
-                         "(--allow-outside-paths to permit)");
+                         "path '" + relative +
+                             "' leaves the data set directory "
+                             "(--allow-outside-paths to permit)");
       }
     }
   }
@@ -50,7 +53,10 @@ DatasetIndex ReadDatasetIndex(const std::string& directory, const DatasetOptions
   index.directory = directory;
   index.yaml_path = (fs::path(directory) / "dataset.yaml").string();
   const std::string& yaml_path = index.yaml_path;
-  if (!fs::is_directory(directory)) {
+  // error_code overloads: a path the OS refuses (too long, no permission) is bad input, not a
+  // std::filesystem_error escaping the loader (found by tests/fuzz, dataset_yaml).
+  std::error_code fs_error;
+  if (!fs::is_directory(directory, fs_error)) {
     throw InputError(InputErrorKind::kMissingFile, directory, 0, "not a directory");
   }
   const YAML::Node root = LoadYamlFile(yaml_path);
@@ -58,7 +64,7 @@ DatasetIndex ReadDatasetIndex(const std::string& directory, const DatasetOptions
   const YAML::Node robot_node = top.Required("robot");
   index.robot_path = ResolvePath(directory, YamlString(robot_node, yaml_path, "dataset.robot"),
                                  options, yaml_path, robot_node);
-  if (!fs::exists(index.robot_path)) {
+  if (!fs::exists(index.robot_path, fs_error)) {
     throw InputError(InputErrorKind::kMissingFile, yaml_path, LineOf(robot_node),
                      "robot file '" + index.robot_path + "' does not exist");
   }
@@ -86,8 +92,8 @@ DatasetIndex ReadDatasetIndex(const std::string& directory, const DatasetOptions
     entry.repetition = run.Int("repetition");
     entry.encoders_path =
         ResolvePath(directory, run.String("encoders"), options, yaml_path, node["encoders"]);
-    entry.ground_truth_path = ResolvePath(directory, run.String("ground_truth"), options,
-                                          yaml_path, node["ground_truth"]);
+    entry.ground_truth_path = ResolvePath(directory, run.String("ground_truth"), options, yaml_path,
+                                          node["ground_truth"]);
     const YAML::Node start = run.Optional("start_pose");
     if (start) {
       ExpectYamlType(start, YAML::NodeType::Sequence, yaml_path, "start_pose");
@@ -116,11 +122,15 @@ void CheckGroundTruthOverlap(const GroundTruthTrack& ground_truth, double enc_be
 }
 
 Dataset LoadDataset(const std::string& directory, const DatasetOptions& options) {
-  const DatasetIndex index = ReadDatasetIndex(directory, options);
+  return LoadDataset(ReadDatasetIndex(directory, options), options);
+}
+
+Dataset LoadDataset(const DatasetIndex& index, const DatasetOptions& options) {
   Dataset dataset;
   dataset.directory = index.directory;
   dataset.robot_path = index.robot_path;
   dataset.runs.resize(index.runs.size());
+  const std::optional<EncoderTicks> ticks = ReadEncoderTicks(index.robot_path);
   ParallelFor(index.runs.size(), options.num_threads, [&](std::size_t i) {
     const DatasetIndexEntry& entry = index.runs[i];
     RunLog& log = dataset.runs[i];
@@ -128,7 +138,7 @@ Dataset LoadDataset(const std::string& directory, const DatasetOptions& options)
     log.trajectory = entry.trajectory;
     log.repetition = entry.repetition;
     log.start_pose = entry.start_pose;
-    log.encoders = ReadEncoderCsv(entry.encoders_path);
+    log.encoders = ReadEncoderCsv(entry.encoders_path, ticks);
     log.ground_truth = ReadGroundTruth(entry.ground_truth_path);
     CheckGroundTruthOverlap(log.ground_truth, log.encoders.t_s.front(), log.encoders.t_s.back(),
                             entry.ground_truth_path);
@@ -160,10 +170,9 @@ std::string EncoderCsv(const EncoderLog& log) {
   char line[160];
   for (std::size_t k = 0; k < log.t_s.size(); ++k) {
     const double* w = k == 0 ? nullptr : log.samples[k - 1].rate_rad_s;
-    const int n = w == nullptr
-                      ? std::snprintf(line, sizeof line, "%.6f,0,0,0\n", log.t_s[k])
-                      : std::snprintf(line, sizeof line, "%.6f,%.9g,%.9g,%.9g\n", log.t_s[k],
-                                      w[0], w[1], w[2]);
+    const int n = w == nullptr ? std::snprintf(line, sizeof line, "%.6f,0,0,0\n", log.t_s[k])
+                               : std::snprintf(line, sizeof line, "%.6f,%.9g,%.9g,%.9g\n",
+                                               log.t_s[k], w[0], w[1], w[2]);
     out.append(line, static_cast<std::size_t>(n));
   }
   return out;
@@ -174,8 +183,8 @@ std::string GroundTruthCsv(const GroundTruthTrack& track) {
   char line[160];
   for (std::size_t k = 0; k < track.t_s.size(); ++k) {
     const Pose2d& p = track.world_T_robot[k];
-    const int n = std::snprintf(line, sizeof line, "%.6f,%.6f,%.6f,%.7f\n", track.t_s[k], p.x,
-                                p.y, p.theta);
+    const int n =
+        std::snprintf(line, sizeof line, "%.6f,%.6f,%.6f,%.7f\n", track.t_s[k], p.x, p.y, p.theta);
     out.append(line, static_cast<std::size_t>(n));
   }
   return out;

@@ -1,6 +1,7 @@
 #pragma once
 // A data set directory: dataset.yaml naming the robot and the runs, and one encoder CSV and one
-// ground-truth file per run (docs/data_format.md). Loading checks everything a fit relies on.
+// ground-truth file per run (README.md, "Data set format"). Loading checks everything a fit relies
+// on.
 
 #include <optional>
 #include <string>
@@ -50,6 +51,8 @@ struct Dataset {
 // Loads dataset.yaml and every run it lists (omni3 encoder CSVs); throws InputError naming the
 // file and line.
 Dataset LoadDataset(const std::string& directory, const DatasetOptions& options = {});
+// The same from an index already read (dataset.yaml is then parsed once).
+Dataset LoadDataset(const DatasetIndex& index, const DatasetOptions& options = {});
 
 // One run as dataset.yaml lists it; used by writers (the simulator, importers).
 struct DatasetEntry {

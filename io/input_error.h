@@ -8,24 +8,24 @@
 namespace fitcal::io {
 
 enum class InputErrorKind {
-  kMissingFile,       // cannot open / read
-  kEmptyFile,         // nothing but (optional) header
-  kBadHeader,         // header row is not the expected one
-  kWrongColumnCount,  // a row with too few or too many fields
-  kNonNumeric,        // a field that is not a number
-  kNonFinite,         // NaN, Inf or out of double range
-  kNonIncreasingTime, // t not strictly increasing
-  kTooFewSamples,     // fewer than two samples
-  kNoOverlap,         // ground truth and encoders do not share time
-  kUnknownModel,      // robot model fitcal does not know
-  kDuplicateRunId,    // two runs with one id
-  kWrongYamlType,     // a YAML node of the wrong kind (map / list / scalar)
-  kMissingKey,        // a required YAML key is absent
-  kUnknownKey,        // a YAML key nobody reads
-  kBadValue,          // a value out of its allowed range (bounds lo > hi, radius <= 0, ...)
-  kBadPath,           // a path that escapes the data set directory
-  kYamlSyntax,        // YAML that does not parse
-  kTooLarge,          // a file larger than fitcal will hold in memory
+  kMissingFile,        // cannot open / read
+  kEmptyFile,          // nothing but (optional) header
+  kBadHeader,          // header row is not the expected one
+  kWrongColumnCount,   // a row with too few or too many fields
+  kNonNumeric,         // a field that is not a number
+  kNonFinite,          // NaN, Inf or out of double range
+  kNonIncreasingTime,  // t not strictly increasing
+  kTooFewSamples,      // fewer than two samples
+  kNoOverlap,          // ground truth and encoders do not share time
+  kUnknownModel,       // robot model fitcal does not know
+  kDuplicateRunId,     // two runs with one id
+  kWrongYamlType,      // a YAML node of the wrong kind (map / list / scalar)
+  kMissingKey,         // a required YAML key is absent
+  kUnknownKey,         // a YAML key nobody reads
+  kBadValue,           // a value out of its allowed range (bounds lo > hi, radius <= 0, ...)
+  kBadPath,            // a path that escapes the data set directory
+  kYamlSyntax,         // YAML that does not parse
+  kTooLarge,           // a file larger than fitcal will hold in memory
 };
 
 const char* ToString(InputErrorKind kind);

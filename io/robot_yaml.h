@@ -1,10 +1,11 @@
 #pragma once
-// The robot YAML (docs/data_format.md): nominal geometry and bounds in, calibrated geometry out.
-// The calibrated file has the same schema plus a `calibration:` block, so it can be read back as
-// the robot of a new fit.
+// The robot YAML (README.md, "Data set format"): nominal geometry and bounds in, calibrated
+// geometry out. The calibrated file has the same schema plus a `calibration:` block, so it can be
+// read back as the robot of a new fit.
 
 #include <Eigen/Core>
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,10 @@ namespace fitcal::io {
 
 // The `model:` of a robot YAML ("omni3", ...); throws for a file that is not a robot YAML.
 std::string ReadRobotModel(const std::string& path);
+
+// The optional `encoder: {ticks_per_rev: N, cumulative: false}` block of any robot YAML (needed
+// when the encoder logs are in ticks); nullopt when absent; InputError when malformed.
+std::optional<EncoderTicks> ReadEncoderTicks(const std::string& path);
 
 // Reads an omni3 robot; throws InputError on anything malformed or physically impossible
 // (non-positive radius, bounds with lo > hi, nominal outside its bounds, ...).

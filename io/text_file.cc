@@ -1,5 +1,6 @@
 #include "io/text_file.h"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <charconv>
@@ -29,6 +30,12 @@ std::size_t MaxLoadableBytes() {
 std::string ReadTextFile(const std::string& path) {
   std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
   if (!file) throw InputError(InputErrorKind::kMissingFile, path, 0, "cannot open file");
+  // A directory or a device opens too, but its "size" is meaningless (ext4 reports 2^31-1 for a
+  // directory): only regular files are read.
+  struct stat info {};
+  if (fstat(fileno(file.get()), &info) != 0 || !S_ISREG(info.st_mode)) {
+    throw InputError(InputErrorKind::kMissingFile, path, 0, "not a regular file");
+  }
   if (std::fseek(file.get(), 0, SEEK_END) != 0) {
     throw InputError(InputErrorKind::kMissingFile, path, 0, "cannot read file (not seekable)");
   }

@@ -53,7 +53,8 @@ struct Parameters {
   }
 };
 
-// Compact kinematic matrix M, Palacin Eq. 3: w = M * v_robot, row i = [-sin d_i, cos d_i, R_i] / r_i.
+// Compact kinematic matrix M, Palacin Eq. 3: w = M * v_robot, row i = [-sin d_i, cos d_i, R_i] /
+// r_i.
 template <typename T>
 Matrix3<T> KinematicMatrix(const T* p) {
   using std::cos;

@@ -4,10 +4,14 @@
 // with R^-1 of Eq. 5 and M^-1 of Eq. 6 (omni3_model.h). Templated on the scalar: the Ceres fit
 // differentiates through it with ceres::Jet, everything else runs it on double.
 //
-// Speed: sin/cos of the heading at every sample would dominate the loop, so the heading's unit
-// vector (c, s) is advanced by a rotation of dtheta_k per sample, using a short Taylor series for
-// the small per-sample angle, and recomputed exactly from theta every kReanchorInterval samples so
-// rounding cannot accumulate. The result equals Eq. 4 to rounding (tests/omni3_replay_test.cc).
+// Speed: the replay runs in chunks of kChunk samples. A first pass computes every sample's
+// robot-frame step M^-1 w dt and the rotation (cos, sin) over its interval; these do not depend on
+// each other, so for double the compiler vectorises the pass. The rotation uses a short Taylor
+// series, as long as the chunk's largest per-sample angle needs (exact to < 1e-17), and the
+// library sin/cos above kSeriesMaxAngle. A second, sequential pass accumulates the world pose and
+// advances the heading's unit vector (c, s) by those rotations; (c, s) is recomputed exactly from
+// theta every kReanchorInterval samples so rounding cannot accumulate. The result equals a literal
+// Eq. 4 to rounding (tests/omni3_replay_test.cc).
 
 #include <cmath>
 #include <cstddef>
@@ -20,26 +24,47 @@ namespace fitcal::omni3 {
 
 namespace internal {
 
-inline constexpr std::size_t kReanchorInterval = 256;
-// Below this per-sample rotation (rad) the degree-10/11 Taylor series of cos/sin is exact to
-// below 1e-17; above it (never at sane sample rates) the library functions are used.
+inline constexpr std::size_t kChunk = 64;
+inline constexpr std::size_t kReanchorInterval = 256;  // a multiple of kChunk
+// Per-sample rotations below kShortSeriesMaxAngle use the degree-6/7 series (truncation error
+// < a^8/8! < 7e-19), below kSeriesMaxAngle the degree-10/11 series (< a^12/12! < 9e-18); larger
+// ones (never at sane sample rates) the library functions.
+inline constexpr double kShortSeriesMaxAngle = 0.02;
 inline constexpr double kSeriesMaxAngle = 0.2;
 
-template <typename T>
-inline void CosSinOfSmallAngle(const T& a, T* c, T* s) {
-  using std::abs;
-  using std::cos;
-  using std::sin;
-  if (abs(a) < T(kSeriesMaxAngle)) {
-    const T a2 = a * a;
-    *c = T(1.0) + a2 * (T(-1.0 / 2) + a2 * (T(1.0 / 24) + a2 * (T(-1.0 / 720) +
-                 a2 * (T(1.0 / 40320) + a2 * T(-1.0 / 3628800)))));
-    *s = a * (T(1.0) + a2 * (T(-1.0 / 6) + a2 * (T(1.0 / 120) + a2 * (T(-1.0 / 5040) +
-                       a2 * (T(1.0 / 362880) + a2 * T(-1.0 / 39916800))))));
-  } else {
-    *c = cos(a);
-    *s = sin(a);
-  }
+inline void CosSinShortSeries(double a, double* c, double* s) {
+  const double a2 = a * a;
+  *c = 1.0 + a2 * (-1.0 / 2 + a2 * (1.0 / 24 + a2 * (-1.0 / 720)));
+  *s = a * (1.0 + a2 * (-1.0 / 6 + a2 * (1.0 / 120 + a2 * (-1.0 / 5040))));
+}
+
+inline void CosSinLongSeries(double a, double* c, double* s) {
+  const double a2 = a * a;
+  *c =
+      1.0 + a2 * (-1.0 / 2 +
+                  a2 * (1.0 / 24 + a2 * (-1.0 / 720 + a2 * (1.0 / 40320 + a2 * (-1.0 / 3628800)))));
+  *s = a * (1.0 + a2 * (-1.0 / 6 +
+                        a2 * (1.0 / 120 +
+                              a2 * (-1.0 / 5040 + a2 * (1.0 / 362880 + a2 * (-1.0 / 39916800))))));
+}
+
+// For a ceres::Jet the series runs on the real part only and the derivatives follow from the
+// chain rule, d cos = -sin da, d sin = cos da: two vector scalings instead of a polynomial in
+// Jets (half of the autodiff replay's cost otherwise).
+template <typename JetT>
+inline void CosSinShortSeries(const JetT& a, JetT* c, JetT* s) {
+  double cv, sv;
+  CosSinShortSeries(a.a, &cv, &sv);
+  *c = JetT(cv, -sv * a.v);
+  *s = JetT(sv, cv * a.v);
+}
+
+template <typename JetT>
+inline void CosSinLongSeries(const JetT& a, JetT* c, JetT* s) {
+  double cv, sv;
+  CosSinLongSeries(a.a, &cv, &sv);
+  *c = JetT(cv, -sv * a.v);
+  *s = JetT(sv, cv * a.v);
 }
 
 struct NoVisit {
@@ -54,37 +79,62 @@ struct NoVisit {
 template <typename T, typename Visitor = internal::NoVisit>
 Pose2<T> ReplayWithMatrix(const Matrix3<T>& m_inv, const WheelSample* samples, std::size_t n,
                           const Pose2<T>& start, Visitor&& visit = Visitor()) {
+  using internal::kChunk;
+  using std::abs;
   using std::cos;
   using std::sin;
+  // Locals, so the compiler knows the matrix does not alias the buffers.
+  const T m00 = m_inv(0, 0), m01 = m_inv(0, 1), m02 = m_inv(0, 2);
+  const T m10 = m_inv(1, 0), m11 = m_inv(1, 1), m12 = m_inv(1, 2);
+  const T m20 = m_inv(2, 0), m21 = m_inv(2, 1), m22 = m_inv(2, 2);
+  T step_x[kChunk], step_y[kChunk], step_theta[kChunk], rot_c[kChunk], rot_s[kChunk];
+
   T x = start.x;
   T y = start.y;
   T theta = start.theta;
-  std::size_t k = 0;
-  while (k < n) {
-    T c = cos(theta);
-    T s = sin(theta);
-    const std::size_t chunk_end = k + internal::kReanchorInterval < n
-                                      ? k + internal::kReanchorInterval : n;
-    for (; k < chunk_end; ++k) {
-      const WheelSample& sample = samples[k];
-      const double* w = sample.rate_rad_s;
-      // Robot-frame velocity M^-1 w (Eq. 4), scaled by the interval length.
-      const T vx = m_inv(0, 0) * w[0] + m_inv(0, 1) * w[1] + m_inv(0, 2) * w[2];
-      const T vy = m_inv(1, 0) * w[0] + m_inv(1, 1) * w[1] + m_inv(1, 2) * w[2];
-      const T omega = m_inv(2, 0) * w[0] + m_inv(2, 1) * w[1] + m_inv(2, 2) * w[2];
-      const T dx_robot = vx * sample.dt_s;
-      const T dy_robot = vy * sample.dt_s;
-      const T dtheta = omega * sample.dt_s;
-      // R(theta(k-1))^-1 of Eq. 5 rotates the robot-frame step into the world frame.
-      x += c * dx_robot - s * dy_robot;
-      y += s * dx_robot + c * dy_robot;
-      theta += dtheta;
-      T cd, sd;
-      internal::CosSinOfSmallAngle(dtheta, &cd, &sd);
-      const T c_next = c * cd - s * sd;
-      s = s * cd + c * sd;
+  T c = cos(theta);
+  T s = sin(theta);
+  for (std::size_t k0 = 0; k0 < n; k0 += kChunk) {
+    const std::size_t m = n - k0 < kChunk ? n - k0 : kChunk;
+    const WheelSample* chunk = samples + k0;
+    // Pass 1: robot-frame step M^-1 w dt of every sample (Eq. 4) and its rotation.
+    double max_angle = 0.0;
+    for (std::size_t j = 0; j < m; ++j) {
+      const double* w = chunk[j].rate_rad_s;
+      const double dt = chunk[j].dt_s;
+      step_x[j] = (m00 * w[0] + m01 * w[1] + m02 * w[2]) * dt;
+      step_y[j] = (m10 * w[0] + m11 * w[1] + m12 * w[2]) * dt;
+      step_theta[j] = (m20 * w[0] + m21 * w[1] + m22 * w[2]) * dt;
+    }
+    for (std::size_t j = 0; j < m; ++j) {
+      const double a = std::abs(ScalarPart(step_theta[j]));
+      max_angle = a > max_angle ? a : max_angle;
+    }
+    if (max_angle < internal::kShortSeriesMaxAngle) {
+      for (std::size_t j = 0; j < m; ++j)
+        internal::CosSinShortSeries(step_theta[j], &rot_c[j], &rot_s[j]);
+    } else if (max_angle < internal::kSeriesMaxAngle) {
+      for (std::size_t j = 0; j < m; ++j)
+        internal::CosSinLongSeries(step_theta[j], &rot_c[j], &rot_s[j]);
+    } else {
+      for (std::size_t j = 0; j < m; ++j) {
+        rot_c[j] = cos(step_theta[j]);
+        rot_s[j] = sin(step_theta[j]);
+      }
+    }
+    // Pass 2: R(theta(k-1))^-1 of Eq. 5 rotates each step into the world frame.
+    for (std::size_t j = 0; j < m; ++j) {
+      x += c * step_x[j] - s * step_y[j];
+      y += s * step_x[j] + c * step_y[j];
+      theta += step_theta[j];
+      const T c_next = c * rot_c[j] - s * rot_s[j];
+      s = s * rot_c[j] + c * rot_s[j];
       c = c_next;
-      visit(k, Pose2<T>{x, y, theta});
+      visit(k0 + j, Pose2<T>{x, y, theta});
+    }
+    if ((k0 + m) % internal::kReanchorInterval == 0) {
+      c = cos(theta);
+      s = sin(theta);
     }
   }
   return Pose2<T>{x, y, theta};

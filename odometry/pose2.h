@@ -25,6 +25,15 @@ T WrapAngle(const T& angle_rad) {
   return angle_rad - two_pi * floor((angle_rad + M_PI) / two_pi);
 }
 
+// The value of a scalar without its derivatives: itself for double, the real part `a` of a
+// ceres::Jet (found by overload, so odometry/ needs no Ceres header). For decisions that must not
+// depend on derivatives, such as which series to use.
+inline double ScalarPart(double v) { return v; }
+template <typename JetT>
+double ScalarPart(const JetT& v) {
+  return v.a;
+}
+
 inline double DegToRad(double angle_deg) { return angle_deg * (M_PI / 180.0); }
 inline double RadToDeg(double angle_rad) { return angle_rad * (180.0 / M_PI); }
 

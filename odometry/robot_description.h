@@ -3,8 +3,11 @@
 // box within which the fit may move each parameter (Eq. 16). Filled from the robot YAML by io/.
 
 #include <array>
+#include <optional>
 #include <string>
+#include <vector>
 
+#include "odometry/effects.h"
 #include "odometry/omni3_model.h"
 
 namespace fitcal {
@@ -21,11 +24,23 @@ struct Omni3Bounds {
   Interval angle_offset_rad;  // bounds on delta_i - nominal delta_i (Eq. 16)
 };
 
+// How the encoders count, when the logs hold ticks instead of wheel rates (robot YAML `encoder:`):
+// ticks per wheel revolution (gear ratio x counts per motor revolution) and whether the log holds
+// running totals (cumulative) or increments since the previous row.
+struct EncoderTicks {
+  double ticks_per_rev = 0.0;
+  bool cumulative = false;
+};
+
 struct Omni3Robot {
   std::string name;
   std::array<std::string, omni3::kNumWheels> wheel_names{"a", "b", "c"};
   omni3::Parameters nominal;
   Omni3Bounds bounds;
+  std::optional<EncoderTicks> encoder;  // set when the encoder logs are in ticks
+  // Effects beyond the nine parameters (robot YAML `effects:`, written by `fitcal diagnose`);
+  // replayed by odometry/effects.h ReplayWithEffects.
+  std::vector<effects::EffectValue> effects;
 
   // Per-parameter [lo, hi] in the flat order of omni3_model.h.
   std::array<Interval, omni3::kNumParameters> ParameterBounds() const {

@@ -15,16 +15,6 @@ namespace {
 
 using ParameterArray = std::array<double, omni3::kNumParameters>;
 
-Omni3Robot Apr02() {
-  Omni3Robot robot;
-  robot.name = "apr02";
-  robot.nominal = sim::PalacinNominalParameters();
-  robot.bounds.distance_m = {0.170, 0.220};  // Palacin Eq. 16
-  robot.bounds.radius_m = {0.138, 0.158};
-  robot.bounds.angle_offset_rad = {-2.0 * M_PI / 180.0, 2.0 * M_PI / 180.0};
-  return robot;
-}
-
 std::vector<AlignedRun> Simulate(const sim::Omni3SimulationOptions& options) {
   std::vector<RunLog> logs;
   for (auto& run : sim::SimulateOmni3(options)) logs.push_back(std::move(run.log));
@@ -52,7 +42,8 @@ TEST(Omni3Fit, NoiseFreeDataLeaveOnlyTheDiscretisationOfEq4) {
   double shift_R[2] = {0.0, 0.0};
   const double periods[2] = {0.010, 0.005};
   for (int i = 0; i < 2; ++i) {
-    const Omni3FitResult fit = FitOmni3Ceres(Simulate(NoiseFree(periods[i])), Apr02());
+    const Omni3FitResult fit =
+        FitOmni3Ceres(Simulate(NoiseFree(periods[i])), sim::PalacinApr02Robot());
     ASSERT_TRUE(fit.usable) << fit.termination << " " << fit.message;
     for (int w = 0; w < 3; ++w) {
       shift_R[i] +=
@@ -87,7 +78,7 @@ NoisyFit FitDefaultNoise(std::uint64_t seed, bool swap_columns_a_b = false) {
   }
   NoisyFit out;
   out.split = SplitByRepetition(AlignRuns(logs), {1, 2, 3, 4, 5});
-  out.fit = FitOmni3Ceres(out.split.training, Apr02());
+  out.fit = FitOmni3Ceres(out.split.training, sim::PalacinApr02Robot());
   return out;
 }
 
@@ -160,7 +151,7 @@ TEST(Omni3Fit, RejectsInvalidOptions) {
   options.weights.position_sigma_m = 0.0;
   std::string error;
   EXPECT_FALSE(options.IsValid(&error));
-  EXPECT_THROW(FitOmni3Ceres({}, Apr02()), std::invalid_argument);
+  EXPECT_THROW(FitOmni3Ceres({}, sim::PalacinApr02Robot()), std::invalid_argument);
 }
 
 }  // namespace

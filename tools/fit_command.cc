@@ -6,14 +6,23 @@
 #include <iostream>
 #include <stdexcept>
 
+#include "calib/degenerate_data.h"
 #include "calib/final_pose_cost.h"
+#include "calib/identifiability.h"
 #include "calib/omni3_ceres_fit.h"
 #include "calib/run_split.h"
+#include "calib/wheel_order_check.h"
 #include "fitcal/version.h"
 #include "io/atomic_file.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/robot_yaml.h"
+#include "io/yaml_reader.h"
+#include "odometry/effects.h"
+#include "tools/asoc_commands.h"
+#include "tools/fit_methods.h"
+#include "tools/output_guard.h"
+#include "tools/sim/flower_candidates.h"
 
 namespace fitcal::tools {
 
@@ -21,6 +30,32 @@ namespace {
 
 double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+// The solver flags of FitCommandOptions as FitMethodSettings; false with a message when a name
+// is unknown or a value out of range.
+bool MakeFitMethodSettings(const FitCommandOptions& o, FitMethodSettings* s, std::string* error) {
+  s->threads = o.threads;
+  s->weights.position_sigma_m = o.position_sigma_m;
+  s->weights.heading_sigma_rad = o.heading_sigma_deg * M_PI / 180.0;
+  s->objective_set = !o.objective.empty();
+  if (s->objective_set && !ParseFinalPoseObjective(o.objective, &s->objective)) {
+    *error = "unknown --objective '" + o.objective + "' (available: squares, eq14)";
+    return false;
+  }
+  if (!ParseCeresRobustLoss(o.loss, &s->loss)) {
+    *error = "unknown --loss '" + o.loss + "' (available: none, huber, cauchy)";
+    return false;
+  }
+  s->loss_scale = o.loss_scale;
+  s->seed = o.seed;
+  s->max_evaluations = o.max_evaluations;
+  s->local_polish = o.polish;
+  if (o.max_evaluations < 1 || !(o.loss_scale > 0.0)) {
+    *error = "--max-evaluations and --loss-scale must be positive";
+    return false;
+  }
+  return true;
 }
 
 double ChangePercent(double before, double after) {
@@ -52,8 +87,16 @@ void PrintParameters(const Omni3Robot& robot, const Omni3FitResult& fit) {
 
 int RunFitCommand(const FitCommandOptions& options) {
   const auto t_total = std::chrono::steady_clock::now();
-  if (options.method != "ceres") {
-    std::cerr << "fitcal: unknown --method '" << options.method << "' (available: ceres)\n";
+  const FitMethod* method = FindFitMethod(options.method);
+  if (method == nullptr) {
+    std::cerr << "fitcal: unknown --method '" << options.method
+              << "' (available: " << FitMethodNames() << ")\n";
+    return 2;
+  }
+  FitMethodSettings settings;
+  std::string settings_error;
+  if (!MakeFitMethodSettings(options, &settings, &settings_error)) {
+    std::cerr << "fitcal: " << settings_error << "\n";
     return 2;
   }
   try {
@@ -61,13 +104,33 @@ int RunFitCommand(const FitCommandOptions& options) {
     io::DatasetOptions dataset_options;
     dataset_options.allow_paths_outside = options.allow_outside_paths;
     dataset_options.num_threads = options.threads;
-    const io::Dataset dataset = io::LoadDataset(options.logs, dataset_options);
+    // ASOC robots (issue 5) have their own encoder format and fit (tools/asoc_commands.h).
+    const io::DatasetIndex index = io::ReadDatasetIndex(options.logs, dataset_options);
+    if (io::ReadRobotModel(index.robot_path) == "asoc") return RunAsocFit(options);
+    const io::Dataset dataset = io::LoadDataset(index, dataset_options);
     const std::string model = io::ReadRobotModel(dataset.robot_path);
     if (model != "omni3") {
       throw io::InputError(io::InputErrorKind::kUnknownModel, dataset.robot_path, 0,
                            "model '" + model + "' is not supported by 'fit' (known: omni3)");
     }
     const Omni3Robot robot = io::ReadOmni3Robot(dataset.robot_path);
+    if (!robot.effects.empty()) {
+      // The methods here fit Eq. 4 alone; refitting would silently drop the declared effects.
+      std::string names;
+      for (const auto& e : robot.effects)
+        names += std::string(names.empty() ? "" : ", ") + effects::Info(e.id).name;
+      std::cerr << "fitcal: " << dataset.robot_path << ": the robot declares effects (" << names
+                << ") that 'fit' does not model; refit them with 'fitcal diagnose', or start from "
+                   "a robot YAML without an effects: list\n";
+      return 2;
+    }
+    if (!options.no_output && !options.force) {
+      const std::string refusal = OverwriteRefusal(options.out, robot.name);
+      if (!refusal.empty()) {
+        std::cerr << "fitcal: " << refusal << "\n";
+        return 2;
+      }
+    }
     const std::vector<int> train_reps = ParseRepetitionList(options.train_reps);
     RunSplit split = SplitByRepetition(AlignRuns(dataset.runs), train_reps);
     const double load_s = Seconds(t_load);
@@ -77,24 +140,48 @@ int RunFitCommand(const FitCommandOptions& options) {
       return 2;
     }
 
-    CeresFitOptions fit_options;
-    fit_options.num_threads = options.threads;
-    fit_options.weights.position_sigma_m = options.position_sigma_m;
-    fit_options.weights.heading_sigma_rad = options.heading_sigma_deg * M_PI / 180.0;
-    const Omni3FitResult fit = FitOmni3Ceres(split.training, robot, fit_options);
+    // Before fitting (issue 7): rates in the wrong unit, miswired encoder columns, data that
+    // cannot determine the parameters.
+    const RateUnitsReport units = CheckRateUnits(dataset.runs, robot);
+    if (units.suspicious)
+      std::cerr << "fitcal: warning: " << options.logs << ": " << units.message << "\n";
+    if (!units.suspicious && !options.skip_wheel_order_check) {
+      WheelOrderOptions order_options;
+      order_options.weights.position_sigma_m = options.position_sigma_m;
+      order_options.weights.heading_sigma_rad = options.heading_sigma_deg * M_PI / 180.0;
+      order_options.num_threads = options.threads;
+      const WheelOrderReport order = CheckWheelOrder(split.training, robot, order_options);
+      if (order.likely_miswired) {
+        std::cerr << "fitcal: " << options.logs << ": " << order.message
+                  << "; nothing written (--skip-wheel-order-check to fit anyway)\n";
+        return 4;
+      }
+    }
+    for (const std::string& problem : FindDegenerateData(split.training, robot)) {
+      std::printf("warning: %s\n", problem.c_str());
+    }
+
+    const FitMethodOutcome outcome = method->run(split.training, robot, settings);
+    const Omni3FitResult& fit = outcome.fit;
 
     const auto nominal = robot.nominal.ToArray();
-    const FinalPoseErrors train_before = EvaluateFinalPoseErrors(nominal, split.training, options.threads);
-    const FinalPoseErrors train_after = EvaluateFinalPoseErrors(fit.parameters, split.training, options.threads);
-    const FinalPoseErrors val_before = EvaluateFinalPoseErrors(nominal, split.validation, options.threads);
-    const FinalPoseErrors val_after = EvaluateFinalPoseErrors(fit.parameters, split.validation, options.threads);
+    const FinalPoseErrors train_before =
+        EvaluateFinalPoseErrors(nominal, split.training, options.threads);
+    const FinalPoseErrors train_after =
+        EvaluateFinalPoseErrors(fit.parameters, split.training, options.threads);
+    const FinalPoseErrors val_before =
+        EvaluateFinalPoseErrors(nominal, split.validation, options.threads);
+    const FinalPoseErrors val_after =
+        EvaluateFinalPoseErrors(fit.parameters, split.validation, options.threads);
 
     std::printf("fitcal %s  omni3 robot '%s'  data set %s\n", kVersion, robot.name.c_str(),
                 options.logs.c_str());
     std::printf("runs: %zu training (repetitions %s), %zu validation (repetitions %s)\n\n",
                 split.training.size(), FormatRepetitionList(split.training_repetitions).c_str(),
-                split.validation.size(), FormatRepetitionList(split.validation_repetitions).c_str());
-    std::printf("  %-30s %10s %10s %9s\n", "CF (Eq. 14, m and rad)", "nominal", "calibrated", "change");
+                split.validation.size(),
+                FormatRepetitionList(split.validation_repetitions).c_str());
+    std::printf("  %-30s %10s %10s %9s\n", "CF (Eq. 14, m and rad)", "nominal", "calibrated",
+                "change");
     std::printf("  %-30s %10.4f %10.4f %+8.1f%%\n", "training", train_before.cf, train_after.cf,
                 ChangePercent(train_before.cf, train_after.cf));
     if (!split.validation.empty()) {
@@ -109,13 +196,34 @@ int RunFitCommand(const FitCommandOptions& options) {
       std::printf("  validation: no held-out repetitions; the result is not validated\n");
     }
     PrintParameters(robot, fit);
-    std::printf("\nsolver: Ceres Levenberg-Marquardt, %s after %d iterations, %.3f s (%s)\n",
-                fit.termination.c_str(), fit.iterations, fit.solve_time_s, fit.message.c_str());
+    {
+      std::vector<std::string> ids;
+      for (const AlignedRun& run : split.training) ids.push_back(run.id);
+      for (const OutlierRun& o : FindOutlierRuns(ids, train_after.per_run_cf)) {
+        std::printf(
+            "warning: run %s: final-pose error %.1fx the median run's (gross wheel slip "
+            "or a ground truth of another run?); a robust loss limits its pull\n",
+            o.id.c_str(), o.error_ratio);
+      }
+    }
+    std::printf("\nsolver: %s, %s after %d iterations (%d evaluations), %.3f s (%s)\n",
+                method->description.c_str(), fit.termination.c_str(), fit.iterations,
+                outcome.evaluations, fit.solve_time_s, fit.message.c_str());
     if (!fit.has_covariance) std::printf("uncertainty: %s\n", fit.covariance_message.c_str());
+    if (fit.usable) {  // issue 4: name what the training runs cannot determine
+      ResidualWeights weights;
+      weights.position_sigma_m = options.position_sigma_m;
+      weights.heading_sigma_rad = options.heading_sigma_deg * M_PI / 180.0;
+      const IdentifiabilityReport ident = AnalyseIdentifiability(
+          FinalPoseJacobian(fit.parameters, split.training, weights, options.threads),
+          fit.parameters, sim::FlowerCandidateMotions(), nominal, weights);
+      for (const std::string& line : IdentifiabilityLines(ident)) std::printf("%s\n", line.c_str());
+    }
     for (int k = 0; k < omni3::kNumParameters; ++k) {
       if (fit.at_bound[k]) {
-        std::printf("warning: a parameter stopped on its bound; the model may be absorbing an "
-                    "effect it does not contain, or the bounds are too tight\n");
+        std::printf(
+            "warning: a parameter stopped on its bound; the model may be absorbing an "
+            "effect it does not contain, or the bounds are too tight\n");
         break;
       }
     }
@@ -129,8 +237,8 @@ int RunFitCommand(const FitCommandOptions& options) {
       Omni3Robot calibrated = robot;
       calibrated.nominal = omni3::Parameters::FromArray(fit.parameters.data());
       io::CalibrationRecord record;
-      record.method = "ceres";
-      record.objective = "sum of squared final-pose residuals (sigma_xy " +
+      record.method = method->name;
+      record.objective = outcome.objective + " (sigma_xy " +
                          std::to_string(options.position_sigma_m) + " m, sigma_theta " +
                          std::to_string(options.heading_sigma_deg) + " deg)";
       record.dataset = options.logs;

@@ -12,10 +12,19 @@ struct FitCommandOptions {
   std::string train_reps = "1-5";
   std::string out = "calibrated.yaml";
   bool no_output = false;
+  bool force = false;  // overwrite --out even when it holds another robot's calibration
+  bool skip_wheel_order_check = false;  // fit even if another column order fits far better
   bool allow_outside_paths = false;
   int threads = 0;
   double position_sigma_m = 1.0;
   double heading_sigma_deg = 180.0 / 3.14159265358979323846;  // 1 rad: Eq. 14's weighting
+  // Solver settings (tools/fit_methods.h); each method uses those that apply to it.
+  std::string objective;        // "" = the method's default; "squares" or "eq14"
+  std::string loss = "none";    // Ceres: none, huber, cauchy
+  double loss_scale = 0.05;     // Ceres robust loss scale, residual units
+  unsigned long seed = 1;       // NLopt
+  int max_evaluations = 20000;  // NLopt
+  bool polish = false;          // NLopt global methods: SLSQP polish of the best point
 };
 
 // Returns the process exit code; prints results to stdout and errors (one line) to stderr.

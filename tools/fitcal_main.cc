@@ -2,34 +2,60 @@
 // `fitcal --logs <dir> --method ceres` without a subcommand runs `fit`.
 
 #include <CLI/CLI.hpp>
-
 #include <cmath>
 #include <iostream>
 
 #include "fitcal/version.h"
+#include "tools/asoc_commands.h"
+#include "tools/compare_command.h"
+#include "tools/diagnose_command.h"
 #include "tools/fit_command.h"
+#include "tools/fit_methods.h"
+#include "tools/generalisation_command.h"
+#include "tools/import_optiodom.h"
+#include "tools/report_command.h"
 #include "tools/simulate_command.h"
 
 namespace {
 
 void AddFitOptions(CLI::App& app, fitcal::tools::FitCommandOptions& o) {
-  app.add_option("--logs", o.logs, "Data set directory (holds dataset.yaml)")->check(CLI::ExistingDirectory);
-  app.add_option("--method", o.method, "Solver: ceres")->capture_default_str();
+  app.add_option("--logs", o.logs, "Data set directory (holds dataset.yaml)")
+      ->check(CLI::ExistingDirectory);
+  app.add_option("--method", o.method, "Solver: " + fitcal::tools::FitMethodNames())
+      ->capture_default_str();
+  app.add_option("--objective", o.objective,
+                 "squares (sum of squared residuals; Ceres default) or eq14 (sum of per-run "
+                 "norms, Palacin Eq. 14; NLopt default)");
+  app.add_option("--loss", o.loss, "Ceres robust loss: none, huber, cauchy")->capture_default_str();
+  app.add_option("--loss-scale", o.loss_scale, "Robust loss scale (residual units: m and rad)")
+      ->capture_default_str();
+  app.add_option("--seed", o.seed, "NLopt random seed (same seed, same result)")
+      ->capture_default_str();
+  app.add_option("--max-evaluations", o.max_evaluations, "NLopt evaluation budget")
+      ->capture_default_str();
+  app.add_flag("--polish", o.polish,
+               "NLopt global methods: polish the best point with SLSQP (autodiff gradient)");
   app.add_option("--train-reps", o.train_reps,
                  "Repetitions used for fitting, e.g. 1-5 or 1,3,5; the others validate")
       ->capture_default_str();
-  app.add_option("--out", o.out, "Calibrated robot YAML to write (atomically)")->capture_default_str();
+  app.add_option("--out", o.out, "Calibrated robot YAML to write (atomically)")
+      ->capture_default_str();
   app.add_flag("--no-output", o.no_output, "Do not write the calibrated YAML");
+  app.add_flag("--force", o.force, "Overwrite --out even if it holds another robot's calibration");
+  app.add_flag("--skip-wheel-order-check", o.skip_wheel_order_check,
+               "Fit even if another encoder column order/sign explains the data far better");
   app.add_flag("--allow-outside-paths", o.allow_outside_paths,
                "Allow dataset.yaml paths that are absolute or leave the data set directory");
   app.add_option("--threads", o.threads, "Worker threads (0 = all cores)")->capture_default_str();
   app.add_option("--position-sigma-m", o.position_sigma_m,
                  "Weight of the position residual as a standard deviation (m); with the default "
                  "1 m and 57.3 deg the objective weighs metres and radians as Eq. 14")
-      ->capture_default_str()->check(CLI::PositiveNumber);
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_option("--heading-sigma-deg", o.heading_sigma_deg,
                  "Weight of the heading residual as a standard deviation (deg)")
-      ->capture_default_str()->check(CLI::PositiveNumber);
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
 }
 
 }  // namespace
@@ -43,31 +69,158 @@ int main(int argc, char** argv) {
 
   fitcal::tools::FitCommandOptions fit;
   AddFitOptions(app, fit);
-  CLI::App* fit_cmd = app.add_subcommand("fit", "Fit, validate on held-out repetitions, write the calibrated YAML (default)");
+  fitcal::tools::AsocCommands asoc_commands;  // asoc-simulate, asoc-geometric, asoc-tables
+  asoc_commands.Register(app);
+  CLI::App* fit_cmd = app.add_subcommand(
+      "fit", "Fit, validate on held-out repetitions, write the calibrated YAML (default)");
   fit_cmd->fallthrough();
 
   fitcal::tools::SimulateCommandOptions simulate;
-  CLI::App* sim_cmd = app.add_subcommand("simulate", "Write a simulated flower data set (docs/simulator.md)");
+  CLI::App* sim_cmd = app.add_subcommand(
+      "simulate", "Write a simulated flower data set (README.md, section Simulator)");
   sim_cmd->add_option("--out", simulate.out, "Output data set directory")->required();
   sim_cmd->add_option("--robot", simulate.robot, "Nominal robot YAML (commands and fit start)")
-      ->capture_default_str()->check(CLI::ExistingFile);
-  sim_cmd->add_option("--truth", simulate.truth, "Robot YAML of the true robot (default: Palacin Table 5)")
+      ->capture_default_str()
+      ->check(CLI::ExistingFile);
+  sim_cmd
+      ->add_option("--truth", simulate.truth,
+                   "Robot YAML of the true robot (default: Palacin Table 5)")
       ->check(CLI::ExistingFile);
   sim_cmd->add_option("--repetitions", simulate.sim.repetitions, "Repetitions of each trajectory")
-      ->capture_default_str()->check(CLI::PositiveNumber);
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   sim_cmd->add_option("--seed", simulate.sim.seed, "Random seed")->capture_default_str();
-  sim_cmd->add_option("--encoder-counts-per-rev", simulate.sim.encoder_counts_per_rev,
-                      "Encoder resolution")->capture_default_str();
-  sim_cmd->add_option("--gt-position-sigma-m", simulate.sim.gt_position_sigma_m,
-                      "Ground-truth position noise (m)")->capture_default_str();
+  sim_cmd
+      ->add_option("--encoder-counts-per-rev", simulate.sim.encoder_counts_per_rev,
+                   "Encoder resolution")
+      ->capture_default_str();
+  sim_cmd
+      ->add_option("--gt-position-sigma-m", simulate.sim.gt_position_sigma_m,
+                   "Ground-truth position noise (m)")
+      ->capture_default_str();
   double gt_heading_sigma_deg = simulate.sim.gt_heading_sigma_rad * 180.0 / M_PI;
-  sim_cmd->add_option("--gt-heading-sigma-deg", gt_heading_sigma_deg, "Ground-truth heading noise (deg)")
+  sim_cmd
+      ->add_option("--gt-heading-sigma-deg", gt_heading_sigma_deg,
+                   "Ground-truth heading noise (deg)")
       ->capture_default_str();
   sim_cmd->add_option("--slip-sigma", simulate.sim.slip_sigma, "Relative wheel slip noise")
       ->capture_default_str();
   sim_cmd->add_flag("--force", simulate.force, "Overwrite an existing data set");
+  sim_cmd->add_option(
+      "--inject", simulate.inject,
+      "Inject a library effect, name=value[,value] (odometry/effects.h); repeatable; "
+      "the data set does not name it");
+
+  fitcal::tools::ImportOptiOdomOptions import_optiodom;
+  CLI::App* import_cmd =
+      app.add_subcommand("import", "Convert published recordings into a fitcal data set");
+  import_cmd->require_subcommand(1);
+  CLI::App* optiodom_cmd = import_cmd->add_subcommand(
+      "optiodom", "OptiOdom omni3 sessions (Sousa et al. 2022; see tools/import_optiodom.h)");
+  optiodom_cmd->add_option("sessions", import_optiodom.sessions, "Session directories")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  optiodom_cmd->add_option("--out", import_optiodom.out, "Output data set directory")->required();
+  optiodom_cmd->add_flag("--force", import_optiodom.force, "Overwrite an existing data set");
+  optiodom_cmd->add_flag("--skip-mapping-check", import_optiodom.skip_mapping_check,
+                         "Write even if another wheel order/sign explains the ground truth better");
+
+  fitcal::tools::GeneraliseCommandOptions generalise;
+  CLI::App* gen_cmd = app.add_subcommand(
+      "generalise",
+      "Train on one path type / session, test on the others (tools/generalisation_command.h)");
+  gen_cmd->add_option("--logs", generalise.logs, "Data set directory")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  gen_cmd
+      ->add_option("--segment-length-m", generalise.segment_length_m,
+                   "Ground-truth path length of a segment-cost window (m)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  gen_cmd->add_flag("!--no-clock-map", generalise.clock_map,
+                    "Do not refine the ground-truth clock before cutting segments");
+  gen_cmd->add_flag("!--no-loso", generalise.leave_one_session_out, "Skip leave-one-session-out");
+  gen_cmd->add_option("--threads", generalise.threads, "Worker threads (0 = all cores)");
+  gen_cmd->add_option("--train-trajectories", generalise.train_trajectories,
+                      "Train on labels matching (list or regular expression), test on the rest, "
+                      "and the other way round");
+  gen_cmd
+      ->add_option("--effects", generalise.effects,
+                   "Library effects to add as a further model (nine + effects, track cost)")
+      ->delimiter(',');
+
+  fitcal::tools::ReportCommandOptions report;
+  CLI::App* report_cmd = app.add_subcommand(
+      "report", "Validation report of a calibration: index.html, summary.md, metrics.csv/json");
+  report_cmd->add_option("--logs", report.logs, "Data set directory")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  report_cmd->add_option("--calibration", report.calibration, "Calibrated robot YAML (from fit)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  report_cmd->add_option("--out", report.out, "Output directory for the report")->required();
+  report_cmd->add_option("--train-reps", report.train_reps,
+                         "Training repetitions (default: as recorded in the calibration YAML)");
+  report_cmd
+      ->add_option("--sampling", report.sampling,
+                   "Odometry at ground-truth times: nearest (default, as the paper) or linear")
+      ->capture_default_str();
+  report_cmd->add_flag("--cv", report.cross_validate,
+                       "Also run leave-one-repetition-out cross-validation");
+  report_cmd->add_flag("--allow-outside-paths", report.allow_outside_paths,
+                       "Allow dataset.yaml paths outside the data set directory");
+  report_cmd->add_option("--threads", report.threads, "Worker threads (0 = all cores)");
+
+  fitcal::tools::CompareCommandOptions compare;
+  CLI::App* compare_cmd = app.add_subcommand(
+      "compare", "Palacin Table 4 on your data: strategies x methods x {1, 5} repetitions");
+  compare_cmd->add_option("--logs", compare.logs, "Data set directory")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  compare_cmd
+      ->add_option("--strategies", compare.strategies,
+                   "STA..STE or trajectory lists such as R1,R5,G4 or B1-B12 (one per item)")
+      ->capture_default_str();
+  compare_cmd
+      ->add_option("--methods", compare.methods,
+                   "Methods (" + fitcal::tools::FitMethodNames() + ") or all")
+      ->capture_default_str();
+  compare_cmd
+      ->add_option("--repetitions", compare.repetitions,
+                   "Train on the first k repetitions, for each k")
+      ->capture_default_str();
+  compare_cmd->add_option("--validation-reps", compare.validation_reps,
+                          "Validation repetitions (default: those after the largest k)");
+  compare_cmd
+      ->add_option("--out", compare.out, "Output prefix: <out>.csv, <out>.md, <out>_trace.csv")
+      ->capture_default_str();
+  compare_cmd->add_flag("--no-output", compare.no_output, "Print the table only");
+  compare_cmd->add_flag("--quiet", compare.quiet, "No progress on stderr");
+  compare_cmd->add_option("--seed", compare.seed, "NLopt random seed")->capture_default_str();
+  compare_cmd->add_option("--max-evaluations", compare.max_evaluations, "NLopt budget per fit")
+      ->capture_default_str();
+  compare_cmd->add_flag("--polish", compare.polish, "NLopt global methods: SLSQP polish");
+  compare_cmd->add_option("--objective", compare.objective,
+                          "squares or eq14 (default: per method)");
+  compare_cmd->add_option("--threads", compare.threads, "Worker threads (0 = all cores)");
+  compare_cmd->add_flag("--allow-outside-paths", compare.allow_outside_paths,
+                        "Allow dataset.yaml paths outside the data set directory");
+
+  fitcal::tools::DiagnoseCommandOptions diagnose;
+  CLI::App* diagnose_cmd = fitcal::tools::AddDiagnoseCommand(app, diagnose);
 
   CLI11_PARSE(app, argc, argv);
+
+  if (diagnose_cmd->parsed()) return fitcal::tools::RunDiagnoseCommand(diagnose);
+
+  if (compare_cmd->parsed()) return fitcal::tools::RunCompareCommand(compare);
+
+  if (report_cmd->parsed()) return fitcal::tools::RunReportCommand(report);
+  if (const int asoc_rc = asoc_commands.Dispatch(app); asoc_rc >= 0) return asoc_rc;
+
+  if (gen_cmd->parsed()) return fitcal::tools::RunGeneraliseCommand(generalise);
+
+  if (optiodom_cmd->parsed()) return fitcal::tools::RunImportOptiOdomCommand(import_optiodom);
 
   if (app.got_subcommand(sim_cmd)) {
     simulate.sim.gt_heading_sigma_rad = gt_heading_sigma_deg * M_PI / 180.0;

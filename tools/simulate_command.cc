@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <stdexcept>
 
 #include "io/atomic_file.h"
 #include "io/dataset.h"
@@ -14,12 +15,53 @@ namespace fitcal::tools {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// "name=v1[,v2]" -> an effect of the registry with its values, checked against its bounds.
+effects::EffectValue ParseInjectedEffect(const std::string& text) {
+  const std::size_t eq = text.find('=');
+  if (eq == std::string::npos)
+    throw std::invalid_argument("--inject '" + text + "': expected name=value[,value]");
+  effects::EffectValue e;
+  e.id = effects::EffectIdFromName(text.substr(0, eq));
+  const effects::EffectInfo& info = effects::Info(e.id);
+  std::string rest = text.substr(eq + 1);
+  for (int k = 0; k < info.num_parameters; ++k) {
+    const std::size_t comma = rest.find(',');
+    const std::string item = rest.substr(0, comma);
+    std::size_t used = 0;
+    try {
+      e.value[k] = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size() ||
+        !(e.value[k] >= info.lower[k] && e.value[k] <= info.upper[k])) {
+      throw std::invalid_argument("--inject '" + text + "': " + info.parameter_names[k] +
+                                  " must be a number in [" + std::to_string(info.lower[k]) + ", " +
+                                  std::to_string(info.upper[k]) + "]");
+    }
+    rest = comma == std::string::npos ? "" : rest.substr(comma + 1);
+    if (k + 1 < info.num_parameters && comma == std::string::npos) {
+      throw std::invalid_argument("--inject '" + text + "': " + info.name + " takes " +
+                                  std::to_string(info.num_parameters) + " values");
+    }
+  }
+  if (!rest.empty()) throw std::invalid_argument("--inject '" + text + "': too many values");
+  return e;
+}
+
+}  // namespace
+
 int RunSimulateCommand(const SimulateCommandOptions& options) {
   try {
     const Omni3Robot nominal = io::ReadOmni3Robot(options.robot);
     sim::Omni3SimulationOptions sim_options = options.sim;
     sim_options.commanded_robot = nominal.nominal;
     if (!options.truth.empty()) sim_options.true_robot = io::ReadOmni3Robot(options.truth).nominal;
+    for (const std::string& text : options.inject) {
+      sim_options.injected_effects.push_back(ParseInjectedEffect(text));
+    }
 
     if (fs::exists(fs::path(options.out) / "dataset.yaml") && !options.force) {
       std::cerr << "fitcal: " << options.out
@@ -38,7 +80,8 @@ int RunSimulateCommand(const SimulateCommandOptions& options) {
       e.repetition = log.repetition;
       e.encoders = "runs/" + log.id + "_encoders.csv";
       e.ground_truth = "runs/" + log.id + "_ground_truth.csv";
-      io::WriteFileAtomically((fs::path(options.out) / e.encoders).string(), io::EncoderCsv(log.encoders));
+      io::WriteFileAtomically((fs::path(options.out) / e.encoders).string(),
+                              io::EncoderCsv(log.encoders));
       io::WriteFileAtomically((fs::path(options.out) / e.ground_truth).string(),
                               io::GroundTruthCsv(log.ground_truth));
     });
@@ -47,8 +90,8 @@ int RunSimulateCommand(const SimulateCommandOptions& options) {
     // dataset.yaml last: a data set is only complete once it exists.
     io::WriteFileAtomically((fs::path(options.out) / "dataset.yaml").string(),
                             io::DatasetYaml("robot.yaml", entries));
-    std::printf("wrote %zu runs (%zu trajectories x %d repetitions, seed %llu) to %s\n", runs.size(),
-                sim_options.trajectories.size(), sim_options.repetitions,
+    std::printf("wrote %zu runs (%zu trajectories x %d repetitions, seed %llu) to %s\n",
+                runs.size(), sim_options.trajectories.size(), sim_options.repetitions,
                 static_cast<unsigned long long>(sim_options.seed), options.out.c_str());
     return 0;
   } catch (const std::exception& e) {

@@ -19,7 +19,8 @@ struct MotionCommand {
 
 // Table A1 in its printed order (R1..R12, G1..G12, B1..B12); speed_m_s and omega_abs_rad_s let
 // the simulator record the same flower at another speed.
-std::vector<MotionCommand> FlowerTrajectories(double speed_m_s = 0.35, double omega_abs_rad_s = 0.35,
+std::vector<MotionCommand> FlowerTrajectories(double speed_m_s = 0.35,
+                                              double omega_abs_rad_s = 0.35,
                                               double distance_m = 1.0);
 
 }  // namespace fitcal::sim

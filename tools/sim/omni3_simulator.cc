@@ -46,7 +46,9 @@ omni3::Parameters Make(double r_a, double r_b, double r_c, double wr_a, double w
 }
 
 void Validate(const Omni3SimulationOptions& o) {
-  const auto fail = [](const char* what) { throw std::invalid_argument(std::string("simulation: ") + what); };
+  const auto fail = [](const char* what) {
+    throw std::invalid_argument(std::string("simulation: ") + what);
+  };
   if (o.repetitions < 1) fail("repetitions must be >= 1");
   if (o.trajectories.empty()) fail("no trajectories");
   if (!(o.encoder_period_s > 0.0)) fail("encoder_period_s must be > 0");
@@ -62,9 +64,11 @@ void Validate(const Omni3SimulationOptions& o) {
     fail("ground-truth period must satisfy 0 < min <= max");
   }
   if (!(o.slip_sigma >= 0.0 && o.slip_correlation_time_s > 0.0)) fail("bad slip model");
-  if (!(o.gt_position_sigma_m >= 0.0 && o.gt_heading_sigma_rad >= 0.0)) fail("negative noise sigma");
+  if (!(o.gt_position_sigma_m >= 0.0 && o.gt_heading_sigma_rad >= 0.0))
+    fail("negative noise sigma");
   for (const MotionCommand& c : o.trajectories) {
-    if (!(c.speed_m_s > 0.0 && c.distance_m > 0.0)) fail("trajectory needs speed > 0 and distance > 0");
+    if (!(c.speed_m_s > 0.0 && c.distance_m > 0.0))
+      fail("trajectory needs speed > 0 and distance > 0");
   }
 }
 
@@ -102,10 +106,18 @@ SimulatedRun SimulateRun(const Omni3SimulationOptions& o, const MotionCommand& c
   Eigen::Vector3d slip(o.slip_sigma * rng.Gaussian(), o.slip_sigma * rng.Gaussian(),
                        o.slip_sigma * rng.Gaussian());
 
+  // Injected effects (see the header); the time offset only moves ground-truth stamps.
+  std::vector<effects::ActiveEffect<double>> active;
+  for (const auto& e : o.injected_effects) active.push_back({e.id, e.value.data()});
+  const auto& table = effects::EffectOpsTable<double>();
+  const double latency_s = effects::TotalLatency(active);
+  const bool injecting = !active.empty() || static_cast<bool>(o.injection_hook);
+
   // Sample schedules: encoders every period with jitter; ground truth at irregular intervals,
   // starting within one period after the encoders.
   const auto encoder_time = [&](int k) {
-    return k * o.encoder_period_s + (k == 0 ? 0.0 : rng.Uniform(-o.encoder_jitter_s, o.encoder_jitter_s));
+    return k * o.encoder_period_s +
+           (k == 0 ? 0.0 : rng.Uniform(-o.encoder_jitter_s, o.encoder_jitter_s));
   };
   int next_encoder = 0;
   double next_encoder_t = encoder_time(0);
@@ -117,11 +129,13 @@ SimulatedRun SimulateRun(const Omni3SimulationOptions& o, const MotionCommand& c
     // Encoder: counts latched at t.
     while (next_encoder_t <= t + 1e-12 && next_encoder_t <= t_end + 1e-12) {
       std::int64_t counts[3];
-      for (int i = 0; i < 3; ++i) counts[i] = static_cast<std::int64_t>(std::floor(angle[i] / count_rad));
+      for (int i = 0; i < 3; ++i)
+        counts[i] = static_cast<std::int64_t>(std::floor(angle[i] / count_rad));
       if (next_encoder > 0) {
         WheelSample s;
         s.dt_s = t - last_encoder_t;
-        for (int i = 0; i < 3; ++i) s.rate_rad_s[i] = (counts[i] - last_counts[i]) * count_rad / s.dt_s;
+        for (int i = 0; i < 3; ++i)
+          s.rate_rad_s[i] = (counts[i] - last_counts[i]) * count_rad / s.dt_s;
         log.encoders.samples.push_back(s);
       }
       log.encoders.t_s.push_back(t);
@@ -132,7 +146,7 @@ SimulatedRun SimulateRun(const Omni3SimulationOptions& o, const MotionCommand& c
       if (next_encoder_t <= t) next_encoder_t = t + h;  // jitter never reorders samples
     }
     while (next_gt_t <= t + 1e-12) {
-      log.ground_truth.t_s.push_back(t);
+      log.ground_truth.t_s.push_back(t + latency_s);
       log.ground_truth.world_T_robot.push_back(
           Pose2d{p.x + o.gt_position_sigma_m * rng.Gaussian(),
                  p.y + o.gt_position_sigma_m * rng.Gaussian(),
@@ -146,14 +160,45 @@ SimulatedRun SimulateRun(const Omni3SimulationOptions& o, const MotionCommand& c
   for (long n = 0; n < steps; ++n) {
     const double t = n * h;
     const double t_mid = t + 0.5 * h;
-    const Eigen::Vector3d goal = (t_mid >= move_begin && t_mid < move_end) ? target : Eigen::Vector3d::Zero();
+    const Eigen::Vector3d goal =
+        (t_mid >= move_begin && t_mid < move_end) ? target : Eigen::Vector3d::Zero();
     wheel_rate += lag * (goal - wheel_rate);
     for (int i = 0; i < 3; ++i) slip[i] = slip_decay * slip[i] + slip_kick * rng.Gaussian();
-    const Eigen::Vector3d contact = wheel_rate.cwiseProduct(Eigen::Vector3d::Ones() + slip);
-    const Eigen::Vector3d v = m_inv_true * contact;
+    const Eigen::Vector3d wheel_accel = (goal - wheel_rate) * (lag / (1.0 - lag) / h);
+    Eigen::Vector3d contact = wheel_rate.cwiseProduct(Eigen::Vector3d::Ones() + slip);
+    Eigen::Vector3d v;
+    Eigen::Vector2d v_world = Eigen::Vector2d::Zero();
+    if (injecting) {
+      effects::SampleContext c;
+      c.t_s = t;
+      c.dt_s = h;
+      for (int i = 0; i < 3; ++i) {
+        c.angle_rad[i] = wheel_angle[i];
+        c.accel_rad_s2[i] = wheel_accel[i];
+        c.moving = c.moving || std::abs(wheel_rate[i]) > effects::kMovingRateRadS;
+      }
+      effects::ApplyRateEffects(active, c, contact.data());
+      v = m_inv_true * contact;
+      for (const auto& e : active) {
+        const auto& ops = table[static_cast<int>(e.id)];
+        if (ops.body != nullptr) ops.body(e.q, c, v.data());
+        if (ops.world != nullptr) ops.world(e.q, c, v_world.data());
+      }
+      if (o.injection_hook) {
+        Omni3SimulationOptions::InjectionState state;
+        state.t_s = t;
+        state.time_since_motion_s = t_mid >= move_begin ? t - move_begin : -1.0;
+        state.wheel_rate = wheel_rate;
+        state.wheel_angle_rad = wheel_angle;
+        state.pose = pose;
+        o.injection_hook(state, &contact, &v, &v_world);
+      }
+    } else {
+      v = m_inv_true * contact;
+    }
     const double heading_mid = pose.theta + 0.5 * h * v[2];
-    pose.x += h * (std::cos(heading_mid) * v[0] - std::sin(heading_mid) * v[1]);
-    pose.y += h * (std::sin(heading_mid) * v[0] + std::cos(heading_mid) * v[1]);
+    pose.x += h * (std::cos(heading_mid) * v[0] - std::sin(heading_mid) * v[1] + v_world[0]);
+    pose.y += h * (std::sin(heading_mid) * v[0] + std::cos(heading_mid) * v[1] + v_world[1]);
     pose.theta += h * v[2];
     wheel_angle += h * wheel_rate;
     latch((n + 1) * h, wheel_angle, pose);
@@ -171,6 +216,16 @@ omni3::Parameters PalacinTable5Parameters() {
 
 omni3::Parameters PalacinNominalParameters() {
   return Make(0.195, 0.195, 0.195, 0.148, 0.148, 0.148, 60.0, 180.0, 300.0);
+}
+
+Omni3Robot PalacinApr02Robot() {
+  Omni3Robot robot;
+  robot.name = "apr02";
+  robot.nominal = PalacinNominalParameters();
+  robot.bounds.distance_m = {0.170, 0.220};  // Palacin Eq. 16
+  robot.bounds.radius_m = {0.138, 0.158};
+  robot.bounds.angle_offset_rad = {-2.0 * M_PI / 180.0, 2.0 * M_PI / 180.0};
+  return robot;
 }
 
 std::vector<SimulatedRun> SimulateOmni3(const Omni3SimulationOptions& options) {

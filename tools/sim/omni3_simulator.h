@@ -1,5 +1,6 @@
 #pragma once
-// Simulated calibration runs of a three-wheeled omni robot. The noise model (docs/simulator.md):
+// Simulated calibration runs of a three-wheeled omni robot. The noise model (also in README.md,
+// "Simulator"):
 //
 // - The wheel controller turns a motion command into target wheel rates with the *commanded*
 //   (nominal) parameters, Eq. 1; each wheel follows its target through a first-order lag with
@@ -17,10 +18,14 @@
 // Reproducible: run i of a simulation draws from its own generator seeded by (seed, i), so the
 // output does not depend on thread count or platform.
 
+#include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
+#include "odometry/effects.h"
 #include "odometry/omni3_model.h"
+#include "odometry/robot_description.h"
 #include "odometry/run_log.h"
 #include "tools/sim/flower_trajectories.h"
 
@@ -30,6 +35,8 @@ namespace fitcal::sim {
 omni3::Parameters PalacinTable5Parameters();
 // Palacin Eq. 15: the nominal parameters.
 omni3::Parameters PalacinNominalParameters();
+// APR-02 as data/robots/apr02.yaml describes it: Eq. 15 nominal, Eq. 16 bounds.
+Omni3Robot PalacinApr02Robot();
 
 struct Omni3SimulationOptions {
   omni3::Parameters true_robot = PalacinTable5Parameters();
@@ -55,11 +62,29 @@ struct Omni3SimulationOptions {
   double gt_heading_sigma_rad = 0.2 * M_PI / 180.0;
 
   double start_position_range_m = 2.0;
+
+  // Effects the nine parameters lack (issue 6); the written data set names none of them.
+  // Library effects (odometry/effects.h) act at every substep with the true wheel state: rate
+  // effects on the contact rates, body effects on M_true^-1 * contact, world effects added to
+  // the world velocity, and the time offset shifts every ground-truth stamp by +latency.
+  std::vector<effects::EffectValue> injected_effects;
+  // Anything else: called at every substep after the library effects; may change the contact
+  // rates (rad/s), the robot-frame velocity (vx, vy, omega) and the additive world velocity.
+  struct InjectionState {
+    double t_s = 0.0;                   // since the run's start
+    double time_since_motion_s = -1.0;  // < 0 before the motion command starts
+    Eigen::Vector3d wheel_rate = Eigen::Vector3d::Zero();
+    Eigen::Vector3d wheel_angle_rad = Eigen::Vector3d::Zero();
+    Pose2d pose;
+  };
+  std::function<void(const InjectionState&, Eigen::Vector3d* contact_rate, Eigen::Vector3d* v_body,
+                     Eigen::Vector2d* v_world)>
+      injection_hook;
 };
 
 struct SimulatedRun {
-  RunLog log;                 // what a recorder would have written
-  Pose2d true_final_pose;     // noise-free truth at the last encoder time
+  RunLog log;              // what a recorder would have written
+  Pose2d true_final_pose;  // noise-free truth at the last encoder time
 };
 
 // All trajectories x repetitions, ordered by repetition then trajectory. Ids are

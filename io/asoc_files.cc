@@ -1,0 +1,241 @@
+#include "io/asoc_files.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <cstdio>
+#include <set>
+
+#include "io/input_error.h"
+#include "io/log_files.h"
+#include "io/text_file.h"
+#include "io/yaml_reader.h"
+#include "odometry/parallel_for.h"
+#include "odometry/pose2.h"
+
+namespace fitcal::io {
+
+namespace {
+
+constexpr int kColumns = 10;
+const char* const kHeader[kColumns] = {"t",        "wheel_1a", "wheel_1b", "wheel_2a", "wheel_2b",
+                                       "wheel_3a", "wheel_3b", "pivot_1",  "pivot_2",  "pivot_3"};
+
+int LineOf(const YAML::Node& node) { return node.Mark().line + 1; }
+
+std::string ExpectedHeader() {
+  std::string h;
+  for (const char* name : kHeader) h += (h.empty() ? "" : ",") + std::string(name);
+  return h;
+}
+
+}  // namespace
+
+asoc::EncoderLog ReadAsocEncoderCsv(const std::string& path) {
+  const std::string text = ReadTextFile(path);
+  LineScanner scanner(text);
+  std::string_view line;
+  while (scanner.Next(&line) && Trim(line).empty()) {
+  }
+  if (Trim(line).empty()) throw InputError(InputErrorKind::kEmptyFile, path, 0, "file is empty");
+  {
+    std::string header;
+    std::size_t pos = 0;
+    while (pos <= line.size()) {
+      std::size_t end = line.find(',', pos);
+      if (end == std::string_view::npos) end = line.size();
+      header += (header.empty() ? "" : ",") + std::string(Trim(line.substr(pos, end - pos)));
+      pos = end + 1;
+    }
+    if (header != ExpectedHeader()) {
+      throw InputError(
+          InputErrorKind::kBadHeader, path, scanner.line_number(),
+          "header must be '" + ExpectedHeader() + "', found '" + std::string(line) + "'");
+    }
+  }
+  asoc::EncoderLog log;
+  while (scanner.Next(&line)) {
+    if (Trim(line).empty()) continue;
+    const int n = scanner.line_number();
+    double v[kColumns];
+    int count = 0;
+    std::size_t pos = 0;
+    while (pos <= line.size()) {
+      std::size_t end = line.find(',', pos);
+      if (end == std::string_view::npos) end = line.size();
+      if (count >= kColumns) {
+        throw InputError(InputErrorKind::kWrongColumnCount, path, n,
+                         "expected " + std::to_string(kColumns) + " fields, found more");
+      }
+      const std::string_view field = line.substr(pos, end - pos);
+      bool finite = true;
+      if (!ParseDouble(field, &v[count], &finite)) {
+        throw InputError(
+            InputErrorKind::kNonNumeric, path, n,
+            std::string(kHeader[count]) + " is not a number: '" + std::string(Trim(field)) + "'");
+      }
+      if (!finite) {
+        throw InputError(
+            InputErrorKind::kNonFinite, path, n,
+            std::string(kHeader[count]) + " is not finite: '" + std::string(Trim(field)) + "'");
+      }
+      ++count;
+      pos = end + 1;
+    }
+    if (count != kColumns) {
+      throw InputError(
+          InputErrorKind::kWrongColumnCount, path, n,
+          "expected " + std::to_string(kColumns) + " fields, found " + std::to_string(count));
+    }
+    if (!log.t_s.empty() && !(v[0] > log.t_s.back())) {
+      throw InputError(InputErrorKind::kNonIncreasingTime, path, n,
+                       "time " + std::to_string(v[0]) + " s is not after the previous row's " +
+                           std::to_string(log.t_s.back()) + " s");
+    }
+    asoc::EncoderSample s;
+    for (int i = 0; i < asoc::kNumCastors; ++i) {
+      s.wheel_rad[i][0] = v[1 + 2 * i];
+      s.wheel_rad[i][1] = v[2 + 2 * i];
+      s.pivot_rad[i] = v[7 + i];
+    }
+    log.t_s.push_back(v[0]);
+    log.samples.push_back(s);
+  }
+  if (log.t_s.size() < 2) {
+    throw InputError(InputErrorKind::kTooFewSamples, path, scanner.line_number(),
+                     "an encoder log needs at least two rows");
+  }
+  return log;
+}
+
+std::string AsocEncoderCsv(const asoc::EncoderLog& log) {
+  std::string out = ExpectedHeader() + "\n";
+  char line[400];
+  for (std::size_t k = 0; k < log.t_s.size(); ++k) {
+    const asoc::EncoderSample& s = log.samples[k];
+    const int n = std::snprintf(
+        line, sizeof line, "%.6f,%.12g,%.12g,%.12g,%.12g,%.12g,%.12g,%.12g,%.12g,%.12g\n",
+        log.t_s[k], s.wheel_rad[0][0], s.wheel_rad[0][1], s.wheel_rad[1][0], s.wheel_rad[1][1],
+        s.wheel_rad[2][0], s.wheel_rad[2][1], s.pivot_rad[0], s.pivot_rad[1], s.pivot_rad[2]);
+    out.append(line, static_cast<std::size_t>(n));
+  }
+  return out;
+}
+
+AsocRobot ReadAsocRobot(const std::string& path) {
+  const YAML::Node root = LoadYamlFile(path);
+  YamlMap map(root, path, "robot");
+  const std::string model = map.String("model");
+  if (model != "asoc") {
+    throw InputError(InputErrorKind::kUnknownModel, path, map.line(map.Required("model")),
+                     "model '" + model + "' is not asoc");
+  }
+  AsocRobot robot;
+  robot.name = map.String("name");
+  robot.pivot_distance_m = map.Double("pivot_distance_m");
+  if (!(robot.pivot_distance_m > 0.0)) {
+    throw InputError(InputErrorKind::kBadValue, path, map.line(map.Required("pivot_distance_m")),
+                     "pivot_distance_m must be positive");
+  }
+  const YAML::Node castors = map.Required("castors");
+  ExpectYamlType(castors, YAML::NodeType::Sequence, path, "robot.castors");
+  if (castors.size() != asoc::kNumCastors) {
+    throw InputError(InputErrorKind::kBadValue, path, LineOf(castors),
+                     "an asoc robot has 3 castors, found " + std::to_string(castors.size()));
+  }
+  std::set<std::string> names;
+  for (int i = 0; i < asoc::kNumCastors; ++i) {
+    const std::string what = "castor " + std::to_string(i + 1);
+    YamlMap c(castors[i], path, what);
+    robot.castor_names[i] = c.String("name");
+    if (!names.insert(robot.castor_names[i]).second) {
+      throw InputError(InputErrorKind::kBadValue, path, LineOf(castors[i]),
+                       "castor name '" + robot.castor_names[i] + "' is used twice");
+    }
+    robot.nominal.pivots[i] = {c.Double("pivot_radius_m"), DegToRad(c.Double("pivot_angle_deg"))};
+    asoc::CastorParameters& p = robot.nominal.castors[i];
+    p.offset_m = c.Double("offset_m");
+    const auto radius = c.Pair("wheel_radius_m");
+    const auto offset = c.Pair("wheel_offset_m");
+    p.wheel_radius_m = {radius.first, radius.second};
+    p.wheel_offset_m = {offset.first, offset.second};
+    p.encoder_bias_rad = DegToRad(c.Double("encoder_bias_deg"));
+    c.RejectUnread();
+    if (!(robot.nominal.pivots[i].radius_m >= 0.0) || !(p.offset_m > 0.0) ||
+        !(p.wheel_radius_m[0] > 0.0) || !(p.wheel_radius_m[1] > 0.0) ||
+        !(p.wheel_offset_m[0] + p.wheel_offset_m[1] > 0.0)) {
+      throw InputError(InputErrorKind::kBadValue, path, LineOf(castors[i]),
+                       what +
+                           ": pivot_radius_m >= 0, offset_m > 0, wheel radii > 0 and a "
+                           "positive axle length (sum of wheel_offset_m) are required");
+    }
+  }
+  // Doebbler's calibration assumes every pair of pivots D apart; the layout must agree (1 mm).
+  for (int i = 0; i < asoc::kNumCastors; ++i) {
+    const int j = (i + 1) % asoc::kNumCastors;
+    const double d = robot.nominal.PivotDistance(i, j);
+    if (std::abs(d - robot.pivot_distance_m) > 1e-3) {
+      throw InputError(InputErrorKind::kBadValue, path, LineOf(castors[i]),
+                       "pivots of castors " + robot.castor_names[i] + " and " +
+                           robot.castor_names[j] + " are " + std::to_string(d) +
+                           " m apart, pivot_distance_m says " +
+                           std::to_string(robot.pivot_distance_m));
+    }
+  }
+  map.Optional("calibration");
+  map.RejectUnread();
+  return robot;
+}
+
+std::string AsocRobotYaml(const AsocRobot& robot, const std::string& calibration_yaml) {
+  YAML::Emitter out;
+  out.SetDoublePrecision(10);
+  out << YAML::BeginMap;
+  out << YAML::Key << "model" << YAML::Value << "asoc";
+  out << YAML::Key << "name" << YAML::Value << robot.name;
+  out << YAML::Key << "pivot_distance_m" << YAML::Value << robot.pivot_distance_m;
+  out << YAML::Key << "castors" << YAML::Value << YAML::BeginSeq;
+  for (int i = 0; i < asoc::kNumCastors; ++i) {
+    const asoc::CastorParameters& c = robot.nominal.castors[i];
+    out << YAML::Flow << YAML::BeginMap;
+    out << YAML::Key << "name" << YAML::Value << robot.castor_names[i];
+    out << YAML::Key << "pivot_radius_m" << YAML::Value << robot.nominal.pivots[i].radius_m;
+    out << YAML::Key << "pivot_angle_deg" << YAML::Value
+        << RadToDeg(robot.nominal.pivots[i].angle_rad);
+    out << YAML::Key << "offset_m" << YAML::Value << c.offset_m;
+    out << YAML::Key << "wheel_radius_m" << YAML::Value << YAML::Flow << YAML::BeginSeq
+        << c.wheel_radius_m[0] << c.wheel_radius_m[1] << YAML::EndSeq;
+    out << YAML::Key << "wheel_offset_m" << YAML::Value << YAML::Flow << YAML::BeginSeq
+        << c.wheel_offset_m[0] << c.wheel_offset_m[1] << YAML::EndSeq;
+    out << YAML::Key << "encoder_bias_deg" << YAML::Value << RadToDeg(c.encoder_bias_rad);
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+  out << YAML::EndMap;
+  std::string text = std::string(out.c_str()) + "\n";
+  if (!calibration_yaml.empty()) text += "calibration: " + calibration_yaml + "\n";
+  return text;
+}
+
+AsocDataset LoadAsocDataset(const std::string& directory, const DatasetOptions& options) {
+  const DatasetIndex index = ReadDatasetIndex(directory, options);
+  AsocDataset dataset;
+  dataset.directory = index.directory;
+  dataset.robot_path = index.robot_path;
+  dataset.runs.resize(index.runs.size());
+  ParallelFor(index.runs.size(), options.num_threads, [&](std::size_t i) {
+    const DatasetIndexEntry& entry = index.runs[i];
+    asoc::RunLog& log = dataset.runs[i];
+    log.id = entry.id;
+    log.trajectory = entry.trajectory;
+    log.repetition = entry.repetition;
+    log.start_pose = entry.start_pose;
+    log.encoders = ReadAsocEncoderCsv(entry.encoders_path);
+    log.ground_truth = ReadGroundTruth(entry.ground_truth_path);
+    CheckGroundTruthOverlap(log.ground_truth, log.encoders.t_s.front(), log.encoders.t_s.back(),
+                            entry.ground_truth_path);
+  });
+  return dataset;
+}
+
+}  // namespace fitcal::io

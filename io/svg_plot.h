@@ -1,0 +1,76 @@
+#pragma once
+// Small, self-contained SVG charts for the HTML report: x-y line/marker plots, grouped bar
+// charts and a heat map. The output is an inline <svg> element (no xmlns, no external fonts,
+// images or style sheets), so an HTML file that embeds it needs nothing else to display.
+// Every chart has a title, axis labels (the caller puts the unit in them: "x [m]") and a legend.
+
+#include <string>
+#include <vector>
+
+namespace fitcal::io {
+
+// Escapes &, <, >, " and ' for XML text and attribute values.
+std::string EscapeXml(const std::string& text);
+
+// "Nice" tick positions (1, 2, 5 x 10^n steps) covering [lo, hi], at most about max_ticks.
+std::vector<double> NiceTicks(double lo, double hi, int max_ticks = 7);
+
+struct Point2 {
+  double x = 0.0;
+  double y = 0.0;
+};
+
+// One legend entry; may hold several polylines (e.g. every validation run of a kind).
+struct SvgSeries {
+  std::string name;
+  std::string color = "#000000";
+  std::vector<std::vector<Point2>> lines;
+  bool draw_lines = true;
+  bool draw_markers = false;
+  double line_width = 1.5;
+  double marker_radius = 3.0;
+  double opacity = 1.0;
+  std::string dash;  // SVG stroke-dasharray, e.g. "4 3"; empty = solid
+};
+
+struct XYPlotOptions {
+  std::string title;
+  std::string x_label;
+  std::string y_label;
+  int width = 640;
+  int height = 440;
+  bool equal_aspect = false;  // one metre is as long on x as on y (trajectories)
+  bool include_origin = false;
+  // Unique id prefix within the embedding document (for the clip path); empty = a counter.
+  std::string id;
+  // Optional fixed ranges (used when lo < hi).
+  double x_lo = 0.0, x_hi = 0.0, y_lo = 0.0, y_hi = 0.0;
+};
+
+std::string XYPlotSvg(const XYPlotOptions& options, const std::vector<SvgSeries>& series);
+
+struct BarSeries {
+  std::string name;
+  std::string color;
+  std::vector<double> values;  // one per category
+};
+
+struct BarChartOptions {
+  std::string title;
+  std::string x_label;
+  std::string y_label;
+  int width = 1100;
+  int height = 360;
+};
+
+// Grouped bars: for each category one bar per series, side by side.
+std::string BarChartSvg(const BarChartOptions& options, const std::vector<std::string>& categories,
+                        const std::vector<BarSeries>& series);
+
+// Square matrix as coloured cells with the value printed in each: blue for lo, white for the
+// middle, red for hi; a colour bar explains the scale.
+std::string HeatMapSvg(const std::string& title, const std::vector<std::string>& labels,
+                       const std::vector<std::vector<double>>& values, double lo = -1.0,
+                       double hi = 1.0, int cell_px = 46);
+
+}  // namespace fitcal::io

@@ -1,0 +1,198 @@
+#include "odometry/effects.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace fitcal::effects {
+
+const std::array<EffectInfo, kNumEffects>& EffectTable() {
+  // Bounds are generous physical limits; "typical" is a realistic magnitude used by the
+  // simulator's examples and the tests.
+  static const std::array<EffectInfo, kNumEffects> table = {{
+      {EffectId::kTimeOffset,
+       "time_offset",
+       "latency between the ground-truth and encoder clocks",
+       "ground truth stamped t = pose at encoder time t - tau",
+       1,
+       {"latency_s", ""},
+       {-0.3, 0},
+       {0.3, 0},
+       {0.04, 0},
+       true,
+       "nothing in the final pose of runs that end at rest",
+       "none needed: the ground-truth track separates it"},
+      {EffectId::kWheelSpeedSlip,
+       "wheel_speed_slip",
+       "effective radius falls with wheel speed",
+       "w' = w (1 - k |w|)",
+       1,
+       {"slip_s_per_rad", ""},
+       {-0.05, 0},
+       {0.05, 0},
+       {0.01, 0},
+       true,
+       "a common wheel-radius scale when every run has the same speed",
+       "the flower at a second speed (e.g. 0.15 and 0.5 m/s)"},
+      {EffectId::kDirectionRadius,
+       "direction_radius",
+       "wheel radius differs forward and backward",
+       "w' = w (1 + a sign(w))",
+       1,
+       {"asymmetry", ""},
+       {-0.05, 0},
+       {0.05, 0},
+       {0.01, 0},
+       true,
+       "the wheel radii when every wheel turns one way only",
+       "runs in which each wheel turns both ways (the flower's R1-R12 do)"},
+      {EffectId::kAccelerationSlip,
+       "acceleration_slip",
+       "wheels slip during start/stop transients",
+       "w' = w (1 - c |dw/dt|)",
+       1,
+       {"slip_s2_per_rad", ""},
+       {-0.05, 0},
+       {0.05, 0},
+       {0.015, 0},
+       true,
+       "the radii when every run has the same speed profile",
+       "runs of different length or acceleration (the flower at a second distance)"},
+      {EffectId::kBacklash,
+       "backlash",
+       "gear backlash eaten at the start of a run",
+       "phi(A) = sign(A) max(0, |A| - beta)",
+       1,
+       {"backlash_rad", ""},
+       {0.0, 0},
+       {0.3, 0},
+       {0.06, 0},
+       true,
+       "the radii when every run has the same length",
+       "runs of a second length (e.g. 0.5 m and 2 m)"},
+      {EffectId::kFloorSlope,
+       "floor_slope",
+       "constant world-frame creep while moving",
+       "pose' += dt (cx, cy) while moving",
+       2,
+       {"creep_x_m_s", "creep_y_m_s"},
+       {-0.05, -0.05},
+       {0.05, 0.05},
+       {0.006, -0.004},
+       true,
+       "nothing when start headings vary",
+       "runs with different start headings in the same place"},
+      {EffectId::kYawRateSlip,
+       "yaw_rate_slip",
+       "body velocity slips with the yaw rate",
+       "v' = v (1 - k |omega|)",
+       1,
+       {"slip_s_per_rad", ""},
+       {-1.0, 0},
+       {1.0, 0},
+       {0.1, 0},
+       true,
+       "the distances R_i when every turning run has the same yaw rate",
+       "the flower at a second yaw rate"},
+      {EffectId::kOncePerRevolution,
+       "once_per_revolution",
+       "once-per-revolution encoder error (eccentric code wheel)",
+       "w' = w (1 + a cos A + b sin A)",
+       2,
+       {"cos_amplitude", "sin_amplitude"},
+       {-0.1, -0.1},
+       {0.1, 0.1},
+       {0.03, -0.02},
+       true,
+       "noise when runs are a whole number of revolutions",
+       "runs of fractional wheel revolutions"},
+      {EffectId::kEncoderClockScale,
+       "encoder_clock_scale",
+       "encoder clock runs fast or slow",
+       "w' = w (1 + s)",
+       1,
+       {"scale_error", ""},
+       {-0.05, 0},
+       {0.05, 0},
+       {0.01, 0},
+       false,
+       "a common scale of the three wheel radii, exactly, on any data",
+       "none: calibrate the clock against an external time reference"},
+      {EffectId::kTranslationYawGain,
+       "translation_yaw_gain",
+       "yaw rate scaled by the robot-frame translation (omni-wheel contact points shift)",
+       "omega' = omega (1 + g_x v_x + g_y v_y)",
+       2,
+       {"gain_x_s_per_m", "gain_y_s_per_m"},
+       {-0.5, -0.5},
+       {0.5, 0.5},
+       {0.08, -0.05},
+       true,
+       "the distances R_i when every turning run translates the same way in the robot frame",
+       "turning runs that translate in different robot-frame directions (e.g. circles driven "
+       "with two different headings relative to the path) and with both yaw-rate signs"},
+      {EffectId::kGroundTruthOffset,
+       "ground_truth_offset",
+       "tracked point offset from the kinematic centre (mocap/SLAM extrinsic)",
+       "v' = v + omega x e  (== R_i - e_x cos delta_i - e_y sin delta_i)",
+       2,
+       {"offset_x_m", "offset_y_m"},
+       {-0.1, -0.1},
+       {0.1, 0.1},
+       {0.02, -0.015},
+       false,
+       "the distances R_i, exactly (R_i' = R_i - e_x cos delta_i - e_y sin delta_i), on any data",
+       "none from odometry: measure the offset (or hold the R_i at measured values); fitted R_i "
+       "far from the measured ones with a common mean suggest it"},
+  }};
+  return table;
+}
+
+EffectId EffectIdFromName(const std::string& name) {
+  for (const EffectInfo& info : EffectTable()) {
+    if (name == info.name) return info.id;
+  }
+  std::string known;
+  for (const EffectInfo& info : EffectTable())
+    known += std::string(known.empty() ? "" : ", ") + info.name;
+  throw std::invalid_argument("unknown effect '" + name + "' (known: " + known + ")");
+}
+
+std::vector<SampleContext> MakeSampleContexts(const WheelSamples& samples) {
+  const std::size_t n = samples.size();
+  std::vector<SampleContext> out(n);
+  // Sample boundary times and cumulative encoder angles.
+  std::vector<double> t(n + 1, 0.0);
+  std::vector<std::array<double, 3>> angle(n + 1, {0.0, 0.0, 0.0});
+  for (std::size_t k = 0; k < n; ++k) {
+    t[k + 1] = t[k] + samples[k].dt_s;
+    for (int i = 0; i < 3; ++i)
+      angle[k + 1][i] = angle[k][i] + samples[k].rate_rad_s[i] * samples[k].dt_s;
+  }
+  // Angle at an arbitrary time by linear interpolation (clamped to the run).
+  const auto angle_at = [&](double time, int wheel) {
+    if (time <= t.front()) return angle.front()[wheel];
+    if (time >= t.back()) return angle.back()[wheel];
+    const std::size_t j =
+        static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), time) - t.begin()) - 1;
+    const double span = t[j + 1] - t[j];
+    const double f = span > 0.0 ? (time - t[j]) / span : 0.0;
+    return angle[j][wheel] + f * (angle[j + 1][wheel] - angle[j][wheel]);
+  };
+  const double h = kAccelerationWindowS;
+  for (std::size_t k = 0; k < n; ++k) {
+    SampleContext& c = out[k];
+    c.t_s = t[k];
+    c.dt_s = samples[k].dt_s;
+    const double mid = t[k] + 0.5 * c.dt_s;
+    for (int i = 0; i < 3; ++i) {
+      c.angle_rad[i] = angle[k][i];
+      const double ahead = (angle_at(mid + h, i) - angle_at(mid, i)) / h;
+      const double behind = (angle_at(mid, i) - angle_at(mid - h, i)) / h;
+      c.accel_rad_s2[i] = (ahead - behind) / h;
+      c.moving = c.moving || std::abs(samples[k].rate_rad_s[i]) > kMovingRateRadS;
+    }
+  }
+  return out;
+}
+
+}  // namespace fitcal::effects

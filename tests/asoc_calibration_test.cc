@@ -1,0 +1,167 @@
+// ASOC calibration: the closed form of Doebbler Eq. 1-9 and the Ceres final-pose fit.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "calib/asoc_ceres_fit.h"
+#include "calib/asoc_geometric.h"
+#include "io/asoc_files.h"
+#include "io/atomic_file.h"
+#include "io/input_error.h"
+#include "tools/sim/asoc_simulator.h"
+
+namespace fitcal::asoc {
+namespace {
+
+// Eq. 1-9 solved on exact (unquantised) measurements made from known parameters with Eq. 4-7
+// return those parameters to rounding.
+TEST(AsocGeometricTest, HoldPairInvertsEq4To7) {
+  const double D = 0.52, r_c = 0.081, r_w1 = 0.0405, r_w2 = 0.0398, d1 = 0.061, d2 = 0.0594;
+  const double beta = 0.1, theta_perp = -2.0;
+  const double G = std::asin(r_c / D), cg = D * std::cos(G);
+  HoldMeasurement m;
+  m.rotation_cw_rad = 4.0;
+  m.rotation_ccw_rad = 3.5;
+  m.wheel_cw_rad = {m.rotation_cw_rad * (cg + d1) / r_w1, m.rotation_cw_rad * (cg - d2) / r_w2};
+  m.wheel_ccw_rad = {m.rotation_ccw_rad * (cg - d1) / r_w1, m.rotation_ccw_rad * (cg + d2) / r_w2};
+  // Castor angles: theta_cw = theta_perp + Gamma, theta_ccw = theta_perp + 180 deg - Gamma; the
+  // encoder reads theta + beta (Eq. 1-2).
+  m.gamma_cw_rad = WrapAngle(theta_perp + G + beta);
+  m.gamma_ccw_rad = WrapAngle(theta_perp + M_PI - G + beta);
+  const CastorParameters c = SolveHoldPair(m, D, theta_perp);
+  EXPECT_NEAR(c.offset_m, r_c, 1e-15);
+  EXPECT_NEAR(c.wheel_radius_m[0], r_w1, 1e-15);
+  EXPECT_NEAR(c.wheel_radius_m[1], r_w2, 1e-15);
+  EXPECT_NEAR(c.wheel_offset_m[0], d1, 1e-15);
+  EXPECT_NEAR(c.wheel_offset_m[1], d2, 1e-15);
+  EXPECT_NEAR(c.encoder_bias_rad, beta, 1e-14);
+}
+
+// End to end: random vehicles drawn as Table I, the simulated manoeuvre with the prototype's
+// quantisation (wheels 0.3 deg, pivots 0.07 deg), the closed form. Tolerances from the
+// quantisation q = 0.07 deg = 1.22e-3 rad of the pivot encoders (which dominates):
+//   beta:  each steady reading is off by at most q/2, so |beta error| <= q/2 = 0.035 deg;
+//   r_c:   Gamma is off by at most q/2, so |dr_c / r_c| <= cot(Gamma) q/2 = 6.4 * 6.1e-4 = 0.39 %
+//          (Gamma = asin(0.08 / 0.52) = 8.9 deg) -> 0.5 %;
+//   r_w:   Delta theta over 270 deg of rotation is off by <= q, 2.6e-4 relative, plus
+//          tan(Gamma) q/2 = 1e-4 from D cos Gamma -> 0.05 %;
+//   d:     the same Delta theta error enters d with lever D / d = 8.7 -> 2.3e-3 -> 0.3 %.
+// The drawn errors are up to 4 % (r_w) and 16 deg (beta): a wrong sign or a swapped wheel in
+// Eq. 1-9 would miss by that much.
+TEST(AsocGeometricTest, RecoversSimulatedParametersToQuantisation) {
+  const Vehicle nominal = sim::AsocPrototypeVehicle();
+  std::mt19937_64 rng(21);
+  for (int set = 0; set < 4; ++set) {
+    const Vehicle truth = sim::DrawVehicle(nominal, sim::ParameterSpread{}, rng);
+    const auto runs = sim::SimulateCalibrationManoeuvre(truth, sim::AsocSimulationOptions{}, rng);
+    const GeometricResult result = CalibrateGeometric(runs, nominal);
+    ASSERT_TRUE(result.usable) << result.message;
+    for (int i = 0; i < kNumCastors; ++i) {
+      const CastorParameters& t = truth.castors[i];
+      const CastorParameters& e = result.estimate.castors[i];
+      EXPECT_EQ(result.num_estimates[i], 2);
+      EXPECT_NEAR(e.offset_m / t.offset_m, 1.0, 5e-3) << "castor " << i;
+      EXPECT_NEAR(e.encoder_bias_rad, t.encoder_bias_rad, 0.035 * M_PI / 180.0) << "castor " << i;
+      for (int k = 0; k < 2; ++k) {
+        EXPECT_NEAR(e.wheel_radius_m[k] / t.wheel_radius_m[k], 1.0, 5e-4) << "castor " << i;
+        EXPECT_NEAR(e.wheel_offset_m[k] / t.wheel_offset_m[k], 1.0, 3e-3) << "castor " << i;
+      }
+    }
+  }
+}
+
+TEST(AsocGeometricTest, MissingHoldRunsMakeTheResultUnusable) {
+  const Vehicle nominal = sim::AsocPrototypeVehicle();
+  std::mt19937_64 rng(2);
+  auto runs = sim::SimulateCalibrationManoeuvre(nominal, sim::AsocSimulationOptions{}, rng);
+  runs.resize(2);  // only castor 1 held: castors 2 and 3 get one estimate, castor 1 none
+  const GeometricResult result = CalibrateGeometric(runs, nominal);
+  EXPECT_FALSE(result.usable);
+  EXPECT_EQ(result.num_estimates[0], 0);
+  EXPECT_EQ(result.num_estimates[1], 1);
+}
+
+// The Ceres final-pose fit on random excursions (ground truth exact, encoders quantised) brings
+// the UMBmark validation error of a random vehicle down from the uncalibrated decimetres to the
+// level the closed form reaches (both limited by quantisation and 20 Hz discretisation, ~mm).
+TEST(AsocCeresFitTest, FinalPoseFitRecoversOdometry) {
+  const Vehicle nominal = sim::AsocPrototypeVehicle();
+  sim::ParameterSpread spread;
+  spread.bias_range_rad = 5.0 * M_PI / 180.0;
+  std::mt19937_64 rng(31);
+  const Vehicle truth = sim::DrawVehicle(nominal, spread, rng);
+  std::vector<AlignedAsocRun> training, validation;
+  for (int k = 0; k < 12; ++k) {
+    training.push_back(AlignAsocRun(sim::SimulateRandomExcursion(truth, {}, rng, 4)));
+  }
+  for (const RunLog& run : sim::SimulateUmbmark(truth, {}, rng, 1)) {
+    validation.push_back(AlignAsocRun(run));
+  }
+  AsocFitOptions options;
+  options.compute_covariance = false;
+  const AsocFitResult fit = FitAsocCeres(training, nominal, options);
+  ASSERT_TRUE(fit.usable) << fit.termination << ": " << fit.message;
+  const double before = AsocFinalPoseCf(nominal, validation);
+  const double after = AsocFinalPoseCf(fit.estimate, validation);
+  const double truth_cf = AsocFinalPoseCf(truth, validation);
+  EXPECT_GT(before, 0.05);
+  EXPECT_LT(after, 0.05 * before);
+  EXPECT_LT(after, truth_cf + 0.01);
+}
+
+std::string TempPath(const std::string& name) {
+  return std::string(FITCAL_BINARY_DIR) + "/asoc_io_test_" + name;
+}
+
+TEST(AsocFilesTest, RobotYamlRoundTrip) {
+  std::mt19937_64 rng(8);
+  io::AsocRobot robot;
+  robot.name = "proto";
+  robot.nominal = sim::DrawVehicle(sim::AsocPrototypeVehicle(), sim::ParameterSpread{}, rng);
+  robot.pivot_distance_m = robot.nominal.PivotDistance(0, 1);
+  robot.castor_names = {"front", "left", "right"};
+  const std::string path = TempPath("robot.yaml");
+  io::WriteFileAtomically(path, io::AsocRobotYaml(robot, "{method: test}"));
+  const io::AsocRobot back = io::ReadAsocRobot(path);
+  EXPECT_EQ(back.castor_names[1], "left");
+  const auto a = robot.nominal.ToArray(), b = back.nominal.ToArray();
+  // Ten significant digits are written: 1e-9 relative.
+  for (int k = 0; k < kNumParameters; ++k) EXPECT_NEAR(a[k], b[k], 1e-9 * (std::abs(a[k]) + 1e-3));
+}
+
+TEST(AsocFilesTest, EncoderCsvRoundTripAndBadInput) {
+  std::mt19937_64 rng(9);
+  const RunLog run = sim::SimulateUmbmark(sim::AsocPrototypeVehicle(), {}, rng, 1)[0];
+  const std::string path = TempPath("enc.csv");
+  io::WriteFileAtomically(path, io::AsocEncoderCsv(run.encoders));
+  const EncoderLog back = io::ReadAsocEncoderCsv(path);
+  ASSERT_EQ(back.samples.size(), run.encoders.samples.size());
+  EXPECT_NEAR(back.samples.back().wheel_rad[2][1], run.encoders.samples.back().wheel_rad[2][1],
+              1e-9);
+  EXPECT_NEAR(back.samples[100].pivot_rad[1], run.encoders.samples[100].pivot_rad[1], 1e-11);
+
+  const auto expect_error = [&](const std::string& text, io::InputErrorKind kind, int line) {
+    io::WriteFileAtomically(path, text);
+    try {
+      io::ReadAsocEncoderCsv(path);
+      ADD_FAILURE() << "no error for: " << text;
+    } catch (const io::InputError& e) {
+      EXPECT_EQ(e.kind(), kind) << e.what();
+      EXPECT_EQ(e.line(), line) << e.what();
+    }
+  };
+  const std::string header =
+      "t,wheel_1a,wheel_1b,wheel_2a,wheel_2b,wheel_3a,wheel_3b,pivot_1,pivot_2,pivot_3\n";
+  expect_error("t,w_a,w_b,w_c\n0,0,0,0\n", io::InputErrorKind::kBadHeader, 1);
+  expect_error(header + "0,0,0,0,0,0,0,0,0,0\n0.05,1,1,1,1,1,1,0,0\n",
+               io::InputErrorKind::kWrongColumnCount, 3);
+  expect_error(header + "0,0,0,0,0,0,0,0,0,0\n0,1,1,1,1,1,1,0,0,0\n",
+               io::InputErrorKind::kNonIncreasingTime, 3);
+  expect_error(header + "0,0,0,0,0,0,0,0,0,0\n0.05,1,x,1,1,1,1,0,0,0\n",
+               io::InputErrorKind::kNonNumeric, 3);
+  expect_error(header + "0,0,0,0,0,0,0,0,0,0\n", io::InputErrorKind::kTooFewSamples, 2);
+}
+
+}  // namespace
+}  // namespace fitcal::asoc

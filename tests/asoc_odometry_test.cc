@@ -1,0 +1,275 @@
+// ASOC model and multi-castor odometry (Doebbler Sec. II-D, III-B).
+#include "odometry/asoc_odometry.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <random>
+
+#include "odometry/asoc_model.h"
+#include "tools/sim/asoc_simulator.h"
+
+namespace fitcal::asoc {
+namespace {
+
+CastorParameters TestCastor() {
+  CastorParameters c;
+  c.offset_m = 0.08;
+  c.wheel_radius_m = {0.040, 0.042};
+  c.wheel_offset_m = {0.060, 0.058};
+  c.encoder_bias_rad = 0.0;
+  return c;
+}
+
+// The pivot velocity from two wheel rates, worked by hand from the derivation in asoc_model.h:
+// roll_1 = 0.04 * 3 = 0.12, roll_2 = 0.042 * 5 = 0.21 (m/s), axle d1 + d2 = 0.118 m:
+//   omega_c = (0.21 - 0.12) / 0.118             = 0.762711864406780 rad/s
+//   u       = (0.058 * 0.12 + 0.06 * 0.21) / 0.118 = 0.165762711864407 m/s
+//   w       = 0.08 * omega_c                     = 0.061016949152542 m/s
+TEST(AsocModelTest, PivotVelocityMatchesHandDerivation) {
+  double p[kParametersPerCastor];
+  TestCastor().ToArray(p);
+  const CastorMotion<double> m = PivotMotionFromWheels(p, 3.0, 5.0);
+  EXPECT_NEAR(m.turn, 0.762711864406780, 1e-14);
+  EXPECT_NEAR(m.along, 0.165762711864407, 1e-14);
+  EXPECT_NEAR(m.lateral, 0.061016949152542, 1e-14);
+}
+
+// The same relation checked as vector algebra: with the computed (u, w, omega_c) the contact
+// point of each wheel has no lateral velocity and rolls at r_w * rate; and the inverse maps back.
+TEST(AsocModelTest, ContactPointsRollWithoutLateralSlip) {
+  const CastorParameters c = TestCastor();
+  double p[kParametersPerCastor];
+  c.ToArray(p);
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-10.0, 10.0);
+  for (int trial = 0; trial < 50; ++trial) {
+    const double w1 = u(rng), w2 = u(rng);
+    const CastorMotion<double> m = PivotMotionFromWheels(p, w1, w2);
+    for (int k = 0; k < 2; ++k) {
+      const double s = k == 0 ? 1.0 : -1.0;
+      // q - p = -r_c c1 + s d c2; v_q = v_p + omega perp(q - p), in castor coordinates.
+      const double vq_along = m.along - m.turn * s * c.wheel_offset_m[k];
+      const double vq_lateral = m.lateral - m.turn * c.offset_m;
+      EXPECT_NEAR(vq_lateral, 0.0, 1e-13);
+      EXPECT_NEAR(vq_along, c.wheel_radius_m[k] * (k == 0 ? w1 : w2), 1e-13);
+    }
+    const auto back = WheelRatesFromPivotMotion(c, m.along, m.lateral);
+    EXPECT_NEAR(back[0], w1, 1e-12);
+    EXPECT_NEAR(back[1], w2, 1e-12);
+  }
+}
+
+// A pure rotation about a stationary pivot at distance D: the wheel rates of Eq. 4-7 (per unit
+// body rotation, castor trailing at Gamma = asin(r_c / D)) must make the pivot move exactly as a
+// rigid body turning about the held pivot, and turn the castor with the body.
+TEST(AsocModelTest, RotationAboutStationaryCastorReproducesEq4To7) {
+  const CastorParameters c = TestCastor();
+  double p[kParametersPerCastor];
+  c.ToArray(p);
+  const double D = 0.52;
+  const double gamma_path = std::asin(c.offset_m / D);  // Eq. 3
+  for (const double psi_dot : {-0.7, 0.4}) {
+    const double rate = std::abs(psi_dot);
+    const bool cw = psi_dot < 0.0;
+    // Eq. 4-7 with dtheta -> |psi_dot| and c -> wheel rate.
+    const double w1 = rate * (D * std::cos(gamma_path) + (cw ? 1 : -1) * c.wheel_offset_m[0]) /
+                      c.wheel_radius_m[0];
+    const double w2 = rate * (D * std::cos(gamma_path) - (cw ? 1 : -1) * c.wheel_offset_m[1]) /
+                      c.wheel_radius_m[1];
+    const CastorMotion<double> m = PivotMotionFromWheels(p, w1, w2);
+    EXPECT_NEAR(m.turn, psi_dot, 1e-14);                           // castor turns with the body
+    EXPECT_NEAR(std::hypot(m.along, m.lateral), D * rate, 1e-14);  // on the circle of radius D
+    EXPECT_NEAR(std::atan2(m.lateral, m.along), cw ? -gamma_path : gamma_path, 1e-14);
+  }
+}
+
+// The simulated calibration manoeuvre (no quantisation) obeys Eq. 4-7 on the integrated angles.
+TEST(AsocModelTest, SimulatedHoldRunObeysEq4To7) {
+  Vehicle truth = sim::AsocPrototypeVehicle();
+  truth.castors[1] = TestCastor();
+  sim::AsocSimulationOptions options;
+  options.wheel_quantum_rad = 0.0;
+  options.pivot_quantum_rad = 0.0;
+  std::mt19937_64 rng(1);
+  const double D = truth.PivotDistance(0, 1);
+  const double cg = D * std::cos(std::asin(truth.castors[1].offset_m / D));
+  for (int direction : {-1, 1}) {
+    const auto segments = sim::RotationAboutPivot(truth, 0, direction, 2.0);
+    const RunLog run = sim::SimulateAsocRun(
+        truth, segments, Pose2d{}, sim::SteadyCastorAngles(truth, segments[0]), options, rng);
+    const double dtheta = std::abs(run.ground_truth.world_T_robot.back().theta);
+    EXPECT_NEAR(dtheta, 2.0, 1e-9);
+    const double c1 = run.encoders.samples.back().wheel_rad[1][0];
+    const double c2 = run.encoders.samples.back().wheel_rad[1][1];
+    const double d1 = truth.castors[1].wheel_offset_m[0], d2 = truth.castors[1].wheel_offset_m[1];
+    // RK4 at 200 Hz on a steady rotation: the integration error is far below 1e-9.
+    EXPECT_NEAR(c1 * truth.castors[1].wheel_radius_m[0], dtheta * (cg - direction * d1), 1e-9);
+    EXPECT_NEAR(c2 * truth.castors[1].wheel_radius_m[1], dtheta * (cg + direction * d2), 1e-9);
+    // The held castor's wheels stay still.
+    EXPECT_NEAR(run.encoders.samples.back().wheel_rad[0][0], 0.0, 1e-12);
+  }
+}
+
+// Least squares of Eq. 15-17 solved by QR, as the reference for the closed forms.
+BodyStep<double> SolveByQr(const std::array<PivotPosition, kNumCastors>& pivots, CastorMask mask,
+                           double psi, const double* dx, const double* dy) {
+  const int n = MaskCount(mask);
+  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(2 * n, 3);
+  Eigen::VectorXd y(2 * n);
+  int row = 0;
+  for (int i = 0; i < kNumCastors; ++i) {
+    if (!((mask >> i) & 1u)) continue;
+    const double a = psi + pivots[i].angle_rad, r = pivots[i].radius_m;
+    h.row(row) << 1.0, 0.0, -r * std::sin(a);
+    h.row(n + row) << 0.0, 1.0, r * std::cos(a);
+    y(row) = dx[i];
+    y(n + row) = dy[i];
+    ++row;
+  }
+  const Eigen::Vector3d x = h.colPivHouseholderQr().solve(y);
+  return {x(0), x(1), x(2)};
+}
+
+TEST(AsocOdometryTest, ClosedFormEq18MatchesLeastSquaresForAnyPivots) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 100; ++trial) {
+    std::array<PivotPosition, kNumCastors> pivots;
+    for (auto& q : pivots) q = {0.2 + 0.3 * std::abs(u(rng)), M_PI * u(rng)};
+    double dx[3], dy[3];
+    for (int i = 0; i < 3; ++i) {
+      dx[i] = 0.01 * u(rng);
+      dy[i] = 0.01 * u(rng);
+    }
+    const double psi = M_PI * u(rng);
+    for (CastorMask mask : {kAllCastors, MaskExcluding(1), MaskExcluding(2), MaskExcluding(3)}) {
+      const BodyStep<double> a = SolveCastGeneral(pivots, mask, psi, dx, dy);
+      const BodyStep<double> b = SolveByQr(pivots, mask, psi, dx, dy);
+      // Both are the same 3x3 solve; 1e-12 m is ~1e4 ulp of the 1e-2 m inputs.
+      EXPECT_NEAR(a.dx_m, b.dx_m, 1e-12);
+      EXPECT_NEAR(a.dy_m, b.dy_m, 1e-12);
+      EXPECT_NEAR(a.dpsi_rad, b.dpsi_rad, 1e-11);
+    }
+  }
+}
+
+TEST(AsocOdometryTest, CentredEq22MatchesGeneralSolution) {
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  // Centred layouts: the prototype (equal R, Eq. 22 verbatim) and an unequal-R triangle whose
+  // centroid is the origin.
+  std::array<PivotPosition, kNumCastors> equal = sim::AsocPrototypeVehicle().pivots;
+  const Eigen::Vector2d a(0.35, 0.05), b(-0.10, 0.30);
+  const Eigen::Vector2d c = -a - b;
+  std::array<PivotPosition, kNumCastors> unequal;
+  int k = 0;
+  for (const Eigen::Vector2d& v : {a, b, c}) unequal[k++] = {v.norm(), std::atan2(v.y(), v.x())};
+  for (const auto& pivots : {equal, unequal}) {
+    ASSERT_TRUE(PivotsCentred(pivots, kAllCastors));
+    for (int trial = 0; trial < 100; ++trial) {
+      double dx[3], dy[3];
+      for (int i = 0; i < 3; ++i) {
+        dx[i] = 0.01 * u(rng);
+        dy[i] = 0.01 * u(rng);
+      }
+      const double psi = M_PI * u(rng);
+      const BodyStep<double> g = SolveCastGeneral(pivots, kAllCastors, psi, dx, dy);
+      const BodyStep<double> s = SolveCastCentred(pivots, kAllCastors, psi, dx, dy);
+      EXPECT_NEAR(g.dx_m, s.dx_m, 1e-15);
+      EXPECT_NEAR(g.dy_m, s.dy_m, 1e-15);
+      EXPECT_NEAR(g.dpsi_rad, s.dpsi_rad, 1e-14);
+    }
+  }
+  EXPECT_FALSE(PivotsCentred(equal, MaskExcluding(1)));
+}
+
+// With the true parameters and no quantisation the odometry closes the UMBmark square up to the
+// discretisation of the updates only (castor rates vary within an update; Eq. 13-14 linearise).
+// That error is second order in the update period: 0.7-5 mm over 6 m at 20 Hz, so at 200 Hz
+// it must be near 5e-3 m / 100 = 5e-5 m; the bound is twice that. Every CAST-i and IPEC-i.
+TEST(AsocOdometryTest, TrueParametersCloseTheSquare) {
+  const Vehicle truth = sim::AsocPrototypeVehicle();
+  sim::AsocSimulationOptions options;
+  options.wheel_quantum_rad = 0.0;
+  options.pivot_quantum_rad = 0.0;
+  options.sample_period_s = 0.005;
+  options.substeps = 2;
+  std::mt19937_64 rng(5);
+  const auto runs = sim::SimulateUmbmark(truth, options, rng, 1);
+  for (int excluded = 0; excluded <= 3; ++excluded) {
+    OdometryOptions o;
+    o.castors = MaskExcluding(excluded);
+    EXPECT_LT(sim::EvaluateUmbmark(runs, truth, o).e_max_m, 1e-4) << "CAST-" << excluded;
+    if (excluded > 0) {
+      o.method = Method::kIpec;
+      EXPECT_LT(sim::EvaluateUmbmark(runs, truth, o).e_max_m, 1e-4) << "IPEC-" << excluded;
+    }
+  }
+}
+
+// Doebbler Table II: two-castor least squares and IPEC give nearly the same answer (394.6 vs
+// 394.1 mm, 0.13 %). On random uncalibrated vehicles with quantised encoders the mean E_max of
+// IPEC-1 and CAST-1 must agree within 2 %, while CAST-0 must differ from both by more (it uses a
+// third castor); a swapped wheel or a wrong sign in either would break the agreement.
+TEST(AsocOdometryTest, TwoCastorCastAgreesWithIpec) {
+  const Vehicle nominal = sim::AsocPrototypeVehicle();
+  sim::ParameterSpread spread;
+  spread.bias_range_rad = 0.0;  // Table II: beta = 0
+  std::mt19937_64 rng(11);
+  double ipec = 0.0, cast1 = 0.0;
+  const int kSets = 6;
+  for (int s = 0; s < kSets; ++s) {
+    const Vehicle truth = sim::DrawVehicle(nominal, spread, rng);
+    const auto runs = sim::SimulateUmbmark(truth, sim::AsocSimulationOptions{}, rng, 1);
+    OdometryOptions o;
+    o.castors = MaskExcluding(1);
+    cast1 += sim::EvaluateUmbmark(runs, nominal, o).e_max_m / kSets;
+    o.method = Method::kIpec;
+    ipec += sim::EvaluateUmbmark(runs, nominal, o).e_max_m / kSets;
+  }
+  EXPECT_GT(cast1, 0.05);  // the uncalibrated error is large (Table II: ~0.4 m)
+  EXPECT_NEAR(ipec / cast1, 1.0, 0.02);
+}
+
+// The redundancy check: a wheel of castor 2 whose encoder over-counts by 30 % for 3 s (a spinning
+// wheel) ruins CAST-0; dropping the inconsistent castor while it slips restores the accuracy.
+TEST(AsocOdometryTest, RedundancyCheckDropsSlippingCastor) {
+  const Vehicle truth = sim::AsocPrototypeVehicle();
+  sim::AsocSimulationOptions options;
+  options.slip_events.push_back({1, 0, 2.0, 5.0, 0.3});
+  std::mt19937_64 rng(6);
+  const auto runs = sim::SimulateUmbmark(truth, options, rng, 1);
+  OdometryOptions plain;
+  OdometryOptions checked;
+  checked.drop_inconsistent_castor = true;
+  const double e_plain = sim::EvaluateUmbmark(runs, truth, plain).e_max_m;
+  const double e_checked = sim::EvaluateUmbmark(runs, truth, checked).e_max_m;
+  // 30 % of ~0.5 m of rolling, split over three castors: centimetres of error without the check.
+  EXPECT_GT(e_plain, 0.02);
+  EXPECT_LT(e_checked, 0.2 * e_plain);
+  // Without slip the check must not drop anything with the true parameters.
+  std::mt19937_64 rng2(6);
+  const auto clean = sim::SimulateUmbmark(truth, sim::AsocSimulationOptions{}, rng2, 1);
+  Odometry odo(truth, checked, Pose2d{}, clean[0].encoders.samples.front());
+  for (std::size_t k = 1; k < clean[0].encoders.samples.size(); ++k)
+    odo.Step(clean[0].encoders.samples[k]);
+  EXPECT_EQ(odo.dropped()[0] + odo.dropped()[1] + odo.dropped()[2], 0);
+}
+
+TEST(AsocOdometryTest, OptionsValidation) {
+  std::string error;
+  OdometryOptions o;
+  EXPECT_TRUE(o.IsValid(&error));
+  o.castors = 0b001;
+  EXPECT_FALSE(o.IsValid(&error));
+  o.method = Method::kIpec;
+  o.castors = kAllCastors;
+  EXPECT_FALSE(o.IsValid(&error));
+  o.castors = MaskExcluding(2);
+  EXPECT_TRUE(o.IsValid(&error));
+}
+
+}  // namespace
+}  // namespace fitcal::asoc

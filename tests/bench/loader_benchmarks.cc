@@ -1,0 +1,165 @@
+// Loader throughput on big inputs (issue 7):
+//   BM_ReadEncoderCsv   a large encoder log (FITCAL_BENCH_ENCODER_MB, default 200 MB; 1024 for
+//                       the issue's 1 GB) written once to a temporary directory; MB/s of file
+//                       text and the bytes the loaded EncoderLog holds per sample (target ~40:
+//                       t_s 8 B + WheelSample 32 B).
+//   BM_LoadDataset      a data set of FITCAL_BENCH_RUNS runs (default 10,000; 100 encoder rows
+//                       and 5 ground-truth rows each): dataset.yaml + every file, all threads.
+// The page cache is warm after the first iteration: these measure parsing, not the disk.
+//   build/tests/loader_benchmarks --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+
+#include <benchmark/benchmark.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <random>
+#include <string>
+
+#include "io/dataset.h"
+#include "io/log_files.h"
+#include "io/text_file.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+long EnvOr(const char* name, long fallback) {
+  const char* v = std::getenv(name);
+  return v != nullptr ? std::atol(v) : fallback;
+}
+
+class TempDir {
+ public:
+  TempDir() {
+    std::string tmpl = (fs::temp_directory_path() / "fitcal-bench-XXXXXX").string();
+    if (mkdtemp(tmpl.data()) == nullptr) std::abort();
+    path_ = tmpl;
+  }
+  ~TempDir() {
+    std::error_code ignored;
+    fs::remove_all(path_, ignored);
+  }
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+// Rows as the simulator writes them (io::EncoderCsv): 100 Hz, rates with 9 significant digits.
+void WriteEncoderCsv(const fs::path& path, std::size_t target_bytes, std::size_t max_rows) {
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  std::fputs("t,w_a,w_b,w_c\n", f);
+  std::mt19937_64 rng(1);
+  std::uniform_real_distribution<double> rate(-12.0, 12.0);
+  std::size_t bytes = 14;
+  for (std::size_t k = 0; bytes < target_bytes && k < max_rows; ++k) {
+    const int n = std::fprintf(f, "%.6f,%.9g,%.9g,%.9g\n", 0.01 * static_cast<double>(k), rate(rng),
+                               rate(rng), rate(rng));
+    bytes += static_cast<std::size_t>(n);
+  }
+  std::fclose(f);
+}
+
+void BM_ReadEncoderCsv(benchmark::State& state) {
+  static TempDir dir;
+  const fs::path path = dir.path() / "big_encoders.csv";
+  const std::size_t target = static_cast<std::size_t>(EnvOr("FITCAL_BENCH_ENCODER_MB", 200)) << 20;
+  if (!fs::exists(path)) WriteEncoderCsv(path, target, static_cast<std::size_t>(-1));
+  const std::size_t file_bytes = fs::file_size(path);
+  double bytes_per_sample = 0.0;
+  std::size_t samples = 0;
+  for (auto _ : state) {
+    const fitcal::EncoderLog log = fitcal::io::ReadEncoderCsv(path.string());
+    samples = log.samples.size();
+    bytes_per_sample = static_cast<double>(log.t_s.capacity() * sizeof(double) +
+                                           log.samples.capacity() * sizeof(fitcal::WheelSample)) /
+                       static_cast<double>(samples);
+    benchmark::DoNotOptimize(log.samples.data());
+  }
+  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * file_bytes));
+  state.counters["file_MB"] = static_cast<double>(file_bytes) / (1 << 20);
+  state.counters["samples"] = static_cast<double>(samples);
+  state.counters["bytes_per_sample"] = bytes_per_sample;
+}
+BENCHMARK(BM_ReadEncoderCsv)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The share of BM_ReadEncoderCsv that is reading the file into memory (no parsing).
+void BM_ReadTextFileOnly(benchmark::State& state) {
+  static TempDir dir;
+  const fs::path path = dir.path() / "big_encoders.csv";
+  const std::size_t target = static_cast<std::size_t>(EnvOr("FITCAL_BENCH_ENCODER_MB", 200)) << 20;
+  if (!fs::exists(path)) WriteEncoderCsv(path, target, static_cast<std::size_t>(-1));
+  for (auto _ : state) {
+    const std::string text = fitcal::io::ReadTextFile(path.string());
+    benchmark::DoNotOptimize(text.data());
+  }
+  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * fs::file_size(path)));
+}
+BENCHMARK(BM_ReadTextFileOnly)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_LoadDataset(benchmark::State& state) {
+  static TempDir dir;
+  const long runs = EnvOr("FITCAL_BENCH_RUNS", 10000);
+  if (!fs::exists(dir.path() / "dataset.yaml")) {
+    fs::copy_file(fs::path(FITCAL_SOURCE_DIR) / "data" / "robots" / "apr02.yaml",
+                  dir.path() / "robot.yaml");
+    fs::create_directories(dir.path() / "runs");
+    std::vector<fitcal::io::DatasetEntry> entries;
+    for (long i = 0; i < runs; ++i) {
+      fitcal::io::DatasetEntry e;
+      e.id = "run" + std::to_string(i);
+      e.trajectory = "T" + std::to_string(i % 36);
+      e.repetition = static_cast<int>(i / 36) + 1;
+      e.encoders = "runs/" + e.id + "_enc.csv";
+      e.ground_truth = "runs/" + e.id + "_gt.csv";
+      WriteEncoderCsv(dir.path() / e.encoders, static_cast<std::size_t>(-1), 100);
+      std::FILE* f = std::fopen((dir.path() / e.ground_truth).c_str(), "wb");
+      std::fputs("t,x,y,theta\n", f);
+      for (int k = 0; k < 5; ++k) std::fprintf(f, "%.3f,%.4f,0,0\n", 0.25 * k, 0.01 * k);
+      std::fclose(f);
+      entries.push_back(e);
+    }
+    std::FILE* f = std::fopen((dir.path() / "dataset.yaml").c_str(), "wb");
+    std::fputs(fitcal::io::DatasetYaml("robot.yaml", entries).c_str(), f);
+    std::fclose(f);
+  }
+  for (auto _ : state) {
+    const fitcal::io::Dataset dataset = fitcal::io::LoadDataset(dir.path().string());
+    benchmark::DoNotOptimize(dataset.runs.data());
+  }
+  state.counters["runs"] = static_cast<double>(runs);
+}
+BENCHMARK(BM_LoadDataset)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_ReadDatasetIndex(benchmark::State& state) {
+  // Only dataset.yaml of the data set above (yaml-cpp parse + path checks).
+  static TempDir dir;
+  const long runs = EnvOr("FITCAL_BENCH_RUNS", 10000);
+  if (!fs::exists(dir.path() / "dataset.yaml")) {
+    fs::copy_file(fs::path(FITCAL_SOURCE_DIR) / "data" / "robots" / "apr02.yaml",
+                  dir.path() / "robot.yaml");
+    std::vector<fitcal::io::DatasetEntry> entries(static_cast<std::size_t>(runs));
+    for (long i = 0; i < runs; ++i) {
+      auto& e = entries[static_cast<std::size_t>(i)];
+      e.id = "run" + std::to_string(i);
+      e.trajectory = "T";
+      e.repetition = 1;
+      e.encoders = "runs/" + e.id + "_enc.csv";
+      e.ground_truth = "runs/" + e.id + "_gt.csv";
+    }
+    std::FILE* f = std::fopen((dir.path() / "dataset.yaml").c_str(), "wb");
+    std::fputs(fitcal::io::DatasetYaml("robot.yaml", entries).c_str(), f);
+    std::fclose(f);
+  }
+  for (auto _ : state) {
+    const fitcal::io::DatasetIndex index = fitcal::io::ReadDatasetIndex(dir.path().string());
+    benchmark::DoNotOptimize(index.runs.data());
+  }
+}
+BENCHMARK(BM_ReadDatasetIndex)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+
+BENCHMARK_MAIN();

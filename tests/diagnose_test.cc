@@ -1,0 +1,238 @@
+// End-to-end tests of the effect tracing (calib/diagnose.h) on small simulated flower data sets.
+
+#include "calib/diagnose.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+
+#include "io/robot_yaml.h"
+#include "tools/sim/omni3_simulator.h"
+
+namespace fitcal {
+namespace {
+
+Omni3Robot NominalRobot() {
+  return io::ReadOmni3Robot(FITCAL_SOURCE_DIR "/data/robots/apr02.yaml");
+}
+
+struct Data {
+  std::vector<TrackRun> training, validation;
+};
+
+Data Simulate(sim::Omni3SimulationOptions o) {
+  o.commanded_robot = NominalRobot().nominal;
+  std::vector<RunLog> logs;
+  for (auto& run : sim::SimulateOmni3(o)) logs.push_back(std::move(run.log));
+  Data d;
+  SplitTrackRuns(PrepareTrackRuns(logs), {1}, &d.training, &d.validation);
+  return d;
+}
+
+// Every identifiable library effect, injected at its registry's realistic magnitude into
+// otherwise clean simulated data (36 flower trajectories x 2 repetitions: repetition 1 trains,
+// 2 validates): diagnose must accept exactly that effect, recover its parameters and match the
+// true model's validation CF.
+class LibraryEffectTest : public ::testing::TestWithParam<effects::EffectId> {};
+
+TEST_P(LibraryEffectTest, DiagnosePicksRecoversAndMatchesTrueModel) {
+  const effects::EffectInfo& info = effects::Info(GetParam());
+  sim::Omni3SimulationOptions o;
+  o.repetitions = 2;
+  o.seed = 11;
+  effects::EffectValue truth;
+  truth.id = info.id;
+  truth.value = info.typical;
+  o.injected_effects = {truth};
+  const Data d = Simulate(o);
+  const Omni3Robot robot = NominalRobot();
+  const DiagnoseResult r = Diagnose(d.training, d.validation, robot);
+  SCOPED_TRACE(FormatDiagnoseReport(r, robot));
+  ASSERT_GE(r.final_fit.effects.size(), 1u);
+  EXPECT_EQ(r.final_fit.effects.front().id, info.id)
+      << effects::Info(r.final_fit.effects.front().id).name;
+  EXPECT_EQ(r.final_fit.effects.size(), 1u);
+  EXPECT_TRUE(r.effects_named);
+  const effects::EffectValue& got = r.final_fit.effects.front();
+  for (int k = 0; k < info.num_parameters; ++k) {
+    // Tolerance: four of the fit's own one-sigma (from the residual noise), and at least 10% of
+    // the value for the bias of the replay's discrete approximation of a continuous effect.
+    const double tol = std::max(4.0 * got.sigma[k], 0.1 * std::abs(info.typical[k]));
+    EXPECT_NEAR(got.value[k], info.typical[k], tol) << info.parameter_names[k];
+  }
+  const ModelScore true_model = ScoreModel(o.true_robot.ToArray(), {truth}, d.validation);
+  std::printf(
+      "%s: true %g, fitted %g +- %g; validation CF declared %.5f, with effect %.5f, true model "
+      "%.5f\n",
+      info.name, info.typical[0], got.value[0], got.sigma[0], r.declared_validation.cf,
+      r.final_validation.cf, true_model.cf);
+  EXPECT_LE(r.final_validation.cf, 1.15 * true_model.cf)
+      << "validation CF " << r.final_validation.cf << " vs true model " << true_model.cf;
+  EXPECT_FALSE(r.unexplained_structure);
+
+  // The calibrated YAML carries the effect and the replay honours it when read back.
+  Omni3Robot calibrated = robot;
+  calibrated.nominal = omni3::Parameters::FromArray(r.final_fit.parameters.data());
+  calibrated.effects = r.final_fit.effects;
+  const std::string path = ::testing::TempDir() + "/fitcal_diagnose_" + info.name + ".yaml";
+  {
+    std::ofstream f(path);
+    f << io::Omni3RobotYaml(calibrated, nullptr);
+  }
+  const Omni3Robot back = io::ReadOmni3Robot(path);
+  ASSERT_EQ(back.effects.size(), 1u);
+  const ModelScore replayed = ScoreModel(back.nominal.ToArray(), back.effects, d.validation);
+  // The YAML keeps 10 significant digits: the CF agrees to far better than its noise.
+  EXPECT_NEAR(replayed.cf, r.final_validation.cf, 1e-6 * r.final_validation.cf);
+  std::remove(path.c_str());
+}
+
+std::vector<effects::EffectId> IdentifiableEffects() {
+  std::vector<effects::EffectId> out;
+  for (const auto& info : effects::EffectTable()) {
+    if (info.identifiable) out.push_back(info.id);
+  }
+  return out;
+}
+
+INSTANTIATE_TEST_SUITE_P(AllLibraryEffects, LibraryEffectTest,
+                         ::testing::ValuesIn(IdentifiableEffects()), [](const auto& param) {
+                           return std::string(effects::Info(param.param).name);
+                         });
+
+// Clean data (no injected effect): the tracing must accept nothing. A cheap configuration (12
+// of the 36 flower trajectories, 2 repetitions) over 20 seeds; the issue allows at most one false
+// positive in 20. Measured: see the printed rate.
+TEST(Diagnose, CleanDataAcceptsNoEffectOverTwentySeeds) {
+  const auto flower = sim::FlowerTrajectories();
+  std::vector<sim::MotionCommand> subset;
+  for (std::size_t i = 0; i < flower.size(); i += 3) subset.push_back(flower[i]);
+  const Omni3Robot robot = NominalRobot();
+  int false_positives = 0;
+  constexpr int kSeeds = 20;
+  for (int seed = 1; seed <= kSeeds; ++seed) {
+    sim::Omni3SimulationOptions o;
+    o.repetitions = 2;
+    o.seed = static_cast<std::uint64_t>(seed) * 7919;
+    o.trajectories = subset;
+    const Data d = Simulate(o);
+    DiagnoseOptions options;
+    options.max_effects = 1;  // the first acceptance is the false positive
+    const DiagnoseResult r = Diagnose(d.training, d.validation, robot, options);
+    if (!r.final_fit.effects.empty()) {
+      ++false_positives;
+      std::printf("seed %d: false positive %s\n", seed,
+                  effects::Info(r.final_fit.effects[0].id).name);
+    }
+  }
+  std::printf("clean data: %d of %d seeds accepted an effect (false-positive rate %.0f%%)\n",
+              false_positives, kSeeds, 100.0 * false_positives / kSeeds);
+  EXPECT_LE(false_positives, 1);
+}
+
+// An effect outside the library: a turning drift that grows with the time since the motion
+// started (omega += k t, e.g. a castor or a roller warming up). No candidate has this shape; the
+// tracing must report unexplained structure rather than name the nearest candidate.
+TEST(Diagnose, EffectOutsideLibraryIsReportedAsUnexplainedStructure) {
+  sim::Omni3SimulationOptions o;
+  o.repetitions = 2;
+  o.seed = 5;
+  constexpr double kDriftRadS2 = 0.006;
+  o.injection_hook = [](const sim::Omni3SimulationOptions::InjectionState& s, Eigen::Vector3d*,
+                        Eigen::Vector3d* v_body, Eigen::Vector2d*) {
+    if (s.time_since_motion_s >= 0.0 && s.wheel_rate.cwiseAbs().maxCoeff() > 0.05) {
+      (*v_body)[2] += kDriftRadS2 * s.time_since_motion_s;
+    }
+  };
+  const Data d = Simulate(o);
+  const Omni3Robot robot = NominalRobot();
+  const DiagnoseResult r = Diagnose(d.training, d.validation, robot);
+  SCOPED_TRACE(FormatDiagnoseReport(r, robot));
+  // A candidate may stand in for part of it (and lower the held-out error), but none is named.
+  EXPECT_FALSE(r.effects_named);
+  EXPECT_TRUE(r.unexplained_structure);
+  EXPECT_LT(r.after.lack_of_fit.p_value, 1e-3);
+}
+
+// Encoder clock scale: the nine parameters absorb it exactly (a common radius scale). The
+// tracing must say it is not identifiable, accept nothing, and the declared fit must already be
+// as good as the true model.
+TEST(Diagnose, ClockScaleIsReportedNotIdentifiable) {
+  sim::Omni3SimulationOptions o;
+  o.repetitions = 2;
+  o.seed = 9;
+  effects::EffectValue truth;
+  truth.id = effects::EffectId::kEncoderClockScale;
+  truth.value = effects::Info(truth.id).typical;
+  o.injected_effects = {truth};
+  const Data d = Simulate(o);
+  const Omni3Robot robot = NominalRobot();
+  const DiagnoseResult r = Diagnose(d.training, d.validation, robot);
+  const std::string report = FormatDiagnoseReport(r, robot);
+  SCOPED_TRACE(report);
+  EXPECT_TRUE(r.final_fit.effects.empty());
+  EXPECT_NE(report.find("encoder_clock_scale: not identifiable"), std::string::npos);
+  // The numerical check agrees with the registry: nothing of its column is separable.
+  EXPECT_LT(SeparableFraction(d.training, r.base.parameters, {}, truth.id), 1e-6);
+  const ModelScore true_model = ScoreModel(o.true_robot.ToArray(), {truth}, d.validation);
+  EXPECT_LE(r.declared_validation.cf, 1.15 * true_model.cf);
+  // The radii absorb the scale: r_i(fitted) ~ r_i(true) (1 + s).
+  for (int i = 0; i < 3; ++i) {
+    const double expected = o.true_robot.radius_m[i] * (1.0 + truth.value[0]);
+    EXPECT_NEAR(r.declared.parameters[omni3::kRadiusIndex + i], expected, 0.003 * expected);
+  }
+}
+
+// What to record next (issue 6, part 5). On straight runs only (R1-R12, no rotation) a
+// yaw-rate slip has no influence at all: the tracing must say it cannot be told apart and name
+// the runs that would separate it, rather than fit it.
+TEST(Diagnose, SaysWhichRunsWouldSeparateAnUnidentifiableCandidate) {
+  const auto flower = sim::FlowerTrajectories();
+  sim::Omni3SimulationOptions o;
+  o.repetitions = 2;
+  o.seed = 21;
+  o.trajectories.assign(flower.begin(), flower.begin() + 12);  // R1..R12
+  const Data d = Simulate(o);
+  DiagnoseOptions options;
+  options.candidates = {effects::EffectId::kYawRateSlip, effects::EffectId::kWheelSpeedSlip};
+  const Omni3Robot robot = NominalRobot();
+  const DiagnoseResult r = Diagnose(d.training, d.validation, robot, options);
+  const std::string report = FormatDiagnoseReport(r, robot);
+  SCOPED_TRACE(report);
+  EXPECT_TRUE(r.final_fit.effects.empty());
+  EXPECT_NE(report.find("yaw_rate_slip cannot be told apart"), std::string::npos);
+  EXPECT_NE(report.find(effects::Info(effects::EffectId::kYawRateSlip).separating_runs),
+            std::string::npos);
+}
+
+// A speed-dependent slip partly trades off with the radii when every run has the same speed;
+// the flower at a second speed (FlowerTrajectories(speed)) separates it. Same number of runs
+// (72) either way: two repetitions of one flower, or one of each speed; the part of the slip's
+// influence that the nine parameters cannot mimic must grow clearly (measured: printed).
+TEST(Diagnose, SecondSpeedFlowerSeparatesSpeedSlip) {
+  const auto unexplained = [](std::vector<sim::MotionCommand> trajectories, int repetitions) {
+    sim::Omni3SimulationOptions o;
+    o.repetitions = repetitions;
+    o.seed = 4;
+    o.trajectories = std::move(trajectories);
+    const Data d = Simulate(o);
+    std::vector<TrackRun> all = d.training;
+    all.insert(all.end(), d.validation.begin(), d.validation.end());
+    double norm = 0.0;
+    SeparableFraction(all, o.true_robot.ToArray(), {}, effects::EffectId::kWheelSpeedSlip, {},
+                      &norm);
+    return norm;
+  };
+  const double one_speed = unexplained(sim::FlowerTrajectories(0.35), 2);
+  auto two = sim::FlowerTrajectories(0.35);
+  const auto fast = sim::FlowerTrajectories(0.6, 0.6);
+  two.insert(two.end(), fast.begin(), fast.end());
+  const double two_speeds = unexplained(two, 1);
+  std::printf("speed slip: unexplained influence |(I-P)J|: one speed %.4g, two speeds %.4g\n",
+              one_speed, two_speeds);
+  EXPECT_GT(two_speeds, 1.5 * one_speed);
+}
+
+}  // namespace
+}  // namespace fitcal

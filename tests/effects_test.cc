@@ -1,0 +1,222 @@
+// Tests of the effect library (odometry/effects.h), the effect fit's building blocks
+// (calib/effect_fit.h), the tail probabilities (calib/statistics.h) and the robot YAML's
+// `effects:` list.
+#include <ceres/jet.h>
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "calib/effect_fit.h"
+#include "calib/statistics.h"
+#include "io/input_error.h"
+#include "io/robot_yaml.h"
+#include "odometry/omni3_replay.h"
+#include "tools/sim/omni3_simulator.h"
+
+namespace fitcal {
+namespace {
+
+using effects::EffectId;
+
+// A curved run with start/stop transients and both wheel directions: 4 s at 100 Hz.
+WheelSamples TestSamples() {
+  WheelSamples s(400);
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    const double t = 0.01 * static_cast<double>(k);
+    const double ramp = std::min(1.0, t / 0.3) * std::min(1.0, (4.0 - t) / 0.3);
+    s[k].dt_s = 0.01;
+    s[k].rate_rad_s[0] = 2.0 * ramp;
+    s[k].rate_rad_s[1] = -1.2 * ramp;
+    s[k].rate_rad_s[2] = 0.4 * ramp + 0.3 * std::sin(t);
+  }
+  return s;
+}
+
+template <typename T>
+Pose2<T> Replay(const T* p, EffectId id, const T* q, const WheelSamples& samples,
+                const std::vector<effects::SampleContext>& contexts) {
+  std::vector<effects::ActiveEffect<T>> active = {{id, q}};
+  return effects::ReplayWithEffects(p, active, samples, contexts, Pose2<T>{T(0.3), T(-0.2), T(0.5)},
+                                    [](std::size_t, const Pose2<T>&, const Pose2<T>&) {});
+}
+
+TEST(EffectTable, OrderMatchesIdsAndNamesRoundTrip) {
+  for (int k = 0; k < effects::kNumEffects; ++k) {
+    const effects::EffectInfo& info = effects::EffectTable()[k];
+    EXPECT_EQ(static_cast<int>(info.id), k);
+    EXPECT_EQ(effects::EffectIdFromName(info.name), info.id);
+    for (int j = 0; j < info.num_parameters; ++j) {
+      EXPECT_LE(info.lower[j], 0.0) << info.name;  // 0 is the neutral value, inside the box
+      EXPECT_GE(info.upper[j], 0.0) << info.name;
+      EXPECT_TRUE(info.typical[j] > info.lower[j] && info.typical[j] < info.upper[j]) << info.name;
+    }
+  }
+  EXPECT_THROW(effects::EffectIdFromName("gremlins"), std::invalid_argument);
+}
+
+// Every effect at its neutral value (0) reproduces the plain replay (Palacin Eq. 4).
+TEST(EffectReplay, NeutralEffectsEqualPlainReplay) {
+  const WheelSamples samples = TestSamples();
+  const auto contexts = effects::MakeSampleContexts(samples);
+  const auto p = sim::PalacinTable5Parameters().ToArray();
+  const Pose2d start{0.3, -0.2, 0.5};
+  const Pose2d plain = omni3::ReplayFinalPose(p.data(), samples, start);
+  const double zero[2] = {0.0, 0.0};
+  for (int k = 0; k < effects::kNumEffects; ++k) {
+    const Pose2d with = Replay(p.data(), static_cast<EffectId>(k), zero, samples, contexts);
+    EXPECT_NEAR(with.x, plain.x, 1e-12) << effects::EffectTable()[k].name;
+    EXPECT_NEAR(with.y, plain.y, 1e-12);
+    EXPECT_NEAR(with.theta, plain.theta, 1e-12);
+  }
+}
+
+// Autodiff through every effect agrees with central differences (the Ceres fit relies on it).
+TEST(EffectReplay, JetDerivativesMatchCentralDifferences) {
+  using Jet = ceres::Jet<double, 2>;
+  const WheelSamples samples = TestSamples();
+  const auto contexts = effects::MakeSampleContexts(samples);
+  const auto p = sim::PalacinTable5Parameters().ToArray();
+  std::array<Jet, 9> pj;
+  for (int i = 0; i < 9; ++i) pj[i] = Jet(p[i]);
+  for (const auto& info : effects::EffectTable()) {
+    if (info.id == EffectId::kTimeOffset) continue;  // acts in the residual, not in the replay
+    for (int j = 0; j < info.num_parameters; ++j) {
+      Jet q[2] = {Jet(info.typical[0]), Jet(info.typical[1])};
+      q[j].v[0] = 1.0;
+      const Pose2<Jet> jet = Replay(pj.data(), info.id, q, samples, contexts);
+      const double h = 1e-6 * std::max(1.0, std::abs(info.typical[j]));
+      double qp[2] = {info.typical[0], info.typical[1]};
+      double qm[2] = {info.typical[0], info.typical[1]};
+      qp[j] += h;
+      qm[j] -= h;
+      const Pose2d a = Replay(p.data(), info.id, qp, samples, contexts);
+      const Pose2d b = Replay(p.data(), info.id, qm, samples, contexts);
+      // Central differences are exact to O(h^2) and rounding ~1e-16 / h = 1e-10 (relative).
+      const double tol = 1e-6 * (1.0 + std::abs(jet.x.v[0]) + std::abs(jet.y.v[0]));
+      EXPECT_NEAR(jet.x.v[0], (a.x - b.x) / (2 * h), tol) << info.name;
+      EXPECT_NEAR(jet.y.v[0], (a.y - b.y) / (2 * h), tol) << info.name;
+      EXPECT_NEAR(jet.theta.v[0], (a.theta - b.theta) / (2 * h), tol) << info.name;
+    }
+  }
+}
+
+// The honest negative, exactly: an encoder clock scale s is a common radius scale (1 + s).
+TEST(EffectReplay, ClockScaleEqualsCommonRadiusScale) {
+  const WheelSamples samples = TestSamples();
+  const auto contexts = effects::MakeSampleContexts(samples);
+  auto p = sim::PalacinTable5Parameters().ToArray();
+  const double s[1] = {0.013};
+  const Pose2d with = Replay(p.data(), EffectId::kEncoderClockScale, s, samples, contexts);
+  for (int i = 0; i < 3; ++i) p[omni3::kRadiusIndex + i] *= 1.0 + s[0];
+  const Pose2d scaled = omni3::ReplayFinalPose(p.data(), samples, Pose2d{0.3, -0.2, 0.5});
+  EXPECT_NEAR(with.x, scaled.x, 1e-12);
+  EXPECT_NEAR(with.y, scaled.y, 1e-12);
+  EXPECT_NEAR(with.theta, scaled.theta, 1e-12);
+}
+
+// Backlash eats exactly beta of each wheel's encoder angle when the wheel turns one way.
+TEST(EffectTransforms, BacklashLosesBetaOfEachWheel) {
+  const WheelSamples samples = TestSamples();
+  const auto contexts = effects::MakeSampleContexts(samples);
+  const double beta[1] = {0.07};
+  double measured = 0.0, transmitted = 0.0;
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    double w[3] = {samples[k].rate_rad_s[0], samples[k].rate_rad_s[1], samples[k].rate_rad_s[2]};
+    effects::Backlash::Rates(beta, contexts[k], w);
+    measured += samples[k].rate_rad_s[0] * samples[k].dt_s;
+    transmitted += w[0] * samples[k].dt_s;
+  }
+  EXPECT_NEAR(measured - transmitted, beta[0], 1e-12);
+}
+
+TEST(EffectTransforms, SpeedSlipAndDirectionRadiusAsDocumented) {
+  effects::SampleContext c;
+  double w[3] = {2.0, -1.0, 0.0};
+  const double k[1] = {0.01};
+  effects::WheelSpeedSlip::Rates(k, c, w);
+  EXPECT_DOUBLE_EQ(w[0], 2.0 * (1.0 - 0.02));
+  EXPECT_DOUBLE_EQ(w[1], -1.0 * (1.0 - 0.01));
+  double v[3] = {2.0, -1.0, 0.5};
+  const double a[1] = {0.02};
+  effects::DirectionRadius::Rates(a, c, v);
+  EXPECT_DOUBLE_EQ(v[0], 2.0 * 1.02);   // forward: larger radius
+  EXPECT_DOUBLE_EQ(v[1], -1.0 * 0.98);  // backward: smaller
+}
+
+// The smoothed acceleration of a linear ramp is its slope (away from the ends).
+TEST(SampleContexts, AccelerationOfARamp) {
+  WheelSamples s(100);
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    s[k].dt_s = 0.01;
+    s[k].rate_rad_s[0] = 5.0 * 0.01 * (static_cast<double>(k) + 0.5);  // 5 rad/s^2
+  }
+  const auto c = effects::MakeSampleContexts(s);
+  EXPECT_NEAR(c[50].accel_rad_s2[0], 5.0, 1e-9);
+  EXPECT_NEAR(c[50].angle_rad[0], 0.5 * 5.0 * 0.5 * 0.5, 1e-12);
+}
+
+// Golden values: R's pt(2.228, 10, lower = FALSE) = 0.02500 and pf(3.708, 3, 10, lower = FALSE)
+// = 0.05000 (the tabulated 97.5% t and 95% F quantiles).
+TEST(Statistics, TailsMatchTables) {
+  EXPECT_NEAR(stats::StudentTUpperTail(2.228, 10), 0.025, 1e-4);
+  EXPECT_NEAR(stats::StudentTUpperTail(-2.228, 10), 0.975, 1e-4);
+  EXPECT_NEAR(stats::StudentTUpperTail(0.0, 5), 0.5, 1e-12);
+  EXPECT_NEAR(stats::FUpperTail(3.708, 3, 10), 0.05, 1e-4);
+  EXPECT_NEAR(stats::FUpperTail(1.0, 200, 200), 0.5, 0.01);
+  EXPECT_NEAR(stats::RegularizedIncompleteBeta(2, 3, 0.4), 0.5248, 1e-4);  // 1 - pbeta(0.4,2,3)
+}
+
+std::string TempPath(const std::string& name) {
+  return (std::filesystem::temp_directory_path() / ("fitcal_effects_test_" + name)).string();
+}
+
+// The calibrated YAML carries the effects and gives them back.
+TEST(RobotYamlEffects, RoundTripAndBadInput) {
+  Omni3Robot robot = io::ReadOmni3Robot(FITCAL_SOURCE_DIR "/data/robots/apr02.yaml");
+  effects::EffectValue slip;
+  slip.id = EffectId::kWheelSpeedSlip;
+  slip.value[0] = 0.0123;
+  slip.sigma[0] = 0.0004;
+  effects::EffectValue slope;
+  slope.id = EffectId::kFloorSlope;
+  slope.value = {0.004, -0.002};
+  robot.effects = {slip, slope};
+  const std::string path = TempPath("robot.yaml");
+  {
+    std::ofstream f(path);
+    f << io::Omni3RobotYaml(robot, nullptr);
+  }
+  const Omni3Robot back = io::ReadOmni3Robot(path);
+  ASSERT_EQ(back.effects.size(), 2u);
+  EXPECT_EQ(back.effects[0].id, EffectId::kWheelSpeedSlip);
+  EXPECT_DOUBLE_EQ(back.effects[0].value[0], 0.0123);
+  EXPECT_DOUBLE_EQ(back.effects[0].sigma[0], 0.0004);
+  EXPECT_EQ(back.effects[1].id, EffectId::kFloorSlope);
+  EXPECT_DOUBLE_EQ(back.effects[1].value[1], -0.002);
+
+  const auto expect_bad = [&](const std::string& effects_text, const std::string& what) {
+    std::string yaml = io::Omni3RobotYaml(
+        io::ReadOmni3Robot(FITCAL_SOURCE_DIR "/data/robots/apr02.yaml"), nullptr);
+    yaml += "effects:\n" + effects_text;
+    {
+      std::ofstream f(path);
+      f << yaml;
+    }
+    try {
+      io::ReadOmni3Robot(path);
+      ADD_FAILURE() << "accepted " << effects_text;
+    } catch (const io::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  expect_bad("  - {name: gremlins, x: 1}\n", "unknown effect");
+  expect_bad("  - {name: backlash, backlash_rad: 2.0}\n", "outside");
+  expect_bad("  - {name: backlash, backlash_rad: 0.1, colour: red}\n", "colour");
+  expect_bad("  - {name: floor_slope, creep_x_m_s: 0.01}\n", "creep_y_m_s");
+  std::filesystem::remove(path);
+}
+
+}  // namespace
+}  // namespace fitcal

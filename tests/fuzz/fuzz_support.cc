@@ -1,0 +1,151 @@
+#include "tests/fuzz/fuzz_support.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <stdexcept>
+
+#include "io/asoc_files.h"
+#include "io/dataset.h"
+#include "io/input_error.h"
+#include "io/log_files.h"
+#include "io/robot_yaml.h"
+
+namespace fitcal::fuzz {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// Valid neighbours for the data set loader: a robot and one run.
+constexpr const char* kRobotYaml =
+    "model: omni3\n"
+    "name: fuzz\n"
+    "wheels:\n"
+    "  - {name: a, distance_m: 0.195, radius_m: 0.148, angle_deg: 60.0}\n"
+    "  - {name: b, distance_m: 0.195, radius_m: 0.148, angle_deg: 180.0}\n"
+    "  - {name: c, distance_m: 0.195, radius_m: 0.148, angle_deg: 300.0}\n"
+    "bounds:\n"
+    "  distance_m: [0.170, 0.220]\n"
+    "  radius_m: [0.138, 0.158]\n"
+    "  angle_offset_deg: [-2.0, 2.0]\n";
+constexpr const char* kEncoderCsv = "t,w_a,w_b,w_c\n0,0,0,0\n0.01,1,2,3\n0.02,1,2,3\n";
+constexpr const char* kGroundTruthCsv = "t,x,y,theta\n0,0,0,0\n0.02,0.001,0,0\n";
+
+void WriteFile(const std::string& path, std::string_view bytes) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  if (!out) throw std::runtime_error("fuzz: cannot write " + path);
+}
+
+// One scratch directory per process, removed at exit.
+class ScratchDir {
+ public:
+  ScratchDir() {
+    std::string tmpl = (fs::temp_directory_path() / "fitcal-fuzz-XXXXXX").string();
+    if (mkdtemp(tmpl.data()) == nullptr) throw std::runtime_error("fuzz: mkdtemp failed");
+    path_ = tmpl;
+    WriteFile(path_ + "/robot.yaml", kRobotYaml);
+    WriteFile(path_ + "/enc.csv", kEncoderCsv);
+    WriteFile(path_ + "/gt.csv", kGroundTruthCsv);
+  }
+  ~ScratchDir() {
+    std::error_code ignored;
+    fs::remove_all(path_, ignored);
+  }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+void FuzzEncoderCsv(const std::string& path, const std::optional<EncoderTicks>& ticks) {
+  const EncoderLog log = io::ReadEncoderCsv(path, ticks);
+  // Contract of a loaded log (run_log.h): one sample per interval, positive dt.
+  if (log.samples.size() + 1 != log.t_s.size()) throw std::logic_error("sample count mismatch");
+  for (const WheelSample& s : log.samples) {
+    if (!(s.dt_s > 0.0)) throw std::logic_error("non-positive dt accepted");
+    for (double w : s.rate_rad_s) {
+      if (!std::isfinite(w)) throw std::logic_error("non-finite wheel rate accepted");
+    }
+  }
+}
+
+void FuzzGroundTruth(const std::string& path) {
+  const GroundTruthTrack track = io::ReadGroundTruth(path);
+  if (track.t_s.size() != track.world_T_robot.size() || track.t_s.size() < 2) {
+    throw std::logic_error("inconsistent ground-truth track");
+  }
+}
+
+void FuzzDataset(const std::string& dir) {
+  io::DatasetOptions options;
+  options.num_threads = 1;
+  const io::Dataset dataset = io::LoadDataset(dir, options);
+  // Nothing outside the scratch directory may have been read.
+  for (const RunLog& run : dataset.runs) {
+    if (run.encoders.t_s.size() < 2) throw std::logic_error("run without samples accepted");
+  }
+}
+
+void FuzzOmni3Robot(const std::string& path) {
+  if (io::ReadRobotModel(path) != "omni3") return;
+  const Omni3Robot robot = io::ReadOmni3Robot(path);
+  // Round trip: what fitcal writes, fitcal must read back.
+  const std::string again = path + ".out.yaml";
+  WriteFile(again, io::Omni3RobotYaml(robot, nullptr));
+  try {
+    io::ReadOmni3Robot(again);
+  } catch (const io::InputError& e) {
+    throw std::logic_error(std::string("written robot YAML does not read back: ") + e.what());
+  }
+}
+
+void FuzzAsocRobot(const std::string& path) {
+  if (io::ReadRobotModel(path) != "asoc") return;
+  const io::AsocRobot robot = io::ReadAsocRobot(path);
+  const std::string again = path + ".out.yaml";
+  WriteFile(again, io::AsocRobotYaml(robot));
+  try {
+    io::ReadAsocRobot(again);
+  } catch (const io::InputError& e) {
+    throw std::logic_error(std::string("written ASOC robot YAML does not read back: ") + e.what());
+  }
+}
+
+}  // namespace
+
+std::vector<std::string> FuzzTargetNames() {
+  std::vector<std::string> names;
+#define FITCAL_FUZZ_TARGET(name, file, call) names.push_back(#name);
+#include "tests/fuzz/loader_fuzz_targets.h"
+#undef FITCAL_FUZZ_TARGET
+  return names;
+}
+
+bool RunFuzzTarget(const std::string& target, std::string_view bytes) {
+  static const ScratchDir scratch;
+  const std::string& dir = scratch.path();
+#define FITCAL_FUZZ_TARGET(name, file, call)   \
+  if (target == #name) {                       \
+    const std::string path = dir + "/" + file; \
+    WriteFile(path, bytes);                    \
+    try {                                      \
+      call;                                    \
+    } catch (const io::InputError&) {          \
+      return false;                            \
+    }                                          \
+    return true;                               \
+  }
+#include "tests/fuzz/loader_fuzz_targets.h"
+#undef FITCAL_FUZZ_TARGET
+  (void)dir;
+  throw std::invalid_argument("unknown fuzz target '" + target + "'");
+}
+
+}  // namespace fitcal::fuzz

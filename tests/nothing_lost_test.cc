@@ -1,0 +1,210 @@
+// Nothing lost (issue 7): a previous calibrated YAML survives an interrupted or refused run, and
+// `--out` does not silently replace another robot's calibration. Drives the fitcal binary on a
+// data set written by `fitcal simulate`.
+
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "io/dataset.h"
+#include "io/log_files.h"
+#include "io/robot_yaml.h"
+
+namespace fitcal {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kFitcal = std::string(FITCAL_BINARY_DIR) + "/tools/fitcal";
+const std::string kRobot = std::string(FITCAL_SOURCE_DIR) + "/data/robots/apr02.yaml";
+
+std::string ReadBytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+void WriteBytes(const fs::path& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out << bytes;
+}
+
+class ScratchDir {
+ public:
+  ScratchDir() {
+    std::string tmpl = (fs::temp_directory_path() / "fitcal-nothing-lost-XXXXXX").string();
+    EXPECT_NE(mkdtemp(tmpl.data()), nullptr);
+    path_ = tmpl;
+  }
+  ~ScratchDir() {
+    std::error_code ignored;
+    fs::remove_all(path_, ignored);
+  }
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+int RunShell(const std::string& command) {
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+}
+
+fs::path Simulate(const fs::path& root, int repetitions) {
+  const fs::path data = root / "data";
+  EXPECT_EQ(RunShell(kFitcal + " simulate --robot '" + kRobot + "' --out '" + data.string() +
+                     "' --repetitions " + std::to_string(repetitions) + " > /dev/null"),
+            0);
+  return data;
+}
+
+// Files in `dir` other than the listed ones (temporaries left behind).
+std::vector<std::string> Leftovers(const fs::path& dir, const std::vector<std::string>& expected) {
+  std::vector<std::string> out;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    if (std::find(expected.begin(), expected.end(), name) == expected.end()) out.push_back(name);
+  }
+  return out;
+}
+
+// A calibrated YAML of robot `name` to be preserved.
+std::string PreviousOutput(const std::string& name) {
+  Omni3Robot robot = io::ReadOmni3Robot(kRobot);
+  robot.name = name;
+  io::CalibrationRecord record;
+  record.method = "ceres";
+  record.termination = "CONVERGENCE";
+  return io::Omni3RobotYaml(robot, &record);
+}
+
+TEST(NothingLostTest, SignalMidFitLeavesThePreviousOutputUntouched) {
+  const ScratchDir scratch;
+  const fs::path data = Simulate(scratch.path(), 5);
+  const fs::path out_dir = scratch.path() / "out";
+  fs::create_directories(out_dir);
+  const fs::path out = out_dir / "calibrated.yaml";
+  const std::string previous = PreviousOutput("apr02");
+  // Signals at increasing delays: early ones land in loading or fitting; a late one may find the
+  // run finished (then the new output is a complete, readable file). At least one must interrupt.
+  int interrupted = 0;
+  for (int signal_number : {SIGINT, SIGTERM, SIGKILL}) {
+    for (int delay_ms : {20, 100, 250}) {
+      SCOPED_TRACE("signal " + std::to_string(signal_number) + " after " +
+                   std::to_string(delay_ms) + " ms");
+      WriteBytes(out, previous);
+      const pid_t pid = fork();
+      ASSERT_GE(pid, 0);
+      if (pid == 0) {
+        const std::string logs = data.string(), out_arg = out.string();
+        std::freopen("/dev/null", "w", stdout);
+        execl(kFitcal.c_str(), "fitcal", "--logs", logs.c_str(), "--out", out_arg.c_str(),
+              "--threads", "1", static_cast<char*>(nullptr));
+        _exit(127);
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
+      kill(pid, signal_number);
+      int status = 0;
+      ASSERT_EQ(waitpid(pid, &status, 0), pid);
+      if (WIFSIGNALED(status)) {
+        ++interrupted;
+        EXPECT_EQ(ReadBytes(out), previous) << "the previous output was changed";
+      } else {
+        EXPECT_EQ(WEXITSTATUS(status), 0);
+        EXPECT_NO_THROW(io::ReadOmni3Robot(out.string()));
+      }
+      EXPECT_TRUE(Leftovers(out_dir, {"calibrated.yaml"}).empty()) << "temporary file left";
+    }
+  }
+  EXPECT_GE(interrupted, 3) << "no run was interrupted: the data set is too small to test this";
+}
+
+TEST(NothingLostTest, RefusedFitLeavesThePreviousOutputUntouched) {
+  // Failure after loading, before any output: miswired encoder columns (a and b swapped).
+  const ScratchDir scratch;
+  const fs::path data = Simulate(scratch.path(), 1);
+  const io::Dataset dataset = io::LoadDataset(data.string());
+  const io::DatasetIndex index = io::ReadDatasetIndex(data.string());
+  for (std::size_t i = 0; i < index.runs.size(); ++i) {
+    EncoderLog log = dataset.runs[i].encoders;
+    for (WheelSample& s : log.samples) std::swap(s.rate_rad_s[0], s.rate_rad_s[1]);
+    WriteBytes(index.runs[i].encoders_path, io::EncoderCsv(log));
+  }
+  const fs::path out = scratch.path() / "calibrated.yaml";
+  const std::string previous = PreviousOutput("apr02");
+  WriteBytes(out, previous);
+  const fs::path err = scratch.path() / "stderr.txt";
+  EXPECT_EQ(RunShell(kFitcal + " --logs '" + data.string() + "' --out '" + out.string() +
+                     "' > /dev/null 2> '" + err.string() + "'"),
+            4);
+  const std::string message = ReadBytes(err);
+  EXPECT_NE(message.find("columns w_a and w_b swapped"), std::string::npos) << message;
+  EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;
+  EXPECT_EQ(ReadBytes(out), previous);
+}
+
+TEST(NothingLostTest, OutRefusesAnotherRobotsCalibrationUnlessForced) {
+  const ScratchDir scratch;
+  const fs::path data = Simulate(scratch.path(), 1);
+  const fs::path out = scratch.path() / "calibrated.yaml";
+  const fs::path err = scratch.path() / "stderr.txt";
+  const std::string fit =
+      kFitcal + " --logs '" + data.string() + "' --train-reps 1 --out '" + out.string() + "'";
+  const std::string quiet = " > /dev/null 2> '" + err.string() + "'";
+
+  const std::string other = PreviousOutput("apr03");
+  WriteBytes(out, other);
+  EXPECT_EQ(RunShell(fit + quiet), 2);
+  EXPECT_NE(ReadBytes(err).find("holds the calibration of robot 'apr03', not 'apr02'"),
+            std::string::npos)
+      << ReadBytes(err);
+  EXPECT_EQ(ReadBytes(out), other);
+
+  WriteBytes(out, "not: [a robot\n");  // not even YAML: refused as well
+  EXPECT_EQ(RunShell(fit + quiet), 2);
+  EXPECT_NE(ReadBytes(err).find("is not a robot YAML"), std::string::npos) << ReadBytes(err);
+
+  WriteBytes(out, other);
+  EXPECT_EQ(RunShell(fit + " --force" + quiet), 0) << ReadBytes(err);
+  EXPECT_EQ(io::ReadOmni3Robot(out.string()).name, "apr02");
+
+  // The same robot's previous calibration is replaced without --force.
+  const std::string same = PreviousOutput("apr02");
+  WriteBytes(out, same);
+  EXPECT_EQ(RunShell(fit + quiet), 0) << ReadBytes(err);
+  EXPECT_NE(ReadBytes(out), same);
+}
+
+TEST(NothingLostTest, RatesInDegreesPerSecondGiveAUnitsWarning) {
+  const ScratchDir scratch;
+  const fs::path data = Simulate(scratch.path(), 1);
+  const io::DatasetIndex index = io::ReadDatasetIndex(data.string());
+  // One run in degrees/s is enough to be told (the check pools path lengths over runs, and a
+  // 57x longer odometry path dominates).
+  for (std::size_t i = 0; i < index.runs.size(); ++i) {
+    EncoderLog log = io::ReadEncoderCsv(index.runs[i].encoders_path);
+    for (WheelSample& s : log.samples) {
+      for (double& w : s.rate_rad_s) w *= 180.0 / M_PI;
+    }
+    WriteBytes(index.runs[i].encoders_path, io::EncoderCsv(log));
+  }
+  const fs::path err = scratch.path() / "stderr.txt";
+  RunShell(kFitcal + " --logs '" + data.string() + "' --no-output > /dev/null 2> '" + err.string() +
+           "'");
+  EXPECT_NE(ReadBytes(err).find("likely units: deg/s instead of rad/s"), std::string::npos)
+      << ReadBytes(err);
+}
+
+}  // namespace
+}  // namespace fitcal

@@ -1,0 +1,165 @@
+// `fitcal import optiodom` on the published recordings in ../shared/data/optiodom (skipped when
+// that directory is absent), and the ticks encoder format it writes.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "calib/aligned_run.h"
+#include "calib/final_pose_cost.h"
+#include "calib/segment_cost.h"
+#include "io/dataset.h"
+#include "io/input_error.h"
+#include "io/log_files.h"
+#include "io/robot_yaml.h"
+#include "tools/import_optiodom.h"
+
+namespace fitcal {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kOmni3 = fs::path(FITCAL_SHARED_DIR) / "data" / "optiodom" / "omni3";
+const fs::path kCircleSession = kOmni3 / "circular" / "221220201643";
+const fs::path kSquareSession = kOmni3 / "square" / "221220201934";
+
+#define SKIP_WITHOUT_DATA()                                                   \
+  if (!fs::is_directory(kCircleSession) || !fs::is_directory(kSquareSession)) \
+  GTEST_SKIP() << "no " << kOmni3
+
+fs::path TempDir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() /
+                       ("fitcal_optiodom_test_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+void WriteText(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
+
+TEST(OptiOdomImport, ReadsMetadataAndMapsTheAuthorsWheelsToOurs) {
+  SKIP_WITHOUT_DATA();
+  const tools::OptiOdomSession s = tools::ReadOptiOdomSession(kCircleSession.string());
+  EXPECT_EQ(s.path_type, "circular");
+  EXPECT_EQ(s.metadata.num_runs, 4);
+  ASSERT_EQ(s.runs.size(), 4u);
+  EXPECT_EQ(s.metadata.TicksPerWheelRev(), 12.0 * 1024.0);  // README: 12:1 gear, 1024 counts
+  const Omni3Robot robot = tools::OptiOdomNominalRobot(s.metadata);
+  EXPECT_DOUBLE_EQ(robot.nominal.radius_m[0], 0.051);  // Di = 0.102 m
+  EXPECT_DOUBLE_EQ(robot.nominal.distance_m[2], 0.195);
+  EXPECT_NEAR(RadToDeg(robot.nominal.angle_rad[1]), 60.0, 1e-12);
+  // Run 1, row 2 of the file holds ticks (-6, 24, 1): ours are their negatives, same order.
+  EXPECT_EQ(s.runs[0].ticks[1][0], 6.0);
+  EXPECT_EQ(s.runs[0].ticks[1][1], -24.0);
+  EXPECT_EQ(s.runs[0].ticks[1][2], -1.0);
+}
+
+// The documented mapping must beat all 47 other wheel orders/signs by a wide margin on the
+// intermediate ground truth (segments), where a wrong sign cannot hide behind a closed path.
+TEST(OptiOdomImport, DocumentedWheelMappingIsTheOneTheGroundTruthSupports) {
+  SKIP_WITHOUT_DATA();
+  for (const fs::path& dir : {kCircleSession, kSquareSession}) {
+    const tools::OptiOdomSession s = tools::ReadOptiOdomSession(dir.string());
+    const Omni3Robot robot = tools::OptiOdomNominalRobot(s.metadata);
+    std::vector<RunLog> logs;
+    for (const auto& run : s.runs) logs.push_back(tools::OptiOdomRunLog(s, run));
+    const auto ranking = tools::RankWheelMappings(logs, robot);
+    ASSERT_EQ(ranking.size(), 48u);
+    EXPECT_TRUE(ranking.front().IsIdentity()) << dir;
+
+    // Nominal parameters over 1 m windows: a few cm and degrees. Any wrong sign or order moves a
+    // window by tens of cm, so every alternative must be at least 3x worse.
+    EXPECT_LT(ranking[0].mean_cf, 0.15) << dir;
+    EXPECT_GT(ranking[1].mean_cf, 3.0 * ranking[0].mean_cf) << dir;
+  }
+}
+
+TEST(OptiOdomImport, WritesATicksDataSetThatLoadsBackToTheSameRuns) {
+  SKIP_WITHOUT_DATA();
+  const fs::path out = TempDir("roundtrip");
+  tools::ImportOptiOdomOptions options;
+  options.sessions = {kCircleSession.string()};
+  options.out = (out / "ds").string();
+  ASSERT_EQ(tools::RunImportOptiOdomCommand(options), 0);
+  const io::Dataset ds = io::LoadDataset(options.out);
+  const Omni3Robot robot = io::ReadOmni3Robot(ds.robot_path);
+  ASSERT_TRUE(robot.encoder.has_value());
+  EXPECT_EQ(robot.encoder->ticks_per_rev, 12288.0);
+  EXPECT_FALSE(robot.encoder->cumulative);
+  const tools::OptiOdomSession s = tools::ReadOptiOdomSession(kCircleSession.string());
+  ASSERT_EQ(ds.runs.size(), 4u);
+  for (std::size_t i = 0; i < 4; ++i) {
+    const RunLog direct = tools::OptiOdomRunLog(s, s.runs[i]);
+    EXPECT_EQ(ds.runs[i].trajectory, "circular_221220201643");
+    EXPECT_EQ(ds.runs[i].repetition, s.runs[i].number);
+    ASSERT_EQ(ds.runs[i].encoders.samples.size(), direct.encoders.samples.size());
+    // Times are written with 1 us resolution: rates (ticks / dt) agree to ~1e-6 / 0.04 relative.
+    for (std::size_t k = 0; k < direct.encoders.samples.size(); ++k) {
+      for (int w = 0; w < 3; ++w) {
+        EXPECT_NEAR(ds.runs[i].encoders.samples[k].rate_rad_s[w],
+                    direct.encoders.samples[k].rate_rad_s[w],
+                    1e-4 * (1.0 + std::abs(direct.encoders.samples[k].rate_rad_s[w])));
+      }
+    }
+  }
+  // Refuses to overwrite without --force.
+  EXPECT_EQ(tools::RunImportOptiOdomCommand(options), 2);
+  fs::remove_all(out);
+}
+
+TEST(OptiOdomImport, BadSessionIsOneErrorAndWritesNothing) {
+  SKIP_WITHOUT_DATA();
+  const fs::path tmp = TempDir("bad");
+  const fs::path session = tmp / "circular" / "221220201643";
+  fs::create_directories(session);
+  // Metadata says N = 4 but only one run file is present.
+  fs::copy_file(kCircleSession / "221220201643_metadata.csv",
+                session / "221220201643_metadata.csv");
+  fs::copy_file(kCircleSession / "221220201643_run-01.csv", session / "221220201643_run-01.csv");
+  try {
+    tools::ReadOptiOdomSession(session.string());
+    FAIL() << "expected an InputError";
+  } catch (const io::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("N = 4"), std::string::npos) << e.what();
+  }
+  tools::ImportOptiOdomOptions options;
+  options.sessions = {session.string()};
+  options.out = (tmp / "out").string();
+  EXPECT_EQ(tools::RunImportOptiOdomCommand(options), 1);
+  EXPECT_FALSE(fs::exists(tmp / "out"));
+  fs::remove_all(tmp);
+}
+
+TEST(EncoderTicks, IncrementsAndCumulativeGiveTheSameRatesAndTicksNeedAResolution) {
+  const fs::path tmp = TempDir("ticks");
+  WriteText(tmp / "inc.csv", "t,ticks_a,ticks_b,ticks_c\n0,5,5,5\n0.04,100,-50,0\n0.1,30,0,-12\n");
+  WriteText(tmp / "cum.csv",
+            "t,ticks_a,ticks_b,ticks_c\n0,1000,0,-7\n0.04,1100,-50,-7\n0.1,1130,-50,-19\n");
+  const EncoderTicks inc{4096.0, false}, cum{4096.0, true};
+  const EncoderLog a = io::ReadEncoderCsv((tmp / "inc.csv").string(), inc);
+  const EncoderLog b = io::ReadEncoderCsv((tmp / "cum.csv").string(), cum);
+  ASSERT_EQ(a.samples.size(), 2u);
+  ASSERT_EQ(b.samples.size(), 2u);
+  const double rad_per_tick = 2.0 * M_PI / 4096.0;
+  EXPECT_NEAR(a.samples[0].rate_rad_s[0], 100 * rad_per_tick / 0.04, 1e-12);
+  EXPECT_NEAR(a.samples[1].rate_rad_s[2], -12 * rad_per_tick / 0.06, 1e-12);
+  for (int k = 0; k < 2; ++k) {
+    for (int w = 0; w < 3; ++w)
+      EXPECT_NEAR(a.samples[k].rate_rad_s[w], b.samples[k].rate_rad_s[w], 1e-12);
+  }
+  try {
+    io::ReadEncoderCsv((tmp / "inc.csv").string());
+    FAIL() << "ticks without a resolution must be rejected";
+  } catch (const io::InputError& e) {
+    EXPECT_EQ(e.line(), 1);
+    EXPECT_NE(std::string(e.what()).find("ticks_per_rev"), std::string::npos);
+  }
+  // The rate format still loads.
+  WriteText(tmp / "w.csv", "t,w_a,w_b,w_c\n0,0,0,0\n0.04,1.5,-2,0.25\n");
+  EXPECT_DOUBLE_EQ(io::ReadEncoderCsv((tmp / "w.csv").string()).samples[0].rate_rad_s[1], -2.0);
+  fs::remove_all(tmp);
+}
+
+}  // namespace
+}  // namespace fitcal

@@ -1,0 +1,400 @@
+#include "tools/asoc_commands.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <random>
+#include <stdexcept>
+
+#include "calib/asoc_ceres_fit.h"
+#include "calib/asoc_geometric.h"
+#include "calib/run_split.h"
+#include "fitcal/version.h"
+#include "io/asoc_files.h"
+#include "io/atomic_file.h"
+#include "io/dataset.h"
+#include "io/input_error.h"
+#include "odometry/parallel_for.h"
+#include "tools/output_guard.h"
+#include "tools/sim/asoc_simulator.h"
+
+namespace fitcal::tools {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::uint64_t SplitMix(std::uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+io::AsocRobot RobotFromVehicle(const std::string& name, const asoc::Vehicle& v) {
+  io::AsocRobot robot;
+  robot.name = name;
+  robot.pivot_distance_m = v.PivotDistance(0, 1);
+  robot.nominal = v;
+  return robot;
+}
+
+bool IsHoldRun(const std::string& trajectory) { return trajectory.rfind("hold_", 0) == 0; }
+
+void PrintCastors(const io::AsocRobot& robot, const asoc::Vehicle& estimate, const char* label) {
+  std::printf("\n  %-8s %10s %10s %10s %10s %10s %12s   (%s)\n", "castor", "r_c [m]", "r_w1 [m]",
+              "r_w2 [m]", "d_1 [m]", "d_2 [m]", "beta [deg]", label);
+  for (int i = 0; i < asoc::kNumCastors; ++i) {
+    const asoc::CastorParameters& c = estimate.castors[i];
+    std::printf("  %-8s %10.6f %10.6f %10.6f %10.6f %10.6f %12.4f\n", robot.castor_names[i].c_str(),
+                c.offset_m, c.wheel_radius_m[0], c.wheel_radius_m[1], c.wheel_offset_m[0],
+                c.wheel_offset_m[1], RadToDeg(c.encoder_bias_rad));
+  }
+}
+
+}  // namespace
+
+int RunAsocSimulate(const AsocSimulateOptions& options) {
+  try {
+    const fs::path out(options.out);
+    if (fs::exists(out / "dataset.yaml") && !options.force) {
+      std::cerr << "fitcal: " << (out / "dataset.yaml").string()
+                << " exists; use --force to overwrite\n";
+      return 2;
+    }
+    fs::create_directories(out / "runs");
+    std::mt19937_64 rng(SplitMix(options.seed));
+    const asoc::Vehicle nominal = sim::AsocPrototypeVehicle();
+    const asoc::Vehicle truth = sim::DrawVehicle(nominal, sim::ParameterSpread{}, rng);
+    sim::AsocSimulationOptions sim_options;
+    sim_options.wheel_slip_sigma = options.wheel_slip_sigma;
+    std::vector<asoc::RunLog> runs = sim::SimulateCalibrationManoeuvre(truth, sim_options, rng);
+    // UMBmark circuits as repetitions 6-10 so that the default --train-reps 1-5 validates on them.
+    for (asoc::RunLog& run : sim::SimulateUmbmark(truth, sim_options, rng, 5)) {
+      run.repetition += 5;
+      run.id = run.trajectory + "-rep" + std::to_string(run.repetition);
+      runs.push_back(std::move(run));
+    }
+    for (int k = 1; k <= options.excursions; ++k) {
+      asoc::RunLog run = sim::SimulateRandomExcursion(truth, sim_options, rng);
+      run.trajectory = "excursion";
+      run.repetition = k;
+      run.id = "excursion-rep" + std::to_string(k);
+      runs.push_back(std::move(run));
+    }
+    std::vector<io::DatasetEntry> entries;
+    for (const asoc::RunLog& run : runs) {
+      const std::string enc = "runs/" + run.id + "_encoders.csv";
+      const std::string gt = "runs/" + run.id + "_ground_truth.csv";
+      io::WriteFileAtomically((out / enc).string(), io::AsocEncoderCsv(run.encoders));
+      io::WriteFileAtomically((out / gt).string(), io::GroundTruthCsv(run.ground_truth));
+      entries.push_back({run.id, run.trajectory, run.repetition, enc, gt});
+    }
+    io::WriteFileAtomically((out / "robot.yaml").string(),
+                            io::AsocRobotYaml(RobotFromVehicle("asoc-prototype", nominal)));
+    io::WriteFileAtomically((out / "truth.yaml").string(),
+                            io::AsocRobotYaml(RobotFromVehicle("asoc-truth", truth)));
+    io::WriteFileAtomically((out / "dataset.yaml").string(),
+                            io::DatasetYaml("robot.yaml", entries));
+    std::printf(
+        "wrote %zu ASOC runs (6 calibration holds, 10 UMBmark, %d excursions) to %s; the "
+        "true parameters are in truth.yaml\n",
+        runs.size(), options.excursions, options.out.c_str());
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "fitcal: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+int RunAsocGeometric(const AsocGeometricOptions& options) {
+  try {
+    io::DatasetOptions dataset_options;
+    dataset_options.allow_paths_outside = options.allow_outside_paths;
+    const io::AsocDataset dataset = io::LoadAsocDataset(options.logs, dataset_options);
+    const io::AsocRobot robot = io::ReadAsocRobot(dataset.robot_path);
+    const asoc::GeometricResult result = asoc::CalibrateGeometric(dataset.runs, robot.nominal);
+    std::printf("fitcal %s  asoc robot '%s'  closed-form calibration (Doebbler Eq. 1-9)  %s\n",
+                kVersion, robot.name.c_str(), options.logs.c_str());
+    PrintCastors(robot, robot.nominal, "nominal");
+    PrintCastors(robot, result.estimate, "calibrated");
+    std::printf("\n  half-difference of the two estimates per castor (repeatability):\n");
+    for (int i = 0; i < asoc::kNumCastors; ++i) {
+      const asoc::CastorParameters& h = result.half_spread[i];
+      std::printf(
+          "  %-8s r_c %.2g m, r_w %.2g/%.2g m, d %.2g/%.2g m, beta %.3g deg (%d estimates)\n",
+          robot.castor_names[i].c_str(), h.offset_m, h.wheel_radius_m[0], h.wheel_radius_m[1],
+          h.wheel_offset_m[0], h.wheel_offset_m[1], RadToDeg(h.encoder_bias_rad),
+          result.num_estimates[i]);
+    }
+    if (!result.usable) {
+      std::cerr << "fitcal: closed form not usable: " << result.message << " nothing written\n";
+      return 3;
+    }
+    if (!options.no_output) {
+      if (const std::string refusal = OverwriteRefusal(options.out, robot.name);
+          !refusal.empty() && !options.force) {
+        std::cerr << "fitcal: " << refusal << "\n";
+        return 2;
+      }
+      io::AsocRobot calibrated = robot;
+      calibrated.nominal = result.estimate;
+      const std::string record = "{method: closed-form Doebbler Eq. 1-9, dataset: '" +
+                                 options.logs + "', tool_version: '" + kVersion + "'}";
+      io::WriteFileAtomically(options.out, io::AsocRobotYaml(calibrated, record));
+      std::printf("wrote %s\n", options.out.c_str());
+    }
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "fitcal: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+int RunAsocFit(const FitCommandOptions& options) {
+  try {
+    io::DatasetOptions dataset_options;
+    dataset_options.allow_paths_outside = options.allow_outside_paths;
+    dataset_options.num_threads = options.threads;
+    const io::AsocDataset dataset = io::LoadAsocDataset(options.logs, dataset_options);
+    const io::AsocRobot robot = io::ReadAsocRobot(dataset.robot_path);
+    if (!options.no_output && !options.force) {
+      if (const std::string refusal = OverwriteRefusal(options.out, robot.name); !refusal.empty()) {
+        std::cerr << "fitcal: " << refusal << "\n";
+        return 2;
+      }
+    }
+    const std::vector<int> train_reps = ParseRepetitionList(options.train_reps);
+    std::vector<asoc::AlignedAsocRun> training, validation, umbmark;
+    std::vector<asoc::RunLog> umbmark_logs;
+    for (const asoc::RunLog& run : dataset.runs) {
+      const bool train =
+          std::find(train_reps.begin(), train_reps.end(), run.repetition) != train_reps.end();
+      (train ? training : validation).push_back(asoc::AlignAsocRun(run));
+      if (!train && run.trajectory.rfind("umbmark_", 0) == 0) umbmark_logs.push_back(run);
+    }
+    if (training.empty()) {
+      std::cerr << "fitcal: no run of " << options.logs << " has a training repetition ("
+                << options.train_reps << ")\n";
+      return 2;
+    }
+    asoc::AsocFitOptions fit_options;
+    fit_options.num_threads = options.threads;
+    fit_options.weights.position_sigma_m = options.position_sigma_m;
+    fit_options.weights.heading_sigma_rad = options.heading_sigma_deg * M_PI / 180.0;
+
+    struct Row {
+      std::string name;
+      asoc::Vehicle vehicle;
+      std::string status;
+    };
+    std::vector<Row> rows;
+    rows.push_back({"nominal", robot.nominal, "-"});
+    std::vector<asoc::RunLog> hold_runs;
+    for (const asoc::RunLog& run : dataset.runs) {
+      if (IsHoldRun(run.trajectory)) hold_runs.push_back(run);
+    }
+    const asoc::GeometricResult closed = asoc::CalibrateGeometric(hold_runs, robot.nominal);
+    if (closed.usable) rows.push_back({"closed form (Eq. 1-9)", closed.estimate, "closed form"});
+    const asoc::AsocFitResult ceres = asoc::FitAsocCeres(training, robot.nominal, fit_options);
+    rows.push_back({"ceres (from nominal)", ceres.estimate, ceres.termination});
+    asoc::AsocFitResult refined;
+    if (closed.usable) {
+      refined = asoc::FitAsocCeres(training, closed.estimate, fit_options);
+      rows.push_back({"closed form + ceres", refined.estimate, refined.termination});
+    }
+    std::printf("fitcal %s  asoc robot '%s'  data set %s\n", kVersion, robot.name.c_str(),
+                options.logs.c_str());
+    std::printf("runs: %zu training, %zu validation (%zu UMBmark circuits); closed form: %s\n\n",
+                training.size(), validation.size(), umbmark_logs.size(),
+                closed.usable ? closed.message.c_str() : "no complete hold runs");
+    std::printf("  %-24s %12s %12s %14s  %s\n", "method", "CF train", "CF valid", "UMBmark E_max",
+                "termination");
+    for (const Row& row : rows) {
+      char emax[32] = "-";
+      if (!umbmark_logs.empty()) {
+        bool has_both = false;
+        for (const auto& r : umbmark_logs) has_both |= r.trajectory == "umbmark_ccw";
+        if (has_both) {
+          std::snprintf(emax, sizeof emax, "%.1f mm",
+                        1000.0 * sim::EvaluateUmbmark(umbmark_logs, row.vehicle, {}).e_max_m);
+        }
+      }
+      std::printf("  %-24s %12.5f %12.5f %14s  %s\n", row.name.c_str(),
+                  asoc::AsocFinalPoseCf(row.vehicle, training),
+                  asoc::AsocFinalPoseCf(row.vehicle, validation), emax, row.status.c_str());
+    }
+    std::printf("  (CF: mean final-pose |[dx, dy, dpsi]|, m and rad, CAST-0 replay)\n");
+    const asoc::AsocFitResult& best = closed.usable ? refined : ceres;
+    PrintCastors(robot, best.estimate, closed.usable ? "closed form + ceres" : "ceres");
+    if (!best.has_covariance) std::printf("uncertainty: %s\n", best.covariance_message.c_str());
+    if (!best.usable) {
+      std::cerr << "fitcal: the fit did not converge (" << best.termination << ": " << best.message
+                << "); nothing written\n";
+      return 3;
+    }
+    if (!options.no_output) {
+      io::AsocRobot calibrated = robot;
+      calibrated.nominal = best.estimate;
+      const std::string record = std::string("{method: '") +
+                                 (closed.usable ? "closed form + ceres" : "ceres") +
+                                 "', dataset: '" + options.logs + "', tool_version: '" + kVersion +
+                                 "', termination: " + best.termination + "}";
+      io::WriteFileAtomically(options.out, io::AsocRobotYaml(calibrated, record));
+      std::printf("wrote %s\n", options.out.c_str());
+    }
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "fitcal: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+int RunAsocTables(const AsocTablesOptions& options) {
+  if (options.sets < 1) {
+    std::cerr << "fitcal: --sets must be at least 1\n";
+    return 2;
+  }
+  const asoc::Vehicle nominal = sim::AsocPrototypeVehicle();
+  sim::AsocSimulationOptions sim_options;
+  sim_options.wheel_slip_sigma = options.wheel_slip_sigma;
+  const std::size_t n = static_cast<std::size_t>(options.sets);
+  // Per set: Table I errors [uncal, cal] x [r_c, r_w, d, beta]; Table II E_max [uncal, cal] x alg.
+  struct SetResult {
+    double param[2][4] = {{0, 0, 0, 0}, {0, 0, 0, 0}};
+    double emax[2][3] = {{0, 0, 0}, {0, 0, 0}};
+  };
+  std::vector<SetResult> results(n);
+  const int excluded[3] = {1, 1, 0};
+  ParallelFor(n, options.threads, [&](std::size_t s) {
+    std::mt19937_64 rng(SplitMix(options.seed ^ SplitMix(s)));
+    SetResult& r = results[s];
+    // Table I: 1000 random parameter sets through the calibration.
+    const asoc::Vehicle truth = sim::DrawVehicle(nominal, sim::ParameterSpread{}, rng);
+    asoc::GeometricResult cal = asoc::CalibrateGeometric(
+        sim::SimulateCalibrationManoeuvre(truth, sim_options, rng), nominal);
+    for (int which = 0; which < 2; ++which) {
+      const asoc::Vehicle& est = which == 0 ? nominal : cal.estimate;
+      for (int i = 0; i < asoc::kNumCastors; ++i) {
+        const asoc::CastorParameters& t = truth.castors[i];
+        const asoc::CastorParameters& e = est.castors[i];
+        r.param[which][0] += std::abs(e.offset_m / t.offset_m - 1.0) / 3.0;
+        for (int k = 0; k < 2; ++k) {
+          r.param[which][1] += std::abs(e.wheel_radius_m[k] / t.wheel_radius_m[k] - 1.0) / 6.0;
+          r.param[which][2] += std::abs(e.wheel_offset_m[k] / t.wheel_offset_m[k] - 1.0) / 6.0;
+        }
+        r.param[which][3] += std::abs(WrapAngle(e.encoder_bias_rad - t.encoder_bias_rad)) / 3.0;
+      }
+    }
+    // Table II: beta = 0 in the truth (Doebbler Sec. IV-B), UMBmark 5 x CW and CCW.
+    sim::ParameterSpread spread;
+    spread.bias_range_rad = 0.0;
+    const asoc::Vehicle truth2 = sim::DrawVehicle(nominal, spread, rng);
+    cal = asoc::CalibrateGeometric(sim::SimulateCalibrationManoeuvre(truth2, sim_options, rng),
+                                   nominal);
+    const auto runs = sim::SimulateUmbmark(truth2, sim_options, rng, 5);
+    for (int a = 0; a < 3; ++a) {
+      asoc::OdometryOptions o;
+      o.castors = asoc::MaskExcluding(excluded[a]);
+      if (a == 0) o.method = asoc::Method::kIpec;
+      r.emax[0][a] = sim::EvaluateUmbmark(runs, nominal, o).e_max_m;
+      r.emax[1][a] = sim::EvaluateUmbmark(runs, cal.estimate, o).e_max_m;
+    }
+  });
+  SetResult mean;
+  for (const SetResult& r : results) {
+    for (int w = 0; w < 2; ++w) {
+      for (int k = 0; k < 4; ++k) mean.param[w][k] += r.param[w][k] / n;
+      for (int a = 0; a < 3; ++a) mean.emax[w][a] += r.emax[w][a] / n;
+    }
+  }
+  std::printf(
+      "Doebbler et al. Tables I and II, %d random parameter sets (seed %llu, wheel slip "
+      "sigma %g per 20 Hz sample)\n\n",
+      options.sets, static_cast<unsigned long long>(options.seed), options.wheel_slip_sigma);
+  std::printf("Table I: mean absolute parameter error\n\n");
+  std::printf("| parameter | uncalibrated | calibrated | paper uncal. | paper cal. |\n");
+  std::printf("|---|---|---|---|---|\n");
+  const char* names[4] = {"r_c", "r_w", "d", "beta"};
+  const char* paper[4][2] = {
+      {"0.21%", "0.09%"}, {"2.07%", "0.04%"}, {"0.89%", "0.04%"}, {"7.98 deg", "0.01 deg"}};
+  for (int k = 0; k < 4; ++k) {
+    if (k < 3) {
+      std::printf("| %s | %.3f%% | %.3f%% | %s | %s |\n", names[k], 100 * mean.param[0][k],
+                  100 * mean.param[1][k], paper[k][0], paper[k][1]);
+    } else {
+      std::printf("| %s | %.3f deg | %.4f deg | %s | %s |\n", names[k], RadToDeg(mean.param[0][k]),
+                  RadToDeg(mean.param[1][k]), paper[k][0], paper[k][1]);
+    }
+  }
+  std::printf("\nTable II: UMBmark E_max (1.5 m square, 5 x CW and CCW, 6 m per circuit)\n\n");
+  std::printf("| algorithm | uncalibrated | calibrated | ratio | paper uncal. | paper cal. |\n");
+  std::printf("|---|---|---|---|---|---|\n");
+  const char* alg[3] = {"IPEC-1", "CAST-1", "CAST-0"};
+  const char* paper2[3][2] = {{"394.6 mm 6.89%", "71.7 mm 1.25%"},
+                              {"394.1 mm 6.88%", "71.6 mm 1.25%"},
+                              {"311.0 mm 5.43%", "39.0 mm 0.68%"}};
+  for (int a = 0; a < 3; ++a) {
+    std::printf("| %s | %.1f mm %.2f%% | %.2f mm %.3f%% | %.0fx | %s | %s |\n", alg[a],
+                1000 * mean.emax[0][a], 100 * mean.emax[0][a] / 6.0, 1000 * mean.emax[1][a],
+                100 * mean.emax[1][a] / 6.0, mean.emax[0][a] / mean.emax[1][a], paper2[a][0],
+                paper2[a][1]);
+  }
+  std::printf(
+      "\nratios: CAST-0 / two-castor uncalibrated %.3f (paper 0.79), calibrated %.3f "
+      "(paper 0.54); IPEC-1 / CAST-1 uncalibrated %.4f (paper 1.0013)\n",
+      mean.emax[0][2] / mean.emax[0][1], mean.emax[1][2] / mean.emax[1][1],
+      mean.emax[0][0] / mean.emax[0][1]);
+  return 0;
+}
+
+void AsocCommands::Register(CLI::App& app) {
+  simulate_cmd = app.add_subcommand(
+      "asoc-simulate", "Write a simulated ASOC data set (calibration holds, UMBmark, excursions)");
+  simulate_cmd->add_option("--out", simulate.out, "Output data set directory")->required();
+  simulate_cmd->add_option("--seed", simulate.seed, "Random seed")->capture_default_str();
+  simulate_cmd->add_option("--excursions", simulate.excursions, "Random excursion runs")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  simulate_cmd
+      ->add_option("--wheel-slip-sigma", simulate.wheel_slip_sigma,
+                   "Relative wheel-encoder noise per 20 Hz sample")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  simulate_cmd->add_flag("--force", simulate.force, "Overwrite an existing data set");
+
+  geometric_cmd = app.add_subcommand(
+      "asoc-geometric", "Closed-form ASOC calibration (Doebbler Eq. 1-9) from hold runs");
+  geometric_cmd->add_option("--logs", geometric.logs, "Data set with hold_<i>_cw/ccw runs")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  geometric_cmd->add_option("--out", geometric.out, "Calibrated robot YAML (atomically)")
+      ->capture_default_str();
+  geometric_cmd->add_flag("--no-output", geometric.no_output, "Do not write the YAML");
+  geometric_cmd->add_flag("--force", geometric.force,
+                          "Replace an --out that holds another robot's calibration");
+  geometric_cmd->add_flag("--allow-outside-paths", geometric.allow_outside_paths,
+                          "Allow dataset.yaml paths outside the data set directory");
+
+  tables_cmd =
+      app.add_subcommand("asoc-tables", "Reproduce Doebbler et al. Tables I and II in simulation");
+  tables_cmd->add_option("--sets", tables.sets, "Random parameter sets")->capture_default_str();
+  tables_cmd->add_option("--seed", tables.seed, "Random seed")->capture_default_str();
+  tables_cmd
+      ->add_option("--wheel-slip-sigma", tables.wheel_slip_sigma,
+                   "Relative wheel-encoder noise per 20 Hz sample (non-systematic error)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  tables_cmd->add_option("--threads", tables.threads, "Worker threads (0 = all cores)")
+      ->capture_default_str();
+}
+
+int AsocCommands::Dispatch(const CLI::App& app) const {
+  if (app.got_subcommand(simulate_cmd)) return RunAsocSimulate(simulate);
+  if (app.got_subcommand(geometric_cmd)) return RunAsocGeometric(geometric);
+  if (app.got_subcommand(tables_cmd)) return RunAsocTables(tables);
+  return -1;
+}
+
+}  // namespace fitcal::tools

@@ -1,0 +1,57 @@
+#pragma once
+// ASOC subcommands (Doebbler et al.): `asoc-simulate` writes an ASOC data set, `asoc-geometric`
+// runs the closed-form calibration (Eq. 1-9) on a calibration-manoeuvre data set,
+// `asoc-tables` reproduces Tables I and II, and RunAsocFit is the `model: asoc` branch of
+// `fitcal --logs DIR --method ceres`.
+
+#include <CLI/CLI.hpp>
+#include <cstdint>
+#include <string>
+
+#include "tools/fit_command.h"
+
+namespace fitcal::tools {
+
+struct AsocSimulateOptions {
+  std::string out;
+  std::uint64_t seed = 1;
+  int excursions = 5;  // random-excursion runs (repetitions 1..N), the fit's training data
+  double wheel_slip_sigma = 0.0;
+  bool force = false;
+};
+
+struct AsocGeometricOptions {
+  std::string logs;
+  std::string out = "calibrated_asoc.yaml";
+  bool no_output = false;
+  bool force = false;  // replace an --out holding another robot's calibration
+  bool allow_outside_paths = false;
+};
+
+struct AsocTablesOptions {
+  int sets = 1000;
+  std::uint64_t seed = 1;
+  double wheel_slip_sigma = 0.0;
+  int threads = 0;
+};
+
+int RunAsocSimulate(const AsocSimulateOptions& options);
+int RunAsocGeometric(const AsocGeometricOptions& options);
+int RunAsocTables(const AsocTablesOptions& options);
+// The ASOC branch of `fitcal fit`: closed form, Ceres, closed form + Ceres on the same validation.
+int RunAsocFit(const FitCommandOptions& options);
+
+// Registers the three subcommands on `app`; `dispatch` runs the one that was given (returns -1
+// when none of them was).
+struct AsocCommands {
+  AsocSimulateOptions simulate;
+  AsocGeometricOptions geometric;
+  AsocTablesOptions tables;
+  CLI::App* simulate_cmd = nullptr;
+  CLI::App* geometric_cmd = nullptr;
+  CLI::App* tables_cmd = nullptr;
+  void Register(CLI::App& app);
+  int Dispatch(const CLI::App& app) const;
+};
+
+}  // namespace fitcal::tools

@@ -1,0 +1,35 @@
+#pragma once
+// `fitcal compare --logs <dir>`: Palacin Table 4 regenerated on the user's data - every strategy
+// (STA..STE or explicit trajectory lists, calib/strategies.h) x every method (tools/fit_methods.h)
+// x training on the first 1 or 5 repetitions, validated on every trajectory of the held-out
+// repetitions (Palacin Sec. 3.2: "five additional" repetitions of the whole flower). Prints the
+// table as Markdown and writes <out>.csv, <out>.md and <out>_trace.csv (best CF vs evaluations
+// per fit), each atomically, after every fit has finished.
+
+#include <string>
+#include <vector>
+
+namespace fitcal::tools {
+
+struct CompareCommandOptions {
+  std::string logs;
+  std::vector<std::string> strategies = {"STA", "STB", "STC", "STD", "STE"};
+  std::vector<std::string> methods = {"ceres", "crs2lm", "esch", "slsqp"};  // or "all"
+  std::vector<int> repetitions = {1, 5};  // train on the first k repetitions of the data set
+  std::string validation_reps;            // "" = every repetition after the largest k
+  std::string out = "compare";            // prefix of the output files
+  bool no_output = false;
+  bool quiet = false;
+  bool allow_outside_paths = false;
+  int threads = 0;
+  unsigned long seed = 1;
+  int max_evaluations = 10000;  // NLopt methods, per fit
+  bool polish = false;          // NLopt global methods: SLSQP polish
+  std::string objective;        // "" = each method's default; "squares" or "eq14"
+};
+
+// Returns the process exit code; the table goes to stdout, progress (on a terminal, unless
+// quiet) and errors (one line) to stderr.
+int RunCompareCommand(const CompareCommandOptions& options);
+
+}  // namespace fitcal::tools

@@ -1,0 +1,38 @@
+#pragma once
+// `fitcal diagnose --logs <dir>`: the declared nine-parameter fit, its residual, the tracing of
+// that residual to library effects (calib/diagnose.h), the error before and after on held-out
+// repetitions. Prints the report and writes, into --out (a directory):
+//   diagnose.md     the report (Markdown)
+//   residuals.csv   the pose error at every ground-truth sample of every run, after the tracing
+//                   (world and robot frame); residuals_declared.csv the same for the declared fit
+//   calibrated.yaml the calibrated robot; carries the `effects:` list when effects were named
+
+#include <string>
+
+namespace CLI {
+class App;
+}
+
+namespace fitcal::tools {
+
+struct DiagnoseCommandOptions {
+  std::string logs;
+  std::string train_reps = "auto";  // "auto": the first half of the repetitions present
+  // Non-empty: split by trajectory label instead (calib/trajectory_split.h): matching runs train,
+  // the others validate (e.g. "^circular" trains on circles and validates on squares).
+  std::string train_trajectories;
+  // Re-stamp each run's ground truth on the encoder clock first (calib/segment_cost.h,
+  // EstimateClockMap): for recordings whose clocks were only mapped by hand.
+  bool clock_map = false;
+  std::string out = "diagnose";
+  int threads = 0;
+  int max_effects = 3;
+  double alpha = 0.01;
+  bool allow_outside_paths = false;
+};
+
+// Adds the `diagnose` subcommand to app; returns it (check ->parsed()).
+CLI::App* AddDiagnoseCommand(CLI::App& app, DiagnoseCommandOptions& options);
+int RunDiagnoseCommand(const DiagnoseCommandOptions& options);
+
+}  // namespace fitcal::tools

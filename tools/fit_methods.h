@@ -1,0 +1,51 @@
+#pragma once
+// The registry of fit methods behind `--method` (fit) and `--methods` (compare): Ceres
+// (Levenberg-Marquardt or dogleg) and every NLopt method of calib/omni3_nlopt_fit.h, each one
+// entry of a table with one function that fits and reports in the Ceres fit's result shape.
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "calib/omni3_ceres_fit.h"
+#include "calib/omni3_nlopt_fit.h"
+
+namespace fitcal::tools {
+
+// Settings a caller may change for any method; each method uses the ones that apply to it.
+struct FitMethodSettings {
+  int threads = 0;
+  ResidualWeights weights;
+  // Ceres: kSumOfSquares by default; NLopt: Eq. 14 by default (see the option docs).
+  bool objective_set = false;
+  FinalPoseObjective objective = FinalPoseObjective::kSumOfSquares;
+  CeresRobustLoss loss = CeresRobustLoss::kNone;  // Ceres only
+  double loss_scale = 0.05;
+  std::uint64_t seed = 1;                              // NLopt only
+  int max_evaluations = 20000;                         // NLopt only
+  bool local_polish = false;                           // NLopt global methods only
+  std::function<void(const NloptProgress&)> progress;  // NLopt only
+};
+
+struct FitMethodOutcome {
+  Omni3FitResult fit;     // parameters, termination, usable, (Ceres) covariance
+  int evaluations = 0;    // objective evaluations over all training runs (Ceres: residual +
+                          // Jacobian evaluations)
+  std::string objective;  // what was minimised, in words
+  std::vector<ConvergencePoint> trace;  // best CF vs evaluations
+};
+
+struct FitMethod {
+  std::string name;
+  std::string description;
+  std::function<FitMethodOutcome(const std::vector<AlignedRun>&, const Omni3Robot&,
+                                 const FitMethodSettings&)>
+      run;
+};
+
+const std::vector<FitMethod>& FitMethods();
+const FitMethod* FindFitMethod(const std::string& name);  // nullptr if unknown
+std::string FitMethodNames();                             // "ceres, ceres-dogleg, crs2lm, ..."
+
+}  // namespace fitcal::tools

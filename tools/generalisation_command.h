@@ -1,0 +1,35 @@
+#pragma once
+// `fitcal generalise --logs DIR`: how well a calibration transfers to paths it was not fitted on.
+// Runs are grouped by path type (the trajectory label up to its first '_', e.g. `circular` of
+// `circular_221220201643`, as `fitcal import optiodom` writes them) and by session (the whole
+// trajectory label). For every model (nominal, nine parameters with the final-pose or the segment
+// cost, the reduced common-distance + three-radii model) it prints:
+//   - train on one path type, test on each other one (final-pose CF, Eq. 14, and segment CF);
+//   - leave-one-session-out: fit on all other sessions, test on the one left out.
+// The Markdown table it prints is the one in the README.
+
+#include <string>
+#include <vector>
+
+namespace fitcal::tools {
+
+struct GeneraliseCommandOptions {
+  std::string logs;
+  double segment_length_m = 1.0;
+  bool clock_map = true;  // refine each run's ground-truth clock before cutting segments
+  bool leave_one_session_out = true;
+  // Non-empty: instead of every pair of path types, train on the runs whose trajectory label
+  // matches (calib/trajectory_split.h: a list of labels or a regular expression) and test on the
+  // others, then the other way round.
+  std::string train_trajectories;
+  // Library effects (odometry/effects.h names) to add as a further model: "nine + effects",
+  // fitted to the training runs' ground-truth tracks (calib/effect_fit.h) and scored on the test
+  // runs' final poses (Eq. 14, replayed with the effects). "nine, track cost" is the same fit
+  // without effects, the like-for-like baseline.
+  std::vector<std::string> effects;
+  int threads = 0;
+};
+
+int RunGeneraliseCommand(const GeneraliseCommandOptions& options);
+
+}  // namespace fitcal::tools

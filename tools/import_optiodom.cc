@@ -1,0 +1,355 @@
+#include "tools/import_optiodom.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <numeric>
+#include <regex>
+#include <set>
+
+#include "calib/aligned_run.h"
+#include "calib/final_pose_cost.h"
+#include "calib/segment_cost.h"
+#include "io/atomic_file.h"
+#include "io/dataset.h"
+#include "io/input_error.h"
+#include "io/robot_yaml.h"
+#include "io/text_file.h"
+#include "odometry/parallel_for.h"
+
+namespace fitcal::tools {
+
+namespace fs = std::filesystem;
+using io::InputError;
+using io::InputErrorKind;
+
+namespace {
+
+// Our wheel angles (deg) for the authors' wheels 1, 2, 3; see the header.
+constexpr double kWheelAngleDeg[3] = {300.0, 60.0, 180.0};
+// Our wheel rate = kTickSign * the authors' (the header derives it).
+constexpr double kTickSign = -1.0;
+
+std::vector<std::string> SplitCsv(std::string_view line) {
+  std::vector<std::string> out;
+  std::size_t pos = 0;
+  while (true) {
+    const std::size_t end = line.find(',', pos);
+    out.emplace_back(io::Trim(line.substr(pos, end == std::string_view::npos ? end : end - pos)));
+    if (end == std::string_view::npos) break;
+    pos = end + 1;
+  }
+  return out;
+}
+
+double ParseNumber(const std::string& field, const std::string& path, int line,
+                   const std::string& what) {
+  double v = 0.0;
+  bool finite = true;
+  if (!io::ParseDouble(field, &v, &finite) || !finite) {
+    throw InputError(InputErrorKind::kNonNumeric, path, line,
+                     what + " is not a finite number: '" + field + "'");
+  }
+  return v;
+}
+
+OptiOdomMetadata ReadMetadata(const std::string& path) {
+  const std::string text = io::ReadTextFile(path);
+  io::LineScanner lines(text);
+  std::string_view line;
+  std::map<std::string, std::pair<int, std::vector<double>>> rows;  // key -> (line, numbers)
+  OptiOdomMetadata meta;
+  while (lines.Next(&line)) {
+    if (io::Trim(line).empty()) continue;
+    std::vector<std::string> fields = SplitCsv(line);
+    const std::string key = fields[0];
+    if (key == "type") {
+      meta.type = fields.size() > 1 ? fields[1] : "";
+      continue;
+    }
+    std::vector<double> values;
+    for (std::size_t i = 1; i < fields.size(); ++i) {
+      if (fields[i].empty()) continue;  // the file pads every row to the widest one
+      values.push_back(
+          ParseNumber(fields[i], path, lines.line_number(), key + " value " + std::to_string(i)));
+    }
+    rows[key] = {lines.line_number(), values};
+  }
+  if (meta.type != "omni3") {
+    throw InputError(
+        InputErrorKind::kUnknownModel, path, 1,
+        "type '" + meta.type + "' is not omni3 (the only OptiOdom robot fitcal imports)");
+  }
+  const auto get = [&](const std::string& key, std::size_t count, bool exact) {
+    const auto it = rows.find(key);
+    if (it == rows.end())
+      throw InputError(InputErrorKind::kMissingKey, path, 0, "no row '" + key + "'");
+    const auto& [line_number, values] = it->second;
+    if (exact ? values.size() != count : values.size() < count) {
+      throw InputError(InputErrorKind::kWrongColumnCount, path, line_number,
+                       key + " needs " + std::to_string(count) + " value(s), found " +
+                           std::to_string(values.size()));
+    }
+    for (double v : values) {
+      if (key.rfind("gt_", 0) != 0 && key.rfind("odo_", 0) != 0 && !(v > 0.0)) {
+        throw InputError(InputErrorKind::kBadValue, path, line_number, key + " must be positive");
+      }
+    }
+    return values;
+  };
+  meta.gear_ratio = get("ngear", 1, true)[0];
+  meta.encoder_counts_per_rev = get("encRes", 1, true)[0];
+  meta.distance_m = get("Li", 1, true)[0];
+  const std::vector<double> d = get("Di", 3, true);
+  std::copy(d.begin(), d.end(), meta.diameter_m.begin());
+  const double n = get("N", 1, true)[0];
+  if (n != std::floor(n))
+    throw InputError(InputErrorKind::kBadValue, path, rows["N"].first, "N is not a whole number");
+  meta.num_runs = static_cast<int>(n);
+  const std::size_t runs = static_cast<std::size_t>(meta.num_runs);
+  meta.gt_ti_s = get("gt_ti", runs, true);
+  meta.gt_tf_s = get("gt_tf", runs, true);
+  meta.odo_ti_s = get("odo_ti", runs, true);
+  meta.odo_tf_s = get("odo_tf", runs, true);
+  return meta;
+}
+
+OptiOdomRun ReadRun(const std::string& path, int number) {
+  const std::string text = io::ReadTextFile(path);
+  io::LineScanner lines(text);
+  std::string_view line;
+  OptiOdomRun run;
+  run.number = number;
+  while (lines.Next(&line)) {
+    if (io::Trim(line).empty()) continue;
+    const std::vector<std::string> fields = SplitCsv(line);
+    if (fields.size() != 7) {
+      throw InputError(InputErrorKind::kWrongColumnCount, path, lines.line_number(),
+                       "expected 7 fields (t, x, y, theta, ticks_1, ticks_2, ticks_3), found " +
+                           std::to_string(fields.size()));
+    }
+    double v[7];
+    for (int i = 0; i < 7; ++i) {
+      v[i] = ParseNumber(fields[i], path, lines.line_number(), "field " + std::to_string(i + 1));
+    }
+    if (!run.t_s.empty() && !(v[0] > run.t_s.back())) {
+      throw InputError(InputErrorKind::kNonIncreasingTime, path, lines.line_number(),
+                       "time " + fields[0] + " s is not after the previous row's");
+    }
+    run.t_s.push_back(v[0]);
+    // + 0.0 turns the file's "-0" into 0.
+    run.ticks.push_back({kTickSign * v[4] + 0.0, kTickSign * v[5] + 0.0, kTickSign * v[6] + 0.0});
+    run.ground_truth.t_s.push_back(v[0]);
+    run.ground_truth.world_T_robot.push_back(Pose2d{v[1], v[2], v[3]});
+  }
+  if (run.t_s.size() < 2) {
+    throw InputError(InputErrorKind::kTooFewSamples, path, 0,
+                     "needs at least two rows, found " + std::to_string(run.t_s.size()));
+  }
+  return run;
+}
+
+}  // namespace
+
+OptiOdomSession ReadOptiOdomSession(const std::string& directory) {
+  const fs::path dir = fs::path(directory).lexically_normal();
+  if (!fs::is_directory(dir))
+    throw InputError(InputErrorKind::kMissingFile, directory, 0, "not a directory");
+  OptiOdomSession session;
+  session.name = (dir.has_filename() ? dir : dir.parent_path()).filename().string();
+  session.path_type =
+      (dir.has_filename() ? dir : dir.parent_path()).parent_path().filename().string();
+  if (session.path_type.empty()) session.path_type = "path";
+  session.metadata = ReadMetadata((dir / (session.name + "_metadata.csv")).string());
+
+  const std::regex run_name(session.name + "_run-([0-9]+)\\.csv");
+  std::vector<std::pair<int, std::string>> files;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    std::smatch m;
+    const std::string name = entry.path().filename().string();
+    if (std::regex_match(name, m, run_name))
+      files.emplace_back(std::stoi(m[1]), entry.path().string());
+  }
+  std::sort(files.begin(), files.end());
+  if (static_cast<int>(files.size()) != session.metadata.num_runs) {
+    throw InputError(
+        InputErrorKind::kBadValue, (dir / (session.name + "_metadata.csv")).string(), 0,
+        "N = " + std::to_string(session.metadata.num_runs) + " runs, but the directory holds " +
+            std::to_string(files.size()) + " run files");
+  }
+  session.runs.resize(files.size());
+  ParallelFor(files.size(), 0,
+              [&](std::size_t i) { session.runs[i] = ReadRun(files[i].second, files[i].first); });
+  return session;
+}
+
+Omni3Robot OptiOdomNominalRobot(const OptiOdomMetadata& metadata) {
+  Omni3Robot robot;
+  robot.name = "optiodom_omni3";
+  robot.wheel_names = {"a", "b", "c"};
+  for (int i = 0; i < 3; ++i) {
+    robot.nominal.distance_m[i] = metadata.distance_m;
+    robot.nominal.radius_m[i] = 0.5 * metadata.diameter_m[i];
+    robot.nominal.angle_rad[i] = DegToRad(kWheelAngleDeg[i]);
+  }
+  // Palacin Eq. 16 gives R +- 0.025 m, r +- 0.010 m on r = 0.148 m (6.8 %), delta +- 2 deg: the
+  // same physical box scaled to this robot's wheels.
+  const double r_min =
+      *std::min_element(robot.nominal.radius_m.begin(), robot.nominal.radius_m.end());
+  const double r_max =
+      *std::max_element(robot.nominal.radius_m.begin(), robot.nominal.radius_m.end());
+  robot.bounds.distance_m = {metadata.distance_m - 0.025, metadata.distance_m + 0.025};
+  robot.bounds.radius_m = {r_min * (1.0 - 0.01 / 0.148), r_max * (1.0 + 0.01 / 0.148)};
+  robot.bounds.angle_offset_rad = {DegToRad(-2.0), DegToRad(2.0)};
+  robot.encoder = EncoderTicks{metadata.TicksPerWheelRev(), false};
+  return robot;
+}
+
+RunLog OptiOdomRunLog(const OptiOdomSession& session, const OptiOdomRun& run) {
+  RunLog log;
+  char id[64];
+  std::snprintf(id, sizeof id, "%s_%s_run%02d", session.path_type.c_str(), session.name.c_str(),
+                run.number);
+  log.id = id;
+  log.trajectory = session.path_type + "_" + session.name;
+  log.repetition = run.number;
+  const double rad_per_tick = 2.0 * M_PI / session.metadata.TicksPerWheelRev();
+  log.encoders.t_s = run.t_s;
+  for (std::size_t k = 1; k < run.t_s.size(); ++k) {
+    WheelSample s;
+    s.dt_s = run.t_s[k] - run.t_s[k - 1];
+    for (int i = 0; i < 3; ++i) s.rate_rad_s[i] = rad_per_tick * run.ticks[k][i] / s.dt_s;
+    log.encoders.samples.push_back(s);
+  }
+  log.ground_truth = run.ground_truth;
+  // The robot is at rest at the start (the ground truth's frame is the start frame).
+  log.start_pose = run.ground_truth.world_T_robot.front();
+  return log;
+}
+
+std::vector<WheelMappingScore> RankWheelMappings(const std::vector<RunLog>& runs,
+                                                 const Omni3Robot& robot) {
+  const std::vector<AlignedRun> aligned = AlignRuns(runs);
+  const auto nominal = robot.nominal.ToArray();
+  std::vector<WheelMappingScore> scores;
+  for (const WheelMapping& mapping : AllWheelMappings()) {
+    const std::vector<AlignedRun> mapped = ApplyWheelMapping(aligned, mapping);
+    std::vector<SegmentedRun> segmented(mapped.size());
+    for (std::size_t r = 0; r < mapped.size(); ++r) {
+      segmented[r] = {&mapped[r], MakeSegments(mapped[r], runs[r].ground_truth, SegmentOptions{})};
+    }
+    scores.push_back({mapping, EvaluateSegmentErrors(nominal, segmented).cf});
+  }
+  std::stable_sort(scores.begin(), scores.end(),
+                   [](const auto& a, const auto& b) { return a.mean_cf < b.mean_cf; });
+  return scores;
+}
+
+namespace {
+
+std::string TicksCsv(const OptiOdomRun& run) {
+  std::string out = "t,ticks_a,ticks_b,ticks_c\n";
+  char line[128];
+  for (std::size_t k = 0; k < run.t_s.size(); ++k) {
+    // Row 0 only sets the start time (increments counted before it are not part of the run).
+    const auto& d = k == 0 ? std::array<double, 3>{0.0, 0.0, 0.0} : run.ticks[k];
+    const int n =
+        std::snprintf(line, sizeof line, "%.6f,%.10g,%.10g,%.10g\n", run.t_s[k], d[0], d[1], d[2]);
+    out.append(line, static_cast<std::size_t>(n));
+  }
+  return out;
+}
+
+}  // namespace
+
+int RunImportOptiOdomCommand(const ImportOptiOdomOptions& options) {
+  try {
+    if (options.sessions.empty()) {
+      std::cerr << "fitcal: import optiodom needs at least one session directory\n";
+      return 2;
+    }
+    if (fs::exists(fs::path(options.out) / "dataset.yaml") && !options.force) {
+      std::cerr << "fitcal: " << options.out
+                << " already holds a data set; use --force to overwrite it\n";
+      return 2;
+    }
+    // Read and check everything before writing anything.
+    std::vector<OptiOdomSession> sessions;
+    for (const std::string& dir : options.sessions) sessions.push_back(ReadOptiOdomSession(dir));
+    const OptiOdomMetadata& first = sessions.front().metadata;
+    for (const OptiOdomSession& s : sessions) {
+      const OptiOdomMetadata& m = s.metadata;
+      if (m.gear_ratio != first.gear_ratio ||
+          m.encoder_counts_per_rev != first.encoder_counts_per_rev ||
+          m.distance_m != first.distance_m || m.diameter_m != first.diameter_m) {
+        throw InputError(InputErrorKind::kBadValue, s.name + "_metadata.csv", 0,
+                         "robot geometry or encoders differ from session " + sessions.front().name +
+                             "'s; import sessions of one robot together");
+      }
+    }
+    const Omni3Robot robot = OptiOdomNominalRobot(first);
+    std::vector<RunLog> logs;
+    std::vector<const OptiOdomRun*> sources;
+    for (const OptiOdomSession& s : sessions) {
+      for (const OptiOdomRun& run : s.runs) {
+        logs.push_back(OptiOdomRunLog(s, run));
+        sources.push_back(&run);
+      }
+    }
+    std::set<std::string> ids;
+    for (const RunLog& log : logs) {
+      if (!ids.insert(log.id).second) {
+        throw InputError(InputErrorKind::kDuplicateRunId, options.out, 0,
+                         "run " + log.id + " is imported twice");
+      }
+    }
+
+    const std::vector<WheelMappingScore> ranking = RankWheelMappings(logs, robot);
+    std::printf(
+        "wheel order/sign check (nominal parameters, mean segment CF, 1 m windows, %zu runs):\n",
+        logs.size());
+    for (std::size_t i = 0; i < 3; ++i) {
+      std::printf("  %s %-12s CF %.4f%s\n", i == 0 ? "best" : "    ",
+                  DescribeWheelMapping(ranking[i].mapping).c_str(), ranking[i].mean_cf,
+                  ranking[i].IsIdentity() ? "  <- documented mapping" : "");
+    }
+    if (!ranking.front().IsIdentity()) {
+      std::cerr << "fitcal: the documented wheel mapping (a,b,c) = (-1,-2,-3) does not explain the "
+                   "ground "
+                   "truth best; "
+                << DescribeWheelMapping(ranking.front().mapping) << " does (CF "
+                << ranking.front().mean_cf
+                << "); nothing written (--skip-mapping-check to write anyway)\n";
+      if (!options.skip_mapping_check) return 3;
+    }
+
+    const fs::path out(options.out);
+    fs::create_directories(out / "runs");
+    std::vector<io::DatasetEntry> entries(logs.size());
+    ParallelFor(logs.size(), 0, [&](std::size_t i) {
+      io::DatasetEntry& e = entries[i];
+      e.id = logs[i].id;
+      e.trajectory = logs[i].trajectory;
+      e.repetition = logs[i].repetition;
+      e.encoders = "runs/" + e.id + "_encoders.csv";
+      e.ground_truth = "runs/" + e.id + "_ground_truth.csv";
+      io::WriteFileAtomically((out / e.encoders).string(), TicksCsv(*sources[i]));
+      io::WriteFileAtomically((out / e.ground_truth).string(),
+                              io::GroundTruthCsv(logs[i].ground_truth));
+    });
+    io::WriteFileAtomically((out / "robot.yaml").string(), io::Omni3RobotYaml(robot, nullptr));
+    io::WriteFileAtomically((out / "dataset.yaml").string(),
+                            io::DatasetYaml("robot.yaml", entries));
+    std::printf("wrote %zu runs of %zu sessions to %s\n", logs.size(), sessions.size(),
+                options.out.c_str());
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "fitcal: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace fitcal::tools
