@@ -34,12 +34,17 @@ class Omni3FinalPoseResidual {
   template <typename T>
   bool operator()(const T* p, T* residual) const {
     const Pose2<T> start{T(run_.start.x), T(run_.start.y), T(run_.start.theta)};
-    const Pose2<T> final_pose = omni3::ReplayFinalPose(p, run_.samples, start);
+    ResidualOfFinalPose(omni3::ReplayFinalPose(p, run_.samples, start), residual);
+    return true;
+  }
+
+  // The residual of a final pose replayed by other means (e.g. with a transformed matrix).
+  template <typename T>
+  void ResidualOfFinalPose(const Pose2<T>& final_pose, T* residual) const {
     const Pose2d& gt = run_.final_ground_truth;
     residual[0] = (final_pose.x - gt.x) * inv_position_sigma_;
     residual[1] = (final_pose.y - gt.y) * inv_position_sigma_;
     residual[2] = WrapAngle(final_pose.theta - gt.theta) * inv_heading_sigma_;
-    return true;
   }
 
   static ceres::CostFunction* Create(const AlignedRun& run, const ResidualWeights& weights) {

@@ -17,18 +17,31 @@ namespace {
 
 const char* kColumnNames[3] = {"w_a", "w_b", "w_c"};
 
-// Final-pose SSR of the runs at p (the fit's objective times 2).
-double SumOfSquares(const Omni3ParameterArray& p, const std::vector<AlignedRun>& runs,
+// Final-pose SSR of the runs replayed with the inverse kinematic matrix m_inv (the fit's
+// objective times 2 when m_inv is Eq. 6 at some parameters).
+double SumOfSquares(const Eigen::Matrix3d& m_inv, const std::vector<AlignedRun>& runs,
                     const ResidualWeights& weights, int num_threads) {
   std::vector<double> per_run(runs.size(), 0.0);
   ParallelFor(runs.size(), num_threads, [&](std::size_t i) {
+    const AlignedRun& run = runs[i];
     double r[3];
-    Omni3FinalPoseResidual(runs[i], weights)(p.data(), r);
+    Omni3FinalPoseResidual(run, weights)
+        .ResidualOfFinalPose(
+            omni3::ReplayWithMatrix(m_inv, run.samples.data(), run.samples.size(), run.start), r);
     per_run[i] = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
   });
   double sum = 0.0;
   for (double v : per_run) sum += v;
   return sum;
+}
+
+// The signed permutation A with (mapped rates) = A (recorded rates). Replaying mapped samples
+// with M^-1 is replaying the recorded ones with M^-1 A, so no run needs to be copied to score a
+// mapping.
+Eigen::Matrix3d MappingMatrix(const WheelMapping& m) {
+  Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
+  for (int i = 0; i < 3; ++i) a(i, m.column[i]) = m.sign[i];
+  return a;
 }
 
 double FittedSumOfSquares(const std::vector<AlignedRun>& runs, const Omni3Robot& robot,
@@ -122,11 +135,12 @@ WheelOrderReport CheckWheelOrder(const std::vector<AlignedRun>& runs, const Omni
   const Omni3ParameterArray nominal = robot.nominal.ToArray();
 
   WheelOrderReport report;
-  report.recorded_nominal_ssr = SumOfSquares(nominal, runs, options.weights, options.num_threads);
+  const Eigen::Matrix3d m_inv = omni3::InverseKinematicMatrix(nominal.data());
+  report.recorded_nominal_ssr = SumOfSquares(m_inv, runs, options.weights, options.num_threads);
   report.best_nominal_ssr = std::numeric_limits<double>::infinity();
   WheelMapping best_other;
   for (std::size_t k = 1; k < mappings.size(); ++k) {
-    const double ssr = SumOfSquares(nominal, ApplyWheelMapping(runs, mappings[k]), options.weights,
+    const double ssr = SumOfSquares(m_inv * MappingMatrix(mappings[k]), runs, options.weights,
                                     options.num_threads);
     if (ssr < report.best_nominal_ssr) {
       report.best_nominal_ssr = ssr;

@@ -15,6 +15,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <type_traits>
 
 #include "odometry/omni3_model.h"
 #include "odometry/pose2.h"
@@ -26,11 +27,19 @@ namespace internal {
 
 inline constexpr std::size_t kChunk = 64;
 inline constexpr std::size_t kReanchorInterval = 256;  // a multiple of kChunk
-// Per-sample rotations below kShortSeriesMaxAngle use the degree-6/7 series (truncation error
-// < a^8/8! < 7e-19), below kSeriesMaxAngle the degree-10/11 series (< a^12/12! < 9e-18); larger
-// ones (never at sane sample rates) the library functions.
+// Per-sample rotations below kTinySeriesMaxAngle use the degree-4/5 series (truncation error
+// < a^6/6! < 2.2e-17), below kShortSeriesMaxAngle the degree-6/7 series (< a^8/8! < 7e-19),
+// below kSeriesMaxAngle the degree-10/11 series (< a^12/12! < 9e-18); larger ones (never at sane
+// sample rates) the library functions.
+inline constexpr double kTinySeriesMaxAngle = 0.005;
 inline constexpr double kShortSeriesMaxAngle = 0.02;
 inline constexpr double kSeriesMaxAngle = 0.2;
+
+inline void CosSinTinySeries(double a, double* c, double* s) {
+  const double a2 = a * a;
+  *c = 1.0 + a2 * (-1.0 / 2 + a2 * (1.0 / 24));
+  *s = a * (1.0 + a2 * (-1.0 / 6 + a2 * (1.0 / 120)));
+}
 
 inline void CosSinShortSeries(double a, double* c, double* s) {
   const double a2 = a * a;
@@ -51,6 +60,14 @@ inline void CosSinLongSeries(double a, double* c, double* s) {
 // For a ceres::Jet the series runs on the real part only and the derivatives follow from the
 // chain rule, d cos = -sin da, d sin = cos da: two vector scalings instead of a polynomial in
 // Jets (half of the autodiff replay's cost otherwise).
+template <typename JetT>
+inline void CosSinTinySeries(const JetT& a, JetT* c, JetT* s) {
+  double cv, sv;
+  CosSinTinySeries(a.a, &cv, &sv);
+  *c = JetT(cv, -sv * a.v);
+  *s = JetT(sv, cv * a.v);
+}
+
 template <typename JetT>
 inline void CosSinShortSeries(const JetT& a, JetT* c, JetT* s) {
   double cv, sv;
@@ -110,7 +127,11 @@ Pose2<T> ReplayWithMatrix(const Matrix3<T>& m_inv, const WheelSample* samples, s
       const double a = std::abs(ScalarPart(step_theta[j]));
       max_angle = a > max_angle ? a : max_angle;
     }
-    if (max_angle < internal::kShortSeriesMaxAngle) {
+    if (max_angle < internal::kTinySeriesMaxAngle) {
+      for (std::size_t j = 0; j < m; ++j) {
+        internal::CosSinTinySeries(step_theta[j], &rot_c[j], &rot_s[j]);
+      }
+    } else if (max_angle < internal::kShortSeriesMaxAngle) {
       for (std::size_t j = 0; j < m; ++j)
         internal::CosSinShortSeries(step_theta[j], &rot_c[j], &rot_s[j]);
     } else if (max_angle < internal::kSeriesMaxAngle) {
@@ -122,15 +143,38 @@ Pose2<T> ReplayWithMatrix(const Matrix3<T>& m_inv, const WheelSample* samples, s
         rot_s[j] = sin(step_theta[j]);
       }
     }
-    // Pass 2: R(theta(k-1))^-1 of Eq. 5 rotates each step into the world frame.
-    for (std::size_t j = 0; j < m; ++j) {
+    // Pass 2: R(theta(k-1))^-1 of Eq. 5 rotates each step into the world frame. On double the
+    // loop is latency-bound, so it takes two samples per iteration: (c, s) advances by the
+    // product of their rotations, which does not depend on (c, s), halving the loop-carried chain
+    // (the pose between them uses (c1, s1)). Jets are throughput-bound: there the extra products
+    // would cost more than they save, so they go one sample at a time.
+    std::size_t j = 0;
+    constexpr bool kPairSamples = std::is_same_v<T, double>;
+    for (; kPairSamples && j + 1 < m; j += 2) {
       x += c * step_x[j] - s * step_y[j];
       y += s * step_x[j] + c * step_y[j];
       theta += step_theta[j];
+      visit(k0 + j, Pose2<T>{x, y, theta});
+      const T c1 = c * rot_c[j] - s * rot_s[j];
+      const T s1 = s * rot_c[j] + c * rot_s[j];
+      x += c1 * step_x[j + 1] - s1 * step_y[j + 1];
+      y += s1 * step_x[j + 1] + c1 * step_y[j + 1];
+      theta += step_theta[j + 1];
+      visit(k0 + j + 1, Pose2<T>{x, y, theta});
+      const T rc2 = rot_c[j] * rot_c[j + 1] - rot_s[j] * rot_s[j + 1];
+      const T rs2 = rot_s[j] * rot_c[j + 1] + rot_c[j] * rot_s[j + 1];
+      const T c2 = c * rc2 - s * rs2;
+      s = s * rc2 + c * rs2;
+      c = c2;
+    }
+    for (; j < m; ++j) {
+      x += c * step_x[j] - s * step_y[j];
+      y += s * step_x[j] + c * step_y[j];
+      theta += step_theta[j];
+      visit(k0 + j, Pose2<T>{x, y, theta});
       const T c_next = c * rot_c[j] - s * rot_s[j];
       s = s * rot_c[j] + c * rot_s[j];
       c = c_next;
-      visit(k0 + j, Pose2<T>{x, y, theta});
     }
     if ((k0 + m) % internal::kReanchorInterval == 0) {
       c = cos(theta);
