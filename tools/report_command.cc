@@ -24,7 +24,9 @@ namespace fitcal::tools {
 
 namespace {
 
-io::ReportMetrics MetricsOf(const TrajectoryErrors& e) {
+// TrajectoryErrors (one run) and Table6Averages (a group) carry the same Eq. 8-14 fields.
+template <typename Metrics>
+io::ReportMetrics MetricsOf(const Metrics& e) {
   io::ReportMetrics m;
   m.rms_distance_m = e.rms_distance_m;
   m.rms_angle_rad = e.rms_angle_rad;
@@ -33,18 +35,6 @@ io::ReportMetrics MetricsOf(const TrajectoryErrors& e) {
   m.final_distance_m = e.final_distance_m;
   m.final_angle_rad = e.final_angle_rad;
   m.cf = e.cf;
-  return m;
-}
-
-io::ReportMetrics MetricsOf(const Table6Averages& a) {
-  io::ReportMetrics m;
-  m.rms_distance_m = a.rms_distance_m;
-  m.rms_angle_rad = a.rms_angle_rad;
-  m.max_distance_m = a.max_distance_m;
-  m.max_angle_rad = a.max_angle_rad;
-  m.final_distance_m = a.final_distance_m;
-  m.final_angle_rad = a.final_angle_rad;
-  m.cf = a.cf;
   return m;
 }
 
