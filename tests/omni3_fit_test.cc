@@ -22,13 +22,7 @@ std::vector<AlignedRun> Simulate(const sim::Omni3SimulationOptions& options) {
 }
 
 sim::Omni3SimulationOptions NoiseFree(double encoder_period_s) {
-  sim::Omni3SimulationOptions options;
-  options.repetitions = 1;
-  options.gt_position_sigma_m = 0.0;
-  options.gt_heading_sigma_rad = 0.0;
-  options.slip_sigma = 0.0;
-  options.encoder_counts_per_rev = 1 << 22;
-  options.encoder_jitter_s = 0.0;
+  sim::Omni3SimulationOptions options = sim::NoiseFreeSimulationOptions();
   options.encoder_period_s = encoder_period_s;
   return options;
 }

@@ -26,16 +26,7 @@ std::vector<AlignedRun> Simulate(const sim::Omni3SimulationOptions& options) {
 
 // Clean data: no slip, no ground-truth noise, near-ideal encoders. What remains between the
 // simulator and Eq. 4 is the replay's discretisation (see omni3_fit_test.cc).
-sim::Omni3SimulationOptions Clean() {
-  sim::Omni3SimulationOptions options;
-  options.repetitions = 1;
-  options.gt_position_sigma_m = 0.0;
-  options.gt_heading_sigma_rad = 0.0;
-  options.slip_sigma = 0.0;
-  options.encoder_counts_per_rev = 1 << 22;
-  options.encoder_jitter_s = 0.0;
-  return options;
-}
+sim::Omni3SimulationOptions Clean() { return sim::NoiseFreeSimulationOptions(); }
 
 // The whole flower once, shared by the tests (simulated once).
 const std::vector<AlignedRun>& CleanFlower() {

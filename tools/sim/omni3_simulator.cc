@@ -218,6 +218,17 @@ omni3::Parameters PalacinNominalParameters() {
   return Make(0.195, 0.195, 0.195, 0.148, 0.148, 0.148, 60.0, 180.0, 300.0);
 }
 
+Omni3SimulationOptions NoiseFreeSimulationOptions() {
+  Omni3SimulationOptions options;
+  options.repetitions = 1;
+  options.gt_position_sigma_m = 0.0;
+  options.gt_heading_sigma_rad = 0.0;
+  options.slip_sigma = 0.0;
+  options.encoder_counts_per_rev = 1 << 22;
+  options.encoder_jitter_s = 0.0;
+  return options;
+}
+
 Omni3Robot PalacinApr02Robot() {
   Omni3Robot robot;
   robot.name = "apr02";

@@ -82,6 +82,11 @@ struct Omni3SimulationOptions {
       injection_hook;
 };
 
+// The default options without noise: no slip, no ground-truth noise, no encoder jitter and
+// near-ideal encoders (2^22 counts/rev), one repetition. What then remains between the
+// simulator and Eq. 4 is the replay's discretisation.
+Omni3SimulationOptions NoiseFreeSimulationOptions();
+
 struct SimulatedRun {
   RunLog log;              // what a recorder would have written
   Pose2d true_final_pose;  // noise-free truth at the last encoder time
