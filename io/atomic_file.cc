@@ -1,26 +1,74 @@
 #include "io/atomic_file.h"
 
 #include <fcntl.h>
+#include <limits.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace fitcal::io {
+namespace {
 
-void WriteFileAtomically(const std::string& path, const std::string& contents) {
+constexpr int kCleanupSignals[] = {SIGINT, SIGTERM, SIGHUP};
+
+// The temporary file of the write in flight, readable from a signal handler: a fixed buffer and a
+// flag, set and cleared with the cleanup signals blocked so the handler never sees half a name.
+char g_in_flight_path[PATH_MAX + 16];
+volatile sig_atomic_t g_has_in_flight = 0;
+
+void RemoveInFlightAndReraise(int signal_number) {
+  if (g_has_in_flight) unlink(g_in_flight_path);
+  signal(signal_number, SIG_DFL);
+  raise(signal_number);
+}
+
+// Blocks the cleanup signals for its lifetime.
+class CleanupSignalsBlocked {
+ public:
+  CleanupSignalsBlocked() {
+    sigset_t set;
+    sigemptyset(&set);
+    for (int s : kCleanupSignals) sigaddset(&set, s);
+    pthread_sigmask(SIG_BLOCK, &set, &previous_);
+  }
+  ~CleanupSignalsBlocked() { pthread_sigmask(SIG_SETMASK, &previous_, nullptr); }
+  CleanupSignalsBlocked(const CleanupSignalsBlocked&) = delete;
+  CleanupSignalsBlocked& operator=(const CleanupSignalsBlocked&) = delete;
+
+ private:
+  sigset_t previous_;
+};
+
+// Creates the temporary file and records it as in flight; returns its descriptor and path.
+int CreateTemporary(const std::string& path, std::string* tmp_path) {
   std::string tmpl = path + ".tmp-XXXXXX";
   std::vector<char> name(tmpl.begin(), tmpl.end());
   name.push_back('\0');
+  const CleanupSignalsBlocked blocked;
   const int fd = mkstemp(name.data());
   if (fd < 0) {
     throw std::runtime_error(path + ": cannot create temporary file: " + std::strerror(errno));
   }
-  const std::string tmp_path(name.data());
+  *tmp_path = name.data();
+  if (tmp_path->size() < sizeof(g_in_flight_path)) {
+    std::memcpy(g_in_flight_path, tmp_path->c_str(), tmp_path->size() + 1);
+    g_has_in_flight = 1;
+  }
+  return fd;
+}
+
+}  // namespace
+
+void WriteFileAtomically(const std::string& path, const std::string& contents) {
+  std::string tmp_path;
+  const int fd = CreateTemporary(path, &tmp_path);
   const char* data = contents.data();
   std::size_t left = contents.size();
   bool ok = true;
@@ -37,11 +85,32 @@ void WriteFileAtomically(const std::string& path, const std::string& contents) {
   const int saved_errno = errno;
   ok = ok && fchmod(fd, 0644) == 0 && fsync(fd) == 0;
   ok = (close(fd) == 0) && ok;
+  StopHereForTests("temporary-written");
+  const CleanupSignalsBlocked blocked;
+  g_has_in_flight = 0;
   if (!ok || std::rename(tmp_path.c_str(), path.c_str()) != 0) {
     const std::string reason = std::strerror(ok ? errno : saved_errno);
     unlink(tmp_path.c_str());
     throw std::runtime_error(path + ": cannot write: " + reason);
   }
+}
+
+void RemoveTemporaryFilesOnSignals() {
+  for (int s : kCleanupSignals) {
+    struct sigaction current;
+    if (sigaction(s, nullptr, &current) != 0 || current.sa_handler == SIG_IGN) continue;
+    struct sigaction action;
+    std::memset(&action, 0, sizeof(action));
+    action.sa_handler = RemoveInFlightAndReraise;
+    sigemptyset(&action.sa_mask);
+    for (int other : kCleanupSignals) sigaddset(&action.sa_mask, other);
+    sigaction(s, &action, nullptr);
+  }
+}
+
+void StopHereForTests(const char* stage) {
+  const char* wanted = std::getenv("FITCAL_TEST_STOP_AT");
+  if (wanted != nullptr && std::strcmp(wanted, stage) == 0) raise(SIGSTOP);
 }
 
 }  // namespace fitcal::io

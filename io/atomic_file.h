@@ -10,4 +10,15 @@ namespace fitcal::io {
 // Throws std::runtime_error (with the path) when the file cannot be written.
 void WriteFileAtomically(const std::string& path, const std::string& contents);
 
+// Installs SIGINT/SIGTERM/SIGHUP handlers that remove the temporary file of a write in flight and
+// then let the signal end the process as it would have (same exit status). Signals a parent set
+// to be ignored (nohup) stay ignored. SIGKILL cannot be caught: after a kill -9 between writing
+// and renaming, the previous output is intact and a `<path>.tmp-XXXXXX` file is left beside it.
+void RemoveTemporaryFilesOnSignals();
+
+// Fault-injection point for the tests: when the environment variable FITCAL_TEST_STOP_AT equals
+// `stage`, the process stops itself (SIGSTOP) so a test can deliver a signal at exactly that
+// point. Without the variable it does nothing.
+void StopHereForTests(const char* stage);
+
 }  // namespace fitcal::io

@@ -108,6 +108,7 @@ int RunFitCommand(const FitCommandOptions& options) {
     const io::DatasetIndex index = io::ReadDatasetIndex(options.logs, dataset_options);
     if (io::ReadRobotModel(index.robot_path) == "asoc") return RunAsocFit(options);
     const io::Dataset dataset = io::LoadDataset(index, dataset_options);
+    io::StopHereForTests("loaded");
     const std::string model = io::ReadRobotModel(dataset.robot_path);
     if (model != "omni3") {
       throw io::InputError(io::InputErrorKind::kUnknownModel, dataset.robot_path, 0,
@@ -256,6 +257,7 @@ int RunFitCommand(const FitCommandOptions& options) {
       record.sigma = fit.sigma;
       record.correlation = fit.correlation;
       record.inverse_kinematic_matrix = omni3::InverseKinematicMatrix(fit.parameters.data());
+      io::StopHereForTests("fitted");
       io::WriteFileAtomically(options.out, io::Omni3RobotYaml(calibrated, &record));
       std::printf("wrote %s\n", options.out.c_str());
     }

@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "fitcal/version.h"
+#include "io/atomic_file.h"
 #include "tools/asoc_commands.h"
 #include "tools/compare_command.h"
 #include "tools/diagnose_command.h"
@@ -61,6 +62,8 @@ void AddFitOptions(CLI::App& app, fitcal::tools::FitCommandOptions& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Ctrl-C or a scheduler's SIGTERM while an output is being written leaves no temporary behind.
+  fitcal::io::RemoveTemporaryFilesOnSignals();
   CLI::App app{"fitcal " + std::string(fitcal::kVersion) +
                ": calibrate the kinematic parameters of a wheeled robot's odometry from encoder "
                "logs and ground truth"};
