@@ -1,9 +1,10 @@
 #pragma once
 // Fits the nine omni3 parameters with NLopt: global methods (the analogues of the genetic
 // algorithm of Palacin Sec. 2.6 / Table 4), local derivative-free methods, and a bounded gradient
-// method (the analogue of MATLAB's fmincon) - all over the SAME per-run residual functor as the
-// Ceres fit (final_pose_residual.h): on double for the cost, through Ceres autodiff for the
-// gradient. Runs are evaluated in parallel on a pool of threads that lives for the whole fit.
+// method (the analogue of MATLAB's fmincon) - all over the SAME per-run residual as the Ceres fit
+// (final_pose_residual.h): for the cost, its formula on the final pose of the precomputed Eq. 4
+// kernel (odometry/omni3_final_pose_kernel.h); for the gradient, its Ceres autodiff. Runs are
+// evaluated in parallel on a pool of threads that lives for the whole fit.
 //
 // The search runs in the box of Palacin Eq. 16, normalised to [0, 1]^9 so that every method sees
 // parameters of one scale (metres of wheel distance and radians of wheel angle would otherwise

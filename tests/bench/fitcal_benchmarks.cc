@@ -13,6 +13,7 @@
 #include "calib/run_split.h"
 #include "io/dataset.h"
 #include "io/robot_yaml.h"
+#include "odometry/omni3_final_pose_kernel.h"
 #include "odometry/omni3_replay.h"
 #include "tools/sim/omni3_simulator.h"
 
@@ -57,6 +58,36 @@ void BM_ReplayJet9(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * state.range(0));
 }
 BENCHMARK(BM_ReplayJet9)->Arg(400);
+
+// The final pose of every training run of data/flower (180 runs): the unit of an NLopt
+// evaluation, by the replay (/0) and by the final-pose kernel (/1), on one core.
+void BM_FinalPoses180Runs(benchmark::State& state) {
+  const io::Dataset dataset = io::LoadDataset(kData);
+  const RunSplit split = SplitByRepetition(AlignRuns(dataset.runs), {1, 2, 3, 4, 5});
+  std::vector<omni3::FinalPoseKernel> kernels;
+  std::size_t samples = 0;
+  for (const AlignedRun& run : split.training) {
+    kernels.emplace_back(run.samples);
+    samples += run.samples.size();
+  }
+  const auto p = sim::PalacinTable5Parameters().ToArray();
+  const bool use_kernel = state.range(0) != 0;
+  for (auto _ : state) {
+    const Eigen::Matrix3d m_inv = omni3::InverseKinematicMatrix(p.data());
+    double sum = 0.0;
+    for (std::size_t i = 0; i < kernels.size(); ++i) {
+      const AlignedRun& run = split.training[i];
+      const Pose2d end = use_kernel ? kernels[i].FinalPose(m_inv, run.start)
+                                    : omni3::ReplayWithMatrix(m_inv, run.samples.data(),
+                                                              run.samples.size(), run.start);
+      sum += end.x + end.y + end.theta;
+    }
+    benchmark::DoNotOptimize(sum);
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(samples));
+  state.SetLabel(use_kernel ? "FinalPoseKernel" : "ReplayWithMatrix");
+}
+BENCHMARK(BM_FinalPoses180Runs)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 void BM_LoadFlowerDataset(benchmark::State& state) {
   for (auto _ : state) {
