@@ -3,11 +3,13 @@
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <yaml-cpp/yaml.h>
 
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 
+#include "io/asoc_files.h"
 #include "io/robot_yaml.h"
 #include "tests/test_files.h"
 
@@ -75,6 +77,30 @@ TEST(FitcalCli, FitsWritesAndReadsBackTheCalibration) {
   // `fitcal fit` is the same command.
   const Result again = RunFitcal(dir, "fit --logs " + data + " --no-output");
   EXPECT_EQ(again.exit_code, 0) << again.err;
+}
+
+// An ASOC data set goes through the same entry point; the calibrated YAML reads back and carries
+// the one-sigma of every castor parameter.
+TEST(FitcalCli, AsocFitWritesCalibrationWithSigma) {
+  TempDir dir;
+  const std::string data = dir.Path("asoc");
+  Result r = RunFitcal(dir, "asoc-simulate --out " + data + " --excursions 12 --seed 3");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string out = dir.Path("asoc_calibrated.yaml");
+  r = RunFitcal(dir, "--logs " + data + " --out " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const io::AsocRobot calibrated = io::ReadAsocRobot(out);
+  const YAML::Node sigma = YAML::LoadFile(out)["calibration"]["sigma"];
+  ASSERT_TRUE(sigma.IsMap()) << Slurp(out);
+  ASSERT_EQ(sigma.size(), 3u);
+  for (const std::string& name : calibrated.castor_names) {
+    const YAML::Node castor = sigma[name];
+    ASSERT_TRUE(castor.IsMap()) << name;
+    EXPECT_GT(castor["offset_m"].as<double>(), 0.0);
+    EXPECT_GT(castor["wheel_radius_m"][1].as<double>(), 0.0);
+    EXPECT_GT(castor["wheel_offset_m"][0].as<double>(), 0.0);
+    EXPECT_GT(castor["encoder_bias_deg"].as<double>(), 0.0);
+  }
 }
 
 TEST(FitcalCli, BadInputGivesOneLineAndWritesNothing) {

@@ -1,5 +1,7 @@
 #include "tools/asoc_commands.h"
 
+#include <yaml-cpp/yaml.h>
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -51,6 +53,54 @@ void PrintCastors(const io::AsocRobot& robot, const asoc::Vehicle& estimate, con
                 c.offset_m, c.wheel_radius_m[0], c.wheel_radius_m[1], c.wheel_offset_m[0],
                 c.wheel_offset_m[1], RadToDeg(c.encoder_bias_rad));
   }
+}
+
+// One-sigma per castor parameter (flat order of asoc::Vehicle::ToArray), beneath PrintCastors.
+void PrintCastorSigmas(const io::AsocRobot& robot,
+                       const std::array<double, asoc::kNumParameters>& sigma) {
+  std::printf(
+      "  one sigma (covariance x residual variance; on simulated data the actual error is "
+      "~1.3 sigma rms):\n");
+  for (int i = 0; i < asoc::kNumCastors; ++i) {
+    const asoc::CastorParameters c =
+        asoc::CastorParameters::FromArray(&sigma[i * asoc::kParametersPerCastor]);
+    std::printf("  %-8s %10.2g %10.2g %10.2g %10.2g %10.2g %12.3g\n", robot.castor_names[i].c_str(),
+                c.offset_m, c.wheel_radius_m[0], c.wheel_radius_m[1], c.wheel_offset_m[0],
+                c.wheel_offset_m[1], RadToDeg(c.encoder_bias_rad));
+  }
+}
+
+// The calibration record of the written YAML: how it was made and, when the covariance exists,
+// `sigma: {<castor>: {offset_m, wheel_radius_m: [2], wheel_offset_m: [2], encoder_bias_deg}}`.
+// Emitted by yaml-cpp so that any path or castor name is quoted correctly.
+// `fit` is null for the closed form (no termination, no covariance).
+std::string AsocCalibrationRecord(const io::AsocRobot& robot, const std::string& method,
+                                  const std::string& dataset, const asoc::AsocFitResult* fit) {
+  YAML::Emitter out;
+  out.SetMapFormat(YAML::Flow);
+  out.SetSeqFormat(YAML::Flow);
+  out.SetDoublePrecision(3);
+  out << YAML::BeginMap << YAML::Key << "method" << YAML::Value << method << YAML::Key << "dataset"
+      << YAML::Value << dataset << YAML::Key << "tool_version" << YAML::Value << kVersion;
+  if (fit != nullptr) out << YAML::Key << "termination" << YAML::Value << fit->termination;
+  if (fit != nullptr && fit->has_covariance) {
+    out << YAML::Key << "sigma" << YAML::Value << YAML::BeginMap;
+    for (int i = 0; i < asoc::kNumCastors; ++i) {
+      const asoc::CastorParameters c =
+          asoc::CastorParameters::FromArray(&fit->sigma[i * asoc::kParametersPerCastor]);
+      out << YAML::Key << robot.castor_names[i] << YAML::Value << YAML::BeginMap;
+      out << YAML::Key << "offset_m" << YAML::Value << c.offset_m;
+      out << YAML::Key << "wheel_radius_m" << YAML::Value << YAML::BeginSeq << c.wheel_radius_m[0]
+          << c.wheel_radius_m[1] << YAML::EndSeq;
+      out << YAML::Key << "wheel_offset_m" << YAML::Value << YAML::BeginSeq << c.wheel_offset_m[0]
+          << c.wheel_offset_m[1] << YAML::EndSeq;
+      out << YAML::Key << "encoder_bias_deg" << YAML::Value << RadToDeg(c.encoder_bias_rad);
+      out << YAML::EndMap;
+    }
+    out << YAML::EndMap;
+  }
+  out << YAML::EndMap;
+  return out.c_str();
 }
 
 }  // namespace
@@ -140,8 +190,8 @@ int RunAsocGeometric(const AsocGeometricOptions& options) {
       }
       io::AsocRobot calibrated = robot;
       calibrated.nominal = result.estimate;
-      const std::string record = "{method: closed-form Doebbler Eq. 1-9, dataset: '" +
-                                 options.logs + "', tool_version: '" + kVersion + "'}";
+      const std::string record =
+          AsocCalibrationRecord(robot, "closed-form Doebbler Eq. 1-9", options.logs, nullptr);
       io::WriteFileAtomically(options.out, io::AsocRobotYaml(calibrated, record));
       std::printf("wrote %s\n", options.out.c_str());
     }
@@ -228,7 +278,11 @@ int RunAsocFit(const FitCommandOptions& options) {
     std::printf("  (CF: mean final-pose |[dx, dy, dpsi]|, m and rad, CAST-0 replay)\n");
     const asoc::AsocFitResult& best = closed.usable ? refined : ceres;
     PrintCastors(robot, best.estimate, closed.usable ? "closed form + ceres" : "ceres");
-    if (!best.has_covariance) std::printf("uncertainty: %s\n", best.covariance_message.c_str());
+    if (best.has_covariance) {
+      PrintCastorSigmas(robot, best.sigma);
+    } else {
+      std::printf("uncertainty: %s\n", best.covariance_message.c_str());
+    }
     if (!best.usable) {
       std::cerr << "fitcal: the fit did not converge (" << best.termination << ": " << best.message
                 << "); nothing written\n";
@@ -237,10 +291,8 @@ int RunAsocFit(const FitCommandOptions& options) {
     if (!options.no_output) {
       io::AsocRobot calibrated = robot;
       calibrated.nominal = best.estimate;
-      const std::string record = std::string("{method: '") +
-                                 (closed.usable ? "closed form + ceres" : "ceres") +
-                                 "', dataset: '" + options.logs + "', tool_version: '" + kVersion +
-                                 "', termination: " + best.termination + "}";
+      const std::string record = AsocCalibrationRecord(
+          robot, closed.usable ? "closed form + ceres" : "ceres", options.logs, &best);
       io::WriteFileAtomically(options.out, io::AsocRobotYaml(calibrated, record));
       std::printf("wrote %s\n", options.out.c_str());
     }
