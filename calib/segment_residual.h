@@ -61,10 +61,16 @@ class Omni3SegmentResidual {
 
   template <typename T>
   bool operator()(const T* p, T* residual) const {
+    ResidualsWithMatrix(omni3::InverseKinematicMatrix(p), residual);
+    return true;
+  }
+
+  // The residuals replayed with any inverse kinematic matrix (e.g. Eq. 6 times a wheel mapping).
+  template <typename T>
+  void ResidualsWithMatrix(const omni3::Matrix3<T>& m_inv, T* residual) const {
     using std::cos;
     using std::sin;
     const AlignedRun& run = *run_.run;
-    const omni3::Matrix3<T> m_inv = omni3::InverseKinematicMatrix(p);
     // Replay once from the identity, keeping the pose after every marked sample count.
     std::vector<Pose2<T>> at_mark(marks_.size());
     Pose2<T> pose{T(0.0), T(0.0), T(0.0)};
@@ -94,7 +100,6 @@ class Omni3SegmentResidual {
       residual[3 * k + 1] = (-sq * ex + cq * ey) * inv_position_sigma_;
       residual[3 * k + 2] = WrapAngle(ptheta - T(q.theta)) * inv_heading_sigma_;
     }
-    return true;
   }
 
   static ceres::CostFunction* Create(const SegmentedRun& run, const ResidualWeights& weights) {

@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
 
 #include "calib/omni3_ceres_fit.h"
+#include "calib/segment_cost.h"
 #include "calib/statistics.h"
 #include "odometry/omni3_replay.h"
 #include "odometry/parallel_for.h"
@@ -123,33 +125,43 @@ bool WheelOrderOptions::IsValid(std::string* error) const {
     *error = "weights must be positive";
     return false;
   }
+  if (!(segment_length_m > 0.0)) {
+    *error = "segment_length_m must be positive";
+    return false;
+  }
   return true;
 }
 
-WheelOrderReport CheckWheelOrder(const std::vector<AlignedRun>& runs, const Omni3Robot& robot,
-                                 const WheelOrderOptions& options) {
-  std::string error;
-  if (!options.IsValid(&error)) throw std::invalid_argument("WheelOrderOptions: " + error);
-  if (runs.empty()) throw std::invalid_argument("CheckWheelOrder: no runs");
-  const std::vector<WheelMapping> mappings = AllWheelMappings();
-  const Omni3ParameterArray nominal = robot.nominal.ToArray();
+namespace {
 
+// What differs between the final-pose and the segment test: how a mapping is scored at the
+// nominal and after a fit, and how many residuals the scores sum.
+struct MappingScorer {
+  std::function<double(const WheelMapping&)> nominal_ssr;
+  std::function<double(const WheelMapping&)> fitted_ssr;
+  int num_residuals = 0;
+  std::string evidence;  // e.g. "final-pose SSR"
+  std::string sample;    // e.g. "36 runs"
+};
+
+// The decision of the header: best other mapping at the nominal; if it beats the recorded order,
+// both fitted; "far better" when the SSR ratio exceeds the Bonferroni F quantile.
+WheelOrderReport Decide(const MappingScorer& scorer, const WheelOrderOptions& options) {
+  const std::vector<WheelMapping> mappings = AllWheelMappings();
   WheelOrderReport report;
-  const Eigen::Matrix3d m_inv = omni3::InverseKinematicMatrix(nominal.data());
-  report.recorded_nominal_ssr = SumOfSquares(m_inv, runs, options.weights, options.num_threads);
+  report.recorded_nominal_ssr = scorer.nominal_ssr(mappings[0]);
   report.best_nominal_ssr = std::numeric_limits<double>::infinity();
   WheelMapping best_other;
   for (std::size_t k = 1; k < mappings.size(); ++k) {
-    const double ssr = SumOfSquares(m_inv * MappingMatrix(mappings[k]), runs, options.weights,
-                                    options.num_threads);
+    const double ssr = scorer.nominal_ssr(mappings[k]);
     if (ssr < report.best_nominal_ssr) {
       report.best_nominal_ssr = ssr;
       best_other = mappings[k];
     }
   }
-  const int n = static_cast<int>(runs.size());
-  report.fitted = 3 * n - omni3::kNumParameters >= 3;
-  report.degrees_of_freedom = report.fitted ? 3 * n - omni3::kNumParameters : 3 * n;
+  const int n = scorer.num_residuals;
+  report.fitted = n - omni3::kNumParameters >= 3;
+  report.degrees_of_freedom = report.fitted ? n - omni3::kNumParameters : n;
   const double alpha = options.false_alarm_probability / static_cast<double>(mappings.size() - 1);
   report.threshold =
       FDistributionQuantile(1.0 - alpha, report.degrees_of_freedom, report.degrees_of_freedom);
@@ -161,8 +173,8 @@ WheelOrderReport CheckWheelOrder(const std::vector<AlignedRun>& runs, const Omni
     return report;
   }
   if (report.fitted) {
-    report.recorded_ssr = FittedSumOfSquares(runs, robot, options);
-    report.best_ssr = FittedSumOfSquares(ApplyWheelMapping(runs, best_other), robot, options);
+    report.recorded_ssr = scorer.fitted_ssr(mappings[0]);
+    report.best_ssr = scorer.fitted_ssr(best_other);
   }
   // A perfect fit of the other order (ssr 0) is "far better" as long as the recorded one is not
   // perfect too.
@@ -175,12 +187,101 @@ WheelOrderReport CheckWheelOrder(const std::vector<AlignedRun>& runs, const Omni
     std::ostringstream msg;
     msg.precision(3);
     msg << "the encoder columns look miswired: with " << DescribeWheelMapping(best_other)
-        << " the runs are explained " << ratio << "x better (final-pose SSR " << report.best_ssr
-        << " vs " << report.recorded_ssr << " as recorded; threshold " << report.threshold
-        << " for " << n << " runs); fix the log or the robot YAML's wheel order";
+        << " the runs are explained " << ratio << "x better (" << scorer.evidence << " "
+        << report.best_ssr << " vs " << report.recorded_ssr << " as recorded; threshold "
+        << report.threshold << " for " << scorer.sample
+        << "); fix the log or the robot YAML's wheel order";
     report.message = msg.str();
   }
   return report;
+}
+
+// Segment SSR (segment_residual.h) of `runs` replayed with m_inv.
+double SegmentSumOfSquares(const Eigen::Matrix3d& m_inv, const std::vector<SegmentedRun>& runs,
+                           const ResidualWeights& weights, int num_threads) {
+  std::vector<double> per_run(runs.size(), 0.0);
+  ParallelFor(runs.size(), num_threads, [&](std::size_t i) {
+    const Omni3SegmentResidual residual(runs[i], weights);
+    std::vector<double> r(static_cast<std::size_t>(residual.NumResiduals()));
+    residual.ResidualsWithMatrix(m_inv, r.data());
+    for (double v : r) per_run[i] += v * v;
+  });
+  double sum = 0.0;
+  for (double v : per_run) sum += v;
+  return sum;
+}
+
+}  // namespace
+
+WheelOrderReport CheckWheelOrder(const std::vector<AlignedRun>& runs, const Omni3Robot& robot,
+                                 const WheelOrderOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw std::invalid_argument("WheelOrderOptions: " + error);
+  if (runs.empty()) throw std::invalid_argument("CheckWheelOrder: no runs");
+  const Omni3ParameterArray nominal = robot.nominal.ToArray();
+  const Eigen::Matrix3d m_inv = omni3::InverseKinematicMatrix(nominal.data());
+  MappingScorer scorer;
+  scorer.nominal_ssr = [&](const WheelMapping& mapping) {
+    return SumOfSquares(m_inv * MappingMatrix(mapping), runs, options.weights, options.num_threads);
+  };
+  scorer.fitted_ssr = [&](const WheelMapping& mapping) {
+    return FittedSumOfSquares(mapping.IsIdentity() ? runs : ApplyWheelMapping(runs, mapping), robot,
+                              options);
+  };
+  scorer.num_residuals = 3 * static_cast<int>(runs.size());
+  scorer.evidence = "final-pose SSR";
+  scorer.sample = std::to_string(runs.size()) + " runs";
+  return Decide(scorer, options);
+}
+
+WheelOrderReport CheckWheelOrderOnSegments(const std::vector<AlignedRun>& runs,
+                                           const std::vector<const GroundTruthTrack*>& tracks,
+                                           const Omni3Robot& robot,
+                                           const WheelOrderOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw std::invalid_argument("WheelOrderOptions: " + error);
+  if (runs.empty() || tracks.size() != runs.size()) {
+    throw std::invalid_argument("CheckWheelOrderOnSegments: no runs, or not one track per run");
+  }
+  // Windows depend on the ground truth only, so every mapping is scored on the same ones.
+  SegmentOptions windows;
+  windows.length_m = options.segment_length_m;
+  windows.stride_fraction = 1.0;  // disjoint: independent residuals for the F test
+  std::vector<std::vector<Segment>> segments(runs.size());
+  int num_windows = 0;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    segments[i] = MakeSegments(runs[i], *tracks[i], windows);
+    num_windows += static_cast<int>(segments[i].size());
+  }
+  WheelOrderReport report;
+  if (num_windows < 4) return report;  // nothing to decide on
+  std::vector<SegmentedRun> segmented(runs.size());
+  for (std::size_t i = 0; i < runs.size(); ++i) segmented[i] = {&runs[i], segments[i]};
+  const Eigen::Matrix3d m_inv = omni3::InverseKinematicMatrix(robot.nominal.ToArray().data());
+  MappingScorer scorer;
+  scorer.nominal_ssr = [&](const WheelMapping& mapping) {
+    return SegmentSumOfSquares(m_inv * MappingMatrix(mapping), segmented, options.weights,
+                               options.num_threads);
+  };
+  scorer.fitted_ssr = [&](const WheelMapping& mapping) {
+    const std::vector<AlignedRun> mapped = ApplyWheelMapping(runs, mapping);
+    std::vector<SegmentedRun> mapped_segmented(mapped.size());
+    for (std::size_t i = 0; i < mapped.size(); ++i) mapped_segmented[i] = {&mapped[i], segments[i]};
+    FitOptions fit;
+    fit.cost = CostKind::kSegment;
+    fit.weights = options.weights;
+    fit.num_threads = options.num_threads;
+    fit.max_num_iterations = 50;
+    const FitResult result = FitOmni3(mapped, mapped_segmented, robot, fit);
+    return SegmentSumOfSquares(omni3::InverseKinematicMatrix(result.parameters.data()),
+                               mapped_segmented, options.weights, options.num_threads);
+  };
+  scorer.num_residuals = 3 * num_windows;
+  scorer.evidence = "segment SSR";
+  std::ostringstream sample;
+  sample << num_windows << " windows of " << options.segment_length_m << " m";
+  scorer.sample = sample.str();
+  return Decide(scorer, options);
 }
 
 RateUnitsReport CheckRateUnits(const std::vector<RunLog>& runs, const Omni3Robot& robot) {

@@ -59,6 +59,7 @@ std::string DescribeWheelMapping(const WheelMapping& mapping);
 struct WheelOrderOptions {
   ResidualWeights weights;                // as the fit's
   double false_alarm_probability = 1e-6;  // alpha above
+  double segment_length_m = 0.5;          // windows of CheckWheelOrderOnSegments
   int num_threads = 0;
   bool IsValid(std::string* error) const;
 };
@@ -72,13 +73,24 @@ struct WheelOrderReport {
   double recorded_ssr = 0.0;  // SSR of the recorded order (fitted when `fitted`)
   double best_ssr = 0.0;      // SSR of the best other mapping (fitted when `fitted`)
   double threshold = 0.0;     // the F quantile the ratio recorded/best had to exceed
-  int degrees_of_freedom = 0;
+  int degrees_of_freedom = 0;  // 0: nothing was decided (too few windows)
   std::string message;  // one line when likely_miswired
 };
 
 // Throws std::invalid_argument for invalid options or no runs.
 WheelOrderReport CheckWheelOrder(const std::vector<AlignedRun>& runs, const Omni3Robot& robot,
                                  const WheelOrderOptions& options = {});
+
+// The same test scored on segments (segment_residual.h: relative pose error over disjoint windows
+// of segment_length_m of ground-truth path, d = 3 W - 9 for W windows) instead of final poses, for
+// runs whose ground truth has intermediate poses. Final poses cannot see every miswiring: on full
+// circles, swapping two columns of a symmetric robot leaves the yaw rate unchanged, so the
+// odometry closes its own circle at the start; the windows see that circle driven the wrong way.
+// tracks[i] is the ground truth of runs[i]. With fewer than 4 windows nothing is decided.
+WheelOrderReport CheckWheelOrderOnSegments(const std::vector<AlignedRun>& runs,
+                                           const std::vector<const GroundTruthTrack*>& tracks,
+                                           const Omni3Robot& robot,
+                                           const WheelOrderOptions& options = {});
 
 struct RateUnitsReport {
   bool suspicious = false;  // the scale is far outside what the bounds allow

@@ -137,6 +137,40 @@ TEST(FitcalCli, BadInputGivesOneLineAndWritesNothing) {
   EXPECT_EQ(Slurp(out), previous);
 }
 
+// The other subcommands refuse impossible requests the same way: a non-zero exit, one stderr line
+// saying what is wrong, and no output written.
+TEST(FitcalCli, SubcommandRefusalsGiveOneLineAndWriteNothing) {
+  TempDir dir;
+  const std::string data = MakeDataset(dir);
+  const std::string out = dir.Path("out");
+  struct Case {
+    std::string args, expected;
+  };
+  const Case cases[] = {
+      {"compare --logs " + data + " --quiet --out " + out, "has 2 repetitions; cannot train on 5"},
+      {"compare --logs " + data + " --strategies BOGUS --repetitions 1 --quiet --out " + out,
+       "strategy BOGUS needs trajectories"},
+      {"compare --logs " + data + " --methods nosuch --repetitions 1 --quiet --out " + out,
+       "unknown method 'nosuch'"},
+      {"diagnose --logs " + data + " --train-trajectories '[' --out " + out,
+       "neither a list of labels in the data nor a valid regular expression"},
+      {"diagnose --logs " + data + " --train-trajectories Z99 --out " + out,
+       "got 0 training and 72 validation runs"},
+      {"report --logs " + data + " --calibration " + kRobot + " --train-reps 1-2 --out " + out,
+       "nothing to validate on"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.args);
+    const Result r = RunFitcal(dir, c.args);
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_EQ(CountLines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(c.expected), std::string::npos) << r.err;
+    for (const char* suffix : {"", ".csv", ".md", "_trace.csv"}) {
+      EXPECT_FALSE(std::ifstream(out + suffix).good()) << out + suffix << " was written";
+    }
+  }
+}
+
 TEST(FitcalCli, UsageErrors) {
   TempDir dir;
   EXPECT_NE(RunFitcal(dir, "--method ceres").exit_code, 0);  // no --logs

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "tools/sim/omni3_simulator.h"
 
@@ -83,6 +84,84 @@ TEST(WheelOrderCheck, EveryKindOfMiswiringIsFoundAndNamed) {
     EXPECT_GT(report.recorded_ssr / report.best_ssr, report.threshold);
     EXPECT_NE(report.message.find(DescribeWheelMapping(fix)), std::string::npos) << report.message;
   }
+}
+
+// Full circles (closed paths) at four robot-frame directions and both spin signs: the kind of run
+// a robot drives on a calibration floor and OptiOdom recorded.
+struct CircleRuns {
+  std::vector<RunLog> logs;
+  std::vector<AlignedRun> runs;
+  std::vector<const GroundTruthTrack*> tracks;
+};
+CircleRuns SimulateCircles(std::uint64_t seed) {
+  sim::Omni3SimulationOptions options;
+  options.seed = seed;
+  options.repetitions = 1;
+  options.trajectories.clear();
+  const double speed = 0.3, omega = 0.5;
+  for (int k = 0; k < 8; ++k) {
+    sim::MotionCommand c;
+    c.label = "C" + std::to_string(k + 1);
+    c.speed_m_s = speed;
+    c.alpha_rad = (k % 4) * M_PI / 2.0 + 0.3;
+    c.omega_rad_s = k < 4 ? omega : -omega;
+    c.distance_m = 2.0 * M_PI * speed / omega;  // one full circle
+    options.trajectories.push_back(c);
+  }
+  CircleRuns out;
+  for (auto& run : sim::SimulateOmni3(options)) out.logs.push_back(std::move(run.log));
+  out.runs = AlignRuns(out.logs);
+  for (const RunLog& log : out.logs) out.tracks.push_back(&log.ground_truth);
+  return out;
+}
+
+TEST(WheelOrderCheck, SegmentsFindASwapThatClosedCirclesHideFromFinalPoses) {
+  const CircleRuns circles = SimulateCircles(6);
+  WheelMapping swap;
+  swap.column = {1, 0, 2};
+  const std::vector<AlignedRun> miswired = Miswire(circles.runs, swap);
+  // The yaw rate is symmetric in the wheels, so the swapped odometry closes its own circle too:
+  // the final poses barely tell the two orders apart.
+  const WheelOrderReport final_pose = CheckWheelOrder(miswired, sim::PalacinApr02Robot());
+  EXPECT_FALSE(final_pose.likely_miswired) << final_pose.message;
+  const WheelOrderReport segments =
+      CheckWheelOrderOnSegments(miswired, circles.tracks, sim::PalacinApr02Robot());
+  ASSERT_TRUE(segments.likely_miswired);
+  EXPECT_EQ(segments.best.column, swap.column);
+  EXPECT_EQ(segments.best.sign, swap.sign);
+  EXPECT_NE(segments.message.find("columns w_a and w_b swapped"), std::string::npos)
+      << segments.message;
+  std::printf("final-pose ratio %.3g (threshold %.3g); segment ratio %.3g (threshold %.3g)\n",
+              final_pose.recorded_ssr / final_pose.best_ssr, final_pose.threshold,
+              segments.recorded_ssr / segments.best_ssr, segments.threshold);
+}
+
+TEST(WheelOrderCheck, SegmentsFindEveryKindOfMiswiringAndPassCorrectWiring) {
+  std::vector<WheelMapping> cases(3);
+  cases[0].sign = {1, -1, 1};
+  cases[1].column = {2, 0, 1};
+  cases[2].column = {2, 1, 0};
+  cases[2].sign = {1, 1, -1};
+  for (std::uint64_t seed : {7u, 8u, 9u}) {
+    const CircleRuns circles = SimulateCircles(seed);
+    const WheelOrderReport ok =
+        CheckWheelOrderOnSegments(circles.runs, circles.tracks, sim::PalacinApr02Robot());
+    EXPECT_FALSE(ok.likely_miswired) << "seed " << seed << ": " << ok.message;
+    const WheelMapping& fix = cases[seed - 7];
+    SCOPED_TRACE(DescribeWheelMapping(fix));
+    const WheelOrderReport bad = CheckWheelOrderOnSegments(
+        Miswire(circles.runs, fix), circles.tracks, sim::PalacinApr02Robot());
+    ASSERT_TRUE(bad.likely_miswired);
+    EXPECT_EQ(bad.best.column, fix.column);
+    EXPECT_EQ(bad.best.sign, fix.sign);
+  }
+  // The flower too (open paths; every run gives one or two windows).
+  const std::vector<RunLog> logs = SimulateLogs(10, 1);
+  std::vector<const GroundTruthTrack*> tracks;
+  for (const RunLog& log : logs) tracks.push_back(&log.ground_truth);
+  const WheelOrderReport flower =
+      CheckWheelOrderOnSegments(AlignRuns(logs), tracks, sim::PalacinApr02Robot());
+  EXPECT_FALSE(flower.likely_miswired) << flower.message;
 }
 
 TEST(WheelOrderCheck, RatesInDegreesPerSecondAreNamed) {

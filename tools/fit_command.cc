@@ -1,10 +1,13 @@
 #include "tools/fit_command.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <stdexcept>
+#include <string>
+#include <unordered_map>
 
 #include "calib/degenerate_data.h"
 #include "calib/final_pose_cost.h"
@@ -27,6 +30,27 @@
 namespace fitcal::tools {
 
 namespace {
+
+// The training runs whose ground truth has poses between the start and the end (at least three
+// inside the run's window), with their tracks.
+void SelectRunsWithIntermediateGroundTruth(const std::vector<AlignedRun>& training,
+                                           const std::vector<RunLog>& logs,
+                                           std::vector<AlignedRun>* runs,
+                                           std::vector<const GroundTruthTrack*>* tracks) {
+  std::unordered_map<std::string, const RunLog*> by_id;
+  for (const RunLog& log : logs) by_id[log.id] = &log;
+  for (const AlignedRun& run : training) {
+    const auto it = by_id.find(run.id);
+    if (it == by_id.end()) continue;
+    const GroundTruthTrack& gt = it->second->ground_truth;
+    const auto inside = std::count_if(gt.t_s.begin(), gt.t_s.end(), [&](double t) {
+      return t >= run.t_start_s && t <= run.t_final_s;
+    });
+    if (inside < 3) continue;
+    runs->push_back(run);
+    tracks->push_back(&gt);
+  }
+}
 
 double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
@@ -151,7 +175,19 @@ int RunFitCommand(const FitCommandOptions& options) {
       order_options.weights.position_sigma_m = options.position_sigma_m;
       order_options.weights.heading_sigma_rad = options.heading_sigma_deg * M_PI / 180.0;
       order_options.num_threads = options.threads;
-      const WheelOrderReport order = CheckWheelOrder(split.training, robot, order_options);
+      // With intermediate ground truth the segment test decides (closed paths hide some
+      // miswirings from final poses, and segments name the mapping more sharply); final poses
+      // cover the runs without it, or data too short for segments.
+      std::vector<AlignedRun> tracked;
+      std::vector<const GroundTruthTrack*> tracks;
+      SelectRunsWithIntermediateGroundTruth(split.training, dataset.runs, &tracked, &tracks);
+      WheelOrderReport order;
+      if (!tracked.empty())
+        order = CheckWheelOrderOnSegments(tracked, tracks, robot, order_options);
+      const bool segments_decided = order.degrees_of_freedom > 0;
+      if (!order.likely_miswired && (!segments_decided || tracked.size() < split.training.size())) {
+        order = CheckWheelOrder(split.training, robot, order_options);
+      }
       if (order.likely_miswired) {
         std::cerr << "fitcal: " << options.logs << ": " << order.message
                   << "; nothing written (--skip-wheel-order-check to fit anyway)\n";
