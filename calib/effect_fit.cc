@@ -56,7 +56,8 @@ void TrackPoseErrors(const TrackRun& run, const T* p, const std::vector<ActiveEf
                      const std::vector<int>& indices, T* err) {
   const AlignedRun& a = run.aligned;
   const T tau = effects::TotalLatency(active);
-  const Pose2<T> start = InterpolateTrack(run.track, T(a.t_start_s) + tau);
+  const Pose2d start_pose = TrackStartPose(a, run.track, ScalarPart(tau));
+  const Pose2<T> start{T(start_pose.x), T(start_pose.y), T(start_pose.theta)};
   std::size_t next = 0;
   const std::size_t n = indices.size();
   const auto error_at = [&](std::size_t j, const Pose2<T>& pose, const Pose2d& gt) {
@@ -149,6 +150,23 @@ std::vector<EffectId> IdsOf(const EffectModel& model) {
 }
 
 }  // namespace
+
+Pose2d TrackStartPose(const AlignedRun& run, const GroundTruthTrack& track, double latency_s) {
+  // Encoder time (from the window start) at which the robot starts moving.
+  double rest_until_s = 0.0;
+  for (const WheelSample& s : run.samples) {
+    bool moving = false;
+    for (double w : s.rate_rad_s) moving = moving || std::abs(w) > effects::kMovingRateRadS;
+    if (moving) break;
+    rest_until_s += s.dt_s;
+  }
+  const auto first = std::lower_bound(track.t_s.begin(), track.t_s.end(), run.t_start_s);
+  if (rest_until_s > 0.0 && first != track.t_s.end() &&
+      *first - run.t_start_s - latency_s <= rest_until_s) {
+    return track.world_T_robot[static_cast<std::size_t>(first - track.t_s.begin())];
+  }
+  return InterpolateGroundTruth(track, run.t_start_s + latency_s);
+}
 
 bool TrackOptions::IsValid(std::string* error) const {
   if (!(edge_margin_s >= 0.0)) {
@@ -268,6 +286,8 @@ TrackErrors ComputeTrackErrors(const Omni3ParameterArray& p, const EffectModel& 
     out.ground_truth.push_back(run.track.world_T_robot[indices[j]]);
     out.error.push_back(Pose2d{err[3 * j], err[3 * j + 1], err[3 * j + 2]});
   }
+  const std::size_t n = indices.size();
+  out.final_error = Pose2d{err[3 * n], err[3 * n + 1], err[3 * n + 2]};
   return out;
 }
 

@@ -34,6 +34,15 @@ struct TrackRun {
   std::vector<int> checkpoints;                  // indices into track
 };
 
+// The pose the replay of a track starts from, given a ground-truth latency (the ground-truth
+// sample stamped t shows encoder time t - latency): the window's first ground-truth sample when it
+// shows the robot still at rest (every wheel below effects::kMovingRateRadS; with a positive
+// latency it shows a time just before the window, when a run that starts at rest was at rest
+// too), else the ground truth interpolated at t_start + latency. Interpolating whenever the
+// latency is not zero would blend the rest pose with a moving one when the robot starts within
+// one ground-truth period: a start error that repeats in every repetition.
+Pose2d TrackStartPose(const AlignedRun& run, const GroundTruthTrack& track, double latency_s);
+
 struct TrackOptions {
   // Checkpoints keep this far from the window's ends so a latency within the effect's bounds
   // never moves them outside the replay.
@@ -77,6 +86,7 @@ struct TrackErrors {
   std::vector<double> t_s;  // ground-truth stamps
   std::vector<Pose2d> ground_truth;
   std::vector<Pose2d> error;  // x, y in m (world), theta wrapped (rad)
+  Pose2d final_error;         // at the window's end, as RunScore's final_d* (Eq. 14's residual)
 };
 TrackErrors ComputeTrackErrors(const Omni3ParameterArray& p, const EffectModel& model,
                                const TrackRun& run, bool all_samples);

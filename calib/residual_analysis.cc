@@ -1,5 +1,6 @@
 #include "calib/residual_analysis.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -78,6 +79,26 @@ Pose2d ErrorAt(const TrackErrors& e, double t) {
           e.error[lo].theta + u * (e.error[hi].theta - e.error[lo].theta)};
 }
 
+using Lof = std::array<double, kLofComponents>;
+
+// The lack-of-fit components of a run: its error at the three checkpoint times and at the end,
+// in the start frame (heading theta0).
+Lof LofComponents(const TrackErrors& track, const std::array<double, 3>& checkpoint_times,
+                  double theta0) {
+  Lof out{};
+  for (int c = 0; c < 3; ++c) {
+    const Pose2d e = ToFrame(ErrorAt(track, checkpoint_times[c]), theta0);
+    out[3 * c] = e.x;
+    out[3 * c + 1] = e.y;
+    out[3 * c + 2] = e.theta;
+  }
+  const Pose2d f = ToFrame(track.final_error, theta0);
+  out[9] = f.x;
+  out[10] = f.y;
+  out[11] = f.theta;
+  return out;
+}
+
 void Accumulate(std::map<std::string, GroupStat>& groups, const std::string& by,
                 const std::string& bin, const double v[3]) {
   GroupStat& g = groups[by + "\x1f" + bin];
@@ -100,34 +121,79 @@ ResidualAnalysis AnalyzeResiduals(const Omni3ParameterArray& p, const EffectMode
   out.runs.resize(n);
   out.track.resize(n);
   out.final_start_frame.resize(n);
-  const ModelScore score = ScoreModel(p, model, runs, ResidualWeights{}, num_threads);
-  std::vector<std::array<double, kLofComponents>> lof(n);
+  std::vector<Lof> lof(n);
+  std::vector<std::array<double, 3>> checkpoint_times(n);
   ParallelFor(n, num_threads, [&](std::size_t i) {
     const TrackRun& run = runs[i];
     out.runs[i] = Features(p, run);
     out.track[i] = ComputeTrackErrors(p, model, run, /*all_samples=*/true);
-    const RunScore& s = score.runs[i];
     const double theta0 = run.aligned.start.theta;
-    out.final_start_frame[i] =
-        ToFrame(Pose2d{s.final_dx_m, s.final_dy_m, s.final_dtheta_rad}, theta0);
+    out.final_start_frame[i] = ToFrame(out.track[i].final_error, theta0);
     const RunFeatures& f = out.runs[i];
     for (int c = 0; c < 3; ++c) {
-      const double t = run.aligned.t_start_s + f.motion_begin_s +
-                       kCheckpointFractions[c] * (f.motion_end_s - f.motion_begin_s);
-      const Pose2d e = ToFrame(ErrorAt(out.track[i], t), theta0);
-      lof[i][3 * c] = e.x;
-      lof[i][3 * c + 1] = e.y;
-      lof[i][3 * c + 2] = e.theta;
+      checkpoint_times[i][c] = run.aligned.t_start_s + f.motion_begin_s +
+                               kCheckpointFractions[c] * (f.motion_end_s - f.motion_begin_s);
     }
-    lof[i][9] = out.final_start_frame[i].x;
-    lof[i][10] = out.final_start_frame[i].y;
-    lof[i][11] = out.final_start_frame[i].theta;
+    lof[i] = LofComponents(out.track[i], checkpoint_times[i], theta0);
   });
+  // How the components move with each fitted parameter (forward differences, the checkpoint
+  // times held): the lack of fit is what no change of the fitted parameters can remove.
+  std::vector<std::vector<Lof>> lof_jacobian;  // [parameter][run]
+  {
+    const int num_effect_parameters = [&] {
+      int k = 0;
+      for (const auto& e : model) k += effects::Info(e.id).num_parameters;
+      return k;
+    }();
+    for (int k = 0; k < omni3::kNumParameters + num_effect_parameters; ++k) {
+      Omni3ParameterArray p_k = p;
+      EffectModel model_k = model;
+      double h = 0.0;
+      if (k < omni3::kNumParameters) {
+        h = 1e-6 * std::max(std::abs(p[k]), 1e-3);
+        p_k[k] += h;
+      } else {
+        int j = k - omni3::kNumParameters;
+        for (auto& e : model_k) {
+          const effects::EffectInfo& info = effects::Info(e.id);
+          if (j < info.num_parameters) {
+            h = 1e-4 * std::max({std::abs(e.value[j]), std::abs(info.typical[j]), 1e-9});
+            e.value[j] += h;
+            break;
+          }
+          j -= info.num_parameters;
+        }
+      }
+      std::vector<Lof> column(n);
+      ParallelFor(n, num_threads, [&](std::size_t i) {
+        const TrackErrors moved = ComputeTrackErrors(p_k, model_k, runs[i], true);
+        const Lof x = LofComponents(moved, checkpoint_times[i], runs[i].aligned.start.theta);
+        for (int c = 0; c < kLofComponents; ++c) column[i][c] = (x[c] - lof[i][c]) / h;
+      });
+      lof_jacobian.push_back(std::move(column));
+    }
+  }
+  (void)num_fitted_parameters;
 
   // Systematic / non-systematic split and the lack-of-fit test, over trajectories with reps.
+  // The 12 components of a run (errors at three checkpoints and at the end, x, y, theta) are
+  // strongly correlated (an error at half way persists to the end), so each trajectory's mean is
+  // weighed with the inverse of their pooled within-trajectory covariance (a Hotelling-type
+  // statistic): weighing each component by its own variance alone counts one deviation up to 12
+  // times and makes F far more variable than F(df_lof, df_pe) (clean simulated data then read as
+  // "structure" for some seeds).
   std::map<std::string, std::vector<std::size_t>> by_trajectory;
   for (std::size_t i = 0; i < n; ++i) by_trajectory[runs[i].aligned.trajectory].push_back(i);
-  std::array<double, kLofComponents> ss_pe{}, ss_lof{};
+  using Vec = Eigen::Matrix<double, kLofComponents, 1>;
+  using Mat = Eigen::Matrix<double, kLofComponents, kLofComponents>;
+  Mat scatter = Mat::Zero();
+  struct TrajectoryMean {
+    double m;
+    Vec mean;
+    Eigen::Matrix<double, kLofComponents, Eigen::Dynamic> jacobian;  // mean over its runs
+  };
+  const int num_parameters = static_cast<int>(lof_jacobian.size());
+  std::vector<TrajectoryMean> trajectory_means;
   double sys_m = 0.0, sys_rad = 0.0, non_m = 0.0, non_rad = 0.0;
   int num_traj = 0, num_runs = 0;
   double df_pe_per_component = 0.0;
@@ -136,22 +202,24 @@ ResidualAnalysis AnalyzeResiduals(const Omni3ParameterArray& p, const EffectMode
     ++num_traj;
     const double m = static_cast<double>(members.size());
     df_pe_per_component += m - 1.0;
-    std::array<double, kLofComponents> mean{};
+    TrajectoryMean t{m, Vec::Zero(),
+                     Eigen::Matrix<double, kLofComponents, Eigen::Dynamic>::Zero(kLofComponents,
+                                                                                 num_parameters)};
     for (std::size_t i : members) {
-      for (int c = 0; c < kLofComponents; ++c) mean[c] += lof[i][c] / m;
+      t.mean += Vec(lof[i].data()) / m;
+      for (int k = 0; k < num_parameters; ++k)
+        t.jacobian.col(k) += Vec(lof_jacobian[k][i].data()) / m;
     }
-    for (int c = 0; c < kLofComponents; ++c) ss_lof[c] += m * mean[c] * mean[c];
     for (std::size_t i : members) {
       ++num_runs;
-      for (int c = 0; c < kLofComponents; ++c) {
-        const double d = lof[i][c] - mean[c];
-        ss_pe[c] += d * d;
-      }
-      sys_m += mean[9] * mean[9] + mean[10] * mean[10];
-      sys_rad += mean[11] * mean[11];
-      non_m += std::pow(lof[i][9] - mean[9], 2) + std::pow(lof[i][10] - mean[10], 2);
-      non_rad += std::pow(lof[i][11] - mean[11], 2);
+      const Vec d = Vec(lof[i].data()) - t.mean;
+      scatter += d * d.transpose();
+      sys_m += t.mean[9] * t.mean[9] + t.mean[10] * t.mean[10];
+      sys_rad += t.mean[11] * t.mean[11];
+      non_m += d[9] * d[9] + d[10] * d[10];
+      non_rad += d[11] * d[11];
     }
+    trajectory_means.push_back(std::move(t));
   }
   if (num_traj > 0 && df_pe_per_component > 0.0) {
     const double runs_d = static_cast<double>(num_runs);
@@ -160,21 +228,55 @@ ResidualAnalysis AnalyzeResiduals(const Omni3ParameterArray& p, const EffectMode
     // Scatter around a mean of m values: divide by (m - 1) per trajectory, not m.
     out.nonsystematic_rms_m = std::sqrt(non_m / df_pe_per_component);
     out.nonsystematic_rms_rad = std::sqrt(non_rad / df_pe_per_component);
-    double lof_w = 0.0;
+    // Whitening by the pure-error covariance; directions without scatter (noise-free data) are
+    // left out.
+    const Eigen::SelfAdjointEigenSolver<Mat> eig(scatter / df_pe_per_component);
+    const double largest = eig.eigenvalues().maxCoeff();
+    Mat whiten = Mat::Zero();
+    int rank = 0;
     for (int c = 0; c < kLofComponents; ++c) {
-      const double var = ss_pe[c] / df_pe_per_component;
-      if (var > 0.0) lof_w += ss_lof[c] / var;
+      const double lambda = eig.eigenvalues()[c];
+      if (!(lambda > 1e-12 * largest)) continue;
+      whiten.row(rank++) = eig.eigenvectors().col(c).transpose() / std::sqrt(lambda);
     }
-    LackOfFit& l = out.lack_of_fit;
-    l.trajectories_with_repetitions = num_traj;
-    l.df_pe = kLofComponents * df_pe_per_component;
-    l.df_lof =
-        std::max(1.0, static_cast<double>(kLofComponents * num_traj - num_fitted_parameters));
-    // lof_w ~ chi^2(df_lof) when the residual is noise; F = (lof_w / df_lof) / 1 with the
-    // variances estimated on df_pe degrees of freedom.
-    l.f = lof_w / l.df_lof;
-    l.p_value = stats::FUpperTail(l.f, l.df_lof, l.df_pe);
-    l.available = true;
+    // Weighted least squares over the trajectory means: the linearised refit of the parameters
+    // on all runs. lof_w is its residual, ~ chi^2(rank * trajectories - identifiable parameters)
+    // when what is left is noise.
+    Eigen::MatrixXd a = Eigen::MatrixXd::Zero(num_parameters, num_parameters);
+    Eigen::VectorXd b = Eigen::VectorXd::Zero(num_parameters);
+    double total = 0.0;
+    for (const TrajectoryMean& t : trajectory_means) {
+      const Eigen::VectorXd z = whiten.topRows(rank) * t.mean;
+      const Eigen::MatrixXd jz = whiten.topRows(rank) * t.jacobian;
+      total += t.m * z.squaredNorm();
+      a += t.m * jz.transpose() * jz;
+      b += t.m * jz.transpose() * z;
+    }
+    int identifiable = 0;
+    double explained = 0.0;
+    if (num_parameters > 0) {
+      const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> ea(a);
+      const double a_max = ea.eigenvalues().maxCoeff();
+      for (int k = 0; k < num_parameters; ++k) {
+        const double lambda = ea.eigenvalues()[k];
+        if (!(lambda > 1e-10 * a_max)) continue;
+        ++identifiable;
+        const double proj = ea.eigenvectors().col(k).dot(b);
+        explained += proj * proj / lambda;
+      }
+    }
+    const double lof_w = std::max(0.0, total - explained);
+    // The covariance is estimated on df_pe_per_component degrees of freedom; the Hotelling
+    // correction leaves df_pe_per_component - rank + 1 for the denominator.
+    if (rank > 0 && df_pe_per_component - rank + 1.0 > 0.0) {
+      LackOfFit& l = out.lack_of_fit;
+      l.trajectories_with_repetitions = num_traj;
+      l.df_pe = df_pe_per_component - rank + 1.0;
+      l.df_lof = std::max(1.0, static_cast<double>(rank * num_traj - identifiable));
+      l.f = lof_w / l.df_lof;
+      l.p_value = stats::FUpperTail(l.f, l.df_lof, l.df_pe);
+      l.available = true;
+    }
   }
 
   // Group statistics.

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "calib/effect_fit.h"
 #include "odometry/omni3_replay.h"
 
 namespace fitcal {
@@ -20,28 +21,50 @@ const char* ToString(OdometrySampling sampling) {
 
 TrajectoryErrors EvaluateTrajectory(const AlignedRun& run, const GroundTruthTrack& track,
                                     const Omni3ParameterArray& p, OdometrySampling sampling) {
+  return EvaluateTrajectory(run, track, p, {}, sampling);
+}
+
+TrajectoryErrors EvaluateTrajectory(const AlignedRun& run, const GroundTruthTrack& track,
+                                    const Omni3ParameterArray& p,
+                                    const std::vector<effects::EffectValue>& effects,
+                                    OdometrySampling sampling) {
   // The odometry at every encoder time of the window: times[0] = t_start with the start pose,
   // times[k + 1] after sample k (Eq. 4). Heading stays unwrapped here; only errors are wrapped.
   const std::size_t n = run.samples.size();
   std::vector<double> times(n + 1);
   std::vector<Pose2d> poses(n + 1);
   times[0] = run.t_start_s;
-  poses[0] = run.start;
   double t = run.t_start_s;
   for (std::size_t k = 0; k < n; ++k) {
     t += run.samples[k].dt_s;
     times[k + 1] = t;
   }
-  const Pose2d final_pose = omni3::ReplayWithMatrix(
-      omni3::InverseKinematicMatrix(p.data()), run.samples.data(), n, run.start,
-      [&poses](std::size_t k, const Pose2d& pose) { poses[k + 1] = pose; });
+  Pose2d final_pose;
+  Pose2d final_ground_truth = run.final_ground_truth;
+  double latency_s = 0.0;
+  if (effects.empty()) {
+    poses[0] = run.start;
+    final_pose = omni3::ReplayWithMatrix(
+        omni3::InverseKinematicMatrix(p.data()), run.samples.data(), n, run.start,
+        [&poses](std::size_t k, const Pose2d& pose) { poses[k + 1] = pose; });
+  } else {
+    std::vector<effects::ActiveEffect<double>> active;
+    for (const effects::EffectValue& e : effects) active.push_back({e.id, e.value.data()});
+    latency_s = effects::TotalLatency(active);
+    poses[0] = TrackStartPose(run, track, latency_s);
+    final_ground_truth = InterpolateGroundTruth(track, run.t_final_s + latency_s);
+    final_pose = effects::ReplayWithEffects(
+        p.data(), active, run.samples, effects::MakeSampleContexts(run.samples), poses[0],
+        [&poses](std::size_t k, const Pose2d&, const Pose2d& after) { poses[k + 1] = after; });
+  }
 
   TrajectoryErrors out;
   for (std::size_t i = 0; i < track.t_s.size(); ++i) {
     const double t_gt = track.t_s[i];
     if (t_gt < run.t_start_s || t_gt > run.t_final_s) continue;
+    const double t_enc = t_gt - latency_s;  // the encoder time this sample shows
     const std::size_t hi = std::min<std::size_t>(
-        static_cast<std::size_t>(std::lower_bound(times.begin(), times.end(), t_gt) -
+        static_cast<std::size_t>(std::lower_bound(times.begin(), times.end(), t_enc) -
                                  times.begin()),
         n);
     const std::size_t lo = hi == 0 ? 0 : hi - 1;
@@ -49,9 +72,9 @@ TrajectoryErrors EvaluateTrajectory(const AlignedRun& run, const GroundTruthTrac
     if (hi == lo || times[hi] <= times[lo]) {
       odom = poses[hi];
     } else if (sampling == OdometrySampling::kNearestTime) {
-      odom = (t_gt - times[lo] <= times[hi] - t_gt) ? poses[lo] : poses[hi];
+      odom = (t_enc - times[lo] <= times[hi] - t_enc) ? poses[lo] : poses[hi];
     } else {
-      const double u = std::clamp((t_gt - times[lo]) / (times[hi] - times[lo]), 0.0, 1.0);
+      const double u = std::clamp((t_enc - times[lo]) / (times[hi] - times[lo]), 0.0, 1.0);
       odom = Pose2d{poses[lo].x + u * (poses[hi].x - poses[lo].x),
                     poses[lo].y + u * (poses[hi].y - poses[lo].y),
                     poses[lo].theta + u * (poses[hi].theta - poses[lo].theta)};
@@ -80,10 +103,10 @@ TrajectoryErrors EvaluateTrajectory(const AlignedRun& run, const GroundTruthTrac
 
   // Final errors and CF exactly as Eq. 14 / final_pose_residual.h.
   out.final_odometry = final_pose;
-  out.final_ground_truth = run.final_ground_truth;
-  const double dx = final_pose.x - run.final_ground_truth.x;
-  const double dy = final_pose.y - run.final_ground_truth.y;
-  const double dtheta = WrapAngle(final_pose.theta - run.final_ground_truth.theta);
+  out.final_ground_truth = final_ground_truth;
+  const double dx = final_pose.x - final_ground_truth.x;
+  const double dy = final_pose.y - final_ground_truth.y;
+  const double dtheta = WrapAngle(final_pose.theta - final_ground_truth.theta);
   out.final_distance_m = std::hypot(dx, dy);
   out.final_angle_rad = std::abs(dtheta);
   out.cf = std::sqrt(dx * dx + dy * dy + dtheta * dtheta);

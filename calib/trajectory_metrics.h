@@ -20,6 +20,7 @@
 
 #include "calib/aligned_run.h"
 #include "calib/final_pose_cost.h"
+#include "odometry/effects.h"
 #include "odometry/run_log.h"
 
 namespace fitcal {
@@ -53,6 +54,16 @@ struct TrajectoryErrors {
 // std::invalid_argument if no ground-truth sample lies inside the window.
 TrajectoryErrors EvaluateTrajectory(const AlignedRun& run, const GroundTruthTrack& track,
                                     const Omni3ParameterArray& p,
+                                    OdometrySampling sampling = OdometrySampling::kNearestTime);
+
+// The same for a model with effects (odometry/effects.h, as a calibrated robot YAML carries them
+// after `fitcal diagnose`), with the semantics of the effect fit (effect_fit.h): the replay
+// applies every effect, and a ground-truth latency tau makes the ground-truth sample stamped t
+// show the odometry at encoder time t - tau (the start pose is TrackStartPose's, the final pose is
+// compared with the ground truth at t_final + tau). With no effects it equals the overload above.
+TrajectoryErrors EvaluateTrajectory(const AlignedRun& run, const GroundTruthTrack& track,
+                                    const Omni3ParameterArray& p,
+                                    const std::vector<effects::EffectValue>& effects,
                                     OdometrySampling sampling = OdometrySampling::kNearestTime);
 
 // Summary statistics named as the evo tool names them (evo_ape/evo_rpe "stats"): rmse, mean,

@@ -69,12 +69,12 @@ struct WheelOrderReport {
   WheelMapping best;             // the best-scoring mapping (identity when not miswired)
   double recorded_nominal_ssr = 0.0;
   double best_nominal_ssr = 0.0;
-  bool fitted = false;        // SSRs below are after a bounded fit of both hypotheses
-  double recorded_ssr = 0.0;  // SSR of the recorded order (fitted when `fitted`)
-  double best_ssr = 0.0;      // SSR of the best other mapping (fitted when `fitted`)
-  double threshold = 0.0;     // the F quantile the ratio recorded/best had to exceed
+  bool fitted = false;         // SSRs below are after a bounded fit of both hypotheses
+  double recorded_ssr = 0.0;   // SSR of the recorded order (fitted when `fitted`)
+  double best_ssr = 0.0;       // SSR of the best other mapping (fitted when `fitted`)
+  double threshold = 0.0;      // the F quantile the ratio recorded/best had to exceed
   int degrees_of_freedom = 0;  // 0: nothing was decided (too few windows)
-  std::string message;  // one line when likely_miswired
+  std::string message;         // one line when likely_miswired
 };
 
 // Throws std::invalid_argument for invalid options or no runs.

@@ -276,7 +276,13 @@ std::string ReportHtml(const ReportData& d) {
     << EscapeXml(d.training_repetitions) << ").<br>"
     << "Odometry sub-sampled at the ground-truth times by <b>" << EscapeXml(d.sampling)
     << "</b> time" << (d.sampling == "nearest" ? " (as Palacin et al. 2022)" : " interpolation")
-    << ". Before = nominal parameters, after = calibrated parameters.</p>\n";
+    << ". Before = nominal parameters, after = calibrated parameters";
+  if (!d.calibrated_effects.empty()) {
+    h << " with the effects";
+    for (std::size_t i = 0; i < d.calibrated_effects.size(); ++i)
+      h << (i ? "; " : " ") << "<code>" << EscapeXml(d.calibrated_effects[i]) << "</code>";
+  }
+  h << ".</p>\n";
 
   h << "<h2>Summary (Palacin Table 6)</h2>\n<p>Averages over the validation runs; improvement = "
        "100 (before &minus; after) / before, positive is better.</p>\n<table>\n<tr><th>group</th>"
@@ -432,7 +438,9 @@ std::string ReportMarkdown(const ReportData& d) {
     << d.calibration << "`\n- fitcal " << d.tool_version << "\n- validation: " << d.runs.size()
     << " runs (repetitions " << d.validation_repetitions << "), training: " << d.training_runs
     << " runs (repetitions " << d.training_repetitions << ")\n- odometry sampled at the "
-    << "ground-truth times by " << d.sampling << " time\n\n## Summary (Palacin Table 6)\n\n"
+    << "ground-truth times by " << d.sampling << " time\n";
+  for (const std::string& e : d.calibrated_effects) m << "- calibrated effect: " << e << "\n";
+  m << "\n## Summary (Palacin Table 6)\n\n"
     << "| group | runs | |";
   for (const Column& c : kColumns) m << " " << c.label << " |";
   m << "\n|---|---:|---|";
@@ -527,7 +535,10 @@ std::string MetricsJson(const ReportData& d) {
     << ",\n  \"dataset\": " << JsonString(d.dataset)
     << ",\n  \"calibration\": " << JsonString(d.calibration)
     << ",\n  \"robot\": " << JsonString(d.robot_name)
-    << ",\n  \"odometry_sampling\": " << JsonString(d.sampling)
+    << ",\n  \"odometry_sampling\": " << JsonString(d.sampling) << ",\n  \"calibrated_effects\": [";
+  for (std::size_t i = 0; i < d.calibrated_effects.size(); ++i)
+    j << (i ? ", " : "") << JsonString(d.calibrated_effects[i]);
+  j << "]"
     << ",\n  \"training_repetitions\": " << JsonString(d.training_repetitions)
     << ",\n  \"validation_repetitions\": " << JsonString(d.validation_repetitions)
     << ",\n  \"summary\": [";

@@ -81,6 +81,9 @@ struct ReportData {
   std::string calibration;
   std::string robot_name;
   std::string sampling;  // "nearest" or "linear"
+  // Effects the calibration carries beyond the nine parameters, replayed in "after", one
+  // description each (e.g. "time_offset: latency_s = 0.08"); empty for the nine alone.
+  std::vector<std::string> calibrated_effects;
   std::string training_repetitions;
   std::string validation_repetitions;
   int training_runs = 0;
