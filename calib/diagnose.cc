@@ -89,7 +89,7 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
   out.declared = FitOmni3Ceres(AlignedOf(training), robot, declared_options);
   out.declared_validation =
       ScoreModel(out.declared.parameters, {}, validation, options.fit.weights, threads);
-  out.before = AnalyzeResiduals(out.declared.parameters, {}, all, omni3::kNumParameters, threads);
+  out.before = AnalyzeResiduals(out.declared.parameters, {}, all, threads);
 
   // 2. The base: nine parameters on the tracks.
   out.base = FitEffectModel(training, robot, out.declared.parameters, {}, options.fit);
@@ -118,8 +118,8 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
     const ModelScore base_val =
         ScoreModel(current.parameters, current.effects, validation, options.fit.weights, threads);
     round.base_validation_objective = base_val.objective;
-    const ResidualAnalysis base_all = AnalyzeResiduals(current.parameters, current.effects, all,
-                                                       NumParameters(current.effects), threads);
+    const ResidualAnalysis base_all =
+        AnalyzeResiduals(current.parameters, current.effects, all, threads);
     round.base_lof_f = base_all.lack_of_fit.f;
     round.base_lof_p = base_all.lack_of_fit.p_value;
     const bool base_lof =
@@ -203,8 +203,8 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
     for (int i : order) {
       CandidateResult& c = round.candidates[i];
       if (base_lof) {
-        const ResidualAnalysis with = AnalyzeResiduals(c.fit.parameters, c.fit.effects, all,
-                                                       NumParameters(c.fit.effects), threads);
+        const ResidualAnalysis with =
+            AnalyzeResiduals(c.fit.parameters, c.fit.effects, all, threads);
         c.lof_f = with.lack_of_fit.f;
         const double excess_before = round.base_lof_f - 1.0;
         const double excess_after = std::max(0.0, c.lof_f - 1.0);
@@ -249,8 +249,7 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
   out.final_fit = current;
   out.final_validation =
       ScoreModel(current.parameters, current.effects, validation, options.fit.weights, threads);
-  out.after = AnalyzeResiduals(current.parameters, current.effects, all,
-                               NumParameters(current.effects), threads);
+  out.after = AnalyzeResiduals(current.parameters, current.effects, all, threads);
   out.unexplained_structure =
       out.after.lack_of_fit.available && out.after.lack_of_fit.p_value < options.lof_alpha;
   out.effects_named = !out.unexplained_structure && !current.effects.empty();

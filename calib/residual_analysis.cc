@@ -114,8 +114,7 @@ void Accumulate(std::map<std::string, GroupStat>& groups, const std::string& by,
 }  // namespace
 
 ResidualAnalysis AnalyzeResiduals(const Omni3ParameterArray& p, const EffectModel& model,
-                                  const std::vector<TrackRun>& runs, int num_fitted_parameters,
-                                  int num_threads) {
+                                  const std::vector<TrackRun>& runs, int num_threads) {
   ResidualAnalysis out;
   const std::size_t n = runs.size();
   out.runs.resize(n);
@@ -173,7 +172,6 @@ ResidualAnalysis AnalyzeResiduals(const Omni3ParameterArray& p, const EffectMode
       lof_jacobian.push_back(std::move(column));
     }
   }
-  (void)num_fitted_parameters;
 
   // Systematic / non-systematic split and the lack-of-fit test, over trajectories with reps.
   // The 12 components of a run (errors at three checkpoints and at the end, x, y, theta) are

@@ -10,14 +10,16 @@
 // - Statistics by trajectory family (label's letters: R/G/B), heading direction alpha of the
 //   motion in the robot frame (30 deg bins), rotation sign, speed; and the growth rate of the
 //   robot-frame error by acceleration phase and by time within the run.
-// - A lack-of-fit F test with the repetitions as pure error, on the start-frame pose errors at
-//   four checkpoints (a quarter, half and three quarters through the motion, and the end):
-//     SS_pe  = sum_traj sum_rep |e - mean_traj e|^2,        df_pe  = sum_traj (n_traj - 1) * 12
-//     SS_lof = sum_traj n_traj |mean_traj e|^2,             df_lof = 12 * n_traj_with_reps - k
-//   each of the 12 components whitened by its pure-error variance first;
-//   F = (SS_lof / df_lof) / (SS_pe / df_pe), p = P(F(df_lof, df_pe) > F). Only trajectories
-//   with at least two repetitions count. A run's checkpoints are correlated, so the F
-//   distribution is approximate: diagnose.h uses a strict threshold.
+// - A lack-of-fit F test with the repetitions as pure error, on e, the start-frame pose errors at
+//   four checkpoints (a quarter, half and three quarters through the motion, and the end): 12
+//   components per run, strongly correlated, so they are whitened by their pooled pure-error
+//   covariance S (rank r; trajectories with at least two repetitions):
+//     S      = sum_traj sum_rep (e - mean_traj e)(...)^T / D,   D = sum_traj (n_traj - 1)
+//     SS_lof = min_delta sum_traj n_traj |S^-1/2 (mean_traj e - J_traj delta)|^2
+//   where J_traj is the mean derivative of e with respect to every fitted parameter (nine plus
+//   the effects', forward differences): what a refit on all runs could still remove is not lack
+//   of fit. df_lof = r * n_traj - (identifiable parameters), df_pe = D - r + 1 (Hotelling);
+//   F = SS_lof / df_lof, p = P(F(df_lof, df_pe) > F).
 
 #include <string>
 #include <vector>
@@ -67,10 +69,10 @@ struct ResidualAnalysis {
   std::vector<GroupStat> groups;
 };
 
-// num_fitted_parameters: k of the lack-of-fit test (9 + effect parameters).
+// The lack-of-fit test counts as fitted every parameter of p and of the model's effects (it
+// subtracts their linearised refit on all runs).
 ResidualAnalysis AnalyzeResiduals(const Omni3ParameterArray& p, const EffectModel& model,
-                                  const std::vector<TrackRun>& runs, int num_fitted_parameters,
-                                  int num_threads = 0);
+                                  const std::vector<TrackRun>& runs, int num_threads = 0);
 
 // Human-readable tables (Markdown).
 std::string FormatResidualAnalysis(const ResidualAnalysis& analysis);
