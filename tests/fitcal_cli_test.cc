@@ -16,6 +16,7 @@
 namespace fitcal {
 namespace {
 
+using fitcal::testing::ReadFileBytes;
 using fitcal::testing::TempDir;
 
 const std::string kFitcal = std::string(FITCAL_BINARY_DIR) + "/tools/fitcal";
@@ -26,20 +27,13 @@ struct Result {
   std::string out, err;
 };
 
-std::string Slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 Result RunFitcal(const TempDir& dir, const std::string& args) {
   const std::string out = dir.Path("stdout.txt"), err = dir.Path("stderr.txt");
   const int status = std::system((kFitcal + " " + args + " >" + out + " 2>" + err).c_str());
   Result r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = Slurp(out);
-  r.err = Slurp(err);
+  r.out = ReadFileBytes(out);
+  r.err = ReadFileBytes(err);
   return r;
 }
 
@@ -69,7 +63,7 @@ TEST(FitcalCli, FitsWritesAndReadsBackTheCalibration) {
   const Omni3Robot calibrated = io::ReadOmni3Robot(out);  // the output is a valid robot file
   // Table 5 (the simulated truth) has R_a = 0.2186 m, far from the nominal 0.195 m.
   EXPECT_NEAR(calibrated.nominal.distance_m[0], 0.2186, 0.003);
-  const std::string yaml = Slurp(out);
+  const std::string yaml = ReadFileBytes(out);
   for (const char* key : {"calibration:", "cf_validation:", "sigma:", "inverse_kinematic_matrix:",
                           "tool_version:", "training_repetitions: [1]"}) {
     EXPECT_NE(yaml.find(key), std::string::npos) << key;
@@ -91,7 +85,7 @@ TEST(FitcalCli, AsocFitWritesCalibrationWithSigma) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const io::AsocRobot calibrated = io::ReadAsocRobot(out);
   const YAML::Node sigma = YAML::LoadFile(out)["calibration"]["sigma"];
-  ASSERT_TRUE(sigma.IsMap()) << Slurp(out);
+  ASSERT_TRUE(sigma.IsMap()) << ReadFileBytes(out);
   ASSERT_EQ(sigma.size(), 3u);
   for (const std::string& name : calibrated.castor_names) {
     const YAML::Node castor = sigma[name];
@@ -112,7 +106,7 @@ TEST(FitcalCli, BadInputGivesOneLineAndWritesNothing) {
 
   // A non-numeric field on line 5 of one encoder file.
   const std::string enc = data + "/runs/G3-rep02_encoders.csv";
-  const std::string original = Slurp(enc);
+  const std::string original = ReadFileBytes(enc);
   std::string text = original;
   std::size_t line_start = 0;
   for (int i = 0; i < 4; ++i) line_start = text.find('\n', line_start) + 1;
@@ -123,18 +117,18 @@ TEST(FitcalCli, BadInputGivesOneLineAndWritesNothing) {
   EXPECT_NE(r.exit_code, 0);
   EXPECT_EQ(CountLines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find(enc + ":5:"), std::string::npos) << r.err;
-  EXPECT_EQ(Slurp(out), previous);
+  EXPECT_EQ(ReadFileBytes(out), previous);
 
   // Unknown model (the encoder file repaired first).
   std::ofstream(enc, std::ios::binary) << original;
-  std::string robot = Slurp(data + "/robot.yaml");
+  std::string robot = ReadFileBytes(data + "/robot.yaml");
   robot.replace(robot.find("omni3"), 5, "omni4");
   dir.Write("flower/robot.yaml", robot);
   const Result m = RunFitcal(dir, "--logs " + data + " --out " + out);
   EXPECT_NE(m.exit_code, 0);
   EXPECT_EQ(CountLines(m.err), 1) << m.err;
   EXPECT_NE(m.err.find("omni4"), std::string::npos) << m.err;
-  EXPECT_EQ(Slurp(out), previous);
+  EXPECT_EQ(ReadFileBytes(out), previous);
 }
 
 // The other subcommands refuse impossible requests the same way: a non-zero exit, one stderr line

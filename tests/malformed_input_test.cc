@@ -9,13 +9,10 @@
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <set>
 #include <string>
 
@@ -23,12 +20,16 @@
 #include "io/input_error.h"
 #include "io/robot_yaml.h"
 #include "io/text_file.h"
+#include "tests/test_files.h"
 
 namespace fitcal {
 namespace {
 
 namespace fs = std::filesystem;
 using io::InputErrorKind;
+using testing::ReadFileBytes;
+using testing::TempDir;
+using testing::WriteFileBytes;
 
 struct MalformedCase {
   const char* file;        // in tests/malformed/
@@ -94,16 +95,6 @@ const MalformedCase kCases[] = {
 
 const fs::path kCorpus = fs::path(FITCAL_SOURCE_DIR) / "tests" / "malformed";
 
-std::string ReadBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
-void WriteBytes(const fs::path& path, const std::string& bytes) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << bytes;
-}
-
 // Which file of the data set a case replaces, from its prefix.
 std::string RoleFile(const std::string& case_file) {
   const std::string name = case_file.rfind("ok_", 0) == 0 ? case_file.substr(3) : case_file;
@@ -117,33 +108,25 @@ std::string RoleFile(const std::string& case_file) {
 // A valid one-run data set in <root>/ds, with `case_file` in place of its role's file.
 class DatasetDir {
  public:
-  explicit DatasetDir(const std::string& case_file) {
-    std::string tmpl = (fs::temp_directory_path() / "fitcal-malformed-XXXXXX").string();
-    EXPECT_NE(mkdtemp(tmpl.data()), nullptr);
-    root_ = tmpl;
-    dir_ = root_ / "ds";
+  explicit DatasetDir(const std::string& case_file) : dir_(temp_.path() / "ds") {
     fs::create_directories(dir_);
     fs::copy_file(fs::path(FITCAL_SOURCE_DIR) / "data" / "robots" / "apr02.yaml",
                   dir_ / "robot.yaml");
-    WriteBytes(dir_ / "dataset.yaml",
-               "robot: robot.yaml\nruns:\n  - {id: r1, trajectory: R1, repetition: 1, "
-               "encoders: enc.csv, ground_truth: gt.csv}\n");
-    WriteBytes(dir_ / "enc.csv", "t,w_a,w_b,w_c\n0.00,0,0,0\n0.01,1,2,3\n0.02,1,2,3\n");
-    WriteBytes(dir_ / "gt.csv", "t,x,y,theta\n0,0,0,0\n0.02,0.001,0,0\n");
+    WriteFileBytes(dir_ / "dataset.yaml",
+                   "robot: robot.yaml\nruns:\n  - {id: r1, trajectory: R1, repetition: 1, "
+                   "encoders: enc.csv, ground_truth: gt.csv}\n");
+    WriteFileBytes(dir_ / "enc.csv", "t,w_a,w_b,w_c\n0.00,0,0,0\n0.01,1,2,3\n0.02,1,2,3\n");
+    WriteFileBytes(dir_ / "gt.csv", "t,x,y,theta\n0,0,0,0\n0.02,0.001,0,0\n");
     if (!case_file.empty()) {
       fs::copy_file(kCorpus / case_file, dir_ / RoleFile(case_file),
                     fs::copy_options::overwrite_existing);
     }
   }
-  ~DatasetDir() {
-    std::error_code ignored;
-    fs::remove_all(root_, ignored);
-  }
-  const fs::path& root() const { return root_; }
+  const fs::path& root() const { return temp_.path(); }
   const fs::path& dir() const { return dir_; }
 
  private:
-  fs::path root_;
+  TempDir temp_;  // declared first: dir_ lives inside it
   fs::path dir_;
 };
 
@@ -171,7 +154,7 @@ CliResult RunFitcal(const std::string& args, const fs::path& scratch) {
   const int status = std::system(command.c_str());
   CliResult result;
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128;
-  result.stderr_text = ReadBytes(err);
+  result.stderr_text = ReadFileBytes(err);
   fs::remove(err);
   return result;
 }

@@ -11,49 +11,24 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <string>
 #include <vector>
 
 #include "io/dataset.h"
 #include "io/log_files.h"
 #include "io/robot_yaml.h"
+#include "tests/test_files.h"
 
 namespace fitcal {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::ReadFileBytes;
+using testing::TempDir;
+using testing::WriteFileBytes;
 
 const std::string kFitcal = std::string(FITCAL_BINARY_DIR) + "/tools/fitcal";
 const std::string kRobot = std::string(FITCAL_SOURCE_DIR) + "/data/robots/apr02.yaml";
-
-std::string ReadBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
-void WriteBytes(const fs::path& path, const std::string& bytes) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << bytes;
-}
-
-class ScratchDir {
- public:
-  ScratchDir() {
-    std::string tmpl = (fs::temp_directory_path() / "fitcal-nothing-lost-XXXXXX").string();
-    EXPECT_NE(mkdtemp(tmpl.data()), nullptr);
-    path_ = tmpl;
-  }
-  ~ScratchDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
 
 int RunShell(const std::string& command) {
   const int status = std::system(command.c_str());
@@ -115,7 +90,7 @@ std::vector<std::string> TemporaryFiles(const fs::path& dir) {
 // temporary file and renaming it over the output), not after a guessed delay, so the test does
 // not depend on how fast the machine is.
 TEST(NothingLostTest, SignalAtEveryStageLeavesThePreviousOutputUntouched) {
-  const ScratchDir scratch;
+  const TempDir scratch;
   const fs::path data = Simulate(scratch.path(), 2);
   const fs::path out_dir = scratch.path() / "out";
   fs::create_directories(out_dir);
@@ -124,7 +99,7 @@ TEST(NothingLostTest, SignalAtEveryStageLeavesThePreviousOutputUntouched) {
   for (const char* stage : {"loaded", "fitted", "temporary-written"}) {
     for (int signal_number : {SIGINT, SIGTERM, SIGHUP, SIGKILL}) {
       SCOPED_TRACE(std::string("signal ") + strsignal(signal_number) + " at stage " + stage);
-      WriteBytes(out, previous);
+      WriteFileBytes(out, previous);
       const pid_t pid = StartFitStoppedAt(data, out, stage);
       ASSERT_GT(pid, 0) << "fitcal ended before reaching the stage";
       if (std::string(stage) == "temporary-written") {
@@ -136,7 +111,7 @@ TEST(NothingLostTest, SignalAtEveryStageLeavesThePreviousOutputUntouched) {
       ASSERT_EQ(waitpid(pid, &status, 0), pid);
       ASSERT_TRUE(WIFSIGNALED(status)) << "the signal did not end fitcal";
       EXPECT_EQ(WTERMSIG(status), signal_number) << "the handler must re-raise the signal";
-      EXPECT_EQ(ReadBytes(out), previous) << "the previous output was changed";
+      EXPECT_EQ(ReadFileBytes(out), previous) << "the previous output was changed";
       const std::vector<std::string> temporaries = TemporaryFiles(out_dir);
       if (signal_number == SIGKILL && std::string(stage) == "temporary-written") {
         // Uncatchable: the temporary stays (named after the output), the output is intact.
@@ -149,41 +124,41 @@ TEST(NothingLostTest, SignalAtEveryStageLeavesThePreviousOutputUntouched) {
     }
   }
   // Not stopped: the run completes and replaces the output with a readable calibration.
-  WriteBytes(out, previous);
+  WriteFileBytes(out, previous);
   ASSERT_EQ(RunShell(kFitcal + " --logs '" + data.string() + "' --out '" + out.string() +
                      "' > /dev/null"),
             0);
-  EXPECT_NE(ReadBytes(out), previous);
+  EXPECT_NE(ReadFileBytes(out), previous);
   EXPECT_NO_THROW(io::ReadOmni3Robot(out.string()));
   EXPECT_TRUE(TemporaryFiles(out_dir).empty());
 }
 
 TEST(NothingLostTest, RefusedFitLeavesThePreviousOutputUntouched) {
   // Failure after loading, before any output: miswired encoder columns (a and b swapped).
-  const ScratchDir scratch;
+  const TempDir scratch;
   const fs::path data = Simulate(scratch.path(), 1);
   const io::Dataset dataset = io::LoadDataset(data.string());
   const io::DatasetIndex index = io::ReadDatasetIndex(data.string());
   for (std::size_t i = 0; i < index.runs.size(); ++i) {
     EncoderLog log = dataset.runs[i].encoders;
     for (WheelSample& s : log.samples) std::swap(s.rate_rad_s[0], s.rate_rad_s[1]);
-    WriteBytes(index.runs[i].encoders_path, io::EncoderCsv(log));
+    WriteFileBytes(index.runs[i].encoders_path, io::EncoderCsv(log));
   }
   const fs::path out = scratch.path() / "calibrated.yaml";
   const std::string previous = PreviousOutput("apr02");
-  WriteBytes(out, previous);
+  WriteFileBytes(out, previous);
   const fs::path err = scratch.path() / "stderr.txt";
   EXPECT_EQ(RunShell(kFitcal + " --logs '" + data.string() + "' --out '" + out.string() +
                      "' > /dev/null 2> '" + err.string() + "'"),
             4);
-  const std::string message = ReadBytes(err);
+  const std::string message = ReadFileBytes(err);
   EXPECT_NE(message.find("columns w_a and w_b swapped"), std::string::npos) << message;
   EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;
-  EXPECT_EQ(ReadBytes(out), previous);
+  EXPECT_EQ(ReadFileBytes(out), previous);
 }
 
 TEST(NothingLostTest, OutRefusesAnotherRobotsCalibrationUnlessForced) {
-  const ScratchDir scratch;
+  const TempDir scratch;
   const fs::path data = Simulate(scratch.path(), 1);
   const fs::path out = scratch.path() / "calibrated.yaml";
   const fs::path err = scratch.path() / "stderr.txt";
@@ -192,30 +167,31 @@ TEST(NothingLostTest, OutRefusesAnotherRobotsCalibrationUnlessForced) {
   const std::string quiet = " > /dev/null 2> '" + err.string() + "'";
 
   const std::string other = PreviousOutput("apr03");
-  WriteBytes(out, other);
+  WriteFileBytes(out, other);
   EXPECT_EQ(RunShell(fit + quiet), 2);
-  EXPECT_NE(ReadBytes(err).find("holds the calibration of robot 'apr03', not 'apr02'"),
+  EXPECT_NE(ReadFileBytes(err).find("holds the calibration of robot 'apr03', not 'apr02'"),
             std::string::npos)
-      << ReadBytes(err);
-  EXPECT_EQ(ReadBytes(out), other);
+      << ReadFileBytes(err);
+  EXPECT_EQ(ReadFileBytes(out), other);
 
-  WriteBytes(out, "not: [a robot\n");  // not even YAML: refused as well
+  WriteFileBytes(out, "not: [a robot\n");  // not even YAML: refused as well
   EXPECT_EQ(RunShell(fit + quiet), 2);
-  EXPECT_NE(ReadBytes(err).find("is not a robot YAML"), std::string::npos) << ReadBytes(err);
+  EXPECT_NE(ReadFileBytes(err).find("is not a robot YAML"), std::string::npos)
+      << ReadFileBytes(err);
 
-  WriteBytes(out, other);
-  EXPECT_EQ(RunShell(fit + " --force" + quiet), 0) << ReadBytes(err);
+  WriteFileBytes(out, other);
+  EXPECT_EQ(RunShell(fit + " --force" + quiet), 0) << ReadFileBytes(err);
   EXPECT_EQ(io::ReadOmni3Robot(out.string()).name, "apr02");
 
   // The same robot's previous calibration is replaced without --force.
   const std::string same = PreviousOutput("apr02");
-  WriteBytes(out, same);
-  EXPECT_EQ(RunShell(fit + quiet), 0) << ReadBytes(err);
-  EXPECT_NE(ReadBytes(out), same);
+  WriteFileBytes(out, same);
+  EXPECT_EQ(RunShell(fit + quiet), 0) << ReadFileBytes(err);
+  EXPECT_NE(ReadFileBytes(out), same);
 }
 
 TEST(NothingLostTest, RatesInDegreesPerSecondGiveAUnitsWarning) {
-  const ScratchDir scratch;
+  const TempDir scratch;
   const fs::path data = Simulate(scratch.path(), 1);
   const io::DatasetIndex index = io::ReadDatasetIndex(data.string());
   // One run in degrees/s is enough to be told (the check pools path lengths over runs, and a
@@ -225,13 +201,13 @@ TEST(NothingLostTest, RatesInDegreesPerSecondGiveAUnitsWarning) {
     for (WheelSample& s : log.samples) {
       for (double& w : s.rate_rad_s) w *= 180.0 / M_PI;
     }
-    WriteBytes(index.runs[i].encoders_path, io::EncoderCsv(log));
+    WriteFileBytes(index.runs[i].encoders_path, io::EncoderCsv(log));
   }
   const fs::path err = scratch.path() / "stderr.txt";
   RunShell(kFitcal + " --logs '" + data.string() + "' --no-output > /dev/null 2> '" + err.string() +
            "'");
-  EXPECT_NE(ReadBytes(err).find("likely units: deg/s instead of rad/s"), std::string::npos)
-      << ReadBytes(err);
+  EXPECT_NE(ReadFileBytes(err).find("likely units: deg/s instead of rad/s"), std::string::npos)
+      << ReadFileBytes(err);
 }
 
 }  // namespace

@@ -1,14 +1,26 @@
 #pragma once
-// A temporary directory per test, removed afterwards, and a helper to write small files into it.
+// A temporary directory per test, removed afterwards, and helpers to read and write whole files.
 
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <string>
 
 namespace fitcal::testing {
+
+// The whole file as bytes ("" when it cannot be read).
+inline std::string ReadFileBytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// Replaces the file's contents with `bytes`.
+inline void WriteFileBytes(const std::filesystem::path& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+}
 
 class TempDir {
  public:
@@ -30,7 +42,7 @@ class TempDir {
   std::string Write(const std::string& name, const std::string& text) const {
     const auto p = path_ / name;
     std::filesystem::create_directories(p.parent_path());
-    std::ofstream(p, std::ios::binary) << text;
+    WriteFileBytes(p, text);
     return p.string();
   }
   const std::filesystem::path& path() const { return path_; }
