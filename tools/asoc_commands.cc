@@ -103,6 +103,18 @@ std::string AsocCalibrationRecord(const io::AsocRobot& robot, const std::string&
   return out.c_str();
 }
 
+// Writes `robot` with the calibrated castors `estimate` and the record above to `out`
+// (atomically), and says so.
+void WriteAsocCalibration(const std::string& out, const io::AsocRobot& robot,
+                          const asoc::Vehicle& estimate, const std::string& method,
+                          const std::string& dataset, const asoc::AsocFitResult* fit) {
+  io::AsocRobot calibrated = robot;
+  calibrated.nominal = estimate;
+  io::WriteFileAtomically(
+      out, io::AsocRobotYaml(calibrated, AsocCalibrationRecord(robot, method, dataset, fit)));
+  std::printf("wrote %s\n", out.c_str());
+}
+
 }  // namespace
 
 int RunAsocSimulate(const AsocSimulateOptions& options) {
@@ -188,12 +200,8 @@ int RunAsocGeometric(const AsocGeometricOptions& options) {
         std::cerr << "fitcal: " << refusal << "\n";
         return 2;
       }
-      io::AsocRobot calibrated = robot;
-      calibrated.nominal = result.estimate;
-      const std::string record =
-          AsocCalibrationRecord(robot, "closed-form Doebbler Eq. 1-9", options.logs, nullptr);
-      io::WriteFileAtomically(options.out, io::AsocRobotYaml(calibrated, record));
-      std::printf("wrote %s\n", options.out.c_str());
+      WriteAsocCalibration(options.out, robot, result.estimate, "closed-form Doebbler Eq. 1-9",
+                           options.logs, nullptr);
     }
     return 0;
   } catch (const std::exception& e) {
@@ -289,12 +297,8 @@ int RunAsocFit(const FitCommandOptions& options) {
       return 3;
     }
     if (!options.no_output) {
-      io::AsocRobot calibrated = robot;
-      calibrated.nominal = best.estimate;
-      const std::string record = AsocCalibrationRecord(
-          robot, closed.usable ? "closed form + ceres" : "ceres", options.logs, &best);
-      io::WriteFileAtomically(options.out, io::AsocRobotYaml(calibrated, record));
-      std::printf("wrote %s\n", options.out.c_str());
+      WriteAsocCalibration(options.out, robot, best.estimate,
+                           closed.usable ? "closed form + ceres" : "ceres", options.logs, &best);
     }
     return 0;
   } catch (const std::exception& e) {

@@ -279,10 +279,7 @@ int RunCompareCommand(const CompareCommandOptions& options) {
                   options.out.c_str());
     }
     return 0;
-  } catch (const io::InputError& e) {
-    std::cerr << "fitcal compare: " << e.what() << "\n";
-    return 1;
-  } catch (const std::exception& e) {
+  } catch (const std::exception& e) {  // io::InputError too: what() is its file:line message
     std::cerr << "fitcal compare: " << e.what() << "\n";
     return 1;
   }

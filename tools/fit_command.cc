@@ -299,10 +299,7 @@ int RunFitCommand(const FitCommandOptions& options) {
     }
     std::printf("time: load %.3f s, total %.3f s\n", load_s, Seconds(t_total));
     return 0;
-  } catch (const io::InputError& e) {
-    std::cerr << "fitcal: " << e.what() << "\n";
-    return 1;
-  } catch (const std::exception& e) {
+  } catch (const std::exception& e) {  // io::InputError too: what() is its file:line message
     std::cerr << "fitcal: " << e.what() << "\n";
     return 1;
   }
