@@ -19,22 +19,42 @@ namespace {
 
 const char* kColumnNames[3] = {"w_a", "w_b", "w_c"};
 
+// sum_i ssr(i) over n runs: each run's term computed in parallel, the sum taken in run order (the
+// same bits on any number of threads).
+template <typename Fn>
+double SumOverRuns(std::size_t n, int num_threads, Fn&& ssr) {
+  std::vector<double> per_run(n, 0.0);
+  ParallelFor(n, num_threads, [&](std::size_t i) { per_run[i] = ssr(i); });
+  double sum = 0.0;
+  for (double v : per_run) sum += v;
+  return sum;
+}
+
 // Final-pose SSR of the runs replayed with the inverse kinematic matrix m_inv (the fit's
 // objective times 2 when m_inv is Eq. 6 at some parameters).
 double SumOfSquares(const Eigen::Matrix3d& m_inv, const std::vector<AlignedRun>& runs,
                     const ResidualWeights& weights, int num_threads) {
-  std::vector<double> per_run(runs.size(), 0.0);
-  ParallelFor(runs.size(), num_threads, [&](std::size_t i) {
+  return SumOverRuns(runs.size(), num_threads, [&](std::size_t i) {
     const AlignedRun& run = runs[i];
     double r[3];
     Omni3FinalPoseResidual(run, weights)
         .ResidualOfFinalPose(
             omni3::ReplayWithMatrix(m_inv, run.samples.data(), run.samples.size(), run.start), r);
-    per_run[i] = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+    return r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
   });
-  double sum = 0.0;
-  for (double v : per_run) sum += v;
-  return sum;
+}
+
+// Segment SSR (segment_residual.h) of `runs` replayed with m_inv.
+double SegmentSumOfSquares(const Eigen::Matrix3d& m_inv, const std::vector<SegmentedRun>& runs,
+                           const ResidualWeights& weights, int num_threads) {
+  return SumOverRuns(runs.size(), num_threads, [&](std::size_t i) {
+    const Omni3SegmentResidual residual(runs[i], weights);
+    std::vector<double> r(static_cast<std::size_t>(residual.NumResiduals()));
+    residual.ResidualsWithMatrix(m_inv, r.data());
+    double ssr = 0.0;
+    for (double v : r) ssr += v * v;
+    return ssr;
+  });
 }
 
 // The signed permutation A with (mapped rates) = A (recorded rates). Replaying mapped samples
@@ -194,21 +214,6 @@ WheelOrderReport Decide(const MappingScorer& scorer, const WheelOrderOptions& op
     report.message = msg.str();
   }
   return report;
-}
-
-// Segment SSR (segment_residual.h) of `runs` replayed with m_inv.
-double SegmentSumOfSquares(const Eigen::Matrix3d& m_inv, const std::vector<SegmentedRun>& runs,
-                           const ResidualWeights& weights, int num_threads) {
-  std::vector<double> per_run(runs.size(), 0.0);
-  ParallelFor(runs.size(), num_threads, [&](std::size_t i) {
-    const Omni3SegmentResidual residual(runs[i], weights);
-    std::vector<double> r(static_cast<std::size_t>(residual.NumResiduals()));
-    residual.ResidualsWithMatrix(m_inv, r.data());
-    for (double v : r) per_run[i] += v * v;
-  });
-  double sum = 0.0;
-  for (double v : per_run) sum += v;
-  return sum;
 }
 
 }  // namespace
