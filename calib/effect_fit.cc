@@ -56,7 +56,7 @@ void TrackPoseErrors(const TrackRun& run, const T* p, const std::vector<ActiveEf
                      const std::vector<int>& indices, T* err) {
   const AlignedRun& a = run.aligned;
   const T tau = effects::TotalLatency(active);
-  const Pose2d start_pose = TrackStartPose(a, run.track, ScalarPart(tau));
+  const Pose2d start_pose = TrackStartPose(a, run.contexts, run.track, ScalarPart(tau));
   const Pose2<T> start{T(start_pose.x), T(start_pose.y), T(start_pose.theta)};
   std::size_t next = 0;
   const std::size_t n = indices.size();
@@ -151,15 +151,14 @@ std::vector<EffectId> IdsOf(const EffectModel& model) {
 
 }  // namespace
 
-Pose2d TrackStartPose(const AlignedRun& run, const GroundTruthTrack& track, double latency_s) {
+Pose2d TrackStartPose(const AlignedRun& run, const std::vector<effects::SampleContext>& contexts,
+                      const GroundTruthTrack& track, double latency_s) {
   // Encoder time (from the window start) at which the robot starts moving.
-  double rest_until_s = 0.0;
-  for (const WheelSample& s : run.samples) {
-    bool moving = false;
-    for (double w : s.rate_rad_s) moving = moving || std::abs(w) > effects::kMovingRateRadS;
-    if (moving) break;
-    rest_until_s += s.dt_s;
-  }
+  const auto first_moving = std::find_if(contexts.begin(), contexts.end(),
+                                         [](const effects::SampleContext& c) { return c.moving; });
+  const double rest_until_s = first_moving != contexts.end() ? first_moving->t_s
+                              : contexts.empty()             ? 0.0
+                                                 : contexts.back().t_s + contexts.back().dt_s;
   const auto first = std::lower_bound(track.t_s.begin(), track.t_s.end(), run.t_start_s);
   if (rest_until_s > 0.0 && first != track.t_s.end() &&
       *first - run.t_start_s - latency_s <= rest_until_s) {

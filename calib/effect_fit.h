@@ -40,8 +40,10 @@ struct TrackRun {
 // latency it shows a time just before the window, when a run that starts at rest was at rest
 // too), else the ground truth interpolated at t_start + latency. Interpolating whenever the
 // latency is not zero would blend the rest pose with a moving one when the robot starts within
-// one ground-truth period: a start error that repeats in every repetition.
-Pose2d TrackStartPose(const AlignedRun& run, const GroundTruthTrack& track, double latency_s);
+// one ground-truth period: a start error that repeats in every repetition. `contexts` are the
+// run's (effects::MakeSampleContexts); their `moving` flags say where the rest ends.
+Pose2d TrackStartPose(const AlignedRun& run, const std::vector<effects::SampleContext>& contexts,
+                      const GroundTruthTrack& track, double latency_s);
 
 struct TrackOptions {
   // Checkpoints keep this far from the window's ends so a latency within the effect's bounds

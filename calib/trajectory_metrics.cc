@@ -51,10 +51,11 @@ TrajectoryErrors EvaluateTrajectory(const AlignedRun& run, const GroundTruthTrac
     std::vector<effects::ActiveEffect<double>> active;
     for (const effects::EffectValue& e : effects) active.push_back({e.id, e.value.data()});
     latency_s = effects::TotalLatency(active);
-    poses[0] = TrackStartPose(run, track, latency_s);
+    const std::vector<effects::SampleContext> contexts = effects::MakeSampleContexts(run.samples);
+    poses[0] = TrackStartPose(run, contexts, track, latency_s);
     final_ground_truth = InterpolateGroundTruth(track, run.t_final_s + latency_s);
     final_pose = effects::ReplayWithEffects(
-        p.data(), active, run.samples, effects::MakeSampleContexts(run.samples), poses[0],
+        p.data(), active, run.samples, contexts, poses[0],
         [&poses](std::size_t k, const Pose2d&, const Pose2d& after) { poses[k + 1] = after; });
   }
 
