@@ -138,38 +138,31 @@ ResidualAnalysis AnalyzeResiduals(const Omni3ParameterArray& p, const EffectMode
   // How the components move with each fitted parameter (forward differences, the checkpoint
   // times held): the lack of fit is what no change of the fitted parameters can remove.
   std::vector<std::vector<Lof>> lof_jacobian;  // [parameter][run]
-  {
-    const int num_effect_parameters = [&] {
-      int k = 0;
-      for (const auto& e : model) k += effects::Info(e.id).num_parameters;
-      return k;
-    }();
-    for (int k = 0; k < omni3::kNumParameters + num_effect_parameters; ++k) {
-      Omni3ParameterArray p_k = p;
+  // One column: the components' change per unit of the parameter that p_k / model_k moved by h.
+  const auto add_column = [&](const Omni3ParameterArray& p_k, const EffectModel& model_k,
+                              double h) {
+    std::vector<Lof> column(n);
+    ParallelFor(n, num_threads, [&](std::size_t i) {
+      const TrackErrors moved = ComputeTrackErrors(p_k, model_k, runs[i], true);
+      const Lof x = LofComponents(moved, checkpoint_times[i], runs[i].aligned.start.theta);
+      for (int c = 0; c < kLofComponents; ++c) column[i][c] = (x[c] - lof[i][c]) / h;
+    });
+    lof_jacobian.push_back(std::move(column));
+  };
+  for (int k = 0; k < omni3::kNumParameters; ++k) {
+    Omni3ParameterArray p_k = p;
+    const double h = 1e-6 * std::max(std::abs(p[k]), 1e-3);
+    p_k[k] += h;
+    add_column(p_k, model, h);
+  }
+  for (std::size_t e = 0; e < model.size(); ++e) {
+    const effects::EffectInfo& info = effects::Info(model[e].id);
+    for (int j = 0; j < info.num_parameters; ++j) {
       EffectModel model_k = model;
-      double h = 0.0;
-      if (k < omni3::kNumParameters) {
-        h = 1e-6 * std::max(std::abs(p[k]), 1e-3);
-        p_k[k] += h;
-      } else {
-        int j = k - omni3::kNumParameters;
-        for (auto& e : model_k) {
-          const effects::EffectInfo& info = effects::Info(e.id);
-          if (j < info.num_parameters) {
-            h = 1e-4 * std::max({std::abs(e.value[j]), std::abs(info.typical[j]), 1e-9});
-            e.value[j] += h;
-            break;
-          }
-          j -= info.num_parameters;
-        }
-      }
-      std::vector<Lof> column(n);
-      ParallelFor(n, num_threads, [&](std::size_t i) {
-        const TrackErrors moved = ComputeTrackErrors(p_k, model_k, runs[i], true);
-        const Lof x = LofComponents(moved, checkpoint_times[i], runs[i].aligned.start.theta);
-        for (int c = 0; c < kLofComponents; ++c) column[i][c] = (x[c] - lof[i][c]) / h;
-      });
-      lof_jacobian.push_back(std::move(column));
+      const double h =
+          1e-4 * std::max({std::abs(model[e].value[j]), std::abs(info.typical[j]), 1e-9});
+      model_k[e].value[j] += h;
+      add_column(p, model_k, h);
     }
   }
 
