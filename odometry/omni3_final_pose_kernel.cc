@@ -54,15 +54,16 @@ inline void CosSinSeries(double d, double* c, double* s) {
   *s = d * ss;
 }
 
-// sum_j cos(delta_j) u_j and sum_j sin(delta_j) u_j over one block, with series of kTerms terms.
-template <int kTerms>
-inline void SeriesSums(const double* delta, const double* u0, const double* u1, const double* u2,
-                       std::size_t len, double* sums) {
+// sum_j cos(delta_j) u_j and sum_j sin(delta_j) u_j over one block, with cos_sin(d, &c, &s)
+// giving cos and sin of d.
+template <typename CosSin>
+inline void CosSinSums(const double* delta, const double* u0, const double* u1, const double* u2,
+                       std::size_t len, CosSin cos_sin, double* sums) {
   double a0 = 0.0, a1 = 0.0, a2 = 0.0, b0 = 0.0, b1 = 0.0, b2 = 0.0;
 #pragma omp simd reduction(+ : a0, a1, a2, b0, b1, b2)
   for (std::size_t j = 0; j < len; ++j) {
     double c, s;
-    CosSinSeries<kTerms>(delta[j], &c, &s);
+    cos_sin(delta[j], &c, &s);
     a0 += c * u0[j];
     a1 += c * u1[j];
     a2 += c * u2[j];
@@ -71,6 +72,14 @@ inline void SeriesSums(const double* delta, const double* u0, const double* u1, 
     b2 += s * u2[j];
   }
   sums[0] = a0, sums[1] = a1, sums[2] = a2, sums[3] = b0, sums[4] = b1, sums[5] = b2;
+}
+
+template <int kTerms>
+inline void SeriesSums(const double* delta, const double* u0, const double* u1, const double* u2,
+                       std::size_t len, double* sums) {
+  CosSinSums(
+      delta, u0, u1, u2, len, [](double d, double* c, double* s) { CosSinSeries<kTerms>(d, c, s); },
+      sums);
 }
 
 FITCAL_VECTOR_CLONES
@@ -91,12 +100,13 @@ void BlockSums(const double* m3, const double* d0, const double* d1, const doubl
   } else if (max_abs < kLongMaxDelta) {
     SeriesSums<10>(delta, u0, u1, u2, len, sums);  // degree 18/19
   } else {
-    std::fill(sums, sums + 6, 0.0);
-    for (std::size_t j = 0; j < len; ++j) {
-      const double c = std::cos(delta[j]), s = std::sin(delta[j]);
-      sums[0] += c * u0[j], sums[1] += c * u1[j], sums[2] += c * u2[j];
-      sums[3] += s * u0[j], sums[4] += s * u1[j], sums[5] += s * u2[j];
-    }
+    CosSinSums(
+        delta, u0, u1, u2, len,
+        [](double d, double* c, double* s) {
+          *c = std::cos(d);
+          *s = std::sin(d);
+        },
+        sums);
   }
 }
 
