@@ -6,9 +6,8 @@
 namespace fitcal {
 
 namespace {
-bool IsRest(const WheelSample& s) {
-  return s.rate_rad_s[0] == 0.0 && s.rate_rad_s[1] == 0.0 && s.rate_rad_s[2] == 0.0;
-}
+// `w`: a sample's three wheel rates.
+bool IsRest(const double* w) { return w[0] == 0.0 && w[1] == 0.0 && w[2] == 0.0; }
 }  // namespace
 
 AlignedRun AlignRun(const RunLog& run) {
@@ -35,16 +34,16 @@ AlignedRun AlignRun(const RunLog& run) {
     const double begin = std::max(t[k], out.t_start_s);
     const double end = std::min(t[k + 1], out.t_final_s);
     if (end <= begin) continue;
-    WheelSample sample = run.encoders.samples[k];
-    sample.dt_s = end - begin;
+    const ConstSampleView sample = run.encoders.samples[k];
+    const double dt = end - begin;
     // Consecutive intervals with all wheels at rest move nothing under any model: one interval
     // of their summed length keeps the time line and saves the replay the work (robots log
     // long rests before and after each run).
-    if (IsRest(sample) && !out.samples.empty() && IsRest(out.samples.back())) {
-      out.samples.back().dt_s += sample.dt_s;
+    if (IsRest(sample.value) && !out.samples.empty() && IsRest(out.samples.back().value)) {
+      out.samples.back().dt_s += dt;
       continue;
     }
-    out.samples.push_back(sample);
+    out.samples.push_back(dt, sample.value);
   }
   return out;
 }

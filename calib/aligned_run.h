@@ -24,7 +24,7 @@ struct AlignedRun {
   double t_final_s = 0.0;
   Pose2d start;               // world_T_robot at t_start
   Pose2d final_ground_truth;  // world_T_robot at t_final, from the ground truth
-  WheelSamples samples;       // clipped to the window
+  EncoderSamples samples{3};  // clipped to the window
 };
 
 // Throws std::invalid_argument if the two clocks share no time.

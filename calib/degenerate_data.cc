@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <map>
 #include <sstream>
 
@@ -10,11 +9,8 @@ namespace fitcal {
 
 namespace {
 
-// Two runs are copies when their samples are bitwise equal.
-bool SameSamples(const WheelSamples& a, const WheelSamples& b) {
-  return a.size() == b.size() &&
-         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(WheelSample)) == 0);
-}
+// Two runs are copies when their samples are equal.
+bool SameSamples(const EncoderSamples& a, const EncoderSamples& b) { return a == b; }
 
 double Median(std::vector<double> v) {
   const std::size_t mid = v.size() / 2;
@@ -44,7 +40,7 @@ std::vector<std::string> FindDegenerateData(const std::vector<AlignedRun>& runs,
   for (int i = 0; i < omni3::kNumWheels; ++i) {
     bool turns = false;
     for (const AlignedRun& run : runs) {
-      for (const WheelSample& s : run.samples) turns = turns || s.rate_rad_s[i] != 0.0;
+      for (const auto& s : run.samples) turns = turns || s.value[i] != 0.0;
     }
     if (!turns && !runs.empty()) {
       problems.push_back("wheel " + robot.wheel_names[i] +

@@ -198,9 +198,9 @@ AlignedRun CandidateRun(const CandidateMotion& motion, const Omni3ParameterArray
                             Eigen::Vector3d(motion.vx_m_s, motion.vy_m_s, motion.omega_rad_s);
   const int n = std::max(1, static_cast<int>(std::ceil(motion.duration_s / period_s)));
   run.samples.resize(static_cast<std::size_t>(n));
-  for (WheelSample& s : run.samples) {
+  for (auto&& s : run.samples) {
     s.dt_s = motion.duration_s / n;
-    for (int i = 0; i < 3; ++i) s.rate_rad_s[i] = w[i];
+    for (int i = 0; i < 3; ++i) s.value[i] = w[i];
   }
   run.t_final_s = motion.duration_s;
   return run;

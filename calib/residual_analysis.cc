@@ -49,8 +49,8 @@ RunFeatures Features(const Omni3ParameterArray& p, const TrackRun& run) {
   bool any = false;
   for (std::size_t k = 0; k < run.aligned.samples.size(); ++k) {
     if (!run.contexts[k].moving) continue;
-    const WheelSample& s = run.aligned.samples[k];
-    const Eigen::Vector3d w(s.rate_rad_s[0], s.rate_rad_s[1], s.rate_rad_s[2]);
+    const auto s = run.aligned.samples[k];
+    const Eigen::Vector3d w(s.value[0], s.value[1], s.value[2]);
     sum += s.dt_s * (m_inv * w);
     time += s.dt_s;
     if (!any) f.motion_begin_s = run.contexts[k].t_s;
@@ -304,7 +304,7 @@ ResidualAnalysis AnalyzeResiduals(const Omni3ParameterArray& p, const EffectMode
       for (int w = 0; w < 3; ++w) {
         if (std::abs(c.accel_rad_s2[w]) > std::abs(accel)) {
           accel = c.accel_rad_s2[w];
-          dir = run.aligned.samples[k].rate_rad_s[w];
+          dir = run.aligned.samples[k].value[w];
         }
       }
       const char* phase = !c.moving ? "rest"

@@ -124,8 +124,8 @@ ClockMap EstimateClockMap(const AlignedRun& run, const GroundTruthTrack& ground_
   const std::size_t n = run.samples.size();
   std::vector<double> speed(n), omega(n);
   for (std::size_t k = 0; k < n; ++k) {
-    const Eigen::Vector3d w(run.samples[k].rate_rad_s[0], run.samples[k].rate_rad_s[1],
-                            run.samples[k].rate_rad_s[2]);
+    const Eigen::Vector3d w(run.samples[k].value[0], run.samples[k].value[1],
+                            run.samples[k].value[2]);
     const Eigen::Vector3d v = m_inv * w;
     speed[k] = std::hypot(v[0], v[1]);
     omega[k] = v[2];

@@ -77,7 +77,7 @@ class Omni3SegmentResidual {
     std::size_t done = 0;
     for (std::size_t m = 0; m < marks_.size(); ++m) {
       if (marks_[m] > done) {
-        pose = omni3::ReplayWithMatrix(m_inv, run.samples.data() + done, marks_[m] - done, pose);
+        pose = omni3::ReplayWithMatrix(m_inv, run.samples, done, marks_[m] - done, pose);
         done = marks_[m];
       }
       at_mark[m] = pose;

@@ -45,7 +45,7 @@ TrajectoryErrors EvaluateTrajectory(const AlignedRun& run, const GroundTruthTrac
   if (effects.empty()) {
     poses[0] = run.start;
     final_pose = omni3::ReplayWithMatrix(
-        omni3::InverseKinematicMatrix(p.data()), run.samples.data(), n, run.start,
+        omni3::InverseKinematicMatrix(p.data()), run.samples, 0, n, run.start,
         [&poses](std::size_t k, const Pose2d& pose) { poses[k + 1] = pose; });
   } else {
     std::vector<effects::ActiveEffect<double>> active;

@@ -39,7 +39,7 @@ double SumOfSquares(const Eigen::Matrix3d& m_inv, const std::vector<AlignedRun>&
     double r[3];
     Omni3FinalPoseResidual(run, weights)
         .ResidualOfFinalPose(
-            omni3::ReplayWithMatrix(m_inv, run.samples.data(), run.samples.size(), run.start), r);
+            omni3::ReplayWithMatrix(m_inv, run.samples, 0, run.samples.size(), run.start), r);
     return r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
   });
 }
@@ -107,9 +107,9 @@ std::vector<AlignedRun> ApplyWheelMapping(const std::vector<AlignedRun>& runs,
                                           const WheelMapping& mapping) {
   std::vector<AlignedRun> out = runs;
   for (AlignedRun& run : out) {
-    for (WheelSample& s : run.samples) {
-      const double w[3] = {s.rate_rad_s[0], s.rate_rad_s[1], s.rate_rad_s[2]};
-      for (int i = 0; i < 3; ++i) s.rate_rad_s[i] = mapping.sign[i] * w[mapping.column[i]];
+    for (auto&& s : run.samples) {
+      const double w[3] = {s.value[0], s.value[1], s.value[2]};
+      for (int i = 0; i < 3; ++i) s.value[i] = mapping.sign[i] * w[mapping.column[i]];
     }
   }
   return out;
@@ -299,7 +299,7 @@ RateUnitsReport CheckRateUnits(const std::vector<RunLog>& runs, const Omni3Robot
   for (const RunLog& log : runs) {
     const AlignedRun run = AlignRun(log);
     Pose2d previous = run.start;
-    omni3::ReplayWithMatrix(omni3::InverseKinematicMatrix(p.data()), run.samples.data(),
+    omni3::ReplayWithMatrix(omni3::InverseKinematicMatrix(p.data()), run.samples, 0,
                             run.samples.size(), run.start, [&](std::size_t, const Pose2d& pose) {
                               odo_length += std::hypot(pose.x - previous.x, pose.y - previous.y) +
                                             mean_distance_m * std::abs(pose.theta - previous.theta);

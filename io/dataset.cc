@@ -169,7 +169,7 @@ std::string EncoderCsv(const EncoderLog& log) {
   out.reserve(log.t_s.size() * 40);
   char line[160];
   for (std::size_t k = 0; k < log.t_s.size(); ++k) {
-    const double* w = k == 0 ? nullptr : log.samples[k - 1].rate_rad_s;
+    const double* w = k == 0 ? nullptr : log.samples[k - 1].value;
     const int n = w == nullptr ? std::snprintf(line, sizeof line, "%.6f,0,0,0\n", log.t_s[k])
                                : std::snprintf(line, sizeof line, "%.6f,%.9g,%.9g,%.9g\n",
                                                log.t_s[k], w[0], w[1], w[2]);

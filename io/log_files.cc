@@ -145,7 +145,7 @@ EncoderLog ReadEncoderCsv(const std::string& path, const std::optional<EncoderTi
   double previous_count[3] = {0.0, 0.0, 0.0};
   EncoderLog log;
   // Reserve exactly once (one row per line; memchr-speed count) so that a large log holds 40
-  // bytes per sample (t + WheelSample) and is never copied while growing.
+  // bytes per sample (t + a 32-byte sample row) and is never copied while growing.
   const std::size_t rows = CountLines(text);
   log.t_s.reserve(rows);
   log.samples.reserve(rows);
@@ -155,17 +155,17 @@ EncoderLog ReadEncoderCsv(const std::string& path, const std::optional<EncoderTi
     ParseRow(line, ',', 4, path, lines.line_number(), row);
     if (!log.t_s.empty()) {
       CheckIncreasing(log.t_s.back(), row[0], path, lines.line_number());
-      WheelSample sample;
-      sample.dt_s = row[0] - log.t_s.back();
+      const double dt = row[0] - log.t_s.back();
+      double values[3];
       for (int i = 0; i < 3; ++i) {
         if (!in_ticks) {
-          sample.rate_rad_s[i] = row[1 + i];
+          values[i] = row[1 + i];
         } else {
           const double dticks = cumulative ? row[1 + i] - previous_count[i] : row[1 + i];
-          sample.rate_rad_s[i] = rad_per_tick * dticks / sample.dt_s;
+          values[i] = rad_per_tick * dticks / dt;
         }
       }
-      log.samples.push_back(sample);
+      log.samples.push_back(dt, values);
     }
     for (int i = 0; i < 3; ++i) previous_count[i] = row[1 + i];
     log.t_s.push_back(row[0]);

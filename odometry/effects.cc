@@ -157,7 +157,7 @@ EffectId EffectIdFromName(const std::string& name) {
   throw std::invalid_argument("unknown effect '" + name + "' (known: " + known + ")");
 }
 
-std::vector<SampleContext> MakeSampleContexts(const WheelSamples& samples) {
+std::vector<SampleContext> MakeSampleContexts(const EncoderSamples& samples) {
   const std::size_t n = samples.size();
   std::vector<SampleContext> out(n);
   // Sample boundary times and cumulative encoder angles.
@@ -166,7 +166,7 @@ std::vector<SampleContext> MakeSampleContexts(const WheelSamples& samples) {
   for (std::size_t k = 0; k < n; ++k) {
     t[k + 1] = t[k] + samples[k].dt_s;
     for (int i = 0; i < 3; ++i)
-      angle[k + 1][i] = angle[k][i] + samples[k].rate_rad_s[i] * samples[k].dt_s;
+      angle[k + 1][i] = angle[k][i] + samples[k].value[i] * samples[k].dt_s;
   }
   // Angle at an arbitrary time by linear interpolation (clamped to the run).
   const auto angle_at = [&](double time, int wheel) {
@@ -189,7 +189,7 @@ std::vector<SampleContext> MakeSampleContexts(const WheelSamples& samples) {
       const double ahead = (angle_at(mid + h, i) - angle_at(mid, i)) / h;
       const double behind = (angle_at(mid, i) - angle_at(mid - h, i)) / h;
       c.accel_rad_s2[i] = (ahead - behind) / h;
-      c.moving = c.moving || std::abs(samples[k].rate_rad_s[i]) > kMovingRateRadS;
+      c.moving = c.moving || std::abs(samples[k].value[i]) > kMovingRateRadS;
     }
   }
   return out;

@@ -24,9 +24,9 @@
 #include <type_traits>
 #include <vector>
 
+#include "odometry/encoder_samples.h"
 #include "odometry/omni3_model.h"
 #include "odometry/pose2.h"
-#include "odometry/wheel_samples.h"
 
 namespace fitcal::effects {
 
@@ -64,7 +64,7 @@ inline constexpr double kMovingRateRadS = 0.05;
 inline constexpr double kAccelerationWindowS = 0.05;
 
 // Precomputes the contexts of a run's samples.
-std::vector<SampleContext> MakeSampleContexts(const WheelSamples& samples);
+std::vector<SampleContext> MakeSampleContexts(const EncoderSamples& samples);
 
 struct EffectInfo {
   EffectId id;
@@ -314,8 +314,9 @@ T TotalLatency(const std::vector<ActiveEffect<T>>& active) {
 // visit(k, pose before sample k, pose after it). Returns the final pose.
 template <typename T, typename Visitor>
 Pose2<T> ReplayWithEffects(const T* p, const std::vector<ActiveEffect<T>>& active,
-                           const WheelSamples& samples, const std::vector<SampleContext>& contexts,
-                           const Pose2<T>& start, Visitor&& visit) {
+                           const EncoderSamples& samples,
+                           const std::vector<SampleContext>& contexts, const Pose2<T>& start,
+                           Visitor&& visit) {
   using std::cos;
   using std::sin;
   const omni3::Matrix3<T> m_inv = omni3::InverseKinematicMatrix(p);
@@ -324,8 +325,7 @@ Pose2<T> ReplayWithEffects(const T* p, const std::vector<ActiveEffect<T>>& activ
   for (std::size_t k = 0; k < samples.size(); ++k) {
     const SampleContext& c = contexts[k];
     const double dt = samples[k].dt_s;
-    T w[3] = {T(samples[k].rate_rad_s[0]), T(samples[k].rate_rad_s[1]),
-              T(samples[k].rate_rad_s[2])};
+    T w[3] = {T(samples[k].value[0]), T(samples[k].value[1]), T(samples[k].value[2])};
     ApplyRateEffects(active, c, w);
     T v[3];
     for (int r = 0; r < 3; ++r) v[r] = m_inv(r, 0) * w[0] + m_inv(r, 1) * w[1] + m_inv(r, 2) * w[2];

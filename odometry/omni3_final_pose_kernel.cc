@@ -1,6 +1,7 @@
 #include "odometry/omni3_final_pose_kernel.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 
 namespace fitcal::omni3 {
@@ -112,7 +113,13 @@ void BlockSums(const double* m3, const double* d0, const double* d1, const doubl
 
 }  // namespace
 
-FinalPoseKernel::FinalPoseKernel(const WheelSample* samples, std::size_t n) {
+FinalPoseKernel::FinalPoseKernel(const EncoderSamples& samples, std::size_t begin_sample,
+                                 std::size_t n) {
+  // Rows of three channels, [dt, w_0, w_1, w_2].
+  constexpr std::size_t kStride = 4;
+  assert(samples.stride() == static_cast<int>(kStride));
+  assert(begin_sample + n <= samples.size());
+  const double* rows = samples.data() + begin_sample * kStride;
   for (int i = 0; i < 3; ++i) {
     step_[i].resize(n);
     offset_[i].resize(n);
@@ -128,7 +135,7 @@ FinalPoseKernel::FinalPoseKernel(const WheelSample* samples, std::size_t n) {
     for (std::size_t k = begin; k < begin + len; ++k) {
       if (k == mid) local_at_mid = local;
       for (int i = 0; i < 3; ++i) {
-        step_[i][k] = samples[k].rate_rad_s[i] * samples[k].dt_s;
+        step_[i][k] = rows[k * kStride + 1 + i] * rows[k * kStride];
         offset_[i][k] = local[i];
         local[i] += step_[i][k];
       }

@@ -19,9 +19,9 @@
 #include <cstddef>
 #include <vector>
 
+#include "odometry/encoder_samples.h"
 #include "odometry/omni3_model.h"
 #include "odometry/pose2.h"
-#include "odometry/wheel_samples.h"
 
 namespace fitcal::omni3 {
 
@@ -31,9 +31,10 @@ class FinalPoseKernel {
  public:
   static constexpr std::size_t kBlock = 64;
 
-  FinalPoseKernel(const WheelSample* samples, std::size_t n);
-  explicit FinalPoseKernel(const WheelSamples& samples)
-      : FinalPoseKernel(samples.data(), samples.size()) {}
+  // From samples[begin..begin+n) (three channels: the wheel rates).
+  FinalPoseKernel(const EncoderSamples& samples, std::size_t begin, std::size_t n);
+  explicit FinalPoseKernel(const EncoderSamples& samples)
+      : FinalPoseKernel(samples, 0, samples.size()) {}
 
   // The final pose of Eq. 4 from `start` with the inverse kinematic matrix m_inv (Eq. 6).
   Pose2d FinalPose(const Matrix3<double>& m_inv, const Pose2d& start) const;

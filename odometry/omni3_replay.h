@@ -13,13 +13,14 @@
 // theta every kReanchorInterval samples so rounding cannot accumulate. The result equals a literal
 // Eq. 4 to rounding (tests/omni3_replay_test.cc).
 
+#include <cassert>
 #include <cmath>
 #include <cstddef>
 #include <type_traits>
 
+#include "odometry/encoder_samples.h"
 #include "odometry/omni3_model.h"
 #include "odometry/pose2.h"
-#include "odometry/wheel_samples.h"
 
 namespace fitcal::omni3 {
 
@@ -91,15 +92,22 @@ struct NoVisit {
 
 }  // namespace internal
 
-// Replays samples[0..n) from `start` with the inverse kinematic matrix m_inv (Eq. 6), calling
-// visit(k, pose(k+1)) after every sample. Returns the final pose.
+// Replays samples[begin..begin+n) (three channels: the wheel rates) from `start` with the
+// inverse kinematic matrix m_inv (Eq. 6), calling visit(k, pose after samples[k]) after every
+// sample. Returns the final pose.
 template <typename T, typename Visitor = internal::NoVisit>
-Pose2<T> ReplayWithMatrix(const Matrix3<T>& m_inv, const WheelSample* samples, std::size_t n,
-                          const Pose2<T>& start, Visitor&& visit = Visitor()) {
+Pose2<T> ReplayWithMatrix(const Matrix3<T>& m_inv, const EncoderSamples& samples, std::size_t begin,
+                          std::size_t n, const Pose2<T>& start, Visitor&& visit = Visitor()) {
   using internal::kChunk;
   using std::abs;
   using std::cos;
   using std::sin;
+  // Rows of three channels, [dt, w_0, w_1, w_2]: a compile-time stride keeps the loads as the
+  // compiler vectorises them.
+  constexpr std::size_t kStride = 4;
+  assert(samples.stride() == static_cast<int>(kStride));
+  assert(begin + n <= samples.size());
+  const double* rows = samples.data() + begin * kStride;
   // Locals, so the compiler knows the matrix does not alias the buffers.
   const T m00 = m_inv(0, 0), m01 = m_inv(0, 1), m02 = m_inv(0, 2);
   const T m10 = m_inv(1, 0), m11 = m_inv(1, 1), m12 = m_inv(1, 2);
@@ -113,12 +121,12 @@ Pose2<T> ReplayWithMatrix(const Matrix3<T>& m_inv, const WheelSample* samples, s
   T s = sin(theta);
   for (std::size_t k0 = 0; k0 < n; k0 += kChunk) {
     const std::size_t m = n - k0 < kChunk ? n - k0 : kChunk;
-    const WheelSample* chunk = samples + k0;
+    const double* chunk = rows + k0 * kStride;
     // Pass 1: robot-frame step M^-1 w dt of every sample (Eq. 4) and its rotation.
     double max_angle = 0.0;
     for (std::size_t j = 0; j < m; ++j) {
-      const double* w = chunk[j].rate_rad_s;
-      const double dt = chunk[j].dt_s;
+      const double* w = chunk + j * kStride + 1;
+      const double dt = chunk[j * kStride];
       step_x[j] = (m00 * w[0] + m01 * w[1] + m02 * w[2]) * dt;
       step_y[j] = (m10 * w[0] + m11 * w[1] + m12 * w[2]) * dt;
       step_theta[j] = (m20 * w[0] + m21 * w[1] + m22 * w[2]) * dt;
@@ -154,13 +162,13 @@ Pose2<T> ReplayWithMatrix(const Matrix3<T>& m_inv, const WheelSample* samples, s
       x += c * step_x[j] - s * step_y[j];
       y += s * step_x[j] + c * step_y[j];
       theta += step_theta[j];
-      visit(k0 + j, Pose2<T>{x, y, theta});
+      visit(begin + k0 + j, Pose2<T>{x, y, theta});
       const T c1 = c * rot_c[j] - s * rot_s[j];
       const T s1 = s * rot_c[j] + c * rot_s[j];
       x += c1 * step_x[j + 1] - s1 * step_y[j + 1];
       y += s1 * step_x[j + 1] + c1 * step_y[j + 1];
       theta += step_theta[j + 1];
-      visit(k0 + j + 1, Pose2<T>{x, y, theta});
+      visit(begin + k0 + j + 1, Pose2<T>{x, y, theta});
       const T rc2 = rot_c[j] * rot_c[j + 1] - rot_s[j] * rot_s[j + 1];
       const T rs2 = rot_s[j] * rot_c[j + 1] + rot_c[j] * rot_s[j + 1];
       const T c2 = c * rc2 - s * rs2;
@@ -171,7 +179,7 @@ Pose2<T> ReplayWithMatrix(const Matrix3<T>& m_inv, const WheelSample* samples, s
       x += c * step_x[j] - s * step_y[j];
       y += s * step_x[j] + c * step_y[j];
       theta += step_theta[j];
-      visit(k0 + j, Pose2<T>{x, y, theta});
+      visit(begin + k0 + j, Pose2<T>{x, y, theta});
       const T c_next = c * rot_c[j] - s * rot_s[j];
       s = s * rot_c[j] + c * rot_s[j];
       c = c_next;
@@ -186,8 +194,8 @@ Pose2<T> ReplayWithMatrix(const Matrix3<T>& m_inv, const WheelSample* samples, s
 
 // The final pose of a run replayed with the nine parameters p (Eq. 15 order).
 template <typename T>
-Pose2<T> ReplayFinalPose(const T* p, const WheelSamples& samples, const Pose2<T>& start) {
-  return ReplayWithMatrix(InverseKinematicMatrix(p), samples.data(), samples.size(), start);
+Pose2<T> ReplayFinalPose(const T* p, const EncoderSamples& samples, const Pose2<T>& start) {
+  return ReplayWithMatrix(InverseKinematicMatrix(p), samples, 0, samples.size(), start);
 }
 
 }  // namespace fitcal::omni3

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "odometry/encoder_samples.h"
 #include "odometry/pose2.h"
-#include "odometry/wheel_samples.h"
 
 namespace fitcal {
 
@@ -15,7 +15,7 @@ namespace fitcal {
 // dt_s = t_s[k+1] - t_s[k] and the mean wheel rates over that interval.
 struct EncoderLog {
   std::vector<double> t_s;
-  WheelSamples samples;
+  EncoderSamples samples{3};
 };
 
 // Ground truth (SLAM, motion capture): poses in the world frame at strictly increasing times.

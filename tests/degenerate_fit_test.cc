@@ -40,7 +40,7 @@ TEST(DegenerateFit, CleanDataRaiseNoProblem) {
 TEST(DegenerateFit, WheelThatNeverTurnsIsNamedAndTheFitFinishes) {
   std::vector<AlignedRun> runs = Simulate(1, 1);
   for (AlignedRun& run : runs) {
-    for (WheelSample& s : run.samples) s.rate_rad_s[2] = 0.0;  // encoder c disconnected
+    for (auto&& s : run.samples) s.value[2] = 0.0;  // encoder c disconnected
   }
   const std::vector<std::string> problems = FindDegenerateData(runs, sim::PalacinApr02Robot());
   ASSERT_EQ(problems.size(), 1u);
@@ -107,13 +107,13 @@ TEST(DegenerateFit, GrossSlipIsFlaggedAndTheRobustLossKeepsTheParameters) {
   const std::size_t victim = 0;
   auto shift_for = [&](double factor) {
     AlignedRun run = all[victim];
-    for (WheelSample& s : run.samples) s.rate_rad_s[0] *= factor;
+    for (auto&& s : run.samples) s.value[0] *= factor;
     const Pose2d a = omni3::ReplayFinalPose(truth.data(), all[victim].samples, all[victim].start);
     const Pose2d b = omni3::ReplayFinalPose(truth.data(), run.samples, run.start);
     return std::hypot(std::hypot(b.x - a.x, b.y - a.y), WrapAngle(b.theta - a.theta));
   };
   const double slip = 0.01 * 10.0 * typical / shift_for(1.01);
-  for (WheelSample& s : slipped[victim].samples) s.rate_rad_s[0] *= 1.0 + slip;
+  for (auto&& s : slipped[victim].samples) s.value[0] *= 1.0 + slip;
   ASSERT_NEAR(shift_for(1.0 + slip) / typical, 10.0, 1.0);
 
   const Omni3FitResult least_squares = FitOmni3Ceres(slipped, sim::PalacinApr02Robot());

@@ -21,21 +21,22 @@ namespace {
 using effects::EffectId;
 
 // A curved run with start/stop transients and both wheel directions: 4 s at 100 Hz.
-WheelSamples TestSamples() {
-  WheelSamples s(400);
+EncoderSamples TestSamples() {
+  EncoderSamples s(3);
+  s.resize(400);
   for (std::size_t k = 0; k < s.size(); ++k) {
     const double t = 0.01 * static_cast<double>(k);
     const double ramp = std::min(1.0, t / 0.3) * std::min(1.0, (4.0 - t) / 0.3);
     s[k].dt_s = 0.01;
-    s[k].rate_rad_s[0] = 2.0 * ramp;
-    s[k].rate_rad_s[1] = -1.2 * ramp;
-    s[k].rate_rad_s[2] = 0.4 * ramp + 0.3 * std::sin(t);
+    s[k].value[0] = 2.0 * ramp;
+    s[k].value[1] = -1.2 * ramp;
+    s[k].value[2] = 0.4 * ramp + 0.3 * std::sin(t);
   }
   return s;
 }
 
 template <typename T>
-Pose2<T> Replay(const T* p, EffectId id, const T* q, const WheelSamples& samples,
+Pose2<T> Replay(const T* p, EffectId id, const T* q, const EncoderSamples& samples,
                 const std::vector<effects::SampleContext>& contexts) {
   std::vector<effects::ActiveEffect<T>> active = {{id, q}};
   return effects::ReplayWithEffects(p, active, samples, contexts, Pose2<T>{T(0.3), T(-0.2), T(0.5)},
@@ -58,7 +59,7 @@ TEST(EffectTable, OrderMatchesIdsAndNamesRoundTrip) {
 
 // Every effect at its neutral value (0) reproduces the plain replay (Palacin Eq. 4).
 TEST(EffectReplay, NeutralEffectsEqualPlainReplay) {
-  const WheelSamples samples = TestSamples();
+  const EncoderSamples samples = TestSamples();
   const auto contexts = effects::MakeSampleContexts(samples);
   const auto p = sim::PalacinTable5Parameters().ToArray();
   const Pose2d start{0.3, -0.2, 0.5};
@@ -75,7 +76,7 @@ TEST(EffectReplay, NeutralEffectsEqualPlainReplay) {
 // Autodiff through every effect agrees with central differences (the Ceres fit relies on it).
 TEST(EffectReplay, JetDerivativesMatchCentralDifferences) {
   using Jet = ceres::Jet<double, 2>;
-  const WheelSamples samples = TestSamples();
+  const EncoderSamples samples = TestSamples();
   const auto contexts = effects::MakeSampleContexts(samples);
   const auto p = sim::PalacinTable5Parameters().ToArray();
   std::array<Jet, 9> pj;
@@ -104,7 +105,7 @@ TEST(EffectReplay, JetDerivativesMatchCentralDifferences) {
 
 // The honest negative, exactly: an encoder clock scale s is a common radius scale (1 + s).
 TEST(EffectReplay, ClockScaleEqualsCommonRadiusScale) {
-  const WheelSamples samples = TestSamples();
+  const EncoderSamples samples = TestSamples();
   const auto contexts = effects::MakeSampleContexts(samples);
   auto p = sim::PalacinTable5Parameters().ToArray();
   const double s[1] = {0.013};
@@ -118,14 +119,14 @@ TEST(EffectReplay, ClockScaleEqualsCommonRadiusScale) {
 
 // Backlash eats exactly beta of each wheel's encoder angle when the wheel turns one way.
 TEST(EffectTransforms, BacklashLosesBetaOfEachWheel) {
-  const WheelSamples samples = TestSamples();
+  const EncoderSamples samples = TestSamples();
   const auto contexts = effects::MakeSampleContexts(samples);
   const double beta[1] = {0.07};
   double measured = 0.0, transmitted = 0.0;
   for (std::size_t k = 0; k < samples.size(); ++k) {
-    double w[3] = {samples[k].rate_rad_s[0], samples[k].rate_rad_s[1], samples[k].rate_rad_s[2]};
+    double w[3] = {samples[k].value[0], samples[k].value[1], samples[k].value[2]};
     effects::Backlash::Rates(beta, contexts[k], w);
-    measured += samples[k].rate_rad_s[0] * samples[k].dt_s;
+    measured += samples[k].value[0] * samples[k].dt_s;
     transmitted += w[0] * samples[k].dt_s;
   }
   EXPECT_NEAR(measured - transmitted, beta[0], 1e-12);
@@ -147,10 +148,11 @@ TEST(EffectTransforms, SpeedSlipAndDirectionRadiusAsDocumented) {
 
 // The smoothed acceleration of a linear ramp is its slope (away from the ends).
 TEST(SampleContexts, AccelerationOfARamp) {
-  WheelSamples s(100);
+  EncoderSamples s(3);
+  s.resize(100);
   for (std::size_t k = 0; k < s.size(); ++k) {
     s[k].dt_s = 0.01;
-    s[k].rate_rad_s[0] = 5.0 * 0.01 * (static_cast<double>(k) + 0.5);  // 5 rad/s^2
+    s[k].value[0] = 5.0 * 0.01 * (static_cast<double>(k) + 0.5);  // 5 rad/s^2
   }
   const auto c = effects::MakeSampleContexts(s);
   EXPECT_NEAR(c[50].accel_rad_s2[0], 5.0, 1e-9);

@@ -52,9 +52,9 @@ TEST(EncoderCsv, ReadsRatesAndIntervals) {
   ASSERT_EQ(log.t_s.size(), 3u);
   ASSERT_EQ(log.samples.size(), 2u);
   EXPECT_NEAR(log.samples[0].dt_s, 0.01, 1e-15);  // row 0 only sets the start time
-  EXPECT_EQ(log.samples[0].rate_rad_s[1], -2.0);
+  EXPECT_EQ(log.samples[0].value[1], -2.0);
   EXPECT_NEAR(log.samples[1].dt_s, 0.02, 1e-15);
-  EXPECT_EQ(log.samples[1].rate_rad_s[2], 6.0);
+  EXPECT_EQ(log.samples[1].value[2], 6.0);
 }
 
 TEST(EncoderCsv, BadInputs) {

@@ -69,13 +69,14 @@ namespace {
 // nine-parameter model with R_i - e_x cos(delta_i) - e_y sin(delta_i) (the replay is linear in the
 // body velocity, so the identity holds to rounding on any wheel data).
 TEST(GroundTruthOffset, EqualsShiftedDistancesExactly) {
-  WheelSamples samples(300);
+  EncoderSamples samples(3);
+  samples.resize(300);
   for (std::size_t k = 0; k < samples.size(); ++k) {
     const double t = 0.01 * static_cast<double>(k);
     samples[k].dt_s = 0.01;
-    samples[k].rate_rad_s[0] = 2.0 + std::sin(t);
-    samples[k].rate_rad_s[1] = -1.2 + 0.5 * t;
-    samples[k].rate_rad_s[2] = 0.7 - std::cos(2 * t);
+    samples[k].value[0] = 2.0 + std::sin(t);
+    samples[k].value[1] = -1.2 + 0.5 * t;
+    samples[k].value[2] = 0.7 - std::cos(2 * t);
   }
   const auto contexts = effects::MakeSampleContexts(samples);
   auto p = sim::PalacinTable5Parameters().ToArray();

@@ -223,7 +223,7 @@ TEST(MalformedInputTest, WindowsLineEndingsAndByteOrderMarkAreAccepted) {
   const DatasetDir data("ok_enc_bom_crlf.csv");
   const io::Dataset dataset = io::LoadDataset(data.dir().string());
   ASSERT_EQ(dataset.runs[0].encoders.samples.size(), 2u);
-  EXPECT_DOUBLE_EQ(dataset.runs[0].encoders.samples[1].rate_rad_s[2], 3.0);
+  EXPECT_DOUBLE_EQ(dataset.runs[0].encoders.samples[1].value[2], 3.0);
 }
 
 TEST(MalformedInputTest, OutsidePathsLoadOnlyWithTheFlag) {

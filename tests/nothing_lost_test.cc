@@ -141,7 +141,7 @@ TEST(NothingLostTest, RefusedFitLeavesThePreviousOutputUntouched) {
   const io::DatasetIndex index = io::ReadDatasetIndex(data.string());
   for (std::size_t i = 0; i < index.runs.size(); ++i) {
     EncoderLog log = dataset.runs[i].encoders;
-    for (WheelSample& s : log.samples) std::swap(s.rate_rad_s[0], s.rate_rad_s[1]);
+    for (auto&& s : log.samples) std::swap(s.value[0], s.value[1]);
     WriteFileBytes(index.runs[i].encoders_path, io::EncoderCsv(log));
   }
   const fs::path out = scratch.path() / "calibrated.yaml";
@@ -198,8 +198,8 @@ TEST(NothingLostTest, RatesInDegreesPerSecondGiveAUnitsWarning) {
   // 57x longer odometry path dominates).
   for (std::size_t i = 0; i < index.runs.size(); ++i) {
     EncoderLog log = io::ReadEncoderCsv(index.runs[i].encoders_path);
-    for (WheelSample& s : log.samples) {
-      for (double& w : s.rate_rad_s) w *= 180.0 / M_PI;
+    for (auto&& s : log.samples) {
+      for (int w = 0; w < 3; ++w) s.value[w] *= 180.0 / M_PI;
     }
     WriteFileBytes(index.runs[i].encoders_path, io::EncoderCsv(log));
   }

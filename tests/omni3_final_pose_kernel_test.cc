@@ -20,13 +20,14 @@ using ParameterArray = std::array<double, kNumParameters>;
 
 // Rates (rad/s) around a common spin `spin_rad_s` of the wheels, which turns the robot at roughly
 // r/(3R) * 3 * spin: the spin sets how far the heading moves inside a block, hence the tier.
-WheelSamples SpinningLog(std::size_t n, double spin_rad_s, unsigned seed) {
+EncoderSamples SpinningLog(std::size_t n, double spin_rad_s, unsigned seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> rate(-3.0, 3.0), dt(0.005, 0.015);
-  WheelSamples samples(n);
-  for (auto& s : samples) {
+  EncoderSamples samples(3);
+  samples.resize(n);
+  for (auto&& s : samples) {
     s.dt_s = dt(rng);
-    for (double& w : s.rate_rad_s) w = spin_rad_s + rate(rng);
+    for (int i = 0; i < 3; ++i) s.value[i] = spin_rad_s + rate(rng);
   }
   return samples;
 }
@@ -40,11 +41,10 @@ void ExpectSamePose(const Pose2d& kernel, const Pose2d& replay, double path_m) {
   EXPECT_NEAR(kernel.theta, replay.theta, 1e-12 * (1.0 + std::abs(replay.theta)));
 }
 
-double PathLength(const Eigen::Matrix3d& m_inv, const WheelSamples& samples) {
+double PathLength(const Eigen::Matrix3d& m_inv, const EncoderSamples& samples) {
   double length = 0.0;
-  for (const WheelSample& s : samples) {
-    const Eigen::Vector3d v =
-        m_inv * Eigen::Vector3d(s.rate_rad_s[0], s.rate_rad_s[1], s.rate_rad_s[2]);
+  for (const auto& s : samples) {
+    const Eigen::Vector3d v = m_inv * Eigen::Vector3d(s.value[0], s.value[1], s.value[2]);
     length += std::hypot(v[0], v[1]) * s.dt_s;
   }
   return length;
@@ -59,8 +59,8 @@ TEST(FinalPoseKernel, EqualsTheReplayInEverySeriesTier) {
     for (std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{63}, std::size_t{64},
                           std::size_t{65}, std::size_t{1000}}) {
       SCOPED_TRACE("spin " + std::to_string(spin) + " rad/s, " + std::to_string(n) + " samples");
-      const WheelSamples log = SpinningLog(n, spin, static_cast<unsigned>(n + 7));
-      const Pose2d replay = ReplayWithMatrix(m_inv, log.data(), log.size(), start);
+      const EncoderSamples log = SpinningLog(n, spin, static_cast<unsigned>(n + 7));
+      const Pose2d replay = ReplayWithMatrix(m_inv, log, 0, log.size(), start);
       const Pose2d kernel = FinalPoseKernel(log).FinalPose(m_inv, start);
       ExpectSamePose(kernel, replay, PathLength(m_inv, log));
     }
@@ -83,11 +83,10 @@ TEST(FinalPoseKernel, EqualsTheReplayOnFlowerRunsOverTheParameterBox) {
     }
     const Eigen::Matrix3d m_inv = InverseKinematicMatrix(p.data());
     for (const sim::SimulatedRun& run : runs) {
-      const WheelSamples& log = run.log.encoders.samples;
+      const EncoderSamples& log = run.log.encoders.samples;
       const Pose2d start{0.0, 0.0, 0.3};
       ExpectSamePose(FinalPoseKernel(log).FinalPose(m_inv, start),
-                     ReplayWithMatrix(m_inv, log.data(), log.size(), start),
-                     PathLength(m_inv, log));
+                     ReplayWithMatrix(m_inv, log, 0, log.size(), start), PathLength(m_inv, log));
     }
   }
 }
@@ -97,12 +96,12 @@ TEST(FinalPoseKernel, SeesAWheelSwap) {
   // much as in the replay (guards against summing the wrong step with the wrong offset).
   const ParameterArray p = sim::PalacinTable5Parameters().ToArray();
   const Eigen::Matrix3d m_inv = InverseKinematicMatrix(p.data());
-  WheelSamples log = SpinningLog(500, 5.0, 11);
-  WheelSamples swapped = log;
-  for (WheelSample& s : swapped) std::swap(s.rate_rad_s[0], s.rate_rad_s[1]);
+  EncoderSamples log = SpinningLog(500, 5.0, 11);
+  EncoderSamples swapped = log;
+  for (auto&& s : swapped) std::swap(s.value[0], s.value[1]);
   const Pose2d a = FinalPoseKernel(log).FinalPose(m_inv, Pose2d{});
   const Pose2d b = FinalPoseKernel(swapped).FinalPose(m_inv, Pose2d{});
-  const Pose2d rb = ReplayWithMatrix(m_inv, swapped.data(), swapped.size(), Pose2d{});
+  const Pose2d rb = ReplayWithMatrix(m_inv, swapped, 0, swapped.size(), Pose2d{});
   EXPECT_GT(std::hypot(a.x - b.x, a.y - b.y), 0.01);
   ExpectSamePose(b, rb, PathLength(m_inv, swapped));
 }

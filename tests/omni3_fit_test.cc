@@ -67,7 +67,7 @@ NoisyFit FitDefaultNoise(std::uint64_t seed, bool swap_columns_a_b = false) {
   for (auto& run : sim::SimulateOmni3(options)) logs.push_back(std::move(run.log));
   if (swap_columns_a_b) {
     for (RunLog& log : logs) {
-      for (WheelSample& s : log.encoders.samples) std::swap(s.rate_rad_s[0], s.rate_rad_s[1]);
+      for (auto&& s : log.encoders.samples) std::swap(s.value[0], s.value[1]);
     }
   }
   NoisyFit out;

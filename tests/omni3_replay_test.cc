@@ -19,24 +19,25 @@ using ParameterArray = std::array<double, kNumParameters>;
 
 ParameterArray Table5() { return sim::PalacinTable5Parameters().ToArray(); }
 
-WheelSamples ConstantLog(const Eigen::Vector3d& w, double dt, int n) {
-  WheelSamples samples(n);
-  for (auto& s : samples) {
+EncoderSamples ConstantLog(const Eigen::Vector3d& w, double dt, int n) {
+  EncoderSamples samples(3);
+  samples.resize(static_cast<std::size_t>(n));
+  for (auto&& s : samples) {
     s.dt_s = dt;
-    for (int i = 0; i < 3; ++i) s.rate_rad_s[i] = w[i];
+    for (int i = 0; i < 3; ++i) s.value[i] = w[i];
   }
   return samples;
 }
 
 // Eq. 4 written literally: R(theta)^-1 * M^-1 * w with sin/cos at every sample.
-Pose2d NaiveReplay(const ParameterArray& p, const WheelSamples& samples, Pose2d pose) {
+Pose2d NaiveReplay(const ParameterArray& p, const EncoderSamples& samples, Pose2d pose) {
   const Eigen::Matrix3d m_inv = InverseKinematicMatrix(p.data());
-  for (const WheelSample& s : samples) {
+  for (const auto& s : samples) {
     Eigen::Matrix3d r_inv;
     r_inv << std::cos(pose.theta), -std::sin(pose.theta), 0, std::sin(pose.theta),
         std::cos(pose.theta), 0, 0, 0, 1;
     const Eigen::Vector3d step =
-        s.dt_s * r_inv * m_inv * Eigen::Vector3d(s.rate_rad_s[0], s.rate_rad_s[1], s.rate_rad_s[2]);
+        s.dt_s * r_inv * m_inv * Eigen::Vector3d(s.value[0], s.value[1], s.value[2]);
     pose.x += step[0];
     pose.y += step[1];
     pose.theta += step[2];
@@ -93,10 +94,11 @@ TEST(Omni3Replay, MatchesTheLiteralEq4OnRandomLogs) {
   std::uniform_real_distribution<double> rate(-30.0, 30.0), dt(0.002, 0.03);
   const ParameterArray p = Table5();
   for (int trial = 0; trial < 20; ++trial) {
-    WheelSamples samples(700 + 37 * trial);
-    for (auto& s : samples) {
+    EncoderSamples samples(3);
+    samples.resize(static_cast<std::size_t>(700 + 37 * trial));
+    for (auto&& s : samples) {
       s.dt_s = dt(rng);
-      for (double& w : s.rate_rad_s) w = rate(rng);
+      for (int i = 0; i < 3; ++i) s.value[i] = rate(rng);
     }
     samples[5].dt_s = 0.5;  // large rotation in one step
     const Pose2d start{1.0, 2.0, -3.0};
@@ -111,14 +113,15 @@ TEST(Omni3Replay, MatchesTheLiteralEq4OnRandomLogs) {
 
 TEST(Omni3Replay, VisitorSeesEveryIntermediatePose) {
   const ParameterArray p = Table5();
-  const WheelSamples samples = ConstantLog(Eigen::Vector3d(1, 2, 3), 0.01, 300);
+  const EncoderSamples samples = ConstantLog(Eigen::Vector3d(1, 2, 3), 0.01, 300);
   std::vector<Pose2d> poses;
   const Pose2d end =
-      ReplayWithMatrix(InverseKinematicMatrix(p.data()), samples.data(), samples.size(), Pose2d{},
+      ReplayWithMatrix(InverseKinematicMatrix(p.data()), samples, 0, samples.size(), Pose2d{},
                        [&](std::size_t, const Pose2d& pose) { poses.push_back(pose); });
   ASSERT_EQ(poses.size(), samples.size());
   EXPECT_EQ(poses.back().x, end.x);
-  const WheelSamples first_half(samples.begin(), samples.begin() + 150);
+  EncoderSamples first_half(3);
+  for (std::size_t k = 0; k < 150; ++k) first_half.push_back(samples[k]);
   const Pose2d half = ReplayFinalPose(p.data(), first_half, Pose2d{});
   EXPECT_NEAR(poses[149].x, half.x, 1e-15);
   EXPECT_NEAR(poses[149].y, half.y, 1e-15);
@@ -128,10 +131,11 @@ TEST(Omni3Replay, JetsAndDoublesAgreeAndDerivativesMatchFiniteDifferences) {
   using Jet = ceres::Jet<double, kNumParameters>;
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> rate(-3.0, 3.0);
-  WheelSamples samples(400);
-  for (auto& s : samples) {
+  EncoderSamples samples(3);
+  samples.resize(400);
+  for (auto&& s : samples) {
     s.dt_s = 0.01;
-    for (double& w : s.rate_rad_s) w = rate(rng);
+    for (int i = 0; i < 3; ++i) s.value[i] = rate(rng);
   }
   const ParameterArray p = Table5();
   const Pose2d start{0.5, 0.5, 0.5};

@@ -97,9 +97,8 @@ TEST(OptiOdomImport, WritesATicksDataSetThatLoadsBackToTheSameRuns) {
     // Times are written with 1 us resolution: rates (ticks / dt) agree to ~1e-6 / 0.04 relative.
     for (std::size_t k = 0; k < direct.encoders.samples.size(); ++k) {
       for (int w = 0; w < 3; ++w) {
-        EXPECT_NEAR(ds.runs[i].encoders.samples[k].rate_rad_s[w],
-                    direct.encoders.samples[k].rate_rad_s[w],
-                    1e-4 * (1.0 + std::abs(direct.encoders.samples[k].rate_rad_s[w])));
+        EXPECT_NEAR(ds.runs[i].encoders.samples[k].value[w], direct.encoders.samples[k].value[w],
+                    1e-4 * (1.0 + std::abs(direct.encoders.samples[k].value[w])));
       }
     }
   }
@@ -142,11 +141,10 @@ TEST(EncoderTicks, IncrementsAndCumulativeGiveTheSameRatesAndTicksNeedAResolutio
   ASSERT_EQ(a.samples.size(), 2u);
   ASSERT_EQ(b.samples.size(), 2u);
   const double rad_per_tick = 2.0 * M_PI / 4096.0;
-  EXPECT_NEAR(a.samples[0].rate_rad_s[0], 100 * rad_per_tick / 0.04, 1e-12);
-  EXPECT_NEAR(a.samples[1].rate_rad_s[2], -12 * rad_per_tick / 0.06, 1e-12);
+  EXPECT_NEAR(a.samples[0].value[0], 100 * rad_per_tick / 0.04, 1e-12);
+  EXPECT_NEAR(a.samples[1].value[2], -12 * rad_per_tick / 0.06, 1e-12);
   for (int k = 0; k < 2; ++k) {
-    for (int w = 0; w < 3; ++w)
-      EXPECT_NEAR(a.samples[k].rate_rad_s[w], b.samples[k].rate_rad_s[w], 1e-12);
+    for (int w = 0; w < 3; ++w) EXPECT_NEAR(a.samples[k].value[w], b.samples[k].value[w], 1e-12);
   }
   try {
     io::ReadEncoderCsv((tmp / "inc.csv").string());
@@ -157,7 +155,7 @@ TEST(EncoderTicks, IncrementsAndCumulativeGiveTheSameRatesAndTicksNeedAResolutio
   }
   // The rate format still loads.
   WriteText(tmp / "w.csv", "t,w_a,w_b,w_c\n0,0,0,0\n0.04,1.5,-2,0.25\n");
-  EXPECT_DOUBLE_EQ(io::ReadEncoderCsv((tmp / "w.csv").string()).samples[0].rate_rad_s[1], -2.0);
+  EXPECT_DOUBLE_EQ(io::ReadEncoderCsv((tmp / "w.csv").string()).samples[0].value[1], -2.0);
   fs::remove_all(tmp);
 }
 

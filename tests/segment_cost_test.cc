@@ -54,15 +54,14 @@ RunLog SimulatedRun(const Omni3ParameterArray& truth, int seed) {
     const Eigen::Vector3d v(0.3 * a * ramp * std::cos(0.2 * b * t), 0.3 * ramp * std::sin(0.25 * t),
                             0.6 * c * ramp * std::sin(0.1 * t + a));
     const Eigen::Vector3d w = m * v;
-    WheelSample s;
-    s.dt_s = dt;
-    for (int i = 0; i < 3; ++i) s.rate_rad_s[i] = w[i];
-    run.encoders.samples.push_back(s);
+    double values[3];
+    for (int i = 0; i < 3; ++i) values[i] = w[i];
+    run.encoders.samples.push_back(dt, values);
     run.encoders.t_s.push_back((k + 1) * dt);
   }
   run.ground_truth.t_s.push_back(0.0);
   run.ground_truth.world_T_robot.push_back(Pose2d{});
-  omni3::ReplayWithMatrix(omni3::InverseKinematicMatrix(truth.data()), run.encoders.samples.data(),
+  omni3::ReplayWithMatrix(omni3::InverseKinematicMatrix(truth.data()), run.encoders.samples, 0,
                           run.encoders.samples.size(), Pose2d{},
                           [&](std::size_t k, const Pose2d& pose) {
                             run.ground_truth.t_s.push_back(run.encoders.t_s[k + 1]);
@@ -111,8 +110,8 @@ TEST(SegmentCost, AWrongWheelSignOrOrderIsImpossibleToMiss) {
   const double good =
       EvaluateSegmentErrors(NominalRobot().nominal.ToArray(), Prepare(runs).segmented, 1).cf;
   RunLog flipped = runs[0], swapped = runs[0];
-  for (WheelSample& s : flipped.encoders.samples) s.rate_rad_s[1] = -s.rate_rad_s[1];
-  for (WheelSample& s : swapped.encoders.samples) std::swap(s.rate_rad_s[0], s.rate_rad_s[2]);
+  for (auto&& s : flipped.encoders.samples) s.value[1] = -s.value[1];
+  for (auto&& s : swapped.encoders.samples) std::swap(s.value[0], s.value[2]);
   const double bad_sign =
       EvaluateSegmentErrors(NominalRobot().nominal.ToArray(), Prepare({flipped}).segmented, 1).cf;
   const double bad_order =

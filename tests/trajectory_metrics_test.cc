@@ -26,10 +26,9 @@ struct TinyLog {
   TinyLog() {
     const Eigen::Vector3d w = omni3::KinematicMatrix(p.data()) * Eigen::Vector3d(1.0, 0.0, 0.0);
     for (int k = 0; k < 4; ++k) {
-      WheelSample s;
-      s.dt_s = 0.25;
-      for (int i = 0; i < 3; ++i) s.rate_rad_s[i] = w[i];
-      run.samples.push_back(s);
+      double values[3];
+      for (int i = 0; i < 3; ++i) values[i] = w[i];
+      run.samples.push_back(0.25, values);
     }
     run.id = "tiny";
     run.t_start_s = 0.0;

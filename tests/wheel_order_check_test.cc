@@ -29,9 +29,9 @@ std::vector<RunLog> SimulateLogs(std::uint64_t seed, int repetitions) {
 std::vector<AlignedRun> Miswire(const std::vector<AlignedRun>& runs, const WheelMapping& fix) {
   std::vector<AlignedRun> out = runs;
   for (AlignedRun& run : out) {
-    for (WheelSample& s : run.samples) {
-      const double w[3] = {s.rate_rad_s[0], s.rate_rad_s[1], s.rate_rad_s[2]};
-      for (int i = 0; i < 3; ++i) s.rate_rad_s[fix.column[i]] = fix.sign[i] * w[i];
+    for (auto&& s : run.samples) {
+      const double w[3] = {s.value[0], s.value[1], s.value[2]};
+      for (int i = 0; i < 3; ++i) s.value[fix.column[i]] = fix.sign[i] * w[i];
     }
   }
   return out;
@@ -172,8 +172,8 @@ TEST(WheelOrderCheck, RatesInDegreesPerSecondAreNamed) {
   // inflation of the ground-truth noise (a few %).
   EXPECT_NEAR(ok.scale, 1.0, 0.1);
   for (RunLog& log : logs) {
-    for (WheelSample& s : log.encoders.samples) {
-      for (double& w : s.rate_rad_s) w *= 180.0 / M_PI;
+    for (auto&& s : log.encoders.samples) {
+      for (int i = 0; i < 3; ++i) s.value[i] *= 180.0 / M_PI;
     }
   }
   const RateUnitsReport deg = CheckRateUnits(logs, sim::PalacinApr02Robot());

@@ -219,10 +219,10 @@ RunLog OptiOdomRunLog(const OptiOdomSession& session, const OptiOdomRun& run) {
   const double rad_per_tick = 2.0 * M_PI / session.metadata.TicksPerWheelRev();
   log.encoders.t_s = run.t_s;
   for (std::size_t k = 1; k < run.t_s.size(); ++k) {
-    WheelSample s;
-    s.dt_s = run.t_s[k] - run.t_s[k - 1];
-    for (int i = 0; i < 3; ++i) s.rate_rad_s[i] = rad_per_tick * run.ticks[k][i] / s.dt_s;
-    log.encoders.samples.push_back(s);
+    const double dt = run.t_s[k] - run.t_s[k - 1];
+    double values[3];
+    for (int i = 0; i < 3; ++i) values[i] = rad_per_tick * run.ticks[k][i] / dt;
+    log.encoders.samples.push_back(dt, values);
   }
   log.ground_truth = run.ground_truth;
   // The robot is at rest at the start (the ground truth's frame is the start frame).

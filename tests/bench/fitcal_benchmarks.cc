@@ -22,19 +22,20 @@ namespace {
 
 const std::string kData = std::string(FITCAL_SOURCE_DIR) + "/data/flower";
 
-WheelSamples RandomLog(std::size_t n) {
+EncoderSamples RandomLog(std::size_t n) {
   std::mt19937_64 rng(1);
   std::uniform_real_distribution<double> rate(-3.0, 3.0), dt(0.009, 0.011);
-  WheelSamples samples(n);
-  for (auto& s : samples) {
+  EncoderSamples samples(3);
+  samples.resize(n);
+  for (auto&& s : samples) {
     s.dt_s = dt(rng);
-    for (double& w : s.rate_rad_s) w = rate(rng);
+    for (int i = 0; i < 3; ++i) s.value[i] = rate(rng);
   }
   return samples;
 }
 
 void BM_ReplayDouble(benchmark::State& state) {
-  const WheelSamples samples = RandomLog(static_cast<std::size_t>(state.range(0)));
+  const EncoderSamples samples = RandomLog(static_cast<std::size_t>(state.range(0)));
   const auto p = sim::PalacinTable5Parameters().ToArray();
   for (auto _ : state) {
     const Pose2d end = omni3::ReplayFinalPose(p.data(), samples, Pose2d{});
@@ -47,7 +48,7 @@ BENCHMARK(BM_ReplayDouble)->Arg(400)->Arg(1 << 20);
 
 void BM_ReplayJet9(benchmark::State& state) {
   using Jet = ceres::Jet<double, omni3::kNumParameters>;
-  const WheelSamples samples = RandomLog(static_cast<std::size_t>(state.range(0)));
+  const EncoderSamples samples = RandomLog(static_cast<std::size_t>(state.range(0)));
   const auto p = sim::PalacinTable5Parameters().ToArray();
   std::array<Jet, omni3::kNumParameters> pj;
   for (int k = 0; k < omni3::kNumParameters; ++k) pj[k] = Jet(p[k], k);
@@ -78,7 +79,7 @@ void BM_FinalPoses180Runs(benchmark::State& state) {
     for (std::size_t i = 0; i < kernels.size(); ++i) {
       const AlignedRun& run = split.training[i];
       const Pose2d end = use_kernel ? kernels[i].FinalPose(m_inv, run.start)
-                                    : omni3::ReplayWithMatrix(m_inv, run.samples.data(),
+                                    : omni3::ReplayWithMatrix(m_inv, run.samples, 0,
                                                               run.samples.size(), run.start);
       sum += end.x + end.y + end.theta;
     }

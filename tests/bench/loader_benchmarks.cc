@@ -2,7 +2,7 @@
 //   BM_ReadEncoderCsv   a large encoder log (FITCAL_BENCH_ENCODER_MB, default 200 MB; 1024 for
 //                       the 1 GB) written once to a temporary directory; MB/s of file
 //                       text and the bytes the loaded EncoderLog holds per sample (target ~40:
-//                       t_s 8 B + WheelSample 32 B).
+//                       t_s 8 B + a 32-byte sample row).
 //   BM_LoadDataset      a data set of FITCAL_BENCH_RUNS runs (default 10,000; 100 encoder rows
 //                       and 5 ground-truth rows each): dataset.yaml + every file, all threads.
 // The page cache is warm after the first iteration: these measure parsing, not the disk.
@@ -73,9 +73,11 @@ void BM_ReadEncoderCsv(benchmark::State& state) {
   for (auto _ : state) {
     const fitcal::EncoderLog log = fitcal::io::ReadEncoderCsv(path.string());
     samples = log.samples.size();
-    bytes_per_sample = static_cast<double>(log.t_s.capacity() * sizeof(double) +
-                                           log.samples.capacity() * sizeof(fitcal::WheelSample)) /
-                       static_cast<double>(samples);
+    bytes_per_sample =
+        static_cast<double>(log.t_s.capacity() * sizeof(double) +
+                            log.samples.capacity_rows() *
+                                static_cast<std::size_t>(log.samples.stride()) * sizeof(double)) /
+        static_cast<double>(samples);
     benchmark::DoNotOptimize(log.samples.data());
   }
   state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * file_bytes));

@@ -68,10 +68,10 @@ void FuzzEncoderCsv(const std::string& path, const std::optional<EncoderTicks>& 
   const EncoderLog log = io::ReadEncoderCsv(path, ticks);
   // Contract of a loaded log (run_log.h): one sample per interval, positive dt.
   if (log.samples.size() + 1 != log.t_s.size()) throw std::logic_error("sample count mismatch");
-  for (const WheelSample& s : log.samples) {
+  for (const auto& s : log.samples) {
     if (!(s.dt_s > 0.0)) throw std::logic_error("non-positive dt accepted");
-    for (double w : s.rate_rad_s) {
-      if (!std::isfinite(w)) throw std::logic_error("non-finite wheel rate accepted");
+    for (int i = 0; i < log.samples.num_channels(); ++i) {
+      if (!std::isfinite(s.value[i])) throw std::logic_error("non-finite wheel rate accepted");
     }
   }
 }

@@ -132,11 +132,10 @@ SimulatedRun SimulateRun(const Omni3SimulationOptions& o, const MotionCommand& c
       for (int i = 0; i < 3; ++i)
         counts[i] = static_cast<std::int64_t>(std::floor(angle[i] / count_rad));
       if (next_encoder > 0) {
-        WheelSample s;
-        s.dt_s = t - last_encoder_t;
-        for (int i = 0; i < 3; ++i)
-          s.rate_rad_s[i] = (counts[i] - last_counts[i]) * count_rad / s.dt_s;
-        log.encoders.samples.push_back(s);
+        const double dt = t - last_encoder_t;
+        double values[3];
+        for (int i = 0; i < 3; ++i) values[i] = (counts[i] - last_counts[i]) * count_rad / dt;
+        log.encoders.samples.push_back(dt, values);
       }
       log.encoders.t_s.push_back(t);
       for (int i = 0; i < 3; ++i) last_counts[i] = counts[i];
