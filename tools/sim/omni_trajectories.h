@@ -1,0 +1,30 @@
+#pragma once
+// Palacin et al. 2022's "flower" calibration trajectories (Fig. 9, Table A1;
+// tools/sim/flower_trajectories.h) for any holonomic robot and the generic simulator
+// (model_simulator.h): straight runs R1..Rn in n directions alpha_i = 360 deg (i - 1) / n of the
+// robot frame, counter-clockwise curves G1..Gn and clockwise curves B1..Bn in the same directions.
+// Each holds the body twist (v cos alpha, v sin alpha, omega) until the robot has covered
+// distance_m (for a curve: an arc of radius v / |omega|). With n = 12 and the defaults these are
+// Table A1's 36 trajectories. Optional spins on the spot (S-ccw, S-cw) excite the yaw alone.
+
+#include <vector>
+
+#include "tools/sim/model_simulator.h"
+
+namespace fitcal::sim {
+
+struct OmniTrajectoryOptions {
+  int num_directions = 12;
+  double speed_m_s = 0.35;
+  double omega_abs_rad_s = 0.35;  // of the curves
+  double distance_m = 1.0;
+  double spin_angle_rad = 0.0;  // > 0: add a CCW and a CW spin on the spot of this angle
+  double spin_rate_rad_s = 0.7;
+};
+
+// The flower (R, G, B families in that order, each in direction order), then the spins, for
+// repetitions 1..repetitions (ordered by repetition, then trajectory).
+std::vector<TrajectorySpec> OmniFlowerTrajectories(int repetitions,
+                                                   const OmniTrajectoryOptions& options = {});
+
+}  // namespace fitcal::sim
