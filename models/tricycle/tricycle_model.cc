@@ -1,0 +1,145 @@
+#include "models/tricycle/tricycle_model.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+
+#include "io/input_error.h"
+#include "io/robot_yaml_blocks.h"
+#include "io/yaml_reader.h"
+#include "models/tricycle/tricycle_checks.h"
+
+namespace fitcal {
+
+namespace {
+
+using io::InputError;
+using io::InputErrorKind;
+using K = TricycleKinematics;
+
+constexpr const char* kDefaultTractionName = "traction";
+constexpr const char* kSteeringColumn = "steering";
+// A steering offset is a small mounting/zeroing error; beyond a right angle the "offset" would
+// swap forward and sideways.
+constexpr double kMaxSteeringOffsetDeg = 90.0;
+
+int LineOf(const YAML::Node& node) { return node.Mark().line + 1; }
+
+// A CSV column name is built from the traction wheel's name: letters, digits, '_' only.
+bool IsColumnSafe(const std::string& name) {
+  if (name.empty()) return false;
+  for (char c : name) {
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_') return false;
+  }
+  return true;
+}
+
+void RequirePositive(double v, const YAML::Node& node, const std::string& path,
+                     const std::string& what) {
+  if (!(v > 0.0)) {
+    throw InputError(InputErrorKind::kBadValue, path, LineOf(node), what + " must be positive");
+  }
+}
+
+// `bounds:` - absolute boxes, lengths positive, the offset within +-90 deg.
+std::vector<Interval> ReadTricycleBounds(io::YamlMap& robot_map, const std::string& path) {
+  const YAML::Node node = robot_map.Required("bounds");
+  io::YamlMap bounds(node, path, "bounds");
+  std::vector<Interval> box(K::kNumParameters);
+  box[K::kRadiusIndex] = io::ReadBoundsPair(bounds, "radius_m", 1.0);
+  box[K::kWheelbaseIndex] = io::ReadBoundsPair(bounds, "wheelbase_m", 1.0);
+  box[K::kSteeringOffsetIndex] = io::ReadBoundsPair(bounds, "steering_offset_deg", M_PI / 180.0);
+  bounds.RejectUnread();
+  if (!(box[K::kRadiusIndex].lo > 0.0) || !(box[K::kWheelbaseIndex].lo > 0.0)) {
+    throw InputError(InputErrorKind::kBadValue, path, LineOf(node),
+                     "bounds on radius_m and wheelbase_m must be positive");
+  }
+  const Interval& offset = box[K::kSteeringOffsetIndex];
+  if (!(std::max(std::abs(offset.lo), std::abs(offset.hi)) < DegToRad(kMaxSteeringOffsetDeg))) {
+    throw InputError(InputErrorKind::kBadValue, path, LineOf(node),
+                     "bounds.steering_offset_deg must lie within (-90, 90)");
+  }
+  return box;
+}
+
+}  // namespace
+
+Robot TricycleRobotDescription(const std::string& name, const std::string& traction_name) {
+  Robot robot;
+  robot.model = "tricycle";
+  robot.name = name;
+  robot.channels.resize(K::kNumChannels);
+  robot.channels[K::kTractionChannel] = {traction_name, ChannelKind::kWheelRate,
+                                         "w_" + traction_name, "ticks_" + traction_name};
+  robot.channels[K::kSteeringChannel] = {kSteeringColumn, ChannelKind::kAngle, kSteeringColumn, ""};
+  robot.parameters.resize(K::kNumParameters);
+  robot.parameters[K::kRadiusIndex] = {"r_" + traction_name, "radius_m", ParameterUnit::kLength};
+  robot.parameters[K::kWheelbaseIndex] = {"wheelbase", "wheelbase_m", ParameterUnit::kLength};
+  robot.parameters[K::kSteeringOffsetIndex] = {"steering_offset", "steering_offset_deg",
+                                               ParameterUnit::kAngle};
+  return robot;
+}
+
+RobotModelPtr ReadTricycleModel(const YAML::Node& root, const std::string& path) {
+  io::YamlMap robot_map(root, path, "robot");
+  robot_map.String("model");
+  const std::string name = robot_map.String("name");
+  const YAML::Node wheel_node = robot_map.Required("traction_wheel");
+  io::YamlMap wheel(wheel_node, path, "traction_wheel");
+  const std::string traction_name =
+      wheel.Has("name") ? wheel.String("name") : std::string(kDefaultTractionName);
+  if (!IsColumnSafe(traction_name) || traction_name == kSteeringColumn) {
+    throw InputError(InputErrorKind::kBadValue, path, LineOf(wheel_node),
+                     "traction_wheel.name '" + traction_name +
+                         "' must be letters, digits and '_' and not 'steering'");
+  }
+  std::vector<double> p(K::kNumParameters);
+  p[K::kRadiusIndex] = wheel.Double("radius_m");
+  RequirePositive(p[K::kRadiusIndex], wheel.Required("radius_m"), path, "traction_wheel.radius_m");
+  wheel.RejectUnread();
+  p[K::kWheelbaseIndex] = robot_map.Double("wheelbase_m");
+  RequirePositive(p[K::kWheelbaseIndex], robot_map.Required("wheelbase_m"), path, "wheelbase_m");
+  p[K::kSteeringOffsetIndex] = DegToRad(robot_map.Double("steering_offset_deg"));
+
+  Robot robot = TricycleRobotDescription(name, traction_name);
+  robot.nominal = p;
+  robot.bounds = ReadTricycleBounds(robot_map, path);
+  io::CheckNominalInsideBounds(robot, path, LineOf(robot_map.Required("bounds")));
+  robot.encoder = io::ReadEncoderTicksNode(robot_map.Optional("encoder"), path);
+  robot.effects = io::ReadEffectsNode(robot_map.Optional("effects"), path);
+  robot_map.Optional("calibration");  // written by fitcal; informational when read back
+  robot_map.RejectUnread();
+  return std::make_shared<TricycleModel>(std::move(robot));
+}
+
+std::string TricycleModel::RobotYaml(const std::vector<double>& p,
+                                     const std::string& calibration_block) const {
+  const std::string& traction_name = robot_.channels[K::kTractionChannel].name;
+  YAML::Emitter out;
+  out.SetDoublePrecision(10);
+  out << YAML::BeginMap;
+  out << YAML::Key << "model" << YAML::Value << "tricycle";
+  out << YAML::Key << "name" << YAML::Value << robot_.name;
+  out << YAML::Key << "traction_wheel" << YAML::Value << YAML::Flow << YAML::BeginMap;
+  if (traction_name != kDefaultTractionName) {
+    out << YAML::Key << "name" << YAML::Value << traction_name;
+  }
+  out << YAML::Key << "radius_m" << YAML::Value << p[K::kRadiusIndex] << YAML::EndMap;
+  out << YAML::Key << "wheelbase_m" << YAML::Value << p[K::kWheelbaseIndex];
+  out << YAML::Key << "steering_offset_deg" << YAML::Value << RadToDeg(p[K::kSteeringOffsetIndex]);
+  out << YAML::Key << "bounds" << YAML::Value << YAML::BeginMap;
+  io::EmitBoundsPair(out, "radius_m", robot_.bounds[K::kRadiusIndex], 1.0);
+  io::EmitBoundsPair(out, "wheelbase_m", robot_.bounds[K::kWheelbaseIndex], 1.0);
+  io::EmitBoundsPair(out, "steering_offset_deg", robot_.bounds[K::kSteeringOffsetIndex],
+                     180.0 / M_PI);
+  out << YAML::EndMap;
+  io::EmitEncoderAndEffects(out, robot_);
+  out << YAML::EndMap;
+  return std::string(out.c_str()) + "\n" + calibration_block;
+}
+
+void TricycleModel::CheckSamples(const EncoderLog& log, const std::string& path) const {
+  tricycle::CheckSteeringSamples(log, path);
+}
+
+}  // namespace fitcal

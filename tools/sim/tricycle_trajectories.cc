@@ -1,0 +1,71 @@
+#include "tools/sim/tricycle_trajectories.h"
+
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace fitcal::sim {
+
+namespace {
+
+// One circle at steering angle phi' (T2): omega = v tan(phi') / L, the heading turns by
+// 2 pi turns in 2 pi turns / |omega|.
+TwistSegment Circle(const TricycleTrajectoryOptions& o, double steering_rad) {
+  const double omega = o.speed_m_s * std::tan(steering_rad) / o.wheelbase_m;
+  return {Twist{o.speed_m_s, 0.0, omega}, 2.0 * M_PI * o.circle_turns / std::abs(omega)};
+}
+
+// Four straight sides, each followed by an in-place quarter turn (sign +1 = ccw), and the first
+// side again.
+std::vector<TwistSegment> Square(const TricycleTrajectoryOptions& o, double sign) {
+  const TwistSegment side{Twist{o.speed_m_s, 0.0, 0.0}, o.square_side_m / o.speed_m_s};
+  const TwistSegment corner{Twist{0.0, 0.0, sign * o.turn_rate_rad_s},
+                            0.5 * M_PI / o.turn_rate_rad_s};
+  std::vector<TwistSegment> out;
+  for (int i = 0; i < 4; ++i) {
+    out.push_back(side);
+    out.push_back(corner);
+  }
+  out.push_back(side);  // open: ends a side away from the start (header)
+  return out;
+}
+
+}  // namespace
+
+std::string TricycleTrajectoryOptions::Check() const {
+  if (!(wheelbase_m > 0.0)) return "wheelbase_m must be positive";
+  if (!(speed_m_s > 0.0)) return "speed_m_s must be positive";
+  if (!(circle_turns > 0.0)) return "circle_turns must be positive";
+  if (!(square_side_m > 0.0)) return "square_side_m must be positive";
+  if (!(turn_rate_rad_s > 0.0)) return "turn_rate_rad_s must be positive";
+  if (repetitions < 1) return "repetitions must be at least 1";
+  for (double deg : steering_deg) {
+    if (!(deg > 0.0 && deg < 90.0)) return "circle steering angles must lie in (0, 90) deg";
+  }
+  return "";
+}
+
+std::vector<TrajectorySpec> TricycleTrajectories(const TricycleTrajectoryOptions& options) {
+  const std::string error = options.Check();
+  if (!error.empty()) throw std::invalid_argument("tricycle trajectories: " + error);
+  std::vector<TrajectorySpec> shapes;
+  for (double deg : options.steering_deg) {
+    char label[32];
+    for (double sign : {1.0, -1.0}) {
+      std::snprintf(label, sizeof label, "circle_%s_%g", sign > 0.0 ? "ccw" : "cw", deg);
+      shapes.push_back({label, 1, {Circle(options, sign * deg * M_PI / 180.0)}});
+    }
+  }
+  shapes.push_back({"square_ccw", 1, Square(options, 1.0)});
+  shapes.push_back({"square_cw", 1, Square(options, -1.0)});
+  std::vector<TrajectorySpec> out;
+  for (int rep = 1; rep <= options.repetitions; ++rep) {
+    for (TrajectorySpec spec : shapes) {
+      spec.repetition = rep;
+      out.push_back(std::move(spec));
+    }
+  }
+  return out;
+}
+
+}  // namespace fitcal::sim

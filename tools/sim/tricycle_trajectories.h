@@ -1,0 +1,49 @@
+#pragma once
+// Calibration trajectories for a tricycle (models/tricycle/), as twist segments for the generic
+// simulator (tools/sim/model_simulator.h):
+//
+//   circle_<dir>_<deg>  circle_turns turns (default 1.25) at a constant steering angle
+//                       phi' = deg, counter-clockwise (ccw, phi' > 0) and clockwise (cw), for each
+//                       angle of steering_deg: forward speed v and yaw rate
+//                       omega = v tan(phi') / L, so the rear axle's centre traces the arc of
+//                       radius L / tan(phi') (tricycle_kinematics.h, T2) for 2 pi turns / |omega|;
+//   square_<dir>        a square of side square_side_m driven forward at v, with in-place turns
+//                       of 90 deg at the corners (steering at +-90 deg, vx = 0, omega = +-rate),
+//                       counter-clockwise and clockwise, then its first side once more.
+// Circles at several steering angles both ways separate the wheelbase from the steering offset
+// (one angle in one direction sees only sin(phi + phi_0) / L); straight legs and in-place turns
+// separate the wheel radius (distance) from the wheelbase (turn per distance).
+//
+// The paths are open on purpose. A closed path (a whole number of circles, a square back at its
+// corner) ends where it started for ANY common scale of r and L: the heading sees r / L only, and
+// the shape scales with L (circle radius L / tan phi') or r (straight sides), so the final pose
+// cannot tell the scale (simulated: sigma of r 7 mm on 2 mm ground-truth noise). Closed circles
+// also hide a steering channel of the wrong sign (a clockwise full turn ends where a
+// counter-clockwise one does). An extra quarter circle, an extra side, put the end a path-sized
+// distance away from the start.
+
+#include <vector>
+
+#include "tools/sim/model_simulator.h"
+
+namespace fitcal::sim {
+
+struct TricycleTrajectoryOptions {
+  double wheelbase_m = 0.15;  // the L used to turn steering angles into yaw rates (nominal)
+  double speed_m_s = 0.1;     // forward speed of the rear axle's centre
+  std::vector<double> steering_deg = {10.0, 20.0, 30.0, 45.0};  // circles, each both ways
+  double circle_turns = 1.25;  // not a whole number: see "open on purpose" above
+  double square_side_m = 1.0;
+  double turn_rate_rad_s = 0.4;  // in-place turns at the square's corners
+  int repetitions = 1;           // each trajectory this many times (repetition 1..n)
+
+  // Empty when valid, else what is wrong.
+  std::string Check() const;
+};
+
+// Repetition 1 of every trajectory (circles in steering_deg order, ccw then cw for each, then the
+// ccw and the cw square), then repetition 2, ... up to `repetitions`. Throws std::invalid_argument
+// for invalid options.
+std::vector<TrajectorySpec> TricycleTrajectories(const TricycleTrajectoryOptions& options = {});
+
+}  // namespace fitcal::sim
