@@ -1,0 +1,107 @@
+#pragma once
+// A differential-drive robot on the model seam (kinematic_model.h): two driven wheels on one
+// axle, the body frame's x axis forward, y to the left, theta counter-clockwise (odometry/pose2.h).
+//
+// Parameters, in the robot YAML's wheel order (= the encoder channels' order):
+//   p = (r_<wheel 0>, r_<wheel 1>, b)   wheel radii (m) and the wheel separation b (m)
+// Which of the two channels is the right wheel is a template argument (kRightChannel = 0 when the
+// YAML lists the right wheel first, as OptiOdom's recordings and issue 13's example do); the YAML
+// reader picks the instantiation from each wheel's side (diff_drive_model.h).
+//
+// Channels: wheel rates w (rad/s), positive when the wheel drives the robot forward.
+//
+// Body step of one encoder interval (Borenstein & Feng 1996, Sec. 2): the wheel distances
+// d_i = r_i w_i dt, the distance of the axle's midpoint and the turn
+//   s = (d_R + d_L) / 2,   dtheta = (d_R - d_L) / b
+// (the right wheel running further turns the robot left, counter-clockwise). With the rates
+// constant over the interval the midpoint moves on an arc of length s, and its displacement in
+// the body frame at the interval's start is the arc's chord:
+//   dx = s sin(dtheta) / dtheta,   dy = s (1 - cos(dtheta)) / dtheta
+// i.e. length s sinc(dtheta/2) in the direction dtheta/2. To first order this is Borenstein &
+// Feng's dx = s, dy = 0; unlike it, it puts the pose on the arc exactly (no O(dtheta) drift of
+// the replay on curves), which is what the generic replay (odometry/replay.h) expects of a body
+// step. Near dtheta = 0 both ratios use their Taylor series (also on ceres::Jet).
+//
+// Inverse kinematics: a differential drive cannot move sideways; for (vx, 0, omega)
+//   w_R = (vx + omega b / 2) / r_R,   w_L = (vx - omega b / 2) / r_L.
+
+#include <cmath>
+
+#include "models/model_interface.h"
+#include "odometry/pose2.h"
+
+namespace fitcal {
+
+namespace diff_drive {
+
+inline constexpr int kNumWheels = 2;
+inline constexpr int kNumParameters = 3;
+inline constexpr int kSeparationIndex = 2;
+
+// Below this |dtheta| the chord ratios use series truncated after the a^6 term: error < a^8/9!
+// < 3e-22 relative, far below rounding.
+inline constexpr double kChordSeriesMaxAngle = 1e-2;
+
+// sin(a) / a and (1 - cos(a)) / a, on double or ceres::Jet.
+template <typename T>
+void ChordRatios(const T& a, T* sin_over_a, T* one_minus_cos_over_a) {
+  using std::cos;
+  using std::sin;
+  if (std::abs(ScalarPart(a)) < kChordSeriesMaxAngle) {
+    const T a2 = a * a;
+    *sin_over_a = 1.0 + a2 * (-1.0 / 6.0 + a2 * (1.0 / 120.0 + a2 * (-1.0 / 5040.0)));
+    *one_minus_cos_over_a =
+        a * (0.5 + a2 * (-1.0 / 24.0 + a2 * (1.0 / 720.0 + a2 * (-1.0 / 40320.0))));
+    return;
+  }
+  *sin_over_a = sin(a) / a;
+  *one_minus_cos_over_a = (1.0 - cos(a)) / a;
+}
+
+}  // namespace diff_drive
+
+template <int kRightChannel>
+struct DiffDriveKinematicsT {
+  static_assert(kRightChannel == 0 || kRightChannel == 1, "two channels");
+  static constexpr int kNumParameters = diff_drive::kNumParameters;
+  static constexpr int kNumChannels = diff_drive::kNumWheels;
+  static constexpr int kRight = kRightChannel;
+  static constexpr int kLeft = 1 - kRightChannel;
+
+  template <typename T>
+  struct Prepared {
+    T r_right;
+    T r_left;
+    T inv_separation;
+  };
+
+  template <typename T>
+  static Prepared<T> Prepare(const T* p) {
+    return {p[kRight], p[kLeft], 1.0 / p[diff_drive::kSeparationIndex]};
+  }
+
+  template <typename T, typename C>
+  static void BodyStep(const Prepared<T>& k, const C* w, double dt, T* dx, T* dy, T* dtheta) {
+    const T d_right = k.r_right * w[kRight] * dt;
+    const T d_left = k.r_left * w[kLeft] * dt;
+    const T s = 0.5 * (d_right + d_left);
+    *dtheta = (d_right - d_left) * k.inv_separation;
+    T sin_over_a, one_minus_cos_over_a;
+    diff_drive::ChordRatios(*dtheta, &sin_over_a, &one_minus_cos_over_a);
+    *dx = s * sin_over_a;
+    *dy = s * one_minus_cos_over_a;
+  }
+
+  static bool ChannelsForTwist(const double* p, const Twist& twist, double* w) {
+    if (twist.vy_m_s != 0.0) return false;
+    const double half_turn = 0.5 * twist.omega_rad_s * p[diff_drive::kSeparationIndex];
+    w[kRight] = (twist.vx_m_s + half_turn) / p[kRight];
+    w[kLeft] = (twist.vx_m_s - half_turn) / p[kLeft];
+    return true;
+  }
+};
+
+// The right wheel first (OptiOdom, issue 13's example YAML).
+using DiffDriveKinematics = DiffDriveKinematicsT<0>;
+
+}  // namespace fitcal

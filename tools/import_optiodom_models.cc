@@ -1,0 +1,437 @@
+#include "tools/import_optiodom_models.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <regex>
+#include <set>
+#include <stdexcept>
+
+#include "calib/aligned_run.h"
+#include "fit/final_pose_errors.h"
+#include "io/atomic_file.h"
+#include "io/dataset.h"
+#include "io/input_error.h"
+#include "io/text_file.h"
+#include "models/diff_drive/diff_drive_model.h"
+
+namespace fitcal::tools {
+
+namespace fs = std::filesystem;
+using io::InputError;
+using io::InputErrorKind;
+
+namespace {
+
+// Runs the authors flagged as bad (../shared/data/optiodom/README.md).
+struct FlaggedRun {
+  const char* path_type;
+  const char* session;
+  int run;
+  const char* reason;
+};
+constexpr FlaggedRun kFlaggedDiffRuns[] = {
+    {"square", "231220200029", 2, "flagged as a bad run by the OptiOdom authors"},
+};
+
+std::vector<std::string> SplitCsv(std::string_view line) {
+  std::vector<std::string> out;
+  std::size_t pos = 0;
+  while (true) {
+    const std::size_t end = line.find(',', pos);
+    out.emplace_back(io::Trim(line.substr(pos, end == std::string_view::npos ? end : end - pos)));
+    if (end == std::string_view::npos) break;
+    pos = end + 1;
+  }
+  return out;
+}
+
+double ParseNumber(const std::string& field, const std::string& path, int line,
+                   const std::string& what) {
+  double v = 0.0;
+  bool finite = true;
+  if (!io::ParseDouble(field, &v, &finite) || !finite) {
+    throw InputError(InputErrorKind::kNonNumeric, path, line,
+                     what + " is not a finite number: '" + field + "'");
+  }
+  return v;
+}
+
+struct DiffMetadata {
+  double gear_ratio = 0.0;            // ngear
+  double counts_per_motor_rev = 0.0;  // encRes
+  double separation_m = 0.0;          // Li
+  double diameter_right_m = 0.0;      // Di[0]
+  double diameter_left_m = 0.0;       // Di[1]
+  int num_runs = 0;                   // N
+  double TicksPerWheelRev() const { return gear_ratio * counts_per_motor_rev; }
+  bool SameRobotAs(const DiffMetadata& o) const {
+    return separation_m == o.separation_m && diameter_right_m == o.diameter_right_m &&
+           diameter_left_m == o.diameter_left_m;
+  }
+};
+
+DiffMetadata ReadDiffMetadata(const std::string& path) {
+  const std::string text = io::ReadTextFile(path);
+  io::LineScanner lines(text);
+  std::string_view line;
+  std::map<std::string, std::pair<int, std::vector<double>>> rows;  // key -> (line, numbers)
+  std::string type;
+  while (lines.Next(&line)) {
+    if (io::Trim(line).empty()) continue;
+    const std::vector<std::string> fields = SplitCsv(line);
+    if (fields[0] == "type") {
+      type = fields.size() > 1 ? fields[1] : "";
+      continue;
+    }
+    std::vector<double> values;
+    for (std::size_t i = 1; i < fields.size(); ++i) {
+      if (fields[i].empty()) continue;  // rows are padded to the widest one
+      values.push_back(ParseNumber(fields[i], path, lines.line_number(), fields[0]));
+    }
+    rows[fields[0]] = {lines.line_number(), values};
+  }
+  if (type != "diff") {
+    throw InputError(InputErrorKind::kUnknownModel, path, 1,
+                     "type '" + type + "' is not diff (a differential-drive session)");
+  }
+  const auto get = [&](const std::string& key, std::size_t count) {
+    const auto it = rows.find(key);
+    if (it == rows.end())
+      throw InputError(InputErrorKind::kMissingKey, path, 0, "no row '" + key + "'");
+    const auto& [line_number, values] = it->second;
+    if (values.size() != count) {
+      throw InputError(InputErrorKind::kWrongColumnCount, path, line_number,
+                       key + " needs " + std::to_string(count) + " value(s), found " +
+                           std::to_string(values.size()));
+    }
+    for (double v : values) {
+      if (!(v > 0.0))
+        throw InputError(InputErrorKind::kBadValue, path, line_number, key + " must be positive");
+    }
+    return values;
+  };
+  DiffMetadata m;
+  m.gear_ratio = get("ngear", 1)[0];
+  m.counts_per_motor_rev = get("encRes", 1)[0];
+  m.separation_m = get("Li", 1)[0];
+  const std::vector<double> d = get("Di", 2);
+  m.diameter_right_m = d[0];
+  m.diameter_left_m = d[1];
+  const double n = get("N", 1)[0];
+  if (n != std::floor(n)) {
+    throw InputError(InputErrorKind::kBadValue, path, rows["N"].first, "N is not a whole number");
+  }
+  m.num_runs = static_cast<int>(n);
+  return m;
+}
+
+// One run file: t, x, y, theta, ticks_right, ticks_left per row.
+struct DiffRun {
+  int number = 0;
+  std::vector<double> t_s;
+  std::vector<std::array<double, 2>> ticks;  // right, left; increments over (t(k-1), t(k)]
+  GroundTruthTrack ground_truth;
+};
+
+DiffRun ReadDiffRun(const std::string& path, int number) {
+  const std::string text = io::ReadTextFile(path);
+  io::LineScanner lines(text);
+  std::string_view line;
+  DiffRun run;
+  run.number = number;
+  while (lines.Next(&line)) {
+    if (io::Trim(line).empty()) continue;
+    const std::vector<std::string> fields = SplitCsv(line);
+    if (fields.size() != 6) {
+      throw InputError(InputErrorKind::kWrongColumnCount, path, lines.line_number(),
+                       "expected 6 fields (t, x, y, theta, ticks_right, ticks_left), found " +
+                           std::to_string(fields.size()));
+    }
+    double v[6];
+    for (int i = 0; i < 6; ++i) {
+      v[i] = ParseNumber(fields[i], path, lines.line_number(), "field " + std::to_string(i + 1));
+    }
+    if (!run.t_s.empty() && !(v[0] > run.t_s.back())) {
+      throw InputError(InputErrorKind::kNonIncreasingTime, path, lines.line_number(),
+                       "time " + fields[0] + " s is not after the previous row's");
+    }
+    run.t_s.push_back(v[0]);
+    run.ticks.push_back({v[4] + 0.0, v[5] + 0.0});  // + 0.0: "-0" -> 0
+    run.ground_truth.t_s.push_back(v[0]);
+    run.ground_truth.world_T_robot.push_back(Pose2d{v[1], v[2], v[3]});
+  }
+  if (run.t_s.size() < 2) {
+    throw InputError(InputErrorKind::kTooFewSamples, path, 0,
+                     "needs at least two rows, found " + std::to_string(run.t_s.size()));
+  }
+  return run;
+}
+
+struct DiffSession {
+  std::string name;       // e.g. 231220200029
+  std::string path_type;  // circular, square
+  std::string metadata_path;
+  DiffMetadata metadata;
+  std::vector<DiffRun> runs;  // by run number
+};
+
+DiffSession ReadDiffSession(const std::string& directory) {
+  fs::path dir = fs::path(directory).lexically_normal();
+  if (!dir.has_filename()) dir = dir.parent_path();
+  if (!fs::is_directory(dir))
+    throw InputError(InputErrorKind::kMissingFile, directory, 0, "not a directory");
+  DiffSession s;
+  s.name = dir.filename().string();
+  s.path_type = dir.parent_path().filename().string();
+  if (s.path_type.empty()) s.path_type = "path";
+  s.metadata_path = (dir / (s.name + "_metadata.csv")).string();
+  s.metadata = ReadDiffMetadata(s.metadata_path);
+  const std::regex run_name(s.name + "_run-([0-9]+)\\.csv");
+  std::vector<std::pair<int, std::string>> files;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    std::smatch m;
+    const std::string name = entry.path().filename().string();
+    if (std::regex_match(name, m, run_name))
+      files.emplace_back(std::stoi(m[1]), entry.path().string());
+  }
+  std::sort(files.begin(), files.end());
+  if (static_cast<int>(files.size()) != s.metadata.num_runs) {
+    throw InputError(InputErrorKind::kBadValue, s.metadata_path, 0,
+                     "N = " + std::to_string(s.metadata.num_runs) +
+                         " runs, but the directory holds " + std::to_string(files.size()) +
+                         " run files");
+  }
+  for (const auto& [number, path] : files) s.runs.push_back(ReadDiffRun(path, number));
+  return s;
+}
+
+const FlaggedRun* FindFlag(const DiffSession& s, int run) {
+  for (const FlaggedRun& f : kFlaggedDiffRuns) {
+    if (s.path_type == f.path_type && s.name == f.session && run == f.run) return &f;
+  }
+  return nullptr;
+}
+
+RunLog DiffRunLog(const DiffSession& s, const DiffRun& run, double ticks_per_rev) {
+  RunLog log;
+  char id[96];
+  std::snprintf(id, sizeof id, "%s-%s-run%02d", s.path_type.c_str(), s.name.c_str(), run.number);
+  log.id = id;
+  log.trajectory = s.path_type + "/" + s.name;
+  log.repetition = run.number;
+  const double rad_per_tick = 2.0 * M_PI / ticks_per_rev;
+  log.encoders.t_s = run.t_s;
+  log.encoders.samples = EncoderSamples(2);
+  for (std::size_t k = 1; k < run.t_s.size(); ++k) {
+    const double dt = run.t_s[k] - run.t_s[k - 1];
+    log.encoders.samples.push_back(
+        dt, {rad_per_tick * run.ticks[k][0] / dt, rad_per_tick * run.ticks[k][1] / dt});
+  }
+  log.ground_truth = run.ground_truth;
+  return log;
+}
+
+std::string TicksCsv(const DiffRun& run) {
+  std::string out = "t,ticks_right,ticks_left\n";
+  char line[128];
+  for (std::size_t k = 0; k < run.t_s.size(); ++k) {
+    // Row 0 only sets the start time (ticks counted before it are not part of the run).
+    const double right = k == 0 ? 0.0 : run.ticks[k][0];
+    const double left = k == 0 ? 0.0 : run.ticks[k][1];
+    const int n = std::snprintf(line, sizeof line, "%.9f,%.10g,%.10g\n", run.t_s[k], right, left);
+    out.append(line, static_cast<std::size_t>(n));
+  }
+  return out;
+}
+
+// The value most sessions declare (ties: the earliest session's).
+const DiffMetadata& MajorityRobot(const std::vector<DiffSession>& sessions) {
+  std::size_t best = 0;
+  int best_count = 0;
+  for (std::size_t i = 0; i < sessions.size(); ++i) {
+    int count = 0;
+    for (const DiffSession& s : sessions) count += s.metadata.SameRobotAs(sessions[i].metadata);
+    if (count > best_count) best = i, best_count = count;
+  }
+  return sessions[best].metadata;
+}
+
+RobotModelPtr NominalDiffDriveModel(const DiffMetadata& m) {
+  Robot robot = DiffDriveRobotDescription("optiodom_diff", {"right", "left"});
+  const double r_right = 0.5 * m.diameter_right_m, r_left = 0.5 * m.diameter_left_m;
+  robot.nominal = {r_right, r_left, m.separation_m};
+  // +-10 % around the nominal values: holds every value the sessions declare (b 0.2-0.205 m,
+  // D 0.084-0.085 m) and any physically plausible calibration of this robot.
+  const Interval radius{0.9 * std::min(r_right, r_left), 1.1 * std::max(r_right, r_left)};
+  robot.bounds = {radius, radius, {0.9 * m.separation_m, 1.1 * m.separation_m}};
+  robot.encoder = EncoderTicks{m.TicksPerWheelRev(), false};
+  return std::make_shared<DiffDriveModel>(std::move(robot));
+}
+
+// Mean over runs of the mean distance between odometry and ground truth at every row.
+double MeanTrackError(const RobotModelInterface& model, const std::vector<RunLog>& logs,
+                      const ChannelMapping& mapping) {
+  const std::vector<double>& p = model.robot().nominal;
+  double sum = 0.0;
+  for (const RunLog& log : logs) {
+    EncoderSamples mapped(2);
+    for (const auto& s : log.encoders.samples) {
+      mapped.push_back(s.dt_s, {mapping.sign[0] * s.value[mapping.column[0]],
+                                mapping.sign[1] * s.value[mapping.column[1]]});
+    }
+    double run_sum = 0.0;
+    const auto& gt = log.ground_truth.world_T_robot;
+    model.Replay(p.data(), mapped, 0, mapped.size(), gt.front(),
+                 [&](std::size_t k, const Pose2d& pose) {
+                   run_sum += std::hypot(pose.x - gt[k + 1].x, pose.y - gt[k + 1].y);
+                 });
+    sum += run_sum / static_cast<double>(mapped.size());
+  }
+  return sum / static_cast<double>(logs.size());
+}
+
+void CheckWheelMapping(const RobotModelInterface& model, const std::vector<RunLog>& logs,
+                       const ImportOptiOdomDiffOptions& options) {
+  const std::vector<ChannelMapping> mappings = model.CandidateMiswirings();
+  const double identity = MeanTrackError(model, logs, mappings.front());
+  for (std::size_t j = 1; j < mappings.size(); ++j) {
+    const double other = MeanTrackError(model, logs, mappings[j]);
+    if (other <= identity && !options.skip_mapping_check) {
+      throw std::runtime_error(
+          "the documented wheel order (ticks right, left; positive forward) does not explain the "
+          "ground truth best: mean track error " +
+          std::to_string(identity) + " m, miswiring " + std::to_string(j) + " " +
+          std::to_string(other) + " m; nothing written");
+    }
+  }
+  if (!options.quiet) {
+    std::printf(
+        "wheel order check: documented order mean track error %.4f m, every other "
+        "order/sign worse\n",
+        identity);
+  }
+}
+
+// The runs to write, session by session; notes sessions that declare other values and runs left
+// out.
+struct CollectedRuns {
+  std::vector<io::DatasetEntry> entries;
+  std::vector<const DiffRun*> sources;
+};
+
+CollectedRuns CollectRuns(const std::vector<DiffSession>& sessions, const DiffMetadata& robot,
+                          const ImportOptiOdomDiffOptions& options, const std::string& out_dir,
+                          OptiOdomDiffImportSummary* summary) {
+  const auto note = [&](const std::string& text) {
+    summary->notes.push_back(text);
+    if (!options.quiet) std::printf("%s\n", text.c_str());
+  };
+  CollectedRuns out;
+  std::set<std::string> ids;
+  for (const DiffSession& s : sessions) {
+    if (s.metadata.TicksPerWheelRev() != robot.TicksPerWheelRev()) {
+      throw InputError(
+          InputErrorKind::kBadValue, s.metadata_path, 0,
+          "ngear * encRes differs from the other sessions'; import one robot at a time");
+    }
+    if (!s.metadata.SameRobotAs(robot)) {
+      char text[256];
+      std::snprintf(text, sizeof text,
+                    "session %s/%s declares b = %g m, D = %g / %g m (the robot YAML keeps the "
+                    "majority's b = %g m, D = %g / %g m)",
+                    s.path_type.c_str(), s.name.c_str(), s.metadata.separation_m,
+                    s.metadata.diameter_right_m, s.metadata.diameter_left_m, robot.separation_m,
+                    robot.diameter_right_m, robot.diameter_left_m);
+      note(text);
+    }
+    for (const DiffRun& run : s.runs) {
+      RunLog log = DiffRunLog(s, run, robot.TicksPerWheelRev());
+      if (const FlaggedRun* flag = FindFlag(s, run.number)) {
+        note(std::string(options.include_flagged ? "imported " : "left out ") + log.id + ": " +
+             flag->reason);
+        if (!options.include_flagged) continue;
+      }
+      if (!ids.insert(log.id).second) {
+        throw InputError(InputErrorKind::kDuplicateRunId, out_dir, 0,
+                         "run " + log.id + " is imported twice");
+      }
+      io::DatasetEntry e;
+      e.id = log.id;
+      e.trajectory = log.trajectory;
+      e.repetition = log.repetition;
+      e.encoders = "runs/" + e.id + "_encoders.csv";
+      e.ground_truth = "runs/" + e.id + "_ground_truth.csv";
+      out.entries.push_back(e);
+      out.sources.push_back(&run);
+      summary->runs.push_back(std::move(log));
+    }
+  }
+  return out;
+}
+
+void WriteDiffDataset(const std::string& out_dir, const RobotModelInterface& model,
+                      const OptiOdomDiffImportSummary& summary, const CollectedRuns& runs) {
+  const fs::path out(out_dir);
+  fs::create_directories(out / "runs");
+  for (std::size_t i = 0; i < runs.entries.size(); ++i) {
+    io::WriteFileAtomically((out / runs.entries[i].encoders).string(), TicksCsv(*runs.sources[i]));
+    io::WriteFileAtomically((out / runs.entries[i].ground_truth).string(),
+                            io::GroundTruthCsv(summary.runs[i].ground_truth));
+  }
+  std::string header =
+      "# OptiOdom differential drive (Sousa et al. 2022, MIT licence), imported by fitcal\n";
+  for (const std::string& n : summary.notes) header += "# " + n + "\n";
+  io::WriteFileAtomically((out / "robot.yaml").string(),
+                          header + model.RobotYaml(model.robot().nominal, ""));
+  io::WriteFileAtomically((out / "dataset.yaml").string(),
+                          header + io::DatasetYaml("robot.yaml", runs.entries));
+}
+
+}  // namespace
+
+OptiOdomDiffImportSummary ImportOptiOdomDiff(const std::vector<std::string>& session_dirs,
+                                             const std::string& out_dir,
+                                             const ImportOptiOdomDiffOptions& options) {
+  if (session_dirs.empty()) {
+    throw std::invalid_argument("import needs at least one session directory");
+  }
+  if (fs::exists(fs::path(out_dir) / "dataset.yaml") && !options.force) {
+    throw std::runtime_error(out_dir + " already holds a data set (force to overwrite)");
+  }
+  // Read and check everything before writing anything.
+  std::vector<DiffSession> sessions;
+  for (const std::string& dir : session_dirs) sessions.push_back(ReadDiffSession(dir));
+  OptiOdomDiffImportSummary summary;
+  summary.num_sessions = static_cast<int>(sessions.size());
+  const DiffMetadata& robot = MajorityRobot(sessions);
+  summary.separation_m = robot.separation_m;
+  summary.diameter_right_m = robot.diameter_right_m;
+  summary.diameter_left_m = robot.diameter_left_m;
+  summary.ticks_per_rev = robot.TicksPerWheelRev();
+  const CollectedRuns runs = CollectRuns(sessions, robot, options, out_dir, &summary);
+  summary.num_runs = static_cast<int>(runs.entries.size());
+  const RobotModelPtr model = NominalDiffDriveModel(robot);
+  CheckWheelMapping(*model, summary.runs, options);
+  const FinalPoseErrors nominal =
+      EvaluateFinalPoseErrors(*model, model->robot().nominal, AlignRuns(summary.runs));
+  summary.nominal_cf = nominal.cf;
+  summary.nominal_mean_position_error_m = nominal.mean_position_error_m;
+  summary.nominal_mean_heading_error_rad = nominal.mean_abs_heading_error_rad;
+  WriteDiffDataset(out_dir, *model, summary, runs);
+  if (!options.quiet) {
+    std::printf(
+        "wrote %d runs of %d sessions to %s; nominal CF (Eq. 14) %.4f, mean final "
+        "position error %.4f m, heading %.3f deg\n",
+        summary.num_runs, summary.num_sessions, out_dir.c_str(), summary.nominal_cf,
+        summary.nominal_mean_position_error_m,
+        summary.nominal_mean_heading_error_rad * 180.0 / M_PI);
+  }
+  return summary;
+}
+
+}  // namespace fitcal::tools

@@ -1,0 +1,112 @@
+#pragma once
+// Simulated calibration runs of any robot model (models/model_interface.h): a trajectory is a
+// list of body twists held for given durations; the simulator turns it into what a recorder
+// would log (encoder channels, ground truth) for a robot whose true parameters are known.
+//
+// The motion and noise model:
+//
+// - Commanded twist. Segments follow each other with raised-cosine ramps of ramp_time_s centred
+//   on every segment boundary (also from rest into the first segment and back to rest after the
+//   last): v(t) = v_prev + (v_next - v_prev) (1 - cos(pi u)) / 2, u = (t - t_b + ramp/2) / ramp.
+//   Velocity and acceleration are continuous, and because the ramp is antisymmetric about the
+//   boundary every segment keeps the integral it was given: a segment of (v, omega) for T seconds
+//   still covers v T metres and omega T radians. Segments must last at least ramp_time_s. The
+//   run starts with rest_before_s and ends with rest_after_s at rest.
+// - The true robot follows the commanded twist exactly (as under a perfect tracking controller):
+//   its channel values are the model's inverse kinematics with the TRUE parameters,
+//   ChannelsForTwist(p_true, v(t)), evaluated on a fine time grid (steps of at most substep_s,
+//   refined so that every encoder and ground-truth time is a grid point) at each step's middle.
+//   A twist the model cannot drive (ChannelsForTwist false) is an error.
+// - Ground truth: the true model replayed on that fine grid (RobotModelInterface::Replay with
+//   p_true, piecewise-constant channel values), sampled every ground_truth_period_s, plus white
+//   Gaussian noise: gt_position_sigma_m per axis and gt_heading_sigma_rad.
+// - Encoders, every encoder_period_s (row 0 only sets the start time):
+//     wheel-rate channels: the true wheel angle advance over the interval (exact integral of the
+//       fine rates) plus white Gaussian noise of wheel_rate_sigma_rad_s * dt per interval (an
+//       encoder rate noise, independent per interval: the odometry's random walk); with
+//       ticks_per_rev[i] > 0 the accumulated measured angle is then counted in whole ticks
+//       (floor), so the quantisation error stays below one tick and does not accumulate; the log
+//       holds the mean rate over the interval (counted angle advance / dt).
+//     angle channels: the reading at each row time plus white Gaussian noise angle_sigma_rad; the
+//       interval value is the mean of the two readings (as the loader makes it, robot.h).
+// - Start pose: start_pose, moved by a uniform offset in +-start_position_range_m per axis and a
+//   uniform heading in [-pi, pi) when random_start_heading; recorded in RunLog::start_pose only
+//   when record_start_pose (otherwise the fit takes it from the noisy ground truth).
+// Reproducible: run i draws from its own generator seeded by (seed, i) with a hand-written
+// Box-Muller normal, so the output does not depend on the standard library or thread count.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "models/model_interface.h"
+#include "odometry/run_log.h"
+
+namespace fitcal::sim {
+
+struct TwistSegment {
+  Twist twist;
+  double duration_s = 0.0;
+};
+
+struct TrajectorySpec {
+  std::string label;  // the data set's trajectory label; repetitions share it
+  int repetition = 1;
+  std::vector<TwistSegment> segments;
+};
+
+struct SimulationOptions {
+  double encoder_period_s = 0.05;
+  double ground_truth_period_s = 0.1;
+  double substep_s = 0.002;  // longest step of the fine truth grid
+  double ramp_time_s = 0.4;
+  double rest_before_s = 0.5;
+  double rest_after_s = 0.5;
+
+  // Per channel (robot order): ticks per wheel revolution, 0 = no quantisation. Empty = none.
+  std::vector<double> ticks_per_rev;
+  double wheel_rate_sigma_rad_s = 0.0;
+  double angle_sigma_rad = 0.0;
+  double gt_position_sigma_m = 0.0;
+  double gt_heading_sigma_rad = 0.0;
+
+  Pose2d start_pose;
+  double start_position_range_m = 0.0;
+  bool random_start_heading = false;
+  bool record_start_pose = false;
+
+  std::uint64_t seed = 1;
+
+  // Empty when valid, else what is wrong.
+  std::string Check(int num_channels) const;
+};
+
+struct SimulatedRun {
+  RunLog log;  // what the loader hands over (interval values, robot channel order)
+  // What the recorder writes: the encoder CSV's channel columns (the robot's rate_column names,
+  // robot order) and one row per encoder time (wheel rates in rad/s over the interval ending at
+  // the row, 0 in row 0; angles as read at the row).
+  std::vector<std::string> encoder_columns;
+  std::vector<std::vector<double>> recorded;
+  Pose2d true_final_pose;  // noise-free truth at the last encoder time
+  Pose2d true_start_pose;
+};
+
+// One run per trajectory spec, in order. Ids are "<label>-rep<NN>". Throws std::invalid_argument
+// for invalid options, a segment shorter than the ramp, or a twist the model cannot drive.
+std::vector<SimulatedRun> SimulateRuns(const RobotModelInterface& model,
+                                       const std::vector<double>& true_parameters,
+                                       const std::vector<TrajectorySpec>& trajectories,
+                                       const SimulationOptions& options);
+
+// The encoder CSV of a run: header `t,<encoder_columns>`, then the recorded rows at full
+// precision (%.17g: the loader reads back the same doubles).
+std::string SimulatedEncoderCsv(const SimulatedRun& run);
+
+// Writes a data set: <dir>/dataset.yaml, <dir>/robot.yaml (robot_yaml_text as given) and
+// runs/<id>_encoders.csv, runs/<id>_ground_truth.csv per run, each file atomically. Creates the
+// directories; throws std::runtime_error when a file cannot be written.
+void WriteSimulatedDataset(const std::string& dir, const std::string& robot_yaml_text,
+                           const std::vector<SimulatedRun>& runs);
+
+}  // namespace fitcal::sim
