@@ -8,16 +8,10 @@
 #include <vector>
 
 #include "calib/aligned_run.h"
+#include "fit/final_pose_errors.h"
 #include "odometry/omni3_model.h"
 
 namespace fitcal {
-
-struct FinalPoseErrors {
-  double cf = 0.0;  // mean per-run CF (Eq. 14)
-  double mean_position_error_m = 0.0;
-  double mean_abs_heading_error_rad = 0.0;
-  std::vector<double> per_run_cf;
-};
 
 using Omni3ParameterArray = std::array<double, omni3::kNumParameters>;
 

@@ -11,16 +11,10 @@
 #include <ceres/autodiff_cost_function.h>
 
 #include "calib/aligned_run.h"
+#include "models/model_interface.h"
 #include "odometry/omni3_replay.h"
 
 namespace fitcal {
-
-// How metres and radians are weighed against each other in the objective. The paper's CF uses 1
-// and 1 (1 m counts like 1 rad); a sigma-whitened objective uses the ground truth's noise.
-struct ResidualWeights {
-  double position_sigma_m = 1.0;
-  double heading_sigma_rad = 1.0;
-};
 
 class Omni3FinalPoseResidual {
  public:

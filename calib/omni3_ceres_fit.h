@@ -15,48 +15,10 @@
 #include "calib/aligned_run.h"
 #include "calib/final_pose_cost.h"
 #include "calib/final_pose_residual.h"
+#include "fit/solver_options.h"
 #include "odometry/robot_description.h"
 
 namespace fitcal {
-
-// Ceres' trust-region strategy: Levenberg-Marquardt (default) or Powell's dogleg.
-enum class CeresTrustRegion { kLevenbergMarquardt, kDogleg };
-// Robust loss on a run's squared residual norm s = |r|^2 (Ceres convention rho(s)), scale in
-// the residual's (weighted) units: Huber is quadratic below the scale and linear above it,
-// Cauchy grows only logarithmically, so one run with wheel slip cannot drag the fit.
-enum class CeresRobustLoss { kNone, kHuber, kCauchy };
-// What is minimised over the runs i:
-//   kSumOfSquares  sum_i |r_i|^2 (default): smooth, Gauss-Newton converges fast, and the
-//                  covariance below is the Gaussian maximum-likelihood one;
-//   kSumOfNorms    sum_i |r_i|, exactly N times Palacin Eq. 14's CF, via the loss
-//                  rho(s) = 2 sqrt(s) on the squared norm (smoothed by 1e-9 at s = 0). It weighs
-//                  every run linearly (L1 over runs), so it is itself robust to an outlying run.
-enum class FinalPoseObjective { kSumOfSquares, kSumOfNorms };
-
-const char* ToString(CeresTrustRegion v);
-const char* ToString(CeresRobustLoss v);
-const char* ToString(FinalPoseObjective v);
-// Parse the names above ("lm"/"dogleg", "none"/"huber"/"cauchy", "squares"/"eq14"); false if
-// the text is none of them.
-bool ParseCeresTrustRegion(const std::string& text, CeresTrustRegion* out);
-bool ParseCeresRobustLoss(const std::string& text, CeresRobustLoss* out);
-bool ParseFinalPoseObjective(const std::string& text, FinalPoseObjective* out);
-
-struct CeresFitOptions {
-  ResidualWeights weights;  // default: 1 m counts like 1 rad, as the paper's CF
-  CeresTrustRegion trust_region = CeresTrustRegion::kLevenbergMarquardt;
-  FinalPoseObjective objective = FinalPoseObjective::kSumOfSquares;
-  CeresRobustLoss loss = CeresRobustLoss::kNone;  // only with kSumOfSquares
-  double loss_scale = 0.05;  // residual units (m and rad by default): ~5x the clean-run CF
-  int max_num_iterations = 100;
-  int num_threads = 0;  // 0 = all cores
-  double function_tolerance = 1e-12;
-  double gradient_tolerance = 1e-14;
-  double parameter_tolerance = 1e-12;
-  bool compute_covariance = true;
-
-  bool IsValid(std::string* error) const;
-};
 
 using Omni3Covariance = Eigen::Matrix<double, omni3::kNumParameters, omni3::kNumParameters>;
 

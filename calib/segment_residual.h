@@ -24,17 +24,10 @@
 
 #include "calib/aligned_run.h"
 #include "calib/final_pose_residual.h"
+#include "models/model_interface.h"
 #include "odometry/omni3_replay.h"
 
 namespace fitcal {
-
-// A window of an aligned run: samples [begin, end) and the ground truth's motion over it.
-struct Segment {
-  std::size_t begin = 0;
-  std::size_t end = 0;
-  Pose2d ground_truth_start_T_end;  // Q_i^-1 Q_j
-  double path_length_m = 0.0;       // ground-truth path length over the window
-};
 
 // The segments of one run, with the run they refer to (which must outlive the functor).
 struct SegmentedRun {

@@ -126,11 +126,14 @@ Dataset LoadDataset(const std::string& directory, const DatasetOptions& options)
 }
 
 Dataset LoadDataset(const DatasetIndex& index, const DatasetOptions& options) {
+  return LoadDataset(index, LegacyThreeWheelRobot(ReadEncoderTicks(index.robot_path)), options);
+}
+
+Dataset LoadDataset(const DatasetIndex& index, const Robot& robot, const DatasetOptions& options) {
   Dataset dataset;
   dataset.directory = index.directory;
   dataset.robot_path = index.robot_path;
   dataset.runs.resize(index.runs.size());
-  const std::optional<EncoderTicks> ticks = ReadEncoderTicks(index.robot_path);
   ParallelFor(index.runs.size(), options.num_threads, [&](std::size_t i) {
     const DatasetIndexEntry& entry = index.runs[i];
     RunLog& log = dataset.runs[i];
@@ -138,7 +141,7 @@ Dataset LoadDataset(const DatasetIndex& index, const DatasetOptions& options) {
     log.trajectory = entry.trajectory;
     log.repetition = entry.repetition;
     log.start_pose = entry.start_pose;
-    log.encoders = ReadEncoderCsv(entry.encoders_path, ticks);
+    log.encoders = ReadEncoderCsv(entry.encoders_path, robot);
     log.ground_truth = ReadGroundTruth(entry.ground_truth_path);
     CheckGroundTruthOverlap(log.ground_truth, log.encoders.t_s.front(), log.encoders.t_s.back(),
                             entry.ground_truth_path);
@@ -174,6 +177,22 @@ std::string EncoderCsv(const EncoderLog& log) {
                                : std::snprintf(line, sizeof line, "%.6f,%.9g,%.9g,%.9g\n",
                                                log.t_s[k], w[0], w[1], w[2]);
     out.append(line, static_cast<std::size_t>(n));
+  }
+  return out;
+}
+
+std::string EncoderCsv(const Robot& robot, const std::vector<double>& t_s,
+                       const std::vector<std::vector<double>>& rows) {
+  std::string out = "t";
+  for (const ChannelInfo& c : robot.channels) out += "," + c.rate_column;
+  out += "\n";
+  char field[64];
+  for (std::size_t k = 0; k < t_s.size(); ++k) {
+    out.append(field, static_cast<std::size_t>(std::snprintf(field, sizeof field, "%.6f", t_s[k])));
+    for (double v : rows[k]) {
+      out.append(field, static_cast<std::size_t>(std::snprintf(field, sizeof field, ",%.9g", v)));
+    }
+    out += "\n";
   }
   return out;
 }

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "models/robot.h"
 #include "odometry/run_log.h"
 
 namespace fitcal::io {
@@ -53,6 +54,9 @@ struct Dataset {
 Dataset LoadDataset(const std::string& directory, const DatasetOptions& options = {});
 // The same from an index already read (dataset.yaml is then parsed once).
 Dataset LoadDataset(const DatasetIndex& index, const DatasetOptions& options = {});
+// Any robot model: every run's encoder CSV read with the robot's channels (log_files.h).
+Dataset LoadDataset(const DatasetIndex& index, const Robot& robot,
+                    const DatasetOptions& options = {});
 
 // One run as dataset.yaml lists it; used by writers (the simulator, importers).
 struct DatasetEntry {
@@ -65,6 +69,11 @@ struct DatasetEntry {
 
 std::string DatasetYaml(const std::string& robot_path, const std::vector<DatasetEntry>& runs);
 std::string EncoderCsv(const EncoderLog& log);
+// Any robot: header `t,<rate column per channel>`, then one row per time with what the CSV
+// holds per channel (rates over the interval ending at the row, angle readings at the row time;
+// row 0 sets the start, its rates are ignored).
+std::string EncoderCsv(const Robot& robot, const std::vector<double>& t_s,
+                       const std::vector<std::vector<double>>& rows);
 std::string GroundTruthCsv(const GroundTruthTrack& track);
 
 }  // namespace fitcal::io

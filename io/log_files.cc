@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstring>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 #include "io/input_error.h"
 #include "io/text_file.h"
@@ -13,7 +15,7 @@ namespace fitcal::io {
 
 namespace {
 
-constexpr int kMaxColumns = 8;
+constexpr int kMaxColumns = 1 + kMaxChannels;
 
 // Splits `line` at `separator` (or at runs of blanks when separator is ' ') into exactly n
 // numbers; throws with the file, the line and the offending field otherwise.
@@ -121,61 +123,191 @@ std::size_t CountLines(std::string_view text) {
 
 }  // namespace
 
-EncoderLog ReadEncoderCsv(const std::string& path, const std::optional<EncoderTicks>& ticks) {
+namespace {
+
+// Which channel each CSV column (after t) carries, and whether it holds ticks. Columns are
+// matched by name (ChannelInfo::rate_column / ticks_column); a header of the legacy positional
+// form `t,w_a,w_b,w_c` (or ticks_a..) is accepted for three-channel robots whatever their wheel
+// names, as fitcal always read it.
+struct ColumnPlan {
+  std::vector<int> channel_of_column;
+  std::vector<bool> ticks;
+  bool any_ticks = false;
+};
+
+std::vector<std::string> SplitHeader(std::string_view line) {
+  std::vector<std::string> out;
+  std::size_t pos = 0;
+  while (pos <= line.size()) {
+    std::size_t end = line.find(',', pos);
+    if (end == std::string_view::npos) end = line.size();
+    out.emplace_back(Trim(line.substr(pos, end - pos)));
+    pos = end + 1;
+  }
+  return out;
+}
+
+std::string ExpectedHeader(const Robot& robot) {
+  std::string out = "t";
+  for (const ChannelInfo& c : robot.channels) {
+    out += "," + c.rate_column;
+    if (!c.ticks_column.empty()) out += "|" + c.ticks_column;
+  }
+  return out;
+}
+
+bool MatchLegacyHeader(const std::vector<std::string>& names, const Robot& robot,
+                       ColumnPlan* plan) {
+  if (robot.NumChannels() != 3 || names.size() != 4) return false;
+  static const char* kLegacy[2][3] = {{"w_a", "w_b", "w_c"}, {"ticks_a", "ticks_b", "ticks_c"}};
+  for (int kind = 0; kind < 2; ++kind) {
+    bool match = true;
+    for (int i = 0; i < 3; ++i) match = match && names[i + 1] == kLegacy[kind][i];
+    if (!match) continue;
+    plan->channel_of_column = {0, 1, 2};
+    plan->ticks.assign(3, kind == 1);
+    plan->any_ticks = kind == 1;
+    return true;
+  }
+  return false;
+}
+
+ColumnPlan PlanColumns(std::string_view header, const Robot& robot, const std::string& path) {
+  const std::vector<std::string> names = SplitHeader(header);
+  const auto bad_header = [&](const std::string& why) {
+    return InputError(InputErrorKind::kBadHeader, path, 1,
+                      why + "; header must be '" + ExpectedHeader(robot) + "'");
+  };
+  if (names.empty() || names[0] != "t") throw bad_header("the first column must be 't'");
+  ColumnPlan plan;
+  if (MatchLegacyHeader(names, robot, &plan)) return plan;
+  std::vector<bool> seen(robot.channels.size(), false);
+  for (std::size_t col = 1; col < names.size(); ++col) {
+    int found = -1;
+    bool ticks = false;
+    for (int c = 0; c < robot.NumChannels(); ++c) {
+      const ChannelInfo& info = robot.channels[c];
+      if (names[col] == info.rate_column ||
+          (!info.ticks_column.empty() && names[col] == info.ticks_column)) {
+        found = c;
+        ticks = names[col] == info.ticks_column;
+      }
+    }
+    if (found < 0)
+      throw bad_header("column '" + names[col].substr(0, 40) + "' is no channel of the robot");
+    if (seen[found]) throw bad_header("channel '" + robot.channels[found].name + "' appears twice");
+    seen[found] = true;
+    plan.channel_of_column.push_back(found);
+    plan.ticks.push_back(ticks);
+    plan.any_ticks = plan.any_ticks || ticks;
+  }
+  for (int c = 0; c < robot.NumChannels(); ++c) {
+    if (!seen[c]) throw bad_header("channel '" + robot.channels[c].name + "' is missing");
+  }
+  return plan;
+}
+
+}  // namespace
+
+EncoderRowConverter::EncoderRowConverter(const Robot& robot, std::vector<int> channel_of_column,
+                                         std::vector<bool> ticks_column)
+    : robot_(robot),
+      channel_of_column_(std::move(channel_of_column)),
+      ticks_column_(std::move(ticks_column)),
+      previous_(channel_of_column_.size(), 0.0) {
+  log_.samples = EncoderSamples(robot.NumChannels());
+  for (bool t : ticks_column_) any_ticks_ = any_ticks_ || t;
+  if (any_ticks_ && robot.encoder) {
+    rad_per_tick_ = 2.0 * M_PI / robot.encoder->ticks_per_rev;
+    cumulative_ = robot.encoder->cumulative;
+  }
+}
+
+namespace {
+std::vector<int> Identity(int n) {
+  std::vector<int> out(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) out[static_cast<std::size_t>(i)] = i;
+  return out;
+}
+}  // namespace
+
+EncoderRowConverter::EncoderRowConverter(const Robot& robot)
+    : EncoderRowConverter(robot, Identity(robot.NumChannels()),
+                          std::vector<bool>(robot.channels.size(), false)) {}
+
+void EncoderRowConverter::Add(double t_s, const double* row) {
+  const std::size_t n = channel_of_column_.size();
+  if (!log_.t_s.empty()) {
+    const double dt = t_s - log_.t_s.back();
+    double values[kMaxChannels];
+    for (std::size_t j = 0; j < n; ++j) {
+      const int c = channel_of_column_[j];
+      if (ticks_column_[j]) {
+        const double dticks = cumulative_ ? row[j] - previous_[j] : row[j];
+        values[c] = rad_per_tick_ * dticks / dt;
+      } else if (robot_.channels[c].kind == ChannelKind::kAngle) {
+        values[c] = 0.5 * (previous_[j] + row[j]);  // mean over the interval (robot.h)
+      } else {
+        values[c] = row[j];
+      }
+    }
+    log_.samples.push_back(dt, values);
+  }
+  for (std::size_t j = 0; j < n; ++j) previous_[j] = row[j];
+  log_.t_s.push_back(t_s);
+}
+
+EncoderLog ReadEncoderCsv(const std::string& path, const Robot& robot) {
   const std::string text = ReadTextFile(path);
   LineScanner lines(text);
   std::string_view line;
   if (!lines.Next(&line) || IsBlank(line)) {
     throw InputError(InputErrorKind::kEmptyFile, path, 1,
-                     "empty file (expected header 't,w_a,w_b,w_c' or 't,ticks_a,ticks_b,ticks_c')");
+                     "empty file (expected header '" + ExpectedHeader(robot) + "')");
   }
-  const bool in_ticks = Trim(line).substr(0, 8) == "t,ticks_";
-  if (in_ticks) {
-    ExpectHeader(line, {"t", "ticks_a", "ticks_b", "ticks_c"}, path, lines.line_number());
-    if (!ticks || !(ticks->ticks_per_rev > 0.0)) {
-      throw InputError(InputErrorKind::kBadHeader, path, lines.line_number(),
-                       "encoder ticks need 'encoder: {ticks_per_rev: N, cumulative: false|true}' "
-                       "in the robot YAML");
-    }
-  } else {
-    ExpectHeader(line, {"t", "w_a", "w_b", "w_c"}, path, lines.line_number());
+  const ColumnPlan plan = PlanColumns(line, robot, path);
+  if (plan.any_ticks && !(robot.encoder && robot.encoder->ticks_per_rev > 0.0)) {
+    throw InputError(InputErrorKind::kBadHeader, path, lines.line_number(),
+                     "encoder ticks need 'encoder: {ticks_per_rev: N, cumulative: false|true}' "
+                     "in the robot YAML");
   }
-  const double rad_per_tick = in_ticks ? 2.0 * M_PI / ticks->ticks_per_rev : 0.0;
-  const bool cumulative = in_ticks && ticks->cumulative;
-  double previous_count[3] = {0.0, 0.0, 0.0};
-  EncoderLog log;
-  // Reserve exactly once (one row per line; memchr-speed count) so that a large log holds 40
-  // bytes per sample (t + a 32-byte sample row) and is never copied while growing.
-  const std::size_t rows = CountLines(text);
-  log.t_s.reserve(rows);
-  log.samples.reserve(rows);
+  const int num_columns = 1 + robot.NumChannels();
+  EncoderRowConverter converter(robot, plan.channel_of_column, plan.ticks);
+  // Reserve exactly once (one row per line; memchr-speed count) so that a large log holds its
+  // samples (8 bytes of time + one row) and is never copied while growing.
+  converter.Reserve(CountLines(text));
   double row[kMaxColumns];
+  double previous_t = 0.0;
+  bool first = true;
   while (lines.Next(&line)) {
     if (IsBlank(line)) continue;
-    ParseRow(line, ',', 4, path, lines.line_number(), row);
-    if (!log.t_s.empty()) {
-      CheckIncreasing(log.t_s.back(), row[0], path, lines.line_number());
-      const double dt = row[0] - log.t_s.back();
-      double values[3];
-      for (int i = 0; i < 3; ++i) {
-        if (!in_ticks) {
-          values[i] = row[1 + i];
-        } else {
-          const double dticks = cumulative ? row[1 + i] - previous_count[i] : row[1 + i];
-          values[i] = rad_per_tick * dticks / dt;
-        }
-      }
-      log.samples.push_back(dt, values);
-    }
-    for (int i = 0; i < 3; ++i) previous_count[i] = row[1 + i];
-    log.t_s.push_back(row[0]);
+    ParseRow(line, ',', num_columns, path, lines.line_number(), row);
+    if (!first) CheckIncreasing(previous_t, row[0], path, lines.line_number());
+    converter.Add(row[0], row + 1);
+    previous_t = row[0];
+    first = false;
   }
+  EncoderLog log = converter.Take();
   if (log.t_s.size() < 2) {
     throw InputError(InputErrorKind::kTooFewSamples, path, 0,
                      "needs at least two rows (a start time and one interval), found " +
                          std::to_string(log.t_s.size()));
   }
   return log;
+}
+
+Robot LegacyThreeWheelRobot(const std::optional<EncoderTicks>& ticks) {
+  Robot robot;
+  for (const char* w : {"a", "b", "c"}) {
+    robot.channels.push_back(
+        {w, ChannelKind::kWheelRate, std::string("w_") + w, std::string("ticks_") + w});
+  }
+  robot.encoder = ticks;
+  return robot;
+}
+
+EncoderLog ReadEncoderCsv(const std::string& path, const std::optional<EncoderTicks>& ticks) {
+  return ReadEncoderCsv(path, LegacyThreeWheelRobot(ticks));
 }
 
 GroundTruthTrack ReadGroundTruth(const std::string& path) {

@@ -3,8 +3,9 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
-#include "odometry/robot_description.h"
+#include "models/robot.h"
 #include "odometry/run_log.h"
 
 namespace fitcal::io {
@@ -15,8 +16,44 @@ namespace fitcal::io {
 // `encoder:` block). Increments: row k holds the ticks counted over (t(k-1), t(k)] and row 0's
 // are ignored (counted before the start); cumulative: running totals, row 0 is the reference.
 // Either way w_i(k) = 2 pi dticks_i(k) / (ticks_per_rev dt(k)).
+// Any robot (models/robot.h): header `t,<column per channel>`, each channel's rate (or angle)
+// column or its ticks column, in any order, matched by name; angle channels hold the reading at
+// the row time and become the mean over each interval. A three-channel robot also accepts the
+// positional legacy header above whatever its wheel names.
+EncoderLog ReadEncoderCsv(const std::string& path, const Robot& robot);
+// The legacy three-wheel form: channels a, b, c.
 EncoderLog ReadEncoderCsv(const std::string& path,
                           const std::optional<EncoderTicks>& ticks = std::nullopt);
+Robot LegacyThreeWheelRobot(const std::optional<EncoderTicks>& ticks);
+
+// Turns encoder CSV rows (as written: per channel a rate, an angle reading at the row time, or
+// ticks) into the interval samples of an EncoderLog, one row at a time; shared by the reader and
+// by anything that produces rows in memory (simulators, importers, bag readers).
+class EncoderRowConverter {
+ public:
+  // channel_of_column[j]: which robot channel column j holds; ticks_column[j]: in ticks.
+  EncoderRowConverter(const Robot& robot, std::vector<int> channel_of_column,
+                      std::vector<bool> ticks_column);
+  // A converter for rows in the robot's channel order, no ticks.
+  explicit EncoderRowConverter(const Robot& robot);
+  void Reserve(std::size_t rows) {
+    log_.t_s.reserve(rows);
+    log_.samples.reserve(rows);
+  }
+  // t_s must increase (checked by the caller); row holds one value per column.
+  void Add(double t_s, const double* row);
+  EncoderLog Take() { return std::move(log_); }
+
+ private:
+  const Robot& robot_;
+  std::vector<int> channel_of_column_;
+  std::vector<bool> ticks_column_;
+  std::vector<double> previous_;
+  bool any_ticks_ = false;
+  double rad_per_tick_ = 0.0;
+  bool cumulative_ = false;
+  EncoderLog log_;
+};
 
 // Ground truth: CSV with header `t,x,y,theta` (s, m, m, rad), or a TUM trajectory
 // (`t x y z qx qy qz qw`, blank-separated, '#' comments) whose yaw is taken from the quaternion.

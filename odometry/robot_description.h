@@ -7,29 +7,16 @@
 #include <string>
 #include <vector>
 
+#include "models/robot.h"
 #include "odometry/effects.h"
 #include "odometry/omni3_model.h"
 
 namespace fitcal {
 
-struct Interval {
-  double lo = 0.0;
-  double hi = 0.0;
-  bool Contains(double v) const { return v >= lo && v <= hi; }
-};
-
 struct Omni3Bounds {
   Interval distance_m;        // absolute bounds on every R_i
   Interval radius_m;          // absolute bounds on every r_i
   Interval angle_offset_rad;  // bounds on delta_i - nominal delta_i (Eq. 16)
-};
-
-// How the encoders count, when the logs hold ticks instead of wheel rates (robot YAML `encoder:`):
-// ticks per wheel revolution (gear ratio x counts per motor revolution) and whether the log holds
-// running totals (cumulative) or increments since the previous row.
-struct EncoderTicks {
-  double ticks_per_rev = 0.0;
-  bool cumulative = false;
 };
 
 struct Omni3Robot {

@@ -21,9 +21,11 @@
 #include "io/input_error.h"
 #include "io/robot_yaml.h"
 #include "io/yaml_reader.h"
+#include "models/model_registry.h"
 #include "odometry/effects.h"
 #include "tools/asoc_commands.h"
 #include "tools/fit_methods.h"
+#include "tools/model_fit_command.h"
 #include "tools/output_guard.h"
 #include "tools/sim/flower_candidates.h"
 
@@ -60,6 +62,7 @@ double Seconds(std::chrono::steady_clock::time_point since) {
 // is unknown or a value out of range.
 bool MakeFitMethodSettings(const FitCommandOptions& o, FitMethodSettings* s, std::string* error) {
   s->threads = o.threads;
+  s->max_iterations = o.max_iterations;
   s->weights.position_sigma_m = o.position_sigma_m;
   s->weights.heading_sigma_rad = o.heading_sigma_deg * M_PI / 180.0;
   s->objective_set = !o.objective.empty();
@@ -130,7 +133,13 @@ int RunFitCommand(const FitCommandOptions& options) {
     dataset_options.num_threads = options.threads;
     // ASOC robots (issue 5) have their own encoder format and fit (tools/asoc_commands.h).
     const io::DatasetIndex index = io::ReadDatasetIndex(options.logs, dataset_options);
-    if (io::ReadRobotModel(index.robot_path) == "asoc") return RunAsocFit(options);
+    const std::string model_name = io::ReadRobotModel(index.robot_path);
+    if (model_name == "asoc") return RunAsocFit(options);
+    // Every model on the seam except omni3, whose fit (with its NLopt methods and fast kernel)
+    // still has its own path below.
+    if (model_name != "omni3") {
+      return RunModelFitCommand(options, index, ReadRobotModelFile(index.robot_path));
+    }
     const io::Dataset dataset = io::LoadDataset(index, dataset_options);
     io::StopHereForTests("loaded");
     const std::string model = io::ReadRobotModel(dataset.robot_path);

@@ -24,6 +24,7 @@ struct FitCommandOptions {
   double loss_scale = 0.05;     // Ceres robust loss scale, residual units
   unsigned long seed = 1;       // NLopt
   int max_evaluations = 20000;  // NLopt
+  int max_iterations = 100;     // Ceres iterations per solve
   bool polish = false;          // NLopt global methods: SLSQP polish of the best point
 };
 

@@ -20,6 +20,7 @@ FitMethodOutcome RunCeres(CeresTrustRegion trust_region, const std::vector<Align
                           const Omni3Robot& robot, const FitMethodSettings& settings) {
   CeresFitOptions options;
   options.num_threads = settings.threads;
+  options.max_num_iterations = settings.max_iterations;
   options.weights = settings.weights;
   options.trust_region = trust_region;
   if (settings.objective_set) options.objective = settings.objective;

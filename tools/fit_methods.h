@@ -16,6 +16,7 @@ namespace fitcal::tools {
 // Settings a caller may change for any method; each method uses the ones that apply to it.
 struct FitMethodSettings {
   int threads = 0;
+  int max_iterations = 100;  // Ceres iterations per solve
   ResidualWeights weights;
   // Ceres: kSumOfSquares by default; NLopt: Eq. 14 by default (see the option docs).
   bool objective_set = false;

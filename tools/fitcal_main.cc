@@ -34,6 +34,9 @@ void AddFitOptions(CLI::App& app, fitcal::tools::FitCommandOptions& o) {
       ->capture_default_str();
   app.add_option("--max-evaluations", o.max_evaluations, "NLopt evaluation budget")
       ->capture_default_str();
+  app.add_option("--max-iterations", o.max_iterations, "Ceres iterations per solve")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_flag("--polish", o.polish,
                "NLopt global methods: polish the best point with SLSQP (autodiff gradient)");
   app.add_option("--train-reps", o.train_reps,

@@ -1,0 +1,241 @@
+#include "fit/model_fit.h"
+
+#include <ceres/ceres.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+
+#include "calib/dense_solver_options.h"
+
+namespace fitcal {
+
+namespace {
+
+constexpr int kMaxActiveSetRounds = 8;
+
+// One Ceres problem over the training runs with the parameters in `fixed` held constant.
+class FitProblem {
+ public:
+  FitProblem(const std::vector<AlignedRun>& training, const RobotModelInterface& model,
+             const ModelFitOptions& fit_options, const std::vector<bool>& fixed, double* p) {
+    const CeresFitOptions& options = fit_options.ceres;
+    ceres::Problem::Options problem_options;
+    problem_options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+    problem_ = std::make_unique<ceres::Problem>(problem_options);
+    for (std::size_t i = 0; i < training.size(); ++i) {
+      const AlignedRun& run = training[i];
+      if (fit_options.segments == nullptr) {
+        problem_->AddResidualBlock(model.FinalPoseCost(run, options.weights), MakeLoss(options), p);
+      } else if (!(*fit_options.segments)[i].empty()) {
+        problem_->AddResidualBlock(
+            model.SegmentCost(run, (*fit_options.segments)[i], options.weights), nullptr, p);
+      }
+    }
+    const Robot& robot = model.robot();
+    const int n = robot.NumParameters();
+    std::vector<int> constant;
+    for (int k = 0; k < n; ++k) {
+      if (fixed[k]) constant.push_back(k);
+    }
+    if (static_cast<int>(constant.size()) == n) {
+      problem_->SetParameterBlockConstant(p);
+    } else if (!constant.empty()) {
+      problem_->SetManifold(p, new ceres::SubsetManifold(n, constant));
+    }
+    for (int k = 0; k < n; ++k) {
+      problem_->SetParameterLowerBound(p, k, robot.bounds[k].lo);
+      problem_->SetParameterUpperBound(p, k, robot.bounds[k].hi);
+    }
+  }
+
+  ceres::Problem& problem() { return *problem_; }
+
+  // Gradient of the (loss-shaped) cost with respect to every parameter.
+  std::vector<double> FullGradient() {
+    double cost = 0.0;
+    std::vector<double> gradient;
+    problem_->Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, &gradient, nullptr);
+    return gradient;
+  }
+
+ private:
+  std::unique_ptr<ceres::Problem> problem_;
+};
+
+ceres::Solver::Options SolverOptionsFor(const CeresFitOptions& options) {
+  DenseSolverTolerances tolerances;
+  tolerances.function = options.function_tolerance;
+  tolerances.gradient = options.gradient_tolerance;
+  tolerances.parameter = options.parameter_tolerance;
+  ceres::Solver::Options solver_options =
+      DenseSolverOptions(options.max_num_iterations, options.num_threads, tolerances);
+  solver_options.trust_region_strategy_type = options.trust_region == CeresTrustRegion::kDogleg
+                                                  ? ceres::DOGLEG
+                                                  : ceres::LEVENBERG_MARQUARDT;
+  return solver_options;
+}
+
+void Accumulate(const ceres::Solver::Summary& summary, ModelFitResult* result) {
+  result->termination = ceres::TerminationTypeToString(summary.termination_type);
+  result->message = summary.message;
+  result->iterations += static_cast<int>(summary.iterations.size());
+  result->num_residual_evaluations += summary.num_residual_evaluations;
+  result->num_jacobian_evaluations += summary.num_jacobian_evaluations;
+  result->final_cost = summary.final_cost;
+}
+
+// A parameter within a part per million of the box width of a bound is on it.
+std::vector<bool> AtBound(const Robot& robot, const std::vector<double>& p) {
+  std::vector<bool> out(p.size(), false);
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    const double tol = 1e-6 * robot.bounds[k].Width();
+    out[k] = p[k] <= robot.bounds[k].lo + tol || p[k] >= robot.bounds[k].hi - tol;
+  }
+  return out;
+}
+
+// Active-set rounds after a bounded solve that did not converge (header comment). Returns the
+// last solve's summary.
+ceres::Solver::Summary RefineWithActiveSet(const std::vector<AlignedRun>& training,
+                                           const RobotModelInterface& model,
+                                           const ModelFitOptions& options,
+                                           ceres::Solver::Summary summary, ModelFitResult* result) {
+  const Robot& robot = model.robot();
+  const int n = robot.NumParameters();
+  std::vector<double>& p = result->parameters;
+  std::vector<bool> fixed = result->held;
+  const std::vector<bool> on_bound = AtBound(robot, p);
+  for (int k = 0; k < n; ++k) {
+    if (!on_bound[k]) continue;
+    fixed[k] = true;
+    p[k] = p[k] - robot.bounds[k].lo < robot.bounds[k].hi - p[k] ? robot.bounds[k].lo
+                                                                 : robot.bounds[k].hi;
+  }
+  for (int round = 0; round < kMaxActiveSetRounds; ++round) {
+    ++result->active_set_rounds;
+    FitProblem fit(training, model, options, fixed, p.data());
+    ceres::Solve(SolverOptionsFor(options.ceres), &fit.problem(), &summary);
+    Accumulate(summary, result);
+    if (summary.termination_type != ceres::CONVERGENCE) break;
+    // Release a bound parameter whose descent direction points into the box.
+    FitProblem all_free(training, model, options, result->held, p.data());
+    const std::vector<double> g = all_free.FullGradient();
+    bool released = false;
+    for (int k = 0; k < n; ++k) {
+      if (!fixed[k] || result->held[k]) continue;
+      const bool at_lo = p[k] <= robot.bounds[k].lo;
+      if ((at_lo && g[k] < 0.0) || (!at_lo && g[k] > 0.0)) {
+        fixed[k] = false;
+        released = true;
+      }
+    }
+    if (!released) break;
+  }
+  return summary;
+}
+
+void ComputeCovariance(const std::vector<AlignedRun>& training, const RobotModelInterface& model,
+                       const ModelFitOptions& options, ModelFitResult* result) {
+  const int n = model.robot().NumParameters();
+  const int num_free =
+      n - static_cast<int>(std::count(result->held.begin(), result->held.end(), true));
+  int num_residuals = 3 * static_cast<int>(training.size());
+  if (options.segments != nullptr) {
+    num_residuals = 0;
+    for (const auto& windows : *options.segments)
+      num_residuals += 3 * static_cast<int>(windows.size());
+  }
+  const int dof = num_residuals - num_free;
+  if (!result->usable || dof <= 0) {
+    result->covariance_message = dof <= 0 ? "too few runs for a covariance (need more than " +
+                                                std::to_string(num_free / 3) + ")"
+                                          : "no covariance: the fit is not usable";
+    return;
+  }
+  std::vector<double> p = result->parameters;
+  FitProblem fit(training, model, options, result->held, p.data());
+  // s^2 from the plain sum of squares, whatever loss shaped the objective.
+  double sum_of_squares_half = 0.0;
+  ceres::Problem::EvaluateOptions evaluate_options;
+  evaluate_options.apply_loss_function = false;
+  fit.problem().Evaluate(evaluate_options, &sum_of_squares_half, nullptr, nullptr, nullptr);
+  result->residual_sigma = std::sqrt(2.0 * sum_of_squares_half / dof);
+  ceres::Covariance::Options cov_options;
+  cov_options.algorithm_type = ceres::DENSE_SVD;
+  cov_options.num_threads = SolverOptionsFor(options.ceres).num_threads;
+  ceres::Covariance covariance(cov_options);
+  const std::vector<std::pair<const double*, const double*>> blocks = {{p.data(), p.data()}};
+  if (!covariance.Compute(blocks, &fit.problem())) {
+    result->covariance_message =
+        "covariance is rank deficient: the runs cannot determine all free parameters";
+    return;
+  }
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> raw(n, n);
+  covariance.GetCovarianceBlock(p.data(), p.data(), raw.data());
+  const double s2 = result->residual_sigma * result->residual_sigma;
+  result->covariance = s2 * raw;
+  result->sigma.assign(n, 0.0);
+  for (int k = 0; k < n; ++k) result->sigma[k] = std::sqrt(std::max(0.0, result->covariance(k, k)));
+  result->correlation = Eigen::MatrixXd::Identity(n, n);
+  for (int r = 0; r < n; ++r) {
+    for (int c = 0; c < n; ++c) {
+      const double d = result->sigma[r] * result->sigma[c];
+      if (d > 0.0) result->correlation(r, c) = result->covariance(r, c) / d;
+    }
+  }
+  result->has_covariance = true;
+}
+
+}  // namespace
+
+ModelFitResult FitModelFrom(const std::vector<AlignedRun>& training,
+                            const RobotModelInterface& model, const std::vector<double>& start,
+                            const ModelFitOptions& options) {
+  std::string error;
+  if (!options.ceres.IsValid(&error)) throw std::invalid_argument("CeresFitOptions: " + error);
+  if (training.empty()) throw std::invalid_argument("FitModel: no training runs");
+  if (options.segments != nullptr && options.segments->size() != training.size()) {
+    throw std::invalid_argument("FitModel: not one window list per training run");
+  }
+  const Robot& robot = model.robot();
+  const int n = robot.NumParameters();
+  if (static_cast<int>(start.size()) != n) throw std::invalid_argument("FitModel: bad start");
+
+  ModelFitResult result;
+  result.parameters = start;
+  result.held.assign(n, false);
+  for (const HeldParameter& h : robot.held) {
+    result.held[h.index] = true;
+    result.parameters[h.index] = robot.nominal[h.index];
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  ceres::Solver::Summary summary;
+  {
+    FitProblem fit(training, model, options, result.held, result.parameters.data());
+    ceres::Solve(SolverOptionsFor(options.ceres), &fit.problem(), &summary);
+  }
+  result.initial_cost = summary.initial_cost;
+  Accumulate(summary, &result);
+  const bool converged = summary.termination_type == ceres::CONVERGENCE;
+  if (!converged && options.active_set_bounds) {
+    summary = RefineWithActiveSet(training, model, options, summary, &result);
+  }
+  result.solve_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  bool finite = true;
+  for (double v : result.parameters) finite = finite && std::isfinite(v);
+  result.at_bound = AtBound(robot, result.parameters);
+  result.usable = finite && summary.termination_type == ceres::CONVERGENCE;
+  if (options.ceres.compute_covariance) ComputeCovariance(training, model, options, &result);
+  return result;
+}
+
+ModelFitResult FitModel(const std::vector<AlignedRun>& training, const RobotModelInterface& model,
+                        const ModelFitOptions& options) {
+  return FitModelFrom(training, model, model.robot().nominal, options);
+}
+
+}  // namespace fitcal

@@ -1,0 +1,73 @@
+#pragma once
+// Fits a robot model's parameters to the final poses of a set of runs with Ceres (Palacin
+// Sec. 2.6 for omni3, the same for every model): one residual block per run (the model's
+// FinalPoseCost, fit/pose_errors.h), autodiff through the replay, started from the robot's
+// nominal parameters (Palacin Eq. 15) and bounded by its box (Eq. 16). Parameters the model
+// holds by construction (Robot::held, gauge) stay at their nominal values.
+//
+// Bounds by an active set. Ceres' bounded Levenberg-Marquardt projects each step onto the box;
+// when the minimum lies outside the box, a parameter rests on its bound and the projected steps
+// keep shrinking without meeting Ceres' convergence tests, so the solve ends NO_CONVERGENCE at a
+// perfectly good constrained minimum. The fit therefore (1) solves with bounds; (2) if that did
+// not converge, fixes every parameter resting on a bound at that bound, and re-solves the rest;
+// (3) releases a fixed parameter whose gradient points into the box (moving it inward would
+// lower the cost: it was not a constrained minimum for it) and repeats, at most
+// kMaxActiveSetRounds times. The result is the Karush-Kuhn-Tucker point of the box problem.
+//
+// Uncertainty: the Ceres covariance of the free parameters scaled by the residual variance
+// s^2 = |r|^2 / (3 N - n_free). Parameters at a bound are flagged; their sigma then describes
+// the unconstrained problem only.
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "calib/aligned_run.h"
+#include "fit/solver_options.h"
+#include "models/model_interface.h"
+
+namespace fitcal {
+
+struct ModelFitResult {
+  bool usable = false;      // converged to finite parameters; check before using them
+  std::string termination;  // Ceres termination type of the last solve, e.g. CONVERGENCE
+  std::string message;      // Ceres' reason for stopping
+  int iterations = 0;       // over all active-set rounds
+  int num_residual_evaluations = 0;
+  int num_jacobian_evaluations = 0;
+  int active_set_rounds = 0;  // solves after the first (0: the plain bounded solve converged)
+  double solve_time_s = 0.0;
+  double initial_cost = 0.0;  // Ceres cost: 0.5 sum |r|^2 (under the objective's loss)
+  double final_cost = 0.0;
+  std::vector<double> parameters;
+  std::vector<bool> at_bound;
+  std::vector<bool> held;  // held at nominal (gauge)
+
+  bool has_covariance = false;
+  std::string covariance_message;
+  double residual_sigma = 0.0;  // sqrt(|r|^2 / (3 N - n_free)), in the objective's units
+  Eigen::MatrixXd covariance;   // n x n, zero rows/columns for held parameters
+  std::vector<double> sigma;
+  Eigen::MatrixXd correlation;
+};
+
+struct ModelFitOptions {
+  CeresFitOptions ceres;
+  // When set, one window list per training run: the fit minimises the segment residuals
+  // (relative pose error over windows, fit/pose_errors.h) instead of the final poses.
+  const std::vector<std::vector<Segment>>* segments = nullptr;
+  // Use the active set above (false: one plain bounded Ceres solve, as before; kept for tests
+  // that show the difference).
+  bool active_set_bounds = true;
+};
+
+// Throws std::invalid_argument for invalid options or no runs.
+ModelFitResult FitModel(const std::vector<AlignedRun>& training, const RobotModelInterface& model,
+                        const ModelFitOptions& options = {});
+
+// The same started from `start` instead of the robot's nominal (e.g. a closed-form calibration).
+ModelFitResult FitModelFrom(const std::vector<AlignedRun>& training,
+                            const RobotModelInterface& model, const std::vector<double>& start,
+                            const ModelFitOptions& options = {});
+
+}  // namespace fitcal

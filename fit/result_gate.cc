@@ -1,0 +1,57 @@
+#include "fit/result_gate.h"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+
+#include "fit/final_pose_errors.h"
+
+namespace fitcal {
+
+GateDecision SelectCalibration(const RobotModelInterface& model,
+                               const std::vector<CalibrationCandidate>& candidates,
+                               const std::vector<AlignedRun>& training,
+                               const std::vector<AlignedRun>& validation, int num_threads) {
+  if (candidates.empty()) throw std::invalid_argument("SelectCalibration: no candidates");
+  GateDecision decision;
+  decision.judged_on_held_out = !validation.empty();
+  const std::vector<AlignedRun>& runs = decision.judged_on_held_out ? validation : training;
+  if (runs.empty()) throw std::invalid_argument("SelectCalibration: no runs");
+  decision.judged_on =
+      decision.judged_on_held_out
+          ? "held-out runs (" + std::to_string(runs.size()) + ")"
+          : "training runs (" + std::to_string(runs.size()) + "; no held-out runs: not validated)";
+  decision.cf.assign(candidates.size(), std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    if (!candidates[i].usable) continue;
+    decision.cf[i] = EvaluateFinalPoseErrors(model, candidates[i].parameters, runs, num_threads).cf;
+    // Strictly better than the best so far: the earlier candidate (nominal first) wins ties.
+    if (std::isfinite(decision.cf[i]) && decision.cf[i] < decision.cf[decision.selected]) {
+      decision.selected = static_cast<int>(i);
+    }
+  }
+  return decision;
+}
+
+std::vector<std::string> GateLines(const std::vector<CalibrationCandidate>& candidates,
+                                   const GateDecision& decision) {
+  std::vector<std::string> out;
+  const double nominal = decision.cf[0];
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    char line[256];
+    if (!candidates[i].usable) {
+      std::snprintf(line, sizeof line, "  %-22s %10s   (not usable: did not converge)",
+                    candidates[i].name.c_str(), "-");
+    } else {
+      const double change = nominal > 0.0 ? 100.0 * (decision.cf[i] - nominal) / nominal : 0.0;
+      std::snprintf(line, sizeof line, "  %-22s %10.4f %+8.1f%%%s", candidates[i].name.c_str(),
+                    decision.cf[i], change,
+                    static_cast<int>(i) == decision.selected ? "   <- selected" : "");
+    }
+    out.push_back(line);
+  }
+  return out;
+}
+
+}  // namespace fitcal

@@ -1,0 +1,40 @@
+#pragma once
+// The result gate: a written calibration is never worse than what it replaces. Every command
+// that writes a calibration hands its candidates here - the nominal robot first, then closed
+// forms (UMBmark, ASOC's geometry), each fit, fits with effects - and writes the one with the
+// lowest CF (Palacin Eq. 14) on the held-out runs; on the training runs, said so, when there are
+// none. The nominal wins ties: a calibration must earn its place.
+
+#include <string>
+#include <vector>
+
+#include "calib/aligned_run.h"
+#include "models/model_interface.h"
+
+namespace fitcal {
+
+struct CalibrationCandidate {
+  std::string name;  // "nominal", "ceres", "umbmark", ...
+  std::vector<double> parameters;
+  bool usable = true;  // a fit that did not converge to a usable point competes not
+};
+
+struct GateDecision {
+  int selected = 0;        // index into the candidates (0 = nominal)
+  std::vector<double> cf;  // per candidate, on the judging runs (NaN when not usable)
+  bool judged_on_held_out = true;
+  std::string judged_on;  // "held-out runs (N)" or "training runs (N; no held-out runs)"
+  bool improves_on_nominal() const { return selected != 0; }
+};
+
+// candidates[0] must be the nominal. Throws std::invalid_argument for no candidates or no runs.
+GateDecision SelectCalibration(const RobotModelInterface& model,
+                               const std::vector<CalibrationCandidate>& candidates,
+                               const std::vector<AlignedRun>& training,
+                               const std::vector<AlignedRun>& validation, int num_threads = 0);
+
+// One line per candidate for the terminal: name, CF, change against nominal, and which won.
+std::vector<std::string> GateLines(const std::vector<CalibrationCandidate>& candidates,
+                                   const GateDecision& decision);
+
+}  // namespace fitcal

@@ -1,0 +1,72 @@
+#include "io/calibration_block.h"
+
+#include <yaml-cpp/yaml.h>
+
+namespace fitcal::io {
+
+namespace {
+
+void EmitRuns(YAML::Emitter& out, const CalibrationBlock& c) {
+  out << YAML::Key << "training_repetitions" << YAML::Value << YAML::Flow << c.training_repetitions;
+  out << YAML::Key << "validation_repetitions" << YAML::Value << YAML::Flow
+      << c.validation_repetitions;
+  out << YAML::Key << "training_runs" << YAML::Value << c.training_runs;
+  out << YAML::Key << "validation_runs" << YAML::Value << c.validation_runs;
+  if (!c.training_run_ids.empty()) {
+    out << YAML::Key << "training_run_ids" << YAML::Value << YAML::Flow << c.training_run_ids;
+  }
+  const auto before_after = [&](const char* key, double before, double after) {
+    out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "before"
+        << YAML::Value << before << YAML::Key << "after" << YAML::Value << after << YAML::EndMap;
+  };
+  before_after("cf_training", c.cf_training_before, c.cf_training_after);
+  before_after("cf_validation", c.cf_validation_before, c.cf_validation_after);
+}
+
+void EmitUncertainty(YAML::Emitter& out, const CalibrationBlock& c, const Robot& robot) {
+  if (!c.has_uncertainty) {
+    out << YAML::Key << "sigma" << YAML::Value << YAML::Null;
+    return;
+  }
+  out << YAML::Key << "sigma" << YAML::Value << YAML::BeginMap;
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    const ParameterInfo& info = robot.parameters[k];
+    out << YAML::Key << info.name + "_" + info.DisplayUnit() << YAML::Value
+        << c.sigma[k] * info.DisplayScale();
+  }
+  out << YAML::EndMap;
+  out << YAML::Key << "correlation" << YAML::Value << YAML::BeginSeq;
+  out.SetDoublePrecision(4);
+  for (int r = 0; r < robot.NumParameters(); ++r) {
+    out << YAML::Flow << YAML::BeginSeq;
+    for (int k = 0; k < robot.NumParameters(); ++k) out << c.correlation(r, k);
+    out << YAML::EndSeq;
+  }
+  out << YAML::EndSeq;
+  out.SetDoublePrecision(10);
+}
+
+}  // namespace
+
+std::string CalibrationBlockYaml(const CalibrationBlock& c, const Robot& robot) {
+  YAML::Emitter out;
+  out.SetDoublePrecision(10);
+  out << YAML::BeginMap << YAML::Key << "calibration" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "method" << YAML::Value << c.method;
+  out << YAML::Key << "objective" << YAML::Value << c.objective;
+  out << YAML::Key << "dataset" << YAML::Value << c.dataset;
+  out << YAML::Key << "tool_version" << YAML::Value << c.tool_version;
+  out << YAML::Key << "termination" << YAML::Value << c.termination;
+  if (!c.selected.empty()) {
+    out << YAML::Key << "selected" << YAML::Value << c.selected;
+    out << YAML::Key << "selected_on" << YAML::Value << c.selected_on;
+  }
+  EmitRuns(out, c);
+  out << YAML::Key << "held" << YAML::Value << YAML::Flow << c.held;
+  out << YAML::Key << "at_bound" << YAML::Value << YAML::Flow << c.at_bound;
+  EmitUncertainty(out, c, robot);
+  out << YAML::EndMap << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+}  // namespace fitcal::io

@@ -1,0 +1,46 @@
+#pragma once
+// The `calibration:` block every calibrated robot YAML carries, for any model: what produced the
+// calibration (method, objective, data set, tool version, termination), which runs trained and
+// validated it (repetitions, run ids, trajectories), the CF (Palacin Eq. 14) before and after on
+// both, which candidate the result gate chose, the parameters held or resting on a bound, and
+// the one-sigma uncertainty of every parameter with their correlation matrix. The model's
+// RobotYaml (models/model_interface.h) appends it to its own keys.
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "models/robot.h"
+
+namespace fitcal::io {
+
+struct CalibrationBlock {
+  std::string method;
+  std::string objective;
+  std::string dataset;
+  std::string tool_version;
+  std::string termination;
+  std::vector<int> training_repetitions;
+  std::vector<int> validation_repetitions;
+  std::vector<std::string> training_run_ids;
+  int training_runs = 0;
+  int validation_runs = 0;
+  double cf_training_before = 0.0;
+  double cf_training_after = 0.0;
+  double cf_validation_before = 0.0;
+  double cf_validation_after = 0.0;
+  // The result gate (which candidate won, on which runs it was judged).
+  std::string selected;
+  std::string selected_on;
+  std::vector<std::string> held;      // parameter names held at nominal, with why
+  std::vector<std::string> at_bound;  // parameter names resting on a bound
+  bool has_uncertainty = false;
+  std::vector<double> sigma;  // one sigma per parameter, SI and rad
+  Eigen::MatrixXd correlation;
+};
+
+// YAML text of the block, starting with "calibration:\n" and indented two spaces; angles' sigmas
+// in degrees under keys ending _deg, lengths under keys ending _m.
+std::string CalibrationBlockYaml(const CalibrationBlock& record, const Robot& robot);
+
+}  // namespace fitcal::io

@@ -1,0 +1,117 @@
+#include "io/robot_yaml_blocks.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "io/input_error.h"
+
+namespace fitcal::io {
+
+Interval ReadBoundsPair(YamlMap& map, const std::string& key, double scale) {
+  const auto [lo, hi] = map.Pair(key);
+  if (lo > hi) {
+    throw InputError(
+        InputErrorKind::kBadValue, map.path(), map.line(map.Required(key)),
+        "bounds." + key + " has lo " + std::to_string(lo) + " > hi " + std::to_string(hi));
+  }
+  return Interval{lo * scale, hi * scale};
+}
+
+std::optional<EncoderTicks> ReadEncoderTicksNode(const YAML::Node& node, const std::string& path) {
+  if (!node) return std::nullopt;
+  YamlMap map(node, path, "encoder");
+  EncoderTicks ticks;
+  ticks.ticks_per_rev = map.Double("ticks_per_rev");
+  if (!(ticks.ticks_per_rev > 0.0)) {
+    throw InputError(InputErrorKind::kBadValue, path, map.line(map.Required("ticks_per_rev")),
+                     "encoder.ticks_per_rev must be positive");
+  }
+  const YAML::Node cumulative = map.Required("cumulative");
+  const std::string text = YamlString(cumulative, path, "encoder.cumulative");
+  if (text != "true" && text != "false") {
+    throw InputError(InputErrorKind::kBadValue, path, map.line(cumulative),
+                     "encoder.cumulative must be true or false, found '" + text + "'");
+  }
+  ticks.cumulative = text == "true";
+  map.RejectUnread();
+  return ticks;
+}
+
+std::vector<effects::EffectValue> ReadEffectsNode(const YAML::Node& node, const std::string& path) {
+  std::vector<effects::EffectValue> out;
+  if (!node || node.IsNull()) return out;
+  ExpectYamlType(node, YAML::NodeType::Sequence, path, "robot.effects");
+  for (std::size_t i = 0; i < node.size(); ++i) {
+    YamlMap map(node[i], path, "effect " + std::to_string(i + 1));
+    const std::string name = map.String("name");
+    effects::EffectValue e;
+    try {
+      e.id = effects::EffectIdFromName(name);
+    } catch (const std::invalid_argument& error) {
+      throw InputError(InputErrorKind::kBadValue, path, node[i].Mark().line + 1, error.what());
+    }
+    const effects::EffectInfo& info = effects::Info(e.id);
+    for (int k = 0; k < info.num_parameters; ++k) {
+      e.value[k] = map.Double(info.parameter_names[k]);
+      if (!(e.value[k] >= info.lower[k] && e.value[k] <= info.upper[k])) {
+        throw InputError(InputErrorKind::kBadValue, path, node[i].Mark().line + 1,
+                         "effect " + name + ": " + info.parameter_names[k] + " lies outside [" +
+                             std::to_string(info.lower[k]) + ", " + std::to_string(info.upper[k]) +
+                             "]");
+      }
+      const std::string sigma_key = std::string("sigma_") + info.parameter_names[k];
+      if (map.Has(sigma_key)) e.sigma[k] = map.Double(sigma_key);
+    }
+    for (const auto& other : out) {
+      if (other.id == e.id) {
+        throw InputError(InputErrorKind::kBadValue, path, node[i].Mark().line + 1,
+                         "effect " + name + " is listed twice");
+      }
+    }
+    map.RejectUnread();
+    out.push_back(e);
+  }
+  return out;
+}
+
+void CheckNominalInsideBounds(const Robot& robot, const std::string& path, int line) {
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    if (!robot.bounds[k].Contains(robot.nominal[k])) {
+      const ParameterInfo& info = robot.parameters[k];
+      const double s = info.DisplayScale();
+      throw InputError(InputErrorKind::kBadValue, path, line,
+                       info.name + " = " + std::to_string(robot.nominal[k] * s) + " " +
+                           info.DisplayUnit() + " lies outside its bounds [" +
+                           std::to_string(robot.bounds[k].lo * s) + ", " +
+                           std::to_string(robot.bounds[k].hi * s) + "]");
+    }
+  }
+}
+
+void EmitBoundsPair(YAML::Emitter& out, const std::string& key, const Interval& v, double scale) {
+  out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq << v.lo * scale
+      << v.hi * scale << YAML::EndSeq;
+}
+
+void EmitEncoderAndEffects(YAML::Emitter& out, const Robot& robot) {
+  if (robot.encoder) {
+    out << YAML::Key << "encoder" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key
+        << "ticks_per_rev" << YAML::Value << robot.encoder->ticks_per_rev << YAML::Key
+        << "cumulative" << YAML::Value << robot.encoder->cumulative << YAML::EndMap;
+  }
+  if (robot.effects.empty()) return;
+  out << YAML::Key << "effects" << YAML::Value << YAML::BeginSeq;
+  for (const effects::EffectValue& e : robot.effects) {
+    const effects::EffectInfo& info = effects::Info(e.id);
+    out << YAML::Flow << YAML::BeginMap << YAML::Key << "name" << YAML::Value << info.name;
+    for (int k = 0; k < info.num_parameters; ++k) {
+      out << YAML::Key << info.parameter_names[k] << YAML::Value << e.value[k];
+      out << YAML::Key << std::string("sigma_") + info.parameter_names[k] << YAML::Value
+          << e.sigma[k];
+    }
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+}
+
+}  // namespace fitcal::io

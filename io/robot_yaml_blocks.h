@@ -1,0 +1,35 @@
+#pragma once
+// The parts of a robot YAML that every model shares: `bounds:` pairs, the `encoder:` ticks block
+// and the `effects:` list, read strictly (unknown keys are errors) and written back in the same
+// schema. Each model's reader (models/<model>/) uses these for the common keys.
+
+#include <yaml-cpp/yaml.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "io/yaml_reader.h"
+#include "models/robot.h"
+
+namespace fitcal::io {
+
+// [lo, hi] of `key` times `scale`; InputError when lo > hi.
+Interval ReadBoundsPair(YamlMap& map, const std::string& key, double scale);
+
+// `encoder: {ticks_per_rev: N, cumulative: false|true}`; nullopt for a null node.
+std::optional<EncoderTicks> ReadEncoderTicksNode(const YAML::Node& node, const std::string& path);
+
+// `effects:` - a list of {name: <registry name>, <parameter>: value, ...} maps, each parameter
+// named as in odometry/effects.h (units in the name) and inside its bounds; optional
+// `sigma_<parameter>` keys carry the fitted uncertainty.
+std::vector<effects::EffectValue> ReadEffectsNode(const YAML::Node& node, const std::string& path);
+
+// The nominal must lie inside the box the fit may search: InputError naming the parameter.
+void CheckNominalInsideBounds(const Robot& robot, const std::string& path, int line);
+
+// Emitters for the same blocks (inside an open top-level map).
+void EmitBoundsPair(YAML::Emitter& out, const std::string& key, const Interval& v, double scale);
+void EmitEncoderAndEffects(YAML::Emitter& out, const Robot& robot);
+
+}  // namespace fitcal::io

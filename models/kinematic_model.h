@@ -1,0 +1,184 @@
+#pragma once
+// From a model's kinematics to the whole seam (model_interface.h), written once for every model.
+//
+// A model's kinematics K is a struct of static functions, templated on the scalar so that Ceres
+// differentiates through them:
+//
+//   struct K {
+//     static constexpr int kNumParameters = ...;  // length of the parameter vector
+//     // Whatever depends on the parameters only (e.g. Palacin's M^-1), computed once per replay.
+//     template <typename T> static Prepared<T> Prepare(const T* p);
+//     // The body-frame step (dx, dy, dtheta) of one encoder interval of length dt from its
+//     // channel values (wheel rates in rad/s, angles in rad; C = double, or T under effects).
+//     template <typename T, typename C>
+//     FITCAL_ALWAYS_INLINE static void BodyStep(const Prepared<T>& k, const C* values, double dt,
+//                          T* dx, T* dy, T* dtheta);
+//     // Inverse kinematics: channel values that drive the twist, false if the model cannot.
+//     static bool ChannelsForTwist(const double* p, const Twist& twist, double* values);
+//   };
+//
+// A K whose kinematics depend on fixed geometry that is not fitted (e.g. the omni model's drive
+// and roller angles, models/omni/omni_kinematics.h) holds it as data members and makes these
+// functions const members instead; it is passed as an instance below. A K of static functions is
+// default-constructed, so both kinds go through the same code.
+//
+// KinematicModel<K> turns it into a RobotModelInterface: the generic replay (odometry/replay.h),
+// the final-pose and segment residuals (fit/pose_errors.h) as autodiff cost functions. A model's
+// own class derives from it and adds its YAML and anything model-specific.
+
+#include <ceres/autodiff_cost_function.h>
+
+#include <algorithm>
+#include <utility>
+#include <vector>
+
+#include "calib/aligned_run.h"
+#include "fit/pose_errors.h"
+#include "models/model_interface.h"
+#include "odometry/replay.h"
+
+namespace fitcal {
+
+// Replays samples [begin, end) with the kinematics K at parameters p.
+template <class K, typename T, typename Visitor = replay_internal::NoVisit>
+Pose2<T> ReplayKinematics(const K& kinematics, const T* p, const EncoderSamples& samples,
+                          std::size_t begin, std::size_t end, const Pose2<T>& start,
+                          Visitor&& visit = Visitor()) {
+  const auto prepared = kinematics.Prepare(p);
+  const auto step = [&kinematics, &prepared](const double* values, double dt, T* dx, T* dy,
+                                             T* dtheta) {
+    kinematics.BodyStep(prepared, values, dt, dx, dy, dtheta);
+  };
+  return ReplaySteps(step, samples, begin, end, start, std::forward<Visitor>(visit));
+}
+template <class K, typename T, typename Visitor = replay_internal::NoVisit>
+Pose2<T> ReplayKinematics(const T* p, const EncoderSamples& samples, std::size_t begin,
+                          std::size_t end, const Pose2<T>& start, Visitor&& visit = Visitor()) {
+  return ReplayKinematics(K(), p, samples, begin, end, start, std::forward<Visitor>(visit));
+}
+
+// Palacin Eq. 14 residual of one run for the kinematics K.
+template <class K>
+class ModelFinalPoseResidual {
+ public:
+  ModelFinalPoseResidual(const AlignedRun& run, const ResidualWeights& weights,
+                         const K& kinematics = K())
+      : run_(run), weights_(weights), kinematics_(kinematics) {}
+
+  template <typename T>
+  bool operator()(const T* p, T* residual) const {
+    const Pose2<T> start{T(run_.start.x), T(run_.start.y), T(run_.start.theta)};
+    const Pose2<T> final_pose =
+        ReplayKinematics(kinematics_, p, run_.samples, 0, run_.samples.size(), start);
+    FinalPoseError(final_pose, run_.final_ground_truth, weights_, residual);
+    return true;
+  }
+
+  static ceres::CostFunction* Create(const AlignedRun& run, const ResidualWeights& weights,
+                                     const K& kinematics = K()) {
+    return new ceres::AutoDiffCostFunction<ModelFinalPoseResidual, 3, K::kNumParameters>(
+        new ModelFinalPoseResidual(run, weights, kinematics));
+  }
+
+ private:
+  const AlignedRun& run_;
+  ResidualWeights weights_;
+  K kinematics_;
+};
+
+// Segment residuals (fit/pose_errors.h) of one run for the kinematics K: the run is replayed once
+// from the identity, keeping the pose at every window start and end.
+template <class K>
+class ModelSegmentResidual {
+ public:
+  ModelSegmentResidual(const AlignedRun& run, const std::vector<Segment>& segments,
+                       const ResidualWeights& weights, const K& kinematics = K())
+      : run_(run), segments_(segments), weights_(weights), kinematics_(kinematics) {
+    for (const Segment& s : segments_) {
+      marks_.push_back(s.begin);
+      marks_.push_back(s.end);
+    }
+    std::sort(marks_.begin(), marks_.end());
+    marks_.erase(std::unique(marks_.begin(), marks_.end()), marks_.end());
+  }
+
+  int NumResiduals() const { return 3 * static_cast<int>(segments_.size()); }
+
+  template <typename T>
+  bool operator()(const T* p, T* residual) const {
+    std::vector<Pose2<T>> at_mark(marks_.size());
+    Pose2<T> pose{T(0.0), T(0.0), T(0.0)};
+    std::size_t done = 0;
+    for (std::size_t m = 0; m < marks_.size(); ++m) {
+      if (marks_[m] > done) {
+        pose = ReplayKinematics(kinematics_, p, run_.samples, done, marks_[m], pose);
+        done = marks_[m];
+      }
+      at_mark[m] = pose;
+    }
+    for (std::size_t k = 0; k < segments_.size(); ++k) {
+      const Segment& s = segments_[k];
+      SegmentError(at_mark[IndexOf(s.begin)], at_mark[IndexOf(s.end)], s.ground_truth_start_T_end,
+                   weights_, residual + 3 * k);
+    }
+    return true;
+  }
+
+  static ceres::CostFunction* Create(const AlignedRun& run, const std::vector<Segment>& segments,
+                                     const ResidualWeights& weights, const K& kinematics = K()) {
+    auto* functor = new ModelSegmentResidual(run, segments, weights, kinematics);
+    return new ceres::AutoDiffCostFunction<ModelSegmentResidual, ceres::DYNAMIC, K::kNumParameters>(
+        functor, functor->NumResiduals());
+  }
+
+ private:
+  std::size_t IndexOf(std::size_t mark) const {
+    return static_cast<std::size_t>(std::lower_bound(marks_.begin(), marks_.end(), mark) -
+                                    marks_.begin());
+  }
+
+  const AlignedRun& run_;
+  const std::vector<Segment>& segments_;
+  ResidualWeights weights_;
+  K kinematics_;
+  std::vector<std::size_t> marks_;
+};
+
+template <class K>
+class KinematicModel : public RobotModelInterface {
+ public:
+  using Kinematics = K;
+
+  explicit KinematicModel(Robot robot, K kinematics = K())
+      : robot_(std::move(robot)), kinematics_(std::move(kinematics)) {}
+
+  const Robot& robot() const override { return robot_; }
+  const K& kinematics() const { return kinematics_; }
+
+  Pose2d Replay(const double* p, const EncoderSamples& samples, std::size_t begin, std::size_t end,
+                const Pose2d& start, const PoseVisitor& visit = nullptr) const override {
+    if (!visit) return ReplayKinematics(kinematics_, p, samples, begin, end, start);
+    return ReplayKinematics(kinematics_, p, samples, begin, end, start,
+                            [&visit](std::size_t k, const Pose2d& pose) { visit(k, pose); });
+  }
+
+  ceres::CostFunction* FinalPoseCost(const AlignedRun& run,
+                                     const ResidualWeights& weights) const override {
+    return ModelFinalPoseResidual<K>::Create(run, weights, kinematics_);
+  }
+
+  ceres::CostFunction* SegmentCost(const AlignedRun& run, const std::vector<Segment>& segments,
+                                   const ResidualWeights& weights) const override {
+    return ModelSegmentResidual<K>::Create(run, segments, weights, kinematics_);
+  }
+
+  bool ChannelsForTwist(const double* p, const Twist& twist, double* values) const override {
+    return kinematics_.ChannelsForTwist(p, twist, values);
+  }
+
+ protected:
+  Robot robot_;
+  K kinematics_;
+};
+
+}  // namespace fitcal

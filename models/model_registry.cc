@@ -1,0 +1,76 @@
+#include "models/model_registry.h"
+
+#include "io/input_error.h"
+#include "io/yaml_reader.h"
+#include "models/diff_drive/diff_drive_model.h"
+#include "models/omni/omni_model.h"
+#include "models/omni3/omni3_robot_model.h"
+#include "models/tricycle/tricycle_model.h"
+
+namespace fitcal {
+
+namespace {
+
+// The built-in models, one entry each.
+std::vector<ModelRegistration>& Registry() {
+  static std::vector<ModelRegistration> registry = {
+      {"omni3", "three-wheeled omni robot, Palacin et al. 2022 (9 parameters)", &ReadOmni3Model,
+       kOmni3ExampleYaml},
+      {"omni", "3 to 8 omni or mecanum wheels (3 parameters per wheel)", &ReadOmniModel,
+       kOmniExampleYaml},
+      {"tricycle", "steered, driven wheel and a rear axle (3 parameters)", &ReadTricycleModel,
+       kTricycleExampleYaml},
+      {"diff_drive", "differential drive, Borenstein & Feng 1996 (3 parameters)",
+       &ReadDiffDriveModel, kDiffDriveExampleYaml},
+  };
+  return registry;
+}
+
+}  // namespace
+
+bool RegisterModel(ModelRegistration registration) {
+  auto& registry = Registry();
+  for (ModelRegistration& existing : registry) {
+    if (existing.name == registration.name) {
+      existing = std::move(registration);
+      return true;
+    }
+  }
+  registry.push_back(std::move(registration));
+  return true;
+}
+
+const std::vector<ModelRegistration>& RegisteredModels() { return Registry(); }
+
+const ModelRegistration* FindModel(const std::string& name) {
+  for (const ModelRegistration& m : Registry()) {
+    if (m.name == name) return &m;
+  }
+  return nullptr;
+}
+
+std::string RegisteredModelNames() {
+  std::string out;
+  for (const ModelRegistration& m : Registry()) out += (out.empty() ? "" : ", ") + m.name;
+  return out;
+}
+
+RobotModelPtr ReadRobotModelFile(const std::string& path) {
+  return ReadRobotModel(io::LoadYamlFile(path), path);
+}
+
+RobotModelPtr ReadRobotModel(const YAML::Node& root, const std::string& path) {
+  io::ExpectYamlType(root, YAML::NodeType::Map, path, "robot file");
+  if (!root["model"]) {
+    throw io::InputError(io::InputErrorKind::kMissingKey, path, 1, "robot has no 'model'");
+  }
+  const std::string model = io::YamlString(root["model"], path, "robot.model");
+  const ModelRegistration* registration = FindModel(model);
+  if (registration == nullptr) {
+    throw io::InputError(io::InputErrorKind::kUnknownModel, path, root["model"].Mark().line + 1,
+                         "unknown model '" + model + "' (known: " + RegisteredModelNames() + ")");
+  }
+  return registration->read(root, path);
+}
+
+}  // namespace fitcal

@@ -1,0 +1,169 @@
+#include "models/omni3/omni3_robot_model.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "io/input_error.h"
+#include "io/robot_yaml_blocks.h"
+#include "io/yaml_reader.h"
+
+namespace fitcal {
+
+namespace {
+
+using io::InputError;
+using io::InputErrorKind;
+
+int LineOf(const YAML::Node& node) { return node.Mark().line + 1; }
+
+struct Omni3Box {
+  Interval distance_m;
+  Interval radius_m;
+  Interval angle_offset_rad;
+};
+
+Omni3Box ReadOmni3Bounds(io::YamlMap& robot_map, const std::string& path) {
+  io::YamlMap bounds(robot_map.Required("bounds"), path, "bounds");
+  Omni3Box box;
+  box.distance_m = io::ReadBoundsPair(bounds, "distance_m", 1.0);
+  box.radius_m = io::ReadBoundsPair(bounds, "radius_m", 1.0);
+  box.angle_offset_rad = io::ReadBoundsPair(bounds, "angle_offset_deg", M_PI / 180.0);
+  bounds.RejectUnread();
+  if (!(box.distance_m.lo > 0.0) || !(box.radius_m.lo > 0.0)) {
+    throw InputError(InputErrorKind::kBadValue, path, LineOf(robot_map.Required("bounds")),
+                     "bounds on distance_m and radius_m must be positive");
+  }
+  return box;
+}
+
+}  // namespace
+
+Robot Omni3RobotDescription(const std::string& name, const std::vector<std::string>& wheel_names) {
+  Robot robot;
+  robot.model = "omni3";
+  robot.name = name;
+  for (const std::string& w : wheel_names) {
+    robot.channels.push_back({w, ChannelKind::kWheelRate, "w_" + w, "ticks_" + w});
+  }
+  // Palacin Eq. 15 order: R_i, then r_i, then delta_i.
+  for (const std::string& w : wheel_names) {
+    robot.parameters.push_back({"R_" + w, "distance_m", ParameterUnit::kLength});
+  }
+  for (const std::string& w : wheel_names) {
+    robot.parameters.push_back({"r_" + w, "radius_m", ParameterUnit::kLength});
+  }
+  for (const std::string& w : wheel_names) {
+    robot.parameters.push_back({"delta_" + w, "angle_offset_deg", ParameterUnit::kAngle});
+  }
+  return robot;
+}
+
+RobotModelPtr ReadOmni3Model(const YAML::Node& root, const std::string& path) {
+  io::YamlMap robot_map(root, path, "robot");
+  robot_map.String("model");
+  const std::string name = robot_map.String("name");
+  const YAML::Node wheels = robot_map.Required("wheels");
+  io::ExpectYamlType(wheels, YAML::NodeType::Sequence, path, "robot.wheels");
+  if (wheels.size() != omni3::kNumWheels) {
+    throw InputError(InputErrorKind::kBadValue, path, LineOf(wheels),
+                     "an omni3 robot has 3 wheels, found " + std::to_string(wheels.size()));
+  }
+  std::vector<std::string> names;
+  std::array<double, omni3::kNumParameters> p{};
+  for (int i = 0; i < omni3::kNumWheels; ++i) {
+    const std::string what = "wheel " + std::to_string(i + 1);
+    io::YamlMap wheel(wheels[i], path, what);
+    names.push_back(wheel.String("name"));
+    if (std::count(names.begin(), names.end(), names.back()) > 1) {
+      throw InputError(InputErrorKind::kBadValue, path, LineOf(wheels[i]),
+                       "wheel name '" + names.back() + "' is used twice");
+    }
+    p[omni3::kDistanceIndex + i] = wheel.Double("distance_m");
+    p[omni3::kRadiusIndex + i] = wheel.Double("radius_m");
+    p[omni3::kAngleIndex + i] = DegToRad(wheel.Double("angle_deg"));
+    if (!(p[omni3::kDistanceIndex + i] > 0.0) || !(p[omni3::kRadiusIndex + i] > 0.0)) {
+      throw InputError(InputErrorKind::kBadValue, path, LineOf(wheels[i]),
+                       what + ": distance_m and radius_m must be positive");
+    }
+    wheel.RejectUnread();
+  }
+  const Omni3Box box = ReadOmni3Bounds(robot_map, path);
+  Robot robot = Omni3RobotDescription(name, names);
+  robot.nominal.assign(p.begin(), p.end());
+  for (int i = 0; i < omni3::kNumWheels; ++i) robot.bounds.push_back(box.distance_m);
+  for (int i = 0; i < omni3::kNumWheels; ++i) robot.bounds.push_back(box.radius_m);
+  for (int i = 0; i < omni3::kNumWheels; ++i) {
+    const double delta = p[omni3::kAngleIndex + i];
+    robot.bounds.push_back({delta + box.angle_offset_rad.lo, delta + box.angle_offset_rad.hi});
+  }
+  io::CheckNominalInsideBounds(robot, path, LineOf(wheels));
+  if (std::abs(omni3::InverseKinematicDenominator(p.data())) < 1e-9) {
+    throw InputError(InputErrorKind::kBadValue, path, LineOf(wheels),
+                     "the wheel angles and distances give a singular kinematic matrix");
+  }
+  robot.encoder = io::ReadEncoderTicksNode(robot_map.Optional("encoder"), path);
+  robot.effects = io::ReadEffectsNode(robot_map.Optional("effects"), path);
+  robot_map.Optional("calibration");  // written by fitcal; informational when read back
+  robot_map.RejectUnread();
+  return std::make_shared<Omni3Model>(std::move(robot), box.angle_offset_rad);
+}
+
+std::shared_ptr<const Omni3Model> Omni3ModelOf(const Omni3Robot& omni3_robot) {
+  Robot robot = Omni3RobotDescription(
+      omni3_robot.name, {omni3_robot.wheel_names.begin(), omni3_robot.wheel_names.end()});
+  const auto p = omni3_robot.nominal.ToArray();
+  robot.nominal.assign(p.begin(), p.end());
+  const auto box = omni3_robot.ParameterBounds();
+  robot.bounds.assign(box.begin(), box.end());
+  robot.encoder = omni3_robot.encoder;
+  robot.effects = omni3_robot.effects;
+  return std::make_shared<Omni3Model>(std::move(robot), omni3_robot.bounds.angle_offset_rad);
+}
+
+std::string Omni3Model::RobotYaml(const std::vector<double>& p,
+                                  const std::string& calibration_block) const {
+  YAML::Emitter out;
+  out.SetDoublePrecision(10);
+  out << YAML::BeginMap;
+  out << YAML::Key << "model" << YAML::Value << "omni3";
+  out << YAML::Key << "name" << YAML::Value << robot_.name;
+  out << YAML::Key << "wheels" << YAML::Value << YAML::BeginSeq;
+  for (int i = 0; i < omni3::kNumWheels; ++i) {
+    out << YAML::Flow << YAML::BeginMap;
+    out << YAML::Key << "name" << YAML::Value << robot_.channels[i].name;
+    out << YAML::Key << "distance_m" << YAML::Value << p[omni3::kDistanceIndex + i];
+    out << YAML::Key << "radius_m" << YAML::Value << p[omni3::kRadiusIndex + i];
+    out << YAML::Key << "angle_deg" << YAML::Value << RadToDeg(p[omni3::kAngleIndex + i]);
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+  out << YAML::Key << "bounds" << YAML::Value << YAML::BeginMap;
+  io::EmitBoundsPair(out, "distance_m", robot_.bounds[omni3::kDistanceIndex], 1.0);
+  io::EmitBoundsPair(out, "radius_m", robot_.bounds[omni3::kRadiusIndex], 1.0);
+  io::EmitBoundsPair(out, "angle_offset_deg", angle_offset_rad_, 180.0 / M_PI);
+  out << YAML::EndMap;
+  io::EmitEncoderAndEffects(out, robot_);
+  out << YAML::EndMap;
+  std::string text = std::string(out.c_str()) + "\n";
+  if (calibration_block.empty()) return text;
+  // M^-1 of Eq. 6 for firmware that takes the matrix, at full precision.
+  const omni3::Matrix3<double> m_inv = omni3::InverseKinematicMatrix(p.data());
+  YAML::Emitter matrix;
+  matrix.SetDoublePrecision(16);
+  matrix << YAML::BeginMap << YAML::Key << "inverse_kinematic_matrix" << YAML::Value
+         << YAML::BeginSeq;
+  for (int r = 0; r < 3; ++r) {
+    matrix << YAML::Flow << YAML::BeginSeq << m_inv(r, 0) << m_inv(r, 1) << m_inv(r, 2)
+           << YAML::EndSeq;
+  }
+  matrix << YAML::EndSeq << YAML::EndMap;
+  std::string indented;
+  for (char c : "  " + std::string(matrix.c_str())) {
+    indented += c;
+    if (c == '\n') indented += "  ";
+  }
+  return text + calibration_block + indented + "\n";
+}
+
+}  // namespace fitcal

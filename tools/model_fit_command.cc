@@ -1,0 +1,264 @@
+#include "tools/model_fit_command.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <unordered_map>
+
+#include "calib/channel_order_check.h"
+#include "calib/run_split.h"
+#include "calib/segment_cost.h"
+#include "fit/final_pose_errors.h"
+#include "fit/model_fit.h"
+#include "fit/result_gate.h"
+#include "fitcal/version.h"
+#include "io/atomic_file.h"
+#include "io/calibration_block.h"
+#include "tools/output_guard.h"
+
+namespace fitcal::tools {
+
+namespace {
+
+double Seconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+bool MakeModelFitOptions(const FitCommandOptions& o, ModelFitOptions* out, std::string* error) {
+  CeresFitOptions& c = out->ceres;
+  if (o.method != "ceres" && o.method != "ceres-dogleg") {
+    *error = "--method " + o.method +
+             " is not available for this robot model yet (available: "
+             "ceres, ceres-dogleg)";
+    return false;
+  }
+  c.trust_region = o.method == "ceres-dogleg" ? CeresTrustRegion::kDogleg
+                                              : CeresTrustRegion::kLevenbergMarquardt;
+  c.weights.position_sigma_m = o.position_sigma_m;
+  c.weights.heading_sigma_rad = o.heading_sigma_deg * M_PI / 180.0;
+  c.num_threads = o.threads;
+  c.max_num_iterations = o.max_iterations;
+  if (!o.objective.empty() && !ParseFinalPoseObjective(o.objective, &c.objective)) {
+    *error = "unknown --objective '" + o.objective + "' (available: squares, eq14)";
+    return false;
+  }
+  if (!ParseCeresRobustLoss(o.loss, &c.loss)) {
+    *error = "unknown --loss '" + o.loss + "' (available: none, huber, cauchy)";
+    return false;
+  }
+  c.loss_scale = o.loss_scale;
+  return c.IsValid(error);
+}
+
+void PrintCfTable(const RobotModelInterface& model, const std::vector<double>& selected,
+                  const RunSplit& split, int threads) {
+  const auto& nominal = model.robot().nominal;
+  const auto row = [&](const char* name, const std::vector<AlignedRun>& runs) {
+    const FinalPoseErrors before = EvaluateFinalPoseErrors(model, nominal, runs, threads);
+    const FinalPoseErrors after = EvaluateFinalPoseErrors(model, selected, runs, threads);
+    const double change = before.cf > 0.0 ? 100.0 * (after.cf - before.cf) / before.cf : 0.0;
+    std::printf("  %-30s %10.4f %10.4f %+8.1f%%\n", name, before.cf, after.cf, change);
+    std::printf("  %-30s %10.4f %10.4f\n", "  mean final position error [m]",
+                before.mean_position_error_m, after.mean_position_error_m);
+    std::printf("  %-30s %10.3f %10.3f\n", "  mean final heading error [deg]",
+                RadToDeg(before.mean_abs_heading_error_rad),
+                RadToDeg(after.mean_abs_heading_error_rad));
+  };
+  std::printf("  %-30s %10s %10s %9s\n", "CF (Eq. 14, m and rad)", "nominal", "calibrated",
+              "change");
+  row("training", split.training);
+  if (!split.validation.empty()) row("validation", split.validation);
+}
+
+void PrintParameters(const Robot& robot, const std::vector<double>& p, const ModelFitResult& fit) {
+  std::printf("\n  %-22s %12s %12s %12s %12s\n", "parameter", "nominal", "calibrated", "+-1 sigma",
+              "change");
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    const ParameterInfo& info = robot.parameters[k];
+    const double s = info.DisplayScale();
+    char sigma[32] = "-";
+    if (fit.has_covariance && !fit.held[k])
+      std::snprintf(sigma, sizeof sigma, "%.2g", fit.sigma[k] * s);
+    // Angles change by degrees, lengths by percent (a percentage of an angle means nothing).
+    char change[32];
+    if (info.unit == ParameterUnit::kAngle) {
+      std::snprintf(change, sizeof change, "%+.3f deg", (p[k] - robot.nominal[k]) * s);
+    } else {
+      std::snprintf(change, sizeof change, "%+.2f%%",
+                    100.0 * (p[k] - robot.nominal[k]) / robot.nominal[k]);
+    }
+    std::printf("  %-22s %12.6f %12.6f %12s %12s%s%s\n", robot.LabelOf(k).c_str(),
+                robot.nominal[k] * s, p[k] * s, sigma, change, fit.at_bound[k] ? "  AT BOUND" : "",
+                fit.held[k] ? "  HELD" : "");
+  }
+  for (const HeldParameter& h : robot.held) {
+    std::printf("  held: %s (%s)\n", robot.parameters[h.index].name.c_str(), h.reason.c_str());
+  }
+}
+
+std::vector<CalibrationCandidate> Candidates(const RobotModelInterface& model,
+                                             const std::vector<AlignedRun>& training,
+                                             const ModelFitResult& fit, const std::string& method) {
+  std::vector<CalibrationCandidate> out = {{"nominal", model.robot().nominal, true}};
+  for (const ClosedFormCalibration& c : model.ClosedForms(training)) {
+    out.push_back({c.method, c.parameters, true});
+  }
+  out.push_back({method, fit.parameters, fit.usable});
+  return out;
+}
+
+io::CalibrationBlock MakeRecord(const FitCommandOptions& options, const RobotModelInterface& model,
+                                const RunSplit& split, const ModelFitResult& fit,
+                                const std::vector<CalibrationCandidate>& candidates,
+                                const GateDecision& gate) {
+  const Robot& robot = model.robot();
+  const std::vector<double>& p = candidates[gate.selected].parameters;
+  io::CalibrationBlock r;
+  r.method = candidates[gate.selected].name;
+  r.objective = "final-pose residuals (sigma_xy " + std::to_string(options.position_sigma_m) +
+                " m, sigma_theta " + std::to_string(options.heading_sigma_deg) + " deg)";
+  r.dataset = options.logs;
+  r.tool_version = kVersion;
+  r.termination = fit.termination;
+  r.training_repetitions = split.training_repetitions;
+  r.validation_repetitions = split.validation_repetitions;
+  for (const AlignedRun& run : split.training) r.training_run_ids.push_back(run.id);
+  r.training_runs = static_cast<int>(split.training.size());
+  r.validation_runs = static_cast<int>(split.validation.size());
+  r.cf_training_before =
+      EvaluateFinalPoseErrors(model, robot.nominal, split.training, options.threads).cf;
+  r.cf_training_after = EvaluateFinalPoseErrors(model, p, split.training, options.threads).cf;
+  r.cf_validation_before =
+      EvaluateFinalPoseErrors(model, robot.nominal, split.validation, options.threads).cf;
+  r.cf_validation_after = EvaluateFinalPoseErrors(model, p, split.validation, options.threads).cf;
+  r.selected = candidates[gate.selected].name;
+  r.selected_on = gate.judged_on;
+  for (const HeldParameter& h : robot.held) r.held.push_back(robot.parameters[h.index].name);
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    if (fit.at_bound[k]) r.at_bound.push_back(robot.parameters[k].name);
+  }
+  // The uncertainty is the fit's; it describes the selected parameters only when the fit won.
+  r.has_uncertainty = fit.has_covariance && candidates[gate.selected].name == options.method;
+  r.sigma = fit.sigma;
+  r.correlation = fit.correlation;
+  return r;
+}
+
+// Windows of 0.5 m of ground-truth path for the runs whose ground truth has intermediate poses
+// (segments see miswirings that closed paths hide from final poses); empty lists otherwise.
+std::vector<std::vector<Segment>> OrderCheckWindows(const std::vector<AlignedRun>& training,
+                                                    const std::vector<RunLog>& logs) {
+  std::unordered_map<std::string, const RunLog*> by_id;
+  for (const RunLog& log : logs) by_id[log.id] = &log;
+  SegmentOptions windows;
+  windows.length_m = 0.5;
+  windows.stride_fraction = 1.0;  // disjoint: independent residuals for the F test
+  std::vector<std::vector<Segment>> out(training.size());
+  int total = 0;
+  for (std::size_t i = 0; i < training.size(); ++i) {
+    out[i] = MakeSegments(training[i], by_id.at(training[i].id)->ground_truth, windows);
+    total += static_cast<int>(out[i].size());
+  }
+  if (total < 4) out.clear();
+  return out;
+}
+
+// Exit code 4 with one line when another channel order explains the runs far better.
+bool ChannelsLookMiswired(const FitCommandOptions& options, const RobotModelInterface& model,
+                          const std::vector<AlignedRun>& training,
+                          const std::vector<RunLog>& logs) {
+  ChannelOrderOptions order_options;
+  order_options.weights.position_sigma_m = options.position_sigma_m;
+  order_options.weights.heading_sigma_rad = DegToRad(options.heading_sigma_deg);
+  order_options.num_threads = options.threads;
+  const std::vector<std::vector<Segment>> windows = OrderCheckWindows(training, logs);
+  ChannelOrderReport order = CheckChannelOrder(training, windows, model, order_options);
+  if (!order.likely_miswired && !windows.empty()) {
+    order = CheckChannelOrder(training, {}, model, order_options);
+  }
+  if (!order.likely_miswired) return false;
+  std::cerr << "fitcal: " << options.logs << ": " << order.message
+            << "; nothing written (--skip-wheel-order-check to fit anyway)\n";
+  return true;
+}
+
+}  // namespace
+
+int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex& index,
+                       const RobotModelPtr& model) {
+  const auto t_total = std::chrono::steady_clock::now();
+  const Robot& robot = model->robot();
+  ModelFitOptions fit_options;
+  std::string error;
+  if (!MakeModelFitOptions(options, &fit_options, &error)) {
+    std::cerr << "fitcal: " << error << "\n";
+    return 2;
+  }
+  if (!robot.effects.empty()) {
+    std::cerr << "fitcal: " << index.robot_path
+              << ": the robot declares effects that 'fit' does not model; refit them with "
+                 "'fitcal diagnose', or start from a robot YAML without an effects: list\n";
+    return 2;
+  }
+  if (!options.no_output && !options.force) {
+    const std::string refusal = OverwriteRefusal(options.out, robot.name);
+    if (!refusal.empty()) {
+      std::cerr << "fitcal: " << refusal << "\n";
+      return 2;
+    }
+  }
+  io::DatasetOptions dataset_options;
+  dataset_options.allow_paths_outside = options.allow_outside_paths;
+  dataset_options.num_threads = options.threads;
+  const io::Dataset dataset = io::LoadDataset(index, robot, dataset_options);
+  io::StopHereForTests("loaded");
+  const RunSplit split =
+      SplitByRepetition(AlignRuns(dataset.runs), ParseRepetitionList(options.train_reps));
+  const double load_s = Seconds(t_total);
+  if (split.training.empty()) {
+    std::cerr << "fitcal: no run of " << options.logs << " has a training repetition ("
+              << options.train_reps << ")\n";
+    return 2;
+  }
+  if (!options.skip_wheel_order_check &&
+      ChannelsLookMiswired(options, *model, split.training, dataset.runs)) {
+    return 4;
+  }
+  const ModelFitResult fit = FitModel(split.training, *model, fit_options);
+  const std::vector<CalibrationCandidate> candidates =
+      Candidates(*model, split.training, fit, options.method);
+  const GateDecision gate =
+      SelectCalibration(*model, candidates, split.training, split.validation, options.threads);
+  const std::vector<double>& selected = candidates[gate.selected].parameters;
+
+  std::printf("fitcal %s  %s robot '%s'  data set %s\n", kVersion, robot.model.c_str(),
+              robot.name.c_str(), options.logs.c_str());
+  std::printf("runs: %zu training (repetitions %s), %zu validation (repetitions %s)\n\n",
+              split.training.size(), FormatRepetitionList(split.training_repetitions).c_str(),
+              split.validation.size(), FormatRepetitionList(split.validation_repetitions).c_str());
+  PrintCfTable(*model, selected, split, options.threads);
+  PrintParameters(robot, selected, fit);
+  std::printf("\nsolver: Ceres %s, %s after %d iterations (%d active-set rounds), %.3f s (%s)\n",
+              options.method.c_str(), fit.termination.c_str(), fit.iterations,
+              fit.active_set_rounds, fit.solve_time_s, fit.message.c_str());
+  if (!fit.has_covariance) std::printf("uncertainty: %s\n", fit.covariance_message.c_str());
+  std::printf("\nresult gate, CF on %s:\n", gate.judged_on.c_str());
+  for (const std::string& line : GateLines(candidates, gate)) std::printf("%s\n", line.c_str());
+  if (!gate.improves_on_nominal()) {
+    std::cerr << "fitcal: no calibration beats the nominal robot on the " << gate.judged_on
+              << "; nothing written\n";
+    return 5;
+  }
+  if (!options.no_output) {
+    const io::CalibrationBlock record = MakeRecord(options, *model, split, fit, candidates, gate);
+    io::StopHereForTests("fitted");
+    io::WriteFileAtomically(options.out,
+                            model->RobotYaml(selected, io::CalibrationBlockYaml(record, robot)));
+    std::printf("wrote %s\n", options.out.c_str());
+  }
+  std::printf("time: load %.3f s, total %.3f s\n", load_s, Seconds(t_total));
+  return 0;
+}
+
+}  // namespace fitcal::tools

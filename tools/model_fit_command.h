@@ -1,0 +1,17 @@
+#pragma once
+// `fitcal fit` for every robot model on the seam (models/model_interface.h): load the data set
+// with the robot's channels, fit on the training repetitions (bounded Ceres fit with its active
+// set, fit/model_fit.h), put the fit beside the nominal and the model's closed forms through the
+// result gate (fit/result_gate.h), print the table and write the winner as a calibrated YAML.
+
+#include "io/dataset.h"
+#include "models/model_interface.h"
+#include "tools/fit_command.h"
+
+namespace fitcal::tools {
+
+// Exit codes as README "Exit codes"; 5 when no candidate beats the nominal (nothing written).
+int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex& index,
+                       const RobotModelPtr& model);
+
+}  // namespace fitcal::tools
