@@ -103,8 +103,12 @@ std::string CdrReader::String() {
     Fail("string of " + std::to_string(length) + " bytes at byte " + std::to_string(at) +
          " has no terminating NUL");
   }
-  impl_->cdr.jump(length);
-  return std::string(text, length - 1);
+  // Read through fastcdr rather than skipped with jump(): fastcdr skips the alignment of a
+  // field no wider than the last one it read, so it must know the last read was 1-byte chars.
+  std::string out(length, '\0');
+  impl_->cdr.deserializeArray(&out[0], length);
+  out.pop_back();
+  return out;
 }
 
 void CdrReader::Array(bool* out, std::size_t count) { ReadArray(out, count); }
