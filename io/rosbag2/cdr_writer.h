@@ -34,6 +34,7 @@ class CdrWriter {
 
  private:
   struct Impl;
+  void Align(std::size_t size);
   std::unique_ptr<Impl> impl_;
 };
 

@@ -244,6 +244,7 @@ bool operator==(const Odometry& a, const Odometry& b) {
 }
 
 bool operator==(const TfMessage& a, const TfMessage& b) { return a.transforms == b.transforms; }
+bool operator==(const StringMessage& a, const StringMessage& b) { return a.data == b.data; }
 
 namespace {
 auto Tie(const BasicTypes& t) {

@@ -177,6 +177,7 @@ bool operator==(const JointState& a, const JointState& b);
 bool operator==(const PoseStamped& a, const PoseStamped& b);
 bool operator==(const Odometry& a, const Odometry& b);
 bool operator==(const TfMessage& a, const TfMessage& b);
+bool operator==(const StringMessage& a, const StringMessage& b);
 bool operator==(const BasicTypes& a, const BasicTypes& b);
 bool operator==(const ArrayValues& a, const ArrayValues& b);
 bool operator==(const Arrays& a, const Arrays& b);
