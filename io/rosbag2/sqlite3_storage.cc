@@ -26,13 +26,23 @@ void CheckSqliteMagic(const std::string& path) {
   }
 }
 
+// SQLite's complaint, with what it means for a bag: a damaged file, or a database that is not
+// a rosbag2 bag (no topics / messages table).
+std::string Why(sqlite3* db) {
+  const int code = sqlite3_errcode(db) & 0xFF;  // primary result code
+  const std::string what = code == SQLITE_CORRUPT || code == SQLITE_NOTADB
+                               ? "corrupt or truncated .db3 file"
+                               : "not a rosbag2 database";
+  return what + " (sqlite3: " + sqlite3_errmsg(db) + ")";
+}
+
 class Statement {
  public:
   Statement(sqlite3* db, const std::string& sql, const std::string& path) : path_(path) {
     if (sqlite3_prepare_v2(db, sql.c_str(), -1, &stmt_, nullptr) != SQLITE_OK) {
-      const std::string why = sqlite3_errmsg(db);
+      const std::string why = Why(db);
       sqlite3_finalize(stmt_);
-      ThrowBagError(InputErrorKind::kBadHeader, path, "not a rosbag2 database: " + why);
+      ThrowBagError(InputErrorKind::kBadHeader, path, why);
     }
   }
   ~Statement() { sqlite3_finalize(stmt_); }
@@ -44,8 +54,7 @@ class Statement {
     const int rc = sqlite3_step(stmt_);
     if (rc == SQLITE_ROW) return true;
     if (rc == SQLITE_DONE) return false;
-    ThrowBagError(InputErrorKind::kBadHeader, path_,
-                  std::string("sqlite3: ") + sqlite3_errmsg(sqlite3_db_handle(stmt_)));
+    ThrowBagError(InputErrorKind::kBadHeader, path_, Why(sqlite3_db_handle(stmt_)));
   }
   sqlite3_stmt* get() const { return stmt_; }
 
