@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <functional>
 #include <limits>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -564,6 +565,57 @@ TEST(Malformed, ShortPayloadsAndUnterminatedStrings) {
   ExpectOneLineError([&] { DecodeString(ByteView(header_only), "s"); }, "CDR header");
   const std::vector<std::uint8_t> xcdr2 = {0x00, 0x07, 0x00, 0x00, 1, 0, 0, 0, 0};
   ExpectOneLineError([&] { DecodeString(ByteView(xcdr2), "s"); }, "unsupported CDR encapsulation");
+}
+
+// Opens `file` and reads and decodes everything in it; an InputError is a fine outcome, any
+// other exception fails the test (and a crash fails the run).
+void ReadEverythingOrInputError(const fs::path& file) {
+  try {
+    BagReader bag(file.string());
+    BagMessage m;
+    while (bag.ReadNext(&m)) {
+      if (IsKnownMessageType(m.topic->type)) DecodeMessage(m.topic->type, m.payload, Describe(m));
+    }
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+  }
+}
+
+// Seeded random damage (1-4 bytes overwritten) and truncation at many lengths, with the MCAP
+// CRCs off so that the damage reaches every parser rather than stopping at a CRC check.
+TEST(Malformed, RandomDamageEndsInInputErrorOrSuccess) {
+  testing::TempDir tmp;
+  std::mt19937 rng(20240611);
+  std::vector<Written> messages = MakeMessages();
+  messages.resize(48);
+  int bag = 0;
+  for (StorageFormat storage : {StorageFormat::kMcap, StorageFormat::kSqlite3}) {
+    for (Compression compression : {Compression::kNone, Compression::kZstd, Compression::kLz4}) {
+      if (storage == StorageFormat::kSqlite3 && compression != Compression::kNone) continue;
+      const fs::path dir = tmp.path() / ("b" + std::to_string(bag++));
+      BagWriterOptions options;
+      options.storage = storage;
+      options.mcap.compression = compression;
+      options.mcap.crcs = false;
+      options.mcap.chunk_bytes = 2048;
+      WriteBag(dir, options, messages);
+      const fs::path file = dir / (dir.filename().string() +
+                                   (storage == StorageFormat::kMcap ? "_0.mcap" : "_0.db3"));
+      const std::string original = testing::ReadFileBytes(file);
+      for (int trial = 0; trial < 150; ++trial) {
+        std::string damaged = original;
+        for (std::uint32_t k = 0, n = 1 + rng() % 4; k < n; ++k) {
+          damaged[rng() % damaged.size()] = static_cast<char>(rng());
+        }
+        testing::WriteFileBytes(file, damaged);
+        ReadEverythingOrInputError(file);
+      }
+      for (std::size_t length = 0; length < original.size(); length += 1 + original.size() / 60) {
+        testing::WriteFileBytes(file, original.substr(0, length));
+        ReadEverythingOrInputError(file);
+      }
+    }
+  }
 }
 
 TEST(Malformed, MetadataProblems) {

@@ -122,6 +122,41 @@ bool Decompressor::Decompress(Compression compression, ByteView input, std::uint
   return false;
 }
 
+bool Decompressor::CheckDeclaredSize(Compression compression, ByteView input,
+                                     std::uint64_t declared_size, std::string* error) {
+  const std::string declared = "declared uncompressed size " + std::to_string(declared_size);
+  if (compression == Compression::kZstd) {
+    const unsigned long long content = ZSTD_getFrameContentSize(input.data, input.size);
+    if (content == ZSTD_CONTENTSIZE_ERROR) {
+      *error = "not a zstd frame";
+      return false;
+    }
+    const bool one_frame = ZSTD_findFrameCompressedSize(input.data, input.size) == input.size;
+    if (content != ZSTD_CONTENTSIZE_UNKNOWN && one_frame && content != declared_size) {
+      *error = declared + " differs from the zstd frame's " + std::to_string(content);
+      return false;
+    }
+  } else if (compression == Compression::kLz4) {
+    constexpr std::uint64_t kMaxLz4Ratio = 255;
+    if (declared_size > input.size * kMaxLz4Ratio + 65536) {
+      *error = declared + " is more than lz4 can expand " + std::to_string(input.size) + " bytes to";
+      return false;
+    }
+    LZ4F_resetDecompressionContext(contexts_->lz4);
+    LZ4F_frameInfo_t info{};
+    std::size_t consumed = input.size;
+    if (LZ4F_isError(LZ4F_getFrameInfo(contexts_->lz4, &info, input.data, &consumed))) {
+      *error = "not an lz4 frame";
+      return false;
+    }
+    if (info.contentSize != 0 && info.contentSize > declared_size) {
+      *error = declared + " is less than the lz4 frame's " + std::to_string(info.contentSize);
+      return false;
+    }
+  }
+  return true;
+}
+
 std::vector<std::uint8_t> Compress(Compression compression, ByteView input) {
   std::vector<std::uint8_t> out;
   if (compression == Compression::kNone) return input.ToVector();

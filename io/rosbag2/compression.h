@@ -35,6 +35,13 @@ class Decompressor {
   bool Decompress(Compression compression, ByteView input, std::uint8_t* out,
                   std::size_t expected_size, std::string* error);
 
+  // Before allocating `declared_size` bytes: false (with the reason) when the compressed stream
+  // cannot decompress to that size. A zstd frame or an lz4 frame header that records its content
+  // size must agree with it; lz4 cannot expand more than 255:1 (a match length grows by 255 per
+  // extra byte, lz4 block format). Guards against a chunk header that claims gigabytes.
+  bool CheckDeclaredSize(Compression compression, ByteView input, std::uint64_t declared_size,
+                         std::string* error);
+
  private:
   struct Contexts;
   std::unique_ptr<Contexts> contexts_;

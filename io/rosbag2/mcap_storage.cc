@@ -390,8 +390,13 @@ ByteView McapStorage::DecompressChunk(const Block& block, ByteView stored,
          "Chunk declares " + std::to_string(block.uncompressed_bytes) +
              " uncompressed bytes, more than the 1 GiB fitcal holds in memory");
   }
-  out->resize(static_cast<std::size_t>(block.uncompressed_bytes));
   std::string error;
+  if (!decompressor_.CheckDeclaredSize(block.compression, stored, block.uncompressed_bytes,
+                                       &error)) {
+    Fail(InputErrorKind::kBadValue, block.record_offset,
+         std::string("bad ") + CompressionName(block.compression) + " Chunk: " + error);
+  }
+  out->resize(static_cast<std::size_t>(block.uncompressed_bytes));
   if (!decompressor_.Decompress(block.compression, stored, out->data(), out->size(), &error)) {
     Fail(InputErrorKind::kBadValue, block.record_offset,
          std::string("cannot decompress the ") + CompressionName(block.compression) +
