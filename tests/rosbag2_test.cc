@@ -372,17 +372,15 @@ TEST_P(RoundTrip, WrittenMessagesReadBackEqualInTimeOrder) {
 
 INSTANTIATE_TEST_SUITE_P(
     Formats, RoundTrip,
-    ::testing::Values(RoundTripCase{"sqlite3", StorageFormat::kSqlite3, Compression::kNone, false},
-                      RoundTripCase{"sqlite3_split", StorageFormat::kSqlite3, Compression::kNone,
-                                    true},
-                      RoundTripCase{"mcap", StorageFormat::kMcap, Compression::kNone, false},
-                      RoundTripCase{"mcap_split", StorageFormat::kMcap, Compression::kNone, true},
-                      RoundTripCase{"mcap_zstd", StorageFormat::kMcap, Compression::kZstd, false},
-                      RoundTripCase{"mcap_zstd_split", StorageFormat::kMcap, Compression::kZstd,
-                                    true},
-                      RoundTripCase{"mcap_lz4", StorageFormat::kMcap, Compression::kLz4, false},
-                      RoundTripCase{"mcap_lz4_split", StorageFormat::kMcap, Compression::kLz4,
-                                    true}),
+    ::testing::Values(
+        RoundTripCase{"sqlite3", StorageFormat::kSqlite3, Compression::kNone, false},
+        RoundTripCase{"sqlite3_split", StorageFormat::kSqlite3, Compression::kNone, true},
+        RoundTripCase{"mcap", StorageFormat::kMcap, Compression::kNone, false},
+        RoundTripCase{"mcap_split", StorageFormat::kMcap, Compression::kNone, true},
+        RoundTripCase{"mcap_zstd", StorageFormat::kMcap, Compression::kZstd, false},
+        RoundTripCase{"mcap_zstd_split", StorageFormat::kMcap, Compression::kZstd, true},
+        RoundTripCase{"mcap_lz4", StorageFormat::kMcap, Compression::kLz4, false},
+        RoundTripCase{"mcap_lz4_split", StorageFormat::kMcap, Compression::kLz4, true}),
     [](const ::testing::TestParamInfo<RoundTripCase>& p) { return p.param.name; });
 
 TEST(RoundTrip, McapWithoutSummaryOrCrcsReads) {
@@ -424,13 +422,13 @@ TEST(Cdr, BigEndianPayloadsDecode) {
 TEST(Cdr, JointStateLayoutIsTheRos2One) {
   // Hand-laid CDR_LE: stamp (7, 8), frame_id "a", name ["j"], position [0.5], no velocity/effort.
   const std::vector<std::uint8_t> bytes = {
-      0x00, 0x01, 0x00, 0x00,                          // encapsulation
-      7,    0,    0,    0,    8, 0, 0, 0,              // sec, nanosec
-      2,    0,    0,    0,    'a', 0, 0, 0,            // "a" + NUL + 2 padding
-      1,    0,    0,    0,    2, 0, 0, 0, 'j', 0, 0, 0,  // name: 1 string "j"
-      1,    0,    0,    0,                             // position: 1 double, at 32: aligned
-      0,    0,    0,    0,    0, 0, 0xE0, 0x3F,        // 0.5
-      0,    0,    0,    0,    0, 0, 0, 0};             // velocity [], effort []
+      0x00, 0x01, 0x00, 0x00,                                    // encapsulation
+      7,    0,    0,    0,    8,   0, 0,    0,                   // sec, nanosec
+      2,    0,    0,    0,    'a', 0, 0,    0,                   // "a" + NUL + 2 padding
+      1,    0,    0,    0,    2,   0, 0,    0,    'j', 0, 0, 0,  // name: 1 string "j"
+      1,    0,    0,    0,                         // position: 1 double, at 32: aligned
+      0,    0,    0,    0,    0,   0, 0xE0, 0x3F,  // 0.5
+      0,    0,    0,    0,    0,   0, 0,    0};    // velocity [], effort []
   const JointState js = DecodeJointState(ByteView(bytes), "hand-made");
   EXPECT_EQ(js.header.stamp.sec, 7);
   EXPECT_EQ(js.header.stamp.nanosec, 8u);

@@ -21,13 +21,13 @@ struct BagFileInfo {  // one entry of `files` (version 5 and later)
 
 struct BagMetadata {
   int version = 0;
-  std::string storage_identifier;               // "sqlite3" or "mcap"
+  std::string storage_identifier;                // "sqlite3" or "mcap"
   std::vector<std::string> relative_file_paths;  // in recording order
   std::vector<BagFileInfo> files;                // empty before version 5
   std::int64_t starting_time_ns = 0;             // starting_time.nanoseconds_since_epoch
   std::int64_t duration_ns = 0;                  // duration.nanoseconds
   std::uint64_t message_count = 0;
-  std::vector<TopicInfo> topics;  // topics_with_message_count, in the file's order
+  std::vector<TopicInfo> topics;   // topics_with_message_count, in the file's order
   std::string compression_format;  // "" or "zstd" (rosbag2 file/message compression)
   std::string compression_mode;    // "", "FILE" or "MESSAGE"
 };

@@ -72,9 +72,9 @@ void BagReader::OpenFromMetadata(const std::string& metadata_path) {
   metadata_ = std::make_unique<BagMetadata>(ReadBagMetadata(metadata_path));
   storage_identifier_ = metadata_->storage_identifier;
   if (storage_identifier_ != "sqlite3" && storage_identifier_ != "mcap") {
-    ThrowBagError(InputErrorKind::kBadValue, metadata_path,
-                  "unknown storage_identifier " + Printable(storage_identifier_) +
-                      " (known: sqlite3, mcap)");
+    ThrowBagError(
+        InputErrorKind::kBadValue, metadata_path,
+        "unknown storage_identifier " + Printable(storage_identifier_) + " (known: sqlite3, mcap)");
   }
   if (!metadata_->compression_mode.empty() || !metadata_->compression_format.empty()) {
     ThrowBagError(InputErrorKind::kBadValue, metadata_path,
@@ -155,7 +155,8 @@ bool BagReader::ReadNext(BagMessage* message) {
   }
   std::size_t best = storages_.size();
   for (std::size_t i = 0; i < storages_.size(); ++i) {
-    if (has_pending_[i] && (best == storages_.size() || pending_[i].time_ns < pending_[best].time_ns)) {
+    if (has_pending_[i] &&
+        (best == storages_.size() || pending_[i].time_ns < pending_[best].time_ns)) {
       best = i;
     }
   }

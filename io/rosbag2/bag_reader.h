@@ -23,10 +23,10 @@
 namespace fitcal::io::rosbag2 {
 
 struct BagMessage {
-  const TopicInfo* topic = nullptr;  // into BagReader::topics()
+  const TopicInfo* topic = nullptr;   // into BagReader::topics()
   const std::string* file = nullptr;  // into BagReader::files()
-  std::int64_t time_ns = 0;          // recording time, ns since the epoch
-  ByteView payload;                  // valid until the next ReadNext
+  std::int64_t time_ns = 0;           // recording time, ns since the epoch
+  ByteView payload;                   // valid until the next ReadNext
 };
 
 // "<file> <topic> message at <time> ns": names a message in decoder errors (the `what` of

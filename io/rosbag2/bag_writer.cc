@@ -27,8 +27,8 @@ BagWriter::~BagWriter() {
 
 void BagWriter::OpenNextFile() {
   const std::string extension = options_.storage == StorageFormat::kMcap ? ".mcap" : ".db3";
-  const std::string name = fs::path(directory_).filename().string() + "_" +
-                           std::to_string(paths_.size()) + extension;
+  const std::string name =
+      fs::path(directory_).filename().string() + "_" + std::to_string(paths_.size()) + extension;
   const std::string path = (fs::path(directory_) / name).string();
   fs::remove(path);  // sqlite3 would otherwise append to an old database
   current_ = options_.storage == StorageFormat::kMcap ? CreateMcapWriter(path, options_.mcap)

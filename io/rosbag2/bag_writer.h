@@ -24,7 +24,7 @@ enum class StorageFormat { kSqlite3, kMcap };
 
 struct BagWriterOptions {
   StorageFormat storage = StorageFormat::kMcap;
-  McapWriterOptions mcap;                   // MCAP only: chunk compression, size, CRCs, summary
+  McapWriterOptions mcap;                  // MCAP only: chunk compression, size, CRCs, summary
   std::uint64_t split_after_messages = 0;  // 0: one file; n: a new file after every n messages
 };
 
@@ -57,7 +57,7 @@ class BagWriter {
   std::unique_ptr<StorageWriter> current_;
   std::vector<std::string> paths_;
   BagMetadata metadata_;
-  BagFileInfo file_;           // the open file's statistics
+  BagFileInfo file_;  // the open file's statistics
   std::int64_t file_end_ns_ = 0;
   bool closed_ = false;
 };

@@ -41,9 +41,7 @@ CdrReader::CdrReader(ByteView payload, std::string what)
 
 CdrReader::~CdrReader() = default;
 
-std::size_t CdrReader::remaining() const {
-  return size_ - impl_->cdr.getSerializedDataLength();
-}
+std::size_t CdrReader::remaining() const { return size_ - impl_->cdr.getSerializedDataLength(); }
 
 void CdrReader::Fail(const std::string& why) const {
   ThrowBagError(InputErrorKind::kBadValue, what_, why);
@@ -57,8 +55,8 @@ T CdrReader::Read() {
     impl_->cdr.deserialize(value);
   } catch (const fcdr::exception::Exception& e) {
     Fail("payload shorter than its fields: a " + std::to_string(sizeof(T)) +
-         "-byte field at byte " + std::to_string(at) + " of " + std::to_string(size_) +
-         " (" + e.what() + ")");
+         "-byte field at byte " + std::to_string(at) + " of " + std::to_string(size_) + " (" +
+         e.what() + ")");
   }
   return value;
 }

@@ -25,8 +25,8 @@ class CdrWriter {
   void Uint32(std::uint32_t value);
   void Float64(double value);
   void String(const std::string& value);
-  void Array(const double* values, std::size_t count);  // float64[N]
-  void Sequence(const std::vector<double>& values);     // float64[]
+  void Array(const double* values, std::size_t count);    // float64[N]
+  void Sequence(const std::vector<double>& values);       // float64[]
   void Sequence(const std::vector<std::string>& values);  // string[]
 
   // The serialized message, header included.

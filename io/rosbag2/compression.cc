@@ -83,8 +83,8 @@ bool DecompressLz4(LZ4F_dctx* ctx, ByteView input, std::uint8_t* out, std::size_
     in_pos += in_size;
     out_pos += out_size;
     if (in_size == 0 && out_size == 0) {
-      *error = "lz4 data decompresses to more than the declared " + std::to_string(expected) +
-               " bytes";
+      *error =
+          "lz4 data decompresses to more than the declared " + std::to_string(expected) + " bytes";
       return false;
     }
   }
@@ -139,7 +139,8 @@ bool Decompressor::CheckDeclaredSize(Compression compression, ByteView input,
   } else if (compression == Compression::kLz4) {
     constexpr std::uint64_t kMaxLz4Ratio = 255;
     if (declared_size > input.size * kMaxLz4Ratio + 65536) {
-      *error = declared + " is more than lz4 can expand " + std::to_string(input.size) + " bytes to";
+      *error =
+          declared + " is more than lz4 can expand " + std::to_string(input.size) + " bytes to";
       return false;
     }
     LZ4F_resetDecompressionContext(contexts_->lz4);

@@ -6,9 +6,10 @@ namespace fitcal::io::rosbag2::mcap {
 
 std::string OpcodeName(std::uint8_t opcode) {
   static constexpr std::array<const char*, 16> kNames = {
-      "opcode 0x00", "Header",     "Footer",          "Schema",     "Channel",  "Message",
-      "Chunk",       "MessageIndex", "ChunkIndex",    "Attachment", "AttachmentIndex",
-      "Statistics",  "Metadata",   "MetadataIndex",   "SummaryOffset", "DataEnd"};
+      "opcode 0x00", "Header",        "Footer",          "Schema",
+      "Channel",     "Message",       "Chunk",           "MessageIndex",
+      "ChunkIndex",  "Attachment",    "AttachmentIndex", "Statistics",
+      "Metadata",    "MetadataIndex", "SummaryOffset",   "DataEnd"};
   if (opcode < kNames.size()) return kNames[opcode];
   static constexpr char kHex[] = "0123456789abcdef";
   return std::string("opcode 0x") + kHex[opcode >> 4] + kHex[opcode & 0xF];

@@ -172,8 +172,7 @@ void McapStorage::Scan() {
     if (length > in.remaining()) {
       Fail(InputErrorKind::kBadValue, offset,
            "truncated file: " + mcap::OpcodeName(opcode) + " record of " + std::to_string(length) +
-               " bytes runs past the end of the file (" + std::to_string(file_.size()) +
-               " bytes)");
+               " bytes runs past the end of the file (" + std::to_string(file_.size()) + " bytes)");
     }
     if (length > kMaxMcapRecordBytes) {
       Fail(InputErrorKind::kTooLarge, offset,
@@ -201,8 +200,9 @@ void McapStorage::ReadLeadingMagicAndHeader(SequentialReader* in) {
   const std::uint8_t* magic = in->Read(mcap::kMagicBytes);
   if (magic == nullptr) {
     ThrowBagError(InputErrorKind::kBadValue, file_.path(),
-                  "truncated file: " + std::to_string(file_.size()) + " bytes, shorter than the "
-                  "MCAP magic");
+                  "truncated file: " + std::to_string(file_.size()) +
+                      " bytes, shorter than the "
+                      "MCAP magic");
   }
   if (std::memcmp(magic, mcap::kMagic, mcap::kMagicBytes) != 0) {
     ThrowBagError(InputErrorKind::kBadHeader, file_.path(),
@@ -284,7 +284,7 @@ void McapStorage::OnChannel(ByteView content, std::uint64_t offset, const char* 
   const std::uint16_t schema_id = fields.U16();
   const std::string topic(fields.String());
   const std::string encoding(fields.String());
-  fields.SkipLengthPrefixed();  // metadata: offered_qos_profiles, type_description_hash
+  fields.SkipLengthPrefixed();             // metadata: offered_qos_profiles, type_description_hash
   if (topic_of_channel_[id] >= 0) return;  // a repeat (identical by the spec)
   const auto schema = schema_names_.find(schema_id);
   if (schema_id != 0 && schema == schema_names_.end()) {
@@ -508,8 +508,7 @@ void McapStorage::CheckFooter(ByteView content, std::uint64_t offset) {
   }
   if (end + mcap::kMagicBytes != file_.size()) {
     Fail(InputErrorKind::kBadValue, end + mcap::kMagicBytes,
-         std::to_string(file_.size() - end - mcap::kMagicBytes) +
-             " bytes after the closing magic");
+         std::to_string(file_.size() - end - mcap::kMagicBytes) + " bytes after the closing magic");
   }
 }
 
@@ -538,12 +537,14 @@ std::unique_ptr<OpenBlock> McapStorage::LoadBlock(std::size_t seq) {
   const Block& block = blocks_[seq];
   auto open = std::make_unique<OpenBlock>();
   open->seq = seq;
-  std::vector<std::uint8_t>& stored = block.compression == Compression::kNone ? open->bytes : scratch_;
+  std::vector<std::uint8_t>& stored =
+      block.compression == Compression::kNone ? open->bytes : scratch_;
   stored.resize(static_cast<std::size_t>(block.stored_bytes));
   if (!file_.ReadAt(block.data_offset, stored.size(), stored.data())) {
     Fail(InputErrorKind::kBadValue, block.record_offset, "the file changed while being read");
   }
-  if (block.compression != Compression::kNone) DecompressChunk(block, ByteView(stored), &open->bytes);
+  if (block.compression != Compression::kNone)
+    DecompressChunk(block, ByteView(stored), &open->bytes);
   open->entries.reserve(static_cast<std::size_t>(block.message_count));
   const char* name = block.is_chunk ? "Message in a Chunk" : "Message";
   WalkRecords(ByteView(open->bytes), file_.path(), block.record_offset,
@@ -588,8 +589,9 @@ bool McapStorage::Next(StoredMessage* message) {
   if (block->next < block->entries.size()) {
     heap_.push(block);
   } else {
-    const auto it = std::find_if(open_.begin(), open_.end(),
-                                 [&](const std::unique_ptr<OpenBlock>& b) { return b.get() == block; });
+    const auto it =
+        std::find_if(open_.begin(), open_.end(),
+                     [&](const std::unique_ptr<OpenBlock>& b) { return b.get() == block; });
     retired_ = std::move(*it);
     open_.erase(it);
   }

@@ -207,7 +207,6 @@ void McapWriter::Close() {
   file_ = nullptr;
 }
 
-
 // Spec "Statistics".
 Bytes StatisticsContent(std::uint64_t message_count, std::size_t topic_count,
                         std::size_t chunk_count, std::uint64_t start_ns, std::uint64_t end_ns,
@@ -273,9 +272,9 @@ void McapWriter::WriteSummary() {
   }
   group(Opcode::kSchema, schemas);
   group(Opcode::kChannel, channels);
-  group(Opcode::kStatistics, {StatisticsContent(message_count_, topics_.size(),
-                                                chunk_indexes_.size(), start_ns_, end_ns_,
-                                                channel_counts_)});
+  group(Opcode::kStatistics,
+        {StatisticsContent(message_count_, topics_.size(), chunk_indexes_.size(), start_ns_,
+                           end_ns_, channel_counts_)});
   group(Opcode::kChunkIndex, chunk_indexes);
   const std::uint64_t summary_offset_start = offset_;
   for (const auto& [opcode, range] : groups) {

@@ -222,8 +222,7 @@ bool operator==(const Transform& a, const Transform& b) {
 }
 
 bool operator==(const TransformStamped& a, const TransformStamped& b) {
-  return a.header == b.header && a.child_frame_id == b.child_frame_id &&
-         a.transform == b.transform;
+  return a.header == b.header && a.child_frame_id == b.child_frame_id && a.transform == b.transform;
 }
 
 bool operator==(const JointState& a, const JointState& b) {

@@ -162,8 +162,8 @@ std::vector<std::uint8_t> EncodeTfMessage(const TfMessage& msg, bool big_endian 
 std::vector<std::uint8_t> EncodeString(const StringMessage& msg, bool big_endian = false);
 
 // Any of the types above, by ROS type name ("sensor_msgs/msg/JointState").
-using RosMessage = std::variant<JointState, PoseStamped, Odometry, TfMessage, StringMessage,
-                                BasicTypes, Arrays>;
+using RosMessage =
+    std::variant<JointState, PoseStamped, Odometry, TfMessage, StringMessage, BasicTypes, Arrays>;
 bool IsKnownMessageType(const std::string& type);
 // Throws InputError ("unknown message type") for a type not listed above.
 RosMessage DecodeMessage(const std::string& type, ByteView payload, const std::string& what);

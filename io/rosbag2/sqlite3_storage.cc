@@ -111,7 +111,8 @@ class Sqlite3Storage : public StorageReader {
 };
 
 void Sqlite3Storage::ReadTopics() {
-  Statement stmt(db_.get(), "SELECT id, name, type, serialization_format FROM topics ORDER BY id", path_);
+  Statement stmt(db_.get(), "SELECT id, name, type, serialization_format FROM topics ORDER BY id",
+                 path_);
   while (stmt.Step()) {
     TopicInfo topic;
     topic.name = ColumnText(stmt.get(), 1);
@@ -160,7 +161,8 @@ bool Sqlite3Storage::Next(StoredMessage* message) {
   // sqlite3_column_blob before sqlite3_column_bytes (sqlite.org/c3ref/column_blob.html).
   const void* blob = sqlite3_column_blob(stmt, 2);
   const int size = sqlite3_column_bytes(stmt, 2);
-  message->payload = ByteView(static_cast<const std::uint8_t*>(blob), static_cast<std::size_t>(size));
+  message->payload =
+      ByteView(static_cast<const std::uint8_t*>(blob), static_cast<std::size_t>(size));
   return true;
 }
 

@@ -30,15 +30,14 @@ class Sqlite3Writer : public StorageWriter {
  public:
   explicit Sqlite3Writer(const std::string& path) : path_(path) {
     sqlite3* db = nullptr;
-    const int rc = sqlite3_open_v2(path.c_str(), &db,
-                                   SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
+    const int rc =
+        sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
     db_ = db;
     try {
       if (rc != SQLITE_OK) Fail("cannot create");
       Exec(kCreateTables);
       Prepare("INSERT INTO topics VALUES(?, ?, ?, ?, '', '')", &insert_topic_);
-      Prepare("INSERT INTO messages(topic_id, timestamp, data) VALUES(?, ?, ?)",
-              &insert_message_);
+      Prepare("INSERT INTO messages(topic_id, timestamp, data) VALUES(?, ?, ?)", &insert_message_);
     } catch (...) {
       Release();
       throw;
@@ -58,8 +57,8 @@ class Sqlite3Writer : public StorageWriter {
     sqlite3_bind_int64(insert_message_, 1, static_cast<sqlite3_int64>(topic_index + 1));
     sqlite3_bind_int64(insert_message_, 2, time_ns);
     // A zero-length blob must still be a blob, not NULL (data is NOT NULL).
-    sqlite3_bind_blob64(insert_message_, 3, payload.size > 0 ? payload.data : nullptr,
-                        payload.size, SQLITE_STATIC);
+    sqlite3_bind_blob64(insert_message_, 3, payload.size > 0 ? payload.data : nullptr, payload.size,
+                        SQLITE_STATIC);
     if (payload.size == 0) sqlite3_bind_zeroblob(insert_message_, 3, 0);
     Run(insert_message_);
   }

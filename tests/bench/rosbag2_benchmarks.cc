@@ -10,7 +10,8 @@
 // bytes_per_second is bag bytes on disk per second; payload_bytes_per_second counts the CDR
 // payloads handed out (the same work whatever the compression). The page cache is warm after the
 // first iteration: these measure parsing, checking and decompression, not the disk.
-//   build/tests/rosbag2_benchmarks --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+//   build/tests/rosbag2_benchmarks --benchmark_repetitions=5
+//   --benchmark_report_aggregates_only=true
 
 #include <benchmark/benchmark.h>
 #include <unistd.h>
