@@ -102,6 +102,13 @@ class McapStorage : public StorageReader {
 
  private:
   // Opening: one pass over the file.
+  struct Record {
+    std::uint64_t offset;
+    std::uint8_t prefix[mcap::kRecordPrefixBytes];  // a copy: Read() may move its buffer
+    std::uint8_t opcode;
+    ByteView content;
+  };
+  Record ReadRecord(SequentialReader* in, const char* missing);
   void Scan();
   void ReadLeadingMagicAndHeader(SequentialReader* in);
   bool ScanDataRecord(std::uint8_t opcode, ByteView content, std::uint64_t offset);
@@ -157,38 +164,45 @@ McapStorage::McapStorage(const std::string& path)
   FinishScan();
 }
 
+// The next record, whole. `missing` says what the file lacks when it ends before a record.
+McapStorage::Record McapStorage::ReadRecord(SequentialReader* in, const char* missing) {
+  Record r{};
+  r.offset = in->offset();
+  const std::uint8_t* prefix = in->Read(mcap::kRecordPrefixBytes);
+  if (prefix == nullptr) {
+    Fail(InputErrorKind::kBadValue, r.offset, std::string("truncated file: ") + missing);
+  }
+  std::memcpy(r.prefix, prefix, mcap::kRecordPrefixBytes);
+  r.opcode = r.prefix[0];
+  const auto length = LoadLe<std::uint64_t>(r.prefix + 1);
+  if (length > in->remaining()) {
+    Fail(InputErrorKind::kBadValue, r.offset,
+         "truncated file: " + mcap::OpcodeName(r.opcode) + " record of " + std::to_string(length) +
+             " bytes runs past the end of the file (" + std::to_string(file_.size()) + " bytes)");
+  }
+  if (length > kMaxMcapRecordBytes) {
+    Fail(InputErrorKind::kTooLarge, r.offset,
+         mcap::OpcodeName(r.opcode) + " record of " + std::to_string(length) +
+             " bytes is larger than the 1 GiB fitcal holds in memory");
+  }
+  r.content =
+      ByteView(in->Read(static_cast<std::size_t>(length)), static_cast<std::size_t>(length));
+  return r;
+}
+
 void McapStorage::Scan() {
   SequentialReader in(file_);
   ReadLeadingMagicAndHeader(&in);
   while (true) {
-    const std::uint64_t offset = in.offset();
-    const std::uint8_t* prefix = in.Read(mcap::kRecordPrefixBytes);
-    if (prefix == nullptr) {
-      Fail(InputErrorKind::kBadValue, offset,
-           "truncated file: it ends without a Data End or Footer record");
-    }
-    const std::uint8_t opcode = prefix[0];
-    const auto length = LoadLe<std::uint64_t>(prefix + 1);
-    if (length > in.remaining()) {
-      Fail(InputErrorKind::kBadValue, offset,
-           "truncated file: " + mcap::OpcodeName(opcode) + " record of " + std::to_string(length) +
-               " bytes runs past the end of the file (" + std::to_string(file_.size()) + " bytes)");
-    }
-    if (length > kMaxMcapRecordBytes) {
-      Fail(InputErrorKind::kTooLarge, offset,
-           mcap::OpcodeName(opcode) + " record of " + std::to_string(length) +
-               " bytes is larger than the 1 GiB fitcal holds in memory");
-    }
+    const Record r = ReadRecord(&in, "it ends without a Data End or Footer record");
     // The data section CRC covers every byte before the Data End record (spec "Data End").
-    if (opcode != static_cast<std::uint8_t>(Opcode::kDataEnd)) {
-      crc_.Update(prefix, mcap::kRecordPrefixBytes);
+    if (r.opcode != static_cast<std::uint8_t>(Opcode::kDataEnd)) {
+      crc_.Update(r.prefix, mcap::kRecordPrefixBytes);
     }
-    const ByteView content(in.Read(static_cast<std::size_t>(length)),
-                           static_cast<std::size_t>(length));
-    if (!ScanDataRecord(opcode, content, offset)) break;
-    crc_.Update(content.data, content.size);
-    if (opcode == static_cast<std::uint8_t>(Opcode::kMessage)) {
-      OnLooseMessage(content, offset, in.offset());
+    if (!ScanDataRecord(r.opcode, r.content, r.offset)) break;
+    crc_.Update(r.content.data, r.content.size);
+    if (r.opcode == static_cast<std::uint8_t>(Opcode::kMessage)) {
+      OnLooseMessage(r.content, r.offset, in.offset());
     }
   }
   ScanSummary(&in);
@@ -199,36 +213,23 @@ void McapStorage::ReadLeadingMagicAndHeader(SequentialReader* in) {
   if (file_.size() == 0) ThrowBagError(InputErrorKind::kEmptyFile, file_.path(), "empty file");
   const std::uint8_t* magic = in->Read(mcap::kMagicBytes);
   if (magic == nullptr) {
-    ThrowBagError(InputErrorKind::kBadValue, file_.path(),
-                  "truncated file: " + std::to_string(file_.size()) +
-                      " bytes, shorter than the "
-                      "MCAP magic");
+    ThrowBagError(
+        InputErrorKind::kBadValue, file_.path(),
+        "truncated file: " + std::to_string(file_.size()) + " bytes, shorter than the MCAP magic");
   }
   if (std::memcmp(magic, mcap::kMagic, mcap::kMagicBytes) != 0) {
     ThrowBagError(InputErrorKind::kBadHeader, file_.path(),
                   "bad magic: the file does not start with the MCAP magic \\x89MCAP0\\r\\n");
   }
   crc_.Update(magic, mcap::kMagicBytes);
-  const std::uint8_t* prefix = in->Read(mcap::kRecordPrefixBytes);
-  if (prefix == nullptr) {
-    Fail(InputErrorKind::kBadValue, mcap::kMagicBytes, "truncated file: no Header record");
+  const Record r = ReadRecord(in, "no Header record");
+  if (r.opcode != static_cast<std::uint8_t>(Opcode::kHeader)) {
+    Fail(InputErrorKind::kBadHeader, r.offset,
+         "the first record is " + mcap::OpcodeName(r.opcode) + ", not a Header");
   }
-  if (prefix[0] != static_cast<std::uint8_t>(Opcode::kHeader)) {
-    Fail(InputErrorKind::kBadHeader, mcap::kMagicBytes,
-         "the first record is " + mcap::OpcodeName(prefix[0]) + ", not a Header");
-  }
-  const auto length = LoadLe<std::uint64_t>(prefix + 1);
-  const std::uint8_t* content = length <= in->remaining() && length <= kMaxMcapRecordBytes
-                                    ? in->Read(static_cast<std::size_t>(length))
-                                    : nullptr;
-  if (content == nullptr) {
-    Fail(InputErrorKind::kBadValue, mcap::kMagicBytes,
-         "truncated file: the Header record runs past the end of the file");
-  }
-  crc_.Update(prefix, mcap::kRecordPrefixBytes);
-  crc_.Update(content, static_cast<std::size_t>(length));
-  FieldReader fields(ByteView(content, static_cast<std::size_t>(length)), file_.path(),
-                     mcap::kMagicBytes, "Header");
+  crc_.Update(r.prefix, mcap::kRecordPrefixBytes);
+  crc_.Update(r.content.data, r.content.size);
+  FieldReader fields(r.content, file_.path(), r.offset, "Header");
   fields.String();  // profile ("ros2" for rosbag2)
   fields.String();  // library
 }
@@ -459,30 +460,18 @@ void McapStorage::OnDataEnd(ByteView content, std::uint64_t offset) {
 void McapStorage::ScanSummary(SequentialReader* in) {
   if (!seen_data_end_) return;  // the Footer came straight after the data
   while (true) {
-    const std::uint64_t offset = in->offset();
-    const std::uint8_t* prefix = in->Read(mcap::kRecordPrefixBytes);
-    if (prefix == nullptr) {
-      Fail(InputErrorKind::kBadValue, offset, "truncated file: it ends without a Footer record");
-    }
-    const auto length = LoadLe<std::uint64_t>(prefix + 1);
-    if (length > in->remaining() || length > kMaxMcapRecordBytes) {
-      Fail(InputErrorKind::kBadValue, offset,
-           "truncated file: " + mcap::OpcodeName(prefix[0]) + " record of " +
-               std::to_string(length) + " bytes runs past the end of the file");
-    }
-    crc_.Update(prefix, mcap::kRecordPrefixBytes);
-    const ByteView content(in->Read(static_cast<std::size_t>(length)),
-                           static_cast<std::size_t>(length));
-    if (prefix[0] == static_cast<std::uint8_t>(Opcode::kFooter)) {
-      CheckFooter(content, offset);
+    const Record r = ReadRecord(in, "it ends without a Footer record");
+    crc_.Update(r.prefix, mcap::kRecordPrefixBytes);
+    if (r.opcode == static_cast<std::uint8_t>(Opcode::kFooter)) {
+      CheckFooter(r.content, r.offset);
       return;
     }
-    if (prefix[0] == static_cast<std::uint8_t>(Opcode::kMessage) ||
-        prefix[0] == static_cast<std::uint8_t>(Opcode::kChunk)) {
-      Fail(InputErrorKind::kBadValue, offset,
-           mcap::OpcodeName(prefix[0]) + " record after Data End (only the summary may follow)");
+    if (r.opcode == static_cast<std::uint8_t>(Opcode::kMessage) ||
+        r.opcode == static_cast<std::uint8_t>(Opcode::kChunk)) {
+      Fail(InputErrorKind::kBadValue, r.offset,
+           mcap::OpcodeName(r.opcode) + " record after Data End (only the summary may follow)");
     }
-    crc_.Update(content.data, content.size);
+    crc_.Update(r.content.data, r.content.size);
   }
 }
 
