@@ -394,6 +394,60 @@ TEST(RoundTrip, McapWithoutSummaryOrCrcsReads) {
   EXPECT_EQ(ReadAll(bag).size(), 160u);
 }
 
+// Messages outside chunks (spec "Data Section"), in a split bag: the reader groups them into
+// blocks and merges the blocks and files by time.
+TEST(RoundTrip, McapWithoutChunksReads) {
+  testing::TempDir tmp;
+  BagWriterOptions options;
+  options.mcap.chunked = false;
+  options.split_after_messages = 100;
+  std::vector<Written> expected = MakeMessages();
+  WriteBag(tmp.path() / "bag", options, expected);
+  std::stable_sort(expected.begin(), expected.end(),
+                   [](const Written& a, const Written& b) { return a.time_ns < b.time_ns; });
+  BagReader bag((tmp.path() / "bag").string());
+  EXPECT_EQ(bag.files().size(), 2u);
+  const std::vector<ReadMessage> read = ReadAll(bag);
+  ASSERT_EQ(read.size(), expected.size());
+  for (std::size_t i = 0; i < read.size(); ++i) {
+    EXPECT_EQ(read[i].time_ns, expected[i].time_ns) << i;
+    EXPECT_EQ(DecodeMessage(read[i].type, ByteView(read[i].payload), read[i].what),
+              expected[i].message)
+        << i;
+  }
+}
+
+// Times written as a permutation, so every chunk (or block of loose messages, 4 MiB each)
+// overlaps every other in time: the reader must merge all of them.
+TEST(RoundTrip, OverlappingChunksComeOutInTimeOrder) {
+  testing::TempDir tmp;
+  const std::int64_t n = 60000;  // ~6 MB of messages: two loose blocks
+  for (bool chunked : {true, false}) {
+    const fs::path dir = tmp.path() / (chunked ? "chunked" : "loose");
+    BagWriterOptions options;
+    options.mcap.chunked = chunked;
+    options.mcap.chunk_bytes = 64 << 10;
+    BagWriter writer(dir.string(), options);
+    writer.AddTopic("/chatter", "std_msgs/msg/String");
+    for (std::int64_t i = 0; i < n; ++i) {
+      const std::int64_t t_ns = (i * 7919) % n;  // 7919 is prime: a permutation of 0..n-1
+      const StringMessage text{"message " + std::to_string(t_ns) + std::string(50, '.')};
+      writer.Write("/chatter", t_ns, ByteView(EncodeString(text)));
+    }
+    writer.Close();
+    BagReader bag(dir.string());
+    BagMessage m;
+    std::int64_t expected_ns = 0;
+    while (bag.ReadNext(&m)) {
+      ASSERT_EQ(m.time_ns, expected_ns);
+      ASSERT_EQ(DecodeString(m.payload, Describe(m)).data.substr(0, 14),
+                ("message " + std::to_string(expected_ns) + "......").substr(0, 14));
+      ++expected_ns;
+    }
+    EXPECT_EQ(expected_ns, n);
+  }
+}
+
 TEST(RoundTrip, EmptyBagHasTopicsAndNoMessages) {
   testing::TempDir tmp;
   for (StorageFormat storage : {StorageFormat::kSqlite3, StorageFormat::kMcap}) {

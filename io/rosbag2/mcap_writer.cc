@@ -83,6 +83,7 @@ class McapWriter : public StorageWriter {
   void Emit(const void* data, std::size_t size);
   void EmitRecord(Opcode opcode, const Bytes& content);
   void FlushChunk();
+  void ResetChunk();
   void WriteMessageIndexes(ChunkIndexEntry* entry);
   void WriteSummary();
   void WriteFooter(std::uint64_t summary_start, std::uint64_t summary_offset_start);
@@ -151,6 +152,11 @@ void McapWriter::Write(std::size_t topic_index, std::int64_t time_ns, ByteView p
 // Spec "Chunk": start/end time, uncompressed size and CRC, compression, records.
 void McapWriter::FlushChunk() {
   if (chunk_.empty()) return;
+  if (!options_.chunked) {  // the same records, straight into the data section
+    Emit(chunk_.data(), chunk_.size());
+    ResetChunk();
+    return;
+  }
   const Bytes stored = Compress(options_.compression, ByteView(chunk_));
   Bytes content;
   AppendLe(&content, chunk_index_.empty() ? std::uint64_t{0} : chunk_start_ns_);
@@ -171,6 +177,10 @@ void McapWriter::FlushChunk() {
   EmitRecord(Opcode::kChunk, content);
   WriteMessageIndexes(&entry);
   chunk_indexes_.push_back(std::move(entry));
+  ResetChunk();
+}
+
+void McapWriter::ResetChunk() {
   chunk_.clear();
   chunk_index_.clear();
   chunk_message_count_ = 0;

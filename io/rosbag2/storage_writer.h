@@ -29,6 +29,7 @@ struct McapWriterOptions {
   std::size_t chunk_bytes = 1 << 20;  // a chunk is closed once its records reach this size
   bool crcs = true;                   // chunk, data section and summary CRCs (0 when off)
   bool summary = true;                // Summary and Summary Offset sections
+  bool chunked = true;                // false: Schema, Channel, Message records outside chunks
 };
 
 // mcap_writer.cc: chunks with Message Index records after each, Data End, optional summary.
