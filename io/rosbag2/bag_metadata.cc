@@ -1,0 +1,170 @@
+#include "io/rosbag2/bag_metadata.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <sstream>
+
+#include "io/input_error.h"
+
+namespace fitcal::io::rosbag2 {
+namespace {
+
+int LineOf(const YAML::Node& node) { return node.Mark().line >= 0 ? node.Mark().line + 1 : 0; }
+
+YAML::Node Required(const YAML::Node& map, const std::string& key, const std::string& path) {
+  if (!map.IsMap()) {
+    throw InputError(InputErrorKind::kWrongYamlType, path, LineOf(map),
+                     "expected a map holding '" + key + "'");
+  }
+  const YAML::Node value = map[key];
+  if (!value) {
+    throw InputError(InputErrorKind::kMissingKey, path, LineOf(map), "missing key '" + key + "'");
+  }
+  return value;
+}
+
+template <typename T>
+T Scalar(const YAML::Node& node, const std::string& key, const std::string& path) {
+  if (!node.IsScalar()) {
+    throw InputError(InputErrorKind::kWrongYamlType, path, LineOf(node),
+                     "'" + key + "' is not a scalar");
+  }
+  try {
+    return node.as<T>();
+  } catch (const YAML::Exception&) {
+    throw InputError(InputErrorKind::kBadValue, path, LineOf(node),
+                     "'" + key + "' has a value of the wrong type");
+  }
+}
+
+template <typename T>
+T Get(const YAML::Node& map, const std::string& key, const std::string& path) {
+  return Scalar<T>(Required(map, key, path), key, path);
+}
+
+// An optional string (a key absent or `~` reads as "").
+std::string OptionalString(const YAML::Node& map, const std::string& key, const std::string& path) {
+  const YAML::Node value = map[key];
+  if (!value || value.IsNull()) return "";
+  return Scalar<std::string>(value, key, path);
+}
+
+YAML::Node RequiredList(const YAML::Node& map, const std::string& key, const std::string& path) {
+  const YAML::Node list = Required(map, key, path);
+  if (!list.IsSequence()) {
+    throw InputError(InputErrorKind::kWrongYamlType, path, LineOf(list),
+                     "'" + key + "' is not a list");
+  }
+  return list;
+}
+
+std::int64_t Nanoseconds(const YAML::Node& map, const std::string& key, const std::string& inner,
+                         const std::string& path) {
+  return Get<std::int64_t>(Required(map, key, path), inner, path);
+}
+
+TopicInfo ReadTopic(const YAML::Node& entry, const std::string& path) {
+  const YAML::Node topic = Required(entry, "topic_metadata", path);
+  TopicInfo info;
+  info.name = Get<std::string>(topic, "name", path);
+  info.type = Get<std::string>(topic, "type", path);
+  info.serialization_format = Get<std::string>(topic, "serialization_format", path);
+  info.message_count = Get<std::uint64_t>(entry, "message_count", path);
+  return info;
+}
+
+BagFileInfo ReadFileInfo(const YAML::Node& entry, const std::string& path) {
+  BagFileInfo file;
+  file.path = Get<std::string>(entry, "path", path);
+  file.starting_time_ns = Nanoseconds(entry, "starting_time", "nanoseconds_since_epoch", path);
+  file.duration_ns = Nanoseconds(entry, "duration", "nanoseconds", path);
+  file.message_count = Get<std::uint64_t>(entry, "message_count", path);
+  return file;
+}
+
+BagMetadata ReadInformation(const YAML::Node& info, const std::string& path) {
+  BagMetadata m;
+  m.version = Get<int>(info, "version", path);
+  m.storage_identifier = Get<std::string>(info, "storage_identifier", path);
+  for (const YAML::Node& p : RequiredList(info, "relative_file_paths", path)) {
+    m.relative_file_paths.push_back(Scalar<std::string>(p, "relative_file_paths", path));
+  }
+  if (info["files"]) {
+    for (const YAML::Node& f : RequiredList(info, "files", path)) {
+      m.files.push_back(ReadFileInfo(f, path));
+    }
+  }
+  m.starting_time_ns = Nanoseconds(info, "starting_time", "nanoseconds_since_epoch", path);
+  m.duration_ns = Nanoseconds(info, "duration", "nanoseconds", path);
+  m.message_count = Get<std::uint64_t>(info, "message_count", path);
+  for (const YAML::Node& t : RequiredList(info, "topics_with_message_count", path)) {
+    m.topics.push_back(ReadTopic(t, path));
+  }
+  m.compression_format = OptionalString(info, "compression_format", path);
+  m.compression_mode = OptionalString(info, "compression_mode", path);
+  return m;
+}
+
+}  // namespace
+
+BagMetadata ReadBagMetadata(const std::string& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw InputError(InputErrorKind::kMissingFile, path, 0, "cannot open metadata.yaml");
+  } catch (const YAML::ParserException& e) {
+    throw InputError(InputErrorKind::kYamlSyntax, path, e.mark.line + 1, e.msg);
+  }
+  return ReadInformation(Required(root, "rosbag2_bagfile_information", path), path);
+}
+
+namespace {
+
+void EmitTopic(YAML::Emitter& out, const TopicInfo& topic) {
+  out << YAML::BeginMap << YAML::Key << "topic_metadata" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "name" << YAML::Value << topic.name;
+  out << YAML::Key << "type" << YAML::Value << topic.type;
+  out << YAML::Key << "serialization_format" << YAML::Value << topic.serialization_format;
+  out << YAML::Key << "offered_qos_profiles" << YAML::Value << YAML::DoubleQuoted << "";
+  out << YAML::EndMap;
+  out << YAML::Key << "message_count" << YAML::Value << topic.message_count << YAML::EndMap;
+}
+
+void EmitTime(YAML::Emitter& out, const char* key, const char* inner, std::int64_t value_ns) {
+  out << YAML::Key << key << YAML::Value << YAML::BeginMap << YAML::Key << inner << YAML::Value
+      << value_ns << YAML::EndMap;
+}
+
+void EmitFile(YAML::Emitter& out, const BagFileInfo& file) {
+  out << YAML::BeginMap << YAML::Key << "path" << YAML::Value << file.path;
+  EmitTime(out, "starting_time", "nanoseconds_since_epoch", file.starting_time_ns);
+  EmitTime(out, "duration", "nanoseconds", file.duration_ns);
+  out << YAML::Key << "message_count" << YAML::Value << file.message_count << YAML::EndMap;
+}
+
+}  // namespace
+
+std::string BagMetadataToYaml(const BagMetadata& m) {
+  YAML::Emitter out;
+  out << YAML::BeginMap << YAML::Key << "rosbag2_bagfile_information" << YAML::Value
+      << YAML::BeginMap;
+  out << YAML::Key << "version" << YAML::Value << m.version;
+  out << YAML::Key << "storage_identifier" << YAML::Value << m.storage_identifier;
+  EmitTime(out, "duration", "nanoseconds", m.duration_ns);
+  EmitTime(out, "starting_time", "nanoseconds_since_epoch", m.starting_time_ns);
+  out << YAML::Key << "message_count" << YAML::Value << m.message_count;
+  out << YAML::Key << "topics_with_message_count" << YAML::Value << YAML::BeginSeq;
+  for (const TopicInfo& topic : m.topics) EmitTopic(out, topic);
+  out << YAML::EndSeq;
+  out << YAML::Key << "compression_format" << YAML::Value << YAML::DoubleQuoted
+      << m.compression_format;
+  out << YAML::Key << "compression_mode" << YAML::Value << YAML::DoubleQuoted << m.compression_mode;
+  out << YAML::Key << "relative_file_paths" << YAML::Value << m.relative_file_paths;
+  out << YAML::Key << "files" << YAML::Value << YAML::BeginSeq;
+  for (const BagFileInfo& file : m.files) EmitFile(out, file);
+  out << YAML::EndSeq << YAML::EndMap << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+}  // namespace fitcal::io::rosbag2

@@ -1,0 +1,173 @@
+#include "io/rosbag2/bag_reader.h"
+
+#include <filesystem>
+#include <limits>
+
+#include "io/rosbag2/errors.h"
+#include "io/rosbag2/mcap_storage.h"
+#include "io/rosbag2/sqlite3_storage.h"
+
+namespace fitcal::io::rosbag2 {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The storage plugin of a single file, from its extension (rosbag2 names them so).
+std::string StorageOfFile(const fs::path& file) {
+  if (file.extension() == ".db3") return "sqlite3";
+  if (file.extension() == ".mcap") return "mcap";
+  ThrowBagError(InputErrorKind::kBadValue, file.string(),
+                "not a bag: expected a bag directory, metadata.yaml, .db3 or .mcap file");
+}
+
+// A relative_file_paths entry resolved against the bag directory. Bags of metadata version < 4
+// stored "<bag dir name>/<file>", relative to the directory above the bag.
+std::string ResolveBagFile(const fs::path& bag_dir, const std::string& relative,
+                           const std::string& metadata_path) {
+  const fs::path rel(relative);
+  for (const fs::path& part : rel) {
+    if (part == "..") {
+      ThrowBagError(InputErrorKind::kBadPath, metadata_path,
+                    "file " + Printable(relative) + " lies outside the bag directory");
+    }
+  }
+  if (rel.is_absolute() || relative.empty()) {
+    ThrowBagError(InputErrorKind::kBadPath, metadata_path,
+                  "file " + Printable(relative) + " is not a path relative to the bag");
+  }
+  const fs::path direct = bag_dir / rel;
+  const fs::path old_style = bag_dir.parent_path() / rel;
+  if (!fs::exists(direct) && fs::exists(old_style)) return old_style.string();
+  return direct.string();
+}
+
+}  // namespace
+
+std::string Describe(const BagMessage& message) {
+  return (message.file != nullptr ? *message.file : std::string("?")) + " " +
+         (message.topic != nullptr ? message.topic->name : std::string("?")) + " message at " +
+         std::to_string(message.time_ns) + " ns";
+}
+
+BagReader::BagReader(const std::string& path) {
+  const fs::path p(path);
+  if (fs::is_directory(p)) {
+    OpenFromMetadata((p / "metadata.yaml").string());
+  } else if (p.filename() == "metadata.yaml") {
+    OpenFromMetadata(path);
+  } else {
+    if (!fs::exists(p)) ThrowBagError(InputErrorKind::kMissingFile, path, "no such bag file");
+    storage_identifier_ = StorageOfFile(p);
+    files_.push_back(path);
+  }
+  OpenStorages();
+}
+
+BagReader::~BagReader() = default;
+
+void BagReader::OpenFromMetadata(const std::string& metadata_path) {
+  if (!fs::exists(metadata_path)) {
+    ThrowBagError(InputErrorKind::kMissingFile, metadata_path, "the bag has no metadata.yaml");
+  }
+  metadata_ = std::make_unique<BagMetadata>(ReadBagMetadata(metadata_path));
+  storage_identifier_ = metadata_->storage_identifier;
+  if (storage_identifier_ != "sqlite3" && storage_identifier_ != "mcap") {
+    ThrowBagError(
+        InputErrorKind::kBadValue, metadata_path,
+        "unknown storage_identifier " + Printable(storage_identifier_) + " (known: sqlite3, mcap)");
+  }
+  if (!metadata_->compression_mode.empty() || !metadata_->compression_format.empty()) {
+    ThrowBagError(InputErrorKind::kBadValue, metadata_path,
+                  "compressed bag (compression_mode " + Printable(metadata_->compression_mode) +
+                      ", format " + Printable(metadata_->compression_format) +
+                      ") is not supported; MCAP chunk compression is");
+  }
+  const fs::path bag_dir = fs::path(metadata_path).parent_path();
+  for (const std::string& relative : metadata_->relative_file_paths) {
+    files_.push_back(ResolveBagFile(bag_dir, relative, metadata_path));
+  }
+}
+
+void BagReader::OpenStorages() {
+  std::int64_t first = std::numeric_limits<std::int64_t>::max();
+  std::int64_t last = std::numeric_limits<std::int64_t>::min();
+  for (const std::string& file : files_) {
+    storages_.push_back(storage_identifier_ == "mcap" ? OpenMcapStorage(file)
+                                                      : OpenSqlite3Storage(file));
+    MergeTopics(storages_.size() - 1);
+    const StorageReader& storage = *storages_.back();
+    std::uint64_t count = 0;
+    for (const TopicInfo& topic : storage.topics()) count += topic.message_count;
+    if (count == 0) continue;
+    first = std::min(first, storage.start_time_ns());
+    last = std::max(last, storage.end_time_ns());
+  }
+  if (first <= last) {
+    start_ns_ = first;
+    end_ns_ = last;
+  }
+  pending_.resize(storages_.size());
+  has_pending_.assign(storages_.size(), false);
+}
+
+// Topics are matched across the files of a split bag by name.
+void BagReader::MergeTopics(std::size_t file_index) {
+  std::vector<std::size_t> map;
+  for (const TopicInfo& topic : storages_[file_index]->topics()) {
+    std::size_t i = 0;
+    while (i < topics_.size() && topics_[i].name != topic.name) ++i;
+    if (i == topics_.size()) {
+      topics_.push_back(topic);
+      topics_.back().message_count = 0;
+    }
+    topics_[i].message_count += topic.message_count;
+    map.push_back(i);
+  }
+  topic_map_.push_back(std::move(map));
+}
+
+const TopicInfo* BagReader::FindTopic(const std::string& name) const {
+  for (const TopicInfo& topic : topics_) {
+    if (topic.name == name) return &topic;
+  }
+  return nullptr;
+}
+
+std::uint64_t BagReader::message_count() const {
+  std::uint64_t count = 0;
+  for (const TopicInfo& topic : topics_) count += topic.message_count;
+  return count;
+}
+
+bool BagReader::Advance(std::size_t file_index) {
+  has_pending_[file_index] = storages_[file_index]->Next(&pending_[file_index]);
+  return has_pending_[file_index];
+}
+
+// A k-way merge of the files, each already in time order. Only the file whose message went out
+// last is advanced, so the payloads of the others stay valid.
+bool BagReader::ReadNext(BagMessage* message) {
+  if (!started_) {
+    for (std::size_t i = 0; i < storages_.size(); ++i) Advance(i);
+    started_ = true;
+  } else if (!storages_.empty() && has_pending_[last_file_]) {
+    Advance(last_file_);
+  }
+  std::size_t best = storages_.size();
+  for (std::size_t i = 0; i < storages_.size(); ++i) {
+    if (has_pending_[i] &&
+        (best == storages_.size() || pending_[i].time_ns < pending_[best].time_ns)) {
+      best = i;
+    }
+  }
+  if (best == storages_.size()) return false;
+  last_file_ = best;
+  const StoredMessage& next = pending_[best];
+  message->topic = &topics_[topic_map_[best][next.topic_index]];
+  message->file = &files_[best];
+  message->time_ns = next.time_ns;
+  message->payload = next.payload;
+  return true;
+}
+
+}  // namespace fitcal::io::rosbag2

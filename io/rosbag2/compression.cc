@@ -1,0 +1,180 @@
+#include "io/rosbag2/compression.h"
+
+#include <lz4frame.h>
+#include <zstd.h>
+
+#include <stdexcept>
+
+namespace fitcal::io::rosbag2 {
+
+std::optional<Compression> ParseCompression(std::string_view name) {
+  if (name.empty()) return Compression::kNone;
+  if (name == "zstd") return Compression::kZstd;
+  if (name == "lz4") return Compression::kLz4;
+  return std::nullopt;
+}
+
+const char* CompressionName(Compression compression) {
+  switch (compression) {
+    case Compression::kNone:
+      return "";
+    case Compression::kZstd:
+      return "zstd";
+    case Compression::kLz4:
+      return "lz4";
+  }
+  return "";
+}
+
+struct Decompressor::Contexts {
+  ZSTD_DCtx* zstd = nullptr;
+  LZ4F_dctx* lz4 = nullptr;
+};
+
+Decompressor::Decompressor() : contexts_(std::make_unique<Contexts>()) {
+  contexts_->zstd = ZSTD_createDCtx();
+  if (LZ4F_isError(LZ4F_createDecompressionContext(&contexts_->lz4, LZ4F_VERSION))) {
+    contexts_->lz4 = nullptr;
+  }
+  if (contexts_->zstd == nullptr || contexts_->lz4 == nullptr) {
+    throw std::bad_alloc();
+  }
+}
+
+Decompressor::~Decompressor() {
+  ZSTD_freeDCtx(contexts_->zstd);
+  LZ4F_freeDecompressionContext(contexts_->lz4);
+}
+
+namespace {
+
+bool DecompressZstd(ZSTD_DCtx* ctx, ByteView input, std::uint8_t* out, std::size_t expected,
+                    std::string* error) {
+  const std::size_t written = ZSTD_decompressDCtx(ctx, out, expected, input.data, input.size);
+  if (ZSTD_isError(written)) {
+    *error = std::string("zstd: ") + ZSTD_getErrorName(written);
+    return false;
+  }
+  if (written != expected) {
+    *error = "zstd data decompresses to " + std::to_string(written) + " bytes, not the declared " +
+             std::to_string(expected);
+    return false;
+  }
+  return true;
+}
+
+// LZ4 frame format (lz4 project's lz4_Frame_format.md): a stream may hold several frames;
+// LZ4F_decompress returns 0 at the end of each one. Output beyond `expected` means the header's
+// uncompressed size is wrong.
+bool DecompressLz4(LZ4F_dctx* ctx, ByteView input, std::uint8_t* out, std::size_t expected,
+                   std::string* error) {
+  LZ4F_resetDecompressionContext(ctx);
+  std::size_t in_pos = 0;
+  std::size_t out_pos = 0;
+  std::size_t hint = 1;  // nonzero: inside a frame
+  while (in_pos < input.size) {
+    std::size_t out_size = expected - out_pos;
+    std::size_t in_size = input.size - in_pos;
+    hint = LZ4F_decompress(ctx, out + out_pos, &out_size, input.data + in_pos, &in_size, nullptr);
+    if (LZ4F_isError(hint)) {
+      *error = std::string("lz4: ") + LZ4F_getErrorName(hint);
+      return false;
+    }
+    in_pos += in_size;
+    out_pos += out_size;
+    if (in_size == 0 && out_size == 0) {
+      *error =
+          "lz4 data decompresses to more than the declared " + std::to_string(expected) + " bytes";
+      return false;
+    }
+  }
+  if (hint != 0) {
+    *error = "lz4 frame is truncated";
+    return false;
+  }
+  if (out_pos != expected) {
+    *error = "lz4 data decompresses to " + std::to_string(out_pos) + " bytes, not the declared " +
+             std::to_string(expected);
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+bool Decompressor::Decompress(Compression compression, ByteView input, std::uint8_t* out,
+                              std::size_t expected_size, std::string* error) {
+  switch (compression) {
+    case Compression::kNone:
+      if (input.size != expected_size) {
+        *error = "uncompressed size " + std::to_string(expected_size) + " differs from the " +
+                 std::to_string(input.size) + " bytes stored";
+        return false;
+      }
+      if (expected_size > 0) std::memcpy(out, input.data, expected_size);
+      return true;
+    case Compression::kZstd:
+      return DecompressZstd(contexts_->zstd, input, out, expected_size, error);
+    case Compression::kLz4:
+      return DecompressLz4(contexts_->lz4, input, out, expected_size, error);
+  }
+  *error = "unknown compression";
+  return false;
+}
+
+bool Decompressor::CheckDeclaredSize(Compression compression, ByteView input,
+                                     std::uint64_t declared_size, std::string* error) {
+  const std::string declared = "declared uncompressed size " + std::to_string(declared_size);
+  if (compression == Compression::kZstd) {
+    const unsigned long long content = ZSTD_getFrameContentSize(input.data, input.size);
+    if (content == ZSTD_CONTENTSIZE_ERROR) {
+      *error = "not a zstd frame";
+      return false;
+    }
+    const bool one_frame = ZSTD_findFrameCompressedSize(input.data, input.size) == input.size;
+    if (content != ZSTD_CONTENTSIZE_UNKNOWN && one_frame && content != declared_size) {
+      *error = declared + " differs from the zstd frame's " + std::to_string(content);
+      return false;
+    }
+  } else if (compression == Compression::kLz4) {
+    constexpr std::uint64_t kMaxLz4Ratio = 255;
+    if (declared_size > input.size * kMaxLz4Ratio + 65536) {
+      *error =
+          declared + " is more than lz4 can expand " + std::to_string(input.size) + " bytes to";
+      return false;
+    }
+    LZ4F_resetDecompressionContext(contexts_->lz4);
+    LZ4F_frameInfo_t info{};
+    std::size_t consumed = input.size;
+    if (LZ4F_isError(LZ4F_getFrameInfo(contexts_->lz4, &info, input.data, &consumed))) {
+      *error = "not an lz4 frame";
+      return false;
+    }
+    if (info.contentSize != 0 && info.contentSize > declared_size) {
+      *error = declared + " is less than the lz4 frame's " + std::to_string(info.contentSize);
+      return false;
+    }
+  }
+  return true;
+}
+
+std::vector<std::uint8_t> Compress(Compression compression, ByteView input) {
+  std::vector<std::uint8_t> out;
+  if (compression == Compression::kNone) return input.ToVector();
+  if (compression == Compression::kZstd) {
+    out.resize(ZSTD_compressBound(input.size));
+    const std::size_t n = ZSTD_compress(out.data(), out.size(), input.data, input.size, 1);
+    if (ZSTD_isError(n)) throw std::runtime_error(std::string("zstd: ") + ZSTD_getErrorName(n));
+    out.resize(n);
+    return out;
+  }
+  LZ4F_preferences_t prefs{};
+  prefs.frameInfo.contentSize = input.size;
+  out.resize(LZ4F_compressFrameBound(input.size, &prefs));
+  const std::size_t n = LZ4F_compressFrame(out.data(), out.size(), input.data, input.size, &prefs);
+  if (LZ4F_isError(n)) throw std::runtime_error(std::string("lz4: ") + LZ4F_getErrorName(n));
+  out.resize(n);
+  return out;
+}
+
+}  // namespace fitcal::io::rosbag2

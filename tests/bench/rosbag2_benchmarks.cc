@@ -1,0 +1,155 @@
+// rosbag2 read throughput (io/rosbag2) on bags of sensor_msgs/msg/JointState (6 joints, ~270
+// bytes of CDR each) that the writer makes once in a temporary directory, about
+// FITCAL_BENCH_BAG_MB (default 50) MB of messages each:
+//   BM_ReadBag/mcap        MCAP, uncompressed 1 MiB chunks with CRCs (target: >= 200 MB/s)
+//   BM_ReadBag/mcap_zstd   MCAP, zstd chunks
+//   BM_ReadBag/mcap_lz4    MCAP, lz4 frame chunks
+//   BM_ReadBag/sqlite3     sqlite3 (.db3)
+//   BM_ReadAndDecode/mcap  the uncompressed MCAP, every message decoded to a JointState
+// One iteration opens the bag (for MCAP the full checking scan) and reads every message.
+// bytes_per_second is bag bytes on disk per second; payload_bytes_per_second counts the CDR
+// payloads handed out (the same work whatever the compression). The page cache is warm after the
+// first iteration: these measure parsing, checking and decompression, not the disk.
+//   build/tests/rosbag2_benchmarks --benchmark_repetitions=5
+//   --benchmark_report_aggregates_only=true
+
+#include <benchmark/benchmark.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <string>
+
+#include "io/rosbag2/bag_reader.h"
+#include "io/rosbag2/bag_writer.h"
+#include "io/rosbag2/ros_messages.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+namespace rb = fitcal::io::rosbag2;
+
+long EnvOr(const char* name, long fallback) {
+  const char* v = std::getenv(name);
+  return v != nullptr ? std::atol(v) : fallback;
+}
+
+class TempDir {
+ public:
+  TempDir() {
+    std::string tmpl = (fs::temp_directory_path() / "fitcal-rosbag2-bench-XXXXXX").string();
+    if (mkdtemp(tmpl.data()) == nullptr) std::abort();
+    path_ = tmpl;
+  }
+  ~TempDir() {
+    std::error_code ignored;
+    fs::remove_all(path_, ignored);
+  }
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+rb::JointState Sample(long i) {
+  rb::JointState js;
+  const std::int64_t t_ns = 1700000000000000000 + i * 10000000;  // 100 Hz
+  js.header.stamp.sec = static_cast<std::int32_t>(t_ns / 1000000000);
+  js.header.stamp.nanosec = static_cast<std::uint32_t>(t_ns % 1000000000);
+  js.header.frame_id = "base_link";
+  for (int j = 0; j < 6; ++j) {
+    js.name.push_back("wheel_" + std::to_string(j));
+    js.position.push_back(0.001 * static_cast<double>(i) * (j + 1));
+    js.velocity.push_back(0.1 * (j + 1));
+    js.effort.push_back(0.0);
+  }
+  return js;
+}
+
+struct Bag {
+  fs::path dir;
+  std::uint64_t file_bytes = 0;
+};
+
+Bag MakeBag(const std::string& name, rb::StorageFormat storage, rb::Compression compression) {
+  static TempDir tmp;
+  const std::uint64_t target_bytes = static_cast<std::uint64_t>(EnvOr("FITCAL_BENCH_BAG_MB", 50))
+                                     << 20;
+  rb::BagWriterOptions options;
+  options.storage = storage;
+  options.mcap.compression = compression;
+  Bag bag{tmp.path() / name, 0};
+  rb::BagWriter writer(bag.dir.string(), options);
+  writer.AddTopic("/joint_states", "sensor_msgs/msg/JointState");
+  std::uint64_t written = 0;
+  for (long i = 0; written < target_bytes; ++i) {
+    const std::vector<std::uint8_t> payload = rb::EncodeJointState(Sample(i));
+    writer.Write("/joint_states", 1700000000000000000 + i * 10000000, rb::ByteView(payload));
+    written += payload.size() + 31;  // + MCAP Message record prefix and fields
+  }
+  writer.Close();
+  for (const std::string& file : writer.files()) bag.file_bytes += fs::file_size(file);
+  return bag;
+}
+
+const Bag& GetBag(const std::string& name) {
+  static std::map<std::string, Bag> bags;
+  auto it = bags.find(name);
+  if (it != bags.end()) return it->second;
+  const rb::StorageFormat storage =
+      name == "sqlite3" ? rb::StorageFormat::kSqlite3 : rb::StorageFormat::kMcap;
+  const rb::Compression compression = name == "mcap_zstd"  ? rb::Compression::kZstd
+                                      : name == "mcap_lz4" ? rb::Compression::kLz4
+                                                           : rb::Compression::kNone;
+  return bags.emplace(name, MakeBag(name, storage, compression)).first->second;
+}
+
+void Report(benchmark::State& state, const Bag& bag, std::uint64_t payload_bytes) {
+  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * bag.file_bytes));
+  state.counters["payload_bytes_per_second"] = benchmark::Counter(
+      static_cast<double>(payload_bytes), benchmark::Counter::kIsRate, benchmark::Counter::kIs1024);
+  state.counters["bag_MB"] = static_cast<double>(bag.file_bytes) / (1 << 20);
+}
+
+void ReadBag(benchmark::State& state, const std::string& name) {
+  const Bag& bag = GetBag(name);
+  std::uint64_t payload_bytes = 0;
+  for (auto _ : state) {
+    rb::BagReader reader(bag.dir.string());
+    rb::BagMessage m;
+    std::uint64_t checksum = 0;
+    while (reader.ReadNext(&m)) {
+      payload_bytes += m.payload.size;
+      checksum += m.payload.data[m.payload.size - 1];  // touch the payload
+    }
+    benchmark::DoNotOptimize(checksum);
+  }
+  Report(state, bag, payload_bytes);
+}
+
+void ReadAndDecode(benchmark::State& state, const std::string& name) {
+  const Bag& bag = GetBag(name);
+  std::uint64_t payload_bytes = 0;
+  for (auto _ : state) {
+    rb::BagReader reader(bag.dir.string());
+    rb::BagMessage m;
+    double sum_rad = 0;
+    while (reader.ReadNext(&m)) {
+      payload_bytes += m.payload.size;
+      sum_rad += rb::DecodeJointState(m.payload, "bench").position[0];
+    }
+    benchmark::DoNotOptimize(sum_rad);
+  }
+  Report(state, bag, payload_bytes);
+}
+
+BENCHMARK_CAPTURE(ReadBag, mcap, std::string("mcap"))->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(ReadBag, mcap_zstd, std::string("mcap_zstd"))->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(ReadBag, mcap_lz4, std::string("mcap_lz4"))->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(ReadBag, sqlite3, std::string("sqlite3"))->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(ReadAndDecode, mcap, std::string("mcap"))->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
