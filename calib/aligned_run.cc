@@ -6,8 +6,14 @@
 namespace fitcal {
 
 namespace {
-// `w`: a sample's three wheel rates.
-bool IsRest(const double* w) { return w[0] == 0.0 && w[1] == 0.0 && w[2] == 0.0; }
+// Every channel of the sample reads zero (wheel rates and angles alike: an interval with a
+// non-zero angle channel is kept as it is, whatever the model makes of it).
+bool IsRest(const double* values, int num_channels) {
+  for (int i = 0; i < num_channels; ++i) {
+    if (values[i] != 0.0) return false;
+  }
+  return true;
+}
 }  // namespace
 
 AlignedRun AlignRun(const RunLog& run) {
@@ -29,6 +35,8 @@ AlignedRun AlignRun(const RunLog& run) {
     throw std::invalid_argument("run " + run.id + ": encoders and ground truth share no time");
   }
   out.final_ground_truth = InterpolateGroundTruth(gt, out.t_final_s);
+  const int channels = run.encoders.samples.num_channels();
+  out.samples = EncoderSamples(channels);
   out.samples.reserve(run.encoders.samples.size());
   for (std::size_t k = 0; k < run.encoders.samples.size(); ++k) {
     const double begin = std::max(t[k], out.t_start_s);
@@ -39,7 +47,8 @@ AlignedRun AlignRun(const RunLog& run) {
     // Consecutive intervals with all wheels at rest move nothing under any model: one interval
     // of their summed length keeps the time line and saves the replay the work (robots log
     // long rests before and after each run).
-    if (IsRest(sample.value) && !out.samples.empty() && IsRest(out.samples.back().value)) {
+    if (IsRest(sample.value, channels) && !out.samples.empty() &&
+        IsRest(out.samples.back().value, channels)) {
       out.samples.back().dt_s += dt;
       continue;
     }

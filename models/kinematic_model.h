@@ -29,6 +29,8 @@
 #include <ceres/autodiff_cost_function.h>
 
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -157,6 +159,7 @@ class KinematicModel : public RobotModelInterface {
 
   Pose2d Replay(const double* p, const EncoderSamples& samples, std::size_t begin, std::size_t end,
                 const Pose2d& start, const PoseVisitor& visit = nullptr) const override {
+    CheckChannels(samples);
     if (!visit) return ReplayKinematics(kinematics_, p, samples, begin, end, start);
     return ReplayKinematics(kinematics_, p, samples, begin, end, start,
                             [&visit](std::size_t k, const Pose2d& pose) { visit(k, pose); });
@@ -164,12 +167,24 @@ class KinematicModel : public RobotModelInterface {
 
   ceres::CostFunction* FinalPoseCost(const AlignedRun& run,
                                      const ResidualWeights& weights) const override {
+    CheckChannels(run.samples);
     return ModelFinalPoseResidual<K>::Create(run, weights, kinematics_);
   }
 
   ceres::CostFunction* SegmentCost(const AlignedRun& run, const std::vector<Segment>& segments,
                                    const ResidualWeights& weights) const override {
+    CheckChannels(run.samples);
     return ModelSegmentResidual<K>::Create(run, segments, weights, kinematics_);
+  }
+
+  // The body step reads robot().NumChannels() values per row: samples of another width would be
+  // read out of bounds. A check that fires in release builds too (STYLE.md habit 7).
+  void CheckChannels(const EncoderSamples& samples) const {
+    if (samples.num_channels() != robot_.NumChannels()) {
+      throw std::invalid_argument("samples with " + std::to_string(samples.num_channels()) +
+                                  " channels replayed by a " + robot_.model + " robot with " +
+                                  std::to_string(robot_.NumChannels()));
+    }
   }
 
   bool ChannelsForTwist(const double* p, const Twist& twist, double* values) const override {

@@ -122,7 +122,8 @@ int main(int argc, char** argv) {
       app.add_subcommand("import", "Convert published recordings into a fitcal data set");
   import_cmd->require_subcommand(1);
   CLI::App* optiodom_cmd = import_cmd->add_subcommand(
-      "optiodom", "OptiOdom omni3 sessions (Sousa et al. 2022; see tools/import_optiodom.h)");
+      "optiodom",
+      "OptiOdom sessions of one robot: omni3, omni4, diff or tricyc (Sousa et al. 2022)");
   optiodom_cmd->add_option("sessions", import_optiodom.sessions, "Session directories")
       ->required()
       ->check(CLI::ExistingDirectory);

@@ -19,6 +19,9 @@
 #include "io/robot_yaml.h"
 #include "io/text_file.h"
 #include "odometry/parallel_for.h"
+#include "tools/import_optiodom_models.h"
+#include "tools/import_optiodom_omni4.h"
+#include "tools/import_optiodom_tricycle.h"
 
 namespace fitcal::tools {
 
@@ -265,11 +268,75 @@ std::string TicksCsv(const OptiOdomRun& run) {
 
 }  // namespace
 
+namespace {
+
+// The `type` row of a session's metadata (diff, tricyc, omni3, omni4).
+std::string OptiOdomSessionType(const std::string& directory) {
+  const fs::path dir(directory);
+  const std::string name =
+      dir.filename().empty() ? dir.parent_path().filename().string() : dir.filename().string();
+  const std::string path = (dir / (name + "_metadata.csv")).string();
+  const std::string text = io::ReadTextFile(path);
+  io::LineScanner lines(text);
+  std::string_view line;
+  while (lines.Next(&line)) {
+    const std::string_view t = io::Trim(line);
+    if (t.substr(0, 5) != "type,") continue;
+    const std::string_view rest = t.substr(5);
+    return std::string(io::Trim(rest.substr(0, rest.find(','))));
+  }
+  throw InputError(InputErrorKind::kMissingKey, path, 0, "no 'type' row");
+}
+
+// The other robots of the OptiOdom study, each with its own importer.
+int ImportOtherOptiOdomRobot(const std::string& type, const ImportOptiOdomOptions& options) {
+  if (type == "diff") {
+    ImportOptiOdomDiffOptions diff;
+    diff.force = options.force;
+    diff.skip_mapping_check = options.skip_mapping_check;
+    ImportOptiOdomDiff(options.sessions, options.out, diff);  // prints its own summary
+    return 0;
+  }
+  if (type == "tricyc") {
+    ImportOptiOdomTricycleOptions tricycle;
+    tricycle.force = options.force;
+    tricycle.skip_sign_check = options.skip_mapping_check;
+    const ImportOptiOdomTricycleSummary s =
+        ImportOptiOdomTricycle(options.sessions, options.out, tricycle);
+    std::printf("imported %zu runs of %d tricycle sessions into %s; nominal CF (Eq. 14) %.4f\n",
+                s.runs.size(), s.num_sessions, options.out.c_str(), s.nominal_cf);
+    return 0;
+  }
+  if (fs::exists(fs::path(options.out) / "dataset.yaml") && !options.force) {
+    std::cerr << "fitcal: " << options.out
+              << " already holds a data set; use --force to overwrite it\n";
+    return 2;
+  }
+  const Omni4ImportResult s = ImportOptiOdomOmni4(options.sessions, options.out);
+  for (const std::string& note : s.notes) std::printf("note: %s\n", note.c_str());
+  std::printf("imported %d runs of %d omni4 sessions into %s; nominal CF (Eq. 14) %.4f\n",
+              s.num_runs, s.num_sessions, options.out.c_str(), s.nominal_mean_cf);
+  return 0;
+}
+
+}  // namespace
+
 int RunImportOptiOdomCommand(const ImportOptiOdomOptions& options) {
   try {
     if (options.sessions.empty()) {
       std::cerr << "fitcal: import optiodom needs at least one session directory\n";
       return 2;
+    }
+    const std::string type = OptiOdomSessionType(options.sessions.front());
+    for (const std::string& dir : options.sessions) {
+      if (OptiOdomSessionType(dir) != type) {
+        std::cerr << "fitcal: " << dir << ": a " << OptiOdomSessionType(dir) << " session among "
+                  << type << " sessions; import one robot at a time\n";
+        return 2;
+      }
+    }
+    if (type == "diff" || type == "tricyc" || type == "omni4") {
+      return ImportOtherOptiOdomRobot(type, options);
     }
     if (fs::exists(fs::path(options.out) / "dataset.yaml") && !options.force) {
       std::cerr << "fitcal: " << options.out
