@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "io/input_error.h"
+#include "io/robot_yaml_blocks.h"
 #include "io/yaml_reader.h"
 #include "odometry/pose2.h"
 
@@ -16,36 +17,6 @@ namespace fitcal::io {
 namespace {
 
 int LineOf(const YAML::Node& node) { return node.Mark().line + 1; }
-
-Interval ReadInterval(YamlMap& map, const std::string& key, double scale) {
-  const auto [lo, hi] = map.Pair(key);
-  if (lo > hi) {
-    throw InputError(
-        InputErrorKind::kBadValue, map.path(), map.line(map.Required(key)),
-        "bounds." + key + " has lo " + std::to_string(lo) + " > hi " + std::to_string(hi));
-  }
-  return Interval{lo * scale, hi * scale};
-}
-
-std::optional<EncoderTicks> ReadEncoderTicksNode(const YAML::Node& node, const std::string& path) {
-  if (!node) return std::nullopt;
-  YamlMap map(node, path, "encoder");
-  EncoderTicks ticks;
-  ticks.ticks_per_rev = map.Double("ticks_per_rev");
-  if (!(ticks.ticks_per_rev > 0.0)) {
-    throw InputError(InputErrorKind::kBadValue, path, map.line(map.Required("ticks_per_rev")),
-                     "encoder.ticks_per_rev must be positive");
-  }
-  const YAML::Node cumulative = map.Required("cumulative");
-  const std::string text = YamlString(cumulative, path, "encoder.cumulative");
-  if (text != "true" && text != "false") {
-    throw InputError(InputErrorKind::kBadValue, path, map.line(cumulative),
-                     "encoder.cumulative must be true or false, found '" + text + "'");
-  }
-  ticks.cumulative = text == "true";
-  map.RejectUnread();
-  return ticks;
-}
 
 }  // namespace
 
@@ -62,50 +33,6 @@ std::string ReadRobotModel(const std::string& path) {
     throw InputError(InputErrorKind::kMissingKey, path, 1, "robot has no 'model'");
   return YamlString(root["model"], path, "robot.model");
 }
-
-namespace {
-
-// `effects:` - a list of {name: <registry name>, <parameter>: value, ...} maps, each parameter
-// named as in odometry/effects.h (units in the name) and inside its bounds; optional
-// `sigma_<parameter>` keys carry the fitted uncertainty.
-std::vector<effects::EffectValue> ReadEffectsNode(const YAML::Node& node, const std::string& path) {
-  std::vector<effects::EffectValue> out;
-  if (!node || node.IsNull()) return out;
-  ExpectYamlType(node, YAML::NodeType::Sequence, path, "robot.effects");
-  for (std::size_t i = 0; i < node.size(); ++i) {
-    YamlMap map(node[i], path, "effect " + std::to_string(i + 1));
-    const std::string name = map.String("name");
-    effects::EffectValue e;
-    try {
-      e.id = effects::EffectIdFromName(name);
-    } catch (const std::invalid_argument& error) {
-      throw InputError(InputErrorKind::kBadValue, path, LineOf(node[i]), error.what());
-    }
-    const effects::EffectInfo& info = effects::Info(e.id);
-    for (int k = 0; k < info.num_parameters; ++k) {
-      e.value[k] = map.Double(info.parameter_names[k]);
-      if (!(e.value[k] >= info.lower[k] && e.value[k] <= info.upper[k])) {
-        throw InputError(InputErrorKind::kBadValue, path, LineOf(node[i]),
-                         "effect " + name + ": " + info.parameter_names[k] + " lies outside [" +
-                             std::to_string(info.lower[k]) + ", " + std::to_string(info.upper[k]) +
-                             "]");
-      }
-      const std::string sigma_key = std::string("sigma_") + info.parameter_names[k];
-      if (map.Has(sigma_key)) e.sigma[k] = map.Double(sigma_key);
-    }
-    for (const auto& other : out) {
-      if (other.id == e.id) {
-        throw InputError(InputErrorKind::kBadValue, path, LineOf(node[i]),
-                         "effect " + name + " is listed twice");
-      }
-    }
-    map.RejectUnread();
-    out.push_back(e);
-  }
-  return out;
-}
-
-}  // namespace
 
 Omni3Robot ReadOmni3Robot(const std::string& path) {
   const YAML::Node root = LoadYamlFile(path);
@@ -143,9 +70,9 @@ Omni3Robot ReadOmni3Robot(const std::string& path) {
     wheel.RejectUnread();
   }
   YamlMap bounds(robot_map.Required("bounds"), path, "bounds");
-  robot.bounds.distance_m = ReadInterval(bounds, "distance_m", 1.0);
-  robot.bounds.radius_m = ReadInterval(bounds, "radius_m", 1.0);
-  robot.bounds.angle_offset_rad = ReadInterval(bounds, "angle_offset_deg", M_PI / 180.0);
+  robot.bounds.distance_m = ReadBoundsPair(bounds, "distance_m", 1.0);
+  robot.bounds.radius_m = ReadBoundsPair(bounds, "radius_m", 1.0);
+  robot.bounds.angle_offset_rad = ReadBoundsPair(bounds, "angle_offset_deg", M_PI / 180.0);
   bounds.RejectUnread();
   if (!(robot.bounds.distance_m.lo > 0.0) || !(robot.bounds.radius_m.lo > 0.0)) {
     throw InputError(InputErrorKind::kBadValue, path, LineOf(robot_map.Required("bounds")),
@@ -209,25 +136,10 @@ std::string Omni3RobotYaml(const Omni3Robot& robot, const CalibrationRecord* cal
   pair("radius_m", robot.bounds.radius_m, 1.0);
   pair("angle_offset_deg", robot.bounds.angle_offset_rad, 180.0 / M_PI);
   out << YAML::EndMap;
-  if (robot.encoder) {
-    out << YAML::Key << "encoder" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key
-        << "ticks_per_rev" << YAML::Value << robot.encoder->ticks_per_rev << YAML::Key
-        << "cumulative" << YAML::Value << robot.encoder->cumulative << YAML::EndMap;
-  }
-  if (!robot.effects.empty()) {
-    out << YAML::Key << "effects" << YAML::Value << YAML::BeginSeq;
-    for (const effects::EffectValue& e : robot.effects) {
-      const effects::EffectInfo& info = effects::Info(e.id);
-      out << YAML::Flow << YAML::BeginMap << YAML::Key << "name" << YAML::Value << info.name;
-      for (int k = 0; k < info.num_parameters; ++k) {
-        out << YAML::Key << info.parameter_names[k] << YAML::Value << e.value[k];
-        out << YAML::Key << std::string("sigma_") + info.parameter_names[k] << YAML::Value
-            << e.sigma[k];
-      }
-      out << YAML::EndMap;
-    }
-    out << YAML::EndSeq;
-  }
+  Robot common;
+  common.encoder = robot.encoder;
+  common.effects = robot.effects;
+  EmitEncoderAndEffects(out, common);
   if (calibration != nullptr) {
     const CalibrationRecord& c = *calibration;
     out << YAML::Key << "calibration" << YAML::Value << YAML::BeginMap;
