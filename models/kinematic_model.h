@@ -48,7 +48,7 @@ Pose2<T> ReplayKinematics(const K& kinematics, const T* p, const EncoderSamples&
                           Visitor&& visit = Visitor()) {
   const auto prepared = kinematics.Prepare(p);
   const auto step = [&kinematics, &prepared](const double* values, double dt, T* dx, T* dy,
-                                             T* dtheta) {
+                                             T* dtheta) __attribute__((always_inline)) {
     kinematics.BodyStep(prepared, values, dt, dx, dy, dtheta);
   };
   return ReplaySteps(step, samples, begin, end, start, std::forward<Visitor>(visit));
