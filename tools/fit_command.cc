@@ -142,11 +142,6 @@ int RunFitCommand(const FitCommandOptions& options) {
     }
     const io::Dataset dataset = io::LoadDataset(index, dataset_options);
     io::StopHereForTests("loaded");
-    const std::string model = io::ReadRobotModel(dataset.robot_path);
-    if (model != "omni3") {
-      throw io::InputError(io::InputErrorKind::kUnknownModel, dataset.robot_path, 0,
-                           "model '" + model + "' is not supported by 'fit' (known: omni3)");
-    }
     const Omni3Robot robot = io::ReadOmni3Robot(dataset.robot_path);
     if (!robot.effects.empty()) {
       // The methods here fit Eq. 4 alone; refitting would silently drop the declared effects.
