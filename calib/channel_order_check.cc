@@ -60,6 +60,8 @@ double FittedSumOfSquares(const RobotModelInterface& model, const std::vector<Al
   fit.ceres.num_threads = options.num_threads;
   fit.ceres.compute_covariance = false;
   fit.ceres.max_num_iterations = 50;
+  // The F test counts every free parameter as fitted: no direction is held.
+  fit.hold_undetermined = false;
   if (!segments.empty()) fit.segments = &segments;
   const ModelFitResult result = FitModel(runs, model, fit);
   return SumOfSquares(model, result.parameters, runs, segments, options);

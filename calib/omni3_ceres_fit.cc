@@ -29,6 +29,14 @@ Omni3FitResult FitOmni3Ceres(const std::vector<AlignedRun>& training, const Omni
   result.final_cost = fit.final_cost;
   std::copy(fit.parameters.begin(), fit.parameters.end(), result.parameters.begin());
   std::copy(fit.at_bound.begin(), fit.at_bound.end(), result.at_bound.begin());
+  for (const UndeterminedDirection& d : fit.held_directions) {
+    result.held_directions.push_back(d.description);
+  }
+  if (!fit.held_directions.empty()) {
+    std::copy(fit.unconstrained_parameters.begin(), fit.unconstrained_parameters.end(),
+              result.unconstrained_parameters.begin());
+    result.unconstrained_usable = fit.unconstrained_usable;
+  }
   result.has_covariance = fit.has_covariance;
   result.residual_sigma = fit.residual_sigma;
   if (fit.has_covariance) {

@@ -34,6 +34,11 @@ struct Omni3FitResult {
   double final_cost = 0.0;
   Omni3ParameterArray parameters{};
   std::array<bool, omni3::kNumParameters> at_bound{};
+  // Directions the training runs do not determine, held at the nominal (fit/model_fit.h), each
+  // described in parameter terms.
+  std::vector<std::string> held_directions;
+  Omni3ParameterArray unconstrained_parameters{};  // the fit without the holds, when held
+  bool unconstrained_usable = false;
 
   // Uncertainty (when has_covariance): covariance scaled by the residual variance.
   bool has_covariance = false;

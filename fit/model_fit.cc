@@ -7,8 +7,10 @@
 #include <cmath>
 #include <memory>
 #include <stdexcept>
+#include <utility>
 
 #include "calib/dense_solver_options.h"
+#include "fit/determined_directions.h"
 
 namespace fitcal {
 
@@ -16,11 +18,56 @@ namespace {
 
 constexpr int kMaxActiveSetRounds = 8;
 
+// Directions held at the nominal and the hold's weight (residual units per prior sigma).
+struct HeldDirections {
+  std::vector<UndeterminedDirection> directions;
+  double weight = 1.0;
+};
+
+// Holds directions at the nominal: r_j = w u_j . ((p - p_nominal) / prior_sigma), one row per
+// held direction u_j (fit/determined_directions.h). Linear, so its Jacobian is the constant
+// matrix. w makes a held direction stiffer than any the data determine by kHoldStiffness.
+class HoldDirectionsCost : public ceres::CostFunction {
+ public:
+  HoldDirectionsCost(const std::vector<UndeterminedDirection>& held, const Robot& robot,
+                     double weight)
+      : nominal_(robot.nominal), rows_(held.size(), robot.NumParameters()) {
+    for (std::size_t j = 0; j < held.size(); ++j) {
+      for (int k = 0; k < robot.NumParameters(); ++k) {
+        const double prior_sigma = robot.bounds[k].Width() / std::sqrt(12.0);
+        rows_(j, k) = robot.IsHeld(k) ? 0.0 : weight * held[j].prior_units[k] / prior_sigma;
+      }
+    }
+    set_num_residuals(static_cast<int>(held.size()));
+    mutable_parameter_block_sizes()->push_back(robot.NumParameters());
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const int n = static_cast<int>(nominal_.size());
+    for (int j = 0; j < rows_.rows(); ++j) {
+      residuals[j] = 0.0;
+      for (int k = 0; k < n; ++k) residuals[j] += rows_(j, k) * (parameters[0][k] - nominal_[k]);
+    }
+    if (jacobians != nullptr && jacobians[0] != nullptr) {
+      for (int j = 0; j < rows_.rows(); ++j) {
+        for (int k = 0; k < n; ++k) jacobians[0][j * n + k] = rows_(j, k);
+      }
+    }
+    return true;
+  }
+
+ private:
+  std::vector<double> nominal_;
+  Eigen::MatrixXd rows_;
+};
+
 // One Ceres problem over the training runs with the parameters in `fixed` held constant.
 class FitProblem {
  public:
   FitProblem(const std::vector<AlignedRun>& training, const RobotModelInterface& model,
-             const ModelFitOptions& fit_options, const std::vector<bool>& fixed, double* p) {
+             const ModelFitOptions& fit_options, const std::vector<bool>& fixed, double* p,
+             const HeldDirections& holds = {}) {
     const CeresFitOptions& options = fit_options.ceres;
     ceres::Problem::Options problem_options;
     problem_options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
@@ -28,11 +75,16 @@ class FitProblem {
     for (std::size_t i = 0; i < training.size(); ++i) {
       const AlignedRun& run = training[i];
       if (fit_options.segments == nullptr) {
-        problem_->AddResidualBlock(model.FinalPoseCost(run, options.weights), MakeLoss(options), p);
+        data_blocks_.push_back(problem_->AddResidualBlock(model.FinalPoseCost(run, options.weights),
+                                                          MakeLoss(options), p));
       } else if (!(*fit_options.segments)[i].empty()) {
-        problem_->AddResidualBlock(
-            model.SegmentCost(run, (*fit_options.segments)[i], options.weights), nullptr, p);
+        data_blocks_.push_back(problem_->AddResidualBlock(
+            model.SegmentCost(run, (*fit_options.segments)[i], options.weights), nullptr, p));
       }
+    }
+    if (!holds.directions.empty()) {
+      problem_->AddResidualBlock(
+          new HoldDirectionsCost(holds.directions, model.robot(), holds.weight), nullptr, p);
     }
     const Robot& robot = model.robot();
     const int n = robot.NumParameters();
@@ -52,6 +104,8 @@ class FitProblem {
   }
 
   ceres::Problem& problem() { return *problem_; }
+  // The runs' residual blocks (not the hold), for the residual variance.
+  const std::vector<ceres::ResidualBlockId>& data_blocks() const { return data_blocks_; }
 
   // Gradient of the (loss-shaped) cost with respect to every parameter.
   std::vector<double> FullGradient() {
@@ -63,6 +117,7 @@ class FitProblem {
 
  private:
   std::unique_ptr<ceres::Problem> problem_;
+  std::vector<ceres::ResidualBlockId> data_blocks_;
 };
 
 ceres::Solver::Options SolverOptionsFor(const CeresFitOptions& options) {
@@ -102,6 +157,7 @@ std::vector<bool> AtBound(const Robot& robot, const std::vector<double>& p) {
 ceres::Solver::Summary RefineWithActiveSet(const std::vector<AlignedRun>& training,
                                            const RobotModelInterface& model,
                                            const ModelFitOptions& options,
+                                           const HeldDirections& holds,
                                            ceres::Solver::Summary summary, ModelFitResult* result) {
   const Robot& robot = model.robot();
   const int n = robot.NumParameters();
@@ -116,12 +172,12 @@ ceres::Solver::Summary RefineWithActiveSet(const std::vector<AlignedRun>& traini
   }
   for (int round = 0; round < kMaxActiveSetRounds; ++round) {
     ++result->active_set_rounds;
-    FitProblem fit(training, model, options, fixed, p.data());
+    FitProblem fit(training, model, options, fixed, p.data(), holds);
     ceres::Solve(SolverOptionsFor(options.ceres), &fit.problem(), &summary);
     Accumulate(summary, result);
     if (summary.termination_type != ceres::CONVERGENCE) break;
     // Release a bound parameter whose descent direction points into the box.
-    FitProblem all_free(training, model, options, result->held, p.data());
+    FitProblem all_free(training, model, options, result->held, p.data(), holds);
     const std::vector<double> g = all_free.FullGradient();
     bool released = false;
     for (int k = 0; k < n; ++k) {
@@ -138,10 +194,12 @@ ceres::Solver::Summary RefineWithActiveSet(const std::vector<AlignedRun>& traini
 }
 
 void ComputeCovariance(const std::vector<AlignedRun>& training, const RobotModelInterface& model,
-                       const ModelFitOptions& options, ModelFitResult* result) {
+                       const ModelFitOptions& options, const HeldDirections& holds,
+                       ModelFitResult* result) {
   const int n = model.robot().NumParameters();
   const int num_free =
-      n - static_cast<int>(std::count(result->held.begin(), result->held.end(), true));
+      n - static_cast<int>(std::count(result->held.begin(), result->held.end(), true)) -
+      static_cast<int>(holds.directions.size());
   int num_residuals = 3 * static_cast<int>(training.size());
   if (options.segments != nullptr) {
     num_residuals = 0;
@@ -156,11 +214,12 @@ void ComputeCovariance(const std::vector<AlignedRun>& training, const RobotModel
     return;
   }
   std::vector<double> p = result->parameters;
-  FitProblem fit(training, model, options, result->held, p.data());
-  // s^2 from the plain sum of squares, whatever loss shaped the objective.
+  FitProblem fit(training, model, options, result->held, p.data(), holds);
+  // s^2 from the plain sum of squares of the runs, whatever loss shaped the objective.
   double sum_of_squares_half = 0.0;
   ceres::Problem::EvaluateOptions evaluate_options;
   evaluate_options.apply_loss_function = false;
+  evaluate_options.residual_blocks = fit.data_blocks();
   fit.problem().Evaluate(evaluate_options, &sum_of_squares_half, nullptr, nullptr, nullptr);
   result->residual_sigma = std::sqrt(2.0 * sum_of_squares_half / dof);
   ceres::Covariance::Options cov_options;
@@ -191,6 +250,56 @@ void ComputeCovariance(const std::vector<AlignedRun>& training, const RobotModel
 
 }  // namespace
 
+namespace {
+
+// One bounded solve from `start` with `holds`, refined by the active set when it did not converge.
+ModelFitResult SolveFrom(const std::vector<AlignedRun>& training, const RobotModelInterface& model,
+                         const std::vector<double>& start, const ModelFitOptions& options,
+                         const HeldDirections& holds) {
+  const Robot& robot = model.robot();
+  ModelFitResult result;
+  result.parameters = start;
+  result.held.assign(robot.NumParameters(), false);
+  for (const HeldParameter& h : robot.held) {
+    result.held[h.index] = true;
+    result.parameters[h.index] = robot.nominal[h.index];
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  ceres::Solver::Summary summary;
+  {
+    FitProblem fit(training, model, options, result.held, result.parameters.data(), holds);
+    ceres::Solve(SolverOptionsFor(options.ceres), &fit.problem(), &summary);
+  }
+  result.initial_cost = summary.initial_cost;
+  Accumulate(summary, &result);
+  const bool converged = summary.termination_type == ceres::CONVERGENCE;
+  if (!converged && options.active_set_bounds) {
+    summary = RefineWithActiveSet(training, model, options, holds, summary, &result);
+  }
+  result.solve_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  bool finite = true;
+  for (double v : result.parameters) finite = finite && std::isfinite(v);
+  result.at_bound = AtBound(robot, result.parameters);
+  result.usable = finite && summary.termination_type == ceres::CONVERGENCE;
+  return result;
+}
+
+// The hold's weight: kHoldStiffness times the stiffest direction the data determine, in the
+// same residual units, so a held direction moves by a part in kHoldStiffness^2 of what the data
+// would move it.
+double HoldWeight(const DirectionAnalysis& analysis) {
+  constexpr double kHoldStiffness = 1e4;
+  const double smallest_fraction = analysis.posterior_fractions.empty()
+                                       ? 1.0
+                                       : *std::min_element(analysis.posterior_fractions.begin(),
+                                                           analysis.posterior_fractions.end());
+  const double w = kHoldStiffness * analysis.residual_sigma / std::max(smallest_fraction, 1e-12);
+  return w > 0.0 && std::isfinite(w) ? w : 1.0;
+}
+
+}  // namespace
+
 ModelFitResult FitModelFrom(const std::vector<AlignedRun>& training,
                             const RobotModelInterface& model, const std::vector<double>& start,
                             const ModelFitOptions& options) {
@@ -200,36 +309,30 @@ ModelFitResult FitModelFrom(const std::vector<AlignedRun>& training,
   if (options.segments != nullptr && options.segments->size() != training.size()) {
     throw std::invalid_argument("FitModel: not one window list per training run");
   }
-  const Robot& robot = model.robot();
-  const int n = robot.NumParameters();
+  const int n = model.robot().NumParameters();
   if (static_cast<int>(start.size()) != n) throw std::invalid_argument("FitModel: bad start");
 
-  ModelFitResult result;
-  result.parameters = start;
-  result.held.assign(n, false);
-  for (const HeldParameter& h : robot.held) {
-    result.held[h.index] = true;
-    result.parameters[h.index] = robot.nominal[h.index];
+  ModelFitResult result = SolveFrom(training, model, start, options, {});
+  HeldDirections holds;
+  if (options.hold_undetermined) {
+    bool finite = true;
+    for (double v : result.parameters) finite = finite && std::isfinite(v);
+    const DirectionAnalysis analysis = AnalyseDeterminedDirections(
+        training, model, finite ? result.parameters : start, options.ceres.weights,
+        options.segments, options.ceres.num_threads);
+    if (analysis.ok && !analysis.undetermined.empty()) {
+      holds.directions = analysis.undetermined;
+      holds.weight = HoldWeight(analysis);
+      ModelFitResult held = SolveFrom(training, model, start, options, holds);
+      held.held_directions = analysis.undetermined;
+      held.unconstrained_parameters = result.parameters;
+      held.unconstrained_usable = result.usable;
+      held.iterations += result.iterations;
+      held.solve_time_s += result.solve_time_s;
+      result = std::move(held);
+    }
   }
-  const auto t0 = std::chrono::steady_clock::now();
-  ceres::Solver::Summary summary;
-  {
-    FitProblem fit(training, model, options, result.held, result.parameters.data());
-    ceres::Solve(SolverOptionsFor(options.ceres), &fit.problem(), &summary);
-  }
-  result.initial_cost = summary.initial_cost;
-  Accumulate(summary, &result);
-  const bool converged = summary.termination_type == ceres::CONVERGENCE;
-  if (!converged && options.active_set_bounds) {
-    summary = RefineWithActiveSet(training, model, options, summary, &result);
-  }
-  result.solve_time_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  bool finite = true;
-  for (double v : result.parameters) finite = finite && std::isfinite(v);
-  result.at_bound = AtBound(robot, result.parameters);
-  result.usable = finite && summary.termination_type == ceres::CONVERGENCE;
-  if (options.ceres.compute_covariance) ComputeCovariance(training, model, options, &result);
+  if (options.ceres.compute_covariance) ComputeCovariance(training, model, options, holds, &result);
   return result;
 }
 

@@ -14,6 +14,8 @@
 // lower the cost: it was not a constrained minimum for it) and repeats, at most
 // kMaxActiveSetRounds times. The result is the Karush-Kuhn-Tucker point of the box problem.
 //
+// Fit what the data determine: see ModelFitOptions::hold_undetermined.
+//
 // Uncertainty: the Ceres covariance of the free parameters scaled by the residual variance
 // s^2 = |r|^2 / (3 N - n_free). Parameters at a bound are flagged; their sigma then describes
 // the unconstrained problem only.
@@ -23,6 +25,7 @@
 #include <vector>
 
 #include "calib/aligned_run.h"
+#include "fit/determined_directions.h"
 #include "fit/solver_options.h"
 #include "models/model_interface.h"
 
@@ -42,6 +45,11 @@ struct ModelFitResult {
   std::vector<double> parameters;
   std::vector<bool> at_bound;
   std::vector<bool> held;  // held at nominal (gauge)
+  // Directions of the parameter space the training runs do not determine, held at the nominal
+  // (fit/determined_directions.h), and the fit without holding them, for comparison.
+  std::vector<UndeterminedDirection> held_directions;
+  std::vector<double> unconstrained_parameters;
+  bool unconstrained_usable = false;
 
   bool has_covariance = false;
   std::string covariance_message;
@@ -59,6 +67,10 @@ struct ModelFitOptions {
   // Use the active set above (false: one plain bounded Ceres solve, as before; kept for tests
   // that show the difference).
   bool active_set_bounds = true;
+  // Hold the directions the runs do not determine at the nominal (fit/determined_directions.h):
+  // after the fit, the information the runs carry along every direction is weighed against the
+  // bounds; when some direction stays undetermined the fit is repeated with it held.
+  bool hold_undetermined = true;
 };
 
 // Throws std::invalid_argument for invalid options or no runs.

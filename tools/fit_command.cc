@@ -15,6 +15,7 @@
 #include "calib/omni3_ceres_fit.h"
 #include "calib/run_split.h"
 #include "calib/wheel_order_check.h"
+#include "fit/result_gate.h"
 #include "fitcal/version.h"
 #include "io/atomic_file.h"
 #include "io/dataset.h"
@@ -22,6 +23,7 @@
 #include "io/robot_yaml.h"
 #include "io/yaml_reader.h"
 #include "models/model_registry.h"
+#include "models/omni3/omni3_robot_model.h"
 #include "odometry/effects.h"
 #include "tools/asoc_commands.h"
 #include "tools/fit_methods.h"
@@ -251,6 +253,9 @@ int RunFitCommand(const FitCommandOptions& options) {
                 method->description.c_str(), fit.termination.c_str(), fit.iterations,
                 outcome.evaluations, fit.solve_time_s, fit.message.c_str());
     if (!fit.has_covariance) std::printf("uncertainty: %s\n", fit.covariance_message.c_str());
+    for (const std::string& d : fit.held_directions) {
+      std::printf("held at nominal, not determined by the training runs: %s\n", d.c_str());
+    }
     if (fit.usable) {  // issue 4: name what the training runs cannot determine
       ResidualWeights weights;
       weights.position_sigma_m = options.position_sigma_m;
@@ -273,12 +278,39 @@ int RunFitCommand(const FitCommandOptions& options) {
                 << "); nothing written\n";
       return 3;
     }
+    // The result gate (fit/result_gate.h): the fit is written only if it beats the nominal
+    // robot on the held-out runs (on the training runs, said so, when there are none).
+    // With held directions and held-out runs, the fit without the holds competes too (as in
+    // model_fit_command.cc).
+    std::vector<CalibrationCandidate> candidates = {
+        {"nominal", std::vector<double>(nominal.begin(), nominal.end()), true},
+        {method->name, std::vector<double>(fit.parameters.begin(), fit.parameters.end()),
+         fit.usable}};
+    if (!fit.held_directions.empty() && !split.validation.empty()) {
+      candidates.push_back({method->name + " without holds",
+                            std::vector<double>(fit.unconstrained_parameters.begin(),
+                                                fit.unconstrained_parameters.end()),
+                            fit.unconstrained_usable});
+    }
+    const GateDecision gate = SelectCalibration(*Omni3ModelOf(robot), candidates, split.training,
+                                                split.validation, options.threads);
+    std::printf("\nresult gate, CF on %s:\n", gate.judged_on.c_str());
+    for (const std::string& line : GateLines(candidates, gate)) std::printf("%s\n", line.c_str());
+    if (!gate.improves_on_nominal()) {
+      std::cerr << "fitcal: no calibration beats the nominal robot on the " << gate.judged_on
+                << "; nothing written\n";
+      return 5;
+    }
 
     if (!options.no_output) {
+      // What the gate selected (the fit, or the fit without its holds) is written, with the CF
+      // that `fitcal report` measures for it; the fit's uncertainty only when the fit won.
+      const double* selected = candidates[gate.selected].parameters.data();
+      const bool fit_won = gate.selected == 1;
       Omni3Robot calibrated = robot;
-      calibrated.nominal = omni3::Parameters::FromArray(fit.parameters.data());
+      calibrated.nominal = omni3::Parameters::FromArray(selected);
       io::CalibrationRecord record;
-      record.method = method->name;
+      record.method = candidates[gate.selected].name;
       record.objective = outcome.objective + " (sigma_xy " +
                          std::to_string(options.position_sigma_m) + " m, sigma_theta " +
                          std::to_string(options.heading_sigma_deg) + " deg)";
@@ -289,14 +321,18 @@ int RunFitCommand(const FitCommandOptions& options) {
       record.validation_repetitions = split.validation_repetitions;
       record.training_runs = static_cast<int>(split.training.size());
       record.validation_runs = static_cast<int>(split.validation.size());
+      Omni3ParameterArray selected_array;
+      std::copy(selected, selected + omni3::kNumParameters, selected_array.begin());
       record.cf_training_before = train_before.cf;
-      record.cf_training_after = train_after.cf;
+      record.cf_training_after =
+          fit_won ? train_after.cf
+                  : EvaluateFinalPoseErrors(selected_array, split.training, options.threads).cf;
       record.cf_validation_before = val_before.cf;
-      record.cf_validation_after = val_after.cf;
-      record.has_uncertainty = fit.has_covariance;
+      record.cf_validation_after = fit_won ? val_after.cf : gate.cf[gate.selected];
+      record.has_uncertainty = fit.has_covariance && fit_won;
       record.sigma = fit.sigma;
       record.correlation = fit.correlation;
-      record.inverse_kinematic_matrix = omni3::InverseKinematicMatrix(fit.parameters.data());
+      record.inverse_kinematic_matrix = omni3::InverseKinematicMatrix(selected);
       io::StopHereForTests("fitted");
       io::WriteFileAtomically(options.out, io::Omni3RobotYaml(calibrated, &record));
       std::printf("wrote %s\n", options.out.c_str());

@@ -97,14 +97,21 @@ void PrintParameters(const Robot& robot, const std::vector<double>& p, const Mod
   }
 }
 
+// Nominal, closed forms, the fit; and when the fit held undetermined directions and held-out
+// runs can judge it, the fit without the holds too (on the training runs alone it would always
+// win, by fitting what the data cannot tell apart).
 std::vector<CalibrationCandidate> Candidates(const RobotModelInterface& model,
-                                             const std::vector<AlignedRun>& training,
-                                             const ModelFitResult& fit, const std::string& method) {
+                                             const RunSplit& split, const ModelFitResult& fit,
+                                             const std::string& method) {
   std::vector<CalibrationCandidate> out = {{"nominal", model.robot().nominal, true}};
-  for (const ClosedFormCalibration& c : model.ClosedForms(training)) {
+  for (const ClosedFormCalibration& c : model.ClosedForms(split.training)) {
     out.push_back({c.method, c.parameters, true});
   }
   out.push_back({method, fit.parameters, fit.usable});
+  if (!fit.held_directions.empty() && !split.validation.empty()) {
+    out.push_back(
+        {method + " without holds", fit.unconstrained_parameters, fit.unconstrained_usable});
+  }
   return out;
 }
 
@@ -227,7 +234,7 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   }
   const ModelFitResult fit = FitModel(split.training, *model, fit_options);
   const std::vector<CalibrationCandidate> candidates =
-      Candidates(*model, split.training, fit, options.method);
+      Candidates(*model, split, fit, options.method);
   const GateDecision gate =
       SelectCalibration(*model, candidates, split.training, split.validation, options.threads);
   const std::vector<double>& selected = candidates[gate.selected].parameters;
@@ -243,6 +250,10 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
               options.method.c_str(), fit.termination.c_str(), fit.iterations,
               fit.active_set_rounds, fit.solve_time_s, fit.message.c_str());
   if (!fit.has_covariance) std::printf("uncertainty: %s\n", fit.covariance_message.c_str());
+  for (const UndeterminedDirection& d : fit.held_directions) {
+    std::printf("held at nominal, not determined by the training runs: %s\n",
+                d.description.c_str());
+  }
   std::printf("\nresult gate, CF on %s:\n", gate.judged_on.c_str());
   for (const std::string& line : GateLines(candidates, gate)) std::printf("%s\n", line.c_str());
   if (!gate.improves_on_nominal()) {

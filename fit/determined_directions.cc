@@ -1,0 +1,188 @@
+#include "fit/determined_directions.h"
+
+#include <ceres/cost_function.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <memory>
+
+#include "odometry/parallel_for.h"
+
+namespace fitcal {
+
+namespace {
+
+// One run's residuals and Jacobian (row-major, residuals x n) at p.
+struct RunJacobian {
+  Eigen::VectorXd residuals;
+  Eigen::MatrixXd jacobian;
+  bool finite = false;
+};
+
+RunJacobian EvaluateRun(const ceres::CostFunction& cost, const std::vector<double>& p) {
+  const int m = cost.num_residuals();
+  const int n = static_cast<int>(p.size());
+  RunJacobian out;
+  out.residuals.resize(m);
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> jac(m, n);
+  const double* parameters[] = {p.data()};
+  double* jacobians[] = {jac.data()};
+  out.finite = cost.Evaluate(parameters, out.residuals.data(), jacobians) &&
+               out.residuals.allFinite() && jac.allFinite();
+  out.jacobian = jac;
+  return out;
+}
+
+std::vector<RunJacobian> EvaluateRuns(const std::vector<AlignedRun>& training,
+                                      const RobotModelInterface& model,
+                                      const std::vector<double>& p, const ResidualWeights& weights,
+                                      const std::vector<std::vector<Segment>>* segments,
+                                      int num_threads) {
+  std::vector<RunJacobian> out(training.size());
+  ParallelFor(training.size(), num_threads, [&](std::size_t i) {
+    if (segments != nullptr && (*segments)[i].empty()) return;
+    std::unique_ptr<ceres::CostFunction> cost(
+        segments == nullptr ? model.FinalPoseCost(training[i], weights)
+                            : model.SegmentCost(training[i], (*segments)[i], weights));
+    out[i] = EvaluateRun(*cost, p);
+    out[i].finite = out[i].finite || out[i].residuals.size() == 0;
+  });
+  return out;
+}
+
+// The box's standard deviation per parameter (uniform prior), 0 for held parameters.
+Eigen::VectorXd PriorSigma(const Robot& robot) {
+  Eigen::VectorXd sigma = Eigen::VectorXd::Zero(robot.NumParameters());
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    if (!robot.IsHeld(k)) sigma[k] = robot.bounds[k].Width() / std::sqrt(12.0);
+  }
+  return sigma;
+}
+
+// "R_fl +29 mm with R_rl -28 mm, delta_fl +3.1 deg": the one-sigma step's large components.
+std::string DescribeStep(const Robot& robot, const Eigen::VectorXd& prior_units,
+                         const Eigen::VectorXd& step) {
+  const double largest = prior_units.cwiseAbs().maxCoeff();
+  std::string out;
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    if (std::abs(prior_units[k]) < 0.1 * largest) continue;
+    const ParameterInfo& info = robot.parameters[k];
+    char text[96];
+    if (info.unit == ParameterUnit::kAngle) {
+      std::snprintf(text, sizeof text, "%s %+.2g deg", info.name.c_str(), step[k] * 180.0 / M_PI);
+    } else {
+      std::snprintf(text, sizeof text, "%s %+.2g mm", info.name.c_str(), step[k] * 1e3);
+    }
+    out += (out.empty() ? "" : ", ") + std::string(text);
+  }
+  return out;
+}
+
+// The trajectory whose runs carry the largest share of the information along `direction`.
+std::string MostInformativeTrajectory(const std::vector<AlignedRun>& training,
+                                      const std::vector<RunJacobian>& runs,
+                                      const Eigen::VectorXd& parameter_step, double* share) {
+  std::map<std::string, double> by_trajectory;
+  double total = 0.0;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    if (runs[i].jacobian.size() == 0) continue;
+    const double info = (runs[i].jacobian * parameter_step).squaredNorm();
+    by_trajectory[training[i].trajectory] += info;
+    total += info;
+  }
+  std::string best;
+  double best_info = -1.0;
+  for (const auto& [name, info] : by_trajectory) {
+    if (info > best_info) best = name, best_info = info;
+  }
+  *share = total > 0.0 ? best_info / total : 0.0;
+  return best;
+}
+
+// The residuals' standard deviation, robust to a few gross runs (wheel slip, a wrong ground
+// truth) that would otherwise make every direction look undetermined: 1.4826 x the median
+// absolute residual (the normal distribution's MAD factor), times sqrt(m / (m - free)) for the
+// degrees of freedom the fit used. With no spare degrees of freedom the data cannot tell noise
+// from parameters; dividing by one keeps every direction's posterior honest (large).
+double RobustSigma(std::vector<double> magnitudes, int num_free) {
+  const std::size_t m = magnitudes.size();
+  std::nth_element(magnitudes.begin(), magnitudes.begin() + m / 2, magnitudes.end());
+  const double mad_sigma = 1.4826 * magnitudes[m / 2];
+  const double dof = std::max(1.0, static_cast<double>(m) - num_free);
+  return mad_sigma * std::sqrt(static_cast<double>(m) / dof);
+}
+
+}  // namespace
+
+DirectionAnalysis AnalyseDeterminedDirections(const std::vector<AlignedRun>& training,
+                                              const RobotModelInterface& model,
+                                              const std::vector<double>& p,
+                                              const ResidualWeights& weights,
+                                              const std::vector<std::vector<Segment>>* segments,
+                                              int num_threads) {
+  const Robot& robot = model.robot();
+  const int n = robot.NumParameters();
+  DirectionAnalysis out;
+  const std::vector<RunJacobian> runs =
+      EvaluateRuns(training, model, p, weights, segments, num_threads);
+  Eigen::MatrixXd jtj = Eigen::MatrixXd::Zero(n, n);
+  std::vector<double> magnitudes;
+  for (const RunJacobian& run : runs) {
+    if (!run.finite) return out;
+    if (run.jacobian.size() == 0) continue;
+    jtj += run.jacobian.transpose() * run.jacobian;
+    for (int i = 0; i < run.residuals.size(); ++i) magnitudes.push_back(std::abs(run.residuals[i]));
+  }
+  if (magnitudes.empty()) return out;
+  out.residual_sigma = RobustSigma(magnitudes, robot.NumFree());
+  const Eigen::VectorXd prior_sigma = PriorSigma(robot);
+  const double s2 = std::max(out.residual_sigma * out.residual_sigma, 1e-300);
+  // Over the free parameters only, so that a held parameter's zero column cannot mix into the
+  // eigenvectors of the undetermined free directions.
+  std::vector<int> free;
+  for (int k = 0; k < n; ++k) {
+    if (!robot.IsHeld(k)) free.push_back(k);
+  }
+  const int f = static_cast<int>(free.size());
+  Eigen::MatrixXd information(f, f);
+  for (int a = 0; a < f; ++a) {
+    for (int b = 0; b < f; ++b) {
+      information(a, b) = prior_sigma[free[a]] * jtj(free[a], free[b]) * prior_sigma[free[b]] / s2;
+    }
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(information);
+  for (int i = 0; i < f; ++i) {
+    Eigen::VectorXd v = Eigen::VectorXd::Zero(n);
+    for (int a = 0; a < f; ++a) v[free[a]] = eigen.eigenvectors()(a, i);
+    const double fraction = 1.0 / std::sqrt(std::max(eigen.eigenvalues()[i], 1e-300));
+    out.posterior_fractions.push_back(fraction);
+    if (fraction <= kMaxPosteriorFraction) continue;
+    UndeterminedDirection d;
+    d.prior_units = v;
+    d.posterior_fraction = fraction;
+    // One posterior sigma along v, capped at the box's own sigma (beyond it the bounds know more).
+    d.one_sigma_step = prior_sigma.cwiseProduct(v) * std::min(fraction, 1.0);
+    double share = 0.0;
+    const std::string trajectory =
+        MostInformativeTrajectory(training, runs, prior_sigma.cwiseProduct(v), &share);
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  " together move the training residuals by only one sigma (%.0f%% of what the "
+                  "bounds allow)",
+                  100.0 * std::min(fraction, 1.0));
+    d.description = DescribeStep(robot, v, d.one_sigma_step) + text;
+    if (!trajectory.empty() && share > 0.0) {
+      std::snprintf(text, sizeof text, "; trajectory '%s' sees it most (%.0f%% of its information)",
+                    trajectory.c_str(), 100.0 * share);
+      d.description += text;
+    }
+    out.undetermined.push_back(d);
+  }
+  out.ok = true;
+  return out;
+}
+
+}  // namespace fitcal
