@@ -10,14 +10,76 @@
 #include "tools/asoc_commands.h"
 #include "tools/compare_command.h"
 #include "tools/diagnose_command.h"
+#include "tools/export_ros2_control.h"
 #include "tools/fit_command.h"
 #include "tools/fit_methods.h"
 #include "tools/generalisation_command.h"
 #include "tools/import_optiodom.h"
+#include "tools/import_rosbag2.h"
 #include "tools/report_command.h"
 #include "tools/simulate_command.h"
 
 namespace {
+
+CLI::App* AddImportRosbag2(CLI::App& import_cmd, fitcal::tools::ImportRosbag2Options& o) {
+  CLI::App* cmd = import_cmd.add_subcommand(
+      "rosbag2", "A ROS 2 bag (sqlite3 or MCAP, split or not): JointState + ground truth");
+  cmd->add_option("bag", o.bag, "Bag directory, its metadata.yaml, or one .db3 / .mcap file")
+      ->required();
+  cmd->add_option("--out", o.out, "Output data set directory (written atomically)")->required();
+  cmd->add_option("--robot", o.robot, "Robot YAML (any model); copied into the data set")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--encoders", o.encoders, "sensor_msgs/msg/JointState topic")
+      ->capture_default_str();
+  cmd->add_option("--joints", o.joints,
+                  "Joint names in the robot's channel order (default: the channel names)")
+      ->delimiter(',');
+  cmd->add_option("--ground-truth", o.ground_truth,
+                  "Ground-truth topic: geometry_msgs/msg/PoseStamped, nav_msgs/msg/Odometry or "
+                  "tf2_msgs/msg/TFMessage")
+      ->required();
+  cmd->add_option("--ground-truth-frames", o.ground_truth_frames,
+                  "For a TFMessage topic: parent:child of the transform, e.g. world:base_link");
+  cmd->add_option("--stamp", o.stamp,
+                  "header (default: when the driver measured; the recording time adds each "
+                  "topic's own transport latency and jitter) or recorded")
+      ->capture_default_str();
+  cmd->add_option("--runs", o.runs, "Cut runs at these spans: t0:t1,t2:t3 (s since the bag start)");
+  cmd->add_option("--split-at-rest", o.split_at_rest_s,
+                  "Cut runs in the middle of every rest at least this long (s)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--rest-rate", o.rest_rate_rad_s, "A wheel slower than this is at rest (rad/s)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--label", o.label, "Trajectory label of the runs (default: the bag's name)");
+  cmd->add_flag("--force", o.force, "Replace an existing data set");
+  return cmd;
+}
+
+CLI::App* AddExportRos2Control(CLI::App& app, fitcal::tools::ExportRos2ControlOptions& o) {
+  CLI::App* export_cmd = app.add_subcommand("export", "Write a calibration for another tool");
+  export_cmd->require_subcommand(1);
+  CLI::App* cmd = export_cmd->add_subcommand(
+      "ros2-control", "The parameter YAML of a ros2_controllers drive controller");
+  cmd->add_option("--calibration", o.calibration, "Calibrated robot YAML (from fit)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  std::string names;
+  for (const std::string& c : fitcal::tools::Ros2Controllers())
+    names += (names.empty() ? "" : ", ") + c;
+  cmd->add_option("--controller", o.controller, "One of " + names)->required();
+  cmd->add_option("--node-name", o.node_name, "Top-level key (default: the controller's name)");
+  cmd->add_option("--joints", o.joints,
+                  "URDF joint names in the robot's channel order (default: the channel names)")
+      ->delimiter(',');
+  cmd->add_option("--out", o.out, "File to write (atomically; default: stdout)");
+  cmd->add_option("--logs", o.logs,
+                  "Data set: print the held-out CF of the exact and the exported parameters")
+      ->check(CLI::ExistingDirectory);
+  cmd->add_flag("--force", o.force, "Overwrite --out");
+  return cmd;
+}
 
 void AddFitOptions(CLI::App& app, fitcal::tools::FitCommandOptions& o) {
   app.add_option("--logs", o.logs, "Data set directory (holds dataset.yaml)")
@@ -132,6 +194,11 @@ int main(int argc, char** argv) {
   optiodom_cmd->add_flag("--skip-mapping-check", import_optiodom.skip_mapping_check,
                          "Write even if another wheel order/sign explains the ground truth better");
 
+  fitcal::tools::ImportRosbag2Options import_rosbag2;
+  CLI::App* rosbag2_cmd = AddImportRosbag2(*import_cmd, import_rosbag2);
+  fitcal::tools::ExportRos2ControlOptions export_ros2;
+  CLI::App* ros2_control_cmd = AddExportRos2Control(app, export_ros2);
+
   fitcal::tools::GeneraliseCommandOptions generalise;
   CLI::App* gen_cmd = app.add_subcommand(
       "generalise",
@@ -228,6 +295,8 @@ int main(int argc, char** argv) {
   if (gen_cmd->parsed()) return fitcal::tools::RunGeneraliseCommand(generalise);
 
   if (optiodom_cmd->parsed()) return fitcal::tools::RunImportOptiOdomCommand(import_optiodom);
+  if (rosbag2_cmd->parsed()) return fitcal::tools::RunImportRosbag2Command(import_rosbag2);
+  if (ros2_control_cmd->parsed()) return fitcal::tools::RunExportRos2ControlCommand(export_ros2);
 
   if (app.got_subcommand(sim_cmd)) {
     simulate.sim.gt_heading_sigma_rad = gt_heading_sigma_deg * M_PI / 180.0;

@@ -18,12 +18,14 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <string>
 
 #include "io/rosbag2/bag_reader.h"
 #include "io/rosbag2/bag_writer.h"
 #include "io/rosbag2/ros_messages.h"
+#include "tools/import_rosbag2.h"
 
 namespace {
 
@@ -151,5 +153,69 @@ BENCHMARK_CAPTURE(ReadBag, sqlite3, std::string("sqlite3"))->Unit(benchmark::kMi
 BENCHMARK_CAPTURE(ReadAndDecode, mcap, std::string("mcap"))->Unit(benchmark::kMillisecond);
 
 }  // namespace
+
+// `fitcal import rosbag2` on one core: a diff_drive robot on wheel_0 (right) and wheel_1 (left) of
+// the JointState bag above plus a PoseStamped ground truth at a tenth of its rate. ReadOnly: read,
+// decode, interval rates, run logs (tools::ReadRosbag2Import); EndToEnd: and the data set
+// written (CSV text, files renamed into place).
+const Bag& ImportBag() {
+  static const Bag bag = [] {
+    static TempDir tmp;
+    const std::uint64_t target_bytes = static_cast<std::uint64_t>(EnvOr("FITCAL_BENCH_BAG_MB", 50))
+                                       << 20;
+    Bag b{tmp.path() / "import", 0};
+    rb::BagWriter writer(b.dir.string(), {});
+    writer.AddTopic("/joint_states", "sensor_msgs/msg/JointState");
+    writer.AddTopic("/mocap/pose", "geometry_msgs/msg/PoseStamped");
+    std::uint64_t written = 0;
+    for (long i = 0; written < target_bytes; ++i) {
+      const rb::JointState js = Sample(i);
+      const std::vector<std::uint8_t> payload = rb::EncodeJointState(js);
+      const std::int64_t t_ns = 1700000000000000000 + i * 10000000;
+      writer.Write("/joint_states", t_ns, rb::ByteView(payload));
+      written += payload.size() + 31;
+      if (i % 10 == 0) {
+        rb::PoseStamped p;
+        p.header = js.header;
+        p.pose.position.x = 0.001 * static_cast<double>(i);
+        const std::vector<std::uint8_t> pose = rb::EncodePoseStamped(p);
+        writer.Write("/mocap/pose", t_ns + 1000, rb::ByteView(pose));
+        written += pose.size() + 31;
+      }
+    }
+    writer.Close();
+    for (const std::string& file : writer.files()) b.file_bytes += fs::file_size(file);
+    std::ofstream(tmp.path() / "robot.yaml")
+        << "model: diff_drive\nname: bench\nwheels:\n  - {name: wheel_0, side: right, radius_m: "
+           "0.05}\n  - {name: wheel_1, side: left, radius_m: 0.05}\nwheel_separation_m: 0.3\n"
+           "bounds: {radius_m: [0.04, 0.06], wheel_separation_m: [0.2, 0.4]}\n";
+    return b;
+  }();
+  return bag;
+}
+
+fitcal::tools::ImportRosbag2Options ImportOptions() {
+  fitcal::tools::ImportRosbag2Options o;
+  o.bag = ImportBag().dir.string();
+  o.robot = (ImportBag().dir.parent_path() / "robot.yaml").string();
+  o.ground_truth = "/mocap/pose";
+  o.out = (ImportBag().dir.parent_path() / "dataset").string();
+  o.force = true;
+  o.quiet = true;
+  return o;
+}
+
+void ImportRosbag2(benchmark::State& state, bool write) {
+  const fitcal::tools::ImportRosbag2Options o = ImportOptions();
+  for (auto _ : state) {
+    const auto imported =
+        write ? fitcal::tools::ImportRosbag2(o) : fitcal::tools::ReadRosbag2Import(o);
+    benchmark::DoNotOptimize(imported.runs.size());
+  }
+  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * ImportBag().file_bytes));
+  state.counters["bag_MB"] = static_cast<double>(ImportBag().file_bytes) / (1 << 20);
+}
+BENCHMARK_CAPTURE(ImportRosbag2, ReadOnly, false)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(ImportRosbag2, EndToEnd, true)->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();

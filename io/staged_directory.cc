@@ -1,0 +1,76 @@
+#include "io/staged_directory.h"
+
+#include <stdlib.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <stdexcept>
+#include <vector>
+
+namespace fitcal::io {
+namespace {
+
+namespace fs = std::filesystem;
+
+// mkdtemp on `<prefix>XXXXXX`: the name is unique and the directory is ours (mode 0700 until the
+// files are in; the rename keeps it, so it is widened to the usual 0755 before).
+std::string MakeUniqueDirectory(const std::string& prefix) {
+  std::string pattern = prefix + "XXXXXX";
+  std::vector<char> name(pattern.begin(), pattern.end());
+  name.push_back('\0');
+  if (mkdtemp(name.data()) == nullptr) {
+    throw std::runtime_error(prefix + ": cannot create a directory: " + std::strerror(errno));
+  }
+  return name.data();
+}
+
+}  // namespace
+
+StagedDirectory::StagedDirectory(const std::string& target) {
+  fs::path t = fs::path(target).lexically_normal();
+  if (!t.has_filename()) t = t.parent_path();  // "out/" names the directory "out"
+  target_ = t.string();
+  std::error_code ec;
+  if (t.has_parent_path()) fs::create_directories(t.parent_path(), ec);
+  if (ec) throw std::runtime_error(target_ + ": cannot create its parent: " + ec.message());
+  staging_ = MakeUniqueDirectory(target_ + ".tmp-");
+  fs::permissions(staging_,
+                  fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec |
+                      fs::perms::others_read | fs::perms::others_exec,
+                  ec);
+}
+
+StagedDirectory::~StagedDirectory() {
+  if (committed_) return;
+  std::error_code ec;
+  fs::remove_all(staging_, ec);
+}
+
+void StagedDirectory::Commit(bool replace_existing) {
+  std::error_code ec;
+  const bool exists = fs::exists(target_, ec);
+  if (exists && !replace_existing) {
+    throw std::runtime_error(target_ + ": exists; refusing to replace it (--force to replace it)");
+  }
+  std::string aside;
+  if (exists) {
+    aside = MakeUniqueDirectory(target_ + ".old-");
+    fs::remove(aside, ec);  // only the unique name is wanted: rename needs it free or empty
+    fs::rename(target_, aside, ec);
+    if (ec) throw std::runtime_error(target_ + ": cannot move it aside: " + ec.message());
+  }
+  fs::rename(staging_, target_, ec);
+  if (ec) {
+    if (!aside.empty()) {
+      std::error_code back;
+      fs::rename(aside, target_, back);
+    }
+    throw std::runtime_error(target_ +
+                             ": cannot rename the new directory into place: " + ec.message());
+  }
+  committed_ = true;
+  if (!aside.empty()) fs::remove_all(aside, ec);
+}
+
+}  // namespace fitcal::io

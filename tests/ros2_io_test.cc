@@ -1,0 +1,448 @@
+// ROS 2 in and out (issue 18): `fitcal import rosbag2` and `fitcal export ros2-control`.
+//
+// Import: a simulated differential drive (tools/sim) is written as a bag the way a robot records
+// it - sensor_msgs/msg/JointState with cumulative wheel angles (extra joint, another joint order,
+// rest messages between runs) and geometry_msgs/msg/PoseStamped ground truth, header stamps, the
+// recording time a few ms later - in both storage formats, compressed or not, split in two files.
+// The imported data set must fit to the same parameters as the simulator's own CSV data set.
+// Export: every controller's YAML parses, holds the documented keys and reads back to the
+// parameters it can represent.
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include "calib/aligned_run.h"
+#include "fit/final_pose_errors.h"
+#include "fit/model_fit.h"
+#include "io/dataset.h"
+#include "io/rosbag2/bag_reader.h"
+#include "io/rosbag2/bag_writer.h"
+#include "io/rosbag2/ros_messages.h"
+#include "models/model_registry.h"
+#include "models/omni/omni_model.h"
+#include "models/omni3/omni3_robot_model.h"
+#include "models/tricycle/tricycle_model.h"
+#include "tests/test_files.h"
+#include "tools/export_ros2_control.h"
+#include "tools/import_rosbag2.h"
+#include "tools/sim/diff_drive_trajectories.h"
+#include "tools/sim/model_simulator.h"
+
+namespace fitcal {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace io::rosbag2;
+
+const char* kRobotYaml = R"(model: diff_drive
+name: bagbot
+wheels:
+  - {name: right, radius_m: 0.042}
+  - {name: left, radius_m: 0.042}
+wheel_separation_m: 0.200
+bounds: {radius_m: [0.038, 0.046], wheel_separation_m: [0.180, 0.220]}
+)";
+const std::vector<double> kTruth = {0.0426, 0.0414, 0.2065};  // r_right, r_left, b
+constexpr std::int64_t kEpochNs = 1700000000000000000;        // the bags' clock origin
+constexpr double kGapS = 3.0;                                 // rest between runs
+constexpr double kEncoderPeriodS = 0.05;
+
+std::int64_t Ns(double t_s) { return kEpochNs + std::llround(t_s * 1e9); }
+
+std::vector<sim::SimulatedRun> SimulatedRuns(const RobotModelInterface& model) {
+  sim::SimulationOptions o;
+  o.encoder_period_s = kEncoderPeriodS;
+  o.gt_position_sigma_m = 0.001;
+  o.gt_heading_sigma_rad = 0.2 * M_PI / 180.0;
+  o.wheel_rate_sigma_rad_s = 0.01;
+  o.seed = 18;
+  sim::DiffDriveTrajectoryOptions shapes;
+  shapes.circle_laps = 0.75;  // open arcs: their end poses see the scale
+  return sim::SimulateRuns(model, kTruth, sim::DiffDriveCalibrationTrajectories(2, shapes), o);
+}
+
+// The bag: runs one after the other on one clock (run i starts where run i-1 ended + kGapS),
+// joint states at rest in the gaps, no ground truth there (the robot is carried back to the start).
+// Returns each run's span on the bag clock (s since the first message).
+std::vector<std::pair<double, double>> WriteRobotBag(const fs::path& dir,
+                                                     const std::vector<sim::SimulatedRun>& runs,
+                                                     BagWriterOptions options) {
+  struct Msg {
+    bool joint;
+    std::int64_t stamp_ns;
+    std::vector<std::uint8_t> payload;
+  };
+  std::vector<Msg> msgs;
+  std::vector<std::pair<double, double>> spans;
+  double offset = 0.0, angle_right = 0.0, angle_left = 0.0;
+  const auto joint = [&](double t) {
+    JointState js;
+    js.header.stamp = {static_cast<std::int32_t>(Ns(t) / 1000000000),
+                       static_cast<std::uint32_t>(Ns(t) % 1000000000)};
+    js.name = {"caster", "left_wheel_joint", "right_wheel_joint"};  // not the robot's order
+    js.position = {0.1, angle_left, angle_right};
+    msgs.push_back({true, Ns(t), EncodeJointState(js)});
+  };
+  for (const sim::SimulatedRun& run : runs) {
+    const std::vector<double>& t = run.log.encoders.t_s;
+    for (std::size_t k = 0; k < t.size(); ++k) {
+      if (k > 0) {  // recorded: mean rates over (t(k-1), t(k)]; the bag holds the angles
+        angle_right += run.recorded[k][0] * (t[k] - t[k - 1]);
+        angle_left += run.recorded[k][1] * (t[k] - t[k - 1]);
+      }
+      joint(offset + t[k] - t.front());
+    }
+    const GroundTruthTrack& gt = run.log.ground_truth;
+    for (std::size_t k = 0; k < gt.t_s.size(); ++k) {
+      PoseStamped p;
+      const std::int64_t ns = Ns(offset + gt.t_s[k] - t.front());
+      p.header.stamp = {static_cast<std::int32_t>(ns / 1000000000),
+                        static_cast<std::uint32_t>(ns % 1000000000)};
+      p.pose.position = {gt.world_T_robot[k].x, gt.world_T_robot[k].y, 0.0};
+      const double yaw = gt.world_T_robot[k].theta;
+      p.pose.orientation = {0.0, 0.0, std::sin(yaw / 2), std::cos(yaw / 2)};
+      msgs.push_back({false, ns, EncodePoseStamped(p)});
+    }
+    spans.emplace_back(offset, offset + t.back() - t.front());
+    offset += t.back() - t.front();
+    const int gap_steps = static_cast<int>(std::lround(kGapS / kEncoderPeriodS));
+    for (int i = 1; i < gap_steps; ++i) joint(offset + i * kEncoderPeriodS);
+    offset += kGapS;
+  }
+  options.split_after_messages = msgs.size() / 2 + 1;  // two files
+  BagWriter bag(dir.string(), options);
+  bag.AddTopic("/joint_states", "sensor_msgs/msg/JointState");
+  bag.AddTopic("/mocap/pose", "geometry_msgs/msg/PoseStamped");
+  bag.AddTopic("/chatter", "std_msgs/msg/String");
+  for (std::size_t i = 0; i < msgs.size(); ++i) {
+    // Recorded 2.0-2.4 ms after the stamp (latency and jitter, below the message spacing).
+    const std::int64_t recorded =
+        msgs[i].stamp_ns + 2000000 + static_cast<std::int64_t>(i % 5) * 100000;
+    bag.Write(msgs[i].joint ? "/joint_states" : "/mocap/pose", recorded, ByteView(msgs[i].payload));
+  }
+  bag.Close();
+  return spans;
+}
+
+tools::ImportRosbag2Options ImportOptions(const testing::TempDir& tmp, const fs::path& bag) {
+  tools::ImportRosbag2Options o;
+  o.bag = bag.string();
+  o.out = tmp.Path("imported");
+  o.robot = tmp.Write("robot.yaml", kRobotYaml);
+  o.joints = {"right_wheel_joint", "left_wheel_joint"};
+  o.ground_truth = "/mocap/pose";
+  o.quiet = true;
+  return o;
+}
+
+ModelFitResult Fit(const RobotModelInterface& model, const std::vector<RunLog>& runs) {
+  const ModelFitResult fit = FitModel(AlignRuns(runs), model);
+  EXPECT_TRUE(fit.usable) << fit.termination << ": " << fit.message;
+  EXPECT_TRUE(fit.has_covariance) << fit.covariance_message;
+  return fit;
+}
+
+struct BagCase {
+  const char* name;
+  StorageFormat storage;
+  Compression compression;
+  bool split_at_rest;  // else --runs from the known spans
+};
+
+class ImportEqualsCsv : public ::testing::TestWithParam<BagCase> {};
+
+// Tolerance: the bag holds the angles the simulator integrated (rate x dt, summed: relative
+// rounding ~1e-13 of a wheel's ~1e3 rad), ns stamps (t moves by <= 0.5 ns: pose error <= 0.3 m/s
+// x 0.5 ns = 1.5e-10 m) and the importer writes 17 significant digits. Against 1 mm / 0.2 deg of
+// ground-truth noise these move the fit by ~1e-7 of its sigma and the CF by ~1e-10 m; 1e-3 sigma
+// and 1e-9 leave room. A lost interval or run moves both far more (a wrong span did: CF +4 %);
+// a swapped wheel makes the runs unexplainable (checked below).
+constexpr double kSigmaFraction = 1e-3;
+
+TEST_P(ImportEqualsCsv, SameFitAsTheSimulatorsCsv) {
+  const BagCase& c = GetParam();
+  testing::TempDir tmp;
+  const RobotModelPtr model = ReadRobotModel(YAML::Load(kRobotYaml), "robot.yaml");
+  const std::vector<sim::SimulatedRun> sim_runs = SimulatedRuns(*model);
+  BagWriterOptions bag_options;
+  bag_options.storage = c.storage;
+  bag_options.mcap.compression = c.compression;
+  bag_options.mcap.chunk_bytes = 64 * 1024;
+  const auto spans = WriteRobotBag(tmp.path() / "bag", sim_runs, bag_options);
+  tools::ImportRosbag2Options o = ImportOptions(tmp, tmp.path() / "bag");
+  if (c.split_at_rest) {
+    o.split_at_rest_s = 2.0;  // the gaps (3 s + the runs' rests), not the 0.6 s corner stops
+  } else {
+    char text[64];
+    for (const auto& [t0, t1] : spans) {
+      // Half an encoder period into the gaps: a span given in decimal seconds must not lose the
+      // run's first or last stamp to rounding (the gaps hold rest messages only).
+      std::snprintf(text, sizeof text, "%s%.9f:%.9f", o.runs.empty() ? "" : ",",
+                    t0 - 0.5 * kEncoderPeriodS, t1 + 0.5 * kEncoderPeriodS);
+      o.runs += text;
+    }
+  }
+  tools::ImportRosbag2(o);
+  const io::Dataset imported = io::LoadDataset(io::ReadDatasetIndex(o.out),
+                                               ReadRobotModelFile(o.out + "/robot.yaml")->robot());
+  ASSERT_EQ(imported.runs.size(), sim_runs.size());
+  std::vector<RunLog> csv;
+  for (const sim::SimulatedRun& r : sim_runs) csv.push_back(r.log);
+  const ModelFitResult from_bag = Fit(*model, imported.runs);
+  const ModelFitResult from_csv = Fit(*model, csv);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_LT(std::abs(from_bag.parameters[k] - from_csv.parameters[k]),
+              kSigmaFraction * from_csv.sigma[k])
+        << model->robot().parameters[k].name;
+    EXPECT_LT(std::abs(from_csv.parameters[k] - kTruth[k]), 5.0 * from_csv.sigma[k]);
+  }
+  const double cf_bag = EvaluateFinalPoseErrors(*model, kTruth, AlignRuns(imported.runs)).cf;
+  const double cf_csv = EvaluateFinalPoseErrors(*model, kTruth, AlignRuns(csv)).cf;
+  EXPECT_NEAR(cf_bag, cf_csv, 1e-9);
+
+  // The same bag with the wheels' joints swapped: a different robot, many sigmas away.
+  o.joints = {"left_wheel_joint", "right_wheel_joint"};
+  o.force = true;
+  tools::ImportRosbag2(o);
+  const io::Dataset swapped = io::LoadDataset(io::ReadDatasetIndex(o.out), model->robot());
+  const ModelFitResult wrong = FitModel(AlignRuns(swapped.runs), *model);
+  const double cf_wrong =
+      EvaluateFinalPoseErrors(*model, wrong.parameters, AlignRuns(swapped.runs)).cf;
+  const double cf_right =
+      EvaluateFinalPoseErrors(*model, from_bag.parameters, AlignRuns(imported.runs)).cf;
+  EXPECT_GT(cf_wrong, 10.0 * cf_right);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Bags, ImportEqualsCsv,
+    ::testing::Values(BagCase{"sqlite3_runs", StorageFormat::kSqlite3, Compression::kNone, false},
+                      BagCase{"sqlite3_rests", StorageFormat::kSqlite3, Compression::kNone, true},
+                      BagCase{"mcap_runs", StorageFormat::kMcap, Compression::kNone, false},
+                      BagCase{"mcap_zstd_rests", StorageFormat::kMcap, Compression::kZstd, true},
+                      BagCase{"mcap_lz4_runs", StorageFormat::kMcap, Compression::kLz4, false}),
+    [](const ::testing::TestParamInfo<BagCase>& p) { return p.param.name; });
+
+// ---------------------------------------------------------------------------------------------
+// Malformed bags: one line, non-zero exit, nothing written (no data set, no temporary sibling).
+
+class CaptureStderr {
+ public:
+  CaptureStderr() : old_(std::cerr.rdbuf(text_.rdbuf())) {}
+  ~CaptureStderr() { std::cerr.rdbuf(old_); }
+  std::string str() const { return text_.str(); }
+
+ private:
+  std::ostringstream text_;
+  std::streambuf* old_;
+};
+
+void ExpectRefused(const tools::ImportRosbag2Options& o, const std::string& what) {
+  int rc = 0;
+  std::string err;
+  {
+    CaptureStderr capture;
+    rc = tools::RunImportRosbag2Command(o);
+    err = capture.str();
+  }
+  EXPECT_NE(rc, 0) << what;
+  EXPECT_EQ(err.rfind("fitcal import rosbag2: ", 0), 0u) << err;
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  EXPECT_NE(err.find(what), std::string::npos) << err;
+  const fs::path out(o.out);
+  EXPECT_FALSE(fs::exists(out)) << what;
+  for (const auto& e : fs::directory_iterator(out.parent_path())) {
+    EXPECT_EQ(e.path().filename().string().rfind(out.filename().string() + ".", 0),
+              std::string::npos)
+        << "left behind: " << e.path();
+  }
+}
+
+class MalformedImport : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const RobotModelPtr model = ReadRobotModel(YAML::Load(kRobotYaml), "robot.yaml");
+    runs_ = SimulatedRuns(*model);
+    runs_.resize(2);
+  }
+  fs::path Bag(const std::string& name, StorageFormat storage) {
+    BagWriterOptions options;
+    options.storage = storage;
+    WriteRobotBag(tmp_.path() / name, runs_, options);
+    return tmp_.path() / name;
+  }
+  testing::TempDir tmp_;
+  std::vector<sim::SimulatedRun> runs_;
+};
+
+TEST_F(MalformedImport, TruncatedAndBadMagic) {
+  for (StorageFormat storage : {StorageFormat::kMcap, StorageFormat::kSqlite3}) {
+    const fs::path bag = Bag(storage == StorageFormat::kMcap ? "m" : "s", storage);
+    const std::string ext = storage == StorageFormat::kMcap ? "_0.mcap" : "_0.db3";
+    const fs::path file = bag / (bag.filename().string() + ext);
+    const std::string bytes = testing::ReadFileBytes(file);
+    testing::WriteFileBytes(file, bytes.substr(0, bytes.size() / 2));
+    ExpectRefused(ImportOptions(tmp_, bag), file.string());
+    std::string bad = bytes;
+    bad.replace(1, 4, "XXXX");
+    testing::WriteFileBytes(file, bad);
+    ExpectRefused(ImportOptions(tmp_, bag), "magic");
+  }
+}
+
+TEST_F(MalformedImport, TopicTypeJointAndStamps) {
+  const fs::path bag = Bag("b", StorageFormat::kMcap);
+  tools::ImportRosbag2Options o = ImportOptions(tmp_, bag);
+  o.ground_truth = "/vicon/pose";
+  ExpectRefused(o, "topic \"/vicon/pose\" is not in the bag");
+  o.ground_truth = "/chatter";
+  ExpectRefused(o, "has type \"std_msgs/msg/String\"");
+  o = ImportOptions(tmp_, bag);
+  o.joints = {"right_wheel_joint", "rear_wheel_joint"};
+  ExpectRefused(o, "joint \"rear_wheel_joint\" is not in the message");
+  // Two runs written on the same clock origin: the second one's stamps go back in time.
+  BagWriterOptions options;
+  WriteRobotBag(tmp_.path() / "x", {runs_[0]}, options);
+  {
+    BagWriter twice((tmp_.path() / "twice").string(), options);
+    twice.AddTopic("/joint_states", "sensor_msgs/msg/JointState");
+    twice.AddTopic("/mocap/pose", "geometry_msgs/msg/PoseStamped");
+    BagReader once((tmp_.path() / "x").string());
+    BagMessage m;
+    std::vector<std::pair<std::string, std::vector<std::uint8_t>>> all;
+    std::vector<std::int64_t> times;
+    while (once.ReadNext(&m)) {
+      all.emplace_back(m.topic->name, m.payload.ToVector());
+      times.push_back(m.time_ns);
+    }
+    for (int pass = 0; pass < 2; ++pass) {
+      for (std::size_t i = 0; i < all.size(); ++i) {
+        twice.Write(all[i].first, times[i] + pass * (times.back() - times.front() + 1000000),
+                    ByteView(all[i].second));
+      }
+    }
+    twice.Close();
+  }
+  ExpectRefused(ImportOptions(tmp_, tmp_.path() / "twice"), "is not after the previous one");
+  o = ImportOptions(tmp_, tmp_.path() / "twice");
+  o.stamp = "recorded";  // the recording times do increase
+  tools::ImportRosbag2(o);
+  EXPECT_TRUE(fs::exists(fs::path(o.out) / "dataset.yaml"));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Export
+
+struct Exported {
+  YAML::Node params;
+  tools::Ros2ControlExport e;
+  RobotModelPtr back;
+};
+
+Exported ExportAndRead(const std::string& cal, const std::string& controller) {
+  Exported x;
+  x.e = tools::ExportRos2Control(cal, controller, "", {});
+  const YAML::Node root = YAML::Load(x.e.parameters_yaml);
+  EXPECT_TRUE(root[controller]) << x.e.parameters_yaml;
+  x.params = root[controller]["ros__parameters"];
+  EXPECT_TRUE(x.params.IsMap()) << x.e.parameters_yaml;
+  x.back = tools::ReadRos2ControlYaml(x.e.parameters_yaml, "exported", cal, {});
+  return x;
+}
+
+// Round trips go through 12-digit decimals: 1e-11 relative.
+constexpr double kRoundTrip = 1e-11;
+
+TEST(ExportRos2Control, DiffDriveIsExact) {
+  testing::TempDir tmp;
+  const RobotModelPtr model = ReadRobotModel(YAML::Load(kRobotYaml), "robot.yaml");
+  const std::string cal = tmp.Write("cal.yaml", model->RobotYaml(kTruth, ""));
+  const Exported x = ExportAndRead(cal, "diff_drive_controller");
+  for (const char* key : {"wheel_separation", "wheel_radius", "left_wheel_radius_multiplier",
+                          "right_wheel_radius_multiplier", "wheel_separation_multiplier"}) {
+    EXPECT_TRUE(x.params[key]) << key;
+  }
+  EXPECT_EQ(x.params["left_wheel_names"][0].as<std::string>(), "left");
+  EXPECT_TRUE(x.e.notes.empty());
+  const double r = x.params["wheel_radius"].as<double>();
+  EXPECT_NEAR(r * x.params["right_wheel_radius_multiplier"].as<double>(), kTruth[0], 1e-12);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(x.back->robot().nominal[k], kTruth[k], kRoundTrip * kTruth[k]) << k;
+  }
+  EXPECT_THROW(tools::ExportRos2Control(cal, "tricycle_controller", "", {}), std::invalid_argument);
+  EXPECT_THROW(tools::ExportRos2Control(cal, "ackermann_controller", "", {}),
+               std::invalid_argument);
+}
+
+TEST(ExportRos2Control, MecanumTakesMeans) {
+  testing::TempDir tmp;
+  const RobotModelPtr model = ReadRobotModel(YAML::Load(kOmniExampleYaml), "robot.yaml");
+  std::vector<double> p = model->robot().nominal;  // R x4, r x4, delta x4
+  const double radii[] = {0.049, 0.050, 0.051, 0.0505};
+  for (int i = 0; i < 4; ++i) p[4 + i] = radii[i];
+  p[0] = 0.26;  // fl further out
+  const std::string cal = tmp.Write("cal.yaml", model->RobotYaml(p, ""));
+  const Exported x = ExportAndRead(cal, "mecanum_drive_controller");
+  const YAML::Node k = x.params["kinematics"];
+  ASSERT_TRUE(k["wheels_radius"] && k["sum_of_robot_center_projection_on_X_Y_axis"]);
+  EXPECT_TRUE(x.params["front_left_wheel_command_joint_name"]);
+  EXPECT_EQ(x.e.notes.size(), 2u);  // one radius, one lx + ly
+  const double mean_r = (0.049 + 0.050 + 0.051 + 0.0505) / 4;
+  EXPECT_NEAR(k["wheels_radius"].as<double>(), mean_r, 1e-12);
+  // lx + ly of the nominal layout (0.2 + 0.15) with the front-left wheel at 0.26 m.
+  const double fl =
+      0.26 * (std::cos(36.86989765 * M_PI / 180) + std::sin(36.86989765 * M_PI / 180));
+  EXPECT_NEAR(k["sum_of_robot_center_projection_on_X_Y_axis"].as<double>(), (fl + 3 * 0.35) / 4,
+              1e-9);
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(x.back->robot().nominal[4 + i], mean_r, kRoundTrip);
+}
+
+TEST(ExportRos2Control, OmniWheelsEquallySpacedAndSignNoted) {
+  testing::TempDir tmp;
+  const RobotModelPtr model = ReadRobotModel(YAML::Load(kOmni3ExampleYaml), "robot.yaml");
+  std::vector<double> p = model->robot().nominal;
+  p[0] = 0.197;
+  p[4] = 0.150;
+  p[8] -= 0.01;  // wheel c 0.57 deg off, further from the x axis than a
+  const std::string cal = tmp.Write("cal.yaml", model->RobotYaml(p, ""));
+  const Exported x = ExportAndRead(cal, "omni_wheel_drive_controller");
+  for (const char* key : {"wheel_radius", "robot_radius", "wheel_offset", "wheel_names"}) {
+    EXPECT_TRUE(x.params[key]) << key;
+  }
+  EXPECT_EQ(x.e.notes.size(), 4u);  // radius, distance, spacing, sign convention
+  // Wheels a (60 deg), b (180), c (300): a is nearest the x axis and comes first.
+  EXPECT_EQ(x.params["wheel_names"][0].as<std::string>(), "a");
+  const double offset = x.params["wheel_offset"].as<double>();
+  // The circular mean of the angles' offsets (0, 0, -0.01 rad): -0.01 / 3 to O(0.01^3).
+  EXPECT_NEAR(offset, 60 * M_PI / 180 - 0.01 / 3, 1e-6);
+  const std::vector<double>& back = x.back->robot().nominal;
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(back[i], (0.197 + 2 * 0.195) / 3, kRoundTrip);
+    EXPECT_NEAR(back[3 + i], (0.150 + 2 * 0.148) / 3, kRoundTrip);
+    EXPECT_NEAR(WrapAngle(back[6 + i] - offset - 2 * M_PI * i / 3), 0.0, 1e-9);
+  }
+}
+
+TEST(ExportRos2Control, TricycleDropsTheSteeringOffset) {
+  testing::TempDir tmp;
+  const RobotModelPtr model = ReadRobotModel(YAML::Load(kTricycleExampleYaml), "robot.yaml");
+  const std::vector<double> p = {0.0331, 0.152, 1.5 * M_PI / 180};
+  const std::string cal = tmp.Write("cal.yaml", model->RobotYaml(p, ""));
+  const Exported x = ExportAndRead(cal, "tricycle_controller");
+  EXPECT_NEAR(x.params["wheelbase"].as<double>(), 0.152, 1e-12);
+  EXPECT_NEAR(x.params["wheel_radius"].as<double>(), 0.0331, 1e-12);
+  EXPECT_EQ(x.params["steering_joint_name"].as<std::string>(), "steering");
+  ASSERT_EQ(x.e.notes.size(), 1u);
+  EXPECT_NE(x.e.notes[0].find("1.5000 deg"), std::string::npos) << x.e.notes[0];
+  EXPECT_NEAR(x.back->robot().nominal[0], 0.0331, kRoundTrip);
+  EXPECT_NEAR(x.back->robot().nominal[1], 0.152, kRoundTrip);
+  EXPECT_EQ(x.back->robot().nominal[2], 0.0);
+}
+
+}  // namespace
+}  // namespace fitcal

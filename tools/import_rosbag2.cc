@@ -1,0 +1,375 @@
+#include "tools/import_rosbag2.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <stdexcept>
+
+#include "calib/aligned_run.h"
+#include "fit/final_pose_errors.h"
+#include "io/atomic_file.h"
+#include "io/dataset.h"
+#include "io/input_error.h"
+#include "io/log_files.h"
+#include "io/staged_directory.h"
+#include "io/text_file.h"
+#include "models/model_registry.h"
+
+namespace fitcal::tools {
+namespace {
+
+namespace fs = std::filesystem;
+using io::InputError;
+using io::InputErrorKind;
+using io::rosbag2::BagStreams;
+
+struct IndexSpan {
+  std::size_t first = 0;  // encoder stamps first..last, inclusive
+  std::size_t last = 0;
+};
+
+double ParseSeconds(const std::string& text, const std::string& what) {
+  double v = 0.0;
+  bool finite = true;
+  if (!io::ParseDouble(io::Trim(text), &v, &finite) || !finite) {
+    throw std::invalid_argument(what + ": '" + text + "' is not a number of seconds");
+  }
+  return v;
+}
+
+// "t0:t1,t2:t3" -> spans in seconds since the bag's start.
+std::vector<std::pair<double, double>> ParseRunSpans(const std::string& text) {
+  std::vector<std::pair<double, double>> spans;
+  std::size_t pos = 0;
+  while (pos <= text.size()) {
+    const std::size_t end = std::min(text.find(',', pos), text.size());
+    const std::string item = text.substr(pos, end - pos);
+    const std::size_t colon = item.find(':');
+    if (colon == std::string::npos) {
+      throw std::invalid_argument("--runs: '" + item + "' is not t0:t1");
+    }
+    const double t0 = ParseSeconds(item.substr(0, colon), "--runs");
+    const double t1 = ParseSeconds(item.substr(colon + 1), "--runs");
+    if (!(t1 > t0))
+      throw std::invalid_argument("--runs: '" + item + "' does not end after it starts");
+    spans.emplace_back(t0, t1);
+    pos = end + 1;
+  }
+  return spans;
+}
+
+std::string RunLabel(const ImportRosbag2Options& o) {
+  std::string label = o.label;
+  if (label.empty()) {
+    fs::path p = fs::path(o.bag).lexically_normal();
+    if (!p.has_filename()) p = p.parent_path();
+    label =
+        p.filename() == "metadata.yaml" ? p.parent_path().filename().string() : p.stem().string();
+  }
+  for (char& c : label) {
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_' && c != '.') c = '_';
+  }
+  return label.empty() ? "bag" : label;
+}
+
+double SecondsSinceStart(const BagStreams& s, std::int64_t t_ns) {
+  return static_cast<double>(t_ns - s.start_time_ns) * 1e-9;
+}
+
+// What the encoder CSV holds at each stamp, robot channel order: a wheel's mean rate over the
+// interval ending at the stamp (0 at stamp 0: row 0 only sets the start), an angle as read.
+std::vector<std::vector<double>> ChannelRows(const Robot& robot, const BagStreams& s) {
+  const std::size_t n = s.joints.t_ns.size(), c = robot.channels.size();
+  const std::vector<double>& v = s.joints.values;
+  std::vector<std::vector<double>> rows(n, std::vector<double>(c, 0.0));
+  for (std::size_t k = 0; k < n; ++k) {
+    const double dt = k == 0 ? 0.0
+                             : SecondsSinceStart(s, s.joints.t_ns[k]) -
+                                   SecondsSinceStart(s, s.joints.t_ns[k - 1]);
+    for (std::size_t j = 0; j < c; ++j) {
+      const double now = v[k * c + j];
+      if (robot.channels[j].kind == ChannelKind::kAngle) {
+        rows[k][j] = now;
+      } else if (k > 0) {
+        const double before = v[(k - 1) * c + j];
+        rows[k][j] = s.joints.positions ? (now - before) / dt : 0.5 * (before + now);
+      }
+    }
+  }
+  return rows;
+}
+
+bool IntervalAtRest(const Robot& robot, const std::vector<double>& row, double rest_rate) {
+  for (std::size_t j = 0; j < row.size(); ++j) {
+    if (robot.channels[j].kind == ChannelKind::kWheelRate && std::abs(row[j]) > rest_rate) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// Cuts at the middle stamp of every rest of at least min_rest_s and keeps the pieces in which
+// some wheel turns.
+std::vector<IndexSpan> SplitAtRests(const Robot& robot, const BagStreams& s,
+                                    const std::vector<std::vector<double>>& rows,
+                                    const ImportRosbag2Options& o) {
+  const std::size_t n = rows.size();
+  std::vector<std::size_t> cuts = {0};
+  std::size_t k = 1;
+  while (k < n) {
+    if (!IntervalAtRest(robot, rows[k], o.rest_rate_rad_s)) {
+      ++k;
+      continue;
+    }
+    const std::size_t begin = k - 1;  // the rest starts at the stamp before its first interval
+    while (k < n && IntervalAtRest(robot, rows[k], o.rest_rate_rad_s)) ++k;
+    const std::size_t end = k - 1;
+    const double length_s =
+        SecondsSinceStart(s, s.joints.t_ns[end]) - SecondsSinceStart(s, s.joints.t_ns[begin]);
+    if (length_s >= o.split_at_rest_s) {
+      // The first stamp at or after the rest's middle in time (stamps need not be uniform).
+      const std::int64_t middle_ns =
+          s.joints.t_ns[begin] + (s.joints.t_ns[end] - s.joints.t_ns[begin]) / 2;
+      std::size_t cut = begin;
+      while (s.joints.t_ns[cut] < middle_ns) ++cut;
+      cuts.push_back(cut);
+    }
+  }
+  cuts.push_back(n - 1);
+  std::vector<IndexSpan> spans;
+  for (std::size_t i = 0; i + 1 < cuts.size(); ++i) {
+    bool moves = false;
+    for (std::size_t j = cuts[i] + 1; j <= cuts[i + 1] && !moves; ++j) {
+      moves = !IntervalAtRest(robot, rows[j], o.rest_rate_rad_s);
+    }
+    if (moves) spans.push_back({cuts[i], cuts[i + 1]});
+  }
+  return spans;
+}
+
+std::vector<IndexSpan> SpansFromTimes(const BagStreams& s, const ImportRosbag2Options& o) {
+  std::vector<IndexSpan> spans;
+  for (const auto& [t0, t1] : ParseRunSpans(o.runs)) {
+    IndexSpan span{s.joints.t_ns.size(), 0};
+    for (std::size_t k = 0; k < s.joints.t_ns.size(); ++k) {
+      const double t = SecondsSinceStart(s, s.joints.t_ns[k]);
+      if (t < t0 || t > t1) continue;
+      span.first = std::min(span.first, k);
+      span.last = k;
+    }
+    if (span.first >= span.last) {
+      char what[160];
+      std::snprintf(what, sizeof what,
+                    "run %g:%g s holds fewer than 2 encoder messages (the bag spans 0:%.3f s)", t0,
+                    t1, SecondsSinceStart(s, s.joints.t_ns.back()));
+      throw InputError(InputErrorKind::kTooFewSamples, s.bag, 0, what);
+    }
+    spans.push_back(span);
+  }
+  return spans;
+}
+
+RunLog MakeRun(const Robot& robot, const BagStreams& s,
+               const std::vector<std::vector<double>>& rows, const IndexSpan& span, int number,
+               const std::string& label, std::vector<double>* t_out,
+               std::vector<std::vector<double>>* rows_out) {
+  RunLog run;
+  char id[32];
+  std::snprintf(id, sizeof id, "-%02d", number);
+  run.id = label + id;
+  run.trajectory = label;
+  run.repetition = number;
+  io::EncoderRowConverter converter(robot);
+  for (std::size_t k = span.first; k <= span.last; ++k) {
+    const double t = SecondsSinceStart(s, s.joints.t_ns[k]);
+    std::vector<double> row = rows[k];
+    if (k == span.first) {  // the run's row 0 only sets its start
+      for (std::size_t j = 0; j < row.size(); ++j) {
+        if (robot.channels[j].kind == ChannelKind::kWheelRate) row[j] = 0.0;
+      }
+    }
+    converter.Add(t, row.data());
+    t_out->push_back(t);
+    rows_out->push_back(std::move(row));
+  }
+  run.encoders = converter.Take();
+  const double t0 = t_out->front(), t1 = t_out->back();
+  for (std::size_t k = 0; k < s.poses.t_ns.size(); ++k) {
+    const double t = SecondsSinceStart(s, s.poses.t_ns[k]);
+    if (t < t0 || t > t1) continue;
+    run.ground_truth.t_s.push_back(t);
+    run.ground_truth.world_T_robot.push_back(s.poses.world_T_robot[k]);
+  }
+  if (run.ground_truth.t_s.size() < 2) {
+    char what[160];
+    std::snprintf(what, sizeof what,
+                  "run %s (%.3f:%.3f s) holds %zu ground-truth pose(s); at "
+                  "least 2 needed",
+                  run.id.c_str(), t0, t1, run.ground_truth.t_s.size());
+    throw InputError(InputErrorKind::kNoOverlap, s.bag, 0, what);
+  }
+  return run;
+}
+
+io::rosbag2::BagStreamRequest MakeRequest(const ImportRosbag2Options& o, const Robot& robot) {
+  io::rosbag2::BagStreamRequest r;
+  r.joint_topic = o.encoders;
+  r.pose_topic = o.ground_truth;
+  if (o.stamp != "header" && o.stamp != "recorded") {
+    throw std::invalid_argument("--stamp must be header or recorded, not '" + o.stamp + "'");
+  }
+  r.stamp =
+      o.stamp == "header" ? io::rosbag2::StampSource::kHeader : io::rosbag2::StampSource::kRecorded;
+  if (!o.ground_truth_frames.empty()) {
+    const std::size_t colon = o.ground_truth_frames.find(':');
+    if (colon == std::string::npos || colon == 0 || colon + 1 == o.ground_truth_frames.size()) {
+      throw std::invalid_argument(
+          "--ground-truth-frames must be parent:child, e.g. world:base_link");
+    }
+    r.parent_frame = o.ground_truth_frames.substr(0, colon);
+    r.child_frame = o.ground_truth_frames.substr(colon + 1);
+    for (std::string* f : {&r.parent_frame, &r.child_frame}) {
+      if ((*f)[0] == '/') f->erase(0, 1);
+    }
+  }
+  if (!o.joints.empty() && o.joints.size() != robot.channels.size()) {
+    throw std::invalid_argument("--joints names " + std::to_string(o.joints.size()) +
+                                " joints; robot '" + robot.name + "' has " +
+                                std::to_string(robot.channels.size()) + " channels");
+  }
+  for (std::size_t j = 0; j < robot.channels.size(); ++j) {
+    r.joints.push_back(o.joints.empty() ? robot.channels[j].name : o.joints[j]);
+    r.needs_position.push_back(robot.channels[j].kind == ChannelKind::kAngle);
+  }
+  return r;
+}
+
+std::string EncoderCsvText(const Robot& robot, const std::vector<double>& t_s,
+                           const std::vector<std::vector<double>>& rows) {
+  std::string out = "t";
+  for (const ChannelInfo& c : robot.channels) out += "," + c.rate_column;
+  out += "\n";
+  char field[40];
+  for (std::size_t k = 0; k < t_s.size(); ++k) {
+    out.append(field, static_cast<std::size_t>(std::snprintf(field, sizeof field, "%.9f", t_s[k])));
+    for (double v : rows[k]) {
+      out.append(field, static_cast<std::size_t>(std::snprintf(field, sizeof field, ",%.17g", v)));
+    }
+    out += "\n";
+  }
+  return out;
+}
+
+// io::GroundTruthCsv rounds to 1 um and 1e-7 rad; a bag's poses are kept to the last bit.
+std::string GroundTruthCsvText(const GroundTruthTrack& track) {
+  std::string out = "t,x,y,theta\n";
+  char line[128];
+  for (std::size_t k = 0; k < track.t_s.size(); ++k) {
+    const Pose2d& p = track.world_T_robot[k];
+    out.append(line,
+               static_cast<std::size_t>(std::snprintf(line, sizeof line, "%.9f,%.17g,%.17g,%.17g\n",
+                                                      track.t_s[k], p.x, p.y, p.theta)));
+  }
+  return out;
+}
+
+void WriteDataset(const ImportRosbag2Options& o, const Robot& robot, const Rosbag2Import& imp) {
+  io::StagedDirectory staged(o.out);
+  const fs::path dir(staged.path());
+  fs::create_directories(dir / "runs");
+  std::vector<io::DatasetEntry> entries;
+  for (std::size_t i = 0; i < imp.runs.size(); ++i) {
+    io::DatasetEntry e;
+    e.id = imp.runs[i].id;
+    e.trajectory = imp.runs[i].trajectory;
+    e.repetition = imp.runs[i].repetition;
+    e.encoders = "runs/" + e.id + "_encoders.csv";
+    e.ground_truth = "runs/" + e.id + "_ground_truth.csv";
+    io::WriteFileAtomically((dir / e.encoders).string(),
+                            EncoderCsvText(robot, imp.encoder_t_s[i], imp.encoder_rows[i]));
+    io::WriteFileAtomically((dir / e.ground_truth).string(),
+                            GroundTruthCsvText(imp.runs[i].ground_truth));
+    entries.push_back(std::move(e));
+  }
+  io::WriteFileAtomically((dir / "robot.yaml").string(), io::ReadTextFile(o.robot));
+  const std::string header =
+      "# imported by fitcal import rosbag2 from " + o.bag + "\n# encoders " + o.encoders + " (" +
+      (imp.streams.joints.positions ? "positions" : "velocities") + "), ground truth " +
+      o.ground_truth + " (" + imp.streams.pose_type + "), " + o.stamp + " stamps; t = 0 at " +
+      std::to_string(imp.streams.start_time_ns) + " ns since the epoch\n";
+  io::WriteFileAtomically((dir / "dataset.yaml").string(),
+                          header + io::DatasetYaml("robot.yaml", entries));
+  io::StopHereForTests("import-rosbag2-before-rename");
+  staged.Commit(o.force);
+}
+
+}  // namespace
+
+Rosbag2Import ReadRosbag2Import(const ImportRosbag2Options& o) {
+  if (o.split_at_rest_s > 0.0 && !o.runs.empty()) {
+    throw std::invalid_argument("--runs and --split-at-rest exclude each other");
+  }
+  if (o.ground_truth.empty()) throw std::invalid_argument("--ground-truth <topic> is required");
+  const RobotModelPtr model = ReadRobotModelFile(o.robot);
+  const Robot& robot = model->robot();
+  Rosbag2Import imp;
+  imp.streams = io::rosbag2::ReadBagStreams(o.bag, MakeRequest(o, robot));
+  const std::vector<std::vector<double>> rows = ChannelRows(robot, imp.streams);
+  std::vector<IndexSpan> spans;
+  if (!o.runs.empty()) {
+    spans = SpansFromTimes(imp.streams, o);
+  } else if (o.split_at_rest_s > 0.0) {
+    spans = SplitAtRests(robot, imp.streams, rows, o);
+    if (spans.empty()) {
+      throw InputError(InputErrorKind::kTooFewSamples, o.bag, 0,
+                       "the wheels never turn faster than --rest-rate: no run to cut");
+    }
+  } else {
+    spans = {{0, rows.size() - 1}};
+  }
+  const std::string label = RunLabel(o);
+  for (std::size_t i = 0; i < spans.size(); ++i) {
+    imp.encoder_t_s.emplace_back();
+    imp.encoder_rows.emplace_back();
+    imp.runs.push_back(MakeRun(robot, imp.streams, rows, spans[i], static_cast<int>(i) + 1, label,
+                               &imp.encoder_t_s.back(), &imp.encoder_rows.back()));
+  }
+  return imp;
+}
+
+Rosbag2Import ImportRosbag2(const ImportRosbag2Options& o) {
+  if (o.out.empty()) throw std::invalid_argument("--out <data set directory> is required");
+  if (fs::exists(o.out) && !o.force) {
+    throw std::runtime_error(o.out + ": exists; refusing to replace it (--force to replace it)");
+  }
+  Rosbag2Import imp = ReadRosbag2Import(o);
+  WriteDataset(o, ReadRobotModelFile(o.robot)->robot(), imp);
+  return imp;
+}
+
+int RunImportRosbag2Command(const ImportRosbag2Options& o) {
+  constexpr const char* kPrefix = "fitcal import rosbag2: ";
+  try {
+    const Rosbag2Import imp = ImportRosbag2(o);
+    if (!o.quiet) {
+      const RobotModelPtr model = ReadRobotModelFile(o.robot);
+      const FinalPoseErrors nominal =
+          EvaluateFinalPoseErrors(*model, model->robot().nominal, AlignRuns(imp.runs));
+      std::printf(
+          "wrote %zu run(s) to %s (%.1f MB of bag, %zu encoder and %zu ground-truth "
+          "samples); nominal CF (Eq. 14) %.4f\n",
+          imp.runs.size(), o.out.c_str(), static_cast<double>(imp.streams.bytes) * 1e-6,
+          imp.streams.joints.t_ns.size(), imp.streams.poses.t_ns.size(), nominal.cf);
+    }
+    return 0;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << kPrefix << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << kPrefix << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace fitcal::tools
