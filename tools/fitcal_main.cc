@@ -198,7 +198,8 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingDirectory);
   compare_cmd
       ->add_option("--strategies", compare.strategies,
-                   "STA..STE or trajectory lists such as R1,R5,G4 or B1-B12 (one per item)")
+                   "STA..STE, trajectory lists such as R1,R5,G4 or B1-B12, all, or a label "
+                   "prefix such as circular/* (one per item)")
       ->capture_default_str();
   compare_cmd
       ->add_option("--methods", compare.methods,
@@ -232,7 +233,10 @@ int main(int argc, char** argv) {
 
   if (diagnose_cmd->parsed()) return fitcal::tools::RunDiagnoseCommand(diagnose);
 
-  if (compare_cmd->parsed()) return fitcal::tools::RunCompareCommand(compare);
+  if (compare_cmd->parsed()) {
+    compare.strategies_given = compare_cmd->count("--strategies") > 0;
+    return fitcal::tools::RunCompareCommand(compare);
+  }
 
   if (report_cmd->parsed()) return fitcal::tools::RunReportCommand(report);
   if (const int asoc_rc = asoc_commands.Dispatch(app); asoc_rc >= 0) return asoc_rc;
