@@ -6,7 +6,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <iostream>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -18,6 +20,8 @@
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/robot_yaml.h"
+#include "models/model_registry.h"
+#include "models/omni3/omni3_robot_model.h"
 #include "tools/fit_methods.h"
 
 namespace fitcal::tools {
@@ -27,8 +31,8 @@ namespace {
 struct Row {
   std::string strategy;
   std::string method;
-  int repetitions = 0;  // 0 = the uncalibrated reference row
-  Eigen::Matrix3d m_inv = Eigen::Matrix3d::Zero();
+  int repetitions = 0;             // 0 = the uncalibrated reference row
+  std::vector<double> parameters;  // empty for the uncalibrated reference row
   double cf_calibration = NAN;
   double cf_validation = NAN;
   double improvement_percent = NAN;
@@ -55,6 +59,61 @@ std::string MatrixText(const Eigen::Matrix3d& m) {
   return out;
 }
 
+// How a row's parameters are shown: omni3 as the M^-1 of Palacin Eq. 6 (Table 4's column, and
+// what firmware takes), every other model as its parameters in display units (m, deg).
+struct ParameterColumns {
+  std::string markdown_header;
+  std::vector<std::string> csv_names;
+  std::function<std::vector<double>(const std::vector<double>&)> csv_values;
+  std::function<std::string(const std::vector<double>&)> markdown;
+};
+
+ParameterColumns ColumnsFor(const Robot& robot) {
+  ParameterColumns c;
+  if (robot.model == "omni3") {
+    c.markdown_header = "M^-1";
+    for (int r = 0; r < 3; ++r) {
+      for (int k = 0; k < 3; ++k)
+        c.csv_names.push_back("m_inv_" + std::to_string(r) + std::to_string(k));
+    }
+    c.csv_values = [](const std::vector<double>& p) {
+      const Eigen::Matrix3d m = omni3::InverseKinematicMatrix(p.data());
+      std::vector<double> out;
+      for (int r = 0; r < 3; ++r) {
+        for (int k = 0; k < 3; ++k) out.push_back(m(r, k));
+      }
+      return out;
+    };
+    c.markdown = [](const std::vector<double>& p) {
+      return MatrixText(omni3::InverseKinematicMatrix(p.data()));
+    };
+    return c;
+  }
+  c.markdown_header = "Parameters";
+  for (const ParameterInfo& info : robot.parameters) {
+    c.csv_names.push_back(info.name + "_" + info.DisplayUnit());
+  }
+  c.csv_values = [robot](const std::vector<double>& p) {
+    std::vector<double> out;
+    for (int k = 0; k < robot.NumParameters(); ++k) {
+      out.push_back(p[k] * robot.parameters[k].DisplayScale());
+    }
+    return out;
+  };
+  c.markdown = [robot](const std::vector<double>& p) {
+    std::string out;
+    char item[96];
+    for (int k = 0; k < robot.NumParameters(); ++k) {
+      const ParameterInfo& info = robot.parameters[k];
+      std::snprintf(item, sizeof item, "%s%s %.6g%s", out.empty() ? "" : ", ", info.name.c_str(),
+                    p[k] * info.DisplayScale(), info.unit == ParameterUnit::kAngle ? " deg" : "");
+      out += item;
+    }
+    return out;
+  };
+  return c;
+}
+
 std::string CsvField(const std::string& s) {
   if (s.find_first_of(",\"\n") == std::string::npos) return s;
   std::string out = "\"";
@@ -62,17 +121,17 @@ std::string CsvField(const std::string& s) {
   return out + "\"";
 }
 
-std::string Csv(const std::vector<Row>& rows) {
+std::string Csv(const std::vector<Row>& rows, const ParameterColumns& columns) {
   std::ostringstream o;
   o << "strategy,method,repetitions";
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) o << ",m_inv_" << r << c;
-  }
+  for (const std::string& name : columns.csv_names) o << "," << name;
   o << ",cf_calibration,cf_validation,improvement_percent,evaluations,wall_s,termination,usable\n";
   for (const Row& row : rows) {
     o << CsvField(row.strategy) << "," << row.method << "," << row.repetitions;
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) o << "," << (row.repetitions ? Fixed(row.m_inv(r, c), 8) : "");
+    const std::vector<double> values =
+        row.parameters.empty() ? std::vector<double>() : columns.csv_values(row.parameters);
+    for (std::size_t c = 0; c < columns.csv_names.size(); ++c) {
+      o << "," << (values.empty() ? "" : Fixed(values[c], 8));
     }
     o << "," << (std::isnan(row.cf_calibration) ? "" : Fixed(row.cf_calibration, 8)) << ","
       << (std::isnan(row.cf_validation) ? "" : Fixed(row.cf_validation, 8)) << ","
@@ -83,16 +142,17 @@ std::string Csv(const std::vector<Row>& rows) {
   return o.str();
 }
 
-std::string Markdown(const std::vector<Row>& rows) {
+std::string Markdown(const std::vector<Row>& rows, const ParameterColumns& columns) {
   std::ostringstream o;
-  o << "| Strategy | Method | Reps | M^-1 | CF calibration | CF validation | Improvement | "
+  o << "| Strategy | Method | Reps | " << columns.markdown_header
+    << " | CF calibration | CF validation | Improvement | "
        "Evaluations | Wall [s] | Termination |\n"
     << "|---|---|---|---|---|---|---|---|---|---|\n";
   for (const Row& row : rows) {
     o << "| " << row.strategy << " | " << row.method << " | "
       << (row.repetitions ? std::to_string(row.repetitions) : "-") << " | "
-      << (row.repetitions ? MatrixText(row.m_inv) : "-") << " | " << Fixed(row.cf_calibration, 4)
-      << " | " << Fixed(row.cf_validation, 4) << " | "
+      << (row.parameters.empty() ? "-" : columns.markdown(row.parameters)) << " | "
+      << Fixed(row.cf_calibration, 4) << " | " << Fixed(row.cf_validation, 4) << " | "
       << (std::isnan(row.improvement_percent) ? "-" : Fixed(row.improvement_percent, 1) + "%")
       << " | " << (row.repetitions ? std::to_string(row.evaluations) : "-") << " | "
       << (row.repetitions ? Fixed(row.wall_s, 2) : "-") << " | " << row.termination
@@ -113,171 +173,318 @@ std::string TraceCsv(const std::vector<Row>& rows) {
   return o.str();
 }
 
-}  // namespace
+// The robot and runs of a data set, for any model; omni3 keeps its own loader, CF and fit path
+// (its NLopt methods search on its fast final-pose kernel), so its tables stay as they were.
+struct CompareData {
+  RobotModelPtr model;
+  std::optional<Omni3Robot> omni3;
+  std::vector<AlignedRun> runs;
 
-int RunCompareCommand(const CompareCommandOptions& options) {
-  // Everything the user typed is checked before any data is read or any fit runs.
+  double Cf(const std::vector<double>& p, const std::vector<AlignedRun>& on, int threads) const {
+    if (omni3) {
+      Omni3ParameterArray a{};
+      std::copy(p.begin(), p.end(), a.begin());
+      return EvaluateFinalPoseErrors(a, on, threads).cf;
+    }
+    return EvaluateFinalPoseErrors(*model, p, on, threads).cf;
+  }
+};
+
+CompareData LoadCompareData(const CompareCommandOptions& options) {
+  io::DatasetOptions dataset_options;
+  dataset_options.allow_paths_outside = options.allow_outside_paths;
+  dataset_options.num_threads = options.threads;
+  const io::DatasetIndex index = io::ReadDatasetIndex(options.logs, dataset_options);
+  const std::string model_name = io::ReadRobotModel(index.robot_path);
+  if (model_name == "asoc") {
+    throw std::invalid_argument(index.robot_path +
+                                ": ASOC robots are compared by their own commands "
+                                "(asoc-geometric, asoc-tables), not by compare");
+  }
+  CompareData d;
+  if (model_name == "omni3") {
+    const io::Dataset dataset = io::LoadDataset(index, dataset_options);
+    d.omni3 = io::ReadOmni3Robot(dataset.robot_path);
+    d.model = Omni3ModelOf(*d.omni3);
+    d.runs = AlignRuns(dataset.runs);
+  } else {
+    d.model = ReadRobotModelFile(index.robot_path);
+    d.runs = AlignRuns(io::LoadDataset(index, d.model->robot(), dataset_options).runs);
+  }
+  return d;
+}
+
+struct FitOutcome {
+  std::vector<double> parameters;
+  int evaluations = 0;
+  std::string termination;
+  bool usable = false;
+  std::vector<ConvergencePoint> trace;
+};
+
+FitOutcome RunMethod(const FitMethod& method, const std::vector<AlignedRun>& training,
+                     const CompareData& d, const FitMethodSettings& s) {
+  FitOutcome out;
+  if (d.omni3) {
+    const FitMethodOutcome o = method.run(training, *d.omni3, s);
+    out = {{o.fit.parameters.begin(), o.fit.parameters.end()},
+           o.evaluations,
+           o.fit.termination,
+           o.fit.usable,
+           o.trace};
+  } else {
+    const ModelFitMethodOutcome o = method.run_model(training, *d.model, s);
+    out = {o.fit.parameters, o.evaluations, o.fit.termination, o.fit.usable, o.trace};
+  }
+  return out;
+}
+
+// "all" (every trajectory of the data set) and "<prefix>*" (the labels starting with prefix, e.g.
+// "circular/*") are resolved against the runs; anything else is calib/strategies.h's.
+TrajectoryStrategy ParseCompareStrategy(const std::string& text) {
+  if (text == "all" || (!text.empty() && text.back() == '*')) return {text, {}};
+  return ParseStrategy(text);
+}
+
+void ResolveStrategy(const std::vector<AlignedRun>& runs, TrajectoryStrategy* s) {
+  if (!s->labels.empty()) return;
+  const std::string prefix = s->name == "all" ? "" : s->name.substr(0, s->name.size() - 1);
+  for (const AlignedRun& run : runs) {
+    if (run.trajectory.compare(0, prefix.size(), prefix) == 0 &&
+        std::find(s->labels.begin(), s->labels.end(), run.trajectory) == s->labels.end()) {
+      s->labels.push_back(run.trajectory);
+    }
+  }
+  if (s->labels.empty()) {
+    throw std::invalid_argument("strategy " + s->name + " matches no trajectory of the data set");
+  }
+}
+
+// Palacin's STA..STE need the flower's labels. For a model other than omni3 and no --strategies,
+// keep those the data set has (the omni model's generalised flower has them all) or, when it has
+// none, train on every trajectory ("all": the split is by repetitions only).
+std::vector<TrajectoryStrategy> DefaultStrategiesFor(const std::vector<AlignedRun>& runs,
+                                                     std::vector<TrajectoryStrategy> strategies) {
+  std::vector<TrajectoryStrategy> present;
+  for (const TrajectoryStrategy& s : strategies) {
+    if (s.labels.empty() || MissingTrajectories(runs, s).empty()) present.push_back(s);
+  }
+  if (present.empty()) present.push_back({"all", {}});
+  return present;
+}
+
+// One row per closed-form calibration of the model (e.g. UMBmark) on these training runs.
+void AddClosedFormRows(const CompareData& d, const std::string& strategy, int k,
+                       const std::vector<AlignedRun>& training,
+                       const std::vector<AlignedRun>& validation, double cf_nominal, int threads,
+                       std::vector<Row>* rows) {
+  for (const ClosedFormCalibration& c : d.model->ClosedForms(training)) {
+    Row row;
+    row.strategy = strategy;
+    row.method = c.method;
+    row.repetitions = k;
+    row.parameters = c.parameters;
+    row.cf_calibration = d.Cf(c.parameters, training, threads);
+    if (!validation.empty()) {
+      row.cf_validation = d.Cf(c.parameters, validation, threads);
+      row.improvement_percent = 100.0 * (cf_nominal - row.cf_validation) / cf_nominal;
+    }
+    row.termination = "closed form";
+    rows->push_back(std::move(row));
+  }
+}
+
+// What the user typed, checked before any data is read or any fit runs.
+struct CompareRequest {
   std::vector<const FitMethod*> methods;
+  std::vector<TrajectoryStrategy> strategies;
+  std::vector<int> counts;  // training repetitions k, sorted, unique
+  FitMethodSettings settings;
+};
+
+// Empty when valid, else the one-line reason (exit code 2).
+std::string ParseRequest(const CompareCommandOptions& options, CompareRequest* r) {
   for (const std::string& name : options.methods) {
     if (name == "all") {
-      for (const FitMethod& m : FitMethods()) methods.push_back(&m);
+      for (const FitMethod& m : FitMethods()) r->methods.push_back(&m);
       continue;
     }
     const FitMethod* m = FindFitMethod(name);
     if (m == nullptr) {
-      std::cerr << "fitcal compare: unknown method '" << name
-                << "' (available: " << FitMethodNames() << ", all)\n";
-      return 2;
+      return "unknown method '" + name + "' (available: " + FitMethodNames() + ", all)";
     }
-    methods.push_back(m);
+    r->methods.push_back(m);
   }
-  std::vector<TrajectoryStrategy> strategies;
-  std::vector<int> counts = options.repetitions;
-  std::sort(counts.begin(), counts.end());
-  counts.erase(std::unique(counts.begin(), counts.end()), counts.end());
-  FitMethodSettings settings;
+  r->counts = options.repetitions;
+  std::sort(r->counts.begin(), r->counts.end());
+  r->counts.erase(std::unique(r->counts.begin(), r->counts.end()), r->counts.end());
+  FitMethodSettings& settings = r->settings;
   try {
-    for (const std::string& text : options.strategies) strategies.push_back(ParseStrategy(text));
-    if (methods.empty() || strategies.empty() || counts.empty() || counts.front() < 1) {
-      throw std::invalid_argument("need at least one method, one strategy and repetitions >= 1");
+    for (const std::string& text : options.strategies)
+      r->strategies.push_back(ParseCompareStrategy(text));
+    if (r->methods.empty() || r->strategies.empty() || r->counts.empty() || r->counts.front() < 1) {
+      return "need at least one method, one strategy and repetitions >= 1";
     }
-    if (options.max_evaluations < 1) throw std::invalid_argument("--max-evaluations must be >= 1");
+    if (options.max_evaluations < 1) return "--max-evaluations must be >= 1";
     settings.objective_set = !options.objective.empty();
     if (settings.objective_set &&
         !ParseFinalPoseObjective(options.objective, &settings.objective)) {
-      throw std::invalid_argument("unknown --objective '" + options.objective +
-                                  "' (available: squares, eq14)");
+      return "unknown --objective '" + options.objective + "' (available: squares, eq14)";
     }
   } catch (const std::invalid_argument& e) {
-    std::cerr << "fitcal compare: " << e.what() << "\n";
-    return 2;
+    return e.what();
   }
   settings.threads = options.threads;
   settings.seed = options.seed;
   settings.max_evaluations = options.max_evaluations;
   settings.local_polish = options.polish;
+  return "";
+}
+
+// The repetitions present, the validation repetitions, and the check that no validation
+// repetition trains; empty when fine, else the one-line reason (exit code 2).
+std::string SplitRepetitions(const CompareCommandOptions& options, const CompareRequest& r,
+                             const std::vector<AlignedRun>& runs, std::vector<int>* present,
+                             std::vector<int>* validation_reps) {
+  std::set<int> present_set;
+  for (const AlignedRun& run : runs) present_set.insert(run.repetition);
+  present->assign(present_set.begin(), present_set.end());
+  if (static_cast<std::size_t>(r.counts.back()) > present->size()) {
+    return options.logs + " has " + std::to_string(present->size()) +
+           " repetitions; cannot train on " + std::to_string(r.counts.back());
+  }
+  for (const TrajectoryStrategy& s : r.strategies) {
+    const std::vector<std::string> missing = MissingTrajectories(runs, s);
+    if (missing.empty()) continue;
+    std::string list;
+    for (const std::string& label : missing) list += (list.empty() ? "" : ", ") + label;
+    return "strategy " + s.name + " needs trajectories the data set " + options.logs +
+           " lacks: " + list + " (choose --strategies from its trajectory labels)";
+  }
+  if (options.validation_reps.empty()) {
+    validation_reps->assign(present->begin() + r.counts.back(), present->end());
+  } else {
+    *validation_reps = ParseRepetitionList(options.validation_reps);
+  }
+  for (int rep : *validation_reps) {
+    for (int k : r.counts) {
+      if (std::find(present->begin(), present->begin() + k, rep) != present->begin() + k) {
+        return "validation repetition " + std::to_string(rep) + " is also a training repetition";
+      }
+    }
+  }
+  return "";
+}
+
+Row FitRow(const FitMethod& method, const std::string& strategy, int k,
+           const std::vector<AlignedRun>& training, const std::vector<AlignedRun>& validation,
+           double cf_nominal, const CompareData& d, FitMethodSettings s, bool show_progress,
+           int threads) {
+  const std::string label = strategy + " " + method.name + " x" + std::to_string(k);
+  if (show_progress) {
+    s.progress = [&label](const NloptProgress& p) {
+      std::fprintf(stderr, "\r[%s] %d evaluations, best CF %.5f, %.1f s   ", label.c_str(),
+                   p.evaluations, p.best_cf, p.elapsed_s);
+      std::fflush(stderr);
+    };
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const FitOutcome outcome = RunMethod(method, training, d, s);
+  Row row;
+  row.strategy = strategy;
+  row.method = method.name;
+  row.repetitions = k;
+  row.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  row.parameters = outcome.parameters;
+  row.cf_calibration = d.Cf(outcome.parameters, training, threads);
+  if (!validation.empty()) {
+    row.cf_validation = d.Cf(outcome.parameters, validation, threads);
+    row.improvement_percent = 100.0 * (cf_nominal - row.cf_validation) / cf_nominal;
+  }
+  row.evaluations = outcome.evaluations;
+  row.termination = outcome.termination;
+  row.usable = outcome.usable;
+  row.trace = outcome.trace;
+  if (show_progress) {
+    std::fprintf(stderr, "\r[%s] CF %.5f -> validation %.5f, %d evaluations, %.2f s%20s\n",
+                 label.c_str(), row.cf_calibration, row.cf_validation, row.evaluations, row.wall_s,
+                 "");
+  }
+  return row;
+}
+
+void PrintAndWrite(const CompareCommandOptions& options, const CompareRequest& r,
+                   const std::vector<int>& validation_reps, std::size_t num_validation,
+                   const std::vector<Row>& rows, const ParameterColumns& columns) {
+  const std::string markdown = Markdown(rows, columns);
+  std::string counts;
+  for (int k : r.counts) counts += (counts.empty() ? "" : " or ") + std::to_string(k);
+  std::printf(
+      "Palacin Table 4 on %s: training on the first %s repetition(s) of each strategy's "
+      "trajectories, validation on every trajectory of repetitions %s (%zu runs); CF "
+      "is Eq. 14 (m and rad)\n\n%s",
+      options.logs.c_str(), counts.c_str(), FormatRepetitionList(validation_reps).c_str(),
+      num_validation, markdown.c_str());
+  if (!options.no_output) {
+    io::WriteFileAtomically(options.out + ".csv", Csv(rows, columns));
+    io::WriteFileAtomically(options.out + ".md", markdown);
+    io::WriteFileAtomically(options.out + "_trace.csv", TraceCsv(rows));
+    std::printf("\nwrote %s.csv, %s.md, %s_trace.csv\n", options.out.c_str(), options.out.c_str(),
+                options.out.c_str());
+  }
+}
+
+}  // namespace
+
+int RunCompareCommand(const CompareCommandOptions& options) {
+  CompareRequest request;
+  if (const std::string error = ParseRequest(options, &request); !error.empty()) {
+    std::cerr << "fitcal compare: " << error << "\n";
+    return 2;
+  }
   const bool show_progress = !options.quiet && isatty(STDERR_FILENO);
-
   try {
-    io::DatasetOptions dataset_options;
-    dataset_options.allow_paths_outside = options.allow_outside_paths;
-    dataset_options.num_threads = options.threads;
-    const io::Dataset dataset = io::LoadDataset(options.logs, dataset_options);
-    const Omni3Robot robot = io::ReadOmni3Robot(dataset.robot_path);
-    const std::vector<AlignedRun> runs = AlignRuns(dataset.runs);
-
-    std::set<int> present_set;
-    for (const AlignedRun& run : runs) present_set.insert(run.repetition);
-    const std::vector<int> present(present_set.begin(), present_set.end());
-    if (static_cast<std::size_t>(counts.back()) > present.size()) {
-      std::cerr << "fitcal compare: " << options.logs << " has " << present.size()
-                << " repetitions; cannot train on " << counts.back() << "\n";
+    const CompareData d = LoadCompareData(options);
+    if (!d.omni3 && !options.strategies_given) {
+      request.strategies = DefaultStrategiesFor(d.runs, request.strategies);
+    }
+    for (TrajectoryStrategy& s : request.strategies) ResolveStrategy(d.runs, &s);
+    std::vector<int> present, validation_reps;
+    if (const std::string error =
+            SplitRepetitions(options, request, d.runs, &present, &validation_reps);
+        !error.empty()) {
+      std::cerr << "fitcal compare: " << error << "\n";
       return 2;
     }
-    for (const TrajectoryStrategy& s : strategies) {
-      const std::vector<std::string> missing = MissingTrajectories(runs, s);
-      if (!missing.empty()) {
-        std::string list;
-        for (const std::string& label : missing) list += (list.empty() ? "" : ", ") + label;
-        std::cerr << "fitcal compare: strategy " << s.name << " needs trajectories the data set "
-                  << options.logs << " lacks: " << list
-                  << " (choose --strategies from its trajectory labels)\n";
-        return 2;
-      }
-    }
-    std::vector<int> validation_reps;
-    if (options.validation_reps.empty()) {
-      validation_reps.assign(present.begin() + counts.back(), present.end());
-    } else {
-      validation_reps = ParseRepetitionList(options.validation_reps);
-    }
     const std::vector<AlignedRun> validation =
-        SplitByRepetition(runs, validation_reps).training;  // every trajectory of those reps
-    for (int rep : validation_reps) {
-      for (int k : counts) {
-        if (std::find(present.begin(), present.begin() + k, rep) != present.begin() + k) {
-          std::cerr << "fitcal compare: validation repetition " << rep
-                    << " is also a training repetition\n";
-          return 2;
-        }
-      }
-    }
+        SplitByRepetition(d.runs, validation_reps).training;  // every trajectory of those reps
 
     std::vector<Row> rows;
     Row none;
     none.strategy = "All";
     none.method = "None";
     none.cf_validation =
-        validation.empty()
-            ? NAN
-            : EvaluateFinalPoseErrors(robot.nominal.ToArray(), validation, options.threads).cf;
+        validation.empty() ? NAN : d.Cf(d.model->robot().nominal, validation, options.threads);
     none.termination = "uncalibrated";
     rows.push_back(none);
-
-    for (const TrajectoryStrategy& strategy : strategies) {
-      for (const FitMethod* method : methods) {
-        for (int k : counts) {
+    for (const TrajectoryStrategy& strategy : request.strategies) {
+      for (int k : request.counts) {
+        const std::vector<int> reps(present.begin(), present.begin() + k);
+        const std::vector<AlignedRun> training = SelectRuns(d.runs, strategy, reps);
+        AddClosedFormRows(d, strategy.name, k, training, validation, none.cf_validation,
+                          options.threads, &rows);
+      }
+      for (const FitMethod* method : request.methods) {
+        for (int k : request.counts) {
           const std::vector<int> reps(present.begin(), present.begin() + k);
-          const std::vector<AlignedRun> training = SelectRuns(runs, strategy, reps);
-          FitMethodSettings s = settings;
-          const std::string label = strategy.name + " " + method->name + " x" + std::to_string(k);
-          if (show_progress) {
-            s.progress = [&label](const NloptProgress& p) {
-              std::fprintf(stderr, "\r[%s] %d evaluations, best CF %.5f, %.1f s   ", label.c_str(),
-                           p.evaluations, p.best_cf, p.elapsed_s);
-              std::fflush(stderr);
-            };
-          }
-          const auto t0 = std::chrono::steady_clock::now();
-          const FitMethodOutcome outcome = method->run(training, robot, s);
-          Row row;
-          row.strategy = strategy.name;
-          row.method = method->name;
-          row.repetitions = k;
-          row.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-          row.m_inv = omni3::InverseKinematicMatrix(outcome.fit.parameters.data());
-          row.cf_calibration =
-              EvaluateFinalPoseErrors(outcome.fit.parameters, training, options.threads).cf;
-          if (!validation.empty()) {
-            row.cf_validation =
-                EvaluateFinalPoseErrors(outcome.fit.parameters, validation, options.threads).cf;
-            row.improvement_percent =
-                100.0 * (none.cf_validation - row.cf_validation) / none.cf_validation;
-          }
-          row.evaluations = outcome.evaluations;
-          row.termination = outcome.fit.termination;
-          row.usable = outcome.fit.usable;
-          row.trace = outcome.trace;
-          if (show_progress) {
-            std::fprintf(stderr, "\r[%s] CF %.5f -> validation %.5f, %d evaluations, %.2f s%20s\n",
-                         label.c_str(), row.cf_calibration, row.cf_validation, row.evaluations,
-                         row.wall_s, "");
-          }
-          rows.push_back(std::move(row));
+          rows.push_back(FitRow(*method, strategy.name, k, SelectRuns(d.runs, strategy, reps),
+                                validation, none.cf_validation, d, request.settings, show_progress,
+                                options.threads));
         }
       }
     }
-
-    const std::string markdown = Markdown(rows);
-    std::printf(
-        "Palacin Table 4 on %s: training on the first %s repetition(s) of each strategy's "
-        "trajectories, validation on every trajectory of repetitions %s (%zu runs); CF "
-        "is Eq. 14 (m and rad)\n\n%s",
-        options.logs.c_str(),
-        [&] {
-          std::string s;
-          for (int k : counts) s += (s.empty() ? "" : " or ") + std::to_string(k);
-          return s;
-        }()
-            .c_str(),
-        FormatRepetitionList(validation_reps).c_str(), validation.size(), markdown.c_str());
-    if (!options.no_output) {
-      io::WriteFileAtomically(options.out + ".csv", Csv(rows));
-      io::WriteFileAtomically(options.out + ".md", markdown);
-      io::WriteFileAtomically(options.out + "_trace.csv", TraceCsv(rows));
-      std::printf("\nwrote %s.csv, %s.md, %s_trace.csv\n", options.out.c_str(), options.out.c_str(),
-                  options.out.c_str());
-    }
+    PrintAndWrite(options, request, validation_reps, validation.size(), rows,
+                  ColumnsFor(d.model->robot()));
     return 0;
   } catch (const std::exception& e) {  // io::InputError too: what() is its file:line message
     std::cerr << "fitcal compare: " << e.what() << "\n";

@@ -1,8 +1,10 @@
 #pragma once
-// `fitcal compare --logs <dir>`: Palacin Table 4 regenerated on the user's data - every strategy
-// (STA..STE or explicit trajectory lists, calib/strategies.h) x every method (tools/fit_methods.h)
-// x training on the first 1 or 5 repetitions, validated on every trajectory of the held-out
-// repetitions (Palacin Sec. 3.2: "five additional" repetitions of the whole flower). Prints the
+// `fitcal compare --logs <dir>`: Palacin Table 4 regenerated on the user's data, for any robot
+// model - every strategy (STA..STE or explicit trajectory lists, calib/strategies.h; "all" or a
+// label prefix) x every method (tools/fit_methods.h) x training on the first 1 or 5 repetitions,
+// validated on every trajectory of the held-out repetitions (Palacin Sec. 3.2: "five additional"
+// repetitions of the whole flower). The model's closed forms (UMBmark for a differential drive)
+// are rows beside the fits, computed from the same training runs. Prints the
 // table as Markdown and writes <out>.csv, <out>.md and <out>_trace.csv (best CF vs evaluations
 // per fit), each atomically, after every fit has finished.
 
@@ -13,7 +15,10 @@ namespace fitcal::tools {
 
 struct CompareCommandOptions {
   std::string logs;
+  // Palacin's STA..STE, trajectory lists, "all" or "<prefix>*" (compare_command.cc). For a model
+  // other than omni3 without strategies_given: those of STA..STE the data set has, else "all".
   std::vector<std::string> strategies = {"STA", "STB", "STC", "STD", "STE"};
+  bool strategies_given = false;
   std::vector<std::string> methods = {"ceres", "crs2lm", "esch", "slsqp"};  // or "all"
   std::vector<int> repetitions = {1, 5};  // train on the first k repetitions of the data set
   std::string validation_reps;            // "" = every repetition after the largest k

@@ -60,33 +60,6 @@ double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
 
-// The solver flags of FitCommandOptions as FitMethodSettings; false with a message when a name
-// is unknown or a value out of range.
-bool MakeFitMethodSettings(const FitCommandOptions& o, FitMethodSettings* s, std::string* error) {
-  s->threads = o.threads;
-  s->max_iterations = o.max_iterations;
-  s->weights.position_sigma_m = o.position_sigma_m;
-  s->weights.heading_sigma_rad = o.heading_sigma_deg * M_PI / 180.0;
-  s->objective_set = !o.objective.empty();
-  if (s->objective_set && !ParseFinalPoseObjective(o.objective, &s->objective)) {
-    *error = "unknown --objective '" + o.objective + "' (available: squares, eq14)";
-    return false;
-  }
-  if (!ParseCeresRobustLoss(o.loss, &s->loss)) {
-    *error = "unknown --loss '" + o.loss + "' (available: none, huber, cauchy)";
-    return false;
-  }
-  s->loss_scale = o.loss_scale;
-  s->seed = o.seed;
-  s->max_evaluations = o.max_evaluations;
-  s->local_polish = o.polish;
-  if (o.max_evaluations < 1 || !(o.loss_scale > 0.0)) {
-    *error = "--max-evaluations and --loss-scale must be positive";
-    return false;
-  }
-  return true;
-}
-
 double ChangePercent(double before, double after) {
   return before > 0.0 ? 100.0 * (after - before) / before : 0.0;
 }

@@ -1,6 +1,12 @@
 #include "tools/fit_methods.h"
 
+#include <algorithm>
+#include <cmath>
+#include <tuple>
+
 #include "calib/final_pose_cost.h"
+#include "fit/final_pose_errors.h"
+#include "fit/model_nlopt_fit.h"
 
 namespace fitcal::tools {
 
@@ -16,8 +22,7 @@ std::string ObjectiveText(FinalPoseObjective objective, CeresRobustLoss loss, do
   return text;
 }
 
-FitMethodOutcome RunCeres(CeresTrustRegion trust_region, const std::vector<AlignedRun>& training,
-                          const Omni3Robot& robot, const FitMethodSettings& settings) {
+CeresFitOptions CeresOptionsFor(CeresTrustRegion trust_region, const FitMethodSettings& settings) {
   CeresFitOptions options;
   options.num_threads = settings.threads;
   options.max_num_iterations = settings.max_iterations;
@@ -26,6 +31,12 @@ FitMethodOutcome RunCeres(CeresTrustRegion trust_region, const std::vector<Align
   if (settings.objective_set) options.objective = settings.objective;
   options.loss = settings.loss;
   options.loss_scale = settings.loss_scale;
+  return options;
+}
+
+FitMethodOutcome RunCeres(CeresTrustRegion trust_region, const std::vector<AlignedRun>& training,
+                          const Omni3Robot& robot, const FitMethodSettings& settings) {
+  const CeresFitOptions options = CeresOptionsFor(trust_region, settings);
   FitMethodOutcome out;
   out.fit = FitOmni3Ceres(training, robot, options);
   out.evaluations = out.fit.num_residual_evaluations + out.fit.num_jacobian_evaluations;
@@ -39,8 +50,8 @@ FitMethodOutcome RunCeres(CeresTrustRegion trust_region, const std::vector<Align
   return out;
 }
 
-FitMethodOutcome RunNlopt(NloptMethod method, const std::vector<AlignedRun>& training,
-                          const Omni3Robot& robot, const FitMethodSettings& settings) {
+// The NLopt options of a method for these settings, shared by omni3 and every other model.
+NloptFitOptions NloptOptionsFor(NloptMethod method, const FitMethodSettings& settings) {
   NloptFitOptions options;
   options.method = method;
   options.num_threads = settings.threads;
@@ -53,6 +64,12 @@ FitMethodOutcome RunNlopt(NloptMethod method, const std::vector<AlignedRun>& tra
   if (options.local_polish) {
     options.local_polish_evaluations = std::min(2000, std::max(1, options.max_evaluations / 5));
   }
+  return options;
+}
+
+FitMethodOutcome RunNlopt(NloptMethod method, const std::vector<AlignedRun>& training,
+                          const Omni3Robot& robot, const FitMethodSettings& settings) {
+  const NloptFitOptions options = NloptOptionsFor(method, settings);
   const NloptFitResult r = FitOmni3Nlopt(training, robot, options);
   FitMethodOutcome out;
   out.fit.usable = r.usable;
@@ -72,23 +89,79 @@ FitMethodOutcome RunNlopt(NloptMethod method, const std::vector<AlignedRun>& tra
   return out;
 }
 
+ModelFitMethodOutcome RunModelCeres(CeresTrustRegion trust_region,
+                                    const std::vector<AlignedRun>& training,
+                                    const RobotModelInterface& model,
+                                    const FitMethodSettings& settings) {
+  ModelFitOptions options;
+  options.ceres = CeresOptionsFor(trust_region, settings);
+  ModelFitMethodOutcome out;
+  out.fit = FitModel(training, model, options);
+  out.evaluations = out.fit.num_residual_evaluations + out.fit.num_jacobian_evaluations;
+  out.objective =
+      ObjectiveText(options.ceres.objective, options.ceres.loss, options.ceres.loss_scale);
+  // Ceres reports no per-evaluation CF: the trace holds the start and the end.
+  out.trace.push_back(
+      {1, EvaluateFinalPoseErrors(model, model.robot().nominal, training, settings.threads).cf,
+       0.0});
+  out.trace.push_back(
+      {out.evaluations,
+       EvaluateFinalPoseErrors(model, out.fit.parameters, training, settings.threads).cf,
+       out.fit.solve_time_s});
+  return out;
+}
+
+ModelFitMethodOutcome RunModelNlopt(NloptMethod method, const std::vector<AlignedRun>& training,
+                                    const RobotModelInterface& model,
+                                    const FitMethodSettings& settings) {
+  const NloptFitOptions options = NloptOptionsFor(method, settings);
+  const NloptSearchResult r = FitModelNlopt(training, model, options);
+  const Robot& robot = model.robot();
+  ModelFitMethodOutcome out;
+  ModelFitResult& fit = out.fit;
+  fit.usable = r.usable;
+  fit.termination = r.termination;
+  fit.message = r.message;
+  fit.iterations = r.evaluations;
+  fit.num_residual_evaluations = r.evaluations - r.gradient_evaluations;
+  fit.num_jacobian_evaluations = r.gradient_evaluations;
+  fit.solve_time_s = r.solve_time_s;
+  fit.parameters = r.parameters;
+  fit.at_bound = r.at_bound;
+  fit.held.assign(robot.NumParameters(), false);
+  for (const HeldParameter& h : robot.held) fit.held[h.index] = true;
+  fit.sigma.assign(robot.NumParameters(), 0.0);
+  fit.covariance_message = "no covariance from NLopt methods (the ceres method computes one)";
+  out.evaluations = r.evaluations;
+  out.objective = ObjectiveText(options.objective, CeresRobustLoss::kNone, 0.0) + ", seed " +
+                  std::to_string(options.seed);
+  out.trace = r.trace;
+  return out;
+}
+
 std::vector<FitMethod> MakeMethods() {
-  std::vector<FitMethod> methods = {
-      {"ceres", "Ceres Levenberg-Marquardt",
-       [](const auto& t, const auto& r, const auto& s) {
-         return RunCeres(CeresTrustRegion::kLevenbergMarquardt, t, r, s);
-       }},
-      {"ceres-dogleg", "Ceres dogleg",
-       [](const auto& t, const auto& r, const auto& s) {
-         return RunCeres(CeresTrustRegion::kDogleg, t, r, s);
-       }},
-  };
+  std::vector<FitMethod> methods;
+  for (const auto& [name, description, region] :
+       {std::tuple{"ceres", "Ceres Levenberg-Marquardt", CeresTrustRegion::kLevenbergMarquardt},
+        std::tuple{"ceres-dogleg", "Ceres dogleg", CeresTrustRegion::kDogleg}}) {
+    const CeresTrustRegion trust_region = region;
+    methods.push_back({name, description,
+                       [trust_region](const auto& t, const auto& r, const auto& s) {
+                         return RunCeres(trust_region, t, r, s);
+                       },
+                       [trust_region](const auto& t, const auto& m, const auto& s) {
+                         return RunModelCeres(trust_region, t, m, s);
+                       }});
+  }
   for (const NloptMethodInfo& info : NloptMethods()) {
     const NloptMethod method = info.method;
-    methods.push_back(
-        {info.name, info.description, [method](const auto& t, const auto& r, const auto& s) {
-           return RunNlopt(method, t, r, s);
-         }});
+    methods.push_back({info.name, info.description,
+                       [method](const auto& t, const auto& r, const auto& s) {
+                         return RunNlopt(method, t, r, s);
+                       },
+                       [method](const auto& t, const auto& m, const auto& s) {
+                         return RunModelNlopt(method, t, m, s);
+                       }});
   }
   return methods;
 }
@@ -111,6 +184,31 @@ std::string FitMethodNames() {
   std::string out;
   for (const FitMethod& method : FitMethods()) out += (out.empty() ? "" : ", ") + method.name;
   return out;
+}
+
+bool MakeFitMethodSettings(const FitCommandOptions& o, FitMethodSettings* s, std::string* error) {
+  s->threads = o.threads;
+  s->max_iterations = o.max_iterations;
+  s->weights.position_sigma_m = o.position_sigma_m;
+  s->weights.heading_sigma_rad = o.heading_sigma_deg * M_PI / 180.0;
+  s->objective_set = !o.objective.empty();
+  if (s->objective_set && !ParseFinalPoseObjective(o.objective, &s->objective)) {
+    *error = "unknown --objective '" + o.objective + "' (available: squares, eq14)";
+    return false;
+  }
+  if (!ParseCeresRobustLoss(o.loss, &s->loss)) {
+    *error = "unknown --loss '" + o.loss + "' (available: none, huber, cauchy)";
+    return false;
+  }
+  s->loss_scale = o.loss_scale;
+  s->seed = o.seed;
+  s->max_evaluations = o.max_evaluations;
+  s->local_polish = o.polish;
+  if (o.max_evaluations < 1 || !(o.loss_scale > 0.0)) {
+    *error = "--max-evaluations and --loss-scale must be positive";
+    return false;
+  }
+  return true;
 }
 
 }  // namespace fitcal::tools

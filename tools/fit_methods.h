@@ -1,7 +1,9 @@
 #pragma once
 // The registry of fit methods behind `--method` (fit) and `--methods` (compare): Ceres
-// (Levenberg-Marquardt or dogleg) and every NLopt method of calib/omni3_nlopt_fit.h, each one
-// entry of a table with one function that fits and reports in the Ceres fit's result shape.
+// (Levenberg-Marquardt or dogleg) and every NLopt method of fit/nlopt_search.h, one entry each,
+// for every robot model: `run_model` fits any model through the seam (fit/model_fit.h,
+// fit/model_nlopt_fit.h), `run` is omni3's own path (its Ceres fit and the NLopt search on its
+// fast final-pose kernel, calib/omni3_nlopt_fit.h), which the omni3 commands keep.
 
 #include <cstdint>
 #include <functional>
@@ -10,6 +12,9 @@
 
 #include "calib/omni3_ceres_fit.h"
 #include "calib/omni3_nlopt_fit.h"
+#include "fit/model_fit.h"
+#include "models/model_interface.h"
+#include "tools/fit_command.h"
 
 namespace fitcal::tools {
 
@@ -37,16 +42,33 @@ struct FitMethodOutcome {
   std::vector<ConvergencePoint> trace;  // best CF vs evaluations
 };
 
+// The same for any model: the fit's result shape is the generic Ceres fit's (NLopt methods leave
+// the covariance out and say so in covariance_message).
+struct ModelFitMethodOutcome {
+  ModelFitResult fit;
+  int evaluations = 0;
+  std::string objective;
+  std::vector<ConvergencePoint> trace;
+};
+
 struct FitMethod {
   std::string name;
   std::string description;
   std::function<FitMethodOutcome(const std::vector<AlignedRun>&, const Omni3Robot&,
                                  const FitMethodSettings&)>
       run;
+  std::function<ModelFitMethodOutcome(const std::vector<AlignedRun>&, const RobotModelInterface&,
+                                      const FitMethodSettings&)>
+      run_model;
 };
 
 const std::vector<FitMethod>& FitMethods();
 const FitMethod* FindFitMethod(const std::string& name);  // nullptr if unknown
 std::string FitMethodNames();                             // "ceres, ceres-dogleg, crs2lm, ..."
+
+// The solver flags of `fitcal fit` as settings; false with a one-line message when a name is
+// unknown or a value out of range.
+bool MakeFitMethodSettings(const FitCommandOptions& options, FitMethodSettings* settings,
+                           std::string* error);
 
 }  // namespace fitcal::tools

@@ -145,8 +145,12 @@ int main(int argc, char** argv) {
 
   fitcal::tools::SimulateCommandOptions simulate;
   CLI::App* sim_cmd = app.add_subcommand(
-      "simulate", "Write a simulated flower data set (README.md, section Simulator)");
+      "simulate",
+      "Write a simulated data set: omni3 flower, or --model's trajectories (README.md, Simulator)");
   sim_cmd->add_option("--out", simulate.out, "Output data set directory")->required();
+  sim_cmd->add_option("--model", simulate.model,
+                      "Robot model (" + fitcal::sim::ScenarioModelNames() +
+                          "; default: the omni3 flower simulator)");
   sim_cmd->add_option("--robot", simulate.robot, "Nominal robot YAML (commands and fit start)")
       ->capture_default_str()
       ->check(CLI::ExistingFile);
@@ -172,6 +176,14 @@ int main(int argc, char** argv) {
                    "Ground-truth heading noise (deg)")
       ->capture_default_str();
   sim_cmd->add_option("--slip-sigma", simulate.sim.slip_sigma, "Relative wheel slip noise")
+      ->capture_default_str();
+  sim_cmd
+      ->add_option("--wheel-rate-sigma-rad-s", simulate.wheel_rate_sigma_rad_s,
+                   "--model: white noise on each interval's mean wheel rate (rad/s)")
+      ->capture_default_str();
+  sim_cmd
+      ->add_option("--angle-sigma-deg", simulate.angle_sigma_deg,
+                   "--model: noise of an angle channel's readings, e.g. steering (deg)")
       ->capture_default_str();
   sim_cmd->add_flag("--force", simulate.force, "Overwrite an existing data set");
   sim_cmd->add_option(
@@ -253,7 +265,8 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingDirectory);
   compare_cmd
       ->add_option("--strategies", compare.strategies,
-                   "STA..STE or trajectory lists such as R1,R5,G4 or B1-B12 (one per item)")
+                   "STA..STE, trajectory lists such as R1,R5,G4 or B1-B12, all, or a label "
+                   "prefix such as circular/* (one per item)")
       ->capture_default_str();
   compare_cmd
       ->add_option("--methods", compare.methods,
@@ -287,7 +300,10 @@ int main(int argc, char** argv) {
 
   if (diagnose_cmd->parsed()) return fitcal::tools::RunDiagnoseCommand(diagnose);
 
-  if (compare_cmd->parsed()) return fitcal::tools::RunCompareCommand(compare);
+  if (compare_cmd->parsed()) {
+    compare.strategies_given = compare_cmd->count("--strategies") > 0;
+    return fitcal::tools::RunCompareCommand(compare);
+  }
 
   if (report_cmd->parsed()) return fitcal::tools::RunReportCommand(report);
   if (const int asoc_rc = asoc_commands.Dispatch(app); asoc_rc >= 0) return asoc_rc;
@@ -300,6 +316,10 @@ int main(int argc, char** argv) {
 
   if (app.got_subcommand(sim_cmd)) {
     simulate.sim.gt_heading_sigma_rad = gt_heading_sigma_deg * M_PI / 180.0;
+    simulate.robot_given = sim_cmd->count("--robot") > 0;
+    for (const char* flag : {"--slip-sigma", "--inject"}) {
+      if (sim_cmd->count(flag) > 0) simulate.omni3_only_flags.push_back(flag);
+    }
     return fitcal::tools::RunSimulateCommand(simulate);
   }
   if (fit.logs.empty()) {

@@ -15,6 +15,7 @@
 #include "fitcal/version.h"
 #include "io/atomic_file.h"
 #include "io/calibration_block.h"
+#include "tools/fit_methods.h"
 #include "tools/output_guard.h"
 
 namespace fitcal::tools {
@@ -23,32 +24,6 @@ namespace {
 
 double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-}
-
-bool MakeModelFitOptions(const FitCommandOptions& o, ModelFitOptions* out, std::string* error) {
-  CeresFitOptions& c = out->ceres;
-  if (o.method != "ceres" && o.method != "ceres-dogleg") {
-    *error = "--method " + o.method +
-             " is not available for this robot model yet (available: "
-             "ceres, ceres-dogleg)";
-    return false;
-  }
-  c.trust_region = o.method == "ceres-dogleg" ? CeresTrustRegion::kDogleg
-                                              : CeresTrustRegion::kLevenbergMarquardt;
-  c.weights.position_sigma_m = o.position_sigma_m;
-  c.weights.heading_sigma_rad = o.heading_sigma_deg * M_PI / 180.0;
-  c.num_threads = o.threads;
-  c.max_num_iterations = o.max_iterations;
-  if (!o.objective.empty() && !ParseFinalPoseObjective(o.objective, &c.objective)) {
-    *error = "unknown --objective '" + o.objective + "' (available: squares, eq14)";
-    return false;
-  }
-  if (!ParseCeresRobustLoss(o.loss, &c.loss)) {
-    *error = "unknown --loss '" + o.loss + "' (available: none, huber, cauchy)";
-    return false;
-  }
-  c.loss_scale = o.loss_scale;
-  return c.IsValid(error);
 }
 
 void PrintCfTable(const RobotModelInterface& model, const std::vector<double>& selected,
@@ -117,13 +92,14 @@ std::vector<CalibrationCandidate> Candidates(const RobotModelInterface& model,
 
 io::CalibrationBlock MakeRecord(const FitCommandOptions& options, const RobotModelInterface& model,
                                 const RunSplit& split, const ModelFitResult& fit,
+                                const std::string& objective,
                                 const std::vector<CalibrationCandidate>& candidates,
                                 const GateDecision& gate) {
   const Robot& robot = model.robot();
   const std::vector<double>& p = candidates[gate.selected].parameters;
   io::CalibrationBlock r;
   r.method = candidates[gate.selected].name;
-  r.objective = "final-pose residuals (sigma_xy " + std::to_string(options.position_sigma_m) +
+  r.objective = objective + " (sigma_xy " + std::to_string(options.position_sigma_m) +
                 " m, sigma_theta " + std::to_string(options.heading_sigma_deg) + " deg)";
   r.dataset = options.logs;
   r.tool_version = kVersion;
@@ -190,16 +166,42 @@ bool ChannelsLookMiswired(const FitCommandOptions& options, const RobotModelInte
   return true;
 }
 
+// The header, the CF table, the parameters and the solver's stop reason.
+void PrintFit(const FitCommandOptions& options, const RobotModelInterface& model,
+              const RunSplit& split, const std::vector<double>& selected, const FitMethod& method,
+              const ModelFitMethodOutcome& outcome) {
+  const Robot& robot = model.robot();
+  const ModelFitResult& fit = outcome.fit;
+  std::printf("fitcal %s  %s robot '%s'  data set %s\n", kVersion, robot.model.c_str(),
+              robot.name.c_str(), options.logs.c_str());
+  std::printf("runs: %zu training (repetitions %s), %zu validation (repetitions %s)\n\n",
+              split.training.size(), FormatRepetitionList(split.training_repetitions).c_str(),
+              split.validation.size(), FormatRepetitionList(split.validation_repetitions).c_str());
+  PrintCfTable(model, selected, split, options.threads);
+  PrintParameters(robot, selected, fit);
+  // Active-set rounds are the Ceres fit's (fit/model_fit.h); NLopt methods have none.
+  const std::string rounds =
+      fit.active_set_rounds > 0
+          ? ", " + std::to_string(fit.active_set_rounds) + " active-set rounds"
+          : "";
+  std::printf("\nsolver: %s, %s after %d iterations (%d evaluations%s), %.3f s (%s)\n",
+              method.description.c_str(), fit.termination.c_str(), fit.iterations,
+              outcome.evaluations, rounds.c_str(), fit.solve_time_s, fit.message.c_str());
+}
+
 }  // namespace
 
 int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex& index,
                        const RobotModelPtr& model) {
   const auto t_total = std::chrono::steady_clock::now();
   const Robot& robot = model->robot();
-  ModelFitOptions fit_options;
+  // Validated by RunFitCommand: a known method, settings in range.
+  const FitMethod* method = FindFitMethod(options.method);
+  FitMethodSettings settings;
   std::string error;
-  if (!MakeModelFitOptions(options, &fit_options, &error)) {
-    std::cerr << "fitcal: " << error << "\n";
+  if (method == nullptr || !MakeFitMethodSettings(options, &settings, &error)) {
+    std::cerr << "fitcal: " << (method == nullptr ? "unknown --method " + options.method : error)
+              << "\n";
     return 2;
   }
   if (!robot.effects.empty()) {
@@ -232,23 +234,15 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
       ChannelsLookMiswired(options, *model, split.training, dataset.runs)) {
     return 4;
   }
-  const ModelFitResult fit = FitModel(split.training, *model, fit_options);
+  const ModelFitMethodOutcome outcome = method->run_model(split.training, *model, settings);
+  const ModelFitResult& fit = outcome.fit;
   const std::vector<CalibrationCandidate> candidates =
       Candidates(*model, split, fit, options.method);
   const GateDecision gate =
       SelectCalibration(*model, candidates, split.training, split.validation, options.threads);
   const std::vector<double>& selected = candidates[gate.selected].parameters;
 
-  std::printf("fitcal %s  %s robot '%s'  data set %s\n", kVersion, robot.model.c_str(),
-              robot.name.c_str(), options.logs.c_str());
-  std::printf("runs: %zu training (repetitions %s), %zu validation (repetitions %s)\n\n",
-              split.training.size(), FormatRepetitionList(split.training_repetitions).c_str(),
-              split.validation.size(), FormatRepetitionList(split.validation_repetitions).c_str());
-  PrintCfTable(*model, selected, split, options.threads);
-  PrintParameters(robot, selected, fit);
-  std::printf("\nsolver: Ceres %s, %s after %d iterations (%d active-set rounds), %.3f s (%s)\n",
-              options.method.c_str(), fit.termination.c_str(), fit.iterations,
-              fit.active_set_rounds, fit.solve_time_s, fit.message.c_str());
+  PrintFit(options, *model, split, selected, *method, outcome);
   if (!fit.has_covariance) std::printf("uncertainty: %s\n", fit.covariance_message.c_str());
   for (const UndeterminedDirection& d : fit.held_directions) {
     std::printf("held at nominal, not determined by the training runs: %s\n",
@@ -262,7 +256,8 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
     return 5;
   }
   if (!options.no_output) {
-    const io::CalibrationBlock record = MakeRecord(options, *model, split, fit, candidates, gate);
+    const io::CalibrationBlock record =
+        MakeRecord(options, *model, split, fit, outcome.objective, candidates, gate);
     io::StopHereForTests("fitted");
     io::WriteFileAtomically(options.out,
                             model->RobotYaml(selected, io::CalibrationBlockYaml(record, robot)));

@@ -1,8 +1,10 @@
 #pragma once
 // `fitcal fit` for every robot model on the seam (models/model_interface.h): load the data set
-// with the robot's channels, fit on the training repetitions (bounded Ceres fit with its active
-// set, fit/model_fit.h), put the fit beside the nominal and the model's closed forms through the
-// result gate (fit/result_gate.h), print the table and write the winner as a calibrated YAML.
+// with the robot's channels, fit on the training repetitions with any --method of
+// tools/fit_methods.h (the bounded Ceres fit with its active set, fit/model_fit.h, or an NLopt
+// search, fit/model_nlopt_fit.h), put the fit beside the nominal and the model's closed forms
+// through the result gate (fit/result_gate.h), print the table and write the winner as a
+// calibrated YAML.
 
 #include "io/dataset.h"
 #include "models/model_interface.h"

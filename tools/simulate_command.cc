@@ -10,6 +10,7 @@
 #include "io/input_error.h"
 #include "io/robot_yaml.h"
 #include "odometry/parallel_for.h"
+#include "tools/model_simulate_command.h"
 
 namespace fitcal::tools {
 
@@ -51,9 +52,29 @@ effects::EffectValue ParseInjectedEffect(const std::string& text) {
   return e;
 }
 
+// --model: the generic simulator with the flags that apply to it.
+int RunModelSimulate(const SimulateCommandOptions& options) {
+  ModelSimulateOptions o;
+  o.out = options.out;
+  o.model = options.model;
+  o.robot = options.robot_given ? options.robot : "";
+  o.truth = options.truth;
+  o.force = options.force;
+  o.noise.repetitions = options.sim.repetitions;
+  o.noise.seed = options.sim.seed;
+  o.noise.ticks_per_rev = options.sim.encoder_counts_per_rev;
+  o.noise.wheel_rate_sigma_rad_s = options.wheel_rate_sigma_rad_s;
+  o.noise.angle_sigma_rad = options.angle_sigma_deg * M_PI / 180.0;
+  o.noise.gt_position_sigma_m = options.sim.gt_position_sigma_m;
+  o.noise.gt_heading_sigma_rad = options.sim.gt_heading_sigma_rad;
+  o.omni3_only_flags = options.omni3_only_flags;
+  return RunModelSimulateCommand(o);
+}
+
 }  // namespace
 
 int RunSimulateCommand(const SimulateCommandOptions& options) {
+  if (!options.model.empty() && options.model != "omni3") return RunModelSimulate(options);
   try {
     const Omni3Robot nominal = io::ReadOmni3Robot(options.robot);
     sim::Omni3SimulationOptions sim_options = options.sim;

@@ -1,23 +1,31 @@
 #pragma once
-// `fitcal simulate`: writes a simulated flower data set (README.md, section Simulator) in the data
-// set format.
+// `fitcal simulate`: writes a simulated flower data set of an omni3 robot (README.md, section
+// Simulator) in the data set format; with --model, a data set of another model
+// (tools/model_simulate_command.h).
 
 #include <string>
 #include <vector>
 
 #include "tools/sim/omni3_simulator.h"
+#include "tools/sim/scenario_noise.h"
 
 namespace fitcal::tools {
 
 struct SimulateCommandOptions {
   std::string out;
+  std::string model;  // "" (or omni3): the omni3 flower simulator below; else model_simulate
   std::string robot = "data/robots/apr02.yaml";  // nominal robot: commands + fit start
-  std::string truth;                             // robot YAML of the true robot; "" = Table 5
+  bool robot_given = false;  // --model: without --robot the model's registry example is nominal
+  std::string truth;         // robot YAML of the true robot; "" = Table 5
   bool force = false;
   // Effects to inject, "name=v1[,v2]" with the registry's names and parameter order
   // (odometry/effects.h); the data set written names none of them.
   std::vector<std::string> inject;
   sim::Omni3SimulationOptions sim;
+  // --model only (the omni3 simulator has slip instead): tools/sim/model_scenarios.h.
+  double wheel_rate_sigma_rad_s = sim::ScenarioNoise{}.wheel_rate_sigma_rad_s;
+  double angle_sigma_deg = sim::ScenarioNoise{}.angle_sigma_rad * 180.0 / M_PI;
+  std::vector<std::string> omni3_only_flags;  // given flags that only the omni3 simulator takes
 };
 
 int RunSimulateCommand(const SimulateCommandOptions& options);

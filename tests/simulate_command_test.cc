@@ -1,0 +1,167 @@
+// `fitcal simulate --model <name>` end to end, through the command line: the data set of every
+// model with calibration trajectories is written atomically, and `fitcal fit` on it recovers the
+// true robot it names (true_robot.yaml) within the sigmas the fit derives from the data's noise.
+// Without --model the omni3 flower simulator is unchanged (the shipped data/flower, bit for bit).
+// The models' own recovery tests (diff_drive_test, tricycle_test, omni_model_test) call the
+// library; these go through the files and the commands a user runs.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+
+#include "models/model_registry.h"
+#include "tests/test_files.h"
+
+namespace fitcal {
+namespace {
+
+namespace fs = std::filesystem;
+using fitcal::testing::ReadFileBytes;
+using fitcal::testing::TempDir;
+
+const std::string kFitcal = std::string(FITCAL_BINARY_DIR) + "/tools/fitcal";
+
+struct Result {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+Result RunFitcal(const TempDir& dir, const std::string& args) {
+  const std::string out = dir.Path("stdout.txt"), err = dir.Path("stderr.txt");
+  const int status = std::system((kFitcal + " " + args + " >" + out + " 2>" + err).c_str());
+  Result r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = ReadFileBytes(out);
+  r.err = ReadFileBytes(err);
+  return r;
+}
+
+struct RecoveryCase {
+  const char* model;
+  int seed;
+  int repetitions;    // the last one validates
+  const char* noise;  // simulate flags beyond the defaults
+};
+
+class SimulatedModel : public ::testing::TestWithParam<RecoveryCase> {};
+
+// simulate --model M (the default noise of README "Simulator": 4096-tick encoders every 10 ms with
+// 0.02 rad/s rate noise, ground truth every 0.2 s with 2 mm and 0.2 deg, an unrecorded random
+// start pose), then fit with the defaults a user gets (Ceres, Eq. 14's 1 m = 1 rad weighting).
+// The fit's sigmas are its covariance scaled by the residual variance, i.e. derived from the noise
+// the data actually carry (start-pose noise included). Each free parameter must land within 4 of
+// them (a false alarm 6e-5 per parameter for Gaussian errors); held parameters stay nominal
+// exactly; and the truth is > 5 sigma from the nominal, so a fit that did not move would fail.
+TEST_P(SimulatedModel, FitCommandRecoversTheTrueRobotWithinItsSigmas) {
+  const RecoveryCase c = GetParam();
+  TempDir dir;
+  const std::string data = dir.Path("data"), cal = dir.Path("calibrated.yaml");
+  Result r = RunFitcal(dir, std::string("simulate --model ") + c.model + " --out " + data +
+                                " --seed " + std::to_string(c.seed) + " --repetitions " +
+                                std::to_string(c.repetitions) + " " + c.noise);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = RunFitcal(dir, "fit --logs " + data + " --train-reps 1-" + std::to_string(c.repetitions - 1) +
+                         " --out " + cal);
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  std::printf("%s", r.out.c_str());
+
+  const Robot truth = ReadRobotModelFile(data + "/true_robot.yaml")->robot();
+  const Robot nominal = ReadRobotModelFile(data + "/robot.yaml")->robot();
+  const Robot fitted = ReadRobotModelFile(cal)->robot();
+  const YAML::Node block = YAML::LoadFile(cal)["calibration"];
+  ASSERT_EQ(block["selected"].as<std::string>(), "ceres");
+  const YAML::Node sigma = block["sigma"];
+  ASSERT_TRUE(sigma.IsMap()) << "no uncertainty in " << cal;
+  for (int k = 0; k < nominal.NumParameters(); ++k) {
+    const ParameterInfo& info = nominal.parameters[k];
+    SCOPED_TRACE(info.name);
+    if (nominal.IsHeld(k)) {
+      EXPECT_EQ(fitted.nominal[k], nominal.nominal[k]);
+      continue;
+    }
+    const double s = sigma[info.name + "_" + info.DisplayUnit()].as<double>() / info.DisplayScale();
+    ASSERT_GT(s, 0.0);
+    EXPECT_LT(std::abs(fitted.nominal[k] - truth.nominal[k]), 4.0 * s);
+    EXPECT_GT(std::abs(nominal.nominal[k] - truth.nominal[k]), 5.0 * s);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryModel, SimulatedModel,
+                         // The differential drive's default truth is UMBmark-sized (E_d 1.005,
+                         // 0.25 % on the separation): a quarter of the default noise keeps it
+                         // > 5 sigma from the nominal with four repetitions.
+                         ::testing::Values(RecoveryCase{"diff_drive", 3, 4,
+                                                        "--gt-position-sigma-m 0.0005 "
+                                                        "--gt-heading-sigma-deg 0.05 "
+                                                        "--wheel-rate-sigma-rad-s 0.005"},
+                                           RecoveryCase{"tricycle", 3, 3, ""},
+                                           RecoveryCase{"omni", 3, 3, ""}),
+                         [](const auto& test) { return std::string(test.param.model); });
+
+// The directory appears whole: an existing one is refused without --force and replaced entirely
+// with it (a stale file does not survive), and no temporary sibling is left behind.
+TEST(SimulateCommand, WritesTheDataSetDirectoryAtomically) {
+  TempDir dir;
+  const std::string data = dir.Path("data");
+  ASSERT_EQ(RunFitcal(dir, "simulate --model diff_drive --repetitions 1 --out " + data).exit_code,
+            0);
+  const std::string dataset = ReadFileBytes(data + "/dataset.yaml");
+  fitcal::testing::WriteFileBytes(data + "/stale.txt", "left from before");
+  const Result refused = RunFitcal(dir, "simulate --model tricycle --repetitions 1 --out " + data);
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_NE(refused.err.find("--force"), std::string::npos) << refused.err;
+  EXPECT_TRUE(fs::exists(data + "/stale.txt"));
+  EXPECT_EQ(ReadFileBytes(data + "/dataset.yaml"), dataset);
+  ASSERT_EQ(
+      RunFitcal(dir, "simulate --model tricycle --repetitions 1 --force --out " + data).exit_code,
+      0);
+  EXPECT_FALSE(fs::exists(data + "/stale.txt"));
+  EXPECT_NE(ReadFileBytes(data + "/robot.yaml").find("model: tricycle"), std::string::npos);
+  for (const auto& entry : fs::directory_iterator(dir.Path(""))) {
+    EXPECT_EQ(entry.path().filename().string().find(".tmp-"), std::string::npos) << entry.path();
+  }
+}
+
+TEST(SimulateCommand, RefusesWhatTheModelSimulatorDoesNotTake) {
+  TempDir dir;
+  const std::string data = dir.Path("data");
+  for (const std::string& args :
+       {std::string("--model diff_drive --slip-sigma 0.01"), std::string("--model asoc"),
+        std::string("--model omni --robot ") + FITCAL_SOURCE_DIR + "/data/robots/apr02.yaml"}) {
+    SCOPED_TRACE(args);
+    const Result r = RunFitcal(dir, "simulate " + args + " --out " + data);
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_FALSE(fs::exists(data));
+  }
+}
+
+// data/flower was written by `fitcal simulate --out data/flower --robot data/robots/apr02.yaml
+// --repetitions 10 --seed 1` (README "Simulator"); run i draws from its own generator seeded by
+// (seed, i), so one repetition with the same seed must reproduce its repetition-1 files exactly.
+TEST(SimulateCommand, WithoutModelTheFlowerIsUnchanged) {
+  TempDir dir;
+  const std::string data = dir.Path("flower");
+  const std::string source = std::string(FITCAL_SOURCE_DIR) + "/data/";
+  ASSERT_EQ(RunFitcal(dir, "simulate --out " + data + " --robot " + source +
+                               "robots/apr02.yaml --repetitions 1 --seed 1")
+                .exit_code,
+            0);
+  int files = 0;
+  for (const auto& entry : fs::directory_iterator(data + "/runs")) {
+    SCOPED_TRACE(entry.path().filename().string());
+    EXPECT_EQ(ReadFileBytes(entry.path()),
+              ReadFileBytes(source + "flower/runs/" + entry.path().filename().string()));
+    ++files;
+  }
+  EXPECT_EQ(files, 72);
+  EXPECT_EQ(ReadFileBytes(data + "/robot.yaml"), ReadFileBytes(source + "flower/robot.yaml"));
+}
+
+}  // namespace
+}  // namespace fitcal

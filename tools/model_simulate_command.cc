@@ -1,0 +1,98 @@
+#include "tools/model_simulate_command.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <stdexcept>
+
+#include "io/atomic_directory.h"
+#include "io/atomic_file.h"
+#include "models/model_registry.h"
+#include "tools/sim/model_scenarios.h"
+#include "tools/sim/model_simulator.h"
+
+namespace fitcal::tools {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The nominal robot: --robot, or the registry's example robot of the model.
+RobotModelPtr NominalModel(const ModelSimulateOptions& options) {
+  if (!options.robot.empty()) return ReadRobotModelFile(options.robot);
+  const ModelRegistration* registration = FindModel(options.model);
+  if (registration == nullptr) {
+    throw std::invalid_argument("unknown --model '" + options.model +
+                                "' (known: " + RegisteredModelNames() + ")");
+  }
+  return ReadRobotModel(YAML::Load(registration->example_yaml), options.model + " example robot");
+}
+
+// The true parameters: --truth (a robot YAML of the same model and channels), or the default.
+std::vector<double> TrueParameters(const ModelSimulateOptions& options,
+                                   const RobotModelInterface& nominal) {
+  const Robot& robot = nominal.robot();
+  if (options.truth.empty()) return sim::DefaultTrueParameters(robot);
+  const RobotModelPtr truth = ReadRobotModelFile(options.truth);
+  const Robot& t = truth->robot();
+  if (t.model != robot.model || t.NumChannels() != robot.NumChannels() ||
+      t.NumParameters() != robot.NumParameters()) {
+    throw std::invalid_argument(options.truth + ": the true robot must be a " + robot.model +
+                                " robot with the nominal robot's channels and parameters");
+  }
+  return t.nominal;
+}
+
+void PrintTruth(const Robot& robot, const std::vector<double>& truth) {
+  std::printf("  %-22s %12s %12s\n", "parameter", "nominal", "true");
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    const double s = robot.parameters[k].DisplayScale();
+    std::printf("  %-22s %12.6f %12.6f%s\n", robot.LabelOf(k).c_str(), robot.nominal[k] * s,
+                truth[k] * s, robot.IsHeld(k) ? "  held (gauge)" : "");
+  }
+}
+
+}  // namespace
+
+int RunModelSimulateCommand(const ModelSimulateOptions& options) {
+  if (!options.omni3_only_flags.empty()) {
+    std::cerr << "fitcal simulate: " << options.omni3_only_flags.front()
+              << " belongs to the omni3 flower simulator, not to --model " << options.model
+              << " (README \"Simulator\")\n";
+    return 2;
+  }
+  if (fs::exists(options.out) && !options.force) {
+    std::cerr << "fitcal simulate: " << options.out << " exists; use --force to replace it\n";
+    return 2;
+  }
+  try {
+    const RobotModelPtr model = NominalModel(options);
+    const Robot& robot = model->robot();
+    if (robot.model != options.model) {
+      std::cerr << "fitcal simulate: " << options.robot << " is a " << robot.model << " robot, not "
+                << options.model << "\n";
+      return 2;
+    }
+    const std::vector<double> truth = TrueParameters(options, *model);
+    const sim::ScenarioNoise& noise = options.noise;
+    const sim::ModelScenario scenario = sim::MakeModelScenario(*model, noise);
+    const std::vector<sim::SimulatedRun> runs =
+        sim::SimulateRuns(*model, truth, scenario.trajectories, scenario.options);
+    io::WriteDirectoryAtomically(options.out, options.force, [&](const std::string& tmp) {
+      sim::WriteSimulatedDataset(tmp, model->RobotYaml(robot.nominal, ""), runs);
+      io::WriteFileAtomically((fs::path(tmp) / "true_robot.yaml").string(),
+                              model->RobotYaml(truth, ""));
+    });
+    std::printf("wrote %zu runs of the %s robot '%s' (%d repetitions, seed %llu) to %s\n",
+                runs.size(), robot.model.c_str(), robot.name.c_str(), noise.repetitions,
+                static_cast<unsigned long long>(noise.seed), options.out.c_str());
+    PrintTruth(robot, truth);
+    return 0;
+  } catch (const std::exception& e) {  // io::InputError too: what() is its file:line message
+    std::cerr << "fitcal simulate: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace fitcal::tools
