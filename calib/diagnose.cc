@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "calib/statistics.h"
+#include "models/omni3/omni3_robot_model.h"
 
 namespace fitcal {
 
@@ -14,8 +15,8 @@ namespace {
 
 using effects::EffectId;
 
-int NumParameters(const EffectModel& model) {
-  int k = omni3::kNumParameters;
+int NumParameters(const Robot& robot, const EffectModel& model) {
+  int k = robot.NumFree();
   for (const auto& e : model) k += effects::Info(e.id).num_parameters;
   return k;
 }
@@ -50,6 +51,47 @@ std::string EffectValueText(const effects::EffectValue& e) {
   return out;
 }
 
+// The held-out comparison of a candidate with the base, per validation run i:
+//   mean_improvement = mean of J_base,i - J_cand,i (objective units; ranks the candidates);
+//   the one-sided paired t test on l_i = ln(J_base,i / J_cand,i), the log ratio: an effect
+//   scales each run's error by its own exposure (a steering scale shows on sharp circles, hardly
+//   on gentle ones), so the differences are heavy-tailed and a t test on them has little power,
+//   while the ratios are comparable across runs.
+void PairedImprovement(const ModelScore& base, const ModelScore& candidate, CandidateResult* c) {
+  const std::size_t n = base.runs.size();
+  constexpr double kTiny = 1e-300;
+  double mean_d = 0.0, mean_l = 0.0, var_l = 0.0;
+  std::vector<double> l(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    mean_d += base.runs[i].objective - candidate.runs[i].objective;
+    l[i] = std::log(std::max(base.runs[i].objective, kTiny) /
+                    std::max(candidate.runs[i].objective, kTiny));
+    mean_l += l[i];
+  }
+  mean_d /= static_cast<double>(std::max<std::size_t>(1, n));
+  mean_l /= static_cast<double>(std::max<std::size_t>(1, n));
+  for (double x : l) var_l += (x - mean_l) * (x - mean_l);
+  var_l /= std::max<double>(1.0, static_cast<double>(n) - 1.0);
+  c->mean_improvement = mean_d;
+  c->t_statistic = var_l > 0.0 ? mean_l / std::sqrt(var_l / static_cast<double>(n)) : 0.0;
+  c->p_value =
+      n >= 2 ? stats::StudentTUpperTail(c->t_statistic, static_cast<double>(n) - 1.0) : 1.0;
+}
+
+// Every identifiable effect of the registry that this robot's channels can show.
+std::vector<EffectId> DefaultCandidates(const Robot& robot) {
+  bool has_angle = false;
+  for (const ChannelInfo& c : robot.channels)
+    has_angle = has_angle || c.kind == ChannelKind::kAngle;
+  std::vector<EffectId> out;
+  for (const auto& info : effects::EffectTable()) {
+    if (info.identifiable && (has_angle || !effects::NeedsAngleChannel(info.id))) {
+      out.push_back(info.id);
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 bool DiagnoseOptions::IsValid(std::string* error) const {
@@ -73,6 +115,13 @@ bool DiagnoseOptions::IsValid(std::string* error) const {
 DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
                         const std::vector<TrackRun>& validation, const Omni3Robot& robot,
                         const DiagnoseOptions& options) {
+  return Diagnose(training, validation, *Omni3ModelOf(robot), options);
+}
+
+DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
+                        const std::vector<TrackRun>& validation, const RobotModelInterface& model,
+                        const DiagnoseOptions& options) {
+  const Robot& robot = model.robot();
   std::string error;
   if (!options.IsValid(&error)) throw std::invalid_argument("DiagnoseOptions: " + error);
   if (training.empty()) throw std::invalid_argument("Diagnose: no training runs");
@@ -83,28 +132,24 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
   all.insert(all.end(), validation.begin(), validation.end());
 
   // 1. The declared fit and its residual.
-  CeresFitOptions declared_options;
-  declared_options.num_threads = threads;
-  declared_options.weights = options.fit.weights;
-  out.declared = FitOmni3Ceres(AlignedOf(training), robot, declared_options);
+  ModelFitOptions declared_options;
+  declared_options.ceres.num_threads = threads;
+  declared_options.ceres.weights = options.fit.weights;
+  out.declared = FitModel(AlignedOf(training), model, declared_options);
   out.declared_validation =
-      ScoreModel(out.declared.parameters, {}, validation, options.fit.weights, threads);
-  out.before = AnalyzeResiduals(out.declared.parameters, {}, all, threads);
+      ScoreModel(model, out.declared.parameters, {}, validation, options.fit.weights, threads);
+  out.before = AnalyzeResiduals(model, out.declared.parameters, {}, all, threads);
 
-  // 2. The base: nine parameters on the tracks.
-  out.base = FitEffectModel(training, robot, out.declared.parameters, {}, options.fit);
+  // 2. The base: the model's parameters on the tracks.
+  out.base = FitEffectModel(training, model, out.declared.parameters, {}, options.fit);
   EffectFitResult current = out.base;
 
-  std::vector<EffectId> candidates = options.candidates;
-  if (candidates.empty()) {
-    for (const auto& info : effects::EffectTable()) {
-      if (info.identifiable) candidates.push_back(info.id);
-    }
-  }
+  std::vector<EffectId> candidates =
+      options.candidates.empty() ? DefaultCandidates(robot) : options.candidates;
   for (const auto& info : effects::EffectTable()) {
     if (info.identifiable) continue;
     const double sep =
-        SeparableFraction(training, current.parameters, {}, info.id, options.fit.weights);
+        SeparableFraction(training, model, current.parameters, {}, info.id, options.fit.weights);
     out.not_identifiable.push_back(
         std::string(info.name) + ": not identifiable - " + info.aliased_with +
         Fmt(" (separable fraction on these runs %.1e); ", sep) + info.separating_runs);
@@ -115,18 +160,19 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
   const bool have_validation = !validation.empty();
   while (have_validation && static_cast<int>(current.effects.size()) < options.max_effects) {
     DiagnoseRound round;
-    const ModelScore base_val =
-        ScoreModel(current.parameters, current.effects, validation, options.fit.weights, threads);
+    const ModelScore base_val = ScoreModel(model, current.parameters, current.effects, validation,
+                                           options.fit.weights, threads);
     round.base_validation_objective = base_val.objective;
     const ResidualAnalysis base_all =
-        AnalyzeResiduals(current.parameters, current.effects, all, threads);
+        AnalyzeResiduals(model, current.parameters, current.effects, all, threads);
     round.base_lof_f = base_all.lack_of_fit.f;
     round.base_lof_p = base_all.lack_of_fit.p_value;
     const bool base_lof =
         base_all.lack_of_fit.available && base_all.lack_of_fit.p_value < options.lof_alpha;
     const double base_bic = Bic(2.0 * current.final_cost, static_cast<int>(training.size()),
-                                NumParameters(current.effects));
-    const int dof_base = 3 * static_cast<int>(training.size()) - NumParameters(current.effects);
+                                NumParameters(robot, current.effects));
+    const int dof_base =
+        3 * static_cast<int>(training.size()) - NumParameters(robot, current.effects);
     const double residual_rms = std::sqrt(2.0 * current.final_cost / std::max(1, dof_base));
     int num_tried = 0;
     for (EffectId id : candidates) {
@@ -136,8 +182,8 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
       CandidateResult c;
       c.id = id;
       double unexplained = 0.0;
-      c.separable_fraction = SeparableFraction(training, current.parameters, current.effects, id,
-                                               options.fit.weights, &unexplained);
+      c.separable_fraction = SeparableFraction(training, model, current.parameters, current.effects,
+                                               id, options.fit.weights, &unexplained);
       c.predicted_sigma =
           unexplained > 0.0 ? residual_rms / unexplained : std::numeric_limits<double>::infinity();
       const auto& info = effects::Info(id);
@@ -156,32 +202,19 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
       effects::EffectValue neutral;
       neutral.id = id;
       start.push_back(neutral);
-      c.fit = FitEffectModel(training, robot, current.parameters, start, options.fit);
+      c.fit = FitEffectModel(training, model, current.parameters, start, options.fit);
       c.fitted = c.fit.usable;
       if (!c.fitted) {
         c.verdict = "fit failed: " + c.fit.termination;
         round.candidates.push_back(c);
         continue;
       }
-      const ModelScore val =
-          ScoreModel(c.fit.parameters, c.fit.effects, validation, options.fit.weights, threads);
+      const ModelScore val = ScoreModel(model, c.fit.parameters, c.fit.effects, validation,
+                                        options.fit.weights, threads);
       c.validation_objective = val.objective;
-      const std::size_t n = validation.size();
-      double mean = 0.0, var = 0.0;
-      for (std::size_t i = 0; i < n; ++i)
-        mean += base_val.runs[i].objective - val.runs[i].objective;
-      mean /= static_cast<double>(n);
-      for (std::size_t i = 0; i < n; ++i) {
-        const double d = base_val.runs[i].objective - val.runs[i].objective - mean;
-        var += d * d;
-      }
-      var /= std::max<double>(1.0, static_cast<double>(n) - 1.0);
-      c.mean_improvement = mean;
-      c.t_statistic = var > 0.0 ? mean / std::sqrt(var / static_cast<double>(n)) : 0.0;
-      c.p_value =
-          n >= 2 ? stats::StudentTUpperTail(c.t_statistic, static_cast<double>(n) - 1.0) : 1.0;
+      PairedImprovement(base_val, val, &c);
       c.delta_bic = Bic(2.0 * c.fit.final_cost, static_cast<int>(training.size()),
-                        NumParameters(c.fit.effects)) -
+                        NumParameters(robot, c.fit.effects)) -
                     base_bic;
       round.candidates.push_back(c);
     }
@@ -204,7 +237,7 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
       CandidateResult& c = round.candidates[i];
       if (base_lof) {
         const ResidualAnalysis with =
-            AnalyzeResiduals(c.fit.parameters, c.fit.effects, all, threads);
+            AnalyzeResiduals(model, c.fit.parameters, c.fit.effects, all, threads);
         c.lof_f = with.lack_of_fit.f;
         const double excess_before = round.base_lof_f - 1.0;
         const double excess_after = std::max(0.0, c.lof_f - 1.0);
@@ -247,9 +280,9 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
 
   // 4. After.
   out.final_fit = current;
-  out.final_validation =
-      ScoreModel(current.parameters, current.effects, validation, options.fit.weights, threads);
-  out.after = AnalyzeResiduals(current.parameters, current.effects, all, threads);
+  out.final_validation = ScoreModel(model, current.parameters, current.effects, validation,
+                                    options.fit.weights, threads);
+  out.after = AnalyzeResiduals(model, current.parameters, current.effects, all, threads);
   out.unexplained_structure =
       out.after.lack_of_fit.available && out.after.lack_of_fit.p_value < options.lof_alpha;
   out.effects_named = !out.unexplained_structure && !current.effects.empty();
@@ -262,7 +295,13 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
 }
 
 std::string FormatDiagnoseReport(const DiagnoseResult& r, const Omni3Robot& robot) {
-  std::string out = "# fitcal diagnose\n\n## Residual of the declared nine-parameter fit\n\n";
+  return FormatDiagnoseReport(r, *Omni3ModelOf(robot));
+}
+
+std::string FormatDiagnoseReport(const DiagnoseResult& r, const RobotModelInterface& model) {
+  const Robot& robot = model.robot();
+  std::string out = "# fitcal diagnose\n\n## Residual of the declared fit of the " +
+                    std::to_string(robot.NumFree()) + " free parameters\n\n";
   out += FormatResidualAnalysis(r.before);
   out += "\n## Tracing\n\n";
   for (std::size_t k = 0; k < r.rounds.size(); ++k) {
@@ -322,24 +361,22 @@ std::string FormatDiagnoseReport(const DiagnoseResult& r, const Omni3Robot& robo
 
   out += Fmt("\n## Held-out error (%.0f validation runs)\n\n", r.num_validation_runs);
   out += "| model | CF (Eq. 14) | track RMSE [m] | track RMSE [deg] |\n|---|---|---|---|\n";
-  out += Fmt("| declared nine parameters | %.5f | %.5f | %.4f |\n", r.declared_validation.cf,
+  out += Fmt("| declared parameters | %.5f | %.5f | %.4f |\n", r.declared_validation.cf,
              r.declared_validation.track_rmse_m, RadToDeg(r.declared_validation.track_rmse_rad));
-  out += Fmt("| nine + accepted effects | %.5f | %.5f | %.4f |\n", r.final_validation.cf,
+  out += Fmt("| parameters + accepted effects | %.5f | %.5f | %.4f |\n", r.final_validation.cf,
              r.final_validation.track_rmse_m, RadToDeg(r.final_validation.track_rmse_rad));
 
   out +=
-      "\n## Nine parameters before / after\n\n| parameter | nominal | declared fit | with effects "
+      "\n## Parameters before / after\n\n| parameter | nominal | declared fit | with effects "
       "| sigma |\n|---|---|---|---|---|\n";
-  const auto nominal = robot.nominal.ToArray();
-  static const char* kSymbol[] = {"R", "r", "delta"};
-  for (int k = 0; k < omni3::kNumParameters; ++k) {
-    const int g = k / omni3::kNumWheels;
-    const double s = g == 2 ? 180.0 / M_PI : 1.0;
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    const double s = robot.parameters[k].DisplayScale();
+    const double sigma =
+        k < static_cast<int>(r.final_fit.sigma.size()) ? r.final_fit.sigma[k] : 0.0;
     char line[256];
-    std::snprintf(line, sizeof line, "| %s_%s%s | %.6f | %.6f | %.6f | %.2g |\n", kSymbol[g],
-                  robot.wheel_names[k % 3].c_str(), g == 2 ? " [deg]" : " [m]", nominal[k] * s,
-                  r.declared.parameters[k] * s, r.final_fit.parameters[k] * s,
-                  r.final_fit.sigma[k] * s);
+    std::snprintf(line, sizeof line, "| %s%s | %.6f | %.6f | %.6f | %.2g |\n",
+                  robot.LabelOf(k).c_str(), robot.IsHeld(k) ? " (held)" : "", robot.nominal[k] * s,
+                  r.declared.parameters[k] * s, r.final_fit.parameters[k] * s, sigma * s);
     out += line;
   }
   return out;

@@ -1,7 +1,7 @@
 #pragma once
-// Closing the loop (issue 6): find the residual the nine-parameter fit leaves, trace it to an
-// effect of the library (odometry/effects.h), add it, and show the error before and after on
-// held-out repetitions.
+// Closing the loop (issue 6), for any robot model: find the residual the model's fit leaves, trace
+// it to an effect of the library (odometry/effects.h), add it, and show the error before and after
+// on held-out repetitions.
 //
 // Procedure (stated once, implemented in Diagnose()):
 //  1. The declared fit: nine parameters on the training final poses (omni3_ceres_fit.h), and its
@@ -17,8 +17,10 @@
 //         model: it is not fitted, and the runs that would separate it are named;
 //       - refit nine + accepted effects + candidate on the training runs;
 //       - validation: per held-out run, d_i = J_base,i - J_cand,i (J the run's mean squared track
-//         error); one-sided paired t test of mean(d) > 0; significant when p < alpha / (number of
-//         candidates tried) (Bonferroni);
+//         error); one-sided paired t test of mean(ln(J_base,i / J_cand,i)) > 0 (the log ratio:
+//         an effect scales each run's error by that run's exposure to it, so the d_i are heavy-
+//         tailed and the ratios comparable); significant when mean(d) > 0 and p < alpha / (number
+//         of candidates tried) (Bonferroni);
 //       - information criterion on the training runs, one observation per run (a run's
 //         checkpoints are correlated): BIC = N ln(S / N) + k ln N, S = sum of run objectives,
 //         k the number of fitted parameters; required: BIC falls;
@@ -40,6 +42,7 @@
 #include "calib/effect_fit.h"
 #include "calib/omni3_ceres_fit.h"
 #include "calib/residual_analysis.h"
+#include "fit/model_fit.h"
 
 namespace fitcal {
 
@@ -83,7 +86,7 @@ struct DiagnoseRound {
 };
 
 struct DiagnoseResult {
-  Omni3FitResult declared;  // nine parameters, final-pose fit
+  ModelFitResult declared;  // the model's parameters, final-pose fit (fit/model_fit.h)
   ModelScore declared_validation;
   ResidualAnalysis before;  // declared fit, all runs
   EffectFitResult base;     // nine parameters, track fit
@@ -100,13 +103,18 @@ struct DiagnoseResult {
   int num_validation_runs = 0;
 };
 
-// Throws std::invalid_argument for invalid options or no training runs.
+// Throws std::invalid_argument for invalid options or no training runs. The TrackRuns' contexts
+// must mark the model's wheel channels (PrepareTrackRuns with WheelChannelMask(robot)).
+DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
+                        const std::vector<TrackRun>& validation, const RobotModelInterface& model,
+                        const DiagnoseOptions& options = {});
 DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
                         const std::vector<TrackRun>& validation, const Omni3Robot& robot,
                         const DiagnoseOptions& options = {});
 
 // The report (Markdown): pattern, effect chosen with value and uncertainty, parameters before
 // and after, held-out error before and after, candidate table, what to record next.
+std::string FormatDiagnoseReport(const DiagnoseResult& result, const RobotModelInterface& model);
 std::string FormatDiagnoseReport(const DiagnoseResult& result, const Omni3Robot& robot);
 
 }  // namespace fitcal

@@ -12,6 +12,7 @@
 
 #include "calib/dense_solver_options.h"
 #include "calib/run_split.h"
+#include "models/omni3/omni3_robot_model.h"
 #include "odometry/parallel_for.h"
 
 namespace fitcal {
@@ -52,8 +53,9 @@ Pose2<T> InterpolateTrack(const GroundTruthTrack& track, const T& t_s) {
 // Pose errors (replay - ground truth) at the ground-truth samples `indices` of the run, and at
 // the window's end. err holds 3 values per index, then 3 for the end.
 template <typename T>
-void TrackPoseErrors(const TrackRun& run, const T* p, const std::vector<ActiveEffect<T>>& active,
-                     const std::vector<int>& indices, T* err) {
+void TrackPoseErrors(const RobotModelInterface& robot_model, const TrackRun& run, const T* p,
+                     const std::vector<ActiveEffect<T>>& active, const std::vector<int>& indices,
+                     T* err) {
   const AlignedRun& a = run.aligned;
   const T tau = effects::TotalLatency(active);
   const Pose2d start_pose = TrackStartPose(a, run.contexts, run.track, ScalarPart(tau));
@@ -81,8 +83,12 @@ void TrackPoseErrors(const TrackRun& run, const T* p, const std::vector<ActiveEf
       ++next;
     }
   };
+  const auto kinematics = robot_model.PrepareKinematics(p);
+  const auto step = [&kinematics](const T* values, double dt, T* dx, T* dy, T* dtheta) {
+    kinematics->Step(values, dt, dx, dy, dtheta);
+  };
   const Pose2<T> final_pose =
-      effects::ReplayWithEffects(p, active, a.samples, run.contexts, start, visit);
+      effects::ReplayStepsWithEffects(step, active, a.samples, run.contexts, start, visit);
   for (; next < n; ++next) {  // only for an empty replay
     error_at(next, final_pose, run.track.world_T_robot[indices[next]]);
   }
@@ -92,11 +98,14 @@ void TrackPoseErrors(const TrackRun& run, const T* p, const std::vector<ActiveEf
   err[3 * n + 2] = WrapAngle(final_pose.theta - gt_end.theta);
 }
 
-// The fit's residual (see the header): parameter block 0 = the nine, block 1 + j = effect j.
+// The fit's residual (see the header): parameter block 0 = the model's parameters, block 1 + j =
+// effect j.
 class EffectTrackResidual {
  public:
-  EffectTrackResidual(const TrackRun& run, std::vector<EffectId> ids, const ResidualWeights& w)
-      : run_(run),
+  EffectTrackResidual(const RobotModelInterface& robot_model, const TrackRun& run,
+                      std::vector<EffectId> ids, const ResidualWeights& w)
+      : robot_model_(robot_model),
+        run_(run),
         ids_(std::move(ids)),
         inv_xy_(1.0 / w.position_sigma_m),
         inv_theta_(1.0 / w.heading_sigma_rad) {}
@@ -110,7 +119,7 @@ class EffectTrackResidual {
     for (std::size_t j = 0; j < ids_.size(); ++j) active.push_back({ids_[j], params[1 + j]});
     const std::size_t n = run_.checkpoints.size();
     std::vector<T> err(3 * n + 3);
-    TrackPoseErrors(run_, params[0], active, run_.checkpoints, err.data());
+    TrackPoseErrors(robot_model_, run_, params[0], active, run_.checkpoints, err.data());
     const double norm = 1.0 / std::sqrt(static_cast<double>(n));
     for (std::size_t j = 0; j < n; ++j) {
       residual[3 * j + 0] = err[3 * j + 0] * (inv_xy_ * norm);
@@ -120,17 +129,19 @@ class EffectTrackResidual {
     return true;
   }
 
-  static ceres::CostFunction* Create(const TrackRun& run, const std::vector<EffectId>& ids,
-                                     const ResidualWeights& w) {
-    auto* functor = new EffectTrackResidual(run, ids, w);
+  static ceres::CostFunction* Create(const RobotModelInterface& robot_model, const TrackRun& run,
+                                     const std::vector<EffectId>& ids, const ResidualWeights& w) {
+    auto* functor = new EffectTrackResidual(robot_model, run, ids, w);
+    // The stride is EffectJet's: the model's PrepareKinematics serves exactly that Jet.
     auto* cost = new ceres::DynamicAutoDiffCostFunction<EffectTrackResidual, 4>(functor);
-    cost->AddParameterBlock(omni3::kNumParameters);
+    cost->AddParameterBlock(robot_model.robot().NumParameters());
     for (EffectId id : ids) cost->AddParameterBlock(effects::Info(id).num_parameters);
     cost->SetNumResiduals(functor->num_residuals());
     return cost;
   }
 
  private:
+  const RobotModelInterface& robot_model_;
   const TrackRun& run_;
   std::vector<EffectId> ids_;
   double inv_xy_;
@@ -149,7 +160,24 @@ std::vector<EffectId> IdsOf(const EffectModel& model) {
   return ids;
 }
 
+// The omni3 kinematics on the seam, for the omni3 overloads (they do not depend on the robot's
+// values: the parameters come with each call).
+const RobotModelInterface& Omni3Seam() {
+  static const std::shared_ptr<const Omni3Model> model = Omni3ModelOf(Omni3Robot{});
+  return *model;
+}
+
+std::vector<double> Vector(const Omni3ParameterArray& p) { return {p.begin(), p.end()}; }
+
 }  // namespace
+
+unsigned WheelChannelMask(const Robot& robot) {
+  unsigned mask = 0;
+  for (int i = 0; i < robot.NumChannels(); ++i) {
+    if (robot.channels[i].kind == ChannelKind::kWheelRate) mask |= 1u << i;
+  }
+  return mask;
+}
 
 Pose2d TrackStartPose(const AlignedRun& run, const std::vector<effects::SampleContext>& contexts,
                       const GroundTruthTrack& track, double latency_s) {
@@ -176,12 +204,16 @@ bool TrackOptions::IsValid(std::string* error) const {
 }
 
 TrackRun PrepareTrackRun(const RunLog& run, const TrackOptions& options) {
+  return PrepareTrackRun(run, ~0u, options);
+}
+
+TrackRun PrepareTrackRun(const RunLog& run, unsigned wheel_mask, const TrackOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) throw std::invalid_argument("TrackOptions: " + error);
   TrackRun out;
   out.aligned = AlignRun(run);
   out.track = run.ground_truth;
-  out.contexts = effects::MakeSampleContexts(out.aligned.samples);
+  out.contexts = effects::MakeSampleContexts(out.aligned.samples, wheel_mask);
   const double lo = out.aligned.t_start_s + options.edge_margin_s;
   const double hi = out.aligned.t_final_s - options.edge_margin_s;
   for (std::size_t g = 0; g < out.track.t_s.size(); ++g) {
@@ -197,8 +229,14 @@ TrackRun PrepareTrackRun(const RunLog& run, const TrackOptions& options) {
 
 std::vector<TrackRun> PrepareTrackRuns(const std::vector<RunLog>& runs,
                                        const TrackOptions& options) {
+  return PrepareTrackRuns(runs, ~0u, options);
+}
+
+std::vector<TrackRun> PrepareTrackRuns(const std::vector<RunLog>& runs, unsigned wheel_mask,
+                                       const TrackOptions& options) {
   std::vector<TrackRun> out(runs.size());
-  ParallelFor(runs.size(), 0, [&](std::size_t i) { out[i] = PrepareTrackRun(runs[i], options); });
+  ParallelFor(runs.size(), 0,
+              [&](std::size_t i) { out[i] = PrepareTrackRun(runs[i], wheel_mask, options); });
   return out;
 }
 
@@ -216,6 +254,12 @@ void SplitTrackRuns(std::vector<TrackRun> runs, const std::vector<int>& training
 ModelScore ScoreModel(const Omni3ParameterArray& p, const EffectModel& model,
                       const std::vector<TrackRun>& runs, const ResidualWeights& weights,
                       int num_threads) {
+  return ScoreModel(Omni3Seam(), Vector(p), model, runs, weights, num_threads);
+}
+
+ModelScore ScoreModel(const RobotModelInterface& robot_model, const std::vector<double>& p,
+                      const EffectModel& model, const std::vector<TrackRun>& runs,
+                      const ResidualWeights& weights, int num_threads) {
   ModelScore out;
   out.runs.resize(runs.size());
   const auto active = ActiveOf(model);
@@ -223,7 +267,7 @@ ModelScore ScoreModel(const Omni3ParameterArray& p, const EffectModel& model,
     const TrackRun& run = runs[i];
     const std::size_t n = run.checkpoints.size();
     std::vector<double> err(3 * n + 3);
-    TrackPoseErrors(run, p.data(), active, run.checkpoints, err.data());
+    TrackPoseErrors(robot_model, run, p.data(), active, run.checkpoints, err.data());
     RunScore& s = out.runs[i];
     double sum_xy = 0.0, sum_th = 0.0;
     for (std::size_t j = 0; j < n; ++j) {
@@ -258,6 +302,11 @@ ModelScore ScoreModel(const Omni3ParameterArray& p, const EffectModel& model,
 
 TrackErrors ComputeTrackErrors(const Omni3ParameterArray& p, const EffectModel& model,
                                const TrackRun& run, bool all_samples) {
+  return ComputeTrackErrors(Omni3Seam(), Vector(p), model, run, all_samples);
+}
+
+TrackErrors ComputeTrackErrors(const RobotModelInterface& robot_model, const std::vector<double>& p,
+                               const EffectModel& model, const TrackRun& run, bool all_samples) {
   std::vector<int> indices = run.checkpoints;
   if (all_samples) {
     indices.clear();
@@ -278,7 +327,7 @@ TrackErrors ComputeTrackErrors(const Omni3ParameterArray& p, const EffectModel& 
                                }),
                 indices.end());
   std::vector<double> err(3 * indices.size() + 3);
-  TrackPoseErrors(run, p.data(), active, indices, err.data());
+  TrackPoseErrors(robot_model, run, p.data(), active, indices, err.data());
   TrackErrors out;
   for (std::size_t j = 0; j < indices.size(); ++j) {
     out.t_s.push_back(run.track.t_s[indices[j]]);
@@ -302,12 +351,105 @@ bool EffectFitOptions::IsValid(std::string* error) const {
   return true;
 }
 
+namespace {
+
+// The model's box (and its held parameters, at the nominal) on block p.
+void BoundModelParameters(const Robot& robot, double* p, ceres::Problem* problem) {
+  std::vector<int> held;
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    if (robot.IsHeld(k)) {
+      p[k] = robot.nominal[k];
+      held.push_back(k);
+    }
+    p[k] = std::clamp(p[k], robot.bounds[k].lo, robot.bounds[k].hi);
+    problem->SetParameterLowerBound(p, k, robot.bounds[k].lo);
+    problem->SetParameterUpperBound(p, k, robot.bounds[k].hi);
+  }
+  if (!held.empty()) {
+    problem->SetManifold(p, new ceres::SubsetManifold(robot.NumParameters(), held));
+  }
+}
+
+// The registry's box on every effect's parameters; returns how many there are.
+int BoundEffectParameters(EffectModel* model, ceres::Problem* problem) {
+  int count = 0;
+  for (auto& e : *model) {
+    const auto& info = effects::Info(e.id);
+    count += info.num_parameters;
+    for (int k = 0; k < info.num_parameters; ++k) {
+      e.value[k] = std::clamp(e.value[k], info.lower[k], info.upper[k]);
+      problem->SetParameterLowerBound(e.value.data(), k, info.lower[k]);
+      problem->SetParameterUpperBound(e.value.data(), k, info.upper[k]);
+    }
+  }
+  return count;
+}
+
+// Finite values, and whether an effect parameter rests on a bound that is not its neutral value.
+bool CheckEffectValues(const std::vector<double>& p, EffectFitResult* result) {
+  bool finite = true;
+  for (double v : p) finite = finite && std::isfinite(v);
+  for (auto& e : result->effects) {
+    const auto& info = effects::Info(e.id);
+    for (int k = 0; k < info.num_parameters; ++k) {
+      finite = finite && std::isfinite(e.value[k]);
+      const double tol = 1e-6 * (info.upper[k] - info.lower[k]);
+      // A one-sided bound at the neutral value (backlash >= 0) is a legitimate "no effect".
+      const bool neutral_bound = info.lower[k] == 0.0 && e.value[k] <= tol;
+      if (!neutral_bound &&
+          (e.value[k] <= info.lower[k] + tol || e.value[k] >= info.upper[k] - tol)) {
+        result->any_at_bound = true;
+      }
+    }
+  }
+  return finite;
+}
+
+// Sigmas of the model's and the effects' parameters (header: s^2 per run-residual).
+void ComputeEffectCovariance(ceres::Problem* problem, const std::vector<double*>& blocks, double s2,
+                             EffectFitResult* result) {
+  ceres::Covariance::Options cov_options;
+  cov_options.algorithm_type = ceres::DENSE_SVD;
+  cov_options.null_space_rank = -1;  // pseudo-inverse: aliased directions are reported, not fatal
+  ceres::Covariance covariance(cov_options);
+  std::vector<std::pair<const double*, const double*>> pairs;
+  for (double* b : blocks) pairs.emplace_back(b, b);
+  if (!covariance.Compute(pairs, problem)) return;
+  const int n = static_cast<int>(result->parameters.size());
+  // In ambient coordinates: a held parameter (SubsetManifold) gets zero variance.
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> c(n, n);
+  result->sigma.assign(n, 0.0);
+  covariance.GetCovarianceBlock(blocks[0], blocks[0], c.data());
+  for (int k = 0; k < n; ++k) result->sigma[k] = std::sqrt(std::max(0.0, s2 * c(k, k)));
+  for (auto& e : result->effects) {
+    const int m = effects::Info(e.id).num_parameters;
+    std::vector<double> ce(static_cast<std::size_t>(m * m));
+    covariance.GetCovarianceBlock(e.value.data(), e.value.data(), ce.data());
+    for (int k = 0; k < m; ++k)
+      e.sigma[k] = std::sqrt(std::max(0.0, s2 * ce[static_cast<std::size_t>(k * m + k)]));
+  }
+  result->has_covariance = true;
+}
+
+}  // namespace
+
 EffectFitResult FitEffectModel(const std::vector<TrackRun>& training, const Omni3Robot& robot,
                                const Omni3ParameterArray& start_p, const EffectModel& start,
+                               const EffectFitOptions& options) {
+  return FitEffectModel(training, *Omni3ModelOf(robot), Vector(start_p), start, options);
+}
+
+EffectFitResult FitEffectModel(const std::vector<TrackRun>& training,
+                               const RobotModelInterface& robot_model,
+                               const std::vector<double>& start_p, const EffectModel& start,
                                const EffectFitOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) throw std::invalid_argument("EffectFitOptions: " + error);
   if (training.empty()) throw std::invalid_argument("FitEffectModel: no training runs");
+  const Robot& robot = robot_model.robot();
+  if (static_cast<int>(start_p.size()) != robot.NumParameters()) {
+    throw std::invalid_argument("FitEffectModel: start has the wrong number of parameters");
+  }
   EffectFitResult result;
   result.parameters = start_p;
   result.effects = start;
@@ -318,25 +460,11 @@ EffectFitResult FitEffectModel(const std::vector<TrackRun>& training, const Omni
   std::vector<double*> blocks = {p};
   for (auto& e : result.effects) blocks.push_back(e.value.data());
   for (const TrackRun& run : training) {
-    problem.AddResidualBlock(EffectTrackResidual::Create(run, ids, options.weights), nullptr,
-                             blocks);
+    problem.AddResidualBlock(EffectTrackResidual::Create(robot_model, run, ids, options.weights),
+                             nullptr, blocks);
   }
-  const auto box = robot.ParameterBounds();
-  for (int k = 0; k < omni3::kNumParameters; ++k) {
-    p[k] = std::clamp(p[k], box[k].lo, box[k].hi);
-    problem.SetParameterLowerBound(p, k, box[k].lo);
-    problem.SetParameterUpperBound(p, k, box[k].hi);
-  }
-  int num_effect_parameters = 0;
-  for (auto& e : result.effects) {
-    const auto& info = effects::Info(e.id);
-    num_effect_parameters += info.num_parameters;
-    for (int k = 0; k < info.num_parameters; ++k) {
-      e.value[k] = std::clamp(e.value[k], info.lower[k], info.upper[k]);
-      problem.SetParameterLowerBound(e.value.data(), k, info.lower[k]);
-      problem.SetParameterUpperBound(e.value.data(), k, info.upper[k]);
-    }
-  }
+  BoundModelParameters(robot, p, &problem);
+  const int num_effect_parameters = BoundEffectParameters(&result.effects, &problem);
 
   DenseSolverTolerances tolerances;
   tolerances.function = options.function_tolerance;
@@ -349,48 +477,13 @@ EffectFitResult FitEffectModel(const std::vector<TrackRun>& training, const Omni
   result.message = summary.message;
   result.iterations = static_cast<int>(summary.iterations.size());
   result.final_cost = summary.final_cost;
-  bool finite = true;
-  for (int k = 0; k < omni3::kNumParameters; ++k) finite = finite && std::isfinite(p[k]);
-  for (auto& e : result.effects) {
-    const auto& info = effects::Info(e.id);
-    for (int k = 0; k < info.num_parameters; ++k) {
-      finite = finite && std::isfinite(e.value[k]);
-      const double tol = 1e-6 * (info.upper[k] - info.lower[k]);
-      // A one-sided bound at the neutral value (backlash >= 0) is a legitimate "no effect".
-      const bool neutral_bound = info.lower[k] == 0.0 && e.value[k] <= tol;
-      if (!neutral_bound &&
-          (e.value[k] <= info.lower[k] + tol || e.value[k] >= info.upper[k] - tol)) {
-        result.any_at_bound = true;
-      }
-    }
-  }
+  const bool finite = CheckEffectValues(result.parameters, &result);
   result.usable = finite && (summary.termination_type == ceres::CONVERGENCE ||
                              summary.termination_type == ceres::NO_CONVERGENCE);
 
-  const int dof =
-      3 * static_cast<int>(training.size()) - omni3::kNumParameters - num_effect_parameters;
+  const int dof = 3 * static_cast<int>(training.size()) - robot.NumFree() - num_effect_parameters;
   if (options.compute_covariance && result.usable && dof > 0) {
-    const double s2 = 2.0 * summary.final_cost / dof;
-    ceres::Covariance::Options cov_options;
-    cov_options.algorithm_type = ceres::DENSE_SVD;
-    cov_options.null_space_rank = -1;  // pseudo-inverse: aliased directions are reported, not fatal
-    ceres::Covariance covariance(cov_options);
-    std::vector<std::pair<const double*, const double*>> pairs;
-    for (double* b : blocks) pairs.emplace_back(b, b);
-    if (covariance.Compute(pairs, &problem)) {
-      Eigen::Matrix<double, omni3::kNumParameters, omni3::kNumParameters, Eigen::RowMajor> c9;
-      covariance.GetCovarianceBlock(p, p, c9.data());
-      for (int k = 0; k < omni3::kNumParameters; ++k)
-        result.sigma[k] = std::sqrt(std::max(0.0, s2 * c9(k, k)));
-      for (auto& e : result.effects) {
-        const int m = effects::Info(e.id).num_parameters;
-        std::vector<double> ce(static_cast<std::size_t>(m * m));
-        covariance.GetCovarianceBlock(e.value.data(), e.value.data(), ce.data());
-        for (int k = 0; k < m; ++k)
-          e.sigma[k] = std::sqrt(std::max(0.0, s2 * ce[static_cast<std::size_t>(k * m + k)]));
-      }
-      result.has_covariance = true;
-    }
+    ComputeEffectCovariance(&problem, blocks, 2.0 * summary.final_cost / dof, &result);
   }
   return result;
 }
@@ -398,12 +491,21 @@ EffectFitResult FitEffectModel(const std::vector<TrackRun>& training, const Omni
 double SeparableFraction(const std::vector<TrackRun>& training, const Omni3ParameterArray& p,
                          const EffectModel& model, EffectId candidate,
                          const ResidualWeights& weights, double* unexplained_norm) {
+  return SeparableFraction(training, Omni3Seam(), Vector(p), model, candidate, weights,
+                           unexplained_norm);
+}
+
+double SeparableFraction(const std::vector<TrackRun>& training,
+                         const RobotModelInterface& robot_model, const std::vector<double>& p,
+                         const EffectModel& model, EffectId candidate,
+                         const ResidualWeights& weights, double* unexplained_norm) {
+  const int num_parameters = robot_model.robot().NumParameters();
   EffectModel with = model;
   effects::EffectValue c;
   c.id = candidate;
   with.push_back(c);
   const std::vector<EffectId> ids = IdsOf(with);
-  int cols = omni3::kNumParameters;
+  int cols = num_parameters;
   for (EffectId id : ids) cols += effects::Info(id).num_parameters;
   const int m_c = effects::Info(candidate).num_parameters;
   int rows = 0;
@@ -411,7 +513,8 @@ double SeparableFraction(const std::vector<TrackRun>& training, const Omni3Param
   Eigen::MatrixXd jac(rows, cols);
   int row = 0;
   for (const TrackRun& run : training) {
-    std::unique_ptr<ceres::CostFunction> cost(EffectTrackResidual::Create(run, ids, weights));
+    std::unique_ptr<ceres::CostFunction> cost(
+        EffectTrackResidual::Create(robot_model, run, ids, weights));
     const int n = cost->num_residuals();
     std::vector<const double*> params = {p.data()};
     for (const auto& e : with) params.push_back(e.value.data());
@@ -419,14 +522,14 @@ double SeparableFraction(const std::vector<TrackRun>& training, const Omni3Param
     std::vector<std::vector<double>> jb(params.size());
     std::vector<double*> jptr(params.size());
     for (std::size_t b = 0; b < params.size(); ++b) {
-      const int size = b == 0 ? omni3::kNumParameters : effects::Info(ids[b - 1]).num_parameters;
+      const int size = b == 0 ? num_parameters : effects::Info(ids[b - 1]).num_parameters;
       jb[b].resize(static_cast<std::size_t>(n * size));
       jptr[b] = jb[b].data();
     }
     cost->Evaluate(params.data(), residual.data(), jptr.data());
     int col = 0;
     for (std::size_t b = 0; b < params.size(); ++b) {
-      const int size = b == 0 ? omni3::kNumParameters : effects::Info(ids[b - 1]).num_parameters;
+      const int size = b == 0 ? num_parameters : effects::Info(ids[b - 1]).num_parameters;
       for (int r = 0; r < n; ++r) {
         for (int k = 0; k < size; ++k)
           jac(row + r, col + k) = jb[b][static_cast<std::size_t>(r * size + k)];

@@ -1,5 +1,6 @@
 #pragma once
-// The nine omni3 parameters plus candidate effects (odometry/effects.h), fitted to the whole
+// A robot model's parameters (models/model_interface.h; the nine of omni3 in the overloads that
+// take an Omni3ParameterArray) plus candidate effects (odometry/effects.h), fitted to the whole
 // ground-truth track of each run. The final pose alone cannot see every effect (a clock latency
 // vanishes when runs end at rest), so the residual of a run is the pose error at every
 // ground-truth sample of its window ("checkpoints"):
@@ -7,8 +8,8 @@
 //   r_j = [ (x(t_j - tau) - x_gt_j) / sigma_xy, (y(...) - y_gt_j) / sigma_xy,
 //           wrap(theta(...) - theta_gt_j) / sigma_theta ] / sqrt(n_checkpoints)
 //
-// with the replay of odometry/effects.h (Palacin Eq. 4 + effect stages) started at the ground
-// truth at t_start + tau; tau is the time-offset effect's latency (0 without it). The
+// with the replay of odometry/effects.h (the model's steps, Palacin Eq. 4, + effect stages) started
+// at the ground truth at t_start + tau; tau is the time-offset effect's latency (0 without it). The
 // 1/sqrt(n) weight makes a run's squared residual its mean squared track error, so every run
 // counts once, whatever its length. One functor serves Ceres (dynamic autodiff) and the
 // double-valued scoring.
@@ -20,6 +21,7 @@
 #include "calib/aligned_run.h"
 #include "calib/final_pose_cost.h"
 #include "calib/final_pose_residual.h"
+#include "models/model_interface.h"
 #include "odometry/effects.h"
 #include "odometry/robot_description.h"
 #include "odometry/run_log.h"
@@ -52,9 +54,15 @@ struct TrackOptions {
   bool IsValid(std::string* error) const;
 };
 
+// Every channel a wheel rate (omni3's three), or those of wheel_mask (WheelChannelMask).
 TrackRun PrepareTrackRun(const RunLog& run, const TrackOptions& options = {});
+TrackRun PrepareTrackRun(const RunLog& run, unsigned wheel_mask, const TrackOptions& options = {});
 std::vector<TrackRun> PrepareTrackRuns(const std::vector<RunLog>& runs,
                                        const TrackOptions& options = {});
+std::vector<TrackRun> PrepareTrackRuns(const std::vector<RunLog>& runs, unsigned wheel_mask,
+                                       const TrackOptions& options = {});
+// Bit i set when the robot's channel i is a wheel rate (effects::SampleContext::wheel_mask).
+unsigned WheelChannelMask(const Robot& robot);
 // Training/validation by repetition (as calib/run_split.h).
 void SplitTrackRuns(std::vector<TrackRun> runs, const std::vector<int>& training_reps,
                     std::vector<TrackRun>* training, std::vector<TrackRun>* validation);
@@ -78,6 +86,9 @@ struct ModelScore {
   double track_rmse_rad = 0.0;
 };
 
+ModelScore ScoreModel(const RobotModelInterface& robot_model, const std::vector<double>& p,
+                      const EffectModel& model, const std::vector<TrackRun>& runs,
+                      const ResidualWeights& weights = {}, int num_threads = 0);
 ModelScore ScoreModel(const Omni3ParameterArray& p, const EffectModel& model,
                       const std::vector<TrackRun>& runs, const ResidualWeights& weights = {},
                       int num_threads = 0);
@@ -90,6 +101,8 @@ struct TrackErrors {
   std::vector<Pose2d> error;  // x, y in m (world), theta wrapped (rad)
   Pose2d final_error;         // at the window's end, as RunScore's final_d* (Eq. 14's residual)
 };
+TrackErrors ComputeTrackErrors(const RobotModelInterface& robot_model, const std::vector<double>& p,
+                               const EffectModel& model, const TrackRun& run, bool all_samples);
 TrackErrors ComputeTrackErrors(const Omni3ParameterArray& p, const EffectModel& model,
                                const TrackRun& run, bool all_samples);
 
@@ -110,19 +123,24 @@ struct EffectFitResult {
   std::string termination;
   std::string message;
   int iterations = 0;
-  double final_cost = 0.0;  // 0.5 * sum of per-run objectives
-  Omni3ParameterArray parameters{};
-  Omni3ParameterArray sigma{};  // one sigma of the nine (when has_covariance)
-  EffectModel effects;          // fitted values and sigmas
+  double final_cost = 0.0;         // 0.5 * sum of per-run objectives
+  std::vector<double> parameters;  // the model's (robot().parameters order)
+  std::vector<double> sigma;       // one sigma of each (when has_covariance; 0 when held)
+  EffectModel effects;             // fitted values and sigmas
   bool has_covariance = false;
   bool any_at_bound = false;
 };
 
-// Fits the nine parameters (started at start_p, bounded by the robot's box) and the effects'
-// parameters (started at the values in `start`, bounded by the registry) to the training runs.
+// Fits the model's parameters (started at start_p, bounded by the robot's box, held parameters
+// at their nominal) and the effects' parameters (started at the values in `start`, bounded by
+// the registry) to the training runs.
 // Covariance: Ceres' covariance scaled by s^2 = sum of run objectives / (3 N_runs - k), i.e. each
 // run counts as three independent residuals (a run's checkpoints are correlated through the
 // drift, so counting them all would understate the uncertainty).
+EffectFitResult FitEffectModel(const std::vector<TrackRun>& training,
+                               const RobotModelInterface& robot_model,
+                               const std::vector<double>& start_p, const EffectModel& start,
+                               const EffectFitOptions& options = {});
 EffectFitResult FitEffectModel(const std::vector<TrackRun>& training, const Omni3Robot& robot,
                                const Omni3ParameterArray& start_p, const EffectModel& start,
                                const EffectFitOptions& options = {});
@@ -135,6 +153,10 @@ EffectFitResult FitEffectModel(const std::vector<TrackRun>& training, const Omni
 // "separable"; *unexplained_norm (optional) gets |(I - P) J_c| itself, so that
 // sigma_c ~ s / |(I - P) J_c| (s the residual RMS) predicts how well the runs could determine the
 // candidate before fitting it.
+double SeparableFraction(const std::vector<TrackRun>& training,
+                         const RobotModelInterface& robot_model, const std::vector<double>& p,
+                         const EffectModel& model, effects::EffectId candidate,
+                         const ResidualWeights& weights = {}, double* unexplained_norm = nullptr);
 double SeparableFraction(const std::vector<TrackRun>& training, const Omni3ParameterArray& p,
                          const EffectModel& model, effects::EffectId candidate,
                          const ResidualWeights& weights = {}, double* unexplained_norm = nullptr);

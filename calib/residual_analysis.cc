@@ -7,6 +7,7 @@
 #include <map>
 
 #include "calib/statistics.h"
+#include "models/omni3/omni3_robot_model.h"
 #include "odometry/parallel_for.h"
 
 namespace fitcal {
@@ -37,21 +38,23 @@ std::string FamilyOf(const std::string& label) {
   return out.empty() ? "-" : out;
 }
 
-RunFeatures Features(const Omni3ParameterArray& p, const TrackRun& run) {
+RunFeatures Features(const RobotModelInterface& robot_model, const std::vector<double>& p,
+                     const TrackRun& run) {
   RunFeatures f;
   f.id = run.aligned.id;
   f.trajectory = run.aligned.trajectory;
   f.family = FamilyOf(run.aligned.trajectory);
   f.repetition = run.aligned.repetition;
-  const auto m_inv = omni3::InverseKinematicMatrix(p.data());
+  const auto kinematics = robot_model.PrepareKinematics(p.data());
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   double time = 0.0;
   bool any = false;
   for (std::size_t k = 0; k < run.aligned.samples.size(); ++k) {
     if (!run.contexts[k].moving) continue;
     const auto s = run.aligned.samples[k];
-    const Eigen::Vector3d w(s.value[0], s.value[1], s.value[2]);
-    sum += s.dt_s * (m_inv * w);
+    Eigen::Vector3d step;
+    kinematics->Step(s.value, s.dt_s, &step[0], &step[1], &step[2]);
+    sum += step;
     time += s.dt_s;
     if (!any) f.motion_begin_s = run.contexts[k].t_s;
     f.motion_end_s = run.contexts[k].t_s + s.dt_s;
@@ -115,6 +118,13 @@ void Accumulate(std::map<std::string, GroupStat>& groups, const std::string& by,
 
 ResidualAnalysis AnalyzeResiduals(const Omni3ParameterArray& p, const EffectModel& model,
                                   const std::vector<TrackRun>& runs, int num_threads) {
+  static const std::shared_ptr<const Omni3Model> omni3_model = Omni3ModelOf(Omni3Robot{});
+  return AnalyzeResiduals(*omni3_model, {p.begin(), p.end()}, model, runs, num_threads);
+}
+
+ResidualAnalysis AnalyzeResiduals(const RobotModelInterface& robot_model,
+                                  const std::vector<double>& p, const EffectModel& model,
+                                  const std::vector<TrackRun>& runs, int num_threads) {
   ResidualAnalysis out;
   const std::size_t n = runs.size();
   out.runs.resize(n);
@@ -124,8 +134,8 @@ ResidualAnalysis AnalyzeResiduals(const Omni3ParameterArray& p, const EffectMode
   std::vector<std::array<double, 3>> checkpoint_times(n);
   ParallelFor(n, num_threads, [&](std::size_t i) {
     const TrackRun& run = runs[i];
-    out.runs[i] = Features(p, run);
-    out.track[i] = ComputeTrackErrors(p, model, run, /*all_samples=*/true);
+    out.runs[i] = Features(robot_model, p, run);
+    out.track[i] = ComputeTrackErrors(robot_model, p, model, run, /*all_samples=*/true);
     const double theta0 = run.aligned.start.theta;
     out.final_start_frame[i] = ToFrame(out.track[i].final_error, theta0);
     const RunFeatures& f = out.runs[i];
@@ -139,18 +149,19 @@ ResidualAnalysis AnalyzeResiduals(const Omni3ParameterArray& p, const EffectMode
   // times held): the lack of fit is what no change of the fitted parameters can remove.
   std::vector<std::vector<Lof>> lof_jacobian;  // [parameter][run]
   // One column: the components' change per unit of the parameter that p_k / model_k moved by h.
-  const auto add_column = [&](const Omni3ParameterArray& p_k, const EffectModel& model_k,
+  const auto add_column = [&](const std::vector<double>& p_k, const EffectModel& model_k,
                               double h) {
     std::vector<Lof> column(n);
     ParallelFor(n, num_threads, [&](std::size_t i) {
-      const TrackErrors moved = ComputeTrackErrors(p_k, model_k, runs[i], true);
+      const TrackErrors moved = ComputeTrackErrors(robot_model, p_k, model_k, runs[i], true);
       const Lof x = LofComponents(moved, checkpoint_times[i], runs[i].aligned.start.theta);
       for (int c = 0; c < kLofComponents; ++c) column[i][c] = (x[c] - lof[i][c]) / h;
     });
     lof_jacobian.push_back(std::move(column));
   };
-  for (int k = 0; k < omni3::kNumParameters; ++k) {
-    Omni3ParameterArray p_k = p;
+  for (int k = 0; k < static_cast<int>(p.size()); ++k) {
+    if (robot_model.robot().IsHeld(k)) continue;  // gauge: no refit can move it
+    std::vector<double> p_k = p;
     const double h = 1e-6 * std::max(std::abs(p[k]), 1e-3);
     p_k[k] += h;
     add_column(p_k, model, h);
@@ -301,8 +312,8 @@ ResidualAnalysis AnalyzeResiduals(const Omni3ParameterArray& p, const EffectMode
       while (k + 1 < run.contexts.size() && run.contexts[k + 1].t_s <= mid) ++k;
       const auto& c = run.contexts[k];
       double accel = 0.0, dir = 0.0;
-      for (int w = 0; w < 3; ++w) {
-        if (std::abs(c.accel_rad_s2[w]) > std::abs(accel)) {
+      for (int w = 0; w < c.num_channels; ++w) {
+        if (c.IsWheel(w) && std::abs(c.accel_rad_s2[w]) > std::abs(accel)) {
           accel = c.accel_rad_s2[w];
           dir = run.aligned.samples[k].value[w];
         }

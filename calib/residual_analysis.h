@@ -16,7 +16,7 @@
 //   covariance S (rank r; trajectories with at least two repetitions):
 //     S      = sum_traj sum_rep (e - mean_traj e)(...)^T / D,   D = sum_traj (n_traj - 1)
 //     SS_lof = min_delta sum_traj n_traj |S^-1/2 (mean_traj e - J_traj delta)|^2
-//   where J_traj is the mean derivative of e with respect to every fitted parameter (nine plus
+//   where J_traj is the mean derivative of e with respect to every fitted parameter (model plus
 //   the effects', forward differences): what a refit on all runs could still remove is not lack
 //   of fit. df_lof = r * n_traj - (identifiable parameters), df_pe = D - r + 1 (Hotelling);
 //   F = SS_lof / df_lof, p = P(F(df_lof, df_pe) > F).
@@ -71,6 +71,9 @@ struct ResidualAnalysis {
 
 // The lack-of-fit test counts as fitted every parameter of p and of the model's effects (it
 // subtracts their linearised refit on all runs).
+ResidualAnalysis AnalyzeResiduals(const RobotModelInterface& robot_model,
+                                  const std::vector<double>& p, const EffectModel& model,
+                                  const std::vector<TrackRun>& runs, int num_threads = 0);
 ResidualAnalysis AnalyzeResiduals(const Omni3ParameterArray& p, const EffectModel& model,
                                   const std::vector<TrackRun>& runs, int num_threads = 0);
 

@@ -29,6 +29,7 @@
 #include <ceres/autodiff_cost_function.h>
 
 #include <algorithm>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -47,8 +48,8 @@ Pose2<T> ReplayKinematics(const K& kinematics, const T* p, const EncoderSamples&
                           std::size_t begin, std::size_t end, const Pose2<T>& start,
                           Visitor&& visit = Visitor()) {
   const auto prepared = kinematics.Prepare(p);
-  const auto step = [&kinematics, &prepared](const double* values, double dt, T* dx, T* dy,
-                                             T* dtheta) __attribute__((always_inline)) {
+  const auto step = [&kinematics, &prepared ](const double* values, double dt, T* dx, T* dy,
+                                              T* dtheta) __attribute__((always_inline)) {
     kinematics.BodyStep(prepared, values, dt, dx, dy, dtheta);
   };
   return ReplaySteps(step, samples, begin, end, start, std::forward<Visitor>(visit));
@@ -151,6 +152,21 @@ class KinematicModel : public RobotModelInterface {
  public:
   using Kinematics = K;
 
+  // K's prepared parameters behind the PreparedKinematics interface.
+  template <typename T>
+  class Prepared final : public PreparedKinematics<T> {
+   public:
+    Prepared(const K& kinematics, const T* p)
+        : kinematics_(kinematics), prepared_(kinematics.Prepare(p)) {}
+    void Step(const T* values, double dt, T* dx, T* dy, T* dtheta) const override {
+      kinematics_.BodyStep(prepared_, values, dt, dx, dy, dtheta);
+    }
+
+   private:
+    const K& kinematics_;
+    decltype(std::declval<const K&>().Prepare(static_cast<const T*>(nullptr))) prepared_;
+  };
+
   explicit KinematicModel(Robot robot, K kinematics = K())
       : robot_(std::move(robot)), kinematics_(std::move(kinematics)) {}
 
@@ -189,6 +205,15 @@ class KinematicModel : public RobotModelInterface {
 
   bool ChannelsForTwist(const double* p, const Twist& twist, double* values) const override {
     return kinematics_.ChannelsForTwist(p, twist, values);
+  }
+
+  std::unique_ptr<const PreparedKinematics<double>> PrepareKinematics(
+      const double* p) const override {
+    return std::make_unique<Prepared<double>>(kinematics_, p);
+  }
+  std::unique_ptr<const PreparedKinematics<EffectJet>> PrepareKinematics(
+      const EffectJet* p) const override {
+    return std::make_unique<Prepared<EffectJet>>(kinematics_, p);
   }
 
  protected:

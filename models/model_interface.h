@@ -15,6 +15,7 @@
 //   - optionally classical calibrations (closed forms) that compete with the fits.
 
 #include <ceres/cost_function.h>
+#include <ceres/jet.h>
 
 #include <functional>
 #include <memory>
@@ -72,6 +73,20 @@ struct ClosedFormCalibration {
   std::string note;  // e.g. which runs it used
 };
 
+// A model's kinematics at fixed parameters, for replays that transform the channel values or the
+// body step on the way (the effect library, odometry/effects.h). T is double or EffectJet.
+template <typename T>
+class PreparedKinematics {
+ public:
+  virtual ~PreparedKinematics() = default;
+  // The body-frame step (dx, dy, dtheta) of one encoder interval of length dt from its channel
+  // values (robot().channels order), as the plain replay computes it.
+  virtual void Step(const T* values, double dt, T* dx, T* dy, T* dtheta) const = 0;
+};
+// The scalar of the effect fit's dynamic autodiff (calib/effect_fit.cc differentiates four
+// parameters per pass).
+using EffectJet = ceres::Jet<double, 4>;
+
 // Called with the sample index k and the pose after sample k.
 using PoseVisitor = std::function<void(std::size_t k, const Pose2d& pose)>;
 
@@ -99,6 +114,12 @@ class RobotModelInterface {
   virtual ceres::CostFunction* SegmentCost(const AlignedRun& run,
                                            const std::vector<Segment>& segments,
                                            const ResidualWeights& weights) const = 0;
+
+  // The kinematics at parameters p for the effect replay (PreparedKinematics above).
+  virtual std::unique_ptr<const PreparedKinematics<double>> PrepareKinematics(
+      const double* p) const = 0;
+  virtual std::unique_ptr<const PreparedKinematics<EffectJet>> PrepareKinematics(
+      const EffectJet* p) const = 0;
 
   // Channel values (robot().channels order) that realise the body twist with parameters p, or
   // false when the model cannot drive that twist (e.g. a sideways motion of a differential drive).

@@ -1,7 +1,9 @@
 #include "odometry/effects.h"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
+#include <string>
 
 namespace fitcal::effects {
 
@@ -143,6 +145,30 @@ const std::array<EffectInfo, kNumEffects>& EffectTable() {
        "the distances R_i, exactly (R_i' = R_i - e_x cos delta_i - e_y sin delta_i), on any data",
        "none from odometry: measure the offset (or hold the R_i at measured values); fitted R_i "
        "far from the measured ones with a common mean suggest it"},
+      {EffectId::kSteeringScale,
+       "steering_scale",
+       "the steered wheel turns (1 + k) times the measured steering angle",
+       "phi' = phi (1 + k)",
+       1,
+       {"scale", ""},
+       {-0.2, 0},
+       {0.2, 0},
+       {0.05, 0},
+       true,
+       "the wheelbase when every run turns at one steering angle",
+       "runs at two or more steering angles, turning both ways (circles of several radii)"},
+      {EffectId::kSteeringLag,
+       "steering_lag",
+       "the measured steering angle lags the wheel's",
+       "phi' = phi + tau dphi/dt",
+       1,
+       {"lag_s", ""},
+       {-0.5, 0},
+       {0.5, 0},
+       {0.1, 0},
+       true,
+       "nothing while the steering angle is constant",
+       "runs that change the steering angle while driving (squares, slaloms)"},
   }};
   return table;
 }
@@ -157,39 +183,66 @@ EffectId EffectIdFromName(const std::string& name) {
   throw std::invalid_argument("unknown effect '" + name + "' (known: " + known + ")");
 }
 
-std::vector<SampleContext> MakeSampleContexts(const EncoderSamples& samples) {
+namespace {
+
+// Linear interpolation of a series (t, value) at `time`, clamped to its ends.
+double InterpolateAt(const std::vector<double>& t, const std::vector<double>& v, double time) {
+  if (time <= t.front()) return v.front();
+  if (time >= t.back()) return v.back();
+  const std::size_t j =
+      static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), time) - t.begin()) - 1;
+  const double span = t[j + 1] - t[j];
+  const double f = span > 0.0 ? (time - t[j]) / span : 0.0;
+  return v[j] + f * (v[j + 1] - v[j]);
+}
+
+}  // namespace
+
+std::vector<SampleContext> MakeSampleContexts(const EncoderSamples& samples, unsigned wheel_mask) {
   const std::size_t n = samples.size();
+  const int channels = samples.num_channels();
+  if (channels > kMaxEffectChannels) {
+    throw std::invalid_argument("the effect replay handles at most " +
+                                std::to_string(kMaxEffectChannels) + " channels, not " +
+                                std::to_string(channels));
+  }
   std::vector<SampleContext> out(n);
-  // Sample boundary times and cumulative encoder angles.
-  std::vector<double> t(n + 1, 0.0);
-  std::vector<std::array<double, 3>> angle(n + 1, {0.0, 0.0, 0.0});
+  if (n == 0) return out;
+  // Sample boundary times, cumulative encoder angles (wheels) and the angle channels' values at
+  // each interval's middle.
+  std::vector<double> t(n + 1, 0.0), mid(n, 0.0);
+  std::vector<std::vector<double>> cumulative(channels, std::vector<double>(n + 1, 0.0));
+  std::vector<std::vector<double>> value(channels, std::vector<double>(n, 0.0));
   for (std::size_t k = 0; k < n; ++k) {
     t[k + 1] = t[k] + samples[k].dt_s;
-    for (int i = 0; i < 3; ++i)
-      angle[k + 1][i] = angle[k][i] + samples[k].value[i] * samples[k].dt_s;
+    mid[k] = t[k] + 0.5 * samples[k].dt_s;
+    for (int i = 0; i < channels; ++i) {
+      cumulative[i][k + 1] = cumulative[i][k] + samples[k].value[i] * samples[k].dt_s;
+      value[i][k] = samples[k].value[i];
+    }
   }
-  // Angle at an arbitrary time by linear interpolation (clamped to the run).
-  const auto angle_at = [&](double time, int wheel) {
-    if (time <= t.front()) return angle.front()[wheel];
-    if (time >= t.back()) return angle.back()[wheel];
-    const std::size_t j =
-        static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), time) - t.begin()) - 1;
-    const double span = t[j + 1] - t[j];
-    const double f = span > 0.0 ? (time - t[j]) / span : 0.0;
-    return angle[j][wheel] + f * (angle[j + 1][wheel] - angle[j][wheel]);
-  };
   const double h = kAccelerationWindowS;
   for (std::size_t k = 0; k < n; ++k) {
     SampleContext& c = out[k];
     c.t_s = t[k];
     c.dt_s = samples[k].dt_s;
-    const double mid = t[k] + 0.5 * c.dt_s;
-    for (int i = 0; i < 3; ++i) {
-      c.angle_rad[i] = angle[k][i];
-      const double ahead = (angle_at(mid + h, i) - angle_at(mid, i)) / h;
-      const double behind = (angle_at(mid, i) - angle_at(mid - h, i)) / h;
-      c.accel_rad_s2[i] = (ahead - behind) / h;
-      c.moving = c.moving || std::abs(samples[k].value[i]) > kMovingRateRadS;
+    c.num_channels = channels;
+    c.wheel_mask = wheel_mask & ((1u << channels) - 1u);
+    for (int i = 0; i < channels; ++i) {
+      if (c.IsWheel(i)) {
+        c.angle_rad[i] = cumulative[i][k];
+        const auto angle_at = [&](double time) { return InterpolateAt(t, cumulative[i], time); };
+        const double ahead = (angle_at(mid[k] + h) - angle_at(mid[k])) / h;
+        const double behind = (angle_at(mid[k]) - angle_at(mid[k] - h)) / h;
+        c.accel_rad_s2[i] = (ahead - behind) / h;
+        c.moving = c.moving || std::abs(samples[k].value[i]) > kMovingRateRadS;
+      } else {
+        c.angle_rad[i] = value[i][k];
+        c.angle_rate_rad_s[i] = n < 2 ? 0.0
+                                      : (InterpolateAt(mid, value[i], mid[k] + h) -
+                                         InterpolateAt(mid, value[i], mid[k] - h)) /
+                                            (2.0 * h);
+      }
     }
   }
   return out;

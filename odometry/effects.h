@@ -1,11 +1,14 @@
 #pragma once
-// Candidate effects that the nine-parameter omni3 model (Palacin Eq. 3-6) lacks, as a registry.
+// Candidate effects that a robot's kinematic model lacks (Palacin Eq. 3-6 for omni3; any model
+// of models/model_interface.h), as a registry.
 //
 // Each effect is a small struct with its own parameters (q, at most kMaxEffectParameters, all
 // neutral at 0) and a templated transform of one stage of the replay, so that Ceres can
 // differentiate through it and the simulator can inject it:
-//   rates  - the wheel rates of one encoder interval, in place, before M^-1 (Eq. 4)
-//   body   - the robot-frame velocity (vx, vy, omega) = M^-1 w, in place
+//   rates  - the channel values of one encoder interval, in place, before the model's kinematics
+//            (M^-1 of Eq. 4 for omni3): wheel effects act on the wheel-rate channels, steering
+//            effects on the angle channels (a tricycle's steering angle)
+//   body   - the robot-frame velocity (vx, vy, omega) the kinematics give, in place
 //   world  - an additive world-frame velocity (vx, vy) while the robot moves
 //   latency- a clock offset between the ground truth and the encoders (used by the residual)
 // The table EffectTable() lists every effect's description (names, units, bounds, a realistic
@@ -22,6 +25,7 @@
 #include <cstddef>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "odometry/encoder_samples.h"
@@ -42,19 +46,32 @@ enum class EffectId : int {
   kEncoderClockScale,
   kTranslationYawGain,
   kGroundTruthOffset,
+  kSteeringScale,
+  kSteeringLag,
   kCount
 };
 inline constexpr int kNumEffects = static_cast<int>(EffectId::kCount);
 inline constexpr int kMaxEffectParameters = 2;
 
+// The most channels an effect replay handles (the omni model's eight wheels).
+inline constexpr int kMaxEffectChannels = 8;
+
 // What an effect may look at for one encoder interval (data only, computed once per run by
-// MakeSampleContexts). Times from the start of the replay window.
+// MakeSampleContexts). Times from the start of the replay window. Per channel i:
+//   wheel-rate channel: angle_rad = encoder angle since the window start at t_s, accel_rad_s2 =
+//     smoothed wheel acceleration (see below);
+//   angle channel (steering): angle_rad = the measured angle of the interval, angle_rate_rad_s =
+//     its smoothed rate of change.
 struct SampleContext {
   double t_s = 0.0;  // start of the interval
   double dt_s = 0.0;
-  double angle_rad[3] = {0.0, 0.0, 0.0};     // encoder angle since the window start, at t_s
-  double accel_rad_s2[3] = {0.0, 0.0, 0.0};  // smoothed wheel acceleration (see below)
-  bool moving = false;                       // any wheel turning faster than kMovingRate
+  int num_channels = 3;
+  unsigned wheel_mask = 0x7;  // bit i set: channel i is a wheel rate
+  double angle_rad[kMaxEffectChannels] = {};
+  double accel_rad_s2[kMaxEffectChannels] = {};
+  double angle_rate_rad_s[kMaxEffectChannels] = {};
+  bool moving = false;  // any wheel turning faster than kMovingRate
+  bool IsWheel(int i) const { return (wheel_mask >> i) & 1u; }
 };
 
 inline constexpr double kMovingRateRadS = 0.05;
@@ -63,8 +80,11 @@ inline constexpr double kMovingRateRadS = 0.05;
 // 0.15 rad/s), a 50 ms window keeps start/stop transients (time constants ~0.1 s) visible.
 inline constexpr double kAccelerationWindowS = 0.05;
 
-// Precomputes the contexts of a run's samples.
-std::vector<SampleContext> MakeSampleContexts(const EncoderSamples& samples);
+// Precomputes the contexts of a run's samples; wheel_mask as SampleContext's (default: every
+// channel is a wheel rate, as omni3's three). Throws std::invalid_argument for more than
+// kMaxEffectChannels channels.
+std::vector<SampleContext> MakeSampleContexts(const EncoderSamples& samples,
+                                              unsigned wheel_mask = ~0u);
 
 struct EffectInfo {
   EffectId id;
@@ -86,6 +106,10 @@ const std::array<EffectInfo, kNumEffects>& EffectTable();
 inline const EffectInfo& Info(EffectId id) { return EffectTable()[static_cast<int>(id)]; }
 // Throws std::invalid_argument for an unknown name.
 EffectId EffectIdFromName(const std::string& name);
+// Steering effects transform angle channels only: a robot without one cannot show them.
+inline bool NeedsAngleChannel(EffectId id) {
+  return id == EffectId::kSteeringScale || id == EffectId::kSteeringLag;
+}
 
 // An effect with its parameter values (and one-sigma uncertainties when fitted).
 struct EffectValue {
@@ -114,17 +138,20 @@ struct TimeOffset {
 // Wheel-speed-dependent slip: effective radius r_i (1 - k |w_i|), k in s/rad.
 struct WheelSpeedSlip {
   template <typename T>
-  static void Rates(const T* q, const SampleContext&, T* w) {
+  static void Rates(const T* q, const SampleContext& c, T* w) {
     using std::abs;
-    for (int i = 0; i < 3; ++i) w[i] = w[i] * (T(1.0) - q[0] * abs(w[i]));
+    for (int i = 0; i < c.num_channels; ++i) {
+      if (c.IsWheel(i)) w[i] = w[i] * (T(1.0) - q[0] * abs(w[i]));
+    }
   }
 };
 
 // Direction-dependent radius: r_i (1 + a) turning forward (w > 0), r_i (1 - a) backward.
 struct DirectionRadius {
   template <typename T>
-  static void Rates(const T* q, const SampleContext&, T* w) {
-    for (int i = 0; i < 3; ++i) {
+  static void Rates(const T* q, const SampleContext& c, T* w) {
+    for (int i = 0; i < c.num_channels; ++i) {
+      if (!c.IsWheel(i)) continue;
       const double sign = w[i] > T(0.0) ? 1.0 : -1.0;
       w[i] = w[i] * (T(1.0) + q[0] * T(sign));
     }
@@ -136,7 +163,9 @@ struct DirectionRadius {
 struct AccelerationSlip {
   template <typename T>
   static void Rates(const T* q, const SampleContext& c, T* w) {
-    for (int i = 0; i < 3; ++i) w[i] = w[i] * (T(1.0) - q[0] * T(std::abs(c.accel_rad_s2[i])));
+    for (int i = 0; i < c.num_channels; ++i) {
+      if (c.IsWheel(i)) w[i] = w[i] * (T(1.0) - q[0] * T(std::abs(c.accel_rad_s2[i])));
+    }
   }
 };
 
@@ -152,7 +181,8 @@ struct Backlash {
   template <typename T>
   static void Rates(const T* q, const SampleContext& c, T* w) {
     if (!(c.dt_s > 0.0)) return;
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; i < c.num_channels; ++i) {
+      if (!c.IsWheel(i)) continue;
       const double a0 = c.angle_rad[i];
       // The interval's encoder angle; w is the measured rate here (rates effects run first).
       const double a1 = a0 + ToDouble(w[i]) * c.dt_s;
@@ -198,7 +228,8 @@ struct YawRateSlip {
 struct OncePerRevolution {
   template <typename T>
   static void Rates(const T* q, const SampleContext& c, T* w) {
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; i < c.num_channels; ++i) {
+      if (!c.IsWheel(i)) continue;
       const double a = c.angle_rad[i] + 0.5 * Backlash::ToDouble(w[i]) * c.dt_s;
       w[i] = w[i] * (T(1.0) + q[0] * T(std::cos(a)) + q[1] * T(std::sin(a)));
     }
@@ -206,11 +237,13 @@ struct OncePerRevolution {
 };
 
 // Encoder clock scale s: the encoder clock runs fast by (1 + s), so every logged rate is low by
-// 1/(1 + s). Multiplies all three wheel rates by one constant: exactly a common radius scale.
+// 1/(1 + s). Multiplies every wheel rate by one constant: exactly a common radius scale.
 struct EncoderClockScale {
   template <typename T>
-  static void Rates(const T* q, const SampleContext&, T* w) {
-    for (int i = 0; i < 3; ++i) w[i] = w[i] * (T(1.0) + q[0]);
+  static void Rates(const T* q, const SampleContext& c, T* w) {
+    for (int i = 0; i < c.num_channels; ++i) {
+      if (c.IsWheel(i)) w[i] = w[i] * (T(1.0) + q[0]);
+    }
   }
 };
 
@@ -249,6 +282,30 @@ struct GroundTruthOffset {
   }
 };
 
+// Steering-angle scale k: the wheel turns (1 + k) times the measured angle (a potentiometer's
+// gain, a linkage ratio). On an angle channel: phi' = phi (1 + k). The steering offset is the
+// tricycle's own parameter; the scale is what the offset cannot absorb (turns both ways).
+struct SteeringScale {
+  template <typename T>
+  static void Rates(const T* q, const SampleContext& c, T* w) {
+    for (int i = 0; i < c.num_channels; ++i) {
+      if (!c.IsWheel(i)) w[i] = w[i] * (T(1.0) + q[0]);
+    }
+  }
+};
+
+// Steering lag tau (s): the measured angle lags the wheel's by tau (actuator or sensor
+// filtering), phi_true(t) = phi_measured(t + tau) ~ phi + tau dphi/dt to first order, with the
+// smoothed angle rate of the context.
+struct SteeringLag {
+  template <typename T>
+  static void Rates(const T* q, const SampleContext& c, T* w) {
+    for (int i = 0; i < c.num_channels; ++i) {
+      if (!c.IsWheel(i)) w[i] = w[i] + q[0] * T(c.angle_rate_rad_s[i]);
+    }
+  }
+};
+
 template <typename T>
 struct EffectOps {
   void (*rates)(const T* q, const SampleContext& c, T* w) = nullptr;
@@ -272,6 +329,8 @@ const std::array<EffectOps<T>, kNumEffects>& EffectOpsTable() {
       {&EncoderClockScale::Rates<T>, nullptr, nullptr, nullptr},
       {nullptr, &TranslationYawGain::Body<T>, nullptr, nullptr},
       {nullptr, &GroundTruthOffset::Body<T>, nullptr, nullptr},
+      {&SteeringScale::Rates<T>, nullptr, nullptr, nullptr},
+      {&SteeringLag::Rates<T>, nullptr, nullptr, nullptr},
   }};
   return table;
 }
@@ -309,42 +368,72 @@ T TotalLatency(const std::vector<ActiveEffect<T>>& active) {
   return tau;
 }
 
-// Dead reckoning with effects, Palacin Eq. 4 with the stages above:
-//   w' = rates(w);  v = body(M^-1 w');  pose += dt (R(theta)^-1 v + world(v))
-// visit(k, pose before sample k, pose after it). Returns the final pose.
-template <typename T, typename Visitor>
-Pose2<T> ReplayWithEffects(const T* p, const std::vector<ActiveEffect<T>>& active,
-                           const EncoderSamples& samples,
-                           const std::vector<SampleContext>& contexts, const Pose2<T>& start,
-                           Visitor&& visit) {
+// Dead reckoning with effects, Palacin Eq. 4 (the generic replay of odometry/replay.h) with the
+// stages above:
+//   w' = rates(w);  (dx, dy, dtheta) = step(w', dt);  v = body((dx, dy, dtheta) / dt);
+//   pose += R(theta) v dt + world(v) dt
+// `step(values, dt, &dx, &dy, &dtheta)` is the model's body step (PreparedKinematics::Step;
+// dt M^-1 w for omni3). Without body effects the step is used as it is, so the replay equals the
+// plain one. visit(k, pose before sample k, pose after it). Returns the final pose.
+template <typename T, typename Step, typename Visitor>
+Pose2<T> ReplayStepsWithEffects(const Step& step, const std::vector<ActiveEffect<T>>& active,
+                                const EncoderSamples& samples,
+                                const std::vector<SampleContext>& contexts, const Pose2<T>& start,
+                                Visitor&& visit) {
   using std::cos;
   using std::sin;
-  const omni3::Matrix3<T> m_inv = omni3::InverseKinematicMatrix(p);
   const auto& table = EffectOpsTable<T>();
+  bool any_body = false;
+  for (const auto& e : active) any_body = any_body || table[static_cast<int>(e.id)].body;
+  const int n = samples.num_channels();
+  T w[kMaxEffectChannels];
   Pose2<T> pose = start;
   for (std::size_t k = 0; k < samples.size(); ++k) {
     const SampleContext& c = contexts[k];
     const double dt = samples[k].dt_s;
-    T w[3] = {T(samples[k].value[0]), T(samples[k].value[1]), T(samples[k].value[2])};
+    for (int i = 0; i < n; ++i) w[i] = T(samples[k].value[i]);
     ApplyRateEffects(active, c, w);
-    T v[3];
-    for (int r = 0; r < 3; ++r) v[r] = m_inv(r, 0) * w[0] + m_inv(r, 1) * w[1] + m_inv(r, 2) * w[2];
+    T d[3];
+    step(w, dt, &d[0], &d[1], &d[2]);
     T v_world[2] = {T(0.0), T(0.0)};
+    if (any_body && dt > 0.0) {
+      for (T& x : d) x = x / dt;
+      for (const auto& e : active) {
+        const auto& ops = table[static_cast<int>(e.id)];
+        if (ops.body != nullptr) ops.body(e.q, c, d);
+      }
+      for (T& x : d) x = x * dt;
+    }
     for (const auto& e : active) {
       const auto& ops = table[static_cast<int>(e.id)];
-      if (ops.body != nullptr) ops.body(e.q, c, v);
       if (ops.world != nullptr) ops.world(e.q, c, v_world);
     }
     const T cs = cos(pose.theta);
     const T sn = sin(pose.theta);
     Pose2<T> next;
-    next.x = pose.x + T(dt) * (cs * v[0] - sn * v[1] + v_world[0]);
-    next.y = pose.y + T(dt) * (sn * v[0] + cs * v[1] + v_world[1]);
-    next.theta = pose.theta + T(dt) * v[2];
+    next.x = pose.x + (cs * d[0] - sn * d[1]) + T(dt) * v_world[0];
+    next.y = pose.y + (sn * d[0] + cs * d[1]) + T(dt) * v_world[1];
+    next.theta = pose.theta + d[2];
     visit(k, pose, next);
     pose = next;
   }
   return pose;
+}
+
+// The omni3 replay with effects: the step of Palacin Eq. 4, dt M^-1 w.
+template <typename T, typename Visitor>
+Pose2<T> ReplayWithEffects(const T* p, const std::vector<ActiveEffect<T>>& active,
+                           const EncoderSamples& samples,
+                           const std::vector<SampleContext>& contexts, const Pose2<T>& start,
+                           Visitor&& visit) {
+  const omni3::Matrix3<T> m_inv = omni3::InverseKinematicMatrix(p);
+  const auto step = [&m_inv](const T* w, double dt, T* dx, T* dy, T* dtheta) {
+    *dx = (m_inv(0, 0) * w[0] + m_inv(0, 1) * w[1] + m_inv(0, 2) * w[2]) * dt;
+    *dy = (m_inv(1, 0) * w[0] + m_inv(1, 1) * w[1] + m_inv(1, 2) * w[2]) * dt;
+    *dtheta = (m_inv(2, 0) * w[0] + m_inv(2, 1) * w[1] + m_inv(2, 2) * w[2]) * dt;
+  };
+  return ReplayStepsWithEffects(step, active, samples, contexts, start,
+                                std::forward<Visitor>(visit));
 }
 
 }  // namespace fitcal::effects

@@ -75,7 +75,7 @@ Row EvaluateTrackModel(const Model& model, const Omni3Robot& robot, const Subset
   o.compute_covariance = false;
   const EffectFitResult fit =
       FitEffectModel(train.tracks, robot, robot.nominal.ToArray(), model.effects, o);
-  row.p = fit.parameters;
+  std::copy(fit.parameters.begin(), fit.parameters.end(), row.p.begin());
   row.effects = fit.effects;
   row.usable = fit.usable;
   const auto box = robot.ParameterBounds();
