@@ -4,7 +4,8 @@
 // exception, a crash or a sanitizer report fails the test. The rosbag2 seeds (tiny bags the
 // writer makes, MCAP and sqlite3) are also mutated here - bit flips, overwritten bytes and length
 // fields, truncations - so every ctest run feeds the bag readers a few thousand malformed files.
-// Rewrite the seeds with FITCAL_WRITE_ROSBAG2_SEEDS=1 (after a change to the writer).
+// Rewrite the seeds with FITCAL_WRITE_ROSBAG2_SEEDS=1 (after a change to the writer), then shrink
+// the .db3 ones below 20 KB: `sqlite3 <seed>.db3 'PRAGMA page_size=512; VACUUM;'`.
 
 #include <gtest/gtest.h>
 #include <unistd.h>
