@@ -66,7 +66,7 @@ int CreateTemporary(const std::string& path, std::string* tmp_path) {
 
 }  // namespace
 
-void WriteFileAtomically(const std::string& path, const std::string& contents) {
+void WriteFileAtomically(const std::string& path, std::string_view contents) {
   std::string tmp_path;
   const int fd = CreateTemporary(path, &tmp_path);
   const char* data = contents.data();

@@ -4,11 +4,12 @@
 // leaves a half-written file and a previous output survives until the new one is complete.
 
 #include <string>
+#include <string_view>
 
 namespace fitcal::io {
 
 // Throws std::runtime_error (with the path) when the file cannot be written.
-void WriteFileAtomically(const std::string& path, const std::string& contents);
+void WriteFileAtomically(const std::string& path, std::string_view contents);
 
 // Installs SIGINT/SIGTERM/SIGHUP handlers that remove the temporary file of a write in flight and
 // then let the signal end the process as it would have (same exit status). Signals a parent set

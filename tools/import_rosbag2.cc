@@ -1,10 +1,15 @@
 #include "tools/import_rosbag2.h"
 
+#include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 #include <stdexcept>
+#include <string_view>
 
 #include "calib/aligned_run.h"
 #include "fit/final_pose_errors.h"
@@ -79,10 +84,11 @@ double SecondsSinceStart(const BagStreams& s, std::int64_t t_ns) {
 
 // What the encoder CSV holds at each stamp, robot channel order: a wheel's mean rate over the
 // interval ending at the stamp (0 at stamp 0: row 0 only sets the start), an angle as read.
-std::vector<std::vector<double>> ChannelRows(const Robot& robot, const BagStreams& s) {
+// Row-major, one row of robot.channels.size() values per stamp.
+std::vector<double> ChannelRows(const Robot& robot, const BagStreams& s) {
   const std::size_t n = s.joints.t_ns.size(), c = robot.channels.size();
   const std::vector<double>& v = s.joints.values;
-  std::vector<std::vector<double>> rows(n, std::vector<double>(c, 0.0));
+  std::vector<double> rows(n * c, 0.0);
   for (std::size_t k = 0; k < n; ++k) {
     const double dt = k == 0 ? 0.0
                              : SecondsSinceStart(s, s.joints.t_ns[k]) -
@@ -90,18 +96,18 @@ std::vector<std::vector<double>> ChannelRows(const Robot& robot, const BagStream
     for (std::size_t j = 0; j < c; ++j) {
       const double now = v[k * c + j];
       if (robot.channels[j].kind == ChannelKind::kAngle) {
-        rows[k][j] = now;
+        rows[k * c + j] = now;
       } else if (k > 0) {
         const double before = v[(k - 1) * c + j];
-        rows[k][j] = s.joints.positions ? (now - before) / dt : 0.5 * (before + now);
+        rows[k * c + j] = s.joints.positions ? (now - before) / dt : 0.5 * (before + now);
       }
     }
   }
   return rows;
 }
 
-bool IntervalAtRest(const Robot& robot, const std::vector<double>& row, double rest_rate) {
-  for (std::size_t j = 0; j < row.size(); ++j) {
+bool IntervalAtRest(const Robot& robot, const double* row, double rest_rate) {
+  for (std::size_t j = 0; j < robot.channels.size(); ++j) {
     if (robot.channels[j].kind == ChannelKind::kWheelRate && std::abs(row[j]) > rest_rate) {
       return false;
     }
@@ -112,18 +118,19 @@ bool IntervalAtRest(const Robot& robot, const std::vector<double>& row, double r
 // Cuts at the middle stamp of every rest of at least min_rest_s and keeps the pieces in which
 // some wheel turns.
 std::vector<IndexSpan> SplitAtRests(const Robot& robot, const BagStreams& s,
-                                    const std::vector<std::vector<double>>& rows,
+                                    const std::vector<double>& rows,
                                     const ImportRosbag2Options& o) {
-  const std::size_t n = rows.size();
+  const std::size_t c = robot.channels.size(), n = s.joints.t_ns.size();
+  const auto row = [&](std::size_t k) { return rows.data() + k * c; };
   std::vector<std::size_t> cuts = {0};
   std::size_t k = 1;
   while (k < n) {
-    if (!IntervalAtRest(robot, rows[k], o.rest_rate_rad_s)) {
+    if (!IntervalAtRest(robot, row(k), o.rest_rate_rad_s)) {
       ++k;
       continue;
     }
     const std::size_t begin = k - 1;  // the rest starts at the stamp before its first interval
-    while (k < n && IntervalAtRest(robot, rows[k], o.rest_rate_rad_s)) ++k;
+    while (k < n && IntervalAtRest(robot, row(k), o.rest_rate_rad_s)) ++k;
     const std::size_t end = k - 1;
     const double length_s =
         SecondsSinceStart(s, s.joints.t_ns[end]) - SecondsSinceStart(s, s.joints.t_ns[begin]);
@@ -141,7 +148,7 @@ std::vector<IndexSpan> SplitAtRests(const Robot& robot, const BagStreams& s,
   for (std::size_t i = 0; i + 1 < cuts.size(); ++i) {
     bool moves = false;
     for (std::size_t j = cuts[i] + 1; j <= cuts[i + 1] && !moves; ++j) {
-      moves = !IntervalAtRest(robot, rows[j], o.rest_rate_rad_s);
+      moves = !IntervalAtRest(robot, row(j), o.rest_rate_rad_s);
     }
     if (moves) spans.push_back({cuts[i], cuts[i + 1]});
   }
@@ -170,28 +177,28 @@ std::vector<IndexSpan> SpansFromTimes(const BagStreams& s, const ImportRosbag2Op
   return spans;
 }
 
-RunLog MakeRun(const Robot& robot, const BagStreams& s,
-               const std::vector<std::vector<double>>& rows, const IndexSpan& span, int number,
-               const std::string& label, std::vector<double>* t_out,
-               std::vector<std::vector<double>>* rows_out) {
+RunLog MakeRun(const Robot& robot, const BagStreams& s, const std::vector<double>& rows,
+               const IndexSpan& span, int number, const std::string& label,
+               std::vector<double>* t_out, std::vector<double>* rows_out) {
   RunLog run;
   char id[32];
   std::snprintf(id, sizeof id, "-%02d", number);
   run.id = label + id;
   run.trajectory = label;
   run.repetition = number;
+  const std::size_t c = robot.channels.size(), count = span.last - span.first + 1;
   io::EncoderRowConverter converter(robot);
+  converter.Reserve(count);
+  t_out->reserve(count);
+  rows_out->assign(rows.begin() + static_cast<std::ptrdiff_t>(span.first * c),
+                   rows.begin() + static_cast<std::ptrdiff_t>((span.last + 1) * c));
+  for (std::size_t j = 0; j < c; ++j) {  // the run's row 0 only sets its start
+    if (robot.channels[j].kind == ChannelKind::kWheelRate) (*rows_out)[j] = 0.0;
+  }
   for (std::size_t k = span.first; k <= span.last; ++k) {
     const double t = SecondsSinceStart(s, s.joints.t_ns[k]);
-    std::vector<double> row = rows[k];
-    if (k == span.first) {  // the run's row 0 only sets its start
-      for (std::size_t j = 0; j < row.size(); ++j) {
-        if (robot.channels[j].kind == ChannelKind::kWheelRate) row[j] = 0.0;
-      }
-    }
-    converter.Add(t, row.data());
+    converter.Add(t, rows_out->data() + (k - span.first) * c);
     t_out->push_back(t);
-    rows_out->push_back(std::move(row));
   }
   run.encoders = converter.Take();
   const double t0 = t_out->front(), t1 = t_out->back();
@@ -245,31 +252,86 @@ io::rosbag2::BagStreamRequest MakeRequest(const ImportRosbag2Options& o, const R
   return r;
 }
 
-std::string EncoderCsvText(const Robot& robot, const std::vector<double>& t_s,
-                           const std::vector<std::vector<double>>& rows) {
-  std::string out = "t";
-  for (const ChannelInfo& c : robot.channels) out += "," + c.rate_column;
-  out += "\n";
-  char field[40];
-  for (std::size_t k = 0; k < t_s.size(); ++k) {
-    out.append(field, static_cast<std::size_t>(std::snprintf(field, sizeof field, "%.9f", t_s[k])));
-    for (double v : rows[k]) {
-      out.append(field, static_cast<std::size_t>(std::snprintf(field, sizeof field, ",%.17g", v)));
+// The CSVs are built in one buffer: t with ns resolution (std::to_chars fixed, 9 decimals: the
+// bytes printf's %.9f gives), every other value as the shortest text that reads back to the same
+// double (std::to_chars): exact on read-back (io::ParseDouble uses std::from_chars), and several
+// times faster than printf.
+class CsvBuffer {
+ public:
+  // Not zero-filled: the text of a long run is megabytes, and each byte is written once.
+  explicit CsvBuffer(std::size_t expected_bytes)
+      : text_(new char[expected_bytes]), capacity_(expected_bytes) {}
+  void Append(std::string_view s) {
+    Room(s.size());
+    std::memcpy(text_.get() + size_, s.data(), s.size());
+    size_ += s.size();
+  }
+  void Char(char c) {
+    Room(1);
+    text_[size_++] = c;
+  }
+  // %.9f; a fixed-point double needs at most 309 + 1 + 9 + sign characters.
+  void Seconds(double t) {
+    Room(330);
+    End(std::to_chars(Next(), text_.get() + capacity_, t, std::chars_format::fixed, 9));
+  }
+  // Shortest round trip: at most 24 characters ("-2.2250738585072014e-308").
+  void Value(double v) {
+    Room(32);
+    End(std::to_chars(Next(), text_.get() + capacity_, v));
+  }
+  std::string_view view() const { return {text_.get(), size_}; }
+
+ private:
+  char* Next() { return text_.get() + size_; }
+  void End(const std::to_chars_result& r) { size_ = static_cast<std::size_t>(r.ptr - text_.get()); }
+  void Room(std::size_t n) {
+    if (capacity_ - size_ >= n) return;
+    const std::size_t capacity = std::max(2 * capacity_, size_ + n);
+    std::unique_ptr<char[]> bigger(new char[capacity]);
+    std::memcpy(bigger.get(), text_.get(), size_);
+    text_ = std::move(bigger);
+    capacity_ = capacity;
+  }
+  std::unique_ptr<char[]> text_;
+  std::size_t capacity_ = 0;
+  std::size_t size_ = 0;
+};
+
+CsvBuffer EncoderCsvText(const Robot& robot, const std::vector<double>& t_s,
+                         const std::vector<double>& rows) {
+  const std::size_t c = robot.channels.size();
+  CsvBuffer out(64 + t_s.size() * (24 + 26 * c));
+  out.Char('t');
+  for (const ChannelInfo& ch : robot.channels) {
+    out.Char(',');
+    out.Append(ch.rate_column);
+  }
+  out.Char('\n');
+  const double* row = rows.data();
+  for (std::size_t k = 0; k < t_s.size(); ++k, row += c) {
+    out.Seconds(t_s[k]);
+    for (std::size_t j = 0; j < c; ++j) {
+      out.Char(',');
+      out.Value(row[j]);
     }
-    out += "\n";
+    out.Char('\n');
   }
   return out;
 }
 
 // io::GroundTruthCsv rounds to 1 um and 1e-7 rad; a bag's poses are kept to the last bit.
-std::string GroundTruthCsvText(const GroundTruthTrack& track) {
-  std::string out = "t,x,y,theta\n";
-  char line[128];
+CsvBuffer GroundTruthCsvText(const GroundTruthTrack& track) {
+  CsvBuffer out(16 + track.t_s.size() * 96);
+  out.Append("t,x,y,theta\n");
   for (std::size_t k = 0; k < track.t_s.size(); ++k) {
     const Pose2d& p = track.world_T_robot[k];
-    out.append(line,
-               static_cast<std::size_t>(std::snprintf(line, sizeof line, "%.9f,%.17g,%.17g,%.17g\n",
-                                                      track.t_s[k], p.x, p.y, p.theta)));
+    out.Seconds(track.t_s[k]);
+    for (double v : {p.x, p.y, p.theta}) {
+      out.Char(',');
+      out.Value(v);
+    }
+    out.Char('\n');
   }
   return out;
 }
@@ -286,10 +348,11 @@ void WriteDataset(const ImportRosbag2Options& o, const Robot& robot, const Rosba
     e.repetition = imp.runs[i].repetition;
     e.encoders = "runs/" + e.id + "_encoders.csv";
     e.ground_truth = "runs/" + e.id + "_ground_truth.csv";
-    io::WriteFileAtomically((dir / e.encoders).string(),
-                            EncoderCsvText(robot, imp.encoder_t_s[i], imp.encoder_rows[i]));
+    io::WriteFileAtomically(
+        (dir / e.encoders).string(),
+        EncoderCsvText(robot, imp.encoder_t_s[i], imp.encoder_values[i]).view());
     io::WriteFileAtomically((dir / e.ground_truth).string(),
-                            GroundTruthCsvText(imp.runs[i].ground_truth));
+                            GroundTruthCsvText(imp.runs[i].ground_truth).view());
     entries.push_back(std::move(e));
   }
   io::WriteFileAtomically((dir / "robot.yaml").string(), io::ReadTextFile(o.robot));
@@ -315,7 +378,7 @@ Rosbag2Import ReadRosbag2Import(const ImportRosbag2Options& o) {
   const Robot& robot = model->robot();
   Rosbag2Import imp;
   imp.streams = io::rosbag2::ReadBagStreams(o.bag, MakeRequest(o, robot));
-  const std::vector<std::vector<double>> rows = ChannelRows(robot, imp.streams);
+  const std::vector<double> rows = ChannelRows(robot, imp.streams);
   std::vector<IndexSpan> spans;
   if (!o.runs.empty()) {
     spans = SpansFromTimes(imp.streams, o);
@@ -326,14 +389,14 @@ Rosbag2Import ReadRosbag2Import(const ImportRosbag2Options& o) {
                        "the wheels never turn faster than --rest-rate: no run to cut");
     }
   } else {
-    spans = {{0, rows.size() - 1}};
+    spans = {{0, imp.streams.joints.t_ns.size() - 1}};
   }
   const std::string label = RunLabel(o);
   for (std::size_t i = 0; i < spans.size(); ++i) {
     imp.encoder_t_s.emplace_back();
-    imp.encoder_rows.emplace_back();
+    imp.encoder_values.emplace_back();
     imp.runs.push_back(MakeRun(robot, imp.streams, rows, spans[i], static_cast<int>(i) + 1, label,
-                               &imp.encoder_t_s.back(), &imp.encoder_rows.back()));
+                               &imp.encoder_t_s.back(), &imp.encoder_values.back()));
   }
   return imp;
 }

@@ -56,9 +56,10 @@ struct ImportRosbag2Options {
 struct Rosbag2Import {
   io::rosbag2::BagStreams streams;
   std::vector<RunLog> runs;  // as fitcal will load them
-  // Per run, what the encoder CSV holds: t (s) and one row per stamp (robot channel order).
+  // Per run, what the encoder CSV holds: t (s), and row-major one row per stamp of one value per
+  // robot channel (robot channel order).
   std::vector<std::vector<double>> encoder_t_s;
-  std::vector<std::vector<std::vector<double>>> encoder_rows;
+  std::vector<std::vector<double>> encoder_values;
 };
 
 // Reads the bag and cuts the runs, writing nothing. Throws io::InputError for a bad bag or bad

@@ -15,6 +15,7 @@
 #include "io/input_error.h"
 #include "io/log_files.h"
 #include "io/robot_yaml.h"
+#include "tools/import_rosbag2.h"
 
 namespace fitcal::fuzz {
 
@@ -36,6 +37,15 @@ constexpr const char* kRobotYaml =
     "  angle_offset_deg: [-2.0, 2.0]\n";
 constexpr const char* kEncoderCsv = "t,w_a,w_b,w_c\n0,0,0,0\n0.01,1,2,3\n0.02,1,2,3\n";
 constexpr const char* kGroundTruthCsv = "t,x,y,theta\n0,0,0,0\n0.02,0.001,0,0\n";
+// The rosbag2 seeds' robot (tests/fuzz_corpus_test.cc writes the seed bags).
+constexpr const char* kDiffDriveYaml =
+    "model: diff_drive\n"
+    "name: fuzz\n"
+    "wheels:\n"
+    "  - {name: right, radius_m: 0.042}\n"
+    "  - {name: left, radius_m: 0.042}\n"
+    "wheel_separation_m: 0.200\n"
+    "bounds: {radius_m: [0.038, 0.046], wheel_separation_m: [0.180, 0.220]}\n";
 
 void WriteFile(const std::string& path, std::string_view bytes) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
@@ -53,6 +63,7 @@ class ScratchDir {
     WriteFile(path_ + "/robot.yaml", kRobotYaml);
     WriteFile(path_ + "/enc.csv", kEncoderCsv);
     WriteFile(path_ + "/gt.csv", kGroundTruthCsv);
+    WriteFile(path_ + "/diff_drive.yaml", kDiffDriveYaml);
   }
   ~ScratchDir() {
     std::error_code ignored;
@@ -115,6 +126,35 @@ void FuzzAsocRobot(const std::string& path) {
     io::ReadAsocRobot(again);
   } catch (const io::InputError& e) {
     throw std::logic_error(std::string("written ASOC robot YAML does not read back: ") + e.what());
+  }
+}
+
+// `fitcal import rosbag2` up to the data set it would write: bag file, topics, stamps, runs.
+void FuzzRosbag2Import(const std::string& path, const std::string& dir) {
+  tools::ImportRosbag2Options o;
+  o.bag = path;
+  o.robot = dir + "/diff_drive.yaml";
+  o.joints = {"right_wheel_joint", "left_wheel_joint"};
+  o.ground_truth = "/mocap/pose";
+  o.quiet = true;
+  const tools::Rosbag2Import imp = tools::ReadRosbag2Import(o);
+  if (imp.runs.empty() || imp.encoder_t_s.size() != imp.runs.size()) {
+    throw std::logic_error("import without runs accepted");
+  }
+  for (std::size_t i = 0; i < imp.runs.size(); ++i) {
+    const RunLog& run = imp.runs[i];
+    if (run.encoders.t_s.size() < 2 || run.ground_truth.t_s.size() < 2 ||
+        imp.encoder_values[i].size() != 2 * imp.encoder_t_s[i].size()) {
+      throw std::logic_error("inconsistent imported run");
+    }
+    for (std::size_t k = 1; k < run.encoders.t_s.size(); ++k) {
+      if (!(run.encoders.t_s[k] > run.encoders.t_s[k - 1])) {
+        throw std::logic_error("non-increasing encoder stamps accepted");
+      }
+    }
+    for (double v : imp.encoder_values[i]) {
+      if (!std::isfinite(v)) throw std::logic_error("non-finite wheel rate accepted");
+    }
   }
 }
 
