@@ -22,7 +22,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Valid neighbours for the data set loader: a robot and one run.
+// Valid neighbours for the data set loader: a robot and two runs.
 constexpr const char* kRobotYaml =
     "model: omni3\n"
     "name: fuzz\n"
@@ -36,6 +36,9 @@ constexpr const char* kRobotYaml =
     "  angle_offset_deg: [-2.0, 2.0]\n";
 constexpr const char* kEncoderCsv = "t,w_a,w_b,w_c\n0,0,0,0\n0.01,1,2,3\n0.02,1,2,3\n";
 constexpr const char* kGroundTruthCsv = "t,x,y,theta\n0,0,0,0\n0.02,0.001,0,0\n";
+// A second run of its own: one file listed for two runs is refused as a duplicated run.
+constexpr const char* kEncoderCsv2 = "t,w_a,w_b,w_c\n0,0,0,0\n0.01,1,2,3\n0.02,1,2,4\n";
+constexpr const char* kGroundTruthCsv2 = "t,x,y,theta\n0,0,0,0\n0.02,0.002,0,0\n";
 
 void WriteFile(const std::string& path, std::string_view bytes) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
@@ -53,6 +56,8 @@ class ScratchDir {
     WriteFile(path_ + "/robot.yaml", kRobotYaml);
     WriteFile(path_ + "/enc.csv", kEncoderCsv);
     WriteFile(path_ + "/gt.csv", kGroundTruthCsv);
+    WriteFile(path_ + "/enc2.csv", kEncoderCsv2);
+    WriteFile(path_ + "/gt2.csv", kGroundTruthCsv2);
   }
   ~ScratchDir() {
     std::error_code ignored;
