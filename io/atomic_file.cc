@@ -23,10 +23,29 @@ constexpr int kCleanupSignals[] = {SIGINT, SIGTERM, SIGHUP};
 char g_in_flight_path[PATH_MAX + 16];
 volatile sig_atomic_t g_has_in_flight = 0;
 
+// A directory being staged (staged_directory.h) and the files already renamed into it, so that a
+// cleanup signal removes it too (unlink and rmdir only: async-signal-safe).
+constexpr int kMaxStagedFiles = 32;
+char g_staging_dir[PATH_MAX + 16];
+char g_staged_files[kMaxStagedFiles][PATH_MAX + 16];
+volatile sig_atomic_t g_num_staged_files = 0;
+volatile sig_atomic_t g_has_staging_dir = 0;
+
 void RemoveInFlightAndReraise(int signal_number) {
   if (g_has_in_flight) unlink(g_in_flight_path);
+  if (g_has_staging_dir) {
+    for (int i = 0; i < g_num_staged_files; ++i) unlink(g_staged_files[i]);
+    rmdir(g_staging_dir);
+  }
   signal(signal_number, SIG_DFL);
   raise(signal_number);
+}
+
+bool InStagingDirectory(const std::string& path) {
+  if (!g_has_staging_dir) return false;
+  const std::size_t n = std::strlen(g_staging_dir);
+  return path.size() > n + 1 && path.compare(0, n, g_staging_dir) == 0 && path[n] == '/' &&
+         path.find('/', n + 1) == std::string::npos;
 }
 
 // Blocks the cleanup signals for its lifetime.
@@ -92,6 +111,21 @@ void WriteFileAtomically(const std::string& path, std::string_view contents) {
     const std::string reason = std::strerror(ok ? errno : saved_errno);
     unlink(tmp_path.c_str());
     throw std::runtime_error(path + ": cannot write: " + reason);
+  }
+  if (InStagingDirectory(path) && g_num_staged_files < kMaxStagedFiles &&
+      path.size() < sizeof(g_staged_files[0])) {
+    std::memcpy(g_staged_files[g_num_staged_files], path.c_str(), path.size() + 1);
+    g_num_staged_files = g_num_staged_files + 1;
+  }
+}
+
+void SetStagingDirectoryForSignals(const std::string& dir) {
+  const CleanupSignalsBlocked blocked;
+  g_num_staged_files = 0;
+  g_has_staging_dir = 0;
+  if (!dir.empty() && dir.size() < sizeof(g_staging_dir)) {
+    std::memcpy(g_staging_dir, dir.c_str(), dir.size() + 1);
+    g_has_staging_dir = 1;
   }
 }
 

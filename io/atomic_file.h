@@ -17,6 +17,10 @@ void WriteFileAtomically(const std::string& path, std::string_view contents);
 // and renaming, the previous output is intact and a `<path>.tmp-XXXXXX` file is left beside it.
 void RemoveTemporaryFilesOnSignals();
 
+// The directory being staged (io/staged_directory.h), "" when none: on SIGINT/SIGTERM/SIGHUP the
+// handler also removes the files WriteFileAtomically renamed into it (up to 32) and the directory.
+void SetStagingDirectoryForSignals(const std::string& dir);
+
 // Fault-injection point for the tests: when the environment variable FITCAL_TEST_STOP_AT equals
 // `stage`, the process stops itself (SIGSTOP) so a test can deliver a signal at exactly that
 // point. Without the variable it does nothing.

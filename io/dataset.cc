@@ -2,10 +2,16 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
+#include <map>
+#include <new>
 #include <set>
 #include <sstream>
+#include <string_view>
+#include <unordered_map>
 
 #include "io/input_error.h"
 #include "io/log_files.h"
@@ -46,6 +52,38 @@ std::string ResolvePath(const std::string& directory, const std::string& relativ
   return p.is_absolute() ? p.string() : (fs::path(directory) / p).string();
 }
 
+// The file's identity for duplicate detection: the canonical path (symlinks and "a/../a"
+// resolved) when the OS can give it, the normalised text otherwise.
+std::string FileIdentity(const std::string& path) {
+  std::error_code ec;
+  const fs::path canonical = fs::weakly_canonical(path, ec);
+  return ec ? fs::path(path).lexically_normal().string() : canonical.string();
+}
+
+// One file listed for two runs (a copy-paste slip, or a data set that lists one pair 100,000
+// times) would count one recording as several: refused before anything is read.
+class SameFileCheck {
+ public:
+  explicit SameFileCheck(std::string yaml_path) : yaml_path_(std::move(yaml_path)) {}
+  void Add(const std::string& path, const char* role, const DatasetIndexEntry& entry,
+           const YAML::Node& node) {
+    const auto [it, fresh] = seen_.emplace(FileIdentity(path), Use{entry.id, LineOf(node)});
+    if (fresh) return;
+    throw InputError(InputErrorKind::kDuplicateRun, yaml_path_, LineOf(node),
+                     "run '" + entry.id + "' lists the " + role + " file '" + path + "' of run '" +
+                         it->second.id + "' (line " + std::to_string(it->second.line) +
+                         "): a duplicated run");
+  }
+
+ private:
+  struct Use {
+    std::string id;
+    int line = 0;
+  };
+  std::string yaml_path_;
+  std::map<std::string, Use> seen_;
+};
+
 }  // namespace
 
 DatasetIndex ReadDatasetIndex(const std::string& directory, const DatasetOptions& options) {
@@ -79,6 +117,7 @@ DatasetIndex ReadDatasetIndex(const std::string& directory, const DatasetOptions
 
   index.runs.resize(runs.size());
   std::set<std::string> ids;
+  SameFileCheck same_file(yaml_path);
   for (std::size_t i = 0; i < runs.size(); ++i) {
     const YAML::Node node = runs[i];
     YamlMap run(node, yaml_path, "run " + std::to_string(i + 1));
@@ -94,6 +133,8 @@ DatasetIndex ReadDatasetIndex(const std::string& directory, const DatasetOptions
         ResolvePath(directory, run.String("encoders"), options, yaml_path, node["encoders"]);
     entry.ground_truth_path = ResolvePath(directory, run.String("ground_truth"), options, yaml_path,
                                           node["ground_truth"]);
+    same_file.Add(entry.encoders_path, "encoder", entry, node);
+    same_file.Add(entry.ground_truth_path, "ground-truth", entry, node);
     const YAML::Node start = run.Optional("start_pose");
     if (start) {
       ExpectYamlType(start, YAML::NodeType::Sequence, yaml_path, "start_pose");
@@ -139,6 +180,104 @@ Dataset LoadDataset(const DatasetIndex& index, const DatasetOptions& options) {
   return LoadDataset(index, LegacyThreeWheelRobot(ReadEncoderTicks(index.robot_path)), options);
 }
 
+namespace {
+
+// Bytes of a vector of doubles, for hashing and comparing logs exactly.
+template <typename T>
+std::string_view Bytes(const std::vector<T>& v) {
+  return {reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T)};
+}
+
+std::size_t LogHash(const std::string_view& a, const std::string_view& b) {
+  const std::hash<std::string_view> hash;
+  return hash(a) ^ (hash(b) * 0x9e3779b97f4a7c15ULL);
+}
+
+// Two runs whose encoder logs (or ground-truth tracks) are equal to the bit are one recording
+// copied: no two drives produce the same timestamps and rates. Counted twice they would weigh one
+// run double and, when all are copies, leave nine parameters to three residuals; the copy is
+// named as what it is, not blamed on the wiring (issue 12).
+void RejectCopiedRuns(const DatasetIndex& index, const std::vector<RunLog>& runs) {
+  for (int part = 0; part < 2; ++part) {
+    std::unordered_multimap<std::size_t, std::size_t> seen;
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+      const RunLog& r = runs[i];
+      const std::string_view a = part == 0 ? Bytes(r.encoders.t_s) : Bytes(r.ground_truth.t_s);
+      const std::string_view b =
+          part == 0 ? std::string_view(reinterpret_cast<const char*>(r.encoders.samples.data()),
+                                       r.encoders.samples.size() *
+                                           static_cast<std::size_t>(r.encoders.samples.stride()) *
+                                           sizeof(double))
+                    : Bytes(r.ground_truth.world_T_robot);
+      const std::size_t h = LogHash(a, b);
+      const auto range = seen.equal_range(h);
+      for (auto it = range.first; it != range.second; ++it) {
+        const RunLog& o = runs[it->second];
+        const bool same = part == 0 ? (o.encoders.t_s == r.encoders.t_s &&
+                                       o.encoders.samples == r.encoders.samples)
+                                    : (o.ground_truth.t_s == r.ground_truth.t_s &&
+                                       Bytes(o.ground_truth.world_T_robot) == b);
+        if (!same) continue;
+        const DatasetIndexEntry& e = index.runs[i];
+        const DatasetIndexEntry& f = index.runs[it->second];
+        throw InputError(InputErrorKind::kDuplicateRun,
+                         part == 0 ? e.encoders_path : e.ground_truth_path, 0,
+                         std::string("run '") + e.id + "' has the same " +
+                             (part == 0 ? "encoder log" : "ground truth") + " as run '" + f.id +
+                             "' (" + (part == 0 ? f.encoders_path : f.ground_truth_path) +
+                             "): a duplicated run (a copied file?)");
+      }
+      seen.emplace(h, i);
+    }
+  }
+}
+
+// A calibration needs motion: when no wheel turns in any run (or no ground truth moves), every
+// parameter is undetermined and a fit would return the nominal with sigma 0 (issue 12).
+constexpr double kTurningRadPerS = 0.01;  // the log reader's own threshold for "turning"
+constexpr double kMovedM = 1e-4;          // below any ground truth's noise
+
+bool WheelsTurn(const EncoderSamples& samples, const Robot& robot) {
+  for (const auto& s : samples) {
+    for (int c = 0; c < robot.NumChannels(); ++c) {
+      if (robot.channels[c].kind == ChannelKind::kWheelRate &&
+          std::abs(s.value[c]) > kTurningRadPerS)
+        return true;
+    }
+  }
+  return false;
+}
+
+bool GroundTruthMoves(const GroundTruthTrack& track) {
+  const Pose2d& first = track.world_T_robot.front();
+  for (const Pose2d& p : track.world_T_robot) {
+    if (std::hypot(p.x - first.x, p.y - first.y) > kMovedM) return true;
+  }
+  return false;
+}
+
+void RejectDataSetWithoutMotion(const DatasetIndex& index, const std::vector<RunLog>& runs,
+                                const Robot& robot) {
+  bool wheels = false, ground_truth = false;
+  for (const RunLog& run : runs) {
+    wheels = wheels || WheelsTurn(run.encoders.samples, robot);
+    ground_truth = ground_truth || GroundTruthMoves(run.ground_truth);
+  }
+  const std::string n = std::to_string(runs.size());
+  if (!wheels) {
+    throw InputError(InputErrorKind::kNoMotion, index.yaml_path, 0,
+                     "no run moves: no wheel turns faster than 0.01 rad/s in any of the " + n +
+                         " runs; nothing to calibrate");
+  }
+  if (!ground_truth) {
+    throw InputError(InputErrorKind::kNoMotion, index.yaml_path, 0,
+                     "no run moves: the ground truth of none of the " + n +
+                         " runs moves by more than 0.1 mm; nothing to calibrate");
+  }
+}
+
+}  // namespace
+
 Dataset LoadDataset(const DatasetIndex& index, const Robot& robot, const DatasetOptions& options) {
   Dataset dataset;
   dataset.directory = index.directory;
@@ -156,6 +295,8 @@ Dataset LoadDataset(const DatasetIndex& index, const Robot& robot, const Dataset
     CheckGroundTruthOverlap(log.ground_truth, log.encoders.t_s.front(), log.encoders.t_s.back(),
                             entry.ground_truth_path);
   });
+  RejectDataSetWithoutMotion(index, dataset.runs, robot);  // first: still runs are all alike
+  RejectCopiedRuns(index, dataset.runs);
   return dataset;
 }
 

@@ -2,6 +2,7 @@
 // The one error type for bad input: which file, which line (0 = the file as a whole), what kind of
 // problem and a sentence for the user. Loaders throw it; the tool's edge prints What() as one line.
 
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 
@@ -26,9 +27,21 @@ enum class InputErrorKind {
   kBadPath,            // a path that escapes the data set directory
   kYamlSyntax,         // YAML that does not parse
   kTooLarge,           // a file larger than fitcal will hold in memory
+  kOutOfMemory,        // memory ran out while the file was read
+  kDuplicateKey,       // a YAML map with one key twice (yaml-cpp would keep one silently)
+  kDuplicateRun,       // two runs of one data set with the same file or the same content
+  kImplausibleValue,   // a finite number no robot can produce (1e300 rad/s, 1e18 s)
+  kClockGap,           // a clock step or gap while the wheels turn
+  kNoMotion,           // no run of the data set moves: nothing to calibrate
 };
 
 const char* ToString(InputErrorKind kind);
+
+// `text` made fit for one line of a message: control characters (a newline in a YAML scalar,
+// binary junk) shown as '?', and at most max_chars characters, the middle elided with the number
+// of bytes left out (a 2 MB field is never echoed whole). Keeps the head and the tail, where a
+// path's file name is.
+std::string OneLine(const std::string& text, std::size_t max_chars = 240);
 
 class InputError : public std::runtime_error {
  public:

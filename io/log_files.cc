@@ -1,15 +1,19 @@
 #include "io/log_files.h"
 
+#include <algorithm>
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <new>
 #include <string_view>
 #include <utility>
 #include <vector>
 
 #include "io/input_error.h"
 #include "io/text_file.h"
+#include "io/warnings.h"
 
 namespace fitcal::io {
 
@@ -107,19 +111,6 @@ void CheckIncreasing(double previous, double t, const std::string& path, int lin
 }
 
 bool IsBlank(std::string_view line) { return Trim(line).empty(); }
-
-// Upper bound on the data rows of a text: its number of lines.
-std::size_t CountLines(std::string_view text) {
-  std::size_t n = 1;
-  const char* p = text.data();
-  const char* end = p + text.size();
-  while ((p = static_cast<const char*>(std::memchr(p, '\n', static_cast<std::size_t>(end - p)))) !=
-         nullptr) {
-    ++n;
-    ++p;
-  }
-  return n;
-}
 
 }  // namespace
 
@@ -257,9 +248,118 @@ void EncoderRowConverter::Add(double t_s, const double* row) {
   log_.t_s.push_back(t_s);
 }
 
-EncoderLog ReadEncoderCsv(const std::string& path, const Robot& robot) {
-  const std::string text = ReadTextFile(path);
-  LineScanner lines(text);
+namespace {
+
+// Finite numbers no robot produces, named instead of fitted (a corrupted field, a unit slip such
+// as nanoseconds for seconds): wheel rates beyond 1e4 rad/s (95,000 rpm), angles beyond 1e4 rad,
+// times beyond 1e10 s (the year 2286 as Unix time; nanosecond stamps are ~1e18), positions beyond
+// 1e7 m (no map frame on Earth spans that).
+constexpr double kMaxWheelRateRadPerS = 1e4;
+constexpr double kMaxAngleRad = 1e4;
+constexpr double kMaxTimeS = 1e10;
+constexpr double kMaxPositionM = 1e7;
+
+std::string Number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", v);
+  return text;
+}
+
+void CheckTimePlausible(double t_s, const std::string& path, int line_number) {
+  if (std::abs(t_s) > kMaxTimeS) {
+    throw InputError(InputErrorKind::kImplausibleValue, path, line_number,
+                     "time " + Number(t_s) + " s is not a plausible time (limit " +
+                         Number(kMaxTimeS) + " s; nanoseconds or microseconds instead of s?)");
+  }
+}
+
+// The last interval's channel values against the limits above.
+void CheckSamplePlausible(const EncoderSamples& samples, const Robot& robot,
+                          const std::string& path, int line_number) {
+  if (samples.empty()) return;
+  const ConstSampleView s = samples.back();
+  for (int c = 0; c < robot.NumChannels(); ++c) {
+    const bool angle = robot.channels[c].kind == ChannelKind::kAngle;
+    const double limit = angle ? kMaxAngleRad : kMaxWheelRateRadPerS;
+    if (std::abs(s.value[c]) <= limit) continue;
+    throw InputError(InputErrorKind::kImplausibleValue, path, line_number,
+                     "channel '" + robot.channels[c].name + "': " + Number(s.value[c]) +
+                         (angle ? " rad is not a physical angle (limit "
+                                : " rad/s is not a physical wheel rate (limit ") +
+                         Number(limit) + "; wrong units or a corrupted field?)");
+  }
+}
+
+// Clock steps and gaps: an interval longer than kGapFactor times the log's median interval (and
+// than kMinGapS) while a wheel turns in it or next to it. A rate log's row holds the mean rate of
+// its interval, so a clock that jumps 60 s forward multiplies that interval's travel by the jump
+// over the true interval, and lost rows leave motion no one measured: refused, not fitted. A gap
+// at rest (the recorder idling) is harmless and accepted.
+constexpr double kGapFactor = 20.0;
+constexpr double kMinGapS = 0.5;
+constexpr double kTurningRadPerS = 0.01;
+
+double MedianIntervalS(const EncoderSamples& samples) {
+  // A strided subset keeps this O(1) in memory for logs of millions of rows.
+  const std::size_t stride = std::max<std::size_t>(1, samples.size() / 100000);
+  std::vector<double> dt;
+  for (std::size_t k = 0; k < samples.size(); k += stride) dt.push_back(samples[k].dt_s);
+  std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
+  return dt[dt.size() / 2];
+}
+
+bool WheelsTurn(const EncoderSamples& samples, std::size_t k, const Robot& robot) {
+  if (k >= samples.size()) return false;
+  for (int c = 0; c < robot.NumChannels(); ++c) {
+    if (robot.channels[c].kind == ChannelKind::kWheelRate &&
+        std::abs(samples[k].value[c]) > kTurningRadPerS)
+      return true;
+  }
+  return false;
+}
+
+// Index of the first sample that is a gap while moving, or samples.size().
+std::size_t FindClockGap(const EncoderSamples& samples, const Robot& robot, double* median_s) {
+  if (samples.size() < 3) return samples.size();
+  *median_s = MedianIntervalS(samples);
+  const double limit = std::max(kGapFactor * *median_s, kMinGapS);
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    if (samples[k].dt_s <= limit) continue;
+    if (WheelsTurn(samples, k, robot) || (k > 0 && WheelsTurn(samples, k - 1, robot)) ||
+        WheelsTurn(samples, k + 1, robot))
+      return k;
+  }
+  return samples.size();
+}
+
+// The file line of data row `row` (row 0 is the first after the header); blank lines skipped as
+// the reader skips them. Only on the error path: the file is read again.
+int LineOfDataRow(const std::string& path, std::size_t row) {
+  TextFileReader lines(path);
+  std::string_view line;
+  lines.Next(&line);  // header
+  std::size_t seen = 0;
+  while (lines.Next(&line)) {
+    if (IsBlank(line)) continue;
+    if (seen++ == row) return lines.line_number();
+  }
+  return 0;
+}
+
+// Memory that runs out while a file is read is reported with the file (the loaders' boundary).
+template <typename Fn>
+auto ReportingOutOfMemory(const std::string& path, Fn&& fn) -> decltype(fn()) {
+  try {
+    return fn();
+  } catch (const std::bad_alloc&) {
+    throw InputError(InputErrorKind::kOutOfMemory, path, 0,
+                     "out of memory while reading this file (split the log, or give fitcal more "
+                     "memory)");
+  }
+}
+
+EncoderLog ReadEncoderRows(TextFileReader& lines, const Robot& robot) {
+  const std::string& path = lines.path();
   std::string_view line;
   if (!lines.Next(&line) || IsBlank(line)) {
     throw InputError(InputErrorKind::kEmptyFile, path, 1,
@@ -273,25 +373,46 @@ EncoderLog ReadEncoderCsv(const std::string& path, const Robot& robot) {
   }
   const int num_columns = 1 + robot.NumChannels();
   EncoderRowConverter converter(robot, plan.channel_of_column, plan.ticks);
-  // Reserve exactly once (one row per line; memchr-speed count) so that a large log holds its
-  // samples (8 bytes of time + one row) and is never copied while growing.
-  converter.Reserve(CountLines(text));
+  // Reserve exactly once (one row per line, counted at memchr speed in a first pass) so that a
+  // large log holds its samples (8 bytes of time + one row) and is never copied while growing.
+  converter.Reserve(lines.CountLinesAndRewind());
+  lines.Next(&line);  // the header again
   double row[kMaxColumns];
   double previous_t = 0.0;
   bool first = true;
   while (lines.Next(&line)) {
     if (IsBlank(line)) continue;
     ParseRow(line, ',', num_columns, path, lines.line_number(), row);
+    CheckTimePlausible(row[0], path, lines.line_number());
     if (!first) CheckIncreasing(previous_t, row[0], path, lines.line_number());
     converter.Add(row[0], row + 1);
+    CheckSamplePlausible(converter.samples(), robot, path, lines.line_number());
     previous_t = row[0];
     first = false;
   }
-  EncoderLog log = converter.Take();
+  return converter.Take();
+}
+
+}  // namespace
+
+EncoderLog ReadEncoderCsv(const std::string& path, const Robot& robot) {
+  EncoderLog log = ReportingOutOfMemory(path, [&] {
+    TextFileReader lines(path);
+    return ReadEncoderRows(lines, robot);
+  });
   if (log.t_s.size() < 2) {
     throw InputError(InputErrorKind::kTooFewSamples, path, 0,
                      "needs at least two rows (a start time and one interval), found " +
                          std::to_string(log.t_s.size()));
+  }
+  double median_s = 0.0;
+  const std::size_t gap = FindClockGap(log.samples, robot, &median_s);
+  if (gap < log.samples.size()) {
+    throw InputError(InputErrorKind::kClockGap, path, LineOfDataRow(path, gap + 1),
+                     "the clock jumps " + Number(log.samples[gap].dt_s) +
+                         " s (the log's median interval is " + Number(median_s) +
+                         " s) while the wheels turn: a clock step or lost rows inside a moving "
+                         "stretch; refused (cut the run into two runs there)");
   }
   return log;
 }
@@ -310,66 +431,116 @@ EncoderLog ReadEncoderCsv(const std::string& path, const std::optional<EncoderTi
   return ReadEncoderCsv(path, LegacyThreeWheelRobot(ticks));
 }
 
-GroundTruthTrack ReadGroundTruth(const std::string& path) {
-  const std::string text = ReadTextFile(path);
-  LineScanner lines(text);
-  std::string_view line;
-  // The first non-blank, non-comment line decides the format.
-  bool tum = false;
-  bool found = false;
-  while (lines.Next(&line)) {
-    const std::string_view t = Trim(line);
-    if (t.empty() || t.front() == '#') {
-      if (!t.empty()) tum = true;  // only TUM files carry '#' comments
-      continue;
+namespace {
+
+// TUM quaternions are written with a few decimals: four components rounded to 1e-4 put the norm
+// at most ~2e-4 from 1, and float32 to ~1e-7. Within kQuaternionNormTolerance the quaternion is
+// normalised (a warning says so); beyond it the numbers are not a rounded unit quaternion (a
+// column shifted, a different convention, corruption), and the yaw of Eq. 1 - 2(qy^2 + qz^2),
+// which assumes norm 1, would be wrong: refused.
+constexpr double kQuaternionNormTolerance = 1e-3;
+// Below this the norm is 1 to the file's printing precision: no warning.
+constexpr double kQuaternionNormSilent = 1e-6;
+
+struct QuaternionRepairs {
+  int count = 0;
+  int worst_line = 0;
+  double worst_error = 0.0;
+};
+
+double YawOfTumRow(const double* row, const std::string& path, int line_number,
+                   QuaternionRepairs* repairs) {
+  double qx = row[4], qy = row[5], qz = row[6], qw = row[7];
+  const double norm = std::sqrt(qx * qx + qy * qy + qz * qz + qw * qw);
+  const double error = std::abs(norm - 1.0);
+  if (!(error <= kQuaternionNormTolerance)) {
+    throw InputError(InputErrorKind::kBadValue, path, line_number,
+                     "quaternion is not a unit quaternion (norm " + Number(norm) +
+                         "; fitcal normalises within " + Number(kQuaternionNormTolerance) +
+                         " of 1, rounding, and refuses beyond)");
+  }
+  if (error > kQuaternionNormSilent) {
+    ++repairs->count;
+    if (error > repairs->worst_error) {
+      repairs->worst_error = error;
+      repairs->worst_line = line_number;
     }
-    found = true;
+  }
+  qx /= norm, qy /= norm, qz /= norm, qw /= norm;
+  return std::atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz));
+}
+
+void CheckPosePlausible(const double* row, const std::string& path, int line_number) {
+  CheckTimePlausible(row[0], path, line_number);
+  if (std::abs(row[1]) > kMaxPositionM || std::abs(row[2]) > kMaxPositionM) {
+    throw InputError(InputErrorKind::kImplausibleValue, path, line_number,
+                     "position (" + Number(row[1]) + ", " + Number(row[2]) +
+                         ") m is beyond any map (limit " + Number(kMaxPositionM) +
+                         " m; wrong units or a corrupted field?)");
+  }
+}
+
+// The first non-blank, non-comment line decides the format; *line is left on it.
+bool DetectTum(TextFileReader& lines, std::string_view* line) {
+  while (lines.Next(line)) {
+    const std::string_view t = Trim(*line);
+    if (t.empty() || t.front() == '#') continue;  // only TUM files carry '#' comments
     if (t.size() >= 2 && t[0] == 't' && t[1] == ',') {
-      ExpectHeader(line, {"t", "x", "y", "theta"}, path, lines.line_number());
-      tum = false;
-    } else if (t.find(',') == std::string_view::npos) {
-      tum = true;
-    } else {
-      throw InputError(
-          InputErrorKind::kBadHeader, path, lines.line_number(),
-          "header must be 't,x,y,theta' (or a TUM file 't x y z qx qy qz qw'), found '" +
-              std::string(line) + "'");
+      ExpectHeader(*line, {"t", "x", "y", "theta"}, lines.path(), lines.line_number());
+      return false;
     }
-    break;
+    if (t.find(',') == std::string_view::npos) return true;
+    throw InputError(InputErrorKind::kBadHeader, lines.path(), lines.line_number(),
+                     "header must be 't,x,y,theta' (or a TUM file 't x y z qx qy qz qw'), found '" +
+                         std::string(*line) + "'");
   }
-  if (!found) {
-    throw InputError(InputErrorKind::kEmptyFile, path, 1,
-                     "empty file (expected header 't,x,y,theta' or TUM rows)");
-  }
+  throw InputError(InputErrorKind::kEmptyFile, lines.path(), 1,
+                   "empty file (expected header 't,x,y,theta' or TUM rows)");
+}
+
+GroundTruthTrack ReadGroundTruthRows(TextFileReader& lines) {
+  const std::string& path = lines.path();
+  std::string_view line;
+  const bool tum = DetectTum(lines, &line);
   GroundTruthTrack track;
   double row[kMaxColumns];
-  auto add = [&](double t, const Pose2d& pose) {
-    if (!track.t_s.empty()) CheckIncreasing(track.t_s.back(), t, path, lines.line_number());
-    track.t_s.push_back(t);
+  QuaternionRepairs repairs;
+  auto add = [&](const Pose2d& pose) {
+    CheckPosePlausible(row, path, lines.line_number());
+    if (!track.t_s.empty()) CheckIncreasing(track.t_s.back(), row[0], path, lines.line_number());
+    track.t_s.push_back(row[0]);
     track.world_T_robot.push_back(pose);
   };
   if (tum) {
-    // The line that decided the format is a data row.
-    do {
+    do {  // the line that decided the format is a data row
       const std::string_view t = Trim(line);
       if (t.empty() || t.front() == '#') continue;
       ParseRow(line, ' ', 8, path, lines.line_number(), row);
-      const double qx = row[4], qy = row[5], qz = row[6], qw = row[7];
-      const double norm = std::sqrt(qx * qx + qy * qy + qz * qz + qw * qw);
-      if (!(norm > 0.5 && norm < 1.5)) {
-        throw InputError(InputErrorKind::kBadValue, path, lines.line_number(),
-                         "quaternion is not a unit quaternion (norm " + std::to_string(norm) + ")");
-      }
-      const double yaw = std::atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz));
-      add(row[0], Pose2d{row[1], row[2], yaw});
+      add(Pose2d{row[1], row[2], YawOfTumRow(row, path, lines.line_number(), &repairs)});
     } while (lines.Next(&line));
   } else {
     while (lines.Next(&line)) {
       if (IsBlank(line)) continue;
       ParseRow(line, ',', 4, path, lines.line_number(), row);
-      add(row[0], Pose2d{row[1], row[2], row[3]});
+      add(Pose2d{row[1], row[2], row[3]});
     }
   }
+  if (repairs.count > 0) {
+    Warn(path, repairs.worst_line,
+         std::to_string(repairs.count) + " quaternion(s) normalised, norm up to " +
+             Number(repairs.worst_error) + " from 1 (within the tolerance " +
+             Number(kQuaternionNormTolerance) + ")");
+  }
+  return track;
+}
+
+}  // namespace
+
+GroundTruthTrack ReadGroundTruth(const std::string& path) {
+  GroundTruthTrack track = ReportingOutOfMemory(path, [&] {
+    TextFileReader lines(path);
+    return ReadGroundTruthRows(lines);
+  });
   if (track.t_s.size() < 2) {
     throw InputError(
         InputErrorKind::kTooFewSamples, path, 0,

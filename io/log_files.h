@@ -42,6 +42,7 @@ class EncoderRowConverter {
   }
   // t_s must increase (checked by the caller); row holds one value per column.
   void Add(double t_s, const double* row);
+  const EncoderSamples& samples() const { return log_.samples; }
   EncoderLog Take() { return std::move(log_); }
 
  private:

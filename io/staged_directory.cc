@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "io/atomic_file.h"
+
 namespace fitcal::io {
 namespace {
 
@@ -35,6 +37,7 @@ StagedDirectory::StagedDirectory(const std::string& target) {
   if (t.has_parent_path()) fs::create_directories(t.parent_path(), ec);
   if (ec) throw std::runtime_error(target_ + ": cannot create its parent: " + ec.message());
   staging_ = MakeUniqueDirectory(target_ + ".tmp-");
+  SetStagingDirectoryForSignals(staging_);
   fs::permissions(staging_,
                   fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec |
                       fs::perms::others_read | fs::perms::others_exec,
@@ -42,12 +45,16 @@ StagedDirectory::StagedDirectory(const std::string& target) {
 }
 
 StagedDirectory::~StagedDirectory() {
+  SetStagingDirectoryForSignals("");
   if (committed_) return;
   std::error_code ec;
   fs::remove_all(staging_, ec);
 }
 
 void StagedDirectory::Commit(bool replace_existing) {
+  // From here a signal leaves the complete staged directory (and perhaps the previous one moved
+  // aside), never a removed staging directory with the target moved away.
+  SetStagingDirectoryForSignals("");
   std::error_code ec;
   const bool exists = fs::exists(target_, ec);
   if (exists && !replace_existing) {

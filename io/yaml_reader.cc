@@ -1,6 +1,9 @@
 #include "io/yaml_reader.h"
 
 #include <cmath>
+#include <map>
+#include <new>
+#include <vector>
 
 #include "io/input_error.h"
 #include "io/text_file.h"
@@ -26,12 +29,55 @@ const char* TypeName(YAML::NodeType::value type) {
 int LineOf(const YAML::Node& node) { return node.Mark().line >= 0 ? node.Mark().line + 1 : 0; }
 }  // namespace
 
+namespace {
+// yaml-cpp keeps both entries of a key written twice, and node[key] finds the first: the second
+// would be silently ignored (a hand edit that "changes" a value without effect). Every map of
+// the document is checked, iteratively (a deeply nested file must not overflow the stack).
+void RejectDuplicateKeys(const YAML::Node& root, const std::string& path) {
+  std::vector<YAML::Node> pending{root};
+  while (!pending.empty()) {
+    const YAML::Node node = pending.back();
+    pending.pop_back();
+    if (node.IsSequence()) {
+      for (const YAML::Node& child : node) pending.push_back(child);
+    } else if (node.IsMap()) {
+      std::map<std::string, int> first_line;
+      for (const auto& entry : node) {
+        if (entry.first.IsScalar()) {
+          const auto [it, fresh] = first_line.emplace(entry.first.Scalar(), LineOf(entry.first));
+          if (!fresh) {
+            throw InputError(InputErrorKind::kDuplicateKey, path, LineOf(entry.first),
+                             "key '" + entry.first.Scalar() +
+                                 "' appears twice in one map (first "
+                                 "at line " +
+                                 std::to_string(it->second) + "); remove one");
+          }
+        }
+        pending.push_back(entry.second);
+      }
+    }
+  }
+}
+}  // namespace
+
+YAML::Node ParseYaml(const std::string& text, const std::string& path) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw InputError(InputErrorKind::kYamlSyntax, path, e.mark.line + 1, e.msg);
+  }
+  RejectDuplicateKeys(root, path);
+  return root;
+}
+
 YAML::Node LoadYamlFile(const std::string& path) {
   const std::string text = ReadTextFile(path);
   try {
-    return YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw InputError(InputErrorKind::kYamlSyntax, path, e.mark.line + 1, e.msg);
+    return ParseYaml(text, path);
+  } catch (const std::bad_alloc&) {
+    throw InputError(InputErrorKind::kOutOfMemory, path, 0,
+                     "out of memory while parsing this file");
   }
 }
 

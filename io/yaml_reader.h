@@ -11,8 +11,10 @@
 
 namespace fitcal::io {
 
-// Parses a YAML file; throws InputError (kMissingFile, kYamlSyntax).
+// Parses a YAML file; throws InputError (kMissingFile, kYamlSyntax, kDuplicateKey).
 YAML::Node LoadYamlFile(const std::string& path);
+// The same for text already in memory; `path` names it in messages.
+YAML::Node ParseYaml(const std::string& text, const std::string& path);
 
 class YamlMap {
  public:

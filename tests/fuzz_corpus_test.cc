@@ -66,6 +66,8 @@ TEST(FuzzCorpusTest, WellFormedSeedsLoad) {
   EXPECT_FALSE(RunFuzzTarget("tum", ReadBytes(root / "tum" / "bad_quaternion.tum")));
   EXPECT_TRUE(RunFuzzTarget("dataset_yaml", ReadBytes(root / "dataset_yaml" / "two_runs.yaml")));
   EXPECT_FALSE(RunFuzzTarget("dataset_yaml", ReadBytes(root / "dataset_yaml" / "outside.yaml")));
+  EXPECT_FALSE(
+      RunFuzzTarget("dataset_yaml", ReadBytes(root / "dataset_yaml" / "same_file_twice.yaml")));
   EXPECT_TRUE(RunFuzzTarget("robot_yaml", ReadBytes(root / "robot_yaml" / "apr02.yaml")));
   EXPECT_FALSE(RunFuzzTarget("robot_yaml", ReadBytes(root / "robot_yaml" / "lo_gt_hi.yaml")));
   EXPECT_TRUE(

@@ -171,9 +171,12 @@ runs:
 
 TEST(Dataset, LoadsRunsAndStartPose) {
   TempDir dir;
+  // A second run of its own (one file listed for two runs is refused as a duplicated run).
+  dir.Write("runs/e2.csv", "t,w_a,w_b,w_c\n0,0,0,0\n0.01,1,2,3\n0.02,1,2,4\n");
+  dir.Write("runs/g2.csv", "t,x,y,theta\n0,0,0,0\n0.02,0.1,0.2,0.4\n");
   WriteDataset(dir, std::string(kDatasetYaml) +
-                        "  - {id: r2, trajectory: R1, repetition: 2, encoders: runs/e.csv, "
-                        "ground_truth: runs/g.csv, start_pose: [1, 2, 0.5]}\n");
+                        "  - {id: r2, trajectory: R1, repetition: 2, encoders: runs/e2.csv, "
+                        "ground_truth: runs/g2.csv, start_pose: [1, 2, 0.5]}\n");
   const Dataset d = LoadDataset(dir.path().string());
   ASSERT_EQ(d.runs.size(), 2u);
   EXPECT_EQ(d.runs[1].repetition, 2);

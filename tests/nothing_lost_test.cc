@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -208,6 +209,88 @@ TEST(NothingLostTest, RatesInDegreesPerSecondGiveAUnitsWarning) {
            "'");
   EXPECT_NE(ReadFileBytes(err).find("likely units: deg/s instead of rad/s"), std::string::npos)
       << ReadFileBytes(err);
+}
+
+// report/ is written as a set (issue 12, item 6): staged in a sibling directory and renamed over
+// the previous report. A signal in the middle, or a write that fails (RLIMIT_FSIZE: EFBIG, as a
+// full disk gives ENOSPC), leaves the previous report byte for byte: never index.html of one run
+// beside metrics.json of another.
+std::map<std::string, std::string> DirectoryBytes(const fs::path& dir) {
+  std::map<std::string, std::string> out;
+  for (const auto& e : fs::directory_iterator(dir))
+    out[e.path().filename().string()] = ReadFileBytes(e.path());
+  return out;
+}
+
+pid_t StartReportStoppedAt(const std::vector<std::string>& args, const char* stage) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    std::freopen("/dev/null", "w", stdout);
+    setenv("FITCAL_TEST_STOP_AT", stage, 1);
+    std::vector<char*> argv{const_cast<char*>("fitcal")};
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execv(kFitcal.c_str(), argv.data());
+    _exit(127);
+  }
+  int status = 0;
+  if (pid < 0 || waitpid(pid, &status, WUNTRACED) != pid || !WIFSTOPPED(status)) return -1;
+  return pid;
+}
+
+TEST(NothingLostTest, ReportDirectoryIsReplacedWholeOrNotAtAll) {
+  const TempDir scratch;
+  const fs::path data = Simulate(scratch.path(), 2);
+  const fs::path cal = scratch.path() / "cal.yaml";
+  ASSERT_EQ(RunShell(kFitcal + " --logs '" + data.string() + "' --train-reps 1 --out '" +
+                     cal.string() + "' > /dev/null"),
+            0);
+  const fs::path report = scratch.path() / "report";
+  const std::string base = kFitcal + " report --logs '" + data.string() + "' --calibration '" +
+                           cal.string() + "' --out '" + report.string() + "'";
+  ASSERT_EQ(RunShell(base + " --train-reps 1 > /dev/null"), 0);
+  const auto previous = DirectoryBytes(report);
+  ASSERT_EQ(previous.size(), 4u);
+  const auto siblings = [&] { return Leftovers(scratch.path(), {"data", "cal.yaml", "report"}); };
+
+  // The next report differs (another training split), so a mix would show.
+  for (int signal_number : {SIGTERM, SIGKILL}) {
+    SCOPED_TRACE(strsignal(signal_number));
+    const pid_t pid =
+        StartReportStoppedAt({"report", "--logs", data.string(), "--calibration", cal.string(),
+                              "--out", report.string(), "--train-reps", "2"},
+                             "report-staged");
+    ASSERT_GT(pid, 0);
+    ASSERT_EQ(siblings().size(), 1u) << "no staged directory beside the report";
+    kill(pid, signal_number);
+    kill(pid, SIGCONT);
+    int status = 0;
+    ASSERT_EQ(waitpid(pid, &status, 0), pid);
+    EXPECT_TRUE(WIFSIGNALED(status));
+    EXPECT_EQ(DirectoryBytes(report), previous) << "the previous report was changed";
+    if (signal_number == SIGKILL) {  // uncatchable: the staged sibling stays, named after it
+      ASSERT_EQ(siblings().size(), 1u);
+      EXPECT_EQ(siblings()[0].rfind("report.tmp-", 0), 0u) << siblings()[0];
+      fs::remove_all(scratch.path() / siblings()[0]);
+    } else {
+      EXPECT_TRUE(siblings().empty()) << siblings()[0];
+    }
+  }
+  // A write that fails: files larger than 8 kB cannot be written (EFBIG; SIGXFSZ ignored).
+  const fs::path err = scratch.path() / "err.txt";
+  EXPECT_EQ(RunShell("trap '' XFSZ; ulimit -f 8; " + base + " --train-reps 2 > /dev/null 2> '" +
+                     err.string() + "'"),
+            1);
+  EXPECT_NE(ReadFileBytes(err).find("cannot write"), std::string::npos) << ReadFileBytes(err);
+  fs::remove(err);
+  EXPECT_EQ(DirectoryBytes(report), previous);
+  EXPECT_TRUE(siblings().empty()) << siblings()[0];
+  // Uninterrupted: replaced as a whole.
+  ASSERT_EQ(RunShell(base + " --train-reps 2 > /dev/null"), 0);
+  const auto next = DirectoryBytes(report);
+  ASSERT_EQ(next.size(), 4u);
+  for (const auto& [name, bytes] : next) EXPECT_NE(bytes, previous.at(name)) << name;
+  EXPECT_TRUE(siblings().empty());
 }
 
 }  // namespace

@@ -16,7 +16,10 @@
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/robot_yaml.h"
+#include "io/staged_directory.h"
 #include "odometry/parallel_for.h"
+#include "tools/cli_validators.h"
+#include "tools/output_guard.h"
 
 namespace fitcal::tools {
 
@@ -29,7 +32,8 @@ CLI::App* AddDiagnoseCommand(CLI::App& app, DiagnoseCommandOptions& o) {
       ->check(CLI::ExistingDirectory);
   cmd->add_option("--train-reps", o.train_reps,
                   "Training repetitions (e.g. 1-5); auto = the first half; the rest validate")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(RepetitionListValidator(/*allow_auto=*/true));
   cmd->add_option("--train-trajectories", o.train_trajectories,
                   "Split by trajectory label instead: a list of labels or a regular expression "
                   "(e.g. ^circular); matching runs train, the others validate");
@@ -49,12 +53,24 @@ CLI::App* AddDiagnoseCommand(CLI::App& app, DiagnoseCommandOptions& o) {
   return cmd;
 }
 
+namespace {
+const std::set<std::string> kDiagnoseFiles = {"diagnose.md", "residuals.csv",
+                                              "residuals_declared.csv", "calibrated.yaml"};
+}  // namespace
+
 int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
   try {
     io::DatasetOptions dataset_options;
     dataset_options.allow_paths_outside = options.allow_outside_paths;
     dataset_options.num_threads = options.threads;
-    const io::Dataset dataset = io::LoadDataset(options.logs, dataset_options);
+    const io::DatasetIndex index = io::ReadDatasetIndex(options.logs, dataset_options);
+    const std::vector<std::string> inputs = DatasetInputs(index);
+    if (const std::string refusal = OutputDirectoryRefusal(options.out, inputs, kDiagnoseFiles);
+        !refusal.empty()) {
+      std::cerr << "fitcal: " << refusal << "\n";
+      return 2;
+    }
+    const io::Dataset dataset = io::LoadDataset(index, dataset_options);
     const std::string model = io::ReadRobotModel(dataset.robot_path);
     if (model != "omni3") {
       throw io::InputError(io::InputErrorKind::kUnknownModel, dataset.robot_path, 0,
@@ -142,18 +158,22 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
     const std::string yaml = io::Omni3RobotYaml(calibrated, &record);
     const std::string csv = ResidualSamplesCsv(result.after);
     const std::string csv_declared = ResidualSamplesCsv(result.before);
-    std::filesystem::create_directories(options.out);
-    const std::filesystem::path dir(options.out);
-    io::WriteFileAtomically((dir / "diagnose.md").string(), report);
-    io::WriteFileAtomically((dir / "residuals.csv").string(), csv);
-    io::WriteFileAtomically((dir / "residuals_declared.csv").string(), csv_declared);
-    io::WriteFileAtomically((dir / "calibrated.yaml").string(), yaml);
+    {  // written as a set: staged, then renamed over the previous output (report_command.cc)
+      io::StagedDirectory staged(options.out);
+      const std::filesystem::path dir(staged.path());
+      io::WriteFileAtomically((dir / "diagnose.md").string(), report);
+      io::WriteFileAtomically((dir / "residuals.csv").string(), csv);
+      io::WriteFileAtomically((dir / "residuals_declared.csv").string(), csv_declared);
+      io::StopHereForTests("diagnose-staged");
+      io::WriteFileAtomically((dir / "calibrated.yaml").string(), yaml);
+      CommitOutputDirectory(staged, options.out, inputs, kDiagnoseFiles);
+    }
     std::printf(
         "\nwrote %s/{diagnose.md, residuals.csv, residuals_declared.csv, calibrated.yaml}\n",
         options.out.c_str());
     return 0;
   } catch (const std::exception& e) {
-    std::cerr << "fitcal: " << e.what() << "\n";
+    std::cerr << "fitcal: " << io::OneLine(e.what(), 500) << "\n";
     return 1;
   }
 }

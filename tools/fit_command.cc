@@ -108,6 +108,14 @@ int RunFitCommand(const FitCommandOptions& options) {
     dataset_options.num_threads = options.threads;
     // ASOC robots (issue 5) have their own encoder format and fit (tools/asoc_commands.h).
     const io::DatasetIndex index = io::ReadDatasetIndex(options.logs, dataset_options);
+    if (!options.no_output) {
+      // Every model's fit writes one file: never over one of its own inputs (exit 2, usage).
+      const std::string refusal = OutputFileRefusal(options.out, DatasetInputs(index));
+      if (!refusal.empty()) {
+        std::cerr << "fitcal: " << refusal << "\n";
+        return 2;
+      }
+    }
     const std::string model_name = io::ReadRobotModel(index.robot_path);
     if (model_name == "asoc") return RunAsocFit(options);
     // Every model on the seam except omni3, whose fit (with its NLopt methods and fast kernel)
@@ -313,7 +321,7 @@ int RunFitCommand(const FitCommandOptions& options) {
     std::printf("time: load %.3f s, total %.3f s\n", load_s, Seconds(t_total));
     return 0;
   } catch (const std::exception& e) {  // io::InputError too: what() is its file:line message
-    std::cerr << "fitcal: " << e.what() << "\n";
+    std::cerr << "fitcal: " << io::OneLine(e.what(), 500) << "\n";
     return 1;
   }
 }

@@ -1,13 +1,18 @@
 // fitcal: offline calibration of wheeled odometry. Subcommands are registered in a table below;
 // `fitcal --logs <dir> --method ceres` without a subcommand runs `fit`.
 
+#include <glog/logging.h>
+
 #include <CLI/CLI.hpp>
 #include <cmath>
+#include <cstdlib>
 #include <iostream>
 
 #include "fitcal/version.h"
 #include "io/atomic_file.h"
+#include "io/input_error.h"
 #include "tools/asoc_commands.h"
+#include "tools/cli_validators.h"
 #include "tools/compare_command.h"
 #include "tools/diagnose_command.h"
 #include "tools/export_ros2_control.h"
@@ -103,7 +108,8 @@ void AddFitOptions(CLI::App& app, fitcal::tools::FitCommandOptions& o) {
                "NLopt global methods: polish the best point with SLSQP (autodiff gradient)");
   app.add_option("--train-reps", o.train_reps,
                  "Repetitions used for fitting, e.g. 1-5 or 1,3,5; the others validate")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(fitcal::tools::RepetitionListValidator());
   app.add_option("--out", o.out, "Calibrated robot YAML to write (atomically)")
       ->capture_default_str();
   app.add_flag("--no-output", o.no_output, "Do not write the calibrated YAML");
@@ -124,9 +130,42 @@ void AddFitOptions(CLI::App& app, fitcal::tools::FitCommandOptions& o) {
       ->check(CLI::PositiveNumber);
 }
 
+// Usage errors exit 2 in one line, as the README says; CLI11's own codes (105 for a validation,
+// 106 for a missing option, ...) and its second "Run with --help" line would say otherwise.
+// Help and version requests keep CLI11's output and exit 0. Returns -1 when parsing succeeded.
+int ParseCommandLine(CLI::App& app, int argc, char** argv) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::cerr << "fitcal: " << fitcal::io::OneLine(e.what(), 300) << " (see fitcal --help)\n";
+    return 2;
+  }
+  return -1;
+}
+
+// Ceres logs through glog, which writes WARNING and above to stderr before InitGoogleLogging:
+// lines such as "W... Ceres was compiled without ..." would break fitcal's one line per problem.
+// What Ceres reports (termination, failure) reaches fitcal through its Summary instead.
+void SilenceLibraryLogging(const char* argv0) {
+  FLAGS_logtostderr = false;
+  FLAGS_alsologtostderr = false;
+  FLAGS_stderrthreshold = google::GLOG_FATAL;
+  FLAGS_minloglevel = google::GLOG_FATAL;
+  google::InitGoogleLogging(argv0);
+  // For refusal_test: a library line at every severity below FATAL, as Ceres writes them on an
+  // ill-posed problem (e.g. "W... residual_block.cc:129] Error in evaluating the ResidualBlock").
+  if (std::getenv("FITCAL_TEST_LIBRARY_LOG") != nullptr) {
+    LOG(INFO) << "test info line";
+    LOG(WARNING) << "test warning line";
+    LOG(ERROR) << "test error line";
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  SilenceLibraryLogging(argv[0]);
   // Ctrl-C or a scheduler's SIGTERM while an output is being written leaves no temporary behind.
   fitcal::io::RemoveTemporaryFilesOnSignals();
   CLI::App app{"fitcal " + std::string(fitcal::kVersion) +
@@ -245,8 +284,10 @@ int main(int argc, char** argv) {
       ->required()
       ->check(CLI::ExistingFile);
   report_cmd->add_option("--out", report.out, "Output directory for the report")->required();
-  report_cmd->add_option("--train-reps", report.train_reps,
-                         "Training repetitions (default: as recorded in the calibration YAML)");
+  report_cmd
+      ->add_option("--train-reps", report.train_reps,
+                   "Training repetitions (default: as recorded in the calibration YAML)")
+      ->check(fitcal::tools::RepetitionListValidator());
   report_cmd
       ->add_option("--sampling", report.sampling,
                    "Odometry at ground-truth times: nearest (default, as the paper) or linear")
@@ -276,8 +317,10 @@ int main(int argc, char** argv) {
       ->add_option("--repetitions", compare.repetitions,
                    "Train on the first k repetitions, for each k")
       ->capture_default_str();
-  compare_cmd->add_option("--validation-reps", compare.validation_reps,
-                          "Validation repetitions (default: those after the largest k)");
+  compare_cmd
+      ->add_option("--validation-reps", compare.validation_reps,
+                   "Validation repetitions (default: those after the largest k)")
+      ->check(fitcal::tools::RepetitionListValidator());
   compare_cmd
       ->add_option("--out", compare.out, "Output prefix: <out>.csv, <out>.md, <out>_trace.csv")
       ->capture_default_str();
@@ -296,7 +339,7 @@ int main(int argc, char** argv) {
   fitcal::tools::DiagnoseCommandOptions diagnose;
   CLI::App* diagnose_cmd = fitcal::tools::AddDiagnoseCommand(app, diagnose);
 
-  CLI11_PARSE(app, argc, argv);
+  if (const int usage_rc = ParseCommandLine(app, argc, argv); usage_rc >= 0) return usage_rc;
 
   if (diagnose_cmd->parsed()) return fitcal::tools::RunDiagnoseCommand(diagnose);
 

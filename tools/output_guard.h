@@ -1,13 +1,42 @@
 #pragma once
-// `--out` must not silently replace another robot's calibration. Shared by every command that
-// writes a calibrated robot YAML.
+// What an output may replace. `--out` must not silently replace another robot's calibration, an
+// input of the same run (the data set, the robot YAML, a log), a directory of someone else's
+// files, or something that is not a file at all. Shared by every command that writes.
 
+#include <set>
 #include <string>
+#include <vector>
+
+#include "io/dataset.h"
+#include "io/staged_directory.h"
 
 namespace fitcal::tools {
 
 // Empty when writing `out` is fine: it does not exist, or it is a robot YAML of the same `name`.
 // Otherwise the one-line reason to refuse (the caller allows it with --force).
 std::string OverwriteRefusal(const std::string& out, const std::string& robot_name);
+
+// Empty when `out` may be written as a file. Refuses (not even --force: a usage error) a path that
+// exists and is not a regular file (a directory; a FIFO or a device: renaming over /dev/null as
+// root would replace the device) and a path that is one of `inputs` (the same file through any
+// name or link), which writing would destroy before anyone noticed.
+std::string OutputFileRefusal(const std::string& out, const std::vector<std::string>& inputs);
+
+// Empty when `out` may be written as a directory that replaces what is there: it does not exist,
+// or it is a directory holding only names in `own_names` (a previous output of the same command).
+// Refuses a directory that holds anything else (the data set directory itself, a parent of it, a
+// user's files), a path that is not a directory, and a directory that is one of `inputs` or holds
+// one.
+std::string OutputDirectoryRefusal(const std::string& out, const std::vector<std::string>& inputs,
+                                   const std::set<std::string>& own_names);
+
+// Renames a complete staged directory over `out`, after checking once more what it replaces
+// (another writer may have put files there meanwhile); throws std::runtime_error otherwise.
+void CommitOutputDirectory(io::StagedDirectory& staged, const std::string& out,
+                           const std::vector<std::string>& inputs,
+                           const std::set<std::string>& own_names);
+
+// Every file a data set run reads: dataset.yaml, the robot YAML, each run's logs.
+std::vector<std::string> DatasetInputs(const io::DatasetIndex& index);
 
 }  // namespace fitcal::tools

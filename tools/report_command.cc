@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <iostream>
 #include <map>
+#include <set>
 
 #include "calib/cross_validation.h"
 #include "calib/identifiability.h"
@@ -18,7 +19,9 @@
 #include "io/input_error.h"
 #include "io/report_writer.h"
 #include "io/robot_yaml.h"
+#include "io/staged_directory.h"
 #include "odometry/effects.h"
+#include "tools/output_guard.h"
 #include "tools/sim/flower_candidates.h"
 
 namespace fitcal::tools {
@@ -64,6 +67,11 @@ std::string FamilyOf(const std::string& label) {
 
 }  // namespace
 
+namespace {
+const std::set<std::string> kReportFiles = {"index.html", "summary.md", "metrics.csv",
+                                            "metrics.json"};
+}  // namespace
+
 int RunReportCommand(const ReportCommandOptions& options) {
   OdometrySampling sampling;
   if (options.sampling == "nearest") {
@@ -79,7 +87,15 @@ int RunReportCommand(const ReportCommandOptions& options) {
     io::DatasetOptions dataset_options;
     dataset_options.allow_paths_outside = options.allow_outside_paths;
     dataset_options.num_threads = options.threads;
-    const io::Dataset dataset = io::LoadDataset(options.logs, dataset_options);
+    const io::DatasetIndex index = io::ReadDatasetIndex(options.logs, dataset_options);
+    std::vector<std::string> inputs = DatasetInputs(index);
+    inputs.push_back(options.calibration);
+    if (const std::string refusal = OutputDirectoryRefusal(options.out, inputs, kReportFiles);
+        !refusal.empty()) {
+      std::cerr << "fitcal: " << refusal << "\n";
+      return 2;
+    }
+    const io::Dataset dataset = io::LoadDataset(index, dataset_options);
     for (const std::string& path : {dataset.robot_path, options.calibration}) {
       const std::string model = io::ReadRobotModel(path);
       if (model != "omni3") {
@@ -299,14 +315,20 @@ int RunReportCommand(const ReportCommandOptions& options) {
       data.parameters.push_back(rp);
     }
 
-    // Everything is computed; only now touch the output directory.
-    namespace fs = std::filesystem;
-    fs::create_directories(options.out);
-    const fs::path out(options.out);
-    io::WriteFileAtomically((out / "index.html").string(), io::ReportHtml(data));
-    io::WriteFileAtomically((out / "summary.md").string(), io::ReportMarkdown(data));
-    io::WriteFileAtomically((out / "metrics.csv").string(), io::MetricsCsv(data));
-    io::WriteFileAtomically((out / "metrics.json").string(), io::MetricsJson(data));
+    // Everything is computed; only now touch the output directory, as a set (README, "Nothing
+    // lost"): the files go into a staged sibling renamed over the previous report, so a signal,
+    // a full disk or a second writer never leaves a mix of old and new files.
+    {
+      namespace fs = std::filesystem;
+      io::StagedDirectory staged(options.out);
+      const fs::path out(staged.path());
+      io::WriteFileAtomically((out / "index.html").string(), io::ReportHtml(data));
+      io::WriteFileAtomically((out / "summary.md").string(), io::ReportMarkdown(data));
+      io::WriteFileAtomically((out / "metrics.csv").string(), io::MetricsCsv(data));
+      io::StopHereForTests("report-staged");
+      io::WriteFileAtomically((out / "metrics.json").string(), io::MetricsJson(data));
+      CommitOutputDirectory(staged, options.out, inputs, kReportFiles);
+    }
 
     const io::ReportSummaryRow& all = data.summary.back();
     std::printf("validation: %zu runs (repetitions %s), odometry sampled by %s time\n",
@@ -326,7 +348,7 @@ int RunReportCommand(const ReportCommandOptions& options) {
                 options.out.c_str());
     return 0;
   } catch (const std::exception& e) {
-    std::cerr << "fitcal report: " << e.what() << "\n";
+    std::cerr << "fitcal report: " << io::OneLine(e.what(), 500) << "\n";
     return 1;
   }
 }

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "io/input_error.h"
+#include "io/yaml_reader.h"
 
 namespace fitcal::io::rosbag2 {
 namespace {
@@ -108,14 +109,8 @@ BagMetadata ReadInformation(const YAML::Node& info, const std::string& path) {
 }  // namespace
 
 BagMetadata ReadBagMetadata(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw InputError(InputErrorKind::kMissingFile, path, 0, "cannot open metadata.yaml");
-  } catch (const YAML::ParserException& e) {
-    throw InputError(InputErrorKind::kYamlSyntax, path, e.mark.line + 1, e.msg);
-  }
+  // The shared reader: regular files only (a FIFO does not block), duplicate keys refused.
+  const YAML::Node root = LoadYamlFile(path);
   return ReadInformation(Required(root, "rosbag2_bagfile_information", path), path);
 }
 

@@ -23,7 +23,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Valid neighbours for the data set loader: a robot and one run.
+// Valid neighbours for the data set loader: a robot and two runs.
 constexpr const char* kRobotYaml =
     "model: omni3\n"
     "name: fuzz\n"
@@ -46,6 +46,9 @@ constexpr const char* kDiffDriveYaml =
     "  - {name: left, radius_m: 0.042}\n"
     "wheel_separation_m: 0.200\n"
     "bounds: {radius_m: [0.038, 0.046], wheel_separation_m: [0.180, 0.220]}\n";
+// A second run of its own: one file listed for two runs is refused as a duplicated run.
+constexpr const char* kEncoderCsv2 = "t,w_a,w_b,w_c\n0,0,0,0\n0.01,1,2,3\n0.02,1,2,4\n";
+constexpr const char* kGroundTruthCsv2 = "t,x,y,theta\n0,0,0,0\n0.02,0.002,0,0\n";
 
 void WriteFile(const std::string& path, std::string_view bytes) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
@@ -64,6 +67,8 @@ class ScratchDir {
     WriteFile(path_ + "/enc.csv", kEncoderCsv);
     WriteFile(path_ + "/gt.csv", kGroundTruthCsv);
     WriteFile(path_ + "/diff_drive.yaml", kDiffDriveYaml);
+    WriteFile(path_ + "/enc2.csv", kEncoderCsv2);
+    WriteFile(path_ + "/gt2.csv", kGroundTruthCsv2);
   }
   ~ScratchDir() {
     std::error_code ignored;
