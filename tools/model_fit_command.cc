@@ -25,6 +25,12 @@ double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
 
+// How the training runs were chosen, for messages: --train-trajectories or --train-reps.
+std::string TrainingSelection(const FitCommandOptions& o) {
+  if (!o.train_trajectories.empty()) return "trajectories matching '" + o.train_trajectories + "'";
+  return "repetitions " + o.train_reps;
+}
+
 bool MakeModelFitOptions(const FitCommandOptions& o, ModelFitOptions* out, std::string* error) {
   CeresFitOptions& c = out->ceres;
   if (o.method != "ceres" && o.method != "ceres-dogleg") {
@@ -221,11 +227,11 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   const io::Dataset dataset = io::LoadDataset(index, robot, dataset_options);
   io::StopHereForTests("loaded");
   const RunSplit split =
-      SplitByRepetition(AlignRuns(dataset.runs), ParseRepetitionList(options.train_reps));
+      SplitForFit(AlignRuns(dataset.runs), options.train_reps, options.train_trajectories);
   const double load_s = Seconds(t_total);
   if (split.training.empty()) {
-    std::cerr << "fitcal: no run of " << options.logs << " has a training repetition ("
-              << options.train_reps << ")\n";
+    std::cerr << "fitcal: no run of " << options.logs << " is a training run ("
+              << TrainingSelection(options) << ")\n";
     return 2;
   }
   if (!options.skip_wheel_order_check &&
@@ -241,9 +247,10 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
 
   std::printf("fitcal %s  %s robot '%s'  data set %s\n", kVersion, robot.model.c_str(),
               robot.name.c_str(), options.logs.c_str());
-  std::printf("runs: %zu training (repetitions %s), %zu validation (repetitions %s)\n\n",
-              split.training.size(), FormatRepetitionList(split.training_repetitions).c_str(),
-              split.validation.size(), FormatRepetitionList(split.validation_repetitions).c_str());
+  std::printf("runs: %zu training (%s; repetitions %s), %zu validation (repetitions %s)\n\n",
+              split.training.size(), TrainingSelection(options).c_str(),
+              FormatRepetitionList(split.training_repetitions).c_str(), split.validation.size(),
+              FormatRepetitionList(split.validation_repetitions).c_str());
   PrintCfTable(*model, selected, split, options.threads);
   PrintParameters(robot, selected, fit);
   std::printf("\nsolver: Ceres %s, %s after %d iterations (%d active-set rounds), %.3f s (%s)\n",
