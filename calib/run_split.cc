@@ -4,6 +4,8 @@
 #include <set>
 #include <stdexcept>
 
+#include "calib/trajectory_split.h"
+
 namespace fitcal {
 
 namespace {
@@ -68,6 +70,28 @@ RunSplit SplitByRepetition(std::vector<AlignedRun> runs, const std::vector<int>&
   split.training_repetitions.assign(seen_train.begin(), seen_train.end());
   split.validation_repetitions.assign(seen_validation.begin(), seen_validation.end());
   return split;
+}
+
+RunSplit SplitByTrajectory(std::vector<AlignedRun> runs, const std::string& selector_text) {
+  std::vector<std::string> labels;
+  for (const AlignedRun& run : runs) labels.push_back(run.trajectory);
+  const TrajectorySelector selector(selector_text, labels);
+  RunSplit split;
+  std::set<int> seen_train, seen_validation;
+  for (AlignedRun& run : runs) {
+    const bool trains = selector.Matches(run.trajectory);
+    (trains ? seen_train : seen_validation).insert(run.repetition);
+    (trains ? split.training : split.validation).push_back(std::move(run));
+  }
+  split.training_repetitions.assign(seen_train.begin(), seen_train.end());
+  split.validation_repetitions.assign(seen_validation.begin(), seen_validation.end());
+  return split;
+}
+
+RunSplit SplitForFit(std::vector<AlignedRun> runs, const std::string& train_reps,
+                     const std::string& train_trajectories) {
+  if (!train_trajectories.empty()) return SplitByTrajectory(std::move(runs), train_trajectories);
+  return SplitByRepetition(std::move(runs), ParseRepetitionList(train_reps));
 }
 
 }  // namespace fitcal

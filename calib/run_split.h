@@ -22,4 +22,14 @@ struct RunSplit {
 
 RunSplit SplitByRepetition(std::vector<AlignedRun> runs, const std::vector<int>& training_reps);
 
+// By trajectory label instead: the runs whose label the selector matches train (a list of labels
+// or a regular expression, calib/trajectory_split.h); the repetition lists name what is present
+// on each side. Throws std::invalid_argument for an invalid selector.
+RunSplit SplitByTrajectory(std::vector<AlignedRun> runs, const std::string& selector);
+
+// SplitByTrajectory when `train_trajectories` is set, else SplitByRepetition of `train_reps`:
+// the choice `fitcal fit --train-reps / --train-trajectories` offers for every model.
+RunSplit SplitForFit(std::vector<AlignedRun> runs, const std::string& train_reps,
+                     const std::string& train_trajectories);
+
 }  // namespace fitcal

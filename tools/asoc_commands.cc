@@ -223,6 +223,11 @@ int RunAsocFit(const FitCommandOptions& options) {
         return 2;
       }
     }
+    if (!options.train_trajectories.empty()) {
+      std::cerr << "fitcal: --train-trajectories is not available for asoc robots yet (their "
+                   "fit has its own command path); use --train-reps\n";
+      return 2;
+    }
     const std::vector<int> train_reps = ParseRepetitionList(options.train_reps);
     std::vector<asoc::AlignedAsocRun> training, validation, umbmark;
     std::vector<asoc::RunLog> umbmark_logs;

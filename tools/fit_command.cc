@@ -143,12 +143,15 @@ int RunFitCommand(const FitCommandOptions& options) {
         return 2;
       }
     }
-    const std::vector<int> train_reps = ParseRepetitionList(options.train_reps);
-    RunSplit split = SplitByRepetition(AlignRuns(dataset.runs), train_reps);
+    RunSplit split =
+        SplitForFit(AlignRuns(dataset.runs), options.train_reps, options.train_trajectories);
     const double load_s = Seconds(t_load);
     if (split.training.empty()) {
-      std::cerr << "fitcal: no run of " << options.logs << " has a training repetition ("
-                << options.train_reps << ")\n";
+      std::cerr << "fitcal: no run of " << options.logs << " is a training run ("
+                << (options.train_trajectories.empty()
+                        ? "repetitions " + options.train_reps
+                        : "trajectories matching '" + options.train_trajectories + "'")
+                << ")\n";
       return 2;
     }
 

@@ -10,6 +10,9 @@ struct FitCommandOptions {
   std::string logs;
   std::string method = "ceres";
   std::string train_reps = "1-5";
+  // Non-empty: train on the runs whose trajectory label matches (calib/trajectory_split.h),
+  // validate on the others; replaces train_reps.
+  std::string train_trajectories;
   std::string out = "calibrated.yaml";
   bool no_output = false;
   bool force = false;  // overwrite --out even when it holds another robot's calibration

@@ -106,10 +106,15 @@ void AddFitOptions(CLI::App& app, fitcal::tools::FitCommandOptions& o) {
       ->check(CLI::PositiveNumber);
   app.add_flag("--polish", o.polish,
                "NLopt global methods: polish the best point with SLSQP (autodiff gradient)");
-  app.add_option("--train-reps", o.train_reps,
-                 "Repetitions used for fitting, e.g. 1-5 or 1,3,5; the others validate")
-      ->capture_default_str()
-      ->check(fitcal::tools::RepetitionListValidator());
+  CLI::Option* reps =
+      app.add_option("--train-reps", o.train_reps,
+                     "Repetitions used for fitting, e.g. 1-5 or 1,3,5; the others validate")
+          ->capture_default_str()
+          ->check(fitcal::tools::RepetitionListValidator());
+  app.add_option("--train-trajectories", o.train_trajectories,
+                 "Fit on the runs whose trajectory label matches (list or regular expression); "
+                 "the others validate")
+      ->excludes(reps);
   app.add_option("--out", o.out, "Calibrated robot YAML to write (atomically)")
       ->capture_default_str();
   app.add_flag("--no-output", o.no_output, "Do not write the calibrated YAML");
@@ -273,6 +278,14 @@ int main(int argc, char** argv) {
       ->add_option("--effects", generalise.effects,
                    "Library effects to add as a further model (nine + effects, track cost)")
       ->delimiter(',');
+  gen_cmd->add_option("--train-reps", generalise.train_reps,
+                      "Models other than omni3: repetitions of every path type that train the "
+                      "split against the other repetitions (default: the first half present)");
+  gen_cmd
+      ->add_option("--sessions", generalise.sessions,
+                   "Models other than omni3: a leave-one-session-out session is a trajectory "
+                   "label (label) or a path type + repetition number (repetition)")
+      ->capture_default_str();
 
   fitcal::tools::ReportCommandOptions report;
   CLI::App* report_cmd = app.add_subcommand(

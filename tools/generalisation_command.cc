@@ -14,7 +14,9 @@
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/robot_yaml.h"
+#include "models/model_registry.h"
 #include "odometry/parallel_for.h"
+#include "tools/model_generalise_command.h"
 
 namespace fitcal::tools {
 
@@ -132,7 +134,22 @@ int RunGeneraliseCommand(const GeneraliseCommandOptions& options) {
   try {
     io::DatasetOptions dataset_options;
     dataset_options.num_threads = options.threads;
-    const io::Dataset dataset = io::LoadDataset(options.logs, dataset_options);
+    const io::DatasetIndex index = io::ReadDatasetIndex(options.logs, dataset_options);
+    const std::string model_name = io::ReadRobotModel(index.robot_path);
+    if (model_name == "asoc") {
+      std::cerr << "fitcal: generalise is not available for asoc robots (their fit has its own "
+                   "command path: fitcal fit)\n";
+      return 2;
+    }
+    if (model_name != "omni3") {
+      return RunModelGeneraliseCommand(options, index, ReadRobotModelFile(index.robot_path));
+    }
+    if (!options.train_reps.empty() || options.sessions != "label") {
+      std::cerr << "fitcal: generalise --train-reps and --sessions apply to the models on the "
+                   "generic path, not to omni3's table\n";
+      return 2;
+    }
+    const io::Dataset dataset = io::LoadDataset(index, dataset_options);
     const Omni3Robot robot = io::ReadOmni3Robot(dataset.robot_path);
     SegmentOptions segment_options;
     segment_options.length_m = options.segment_length_m;

@@ -6,7 +6,9 @@
 // cost, the reduced common-distance + three-radii model) it prints:
 //   - train on one path type, test on each other one (final-pose CF, Eq. 14, and segment CF);
 //   - leave-one-session-out: fit on all other sessions, test on the one left out.
-// The Markdown table it prints is the one in the README.
+// The Markdown table it prints is the one in the README. Every other model on the seam goes
+// through tools/model_generalise_command.h (nominal, closed forms and the fit; the same splits
+// plus training repetitions against the rest).
 
 #include <string>
 #include <vector>
@@ -28,6 +30,12 @@ struct GeneraliseCommandOptions {
   // without effects, the like-for-like baseline.
   std::vector<std::string> effects;
   int threads = 0;
+  // Models other than omni3 (tools/model_generalise_command.h): the repetitions that train the
+  // "every path type" split ("" or "auto": the first half of those present), and what a session
+  // of leave-one-session-out is: "label" (the trajectory label) or "repetition" (path type +
+  // repetition number, as the OptiOdom tricycle import numbers its sessions).
+  std::string train_reps;
+  std::string sessions = "label";
 };
 
 int RunGeneraliseCommand(const GeneraliseCommandOptions& options);

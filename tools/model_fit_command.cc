@@ -26,6 +26,12 @@ double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
 
+// How the training runs were chosen, for messages: --train-trajectories or --train-reps.
+std::string TrainingSelection(const FitCommandOptions& o) {
+  if (!o.train_trajectories.empty()) return "trajectories matching '" + o.train_trajectories + "'";
+  return "repetitions " + o.train_reps;
+}
+
 void PrintCfTable(const RobotModelInterface& model, const std::vector<double>& selected,
                   const RunSplit& split, int threads) {
   const auto& nominal = model.robot().nominal;
@@ -174,9 +180,10 @@ void PrintFit(const FitCommandOptions& options, const RobotModelInterface& model
   const ModelFitResult& fit = outcome.fit;
   std::printf("fitcal %s  %s robot '%s'  data set %s\n", kVersion, robot.model.c_str(),
               robot.name.c_str(), options.logs.c_str());
-  std::printf("runs: %zu training (repetitions %s), %zu validation (repetitions %s)\n\n",
-              split.training.size(), FormatRepetitionList(split.training_repetitions).c_str(),
-              split.validation.size(), FormatRepetitionList(split.validation_repetitions).c_str());
+  std::printf("runs: %zu training (%s; repetitions %s), %zu validation (repetitions %s)\n\n",
+              split.training.size(), TrainingSelection(options).c_str(),
+              FormatRepetitionList(split.training_repetitions).c_str(), split.validation.size(),
+              FormatRepetitionList(split.validation_repetitions).c_str());
   PrintCfTable(model, selected, split, options.threads);
   PrintParameters(robot, selected, fit);
   // Active-set rounds are the Ceres fit's (fit/model_fit.h); NLopt methods have none.
@@ -223,11 +230,11 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   const io::Dataset dataset = io::LoadDataset(index, robot, dataset_options);
   io::StopHereForTests("loaded");
   const RunSplit split =
-      SplitByRepetition(AlignRuns(dataset.runs), ParseRepetitionList(options.train_reps));
+      SplitForFit(AlignRuns(dataset.runs), options.train_reps, options.train_trajectories);
   const double load_s = Seconds(t_total);
   if (split.training.empty()) {
-    std::cerr << "fitcal: no run of " << options.logs << " has a training repetition ("
-              << options.train_reps << ")\n";
+    std::cerr << "fitcal: no run of " << options.logs << " is a training run ("
+              << TrainingSelection(options) << ")\n";
     return 2;
   }
   if (!options.skip_wheel_order_check &&
