@@ -146,10 +146,18 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
 
   std::vector<EffectId> candidates =
       options.candidates.empty() ? DefaultCandidates(robot) : options.candidates;
+  // The registry's "not identifiable" holds for omni3 (e.g. a tracked-point offset is exactly a
+  // change of its wheel distances); another model may separate the effect (a differential drive
+  // cannot move sideways, so the same offset shows). Checked numerically here: an effect whose
+  // separable fraction reaches min_separable_fraction becomes a candidate like the others.
   for (const auto& info : effects::EffectTable()) {
     if (info.identifiable) continue;
     const double sep =
         SeparableFraction(training, model, current.parameters, {}, info.id, options.fit.weights);
+    if (options.candidates.empty() && sep >= options.min_separable_fraction) {
+      candidates.push_back(info.id);
+      continue;
+    }
     out.not_identifiable.push_back(
         std::string(info.name) + ": not identifiable - " + info.aliased_with +
         Fmt(" (separable fraction on these runs %.1e); ", sep) + info.separating_runs);

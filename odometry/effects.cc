@@ -117,7 +117,7 @@ const std::array<EffectInfo, kNumEffects>& EffectTable() {
        {0.05, 0},
        {0.01, 0},
        false,
-       "a common scale of the three wheel radii, exactly, on any data",
+       "a common scale of the wheel radii, exactly, on any data",
        "none: calibrate the clock against an external time reference"},
       {EffectId::kTranslationYawGain,
        "translation_yaw_gain",

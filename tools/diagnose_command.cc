@@ -13,10 +13,13 @@
 #include "calib/trajectory_split.h"
 #include "fitcal/version.h"
 #include "io/atomic_file.h"
+#include "io/calibration_block.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/robot_yaml.h"
+#include "io/robot_yaml_blocks.h"
 #include "io/staged_directory.h"
+#include "models/model_registry.h"
 #include "odometry/parallel_for.h"
 #include "tools/cli_validators.h"
 #include "tools/output_guard.h"
@@ -26,7 +29,7 @@ namespace fitcal::tools {
 CLI::App* AddDiagnoseCommand(CLI::App& app, DiagnoseCommandOptions& o) {
   CLI::App* cmd = app.add_subcommand(
       "diagnose",
-      "Trace the residual of the nine-parameter fit to missing effects (calib/diagnose.h)");
+      "Trace the residual of the model's fit to missing effects, any model (calib/diagnose.h)");
   cmd->add_option("--logs", o.logs, "Data set directory")
       ->required()
       ->check(CLI::ExistingDirectory);
@@ -54,8 +57,139 @@ CLI::App* AddDiagnoseCommand(CLI::App& app, DiagnoseCommandOptions& o) {
 }
 
 namespace {
+
 const std::set<std::string> kDiagnoseFiles = {"diagnose.md", "residuals.csv",
                                               "residuals_declared.csv", "calibrated.yaml"};
+
+struct DiagnoseSplit {
+  std::vector<TrackRun> training, validation;
+  std::vector<int> train_reps;
+  std::string text;
+};
+
+// Training and held-out track runs, by --train-trajectories or by --train-reps ("auto": the
+// first half of the repetitions present). wheel_mask marks the robot's wheel-rate channels.
+DiagnoseSplit SplitRuns(const DiagnoseCommandOptions& options, const std::vector<RunLog>& runs,
+                        unsigned wheel_mask) {
+  DiagnoseSplit out;
+  if (!options.train_trajectories.empty()) {
+    std::vector<std::string> labels;
+    for (const RunLog& run : runs) labels.push_back(run.trajectory);
+    const TrajectorySelector selector(options.train_trajectories, labels);
+    std::set<int> reps;
+    for (TrackRun& run : PrepareTrackRuns(runs, wheel_mask)) {
+      const bool train = selector.Matches(run.aligned.trajectory);
+      if (train) reps.insert(run.aligned.repetition);
+      (train ? out.training : out.validation).push_back(std::move(run));
+    }
+    out.train_reps.assign(reps.begin(), reps.end());
+    out.text = "training trajectories matching '" + options.train_trajectories + "'";
+    return out;
+  }
+  if (options.train_reps == "auto") {
+    std::set<int> reps;
+    for (const RunLog& run : runs) reps.insert(run.repetition);
+    const std::vector<int> all(reps.begin(), reps.end());
+    out.train_reps.assign(all.begin(), all.begin() + static_cast<long>((all.size() + 1) / 2));
+  } else {
+    out.train_reps = ParseRepetitionList(options.train_reps);
+  }
+  SplitTrackRuns(PrepareTrackRuns(runs, wheel_mask), out.train_reps, &out.training,
+                 &out.validation);
+  out.text = "training repetitions " + FormatRepetitionList(out.train_reps);
+  return out;
+}
+
+std::vector<int> ValidationRepetitions(const DiagnoseSplit& split) {
+  std::set<int> reps;
+  for (const TrackRun& r : split.validation) reps.insert(r.aligned.repetition);
+  return {reps.begin(), reps.end()};
+}
+
+// The calibrated omni3 YAML as before the seam (with M^-1 in the record).
+std::string Omni3CalibratedYaml(const DiagnoseCommandOptions& options, const std::string& path,
+                                const DiagnoseSplit& split, const DiagnoseResult& result) {
+  const Omni3Robot robot = io::ReadOmni3Robot(path);
+  Omni3Robot calibrated = robot;
+  calibrated.nominal = omni3::Parameters::FromArray(result.final_fit.parameters.data());
+  if (result.effects_named) calibrated.effects = result.final_fit.effects;
+  io::CalibrationRecord record;
+  record.method = "ceres (track residuals) + diagnose";
+  record.objective = "sum over runs of the mean squared track error (m and rad)";
+  record.dataset = options.logs;
+  record.tool_version = kVersion;
+  record.termination = result.final_fit.termination;
+  record.training_repetitions = split.train_reps;
+  record.training_runs = static_cast<int>(split.training.size());
+  record.validation_runs = static_cast<int>(split.validation.size());
+  record.validation_repetitions = ValidationRepetitions(split);
+  record.cf_validation_before = result.declared_validation.cf;
+  record.cf_validation_after = result.final_validation.cf;
+  record.has_uncertainty = false;
+  record.inverse_kinematic_matrix =
+      omni3::InverseKinematicMatrix(result.final_fit.parameters.data());
+  return io::Omni3RobotYaml(calibrated, &record);
+}
+
+// Any other model: its own YAML with the calibration block, then the accepted effects.
+std::string ModelCalibratedYaml(const DiagnoseCommandOptions& options,
+                                const RobotModelInterface& model, const DiagnoseSplit& split,
+                                const DiagnoseResult& result) {
+  const Robot& robot = model.robot();
+  io::CalibrationBlock block;
+  block.method = "ceres (track residuals) + diagnose";
+  block.objective = "sum over runs of the mean squared track error (m and rad)";
+  block.dataset = options.logs;
+  block.tool_version = kVersion;
+  block.termination = result.final_fit.termination;
+  block.training_repetitions = split.train_reps;
+  block.validation_repetitions = ValidationRepetitions(split);
+  for (const TrackRun& r : split.training) block.training_run_ids.push_back(r.aligned.id);
+  block.training_runs = static_cast<int>(split.training.size());
+  block.validation_runs = static_cast<int>(split.validation.size());
+  block.cf_validation_before = result.declared_validation.cf;
+  block.cf_validation_after = result.final_validation.cf;
+  for (const HeldParameter& h : robot.held) block.held.push_back(robot.parameters[h.index].name);
+  std::string yaml =
+      model.RobotYaml(result.final_fit.parameters, io::CalibrationBlockYaml(block, robot));
+  if (result.effects_named) {
+    Robot with_effects;
+    with_effects.effects = result.final_fit.effects;
+    YAML::Emitter out;
+    out << YAML::BeginMap;
+    io::EmitEncoderAndEffects(out, with_effects);
+    out << YAML::EndMap;
+    yaml += std::string(out.c_str()) + "\n";
+  }
+  return yaml;
+}
+
+// Re-stamps each run's ground truth on the encoder clock (omni3's speed-profile match).
+void MapClocks(const std::string& robot_path, int threads, std::vector<RunLog>* runs) {
+  const auto nominal = io::ReadOmni3Robot(robot_path).nominal.ToArray();
+  ParallelFor(runs->size(), threads, [&](std::size_t i) {
+    RunLog& run = (*runs)[i];
+    const ClockMap map = EstimateClockMap(AlignRun(run), run.ground_truth, nominal);
+    run.ground_truth = ApplyClockMap(run.ground_truth, map);
+  });
+}
+
+void WriteOutputs(const DiagnoseCommandOptions& options, const std::vector<std::string>& inputs,
+                  const std::string& report, const DiagnoseResult& result,
+                  const std::string& yaml) {
+  const std::string csv = ResidualSamplesCsv(result.after);
+  const std::string csv_declared = ResidualSamplesCsv(result.before);
+  // Written as a set: staged, then renamed over the previous output (report_command.cc).
+  io::StagedDirectory staged(options.out);
+  const std::filesystem::path dir(staged.path());
+  io::WriteFileAtomically((dir / "diagnose.md").string(), report);
+  io::WriteFileAtomically((dir / "residuals.csv").string(), csv);
+  io::WriteFileAtomically((dir / "residuals_declared.csv").string(), csv_declared);
+  io::StopHereForTests("diagnose-staged");
+  io::WriteFileAtomically((dir / "calibrated.yaml").string(), yaml);
+  CommitOutputDirectory(staged, options.out, inputs, kDiagnoseFiles);
+}
+
 }  // namespace
 
 int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
@@ -70,104 +204,48 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
       std::cerr << "fitcal: " << refusal << "\n";
       return 2;
     }
-    const io::Dataset dataset = io::LoadDataset(index, dataset_options);
-    const std::string model = io::ReadRobotModel(dataset.robot_path);
-    if (model != "omni3") {
-      throw io::InputError(io::InputErrorKind::kUnknownModel, dataset.robot_path, 0,
-                           "model '" + model + "' is not supported by 'diagnose' (known: omni3)");
+    const RobotModelPtr model = ReadRobotModelFile(index.robot_path);
+    const Robot& robot = model->robot();
+    const bool omni3 = robot.model == "omni3";
+    if (!omni3 && options.clock_map) {
+      std::cerr << "fitcal: --clock-map matches omni3 speed profiles only; the robot is a "
+                << robot.model << "\n";
+      return 2;
     }
-    const Omni3Robot robot = io::ReadOmni3Robot(dataset.robot_path);
-    std::vector<int> train_reps;
-    std::vector<RunLog> runs = dataset.runs;
-    if (options.clock_map) {
-      const auto nominal = robot.nominal.ToArray();
-      ParallelFor(runs.size(), options.threads, [&](std::size_t i) {
-        const ClockMap map = EstimateClockMap(AlignRun(runs[i]), runs[i].ground_truth, nominal);
-        runs[i].ground_truth = ApplyClockMap(runs[i].ground_truth, map);
-      });
+    if (!omni3 && !robot.effects.empty()) {
+      std::cerr << "fitcal: " << index.robot_path
+                << ": the robot already declares effects; diagnose starts from a robot YAML "
+                   "without an effects: list\n";
+      return 2;
     }
-    std::vector<TrackRun> training, validation;
-    std::string split_text;
-    if (!options.train_trajectories.empty()) {
-      std::vector<std::string> labels;
-      for (const RunLog& run : runs) labels.push_back(run.trajectory);
-      const TrajectorySelector selector(options.train_trajectories, labels);
-      std::set<int> reps;
-      for (TrackRun& run : PrepareTrackRuns(runs)) {
-        const bool train = selector.Matches(run.aligned.trajectory);
-        if (train) reps.insert(run.aligned.repetition);
-        (train ? training : validation).push_back(std::move(run));
-      }
-      train_reps.assign(reps.begin(), reps.end());
-      split_text = "training trajectories matching '" + options.train_trajectories + "'";
-    } else if (options.train_reps == "auto") {
-      std::set<int> reps;
-      for (const RunLog& run : dataset.runs) reps.insert(run.repetition);
-      const std::vector<int> all(reps.begin(), reps.end());
-      train_reps.assign(all.begin(), all.begin() + static_cast<long>((all.size() + 1) / 2));
-    } else {
-      train_reps = ParseRepetitionList(options.train_reps);
-    }
-    if (options.train_trajectories.empty()) {
-      SplitTrackRuns(PrepareTrackRuns(runs), train_reps, &training, &validation);
-      split_text = "training repetitions " + FormatRepetitionList(train_reps);
-    }
-    if (training.empty() || validation.empty()) {
-      std::cerr << "fitcal: diagnose needs training and held-out runs; got " << training.size()
-                << " training and " << validation.size() << " validation runs (" << split_text
-                << ")\n";
+    std::vector<RunLog> runs = io::LoadDataset(index, robot, dataset_options).runs;
+    if (options.clock_map) MapClocks(index.robot_path, options.threads, &runs);
+    const DiagnoseSplit split = SplitRuns(options, runs, WheelChannelMask(robot));
+    if (split.training.empty() || split.validation.empty()) {
+      std::cerr << "fitcal: diagnose needs training and held-out runs; got "
+                << split.training.size() << " training and " << split.validation.size()
+                << " validation runs (" << split.text << ")\n";
       return 2;
     }
     DiagnoseOptions diagnose_options;
     diagnose_options.fit.num_threads = options.threads;
     diagnose_options.max_effects = options.max_effects;
     diagnose_options.alpha = options.alpha;
-    const DiagnoseResult result = Diagnose(training, validation, robot, diagnose_options);
+    const DiagnoseResult result =
+        Diagnose(split.training, split.validation, *model, diagnose_options);
     if (!result.declared.usable || !result.final_fit.usable) {
       std::cerr << "fitcal: the fit did not converge (" << result.declared.termination
                 << "); nothing written\n";
       return 3;
     }
-    std::string report = FormatDiagnoseReport(result, robot);
-    report = "data set: " + options.logs + ", " + split_text +
-             (options.clock_map ? ", ground-truth clocks re-mapped" : "") + ", fitcal " + kVersion +
-             "\n\n" + report;
+    const std::string report = "data set: " + options.logs + ", " + split.text +
+                               (options.clock_map ? ", ground-truth clocks re-mapped" : "") +
+                               ", fitcal " + kVersion + "\n\n" +
+                               FormatDiagnoseReport(result, *model);
     std::printf("%s", report.c_str());
-
-    // Outputs: all text is built first, then written; the YAML last.
-    Omni3Robot calibrated = robot;
-    calibrated.nominal = omni3::Parameters::FromArray(result.final_fit.parameters.data());
-    if (result.effects_named) calibrated.effects = result.final_fit.effects;
-    io::CalibrationRecord record;
-    record.method = "ceres (track residuals) + diagnose";
-    record.objective = "sum over runs of the mean squared track error (m and rad)";
-    record.dataset = options.logs;
-    record.tool_version = kVersion;
-    record.termination = result.final_fit.termination;
-    record.training_repetitions = train_reps;
-    record.training_runs = static_cast<int>(training.size());
-    record.validation_runs = static_cast<int>(validation.size());
-    std::set<int> val_reps;
-    for (const TrackRun& r : validation) val_reps.insert(r.aligned.repetition);
-    record.validation_repetitions.assign(val_reps.begin(), val_reps.end());
-    record.cf_validation_before = result.declared_validation.cf;
-    record.cf_validation_after = result.final_validation.cf;
-    record.has_uncertainty = false;
-    record.inverse_kinematic_matrix =
-        omni3::InverseKinematicMatrix(result.final_fit.parameters.data());
-    const std::string yaml = io::Omni3RobotYaml(calibrated, &record);
-    const std::string csv = ResidualSamplesCsv(result.after);
-    const std::string csv_declared = ResidualSamplesCsv(result.before);
-    {  // written as a set: staged, then renamed over the previous output (report_command.cc)
-      io::StagedDirectory staged(options.out);
-      const std::filesystem::path dir(staged.path());
-      io::WriteFileAtomically((dir / "diagnose.md").string(), report);
-      io::WriteFileAtomically((dir / "residuals.csv").string(), csv);
-      io::WriteFileAtomically((dir / "residuals_declared.csv").string(), csv_declared);
-      io::StopHereForTests("diagnose-staged");
-      io::WriteFileAtomically((dir / "calibrated.yaml").string(), yaml);
-      CommitOutputDirectory(staged, options.out, inputs, kDiagnoseFiles);
-    }
+    const std::string yaml = omni3 ? Omni3CalibratedYaml(options, index.robot_path, split, result)
+                                   : ModelCalibratedYaml(options, *model, split, result);
+    WriteOutputs(options, inputs, report, result, yaml);
     std::printf(
         "\nwrote %s/{diagnose.md, residuals.csv, residuals_declared.csv, calibrated.yaml}\n",
         options.out.c_str());
