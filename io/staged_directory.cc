@@ -1,5 +1,7 @@
 #include "io/staged_directory.h"
 
+#include <fcntl.h>
+#include <stdio.h>
 #include <stdlib.h>
 
 #include <cerrno>
@@ -60,8 +62,16 @@ void StagedDirectory::Commit(bool replace_existing) {
   if (exists && !replace_existing) {
     throw std::runtime_error(target_ + ": exists; refusing to replace it (--force to replace it)");
   }
+  // An existing target is swapped with the staged directory in one step (renameat2
+  // RENAME_EXCHANGE: never a moment without the target); where the file system cannot exchange,
+  // it is moved aside first (a moment without it, never a mixed one).
   std::string aside;
   if (exists) {
+    if (renameat2(AT_FDCWD, staging_.c_str(), AT_FDCWD, target_.c_str(), RENAME_EXCHANGE) == 0) {
+      committed_ = true;
+      fs::remove_all(staging_, ec);  // now the previous directory
+      return;
+    }
     aside = MakeUniqueDirectory(target_ + ".old-");
     fs::remove(aside, ec);  // only the unique name is wanted: rename needs it free or empty
     fs::rename(target_, aside, ec);

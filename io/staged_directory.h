@@ -3,9 +3,10 @@
 // file: everything goes into a temporary sibling `<target>.tmp-XXXXXX`, which Commit renames to
 // the target once complete. A failure before Commit (an exception unwinding past the object)
 // removes the sibling, so the target is either absent, the previous directory untouched, or the
-// new directory complete. An existing target is replaced only when asked (replace_existing): it
-// is renamed aside first, the new one renamed in, then the old one removed; a crash in between
-// leaves `<target>.old-XXXXXX` beside the complete new directory. SIGKILL before Commit leaves
+// new directory complete. An existing target is replaced only when asked (replace_existing): the
+// two are swapped in one rename (RENAME_EXCHANGE) and the old one removed; where the file system
+// cannot exchange, it is renamed aside first, the new one renamed in, then the old one removed (a
+// crash in between leaves `<target>.old-XXXXXX` beside the complete new directory). SIGKILL before Commit leaves
 // the `.tmp-XXXXXX` sibling and the target as it was.
 
 #include <string>

@@ -6,8 +6,8 @@
 #include <iostream>
 #include <stdexcept>
 
-#include "io/atomic_directory.h"
 #include "io/atomic_file.h"
+#include "io/staged_directory.h"
 #include "models/model_registry.h"
 #include "tools/sim/model_scenarios.h"
 #include "tools/sim/model_simulator.h"
@@ -79,11 +79,13 @@ int RunModelSimulateCommand(const ModelSimulateOptions& options) {
     const sim::ModelScenario scenario = sim::MakeModelScenario(*model, noise);
     const std::vector<sim::SimulatedRun> runs =
         sim::SimulateRuns(*model, truth, scenario.trajectories, scenario.options);
-    io::WriteDirectoryAtomically(options.out, options.force, [&](const std::string& tmp) {
-      sim::WriteSimulatedDataset(tmp, model->RobotYaml(robot.nominal, ""), runs);
-      io::WriteFileAtomically((fs::path(tmp) / "true_robot.yaml").string(),
+    {
+      io::StagedDirectory staged(options.out);
+      sim::WriteSimulatedDataset(staged.path(), model->RobotYaml(robot.nominal, ""), runs);
+      io::WriteFileAtomically((fs::path(staged.path()) / "true_robot.yaml").string(),
                               model->RobotYaml(truth, ""));
-    });
+      staged.Commit(options.force);
+    }
     std::printf("wrote %zu runs of the %s robot '%s' (%d repetitions, seed %llu) to %s\n",
                 runs.size(), robot.model.c_str(), robot.name.c_str(), noise.repetitions,
                 static_cast<unsigned long long>(noise.seed), options.out.c_str());

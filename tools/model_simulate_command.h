@@ -4,7 +4,7 @@
 // model's registry example) commands the trajectories, a true robot (--truth, or the nominal moved
 // part of the way to its bounds) drives them, and the data set - robot.yaml (nominal),
 // true_robot.yaml (the truth, for checking a fit), dataset.yaml and the runs - is built in a
-// temporary sibling directory and renamed into place (io/atomic_directory.h).
+// temporary sibling directory and renamed into place (io/staged_directory.h).
 
 #include <string>
 #include <vector>
