@@ -180,9 +180,12 @@ void PrintFit(const FitCommandOptions& options, const RobotModelInterface& model
   const ModelFitResult& fit = outcome.fit;
   std::printf("fitcal %s  %s robot '%s'  data set %s\n", kVersion, robot.model.c_str(),
               robot.name.c_str(), options.logs.c_str());
-  std::printf("runs: %zu training (%s; repetitions %s), %zu validation (repetitions %s)\n\n",
-              split.training.size(), TrainingSelection(options).c_str(),
-              FormatRepetitionList(split.training_repetitions).c_str(), split.validation.size(),
+  const std::string reps = FormatRepetitionList(split.training_repetitions);
+  const std::string selection = options.train_trajectories.empty()
+                                    ? "repetitions " + reps
+                                    : TrainingSelection(options) + "; repetitions " + reps;
+  std::printf("runs: %zu training (%s), %zu validation (repetitions %s)\n\n",
+              split.training.size(), selection.c_str(), split.validation.size(),
               FormatRepetitionList(split.validation_repetitions).c_str());
   PrintCfTable(model, selected, split, options.threads);
   PrintParameters(robot, selected, fit);
