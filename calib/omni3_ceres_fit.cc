@@ -19,6 +19,7 @@ Omni3FitResult FitOmni3Ceres(const std::vector<AlignedRun>& training, const Omni
   const ModelFitResult fit = FitModel(training, *Omni3ModelOf(robot), model_options);
   Omni3FitResult result;
   result.usable = fit.usable;
+  result.stopped_early = fit.stopped_early;
   result.termination = fit.termination;
   result.message = fit.message;
   result.iterations = fit.iterations;

@@ -23,9 +23,10 @@ namespace fitcal {
 using Omni3Covariance = Eigen::Matrix<double, omni3::kNumParameters, omni3::kNumParameters>;
 
 struct Omni3FitResult {
-  bool usable = false;      // converged to finite parameters; check before using them
-  std::string termination;  // Ceres termination type, e.g. CONVERGENCE
-  std::string message;      // Ceres' reason for stopping
+  bool usable = false;         // converged to finite parameters; check before using them
+  bool stopped_early = false;  // NO_CONVERGENCE at the iteration limit, finite (model_fit.h)
+  std::string termination;     // Ceres termination type, e.g. CONVERGENCE
+  std::string message;         // Ceres' reason for stopping
   int iterations = 0;
   int num_residual_evaluations = 0;  // evaluations of all runs' residuals
   int num_jacobian_evaluations = 0;  // evaluations of all runs' residuals and Jacobians

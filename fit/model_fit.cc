@@ -282,6 +282,7 @@ ModelFitResult SolveFrom(const std::vector<AlignedRun>& training, const RobotMod
   for (double v : result.parameters) finite = finite && std::isfinite(v);
   result.at_bound = AtBound(robot, result.parameters);
   result.usable = finite && summary.termination_type == ceres::CONVERGENCE;
+  result.stopped_early = finite && summary.termination_type == ceres::NO_CONVERGENCE;
   return result;
 }
 

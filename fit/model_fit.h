@@ -32,7 +32,10 @@
 namespace fitcal {
 
 struct ModelFitResult {
-  bool usable = false;      // converged to finite parameters; check before using them
+  bool usable = false;  // converged to finite parameters; check before using them
+  // Stopped at the iteration limit (NO_CONVERGENCE) with finite parameters: a point that may
+  // still be good; commands let it compete in the result gate and flag it when it wins.
+  bool stopped_early = false;
   std::string termination;  // Ceres termination type of the last solve, e.g. CONVERGENCE
   std::string message;      // Ceres' reason for stopping
   int iterations = 0;       // over all active-set rounds

@@ -73,6 +73,32 @@ TEST(FitcalCli, FitsWritesAndReadsBackTheCalibration) {
   EXPECT_EQ(again.exit_code, 0) << again.err;
 }
 
+// A Ceres fit cut off at one iteration stops NO_CONVERGENCE with a point that already beats the
+// nominal (the first Levenberg-Marquardt step from Eq. 15 takes most of the way on the flower):
+// it is written, flagged on stderr, and the exit status is 6 (README, exit codes), for omni3 and
+// for a model on the generic path.
+TEST(FitcalCli, FitStoppedAtTheIterationLimitIsWrittenAndFlagged) {
+  TempDir dir;
+  const std::string data = MakeDataset(dir);
+  const std::string out = dir.Path("cut.yaml");
+  const Result r =
+      RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --max-iterations 1 --out " + out);
+  EXPECT_EQ(r.exit_code, 6) << r.out << r.err;
+  EXPECT_EQ(CountLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("iteration limit"), std::string::npos) << r.err;
+  EXPECT_NE(ReadFileBytes(out).find("termination: NO_CONVERGENCE"), std::string::npos);
+  // Converged, the same command exits 0.
+  const Result full = RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --no-output");
+  EXPECT_EQ(full.exit_code, 0) << full.err;
+
+  const std::string diff = dir.Path("diff");
+  ASSERT_EQ(RunFitcal(dir, "simulate --model diff_drive --out " + diff + " --seed 3").exit_code, 0);
+  const std::string diff_out = dir.Path("diff_cut.yaml");
+  const Result d = RunFitcal(dir, "fit --logs " + diff + " --max-iterations 1 --out " + diff_out);
+  EXPECT_EQ(d.exit_code, 6) << d.out << d.err;
+  EXPECT_NE(ReadFileBytes(diff_out).find("NO_CONVERGENCE"), std::string::npos);
+}
+
 // An ASOC data set goes through the same entry point; the calibrated YAML reads back and carries
 // the one-sigma of every castor parameter.
 TEST(FitcalCli, AsocFitWritesCalibrationWithSigma) {

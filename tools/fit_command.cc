@@ -257,7 +257,7 @@ int RunFitCommand(const FitCommandOptions& options) {
         break;
       }
     }
-    if (!fit.usable) {
+    if (!fit.usable && !fit.stopped_early) {
       std::cerr << "fitcal: the fit did not converge (" << fit.termination << ": " << fit.message
                 << "); nothing written\n";
       return 3;
@@ -269,7 +269,7 @@ int RunFitCommand(const FitCommandOptions& options) {
     std::vector<CalibrationCandidate> candidates = {
         {"nominal", std::vector<double>(nominal.begin(), nominal.end()), true},
         {method->name, std::vector<double>(fit.parameters.begin(), fit.parameters.end()),
-         fit.usable}};
+         fit.usable || fit.stopped_early}};
     if (!fit.held_directions.empty() && !split.validation.empty()) {
       candidates.push_back({method->name + " without holds",
                             std::vector<double>(fit.unconstrained_parameters.begin(),
@@ -322,7 +322,7 @@ int RunFitCommand(const FitCommandOptions& options) {
       std::printf("wrote %s\n", options.out.c_str());
     }
     std::printf("time: load %.3f s, total %.3f s\n", load_s, Seconds(t_total));
-    return 0;
+    return StoppedEarlyExit(fit.stopped_early && gate.selected == 1, fit.termination);
   } catch (const std::exception& e) {  // io::InputError too: what() is its file:line message
     std::cerr << "fitcal: " << io::OneLine(e.what(), 500) << "\n";
     return 1;

@@ -88,7 +88,7 @@ std::vector<CalibrationCandidate> Candidates(const RobotModelInterface& model,
   for (const ClosedFormCalibration& c : model.ClosedForms(split.training)) {
     out.push_back({c.method, c.parameters, true});
   }
-  out.push_back({method, fit.parameters, fit.usable});
+  out.push_back({method, fit.parameters, fit.usable || fit.stopped_early});
   if (!fit.held_directions.empty() && !split.validation.empty()) {
     out.push_back(
         {method + " without holds", fit.unconstrained_parameters, fit.unconstrained_usable});
@@ -184,8 +184,8 @@ void PrintFit(const FitCommandOptions& options, const RobotModelInterface& model
   const std::string selection = options.train_trajectories.empty()
                                     ? "repetitions " + reps
                                     : TrainingSelection(options) + "; repetitions " + reps;
-  std::printf("runs: %zu training (%s), %zu validation (repetitions %s)\n\n",
-              split.training.size(), selection.c_str(), split.validation.size(),
+  std::printf("runs: %zu training (%s), %zu validation (repetitions %s)\n\n", split.training.size(),
+              selection.c_str(), split.validation.size(),
               FormatRepetitionList(split.validation_repetitions).c_str());
   PrintCfTable(model, selected, split, options.threads);
   PrintParameters(robot, selected, fit);
@@ -200,6 +200,15 @@ void PrintFit(const FitCommandOptions& options, const RobotModelInterface& model
 }
 
 }  // namespace
+
+int StoppedEarlyExit(bool selected_fit_stopped_early, const std::string& termination) {
+  if (!selected_fit_stopped_early) return 0;
+  std::cerr << "fitcal: warning: the written calibration is the solver's last point ("
+            << termination
+            << " at the iteration limit): it beats the nominal, but check it or raise "
+               "--max-iterations\n";
+  return 6;
+}
 
 int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex& index,
                        const RobotModelPtr& model) {
@@ -274,7 +283,8 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
     std::printf("wrote %s\n", options.out.c_str());
   }
   std::printf("time: load %.3f s, total %.3f s\n", load_s, Seconds(t_total));
-  return 0;
+  return StoppedEarlyExit(fit.stopped_early && candidates[gate.selected].name == options.method,
+                          fit.termination);
 }
 
 }  // namespace fitcal::tools

@@ -6,6 +6,8 @@
 // through the result gate (fit/result_gate.h), print the table and write the winner as a
 // calibrated YAML.
 
+#include <string>
+
 #include "io/dataset.h"
 #include "models/model_interface.h"
 #include "tools/fit_command.h"
@@ -15,5 +17,9 @@ namespace fitcal::tools {
 // Exit codes as README "Exit codes"; 5 when no candidate beats the nominal (nothing written).
 int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex& index,
                        const RobotModelPtr& model);
+
+// Exit 6 with a one-line warning when the written calibration is a fit that stopped at the
+// iteration limit (it beat the nominal in the gate, but the solver did not converge); else 0.
+int StoppedEarlyExit(bool selected_fit_stopped_early, const std::string& termination);
 
 }  // namespace fitcal::tools
