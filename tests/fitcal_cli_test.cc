@@ -5,7 +5,9 @@
 #include <sys/wait.h>
 #include <yaml-cpp/yaml.h>
 
+#include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -97,6 +99,31 @@ TEST(FitcalCli, FitStoppedAtTheIterationLimitIsWrittenAndFlagged) {
   const Result d = RunFitcal(dir, "fit --logs " + diff + " --max-iterations 1 --out " + diff_out);
   EXPECT_EQ(d.exit_code, 6) << d.out << d.err;
   EXPECT_NE(ReadFileBytes(diff_out).find("NO_CONVERGENCE"), std::string::npos);
+}
+
+// The real OptiOdom three-wheel robot (skipped without ../shared): every split a user would try
+// converges and writes a calibration that beats the nominal on the runs it did not train on (on
+// the training runs for 1-99, which leaves none), as the calibration block records it.
+TEST(FitcalCli, RealOmni3EverySplitWritesACalibrationBetterThanNominal) {
+  const std::string shared = std::string(FITCAL_SHARED_DIR) + "/data/optiodom/omni3";
+  if (!std::filesystem::is_directory(shared)) GTEST_SKIP() << "no " << shared;
+  TempDir dir;
+  const std::string data = dir.Path("od3");
+  const Result imported = RunFitcal(
+      dir, "import optiodom " + shared + "/circular/* " + shared + "/square/* --out " + data);
+  ASSERT_EQ(imported.exit_code, 0) << imported.err;
+  for (const std::string split : {"--train-reps 1-2", "--train-reps 1-5", "--train-reps 1-99",
+                                  "--train-trajectories '^circular'"}) {
+    SCOPED_TRACE(split);
+    const std::string out = dir.Path("cal.yaml");
+    std::remove(out.c_str());
+    const Result r = RunFitcal(dir, "fit --logs " + data + " " + split + " --out " + out);
+    ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+    const YAML::Node calibration = YAML::LoadFile(out)["calibration"];
+    const char* judged = split == "--train-reps 1-99" ? "cf_training" : "cf_validation";
+    EXPECT_LT(calibration[judged]["after"].as<double>(),
+              calibration[judged]["before"].as<double>());
+  }
 }
 
 // An ASOC data set goes through the same entry point; the calibrated YAML reads back and carries
