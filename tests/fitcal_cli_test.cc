@@ -126,6 +126,31 @@ TEST(FitcalCli, RealOmni3EverySplitWritesACalibrationBetterThanNominal) {
   }
 }
 
+// The CF a calibrated YAML records is the one `fitcal report` measures for that file, to 1e-9
+// (the YAML keeps 10 significant digits of each parameter: the replay of the rounded values moves
+// the CF by ~1e-11 here).
+TEST(FitcalCli, RecordedCfIsTheOneReportMeasures) {
+  TempDir dir;
+  const std::string data = MakeDataset(dir);
+  const std::string cal = dir.Path("cal.yaml");
+  ASSERT_EQ(RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --out " + cal).exit_code, 0);
+  const std::string report = dir.Path("report");
+  const Result r =
+      RunFitcal(dir, "report --logs " + data + " --calibration " + cal + " --out " + report);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const YAML::Node recorded = YAML::LoadFile(cal)["calibration"]["cf_validation"];
+  const std::string json = ReadFileBytes(report + "/metrics.json");
+  // The "all validation runs" group's after/before CF, read from the JSON text.
+  const std::size_t group = json.find("\"all validation runs\"");
+  ASSERT_NE(group, std::string::npos);
+  const auto cf_after = [&](const char* side) {
+    const std::size_t at = json.find("\"cf\": ", json.find(side, group));
+    return std::stod(json.substr(at + 6, 24));
+  };
+  EXPECT_NEAR(cf_after("\"before\""), recorded["before"].as<double>(), 1e-9);
+  EXPECT_NEAR(cf_after("\"after\""), recorded["after"].as<double>(), 1e-9);
+}
+
 // An ASOC data set goes through the same entry point; the calibrated YAML reads back and carries
 // the one-sigma of every castor parameter.
 TEST(FitcalCli, AsocFitWritesCalibrationWithSigma) {
