@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <random>
 #include <stdexcept>
 
@@ -113,6 +114,55 @@ void WriteAsocCalibration(const std::string& out, const io::AsocRobot& robot,
   io::WriteFileAtomically(
       out, io::AsocRobotYaml(calibrated, AsocCalibrationRecord(robot, method, dataset, fit)));
   std::printf("wrote %s\n", out.c_str());
+}
+
+// One calibration the ASOC fit can write: the nominal, the closed form (Doebbler Eq. 1-9) and
+// the Ceres fits; `fit` is null for the first two.
+struct AsocCandidate {
+  std::string name;
+  asoc::Vehicle vehicle;
+  std::string status;
+  bool usable = true;
+  const asoc::AsocFitResult* fit = nullptr;
+};
+
+// Prints every candidate's CF (and UMBmark E_max when the data have both circuits) and returns
+// the result gate's choice (fit/result_gate.h's rule): the lowest CF on the held-out runs (on the
+// training runs when there are none) among the usable candidates, the nominal (index 0) winning
+// ties.
+int PrintAndGateAsocCandidates(const std::vector<AsocCandidate>& rows,
+                               const std::vector<asoc::AlignedAsocRun>& training,
+                               const std::vector<asoc::AlignedAsocRun>& validation,
+                               const std::vector<asoc::RunLog>& umbmark_logs) {
+  bool has_both = false;
+  for (const auto& r : umbmark_logs) has_both |= r.trajectory == "umbmark_ccw";
+  std::printf("  %-24s %12s %12s %14s  %s\n", "method", "CF train", "CF valid", "UMBmark E_max",
+              "termination");
+  int selected = 0;
+  double best_cf = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const AsocCandidate& row = rows[i];
+    char emax[32] = "-";
+    if (has_both) {
+      std::snprintf(emax, sizeof emax, "%.1f mm",
+                    1000.0 * sim::EvaluateUmbmark(umbmark_logs, row.vehicle, {}).e_max_m);
+    }
+    const double cf_train = asoc::AsocFinalPoseCf(row.vehicle, training);
+    const double cf_valid =
+        validation.empty() ? NAN : asoc::AsocFinalPoseCf(row.vehicle, validation);
+    std::printf("  %-24s %12.5f %12.5f %14s  %s\n", row.name.c_str(), cf_train, cf_valid, emax,
+                row.status.c_str());
+    const double judged = validation.empty() ? cf_train : cf_valid;
+    if (row.usable && std::isfinite(judged) && judged < best_cf) {
+      best_cf = judged;
+      selected = static_cast<int>(i);
+    }
+  }
+  std::printf("  (CF: mean final-pose |[dx, dy, dpsi]|, m and rad, CAST-0 replay)\n");
+  std::printf("result gate, CF on the %s runs: %s selected\n",
+              validation.empty() ? "training (no held-out)" : "held-out",
+              rows[selected].name.c_str());
+  return selected;
 }
 
 }  // namespace
@@ -247,63 +297,45 @@ int RunAsocFit(const FitCommandOptions& options) {
     fit_options.weights.position_sigma_m = options.position_sigma_m;
     fit_options.weights.heading_sigma_rad = options.heading_sigma_deg * M_PI / 180.0;
 
-    struct Row {
-      std::string name;
-      asoc::Vehicle vehicle;
-      std::string status;
-    };
-    std::vector<Row> rows;
-    rows.push_back({"nominal", robot.nominal, "-"});
+    std::vector<AsocCandidate> rows;
+    rows.push_back({"nominal", robot.nominal, "-", true, nullptr});
     std::vector<asoc::RunLog> hold_runs;
     for (const asoc::RunLog& run : dataset.runs) {
       if (IsHoldRun(run.trajectory)) hold_runs.push_back(run);
     }
     const asoc::GeometricResult closed = asoc::CalibrateGeometric(hold_runs, robot.nominal);
-    if (closed.usable) rows.push_back({"closed form (Eq. 1-9)", closed.estimate, "closed form"});
+    if (closed.usable) {
+      rows.push_back({"closed form (Eq. 1-9)", closed.estimate, "closed form", true, nullptr});
+    }
     const asoc::AsocFitResult ceres = asoc::FitAsocCeres(training, robot.nominal, fit_options);
-    rows.push_back({"ceres (from nominal)", ceres.estimate, ceres.termination});
+    rows.push_back(
+        {"ceres (from nominal)", ceres.estimate, ceres.termination, ceres.usable, &ceres});
     asoc::AsocFitResult refined;
     if (closed.usable) {
       refined = asoc::FitAsocCeres(training, closed.estimate, fit_options);
-      rows.push_back({"closed form + ceres", refined.estimate, refined.termination});
+      rows.push_back(
+          {"closed form + ceres", refined.estimate, refined.termination, refined.usable, &refined});
     }
     std::printf("fitcal %s  asoc robot '%s'  data set %s\n", kVersion, robot.name.c_str(),
                 options.logs.c_str());
     std::printf("runs: %zu training, %zu validation (%zu UMBmark circuits); closed form: %s\n\n",
                 training.size(), validation.size(), umbmark_logs.size(),
                 closed.usable ? closed.message.c_str() : "no complete hold runs");
-    std::printf("  %-24s %12s %12s %14s  %s\n", "method", "CF train", "CF valid", "UMBmark E_max",
-                "termination");
-    for (const Row& row : rows) {
-      char emax[32] = "-";
-      if (!umbmark_logs.empty()) {
-        bool has_both = false;
-        for (const auto& r : umbmark_logs) has_both |= r.trajectory == "umbmark_ccw";
-        if (has_both) {
-          std::snprintf(emax, sizeof emax, "%.1f mm",
-                        1000.0 * sim::EvaluateUmbmark(umbmark_logs, row.vehicle, {}).e_max_m);
-        }
-      }
-      std::printf("  %-24s %12.5f %12.5f %14s  %s\n", row.name.c_str(),
-                  asoc::AsocFinalPoseCf(row.vehicle, training),
-                  asoc::AsocFinalPoseCf(row.vehicle, validation), emax, row.status.c_str());
+    const int selected = PrintAndGateAsocCandidates(rows, training, validation, umbmark_logs);
+    const AsocCandidate& best = rows[selected];
+    PrintCastors(robot, best.vehicle, best.name.c_str());
+    if (best.fit != nullptr && best.fit->has_covariance) {
+      PrintCastorSigmas(robot, best.fit->sigma);
+    } else if (best.fit != nullptr) {
+      std::printf("uncertainty: %s\n", best.fit->covariance_message.c_str());
     }
-    std::printf("  (CF: mean final-pose |[dx, dy, dpsi]|, m and rad, CAST-0 replay)\n");
-    const asoc::AsocFitResult& best = closed.usable ? refined : ceres;
-    PrintCastors(robot, best.estimate, closed.usable ? "closed form + ceres" : "ceres");
-    if (best.has_covariance) {
-      PrintCastorSigmas(robot, best.sigma);
-    } else {
-      std::printf("uncertainty: %s\n", best.covariance_message.c_str());
-    }
-    if (!best.usable) {
-      std::cerr << "fitcal: the fit did not converge (" << best.termination << ": " << best.message
-                << "); nothing written\n";
-      return 3;
+    if (selected == 0) {
+      std::cerr << "fitcal: no calibration beats the nominal vehicle on the "
+                << (validation.empty() ? "training" : "held-out") << " runs; nothing written\n";
+      return 5;
     }
     if (!options.no_output) {
-      WriteAsocCalibration(options.out, robot, best.estimate,
-                           closed.usable ? "closed form + ceres" : "ceres", options.logs, &best);
+      WriteAsocCalibration(options.out, robot, best.vehicle, best.name, options.logs, best.fit);
     }
     return 0;
   } catch (const std::exception& e) {
