@@ -100,6 +100,56 @@ DiagnoseSplit SplitRuns(const DiagnoseCommandOptions& options, const std::vector
   return out;
 }
 
+// What diagnose may write, judged like the fit's result gate (fit/result_gate.h) on the
+// held-out runs by the track replay's final-pose CF: the nominal, the declared final-pose fit,
+// the track fit, and the track fit with its effects when they were named. A track fit with
+// effects that were not named is not a candidate: the file would claim a CF its parameters reach
+// only together with effects it does not carry.
+struct DiagnoseChoice {
+  std::string name;
+  std::vector<double> parameters;
+  EffectModel effects;
+  double cf_before = 0.0;  // nominal, held-out
+  double cf_after = 0.0;
+};
+
+DiagnoseChoice GateDiagnosis(const RobotModelInterface& model, const DiagnoseSplit& split,
+                             const DiagnoseResult& result, int threads) {
+  const std::vector<double>& nominal = model.robot().nominal;
+  const auto cf = [&](const std::vector<double>& p, const EffectModel& e) {
+    return ScoreModel(model, p, e, split.validation, {}, threads).cf;
+  };
+  std::vector<DiagnoseChoice> candidates = {
+      {"nominal", nominal, {}, 0.0, cf(nominal, {})},
+      {"declared final-pose fit",
+       result.declared.parameters,
+       {},
+       0.0,
+       result.declared_validation.cf},
+      {"track fit", result.base.parameters, {}, 0.0, cf(result.base.parameters, {})}};
+  if (result.effects_named) {
+    candidates.push_back({"track fit + effects", result.final_fit.parameters,
+                          result.final_fit.effects, 0.0, result.final_validation.cf});
+  }
+  std::size_t best = 0;
+  std::printf("\nresult gate, CF on the held-out runs (%zu):\n", split.validation.size());
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    if (candidates[i].cf_after < candidates[best].cf_after) best = i;
+  }
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    std::printf("  %-28s %10.5f%s\n", candidates[i].name.c_str(), candidates[i].cf_after,
+                i == best ? "   <- selected" : "");
+  }
+  candidates[best].cf_before = candidates[0].cf_after;
+  return candidates[best];
+}
+
+std::string ObjectiveOf(const DiagnoseChoice& choice) {
+  return choice.name == "declared final-pose fit"
+             ? "sum over runs of the squared final-pose error (m and rad)"
+             : "sum over runs of the mean squared track error (m and rad)";
+}
+
 std::vector<int> ValidationRepetitions(const DiagnoseSplit& split) {
   std::set<int> reps;
   for (const TrackRun& r : split.validation) reps.insert(r.aligned.repetition);
@@ -108,14 +158,15 @@ std::vector<int> ValidationRepetitions(const DiagnoseSplit& split) {
 
 // The calibrated omni3 YAML as before the seam (with M^-1 in the record).
 std::string Omni3CalibratedYaml(const DiagnoseCommandOptions& options, const std::string& path,
-                                const DiagnoseSplit& split, const DiagnoseResult& result) {
+                                const DiagnoseSplit& split, const DiagnoseResult& result,
+                                const DiagnoseChoice& choice) {
   const Omni3Robot robot = io::ReadOmni3Robot(path);
   Omni3Robot calibrated = robot;
-  calibrated.nominal = omni3::Parameters::FromArray(result.final_fit.parameters.data());
-  if (result.effects_named) calibrated.effects = result.final_fit.effects;
+  calibrated.nominal = omni3::Parameters::FromArray(choice.parameters.data());
+  calibrated.effects = choice.effects;
   io::CalibrationRecord record;
-  record.method = "ceres (track residuals) + diagnose";
-  record.objective = "sum over runs of the mean squared track error (m and rad)";
+  record.method = "diagnose: " + choice.name;
+  record.objective = ObjectiveOf(choice);
   record.dataset = options.logs;
   record.tool_version = kVersion;
   record.termination = result.final_fit.termination;
@@ -123,22 +174,21 @@ std::string Omni3CalibratedYaml(const DiagnoseCommandOptions& options, const std
   record.training_runs = static_cast<int>(split.training.size());
   record.validation_runs = static_cast<int>(split.validation.size());
   record.validation_repetitions = ValidationRepetitions(split);
-  record.cf_validation_before = result.declared_validation.cf;
-  record.cf_validation_after = result.final_validation.cf;
+  record.cf_validation_before = choice.cf_before;
+  record.cf_validation_after = choice.cf_after;
   record.has_uncertainty = false;
-  record.inverse_kinematic_matrix =
-      omni3::InverseKinematicMatrix(result.final_fit.parameters.data());
+  record.inverse_kinematic_matrix = omni3::InverseKinematicMatrix(choice.parameters.data());
   return io::Omni3RobotYaml(calibrated, &record);
 }
 
 // Any other model: its own YAML with the calibration block, then the accepted effects.
 std::string ModelCalibratedYaml(const DiagnoseCommandOptions& options,
                                 const RobotModelInterface& model, const DiagnoseSplit& split,
-                                const DiagnoseResult& result) {
+                                const DiagnoseResult& result, const DiagnoseChoice& choice) {
   const Robot& robot = model.robot();
   io::CalibrationBlock block;
-  block.method = "ceres (track residuals) + diagnose";
-  block.objective = "sum over runs of the mean squared track error (m and rad)";
+  block.method = "diagnose: " + choice.name;
+  block.objective = ObjectiveOf(choice);
   block.dataset = options.logs;
   block.tool_version = kVersion;
   block.termination = result.final_fit.termination;
@@ -147,14 +197,15 @@ std::string ModelCalibratedYaml(const DiagnoseCommandOptions& options,
   for (const TrackRun& r : split.training) block.training_run_ids.push_back(r.aligned.id);
   block.training_runs = static_cast<int>(split.training.size());
   block.validation_runs = static_cast<int>(split.validation.size());
-  block.cf_validation_before = result.declared_validation.cf;
-  block.cf_validation_after = result.final_validation.cf;
+  block.cf_validation_before = choice.cf_before;
+  block.cf_validation_after = choice.cf_after;
+  block.selected = choice.name;
+  block.selected_on = "held-out runs (" + std::to_string(split.validation.size()) + ")";
   for (const HeldParameter& h : robot.held) block.held.push_back(robot.parameters[h.index].name);
-  std::string yaml =
-      model.RobotYaml(result.final_fit.parameters, io::CalibrationBlockYaml(block, robot));
-  if (result.effects_named) {
+  std::string yaml = model.RobotYaml(choice.parameters, io::CalibrationBlockYaml(block, robot));
+  if (!choice.effects.empty()) {
     Robot with_effects;
-    with_effects.effects = result.final_fit.effects;
+    with_effects.effects = choice.effects;
     YAML::Emitter out;
     out << YAML::BeginMap;
     io::EmitEncoderAndEffects(out, with_effects);
@@ -243,8 +294,15 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
                                ", fitcal " + kVersion + "\n\n" +
                                FormatDiagnoseReport(result, *model);
     std::printf("%s", report.c_str());
-    const std::string yaml = omni3 ? Omni3CalibratedYaml(options, index.robot_path, split, result)
-                                   : ModelCalibratedYaml(options, *model, split, result);
+    const DiagnoseChoice choice = GateDiagnosis(*model, split, result, options.threads);
+    if (choice.name == "nominal") {
+      std::cerr << "fitcal: no calibration beats the nominal robot on the held-out runs; nothing "
+                   "written\n";
+      return 5;
+    }
+    const std::string yaml =
+        omni3 ? Omni3CalibratedYaml(options, index.robot_path, split, result, choice)
+              : ModelCalibratedYaml(options, *model, split, result, choice);
     WriteOutputs(options, inputs, report, result, yaml);
     std::printf(
         "\nwrote %s/{diagnose.md, residuals.csv, residuals_declared.csv, calibrated.yaml}\n",
