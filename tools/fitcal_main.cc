@@ -185,7 +185,9 @@ int main(int argc, char** argv) {
   asoc_commands.Register(app);
   CLI::App* fit_cmd = app.add_subcommand(
       "fit", "Fit, validate on held-out repetitions, write the calibrated YAML (default)");
-  fit_cmd->fallthrough();
+  // The same options on `fit` itself, bound to the same settings, so `fitcal fit --help` lists
+  // every flag (`fitcal --logs ...` without a subcommand keeps working).
+  AddFitOptions(*fit_cmd, fit);
 
   fitcal::tools::SimulateCommandOptions simulate;
   CLI::App* sim_cmd = app.add_subcommand(
