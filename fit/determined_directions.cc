@@ -175,7 +175,9 @@ DirectionAnalysis AnalyseDeterminedDirections(const std::vector<AlignedRun>& tra
                   100.0 * std::min(fraction, 1.0));
     d.description = DescribeStep(robot, v, d.one_sigma_step) + text;
     if (!trajectory.empty() && share > 0.0) {
-      std::snprintf(text, sizeof text, "; trajectory '%s' sees it most (%.0f%% of its information)",
+      std::snprintf(text, sizeof text,
+                    "; more runs like '%s', which sees it most (%.0f%% of its information), "
+                    "would determine it",
                     trajectory.c_str(), 100.0 * share);
       d.description += text;
     }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <regex>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -247,7 +248,16 @@ int RunFitCommand(const FitCommandOptions& options) {
       const IdentifiabilityReport ident = AnalyseIdentifiability(
           FinalPoseJacobian(fit.parameters, split.training, weights, options.threads),
           fit.parameters, sim::FlowerCandidateMotions(), nominal, weights);
-      for (const std::string& line : IdentifiabilityLines(ident)) std::printf("%s\n", line.c_str());
+      // The advice names flower trajectories (R/G/B families): only for data sets that have them.
+      const bool flower =
+          std::any_of(split.training.begin(), split.training.end(), [](const AlignedRun& run) {
+            return std::regex_match(run.trajectory, std::regex("[RGB][0-9]+"));
+          });
+      for (const std::string& line : IdentifiabilityLines(ident)) {
+        if (flower || line.find("would be fixed by adding") == std::string::npos) {
+          std::printf("%s\n", line.c_str());
+        }
+      }
     }
     for (int k = 0; k < omni3::kNumParameters; ++k) {
       if (fit.at_bound[k]) {
