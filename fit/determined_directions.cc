@@ -102,6 +102,28 @@ std::string MostInformativeTrajectory(const std::vector<AlignedRun>& training,
   return best;
 }
 
+// A held direction in words: its one-sigma step in parameter terms, how much of the bounds'
+// range that is, and which of the data set's own trajectories would determine it.
+std::string DescribeDirection(const std::vector<AlignedRun>& training,
+                              const std::vector<RunJacobian>& runs, const Robot& robot,
+                              const Eigen::VectorXd& v, const Eigen::VectorXd& prior_sigma,
+                              double fraction, const Eigen::VectorXd& one_sigma_step) {
+  char percent[32];
+  std::snprintf(percent, sizeof percent, "%.0f%%", 100.0 * std::min(fraction, 1.0));
+  std::string out = DescribeStep(robot, v, one_sigma_step) +
+                    " together move the training residuals by only one sigma (" + percent +
+                    " of what the bounds allow)";
+  double share = 0.0;
+  const std::string trajectory =
+      MostInformativeTrajectory(training, runs, prior_sigma.cwiseProduct(v), &share);
+  if (!trajectory.empty() && share > 0.0) {
+    std::snprintf(percent, sizeof percent, "%.0f%%", 100.0 * share);
+    out += "; more runs like '" + trajectory + "', which sees it most (" + percent +
+           " of its information), would determine it";
+  }
+  return out;
+}
+
 // The residuals' standard deviation, robust to a few gross runs (wheel slip, a wrong ground
 // truth) that would otherwise make every direction look undetermined: 1.4826 x the median
 // absolute residual (the normal distribution's MAD factor), times sqrt(m / (m - free)) for the
@@ -165,22 +187,8 @@ DirectionAnalysis AnalyseDeterminedDirections(const std::vector<AlignedRun>& tra
     d.posterior_fraction = fraction;
     // One posterior sigma along v, capped at the box's own sigma (beyond it the bounds know more).
     d.one_sigma_step = prior_sigma.cwiseProduct(v) * std::min(fraction, 1.0);
-    double share = 0.0;
-    const std::string trajectory =
-        MostInformativeTrajectory(training, runs, prior_sigma.cwiseProduct(v), &share);
-    char text[160];
-    std::snprintf(text, sizeof text,
-                  " together move the training residuals by only one sigma (%.0f%% of what the "
-                  "bounds allow)",
-                  100.0 * std::min(fraction, 1.0));
-    d.description = DescribeStep(robot, v, d.one_sigma_step) + text;
-    if (!trajectory.empty() && share > 0.0) {
-      std::snprintf(text, sizeof text,
-                    "; more runs like '%s', which sees it most (%.0f%% of its information), "
-                    "would determine it",
-                    trajectory.c_str(), 100.0 * share);
-      d.description += text;
-    }
+    d.description =
+        DescribeDirection(training, runs, robot, v, prior_sigma, fraction, d.one_sigma_step);
     out.undetermined.push_back(d);
   }
   out.ok = true;

@@ -23,6 +23,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -386,6 +387,10 @@ Pose2<T> ReplayStepsWithEffects(const Step& step, const std::vector<ActiveEffect
   bool any_body = false;
   for (const auto& e : active) any_body = any_body || table[static_cast<int>(e.id)].body;
   const int n = samples.num_channels();
+  if (n > kMaxEffectChannels) {
+    throw std::invalid_argument("the effect replay handles at most " +
+                                std::to_string(kMaxEffectChannels) + " channels");
+  }
   T w[kMaxEffectChannels];
   Pose2<T> pose = start;
   for (std::size_t k = 0; k < samples.size(); ++k) {

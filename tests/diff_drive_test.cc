@@ -114,7 +114,7 @@ TEST(DiffDriveKinematics, InverseKinematicsAndSidewaysMotion) {
 
 std::vector<double> TrueRobot() { return {0.042 * 1.004, 0.042 * 0.996, 0.206}; }
 
-std::vector<AlignedRun> Aligned(const std::vector<sim::SimulatedRun>& runs) {
+std::vector<AlignedRun> Aligned(const std::vector<sim::ModelSimulatedRun>& runs) {
   std::vector<RunLog> logs;
   for (const auto& r : runs) logs.push_back(r.log);
   return AlignRuns(logs);

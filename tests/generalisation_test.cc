@@ -74,7 +74,7 @@ class GeneralisationTest : public ::testing::Test {
     model_ = ReadRobotModel(YAML::Load(FindModel("test_unicycle")->example_yaml), "example");
     std::vector<sim::TrajectorySpec> specs;
     for (const Shape& s : kShapes) specs.push_back(Spec(s));
-    for (const sim::SimulatedRun& run :
+    for (const sim::ModelSimulatedRun& run :
          sim::SimulateRuns(*model_, {kTrueRadius, kTrueGain}, specs, sim::SimulationOptions{})) {
       runs_.push_back(AlignRun(run.log));
     }

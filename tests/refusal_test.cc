@@ -333,6 +333,11 @@ TEST(RefusalTest, ErrorLinesAreShortWhateverTheInputEchoes) {
 // of a 3.5-million-row log (140 MB) cannot be allocated (more than the 64 MB of freed heap glibc
 // may keep mapped, which the cap cannot see, after the other tests).
 TEST(RefusalTest, OutOfMemoryNamesTheFile) {
+#if defined(__SANITIZE_ADDRESS__)
+  // Under a memory limit AddressSanitizer's allocator aborts the process instead of throwing
+  // std::bad_alloc, so the path under test cannot run there; the plain build runs it.
+  GTEST_SKIP() << "AddressSanitizer aborts on allocation failure instead of throwing bad_alloc";
+#endif
   const Fixture f;
   std::string big = "t,w_a,w_b,w_c\n";
   big.reserve(48u << 20);

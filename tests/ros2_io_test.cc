@@ -55,7 +55,7 @@ constexpr double kEncoderPeriodS = 0.05;
 
 std::int64_t Ns(double t_s) { return kEpochNs + std::llround(t_s * 1e9); }
 
-std::vector<sim::SimulatedRun> SimulatedRuns(const RobotModelInterface& model) {
+std::vector<sim::ModelSimulatedRun> SimulatedRuns(const RobotModelInterface& model) {
   sim::SimulationOptions o;
   o.encoder_period_s = kEncoderPeriodS;
   o.gt_position_sigma_m = 0.001;
@@ -71,7 +71,7 @@ std::vector<sim::SimulatedRun> SimulatedRuns(const RobotModelInterface& model) {
 // joint states at rest in the gaps, no ground truth there (the robot is carried back to the start).
 // Returns each run's span on the bag clock (s since the first message).
 std::vector<std::pair<double, double>> WriteRobotBag(const fs::path& dir,
-                                                     const std::vector<sim::SimulatedRun>& runs,
+                                                     const std::vector<sim::ModelSimulatedRun>& runs,
                                                      BagWriterOptions options) {
   struct Msg {
     bool joint;
@@ -89,7 +89,7 @@ std::vector<std::pair<double, double>> WriteRobotBag(const fs::path& dir,
     js.position = {0.1, angle_left, angle_right};
     msgs.push_back({true, Ns(t), EncodeJointState(js)});
   };
-  for (const sim::SimulatedRun& run : runs) {
+  for (const sim::ModelSimulatedRun& run : runs) {
     const std::vector<double>& t = run.log.encoders.t_s;
     for (std::size_t k = 0; k < t.size(); ++k) {
       if (k > 0) {  // recorded: mean rates over (t(k-1), t(k)]; the bag holds the angles
@@ -169,7 +169,7 @@ TEST_P(ImportEqualsCsv, SameFitAsTheSimulatorsCsv) {
   const BagCase& c = GetParam();
   testing::TempDir tmp;
   const RobotModelPtr model = ReadRobotModel(YAML::Load(kRobotYaml), "robot.yaml");
-  const std::vector<sim::SimulatedRun> sim_runs = SimulatedRuns(*model);
+  const std::vector<sim::ModelSimulatedRun> sim_runs = SimulatedRuns(*model);
   BagWriterOptions bag_options;
   bag_options.storage = c.storage;
   bag_options.mcap.compression = c.compression;
@@ -213,7 +213,7 @@ TEST_P(ImportEqualsCsv, SameFitAsTheSimulatorsCsv) {
     }
   }
   std::vector<RunLog> csv;
-  for (const sim::SimulatedRun& r : sim_runs) csv.push_back(r.log);
+  for (const sim::ModelSimulatedRun& r : sim_runs) csv.push_back(r.log);
   const ModelFitResult from_bag = Fit(*model, imported.runs);
   const ModelFitResult from_csv = Fit(*model, csv);
   for (int k = 0; k < 3; ++k) {
@@ -297,7 +297,7 @@ class MalformedImport : public ::testing::Test {
     return tmp_.path() / name;
   }
   testing::TempDir tmp_;
-  std::vector<sim::SimulatedRun> runs_;
+  std::vector<sim::ModelSimulatedRun> runs_;
 };
 
 TEST_F(MalformedImport, TruncatedAndBadMagic) {

@@ -157,7 +157,7 @@ EncoderSamples FineChannels(const RobotModelInterface& model, const double* p,
 // The encoder log and the recorded rows from the fine channel values (header: noise model).
 void RecordEncoders(const RobotModelInterface& model, const double* p, const TwistProfile& profile,
                     const FineGrid& grid, const EncoderSamples& fine, const SimulationOptions& o,
-                    Rng& rng, SimulatedRun* run) {
+                    Rng& rng, ModelSimulatedRun* run) {
   const Robot& robot = model.robot();
   const int c = robot.NumChannels();
   std::vector<double> reading(c), previous(c), value(c), angle(c, 0.0), counted(c, 0.0), tmp(c);
@@ -211,12 +211,12 @@ void RecordEncoders(const RobotModelInterface& model, const double* p, const Twi
   }
 }
 
-SimulatedRun SimulateRun(const RobotModelInterface& model, const std::vector<double>& p,
+ModelSimulatedRun SimulateRun(const RobotModelInterface& model, const std::vector<double>& p,
                          const TrajectorySpec& spec, const SimulationOptions& o, Rng& rng) {
   const TwistProfile profile(spec.segments, o);
   const FineGrid grid = MakeGrid(profile.end_s(), o);
   const EncoderSamples fine = FineChannels(model, p.data(), profile, grid);
-  SimulatedRun run;
+  ModelSimulatedRun run;
   run.true_start_pose = StartPose(o, rng);
   // The truth: the true model replayed on the fine grid.
   std::vector<Pose2d> truth(grid.t_s.size());
@@ -267,7 +267,7 @@ std::string SimulationOptions::Check(int num_channels) const {
   return "";
 }
 
-std::vector<SimulatedRun> SimulateRuns(const RobotModelInterface& model,
+std::vector<ModelSimulatedRun> SimulateRuns(const RobotModelInterface& model,
                                        const std::vector<double>& true_parameters,
                                        const std::vector<TrajectorySpec>& trajectories,
                                        const SimulationOptions& options) {
@@ -276,7 +276,7 @@ std::vector<SimulatedRun> SimulateRuns(const RobotModelInterface& model,
   if (static_cast<int>(true_parameters.size()) != model.robot().NumParameters()) {
     throw std::invalid_argument("the true parameter vector has the wrong length");
   }
-  std::vector<SimulatedRun> runs;
+  std::vector<ModelSimulatedRun> runs;
   for (std::size_t i = 0; i < trajectories.size(); ++i) {
     Rng rng(options.seed, i);
     runs.push_back(SimulateRun(model, true_parameters, trajectories[i], options, rng));
@@ -284,7 +284,7 @@ std::vector<SimulatedRun> SimulateRuns(const RobotModelInterface& model,
   return runs;
 }
 
-std::string SimulatedEncoderCsv(const SimulatedRun& run) {
+std::string SimulatedEncoderCsv(const ModelSimulatedRun& run) {
   std::string out = "t";
   for (const std::string& column : run.encoder_columns) out += "," + column;
   out += "\n";
@@ -302,12 +302,12 @@ std::string SimulatedEncoderCsv(const SimulatedRun& run) {
 }
 
 void WriteSimulatedDataset(const std::string& dir, const std::string& robot_yaml_text,
-                           const std::vector<SimulatedRun>& runs) {
+                           const std::vector<ModelSimulatedRun>& runs) {
   namespace fs = std::filesystem;
   const fs::path out(dir);
   fs::create_directories(out / "runs");
   std::vector<io::DatasetEntry> entries;
-  for (const SimulatedRun& run : runs) {
+  for (const ModelSimulatedRun& run : runs) {
     io::DatasetEntry e;
     e.id = run.log.id;
     e.trajectory = run.log.trajectory;

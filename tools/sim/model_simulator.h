@@ -81,7 +81,9 @@ struct SimulationOptions {
   std::string Check(int num_channels) const;
 };
 
-struct SimulatedRun {
+// (Not "SimulatedRun": that is omni3_simulator.h's, in the same namespace; two classes of one
+// name in one program break the one-definition rule.)
+struct ModelSimulatedRun {
   RunLog log;  // what the loader hands over (interval values, robot channel order)
   // What the recorder writes: the encoder CSV's channel columns (the robot's rate_column names,
   // robot order) and one row per encoder time (wheel rates in rad/s over the interval ending at
@@ -94,19 +96,19 @@ struct SimulatedRun {
 
 // One run per trajectory spec, in order. Ids are "<label>-rep<NN>". Throws std::invalid_argument
 // for invalid options, a segment shorter than the ramp, or a twist the model cannot drive.
-std::vector<SimulatedRun> SimulateRuns(const RobotModelInterface& model,
-                                       const std::vector<double>& true_parameters,
-                                       const std::vector<TrajectorySpec>& trajectories,
-                                       const SimulationOptions& options);
+std::vector<ModelSimulatedRun> SimulateRuns(const RobotModelInterface& model,
+                                            const std::vector<double>& true_parameters,
+                                            const std::vector<TrajectorySpec>& trajectories,
+                                            const SimulationOptions& options);
 
 // The encoder CSV of a run: header `t,<encoder_columns>`, then the recorded rows at full
 // precision (%.17g: the loader reads back the same doubles).
-std::string SimulatedEncoderCsv(const SimulatedRun& run);
+std::string SimulatedEncoderCsv(const ModelSimulatedRun& run);
 
 // Writes a data set: <dir>/dataset.yaml, <dir>/robot.yaml (robot_yaml_text as given) and
 // runs/<id>_encoders.csv, runs/<id>_ground_truth.csv per run, each file atomically. Creates the
 // directories; throws std::runtime_error when a file cannot be written.
 void WriteSimulatedDataset(const std::string& dir, const std::string& robot_yaml_text,
-                           const std::vector<SimulatedRun>& runs);
+                           const std::vector<ModelSimulatedRun>& runs);
 
 }  // namespace fitcal::sim
