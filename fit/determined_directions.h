@@ -18,9 +18,9 @@
 #include <string>
 #include <vector>
 
-#include "calib/aligned_run.h"
 #include "fit/solver_options.h"
 #include "models/model_interface.h"
+#include "odometry/aligned_run.h"
 
 namespace fitcal {
 

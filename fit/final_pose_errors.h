@@ -7,8 +7,8 @@
 #include <array>
 #include <vector>
 
-#include "calib/aligned_run.h"
 #include "models/model_interface.h"
+#include "odometry/aligned_run.h"
 
 namespace fitcal {
 

@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <utility>
 
-#include "calib/dense_solver_options.h"
+#include "fit/dense_solver_options.h"
 #include "fit/determined_directions.h"
 
 namespace fitcal {

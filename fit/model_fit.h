@@ -24,10 +24,10 @@
 #include <string>
 #include <vector>
 
-#include "calib/aligned_run.h"
 #include "fit/determined_directions.h"
 #include "fit/solver_options.h"
 #include "models/model_interface.h"
+#include "odometry/aligned_run.h"
 
 namespace fitcal {
 

@@ -5,13 +5,13 @@
 // evaluates the CF), the gradient from the model's autodiff FinalPoseCost (the residual the Ceres
 // fit minimises). The box is the robot's bounds (normalised to [0, 1] per free parameter); held
 // (gauge) parameters stay at their nominal values; the start is the nominal (Palacin Eq. 15).
-// omni3 has a faster value path (its final-pose kernel) in calib/omni3_nlopt_fit.h.
+// omni3 has a faster value path (its final-pose kernel) in fit/omni3_nlopt_fit.h.
 
 #include <vector>
 
-#include "calib/aligned_run.h"
 #include "fit/nlopt_search.h"
 #include "models/model_interface.h"
+#include "odometry/aligned_run.h"
 
 namespace fitcal {
 

@@ -1,6 +1,6 @@
 #pragma once
 // The NLopt search behind every model's NLopt methods (`--method crs2lm`, ... for omni3 in
-// calib/omni3_nlopt_fit.h, for any model in fit/model_nlopt_fit.h): global methods (the analogues
+// fit/omni3_nlopt_fit.h, for any model in fit/model_nlopt_fit.h): global methods (the analogues
 // of the genetic algorithm of Palacin Sec. 2.6 / Table 4), local derivative-free methods, and
 // bounded gradient methods (the analogue of MATLAB's fmincon), over per-run final-pose residuals
 // (fit/pose_errors.h) that a RunResiduals supplies - in doubles for the value, with the autodiff

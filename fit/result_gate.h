@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "calib/aligned_run.h"
 #include "models/model_interface.h"
+#include "odometry/aligned_run.h"
 
 namespace fitcal {
 

@@ -21,8 +21,8 @@
 #include <vector>
 
 #include "io/dataset.h"
-#include "odometry/asoc_model.h"
-#include "odometry/asoc_run_log.h"
+#include "models/asoc/asoc_model.h"
+#include "models/asoc/asoc_run_log.h"
 
 namespace fitcal::io {
 

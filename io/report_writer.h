@@ -1,9 +1,9 @@
 #pragma once
 // Text of the validation report (`fitcal report`): index.html (one self-contained file with
 // inline SVG figures, no network), summary.md, metrics.csv and metrics.json. Pure formatting:
-// the caller (tools/report_command.cc) computes every number with calib/ and fills ReportData
-// with plain values; nothing here knows a solver. Angles are radians in ReportData and degrees in
-// the outputs (columns ending _deg).
+// the caller (tools/report_command.cc) computes every number with fit/, validation/ and diagnosis/
+// and fills ReportData with plain values; nothing here knows a solver. Angles are radians in
+// ReportData and degrees in the outputs (columns ending _deg).
 
 #include <string>
 #include <vector>

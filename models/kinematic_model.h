@@ -35,9 +35,9 @@
 #include <utility>
 #include <vector>
 
-#include "calib/aligned_run.h"
 #include "fit/pose_errors.h"
 #include "models/model_interface.h"
+#include "odometry/aligned_run.h"
 #include "odometry/replay.h"
 
 namespace fitcal {

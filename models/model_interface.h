@@ -83,7 +83,7 @@ class PreparedKinematics {
   // values (robot().channels order), as the plain replay computes it.
   virtual void Step(const T* values, double dt, T* dx, T* dy, T* dtheta) const = 0;
 };
-// The scalar of the effect fit's dynamic autodiff (calib/effect_fit.cc differentiates four
+// The scalar of the effect fit's dynamic autodiff (diagnosis/effect_fit.cc differentiates four
 // parameters per pass).
 using EffectJet = ceres::Jet<double, 4>;
 

@@ -5,11 +5,11 @@
 #include <cstdio>
 #include <random>
 
-#include "calib/asoc_ceres_fit.h"
-#include "calib/asoc_geometric.h"
 #include "io/asoc_files.h"
 #include "io/atomic_file.h"
 #include "io/input_error.h"
+#include "models/asoc/asoc_ceres_fit.h"
+#include "models/asoc/asoc_geometric.h"
 #include "tools/sim/asoc_simulator.h"
 
 namespace fitcal::asoc {

@@ -1,5 +1,5 @@
 // ASOC model and multi-castor odometry (Doebbler Sec. II-D, III-B).
-#include "odometry/asoc_odometry.h"
+#include "models/asoc/asoc_odometry.h"
 
 #include <gtest/gtest.h>
 
@@ -7,7 +7,7 @@
 #include <cmath>
 #include <random>
 
-#include "odometry/asoc_model.h"
+#include "models/asoc/asoc_model.h"
 #include "tools/sim/asoc_simulator.h"
 
 namespace fitcal::asoc {

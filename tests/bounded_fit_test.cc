@@ -11,9 +11,9 @@
 #include <filesystem>
 #include <vector>
 
-#include "calib/aligned_run.h"
 #include "fit/model_fit.h"
 #include "models/omni3/omni3_robot_model.h"
+#include "odometry/aligned_run.h"
 #include "tools/import_optiodom.h"
 
 namespace fitcal {

@@ -12,7 +12,7 @@
 
 #include <cmath>
 
-#include "calib/omni3_ceres_fit.h"
+#include "fit/omni3_ceres_fit.h"
 #include "tools/sim/omni3_simulator.h"
 
 namespace fitcal {

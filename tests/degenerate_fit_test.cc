@@ -1,5 +1,5 @@
 // Degenerate data (issue 7): a wheel that never turns, all runs identical, one run with gross
-// slip. The fit must finish, the diagnostics (calib/degenerate_data.h) must say what is wrong,
+// slip. The fit must finish, the diagnostics (diagnosis/degenerate_data.h) must say what is wrong,
 // and with a robust loss one slipping run must not drag the parameters.
 
 #include <gtest/gtest.h>
@@ -7,11 +7,11 @@
 #include <algorithm>
 #include <cmath>
 
-#include "calib/degenerate_data.h"
-#include "calib/final_pose_cost.h"
-#include "calib/omni3_ceres_fit.h"
-#include "calib/run_split.h"
+#include "diagnosis/degenerate_data.h"
+#include "fit/final_pose_cost.h"
+#include "fit/omni3_ceres_fit.h"
 #include "tools/sim/omni3_simulator.h"
+#include "validation/run_split.h"
 
 namespace fitcal {
 namespace {

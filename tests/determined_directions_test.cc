@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "calib/aligned_run.h"
 #include "fit/final_pose_errors.h"
 #include "fit/model_fit.h"
 #include "models/model_registry.h"
+#include "odometry/aligned_run.h"
 #include "tools/sim/model_simulator.h"
 #include "tools/sim/omni_trajectories.h"
 

@@ -1,6 +1,7 @@
-// End-to-end tests of the effect tracing (calib/diagnose.h) on small simulated flower data sets.
+// End-to-end tests of the effect tracing (diagnosis/diagnose.h) on small simulated flower data
+// sets.
 
-#include "calib/diagnose.h"
+#include "diagnosis/diagnose.h"
 
 #include <gtest/gtest.h>
 

@@ -17,7 +17,6 @@
 #include <map>
 #include <sstream>
 
-#include "calib/aligned_run.h"
 #include "fit/final_pose_errors.h"
 #include "fit/model_fit.h"
 #include "fit/pose_errors.h"
@@ -26,6 +25,7 @@
 #include "models/diff_drive/diff_drive_model.h"
 #include "models/diff_drive/umbmark.h"
 #include "models/model_registry.h"
+#include "odometry/aligned_run.h"
 #include "tests/test_files.h"
 #include "tools/import_optiodom_models.h"
 #include "tools/sim/diff_drive_trajectories.h"

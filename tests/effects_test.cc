@@ -1,5 +1,5 @@
 // Tests of the effect library (odometry/effects.h), the effect fit's building blocks
-// (calib/effect_fit.h), the tail probabilities (calib/statistics.h) and the robot YAML's
+// (diagnosis/effect_fit.h), the tail probabilities (diagnosis/statistics.h) and the robot YAML's
 // `effects:` list.
 #include <ceres/jet.h>
 #include <gtest/gtest.h>
@@ -8,8 +8,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include "calib/effect_fit.h"
-#include "calib/statistics.h"
+#include "diagnosis/effect_fit.h"
+#include "diagnosis/statistics.h"
 #include "io/input_error.h"
 #include "io/robot_yaml.h"
 #include "odometry/omni3_replay.h"

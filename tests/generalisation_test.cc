@@ -1,4 +1,4 @@
-// The generic generalisation path (calib/generalisation.h) on the test-only unicycle
+// The generic generalisation path (validation/generalisation.h) on the test-only unicycle
 // (tests/models/unicycle_test_model.h): two path types whose final poses are known in closed
 // form, so the held-out CF of every candidate on every split is computed here independently of
 // the replay, the fit and the scoring.
@@ -10,7 +10,7 @@
 //   Theta' = k Theta / k_t,  D' = r D / r_t,  final pose (D' cos Theta', D' sin Theta', Theta')
 // against the truth (D cos Theta, D sin Theta, Theta), both from the origin.
 
-#include "calib/generalisation.h"
+#include "validation/generalisation.h"
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>

@@ -1,4 +1,4 @@
-// Identifiability (calib/identifiability.h): the warning must fire for Palacin's strategy STA
+// Identifiability (diagnosis/identifiability.h): the warning must fire for Palacin's strategy STA
 // (straight runs R1, R5, R9 only) and stay silent for STE (all 36 flower trajectories).
 //
 // Why STA cannot work: straight runs command omega = 0, so the wheel rates w = M_nom (vx, vy, 0)
@@ -7,15 +7,15 @@
 // the symmetric nominal robot, whose M^-1 has an equal-weight omega row) changes M^-1 only along
 // the wheel-rate direction (1, 1, 1), i.e. outside that plane: all three R_i are unobservable.
 
-#include "calib/identifiability.h"
+#include "diagnosis/identifiability.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <string>
 
-#include "calib/aligned_run.h"
-#include "calib/strategies.h"
+#include "fit/strategies.h"
+#include "odometry/aligned_run.h"
 #include "tools/sim/flower_candidates.h"
 #include "tools/sim/omni3_simulator.h"
 

@@ -16,10 +16,10 @@
 #include <cmath>
 #include <vector>
 
-#include "calib/aligned_run.h"
 #include "fit/model_fit.h"
 #include "fit/pose_errors.h"
 #include "models/model_registry.h"
+#include "odometry/aligned_run.h"
 #include "tests/models/unicycle_test_model.h"
 
 namespace fitcal {

@@ -13,11 +13,11 @@
 #include <cstdlib>
 #include <cstring>
 
-#include "calib/aligned_run.h"
 #include "fit/final_pose_errors.h"
 #include "fit/model_fit.h"
 #include "fit/model_nlopt_fit.h"
 #include "models/model_registry.h"
+#include "odometry/aligned_run.h"
 #include "tests/test_files.h"
 #include "tools/sim/model_scenarios.h"
 

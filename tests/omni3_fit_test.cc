@@ -1,14 +1,14 @@
-// End-to-end recovery of known parameters by the Ceres fit (calib/omni3_ceres_fit.h) on data from
+// End-to-end recovery of known parameters by the Ceres fit (fit/omni3_ceres_fit.h) on data from
 // the simulator (tools/sim/omni3_simulator.h), with tolerances derived from the noise.
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "calib/final_pose_cost.h"
-#include "calib/omni3_ceres_fit.h"
-#include "calib/run_split.h"
+#include "fit/final_pose_cost.h"
+#include "fit/omni3_ceres_fit.h"
 #include "tools/sim/omni3_simulator.h"
+#include "validation/run_split.h"
 
 namespace fitcal {
 namespace {

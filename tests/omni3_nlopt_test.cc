@@ -1,4 +1,4 @@
-// The NLopt back end (calib/omni3_nlopt_fit.h) against the Ceres fit on simulated flower data,
+// The NLopt back end (fit/omni3_nlopt_fit.h) against the Ceres fit on simulated flower data,
 // seed reproducibility, the Ceres objective/loss options, and what strategy STA cannot determine.
 
 #include <gtest/gtest.h>
@@ -9,10 +9,10 @@
 #include <cstring>
 #include <memory>
 
-#include "calib/final_pose_cost.h"
-#include "calib/omni3_ceres_fit.h"
-#include "calib/omni3_nlopt_fit.h"
-#include "calib/strategies.h"
+#include "fit/final_pose_cost.h"
+#include "fit/omni3_ceres_fit.h"
+#include "fit/omni3_nlopt_fit.h"
+#include "fit/strategies.h"
 #include "tools/sim/omni3_simulator.h"
 
 namespace fitcal {

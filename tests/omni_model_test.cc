@@ -17,7 +17,6 @@
 #include <random>
 #include <sstream>
 
-#include "calib/aligned_run.h"
 #include "fit/model_fit.h"
 #include "fit/pose_errors.h"
 #include "io/dataset.h"
@@ -26,6 +25,7 @@
 #include "models/model_registry.h"
 #include "models/omni/omni_kinematics.h"
 #include "models/omni3/omni3_kinematics.h"
+#include "odometry/aligned_run.h"
 #include "tools/import_optiodom_omni4.h"
 #include "tools/sim/model_simulator.h"
 #include "tools/sim/omni_trajectories.h"
@@ -371,8 +371,8 @@ TEST(OmniModel, GaugeOfFourMecanumWheelsIsNamed) {
 }
 
 // A simulated run on the encoders' clock: the simulator records the start pose and its ground
-// truth covers the whole encoder span, so the run needs no clipping (calib/aligned_run.h does the
-// same for these runs, for any channel count).
+// truth covers the whole encoder span, so the run needs no clipping (odometry/aligned_run.h does
+// the same for these runs, for any channel count).
 AlignedRun AlignedOnEncoderClock(const RunLog& log) {
   AlignedRun run;
   run.id = log.id;

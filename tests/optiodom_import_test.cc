@@ -6,13 +6,13 @@
 #include <filesystem>
 #include <fstream>
 
-#include "calib/aligned_run.h"
-#include "calib/final_pose_cost.h"
-#include "calib/segment_cost.h"
+#include "fit/final_pose_cost.h"
+#include "fit/segment_cost.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/log_files.h"
 #include "io/robot_yaml.h"
+#include "odometry/aligned_run.h"
 #include "tools/import_optiodom.h"
 
 namespace fitcal {

@@ -17,7 +17,6 @@
 #include <iostream>
 #include <sstream>
 
-#include "calib/aligned_run.h"
 #include "fit/final_pose_errors.h"
 #include "fit/model_fit.h"
 #include "io/dataset.h"
@@ -28,6 +27,7 @@
 #include "models/omni/omni_model.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "models/tricycle/tricycle_model.h"
+#include "odometry/aligned_run.h"
 #include "tests/test_files.h"
 #include "tools/export_ros2_control.h"
 #include "tools/import_rosbag2.h"
@@ -70,9 +70,9 @@ std::vector<sim::ModelSimulatedRun> SimulatedRuns(const RobotModelInterface& mod
 // The bag: runs one after the other on one clock (run i starts where run i-1 ended + kGapS),
 // joint states at rest in the gaps, no ground truth there (the robot is carried back to the start).
 // Returns each run's span on the bag clock (s since the first message).
-std::vector<std::pair<double, double>> WriteRobotBag(const fs::path& dir,
-                                                     const std::vector<sim::ModelSimulatedRun>& runs,
-                                                     BagWriterOptions options) {
+std::vector<std::pair<double, double>> WriteRobotBag(
+    const fs::path& dir, const std::vector<sim::ModelSimulatedRun>& runs,
+    BagWriterOptions options) {
   struct Msg {
     bool joint;
     std::int64_t stamp_ns;

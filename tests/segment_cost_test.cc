@@ -2,7 +2,7 @@
 // ground truth is the exact replay of known parameters (so every residual at the truth is zero to
 // rounding and any tolerance below is about rounding or the search grid, stated where used).
 
-#include "calib/segment_cost.h"
+#include "fit/segment_cost.h"
 
 #include <gtest/gtest.h>
 

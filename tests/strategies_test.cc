@@ -1,7 +1,7 @@
-// Trajectory strategies of Palacin Table 4 (calib/strategies.h): the printed lists, label-list
+// Trajectory strategies of Palacin Table 4 (fit/strategies.h): the printed lists, label-list
 // parsing and run selection.
 
-#include "calib/strategies.h"
+#include "fit/strategies.h"
 
 #include <gtest/gtest.h>
 

@@ -1,13 +1,13 @@
-// Trajectory metrics (calib/trajectory_metrics.h, Palacin Eq. 8-14) on a tiny hand-computed log,
-// evo-style summary statistics, and the Table 6 improvement formula against the paper's table.
+// Trajectory metrics (validation/trajectory_metrics.h, Palacin Eq. 8-14) on a tiny hand-computed
+// log, evo-style summary statistics, and the Table 6 improvement formula against the paper's table.
 
-#include "calib/trajectory_metrics.h"
+#include "validation/trajectory_metrics.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "calib/effect_fit.h"
+#include "diagnosis/effect_fit.h"
 #include "tools/sim/omni3_simulator.h"
 
 namespace fitcal {

@@ -1,4 +1,4 @@
-// Closing the loop on a model other than omni3 (calib/diagnose.h through the seam): a tricycle
+// Closing the loop on a model other than omni3 (diagnosis/diagnose.h through the seam): a tricycle
 // whose steering sensor reads a scaled angle. The diagnosis must name steering_scale with its
 // size and improve the held-out error; on the clean tricycle it must accept nothing.
 
@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "calib/diagnose.h"
-#include "calib/effect_fit.h"
+#include "diagnosis/diagnose.h"
+#include "diagnosis/effect_fit.h"
 #include "models/tricycle/tricycle_model.h"
 #include "tools/sim/model_simulator.h"
 #include "tools/sim/tricycle_trajectories.h"
@@ -25,7 +25,8 @@ struct Split {
 // The example tricycle (truth = nominal with the wheelbase and offset moved), circles at four
 // steering angles both ways and squares, three repetitions: the first trains, the others
 // validate (20 held-out runs: the paired t test of diagnose needs them, since a scale error shows
-// most on the sharpest circles and little on the others). The recorded steering angle is the true one divided by (1 + steering_scale).
+// most on the sharpest circles and little on the others). The recorded steering angle is the true
+// one divided by (1 + steering_scale).
 Split Simulate(const RobotModelInterface& model, double steering_scale, std::uint64_t seed) {
   std::vector<double> truth = model.robot().nominal;
   truth[1] *= 1.02;
@@ -42,7 +43,8 @@ Split Simulate(const RobotModelInterface& model, double steering_scale, std::uin
   options.record_start_pose = true;
   options.seed = seed;
   std::vector<RunLog> logs;
-  for (auto& s : sim::SimulateRuns(model, truth, sim::TricycleTrajectories(trajectories), options)) {
+  for (auto& s :
+       sim::SimulateRuns(model, truth, sim::TricycleTrajectories(trajectories), options)) {
     RunLog log = s.log;
     EncoderSamples scaled(log.encoders.samples.num_channels());
     for (const auto& sample : log.encoders.samples) {

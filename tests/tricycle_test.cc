@@ -14,8 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "calib/aligned_run.h"
-#include "calib/channel_order_check.h"
+#include "diagnosis/channel_order_check.h"
 #include "fit/final_pose_errors.h"
 #include "fit/model_fit.h"
 #include "fit/pose_errors.h"
@@ -23,6 +22,7 @@
 #include "models/model_registry.h"
 #include "models/tricycle/tricycle_checks.h"
 #include "models/tricycle/tricycle_model.h"
+#include "odometry/aligned_run.h"
 #include "tests/test_files.h"
 #include "tools/import_optiodom_tricycle.h"
 #include "tools/sim/model_simulator.h"
@@ -431,7 +431,8 @@ TEST(TricycleSimulation, WrongSteeringSignIsCaughtByTheMiswiringScores) {
   EXPECT_LT(ssr[best], 1e-3);
   EXPECT_GT(ssr[0], 100.0 * ssr[best]) << "the identity explains the flipped channel too well";
 
-  // The generic check (calib/channel_order_check.h) says the same, and nothing on the clean runs.
+  // The generic check (diagnosis/channel_order_check.h) says the same, and nothing on the clean
+  // runs.
   const ChannelOrderReport report = CheckChannelOrder(flipped, {}, *model);
   EXPECT_TRUE(report.likely_miswired);
   EXPECT_EQ(report.best.sign[K::kSteeringChannel], -1) << report.message;

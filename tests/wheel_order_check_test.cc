@@ -1,9 +1,9 @@
 // The wheel order / sign check and the units check that run before a fit
-// (calib/wheel_order_check.h), on simulated runs (tools/sim) with the documented default noise
+// (diagnosis/wheel_order_check.h), on simulated runs (tools/sim) with the documented default noise
 // and the simulator's true robot (Palacin Table 5) differing from the nominal (Eq. 15), as in a
 // real calibration.
 
-#include "calib/wheel_order_check.h"
+#include "diagnosis/wheel_order_check.h"
 
 #include <gtest/gtest.h>
 

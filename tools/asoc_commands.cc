@@ -10,17 +10,17 @@
 #include <random>
 #include <stdexcept>
 
-#include "calib/asoc_ceres_fit.h"
-#include "calib/asoc_geometric.h"
-#include "calib/run_split.h"
 #include "fitcal/version.h"
 #include "io/asoc_files.h"
 #include "io/atomic_file.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
+#include "models/asoc/asoc_ceres_fit.h"
+#include "models/asoc/asoc_geometric.h"
 #include "odometry/parallel_for.h"
 #include "tools/output_guard.h"
 #include "tools/sim/asoc_simulator.h"
+#include "validation/run_split.h"
 
 namespace fitcal::tools {
 

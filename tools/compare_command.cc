@@ -13,9 +13,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "calib/final_pose_cost.h"
-#include "calib/run_split.h"
-#include "calib/strategies.h"
+#include "fit/final_pose_cost.h"
+#include "fit/strategies.h"
 #include "io/atomic_file.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
@@ -23,6 +22,7 @@
 #include "models/model_registry.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "tools/fit_methods.h"
+#include "validation/run_split.h"
 
 namespace fitcal::tools {
 
@@ -240,7 +240,7 @@ FitOutcome RunMethod(const FitMethod& method, const std::vector<AlignedRun>& tra
 }
 
 // "all" (every trajectory of the data set) and "<prefix>*" (the labels starting with prefix, e.g.
-// "circular/*") are resolved against the runs; anything else is calib/strategies.h's.
+// "circular/*") are resolved against the runs; anything else is fit/strategies.h's.
 TrajectoryStrategy ParseCompareStrategy(const std::string& text) {
   if (text == "all" || (!text.empty() && text.back() == '*')) return {text, {}};
   return ParseStrategy(text);

@@ -7,10 +7,8 @@
 #include <iostream>
 #include <set>
 
-#include "calib/diagnose.h"
-#include "calib/run_split.h"
-#include "calib/segment_cost.h"
-#include "calib/trajectory_split.h"
+#include "diagnosis/diagnose.h"
+#include "fit/segment_cost.h"
 #include "fitcal/version.h"
 #include "io/atomic_file.h"
 #include "io/calibration_block.h"
@@ -23,13 +21,15 @@
 #include "odometry/parallel_for.h"
 #include "tools/cli_validators.h"
 #include "tools/output_guard.h"
+#include "validation/run_split.h"
+#include "validation/trajectory_split.h"
 
 namespace fitcal::tools {
 
 CLI::App* AddDiagnoseCommand(CLI::App& app, DiagnoseCommandOptions& o) {
   CLI::App* cmd = app.add_subcommand(
       "diagnose",
-      "Trace the residual of the model's fit to missing effects, any model (calib/diagnose.h)");
+      "Trace the residual of the model's fit to missing effects, any model (diagnosis/diagnose.h)");
   cmd->add_option("--logs", o.logs, "Data set directory")
       ->required()
       ->check(CLI::ExistingDirectory);

@@ -1,6 +1,6 @@
 #pragma once
 // `fitcal diagnose --logs <dir>`: the declared nine-parameter fit, its residual, the tracing of
-// that residual to library effects (calib/diagnose.h), the error before and after on held-out
+// that residual to library effects (diagnosis/diagnose.h), the error before and after on held-out
 // repetitions. Prints the report and writes, into --out (a directory):
 //   diagnose.md     the report (Markdown)
 //   residuals.csv   the pose error at every ground-truth sample of every run, after the tracing
@@ -18,10 +18,10 @@ namespace fitcal::tools {
 struct DiagnoseCommandOptions {
   std::string logs;
   std::string train_reps = "auto";  // "auto": the first half of the repetitions present
-  // Non-empty: split by trajectory label instead (calib/trajectory_split.h): matching runs train,
-  // the others validate (e.g. "^circular" trains on circles and validates on squares).
+  // Non-empty: split by trajectory label instead (validation/trajectory_split.h): matching runs
+  // train, the others validate (e.g. "^circular" trains on circles and validates on squares).
   std::string train_trajectories;
-  // Re-stamp each run's ground truth on the encoder clock first (calib/segment_cost.h,
+  // Re-stamp each run's ground truth on the encoder clock first (fit/segment_cost.h,
   // EstimateClockMap): for recordings whose clocks were only mapped by hand.
   bool clock_map = false;
   std::string out = "diagnose";

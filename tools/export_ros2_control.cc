@@ -11,7 +11,6 @@
 #include <set>
 #include <stdexcept>
 
-#include "calib/aligned_run.h"
 #include "fit/final_pose_errors.h"
 #include "io/atomic_file.h"
 #include "io/calibration_yaml.h"
@@ -20,6 +19,7 @@
 #include "io/yaml_reader.h"
 #include "models/diff_drive/diff_drive_model.h"
 #include "models/model_registry.h"
+#include "odometry/aligned_run.h"
 
 namespace fitcal::tools {
 namespace {

@@ -10,12 +10,11 @@
 #include <string>
 #include <unordered_map>
 
-#include "calib/degenerate_data.h"
-#include "calib/final_pose_cost.h"
-#include "calib/identifiability.h"
-#include "calib/omni3_ceres_fit.h"
-#include "calib/run_split.h"
-#include "calib/wheel_order_check.h"
+#include "diagnosis/degenerate_data.h"
+#include "diagnosis/identifiability.h"
+#include "diagnosis/wheel_order_check.h"
+#include "fit/final_pose_cost.h"
+#include "fit/omni3_ceres_fit.h"
 #include "fit/result_gate.h"
 #include "fitcal/version.h"
 #include "io/atomic_file.h"
@@ -31,6 +30,7 @@
 #include "tools/model_fit_command.h"
 #include "tools/output_guard.h"
 #include "tools/sim/flower_candidates.h"
+#include "validation/run_split.h"
 
 namespace fitcal::tools {
 

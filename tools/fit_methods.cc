@@ -4,7 +4,7 @@
 #include <cmath>
 #include <tuple>
 
-#include "calib/final_pose_cost.h"
+#include "fit/final_pose_cost.h"
 #include "fit/final_pose_errors.h"
 #include "fit/model_nlopt_fit.h"
 

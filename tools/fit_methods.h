@@ -3,16 +3,16 @@
 // (Levenberg-Marquardt or dogleg) and every NLopt method of fit/nlopt_search.h, one entry each,
 // for every robot model: `run_model` fits any model through the seam (fit/model_fit.h,
 // fit/model_nlopt_fit.h), `run` is omni3's own path (its Ceres fit and the NLopt search on its
-// fast final-pose kernel, calib/omni3_nlopt_fit.h), which the omni3 commands keep.
+// fast final-pose kernel, fit/omni3_nlopt_fit.h), which the omni3 commands keep.
 
 #include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
 
-#include "calib/omni3_ceres_fit.h"
-#include "calib/omni3_nlopt_fit.h"
 #include "fit/model_fit.h"
+#include "fit/omni3_ceres_fit.h"
+#include "fit/omni3_nlopt_fit.h"
 #include "models/model_interface.h"
 #include "tools/fit_command.h"
 

@@ -6,17 +6,17 @@
 #include <map>
 #include <set>
 
-#include "calib/aligned_run.h"
-#include "calib/effect_fit.h"
-#include "calib/final_pose_cost.h"
-#include "calib/segment_cost.h"
-#include "calib/trajectory_split.h"
+#include "diagnosis/effect_fit.h"
+#include "fit/final_pose_cost.h"
+#include "fit/segment_cost.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/robot_yaml.h"
 #include "models/model_registry.h"
+#include "odometry/aligned_run.h"
 #include "odometry/parallel_for.h"
 #include "tools/model_generalise_command.h"
+#include "validation/trajectory_split.h"
 
 namespace fitcal::tools {
 
@@ -35,7 +35,7 @@ struct Model {
   std::string name;
   bool fit = true;
   FitOptions options;
-  bool track = false;  // fit nine + `effects` on the ground-truth tracks (calib/effect_fit.h)
+  bool track = false;  // fit nine + `effects` on the ground-truth tracks (diagnosis/effect_fit.h)
   EffectModel effects;
 };
 

@@ -10,14 +10,14 @@
 #include <regex>
 #include <set>
 
-#include "calib/aligned_run.h"
-#include "calib/final_pose_cost.h"
-#include "calib/segment_cost.h"
+#include "fit/final_pose_cost.h"
+#include "fit/segment_cost.h"
 #include "io/atomic_file.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/robot_yaml.h"
 #include "io/text_file.h"
+#include "odometry/aligned_run.h"
 #include "odometry/parallel_for.h"
 #include "tools/import_optiodom_models.h"
 #include "tools/import_optiodom_omni4.h"

@@ -23,7 +23,7 @@
 #include <string>
 #include <vector>
 
-#include "calib/wheel_order_check.h"
+#include "diagnosis/wheel_order_check.h"
 #include "odometry/robot_description.h"
 #include "odometry/run_log.h"
 
@@ -68,12 +68,12 @@ RunLog OptiOdomRunLog(const OptiOdomSession& session, const OptiOdomRun& run);
 
 // The wheel order/sign check: replays every run with the nominal parameters under each of the 48
 // assignments of input channels to wheels (3! orders x 2^3 signs) applied on top of the importer's
-// mapping, and ranks them by the mean segment CF over 1 m windows (calib/segment_cost.h). The
+// mapping, and ranks them by the mean segment CF over 1 m windows (fit/segment_cost.h). The
 // intermediate ground truth is used because the final pose of a closed path hides sign errors (on
 // single OptiOdom sessions the final-pose CF does not rank the right mapping first). The identity
 // must come first for the documented mapping to be right.
 struct WheelMappingScore {
-  WheelMapping mapping;  // calib/wheel_order_check.h: wheel i = sign[i] * channel column[i]
+  WheelMapping mapping;  // diagnosis/wheel_order_check.h: wheel i = sign[i] * channel column[i]
   double mean_cf = 0.0;  // mean segment CF (m and rad per 1 m window)
   bool IsIdentity() const { return mapping.IsIdentity(); }
 };

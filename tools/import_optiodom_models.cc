@@ -11,13 +11,13 @@
 #include <set>
 #include <stdexcept>
 
-#include "calib/aligned_run.h"
 #include "fit/final_pose_errors.h"
 #include "io/atomic_file.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/text_file.h"
 #include "models/diff_drive/diff_drive_model.h"
+#include "odometry/aligned_run.h"
 
 namespace fitcal::tools {
 

@@ -9,7 +9,6 @@
 #include <set>
 #include <stdexcept>
 
-#include "calib/aligned_run.h"
 #include "fit/final_pose_errors.h"
 #include "io/atomic_file.h"
 #include "io/dataset.h"
@@ -17,6 +16,7 @@
 #include "io/text_file.h"
 #include "models/tricycle/tricycle_checks.h"
 #include "models/tricycle/tricycle_model.h"
+#include "odometry/aligned_run.h"
 
 namespace fitcal::tools {
 

@@ -11,7 +11,6 @@
 #include <stdexcept>
 #include <string_view>
 
-#include "calib/aligned_run.h"
 #include "fit/final_pose_errors.h"
 #include "io/atomic_file.h"
 #include "io/dataset.h"
@@ -20,6 +19,7 @@
 #include "io/staged_directory.h"
 #include "io/text_file.h"
 #include "models/model_registry.h"
+#include "odometry/aligned_run.h"
 
 namespace fitcal::tools {
 namespace {

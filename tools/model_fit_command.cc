@@ -6,17 +6,17 @@
 #include <iostream>
 #include <unordered_map>
 
-#include "calib/channel_order_check.h"
-#include "calib/run_split.h"
-#include "calib/segment_cost.h"
+#include "diagnosis/channel_order_check.h"
 #include "fit/final_pose_errors.h"
 #include "fit/model_fit.h"
 #include "fit/result_gate.h"
+#include "fit/segment_cost.h"
 #include "fitcal/version.h"
 #include "io/atomic_file.h"
 #include "io/calibration_block.h"
 #include "tools/fit_methods.h"
 #include "tools/output_guard.h"
+#include "validation/run_split.h"
 
 namespace fitcal::tools {
 

@@ -4,9 +4,9 @@
 #include <iostream>
 #include <set>
 
-#include "calib/generalisation.h"
-#include "calib/run_split.h"
-#include "calib/trajectory_split.h"
+#include "validation/generalisation.h"
+#include "validation/run_split.h"
+#include "validation/trajectory_split.h"
 
 namespace fitcal::tools {
 

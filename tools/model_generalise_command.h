@@ -1,7 +1,7 @@
 #pragma once
 // `fitcal generalise` for every robot model on the seam except omni3 (whose table, with its
 // segment cost, reduced model and effects, stays in generalisation_command.cc): the splits and
-// candidates of calib/generalisation.h, printed as the Markdown tables of the README.
+// candidates of validation/generalisation.h, printed as the Markdown tables of the README.
 
 #include "io/dataset.h"
 #include "models/model_interface.h"

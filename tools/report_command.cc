@@ -8,10 +8,7 @@
 #include <map>
 #include <set>
 
-#include "calib/cross_validation.h"
-#include "calib/identifiability.h"
-#include "calib/run_split.h"
-#include "calib/trajectory_metrics.h"
+#include "diagnosis/identifiability.h"
 #include "fitcal/version.h"
 #include "io/atomic_file.h"
 #include "io/calibration_yaml.h"
@@ -23,6 +20,9 @@
 #include "odometry/effects.h"
 #include "tools/output_guard.h"
 #include "tools/sim/flower_candidates.h"
+#include "validation/cross_validation.h"
+#include "validation/run_split.h"
+#include "validation/trajectory_metrics.h"
 
 namespace fitcal::tools {
 

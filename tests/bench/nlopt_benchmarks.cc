@@ -10,8 +10,8 @@
 
 #include <vector>
 
-#include "calib/aligned_run.h"
-#include "calib/omni3_nlopt_fit.h"
+#include "fit/omni3_nlopt_fit.h"
+#include "odometry/aligned_run.h"
 #include "tools/sim/omni3_simulator.h"
 
 namespace fitcal {

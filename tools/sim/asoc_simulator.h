@@ -24,9 +24,9 @@
 #include <string>
 #include <vector>
 
-#include "odometry/asoc_model.h"
-#include "odometry/asoc_odometry.h"
-#include "odometry/asoc_run_log.h"
+#include "models/asoc/asoc_model.h"
+#include "models/asoc/asoc_odometry.h"
+#include "models/asoc/asoc_run_log.h"
 
 namespace fitcal::sim {
 

@@ -1,11 +1,11 @@
 #pragma once
 // The 36 flower trajectories (Palacin Table A1) as candidate motions for the identifiability
-// advice (calib/identifiability.h): "which trajectories would fix it" is answered from these.
+// advice (diagnosis/identifiability.h): "which trajectories would fix it" is answered from these.
 
 #include <cmath>
 #include <vector>
 
-#include "calib/identifiability.h"
+#include "diagnosis/identifiability.h"
 #include "tools/sim/flower_trajectories.h"
 
 namespace fitcal::sim {

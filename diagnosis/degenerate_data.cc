@@ -1,0 +1,99 @@
+#include "diagnosis/degenerate_data.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+
+namespace fitcal {
+
+namespace {
+
+// Two runs are copies when their samples are equal.
+bool SameSamples(const EncoderSamples& a, const EncoderSamples& b) { return a == b; }
+
+double Median(std::vector<double> v) {
+  const std::size_t mid = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
+  if (v.size() % 2 == 1) return v[mid];
+  const double upper = v[mid];
+  return 0.5 * (upper + *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid)));
+}
+
+}  // namespace
+
+double ChiSquare1Quantile(double p) {
+  // chi^2_1 = Z^2: P(chi^2_1 <= x) = erf(sqrt(x / 2)); bisection on sqrt(x) in [0, 40].
+  double lo = 0.0, hi = 40.0;
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (std::erf(mid / std::sqrt(2.0)) < p ? lo : hi) = mid;
+  }
+  const double z = 0.5 * (lo + hi);
+  return z * z;
+}
+
+std::vector<std::string> FindDegenerateData(const std::vector<AlignedRun>& runs,
+                                            const Omni3Robot& robot) {
+  std::vector<std::string> problems;
+  // A wheel that never turns: every rate exactly zero (an encoder that counts nothing).
+  for (int i = 0; i < omni3::kNumWheels; ++i) {
+    bool turns = false;
+    for (const AlignedRun& run : runs) {
+      for (const auto& s : run.samples) turns = turns || s.value[i] != 0.0;
+    }
+    if (!turns && !runs.empty()) {
+      problems.push_back("wheel " + robot.wheel_names[i] +
+                         " never turns in any run (disconnected encoder or stuck wheel?): its "
+                         "radius r_" +
+                         robot.wheel_names[i] +
+                         " is not determined by the data and stays at the nominal");
+    }
+  }
+  // Copies: group runs with bitwise-identical encoder samples.
+  std::vector<bool> seen(runs.size(), false);
+  std::size_t distinct = 0;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    if (seen[i]) continue;
+    ++distinct;
+    std::vector<std::string> copies;
+    for (std::size_t j = i + 1; j < runs.size(); ++j) {
+      if (!seen[j] && SameSamples(runs[i].samples, runs[j].samples)) {
+        seen[j] = true;
+        copies.push_back(runs[j].id);
+      }
+    }
+    if (!copies.empty() && copies.size() + 1 < runs.size()) {
+      std::string list;
+      for (const std::string& id : copies) list += (list.empty() ? "" : ", ") + id;
+      problems.push_back("runs " + runs[i].id + " and " + list +
+                         " have identical encoder logs (a copied file?): they count as one run");
+    }
+  }
+  if (runs.size() > 1 && distinct == 1) {
+    problems.push_back("all " + std::to_string(runs.size()) +
+                       " runs have identical encoder logs: one run's 3 final-pose residuals "
+                       "cannot determine the 9 parameters; the fit is underdetermined");
+  }
+  return problems;
+}
+
+std::vector<OutlierRun> FindOutlierRuns(const std::vector<std::string>& run_ids,
+                                        const std::vector<double>& per_run_norm, double alpha) {
+  std::vector<OutlierRun> out;
+  const std::size_t n = per_run_norm.size();
+  if (n < 3 || run_ids.size() != n) return out;  // no robust scale from fewer runs
+  std::vector<double> squared(n);
+  for (std::size_t i = 0; i < n; ++i) squared[i] = per_run_norm[i] * per_run_norm[i];
+  const double median_squared = Median(squared);
+  if (!(median_squared > 0.0)) return out;
+  const double s2 = median_squared / ChiSquare1Quantile(0.5);
+  const double limit = ChiSquare1Quantile(1.0 - alpha / static_cast<double>(n));
+  const double median_norm = std::sqrt(median_squared);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (squared[i] / s2 > limit) out.push_back({run_ids[i], per_run_norm[i] / median_norm});
+  }
+  return out;
+}
+
+}  // namespace fitcal

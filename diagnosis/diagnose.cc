@@ -1,0 +1,393 @@
+#include "diagnosis/diagnose.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+
+#include "diagnosis/statistics.h"
+#include "models/omni3/omni3_robot_model.h"
+
+namespace fitcal {
+
+namespace {
+
+using effects::EffectId;
+
+int NumParameters(const Robot& robot, const EffectModel& model) {
+  int k = robot.NumFree();
+  for (const auto& e : model) k += effects::Info(e.id).num_parameters;
+  return k;
+}
+
+double Bic(double sum_objective, int num_runs, int k) {
+  const double n = static_cast<double>(num_runs);
+  return n * std::log(std::max(sum_objective, 1e-300) / n) + k * std::log(n);
+}
+
+std::vector<AlignedRun> AlignedOf(const std::vector<TrackRun>& runs) {
+  std::vector<AlignedRun> out;
+  out.reserve(runs.size());
+  for (const TrackRun& r : runs) out.push_back(r.aligned);
+  return out;
+}
+
+std::string Fmt(const char* format, double a, double b = 0.0, double c = 0.0) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, format, a, b, c);
+  return buf;
+}
+
+std::string EffectValueText(const effects::EffectValue& e) {
+  const auto& info = effects::Info(e.id);
+  std::string out = info.name;
+  for (int k = 0; k < info.num_parameters; ++k) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, " %s = %.4g +- %.2g", info.parameter_names[k], e.value[k],
+                  e.sigma[k]);
+    out += buf;
+  }
+  return out;
+}
+
+// The held-out comparison of a candidate with the base, per validation run i:
+//   mean_improvement = mean of J_base,i - J_cand,i (objective units; ranks the candidates);
+//   the one-sided paired t test on l_i = ln(J_base,i / J_cand,i), the log ratio: an effect
+//   scales each run's error by its own exposure (a steering scale shows on sharp circles, hardly
+//   on gentle ones), so the differences are heavy-tailed and a t test on them has little power,
+//   while the ratios are comparable across runs.
+void PairedImprovement(const ModelScore& base, const ModelScore& candidate, CandidateResult* c) {
+  const std::size_t n = base.runs.size();
+  constexpr double kTiny = 1e-300;
+  double mean_d = 0.0, mean_l = 0.0, var_l = 0.0;
+  std::vector<double> l(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    mean_d += base.runs[i].objective - candidate.runs[i].objective;
+    l[i] = std::log(std::max(base.runs[i].objective, kTiny) /
+                    std::max(candidate.runs[i].objective, kTiny));
+    mean_l += l[i];
+  }
+  mean_d /= static_cast<double>(std::max<std::size_t>(1, n));
+  mean_l /= static_cast<double>(std::max<std::size_t>(1, n));
+  for (double x : l) var_l += (x - mean_l) * (x - mean_l);
+  var_l /= std::max<double>(1.0, static_cast<double>(n) - 1.0);
+  c->mean_improvement = mean_d;
+  c->t_statistic = var_l > 0.0 ? mean_l / std::sqrt(var_l / static_cast<double>(n)) : 0.0;
+  c->p_value =
+      n >= 2 ? stats::StudentTUpperTail(c->t_statistic, static_cast<double>(n) - 1.0) : 1.0;
+}
+
+// Every identifiable effect of the registry that this robot's channels can show.
+std::vector<EffectId> DefaultCandidates(const Robot& robot) {
+  bool has_angle = false;
+  for (const ChannelInfo& c : robot.channels)
+    has_angle = has_angle || c.kind == ChannelKind::kAngle;
+  std::vector<EffectId> out;
+  for (const auto& info : effects::EffectTable()) {
+    if (info.identifiable && (has_angle || !effects::NeedsAngleChannel(info.id))) {
+      out.push_back(info.id);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+bool DiagnoseOptions::IsValid(std::string* error) const {
+  if (!fit.IsValid(error)) return false;
+  if (!(alpha > 0.0 && alpha < 1.0) || !(lof_alpha > 0.0 && lof_alpha < 1.0)) {
+    *error = "alpha and lof_alpha must be in (0, 1)";
+    return false;
+  }
+  if (!(min_explained_fraction >= 0.0 && min_explained_fraction <= 1.0) ||
+      !(min_separable_fraction >= 0.0 && min_separable_fraction < 1.0)) {
+    *error = "fractions must be in [0, 1]";
+    return false;
+  }
+  if (max_effects < 0) {
+    *error = "max_effects must be >= 0";
+    return false;
+  }
+  return true;
+}
+
+DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
+                        const std::vector<TrackRun>& validation, const Omni3Robot& robot,
+                        const DiagnoseOptions& options) {
+  return Diagnose(training, validation, *Omni3ModelOf(robot), options);
+}
+
+DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
+                        const std::vector<TrackRun>& validation, const RobotModelInterface& model,
+                        const DiagnoseOptions& options) {
+  const Robot& robot = model.robot();
+  std::string error;
+  if (!options.IsValid(&error)) throw std::invalid_argument("DiagnoseOptions: " + error);
+  if (training.empty()) throw std::invalid_argument("Diagnose: no training runs");
+  const int threads = options.fit.num_threads;
+  DiagnoseResult out;
+  out.num_validation_runs = static_cast<int>(validation.size());
+  std::vector<TrackRun> all = training;
+  all.insert(all.end(), validation.begin(), validation.end());
+
+  // 1. The declared fit and its residual.
+  ModelFitOptions declared_options;
+  declared_options.ceres.num_threads = threads;
+  declared_options.ceres.weights = options.fit.weights;
+  out.declared = FitModel(AlignedOf(training), model, declared_options);
+  out.declared_validation =
+      ScoreModel(model, out.declared.parameters, {}, validation, options.fit.weights, threads);
+  out.before = AnalyzeResiduals(model, out.declared.parameters, {}, all, threads);
+
+  // 2. The base: the model's parameters on the tracks.
+  out.base = FitEffectModel(training, model, out.declared.parameters, {}, options.fit);
+  EffectFitResult current = out.base;
+
+  std::vector<EffectId> candidates =
+      options.candidates.empty() ? DefaultCandidates(robot) : options.candidates;
+  // The registry's "not identifiable" holds for omni3 (e.g. a tracked-point offset is exactly a
+  // change of its wheel distances); another model may separate the effect (a differential drive
+  // cannot move sideways, so the same offset shows). Checked numerically here: an effect whose
+  // separable fraction reaches min_separable_fraction becomes a candidate like the others.
+  for (const auto& info : effects::EffectTable()) {
+    if (info.identifiable) continue;
+    const double sep =
+        SeparableFraction(training, model, current.parameters, {}, info.id, options.fit.weights);
+    if (options.candidates.empty() && sep >= options.min_separable_fraction) {
+      candidates.push_back(info.id);
+      continue;
+    }
+    out.not_identifiable.push_back(
+        std::string(info.name) + ": not identifiable - " + info.aliased_with +
+        Fmt(" (separable fraction on these runs %.1e); ", sep) + info.separating_runs);
+  }
+
+  // 3. Tracing.
+  std::vector<std::string> practically_aliased;
+  const bool have_validation = !validation.empty();
+  while (have_validation && static_cast<int>(current.effects.size()) < options.max_effects) {
+    DiagnoseRound round;
+    const ModelScore base_val = ScoreModel(model, current.parameters, current.effects, validation,
+                                           options.fit.weights, threads);
+    round.base_validation_objective = base_val.objective;
+    const ResidualAnalysis base_all =
+        AnalyzeResiduals(model, current.parameters, current.effects, all, threads);
+    round.base_lof_f = base_all.lack_of_fit.f;
+    round.base_lof_p = base_all.lack_of_fit.p_value;
+    const bool base_lof =
+        base_all.lack_of_fit.available && base_all.lack_of_fit.p_value < options.lof_alpha;
+    const double base_bic = Bic(2.0 * current.final_cost, static_cast<int>(training.size()),
+                                NumParameters(robot, current.effects));
+    const int dof_base =
+        3 * static_cast<int>(training.size()) - NumParameters(robot, current.effects);
+    const double residual_rms = std::sqrt(2.0 * current.final_cost / std::max(1, dof_base));
+    int num_tried = 0;
+    for (EffectId id : candidates) {
+      const bool in_model = std::any_of(current.effects.begin(), current.effects.end(),
+                                        [&](const effects::EffectValue& e) { return e.id == id; });
+      if (in_model) continue;
+      CandidateResult c;
+      c.id = id;
+      double unexplained = 0.0;
+      c.separable_fraction = SeparableFraction(training, model, current.parameters, current.effects,
+                                               id, options.fit.weights, &unexplained);
+      c.predicted_sigma =
+          unexplained > 0.0 ? residual_rms / unexplained : std::numeric_limits<double>::infinity();
+      const auto& info = effects::Info(id);
+      double typical = 0.0;
+      for (int j = 0; j < info.num_parameters; ++j)
+        typical = std::max(typical, std::abs(info.typical[j]));
+      c.resolvable = c.separable_fraction >= options.min_separable_fraction &&
+                     typical >= options.min_resolvable_sigmas * c.predicted_sigma;
+      if (!c.resolvable) {
+        c.verdict = "cannot be told apart from the model on these runs";
+        round.candidates.push_back(c);
+        continue;
+      }
+      ++num_tried;
+      EffectModel start = current.effects;
+      effects::EffectValue neutral;
+      neutral.id = id;
+      start.push_back(neutral);
+      c.fit = FitEffectModel(training, model, current.parameters, start, options.fit);
+      c.fitted = c.fit.usable;
+      if (!c.fitted) {
+        c.verdict = "fit failed: " + c.fit.termination;
+        round.candidates.push_back(c);
+        continue;
+      }
+      const ModelScore val = ScoreModel(model, c.fit.parameters, c.fit.effects, validation,
+                                        options.fit.weights, threads);
+      c.validation_objective = val.objective;
+      PairedImprovement(base_val, val, &c);
+      c.delta_bic = Bic(2.0 * c.fit.final_cost, static_cast<int>(training.size()),
+                        NumParameters(robot, c.fit.effects)) -
+                    base_bic;
+      round.candidates.push_back(c);
+    }
+    // Decide with the Bonferroni threshold, then check the explanation of the best ones.
+    const double threshold = options.alpha / std::max(1, num_tried);
+    int best = -1;
+    std::vector<int> order;
+    for (int i = 0; i < static_cast<int>(round.candidates.size()); ++i) {
+      CandidateResult& c = round.candidates[i];
+      if (!c.fitted) continue;
+      c.significant = c.p_value < threshold && c.delta_bic < 0.0 && c.mean_improvement > 0.0;
+      c.verdict = c.significant ? "significant"
+                                : Fmt("not significant (p %.2g vs %.2g)", c.p_value, threshold);
+      if (c.significant) order.push_back(i);
+    }
+    std::sort(order.begin(), order.end(), [&](int a, int b) {
+      return round.candidates[a].mean_improvement > round.candidates[b].mean_improvement;
+    });
+    for (int i : order) {
+      CandidateResult& c = round.candidates[i];
+      if (base_lof) {
+        const ResidualAnalysis with =
+            AnalyzeResiduals(model, c.fit.parameters, c.fit.effects, all, threads);
+        c.lof_f = with.lack_of_fit.f;
+        const double excess_before = round.base_lof_f - 1.0;
+        const double excess_after = std::max(0.0, c.lof_f - 1.0);
+        c.explains = excess_after <= (1.0 - options.min_explained_fraction) * excess_before;
+      } else {
+        c.explains = true;
+      }
+      if (!c.explains) {
+        c.verdict = Fmt("significant but explains only %.0f%% of the structure",
+                        100.0 * (1.0 - std::max(0.0, c.lof_f - 1.0) / (round.base_lof_f - 1.0)));
+        continue;
+      }
+      best = i;
+      break;
+    }
+    for (const CandidateResult& c : round.candidates) {
+      if (!c.resolvable) {
+        const auto& info = effects::Info(c.id);
+        practically_aliased.push_back(
+            std::string(info.name) +
+            Fmt(" cannot be told apart from the model on these runs "
+                "(separable fraction %.2g, predicted sigma %.2g; it trades off with ",
+                c.separable_fraction, c.predicted_sigma) +
+            info.aliased_with + "); record: " + info.separating_runs);
+      }
+    }
+    if (best < 0) {
+      out.rounds.push_back(std::move(round));
+      break;
+    }
+    round.candidates[best].accepted = true;
+    round.candidates[best].verdict = "ACCEPTED";
+    current = round.candidates[best].fit;
+    out.rounds.push_back(std::move(round));
+  }
+  std::sort(practically_aliased.begin(), practically_aliased.end());
+  practically_aliased.erase(std::unique(practically_aliased.begin(), practically_aliased.end()),
+                            practically_aliased.end());
+  out.record_next = practically_aliased;
+
+  // 4. After.
+  out.final_fit = current;
+  out.final_validation = ScoreModel(model, current.parameters, current.effects, validation,
+                                    options.fit.weights, threads);
+  out.after = AnalyzeResiduals(model, current.parameters, current.effects, all, threads);
+  out.unexplained_structure =
+      out.after.lack_of_fit.available && out.after.lack_of_fit.p_value < options.lof_alpha;
+  out.effects_named = !out.unexplained_structure && !current.effects.empty();
+  if (out.unexplained_structure) {
+    out.record_next.push_back(
+        "structured residual remains that no candidate explains: record runs that vary what the "
+        "pattern depends on (speed, yaw rate, run length, start heading) to narrow it down");
+  }
+  return out;
+}
+
+std::string FormatDiagnoseReport(const DiagnoseResult& r, const Omni3Robot& robot) {
+  return FormatDiagnoseReport(r, *Omni3ModelOf(robot));
+}
+
+std::string FormatDiagnoseReport(const DiagnoseResult& r, const RobotModelInterface& model) {
+  const Robot& robot = model.robot();
+  std::string out = "# fitcal diagnose\n\n## Residual of the declared fit of the " +
+                    std::to_string(robot.NumFree()) + " free parameters\n\n";
+  out += FormatResidualAnalysis(r.before);
+  out += "\n## Tracing\n\n";
+  for (std::size_t k = 0; k < r.rounds.size(); ++k) {
+    const DiagnoseRound& round = r.rounds[k];
+    out += Fmt("Round %.0f: base validation objective %.4g, lack of fit F = %.2f",
+               static_cast<double>(k + 1), round.base_validation_objective, round.base_lof_f) +
+           Fmt(" (p = %.2g)\n\n", round.base_lof_p);
+    out +=
+        "| candidate | separable | predicted sigma | value +- sigma | validation objective | mean "
+        "d | t | p | dBIC | verdict |\n";
+    out += "|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const CandidateResult& c : round.candidates) {
+      std::string value = "-";
+      if (c.fitted) {
+        value.clear();
+        for (const auto& e : c.fit.effects) {
+          if (e.id == c.id) {
+            for (int j = 0; j < effects::Info(e.id).num_parameters; ++j) {
+              value += Fmt("%.4g +- %.2g ", e.value[j], e.sigma[j]);
+            }
+          }
+        }
+      }
+      char line[512];
+      std::snprintf(line, sizeof line,
+                    "| %s | %.2g | %.2g | %s | %.4g | %.3g | %.2f | %.2g | %.1f | %s |\n",
+                    effects::Info(c.id).name, c.separable_fraction, c.predicted_sigma,
+                    value.c_str(), c.validation_objective, c.mean_improvement, c.t_statistic,
+                    c.p_value, c.delta_bic, c.verdict.c_str());
+      out += line;
+    }
+    out += "\n";
+  }
+  out += "## Result\n\n";
+  if (r.final_fit.effects.empty()) {
+    out += "No effect accepted.\n";
+  } else {
+    for (const auto& e : r.final_fit.effects) {
+      out += (r.effects_named ? "- accepted: "
+                              : "- partial (NOT named as the cause: structure remains): ") +
+             EffectValueText(e) + "\n";
+    }
+  }
+  if (r.unexplained_structure) {
+    out +=
+        Fmt("- UNEXPLAINED STRUCTURE: the residual still shows repeatable structure "
+            "(lack of fit F = %.2f, p = %.2g) that no candidate explains; see the tables above.\n",
+            r.after.lack_of_fit.f, r.after.lack_of_fit.p_value);
+  } else {
+    out +=
+        Fmt("- the remaining residual is consistent with the noise floor (lack of fit F = %.2f, p "
+            "= %.2g)\n",
+            r.after.lack_of_fit.f, r.after.lack_of_fit.p_value);
+  }
+  for (const std::string& line : r.not_identifiable) out += "- " + line + "\n";
+  for (const std::string& line : r.record_next) out += "- record next: " + line + "\n";
+
+  out += Fmt("\n## Held-out error (%.0f validation runs)\n\n", r.num_validation_runs);
+  out += "| model | CF (Eq. 14) | track RMSE [m] | track RMSE [deg] |\n|---|---|---|---|\n";
+  out += Fmt("| declared parameters | %.5f | %.5f | %.4f |\n", r.declared_validation.cf,
+             r.declared_validation.track_rmse_m, RadToDeg(r.declared_validation.track_rmse_rad));
+  out += Fmt("| parameters + accepted effects | %.5f | %.5f | %.4f |\n", r.final_validation.cf,
+             r.final_validation.track_rmse_m, RadToDeg(r.final_validation.track_rmse_rad));
+
+  out +=
+      "\n## Parameters before / after\n\n| parameter | nominal | declared fit | with effects "
+      "| sigma |\n|---|---|---|---|---|\n";
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    const double s = robot.parameters[k].DisplayScale();
+    const double sigma =
+        k < static_cast<int>(r.final_fit.sigma.size()) ? r.final_fit.sigma[k] : 0.0;
+    char line[256];
+    std::snprintf(line, sizeof line, "| %s%s | %.6f | %.6f | %.6f | %.2g |\n",
+                  robot.LabelOf(k).c_str(), robot.IsHeld(k) ? " (held)" : "", robot.nominal[k] * s,
+                  r.declared.parameters[k] * s, r.final_fit.parameters[k] * s, sigma * s);
+    out += line;
+  }
+  return out;
+}
+
+}  // namespace fitcal

@@ -1,0 +1,120 @@
+#pragma once
+// Closing the loop (issue 6), for any robot model: find the residual the model's fit leaves, trace
+// it to an effect of the library (odometry/effects.h), add it, and show the error before and after
+// on held-out repetitions.
+//
+// Procedure (stated once, implemented in Diagnose()):
+//  1. The declared fit: nine parameters on the training final poses (omni3_ceres_fit.h), and its
+//     residual analysis (residual_analysis.h) over all runs.
+//  2. The base of the tracing: the nine parameters refitted on the training tracks
+//     (effect_fit.h), so that every candidate is compared under the same objective.
+//  3. For each candidate effect not yet in the model:
+//       - separability: the part of its Jacobian column outside the span of the others
+//         (SeparableFraction) and the sigma it predicts, sigma_c = s / |(I - P) J_c| with s the
+//         base's residual RMS (one run = three residuals, as the fit's covariance). When the
+//         fraction is below min_separable_fraction, or the registry's realistic magnitude is
+//         less than min_resolvable_sigmas predicted sigmas, the runs cannot tell it from the
+//         model: it is not fitted, and the runs that would separate it are named;
+//       - refit nine + accepted effects + candidate on the training runs;
+//       - validation: per held-out run, d_i = J_base,i - J_cand,i (J the run's mean squared track
+//         error); one-sided paired t test of mean(ln(J_base,i / J_cand,i)) > 0 (the log ratio:
+//         an effect scales each run's error by that run's exposure to it, so the d_i are heavy-
+//         tailed and the ratios comparable); significant when mean(d) > 0 and p < alpha / (number
+//         of candidates tried) (Bonferroni);
+//       - information criterion on the training runs, one observation per run (a run's
+//         checkpoints are correlated): BIC = N ln(S / N) + k ln N, S = sum of run objectives,
+//         k the number of fitted parameters; required: BIC falls;
+//       - explanation: where the base leaves significant lack of fit (p < lof_alpha), the
+//         candidate must remove at least min_explained_fraction of its excess (F - 1), so a
+//         candidate that merely nibbles at an effect outside the library is not named.
+//     The accepted candidate is the one passing all tests with the largest mean(d); then the
+//     search repeats for a second effect, and so on, until none passes (or max_effects).
+//  4. After: lack of fit of the final model; if still significant (p < lof_alpha), the residual
+//     is reported as structure that no candidate explains, with its pattern, and the accepted
+//     effects (if any) are reported as a partial description, not named as the cause.
+// Structurally non-identifiable effects (registry: identifiable = false, e.g. the encoder clock
+// scale, which equals a common radius scale) are never fitted; their separable fraction is
+// computed and reported to show that the data agree.
+
+#include <string>
+#include <vector>
+
+#include "diagnosis/effect_fit.h"
+#include "diagnosis/residual_analysis.h"
+#include "fit/model_fit.h"
+#include "fit/omni3_ceres_fit.h"
+
+namespace fitcal {
+
+struct DiagnoseOptions {
+  EffectFitOptions fit;
+  double alpha = 0.01;                   // family-wise, split over the candidates (Bonferroni)
+  double lof_alpha = 0.001;              // lack-of-fit threshold (approximate F, see above)
+  double min_explained_fraction = 0.5;   // of the lack-of-fit excess, when it is significant
+  double min_separable_fraction = 0.02;  // below: not separable from the nine on these runs
+  double min_resolvable_sigmas = 3.0;    // realistic magnitude / predicted sigma, at least
+  int max_effects = 3;
+  // Candidates (default, empty: every identifiable effect of the registry).
+  std::vector<effects::EffectId> candidates;
+  bool IsValid(std::string* error) const;
+};
+
+struct CandidateResult {
+  effects::EffectId id{};
+  double separable_fraction = 0.0;
+  double predicted_sigma = 0.0;  // of the candidate's least determined parameter
+  bool resolvable = false;
+  bool fitted = false;
+  EffectFitResult fit;
+  double validation_objective = 0.0;  // sum over held-out runs
+  double mean_improvement = 0.0;      // mean of d_i
+  double t_statistic = 0.0;
+  double p_value = 1.0;
+  double delta_bic = 0.0;
+  double lof_f = 0.0;  // lack of fit with the candidate (all runs)
+  bool significant = false;
+  bool explains = false;
+  bool accepted = false;
+  std::string verdict;
+};
+
+struct DiagnoseRound {
+  double base_validation_objective = 0.0;
+  double base_lof_f = 0.0;
+  double base_lof_p = 1.0;
+  std::vector<CandidateResult> candidates;
+};
+
+struct DiagnoseResult {
+  ModelFitResult declared;  // the model's parameters, final-pose fit (fit/model_fit.h)
+  ModelScore declared_validation;
+  ResidualAnalysis before;  // declared fit, all runs
+  EffectFitResult base;     // nine parameters, track fit
+  std::vector<DiagnoseRound> rounds;
+  EffectFitResult final_fit;  // nine + accepted effects (== base when none)
+  ModelScore final_validation;
+  ResidualAnalysis after;
+  bool unexplained_structure = false;
+  // The accepted effects are named as causes only when nothing structured remains; otherwise
+  // they are a partial description (they may stand in for an effect outside the library).
+  bool effects_named = false;
+  std::vector<std::string> not_identifiable;  // one line each
+  std::vector<std::string> record_next;       // which runs to record, one line each
+  int num_validation_runs = 0;
+};
+
+// Throws std::invalid_argument for invalid options or no training runs. The TrackRuns' contexts
+// must mark the model's wheel channels (PrepareTrackRuns with WheelChannelMask(robot)).
+DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
+                        const std::vector<TrackRun>& validation, const RobotModelInterface& model,
+                        const DiagnoseOptions& options = {});
+DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
+                        const std::vector<TrackRun>& validation, const Omni3Robot& robot,
+                        const DiagnoseOptions& options = {});
+
+// The report (Markdown): pattern, effect chosen with value and uncertainty, parameters before
+// and after, held-out error before and after, candidate table, what to record next.
+std::string FormatDiagnoseReport(const DiagnoseResult& result, const RobotModelInterface& model);
+std::string FormatDiagnoseReport(const DiagnoseResult& result, const Omni3Robot& robot);
+
+}  // namespace fitcal

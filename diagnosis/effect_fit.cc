@@ -1,0 +1,556 @@
+#include "diagnosis/effect_fit.h"
+
+#include <ceres/ceres.h>
+#include <ceres/dynamic_autodiff_cost_function.h>
+
+#include <Eigen/QR>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+
+#include "fit/dense_solver_options.h"
+#include "models/omni3/omni3_robot_model.h"
+#include "odometry/parallel_for.h"
+#include "validation/run_split.h"
+
+namespace fitcal {
+
+namespace {
+
+using effects::ActiveEffect;
+using effects::EffectId;
+
+template <typename T>
+double Value(const T& x) {
+  if constexpr (std::is_same_v<T, double>) {
+    return x;
+  } else {
+    return x.a;
+  }
+}
+
+// Ground truth at a (possibly differentiated) time, linear interpolation as
+// InterpolateGroundTruth; the bracket is chosen on the value, the fraction keeps derivatives.
+template <typename T>
+Pose2<T> InterpolateTrack(const GroundTruthTrack& track, const T& t_s) {
+  const auto& t = track.t_s;
+  const double tv = Value(t_s);
+  const auto& poses = track.world_T_robot;
+  if (tv <= t.front()) return {T(poses.front().x), T(poses.front().y), T(poses.front().theta)};
+  if (tv >= t.back()) return {T(poses.back().x), T(poses.back().y), T(poses.back().theta)};
+  const std::size_t hi =
+      static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), tv) - t.begin());
+  const std::size_t lo = hi - 1;
+  const T u = (t_s - T(t[lo])) / T(t[hi] - t[lo]);
+  const Pose2d& a = poses[lo];
+  const Pose2d& b = poses[hi];
+  return {T(a.x) + u * T(b.x - a.x), T(a.y) + u * T(b.y - a.y),
+          T(a.theta) + u * T(WrapAngle(b.theta - a.theta))};
+}
+
+// Pose errors (replay - ground truth) at the ground-truth samples `indices` of the run, and at
+// the window's end. err holds 3 values per index, then 3 for the end.
+template <typename T>
+void TrackPoseErrors(const RobotModelInterface& robot_model, const TrackRun& run, const T* p,
+                     const std::vector<ActiveEffect<T>>& active, const std::vector<int>& indices,
+                     T* err) {
+  const AlignedRun& a = run.aligned;
+  const T tau = effects::TotalLatency(active);
+  const Pose2d start_pose = TrackStartPose(a, run.contexts, run.track, ScalarPart(tau));
+  const Pose2<T> start{T(start_pose.x), T(start_pose.y), T(start_pose.theta)};
+  std::size_t next = 0;
+  const std::size_t n = indices.size();
+  const auto error_at = [&](std::size_t j, const Pose2<T>& pose, const Pose2d& gt) {
+    err[3 * j + 0] = pose.x - T(gt.x);
+    err[3 * j + 1] = pose.y - T(gt.y);
+    err[3 * j + 2] = WrapAngle(pose.theta - T(gt.theta));
+  };
+  const auto visit = [&](std::size_t k, const Pose2<T>& before, const Pose2<T>& after) {
+    const double t0 = run.contexts[k].t_s;
+    const double t1 = t0 + run.contexts[k].dt_s;
+    while (next < n) {
+      const int g = indices[next];
+      // Encoder time (from the window start) of this ground-truth sample.
+      const T e = T(run.track.t_s[g] - a.t_start_s) - tau;
+      const double ev = Value(e);
+      if (ev > t1 && k + 1 < run.contexts.size()) break;
+      const T f = (e - T(t0)) / T(t1 - t0);
+      const Pose2<T> pose{before.x + f * (after.x - before.x), before.y + f * (after.y - before.y),
+                          before.theta + f * (after.theta - before.theta)};
+      error_at(next, pose, run.track.world_T_robot[g]);
+      ++next;
+    }
+  };
+  const auto kinematics = robot_model.PrepareKinematics(p);
+  const auto step = [&kinematics](const T* values, double dt, T* dx, T* dy, T* dtheta) {
+    kinematics->Step(values, dt, dx, dy, dtheta);
+  };
+  const Pose2<T> final_pose =
+      effects::ReplayStepsWithEffects(step, active, a.samples, run.contexts, start, visit);
+  for (; next < n; ++next) {  // only for an empty replay
+    error_at(next, final_pose, run.track.world_T_robot[indices[next]]);
+  }
+  const Pose2<T> gt_end = InterpolateTrack(run.track, T(a.t_final_s) + tau);
+  err[3 * n + 0] = final_pose.x - gt_end.x;
+  err[3 * n + 1] = final_pose.y - gt_end.y;
+  err[3 * n + 2] = WrapAngle(final_pose.theta - gt_end.theta);
+}
+
+// The fit's residual (see the header): parameter block 0 = the model's parameters, block 1 + j =
+// effect j.
+class EffectTrackResidual {
+ public:
+  EffectTrackResidual(const RobotModelInterface& robot_model, const TrackRun& run,
+                      std::vector<EffectId> ids, const ResidualWeights& w)
+      : robot_model_(robot_model),
+        run_(run),
+        ids_(std::move(ids)),
+        inv_xy_(1.0 / w.position_sigma_m),
+        inv_theta_(1.0 / w.heading_sigma_rad) {}
+
+  int num_residuals() const { return 3 * static_cast<int>(run_.checkpoints.size()); }
+
+  template <typename T>
+  bool operator()(T const* const* params, T* residual) const {
+    std::vector<ActiveEffect<T>> active;
+    active.reserve(ids_.size());
+    for (std::size_t j = 0; j < ids_.size(); ++j) active.push_back({ids_[j], params[1 + j]});
+    const std::size_t n = run_.checkpoints.size();
+    std::vector<T> err(3 * n + 3);
+    TrackPoseErrors(robot_model_, run_, params[0], active, run_.checkpoints, err.data());
+    const double norm = 1.0 / std::sqrt(static_cast<double>(n));
+    for (std::size_t j = 0; j < n; ++j) {
+      residual[3 * j + 0] = err[3 * j + 0] * (inv_xy_ * norm);
+      residual[3 * j + 1] = err[3 * j + 1] * (inv_xy_ * norm);
+      residual[3 * j + 2] = err[3 * j + 2] * (inv_theta_ * norm);
+    }
+    return true;
+  }
+
+  static ceres::CostFunction* Create(const RobotModelInterface& robot_model, const TrackRun& run,
+                                     const std::vector<EffectId>& ids, const ResidualWeights& w) {
+    auto* functor = new EffectTrackResidual(robot_model, run, ids, w);
+    // The stride is EffectJet's: the model's PrepareKinematics serves exactly that Jet.
+    auto* cost = new ceres::DynamicAutoDiffCostFunction<EffectTrackResidual, 4>(functor);
+    cost->AddParameterBlock(robot_model.robot().NumParameters());
+    for (EffectId id : ids) cost->AddParameterBlock(effects::Info(id).num_parameters);
+    cost->SetNumResiduals(functor->num_residuals());
+    return cost;
+  }
+
+ private:
+  const RobotModelInterface& robot_model_;
+  const TrackRun& run_;
+  std::vector<EffectId> ids_;
+  double inv_xy_;
+  double inv_theta_;
+};
+
+std::vector<ActiveEffect<double>> ActiveOf(const EffectModel& model) {
+  std::vector<ActiveEffect<double>> active;
+  for (const auto& e : model) active.push_back({e.id, e.value.data()});
+  return active;
+}
+
+std::vector<EffectId> IdsOf(const EffectModel& model) {
+  std::vector<EffectId> ids;
+  for (const auto& e : model) ids.push_back(e.id);
+  return ids;
+}
+
+// The omni3 kinematics on the seam, for the omni3 overloads (they do not depend on the robot's
+// values: the parameters come with each call).
+const RobotModelInterface& Omni3Seam() {
+  static const std::shared_ptr<const Omni3Model> model = Omni3ModelOf(Omni3Robot{});
+  return *model;
+}
+
+std::vector<double> Vector(const Omni3ParameterArray& p) { return {p.begin(), p.end()}; }
+
+}  // namespace
+
+unsigned WheelChannelMask(const Robot& robot) {
+  unsigned mask = 0;
+  for (int i = 0; i < robot.NumChannels(); ++i) {
+    if (robot.channels[i].kind == ChannelKind::kWheelRate) mask |= 1u << i;
+  }
+  return mask;
+}
+
+Pose2d TrackStartPose(const AlignedRun& run, const std::vector<effects::SampleContext>& contexts,
+                      const GroundTruthTrack& track, double latency_s) {
+  // Encoder time (from the window start) at which the robot starts moving.
+  const auto first_moving = std::find_if(contexts.begin(), contexts.end(),
+                                         [](const effects::SampleContext& c) { return c.moving; });
+  const double rest_until_s = first_moving != contexts.end() ? first_moving->t_s
+                              : contexts.empty()             ? 0.0
+                                                 : contexts.back().t_s + contexts.back().dt_s;
+  const auto first = std::lower_bound(track.t_s.begin(), track.t_s.end(), run.t_start_s);
+  if (rest_until_s > 0.0 && first != track.t_s.end() &&
+      *first - run.t_start_s - latency_s <= rest_until_s) {
+    return track.world_T_robot[static_cast<std::size_t>(first - track.t_s.begin())];
+  }
+  return InterpolateGroundTruth(track, run.t_start_s + latency_s);
+}
+
+bool TrackOptions::IsValid(std::string* error) const {
+  if (!(edge_margin_s >= 0.0)) {
+    *error = "edge_margin_s must be >= 0";
+    return false;
+  }
+  return true;
+}
+
+TrackRun PrepareTrackRun(const RunLog& run, const TrackOptions& options) {
+  return PrepareTrackRun(run, ~0u, options);
+}
+
+TrackRun PrepareTrackRun(const RunLog& run, unsigned wheel_mask, const TrackOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw std::invalid_argument("TrackOptions: " + error);
+  TrackRun out;
+  out.aligned = AlignRun(run);
+  out.track = run.ground_truth;
+  out.contexts = effects::MakeSampleContexts(out.aligned.samples, wheel_mask);
+  const double lo = out.aligned.t_start_s + options.edge_margin_s;
+  const double hi = out.aligned.t_final_s - options.edge_margin_s;
+  for (std::size_t g = 0; g < out.track.t_s.size(); ++g) {
+    if (out.track.t_s[g] >= lo && out.track.t_s[g] <= hi)
+      out.checkpoints.push_back(static_cast<int>(g));
+  }
+  if (out.checkpoints.empty()) {
+    throw std::invalid_argument("run " + run.id +
+                                ": no ground-truth sample inside the window for track residuals");
+  }
+  return out;
+}
+
+std::vector<TrackRun> PrepareTrackRuns(const std::vector<RunLog>& runs,
+                                       const TrackOptions& options) {
+  return PrepareTrackRuns(runs, ~0u, options);
+}
+
+std::vector<TrackRun> PrepareTrackRuns(const std::vector<RunLog>& runs, unsigned wheel_mask,
+                                       const TrackOptions& options) {
+  std::vector<TrackRun> out(runs.size());
+  ParallelFor(runs.size(), 0,
+              [&](std::size_t i) { out[i] = PrepareTrackRun(runs[i], wheel_mask, options); });
+  return out;
+}
+
+void SplitTrackRuns(std::vector<TrackRun> runs, const std::vector<int>& training_reps,
+                    std::vector<TrackRun>* training, std::vector<TrackRun>* validation) {
+  training->clear();
+  validation->clear();
+  for (TrackRun& run : runs) {
+    const bool train = std::find(training_reps.begin(), training_reps.end(),
+                                 run.aligned.repetition) != training_reps.end();
+    (train ? training : validation)->push_back(std::move(run));
+  }
+}
+
+ModelScore ScoreModel(const Omni3ParameterArray& p, const EffectModel& model,
+                      const std::vector<TrackRun>& runs, const ResidualWeights& weights,
+                      int num_threads) {
+  return ScoreModel(Omni3Seam(), Vector(p), model, runs, weights, num_threads);
+}
+
+ModelScore ScoreModel(const RobotModelInterface& robot_model, const std::vector<double>& p,
+                      const EffectModel& model, const std::vector<TrackRun>& runs,
+                      const ResidualWeights& weights, int num_threads) {
+  ModelScore out;
+  out.runs.resize(runs.size());
+  const auto active = ActiveOf(model);
+  ParallelFor(runs.size(), num_threads, [&](std::size_t i) {
+    const TrackRun& run = runs[i];
+    const std::size_t n = run.checkpoints.size();
+    std::vector<double> err(3 * n + 3);
+    TrackPoseErrors(robot_model, run, p.data(), active, run.checkpoints, err.data());
+    RunScore& s = out.runs[i];
+    double sum_xy = 0.0, sum_th = 0.0;
+    for (std::size_t j = 0; j < n; ++j) {
+      sum_xy += err[3 * j] * err[3 * j] + err[3 * j + 1] * err[3 * j + 1];
+      sum_th += err[3 * j + 2] * err[3 * j + 2];
+    }
+    s.objective = (sum_xy / (weights.position_sigma_m * weights.position_sigma_m) +
+                   sum_th / (weights.heading_sigma_rad * weights.heading_sigma_rad)) /
+                  static_cast<double>(n);
+    s.track_rmse_m = std::sqrt(sum_xy / static_cast<double>(n));
+    s.track_rmse_rad = std::sqrt(sum_th / static_cast<double>(n));
+    s.final_dx_m = err[3 * n];
+    s.final_dy_m = err[3 * n + 1];
+    s.final_dtheta_rad = err[3 * n + 2];
+    s.cf = std::sqrt(s.final_dx_m * s.final_dx_m + s.final_dy_m * s.final_dy_m +
+                     s.final_dtheta_rad * s.final_dtheta_rad);
+  });
+  for (const RunScore& s : out.runs) {
+    out.objective += s.objective;
+    out.cf += s.cf;
+    out.track_rmse_m += s.track_rmse_m * s.track_rmse_m;
+    out.track_rmse_rad += s.track_rmse_rad * s.track_rmse_rad;
+  }
+  if (!runs.empty()) {
+    const double n = static_cast<double>(runs.size());
+    out.cf /= n;
+    out.track_rmse_m = std::sqrt(out.track_rmse_m / n);
+    out.track_rmse_rad = std::sqrt(out.track_rmse_rad / n);
+  }
+  return out;
+}
+
+TrackErrors ComputeTrackErrors(const Omni3ParameterArray& p, const EffectModel& model,
+                               const TrackRun& run, bool all_samples) {
+  return ComputeTrackErrors(Omni3Seam(), Vector(p), model, run, all_samples);
+}
+
+TrackErrors ComputeTrackErrors(const RobotModelInterface& robot_model, const std::vector<double>& p,
+                               const EffectModel& model, const TrackRun& run, bool all_samples) {
+  std::vector<int> indices = run.checkpoints;
+  if (all_samples) {
+    indices.clear();
+    for (std::size_t g = 0; g < run.track.t_s.size(); ++g) {
+      const double t = run.track.t_s[g];
+      if (t >= run.aligned.t_start_s && t <= run.aligned.t_final_s) {
+        indices.push_back(static_cast<int>(g));
+      }
+    }
+  }
+  // With a latency the window's edge samples may fall outside the replay: keep them inside.
+  const auto active = ActiveOf(model);
+  const double tau = effects::TotalLatency(active);
+  indices.erase(std::remove_if(indices.begin(), indices.end(),
+                               [&](int g) {
+                                 const double e = run.track.t_s[g] - tau;
+                                 return e < run.aligned.t_start_s || e > run.aligned.t_final_s;
+                               }),
+                indices.end());
+  std::vector<double> err(3 * indices.size() + 3);
+  TrackPoseErrors(robot_model, run, p.data(), active, indices, err.data());
+  TrackErrors out;
+  for (std::size_t j = 0; j < indices.size(); ++j) {
+    out.t_s.push_back(run.track.t_s[indices[j]]);
+    out.ground_truth.push_back(run.track.world_T_robot[indices[j]]);
+    out.error.push_back(Pose2d{err[3 * j], err[3 * j + 1], err[3 * j + 2]});
+  }
+  const std::size_t n = indices.size();
+  out.final_error = Pose2d{err[3 * n], err[3 * n + 1], err[3 * n + 2]};
+  return out;
+}
+
+bool EffectFitOptions::IsValid(std::string* error) const {
+  if (!(weights.position_sigma_m > 0.0) || !(weights.heading_sigma_rad > 0.0)) {
+    *error = "residual sigmas must be positive";
+    return false;
+  }
+  if (max_num_iterations < 1 || num_threads < 0) {
+    *error = "max_num_iterations must be >= 1 and num_threads >= 0";
+    return false;
+  }
+  return true;
+}
+
+namespace {
+
+// The model's box (and its held parameters, at the nominal) on block p.
+void BoundModelParameters(const Robot& robot, double* p, ceres::Problem* problem) {
+  std::vector<int> held;
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    if (robot.IsHeld(k)) {
+      p[k] = robot.nominal[k];
+      held.push_back(k);
+    }
+    p[k] = std::clamp(p[k], robot.bounds[k].lo, robot.bounds[k].hi);
+    problem->SetParameterLowerBound(p, k, robot.bounds[k].lo);
+    problem->SetParameterUpperBound(p, k, robot.bounds[k].hi);
+  }
+  if (!held.empty()) {
+    problem->SetManifold(p, new ceres::SubsetManifold(robot.NumParameters(), held));
+  }
+}
+
+// The registry's box on every effect's parameters; returns how many there are.
+int BoundEffectParameters(EffectModel* model, ceres::Problem* problem) {
+  int count = 0;
+  for (auto& e : *model) {
+    const auto& info = effects::Info(e.id);
+    count += info.num_parameters;
+    for (int k = 0; k < info.num_parameters; ++k) {
+      e.value[k] = std::clamp(e.value[k], info.lower[k], info.upper[k]);
+      problem->SetParameterLowerBound(e.value.data(), k, info.lower[k]);
+      problem->SetParameterUpperBound(e.value.data(), k, info.upper[k]);
+    }
+  }
+  return count;
+}
+
+// Finite values, and whether an effect parameter rests on a bound that is not its neutral value.
+bool CheckEffectValues(const std::vector<double>& p, EffectFitResult* result) {
+  bool finite = true;
+  for (double v : p) finite = finite && std::isfinite(v);
+  for (auto& e : result->effects) {
+    const auto& info = effects::Info(e.id);
+    for (int k = 0; k < info.num_parameters; ++k) {
+      finite = finite && std::isfinite(e.value[k]);
+      const double tol = 1e-6 * (info.upper[k] - info.lower[k]);
+      // A one-sided bound at the neutral value (backlash >= 0) is a legitimate "no effect".
+      const bool neutral_bound = info.lower[k] == 0.0 && e.value[k] <= tol;
+      if (!neutral_bound &&
+          (e.value[k] <= info.lower[k] + tol || e.value[k] >= info.upper[k] - tol)) {
+        result->any_at_bound = true;
+      }
+    }
+  }
+  return finite;
+}
+
+// Sigmas of the model's and the effects' parameters (header: s^2 per run-residual).
+void ComputeEffectCovariance(ceres::Problem* problem, const std::vector<double*>& blocks, double s2,
+                             EffectFitResult* result) {
+  ceres::Covariance::Options cov_options;
+  cov_options.algorithm_type = ceres::DENSE_SVD;
+  cov_options.null_space_rank = -1;  // pseudo-inverse: aliased directions are reported, not fatal
+  ceres::Covariance covariance(cov_options);
+  std::vector<std::pair<const double*, const double*>> pairs;
+  for (double* b : blocks) pairs.emplace_back(b, b);
+  if (!covariance.Compute(pairs, problem)) return;
+  const int n = static_cast<int>(result->parameters.size());
+  // In ambient coordinates: a held parameter (SubsetManifold) gets zero variance.
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> c(n, n);
+  result->sigma.assign(n, 0.0);
+  covariance.GetCovarianceBlock(blocks[0], blocks[0], c.data());
+  for (int k = 0; k < n; ++k) result->sigma[k] = std::sqrt(std::max(0.0, s2 * c(k, k)));
+  for (auto& e : result->effects) {
+    const int m = effects::Info(e.id).num_parameters;
+    std::vector<double> ce(static_cast<std::size_t>(m * m));
+    covariance.GetCovarianceBlock(e.value.data(), e.value.data(), ce.data());
+    for (int k = 0; k < m; ++k)
+      e.sigma[k] = std::sqrt(std::max(0.0, s2 * ce[static_cast<std::size_t>(k * m + k)]));
+  }
+  result->has_covariance = true;
+}
+
+}  // namespace
+
+EffectFitResult FitEffectModel(const std::vector<TrackRun>& training, const Omni3Robot& robot,
+                               const Omni3ParameterArray& start_p, const EffectModel& start,
+                               const EffectFitOptions& options) {
+  return FitEffectModel(training, *Omni3ModelOf(robot), Vector(start_p), start, options);
+}
+
+EffectFitResult FitEffectModel(const std::vector<TrackRun>& training,
+                               const RobotModelInterface& robot_model,
+                               const std::vector<double>& start_p, const EffectModel& start,
+                               const EffectFitOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw std::invalid_argument("EffectFitOptions: " + error);
+  if (training.empty()) throw std::invalid_argument("FitEffectModel: no training runs");
+  const Robot& robot = robot_model.robot();
+  if (static_cast<int>(start_p.size()) != robot.NumParameters()) {
+    throw std::invalid_argument("FitEffectModel: start has the wrong number of parameters");
+  }
+  EffectFitResult result;
+  result.parameters = start_p;
+  result.effects = start;
+  double* p = result.parameters.data();
+  const std::vector<EffectId> ids = IdsOf(start);
+
+  ceres::Problem problem;
+  std::vector<double*> blocks = {p};
+  for (auto& e : result.effects) blocks.push_back(e.value.data());
+  for (const TrackRun& run : training) {
+    problem.AddResidualBlock(EffectTrackResidual::Create(robot_model, run, ids, options.weights),
+                             nullptr, blocks);
+  }
+  BoundModelParameters(robot, p, &problem);
+  const int num_effect_parameters = BoundEffectParameters(&result.effects, &problem);
+
+  DenseSolverTolerances tolerances;
+  tolerances.function = options.function_tolerance;
+  tolerances.parameter = options.parameter_tolerance;
+  const ceres::Solver::Options solver_options =
+      DenseSolverOptions(options.max_num_iterations, options.num_threads, tolerances);
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, &problem, &summary);
+  result.termination = ceres::TerminationTypeToString(summary.termination_type);
+  result.message = summary.message;
+  result.iterations = static_cast<int>(summary.iterations.size());
+  result.final_cost = summary.final_cost;
+  const bool finite = CheckEffectValues(result.parameters, &result);
+  result.usable = finite && (summary.termination_type == ceres::CONVERGENCE ||
+                             summary.termination_type == ceres::NO_CONVERGENCE);
+
+  const int dof = 3 * static_cast<int>(training.size()) - robot.NumFree() - num_effect_parameters;
+  if (options.compute_covariance && result.usable && dof > 0) {
+    ComputeEffectCovariance(&problem, blocks, 2.0 * summary.final_cost / dof, &result);
+  }
+  return result;
+}
+
+double SeparableFraction(const std::vector<TrackRun>& training, const Omni3ParameterArray& p,
+                         const EffectModel& model, EffectId candidate,
+                         const ResidualWeights& weights, double* unexplained_norm) {
+  return SeparableFraction(training, Omni3Seam(), Vector(p), model, candidate, weights,
+                           unexplained_norm);
+}
+
+double SeparableFraction(const std::vector<TrackRun>& training,
+                         const RobotModelInterface& robot_model, const std::vector<double>& p,
+                         const EffectModel& model, EffectId candidate,
+                         const ResidualWeights& weights, double* unexplained_norm) {
+  const int num_parameters = robot_model.robot().NumParameters();
+  EffectModel with = model;
+  effects::EffectValue c;
+  c.id = candidate;
+  with.push_back(c);
+  const std::vector<EffectId> ids = IdsOf(with);
+  int cols = num_parameters;
+  for (EffectId id : ids) cols += effects::Info(id).num_parameters;
+  const int m_c = effects::Info(candidate).num_parameters;
+  int rows = 0;
+  for (const TrackRun& run : training) rows += 3 * static_cast<int>(run.checkpoints.size());
+  Eigen::MatrixXd jac(rows, cols);
+  int row = 0;
+  for (const TrackRun& run : training) {
+    std::unique_ptr<ceres::CostFunction> cost(
+        EffectTrackResidual::Create(robot_model, run, ids, weights));
+    const int n = cost->num_residuals();
+    std::vector<const double*> params = {p.data()};
+    for (const auto& e : with) params.push_back(e.value.data());
+    std::vector<double> residual(static_cast<std::size_t>(n));
+    std::vector<std::vector<double>> jb(params.size());
+    std::vector<double*> jptr(params.size());
+    for (std::size_t b = 0; b < params.size(); ++b) {
+      const int size = b == 0 ? num_parameters : effects::Info(ids[b - 1]).num_parameters;
+      jb[b].resize(static_cast<std::size_t>(n * size));
+      jptr[b] = jb[b].data();
+    }
+    cost->Evaluate(params.data(), residual.data(), jptr.data());
+    int col = 0;
+    for (std::size_t b = 0; b < params.size(); ++b) {
+      const int size = b == 0 ? num_parameters : effects::Info(ids[b - 1]).num_parameters;
+      for (int r = 0; r < n; ++r) {
+        for (int k = 0; k < size; ++k)
+          jac(row + r, col + k) = jb[b][static_cast<std::size_t>(r * size + k)];
+      }
+      col += size;
+    }
+    row += n;
+  }
+  const Eigen::MatrixXd others = jac.leftCols(cols - m_c);
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(others);
+  double fraction = 1.0;
+  double smallest = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < m_c; ++k) {
+    const Eigen::VectorXd column = jac.col(cols - m_c + k);
+    const double norm = column.norm();
+    const double left = norm > 0.0 ? (column - others * qr.solve(column)).norm() : 0.0;
+    smallest = std::min(smallest, left);
+    fraction = std::min(fraction, norm > 0.0 ? left / norm : 0.0);
+  }
+  if (unexplained_norm != nullptr) *unexplained_norm = smallest;
+  return fraction;
+}
+
+}  // namespace fitcal

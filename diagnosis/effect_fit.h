@@ -1,0 +1,164 @@
+#pragma once
+// A robot model's parameters (models/model_interface.h; the nine of omni3 in the overloads that
+// take an Omni3ParameterArray) plus candidate effects (odometry/effects.h), fitted to the whole
+// ground-truth track of each run. The final pose alone cannot see every effect (a clock latency
+// vanishes when runs end at rest), so the residual of a run is the pose error at every
+// ground-truth sample of its window ("checkpoints"):
+//
+//   r_j = [ (x(t_j - tau) - x_gt_j) / sigma_xy, (y(...) - y_gt_j) / sigma_xy,
+//           wrap(theta(...) - theta_gt_j) / sigma_theta ] / sqrt(n_checkpoints)
+//
+// with the replay of odometry/effects.h (the model's steps, Palacin Eq. 4, + effect stages) started
+// at the ground truth at t_start + tau; tau is the time-offset effect's latency (0 without it). The
+// 1/sqrt(n) weight makes a run's squared residual its mean squared track error, so every run
+// counts once, whatever its length. One functor serves Ceres (dynamic autodiff) and the
+// double-valued scoring.
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "fit/final_pose_cost.h"
+#include "fit/final_pose_residual.h"
+#include "models/model_interface.h"
+#include "odometry/aligned_run.h"
+#include "odometry/effects.h"
+#include "odometry/robot_description.h"
+#include "odometry/run_log.h"
+
+namespace fitcal {
+
+// A run prepared for track residuals.
+struct TrackRun {
+  AlignedRun aligned;
+  GroundTruthTrack track;                        // the whole ground truth (interpolation)
+  std::vector<effects::SampleContext> contexts;  // one per aligned sample
+  std::vector<int> checkpoints;                  // indices into track
+};
+
+// The pose the replay of a track starts from, given a ground-truth latency (the ground-truth
+// sample stamped t shows encoder time t - latency): the window's first ground-truth sample when it
+// shows the robot still at rest (every wheel below effects::kMovingRateRadS; with a positive
+// latency it shows a time just before the window, when a run that starts at rest was at rest
+// too), else the ground truth interpolated at t_start + latency. Interpolating whenever the
+// latency is not zero would blend the rest pose with a moving one when the robot starts within
+// one ground-truth period: a start error that repeats in every repetition. `contexts` are the
+// run's (effects::MakeSampleContexts); their `moving` flags say where the rest ends.
+Pose2d TrackStartPose(const AlignedRun& run, const std::vector<effects::SampleContext>& contexts,
+                      const GroundTruthTrack& track, double latency_s);
+
+struct TrackOptions {
+  // Checkpoints keep this far from the window's ends so a latency within the effect's bounds
+  // never moves them outside the replay.
+  double edge_margin_s = 0.3;
+  bool IsValid(std::string* error) const;
+};
+
+// Every channel a wheel rate (omni3's three), or those of wheel_mask (WheelChannelMask).
+TrackRun PrepareTrackRun(const RunLog& run, const TrackOptions& options = {});
+TrackRun PrepareTrackRun(const RunLog& run, unsigned wheel_mask, const TrackOptions& options = {});
+std::vector<TrackRun> PrepareTrackRuns(const std::vector<RunLog>& runs,
+                                       const TrackOptions& options = {});
+std::vector<TrackRun> PrepareTrackRuns(const std::vector<RunLog>& runs, unsigned wheel_mask,
+                                       const TrackOptions& options = {});
+// Bit i set when the robot's channel i is a wheel rate (effects::SampleContext::wheel_mask).
+unsigned WheelChannelMask(const Robot& robot);
+// Training/validation by repetition (as validation/run_split.h).
+void SplitTrackRuns(std::vector<TrackRun> runs, const std::vector<int>& training_reps,
+                    std::vector<TrackRun>* training, std::vector<TrackRun>* validation);
+
+using EffectModel = std::vector<effects::EffectValue>;
+
+// Scores of one run under a model (double evaluation of the functor below).
+struct RunScore {
+  double objective = 0.0;  // mean squared weighted track error (the fit's per-run cost)
+  double cf = 0.0;         // Palacin Eq. 14 at the window's end
+  double final_dx_m = 0.0, final_dy_m = 0.0, final_dtheta_rad = 0.0;  // world frame
+  double track_rmse_m = 0.0;    // position RMSE over the checkpoints
+  double track_rmse_rad = 0.0;  // heading RMSE over the checkpoints
+};
+
+struct ModelScore {
+  std::vector<RunScore> runs;
+  double objective = 0.0;     // sum over runs
+  double cf = 0.0;            // mean over runs
+  double track_rmse_m = 0.0;  // sqrt(mean over runs of track_rmse_m^2)
+  double track_rmse_rad = 0.0;
+};
+
+ModelScore ScoreModel(const RobotModelInterface& robot_model, const std::vector<double>& p,
+                      const EffectModel& model, const std::vector<TrackRun>& runs,
+                      const ResidualWeights& weights = {}, int num_threads = 0);
+ModelScore ScoreModel(const Omni3ParameterArray& p, const EffectModel& model,
+                      const std::vector<TrackRun>& runs, const ResidualWeights& weights = {},
+                      int num_threads = 0);
+
+// Pose error of the replay at every checkpoint of a run (world frame, replay minus ground
+// truth), with the checkpoint times and ground-truth poses; for residual analysis.
+struct TrackErrors {
+  std::vector<double> t_s;  // ground-truth stamps
+  std::vector<Pose2d> ground_truth;
+  std::vector<Pose2d> error;  // x, y in m (world), theta wrapped (rad)
+  Pose2d final_error;         // at the window's end, as RunScore's final_d* (Eq. 14's residual)
+};
+TrackErrors ComputeTrackErrors(const RobotModelInterface& robot_model, const std::vector<double>& p,
+                               const EffectModel& model, const TrackRun& run, bool all_samples);
+TrackErrors ComputeTrackErrors(const Omni3ParameterArray& p, const EffectModel& model,
+                               const TrackRun& run, bool all_samples);
+
+struct EffectFitOptions {
+  ResidualWeights weights;
+  int max_num_iterations = 50;
+  int num_threads = 0;
+  double function_tolerance = 1e-10;
+  double parameter_tolerance = 1e-10;
+  bool compute_covariance = true;
+  bool IsValid(std::string* error) const;
+};
+
+struct EffectFitResult {
+  // Finite parameters after CONVERGENCE or NO_CONVERGENCE (iteration limit: the tracing judges
+  // every fit on held-out runs, so a fit that was still creeping is scored, not trusted blindly).
+  bool usable = false;
+  std::string termination;
+  std::string message;
+  int iterations = 0;
+  double final_cost = 0.0;         // 0.5 * sum of per-run objectives
+  std::vector<double> parameters;  // the model's (robot().parameters order)
+  std::vector<double> sigma;       // one sigma of each (when has_covariance; 0 when held)
+  EffectModel effects;             // fitted values and sigmas
+  bool has_covariance = false;
+  bool any_at_bound = false;
+};
+
+// Fits the model's parameters (started at start_p, bounded by the robot's box, held parameters
+// at their nominal) and the effects' parameters (started at the values in `start`, bounded by
+// the registry) to the training runs.
+// Covariance: Ceres' covariance scaled by s^2 = sum of run objectives / (3 N_runs - k), i.e. each
+// run counts as three independent residuals (a run's checkpoints are correlated through the
+// drift, so counting them all would understate the uncertainty).
+EffectFitResult FitEffectModel(const std::vector<TrackRun>& training,
+                               const RobotModelInterface& robot_model,
+                               const std::vector<double>& start_p, const EffectModel& start,
+                               const EffectFitOptions& options = {});
+EffectFitResult FitEffectModel(const std::vector<TrackRun>& training, const Omni3Robot& robot,
+                               const Omni3ParameterArray& start_p, const EffectModel& start,
+                               const EffectFitOptions& options = {});
+
+// How much of a candidate's influence on the training residuals lies outside what the nine
+// parameters (and the effects already in `model`) can produce: |(I - P) J_c| / |J_c| for the
+// candidate's Jacobian column J_c (the smallest over its parameters) at the given solution, P the
+// projection on the other columns. 0: the data cannot tell the candidate from the others.
+// The fraction says nothing of size: an effect with almost no influence can still be
+// "separable"; *unexplained_norm (optional) gets |(I - P) J_c| itself, so that
+// sigma_c ~ s / |(I - P) J_c| (s the residual RMS) predicts how well the runs could determine the
+// candidate before fitting it.
+double SeparableFraction(const std::vector<TrackRun>& training,
+                         const RobotModelInterface& robot_model, const std::vector<double>& p,
+                         const EffectModel& model, effects::EffectId candidate,
+                         const ResidualWeights& weights = {}, double* unexplained_norm = nullptr);
+double SeparableFraction(const std::vector<TrackRun>& training, const Omni3ParameterArray& p,
+                         const EffectModel& model, effects::EffectId candidate,
+                         const ResidualWeights& weights = {}, double* unexplained_norm = nullptr);
+
+}  // namespace fitcal

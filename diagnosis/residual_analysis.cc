@@ -1,0 +1,395 @@
+#include "diagnosis/residual_analysis.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+#include "diagnosis/statistics.h"
+#include "models/omni3/omni3_robot_model.h"
+#include "odometry/parallel_for.h"
+
+namespace fitcal {
+
+namespace {
+
+constexpr double kCheckpointFractions[] = {0.25, 0.5, 0.75};
+constexpr int kLofComponents = 12;  // 4 checkpoints x (x, y, theta)
+constexpr double kRotatingRateRadS = 0.02;
+// Acceleration phase of a ground-truth interval: the largest smoothed wheel acceleration above
+// this counts as accelerating or decelerating (cruising below it).
+constexpr double kAccelerationPhaseRadS2 = 1.0;
+
+Pose2d ToFrame(const Pose2d& world_error, double theta) {
+  const double c = std::cos(theta), s = std::sin(theta);
+  return {c * world_error.x + s * world_error.y, -s * world_error.x + c * world_error.y,
+          world_error.theta};
+}
+
+std::string FamilyOf(const std::string& label) {
+  std::string out;
+  for (char ch : label) {
+    if (std::isalpha(static_cast<unsigned char>(ch)))
+      out += ch;
+    else
+      break;
+  }
+  return out.empty() ? "-" : out;
+}
+
+RunFeatures Features(const RobotModelInterface& robot_model, const std::vector<double>& p,
+                     const TrackRun& run) {
+  RunFeatures f;
+  f.id = run.aligned.id;
+  f.trajectory = run.aligned.trajectory;
+  f.family = FamilyOf(run.aligned.trajectory);
+  f.repetition = run.aligned.repetition;
+  const auto kinematics = robot_model.PrepareKinematics(p.data());
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double time = 0.0;
+  bool any = false;
+  for (std::size_t k = 0; k < run.aligned.samples.size(); ++k) {
+    if (!run.contexts[k].moving) continue;
+    const auto s = run.aligned.samples[k];
+    Eigen::Vector3d step;
+    kinematics->Step(s.value, s.dt_s, &step[0], &step[1], &step[2]);
+    sum += step;
+    time += s.dt_s;
+    if (!any) f.motion_begin_s = run.contexts[k].t_s;
+    f.motion_end_s = run.contexts[k].t_s + s.dt_s;
+    any = true;
+  }
+  if (time > 0.0) {
+    const Eigen::Vector3d v = sum / time;
+    f.alpha_rad = std::atan2(v[1], v[0]);
+    f.speed_m_s = std::hypot(v[0], v[1]);
+    f.rotation_sign = v[2] > kRotatingRateRadS ? 1 : (v[2] < -kRotatingRateRadS ? -1 : 0);
+  }
+  return f;
+}
+
+Pose2d ErrorAt(const TrackErrors& e, double t) {
+  if (e.t_s.empty()) return {};
+  if (t <= e.t_s.front()) return e.error.front();
+  if (t >= e.t_s.back()) return e.error.back();
+  const std::size_t hi =
+      static_cast<std::size_t>(std::upper_bound(e.t_s.begin(), e.t_s.end(), t) - e.t_s.begin());
+  const std::size_t lo = hi - 1;
+  const double u = (t - e.t_s[lo]) / (e.t_s[hi] - e.t_s[lo]);
+  return {e.error[lo].x + u * (e.error[hi].x - e.error[lo].x),
+          e.error[lo].y + u * (e.error[hi].y - e.error[lo].y),
+          e.error[lo].theta + u * (e.error[hi].theta - e.error[lo].theta)};
+}
+
+using Lof = std::array<double, kLofComponents>;
+
+// The lack-of-fit components of a run: its error at the three checkpoint times and at the end,
+// in the start frame (heading theta0).
+Lof LofComponents(const TrackErrors& track, const std::array<double, 3>& checkpoint_times,
+                  double theta0) {
+  Lof out{};
+  for (int c = 0; c < 3; ++c) {
+    const Pose2d e = ToFrame(ErrorAt(track, checkpoint_times[c]), theta0);
+    out[3 * c] = e.x;
+    out[3 * c + 1] = e.y;
+    out[3 * c + 2] = e.theta;
+  }
+  const Pose2d f = ToFrame(track.final_error, theta0);
+  out[9] = f.x;
+  out[10] = f.y;
+  out[11] = f.theta;
+  return out;
+}
+
+void Accumulate(std::map<std::string, GroupStat>& groups, const std::string& by,
+                const std::string& bin, const double v[3]) {
+  GroupStat& g = groups[by + "\x1f" + bin];
+  g.by = by;
+  g.bin = bin;
+  ++g.count;
+  for (int c = 0; c < 3; ++c) {
+    g.mean[c] += v[c];
+    g.rms[c] += v[c] * v[c];
+  }
+}
+
+}  // namespace
+
+ResidualAnalysis AnalyzeResiduals(const Omni3ParameterArray& p, const EffectModel& model,
+                                  const std::vector<TrackRun>& runs, int num_threads) {
+  static const std::shared_ptr<const Omni3Model> omni3_model = Omni3ModelOf(Omni3Robot{});
+  return AnalyzeResiduals(*omni3_model, {p.begin(), p.end()}, model, runs, num_threads);
+}
+
+ResidualAnalysis AnalyzeResiduals(const RobotModelInterface& robot_model,
+                                  const std::vector<double>& p, const EffectModel& model,
+                                  const std::vector<TrackRun>& runs, int num_threads) {
+  ResidualAnalysis out;
+  const std::size_t n = runs.size();
+  out.runs.resize(n);
+  out.track.resize(n);
+  out.final_start_frame.resize(n);
+  std::vector<Lof> lof(n);
+  std::vector<std::array<double, 3>> checkpoint_times(n);
+  ParallelFor(n, num_threads, [&](std::size_t i) {
+    const TrackRun& run = runs[i];
+    out.runs[i] = Features(robot_model, p, run);
+    out.track[i] = ComputeTrackErrors(robot_model, p, model, run, /*all_samples=*/true);
+    const double theta0 = run.aligned.start.theta;
+    out.final_start_frame[i] = ToFrame(out.track[i].final_error, theta0);
+    const RunFeatures& f = out.runs[i];
+    for (int c = 0; c < 3; ++c) {
+      checkpoint_times[i][c] = run.aligned.t_start_s + f.motion_begin_s +
+                               kCheckpointFractions[c] * (f.motion_end_s - f.motion_begin_s);
+    }
+    lof[i] = LofComponents(out.track[i], checkpoint_times[i], theta0);
+  });
+  // How the components move with each fitted parameter (forward differences, the checkpoint
+  // times held): the lack of fit is what no change of the fitted parameters can remove.
+  std::vector<std::vector<Lof>> lof_jacobian;  // [parameter][run]
+  // One column: the components' change per unit of the parameter that p_k / model_k moved by h.
+  const auto add_column = [&](const std::vector<double>& p_k, const EffectModel& model_k,
+                              double h) {
+    std::vector<Lof> column(n);
+    ParallelFor(n, num_threads, [&](std::size_t i) {
+      const TrackErrors moved = ComputeTrackErrors(robot_model, p_k, model_k, runs[i], true);
+      const Lof x = LofComponents(moved, checkpoint_times[i], runs[i].aligned.start.theta);
+      for (int c = 0; c < kLofComponents; ++c) column[i][c] = (x[c] - lof[i][c]) / h;
+    });
+    lof_jacobian.push_back(std::move(column));
+  };
+  for (int k = 0; k < static_cast<int>(p.size()); ++k) {
+    if (robot_model.robot().IsHeld(k)) continue;  // gauge: no refit can move it
+    std::vector<double> p_k = p;
+    const double h = 1e-6 * std::max(std::abs(p[k]), 1e-3);
+    p_k[k] += h;
+    add_column(p_k, model, h);
+  }
+  for (std::size_t e = 0; e < model.size(); ++e) {
+    const effects::EffectInfo& info = effects::Info(model[e].id);
+    for (int j = 0; j < info.num_parameters; ++j) {
+      EffectModel model_k = model;
+      const double h =
+          1e-4 * std::max({std::abs(model[e].value[j]), std::abs(info.typical[j]), 1e-9});
+      model_k[e].value[j] += h;
+      add_column(p, model_k, h);
+    }
+  }
+
+  // Systematic / non-systematic split and the lack-of-fit test, over trajectories with reps.
+  // The 12 components of a run (errors at three checkpoints and at the end, x, y, theta) are
+  // strongly correlated (an error at half way persists to the end), so each trajectory's mean is
+  // weighed with the inverse of their pooled within-trajectory covariance (a Hotelling-type
+  // statistic): weighing each component by its own variance alone counts one deviation up to 12
+  // times and makes F far more variable than F(df_lof, df_pe) (clean simulated data then read as
+  // "structure" for some seeds).
+  std::map<std::string, std::vector<std::size_t>> by_trajectory;
+  for (std::size_t i = 0; i < n; ++i) by_trajectory[runs[i].aligned.trajectory].push_back(i);
+  using Vec = Eigen::Matrix<double, kLofComponents, 1>;
+  using Mat = Eigen::Matrix<double, kLofComponents, kLofComponents>;
+  Mat scatter = Mat::Zero();
+  struct TrajectoryMean {
+    double m;
+    Vec mean;
+    Eigen::Matrix<double, kLofComponents, Eigen::Dynamic> jacobian;  // mean over its runs
+  };
+  const int num_parameters = static_cast<int>(lof_jacobian.size());
+  std::vector<TrajectoryMean> trajectory_means;
+  double sys_m = 0.0, sys_rad = 0.0, non_m = 0.0, non_rad = 0.0;
+  int num_traj = 0, num_runs = 0;
+  double df_pe_per_component = 0.0;
+  for (const auto& [label, members] : by_trajectory) {
+    if (members.size() < 2) continue;
+    ++num_traj;
+    const double m = static_cast<double>(members.size());
+    df_pe_per_component += m - 1.0;
+    TrajectoryMean t{m, Vec::Zero(),
+                     Eigen::Matrix<double, kLofComponents, Eigen::Dynamic>::Zero(kLofComponents,
+                                                                                 num_parameters)};
+    for (std::size_t i : members) {
+      t.mean += Vec(lof[i].data()) / m;
+      for (int k = 0; k < num_parameters; ++k)
+        t.jacobian.col(k) += Vec(lof_jacobian[k][i].data()) / m;
+    }
+    for (std::size_t i : members) {
+      ++num_runs;
+      const Vec d = Vec(lof[i].data()) - t.mean;
+      scatter += d * d.transpose();
+      sys_m += t.mean[9] * t.mean[9] + t.mean[10] * t.mean[10];
+      sys_rad += t.mean[11] * t.mean[11];
+      non_m += d[9] * d[9] + d[10] * d[10];
+      non_rad += d[11] * d[11];
+    }
+    trajectory_means.push_back(std::move(t));
+  }
+  if (num_traj > 0 && df_pe_per_component > 0.0) {
+    const double runs_d = static_cast<double>(num_runs);
+    out.systematic_rms_m = std::sqrt(sys_m / runs_d);
+    out.systematic_rms_rad = std::sqrt(sys_rad / runs_d);
+    // Scatter around a mean of m values: divide by (m - 1) per trajectory, not m.
+    out.nonsystematic_rms_m = std::sqrt(non_m / df_pe_per_component);
+    out.nonsystematic_rms_rad = std::sqrt(non_rad / df_pe_per_component);
+    // Whitening by the pure-error covariance; directions without scatter (noise-free data) are
+    // left out.
+    const Eigen::SelfAdjointEigenSolver<Mat> eig(scatter / df_pe_per_component);
+    const double largest = eig.eigenvalues().maxCoeff();
+    Mat whiten = Mat::Zero();
+    int rank = 0;
+    for (int c = 0; c < kLofComponents; ++c) {
+      const double lambda = eig.eigenvalues()[c];
+      if (!(lambda > 1e-12 * largest)) continue;
+      whiten.row(rank++) = eig.eigenvectors().col(c).transpose() / std::sqrt(lambda);
+    }
+    // Weighted least squares over the trajectory means: the linearised refit of the parameters
+    // on all runs. lof_w is its residual, ~ chi^2(rank * trajectories - identifiable parameters)
+    // when what is left is noise.
+    Eigen::MatrixXd a = Eigen::MatrixXd::Zero(num_parameters, num_parameters);
+    Eigen::VectorXd b = Eigen::VectorXd::Zero(num_parameters);
+    double total = 0.0;
+    for (const TrajectoryMean& t : trajectory_means) {
+      const Eigen::VectorXd z = whiten.topRows(rank) * t.mean;
+      const Eigen::MatrixXd jz = whiten.topRows(rank) * t.jacobian;
+      total += t.m * z.squaredNorm();
+      a += t.m * jz.transpose() * jz;
+      b += t.m * jz.transpose() * z;
+    }
+    int identifiable = 0;
+    double explained = 0.0;
+    if (num_parameters > 0) {
+      const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> ea(a);
+      const double a_max = ea.eigenvalues().maxCoeff();
+      for (int k = 0; k < num_parameters; ++k) {
+        const double lambda = ea.eigenvalues()[k];
+        if (!(lambda > 1e-10 * a_max)) continue;
+        ++identifiable;
+        const double proj = ea.eigenvectors().col(k).dot(b);
+        explained += proj * proj / lambda;
+      }
+    }
+    const double lof_w = std::max(0.0, total - explained);
+    // The covariance is estimated on df_pe_per_component degrees of freedom; the Hotelling
+    // correction leaves df_pe_per_component - rank + 1 for the denominator.
+    if (rank > 0 && df_pe_per_component - rank + 1.0 > 0.0) {
+      LackOfFit& l = out.lack_of_fit;
+      l.trajectories_with_repetitions = num_traj;
+      l.df_pe = df_pe_per_component - rank + 1.0;
+      l.df_lof = std::max(1.0, static_cast<double>(rank * num_traj - identifiable));
+      l.f = lof_w / l.df_lof;
+      l.p_value = stats::FUpperTail(l.f, l.df_lof, l.df_pe);
+      l.available = true;
+    }
+  }
+
+  // Group statistics.
+  std::map<std::string, GroupStat> groups;
+  for (std::size_t i = 0; i < n; ++i) {
+    const RunFeatures& f = out.runs[i];
+    const Pose2d& e = out.final_start_frame[i];
+    const double v[3] = {e.x, e.y, e.theta};
+    Accumulate(groups, "family", f.family, v);
+    char bin[32];
+    const double alpha_deg = std::fmod(RadToDeg(f.alpha_rad) + 360.0 + 15.0, 360.0) - 15.0;
+    std::snprintf(bin, sizeof bin, "%+04.0f", 30.0 * std::round(alpha_deg / 30.0) + 0.0);
+    Accumulate(groups, "alpha_deg", bin, v);
+    Accumulate(groups, "rotation",
+               f.rotation_sign > 0 ? "ccw" : (f.rotation_sign < 0 ? "cw" : "none"), v);
+    std::snprintf(bin, sizeof bin, "%.2f", 0.05 * std::round(f.speed_m_s / 0.05));
+    Accumulate(groups, "speed_m_s", bin, v);
+    // Error growth rate between consecutive ground-truth samples, robot frame.
+    const TrackErrors& t = out.track[i];
+    const TrackRun& run = runs[i];
+    for (std::size_t j = 1; j < t.t_s.size(); ++j) {
+      const double dt = t.t_s[j] - t.t_s[j - 1];
+      if (!(dt > 0.0)) continue;
+      const Pose2d de{t.error[j].x - t.error[j - 1].x, t.error[j].y - t.error[j - 1].y,
+                      t.error[j].theta - t.error[j - 1].theta};
+      const Pose2d r = ToFrame(de, t.ground_truth[j - 1].theta);
+      const double rate[3] = {r.x / dt, r.y / dt, r.theta / dt};
+      const double mid = 0.5 * (t.t_s[j] + t.t_s[j - 1]) - run.aligned.t_start_s;
+      // Phase from the sample context at mid.
+      std::size_t k = 0;
+      while (k + 1 < run.contexts.size() && run.contexts[k + 1].t_s <= mid) ++k;
+      const auto& c = run.contexts[k];
+      double accel = 0.0, dir = 0.0;
+      for (int w = 0; w < c.num_channels; ++w) {
+        if (c.IsWheel(w) && std::abs(c.accel_rad_s2[w]) > std::abs(accel)) {
+          accel = c.accel_rad_s2[w];
+          dir = run.aligned.samples[k].value[w];
+        }
+      }
+      const char* phase = !c.moving ? "rest"
+                          : std::abs(accel) < kAccelerationPhaseRadS2
+                              ? "cruise"
+                              : (accel * dir > 0.0 ? "accelerate" : "decelerate");
+      Accumulate(groups, "phase", phase, rate);
+      const double span = f.motion_end_s - f.motion_begin_s;
+      const double frac = span > 0.0 ? (mid - f.motion_begin_s) / span : 0.0;
+      const char* when = frac < 0.0    ? "before motion"
+                         : frac < 0.25 ? "0-25%"
+                         : frac < 0.5  ? "25-50%"
+                         : frac < 0.75 ? "50-75%"
+                         : frac <= 1.0 ? "75-100%"
+                                       : "after motion";
+      Accumulate(groups, "time_in_run", when, rate);
+    }
+  }
+  for (auto& [key, g] : groups) {
+    for (int c = 0; c < 3; ++c) {
+      g.mean[c] /= g.count;
+      g.rms[c] = std::sqrt(g.rms[c] / g.count);
+    }
+    out.groups.push_back(g);
+  }
+  return out;
+}
+
+std::string FormatResidualAnalysis(const ResidualAnalysis& a) {
+  std::string out;
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "final-pose residual (start frame): systematic %.4f m / %.3f deg, "
+                "non-systematic (noise floor) %.4f m / %.3f deg\n",
+                a.systematic_rms_m, RadToDeg(a.systematic_rms_rad), a.nonsystematic_rms_m,
+                RadToDeg(a.nonsystematic_rms_rad));
+  out += line;
+  if (a.lack_of_fit.available) {
+    std::snprintf(line, sizeof line,
+                  "lack of fit vs pure error (%d trajectories with repetitions): F = %.2f on "
+                  "(%.0f, %.0f) df, p = %.2g\n",
+                  a.lack_of_fit.trajectories_with_repetitions, a.lack_of_fit.f,
+                  a.lack_of_fit.df_lof, a.lack_of_fit.df_pe, a.lack_of_fit.p_value);
+    out += line;
+  } else {
+    out += "lack of fit: not available (no trajectory has two repetitions)\n";
+  }
+  out +=
+      "\n| by | bin | n | mean x | mean y | mean theta [deg] | rms x | rms y | rms theta [deg] |\n";
+  out += "|---|---|---|---|---|---|---|---|---|\n";
+  for (const GroupStat& g : a.groups) {
+    const bool rate = g.by == "phase" || g.by == "time_in_run";
+    std::snprintf(line, sizeof line,
+                  "| %s%s | %s | %d | %+.4f | %+.4f | %+.3f | %.4f | %.4f | %.3f |\n", g.by.c_str(),
+                  rate ? " (rate /s)" : "", g.bin.c_str(), g.count, g.mean[0], g.mean[1],
+                  RadToDeg(g.mean[2]), g.rms[0], g.rms[1], RadToDeg(g.rms[2]));
+    out += line;
+  }
+  return out;
+}
+
+std::string ResidualSamplesCsv(const ResidualAnalysis& a) {
+  std::string out = "run,t,err_x_world_m,err_y_world_m,err_theta_rad,err_x_robot_m,err_y_robot_m\n";
+  char line[256];
+  for (std::size_t i = 0; i < a.track.size(); ++i) {
+    const TrackErrors& t = a.track[i];
+    for (std::size_t j = 0; j < t.t_s.size(); ++j) {
+      const Pose2d r = ToFrame(t.error[j], t.ground_truth[j].theta);
+      std::snprintf(line, sizeof line, "%s,%.6f,%.6g,%.6g,%.6g,%.6g,%.6g\n", a.runs[i].id.c_str(),
+                    t.t_s[j], t.error[j].x, t.error[j].y, t.error[j].theta, r.x, r.y);
+      out += line;
+    }
+  }
+  return out;
+}
+
+}  // namespace fitcal

@@ -1,0 +1,86 @@
+#pragma once
+// What a fitted model leaves unexplained, in a form a person can read (issue 6, part 1).
+//
+// - Pose error (replay - ground truth) at every ground-truth sample of every run, in the world
+//   frame and in the robot frame (rotated by -theta_gt).
+// - The final-pose error in the run's start frame (rotated by -theta_start: repetitions of one
+//   trajectory then share a frame), split into a systematic part (the mean over the repetitions
+//   of a trajectory) and a non-systematic part (the scatter around it): the scatter is the noise
+//   floor measured by the data itself.
+// - Statistics by trajectory family (label's letters: R/G/B), heading direction alpha of the
+//   motion in the robot frame (30 deg bins), rotation sign, speed; and the growth rate of the
+//   robot-frame error by acceleration phase and by time within the run.
+// - A lack-of-fit F test with the repetitions as pure error, on e, the start-frame pose errors at
+//   four checkpoints (a quarter, half and three quarters through the motion, and the end): 12
+//   components per run, strongly correlated, so they are whitened by their pooled pure-error
+//   covariance S (rank r; trajectories with at least two repetitions):
+//     S      = sum_traj sum_rep (e - mean_traj e)(...)^T / D,   D = sum_traj (n_traj - 1)
+//     SS_lof = min_delta sum_traj n_traj |S^-1/2 (mean_traj e - J_traj delta)|^2
+//   where J_traj is the mean derivative of e with respect to every fitted parameter (model plus
+//   the effects', forward differences): what a refit on all runs could still remove is not lack
+//   of fit. df_lof = r * n_traj - (identifiable parameters), df_pe = D - r + 1 (Hotelling);
+//   F = SS_lof / df_lof, p = P(F(df_lof, df_pe) > F).
+
+#include <string>
+#include <vector>
+
+#include "diagnosis/effect_fit.h"
+
+namespace fitcal {
+
+struct RunFeatures {
+  std::string id;
+  std::string trajectory;
+  std::string family;  // leading letters of the trajectory label ("R", "G", "B", ...)
+  int repetition = 0;
+  double alpha_rad = 0.0;  // direction of the mean robot-frame velocity while moving
+  int rotation_sign = 0;   // sign of the mean yaw rate (0 when |omega| < 0.02 rad/s)
+  double speed_m_s = 0.0;  // mean speed while moving
+  double motion_begin_s = 0.0, motion_end_s = 0.0;  // from the window start
+};
+
+struct GroupStat {
+  std::string by;  // "family", "alpha_deg", ...
+  std::string bin;
+  int count = 0;
+  // Final-pose error in the start frame (m, m, rad) for run groups; error growth rate in the
+  // robot frame (m/s, m/s, rad/s) for sample groups.
+  double mean[3] = {0.0, 0.0, 0.0};
+  double rms[3] = {0.0, 0.0, 0.0};
+};
+
+struct LackOfFit {
+  int trajectories_with_repetitions = 0;
+  double df_lof = 0.0, df_pe = 0.0;
+  double f = 0.0;
+  double p_value = 1.0;
+  bool available = false;  // needs >= 2 repetitions of some trajectory
+};
+
+struct ResidualAnalysis {
+  std::vector<RunFeatures> runs;
+  std::vector<TrackErrors> track;         // every ground-truth sample, world frame
+  std::vector<Pose2d> final_start_frame;  // per run
+  // Split of the final-pose error: RMS of the per-trajectory means (systematic) and of the
+  // scatter around them (non-systematic, the noise floor), position (m) and heading (rad).
+  double systematic_rms_m = 0.0, systematic_rms_rad = 0.0;
+  double nonsystematic_rms_m = 0.0, nonsystematic_rms_rad = 0.0;
+  LackOfFit lack_of_fit;
+  std::vector<GroupStat> groups;
+};
+
+// The lack-of-fit test counts as fitted every parameter of p and of the model's effects (it
+// subtracts their linearised refit on all runs).
+ResidualAnalysis AnalyzeResiduals(const RobotModelInterface& robot_model,
+                                  const std::vector<double>& p, const EffectModel& model,
+                                  const std::vector<TrackRun>& runs, int num_threads = 0);
+ResidualAnalysis AnalyzeResiduals(const Omni3ParameterArray& p, const EffectModel& model,
+                                  const std::vector<TrackRun>& runs, int num_threads = 0);
+
+// Human-readable tables (Markdown).
+std::string FormatResidualAnalysis(const ResidualAnalysis& analysis);
+// Every ground-truth sample's error:
+// run,t,err_x_world,err_y_world,err_theta,err_x_robot,err_y_robot
+std::string ResidualSamplesCsv(const ResidualAnalysis& analysis);
+
+}  // namespace fitcal

@@ -1,0 +1,65 @@
+#pragma once
+// The closed-form geometric calibration of an ASOC vehicle, Doebbler Sec. III-A, Eq. 1-9, from
+// internal sensors only. The manoeuvre: hold castor j still and drive the others so the body
+// rotates about pivot j, once clockwise and once counter-clockwise. For every active castor i:
+//   gamma_cw, gamma_ccw  its pivot encoder reading during the CW / CCW rotation (steady state),
+//   c_cw1..c_ccw2        the angles its wheels turned,
+//   dtheta_cw, dtheta_ccw the angle pivot j's encoder turned (the body's rotation, > 0).
+// With D = |p_i - p_j| known (the pivot layout is known geometry):
+//   Gamma = (180 deg - (gamma_ccw - gamma_cw)) / 2                           Eq. 1
+//   beta  = (gamma_ccw + gamma_cw - 180 deg) / 2 - theta_perp                Eq. 2
+//   r_c   = D sin Gamma                                                      Eq. 3
+//   r_wk  = 2 D cos Gamma dth_ccw dth_cw / (dth_ccw c_cwk + dth_cw c_ccwk)   Eq. 8
+//   d_k   = s_k D cos Gamma (dth_ccw c_cwk - dth_cw c_ccwk) / (same)         Eq. 9, s = (+1, -1)
+// where theta_perp, the castor angle aligned with the CW direction of travel, is the body angle of
+// (p_i - p_j) minus 90 deg (the CW velocity of pivot i). Holding each of the three castors in turn
+// gives two estimates per castor; they are averaged (beta on the circle).
+//
+// Runs are found by trajectory label "hold_<j>_cw" / "hold_<j>_ccw" (j 1-based). The steady
+// castor angle is the circular mean of the readings over the middle `steady_fraction` of the run,
+// which skips start/stop transients when the castors were not perfectly pre-aligned.
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "models/asoc/asoc_model.h"
+#include "models/asoc/asoc_run_log.h"
+
+namespace fitcal::asoc {
+
+struct GeometricOptions {
+  double steady_fraction = 0.5;
+  bool IsValid(std::string* error) const;
+};
+
+// The measurements Eq. 1-9 use for one (active castor i, held castor j) pair.
+struct HoldMeasurement {
+  double gamma_cw_rad = 0.0;
+  double gamma_ccw_rad = 0.0;
+  std::array<double, 2> wheel_cw_rad{};
+  std::array<double, 2> wheel_ccw_rad{};
+  double rotation_cw_rad = 0.0;   // dtheta_cw, magnitude
+  double rotation_ccw_rad = 0.0;  // dtheta_ccw, magnitude
+};
+
+// Eq. 1-9 for one pair: D the pivot distance, theta_perp as above.
+CastorParameters SolveHoldPair(const HoldMeasurement& m, double pivot_distance_m,
+                               double theta_perp_rad);
+
+struct GeometricResult {
+  bool usable = false;
+  std::string message;  // why not usable, or a summary
+  Vehicle estimate;     // nominal pivot layout + the calibrated castors
+  // Per castor: how many pair estimates were averaged and their half-difference (a direct look at
+  // the repeatability: the two estimates of one castor should agree to quantisation level).
+  std::array<int, kNumCastors> num_estimates{};
+  std::array<CastorParameters, kNumCastors> half_spread{};
+};
+
+// Throws std::invalid_argument for invalid options. Castors without any usable hold pair keep
+// their nominal parameters and make the result unusable.
+GeometricResult CalibrateGeometric(const std::vector<RunLog>& runs, const Vehicle& nominal,
+                                   const GeometricOptions& options = {});
+
+}  // namespace fitcal::asoc

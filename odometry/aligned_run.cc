@@ -1,0 +1,67 @@
+#include "odometry/aligned_run.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace fitcal {
+
+namespace {
+// Every channel of the sample reads zero (wheel rates and angles alike: an interval with a
+// non-zero angle channel is kept as it is, whatever the model makes of it).
+bool IsRest(const double* values, int num_channels) {
+  for (int i = 0; i < num_channels; ++i) {
+    if (values[i] != 0.0) return false;
+  }
+  return true;
+}
+}  // namespace
+
+AlignedRun AlignRun(const RunLog& run) {
+  const std::vector<double>& t = run.encoders.t_s;
+  const GroundTruthTrack& gt = run.ground_truth;
+  AlignedRun out;
+  out.id = run.id;
+  out.trajectory = run.trajectory;
+  out.repetition = run.repetition;
+  if (run.start_pose) {
+    out.t_start_s = t.front();
+    out.start = *run.start_pose;
+  } else {
+    out.t_start_s = std::max(t.front(), gt.t_s.front());
+    out.start = InterpolateGroundTruth(gt, out.t_start_s);
+  }
+  out.t_final_s = std::min(t.back(), gt.t_s.back());
+  if (!(out.t_final_s > out.t_start_s)) {
+    throw std::invalid_argument("run " + run.id + ": encoders and ground truth share no time");
+  }
+  out.final_ground_truth = InterpolateGroundTruth(gt, out.t_final_s);
+  const int channels = run.encoders.samples.num_channels();
+  out.samples = EncoderSamples(channels);
+  out.samples.reserve(run.encoders.samples.size());
+  for (std::size_t k = 0; k < run.encoders.samples.size(); ++k) {
+    const double begin = std::max(t[k], out.t_start_s);
+    const double end = std::min(t[k + 1], out.t_final_s);
+    if (end <= begin) continue;
+    const ConstSampleView sample = run.encoders.samples[k];
+    const double dt = end - begin;
+    // Consecutive intervals with all wheels at rest move nothing under any model: one interval
+    // of their summed length keeps the time line and saves the replay the work (robots log
+    // long rests before and after each run).
+    if (IsRest(sample.value, channels) && !out.samples.empty() &&
+        IsRest(out.samples.back().value, channels)) {
+      out.samples.back().dt_s += dt;
+      continue;
+    }
+    out.samples.push_back(dt, sample.value);
+  }
+  return out;
+}
+
+std::vector<AlignedRun> AlignRuns(const std::vector<RunLog>& runs) {
+  std::vector<AlignedRun> out;
+  out.reserve(runs.size());
+  for (const RunLog& run : runs) out.push_back(AlignRun(run));
+  return out;
+}
+
+}  // namespace fitcal

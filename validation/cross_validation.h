@@ -1,0 +1,43 @@
+#pragma once
+// Leave-one-repetition-out cross-validation of the Ceres fit: for every repetition present in the
+// runs, fit on all other repetitions and validate (Palacin Eq. 14 CF) on the held-out one. The
+// spread of the fitted parameters across folds shows how much a calibration depends on which
+// repetitions it saw; the spread of the validation CF shows how well it generalises.
+
+#include <string>
+#include <vector>
+
+#include "fit/omni3_ceres_fit.h"
+#include "odometry/aligned_run.h"
+#include "odometry/robot_description.h"
+#include "validation/trajectory_metrics.h"
+
+namespace fitcal {
+
+struct CrossValidationFold {
+  int held_out_repetition = 0;
+  int training_runs = 0;
+  int validation_runs = 0;
+  bool usable = false;      // the fold's fit converged
+  std::string termination;  // the fold's Ceres termination type
+  Omni3ParameterArray parameters{};
+  double cf_training = 0.0;           // fitted parameters on the fold's training runs
+  double cf_validation_before = 0.0;  // nominal parameters on the held-out repetition
+  double cf_validation_after = 0.0;   // fitted parameters on the held-out repetition
+};
+
+struct CrossValidationResult {
+  std::vector<CrossValidationFold> folds;
+  int usable_folds = 0;
+  // Over the usable folds: per parameter (flat order, SI and rad) and for the validation CF.
+  std::array<SummaryStatistics, omni3::kNumParameters> parameter_spread{};
+  SummaryStatistics cf_validation_after;
+  SummaryStatistics cf_validation_before;
+};
+
+// Needs at least two repetitions; throws std::invalid_argument otherwise.
+CrossValidationResult LeaveOneRepetitionOut(const std::vector<AlignedRun>& runs,
+                                            const Omni3Robot& robot,
+                                            const CeresFitOptions& options = {});
+
+}  // namespace fitcal

@@ -1,0 +1,154 @@
+#include "validation/generalisation.h"
+
+#include <map>
+#include <set>
+#include <stdexcept>
+
+namespace fitcal {
+
+namespace {
+
+std::vector<AlignedRun> Pick(const std::vector<AlignedRun>& runs,
+                             const std::vector<std::size_t>& indices) {
+  std::vector<AlignedRun> out;
+  out.reserve(indices.size());
+  for (std::size_t i : indices) out.push_back(runs.at(i));
+  return out;
+}
+
+CandidateScore Score(const RobotModelInterface& model, std::string name,
+                     std::vector<double> parameters, bool usable,
+                     const std::vector<AlignedRun>& train, const std::vector<AlignedRun>& test,
+                     int threads) {
+  CandidateScore s;
+  s.name = std::move(name);
+  s.usable = usable;
+  s.parameters = std::move(parameters);
+  s.train = EvaluateFinalPoseErrors(model, s.parameters, train, threads);
+  s.test = EvaluateFinalPoseErrors(model, s.parameters, test, threads);
+  return s;
+}
+
+}  // namespace
+
+std::string PathTypeOf(const std::string& trajectory_label) {
+  return trajectory_label.substr(0, trajectory_label.find_first_of("_/"));
+}
+
+std::vector<GeneralisationSplit> PathTypeSplits(const std::vector<AlignedRun>& runs) {
+  std::set<std::string> types;
+  for (const AlignedRun& run : runs) types.insert(PathTypeOf(run.trajectory));
+  std::vector<GeneralisationSplit> out;
+  for (const std::string& train_type : types) {
+    for (const std::string& test_type : types) {
+      if (train_type == test_type) continue;
+      GeneralisationSplit s{train_type, test_type, {}, {}};
+      for (std::size_t i = 0; i < runs.size(); ++i) {
+        const std::string type = PathTypeOf(runs[i].trajectory);
+        if (type == train_type) s.train.push_back(i);
+        if (type == test_type) s.test.push_back(i);
+      }
+      out.push_back(std::move(s));
+    }
+  }
+  return out;
+}
+
+std::vector<GeneralisationSplit> PredicateSplits(
+    const std::vector<AlignedRun>& runs, const std::function<bool(const AlignedRun&)>& trains,
+    const std::string& train_name, const std::string& test_name) {
+  GeneralisationSplit a{train_name, test_name, {}, {}};
+  for (std::size_t i = 0; i < runs.size(); ++i) (trains(runs[i]) ? a.train : a.test).push_back(i);
+  if (a.train.empty() || a.test.empty()) return {};
+  GeneralisationSplit b{test_name, train_name, a.test, a.train};
+  return {a, b};
+}
+
+std::string SessionOf(const AlignedRun& run, SessionKey key) {
+  if (key == SessionKey::kLabel) return run.trajectory;
+  return PathTypeOf(run.trajectory) + " " + std::to_string(run.repetition);
+}
+
+std::vector<GeneralisationSplit> LeaveOneSessionOutSplits(const std::vector<AlignedRun>& runs,
+                                                          SessionKey key) {
+  std::set<std::string> sessions;
+  for (const AlignedRun& run : runs) sessions.insert(SessionOf(run, key));
+  if (sessions.size() < 2) return {};
+  std::vector<GeneralisationSplit> out;
+  for (const std::string& held_out : sessions) {
+    GeneralisationSplit s{"all but " + held_out, held_out, {}, {}};
+    for (std::size_t i = 0; i < runs.size(); ++i)
+      (SessionOf(runs[i], key) == held_out ? s.test : s.train).push_back(i);
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+SplitScores EvaluateSplit(const RobotModelInterface& model, const std::vector<AlignedRun>& runs,
+                          const GeneralisationSplit& split, const ModelFitOptions& options) {
+  if (split.train.empty() || split.test.empty()) {
+    throw std::invalid_argument("generalisation split '" + split.train_name + "' -> '" +
+                                split.test_name + "' has no training or no held-out run");
+  }
+  const std::vector<AlignedRun> train = Pick(runs, split.train), test = Pick(runs, split.test);
+  const int threads = options.ceres.num_threads;
+  SplitScores out;
+  out.split = split;
+  out.candidates.push_back(
+      Score(model, "nominal", model.robot().nominal, true, train, test, threads));
+  for (const ClosedFormCalibration& c : model.ClosedForms(train)) {
+    out.candidates.push_back(Score(model, c.method, c.parameters, true, train, test, threads));
+  }
+  const ModelFitResult fit = FitModel(train, model, options);
+  CandidateScore fitted = Score(model, "fit", fit.parameters, fit.usable, train, test, threads);
+  fitted.is_fit = true;
+  fitted.held_directions = static_cast<int>(fit.held_directions.size());
+  for (bool b : fit.at_bound) fitted.at_bound += b;
+  out.candidates.push_back(std::move(fitted));
+  // The gate's "without holds" candidate: what fitting the undetermined directions too would
+  // have given, so the table shows what holding them gained or cost on these held-out runs.
+  if (!fit.held_directions.empty()) {
+    CandidateScore free = Score(model, "fit without holds", fit.unconstrained_parameters,
+                                fit.unconstrained_usable, train, test, threads);
+    free.is_fit = true;
+    out.candidates.push_back(std::move(free));
+  }
+  return out;
+}
+
+std::vector<FoldSummary> SummariseFolds(const std::vector<SplitScores>& folds) {
+  std::vector<FoldSummary> out;
+  std::map<std::string, std::size_t> index;
+  std::map<std::string, int> runs;  // held-out runs per candidate
+  for (const SplitScores& fold : folds) {
+    const int n = static_cast<int>(fold.split.test.size());
+    for (const CandidateScore& c : fold.candidates) {
+      auto it = index.find(c.name);
+      if (it == index.end()) {
+        it = index.emplace(c.name, out.size()).first;
+        out.push_back(FoldSummary{});
+        out.back().name = c.name;
+      }
+      FoldSummary& s = out[it->second];
+      ++s.folds;
+      s.unusable_folds += !c.usable;
+      s.mean_session_cf += c.test.cf;
+      s.run_cf += c.test.cf * n;
+      s.run_position_m += c.test.mean_position_error_m * n;
+      s.run_heading_rad += c.test.mean_abs_heading_error_rad * n;
+      s.folds_with_held_directions += c.held_directions > 0;
+      s.folds_at_bound += c.at_bound > 0;
+      runs[c.name] += n;
+    }
+  }
+  for (FoldSummary& s : out) {
+    const double n = runs[s.name];
+    s.mean_session_cf /= s.folds;
+    s.run_cf /= n;
+    s.run_position_m /= n;
+    s.run_heading_rad /= n;
+  }
+  return out;
+}
+
+}  // namespace fitcal

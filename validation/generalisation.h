@@ -1,0 +1,102 @@
+#pragma once
+// How well a calibration transfers to runs it was not fitted on, for any robot model
+// (models/model_interface.h). A split names training and held-out runs; on each split every
+// candidate the result gate would see - the nominal robot, the model's closed forms computed from
+// the training runs (UMBmark for diff_drive), the bounded fit (fit/model_fit.h) and, when it held
+// directions the training runs do not determine, the fit without those holds - is scored on the
+// held-out runs: CF (Palacin Eq. 14), mean final position error and mean |heading error|.
+//
+// The held-out runs only score here; nothing is selected on them (a gate choosing on the runs it
+// is then scored on would report the best of several candidates as if it had been chosen blind).
+//
+// Splits:
+//   - path types: the trajectory label up to its first '_' or '/' (`circular` of
+//     `circular_231220200121` or `circular/231220200121`, as `fitcal import optiodom` writes them);
+//     train on one, test on each other one;
+//   - a predicate (e.g. a --train-trajectories selector): its runs against the rest, both ways;
+//   - repetitions: training repetitions of every path type against the other repetitions;
+//   - leave-one-session-out: every session held out once, the others train.
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "fit/final_pose_errors.h"
+#include "fit/model_fit.h"
+#include "models/model_interface.h"
+#include "odometry/aligned_run.h"
+
+namespace fitcal {
+
+// The label up to its first '_' or '/' (the whole label when it has neither).
+std::string PathTypeOf(const std::string& trajectory_label);
+
+struct GeneralisationSplit {
+  std::string train_name;
+  std::string test_name;
+  std::vector<std::size_t> train;  // indices into the runs
+  std::vector<std::size_t> test;
+};
+
+// Every ordered pair of distinct path types present, in sorted order.
+std::vector<GeneralisationSplit> PathTypeSplits(const std::vector<AlignedRun>& runs);
+
+// The runs for which `trains` holds against the rest, then the other way round. Empty when
+// either side has no run.
+std::vector<GeneralisationSplit> PredicateSplits(
+    const std::vector<AlignedRun>& runs, const std::function<bool(const AlignedRun&)>& trains,
+    const std::string& train_name, const std::string& test_name);
+
+// What a session is in a data set. OptiOdom's omni3, omni4 and diff_drive imports give every
+// recording session its own trajectory label; its tricycle import labels runs by path type and
+// direction (`circular_cw`) and numbers the sessions of each path type as repetitions.
+enum class SessionKey {
+  kLabel,                  // the whole trajectory label
+  kPathTypeAndRepetition,  // path type + repetition number
+};
+
+std::string SessionOf(const AlignedRun& run, SessionKey key);
+
+// One split per session (sorted), holding it out; the others train. Empty with fewer than two
+// sessions.
+std::vector<GeneralisationSplit> LeaveOneSessionOutSplits(const std::vector<AlignedRun>& runs,
+                                                          SessionKey key);
+
+struct CandidateScore {
+  std::string name;  // "nominal", "umbmark", "fit", "fit without holds"
+  bool usable = true;
+  std::vector<double> parameters;
+  FinalPoseErrors train;
+  FinalPoseErrors test;
+  bool is_fit = false;  // the two fields below apply
+  int held_directions = 0;
+  int at_bound = 0;
+};
+
+struct SplitScores {
+  GeneralisationSplit split;
+  std::vector<CandidateScore> candidates;  // nominal first
+};
+
+// Fits on split.train (options.ceres.num_threads also drives the evaluation) and scores every
+// candidate on split.test. Throws std::invalid_argument when either side is empty.
+SplitScores EvaluateSplit(const RobotModelInterface& model, const std::vector<AlignedRun>& runs,
+                          const GeneralisationSplit& split, const ModelFitOptions& options);
+
+// One candidate over the folds of leave-one-session-out (candidates are matched by name; a closed
+// form may exist in some folds only).
+struct FoldSummary {
+  std::string name;
+  int folds = 0;                 // folds in which the candidate existed
+  int unusable_folds = 0;        // of those, folds where it did not converge (still scored)
+  double mean_session_cf = 0.0;  // mean over folds of the held-out session's CF
+  double run_cf = 0.0;           // mean over every held-out run (Eq. 14 over the runs)
+  double run_position_m = 0.0;   // mean final position error over every held-out run
+  double run_heading_rad = 0.0;  // mean |final heading error| over every held-out run
+  int folds_with_held_directions = 0;
+  int folds_at_bound = 0;
+};
+
+std::vector<FoldSummary> SummariseFolds(const std::vector<SplitScores>& folds);
+
+}  // namespace fitcal

@@ -1,0 +1,98 @@
+#pragma once
+// Trajectory error metrics of one run, Palacin et al. 2022 Sec. 2.5 (Eq. 8-13), and the summary of
+// many runs that the paper prints as Table 6.
+//
+// The odometry (Eq. 4, replayed with the given parameters from the run's start pose) is compared
+// with the ground truth at the ground-truth times p = 1..m that fall inside the run's window
+// [t_start, t_final] (aligned_run.h):
+//   distance_error(p) = sqrt((xgt(p) - x(p))^2 + (ygt(p) - y(p))^2)            Eq. 8
+//   angle_error(p)    = |wrap(thetagt(p) - theta(p))|                            Eq. 9
+//   max of each over p                                                           Eq. 10, 11
+//   RMSE of each over p                                                          Eq. 12, 13
+// The odometry pose "at" a ground-truth time is, by default, the odometry sample nearest in time
+// (the paper's Sec. 2.5: the odometry is sub-sampled at the ground-truth times); linear
+// interpolation between the two bracketing encoder times is the alternative. The final errors are
+// those of Eq. 14 (replay to t_final against the ground truth interpolated at t_final), so the
+// per-run CF here equals final_pose_cost.h's.
+
+#include <string>
+#include <vector>
+
+#include "fit/final_pose_cost.h"
+#include "odometry/aligned_run.h"
+#include "odometry/effects.h"
+#include "odometry/run_log.h"
+
+namespace fitcal {
+
+enum class OdometrySampling {
+  kNearestTime,          // default: the encoder pose nearest in time (the paper's sub-sampling)
+  kLinearInterpolation,  // between the two encoder poses around the ground-truth time
+};
+
+const char* ToString(OdometrySampling sampling);
+
+// One run replayed with one parameter set.
+struct TrajectoryErrors {
+  std::vector<double> t_s;               // ground-truth times used (inside the window)
+  std::vector<Pose2d> ground_truth;      // world_T_robot from the ground truth at t_s
+  std::vector<Pose2d> odometry;          // odometry sub-sampled at t_s
+  std::vector<double> distance_error_m;  // Eq. 8
+  std::vector<double> angle_error_rad;   // Eq. 9, in [0, pi]
+  double rms_distance_m = 0.0;           // Eq. 12
+  double rms_angle_rad = 0.0;            // Eq. 13
+  double max_distance_m = 0.0;           // Eq. 10
+  double max_angle_rad = 0.0;            // Eq. 11
+  Pose2d final_odometry;                 // replayed pose at t_final
+  Pose2d final_ground_truth;             // ground truth at t_final
+  double final_distance_m = 0.0;         // |final position error|
+  double final_angle_rad = 0.0;          // |wrap(final heading error)|
+  double cf = 0.0;                       // Eq. 14 of this run (m and rad)
+};
+
+// `track` is the run's ground truth (RunLog::ground_truth); `run` its AlignRun(). Throws
+// std::invalid_argument if no ground-truth sample lies inside the window.
+TrajectoryErrors EvaluateTrajectory(const AlignedRun& run, const GroundTruthTrack& track,
+                                    const Omni3ParameterArray& p,
+                                    OdometrySampling sampling = OdometrySampling::kNearestTime);
+
+// The same for a model with effects (odometry/effects.h, as a calibrated robot YAML carries them
+// after `fitcal diagnose`), with the semantics of the effect fit (effect_fit.h): the replay
+// applies every effect, and a ground-truth latency tau makes the ground-truth sample stamped t
+// show the odometry at encoder time t - tau (the start pose is TrackStartPose's, the final pose is
+// compared with the ground truth at t_final + tau). With no effects it equals the overload above.
+TrajectoryErrors EvaluateTrajectory(const AlignedRun& run, const GroundTruthTrack& track,
+                                    const Omni3ParameterArray& p,
+                                    const std::vector<effects::EffectValue>& effects,
+                                    OdometrySampling sampling = OdometrySampling::kNearestTime);
+
+// Summary statistics named as the evo tool names them (evo_ape/evo_rpe "stats"): rmse, mean,
+// median, std (population, ddof = 0, as numpy.std), min, max. All zero for no values.
+struct SummaryStatistics {
+  double rmse = 0.0;
+  double mean = 0.0;
+  double median = 0.0;
+  double std = 0.0;
+  double min = 0.0;
+  double max = 0.0;
+  int count = 0;
+};
+SummaryStatistics Summarize(std::vector<double> values);
+
+// Palacin Table 6, one row pair: averages over runs of each per-run metric, with the nominal
+// ("before") and with the calibrated ("after") parameters.
+struct Table6Averages {
+  double rms_distance_m = 0.0;
+  double rms_angle_rad = 0.0;
+  double max_distance_m = 0.0;
+  double max_angle_rad = 0.0;
+  double final_distance_m = 0.0;
+  double final_angle_rad = 0.0;
+  double cf = 0.0;
+};
+Table6Averages AverageOf(const std::vector<const TrajectoryErrors*>& runs);
+
+// Improvement in percent as the paper's Table 6: 100 (before - after) / before (positive = better).
+double ImprovementPercent(double before, double after);
+
+}  // namespace fitcal
