@@ -42,8 +42,9 @@ std::string AsocEncoderCsv(const asoc::EncoderLog& log);
 // True when the file's first line is the ASOC encoder header above (read no further).
 bool IsAsocEncoderCsv(const std::string& path);
 // The log as the asoc model's channels (asoc::kChannelsPerCastor order), one sample per interval:
-// each wheel's mean rate (angle increment / dt) and each pivot's mean reading (the midpoint of the
-// two readings along the shorter arc: pivot encoders wrap at +-pi).
+// each wheel's mean rate (angle increment / dt) and each pivot's angle at the interval's middle
+// (cubic midpoint of four readings, along the shorter arc: pivot encoders wrap at +-pi; the mean
+// of the two readings at the log's ends; asoc_files.cc).
 EncoderLog AsocEncoderLogAsChannels(const asoc::EncoderLog& log);
 
 // `bounds:` of an asoc robot, absolute, one box per kind of parameter (SI, beta in rad).

@@ -53,10 +53,10 @@ double PositionError(const Pose2d& a, const Pose2d& b) { return std::hypot(a.x -
 // UMBmark circuits of a drawn vehicle (6 m each, encoders quantised as the prototype's), replayed
 // with the true parameters. The paper's CAST-0 linearises about the heading before each 20 Hz
 // update; the seam's body step solves Eq. 13-14 about the interval's middle (exact for a rigid
-// step) from the interval-mean pivot angles (second order in the castors' swing at the corners).
-// Both leave only the update and quantisation error of a few mm after 6 m (measured: seam 1.4 /
-// 4.6 mm, silo 0.5 / 2.8 mm for CW / CCW; heading within 4e-3 rad); bounds with margin: 8 mm and
-// 6e-3 rad from the truth, 4 mm between the two.
+// step) from the pivot angles at the intervals' middles (io/asoc_files.h). Both leave only the
+// update and quantisation error of a few mm after 6 m (measured: seam 0.03 / 3.3 mm, silo 0.5 /
+// 2.8 mm for CW / CCW, 0.5 mm apart; heading within 3e-3 rad); bounds with margin: 5 mm and
+// 4e-3 rad from the truth, 1 mm between the two.
 TEST(AsocModelTest, BodyStepReplaysUmbmarkAsThePapersOdometry) {
   const asoc::Vehicle nominal = sim::AsocPrototypeVehicle();
   std::mt19937_64 rng(7);
@@ -69,10 +69,10 @@ TEST(AsocModelTest, BodyStepReplaysUmbmarkAsThePapersOdometry) {
     const Pose2d seam = model->ReplayFinalPose(p.data(), generic.samples, generic.start);
     const Pose2d silo = asoc::RunOdometry(truth, {}, run.encoders, *run.start_pose);
     const Pose2d& gt = generic.final_ground_truth;
-    EXPECT_LT(PositionError(seam, gt), 8e-3);
-    EXPECT_LT(PositionError(silo, gt), 8e-3);
-    EXPECT_LT(PositionError(seam, silo), 4e-3);
-    EXPECT_NEAR(seam.theta, gt.theta, 6e-3);
+    EXPECT_LT(PositionError(seam, gt), 5e-3);
+    EXPECT_LT(PositionError(silo, gt), 5e-3);
+    EXPECT_LT(PositionError(seam, silo), 1e-3);
+    EXPECT_NEAR(seam.theta, gt.theta, 4e-3);
   }
 }
 
@@ -162,7 +162,8 @@ TEST(AsocModelTest, OdometryVariantsFromTheRobotYaml) {
 }
 
 // ASOC's encoder file (cumulative wheel angles, pivot readings wrapping at +-pi) becomes the
-// model's channels: rates are increments over dt, pivot angles the mean along the shorter arc.
+// model's channels: rates are increments over dt, pivot angles the interval's middle along the
+// shorter arc (at the log's ends the mean of the two readings).
 TEST(AsocModelTest, NativeEncoderLogBecomesTheModelsChannels) {
   asoc::EncoderLog log;
   log.t_s = {0.0, 0.05, 0.15};
@@ -183,6 +184,17 @@ TEST(AsocModelTest, NativeEncoderLogBecomesTheModelsChannels) {
   const int pivot_2 = asoc::kChannelsPerCastor + asoc::kPivotChannel;
   EXPECT_NEAR(WrapAngle(channels.samples[0].value[pivot_2] - (M_PI + 0.01)), 0.0, 1e-12);
   EXPECT_NEAR(WrapAngle(channels.samples[1].value[pivot_2] - (-M_PI + 0.03)), 0.0, 1e-12);
+
+  // Inside the log the pivot angle is the cubic midpoint of four readings, exact for a castor
+  // whose angle is quadratic in time (the mean of two readings would say 2.5 here).
+  asoc::EncoderLog swing;
+  for (int k = 0; k < 4; ++k) {
+    swing.t_s.push_back(k);
+    swing.samples.emplace_back();
+    swing.samples.back().pivot_rad[0] = 0.1 * k * k;
+  }
+  EXPECT_NEAR(io::AsocEncoderLogAsChannels(swing).samples[1].value[asoc::kPivotChannel], 0.225,
+              1e-15);
 }
 
 }  // namespace
