@@ -14,9 +14,20 @@
 //     - {name: c1, pivot_radius_m: 0.3, pivot_angle_deg: 0, offset_m: 0.08,
 //        wheel_radius_m: [0.04, 0.04], wheel_offset_m: [0.06, 0.06], encoder_bias_deg: 0}
 //     - ... (three castors)
+//   bounds: {offset_m: [lo, hi], wheel_radius_m: [lo, hi], wheel_offset_m: [lo, hi],
+//            encoder_bias_deg: [lo, hi]}   # optional, absolute; default: a box around each
+//                                          # value (models/asoc/asoc_robot_model.cc)
+//   odometry: {algorithm: CAST-0, redundancy_check: false}   # optional (Doebbler Table II names:
+//                                          # CAST-0..3, IPEC-1..3; models/asoc/asoc_kinematics.h)
+//   encoder: {...}, effects: [...]         # optional, as for every model (io/robot_yaml_blocks.h)
 //   calibration: {...}            # optional, written by fitcal, informational when read
-// Ground truth and dataset.yaml are as for omni3 (io/dataset.h, io/log_files.h).
+// Ground truth and dataset.yaml are as for omni3 (io/dataset.h, io/log_files.h). The generic
+// commands read these encoder files through AsocEncoderLogAsChannels (io/dataset.cc); a user's own
+// logs may instead use the generic CSV with the asoc model's channel columns (README, ASOC).
 
+#include <yaml-cpp/yaml.h>
+
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,18 +39,42 @@ namespace fitcal::io {
 
 asoc::EncoderLog ReadAsocEncoderCsv(const std::string& path);
 std::string AsocEncoderCsv(const asoc::EncoderLog& log);
+// True when the file's first line is the ASOC encoder header above (read no further).
+bool IsAsocEncoderCsv(const std::string& path);
+// The log as the asoc model's channels (asoc::kChannelsPerCastor order), one sample per interval:
+// each wheel's mean rate (angle increment / dt) and each pivot's angle at the interval's middle
+// (cubic midpoint of four readings, along the shorter arc: pivot encoders wrap at +-pi; the mean
+// of the two readings at the log's ends; asoc_files.cc).
+EncoderLog AsocEncoderLogAsChannels(const asoc::EncoderLog& log);
+
+// `bounds:` of an asoc robot, absolute, one box per kind of parameter (SI, beta in rad).
+struct AsocBounds {
+  Interval offset_m;
+  Interval wheel_radius_m;
+  Interval wheel_offset_m;
+  Interval encoder_bias_rad;
+};
 
 struct AsocRobot {
   std::string name;
   double pivot_distance_m = 0.0;
   std::array<std::string, asoc::kNumCastors> castor_names{"1", "2", "3"};
   asoc::Vehicle nominal;
+  std::optional<AsocBounds> bounds;
+  std::string odometry = "CAST-0";  // `odometry.algorithm`, checked by the model's reader
+  int odometry_line = 0;            // its line in the file, for messages
+  bool redundancy_check = false;
+  std::optional<EncoderTicks> encoder;
+  std::vector<effects::EffectValue> effects;
 };
 
 // Throws InputError (file, line, cause) on anything malformed or physically impossible.
 AsocRobot ReadAsocRobot(const std::string& path);
+// The same from a parsed YAML (`path` names it in messages); the model registry's reader.
+AsocRobot ReadAsocRobotNode(const YAML::Node& root, const std::string& path);
 // The YAML text; `calibration_yaml`, when not empty, is emitted verbatim under `calibration:`
-// (a flow map written by the caller).
+// (a flow map written by the caller). Optional keys are written when set (odometry when not the
+// default CAST-0).
 std::string AsocRobotYaml(const AsocRobot& robot, const std::string& calibration_yaml = "");
 
 struct AsocDataset {

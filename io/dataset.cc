@@ -13,6 +13,7 @@
 #include <string_view>
 #include <unordered_map>
 
+#include "io/asoc_files.h"
 #include "io/input_error.h"
 #include "io/log_files.h"
 #include "io/robot_yaml.h"
@@ -276,6 +277,16 @@ void RejectDataSetWithoutMotion(const DatasetIndex& index, const std::vector<Run
   }
 }
 
+// ASOC data sets keep their own encoder files (io/asoc_files.h: cumulative wheel angles and pivot
+// readings); an asoc robot's run in that format is converted to the model's channels here, so
+// that every command sees the same runs. Any other file goes through the generic reader.
+EncoderLog ReadRunEncoders(const std::string& path, const Robot& robot) {
+  if (robot.model == "asoc" && IsAsocEncoderCsv(path)) {
+    return AsocEncoderLogAsChannels(ReadAsocEncoderCsv(path));
+  }
+  return ReadEncoderCsv(path, robot);
+}
+
 }  // namespace
 
 Dataset LoadDataset(const DatasetIndex& index, const Robot& robot, const DatasetOptions& options) {
@@ -290,7 +301,7 @@ Dataset LoadDataset(const DatasetIndex& index, const Robot& robot, const Dataset
     log.trajectory = entry.trajectory;
     log.repetition = entry.repetition;
     log.start_pose = entry.start_pose;
-    log.encoders = ReadEncoderCsv(entry.encoders_path, robot);
+    log.encoders = ReadRunEncoders(entry.encoders_path, robot);
     log.ground_truth = ReadGroundTruth(entry.ground_truth_path);
     CheckGroundTruthOverlap(log.ground_truth, log.encoders.t_s.front(), log.encoders.t_s.back(),
                             entry.ground_truth_path);

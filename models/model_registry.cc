@@ -2,6 +2,7 @@
 
 #include "io/input_error.h"
 #include "io/yaml_reader.h"
+#include "models/asoc/asoc_robot_model.h"
 #include "models/diff_drive/diff_drive_model.h"
 #include "models/omni/omni_model.h"
 #include "models/omni3/omni3_robot_model.h"
@@ -22,6 +23,8 @@ std::vector<ModelRegistration>& Registry() {
        kTricycleExampleYaml},
       {"diff_drive", "differential drive, Borenstein & Feng 1996 (3 parameters)",
        &ReadDiffDriveModel, kDiffDriveExampleYaml},
+      {"asoc", "three active split offset castors, Doebbler et al. (18 parameters)", &ReadAsocModel,
+       kAsocExampleYaml},
   };
   return registry;
 }

@@ -151,46 +151,36 @@ TEST(FitcalCli, RecordedCfIsTheOneReportMeasures) {
   EXPECT_NEAR(cf_after("\"after\""), recorded["after"].as<double>(), 1e-9);
 }
 
-// An ASOC data set goes through the same entry point and the result gate. On the simulated
-// vehicle the closed form (Doebbler Eq. 1-9, from the hold runs) beats the Ceres refit on the
-// held-out runs (CF 0.0017 vs 0.0038: the refit trades the held-out runs for the training ones),
-// and the closed form is what is written. When no run is labelled a hold run there is no closed
-// form; the fit is written, and the calibrated YAML reads back with the one-sigma of every castor
-// parameter.
-TEST(FitcalCli, AsocFitWritesTheGatesChoiceAndTheFitsSigma) {
+// An ASOC data set (asoc-simulate's own encoder files, converted on load) goes through the
+// generic commands like any model: `fit` with the closed form of Doebbler Eq. 1-9 (from the hold
+// runs) in the result gate, every --method on the seam (crs2lm runs NLopt, not Ceres), `compare`.
+TEST(FitcalCli, AsocDataSetGoesThroughTheGenericCommands) {
   TempDir dir;
   const std::string data = dir.Path("asoc");
-  Result r = RunFitcal(dir, "asoc-simulate --out " + data + " --excursions 12 --seed 3");
+  Result r = RunFitcal(dir, "asoc-simulate --out " + data + " --excursions 2 --seed 3");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const std::string closed = dir.Path("asoc_closed.yaml");
-  r = RunFitcal(dir, "--logs " + data + " --out " + closed);
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("closed form (Eq. 1-9) selected"), std::string::npos) << r.out;
-  EXPECT_EQ(YAML::LoadFile(closed)["calibration"]["method"].as<std::string>(),
-            "closed form (Eq. 1-9)");
-
-  // The same runs with the hold runs relabelled: they still train, but no longer name hold runs.
-  std::string index = ReadFileBytes(data + "/dataset.yaml");
-  for (std::size_t at = index.find("trajectory: hold_"); at != std::string::npos;
-       at = index.find("trajectory: hold_", at)) {
-    index.replace(at, 17, "trajectory: held_");
-  }
-  dir.Write("asoc/dataset.yaml", index);
   const std::string out = dir.Path("asoc_calibrated.yaml");
-  r = RunFitcal(dir, "--logs " + data + " --out " + out);
+  r = RunFitcal(dir, "fit --logs " + data + " --train-reps 1-2 --out " + out);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const io::AsocRobot calibrated = io::ReadAsocRobot(out);
-  const YAML::Node sigma = YAML::LoadFile(out)["calibration"]["sigma"];
-  ASSERT_TRUE(sigma.IsMap()) << ReadFileBytes(out);
-  ASSERT_EQ(sigma.size(), 3u);
-  for (const std::string& name : calibrated.castor_names) {
-    const YAML::Node castor = sigma[name];
-    ASSERT_TRUE(castor.IsMap()) << name;
-    EXPECT_GT(castor["offset_m"].as<double>(), 0.0);
-    EXPECT_GT(castor["wheel_radius_m"][1].as<double>(), 0.0);
-    EXPECT_GT(castor["wheel_offset_m"][0].as<double>(), 0.0);
-    EXPECT_GT(castor["encoder_bias_deg"].as<double>(), 0.0);
-  }
+  EXPECT_NE(r.out.find("asoc robot 'asoc-prototype'"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("asoc-geometric"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("result gate"), std::string::npos) << r.out;
+  const io::AsocRobot calibrated = io::ReadAsocRobot(out);  // the silo's commands still read it
+  EXPECT_EQ(calibrated.name, "asoc-prototype");
+  const YAML::Node record = YAML::LoadFile(out)["calibration"];
+  ASSERT_TRUE(record.IsMap()) << ReadFileBytes(out);
+  EXPECT_TRUE(record["selected"]) << ReadFileBytes(out);
+
+  r = RunFitcal(dir, "fit --logs " + data +
+                         " --train-reps 1 --method crs2lm --max-evaluations 200 --no-output");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("solver: NLopt CRS2-LM"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("Levenberg-Marquardt"), std::string::npos) << r.out;
+
+  r = RunFitcal(dir,
+                "compare --logs " + data + " --methods ceres --repetitions 1 --no-output --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("asoc-geometric"), std::string::npos) << r.out;
 }
 
 TEST(FitcalCli, BadInputGivesOneLineAndWritesNothing) {

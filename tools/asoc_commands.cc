@@ -6,7 +6,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
-#include <limits>
 #include <random>
 #include <stdexcept>
 
@@ -15,12 +14,10 @@
 #include "io/atomic_file.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
-#include "models/asoc/asoc_ceres_fit.h"
 #include "models/asoc/asoc_geometric.h"
 #include "odometry/parallel_for.h"
 #include "tools/output_guard.h"
 #include "tools/sim/asoc_simulator.h"
-#include "validation/run_split.h"
 
 namespace fitcal::tools {
 
@@ -43,8 +40,6 @@ io::AsocRobot RobotFromVehicle(const std::string& name, const asoc::Vehicle& v) 
   return robot;
 }
 
-bool IsHoldRun(const std::string& trajectory) { return trajectory.rfind("hold_", 0) == 0; }
-
 void PrintCastors(const io::AsocRobot& robot, const asoc::Vehicle& estimate, const char* label) {
   std::printf("\n  %-8s %10s %10s %10s %10s %10s %12s   (%s)\n", "castor", "r_c [m]", "r_w1 [m]",
               "r_w2 [m]", "d_1 [m]", "d_2 [m]", "beta [deg]", label);
@@ -56,51 +51,14 @@ void PrintCastors(const io::AsocRobot& robot, const asoc::Vehicle& estimate, con
   }
 }
 
-// One-sigma per castor parameter (flat order of asoc::Vehicle::ToArray), beneath PrintCastors.
-void PrintCastorSigmas(const io::AsocRobot& robot,
-                       const std::array<double, asoc::kNumParameters>& sigma) {
-  std::printf(
-      "  one sigma (covariance x residual variance; on simulated data the actual error is "
-      "~1.3 sigma rms):\n");
-  for (int i = 0; i < asoc::kNumCastors; ++i) {
-    const asoc::CastorParameters c =
-        asoc::CastorParameters::FromArray(&sigma[i * asoc::kParametersPerCastor]);
-    std::printf("  %-8s %10.2g %10.2g %10.2g %10.2g %10.2g %12.3g\n", robot.castor_names[i].c_str(),
-                c.offset_m, c.wheel_radius_m[0], c.wheel_radius_m[1], c.wheel_offset_m[0],
-                c.wheel_offset_m[1], RadToDeg(c.encoder_bias_rad));
-  }
-}
-
-// The calibration record of the written YAML: how it was made and, when the covariance exists,
-// `sigma: {<castor>: {offset_m, wheel_radius_m: [2], wheel_offset_m: [2], encoder_bias_deg}}`.
-// Emitted by yaml-cpp so that any path or castor name is quoted correctly.
-// `fit` is null for the closed form (no termination, no covariance).
-std::string AsocCalibrationRecord(const io::AsocRobot& robot, const std::string& method,
-                                  const std::string& dataset, const asoc::AsocFitResult* fit) {
+// The calibration record of the written YAML: how it was made. Emitted by yaml-cpp so that any
+// path is quoted correctly.
+std::string AsocCalibrationRecord(const std::string& method, const std::string& dataset) {
   YAML::Emitter out;
   out.SetMapFormat(YAML::Flow);
-  out.SetSeqFormat(YAML::Flow);
-  out.SetDoublePrecision(3);
   out << YAML::BeginMap << YAML::Key << "method" << YAML::Value << method << YAML::Key << "dataset"
-      << YAML::Value << dataset << YAML::Key << "tool_version" << YAML::Value << kVersion;
-  if (fit != nullptr) out << YAML::Key << "termination" << YAML::Value << fit->termination;
-  if (fit != nullptr && fit->has_covariance) {
-    out << YAML::Key << "sigma" << YAML::Value << YAML::BeginMap;
-    for (int i = 0; i < asoc::kNumCastors; ++i) {
-      const asoc::CastorParameters c =
-          asoc::CastorParameters::FromArray(&fit->sigma[i * asoc::kParametersPerCastor]);
-      out << YAML::Key << robot.castor_names[i] << YAML::Value << YAML::BeginMap;
-      out << YAML::Key << "offset_m" << YAML::Value << c.offset_m;
-      out << YAML::Key << "wheel_radius_m" << YAML::Value << YAML::BeginSeq << c.wheel_radius_m[0]
-          << c.wheel_radius_m[1] << YAML::EndSeq;
-      out << YAML::Key << "wheel_offset_m" << YAML::Value << YAML::BeginSeq << c.wheel_offset_m[0]
-          << c.wheel_offset_m[1] << YAML::EndSeq;
-      out << YAML::Key << "encoder_bias_deg" << YAML::Value << RadToDeg(c.encoder_bias_rad);
-      out << YAML::EndMap;
-    }
-    out << YAML::EndMap;
-  }
-  out << YAML::EndMap;
+      << YAML::Value << dataset << YAML::Key << "tool_version" << YAML::Value << kVersion
+      << YAML::EndMap;
   return out.c_str();
 }
 
@@ -108,61 +66,34 @@ std::string AsocCalibrationRecord(const io::AsocRobot& robot, const std::string&
 // (atomically), and says so.
 void WriteAsocCalibration(const std::string& out, const io::AsocRobot& robot,
                           const asoc::Vehicle& estimate, const std::string& method,
-                          const std::string& dataset, const asoc::AsocFitResult* fit) {
+                          const std::string& dataset) {
   io::AsocRobot calibrated = robot;
   calibrated.nominal = estimate;
-  io::WriteFileAtomically(
-      out, io::AsocRobotYaml(calibrated, AsocCalibrationRecord(robot, method, dataset, fit)));
+  io::WriteFileAtomically(out,
+                          io::AsocRobotYaml(calibrated, AsocCalibrationRecord(method, dataset)));
   std::printf("wrote %s\n", out.c_str());
 }
 
-// One calibration the ASOC fit can write: the nominal, the closed form (Doebbler Eq. 1-9) and
-// the Ceres fits; `fit` is null for the first two.
-struct AsocCandidate {
-  std::string name;
-  asoc::Vehicle vehicle;
-  std::string status;
-  bool usable = true;
-  const asoc::AsocFitResult* fit = nullptr;
-};
-
-// Prints every candidate's CF (and UMBmark E_max when the data have both circuits) and returns
-// the result gate's choice (fit/result_gate.h's rule): the lowest CF on the held-out runs (on the
-// training runs when there are none) among the usable candidates, the nominal (index 0) winning
-// ties.
-int PrintAndGateAsocCandidates(const std::vector<AsocCandidate>& rows,
-                               const std::vector<asoc::AlignedAsocRun>& training,
-                               const std::vector<asoc::AlignedAsocRun>& validation,
-                               const std::vector<asoc::RunLog>& umbmark_logs) {
-  bool has_both = false;
-  for (const auto& r : umbmark_logs) has_both |= r.trajectory == "umbmark_ccw";
-  std::printf("  %-24s %12s %12s %14s  %s\n", "method", "CF train", "CF valid", "UMBmark E_max",
-              "termination");
-  int selected = 0;
-  double best_cf = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    const AsocCandidate& row = rows[i];
-    char emax[32] = "-";
-    if (has_both) {
-      std::snprintf(emax, sizeof emax, "%.1f mm",
-                    1000.0 * sim::EvaluateUmbmark(umbmark_logs, row.vehicle, {}).e_max_m);
-    }
-    const double cf_train = asoc::AsocFinalPoseCf(row.vehicle, training);
-    const double cf_valid =
-        validation.empty() ? NAN : asoc::AsocFinalPoseCf(row.vehicle, validation);
-    std::printf("  %-24s %12.5f %12.5f %14s  %s\n", row.name.c_str(), cf_train, cf_valid, emax,
-                row.status.c_str());
-    const double judged = validation.empty() ? cf_train : cf_valid;
-    if (row.usable && std::isfinite(judged) && judged < best_cf) {
-      best_cf = judged;
-      selected = static_cast<int>(i);
+// UMBmark circuits, 5 CW and 5 CCW, as repetitions 6-10 so that the default --train-reps 1-5
+// validates on them. Each repetition drives at its own speed (0.30, 0.306, ... m/s): noise-free
+// identical circuits would be one recording copied, which the loader refuses (io/dataset.cc).
+std::vector<asoc::RunLog> UmbmarkCircuits(const asoc::Vehicle& truth,
+                                          const sim::AsocSimulationOptions& options,
+                                          std::mt19937_64& rng) {
+  std::vector<asoc::RunLog> runs;
+  for (int direction : {-1, +1}) {
+    for (int rep = 6; rep <= 10; ++rep) {
+      const double speed_m_s = 0.3 * (1.0 + 0.02 * (rep - 6));
+      const std::vector<sim::Segment> square = sim::UmbmarkSquare(direction, 1.5, speed_m_s);
+      asoc::RunLog run = sim::SimulateAsocRun(
+          truth, square, Pose2d{}, sim::SteadyCastorAngles(truth, square.front()), options, rng);
+      run.trajectory = direction < 0 ? "umbmark_cw" : "umbmark_ccw";
+      run.repetition = rep;
+      run.id = run.trajectory + "-rep" + std::to_string(rep);
+      runs.push_back(std::move(run));
     }
   }
-  std::printf("  (CF: mean final-pose |[dx, dy, dpsi]|, m and rad, CAST-0 replay)\n");
-  std::printf("result gate, CF on the %s runs: %s selected\n",
-              validation.empty() ? "training (no held-out)" : "held-out",
-              rows[selected].name.c_str());
-  return selected;
+  return runs;
 }
 
 }  // namespace
@@ -182,12 +113,8 @@ int RunAsocSimulate(const AsocSimulateOptions& options) {
     sim::AsocSimulationOptions sim_options;
     sim_options.wheel_slip_sigma = options.wheel_slip_sigma;
     std::vector<asoc::RunLog> runs = sim::SimulateCalibrationManoeuvre(truth, sim_options, rng);
-    // UMBmark circuits as repetitions 6-10 so that the default --train-reps 1-5 validates on them.
-    for (asoc::RunLog& run : sim::SimulateUmbmark(truth, sim_options, rng, 5)) {
-      run.repetition += 5;
-      run.id = run.trajectory + "-rep" + std::to_string(run.repetition);
+    for (asoc::RunLog& run : UmbmarkCircuits(truth, sim_options, rng))
       runs.push_back(std::move(run));
-    }
     for (int k = 1; k <= options.excursions; ++k) {
       asoc::RunLog run = sim::SimulateRandomExcursion(truth, sim_options, rng);
       run.trajectory = "excursion";
@@ -240,6 +167,7 @@ int RunAsocGeometric(const AsocGeometricOptions& options) {
           h.wheel_offset_m[0], h.wheel_offset_m[1], RadToDeg(h.encoder_bias_rad),
           result.num_estimates[i]);
     }
+    if (result.usable) std::printf("  %s\n", result.message.c_str());
     if (!result.usable) {
       std::cerr << "fitcal: closed form not usable: " << result.message << " nothing written\n";
       return 3;
@@ -251,91 +179,7 @@ int RunAsocGeometric(const AsocGeometricOptions& options) {
         return 2;
       }
       WriteAsocCalibration(options.out, robot, result.estimate, "closed-form Doebbler Eq. 1-9",
-                           options.logs, nullptr);
-    }
-    return 0;
-  } catch (const std::exception& e) {
-    std::cerr << "fitcal: " << e.what() << "\n";
-    return 1;
-  }
-}
-
-int RunAsocFit(const FitCommandOptions& options) {
-  try {
-    io::DatasetOptions dataset_options;
-    dataset_options.allow_paths_outside = options.allow_outside_paths;
-    dataset_options.num_threads = options.threads;
-    const io::AsocDataset dataset = io::LoadAsocDataset(options.logs, dataset_options);
-    const io::AsocRobot robot = io::ReadAsocRobot(dataset.robot_path);
-    if (!options.no_output && !options.force) {
-      if (const std::string refusal = OverwriteRefusal(options.out, robot.name); !refusal.empty()) {
-        std::cerr << "fitcal: " << refusal << "\n";
-        return 2;
-      }
-    }
-    if (!options.train_trajectories.empty()) {
-      std::cerr << "fitcal: --train-trajectories is not available for asoc robots yet (their "
-                   "fit has its own command path); use --train-reps\n";
-      return 2;
-    }
-    const std::vector<int> train_reps = ParseRepetitionList(options.train_reps);
-    std::vector<asoc::AlignedAsocRun> training, validation, umbmark;
-    std::vector<asoc::RunLog> umbmark_logs;
-    for (const asoc::RunLog& run : dataset.runs) {
-      const bool train =
-          std::find(train_reps.begin(), train_reps.end(), run.repetition) != train_reps.end();
-      (train ? training : validation).push_back(asoc::AlignAsocRun(run));
-      if (!train && run.trajectory.rfind("umbmark_", 0) == 0) umbmark_logs.push_back(run);
-    }
-    if (training.empty()) {
-      std::cerr << "fitcal: no run of " << options.logs << " has a training repetition ("
-                << options.train_reps << ")\n";
-      return 2;
-    }
-    asoc::AsocFitOptions fit_options;
-    fit_options.num_threads = options.threads;
-    fit_options.weights.position_sigma_m = options.position_sigma_m;
-    fit_options.weights.heading_sigma_rad = options.heading_sigma_deg * M_PI / 180.0;
-
-    std::vector<AsocCandidate> rows;
-    rows.push_back({"nominal", robot.nominal, "-", true, nullptr});
-    std::vector<asoc::RunLog> hold_runs;
-    for (const asoc::RunLog& run : dataset.runs) {
-      if (IsHoldRun(run.trajectory)) hold_runs.push_back(run);
-    }
-    const asoc::GeometricResult closed = asoc::CalibrateGeometric(hold_runs, robot.nominal);
-    if (closed.usable) {
-      rows.push_back({"closed form (Eq. 1-9)", closed.estimate, "closed form", true, nullptr});
-    }
-    const asoc::AsocFitResult ceres = asoc::FitAsocCeres(training, robot.nominal, fit_options);
-    rows.push_back(
-        {"ceres (from nominal)", ceres.estimate, ceres.termination, ceres.usable, &ceres});
-    asoc::AsocFitResult refined;
-    if (closed.usable) {
-      refined = asoc::FitAsocCeres(training, closed.estimate, fit_options);
-      rows.push_back(
-          {"closed form + ceres", refined.estimate, refined.termination, refined.usable, &refined});
-    }
-    std::printf("fitcal %s  asoc robot '%s'  data set %s\n", kVersion, robot.name.c_str(),
-                options.logs.c_str());
-    std::printf("runs: %zu training, %zu validation (%zu UMBmark circuits); closed form: %s\n\n",
-                training.size(), validation.size(), umbmark_logs.size(),
-                closed.usable ? closed.message.c_str() : "no complete hold runs");
-    const int selected = PrintAndGateAsocCandidates(rows, training, validation, umbmark_logs);
-    const AsocCandidate& best = rows[selected];
-    PrintCastors(robot, best.vehicle, best.name.c_str());
-    if (best.fit != nullptr && best.fit->has_covariance) {
-      PrintCastorSigmas(robot, best.fit->sigma);
-    } else if (best.fit != nullptr) {
-      std::printf("uncertainty: %s\n", best.fit->covariance_message.c_str());
-    }
-    if (selected == 0) {
-      std::cerr << "fitcal: no calibration beats the nominal vehicle on the "
-                << (validation.empty() ? "training" : "held-out") << " runs; nothing written\n";
-      return 5;
-    }
-    if (!options.no_output) {
-      WriteAsocCalibration(options.out, robot, best.vehicle, best.name, options.logs, best.fit);
+                           options.logs);
     }
     return 0;
   } catch (const std::exception& e) {

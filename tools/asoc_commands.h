@@ -1,14 +1,12 @@
 #pragma once
 // ASOC subcommands (Doebbler et al.): `asoc-simulate` writes an ASOC data set, `asoc-geometric`
 // runs the closed-form calibration (Eq. 1-9) on a calibration-manoeuvre data set,
-// `asoc-tables` reproduces Tables I and II, and RunAsocFit is the `model: asoc` branch of
-// `fitcal --logs DIR --method ceres`.
+// `asoc-tables` reproduces Tables I and II. Fitting, comparing, diagnosing and generalising an
+// ASOC data set go through the generic commands (the asoc model, models/asoc/asoc_robot_model.h).
 
 #include <CLI/CLI.hpp>
 #include <cstdint>
 #include <string>
-
-#include "tools/fit_command.h"
 
 namespace fitcal::tools {
 
@@ -38,8 +36,6 @@ struct AsocTablesOptions {
 int RunAsocSimulate(const AsocSimulateOptions& options);
 int RunAsocGeometric(const AsocGeometricOptions& options);
 int RunAsocTables(const AsocTablesOptions& options);
-// The ASOC branch of `fitcal fit`: closed form, Ceres, closed form + Ceres on the same validation.
-int RunAsocFit(const FitCommandOptions& options);
 
 // Registers the three subcommands on `app`; `dispatch` runs the one that was given (returns -1
 // when none of them was).

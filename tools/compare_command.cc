@@ -196,11 +196,6 @@ CompareData LoadCompareData(const CompareCommandOptions& options) {
   dataset_options.num_threads = options.threads;
   const io::DatasetIndex index = io::ReadDatasetIndex(options.logs, dataset_options);
   const std::string model_name = io::ReadRobotModel(index.robot_path);
-  if (model_name == "asoc") {
-    throw std::invalid_argument(index.robot_path +
-                                ": ASOC robots are compared by their own commands "
-                                "(asoc-geometric, asoc-tables), not by compare");
-  }
   CompareData d;
   if (model_name == "omni3") {
     const io::Dataset dataset = io::LoadDataset(index, dataset_options);

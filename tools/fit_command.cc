@@ -25,7 +25,6 @@
 #include "models/model_registry.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "odometry/effects.h"
-#include "tools/asoc_commands.h"
 #include "tools/fit_methods.h"
 #include "tools/model_fit_command.h"
 #include "tools/output_guard.h"
@@ -107,7 +106,6 @@ int RunFitCommand(const FitCommandOptions& options) {
     io::DatasetOptions dataset_options;
     dataset_options.allow_paths_outside = options.allow_outside_paths;
     dataset_options.num_threads = options.threads;
-    // ASOC robots (issue 5) have their own encoder format and fit (tools/asoc_commands.h).
     const io::DatasetIndex index = io::ReadDatasetIndex(options.logs, dataset_options);
     if (!options.no_output) {
       // Every model's fit writes one file: never over one of its own inputs (exit 2, usage).
@@ -118,7 +116,6 @@ int RunFitCommand(const FitCommandOptions& options) {
       }
     }
     const std::string model_name = io::ReadRobotModel(index.robot_path);
-    if (model_name == "asoc") return RunAsocFit(options);
     // Every model on the seam except omni3, whose fit (with its NLopt methods and fast kernel)
     // still has its own path below.
     if (model_name != "omni3") {

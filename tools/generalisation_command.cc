@@ -136,11 +136,6 @@ int RunGeneraliseCommand(const GeneraliseCommandOptions& options) {
     dataset_options.num_threads = options.threads;
     const io::DatasetIndex index = io::ReadDatasetIndex(options.logs, dataset_options);
     const std::string model_name = io::ReadRobotModel(index.robot_path);
-    if (model_name == "asoc") {
-      std::cerr << "fitcal: generalise is not available for asoc robots (their fit has its own "
-                   "command path: fitcal fit)\n";
-      return 2;
-    }
     if (model_name != "omni3") {
       return RunModelGeneraliseCommand(options, index, ReadRobotModelFile(index.robot_path));
     }

@@ -1,7 +1,7 @@
 #include "models/asoc/asoc_geometric.h"
 
+#include <algorithm>
 #include <cmath>
-#include <map>
 #include <stdexcept>
 
 #include "odometry/pose2.h"
@@ -62,51 +62,106 @@ CastorParameters SolveHoldPair(const HoldMeasurement& m, double pivot_distance_m
   return out;
 }
 
-GeometricResult CalibrateGeometric(const std::vector<RunLog>& runs, const Vehicle& nominal,
-                                   const GeometricOptions& options) {
-  std::string error;
-  if (!options.IsValid(&error)) throw std::invalid_argument("GeometricOptions: " + error);
-  // hold runs by (held castor, direction).
-  std::map<std::pair<int, int>, const RunLog*> hold;
-  for (const RunLog& run : runs) {
-    for (int j = 0; j < kNumCastors; ++j) {
-      const std::string prefix = "hold_" + std::to_string(j + 1);
-      if (run.trajectory == prefix + "_cw") hold[{j, -1}] = &run;
-      if (run.trajectory == prefix + "_ccw") hold[{j, +1}] = &run;
+bool ParseHoldLabel(const std::string& trajectory, int* held, int* direction) {
+  for (int j = 0; j < kNumCastors; ++j) {
+    const std::string prefix = "hold_" + std::to_string(j + 1);
+    if (trajectory == prefix + "_cw" || trajectory == prefix + "_ccw") {
+      *held = j;
+      *direction = trajectory == prefix + "_cw" ? -1 : +1;
+      return true;
     }
   }
-  GeometricResult result;
-  result.estimate = nominal;
+  return false;
+}
+
+HoldRun MeasureHoldRun(const EncoderLog& log, int held, int direction, double steady_fraction) {
+  HoldRun run;
+  run.held = held;
+  run.direction = direction;
+  run.rotation_rad = PivotRotation(log, held);
+  for (int i = 0; i < kNumCastors; ++i) {
+    run.steady_gamma_rad[i] = SteadyAngle(log, i, steady_fraction);
+    for (int k = 0; k < 2; ++k) {
+      run.wheel_rad[i][k] =
+          log.samples.back().wheel_rad[i][k] - log.samples.front().wheel_rad[i][k];
+    }
+  }
+  return run;
+}
+
+namespace {
+
+// The estimates of castor i from every CW x CCW pair of runs holding castor j != i; sets
+// used[r] for the runs that entered a pair.
+std::array<std::vector<CastorParameters>, kNumCastors> PairEstimates(
+    const std::vector<HoldRun>& runs, const Vehicle& nominal, std::vector<bool>* used) {
   std::array<std::vector<CastorParameters>, kNumCastors> estimates;
   for (int j = 0; j < kNumCastors; ++j) {
-    const auto cw = hold.find({j, -1}), ccw = hold.find({j, +1});
-    if (cw == hold.end() || ccw == hold.end()) continue;
-    const EncoderLog& log_cw = cw->second->encoders;
-    const EncoderLog& log_ccw = ccw->second->encoders;
-    if (log_cw.samples.size() < 4 || log_ccw.samples.size() < 4) continue;
-    const double rotation_cw = PivotRotation(log_cw, j);
-    const double rotation_ccw = PivotRotation(log_ccw, j);
-    // The body turns CW (negative) in a CW run, so the held castor's body-relative angle rises.
-    if (!(rotation_cw > 0.0) || !(rotation_ccw < 0.0)) continue;
-    for (int i = 0; i < kNumCastors; ++i) {
-      if (i == j) continue;
-      HoldMeasurement m;
-      m.gamma_cw_rad = SteadyAngle(log_cw, i, options.steady_fraction);
-      m.gamma_ccw_rad = SteadyAngle(log_ccw, i, options.steady_fraction);
-      for (int k = 0; k < 2; ++k) {
-        m.wheel_cw_rad[k] =
-            log_cw.samples.back().wheel_rad[i][k] - log_cw.samples.front().wheel_rad[i][k];
-        m.wheel_ccw_rad[k] =
-            log_ccw.samples.back().wheel_rad[i][k] - log_ccw.samples.front().wheel_rad[i][k];
+    for (std::size_t a = 0; a < runs.size(); ++a) {
+      // The body turns CW (negative) in a CW run, so the held castor's body-relative angle rises.
+      const HoldRun& cw = runs[a];
+      if (cw.held != j || cw.direction != -1 || !(cw.rotation_rad > 0.0)) continue;
+      for (std::size_t b = 0; b < runs.size(); ++b) {
+        const HoldRun& ccw = runs[b];
+        if (ccw.held != j || ccw.direction != +1 || !(ccw.rotation_rad < 0.0)) continue;
+        (*used)[a] = (*used)[b] = true;
+        for (int i = 0; i < kNumCastors; ++i) {
+          if (i == j) continue;
+          HoldMeasurement m;
+          m.gamma_cw_rad = cw.steady_gamma_rad[i];
+          m.gamma_ccw_rad = ccw.steady_gamma_rad[i];
+          m.wheel_cw_rad = cw.wheel_rad[i];
+          m.wheel_ccw_rad = ccw.wheel_rad[i];
+          m.rotation_cw_rad = cw.rotation_rad;
+          m.rotation_ccw_rad = -ccw.rotation_rad;
+          const double ex = nominal.pivots[i].x_m() - nominal.pivots[j].x_m();
+          const double ey = nominal.pivots[i].y_m() - nominal.pivots[j].y_m();
+          const double theta_perp = std::atan2(ey, ex) - 0.5 * M_PI;
+          estimates[i].push_back(SolveHoldPair(m, nominal.PivotDistance(i, j), theta_perp));
+        }
       }
-      m.rotation_cw_rad = rotation_cw;
-      m.rotation_ccw_rad = -rotation_ccw;
-      const double ex = nominal.pivots[i].x_m() - nominal.pivots[j].x_m();
-      const double ey = nominal.pivots[i].y_m() - nominal.pivots[j].y_m();
-      const double theta_perp = std::atan2(ey, ex) - 0.5 * M_PI;
-      estimates[i].push_back(SolveHoldPair(m, nominal.PivotDistance(i, j), theta_perp));
     }
   }
+  return estimates;
+}
+
+// The mean of a castor's estimates (beta on the circle) and their half range per parameter.
+void AverageEstimates(const std::vector<CastorParameters>& e, CastorParameters* mean,
+                      CastorParameters* half_spread) {
+  double p[kParametersPerCastor] = {0, 0, 0, 0, 0, 0};
+  double lo[kParametersPerCastor] = {0, 0, 0, 0, 0, 0},
+         hi[kParametersPerCastor] = {0, 0, 0, 0, 0, 0};
+  double bs = 0.0, bc = 0.0;
+  for (std::size_t n = 0; n < e.size(); ++n) {
+    double q[kParametersPerCastor];
+    e[n].ToArray(q);
+    for (int k = 0; k < kParametersPerCastor; ++k) {
+      p[k] += q[k] / e.size();
+      lo[k] = n == 0 ? q[k] : std::min(lo[k], q[k]);
+      hi[k] = n == 0 ? q[k] : std::max(hi[k], q[k]);
+    }
+    bs += std::sin(e[n].encoder_bias_rad);
+    bc += std::cos(e[n].encoder_bias_rad);
+  }
+  p[kBiasIndex] = std::atan2(bs, bc);
+  *mean = CastorParameters::FromArray(p);
+  double h[kParametersPerCastor];
+  for (int k = 0; k < kParametersPerCastor; ++k) h[k] = 0.5 * (hi[k] - lo[k]);
+  double bias_spread = 0.0;  // on the circle, from the mean
+  for (const CastorParameters& c : e) {
+    bias_spread = std::max(bias_spread, std::abs(WrapAngle(c.encoder_bias_rad - p[kBiasIndex])));
+  }
+  h[kBiasIndex] = bias_spread;
+  *half_spread = CastorParameters::FromArray(h);
+}
+
+}  // namespace
+
+GeometricResult CalibrateFromHoldRuns(const std::vector<HoldRun>& runs, const Vehicle& nominal) {
+  GeometricResult result;
+  result.estimate = nominal;
+  std::vector<bool> used(runs.size(), false);
+  const auto estimates = PairEstimates(runs, nominal, &used);
   result.usable = true;
   for (int i = 0; i < kNumCastors; ++i) {
     const auto& e = estimates[i];
@@ -116,25 +171,7 @@ GeometricResult CalibrateGeometric(const std::vector<RunLog>& runs, const Vehicl
       result.message += "castor " + std::to_string(i + 1) + " has no CW+CCW pair of hold runs; ";
       continue;
     }
-    double p[kParametersPerCastor] = {0, 0, 0, 0, 0, 0};
-    double bs = 0.0, bc = 0.0;
-    for (const CastorParameters& c : e) {
-      double q[kParametersPerCastor];
-      c.ToArray(q);
-      for (int k = 0; k < kParametersPerCastor; ++k) p[k] += q[k] / e.size();
-      bs += std::sin(c.encoder_bias_rad);
-      bc += std::cos(c.encoder_bias_rad);
-    }
-    p[kBiasIndex] = std::atan2(bs, bc);
-    result.estimate.castors[i] = CastorParameters::FromArray(p);
-    if (e.size() == 2) {
-      double a[kParametersPerCastor], b[kParametersPerCastor], h[kParametersPerCastor];
-      e[0].ToArray(a);
-      e[1].ToArray(b);
-      for (int k = 0; k < kParametersPerCastor; ++k) h[k] = 0.5 * std::abs(a[k] - b[k]);
-      h[kBiasIndex] = 0.5 * std::abs(WrapAngle(a[kBiasIndex] - b[kBiasIndex]));
-      result.half_spread[i] = CastorParameters::FromArray(h);
-    }
+    AverageEstimates(e, &result.estimate.castors[i], &result.half_spread[i]);
     double check[kParametersPerCastor];
     result.estimate.castors[i].ToArray(check);
     for (int k = 0; k < kParametersPerCastor; ++k) {
@@ -145,9 +182,26 @@ GeometricResult CalibrateGeometric(const std::vector<RunLog>& runs, const Vehicl
       }
     }
   }
-  if (result.usable)
-    result.message = "closed form (Eq. 1-9) from " + std::to_string(hold.size()) + " hold runs";
+  if (result.usable) {
+    const auto n = std::count(used.begin(), used.end(), true);
+    result.message = "closed form (Eq. 1-9) from " + std::to_string(n) + " of " +
+                     std::to_string(runs.size()) + " hold runs";
+  }
   return result;
+}
+
+GeometricResult CalibrateGeometric(const std::vector<RunLog>& runs, const Vehicle& nominal,
+                                   const GeometricOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw std::invalid_argument("GeometricOptions: " + error);
+  std::vector<HoldRun> holds;
+  for (const RunLog& run : runs) {
+    int held = 0, direction = 0;
+    if (!ParseHoldLabel(run.trajectory, &held, &direction)) continue;
+    if (run.encoders.samples.size() < 4) continue;
+    holds.push_back(MeasureHoldRun(run.encoders, held, direction, options.steady_fraction));
+  }
+  return CalibrateFromHoldRuns(holds, nominal);
 }
 
 }  // namespace fitcal::asoc

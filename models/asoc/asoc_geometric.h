@@ -17,7 +17,9 @@
 //
 // Runs are found by trajectory label "hold_<j>_cw" / "hold_<j>_ccw" (j 1-based). The steady
 // castor angle is the circular mean of the readings over the middle `steady_fraction` of the run,
-// which skips start/stop transients when the castors were not perfectly pre-aligned.
+// which skips start/stop transients when the castors were not perfectly pre-aligned. Every hold run
+// is used: each CW run of castor j is paired with each CCW run of castor j, and all the pair
+// estimates of a castor are averaged.
 
 #include <array>
 #include <string>
@@ -47,6 +49,20 @@ struct HoldMeasurement {
 CastorParameters SolveHoldPair(const HoldMeasurement& m, double pivot_distance_m,
                                double theta_perp_rad);
 
+// What one hold run contributes (measured from the encoders only, from either kind of log).
+struct HoldRun {
+  int held = 0;               // 0-based castor held still
+  int direction = 0;          // -1 CW, +1 CCW (from the label)
+  double rotation_rad = 0.0;  // the held castor's pivot encoder turn, unwrapped, signed
+  std::array<double, kNumCastors> steady_gamma_rad{};          // per castor, circular mean
+  std::array<std::array<double, 2>, kNumCastors> wheel_rad{};  // angle each wheel turned
+};
+
+// "hold_<j>_cw" / "hold_<j>_ccw" (j = 1..3): the held castor (0-based) and the direction.
+bool ParseHoldLabel(const std::string& trajectory, int* held, int* direction);
+// A hold run of the silo's log (readings at sample times).
+HoldRun MeasureHoldRun(const EncoderLog& log, int held, int direction, double steady_fraction);
+
 struct GeometricResult {
   bool usable = false;
   std::string message;  // why not usable, or a summary
@@ -57,8 +73,12 @@ struct GeometricResult {
   std::array<CastorParameters, kNumCastors> half_spread{};
 };
 
-// Throws std::invalid_argument for invalid options. Castors without any usable hold pair keep
-// their nominal parameters and make the result unusable.
+// Eq. 1-9 on every CW x CCW pair of hold runs of each held castor, averaged per castor. Castors
+// without any usable hold pair keep their nominal parameters and make the result unusable.
+GeometricResult CalibrateFromHoldRuns(const std::vector<HoldRun>& runs, const Vehicle& nominal);
+
+// The hold runs among `runs` (by label, >= 4 samples) through CalibrateFromHoldRuns. Throws
+// std::invalid_argument for invalid options.
 GeometricResult CalibrateGeometric(const std::vector<RunLog>& runs, const Vehicle& nominal,
                                    const GeometricOptions& options = {});
 

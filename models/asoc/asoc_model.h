@@ -53,6 +53,15 @@ inline constexpr int kWheelRadiusIndex = 1;  // r_w1, r_w2
 inline constexpr int kWheelOffsetIndex = 3;  // d_1, d_2
 inline constexpr int kBiasIndex = 5;         // beta
 
+// The encoder channels of an ASOC vehicle on the model seam (models/asoc/asoc_kinematics.h), castor
+// by castor: wheel 1 ("a") rate, wheel 2 ("b") rate (rad/s over an interval), pivot angle gamma_i
+// (rad, the mean of the interval's two readings). Channel of castor i, kind k: 3 i + k.
+inline constexpr int kChannelsPerCastor = 3;
+inline constexpr int kNumChannels = kNumCastors * kChannelsPerCastor;
+inline constexpr int kWheelAChannel = 0;
+inline constexpr int kWheelBChannel = 1;
+inline constexpr int kPivotChannel = 2;
+
 // Where a pivot is on the body (known geometry: Doebbler assumes the pivot distance D known).
 struct PivotPosition {
   double radius_m = 0.0;   // R_i
@@ -144,26 +153,31 @@ inline std::array<double, 2> WheelRatesFromPivotMotion(const CastorParameters& c
           (along + c.wheel_offset_m[1] * turn) / c.wheel_radius_m[1]};
 }
 
-// The pivot's world displacement over one interval, from the wheel angle increments and the
-// castor's absolute heading chi at the interval's start. The castor turns by omega_c over the
-// interval; with constant rates the pivot runs along an arc whose chord is the motion (u, w)
-// rotated to the mid heading chi + omega_c / 2 and shortened by sinc(omega_c / 2). This is
-// Borenstein's midpoint odometry, adapted to the pivot offset as Doebbler Sec. III-B describes.
+// The chord of the pivot's arc over one interval: with constant rates the castor turns by
+// omega_c and the pivot runs along an arc whose chord is the motion (u, w) rotated to the castor's
+// heading at the interval's middle and shortened by sinc(omega_c / 2). Borenstein's midpoint
+// odometry, adapted to the pivot offset as Doebbler Sec. III-B describes.
 template <typename T>
-void PivotDisplacement(const T* p, const T& wheel_1_delta_rad, const T& wheel_2_delta_rad,
-                       const T& castor_heading_rad, T* dx_m, T* dy_m) {
+void PivotChord(const CastorMotion<T>& m, const T& mid_heading_rad, T* dx_m, T* dy_m) {
   using std::abs;
   using std::cos;
   using std::sin;
-  const CastorMotion<T> m = PivotMotionFromWheels(p, wheel_1_delta_rad, wheel_2_delta_rad);
   const T half = m.turn * 0.5;
   // sinc(half) by its series below 1e-4 rad (exact to 1e-17 there), by sin/x above.
   const T chord = abs(half) < T(1e-4) ? T(1.0) - half * half / 6.0 : sin(half) / half;
-  const T mid = castor_heading_rad + half;
-  const T c = cos(mid) * chord;
-  const T s = sin(mid) * chord;
+  const T c = cos(mid_heading_rad) * chord;
+  const T s = sin(mid_heading_rad) * chord;
   *dx_m = c * m.along - s * m.lateral;
   *dy_m = s * m.along + c * m.lateral;
+}
+
+// The pivot's world displacement over one interval, from the wheel angle increments and the
+// castor's absolute heading chi at the interval's start (mid heading chi + omega_c / 2).
+template <typename T>
+void PivotDisplacement(const T* p, const T& wheel_1_delta_rad, const T& wheel_2_delta_rad,
+                       const T& castor_heading_rad, T* dx_m, T* dy_m) {
+  const CastorMotion<T> m = PivotMotionFromWheels(p, wheel_1_delta_rad, wheel_2_delta_rad);
+  PivotChord(m, T(castor_heading_rad + m.turn * 0.5), dx_m, dy_m);
 }
 
 }  // namespace fitcal::asoc

@@ -23,6 +23,7 @@
 // prediction by more than tolerance_m + tolerance_fraction * (the step length).
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <stdexcept>
@@ -174,6 +175,41 @@ Pose2<T> ReplayCastFinalPose(const T* p, const std::array<PivotPosition, kNumCas
   return pose;
 }
 
+// The redundancy check (Doebbler Sec. III-B, end; header above): the castor whose displacement
+// (dx_i, dy_i) disagrees with the CAST prediction of the other two by more than
+// tolerance_m + tolerance_fraction * (the step length), or -1. psi: the heading the displacements
+// are expressed at (the body frame's, Eq. 13-14).
+inline int InconsistentCastor(const std::array<PivotPosition, kNumCastors>& pivots, double psi,
+                              const double* dx, const double* dy, double tolerance_m,
+                              double tolerance_fraction) {
+  int suspect = -1;
+  double best_pair_residual = 0.0;
+  double step_length = 0.0;
+  for (int i = 0; i < kNumCastors; ++i)
+    step_length = std::max(step_length, std::hypot(dx[i], dy[i]));
+  const double c = std::cos(psi), s = std::sin(psi);
+  for (int k = 0; k < kNumCastors; ++k) {
+    const int i = (k + 1) % kNumCastors, j = (k + 2) % kNumCastors;
+    // Change of the distance between pivots i and j: zero for a rigid body (first order).
+    const double ex = pivots[j].x_m() - pivots[i].x_m();
+    const double ey = pivots[j].y_m() - pivots[i].y_m();
+    const double wx = c * ex - s * ey, wy = s * ex + c * ey;
+    const double residual =
+        std::abs(((dx[j] - dx[i]) * wx + (dy[j] - dy[i]) * wy) / std::hypot(wx, wy));
+    if (suspect < 0 || residual < best_pair_residual) {
+      suspect = k;
+      best_pair_residual = residual;
+    }
+  }
+  const BodyStep<double> pair =
+      SolveCastGeneral(pivots, kAllCastors & ~(1u << suspect), psi, dx, dy);
+  const PivotPosition& q = pivots[suspect];
+  const double pred_x = pair.dx_m - pair.dpsi_rad * (q.y_m() * c + q.x_m() * s);  // Eq. 13
+  const double pred_y = pair.dy_m + pair.dpsi_rad * (q.x_m() * c - q.y_m() * s);  // Eq. 14
+  const double miss = std::hypot(dx[suspect] - pred_x, dy[suspect] - pred_y);
+  return miss > tolerance_m + tolerance_fraction * step_length ? suspect : -1;
+}
+
 enum class Method { kCast, kIpec };
 
 struct OdometryOptions {
@@ -265,35 +301,9 @@ class Odometry {
 
   // The castor the redundancy check would drop for these displacements, or -1.
   int InconsistentCastor(const double* dx, const double* dy) const {
-    int suspect = -1;
-    double best_pair_residual = 0.0;
-    double step_length = 0.0;
-    for (int i = 0; i < kNumCastors; ++i)
-      step_length = std::max(step_length, std::hypot(dx[i], dy[i]));
-    for (int k = 0; k < kNumCastors; ++k) {
-      const int i = (k + 1) % kNumCastors, j = (k + 2) % kNumCastors;
-      // Change of the distance between pivots i and j: zero for a rigid body (first order).
-      const double ex = vehicle_.pivots[j].x_m() - vehicle_.pivots[i].x_m();
-      const double ey = vehicle_.pivots[j].y_m() - vehicle_.pivots[i].y_m();
-      const double c = std::cos(pose_.theta), s = std::sin(pose_.theta);
-      const double wx = c * ex - s * ey, wy = s * ex + c * ey;
-      const double residual =
-          std::abs(((dx[j] - dx[i]) * wx + (dy[j] - dy[i]) * wy) / std::hypot(wx, wy));
-      if (suspect < 0 || residual < best_pair_residual) {
-        suspect = k;
-        best_pair_residual = residual;
-      }
-    }
-    const BodyStep<double> pair =
-        SolveCastGeneral(vehicle_.pivots, kAllCastors & ~(1u << suspect), pose_.theta, dx, dy);
-    const PivotPosition& q = vehicle_.pivots[suspect];
-    const double c = std::cos(pose_.theta), s = std::sin(pose_.theta);
-    const double pred_x = pair.dx_m - pair.dpsi_rad * (q.y_m() * c + q.x_m() * s);  // Eq. 13
-    const double pred_y = pair.dy_m + pair.dpsi_rad * (q.x_m() * c - q.y_m() * s);  // Eq. 14
-    const double miss = std::hypot(dx[suspect] - pred_x, dy[suspect] - pred_y);
-    const double tolerance =
-        options_.consistency_tolerance_m + options_.consistency_tolerance_fraction * step_length;
-    return miss > tolerance ? suspect : -1;
+    return asoc::InconsistentCastor(vehicle_.pivots, pose_.theta, dx, dy,
+                                    options_.consistency_tolerance_m,
+                                    options_.consistency_tolerance_fraction);
   }
 
  private:

@@ -1,0 +1,67 @@
+#include "models/asoc/asoc_kinematics.h"
+
+#include <cmath>
+
+namespace fitcal {
+
+std::string AsocOdometryOptions::Name() const {
+  return std::string(method == asoc::Method::kIpec ? "IPEC-" : "CAST-") +
+         std::to_string(excluded_castor);
+}
+
+bool AsocOdometryOptions::Parse(const std::string& name, AsocOdometryOptions* out) {
+  if (name.size() != 6 || name[4] != '-' || name[5] < '0' || name[5] > '3') return false;
+  const std::string kind = name.substr(0, 4);
+  if (kind != "CAST" && kind != "IPEC") return false;
+  out->method = kind == "IPEC" ? asoc::Method::kIpec : asoc::Method::kCast;
+  out->excluded_castor = name[5] - '0';
+  return true;
+}
+
+bool AsocOdometryOptions::IsValid(std::string* error) const {
+  if (excluded_castor < 0 || excluded_castor > asoc::kNumCastors) {
+    *error = "the castor left out must be 1, 2 or 3 (0: none)";
+    return false;
+  }
+  if (method == asoc::Method::kIpec && excluded_castor == 0) {
+    *error = "IPEC uses two castors: IPEC-1, IPEC-2 or IPEC-3";
+    return false;
+  }
+  if (redundancy_check && (method != asoc::Method::kCast || excluded_castor != 0)) {
+    *error = "the redundancy check needs all three castors (CAST-0)";
+    return false;
+  }
+  if (!(consistency_tolerance_m >= 0.0) || !(consistency_tolerance_fraction >= 0.0)) {
+    *error = "consistency tolerances must be >= 0";
+    return false;
+  }
+  return true;
+}
+
+bool AsocKinematics::ChannelsForTwist(const double* p, const Twist& twist, double* values) const {
+  for (int i = 0; i < asoc::kNumCastors; ++i) {
+    const asoc::CastorParameters c =
+        asoc::CastorParameters::FromArray(p + i * asoc::kParametersPerCastor);
+    double* v = values + i * asoc::kChannelsPerCastor;
+    // The pivot's body-frame velocity v + omega x p_i.
+    const double bx = twist.vx_m_s - twist.omega_rad_s * pivots[i].y_m();
+    const double by = twist.vy_m_s + twist.omega_rad_s * pivots[i].x_m();
+    const double speed = std::hypot(bx, by);
+    const double lateral = c.offset_m * twist.omega_rad_s;  // w = r_c chi_dot, chi_dot = omega
+    if (speed < 1e-12 && twist.omega_rad_s == 0.0) {        // at rest: the castor keeps theta = 0
+      v[asoc::kWheelAChannel] = v[asoc::kWheelBChannel] = 0.0;
+      v[asoc::kPivotChannel] = c.encoder_bias_rad;
+      continue;
+    }
+    if (!(std::abs(lateral) < speed)) return false;
+    const double along = std::sqrt(speed * speed - lateral * lateral);  // u > 0: trailing
+    const double theta = std::atan2(by, bx) - std::atan2(lateral, along);
+    const auto rates = asoc::WheelRatesFromPivotMotion(c, along, lateral);
+    v[asoc::kWheelAChannel] = rates[0];
+    v[asoc::kWheelBChannel] = rates[1];
+    v[asoc::kPivotChannel] = theta + c.encoder_bias_rad;  // gamma = theta + beta (Eq. 2)
+  }
+  return true;
+}
+
+}  // namespace fitcal
