@@ -75,13 +75,11 @@ TEST(VerdictTest, OneTrajectoryWorseWarnsAndNamesIt) {
   EXPECT_NE(r->message.find("68 -> 102 mm"), std::string::npos) << r->message;
   // A family whose CF gets worse is a regression too.
   in = GoodCase();
-  in.families[1].cf_after = 0.081;
+  in.families[1].cf_after = 0.085;  // +6 %
   EXPECT_EQ(JudgeCalibration(in).level, VerdictLevel::kWarn);
-  // With a measured repetition noise (sigma 5 mm per axis), a group of 5 runs must be worse by
-  // more than 2 sqrt(2) 5 mm / sqrt(5) = 6.3 mm: 3 mm is noise, 34 mm is not.
+  // Within kRegressionTolerance (5 %) is not a regression: 68 -> 71 mm (+4.4 %) is let through,
+  // 68 -> 102 mm is not.
   in = GoodCase();
-  in.noise_floor.available = true;
-  in.noise_floor.noise_sigma_m = 0.005;
   in.trajectories.push_back(Group("square_a", 0.09, 0.085, 0.068, 0.071));
   EXPECT_EQ(Find(JudgeCalibration(in), "regressions")->level, VerdictLevel::kPass);
   in.trajectories.push_back(Group("square_b", 0.09, 0.08, 0.068, 0.102));

@@ -11,8 +11,8 @@
 //   improvement      the held-out CF (Palacin Eq. 14) over all validation runs: not lower than the
 //                    nominal's -> FAIL (the calibration does not help on data it did not see).
 //   regressions      any trajectory group or single trajectory whose mean held-out CF or mean final
-//                    position error is larger with the calibration than with the nominal, by more
-//                    than two standard errors of the repetition noise when it is measured -> WARN.
+//                    position error is more than kRegressionTolerance (5 %) larger with the
+//                    calibration than with the nominal -> WARN.
 //   generalisation   held-out CF more than kGapFactor times the training CF the calibration
 //                    recorded -> WARN (it fits its training runs much better than new ones).
 //   noise floor      the systematic part of the final position errors (the mean per trajectory)
@@ -85,6 +85,8 @@ struct Verdict {
 // (expected ratio 1 + p / (3 N) for p parameters and N runs, ~1.05 for the flower); twice is far
 // outside that and still below the 3-8x seen when trained on one path type and used on another.
 constexpr double kGapFactor = 2.0;
+// A group is worse when its mean CF or final position error grows by more than this fraction.
+constexpr double kRegressionTolerance = 0.05;
 // Significance of the noise-floor F test (one false alarm in a thousand calibrations).
 constexpr double kNoiseFloorAlpha = 1e-3;
 
