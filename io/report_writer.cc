@@ -589,18 +589,21 @@ void HtmlParameters(std::ostringstream& h, const ReportData& d) {
 void HtmlEffects(std::ostringstream& h, const ReportData& d) {
   if (d.effects.empty()) return;
   h << "<h2 id=\"effects\">Effects</h2>\n<p>Effects the calibration carries beyond the model's "
-       "parameters (<code>fitcal diagnose</code>), with the one-sigma the YAML records. Held-out "
-       "CF (Eq. 14, all validation runs): nominal "
-    << Fmt("%.4f", d.summary.back().before.cf) << ", calibrated parameters alone "
-    << Fmt("%.4f", d.cf_parameters_only) << ", parameters + effects "
-    << Fmt("%.4f", d.summary.back().after.cf) << ".</p>\n";
+       "parameters (<code>fitcal diagnose</code>), with the one-sigma the YAML records, and the "
+       "held-out CF (Eq. 14, all validation runs) of the model with and without them.</p>\n";
+  OpenTable(h);
+  h << "<tr><th></th><th>nominal</th><th>calibrated parameters alone</th>"
+       "<th>parameters + effects</th></tr>\n<tr><td>held-out CF</td><td>"
+    << Fmt("%.4f", d.summary.back().before.cf) << "</td><td>" << Fmt("%.4f", d.cf_parameters_only)
+    << "</td><td>" << Fmt("%.4f", d.summary.back().after.cf) << "</td></tr>\n";
+  CloseTable(h);
   OpenTable(h);
   h << "<tr><th>effect</th><th>parameter</th><th>value</th><th>&plusmn;1 sigma</th></tr>\n";
   for (const ReportEffect& e : d.effects) {
     for (std::size_t k = 0; k < e.values.size(); ++k) {
-      h << "<tr><td>" << EscapeXml(e.name) << "</td><td>" << EscapeXml(e.parameter_names[k])
-        << "</td><td>" << Fmt("%.6g", e.values[k]) << "</td><td>" << Fmt("%.2g", e.sigmas[k])
-        << "</td></tr>\n";
+      h << "<tr><td>" << EscapeXml(e.name) << "</td><td class=\"k\">"
+        << EscapeXml(e.parameter_names[k]) << "</td><td>" << Fmt("%.6g", e.values[k]) << "</td><td>"
+        << Fmt("%.2g", e.sigmas[k]) << "</td></tr>\n";
     }
   }
   CloseTable(h);
@@ -871,9 +874,13 @@ void MdParameters(std::ostringstream& m, const ReportData& d) {
     m << MdRow(cells);
   }
   if (d.effects.empty()) return;
-  m << "\n## Effects\n\nHeld-out CF: nominal " << Fmt("%.4f", d.summary.back().before.cf)
-    << ", calibrated parameters alone " << Fmt("%.4f", d.cf_parameters_only)
-    << ", parameters + effects " << Fmt("%.4f", d.summary.back().after.cf) << ".\n\n";
+  m << "\n## Effects\n\n";
+  const std::vector<std::string> header_cf = {"", "nominal", "calibrated parameters alone",
+                                              "parameters + effects"};
+  m << MdRow(header_cf) << MdRule(header_cf.size(), 1)
+    << MdRow({"held-out CF", Fmt("%.4f", d.summary.back().before.cf),
+              Fmt("%.4f", d.cf_parameters_only), Fmt("%.4f", d.summary.back().after.cf)})
+    << "\n";
   const std::vector<std::string> header_e = {"effect", "parameter", "value", "+-1 sigma"};
   m << MdRow(header_e) << MdRule(header_e.size(), 2);
   for (const ReportEffect& e : d.effects) {
