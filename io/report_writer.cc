@@ -669,8 +669,9 @@ void HtmlPerRun(std::ostringstream& h, const ReportData& d) {
 void HtmlComparison(std::ostringstream& h, const ReportData& d) {
   if (d.comparison.empty()) return;
   h << "<h2 id=\"comparison\">Calibrations compared</h2>\n<p>Every calibration on the same "
-       "validation runs (those none of them trained on); the rest of the page reports the first."
-       "</p>\n";
+       "validation runs (those none of them trained on); the rest of the page reports the first. "
+       "Below, the held-out CF per trajectory of calibration #1, #2, ... in the order above, the "
+       "lowest in bold.</p>\n";
   OpenTable(h);
   h << "<tr><th>calibration</th><th>verdict</th><th>training</th><th>held-out CF</th>"
        "<th>final position error [mm]</th><th>final |heading error| [deg]</th>"
@@ -681,7 +682,7 @@ void HtmlComparison(std::ostringstream& h, const ReportData& d) {
     << Fmt("%.2f", d.comparison[0].drift.before_translation_percent) << "</td></tr>\n";
   for (const ReportComparisonRow& c : d.comparison) {
     h << "<tr><td><code>" << EscapeXml(c.calibration) << "</code></td><td class=\""
-      << EscapeXml(c.verdict) << "\">" << EscapeXml(c.verdict) << "</td><td>"
+      << EscapeXml(c.verdict) << "\">" << EscapeXml(c.verdict) << "</td><td class=\"k\">"
       << EscapeXml(c.training_source) << "</td><td>" << Fmt("%.4f", c.all.after.cf) << "</td><td>"
       << Fmt("%.1f", 1e3 * c.all.after.final_distance_m) << "</td><td>"
       << Fmt("%.3f", kDeg * c.all.after.final_angle_rad) << "</td><td>"

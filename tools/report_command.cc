@@ -409,8 +409,9 @@ void AddModelIdentifiability(const ReportInputs& in, const CalibrationInput& cal
     data->identifiability_lines.push_back("not determined by the training runs: " + u.description);
   }
   if (!d.ok) data->identifiability_lines.push_back("no Jacobian at the calibrated parameters");
-  data->uncertainty_note = "Parameter sigmas: see the output of `fitcal fit` for a " +
-                           in.model->robot().model + " robot (this report does not refit).";
+  data->uncertainty_note = "No parameter sigma here: this report does not refit a " +
+                           in.model->robot().model +
+                           " robot; fitcal fit prints the fit's and records them in the YAML.";
 }
 
 // Uncertainty and identifiability from the training runs, only when they are in this data set.
