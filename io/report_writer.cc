@@ -614,9 +614,12 @@ void HtmlIdentifiability(std::ostringstream& h, const ReportData& d) {
   if (!d.identifiability_checked) {
     h << "<p>Not analysed: the calibration's training runs are not in this data set.</p>\n";
   } else if (d.identifiable) {
-    h << "<p class=\"ok\">The training runs determine every parameter (condition number "
-      << Fmt("%.3g", d.condition_number)
-      << " in relative units; no parameter pair correlated beyond 0.99).</p>\n";
+    h << "<p class=\"ok\">The training runs determine every parameter"
+      << (d.condition_number > 0.0 ? " (condition number " + Fmt("%.3g", d.condition_number) +
+                                         " in relative units; no parameter pair correlated "
+                                         "beyond 0.99)"
+                                   : "")
+      << ".</p>\n";
   } else {
     h << "<div class=\"warn\">";
     for (const std::string& line : d.identifiability_lines) h << EscapeXml(line) << "\n";
@@ -931,8 +934,10 @@ std::string ReportMarkdown(const ReportData& d) {
   if (!d.identifiability_checked) {
     m << "Not analysed: the calibration's training runs are not in this data set.\n";
   } else if (d.identifiable) {
-    m << "The training runs determine every parameter (condition number "
-      << Fmt("%.3g", d.condition_number) << ").\n";
+    m << "The training runs determine every parameter"
+      << (d.condition_number > 0.0 ? " (condition number " + Fmt("%.3g", d.condition_number) + ")"
+                                   : "")
+      << ".\n";
   } else {
     m << "```\n";
     for (const std::string& line : d.identifiability_lines) m << line << "\n";
