@@ -12,8 +12,15 @@ void EmitRuns(YAML::Emitter& out, const CalibrationBlock& c) {
       << c.validation_repetitions;
   out << YAML::Key << "training_runs" << YAML::Value << c.training_runs;
   out << YAML::Key << "validation_runs" << YAML::Value << c.validation_runs;
+  if (!c.training_trajectories.empty()) {
+    out << YAML::Key << "training_trajectories" << YAML::Value << c.training_trajectories;
+  }
   if (!c.training_run_ids.empty()) {
     out << YAML::Key << "training_run_ids" << YAML::Value << YAML::Flow << c.training_run_ids;
+  }
+  if (!c.training_fingerprint.empty()) {
+    out << YAML::Key << "training_fingerprint" << YAML::Value << YAML::DoubleQuoted
+        << c.training_fingerprint;
   }
   const auto before_after = [&](const char* key, double before, double after) {
     out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "before"

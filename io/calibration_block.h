@@ -23,6 +23,8 @@ struct CalibrationBlock {
   std::vector<int> training_repetitions;
   std::vector<int> validation_repetitions;
   std::vector<std::string> training_run_ids;
+  std::string training_trajectories;  // the --train-trajectories selector, when split so
+  std::string training_fingerprint;   // of the training runs' encoder logs (training_runs.h)
   int training_runs = 0;
   int validation_runs = 0;
   double cf_training_before = 0.0;

@@ -1,6 +1,7 @@
 #pragma once
-// Reads back what `fitcal fit` recorded in the `calibration:` block of a calibrated robot YAML
-// (io/robot_yaml.h writes it). Only what the report needs: which repetitions trained the fit.
+// Reads back what `fitcal fit` and `fitcal diagnose` recorded in the `calibration:` block of a
+// calibrated robot YAML (io/robot_yaml.h, io/calibration_block.h write it): what the report needs
+// to know which runs trained the calibration and how the solver ended.
 
 #include <optional>
 #include <string>
@@ -11,5 +12,23 @@ namespace fitcal::io {
 // The recorded training repetitions, or nullopt when the file has no calibration block (a plain
 // robot YAML). Throws InputError (file, line) when the block is present but malformed.
 std::optional<std::vector<int>> ReadCalibrationTrainingRepetitions(const std::string& path);
+
+// What trained a calibration and how it ended. Keys a file written by an older fitcal lacks stay
+// empty (training_run_ids, training_trajectories, training_fingerprint, at_bound).
+struct CalibrationProvenance {
+  std::string method;
+  std::string dataset;      // the --logs the fit was given, as typed
+  std::string termination;  // solver termination ("CONVERGENCE", "NO_CONVERGENCE", ...)
+  std::vector<int> training_repetitions;
+  std::vector<std::string> training_run_ids;
+  std::string training_trajectories;  // the --train-trajectories selector; empty by repetition
+  std::string training_fingerprint;   // validation/training_runs.h, TrainingFingerprint
+  std::vector<std::string> at_bound;  // parameter names resting on a bound
+  bool has_training_cf = false;
+  double cf_training_before = 0.0, cf_training_after = 0.0;
+};
+
+// nullopt for a plain robot YAML; InputError (file, line) for a malformed block.
+std::optional<CalibrationProvenance> ReadCalibrationProvenance(const std::string& path);
 
 }  // namespace fitcal::io

@@ -1,5 +1,6 @@
 #include "io/report_writer.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -123,6 +124,99 @@ SvgSeries Series(const std::string& name, const std::string& colour) {
 
 double ParamScale(const ReportParameter& p) { return p.is_angle ? kDeg : 1.0; }
 
+// At most `most` points of a polyline for drawing, evenly strided, first and last kept: a run
+// logged at 100 Hz has far more points than a 600-pixel figure can show, and the real-data report
+// must stay small (README: under 2 MB for the OptiOdom omni3 set).
+std::vector<Point2> Thinned(const std::vector<Point2>& line, std::size_t most) {
+  if (line.size() <= most || most < 2) return line;
+  std::vector<Point2> out;
+  out.reserve(most);
+  const double step = static_cast<double>(line.size() - 1) / static_cast<double>(most - 1);
+  for (std::size_t i = 0; i < most; ++i) {
+    out.push_back(line[static_cast<std::size_t>(std::lround(step * static_cast<double>(i)))]);
+  }
+  return out;
+}
+
+// Points per polyline of the figure of every run: ~60,000 points in all (~1 MB of SVG), at
+// least 40 per run so that a circle still looks round.
+std::size_t PointsPerRun(std::size_t runs, std::size_t lines_per_run) {
+  const std::size_t total = 60000;
+  return std::max<std::size_t>(
+      40, std::min<std::size_t>(400, total / std::max<std::size_t>(1, runs * lines_per_run)));
+}
+
+// The runs the error-along-time figures show: largest calibrated CF first.
+std::vector<std::size_t> WorstRuns(const ReportData& data) {
+  std::vector<std::size_t> order(data.runs.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return data.runs[a].after.cf > data.runs[b].after.cf;
+  });
+  order.resize(std::min<std::size_t>(order.size(), std::max(0, data.worst_runs_drawn)));
+  return order;
+}
+
+std::string ErrorAlongTimeSvgs(const ReportRun& r, std::size_t k) {
+  SvgSeries bd = Series(kBeforeName, kBeforeColour), ad = Series(kAfterName, kAfterColour);
+  SvgSeries ba = bd, aa = ad;
+  std::vector<Point2> lines[4];
+  for (std::size_t i = 0; i < r.t_s.size(); ++i) {
+    lines[0].push_back({r.t_s[i], 1e3 * r.before_distance_m[i]});
+    lines[1].push_back({r.t_s[i], 1e3 * r.after_distance_m[i]});
+    lines[2].push_back({r.t_s[i], kDeg * r.before_angle_rad[i]});
+    lines[3].push_back({r.t_s[i], kDeg * r.after_angle_rad[i]});
+  }
+  SvgSeries* series[4] = {&bd, &ad, &ba, &aa};
+  for (int i = 0; i < 4; ++i) {
+    series[i]->lines.push_back(Thinned(lines[i], 400));
+    series[i]->draw_markers = r.t_s.size() <= 60;  // markers only where they can be told apart
+  }
+  XYPlotOptions o;
+  o.width = 520;
+  o.height = 360;
+  o.include_origin = true;
+  o.id = "run" + std::to_string(k) + "-distance";
+  o.title = r.id + ": distance error (Eq. 8)";
+  o.x_label = "time since start [s]";
+  o.y_label = "distance error [mm]";
+  std::string both = XYPlotSvg(o, {bd, ad});
+  o.id = "run" + std::to_string(k) + "-heading";
+  o.title = r.id + ": heading error (Eq. 9)";
+  o.y_label = "|heading error| [deg]";
+  return both + XYPlotSvg(o, {ba, aa});
+}
+
+// Histogram of the final position errors, nominal and calibrated, in bins of the noise floor's
+// size when it is measured (so that "at the noise floor" is the first bins).
+std::string ResidualHistogramSvg(const ReportData& data) {
+  double largest = 0.0;
+  for (const ReportRun& r : data.runs) {
+    largest = std::max({largest, r.before.final_distance_m, r.after.final_distance_m});
+  }
+  if (data.runs.empty() || !(largest > 0.0)) return "";
+  const int bins = 12;
+  const double width_m = largest / bins * (1.0 + 1e-9);
+  BarSeries before{"nominal parameters", kBeforeColour, std::vector<double>(bins, 0.0)};
+  BarSeries after{"calibrated parameters", kAfterColour, std::vector<double>(bins, 0.0)};
+  for (const ReportRun& r : data.runs) {
+    before.values[std::min(bins - 1, static_cast<int>(r.before.final_distance_m / width_m))] += 1;
+    after.values[std::min(bins - 1, static_cast<int>(r.after.final_distance_m / width_m))] += 1;
+  }
+  std::vector<std::string> categories;
+  for (int b = 0; b < bins; ++b) categories.push_back(Fmt("%.0f", 1e3 * width_m * (b + 1)));
+  BarChartOptions o;
+  o.title = "Final position error of the validation runs";
+  o.x_label = "final position error up to [mm]";
+  if (data.noise_floor.available) {
+    o.x_label += " (noise of one run: " +
+                 Fmt("%.1f mm", 1e3 * std::sqrt(2.0) * data.noise_floor.noise_sigma_m) + ")";
+  }
+  o.y_label = "runs";
+  o.width = 760;
+  return BarChartSvg(o, categories, {before, after});
+}
+
 }  // namespace
 
 ReportFigures MakeReportFigures(const ReportData& data) {
@@ -136,14 +230,15 @@ ReportFigures MakeReportFigures(const ReportData& data) {
     before.line_width = after.line_width = 1.2;
     before.opacity = 0.8;
     before.dash = "5 3";
+    const std::size_t most = PointsPerRun(data.runs.size(), 3);
     for (const ReportRun& r : data.runs) {
-      gt.lines.push_back(r.ground_truth_xy);
-      before.lines.push_back(r.before_xy);
-      after.lines.push_back(r.after_xy);
+      gt.lines.push_back(Thinned(r.ground_truth_xy, most));
+      before.lines.push_back(Thinned(r.before_xy, most));
+      after.lines.push_back(Thinned(r.after_xy, most));
     }
     XYPlotOptions o;
     o.id = "flower";
-    o.title = "Validation runs in their start frame (the flower)";
+    o.title = "Validation runs in their start frame";
     o.x_label = "x in the start frame [m] (robot heading at start = +x)";
     o.y_label = "y in the start frame [m]";
     o.width = 600;
@@ -205,7 +300,7 @@ ReportFigures MakeReportFigures(const ReportData& data) {
     }
     BarChartOptions o;
     o.title = "Final position error per trajectory (mean over validation repetitions)";
-    o.x_label = "trajectory (R straight, G counter-clockwise, B clockwise)";
+    o.x_label = "trajectory";
     o.y_label = "final position error [mm]";
     f.final_distance_bars = BarChartSvg(o, order, {bd, ad});
     o.title = "Final heading error per trajectory (mean over validation repetitions)";
@@ -218,130 +313,230 @@ ReportFigures MakeReportFigures(const ReportData& data) {
     f.correlation = HeatMapSvg("Correlation of the fitted parameters (-1 blue, +1 red)", labels,
                                data.correlation);
   }
-  for (const ReportRun& r : data.runs) {
-    SvgSeries bd = Series(kBeforeName, kBeforeColour), ad = Series(kAfterName, kAfterColour);
-    SvgSeries ba = bd, aa = ad;
-    bd.lines.emplace_back();
-    ad.lines.emplace_back();
-    ba.lines.emplace_back();
-    aa.lines.emplace_back();
-    for (SvgSeries* s : {&bd, &ad, &ba, &aa}) s->draw_markers = true;
-    for (std::size_t i = 0; i < r.t_s.size(); ++i) {
-      bd.lines[0].push_back({r.t_s[i], 1e3 * r.before_distance_m[i]});
-      ad.lines[0].push_back({r.t_s[i], 1e3 * r.after_distance_m[i]});
-      ba.lines[0].push_back({r.t_s[i], kDeg * r.before_angle_rad[i]});
-      aa.lines[0].push_back({r.t_s[i], kDeg * r.after_angle_rad[i]});
-    }
-    XYPlotOptions o;
-    o.width = 520;
-    o.height = 360;
-    o.include_origin = true;
-    o.id = "run" + std::to_string(f.error_along_time.size()) + "-distance";
-    o.title = r.id + ": distance error (Eq. 8)";
-    o.x_label = "time since start [s]";
-    o.y_label = "distance error [mm]";
-    std::string both = XYPlotSvg(o, {bd, ad});
-    o.id = "run" + std::to_string(f.error_along_time.size()) + "-heading";
-    o.title = r.id + ": heading error (Eq. 9)";
-    o.y_label = "|heading error| [deg]";
-    both += XYPlotSvg(o, {ba, aa});
-    f.error_along_time.push_back(both);
+  for (std::size_t k : WorstRuns(data)) {
+    f.error_along_time.push_back(ErrorAlongTimeSvgs(data.runs[k], k));
+    f.error_along_time_runs.push_back(k);
   }
+  f.residual_histogram = ResidualHistogramSvg(data);
   return f;
 }
 
-std::string ReportHtml(const ReportData& d) {
-  const ReportFigures f = MakeReportFigures(d);
-  std::ostringstream h;
-  h << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
-    << "<title>fitcal validation report</title>\n<style>\n"
-    << "body{font-family:sans-serif;margin:24px;max-width:1300px;color:#222}\n"
-    << "table{border-collapse:collapse;margin:8px 0 16px}\n"
-    << "th,td{border:1px solid #bbb;padding:3px 8px;text-align:right}\n"
-    << "th:first-child,td:first-child{text-align:left}\n"
-    << "th{background:#f0f0f0}\n"
-    << ".warn{background:#fff3cd;border:1px solid #e0b000;padding:8px 12px;white-space:pre-wrap;"
-       "font-family:monospace}\n"
-    << ".ok{background:#e6f4ea;border:1px solid #5a5;padding:8px 12px}\n"
-    << ".figs{display:flex;flex-wrap:wrap;gap:12px}\n"
-    << "figure{margin:0 0 12px}figcaption{font-size:13px;color:#555;max-width:640px}\n"
-    << ".better{color:#060}.worse{color:#a00}\n"
-    << "</style>\n</head>\n<body>\n";
-  h << "<h1>fitcal validation report</h1>\n<p>Robot <b>" << EscapeXml(d.robot_name)
-    << "</b>, data set <code>" << EscapeXml(d.dataset) << "</code>, calibration <code>"
-    << EscapeXml(d.calibration) << "</code>, fitcal " << EscapeXml(d.tool_version) << ".<br>"
+namespace {
+
+const char* const kStyle =
+    "*{box-sizing:border-box}\n"
+    "body{font-family:sans-serif;margin:0 auto;padding:16px;max-width:1300px;color:#222;"
+    "line-height:1.4}\n"
+    "svg{max-width:100%;height:auto}\n"
+    "figure.wide{overflow-x:auto}figure.wide svg{min-width:640px}\n"
+    ".scroll{overflow-x:auto;max-width:100%}\n"
+    "table{border-collapse:collapse;margin:8px 0 16px}\n"
+    "th,td{border:1px solid #bbb;padding:3px 8px;text-align:right}\n"
+    "th:first-child,td:first-child,td.k{text-align:left}\n"
+    "th{background:#f0f0f0}\n"
+    "code{overflow-wrap:anywhere}\n"
+    ".warn{background:#fff3cd;border:1px solid #e0b000;padding:8px 12px;white-space:pre-wrap;"
+    "font-family:monospace;overflow-x:auto}\n"
+    ".ok{background:#e6f4ea;border:1px solid #5a5;padding:8px 12px}\n"
+    ".banner{padding:10px 16px;border:2px solid;margin:12px 0 20px}\n"
+    ".banner h2{margin:0 0 6px}\n"
+    ".PASS{background:#e6f4ea;border-color:#2a7a2a}\n"
+    ".WARN{background:#fff3cd;border-color:#b08000}\n"
+    ".FAIL{background:#fde2e1;border-color:#b00020}\n"
+    ".banner li.PASS,.banner li.WARN,.banner li.FAIL{background:none;border:none}\n"
+    ".figs{display:flex;flex-wrap:wrap;gap:12px}\n"
+    "figure{margin:0 0 12px;max-width:100%}figcaption{font-size:13px;color:#555;"
+    "max-width:640px}\n"
+    ".better{color:#060}.worse{color:#a00;font-weight:bold}\n";
+
+// A table inside a horizontally scrolling box: wide tables scroll on a phone instead of pushing
+// the page wider than the screen.
+void OpenTable(std::ostringstream& h, const std::string& id = "") {
+  h << "<div class=\"scroll\"" << (id.empty() ? "" : " id=\"" + id + "\"") << ">\n<table>\n";
+}
+void CloseTable(std::ostringstream& h) { h << "</table>\n</div>\n"; }
+
+void HtmlVerdict(std::ostringstream& h, const ReportData& d) {
+  h << "<div class=\"banner " << EscapeXml(d.verdict)
+    << "\" id=\"verdict\">\n<h2>Verdict: " << EscapeXml(d.verdict) << "</h2>\n<ul>\n";
+  for (const ReportVerdictReason& r : d.verdict_reasons) {
+    h << "<li class=\"" << EscapeXml(r.level) << "\"><b>" << EscapeXml(r.level) << "</b> "
+      << EscapeXml(r.check) << ": " << EscapeXml(r.message) << " (<a href=\"#"
+      << EscapeXml(r.section) << "\">" << EscapeXml(r.section) << "</a>)</li>\n";
+  }
+  h << "</ul>\n</div>\n";
+}
+
+void HtmlHeader(std::ostringstream& h, const ReportData& d) {
+  h << "<p>Robot <b>" << EscapeXml(d.robot_name) << "</b>, data set <code>" << EscapeXml(d.dataset)
+    << "</code>, calibration <code>" << EscapeXml(d.calibration) << "</code>, fitcal "
+    << EscapeXml(d.tool_version) << ".<br>"
     << "Validation: " << d.runs.size() << " runs (repetitions "
     << EscapeXml(d.validation_repetitions)
-    << ") that the fit did not use; training: " << d.training_runs << " runs (repetitions "
-    << EscapeXml(d.training_repetitions) << ").<br>"
+    << ") that the calibration did not train on; training: " << EscapeXml(d.training_source)
+    << ".<br>"
     << "Odometry sub-sampled at the ground-truth times by <b>" << EscapeXml(d.sampling)
     << "</b> time" << (d.sampling == "nearest" ? " (as Palacin et al. 2022)" : " interpolation")
-    << ". Before = nominal parameters, after = calibrated parameters";
-  if (!d.calibrated_effects.empty()) {
-    h << " with the effects";
-    for (std::size_t i = 0; i < d.calibrated_effects.size(); ++i)
-      h << (i ? "; " : " ") << "<code>" << EscapeXml(d.calibrated_effects[i]) << "</code>";
-  }
-  h << ".</p>\n";
+    << ". Before = nominal parameters, after = calibrated parameters"
+    << (d.effects.empty() ? "" : " with the calibration's effects (see Effects)") << ".</p>\n";
+}
 
-  h << "<h2>Summary (Palacin Table 6)</h2>\n<p>Averages over the validation runs; improvement = "
-       "100 (before &minus; after) / before, positive is better.</p>\n<table>\n<tr><th>group</th>"
-       "<th>runs</th><th></th>";
+void HtmlSummaryRows(std::ostringstream& h, const ReportSummaryRow& row) {
+  for (int part = 0; part < 3; ++part) {
+    h << "<tr>";
+    if (part == 0) {
+      h << "<td rowspan=\"3\"><b>" << EscapeXml(row.group) << "</b></td><td rowspan=\"3\">"
+        << row.runs << "</td>";
+    }
+    h << "<td class=\"k\">"
+      << (part == 0   ? "before"
+          : part == 1 ? "after"
+                      : "improvement")
+      << "</td>";
+    for (const Column& c : kColumns) {
+      const double b = ValueOf(c, row.before), a = ValueOf(c, row.after);
+      if (part == 2) {
+        const double imp = Improvement(b, a);
+        h << "<td class=\"" << (imp >= 0 ? "better" : "worse") << "\">" << Fmt("%+.1f %%", imp)
+          << "</td>";
+      } else {
+        h << "<td>" << Fmt(FormatOf(c), part == 0 ? b : a) << "</td>";
+      }
+    }
+    h << "</tr>\n";
+  }
+}
+
+void HtmlSummary(std::ostringstream& h, const ReportData& d) {
+  h << "<h2 id=\"summary\">Summary (Palacin Table 6)</h2>\n<p>Averages over the validation runs; "
+       "improvement = 100 (before &minus; after) / before, positive is better.</p>\n";
+  OpenTable(h);
+  h << "<tr><th>group</th><th>runs</th><th></th>";
   for (const Column& c : kColumns) h << "<th>" << EscapeXml(c.label) << "</th>";
   h << "</tr>\n";
-  for (const ReportSummaryRow& row : d.summary) {
-    for (int part = 0; part < 3; ++part) {
-      h << "<tr>";
-      if (part == 0) {
-        h << "<td rowspan=\"3\"><b>" << EscapeXml(row.group) << "</b></td><td rowspan=\"3\">"
-          << row.runs << "</td>";
-      }
-      h << "<td>" << (part == 0 ? "before" : part == 1 ? "after" : "improvement") << "</td>";
-      for (const Column& c : kColumns) {
-        const double b = ValueOf(c, row.before), a = ValueOf(c, row.after);
-        if (part == 2) {
-          const double imp = Improvement(b, a);
-          h << "<td class=\"" << (imp >= 0 ? "better" : "worse") << "\">" << Fmt("%+.1f %%", imp)
-            << "</td>";
-        } else {
-          h << "<td>" << Fmt(FormatOf(c), part == 0 ? b : a) << "</td>";
-        }
-      }
-      h << "</tr>\n";
-    }
-  }
-  h << "</table>\n";
+  for (const ReportSummaryRow& row : d.summary) HtmlSummaryRows(h, row);
+  CloseTable(h);
+}
 
-  h << "<h2>Trajectories</h2>\n<div class=\"figs\">\n<figure>" << f.flower
+// One row per trajectory: where a calibration that helps overall makes one path worse.
+void HtmlTrajectoryGroups(std::ostringstream& h, const ReportData& d) {
+  h << "<h2 id=\"groups\">Per trajectory</h2>\n<p>Mean over each trajectory's validation runs; "
+       "a red value is worse with the calibration than with the nominal.</p>\n";
+  OpenTable(h);
+  h << "<tr><th>trajectory</th><th>runs</th><th>CF before</th><th>CF after</th>"
+       "<th>final position error before [mm]</th><th>after [mm]</th>"
+       "<th>final |heading error| before [deg]</th><th>after [deg]</th></tr>\n";
+  for (const ReportSummaryRow& row : d.trajectories) {
+    const auto cell = [&](double before, double after, const char* format, double scale) {
+      h << "<td>" << Fmt(format, before * scale) << "</td><td"
+        << (after > before ? " class=\"worse\"" : "") << ">" << Fmt(format, after * scale)
+        << "</td>";
+    };
+    h << "<tr><td>" << EscapeXml(row.group) << "</td><td>" << row.runs << "</td>";
+    cell(row.before.cf, row.after.cf, "%.4f", 1.0);
+    cell(row.before.final_distance_m, row.after.final_distance_m, "%.1f", 1e3);
+    cell(row.before.final_angle_rad, row.after.final_angle_rad, "%.3f", kDeg);
+    h << "</tr>\n";
+  }
+  CloseTable(h);
+}
+
+// Mean signed final error (bias) in the start frame: what a constant offset of the odometry
+// looks like, which the absolute errors hide.
+struct Bias {
+  double x_m = 0.0, y_m = 0.0, heading_rad = 0.0;
+};
+Bias MeanFinalError(const ReportData& d, bool after) {
+  Bias b;
+  for (const ReportRun& r : d.runs) {
+    const Point2& e = after ? r.after_final_error : r.before_final_error;
+    b.x_m += e.x;
+    b.y_m += e.y;
+    b.heading_rad += after ? r.after_final_heading_rad : r.before_final_heading_rad;
+  }
+  const double n = std::max<double>(1.0, static_cast<double>(d.runs.size()));
+  return {b.x_m / n, b.y_m / n, b.heading_rad / n};
+}
+
+void HtmlDrift(std::ostringstream& h, const ReportData& d) {
+  h << "<h2 id=\"drift\">Drift per distance and bias</h2>\n<p>Relative pose error over windows of "
+       "the given ground-truth path length (KITTI's odometry metric; evo_rpe with a delta in "
+       "metres): translation error in % of the distance, rotation error in deg per metre, mean "
+       "over every window of every validation run.</p>\n";
+  OpenTable(h);
+  h << "<tr><th>path length [m]</th><th>windows</th><th>translation before [%]</th>"
+       "<th>after [%]</th><th>rotation before [deg/m]</th><th>after [deg/m]</th></tr>\n";
+  for (const ReportDriftRow& r : d.drift) {
+    h << "<tr><td>" << Fmt("%g", r.length_m) << "</td><td>" << r.windows << "</td><td>"
+      << Fmt("%.2f", r.before_translation_percent) << "</td><td>"
+      << Fmt("%.2f", r.after_translation_percent) << "</td><td>"
+      << Fmt("%.3f", kDeg * r.before_rotation_rad_per_m) << "</td><td>"
+      << Fmt("%.3f", kDeg * r.after_rotation_rad_per_m) << "</td></tr>\n";
+  }
+  CloseTable(h);
+  h << "<p>Signed mean final error (bias) over the validation runs, in each run's start "
+       "frame:</p>\n";
+  OpenTable(h);
+  h << "<tr><th></th><th>x [mm]</th><th>y [mm]</th><th>heading [deg]</th></tr>\n";
+  for (bool after : {false, true}) {
+    const Bias b = MeanFinalError(d, after);
+    h << "<tr><td>" << (after ? "after" : "before") << "</td><td>" << Fmt("%+.1f", 1e3 * b.x_m)
+      << "</td><td>" << Fmt("%+.1f", 1e3 * b.y_m) << "</td><td>"
+      << Fmt("%+.3f", kDeg * b.heading_rad) << "</td></tr>\n";
+  }
+  CloseTable(h);
+}
+
+void HtmlFigures(std::ostringstream& h, const ReportData& d, const ReportFigures& f) {
+  h << "<h2 id=\"trajectories\">Trajectories</h2>\n<div class=\"figs\">\n<figure>" << f.flower
     << "<figcaption>Each validation run drawn from its own start pose (origin, heading +x). "
        "Grey: ground truth; dashed vermillion: odometry with the nominal parameters; blue: "
-       "odometry with the calibrated parameters. Compare Palacin Fig. 9-10.</figcaption>"
+       "odometry with the calibrated parameters (compare Palacin Fig. 9-10).</figcaption>"
        "</figure>\n<figure>"
     << f.end_points
     << "<figcaption>The end of every validation run, magnified: where the odometry ended "
        "relative to the ground truth (origin). A tight blue cluster at the origin is a good "
        "calibration.</figcaption></figure>\n</div>\n";
-  h << "<h2>Final error per trajectory</h2>\n<figure>" << f.final_distance_bars
-    << "</figure>\n<figure>" << f.final_angle_bars << "</figure>\n";
-
-  h << "<h2 id=\"errors\">Error along time</h2>\n<p>Run: <select id=\"runsel\" "
-       "onchange=\"showRun(this.value)\">\n";
-  for (std::size_t i = 0; i < d.runs.size(); ++i) {
-    h << "<option value=\"run" << i << "\">" << EscapeXml(d.runs[i].id) << "</option>\n";
+  // The bar charts are wide: on a phone they keep readable labels and scroll sideways instead of
+  // shrinking to a third.
+  h << "<h2>Final error per trajectory</h2>\n<figure class=\"wide\">" << f.final_distance_bars
+    << "</figure>\n<figure class=\"wide\">" << f.final_angle_bars << "</figure>\n";
+  h << "<h2 id=\"errors\">Error along time: the " << f.error_along_time.size() << " worst of "
+    << d.runs.size()
+    << " runs</h2>\n<p>The validation runs with the largest calibrated CF (Eq. 14), worst first: "
+       "the odometry at each ground-truth time (Eq. 8 and 9). Every run is in the per-run table "
+       "and in metrics.csv.</p>\n";
+  for (const std::string& svgs : f.error_along_time) {
+    h << "<div class=\"figs\">\n" << svgs << "</div>\n";
   }
-  h << "</select> (the odometry at each ground-truth time; Eq. 8 and 9)</p>\n";
-  for (std::size_t i = 0; i < d.runs.size(); ++i) {
-    h << "<div class=\"run figs\" id=\"run" << i << "\""
-      << (i == 0 ? "" : " style=\"display:none\"") << ">\n"
-      << f.error_along_time[i] << "</div>\n";
-  }
-  h << "<script>\nfunction showRun(id){document.querySelectorAll('div.run').forEach("
-       "function(d){d.style.display=(d.id===id)?'flex':'none';});}\n</script>\n";
+}
 
-  h << "<h2 id=\"statistics\">Statistics over validation runs (named as "
-       "evo)</h2>\n<table>\n<tr><th>metric</th>"
-       "<th></th><th>rmse</th><th>mean</th><th>median</th><th>std</th><th>min</th><th>max</th>"
-       "</tr>\n";
+void HtmlResiduals(std::ostringstream& h, const ReportData& d, const ReportFigures& f) {
+  h << "<h2 id=\"residuals\">Residual against the noise floor</h2>\n<p>";
+  const ReportNoiseFloor& n = d.noise_floor;
+  if (n.available) {
+    h << "Noise floor: the scatter of the calibrated final position errors between repetitions "
+         "of one trajectory, "
+      << Fmt("%.1f mm", 1e3 * n.noise_sigma_m)
+      << " per axis. Systematic part (each run's trajectory mean): "
+      << Fmt("%.1f mm", 1e3 * n.systematic_rms_m) << " RMS; F = " << Fmt("%.2f", n.f_statistic)
+      << ", p = " << Fmt("%.2g", n.p_value)
+      << ". A significant systematic part larger than the noise means the model lacks an effect "
+         "(<code>fitcal diagnose</code>).";
+  } else {
+    h << "No trajectory has two validation runs: the repetition noise is not measured.";
+  }
+  h << "</p>\n";
+  if (!f.residual_histogram.empty()) {
+    h << "<figure class=\"wide\">" << f.residual_histogram << "</figure>\n";
+  }
+}
+
+void HtmlStatistics(std::ostringstream& h, const ReportData& d) {
+  h << "<h2 id=\"statistics\">Statistics over validation runs (named as evo)</h2>\n";
+  OpenTable(h);
+  h << "<tr><th>metric</th><th></th><th>rmse</th><th>mean</th><th>median</th><th>std</th>"
+       "<th>min</th><th>max</th></tr>\n";
   for (const ReportStatisticsRow& s : d.statistics) {
     const double scale = s.is_angle ? kDeg : 1.0;
     const char* fmt = s.is_angle ? "%.3f" : "%.4f";
@@ -351,19 +546,27 @@ std::string ReportHtml(const ReportData& d) {
       if (part == 0) {
         h << "<td rowspan=\"2\">" << EscapeXml(s.metric) << (s.is_angle ? " [deg]" : "") << "</td>";
       }
-      h << "<td>" << (part == 0 ? "before" : "after") << "</td>";
+      h << "<td class=\"k\">" << (part == 0 ? "before" : "after") << "</td>";
       for (double x : {v.rmse, v.mean, v.median, v.std, v.min, v.max}) {
         h << "<td>" << Fmt(fmt, x * scale) << "</td>";
       }
       h << "</tr>\n";
     }
   }
-  h << "</table>\n";
+  CloseTable(h);
+}
 
-  h << "<h2 id=\"parameters\">Parameters</h2>\n<p>" << EscapeXml(d.uncertainty_note)
-    << "</p>\n<table>\n"
-    << "<tr><th>parameter</th><th>unit</th><th>nominal</th><th>calibrated</th>"
-       "<th>&plusmn;1 sigma</th><th>change</th>"
+// Lengths change by percent, angles by degrees (a percentage of an angle means nothing).
+std::string ChangeText(const ReportParameter& p) {
+  if (p.is_angle) return Fmt("%+.3f deg", (p.calibrated - p.nominal) * kDeg);
+  return Fmt("%+.2f %%", p.nominal != 0.0 ? 100.0 * (p.calibrated - p.nominal) / p.nominal : 0.0);
+}
+
+void HtmlParameters(std::ostringstream& h, const ReportData& d) {
+  h << "<h2 id=\"parameters\">Parameters</h2>\n<p>" << EscapeXml(d.uncertainty_note) << "</p>\n";
+  OpenTable(h);
+  h << "<tr><th>parameter</th><th>unit</th><th>nominal</th><th>calibrated</th>"
+       "<th>&plusmn;1 sigma</th><th>change</th><th>bound</th>"
     << (d.has_cv ? "<th>CV mean</th><th>CV std</th><th>CV min</th><th>CV max</th>" : "")
     << "</tr>\n";
   for (const ReportParameter& p : d.parameters) {
@@ -371,9 +574,8 @@ std::string ReportHtml(const ReportData& d) {
     const char* fmt = p.is_angle ? "%.4f" : "%.6f";
     h << "<tr><td>" << EscapeXml(p.name) << "</td><td>" << EscapeXml(p.unit) << "</td><td>"
       << Fmt(fmt, p.nominal * s) << "</td><td>" << Fmt(fmt, p.calibrated * s) << "</td><td>"
-      << (p.has_sigma ? Fmt("%.2g", p.sigma * s) : "-") << "</td><td>"
-      << Fmt("%+.2f %%", p.nominal != 0.0 ? 100.0 * (p.calibrated - p.nominal) / p.nominal : 0.0)
-      << "</td>";
+      << (p.has_sigma ? Fmt("%.2g", p.sigma * s) : "-") << "</td><td>" << ChangeText(p)
+      << "</td><td" << (p.at_bound ? " class=\"worse\">AT BOUND" : ">") << "</td>";
     if (d.has_cv) {
       h << "<td>" << Fmt(fmt, p.cv_mean * s) << "</td><td>" << Fmt("%.2g", p.cv_std * s)
         << "</td><td>" << Fmt(fmt, p.cv_min * s) << "</td><td>" << Fmt(fmt, p.cv_max * s)
@@ -381,122 +583,361 @@ std::string ReportHtml(const ReportData& d) {
     }
     h << "</tr>\n";
   }
-  h << "</table>\n";
-  if (!f.correlation.empty()) h << "<figure>" << f.correlation << "</figure>\n";
+  CloseTable(h);
+}
 
+void HtmlEffects(std::ostringstream& h, const ReportData& d) {
+  if (d.effects.empty()) return;
+  h << "<h2 id=\"effects\">Effects</h2>\n<p>Effects the calibration carries beyond the model's "
+       "parameters (<code>fitcal diagnose</code>), with the one-sigma the YAML records, and the "
+       "held-out CF (Eq. 14, all validation runs) of the model with and without them.</p>\n";
+  OpenTable(h);
+  h << "<tr><th></th><th>nominal</th><th>calibrated parameters alone</th>"
+       "<th>parameters + effects</th></tr>\n<tr><td>held-out CF</td><td>"
+    << Fmt("%.4f", d.summary.back().before.cf) << "</td><td>" << Fmt("%.4f", d.cf_parameters_only)
+    << "</td><td>" << Fmt("%.4f", d.summary.back().after.cf) << "</td></tr>\n";
+  CloseTable(h);
+  OpenTable(h);
+  h << "<tr><th>effect</th><th>parameter</th><th>value</th><th>&plusmn;1 sigma</th></tr>\n";
+  for (const ReportEffect& e : d.effects) {
+    for (std::size_t k = 0; k < e.values.size(); ++k) {
+      h << "<tr><td>" << EscapeXml(e.name) << "</td><td class=\"k\">"
+        << EscapeXml(e.parameter_names[k]) << "</td><td>" << Fmt("%.6g", e.values[k]) << "</td><td>"
+        << Fmt("%.2g", e.sigmas[k]) << "</td></tr>\n";
+    }
+  }
+  CloseTable(h);
+}
+
+void HtmlIdentifiability(std::ostringstream& h, const ReportData& d) {
   h << "<h2 id=\"identifiability\">Identifiability</h2>\n";
-  if (d.identifiable) {
-    h << "<p class=\"ok\">The training runs determine all nine parameters (condition number "
-      << Fmt("%.3g", d.condition_number)
-      << " in relative units; no parameter pair correlated beyond 0.99).</p>\n";
+  if (!d.identifiability_checked) {
+    h << "<p>Not analysed: the calibration's training runs are not in this data set.</p>\n";
+  } else if (d.identifiable) {
+    h << "<p class=\"ok\">The training runs determine every parameter"
+      << (d.condition_number > 0.0 ? " (condition number " + Fmt("%.3g", d.condition_number) +
+                                         " in relative units; no parameter pair correlated "
+                                         "beyond 0.99)"
+                                   : "")
+      << ".</p>\n";
   } else {
     h << "<div class=\"warn\">";
     for (const std::string& line : d.identifiability_lines) h << EscapeXml(line) << "\n";
     h << "</div>\n";
   }
+}
 
-  if (d.has_cv) {
-    h << "<h2>Leave-one-repetition-out cross-validation</h2>\n<p>Each fold fits on all "
-         "repetitions but one and validates on the one left out. Validation CF (calibrated): mean "
-      << Fmt("%.4f", d.cv_cf_after.mean) << ", std " << Fmt("%.4f", d.cv_cf_after.std) << ", min "
-      << Fmt("%.4f", d.cv_cf_after.min) << ", max " << Fmt("%.4f", d.cv_cf_after.max)
-      << " (nominal: mean " << Fmt("%.4f", d.cv_cf_before.mean)
-      << "). The parameter spread across folds is in the parameter table; the folds share all but "
-         "one repetition, so that spread understates the uncertainty of one fit (a jackknife "
-         "estimate multiplies the CV std by sqrt(folds - 1)).</p>\n<table>\n<tr><th>held-out "
-         "repetition</th><th>converged</th><th>training CF</th><th>validation CF before</th>"
-         "<th>validation CF after</th></tr>\n";
-    for (const ReportFold& fold : d.folds) {
-      h << "<tr><td>" << fold.held_out_repetition << "</td><td>" << (fold.usable ? "yes" : "NO")
-        << "</td><td>" << Fmt("%.4f", fold.cf_training) << "</td><td>"
-        << Fmt("%.4f", fold.cf_validation_before) << "</td><td>"
-        << Fmt("%.4f", fold.cf_validation_after) << "</td></tr>\n";
-    }
-    h << "</table>\n";
+void HtmlCrossValidation(std::ostringstream& h, const ReportData& d) {
+  if (!d.has_cv) return;
+  h << "<h2>Leave-one-repetition-out cross-validation</h2>\n<p>Each fold fits on all "
+       "repetitions but one and validates on the one left out. Validation CF (calibrated): mean "
+    << Fmt("%.4f", d.cv_cf_after.mean) << ", std " << Fmt("%.4f", d.cv_cf_after.std) << ", min "
+    << Fmt("%.4f", d.cv_cf_after.min) << ", max " << Fmt("%.4f", d.cv_cf_after.max)
+    << " (nominal: mean " << Fmt("%.4f", d.cv_cf_before.mean)
+    << "). The parameter spread across folds is in the parameter table; the folds share all but "
+       "one repetition, so that spread understates the uncertainty of one fit (a jackknife "
+       "estimate multiplies the CV std by sqrt(folds - 1)).</p>\n";
+  OpenTable(h);
+  h << "<tr><th>held-out repetition</th><th>converged</th><th>training CF</th>"
+       "<th>validation CF before</th><th>validation CF after</th></tr>\n";
+  for (const ReportFold& fold : d.folds) {
+    h << "<tr><td>" << fold.held_out_repetition << "</td><td>" << (fold.usable ? "yes" : "NO")
+      << "</td><td>" << Fmt("%.4f", fold.cf_training) << "</td><td>"
+      << Fmt("%.4f", fold.cf_validation_before) << "</td><td>"
+      << Fmt("%.4f", fold.cf_validation_after) << "</td></tr>\n";
   }
+  CloseTable(h);
+}
 
+void HtmlPerRun(std::ostringstream& h, const ReportData& d) {
   h << "<h2>Per-run metrics</h2>\n<details><summary>" << d.runs.size()
-    << " validation runs (also in metrics.csv)</summary>\n<table>\n<tr><th>run</th>";
+    << " validation runs (also in metrics.csv)</summary>\n";
+  OpenTable(h);
+  h << "<tr><th>run</th><th>path length [m]</th>";
   for (const Column& c : kColumns) h << "<th>" << EscapeXml(c.label) << "<br>before / after</th>";
   h << "</tr>\n";
   for (const ReportRun& r : d.runs) {
-    h << "<tr><td>" << EscapeXml(r.id) << "</td>";
+    h << "<tr><td>" << EscapeXml(r.id) << "</td><td>" << Fmt("%.2f", r.path_length_m) << "</td>";
     for (const Column& c : kColumns) {
       h << "<td>" << Fmt(FormatOf(c), ValueOf(c, r.before)) << " / "
         << Fmt(FormatOf(c), ValueOf(c, r.after)) << "</td>";
     }
     h << "</tr>\n";
   }
-  h << "</table>\n</details>\n</body>\n</html>\n";
+  CloseTable(h);
+  h << "</details>\n";
+}
+
+// Several calibrations side by side on the same validation runs.
+void HtmlComparison(std::ostringstream& h, const ReportData& d) {
+  if (d.comparison.empty()) return;
+  h << "<h2 id=\"comparison\">Calibrations compared</h2>\n<p>Every calibration on the same "
+       "validation runs (those none of them trained on); the rest of the page reports the first. "
+       "Below, the held-out CF per trajectory of calibration #1, #2, ... in the order above, the "
+       "lowest in bold.</p>\n";
+  OpenTable(h);
+  h << "<tr><th>calibration</th><th>verdict</th><th>training</th><th>held-out CF</th>"
+       "<th>final position error [mm]</th><th>final |heading error| [deg]</th>"
+       "<th>drift [% of distance]</th></tr>\n";
+  h << "<tr><td>nominal</td><td></td><td></td><td>" << Fmt("%.4f", d.comparison[0].all.before.cf)
+    << "</td><td>" << Fmt("%.1f", 1e3 * d.comparison[0].all.before.final_distance_m) << "</td><td>"
+    << Fmt("%.3f", kDeg * d.comparison[0].all.before.final_angle_rad) << "</td><td>"
+    << Fmt("%.2f", d.comparison[0].drift.before_translation_percent) << "</td></tr>\n";
+  for (const ReportComparisonRow& c : d.comparison) {
+    h << "<tr><td><code>" << EscapeXml(c.calibration) << "</code></td><td class=\""
+      << EscapeXml(c.verdict) << "\">" << EscapeXml(c.verdict) << "</td><td class=\"k\">"
+      << EscapeXml(c.training_source) << "</td><td>" << Fmt("%.4f", c.all.after.cf) << "</td><td>"
+      << Fmt("%.1f", 1e3 * c.all.after.final_distance_m) << "</td><td>"
+      << Fmt("%.3f", kDeg * c.all.after.final_angle_rad) << "</td><td>"
+      << Fmt("%.2f", c.drift.after_translation_percent) << "</td></tr>\n";
+  }
+  CloseTable(h);
+  OpenTable(h);
+  h << "<tr><th>trajectory</th><th>runs</th><th>CF nominal</th>";
+  for (std::size_t k = 0; k < d.comparison.size(); ++k) h << "<th>CF #" << k + 1 << "</th>";
+  h << "</tr>\n";
+  for (std::size_t t = 0; t < d.trajectories.size(); ++t) {
+    h << "<tr><td>" << EscapeXml(d.trajectories[t].group) << "</td><td>" << d.trajectories[t].runs
+      << "</td><td>" << Fmt("%.4f", d.trajectories[t].before.cf) << "</td>";
+    double best = d.trajectories[t].before.cf;
+    for (const ReportComparisonRow& c : d.comparison)
+      best = std::min(best, c.trajectory_cf_after[t]);
+    for (const ReportComparisonRow& c : d.comparison) {
+      const double v = c.trajectory_cf_after[t];
+      h << "<td>" << (v == best ? "<b>" : "") << Fmt("%.4f", v) << (v == best ? "</b>" : "")
+        << "</td>";
+    }
+    h << "</tr>\n";
+  }
+  CloseTable(h);
+}
+
+}  // namespace
+
+std::string ReportHtml(const ReportData& d) {
+  const ReportFigures f = MakeReportFigures(d);
+  std::ostringstream h;
+  h << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+    << "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
+    << "<title>fitcal validation report: " << EscapeXml(d.verdict) << "</title>\n<style>\n"
+    << kStyle << "</style>\n</head>\n<body>\n<h1>fitcal validation report</h1>\n";
+  HtmlVerdict(h, d);
+  HtmlHeader(h, d);
+  HtmlComparison(h, d);
+  HtmlSummary(h, d);
+  HtmlTrajectoryGroups(h, d);
+  HtmlDrift(h, d);
+  HtmlFigures(h, d, f);
+  HtmlResiduals(h, d, f);
+  HtmlStatistics(h, d);
+  h << "<h2 id=\"calibration\">Calibration</h2>\n<p>" << EscapeXml(d.calibration_note) << "</p>\n";
+  HtmlParameters(h, d);
+  if (!f.correlation.empty()) h << "<figure>" << f.correlation << "</figure>\n";
+  HtmlEffects(h, d);
+  HtmlIdentifiability(h, d);
+  HtmlCrossValidation(h, d);
+  HtmlPerRun(h, d);
+  h << "</body>\n</html>\n";
   return h.str();
 }
 
-std::string ReportMarkdown(const ReportData& d) {
-  std::ostringstream m;
-  m << "# fitcal validation report\n\n"
-    << "- robot: " << d.robot_name << "\n- data set: `" << d.dataset << "`\n- calibration: `"
-    << d.calibration << "`\n- fitcal " << d.tool_version << "\n- validation: " << d.runs.size()
-    << " runs (repetitions " << d.validation_repetitions << "), training: " << d.training_runs
-    << " runs (repetitions " << d.training_repetitions << ")\n- odometry sampled at the "
-    << "ground-truth times by " << d.sampling << " time\n";
-  for (const std::string& e : d.calibrated_effects) m << "- calibrated effect: " << e << "\n";
-  m << "\n## Summary (Palacin Table 6)\n\n"
-    << "| group | runs | |";
-  for (const Column& c : kColumns) m << " " << c.label << " |";
-  m << "\n|---|---:|---|";
-  for (std::size_t i = 0; i < std::size(kColumns); ++i) m << "---:|";
-  m << "\n";
-  for (const ReportSummaryRow& row : d.summary) {
-    for (int part = 0; part < 3; ++part) {
-      m << "| " << (part == 0 ? row.group : "") << " | "
-        << (part == 0 ? std::to_string(row.runs) : "") << " | "
-        << (part == 0   ? "before"
-            : part == 1 ? "after"
-                        : "improvement")
-        << " |";
-      for (const Column& c : kColumns) {
-        const double b = ValueOf(c, row.before), a = ValueOf(c, row.after);
-        m << " "
-          << (part == 2 ? Fmt("%+.1f %%", Improvement(b, a)) : Fmt(FormatOf(c), part == 0 ? b : a))
-          << " |";
-      }
-      m << "\n";
+namespace {
+
+// A GitHub-flavoured Markdown table cell: '|' escaped (a bare one splits the cell, as the
+// "|angle|" labels did), line breaks as spaces.
+std::string MdCell(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    if (c == '|') {
+      out += "\\|";
+    } else if (c == '\n') {
+      out += ' ';
+    } else {
+      out += c;
     }
   }
-  m << "\n## Statistics over validation runs (evo names)\n\n| metric | | rmse | mean | median | "
-       "std | min | max |\n|---|---|---:|---:|---:|---:|---:|---:|\n";
+  return out;
+}
+
+// "| a | b |" from cells (escaped).
+std::string MdRow(const std::vector<std::string>& cells) {
+  std::string out = "|";
+  for (const std::string& c : cells) out += " " + MdCell(c) + " |";
+  return out + "\n";
+}
+
+// The separator row: the first `left` columns left-aligned, the rest right-aligned.
+std::string MdRule(std::size_t columns, std::size_t left) {
+  std::string out = "|";
+  for (std::size_t i = 0; i < columns; ++i) out += i < left ? "---|" : "---:|";
+  return out + "\n";
+}
+
+void MdVerdict(std::ostringstream& m, const ReportData& d) {
+  m << "## Verdict: " << d.verdict << "\n\n";
+  for (const ReportVerdictReason& r : d.verdict_reasons) {
+    m << "- **" << r.level << "** " << r.check << ": " << r.message << "\n";
+  }
+  m << "\n";
+}
+
+void MdSummary(std::ostringstream& m, const ReportData& d) {
+  m << "## Summary (Palacin Table 6)\n\n";
+  std::vector<std::string> header = {"group", "runs", ""};
+  for (const Column& c : kColumns) header.push_back(c.label);
+  m << MdRow(header) << MdRule(header.size(), 3);
+  for (const ReportSummaryRow& row : d.summary) {
+    for (int part = 0; part < 3; ++part) {
+      std::vector<std::string> cells = {part == 0 ? row.group : "",
+                                        part == 0 ? std::to_string(row.runs) : "",
+                                        part == 0   ? "before"
+                                        : part == 1 ? "after"
+                                                    : "improvement"};
+      for (const Column& c : kColumns) {
+        const double b = ValueOf(c, row.before), a = ValueOf(c, row.after);
+        cells.push_back(part == 2 ? Fmt("%+.1f %%", Improvement(b, a))
+                                  : Fmt(FormatOf(c), part == 0 ? b : a));
+      }
+      m << MdRow(cells);
+    }
+  }
+  m << "\n## Per trajectory\n\n";
+  const std::vector<std::string> per = {
+      "trajectory", "runs", "CF before", "CF after", "final position before [mm]", "after [mm]"};
+  m << MdRow(per) << MdRule(per.size(), 1);
+  for (const ReportSummaryRow& row : d.trajectories) {
+    m << MdRow({row.group, std::to_string(row.runs), Fmt("%.4f", row.before.cf),
+                Fmt("%.4f", row.after.cf), Fmt("%.1f", 1e3 * row.before.final_distance_m),
+                Fmt("%.1f", 1e3 * row.after.final_distance_m) +
+                    (row.after.final_distance_m > row.before.final_distance_m ? " (worse)" : "")});
+  }
+}
+
+void MdDrift(std::ostringstream& m, const ReportData& d) {
+  m << "\n## Drift per distance (relative pose error) and bias\n\n";
+  const std::vector<std::string> header = {"path length [m]",         "windows",
+                                           "translation before [%]",  "after [%]",
+                                           "rotation before [deg/m]", "after [deg/m]"};
+  m << MdRow(header) << MdRule(header.size(), 0);
+  for (const ReportDriftRow& r : d.drift) {
+    m << MdRow({Fmt("%g", r.length_m), std::to_string(r.windows),
+                Fmt("%.2f", r.before_translation_percent), Fmt("%.2f", r.after_translation_percent),
+                Fmt("%.3f", kDeg * r.before_rotation_rad_per_m),
+                Fmt("%.3f", kDeg * r.after_rotation_rad_per_m)});
+  }
+  m << "\n";
+  const std::vector<std::string> bias = {"signed mean final error", "x [mm]", "y [mm]",
+                                         "heading [deg]"};
+  m << MdRow(bias) << MdRule(bias.size(), 1);
+  for (bool after : {false, true}) {
+    const Bias b = MeanFinalError(d, after);
+    m << MdRow({after ? "after" : "before", Fmt("%+.1f", 1e3 * b.x_m), Fmt("%+.1f", 1e3 * b.y_m),
+                Fmt("%+.3f", kDeg * b.heading_rad)});
+  }
+}
+
+void MdStatistics(std::ostringstream& m, const ReportData& d) {
+  m << "\n## Statistics over validation runs (evo names)\n\n";
+  const std::vector<std::string> header = {"metric", "",    "rmse", "mean",
+                                           "median", "std", "min",  "max"};
+  m << MdRow(header) << MdRule(header.size(), 2);
   for (const ReportStatisticsRow& s : d.statistics) {
     const double scale = s.is_angle ? kDeg : 1.0;
     for (int part = 0; part < 2; ++part) {
       const ReportStatistics& v = part == 0 ? s.before : s.after;
-      m << "| " << (part == 0 ? s.metric + (s.is_angle ? " [deg]" : "") : "") << " | "
-        << (part == 0 ? "before" : "after") << " |";
+      std::vector<std::string> cells = {part == 0 ? s.metric + (s.is_angle ? " [deg]" : "") : "",
+                                        part == 0 ? "before" : "after"};
       for (double x : {v.rmse, v.mean, v.median, v.std, v.min, v.max}) {
-        m << " " << Fmt(s.is_angle ? "%.3f" : "%.4f", x * scale) << " |";
+        cells.push_back(Fmt(s.is_angle ? "%.3f" : "%.4f", x * scale));
       }
-      m << "\n";
+      m << MdRow(cells);
     }
   }
-  m << "\n## Parameters\n\n"
-    << d.uncertainty_note << "\n\n| parameter | unit | nominal | calibrated | +-1 sigma |"
-    << (d.has_cv ? " CV std | CV min | CV max |" : "") << "\n|---|---|---:|---:|---:|"
-    << (d.has_cv ? "---:|---:|---:|" : "") << "\n";
+}
+
+void MdParameters(std::ostringstream& m, const ReportData& d) {
+  m << "\n## Parameters\n\n" << d.uncertainty_note << "\n\n";
+  std::vector<std::string> header = {"parameter", "unit",   "nominal", "calibrated",
+                                     "+-1 sigma", "change", "bound"};
+  if (d.has_cv) header.insert(header.end(), {"CV std", "CV min", "CV max"});
+  m << MdRow(header) << MdRule(header.size(), 2);
   for (const ReportParameter& p : d.parameters) {
     const double s = ParamScale(p);
     const char* fmt = p.is_angle ? "%.4f" : "%.6f";
-    m << "| " << p.name << " | " << p.unit << " | " << Fmt(fmt, p.nominal * s) << " | "
-      << Fmt(fmt, p.calibrated * s) << " | " << (p.has_sigma ? Fmt("%.2g", p.sigma * s) : "-")
-      << " |";
+    std::vector<std::string> cells = {p.name,
+                                      p.unit,
+                                      Fmt(fmt, p.nominal * s),
+                                      Fmt(fmt, p.calibrated * s),
+                                      p.has_sigma ? Fmt("%.2g", p.sigma * s) : "-",
+                                      ChangeText(p),
+                                      p.at_bound ? "AT BOUND" : ""};
     if (d.has_cv) {
-      m << " " << Fmt("%.2g", p.cv_std * s) << " | " << Fmt(fmt, p.cv_min * s) << " | "
-        << Fmt(fmt, p.cv_max * s) << " |";
+      cells.insert(cells.end(),
+                   {Fmt("%.2g", p.cv_std * s), Fmt(fmt, p.cv_min * s), Fmt(fmt, p.cv_max * s)});
     }
-    m << "\n";
+    m << MdRow(cells);
   }
+  if (d.effects.empty()) return;
+  m << "\n## Effects\n\n";
+  const std::vector<std::string> header_cf = {"", "nominal", "calibrated parameters alone",
+                                              "parameters + effects"};
+  m << MdRow(header_cf) << MdRule(header_cf.size(), 1)
+    << MdRow({"held-out CF", Fmt("%.4f", d.summary.back().before.cf),
+              Fmt("%.4f", d.cf_parameters_only), Fmt("%.4f", d.summary.back().after.cf)})
+    << "\n";
+  const std::vector<std::string> header_e = {"effect", "parameter", "value", "+-1 sigma"};
+  m << MdRow(header_e) << MdRule(header_e.size(), 2);
+  for (const ReportEffect& e : d.effects) {
+    for (std::size_t k = 0; k < e.values.size(); ++k) {
+      m << MdRow(
+          {e.name, e.parameter_names[k], Fmt("%.6g", e.values[k]), Fmt("%.2g", e.sigmas[k])});
+    }
+  }
+}
+
+void MdComparison(std::ostringstream& m, const ReportData& d) {
+  if (d.comparison.empty()) return;
+  m << "## Calibrations compared (same validation runs)\n\n";
+  const std::vector<std::string> header = {"calibration", "verdict", "held-out CF",
+                                           "final position error [mm]",
+                                           "final |heading error| [deg]"};
+  m << MdRow(header) << MdRule(header.size(), 2);
+  const ReportSummaryRow& nominal = d.comparison[0].all;
+  m << MdRow({"nominal", "", Fmt("%.4f", nominal.before.cf),
+              Fmt("%.1f", 1e3 * nominal.before.final_distance_m),
+              Fmt("%.3f", kDeg * nominal.before.final_angle_rad)});
+  for (const ReportComparisonRow& c : d.comparison) {
+    m << MdRow({c.calibration, c.verdict, Fmt("%.4f", c.all.after.cf),
+                Fmt("%.1f", 1e3 * c.all.after.final_distance_m),
+                Fmt("%.3f", kDeg * c.all.after.final_angle_rad)});
+  }
+  m << "\n";
+}
+
+}  // namespace
+
+std::string ReportMarkdown(const ReportData& d) {
+  std::ostringstream m;
+  m << "# fitcal validation report\n\n";
+  MdVerdict(m, d);
+  m << "- robot: " << d.robot_name << "\n- data set: `" << d.dataset << "`\n- calibration: `"
+    << d.calibration << "` (" << d.calibration_note << ")\n- fitcal " << d.tool_version
+    << "\n- validation: " << d.runs.size() << " runs (repetitions " << d.validation_repetitions
+    << "); training: " << d.training_source << "\n- odometry sampled at the "
+    << "ground-truth times by " << d.sampling << " time\n\n";
+  MdComparison(m, d);
+  MdSummary(m, d);
+  MdDrift(m, d);
+  MdStatistics(m, d);
+  MdParameters(m, d);
   m << "\n## Identifiability\n\n";
-  if (d.identifiable) {
-    m << "All nine parameters are determined by the training runs (condition number "
-      << Fmt("%.3g", d.condition_number) << ").\n";
+  if (!d.identifiability_checked) {
+    m << "Not analysed: the calibration's training runs are not in this data set.\n";
+  } else if (d.identifiable) {
+    m << "The training runs determine every parameter"
+      << (d.condition_number > 0.0 ? " (condition number " + Fmt("%.3g", d.condition_number) + ")"
+                                   : "")
+      << ".\n";
   } else {
     m << "```\n";
     for (const std::string& line : d.identifiability_lines) m << line << "\n";
@@ -518,16 +959,121 @@ std::string MetricsCsv(const ReportData& d) {
   for (const char* when : {"before", "after"}) {
     for (const Column& col : kColumns) c << "," << when << "_" << KeyOf(col);
   }
-  c << "\n";
+  // Signed final errors in the start frame (the bias of the summary) and the path length.
+  c << ",path_length_m,before_final_x_m,before_final_y_m,before_final_heading_deg,"
+       "after_final_x_m,after_final_y_m,after_final_heading_deg\n";
   for (const ReportRun& r : d.runs) {
     c << r.id << "," << r.trajectory << "," << r.repetition;
     for (const ReportMetrics* m : {&r.before, &r.after}) {
       for (const Column& col : kColumns) c << "," << JsonNumber(ValueOf(col, *m));
     }
+    c << "," << JsonNumber(r.path_length_m);
+    for (bool after : {false, true}) {
+      const Point2& e = after ? r.after_final_error : r.before_final_error;
+      c << "," << JsonNumber(e.x) << "," << JsonNumber(e.y) << ","
+        << JsonNumber(kDeg * (after ? r.after_final_heading_rad : r.before_final_heading_rad));
+    }
     c << "\n";
   }
   return c.str();
 }
+
+namespace {
+
+// {"level": "WARN", "reasons": [{"level", "check", "section", "message"}, ...]}
+std::string JsonVerdict(const ReportData& d) {
+  std::string out = "{\"level\": " + JsonString(d.verdict) + ", \"reasons\": [";
+  for (std::size_t i = 0; i < d.verdict_reasons.size(); ++i) {
+    const ReportVerdictReason& r = d.verdict_reasons[i];
+    out += std::string(i ? "," : "") + "\n    {\"level\": " + JsonString(r.level) +
+           ", \"check\": " + JsonString(r.check) + ", \"section\": " + JsonString(r.section) +
+           ", \"message\": " + JsonString(r.message) + "}";
+  }
+  return out + "]}";
+}
+
+// {"cf_parameters_only": x, "list": [{"name", "parameters": [{"name", "value", "sigma"}]}]}
+std::string JsonEffects(const ReportData& d) {
+  std::string out = "{\"cf_parameters_only\": " +
+                    (d.effects.empty() ? std::string("null") : JsonNumber(d.cf_parameters_only)) +
+                    ", \"list\": [";
+  for (std::size_t i = 0; i < d.effects.size(); ++i) {
+    const ReportEffect& e = d.effects[i];
+    out += std::string(i ? ", " : "") + "{\"name\": " + JsonString(e.name) + ", \"parameters\": [";
+    for (std::size_t k = 0; k < e.values.size(); ++k) {
+      out += std::string(k ? ", " : "") + "{\"name\": " + JsonString(e.parameter_names[k]) +
+             ", \"value\": " + JsonNumber(e.values[k]) + ", \"sigma\": " + JsonNumber(e.sigmas[k]) +
+             "}";
+    }
+    out += "]}";
+  }
+  return out + "]}";
+}
+
+std::string JsonTrajectories(const ReportData& d) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < d.trajectories.size(); ++i) {
+    const ReportSummaryRow& row = d.trajectories[i];
+    out += std::string(i ? "," : "") + "\n    {\"trajectory\": " + JsonString(row.group) +
+           ", \"runs\": " + std::to_string(row.runs) + ", \"before\": " + JsonMetrics(row.before) +
+           ", \"after\": " + JsonMetrics(row.after) + "}";
+  }
+  return out + "]";
+}
+
+std::string JsonDrift(const ReportData& d) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < d.drift.size(); ++i) {
+    const ReportDriftRow& r = d.drift[i];
+    out += std::string(i ? ", " : "") + "{\"length_m\": " + JsonNumber(r.length_m) +
+           ", \"windows\": " + std::to_string(r.windows) +
+           ", \"translation_percent\": {\"before\": " + JsonNumber(r.before_translation_percent) +
+           ", \"after\": " + JsonNumber(r.after_translation_percent) +
+           "}, \"rotation_deg_per_m\": {\"before\": " +
+           JsonNumber(kDeg * r.before_rotation_rad_per_m) +
+           ", \"after\": " + JsonNumber(kDeg * r.after_rotation_rad_per_m) + "}}";
+  }
+  return out + "]";
+}
+
+std::string JsonBias(const ReportData& d) {
+  std::string out = "{";
+  for (bool after : {false, true}) {
+    const Bias b = MeanFinalError(d, after);
+    out += std::string(after ? ", \"after\": " : "\"before\": ") +
+           "{\"x_m\": " + JsonNumber(b.x_m) + ", \"y_m\": " + JsonNumber(b.y_m) +
+           ", \"heading_deg\": " + JsonNumber(kDeg * b.heading_rad) + "}";
+  }
+  return out + "}";
+}
+
+std::string JsonNoiseFloor(const ReportData& d) {
+  const ReportNoiseFloor& n = d.noise_floor;
+  if (!n.available) return "null";
+  return "{\"sigma_per_axis_m\": " + JsonNumber(n.noise_sigma_m) +
+         ", \"systematic_rms_m\": " + JsonNumber(n.systematic_rms_m) +
+         ", \"f_statistic\": " + JsonNumber(n.f_statistic) +
+         ", \"p_value\": " + JsonNumber(n.p_value) + "}";
+}
+
+std::string JsonComparison(const ReportData& d) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < d.comparison.size(); ++i) {
+    const ReportComparisonRow& c = d.comparison[i];
+    out += std::string(i ? "," : "") + "\n    {\"calibration\": " + JsonString(c.calibration) +
+           ", \"verdict\": " + JsonString(c.verdict) +
+           ", \"training_source\": " + JsonString(c.training_source) +
+           ", \"before\": " + JsonMetrics(c.all.before) +
+           ", \"after\": " + JsonMetrics(c.all.after) + ", \"per_trajectory_cf_after\": [";
+    for (std::size_t t = 0; t < c.trajectory_cf_after.size(); ++t) {
+      out += std::string(t ? ", " : "") + JsonNumber(c.trajectory_cf_after[t]);
+    }
+    out += "]}";
+  }
+  return out + "]";
+}
+
+}  // namespace
 
 std::string MetricsJson(const ReportData& d) {
   std::ostringstream j;
@@ -535,10 +1081,12 @@ std::string MetricsJson(const ReportData& d) {
     << ",\n  \"dataset\": " << JsonString(d.dataset)
     << ",\n  \"calibration\": " << JsonString(d.calibration)
     << ",\n  \"robot\": " << JsonString(d.robot_name)
-    << ",\n  \"odometry_sampling\": " << JsonString(d.sampling) << ",\n  \"calibrated_effects\": [";
-  for (std::size_t i = 0; i < d.calibrated_effects.size(); ++i)
-    j << (i ? ", " : "") << JsonString(d.calibrated_effects[i]);
-  j << "]"
+    << ",\n  \"odometry_sampling\": " << JsonString(d.sampling)
+    << ",\n  \"verdict\": " << JsonVerdict(d)
+    << ",\n  \"training_source\": " << JsonString(d.training_source)
+    << ",\n  \"effects\": " << JsonEffects(d) << ",\n  \"per_trajectory\": " << JsonTrajectories(d)
+    << ",\n  \"drift\": " << JsonDrift(d) << ",\n  \"comparison\": " << JsonComparison(d)
+    << ",\n  \"bias\": " << JsonBias(d) << ",\n  \"noise_floor\": " << JsonNoiseFloor(d)
     << ",\n  \"training_repetitions\": " << JsonString(d.training_repetitions)
     << ",\n  \"validation_repetitions\": " << JsonString(d.validation_repetitions)
     << ",\n  \"summary\": [";
@@ -571,7 +1119,8 @@ std::string MetricsJson(const ReportData& d) {
     j << (i ? "," : "") << "\n    {\"name\": " << JsonString(p.name) << ", \"nominal" << u
       << "\": " << JsonNumber(p.nominal * s) << ", \"calibrated" << u
       << "\": " << JsonNumber(p.calibrated * s) << ", \"sigma" << u
-      << "\": " << (p.has_sigma ? JsonNumber(p.sigma * s) : "null");
+      << "\": " << (p.has_sigma ? JsonNumber(p.sigma * s) : "null")
+      << ", \"at_bound\": " << (p.at_bound ? "true" : "false");
     if (p.has_cv) {
       j << ", \"cv_std" << u << "\": " << JsonNumber(p.cv_std * s) << ", \"cv_min" << u
         << "\": " << JsonNumber(p.cv_min * s) << ", \"cv_max" << u
@@ -593,7 +1142,8 @@ std::string MetricsJson(const ReportData& d) {
   } else {
     j << "null";
   }
-  j << ",\n  \"identifiability\": {\"identifiable\": " << (d.identifiable ? "true" : "false")
+  j << ",\n  \"identifiability\": {\"checked\": " << (d.identifiability_checked ? "true" : "false")
+    << ", \"identifiable\": " << (d.identifiable ? "true" : "false")
     << ", \"condition_number\": " << JsonNumber(d.condition_number) << ", \"warnings\": [";
   for (std::size_t i = 0; i < d.identifiability_lines.size(); ++i) {
     j << (i ? ", " : "") << JsonString(d.identifiability_lines[i]);

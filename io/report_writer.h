@@ -27,14 +27,17 @@ struct ReportRun {
   std::string id;
   std::string trajectory;
   int repetition = 0;
+  double path_length_m = 0.0;  // ground-truth path length over the window
   // Along the run at the ground-truth times, in the run's start frame (start pose at the origin,
   // heading along +x) so that all runs draw the flower of Palacin Fig. 9.
   std::vector<double> t_s;  // since the start of the window
   std::vector<Point2> ground_truth_xy, before_xy, after_xy;
   std::vector<double> before_distance_m, after_distance_m;  // Eq. 8
   std::vector<double> before_angle_rad, after_angle_rad;    // Eq. 9
-  // Final odometry minus final ground truth, in the start frame (m).
+  // Final odometry minus final ground truth, in the start frame (m), and the signed final heading
+  // error wrap(theta_odometry - theta_ground_truth) (rad).
   Point2 before_final_error, after_final_error;
+  double before_final_heading_rad = 0.0, after_final_heading_rad = 0.0;
   ReportMetrics before, after;
 };
 
@@ -56,8 +59,9 @@ struct ReportStatisticsRow {
 };
 
 struct ReportParameter {
-  std::string name;  // "R_a"
-  std::string unit;  // "m" or "deg" (display unit; values below are in SI + rad)
+  std::string name;       // "R_a"
+  bool at_bound = false;  // resting on a bound of the robot's box
+  std::string unit;       // "m" or "deg" (display unit; values below are in SI + rad)
   bool is_angle = false;
   double nominal = 0.0;
   double calibrated = 0.0;
@@ -75,25 +79,87 @@ struct ReportFold {
   double cf_validation_after = 0.0;
 };
 
+// The verdict (validation/verdict.h) as text: level "PASS", "WARN" or "FAIL" per reason.
+struct ReportVerdictReason {
+  std::string level;
+  std::string check;    // machine-readable name of the check
+  std::string section;  // id of the report section it refers to
+  std::string message;
+};
+
+// An effect the calibration carries beyond the model's parameters (odometry/effects.h).
+struct ReportEffect {
+  std::string name;
+  std::vector<std::string> parameter_names;
+  std::vector<double> values, sigmas;  // as the YAML records them (SI and rad)
+};
+
+// Drift per distance travelled: the relative pose error over windows of one ground-truth path
+// length (KITTI's odometry metric, evo_rpe with --delta in metres), mean over every window of every
+// validation run.
+struct ReportDriftRow {
+  double length_m = 0.0;
+  int windows = 0;
+  double before_translation_percent = 0.0, after_translation_percent = 0.0;
+  double before_rotation_rad_per_m = 0.0, after_rotation_rad_per_m = 0.0;
+};
+
+// The repeatability test of the calibrated final position errors (validation/verdict.h).
+struct ReportNoiseFloor {
+  bool available = false;
+  double noise_sigma_m = 0.0;  // per axis
+  double systematic_rms_m = 0.0;
+  double f_statistic = 0.0, p_value = 1.0;
+};
+
+// One calibration of a comparison (`report --calibration a.yaml --calibration b.yaml`), all on
+// the same validation runs.
+struct ReportComparisonRow {
+  std::string calibration;
+  std::string verdict;
+  std::string training_source;
+  ReportSummaryRow all;                     // all validation runs, nominal and this calibration
+  std::vector<double> trajectory_cf_after;  // in the order of ReportData::trajectories
+  ReportDriftRow drift;                     // the longest window length
+};
+
 struct ReportData {
   std::string tool_version;
   std::string dataset;
   std::string calibration;
   std::string robot_name;
   std::string sampling;  // "nearest" or "linear"
-  // Effects the calibration carries beyond the nine parameters, replayed in "after", one
-  // description each (e.g. "time_offset: latency_s = 0.08"); empty for the nine alone.
-  std::vector<std::string> calibrated_effects;
+  std::string verdict;   // "PASS", "WARN" or "FAIL"
+  std::vector<ReportVerdictReason> verdict_reasons;
+  // Effects the calibration carries beyond the model's parameters, replayed in "after"; empty for
+  // the parameters alone. With effects, cf_parameters_only is the held-out CF (all runs) of the
+  // calibrated parameters replayed without them.
+  std::vector<ReportEffect> effects;
+  double cf_parameters_only = 0.0;
+  // Where the training runs are: e.g. "180 runs of this data set (recorded by id)" or "another
+  // data set (data/circles): every run here validates".
+  std::string training_source;
+  // What produced the calibration, as its YAML records it (method, solver termination).
+  std::string calibration_note;
   std::string training_repetitions;
   std::string validation_repetitions;
   int training_runs = 0;
+  // Every calibration compared, this one first; empty for a report of one calibration.
+  std::vector<ReportComparisonRow> comparison;
   std::vector<ReportRun> runs;  // validation runs
+  // The error-along-time figures are drawn for the runs with the largest calibrated CF, at most
+  // this many (every run is in the tables and in metrics.csv).
+  int worst_runs_drawn = 8;
   std::vector<ReportSummaryRow> summary;
+  std::vector<ReportSummaryRow> trajectories;  // one row per trajectory label
+  std::vector<ReportDriftRow> drift;
+  ReportNoiseFloor noise_floor;
   std::vector<ReportStatisticsRow> statistics;
   std::vector<ReportParameter> parameters;
   std::string uncertainty_note;  // how sigma was obtained, or why there is none
   bool has_correlation = false;
   std::vector<std::vector<double>> correlation;
+  bool identifiability_checked = true;  // false when the training runs are not in this data set
   bool identifiable = true;
   double condition_number = 0.0;
   std::vector<std::string> identifiability_lines;
@@ -107,10 +173,13 @@ struct ReportData {
 struct ReportFigures {
   std::string flower;
   std::string end_points;
+  std::string residual_histogram;  // final position errors against the noise floor
   std::string final_distance_bars;
   std::string final_angle_bars;
-  std::string correlation;                    // empty without a correlation matrix
-  std::vector<std::string> error_along_time;  // one per run, same order as ReportData::runs
+  std::string correlation;  // empty without a correlation matrix
+  // The worst runs (largest calibrated CF, at most worst_runs_drawn), worst first.
+  std::vector<std::string> error_along_time;
+  std::vector<std::size_t> error_along_time_runs;  // their indices in ReportData::runs
 };
 ReportFigures MakeReportFigures(const ReportData& data);
 

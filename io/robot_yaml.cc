@@ -154,6 +154,15 @@ std::string Omni3RobotYaml(const Omni3Robot& robot, const CalibrationRecord* cal
         << c.validation_repetitions;
     out << YAML::Key << "training_runs" << YAML::Value << c.training_runs;
     out << YAML::Key << "validation_runs" << YAML::Value << c.validation_runs;
+    if (!c.training_trajectories.empty()) {
+      out << YAML::Key << "training_trajectories" << YAML::Value << c.training_trajectories;
+    }
+    if (!c.training_run_ids.empty()) {
+      out << YAML::Key << "training_run_ids" << YAML::Value << YAML::Flow << c.training_run_ids;
+      out << YAML::Key << "training_fingerprint" << YAML::Value << YAML::DoubleQuoted
+          << c.training_fingerprint;
+    }
+    out << YAML::Key << "at_bound" << YAML::Value << YAML::Flow << c.at_bound;
     out << YAML::Key << "cf_training" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key
         << "before" << YAML::Value << c.cf_training_before << YAML::Key << "after" << YAML::Value
         << c.cf_training_after << YAML::EndMap;

@@ -33,6 +33,13 @@ struct CalibrationRecord {
   std::string termination;
   std::vector<int> training_repetitions;
   std::vector<int> validation_repetitions;
+  // Which runs trained it (`fitcal report` validates on every other run of any data set):
+  // their ids, the --train-trajectories selector when the split was by trajectory, and the
+  // fingerprint of their encoder logs (validation/training_runs.h).
+  std::vector<std::string> training_run_ids;
+  std::string training_trajectories;
+  std::string training_fingerprint;
+  std::vector<std::string> at_bound;  // parameter names resting on a bound
   int training_runs = 0;
   int validation_runs = 0;
   double cf_training_before = 0.0;

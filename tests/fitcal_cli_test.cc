@@ -151,6 +151,105 @@ TEST(FitcalCli, RecordedCfIsTheOneReportMeasures) {
   EXPECT_NEAR(cf_after("\"after\""), recorded["after"].as<double>(), 1e-9);
 }
 
+// A calibration validates on any data set (issue 17): on the data set that trained it, every run
+// it did not train on (recorded by id, also for a split by trajectory); on another data set
+// (another simulator seed, same run ids), every run, with no identifiability advice about a data
+// set that trained nothing. The verdict is in the terminal, metrics.json and, with --strict, in
+// the exit status: the nominal robot as "calibration" improves nothing (FAIL, exit 7).
+TEST(FitcalCli, ReportValidatesOnAnyDataSetWithAVerdict) {
+  TempDir dir;
+  const std::string data = MakeDataset(dir);
+  const std::string other = dir.Path("other");
+  ASSERT_EQ(
+      RunFitcal(dir, "simulate --out " + other + " --robot " + kRobot + " --repetitions 2 --seed 6")
+          .exit_code,
+      0);
+  const std::string cal = dir.Path("cal.yaml");
+  ASSERT_EQ(RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --out " + cal).exit_code, 0);
+  const YAML::Node block = YAML::LoadFile(cal)["calibration"];
+  EXPECT_EQ(block["training_run_ids"].size(), 36u);
+  EXPECT_EQ(block["training_fingerprint"].as<std::string>().size(), 16u);
+
+  const auto report = [&](const std::string& logs, const std::string& calibration,
+                          const std::string& extra) {
+    const std::string out = dir.Path("report");
+    const Result r = RunFitcal(dir, "report --logs " + logs + " --calibration " + calibration +
+                                        " --out " + out + " " + extra);
+    return std::make_pair(r, YAML::Load(ReadFileBytes(out + "/metrics.json")));
+  };
+  // This seed's single repetition puts R_a on its bound (the fit prints AT BOUND and records
+  // it): the verdict is WARN for that reason alone, and --strict exits 8.
+  ASSERT_EQ(block["at_bound"].size(), 1u);
+  EXPECT_EQ(block["at_bound"][0].as<std::string>(), "R_a");
+  const auto [own, own_json] = report(data, cal, "--strict");
+  EXPECT_EQ(own.exit_code, 8) << own.out << own.err;
+  EXPECT_EQ(own_json["runs"].size(), 36u);  // repetition 2 only
+  EXPECT_EQ(own_json["verdict"]["level"].as<std::string>(), "WARN") << own.out;
+  EXPECT_NE(own.out.find("verdict: WARN"), std::string::npos) << own.out;
+  const YAML::Node reasons = own_json["verdict"]["reasons"];
+  EXPECT_EQ(reasons[0]["check"].as<std::string>(), "bounds");
+  EXPECT_NE(reasons[0]["message"].as<std::string>().find("R_a"), std::string::npos);
+  for (std::size_t i = 1; i < reasons.size(); ++i) {
+    EXPECT_EQ(reasons[i]["level"].as<std::string>(), "PASS") << reasons[i]["message"];
+  }
+
+  const auto [cross, cross_json] = report(other, cal, "--strict");
+  EXPECT_EQ(cross.exit_code, 8) << cross.out << cross.err;
+  EXPECT_EQ(cross_json["runs"].size(), 72u);  // every run of the other data set
+  EXPECT_NE(cross_json["training_source"].as<std::string>().find("another data set"),
+            std::string::npos);
+  EXPECT_EQ(cross.out.find("would be fixed by adding"), std::string::npos) << cross.out;
+  EXPECT_EQ(cross.out.find("unseen direction"), std::string::npos) << cross.out;
+
+  // Split by trajectory: repetitions overlap (1-2 on both sides); the ids tell them apart.
+  const std::string by_label = dir.Path("by_label.yaml");
+  ASSERT_EQ(RunFitcal(dir, "fit --logs " + data + " --train-trajectories '^[GB]' --out " + by_label)
+                .exit_code,
+            0);
+  const auto [labelled, labelled_json] = report(data, by_label, "");
+  EXPECT_EQ(labelled.exit_code, 0) << labelled.out << labelled.err;
+  EXPECT_EQ(labelled_json["runs"].size(), 24u);  // R1-R12, both repetitions
+  for (const YAML::Node& run : labelled_json["runs"]) {
+    EXPECT_EQ(run["trajectory"].as<std::string>()[0], 'R');
+  }
+
+  // Two calibrations side by side, on the runs neither trained on: repetition 2 of R1-R12.
+  const auto [both, both_json] = report(data, cal, "--calibration " + by_label);
+  EXPECT_EQ(both.exit_code, 0) << both.out << both.err;
+  EXPECT_EQ(both_json["runs"].size(), 12u);
+  ASSERT_EQ(both_json["comparison"].size(), 2u);
+  EXPECT_EQ(both_json["comparison"][1]["calibration"].as<std::string>(), by_label);
+  EXPECT_EQ(both_json["comparison"][0]["per_trajectory_cf_after"].size(), 12u);
+
+  const auto [nominal, nominal_json] = report(data, kRobot, "--strict");
+  EXPECT_EQ(nominal.exit_code, 7) << nominal.out << nominal.err;
+  EXPECT_EQ(nominal_json["verdict"]["level"].as<std::string>(), "FAIL");
+  EXPECT_EQ(nominal_json["runs"].size(), 72u);  // a plain robot YAML trained on nothing
+}
+
+// The report serves every model through the seam: a simulated differential drive, fitted, is
+// judged PASS on its held-out runs (the simulator's robot is the model: nothing systematic is
+// left, the noise-floor test finds p = 0.79 for this seed), with the model's own parameters.
+TEST(FitcalCli, ReportServesADifferentialDrive) {
+  TempDir dir;
+  const std::string data = dir.Path("diff");
+  ASSERT_EQ(RunFitcal(dir, "simulate --model diff_drive --out " + data + " --seed 3").exit_code, 0);
+  const std::string cal = dir.Path("cal.yaml");
+  ASSERT_EQ(RunFitcal(dir, "fit --logs " + data + " --out " + cal).exit_code, 0);
+  const std::string out = dir.Path("report");
+  const Result r = RunFitcal(
+      dir, "report --logs " + data + " --calibration " + cal + " --out " + out + " --strict");
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+  const YAML::Node j = YAML::Load(ReadFileBytes(out + "/metrics.json"));
+  EXPECT_EQ(j["verdict"]["level"].as<std::string>(), "PASS") << r.out;
+  ASSERT_EQ(j["parameters"].size(), 3u);
+  EXPECT_EQ(j["parameters"][2]["name"].as<std::string>(), "wheel_separation");
+  EXPECT_TRUE(j["identifiability"]["checked"].as<bool>());
+  EXPECT_FALSE(j["noise_floor"].IsNull());
+  EXPECT_LT(j["summary"][0]["after"]["cf"].as<double>(),
+            0.2 * j["summary"][0]["before"]["cf"].as<double>());
+}
+
 // An ASOC data set (asoc-simulate's own encoder files, converted on load) goes through the
 // generic commands like any model: `fit` with the closed form of Doebbler Eq. 1-9 (from the hold
 // runs) in the result gate, every --method on the seam (crs2lm runs NLopt, not Ceres), `compare`.

@@ -3,8 +3,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <optional>
 
+#include "io/calibration_yaml.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/log_files.h"
@@ -127,6 +131,39 @@ TEST(RobotYaml, RoundTripsThroughTheCalibratedSchema) {
     EXPECT_NEAR(back.nominal.angle_rad[i], robot.nominal.angle_rad[i], 1e-9);
   }
   EXPECT_NEAR(back.bounds.angle_offset_rad.lo, robot.bounds.angle_offset_rad.lo, 1e-12);
+}
+
+// What `fit` records about its training runs reads back for the report
+// (io/calibration_yaml.h); a plain robot YAML records nothing; a malformed list names its line.
+TEST(RobotYaml, CalibrationProvenanceRoundTrips) {
+  TempDir dir;
+  const Omni3Robot robot = ReadOmni3Robot(dir.Write("robot.yaml", kRobot));
+  EXPECT_FALSE(ReadCalibrationProvenance(dir.Path("robot.yaml")).has_value());
+  CalibrationRecord record;
+  record.method = "ceres";
+  record.termination = "NO_CONVERGENCE";
+  record.training_repetitions = {1, 2};
+  record.training_run_ids = {"R1-rep01", "G1-rep02"};
+  record.training_trajectories = "^[RG]";
+  record.training_fingerprint = "0123456789012345";  // digits only: must stay a string
+  record.at_bound = {"R_a"};
+  record.cf_training_after = 0.0125;
+  const std::string path = dir.Write("calibrated.yaml", Omni3RobotYaml(robot, &record));
+  const std::optional<CalibrationProvenance> p = ReadCalibrationProvenance(path);
+  ASSERT_TRUE(p.has_value());
+  EXPECT_EQ(p->termination, "NO_CONVERGENCE");
+  EXPECT_EQ(p->training_repetitions, (std::vector<int>{1, 2}));
+  EXPECT_EQ(p->training_run_ids, record.training_run_ids);
+  EXPECT_EQ(p->training_trajectories, "^[RG]");
+  EXPECT_EQ(p->training_fingerprint, "0123456789012345");
+  EXPECT_EQ(p->at_bound, record.at_bound);
+  ASSERT_TRUE(p->has_training_cf);
+  EXPECT_DOUBLE_EQ(p->cf_training_after, 0.0125);
+  const std::string bad = dir.Write("bad.yaml", std::string(kRobot) +
+                                                    "calibration:\n  training_repetitions: [1]\n"
+                                                    "  training_run_ids: 5\n");
+  ExpectInputError([&] { ReadCalibrationProvenance(bad); }, InputErrorKind::kWrongYamlType, bad,
+                   static_cast<int>(std::count(kRobot, kRobot + std::strlen(kRobot), '\n')) + 3);
 }
 
 TEST(RobotYaml, BadInputs) {

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <regex>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -93,6 +94,8 @@ ReportData SmallReport() {
     r.after.cf = 0.005;
     r.before.final_angle_rad = 0.01;
     r.after.final_angle_rad = 0.001;
+    r.before.final_distance_m = 0.02 + 0.01 * k;
+    r.after.final_distance_m = 0.002;
     d.runs.push_back(r);
   }
   ReportSummaryRow all;
@@ -124,7 +127,24 @@ ReportData SmallReport() {
   d.identifiable = false;
   d.identifiability_lines = {"warning: the training runs cannot determine all nine parameters",
                              "  correlation(R_a, r_a) = -0.9950"};
+  d.parameters[0].at_bound = true;
+  d.verdict = "WARN";
+  d.verdict_reasons = {{"WARN", "bounds", "parameters", "R_a rests on a bound"},
+                       {"PASS", "improvement", "summary", "held-out CF 0.06 -> 0.005"}};
+  d.training_source = "3 runs of this data set, recorded by id";
+  d.trajectories = {all};
+  d.drift = {{1.0, 12, 2.0, 0.2, 0.01, 0.001}};
+  d.effects = {{"time_offset", {"latency_s"}, {0.08}, {0.002}}};
+  d.cf_parameters_only = 0.007;
   return d;
+}
+
+// Cells of a GitHub-flavoured Markdown table row: the '|' not escaped by a backslash, minus one.
+int MarkdownCells(const std::string& row) {
+  int pipes = 0;
+  for (std::size_t i = 0; i < row.size(); ++i)
+    pipes += row[i] == '|' && (i == 0 || row[i - 1] != '\\');
+  return pipes - 1;
 }
 
 TEST(ReportTest, HtmlIsWellFormedAndEmbedsEveryFigure) {
@@ -141,11 +161,14 @@ TEST(ReportTest, HtmlIsWellFormedAndEmbedsEveryFigure) {
     EXPECT_EQ(CheckWellFormed("<!DOCTYPE html>" + fig), "");
     EXPECT_NE(html.find(fig), std::string::npos) << fig.substr(0, 200);
   }
-  // One <svg> per figure: 5 single figures and two (distance, heading) per run.
+  ASSERT_FALSE(f.residual_histogram.empty());
+  EXPECT_NE(html.find(f.residual_histogram), std::string::npos);
+  // One <svg> per figure: 6 single figures and two (distance, heading) per run drawn (all three
+  // here: fewer than worst_runs_drawn).
   std::size_t svgs = 0;
   for (std::size_t p = html.find("<svg"); p != std::string::npos; p = html.find("<svg", p + 1))
     ++svgs;
-  EXPECT_EQ(svgs, 5 + 2 * d.runs.size());
+  EXPECT_EQ(svgs, 6 + 2 * d.runs.size());
   // Clip-path ids must be unique within the document.
   std::set<std::string> ids;
   const std::regex id_re("id=\"([^\"]+)\"");
@@ -160,14 +183,101 @@ TEST(ReportTest, HtmlIsWellFormedAndEmbedsEveryFigure) {
 
 TEST(ReportTest, HtmlReferencesNothingOutsideItself) {
   const std::string html = ReportHtml(SmallReport());
-  for (const char* bad : {"src=", "href=", "@import", "http:", "https:", "xlink", "<link",
-                          "<iframe", "<object", "<embed", "<img"}) {
+  for (const char* bad : {"src=", "@import", "http:", "https:", "xlink", "<link", "<iframe",
+                          "<object", "<embed", "<img", "<script"}) {
     EXPECT_EQ(html.find(bad), std::string::npos) << bad;
   }
+  // Links only to the document's own sections (the verdict's reasons), each of which exists.
+  int links = 0;
+  for (std::size_t p = html.find("href="); p != std::string::npos; p = html.find("href=", p + 1)) {
+    ASSERT_EQ(html.substr(p, 7), "href=\"#") << html.substr(p, 40);
+    const std::string id = html.substr(p + 7, html.find('"', p + 7) - p - 7);
+    EXPECT_NE(html.find("id=\"" + id + "\""), std::string::npos) << id;
+    ++links;
+  }
+  EXPECT_EQ(links, 2);
   // Only in-document url(#...) references.
   for (std::size_t p = html.find("url("); p != std::string::npos; p = html.find("url(", p + 1)) {
     EXPECT_EQ(html[p + 4], '#') << html.substr(p, 40);
   }
+}
+
+// The page is usable on a phone (viewport meta; figures and tables scale or scroll), needs no
+// JavaScript, and stays small on a large data set: 120 runs of 3000 samples each (a 100 Hz
+// recording of 30 s) come out under the 2 MB budget of the issue, because tracks are thinned for
+// drawing and only the worst runs get their error-along-time figures.
+TEST(ReportTest, HtmlIsResponsiveAndWithinItsSizeBudget) {
+  ReportData d = SmallReport();
+  const ReportRun model = d.runs[0];
+  d.runs.clear();
+  for (int k = 0; k < 120; ++k) {
+    ReportRun r = model;
+    r.id = "run" + std::to_string(k);
+    r.trajectory = "T" + std::to_string(k % 12);
+    r.t_s.clear();
+    r.ground_truth_xy.clear();
+    r.before_xy.clear();
+    r.after_xy.clear();
+    r.before_distance_m.clear();
+    r.after_distance_m.clear();
+    r.before_angle_rad.clear();
+    r.after_angle_rad.clear();
+    for (int i = 0; i < 3000; ++i) {
+      const double t = 0.01 * i, a = 0.002 * i + 0.01 * k;
+      r.t_s.push_back(t);
+      r.ground_truth_xy.push_back({std::cos(a), std::sin(a)});
+      r.before_xy.push_back({1.02 * std::cos(a), std::sin(a)});
+      r.after_xy.push_back({1.002 * std::cos(a), std::sin(a)});
+      r.before_distance_m.push_back(0.02 * t);
+      r.after_distance_m.push_back(0.002 * t);
+      r.before_angle_rad.push_back(0.01 * t);
+      r.after_angle_rad.push_back(0.001 * t);
+    }
+    r.after.cf = 0.001 * k;
+    d.runs.push_back(r);
+  }
+  const std::string html = ReportHtml(d);
+  EXPECT_EQ(CheckWellFormed(html), "");
+  EXPECT_LT(html.size(), 2u << 20) << html.size();
+  EXPECT_NE(html.find("<meta name=\"viewport\" content=\"width=device-width"), std::string::npos);
+  EXPECT_NE(html.find("svg{max-width:100%;height:auto}"), std::string::npos);
+  EXPECT_NE(html.find("<div class=\"scroll\">\n<table>"), std::string::npos);
+  EXPECT_EQ(html.find("<script"), std::string::npos);
+  // The worst runs drawn (largest calibrated CF first), not one run behind a selector.
+  const ReportFigures f = MakeReportFigures(d);
+  ASSERT_EQ(f.error_along_time_runs.size(), static_cast<std::size_t>(d.worst_runs_drawn));
+  EXPECT_EQ(f.error_along_time_runs[0], 119u);
+  EXPECT_EQ(f.error_along_time_runs[1], 118u);
+  // Generic labels: nothing of the flower's R/G/B naming on other data.
+  EXPECT_EQ(html.find("R straight"), std::string::npos);
+}
+
+// summary.md renders as tables: in every table, every row has as many cells as the header
+// (the "|angle|" column labels are escaped, not cell separators).
+TEST(ReportTest, MarkdownTablesHaveConsistentCellCounts) {
+  const std::string md = ReportMarkdown(SmallReport());
+  std::istringstream lines(md);
+  std::string line;
+  int header = -1, tables = 0, rows = 0;
+  while (std::getline(lines, line)) {
+    if (line.empty() || line[0] != '|') {
+      header = -1;
+      continue;
+    }
+    if (header < 0) {
+      header = MarkdownCells(line);
+      ++tables;
+      continue;
+    }
+    ++rows;
+    EXPECT_EQ(MarkdownCells(line), header) << line;
+  }
+  EXPECT_GE(tables, 6);
+  EXPECT_GT(rows, 20);
+  EXPECT_NE(md.find("RMS \\|angle\\| error"), std::string::npos);
+  EXPECT_NE(md.find("## Verdict: WARN"), std::string::npos);
+  EXPECT_NE(md.find("| R_a | m |"), std::string::npos);
+  EXPECT_NE(md.find("AT BOUND"), std::string::npos);
 }
 
 TEST(ReportTest, CsvAndJsonCarryTheNumbers) {
@@ -186,6 +296,15 @@ TEST(ReportTest, CsvAndJsonCarryTheNumbers) {
   EXPECT_EQ(j["runs"].size(), d.runs.size());
   EXPECT_NEAR(j["correlation"][0][3].as<double>(), -0.995, 1e-12);
   EXPECT_FALSE(j["identifiability"]["identifiable"].as<bool>());
+  // The verdict and the effects are structured, not strings.
+  EXPECT_EQ(j["verdict"]["level"].as<std::string>(), "WARN");
+  EXPECT_EQ(j["verdict"]["reasons"][0]["check"].as<std::string>(), "bounds");
+  EXPECT_EQ(j["verdict"]["reasons"][0]["section"].as<std::string>(), "parameters");
+  EXPECT_NEAR(j["effects"]["list"][0]["parameters"][0]["value"].as<double>(), 0.08, 1e-12);
+  EXPECT_NEAR(j["effects"]["list"][0]["parameters"][0]["sigma"].as<double>(), 0.002, 1e-12);
+  EXPECT_NEAR(j["effects"]["cf_parameters_only"].as<double>(), 0.007, 1e-12);
+  EXPECT_TRUE(j["parameters"][0]["at_bound"].as<bool>());
+  EXPECT_NEAR(j["drift"][0]["translation_percent"]["after"].as<double>(), 0.2, 1e-12);
   for (const char* stat : {"rmse", "mean", "median", "std", "min", "max"}) {
     EXPECT_TRUE(j["statistics"]["cf"]["before"][stat]) << stat;
   }

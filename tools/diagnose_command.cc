@@ -22,6 +22,7 @@
 #include "tools/cli_validators.h"
 #include "tools/output_guard.h"
 #include "validation/run_split.h"
+#include "validation/training_runs.h"
 #include "validation/trajectory_split.h"
 
 namespace fitcal::tools {
@@ -158,8 +159,8 @@ std::vector<int> ValidationRepetitions(const DiagnoseSplit& split) {
 
 // The calibrated omni3 YAML as before the seam (with M^-1 in the record).
 std::string Omni3CalibratedYaml(const DiagnoseCommandOptions& options, const std::string& path,
-                                const DiagnoseSplit& split, const DiagnoseResult& result,
-                                const DiagnoseChoice& choice) {
+                                const std::vector<RunLog>& logs, const DiagnoseSplit& split,
+                                const DiagnoseResult& result, const DiagnoseChoice& choice) {
   const Omni3Robot robot = io::ReadOmni3Robot(path);
   Omni3Robot calibrated = robot;
   calibrated.nominal = omni3::Parameters::FromArray(choice.parameters.data());
@@ -171,6 +172,9 @@ std::string Omni3CalibratedYaml(const DiagnoseCommandOptions& options, const std
   record.tool_version = kVersion;
   record.termination = result.final_fit.termination;
   record.training_repetitions = split.train_reps;
+  for (const TrackRun& r : split.training) record.training_run_ids.push_back(r.aligned.id);
+  record.training_trajectories = options.train_trajectories;
+  record.training_fingerprint = TrainingFingerprint(logs, record.training_run_ids);
   record.training_runs = static_cast<int>(split.training.size());
   record.validation_runs = static_cast<int>(split.validation.size());
   record.validation_repetitions = ValidationRepetitions(split);
@@ -183,8 +187,9 @@ std::string Omni3CalibratedYaml(const DiagnoseCommandOptions& options, const std
 
 // Any other model: its own YAML with the calibration block, then the accepted effects.
 std::string ModelCalibratedYaml(const DiagnoseCommandOptions& options,
-                                const RobotModelInterface& model, const DiagnoseSplit& split,
-                                const DiagnoseResult& result, const DiagnoseChoice& choice) {
+                                const RobotModelInterface& model, const std::vector<RunLog>& logs,
+                                const DiagnoseSplit& split, const DiagnoseResult& result,
+                                const DiagnoseChoice& choice) {
   const Robot& robot = model.robot();
   io::CalibrationBlock block;
   block.method = "diagnose: " + choice.name;
@@ -195,6 +200,8 @@ std::string ModelCalibratedYaml(const DiagnoseCommandOptions& options,
   block.training_repetitions = split.train_reps;
   block.validation_repetitions = ValidationRepetitions(split);
   for (const TrackRun& r : split.training) block.training_run_ids.push_back(r.aligned.id);
+  block.training_trajectories = options.train_trajectories;
+  block.training_fingerprint = TrainingFingerprint(logs, block.training_run_ids);
   block.training_runs = static_cast<int>(split.training.size());
   block.validation_runs = static_cast<int>(split.validation.size());
   block.cf_validation_before = choice.cf_before;
@@ -301,8 +308,8 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
       return 5;
     }
     const std::string yaml =
-        omni3 ? Omni3CalibratedYaml(options, index.robot_path, split, result, choice)
-              : ModelCalibratedYaml(options, *model, split, result, choice);
+        omni3 ? Omni3CalibratedYaml(options, index.robot_path, runs, split, result, choice)
+              : ModelCalibratedYaml(options, *model, runs, split, result, choice);
     WriteOutputs(options, inputs, report, result, yaml);
     std::printf(
         "\nwrote %s/{diagnose.md, residuals.csv, residuals_declared.csv, calibrated.yaml}\n",

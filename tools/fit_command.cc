@@ -30,6 +30,7 @@
 #include "tools/output_guard.h"
 #include "tools/sim/flower_candidates.h"
 #include "validation/run_split.h"
+#include "validation/training_runs.h"
 
 namespace fitcal::tools {
 
@@ -310,6 +311,12 @@ int RunFitCommand(const FitCommandOptions& options) {
       record.termination = fit.termination;
       record.training_repetitions = split.training_repetitions;
       record.validation_repetitions = split.validation_repetitions;
+      for (const AlignedRun& run : split.training) record.training_run_ids.push_back(run.id);
+      record.training_trajectories = options.train_trajectories;
+      record.training_fingerprint = TrainingFingerprint(dataset.runs, record.training_run_ids);
+      for (int k = 0; k < omni3::kNumParameters; ++k) {
+        if (fit_won && fit.at_bound[k]) record.at_bound.push_back(ParameterName(k));
+      }
       record.training_runs = static_cast<int>(split.training.size());
       record.validation_runs = static_cast<int>(split.validation.size());
       Omni3ParameterArray selected_array;

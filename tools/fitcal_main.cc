@@ -295,13 +295,17 @@ int main(int argc, char** argv) {
   report_cmd->add_option("--logs", report.logs, "Data set directory")
       ->required()
       ->check(CLI::ExistingDirectory);
-  report_cmd->add_option("--calibration", report.calibration, "Calibrated robot YAML (from fit)")
+  report_cmd
+      ->add_option("--calibration", report.calibrations,
+                   "Calibrated robot YAML (from fit or diagnose); repeat it to compare several "
+                   "calibrations on the same runs (the first is reported in full)")
       ->required()
       ->check(CLI::ExistingFile);
   report_cmd->add_option("--out", report.out, "Output directory for the report")->required();
   report_cmd
       ->add_option("--train-reps", report.train_reps,
-                   "Training repetitions (default: as recorded in the calibration YAML)")
+                   "Training repetitions of this data set (default: the runs the calibration "
+                   "YAML records; on another data set every run validates)")
       ->check(fitcal::tools::RepetitionListValidator());
   report_cmd
       ->add_option("--sampling", report.sampling,
@@ -309,6 +313,14 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   report_cmd->add_flag("--cv", report.cross_validate,
                        "Also run leave-one-repetition-out cross-validation");
+  report_cmd->add_flag("--strict", report.strict,
+                       "Exit 7 when the verdict is FAIL and 8 when it is WARN (the report is "
+                       "written either way), for CI pipelines");
+  report_cmd
+      ->add_option("--worst-runs", report.worst_runs,
+                   "Draw the error along time of this many of the worst validation runs")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   report_cmd->add_flag("--allow-outside-paths", report.allow_outside_paths,
                        "Allow dataset.yaml paths outside the data set directory");
   report_cmd->add_option("--threads", report.threads, "Worker threads (0 = all cores)");

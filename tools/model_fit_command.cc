@@ -17,6 +17,7 @@
 #include "tools/fit_methods.h"
 #include "tools/output_guard.h"
 #include "validation/run_split.h"
+#include "validation/training_runs.h"
 
 namespace fitcal::tools {
 
@@ -97,8 +98,8 @@ std::vector<CalibrationCandidate> Candidates(const RobotModelInterface& model,
 }
 
 io::CalibrationBlock MakeRecord(const FitCommandOptions& options, const RobotModelInterface& model,
-                                const RunSplit& split, const ModelFitResult& fit,
-                                const std::string& objective,
+                                const std::vector<RunLog>& logs, const RunSplit& split,
+                                const ModelFitResult& fit, const std::string& objective,
                                 const std::vector<CalibrationCandidate>& candidates,
                                 const GateDecision& gate) {
   const Robot& robot = model.robot();
@@ -113,6 +114,8 @@ io::CalibrationBlock MakeRecord(const FitCommandOptions& options, const RobotMod
   r.training_repetitions = split.training_repetitions;
   r.validation_repetitions = split.validation_repetitions;
   for (const AlignedRun& run : split.training) r.training_run_ids.push_back(run.id);
+  r.training_trajectories = options.train_trajectories;
+  r.training_fingerprint = TrainingFingerprint(logs, r.training_run_ids);
   r.training_runs = static_cast<int>(split.training.size());
   r.validation_runs = static_cast<int>(split.validation.size());
   r.cf_training_before =
@@ -276,7 +279,7 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   }
   if (!options.no_output) {
     const io::CalibrationBlock record =
-        MakeRecord(options, *model, split, fit, outcome.objective, candidates, gate);
+        MakeRecord(options, *model, dataset.runs, split, fit, outcome.objective, candidates, gate);
     io::StopHereForTests("fitted");
     io::WriteFileAtomically(options.out,
                             model->RobotYaml(selected, io::CalibrationBlockYaml(record, robot)));

@@ -1,14 +1,19 @@
 #include "tools/report_command.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <map>
+#include <optional>
+#include <regex>
 #include <set>
 
 #include "diagnosis/identifiability.h"
+#include "fit/determined_directions.h"
 #include "fitcal/version.h"
 #include "io/atomic_file.h"
 #include "io/calibration_yaml.h"
@@ -17,16 +22,23 @@
 #include "io/report_writer.h"
 #include "io/robot_yaml.h"
 #include "io/staged_directory.h"
+#include "models/model_registry.h"
 #include "odometry/effects.h"
 #include "tools/output_guard.h"
 #include "tools/sim/flower_candidates.h"
 #include "validation/cross_validation.h"
+#include "validation/relative_pose_error.h"
 #include "validation/run_split.h"
+#include "validation/training_runs.h"
 #include "validation/trajectory_metrics.h"
+#include "validation/verdict.h"
 
 namespace fitcal::tools {
 
 namespace {
+
+const std::set<std::string> kReportFiles = {"index.html", "summary.md", "metrics.csv",
+                                            "metrics.json"};
 
 // TrajectoryErrors (one run) and Table6Averages (a group) carry the same Eq. 8-14 fields.
 template <typename Metrics>
@@ -46,15 +58,20 @@ io::ReportStatistics StatsOf(const SummaryStatistics& s) {
   return {s.rmse, s.mean, s.median, s.std, s.min, s.max};
 }
 
-// A world point in the frame of `start` (origin at the start position, +x along its heading).
-io::Point2 InStartFrame(const Pose2d& start, double x, double y) {
-  const double c = std::cos(start.theta), s = std::sin(start.theta);
-  const double dx = x - start.x, dy = y - start.y;
-  return {c * dx + s * dy, -s * dx + c * dy};
-}
+// A world vector in the frame of `start` (+x along its heading).
 io::Point2 VectorInStartFrame(const Pose2d& start, double dx, double dy) {
   const double c = std::cos(start.theta), s = std::sin(start.theta);
   return {c * dx + s * dy, -s * dx + c * dy};
+}
+// A world point in the frame of `start` (origin at the start position).
+io::Point2 InStartFrame(const Pose2d& start, double x, double y) {
+  return VectorInStartFrame(start, x - start.x, y - start.y);
+}
+
+Omni3ParameterArray ArrayOf(const std::vector<double>& p) {
+  Omni3ParameterArray a{};
+  std::copy(p.begin(), p.begin() + omni3::kNumParameters, a.begin());
+  return a;
 }
 
 // Family of a trajectory label for the Table 6 rows: the label without its trailing number
@@ -65,11 +82,579 @@ std::string FamilyOf(const std::string& label) {
   return end == 0 ? label : label.substr(0, end);
 }
 
-}  // namespace
+// One calibration to judge: the calibrated robot and what its YAML records.
+struct CalibrationInput {
+  std::string path;
+  Robot calibrated;  // its nominal values are the calibrated parameters
+  std::optional<io::CalibrationProvenance> provenance;
+};
 
-namespace {
-const std::set<std::string> kReportFiles = {"index.html", "summary.md", "metrics.csv",
-                                            "metrics.json"};
+// Everything the report reads, loaded and checked before anything is computed.
+struct ReportInputs {
+  io::DatasetIndex index;
+  std::vector<std::string> inputs;  // files the output must not overwrite
+  io::Dataset dataset;
+  RobotModelPtr model;  // the data set's robot (nominal parameters, absolute bounds), any model
+  bool omni3 = false;
+  Omni3Robot omni3_robot;  // omni3 only: its identifiability analysis and cross-validation
+  std::vector<CalibrationInput> calibrations;  // the first is the report's; others compared
+};
+
+// The validation runs of one report, each replayed with the nominal and the calibrated model.
+struct EvaluatedRuns {
+  TrainingSplit split;
+  std::vector<TrajectoryErrors> before, after;
+  std::vector<double> cf_parameters_only;  // calibrated parameters without the effects
+};
+
+TrainingSplit SplitForReport(const ReportCommandOptions& options, const ReportInputs& in,
+                             const CalibrationInput& cal) {
+  std::vector<AlignedRun> aligned = AlignRuns(in.dataset.runs);
+  if (!options.train_reps.empty()) {
+    return {SplitByRepetition(std::move(aligned), ParseRepetitionList(options.train_reps)),
+            "by repetition (--train-reps)"};
+  }
+  RecordedTraining recorded;
+  if (cal.provenance) {
+    recorded.run_ids = cal.provenance->training_run_ids;
+    recorded.fingerprint = cal.provenance->training_fingerprint;
+    recorded.repetitions = cal.provenance->training_repetitions;
+  }
+  return SplitAsRecorded(in.dataset.runs, std::move(aligned), recorded);
+}
+
+std::string TrainingSource(const CalibrationInput& cal, const TrainingSplit& t) {
+  const std::string n = std::to_string(t.split.training.size());
+  const std::string reps = FormatRepetitionList(t.split.training_repetitions);
+  if (t.how == "by id") {
+    const std::string& selector = cal.provenance->training_trajectories;
+    return n + " runs of this data set, recorded by id (repetitions " + reps +
+           (selector.empty() ? "" : "; trajectories matching '" + selector + "'") + ")";
+  }
+  if (t.how != "none")
+    return n + " runs of this data set, " + t.how + " (repetitions " + reps + ")";
+  if (!cal.provenance) return "none recorded (a robot YAML without a calibration block)";
+  return "another data set (" + cal.provenance->dataset + "): every run here validates";
+}
+
+ReportInputs LoadInputs(const ReportCommandOptions& options, std::string* refusal) {
+  ReportInputs in;
+  io::DatasetOptions dataset_options;
+  dataset_options.allow_paths_outside = options.allow_outside_paths;
+  dataset_options.num_threads = options.threads;
+  in.index = io::ReadDatasetIndex(options.logs, dataset_options);
+  in.inputs = DatasetInputs(in.index);
+  in.inputs.insert(in.inputs.end(), options.calibrations.begin(), options.calibrations.end());
+  *refusal = OutputDirectoryRefusal(options.out, in.inputs, kReportFiles);
+  if (!refusal->empty()) return in;
+  in.model = ReadRobotModelFile(in.index.robot_path);
+  in.omni3 = in.model->robot().model == "omni3";
+  // omni3 data sets load as `fit` loads them (their runs' fingerprints must agree).
+  in.dataset = in.omni3 ? io::LoadDataset(in.index, dataset_options)
+                        : io::LoadDataset(in.index, in.model->robot(), dataset_options);
+  if (in.omni3) in.omni3_robot = io::ReadOmni3Robot(in.dataset.robot_path);
+  for (const std::string& path : options.calibrations) {
+    Robot calibrated = ReadRobotModelFile(path)->robot();
+    if (calibrated.model != in.model->robot().model ||
+        calibrated.NumParameters() != in.model->robot().NumParameters()) {
+      throw io::InputError(
+          io::InputErrorKind::kBadValue, path, 0,
+          "a " + calibrated.model + " robot with " + std::to_string(calibrated.NumParameters()) +
+              " parameters cannot calibrate the data set's " + in.model->robot().model + " robot");
+    }
+    in.calibrations.push_back({path, std::move(calibrated), io::ReadCalibrationProvenance(path)});
+  }
+  return in;
+}
+
+// Each calibration's split, the validation runs restricted to those every calibration left out:
+// several calibrations are compared on the same runs, the ones none of them trained on.
+std::vector<TrainingSplit> CommonSplits(const ReportCommandOptions& options,
+                                        const ReportInputs& in) {
+  std::vector<TrainingSplit> splits;
+  std::map<std::string, int> validating;  // run id -> calibrations it validates
+  for (const CalibrationInput& cal : in.calibrations) {
+    splits.push_back(SplitForReport(options, in, cal));
+    for (const AlignedRun& run : splits.back().split.validation) ++validating[run.id];
+  }
+  const int all = static_cast<int>(in.calibrations.size());
+  for (TrainingSplit& t : splits) {
+    std::vector<AlignedRun> kept;
+    std::set<int> reps;
+    for (AlignedRun& run : t.split.validation) {
+      if (validating[run.id] != all) continue;
+      reps.insert(run.repetition);
+      kept.push_back(std::move(run));
+    }
+    t.split.validation = std::move(kept);
+    t.split.validation_repetitions.assign(reps.begin(), reps.end());
+  }
+  return splits;
+}
+
+EvaluatedRuns EvaluateRuns(const ReportInputs& in, const CalibrationInput& cal, TrainingSplit split,
+                           OdometrySampling sampling) {
+  EvaluatedRuns e;
+  e.split = std::move(split);
+  std::map<std::string, const RunLog*> logs_by_id;
+  for (const RunLog& log : in.dataset.runs) logs_by_id[log.id] = &log;
+  const std::vector<double>& nominal = in.model->robot().nominal;
+  const std::vector<double>& p = cal.calibrated.nominal;
+  const std::vector<effects::EffectValue>& effects = cal.calibrated.effects;
+  // omni3 keeps its own replay (Eq. 4 with M^-1), whose CF `fit` records; every other model
+  // replays through the seam.
+  const auto evaluate = [&](const AlignedRun& run, const GroundTruthTrack& track,
+                            const std::vector<double>& q,
+                            const std::vector<effects::EffectValue>& with) {
+    return in.omni3 ? EvaluateTrajectory(run, track, ArrayOf(q), with, sampling)
+                    : EvaluateTrajectory(*in.model, run, track, q, with, sampling);
+  };
+  for (const AlignedRun& run : e.split.split.validation) {
+    const GroundTruthTrack& track = logs_by_id.at(run.id)->ground_truth;
+    e.before.push_back(evaluate(run, track, nominal, {}));
+    // The calibrated model as the YAML describes it: the parameters and any effects `fitcal
+    // diagnose` accepted (the replay honours them, latency included).
+    e.after.push_back(evaluate(run, track, p, effects));
+    e.cf_parameters_only.push_back(effects.empty() ? e.after.back().cf
+                                                   : evaluate(run, track, p, {}).cf);
+  }
+  return e;
+}
+
+io::ReportRun MakeReportRun(const AlignedRun& run, const TrajectoryErrors& b,
+                            const TrajectoryErrors& a) {
+  io::ReportRun r;
+  r.id = run.id;
+  r.trajectory = run.trajectory;
+  r.repetition = run.repetition;
+  r.ground_truth_xy.push_back({0.0, 0.0});
+  r.before_xy.push_back({0.0, 0.0});
+  r.after_xy.push_back({0.0, 0.0});
+  for (std::size_t i = 0; i < b.t_s.size(); ++i) {
+    r.t_s.push_back(b.t_s[i] - run.t_start_s);
+    r.ground_truth_xy.push_back(InStartFrame(run.start, b.ground_truth[i].x, b.ground_truth[i].y));
+    r.before_xy.push_back(InStartFrame(run.start, b.odometry[i].x, b.odometry[i].y));
+    r.after_xy.push_back(InStartFrame(run.start, a.odometry[i].x, a.odometry[i].y));
+  }
+  r.ground_truth_xy.push_back(
+      InStartFrame(run.start, run.final_ground_truth.x, run.final_ground_truth.y));
+  r.before_xy.push_back(InStartFrame(run.start, b.final_odometry.x, b.final_odometry.y));
+  r.after_xy.push_back(InStartFrame(run.start, a.final_odometry.x, a.final_odometry.y));
+  for (std::size_t i = 1; i < r.ground_truth_xy.size(); ++i) {
+    r.path_length_m += std::hypot(r.ground_truth_xy[i].x - r.ground_truth_xy[i - 1].x,
+                                  r.ground_truth_xy[i].y - r.ground_truth_xy[i - 1].y);
+  }
+  r.before_distance_m = b.distance_error_m;
+  r.after_distance_m = a.distance_error_m;
+  r.before_angle_rad = b.angle_error_rad;
+  r.after_angle_rad = a.angle_error_rad;
+  r.before_final_error = VectorInStartFrame(run.start, b.final_odometry.x - b.final_ground_truth.x,
+                                            b.final_odometry.y - b.final_ground_truth.y);
+  r.after_final_error = VectorInStartFrame(run.start, a.final_odometry.x - a.final_ground_truth.x,
+                                           a.final_odometry.y - a.final_ground_truth.y);
+  r.before_final_heading_rad = WrapAngle(b.final_odometry.theta - b.final_ground_truth.theta);
+  r.after_final_heading_rad = WrapAngle(a.final_odometry.theta - a.final_ground_truth.theta);
+  r.before = MetricsOf(b);
+  r.after = MetricsOf(a);
+  return r;
+}
+
+// Table 6 rows (per family when there are several, then all runs) and one row per trajectory.
+void AddGroupRows(const EvaluatedRuns& e, io::ReportData* data) {
+  const std::vector<AlignedRun>& runs = e.split.split.validation;
+  const auto row = [&](const std::string& name, const std::function<bool(const AlignedRun&)>& in) {
+    std::vector<const TrajectoryErrors*> b, a;
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+      if (!in(runs[i])) continue;
+      b.push_back(&e.before[i]);
+      a.push_back(&e.after[i]);
+    }
+    return io::ReportSummaryRow{name, static_cast<int>(b.size()), MetricsOf(AverageOf(b)),
+                                MetricsOf(AverageOf(a))};
+  };
+  std::vector<std::string> families, labels;
+  for (const AlignedRun& run : runs) {
+    const std::string f = FamilyOf(run.trajectory);
+    if (std::find(families.begin(), families.end(), f) == families.end()) families.push_back(f);
+    if (std::find(labels.begin(), labels.end(), run.trajectory) == labels.end()) {
+      labels.push_back(run.trajectory);
+    }
+  }
+  if (families.size() > 1) {
+    for (const std::string& f : families) {
+      data->summary.push_back(row("trajectories " + f + "*", [&](const AlignedRun& r) {
+        return FamilyOf(r.trajectory) == f;
+      }));
+    }
+  }
+  data->summary.push_back(row("all validation runs", [](const AlignedRun&) { return true; }));
+  for (const std::string& label : labels) {
+    data->trajectories.push_back(
+        row(label, [&](const AlignedRun& r) { return r.trajectory == label; }));
+  }
+}
+
+// evo-style statistics of the per-run quantities.
+void AddStatistics(const EvaluatedRuns& e, io::ReportData* data) {
+  struct StatDef {
+    const char* name;
+    bool is_angle;
+    double TrajectoryErrors::*field;
+  };
+  const StatDef stat_defs[] = {{"rms_distance_m", false, &TrajectoryErrors::rms_distance_m},
+                               {"rms_angle", true, &TrajectoryErrors::rms_angle_rad},
+                               {"final_distance_m", false, &TrajectoryErrors::final_distance_m},
+                               {"final_angle", true, &TrajectoryErrors::final_angle_rad},
+                               {"cf", false, &TrajectoryErrors::cf}};
+  for (const StatDef& s : stat_defs) {
+    std::vector<double> vb, va;
+    for (std::size_t i = 0; i < e.before.size(); ++i) {
+      vb.push_back(e.before[i].*s.field);
+      va.push_back(e.after[i].*s.field);
+    }
+    data->statistics.push_back(io::ReportStatisticsRow{s.name, s.is_angle, StatsOf(Summarize(vb)),
+                                                       StatsOf(Summarize(va))});
+  }
+}
+
+// Relative pose error over path lengths suited to these runs (validation/relative_pose_error.h).
+void AddDrift(const EvaluatedRuns& e, io::ReportData* data) {
+  std::vector<double> lengths;
+  for (const io::ReportRun& r : data->runs) lengths.push_back(r.path_length_m);
+  for (double length : RelativePoseErrorLengths(Summarize(lengths).median)) {
+    RelativePoseErrorSum before, after;
+    for (std::size_t i = 0; i < e.before.size(); ++i) {
+      AddRelativePoseErrors(e.before[i].ground_truth, e.before[i].odometry, length, &before);
+      AddRelativePoseErrors(e.after[i].ground_truth, e.after[i].odometry, length, &after);
+    }
+    data->drift.push_back({length, before.windows, before.MeanTranslationPercent(),
+                           after.MeanTranslationPercent(), before.MeanRotationRadPerM(),
+                           after.MeanRotationRadPerM()});
+  }
+}
+
+// Uncertainty and identifiability at the calibrated parameters from the training runs, when they
+// are in this data set: covariance s^2 (J^T J)^-1 with s^2 = |r|^2 / (3 N - 9), the fit's
+// (omni3_ceres_fit.h). Advice on trajectories only for training runs of the flower, whose
+// candidate runs the analysis knows; never for another data set's trajectory family.
+void AddOmni3Uncertainty(const ReportInputs& in, const CalibrationInput& cal,
+                         const std::vector<AlignedRun>& training, int threads, io::ReportData* data,
+                         std::vector<double>* sigma, bool* has_sigma) {
+  const Omni3ParameterArray nominal = ArrayOf(in.model->robot().nominal);
+  const Omni3ParameterArray p = ArrayOf(cal.calibrated.nominal);
+  const bool flower = std::any_of(training.begin(), training.end(), [](const AlignedRun& run) {
+    return std::regex_match(run.trajectory, std::regex("[RGB][0-9]+"));
+  });
+  const Eigen::MatrixXd jacobian = FinalPoseJacobian(p, training, ResidualWeights{}, threads);
+  const IdentifiabilityReport ident = AnalyseIdentifiability(
+      jacobian, p, flower ? sim::FlowerCandidateMotions() : std::vector<CandidateMotion>{},
+      nominal);
+  data->identifiable = ident.identifiable;
+  data->condition_number = ident.condition_number;
+  data->identifiability_lines = IdentifiabilityLines(ident);
+  const int dof = 3 * static_cast<int>(training.size()) - omni3::kNumParameters;
+  if (dof <= 0 || ident.rank_deficient) {
+    data->uncertainty_note = dof <= 0 ? "No uncertainty: too few training runs (need more than 3)."
+                                      : "No uncertainty: the covariance is rank deficient (see "
+                                        "Identifiability below).";
+    return;
+  }
+  if (!cal.calibrated.effects.empty()) {
+    // The covariance of the parameters alone would describe another model than the one used
+    // (the effects move with them); the effects' own sigmas are in the Effects table.
+    data->uncertainty_note =
+        "No parameter sigma: the calibration carries effects, and the covariance of the "
+        "parameters without them describes another model than the one replayed here.";
+    return;
+  }
+  double sum_r2 = 0.0;
+  for (const AlignedRun& run : training) {
+    double r[3];
+    Omni3FinalPoseResidual(run, ResidualWeights{})(p.data(), r);
+    sum_r2 += r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+  }
+  const Eigen::MatrixXd jtj = jacobian.transpose() * jacobian;
+  const Eigen::MatrixXd cov =
+      (sum_r2 / dof) * jtj.ldlt().solve(Eigen::MatrixXd::Identity(jtj.rows(), jtj.cols()));
+  *has_sigma = true;
+  data->has_correlation = true;
+  data->correlation.assign(omni3::kNumParameters, std::vector<double>(omni3::kNumParameters));
+  sigma->assign(omni3::kNumParameters, 0.0);
+  for (int k = 0; k < omni3::kNumParameters; ++k) (*sigma)[k] = std::sqrt(std::max(0.0, cov(k, k)));
+  for (int a = 0; a < omni3::kNumParameters; ++a) {
+    for (int b = 0; b < omni3::kNumParameters; ++b) {
+      const double den = (*sigma)[a] * (*sigma)[b];
+      data->correlation[a][b] = den > 0.0 ? cov(a, b) / den : (a == b ? 1.0 : 0.0);
+    }
+  }
+  char note[320];
+  std::snprintf(note, sizeof note,
+                "One sigma from the covariance s^2 (J^T J)^-1 of the final-pose residuals of the "
+                "%zu training runs at the calibrated parameters, scaled by their residual variance "
+                "(s = %.3g, metres and radians weighed 1:1 as Eq. 14).",
+                training.size(), std::sqrt(sum_r2 / dof));
+  data->uncertainty_note = note;
+}
+
+// Any other model: which directions of its parameter space the training runs determine
+// (fit/determined_directions.h, as `fit` holds them), named in parameter terms with the training
+// trajectory that sees each most. The covariance is the fit's (`fitcal fit` prints it).
+void AddModelIdentifiability(const ReportInputs& in, const CalibrationInput& cal,
+                             const std::vector<AlignedRun>& training, int threads,
+                             io::ReportData* data) {
+  const DirectionAnalysis d = AnalyseDeterminedDirections(
+      training, *in.model, cal.calibrated.nominal, ResidualWeights{}, nullptr, threads);
+  data->identifiable = d.ok && d.undetermined.empty();
+  for (const UndeterminedDirection& u : d.undetermined) {
+    data->identifiability_lines.push_back("not determined by the training runs: " + u.description);
+  }
+  if (!d.ok) data->identifiability_lines.push_back("no Jacobian at the calibrated parameters");
+  data->uncertainty_note = "No parameter sigma here: this report does not refit a " +
+                           in.model->robot().model +
+                           " robot; fitcal fit prints the fit's and records them in the YAML.";
+}
+
+// Uncertainty and identifiability from the training runs, only when they are in this data set.
+void AddUncertainty(const ReportInputs& in, const CalibrationInput& cal,
+                    const std::vector<AlignedRun>& training, int threads, io::ReportData* data,
+                    std::vector<double>* sigma, bool* has_sigma) {
+  *has_sigma = false;
+  data->identifiability_checked = !training.empty();
+  if (training.empty()) {
+    data->uncertainty_note =
+        "No uncertainty from this data set: the calibration's training runs are not in it.";
+    return;
+  }
+  if (in.omni3) {
+    AddOmni3Uncertainty(in, cal, training, threads, data, sigma, has_sigma);
+  } else {
+    AddModelIdentifiability(in, cal, training, threads, data);
+  }
+}
+
+// A parameter rests on a bound when it is within 1e-6 of the box's width of it: far above the
+// YAML's 10 significant digits (1e-11 m on a 0.2 m distance), far below any meaningful change.
+bool AtBound(double value, const Interval& box) {
+  const double tolerance = 1e-6 * box.Width();
+  return value <= box.lo + tolerance || value >= box.hi - tolerance;
+}
+
+void AddParameters(const ReportInputs& in, const CalibrationInput& cal,
+                   const std::optional<CrossValidationResult>& cv, const std::vector<double>& sigma,
+                   bool has_sigma, io::ReportData* data) {
+  const Robot& robot = in.model->robot();
+  std::set<std::string> recorded_at_bound;
+  if (cal.provenance) {
+    recorded_at_bound.insert(cal.provenance->at_bound.begin(), cal.provenance->at_bound.end());
+  }
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    io::ReportParameter rp;
+    rp.name = robot.parameters[k].name;
+    rp.is_angle = robot.parameters[k].unit == ParameterUnit::kAngle;
+    rp.unit = robot.parameters[k].DisplayUnit();
+    rp.nominal = robot.nominal[k];
+    rp.calibrated = cal.calibrated.nominal[k];
+    rp.has_sigma = has_sigma && !robot.IsHeld(k);
+    rp.sigma = has_sigma ? sigma[k] : 0.0;
+    rp.at_bound = recorded_at_bound.count(rp.name) > 0 ||
+                  (!robot.IsHeld(k) && AtBound(rp.calibrated, robot.bounds[k]));
+    if (cv) {
+      const SummaryStatistics& s = cv->parameter_spread[k];
+      rp.has_cv = s.count > 0;
+      rp.cv_mean = s.mean;
+      rp.cv_std = s.std;
+      rp.cv_min = s.min;
+      rp.cv_max = s.max;
+    }
+    data->parameters.push_back(rp);
+  }
+}
+
+void AddEffects(const CalibrationInput& cal, const EvaluatedRuns& e, io::ReportData* data) {
+  for (const effects::EffectValue& value : cal.calibrated.effects) {
+    const effects::EffectInfo& info = effects::Info(value.id);
+    io::ReportEffect effect;
+    effect.name = info.name;
+    for (int k = 0; k < info.num_parameters; ++k) {
+      effect.parameter_names.push_back(info.parameter_names[k]);
+      effect.values.push_back(value.value[k]);
+      effect.sigmas.push_back(value.sigma[k]);
+    }
+    data->effects.push_back(effect);
+  }
+  double sum = 0.0;
+  for (double cf : e.cf_parameters_only) sum += cf;
+  data->cf_parameters_only = e.cf_parameters_only.empty() ? 0.0 : sum / e.cf_parameters_only.size();
+}
+
+GroupOutcome OutcomeOf(const io::ReportSummaryRow& row) {
+  return {row.group,
+          row.runs,
+          row.before.cf,
+          row.after.cf,
+          row.before.final_distance_m,
+          row.after.final_distance_m};
+}
+
+void AddVerdict(const CalibrationInput& cal, io::ReportData* data) {
+  VerdictInputs v;
+  if (cal.provenance) {
+    v.termination = cal.provenance->termination;
+    v.has_training_cf = cal.provenance->has_training_cf;
+    v.training_cf_after = cal.provenance->cf_training_after;
+  }
+  for (const io::ReportParameter& p : data->parameters) {
+    if (p.at_bound) v.at_bound.push_back(p.name);
+  }
+  v.overall = OutcomeOf(data->summary.back());
+  for (std::size_t i = 0; i + 1 < data->summary.size(); ++i) {
+    v.families.push_back(OutcomeOf(data->summary[i]));
+  }
+  for (const io::ReportSummaryRow& row : data->trajectories) {
+    v.trajectories.push_back(OutcomeOf(row));
+  }
+  std::vector<FinalErrorSample> errors;
+  for (const io::ReportRun& r : data->runs) {
+    errors.push_back({r.trajectory, r.after_final_error.x, r.after_final_error.y});
+  }
+  v.noise_floor = TestAgainstNoiseFloor(errors);
+  data->noise_floor = {v.noise_floor.available, v.noise_floor.noise_sigma_m,
+                       v.noise_floor.systematic_rms_m, v.noise_floor.f_statistic,
+                       v.noise_floor.p_value};
+  v.identifiability_checked = data->identifiability_checked;
+  v.identifiable = data->identifiable;
+  const Verdict verdict = JudgeCalibration(v);
+  data->verdict = ToString(verdict.level);
+  for (const VerdictReason& r : verdict.reasons) {
+    data->verdict_reasons.push_back({ToString(r.level), r.check, r.section, r.message});
+  }
+}
+
+std::string CalibrationNote(const CalibrationInput& cal) {
+  if (!cal.provenance) return "a robot YAML without a calibration block";
+  const io::CalibrationProvenance& p = *cal.provenance;
+  return "method " + (p.method.empty() ? std::string("not recorded") : p.method) +
+         ", solver termination " + (p.termination.empty() ? "not recorded" : p.termination) +
+         ", trained on data set " + (p.dataset.empty() ? "not recorded" : p.dataset);
+}
+
+void WriteReport(const ReportCommandOptions& options, const ReportInputs& in,
+                 const io::ReportData& data) {
+  // Everything is computed; only now touch the output directory, as a set (README, "Nothing
+  // lost"): the files go into a staged sibling renamed over the previous report, so a signal,
+  // a full disk or a second writer never leaves a mix of old and new files.
+  namespace fs = std::filesystem;
+  io::StagedDirectory staged(options.out);
+  const fs::path out(staged.path());
+  io::WriteFileAtomically((out / "index.html").string(), io::ReportHtml(data));
+  io::WriteFileAtomically((out / "summary.md").string(), io::ReportMarkdown(data));
+  io::WriteFileAtomically((out / "metrics.csv").string(), io::MetricsCsv(data));
+  io::StopHereForTests("report-staged");
+  io::WriteFileAtomically((out / "metrics.json").string(), io::MetricsJson(data));
+  CommitOutputDirectory(staged, options.out, in.inputs, kReportFiles);
+}
+
+void PrintReport(const ReportCommandOptions& options, const io::ReportData& data,
+                 const std::optional<CrossValidationResult>& cv) {
+  const io::ReportSummaryRow& all = data.summary.back();
+  std::printf("validation: %zu runs (repetitions %s), odometry sampled by %s time\n",
+              data.runs.size(), data.validation_repetitions.c_str(), data.sampling.c_str());
+  std::printf("training: %s\n", data.training_source.c_str());
+  std::printf("  CF (Eq. 14)            %.4f -> %.4f  (%+.1f %%)\n", all.before.cf, all.after.cf,
+              ImprovementPercent(all.before.cf, all.after.cf));
+  std::printf("  RMS distance error [m] %.4f -> %.4f  (%+.1f %%)\n", all.before.rms_distance_m,
+              all.after.rms_distance_m,
+              ImprovementPercent(all.before.rms_distance_m, all.after.rms_distance_m));
+  for (const std::string& line : data.identifiability_lines) std::printf("%s\n", line.c_str());
+  if (cv) {
+    std::printf("cross-validation: %zu folds, validation CF %.4f +- %.4f (min %.4f, max %.4f)\n",
+                cv->folds.size(), cv->cf_validation_after.mean, cv->cf_validation_after.std,
+                cv->cf_validation_after.min, cv->cf_validation_after.max);
+  }
+  for (const io::ReportComparisonRow& c : data.comparison) {
+    std::printf("  compared: %-40s %s  held-out CF %.4f -> %.4f\n", c.calibration.c_str(),
+                c.verdict.c_str(), c.all.before.cf, c.all.after.cf);
+  }
+  std::printf("verdict: %s\n", data.verdict.c_str());
+  for (const io::ReportVerdictReason& r : data.verdict_reasons) {
+    std::printf("  %s %s: %s\n", r.level.c_str(), r.check.c_str(), r.message.c_str());
+  }
+  std::printf("wrote %s/{index.html, summary.md, metrics.csv, metrics.json}\n",
+              options.out.c_str());
+}
+
+// --strict: the verdict as the exit status, for CI pipelines (README, exit codes).
+int ExitStatus(const ReportCommandOptions& options, const std::string& verdict) {
+  if (!options.strict || verdict == "PASS") return 0;
+  return verdict == "FAIL" ? kReportFailExit : kReportWarnExit;
+}
+
+std::optional<CrossValidationResult> AddCrossValidation(const ReportCommandOptions& options,
+                                                        const ReportInputs& in,
+                                                        io::ReportData* data) {
+  if (!options.cross_validate) return std::nullopt;
+  CeresFitOptions fit_options;
+  fit_options.num_threads = options.threads;
+  CrossValidationResult cv =
+      LeaveOneRepetitionOut(AlignRuns(in.dataset.runs), in.omni3_robot, fit_options);
+  data->has_cv = true;
+  data->cv_cf_after = StatsOf(cv.cf_validation_after);
+  data->cv_cf_before = StatsOf(cv.cf_validation_before);
+  for (const CrossValidationFold& f : cv.folds) {
+    data->folds.push_back(io::ReportFold{f.held_out_repetition, f.usable, f.cf_training,
+                                         f.cf_validation_before, f.cf_validation_after});
+  }
+  return cv;
+}
+
+// The whole report of one calibration on its validation runs; `cv` (the first calibration's
+// only: it does not depend on the calibration) receives the cross-validation when asked for.
+io::ReportData BuildReportData(const ReportCommandOptions& options, const ReportInputs& in,
+                               const CalibrationInput& cal, TrainingSplit split,
+                               OdometrySampling sampling,
+                               std::optional<CrossValidationResult>* cv) {
+  const EvaluatedRuns e = EvaluateRuns(in, cal, std::move(split), sampling);
+  const std::vector<AlignedRun>& training = e.split.split.training;
+  io::ReportData data;
+  data.tool_version = kVersion;
+  data.dataset = options.logs;
+  data.calibration = cal.path;
+  data.robot_name = cal.calibrated.name;
+  data.sampling = ToString(sampling);
+  data.worst_runs_drawn = options.worst_runs;
+  data.training_source = TrainingSource(cal, e.split);
+  data.calibration_note = CalibrationNote(cal);
+  data.training_repetitions = FormatRepetitionList(e.split.split.training_repetitions);
+  data.validation_repetitions = FormatRepetitionList(e.split.split.validation_repetitions);
+  data.training_runs = static_cast<int>(training.size());
+  for (std::size_t i = 0; i < e.before.size(); ++i) {
+    data.runs.push_back(MakeReportRun(e.split.split.validation[i], e.before[i], e.after[i]));
+  }
+  AddGroupRows(e, &data);
+  AddStatistics(e, &data);
+  AddDrift(e, &data);
+  std::vector<double> sigma;
+  bool has_sigma = false;
+  AddUncertainty(in, cal, training, options.threads, &data, &sigma, &has_sigma);
+  if (cv != nullptr) *cv = AddCrossValidation(options, in, &data);
+  AddParameters(in, cal, cv != nullptr ? *cv : std::nullopt, sigma, has_sigma, &data);
+  AddEffects(cal, e, &data);
+  AddVerdict(cal, &data);
+  return data;
+}
+
+io::ReportComparisonRow ComparisonRowOf(const io::ReportData& d) {
+  io::ReportComparisonRow row;
+  row.calibration = d.calibration;
+  row.verdict = d.verdict;
+  row.training_source = d.training_source;
+  row.all = d.summary.back();
+  for (const io::ReportSummaryRow& t : d.trajectories)
+    row.trajectory_cf_after.push_back(t.after.cf);
+  if (!d.drift.empty()) row.drift = d.drift.back();
+  return row;
+}
+
 }  // namespace
 
 int RunReportCommand(const ReportCommandOptions& options) {
@@ -84,269 +669,38 @@ int RunReportCommand(const ReportCommandOptions& options) {
     return 2;
   }
   try {
-    io::DatasetOptions dataset_options;
-    dataset_options.allow_paths_outside = options.allow_outside_paths;
-    dataset_options.num_threads = options.threads;
-    const io::DatasetIndex index = io::ReadDatasetIndex(options.logs, dataset_options);
-    std::vector<std::string> inputs = DatasetInputs(index);
-    inputs.push_back(options.calibration);
-    if (const std::string refusal = OutputDirectoryRefusal(options.out, inputs, kReportFiles);
-        !refusal.empty()) {
+    std::string refusal;
+    const ReportInputs in = LoadInputs(options, &refusal);
+    if (!refusal.empty()) {
       std::cerr << "fitcal: " << refusal << "\n";
       return 2;
     }
-    const io::Dataset dataset = io::LoadDataset(index, dataset_options);
-    for (const std::string& path : {dataset.robot_path, options.calibration}) {
-      const std::string model = io::ReadRobotModel(path);
-      if (model != "omni3") {
-        throw io::InputError(io::InputErrorKind::kUnknownModel, path, 0,
-                             "model '" + model + "' is not supported by 'report' (known: omni3)");
-      }
-    }
-    const Omni3Robot robot = io::ReadOmni3Robot(dataset.robot_path);
-    const Omni3Robot calibrated = io::ReadOmni3Robot(options.calibration);
-    std::vector<int> train_reps;
-    if (!options.train_reps.empty()) {
-      train_reps = ParseRepetitionList(options.train_reps);
-    } else if (auto recorded = io::ReadCalibrationTrainingRepetitions(options.calibration)) {
-      train_reps = *recorded;
-    } else {
-      train_reps = ParseRepetitionList("1-5");
-    }
-    const std::vector<AlignedRun> aligned = AlignRuns(dataset.runs);
-    const RunSplit split = SplitByRepetition(aligned, train_reps);
-    if (split.validation.empty()) {
-      std::cerr << "fitcal report: no run of " << options.logs
-                << " is outside the training repetitions (" << FormatRepetitionList(train_reps)
-                << "); nothing to validate on\n";
+    if (options.cross_validate && !in.omni3) {
+      std::cerr << "fitcal report: --cv refits omni3 robots only; the data set's robot is a "
+                << in.model->robot().model << "\n";
       return 2;
     }
-    const Omni3ParameterArray nominal = robot.nominal.ToArray();
-    const Omni3ParameterArray p = calibrated.nominal.ToArray();
-
-    io::ReportData data;
-    data.tool_version = kVersion;
-    data.dataset = options.logs;
-    data.calibration = options.calibration;
-    data.robot_name = calibrated.name;
-    data.sampling = ToString(sampling);
-    for (const effects::EffectValue& e : calibrated.effects) {
-      const effects::EffectInfo& info = effects::Info(e.id);
-      std::string text = std::string(info.name) + ":";
-      for (int k = 0; k < info.num_parameters; ++k) {
-        char buf[128];
-        std::snprintf(buf, sizeof buf, "%s %s = %.4g +- %.2g", k ? "," : "",
-                      info.parameter_names[k], e.value[k], e.sigma[k]);
-        text += buf;
-      }
-      data.calibrated_effects.push_back(text);
-    }
-    data.training_repetitions = FormatRepetitionList(split.training_repetitions);
-    data.validation_repetitions = FormatRepetitionList(split.validation_repetitions);
-    data.training_runs = static_cast<int>(split.training.size());
-
-    // Trajectory metrics of every validation run (the RunLog holds the ground-truth track).
-    std::map<std::string, const RunLog*> logs_by_id;
-    for (const RunLog& log : dataset.runs) logs_by_id[log.id] = &log;
-    std::vector<TrajectoryErrors> before, after;
-    for (const AlignedRun& run : split.validation) {
-      const GroundTruthTrack& track = logs_by_id.at(run.id)->ground_truth;
-      before.push_back(EvaluateTrajectory(run, track, nominal, sampling));
-      // The calibrated model as the YAML describes it: nine parameters and any effects
-      // `fitcal diagnose` accepted (the replay honours them, latency included).
-      after.push_back(EvaluateTrajectory(run, track, p, calibrated.effects, sampling));
-      const TrajectoryErrors& b = before.back();
-      const TrajectoryErrors& a = after.back();
-      io::ReportRun r;
-      r.id = run.id;
-      r.trajectory = run.trajectory;
-      r.repetition = run.repetition;
-      r.ground_truth_xy.push_back({0.0, 0.0});
-      r.before_xy.push_back({0.0, 0.0});
-      r.after_xy.push_back({0.0, 0.0});
-      for (std::size_t i = 0; i < b.t_s.size(); ++i) {
-        r.t_s.push_back(b.t_s[i] - run.t_start_s);
-        r.ground_truth_xy.push_back(
-            InStartFrame(run.start, b.ground_truth[i].x, b.ground_truth[i].y));
-        r.before_xy.push_back(InStartFrame(run.start, b.odometry[i].x, b.odometry[i].y));
-        r.after_xy.push_back(InStartFrame(run.start, a.odometry[i].x, a.odometry[i].y));
-      }
-      r.ground_truth_xy.push_back(
-          InStartFrame(run.start, run.final_ground_truth.x, run.final_ground_truth.y));
-      r.before_xy.push_back(InStartFrame(run.start, b.final_odometry.x, b.final_odometry.y));
-      r.after_xy.push_back(InStartFrame(run.start, a.final_odometry.x, a.final_odometry.y));
-      r.before_distance_m = b.distance_error_m;
-      r.after_distance_m = a.distance_error_m;
-      r.before_angle_rad = b.angle_error_rad;
-      r.after_angle_rad = a.angle_error_rad;
-      r.before_final_error =
-          VectorInStartFrame(run.start, b.final_odometry.x - b.final_ground_truth.x,
-                             b.final_odometry.y - b.final_ground_truth.y);
-      r.after_final_error =
-          VectorInStartFrame(run.start, a.final_odometry.x - a.final_ground_truth.x,
-                             a.final_odometry.y - a.final_ground_truth.y);
-      r.before = MetricsOf(b);
-      r.after = MetricsOf(a);
-      data.runs.push_back(std::move(r));
-    }
-
-    // Table 6 rows: per family (in order of appearance) and overall.
-    std::vector<std::string> families;
-    for (const AlignedRun& run : split.validation) {
-      const std::string f = FamilyOf(run.trajectory);
-      if (std::find(families.begin(), families.end(), f) == families.end()) families.push_back(f);
-    }
-    auto add_row = [&](const std::string& name, const std::string& family) {
-      std::vector<const TrajectoryErrors*> b, a;
-      for (std::size_t i = 0; i < split.validation.size(); ++i) {
-        if (family.empty() || FamilyOf(split.validation[i].trajectory) == family) {
-          b.push_back(&before[i]);
-          a.push_back(&after[i]);
-        }
-      }
-      data.summary.push_back(io::ReportSummaryRow{
-          name, static_cast<int>(b.size()), MetricsOf(AverageOf(b)), MetricsOf(AverageOf(a))});
-    };
-    if (families.size() > 1) {
-      for (const std::string& f : families) add_row("trajectories " + f + "*", f);
-    }
-    add_row("all validation runs", "");
-
-    // evo-style statistics of the per-run quantities.
-    struct StatDef {
-      const char* name;
-      bool is_angle;
-      double TrajectoryErrors::*field;
-    };
-    const StatDef stat_defs[] = {{"rms_distance_m", false, &TrajectoryErrors::rms_distance_m},
-                                 {"rms_angle", true, &TrajectoryErrors::rms_angle_rad},
-                                 {"final_distance_m", false, &TrajectoryErrors::final_distance_m},
-                                 {"final_angle", true, &TrajectoryErrors::final_angle_rad},
-                                 {"cf", false, &TrajectoryErrors::cf}};
-    for (const StatDef& s : stat_defs) {
-      std::vector<double> vb, va;
-      for (std::size_t i = 0; i < before.size(); ++i) {
-        vb.push_back(before[i].*s.field);
-        va.push_back(after[i].*s.field);
-      }
-      data.statistics.push_back(io::ReportStatisticsRow{s.name, s.is_angle, StatsOf(Summarize(vb)),
-                                                        StatsOf(Summarize(va))});
-    }
-
-    // Uncertainty at the calibrated parameters from the training runs: covariance
-    // s^2 (J^T J)^-1 with s^2 = |r|^2 / (3 N - 9), the same as the fit's (omni3_ceres_fit.h).
-    const Eigen::MatrixXd jacobian =
-        FinalPoseJacobian(p, split.training, ResidualWeights{}, options.threads);
-    const IdentifiabilityReport ident =
-        AnalyseIdentifiability(jacobian, p, sim::FlowerCandidateMotions(), nominal);
-    data.identifiable = ident.identifiable;
-    data.condition_number = ident.condition_number;
-    data.identifiability_lines = IdentifiabilityLines(ident);
-    const int dof = 3 * static_cast<int>(split.training.size()) - omni3::kNumParameters;
-    Omni3ParameterArray sigma{};
-    const bool has_sigma = dof > 0 && !ident.rank_deficient;
-    if (has_sigma) {
-      double sum_r2 = 0.0;
-      for (const AlignedRun& run : split.training) {
-        double r[3];
-        Omni3FinalPoseResidual(run, ResidualWeights{})(p.data(), r);
-        sum_r2 += r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-      }
-      const Eigen::MatrixXd jtj = jacobian.transpose() * jacobian;
-      const Eigen::MatrixXd cov =
-          (sum_r2 / dof) * jtj.ldlt().solve(Eigen::MatrixXd::Identity(jtj.rows(), jtj.cols()));
-      data.has_correlation = true;
-      data.correlation.assign(omni3::kNumParameters, std::vector<double>(omni3::kNumParameters));
-      for (int k = 0; k < omni3::kNumParameters; ++k)
-        sigma[k] = std::sqrt(std::max(0.0, cov(k, k)));
-      for (int a = 0; a < omni3::kNumParameters; ++a) {
-        for (int b = 0; b < omni3::kNumParameters; ++b) {
-          const double den = sigma[a] * sigma[b];
-          data.correlation[a][b] = den > 0.0 ? cov(a, b) / den : (a == b ? 1.0 : 0.0);
-        }
-      }
-      char note[256];
-      std::snprintf(note, sizeof note,
-                    "One sigma from the covariance s^2 (J^T J)^-1 of the final-pose residuals of "
-                    "the %zu training runs at the calibrated parameters, scaled by their residual "
-                    "variance (s = %.3g, metres and radians weighed 1:1 as Eq. 14).",
-                    split.training.size(), std::sqrt(sum_r2 / dof));
-      data.uncertainty_note = note;
-      if (!calibrated.effects.empty()) {
-        data.uncertainty_note +=
-            " The calibration also carries effects; this covariance is that of the nine "
-            "parameters alone (the effects' one-sigma is in the YAML's effects: list).";
-      }
-    } else {
-      data.uncertainty_note = dof <= 0 ? "No uncertainty: too few training runs (need more than 3)."
-                                       : "No uncertainty: the covariance is rank deficient (see "
-                                         "Identifiability below).";
+    std::vector<TrainingSplit> splits = CommonSplits(options, in);
+    if (splits.front().split.validation.empty()) {
+      std::cerr << "fitcal report: every run of " << options.logs
+                << (splits.size() > 1
+                        ? " trained at least one of the calibrations"
+                        : " trained the calibration (repetitions " +
+                              FormatRepetitionList(splits.front().split.training_repetitions) + ")")
+                << "; nothing to validate on\n";
+      return 2;
     }
     std::optional<CrossValidationResult> cv;
-    if (options.cross_validate) {
-      CeresFitOptions fit_options;
-      fit_options.num_threads = options.threads;
-      cv = LeaveOneRepetitionOut(aligned, robot, fit_options);
-      data.has_cv = true;
-      data.cv_cf_after = StatsOf(cv->cf_validation_after);
-      data.cv_cf_before = StatsOf(cv->cf_validation_before);
-      for (const CrossValidationFold& f : cv->folds) {
-        data.folds.push_back(io::ReportFold{f.held_out_repetition, f.usable, f.cf_training,
-                                            f.cf_validation_before, f.cf_validation_after});
-      }
+    io::ReportData data = BuildReportData(options, in, in.calibrations.front(),
+                                          std::move(splits.front()), sampling, &cv);
+    for (std::size_t i = 1; i < in.calibrations.size(); ++i) {
+      if (i == 1) data.comparison.push_back(ComparisonRowOf(data));
+      data.comparison.push_back(ComparisonRowOf(BuildReportData(
+          options, in, in.calibrations[i], std::move(splits[i]), sampling, nullptr)));
     }
-    for (int k = 0; k < omni3::kNumParameters; ++k) {
-      io::ReportParameter rp;
-      rp.name = ParameterName(k);
-      rp.is_angle = k >= omni3::kAngleIndex;
-      rp.unit = rp.is_angle ? "deg" : "m";
-      rp.nominal = nominal[k];
-      rp.calibrated = p[k];
-      rp.has_sigma = has_sigma;
-      rp.sigma = sigma[k];
-      if (cv) {
-        const SummaryStatistics& s = cv->parameter_spread[k];
-        rp.has_cv = s.count > 0;
-        rp.cv_mean = s.mean;
-        rp.cv_std = s.std;
-        rp.cv_min = s.min;
-        rp.cv_max = s.max;
-      }
-      data.parameters.push_back(rp);
-    }
-
-    // Everything is computed; only now touch the output directory, as a set (README, "Nothing
-    // lost"): the files go into a staged sibling renamed over the previous report, so a signal,
-    // a full disk or a second writer never leaves a mix of old and new files.
-    {
-      namespace fs = std::filesystem;
-      io::StagedDirectory staged(options.out);
-      const fs::path out(staged.path());
-      io::WriteFileAtomically((out / "index.html").string(), io::ReportHtml(data));
-      io::WriteFileAtomically((out / "summary.md").string(), io::ReportMarkdown(data));
-      io::WriteFileAtomically((out / "metrics.csv").string(), io::MetricsCsv(data));
-      io::StopHereForTests("report-staged");
-      io::WriteFileAtomically((out / "metrics.json").string(), io::MetricsJson(data));
-      CommitOutputDirectory(staged, options.out, inputs, kReportFiles);
-    }
-
-    const io::ReportSummaryRow& all = data.summary.back();
-    std::printf("validation: %zu runs (repetitions %s), odometry sampled by %s time\n",
-                data.runs.size(), data.validation_repetitions.c_str(), data.sampling.c_str());
-    std::printf("  CF (Eq. 14)            %.4f -> %.4f  (%+.1f %%)\n", all.before.cf, all.after.cf,
-                ImprovementPercent(all.before.cf, all.after.cf));
-    std::printf("  RMS distance error [m] %.4f -> %.4f  (%+.1f %%)\n", all.before.rms_distance_m,
-                all.after.rms_distance_m,
-                ImprovementPercent(all.before.rms_distance_m, all.after.rms_distance_m));
-    for (const std::string& line : data.identifiability_lines) std::printf("%s\n", line.c_str());
-    if (cv) {
-      std::printf("cross-validation: %zu folds, validation CF %.4f +- %.4f (min %.4f, max %.4f)\n",
-                  cv->folds.size(), cv->cf_validation_after.mean, cv->cf_validation_after.std,
-                  cv->cf_validation_after.min, cv->cf_validation_after.max);
-    }
-    std::printf("wrote %s/{index.html, summary.md, metrics.csv, metrics.json}\n",
-                options.out.c_str());
-    return 0;
+    WriteReport(options, in, data);
+    PrintReport(options, data, cv);
+    return ExitStatus(options, data.verdict);
   } catch (const std::exception& e) {
     std::cerr << "fitcal report: " << io::OneLine(e.what(), 500) << "\n";
     return 1;

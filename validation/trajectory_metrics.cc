@@ -24,41 +24,106 @@ TrajectoryErrors EvaluateTrajectory(const AlignedRun& run, const GroundTruthTrac
   return EvaluateTrajectory(run, track, p, {}, sampling);
 }
 
+namespace {
+
+// The odometry at every encoder time of a run's window: times[0] = t_start with the start pose,
+// times[k + 1] after sample k. Heading stays unwrapped here; only errors are wrapped.
+struct ReplayedRun {
+  std::vector<double> times;
+  std::vector<Pose2d> poses;
+  Pose2d final_pose;
+  Pose2d final_ground_truth;
+  double latency_s = 0.0;  // a ground-truth latency effect: the sample stamped t shows t - tau
+};
+
+ReplayedRun PrepareReplay(const AlignedRun& run) {
+  const std::size_t n = run.samples.size();
+  ReplayedRun r;
+  r.times.resize(n + 1);
+  r.poses.resize(n + 1);
+  r.times[0] = run.t_start_s;
+  double t = run.t_start_s;
+  for (std::size_t k = 0; k < n; ++k) {
+    t += run.samples[k].dt_s;
+    r.times[k + 1] = t;
+  }
+  r.final_ground_truth = run.final_ground_truth;
+  return r;
+}
+
+// The effect replay of any model's body step (odometry/effects.h), started where the effect fit
+// starts it (TrackStartPose) and compared with the ground truth at t_final + latency.
+template <typename Step>
+void ReplayWithEffectList(const Step& step, const AlignedRun& run, const GroundTruthTrack& track,
+                          const std::vector<effects::EffectValue>& effects, unsigned wheel_mask,
+                          ReplayedRun* r) {
+  std::vector<effects::ActiveEffect<double>> active;
+  for (const effects::EffectValue& e : effects) active.push_back({e.id, e.value.data()});
+  r->latency_s = effects::TotalLatency(active);
+  const std::vector<effects::SampleContext> contexts =
+      effects::MakeSampleContexts(run.samples, wheel_mask);
+  r->poses[0] = TrackStartPose(run, contexts, track, r->latency_s);
+  r->final_ground_truth = InterpolateGroundTruth(track, run.t_final_s + r->latency_s);
+  r->final_pose = effects::ReplayStepsWithEffects(
+      step, active, run.samples, contexts, r->poses[0],
+      [r](std::size_t k, const Pose2d&, const Pose2d& after) { r->poses[k + 1] = after; });
+}
+
+TrajectoryErrors ErrorsAlongTrack(const AlignedRun& run, const GroundTruthTrack& track,
+                                  const ReplayedRun& replayed, OdometrySampling sampling);
+
+}  // namespace
+
 TrajectoryErrors EvaluateTrajectory(const AlignedRun& run, const GroundTruthTrack& track,
                                     const Omni3ParameterArray& p,
                                     const std::vector<effects::EffectValue>& effects,
                                     OdometrySampling sampling) {
-  // The odometry at every encoder time of the window: times[0] = t_start with the start pose,
-  // times[k + 1] after sample k (Eq. 4). Heading stays unwrapped here; only errors are wrapped.
-  const std::size_t n = run.samples.size();
-  std::vector<double> times(n + 1);
-  std::vector<Pose2d> poses(n + 1);
-  times[0] = run.t_start_s;
-  double t = run.t_start_s;
-  for (std::size_t k = 0; k < n; ++k) {
-    t += run.samples[k].dt_s;
-    times[k + 1] = t;
-  }
-  Pose2d final_pose;
-  Pose2d final_ground_truth = run.final_ground_truth;
-  double latency_s = 0.0;
+  ReplayedRun r = PrepareReplay(run);
   if (effects.empty()) {
-    poses[0] = run.start;
-    final_pose = omni3::ReplayWithMatrix(
-        omni3::InverseKinematicMatrix(p.data()), run.samples, 0, n, run.start,
-        [&poses](std::size_t k, const Pose2d& pose) { poses[k + 1] = pose; });
+    r.poses[0] = run.start;
+    r.final_pose = omni3::ReplayWithMatrix(
+        omni3::InverseKinematicMatrix(p.data()), run.samples, 0, run.samples.size(), run.start,
+        [&r](std::size_t k, const Pose2d& pose) { r.poses[k + 1] = pose; });
   } else {
-    std::vector<effects::ActiveEffect<double>> active;
-    for (const effects::EffectValue& e : effects) active.push_back({e.id, e.value.data()});
-    latency_s = effects::TotalLatency(active);
-    const std::vector<effects::SampleContext> contexts = effects::MakeSampleContexts(run.samples);
-    poses[0] = TrackStartPose(run, contexts, track, latency_s);
-    final_ground_truth = InterpolateGroundTruth(track, run.t_final_s + latency_s);
-    final_pose = effects::ReplayWithEffects(
-        p.data(), active, run.samples, contexts, poses[0],
-        [&poses](std::size_t k, const Pose2d&, const Pose2d& after) { poses[k + 1] = after; });
+    const omni3::Matrix3<double> m_inv = omni3::InverseKinematicMatrix(p.data());
+    const auto step = [&m_inv](const double* w, double dt, double* dx, double* dy, double* dth) {
+      *dx = (m_inv(0, 0) * w[0] + m_inv(0, 1) * w[1] + m_inv(0, 2) * w[2]) * dt;
+      *dy = (m_inv(1, 0) * w[0] + m_inv(1, 1) * w[1] + m_inv(1, 2) * w[2]) * dt;
+      *dth = (m_inv(2, 0) * w[0] + m_inv(2, 1) * w[1] + m_inv(2, 2) * w[2]) * dt;
+    };
+    ReplayWithEffectList(step, run, track, effects, ~0u, &r);
   }
+  return ErrorsAlongTrack(run, track, r, sampling);
+}
 
+TrajectoryErrors EvaluateTrajectory(const RobotModelInterface& model, const AlignedRun& run,
+                                    const GroundTruthTrack& track, const std::vector<double>& p,
+                                    const std::vector<effects::EffectValue>& effects,
+                                    OdometrySampling sampling) {
+  ReplayedRun r = PrepareReplay(run);
+  if (effects.empty()) {
+    r.poses[0] = run.start;
+    r.final_pose = model.Replay(p.data(), run.samples, 0, run.samples.size(), run.start,
+                                [&r](std::size_t k, const Pose2d& pose) { r.poses[k + 1] = pose; });
+  } else {
+    const auto kinematics = model.PrepareKinematics(p.data());
+    const auto step = [&kinematics](const double* w, double dt, double* dx, double* dy,
+                                    double* dtheta) { kinematics->Step(w, dt, dx, dy, dtheta); };
+    ReplayWithEffectList(step, run, track, effects, WheelChannelMask(model.robot()), &r);
+  }
+  return ErrorsAlongTrack(run, track, r, sampling);
+}
+
+namespace {
+
+TrajectoryErrors ErrorsAlongTrack(const AlignedRun& run, const GroundTruthTrack& track,
+                                  const ReplayedRun& replayed, OdometrySampling sampling) {
+  const std::vector<double>& times = replayed.times;
+  const std::vector<Pose2d>& poses = replayed.poses;
+  const std::size_t n = run.samples.size();
+  const double latency_s = replayed.latency_s;
+  const Pose2d& final_pose = replayed.final_pose;
+  const Pose2d& final_ground_truth = replayed.final_ground_truth;
   TrajectoryErrors out;
   for (std::size_t i = 0; i < track.t_s.size(); ++i) {
     const double t_gt = track.t_s[i];
@@ -113,6 +178,8 @@ TrajectoryErrors EvaluateTrajectory(const AlignedRun& run, const GroundTruthTrac
   out.cf = std::sqrt(dx * dx + dy * dy + dtheta * dtheta);
   return out;
 }
+
+}  // namespace
 
 SummaryStatistics Summarize(std::vector<double> values) {
   SummaryStatistics s;

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "fit/final_pose_cost.h"
+#include "models/model_interface.h"
 #include "odometry/aligned_run.h"
 #include "odometry/effects.h"
 #include "odometry/run_log.h"
@@ -63,6 +64,15 @@ TrajectoryErrors EvaluateTrajectory(const AlignedRun& run, const GroundTruthTrac
 // compared with the ground truth at t_final + tau). With no effects it equals the overload above.
 TrajectoryErrors EvaluateTrajectory(const AlignedRun& run, const GroundTruthTrack& track,
                                     const Omni3ParameterArray& p,
+                                    const std::vector<effects::EffectValue>& effects,
+                                    OdometrySampling sampling = OdometrySampling::kNearestTime);
+
+// Any model through the seam (models/model_interface.h): the same metrics with the model's own
+// replay at parameters p (robot().parameters order), and its effects replayed through the model's
+// kinematics as the effect fit does (diagnosis/effect_fit.h). For omni3 it equals the overloads
+// above to rounding.
+TrajectoryErrors EvaluateTrajectory(const RobotModelInterface& model, const AlignedRun& run,
+                                    const GroundTruthTrack& track, const std::vector<double>& p,
                                     const std::vector<effects::EffectValue>& effects,
                                     OdometrySampling sampling = OdometrySampling::kNearestTime);
 

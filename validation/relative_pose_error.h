@@ -1,0 +1,40 @@
+#pragma once
+// Drift per distance travelled: the relative pose error over windows of a set ground-truth path
+// length, the metric of the KITTI odometry benchmark (Geiger et al. 2012, devkit evaluate_odometry:
+// translation error in % of the length, rotation error per metre) and of evo_rpe with a delta in
+// metres. For a window from ground-truth sample i to the first sample j at least `length_m` of
+// path further,
+//   E = (gt_i^-1 gt_j)^-1 (odo_i^-1 odo_j),
+//   translation error = |t(E)| / length_m,   rotation error = |wrap(theta(E))| / length_m.
+// A window starts at every sample (KITTI: every 10th frame at 10 Hz, i.e. once a second); the
+// means weigh every window alike.
+
+#include <vector>
+
+#include "odometry/pose2.h"
+
+namespace fitcal {
+
+struct RelativePoseErrorSum {
+  int windows = 0;
+  double translation_ratio_sum = 0.0;  // sum of |t(E)| / length (unitless)
+  double rotation_rad_per_m_sum = 0.0;
+  double MeanTranslationPercent() const {
+    return windows > 0 ? 100.0 * translation_ratio_sum / windows : 0.0;
+  }
+  double MeanRotationRadPerM() const {
+    return windows > 0 ? rotation_rad_per_m_sum / windows : 0.0;
+  }
+};
+
+// Adds the windows of one run: `ground_truth` and `odometry` are poses at the same times, in any
+// one world frame each. Runs shorter than length_m add nothing.
+void AddRelativePoseErrors(const std::vector<Pose2d>& ground_truth,
+                           const std::vector<Pose2d>& odometry, double length_m,
+                           RelativePoseErrorSum* sum);
+
+// Window lengths for runs of this median path length: the largest three of 0.25, 0.5, 1, 2, 5,
+// 10, 20, 50, 100 m that fit twice into it (so that every run holds windows of each).
+std::vector<double> RelativePoseErrorLengths(double median_path_length_m);
+
+}  // namespace fitcal
