@@ -78,6 +78,18 @@ void PairedImprovement(const ModelScore& base, const ModelScore& candidate, Cand
       n >= 2 ? stats::StudentTUpperTail(c->t_statistic, static_cast<double>(n) - 1.0) : 1.0;
 }
 
+// The verdict of a significant candidate that removes too little of the lack-of-fit excess
+// F - 1: the fraction it removes, in [0, 100] % ("none" when it leaves the excess as large or
+// larger; a negative percentage, or "-0%" from rounding, said nothing a reader could use).
+std::string ExplainedText(double base_lof_f, double candidate_lof_f) {
+  const double excess_before = base_lof_f - 1.0;
+  const double fraction =
+      excess_before > 0.0 ? 1.0 - std::max(0.0, candidate_lof_f - 1.0) / excess_before : 0.0;
+  const double percent = std::clamp(100.0 * fraction, 0.0, 100.0);
+  if (percent < 0.5) return "significant but explains none of the structure";
+  return Fmt("significant but explains only %.0f%% of the structure", percent);
+}
+
 // Every identifiable effect of the registry that this robot's channels can show.
 std::vector<EffectId> DefaultCandidates(const Robot& robot) {
   bool has_angle = false;
@@ -254,8 +266,7 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
         c.explains = true;
       }
       if (!c.explains) {
-        c.verdict = Fmt("significant but explains only %.0f%% of the structure",
-                        100.0 * (1.0 - std::max(0.0, c.lof_f - 1.0) / (round.base_lof_f - 1.0)));
+        c.verdict = ExplainedText(round.base_lof_f, c.lof_f);
         continue;
       }
       best = i;
@@ -291,10 +302,18 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
   out.final_validation = ScoreModel(model, current.parameters, current.effects, validation,
                                     options.fit.weights, threads);
   out.after = AnalyzeResiduals(model, current.parameters, current.effects, all, threads);
-  out.unexplained_structure =
+  out.covariates = AnalyzeCovariates(out.after, options.covariate_alpha);
+  out.lack_of_fit =
       out.after.lack_of_fit.available && out.after.lack_of_fit.p_value < options.lof_alpha;
+  out.unexplained_structure = out.lack_of_fit || out.covariates.any_significant;
   out.effects_named = !out.unexplained_structure && !current.effects.empty();
-  if (out.unexplained_structure) {
+  for (const CovariateTest& t : out.covariates.tests) {
+    if (t.significant) {
+      out.record_next.push_back("runs that vary " + t.name +
+                                " within repetitions of one trajectory, to model what drifts");
+    }
+  }
+  if (out.lack_of_fit) {
     out.record_next.push_back(
         "structured residual remains that no candidate explains: record runs that vary what the "
         "pattern depends on (speed, yaw rate, run length, start heading) to narrow it down");
@@ -353,12 +372,15 @@ std::string FormatDiagnoseReport(const DiagnoseResult& r, const RobotModelInterf
              EffectValueText(e) + "\n";
     }
   }
-  if (r.unexplained_structure) {
+  for (const CovariateTest& t : r.covariates.tests) {
+    if (t.significant) out += "- " + CovariateFinding(t) + "\n";
+  }
+  if (r.lack_of_fit) {
     out +=
         Fmt("- UNEXPLAINED STRUCTURE: the residual still shows repeatable structure "
             "(lack of fit F = %.2f, p = %.2g) that no candidate explains; see the tables above.\n",
             r.after.lack_of_fit.f, r.after.lack_of_fit.p_value);
-  } else {
+  } else if (!r.unexplained_structure) {
     out +=
         Fmt("- the remaining residual is consistent with the noise floor (lack of fit F = %.2f, p "
             "= %.2g)\n",
@@ -367,6 +389,8 @@ std::string FormatDiagnoseReport(const DiagnoseResult& r, const RobotModelInterf
   for (const std::string& line : r.not_identifiable) out += "- " + line + "\n";
   for (const std::string& line : r.record_next) out += "- record next: " + line + "\n";
 
+  out += "\n## Residual of the final model against covariates\n\n" +
+         FormatCovariateStructure(r.covariates);
   out += Fmt("\n## Held-out error (%.0f validation runs)\n\n", r.num_validation_runs);
   out += "| model | CF (Eq. 14) | track RMSE [m] | track RMSE [deg] |\n|---|---|---|---|\n";
   out += Fmt("| declared parameters | %.5f | %.5f | %.4f |\n", r.declared_validation.cf,

@@ -29,9 +29,11 @@
 //         candidate that merely nibbles at an effect outside the library is not named.
 //     The accepted candidate is the one passing all tests with the largest mean(d); then the
 //     search repeats for a second effect, and so on, until none passes (or max_effects).
-//  4. After: lack of fit of the final model; if still significant (p < lof_alpha), the residual
-//     is reported as structure that no candidate explains, with its pattern, and the accepted
-//     effects (if any) are reported as a partial description, not named as the cause.
+//  4. After: lack of fit of the final model, and its residual against covariates of the runs
+//     (covariate_structure.h: what differs between repetitions, which the lack of fit takes as
+//     noise). If either is significant (p < lof_alpha; Holm at covariate_alpha), the residual is
+//     reported as structure that no candidate explains, with its pattern and the covariates it
+//     follows, and the accepted effects (if any) are a partial description, not the cause.
 // Structurally non-identifiable effects (registry: identifiable = false, e.g. the encoder clock
 // scale, which equals a common radius scale) are never fitted; their separable fraction is
 // computed and reported to show that the data agree.
@@ -39,6 +41,7 @@
 #include <string>
 #include <vector>
 
+#include "diagnosis/covariate_structure.h"
 #include "diagnosis/effect_fit.h"
 #include "diagnosis/residual_analysis.h"
 #include "fit/model_fit.h"
@@ -54,6 +57,9 @@ struct DiagnoseOptions {
   double min_separable_fraction = 0.02;  // below: not separable from the nine on these runs
   double min_resolvable_sigmas = 3.0;    // realistic magnitude / predicted sigma, at least
   int max_effects = 3;
+  // Residual against covariates of the runs (covariate_structure.h), family-wise over the
+  // covariates (Holm): a significant one is unexplained structure, as a significant lack of fit.
+  double covariate_alpha = 0.01;
   // Candidates (default, empty: every identifiable effect of the registry).
   std::vector<effects::EffectId> candidates;
   bool IsValid(std::string* error) const;
@@ -94,6 +100,9 @@ struct DiagnoseResult {
   EffectFitResult final_fit;  // nine + accepted effects (== base when none)
   ModelScore final_validation;
   ResidualAnalysis after;
+  CovariateStructure covariates;  // of `after`
+  bool lack_of_fit = false;       // significant lack of fit of `after` (p < lof_alpha)
+  // Significant lack of fit, or a covariate the residual significantly depends on.
   bool unexplained_structure = false;
   // The accepted effects are named as causes only when nothing structured remains; otherwise
   // they are a partial description (they may stand in for an effect outside the library).

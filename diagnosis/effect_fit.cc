@@ -52,46 +52,92 @@ Pose2<T> InterpolateTrack(const GroundTruthTrack& track, const T& t_s) {
 
 // Pose errors (replay - ground truth) at the ground-truth samples `indices` of the run, and at
 // the window's end. err holds 3 values per index, then 3 for the end.
+//
+// Start pose (any start, at rest or moving): the replay runs from TrackStartPose, the rest pose
+// when the log begins at rest. A log that begins moving has no such pose: there the replayed
+// poses P(e) are carried by the rigid transform C that puts the replay through the anchor
+// samples G_j (StartAnchorIndices) at the encoder times they show, e_j = t_j - t_start - tau, in
+// the least-squares sense (one anchor today):
+//   turn = mean_j (G_j.theta - P_j.theta),  C.xy = mean_j (G_j.xy - R(turn) P_j.xy),
+//   Q(e) = C * P(e):  Q.theta = P.theta + turn,  Q.xy = C.xy + R(turn) P.xy.
+// The odometry itself carries the pose from the anchor back to the window's start, so no
+// ground-truth interpolation across a (possibly sparse, 0.2-0.3 s) ground-truth interval enters
+// the start, and tau reaches the start through the e_j (differentiated). A world-frame effect
+// (FloorSlope) is replayed in S's frame and then turned by `turn`, a second-order error (creep x
+// the start's error).
 template <typename T>
 void TrackPoseErrors(const RobotModelInterface& robot_model, const TrackRun& run, const T* p,
                      const std::vector<ActiveEffect<T>>& active, const std::vector<int>& indices,
                      T* err) {
+  using std::cos;
+  using std::sin;
   const AlignedRun& a = run.aligned;
   const T tau = effects::TotalLatency(active);
   const Pose2d start_pose = TrackStartPose(a, run.contexts, run.track, ScalarPart(tau));
   const Pose2<T> start{T(start_pose.x), T(start_pose.y), T(start_pose.theta)};
+  const std::vector<int> anchors = StartAnchorIndices(a, run.contexts, run.track, ScalarPart(tau));
+  std::vector<Pose2<T>> anchor_pose(anchors.size(), start);
+  std::size_t next_anchor = 0;
   std::size_t next = 0;
   const std::size_t n = indices.size();
-  const auto error_at = [&](std::size_t j, const Pose2<T>& pose, const Pose2d& gt) {
-    err[3 * j + 0] = pose.x - T(gt.x);
-    err[3 * j + 1] = pose.y - T(gt.y);
-    err[3 * j + 2] = WrapAngle(pose.theta - T(gt.theta));
+  std::vector<Pose2<T>> replayed(n);
+  const auto lerp = [](const Pose2<T>& p0, const Pose2<T>& p1, const T& f) {
+    return Pose2<T>{p0.x + f * (p1.x - p0.x), p0.y + f * (p1.y - p0.y),
+                    p0.theta + f * (p1.theta - p0.theta)};
   };
+  // Encoder time (from the window start) that ground-truth sample g shows.
+  const auto encoder_time = [&](int g) { return T(run.track.t_s[g] - a.t_start_s) - tau; };
   const auto visit = [&](std::size_t k, const Pose2<T>& before, const Pose2<T>& after) {
     const double t0 = run.contexts[k].t_s;
     const double t1 = t0 + run.contexts[k].dt_s;
+    const bool last = k + 1 == run.contexts.size();
+    while (next_anchor < anchors.size()) {
+      const T e = encoder_time(anchors[next_anchor]);
+      if (Value(e) > t1 && !last) break;
+      anchor_pose[next_anchor++] = lerp(before, after, (e - T(t0)) / T(t1 - t0));
+    }
     while (next < n) {
-      const int g = indices[next];
-      // Encoder time (from the window start) of this ground-truth sample.
-      const T e = T(run.track.t_s[g] - a.t_start_s) - tau;
-      const double ev = Value(e);
-      if (ev > t1 && k + 1 < run.contexts.size()) break;
-      const T f = (e - T(t0)) / T(t1 - t0);
-      const Pose2<T> pose{before.x + f * (after.x - before.x), before.y + f * (after.y - before.y),
-                          before.theta + f * (after.theta - before.theta)};
-      error_at(next, pose, run.track.world_T_robot[g]);
-      ++next;
+      const T e = encoder_time(indices[next]);
+      if (Value(e) > t1 && !last) break;
+      replayed[next++] = lerp(before, after, (e - T(t0)) / T(t1 - t0));
     }
   };
   const auto kinematics = robot_model.PrepareKinematics(p);
   const auto step = [&kinematics](const T* values, double dt, T* dx, T* dy, T* dtheta) {
     kinematics->Step(values, dt, dx, dy, dtheta);
   };
-  const Pose2<T> final_pose =
+  Pose2<T> final_pose =
       effects::ReplayStepsWithEffects(step, active, a.samples, run.contexts, start, visit);
-  for (; next < n; ++next) {  // only for an empty replay
-    error_at(next, final_pose, run.track.world_T_robot[indices[next]]);
+  for (; next < n; ++next) replayed[next] = final_pose;  // only for an empty replay
+  // C (identity without anchors): the mean turn, then the mean translation under it.
+  const double m = static_cast<double>(anchors.size());
+  T turn(0.0);
+  for (std::size_t j = 0; j < anchors.size(); ++j) {
+    const double g_theta = run.track.world_T_robot[anchors[j]].theta;
+    // Each difference taken near the first one: headings may wrap between the two tracks.
+    const T d = T(g_theta) - anchor_pose[j].theta;
+    const T d0 = T(run.track.world_T_robot[anchors[0]].theta) - anchor_pose[0].theta;
+    turn += (d0 + WrapAngle(d - d0)) / m;
   }
+  const T c = cos(turn), s = sin(turn);
+  T cx(0.0), cy(0.0);
+  for (std::size_t j = 0; j < anchors.size(); ++j) {
+    const Pose2d& g = run.track.world_T_robot[anchors[j]];
+    cx += (T(g.x) - (c * anchor_pose[j].x - s * anchor_pose[j].y)) / m;
+    cy += (T(g.y) - (s * anchor_pose[j].x + c * anchor_pose[j].y)) / m;
+  }
+  const auto carried = [&](const Pose2<T>& q) {
+    if (anchors.empty()) return q;
+    return Pose2<T>{cx + c * q.x - s * q.y, cy + s * q.x + c * q.y, q.theta + turn};
+  };
+  for (std::size_t j = 0; j < n; ++j) {
+    const Pose2<T> pose = carried(replayed[j]);
+    const Pose2d& gt = run.track.world_T_robot[indices[j]];
+    err[3 * j + 0] = pose.x - T(gt.x);
+    err[3 * j + 1] = pose.y - T(gt.y);
+    err[3 * j + 2] = WrapAngle(pose.theta - T(gt.theta));
+  }
+  final_pose = carried(final_pose);
   const Pose2<T> gt_end = InterpolateTrack(run.track, T(a.t_final_s) + tau);
   err[3 * n + 0] = final_pose.x - gt_end.x;
   err[3 * n + 1] = final_pose.y - gt_end.y;
@@ -179,8 +225,8 @@ unsigned WheelChannelMask(const Robot& robot) {
   return mask;
 }
 
-Pose2d TrackStartPose(const AlignedRun& run, const std::vector<effects::SampleContext>& contexts,
-                      const GroundTruthTrack& track, double latency_s) {
+bool TrackStartsAtRest(const AlignedRun& run, const std::vector<effects::SampleContext>& contexts,
+                       const GroundTruthTrack& track, double latency_s) {
   // Encoder time (from the window start) at which the robot starts moving.
   const auto first_moving = std::find_if(contexts.begin(), contexts.end(),
                                          [](const effects::SampleContext& c) { return c.moving; });
@@ -188,11 +234,28 @@ Pose2d TrackStartPose(const AlignedRun& run, const std::vector<effects::SampleCo
                               : contexts.empty()             ? 0.0
                                                  : contexts.back().t_s + contexts.back().dt_s;
   const auto first = std::lower_bound(track.t_s.begin(), track.t_s.end(), run.t_start_s);
-  if (rest_until_s > 0.0 && first != track.t_s.end() &&
-      *first - run.t_start_s - latency_s <= rest_until_s) {
+  return rest_until_s > 0.0 && first != track.t_s.end() &&
+         *first - run.t_start_s - latency_s <= rest_until_s;
+}
+
+Pose2d TrackStartPose(const AlignedRun& run, const std::vector<effects::SampleContext>& contexts,
+                      const GroundTruthTrack& track, double latency_s) {
+  if (TrackStartsAtRest(run, contexts, track, latency_s)) {
+    const auto first = std::lower_bound(track.t_s.begin(), track.t_s.end(), run.t_start_s);
     return track.world_T_robot[static_cast<std::size_t>(first - track.t_s.begin())];
   }
   return InterpolateGroundTruth(track, run.t_start_s + latency_s);
+}
+
+std::vector<int> StartAnchorIndices(const AlignedRun& run,
+                                    const std::vector<effects::SampleContext>& contexts,
+                                    const GroundTruthTrack& track, double latency_s) {
+  if (TrackStartsAtRest(run, contexts, track, latency_s)) return {};
+  // The largest latency the time-offset effect admits (its registry bound).
+  const double margin_s = effects::Info(EffectId::kTimeOffset).upper[0];
+  const auto first = std::lower_bound(track.t_s.begin(), track.t_s.end(), run.t_start_s + margin_s);
+  if (first == track.t_s.end() || *first > run.t_final_s - margin_s) return {};
+  return {static_cast<int>(first - track.t_s.begin())};
 }
 
 bool TrackOptions::IsValid(std::string* error) const {

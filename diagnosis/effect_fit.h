@@ -9,7 +9,9 @@
 //           wrap(theta(...) - theta_gt_j) / sigma_theta ] / sqrt(n_checkpoints)
 //
 // with the replay of odometry/effects.h (the model's steps, Palacin Eq. 4, + effect stages) started
-// at the ground truth at t_start + tau; tau is the time-offset effect's latency (0 without it). The
+// at the rest pose (TrackStartsAtRest) or moved rigidly through the anchor ground-truth sample at
+// the encoder time it shows (StartAnchorIndices);
+// tau is the time-offset effect's latency (0 without it). The
 // 1/sqrt(n) weight makes a run's squared residual its mean squared track error, so every run
 // counts once, whatever its length. One functor serves Ceres (dynamic autodiff) and the
 // double-valued scoring.
@@ -36,16 +38,34 @@ struct TrackRun {
   std::vector<int> checkpoints;                  // indices into track
 };
 
+// Whether the window's first ground-truth sample shows the robot still at rest (every wheel
+// below effects::kMovingRateRadS until the encoder time it shows; with a positive latency it shows
+// a time just before the window, when a run that starts at rest was at rest too). `contexts` are
+// the run's (effects::MakeSampleContexts); their `moving` flags say where the rest ends.
+bool TrackStartsAtRest(const AlignedRun& run, const std::vector<effects::SampleContext>& contexts,
+                       const GroundTruthTrack& track, double latency_s);
+
 // The pose the replay of a track starts from, given a ground-truth latency (the ground-truth
-// sample stamped t shows encoder time t - latency): the window's first ground-truth sample when it
-// shows the robot still at rest (every wheel below effects::kMovingRateRadS; with a positive
-// latency it shows a time just before the window, when a run that starts at rest was at rest
-// too), else the ground truth interpolated at t_start + latency. Interpolating whenever the
-// latency is not zero would blend the rest pose with a moving one when the robot starts within
-// one ground-truth period: a start error that repeats in every repetition. `contexts` are the
-// run's (effects::MakeSampleContexts); their `moving` flags say where the rest ends.
+// sample stamped t shows encoder time t - latency): that first sample when TrackStartsAtRest,
+// else the ground truth interpolated at t_start + latency - only a first guess then: the track
+// residual carries the replay through the anchor (StartAnchorIndices), since interpolating a
+// ground truth sampled every 0.2-0.3 s across the start of the motion blends the rest pose with
+// one a ground-truth period into the motion (issue 16: a 0.06 s latency read as 0.083 s).
 Pose2d TrackStartPose(const AlignedRun& run, const std::vector<effects::SampleContext>& contexts,
                       const GroundTruthTrack& track, double latency_s);
+
+// The ground-truth samples that anchor the replay of a log that does not begin at rest: the first
+// sample at least the largest admissible latency (the time-offset effect's bound, 0.3 s) after the
+// window's start and that far before its end, so that the encoder time it shows,
+// t - t_start - tau, lies inside the replay for every admissible tau. The replay is moved rigidly
+// to pass through it at that encoder time: the start pose is the anchor carried back by the
+// model's own odometry, and tau reaches it (differentiably) through that encoder time. One
+// sample: averaging a span of them would lower the start's ground-truth noise but absorb what
+// the track shows in that span (a backlash at the start of the motion). Empty when the log
+// begins at rest (the rest pose is the start) or the window holds no such sample.
+std::vector<int> StartAnchorIndices(const AlignedRun& run,
+                                    const std::vector<effects::SampleContext>& contexts,
+                                    const GroundTruthTrack& track, double latency_s);
 
 struct TrackOptions {
   // Checkpoints keep this far from the window's ends so a latency within the effect's bounds

@@ -45,6 +45,9 @@ RunFeatures Features(const RobotModelInterface& robot_model, const std::vector<d
   f.trajectory = run.aligned.trajectory;
   f.family = FamilyOf(run.aligned.trajectory);
   f.repetition = run.aligned.repetition;
+  f.start_heading_rad = run.aligned.start.theta;
+  f.t_start_s = run.aligned.t_start_s;
+  f.duration_s = run.aligned.t_final_s - run.aligned.t_start_s;
   const auto kinematics = robot_model.PrepareKinematics(p.data());
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   double time = 0.0;
@@ -55,6 +58,7 @@ RunFeatures Features(const RobotModelInterface& robot_model, const std::vector<d
     Eigen::Vector3d step;
     kinematics->Step(s.value, s.dt_s, &step[0], &step[1], &step[2]);
     sum += step;
+    f.distance_m += std::hypot(step[0], step[1]);
     time += s.dt_s;
     if (!any) f.motion_begin_s = run.contexts[k].t_s;
     f.motion_end_s = run.contexts[k].t_s + s.dt_s;
@@ -174,6 +178,14 @@ ResidualAnalysis AnalyzeResiduals(const RobotModelInterface& robot_model,
           1e-4 * std::max({std::abs(model[e].value[j]), std::abs(info.typical[j]), 1e-9});
       model_k[e].value[j] += h;
       add_column(p, model_k, h);
+    }
+  }
+
+  out.final_jacobian.assign(n, Eigen::MatrixXd::Zero(3, static_cast<int>(lof_jacobian.size())));
+  for (std::size_t k = 0; k < lof_jacobian.size(); ++k) {
+    for (std::size_t i = 0; i < n; ++i) {
+      for (int c = 0; c < 3; ++c)
+        out.final_jacobian[i](c, static_cast<int>(k)) = lof_jacobian[k][i][9 + c];
     }
   }
 

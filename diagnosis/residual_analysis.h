@@ -21,6 +21,7 @@
 //   of fit. df_lof = r * n_traj - (identifiable parameters), df_pe = D - r + 1 (Hotelling);
 //   F = SS_lof / df_lof, p = P(F(df_lof, df_pe) > F).
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,11 @@ struct RunFeatures {
   int rotation_sign = 0;   // sign of the mean yaw rate (0 when |omega| < 0.02 rad/s)
   double speed_m_s = 0.0;  // mean speed while moving
   double motion_begin_s = 0.0, motion_end_s = 0.0;  // from the window start
+  // Covariates of the run as a whole (diagnosis/covariate_structure.h).
+  double distance_m = 0.0;         // path length of the replay
+  double start_heading_rad = 0.0;  // world-frame heading at the window's start
+  double t_start_s = 0.0;          // the window's start on the encoder clock
+  double duration_s = 0.0;         // the window's length
 };
 
 struct GroupStat {
@@ -67,6 +73,9 @@ struct ResidualAnalysis {
   double nonsystematic_rms_m = 0.0, nonsystematic_rms_rad = 0.0;
   LackOfFit lack_of_fit;
   std::vector<GroupStat> groups;
+  // Per run: d(final_start_frame)/d(fitted parameter), 3 x (free model parameters + effect
+  // parameters), the columns the lack-of-fit test refits (forward differences).
+  std::vector<Eigen::MatrixXd> final_jacobian;
 };
 
 // The lack-of-fit test counts as fitted every parameter of p and of the model's effects (it

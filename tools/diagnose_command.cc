@@ -7,6 +7,7 @@
 #include <iostream>
 #include <set>
 
+#include "diagnosis/clock_choice.h"
 #include "diagnosis/diagnose.h"
 #include "fit/segment_cost.h"
 #include "fitcal/version.h"
@@ -112,6 +113,8 @@ struct DiagnoseChoice {
   EffectModel effects;
   double cf_before = 0.0;  // nominal, held-out
   double cf_after = 0.0;
+  double cf_training_before = 0.0;  // nominal, training runs (the same track-replay CF)
+  double cf_training_after = 0.0;
 };
 
 DiagnoseChoice GateDiagnosis(const RobotModelInterface& model, const DiagnoseSplit& split,
@@ -142,6 +145,11 @@ DiagnoseChoice GateDiagnosis(const RobotModelInterface& model, const DiagnoseSpl
                 i == best ? "   <- selected" : "");
   }
   candidates[best].cf_before = candidates[0].cf_after;
+  const auto cf_training = [&](const DiagnoseChoice& c) {
+    return ScoreModel(model, c.parameters, c.effects, split.training, {}, threads).cf;
+  };
+  candidates[best].cf_training_before = cf_training(candidates[0]);
+  candidates[best].cf_training_after = cf_training(candidates[best]);
   return candidates[best];
 }
 
@@ -178,6 +186,8 @@ std::string Omni3CalibratedYaml(const DiagnoseCommandOptions& options, const std
   record.training_runs = static_cast<int>(split.training.size());
   record.validation_runs = static_cast<int>(split.validation.size());
   record.validation_repetitions = ValidationRepetitions(split);
+  record.cf_training_before = choice.cf_training_before;
+  record.cf_training_after = choice.cf_training_after;
   record.cf_validation_before = choice.cf_before;
   record.cf_validation_after = choice.cf_after;
   record.has_uncertainty = false;
@@ -204,6 +214,8 @@ std::string ModelCalibratedYaml(const DiagnoseCommandOptions& options,
   block.training_fingerprint = TrainingFingerprint(logs, block.training_run_ids);
   block.training_runs = static_cast<int>(split.training.size());
   block.validation_runs = static_cast<int>(split.validation.size());
+  block.cf_training_before = choice.cf_training_before;
+  block.cf_training_after = choice.cf_training_after;
   block.cf_validation_before = choice.cf_before;
   block.cf_validation_after = choice.cf_after;
   block.selected = choice.name;
@@ -222,14 +234,27 @@ std::string ModelCalibratedYaml(const DiagnoseCommandOptions& options,
   return yaml;
 }
 
-// Re-stamps each run's ground truth on the encoder clock (omni3's speed-profile match).
-void MapClocks(const std::string& robot_path, int threads, std::vector<RunLog>* runs) {
+// Re-stamps each run's ground truth on the encoder clock (omni3's speed-profile match), keeping
+// the map only on the runs whose track error under the final-pose fit it lowers
+// (diagnosis/clock_choice.h): a correctly clocked data set keeps the identity.
+void MapClocks(const std::string& robot_path, const RobotModelInterface& model, int threads,
+               std::vector<RunLog>* runs) {
   const auto nominal = io::ReadOmni3Robot(robot_path).nominal.ToArray();
-  ParallelFor(runs->size(), threads, [&](std::size_t i) {
-    RunLog& run = (*runs)[i];
+  std::vector<RunLog> mapped = *runs;
+  ParallelFor(mapped.size(), threads, [&](std::size_t i) {
+    RunLog& run = mapped[i];
     const ClockMap map = EstimateClockMap(AlignRun(run), run.ground_truth, nominal);
     run.ground_truth = ApplyClockMap(run.ground_truth, map);
   });
+  ModelFitOptions fit_options;
+  fit_options.ceres.num_threads = threads;
+  const ModelFitResult fit = FitModel(AlignRuns(*runs), model, fit_options);
+  const std::vector<double>& p = fit.usable ? fit.parameters : model.robot().nominal;
+  const ClockChoice choice =
+      ChooseClocks(model, p, *runs, mapped, WheelChannelMask(model.robot()), threads);
+  std::printf("clock map kept on %d of %zu runs (the identity fits the others better)\n",
+              choice.num_mapped, runs->size());
+  *runs = ApplyClockChoice(choice, std::move(*runs), mapped);
 }
 
 void WriteOutputs(const DiagnoseCommandOptions& options, const std::vector<std::string>& inputs,
@@ -277,7 +302,7 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
       return 2;
     }
     std::vector<RunLog> runs = io::LoadDataset(index, robot, dataset_options).runs;
-    if (options.clock_map) MapClocks(index.robot_path, options.threads, &runs);
+    if (options.clock_map) MapClocks(index.robot_path, *model, options.threads, &runs);
     const DiagnoseSplit split = SplitRuns(options, runs, WheelChannelMask(robot));
     if (split.training.empty() || split.validation.empty()) {
       std::cerr << "fitcal: diagnose needs training and held-out runs; got "

@@ -60,8 +60,9 @@ TrajectoryErrors EvaluateTrajectory(const AlignedRun& run, const GroundTruthTrac
 // The same for a model with effects (odometry/effects.h, as a calibrated robot YAML carries them
 // after `fitcal diagnose`), with the semantics of the effect fit (effect_fit.h): the replay
 // applies every effect, and a ground-truth latency tau makes the ground-truth sample stamped t
-// show the odometry at encoder time t - tau (the start pose is TrackStartPose's, the final pose is
-// compared with the ground truth at t_final + tau). With no effects it equals the overload above.
+// show the odometry at encoder time t - tau (the replay is carried through the anchor samples of
+// StartAnchorIndices, the final pose is compared with the ground truth at t_final + tau). With no
+// effects it equals the overload above.
 TrajectoryErrors EvaluateTrajectory(const AlignedRun& run, const GroundTruthTrack& track,
                                     const Omni3ParameterArray& p,
                                     const std::vector<effects::EffectValue>& effects,

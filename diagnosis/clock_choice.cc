@@ -1,0 +1,38 @@
+#include "diagnosis/clock_choice.h"
+
+#include <stdexcept>
+
+#include "diagnosis/effect_fit.h"
+
+namespace fitcal {
+
+ClockChoice ChooseClocks(const RobotModelInterface& model, const std::vector<double>& p,
+                         const std::vector<RunLog>& original, const std::vector<RunLog>& mapped,
+                         unsigned wheel_mask, int num_threads) {
+  if (original.size() != mapped.size()) {
+    throw std::invalid_argument("ChooseClocks: the mapped runs are not the original runs");
+  }
+  const ModelScore identity =
+      ScoreModel(model, p, {}, PrepareTrackRuns(original, wheel_mask), {}, num_threads);
+  const ModelScore remapped =
+      ScoreModel(model, p, {}, PrepareTrackRuns(mapped, wheel_mask), {}, num_threads);
+  ClockChoice out;
+  for (std::size_t i = 0; i < original.size(); ++i) {
+    out.objective_identity.push_back(identity.runs[i].objective);
+    out.objective_mapped.push_back(remapped.runs[i].objective);
+    const bool keep = remapped.runs[i].objective < identity.runs[i].objective;
+    out.mapped.push_back(keep);
+    out.num_mapped += keep ? 1 : 0;
+  }
+  return out;
+}
+
+std::vector<RunLog> ApplyClockChoice(const ClockChoice& choice, std::vector<RunLog> original,
+                                     const std::vector<RunLog>& mapped) {
+  for (std::size_t i = 0; i < original.size() && i < choice.mapped.size(); ++i) {
+    if (choice.mapped[i]) original[i].ground_truth = mapped[i].ground_truth;
+  }
+  return original;
+}
+
+}  // namespace fitcal

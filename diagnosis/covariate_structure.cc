@@ -1,0 +1,276 @@
+#include "diagnosis/covariate_structure.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <numeric>
+
+#include "diagnosis/statistics.h"
+
+namespace fitcal {
+
+namespace {
+
+// Below this mean speed a run's direction of travel is its start heading (a turn on the spot).
+constexpr double kTravellingSpeedMS = 0.02;
+
+struct Groups {
+  std::vector<std::vector<std::size_t>> members;
+  bool within = false;  // trajectories with repetitions (else: all runs, one group)
+};
+
+Groups MakeGroups(const ResidualAnalysis& a) {
+  std::map<std::string, std::vector<std::size_t>> by_trajectory;
+  for (std::size_t i = 0; i < a.runs.size(); ++i) by_trajectory[a.runs[i].trajectory].push_back(i);
+  Groups g;
+  for (auto& [label, members] : by_trajectory) {
+    if (members.size() >= 2) g.members.push_back(members);
+  }
+  g.within = !g.members.empty();
+  if (!g.within) {
+    g.members.emplace_back(a.runs.size());
+    std::iota(g.members.back().begin(), g.members.back().end(), std::size_t{0});
+  }
+  return g;
+}
+
+struct Covariate {
+  std::string name;
+  bool direction = false;
+  std::vector<std::vector<double>> value;  // [run][column]
+};
+
+// Run order: the encoder clock's start time when the runs' windows never overlap (the logs share
+// a session clock), else the repetition number (repetitions are recorded in order).
+std::vector<std::vector<double>> RunOrder(const ResidualAnalysis& a) {
+  std::vector<std::size_t> order(a.runs.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(), [&](std::size_t i, std::size_t j) {
+    return a.runs[i].t_start_s < a.runs[j].t_start_s;
+  });
+  bool session_clock = order.size() >= 2;
+  for (std::size_t k = 1; k < order.size(); ++k) {
+    const RunFeatures& prev = a.runs[order[k - 1]];
+    session_clock = session_clock && a.runs[order[k]].t_start_s >= prev.t_start_s + prev.duration_s;
+  }
+  std::vector<std::vector<double>> out;
+  for (const RunFeatures& f : a.runs) {
+    out.push_back({session_clock ? f.t_start_s : static_cast<double>(f.repetition)});
+  }
+  return out;
+}
+
+std::vector<Covariate> MakeCovariates(const ResidualAnalysis& a) {
+  std::vector<Covariate> out;
+  out.push_back({"run order within the session", false, RunOrder(a)});
+  Covariate world{"world-frame direction of travel", true, {}};
+  Covariate distance{"distance travelled", false, {}};
+  Covariate speed{"speed", false, {}};
+  Covariate turning{"turning direction", false, {}};
+  for (const RunFeatures& f : a.runs) {
+    const double phi = f.start_heading_rad + (f.speed_m_s > kTravellingSpeedMS ? f.alpha_rad : 0.0);
+    world.value.push_back({std::cos(phi), std::sin(phi)});
+    distance.value.push_back({f.distance_m});
+    speed.value.push_back({f.speed_m_s});
+    turning.value.push_back({static_cast<double>(f.rotation_sign)});
+  }
+  for (Covariate* c : {&world, &distance, &speed, &turning}) out.push_back(std::move(*c));
+  return out;
+}
+
+// Whitening of the grouped deviations: rows S^-1/2 (rank r), and the degrees of freedom D.
+struct Whitened {
+  Eigen::MatrixXd whiten;          // r x 3
+  std::vector<Eigen::VectorXd> z;  // per run (empty for runs outside the groups)
+  std::vector<bool> in_group;
+  double dof = 0.0;    // D
+  double total = 0.0;  // SS_tot
+};
+
+Whitened Whiten(const ResidualAnalysis& a, const Groups& g) {
+  const std::size_t n = a.runs.size();
+  std::vector<Eigen::Vector3d> d(n, Eigen::Vector3d::Zero());
+  Whitened w;
+  w.z.resize(n);
+  w.in_group.assign(n, false);
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const auto& members : g.members) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (std::size_t i : members) {
+      const Pose2d& e = a.final_start_frame[i];
+      mean += Eigen::Vector3d(e.x, e.y, e.theta) / static_cast<double>(members.size());
+    }
+    for (std::size_t i : members) {
+      const Pose2d& e = a.final_start_frame[i];
+      d[i] = Eigen::Vector3d(e.x, e.y, e.theta) - mean;
+      scatter += d[i] * d[i].transpose();
+      w.in_group[i] = true;
+    }
+    w.dof += static_cast<double>(members.size()) - 1.0;
+  }
+  if (!(w.dof > 0.0)) return w;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(scatter / w.dof);
+  const double largest = eig.eigenvalues().maxCoeff();
+  std::vector<Eigen::RowVector3d> rows;
+  for (int c = 0; c < 3; ++c) {
+    const double lambda = eig.eigenvalues()[c];
+    if (lambda > 1e-12 * largest && lambda > 0.0) {
+      rows.push_back(eig.eigenvectors().col(c).transpose() / std::sqrt(lambda));
+    }
+  }
+  w.whiten.resize(static_cast<int>(rows.size()), 3);
+  for (std::size_t r = 0; r < rows.size(); ++r) w.whiten.row(static_cast<int>(r)) = rows[r];
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!w.in_group[i]) continue;
+    w.z[i] = w.whiten * d[i];
+    w.total += w.z[i].squaredNorm();
+  }
+  return w;
+}
+
+// The F test of one covariate (header). Leaves `test` not tested with the reason when the data
+// cannot carry it.
+void TestCovariate(const ResidualAnalysis& a, const Groups& g, const Whitened& w,
+                   const Covariate& cov, CovariateTest* test) {
+  test->name = cov.name;
+  test->direction = cov.direction;
+  const int r = static_cast<int>(w.whiten.rows());
+  if (r == 0) {
+    test->why_not = "no scatter to test against";
+    return;
+  }
+  const int h = static_cast<int>(cov.value.front().size());
+  const int k = a.final_jacobian.empty() ? 0 : static_cast<int>(a.final_jacobian.front().cols());
+  const int q_max = h * (k + 3);
+  // Centred covariate, and how much of its spread lies within the groups.
+  std::vector<std::vector<double>> centred(a.runs.size(), std::vector<double>(h, 0.0));
+  double within = 0.0, overall = 0.0;
+  for (int c = 0; c < h; ++c) {
+    double mean_all = 0.0;
+    for (const auto& v : cov.value) mean_all += v[c] / static_cast<double>(cov.value.size());
+    for (const auto& v : cov.value) overall += (v[c] - mean_all) * (v[c] - mean_all);
+    for (const auto& members : g.members) {
+      double mean = 0.0;
+      for (std::size_t i : members) mean += cov.value[i][c] / static_cast<double>(members.size());
+      for (std::size_t i : members) {
+        centred[i][c] = cov.value[i][c] - mean;
+        within += centred[i][c] * centred[i][c];
+      }
+    }
+  }
+  if (!(within > 1e-6 * overall) || !(within > 0.0)) {
+    test->why_not = g.within ? "does not vary between repetitions of a trajectory"
+                             : "does not vary between the runs";
+    return;
+  }
+  Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(q_max, q_max);
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(q_max);
+  for (std::size_t i = 0; i < a.runs.size(); ++i) {
+    if (!w.in_group[i]) continue;
+    Eigen::MatrixXd x(3, q_max);
+    for (int c = 0; c < h; ++c) {
+      if (k > 0) x.block(0, c * (k + 3), 3, k) = centred[i][c] * a.final_jacobian[i];
+      x.block(0, c * (k + 3) + k, 3, 3) = centred[i][c] * Eigen::Matrix3d::Identity();
+    }
+    const Eigen::MatrixXd xw = w.whiten * x;
+    normal += xw.transpose() * xw;
+    b += xw.transpose() * w.z[i];
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(normal);
+  const double largest = eig.eigenvalues().maxCoeff();
+  int q = 0;
+  double explained = 0.0;
+  for (int j = 0; j < q_max; ++j) {
+    const double lambda = eig.eigenvalues()[j];
+    if (!(lambda > 1e-10 * largest)) continue;
+    ++q;
+    const double proj = eig.eigenvectors().col(j).dot(b);
+    explained += proj * proj / lambda;
+  }
+  // Without repetitions the residuals carry the fit of the k parameters (k / r runs' worth).
+  const double dof = w.dof - (g.within ? 0.0 : static_cast<double>(k) / r);
+  const double df2 = r * dof - q;
+  if (q == 0 || !(df2 >= 1.0)) {
+    test->why_not = "too few runs for its alternatives";
+    return;
+  }
+  test->tested = true;
+  test->df1 = q;
+  test->df2 = df2;
+  explained = std::min(explained, w.total);
+  test->f = (explained / q) / std::max((w.total - explained) / df2, 1e-300);
+  test->p_value = stats::FUpperTail(test->f, test->df1, test->df2);
+}
+
+}  // namespace
+
+CovariateStructure AnalyzeCovariates(const ResidualAnalysis& analysis, double alpha) {
+  CovariateStructure out;
+  out.alpha = alpha;
+  if (analysis.runs.size() < 3 || analysis.final_jacobian.size() != analysis.runs.size()) {
+    return out;
+  }
+  const Groups groups = MakeGroups(analysis);
+  out.within_repetitions = groups.within;
+  const Whitened whitened = Whiten(analysis, groups);
+  for (const Covariate& c : MakeCovariates(analysis)) {
+    CovariateTest test;
+    TestCovariate(analysis, groups, whitened, c, &test);
+    out.tests.push_back(test);
+  }
+  // Holm's step-down over the tested covariates.
+  std::vector<CovariateTest*> tested;
+  for (CovariateTest& t : out.tests) {
+    if (t.tested) tested.push_back(&t);
+  }
+  std::sort(tested.begin(), tested.end(),
+            [](const CovariateTest* x, const CovariateTest* y) { return x->p_value < y->p_value; });
+  bool rejecting = true;
+  for (std::size_t j = 0; j < tested.size(); ++j) {
+    tested[j]->holm_threshold = alpha / static_cast<double>(tested.size() - j);
+    rejecting = rejecting && tested[j]->p_value < tested[j]->holm_threshold;
+    tested[j]->significant = rejecting;
+    out.any_significant = out.any_significant || rejecting;
+  }
+  return out;
+}
+
+std::string CovariateFinding(const CovariateTest& t) {
+  char line[320];
+  std::snprintf(line, sizeof line,
+                "unexplained: the residual %s %s (F = %.2f on (%.0f, %.0f) df, p = %.2g, Holm "
+                "threshold %.2g)",
+                t.direction ? "depends on the" : "drifts with", t.name.c_str(), t.f, t.df1, t.df2,
+                t.p_value, t.holm_threshold);
+  return line;
+}
+
+std::string FormatCovariateStructure(const CovariateStructure& s) {
+  char line[320];
+  std::snprintf(line, sizeof line,
+                "Residual against covariates (%s; family-wise alpha %.2g, Holm step-down over the "
+                "covariates tested):\n\n",
+                s.within_repetitions ? "deviations between repetitions of each trajectory"
+                                     : "all runs, no repetitions",
+                s.alpha);
+  std::string out = line;
+  out += "| covariate | F | df | p | Holm threshold | verdict |\n|---|---|---|---|---|---|\n";
+  for (const CovariateTest& t : s.tests) {
+    if (!t.tested) {
+      out += "| " + t.name + " | - | - | - | - | not tested: " + t.why_not + " |\n";
+      continue;
+    }
+    std::snprintf(line, sizeof line, "| %s | %.2f | (%.0f, %.0f) | %.2g | %.2g | %s |\n",
+                  t.name.c_str(), t.f, t.df1, t.df2, t.p_value, t.holm_threshold,
+                  t.significant ? "STRUCTURE" : "-");
+    out += line;
+  }
+  out +=
+      "| absolute wheel angle | - | - | - | - | not tested: the loaded logs carry wheel rates, "
+      "not the cumulative tick count at the start |\n";
+  return out;
+}
+
+}  // namespace fitcal
