@@ -69,8 +69,6 @@ template <typename T>
 void TrackPoseErrors(const RobotModelInterface& robot_model, const TrackRun& run, const T* p,
                      const std::vector<ActiveEffect<T>>& active, const std::vector<int>& indices,
                      T* err) {
-  using std::cos;
-  using std::sin;
   const AlignedRun& a = run.aligned;
   const T tau = effects::TotalLatency(active);
   const Pose2d start_pose = TrackStartPose(a, run.contexts, run.track, ScalarPart(tau));
@@ -109,27 +107,7 @@ void TrackPoseErrors(const RobotModelInterface& robot_model, const TrackRun& run
   Pose2<T> final_pose =
       effects::ReplayStepsWithEffects(step, active, a.samples, run.contexts, start, visit);
   for (; next < n; ++next) replayed[next] = final_pose;  // only for an empty replay
-  // C (identity without anchors): the mean turn, then the mean translation under it.
-  const double m = static_cast<double>(anchors.size());
-  T turn(0.0);
-  for (std::size_t j = 0; j < anchors.size(); ++j) {
-    const double g_theta = run.track.world_T_robot[anchors[j]].theta;
-    // Each difference taken near the first one: headings may wrap between the two tracks.
-    const T d = T(g_theta) - anchor_pose[j].theta;
-    const T d0 = T(run.track.world_T_robot[anchors[0]].theta) - anchor_pose[0].theta;
-    turn += (d0 + WrapAngle(d - d0)) / m;
-  }
-  const T c = cos(turn), s = sin(turn);
-  T cx(0.0), cy(0.0);
-  for (std::size_t j = 0; j < anchors.size(); ++j) {
-    const Pose2d& g = run.track.world_T_robot[anchors[j]];
-    cx += (T(g.x) - (c * anchor_pose[j].x - s * anchor_pose[j].y)) / m;
-    cy += (T(g.y) - (s * anchor_pose[j].x + c * anchor_pose[j].y)) / m;
-  }
-  const auto carried = [&](const Pose2<T>& q) {
-    if (anchors.empty()) return q;
-    return Pose2<T>{cx + c * q.x - s * q.y, cy + s * q.x + c * q.y, q.theta + turn};
-  };
+  const AnchorCarry<T> carried = FitAnchorCarry(run.track, anchors, anchor_pose);
   for (std::size_t j = 0; j < n; ++j) {
     const Pose2<T> pose = carried(replayed[j]);
     const Pose2d& gt = run.track.world_T_robot[indices[j]];

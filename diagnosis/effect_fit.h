@@ -67,6 +67,49 @@ std::vector<int> StartAnchorIndices(const AlignedRun& run,
                                     const std::vector<effects::SampleContext>& contexts,
                                     const GroundTruthTrack& track, double latency_s);
 
+// The rigid transform C that puts replayed poses P_j through the anchor ground-truth samples G_j
+// (StartAnchorIndices) in the least-squares sense:
+//   turn = mean_j (G_j.theta - P_j.theta),  C.xy = mean_j (G_j.xy - R(turn) P_j.xy),
+//   C * P:  theta + turn,  C.xy + R(turn) P.xy.
+// The identity without anchors. T is double or a Jet (the effect fit differentiates through it).
+template <typename T>
+struct AnchorCarry {
+  bool identity = true;
+  T turn = T(0.0), cos_turn = T(1.0), sin_turn = T(0.0), x = T(0.0), y = T(0.0);
+  Pose2<T> operator()(const Pose2<T>& q) const {
+    if (identity) return q;
+    return {x + cos_turn * q.x - sin_turn * q.y, y + sin_turn * q.x + cos_turn * q.y,
+            q.theta + turn};
+  }
+};
+
+template <typename T>
+AnchorCarry<T> FitAnchorCarry(const GroundTruthTrack& track, const std::vector<int>& anchors,
+                              const std::vector<Pose2<T>>& anchor_pose) {
+  using std::cos;
+  using std::sin;
+  AnchorCarry<T> carry;
+  if (anchors.empty()) return carry;
+  carry.identity = false;
+  const double m = static_cast<double>(anchors.size());
+  // Each difference taken near the first one: headings may wrap between the two tracks.
+  const T d0 = T(track.world_T_robot[anchors[0]].theta) - anchor_pose[0].theta;
+  for (std::size_t j = 0; j < anchors.size(); ++j) {
+    const T d = T(track.world_T_robot[anchors[j]].theta) - anchor_pose[j].theta;
+    carry.turn += (d0 + WrapAngle(d - d0)) / m;
+  }
+  carry.cos_turn = cos(carry.turn);
+  carry.sin_turn = sin(carry.turn);
+  for (std::size_t j = 0; j < anchors.size(); ++j) {
+    const Pose2d& g = track.world_T_robot[anchors[j]];
+    carry.x +=
+        (T(g.x) - (carry.cos_turn * anchor_pose[j].x - carry.sin_turn * anchor_pose[j].y)) / m;
+    carry.y +=
+        (T(g.y) - (carry.sin_turn * anchor_pose[j].x + carry.cos_turn * anchor_pose[j].y)) / m;
+  }
+  return carry;
+}
+
 struct TrackOptions {
   // Checkpoints keep this far from the window's ends so a latency within the effect's bounds
   // never moves them outside the replay.

@@ -21,14 +21,15 @@ const char* ToString(OdometrySampling sampling) {
 
 namespace {
 
-// As the effect fit's track residual (effect_fit.h, StartAnchorIndices): the replay is moved
-// rigidly so that it passes through the anchor ground-truth samples at the encoder times they
-// show (least squares), whatever the log's start (at rest or moving). Returns the moved final
+// As the effect fit's track residual (effect_fit.h, StartAnchorIndices, FitAnchorCarry): the
+// replay is moved rigidly so that it passes through the anchor ground-truth samples at the
+// encoder times they show, whatever the log's start (at rest or moving). Returns the moved final
 // pose.
-Pose2d CarryThroughAnchors(const AlignedRun& run, const GroundTruthTrack& track, double latency_s,
+Pose2d CarryThroughAnchors(const AlignedRun& run,
+                           const std::vector<effects::SampleContext>& contexts,
+                           const GroundTruthTrack& track, double latency_s,
                            const std::vector<double>& times, std::vector<Pose2d>* poses,
                            const Pose2d& final_pose) {
-  const std::vector<effects::SampleContext> contexts = effects::MakeSampleContexts(run.samples);
   const std::vector<int> anchors = StartAnchorIndices(run, contexts, track, latency_s);
   if (anchors.empty() || times.size() < 2) return final_pose;
   const auto odometry_at = [&](double e) {
@@ -41,25 +42,11 @@ Pose2d CarryThroughAnchors(const AlignedRun& run, const GroundTruthTrack& track,
     const Pose2d& b = (*poses)[hi];
     return Pose2d{a.x + u * (b.x - a.x), a.y + u * (b.y - a.y), a.theta + u * (b.theta - a.theta)};
   };
-  std::vector<Pose2d> p(anchors.size());
-  const double m = static_cast<double>(anchors.size());
-  double turn = 0.0, d0 = 0.0;
+  std::vector<Pose2d> anchor_pose(anchors.size());
   for (std::size_t j = 0; j < anchors.size(); ++j) {
-    p[j] = odometry_at(track.t_s[anchors[j]] - latency_s);
-    const double d = track.world_T_robot[anchors[j]].theta - p[j].theta;
-    if (j == 0) d0 = d;
-    turn += (d0 + WrapAngle(d - d0)) / m;
+    anchor_pose[j] = odometry_at(track.t_s[anchors[j]] - latency_s);
   }
-  const double c = std::cos(turn), s = std::sin(turn);
-  double cx = 0.0, cy = 0.0;
-  for (std::size_t j = 0; j < anchors.size(); ++j) {
-    const Pose2d& g = track.world_T_robot[anchors[j]];
-    cx += (g.x - (c * p[j].x - s * p[j].y)) / m;
-    cy += (g.y - (s * p[j].x + c * p[j].y)) / m;
-  }
-  const auto carried = [&](const Pose2d& q) {
-    return Pose2d{cx + c * q.x - s * q.y, cy + s * q.x + c * q.y, q.theta + turn};
-  };
+  const AnchorCarry<double> carried = FitAnchorCarry(track, anchors, anchor_pose);
   for (Pose2d& q : *poses) q = carried(q);
   return carried(final_pose);
 }
@@ -115,7 +102,7 @@ void ReplayWithEffectList(const Step& step, const AlignedRun& run, const GroundT
       step, active, run.samples, contexts, r->poses[0],
       [r](std::size_t k, const Pose2d&, const Pose2d& after) { r->poses[k + 1] = after; });
   r->final_pose =
-      CarryThroughAnchors(run, track, r->latency_s, r->times, &r->poses, r->final_pose);
+      CarryThroughAnchors(run, contexts, track, r->latency_s, r->times, &r->poses, r->final_pose);
 }
 
 TrajectoryErrors ErrorsAlongTrack(const AlignedRun& run, const GroundTruthTrack& track,
