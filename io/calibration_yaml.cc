@@ -48,6 +48,54 @@ std::string OptionalString(const YAML::Node& block, const char* key, const std::
   return YamlString(node, path, std::string("calibration.") + key);
 }
 
+// `sigma: {name_unit: value, ...}` and `correlation: [[...], ...]`, square and of the same size,
+// or nothing at all when the fit recorded no uncertainty.
+void ReadUncertainty(const YAML::Node& block, const std::string& path, CalibrationProvenance* p) {
+  const YAML::Node sigma = block["sigma"];
+  if (!sigma || sigma.IsNull()) return;
+  ExpectYamlType(sigma, YAML::NodeType::Map, path, "calibration.sigma");
+  const auto add = [&](const std::string& key, const YAML::Node& node) {
+    const double value = YamlDouble(node, path, "calibration.sigma." + key);
+    if (!(value >= 0.0) || !std::isfinite(value)) {
+      throw InputError(InputErrorKind::kBadValue, path, node.Mark().line + 1,
+                       "calibration.sigma." + key + ": not a finite non-negative number");
+    }
+    p->sigma.emplace_back(key, value);
+  };
+  for (const auto& entry : sigma) {
+    const std::string key = YamlString(entry.first, path, "calibration.sigma");
+    if (!entry.second.IsSequence()) {
+      add(key, entry.second);
+      continue;
+    }
+    // The omni3 file writes one list per quantity (`distance_m: [a, b, c]`).
+    for (std::size_t i = 0; i < entry.second.size(); ++i) {
+      add(key + "[" + std::to_string(i) + "]", entry.second[i]);
+    }
+  }
+  const YAML::Node correlation = block["correlation"];
+  if (!correlation || correlation.IsNull()) return;
+  ExpectYamlType(correlation, YAML::NodeType::Sequence, path, "calibration.correlation");
+  for (const YAML::Node& row : correlation) {
+    ExpectYamlType(row, YAML::NodeType::Sequence, path, "calibration.correlation");
+    std::vector<double> values;
+    for (const YAML::Node& item : row) {
+      values.push_back(YamlDouble(item, path, "calibration.correlation"));
+    }
+    if (values.size() != p->sigma.size()) {
+      throw InputError(InputErrorKind::kBadValue, path, row.Mark().line + 1,
+                       "calibration.correlation: a row of " + std::to_string(values.size()) +
+                           " values for " + std::to_string(p->sigma.size()) + " sigmas");
+    }
+    p->correlation.push_back(std::move(values));
+  }
+  if (p->correlation.size() != p->sigma.size()) {
+    throw InputError(InputErrorKind::kBadValue, path, correlation.Mark().line + 1,
+                     "calibration.correlation: " + std::to_string(p->correlation.size()) +
+                         " rows for " + std::to_string(p->sigma.size()) + " sigmas");
+  }
+}
+
 }  // namespace
 
 std::optional<std::vector<int>> ReadCalibrationTrainingRepetitions(const std::string& path) {
@@ -82,6 +130,7 @@ std::optional<CalibrationProvenance> ReadCalibrationProvenance(const std::string
     p.cf_training_after = YamlDouble(cf["after"], path, "calibration.cf_training.after");
     p.has_training_cf = true;
   }
+  ReadUncertainty(block, path, &p);
   return p;
 }
 

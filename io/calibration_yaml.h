@@ -5,6 +5,7 @@
 
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace fitcal::io {
@@ -26,6 +27,11 @@ struct CalibrationProvenance {
   std::vector<std::string> at_bound;  // parameter names resting on a bound
   bool has_training_cf = false;
   double cf_training_before = 0.0, cf_training_after = 0.0;
+  // The fit's one-sigma uncertainty as written: keyed "<parameter>_<display unit>" in display
+  // units (degrees for angles), with the correlation matrix in the same order; empty when the
+  // file records `sigma: ~`.
+  std::vector<std::pair<std::string, double>> sigma;
+  std::vector<std::vector<double>> correlation;
 };
 
 // nullopt for a plain robot YAML; InputError (file, line) for a malformed block.

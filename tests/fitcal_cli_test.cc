@@ -244,6 +244,13 @@ TEST(FitcalCli, ReportServesADifferentialDrive) {
   EXPECT_EQ(j["verdict"]["level"].as<std::string>(), "PASS") << r.out;
   ASSERT_EQ(j["parameters"].size(), 3u);
   EXPECT_EQ(j["parameters"][2]["name"].as<std::string>(), "wheel_separation");
+  // The sigmas the fit recorded are the report's, read back to the YAML's 10 digits.
+  const YAML::Node recorded = YAML::LoadFile(cal)["calibration"]["sigma"];
+  ASSERT_TRUE(recorded.IsMap()) << ReadFileBytes(cal);
+  EXPECT_GT(recorded["wheel_separation_m"].as<double>(), 0.0);
+  EXPECT_NEAR(j["parameters"][2]["sigma_m"].as<double>(),
+              recorded["wheel_separation_m"].as<double>(), 1e-12);
+  EXPECT_EQ(j["correlation"].size(), 3u);
   EXPECT_TRUE(j["identifiability"]["checked"].as<bool>());
   EXPECT_FALSE(j["noise_floor"].IsNull());
   EXPECT_LT(j["summary"][0]["after"]["cf"].as<double>(),

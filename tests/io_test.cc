@@ -148,6 +148,8 @@ TEST(RobotYaml, CalibrationProvenanceRoundTrips) {
   record.training_fingerprint = "0123456789012345";  // digits only: must stay a string
   record.at_bound = {"R_a"};
   record.cf_training_after = 0.0125;
+  record.has_uncertainty = true;
+  record.sigma.fill(1e-4);
   const std::string path = dir.Write("calibrated.yaml", Omni3RobotYaml(robot, &record));
   const std::optional<CalibrationProvenance> p = ReadCalibrationProvenance(path);
   ASSERT_TRUE(p.has_value());
@@ -159,6 +161,17 @@ TEST(RobotYaml, CalibrationProvenanceRoundTrips) {
   EXPECT_EQ(p->at_bound, record.at_bound);
   ASSERT_TRUE(p->has_training_cf);
   EXPECT_DOUBLE_EQ(p->cf_training_after, 0.0125);
+  ASSERT_EQ(p->sigma.size(), 9u);  // omni3 writes one list of three per quantity
+  EXPECT_EQ(p->sigma[3].first, "radius_m[0]");
+  EXPECT_DOUBLE_EQ(p->sigma[3].second, 1e-4);
+  EXPECT_EQ(p->correlation.size(), 9u);
+  const std::string uneven =
+      dir.Write("uneven.yaml", std::string(kRobot) +
+                                   "calibration:\n  training_repetitions: [1]\n"
+                                   "  sigma: {r_m: 0.001, b_m: 0.002}\n"
+                                   "  correlation:\n    - [1, 0.5]\n    - [0.5]\n");
+  ExpectInputError([&] { ReadCalibrationProvenance(uneven); }, InputErrorKind::kBadValue, uneven,
+                   static_cast<int>(std::count(kRobot, kRobot + std::strlen(kRobot), '\n')) + 6);
   const std::string bad = dir.Write("bad.yaml", std::string(kRobot) +
                                                     "calibration:\n  training_repetitions: [1]\n"
                                                     "  training_run_ids: 5\n");

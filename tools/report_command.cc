@@ -410,8 +410,33 @@ void AddModelIdentifiability(const ReportInputs& in, const CalibrationInput& cal
   }
   if (!d.ok) data->identifiability_lines.push_back("no Jacobian at the calibrated parameters");
   data->uncertainty_note = "No parameter sigma here: this report does not refit a " +
-                           in.model->robot().model +
-                           " robot; fitcal fit prints the fit's and records them in the YAML.";
+                           in.model->robot().model + " robot, and the calibration records none.";
+}
+
+// The sigmas and correlation the fit recorded in the calibration's YAML, matched to this robot's
+// parameters by their written key; false (nothing set) unless every parameter has one. They are
+// the fit's, from its own training runs, so they hold whichever data set this report validates on.
+bool AddRecordedUncertainty(const CalibrationInput& cal, io::ReportData* data,
+                            std::vector<double>* sigma, bool* has_sigma) {
+  if (!cal.provenance || cal.provenance->sigma.empty()) return false;
+  const Robot& robot = cal.calibrated;
+  const auto& recorded = cal.provenance->sigma;
+  if (static_cast<int>(recorded.size()) != robot.NumParameters()) return false;
+  std::vector<double> values(robot.NumParameters());
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    const ParameterInfo& info = robot.parameters[k];
+    if (recorded[k].first != info.name + "_" + info.DisplayUnit()) return false;
+    values[k] = recorded[k].second / info.DisplayScale();
+  }
+  *sigma = std::move(values);
+  *has_sigma = true;
+  data->has_correlation = !cal.provenance->correlation.empty();
+  data->correlation = cal.provenance->correlation;
+  const std::string& method = cal.provenance->method;
+  data->uncertainty_note = "One sigma as the fit" + (method.empty() ? "" : " (" + method + ")") +
+                           " recorded it in the calibration: the covariance of its residuals on "
+                           "its own training runs at the calibrated parameters.";
+  return true;
 }
 
 // Uncertainty and identifiability from the training runs, only when they are in this data set.
@@ -423,12 +448,14 @@ void AddUncertainty(const ReportInputs& in, const CalibrationInput& cal,
   if (training.empty()) {
     data->uncertainty_note =
         "No uncertainty from this data set: the calibration's training runs are not in it.";
+    AddRecordedUncertainty(cal, data, sigma, has_sigma);
     return;
   }
   if (in.omni3) {
     AddOmni3Uncertainty(in, cal, training, threads, data, sigma, has_sigma);
   } else {
     AddModelIdentifiability(in, cal, training, threads, data);
+    AddRecordedUncertainty(cal, data, sigma, has_sigma);
   }
 }
 
