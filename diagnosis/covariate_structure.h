@@ -29,8 +29,16 @@
 // Covariates: run order within the session (the encoder clock's start time when the logs share a
 // session clock, else the repetition number), world-frame direction of travel (cos, sin of the
 // start heading + the robot-frame direction of motion), distance travelled, speed, turning
-// direction, and the absolute wheel angle at the start when the logs carry cumulative ticks (not
-// yet carried by RunLog: reported as unavailable).
+// direction, and the absolute wheel angle when the logs carry it (cumulative counts,
+// TrackRun::start_wheel_angle_rad). The wheel angle changes during a run, so its alternative is
+// not c~ times something but an error periodic in each wheel's revolution,
+//   d_i = (G_i - mean_g G) beta,   G_i = d y_i / d(a_j, b_j)  (residual_analysis.h),
+// w_j' = w_j (1 + a_j cos A_j + b_j sin A_j), A_j wheel j's absolute angle: an eccentric wheel
+// r(A) = r0 (1 + e cos(A - A0)) to first order. Runs that start at the same wheel angles share
+// G_i, so it is tested only where the start angles differ between repetitions.
+// A covariate whose within-group spread is below its resolution (1 mrad of direction, 1 mm,
+// 0.1 mm/s) is not tested: data sets rebased to start every run at heading 0 have no world-frame
+// direction, whatever rounding leaves in it.
 
 #include <string>
 #include <vector>
