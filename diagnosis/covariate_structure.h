@@ -19,9 +19,14 @@
 //   - an additive error that drifts with c:   d_i = c~_i beta       (beta in the start frame).
 // Least squares over all runs gives SS_reg = b^T A^+ b (A = sum X_i^T X_i, b = sum X_i^T z_i,
 // X_i = S^-1/2 [c~_i J_i, c~_i I]); with q the rank of A and SS_tot = sum |z_i|^2,
-//   F = (SS_reg / q) / ((SS_tot - SS_reg) / (r D' - q)),  p = P(F(q, r D' - q) > F),
+//   F = (SS_reg / q) / ((SS_tot - SS_reg) / (r D' - q)),
 // D' = D, less the fitted parameters' share (k / r) when all runs form one group (their residuals
 // then carry the fit). A covariate that does not vary within the groups is not tested there.
+// p is a permutation p: the fraction of 1999 reassignments of the alternatives among the runs of
+// each group (seeded, reproducible) whose SS_reg reaches the observed one, (1 + count) / 2000.
+// Under "no dependence" the runs of a group are exchangeable, whatever the noise level of each
+// trajectory; the F(q, r D' - q) reference assumes one level for all and read clean data with
+// four repetitions as structure in 3 of 12 seeds.
 //
 // Multiple testing: Holm's step-down over the covariates tested (family-wise error <= alpha):
 // sorted p_(1) <= ... <= p_(m), reject while p_(j) < alpha / (m - j + 1).

@@ -50,11 +50,13 @@ const CovariateTest& WheelAngleTest(const DiagnoseResult& r) {
   return r.covariates.tests.front();
 }
 
-// e = 1.5 %: wheel a's travel per revolution is unchanged, but a run's final pose moves by
-// r e (sin A_end - sin A_start) along the wheel (~2 mm, and ~0.6 deg of heading through its
-// lever arm), at a phase that changes from run to run: the repetitions' scatter holds it.
+// e = 2 %: wheel a's travel per revolution is unchanged, but a run's final pose moves by
+// r e (sin A_end - sin A_start) along the wheel (~3 mm, and ~0.9 deg of heading through its
+// lever arm), at a phase that changes from run to run: the repetitions' scatter holds it and the
+// lack of fit does not see it. Power measured over seeds 1-12: named in 11 of 12 at e = 2 %, 7 of
+// 12 at 1.5 %; clean, 0 of 12 report any structure.
 TEST(WheelAngle, EccentricWheelIsNamedAsTheAbsoluteWheelAngle) {
-  const DiagnoseResult r = DiagnoseEccentric(0.015, 7);
+  const DiagnoseResult r = DiagnoseEccentric(0.02, 1);
   const std::string report = FormatDiagnoseReport(r, NominalRobot());
   SCOPED_TRACE(report);
   const CovariateTest& t = WheelAngleTest(r);
@@ -75,7 +77,7 @@ TEST(WheelAngle, EccentricWheelIsNamedAsTheAbsoluteWheelAngle) {
 // significant; nothing is reported. (The clean 20-seed rate with every covariate, this one
 // included, is diagnose_test's CleanDataAcceptsNoEffectOverTwentySeeds.)
 TEST(WheelAngle, RoundWheelsStaySilent) {
-  const DiagnoseResult r = DiagnoseEccentric(0.0, 7);
+  const DiagnoseResult r = DiagnoseEccentric(0.0, 1);
   const CovariateTest& t = WheelAngleTest(r);
   ASSERT_TRUE(t.tested) << t.why_not;
   EXPECT_FALSE(t.significant) << "p = " << t.p_value;
