@@ -21,8 +21,18 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// Removes the imported data set when the benchmarks end.
+struct RemovedAtExit {
+  std::string path;
+  ~RemovedAtExit() {
+    std::error_code ignored;
+    if (!path.empty()) fs::remove_all(path, ignored);
+  }
+};
+
 // The imported data set's directory; empty when ../shared holds no OptiOdom omni3 sessions.
 const std::string& ImportedOmni3() {
+  static RemovedAtExit cleanup;
   static const std::string directory = [] {
     const fs::path root = fs::path(FITCAL_SHARED_DIR) / "data" / "optiodom" / "omni3";
     tools::ImportOptiOdomOptions options;
@@ -38,6 +48,7 @@ const std::string& ImportedOmni3() {
     options.force = true;
     return tools::RunImportOptiOdomCommand(options) == 0 ? options.out : std::string();
   }();
+  cleanup.path = directory;
   return directory;
 }
 
