@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <map>
 #include <numeric>
+#include <random>
 
 #include "diagnosis/statistics.h"
 
@@ -15,6 +16,11 @@ namespace {
 
 // Below this mean speed a run's direction of travel is its start heading (a turn on the spot).
 constexpr double kTravellingSpeedMS = 0.02;
+// Permutations of the covariate test (p resolves 1 / (kPermutations + 1) = 5e-4, below Holm's
+// smallest threshold for six covariates at 0.01, 1.7e-3); a fixed seed: the same data give the
+// same p.
+constexpr int kPermutations = 1999;
+constexpr std::uint64_t kPermutationSeed = 16;
 
 struct Groups {
   std::vector<std::vector<std::size_t>> members;
@@ -23,7 +29,9 @@ struct Groups {
 
 Groups MakeGroups(const ResidualAnalysis& a) {
   std::map<std::string, std::vector<std::size_t>> by_trajectory;
-  for (std::size_t i = 0; i < a.runs.size(); ++i) by_trajectory[a.runs[i].trajectory].push_back(i);
+  for (std::size_t i = 0; i < a.runs.size(); ++i) {
+    by_trajectory[a.runs[i].repetition_group].push_back(i);
+  }
   Groups g;
   for (auto& [label, members] : by_trajectory) {
     if (members.size() >= 2) g.members.push_back(members);
@@ -40,6 +48,14 @@ struct Covariate {
   std::string name;
   bool direction = false;
   std::vector<std::vector<double>> value;  // [run][column]
+  // The smallest within-group RMS spread that is a real difference (the covariate's resolution):
+  // a direction of travel that differs by rounding only (every run starts at the same heading)
+  // is not a covariate, however its relative spread reads.
+  double resolution = 0.0;
+  // Instead of value: the alternative's own regressor per run, 3 x m (the absolute wheel angle,
+  // whose exposure is an integral over the run, not one number); `why_not` when unavailable.
+  std::vector<Eigen::MatrixXd> regressor;
+  std::string why_not;
 };
 
 // Run order: the encoder clock's start time when the runs' windows never overlap (the logs share
@@ -62,13 +78,19 @@ std::vector<std::vector<double>> RunOrder(const ResidualAnalysis& a) {
   return out;
 }
 
+// Resolutions (Covariate::resolution): 1 mrad of direction on the unit circle, 1 mm, 0.1 mm/s,
+// half a turning sign; run order: 1 ms of session clock or half a repetition.
+constexpr double kDirectionResolution = 1e-3;
+constexpr double kDistanceResolutionM = 1e-3;
+constexpr double kSpeedResolutionMS = 1e-4;
+
 std::vector<Covariate> MakeCovariates(const ResidualAnalysis& a) {
   std::vector<Covariate> out;
-  out.push_back({"run order within the session", false, RunOrder(a)});
-  Covariate world{"world-frame direction of travel", true, {}};
-  Covariate distance{"distance travelled", false, {}};
-  Covariate speed{"speed", false, {}};
-  Covariate turning{"turning direction", false, {}};
+  out.push_back({"run order within the session", false, RunOrder(a), 1e-3, {}, {}});
+  Covariate world{"world-frame direction of travel", true, {}, kDirectionResolution, {}, {}};
+  Covariate distance{"distance travelled", false, {}, kDistanceResolutionM, {}, {}};
+  Covariate speed{"speed", false, {}, kSpeedResolutionMS, {}, {}};
+  Covariate turning{"turning direction", false, {}, 0.5, {}, {}};
   for (const RunFeatures& f : a.runs) {
     const double phi = f.start_heading_rad + (f.speed_m_s > kTravellingSpeedMS ? f.alpha_rad : 0.0);
     world.value.push_back({std::cos(phi), std::sin(phi)});
@@ -77,6 +99,71 @@ std::vector<Covariate> MakeCovariates(const ResidualAnalysis& a) {
     turning.value.push_back({static_cast<double>(f.rotation_sign)});
   }
   for (Covariate* c : {&world, &distance, &speed, &turning}) out.push_back(std::move(*c));
+  Covariate wheel{"absolute wheel angle", true, {}, 0.0, a.wheel_angle_jacobian, {}};
+  if (wheel.regressor.empty()) {
+    wheel.why_not =
+        "the logs do not carry the wheels' absolute angles (encoder CSV with cumulative ticks)";
+  }
+  out.push_back(std::move(wheel));
+  return out;
+}
+
+// The alternative's regressor of run i, centred in its group: [c~ J_i, c~ I] per column of a
+// value covariate (header), or the given regressor minus its group mean.
+struct Centred {
+  std::vector<Eigen::MatrixXd> x;  // per run, 3 x q_max (zero outside the groups)
+  double within = 0.0;             // sum of squares of the centred covariate
+  double overall = 0.0;            // ... of the covariate centred over all runs
+  double within_rms = 0.0;         // RMS within-group spread, per run and column
+};
+
+Centred CentreRegressor(const Groups& g, const Covariate& cov, std::size_t n) {
+  Centred out;
+  const int m = static_cast<int>(cov.regressor.front().cols());
+  out.x.assign(n, Eigen::MatrixXd::Zero(3, m));
+  Eigen::MatrixXd mean_all = Eigen::MatrixXd::Zero(3, m);
+  for (const auto& x : cov.regressor) mean_all += x / static_cast<double>(n);
+  for (const auto& x : cov.regressor) out.overall += (x - mean_all).squaredNorm();
+  for (const auto& members : g.members) {
+    Eigen::MatrixXd mean = Eigen::MatrixXd::Zero(3, m);
+    for (std::size_t i : members) mean += cov.regressor[i] / static_cast<double>(members.size());
+    for (std::size_t i : members) {
+      out.x[i] = cov.regressor[i] - mean;
+      out.within += out.x[i].squaredNorm();
+    }
+  }
+  return out;
+}
+
+Centred CentreValues(const Groups& g, const Covariate& cov, int k,
+                     const std::vector<Eigen::MatrixXd>& jacobian) {
+  Centred out;
+  const std::size_t n = cov.value.size();
+  const int h = static_cast<int>(cov.value.front().size());
+  std::vector<std::vector<double>> centred(n, std::vector<double>(h, 0.0));
+  std::size_t count = 0;
+  for (int c = 0; c < h; ++c) {
+    double mean_all = 0.0;
+    for (const auto& v : cov.value) mean_all += v[c] / static_cast<double>(n);
+    for (const auto& v : cov.value) out.overall += (v[c] - mean_all) * (v[c] - mean_all);
+    for (const auto& members : g.members) {
+      double mean = 0.0;
+      for (std::size_t i : members) mean += cov.value[i][c] / static_cast<double>(members.size());
+      for (std::size_t i : members) {
+        centred[i][c] = cov.value[i][c] - mean;
+        out.within += centred[i][c] * centred[i][c];
+        ++count;
+      }
+    }
+  }
+  out.within_rms = std::sqrt(out.within / static_cast<double>(std::max<std::size_t>(1, count)));
+  out.x.assign(n, Eigen::MatrixXd::Zero(3, h * (k + 3)));
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int c = 0; c < h; ++c) {
+      if (k > 0) out.x[i].block(0, c * (k + 3), 3, k) = centred[i][c] * jacobian[i];
+      out.x[i].block(0, c * (k + 3) + k, 3, 3) = centred[i][c] * Eigen::Matrix3d::Identity();
+    }
+  }
   return out;
 }
 
@@ -130,64 +217,85 @@ Whitened Whiten(const ResidualAnalysis& a, const Groups& g) {
   return w;
 }
 
+// SS_reg of the regression of z_i on the (whitened, centred) alternative of run perm[i]; b and
+// proj are workspace (the permutations call this thousands of times).
+double Explained(const std::vector<Eigen::MatrixXd>& xw, const Whitened& w,
+                 const Eigen::MatrixXd& projector, const std::vector<std::size_t>& perm,
+                 Eigen::VectorXd* b, Eigen::VectorXd* proj) {
+  b->setZero(projector.rows());
+  for (std::size_t i = 0; i < perm.size(); ++i) {
+    if (w.in_group[i]) b->noalias() += xw[perm[i]].transpose() * w.z[i];
+  }
+  proj->noalias() = projector.transpose() * *b;
+  return proj->squaredNorm();
+}
+
+// p of SS_reg by permuting the alternatives among the runs of each set of repetitions (header):
+// exchangeable under "no dependence" whatever each trajectory's own noise level, which the
+// F(q, df2) reference assumes equal (measured on clean simulated data with four repetitions:
+// 3 of 12 seeds crossed the family-wise 0.01 with the F reference). A is the same for every
+// permutation (the same regressors, reassigned), so each costs one b.
+double PermutationPValue(const Groups& g, const std::vector<Eigen::MatrixXd>& xw, const Whitened& w,
+                         const Eigen::MatrixXd& projector, double observed) {
+  std::mt19937_64 rng(kPermutationSeed);
+  std::vector<std::size_t> perm(xw.size());
+  std::iota(perm.begin(), perm.end(), std::size_t{0});
+  int at_least = 0;
+  Eigen::VectorXd b, proj;
+  for (int n = 0; n < kPermutations; ++n) {
+    for (const auto& members : g.members) {
+      for (std::size_t j = members.size(); j > 1; --j) {  // Fisher-Yates within the set
+        std::swap(perm[members[j - 1]], perm[members[rng() % j]]);
+      }
+    }
+    if (Explained(xw, w, projector, perm, &b, &proj) >= observed * (1.0 - 1e-12)) ++at_least;
+  }
+  return (1.0 + at_least) / (1.0 + kPermutations);
+}
+
 // The F test of one covariate (header). Leaves `test` not tested with the reason when the data
 // cannot carry it.
 void TestCovariate(const ResidualAnalysis& a, const Groups& g, const Whitened& w,
                    const Covariate& cov, CovariateTest* test) {
   test->name = cov.name;
   test->direction = cov.direction;
+  if (!cov.why_not.empty()) {
+    test->why_not = cov.why_not;
+    return;
+  }
   const int r = static_cast<int>(w.whiten.rows());
   if (r == 0) {
     test->why_not = "no scatter to test against";
     return;
   }
-  const int h = static_cast<int>(cov.value.front().size());
   const int k = a.final_jacobian.empty() ? 0 : static_cast<int>(a.final_jacobian.front().cols());
-  const int q_max = h * (k + 3);
-  // Centred covariate, and how much of its spread lies within the groups.
-  std::vector<std::vector<double>> centred(a.runs.size(), std::vector<double>(h, 0.0));
-  double within = 0.0, overall = 0.0;
-  for (int c = 0; c < h; ++c) {
-    double mean_all = 0.0;
-    for (const auto& v : cov.value) mean_all += v[c] / static_cast<double>(cov.value.size());
-    for (const auto& v : cov.value) overall += (v[c] - mean_all) * (v[c] - mean_all);
-    for (const auto& members : g.members) {
-      double mean = 0.0;
-      for (std::size_t i : members) mean += cov.value[i][c] / static_cast<double>(members.size());
-      for (std::size_t i : members) {
-        centred[i][c] = cov.value[i][c] - mean;
-        within += centred[i][c] * centred[i][c];
-      }
-    }
-  }
-  if (!(within > 1e-6 * overall) || !(within > 0.0)) {
+  const Centred centred = cov.regressor.empty() ? CentreValues(g, cov, k, a.final_jacobian)
+                                                : CentreRegressor(g, cov, a.runs.size());
+  if (!(centred.within > 1e-6 * centred.overall) || !(centred.within > 0.0) ||
+      !(centred.within_rms >= cov.resolution)) {
     test->why_not = g.within ? "does not vary between repetitions of a trajectory"
                              : "does not vary between the runs";
     return;
   }
+  const int q_max = static_cast<int>(centred.x.front().cols());
   Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(q_max, q_max);
-  Eigen::VectorXd b = Eigen::VectorXd::Zero(q_max);
+  std::vector<Eigen::MatrixXd> xw(a.runs.size());
   for (std::size_t i = 0; i < a.runs.size(); ++i) {
     if (!w.in_group[i]) continue;
-    Eigen::MatrixXd x(3, q_max);
-    for (int c = 0; c < h; ++c) {
-      if (k > 0) x.block(0, c * (k + 3), 3, k) = centred[i][c] * a.final_jacobian[i];
-      x.block(0, c * (k + 3) + k, 3, 3) = centred[i][c] * Eigen::Matrix3d::Identity();
-    }
-    const Eigen::MatrixXd xw = w.whiten * x;
-    normal += xw.transpose() * xw;
-    b += xw.transpose() * w.z[i];
+    xw[i] = w.whiten * centred.x[i];
+    normal += xw[i].transpose() * xw[i];
   }
+  // SS_reg = |P^T b|^2 with P = V diag(lambda^-1/2) over the non-null eigenvectors of A.
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(normal);
   const double largest = eig.eigenvalues().maxCoeff();
-  int q = 0;
-  double explained = 0.0;
+  std::vector<int> kept;
   for (int j = 0; j < q_max; ++j) {
-    const double lambda = eig.eigenvalues()[j];
-    if (!(lambda > 1e-10 * largest)) continue;
-    ++q;
-    const double proj = eig.eigenvectors().col(j).dot(b);
-    explained += proj * proj / lambda;
+    if (eig.eigenvalues()[j] > 1e-10 * largest) kept.push_back(j);
+  }
+  const int q = static_cast<int>(kept.size());
+  Eigen::MatrixXd projector(q_max, q);
+  for (int j = 0; j < q; ++j) {
+    projector.col(j) = eig.eigenvectors().col(kept[j]) / std::sqrt(eig.eigenvalues()[kept[j]]);
   }
   // Without repetitions the residuals carry the fit of the k parameters (k / r runs' worth).
   const double dof = w.dof - (g.within ? 0.0 : static_cast<double>(k) / r);
@@ -196,12 +304,15 @@ void TestCovariate(const ResidualAnalysis& a, const Groups& g, const Whitened& w
     test->why_not = "too few runs for its alternatives";
     return;
   }
+  std::vector<std::size_t> identity(a.runs.size());
+  std::iota(identity.begin(), identity.end(), std::size_t{0});
+  Eigen::VectorXd b, proj;
+  const double explained = std::min(Explained(xw, w, projector, identity, &b, &proj), w.total);
   test->tested = true;
   test->df1 = q;
   test->df2 = df2;
-  explained = std::min(explained, w.total);
   test->f = (explained / q) / std::max((w.total - explained) / df2, 1e-300);
-  test->p_value = stats::FUpperTail(test->f, test->df1, test->df2);
+  test->p_value = PermutationPValue(g, xw, w, projector, explained);
 }
 
 }  // namespace
@@ -250,7 +361,8 @@ std::string CovariateFinding(const CovariateTest& t) {
 std::string FormatCovariateStructure(const CovariateStructure& s) {
   char line[320];
   std::snprintf(line, sizeof line,
-                "Residual against covariates (%s; family-wise alpha %.2g, Holm step-down over the "
+                "Residual against covariates (%s; p from 1999 permutations of the covariate "
+                "within each set of repetitions; family-wise alpha %.2g, Holm step-down over the "
                 "covariates tested):\n\n",
                 s.within_repetitions ? "deviations between repetitions of each trajectory"
                                      : "all runs, no repetitions",
@@ -267,9 +379,6 @@ std::string FormatCovariateStructure(const CovariateStructure& s) {
                   t.significant ? "STRUCTURE" : "-");
     out += line;
   }
-  out +=
-      "| absolute wheel angle | - | - | - | - | not tested: the loaded logs carry wheel rates, "
-      "not the cumulative tick count at the start |\n";
   return out;
 }
 

@@ -19,9 +19,14 @@
 //   - an additive error that drifts with c:   d_i = c~_i beta       (beta in the start frame).
 // Least squares over all runs gives SS_reg = b^T A^+ b (A = sum X_i^T X_i, b = sum X_i^T z_i,
 // X_i = S^-1/2 [c~_i J_i, c~_i I]); with q the rank of A and SS_tot = sum |z_i|^2,
-//   F = (SS_reg / q) / ((SS_tot - SS_reg) / (r D' - q)),  p = P(F(q, r D' - q) > F),
+//   F = (SS_reg / q) / ((SS_tot - SS_reg) / (r D' - q)),
 // D' = D, less the fitted parameters' share (k / r) when all runs form one group (their residuals
 // then carry the fit). A covariate that does not vary within the groups is not tested there.
+// p is a permutation p: the fraction of 1999 reassignments of the alternatives among the runs of
+// each group (seeded, reproducible) whose SS_reg reaches the observed one, (1 + count) / 2000.
+// Under "no dependence" the runs of a group are exchangeable, whatever the noise level of each
+// trajectory; the F(q, r D' - q) reference assumes one level for all and read clean data with
+// four repetitions as structure in 3 of 12 seeds.
 //
 // Multiple testing: Holm's step-down over the covariates tested (family-wise error <= alpha):
 // sorted p_(1) <= ... <= p_(m), reject while p_(j) < alpha / (m - j + 1).
@@ -29,8 +34,16 @@
 // Covariates: run order within the session (the encoder clock's start time when the logs share a
 // session clock, else the repetition number), world-frame direction of travel (cos, sin of the
 // start heading + the robot-frame direction of motion), distance travelled, speed, turning
-// direction, and the absolute wheel angle at the start when the logs carry cumulative ticks (not
-// yet carried by RunLog: reported as unavailable).
+// direction, and the absolute wheel angle when the logs carry it (cumulative counts,
+// TrackRun::start_wheel_angle_rad). The wheel angle changes during a run, so its alternative is
+// not c~ times something but an error periodic in each wheel's revolution,
+//   d_i = (G_i - mean_g G) beta,   G_i = d y_i / d(a_j, b_j)  (residual_analysis.h),
+// w_j' = w_j (1 + a_j cos A_j + b_j sin A_j), A_j wheel j's absolute angle: an eccentric wheel
+// r(A) = r0 (1 + e cos(A - A0)) to first order. Runs that start at the same wheel angles share
+// G_i, so it is tested only where the start angles differ between repetitions.
+// A covariate whose within-group spread is below its resolution (1 mrad of direction, 1 mm,
+// 0.1 mm/s) is not tested: data sets rebased to start every run at heading 0 have no world-frame
+// direction, whatever rounding leaves in it.
 
 #include <string>
 #include <vector>

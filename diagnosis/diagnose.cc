@@ -395,8 +395,13 @@ std::string FormatDiagnoseReport(const DiagnoseResult& r, const RobotModelInterf
   out += "| model | CF (Eq. 14) | track RMSE [m] | track RMSE [deg] |\n|---|---|---|---|\n";
   out += Fmt("| declared parameters | %.5f | %.5f | %.4f |\n", r.declared_validation.cf,
              r.declared_validation.track_rmse_m, RadToDeg(r.declared_validation.track_rmse_rad));
-  out += Fmt("| parameters + accepted effects | %.5f | %.5f | %.4f |\n", r.final_validation.cf,
-             r.final_validation.track_rmse_m, RadToDeg(r.final_validation.track_rmse_rad));
+  // The second row is the track fit; "+ accepted effects" only when there are some.
+  out +=
+      Fmt(r.final_fit.effects.empty() ? "| parameters, track fit (no effect accepted) | %.5f | "
+                                        "%.5f | %.4f |\n"
+                                      : "| parameters + accepted effects | %.5f | %.5f | %.4f |\n",
+          r.final_validation.cf, r.final_validation.track_rmse_m,
+          RadToDeg(r.final_validation.track_rmse_rad));
 
   out +=
       "\n## Parameters before / after\n\n| parameter | nominal | declared fit | with effects "

@@ -244,6 +244,23 @@ bool TrackOptions::IsValid(std::string* error) const {
   return true;
 }
 
+namespace {
+
+// The absolute wheel angles at t_start: the log's start angles advanced by each channel's rate
+// over the part of the log before the window.
+std::vector<double> WindowStartWheelAngles(const EncoderLog& log, double t_start_s) {
+  std::vector<double> angle = log.start_angle_rad;
+  if (angle.empty()) return angle;
+  for (std::size_t k = 0; k < log.samples.size() && log.t_s[k] < t_start_s; ++k) {
+    const double dt = std::min(log.t_s[k + 1], t_start_s) - log.t_s[k];
+    for (std::size_t i = 0; i < angle.size(); ++i) angle[i] += log.samples[k].value[i] * dt;
+  }
+  for (double& a : angle) a = a - 2.0 * M_PI * std::floor(a / (2.0 * M_PI));
+  return angle;
+}
+
+}  // namespace
+
 TrackRun PrepareTrackRun(const RunLog& run, const TrackOptions& options) {
   return PrepareTrackRun(run, ~0u, options);
 }
@@ -255,6 +272,7 @@ TrackRun PrepareTrackRun(const RunLog& run, unsigned wheel_mask, const TrackOpti
   out.aligned = AlignRun(run);
   out.track = run.ground_truth;
   out.contexts = effects::MakeSampleContexts(out.aligned.samples, wheel_mask);
+  out.start_wheel_angle_rad = WindowStartWheelAngles(run.encoders, out.aligned.t_start_s);
   const double lo = out.aligned.t_start_s + options.edge_margin_s;
   const double hi = out.aligned.t_final_s - options.edge_margin_s;
   for (std::size_t g = 0; g < out.track.t_s.size(); ++g) {

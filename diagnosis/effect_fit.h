@@ -36,6 +36,9 @@ struct TrackRun {
   GroundTruthTrack track;                        // the whole ground truth (interpolation)
   std::vector<effects::SampleContext> contexts;  // one per aligned sample
   std::vector<int> checkpoints;                  // indices into track
+  // Each channel's absolute wheel angle at the window's start (rad, in [0, 2 pi); NaN where
+  // unknown), from EncoderLog::start_angle_rad; empty when the log carries none.
+  std::vector<double> start_wheel_angle_rad;
 };
 
 // Whether the window's first ground-truth sample shows the robot still at rest (every wheel

@@ -69,8 +69,43 @@ RunFeatures Features(const RobotModelInterface& robot_model, const std::vector<d
     f.alpha_rad = std::atan2(v[1], v[0]);
     f.speed_m_s = std::hypot(v[0], v[1]);
     f.rotation_sign = v[2] > kRotatingRateRadS ? 1 : (v[2] < -kRotatingRateRadS ? -1 : 0);
+    f.yaw_rate_rad_s = v[2];
   }
   return f;
+}
+
+// Whether run b repeats the motion of run a (header: repetitions). Tolerances: what separates
+// different commands (a 30 deg step of direction, a second speed, the other turning sign) while
+// leaving the spread of one command's repetitions (slip, a few % of wear) inside.
+bool SameMotion(const RunFeatures& a, const RunFeatures& b) {
+  constexpr double kDirectionTolRad = M_PI / 6.0;
+  constexpr double kRelativeTol = 0.2;
+  constexpr double kSpeedFloorMS = 0.02, kYawFloorRadS = 0.02, kDistanceFloorM = 0.01;
+  const auto close = [&](double x, double y, double floor) {
+    return std::abs(x - y) <= kRelativeTol * std::max(std::abs(x), std::abs(y)) + floor;
+  };
+  if (a.rotation_sign != b.rotation_sign) return false;
+  if (!close(a.speed_m_s, b.speed_m_s, kSpeedFloorMS)) return false;
+  if (!close(a.yaw_rate_rad_s, b.yaw_rate_rad_s, kYawFloorRadS)) return false;
+  if (!close(a.distance_m, b.distance_m, kDistanceFloorM)) return false;
+  if (a.speed_m_s > kSpeedFloorMS && b.speed_m_s > kSpeedFloorMS &&
+      std::abs(WrapAngle(a.alpha_rad - b.alpha_rad)) > kDirectionTolRad) {
+    return false;
+  }
+  return true;
+}
+
+// Splits each label's runs into sets of the same motion, each matched against its first run.
+void AssignRepetitionGroups(std::vector<RunFeatures>* runs) {
+  std::map<std::string, std::vector<std::size_t>> leaders;  // label -> first run of each set
+  for (std::size_t i = 0; i < runs->size(); ++i) {
+    RunFeatures& f = (*runs)[i];
+    std::vector<std::size_t>& sets = leaders[f.trajectory];
+    std::size_t k = 0;
+    while (k < sets.size() && !SameMotion((*runs)[sets[k]], f)) ++k;
+    if (k == sets.size()) sets.push_back(i);
+    f.repetition_group = k == 0 ? f.trajectory : f.trajectory + " #" + std::to_string(k + 1);
+  }
 }
 
 Pose2d ErrorAt(const TrackErrors& e, double t) {
@@ -116,6 +151,58 @@ void Accumulate(std::map<std::string, GroupStat>& groups, const std::string& by,
     g.mean[c] += v[c];
     g.rms[c] += v[c] * v[c];
   }
+}
+
+// Wheel channels with a known absolute start angle, the same in every run; empty when a run
+// lacks one.
+std::vector<int> WheelsWithAbsoluteAngle(const std::vector<TrackRun>& runs) {
+  std::vector<int> out;
+  if (runs.empty() || runs.front().contexts.empty()) return out;
+  const effects::SampleContext& c0 = runs.front().contexts.front();
+  for (int i = 0; i < c0.num_channels; ++i) {
+    bool known = c0.IsWheel(i);
+    for (const TrackRun& r : runs) {
+      known = known && static_cast<int>(r.start_wheel_angle_rad.size()) > i &&
+              std::isfinite(r.start_wheel_angle_rad[i]);
+    }
+    if (known) out.push_back(i);
+  }
+  return out;
+}
+
+// The final-pose (start frame) change per unit of a once-per-revolution rate error of one wheel
+// at its absolute angle: the library's once_per_revolution (effects.h) replayed on contexts that
+// mark only that wheel and carry its absolute angle. Columns: (cos, sin) per wheel.
+Eigen::MatrixXd WheelAngleJacobian(const RobotModelInterface& robot_model,
+                                   const std::vector<double>& p, const EffectModel& model,
+                                   const TrackRun& run, const std::vector<int>& wheels) {
+  constexpr double kStep = 1e-4;  // relative rate error: linear to ~1e-8, far above rounding
+  Eigen::MatrixXd out(3, 2 * static_cast<int>(wheels.size()));
+  TrackRun moved = run;
+  const double theta0 = run.aligned.start.theta;
+  for (std::size_t w = 0; w < wheels.size(); ++w) {
+    const int i = wheels[w];
+    for (std::size_t k = 0; k < run.contexts.size(); ++k) {
+      moved.contexts[k].wheel_mask = 1u << i;
+      moved.contexts[k].angle_rad[i] = run.contexts[k].angle_rad[i] + run.start_wheel_angle_rad[i];
+    }
+    EffectModel with = model;
+    with.push_back({});
+    with.back().id = effects::EffectId::kOncePerRevolution;
+    const Pose2d base =
+        ToFrame(ComputeTrackErrors(robot_model, p, with, moved, false).final_error, theta0);
+    for (int j = 0; j < 2; ++j) {
+      with.back().value = {};
+      with.back().value[j] = kStep;
+      const Pose2d e =
+          ToFrame(ComputeTrackErrors(robot_model, p, with, moved, false).final_error, theta0);
+      const int col = 2 * static_cast<int>(w) + j;
+      out(0, col) = (e.x - base.x) / kStep;
+      out(1, col) = (e.y - base.y) / kStep;
+      out(2, col) = WrapAngle(e.theta - base.theta) / kStep;
+    }
+  }
+  return out;
 }
 
 }  // namespace
@@ -189,6 +276,15 @@ ResidualAnalysis AnalyzeResiduals(const RobotModelInterface& robot_model,
     }
   }
 
+  const std::vector<int> angle_wheels = WheelsWithAbsoluteAngle(runs);
+  if (!angle_wheels.empty()) {
+    out.wheel_angle_jacobian.resize(n);
+    ParallelFor(n, num_threads, [&](std::size_t i) {
+      out.wheel_angle_jacobian[i] =
+          WheelAngleJacobian(robot_model, p, model, runs[i], angle_wheels);
+    });
+  }
+
   // Systematic / non-systematic split and the lack-of-fit test, over trajectories with reps.
   // The 12 components of a run (errors at three checkpoints and at the end, x, y, theta) are
   // strongly correlated (an error at half way persists to the end), so each trajectory's mean is
@@ -196,8 +292,9 @@ ResidualAnalysis AnalyzeResiduals(const RobotModelInterface& robot_model,
   // statistic): weighing each component by its own variance alone counts one deviation up to 12
   // times and makes F far more variable than F(df_lof, df_pe) (clean simulated data then read as
   // "structure" for some seeds).
+  AssignRepetitionGroups(&out.runs);
   std::map<std::string, std::vector<std::size_t>> by_trajectory;
-  for (std::size_t i = 0; i < n; ++i) by_trajectory[runs[i].aligned.trajectory].push_back(i);
+  for (std::size_t i = 0; i < n; ++i) by_trajectory[out.runs[i].repetition_group].push_back(i);
   using Vec = Eigen::Matrix<double, kLofComponents, 1>;
   using Mat = Eigen::Matrix<double, kLofComponents, kLofComponents>;
   Mat scatter = Mat::Zero();

@@ -10,6 +10,9 @@
 // - Statistics by trajectory family (label's letters: R/G/B), heading direction alpha of the
 //   motion in the robot frame (30 deg bins), rotation sign, speed; and the growth rate of the
 //   robot-frame error by acceleration phase and by time within the run.
+// - Repetitions: runs with the same trajectory label and the same motion (turning sign; direction
+//   of travel within 30 deg, speed, yaw rate and distance within 20 %, RunFeatures::
+//   repetition_group).
 // - A lack-of-fit F test with the repetitions as pure error, on e, the start-frame pose errors at
 //   four checkpoints (a quarter, half and three quarters through the motion, and the end): 12
 //   components per run, strongly correlated, so they are whitened by their pooled pure-error
@@ -34,10 +37,16 @@ struct RunFeatures {
   std::string trajectory;
   std::string family;  // leading letters of the trajectory label ("R", "G", "B", ...)
   int repetition = 0;
-  double alpha_rad = 0.0;  // direction of the mean robot-frame velocity while moving
-  int rotation_sign = 0;   // sign of the mean yaw rate (0 when |omega| < 0.02 rad/s)
-  double speed_m_s = 0.0;  // mean speed while moving
+  double alpha_rad = 0.0;       // direction of the mean robot-frame velocity while moving
+  int rotation_sign = 0;        // sign of the mean yaw rate (0 when |omega| < 0.02 rad/s)
+  double speed_m_s = 0.0;       // mean speed while moving
+  double yaw_rate_rad_s = 0.0;  // mean yaw rate while moving
   double motion_begin_s = 0.0, motion_end_s = 0.0;  // from the window start
+  // The runs this one repeats: its trajectory label, split where runs under one label differ in
+  // their motion (AnalyzeResiduals; "<label> #2", ...). A session label over runs of several
+  // patterns, clockwise and counter-clockwise, is no set of repetitions: their differences are
+  // the model's, not noise, and read as drift with run order if taken for repetitions.
+  std::string repetition_group;
   // Covariates of the run as a whole (diagnosis/covariate_structure.h).
   double distance_m = 0.0;         // path length of the replay
   double start_heading_rad = 0.0;  // world-frame heading at the window's start
@@ -76,6 +85,12 @@ struct ResidualAnalysis {
   // Per run: d(final_start_frame)/d(fitted parameter), 3 x (free model parameters + effect
   // parameters), the columns the lack-of-fit test refits (forward differences).
   std::vector<Eigen::MatrixXd> final_jacobian;
+  // Per run, when every run carries its wheels' absolute start angles (TrackRun::
+  // start_wheel_angle_rad): d(final_start_frame)/d(a_j, b_j) at a = b = 0 for an error periodic in
+  // the revolution of wheel j, w_j' = w_j (1 + a_j cos A_j + b_j sin A_j) with A_j the absolute
+  // wheel angle (an eccentric wheel, r(A) = r0 (1 + e cos(A - A0))), 3 x (2 wheels); forward
+  // differences. Empty otherwise.
+  std::vector<Eigen::MatrixXd> wheel_angle_jacobian;
 };
 
 // The lack-of-fit test counts as fitted every parameter of p and of the model's effects (it

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <new>
 #include <string_view>
 #include <utility>
@@ -228,6 +229,17 @@ EncoderRowConverter::EncoderRowConverter(const Robot& robot)
 
 void EncoderRowConverter::Add(double t_s, const double* row) {
   const std::size_t n = channel_of_column_.size();
+  if (log_.t_s.empty() && cumulative_) {
+    // Cumulative counts: row 0's count is the wheel's absolute angle (mod one revolution).
+    log_.start_angle_rad.assign(static_cast<std::size_t>(robot_.NumChannels()),
+                                std::numeric_limits<double>::quiet_NaN());
+    for (std::size_t j = 0; j < n; ++j) {
+      const int c = channel_of_column_[j];
+      if (!ticks_column_[j] || robot_.channels[c].kind == ChannelKind::kAngle) continue;
+      const double angle = std::fmod(rad_per_tick_ * row[j], 2.0 * M_PI);
+      log_.start_angle_rad[static_cast<std::size_t>(c)] = angle < 0.0 ? angle + 2.0 * M_PI : angle;
+    }
+  }
   if (!log_.t_s.empty()) {
     const double dt = t_s - log_.t_s.back();
     double values[kMaxChannels];

@@ -14,7 +14,8 @@ namespace fitcal::io {
 // rad/s over (t(k-1), t(k)]; row 0 only sets the start time.
 // Or header `t,ticks_a,ticks_b,ticks_c`: encoder ticks, which need `ticks` (the robot YAML's
 // `encoder:` block). Increments: row k holds the ticks counted over (t(k-1), t(k)] and row 0's
-// are ignored (counted before the start); cumulative: running totals, row 0 is the reference.
+// are ignored (counted before the start); cumulative: running totals, row 0 is the reference,
+// and its count gives each wheel's absolute angle at the start (EncoderLog::start_angle_rad).
 // Either way w_i(k) = 2 pi dticks_i(k) / (ticks_per_rev dt(k)).
 // Any robot (models/robot.h): header `t,<column per channel>`, each channel's rate (or angle)
 // column or its ticks column, in any order, matched by name; angle channels hold the reading at

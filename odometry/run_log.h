@@ -16,6 +16,11 @@ namespace fitcal {
 struct EncoderLog {
   std::vector<double> t_s;
   EncoderSamples samples{3};
+  // The absolute wheel angle at t_s[0], one per channel (rad, in [0, 2 pi)): known when the
+  // recorder logs cumulative counts that are not reset between runs (the count's zero is then a
+  // fixed mark on the wheel); NaN for a channel without it (angle channels, rate columns). Empty:
+  // the log carries none. One value per channel per run: the per-sample memory is unchanged.
+  std::vector<double> start_angle_rad;
 };
 
 // Ground truth (SLAM, motion capture): poses in the world frame at strictly increasing times.

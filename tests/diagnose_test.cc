@@ -121,6 +121,7 @@ TEST(Diagnose, CleanDataAcceptsNoEffectOverTwentySeeds) {
     o.repetitions = 2;
     o.seed = static_cast<std::uint64_t>(seed) * 7919;
     o.trajectories = subset;
+    o.random_wheel_start_angle = true;  // every covariate tested, the absolute wheel angle too
     const Data d = Simulate(o);
     DiagnoseOptions options;
     options.max_effects = 1;  // the first acceptance is the false positive

@@ -61,6 +61,24 @@ TEST(EncoderCsv, ReadsRatesAndIntervals) {
   EXPECT_EQ(log.samples[1].value[2], 6.0);
 }
 
+// Cumulative counts that run on between runs: row 0's count is each wheel's absolute angle (mod
+// one revolution), kept per run; increments and rate columns carry none.
+TEST(EncoderCsv, CumulativeTicksCarryTheAbsoluteStartAngle) {
+  TempDir dir;
+  const std::string text = "t,ticks_a,ticks_b,ticks_c\n0,1000,-100,4096\n0.01,1010,-90,4100\n";
+  const EncoderLog log = ReadEncoderCsv(dir.Write("c.csv", text), EncoderTicks{4096.0, true});
+  ASSERT_EQ(log.start_angle_rad.size(), 3u);
+  const double rad_per_tick = 2.0 * M_PI / 4096.0;
+  EXPECT_NEAR(log.start_angle_rad[0], 1000 * rad_per_tick, 1e-12);
+  EXPECT_NEAR(log.start_angle_rad[1], 2.0 * M_PI - 100 * rad_per_tick, 1e-12);  // in [0, 2 pi)
+  EXPECT_NEAR(log.start_angle_rad[2], 0.0, 1e-12);                              // one full turn
+  EXPECT_NEAR(log.samples[0].value[0], 10 * rad_per_tick / 0.01, 1e-9);
+  const EncoderLog increments =
+      ReadEncoderCsv(dir.Write("i.csv", text), EncoderTicks{4096.0, false});
+  EXPECT_TRUE(increments.start_angle_rad.empty());
+  EXPECT_TRUE(ReadEncoderCsv(dir.Write("r.csv", kEncoders)).start_angle_rad.empty());
+}
+
 TEST(EncoderCsv, BadInputs) {
   TempDir dir;
   const auto check = [&](const std::string& text, InputErrorKind kind, int line) {

@@ -59,6 +59,9 @@ void Validate(const Omni3SimulationOptions& o) {
     fail("substep_s must be > 0 and not longer than an encoder period");
   }
   if (o.encoder_counts_per_rev < 1) fail("encoder_counts_per_rev must be >= 1");
+  for (double e : o.wheel_eccentricity) {
+    if (!(std::abs(e) < 0.5)) fail("wheel_eccentricity must be in (-0.5, 0.5)");
+  }
   if (!(o.controller_time_constant_s > 0.0)) fail("controller_time_constant_s must be > 0");
   if (!(o.gt_period_min_s > 0.0 && o.gt_period_max_s >= o.gt_period_min_s)) {
     fail("ground-truth period must satisfy 0 < min <= max");
@@ -105,6 +108,16 @@ SimulatedRun SimulateRun(const Omni3SimulationOptions& o, const MotionCommand& c
   Eigen::Vector3d wheel_angle = Eigen::Vector3d::Zero();
   Eigen::Vector3d slip(o.slip_sigma * rng.Gaussian(), o.slip_sigma * rng.Gaussian(),
                        o.slip_sigma * rng.Gaussian());
+  Eigen::Vector3d wheel_start = Eigen::Vector3d::Zero();  // absolute angle at t = 0
+  if (o.random_wheel_start_angle) {
+    Random wheel_rng(SplitMix(o.seed ^ SplitMix(stream) ^ 0x57686565ull));
+    log.encoders.start_angle_rad.resize(3);
+    for (int i = 0; i < 3; ++i) {
+      wheel_start[i] = wheel_rng.Uniform(0.0, 2.0 * M_PI);
+      log.encoders.start_angle_rad[i] = wheel_start[i];
+    }
+  }
+  const bool eccentric = o.wheel_eccentricity != std::array<double, 3>{};
 
   // Injected effects (see the header); the time offset only moves ground-truth stamps.
   std::vector<effects::ActiveEffect<double>> active;
@@ -165,6 +178,10 @@ SimulatedRun SimulateRun(const Omni3SimulationOptions& o, const MotionCommand& c
     for (int i = 0; i < 3; ++i) slip[i] = slip_decay * slip[i] + slip_kick * rng.Gaussian();
     const Eigen::Vector3d wheel_accel = (goal - wheel_rate) * (lag / (1.0 - lag) / h);
     Eigen::Vector3d contact = wheel_rate.cwiseProduct(Eigen::Vector3d::Ones() + slip);
+    for (int i = 0; eccentric && i < 3; ++i) {
+      const double angle_mid = wheel_start[i] + wheel_angle[i] + 0.5 * h * wheel_rate[i];
+      contact[i] *= 1.0 + o.wheel_eccentricity[i] * std::cos(angle_mid);
+    }
     Eigen::Vector3d v;
     Eigen::Vector2d v_world = Eigen::Vector2d::Zero();
     if (injecting) {

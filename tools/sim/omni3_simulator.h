@@ -19,6 +19,7 @@
 // output does not depend on thread count or platform.
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -62,6 +63,15 @@ struct Omni3SimulationOptions {
   double gt_heading_sigma_rad = 0.2 * M_PI / 180.0;
 
   double start_position_range_m = 2.0;
+
+  // Wheels' absolute angles: with random_wheel_start_angle each run starts at uniformly random
+  // absolute wheel angles A_i(0) (a robot whose encoder counts run on between runs), drawn from
+  // a generator of their own (the other draws stay as without it), and the log carries them
+  // (EncoderLog::start_angle_rad, as a recorder of cumulative counts would). wheel_eccentricity
+  // e_i makes wheel i's rolling radius r_i (1 + e_i cos A_i) (an eccentric hub or tyre): an
+  // error periodic in the wheel's revolution.
+  bool random_wheel_start_angle = false;
+  std::array<double, 3> wheel_eccentricity{};
 
   // Effects the nine parameters lack (issue 6); the written data set names none of them.
   // Library effects (odometry/effects.h) act at every substep with the true wheel state: rate
