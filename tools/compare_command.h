@@ -11,10 +11,12 @@
 #include <string>
 #include <vector>
 
+#include "tools/dataset_command.h"
+
 namespace fitcal::tools {
 
-struct CompareCommandOptions {
-  std::string logs;
+// --logs, --threads and --allow-outside-paths come from DatasetCommandOptions.
+struct CompareCommandOptions : DatasetCommandOptions {
   // Palacin's STA..STE, trajectory lists, "all" or "<prefix>*" (compare_command.cc). For a model
   // other than omni3 without strategies_given: those of STA..STE the data set has, else "all".
   std::vector<std::string> strategies = {"STA", "STB", "STC", "STD", "STE"};
@@ -25,8 +27,6 @@ struct CompareCommandOptions {
   std::string out = "compare";            // prefix of the output files
   bool no_output = false;
   bool quiet = false;
-  bool allow_outside_paths = false;
-  int threads = 0;
   unsigned long seed = 1;
   int max_evaluations = 10000;  // NLopt methods, per fit
   bool polish = false;          // NLopt global methods: SLSQP polish
@@ -35,6 +35,9 @@ struct CompareCommandOptions {
 
 // Returns the process exit code; the table goes to stdout, progress (on a terminal, unless
 // quiet) and errors (one line) to stderr.
+// Declares every flag of `compare` on its subcommand `app`, bound to `options`.
+void AddCompareOptions(CLI::App& app, CompareCommandOptions& options);
+
 int RunCompareCommand(const CompareCommandOptions& options);
 
 }  // namespace fitcal::tools

@@ -235,14 +235,10 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   if (!options.no_output && !options.force) {
     const std::string refusal = OverwriteRefusal(options.out, robot.name);
     if (!refusal.empty()) {
-      std::cerr << "fitcal: " << refusal << "\n";
-      return 2;
+      return Refuse(refusal);
     }
   }
-  io::DatasetOptions dataset_options;
-  dataset_options.allow_paths_outside = options.allow_outside_paths;
-  dataset_options.num_threads = options.threads;
-  const io::Dataset dataset = io::LoadDataset(index, robot, dataset_options);
+  const io::Dataset dataset = LoadRuns(options, index, &robot);
   io::StopHereForTests("loaded");
   const RunSplit split =
       SplitForFit(AlignRuns(dataset.runs), options.train_reps, options.train_trajectories);
