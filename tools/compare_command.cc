@@ -319,19 +319,11 @@ std::string ParseRequest(const CompareCommandOptions& options, CompareRequest* r
     if (r->methods.empty() || r->strategies.empty() || r->counts.empty() || r->counts.front() < 1) {
       return "need at least one method, one strategy and repetitions >= 1";
     }
-    if (options.max_evaluations < 1) return "--max-evaluations must be >= 1";
-    settings.objective_set = !options.objective.empty();
-    if (settings.objective_set &&
-        !ParseFinalPoseObjective(options.objective, &settings.objective)) {
-      return "unknown --objective '" + options.objective + "' (available: squares, eq14)";
-    }
   } catch (const std::invalid_argument& e) {
     return e.what();
   }
-  settings.threads = options.threads;
-  settings.seed = options.seed;
-  settings.max_evaluations = options.max_evaluations;
-  settings.local_polish = options.polish;
+  std::string error;
+  if (!MakeFitMethodSettings(options, options.threads, &settings, &error)) return error;
   return "";
 }
 
@@ -449,11 +441,7 @@ void AddCompareOptions(CLI::App& app, CompareCommandOptions& o) {
       ->capture_default_str();
   app.add_flag("--no-output", o.no_output, "Print the table only");
   app.add_flag("--quiet", o.quiet, "No progress on stderr");
-  app.add_option("--seed", o.seed, "NLopt random seed")->capture_default_str();
-  app.add_option("--max-evaluations", o.max_evaluations, "NLopt budget per fit")
-      ->capture_default_str();
-  app.add_flag("--polish", o.polish, "NLopt global methods: SLSQP polish");
-  app.add_option("--objective", o.objective, "squares or eq14 (default: per method)");
+  AddSolverOptions(app, o);
 }
 
 int RunCompareCommand(const CompareCommandOptions& options) {

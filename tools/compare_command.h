@@ -12,11 +12,13 @@
 #include <vector>
 
 #include "tools/dataset_command.h"
+#include "tools/solver_options.h"
 
 namespace fitcal::tools {
 
-// --logs, --threads and --allow-outside-paths come from DatasetCommandOptions.
-struct CompareCommandOptions : DatasetCommandOptions {
+// --logs, --threads and --allow-outside-paths come from DatasetCommandOptions, the solver flags
+// from SolverOptions (the same as fit's).
+struct CompareCommandOptions : DatasetCommandOptions, SolverOptions {
   // Palacin's STA..STE, trajectory lists, "all" or "<prefix>*" (compare_command.cc). For a model
   // other than omni3 without strategies_given: those of STA..STE the data set has, else "all".
   std::vector<std::string> strategies = {"STA", "STB", "STC", "STD", "STE"};
@@ -27,10 +29,9 @@ struct CompareCommandOptions : DatasetCommandOptions {
   std::string out = "compare";            // prefix of the output files
   bool no_output = false;
   bool quiet = false;
-  unsigned long seed = 1;
-  int max_evaluations = 10000;  // NLopt methods, per fit
-  bool polish = false;          // NLopt global methods: SLSQP polish
-  std::string objective;        // "" = each method's default; "squares" or "eq14"
+
+  // Each of the many fits compare runs gets half the NLopt budget of a single `fit`.
+  CompareCommandOptions() { max_evaluations = 10000; }
 };
 
 // Returns the process exit code; the table goes to stdout, progress (on a terminal, unless

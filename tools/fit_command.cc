@@ -93,21 +93,7 @@ void PrintParameters(const Omni3Robot& robot, const Omni3FitResult& fit) {
 void AddFitOptions(CLI::App& app, FitCommandOptions& o) {
   AddDatasetOptions(app, o, LogsFlag::kCheckedByCommand);
   app.add_option("--method", o.method, "Solver: " + FitMethodNames())->capture_default_str();
-  app.add_option("--objective", o.objective,
-                 "squares (sum of squared residuals; Ceres default) or eq14 (sum of per-run "
-                 "norms, Palacin Eq. 14; NLopt default)");
-  app.add_option("--loss", o.loss, "Ceres robust loss: none, huber, cauchy")->capture_default_str();
-  app.add_option("--loss-scale", o.loss_scale, "Robust loss scale (residual units: m and rad)")
-      ->capture_default_str();
-  app.add_option("--seed", o.seed, "NLopt random seed (same seed, same result)")
-      ->capture_default_str();
-  app.add_option("--max-evaluations", o.max_evaluations, "NLopt evaluation budget")
-      ->capture_default_str();
-  app.add_option("--max-iterations", o.max_iterations, "Ceres iterations per solve")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
-  app.add_flag("--polish", o.polish,
-               "NLopt global methods: polish the best point with SLSQP (autodiff gradient)");
+  AddSolverOptions(app, o);
   CLI::Option* reps =
       app.add_option("--train-reps", o.train_reps,
                      "Repetitions used for fitting, e.g. 1-5 or 1,3,5; the others validate")
@@ -123,15 +109,6 @@ void AddFitOptions(CLI::App& app, FitCommandOptions& o) {
   app.add_flag("--force", o.force, "Overwrite --out even if it holds another robot's calibration");
   app.add_flag("--skip-wheel-order-check", o.skip_wheel_order_check,
                "Fit even if another encoder column order/sign explains the data far better");
-  app.add_option("--position-sigma-m", o.position_sigma_m,
-                 "Weight of the position residual as a standard deviation (m); with the default "
-                 "1 m and 57.3 deg the objective weighs metres and radians as Eq. 14")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
-  app.add_option("--heading-sigma-deg", o.heading_sigma_deg,
-                 "Weight of the heading residual as a standard deviation (deg)")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
 }
 
 int RunFitCommand(const FitCommandOptions& options) {
@@ -148,7 +125,7 @@ int RunFitCommand(const FitCommandOptions& options) {
   }
   FitMethodSettings settings;
   std::string settings_error;
-  if (!MakeFitMethodSettings(options, &settings, &settings_error)) {
+  if (!MakeFitMethodSettings(options, options.threads, &settings, &settings_error)) {
     std::cerr << "fitcal: " << settings_error << "\n";
     return 2;
   }
@@ -205,8 +182,7 @@ int RunFitCommand(const FitCommandOptions& options) {
       std::cerr << "fitcal: warning: " << options.logs << ": " << units.message << "\n";
     if (!units.suspicious && !options.skip_wheel_order_check) {
       WheelOrderOptions order_options;
-      order_options.weights.position_sigma_m = options.position_sigma_m;
-      order_options.weights.heading_sigma_rad = options.heading_sigma_deg * M_PI / 180.0;
+      order_options.weights = options.Weights();
       order_options.num_threads = options.threads;
       // With intermediate ground truth the segment test decides (closed paths hide some
       // miswirings from final poses, and segments name the mapping more sharply); final poses
@@ -284,9 +260,7 @@ int RunFitCommand(const FitCommandOptions& options) {
       std::printf("held at nominal, not determined by the training runs: %s\n", d.c_str());
     }
     if (fit.usable) {  // issue 4: name what the training runs cannot determine
-      ResidualWeights weights;
-      weights.position_sigma_m = options.position_sigma_m;
-      weights.heading_sigma_rad = options.heading_sigma_deg * M_PI / 180.0;
+      const ResidualWeights weights = options.Weights();
       const IdentifiabilityReport ident = AnalyseIdentifiability(
           FinalPoseJacobian(fit.parameters, split.training, weights, options.threads),
           fit.parameters, sim::FlowerCandidateMotions(), nominal, weights);

@@ -221,7 +221,7 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   const FitMethod* method = FindFitMethod(options.method);
   FitMethodSettings settings;
   std::string error;
-  if (method == nullptr || !MakeFitMethodSettings(options, &settings, &error)) {
+  if (method == nullptr || !MakeFitMethodSettings(options, options.threads, &settings, &error)) {
     std::cerr << "fitcal: " << (method == nullptr ? "unknown --method " + options.method : error)
               << "\n";
     return 2;
