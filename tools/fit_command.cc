@@ -175,8 +175,8 @@ int RunFitCommand(const FitCommandOptions& options) {
       return 2;
     }
 
-    // Before fitting (issue 7): rates in the wrong unit, miswired encoder columns, data that
-    // cannot determine the parameters.
+    // Before fitting, as a fit would not notice them: rates in the wrong unit, miswired encoder
+    // columns, data that cannot determine the parameters.
     const RateUnitsReport units = CheckRateUnits(dataset.runs, robot);
     if (units.suspicious)
       std::cerr << "fitcal: warning: " << options.logs << ": " << units.message << "\n";
@@ -259,7 +259,7 @@ int RunFitCommand(const FitCommandOptions& options) {
     for (const std::string& d : fit.held_directions) {
       std::printf("held at nominal, not determined by the training runs: %s\n", d.c_str());
     }
-    if (fit.usable) {  // issue 4: name what the training runs cannot determine
+    if (fit.usable) {  // name what the training runs cannot determine (Eq. 14's Jacobian)
       const ResidualWeights weights = options.Weights();
       const IdentifiabilityReport ident = AnalyseIdentifiability(
           FinalPoseJacobian(fit.parameters, split.training, weights, options.threads),
