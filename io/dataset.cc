@@ -26,8 +26,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-int LineOf(const YAML::Node& node) { return node.Mark().line + 1; }
-
 // Resolves a path from dataset.yaml against the data set directory, refusing absolute paths and
 // '..' escapes unless allowed: a data set is a self-contained directory.
 std::string ResolvePath(const std::string& directory, const std::string& relative,

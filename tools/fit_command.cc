@@ -256,9 +256,7 @@ int RunFitCommand(const FitCommandOptions& options) {
                 method->description.c_str(), fit.termination.c_str(), fit.iterations,
                 outcome.evaluations, fit.solve_time_s, fit.message.c_str());
     if (!fit.has_covariance) std::printf("uncertainty: %s\n", fit.covariance_message.c_str());
-    for (const std::string& d : fit.held_directions) {
-      std::printf("held at nominal, not determined by the training runs: %s\n", d.c_str());
-    }
+    for (const std::string& d : fit.held_directions) PrintHeldAtNominal(d);
     if (fit.usable) {  // name what the training runs cannot determine (Eq. 14's Jacobian)
       const ResidualWeights weights = options.Weights();
       const IdentifiabilityReport ident = AnalyseIdentifiability(

@@ -213,6 +213,10 @@ int StoppedEarlyExit(bool selected_fit_stopped_early, const std::string& termina
   return 6;
 }
 
+void PrintHeldAtNominal(const std::string& direction) {
+  std::printf("held at nominal, not determined by the training runs: %s\n", direction.c_str());
+}
+
 int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex& index,
                        const RobotModelPtr& model) {
   const auto t_total = std::chrono::steady_clock::now();
@@ -262,10 +266,7 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
 
   PrintFit(options, *model, split, selected, *method, outcome);
   if (!fit.has_covariance) std::printf("uncertainty: %s\n", fit.covariance_message.c_str());
-  for (const UndeterminedDirection& d : fit.held_directions) {
-    std::printf("held at nominal, not determined by the training runs: %s\n",
-                d.description.c_str());
-  }
+  for (const UndeterminedDirection& d : fit.held_directions) PrintHeldAtNominal(d.description);
   std::printf("\nresult gate, CF on %s:\n", gate.judged_on.c_str());
   for (const std::string& line : GateLines(candidates, gate)) std::printf("%s\n", line.c_str());
   if (!gate.improves_on_nominal()) {

@@ -15,6 +15,7 @@
 
 #include "diagnosis/identifiability.h"
 #include "fit/determined_directions.h"
+#include "fit/model_fit.h"
 #include "fitcal/version.h"
 #include "io/atomic_file.h"
 #include "io/calibration_yaml.h"
@@ -429,13 +430,6 @@ void AddUncertainty(const ReportInputs& in, const CalibrationInput& cal,
   } else {
     AddModelIdentifiability(in, cal, training, threads, data);
   }
-}
-
-// A parameter rests on a bound when it is within 1e-6 of the box's width of it: far above the
-// YAML's 10 significant digits (1e-11 m on a 0.2 m distance), far below any meaningful change.
-bool AtBound(double value, const Interval& box) {
-  const double tolerance = 1e-6 * box.Width();
-  return value <= box.lo + tolerance || value >= box.hi - tolerance;
 }
 
 void AddParameters(const ReportInputs& in, const CalibrationInput& cal,
