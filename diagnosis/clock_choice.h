@@ -1,6 +1,6 @@
 #pragma once
 // Whether a re-stamped ground truth (fit/segment_cost.h, EstimateClockMap / ApplyClockMap) is
-// kept, run by run (issue 16 item 3).
+// kept, run by run: a map fitted to noise would shift a run that was on time.
 //
 // The clock map matches the speed profiles of odometry and ground truth; on a ground truth
 // sampled every 0.2-0.3 s the interpolated speed profile is smeared, and a map estimated on a

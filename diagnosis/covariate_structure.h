@@ -1,5 +1,5 @@
 #pragma once
-// Residual structure against covariates of the runs (issue 16 item 2): what the repetitions
+// Residual structure against covariates of the runs: what the repetitions
 // hide. The lack-of-fit test (residual_analysis.h) takes the scatter between repetitions of a
 // trajectory as its noise floor, so an effect that differs from one repetition to the next (wear
 // or warming over a session, anything tied to the world frame when each run starts at another

@@ -1,5 +1,5 @@
 #pragma once
-// Closing the loop (issue 6), for any robot model: find the residual the model's fit leaves, trace
+// Closing the loop, for any robot model: find the residual the model's fit leaves, trace
 // it to an effect of the library (odometry/effects.h), add it, and show the error before and after
 // on held-out repetitions.
 //

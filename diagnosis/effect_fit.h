@@ -53,7 +53,7 @@ bool TrackStartsAtRest(const AlignedRun& run, const std::vector<effects::SampleC
 // else the ground truth interpolated at t_start + latency - only a first guess then: the track
 // residual carries the replay through the anchor (StartAnchorIndices), since interpolating a
 // ground truth sampled every 0.2-0.3 s across the start of the motion blends the rest pose with
-// one a ground-truth period into the motion (issue 16: a 0.06 s latency read as 0.083 s).
+// one a ground-truth period into the motion (a 0.06 s latency was read as 0.083 s that way).
 Pose2d TrackStartPose(const AlignedRun& run, const std::vector<effects::SampleContext>& contexts,
                       const GroundTruthTrack& track, double latency_s);
 

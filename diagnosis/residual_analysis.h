@@ -1,5 +1,5 @@
 #pragma once
-// What a fitted model leaves unexplained, in a form a person can read (issue 6, part 1).
+// What a fitted model leaves unexplained, in a form a person can read.
 //
 // - Pose error (replay - ground truth) at every ground-truth sample of every run, in the world
 //   frame and in the robot frame (rotated by -theta_gt).

@@ -142,13 +142,10 @@ void Accumulate(const ceres::Solver::Summary& summary, ModelFitResult* result) {
   result->final_cost = summary.final_cost;
 }
 
-// A parameter within a part per million of the box width of a bound is on it.
-std::vector<bool> AtBound(const Robot& robot, const std::vector<double>& p) {
+// Which parameters rest on a bound of the robot's box (AtBound).
+std::vector<bool> ParametersAtBound(const Robot& robot, const std::vector<double>& p) {
   std::vector<bool> out(p.size(), false);
-  for (std::size_t k = 0; k < p.size(); ++k) {
-    const double tol = 1e-6 * robot.bounds[k].Width();
-    out[k] = p[k] <= robot.bounds[k].lo + tol || p[k] >= robot.bounds[k].hi - tol;
-  }
+  for (std::size_t k = 0; k < p.size(); ++k) out[k] = AtBound(p[k], robot.bounds[k]);
   return out;
 }
 
@@ -163,7 +160,7 @@ ceres::Solver::Summary RefineWithActiveSet(const std::vector<AlignedRun>& traini
   const int n = robot.NumParameters();
   std::vector<double>& p = result->parameters;
   std::vector<bool> fixed = result->held;
-  const std::vector<bool> on_bound = AtBound(robot, p);
+  const std::vector<bool> on_bound = ParametersAtBound(robot, p);
   for (int k = 0; k < n; ++k) {
     if (!on_bound[k]) continue;
     fixed[k] = true;
@@ -250,6 +247,11 @@ void ComputeCovariance(const std::vector<AlignedRun>& training, const RobotModel
 
 }  // namespace
 
+bool AtBound(double value, const Interval& box) {
+  const double tolerance = 1e-6 * box.Width();
+  return value <= box.lo + tolerance || value >= box.hi - tolerance;
+}
+
 namespace {
 
 // One bounded solve from `start` with `holds`, refined by the active set when it did not converge.
@@ -280,7 +282,7 @@ ModelFitResult SolveFrom(const std::vector<AlignedRun>& training, const RobotMod
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   bool finite = true;
   for (double v : result.parameters) finite = finite && std::isfinite(v);
-  result.at_bound = AtBound(robot, result.parameters);
+  result.at_bound = ParametersAtBound(robot, result.parameters);
   result.usable = finite && summary.termination_type == ceres::CONVERGENCE;
   result.stopped_early = finite && summary.termination_type == ceres::NO_CONVERGENCE;
   return result;

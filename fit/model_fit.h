@@ -76,6 +76,10 @@ struct ModelFitOptions {
   bool hold_undetermined = true;
 };
 
+// A value rests on a bound when it is within 1e-6 of the box's width of it: far above the YAML's
+// 10 significant digits (1e-11 m on a 0.2 m distance), far below any meaningful change.
+bool AtBound(double value, const Interval& box);
+
 // Throws std::invalid_argument for invalid options or no runs.
 ModelFitResult FitModel(const std::vector<AlignedRun>& training, const RobotModelInterface& model,
                         const ModelFitOptions& options = {});

@@ -23,8 +23,6 @@ constexpr int kColumns = 10;
 const char* const kHeader[kColumns] = {"t",        "wheel_1a", "wheel_1b", "wheel_2a", "wheel_2b",
                                        "wheel_3a", "wheel_3b", "pivot_1",  "pivot_2",  "pivot_3"};
 
-int LineOf(const YAML::Node& node) { return node.Mark().line + 1; }
-
 std::string ExpectedHeader() {
   std::string h;
   for (const char* name : kHeader) h += (h.empty() ? "" : ",") + std::string(name);

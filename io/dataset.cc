@@ -26,8 +26,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-int LineOf(const YAML::Node& node) { return node.Mark().line + 1; }
-
 // Resolves a path from dataset.yaml against the data set directory, refusing absolute paths and
 // '..' escapes unless allowed: a data set is a self-contained directory.
 std::string ResolvePath(const std::string& directory, const std::string& relative,
@@ -197,7 +195,7 @@ std::size_t LogHash(const std::string_view& a, const std::string_view& b) {
 // Two runs whose encoder logs (or ground-truth tracks) are equal to the bit are one recording
 // copied: no two drives produce the same timestamps and rates. Counted twice they would weigh one
 // run double and, when all are copies, leave nine parameters to three residuals; the copy is
-// named as what it is, not blamed on the wiring (issue 12).
+// named as what it is, not blamed on the wiring.
 void RejectCopiedRuns(const DatasetIndex& index, const std::vector<RunLog>& runs) {
   for (int part = 0; part < 2; ++part) {
     std::unordered_multimap<std::size_t, std::size_t> seen;
@@ -234,7 +232,7 @@ void RejectCopiedRuns(const DatasetIndex& index, const std::vector<RunLog>& runs
 }
 
 // A calibration needs motion: when no wheel turns in any run (or no ground truth moves), every
-// parameter is undetermined and a fit would return the nominal with sigma 0 (issue 12).
+// parameter is undetermined and a fit would return the nominal with sigma 0.
 constexpr double kTurningRadPerS = 0.01;  // the log reader's own threshold for "turning"
 constexpr double kMovedM = 1e-4;          // below any ground truth's noise
 

@@ -14,12 +14,6 @@
 
 namespace fitcal::io {
 
-namespace {
-
-int LineOf(const YAML::Node& node) { return node.Mark().line + 1; }
-
-}  // namespace
-
 std::optional<EncoderTicks> ReadEncoderTicks(const std::string& path) {
   const YAML::Node root = LoadYamlFile(path);
   ExpectYamlType(root, YAML::NodeType::Map, path, "robot file");

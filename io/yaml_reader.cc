@@ -26,8 +26,9 @@ const char* TypeName(YAML::NodeType::value type) {
   }
   return "unknown";
 }
-int LineOf(const YAML::Node& node) { return node.Mark().line >= 0 ? node.Mark().line + 1 : 0; }
 }  // namespace
+
+int LineOf(const YAML::Node& node) { return node.Mark().line >= 0 ? node.Mark().line + 1 : 0; }
 
 namespace {
 // yaml-cpp keeps both entries of a key written twice, and node[key] finds the first: the second

@@ -11,6 +11,10 @@
 
 namespace fitcal::io {
 
+// The 1-based line of a node in its file, as InputError reports it; 0 for a node without a position
+// (a missing key's null node).
+int LineOf(const YAML::Node& node);
+
 // Parses a YAML file; throws InputError (kMissingFile, kYamlSyntax, kDuplicateKey).
 YAML::Node LoadYamlFile(const std::string& path);
 // The same for text already in memory; `path` names it in messages.

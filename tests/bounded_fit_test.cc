@@ -1,4 +1,4 @@
-// Bounded fits that converge (fit/model_fit.h, active set), on the case issue 12 reported: the
+// Bounded fits that converge (fit/model_fit.h, active set), on a case where the plain solve stalls: the
 // real OptiOdom three-wheel robot, all 67 runs, in Palacin Eq. 16's box (R +- 0.025 m). Its
 // tracked point sits ~3 cm off the kinematic centre, so the constrained minimum has a distance
 // on its bound; Ceres' plain bounded solve then keeps shrinking projected steps and stops at

@@ -1,4 +1,4 @@
-// Degenerate data (issue 7): a wheel that never turns, all runs identical, one run with gross
+// Degenerate data: a wheel that never turns, all runs identical, one run with gross
 // slip. The fit must finish, the diagnostics (diagnosis/degenerate_data.h) must say what is wrong,
 // and with a robust loss one slipping run must not drag the parameters.
 

@@ -1,4 +1,4 @@
-// What the repetitions hide (issue 16): latency at any start, the clock map kept only where it
+// What the repetitions hide: latency at any start, the clock map kept only where it
 // helps, and residual structure against covariates of the runs (diagnosis/covariate_structure.h)
 // on simulated omni3 flower data sets with effects that differ between repetitions.
 

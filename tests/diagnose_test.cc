@@ -114,7 +114,7 @@ TEST(Diagnose, CleanDataAcceptsNoEffectOverTwentySeeds) {
   for (std::size_t i = 0; i < flower.size(); i += 3) subset.push_back(flower[i]);
   const Omni3Robot robot = NominalRobot();
   int false_positives = 0;
-  int structure_false_positives = 0;  // lack of fit or a covariate (issue 16)
+  int structure_false_positives = 0;  // lack of fit or a covariate
   constexpr int kSeeds = 20;
   for (int seed = 1; seed <= kSeeds; ++seed) {
     sim::Omni3SimulationOptions o;
@@ -241,7 +241,7 @@ TEST(Diagnose, ClockScaleIsReportedNotIdentifiable) {
   }
 }
 
-// What to record next (issue 6, part 5). On straight runs only (R1-R12, no rotation) a
+// What to record next. On straight runs only (R1-R12, no rotation) a
 // yaw-rate slip has no influence at all: the tracing must say it cannot be told apart and name
 // the runs that would separate it, rather than fit it.
 TEST(Diagnose, SaysWhichRunsWouldSeparateAnUnidentifiableCandidate) {

@@ -1,4 +1,4 @@
-// An error periodic in a wheel's revolution (issue 16, absolute wheel angle): an eccentric wheel
+// An error periodic in a wheel's revolution: an eccentric wheel
 // whose runs each start at another absolute wheel angle scatters the repetitions of a trajectory
 // differently every time, so the lack of fit takes it as noise. When the logs carry the wheels'
 // absolute angles (cumulative counts), diagnose tests the residual against them

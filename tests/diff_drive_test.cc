@@ -1,4 +1,4 @@
-// The differential-drive model (issue 13) on the model seam: kinematics against a hand-derived
+// The differential-drive model on the model seam: kinematics against a hand-derived
 // arc, autodiff against central differences, the robot YAML (round trip, malformed input),
 // UMBmark (a worked example from the paper's equations, recovery of a simulated robot), the
 // generic simulator, recovery of a simulated robot by the Ceres fit within sigmas derived from
@@ -580,7 +580,7 @@ TEST(OptiOdomDiffImport, ReproducesTheNominalFinalErrorsOfRealSessions) {
 }
 
 // Every shared session: what the importer reports, and the measured numbers this robot gives
-// (printed; README issue 13). Trained on odd repetitions, held out on even ones.
+// (printed for the README). Trained on odd repetitions, held out on even ones.
 std::vector<AlignedRun> Select(const std::vector<AlignedRun>& runs, bool odd,
                                const std::string& label_part = "") {
   std::vector<AlignedRun> out;

@@ -151,7 +151,7 @@ TEST(FitcalCli, RecordedCfIsTheOneReportMeasures) {
   EXPECT_NEAR(cf_after("\"after\""), recorded["after"].as<double>(), 1e-9);
 }
 
-// A calibration validates on any data set (issue 17): on the data set that trained it, every run
+// A calibration validates on any data set, since the YAML records its training runs: on the data set that trained it, every run
 // it did not train on (recorded by id, also for a split by trajectory); on another data set
 // (another simulator seed, same run ids), every run, with no identifiability advice about a data
 // set that trained nothing. The verdict is in the terminal, metrics.json and, with --strict, in

@@ -1,4 +1,4 @@
-// Tests of the pieces added to close the loop on measured data (issue 8, part 4): the
+// Tests of the pieces added to close the loop on measured data: the
 // trajectory-label split (validation/trajectory_split.h) and the translation-dependent yaw gain
 // (odometry/effects.h TranslationYawGain). Recovery of the effect by diagnose on simulated data and
 // the clean-data false-positive rate are covered for every registry effect by diagnose_test.cc.

@@ -1,4 +1,4 @@
-// Nothing lost (issue 7): a previous calibrated YAML survives an interrupted or refused run, and
+// Nothing lost: a previous calibrated YAML survives an interrupted or refused run, and
 // `--out` does not silently replace another robot's calibration. Drives the fitcal binary on a
 // data set written by `fitcal simulate`.
 
@@ -211,7 +211,7 @@ TEST(NothingLostTest, RatesInDegreesPerSecondGiveAUnitsWarning) {
       << ReadFileBytes(err);
 }
 
-// report/ is written as a set (issue 12, item 6): staged in a sibling directory and renamed over
+// report/ is written as a set (its files refer to each other): staged in a sibling directory and renamed over
 // the previous report. A signal in the middle, or a write that fails (RLIMIT_FSIZE: EFBIG, as a
 // full disk gives ENOSPC), leaves the previous report byte for byte: never index.html of one run
 // beside metrics.json of another.

@@ -1,4 +1,4 @@
-// Refusing what cannot be calibrated (issue 12, item 5), before fitting: one test per class of
+// Refusing what cannot be calibrated, before fitting (a fit would return nonsense silently): one test per class of
 // data fitcal refuses. Each drives the fitcal binary on an otherwise valid data set with one
 // defect and asserts the one line `fitcal: <file>[:line]: <what>` on stderr, the exit status (1
 // bad input, 2 usage) and that nothing was written (no --out, no file created anywhere under the
@@ -401,7 +401,7 @@ TEST(RefusalTest, UsageErrorsExitTwoInOneLine) {
 }
 
 // Ceres logs through glog, which writes to stderr before InitGoogleLogging: on rates of 1e150
-// rad/s (accepted before issue 12) it printed "E... polynomial.cc:238] Failed to extract
+// rad/s (once accepted) it printed "E... polynomial.cc:238] Failed to extract
 // eigenvalues" and "W... residual_block.cc:129] Error in evaluating the ResidualBlock". Such rates
 // are now refused, so FITCAL_TEST_LIBRARY_LOG makes fitcal write one glog line of every severity
 // below FATAL where Ceres would; none may reach stderr, on an ill-posed fit either.

@@ -1,4 +1,4 @@
-// ROS 2 in and out (issue 18): `fitcal import rosbag2` and `fitcal export ros2-control`.
+// ROS 2 in and out: `fitcal import rosbag2` and `fitcal export ros2-control`.
 //
 // Import: a simulated differential drive (tools/sim) is written as a bag the way a robot records
 // it - sensor_msgs/msg/JointState with cumulative wheel angles (extra joint, another joint order,

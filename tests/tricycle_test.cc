@@ -1,5 +1,5 @@
 // The tricycle model (models/tricycle/), its trajectories, its checks and the OptiOdom tricycle
-// import (issue 14).
+// import.
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>

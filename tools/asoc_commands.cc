@@ -286,52 +286,41 @@ int RunAsocTables(const AsocTablesOptions& options) {
   return 0;
 }
 
-void AsocCommands::Register(CLI::App& app) {
-  simulate_cmd = app.add_subcommand(
-      "asoc-simulate", "Write a simulated ASOC data set (calibration holds, UMBmark, excursions)");
-  simulate_cmd->add_option("--out", simulate.out, "Output data set directory")->required();
-  simulate_cmd->add_option("--seed", simulate.seed, "Random seed")->capture_default_str();
-  simulate_cmd->add_option("--excursions", simulate.excursions, "Random excursion runs")
+void AddAsocSimulateOptions(CLI::App& app, AsocSimulateOptions& simulate) {
+  app.add_option("--out", simulate.out, "Output data set directory")->required();
+  app.add_option("--seed", simulate.seed, "Random seed")->capture_default_str();
+  app.add_option("--excursions", simulate.excursions, "Random excursion runs")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
-  simulate_cmd
-      ->add_option("--wheel-slip-sigma", simulate.wheel_slip_sigma,
-                   "Relative wheel-encoder noise per 20 Hz sample")
+  app.add_option("--wheel-slip-sigma", simulate.wheel_slip_sigma,
+                 "Relative wheel-encoder noise per 20 Hz sample")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
-  simulate_cmd->add_flag("--force", simulate.force, "Overwrite an existing data set");
-
-  geometric_cmd = app.add_subcommand(
-      "asoc-geometric", "Closed-form ASOC calibration (Doebbler Eq. 1-9) from hold runs");
-  geometric_cmd->add_option("--logs", geometric.logs, "Data set with hold_<i>_cw/ccw runs")
-      ->required()
-      ->check(CLI::ExistingDirectory);
-  geometric_cmd->add_option("--out", geometric.out, "Calibrated robot YAML (atomically)")
-      ->capture_default_str();
-  geometric_cmd->add_flag("--no-output", geometric.no_output, "Do not write the YAML");
-  geometric_cmd->add_flag("--force", geometric.force,
-                          "Replace an --out that holds another robot's calibration");
-  geometric_cmd->add_flag("--allow-outside-paths", geometric.allow_outside_paths,
-                          "Allow dataset.yaml paths outside the data set directory");
-
-  tables_cmd =
-      app.add_subcommand("asoc-tables", "Reproduce Doebbler et al. Tables I and II in simulation");
-  tables_cmd->add_option("--sets", tables.sets, "Random parameter sets")->capture_default_str();
-  tables_cmd->add_option("--seed", tables.seed, "Random seed")->capture_default_str();
-  tables_cmd
-      ->add_option("--wheel-slip-sigma", tables.wheel_slip_sigma,
-                   "Relative wheel-encoder noise per 20 Hz sample (non-systematic error)")
-      ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
-  tables_cmd->add_option("--threads", tables.threads, "Worker threads (0 = all cores)")
-      ->capture_default_str();
+  app.add_flag("--force", simulate.force, "Overwrite an existing data set");
 }
 
-int AsocCommands::Dispatch(const CLI::App& app) const {
-  if (app.got_subcommand(simulate_cmd)) return RunAsocSimulate(simulate);
-  if (app.got_subcommand(geometric_cmd)) return RunAsocGeometric(geometric);
-  if (app.got_subcommand(tables_cmd)) return RunAsocTables(tables);
-  return -1;
+void AddAsocGeometricOptions(CLI::App& app, AsocGeometricOptions& geometric) {
+  app.add_option("--logs", geometric.logs, "Data set with hold_<i>_cw/ccw runs")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  app.add_option("--out", geometric.out, "Calibrated robot YAML (atomically)")
+      ->capture_default_str();
+  app.add_flag("--no-output", geometric.no_output, "Do not write the YAML");
+  app.add_flag("--force", geometric.force,
+               "Replace an --out that holds another robot's calibration");
+  app.add_flag("--allow-outside-paths", geometric.allow_outside_paths,
+               "Allow dataset.yaml paths outside the data set directory");
+}
+
+void AddAsocTablesOptions(CLI::App& app, AsocTablesOptions& tables) {
+  app.add_option("--sets", tables.sets, "Random parameter sets")->capture_default_str();
+  app.add_option("--seed", tables.seed, "Random seed")->capture_default_str();
+  app.add_option("--wheel-slip-sigma", tables.wheel_slip_sigma,
+                 "Relative wheel-encoder noise per 20 Hz sample (non-systematic error)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--threads", tables.threads, "Worker threads (0 = all cores)")
+      ->capture_default_str();
 }
 
 }  // namespace fitcal::tools

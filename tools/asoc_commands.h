@@ -37,17 +37,9 @@ int RunAsocSimulate(const AsocSimulateOptions& options);
 int RunAsocGeometric(const AsocGeometricOptions& options);
 int RunAsocTables(const AsocTablesOptions& options);
 
-// Registers the three subcommands on `app`; `dispatch` runs the one that was given (returns -1
-// when none of them was).
-struct AsocCommands {
-  AsocSimulateOptions simulate;
-  AsocGeometricOptions geometric;
-  AsocTablesOptions tables;
-  CLI::App* simulate_cmd = nullptr;
-  CLI::App* geometric_cmd = nullptr;
-  CLI::App* tables_cmd = nullptr;
-  void Register(CLI::App& app);
-  int Dispatch(const CLI::App& app) const;
-};
+// Declare every flag of each subcommand on it, bound to the options.
+void AddAsocSimulateOptions(CLI::App& app, AsocSimulateOptions& options);
+void AddAsocGeometricOptions(CLI::App& app, AsocGeometricOptions& options);
+void AddAsocTablesOptions(CLI::App& app, AsocTablesOptions& options);
 
 }  // namespace fitcal::tools

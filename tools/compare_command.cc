@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -21,6 +22,7 @@
 #include "io/robot_yaml.h"
 #include "models/model_registry.h"
 #include "models/omni3/omni3_robot_model.h"
+#include "tools/cli_validators.h"
 #include "tools/fit_methods.h"
 #include "validation/run_split.h"
 
@@ -191,20 +193,17 @@ struct CompareData {
 };
 
 CompareData LoadCompareData(const CompareCommandOptions& options) {
-  io::DatasetOptions dataset_options;
-  dataset_options.allow_paths_outside = options.allow_outside_paths;
-  dataset_options.num_threads = options.threads;
-  const io::DatasetIndex index = io::ReadDatasetIndex(options.logs, dataset_options);
+  const io::DatasetIndex index = OpenDataset(options).index;
   const std::string model_name = io::ReadRobotModel(index.robot_path);
   CompareData d;
   if (model_name == "omni3") {
-    const io::Dataset dataset = io::LoadDataset(index, dataset_options);
+    const io::Dataset dataset = LoadRuns(options, index, /*robot=*/nullptr);
     d.omni3 = io::ReadOmni3Robot(dataset.robot_path);
     d.model = Omni3ModelOf(*d.omni3);
     d.runs = AlignRuns(dataset.runs);
   } else {
     d.model = ReadRobotModelFile(index.robot_path);
-    d.runs = AlignRuns(io::LoadDataset(index, d.model->robot(), dataset_options).runs);
+    d.runs = AlignRuns(LoadRuns(options, index, &d.model->robot()).runs);
   }
   return d;
 }
@@ -320,19 +319,11 @@ std::string ParseRequest(const CompareCommandOptions& options, CompareRequest* r
     if (r->methods.empty() || r->strategies.empty() || r->counts.empty() || r->counts.front() < 1) {
       return "need at least one method, one strategy and repetitions >= 1";
     }
-    if (options.max_evaluations < 1) return "--max-evaluations must be >= 1";
-    settings.objective_set = !options.objective.empty();
-    if (settings.objective_set &&
-        !ParseFinalPoseObjective(options.objective, &settings.objective)) {
-      return "unknown --objective '" + options.objective + "' (available: squares, eq14)";
-    }
   } catch (const std::invalid_argument& e) {
     return e.what();
   }
-  settings.threads = options.threads;
-  settings.seed = options.seed;
-  settings.max_evaluations = options.max_evaluations;
-  settings.local_polish = options.polish;
+  std::string error;
+  if (!MakeFitMethodSettings(options, options.threads, &settings, &error)) return error;
   return "";
 }
 
@@ -431,6 +422,28 @@ void PrintAndWrite(const CompareCommandOptions& options, const CompareRequest& r
 
 }  // namespace
 
+void AddCompareOptions(CLI::App& app, CompareCommandOptions& o) {
+  AddDatasetOptions(app, o);
+  // A model other than omni3 takes the STA..STE it has unless --strategies names some.
+  app.callback([&app, &o] { o.strategies_given = app.count("--strategies") > 0; });
+  app.add_option("--strategies", o.strategies,
+                 "STA..STE, trajectory lists such as R1,R5,G4 or B1-B12, all, or a label "
+                 "prefix such as circular/* (one per item)")
+      ->capture_default_str();
+  app.add_option("--methods", o.methods, "Methods (" + FitMethodNames() + ") or all")
+      ->capture_default_str();
+  app.add_option("--repetitions", o.repetitions, "Train on the first k repetitions, for each k")
+      ->capture_default_str();
+  app.add_option("--validation-reps", o.validation_reps,
+                 "Validation repetitions (default: those after the largest k)")
+      ->check(RepetitionListValidator());
+  app.add_option("--out", o.out, "Output prefix: <out>.csv, <out>.md, <out>_trace.csv")
+      ->capture_default_str();
+  app.add_flag("--no-output", o.no_output, "Print the table only");
+  app.add_flag("--quiet", o.quiet, "No progress on stderr");
+  AddSolverOptions(app, o);
+}
+
 int RunCompareCommand(const CompareCommandOptions& options) {
   CompareRequest request;
   if (const std::string error = ParseRequest(options, &request); !error.empty()) {
@@ -438,7 +451,7 @@ int RunCompareCommand(const CompareCommandOptions& options) {
     return 2;
   }
   const bool show_progress = !options.quiet && isatty(STDERR_FILENO);
-  try {
+  return RunReportingErrors("fitcal compare", [&]() -> int {
     const CompareData d = LoadCompareData(options);
     if (!d.omni3 && !options.strategies_given) {
       request.strategies = DefaultStrategiesFor(d.runs, request.strategies);
@@ -481,10 +494,7 @@ int RunCompareCommand(const CompareCommandOptions& options) {
     PrintAndWrite(options, request, validation_reps, validation.size(), rows,
                   ColumnsFor(d.model->robot()));
     return 0;
-  } catch (const std::exception& e) {  // io::InputError too: what() is its file:line message
-    std::cerr << "fitcal compare: " << e.what() << "\n";
-    return 1;
-  }
+  });
 }
 
 }  // namespace fitcal::tools

@@ -11,10 +11,14 @@
 #include <string>
 #include <vector>
 
+#include "tools/dataset_command.h"
+#include "tools/solver_options.h"
+
 namespace fitcal::tools {
 
-struct CompareCommandOptions {
-  std::string logs;
+// --logs, --threads and --allow-outside-paths come from DatasetCommandOptions, the solver flags
+// from SolverOptions (the same as fit's).
+struct CompareCommandOptions : DatasetCommandOptions, SolverOptions {
   // Palacin's STA..STE, trajectory lists, "all" or "<prefix>*" (compare_command.cc). For a model
   // other than omni3 without strategies_given: those of STA..STE the data set has, else "all".
   std::vector<std::string> strategies = {"STA", "STB", "STC", "STD", "STE"};
@@ -25,16 +29,16 @@ struct CompareCommandOptions {
   std::string out = "compare";            // prefix of the output files
   bool no_output = false;
   bool quiet = false;
-  bool allow_outside_paths = false;
-  int threads = 0;
-  unsigned long seed = 1;
-  int max_evaluations = 10000;  // NLopt methods, per fit
-  bool polish = false;          // NLopt global methods: SLSQP polish
-  std::string objective;        // "" = each method's default; "squares" or "eq14"
+
+  // Each of the many fits compare runs gets half the NLopt budget of a single `fit`.
+  CompareCommandOptions() { max_evaluations = 10000; }
 };
 
 // Returns the process exit code; the table goes to stdout, progress (on a terminal, unless
 // quiet) and errors (one line) to stderr.
+// Declares every flag of `compare` on its subcommand `app`, bound to `options`.
+void AddCompareOptions(CLI::App& app, CompareCommandOptions& options);
+
 int RunCompareCommand(const CompareCommandOptions& options);
 
 }  // namespace fitcal::tools

@@ -28,34 +28,25 @@
 
 namespace fitcal::tools {
 
-CLI::App* AddDiagnoseCommand(CLI::App& app, DiagnoseCommandOptions& o) {
-  CLI::App* cmd = app.add_subcommand(
-      "diagnose",
-      "Trace the residual of the model's fit to missing effects, any model (diagnosis/diagnose.h)");
-  cmd->add_option("--logs", o.logs, "Data set directory")
-      ->required()
-      ->check(CLI::ExistingDirectory);
-  cmd->add_option("--train-reps", o.train_reps,
-                  "Training repetitions (e.g. 1-5); auto = the first half; the rest validate")
+void AddDiagnoseOptions(CLI::App& cmd, DiagnoseCommandOptions& o) {
+  AddDatasetOptions(cmd, o);
+  cmd.add_option("--train-reps", o.train_reps,
+                 "Training repetitions (e.g. 1-5); auto = the first half; the rest validate")
       ->capture_default_str()
       ->check(RepetitionListValidator(/*allow_auto=*/true));
-  cmd->add_option("--train-trajectories", o.train_trajectories,
-                  "Split by trajectory label instead: a list of labels or a regular expression "
-                  "(e.g. ^circular); matching runs train, the others validate");
-  cmd->add_flag("--clock-map", o.clock_map,
-                "Re-stamp each run's ground truth on the encoder clock (speed-profile match)");
-  cmd->add_option("--out", o.out, "Output directory (diagnose.md, residuals.csv, calibrated.yaml)")
+  cmd.add_option("--train-trajectories", o.train_trajectories,
+                 "Split by trajectory label instead: a list of labels or a regular expression "
+                 "(e.g. ^circular); matching runs train, the others validate");
+  cmd.add_flag("--clock-map", o.clock_map,
+               "Re-stamp each run's ground truth on the encoder clock (speed-profile match)");
+  cmd.add_option("--out", o.out, "Output directory (diagnose.md, residuals.csv, calibrated.yaml)")
       ->capture_default_str();
-  cmd->add_option("--max-effects", o.max_effects, "Most effects to add")
+  cmd.add_option("--max-effects", o.max_effects, "Most effects to add")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--alpha", o.alpha, "Family-wise significance level of the tracing")
+  cmd.add_option("--alpha", o.alpha, "Family-wise significance level of the tracing")
       ->capture_default_str()
       ->check(CLI::Range(1e-9, 0.5));
-  cmd->add_option("--threads", o.threads, "Worker threads (0 = all cores)")->capture_default_str();
-  cmd->add_flag("--allow-outside-paths", o.allow_outside_paths,
-                "Allow dataset.yaml paths outside the data set directory");
-  return cmd;
 }
 
 namespace {
@@ -276,16 +267,13 @@ void WriteOutputs(const DiagnoseCommandOptions& options, const std::vector<std::
 }  // namespace
 
 int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
-  try {
-    io::DatasetOptions dataset_options;
-    dataset_options.allow_paths_outside = options.allow_outside_paths;
-    dataset_options.num_threads = options.threads;
-    const io::DatasetIndex index = io::ReadDatasetIndex(options.logs, dataset_options);
-    const std::vector<std::string> inputs = DatasetInputs(index);
+  return RunReportingErrors("fitcal", [&]() -> int {
+    const OpenedDataset opened = OpenDataset(options);
+    const io::DatasetIndex& index = opened.index;
+    const std::vector<std::string>& inputs = opened.inputs;
     if (const std::string refusal = OutputDirectoryRefusal(options.out, inputs, kDiagnoseFiles);
         !refusal.empty()) {
-      std::cerr << "fitcal: " << refusal << "\n";
-      return 2;
+      return Refuse(refusal);
     }
     const RobotModelPtr model = ReadRobotModelFile(index.robot_path);
     const Robot& robot = model->robot();
@@ -301,7 +289,7 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
                    "without an effects: list\n";
       return 2;
     }
-    std::vector<RunLog> runs = io::LoadDataset(index, robot, dataset_options).runs;
+    std::vector<RunLog> runs = LoadRuns(options, index, &robot).runs;
     if (options.clock_map) MapClocks(index.robot_path, *model, options.threads, &runs);
     const DiagnoseSplit split = SplitRuns(options, runs, WheelChannelMask(robot));
     if (split.training.empty() || split.validation.empty()) {
@@ -340,10 +328,7 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
         "\nwrote %s/{diagnose.md, residuals.csv, residuals_declared.csv, calibrated.yaml}\n",
         options.out.c_str());
     return 0;
-  } catch (const std::exception& e) {
-    std::cerr << "fitcal: " << io::OneLine(e.what(), 500) << "\n";
-    return 1;
-  }
+  });
 }
 
 }  // namespace fitcal::tools

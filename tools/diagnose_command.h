@@ -9,14 +9,16 @@
 
 #include <string>
 
+#include "tools/dataset_command.h"
+
 namespace CLI {
 class App;
 }
 
 namespace fitcal::tools {
 
-struct DiagnoseCommandOptions {
-  std::string logs;
+// --logs, --threads and --allow-outside-paths come from DatasetCommandOptions.
+struct DiagnoseCommandOptions : DatasetCommandOptions {
   std::string train_reps = "auto";  // "auto": the first half of the repetitions present
   // Non-empty: split by trajectory label instead (validation/trajectory_split.h): matching runs
   // train, the others validate (e.g. "^circular" trains on circles and validates on squares).
@@ -25,14 +27,12 @@ struct DiagnoseCommandOptions {
   // EstimateClockMap): for recordings whose clocks were only mapped by hand.
   bool clock_map = false;
   std::string out = "diagnose";
-  int threads = 0;
   int max_effects = 3;
   double alpha = 0.01;
-  bool allow_outside_paths = false;
 };
 
-// Adds the `diagnose` subcommand to app; returns it (check ->parsed()).
-CLI::App* AddDiagnoseCommand(CLI::App& app, DiagnoseCommandOptions& options);
+// Declares every flag of `diagnose` on its subcommand `cmd`, bound to `options`.
+void AddDiagnoseOptions(CLI::App& cmd, DiagnoseCommandOptions& options);
 int RunDiagnoseCommand(const DiagnoseCommandOptions& options);
 
 }  // namespace fitcal::tools

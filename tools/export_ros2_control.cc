@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -576,6 +577,24 @@ std::string CostComment(const ExportRos2ControlOptions& o, const std::string& pa
 }
 
 }  // namespace
+
+void AddExportRos2ControlOptions(CLI::App& app, ExportRos2ControlOptions& o) {
+  app.add_option("--calibration", o.calibration, "Calibrated robot YAML (from fit)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  std::string names;
+  for (const std::string& c : Ros2Controllers()) names += (names.empty() ? "" : ", ") + c;
+  app.add_option("--controller", o.controller, "One of " + names)->required();
+  app.add_option("--node-name", o.node_name, "Top-level key (default: the controller's name)");
+  app.add_option("--joints", o.joints,
+                 "URDF joint names in the robot's channel order (default: the channel names)")
+      ->delimiter(',');
+  app.add_option("--out", o.out, "File to write (atomically; default: stdout)");
+  app.add_option("--logs", o.logs,
+                 "Data set: print the held-out CF of the exact and the exported parameters")
+      ->check(CLI::ExistingDirectory);
+  app.add_flag("--force", o.force, "Overwrite --out");
+}
 
 int RunExportRos2ControlCommand(const ExportRos2ControlOptions& o) {
   constexpr const char* kPrefix = "fitcal export ros2-control: ";

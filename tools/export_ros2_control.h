@@ -37,6 +37,10 @@
 
 #include "models/model_interface.h"
 
+namespace CLI {
+class App;
+}
+
 namespace fitcal::tools {
 
 struct Ros2ControlExport {
@@ -74,6 +78,9 @@ struct ExportRos2ControlOptions {
 
 // One line `fitcal export ros2-control: ...` and exit 1 (bad input) or 2 (mismatch, bad
 // options); notes one line each on stderr; 0 after writing.
+// Declares every flag of `export ros2-control` on its subcommand `app`, bound to `options`.
+void AddExportRos2ControlOptions(CLI::App& app, ExportRos2ControlOptions& options);
+
 int RunExportRos2ControlCommand(const ExportRos2ControlOptions& options);
 
 }  // namespace fitcal::tools

@@ -1,5 +1,6 @@
 #include "tools/fit_command.h"
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -25,6 +26,7 @@
 #include "models/model_registry.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "odometry/effects.h"
+#include "tools/cli_validators.h"
 #include "tools/fit_methods.h"
 #include "tools/model_fit_command.h"
 #include "tools/output_guard.h"
@@ -88,7 +90,32 @@ void PrintParameters(const Omni3Robot& robot, const Omni3FitResult& fit) {
 
 }  // namespace
 
+void AddFitOptions(CLI::App& app, FitCommandOptions& o) {
+  AddDatasetOptions(app, o, LogsFlag::kCheckedByCommand);
+  app.add_option("--method", o.method, "Solver: " + FitMethodNames())->capture_default_str();
+  AddSolverOptions(app, o);
+  CLI::Option* reps =
+      app.add_option("--train-reps", o.train_reps,
+                     "Repetitions used for fitting, e.g. 1-5 or 1,3,5; the others validate")
+          ->capture_default_str()
+          ->check(RepetitionListValidator());
+  app.add_option("--train-trajectories", o.train_trajectories,
+                 "Fit on the runs whose trajectory label matches (list or regular expression); "
+                 "the others validate")
+      ->excludes(reps);
+  app.add_option("--out", o.out, "Calibrated robot YAML to write (atomically)")
+      ->capture_default_str();
+  app.add_flag("--no-output", o.no_output, "Do not write the calibrated YAML");
+  app.add_flag("--force", o.force, "Overwrite --out even if it holds another robot's calibration");
+  app.add_flag("--skip-wheel-order-check", o.skip_wheel_order_check,
+               "Fit even if another encoder column order/sign explains the data far better");
+}
+
 int RunFitCommand(const FitCommandOptions& options) {
+  if (options.logs.empty()) {
+    std::cerr << "fitcal: --logs <data set directory> is required (see fitcal --help)\n";
+    return 2;
+  }
   const auto t_total = std::chrono::steady_clock::now();
   const FitMethod* method = FindFitMethod(options.method);
   if (method == nullptr) {
@@ -98,23 +125,18 @@ int RunFitCommand(const FitCommandOptions& options) {
   }
   FitMethodSettings settings;
   std::string settings_error;
-  if (!MakeFitMethodSettings(options, &settings, &settings_error)) {
+  if (!MakeFitMethodSettings(options, options.threads, &settings, &settings_error)) {
     std::cerr << "fitcal: " << settings_error << "\n";
     return 2;
   }
-  try {
+  return RunReportingErrors("fitcal", [&]() -> int {
     const auto t_load = std::chrono::steady_clock::now();
-    io::DatasetOptions dataset_options;
-    dataset_options.allow_paths_outside = options.allow_outside_paths;
-    dataset_options.num_threads = options.threads;
-    const io::DatasetIndex index = io::ReadDatasetIndex(options.logs, dataset_options);
+    const OpenedDataset opened = OpenDataset(options);
+    const io::DatasetIndex& index = opened.index;
     if (!options.no_output) {
       // Every model's fit writes one file: never over one of its own inputs (exit 2, usage).
-      const std::string refusal = OutputFileRefusal(options.out, DatasetInputs(index));
-      if (!refusal.empty()) {
-        std::cerr << "fitcal: " << refusal << "\n";
-        return 2;
-      }
+      const std::string refusal = OutputFileRefusal(options.out, opened.inputs);
+      if (!refusal.empty()) return Refuse(refusal);
     }
     const std::string model_name = io::ReadRobotModel(index.robot_path);
     // Every model on the seam except omni3, whose fit (with its NLopt methods and fast kernel)
@@ -122,7 +144,7 @@ int RunFitCommand(const FitCommandOptions& options) {
     if (model_name != "omni3") {
       return RunModelFitCommand(options, index, ReadRobotModelFile(index.robot_path));
     }
-    const io::Dataset dataset = io::LoadDataset(index, dataset_options);
+    const io::Dataset dataset = LoadRuns(options, index, /*robot=*/nullptr);
     io::StopHereForTests("loaded");
     const Omni3Robot robot = io::ReadOmni3Robot(dataset.robot_path);
     if (!robot.effects.empty()) {
@@ -138,8 +160,7 @@ int RunFitCommand(const FitCommandOptions& options) {
     if (!options.no_output && !options.force) {
       const std::string refusal = OverwriteRefusal(options.out, robot.name);
       if (!refusal.empty()) {
-        std::cerr << "fitcal: " << refusal << "\n";
-        return 2;
+        return Refuse(refusal);
       }
     }
     RunSplit split =
@@ -154,15 +175,14 @@ int RunFitCommand(const FitCommandOptions& options) {
       return 2;
     }
 
-    // Before fitting (issue 7): rates in the wrong unit, miswired encoder columns, data that
-    // cannot determine the parameters.
+    // Before fitting, as a fit would not notice them: rates in the wrong unit, miswired encoder
+    // columns, data that cannot determine the parameters.
     const RateUnitsReport units = CheckRateUnits(dataset.runs, robot);
     if (units.suspicious)
       std::cerr << "fitcal: warning: " << options.logs << ": " << units.message << "\n";
     if (!units.suspicious && !options.skip_wheel_order_check) {
       WheelOrderOptions order_options;
-      order_options.weights.position_sigma_m = options.position_sigma_m;
-      order_options.weights.heading_sigma_rad = options.heading_sigma_deg * M_PI / 180.0;
+      order_options.weights = options.Weights();
       order_options.num_threads = options.threads;
       // With intermediate ground truth the segment test decides (closed paths hide some
       // miswirings from final poses, and segments name the mapping more sharply); final poses
@@ -236,13 +256,9 @@ int RunFitCommand(const FitCommandOptions& options) {
                 method->description.c_str(), fit.termination.c_str(), fit.iterations,
                 outcome.evaluations, fit.solve_time_s, fit.message.c_str());
     if (!fit.has_covariance) std::printf("uncertainty: %s\n", fit.covariance_message.c_str());
-    for (const std::string& d : fit.held_directions) {
-      std::printf("held at nominal, not determined by the training runs: %s\n", d.c_str());
-    }
-    if (fit.usable) {  // issue 4: name what the training runs cannot determine
-      ResidualWeights weights;
-      weights.position_sigma_m = options.position_sigma_m;
-      weights.heading_sigma_rad = options.heading_sigma_deg * M_PI / 180.0;
+    for (const std::string& d : fit.held_directions) PrintHeldAtNominal(d);
+    if (fit.usable) {  // name what the training runs cannot determine (Eq. 14's Jacobian)
+      const ResidualWeights weights = options.Weights();
       const IdentifiabilityReport ident = AnalyseIdentifiability(
           FinalPoseJacobian(fit.parameters, split.training, weights, options.threads),
           fit.parameters, sim::FlowerCandidateMotions(), nominal, weights);
@@ -337,10 +353,7 @@ int RunFitCommand(const FitCommandOptions& options) {
     }
     std::printf("time: load %.3f s, total %.3f s\n", load_s, Seconds(t_total));
     return StoppedEarlyExit(fit.stopped_early && gate.selected == 1, fit.termination);
-  } catch (const std::exception& e) {  // io::InputError too: what() is its file:line message
-    std::cerr << "fitcal: " << io::OneLine(e.what(), 500) << "\n";
-    return 1;
-  }
+  });
 }
 
 }  // namespace fitcal::tools

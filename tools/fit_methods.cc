@@ -186,11 +186,11 @@ std::string FitMethodNames() {
   return out;
 }
 
-bool MakeFitMethodSettings(const FitCommandOptions& o, FitMethodSettings* s, std::string* error) {
-  s->threads = o.threads;
+bool MakeFitMethodSettings(const SolverOptions& o, int threads, FitMethodSettings* s,
+                           std::string* error) {
+  s->threads = threads;
   s->max_iterations = o.max_iterations;
-  s->weights.position_sigma_m = o.position_sigma_m;
-  s->weights.heading_sigma_rad = o.heading_sigma_deg * M_PI / 180.0;
+  s->weights = o.Weights();
   s->objective_set = !o.objective.empty();
   if (s->objective_set && !ParseFinalPoseObjective(o.objective, &s->objective)) {
     *error = "unknown --objective '" + o.objective + "' (available: squares, eq14)";

@@ -14,11 +14,12 @@
 #include "fit/omni3_ceres_fit.h"
 #include "fit/omni3_nlopt_fit.h"
 #include "models/model_interface.h"
-#include "tools/fit_command.h"
+#include "tools/solver_options.h"
 
 namespace fitcal::tools {
 
-// Settings a caller may change for any method; each method uses the ones that apply to it.
+// SolverOptions checked and in the solvers' terms (enums, SI weights), with the worker threads and
+// a progress callback; each method uses the ones that apply to it.
 struct FitMethodSettings {
   int threads = 0;
   int max_iterations = 100;  // Ceres iterations per solve
@@ -66,9 +67,9 @@ const std::vector<FitMethod>& FitMethods();
 const FitMethod* FindFitMethod(const std::string& name);  // nullptr if unknown
 std::string FitMethodNames();                             // "ceres, ceres-dogleg, crs2lm, ..."
 
-// The solver flags of `fitcal fit` as settings; false with a one-line message when a name is
-// unknown or a value out of range.
-bool MakeFitMethodSettings(const FitCommandOptions& options, FitMethodSettings* settings,
+// The solver flags (tools/solver_options.h) checked and turned into settings; false with a
+// one-line message when a name is unknown or a value out of range.
+bool MakeFitMethodSettings(const SolverOptions& options, int threads, FitMethodSettings* settings,
                            std::string* error);
 
 }  // namespace fitcal::tools

@@ -1,5 +1,6 @@
 #include "tools/generalisation_command.h"
 
+#include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -130,11 +131,33 @@ Row Evaluate(const Model& model, const Omni3Robot& robot, const Subset& train, c
 
 }  // namespace
 
+void AddGeneraliseOptions(CLI::App& app, GeneraliseCommandOptions& o) {
+  AddDatasetOptions(app, o);
+  app.add_option("--segment-length-m", o.segment_length_m,
+                 "Ground-truth path length of a segment-cost window (m)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_flag("!--no-clock-map", o.clock_map,
+               "Do not refine the ground-truth clock before cutting segments");
+  app.add_flag("!--no-loso", o.leave_one_session_out, "Skip leave-one-session-out");
+  app.add_option("--train-trajectories", o.train_trajectories,
+                 "Train on labels matching (list or regular expression), test on the rest, "
+                 "and the other way round");
+  app.add_option("--effects", o.effects,
+                 "Library effects to add as a further model (nine + effects, track cost)")
+      ->delimiter(',');
+  app.add_option("--train-reps", o.train_reps,
+                 "Models other than omni3: repetitions of every path type that train the "
+                 "split against the other repetitions (default: the first half present)");
+  app.add_option("--sessions", o.sessions,
+                 "Models other than omni3: a leave-one-session-out session is a trajectory "
+                 "label (label) or a path type + repetition number (repetition)")
+      ->capture_default_str();
+}
+
 int RunGeneraliseCommand(const GeneraliseCommandOptions& options) {
-  try {
-    io::DatasetOptions dataset_options;
-    dataset_options.num_threads = options.threads;
-    const io::DatasetIndex index = io::ReadDatasetIndex(options.logs, dataset_options);
+  return RunReportingErrors("fitcal", [&]() -> int {
+    const io::DatasetIndex index = OpenDataset(options).index;
     const std::string model_name = io::ReadRobotModel(index.robot_path);
     if (model_name != "omni3") {
       return RunModelGeneraliseCommand(options, index, ReadRobotModelFile(index.robot_path));
@@ -144,7 +167,7 @@ int RunGeneraliseCommand(const GeneraliseCommandOptions& options) {
                    "generic path, not to omni3's table\n";
       return 2;
     }
-    const io::Dataset dataset = io::LoadDataset(index, dataset_options);
+    const io::Dataset dataset = LoadRuns(options, index, /*robot=*/nullptr);
     const Omni3Robot robot = io::ReadOmni3Robot(dataset.robot_path);
     SegmentOptions segment_options;
     segment_options.length_m = options.segment_length_m;
@@ -310,10 +333,7 @@ int RunGeneraliseCommand(const GeneraliseCommandOptions& options) {
       }
     }
     return 0;
-  } catch (const std::exception& e) {
-    std::cerr << "fitcal: " << e.what() << "\n";
-    return 1;
-  }
+  });
 }
 
 }  // namespace fitcal::tools

@@ -13,10 +13,12 @@
 #include <string>
 #include <vector>
 
+#include "tools/dataset_command.h"
+
 namespace fitcal::tools {
 
-struct GeneraliseCommandOptions {
-  std::string logs;
+// --logs, --threads and --allow-outside-paths come from DatasetCommandOptions.
+struct GeneraliseCommandOptions : DatasetCommandOptions {
   double segment_length_m = 1.0;
   bool clock_map = true;  // refine each run's ground-truth clock before cutting segments
   bool leave_one_session_out = true;
@@ -29,7 +31,6 @@ struct GeneraliseCommandOptions {
   // test runs' final poses (Eq. 14, replayed with the effects). "nine, track cost" is the same fit
   // without effects, the like-for-like baseline.
   std::vector<std::string> effects;
-  int threads = 0;
   // Models other than omni3 (tools/model_generalise_command.h): the repetitions that train the
   // "every path type" split ("" or "auto": the first half of those present), and what a session
   // of leave-one-session-out is: "label" (the trajectory label) or "repetition" (path type +
@@ -37,6 +38,9 @@ struct GeneraliseCommandOptions {
   std::string train_reps;
   std::string sessions = "label";
 };
+
+// Declares every flag of `generalise` on its subcommand `app`, bound to `options`.
+void AddGeneraliseOptions(CLI::App& app, GeneraliseCommandOptions& options);
 
 int RunGeneraliseCommand(const GeneraliseCommandOptions& options);
 

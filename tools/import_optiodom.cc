@@ -1,5 +1,6 @@
 #include "tools/import_optiodom.h"
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -325,6 +326,16 @@ int ImportOtherOptiOdomRobot(const std::string& type, const ImportOptiOdomOption
 }
 
 }  // namespace
+
+void AddImportOptiOdomOptions(CLI::App& app, ImportOptiOdomOptions& o) {
+  app.add_option("sessions", o.sessions, "Session directories")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  app.add_option("--out", o.out, "Output data set directory")->required();
+  app.add_flag("--force", o.force, "Overwrite an existing data set");
+  app.add_flag("--skip-mapping-check", o.skip_mapping_check,
+               "Write even if another wheel order/sign explains the ground truth better");
+}
 
 int RunImportOptiOdomCommand(const ImportOptiOdomOptions& options) {
   try {

@@ -27,6 +27,10 @@
 #include "odometry/robot_description.h"
 #include "odometry/run_log.h"
 
+namespace CLI {
+class App;
+}
+
 namespace fitcal::tools {
 
 struct OptiOdomMetadata {
@@ -86,6 +90,9 @@ struct ImportOptiOdomOptions {
   bool force = false;               // overwrite an existing data set
   bool skip_mapping_check = false;  // write even if another wheel mapping fits better
 };
+
+// Declares every flag of `import optiodom` on its subcommand `app`, bound to `options`.
+void AddImportOptiOdomOptions(CLI::App& app, ImportOptiOdomOptions& options);
 
 int RunImportOptiOdomCommand(const ImportOptiOdomOptions& options);
 

@@ -1,5 +1,6 @@
 #include "tools/import_rosbag2.h"
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -409,6 +410,39 @@ Rosbag2Import ImportRosbag2(const ImportRosbag2Options& o) {
   Rosbag2Import imp = ReadRosbag2Import(o);
   WriteDataset(o, ReadRobotModelFile(o.robot)->robot(), imp);
   return imp;
+}
+
+void AddImportRosbag2Options(CLI::App& app, ImportRosbag2Options& o) {
+  app.add_option("bag", o.bag, "Bag directory, its metadata.yaml, or one .db3 / .mcap file")
+      ->required();
+  app.add_option("--out", o.out, "Output data set directory (written atomically)")->required();
+  app.add_option("--robot", o.robot, "Robot YAML (any model); copied into the data set")
+      ->required()
+      ->check(CLI::ExistingFile);
+  app.add_option("--encoders", o.encoders, "sensor_msgs/msg/JointState topic")
+      ->capture_default_str();
+  app.add_option("--joints", o.joints,
+                 "Joint names in the robot's channel order (default: the channel names)")
+      ->delimiter(',');
+  app.add_option("--ground-truth", o.ground_truth,
+                 "Ground-truth topic: geometry_msgs/msg/PoseStamped, nav_msgs/msg/Odometry or "
+                 "tf2_msgs/msg/TFMessage")
+      ->required();
+  app.add_option("--ground-truth-frames", o.ground_truth_frames,
+                 "For a TFMessage topic: parent:child of the transform, e.g. world:base_link");
+  app.add_option("--stamp", o.stamp,
+                 "header (default: when the driver measured; the recording time adds each "
+                 "topic's own transport latency and jitter) or recorded")
+      ->capture_default_str();
+  app.add_option("--runs", o.runs, "Cut runs at these spans: t0:t1,t2:t3 (s since the bag start)");
+  app.add_option("--split-at-rest", o.split_at_rest_s,
+                 "Cut runs in the middle of every rest at least this long (s)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--rest-rate", o.rest_rate_rad_s, "A wheel slower than this is at rest (rad/s)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_option("--label", o.label, "Trajectory label of the runs (default: the bag's name)");
+  app.add_flag("--force", o.force, "Replace an existing data set");
 }
 
 int RunImportRosbag2Command(const ImportRosbag2Options& o) {

@@ -34,6 +34,10 @@
 #include "io/rosbag2/bag_streams.h"
 #include "odometry/run_log.h"
 
+namespace CLI {
+class App;
+}
+
 namespace fitcal::tools {
 
 struct ImportRosbag2Options {
@@ -72,6 +76,9 @@ Rosbag2Import ImportRosbag2(const ImportRosbag2Options& options);
 
 // The command: one line `fitcal import rosbag2: <file>: <what>` on stderr and exit 1 for bad
 // input or an unwritable output, 2 for bad options; 0 after writing.
+// Declares every flag of `import rosbag2` on its subcommand `app`, bound to `options`.
+void AddImportRosbag2Options(CLI::App& app, ImportRosbag2Options& options);
+
 int RunImportRosbag2Command(const ImportRosbag2Options& options);
 
 }  // namespace fitcal::tools

@@ -213,6 +213,10 @@ int StoppedEarlyExit(bool selected_fit_stopped_early, const std::string& termina
   return 6;
 }
 
+void PrintHeldAtNominal(const std::string& direction) {
+  std::printf("held at nominal, not determined by the training runs: %s\n", direction.c_str());
+}
+
 int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex& index,
                        const RobotModelPtr& model) {
   const auto t_total = std::chrono::steady_clock::now();
@@ -221,7 +225,7 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   const FitMethod* method = FindFitMethod(options.method);
   FitMethodSettings settings;
   std::string error;
-  if (method == nullptr || !MakeFitMethodSettings(options, &settings, &error)) {
+  if (method == nullptr || !MakeFitMethodSettings(options, options.threads, &settings, &error)) {
     std::cerr << "fitcal: " << (method == nullptr ? "unknown --method " + options.method : error)
               << "\n";
     return 2;
@@ -235,14 +239,10 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   if (!options.no_output && !options.force) {
     const std::string refusal = OverwriteRefusal(options.out, robot.name);
     if (!refusal.empty()) {
-      std::cerr << "fitcal: " << refusal << "\n";
-      return 2;
+      return Refuse(refusal);
     }
   }
-  io::DatasetOptions dataset_options;
-  dataset_options.allow_paths_outside = options.allow_outside_paths;
-  dataset_options.num_threads = options.threads;
-  const io::Dataset dataset = io::LoadDataset(index, robot, dataset_options);
+  const io::Dataset dataset = LoadRuns(options, index, &robot);
   io::StopHereForTests("loaded");
   const RunSplit split =
       SplitForFit(AlignRuns(dataset.runs), options.train_reps, options.train_trajectories);
@@ -266,10 +266,7 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
 
   PrintFit(options, *model, split, selected, *method, outcome);
   if (!fit.has_covariance) std::printf("uncertainty: %s\n", fit.covariance_message.c_str());
-  for (const UndeterminedDirection& d : fit.held_directions) {
-    std::printf("held at nominal, not determined by the training runs: %s\n",
-                d.description.c_str());
-  }
+  for (const UndeterminedDirection& d : fit.held_directions) PrintHeldAtNominal(d.description);
   std::printf("\nresult gate, CF on %s:\n", gate.judged_on.c_str());
   for (const std::string& line : GateLines(candidates, gate)) std::printf("%s\n", line.c_str());
   if (!gate.improves_on_nominal()) {

@@ -14,6 +14,10 @@
 
 namespace fitcal::tools {
 
+// One line of the fit's output per direction held at the nominal (fit/determined_directions.h),
+// the same for omni3's fit and every other model's.
+void PrintHeldAtNominal(const std::string& direction);
+
 // Exit codes as README "Exit codes"; 5 when no candidate beats the nominal (nothing written).
 int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex& index,
                        const RobotModelPtr& model);

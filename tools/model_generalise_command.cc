@@ -85,8 +85,8 @@ bool RefuseOmni3OnlyOptions(const GeneraliseCommandOptions& o, const std::string
   std::string flag;
   if (!o.effects.empty()) flag = "--effects";
   if (!o.clock_map) flag = "--no-clock-map";
-  if (o.segment_length_m != GeneraliseCommandOptions{}.segment_length_m)
-    flag = "--segment-length-m";
+  const GeneraliseCommandOptions defaults;
+  if (o.segment_length_m != defaults.segment_length_m) flag = "--segment-length-m";
   if (flag.empty()) return false;
   std::cerr << "fitcal: generalise " << flag << " belongs to the omni3 table (segment cost, "
             << "effects); not available for model " << model << "\n";
@@ -107,10 +107,7 @@ int RunModelGeneraliseCommand(const GeneraliseCommandOptions& options,
               << "' (available: label, repetition)\n";
     return 2;
   }
-  io::DatasetOptions dataset_options;
-  dataset_options.num_threads = options.threads;
-  const std::vector<AlignedRun> runs =
-      AlignRuns(io::LoadDataset(index, robot, dataset_options).runs);
+  const std::vector<AlignedRun> runs = AlignRuns(LoadRuns(options, index, &robot).runs);
   ModelFitOptions fit_options;
   fit_options.ceres.num_threads = options.threads;
 

@@ -1,5 +1,6 @@
 #include "tools/report_command.h"
 
+#include <CLI/CLI.hpp>
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
@@ -14,6 +15,7 @@
 
 #include "diagnosis/identifiability.h"
 #include "fit/determined_directions.h"
+#include "fit/model_fit.h"
 #include "fitcal/version.h"
 #include "io/atomic_file.h"
 #include "io/calibration_yaml.h"
@@ -24,6 +26,7 @@
 #include "io/staged_directory.h"
 #include "models/model_registry.h"
 #include "odometry/effects.h"
+#include "tools/cli_validators.h"
 #include "tools/output_guard.h"
 #include "tools/sim/flower_candidates.h"
 #include "validation/cross_validation.h"
@@ -139,19 +142,16 @@ std::string TrainingSource(const CalibrationInput& cal, const TrainingSplit& t) 
 
 ReportInputs LoadInputs(const ReportCommandOptions& options, std::string* refusal) {
   ReportInputs in;
-  io::DatasetOptions dataset_options;
-  dataset_options.allow_paths_outside = options.allow_outside_paths;
-  dataset_options.num_threads = options.threads;
-  in.index = io::ReadDatasetIndex(options.logs, dataset_options);
-  in.inputs = DatasetInputs(in.index);
+  OpenedDataset opened = OpenDataset(options);
+  in.index = std::move(opened.index);
+  in.inputs = std::move(opened.inputs);
   in.inputs.insert(in.inputs.end(), options.calibrations.begin(), options.calibrations.end());
   *refusal = OutputDirectoryRefusal(options.out, in.inputs, kReportFiles);
   if (!refusal->empty()) return in;
   in.model = ReadRobotModelFile(in.index.robot_path);
   in.omni3 = in.model->robot().model == "omni3";
   // omni3 data sets load as `fit` loads them (their runs' fingerprints must agree).
-  in.dataset = in.omni3 ? io::LoadDataset(in.index, dataset_options)
-                        : io::LoadDataset(in.index, in.model->robot(), dataset_options);
+  in.dataset = LoadRuns(options, in.index, in.omni3 ? nullptr : &in.model->robot());
   if (in.omni3) in.omni3_robot = io::ReadOmni3Robot(in.dataset.robot_path);
   for (const std::string& path : options.calibrations) {
     Robot calibrated = ReadRobotModelFile(path)->robot();
@@ -459,13 +459,6 @@ void AddUncertainty(const ReportInputs& in, const CalibrationInput& cal,
   }
 }
 
-// A parameter rests on a bound when it is within 1e-6 of the box's width of it: far above the
-// YAML's 10 significant digits (1e-11 m on a 0.2 m distance), far below any meaningful change.
-bool AtBound(double value, const Interval& box) {
-  const double tolerance = 1e-6 * box.Width();
-  return value <= box.lo + tolerance || value >= box.hi - tolerance;
-}
-
 void AddParameters(const ReportInputs& in, const CalibrationInput& cal,
                    const std::optional<CrossValidationResult>& cv, const std::vector<double>& sigma,
                    bool has_sigma, io::ReportData* data) {
@@ -684,6 +677,31 @@ io::ReportComparisonRow ComparisonRowOf(const io::ReportData& d) {
 
 }  // namespace
 
+void AddReportOptions(CLI::App& app, ReportCommandOptions& o) {
+  AddDatasetOptions(app, o);
+  app.add_option("--calibration", o.calibrations,
+                 "Calibrated robot YAML (from fit or diagnose); repeat it to compare several "
+                 "calibrations on the same runs (the first is reported in full)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  app.add_option("--out", o.out, "Output directory for the report")->required();
+  app.add_option("--train-reps", o.train_reps,
+                 "Training repetitions of this data set (default: the runs the calibration "
+                 "YAML records; on another data set every run validates)")
+      ->check(RepetitionListValidator());
+  app.add_option("--sampling", o.sampling,
+                 "Odometry at ground-truth times: nearest (default, as the paper) or linear")
+      ->capture_default_str();
+  app.add_flag("--cv", o.cross_validate, "Also run leave-one-repetition-out cross-validation");
+  app.add_flag("--strict", o.strict,
+               "Exit 7 when the verdict is FAIL and 8 when it is WARN (the report is "
+               "written either way), for CI pipelines");
+  app.add_option("--worst-runs", o.worst_runs,
+                 "Draw the error along time of this many of the worst validation runs")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+}
+
 int RunReportCommand(const ReportCommandOptions& options) {
   OdometrySampling sampling;
   if (options.sampling == "nearest") {
@@ -695,12 +713,11 @@ int RunReportCommand(const ReportCommandOptions& options) {
               << "' (nearest or linear)\n";
     return 2;
   }
-  try {
+  return RunReportingErrors("fitcal report", [&]() -> int {
     std::string refusal;
     const ReportInputs in = LoadInputs(options, &refusal);
     if (!refusal.empty()) {
-      std::cerr << "fitcal: " << refusal << "\n";
-      return 2;
+      return Refuse(refusal);
     }
     if (options.cross_validate && !in.omni3) {
       std::cerr << "fitcal report: --cv refits omni3 robots only; the data set's robot is a "
@@ -728,10 +745,7 @@ int RunReportCommand(const ReportCommandOptions& options) {
     WriteReport(options, in, data);
     PrintReport(options, data, cv);
     return ExitStatus(options, data.verdict);
-  } catch (const std::exception& e) {
-    std::cerr << "fitcal report: " << io::OneLine(e.what(), 500) << "\n";
-    return 1;
-  }
+  });
 }
 
 }  // namespace fitcal::tools

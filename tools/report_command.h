@@ -10,10 +10,12 @@
 #include <string>
 #include <vector>
 
+#include "tools/dataset_command.h"
+
 namespace fitcal::tools {
 
-struct ReportCommandOptions {
-  std::string logs;
+// --logs, --threads and --allow-outside-paths come from DatasetCommandOptions.
+struct ReportCommandOptions : DatasetCommandOptions {
   // Calibrated robot YAMLs; the first is reported in full, the others are compared with it on
   // the runs none of them trained on.
   std::vector<std::string> calibrations;
@@ -25,8 +27,6 @@ struct ReportCommandOptions {
   // Exit status from the verdict (kReportFailExit, kReportWarnExit) instead of 0, for CI.
   bool strict = false;
   int worst_runs = 8;  // error-along-time figures drawn for this many of the worst runs
-  bool allow_outside_paths = false;
-  int threads = 0;
 };
 
 // Exit statuses of `report --strict` (README, exit codes): the report is written either way.
@@ -34,6 +34,9 @@ constexpr int kReportFailExit = 7;
 constexpr int kReportWarnExit = 8;
 
 // Returns the process exit code; errors are one line on stderr and nothing is written.
+// Declares every flag of `report` on its subcommand `app`, bound to `options`.
+void AddReportOptions(CLI::App& app, ReportCommandOptions& options);
+
 int RunReportCommand(const ReportCommandOptions& options);
 
 }  // namespace fitcal::tools

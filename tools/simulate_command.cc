@@ -1,5 +1,6 @@
 #include "tools/simulate_command.h"
 
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -72,6 +73,49 @@ int RunModelSimulate(const SimulateCommandOptions& options) {
 }
 
 }  // namespace
+
+void AddSimulateOptions(CLI::App& app, SimulateCommandOptions& o) {
+  app.add_option("--out", o.out, "Output data set directory")->required();
+  app.add_option(
+      "--model", o.model,
+      "Robot model (" + sim::ScenarioModelNames() + "; default: the omni3 flower simulator)");
+  app.add_option("--robot", o.robot, "Nominal robot YAML (commands and fit start)")
+      ->capture_default_str()
+      ->check(CLI::ExistingFile);
+  app.add_option("--truth", o.truth, "Robot YAML of the true robot (default: Palacin Table 5)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--repetitions", o.sim.repetitions, "Repetitions of each trajectory")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_option("--seed", o.sim.seed, "Random seed")->capture_default_str();
+  app.add_option("--encoder-counts-per-rev", o.sim.encoder_counts_per_rev, "Encoder resolution")
+      ->capture_default_str();
+  app.add_option("--gt-position-sigma-m", o.sim.gt_position_sigma_m,
+                 "Ground-truth position noise (m)")
+      ->capture_default_str();
+  app.add_option("--gt-heading-sigma-deg", o.gt_heading_sigma_deg,
+                 "Ground-truth heading noise (deg)")
+      ->capture_default_str();
+  app.add_option("--slip-sigma", o.sim.slip_sigma, "Relative wheel slip noise")
+      ->capture_default_str();
+  app.add_option("--wheel-rate-sigma-rad-s", o.wheel_rate_sigma_rad_s,
+                 "--model: white noise on each interval's mean wheel rate (rad/s)")
+      ->capture_default_str();
+  app.add_option("--angle-sigma-deg", o.angle_sigma_deg,
+                 "--model: noise of an angle channel's readings, e.g. steering (deg)")
+      ->capture_default_str();
+  app.add_flag("--force", o.force, "Overwrite an existing data set");
+  app.add_option("--inject", o.inject,
+                 "Inject a library effect, name=value[,value] (odometry/effects.h); repeatable; "
+                 "the data set does not name it");
+  app.callback([&app, &o] {
+    o.sim.gt_heading_sigma_rad = o.gt_heading_sigma_deg * M_PI / 180.0;
+    o.robot_given = app.count("--robot") > 0;
+    for (const char* flag : {"--slip-sigma", "--inject"}) {
+      if (app.count(flag) > 0) o.omni3_only_flags.push_back(flag);
+    }
+  });
+}
 
 int RunSimulateCommand(const SimulateCommandOptions& options) {
   if (!options.model.empty() && options.model != "omni3") return RunModelSimulate(options);

@@ -9,6 +9,10 @@
 #include "tools/sim/omni3_simulator.h"
 #include "tools/sim/scenario_noise.h"
 
+namespace CLI {
+class App;
+}
+
 namespace fitcal::tools {
 
 struct SimulateCommandOptions {
@@ -22,11 +26,17 @@ struct SimulateCommandOptions {
   // (odometry/effects.h); the data set written names none of them.
   std::vector<std::string> inject;
   sim::Omni3SimulationOptions sim;
+  // --gt-heading-sigma-deg as given; sim.gt_heading_sigma_rad is set from it once parsed.
+  double gt_heading_sigma_deg = sim::Omni3SimulationOptions{}.gt_heading_sigma_rad * 180.0 / M_PI;
   // --model only (the omni3 simulator has slip instead): tools/sim/model_scenarios.h.
   double wheel_rate_sigma_rad_s = sim::ScenarioNoise{}.wheel_rate_sigma_rad_s;
   double angle_sigma_deg = sim::ScenarioNoise{}.angle_sigma_rad * 180.0 / M_PI;
   std::vector<std::string> omni3_only_flags;  // given flags that only the omni3 simulator takes
 };
+
+// Declares every flag of `simulate` on its subcommand `app`, bound to `options`; once parsed, the
+// degrees are converted and the flags given recorded.
+void AddSimulateOptions(CLI::App& app, SimulateCommandOptions& options);
 
 int RunSimulateCommand(const SimulateCommandOptions& options);
 

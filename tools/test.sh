@@ -9,7 +9,7 @@ cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DFITCAL_WERROR=ON
 cmake --build build -j "$jobs"
 ctest --test-dir build --output-on-failure -j "$jobs"
 
-# The unit tests once more under AddressSanitizer + UndefinedBehaviorSanitizer (issue 7), in their
+# The unit tests once more under AddressSanitizer + UndefinedBehaviorSanitizer (memory errors a Release run hides), in their
 # own build directory; -O1 keeps the instrumented build and the Ceres fits fast enough for CI.
 # FITCAL_ASAN_BUILD_DIR lets a developer keep this build apart from others (default build-asan).
 asan_dir=${FITCAL_ASAN_BUILD_DIR:-build-asan}

@@ -10,8 +10,6 @@
 namespace fitcal::io::rosbag2 {
 namespace {
 
-int LineOf(const YAML::Node& node) { return node.Mark().line >= 0 ? node.Mark().line + 1 : 0; }
-
 YAML::Node Required(const YAML::Node& map, const std::string& key, const std::string& path) {
   if (!map.IsMap()) {
     throw InputError(InputErrorKind::kWrongYamlType, path, LineOf(map),

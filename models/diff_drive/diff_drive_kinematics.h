@@ -5,7 +5,7 @@
 // Parameters, in the robot YAML's wheel order (= the encoder channels' order):
 //   p = (r_<wheel 0>, r_<wheel 1>, b)   wheel radii (m) and the wheel separation b (m)
 // Which of the two channels is the right wheel is a template argument (kRightChannel = 0 when the
-// YAML lists the right wheel first, as OptiOdom's recordings and issue 13's example do); the YAML
+// YAML lists the right wheel first, as OptiOdom's recordings and the example YAML do); the YAML
 // reader picks the instantiation from each wheel's side (diff_drive_model.h).
 //
 // Channels: wheel rates w (rad/s), positive when the wheel drives the robot forward.
@@ -101,7 +101,7 @@ struct DiffDriveKinematicsT {
   }
 };
 
-// The right wheel first (OptiOdom, issue 13's example YAML).
+// The right wheel first (OptiOdom's recordings, kDiffDriveExampleYaml).
 using DiffDriveKinematics = DiffDriveKinematicsT<0>;
 
 }  // namespace fitcal

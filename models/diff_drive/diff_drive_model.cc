@@ -15,8 +15,7 @@ namespace {
 
 using io::InputError;
 using io::InputErrorKind;
-
-int LineOf(const YAML::Node& node) { return node.Mark().line + 1; }
+using io::LineOf;
 
 struct DiffDriveWheel {
   std::string name;

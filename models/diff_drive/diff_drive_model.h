@@ -1,6 +1,6 @@
 #pragma once
 // A differential-drive robot on the model seam: the kinematics of diff_drive_kinematics.h, the
-// robot YAML schema of issue 13 and UMBmark (umbmark.h) as its classical calibration.
+// robot YAML schema below and UMBmark (umbmark.h) as its classical calibration.
 //
 // Robot YAML:
 //
@@ -73,7 +73,7 @@ class DiffDriveModelT : public KinematicModel<DiffDriveKinematicsT<kRightChannel
 // The right wheel first.
 using DiffDriveModel = DiffDriveModelT<0>;
 
-// The robot of issue 13's example (the OptiOdom differential drive's nominal values).
+// An example robot: the OptiOdom differential drive's nominal values, right wheel first.
 inline constexpr const char* kDiffDriveExampleYaml = R"(model: diff_drive
 name: example_diff_drive
 wheels:

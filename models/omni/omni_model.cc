@@ -22,6 +22,7 @@ namespace {
 
 using io::InputError;
 using io::InputErrorKind;
+using io::LineOf;
 
 // Singular values below this fraction of the largest count as zero: the kinematic matrix's
 // (geometry check) and the parameter Jacobian's (gauge). Both are computed in units where every
@@ -295,8 +296,6 @@ RobotModelPtr MakeOmniModelWithEffects(const std::string& name,
                                           &BuildOmniModel<7>, &BuildOmniModel<8>};
   return kBuilders[wheels.size() - kOmniMinWheels](std::move(robot), wheels, bounds);
 }
-
-int LineOf(const YAML::Node& node) { return node.Mark().line + 1; }
 
 OmniWheel ReadWheel(const YAML::Node& node, const std::string& path, int index) {
   io::YamlMap map(node, path, "wheel " + std::to_string(index + 1));

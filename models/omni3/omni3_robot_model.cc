@@ -14,8 +14,7 @@ namespace {
 
 using io::InputError;
 using io::InputErrorKind;
-
-int LineOf(const YAML::Node& node) { return node.Mark().line + 1; }
+using io::LineOf;
 
 struct Omni3Box {
   Interval distance_m;

@@ -15,6 +15,7 @@ namespace {
 
 using io::InputError;
 using io::InputErrorKind;
+using io::LineOf;
 using K = TricycleKinematics;
 
 constexpr const char* kDefaultTractionName = "traction";
@@ -22,8 +23,6 @@ constexpr const char* kSteeringColumn = "steering";
 // A steering offset is a small mounting/zeroing error; beyond a right angle the "offset" would
 // swap forward and sideways.
 constexpr double kMaxSteeringOffsetDeg = 90.0;
-
-int LineOf(const YAML::Node& node) { return node.Mark().line + 1; }
 
 // A CSV column name is built from the traction wheel's name: letters, digits, '_' only.
 bool IsColumnSafe(const std::string& name) {

@@ -1,4 +1,4 @@
-// Loader throughput on big inputs (issue 7):
+// Loader throughput on big inputs:
 //   BM_ReadEncoderCsv   a large encoder log (FITCAL_BENCH_ENCODER_MB, default 200 MB; 1024 for
 //                       the issue's 1 GB) written once to a temporary directory; MB/s of file
 //                       text and the bytes the loaded EncoderLog holds per sample (target ~40:

@@ -1,4 +1,4 @@
-// Speed of the NLopt back end (issue 3). The budgets are the paper's and the SciPy reference's:
+// Speed of the NLopt back end. The budgets are the paper's and the SciPy reference's:
 //   - 37,545 cost evaluations, Palacin Table 4's STE-GA5 (180 training runs); target < 5 s on
 //     2 cores;
 //   - 25,000 evaluations on 36 runs, where SciPy's differential evolution needs about 68 s.

@@ -73,7 +73,7 @@ struct Omni3SimulationOptions {
   bool random_wheel_start_angle = false;
   std::array<double, 3> wheel_eccentricity{};
 
-  // Effects the nine parameters lack (issue 6); the written data set names none of them.
+  // Effects the nine parameters lack (odometry/effects.h); the written data set names none of them.
   // Library effects (odometry/effects.h) act at every substep with the true wheel state: rate
   // effects on the contact rates, body effects on M_true^-1 * contact, world effects added to
   // the world velocity, and the time offset shifts every ground-truth stamp by +latency.

@@ -1,0 +1,41 @@
+#include "tools/solver_options.h"
+
+#include <cmath>
+
+namespace fitcal::tools {
+
+ResidualWeights SolverOptions::Weights() const {
+  ResidualWeights weights;
+  weights.position_sigma_m = position_sigma_m;
+  weights.heading_sigma_rad = heading_sigma_deg * M_PI / 180.0;
+  return weights;
+}
+
+void AddSolverOptions(CLI::App& app, SolverOptions& o) {
+  app.add_option("--objective", o.objective,
+                 "squares (sum of squared residuals; Ceres default) or eq14 (sum of per-run "
+                 "norms, Palacin Eq. 14; NLopt default)");
+  app.add_option("--loss", o.loss, "Ceres robust loss: none, huber, cauchy")->capture_default_str();
+  app.add_option("--loss-scale", o.loss_scale, "Robust loss scale (residual units: m and rad)")
+      ->capture_default_str();
+  app.add_option("--seed", o.seed, "NLopt random seed (same seed, same result)")
+      ->capture_default_str();
+  app.add_option("--max-evaluations", o.max_evaluations, "NLopt evaluation budget per fit")
+      ->capture_default_str();
+  app.add_option("--max-iterations", o.max_iterations, "Ceres iterations per solve")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_flag("--polish", o.polish,
+               "NLopt global methods: polish the best point with SLSQP (autodiff gradient)");
+  app.add_option("--position-sigma-m", o.position_sigma_m,
+                 "Weight of the position residual as a standard deviation (m); with the default "
+                 "1 m and 57.3 deg the objective weighs metres and radians as Eq. 14")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_option("--heading-sigma-deg", o.heading_sigma_deg,
+                 "Weight of the heading residual as a standard deviation (deg)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+}
+
+}  // namespace fitcal::tools

@@ -1,0 +1,34 @@
+#pragma once
+// The solver settings of every command that fits (fit, compare), in one options struct with its
+// defaults in the class, declared as flags once (AddSolverOptions) and checked once
+// (MakeFitMethodSettings, tools/fit_methods.h) before anything is read. Each method uses the
+// settings that apply to it: Ceres the objective, loss and iterations; NLopt the objective, seed,
+// budget and polish; both the residual weights.
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "models/model_interface.h"
+
+namespace fitcal::tools {
+
+struct SolverOptions {
+  std::string objective;        // "" = the method's default; "squares" or "eq14"
+  std::string loss = "none";    // Ceres: none, huber, cauchy
+  double loss_scale = 0.05;     // Ceres robust loss scale, residual units
+  unsigned long seed = 1;       // NLopt
+  int max_evaluations = 20000;  // NLopt, the whole fit
+  int max_iterations = 100;     // Ceres iterations per solve
+  bool polish = false;          // NLopt global methods: SLSQP polish of the best point
+  // The residual's weights as standard deviations; 1 m and 1 rad weigh metres and radians as
+  // Palacin Eq. 14's CF does.
+  double position_sigma_m = 1.0;
+  double heading_sigma_deg = 180.0 / 3.14159265358979323846;
+
+  ResidualWeights Weights() const;  // the sigmas in SI units (the heading's in radians)
+};
+
+// Declares the solver flags on `app`, bound to `options`; each shows its default.
+void AddSolverOptions(CLI::App& app, SolverOptions& options);
+
+}  // namespace fitcal::tools
