@@ -10,6 +10,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "fit/correlation.h"
 #include "fit/dense_solver_options.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "odometry/parallel_for.h"
@@ -480,6 +481,7 @@ void ComputeEffectCovariance(ceres::Problem* problem, const std::vector<double*>
   result->sigma.assign(n, 0.0);
   covariance.GetCovarianceBlock(blocks[0], blocks[0], c.data());
   for (int k = 0; k < n; ++k) result->sigma[k] = std::sqrt(std::max(0.0, s2 * c(k, k)));
+  result->correlation = CorrelationOf(c);
   for (auto& e : result->effects) {
     const int m = effects::Info(e.id).num_parameters;
     std::vector<double> ce(static_cast<std::size_t>(m * m));

@@ -192,6 +192,7 @@ struct EffectFitResult {
   double final_cost = 0.0;         // 0.5 * sum of per-run objectives
   std::vector<double> parameters;  // the model's (robot().parameters order)
   std::vector<double> sigma;       // one sigma of each (when has_covariance; 0 when held)
+  Eigen::MatrixXd correlation;     // of the model's parameters, with the effects in the fit
   EffectModel effects;             // fitted values and sigmas
   bool has_covariance = false;
   bool any_at_bound = false;

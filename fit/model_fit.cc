@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "fit/correlation.h"
 #include "fit/dense_solver_options.h"
 #include "fit/determined_directions.h"
 
@@ -235,13 +236,7 @@ void ComputeCovariance(const std::vector<AlignedRun>& training, const RobotModel
   result->covariance = s2 * raw;
   result->sigma.assign(n, 0.0);
   for (int k = 0; k < n; ++k) result->sigma[k] = std::sqrt(std::max(0.0, result->covariance(k, k)));
-  result->correlation = Eigen::MatrixXd::Identity(n, n);
-  for (int r = 0; r < n; ++r) {
-    for (int c = 0; c < n; ++c) {
-      const double d = result->sigma[r] * result->sigma[c];
-      if (d > 0.0) result->correlation(r, c) = result->covariance(r, c) / d;
-    }
-  }
+  result->correlation = CorrelationOf(result->covariance);
   result->has_covariance = true;
 }
 

@@ -257,6 +257,29 @@ TEST(FitcalCli, ReportServesADifferentialDrive) {
             0.2 * j["summary"][0]["before"]["cf"].as<double>());
 }
 
+// `diagnose` records the uncertainty of the fit it wrote (the model actually used, with its
+// effects when it wrote any), and the report shows those sigmas, not nothing.
+TEST(FitcalCli, DiagnoseRecordsTheWrittenFitsSigmasAndTheReportShowsThem) {
+  TempDir dir;
+  const std::string data = dir.Path("diff");
+  ASSERT_EQ(RunFitcal(dir, "simulate --model diff_drive --out " + data + " --seed 3").exit_code, 0);
+  const std::string diag = dir.Path("diag");
+  Result r = RunFitcal(dir, "diagnose --logs " + data + " --out " + diag);
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  const std::string cal = diag + "/calibrated.yaml";
+  const YAML::Node block = YAML::LoadFile(cal)["calibration"];
+  ASSERT_TRUE(block["sigma"].IsMap()) << ReadFileBytes(cal);
+  EXPECT_GT(block["sigma"]["wheel_separation_m"].as<double>(), 0.0);
+  ASSERT_EQ(block["correlation"].size(), 3u);
+  EXPECT_DOUBLE_EQ(block["correlation"][1][1].as<double>(), 1.0);
+  const std::string out = dir.Path("report");
+  r = RunFitcal(dir, "report --logs " + data + " --calibration " + cal + " --out " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  const YAML::Node j = YAML::Load(ReadFileBytes(out + "/metrics.json"));
+  EXPECT_NEAR(j["parameters"][2]["sigma_m"].as<double>(),
+              block["sigma"]["wheel_separation_m"].as<double>(), 1e-12);
+}
+
 // An ASOC data set (asoc-simulate's own encoder files, converted on load) goes through the
 // generic commands like any model: `fit` with the closed form of Doebbler Eq. 1-9 (from the hold
 // runs) in the result gate, every --method on the seam (crs2lm runs NLopt, not Ceres), `compare`.

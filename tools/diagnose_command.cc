@@ -106,7 +106,23 @@ struct DiagnoseChoice {
   double cf_after = 0.0;
   double cf_training_before = 0.0;  // nominal, training runs (the same track-replay CF)
   double cf_training_after = 0.0;
+  // The covariance of the fit that made these parameters, with its effects: empty for the
+  // nominal or when the fit had none.
+  std::vector<double> sigma = {};
+  Eigen::MatrixXd correlation = Eigen::MatrixXd();
 };
+
+// The candidate a fit makes, carrying that fit's own uncertainty.
+DiagnoseChoice FitChoice(const std::string& name, const std::vector<double>& parameters,
+                         const EffectModel& effects, double cf_after, bool has_covariance,
+                         const std::vector<double>& sigma, const Eigen::MatrixXd& correlation) {
+  DiagnoseChoice c{name, parameters, effects, 0.0, cf_after};
+  if (has_covariance && correlation.rows() == static_cast<Eigen::Index>(sigma.size())) {
+    c.sigma = sigma;
+    c.correlation = correlation;
+  }
+  return c;
+}
 
 DiagnoseChoice GateDiagnosis(const RobotModelInterface& model, const DiagnoseSplit& split,
                              const DiagnoseResult& result, int threads) {
@@ -114,17 +130,19 @@ DiagnoseChoice GateDiagnosis(const RobotModelInterface& model, const DiagnoseSpl
   const auto cf = [&](const std::vector<double>& p, const EffectModel& e) {
     return ScoreModel(model, p, e, split.validation, {}, threads).cf;
   };
+  const ModelFitResult& declared = result.declared;
+  const EffectFitResult& base = result.base;
+  const EffectFitResult& final_fit = result.final_fit;
   std::vector<DiagnoseChoice> candidates = {
       {"nominal", nominal, {}, 0.0, cf(nominal, {})},
-      {"declared final-pose fit",
-       result.declared.parameters,
-       {},
-       0.0,
-       result.declared_validation.cf},
-      {"track fit", result.base.parameters, {}, 0.0, cf(result.base.parameters, {})}};
+      FitChoice("declared final-pose fit", declared.parameters, {}, result.declared_validation.cf,
+                declared.has_covariance, declared.sigma, declared.correlation),
+      FitChoice("track fit", base.parameters, {}, cf(base.parameters, {}), base.has_covariance,
+                base.sigma, base.correlation)};
   if (result.effects_named) {
-    candidates.push_back({"track fit + effects", result.final_fit.parameters,
-                          result.final_fit.effects, 0.0, result.final_validation.cf});
+    candidates.push_back(FitChoice("track fit + effects", final_fit.parameters, final_fit.effects,
+                                   result.final_validation.cf, final_fit.has_covariance,
+                                   final_fit.sigma, final_fit.correlation));
   }
   std::size_t best = 0;
   std::printf("\nresult gate, CF on the held-out runs (%zu):\n", split.validation.size());
@@ -181,7 +199,11 @@ std::string Omni3CalibratedYaml(const DiagnoseCommandOptions& options, const std
   record.cf_training_after = choice.cf_training_after;
   record.cf_validation_before = choice.cf_before;
   record.cf_validation_after = choice.cf_after;
-  record.has_uncertainty = false;
+  record.has_uncertainty = choice.sigma.size() == record.sigma.size();
+  if (record.has_uncertainty) {
+    std::copy(choice.sigma.begin(), choice.sigma.end(), record.sigma.begin());
+    record.correlation = choice.correlation;
+  }
   record.inverse_kinematic_matrix = omni3::InverseKinematicMatrix(choice.parameters.data());
   return io::Omni3RobotYaml(calibrated, &record);
 }
@@ -212,6 +234,11 @@ std::string ModelCalibratedYaml(const DiagnoseCommandOptions& options,
   block.selected = choice.name;
   block.selected_on = "held-out runs (" + std::to_string(split.validation.size()) + ")";
   for (const HeldParameter& h : robot.held) block.held.push_back(robot.parameters[h.index].name);
+  block.has_uncertainty = static_cast<int>(choice.sigma.size()) == robot.NumParameters();
+  if (block.has_uncertainty) {
+    block.sigma = choice.sigma;
+    block.correlation = choice.correlation;
+  }
   std::string yaml = model.RobotYaml(choice.parameters, io::CalibrationBlockYaml(block, robot));
   if (!choice.effects.empty()) {
     Robot with_effects;

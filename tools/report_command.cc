@@ -413,6 +413,16 @@ void AddModelIdentifiability(const ReportInputs& in, const CalibrationInput& cal
                            in.model->robot().model + " robot, and the calibration records none.";
 }
 
+// A recorded sigma's key names its parameter and display unit: "<name>_<unit>", or for the omni3
+// file, which writes one list per quantity in the parameters' order, "<quantity>_<unit>[i]".
+bool RecordedKeyMatches(const std::string& key, const ParameterInfo& info) {
+  const std::string unit = "_" + info.DisplayUnit();
+  if (key == info.name + unit) return true;
+  const std::size_t bracket = key.find('[');
+  if (bracket == std::string::npos || bracket < unit.size()) return false;
+  return key.compare(bracket - unit.size(), unit.size(), unit) == 0;
+}
+
 // The sigmas and correlation the fit recorded in the calibration's YAML, matched to this robot's
 // parameters by their written key; false (nothing set) unless every parameter has one. They are
 // the fit's, from its own training runs, so they hold whichever data set this report validates on.
@@ -424,9 +434,8 @@ bool AddRecordedUncertainty(const CalibrationInput& cal, io::ReportData* data,
   if (static_cast<int>(recorded.size()) != robot.NumParameters()) return false;
   std::vector<double> values(robot.NumParameters());
   for (int k = 0; k < robot.NumParameters(); ++k) {
-    const ParameterInfo& info = robot.parameters[k];
-    if (recorded[k].first != info.name + "_" + info.DisplayUnit()) return false;
-    values[k] = recorded[k].second / info.DisplayScale();
+    if (!RecordedKeyMatches(recorded[k].first, robot.parameters[k])) return false;
+    values[k] = recorded[k].second / robot.parameters[k].DisplayScale();
   }
   *sigma = std::move(values);
   *has_sigma = true;
@@ -453,6 +462,10 @@ void AddUncertainty(const ReportInputs& in, const CalibrationInput& cal,
   }
   if (in.omni3) {
     AddOmni3Uncertainty(in, cal, training, threads, data, sigma, has_sigma);
+    // With effects, only the fit that carried them knows the parameters' covariance.
+    if (!*has_sigma && !cal.calibrated.effects.empty()) {
+      AddRecordedUncertainty(cal, data, sigma, has_sigma);
+    }
   } else {
     AddModelIdentifiability(in, cal, training, threads, data);
     AddRecordedUncertainty(cal, data, sigma, has_sigma);
