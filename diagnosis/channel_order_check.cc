@@ -1,5 +1,7 @@
 #include "diagnosis/channel_order_check.h"
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -25,31 +27,104 @@ double SumOverRuns(std::size_t n, int num_threads, Fn&& ssr) {
   return sum;
 }
 
+// Buffers one worker reuses for every run and mapping: a run's samples with a mapping applied,
+// and the pose after every sample count. A run's are ~0.5 MB: made per run and mapping they were
+// allocated and freed (mmap, page faults) hundreds of times per run.
+struct RunScratch {
+  explicit RunScratch(int num_channels) : mapped(num_channels) {}
+  EncoderSamples mapped;
+  std::vector<Pose2d> after;
+};
+
+// The run's samples with channel i = sign_i * recorded column_i, written into scratch->mapped
+// (the same numbers ApplyChannelMapping gives).
+const EncoderSamples& MapInto(const EncoderSamples& samples, const ChannelMapping& mapping,
+                              RunScratch* scratch) {
+  EncoderSamples& out = scratch->mapped;
+  out.resize(samples.size());
+  const int n = samples.num_channels();
+  const int stride = samples.stride();
+  const double* in = samples.data();
+  double* o = out.data();
+  for (std::size_t k = 0; k < samples.size(); ++k, in += stride, o += stride) {
+    o[0] = in[0];
+    for (int i = 0; i < n; ++i) o[1 + i] = mapping.sign[i] * in[1 + mapping.column[i]];
+  }
+  return out;
+}
+
+// SSR of one run replayed from `samples` with p: its final pose, or its segments when given.
+double RunSumOfSquares(const RobotModelInterface& model, const std::vector<double>& p,
+                       const AlignedRun& run, const EncoderSamples& samples,
+                       const std::vector<Segment>* segments, const ChannelOrderOptions& options,
+                       std::vector<Pose2d>* after) {
+  if (segments == nullptr) {
+    double r[3];
+    FinalPoseError(model.ReplayFinalPose(p.data(), samples, run.start), run.final_ground_truth,
+                   options.weights, r);
+    return r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+  }
+  // Replay once from the identity, keeping the pose after every sample count.
+  after->resize(samples.size() + 1);
+  (*after)[0] = Pose2d{};
+  Pose2d* poses = after->data();
+  model.Replay(p.data(), samples, 0, samples.size(), Pose2d{},
+               [poses](std::size_t k, const Pose2d& pose) { poses[k + 1] = pose; });
+  double ssr = 0.0;
+  for (const Segment& s : *segments) {
+    double r[3];
+    SegmentError(poses[s.begin], poses[s.end], s.ground_truth_start_T_end, options.weights, r);
+    ssr += r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+  }
+  return ssr;
+}
+
 // SSR of the runs replayed with p: final poses, or the segments when given.
 double SumOfSquares(const RobotModelInterface& model, const std::vector<double>& p,
                     const std::vector<AlignedRun>& runs,
                     const std::vector<std::vector<Segment>>& segments,
                     const ChannelOrderOptions& options) {
   return SumOverRuns(runs.size(), options.num_threads, [&](std::size_t i) {
-    const AlignedRun& run = runs[i];
-    double ssr = 0.0;
-    if (segments.empty()) {
-      double r[3];
-      FinalPoseError(model.ReplayFinalPose(p.data(), run.samples, run.start),
-                     run.final_ground_truth, options.weights, r);
-      return r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-    }
-    // Replay once from the identity, keeping the pose after every sample count.
-    std::vector<Pose2d> after(run.samples.size() + 1);
-    model.Replay(p.data(), run.samples, 0, run.samples.size(), Pose2d{},
-                 [&after](std::size_t k, const Pose2d& pose) { after[k + 1] = pose; });
-    for (const Segment& s : segments[i]) {
-      double r[3];
-      SegmentError(after[s.begin], after[s.end], s.ground_truth_start_T_end, options.weights, r);
-      ssr += r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-    }
-    return ssr;
+    std::vector<Pose2d> after;
+    return RunSumOfSquares(model, p, runs[i], runs[i].samples,
+                           segments.empty() ? nullptr : &segments[i], options, &after);
   });
+}
+
+// The nominal SSR of every mapping k >= 1 (ssr[0] is left at infinity), or infinity for a mapping
+// that cannot be the smallest: each mapping's runs are summed in run order (the bits of
+// SumOfSquares on the mapped runs), and a sum stops as soon as it exceeds a complete sum of
+// another mapping - the terms are non-negative, so it can only grow. The smallest value and the
+// first mapping that has it are the same as with every sum complete, on any number of threads.
+std::vector<double> OtherMappingsNominalSsr(const RobotModelInterface& model,
+                                            const std::vector<AlignedRun>& runs,
+                                            const std::vector<std::vector<Segment>>& segments,
+                                            const std::vector<ChannelMapping>& mappings,
+                                            const ChannelOrderOptions& options) {
+  const double inf = std::numeric_limits<double>::infinity();
+  std::vector<double> ssr(mappings.size(), inf);
+  if (mappings.size() < 2) return ssr;
+  std::atomic<double> smallest{inf};
+  std::atomic<std::size_t> next{1};
+  const std::size_t workers = std::min<std::size_t>(
+      mappings.size() - 1, static_cast<std::size_t>(ResolveThreadCount(options.num_threads)));
+  ParallelFor(workers, static_cast<int>(workers), [&](std::size_t) {
+    RunScratch scratch(runs.front().samples.num_channels());
+    for (std::size_t k = next++; k < mappings.size(); k = next++) {
+      double sum = 0.0;
+      for (std::size_t i = 0; i < runs.size() && sum <= smallest.load(); ++i) {
+        const EncoderSamples& mapped = MapInto(runs[i].samples, mappings[k], &scratch);
+        sum += RunSumOfSquares(model, model.robot().nominal, runs[i], mapped,
+                               segments.empty() ? nullptr : &segments[i], options, &scratch.after);
+      }
+      if (!(sum <= smallest.load())) continue;  // stopped early, or above a complete sum
+      ssr[k] = sum;
+      double seen = smallest.load();
+      while (sum < seen && !smallest.compare_exchange_weak(seen, sum)) {
+      }
+    }
+  });
+  return ssr;
 }
 
 double FittedSumOfSquares(const RobotModelInterface& model, const std::vector<AlignedRun>& runs,
@@ -137,11 +212,11 @@ ChannelOrderReport CheckChannelOrder(const std::vector<AlignedRun>& runs,
   }
   report.recorded_nominal_ssr = SumOfSquares(model, robot.nominal, runs, segments, options);
   report.best_nominal_ssr = std::numeric_limits<double>::infinity();
+  const std::vector<double> other_ssr =
+      OtherMappingsNominalSsr(model, runs, segments, mappings, options);
   for (std::size_t k = 1; k < mappings.size(); ++k) {
-    const double ssr = SumOfSquares(model, robot.nominal, ApplyChannelMapping(runs, mappings[k]),
-                                    segments, options);
-    if (ssr < report.best_nominal_ssr) {
-      report.best_nominal_ssr = ssr;
+    if (other_ssr[k] < report.best_nominal_ssr) {
+      report.best_nominal_ssr = other_ssr[k];
       report.best = mappings[k];
     }
   }

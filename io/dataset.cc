@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -357,14 +358,34 @@ std::string EncoderCsv(const Robot& robot, const std::vector<double>& t_s,
   return out;
 }
 
+void AppendFixed(std::string* out, double v, int precision) {
+  char buffer[400];  // %.9f of the largest double fits
+  const auto [end, ec] =
+      std::to_chars(buffer, buffer + sizeof buffer, v, std::chars_format::fixed, precision);
+  out->append(buffer, ec == std::errc() ? end : buffer);
+}
+
+void AppendGeneral(std::string* out, double v, int precision) {
+  char buffer[64];
+  const auto [end, ec] =
+      std::to_chars(buffer, buffer + sizeof buffer, v, std::chars_format::general, precision);
+  out->append(buffer, ec == std::errc() ? end : buffer);
+}
+
 std::string GroundTruthCsv(const GroundTruthTrack& track) {
   std::string out = "t,x,y,theta\n";
-  char line[160];
+  out.reserve(48 * track.t_s.size() + out.size());
   for (std::size_t k = 0; k < track.t_s.size(); ++k) {
     const Pose2d& p = track.world_T_robot[k];
-    const int n =
-        std::snprintf(line, sizeof line, "%.6f,%.6f,%.6f,%.7f\n", track.t_s[k], p.x, p.y, p.theta);
-    out.append(line, static_cast<std::size_t>(n));
+    // Text of "%.6f,%.6f,%.6f,%.7f\n".
+    AppendFixed(&out, track.t_s[k], 6);
+    out += ',';
+    AppendFixed(&out, p.x, 6);
+    out += ',';
+    AppendFixed(&out, p.y, 6);
+    out += ',';
+    AppendFixed(&out, p.theta, 7);
+    out += '\n';
   }
   return out;
 }

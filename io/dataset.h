@@ -76,4 +76,9 @@ std::string EncoderCsv(const Robot& robot, const std::vector<double>& t_s,
                        const std::vector<std::vector<double>>& rows);
 std::string GroundTruthCsv(const GroundTruthTrack& track);
 
+// Appends v as printf("%.<precision>f") / printf("%.<precision>g") would write it, byte for byte,
+// without printf's per-call parsing and locale work (std::to_chars, ~5x faster per value).
+void AppendFixed(std::string* out, double v, int precision);
+void AppendGeneral(std::string* out, double v, int precision);
+
 }  // namespace fitcal::io

@@ -238,13 +238,18 @@ RunLog DiffRunLog(const DiffSession& s, const DiffRun& run, double ticks_per_rev
 
 std::string TicksCsv(const DiffRun& run) {
   std::string out = "t,ticks_right,ticks_left\n";
-  char line[128];
+  out.reserve(40 * run.t_s.size() + out.size());
   for (std::size_t k = 0; k < run.t_s.size(); ++k) {
     // Row 0 only sets the start time (ticks counted before it are not part of the run).
     const double right = k == 0 ? 0.0 : run.ticks[k][0];
     const double left = k == 0 ? 0.0 : run.ticks[k][1];
-    const int n = std::snprintf(line, sizeof line, "%.9f,%.10g,%.10g\n", run.t_s[k], right, left);
-    out.append(line, static_cast<std::size_t>(n));
+    // Text of "%.9f,%.10g,%.10g\n".
+    io::AppendFixed(&out, run.t_s[k], 9);
+    out += ',';
+    io::AppendGeneral(&out, right, 10);
+    out += ',';
+    io::AppendGeneral(&out, left, 10);
+    out += '\n';
   }
   return out;
 }
