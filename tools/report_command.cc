@@ -416,7 +416,7 @@ void AddModelIdentifiability(const ReportInputs& in, const CalibrationInput& cal
 // A recorded sigma's key names its parameter and display unit: "<name>_<unit>", or for the omni3
 // file, which writes one list per quantity in the parameters' order, "<quantity>_<unit>[i]".
 bool RecordedKeyMatches(const std::string& key, const ParameterInfo& info) {
-  const std::string unit = "_" + info.DisplayUnit();
+  const std::string unit = std::string("_") + info.DisplayUnit();
   if (key == info.name + unit) return true;
   const std::size_t bracket = key.find('[');
   if (bracket == std::string::npos || bracket < unit.size()) return false;
