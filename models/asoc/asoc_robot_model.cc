@@ -15,7 +15,7 @@ using io::InputError;
 using io::InputErrorKind;
 
 // Without `bounds:`: r_c within +-15 % (held, see Gauge), beta within +-30 deg of their values (the
-// box of the ASOC Ceres fit before the seam, asoc_ceres_fit.h), wheel radii +-30 % and wheel
+// box of the ASOC-only Ceres fit that preceded the seam), wheel radii +-30 % and wheel
 // offsets +-50 %: with beta held, the wheel parameters absorb the pivot bias (Gauge below), and a
 // bias of 15 deg (Table I's spread) moves the d_k by ~40 % and the r_wk by ~25 %. Measured on
 // `asoc-simulate --seed 3`: with +-15 % everywhere the fit stopped on bounds (validation CF 0.026
