@@ -9,6 +9,7 @@
 #include "diagnosis/statistics.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "odometry/parallel_for.h"
+#include "validation/trajectory_family.h"
 
 namespace fitcal {
 
@@ -27,23 +28,12 @@ Pose2d ToFrame(const Pose2d& world_error, double theta) {
           world_error.theta};
 }
 
-std::string FamilyOf(const std::string& label) {
-  std::string out;
-  for (char ch : label) {
-    if (std::isalpha(static_cast<unsigned char>(ch)))
-      out += ch;
-    else
-      break;
-  }
-  return out.empty() ? "-" : out;
-}
-
 RunFeatures Features(const RobotModelInterface& robot_model, const std::vector<double>& p,
                      const TrackRun& run) {
   RunFeatures f;
   f.id = run.aligned.id;
   f.trajectory = run.aligned.trajectory;
-  f.family = FamilyOf(run.aligned.trajectory);
+  f.family = TrajectoryFamily(run.aligned.trajectory);
   f.repetition = run.aligned.repetition;
   f.start_heading_rad = run.aligned.start.theta;
   f.t_start_s = run.aligned.t_start_s;
@@ -209,8 +199,7 @@ Eigen::MatrixXd WheelAngleJacobian(const RobotModelInterface& robot_model,
 
 ResidualAnalysis AnalyzeResiduals(const Omni3ParameterArray& p, const EffectModel& model,
                                   const std::vector<TrackRun>& runs, int num_threads) {
-  static const std::shared_ptr<const Omni3Model> omni3_model = Omni3ModelOf(Omni3Robot{});
-  return AnalyzeResiduals(*omni3_model, {p.begin(), p.end()}, model, runs, num_threads);
+  return AnalyzeResiduals(DefaultOmni3Model(), {p.begin(), p.end()}, model, runs, num_threads);
 }
 
 ResidualAnalysis AnalyzeResiduals(const RobotModelInterface& robot_model,

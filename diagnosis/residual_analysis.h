@@ -35,7 +35,7 @@ namespace fitcal {
 struct RunFeatures {
   std::string id;
   std::string trajectory;
-  std::string family;  // leading letters of the trajectory label ("R", "G", "B", ...)
+  std::string family;  // TrajectoryFamily of the label ("R", "G", "B", ...)
   int repetition = 0;
   double alpha_rad = 0.0;       // direction of the mean robot-frame velocity while moving
   int rotation_sign = 0;        // sign of the mean yaw rate (0 when |omega| < 0.02 rad/s)

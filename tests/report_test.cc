@@ -13,6 +13,7 @@
 
 #include "io/report_writer.h"
 #include "io/svg_plot.h"
+#include "validation/trajectory_family.h"
 
 namespace fitcal::io {
 namespace {
@@ -344,6 +345,19 @@ TEST(SvgPlotTest, TicksEscapingAndLabels) {
   const double dx = std::stod(m[3]) - std::stod(m[1]);
   const double dy = std::stod(m[2]) - std::stod(m[4]);
   EXPECT_NEAR(dy / dx, 2.0, 0.01);  // the segment (1, 2) keeps its slope on screen
+}
+
+// The family the report's summary rows and the residual statistics group runs by: the flower's
+// R/G/B, OptiOdom's path types without their session stamps, ASOC's hold runs together.
+TEST(TrajectoryFamilyTest, LeadingLettersOfTheLabel) {
+  EXPECT_EQ(TrajectoryFamily("R12"), "R");
+  EXPECT_EQ(TrajectoryFamily("G3"), "G");
+  EXPECT_EQ(TrajectoryFamily("circular_221220201643"), "circular");
+  EXPECT_EQ(TrajectoryFamily("square_2"), "square");
+  EXPECT_EQ(TrajectoryFamily("hold_1_cw"), "hold");
+  EXPECT_EQ(TrajectoryFamily("CCW"), "CCW");
+  EXPECT_EQ(TrajectoryFamily("7b"), "7b");
+  EXPECT_EQ(TrajectoryFamily(""), "-");
 }
 
 }  // namespace

@@ -33,6 +33,7 @@
 #include "validation/relative_pose_error.h"
 #include "validation/run_split.h"
 #include "validation/training_runs.h"
+#include "validation/trajectory_family.h"
 #include "validation/trajectory_metrics.h"
 #include "validation/verdict.h"
 
@@ -75,14 +76,6 @@ Omni3ParameterArray ArrayOf(const std::vector<double>& p) {
   Omni3ParameterArray a{};
   std::copy(p.begin(), p.begin() + omni3::kNumParameters, a.begin());
   return a;
-}
-
-// Family of a trajectory label for the Table 6 rows: the label without its trailing number
-// ("R12" -> "R"); labels without a number form their own group.
-std::string FamilyOf(const std::string& label) {
-  std::size_t end = label.size();
-  while (end > 0 && std::isdigit(static_cast<unsigned char>(label[end - 1]))) --end;
-  return end == 0 ? label : label.substr(0, end);
 }
 
 // One calibration to judge: the calibrated robot and what its YAML records.
@@ -274,7 +267,7 @@ void AddGroupRows(const EvaluatedRuns& e, io::ReportData* data) {
   };
   std::vector<std::string> families, labels;
   for (const AlignedRun& run : runs) {
-    const std::string f = FamilyOf(run.trajectory);
+    const std::string f = TrajectoryFamily(run.trajectory);
     if (std::find(families.begin(), families.end(), f) == families.end()) families.push_back(f);
     if (std::find(labels.begin(), labels.end(), run.trajectory) == labels.end()) {
       labels.push_back(run.trajectory);
@@ -283,7 +276,7 @@ void AddGroupRows(const EvaluatedRuns& e, io::ReportData* data) {
   if (families.size() > 1) {
     for (const std::string& f : families) {
       data->summary.push_back(row("trajectories " + f + "*", [&](const AlignedRun& r) {
-        return FamilyOf(r.trajectory) == f;
+        return TrajectoryFamily(r.trajectory) == f;
       }));
     }
   }
