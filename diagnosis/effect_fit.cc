@@ -185,13 +185,6 @@ std::vector<EffectId> IdsOf(const EffectModel& model) {
   return ids;
 }
 
-// The omni3 kinematics on the seam, for the omni3 overloads (they do not depend on the robot's
-// values: the parameters come with each call).
-const RobotModelInterface& Omni3Seam() {
-  static const std::shared_ptr<const Omni3Model> model = Omni3ModelOf(Omni3Robot{});
-  return *model;
-}
-
 std::vector<double> Vector(const Omni3ParameterArray& p) { return {p.begin(), p.end()}; }
 
 }  // namespace
@@ -314,7 +307,7 @@ void SplitTrackRuns(std::vector<TrackRun> runs, const std::vector<int>& training
 ModelScore ScoreModel(const Omni3ParameterArray& p, const EffectModel& model,
                       const std::vector<TrackRun>& runs, const ResidualWeights& weights,
                       int num_threads) {
-  return ScoreModel(Omni3Seam(), Vector(p), model, runs, weights, num_threads);
+  return ScoreModel(DefaultOmni3Model(), Vector(p), model, runs, weights, num_threads);
 }
 
 ModelScore ScoreModel(const RobotModelInterface& robot_model, const std::vector<double>& p,
@@ -362,7 +355,7 @@ ModelScore ScoreModel(const RobotModelInterface& robot_model, const std::vector<
 
 TrackErrors ComputeTrackErrors(const Omni3ParameterArray& p, const EffectModel& model,
                                const TrackRun& run, bool all_samples) {
-  return ComputeTrackErrors(Omni3Seam(), Vector(p), model, run, all_samples);
+  return ComputeTrackErrors(DefaultOmni3Model(), Vector(p), model, run, all_samples);
 }
 
 TrackErrors ComputeTrackErrors(const RobotModelInterface& robot_model, const std::vector<double>& p,
@@ -552,7 +545,7 @@ EffectFitResult FitEffectModel(const std::vector<TrackRun>& training,
 double SeparableFraction(const std::vector<TrackRun>& training, const Omni3ParameterArray& p,
                          const EffectModel& model, EffectId candidate,
                          const ResidualWeights& weights, double* unexplained_norm) {
-  return SeparableFraction(training, Omni3Seam(), Vector(p), model, candidate, weights,
+  return SeparableFraction(training, DefaultOmni3Model(), Vector(p), model, candidate, weights,
                            unexplained_norm);
 }
 

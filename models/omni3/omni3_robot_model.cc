@@ -120,6 +120,11 @@ std::shared_ptr<const Omni3Model> Omni3ModelOf(const Omni3Robot& omni3_robot) {
   return std::make_shared<Omni3Model>(std::move(robot), omni3_robot.bounds.angle_offset_rad);
 }
 
+const Omni3Model& DefaultOmni3Model() {
+  static const std::shared_ptr<const Omni3Model> model = Omni3ModelOf(Omni3Robot{});
+  return *model;
+}
+
 std::string Omni3Model::RobotYaml(const std::vector<double>& p,
                                   const std::string& calibration_block) const {
   YAML::Emitter out;
