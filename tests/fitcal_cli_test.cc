@@ -151,11 +151,12 @@ TEST(FitcalCli, RecordedCfIsTheOneReportMeasures) {
   EXPECT_NEAR(cf_after("\"after\""), recorded["after"].as<double>(), 1e-9);
 }
 
-// A calibration validates on any data set, since the YAML records its training runs: on the data set that trained it, every run
-// it did not train on (recorded by id, also for a split by trajectory); on another data set
-// (another simulator seed, same run ids), every run, with no identifiability advice about a data
-// set that trained nothing. The verdict is in the terminal, metrics.json and, with --strict, in
-// the exit status: the nominal robot as "calibration" improves nothing (FAIL, exit 7).
+// A calibration validates on any data set, since the YAML records its training runs: on the data
+// set that trained it, every run it did not train on (recorded by id, also for a split by
+// trajectory); on another data set (another simulator seed, same run ids), every run, with no
+// identifiability advice about a data set that trained nothing. The verdict is in the terminal,
+// metrics.json and, with --strict, in the exit status: the nominal robot as "calibration" improves
+// nothing (FAIL, exit 7).
 TEST(FitcalCli, ReportValidatesOnAnyDataSetWithAVerdict) {
   TempDir dir;
   const std::string data = MakeDataset(dir);
@@ -255,6 +256,35 @@ TEST(FitcalCli, ReportServesADifferentialDrive) {
   EXPECT_FALSE(j["noise_floor"].IsNull());
   EXPECT_LT(j["summary"][0]["after"]["cf"].as<double>(),
             0.2 * j["summary"][0]["before"]["cf"].as<double>());
+}
+
+// `report --cv` refits any model on the seam, one fold per repetition (three here), and shows
+// the spread of each of the model's own parameters across the folds.
+TEST(FitcalCli, ReportCrossValidatesAnyModel) {
+  TempDir dir;
+  const std::string data = dir.Path("diff");
+  ASSERT_EQ(
+      RunFitcal(dir, "simulate --model diff_drive --out " + data + " --seed 3 --repetitions 3")
+          .exit_code,
+      0);
+  const std::string cal = dir.Path("cal.yaml");
+  ASSERT_EQ(RunFitcal(dir, "fit --logs " + data + " --train-reps 1-2 --out " + cal).exit_code, 0);
+  const std::string out = dir.Path("report");
+  const Result r =
+      RunFitcal(dir, "report --logs " + data + " --calibration " + cal + " --out " + out + " --cv");
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("cross-validation: 3 folds"), std::string::npos) << r.out;
+  const YAML::Node j = YAML::Load(ReadFileBytes(out + "/metrics.json"));
+  const YAML::Node folds = j["cross_validation"]["folds"];
+  ASSERT_EQ(folds.size(), 3u);
+  for (std::size_t i = 0; i < folds.size(); ++i) {
+    EXPECT_EQ(folds[i]["held_out_repetition"].as<int>(), static_cast<int>(i) + 1);
+    EXPECT_TRUE(folds[i]["usable"].as<bool>());
+    EXPECT_LT(folds[i]["cf_validation_after"].as<double>(),
+              folds[i]["cf_validation_before"].as<double>());
+  }
+  ASSERT_EQ(j["parameters"].size(), 3u);
+  EXPECT_GT(j["parameters"][2]["cv_std_m"].as<double>(), 0.0);
 }
 
 // `diagnose` records the uncertainty of the fit it wrote (the model actually used, with its

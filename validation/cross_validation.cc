@@ -1,24 +1,35 @@
 #include "validation/cross_validation.h"
 
+#include <functional>
 #include <set>
 #include <stdexcept>
 
-namespace fitcal {
+#include "fit/final_pose_errors.h"
 
-CrossValidationResult LeaveOneRepetitionOut(const std::vector<AlignedRun>& runs,
-                                            const Omni3Robot& robot,
-                                            const CeresFitOptions& options) {
+namespace fitcal {
+namespace {
+
+struct FoldFit {
+  bool usable = false;
+  std::string termination;
+  std::vector<double> parameters;
+};
+using FoldFitter = std::function<FoldFit(const std::vector<AlignedRun>& training)>;
+using RunsCf =
+    std::function<double(const std::vector<double>& p, const std::vector<AlignedRun>& runs)>;
+
+// The folds, whatever fits them: `fit` refits on a fold's training runs, `cf` scores parameters.
+CrossValidationResult CrossValidate(const std::vector<AlignedRun>& runs,
+                                    const std::vector<double>& nominal, const FoldFitter& fit,
+                                    const RunsCf& cf) {
   std::set<int> repetitions;
   for (const AlignedRun& run : runs) repetitions.insert(run.repetition);
   if (repetitions.size() < 2) {
     throw std::invalid_argument("cross-validation needs runs of at least two repetitions (found " +
                                 std::to_string(repetitions.size()) + ")");
   }
-  CeresFitOptions fold_options = options;
-  fold_options.compute_covariance = false;  // the spread across folds is the point here
-  const Omni3ParameterArray nominal = robot.nominal.ToArray();
   CrossValidationResult result;
-  std::array<std::vector<double>, omni3::kNumParameters> values;
+  std::vector<std::vector<double>> values(nominal.size());
   std::vector<double> cf_after, cf_before;
   for (int held_out : repetitions) {
     std::vector<AlignedRun> training, validation;
@@ -29,27 +40,67 @@ CrossValidationResult LeaveOneRepetitionOut(const std::vector<AlignedRun>& runs,
     fold.held_out_repetition = held_out;
     fold.training_runs = static_cast<int>(training.size());
     fold.validation_runs = static_cast<int>(validation.size());
-    const Omni3FitResult fit = FitOmni3Ceres(training, robot, fold_options);
-    fold.usable = fit.usable;
-    fold.termination = fit.termination;
-    fold.parameters = fit.parameters;
-    fold.cf_training = EvaluateFinalPoseErrors(fit.parameters, training, options.num_threads).cf;
-    fold.cf_validation_before =
-        EvaluateFinalPoseErrors(nominal, validation, options.num_threads).cf;
-    fold.cf_validation_after =
-        EvaluateFinalPoseErrors(fit.parameters, validation, options.num_threads).cf;
+    const FoldFit f = fit(training);
+    fold.usable = f.usable;
+    fold.termination = f.termination;
+    fold.parameters = f.parameters;
+    fold.cf_training = cf(f.parameters, training);
+    fold.cf_validation_before = cf(nominal, validation);
+    fold.cf_validation_after = cf(f.parameters, validation);
     if (fold.usable) {
       ++result.usable_folds;
-      for (int k = 0; k < omni3::kNumParameters; ++k) values[k].push_back(fit.parameters[k]);
+      for (std::size_t k = 0; k < nominal.size(); ++k) values[k].push_back(f.parameters[k]);
       cf_after.push_back(fold.cf_validation_after);
       cf_before.push_back(fold.cf_validation_before);
     }
-    result.folds.push_back(fold);
+    result.folds.push_back(std::move(fold));
   }
-  for (int k = 0; k < omni3::kNumParameters; ++k) result.parameter_spread[k] = Summarize(values[k]);
+  for (std::vector<double>& v : values) result.parameter_spread.push_back(Summarize(std::move(v)));
   result.cf_validation_after = Summarize(cf_after);
   result.cf_validation_before = Summarize(cf_before);
   return result;
+}
+
+}  // namespace
+
+CrossValidationResult LeaveOneRepetitionOut(const std::vector<AlignedRun>& runs,
+                                            const RobotModelInterface& model,
+                                            const ModelFitOptions& options) {
+  ModelFitOptions fold_options = options;
+  fold_options.ceres.compute_covariance = false;  // the spread across folds is the point here
+  const int threads = options.ceres.num_threads;
+  return CrossValidate(
+      runs, model.robot().nominal,
+      [&](const std::vector<AlignedRun>& training) {
+        const ModelFitResult fit = FitModel(training, model, fold_options);
+        return FoldFit{fit.usable, fit.termination, fit.parameters};
+      },
+      [&](const std::vector<double>& p, const std::vector<AlignedRun>& on) {
+        return EvaluateFinalPoseErrors(model, p, on, threads).cf;
+      });
+}
+
+CrossValidationResult LeaveOneRepetitionOut(const std::vector<AlignedRun>& runs,
+                                            const Omni3Robot& robot,
+                                            const CeresFitOptions& options) {
+  CeresFitOptions fold_options = options;
+  fold_options.compute_covariance = false;
+  const Omni3ParameterArray nominal = robot.nominal.ToArray();
+  const auto as_array = [](const std::vector<double>& p) {
+    Omni3ParameterArray a{};
+    std::copy(p.begin(), p.end(), a.begin());
+    return a;
+  };
+  return CrossValidate(
+      runs, std::vector<double>(nominal.begin(), nominal.end()),
+      [&](const std::vector<AlignedRun>& training) {
+        const Omni3FitResult fit = FitOmni3Ceres(training, robot, fold_options);
+        return FoldFit{fit.usable, fit.termination,
+                       std::vector<double>(fit.parameters.begin(), fit.parameters.end())};
+      },
+      [&](const std::vector<double>& p, const std::vector<AlignedRun>& on) {
+        return EvaluateFinalPoseErrors(as_array(p), on, options.num_threads).cf;
+      });
 }
 
 }  // namespace fitcal
