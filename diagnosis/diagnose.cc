@@ -185,6 +185,7 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
     round.base_validation_objective = base_val.objective;
     const ResidualAnalysis base_all =
         AnalyzeResiduals(model, current.parameters, current.effects, all, threads);
+    round.base_lof_available = base_all.lack_of_fit.available;
     round.base_lof_f = base_all.lack_of_fit.f;
     round.base_lof_p = base_all.lack_of_fit.p_value;
     const bool base_lof =
@@ -305,13 +306,22 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
   out.covariates = AnalyzeCovariates(out.after, options.covariate_alpha);
   out.lack_of_fit =
       out.after.lack_of_fit.available && out.after.lack_of_fit.p_value < options.lof_alpha;
-  out.unexplained_structure = out.lack_of_fit || out.covariates.any_significant;
+  out.above_sensor_floor =
+      out.after.sensor_floor.available && out.after.sensor_floor.p_value < options.lof_alpha;
+  out.unexplained_structure =
+      out.lack_of_fit || out.covariates.any_significant || out.above_sensor_floor;
   out.effects_named = !out.unexplained_structure && !current.effects.empty();
   for (const CovariateTest& t : out.covariates.tests) {
     if (t.significant) {
       out.record_next.push_back("runs that vary " + t.name +
                                 " within repetitions of one trajectory, to model what drifts");
     }
+  }
+  if (out.above_sensor_floor && !out.lack_of_fit) {
+    out.record_next.push_back(
+        "the runs differ from the model by more than the sensors' noise, but no repeatable "
+        "pattern is established: record repetitions of each motion, at other times, headings "
+        "and wheel angles, so that the lack-of-fit and covariate tests can name what it follows");
   }
   if (out.lack_of_fit) {
     out.record_next.push_back(
@@ -333,9 +343,12 @@ std::string FormatDiagnoseReport(const DiagnoseResult& r, const RobotModelInterf
   out += "\n## Tracing\n\n";
   for (std::size_t k = 0; k < r.rounds.size(); ++k) {
     const DiagnoseRound& round = r.rounds[k];
-    out += Fmt("Round %.0f: base validation objective %.4g, lack of fit F = %.2f",
-               static_cast<double>(k + 1), round.base_validation_objective, round.base_lof_f) +
-           Fmt(" (p = %.2g)\n\n", round.base_lof_p);
+    out +=
+        Fmt("Round %.0f: base validation objective %.4g, ", static_cast<double>(k + 1),
+            round.base_validation_objective) +
+        (round.base_lof_available ? Fmt("lack of fit F = %.2f", round.base_lof_f) +
+                                        Fmt(" (p = %.2g)\n\n", round.base_lof_p)
+                                  : std::string("lack of fit not available (no repetitions)\n\n"));
     out +=
         "| candidate | separable | predicted sigma | value +- sigma | validation objective | mean "
         "d | t | p | dBIC | verdict |\n";
@@ -380,11 +393,20 @@ std::string FormatDiagnoseReport(const DiagnoseResult& r, const RobotModelInterf
         Fmt("- UNEXPLAINED STRUCTURE: the residual still shows repeatable structure "
             "(lack of fit F = %.2f, p = %.2g) that no candidate explains; see the tables above.\n",
             r.after.lack_of_fit.f, r.after.lack_of_fit.p_value);
-  } else if (!r.unexplained_structure) {
-    out +=
-        Fmt("- the remaining residual is consistent with the noise floor (lack of fit F = %.2f, p "
-            "= %.2g)\n",
-            r.after.lack_of_fit.f, r.after.lack_of_fit.p_value);
+  }
+  if (r.above_sensor_floor) out += "- " + SensorFloorFinding(r.after.sensor_floor) + "\n";
+  if (!r.unexplained_structure) {
+    out += (r.after.lack_of_fit.available
+                ? Fmt("- the remaining residual is consistent with the noise floor (lack of fit "
+                      "F = %.2f, ",
+                      r.after.lack_of_fit.f) +
+                      Fmt("p = %.2g", r.after.lack_of_fit.p_value)
+                : std::string("- the remaining residual is consistent with the noise floor (no "
+                              "repetitions for a lack of fit")) +
+           (r.after.sensor_floor.available
+                ? Fmt("; %.2f times the sensors' noise, ", r.after.sensor_floor.ratio) +
+                      Fmt("p = %.2g)\n", r.after.sensor_floor.p_value)
+                : std::string(")\n"));
   }
   for (const std::string& line : r.not_identifiable) out += "- " + line + "\n";
   for (const std::string& line : r.record_next) out += "- record next: " + line + "\n";

@@ -29,9 +29,10 @@
 //         candidate that merely nibbles at an effect outside the library is not named.
 //     The accepted candidate is the one passing all tests with the largest mean(d); then the
 //     search repeats for a second effect, and so on, until none passes (or max_effects).
-//  4. After: lack of fit of the final model, and its residual against covariates of the runs
+//  4. After: lack of fit of the final model, its residual against the sensors' own noise
+//     (sensor_noise_floor.h: no repetitions needed) and against covariates of the runs
 //     (covariate_structure.h: what differs between repetitions, which the lack of fit takes as
-//     noise). If either is significant (p < lof_alpha; Holm at covariate_alpha), the residual is
+//     noise). If any is significant (p < lof_alpha; Holm at covariate_alpha), the residual is
 //     reported as structure that no candidate explains, with its pattern and the covariates it
 //     follows, and the accepted effects (if any) are a partial description, not the cause.
 // Structurally non-identifiable effects (registry: identifiable = false, e.g. the encoder clock
@@ -86,6 +87,7 @@ struct CandidateResult {
 
 struct DiagnoseRound {
   double base_validation_objective = 0.0;
+  bool base_lof_available = false;  // some trajectory has repetitions
   double base_lof_f = 0.0;
   double base_lof_p = 1.0;
   std::vector<CandidateResult> candidates;
@@ -102,7 +104,11 @@ struct DiagnoseResult {
   ResidualAnalysis after;
   CovariateStructure covariates;  // of `after`
   bool lack_of_fit = false;       // significant lack of fit of `after` (p < lof_alpha)
-  // Significant lack of fit, or a covariate the residual significantly depends on.
+  // `after` significantly above the sensors' own noise (sensor_noise_floor.h, p < lof_alpha):
+  // seen without repetitions, and when what differs between repetitions hides in their scatter.
+  bool above_sensor_floor = false;
+  // Significant lack of fit, residual above the sensor floor, or a covariate the residual
+  // significantly depends on.
   bool unexplained_structure = false;
   // The accepted effects are named as causes only when nothing structured remains; otherwise
   // they are a partial description (they may stand in for an effect outside the library).

@@ -195,6 +195,46 @@ Eigen::MatrixXd WheelAngleJacobian(const RobotModelInterface& robot_model,
   return out;
 }
 
+// The residual against the sensors' own noise (sensor_noise_floor.h), on the lack-of-fit
+// components: the three checkpoints and the window's end.
+void AddSensorFloor(const std::vector<TrackRun>& runs, const std::vector<Lof>& lof,
+                    const std::vector<std::vector<Lof>>& lof_jacobian,
+                    const std::vector<std::array<double, 3>>& checkpoint_times, int num_threads,
+                    ResidualAnalysis* out) {
+  out->sensor_noise = EstimateSensorNoise(out->track);
+  if (!out->sensor_noise.available) return;
+  const std::size_t n = runs.size();
+  std::vector<Eigen::VectorXd> e(n);
+  std::vector<Eigen::MatrixXd> jacobian(n), covariance(n);
+  std::vector<std::string> group(n);
+  ParallelFor(n, num_threads, [&](std::size_t i) {
+    const TrackErrors& track = out->track[i];
+    if (track.t_s.empty()) return;
+    const std::vector<double> times = {checkpoint_times[i][0], checkpoint_times[i][1],
+                                       checkpoint_times[i][2], track.t_s.back()};
+    covariance[i] =
+        PropagateSensorNoise(out->sensor_noise, track, times, runs[i].aligned.start.theta);
+    e[i] = Eigen::Map<const Eigen::VectorXd>(lof[i].data(), kLofComponents);
+    jacobian[i].resize(kLofComponents, static_cast<int>(lof_jacobian.size()));
+    for (std::size_t k = 0; k < lof_jacobian.size(); ++k) {
+      jacobian[i].col(static_cast<int>(k)) =
+          Eigen::Map<const Eigen::VectorXd>(lof_jacobian[k][i].data(), kLofComponents);
+    }
+    group[i] = out->runs[i].repetition_group;
+  });
+  std::vector<Eigen::VectorXd> e_used;
+  std::vector<Eigen::MatrixXd> jacobian_used, covariance_used;
+  std::vector<std::string> group_used;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (covariance[i].size() == 0) continue;  // a run without ground truth in its window
+    e_used.push_back(e[i]);
+    jacobian_used.push_back(jacobian[i]);
+    covariance_used.push_back(covariance[i]);
+    group_used.push_back(group[i]);
+  }
+  out->sensor_floor = TestAgainstSensorFloor(e_used, jacobian_used, covariance_used, group_used);
+}
+
 }  // namespace
 
 ResidualAnalysis AnalyzeResiduals(const Omni3ParameterArray& p, const EffectModel& model,
@@ -282,6 +322,7 @@ ResidualAnalysis AnalyzeResiduals(const RobotModelInterface& robot_model,
   // times and makes F far more variable than F(df_lof, df_pe) (clean simulated data then read as
   // "structure" for some seeds).
   AssignRepetitionGroups(&out.runs);
+  AddSensorFloor(runs, lof, lof_jacobian, checkpoint_times, num_threads, &out);
   std::map<std::string, std::vector<std::size_t>> by_trajectory;
   for (std::size_t i = 0; i < n; ++i) by_trajectory[out.runs[i].repetition_group].push_back(i);
   using Vec = Eigen::Matrix<double, kLofComponents, 1>;
@@ -353,18 +394,7 @@ ResidualAnalysis AnalyzeResiduals(const RobotModelInterface& robot_model,
       b += t.m * jz.transpose() * z;
     }
     int identifiable = 0;
-    double explained = 0.0;
-    if (num_parameters > 0) {
-      const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> ea(a);
-      const double a_max = ea.eigenvalues().maxCoeff();
-      for (int k = 0; k < num_parameters; ++k) {
-        const double lambda = ea.eigenvalues()[k];
-        if (!(lambda > 1e-10 * a_max)) continue;
-        ++identifiable;
-        const double proj = ea.eigenvectors().col(k).dot(b);
-        explained += proj * proj / lambda;
-      }
-    }
+    const double explained = ExplainedByLinearisedRefit(a, b, &identifiable);
     const double lof_w = std::max(0.0, total - explained);
     // The covariance is estimated on df_pe_per_component degrees of freedom; the Hotelling
     // correction leaves df_pe_per_component - rank + 1 for the denominator.
@@ -461,6 +491,7 @@ std::string FormatResidualAnalysis(const ResidualAnalysis& a) {
   } else {
     out += "lack of fit: not available (no trajectory has two repetitions)\n";
   }
+  out += FormatSensorFloor(a.sensor_noise, a.sensor_floor);
   out +=
       "\n| by | bin | n | mean x | mean y | mean theta [deg] | rms x | rms y | rms theta [deg] |\n";
   out += "|---|---|---|---|---|---|---|---|---|\n";

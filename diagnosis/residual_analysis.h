@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "diagnosis/effect_fit.h"
+#include "diagnosis/sensor_noise_floor.h"
 
 namespace fitcal {
 
@@ -81,6 +82,11 @@ struct ResidualAnalysis {
   double systematic_rms_m = 0.0, systematic_rms_rad = 0.0;
   double nonsystematic_rms_m = 0.0, nonsystematic_rms_rad = 0.0;
   LackOfFit lack_of_fit;
+  // The noise floor from the sensors (sensor_noise_floor.h): estimated from every run's residual
+  // track, propagated to its lack-of-fit components, and the residual of all runs tested against
+  // it (no repetitions needed), with the repetitions' scatter checked against it.
+  SensorNoise sensor_noise;
+  SensorFloorTest sensor_floor;
   std::vector<GroupStat> groups;
   // Per run: d(final_start_frame)/d(fitted parameter), 3 x (free model parameters + effect
   // parameters), the columns the lack-of-fit test refits (forward differences).

@@ -1,5 +1,6 @@
 #include "diagnosis/statistics.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -61,6 +62,54 @@ double StudentTUpperTail(double t, double df) {
 double FUpperTail(double f, double d1, double d2) {
   if (!(f > 0.0)) return 1.0;
   return RegularizedIncompleteBeta(0.5 * d2, 0.5 * d1, d2 / (d2 + d1 * f));
+}
+
+namespace {
+
+// P(a, x) by its series, for x < a + 1 (Numerical Recipes 3rd ed. Sec. 6.2).
+double LowerGammaSeries(double a, double x) {
+  constexpr int kMaxIterations = 100000;
+  double ap = a, del = 1.0 / a, sum = del;
+  for (int n = 0; n < kMaxIterations; ++n) {
+    ap += 1.0;
+    del *= x / ap;
+    sum += del;
+    if (std::abs(del) < std::abs(sum) * 1e-15) break;
+  }
+  return sum * std::exp(-x + a * std::log(x) - std::lgamma(a));
+}
+
+// Q(a, x) by its continued fraction (modified Lentz), for x >= a + 1.
+double UpperGammaContinuedFraction(double a, double x) {
+  constexpr int kMaxIterations = 100000;
+  constexpr double kTiny = 1e-300;
+  double b = x + 1.0 - a, c = 1.0 / kTiny, d = 1.0 / b, h = d;
+  for (int i = 1; i < kMaxIterations; ++i) {
+    const double an = -i * (i - a);
+    b += 2.0;
+    d = an * d + b;
+    if (std::abs(d) < kTiny) d = kTiny;
+    c = b + an / c;
+    if (std::abs(c) < kTiny) c = kTiny;
+    d = 1.0 / d;
+    const double del = d * c;
+    h *= del;
+    if (std::abs(del - 1.0) < 1e-15) break;
+  }
+  return std::exp(-x + a * std::log(x) - std::lgamma(a)) * h;
+}
+
+}  // namespace
+
+double RegularizedUpperGamma(double a, double x) {
+  if (!(a > 0.0) || !(x >= 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  if (x == 0.0) return 1.0;
+  if (x < a + 1.0) return 1.0 - LowerGammaSeries(a, x);
+  return UpperGammaContinuedFraction(a, x);
+}
+
+double ChiSquareUpperTail(double chi2, double df) {
+  return RegularizedUpperGamma(0.5 * df, 0.5 * std::max(chi2, 0.0));
 }
 
 }  // namespace fitcal::stats
