@@ -15,6 +15,24 @@ namespace {
 
 // Fewer intervals than this over all runs estimate no variance worth propagating.
 constexpr int kMinIntervals = 30;
+// The walk is estimated and propagated on ground-truth samples at least this far apart (less 10 %
+// for jitter). Shorter intervals see errors that do not accumulate but are correlated over a few
+// samples - an encoder period longer than the ground truth's, recorder jitter, a small latency -
+// and read them as walk: on the real differential drive (20 Hz ground truth) the heading walk per
+// second read 6.7e-5 rad^2 at 50 ms, 0.8-2.4e-5 at 0.1-0.8 s.
+constexpr double kMinIntervalS = 0.2;
+
+// The samples the walk is estimated and propagated on: the first, then each at least
+// kMinIntervalS after the previous one kept.
+std::vector<std::size_t> WalkGrid(const std::vector<double>& t_s) {
+  std::vector<std::size_t> grid;
+  if (t_s.empty()) return grid;
+  grid.push_back(0);
+  for (std::size_t j = 1; j < t_s.size(); ++j) {
+    if (t_s[j] - t_s[grid.back()] >= 0.9 * kMinIntervalS) grid.push_back(j);
+  }
+  return grid;
+}
 
 using Increment = std::array<double, 3>;
 
@@ -22,15 +40,17 @@ using Increment = std::array<double, 3>;
 // step error less what the heading error already there does to the step.
 std::vector<Increment> BodyIncrements(const TrackErrors& t) {
   std::vector<Increment> u;
-  for (std::size_t j = 1; j < t.error.size(); ++j) {
-    const Pose2d& g0 = t.ground_truth[j - 1];
+  const std::vector<std::size_t> grid = WalkGrid(t.t_s);
+  for (std::size_t m = 1; m < grid.size(); ++m) {
+    const std::size_t i = grid[m - 1], j = grid[m];
+    const Pose2d& g0 = t.ground_truth[i];
     const Pose2d& g1 = t.ground_truth[j];
-    const double e_theta = t.error[j - 1].theta;
-    const double px = t.error[j].x - t.error[j - 1].x + e_theta * (g1.y - g0.y);
-    const double py = t.error[j].y - t.error[j - 1].y - e_theta * (g1.x - g0.x);
+    const double e_theta = t.error[i].theta;
+    const double px = t.error[j].x - t.error[i].x + e_theta * (g1.y - g0.y);
+    const double py = t.error[j].y - t.error[i].y - e_theta * (g1.x - g0.x);
     const double c = std::cos(g0.theta), s = std::sin(g0.theta);
     u.push_back({c * px + s * py, -s * px + c * py,
-                 std::remainder(t.error[j].theta - t.error[j - 1].theta, 2.0 * M_PI)});
+                 std::remainder(t.error[j].theta - t.error[i].theta, 2.0 * M_PI)});
   }
   return u;
 }
@@ -194,16 +214,21 @@ Eigen::MatrixXd PropagateSensorNoise(const SensorNoise& noise, const TrackErrors
     }
     AddSource(axis == 2 ? s_theta : s_xy, a, &sigma);
   }
-  // The walk: interval k (samples k-1 to k) moves every error read at a sample j >= k.
-  for (std::size_t k = 1; k < g.size(); ++k) {
-    const double c0 = std::cos(g[k - 1].theta), s0 = std::sin(g[k - 1].theta);
+  // The walk: interval m of the grid (samples a to b) moves every error read at a sample j >= b,
+  // and a sample inside it by the fraction of the interval's time before it.
+  const std::vector<std::size_t> grid = WalkGrid(track.t_s);
+  for (std::size_t m = 1; m < grid.size(); ++m) {
+    const std::size_t ia = grid[m - 1], ib = grid[m];
+    const double c0 = std::cos(g[ia].theta), s0 = std::sin(g[ia].theta);
+    const double span = track.t_s[ib] - track.t_s[ia];
     for (int axis = 0; axis < 3; ++axis) {
       a.setZero();
       for (int c = 0; c < static_cast<int>(times.size()); ++c) {
         for (int h = 0; h < 2; ++h) {
           const std::size_t j = at[c].sample[h];
-          const double w = at[c].weight[h];
-          if (w == 0.0 || j < k) continue;
+          if (at[c].weight[h] == 0.0 || j <= ia) continue;
+          const double w =
+              at[c].weight[h] * (j >= ib ? 1.0 : (track.t_s[j] - track.t_s[ia]) / span);
           if (axis == 0) {
             a[3 * c + 0] += w * c0;
             a[3 * c + 1] += w * s0;
@@ -211,8 +236,8 @@ Eigen::MatrixXd PropagateSensorNoise(const SensorNoise& noise, const TrackErrors
             a[3 * c + 0] -= w * s0;
             a[3 * c + 1] += w * c0;
           } else {
-            a[3 * c + 0] -= w * (g[j].y - g[k].y);
-            a[3 * c + 1] += w * (g[j].x - g[k].x);
+            a[3 * c + 0] -= w * (g[j].y - g[ib].y);
+            a[3 * c + 1] += w * (g[j].x - g[ib].x);
             a[3 * c + 2] += w;
           }
         }
@@ -287,7 +312,7 @@ std::string FormatSensorFloor(const SensorNoise& noise, const SensorFloorTest& t
   std::snprintf(line, sizeof line,
                 "sensor noise floor (from the residual track's high frequencies, %d intervals): "
                 "ground truth %.2f mm / %.2f mm / %.3f deg, odometry walk %.2f mm / %.2f mm / "
-                "%.3f deg per interval (x / y body / heading, one sigma)\n",
+                "%.3f deg per interval of >= 0.2 s (x / y body / heading, one sigma)\n",
                 noise.num_intervals, 1e3 * std::sqrt(noise.ground_truth_var[0]),
                 1e3 * std::sqrt(noise.ground_truth_var[1]),
                 RadToDeg(std::sqrt(noise.ground_truth_var[2])),
@@ -307,6 +332,12 @@ std::string FormatSensorFloor(const SensorNoise& noise, const SensorFloorTest& t
                   "(%.0f df, p = %.2g that they scatter this much by the sensors' noise alone)\n",
                   test.repetition_ratio, test.repetition_df, test.repetition_p_above);
     out += line;
+    if (test.repetition_ratio < 0.5 && test.repetition_p_above > 0.999) {
+      out +=
+          "  (the floor is well above what the repetitions show: here the odometry's errors do not "
+          "accumulate as a random walk - e.g. errors periodic in the wheel revolution - and the "
+          "test against the floor is conservative)\n";
+    }
   }
   return out;
 }

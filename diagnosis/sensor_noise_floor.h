@@ -9,9 +9,10 @@
 //   - the ground truth's measurement noise n_j, white, variance s^2 per component: it enters
 //     every r_j once (with the opposite sign) and the start pose once (r_0 = 0);
 //   - the odometry's own noise (encoder quantisation and rate noise, random wheel slip), a random
-//     walk: body-frame increments w_k per ground-truth interval, variance q^2 per component (x,
-//     y, theta), each turned into the world by the heading of its interval, and each heading
-//     increment carried to position by the lever arm to every later sample.
+//     walk: body-frame increments w_k per interval of a grid of ground-truth samples at least
+//     0.2 s apart (kMinIntervalS in the .cc says why), variance q^2 per component (x, y, theta),
+//     each turned into the world by the heading of its interval, and each heading increment carried
+//     to position by the lever arm to every later sample.
 // The body-frame increments of the residual, u_k = R(theta_k-1)^T (dr_xy - e_theta J dg_xy) and
 // u_theta = dr_theta (dg the ground truth's step, J a quarter turn: the first term removes what an
 // existing heading error does to the step), are then w_k + n_k - n_k-1 + (the systematic part,
@@ -49,9 +50,9 @@ namespace fitcal {
 
 struct SensorNoise {
   bool available = false;  // needs a few intervals (kMinIntervals in the .cc)
-  int num_intervals = 0;
+  int num_intervals = 0;   // of the walk's grid, over all runs
   // Per component x, y (body frame) and theta: the ground truth's white noise s^2 (m^2, rad^2)
-  // and the odometry's random walk q^2 per ground-truth interval.
+  // and the odometry's random walk q^2 per interval of the walk's grid (header).
   std::array<double, 3> ground_truth_var{};
   std::array<double, 3> walk_var_per_interval{};
 };

@@ -42,7 +42,8 @@ std::vector<Pose2d> Petal(double dt, int samples) {
 // the body frame by the walk (x, y, theta), and is compared with a ground truth that carries
 // white noise; the replay starts at sample 0's measured pose. Composition is nonlinear, so the
 // Monte Carlo checks the linearised propagation too.
-TrackErrors Draw(const std::vector<Pose2d>& truth, const SensorNoise& noise, std::mt19937_64& rng) {
+TrackErrors Draw(const std::vector<Pose2d>& truth, const SensorNoise& noise, double dt,
+                 std::mt19937_64& rng) {
   std::normal_distribution<double> unit(0.0, 1.0);
   const auto gt_noise = [&](const Pose2d& p) {
     return Pose2d{p.x + std::sqrt(noise.ground_truth_var[0]) * unit(rng),
@@ -66,7 +67,7 @@ TrackErrors Draw(const std::vector<Pose2d>& truth, const SensorNoise& noise, std
       odo = {odo.x + co * bx - so * by, odo.y + so * bx + co * by, odo.theta + bt};
     }
     const Pose2d measured = j == 0 ? odo : gt_noise(truth[j]);
-    t.t_s.push_back(0.25 * static_cast<double>(j));
+    t.t_s.push_back(dt * static_cast<double>(j));
     t.ground_truth.push_back(measured);
     t.error.push_back({odo.x - measured.x, odo.y - measured.y, odo.theta - measured.theta});
   }
@@ -92,7 +93,7 @@ TEST(SensorNoiseFloor, EstimatorRecoversBothProcesses) {
   const std::vector<Pose2d> path = Petal(0.25, 25);
   std::mt19937_64 rng(11);
   std::vector<TrackErrors> tracks;
-  for (int r = 0; r < 2000; ++r) tracks.push_back(Draw(path, truth, rng));
+  for (int r = 0; r < 2000; ++r) tracks.push_back(Draw(path, truth, 0.25, rng));
   const SensorNoise est = EstimateSensorNoise(tracks);
   ASSERT_TRUE(est.available);
   EXPECT_EQ(est.num_intervals, 2000 * 24);
@@ -105,31 +106,52 @@ TEST(SensorNoiseFloor, EstimatorRecoversBothProcesses) {
   }
 }
 
-// The propagated covariance of the errors at four times (between samples, and the end) against
-// the empirical covariance of 4000 draws: each entry within 0.1 sqrt(C_ii C_jj) (the empirical
-// entries' standard error is about sqrt(2 / 4000) = 2.2 % of that scale; 0.1 is 4.5 of them). A
-// lever arm with the wrong sign, a missing start-pose term or a frame turned the wrong way moves
-// the position entries by tens of percent.
-TEST(SensorNoiseFloor, PropagationMatchesAMonteCarloOfTheReplay) {
-  const SensorNoise noise = Noise();
-  const std::vector<Pose2d> path = Petal(0.25, 25);
+// Ground truth every 50 ms: the walk is estimated on samples 0.2 s apart, so four 50 ms steps of
+// the walk make one of its intervals (q^2 read 4 times larger) and the white noise is unchanged.
+// 1500 runs x 30 grid intervals: standard errors as above on N = 45000 (1.5 % and 3.6 %), the
+// same tolerances.
+TEST(SensorNoiseFloor, EstimatorWorksOnIntervalsOfAtLeastTwoTenthsOfASecond) {
+  SensorNoise truth = Noise();
+  for (double& q : truth.walk_var_per_interval) q /= 4.0;
+  const std::vector<Pose2d> path = Petal(0.05, 121);
+  std::mt19937_64 rng(14);
+  std::vector<TrackErrors> tracks;
+  for (int r = 0; r < 1500; ++r) tracks.push_back(Draw(path, truth, 0.05, rng));
+  const SensorNoise est = EstimateSensorNoise(tracks);
+  ASSERT_TRUE(est.available);
+  EXPECT_EQ(est.num_intervals, 1500 * 30);
+  for (int c = 0; c < 3; ++c) {
+    SCOPED_TRACE(c);
+    const double q2 = 4.0 * truth.walk_var_per_interval[c];
+    EXPECT_NEAR(est.ground_truth_var[c], truth.ground_truth_var[c],
+                0.07 * truth.ground_truth_var[c]);
+    EXPECT_NEAR(est.walk_var_per_interval[c], q2, 0.2 * std::max(q2, truth.ground_truth_var[c]));
+  }
+}
+
+// One Monte Carlo case: ground truth every dt, the walk per dt step, `noise` as the propagation
+// reads it (the walk per interval of its 0.2 s grid).
+void ExpectPropagationMatchesMonteCarlo(double dt, const SensorNoise& drawn,
+                                        const SensorNoise& noise, std::uint64_t seed) {
+  const std::vector<Pose2d> path = Petal(dt, static_cast<int>(std::lround(6.0 / dt)) + 1);
   const std::vector<double> times = {1.1, 2.6, 4.3, 6.0};
   const double theta0 = 0.7;  // the start frame: any turn
-  std::mt19937_64 rng(12);
+  std::mt19937_64 rng(seed);
   constexpr int kDraws = 4000;
   Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(12, 12);
   Eigen::VectorXd mean = Eigen::VectorXd::Zero(12);
   std::vector<Eigen::VectorXd> samples;
   TrackErrors shape;
   for (int d = 0; d < kDraws; ++d) {
-    const TrackErrors t = Draw(path, noise, rng);
+    const TrackErrors t = Draw(path, drawn, dt, rng);
     if (d == 0) shape = t;
     Eigen::VectorXd v(12);
     for (int c = 0; c < 4; ++c) {
-      const double u = times[c] / 0.25;
-      const std::size_t lo = std::min<std::size_t>(static_cast<std::size_t>(u), t.error.size() - 1);
+      const double u = times[c] / dt;
+      const std::size_t lo =
+          std::min<std::size_t>(static_cast<std::size_t>(u + 1e-9), t.error.size() - 1);
       const std::size_t hi = std::min(lo + 1, t.error.size() - 1);
-      const double w = u - static_cast<double>(lo);
+      const double w = std::max(0.0, u - static_cast<double>(lo));
       const Pose2d e{(1 - w) * t.error[lo].x + w * t.error[hi].x,
                      (1 - w) * t.error[lo].y + w * t.error[hi].y,
                      (1 - w) * t.error[lo].theta + w * t.error[hi].theta};
@@ -151,6 +173,20 @@ TEST(SensorNoiseFloor, PropagationMatchesAMonteCarloOfTheReplay) {
       EXPECT_NEAR(predicted(i, j), empirical(i, j), 0.1 * scale) << i << ", " << j;
     }
   }
+}
+
+// The propagated covariance of the errors at four times (between samples, and the end) against
+// the empirical covariance of 4000 draws: each entry within 0.1 sqrt(C_ii C_jj) (the empirical
+// entries' standard error is about sqrt(2 / 4000) = 2.2 % of that scale; 0.1 is 4.5 of them). A
+// lever arm with the wrong sign, a missing start-pose term or a frame turned the wrong way moves
+// the position entries by tens of percent. With ground truth every 0.25 s the grid is every
+// sample; every 50 ms it is every fourth, and times inside a grid interval take its walk in
+// proportion to time.
+TEST(SensorNoiseFloor, PropagationMatchesAMonteCarloOfTheReplay) {
+  ExpectPropagationMatchesMonteCarlo(0.25, Noise(), Noise(), 12);
+  SensorNoise per_step = Noise();
+  for (double& q : per_step.walk_var_per_interval) q /= 4.0;
+  ExpectPropagationMatchesMonteCarlo(0.05, per_step, Noise(), 15);
 }
 
 // Residuals drawn from the floor read about 1 times it and pass; the same residuals 1.5 times
