@@ -167,21 +167,14 @@ SensorNoise EstimateSensorNoise(const std::vector<TrackErrors>& tracks) {
   return noise;
 }
 
-Eigen::MatrixXd PropagateSensorNoise(const SensorNoise& noise, const TrackErrors& track,
-                                     const std::vector<double>& times, double theta0) {
-  const int rows = 3 * static_cast<int>(times.size());
-  Eigen::MatrixXd sigma = Eigen::MatrixXd::Zero(rows, rows);
-  if (track.t_s.empty()) return sigma;
-  std::vector<Interpolation> at;
-  for (double t : times) at.push_back(At(track, t));
-  const std::vector<Pose2d>& g = track.ground_truth;
-  // The ground truth's position noise, taken as isotropic (the body axes' mean).
-  const double s_xy = 0.5 * (noise.ground_truth_var[0] + noise.ground_truth_var[1]);
-  const double s_theta = noise.ground_truth_var[2];
-  Eigen::VectorXd a(rows);
-  // Sample j's own noise, -n_j, where a time reads sample j (the start's, j = 0, is below).
+namespace {
+
+// Sample j's own noise, -n_j, where a time reads sample j (the start's, j = 0, is AddStartNoise's).
+void AddGroundTruthNoise(double s_xy, double s_theta, const std::vector<Interpolation>& at,
+                         Eigen::MatrixXd* sigma) {
+  Eigen::VectorXd a(sigma->rows());
   std::map<std::size_t, std::vector<std::pair<int, double>>> readers;  // sample -> (time, weight)
-  for (int c = 0; c < static_cast<int>(times.size()); ++c) {
+  for (int c = 0; c < static_cast<int>(at.size()); ++c) {
     for (int h = 0; h < 2; ++h) {
       if (at[c].weight[h] != 0.0) readers[at[c].sample[h]].push_back({c, at[c].weight[h]});
     }
@@ -191,14 +184,19 @@ Eigen::MatrixXd PropagateSensorNoise(const SensorNoise& noise, const TrackErrors
       if (j == 0) continue;
       a.setZero();
       for (const auto& [c, w] : list) a[3 * c + axis] -= w;
-      AddSource(axis == 2 ? s_theta : s_xy, a, &sigma);
+      AddSource(axis == 2 ? s_theta : s_xy, a, sigma);
     }
   }
-  // The start: the replay begins at sample 0's measured pose, so n_0 moves every later error
-  // (its heading through the lever arm to the sample) and cancels at sample 0 itself.
+}
+
+// The start: the replay begins at sample 0's measured pose, so n_0 moves every later error (its
+// heading through the lever arm to the sample) and cancels at sample 0 itself.
+void AddStartNoise(double s_xy, double s_theta, const std::vector<Pose2d>& g,
+                   const std::vector<Interpolation>& at, Eigen::MatrixXd* sigma) {
+  Eigen::VectorXd a(sigma->rows());
   for (int axis = 0; axis < 3; ++axis) {
     a.setZero();
-    for (int c = 0; c < static_cast<int>(times.size()); ++c) {
+    for (int c = 0; c < static_cast<int>(at.size()); ++c) {
       for (int h = 0; h < 2; ++h) {
         const std::size_t j = at[c].sample[h];
         const double w = at[c].weight[h];
@@ -212,10 +210,16 @@ Eigen::MatrixXd PropagateSensorNoise(const SensorNoise& noise, const TrackErrors
         }
       }
     }
-    AddSource(axis == 2 ? s_theta : s_xy, a, &sigma);
+    AddSource(axis == 2 ? s_theta : s_xy, a, sigma);
   }
-  // The walk: interval m of the grid (samples a to b) moves every error read at a sample j >= b,
-  // and a sample inside it by the fraction of the interval's time before it.
+}
+
+// The walk: interval m of the grid (samples a to b) moves every error read at a sample j >= b,
+// and a sample inside it by the fraction of the interval's time before it.
+void AddWalk(const SensorNoise& noise, const TrackErrors& track,
+             const std::vector<Interpolation>& at, Eigen::MatrixXd* sigma) {
+  Eigen::VectorXd a(sigma->rows());
+  const std::vector<Pose2d>& g = track.ground_truth;
   const std::vector<std::size_t> grid = WalkGrid(track.t_s);
   for (std::size_t m = 1; m < grid.size(); ++m) {
     const std::size_t ia = grid[m - 1], ib = grid[m];
@@ -223,7 +227,7 @@ Eigen::MatrixXd PropagateSensorNoise(const SensorNoise& noise, const TrackErrors
     const double span = track.t_s[ib] - track.t_s[ia];
     for (int axis = 0; axis < 3; ++axis) {
       a.setZero();
-      for (int c = 0; c < static_cast<int>(times.size()); ++c) {
+      for (int c = 0; c < static_cast<int>(at.size()); ++c) {
         for (int h = 0; h < 2; ++h) {
           const std::size_t j = at[c].sample[h];
           if (at[c].weight[h] == 0.0 || j <= ia) continue;
@@ -242,9 +246,26 @@ Eigen::MatrixXd PropagateSensorNoise(const SensorNoise& noise, const TrackErrors
           }
         }
       }
-      AddSource(noise.walk_var_per_interval[axis], a, &sigma);
+      AddSource(noise.walk_var_per_interval[axis], a, sigma);
     }
   }
+}
+
+}  // namespace
+
+Eigen::MatrixXd PropagateSensorNoise(const SensorNoise& noise, const TrackErrors& track,
+                                     const std::vector<double>& times, double theta0) {
+  const int rows = 3 * static_cast<int>(times.size());
+  Eigen::MatrixXd sigma = Eigen::MatrixXd::Zero(rows, rows);
+  if (track.t_s.empty()) return sigma;
+  std::vector<Interpolation> at;
+  for (double t : times) at.push_back(At(track, t));
+  // The ground truth's position noise, taken as isotropic (the body axes' mean).
+  const double s_xy = 0.5 * (noise.ground_truth_var[0] + noise.ground_truth_var[1]);
+  const double s_theta = noise.ground_truth_var[2];
+  AddGroundTruthNoise(s_xy, s_theta, at, &sigma);
+  AddStartNoise(s_xy, s_theta, track.ground_truth, at, &sigma);
+  AddWalk(noise, track, at, &sigma);
   // Into the start frame: every position pair turned by -theta0.
   Eigen::MatrixXd turn = Eigen::MatrixXd::Identity(rows, rows);
   const double c = std::cos(theta0), s = std::sin(theta0);
