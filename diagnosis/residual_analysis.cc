@@ -441,8 +441,8 @@ ResidualAnalysis AnalyzeResiduals(const RobotModelInterface& robot_model,
       const auto& c = run.contexts[k];
       double accel = 0.0, dir = 0.0;
       for (int w = 0; w < c.num_channels; ++w) {
-        if (c.IsWheel(w) && std::abs(c.accel_rad_s2[w]) > std::abs(accel)) {
-          accel = c.accel_rad_s2[w];
+        if (c.IsWheel(w) && std::abs(c.accel_rad_s2(w)) > std::abs(accel)) {
+          accel = c.accel_rad_s2(w);
           dir = run.aligned.samples[k].value[w];
         }
       }

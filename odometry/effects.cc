@@ -234,14 +234,14 @@ std::vector<SampleContext> MakeSampleContexts(const EncoderSamples& samples, uns
         const auto angle_at = [&](double time) { return InterpolateAt(t, cumulative[i], time); };
         const double ahead = (angle_at(mid[k] + h) - angle_at(mid[k])) / h;
         const double behind = (angle_at(mid[k]) - angle_at(mid[k] - h)) / h;
-        c.accel_rad_s2[i] = (ahead - behind) / h;
+        c.derivative[i] = (ahead - behind) / h;
         c.moving = c.moving || std::abs(samples[k].value[i]) > kMovingRateRadS;
       } else {
         c.angle_rad[i] = value[i][k];
-        c.angle_rate_rad_s[i] = n < 2 ? 0.0
-                                      : (InterpolateAt(mid, value[i], mid[k] + h) -
-                                         InterpolateAt(mid, value[i], mid[k] - h)) /
-                                            (2.0 * h);
+        c.derivative[i] = n < 2 ? 0.0
+                                : (InterpolateAt(mid, value[i], mid[k] + h) -
+                                   InterpolateAt(mid, value[i], mid[k] - h)) /
+                                      (2.0 * h);
       }
     }
   }

@@ -54,23 +54,27 @@ enum class EffectId : int {
 inline constexpr int kNumEffects = static_cast<int>(EffectId::kCount);
 inline constexpr int kMaxEffectParameters = 2;
 
-// The most channels an effect replay handles (the omni model's eight wheels).
-inline constexpr int kMaxEffectChannels = 8;
+// The most channels an effect replay handles: an ASOC base of four castors (three channels each),
+// the omni model's eight wheels.
+inline constexpr int kMaxEffectChannels = 12;
 
 // What an effect may look at for one encoder interval (data only, computed once per run by
 // MakeSampleContexts). Times from the start of the replay window. Per channel i:
-//   wheel-rate channel: angle_rad = encoder angle since the window start at t_s, accel_rad_s2 =
-//     smoothed wheel acceleration (see below);
-//   angle channel (steering): angle_rad = the measured angle of the interval, angle_rate_rad_s =
-//     its smoothed rate of change.
+//   wheel-rate channel: angle_rad = encoder angle since the window start at t_s, accel_rad_s2(i)
+//     = smoothed wheel acceleration (see below);
+//   angle channel (steering, castor pivot): angle_rad = the measured angle of the interval,
+//     angle_rate_rad_s(i) = its smoothed rate of change.
+// A channel is one or the other, so the two derivatives share one array: two arrays of 12 doubles
+// per sample (as three of 8 did), for every sample of every run of every model.
 struct SampleContext {
   double t_s = 0.0;  // start of the interval
   double dt_s = 0.0;
   int num_channels = 3;
   unsigned wheel_mask = 0x7;  // bit i set: channel i is a wheel rate
   double angle_rad[kMaxEffectChannels] = {};
-  double accel_rad_s2[kMaxEffectChannels] = {};
-  double angle_rate_rad_s[kMaxEffectChannels] = {};
+  double derivative[kMaxEffectChannels] = {};  // accel_rad_s2 or angle_rate_rad_s, by the mask
+  double accel_rad_s2(int i) const { return derivative[i]; }
+  double angle_rate_rad_s(int i) const { return derivative[i]; }
   bool moving = false;  // any wheel turning faster than kMovingRate
   bool IsWheel(int i) const { return (wheel_mask >> i) & 1u; }
 };
@@ -165,7 +169,7 @@ struct AccelerationSlip {
   template <typename T>
   static void Rates(const T* q, const SampleContext& c, T* w) {
     for (int i = 0; i < c.num_channels; ++i) {
-      if (c.IsWheel(i)) w[i] = w[i] * (T(1.0) - q[0] * T(std::abs(c.accel_rad_s2[i])));
+      if (c.IsWheel(i)) w[i] = w[i] * (T(1.0) - q[0] * T(std::abs(c.accel_rad_s2(i))));
     }
   }
 };
@@ -302,7 +306,7 @@ struct SteeringLag {
   template <typename T>
   static void Rates(const T* q, const SampleContext& c, T* w) {
     for (int i = 0; i < c.num_channels; ++i) {
-      if (!c.IsWheel(i)) w[i] = w[i] + q[0] * T(c.angle_rate_rad_s[i]);
+      if (!c.IsWheel(i)) w[i] = w[i] + q[0] * T(c.angle_rate_rad_s(i));
     }
   }
 };

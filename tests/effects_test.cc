@@ -155,8 +155,26 @@ TEST(SampleContexts, AccelerationOfARamp) {
     s[k].value[0] = 5.0 * 0.01 * (static_cast<double>(k) + 0.5);  // 5 rad/s^2
   }
   const auto c = effects::MakeSampleContexts(s);
-  EXPECT_NEAR(c[50].accel_rad_s2[0], 5.0, 1e-9);
+  EXPECT_NEAR(c[50].accel_rad_s2(0), 5.0, 1e-9);
   EXPECT_NEAR(c[50].angle_rad[0], 0.5 * 5.0 * 0.5 * 0.5, 1e-12);
+}
+
+// Up to kMaxEffectChannels channels (an ASOC base of four castors); one more is refused.
+TEST(SampleContexts, TwelveChannelsAndNoMore) {
+  for (int channels : {9, effects::kMaxEffectChannels}) {
+    EncoderSamples s(channels);
+    s.resize(10);
+    for (std::size_t k = 0; k < s.size(); ++k) {
+      s[k].dt_s = 0.01;
+      for (int i = 0; i < channels; ++i) s[k].value[i] = 1.0 + i;
+    }
+    const auto c = effects::MakeSampleContexts(s);
+    // Channel i turns at 1 + i rad/s: its angle at the start of interval 5 is 0.05 (1 + i) rad.
+    EXPECT_NEAR(c[5].angle_rad[channels - 1], 0.05 * channels, 1e-12);
+  }
+  EncoderSamples too_many(effects::kMaxEffectChannels + 1);
+  too_many.resize(2);
+  EXPECT_THROW(effects::MakeSampleContexts(too_many), std::invalid_argument);
 }
 
 // Golden values: R's pt(2.228, 10, lower = FALSE) = 0.02500 and pf(3.708, 3, 10, lower = FALSE)

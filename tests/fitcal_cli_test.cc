@@ -340,6 +340,14 @@ TEST(FitcalCli, AsocDataSetGoesThroughTheGenericCommands) {
                 "compare --logs " + data + " --methods ceres --repetitions 1 --no-output --quiet");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("asoc-geometric"), std::string::npos) << r.out;
+
+  // diagnose: nine channels (three per castor) through the effect replay, the residual analysis
+  // and the sensor floor (no candidate traced here: --max-effects 0 keeps the test short).
+  const std::string diag = dir.Path("diag");
+  r = RunFitcal(dir, "diagnose --logs " + data + " --out " + diag + " --max-effects 0");
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(ReadFileBytes(diag + "/diagnose.md").find("sensor noise floor"), std::string::npos);
+  EXPECT_EQ(YAML::LoadFile(diag + "/calibrated.yaml")["model"].as<std::string>(), "asoc");
 }
 
 TEST(FitcalCli, BadInputGivesOneLineAndWritesNothing) {

@@ -190,7 +190,7 @@ SimulatedRun SimulateRun(const Omni3SimulationOptions& o, const MotionCommand& c
       c.dt_s = h;
       for (int i = 0; i < 3; ++i) {
         c.angle_rad[i] = wheel_angle[i];
-        c.accel_rad_s2[i] = wheel_accel[i];
+        c.derivative[i] = wheel_accel[i];
         c.moving = c.moving || std::abs(wheel_rate[i]) > effects::kMovingRateRadS;
       }
       effects::ApplyRateEffects(active, c, contact.data());
