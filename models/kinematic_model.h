@@ -36,29 +36,13 @@
 #include <vector>
 
 #include "fit/pose_errors.h"
+#include "models/final_pose_jacobian.h"
 #include "models/model_interface.h"
+#include "models/replay_kinematics.h"
 #include "odometry/aligned_run.h"
 #include "odometry/replay.h"
 
 namespace fitcal {
-
-// Replays samples [begin, end) with the kinematics K at parameters p.
-template <class K, typename T, typename Visitor = replay_internal::NoVisit>
-Pose2<T> ReplayKinematics(const K& kinematics, const T* p, const EncoderSamples& samples,
-                          std::size_t begin, std::size_t end, const Pose2<T>& start,
-                          Visitor&& visit = Visitor()) {
-  const auto prepared = kinematics.Prepare(p);
-  const auto step = [&kinematics, &prepared ](const double* values, double dt, T* dx, T* dy,
-                                              T* dtheta) __attribute__((always_inline)) {
-    kinematics.BodyStep(prepared, values, dt, dx, dy, dtheta);
-  };
-  return ReplaySteps(step, samples, begin, end, start, std::forward<Visitor>(visit));
-}
-template <class K, typename T, typename Visitor = replay_internal::NoVisit>
-Pose2<T> ReplayKinematics(const T* p, const EncoderSamples& samples, std::size_t begin,
-                          std::size_t end, const Pose2<T>& start, Visitor&& visit = Visitor()) {
-  return ReplayKinematics(K(), p, samples, begin, end, start, std::forward<Visitor>(visit));
-}
 
 // Palacin Eq. 14 residual of one run for the kinematics K.
 template <class K>
@@ -184,7 +168,11 @@ class KinematicModel : public RobotModelInterface {
   ceres::CostFunction* FinalPoseCost(const AlignedRun& run,
                                      const ResidualWeights& weights) const override {
     CheckChannels(run.samples);
-    return ModelFinalPoseResidual<K>::Create(run, weights, kinematics_);
+    if constexpr (FinalPoseJacobianKindOf<K>::value == FinalPoseJacobianKind::kAutodiff) {
+      return ModelFinalPoseResidual<K>::Create(run, weights, kinematics_);
+    } else {
+      return new FinalPoseJacobianCost<K>(run, weights, kinematics_);
+    }
   }
 
   ceres::CostFunction* SegmentCost(const AlignedRun& run, const std::vector<Segment>& segments,

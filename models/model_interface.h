@@ -83,6 +83,15 @@ class PreparedKinematics {
   // values (robot().channels order), as the plain replay computes it.
   virtual void Step(const T* values, double dt, T* dx, T* dy, T* dtheta) const = 0;
 };
+// How a model's final-pose cost gets its Jacobian (models/final_pose_jacobian.h). A kinematics K
+// (kinematic_model.h) declares `static constexpr FinalPoseJacobianKind kFinalPoseJacobianKind`;
+// without it Ceres differentiates the whole replay in Jets.
+enum class FinalPoseJacobianKind {
+  kAutodiff,          // ceres::Jet through every sample of the replay
+  kPerSampleStep,     // Jets on each body step only; the poses are integrated in double
+  kLinearInChannels,  // the step is dt M(p) w: dM/dp once per evaluation, sums over the channels
+};
+
 // The scalar of the effect fit's dynamic autodiff (diagnosis/effect_fit.cc differentiates four
 // parameters per pass).
 using EffectJet = ceres::Jet<double, 4>;

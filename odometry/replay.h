@@ -123,6 +123,16 @@ struct NoVisit {
 
 }  // namespace replay_internal
 
+// A visitor that also wants every step as the replay applies it derives from StepVisitor and
+// provides Step(k, c, s, dx, dy, dtheta): sample k's body-frame step and the unit vector
+// (c, s) = (cos, sin) of the heading before it, exactly the values the replay rotates the step
+// with. The replay then goes one sample at a time, as it does on Jets, so its poses equal the real
+// parts of a Jet replay's (the analytic final-pose Jacobian, models/final_pose_jacobian.h).
+struct StepVisitor {
+  template <typename T>
+  void operator()(std::size_t, const Pose2<T>&) const {}
+};
+
 // Replays samples [begin, end) from `start`. body_step(values, dt, &dx, &dy, &dtheta) gives the
 // body-frame step of one interval from its channel values (model-specific). Calls
 // visit(k, pose after sample k) for every sample. Returns the final pose.
@@ -155,7 +165,8 @@ Pose2<T> ReplaySteps(const BodyStep& body_step, const EncoderSamples& samples, s
     // (the pose between them uses (c1, s1)). Jets are throughput-bound: there the extra products
     // would cost more than they save, so they go one sample at a time.
     std::size_t j = 0;
-    constexpr bool kPairSamples = std::is_same_v<T, double>;
+    constexpr bool kWantsSteps = std::is_base_of_v<StepVisitor, std::decay_t<Visitor>>;
+    constexpr bool kPairSamples = std::is_same_v<T, double> && !kWantsSteps;
     for (; kPairSamples && j + 1 < m; j += 2) {
       x += c * step_x[j] - s * step_y[j];
       y += s * step_x[j] + c * step_y[j];
@@ -174,6 +185,7 @@ Pose2<T> ReplaySteps(const BodyStep& body_step, const EncoderSamples& samples, s
       c = c2;
     }
     for (; j < m; ++j) {
+      if constexpr (kWantsSteps) visit.Step(k0 + j, c, s, step_x[j], step_y[j], step_theta[j]);
       x += c * step_x[j] - s * step_y[j];
       y += s * step_x[j] + c * step_y[j];
       theta += step_theta[j];

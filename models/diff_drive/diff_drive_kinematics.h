@@ -67,6 +67,10 @@ struct DiffDriveKinematicsT {
   static constexpr int kNumChannels = diff_drive::kNumWheels;
   static constexpr int kRight = kRightChannel;
   static constexpr int kLeft = 1 - kRightChannel;
+  // The chord makes the step nonlinear in the rates: Jets on each step, poses in double
+  // (models/final_pose_jacobian.h).
+  static constexpr FinalPoseJacobianKind kFinalPoseJacobianKind =
+      FinalPoseJacobianKind::kPerSampleStep;
 
   template <typename T>
   struct Prepared {

@@ -86,6 +86,10 @@ struct OmniKinematics {
   static constexpr int kDistanceIndex = 0;   // R_1..R_N
   static constexpr int kRadiusIndex = N;     // r_1..r_N
   static constexpr int kAngleIndex = 2 * N;  // delta_1..delta_N
+  // The body step F w dt is linear in the rates: analytic final-pose Jacobian
+  // (models/final_pose_jacobian.h).
+  static constexpr FinalPoseJacobianKind kFinalPoseJacobianKind =
+      FinalPoseJacobianKind::kLinearInChannels;
 
   template <typename T>
   using KinematicMatrixT = Eigen::Matrix<T, N, 3>;  // J: w = J v

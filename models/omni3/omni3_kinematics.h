@@ -13,6 +13,10 @@ namespace fitcal {
 struct Omni3Kinematics {
   static constexpr int kNumParameters = omni3::kNumParameters;
   static constexpr int kNumChannels = omni3::kNumWheels;
+  // The body step M^-1 w dt (Eq. 4) is linear in the rates: analytic final-pose Jacobian
+  // (models/final_pose_jacobian.h).
+  static constexpr FinalPoseJacobianKind kFinalPoseJacobianKind =
+      FinalPoseJacobianKind::kLinearInChannels;
 
   template <typename T>
   static omni3::Matrix3<T> Prepare(const T* p) {

@@ -1,0 +1,206 @@
+#pragma once
+// The final-pose residual (Palacin Eq. 14) of one run with an analytic Jacobian, for kinematics
+// that declare how (FinalPoseJacobianKind in model_interface.h). Same residuals as the autodiff
+// ModelFinalPoseResidual (kinematic_model.h), same Jacobian to rounding
+// (tests/final_pose_jacobian_test.cc); far cheaper, because Ceres' autodiff carries a Jet of all P
+// parameters through every sample of the replay.
+//
+// The replay (odometry/replay.h, Palacin Eq. 4 and 5) moves the pose by the body step
+// (dx_k, dy_k, dtheta_k) = S(p, w_k, dt_k), rotated by the heading before it, c_k = cos theta_k,
+// s_k = sin theta_k:
+//   x_N = x_0 + sum_k (c_k dx_k - s_k dy_k),  y_N = y_0 + sum_k (s_k dx_k + c_k dy_k),
+//   theta_N = theta_0 + sum_k dtheta_k.
+// The start pose is the ground truth's and does not depend on p. With G_k = dS/dp (3 x P) and
+// T_k = dtheta_k/dp = sum_{j<k} G_j,theta the heading's derivative before step k, the chain rule
+// (d c_k = -s_k T_k, d s_k = c_k T_k) gives
+//   dx_N/dp = sum_k (c_k G_kx - s_k G_ky - Dy_k T_k),   Dy_k = s_k dx_k + c_k dy_k,
+//   dy_N/dp = sum_k (s_k G_kx + c_k G_ky + Dx_k T_k),   Dx_k = c_k dx_k - s_k dy_k,
+//   dtheta_N/dp = sum_k G_k,theta,
+// with (Dx_k, Dy_k) the world-frame step. The poses and (c_k, s_k) are the replay's own (a
+// StepVisitor of ReplaySteps), so the residuals are the autodiff path's bit for bit.
+//
+// kPerSampleStep: G_k from a Jet of the body step alone; O(P) doubles per sample after it.
+// kLinearInChannels: the step is S = dt_k M(p) w_k with M 3 x n, so G_k = dt_k (dM/dp) w_k and
+// T_k = (dM_theta/dp) W_k with W_k = sum_{j<k} dt_j w_j. The sums over k then run over the n
+// channels instead of the P parameters:
+//   dx_N/dp = dM_x/dp . A_c - dM_y/dp . A_s - dM_theta/dp . B_y,
+//   dy_N/dp = dM_x/dp . A_s + dM_y/dp . A_c + dM_theta/dp . B_x,
+//   dtheta_N/dp = dM_theta/dp . W_N,
+// A_c = sum_k c_k dt_k w_k, A_s = sum_k s_k dt_k w_k, B_x = sum_k Dx_k W_k, B_y = sum_k Dy_k W_k,
+// and M, dM/dp are computed once per evaluation (Jets on the 3 x n matrix).
+
+#include <ceres/jet.h>
+#include <ceres/sized_cost_function.h>
+
+#include <array>
+#include <cstddef>
+#include <type_traits>
+
+#include "fit/pose_errors.h"
+#include "models/model_interface.h"
+#include "models/replay_kinematics.h"
+#include "odometry/aligned_run.h"
+#include "odometry/replay.h"
+
+namespace fitcal {
+
+// K::kFinalPoseJacobianKind, kAutodiff when K does not declare it.
+template <class K, class = void>
+struct FinalPoseJacobianKindOf
+    : std::integral_constant<FinalPoseJacobianKind, FinalPoseJacobianKind::kAutodiff> {};
+template <class K>
+struct FinalPoseJacobianKindOf<K, std::void_t<decltype(K::kFinalPoseJacobianKind)>>
+    : std::integral_constant<FinalPoseJacobianKind, K::kFinalPoseJacobianKind> {};
+
+namespace final_pose_jacobian_internal {
+
+template <int P>
+using Row = std::array<double, P>;
+
+// Accumulates dx_N/dp, dy_N/dp, dtheta_N/dp with a Jet of each body step (kPerSampleStep).
+template <class K, typename Prepared>
+class PerSampleSums : public StepVisitor {
+ public:
+  static constexpr int P = K::kNumParameters;
+  using JetP = ceres::Jet<double, P>;
+
+  PerSampleSums(const K& kinematics, const Prepared& prepared_jet, const EncoderSamples& samples)
+      : kinematics_(kinematics),
+        prepared_jet_(prepared_jet),
+        rows_(samples.data()),
+        stride_(static_cast<std::size_t>(samples.stride())) {}
+
+  void Step(std::size_t k, double c, double s, double dx, double dy, double /*dtheta*/) {
+    const double* row = rows_ + k * stride_;
+    JetP gx, gy, gt;
+    kinematics_.BodyStep(prepared_jet_, row + 1, row[0], &gx, &gy, &gt);
+    const double world_dx = c * dx - s * dy;
+    const double world_dy = s * dx + c * dy;
+    for (int j = 0; j < P; ++j) {
+      d_x[j] += c * gx.v[j] - s * gy.v[j] - world_dy * d_theta[j];
+      d_y[j] += s * gx.v[j] + c * gy.v[j] + world_dx * d_theta[j];
+      d_theta[j] += gt.v[j];
+    }
+  }
+
+  Row<P> d_x{}, d_y{}, d_theta{};  // derivatives of the pose after the last visited step
+
+ private:
+  const K& kinematics_;
+  const Prepared& prepared_jet_;
+  const double* rows_;
+  std::size_t stride_;
+};
+
+// The channel sums A_c, A_s, B_x, B_y, W of kLinearInChannels.
+template <int N>
+class ChannelSums : public StepVisitor {
+ public:
+  explicit ChannelSums(const EncoderSamples& samples)
+      : rows_(samples.data()), stride_(static_cast<std::size_t>(samples.stride())) {}
+
+  void Step(std::size_t k, double c, double s, double dx, double dy, double /*dtheta*/) {
+    const double* row = rows_ + k * stride_;
+    const double dt = row[0];
+    const double world_dx = c * dx - s * dy;
+    const double world_dy = s * dx + c * dy;
+    for (int i = 0; i < N; ++i) {
+      const double u = dt * row[1 + i];
+      a_c[i] += c * u;
+      a_s[i] += s * u;
+      b_x[i] += world_dx * w[i];
+      b_y[i] += world_dy * w[i];
+      w[i] += u;
+    }
+  }
+
+  std::array<double, N> a_c{}, a_s{}, b_x{}, b_y{}, w{};
+
+ private:
+  const double* rows_;
+  std::size_t stride_;
+};
+
+}  // namespace final_pose_jacobian_internal
+
+template <class K>
+class FinalPoseJacobianCost final : public ceres::SizedCostFunction<3, K::kNumParameters> {
+ public:
+  static constexpr int P = K::kNumParameters;
+  static constexpr FinalPoseJacobianKind kKind = FinalPoseJacobianKindOf<K>::value;
+  static_assert(kKind != FinalPoseJacobianKind::kAutodiff, "K has no analytic final-pose Jacobian");
+  using JetP = ceres::Jet<double, P>;
+  using Row = final_pose_jacobian_internal::Row<P>;
+
+  FinalPoseJacobianCost(const AlignedRun& run, const ResidualWeights& weights, const K& kinematics)
+      : run_(run), weights_(weights), kinematics_(kinematics) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const double* p = parameters[0];
+    if (jacobians == nullptr || jacobians[0] == nullptr) {
+      // The plain replay, as the autodiff functor runs on double.
+      FinalPoseError(
+          ReplayKinematics(kinematics_, p, run_.samples, 0, run_.samples.size(), run_.start),
+          run_.final_ground_truth, weights_, residuals);
+      return true;
+    }
+    std::array<Row, 3> d{};
+    FinalPoseError(ReplayWithDerivatives(p, &d), run_.final_ground_truth, weights_, residuals);
+    // residual = (pose - ground truth) / sigma; the heading's wrap has derivative 1.
+    const double inv_sigma[3] = {1.0 / weights_.position_sigma_m, 1.0 / weights_.position_sigma_m,
+                                 1.0 / weights_.heading_sigma_rad};
+    for (int r = 0; r < 3; ++r) {
+      for (int j = 0; j < P; ++j) jacobians[0][r * P + j] = d[r][j] * inv_sigma[r];
+    }
+    return true;
+  }
+
+ private:
+  Pose2d ReplayWithDerivatives(const double* p, std::array<Row, 3>* d) const {
+    std::array<JetP, P> p_jet;
+    for (int j = 0; j < P; ++j) p_jet[j] = JetP(p[j], j);
+    const auto prepared_jet = kinematics_.Prepare(p_jet.data());
+    const std::size_t n = run_.samples.size();
+    if constexpr (kKind == FinalPoseJacobianKind::kPerSampleStep) {
+      final_pose_jacobian_internal::PerSampleSums<K, decltype(prepared_jet)> sums(
+          kinematics_, prepared_jet, run_.samples);
+      const Pose2d final_pose =
+          ReplayKinematics(kinematics_, p, run_.samples, 0, n, run_.start, sums);
+      *d = {sums.d_x, sums.d_y, sums.d_theta};
+      return final_pose;
+    } else {
+      constexpr int N = K::kNumChannels;
+      // Column i of M and of dM/dp: the step of a unit rate on channel i over 1 s (the step is
+      // linear in the rates, so this is exact).
+      std::array<std::array<JetP, 3>, N> m;
+      for (int i = 0; i < N; ++i) {
+        std::array<double, N> unit{};
+        unit[i] = 1.0;
+        kinematics_.BodyStep(prepared_jet, unit.data(), 1.0, &m[i][0], &m[i][1], &m[i][2]);
+      }
+      final_pose_jacobian_internal::ChannelSums<N> sums(run_.samples);
+      const Pose2d final_pose =
+          ReplayKinematics(kinematics_, p, run_.samples, 0, n, run_.start, sums);
+      for (int j = 0; j < P; ++j) {
+        double dx = 0.0, dy = 0.0, dtheta = 0.0;
+        for (int i = 0; i < N; ++i) {
+          const double mx = m[i][0].v[j], my = m[i][1].v[j], mt = m[i][2].v[j];
+          dx += mx * sums.a_c[i] - my * sums.a_s[i] - mt * sums.b_y[i];
+          dy += mx * sums.a_s[i] + my * sums.a_c[i] + mt * sums.b_x[i];
+          dtheta += mt * sums.w[i];
+        }
+        (*d)[0][j] = dx;
+        (*d)[1][j] = dy;
+        (*d)[2][j] = dtheta;
+      }
+      return final_pose;
+    }
+  }
+
+  const AlignedRun& run_;
+  ResidualWeights weights_;
+  K kinematics_;
+};
+
+}  // namespace fitcal

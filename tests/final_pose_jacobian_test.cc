@@ -1,0 +1,209 @@
+// The analytic final-pose cost (models/final_pose_jacobian.h) against the autodiff one it replaces
+// (ModelFinalPoseResidual, kinematic_model.h): same residuals and Jacobians, for every kind of
+// analytic path (omni3, the omni model on 3 omni and 4 mecanum wheels: linear in the rates;
+// diff drive with either wheel first: Jets per step), on simulated runs (constant twists) and
+// real-like ones (noisy 10 ms rates with jittered intervals, rests, turns of several revolutions,
+// thousands of samples across the replay's re-anchoring).
+//
+// Tolerance. Both paths replay the same poses (the analytic one visits the replay's own steps),
+// so the residuals agree to rounding of the final subtraction. The Jacobians are the same sums in
+// another order (per channel instead of per parameter, d cos = -sin dtheta instead of the
+// rotations' Jet products): each of up to ~10^4 terms carries a rounding of ~1e-16 of the largest
+// entry, a random walk of < 1e-13 relative. 1e-9 of the row's largest entry leaves a margin of
+// 10^4 for that and catches any wrong term (a missing or mis-signed one is O(1) of it).
+
+#include "models/final_pose_jacobian.h"
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "models/diff_drive/diff_drive_kinematics.h"
+#include "models/kinematic_model.h"
+#include "models/model_registry.h"
+#include "models/omni/omni_kinematics.h"
+#include "models/omni3/omni3_kinematics.h"
+#include "odometry/aligned_run.h"
+
+namespace fitcal {
+namespace {
+
+constexpr double kRelativeTolerance = 1e-9;
+
+const char* const kOmni3WheelYaml = R"(model: omni
+name: omni_three
+wheels:
+  - {name: a, distance_m: 0.195, radius_m: 0.148, angle_deg: 60.0}
+  - {name: b, distance_m: 0.195, radius_m: 0.148, angle_deg: 180.0}
+  - {name: c, distance_m: 0.195, radius_m: 0.148, angle_deg: 300.0}
+bounds: {distance_m: [0.17, 0.22], radius_m: [0.138, 0.158], angle_offset_deg: [-2.0, 2.0]}
+)";
+
+// OptiOdom's four-wheel mecanum layout (fitcal import optiodom).
+const char* const kMecanumYaml = R"(model: omni
+name: mecanum
+wheels:
+  - {name: fl, distance_m: 0.1414213562, angle_deg: 45, radius_m: 0.03, drive_angle_deg: 0, roller_angle_deg: -45}
+  - {name: fr, distance_m: 0.1414213562, angle_deg: -45, radius_m: 0.03, drive_angle_deg: 180, roller_angle_deg: 45}
+  - {name: rl, distance_m: 0.1414213562, angle_deg: 135, radius_m: 0.03, drive_angle_deg: 0, roller_angle_deg: 45}
+  - {name: rr, distance_m: 0.1414213562, angle_deg: -135, radius_m: 0.03, drive_angle_deg: 180, roller_angle_deg: -45}
+bounds: {distance_m: [0.1164213562, 0.1664213562], radius_m: [0.0255, 0.0345], angle_offset_deg: [-5, 5]}
+)";
+
+const char* const kDiffDriveLeftFirstYaml = R"(model: diff_drive
+name: left_first
+wheels:
+  - {name: left, radius_m: 0.042}
+  - {name: right, radius_m: 0.040}
+wheel_separation_m: 0.200
+bounds: {radius_m: [0.038, 0.046], wheel_separation_m: [0.180, 0.220]}
+)";
+
+// Runs of constant twists, 10 ms samples, from a start pose away from the origin.
+std::vector<AlignedRun> SimulatedRuns(const RobotModelInterface& model) {
+  const std::vector<Twist> twists = {{0.3, 0.0, 0.0}, {0.3, 0.0, 0.5}, {-0.2, 0.0, -0.9},
+                                     {0.2, 0.2, 0.4}, {0.0, 0.3, 0.0}, {0.0, 0.0, 1.2}};
+  std::vector<AlignedRun> runs;
+  std::vector<double> values(model.robot().NumChannels());
+  for (const Twist& twist : twists) {
+    if (!model.ChannelsForTwist(model.robot().nominal.data(), twist, values.data())) continue;
+    AlignedRun run;
+    run.id = "twist" + std::to_string(runs.size());
+    run.samples = EncoderSamples(model.robot().NumChannels());
+    for (int k = 0; k < 700; ++k) run.samples.push_back(0.01, values.data());
+    run.start = Pose2d{0.4, -1.2, 2.5};
+    runs.push_back(std::move(run));
+  }
+  return runs;
+}
+
+// A long real-like run: the commanded twist wanders (several full turns), each wheel rate gets
+// noise, intervals jitter around 10 ms, and the robot rests now and then (zero rates, as the
+// aligner's merged rests).
+AlignedRun RealLikeRun(const RobotModelInterface& model, unsigned seed, std::size_t n) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  std::uniform_real_distribution<double> jitter(0.008, 0.012);
+  const int channels = model.robot().NumChannels();
+  AlignedRun run;
+  run.id = "real_like" + std::to_string(seed);
+  run.samples = EncoderSamples(channels);
+  run.start = Pose2d{-0.7, 0.3, -3.0};
+  std::vector<double> values(channels);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double phase = 2.0 * M_PI * static_cast<double>(k) / 3000.0;
+    const bool holonomic =
+        model.ChannelsForTwist(model.robot().nominal.data(), Twist{0.0, 0.1, 0.0}, values.data());
+    const Twist twist{0.35 * std::cos(phase), holonomic ? 0.25 * std::sin(0.7 * phase) : 0.0,
+                      1.1 * std::sin(1.3 * phase) + 0.4};
+    model.ChannelsForTwist(model.robot().nominal.data(), twist, values.data());
+    const bool resting = (k / 500) % 7 == 3;
+    for (double& w : values) w = resting ? 0.0 : w * (1.0 + 0.05 * noise(rng)) + 0.2 * noise(rng);
+    run.samples.push_back(jitter(rng), values.data());
+  }
+  return run;
+}
+
+// Every residual and Jacobian entry of `analytic` equals `autodiff`'s within kRelativeTolerance of
+// the row's largest entry; returns the largest relative difference seen.
+double ExpectSameCost(const ceres::CostFunction& analytic, const ceres::CostFunction& autodiff,
+                      const std::vector<double>& p) {
+  const int np = static_cast<int>(p.size());
+  double r_a[3], r_d[3], r_plain[3];
+  std::vector<double> j_a(3 * np), j_d(3 * np);
+  const double* params[] = {p.data()};
+  double* jac_a[] = {j_a.data()};
+  double* jac_d[] = {j_d.data()};
+  EXPECT_TRUE(analytic.Evaluate(params, r_a, jac_a));
+  EXPECT_TRUE(autodiff.Evaluate(params, r_d, jac_d));
+  EXPECT_TRUE(analytic.Evaluate(params, r_plain, nullptr));
+  double worst = 0.0;
+  for (int r = 0; r < 3; ++r) {
+    // With Jacobians both paths go one sample at a time (bit for bit the same poses); without,
+    // the plain replay pairs samples, equal to rounding.
+    EXPECT_NEAR(r_a[r], r_d[r], kRelativeTolerance * std::max(1.0, std::abs(r_d[r])));
+    EXPECT_NEAR(r_plain[r], r_d[r], kRelativeTolerance * std::max(1.0, std::abs(r_d[r])));
+    double row_max = 0.0;
+    for (int j = 0; j < np; ++j) row_max = std::max(row_max, std::abs(j_d[r * np + j]));
+    EXPECT_GT(row_max, 0.0) << "row " << r;
+    for (int j = 0; j < np; ++j) {
+      const double diff = std::abs(j_a[r * np + j] - j_d[r * np + j]) / row_max;
+      worst = std::max(worst, diff);
+      EXPECT_LT(diff, kRelativeTolerance) << "d r" << r << " / d p" << j << ": analytic "
+                                          << j_a[r * np + j] << ", autodiff " << j_d[r * np + j];
+    }
+  }
+  return worst;
+}
+
+// For a model of kinematics K: its FinalPoseCost is the analytic one, and equals autodiff on the
+// simulated and real-like runs at the nominal and at parameters moved inside the bounds.
+template <class K>
+void CheckModel(const std::string& yaml, FinalPoseJacobianKind expected_kind) {
+  const RobotModelPtr model = ReadRobotModel(YAML::Load(yaml), "test robot");
+  const auto* kinematic = dynamic_cast<const KinematicModel<K>*>(model.get());
+  ASSERT_NE(kinematic, nullptr) << "unexpected kinematics for " << model->robot().name;
+  ASSERT_EQ(FinalPoseJacobianKindOf<K>::value, expected_kind);
+  std::vector<AlignedRun> runs = SimulatedRuns(*model);
+  runs.push_back(RealLikeRun(*model, 7, 4000));
+  runs.push_back(RealLikeRun(*model, 8, 11500));  // an OptiOdom-length run
+  const Robot& robot = model->robot();
+  std::vector<double> moved = robot.nominal;
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    moved[k] += (k % 2 == 0 ? 0.6 : -0.4) * (robot.bounds[k].hi - robot.bounds[k].lo) / 2.0;
+  }
+  const ResidualWeights sigma_weights{0.02, 0.05};
+  double worst = 0.0;
+  for (AlignedRun& run : runs) {
+    SCOPED_TRACE(run.id);
+    // The ground truth where the moved parameters end, so residuals are small and not zero.
+    run.final_ground_truth = model->ReplayFinalPose(moved.data(), run.samples, run.start);
+    run.final_ground_truth.x += 0.01;
+    run.final_ground_truth.theta += 0.02;
+    for (const ResidualWeights& weights : {ResidualWeights{}, sigma_weights}) {
+      std::unique_ptr<ceres::CostFunction> analytic(model->FinalPoseCost(run, weights));
+      ASSERT_NE(dynamic_cast<const FinalPoseJacobianCost<K>*>(analytic.get()), nullptr);
+      std::unique_ptr<ceres::CostFunction> autodiff(
+          ModelFinalPoseResidual<K>::Create(run, weights, kinematic->kinematics()));
+      for (const std::vector<double>& p : {robot.nominal, moved}) {
+        worst = std::max(worst, ExpectSameCost(*analytic, *autodiff, p));
+      }
+    }
+  }
+  char worst_text[32];
+  std::snprintf(worst_text, sizeof(worst_text), "%.3g", worst);
+  ::testing::Test::RecordProperty("worst_relative_jacobian_difference", worst_text);
+}
+
+TEST(FinalPoseJacobian, Omni3PalacinModel) {
+  CheckModel<Omni3Kinematics>(FindModel("omni3")->example_yaml,
+                              FinalPoseJacobianKind::kLinearInChannels);
+}
+
+TEST(FinalPoseJacobian, OmniThreeWheels) {
+  CheckModel<OmniKinematics<3>>(kOmni3WheelYaml, FinalPoseJacobianKind::kLinearInChannels);
+}
+
+TEST(FinalPoseJacobian, OmniFourMecanumWheels) {
+  CheckModel<OmniKinematics<4>>(kMecanumYaml, FinalPoseJacobianKind::kLinearInChannels);
+}
+
+TEST(FinalPoseJacobian, DiffDriveRightWheelFirst) {
+  CheckModel<DiffDriveKinematicsT<0>>(FindModel("diff_drive")->example_yaml,
+                                      FinalPoseJacobianKind::kPerSampleStep);
+}
+
+TEST(FinalPoseJacobian, DiffDriveLeftWheelFirst) {
+  CheckModel<DiffDriveKinematicsT<1>>(kDiffDriveLeftFirstYaml,
+                                      FinalPoseJacobianKind::kPerSampleStep);
+}
+
+}  // namespace
+}  // namespace fitcal
