@@ -157,18 +157,18 @@ struct HiddenData {
   std::vector<TrackRun> training, validation;
 };
 
-// Wear over a session: the wheel radii shrink by kWearPerRepetition with every repetition (all
-// trajectories of repetition r recorded before those of r + 1). Four repetitions, two train.
-HiddenData SimulateWear(std::uint64_t seed) {
-  constexpr double kWearPerRepetition = 0.004;
+// Four repetitions of FlowerSubset(), simulated one at a time (all trajectories of repetition r
+// recorded before those of r + 1) with `configure` applied to repetition r's options; two train.
+HiddenData SimulateRepetitions(
+    std::uint64_t seed,
+    const std::function<void(int rep, sim::Omni3SimulationOptions*)>& configure) {
   std::vector<RunLog> logs;
   for (int rep = 1; rep <= 4; ++rep) {
     sim::Omni3SimulationOptions o;
     o.trajectories = FlowerSubset();
     o.repetitions = 1;
     o.seed = seed * 100 + static_cast<std::uint64_t>(rep);
-    const double scale = 1.0 - kWearPerRepetition * (rep - 1);
-    for (double& r : o.true_robot.radius_m) r *= scale;
+    configure(rep, &o);
     for (RunLog& log : SimulateLogs(o)) {
       log.repetition = rep;
       log.id = log.trajectory + "-rep0" + std::to_string(rep);
@@ -178,6 +178,15 @@ HiddenData SimulateWear(std::uint64_t seed) {
   HiddenData d;
   SplitTrackRuns(PrepareTrackRuns(logs), {1, 2}, &d.training, &d.validation);
   return d;
+}
+
+// Wear over a session: the wheel radii shrink by kWearPerRepetition with every repetition.
+HiddenData SimulateWear(std::uint64_t seed) {
+  constexpr double kWearPerRepetition = 0.004;
+  return SimulateRepetitions(seed, [](int rep, sim::Omni3SimulationOptions* o) {
+    const double scale = 1.0 - kWearPerRepetition * (rep - 1);
+    for (double& r : o->true_robot.radius_m) r *= scale;
+  });
 }
 
 // A floor with a pile direction (carpet): the robot moves kPile faster along world +x than
@@ -248,28 +257,15 @@ TEST(HiddenStructure, WithoutRepetitionsTheSensorFloorSeesAnUndeclaredEffect) {
 // (not significant).
 constexpr double kRepetitionFactors[4] = {1.03, 0.9, 1.1, 0.96};
 
-// Simulates four repetitions of FlowerSubset(), repetition r with `vary` applied to its
-// commands and `hook` as the effect nobody declared.
+// Four repetitions (SimulateRepetitions), repetition r with `vary` applied to its commands and
+// `hook` as the effect nobody declared.
 HiddenData SimulateVaried(std::uint64_t seed,
                           const std::function<void(double factor, sim::MotionCommand*)>& vary,
                           const decltype(sim::Omni3SimulationOptions::injection_hook)& hook) {
-  std::vector<RunLog> logs;
-  for (int rep = 1; rep <= 4; ++rep) {
-    sim::Omni3SimulationOptions o;
-    o.trajectories = FlowerSubset();
-    for (sim::MotionCommand& m : o.trajectories) vary(kRepetitionFactors[rep - 1], &m);
-    o.repetitions = 1;
-    o.seed = seed * 100 + static_cast<std::uint64_t>(rep);
-    o.injection_hook = hook;
-    for (RunLog& log : SimulateLogs(o)) {
-      log.repetition = rep;
-      log.id = log.trajectory + "-rep0" + std::to_string(rep);
-      logs.push_back(std::move(log));
-    }
-  }
-  HiddenData d;
-  SplitTrackRuns(PrepareTrackRuns(logs), {1, 2}, &d.training, &d.validation);
-  return d;
+  return SimulateRepetitions(seed, [&](int rep, sim::Omni3SimulationOptions* o) {
+    for (sim::MotionCommand& m : o->trajectories) vary(kRepetitionFactors[rep - 1], &m);
+    o->injection_hook = hook;
+  });
 }
 
 // Each repetition at another speed, and a sideways skid growing with the square of the speed,

@@ -83,27 +83,35 @@ SensorNoise Noise() {
   return n;
 }
 
-// 2000 runs x 24 intervals: the pooled lag-0 and lag-1 autocovariances have standard errors of
-// about sqrt(10 / N) s^2 = 1.4 % of s^2 (N = 48000 intervals, gamma_0 = q^2 + 2 s^2 <= 3 s^2) and
-// sqrt(58 / N) = 3.5 % for q^2 = gamma_0 - 2 s^2 when q^2 ~ s^2; the tolerances below are about
-// 5 standard errors (7 % on s^2, and 20 % of the larger of q^2 and s^2 on q^2). Swapping the two
-// processes, or reading gamma_1 with the wrong sign, misses by 100 %.
-TEST(SensorNoiseFloor, EstimatorRecoversBothProcesses) {
-  const SensorNoise truth = Noise();
-  const std::vector<Pose2d> path = Petal(0.25, 25);
-  std::mt19937_64 rng(11);
+// `runs` draws of the petal sampled every dt; the walk's grid interval holds `grid_steps` dt
+// steps, so the estimate of q^2 is grid_steps times the per-step walk drawn, and s^2 is the
+// drawn white noise. Tolerances about 5 standard errors (below): 7 % on s^2, and 20 % of the
+// larger of q^2 and s^2 on q^2.
+void ExpectEstimatorRecovers(const SensorNoise& truth, double dt, int runs, int grid_steps,
+                             std::uint64_t seed) {
+  const int samples = static_cast<int>(std::lround(6.0 / dt)) + 1;
+  const std::vector<Pose2d> path = Petal(dt, samples);
+  std::mt19937_64 rng(seed);
   std::vector<TrackErrors> tracks;
-  for (int r = 0; r < 2000; ++r) tracks.push_back(Draw(path, truth, 0.25, rng));
+  for (int r = 0; r < runs; ++r) tracks.push_back(Draw(path, truth, dt, rng));
   const SensorNoise est = EstimateSensorNoise(tracks);
   ASSERT_TRUE(est.available);
-  EXPECT_EQ(est.num_intervals, 2000 * 24);
+  EXPECT_EQ(est.num_intervals, runs * ((samples - 1) / grid_steps));
   for (int c = 0; c < 3; ++c) {
     SCOPED_TRACE(c);
+    const double q2 = grid_steps * truth.walk_var_per_interval[c];
     EXPECT_NEAR(est.ground_truth_var[c], truth.ground_truth_var[c],
                 0.07 * truth.ground_truth_var[c]);
-    EXPECT_NEAR(est.walk_var_per_interval[c], truth.walk_var_per_interval[c],
-                0.2 * std::max(truth.walk_var_per_interval[c], truth.ground_truth_var[c]));
+    EXPECT_NEAR(est.walk_var_per_interval[c], q2, 0.2 * std::max(q2, truth.ground_truth_var[c]));
   }
+}
+
+// 2000 runs x 24 intervals: the pooled lag-0 and lag-1 autocovariances have standard errors of
+// about sqrt(10 / N) s^2 = 1.4 % of s^2 (N = 48000 intervals, gamma_0 = q^2 + 2 s^2 <= 3 s^2) and
+// sqrt(58 / N) = 3.5 % for q^2 = gamma_0 - 2 s^2 when q^2 ~ s^2. Swapping the two processes, or
+// reading gamma_1 with the wrong sign, misses by 100 %.
+TEST(SensorNoiseFloor, EstimatorRecoversBothProcesses) {
+  ExpectEstimatorRecovers(Noise(), 0.25, 2000, 1, 11);
 }
 
 // Ground truth every 50 ms: the walk is estimated on samples 0.2 s apart, so four 50 ms steps of
@@ -111,22 +119,9 @@ TEST(SensorNoiseFloor, EstimatorRecoversBothProcesses) {
 // 1500 runs x 30 grid intervals: standard errors as above on N = 45000 (1.5 % and 3.6 %), the
 // same tolerances.
 TEST(SensorNoiseFloor, EstimatorWorksOnIntervalsOfAtLeastTwoTenthsOfASecond) {
-  SensorNoise truth = Noise();
-  for (double& q : truth.walk_var_per_interval) q /= 4.0;
-  const std::vector<Pose2d> path = Petal(0.05, 121);
-  std::mt19937_64 rng(14);
-  std::vector<TrackErrors> tracks;
-  for (int r = 0; r < 1500; ++r) tracks.push_back(Draw(path, truth, 0.05, rng));
-  const SensorNoise est = EstimateSensorNoise(tracks);
-  ASSERT_TRUE(est.available);
-  EXPECT_EQ(est.num_intervals, 1500 * 30);
-  for (int c = 0; c < 3; ++c) {
-    SCOPED_TRACE(c);
-    const double q2 = 4.0 * truth.walk_var_per_interval[c];
-    EXPECT_NEAR(est.ground_truth_var[c], truth.ground_truth_var[c],
-                0.07 * truth.ground_truth_var[c]);
-    EXPECT_NEAR(est.walk_var_per_interval[c], q2, 0.2 * std::max(q2, truth.ground_truth_var[c]));
-  }
+  SensorNoise per_step = Noise();
+  for (double& q : per_step.walk_var_per_interval) q /= 4.0;
+  ExpectEstimatorRecovers(per_step, 0.05, 1500, 4, 14);
 }
 
 // One Monte Carlo case: ground truth every dt, the walk per dt step, `noise` as the propagation
