@@ -70,16 +70,19 @@ class PerSampleSums : public StepVisitor {
         rows_(samples.data()),
         stride_(static_cast<std::size_t>(samples.stride())) {}
 
-  void Step(std::size_t k, double c, double s, double dx, double dy, double /*dtheta*/) {
-    const double* row = rows_ + k * stride_;
-    JetP gx, gy, gt;
-    kinematics_.BodyStep(prepared_jet_, row + 1, row[0], &gx, &gy, &gt);
-    const double world_dx = c * dx - s * dy;
-    const double world_dy = s * dx + c * dy;
-    for (int j = 0; j < P; ++j) {
-      d_x[j] += c * gx.v[j] - s * gy.v[j] - world_dy * d_theta[j];
-      d_y[j] += s * gx.v[j] + c * gy.v[j] + world_dx * d_theta[j];
-      d_theta[j] += gt.v[j];
+  void Steps(std::size_t k0, std::size_t m, const double* c, const double* s, const double* dx,
+             const double* dy, const double* /*dtheta*/) {
+    for (std::size_t j = 0; j < m; ++j) {
+      const double* row = rows_ + (k0 + j) * stride_;
+      JetP gx, gy, gt;
+      kinematics_.BodyStep(prepared_jet_, row + 1, row[0], &gx, &gy, &gt);
+      const double world_dx = c[j] * dx[j] - s[j] * dy[j];
+      const double world_dy = s[j] * dx[j] + c[j] * dy[j];
+      for (int i = 0; i < P; ++i) {
+        d_x[i] += c[j] * gx.v[i] - s[j] * gy.v[i] - world_dy * d_theta[i];
+        d_y[i] += s[j] * gx.v[i] + c[j] * gy.v[i] + world_dx * d_theta[i];
+        d_theta[i] += gt.v[i];
+      }
     }
   }
 
@@ -99,19 +102,26 @@ class ChannelSums : public StepVisitor {
   explicit ChannelSums(const EncoderSamples& samples)
       : rows_(samples.data()), stride_(static_cast<std::size_t>(samples.stride())) {}
 
-  void Step(std::size_t k, double c, double s, double dx, double dy, double /*dtheta*/) {
-    const double* row = rows_ + k * stride_;
-    const double dt = row[0];
-    const double world_dx = c * dx - s * dy;
-    const double world_dy = s * dx + c * dy;
-    for (int i = 0; i < N; ++i) {
-      const double u = dt * row[1 + i];
-      a_c[i] += c * u;
-      a_s[i] += s * u;
-      b_x[i] += world_dx * w[i];
-      b_y[i] += world_dy * w[i];
-      w[i] += u;
+  // The sums run in local copies: members would stay in memory, since the compiler cannot rule
+  // out that they alias the rows it reads (same type), and every add would go through a store.
+  void Steps(std::size_t k0, std::size_t m, const double* c, const double* s, const double* dx,
+             const double* dy, const double* /*dtheta*/) {
+    std::array<double, N> l_a_c = a_c, l_a_s = a_s, l_b_x = b_x, l_b_y = b_y, l_w = w;
+    for (std::size_t j = 0; j < m; ++j) {
+      const double* row = rows_ + (k0 + j) * stride_;
+      const double dt = row[0];
+      const double world_dx = c[j] * dx[j] - s[j] * dy[j];
+      const double world_dy = s[j] * dx[j] + c[j] * dy[j];
+      for (int i = 0; i < N; ++i) {
+        const double u = dt * row[1 + i];
+        l_a_c[i] += c[j] * u;
+        l_a_s[i] += s[j] * u;
+        l_b_x[i] += world_dx * l_w[i];
+        l_b_y[i] += world_dy * l_w[i];
+        l_w[i] += u;
+      }
     }
+    a_c = l_a_c, a_s = l_a_s, b_x = l_b_x, b_y = l_b_y, w = l_w;
   }
 
   std::array<double, N> a_c{}, a_s{}, b_x{}, b_y{}, w{};

@@ -124,10 +124,11 @@ struct NoVisit {
 }  // namespace replay_internal
 
 // A visitor that also wants every step as the replay applies it derives from StepVisitor and
-// provides Step(k, c, s, dx, dy, dtheta): sample k's body-frame step and the unit vector
-// (c, s) = (cos, sin) of the heading before it, exactly the values the replay rotates the step
-// with. The replay then goes one sample at a time, as it does on Jets, so its poses equal the real
-// parts of a Jet replay's (the analytic final-pose Jacobian, models/final_pose_jacobian.h).
+// provides Steps(k0, m, c, s, dx, dy, dtheta): samples k0 .. k0 + m - 1 of a chunk, their
+// body-frame steps and the unit vectors (c, s) = (cos, sin) of the heading before each, exactly
+// the values the replay rotated the steps with. It is called once per chunk, after the chunk's
+// poses, so the visitor can sum over the chunk with its accumulators in registers (the
+// analytic final-pose Jacobian, models/final_pose_jacobian.h).
 struct StepVisitor {
   template <typename T>
   void operator()(std::size_t, const Pose2<T>&) const {}
@@ -143,6 +144,9 @@ Pose2<T> ReplaySteps(const BodyStep& body_step, const EncoderSamples& samples, s
   using std::cos;
   using std::sin;
   T step_x[kChunk], step_y[kChunk], step_theta[kChunk], rot_c[kChunk], rot_s[kChunk];
+  constexpr bool kWantsSteps = std::is_base_of_v<StepVisitor, std::decay_t<Visitor>>;
+  // The heading vector before each step of the chunk, for a StepVisitor.
+  T heading_c[kWantsSteps ? kChunk : 1], heading_s[kWantsSteps ? kChunk : 1];
   const std::size_t stride = static_cast<std::size_t>(samples.stride());
   const double* rows = samples.data();
 
@@ -165,15 +169,16 @@ Pose2<T> ReplaySteps(const BodyStep& body_step, const EncoderSamples& samples, s
     // (the pose between them uses (c1, s1)). Jets are throughput-bound: there the extra products
     // would cost more than they save, so they go one sample at a time.
     std::size_t j = 0;
-    constexpr bool kWantsSteps = std::is_base_of_v<StepVisitor, std::decay_t<Visitor>>;
-    constexpr bool kPairSamples = std::is_same_v<T, double> && !kWantsSteps;
+    constexpr bool kPairSamples = std::is_same_v<T, double>;
     for (; kPairSamples && j + 1 < m; j += 2) {
+      if constexpr (kWantsSteps) heading_c[j] = c, heading_s[j] = s;
       x += c * step_x[j] - s * step_y[j];
       y += s * step_x[j] + c * step_y[j];
       theta += step_theta[j];
       visit(k0 + j, Pose2<T>{x, y, theta});
       const T c1 = c * rot_c[j] - s * rot_s[j];
       const T s1 = s * rot_c[j] + c * rot_s[j];
+      if constexpr (kWantsSteps) heading_c[j + 1] = c1, heading_s[j + 1] = s1;
       x += c1 * step_x[j + 1] - s1 * step_y[j + 1];
       y += s1 * step_x[j + 1] + c1 * step_y[j + 1];
       theta += step_theta[j + 1];
@@ -185,7 +190,7 @@ Pose2<T> ReplaySteps(const BodyStep& body_step, const EncoderSamples& samples, s
       c = c2;
     }
     for (; j < m; ++j) {
-      if constexpr (kWantsSteps) visit.Step(k0 + j, c, s, step_x[j], step_y[j], step_theta[j]);
+      if constexpr (kWantsSteps) heading_c[j] = c, heading_s[j] = s;
       x += c * step_x[j] - s * step_y[j];
       y += s * step_x[j] + c * step_y[j];
       theta += step_theta[j];
@@ -194,6 +199,7 @@ Pose2<T> ReplaySteps(const BodyStep& body_step, const EncoderSamples& samples, s
       s = s * rot_c[j] + c * rot_s[j];
       c = c_next;
     }
+    if constexpr (kWantsSteps) visit.Steps(k0, m, heading_c, heading_s, step_x, step_y, step_theta);
     if ((k0 + m - begin) % replay_internal::kReanchorInterval == 0) {
       c = cos(theta);
       s = sin(theta);

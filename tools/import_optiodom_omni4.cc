@@ -252,33 +252,57 @@ EncoderSamples Merged(const EncoderSamples& samples) {
   return out;
 }
 
-// Mean over windows (i, i + 2 strides) of |t_P - t_Q| + |wrap(theta_P - theta_Q)| of the relative
-// poses P_i^-1 P_j (odometry of the merged samples remapped) and Q_i^-1 Q_j (ground truth, the
-// rows that end those merged intervals).
-void AddWindowErrors(const RunLog& log, const EncoderSamples& merged,
-                     const RobotModelInterface& model, const ChannelMapping& mapping, double* sum,
-                     int* count) {
-  EncoderSamples mapped = merged;
-  for (auto&& s : mapped) {
-    double w[kWheels];
-    for (int i = 0; i < kWheels; ++i) w[i] = s.value[i];
-    for (int i = 0; i < kWheels; ++i) s.value[i] = mapping.sign[i] * w[mapping.column[i]];
-  }
-  std::vector<Pose2d> odometry(1, log.ground_truth.world_T_robot.front());
+// What the layout check needs of a run besides the mapping: the merged samples, the rows of the
+// ground truth that end every kWindowStride-th merged interval, and the ground truth's relative
+// poses Q_i^-1 Q_{i+2} between them. Computed once, not once per candidate mapping.
+struct LayoutRun {
+  const RunLog* log = nullptr;
+  EncoderSamples merged{kWheels};
+  std::vector<Pose2d> truth_window;  // Q_i^-1 Q_{i+2}
+};
+
+LayoutRun MakeLayoutRun(const RunLog& log) {
+  LayoutRun run;
+  run.log = &log;
+  run.merged = Merged(log.encoders.samples);
   std::vector<std::size_t> row(1, 0);
+  for (std::size_t k = 0; k < run.merged.size(); ++k) {
+    if ((k + 1) % kWindowStride == 0 && (k + 1) * kMerge <= log.encoders.samples.size()) {
+      row.push_back((k + 1) * kMerge);
+    }
+  }
+  const std::vector<Pose2d>& truth = log.ground_truth.world_T_robot;
+  for (std::size_t i = 0; i + 2 < row.size(); ++i) {
+    run.truth_window.push_back(RelativePose(truth[row[i]], truth[row[i + 2]]));
+  }
+  return run;
+}
+
+// Mean over windows (i, i + 2 strides) of |t_P - t_Q| + |wrap(theta_P - theta_Q)| of the relative
+// poses P_i^-1 P_j (odometry of the merged samples remapped into *mapped, a buffer the caller
+// keeps) and Q_i^-1 Q_j (ground truth, the rows that end those merged intervals).
+void AddWindowErrors(const LayoutRun& run, const RobotModelInterface& model,
+                     const ChannelMapping& mapping, EncoderSamples* mapped,
+                     std::vector<Pose2d>* odometry, double* sum, int* count) {
+  mapped->resize(run.merged.size());
+  for (std::size_t k = 0; k < run.merged.size(); ++k) {
+    const auto from = run.merged[k];
+    auto to = (*mapped)[k];
+    to.dt_s = from.dt_s;
+    for (int i = 0; i < kWheels; ++i) to.value[i] = mapping.sign[i] * from.value[mapping.column[i]];
+  }
+  const RunLog& log = *run.log;
+  odometry->assign(1, log.ground_truth.world_T_robot.front());
   model.Replay(
-      model.robot().nominal.data(), mapped, 0, mapped.size(), odometry.front(),
+      model.robot().nominal.data(), *mapped, 0, mapped->size(), odometry->front(),
       [&](std::size_t k, const Pose2d& pose) {
         if ((k + 1) % kWindowStride == 0 && (k + 1) * kMerge <= log.encoders.samples.size()) {
-          odometry.push_back(pose);
-          row.push_back((k + 1) * kMerge);
+          odometry->push_back(pose);
         }
       });
-  const std::vector<Pose2d>& truth = log.ground_truth.world_T_robot;
-  for (std::size_t i = 0; i + 2 < odometry.size(); ++i) {
+  for (std::size_t i = 0; i + 2 < odometry->size(); ++i) {
     double r[3];
-    SegmentError(odometry[i], odometry[i + 2], RelativePose(truth[row[i]], truth[row[i + 2]]),
-                 ResidualWeights{}, r);
+    SegmentError((*odometry)[i], (*odometry)[i + 2], run.truth_window[i], ResidualWeights{}, r);
     *sum += std::hypot(r[0], r[1]) + std::abs(r[2]);
     ++*count;
   }
@@ -354,19 +378,21 @@ RobotModelPtr OptiOdomOmni4NominalModel(const OptiOdomOmni4Metadata& metadata) {
 
 std::vector<Omni4LayoutScore> CheckOmni4Layout(const std::vector<OptiOdomOmni4Session>& sessions,
                                                const RobotModelInterface& model) {
-  std::vector<const RunLog*> runs;
+  std::vector<const RunLog*> logs;
   for (const OptiOdomOmni4Session& s : sessions) {
-    for (const RunLog& log : s.runs) runs.push_back(&log);
+    for (const RunLog& log : s.runs) logs.push_back(&log);
   }
-  std::vector<EncoderSamples> merged;
-  for (const RunLog* run : runs) merged.push_back(Merged(run->encoders.samples));
+  std::vector<LayoutRun> runs(logs.size());
+  ParallelFor(logs.size(), 0, [&](std::size_t r) { runs[r] = MakeLayoutRun(*logs[r]); });
   const std::vector<ChannelMapping> candidates = model.CandidateMiswirings();
   std::vector<Omni4LayoutScore> scores(candidates.size());
   ParallelFor(candidates.size(), 0, [&](std::size_t m) {
     double sum = 0.0;
     int count = 0;
-    for (std::size_t r = 0; r < runs.size(); ++r) {
-      AddWindowErrors(*runs[r], merged[r], model, candidates[m], &sum, &count);
+    EncoderSamples mapped(kWheels);
+    std::vector<Pose2d> odometry;
+    for (const LayoutRun& run : runs) {
+      AddWindowErrors(run, model, candidates[m], &mapped, &odometry, &sum, &count);
     }
     scores[m] = {candidates[m], count > 0 ? sum / count : 0.0};
   });
