@@ -17,7 +17,9 @@
 //   dy_N/dp = sum_k (s_k G_kx + c_k G_ky + Dx_k T_k),   Dx_k = c_k dx_k - s_k dy_k,
 //   dtheta_N/dp = sum_k G_k,theta,
 // with (Dx_k, Dy_k) the world-frame step. The poses and (c_k, s_k) are the replay's own (a
-// StepVisitor of ReplaySteps), so the residuals are the autodiff path's bit for bit.
+// StepVisitor of ReplaySteps, two samples per iteration as the plain replay on double), so the
+// residuals are the residual-only evaluation's bit for bit, and the autodiff path's (one sample at
+// a time on Jets) to rounding.
 //
 // kPerSampleStep: G_k from a Jet of the body step alone; O(P) doubles per sample after it.
 // kLinearInChannels: the step is S = dt_k M(p) w_k with M 3 x n, so G_k = dt_k (dM/dp) w_k and
