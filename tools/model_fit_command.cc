@@ -97,6 +97,29 @@ std::vector<CalibrationCandidate> Candidates(const RobotModelInterface& model,
   return out;
 }
 
+}  // namespace
+
+void RecordFitSource(const FitCommandOptions& options, const std::vector<RunLog>& logs,
+                     const RunSplit& split, const std::string& method, const std::string& objective,
+                     const std::string& termination, io::CalibrationSource* source) {
+  io::CalibrationSource& s = *source;
+  s.method = method;
+  s.objective = objective + " (sigma_xy " + std::to_string(options.position_sigma_m) +
+                " m, sigma_theta " + std::to_string(options.heading_sigma_deg) + " deg)";
+  s.dataset = options.logs;
+  s.tool_version = kVersion;
+  s.termination = termination;
+  s.training_repetitions = split.training_repetitions;
+  s.validation_repetitions = split.validation_repetitions;
+  for (const AlignedRun& run : split.training) s.training_run_ids.push_back(run.id);
+  s.training_trajectories = options.train_trajectories;
+  s.training_fingerprint = TrainingFingerprint(logs, s.training_run_ids);
+  s.training_runs = static_cast<int>(split.training.size());
+  s.validation_runs = static_cast<int>(split.validation.size());
+}
+
+namespace {
+
 io::CalibrationBlock MakeRecord(const FitCommandOptions& options, const RobotModelInterface& model,
                                 const std::vector<RunLog>& logs, const RunSplit& split,
                                 const ModelFitResult& fit, const std::string& objective,
@@ -105,19 +128,8 @@ io::CalibrationBlock MakeRecord(const FitCommandOptions& options, const RobotMod
   const Robot& robot = model.robot();
   const std::vector<double>& p = candidates[gate.selected].parameters;
   io::CalibrationBlock r;
-  r.method = candidates[gate.selected].name;
-  r.objective = objective + " (sigma_xy " + std::to_string(options.position_sigma_m) +
-                " m, sigma_theta " + std::to_string(options.heading_sigma_deg) + " deg)";
-  r.dataset = options.logs;
-  r.tool_version = kVersion;
-  r.termination = fit.termination;
-  r.training_repetitions = split.training_repetitions;
-  r.validation_repetitions = split.validation_repetitions;
-  for (const AlignedRun& run : split.training) r.training_run_ids.push_back(run.id);
-  r.training_trajectories = options.train_trajectories;
-  r.training_fingerprint = TrainingFingerprint(logs, r.training_run_ids);
-  r.training_runs = static_cast<int>(split.training.size());
-  r.validation_runs = static_cast<int>(split.validation.size());
+  RecordFitSource(options, logs, split, candidates[gate.selected].name, objective, fit.termination,
+                  &r);
   r.cf_training_before =
       EvaluateFinalPoseErrors(model, robot.nominal, split.training, options.threads).cf;
   r.cf_training_after = EvaluateFinalPoseErrors(model, p, split.training, options.threads).cf;
