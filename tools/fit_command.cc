@@ -302,13 +302,7 @@ int RunFitCommand(const FitCommandOptions& options) {
     }
     const GateDecision gate = SelectCalibration(*Omni3ModelOf(robot), candidates, split.training,
                                                 split.validation, options.threads);
-    std::printf("\nresult gate, CF on %s:\n", gate.judged_on.c_str());
-    for (const std::string& line : GateLines(candidates, gate)) std::printf("%s\n", line.c_str());
-    if (!gate.improves_on_nominal()) {
-      std::cerr << "fitcal: no calibration beats the nominal robot on the " << gate.judged_on
-                << "; nothing written\n";
-      return 5;
-    }
+    if (!PrintGate(candidates, gate)) return 5;
 
     if (!options.no_output) {
       // What the gate selected (the fit, or the fit without its holds) is written, with the CF

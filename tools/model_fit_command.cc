@@ -99,6 +99,15 @@ std::vector<CalibrationCandidate> Candidates(const RobotModelInterface& model,
 
 }  // namespace
 
+bool PrintGate(const std::vector<CalibrationCandidate>& candidates, const GateDecision& gate) {
+  std::printf("\nresult gate, CF on %s:\n", gate.judged_on.c_str());
+  for (const std::string& line : GateLines(candidates, gate)) std::printf("%s\n", line.c_str());
+  if (gate.improves_on_nominal()) return true;
+  std::cerr << "fitcal: no calibration beats the nominal robot on the " << gate.judged_on
+            << "; nothing written\n";
+  return false;
+}
+
 void RecordFitSource(const FitCommandOptions& options, const std::vector<RunLog>& logs,
                      const RunSplit& split, const std::string& method, const std::string& objective,
                      const std::string& termination, io::CalibrationSource* source) {
@@ -279,13 +288,7 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   PrintFit(options, *model, split, selected, *method, outcome);
   if (!fit.has_covariance) std::printf("uncertainty: %s\n", fit.covariance_message.c_str());
   for (const UndeterminedDirection& d : fit.held_directions) PrintHeldAtNominal(d.description);
-  std::printf("\nresult gate, CF on %s:\n", gate.judged_on.c_str());
-  for (const std::string& line : GateLines(candidates, gate)) std::printf("%s\n", line.c_str());
-  if (!gate.improves_on_nominal()) {
-    std::cerr << "fitcal: no calibration beats the nominal robot on the " << gate.judged_on
-              << "; nothing written\n";
-    return 5;
-  }
+  if (!PrintGate(candidates, gate)) return 5;
   if (!options.no_output) {
     const io::CalibrationBlock record =
         MakeRecord(options, *model, dataset.runs, split, fit, outcome.objective, candidates, gate);
