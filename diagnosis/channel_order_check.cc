@@ -16,17 +16,6 @@ namespace fitcal {
 
 namespace {
 
-// sum_i ssr(i): each run's term computed in parallel, the sum taken in run order (the same bits
-// on any number of threads).
-template <typename Fn>
-double SumOverRuns(std::size_t n, int num_threads, Fn&& ssr) {
-  std::vector<double> per_run(n, 0.0);
-  ParallelFor(n, num_threads, [&](std::size_t i) { per_run[i] = ssr(i); });
-  double sum = 0.0;
-  for (double v : per_run) sum += v;
-  return sum;
-}
-
 // Buffers one worker reuses for every run and mapping: a run's samples with a mapping applied,
 // and the pose after every sample count. A run's are ~0.5 MB: made per run and mapping they were
 // allocated and freed (mmap, page faults) hundreds of times per run.
@@ -183,15 +172,7 @@ std::string DescribeChannelMapping(const Robot& robot, const ChannelMapping& m) 
 }
 
 bool ChannelOrderOptions::IsValid(std::string* error) const {
-  if (!(false_alarm_probability > 0.0 && false_alarm_probability < 1.0)) {
-    *error = "false_alarm_probability must be in (0, 1)";
-    return false;
-  }
-  if (!(weights.position_sigma_m > 0.0) || !(weights.heading_sigma_rad > 0.0)) {
-    *error = "weights must be positive";
-    return false;
-  }
-  return true;
+  return IsValidMiswiringOptions(false_alarm_probability, weights, error);
 }
 
 ChannelOrderReport CheckChannelOrder(const std::vector<AlignedRun>& runs,
@@ -220,37 +201,20 @@ ChannelOrderReport CheckChannelOrder(const std::vector<AlignedRun>& runs,
       report.best = mappings[k];
     }
   }
-  const int free = robot.NumFree();
-  report.fitted = num_residuals - free >= 3;
-  report.degrees_of_freedom = report.fitted ? num_residuals - free : num_residuals;
-  const double alpha = options.false_alarm_probability /
-                       static_cast<double>(std::max<std::size_t>(1, mappings.size() - 1));
-  report.threshold =
-      FDistributionQuantile(1.0 - alpha, report.degrees_of_freedom, report.degrees_of_freedom);
-  report.recorded_ssr = report.recorded_nominal_ssr;
-  report.best_ssr = report.best_nominal_ssr;
-  if (!(report.best_nominal_ssr < report.recorded_nominal_ssr)) {
-    report.fitted = false;
-    return report;
-  }
-  if (report.fitted) {
-    report.recorded_ssr = FittedSumOfSquares(model, runs, segments, options);
-    report.best_ssr =
-        FittedSumOfSquares(model, ApplyChannelMapping(runs, report.best), segments, options);
-  }
-  const double ratio = report.best_ssr > 0.0       ? report.recorded_ssr / report.best_ssr
-                       : report.recorded_ssr > 0.0 ? std::numeric_limits<double>::infinity()
-                                                   : 1.0;
-  if (!(ratio > report.threshold)) return report;
-  report.likely_miswired = true;
-  std::ostringstream msg;
-  msg.precision(3);
-  msg << "the encoder columns look miswired: with " << DescribeChannelMapping(robot, report.best)
-      << " the runs are explained " << ratio << "x better ("
-      << (segments.empty() ? "final-pose" : "segment") << " SSR " << report.best_ssr << " vs "
-      << report.recorded_ssr << " as recorded; threshold " << report.threshold << " for "
-      << runs.size() << " runs); fix the log or the robot YAML's channel order";
-  report.message = msg.str();
+  MiswiringTest test;
+  test.num_residuals = num_residuals;
+  test.num_free_parameters = robot.NumFree();
+  test.num_alternatives = mappings.size() - 1;
+  test.false_alarm_probability = options.false_alarm_probability;
+  test.fitted_ssr = [&](bool other) {
+    if (!other) return FittedSumOfSquares(model, runs, segments, options);
+    return FittedSumOfSquares(model, ApplyChannelMapping(runs, report.best), segments, options);
+  };
+  test.describe_best = [&] { return DescribeChannelMapping(robot, report.best); };
+  test.evidence = segments.empty() ? "final-pose SSR" : "segment SSR";
+  test.sample = std::to_string(runs.size()) + " runs";
+  test.order = "channel order";
+  DecideMiswiring(test, &report);
   return report;
 }
 

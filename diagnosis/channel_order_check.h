@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "diagnosis/wheel_order_check.h"
 #include "models/model_interface.h"
 #include "odometry/aligned_run.h"
 
@@ -41,17 +42,9 @@ struct ChannelOrderOptions {
   bool IsValid(std::string* error) const;
 };
 
-struct ChannelOrderReport {
-  bool likely_miswired = false;  // another mapping explains the data far better
-  ChannelMapping best;           // the best other mapping when likely_miswired
-  double recorded_nominal_ssr = 0.0;
-  double best_nominal_ssr = 0.0;
-  bool fitted = false;
-  double recorded_ssr = 0.0;
-  double best_ssr = 0.0;
-  double threshold = 0.0;
-  int degrees_of_freedom = 0;  // 0: nothing was decided (too few residuals)
-  std::string message;         // one line when likely_miswired
+// The scores and decision as in wheel_order_check.h.
+struct ChannelOrderReport : MiswiringScores {
+  ChannelMapping best;  // the best other mapping when likely_miswired
 };
 
 // segments: empty for the final-pose test, else one window list per run (segment test).

@@ -19,17 +19,6 @@ namespace {
 
 const char* kColumnNames[3] = {"w_a", "w_b", "w_c"};
 
-// sum_i ssr(i) over n runs: each run's term computed in parallel, the sum taken in run order (the
-// same bits on any number of threads).
-template <typename Fn>
-double SumOverRuns(std::size_t n, int num_threads, Fn&& ssr) {
-  std::vector<double> per_run(n, 0.0);
-  ParallelFor(n, num_threads, [&](std::size_t i) { per_run[i] = ssr(i); });
-  double sum = 0.0;
-  for (double v : per_run) sum += v;
-  return sum;
-}
-
 // Final-pose SSR of the runs replayed with the inverse kinematic matrix m_inv (the fit's
 // objective times 2 when m_inv is Eq. 6 at some parameters).
 double SumOfSquares(const Eigen::Matrix3d& m_inv, const std::vector<AlignedRun>& runs,
@@ -89,6 +78,41 @@ double FDistributionQuantile(double p, double d1, double d2) {
   return std::exp(0.5 * (lo + hi));
 }
 
+void DecideMiswiring(const MiswiringTest& test, MiswiringScores* scores) {
+  MiswiringScores& s = *scores;
+  const int n = test.num_residuals;
+  s.fitted = n - test.num_free_parameters >= 3;
+  s.degrees_of_freedom = s.fitted ? n - test.num_free_parameters : n;
+  const double alpha = test.false_alarm_probability /
+                       static_cast<double>(std::max<std::size_t>(1, test.num_alternatives));
+  s.threshold = FDistributionQuantile(1.0 - alpha, s.degrees_of_freedom, s.degrees_of_freedom);
+  s.recorded_ssr = s.recorded_nominal_ssr;
+  s.best_ssr = s.best_nominal_ssr;
+  // The recorded order is already at least as good at the nominal: nothing to fit.
+  if (!(s.best_nominal_ssr < s.recorded_nominal_ssr)) {
+    s.fitted = false;
+    return;
+  }
+  if (s.fitted) {
+    s.recorded_ssr = test.fitted_ssr(false);
+    s.best_ssr = test.fitted_ssr(true);
+  }
+  // A perfect fit of the other order (ssr 0) is "far better" as long as the recorded one is not
+  // perfect too.
+  const double ratio = s.best_ssr > 0.0       ? s.recorded_ssr / s.best_ssr
+                       : s.recorded_ssr > 0.0 ? std::numeric_limits<double>::infinity()
+                                              : 1.0;
+  if (!(ratio > s.threshold)) return;
+  s.likely_miswired = true;
+  std::ostringstream msg;
+  msg.precision(3);
+  msg << "the encoder columns look miswired: with " << test.describe_best()
+      << " the runs are explained " << ratio << "x better (" << test.evidence << " " << s.best_ssr
+      << " vs " << s.recorded_ssr << " as recorded; threshold " << s.threshold << " for "
+      << test.sample << "); fix the log or the robot YAML's " << test.order;
+  s.message = msg.str();
+}
+
 std::vector<WheelMapping> AllWheelMappings() {
   std::vector<WheelMapping> out;
   std::array<int, 3> perm{0, 1, 2};
@@ -136,7 +160,8 @@ std::string DescribeWheelMapping(const WheelMapping& m) {
   return out.empty() ? "recorded order" : out;
 }
 
-bool WheelOrderOptions::IsValid(std::string* error) const {
+bool IsValidMiswiringOptions(double false_alarm_probability, const ResidualWeights& weights,
+                             std::string* error) {
   if (!(false_alarm_probability > 0.0 && false_alarm_probability < 1.0)) {
     *error = "false_alarm_probability must be in (0, 1)";
     return false;
@@ -145,6 +170,11 @@ bool WheelOrderOptions::IsValid(std::string* error) const {
     *error = "weights must be positive";
     return false;
   }
+  return true;
+}
+
+bool WheelOrderOptions::IsValid(std::string* error) const {
+  if (!IsValidMiswiringOptions(false_alarm_probability, weights, error)) return false;
   if (!(segment_length_m > 0.0)) {
     *error = "segment_length_m must be positive";
     return false;
@@ -164,8 +194,7 @@ struct MappingScorer {
   std::string sample;    // e.g. "36 runs"
 };
 
-// The decision of the header: best other mapping at the nominal; if it beats the recorded order,
-// both fitted; "far better" when the SSR ratio exceeds the Bonferroni F quantile.
+// The best other mapping at the nominal, then the decision of the header (DecideMiswiring).
 WheelOrderReport Decide(const MappingScorer& scorer, const WheelOrderOptions& options) {
   const std::vector<WheelMapping> mappings = AllWheelMappings();
   WheelOrderReport report;
@@ -179,40 +208,18 @@ WheelOrderReport Decide(const MappingScorer& scorer, const WheelOrderOptions& op
       best_other = mappings[k];
     }
   }
-  const int n = scorer.num_residuals;
-  report.fitted = n - omni3::kNumParameters >= 3;
-  report.degrees_of_freedom = report.fitted ? n - omni3::kNumParameters : n;
-  const double alpha = options.false_alarm_probability / static_cast<double>(mappings.size() - 1);
-  report.threshold =
-      FDistributionQuantile(1.0 - alpha, report.degrees_of_freedom, report.degrees_of_freedom);
-  report.recorded_ssr = report.recorded_nominal_ssr;
-  report.best_ssr = report.best_nominal_ssr;
-  // The recorded order is already at least as good at the nominal: nothing to fit.
-  if (!(report.best_nominal_ssr < report.recorded_nominal_ssr)) {
-    report.fitted = false;
-    return report;
-  }
-  if (report.fitted) {
-    report.recorded_ssr = scorer.fitted_ssr(mappings[0]);
-    report.best_ssr = scorer.fitted_ssr(best_other);
-  }
-  // A perfect fit of the other order (ssr 0) is "far better" as long as the recorded one is not
-  // perfect too.
-  const double ratio = report.best_ssr > 0.0       ? report.recorded_ssr / report.best_ssr
-                       : report.recorded_ssr > 0.0 ? std::numeric_limits<double>::infinity()
-                                                   : 1.0;
-  if (ratio > report.threshold) {
-    report.likely_miswired = true;
-    report.best = best_other;
-    std::ostringstream msg;
-    msg.precision(3);
-    msg << "the encoder columns look miswired: with " << DescribeWheelMapping(best_other)
-        << " the runs are explained " << ratio << "x better (" << scorer.evidence << " "
-        << report.best_ssr << " vs " << report.recorded_ssr << " as recorded; threshold "
-        << report.threshold << " for " << scorer.sample
-        << "); fix the log or the robot YAML's wheel order";
-    report.message = msg.str();
-  }
+  MiswiringTest test;
+  test.num_residuals = scorer.num_residuals;
+  test.num_free_parameters = omni3::kNumParameters;
+  test.num_alternatives = mappings.size() - 1;
+  test.false_alarm_probability = options.false_alarm_probability;
+  test.fitted_ssr = [&](bool other) { return scorer.fitted_ssr(other ? best_other : mappings[0]); };
+  test.describe_best = [&] { return DescribeWheelMapping(best_other); };
+  test.evidence = scorer.evidence;
+  test.sample = scorer.sample;
+  test.order = "wheel order";
+  DecideMiswiring(test, &report);
+  if (report.likely_miswired) report.best = best_other;
   return report;
 }
 

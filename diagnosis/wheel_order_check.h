@@ -26,11 +26,14 @@
 // rev/s: 1/(2 pi), rpm: 30/pi).
 
 #include <array>
+#include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "fit/final_pose_residual.h"
 #include "odometry/aligned_run.h"
+#include "odometry/parallel_for.h"
 #include "odometry/robot_description.h"
 #include "odometry/run_log.h"
 
@@ -64,9 +67,10 @@ struct WheelOrderOptions {
   bool IsValid(std::string* error) const;
 };
 
-struct WheelOrderReport {
+// The scores and the decision of the test above, for this check and for the channel-order check
+// of any model (channel_order_check.h); each report adds the mapping it found.
+struct MiswiringScores {
   bool likely_miswired = false;  // another mapping explains the data far better
-  WheelMapping best;             // the best-scoring mapping (identity when not miswired)
   double recorded_nominal_ssr = 0.0;
   double best_nominal_ssr = 0.0;
   bool fitted = false;         // SSRs below are after a bounded fit of both hypotheses
@@ -76,6 +80,46 @@ struct WheelOrderReport {
   int degrees_of_freedom = 0;  // 0: nothing was decided (too few windows)
   std::string message;         // one line when likely_miswired
 };
+
+struct WheelOrderReport : MiswiringScores {
+  WheelMapping best;  // the best-scoring mapping (identity when not miswired)
+};
+
+// What the decision needs besides the nominal SSRs: how many residuals the SSRs sum and how many
+// parameters a fit frees (d above), how many other mappings were scored (Bonferroni), the fit of
+// a hypothesis, and the words of the message.
+struct MiswiringTest {
+  int num_residuals = 0;
+  int num_free_parameters = 0;
+  std::size_t num_alternatives = 0;
+  double false_alarm_probability = 0.0;
+  // The SSR after a bounded fit of the best other mapping (true) or of the recorded one (false).
+  std::function<double(bool best_other)> fitted_ssr;
+  std::function<std::string()> describe_best;  // the best other mapping in words
+  std::string evidence;                        // e.g. "final-pose SSR"
+  std::string sample;                          // e.g. "36 runs"
+  std::string order;                           // what to fix in the robot YAML, e.g. "wheel order"
+};
+
+// The options this check and the channel-order check share: alpha in (0, 1), positive weights.
+bool IsValidMiswiringOptions(double false_alarm_probability, const ResidualWeights& weights,
+                             std::string* error);
+
+// The decision of the header on scores whose recorded_nominal_ssr and best_nominal_ssr are set:
+// fills the rest of *scores (both hypotheses fitted when the other beats the recorded one at the
+// nominal and d allows it).
+void DecideMiswiring(const MiswiringTest& test, MiswiringScores* scores);
+
+// sum_i ssr(i) over n runs: each run's term computed in parallel, the sum taken in run order (the
+// same bits on any number of threads).
+template <typename Fn>
+double SumOverRuns(std::size_t n, int num_threads, Fn&& ssr) {
+  std::vector<double> per_run(n, 0.0);
+  ParallelFor(n, num_threads, [&](std::size_t i) { per_run[i] = ssr(i); });
+  double sum = 0.0;
+  for (double v : per_run) sum += v;
+  return sum;
+}
 
 // Throws std::invalid_argument for invalid options or no runs.
 WheelOrderReport CheckWheelOrder(const std::vector<AlignedRun>& runs, const Omni3Robot& robot,

@@ -115,7 +115,9 @@ class RunResiduals {
                                    double* jacobian) const = 0;
 };
 
-struct NloptSearchResult {
+// How a search went, whatever holds its parameters: NloptSearchResult here, omni3's
+// NloptFitResult (fit/omni3_nlopt_fit.h) with its nine.
+struct NloptSearchSummary {
   bool usable = false;           // finite parameters and NLopt stopped on a success code
   std::string termination;       // NLopt's result, e.g. "NLOPT_MAXEVAL_REACHED"
   std::string message;           // the method, polish and stop reason in words
@@ -126,9 +128,12 @@ struct NloptSearchResult {
   double final_objective = 0.0;
   double initial_cf = 0.0;  // Eq. 14 (weighted as the residuals) at the start
   double final_cf = 0.0;
-  std::vector<double> parameters;       // all of them, held ones at their start value
-  std::vector<bool> at_bound;           // within 1e-6 of the box width of a bound
   std::vector<ConvergencePoint> trace;  // one point per improvement of the best CF
+};
+
+struct NloptSearchResult : NloptSearchSummary {
+  std::vector<double> parameters;  // all of them, held ones at their start value
+  std::vector<bool> at_bound;      // within 1e-6 of the box width of a bound
 };
 
 // Searches the box `bounds` (one interval per parameter, start inside it) from `start`; held[k]

@@ -70,21 +70,11 @@ NloptFitResult FitOmni3Nlopt(const std::vector<AlignedRun>& training, const Omni
                      std::vector<bool>(omni3::kNumParameters, false), options);
 
   NloptFitResult result;
-  result.usable = r.usable;
-  result.termination = r.termination;
-  result.message = r.message;
-  result.evaluations = r.evaluations;
-  result.gradient_evaluations = r.gradient_evaluations;
-  result.solve_time_s = r.solve_time_s;
-  result.initial_objective = r.initial_objective;
-  result.final_objective = r.final_objective;
-  result.initial_cf = r.initial_cf;
-  result.final_cf = r.final_cf;
+  static_cast<NloptSearchSummary&>(result) = r;
   for (int k = 0; k < omni3::kNumParameters; ++k) {
     result.parameters[k] = r.parameters[k];
     result.at_bound[k] = r.at_bound[k];
   }
-  result.trace = r.trace;
   return result;
 }
 

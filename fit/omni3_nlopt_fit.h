@@ -19,20 +19,11 @@
 
 namespace fitcal {
 
-struct NloptFitResult {
-  bool usable = false;           // finite parameters and NLopt stopped on a success code
-  std::string termination;       // NLopt's result, e.g. "NLOPT_MAXEVAL_REACHED"
-  std::string message;           // the method, polish and stop reason in words
-  int evaluations = 0;           // objective evaluations (each one replays every training run)
-  int gradient_evaluations = 0;  // of them, evaluations with the gradient
-  double solve_time_s = 0.0;
-  double initial_objective = 0.0;
-  double final_objective = 0.0;
-  double initial_cf = 0.0;  // Eq. 14 on the training runs at the nominal parameters
-  double final_cf = 0.0;
+// The search's summary (Eq. 14 at the nominal parameters for initial_cf) with the nine
+// parameters.
+struct NloptFitResult : NloptSearchSummary {
   Omni3ParameterArray parameters{};
   std::array<bool, omni3::kNumParameters> at_bound{};
-  std::vector<ConvergencePoint> trace;  // one point per improvement of the best CF
 };
 
 // Throws std::invalid_argument for invalid options or no runs.

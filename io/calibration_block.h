@@ -14,7 +14,10 @@
 
 namespace fitcal::io {
 
-struct CalibrationBlock {
+// What produced a calibration and on which runs, with the CF before and after on both: the keys
+// the omni3 YAML's `calibration:` block (io/robot_yaml.h, its own pre-seam layout) shares with
+// every other model's, filled once by each command for both.
+struct CalibrationSource {
   std::string method;
   std::string objective;
   std::string dataset;
@@ -22,6 +25,7 @@ struct CalibrationBlock {
   std::string termination;
   std::vector<int> training_repetitions;
   std::vector<int> validation_repetitions;
+  // Which runs trained it (`fitcal report` validates on every other run of any data set).
   std::vector<std::string> training_run_ids;
   std::string training_trajectories;  // the --train-trajectories selector, when split so
   std::string training_fingerprint;   // of the training runs' encoder logs (training_runs.h)
@@ -31,11 +35,14 @@ struct CalibrationBlock {
   double cf_training_after = 0.0;
   double cf_validation_before = 0.0;
   double cf_validation_after = 0.0;
+  std::vector<std::string> at_bound;  // parameter names resting on a bound
+};
+
+struct CalibrationBlock : CalibrationSource {
   // The result gate (which candidate won, on which runs it was judged).
   std::string selected;
   std::string selected_on;
-  std::vector<std::string> held;      // parameter names held at nominal, with why
-  std::vector<std::string> at_bound;  // parameter names resting on a bound
+  std::vector<std::string> held;  // parameter names held at nominal, with why
   bool has_uncertainty = false;
   std::vector<double> sigma;  // one sigma per parameter, SI and rad
   Eigen::MatrixXd correlation;

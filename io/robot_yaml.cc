@@ -137,32 +137,15 @@ std::string Omni3RobotYaml(const Omni3Robot& robot, const CalibrationRecord* cal
   if (calibration != nullptr) {
     const CalibrationRecord& c = *calibration;
     out << YAML::Key << "calibration" << YAML::Value << YAML::BeginMap;
-    out << YAML::Key << "method" << YAML::Value << c.method;
-    out << YAML::Key << "objective" << YAML::Value << c.objective;
-    out << YAML::Key << "dataset" << YAML::Value << c.dataset;
-    out << YAML::Key << "tool_version" << YAML::Value << c.tool_version;
-    out << YAML::Key << "termination" << YAML::Value << c.termination;
-    out << YAML::Key << "training_repetitions" << YAML::Value << YAML::Flow
-        << c.training_repetitions;
-    out << YAML::Key << "validation_repetitions" << YAML::Value << YAML::Flow
-        << c.validation_repetitions;
-    out << YAML::Key << "training_runs" << YAML::Value << c.training_runs;
-    out << YAML::Key << "validation_runs" << YAML::Value << c.validation_runs;
-    if (!c.training_trajectories.empty()) {
-      out << YAML::Key << "training_trajectories" << YAML::Value << c.training_trajectories;
-    }
+    EmitCalibrationOrigin(out, c);
+    EmitCalibrationRunCounts(out, c);
     if (!c.training_run_ids.empty()) {
       out << YAML::Key << "training_run_ids" << YAML::Value << YAML::Flow << c.training_run_ids;
       out << YAML::Key << "training_fingerprint" << YAML::Value << YAML::DoubleQuoted
           << c.training_fingerprint;
     }
     out << YAML::Key << "at_bound" << YAML::Value << YAML::Flow << c.at_bound;
-    out << YAML::Key << "cf_training" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key
-        << "before" << YAML::Value << c.cf_training_before << YAML::Key << "after" << YAML::Value
-        << c.cf_training_after << YAML::EndMap;
-    out << YAML::Key << "cf_validation" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key
-        << "before" << YAML::Value << c.cf_validation_before << YAML::Key << "after" << YAML::Value
-        << c.cf_validation_after << YAML::EndMap;
+    EmitCalibrationCf(out, c);
     if (c.has_uncertainty) {
       out << YAML::Key << "sigma" << YAML::Value << YAML::BeginMap;
       EmitTriple(out, "distance_m", &c.sigma[omni3::kDistanceIndex], 1.0);

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "io/calibration_block.h"
 #include "odometry/robot_description.h"
 
 namespace fitcal::io {
@@ -24,28 +25,9 @@ std::optional<EncoderTicks> ReadEncoderTicks(const std::string& path);
 // (non-positive radius, bounds with lo > hi, nominal outside its bounds, ...).
 Omni3Robot ReadOmni3Robot(const std::string& path);
 
-// What a calibration did, stored beside the calibrated parameters.
-struct CalibrationRecord {
-  std::string method;
-  std::string objective;
-  std::string dataset;
-  std::string tool_version;
-  std::string termination;
-  std::vector<int> training_repetitions;
-  std::vector<int> validation_repetitions;
-  // Which runs trained it (`fitcal report` validates on every other run of any data set):
-  // their ids, the --train-trajectories selector when the split was by trajectory, and the
-  // fingerprint of their encoder logs (validation/training_runs.h).
-  std::vector<std::string> training_run_ids;
-  std::string training_trajectories;
-  std::string training_fingerprint;
-  std::vector<std::string> at_bound;  // parameter names resting on a bound
-  int training_runs = 0;
-  int validation_runs = 0;
-  double cf_training_before = 0.0;
-  double cf_training_after = 0.0;
-  double cf_validation_before = 0.0;
-  double cf_validation_after = 0.0;
+// What a calibration did, stored beside the calibrated parameters: the keys every model's
+// calibrated YAML has (io/calibration_block.h), then omni3's uncertainty and M^-1 (Eq. 6).
+struct CalibrationRecord : CalibrationSource {
   bool has_uncertainty = false;
   std::array<double, omni3::kNumParameters> sigma{};  // one sigma, flat order, SI + rad
   Eigen::Matrix<double, omni3::kNumParameters, omni3::kNumParameters> correlation =

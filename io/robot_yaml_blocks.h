@@ -14,6 +14,8 @@
 
 namespace fitcal::io {
 
+struct CalibrationSource;  // io/calibration_block.h
+
 // [lo, hi] of `key` times `scale`; InputError when lo > hi.
 Interval ReadBoundsPair(YamlMap& map, const std::string& key, double scale);
 
@@ -31,5 +33,13 @@ void CheckNominalInsideBounds(const Robot& robot, const std::string& path, int l
 // Emitters for the same blocks (inside an open top-level map).
 void EmitBoundsPair(YAML::Emitter& out, const std::string& key, const Interval& v, double scale);
 void EmitEncoderAndEffects(YAML::Emitter& out, const Robot& robot);
+
+// Keys of the `calibration:` block (inside its open map) that the omni3 layout and every other
+// model's write alike: what produced the calibration (method .. termination); the repetitions and
+// run counts, with the --train-trajectories selector when split so; the CF (Palacin Eq. 14)
+// before and after on the training and validation runs.
+void EmitCalibrationOrigin(YAML::Emitter& out, const CalibrationSource& c);
+void EmitCalibrationRunCounts(YAML::Emitter& out, const CalibrationSource& c);
+void EmitCalibrationCf(YAML::Emitter& out, const CalibrationSource& c);
 
 }  // namespace fitcal::io

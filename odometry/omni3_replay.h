@@ -21,74 +21,17 @@
 #include "odometry/encoder_samples.h"
 #include "odometry/omni3_model.h"
 #include "odometry/pose2.h"
+#include "odometry/replay.h"
 
 namespace fitcal::omni3 {
 
 namespace internal {
 
-inline constexpr std::size_t kChunk = 64;
-inline constexpr std::size_t kReanchorInterval = 256;  // a multiple of kChunk
-// Per-sample rotations below kTinySeriesMaxAngle use the degree-4/5 series (truncation error
-// < a^6/6! < 2.2e-17), below kShortSeriesMaxAngle the degree-6/7 series (< a^8/8! < 7e-19),
-// below kSeriesMaxAngle the degree-10/11 series (< a^12/12! < 9e-18); larger ones (never at sane
-// sample rates) the library functions.
-inline constexpr double kTinySeriesMaxAngle = 0.005;
-inline constexpr double kShortSeriesMaxAngle = 0.02;
-inline constexpr double kSeriesMaxAngle = 0.2;
-
-inline void CosSinTinySeries(double a, double* c, double* s) {
-  const double a2 = a * a;
-  *c = 1.0 + a2 * (-1.0 / 2 + a2 * (1.0 / 24));
-  *s = a * (1.0 + a2 * (-1.0 / 6 + a2 * (1.0 / 120)));
-}
-
-inline void CosSinShortSeries(double a, double* c, double* s) {
-  const double a2 = a * a;
-  *c = 1.0 + a2 * (-1.0 / 2 + a2 * (1.0 / 24 + a2 * (-1.0 / 720)));
-  *s = a * (1.0 + a2 * (-1.0 / 6 + a2 * (1.0 / 120 + a2 * (-1.0 / 5040))));
-}
-
-inline void CosSinLongSeries(double a, double* c, double* s) {
-  const double a2 = a * a;
-  *c =
-      1.0 + a2 * (-1.0 / 2 +
-                  a2 * (1.0 / 24 + a2 * (-1.0 / 720 + a2 * (1.0 / 40320 + a2 * (-1.0 / 3628800)))));
-  *s = a * (1.0 + a2 * (-1.0 / 6 +
-                        a2 * (1.0 / 120 +
-                              a2 * (-1.0 / 5040 + a2 * (1.0 / 362880 + a2 * (-1.0 / 39916800))))));
-}
-
-// For a ceres::Jet the series runs on the real part only and the derivatives follow from the
-// chain rule, d cos = -sin da, d sin = cos da: two vector scalings instead of a polynomial in
-// Jets (half of the autodiff replay's cost otherwise).
-template <typename JetT>
-inline void CosSinTinySeries(const JetT& a, JetT* c, JetT* s) {
-  double cv, sv;
-  CosSinTinySeries(a.a, &cv, &sv);
-  *c = JetT(cv, -sv * a.v);
-  *s = JetT(sv, cv * a.v);
-}
-
-template <typename JetT>
-inline void CosSinShortSeries(const JetT& a, JetT* c, JetT* s) {
-  double cv, sv;
-  CosSinShortSeries(a.a, &cv, &sv);
-  *c = JetT(cv, -sv * a.v);
-  *s = JetT(sv, cv * a.v);
-}
-
-template <typename JetT>
-inline void CosSinLongSeries(const JetT& a, JetT* c, JetT* s) {
-  double cv, sv;
-  CosSinLongSeries(a.a, &cv, &sv);
-  *c = JetT(cv, -sv * a.v);
-  *s = JetT(sv, cv * a.v);
-}
-
-struct NoVisit {
-  template <typename T>
-  void operator()(std::size_t, const Pose2<T>&) const {}
-};
+// The chunk, re-anchoring interval and per-chunk rotations (series by the chunk's largest angle)
+// are the generic replay's (odometry/replay.h).
+using replay_internal::kChunk;
+using replay_internal::kReanchorInterval;
+using replay_internal::NoVisit;
 
 }  // namespace internal
 
@@ -123,7 +66,6 @@ Pose2<T> ReplayWithMatrix(const Matrix3<T>& m_inv, const EncoderSamples& samples
     const std::size_t m = n - k0 < kChunk ? n - k0 : kChunk;
     const double* chunk = rows + k0 * kStride;
     // Pass 1: robot-frame step M^-1 w dt of every sample (Eq. 4) and its rotation.
-    double max_angle = 0.0;
     for (std::size_t j = 0; j < m; ++j) {
       const double* w = chunk + j * kStride + 1;
       const double dt = chunk[j * kStride];
@@ -131,26 +73,7 @@ Pose2<T> ReplayWithMatrix(const Matrix3<T>& m_inv, const EncoderSamples& samples
       step_y[j] = (m10 * w[0] + m11 * w[1] + m12 * w[2]) * dt;
       step_theta[j] = (m20 * w[0] + m21 * w[1] + m22 * w[2]) * dt;
     }
-    for (std::size_t j = 0; j < m; ++j) {
-      const double a = std::abs(ScalarPart(step_theta[j]));
-      max_angle = a > max_angle ? a : max_angle;
-    }
-    if (max_angle < internal::kTinySeriesMaxAngle) {
-      for (std::size_t j = 0; j < m; ++j) {
-        internal::CosSinTinySeries(step_theta[j], &rot_c[j], &rot_s[j]);
-      }
-    } else if (max_angle < internal::kShortSeriesMaxAngle) {
-      for (std::size_t j = 0; j < m; ++j)
-        internal::CosSinShortSeries(step_theta[j], &rot_c[j], &rot_s[j]);
-    } else if (max_angle < internal::kSeriesMaxAngle) {
-      for (std::size_t j = 0; j < m; ++j)
-        internal::CosSinLongSeries(step_theta[j], &rot_c[j], &rot_s[j]);
-    } else {
-      for (std::size_t j = 0; j < m; ++j) {
-        rot_c[j] = cos(step_theta[j]);
-        rot_s[j] = sin(step_theta[j]);
-      }
-    }
+    replay_internal::ChunkRotations(step_theta, m, rot_c, rot_s);
     // Pass 2: R(theta(k-1))^-1 of Eq. 5 rotates each step into the world frame. On double the
     // loop is latency-bound, so it takes two samples per iteration: (c, s) advances by the
     // product of their rotations, which does not depend on (c, s), halving the loop-carried chain

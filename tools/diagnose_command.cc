@@ -174,6 +174,30 @@ std::vector<int> ValidationRepetitions(const DiagnoseSplit& split) {
   return {reps.begin(), reps.end()};
 }
 
+// What both calibrated YAMLs record of the diagnosis: the chosen candidate, its objective, the
+// training and held-out runs, and the CF before and after on both.
+void RecordSource(const DiagnoseCommandOptions& options, const std::vector<RunLog>& logs,
+                  const DiagnoseSplit& split, const DiagnoseResult& result,
+                  const DiagnoseChoice& choice, io::CalibrationSource* source) {
+  io::CalibrationSource& s = *source;
+  s.method = "diagnose: " + choice.name;
+  s.objective = ObjectiveOf(choice);
+  s.dataset = options.logs;
+  s.tool_version = kVersion;
+  s.termination = result.final_fit.termination;
+  s.training_repetitions = split.train_reps;
+  s.validation_repetitions = ValidationRepetitions(split);
+  for (const TrackRun& r : split.training) s.training_run_ids.push_back(r.aligned.id);
+  s.training_trajectories = options.train_trajectories;
+  s.training_fingerprint = TrainingFingerprint(logs, s.training_run_ids);
+  s.training_runs = static_cast<int>(split.training.size());
+  s.validation_runs = static_cast<int>(split.validation.size());
+  s.cf_training_before = choice.cf_training_before;
+  s.cf_training_after = choice.cf_training_after;
+  s.cf_validation_before = choice.cf_before;
+  s.cf_validation_after = choice.cf_after;
+}
+
 // The calibrated omni3 YAML as before the seam (with M^-1 in the record).
 std::string Omni3CalibratedYaml(const DiagnoseCommandOptions& options, const std::string& path,
                                 const std::vector<RunLog>& logs, const DiagnoseSplit& split,
@@ -183,22 +207,7 @@ std::string Omni3CalibratedYaml(const DiagnoseCommandOptions& options, const std
   calibrated.nominal = omni3::Parameters::FromArray(choice.parameters.data());
   calibrated.effects = choice.effects;
   io::CalibrationRecord record;
-  record.method = "diagnose: " + choice.name;
-  record.objective = ObjectiveOf(choice);
-  record.dataset = options.logs;
-  record.tool_version = kVersion;
-  record.termination = result.final_fit.termination;
-  record.training_repetitions = split.train_reps;
-  for (const TrackRun& r : split.training) record.training_run_ids.push_back(r.aligned.id);
-  record.training_trajectories = options.train_trajectories;
-  record.training_fingerprint = TrainingFingerprint(logs, record.training_run_ids);
-  record.training_runs = static_cast<int>(split.training.size());
-  record.validation_runs = static_cast<int>(split.validation.size());
-  record.validation_repetitions = ValidationRepetitions(split);
-  record.cf_training_before = choice.cf_training_before;
-  record.cf_training_after = choice.cf_training_after;
-  record.cf_validation_before = choice.cf_before;
-  record.cf_validation_after = choice.cf_after;
+  RecordSource(options, logs, split, result, choice, &record);
   record.has_uncertainty = choice.sigma.size() == record.sigma.size();
   if (record.has_uncertainty) {
     std::copy(choice.sigma.begin(), choice.sigma.end(), record.sigma.begin());
@@ -215,22 +224,7 @@ std::string ModelCalibratedYaml(const DiagnoseCommandOptions& options,
                                 const DiagnoseChoice& choice) {
   const Robot& robot = model.robot();
   io::CalibrationBlock block;
-  block.method = "diagnose: " + choice.name;
-  block.objective = ObjectiveOf(choice);
-  block.dataset = options.logs;
-  block.tool_version = kVersion;
-  block.termination = result.final_fit.termination;
-  block.training_repetitions = split.train_reps;
-  block.validation_repetitions = ValidationRepetitions(split);
-  for (const TrackRun& r : split.training) block.training_run_ids.push_back(r.aligned.id);
-  block.training_trajectories = options.train_trajectories;
-  block.training_fingerprint = TrainingFingerprint(logs, block.training_run_ids);
-  block.training_runs = static_cast<int>(split.training.size());
-  block.validation_runs = static_cast<int>(split.validation.size());
-  block.cf_training_before = choice.cf_training_before;
-  block.cf_training_after = choice.cf_training_after;
-  block.cf_validation_before = choice.cf_before;
-  block.cf_validation_after = choice.cf_after;
+  RecordSource(options, logs, split, result, choice, &block);
   block.selected = choice.name;
   block.selected_on = "held-out runs (" + std::to_string(split.validation.size()) + ")";
   for (const HeldParameter& h : robot.held) block.held.push_back(robot.parameters[h.index].name);

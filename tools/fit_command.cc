@@ -302,13 +302,7 @@ int RunFitCommand(const FitCommandOptions& options) {
     }
     const GateDecision gate = SelectCalibration(*Omni3ModelOf(robot), candidates, split.training,
                                                 split.validation, options.threads);
-    std::printf("\nresult gate, CF on %s:\n", gate.judged_on.c_str());
-    for (const std::string& line : GateLines(candidates, gate)) std::printf("%s\n", line.c_str());
-    if (!gate.improves_on_nominal()) {
-      std::cerr << "fitcal: no calibration beats the nominal robot on the " << gate.judged_on
-                << "; nothing written\n";
-      return 5;
-    }
+    if (!PrintGate(candidates, gate)) return 5;
 
     if (!options.no_output) {
       // What the gate selected (the fit, or the fit without its holds) is written, with the CF
@@ -318,23 +312,11 @@ int RunFitCommand(const FitCommandOptions& options) {
       Omni3Robot calibrated = robot;
       calibrated.nominal = omni3::Parameters::FromArray(selected);
       io::CalibrationRecord record;
-      record.method = candidates[gate.selected].name;
-      record.objective = outcome.objective + " (sigma_xy " +
-                         std::to_string(options.position_sigma_m) + " m, sigma_theta " +
-                         std::to_string(options.heading_sigma_deg) + " deg)";
-      record.dataset = options.logs;
-      record.tool_version = kVersion;
-      record.termination = fit.termination;
-      record.training_repetitions = split.training_repetitions;
-      record.validation_repetitions = split.validation_repetitions;
-      for (const AlignedRun& run : split.training) record.training_run_ids.push_back(run.id);
-      record.training_trajectories = options.train_trajectories;
-      record.training_fingerprint = TrainingFingerprint(dataset.runs, record.training_run_ids);
+      RecordFitSource(options, dataset.runs, split, candidates[gate.selected].name,
+                      outcome.objective, fit.termination, &record);
       for (int k = 0; k < omni3::kNumParameters; ++k) {
         if (fit_won && fit.at_bound[k]) record.at_bound.push_back(ParameterName(k));
       }
-      record.training_runs = static_cast<int>(split.training.size());
-      record.validation_runs = static_cast<int>(split.validation.size());
       Omni3ParameterArray selected_array;
       std::copy(selected, selected + omni3::kNumParameters, selected_array.begin());
       record.cf_training_before = train_before.cf;

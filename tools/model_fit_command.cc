@@ -97,6 +97,38 @@ std::vector<CalibrationCandidate> Candidates(const RobotModelInterface& model,
   return out;
 }
 
+}  // namespace
+
+bool PrintGate(const std::vector<CalibrationCandidate>& candidates, const GateDecision& gate) {
+  std::printf("\nresult gate, CF on %s:\n", gate.judged_on.c_str());
+  for (const std::string& line : GateLines(candidates, gate)) std::printf("%s\n", line.c_str());
+  if (gate.improves_on_nominal()) return true;
+  std::cerr << "fitcal: no calibration beats the nominal robot on the " << gate.judged_on
+            << "; nothing written\n";
+  return false;
+}
+
+void RecordFitSource(const FitCommandOptions& options, const std::vector<RunLog>& logs,
+                     const RunSplit& split, const std::string& method, const std::string& objective,
+                     const std::string& termination, io::CalibrationSource* source) {
+  io::CalibrationSource& s = *source;
+  s.method = method;
+  s.objective = objective + " (sigma_xy " + std::to_string(options.position_sigma_m) +
+                " m, sigma_theta " + std::to_string(options.heading_sigma_deg) + " deg)";
+  s.dataset = options.logs;
+  s.tool_version = kVersion;
+  s.termination = termination;
+  s.training_repetitions = split.training_repetitions;
+  s.validation_repetitions = split.validation_repetitions;
+  for (const AlignedRun& run : split.training) s.training_run_ids.push_back(run.id);
+  s.training_trajectories = options.train_trajectories;
+  s.training_fingerprint = TrainingFingerprint(logs, s.training_run_ids);
+  s.training_runs = static_cast<int>(split.training.size());
+  s.validation_runs = static_cast<int>(split.validation.size());
+}
+
+namespace {
+
 io::CalibrationBlock MakeRecord(const FitCommandOptions& options, const RobotModelInterface& model,
                                 const std::vector<RunLog>& logs, const RunSplit& split,
                                 const ModelFitResult& fit, const std::string& objective,
@@ -105,19 +137,8 @@ io::CalibrationBlock MakeRecord(const FitCommandOptions& options, const RobotMod
   const Robot& robot = model.robot();
   const std::vector<double>& p = candidates[gate.selected].parameters;
   io::CalibrationBlock r;
-  r.method = candidates[gate.selected].name;
-  r.objective = objective + " (sigma_xy " + std::to_string(options.position_sigma_m) +
-                " m, sigma_theta " + std::to_string(options.heading_sigma_deg) + " deg)";
-  r.dataset = options.logs;
-  r.tool_version = kVersion;
-  r.termination = fit.termination;
-  r.training_repetitions = split.training_repetitions;
-  r.validation_repetitions = split.validation_repetitions;
-  for (const AlignedRun& run : split.training) r.training_run_ids.push_back(run.id);
-  r.training_trajectories = options.train_trajectories;
-  r.training_fingerprint = TrainingFingerprint(logs, r.training_run_ids);
-  r.training_runs = static_cast<int>(split.training.size());
-  r.validation_runs = static_cast<int>(split.validation.size());
+  RecordFitSource(options, logs, split, candidates[gate.selected].name, objective, fit.termination,
+                  &r);
   r.cf_training_before =
       EvaluateFinalPoseErrors(model, robot.nominal, split.training, options.threads).cf;
   r.cf_training_after = EvaluateFinalPoseErrors(model, p, split.training, options.threads).cf;
@@ -267,13 +288,7 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   PrintFit(options, *model, split, selected, *method, outcome);
   if (!fit.has_covariance) std::printf("uncertainty: %s\n", fit.covariance_message.c_str());
   for (const UndeterminedDirection& d : fit.held_directions) PrintHeldAtNominal(d.description);
-  std::printf("\nresult gate, CF on %s:\n", gate.judged_on.c_str());
-  for (const std::string& line : GateLines(candidates, gate)) std::printf("%s\n", line.c_str());
-  if (!gate.improves_on_nominal()) {
-    std::cerr << "fitcal: no calibration beats the nominal robot on the " << gate.judged_on
-              << "; nothing written\n";
-    return 5;
-  }
+  if (!PrintGate(candidates, gate)) return 5;
   if (!options.no_output) {
     const io::CalibrationBlock record =
         MakeRecord(options, *model, dataset.runs, split, fit, outcome.objective, candidates, gate);

@@ -8,15 +8,29 @@
 
 #include <string>
 
+#include "fit/result_gate.h"
+#include "io/calibration_block.h"
 #include "io/dataset.h"
 #include "models/model_interface.h"
 #include "tools/fit_command.h"
+#include "validation/run_split.h"
 
 namespace fitcal::tools {
 
 // One line of the fit's output per direction held at the nominal (fit/determined_directions.h),
 // the same for omni3's fit and every other model's.
 void PrintHeldAtNominal(const std::string& direction);
+
+// The result gate's table (fit/result_gate.h), the same for omni3's fit and every other model's;
+// false, with one line on stderr, when no candidate beats the nominal (exit 5, nothing written).
+bool PrintGate(const std::vector<CalibrationCandidate>& candidates, const GateDecision& gate);
+
+// The `calibration:` keys omni3's fit and every other model's record alike: the method the result
+// gate selected, the fit's objective with the weights, the data set, the fit's termination and
+// the training and held-out runs (logs: all of them, for the training runs' fingerprint).
+void RecordFitSource(const FitCommandOptions& options, const std::vector<RunLog>& logs,
+                     const RunSplit& split, const std::string& method, const std::string& objective,
+                     const std::string& termination, io::CalibrationSource* source);
 
 // Exit codes as README "Exit codes"; 5 when no candidate beats the nominal (nothing written).
 int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex& index,

@@ -311,6 +311,8 @@ OmniWheel ReadWheel(const YAML::Node& node, const std::string& path, int index) 
   return w;
 }
 
+}  // namespace
+
 OmniBounds ReadOmniBounds(io::YamlMap& robot_map, const std::string& path) {
   io::YamlMap bounds(robot_map.Required("bounds"), path, "bounds");
   OmniBounds box;
@@ -324,8 +326,6 @@ OmniBounds ReadOmniBounds(io::YamlMap& robot_map, const std::string& path) {
   }
   return box;
 }
-
-}  // namespace
 
 RobotModelPtr MakeOmniModel(const std::string& name, const std::vector<OmniWheel>& wheels,
                             const OmniBounds& bounds, const std::optional<EncoderTicks>& encoder) {

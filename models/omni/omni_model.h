@@ -35,6 +35,10 @@
 
 namespace fitcal {
 
+namespace io {
+class YamlMap;  // io/yaml_reader.h
+}  // namespace io
+
 inline constexpr int kOmniMinWheels = 3;
 inline constexpr int kOmniMaxWheels = 8;
 
@@ -55,6 +59,10 @@ struct OmniBounds {
   Interval radius_m;
   Interval angle_offset_rad;  // relative to each wheel's nominal angle
 };
+
+// The `bounds:` block of an omni or omni3 robot YAML (the box of Palacin Eq. 16), read strictly;
+// InputError for a bound on distance or radius that is not positive.
+OmniBounds ReadOmniBounds(io::YamlMap& robot_map, const std::string& path);
 
 // A mecanum robot in ros2_controllers' layout: wheels at (+-0.2, +-0.15) m, all driven forward,
 // rollers -45 deg on the front-left/rear-right and +45 deg on the front-right/rear-left wheels.

@@ -7,6 +7,7 @@
 #include "io/input_error.h"
 #include "io/robot_yaml_blocks.h"
 #include "io/yaml_reader.h"
+#include "models/omni/omni_model.h"
 
 namespace fitcal {
 
@@ -15,26 +16,6 @@ namespace {
 using io::InputError;
 using io::InputErrorKind;
 using io::LineOf;
-
-struct Omni3Box {
-  Interval distance_m;
-  Interval radius_m;
-  Interval angle_offset_rad;
-};
-
-Omni3Box ReadOmni3Bounds(io::YamlMap& robot_map, const std::string& path) {
-  io::YamlMap bounds(robot_map.Required("bounds"), path, "bounds");
-  Omni3Box box;
-  box.distance_m = io::ReadBoundsPair(bounds, "distance_m", 1.0);
-  box.radius_m = io::ReadBoundsPair(bounds, "radius_m", 1.0);
-  box.angle_offset_rad = io::ReadBoundsPair(bounds, "angle_offset_deg", M_PI / 180.0);
-  bounds.RejectUnread();
-  if (!(box.distance_m.lo > 0.0) || !(box.radius_m.lo > 0.0)) {
-    throw InputError(InputErrorKind::kBadValue, path, LineOf(robot_map.Required("bounds")),
-                     "bounds on distance_m and radius_m must be positive");
-  }
-  return box;
-}
 
 }  // namespace
 
@@ -87,7 +68,7 @@ RobotModelPtr ReadOmni3Model(const YAML::Node& root, const std::string& path) {
     }
     wheel.RejectUnread();
   }
-  const Omni3Box box = ReadOmni3Bounds(robot_map, path);
+  const OmniBounds box = ReadOmniBounds(robot_map, path);
   Robot robot = Omni3RobotDescription(name, names);
   robot.nominal.assign(p.begin(), p.end());
   for (int i = 0; i < omni3::kNumWheels; ++i) robot.bounds.push_back(box.distance_m);
