@@ -462,6 +462,25 @@ Pose2d AuthorsFinalPose(const fs::path& file, double diameter_m, double l1_plus_
   return pose;
 }
 
+// The pruned layout check returns the same best two as replaying all 384 candidates over every
+// run, to the bit (same sums in the same run order).
+TEST(OptiOdomOmni4, PrunedLayoutCheckFindsTheExhaustiveBestTwo) {
+  if (!fs::is_directory(kSession)) GTEST_SKIP() << "no " << kSession;
+  const std::vector<tools::OptiOdomOmni4Session> sessions = {
+      tools::ReadOptiOdomOmni4Session(kSession.string())};
+  const RobotModelPtr model = tools::OptiOdomOmni4NominalModel(sessions[0].metadata);
+  const auto pruned = tools::CheckOmni4Layout(sessions, *model);
+  const auto all = tools::CheckOmni4Layout(sessions, *model, tools::LayoutSearch::kExhaustive);
+  ASSERT_EQ(all.size(), 2u);
+  ASSERT_EQ(pruned.size(), 2u);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_EQ(pruned[i].mean_window_error, all[i].mean_window_error) << i;
+    EXPECT_EQ(pruned[i].mapping.column, all[i].mapping.column) << i;
+    EXPECT_EQ(pruned[i].mapping.sign, all[i].mapping.sign) << i;
+  }
+  EXPECT_TRUE(pruned[0].mapping.IsIdentity());
+}
+
 TEST(OptiOdomOmni4, ImportedSessionReproducesTheAuthorsNominalOdometry) {
   if (!fs::is_directory(kSession)) GTEST_SKIP() << "no " << kSession;
   const fs::path out = fs::temp_directory_path() / ("fitcal_omni4_" + std::to_string(::getpid()));

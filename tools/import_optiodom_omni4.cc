@@ -5,7 +5,9 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <map>
+#include <mutex>
 #include <regex>
 
 #include "fit/pose_errors.h"
@@ -308,6 +310,30 @@ void AddWindowErrors(const LayoutRun& run, const RobotModelInterface& model,
   }
 }
 
+// The two smallest complete window-error sums seen so far, shared by the threads of the layout
+// check.
+class SmallestTwoSums {
+ public:
+  double Second() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return second_;
+  }
+  void Offer(double sum) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (sum < first_) {
+      second_ = first_;
+      first_ = sum;
+    } else if (sum < second_) {
+      second_ = sum;
+    }
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  double first_ = std::numeric_limits<double>::infinity();
+  double second_ = std::numeric_limits<double>::infinity();
+};
+
 }  // namespace
 
 OptiOdomOmni4Session ReadOptiOdomOmni4Session(const std::string& directory) {
@@ -377,7 +403,8 @@ RobotModelPtr OptiOdomOmni4NominalModel(const OptiOdomOmni4Metadata& metadata) {
 }
 
 std::vector<Omni4LayoutScore> CheckOmni4Layout(const std::vector<OptiOdomOmni4Session>& sessions,
-                                               const RobotModelInterface& model) {
+                                               const RobotModelInterface& model,
+                                               LayoutSearch search) {
   std::vector<const RunLog*> logs;
   for (const OptiOdomOmni4Session& s : sessions) {
     for (const RunLog& log : s.runs) logs.push_back(&log);
@@ -385,21 +412,35 @@ std::vector<Omni4LayoutScore> CheckOmni4Layout(const std::vector<OptiOdomOmni4Se
   std::vector<LayoutRun> runs(logs.size());
   ParallelFor(logs.size(), 0, [&](std::size_t r) { runs[r] = MakeLayoutRun(*logs[r]); });
   const std::vector<ChannelMapping> candidates = model.CandidateMiswirings();
+  SmallestTwoSums smallest;
   std::vector<Omni4LayoutScore> scores(candidates.size());
+  std::vector<char> complete(candidates.size(), 0);
   ParallelFor(candidates.size(), 0, [&](std::size_t m) {
     double sum = 0.0;
     int count = 0;
     EncoderSamples mapped(kWheels);
     std::vector<Pose2d> odometry;
     for (const LayoutRun& run : runs) {
+      // Window errors are non-negative: past the second smallest complete sum, this candidate
+      // cannot be among the best two.
+      if (search == LayoutSearch::kPruned && sum > smallest.Second()) return;
       AddWindowErrors(run, model, candidates[m], &mapped, &odometry, &sum, &count);
     }
+    smallest.Offer(sum);
     scores[m] = {candidates[m], count > 0 ? sum / count : 0.0};
+    complete[m] = 1;
   });
-  std::stable_sort(scores.begin(), scores.end(), [](const auto& a, const auto& b) {
+  std::vector<Omni4LayoutScore> best;
+  for (std::size_t m = 0; m < candidates.size(); ++m) {
+    if (complete[m]) best.push_back(scores[m]);
+  }
+  std::stable_sort(best.begin(), best.end(), [](const auto& a, const auto& b) {
     return a.mean_window_error < b.mean_window_error;
   });
-  return scores;
+  // Which other candidates ran to the end depends on the threads' timing: keep the two that are
+  // exact whatever it was.
+  if (best.size() > 2) best.resize(2);
+  return best;
 }
 
 Omni4ImportResult ImportOptiOdomOmni4(const std::vector<std::string>& session_dirs,

@@ -79,18 +79,24 @@ RobotModelPtr OptiOdomOmni4NominalModel(const OptiOdomOmni4Metadata& metadata);
 // signs) scored by the mean relative pose error over 2 s windows (1 s apart) at the nominal
 // parameters, over every run (replayed at 100 ms: ten cycles merged, their mean rates). Single
 // runs can be blind to a swap (a spin turns every wheel alike), so all runs are used. The
-// identity must come first.
+// identity must come first. Returns the best two, exact, best first: a candidate stops being
+// replayed once its partial sum exceeds the second smallest complete one (the errors are
+// non-negative, so it cannot be among the two), which rules out most of the 384 within a few runs.
 struct Omni4LayoutScore {
   ChannelMapping mapping;
   double mean_window_error = 0.0;  // |translation error| (m) + |heading error| (rad) per window
 };
+// kExhaustive replays every candidate over every run (for the test that the pruning changes
+// nothing).
+enum class LayoutSearch { kPruned, kExhaustive };
 std::vector<Omni4LayoutScore> CheckOmni4Layout(const std::vector<OptiOdomOmni4Session>& sessions,
-                                               const RobotModelInterface& model);
+                                               const RobotModelInterface& model,
+                                               LayoutSearch search = LayoutSearch::kPruned);
 
 struct Omni4ImportResult {
   int num_sessions = 0;
   int num_runs = 0;
-  std::vector<Omni4LayoutScore> layout;  // best first
+  std::vector<Omni4LayoutScore> layout;  // the best two, best first
   double nominal_mean_cf = 0.0;          // mean over runs of |final-pose residual| (Eq. 14)
   std::vector<std::string> notes;        // e.g. sessions that declare perturbed nominal values
 };
