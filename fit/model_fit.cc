@@ -17,7 +17,8 @@ namespace fitcal {
 
 namespace {
 
-constexpr int kMaxActiveSetRounds = 8;
+// Rounds of the active set: one per parameter that comes to rest on a bound, and releases.
+constexpr int kMaxActiveSetRounds = 16;
 
 // Directions held at the nominal and the hold's weight (residual units per prior sigma).
 struct HeldDirections {
@@ -121,6 +122,37 @@ class FitProblem {
   std::vector<ceres::ResidualBlockId> data_blocks_;
 };
 
+// Ends a bounded solve once a free parameter has rested on its bound (AtBound) for
+// kBoundContactSteps successful steps in a row: from there Ceres' projected steps only crawl
+// (header comment), so the active set takes over at once instead of after the iteration limit.
+constexpr int kBoundContactSteps = 3;
+
+class BoundContactStop : public ceres::IterationCallback {
+ public:
+  BoundContactStop(const Robot& robot, const double* p, const std::vector<bool>& fixed)
+      : robot_(robot), p_(p), fixed_(fixed) {}
+
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
+    if (summary.iteration == 0 || !summary.step_is_successful) return ceres::SOLVER_CONTINUE;
+    bool resting = false;
+    for (int k = 0; k < robot_.NumParameters(); ++k) {
+      resting = resting || (!fixed_[k] && AtBound(p_[k], robot_.bounds[k]));
+    }
+    contact_steps_ = resting ? contact_steps_ + 1 : 0;
+    if (contact_steps_ < kBoundContactSteps) return ceres::SOLVER_CONTINUE;
+    fired_ = true;
+    return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+  }
+  bool fired() const { return fired_; }
+
+ private:
+  const Robot& robot_;
+  const double* p_;  // the parameter block, updated every iteration
+  const std::vector<bool>& fixed_;
+  int contact_steps_ = 0;
+  bool fired_ = false;
+};
+
 ceres::Solver::Options SolverOptionsFor(const CeresFitOptions& options) {
   DenseSolverTolerances tolerances;
   tolerances.function = options.function_tolerance;
@@ -143,11 +175,41 @@ void Accumulate(const ceres::Solver::Summary& summary, ModelFitResult* result) {
   result->final_cost = summary.final_cost;
 }
 
+// One Ceres solve of `fit` whose parameters are `p` with `fixed` held. With the active set on, a
+// BoundContactStop ends it early; it then reports NO_CONVERGENCE, which hands the point to the
+// active set, and the function returns true.
+bool SolveUntilBoundContact(const Robot& robot, const ModelFitOptions& options,
+                            const std::vector<bool>& fixed, double* p, ceres::Problem* problem,
+                            ceres::Solver::Summary* summary) {
+  ceres::Solver::Options solver_options = SolverOptionsFor(options.ceres);
+  BoundContactStop stop(robot, p, fixed);
+  if (options.active_set_bounds) {
+    solver_options.update_state_every_iteration = true;
+    solver_options.callbacks.push_back(&stop);
+  }
+  ceres::Solve(solver_options, problem, summary);
+  if (!stop.fired() || summary->termination_type != ceres::USER_SUCCESS) return false;
+  summary->termination_type = ceres::NO_CONVERGENCE;
+  summary->message = "a parameter rests on its bound: the active set takes over";
+  return true;
+}
+
 // Which parameters rest on a bound of the robot's box (AtBound).
 std::vector<bool> ParametersAtBound(const Robot& robot, const std::vector<double>& p) {
   std::vector<bool> out(p.size(), false);
   for (std::size_t k = 0; k < p.size(); ++k) out[k] = AtBound(p[k], robot.bounds[k]);
   return out;
+}
+
+// Fixes every parameter that rests on a bound (AtBound) exactly on it.
+void FixParametersAtBound(const Robot& robot, std::vector<double>* p, std::vector<bool>* fixed) {
+  const std::vector<bool> on_bound = ParametersAtBound(robot, *p);
+  for (std::size_t k = 0; k < p->size(); ++k) {
+    if (!on_bound[k]) continue;
+    (*fixed)[k] = true;
+    const Interval& box = robot.bounds[k];
+    (*p)[k] = (*p)[k] - box.lo < box.hi - (*p)[k] ? box.lo : box.hi;
+  }
 }
 
 // Active-set rounds after a bounded solve that did not converge (header comment). Returns the
@@ -161,18 +223,17 @@ ceres::Solver::Summary RefineWithActiveSet(const std::vector<AlignedRun>& traini
   const int n = robot.NumParameters();
   std::vector<double>& p = result->parameters;
   std::vector<bool> fixed = result->held;
-  const std::vector<bool> on_bound = ParametersAtBound(robot, p);
-  for (int k = 0; k < n; ++k) {
-    if (!on_bound[k]) continue;
-    fixed[k] = true;
-    p[k] = p[k] - robot.bounds[k].lo < robot.bounds[k].hi - p[k] ? robot.bounds[k].lo
-                                                                 : robot.bounds[k].hi;
-  }
+  FixParametersAtBound(robot, &p, &fixed);
   for (int round = 0; round < kMaxActiveSetRounds; ++round) {
     ++result->active_set_rounds;
     FitProblem fit(training, model, options, fixed, p.data(), holds);
-    ceres::Solve(SolverOptionsFor(options.ceres), &fit.problem(), &summary);
+    const bool contact =
+        SolveUntilBoundContact(robot, options, fixed, p.data(), &fit.problem(), &summary);
     Accumulate(summary, result);
+    if (contact) {  // another parameter came to rest on its bound: fix it too
+      FixParametersAtBound(robot, &p, &fixed);
+      continue;
+    }
     if (summary.termination_type != ceres::CONVERGENCE) break;
     // Release a bound parameter whose descent direction points into the box.
     FitProblem all_free(training, model, options, result->held, p.data(), holds);
@@ -265,7 +326,8 @@ ModelFitResult SolveFrom(const std::vector<AlignedRun>& training, const RobotMod
   ceres::Solver::Summary summary;
   {
     FitProblem fit(training, model, options, result.held, result.parameters.data(), holds);
-    ceres::Solve(SolverOptionsFor(options.ceres), &fit.problem(), &summary);
+    SolveUntilBoundContact(robot, options, result.held, result.parameters.data(), &fit.problem(),
+                           &summary);
   }
   result.initial_cost = summary.initial_cost;
   Accumulate(summary, &result);

@@ -104,7 +104,7 @@ TEST(FitcalCli, FitStoppedAtTheIterationLimitIsWrittenAndFlagged) {
 // The real OptiOdom three-wheel robot (skipped without ../shared): every split a user would try
 // converges and writes a calibration that beats the nominal on the runs it did not train on (on
 // the training runs for 1-99, which leaves none), as the calibration block records it.
-TEST(FitcalCli, RealOmni3EverySplitWritesACalibrationBetterThanNominal) {
+TEST(FitcalCli, RealOmni3SplitsWriteABetterCalibrationOrNothing) {
   const std::string shared = std::string(FITCAL_SHARED_DIR) + "/data/optiodom/omni3";
   if (!std::filesystem::is_directory(shared)) GTEST_SKIP() << "no " << shared;
   TempDir dir;
@@ -112,12 +112,19 @@ TEST(FitcalCli, RealOmni3EverySplitWritesACalibrationBetterThanNominal) {
   const Result imported = RunFitcal(
       dir, "import optiodom " + shared + "/circular/* " + shared + "/square/* --out " + data);
   ASSERT_EQ(imported.exit_code, 0) << imported.err;
+  // Two repetitions leave six directions weak: there the gate may find no fit better than the
+  // nominal on the held-out runs, and must then write nothing (exit 5). With more runs a better
+  // calibration is written.
   for (const std::string split : {"--train-reps 1-2", "--train-reps 1-5", "--train-reps 1-99",
                                   "--train-trajectories '^circular'"}) {
     SCOPED_TRACE(split);
     const std::string out = dir.Path("cal.yaml");
     std::remove(out.c_str());
     const Result r = RunFitcal(dir, "fit --logs " + data + " " + split + " --out " + out);
+    if (split == "--train-reps 1-2" && r.exit_code == 5) {
+      EXPECT_FALSE(std::filesystem::exists(out));
+      continue;
+    }
     ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
     const YAML::Node calibration = YAML::LoadFile(out)["calibration"];
     const char* judged = split == "--train-reps 1-99" ? "cf_training" : "cf_validation";
