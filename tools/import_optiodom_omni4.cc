@@ -254,6 +254,13 @@ EncoderSamples Merged(const EncoderSamples& samples) {
   return out;
 }
 
+// Whether merged interval k ends a window stride: a complete one (all kMerge cycles in the log),
+// so the ground-truth row (k + 1) * kMerge closes it. The odometry and the ground truth of a
+// window must use the same ends.
+bool EndsWindowStride(std::size_t k, std::size_t num_cycles) {
+  return (k + 1) % kWindowStride == 0 && (k + 1) * kMerge <= num_cycles;
+}
+
 // What the layout check needs of a run besides the mapping: the merged samples, the rows of the
 // ground truth that end every kWindowStride-th merged interval, and the ground truth's relative
 // poses Q_i^-1 Q_{i+2} between them. Computed once, not once per candidate mapping.
@@ -269,9 +276,7 @@ LayoutRun MakeLayoutRun(const RunLog& log) {
   run.merged = Merged(log.encoders.samples);
   std::vector<std::size_t> row(1, 0);
   for (std::size_t k = 0; k < run.merged.size(); ++k) {
-    if ((k + 1) % kWindowStride == 0 && (k + 1) * kMerge <= log.encoders.samples.size()) {
-      row.push_back((k + 1) * kMerge);
-    }
+    if (EndsWindowStride(k, log.encoders.samples.size())) row.push_back((k + 1) * kMerge);
   }
   const std::vector<Pose2d>& truth = log.ground_truth.world_T_robot;
   for (std::size_t i = 0; i + 2 < row.size(); ++i) {
@@ -295,13 +300,10 @@ void AddWindowErrors(const LayoutRun& run, const RobotModelInterface& model,
   }
   const RunLog& log = *run.log;
   odometry->assign(1, log.ground_truth.world_T_robot.front());
-  model.Replay(
-      model.robot().nominal.data(), *mapped, 0, mapped->size(), odometry->front(),
-      [&](std::size_t k, const Pose2d& pose) {
-        if ((k + 1) % kWindowStride == 0 && (k + 1) * kMerge <= log.encoders.samples.size()) {
-          odometry->push_back(pose);
-        }
-      });
+  model.Replay(model.robot().nominal.data(), *mapped, 0, mapped->size(), odometry->front(),
+               [&](std::size_t k, const Pose2d& pose) {
+                 if (EndsWindowStride(k, log.encoders.samples.size())) odometry->push_back(pose);
+               });
   for (std::size_t i = 0; i + 2 < odometry->size(); ++i) {
     double r[3];
     SegmentError((*odometry)[i], (*odometry)[i + 2], run.truth_window[i], ResidualWeights{}, r);
