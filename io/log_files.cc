@@ -531,13 +531,6 @@ GroundTruthTrack ReadGroundTruthRows(TextFileReader& lines) {
       add(Pose2d{row[1], row[2], YawOfTumRow(row, path, lines.line_number(), &repairs)});
     } while (lines.Next(&line));
   } else {
-    // Reserve once, as for the encoder log: a 10 ms track is never copied while it grows.
-    const int header_line = lines.line_number();
-    const std::size_t rows = lines.CountLinesAndRewind();
-    track.t_s.reserve(rows);
-    track.world_T_robot.reserve(rows);
-    while (lines.line_number() < header_line && lines.Next(&line)) {
-    }
     while (lines.Next(&line)) {
       if (IsBlank(line)) continue;
       ParseRow(line, ',', 4, path, lines.line_number(), row);
