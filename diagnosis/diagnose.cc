@@ -92,14 +92,9 @@ std::string ExplainedText(double base_lof_f, double candidate_lof_f) {
 
 // Every identifiable effect of the registry that this robot's channels can show.
 std::vector<EffectId> DefaultCandidates(const Robot& robot) {
-  bool has_angle = false;
-  for (const ChannelInfo& c : robot.channels)
-    has_angle = has_angle || c.kind == ChannelKind::kAngle;
   std::vector<EffectId> out;
   for (const auto& info : effects::EffectTable()) {
-    if (info.identifiable && (has_angle || !effects::NeedsAngleChannel(info.id))) {
-      out.push_back(info.id);
-    }
+    if (info.identifiable && CanShowEffect(robot, info.id)) out.push_back(info.id);
   }
   return out;
 }

@@ -82,6 +82,33 @@ std::vector<Segment> MakeSegments(const AlignedRun& run, const GroundTruthTrack&
   return out;
 }
 
+std::vector<Segment> MakeCheckpointsFromStart(const AlignedRun& run,
+                                              const GroundTruthTrack& ground_truth,
+                                              double spacing_m) {
+  if (!(spacing_m > 0.0)) throw std::invalid_argument("checkpoint spacing must be positive");
+  const std::vector<double> t = BoundaryTimes(run);
+  std::vector<Segment> out;
+  if (t.size() < 2) return out;
+  const Pose2d start = InterpolateGroundTruth(ground_truth, t[0]);
+  Pose2d previous = start;
+  double path_m = 0.0, next_checkpoint_m = spacing_m;
+  for (std::size_t j = 1; j < t.size(); ++j) {
+    const Pose2d q = InterpolateGroundTruth(ground_truth, t[j]);
+    path_m += std::hypot(q.x - previous.x, q.y - previous.y);
+    previous = q;
+    const bool last = j + 1 == t.size();
+    if (path_m < next_checkpoint_m && !last) continue;
+    Segment seg;
+    seg.begin = 0;
+    seg.end = j;
+    seg.ground_truth_start_T_end = Between(start, q);
+    seg.path_length_m = path_m;
+    out.push_back(seg);
+    next_checkpoint_m = path_m + spacing_m;  // the count restarts at each, as the authors'
+  }
+  return out;
+}
+
 SegmentErrors EvaluateSegmentErrors(const Omni3ParameterArray& p,
                                     const std::vector<SegmentedRun>& runs, int num_threads) {
   std::vector<SegmentErrors> per_run(runs.size());

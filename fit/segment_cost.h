@@ -37,6 +37,17 @@ struct SegmentOptions {
 std::vector<Segment> MakeSegments(const AlignedRun& run, const GroundTruthTrack& ground_truth,
                                   const SegmentOptions& options);
 
+// Sousa et al.'s OptiOdom cost ("OptiOdom: a Generic Approach for Odometry Calibration of Wheeled
+// Mobile Robots", J. Intell. Robot. Syst. 2022; their simulateRobot_*.m and Rprop_*.m): windows
+// that all begin at the run's start and end at a checkpoint after every `spacing_m` of path since
+// the previous one, and at the run's end, so each accumulates the whole drift up to its checkpoint.
+// The authors count 0.5 m of nominal odometry distance; the ground truth's path length is counted
+// here, which does not move with the parameters being fitted. With a heading weight near zero the
+// segment residual's squared norm is their cost, the squared position error in the start frame.
+std::vector<Segment> MakeCheckpointsFromStart(const AlignedRun& run,
+                                              const GroundTruthTrack& ground_truth,
+                                              double spacing_m);
+
 struct SegmentErrors {
   double cf = 0.0;  // mean over windows of |r| (metres and radians, Eq. 14 per window)
   double mean_translation_error_m = 0.0;

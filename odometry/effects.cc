@@ -169,6 +169,18 @@ const std::array<EffectInfo, kNumEffects>& EffectTable() {
        true,
        "nothing while the steering angle is constant",
        "runs that change the steering angle while driving (squares, slaloms)"},
+      {EffectId::kPivotYawGain,
+       "pivot_yaw_gain",
+       "the yaw rate grows as a wheel pair's turn tightens towards a pivot",
+       "omega' = omega (1 + g |w_R - w_L| / (|w_R| + |w_L|))",
+       1,
+       {"gain", ""},
+       {-0.1, 0},
+       {0.1, 0},
+       {0.007, 0},
+       true,
+       "the wheel separation when every run turns at one radius",
+       "runs at two turning radii: circles and pivot turns (UMBmark squares)"},
   }};
   return table;
 }
@@ -243,6 +255,11 @@ std::vector<SampleContext> MakeSampleContexts(const EncoderSamples& samples, uns
                                    InterpolateAt(mid, value[i], mid[k] - h)) /
                                       (2.0 * h);
       }
+    }
+    if (channels == 2 && c.wheel_mask == 0x3u) {
+      const double a = samples[k].value[0], b = samples[k].value[1];
+      const double sum = std::abs(a) + std::abs(b);
+      c.turn_fraction = sum > 0.0 ? std::abs(a - b) / sum : 0.0;
     }
   }
   return out;

@@ -49,6 +49,7 @@ enum class EffectId : int {
   kGroundTruthOffset,
   kSteeringScale,
   kSteeringLag,
+  kPivotYawGain,
   kCount
 };
 inline constexpr int kNumEffects = static_cast<int>(EffectId::kCount);
@@ -76,6 +77,12 @@ struct SampleContext {
   double accel_rad_s2(int i) const { return derivative[i]; }
   double angle_rate_rad_s(int i) const { return derivative[i]; }
   bool moving = false;  // any wheel turning faster than kMovingRate
+  // Data with exactly two channels, both wheel rates (a differential drive's right and left):
+  // |w_0 - w_1| / (|w_0| + |w_1|), the pair's turn fraction. It is the half-track over the turning
+  // radius, b / (2 R), while both wheels turn one way (0 driving straight), and 1 once they turn
+  // against each other (the instantaneous centre of rotation between the wheels: a pivot). 0 for
+  // any other channel layout and at rest.
+  double turn_fraction = 0.0;
   bool IsWheel(int i) const { return (wheel_mask >> i) & 1u; }
 };
 
@@ -115,6 +122,9 @@ EffectId EffectIdFromName(const std::string& name);
 inline bool NeedsAngleChannel(EffectId id) {
   return id == EffectId::kSteeringScale || id == EffectId::kSteeringLag;
 }
+// Effects that read SampleContext::turn_fraction: only a robot with two wheel channels and no
+// other channel can show them.
+inline bool NeedsWheelPair(EffectId id) { return id == EffectId::kPivotYawGain; }
 
 // An effect with its parameter values (and one-sigma uncertainties when fitted).
 struct EffectValue {
@@ -311,6 +321,21 @@ struct SteeringLag {
   }
 };
 
+// Pivot yaw gain g: the yaw rate grows with the turn fraction s of the wheel pair (SampleContext),
+//   omega' = omega (1 + g s),
+// i.e. the effective wheel separation is b / (1 + g s): b driving gently curved arcs, b / (1 + g)
+// pivoting on the spot. Why: the wheels' contact patches have a width, and where in each patch
+// the wheel effectively rolls depends on how the patch scrubs - on the turning radius. In a pivot
+// turn the patches twist about points inside the track, in a wide arc they roll. A castor
+// dragged sideways in a pivot does the same. Constant parameters fit one turning radius; runs at
+// two (circles and UMBmark squares, whose corners are pivots) each pull b their own way.
+struct PivotYawGain {
+  template <typename T>
+  static void Body(const T* q, const SampleContext& c, T* v) {
+    v[2] = v[2] * (T(1.0) + q[0] * T(c.turn_fraction));
+  }
+};
+
 template <typename T>
 struct EffectOps {
   void (*rates)(const T* q, const SampleContext& c, T* w) = nullptr;
@@ -336,6 +361,7 @@ const std::array<EffectOps<T>, kNumEffects>& EffectOpsTable() {
       {nullptr, &GroundTruthOffset::Body<T>, nullptr, nullptr},
       {&SteeringScale::Rates<T>, nullptr, nullptr, nullptr},
       {&SteeringLag::Rates<T>, nullptr, nullptr, nullptr},
+      {nullptr, &PivotYawGain::Body<T>, nullptr, nullptr},
   }};
   return table;
 }

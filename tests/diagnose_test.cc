@@ -91,11 +91,14 @@ TEST_P(LibraryEffectTest, DiagnosePicksRecoversAndMatchesTrueModel) {
 }
 
 // Every identifiable effect an omni3 robot can show (steering effects need an angle channel:
-// tests/tricycle_effects_test.cc).
+// tests/tricycle_effects_test.cc; the pivot yaw gain a wheel pair: diff_drive_effects_test.cc).
 std::vector<effects::EffectId> IdentifiableEffects() {
   std::vector<effects::EffectId> out;
   for (const auto& info : effects::EffectTable()) {
-    if (info.identifiable && !effects::NeedsAngleChannel(info.id)) out.push_back(info.id);
+    if (info.identifiable && !effects::NeedsAngleChannel(info.id) &&
+        !effects::NeedsWheelPair(info.id)) {
+      out.push_back(info.id);
+    }
   }
   return out;
 }

@@ -20,6 +20,7 @@
 #include "fit/final_pose_errors.h"
 #include "fit/model_fit.h"
 #include "fit/pose_errors.h"
+#include "fit/segment_cost.h"
 #include "io/input_error.h"
 #include "io/log_files.h"
 #include "models/diff_drive/diff_drive_model.h"
@@ -30,6 +31,7 @@
 #include "tools/import_optiodom_models.h"
 #include "tools/sim/diff_drive_trajectories.h"
 #include "tools/sim/model_simulator.h"
+#include "validation/generalisation.h"
 
 namespace fitcal {
 namespace {
@@ -667,6 +669,31 @@ TEST(OptiOdomDiffImport, EverySessionNominalUmbmarkAndFit) {
       after.mean_abs_heading_error_rad * 180.0 / M_PI);
   EXPECT_LT(after.cf, 0.5 * before.cf);
   for (int k = 0; k < 3; ++k) EXPECT_FALSE(fit.at_bound[k]) << model->robot().parameters[k].name;
+
+  // Against the method published with these recordings (Sousa et al.'s OptiOdom cost, position
+  // from the start every 0.5 m; validation/generalisation.h) on the same split: the README's
+  // tables say the fit's final poses transfer better whenever circles train. Measured: 0.0309
+  // against 0.0319 here (the data are fixed, so the margin is not noise; a change that loses it
+  // must say so in the README).
+  GeneralisationSplit split{"odd", "even", {}, {}};
+  std::vector<std::vector<Segment>> checkpoints;
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    (all[i].repetition % 2 == 1 ? split.train : split.test).push_back(i);
+    checkpoints.push_back(MakeCheckpointsFromStart(all[i], summary.runs[i].ground_truth, 0.5));
+  }
+  const SplitScores scores =
+      EvaluateSplit(*model, all, split, {}, TrackCandidates{&checkpoints, nullptr, {}});
+  double fit_cf = -1.0, optiodom_cf = -1.0;
+  for (const CandidateScore& c : scores.candidates) {
+    if (c.name == "fit") fit_cf = c.test.cf;
+    if (c.name == "optiodom") optiodom_cf = c.test.cf;
+  }
+  std::printf("held out (even repetitions): CF OptiOdom's method %.4f, fit %.4f\n", optiodom_cf,
+              fit_cf);
+  EXPECT_NEAR(fit_cf, after.cf, 1e-9);  // the same fit as above
+  ASSERT_GT(optiodom_cf, 0.0);
+  EXPECT_LT(optiodom_cf, 0.5 * before.cf);  // a real calibration ...
+  EXPECT_LT(fit_cf, optiodom_cf);           // ... which the fit beats
 }
 
 }  // namespace

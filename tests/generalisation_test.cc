@@ -18,6 +18,7 @@
 #include <cmath>
 #include <vector>
 
+#include "fit/segment_cost.h"
 #include "models/model_registry.h"
 #include "tests/models/unicycle_test_model.h"
 #include "tools/sim/model_simulator.h"
@@ -141,6 +142,91 @@ TEST_F(GeneralisationTest, LeaveOneSessionOutHoldsOutEverySessionOnce) {
 
   // Path type + repetition: every run here is repetition 1, so two sessions.
   EXPECT_EQ(LeaveOneSessionOutSplits(runs_, SessionKey::kPathTypeAndRepetition).size(), 2u);
+}
+
+// Sousa et al.'s OptiOdom candidate scores the position from the start at checkpoints along the
+// track, so it sees what a closed path hides from its final pose: a run that drives D metres out
+// and D back ends where it started whatever the radius, while its checkpoints on the way out are
+// D' = r D / r_t from the start. Trained on such runs, the final-pose fit learns nothing about r
+// (and holds it), the OptiOdom candidate recovers the true radius - which the lines then confirm.
+TEST(GeneralisationOptiOdom, CheckpointsSeeWhatAClosedPathHidesFromItsFinalPose) {
+  const RobotModelPtr model =
+      ReadRobotModel(YAML::Load(FindModel("test_unicycle")->example_yaml), "example");
+  std::vector<sim::TrajectorySpec> specs;
+  for (const char* label : {"outback_a", "outback_b"}) {
+    sim::TrajectorySpec spec;
+    spec.label = label;
+    spec.segments = {{Twist{kSpeed, 0.0, 0.0}, 8.0},
+                     {Twist{0.0, 0.0, 0.0}, 1.0},
+                     {Twist{-kSpeed, 0.0, 0.0}, 8.0}};
+    specs.push_back(spec);
+  }
+  specs.push_back(Spec(kShapes[0]));
+  specs.push_back(Spec(kShapes[1]));
+  // Ground truth at the encoder instants: the checkpoints need no interpolation, so noise-free
+  // data are reproduced to the solver's tolerance.
+  sim::SimulationOptions sim_options;
+  sim_options.ground_truth_period_s = sim_options.encoder_period_s;
+  std::vector<AlignedRun> runs;
+  std::vector<RunLog> logs;
+  for (const sim::ModelSimulatedRun& run :
+       sim::SimulateRuns(*model, {kTrueRadius, kTrueGain}, specs, sim_options)) {
+    runs.push_back(AlignRun(run.log));
+    logs.push_back(run.log);
+  }
+  std::vector<std::vector<Segment>> checkpoints;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    checkpoints.push_back(MakeCheckpointsFromStart(runs[i], logs[i].ground_truth, 0.5));
+  }
+  // 3.2 m out and back: a checkpoint after every 0.5 m (six), and the end.
+  ASSERT_EQ(checkpoints[0].size(), 7u);
+  const GeneralisationSplit split{"outback", "line", {0, 1}, {2, 3}};
+  const SplitScores scores =
+      EvaluateSplit(*model, runs, split, {}, TrackCandidates{&checkpoints, nullptr, {}});
+  const double r0 = model->robot().nominal[0], k0 = model->robot().nominal[1];
+  const double nominal_cf = MeanExpectedCf({0, 1}, r0, k0);
+  ASSERT_GT(nominal_cf, 0.05);
+  const auto find = [&](const std::string& name) {
+    for (const CandidateScore& c : scores.candidates)
+      if (c.name == name) return c;
+    ADD_FAILURE() << "no candidate " << name;
+    return CandidateScore{};
+  };
+  EXPECT_NEAR(find("fit").test.cf, nominal_cf, kCfTolerance);
+  const CandidateScore optiodom = find("optiodom");
+  ASSERT_TRUE(optiodom.usable);
+  EXPECT_NEAR(optiodom.parameters[0], kTrueRadius, 1e-8);
+  EXPECT_NEAR(optiodom.test.cf, 0.0, kCfTolerance);
+  // Without checkpoints there is no such candidate.
+  for (const CandidateScore& c : EvaluateSplit(*model, runs, split, {}).candidates) {
+    EXPECT_NE(c.name, "optiodom");
+  }
+}
+
+// Checkpoints begin at the start, end after every `spacing` of ground-truth path since the last
+// one, and at the run's end.
+TEST(GeneralisationOptiOdom, CheckpointsFollowTheGroundTruthPath) {
+  const RobotModelPtr model =
+      ReadRobotModel(YAML::Load(FindModel("test_unicycle")->example_yaml), "example");
+  sim::SimulationOptions sim_options;
+  sim_options.ground_truth_period_s = sim_options.encoder_period_s;
+  const sim::ModelSimulatedRun run =
+      sim::SimulateRuns(*model, {kTrueRadius, kTrueGain}, {Spec(kShapes[1])}, sim_options)[0];
+  const AlignedRun aligned = AlignRun(run.log);
+  const std::vector<Segment> c = MakeCheckpointsFromStart(aligned, run.log.ground_truth, 0.3);
+  ASSERT_EQ(c.size(), 5u);  // 1.4 m: after 0.3, 0.6, 0.9 and 1.2 m, then the end
+  for (std::size_t k = 0; k < c.size(); ++k) {
+    EXPECT_EQ(c[k].begin, 0u);
+    if (k + 1 < c.size()) {
+      // The first encoder boundary at or past the checkpoint: within one interval (0.01 m).
+      EXPECT_GE(c[k].path_length_m, 0.3 * (k + 1) - 1e-12);
+      EXPECT_LT(c[k].path_length_m, 0.3 * (k + 1) + kSpeed * sim_options.encoder_period_s);
+      EXPECT_NEAR(c[k].ground_truth_start_T_end.x, c[k].path_length_m, 1e-9);
+    }
+  }
+  EXPECT_EQ(c.back().end, aligned.samples.size());
+  EXPECT_NEAR(c.back().ground_truth_start_T_end.x, 1.4, 1e-9);
+  EXPECT_THROW(MakeCheckpointsFromStart(aligned, run.log.ground_truth, 0.0), std::invalid_argument);
 }
 
 TEST(GeneralisationSplits, PredicateSplitsGoBothWaysAndNeedBothSides) {

@@ -132,7 +132,12 @@ TEST(SimulateCommand, RefusesWhatTheModelSimulatorDoesNotTake) {
   const std::string data = dir.Path("data");
   for (const std::string& args :
        {std::string("--model diff_drive --slip-sigma 0.01"), std::string("--model asoc"),
-        std::string("--model omni --robot ") + FITCAL_SOURCE_DIR + "/data/robots/apr02.yaml"}) {
+        std::string("--model omni --robot ") + FITCAL_SOURCE_DIR + "/data/robots/apr02.yaml",
+        // Effects the three-wheeled flower robot has no channel for.
+        std::string("--robot ") + FITCAL_SOURCE_DIR + "/data/robots/apr02.yaml --inject " +
+            "pivot_yaw_gain=0.01",
+        std::string("--robot ") + FITCAL_SOURCE_DIR + "/data/robots/apr02.yaml --inject " +
+            "steering_scale=0.01"}) {
     SCOPED_TRACE(args);
     const Result r = RunFitcal(dir, "simulate " + args + " --out " + data);
     EXPECT_NE(r.exit_code, 0);

@@ -153,6 +153,9 @@ void AddGeneraliseOptions(CLI::App& app, GeneraliseCommandOptions& o) {
                  "Models other than omni3: a leave-one-session-out session is a trajectory "
                  "label (label) or a path type + repetition number (repetition)")
       ->capture_default_str();
+  app.add_flag("--optiodom", o.optiodom,
+               "Models other than omni3: also score OptiOdom's method (Sousa et al. 2022: "
+               "position from the start every 0.5 m of path) on the same splits");
 }
 
 int RunGeneraliseCommand(const GeneraliseCommandOptions& options) {
@@ -162,9 +165,10 @@ int RunGeneraliseCommand(const GeneraliseCommandOptions& options) {
     if (model_name != "omni3") {
       return RunModelGeneraliseCommand(options, index, ReadRobotModelFile(index.robot_path));
     }
-    if (!options.train_reps.empty() || options.sessions != "label") {
-      std::cerr << "fitcal: generalise --train-reps and --sessions apply to the models on the "
-                   "generic path, not to omni3's table\n";
+    if (!options.train_reps.empty() || options.sessions != "label" || options.optiodom) {
+      std::cerr << "fitcal: generalise --train-reps, --sessions and --optiodom apply to the "
+                   "models on the generic path, not to omni3's table (its reduced model is "
+                   "OptiOdom's)\n";
       return 2;
     }
     const io::Dataset dataset = LoadRuns(options, index, /*robot=*/nullptr);

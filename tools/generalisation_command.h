@@ -37,6 +37,11 @@ struct GeneraliseCommandOptions : DatasetCommandOptions {
   // repetition number, as the OptiOdom tricycle import numbers its sessions).
   std::string train_reps;
   std::string sessions = "label";
+  // Models other than omni3: score the method published with the OptiOdom recordings as one more
+  // candidate (validation/generalisation.h TrackCandidates; needs ground-truth tracks). Off by
+  // default: its checkpoint cost costs more than the fit (omni4's leave-one-session-out 32 -> 60
+  // s on one core).
+  bool optiodom = false;
 };
 
 // Declares every flag of `generalise` on its subcommand `app`, bound to `options`.

@@ -2,8 +2,14 @@
 
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <set>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
 
+#include "diagnosis/effect_fit.h"
+#include "fit/segment_cost.h"
 #include "validation/generalisation.h"
 #include "validation/run_split.h"
 #include "validation/trajectory_split.h"
@@ -83,14 +89,54 @@ void PrintLeaveOneSessionOut(const std::vector<SplitScores>& folds) {
 // Refuses the omni3-only flags in one line rather than ignoring them.
 bool RefuseOmni3OnlyOptions(const GeneraliseCommandOptions& o, const std::string& model) {
   std::string flag;
-  if (!o.effects.empty()) flag = "--effects";
   if (!o.clock_map) flag = "--no-clock-map";
   const GeneraliseCommandOptions defaults;
   if (o.segment_length_m != defaults.segment_length_m) flag = "--segment-length-m";
   if (flag.empty()) return false;
-  std::cerr << "fitcal: generalise " << flag << " belongs to the omni3 table (segment cost, "
-            << "effects); not available for model " << model << "\n";
+  std::cerr << "fitcal: generalise " << flag << " belongs to the omni3 table (segment cost); "
+            << "not available for model " << model << "\n";
   return true;
+}
+
+// OptiOdom's checkpoints (every 0.5 m of path, as Sousa et al.) for every run, or nothing when
+// some run's ground truth holds no pose between its start and end (their cost needs the track).
+std::optional<std::vector<std::vector<Segment>>> OptiOdomCheckpoints(
+    const std::vector<AlignedRun>& runs, const std::vector<RunLog>& logs) {
+  constexpr double kSpacingM = 0.5;
+  std::unordered_map<std::string, const RunLog*> by_id;
+  for (const RunLog& log : logs) by_id[log.id] = &log;
+  std::vector<std::vector<Segment>> out;
+  for (const AlignedRun& run : runs) {
+    const GroundTruthTrack& track = by_id.at(run.id)->ground_truth;
+    if (track.t_s.size() < 3) return std::nullopt;
+    out.push_back(MakeCheckpointsFromStart(run, track, kSpacingM));
+  }
+  return out;
+}
+
+// The --effects list, or one line on stderr and nullopt for an unknown name or an effect this
+// robot's channels cannot show.
+std::optional<EffectModel> ReadEffectList(const std::vector<std::string>& names,
+                                          const Robot& robot) {
+  EffectModel out;
+  for (const std::string& name : names) {
+    effects::EffectValue e;
+    try {
+      e.id = effects::EffectIdFromName(name);
+    } catch (const std::invalid_argument& error) {
+      std::cerr << "fitcal: generalise --effects: " << error.what() << "\n";
+      return std::nullopt;
+    }
+    if (!CanShowEffect(robot, e.id)) {
+      std::cerr << "fitcal: generalise --effects: " << name << " needs "
+                << (effects::NeedsWheelPair(e.id) ? "a robot with two wheel channels and no other"
+                                                  : "an angle channel (steering)")
+                << "; model " << robot.model << " cannot show it\n";
+      return std::nullopt;
+    }
+    out.push_back(e);
+  }
+  return out;
 }
 
 }  // namespace
@@ -107,7 +153,28 @@ int RunModelGeneraliseCommand(const GeneraliseCommandOptions& options,
               << "' (available: label, repetition)\n";
     return 2;
   }
-  const std::vector<AlignedRun> runs = AlignRuns(LoadRuns(options, index, &robot).runs);
+  const io::Dataset dataset = LoadRuns(options, index, &robot);
+  const std::vector<AlignedRun> runs = AlignRuns(dataset.runs);
+  TrackCandidates track_candidates;
+  std::optional<std::vector<std::vector<Segment>>> checkpoints;
+  if (options.optiodom) {
+    checkpoints = OptiOdomCheckpoints(runs, dataset.runs);
+    if (!checkpoints) {
+      std::cerr << "fitcal: generalise --optiodom: " << options.logs
+                << ": OptiOdom's method needs a ground-truth track (poses between each run's "
+                   "start and end), and some run has only its ends\n";
+      return 2;
+    }
+    track_candidates.optiodom_checkpoints = &*checkpoints;
+  }
+  const std::optional<EffectModel> effect_list = ReadEffectList(options.effects, robot);
+  if (!effect_list) return 2;
+  std::vector<TrackRun> tracks;
+  if (!effect_list->empty()) {
+    tracks = PrepareTrackRuns(dataset.runs, WheelChannelMask(robot));
+    track_candidates.tracks = &tracks;
+    track_candidates.effects = *effect_list;
+  }
   ModelFitOptions fit_options;
   fit_options.ceres.num_threads = options.threads;
 
@@ -140,13 +207,13 @@ int RunModelGeneraliseCommand(const GeneraliseCommandOptions& options,
               robot.name.c_str(), options.logs.c_str(), runs.size());
   PrintSplitTableHeader();
   for (const GeneralisationSplit& split : splits) {
-    PrintSplitRows(EvaluateSplit(*model, runs, split, fit_options));
+    PrintSplitRows(EvaluateSplit(*model, runs, split, fit_options, track_candidates));
     std::fflush(stdout);
   }
   if (options.leave_one_session_out) {
     std::vector<SplitScores> folds;
     for (const GeneralisationSplit& split : LeaveOneSessionOutSplits(runs, session_key)) {
-      folds.push_back(EvaluateSplit(*model, runs, split, fit_options));
+      folds.push_back(EvaluateSplit(*model, runs, split, fit_options, track_candidates));
     }
     if (!folds.empty()) PrintLeaveOneSessionOut(folds);
   }

@@ -27,6 +27,14 @@ effects::EffectValue ParseInjectedEffect(const std::string& text) {
   effects::EffectValue e;
   e.id = effects::EffectIdFromName(text.substr(0, eq));
   const effects::EffectInfo& info = effects::Info(e.id);
+  // The flower robot has three wheel channels: an effect on a steering angle or on a wheel pair
+  // would be written nowhere (a data set that silently lacks the effect asked for).
+  if (effects::NeedsAngleChannel(e.id) || effects::NeedsWheelPair(e.id)) {
+    throw std::invalid_argument(
+        "--inject '" + text + "': " + info.name +
+        " cannot act on the omni3 flower robot (it needs " +
+        (effects::NeedsWheelPair(e.id) ? "a pair of wheels" : "a steering angle") + ")");
+  }
   std::string rest = text.substr(eq + 1);
   for (int k = 0; k < info.num_parameters; ++k) {
     const std::size_t comma = rest.find(',');

@@ -1,5 +1,6 @@
 #include "validation/generalisation.h"
 
+#include <cmath>
 #include <map>
 #include <set>
 #include <stdexcept>
@@ -7,14 +8,6 @@
 namespace fitcal {
 
 namespace {
-
-std::vector<AlignedRun> Pick(const std::vector<AlignedRun>& runs,
-                             const std::vector<std::size_t>& indices) {
-  std::vector<AlignedRun> out;
-  out.reserve(indices.size());
-  for (std::size_t i : indices) out.push_back(runs.at(i));
-  return out;
-}
 
 CandidateScore Score(const RobotModelInterface& model, std::string name,
                      std::vector<double> parameters, bool usable,
@@ -27,6 +20,70 @@ CandidateScore Score(const RobotModelInterface& model, std::string name,
   s.train = EvaluateFinalPoseErrors(model, s.parameters, train, threads);
   s.test = EvaluateFinalPoseErrors(model, s.parameters, test, threads);
   return s;
+}
+
+// Sousa et al.'s OptiOdom calibration of the training runs (see EvaluateSplit in the header).
+CandidateScore OptiOdomCandidate(const RobotModelInterface& model,
+                                 const std::vector<AlignedRun>& train,
+                                 const std::vector<AlignedRun>& test,
+                                 const std::vector<std::vector<Segment>>& train_checkpoints,
+                                 const ModelFitOptions& options) {
+  ModelFitOptions o = options;
+  o.segments = &train_checkpoints;
+  o.hold_undetermined = false;  // their method moves every parameter
+  o.ceres.objective = FinalPoseObjective::kSumOfSquares;
+  o.ceres.loss = CeresRobustLoss::kNone;
+  o.ceres.compute_covariance = false;
+  o.ceres.weights.position_sigma_m = 1.0;
+  // Their cost has no heading term: a heading sigma of 1e6 rad weighs it 1e-12 against 1 m.
+  o.ceres.weights.heading_sigma_rad = 1e6;
+  const ModelFitResult fit = FitModel(train, model, o);
+  CandidateScore s =
+      Score(model, "optiodom", fit.parameters, fit.usable, train, test, options.ceres.num_threads);
+  s.is_fit = true;
+  for (bool b : fit.at_bound) s.at_bound += b;
+  return s;
+}
+
+// Final-pose errors of a track score (the effect replay's pose at the window's end).
+FinalPoseErrors FinalErrors(const ModelScore& score) {
+  FinalPoseErrors e;
+  e.cf = score.cf;
+  for (const RunScore& r : score.runs) {
+    const double n = static_cast<double>(score.runs.size());
+    e.mean_position_error_m += std::hypot(r.final_dx_m, r.final_dy_m) / n;
+    e.mean_abs_heading_error_rad += std::abs(r.final_dtheta_rad) / n;
+    e.per_run_cf.push_back(r.cf);
+  }
+  return e;
+}
+
+// The model's parameters and `effects` fitted on the training tracks, scored on the held-out ones.
+CandidateScore TrackFitCandidate(const RobotModelInterface& model, const std::string& name,
+                                 const std::vector<TrackRun>& train,
+                                 const std::vector<TrackRun>& test, const EffectModel& effects,
+                                 int threads) {
+  EffectFitOptions o;
+  o.num_threads = threads;
+  o.compute_covariance = false;
+  const EffectFitResult fit = FitEffectModel(train, model, model.robot().nominal, effects, o);
+  CandidateScore s;
+  s.name = name;
+  s.usable = fit.usable;
+  s.parameters = fit.parameters;
+  s.is_fit = true;
+  s.at_bound = fit.any_at_bound ? 1 : 0;
+  s.train = FinalErrors(ScoreModel(model, fit.parameters, fit.effects, train, {}, threads));
+  s.test = FinalErrors(ScoreModel(model, fit.parameters, fit.effects, test, {}, threads));
+  return s;
+}
+
+template <typename T>
+std::vector<T> PickEach(const std::vector<T>& all, const std::vector<std::size_t>& indices) {
+  std::vector<T> out;
+  out.reserve(indices.size());
+  for (std::size_t i : indices) out.push_back(all.at(i));
+  return out;
 }
 
 }  // namespace
@@ -85,12 +142,14 @@ std::vector<GeneralisationSplit> LeaveOneSessionOutSplits(const std::vector<Alig
 }
 
 SplitScores EvaluateSplit(const RobotModelInterface& model, const std::vector<AlignedRun>& runs,
-                          const GeneralisationSplit& split, const ModelFitOptions& options) {
+                          const GeneralisationSplit& split, const ModelFitOptions& options,
+                          const TrackCandidates& track_candidates) {
   if (split.train.empty() || split.test.empty()) {
     throw std::invalid_argument("generalisation split '" + split.train_name + "' -> '" +
                                 split.test_name + "' has no training or no held-out run");
   }
-  const std::vector<AlignedRun> train = Pick(runs, split.train), test = Pick(runs, split.test);
+  const std::vector<AlignedRun> train = PickEach(runs, split.train);
+  const std::vector<AlignedRun> test = PickEach(runs, split.test);
   const int threads = options.ceres.num_threads;
   SplitScores out;
   out.split = split;
@@ -112,6 +171,29 @@ SplitScores EvaluateSplit(const RobotModelInterface& model, const std::vector<Al
                                 fit.unconstrained_usable, train, test, threads);
     free.is_fit = true;
     out.candidates.push_back(std::move(free));
+  }
+  if (const auto* checkpoints = track_candidates.optiodom_checkpoints) {
+    if (checkpoints->size() != runs.size()) {
+      throw std::invalid_argument("EvaluateSplit: not one checkpoint list per run");
+    }
+    const std::vector<std::vector<Segment>> train_checkpoints = PickEach(*checkpoints, split.train);
+    out.candidates.push_back(OptiOdomCandidate(model, train, test, train_checkpoints, options));
+  }
+  if (track_candidates.tracks != nullptr && !track_candidates.effects.empty()) {
+    const std::vector<TrackRun>& tracks = *track_candidates.tracks;
+    if (tracks.size() != runs.size()) {
+      throw std::invalid_argument("EvaluateSplit: not one track per run");
+    }
+    const std::vector<TrackRun> train_tracks = PickEach(tracks, split.train);
+    const std::vector<TrackRun> test_tracks = PickEach(tracks, split.test);
+    std::string with = "track fit +";
+    for (const effects::EffectValue& e : track_candidates.effects) {
+      with += std::string(" ") + effects::Info(e.id).name;
+    }
+    out.candidates.push_back(
+        TrackFitCandidate(model, "track fit", train_tracks, test_tracks, {}, threads));
+    out.candidates.push_back(TrackFitCandidate(model, with, train_tracks, test_tracks,
+                                               track_candidates.effects, threads));
   }
   return out;
 }

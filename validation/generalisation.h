@@ -3,8 +3,10 @@
 // (models/model_interface.h). A split names training and held-out runs; on each split every
 // candidate the result gate would see - the nominal robot, the model's closed forms computed from
 // the training runs (UMBmark for diff_drive), the bounded fit (fit/model_fit.h) and, when it held
-// directions the training runs do not determine, the fit without those holds - is scored on the
-// held-out runs: CF (Palacin Eq. 14), mean final position error and mean |heading error|.
+// directions the training runs do not determine, the fit without those holds - and, when the
+// ground truth is a track, the method published with the OptiOdom recordings (EvaluateSplit) is
+// scored on the held-out runs: CF (Palacin Eq. 14), mean final position error and mean |heading
+// error|.
 //
 // The held-out runs only score here; nothing is selected on them (a gate choosing on the runs it
 // is then scored on would report the best of several candidates as if it had been chosen blind).
@@ -21,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "diagnosis/effect_fit.h"
 #include "fit/final_pose_errors.h"
 #include "fit/model_fit.h"
 #include "models/model_interface.h"
@@ -78,10 +81,27 @@ struct SplitScores {
   std::vector<CandidateScore> candidates;  // nominal first
 };
 
+// Further candidates of EvaluateSplit, for data whose ground truth is a track.
+struct TrackCandidates {
+  // The method published with the OptiOdom recordings, "optiodom": Sousa et al.'s cost (squared
+  // position error from the start at every checkpoint) minimised over every parameter from the
+  // nominal, nothing held, within the model's bounds - the minimum their resilient
+  // back-propagation searches for, found here by the fit's own Ceres solve. One list per run of
+  // `runs` (fit/segment_cost.h MakeCheckpointsFromStart).
+  const std::vector<std::vector<Segment>>* optiodom_checkpoints = nullptr;
+  // The model's parameters fitted on the training tracks (diagnosis/effect_fit.h) alone, "track
+  // fit", and with these library effects, "track fit + <names>": what closing the loop gains on
+  // the held-out runs, like for like. One TrackRun per run of `runs`; used when `effects` is not
+  // empty.
+  const std::vector<TrackRun>* tracks = nullptr;
+  EffectModel effects;
+};
+
 // Fits on split.train (options.ceres.num_threads also drives the evaluation) and scores every
 // candidate on split.test. Throws std::invalid_argument when either side is empty.
 SplitScores EvaluateSplit(const RobotModelInterface& model, const std::vector<AlignedRun>& runs,
-                          const GeneralisationSplit& split, const ModelFitOptions& options);
+                          const GeneralisationSplit& split, const ModelFitOptions& options,
+                          const TrackCandidates& track_candidates = {});
 
 // One candidate over the folds of leave-one-session-out (candidates are matched by name; a closed
 // form may exist in some folds only).
