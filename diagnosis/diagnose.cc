@@ -94,7 +94,7 @@ std::string ExplainedText(double base_lof_f, double candidate_lof_f) {
 std::vector<EffectId> DefaultCandidates(const Robot& robot) {
   std::vector<EffectId> out;
   for (const auto& info : effects::EffectTable()) {
-    if (info.identifiable && CanShowEffect(robot, info.id)) out.push_back(info.id);
+    if (info.identifiable && robot.CanShow(info.id)) out.push_back(info.id);
   }
   return out;
 }

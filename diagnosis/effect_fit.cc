@@ -197,15 +197,6 @@ unsigned WheelChannelMask(const Robot& robot) {
   return mask;
 }
 
-bool CanShowEffect(const Robot& robot, effects::EffectId id) {
-  const unsigned mask = WheelChannelMask(robot);
-  const int channels = robot.NumChannels();
-  const bool has_angle = mask != (1u << channels) - 1u;
-  if (effects::NeedsAngleChannel(id)) return has_angle;
-  if (effects::NeedsWheelPair(id)) return channels == 2 && !has_angle;
-  return true;
-}
-
 bool TrackStartsAtRest(const AlignedRun& run, const std::vector<effects::SampleContext>& contexts,
                        const GroundTruthTrack& track, double latency_s) {
   // Encoder time (from the window start) at which the robot starts moving.

@@ -129,10 +129,6 @@ std::vector<TrackRun> PrepareTrackRuns(const std::vector<RunLog>& runs, unsigned
                                        const TrackOptions& options = {});
 // Bit i set when the robot's channel i is a wheel rate (effects::SampleContext::wheel_mask).
 unsigned WheelChannelMask(const Robot& robot);
-// Whether the robot's channels let the effect act: a steering effect needs an angle channel, the
-// pivot yaw gain a pair of wheel channels and nothing else (effects::NeedsAngleChannel,
-// NeedsWheelPair); every other effect acts on any robot.
-bool CanShowEffect(const Robot& robot, effects::EffectId id);
 // Training/validation by repetition (as validation/run_split.h).
 void SplitTrackRuns(std::vector<TrackRun> runs, const std::vector<int>& training_reps,
                     std::vector<TrackRun>* training, std::vector<TrackRun>* validation);

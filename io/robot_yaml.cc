@@ -90,6 +90,15 @@ Omni3Robot ReadOmni3Robot(const std::string& path) {
   }
   robot.encoder = ReadEncoderTicksNode(robot_map.Optional("encoder"), path);
   robot.effects = ReadEffectsNode(robot_map.Optional("effects"), path);
+  // Three wheel channels: a steering or wheel-pair effect would be replayed as nothing.
+  for (std::size_t i = 0; i < robot.effects.size(); ++i) {
+    const effects::EffectId id = robot.effects[i].id;
+    if (!effects::NeedsAngleChannel(id) && !effects::NeedsWheelPair(id)) continue;
+    throw InputError(InputErrorKind::kBadValue, path, LineOf(root["effects"][i]),
+                     std::string("effect ") + effects::Info(id).name +
+                         " needs a steering angle or a pair of wheels; an omni3 robot cannot "
+                         "carry it");
+  }
   robot_map.Optional("calibration");  // written by fitcal; informational when read back
   robot_map.RejectUnread();
   return robot;

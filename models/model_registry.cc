@@ -62,6 +62,30 @@ RobotModelPtr ReadRobotModelFile(const std::string& path) {
   return ReadRobotModel(io::LoadYamlFile(path), path);
 }
 
+namespace {
+
+// A declared effect these channels cannot carry (a steering scale on a differential drive) would
+// be replayed as nothing: one line instead, at the effect's entry.
+void RefuseEffectsTheChannelsCannotShow(const Robot& robot, const YAML::Node& root,
+                                        const std::string& path) {
+  const YAML::Node list = root["effects"];
+  for (std::size_t i = 0; i < robot.effects.size(); ++i) {
+    const effects::EffectId id = robot.effects[i].id;
+    if (robot.CanShow(id)) continue;
+    const int line = list && list.IsSequence() && i < list.size() ? list[i].Mark().line + 1
+                     : list                                       ? list.Mark().line + 1
+                                                                  : 1;
+    throw io::InputError(
+        io::InputErrorKind::kBadValue, path, line,
+        std::string("effect ") + effects::Info(id).name + " needs " +
+            (effects::NeedsWheelPair(id) ? "exactly two wheel channels and no other"
+                                         : "an angle channel (a steering angle)") +
+            "; a " + robot.model + " robot cannot carry it");
+  }
+}
+
+}  // namespace
+
 RobotModelPtr ReadRobotModel(const YAML::Node& root, const std::string& path) {
   io::ExpectYamlType(root, YAML::NodeType::Map, path, "robot file");
   if (!root["model"]) {
@@ -73,7 +97,9 @@ RobotModelPtr ReadRobotModel(const YAML::Node& root, const std::string& path) {
     throw io::InputError(io::InputErrorKind::kUnknownModel, path, root["model"].Mark().line + 1,
                          "unknown model '" + model + "' (known: " + RegisteredModelNames() + ")");
   }
-  return registration->read(root, path);
+  RobotModelPtr robot_model = registration->read(root, path);
+  RefuseEffectsTheChannelsCannotShow(robot_model->robot(), root, path);
+  return robot_model;
 }
 
 }  // namespace fitcal

@@ -92,26 +92,6 @@ Split Simulate(const RobotModelInterface& model, double pivot_gain, std::uint64_
 
 RobotModelPtr DiffDrive() { return ReadDiffDriveModel(YAML::Load(kDiffDriveExampleYaml), "ex"); }
 
-TEST(PivotYawGain, TurnFractionOfAWheelPairAndTheYawItScales) {
-  EncoderSamples samples(2);
-  const double straight[2] = {3.0, 3.0}, arc[2] = {1.2, 0.8}, pivot[2] = {-2.0, 2.0};
-  const double rest[2] = {0.0, 0.0};
-  for (const double* v : {straight, arc, pivot, rest}) samples.push_back(0.02, v);
-  const auto contexts = effects::MakeSampleContexts(samples, 0x3u);
-  EXPECT_DOUBLE_EQ(contexts[0].turn_fraction, 0.0);
-  EXPECT_DOUBLE_EQ(contexts[1].turn_fraction, 0.4 / 2.0);  // b / (2 R) of the arc
-  EXPECT_DOUBLE_EQ(contexts[2].turn_fraction, 1.0);
-  EXPECT_DOUBLE_EQ(contexts[3].turn_fraction, 0.0);
-  // Only a pair of wheel channels has one: a tricycle's wheel + steering angle has none.
-  EXPECT_DOUBLE_EQ(effects::MakeSampleContexts(samples, 0x1u)[1].turn_fraction, 0.0);
-
-  const double g[1] = {0.01};
-  double v[3] = {0.2, 0.0, 0.5};
-  effects::PivotYawGain::Body(g, contexts[1], v);
-  EXPECT_DOUBLE_EQ(v[0], 0.2);
-  EXPECT_DOUBLE_EQ(v[2], 0.5 * (1.0 + 0.01 * 0.2));
-}
-
 TEST(DiffDriveDiagnose, NamesAPivotYawGainWithItsSize) {
   const auto model = DiffDrive();
   const double injected = effects::Info(EffectId::kPivotYawGain).typical[0];
@@ -123,8 +103,8 @@ TEST(DiffDriveDiagnose, NamesAPivotYawGainWithItsSize) {
   ASSERT_EQ(r.final_fit.effects.size(), 1u);
   const effects::EffectValue& e = r.final_fit.effects[0];
   EXPECT_EQ(e.id, EffectId::kPivotYawGain);
-  std::printf("pivot_yaw_gain %.5f +- %.5f (injected %.4f); held-out CF %.4f -> %.4f\n",
-              e.value[0], e.sigma[0], injected, r.declared_validation.cf, r.final_validation.cf);
+  std::printf("pivot_yaw_gain %.5f +- %.5f (injected %.4f); held-out CF %.4f -> %.4f\n", e.value[0],
+              e.sigma[0], injected, r.declared_validation.cf, r.final_validation.cf);
   // Within four of its own sigmas (the fit's covariance, from the noise) of the injected size.
   EXPECT_GT(e.sigma[0], 0.0);
   EXPECT_LT(std::abs(e.value[0] - injected), 4.0 * e.sigma[0]);

@@ -317,6 +317,11 @@ TEST(DiffDriveYaml, MalformedRobotsAreOneLineInputErrors) {
       {"missing separation", "wheel_separation_m: 0.200\n", "", io::InputErrorKind::kMissingKey, 0},
       {"non-positive bounds", "radius_m: [0.038, 0.046]", "radius_m: [0.0, 0.046]",
        io::InputErrorKind::kBadValue, 7},
+      // A wheel pair carries the pivot yaw gain (line 4), not a steering effect (line 5).
+      {"steering effect", "name: test\n",
+       "name: test\neffects:\n  - {name: pivot_yaw_gain, gain: 0.0}\n"
+       "  - {name: steering_scale, scale: 0.01}\n",
+       io::InputErrorKind::kBadValue, 5},
   };
   for (const Malformed& c : cases) {
     SCOPED_TRACE(c.what);

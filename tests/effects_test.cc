@@ -132,6 +132,27 @@ TEST(EffectTransforms, BacklashLosesBetaOfEachWheel) {
   EXPECT_NEAR(measured - transmitted, beta[0], 1e-12);
 }
 
+// A wheel pair's turn fraction (SampleContext) and the pivot yaw gain that scales the yaw by it.
+TEST(EffectTransforms, PivotYawGainScalesTheYawByTheWheelPairsTurnFraction) {
+  EncoderSamples samples(2);
+  const double straight[2] = {3.0, 3.0}, arc[2] = {1.2, 0.8}, pivot[2] = {-2.0, 2.0};
+  const double rest[2] = {0.0, 0.0};
+  for (const double* v : {straight, arc, pivot, rest}) samples.push_back(0.02, v);
+  const auto contexts = effects::MakeSampleContexts(samples, 0x3u);
+  EXPECT_DOUBLE_EQ(contexts[0].turn_fraction, 0.0);
+  EXPECT_DOUBLE_EQ(contexts[1].turn_fraction, 0.4 / 2.0);  // b / (2 R) of the arc
+  EXPECT_DOUBLE_EQ(contexts[2].turn_fraction, 1.0);
+  EXPECT_DOUBLE_EQ(contexts[3].turn_fraction, 0.0);
+  // Only a pair of wheel channels has one: a tricycle's wheel + steering angle has none.
+  EXPECT_DOUBLE_EQ(effects::MakeSampleContexts(samples, 0x1u)[1].turn_fraction, 0.0);
+
+  const double g[1] = {0.01};
+  double v[3] = {0.2, 0.0, 0.5};
+  effects::PivotYawGain::Body(g, contexts[1], v);
+  EXPECT_DOUBLE_EQ(v[0], 0.2);
+  EXPECT_DOUBLE_EQ(v[2], 0.5 * (1.0 + 0.01 * 0.2));
+}
+
 TEST(EffectTransforms, SpeedSlipAndDirectionRadiusAsDocumented) {
   effects::SampleContext c;
   double w[3] = {2.0, -1.0, 0.0};

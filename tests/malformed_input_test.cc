@@ -75,6 +75,7 @@ const MalformedCase kCases[] = {
     {"robot_yaml_syntax.yaml",          InputErrorKind::kYamlSyntax,        "robot.yaml", 8},
     {"robot_unknown_model.yaml",        InputErrorKind::kUnknownModel,      "robot.yaml", 3},
     {"robot_wheel_not_a_map.yaml",      InputErrorKind::kWrongYamlType,     "robot.yaml", 6},
+    {"robot_effect_needs_steering.yaml", InputErrorKind::kBadValue,         "robot.yaml", 15},
     {"dataset_dotdot_escape.yaml",      InputErrorKind::kBadPath,           "dataset.yaml", 3},
     {"dataset_absolute_path.yaml",      InputErrorKind::kBadPath,           "dataset.yaml", 3},
     {"dataset_robot_outside.yaml",      InputErrorKind::kBadPath,           "dataset.yaml", 1},

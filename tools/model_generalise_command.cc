@@ -127,7 +127,7 @@ std::optional<EffectModel> ReadEffectList(const std::vector<std::string>& names,
       std::cerr << "fitcal: generalise --effects: " << error.what() << "\n";
       return std::nullopt;
     }
-    if (!CanShowEffect(robot, e.id)) {
+    if (!robot.CanShow(e.id)) {
       std::cerr << "fitcal: generalise --effects: " << name << " needs "
                 << (effects::NeedsWheelPair(e.id) ? "a robot with two wheel channels and no other"
                                                   : "an angle channel (steering)")
