@@ -304,6 +304,18 @@ void SplitTrackRuns(std::vector<TrackRun> runs, const std::vector<int>& training
   }
 }
 
+FinalPoseErrors FinalPoseErrorsOf(const ModelScore& score) {
+  FinalPoseErrors e;
+  e.cf = score.cf;
+  const double n = static_cast<double>(score.runs.size());
+  for (const RunScore& r : score.runs) {
+    e.mean_position_error_m += std::hypot(r.final_dx_m, r.final_dy_m) / n;
+    e.mean_abs_heading_error_rad += std::abs(r.final_dtheta_rad) / n;
+    e.per_run_cf.push_back(r.cf);
+  }
+  return e;
+}
+
 ModelScore ScoreModel(const Omni3ParameterArray& p, const EffectModel& model,
                       const std::vector<TrackRun>& runs, const ResidualWeights& weights,
                       int num_threads) {

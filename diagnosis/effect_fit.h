@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "fit/final_pose_cost.h"
+#include "fit/final_pose_errors.h"
 #include "fit/final_pose_residual.h"
 #include "models/model_interface.h"
 #include "odometry/aligned_run.h"
@@ -151,6 +152,10 @@ struct ModelScore {
   double track_rmse_m = 0.0;  // sqrt(mean over runs of track_rmse_m^2)
   double track_rmse_rad = 0.0;
 };
+
+// The score's final poses as the final-pose fit reports them: CF, mean position and mean
+// |heading| error over the runs (the effect replay's pose at each window's end).
+FinalPoseErrors FinalPoseErrorsOf(const ModelScore& score);
 
 ModelScore ScoreModel(const RobotModelInterface& robot_model, const std::vector<double>& p,
                       const EffectModel& model, const std::vector<TrackRun>& runs,

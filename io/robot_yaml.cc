@@ -93,7 +93,7 @@ Omni3Robot ReadOmni3Robot(const std::string& path) {
   // Three wheel channels: a steering or wheel-pair effect would be replayed as nothing.
   for (std::size_t i = 0; i < robot.effects.size(); ++i) {
     const effects::EffectId id = robot.effects[i].id;
-    if (!effects::NeedsAngleChannel(id) && !effects::NeedsWheelPair(id)) continue;
+    if (effects::ChannelsCanCarry(id, omni3::kNumWheels, /*has_angle_channel=*/false)) continue;
     throw InputError(InputErrorKind::kBadValue, path, LineOf(root["effects"][i]),
                      std::string("effect ") + effects::Info(id).name +
                          " needs a steering angle or a pair of wheels; an omni3 robot cannot "

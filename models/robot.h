@@ -89,15 +89,11 @@ struct Robot {
     return false;
   }
   int NumFree() const { return NumParameters() - static_cast<int>(held.size()); }
-  // Whether these channels let the effect act: a steering effect needs an angle channel, the
-  // pivot yaw gain a pair of wheel channels and nothing else (effects::NeedsAngleChannel,
-  // NeedsWheelPair); every other effect acts on any robot.
+  // Whether these channels let the effect act (effects::ChannelsCanCarry).
   bool CanShow(effects::EffectId id) const {
     bool has_angle = false;
     for (const ChannelInfo& c : channels) has_angle = has_angle || c.kind == ChannelKind::kAngle;
-    if (effects::NeedsAngleChannel(id)) return has_angle;
-    if (effects::NeedsWheelPair(id)) return NumChannels() == 2 && !has_angle;
-    return true;
+    return effects::ChannelsCanCarry(id, NumChannels(), has_angle);
   }
   // "R_a [m]" for tables.
   std::string LabelOf(int k) const {

@@ -125,6 +125,14 @@ inline bool NeedsAngleChannel(EffectId id) {
 // Effects that read SampleContext::turn_fraction: only a robot with two wheel channels and no
 // other channel can show them.
 inline bool NeedsWheelPair(EffectId id) { return id == EffectId::kPivotYawGain; }
+// Whether channels of this kind let the effect act (a steering effect on a robot without an
+// angle channel, or the pivot yaw gain on anything but a wheel pair, would be replayed as
+// nothing); every other effect acts on any robot.
+inline bool ChannelsCanCarry(EffectId id, int num_channels, bool has_angle_channel) {
+  if (NeedsAngleChannel(id)) return has_angle_channel;
+  if (NeedsWheelPair(id)) return num_channels == 2 && !has_angle_channel;
+  return true;
+}
 
 // An effect with its parameter values (and one-sigma uncertainties when fitted).
 struct EffectValue {

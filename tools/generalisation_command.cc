@@ -94,15 +94,11 @@ Row EvaluateTrackModel(const Model& model, const Omni3Robot& robot, const Subset
     }
   }
   row.train_cf = ScoreModel(row.p, row.effects, train.tracks, {}, threads).cf;
-  const ModelScore s = ScoreModel(row.p, row.effects, test.tracks, {}, threads);
-  row.test_cf = s.cf;
-  double pos = 0.0, head = 0.0;
-  for (const RunScore& r : s.runs) {
-    pos += std::hypot(r.final_dx_m, r.final_dy_m) / s.runs.size();
-    head += std::abs(r.final_dtheta_rad) / s.runs.size();
-  }
-  row.test_position_m = pos;
-  row.test_heading_deg = RadToDeg(head);
+  const FinalPoseErrors e =
+      FinalPoseErrorsOf(ScoreModel(row.p, row.effects, test.tracks, {}, threads));
+  row.test_cf = e.cf;
+  row.test_position_m = e.mean_position_error_m;
+  row.test_heading_deg = RadToDeg(e.mean_abs_heading_error_rad);
   row.has_segment_cf = false;
   return row;
 }

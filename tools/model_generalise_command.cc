@@ -6,7 +6,6 @@
 #include <set>
 #include <stdexcept>
 #include <string>
-#include <unordered_map>
 
 #include "diagnosis/effect_fit.h"
 #include "fit/segment_cost.h"
@@ -103,13 +102,11 @@ bool RefuseOmni3OnlyOptions(const GeneraliseCommandOptions& o, const std::string
 std::optional<std::vector<std::vector<Segment>>> OptiOdomCheckpoints(
     const std::vector<AlignedRun>& runs, const std::vector<RunLog>& logs) {
   constexpr double kSpacingM = 0.5;
-  std::unordered_map<std::string, const RunLog*> by_id;
-  for (const RunLog& log : logs) by_id[log.id] = &log;
   std::vector<std::vector<Segment>> out;
-  for (const AlignedRun& run : runs) {
-    const GroundTruthTrack& track = by_id.at(run.id)->ground_truth;
+  for (std::size_t i = 0; i < runs.size(); ++i) {  // runs = AlignRuns(logs), in the same order
+    const GroundTruthTrack& track = logs[i].ground_truth;
     if (track.t_s.size() < 3) return std::nullopt;
-    out.push_back(MakeCheckpointsFromStart(run, track, kSpacingM));
+    out.push_back(MakeCheckpointsFromStart(runs[i], track, kSpacingM));
   }
   return out;
 }

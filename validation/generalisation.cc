@@ -45,19 +45,6 @@ CandidateScore OptiOdomCandidate(const RobotModelInterface& model,
   return s;
 }
 
-// Final-pose errors of a track score (the effect replay's pose at the window's end).
-FinalPoseErrors FinalErrors(const ModelScore& score) {
-  FinalPoseErrors e;
-  e.cf = score.cf;
-  for (const RunScore& r : score.runs) {
-    const double n = static_cast<double>(score.runs.size());
-    e.mean_position_error_m += std::hypot(r.final_dx_m, r.final_dy_m) / n;
-    e.mean_abs_heading_error_rad += std::abs(r.final_dtheta_rad) / n;
-    e.per_run_cf.push_back(r.cf);
-  }
-  return e;
-}
-
 // The model's parameters and `effects` fitted on the training tracks, scored on the held-out ones.
 CandidateScore TrackFitCandidate(const RobotModelInterface& model, const std::string& name,
                                  const std::vector<TrackRun>& train,
@@ -73,8 +60,8 @@ CandidateScore TrackFitCandidate(const RobotModelInterface& model, const std::st
   s.parameters = fit.parameters;
   s.is_fit = true;
   s.at_bound = fit.any_at_bound ? 1 : 0;
-  s.train = FinalErrors(ScoreModel(model, fit.parameters, fit.effects, train, {}, threads));
-  s.test = FinalErrors(ScoreModel(model, fit.parameters, fit.effects, test, {}, threads));
+  s.train = FinalPoseErrorsOf(ScoreModel(model, fit.parameters, fit.effects, train, {}, threads));
+  s.test = FinalPoseErrorsOf(ScoreModel(model, fit.parameters, fit.effects, test, {}, threads));
   return s;
 }
 
