@@ -53,29 +53,21 @@ std::string EffectValueText(const effects::EffectValue& e) {
 
 // The held-out comparison of a candidate with the base, per validation run i:
 //   mean_improvement = mean of J_base,i - J_cand,i (objective units; ranks the candidates);
-//   the one-sided paired t test on l_i = ln(J_base,i / J_cand,i), the log ratio: an effect
-//   scales each run's error by its own exposure (a steering scale shows on sharp circles, hardly
-//   on gentle ones), so the differences are heavy-tailed and a t test on them has little power,
-//   while the ratios are comparable across runs.
+//   the one-sided paired t test on the log ratios ln(J_base,i / J_cand,i)
+//   (stats::PairedLogRatioTest: a steering scale shows on sharp circles, hardly on gentle ones).
 void PairedImprovement(const ModelScore& base, const ModelScore& candidate, CandidateResult* c) {
   const std::size_t n = base.runs.size();
-  constexpr double kTiny = 1e-300;
-  double mean_d = 0.0, mean_l = 0.0, var_l = 0.0;
-  std::vector<double> l(n);
+  std::vector<double> j_base(n), j_candidate(n);
+  double mean_d = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
-    mean_d += base.runs[i].objective - candidate.runs[i].objective;
-    l[i] = std::log(std::max(base.runs[i].objective, kTiny) /
-                    std::max(candidate.runs[i].objective, kTiny));
-    mean_l += l[i];
+    j_base[i] = base.runs[i].objective;
+    j_candidate[i] = candidate.runs[i].objective;
+    mean_d += j_base[i] - j_candidate[i];
   }
-  mean_d /= static_cast<double>(std::max<std::size_t>(1, n));
-  mean_l /= static_cast<double>(std::max<std::size_t>(1, n));
-  for (double x : l) var_l += (x - mean_l) * (x - mean_l);
-  var_l /= std::max<double>(1.0, static_cast<double>(n) - 1.0);
-  c->mean_improvement = mean_d;
-  c->t_statistic = var_l > 0.0 ? mean_l / std::sqrt(var_l / static_cast<double>(n)) : 0.0;
-  c->p_value =
-      n >= 2 ? stats::StudentTUpperTail(c->t_statistic, static_cast<double>(n) - 1.0) : 1.0;
+  c->mean_improvement = mean_d / static_cast<double>(std::max<std::size_t>(1, n));
+  const stats::PairedTest test = stats::PairedLogRatioTest(j_base, j_candidate);
+  c->t_statistic = test.t;
+  c->p_value = test.p;
 }
 
 // The verdict of a significant candidate that removes too little of the lack-of-fit excess

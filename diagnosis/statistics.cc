@@ -112,4 +112,25 @@ double ChiSquareUpperTail(double chi2, double df) {
   return RegularizedUpperGamma(0.5 * df, 0.5 * std::max(chi2, 0.0));
 }
 
+PairedTest PairedLogRatioTest(const std::vector<double>& base,
+                              const std::vector<double>& candidate) {
+  const std::size_t n = std::min(base.size(), candidate.size());
+  constexpr double kTiny = 1e-300;
+  std::vector<double> l(n);
+  double mean = 0.0, var = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    l[i] = std::log(std::max(base[i], kTiny) / std::max(candidate[i], kTiny));
+    mean += l[i];
+  }
+  PairedTest out;
+  if (n < 2) return out;
+  const double count = static_cast<double>(n);
+  mean /= count;
+  for (double x : l) var += (x - mean) * (x - mean);
+  var /= count - 1.0;
+  out.t = var > 0.0 ? mean / std::sqrt(var / count) : 0.0;
+  out.p = StudentTUpperTail(out.t, count - 1.0);
+  return out;
+}
+
 }  // namespace fitcal::stats

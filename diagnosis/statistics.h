@@ -4,6 +4,8 @@
 // Numerical Recipes 3rd ed. Sec. 6.4, Lentz's method); chi-square through the regularised
 // incomplete gamma function Q(a, x) (series and continued fraction, Sec. 6.2).
 
+#include <vector>
+
 namespace fitcal::stats {
 
 // I_x(a, b), a, b > 0, x in [0, 1].
@@ -16,5 +18,16 @@ double FUpperTail(double f, double d1, double d2);
 double RegularizedUpperGamma(double a, double x);
 // P(X > chi2) for X chi-square with df degrees of freedom.
 double ChiSquareUpperTail(double chi2, double df);
+
+// The one-sided paired t test that `candidate`'s per-run errors are lower than `base`'s, on the
+// log ratios l_i = ln(base_i / candidate_i): an effect scales each run's error by that run's
+// exposure to it, so the differences are heavy-tailed while the ratios are comparable across
+// runs. p = P(T > t) on n - 1 df (1 for fewer than two runs).
+struct PairedTest {
+  double t = 0.0;
+  double p = 1.0;
+};
+PairedTest PairedLogRatioTest(const std::vector<double>& base,
+                              const std::vector<double>& candidate);
 
 }  // namespace fitcal::stats

@@ -1,5 +1,6 @@
 #include "fit/result_gate.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -12,7 +13,8 @@ namespace fitcal {
 GateDecision SelectCalibration(const RobotModelInterface& model,
                                const std::vector<CalibrationCandidate>& candidates,
                                const std::vector<AlignedRun>& training,
-                               const std::vector<AlignedRun>& validation, int num_threads) {
+                               const std::vector<AlignedRun>& validation, int num_threads,
+                               const EffectCandidateCf& effect_cf) {
   if (candidates.empty()) throw std::invalid_argument("SelectCalibration: no candidates");
   GateDecision decision;
   decision.judged_on_held_out = !validation.empty();
@@ -25,7 +27,16 @@ GateDecision SelectCalibration(const RobotModelInterface& model,
   decision.cf.assign(candidates.size(), std::numeric_limits<double>::quiet_NaN());
   for (std::size_t i = 0; i < candidates.size(); ++i) {
     if (!candidates[i].usable) continue;
-    decision.cf[i] = EvaluateFinalPoseErrors(model, candidates[i].parameters, runs, num_threads).cf;
+    if (!candidates[i].effects.empty()) {
+      if (!effect_cf) {
+        throw std::invalid_argument("SelectCalibration: candidate '" + candidates[i].name +
+                                    "' carries effects and no effect_cf scores it");
+      }
+      decision.cf[i] = effect_cf(candidates[i], runs);
+    } else {
+      decision.cf[i] =
+          EvaluateFinalPoseErrors(model, candidates[i].parameters, runs, num_threads).cf;
+    }
     // Strictly better than the best so far: the earlier candidate (nominal first) wins ties.
     if (std::isfinite(decision.cf[i]) && decision.cf[i] < decision.cf[decision.selected]) {
       decision.selected = static_cast<int>(i);
@@ -38,15 +49,19 @@ std::vector<std::string> GateLines(const std::vector<CalibrationCandidate>& cand
                                    const GateDecision& decision) {
   std::vector<std::string> out;
   const double nominal = decision.cf[0];
+  int width = 22;  // the names' column, wider for a long name ("track fit + <effects>")
+  for (const CalibrationCandidate& c : candidates) {
+    width = std::max(width, static_cast<int>(c.name.size()));
+  }
   for (std::size_t i = 0; i < candidates.size(); ++i) {
-    char line[256];
+    char line[512];
     if (!candidates[i].usable) {
-      std::snprintf(line, sizeof line, "  %-22s %10s   (not usable: did not converge)",
+      std::snprintf(line, sizeof line, "  %-*s %10s   (not usable: did not converge)", width,
                     candidates[i].name.c_str(), "-");
     } else {
       const double change = nominal > 0.0 ? 100.0 * (decision.cf[i] - nominal) / nominal : 0.0;
-      std::snprintf(line, sizeof line, "  %-22s %10.4f %+8.1f%%%s", candidates[i].name.c_str(),
-                    decision.cf[i], change,
+      std::snprintf(line, sizeof line, "  %-*s %10.4f %+8.1f%%%s", width,
+                    candidates[i].name.c_str(), decision.cf[i], change,
                     static_cast<int>(i) == decision.selected ? "   <- selected" : "");
     }
     out.push_back(line);

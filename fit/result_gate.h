@@ -5,11 +5,13 @@
 // lowest CF (Palacin Eq. 14) on the held-out runs; on the training runs, said so, when there are
 // none. The nominal wins ties: a calibration must earn its place.
 
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "models/model_interface.h"
 #include "odometry/aligned_run.h"
+#include "odometry/effects.h"
 
 namespace fitcal {
 
@@ -17,7 +19,14 @@ struct CalibrationCandidate {
   std::string name;  // "nominal", "ceres", "umbmark", ...
   std::vector<double> parameters;
   bool usable = true;  // a fit that did not converge to a usable point competes not
+  // Effects (odometry/effects.h) the candidate's odometry applies on top of the parameters.
+  std::vector<effects::EffectValue> effects = {};
 };
+
+// The CF (Eq. 14, mean over `runs`) of a candidate that carries effects: their replay needs each
+// run's ground-truth track (validation/trajectory_metrics.h), which the gate does not hold.
+using EffectCandidateCf =
+    std::function<double(const CalibrationCandidate&, const std::vector<AlignedRun>& runs)>;
 
 struct GateDecision {
   int selected = 0;        // index into the candidates (0 = nominal)
@@ -27,11 +36,14 @@ struct GateDecision {
   bool improves_on_nominal() const { return selected != 0; }
 };
 
-// candidates[0] must be the nominal. Throws std::invalid_argument for no candidates or no runs.
+// candidates[0] must be the nominal. Candidates without effects are replayed here; those with
+// effects are scored by effect_cf, the same Eq. 14 at the same final poses. Throws
+// std::invalid_argument for no candidates, no runs, or a candidate with effects and no effect_cf.
 GateDecision SelectCalibration(const RobotModelInterface& model,
                                const std::vector<CalibrationCandidate>& candidates,
                                const std::vector<AlignedRun>& training,
-                               const std::vector<AlignedRun>& validation, int num_threads = 0);
+                               const std::vector<AlignedRun>& validation, int num_threads = 0,
+                               const EffectCandidateCf& effect_cf = {});
 
 // One line per candidate for the terminal: name, CF, change against nominal, and which won.
 std::vector<std::string> GateLines(const std::vector<CalibrationCandidate>& candidates,

@@ -94,14 +94,19 @@ void EmitBoundsPair(YAML::Emitter& out, const std::string& key, const Interval& 
 }
 
 void EmitEncoderAndEffects(YAML::Emitter& out, const Robot& robot) {
+  EmitEncoderAndEffects(out, robot, robot.effects);
+}
+
+void EmitEncoderAndEffects(YAML::Emitter& out, const Robot& robot,
+                           const std::vector<effects::EffectValue>& effects) {
   if (robot.encoder) {
     out << YAML::Key << "encoder" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key
         << "ticks_per_rev" << YAML::Value << robot.encoder->ticks_per_rev << YAML::Key
         << "cumulative" << YAML::Value << robot.encoder->cumulative << YAML::EndMap;
   }
-  if (robot.effects.empty()) return;
+  if (effects.empty()) return;
   out << YAML::Key << "effects" << YAML::Value << YAML::BeginSeq;
-  for (const effects::EffectValue& e : robot.effects) {
+  for (const effects::EffectValue& e : effects) {
     const effects::EffectInfo& info = effects::Info(e.id);
     out << YAML::Flow << YAML::BeginMap << YAML::Key << "name" << YAML::Value << info.name;
     for (int k = 0; k < info.num_parameters; ++k) {

@@ -33,6 +33,9 @@ void CheckNominalInsideBounds(const Robot& robot, const std::string& path, int l
 // Emitters for the same blocks (inside an open top-level map).
 void EmitBoundsPair(YAML::Emitter& out, const std::string& key, const Interval& v, double scale);
 void EmitEncoderAndEffects(YAML::Emitter& out, const Robot& robot);
+// The robot's encoder block with `effects` in place of the ones it declares.
+void EmitEncoderAndEffects(YAML::Emitter& out, const Robot& robot,
+                           const std::vector<effects::EffectValue>& effects);
 
 // Keys of the `calibration:` block (inside its open map) that the omni3 layout and every other
 // model's write alike: what produced the calibration (method .. termination); the repetitions and

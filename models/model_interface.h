@@ -134,10 +134,16 @@ class RobotModelInterface {
   // false when the model cannot drive that twist (e.g. a sideways motion of a differential drive).
   virtual bool ChannelsForTwist(const double* p, const Twist& twist, double* values) const = 0;
 
-  // The calibrated robot YAML: the input schema with the values p, plus the calibration block
-  // (calibration_block: YAML text, indented as a top-level map, or empty).
+  // The calibrated robot YAML: the input schema with the values p and the effects `effects` (in
+  // place of the ones robot() declares: a fit may refit, add or drop them), plus the calibration
+  // block (calibration_block: YAML text, indented as a top-level map, or empty).
   virtual std::string RobotYaml(const std::vector<double>& p,
+                                const std::vector<effects::EffectValue>& effects,
                                 const std::string& calibration_block) const = 0;
+  // The same with the effects robot() declares.
+  std::string RobotYaml(const std::vector<double>& p, const std::string& calibration_block) const {
+    return RobotYaml(p, robot().effects, calibration_block);
+  }
 
   // The miswirings the wheel-order check scores (the identity first). Default: every permutation
   // within each group of channels of one kind and every sign pattern of the wheel channels,

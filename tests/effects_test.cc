@@ -4,6 +4,7 @@
 #include <ceres/jet.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -207,6 +208,18 @@ TEST(Statistics, TailsMatchTables) {
   EXPECT_NEAR(stats::FUpperTail(3.708, 3, 10), 0.05, 1e-4);
   EXPECT_NEAR(stats::FUpperTail(1.0, 200, 200), 0.5, 0.01);
   EXPECT_NEAR(stats::RegularizedIncompleteBeta(2, 3, 0.4), 0.5248, 1e-4);  // 1 - pbeta(0.4,2,3)
+}
+
+// By hand: base (2, 4, 8) against candidate (1, 2, 2) gives log ratios a, a, 2a (a = ln 2), mean
+// 4a/3, variance a^2/3 on 2 df, standard error a/3: t = 4 exactly, and on 2 df
+// P(T > t) = (1 - t / sqrt(t^2 + 2)) / 2 = 0.0285955.
+TEST(Statistics, PairedLogRatioTestByHand) {
+  const stats::PairedTest test = stats::PairedLogRatioTest({2.0, 4.0, 8.0}, {1.0, 2.0, 2.0});
+  EXPECT_NEAR(test.t, 4.0, 1e-12);
+  EXPECT_NEAR(test.p, 0.5 * (1.0 - 4.0 / std::sqrt(18.0)), 1e-9);
+  // Worse candidates are not better: the upper tail of a negative t.
+  EXPECT_GT(stats::PairedLogRatioTest({1.0, 2.0, 2.0}, {2.0, 4.0, 8.0}).p, 0.9);
+  EXPECT_EQ(stats::PairedLogRatioTest({1.0}, {0.5}).p, 1.0);  // one run tests nothing
 }
 
 std::string TempPath(const std::string& name) {

@@ -21,23 +21,10 @@ namespace {
 using fitcal::testing::ReadFileBytes;
 using fitcal::testing::TempDir;
 
-const std::string kFitcal = std::string(FITCAL_BINARY_DIR) + "/tools/fitcal";
 const std::string kRobot = std::string(FITCAL_SOURCE_DIR) + "/data/robots/apr02.yaml";
 
-struct Result {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-Result RunFitcal(const TempDir& dir, const std::string& args) {
-  const std::string out = dir.Path("stdout.txt"), err = dir.Path("stderr.txt");
-  const int status = std::system((kFitcal + " " + args + " >" + out + " 2>" + err).c_str());
-  Result r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = ReadFileBytes(out);
-  r.err = ReadFileBytes(err);
-  return r;
-}
+using Result = fitcal::testing::FitcalRun;
+using fitcal::testing::RunFitcal;
 
 int CountLines(const std::string& s) {
   int n = 0;
@@ -412,6 +399,11 @@ TEST(FitcalCli, SubcommandRefusalsGiveOneLineAndWriteNothing) {
        "got 0 training and 72 validation runs"},
       {"report --logs " + data + " --calibration " + kRobot + " --train-reps 1-2 --out " + out,
        "nothing to validate on"},
+      {"fit --logs " + data + " --effects nosuch --out " + out, "unknown effect 'nosuch'"},
+      {"fit --logs " + data + " --effects time_offset,time_offset --out " + out,
+       "time_offset is named twice"},
+      {"fit --logs " + data + " --effects pivot_yaw_gain --out " + out,
+       "pivot_yaw_gain needs a robot with two wheel channels"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.args);
@@ -423,6 +415,34 @@ TEST(FitcalCli, SubcommandRefusalsGiveOneLineAndWriteNothing) {
       EXPECT_FALSE(std::ifstream(out + suffix).good()) << out + suffix << " was written";
     }
   }
+}
+
+// Effects are fitted on the ground truth between a run's ends: a run whose ground truth holds only
+// its ends cannot show them, and `fit --effects` says so in one line and writes nothing.
+TEST(FitcalCli, EffectsNeedTheGroundTruthAlongTheRuns) {
+  TempDir dir;
+  const std::string data = MakeDataset(dir);
+  std::string ends_only;
+  for (const auto& entry : std::filesystem::directory_iterator(data + "/runs")) {
+    const std::string name = entry.path().filename().string();
+    if (name.find("_ground_truth.csv") != std::string::npos) ends_only = entry.path().string();
+  }
+  ASSERT_FALSE(ends_only.empty());
+  std::istringstream rows(ReadFileBytes(ends_only));
+  std::string line, header, first, last;
+  std::getline(rows, header);
+  std::getline(rows, first);
+  while (std::getline(rows, line)) last = line;
+  fitcal::testing::WriteFileBytes(ends_only, header + "\n" + first + "\n" + last + "\n");
+  const std::string out = dir.Path("calibrated.yaml");
+  ASSERT_EQ(RunFitcal(dir, "fit --logs " + data + " --out " + out).exit_code, 0);
+  std::filesystem::remove(out);
+  const Result r = RunFitcal(dir, "fit --logs " + data + " --effects time_offset --out " + out);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(CountLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("effects are fitted on the ground truth along each run"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
 }
 
 TEST(FitcalCli, UsageErrors) {

@@ -168,6 +168,29 @@ TEST(ModelHarness, ParametersRoundTripThroughTheRobotYaml) {
   }
 }
 
+// The effects a calibration carries are written with it and read back (a fit may refit, add or
+// drop them, so they are given, not taken from the robot): every model, with an effect every
+// model's channels can show.
+TEST(ModelHarness, EffectsRoundTripThroughTheRobotYaml) {
+  effects::EffectValue latency;
+  latency.id = effects::EffectId::kTimeOffset;
+  latency.value[0] = 0.0123456789;
+  latency.sigma[0] = 0.0011;
+  for (const ModelRegistration& m : RegisteredModels()) {
+    SCOPED_TRACE(m.name);
+    const RobotModelPtr model = ExampleModel(m);
+    ASSERT_TRUE(model->robot().effects.empty());
+    const RobotModelPtr back =
+        ReadRobotModel(YAML::Load(model->RobotYaml(model->robot().nominal, {latency}, "")), "rt");
+    ASSERT_EQ(back->robot().effects.size(), 1u);
+    EXPECT_EQ(back->robot().effects[0].id, latency.id);
+    EXPECT_NEAR(back->robot().effects[0].value[0], latency.value[0], 1e-12);
+    const RobotModelPtr none = ReadRobotModel(
+        YAML::Load(back->RobotYaml(back->robot().nominal, {}, "")), "without effects");
+    EXPECT_TRUE(none->robot().effects.empty());
+  }
+}
+
 // Samples with channel i read as sign[i] * column[i].
 EncoderSamples Mapped(const EncoderSamples& samples, const ChannelMapping& mapping) {
   EncoderSamples out(samples.num_channels());

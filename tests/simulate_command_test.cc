@@ -24,22 +24,8 @@ namespace fs = std::filesystem;
 using fitcal::testing::ReadFileBytes;
 using fitcal::testing::TempDir;
 
-const std::string kFitcal = std::string(FITCAL_BINARY_DIR) + "/tools/fitcal";
-
-struct Result {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-Result RunFitcal(const TempDir& dir, const std::string& args) {
-  const std::string out = dir.Path("stdout.txt"), err = dir.Path("stderr.txt");
-  const int status = std::system((kFitcal + " " + args + " >" + out + " 2>" + err).c_str());
-  Result r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = ReadFileBytes(out);
-  r.err = ReadFileBytes(err);
-  return r;
-}
+using Result = fitcal::testing::FitcalRun;
+using fitcal::testing::RunFitcal;
 
 struct RecoveryCase {
   const char* model;

@@ -2,7 +2,9 @@
 // A temporary directory per test, removed afterwards, and helpers to read and write whole files.
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -50,5 +52,24 @@ class TempDir {
  private:
   std::filesystem::path path_;
 };
+
+#ifdef FITCAL_BINARY_DIR
+// The fitcal binary run as a user runs it: its exit code and what it printed.
+struct FitcalRun {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+inline FitcalRun RunFitcal(const TempDir& dir, const std::string& args) {
+  static const std::string fitcal = std::string(FITCAL_BINARY_DIR) + "/tools/fitcal";
+  const std::string out = dir.Path("stdout.txt"), err = dir.Path("stderr.txt");
+  const int status = std::system((fitcal + " " + args + " >" + out + " 2>" + err).c_str());
+  FitcalRun r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = ReadFileBytes(out);
+  r.err = ReadFileBytes(err);
+  return r;
+}
+#endif
 
 }  // namespace fitcal::testing

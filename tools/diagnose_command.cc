@@ -217,7 +217,7 @@ std::string Omni3CalibratedYaml(const DiagnoseCommandOptions& options, const std
   return io::Omni3RobotYaml(calibrated, &record);
 }
 
-// Any other model: its own YAML with the calibration block, then the accepted effects.
+// Any other model: its own YAML with the accepted effects and the calibration block.
 std::string ModelCalibratedYaml(const DiagnoseCommandOptions& options,
                                 const RobotModelInterface& model, const std::vector<RunLog>& logs,
                                 const DiagnoseSplit& split, const DiagnoseResult& result,
@@ -233,17 +233,7 @@ std::string ModelCalibratedYaml(const DiagnoseCommandOptions& options,
     block.sigma = choice.sigma;
     block.correlation = choice.correlation;
   }
-  std::string yaml = model.RobotYaml(choice.parameters, io::CalibrationBlockYaml(block, robot));
-  if (!choice.effects.empty()) {
-    Robot with_effects;
-    with_effects.effects = choice.effects;
-    YAML::Emitter out;
-    out << YAML::BeginMap;
-    io::EmitEncoderAndEffects(out, with_effects);
-    out << YAML::EndMap;
-    yaml += std::string(out.c_str()) + "\n";
-  }
-  return yaml;
+  return model.RobotYaml(choice.parameters, choice.effects, io::CalibrationBlockYaml(block, robot));
 }
 
 // Re-stamps each run's ground truth on the encoder clock (omni3's speed-profile match), keeping

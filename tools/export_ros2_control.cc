@@ -21,6 +21,7 @@
 #include "models/diff_drive/diff_drive_model.h"
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
+#include "odometry/effects.h"
 
 namespace fitcal::tools {
 namespace {
@@ -486,6 +487,17 @@ Ros2ControlExport ExportRos2Control(const std::string& calibration_path,
     throw std::invalid_argument(calibration_path + ": robot model '" + c.robot().model +
                                 "' does not fit " + controller + " (it takes model " + entry.model +
                                 ")");
+  }
+  if (!c.robot().effects.empty()) {
+    // Its parameters were fitted together with the effects, which the controller cannot apply:
+    // alone they are worse than a calibration fitted without effects.
+    std::string names;
+    for (const effects::EffectValue& e : c.robot().effects) {
+      names += (names.empty() ? "" : ", ") + std::string(effects::Info(e.id).name);
+    }
+    throw std::invalid_argument(calibration_path + ": the calibration carries effects (" + names +
+                                ") that " + controller +
+                                " cannot apply; export a calibration fitted without effects");
   }
   Ros2ControlExport out;
   out.parameters_yaml = (node_name.empty() ? controller : node_name) + ":\n  ros__parameters:\n" +

@@ -25,7 +25,6 @@
 #include "io/yaml_reader.h"
 #include "models/model_registry.h"
 #include "models/omni3/omni3_robot_model.h"
-#include "odometry/effects.h"
 #include "tools/cli_validators.h"
 #include "tools/fit_methods.h"
 #include "tools/model_fit_command.h"
@@ -109,6 +108,11 @@ void AddFitOptions(CLI::App& app, FitCommandOptions& o) {
   app.add_flag("--force", o.force, "Overwrite --out even if it holds another robot's calibration");
   app.add_flag("--skip-wheel-order-check", o.skip_wheel_order_check,
                "Fit even if another encoder column order/sign explains the data far better");
+  app.add_option("--effects", o.effects,
+                 "Library effects to fit with the parameters on the ground-truth tracks (e.g. "
+                 "pivot_yaw_gain), one more candidate of the result gate; an effect the robot "
+                 "YAML declares is refitted without naming it")
+      ->delimiter(',');
 }
 
 int RunFitCommand(const FitCommandOptions& options) {
@@ -138,25 +142,16 @@ int RunFitCommand(const FitCommandOptions& options) {
       const std::string refusal = OutputFileRefusal(options.out, opened.inputs);
       if (!refusal.empty()) return Refuse(refusal);
     }
-    const std::string model_name = io::ReadRobotModel(index.robot_path);
     // Every model on the seam except omni3, whose fit (with its NLopt methods and fast kernel)
-    // still has its own path below.
-    if (model_name != "omni3") {
-      return RunModelFitCommand(options, index, ReadRobotModelFile(index.robot_path));
+    // still has its own path below - which fits Eq. 4 alone: omni3 with effects takes the seam's.
+    const RobotModelPtr model = ReadRobotModelFile(index.robot_path);
+    if (model->robot().model != "omni3" || !options.effects.empty() ||
+        !model->robot().effects.empty()) {
+      return RunModelFitCommand(options, index, model);
     }
     const io::Dataset dataset = LoadRuns(options, index, /*robot=*/nullptr);
     io::StopHereForTests("loaded");
     const Omni3Robot robot = io::ReadOmni3Robot(dataset.robot_path);
-    if (!robot.effects.empty()) {
-      // The methods here fit Eq. 4 alone; refitting would silently drop the declared effects.
-      std::string names;
-      for (const auto& e : robot.effects)
-        names += std::string(names.empty() ? "" : ", ") + effects::Info(e.id).name;
-      std::cerr << "fitcal: " << dataset.robot_path << ": the robot declares effects (" << names
-                << ") that 'fit' does not model; refit them with 'fitcal diagnose', or start from "
-                   "a robot YAML without an effects: list\n";
-      return 2;
-    }
     if (!options.no_output && !options.force) {
       const std::string refusal = OverwriteRefusal(options.out, robot.name);
       if (!refusal.empty()) {

@@ -3,6 +3,7 @@
 // training repetitions, validate on the rest, print the table and write the calibrated YAML.
 
 #include <string>
+#include <vector>
 
 #include "tools/dataset_command.h"
 #include "tools/solver_options.h"
@@ -21,6 +22,9 @@ struct FitCommandOptions : DatasetCommandOptions, SolverOptions {
   bool no_output = false;
   bool force = false;  // overwrite --out even when it holds another robot's calibration
   bool skip_wheel_order_check = false;  // fit even if another column order fits far better
+  // Library effects (odometry/effects.h) to fit with the parameters on the training tracks, as
+  // one more candidate of the result gate; the effects a robot YAML declares are refitted too.
+  std::vector<std::string> effects;
 };
 
 // Declares every flag of `fit` on `app` (the `fit` subcommand, and the top level: `fitcal --logs

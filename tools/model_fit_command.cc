@@ -1,12 +1,18 @@
 #include "tools/model_fit_command.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <optional>
+#include <string>
 #include <unordered_map>
+#include <vector>
 
 #include "diagnosis/channel_order_check.h"
+#include "diagnosis/effect_fit.h"
+#include "diagnosis/statistics.h"
 #include "fit/final_pose_errors.h"
 #include "fit/model_fit.h"
 #include "fit/result_gate.h"
@@ -14,10 +20,12 @@
 #include "fitcal/version.h"
 #include "io/atomic_file.h"
 #include "io/calibration_block.h"
+#include "tools/effect_list.h"
 #include "tools/fit_methods.h"
 #include "tools/output_guard.h"
 #include "validation/run_split.h"
 #include "validation/training_runs.h"
+#include "validation/trajectory_metrics.h"
 
 namespace fitcal::tools {
 
@@ -33,12 +41,40 @@ std::string TrainingSelection(const FitCommandOptions& o) {
   return "repetitions " + o.train_reps;
 }
 
-void PrintCfTable(const RobotModelInterface& model, const std::vector<double>& selected,
-                  const RunSplit& split, int threads) {
-  const auto& nominal = model.robot().nominal;
+// The final-pose errors of a candidate of the gate on some runs: replayed by the model alone, or
+// with its effects against each run's ground-truth track (the same Eq. 14 at the same poses).
+class CandidateErrors {
+ public:
+  CandidateErrors(const RobotModelInterface& model, const std::vector<RunLog>& logs, int threads)
+      : model_(model), threads_(threads) {
+    for (const RunLog& log : logs) track_of_[log.id] = &log.ground_truth;
+  }
+
+  FinalPoseErrors operator()(const CalibrationCandidate& c,
+                             const std::vector<AlignedRun>& runs) const {
+    if (c.effects.empty()) return EvaluateFinalPoseErrors(model_, c.parameters, runs, threads_);
+    std::vector<const GroundTruthTrack*> tracks;
+    for (const AlignedRun& run : runs) tracks.push_back(track_of_.at(run.id));
+    return EvaluateFinalPoseErrors(model_, c.parameters, c.effects, runs, tracks, threads_);
+  }
+
+  EffectCandidateCf Cf() const {
+    return [this](const CalibrationCandidate& c, const std::vector<AlignedRun>& runs) {
+      return (*this)(c, runs).cf;
+    };
+  }
+
+ private:
+  const RobotModelInterface& model_;
+  int threads_;
+  std::unordered_map<std::string, const GroundTruthTrack*> track_of_;
+};
+
+void PrintCfTable(const CalibrationCandidate& nominal, const CalibrationCandidate& selected,
+                  const RunSplit& split, const CandidateErrors& errors) {
   const auto row = [&](const char* name, const std::vector<AlignedRun>& runs) {
-    const FinalPoseErrors before = EvaluateFinalPoseErrors(model, nominal, runs, threads);
-    const FinalPoseErrors after = EvaluateFinalPoseErrors(model, selected, runs, threads);
+    const FinalPoseErrors before = errors(nominal, runs);
+    const FinalPoseErrors after = errors(selected, runs);
     const double change = before.cf > 0.0 ? 100.0 * (after.cf - before.cf) / before.cf : 0.0;
     std::printf("  %-30s %10.4f %10.4f %+8.1f%%\n", name, before.cf, after.cf, change);
     std::printf("  %-30s %10.4f %10.4f\n", "  mean final position error [m]",
@@ -53,7 +89,79 @@ void PrintCfTable(const RobotModelInterface& model, const std::vector<double>& s
   if (!split.validation.empty()) row("validation", split.validation);
 }
 
-void PrintParameters(const Robot& robot, const std::vector<double>& p, const ModelFitResult& fit) {
+// What the parameter table and the calibration record say of the selected candidate: the
+// uncertainty, bound contacts and holds of the fit that made it (none for the nominal or a
+// closed form; a fit's bound contacts also for the fit without its holds).
+struct SelectedFit {
+  bool has_covariance = false;
+  std::vector<double> sigma;
+  Eigen::MatrixXd correlation;
+  std::vector<bool> at_bound, held;  // per parameter
+  std::string objective, termination;
+};
+
+constexpr const char* kTrackObjective = "sum over runs of the mean squared track error (m and rad)";
+
+// The effect fit reports only whether some parameter ended on a bound: which ones, here.
+std::vector<bool> OnBounds(const Robot& robot, const std::vector<double>& p) {
+  std::vector<bool> out(p.size(), false);
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    const Interval& b = robot.bounds[k];
+    const double tolerance = 1e-9 * (b.hi - b.lo);
+    out[k] = p[k] <= b.lo + tolerance || p[k] >= b.hi - tolerance;
+  }
+  return out;
+}
+
+// The fits on the training tracks when effects are fitted (diagnosis/effect_fit.h): the
+// parameters alone and with the effects, on one objective, so that the effects are judged like
+// for like; with their indices among the gate's candidates.
+struct TrackFits {
+  EffectFitResult without_effects, with_effects;
+  int without_index = -1, with_index = -1;
+};
+
+SelectedFit DescribeSelected(const Robot& robot,
+                             const std::vector<CalibrationCandidate>& candidates,
+                             int selected_index, const std::string& method,
+                             const std::string& method_objective, const ModelFitResult& fit,
+                             const std::optional<TrackFits>& track_fits) {
+  const CalibrationCandidate& selected = candidates[selected_index];
+  const std::size_t n = robot.nominal.size();
+  SelectedFit out{false,
+                  {},
+                  {},
+                  std::vector<bool>(n, false),
+                  std::vector<bool>(n, false),
+                  method_objective,
+                  fit.termination};
+  const EffectFitResult* track_fit = nullptr;
+  if (track_fits && selected_index == track_fits->with_index) {
+    track_fit = &track_fits->with_effects;
+  } else if (track_fits && selected_index == track_fits->without_index) {
+    track_fit = &track_fits->without_effects;
+  }
+  if (track_fit != nullptr) {
+    out.has_covariance = track_fit->has_covariance;
+    out.sigma = track_fit->sigma;
+    out.correlation = track_fit->correlation;
+    out.at_bound = OnBounds(robot, selected.parameters);
+    for (const HeldParameter& h : robot.held) out.held[h.index] = true;
+    out.objective = kTrackObjective;
+    out.termination = track_fit->termination;
+  } else if (selected.name == method) {
+    out.has_covariance = fit.has_covariance;
+    out.sigma = fit.sigma;
+    out.correlation = fit.correlation;
+    out.at_bound = fit.at_bound;
+    out.held = fit.held;
+  } else if (selected.name == method + " without holds") {
+    out.at_bound = fit.at_bound;
+  }
+  return out;
+}
+
+void PrintParameters(const Robot& robot, const std::vector<double>& p, const SelectedFit& fit) {
   std::printf("\n  %-22s %12s %12s %12s %12s\n", "parameter", "nominal", "calibrated", "+-1 sigma",
               "change");
   for (int k = 0; k < robot.NumParameters(); ++k) {
@@ -79,13 +187,14 @@ void PrintParameters(const Robot& robot, const std::vector<double>& p, const Mod
   }
 }
 
-// Nominal, closed forms, the fit; and when the fit held undetermined directions and held-out
-// runs can judge it, the fit without the holds too (on the training runs alone it would always
-// win, by fitting what the data cannot tell apart).
+// Nominal (with the effects the robot declares), closed forms, the fit; and when the fit held
+// undetermined directions and held-out runs can judge it, the fit without the holds too (on the
+// training runs alone it would always win, by fitting what the data cannot tell apart).
 std::vector<CalibrationCandidate> Candidates(const RobotModelInterface& model,
                                              const RunSplit& split, const ModelFitResult& fit,
                                              const std::string& method) {
-  std::vector<CalibrationCandidate> out = {{"nominal", model.robot().nominal, true}};
+  std::vector<CalibrationCandidate> out = {
+      {"nominal", model.robot().nominal, true, model.robot().effects}};
   for (const ClosedFormCalibration& c : model.ClosedForms(split.training)) {
     out.push_back({c.method, c.parameters, true});
   }
@@ -99,9 +208,11 @@ std::vector<CalibrationCandidate> Candidates(const RobotModelInterface& model,
 
 }  // namespace
 
-bool PrintGate(const std::vector<CalibrationCandidate>& candidates, const GateDecision& gate) {
+bool PrintGate(const std::vector<CalibrationCandidate>& candidates, const GateDecision& gate,
+               const std::string& effects_line) {
   std::printf("\nresult gate, CF on %s:\n", gate.judged_on.c_str());
   for (const std::string& line : GateLines(candidates, gate)) std::printf("%s\n", line.c_str());
+  if (!effects_line.empty()) std::printf("%s\n", effects_line.c_str());
   if (gate.improves_on_nominal()) return true;
   std::cerr << "fitcal: no calibration beats the nominal robot on the " << gate.judged_on
             << "; nothing written\n";
@@ -131,30 +242,30 @@ namespace {
 
 io::CalibrationBlock MakeRecord(const FitCommandOptions& options, const RobotModelInterface& model,
                                 const std::vector<RunLog>& logs, const RunSplit& split,
-                                const ModelFitResult& fit, const std::string& objective,
                                 const std::vector<CalibrationCandidate>& candidates,
-                                const GateDecision& gate) {
+                                const GateDecision& gate, const SelectedFit& selected_fit,
+                                const CandidateErrors& errors) {
   const Robot& robot = model.robot();
-  const std::vector<double>& p = candidates[gate.selected].parameters;
+  const CalibrationCandidate& nominal = candidates[0];
+  const CalibrationCandidate& selected = candidates[gate.selected];
   io::CalibrationBlock r;
-  RecordFitSource(options, logs, split, candidates[gate.selected].name, objective, fit.termination,
-                  &r);
-  r.cf_training_before =
-      EvaluateFinalPoseErrors(model, robot.nominal, split.training, options.threads).cf;
-  r.cf_training_after = EvaluateFinalPoseErrors(model, p, split.training, options.threads).cf;
-  r.cf_validation_before =
-      EvaluateFinalPoseErrors(model, robot.nominal, split.validation, options.threads).cf;
-  r.cf_validation_after = EvaluateFinalPoseErrors(model, p, split.validation, options.threads).cf;
-  r.selected = candidates[gate.selected].name;
+  RecordFitSource(options, logs, split, selected.name, selected_fit.objective,
+                  selected_fit.termination, &r);
+  r.cf_training_before = errors(nominal, split.training).cf;
+  r.cf_training_after = errors(selected, split.training).cf;
+  r.cf_validation_before = errors(nominal, split.validation).cf;
+  r.cf_validation_after = errors(selected, split.validation).cf;
+  r.selected = selected.name;
   r.selected_on = gate.judged_on;
   for (const HeldParameter& h : robot.held) r.held.push_back(robot.parameters[h.index].name);
   for (int k = 0; k < robot.NumParameters(); ++k) {
-    if (fit.at_bound[k]) r.at_bound.push_back(robot.parameters[k].name);
+    if (selected_fit.at_bound[k]) r.at_bound.push_back(robot.parameters[k].name);
   }
-  // The uncertainty is the fit's; it describes the selected parameters only when the fit won.
-  r.has_uncertainty = fit.has_covariance && candidates[gate.selected].name == options.method;
-  r.sigma = fit.sigma;
-  r.correlation = fit.correlation;
+  // The uncertainty is the selected fit's (with its effects, when it carries some; the effects'
+  // own sigmas are written with them).
+  r.has_uncertainty = selected_fit.has_covariance;
+  r.sigma = selected_fit.sigma;
+  r.correlation = selected_fit.correlation;
   return r;
 }
 
@@ -196,10 +307,12 @@ bool ChannelsLookMiswired(const FitCommandOptions& options, const RobotModelInte
   return true;
 }
 
-// The header, the CF table, the parameters and the solver's stop reason.
+// The header, the CF table, the parameters and the solvers' stop reasons.
 void PrintFit(const FitCommandOptions& options, const RobotModelInterface& model,
-              const RunSplit& split, const std::vector<double>& selected, const FitMethod& method,
-              const ModelFitMethodOutcome& outcome) {
+              const RunSplit& split, const std::vector<CalibrationCandidate>& candidates,
+              const GateDecision& gate, const SelectedFit& selected_fit,
+              const CandidateErrors& errors, const FitMethod& method,
+              const ModelFitMethodOutcome& outcome, const std::optional<TrackFits>& track_fits) {
   const Robot& robot = model.robot();
   const ModelFitResult& fit = outcome.fit;
   std::printf("fitcal %s  %s robot '%s'  data set %s\n", kVersion, robot.model.c_str(),
@@ -211,8 +324,16 @@ void PrintFit(const FitCommandOptions& options, const RobotModelInterface& model
   std::printf("runs: %zu training (%s), %zu validation (repetitions %s)\n\n", split.training.size(),
               selection.c_str(), split.validation.size(),
               FormatRepetitionList(split.validation_repetitions).c_str());
-  PrintCfTable(model, selected, split, options.threads);
-  PrintParameters(robot, selected, fit);
+  const CalibrationCandidate& selected = candidates[gate.selected];
+  PrintCfTable(candidates[0], selected, split, errors);
+  PrintParameters(robot, selected.parameters, selected_fit);
+  for (const effects::EffectValue& e : selected.effects) {
+    const effects::EffectInfo& info = effects::Info(e.id);
+    for (int k = 0; k < info.num_parameters; ++k) {
+      std::printf("  effect %s: %s = %.6g +- %.2g\n", info.name, info.parameter_names[k],
+                  e.value[k], e.sigma[k]);
+    }
+  }
   // Active-set rounds are the Ceres fit's (fit/model_fit.h); NLopt methods have none.
   const std::string rounds =
       fit.active_set_rounds > 0
@@ -221,6 +342,131 @@ void PrintFit(const FitCommandOptions& options, const RobotModelInterface& model
   std::printf("\nsolver: %s, %s after %d iterations (%d evaluations%s), %.3f s (%s)\n",
               method.description.c_str(), fit.termination.c_str(), fit.iterations,
               outcome.evaluations, rounds.c_str(), fit.solve_time_s, fit.message.c_str());
+  if (track_fits) {
+    std::printf(
+        "track fits (training tracks): parameters alone %s after %d iterations, with the "
+        "effects %s after %d\n",
+        track_fits->without_effects.termination.c_str(), track_fits->without_effects.iterations,
+        track_fits->with_effects.termination.c_str(), track_fits->with_effects.iterations);
+  }
+}
+
+std::string EffectNames(const EffectModel& effects) {
+  std::string out;
+  for (const effects::EffectValue& e : effects) {
+    out += std::string(out.empty() ? "" : ", ") + effects::Info(e.id).name;
+  }
+  return out;
+}
+
+// The effects a fit refits: those the robot declares (their values start the fit) and the ones
+// --effects names; nullopt after one line on stderr for a name ReadEffectList refuses.
+std::optional<EffectModel> EffectsToFit(const FitCommandOptions& options, const Robot& robot) {
+  const std::optional<EffectModel> named = ReadEffectList(options.effects, robot, "fit");
+  if (!named) return std::nullopt;
+  EffectModel out = robot.effects;
+  for (const effects::EffectValue& e : *named) {
+    const bool declared = std::any_of(out.begin(), out.end(),
+                                      [&e](const effects::EffectValue& d) { return d.id == e.id; });
+    if (!declared) out.push_back(e);
+  }
+  return out;
+}
+
+// The training runs prepared for the effect fit's track residuals; nullopt after one line on
+// stderr when some training run has no ground truth between its ends.
+std::optional<std::vector<TrackRun>> TrainingTracks(const FitCommandOptions& options,
+                                                    const Robot& robot,
+                                                    const std::vector<RunLog>& logs,
+                                                    const RunSplit& split) {
+  std::unordered_map<std::string, const RunLog*> by_id;
+  for (const RunLog& log : logs) by_id[log.id] = &log;
+  std::vector<RunLog> training;
+  for (const AlignedRun& run : split.training) training.push_back(*by_id.at(run.id));
+  try {
+    return PrepareTrackRuns(training, WheelChannelMask(robot));
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "fitcal: fit: " << options.logs
+              << ": effects are fitted on the ground truth along each run (a track): " << e.what()
+              << "; nothing written\n";
+    return std::nullopt;
+  }
+}
+
+// The model's parameters and `effects` fitted on the training tracks (diagnosis/effect_fit.h),
+// from the nominal, as `diagnose` and `generalise --effects` fit them.
+EffectFitResult FitEffects(const FitCommandOptions& options, const RobotModelInterface& model,
+                           const std::vector<TrackRun>& training, const EffectModel& effects) {
+  EffectFitOptions o;
+  o.weights = options.Weights();
+  o.num_threads = options.threads;
+  return FitEffectModel(training, model, model.robot().nominal, effects, o);
+}
+
+// An effect earns its place as a calibration earns it against the nominal: the gate's choice,
+// when it carries effects, must have lower per-run CFs than the same track fit without them
+// (like for like: the track objective alone must not be credited to the effects), by the
+// one-sided paired test on the log ratios (stats::PairedLogRatioTest, p < kEffectAlpha) on the
+// runs that judged; otherwise the best candidate without effects is selected. The line that says
+// which, or empty.
+constexpr double kEffectAlpha = 0.01;
+
+std::string RequireEffectsToEarnTheirPlace(const std::vector<CalibrationCandidate>& candidates,
+                                           const RunSplit& split, const CandidateErrors& errors,
+                                           const TrackFits& track_fits, GateDecision* gate) {
+  const CalibrationCandidate& chosen = candidates[gate->selected];
+  if (chosen.effects.empty()) return "";
+  const CalibrationCandidate& without = candidates[track_fits.without_index];
+  const std::vector<AlignedRun>& runs =
+      gate->judged_on_held_out ? split.validation : split.training;
+  const stats::PairedTest test =
+      stats::PairedLogRatioTest(errors(without, runs).per_run_cf, errors(chosen, runs).per_run_cf);
+  char line[400];
+  if (test.p < kEffectAlpha) {
+    std::snprintf(line, sizeof line,
+                  "effects: '%s' beats '%s' run by run (paired log-ratio t = %.2f, p = %.2g < %g)",
+                  chosen.name.c_str(), without.name.c_str(), test.t, test.p, kEffectAlpha);
+    return line;
+  }
+  int best = 0;  // the nominal when it carries no effects, else the best candidate without
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    if (!candidates[i].effects.empty() || !std::isfinite(gate->cf[i])) continue;
+    if (!candidates[best].effects.empty() || gate->cf[i] < gate->cf[best]) {
+      best = static_cast<int>(i);
+    }
+  }
+  std::snprintf(line, sizeof line,
+                "effects: '%s' is not significantly better than '%s' run by run (paired "
+                "log-ratio t = %.2f, p = %.2g >= %g): '%s' is selected",
+                chosen.name.c_str(), without.name.c_str(), test.t, test.p, kEffectAlpha,
+                candidates[best].name.c_str());
+  gate->selected = best;
+  return line;
+}
+
+// When the selected calibration carries effects: what an odometry of the parameters alone (a
+// ros2_controllers controller) gets from it, and from the best candidate without effects.
+void WarnOfEffects(const std::vector<CalibrationCandidate>& candidates, const GateDecision& gate,
+                   const RunSplit& split, const CandidateErrors& errors) {
+  const CalibrationCandidate& selected = candidates[gate.selected];
+  if (selected.effects.empty()) return;
+  const std::vector<AlignedRun>& runs = gate.judged_on_held_out ? split.validation : split.training;
+  const double alone = errors({selected.name, selected.parameters, true, {}}, runs).cf;
+  int best = -1;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    if (!candidates[i].effects.empty() || !std::isfinite(gate.cf[i])) continue;
+    if (best < 0 || gate.cf[i] < gate.cf[best]) best = static_cast<int>(i);
+  }
+  std::cerr << "fitcal: note: the calibration carries effects (" << EffectNames(selected.effects)
+            << ") that an odometry of the parameters alone (a ros2_controllers controller) does "
+               "not apply: there its parameters give CF "
+            << alone << " on the " << gate.judged_on;
+  if (best >= 0) {
+    std::cerr << ", the best calibration without effects ('" << candidates[best].name << "') "
+              << gate.cf[best];
+  }
+  std::cerr << "; for such a controller, fit without effects (no --effects, no effects: in the "
+               "robot YAML)\n";
 }
 
 }  // namespace
@@ -251,12 +497,8 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
               << "\n";
     return 2;
   }
-  if (!robot.effects.empty()) {
-    std::cerr << "fitcal: " << index.robot_path
-              << ": the robot declares effects that 'fit' does not model; refit them with "
-                 "'fitcal diagnose', or start from a robot YAML without an effects: list\n";
-    return 2;
-  }
+  const std::optional<EffectModel> effects_to_fit = EffectsToFit(options, robot);
+  if (!effects_to_fit) return 2;
   if (!options.no_output && !options.force) {
     const std::string refusal = OverwriteRefusal(options.out, robot.name);
     if (!refusal.empty()) {
@@ -277,24 +519,47 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
       ChannelsLookMiswired(options, *model, split.training, dataset.runs)) {
     return 4;
   }
+  std::optional<std::vector<TrackRun>> training_tracks;
+  if (!effects_to_fit->empty()) {
+    training_tracks = TrainingTracks(options, robot, dataset.runs, split);
+    if (!training_tracks) return 2;
+  }
   const ModelFitMethodOutcome outcome = method->run_model(split.training, *model, settings);
   const ModelFitResult& fit = outcome.fit;
-  const std::vector<CalibrationCandidate> candidates =
-      Candidates(*model, split, fit, options.method);
-  const GateDecision gate =
-      SelectCalibration(*model, candidates, split.training, split.validation, options.threads);
-  const std::vector<double>& selected = candidates[gate.selected].parameters;
+  std::vector<CalibrationCandidate> candidates = Candidates(*model, split, fit, options.method);
+  std::optional<TrackFits> track_fits;
+  if (training_tracks) {
+    TrackFits& t = track_fits.emplace();
+    t.without_effects = FitEffects(options, *model, *training_tracks, {});
+    t.with_effects = FitEffects(options, *model, *training_tracks, *effects_to_fit);
+    t.without_index = static_cast<int>(candidates.size());
+    candidates.push_back({"track fit", t.without_effects.parameters, t.without_effects.usable});
+    t.with_index = static_cast<int>(candidates.size());
+    candidates.push_back({"track fit + " + EffectNames(*effects_to_fit), t.with_effects.parameters,
+                          t.with_effects.usable, t.with_effects.effects});
+  }
+  const CandidateErrors errors(*model, dataset.runs, options.threads);
+  GateDecision gate = SelectCalibration(*model, candidates, split.training, split.validation,
+                                        options.threads, errors.Cf());
+  const std::string effects_line =
+      track_fits ? RequireEffectsToEarnTheirPlace(candidates, split, errors, *track_fits, &gate)
+                 : "";
+  const CalibrationCandidate& selected = candidates[gate.selected];
+  const SelectedFit selected_fit = DescribeSelected(
+      robot, candidates, gate.selected, options.method, outcome.objective, fit, track_fits);
 
-  PrintFit(options, *model, split, selected, *method, outcome);
+  PrintFit(options, *model, split, candidates, gate, selected_fit, errors, *method, outcome,
+           track_fits);
   if (!fit.has_covariance) std::printf("uncertainty: %s\n", fit.covariance_message.c_str());
   for (const UndeterminedDirection& d : fit.held_directions) PrintHeldAtNominal(d.description);
-  if (!PrintGate(candidates, gate)) return 5;
+  if (!PrintGate(candidates, gate, effects_line)) return 5;
+  WarnOfEffects(candidates, gate, split, errors);
   if (!options.no_output) {
     const io::CalibrationBlock record =
-        MakeRecord(options, *model, dataset.runs, split, fit, outcome.objective, candidates, gate);
+        MakeRecord(options, *model, dataset.runs, split, candidates, gate, selected_fit, errors);
     io::StopHereForTests("fitted");
-    io::WriteFileAtomically(options.out,
-                            model->RobotYaml(selected, io::CalibrationBlockYaml(record, robot)));
+    io::WriteFileAtomically(options.out, model->RobotYaml(selected.parameters, selected.effects,
+                                                          io::CalibrationBlockYaml(record, robot)));
     std::printf("wrote %s\n", options.out.c_str());
   }
   std::printf("time: load %.3f s, total %.3f s\n", load_s, Seconds(t_total));

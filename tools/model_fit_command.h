@@ -21,9 +21,11 @@ namespace fitcal::tools {
 // the same for omni3's fit and every other model's.
 void PrintHeldAtNominal(const std::string& direction);
 
-// The result gate's table (fit/result_gate.h), the same for omni3's fit and every other model's;
-// false, with one line on stderr, when no candidate beats the nominal (exit 5, nothing written).
-bool PrintGate(const std::vector<CalibrationCandidate>& candidates, const GateDecision& gate);
+// The result gate's table (fit/result_gate.h), the same for omni3's fit and every other model's,
+// then effects_line (whether the effects earned their place) when not empty; false, with one line
+// on stderr, when no candidate beats the nominal (exit 5, nothing written).
+bool PrintGate(const std::vector<CalibrationCandidate>& candidates, const GateDecision& gate,
+               const std::string& effects_line = "");
 
 // The `calibration:` keys omni3's fit and every other model's record alike: the method the result
 // gate selected, the fit's objective with the weights, the data set, the fit's termination and

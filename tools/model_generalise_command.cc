@@ -9,6 +9,7 @@
 
 #include "diagnosis/effect_fit.h"
 #include "fit/segment_cost.h"
+#include "tools/effect_list.h"
 #include "validation/generalisation.h"
 #include "validation/run_split.h"
 #include "validation/trajectory_split.h"
@@ -111,31 +112,6 @@ std::optional<std::vector<std::vector<Segment>>> OptiOdomCheckpoints(
   return out;
 }
 
-// The --effects list, or one line on stderr and nullopt for an unknown name or an effect this
-// robot's channels cannot show.
-std::optional<EffectModel> ReadEffectList(const std::vector<std::string>& names,
-                                          const Robot& robot) {
-  EffectModel out;
-  for (const std::string& name : names) {
-    effects::EffectValue e;
-    try {
-      e.id = effects::EffectIdFromName(name);
-    } catch (const std::invalid_argument& error) {
-      std::cerr << "fitcal: generalise --effects: " << error.what() << "\n";
-      return std::nullopt;
-    }
-    if (!robot.CanShow(e.id)) {
-      std::cerr << "fitcal: generalise --effects: " << name << " needs "
-                << (effects::NeedsWheelPair(e.id) ? "a robot with two wheel channels and no other"
-                                                  : "an angle channel (steering)")
-                << "; model " << robot.model << " cannot show it\n";
-      return std::nullopt;
-    }
-    out.push_back(e);
-  }
-  return out;
-}
-
 }  // namespace
 
 int RunModelGeneraliseCommand(const GeneraliseCommandOptions& options,
@@ -164,7 +140,8 @@ int RunModelGeneraliseCommand(const GeneraliseCommandOptions& options,
     }
     track_candidates.optiodom_checkpoints = &*checkpoints;
   }
-  const std::optional<EffectModel> effect_list = ReadEffectList(options.effects, robot);
+  const std::optional<EffectModel> effect_list =
+      ReadEffectList(options.effects, robot, "generalise");
   if (!effect_list) return 2;
   std::vector<TrackRun> tracks;
   if (!effect_list->empty()) {

@@ -6,6 +6,7 @@
 
 #include "diagnosis/effect_fit.h"
 #include "odometry/omni3_replay.h"
+#include "odometry/parallel_for.h"
 
 namespace fitcal {
 
@@ -216,6 +217,35 @@ TrajectoryErrors ErrorsAlongTrack(const AlignedRun& run, const GroundTruthTrack&
 }
 
 }  // namespace
+
+FinalPoseErrors EvaluateFinalPoseErrors(const RobotModelInterface& model,
+                                        const std::vector<double>& p,
+                                        const std::vector<effects::EffectValue>& effects,
+                                        const std::vector<AlignedRun>& runs,
+                                        const std::vector<const GroundTruthTrack*>& tracks,
+                                        int num_threads) {
+  if (tracks.size() != runs.size()) {
+    throw std::invalid_argument("EvaluateFinalPoseErrors: one ground-truth track per run");
+  }
+  std::vector<TrajectoryErrors> errors(runs.size());
+  ParallelFor(runs.size(), num_threads, [&](std::size_t i) {
+    errors[i] = EvaluateTrajectory(model, runs[i], *tracks[i], p, effects);
+  });
+  FinalPoseErrors out;
+  for (const TrajectoryErrors& e : errors) {
+    out.per_run_cf.push_back(e.cf);
+    out.cf += e.cf;
+    out.mean_position_error_m += e.final_distance_m;
+    out.mean_abs_heading_error_rad += e.final_angle_rad;
+  }
+  if (!runs.empty()) {
+    const double n = static_cast<double>(runs.size());
+    out.cf /= n;
+    out.mean_position_error_m /= n;
+    out.mean_abs_heading_error_rad /= n;
+  }
+  return out;
+}
 
 SummaryStatistics Summarize(std::vector<double> values) {
   SummaryStatistics s;

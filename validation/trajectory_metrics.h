@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "fit/final_pose_cost.h"
+#include "fit/final_pose_errors.h"
 #include "models/model_interface.h"
 #include "odometry/aligned_run.h"
 #include "odometry/effects.h"
@@ -76,6 +77,17 @@ TrajectoryErrors EvaluateTrajectory(const RobotModelInterface& model, const Alig
                                     const GroundTruthTrack& track, const std::vector<double>& p,
                                     const std::vector<effects::EffectValue>& effects,
                                     OdometrySampling sampling = OdometrySampling::kNearestTime);
+
+// The final-pose errors (fit/final_pose_errors.h: Eq. 14 and the mean position and |heading|
+// errors) of the model at p with `effects`, each run replayed by the overload above against its
+// ground truth (tracks[i] is runs[i]'s), in parallel. Without effects it equals
+// EvaluateFinalPoseErrors, which needs no track.
+FinalPoseErrors EvaluateFinalPoseErrors(const RobotModelInterface& model,
+                                        const std::vector<double>& p,
+                                        const std::vector<effects::EffectValue>& effects,
+                                        const std::vector<AlignedRun>& runs,
+                                        const std::vector<const GroundTruthTrack*>& tracks,
+                                        int num_threads = 0);
 
 // Summary statistics named as the evo tool names them (evo_ape/evo_rpe "stats"): rmse, mean,
 // median, std (population, ddof = 0, as numpy.std), min, max. All zero for no values.

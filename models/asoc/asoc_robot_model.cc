@@ -137,9 +137,11 @@ RobotModelPtr ReadAsocModel(const YAML::Node& root, const std::string& path) {
 }
 
 std::string AsocModel::RobotYaml(const std::vector<double>& p,
+                                 const std::vector<effects::EffectValue>& effects,
                                  const std::string& calibration_block) const {
   io::AsocRobot out = asoc_;
   out.nominal.SetFromArray(p.data());
+  out.effects = effects;
   return io::AsocRobotYaml(out) + calibration_block;
 }
 

@@ -33,7 +33,9 @@ class AsocModel : public KinematicModel<AsocKinematics> {
 
   const io::AsocRobot& asoc_robot() const { return asoc_; }
 
+  using RobotModelInterface::RobotYaml;
   std::string RobotYaml(const std::vector<double>& p,
+                        const std::vector<effects::EffectValue>& effects,
                         const std::string& calibration_block) const override;
 
   // Doebbler Eq. 1-9 from every hold run (`hold_<j>_cw` / `hold_<j>_ccw`) among the training runs.

@@ -150,6 +150,7 @@ int DiffDriveRightChannel(const RobotModelInterface& model) {
 }
 
 std::string DiffDriveRobotYaml(const Robot& robot, int right_channel, const std::vector<double>& p,
+                               const std::vector<effects::EffectValue>& effects,
                                const std::string& calibration_block) {
   YAML::Emitter out;
   out.SetDoublePrecision(10);
@@ -172,7 +173,7 @@ std::string DiffDriveRobotYaml(const Robot& robot, int right_channel, const std:
   io::EmitBoundsPair(out, "radius_m", robot.bounds[0], 1.0);
   io::EmitBoundsPair(out, "wheel_separation_m", robot.bounds[diff_drive::kSeparationIndex], 1.0);
   out << YAML::EndMap;
-  io::EmitEncoderAndEffects(out, robot);
+  io::EmitEncoderAndEffects(out, robot, effects);
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n" + calibration_block;
 }

@@ -39,8 +39,9 @@ namespace fitcal {
 Robot DiffDriveRobotDescription(const std::string& name,
                                 const std::vector<std::string>& wheel_names);
 
-// The robot YAML of a differential drive with parameters p; right_channel: 0 or 1.
+// The robot YAML of a differential drive with parameters p and `effects`; right_channel: 0 or 1.
 std::string DiffDriveRobotYaml(const Robot& robot, int right_channel, const std::vector<double>& p,
+                               const std::vector<effects::EffectValue>& effects,
                                const std::string& calibration_block);
 
 // UMBmark (umbmark.h) from the training runs whose trajectory label contains "square".
@@ -57,9 +58,11 @@ class DiffDriveModelT : public KinematicModel<DiffDriveKinematicsT<kRightChannel
   explicit DiffDriveModelT(Robot robot)
       : KinematicModel<DiffDriveKinematicsT<kRightChannel>>(std::move(robot)) {}
 
+  using RobotModelInterface::RobotYaml;
   std::string RobotYaml(const std::vector<double>& p,
+                        const std::vector<effects::EffectValue>& effects,
                         const std::string& calibration_block) const override {
-    return DiffDriveRobotYaml(this->robot_, kRightChannel, p, calibration_block);
+    return DiffDriveRobotYaml(this->robot_, kRightChannel, p, effects, calibration_block);
   }
 
   // UMBmark (Borenstein & Feng 1996) from the CW and CCW squares among the training runs; empty

@@ -36,7 +36,9 @@ class OmniModel : public KinematicModel<OmniKinematics<N>> {
       : KinematicModel<OmniKinematics<N>>(std::move(robot), kinematics),
         angle_offset_rad_(angle_offset_rad) {}
 
+  using RobotModelInterface::RobotYaml;
   std::string RobotYaml(const std::vector<double>& p,
+                        const std::vector<effects::EffectValue>& effects,
                         const std::string& calibration_block) const override;
 
  private:
@@ -54,6 +56,7 @@ std::string Indented(const std::string& text) {
 
 template <int N>
 std::string OmniModel<N>::RobotYaml(const std::vector<double>& p,
+                                    const std::vector<effects::EffectValue>& effects,
                                     const std::string& calibration_block) const {
   using K = OmniKinematics<N>;
   const Robot& robot = this->robot_;
@@ -83,7 +86,7 @@ std::string OmniModel<N>::RobotYaml(const std::vector<double>& p,
   io::EmitBoundsPair(out, "radius_m", robot.bounds[K::kRadiusIndex], 1.0);
   io::EmitBoundsPair(out, "angle_offset_deg", angle_offset_rad_, 180.0 / M_PI);
   out << YAML::EndMap;
-  io::EmitEncoderAndEffects(out, robot);
+  io::EmitEncoderAndEffects(out, robot, effects);
   out << YAML::EndMap;
   std::string text = std::string(out.c_str()) + "\n";
   if (calibration_block.empty()) return text;

@@ -77,7 +77,12 @@ RobotModelPtr ReadOmni3Model(const YAML::Node& root, const std::string& path) {
     const double delta = p[omni3::kAngleIndex + i];
     robot.bounds.push_back({delta + box.angle_offset_rad.lo, delta + box.angle_offset_rad.hi});
   }
-  io::CheckNominalInsideBounds(robot, path, LineOf(wheels));
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    // Named at the line of its wheel (parameters are grouped by kind, three wheels each).
+    if (!robot.bounds[k].Contains(robot.nominal[k])) {
+      io::CheckNominalInsideBounds(robot, path, LineOf(wheels[k % omni3::kNumWheels]));
+    }
+  }
   if (std::abs(omni3::InverseKinematicDenominator(p.data())) < 1e-9) {
     throw InputError(InputErrorKind::kBadValue, path, LineOf(wheels),
                      "the wheel angles and distances give a singular kinematic matrix");
@@ -107,6 +112,7 @@ const Omni3Model& DefaultOmni3Model() {
 }
 
 std::string Omni3Model::RobotYaml(const std::vector<double>& p,
+                                  const std::vector<effects::EffectValue>& effects,
                                   const std::string& calibration_block) const {
   YAML::Emitter out;
   out.SetDoublePrecision(10);
@@ -128,7 +134,7 @@ std::string Omni3Model::RobotYaml(const std::vector<double>& p,
   io::EmitBoundsPair(out, "radius_m", robot_.bounds[omni3::kRadiusIndex], 1.0);
   io::EmitBoundsPair(out, "angle_offset_deg", angle_offset_rad_, 180.0 / M_PI);
   out << YAML::EndMap;
-  io::EmitEncoderAndEffects(out, robot_);
+  io::EmitEncoderAndEffects(out, robot_, effects);
   out << YAML::EndMap;
   std::string text = std::string(out.c_str()) + "\n";
   if (calibration_block.empty()) return text;

@@ -19,7 +19,9 @@ class Omni3Model : public KinematicModel<Omni3Kinematics> {
   Omni3Model(Robot robot, Interval angle_offset_rad)
       : KinematicModel(std::move(robot)), angle_offset_rad_(angle_offset_rad) {}
 
+  using RobotModelInterface::RobotYaml;
   std::string RobotYaml(const std::vector<double>& p,
+                        const std::vector<effects::EffectValue>& effects,
                         const std::string& calibration_block) const override;
 
  private:

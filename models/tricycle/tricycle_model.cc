@@ -112,6 +112,7 @@ RobotModelPtr ReadTricycleModel(const YAML::Node& root, const std::string& path)
 }
 
 std::string TricycleModel::RobotYaml(const std::vector<double>& p,
+                                     const std::vector<effects::EffectValue>& effects,
                                      const std::string& calibration_block) const {
   const std::string& traction_name = robot_.channels[K::kTractionChannel].name;
   YAML::Emitter out;
@@ -132,7 +133,7 @@ std::string TricycleModel::RobotYaml(const std::vector<double>& p,
   io::EmitBoundsPair(out, "steering_offset_deg", robot_.bounds[K::kSteeringOffsetIndex],
                      180.0 / M_PI);
   out << YAML::EndMap;
-  io::EmitEncoderAndEffects(out, robot_);
+  io::EmitEncoderAndEffects(out, robot_, effects);
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n" + calibration_block;
 }

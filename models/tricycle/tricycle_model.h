@@ -29,7 +29,9 @@ class TricycleModel : public KinematicModel<TricycleKinematics> {
  public:
   explicit TricycleModel(Robot robot) : KinematicModel(std::move(robot)) {}
 
+  using RobotModelInterface::RobotYaml;
   std::string RobotYaml(const std::vector<double>& p,
+                        const std::vector<effects::EffectValue>& effects,
                         const std::string& calibration_block) const override;
 
   // The loader's hook for model-specific checks of a log (proposed as a virtual of

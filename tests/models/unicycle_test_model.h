@@ -42,7 +42,9 @@ class UnicycleModel : public KinematicModel<UnicycleKinematics> {
  public:
   using KinematicModel::KinematicModel;
 
+  using RobotModelInterface::RobotYaml;
   std::string RobotYaml(const std::vector<double>& p,
+                        const std::vector<effects::EffectValue>& effects,
                         const std::string& calibration_block) const override {
     YAML::Emitter out;
     out.SetDoublePrecision(12);
@@ -54,7 +56,7 @@ class UnicycleModel : public KinematicModel<UnicycleKinematics> {
     io::EmitBoundsPair(out, "radius_m", robot_.bounds[0], 1.0);
     io::EmitBoundsPair(out, "turn_gain", robot_.bounds[1], 1.0);
     out << YAML::EndMap;
-    io::EmitEncoderAndEffects(out, robot_);
+    io::EmitEncoderAndEffects(out, robot_, effects);
     out << YAML::EndMap;
     return std::string(out.c_str()) + "\n" + calibration_block;
   }
