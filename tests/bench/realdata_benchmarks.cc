@@ -62,6 +62,11 @@ void BM_ImportAndFit(benchmark::State& state, const std::string& robot,
 BENCHMARK_CAPTURE(BM_ImportAndFit, diff, std::string("diff"), std::string())
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+// The calibration that carries the diff drive's pivot effect (README, "The other OptiOdom robots").
+BENCHMARK_CAPTURE(BM_ImportAndFit, diff_pivot, std::string("diff"),
+                  std::string("--effects pivot_yaw_gain"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK_CAPTURE(BM_ImportAndFit, omni4, std::string("omni4"), std::string("--train-reps 1-5"))
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
