@@ -194,13 +194,6 @@ bool SolveUntilBoundContact(const Robot& robot, const ModelFitOptions& options,
   return true;
 }
 
-// Which parameters rest on a bound of the robot's box (AtBound).
-std::vector<bool> ParametersAtBound(const Robot& robot, const std::vector<double>& p) {
-  std::vector<bool> out(p.size(), false);
-  for (std::size_t k = 0; k < p.size(); ++k) out[k] = AtBound(p[k], robot.bounds[k]);
-  return out;
-}
-
 // Fixes every parameter that rests on a bound (AtBound) exactly on it.
 void FixParametersAtBound(const Robot& robot, std::vector<double>* p, std::vector<bool>* fixed) {
   const std::vector<bool> on_bound = ParametersAtBound(robot, *p);
@@ -306,6 +299,12 @@ void ComputeCovariance(const std::vector<AlignedRun>& training, const RobotModel
 bool AtBound(double value, const Interval& box) {
   const double tolerance = 1e-6 * box.Width();
   return value <= box.lo + tolerance || value >= box.hi - tolerance;
+}
+
+std::vector<bool> ParametersAtBound(const Robot& robot, const std::vector<double>& p) {
+  std::vector<bool> out(p.size(), false);
+  for (std::size_t k = 0; k < p.size(); ++k) out[k] = AtBound(p[k], robot.bounds[k]);
+  return out;
 }
 
 namespace {

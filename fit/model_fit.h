@@ -82,6 +82,8 @@ struct ModelFitOptions {
 // A value rests on a bound when it is within 1e-6 of the box's width of it: far above the YAML's
 // 10 significant digits (1e-11 m on a 0.2 m distance), far below any meaningful change.
 bool AtBound(double value, const Interval& box);
+// Which parameters (robot().parameters order) rest on a bound of the robot's box (AtBound).
+std::vector<bool> ParametersAtBound(const Robot& robot, const std::vector<double>& p);
 
 // Throws std::invalid_argument for invalid options or no runs.
 ModelFitResult FitModel(const std::vector<AlignedRun>& training, const RobotModelInterface& model,

@@ -102,17 +102,6 @@ struct SelectedFit {
 
 constexpr const char* kTrackObjective = "sum over runs of the mean squared track error (m and rad)";
 
-// The effect fit reports only whether some parameter ended on a bound: which ones, here.
-std::vector<bool> OnBounds(const Robot& robot, const std::vector<double>& p) {
-  std::vector<bool> out(p.size(), false);
-  for (std::size_t k = 0; k < p.size(); ++k) {
-    const Interval& b = robot.bounds[k];
-    const double tolerance = 1e-9 * (b.hi - b.lo);
-    out[k] = p[k] <= b.lo + tolerance || p[k] >= b.hi - tolerance;
-  }
-  return out;
-}
-
 // The fits on the training tracks when effects are fitted (diagnosis/effect_fit.h): the
 // parameters alone and with the effects, on one objective, so that the effects are judged like
 // for like; with their indices among the gate's candidates.
@@ -145,7 +134,9 @@ SelectedFit DescribeSelected(const Robot& robot,
     out.has_covariance = track_fit->has_covariance;
     out.sigma = track_fit->sigma;
     out.correlation = track_fit->correlation;
-    out.at_bound = OnBounds(robot, selected.parameters);
+    // The effect fit reports only whether some parameter ended on a bound: which ones, by the
+    // fit's own rule.
+    out.at_bound = ParametersAtBound(robot, selected.parameters);
     for (const HeldParameter& h : robot.held) out.held[h.index] = true;
     out.objective = kTrackObjective;
     out.termination = track_fit->termination;
@@ -403,6 +394,17 @@ EffectFitResult FitEffects(const FitCommandOptions& options, const RobotModelInt
   return FitEffectModel(training, model, model.robot().nominal, effects, o);
 }
 
+// The candidate without effects with the lowest CF on the runs that judged (-1: none usable).
+int BestWithoutEffects(const std::vector<CalibrationCandidate>& candidates,
+                       const GateDecision& gate) {
+  int best = -1;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    if (!candidates[i].effects.empty() || !std::isfinite(gate.cf[i])) continue;
+    if (best < 0 || gate.cf[i] < gate.cf[best]) best = static_cast<int>(i);
+  }
+  return best;
+}
+
 // An effect earns its place as a calibration earns it against the nominal: the gate's choice,
 // when it carries effects, must have lower per-run CFs than the same track fit without them
 // (like for like: the track objective alone must not be credited to the effects), by the
@@ -428,13 +430,8 @@ std::string RequireEffectsToEarnTheirPlace(const std::vector<CalibrationCandidat
                   chosen.name.c_str(), without.name.c_str(), test.t, test.p, kEffectAlpha);
     return line;
   }
-  int best = 0;  // the nominal when it carries no effects, else the best candidate without
-  for (std::size_t i = 0; i < candidates.size(); ++i) {
-    if (!candidates[i].effects.empty() || !std::isfinite(gate->cf[i])) continue;
-    if (!candidates[best].effects.empty() || gate->cf[i] < gate->cf[best]) {
-      best = static_cast<int>(i);
-    }
-  }
+  // The nominal carries effects only when the robot declares them; then some fit must stand in.
+  const int best = std::max(0, BestWithoutEffects(candidates, *gate));
   std::snprintf(line, sizeof line,
                 "effects: '%s' is not significantly better than '%s' run by run (paired "
                 "log-ratio t = %.2f, p = %.2g >= %g): '%s' is selected",
@@ -452,11 +449,7 @@ void WarnOfEffects(const std::vector<CalibrationCandidate>& candidates, const Ga
   if (selected.effects.empty()) return;
   const std::vector<AlignedRun>& runs = gate.judged_on_held_out ? split.validation : split.training;
   const double alone = errors({selected.name, selected.parameters, true, {}}, runs).cf;
-  int best = -1;
-  for (std::size_t i = 0; i < candidates.size(); ++i) {
-    if (!candidates[i].effects.empty() || !std::isfinite(gate.cf[i])) continue;
-    if (best < 0 || gate.cf[i] < gate.cf[best]) best = static_cast<int>(i);
-  }
+  const int best = BestWithoutEffects(candidates, gate);
   std::cerr << "fitcal: note: the calibration carries effects (" << EffectNames(selected.effects)
             << ") that an odometry of the parameters alone (a ros2_controllers controller) does "
                "not apply: there its parameters give CF "
