@@ -21,6 +21,7 @@
 #include "models/diff_drive/diff_drive_model.h"
 #include "models/model_registry.h"
 #include "odometry/effects.h"
+#include "tests/diagnose_expectations.h"
 #include "tests/test_files.h"
 #include "tools/sim/diff_drive_trajectories.h"
 #include "tools/sim/model_simulator.h"
@@ -118,29 +119,14 @@ TEST(DiffDriveDiagnose, NamesAPivotYawGainWithItsSize) {
   const auto model = DiffDrive();
   const double injected = effects::Info(EffectId::kPivotYawGain).typical[0];
   const Split d = Simulate(*model, injected, 31);
-  DiagnoseOptions options;
-  options.fit.num_threads = 2;
-  const DiagnoseResult r = Diagnose(d.training, d.validation, *model, options);
-  SCOPED_TRACE(FormatDiagnoseReport(r, *model));
-  ASSERT_EQ(r.final_fit.effects.size(), 1u);
-  const effects::EffectValue& e = r.final_fit.effects[0];
-  EXPECT_EQ(e.id, EffectId::kPivotYawGain);
-  std::printf("pivot_yaw_gain %.5f +- %.5f (injected %.4f); held-out CF %.4f -> %.4f\n", e.value[0],
-              e.sigma[0], injected, r.declared_validation.cf, r.final_validation.cf);
-  // Within four of its own sigmas (the fit's covariance, from the noise) of the injected size.
-  EXPECT_GT(e.sigma[0], 0.0);
-  EXPECT_LT(std::abs(e.value[0] - injected), 4.0 * e.sigma[0]);
-  EXPECT_LT(r.final_validation.cf, 0.5 * r.declared_validation.cf);
+  fitcal::testing::ExpectDiagnoseNamesTheInjectedEffect(d.training, d.validation, *model,
+                                                        EffectId::kPivotYawGain, injected);
 }
 
 TEST(DiffDriveDiagnose, CleanDiffDriveAcceptsNothing) {
   const auto model = DiffDrive();
   const Split d = Simulate(*model, 0.0, 32);
-  DiagnoseOptions options;
-  options.fit.num_threads = 2;
-  const DiagnoseResult r = Diagnose(d.training, d.validation, *model, options);
-  SCOPED_TRACE(FormatDiagnoseReport(r, *model));
-  EXPECT_TRUE(r.final_fit.effects.empty());
+  fitcal::testing::ExpectDiagnoseAcceptsNothing(d.training, d.validation, *model);
 }
 
 // The data set a user records (WriteSimulatedDataset, as `fitcal simulate` writes it), with the

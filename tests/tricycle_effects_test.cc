@@ -12,6 +12,7 @@
 #include "diagnosis/diagnose.h"
 #include "diagnosis/effect_fit.h"
 #include "models/tricycle/tricycle_model.h"
+#include "tests/diagnose_expectations.h"
 #include "tools/sim/model_simulator.h"
 #include "tools/sim/tricycle_trajectories.h"
 
@@ -68,28 +69,14 @@ TEST(TricycleDiagnose, NamesAScaledSteeringSensorWithItsSize) {
   const auto model = Tricycle();
   const double injected = effects::Info(effects::EffectId::kSteeringScale).typical[0];
   const Split d = Simulate(*model, injected, 21);
-  DiagnoseOptions options;
-  options.fit.num_threads = 2;
-  const DiagnoseResult r = Diagnose(d.training, d.validation, *model, options);
-  const std::string report = FormatDiagnoseReport(r, *model);
-  SCOPED_TRACE(report);
-  ASSERT_EQ(r.final_fit.effects.size(), 1u);
-  const effects::EffectValue& e = r.final_fit.effects[0];
-  EXPECT_EQ(e.id, effects::EffectId::kSteeringScale);
-  // Within four of its own sigmas (the fit's covariance, from the noise) of the injected size.
-  EXPECT_GT(e.sigma[0], 0.0);
-  EXPECT_LT(std::abs(e.value[0] - injected), 4.0 * e.sigma[0]);
-  EXPECT_LT(r.final_validation.cf, 0.5 * r.declared_validation.cf);
+  fitcal::testing::ExpectDiagnoseNamesTheInjectedEffect(
+      d.training, d.validation, *model, effects::EffectId::kSteeringScale, injected);
 }
 
 TEST(TricycleDiagnose, CleanTricycleAcceptsNothing) {
   const auto model = Tricycle();
   const Split d = Simulate(*model, 0.0, 22);
-  DiagnoseOptions options;
-  options.fit.num_threads = 2;
-  const DiagnoseResult r = Diagnose(d.training, d.validation, *model, options);
-  SCOPED_TRACE(FormatDiagnoseReport(r, *model));
-  EXPECT_TRUE(r.final_fit.effects.empty());
+  fitcal::testing::ExpectDiagnoseAcceptsNothing(d.training, d.validation, *model);
 }
 
 }  // namespace
