@@ -5,18 +5,33 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 tools/install_deps.sh
 jobs=$(nproc)
+start=$SECONDS
+
+# The slowest build steps of a build directory, from ninja's own log (kept in the directory), so
+# that the next slow step is visible in every CI log.
+slowest_steps() {
+  echo "slowest build steps in $1 (s):"
+  awk 'NR > 1 { printf "%8.1f  %s\n", ($2 - $1) / 1000, $4 }' "$1/.ninja_log" | sort -rn | head -8
+}
+
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DFITCAL_WERROR=ON
 cmake --build build -j "$jobs"
+slowest_steps build
+echo "release build: $((SECONDS - start)) s"
 ctest --test-dir build --output-on-failure -j "$jobs"
+echo "release tests done: $((SECONDS - start)) s"
 
-# The unit tests once more under AddressSanitizer + UndefinedBehaviorSanitizer (memory errors a Release run hides), in their
-# own build directory; -O1 keeps the instrumented build and the Ceres fits fast enough for CI.
+# Sanitizers by purpose: AddressSanitizer + UndefinedBehaviorSanitizer on the executables marked
+# SANITIZE in tests/CMakeLists.txt (parsers, writers, the command line, the model harness), in
+# their own build directory; -O1 keeps the instrumented build and the Ceres fits fast enough.
 # FITCAL_ASAN_BUILD_DIR lets a developer keep this build apart from others (default build-asan).
 asan_dir=${FITCAL_ASAN_BUILD_DIR:-build-asan}
 cmake -S . -B "$asan_dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DFITCAL_SANITIZE=ON -DFITCAL_WERROR=ON \
   -DFITCAL_BUILD_BENCHMARKS=OFF
 cmake --build "$asan_dir" -j "$jobs"
-# A test too slow under the sanitizers for CI can opt out with the ctest label no_sanitize.
+slowest_steps "$asan_dir"
+echo "sanitizer build: $((SECONDS - start)) s"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-  ctest --test-dir "$asan_dir" --output-on-failure -j "$jobs" -LE no_sanitize
+  ctest --test-dir "$asan_dir" --output-on-failure -j "$jobs" -L sanitize
+echo "tools/test.sh: $((SECONDS - start)) s"
