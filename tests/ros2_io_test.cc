@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <sstream>
 
@@ -67,12 +68,20 @@ std::vector<sim::ModelSimulatedRun> SimulatedRuns(const RobotModelInterface& mod
   return sim::SimulateRuns(model, kTruth, sim::DiffDriveCalibrationTrajectories(2, shapes), o);
 }
 
+// What real recorders do to a bag, applied while it is written.
+struct BagEdits {
+  std::function<void(std::size_t, JointState*)> joint;  // message index on /joint_states
+  std::function<void(std::size_t, PoseStamped*)> pose;  // message index on /mocap/pose
+  bool other_node = false;  // a second node's JointState (other joints) after every 7th message
+  std::int64_t clock_step_back_ns = 0;  // recording times of the second half moved back by this
+};
+
 // The bag: runs one after the other on one clock (run i starts where run i-1 ended + kGapS),
 // joint states at rest in the gaps, no ground truth there (the robot is carried back to the start).
 // Returns each run's span on the bag clock (s since the first message).
 std::vector<std::pair<double, double>> WriteRobotBag(
     const fs::path& dir, const std::vector<sim::ModelSimulatedRun>& runs,
-    BagWriterOptions options) {
+    BagWriterOptions options, const BagEdits& edits = {}) {
   struct Msg {
     bool joint;
     std::int64_t stamp_ns;
@@ -81,13 +90,25 @@ std::vector<std::pair<double, double>> WriteRobotBag(
   std::vector<Msg> msgs;
   std::vector<std::pair<double, double>> spans;
   double offset = 0.0, angle_right = 0.0, angle_left = 0.0;
+  std::size_t joint_count = 0, pose_count = 0;
   const auto joint = [&](double t) {
     JointState js;
     js.header.stamp = {static_cast<std::int32_t>(Ns(t) / 1000000000),
                        static_cast<std::uint32_t>(Ns(t) % 1000000000)};
     js.name = {"caster", "left_wheel_joint", "right_wheel_joint"};  // not the robot's order
     js.position = {0.1, angle_left, angle_right};
+    if (edits.joint) edits.joint(joint_count, &js);
     msgs.push_back({true, Ns(t), EncodeJointState(js)});
+    if (edits.other_node && joint_count % 7 == 0) {
+      JointState gripper;
+      const std::int64_t ns = Ns(t) + 1000000;  // 1 ms later: between two of the robot's
+      gripper.header.stamp = {static_cast<std::int32_t>(ns / 1000000000),
+                              static_cast<std::uint32_t>(ns % 1000000000)};
+      gripper.name = {"gripper_left_finger", "gripper_right_finger"};
+      gripper.position = {0.01, -0.01};
+      msgs.push_back({true, ns, EncodeJointState(gripper)});
+    }
+    ++joint_count;
   };
   for (const sim::ModelSimulatedRun& run : runs) {
     const std::vector<double>& t = run.log.encoders.t_s;
@@ -107,6 +128,8 @@ std::vector<std::pair<double, double>> WriteRobotBag(
       p.pose.position = {gt.world_T_robot[k].x, gt.world_T_robot[k].y, 0.0};
       const double yaw = gt.world_T_robot[k].theta;
       p.pose.orientation = {0.0, 0.0, std::sin(yaw / 2), std::cos(yaw / 2)};
+      if (edits.pose) edits.pose(pose_count, &p);
+      ++pose_count;
       msgs.push_back({false, ns, EncodePoseStamped(p)});
     }
     spans.emplace_back(offset, offset + t.back() - t.front());
@@ -120,10 +143,13 @@ std::vector<std::pair<double, double>> WriteRobotBag(
   bag.AddTopic("/joint_states", "sensor_msgs/msg/JointState");
   bag.AddTopic("/mocap/pose", "geometry_msgs/msg/PoseStamped");
   bag.AddTopic("/chatter", "std_msgs/msg/String");
+  std::stable_sort(msgs.begin(), msgs.end(),
+                   [](const Msg& a, const Msg& b) { return a.stamp_ns < b.stamp_ns; });
   for (std::size_t i = 0; i < msgs.size(); ++i) {
     // Recorded 2.0-2.4 ms after the stamp (latency and jitter, below the message spacing).
     const std::int64_t recorded =
-        msgs[i].stamp_ns + 2000000 + static_cast<std::int64_t>(i % 5) * 100000;
+        msgs[i].stamp_ns + 2000000 + static_cast<std::int64_t>(i % 5) * 100000 -
+        (i >= msgs.size() / 2 ? edits.clock_step_back_ns : 0);
     bag.Write(msgs[i].joint ? "/joint_states" : "/mocap/pose", recorded, ByteView(msgs[i].payload));
   }
   bag.Close();
@@ -290,11 +316,18 @@ class MalformedImport : public ::testing::Test {
     runs_ = SimulatedRuns(*model);
     runs_.resize(2);
   }
-  fs::path Bag(const std::string& name, StorageFormat storage) {
+  fs::path Bag(const std::string& name, StorageFormat storage, const BagEdits& edits = {}) {
     BagWriterOptions options;
     options.storage = storage;
-    WriteRobotBag(tmp_.path() / name, runs_, options);
+    WriteRobotBag(tmp_.path() / name, runs_, options, edits);
     return tmp_.path() / name;
+  }
+  // The bag imported (as the user would, split at the rests between runs).
+  tools::Rosbag2Import Import(const fs::path& bag, const std::string& out) {
+    tools::ImportRosbag2Options o = ImportOptions(tmp_, bag);
+    o.out = tmp_.Path(out);
+    o.split_at_rest_s = 2.0;
+    return tools::ImportRosbag2(o);
   }
   testing::TempDir tmp_;
   std::vector<sim::ModelSimulatedRun> runs_;
@@ -350,9 +383,129 @@ TEST_F(MalformedImport, TopicTypeJointAndStamps) {
   }
   ExpectRefused(ImportOptions(tmp_, tmp_.path() / "twice"), "is not after the previous one");
   o = ImportOptions(tmp_, tmp_.path() / "twice");
-  o.stamp = "recorded";  // the recording times do increase
-  tools::ImportRosbag2(o);
-  EXPECT_TRUE(fs::exists(fs::path(o.out) / "dataset.yaml"));
+  // The recording times do increase, but the wheel angles jump back where the second copy
+  // starts: a data set `fit` refuses, so the import refuses it (it used to write it).
+  o.stamp = "recorded";
+  ExpectRefused(o, "imported/runs/twice-01_encoders.csv:");
+  ExpectRefused(o, "is not a physical wheel rate");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bags as real robots record them (issue 33): each one either imported exactly as the clean bag
+// or refused in one line naming where.
+
+// Same runs, same encoder rows to 1e-9 rad/s (an unwrapped angle is the cumulative one up to
+// the rounding of ~1e3 rad sums, ~1e-13 rad, over 0.05 s), same ground truth.
+void ExpectSameImport(const tools::Rosbag2Import& a, const tools::Rosbag2Import& b) {
+  ASSERT_EQ(a.runs.size(), b.runs.size());
+  for (std::size_t i = 0; i < a.runs.size(); ++i) {
+    ASSERT_EQ(a.encoder_t_s[i], b.encoder_t_s[i]) << "run " << i;
+    ASSERT_EQ(a.encoder_values[i].size(), b.encoder_values[i].size());
+    for (std::size_t k = 0; k < a.encoder_values[i].size(); ++k) {
+      ASSERT_NEAR(a.encoder_values[i][k], b.encoder_values[i][k], 1e-9) << "run " << i;
+    }
+    ASSERT_EQ(a.runs[i].ground_truth.t_s, b.runs[i].ground_truth.t_s);
+  }
+}
+
+TEST_F(MalformedImport, ZeroOrNonUnitQuaternionRefusedWithTopicAndTime) {
+  for (const double scale : {0.0, 0.5}) {
+    BagEdits edits;
+    edits.pose = [&](std::size_t i, PoseStamped* p) {
+      if (i != 17) return;
+      Quaternion& q = p->pose.orientation;
+      q = {q.x * scale, q.y * scale, q.z * scale, q.w * scale};
+    };
+    const fs::path bag = Bag(scale == 0.0 ? "zero_q" : "half_q", StorageFormat::kMcap, edits);
+    const std::string what = scale == 0.0 ? "is a zero quaternion" : "is not a unit quaternion";
+    ExpectRefused(ImportOptions(tmp_, bag), what);
+    ExpectRefused(ImportOptions(tmp_, bag), "/mocap/pose message at ");
+  }
+}
+
+TEST_F(MalformedImport, WrappedJointPositionsUnwrapped) {
+  const tools::Rosbag2Import clean = Import(Bag("clean", StorageFormat::kMcap), "clean_out");
+  BagEdits edits;
+  edits.joint = [](std::size_t, JointState* js) {
+    for (double& angle : js->position) angle = WrapAngle(angle);
+  };
+  const tools::Rosbag2Import wrapped = Import(Bag("wrapped", StorageFormat::kMcap, edits), "w");
+  ExpectSameImport(clean, wrapped);
+  ASSERT_EQ(wrapped.notes.size(), 2u);  // both wheels (the caster is not the robot's)
+  EXPECT_NE(wrapped.notes[0].find("unwrapped"), std::string::npos) << wrapped.notes[0];
+  // A glitch of 2 rad in one wrapped reading: a step nobody can unwrap with confidence.
+  edits.joint = [](std::size_t i, JointState* js) {
+    for (double& angle : js->position) angle = WrapAngle(angle + (i == 40 ? 2.0 : 0.0));
+  };
+  ExpectRefused(ImportOptions(tmp_, Bag("glitch", StorageFormat::kMcap, edits)),
+                "too fast to unwrap");
+}
+
+TEST_F(MalformedImport, OtherNodesJointStatesSkipped) {
+  const tools::Rosbag2Import clean = Import(Bag("clean", StorageFormat::kSqlite3), "clean_out");
+  BagEdits edits;
+  edits.other_node = true;
+  const tools::Rosbag2Import mixed = Import(Bag("mixed", StorageFormat::kSqlite3, edits), "m");
+  ExpectSameImport(clean, mixed);
+}
+
+TEST_F(MalformedImport, RecordingClockSteppingBack) {
+  for (StorageFormat storage : {StorageFormat::kMcap, StorageFormat::kSqlite3}) {
+    const bool mcap = storage == StorageFormat::kMcap;
+    const tools::Rosbag2Import clean =
+        Import(Bag(mcap ? "clean_m" : "clean_s", storage), mcap ? "cm" : "cs");
+    BagEdits edits;
+    edits.clock_step_back_ns = 1500000000;  // 1.5 s, halfway through the recording
+    const fs::path bag = Bag(mcap ? "step_m" : "step_s", storage, edits);
+    tools::ImportRosbag2Options o = ImportOptions(tmp_, bag);
+    o.stamp = "recorded";
+    // 1.5 s less the recorder's latency jitter (0.4 ms) between the messages either side.
+    ExpectRefused(o, "the recording clock steps back by 1.4");
+    // The header stamps still order every stream: imported as the clean bag, with a note.
+    const tools::Rosbag2Import stepped = Import(bag, mcap ? "sm" : "ss");
+    ExpectSameImport(clean, stepped);
+    ASSERT_EQ(stepped.notes.size(), 1u);
+    EXPECT_NE(stepped.notes[0].find("order of their header stamps"), std::string::npos);
+  }
+}
+
+// A reader must not write next to its input: the recorder's own sqlite3 bag (WAL mode), copied
+// and made read-only, is read without a byte or a file changing around it.
+TEST(Rosbag2ReadOnly, BagDirectoryUnchanged) {
+  testing::TempDir tmp;
+  const fs::path shared = fs::path(FITCAL_SHARED_DIR) / "data/rosbag2";
+  if (!fs::exists(shared)) GTEST_SKIP() << shared << " missing";
+  const fs::path bag = tmp.path() / "bags";
+  fs::copy(shared, bag, fs::copy_options::recursive);
+  const auto listing = [&] {
+    std::vector<std::pair<std::string, std::string>> files;
+    for (const auto& e : fs::recursive_directory_iterator(bag)) {
+      files.emplace_back(e.path().string(), e.is_regular_file()
+                                                ? testing::ReadFileBytes(e.path())
+                                                : std::string("<dir>"));
+    }
+    std::sort(files.begin(), files.end());
+    return files;
+  };
+  for (const auto& e : fs::recursive_directory_iterator(bag)) {
+    fs::permissions(e.path(), fs::perms::owner_write | fs::perms::group_write |
+                                  fs::perms::others_write,
+                    fs::perm_options::remove);
+  }
+  const auto before = listing();
+  std::size_t messages = 0;
+  for (const char* dir : {"sqlite3/talker", "sqlite3/cdr_test", "mcap/talker", "mcap/cdr_test"}) {
+    BagReader reader((bag / dir).string());
+    BagMessage m;
+    while (reader.ReadNext(&m)) ++messages;
+    std::string file;
+    EXPECT_FALSE(reader.RecordingClockStepBack(&file)) << dir;
+  }
+  EXPECT_GT(messages, 10u);
+  EXPECT_EQ(listing(), before);  // no -shm / -wal file, no byte changed
+  for (const auto& e : fs::recursive_directory_iterator(bag)) {
+    fs::permissions(e.path(), fs::perms::owner_write, fs::perm_options::add);
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
