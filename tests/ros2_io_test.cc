@@ -16,10 +16,12 @@
 #include <filesystem>
 #include <functional>
 #include <iostream>
+#include <map>
 #include <sstream>
 
 #include "fit/final_pose_errors.h"
 #include "fit/model_fit.h"
+#include "io/calibration_yaml.h"
 #include "io/dataset.h"
 #include "io/rosbag2/bag_reader.h"
 #include "io/rosbag2/bag_writer.h"
@@ -611,10 +613,219 @@ TEST(ExportRos2Control, TricycleDropsTheSteeringOffset) {
   EXPECT_NEAR(x.params["wheel_radius"].as<double>(), 0.0331, 1e-12);
   EXPECT_EQ(x.params["steering_joint_name"].as<std::string>(), "steering");
   ASSERT_EQ(x.e.notes.size(), 1u);
-  EXPECT_NE(x.e.notes[0].find("1.5000 deg"), std::string::npos) << x.e.notes[0];
+  EXPECT_NE(x.e.notes[0].find("+1.500000 deg"), std::string::npos) << x.e.notes[0];
   EXPECT_NEAR(x.back->robot().nominal[0], 0.0331, kRoundTrip);
   EXPECT_NEAR(x.back->robot().nominal[1], 0.152, kRoundTrip);
   EXPECT_EQ(x.back->robot().nominal[2], 0.0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Export per ROS 2 distribution: every key written is declared, with its type, by that
+// distribution's controller (tests/data/ros2_controllers/<distro>/<controller>.txt: our
+// extraction of the names and types from ros2_controllers' parameter definitions).
+
+using KeyTypes = std::map<std::string, std::string>;
+
+KeyTypes DeclaredKeys(const std::string& distro, const std::string& controller) {
+  const fs::path file =
+      fs::path(FITCAL_SOURCE_DIR) / "tests/data/ros2_controllers" / distro / (controller + ".txt");
+  std::istringstream in(testing::ReadFileBytes(file));
+  KeyTypes keys;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream words(line);
+    std::string key, type;
+    words >> key >> type;
+    keys[key] = type;
+  }
+  return keys;
+}
+
+// The parameters as "a.b.c" -> node (nested maps dotted, as the declarations name them).
+void Flatten(const YAML::Node& map, const std::string& prefix,
+             std::vector<std::pair<std::string, YAML::Node>>* out) {
+  for (const auto& kv : map) {
+    const std::string key = prefix + kv.first.as<std::string>();
+    if (kv.second.IsMap()) {
+      Flatten(kv.second, key + ".", out);
+    } else {
+      out->emplace_back(key, kv.second);
+    }
+  }
+}
+
+// What rclcpp makes of a YAML scalar: a double needs a '.' or an exponent, else it is an integer.
+bool IsDoubleText(const YAML::Node& n) {
+  if (!n.IsScalar() || n.Tag() == "!") return false;  // a quoted scalar is a string
+  double v = 0.0;
+  if (!YAML::convert<double>::decode(n, v)) return false;
+  return n.Scalar().find_first_of(".eE") != std::string::npos;
+}
+
+void ExpectType(const std::string& key, const YAML::Node& n, const std::string& type) {
+  if (type == "double") {
+    EXPECT_TRUE(IsDoubleText(n)) << key << ": " << n;
+  } else if (type == "int") {
+    EXPECT_TRUE(n.IsScalar() && n.Scalar().find_first_not_of("-0123456789") == std::string::npos)
+        << key << ": " << n;
+  } else if (type == "string") {
+    EXPECT_TRUE(n.IsScalar() && n.Tag() == "!") << key << " should be a quoted string: " << n;
+  } else if (type == "string_array") {
+    ASSERT_TRUE(n.IsSequence()) << key;
+    for (const YAML::Node& e : n) EXPECT_EQ(e.Tag(), "!") << key << " holds a non-string";
+  } else if (type == "double_array") {
+    ASSERT_TRUE(n.IsSequence()) << key;
+    for (const YAML::Node& e : n) EXPECT_TRUE(IsDoubleText(e)) << key << ": " << e;
+  } else {
+    ADD_FAILURE() << key << ": unknown declared type " << type;
+  }
+}
+
+struct ControllerCase {
+  const char* controller;
+  std::string robot_yaml;
+};
+
+TEST(ExportRos2Control, EveryKeyDeclaredOnItsDistribution) {
+  testing::TempDir tmp;
+  const std::vector<ControllerCase> cases = {{"diff_drive_controller", kRobotYaml},
+                                             {"mecanum_drive_controller", kOmniExampleYaml},
+                                             {"omni_wheel_drive_controller", kOmni3ExampleYaml},
+                                             {"tricycle_controller", kTricycleExampleYaml}};
+  int checked = 0;
+  for (const std::string& distro : tools::RosDistros()) {
+    for (const ControllerCase& c : cases) {
+      SCOPED_TRACE(distro + " " + c.controller);
+      const RobotModelPtr model = ReadRobotModel(YAML::Load(c.robot_yaml), "robot.yaml");
+      std::vector<double> p = model->robot().nominal;
+      p[0] *= 1.01;  // a calibration that differs from the nominal: every note written
+      const std::string cal = tmp.Write("cal.yaml", model->RobotYaml(p, ""));
+      const KeyTypes declared = DeclaredKeys(distro, c.controller);
+      if (declared.empty()) {  // the distribution does not ship it: refused in one line
+        EXPECT_THROW(tools::ExportRos2Control(cal, c.controller, "", {}, distro),
+                     std::invalid_argument);
+        continue;
+      }
+      const tools::Ros2ControlExport e = tools::ExportRos2Control(cal, c.controller, "", {}, distro);
+      OdometryCovariance covariance;  // as written with --logs
+      covariance.twist_variance = {1e-4, 2e-5, 3e-4};
+      covariance.pose_variance_per_m = {1e-5, 2e-6, 3e-5};
+      const std::string yaml =
+          e.parameters_yaml + tools::Ros2CovarianceParameters(c.controller, covariance);
+      std::vector<std::pair<std::string, YAML::Node>> written;
+      Flatten(YAML::Load(yaml)[c.controller]["ros__parameters"], "", &written);
+      EXPECT_GE(written.size(), 4u);
+      for (const auto& [key, node] : written) {
+        const auto it = declared.find(key);
+        if (it == declared.end()) {
+          ADD_FAILURE() << key << " is not declared on " << distro;
+          continue;
+        }
+        ExpectType(key, node, it->second);
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 40);
+  // The kept lists themselves: the key the issue found stale.
+  EXPECT_EQ(DeclaredKeys("humble", "diff_drive_controller").count("wheels_per_side"), 1u);
+  EXPECT_EQ(DeclaredKeys("jazzy", "diff_drive_controller").count("wheels_per_side"), 0u);
+  EXPECT_EQ(DeclaredKeys("rolling", "diff_drive_controller").count("wheels_per_side"), 0u);
+  EXPECT_THROW(tools::ExportRos2Control(tmp.Path("cal.yaml"), "tricycle_controller", "", {},
+                                        "iron"),
+               std::invalid_argument);
+}
+
+TEST(ExportRos2Control, TricycleOffsetStatedWithSignAndPlace) {
+  testing::TempDir tmp;
+  const RobotModelPtr model = ReadRobotModel(YAML::Load(kTricycleExampleYaml), "robot.yaml");
+  const double offset_rad = -2.25 * M_PI / 180;
+  const std::string cal = tmp.Write("cal.yaml", model->RobotYaml({0.0331, 0.152, offset_rad}, ""));
+  const tools::Ros2ControlExport e = tools::ExportRos2Control(cal, "tricycle_controller", "", {});
+  ASSERT_EQ(e.notes.size(), 1u);
+  const std::string& note = e.notes[0];
+  char value[64];
+  std::snprintf(value, sizeof value, "add %+.9g rad", offset_rad);
+  EXPECT_NE(note.find(value), std::string::npos) << note;
+  EXPECT_NE(note.find("-2.250000 deg"), std::string::npos) << note;
+  EXPECT_NE(note.find("steering joint 'steering'"), std::string::npos) << note;
+  EXPECT_NE(note.find("SimpleTransmission"), std::string::npos) << note;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Export replayed on a data set, as a user runs it.
+
+std::string Fitcal(const testing::TempDir& dir, const std::string& args, int expected_exit) {
+  const testing::FitcalRun r = testing::RunFitcal(dir, args);
+  EXPECT_EQ(r.exit_code, expected_exit) << args << "\n" << r.out << r.err;
+  return r.out + r.err;
+}
+
+// Issue 30: after `fit --train-trajectories` the export filtered held-out runs by repetition,
+// found none (every repetition also trains) and replayed on every run, training runs included.
+// It must take the runs `report` takes: those whose id the calibration did not train on.
+TEST(ExportRos2Control, HeldOutRunsAreTheOnesReportTakes) {
+  testing::TempDir dir;
+  const std::string data = dir.Path("data"), cal = dir.Path("cal.yaml");
+  Fitcal(dir, "simulate --model diff_drive --out " + data + " --repetitions 2 --seed 4", 0);
+  Fitcal(dir, "fit --logs " + data + " --train-trajectories '^square' --out " + cal, 0);
+  int held_out = 0, all = 0;
+  for (const YAML::Node& run : YAML::LoadFile(data + "/dataset.yaml")["runs"]) {
+    ++all;
+    held_out += run["trajectory"].as<std::string>().rfind("square", 0) != 0;
+  }
+  ASSERT_GT(held_out, 0);
+  ASSERT_LT(held_out, all);
+  const std::string params = dir.Path("params.yaml"), with_cov = dir.Path("cal_cov.yaml");
+  const std::string out = Fitcal(dir,
+                                 "export ros2-control --controller diff_drive_controller "
+                                 "--calibration " +
+                                     cal + " --logs " + data + " --out " + params +
+                                     " --calibration-out " + with_cov,
+                                 0);
+  EXPECT_NE(out.find("over " + std::to_string(held_out) + " runs of " + data +
+                     " held out from the calibration"),
+            std::string::npos)
+      << out;
+  // The covariance where the controller declares it, and in a calibration every reader takes.
+  const YAML::Node p = YAML::LoadFile(params)["diff_drive_controller"]["ros__parameters"];
+  ASSERT_EQ(p["twist_covariance_diagonal"].size(), 6u);
+  ASSERT_EQ(p["pose_covariance_diagonal"].size(), 6u);
+  EXPECT_GT(p["twist_covariance_diagonal"][0].as<double>(), 0.0);
+  EXPECT_GT(p["pose_covariance_diagonal"][5].as<double>(), 0.0);
+  const YAML::Node block = YAML::LoadFile(with_cov)["calibration"]["odometry_covariance"];
+  EXPECT_EQ(block["held_out_runs"].as<int>(), held_out);
+  EXPECT_EQ(block["twist_variance"].size(), 3u);
+  EXPECT_EQ(ReadRobotModelFile(with_cov)->robot().nominal, ReadRobotModelFile(cal)->robot().nominal);
+  EXPECT_TRUE(io::ReadCalibrationProvenance(with_cov));
+  std::string which;
+  const RobotModelPtr model = ReadRobotModelFile(cal);
+  const std::vector<AlignedRun> runs = tools::ExportHeldOutRuns(cal, data, model->robot(), &which);
+  ASSERT_EQ(static_cast<int>(runs.size()), held_out);
+  for (const AlignedRun& r : runs) EXPECT_EQ(r.trajectory.rfind("square", 0), std::string::npos);
+}
+
+// Parameters that replay worse than the nominal robot: one line, exit 5, nothing written, unless
+// --allow-worse.
+TEST(ExportRos2Control, WorseThanNominalIsRefused) {
+  testing::TempDir dir;
+  const std::string data = dir.Path("data");
+  Fitcal(dir, "simulate --model diff_drive --out " + data + " --repetitions 1 --seed 4", 0);
+  const RobotModelPtr nominal = ReadRobotModelFile(data + "/robot.yaml");
+  std::vector<double> p = nominal->robot().nominal;
+  p[0] *= 1.08;  // one wheel 8 % too large: far worse than the nominal robot
+  const std::string cal = dir.Write("bad.yaml", nominal->RobotYaml(p, ""));
+  const std::string out = dir.Path("params.yaml");
+  const std::string args = "export ros2-control --controller diff_drive_controller --calibration " +
+                           cal + " --logs " + data + " --out " + out;
+  const testing::FitcalRun refused = testing::RunFitcal(dir, args);
+  EXPECT_EQ(refused.exit_code, 5) << refused.out << refused.err;
+  EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+  EXPECT_NE(refused.err.find("worse than the nominal robot"), std::string::npos) << refused.err;
+  EXPECT_FALSE(fs::exists(out));
+  Fitcal(dir, args + " --allow-worse", 0);
+  EXPECT_TRUE(fs::exists(out));
 }
 
 }  // namespace
