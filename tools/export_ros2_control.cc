@@ -795,11 +795,14 @@ int RunExportRos2ControlCommand(const ExportRos2ControlOptions& o) {
       const std::string line = ReplayLine(o, replay);
       if (!o.out.empty()) std::printf("%s\n", line.c_str());
       if (replay.Worse() && !o.allow_worse) {
-        char text_worse[200];
+        char text_worse[300];
         std::snprintf(text_worse, sizeof text_worse,
                       "these parameters replay worse than the nominal robot (CF %.6f > %.6f on "
-                      "%zu runs); nothing written (--allow-worse writes them)",
-                      replay.cf_exported, replay.cf_nominal, replay.runs);
+                      "%zu runs); nothing written (--allow-worse writes them%s)",
+                      replay.cf_exported, replay.cf_nominal, replay.runs,
+                      e.notes.empty() ? ""
+                                      : ", with notes on what the controller leaves out: "
+                                        "apply that first, e.g. a steering offset");
         throw WorseThanNominal(text_worse);
       }
       text += "# " + line + "\n";

@@ -150,6 +150,7 @@ void FlagTrend(FleetSeries* s) {
   const double standard_error = scatter / std::sqrt(sxx);
   const double span_days = *std::max_element(x.begin(), x.end()) - *std::min_element(x.begin(), x.end());
   s->slope_per_30_days = 30.0 * slope;
+  s->has_slope = true;
   s->trend = std::abs(slope) > kTrendT * standard_error &&
              std::abs(slope) * span_days > scatter;
 }
@@ -171,7 +172,7 @@ std::vector<FleetSeries> ReadFleet(const std::vector<std::string>& inputs) {
       auto it = index.find(key);
       if (it == index.end()) {
         it = index.emplace(key, out.size()).first;
-        out.push_back({c.robot, name, {}, {}, {}, {}, false, 0.0});
+        out.push_back({c.robot, name, {}, {}, {}, {}, false, false, 0.0});
       }
       FleetSeries& s = out[it->second];
       s.dates.push_back(c.date);
@@ -199,9 +200,11 @@ std::string FleetTable(const std::vector<FleetSeries>& series) {
     }
     std::string flags = s.trend ? "TREND" : "";
     for (const std::string& d : s.outliers) flags += (flags.empty() ? "" : " ") + ("OUTLIER " + d);
-    std::snprintf(line, sizeof line, "  %-22s %3zu  %-10s %12.6g  %-10s %12.6g %12.6g %+14.4g  %s\n",
+    char slope[32] = "-";
+    if (s.has_slope) std::snprintf(slope, sizeof slope, "%+.4g", s.slope_per_30_days);
+    std::snprintf(line, sizeof line, "  %-22s %3zu  %-10s %12.6g  %-10s %12.6g %12.6g %14s  %s\n",
                   s.parameter.c_str(), s.values.size(), s.dates.front().c_str(), s.values.front(),
-                  s.dates.back().c_str(), s.values.back(), Median(s.values), s.slope_per_30_days,
+                  s.dates.back().c_str(), s.values.back(), Median(s.values), slope,
                   flags.c_str());
     out += line;
   }

@@ -32,6 +32,7 @@ struct FleetSeries {
   std::vector<std::string> files;
   std::vector<std::string> outliers;  // dates of the flagged calibrations
   bool trend = false;
+  bool has_slope = false;  // enough calibrations (kMinForTrend) for a line
   double slope_per_30_days = 0.0;
 };
 
