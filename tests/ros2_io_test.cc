@@ -435,6 +435,16 @@ TEST_F(MalformedImport, WrappedJointPositionsUnwrapped) {
   ExpectSameImport(clean, wrapped);
   ASSERT_EQ(wrapped.notes.size(), 2u);  // both wheels (the caster is not the robot's)
   EXPECT_NE(wrapped.notes[0].find("unwrapped"), std::string::npos) << wrapped.notes[0];
+  // The other convention, [0, 2 pi).
+  edits.joint = [](std::size_t, JointState* js) {
+    for (double& angle : js->position) angle = WrapAngle(angle) + M_PI;
+  };
+  BagEdits shifted;  // the same bag with every angle + pi: the rates are unchanged
+  shifted.joint = [](std::size_t, JointState* js) {
+    for (double& angle : js->position) angle += M_PI;
+  };
+  ExpectSameImport(Import(Bag("shifted", StorageFormat::kMcap, shifted), "s"),
+                   Import(Bag("wrapped_0_2pi", StorageFormat::kMcap, edits), "w2"));
   // A glitch of 2 rad in one wrapped reading: a step nobody can unwrap with confidence.
   edits.joint = [](std::size_t i, JointState* js) {
     for (double& angle : js->position) angle = WrapAngle(angle + (i == 40 ? 2.0 : 0.0));

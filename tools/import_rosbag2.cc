@@ -107,9 +107,9 @@ std::vector<double> ChannelRows(const Robot& robot, const BagStreams& s) {
   return rows;
 }
 
-// Joint positions wrapped to [-pi, pi) (a driver that reports a wheel's angle modulo a turn, not
-// cumulatively): every reading of the wheel within [-pi, pi] and some step between two messages
-// longer than pi. Each step is then taken as the shortest rotation, WrapAngle(step) - right
+// Joint positions wrapped to one turn (a driver that reports a wheel's angle modulo a turn, in
+// [-pi, pi) or [0, 2 pi), not cumulatively): every reading of the wheel within one turn of the
+// others and some step between two messages longer than pi. Each step is then taken as the shortest rotation, WrapAngle(step) - right
 // while the wheel turns less than half a turn between messages. A wrapped step longer than
 // kMaxUnwrappedStepRad leaves too little margin to tell the direction: refused, naming the joint.
 constexpr double kMaxUnwrappedStepRad = 0.5 * M_PI;
@@ -123,12 +123,14 @@ std::vector<std::string> UnwrapWrappedWheels(const Robot& robot,
   std::vector<double>& v = s->joints.values;
   for (std::size_t j = 0; j < c; ++j) {
     if (robot.channels[j].kind != ChannelKind::kWheelRate) continue;
-    bool in_range = true, jumps = false;
-    for (std::size_t k = 0; k < n && in_range; ++k) {
-      in_range = std::abs(v[k * c + j]) <= M_PI + 1e-9;
-      jumps = jumps || (k > 0 && std::abs(v[k * c + j] - v[(k - 1) * c + j]) > M_PI);
+    double lo = v[j], hi = v[j];
+    bool jumps = false;
+    for (std::size_t k = 1; k < n; ++k) {
+      lo = std::min(lo, v[k * c + j]);
+      hi = std::max(hi, v[k * c + j]);
+      jumps = jumps || std::abs(v[k * c + j] - v[(k - 1) * c + j]) > M_PI;
     }
-    if (!in_range || !jumps) continue;
+    if (hi - lo > 2.0 * M_PI + 1e-9 || !jumps) continue;
     int wraps = 0;
     double previous_raw = v[j];
     for (std::size_t k = 1; k < n; ++k) {
@@ -137,7 +139,7 @@ std::vector<std::string> UnwrapWrappedWheels(const Robot& robot,
       if (std::abs(step) > kMaxUnwrappedStepRad) {
         char what[240];
         std::snprintf(what, sizeof what,
-                      "joint \"%s\": positions wrapped to [-pi, pi) with a step of %.3f rad "
+                      "joint \"%s\": positions wrapped to one turn with a step of %.3f rad "
                       "between messages at %.9f s: too fast to unwrap unambiguously",
                       joint_names[j].c_str(), step, SecondsSinceStart(*s, s->joints.t_ns[k]));
         throw InputError(InputErrorKind::kBadValue, s->bag, 0, what);
@@ -146,7 +148,7 @@ std::vector<std::string> UnwrapWrappedWheels(const Robot& robot,
       previous_raw = raw;
       v[k * c + j] = v[(k - 1) * c + j] + step;
     }
-    notes.push_back("joint \"" + joint_names[j] + "\": positions wrapped to [-pi, pi) unwrapped (" +
+    notes.push_back("joint \"" + joint_names[j] + "\": positions wrapped to one turn unwrapped (" +
                     std::to_string(wraps) + " wraps)");
   }
   return notes;

@@ -26,7 +26,7 @@
 // `fitcal fit --train-reps` chooses runs by number.
 //
 // Real recordings. Messages on the encoder topic that carry none of the robot's joints (another
-// node's JointState) are skipped. Wheel positions wrapped to [-pi, pi) are unwrapped (or refused
+// node's JointState) are skipped. Wheel positions wrapped to one turn are unwrapped (or refused
 // when too fast to unwrap). A ground-truth orientation that is not a unit quaternion is refused
 // naming topic and time. With --stamp recorded, a recording clock that steps back (seen as
 // header stamps going back in recorded order) is refused at that instant. The data set is read
