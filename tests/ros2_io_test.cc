@@ -488,13 +488,31 @@ TEST(Rosbag2ReadOnly, BagDirectoryUnchanged) {
   const fs::path shared = fs::path(FITCAL_SHARED_DIR) / "data/rosbag2";
   if (!fs::exists(shared)) GTEST_SKIP() << shared << " missing";
   const fs::path bag = tmp.path() / "bags";
-  fs::copy(shared, bag, fs::copy_options::recursive);
+  // Copied file by file: fs::copy would give the copies the shared tree's missing write bits
+  // before their contents are in (CI lays ../shared read-only).
+  for (const auto& e : fs::recursive_directory_iterator(shared)) {
+    const fs::path to = bag / fs::relative(e.path(), shared);
+    if (e.is_directory()) {
+      fs::create_directories(to);
+    } else {
+      fs::create_directories(to.parent_path());
+      testing::WriteFileBytes(to, testing::ReadFileBytes(e.path()));
+    }
+  }
+  // Every path with its size and an FNV-1a 64 checksum of its bytes ("dir" for a directory).
   const auto listing = [&] {
-    std::vector<std::pair<std::string, std::string>> files;
+    std::vector<std::string> files;
     for (const auto& e : fs::recursive_directory_iterator(bag)) {
-      files.emplace_back(e.path().string(), e.is_regular_file()
-                                                ? testing::ReadFileBytes(e.path())
-                                                : std::string("<dir>"));
+      std::string entry = fs::relative(e.path(), bag).string() + " ";
+      if (e.is_regular_file()) {
+        const std::string bytes = testing::ReadFileBytes(e.path());
+        std::uint64_t h = 14695981039346656037ull;
+        for (const char c : bytes) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+        entry += std::to_string(bytes.size()) + " " + std::to_string(h);
+      } else {
+        entry += "dir";
+      }
+      files.push_back(entry);
     }
     std::sort(files.begin(), files.end());
     return files;
