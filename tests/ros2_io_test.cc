@@ -36,6 +36,7 @@
 #include "tools/import_rosbag2.h"
 #include "tools/sim/diff_drive_trajectories.h"
 #include "tools/sim/model_simulator.h"
+#include "tools/sim/tricycle_trajectories.h"
 
 namespace fitcal {
 namespace {
@@ -779,6 +780,31 @@ TEST(ExportRos2Control, TricycleOffsetStatedWithSignAndPlace) {
   EXPECT_NE(note.find("-2.250000 deg"), std::string::npos) << note;
   EXPECT_NE(note.find("steering joint 'steering'"), std::string::npos) << note;
   EXPECT_NE(note.find("SimpleTransmission"), std::string::npos) << note;
+
+  // The sign: the runs of a robot with this offset, their steering readings moved by the value
+  // the note gives, replay with the exported parameters (no offset) exactly as with the
+  // calibration; moved the other way they replay far worse.
+  const std::vector<double> truth = {0.0331, 0.152, offset_rad};
+  sim::SimulationOptions o;
+  o.seed = 3;
+  sim::TricycleTrajectoryOptions shapes;
+  std::vector<AlignedRun> runs;
+  for (const sim::ModelSimulatedRun& r :
+       sim::SimulateRuns(*model, truth, sim::TricycleTrajectories(shapes), o)) {
+    runs.push_back(AlignRun(r.log));
+  }
+  const RobotModelPtr exported = tools::ReadRos2ControlYaml(e.parameters_yaml, "exported", cal, {});
+  const double added_rad = std::stod(note.substr(note.find("add ") + 4));
+  const auto moved = [&](double by_rad) {
+    std::vector<AlignedRun> out = runs;
+    for (AlignedRun& r : out) {
+      for (std::size_t k = 0; k < r.samples.size(); ++k) r.samples[k].value[1] += by_rad;
+    }
+    return EvaluateFinalPoseErrors(*exported, exported->robot().nominal, out).cf;
+  };
+  const double cf_exact = EvaluateFinalPoseErrors(*model, truth, runs).cf;
+  EXPECT_NEAR(moved(added_rad), cf_exact, 1e-9);  // noise-free runs: both ~0
+  EXPECT_GT(moved(-added_rad), 100.0 * cf_exact + 1e-3);
 }
 
 // ---------------------------------------------------------------------------------------------
