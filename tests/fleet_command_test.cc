@@ -72,6 +72,17 @@ TEST(Fleet, FlagsTrendsAndOutliers) {
   EXPECT_NE(table.find("OUTLIER 2026-04-08"), std::string::npos) << table;
   EXPECT_NE(table.find("cf_validation_after"), std::string::npos) << table;
 
+  // A report's metrics.json is read too; beside its calibration of the same date it counts once.
+  tmp.Write("fleet/r1/2026-04-22/report/metrics.json",
+            R"({"robot": "r1", "parameters": [{"name": "r_left", "calibrated_m": 0.0412},
+                {"name": "wheel_separation", "calibrated_m": 0.2}],
+               "summary": [{"group": "all validation runs", "after": {"cf": 0.01}}]})");
+  tmp.Write("fleet/r1/2026-04-29/report/metrics.json",
+            R"({"robot": "r1", "parameters": [{"name": "r_left", "calibrated_m": 0.0411}]})");
+  const std::vector<tools::FleetSeries> with_reports = tools::ReadFleet({tmp.Path("fleet")});
+  EXPECT_EQ(Find(with_reports, "r1", "r_left").values.size(), 9u);  // + 2026-04-29 only
+  EXPECT_EQ(Find(with_reports, "r1", "r_left").values.back(), 0.0411);
+
   tmp.Write("undated/cal.yaml", testing::ReadFileBytes(worn.files[0]));
   EXPECT_THROW(tools::ReadFleet({tmp.Path("undated/cal.yaml")}), io::InputError);
 }

@@ -79,6 +79,38 @@ Calibration ReadCalibration(const std::string& path) {
   return c;
 }
 
+// A report's metrics.json (tools/report_command.h): the robot, each parameter's calibrated value
+// (key calibrated_<unit>; degrees turned to radians, as the model holds angles) and the held-out
+// CF of "all validation runs". JSON is YAML: yaml-cpp reads it.
+Calibration ReadMetricsJson(const std::string& path) {
+  const YAML::Node root = io::LoadYamlFile(path);
+  Calibration c;
+  c.file = path;
+  c.date = DateOf(path);
+  if (!root.IsMap() || !root["robot"] || !root["parameters"].IsSequence()) {
+    throw io::InputError(io::InputErrorKind::kMissingKey, path, 1,
+                         "not a fitcal report's metrics.json (robot, parameters)");
+  }
+  c.robot = root["robot"].as<std::string>();
+  for (const YAML::Node& p : root["parameters"]) {
+    for (const auto& kv : p) {
+      const std::string key = kv.first.as<std::string>();
+      if (key.rfind("calibrated_", 0) != 0) continue;
+      const double v = io::YamlDouble(kv.second, path, "parameters." + key);
+      const bool degrees = key.size() > 4 && key.compare(key.size() - 4, 4, "_deg") == 0;
+      c.values.emplace_back(p["name"].as<std::string>(), degrees ? v * M_PI / 180.0 : v);
+    }
+  }
+  for (const YAML::Node& g : root["summary"]) {
+    if (g["group"] && g["group"].as<std::string>() == "all validation runs" && g["after"]) {
+      c.values.emplace_back(kCfRow, io::YamlDouble(g["after"]["cf"], path, "summary.after.cf"));
+    }
+  }
+  return c;
+}
+
+bool IsMetricsJson(const fs::path& p) { return p.filename() == "metrics.json"; }
+
 bool IsCalibrationYaml(const fs::path& p) {
   if (p.extension() != ".yaml" && p.extension() != ".yml") return false;
   try {
@@ -96,7 +128,9 @@ std::vector<std::string> Files(const std::vector<std::string>& inputs) {
       continue;
     }
     for (const auto& e : fs::recursive_directory_iterator(in)) {
-      if (e.is_regular_file() && IsCalibrationYaml(e.path())) files.push_back(e.path().string());
+      if (e.is_regular_file() && (IsCalibrationYaml(e.path()) || IsMetricsJson(e.path()))) {
+        files.push_back(e.path().string());
+      }
     }
   }
   std::sort(files.begin(), files.end());
@@ -159,7 +193,9 @@ void FlagTrend(FleetSeries* s) {
 
 std::vector<FleetSeries> ReadFleet(const std::vector<std::string>& inputs) {
   std::vector<Calibration> all;
-  for (const std::string& f : Files(inputs)) all.push_back(ReadCalibration(f));
+  for (const std::string& f : Files(inputs)) {
+    all.push_back(IsMetricsJson(f) ? ReadMetricsJson(f) : ReadCalibration(f));
+  }
   if (all.empty()) throw std::invalid_argument("no calibrated YAML found in the inputs");
   std::stable_sort(all.begin(), all.end(), [](const Calibration& a, const Calibration& b) {
     return std::tie(a.robot, a.date) < std::tie(b.robot, b.date);
@@ -175,6 +211,8 @@ std::vector<FleetSeries> ReadFleet(const std::vector<std::string>& inputs) {
         out.push_back({c.robot, name, {}, {}, {}, {}, false, false, 0.0});
       }
       FleetSeries& s = out[it->second];
+      // A calibration and its report (metrics.json) on the same date are one result.
+      if (!s.dates.empty() && s.dates.back() == c.date) continue;
       s.dates.push_back(c.date);
       s.values.push_back(value);
       s.files.push_back(c.file);

@@ -9,7 +9,9 @@
 //   trend    a least-squares line over the dates whose slope is kTrendT standard errors from 0
 //            and moves the value by more than the scatter about the line over the span (needs
 //            >= 4 calibrations): a wheel wearing, a radius shrinking over weeks.
-// Directories are searched recursively for *.yaml files that hold a `calibration:` block.
+// Directories are searched recursively for *.yaml files that hold a `calibration:` block and for
+// reports' metrics.json (robot, calibrated parameters, held-out CF); a calibration and its report
+// of one robot and date count once.
 
 #include <string>
 #include <vector>
