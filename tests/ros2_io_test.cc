@@ -14,11 +14,14 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <iostream>
+#include <map>
 #include <sstream>
 
 #include "fit/final_pose_errors.h"
 #include "fit/model_fit.h"
+#include "io/calibration_yaml.h"
 #include "io/dataset.h"
 #include "io/rosbag2/bag_reader.h"
 #include "io/rosbag2/bag_writer.h"
@@ -33,6 +36,7 @@
 #include "tools/import_rosbag2.h"
 #include "tools/sim/diff_drive_trajectories.h"
 #include "tools/sim/model_simulator.h"
+#include "tools/sim/tricycle_trajectories.h"
 
 namespace fitcal {
 namespace {
@@ -67,12 +71,20 @@ std::vector<sim::ModelSimulatedRun> SimulatedRuns(const RobotModelInterface& mod
   return sim::SimulateRuns(model, kTruth, sim::DiffDriveCalibrationTrajectories(2, shapes), o);
 }
 
+// What real recorders do to a bag, applied while it is written.
+struct BagEdits {
+  std::function<void(std::size_t, JointState*)> joint;  // message index on /joint_states
+  std::function<void(std::size_t, PoseStamped*)> pose;  // message index on /mocap/pose
+  bool other_node = false;  // a second node's JointState (other joints) after every 7th message
+  std::int64_t clock_step_back_ns = 0;  // recording times of the second half moved back by this
+};
+
 // The bag: runs one after the other on one clock (run i starts where run i-1 ended + kGapS),
 // joint states at rest in the gaps, no ground truth there (the robot is carried back to the start).
 // Returns each run's span on the bag clock (s since the first message).
 std::vector<std::pair<double, double>> WriteRobotBag(
     const fs::path& dir, const std::vector<sim::ModelSimulatedRun>& runs,
-    BagWriterOptions options) {
+    BagWriterOptions options, const BagEdits& edits = {}) {
   struct Msg {
     bool joint;
     std::int64_t stamp_ns;
@@ -81,13 +93,25 @@ std::vector<std::pair<double, double>> WriteRobotBag(
   std::vector<Msg> msgs;
   std::vector<std::pair<double, double>> spans;
   double offset = 0.0, angle_right = 0.0, angle_left = 0.0;
+  std::size_t joint_count = 0, pose_count = 0;
   const auto joint = [&](double t) {
     JointState js;
     js.header.stamp = {static_cast<std::int32_t>(Ns(t) / 1000000000),
                        static_cast<std::uint32_t>(Ns(t) % 1000000000)};
     js.name = {"caster", "left_wheel_joint", "right_wheel_joint"};  // not the robot's order
     js.position = {0.1, angle_left, angle_right};
+    if (edits.joint) edits.joint(joint_count, &js);
     msgs.push_back({true, Ns(t), EncodeJointState(js)});
+    if (edits.other_node && joint_count % 7 == 0) {
+      JointState gripper;
+      const std::int64_t ns = Ns(t) + 1000000;  // 1 ms later: between two of the robot's
+      gripper.header.stamp = {static_cast<std::int32_t>(ns / 1000000000),
+                              static_cast<std::uint32_t>(ns % 1000000000)};
+      gripper.name = {"gripper_left_finger", "gripper_right_finger"};
+      gripper.position = {0.01, -0.01};
+      msgs.push_back({true, ns, EncodeJointState(gripper)});
+    }
+    ++joint_count;
   };
   for (const sim::ModelSimulatedRun& run : runs) {
     const std::vector<double>& t = run.log.encoders.t_s;
@@ -107,6 +131,8 @@ std::vector<std::pair<double, double>> WriteRobotBag(
       p.pose.position = {gt.world_T_robot[k].x, gt.world_T_robot[k].y, 0.0};
       const double yaw = gt.world_T_robot[k].theta;
       p.pose.orientation = {0.0, 0.0, std::sin(yaw / 2), std::cos(yaw / 2)};
+      if (edits.pose) edits.pose(pose_count, &p);
+      ++pose_count;
       msgs.push_back({false, ns, EncodePoseStamped(p)});
     }
     spans.emplace_back(offset, offset + t.back() - t.front());
@@ -120,10 +146,13 @@ std::vector<std::pair<double, double>> WriteRobotBag(
   bag.AddTopic("/joint_states", "sensor_msgs/msg/JointState");
   bag.AddTopic("/mocap/pose", "geometry_msgs/msg/PoseStamped");
   bag.AddTopic("/chatter", "std_msgs/msg/String");
+  std::stable_sort(msgs.begin(), msgs.end(),
+                   [](const Msg& a, const Msg& b) { return a.stamp_ns < b.stamp_ns; });
   for (std::size_t i = 0; i < msgs.size(); ++i) {
     // Recorded 2.0-2.4 ms after the stamp (latency and jitter, below the message spacing).
     const std::int64_t recorded =
-        msgs[i].stamp_ns + 2000000 + static_cast<std::int64_t>(i % 5) * 100000;
+        msgs[i].stamp_ns + 2000000 + static_cast<std::int64_t>(i % 5) * 100000 -
+        (i >= msgs.size() / 2 ? edits.clock_step_back_ns : 0);
     bag.Write(msgs[i].joint ? "/joint_states" : "/mocap/pose", recorded, ByteView(msgs[i].payload));
   }
   bag.Close();
@@ -290,11 +319,18 @@ class MalformedImport : public ::testing::Test {
     runs_ = SimulatedRuns(*model);
     runs_.resize(2);
   }
-  fs::path Bag(const std::string& name, StorageFormat storage) {
+  fs::path Bag(const std::string& name, StorageFormat storage, const BagEdits& edits = {}) {
     BagWriterOptions options;
     options.storage = storage;
-    WriteRobotBag(tmp_.path() / name, runs_, options);
+    WriteRobotBag(tmp_.path() / name, runs_, options, edits);
     return tmp_.path() / name;
+  }
+  // The bag imported (as the user would, split at the rests between runs).
+  tools::Rosbag2Import Import(const fs::path& bag, const std::string& out) {
+    tools::ImportRosbag2Options o = ImportOptions(tmp_, bag);
+    o.out = tmp_.Path(out);
+    o.split_at_rest_s = 2.0;
+    return tools::ImportRosbag2(o);
   }
   testing::TempDir tmp_;
   std::vector<sim::ModelSimulatedRun> runs_;
@@ -350,9 +386,157 @@ TEST_F(MalformedImport, TopicTypeJointAndStamps) {
   }
   ExpectRefused(ImportOptions(tmp_, tmp_.path() / "twice"), "is not after the previous one");
   o = ImportOptions(tmp_, tmp_.path() / "twice");
-  o.stamp = "recorded";  // the recording times do increase
-  tools::ImportRosbag2(o);
-  EXPECT_TRUE(fs::exists(fs::path(o.out) / "dataset.yaml"));
+  // The recording times do increase, but the wheel angles jump back where the second copy
+  // starts: a data set `fit` refuses, so the import refuses it (it used to write it).
+  o.stamp = "recorded";
+  ExpectRefused(o, "imported/runs/twice-01_encoders.csv:");
+  ExpectRefused(o, "is not a physical wheel rate");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bags as real robots record them (issue 33): each one either imported exactly as the clean bag
+// or refused in one line naming where.
+
+// Same runs, same encoder rows to 1e-9 rad/s (an unwrapped angle is the cumulative one up to
+// the rounding of ~1e3 rad sums, ~1e-13 rad, over 0.05 s), same ground truth.
+void ExpectSameImport(const tools::Rosbag2Import& a, const tools::Rosbag2Import& b) {
+  ASSERT_EQ(a.runs.size(), b.runs.size());
+  for (std::size_t i = 0; i < a.runs.size(); ++i) {
+    ASSERT_EQ(a.encoder_t_s[i], b.encoder_t_s[i]) << "run " << i;
+    ASSERT_EQ(a.encoder_values[i].size(), b.encoder_values[i].size());
+    for (std::size_t k = 0; k < a.encoder_values[i].size(); ++k) {
+      ASSERT_NEAR(a.encoder_values[i][k], b.encoder_values[i][k], 1e-9) << "run " << i;
+    }
+    ASSERT_EQ(a.runs[i].ground_truth.t_s, b.runs[i].ground_truth.t_s);
+  }
+}
+
+TEST_F(MalformedImport, ZeroOrNonUnitQuaternionRefusedWithTopicAndTime) {
+  for (const double scale : {0.0, 0.5}) {
+    BagEdits edits;
+    edits.pose = [&](std::size_t i, PoseStamped* p) {
+      if (i != 17) return;
+      Quaternion& q = p->pose.orientation;
+      q = {q.x * scale, q.y * scale, q.z * scale, q.w * scale};
+    };
+    const fs::path bag = Bag(scale == 0.0 ? "zero_q" : "half_q", StorageFormat::kMcap, edits);
+    const std::string what = scale == 0.0 ? "is a zero quaternion" : "is not a unit quaternion";
+    ExpectRefused(ImportOptions(tmp_, bag), what);
+    ExpectRefused(ImportOptions(tmp_, bag), "/mocap/pose message at ");
+  }
+}
+
+TEST_F(MalformedImport, WrappedJointPositionsUnwrapped) {
+  const tools::Rosbag2Import clean = Import(Bag("clean", StorageFormat::kMcap), "clean_out");
+  BagEdits edits;
+  edits.joint = [](std::size_t, JointState* js) {
+    for (double& angle : js->position) angle = WrapAngle(angle);
+  };
+  const tools::Rosbag2Import wrapped = Import(Bag("wrapped", StorageFormat::kMcap, edits), "w");
+  ExpectSameImport(clean, wrapped);
+  ASSERT_EQ(wrapped.notes.size(), 2u);  // both wheels (the caster is not the robot's)
+  EXPECT_NE(wrapped.notes[0].find("unwrapped"), std::string::npos) << wrapped.notes[0];
+  // The other convention, [0, 2 pi).
+  edits.joint = [](std::size_t, JointState* js) {
+    for (double& angle : js->position) angle = WrapAngle(angle) + M_PI;
+  };
+  BagEdits shifted;  // the same bag with every angle + pi: the rates are unchanged
+  shifted.joint = [](std::size_t, JointState* js) {
+    for (double& angle : js->position) angle += M_PI;
+  };
+  ExpectSameImport(Import(Bag("shifted", StorageFormat::kMcap, shifted), "s"),
+                   Import(Bag("wrapped_0_2pi", StorageFormat::kMcap, edits), "w2"));
+  // A glitch of 2 rad in one wrapped reading: a step nobody can unwrap with confidence.
+  edits.joint = [](std::size_t i, JointState* js) {
+    for (double& angle : js->position) angle = WrapAngle(angle + (i == 40 ? 2.0 : 0.0));
+  };
+  ExpectRefused(ImportOptions(tmp_, Bag("glitch", StorageFormat::kMcap, edits)),
+                "too fast to unwrap");
+}
+
+TEST_F(MalformedImport, OtherNodesJointStatesSkipped) {
+  const tools::Rosbag2Import clean = Import(Bag("clean", StorageFormat::kSqlite3), "clean_out");
+  BagEdits edits;
+  edits.other_node = true;
+  const tools::Rosbag2Import mixed = Import(Bag("mixed", StorageFormat::kSqlite3, edits), "m");
+  ExpectSameImport(clean, mixed);
+}
+
+TEST_F(MalformedImport, RecordingClockSteppingBack) {
+  for (StorageFormat storage : {StorageFormat::kMcap, StorageFormat::kSqlite3}) {
+    const bool mcap = storage == StorageFormat::kMcap;
+    const tools::Rosbag2Import clean =
+        Import(Bag(mcap ? "clean_m" : "clean_s", storage), mcap ? "cm" : "cs");
+    BagEdits edits;
+    edits.clock_step_back_ns = 1500000000;  // 1.5 s, halfway through the recording
+    const fs::path bag = Bag(mcap ? "step_m" : "step_s", storage, edits);
+    tools::ImportRosbag2Options o = ImportOptions(tmp_, bag);
+    o.stamp = "recorded";
+    // 1.5 s less the recorder's latency jitter (0.4 ms) between the messages either side.
+    ExpectRefused(o, "the recording clock steps back by 1.4");
+    // The header stamps still order every stream: imported as the clean bag, with a note.
+    const tools::Rosbag2Import stepped = Import(bag, mcap ? "sm" : "ss");
+    ExpectSameImport(clean, stepped);
+    ASSERT_EQ(stepped.notes.size(), 1u);
+    EXPECT_NE(stepped.notes[0].find("order of their header stamps"), std::string::npos);
+  }
+}
+
+// A reader must not write next to its input: the recorder's own sqlite3 bag (WAL mode), copied
+// and made read-only, is read without a byte or a file changing around it.
+TEST(Rosbag2ReadOnly, BagDirectoryUnchanged) {
+  testing::TempDir tmp;
+  const fs::path shared = fs::path(FITCAL_SHARED_DIR) / "data/rosbag2";
+  if (!fs::exists(shared)) GTEST_SKIP() << shared << " missing";
+  const fs::path bag = tmp.path() / "bags";
+  // Copied file by file: fs::copy would give the copies the shared tree's missing write bits
+  // before their contents are in (CI lays ../shared read-only).
+  for (const auto& e : fs::recursive_directory_iterator(shared)) {
+    const fs::path to = bag / fs::relative(e.path(), shared);
+    if (e.is_directory()) {
+      fs::create_directories(to);
+    } else {
+      fs::create_directories(to.parent_path());
+      testing::WriteFileBytes(to, testing::ReadFileBytes(e.path()));
+    }
+  }
+  // Every path with its size and an FNV-1a 64 checksum of its bytes ("dir" for a directory).
+  const auto listing = [&] {
+    std::vector<std::string> files;
+    for (const auto& e : fs::recursive_directory_iterator(bag)) {
+      std::string entry = fs::relative(e.path(), bag).string() + " ";
+      if (e.is_regular_file()) {
+        const std::string bytes = testing::ReadFileBytes(e.path());
+        std::uint64_t h = 14695981039346656037ull;
+        for (const char c : bytes) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+        entry += std::to_string(bytes.size()) + " " + std::to_string(h);
+      } else {
+        entry += "dir";
+      }
+      files.push_back(entry);
+    }
+    std::sort(files.begin(), files.end());
+    return files;
+  };
+  for (const auto& e : fs::recursive_directory_iterator(bag)) {
+    fs::permissions(e.path(), fs::perms::owner_write | fs::perms::group_write |
+                                  fs::perms::others_write,
+                    fs::perm_options::remove);
+  }
+  const auto before = listing();
+  std::size_t messages = 0;
+  for (const char* dir : {"sqlite3/talker", "sqlite3/cdr_test", "mcap/talker", "mcap/cdr_test"}) {
+    BagReader reader((bag / dir).string());
+    BagMessage m;
+    while (reader.ReadNext(&m)) ++messages;
+    std::string file;
+    EXPECT_FALSE(reader.RecordingClockStepBack(&file)) << dir;
+  }
+  EXPECT_GT(messages, 10u);
+  EXPECT_EQ(listing(), before);  // no -shm / -wal file, no byte changed
+  for (const auto& e : fs::recursive_directory_iterator(bag)) {
+    fs::permissions(e.path(), fs::perms::owner_write, fs::perm_options::add);
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -458,10 +642,244 @@ TEST(ExportRos2Control, TricycleDropsTheSteeringOffset) {
   EXPECT_NEAR(x.params["wheel_radius"].as<double>(), 0.0331, 1e-12);
   EXPECT_EQ(x.params["steering_joint_name"].as<std::string>(), "steering");
   ASSERT_EQ(x.e.notes.size(), 1u);
-  EXPECT_NE(x.e.notes[0].find("1.5000 deg"), std::string::npos) << x.e.notes[0];
+  EXPECT_NE(x.e.notes[0].find("+1.500000 deg"), std::string::npos) << x.e.notes[0];
   EXPECT_NEAR(x.back->robot().nominal[0], 0.0331, kRoundTrip);
   EXPECT_NEAR(x.back->robot().nominal[1], 0.152, kRoundTrip);
   EXPECT_EQ(x.back->robot().nominal[2], 0.0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Export per ROS 2 distribution: every key written is declared, with its type, by that
+// distribution's controller (tests/data/ros2_controllers/<distro>/<controller>.txt: our
+// extraction of the names and types from ros2_controllers' parameter definitions).
+
+using KeyTypes = std::map<std::string, std::string>;
+
+KeyTypes DeclaredKeys(const std::string& distro, const std::string& controller) {
+  const fs::path file =
+      fs::path(FITCAL_SOURCE_DIR) / "tests/data/ros2_controllers" / distro / (controller + ".txt");
+  std::istringstream in(testing::ReadFileBytes(file));
+  KeyTypes keys;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream words(line);
+    std::string key, type;
+    words >> key >> type;
+    keys[key] = type;
+  }
+  return keys;
+}
+
+// The parameters as "a.b.c" -> node (nested maps dotted, as the declarations name them).
+void Flatten(const YAML::Node& map, const std::string& prefix,
+             std::vector<std::pair<std::string, YAML::Node>>* out) {
+  for (const auto& kv : map) {
+    const std::string key = prefix + kv.first.as<std::string>();
+    if (kv.second.IsMap()) {
+      Flatten(kv.second, key + ".", out);
+    } else {
+      out->emplace_back(key, kv.second);
+    }
+  }
+}
+
+// What rclcpp makes of a YAML scalar: a double needs a '.' or an exponent, else it is an integer.
+bool IsDoubleText(const YAML::Node& n) {
+  if (!n.IsScalar() || n.Tag() == "!") return false;  // a quoted scalar is a string
+  double v = 0.0;
+  if (!YAML::convert<double>::decode(n, v)) return false;
+  return n.Scalar().find_first_of(".eE") != std::string::npos;
+}
+
+void ExpectType(const std::string& key, const YAML::Node& n, const std::string& type) {
+  if (type == "double") {
+    EXPECT_TRUE(IsDoubleText(n)) << key << ": " << n;
+  } else if (type == "int") {
+    EXPECT_TRUE(n.IsScalar() && n.Scalar().find_first_not_of("-0123456789") == std::string::npos)
+        << key << ": " << n;
+  } else if (type == "string") {
+    EXPECT_TRUE(n.IsScalar() && n.Tag() == "!") << key << " should be a quoted string: " << n;
+  } else if (type == "string_array") {
+    ASSERT_TRUE(n.IsSequence()) << key;
+    for (const YAML::Node& e : n) EXPECT_EQ(e.Tag(), "!") << key << " holds a non-string";
+  } else if (type == "double_array") {
+    ASSERT_TRUE(n.IsSequence()) << key;
+    for (const YAML::Node& e : n) EXPECT_TRUE(IsDoubleText(e)) << key << ": " << e;
+  } else {
+    ADD_FAILURE() << key << ": unknown declared type " << type;
+  }
+}
+
+struct ControllerCase {
+  const char* controller;
+  std::string robot_yaml;
+};
+
+TEST(ExportRos2Control, EveryKeyDeclaredOnItsDistribution) {
+  testing::TempDir tmp;
+  const std::vector<ControllerCase> cases = {{"diff_drive_controller", kRobotYaml},
+                                             {"mecanum_drive_controller", kOmniExampleYaml},
+                                             {"omni_wheel_drive_controller", kOmni3ExampleYaml},
+                                             {"tricycle_controller", kTricycleExampleYaml}};
+  int checked = 0;
+  for (const std::string& distro : tools::RosDistros()) {
+    for (const ControllerCase& c : cases) {
+      SCOPED_TRACE(distro + " " + c.controller);
+      const RobotModelPtr model = ReadRobotModel(YAML::Load(c.robot_yaml), "robot.yaml");
+      std::vector<double> p = model->robot().nominal;
+      p[0] *= 1.01;  // a calibration that differs from the nominal: every note written
+      const std::string cal = tmp.Write("cal.yaml", model->RobotYaml(p, ""));
+      const KeyTypes declared = DeclaredKeys(distro, c.controller);
+      if (declared.empty()) {  // the distribution does not ship it: refused in one line
+        EXPECT_THROW(tools::ExportRos2Control(cal, c.controller, "", {}, distro),
+                     std::invalid_argument);
+        continue;
+      }
+      const tools::Ros2ControlExport e = tools::ExportRos2Control(cal, c.controller, "", {}, distro);
+      OdometryCovariance covariance;  // as written with --logs
+      covariance.twist_variance = {1e-4, 2e-5, 3e-4};
+      covariance.pose_variance_per_m = {1e-5, 2e-6, 3e-5};
+      const std::string yaml =
+          e.parameters_yaml + tools::Ros2CovarianceParameters(c.controller, covariance);
+      std::vector<std::pair<std::string, YAML::Node>> written;
+      Flatten(YAML::Load(yaml)[c.controller]["ros__parameters"], "", &written);
+      EXPECT_GE(written.size(), 4u);
+      for (const auto& [key, node] : written) {
+        const auto it = declared.find(key);
+        if (it == declared.end()) {
+          ADD_FAILURE() << key << " is not declared on " << distro;
+          continue;
+        }
+        ExpectType(key, node, it->second);
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 40);
+  // The kept lists themselves: the key the issue found stale.
+  EXPECT_EQ(DeclaredKeys("humble", "diff_drive_controller").count("wheels_per_side"), 1u);
+  EXPECT_EQ(DeclaredKeys("jazzy", "diff_drive_controller").count("wheels_per_side"), 0u);
+  EXPECT_EQ(DeclaredKeys("rolling", "diff_drive_controller").count("wheels_per_side"), 0u);
+  EXPECT_THROW(tools::ExportRos2Control(tmp.Path("cal.yaml"), "tricycle_controller", "", {},
+                                        "iron"),
+               std::invalid_argument);
+}
+
+TEST(ExportRos2Control, TricycleOffsetStatedWithSignAndPlace) {
+  testing::TempDir tmp;
+  const RobotModelPtr model = ReadRobotModel(YAML::Load(kTricycleExampleYaml), "robot.yaml");
+  const double offset_rad = -2.25 * M_PI / 180;
+  const std::string cal = tmp.Write("cal.yaml", model->RobotYaml({0.0331, 0.152, offset_rad}, ""));
+  const tools::Ros2ControlExport e = tools::ExportRos2Control(cal, "tricycle_controller", "", {});
+  ASSERT_EQ(e.notes.size(), 1u);
+  const std::string& note = e.notes[0];
+  char value[64];
+  std::snprintf(value, sizeof value, "add %+.9g rad", offset_rad);
+  EXPECT_NE(note.find(value), std::string::npos) << note;
+  EXPECT_NE(note.find("-2.250000 deg"), std::string::npos) << note;
+  EXPECT_NE(note.find("steering joint 'steering'"), std::string::npos) << note;
+  EXPECT_NE(note.find("SimpleTransmission"), std::string::npos) << note;
+
+  // The sign: the runs of a robot with this offset, their steering readings moved by the value
+  // the note gives, replay with the exported parameters (no offset) exactly as with the
+  // calibration; moved the other way they replay far worse.
+  const std::vector<double> truth = {0.0331, 0.152, offset_rad};
+  sim::SimulationOptions o;
+  o.seed = 3;
+  sim::TricycleTrajectoryOptions shapes;
+  std::vector<AlignedRun> runs;
+  for (const sim::ModelSimulatedRun& r :
+       sim::SimulateRuns(*model, truth, sim::TricycleTrajectories(shapes), o)) {
+    runs.push_back(AlignRun(r.log));
+  }
+  const RobotModelPtr exported = tools::ReadRos2ControlYaml(e.parameters_yaml, "exported", cal, {});
+  const double added_rad = std::stod(note.substr(note.find("add ") + 4));
+  const auto moved = [&](double by_rad) {
+    std::vector<AlignedRun> out = runs;
+    for (AlignedRun& r : out) {
+      for (std::size_t k = 0; k < r.samples.size(); ++k) r.samples[k].value[1] += by_rad;
+    }
+    return EvaluateFinalPoseErrors(*exported, exported->robot().nominal, out).cf;
+  };
+  const double cf_exact = EvaluateFinalPoseErrors(*model, truth, runs).cf;
+  EXPECT_NEAR(moved(added_rad), cf_exact, 1e-9);  // noise-free runs: both ~0
+  EXPECT_GT(moved(-added_rad), 100.0 * cf_exact + 1e-3);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Export replayed on a data set, as a user runs it.
+
+std::string Fitcal(const testing::TempDir& dir, const std::string& args, int expected_exit) {
+  const testing::FitcalRun r = testing::RunFitcal(dir, args);
+  EXPECT_EQ(r.exit_code, expected_exit) << args << "\n" << r.out << r.err;
+  return r.out + r.err;
+}
+
+// Issue 30: after `fit --train-trajectories` the export filtered held-out runs by repetition,
+// found none (every repetition also trains) and replayed on every run, training runs included.
+// It must take the runs `report` takes: those whose id the calibration did not train on.
+TEST(ExportRos2Control, HeldOutRunsAreTheOnesReportTakes) {
+  testing::TempDir dir;
+  const std::string data = dir.Path("data"), cal = dir.Path("cal.yaml");
+  Fitcal(dir, "simulate --model diff_drive --out " + data + " --repetitions 2 --seed 4", 0);
+  Fitcal(dir, "fit --logs " + data + " --train-trajectories '^square' --out " + cal, 0);
+  int held_out = 0, all = 0;
+  for (const YAML::Node& run : YAML::LoadFile(data + "/dataset.yaml")["runs"]) {
+    ++all;
+    held_out += run["trajectory"].as<std::string>().rfind("square", 0) != 0;
+  }
+  ASSERT_GT(held_out, 0);
+  ASSERT_LT(held_out, all);
+  const std::string params = dir.Path("params.yaml"), with_cov = dir.Path("cal_cov.yaml");
+  const std::string out = Fitcal(dir,
+                                 "export ros2-control --controller diff_drive_controller "
+                                 "--calibration " +
+                                     cal + " --logs " + data + " --out " + params +
+                                     " --calibration-out " + with_cov,
+                                 0);
+  EXPECT_NE(out.find("over " + std::to_string(held_out) + " runs of " + data +
+                     " held out from the calibration"),
+            std::string::npos)
+      << out;
+  // The covariance where the controller declares it, and in a calibration every reader takes.
+  const YAML::Node p = YAML::LoadFile(params)["diff_drive_controller"]["ros__parameters"];
+  ASSERT_EQ(p["twist_covariance_diagonal"].size(), 6u);
+  ASSERT_EQ(p["pose_covariance_diagonal"].size(), 6u);
+  EXPECT_GT(p["twist_covariance_diagonal"][0].as<double>(), 0.0);
+  EXPECT_GT(p["pose_covariance_diagonal"][5].as<double>(), 0.0);
+  const YAML::Node block = YAML::LoadFile(with_cov)["calibration"]["odometry_covariance"];
+  EXPECT_EQ(block["held_out_runs"].as<int>(), held_out);
+  EXPECT_EQ(block["twist_variance"].size(), 3u);
+  EXPECT_EQ(ReadRobotModelFile(with_cov)->robot().nominal, ReadRobotModelFile(cal)->robot().nominal);
+  EXPECT_TRUE(io::ReadCalibrationProvenance(with_cov));
+  std::string which;
+  const RobotModelPtr model = ReadRobotModelFile(cal);
+  const std::vector<AlignedRun> runs = tools::ExportHeldOutRuns(cal, data, model->robot(), &which);
+  ASSERT_EQ(static_cast<int>(runs.size()), held_out);
+  for (const AlignedRun& r : runs) EXPECT_EQ(r.trajectory.rfind("square", 0), std::string::npos);
+}
+
+// Parameters that replay worse than the nominal robot: one line, exit 5, nothing written, unless
+// --allow-worse.
+TEST(ExportRos2Control, WorseThanNominalIsRefused) {
+  testing::TempDir dir;
+  const std::string data = dir.Path("data");
+  Fitcal(dir, "simulate --model diff_drive --out " + data + " --repetitions 1 --seed 4", 0);
+  const RobotModelPtr nominal = ReadRobotModelFile(data + "/robot.yaml");
+  std::vector<double> p = nominal->robot().nominal;
+  p[0] *= 1.08;  // one wheel 8 % too large: far worse than the nominal robot
+  const std::string cal = dir.Write("bad.yaml", nominal->RobotYaml(p, ""));
+  const std::string out = dir.Path("params.yaml");
+  const std::string args = "export ros2-control --controller diff_drive_controller --calibration " +
+                           cal + " --logs " + data + " --out " + out;
+  const testing::FitcalRun refused = testing::RunFitcal(dir, args);
+  EXPECT_EQ(refused.exit_code, 5) << refused.out << refused.err;
+  EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+  EXPECT_NE(refused.err.find("worse than the nominal robot"), std::string::npos) << refused.err;
+  EXPECT_FALSE(fs::exists(out));
+  Fitcal(dir, args + " --allow-worse", 0);
+  EXPECT_TRUE(fs::exists(out));
 }
 
 }  // namespace

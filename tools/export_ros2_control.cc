@@ -10,6 +10,7 @@
 #include <iostream>
 #include <numeric>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 
 #include "fit/final_pose_errors.h"
@@ -22,6 +23,9 @@
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
 #include "odometry/effects.h"
+#include "io/text_file.h"
+#include "validation/odometry_covariance.h"
+#include "validation/training_runs.h"
 
 namespace fitcal::tools {
 namespace {
@@ -116,13 +120,16 @@ void NoteSpread(const std::vector<double>& v, const std::string& what, const std
   notes->push_back(text);
 }
 
-std::string DiffDriveParameters(const Calibrated& c, std::vector<std::string>*) {
+std::string DiffDriveParameters(const Calibrated& c, const std::string& distro,
+                                std::vector<std::string>*) {
   const int right = DiffDriveRightChannel(*c.model), left = 1 - right;
   const double r_right = c.p()[right], r_left = c.p()[left];
   const double radius = 0.5 * (r_right + r_left);
   return "    left_wheel_names: " + NameList({c.joints[left]}) +
          "\n    right_wheel_names: " + NameList({c.joints[right]}) +
-         "\n    wheels_per_side: 1\n    wheel_separation: " +
+         // humble declares wheels_per_side (and overwrites it with the names' count); jazzy and
+         // rolling no longer declare it, and an undeclared key is ignored there.
+         (distro == "humble" ? "\n    wheels_per_side: 1" : "") + "\n    wheel_separation: " +
          Num(c.p()[diff_drive::kSeparationIndex]) + "\n    wheel_radius: " + Num(radius) +
          "\n    wheel_separation_multiplier: 1.0" +
          "\n    left_wheel_radius_multiplier: " + Num(r_left / radius) +
@@ -171,7 +178,8 @@ std::vector<int> MecanumCorners(const std::vector<OmniWheelGeometry>& wheels, co
   return at;
 }
 
-std::string MecanumParameters(const Calibrated& c, std::vector<std::string>* notes) {
+std::string MecanumParameters(const Calibrated& c, const std::string&,
+                              std::vector<std::string>* notes) {
   if (c.robot().model != "omni" || c.robot().NumChannels() != 4) {
     throw std::invalid_argument("mecanum_drive_controller takes an omni robot of 4 mecanum wheels");
   }
@@ -252,7 +260,8 @@ std::vector<int> OmniOrder(const std::vector<OmniWheelGeometry>& wheels, double*
   return order;
 }
 
-std::string OmniWheelParameters(const Calibrated& c, std::vector<std::string>* notes) {
+std::string OmniWheelParameters(const Calibrated& c, const std::string&,
+                               std::vector<std::string>* notes) {
   if (c.robot().model != "omni3" && c.robot().model != "omni") {
     throw std::invalid_argument("omni_wheel_drive_controller takes an omni3 or omni robot");
   }
@@ -292,15 +301,22 @@ std::string OmniWheelParameters(const Calibrated& c, std::vector<std::string>* n
          "\n";
 }
 
-std::string TricycleParameters(const Calibrated& c, std::vector<std::string>* notes) {
+std::string TricycleParameters(const Calibrated& c, const std::string&,
+                               std::vector<std::string>* notes) {
   const double offset_rad = c.p()[2];
   if (offset_rad != 0.0) {
-    char text[220];
+    // models/tricycle/tricycle_kinematics.h: true steering = measured + phi_0. The controller
+    // reads the steering joint's state as the true angle, so the joint must report phi_0 more:
+    // ros2_control's SimpleTransmission computes joint = actuator / reduction + offset, which
+    // also shifts the commands the same way.
+    char text[400];
     std::snprintf(text, sizeof text,
-                  "tricycle_controller has no steering offset: the calibrated "
-                  "%.4f deg is left out (put it in the steering joint's zero, hardware interface "
-                  "or URDF)",
-                  offset_rad / kDeg);
+                  "tricycle_controller has no steering offset: add %+.9g rad (%+.6f deg) to "
+                  "the steering joint '%s' position (true steering = measured %+.6f deg), e.g. "
+                  "<offset>%.9g</offset> in its SimpleTransmission <joint> in the URDF "
+                  "(joint = actuator / reduction + offset), or zero the steering encoder there",
+                  offset_rad, offset_rad / kDeg, c.joints[1].c_str(), offset_rad / kDeg,
+                  offset_rad);
     notes->push_back(text);
   }
   return "    traction_joint_name: " + Quoted(c.joints[0]) +
@@ -310,14 +326,15 @@ std::string TricycleParameters(const Calibrated& c, std::vector<std::string>* no
 
 struct ControllerEntry {
   const char* name;
-  const char* model;  // the fitcal model(s) it takes, for the mismatch message
-  std::string (*write)(const Calibrated&, std::vector<std::string>*);
+  const char* model;    // the fitcal model(s) it takes, for the mismatch message
+  const char* distros;  // the distributions that ship it (tests/data/ros2_controllers/)
+  std::string (*write)(const Calibrated&, const std::string& distro, std::vector<std::string>*);
 };
 const ControllerEntry kControllers[] = {
-    {"diff_drive_controller", "diff_drive", DiffDriveParameters},
-    {"mecanum_drive_controller", "omni", MecanumParameters},
-    {"omni_wheel_drive_controller", "omni3 omni", OmniWheelParameters},
-    {"tricycle_controller", "tricycle", TricycleParameters},
+    {"diff_drive_controller", "diff_drive", "humble jazzy rolling", DiffDriveParameters},
+    {"mecanum_drive_controller", "omni", "humble jazzy rolling", MecanumParameters},
+    {"omni_wheel_drive_controller", "omni3 omni", "jazzy rolling", OmniWheelParameters},
+    {"tricycle_controller", "tricycle", "humble jazzy rolling", TricycleParameters},
 };
 
 const ControllerEntry& FindController(const std::string& name) {
@@ -330,9 +347,25 @@ const ControllerEntry& FindController(const std::string& name) {
   throw std::invalid_argument("unknown controller '" + name + "' (fitcal writes " + known + ")");
 }
 
+bool InList(const char* list, const std::string& word) {
+  return (std::string(" ") + list + " ").find(" " + word + " ") != std::string::npos;
+}
+
 bool TakesModel(const ControllerEntry& e, const std::string& model) {
-  const std::string models = std::string(" ") + e.model + " ";
-  return models.find(" " + model + " ") != std::string::npos;
+  return InList(e.model, model);
+}
+
+void CheckDistro(const ControllerEntry& e, const std::string& distro) {
+  const std::vector<std::string>& all = RosDistros();
+  if (std::find(all.begin(), all.end(), distro) == all.end()) {
+    std::string known;
+    for (const std::string& d : all) known += (known.empty() ? "" : ", ") + d;
+    throw std::invalid_argument("--ros-distro '" + distro + "' is not one of " + known);
+  }
+  if (!InList(e.distros, distro)) {
+    throw std::invalid_argument(std::string(e.name) + " is not in ROS 2 " + distro +
+                                " (it ships in " + e.distros + ")");
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -469,6 +502,11 @@ std::string TricycleRobotText(const Calibrated& c, const YAML::Node& p, const st
 
 }  // namespace
 
+const std::vector<std::string>& RosDistros() {
+  static const std::vector<std::string> names = {"humble", "jazzy", "rolling"};
+  return names;
+}
+
 const std::vector<std::string>& Ros2Controllers() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> v;
@@ -480,8 +518,10 @@ const std::vector<std::string>& Ros2Controllers() {
 
 Ros2ControlExport ExportRos2Control(const std::string& calibration_path,
                                     const std::string& controller, const std::string& node_name,
-                                    const std::vector<std::string>& joints) {
+                                    const std::vector<std::string>& joints,
+                                    const std::string& ros_distro) {
   const ControllerEntry& entry = FindController(controller);
+  CheckDistro(entry, ros_distro);
   const Calibrated c = ReadCalibrated(calibration_path, joints);
   if (!TakesModel(entry, c.robot().model)) {
     throw std::invalid_argument(calibration_path + ": robot model '" + c.robot().model +
@@ -501,7 +541,7 @@ Ros2ControlExport ExportRos2Control(const std::string& calibration_path,
   }
   Ros2ControlExport out;
   out.parameters_yaml = (node_name.empty() ? controller : node_name) + ":\n  ros__parameters:\n" +
-                        entry.write(c, &out.notes);
+                        entry.write(c, ros_distro, &out.notes);
   return out;
 }
 
@@ -545,48 +585,160 @@ RobotModelPtr ReadRos2ControlYaml(const std::string& yaml_text, const std::strin
 }  // namespace fitcal::tools
 
 namespace fitcal::tools {
-namespace {
 
-// The held-out runs of the data set: repetitions the calibration did not train on (its
-// `calibration:` block), or every run when it names none; `*which` says which.
-std::vector<AlignedRun> HeldOutRuns(const ExportRos2ControlOptions& o, const Robot& robot,
-                                    std::string* which) {
-  const io::Dataset data = io::LoadDataset(io::ReadDatasetIndex(o.logs), robot);
-  const std::optional<std::vector<int>> training =
-      io::ReadCalibrationTrainingRepetitions(o.calibration);
-  std::vector<RunLog> held_out;
-  if (training) {
-    const std::set<int> train(training->begin(), training->end());
+std::vector<AlignedRun> ExportHeldOutRuns(const std::string& calibration_path,
+                                          const std::string& logs, const Robot& robot,
+                                          std::string* which,
+                                          std::vector<RunLog>* held_out_logs) {
+  const io::Dataset data = io::LoadDataset(io::ReadDatasetIndex(logs), robot);
+  // The rule `report` uses (tools/report_command.cc, SplitForReport): the recorded training run
+  // ids (and fingerprint) when this data set holds them, by repetition for older files.
+  RecordedTraining recorded;
+  if (const std::optional<io::CalibrationProvenance> p =
+          io::ReadCalibrationProvenance(calibration_path)) {
+    recorded.run_ids = p->training_run_ids;
+    recorded.fingerprint = p->training_fingerprint;
+    recorded.repetitions = p->training_repetitions;
+  }
+  TrainingSplit t = SplitAsRecorded(data.runs, AlignRuns(data.runs), recorded);
+  std::vector<AlignedRun> runs;
+  if (t.split.validation.empty()) {
+    *which = "(the calibration trained on every run of this data set)";
+    runs = std::move(t.split.training);
+  } else {
+    *which = t.how == "none" ? "(none of them trained the calibration)"
+                             : "held out from the calibration";
+    runs = std::move(t.split.validation);
+  }
+  if (held_out_logs != nullptr) {
+    std::set<std::string> ids;
+    for (const AlignedRun& r : runs) ids.insert(r.id);
     for (const RunLog& r : data.runs) {
-      if (train.count(r.repetition) == 0) held_out.push_back(r);
+      if (ids.count(r.id) > 0) held_out_logs->push_back(r);
     }
   }
-  *which = "held-out";
-  if (held_out.empty()) {
-    held_out = data.runs;
-    *which = "all (the calibration names no held-out repetition)";
-  }
-  return AlignRuns(held_out);
+  return runs;
 }
 
-// "# held-out CF ..." comment and stdout line: the cost of the approximation on real runs.
-std::string CostComment(const ExportRos2ControlOptions& o, const std::string& parameters_yaml) {
+namespace {
+
+// The exported parameters replayed on the held-out runs beside the nominal robot and the exact
+// calibration: CF (Palacin Eq. 14) of each, and the odometry covariance of both calibrations.
+struct Replay {
+  std::size_t runs = 0;
+  std::string which;
+  double cf_nominal = 0.0, cf_exact = 0.0, cf_exported = 0.0;
+  OdometryCovariance exported_covariance, exact_covariance;
+  bool Worse() const { return cf_exported > cf_nominal; }
+};
+
+// Twist errors are taken over windows of this length (docs/ros2.md: long enough that the
+// ground truth's own noise is small beside the odometry's drift, short beside a run).
+constexpr double kCovarianceWindowS = 1.0;
+
+Replay ReplayOnHeldOutRuns(const ExportRos2ControlOptions& o, const std::string& parameters_yaml) {
   const RobotModelPtr exact = ReadRobotModelFile(o.calibration);
   const RobotModelPtr exported =
       ReadRos2ControlYaml(parameters_yaml, o.controller, o.calibration, o.joints);
-  std::string which;
-  const std::vector<AlignedRun> runs = HeldOutRuns(o, exact->robot(), &which);
-  const double cf_exact = EvaluateFinalPoseErrors(*exact, exact->robot().nominal, runs).cf;
-  const double cf_exported = EvaluateFinalPoseErrors(*exported, exported->robot().nominal, runs).cf;
-  char text[320];
-  std::snprintf(text, sizeof text,
-                "CF (Palacin Eq. 14, m and rad) over %zu %s runs of %s: exact "
-                "calibration %.6f, these parameters %.6f (%+.1f %%)",
-                runs.size(), which.c_str(), o.logs.c_str(), cf_exact, cf_exported,
-                100.0 * (cf_exported / cf_exact - 1.0));
-  std::printf("%s\n", text);
-  return std::string("# ") + text + "\n";
+  const io::DatasetIndex index = io::ReadDatasetIndex(o.logs);
+  const RobotModelPtr nominal = ReadRobotModelFile(index.robot_path);
+  if (nominal->robot().model != exact->robot().model) {
+    throw std::invalid_argument(o.logs + ": its robot is a " + nominal->robot().model +
+                                ", the calibration a " + exact->robot().model);
+  }
+  Replay r;
+  std::vector<RunLog> logs;
+  const std::vector<AlignedRun> runs =
+      ExportHeldOutRuns(o.calibration, o.logs, exact->robot(), &r.which, &logs);
+  r.runs = runs.size();
+  r.cf_nominal = EvaluateFinalPoseErrors(*nominal, nominal->robot().nominal, runs).cf;
+  r.cf_exact = EvaluateFinalPoseErrors(*exact, exact->robot().nominal, runs).cf;
+  r.cf_exported = EvaluateFinalPoseErrors(*exported, exported->robot().nominal, runs).cf;
+  for (auto [model, covariance] : {std::make_pair(exported.get(), &r.exported_covariance),
+                                   std::make_pair(exact.get(), &r.exact_covariance)}) {
+    *covariance = EstimateOdometryCovariance(
+        CollectOdometryErrors(*model, model->robot().nominal, logs, kCovarianceWindowS),
+        kCovarianceWindowS);
+  }
+  return r;
 }
+
+std::string ReplayLine(const ExportRos2ControlOptions& o, const Replay& r) {
+  char text[400];
+  std::snprintf(text, sizeof text,
+                "CF (Palacin Eq. 14, m and rad) over %zu runs of %s %s: nominal robot %.6f, "
+                "exact calibration %.6f, these parameters %.6f (%+.1f %% vs exact)",
+                r.runs, o.logs.c_str(), r.which.c_str(), r.cf_nominal, r.cf_exact, r.cf_exported,
+                100.0 * (r.cf_exported / r.cf_exact - 1.0));
+  return text;
+}
+
+// Variance written for the axes planar odometry does not measure (z, roll, pitch): large, so
+// that an EKF that fuses them anyway gives them no weight (robot_localization's two_d_mode
+// ignores them).
+constexpr double kUnmeasuredVariance = 1e6;
+
+std::string Diagonal(const std::array<double, 3>& planar) {
+  return "[" + Num(planar[0]) + ", " + Num(planar[1]) + ", " + Num(kUnmeasuredVariance) + ", " +
+         Num(kUnmeasuredVariance) + ", " + Num(kUnmeasuredVariance) + ", " + Num(planar[2]) + "]";
+}
+
+}  // namespace
+
+std::string Ros2CovarianceParameters(const std::string& controller, const OdometryCovariance& c) {
+  if (controller == "omni_wheel_drive_controller") {
+    return "    diagonal_covariance:\n      pose: " + Diagonal(c.pose_variance_per_m) +
+           "\n      twist: " + Diagonal(c.twist_variance) + "\n";
+  }
+  return "    pose_covariance_diagonal: " + Diagonal(c.pose_variance_per_m) +
+         "\n    twist_covariance_diagonal: " + Diagonal(c.twist_variance) + "\n";
+}
+
+namespace {
+
+std::string CovarianceLine(const OdometryCovariance& c) {
+  char text[400];
+  std::snprintf(text, sizeof text,
+                "odometry covariance from %zu held-out runs (%zu windows of %.1f s): twist sigma "
+                "vx %.4g m/s, vy %.4g m/s, omega %.4g rad/s; pose sigma per sqrt(m) x %.4g m, "
+                "y %.4g m, theta %.4g rad",
+                c.runs, c.windows, c.window_s, std::sqrt(c.twist_variance[0]),
+                std::sqrt(c.twist_variance[1]), std::sqrt(c.twist_variance[2]),
+                std::sqrt(c.pose_variance_per_m[0]), std::sqrt(c.pose_variance_per_m[1]),
+                std::sqrt(c.pose_variance_per_m[2]));
+  return text;
+}
+
+// The calibration file with `calibration.odometry_covariance` (one flow-style line right after
+// `calibration:`, replacing an earlier one): the file stays a robot YAML every reader takes.
+std::string CalibrationWithCovariance(const std::string& path, const OdometryCovariance& c) {
+  std::istringstream in(io::ReadTextFile(path));
+  std::string out, line;
+  bool found = false;
+  while (std::getline(in, line)) {
+    if (line.rfind("  odometry_covariance:", 0) == 0) continue;
+    out += line + "\n";
+    if (line == "calibration:") {
+      found = true;
+      out += "  odometry_covariance: {window_s: " + Num(c.window_s) +
+             ", held_out_runs: " + std::to_string(c.runs) + ", windows: " +
+             std::to_string(c.windows) + ", twist_variance: [" + Num(c.twist_variance[0]) +
+             ", " + Num(c.twist_variance[1]) + ", " + Num(c.twist_variance[2]) +
+             "], pose_variance_per_m: [" + Num(c.pose_variance_per_m[0]) + ", " +
+             Num(c.pose_variance_per_m[1]) + ", " + Num(c.pose_variance_per_m[2]) + "]}\n";
+    }
+  }
+  if (!found) {
+    throw std::invalid_argument(path + ": no calibration: block (a calibration written by fit) "
+                                "to hold the odometry covariance (--calibration-out)");
+  }
+  return out;
+}
+
+// Thrown when the exported parameters would make the robot worse: exit 5, nothing written.
+struct WorseThanNominal : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 }  // namespace
 
@@ -603,8 +755,18 @@ void AddExportRos2ControlOptions(CLI::App& app, ExportRos2ControlOptions& o) {
       ->delimiter(',');
   app.add_option("--out", o.out, "File to write (atomically; default: stdout)");
   app.add_option("--logs", o.logs,
-                 "Data set: print the held-out CF of the exact and the exported parameters")
+                 "Data set: replay the exported parameters on its held-out runs beside the "
+                 "nominal robot and the exact calibration; refuse them if worse than nominal")
       ->check(CLI::ExistingDirectory);
+  std::string distros;
+  for (const std::string& d : RosDistros()) distros += (distros.empty() ? "" : "|") + d;
+  app.add_option("--ros-distro", o.ros_distro,
+                 "ROS 2 distribution (" + distros + "): only the keys it declares are written")
+      ->capture_default_str();
+  app.add_flag("--allow-worse", o.allow_worse,
+               "Write the parameters even when they replay worse than the nominal robot");
+  app.add_option("--calibration-out", o.calibration_out,
+                 "With --logs: write the calibration with its odometry covariance here");
   app.add_flag("--force", o.force, "Overwrite --out");
 }
 
@@ -615,23 +777,56 @@ int RunExportRos2ControlCommand(const ExportRos2ControlOptions& o) {
       throw std::runtime_error(o.out + ": exists; refusing to overwrite it (--force)");
     }
     const Ros2ControlExport e =
-        ExportRos2Control(o.calibration, o.controller, o.node_name, o.joints);
-    std::string text = "# " + o.controller +
-                       " parameters (ros2_controllers) from the fitcal "
-                       "calibration " +
-                       o.calibration + "\n";
-    for (const std::string& note : e.notes) {
-      std::cerr << kPrefix << "note: " << note << "\n";
-      text += "# not representable: " + note + "\n";
+        ExportRos2Control(o.calibration, o.controller, o.node_name, o.joints, o.ros_distro);
+    std::string text = "# " + o.controller + " parameters (ros2_controllers, ROS 2 " +
+                       o.ros_distro + ") from the fitcal calibration " + o.calibration + "\n";
+    for (const std::string& note : e.notes) text += "# not representable: " + note + "\n";
+    if (!o.calibration_out.empty() && o.logs.empty()) {
+      throw std::invalid_argument("--calibration-out needs --logs (the covariance comes from "
+                                  "the held-out runs)");
     }
-    if (!o.logs.empty()) text += CostComment(o, e.parameters_yaml);
-    text += e.parameters_yaml;
+    if (!o.calibration_out.empty() && std::filesystem::exists(o.calibration_out) && !o.force) {
+      throw std::runtime_error(o.calibration_out + ": exists; refusing to overwrite it (--force)");
+    }
+    std::string parameters = e.parameters_yaml, calibration_text;
+    if (!o.logs.empty()) {
+      const Replay replay = ReplayOnHeldOutRuns(o, e.parameters_yaml);
+      // On stdout beside a written file; in the YAML's comments either way (stdout stays YAML).
+      const std::string line = ReplayLine(o, replay);
+      if (!o.out.empty()) std::printf("%s\n", line.c_str());
+      if (replay.Worse() && !o.allow_worse) {
+        char text_worse[300];
+        std::snprintf(text_worse, sizeof text_worse,
+                      "these parameters replay worse than the nominal robot (CF %.6f > %.6f on "
+                      "%zu runs); nothing written (--allow-worse writes them%s)",
+                      replay.cf_exported, replay.cf_nominal, replay.runs,
+                      e.notes.empty() ? ""
+                                      : ", with notes on what the controller leaves out: "
+                                        "apply that first, e.g. a steering offset");
+        throw WorseThanNominal(text_worse);
+      }
+      text += "# " + line + "\n";
+      const std::string covariance = CovarianceLine(replay.exported_covariance);
+      if (!o.out.empty()) std::printf("%s\n", covariance.c_str());
+      text += "# " + covariance + " (docs/ros2.md)\n";
+      parameters += Ros2CovarianceParameters(o.controller, replay.exported_covariance);
+      if (!o.calibration_out.empty()) {
+        calibration_text = CalibrationWithCovariance(o.calibration, replay.exact_covariance);
+      }
+    }
+    text += parameters;
+    // The notes after the verdict: a refusal is one line.
+    for (const std::string& note : e.notes) std::cerr << kPrefix << "note: " << note << "\n";
     if (o.out.empty()) {
       std::cout << text;
     } else {
       io::WriteFileAtomically(o.out, text);
     }
+    if (!calibration_text.empty()) io::WriteFileAtomically(o.calibration_out, calibration_text);
     return 0;
+  } catch (const WorseThanNominal& e) {
+    std::cerr << kPrefix << e.what() << "\n";
+    return 5;
   } catch (const std::invalid_argument& e) {
     std::cerr << kPrefix << e.what() << "\n";
     return 2;

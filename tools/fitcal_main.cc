@@ -20,6 +20,7 @@
 #include "tools/compare_command.h"
 #include "tools/diagnose_command.h"
 #include "tools/export_ros2_control.h"
+#include "tools/fleet_command.h"
 #include "tools/fit_command.h"
 #include "tools/generalisation_command.h"
 #include "tools/import_optiodom.h"
@@ -112,6 +113,9 @@ std::vector<Command> Commands() {
       MakeCommand("export", "ros2-control",
                   "The parameter YAML of a ros2_controllers drive controller",
                   &AddExportRos2ControlOptions, &RunExportRos2ControlCommand),
+      MakeCommand("", "fleet",
+                  "Calibrations across robots and dates: a table per robot, outliers and trends",
+                  &AddFleetOptions, &RunFleetCommand),
       MakeCommand("", "asoc-simulate",
                   "Write a simulated ASOC data set (calibration holds, UMBmark, excursions)",
                   &AddAsocSimulateOptions, &RunAsocSimulate),

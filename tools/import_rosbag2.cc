@@ -107,6 +107,53 @@ std::vector<double> ChannelRows(const Robot& robot, const BagStreams& s) {
   return rows;
 }
 
+// Joint positions wrapped to one turn (a driver that reports a wheel's angle modulo a turn, in
+// [-pi, pi) or [0, 2 pi), not cumulatively): every reading of the wheel within one turn of the
+// others and some step between two messages longer than pi. Each step is then taken as the shortest rotation, WrapAngle(step) - right
+// while the wheel turns less than half a turn between messages. A wrapped step longer than
+// kMaxUnwrappedStepRad leaves too little margin to tell the direction: refused, naming the joint.
+constexpr double kMaxUnwrappedStepRad = 0.5 * M_PI;
+
+std::vector<std::string> UnwrapWrappedWheels(const Robot& robot,
+                                             const std::vector<std::string>& joint_names,
+                                             BagStreams* s) {
+  std::vector<std::string> notes;
+  if (!s->joints.positions) return notes;
+  const std::size_t n = s->joints.t_ns.size(), c = robot.channels.size();
+  std::vector<double>& v = s->joints.values;
+  for (std::size_t j = 0; j < c; ++j) {
+    if (robot.channels[j].kind != ChannelKind::kWheelRate) continue;
+    double lo = v[j], hi = v[j];
+    bool jumps = false;
+    for (std::size_t k = 1; k < n; ++k) {
+      lo = std::min(lo, v[k * c + j]);
+      hi = std::max(hi, v[k * c + j]);
+      jumps = jumps || std::abs(v[k * c + j] - v[(k - 1) * c + j]) > M_PI;
+    }
+    if (hi - lo > 2.0 * M_PI + 1e-9 || !jumps) continue;
+    int wraps = 0;
+    double previous_raw = v[j];
+    for (std::size_t k = 1; k < n; ++k) {
+      const double raw = v[k * c + j];
+      const double step = WrapAngle(raw - previous_raw);
+      if (std::abs(step) > kMaxUnwrappedStepRad) {
+        char what[240];
+        std::snprintf(what, sizeof what,
+                      "joint \"%s\": positions wrapped to one turn with a step of %.3f rad "
+                      "between messages at %.9f s: too fast to unwrap unambiguously",
+                      joint_names[j].c_str(), step, SecondsSinceStart(*s, s->joints.t_ns[k]));
+        throw InputError(InputErrorKind::kBadValue, s->bag, 0, what);
+      }
+      wraps += std::abs(raw - previous_raw) > M_PI;
+      previous_raw = raw;
+      v[k * c + j] = v[(k - 1) * c + j] + step;
+    }
+    notes.push_back("joint \"" + joint_names[j] + "\": positions wrapped to one turn unwrapped (" +
+                    std::to_string(wraps) + " wraps)");
+  }
+  return notes;
+}
+
 bool IntervalAtRest(const Robot& robot, const double* row, double rest_rate) {
   for (std::size_t j = 0; j < robot.channels.size(); ++j) {
     if (robot.channels[j].kind == ChannelKind::kWheelRate && std::abs(row[j]) > rest_rate) {
@@ -337,6 +384,24 @@ CsvBuffer GroundTruthCsvText(const GroundTruthTrack& track) {
   return out;
 }
 
+// The staged data set read back by the loader `fit` uses (io/dataset.h: physical limits of
+// rates, angles and times, clock steps and gaps while the wheels turn, runs that move): a data
+// set the import writes is one `fit` accepts. A refusal names the bag and the file as it would
+// be under --out.
+void RefuseWhatFitRefuses(const ImportRosbag2Options& o, const std::string& staged_dir,
+                          const Robot& robot) {
+  try {
+    io::LoadDataset(io::ReadDatasetIndex(staged_dir), robot);
+  } catch (const InputError& e) {
+    std::string what = e.what();
+    for (std::size_t at = what.find(staged_dir); at != std::string::npos;
+         at = what.find(staged_dir, at + o.out.size())) {
+      what.replace(at, staged_dir.size(), o.out);
+    }
+    throw InputError(e.kind(), o.bag, 0, "the data set it makes would be refused: " + what);
+  }
+}
+
 void WriteDataset(const ImportRosbag2Options& o, const Robot& robot, const Rosbag2Import& imp) {
   io::StagedDirectory staged(o.out);
   const fs::path dir(staged.path());
@@ -364,6 +429,7 @@ void WriteDataset(const ImportRosbag2Options& o, const Robot& robot, const Rosba
       std::to_string(imp.streams.start_time_ns) + " ns since the epoch\n";
   io::WriteFileAtomically((dir / "dataset.yaml").string(),
                           header + io::DatasetYaml("robot.yaml", entries));
+  RefuseWhatFitRefuses(o, staged.path(), robot);
   io::StopHereForTests("import-rosbag2-before-rename");
   staged.Commit(o.force);
 }
@@ -378,7 +444,12 @@ Rosbag2Import ReadRosbag2Import(const ImportRosbag2Options& o) {
   const RobotModelPtr model = ReadRobotModelFile(o.robot);
   const Robot& robot = model->robot();
   Rosbag2Import imp;
-  imp.streams = io::rosbag2::ReadBagStreams(o.bag, MakeRequest(o, robot));
+  const io::rosbag2::BagStreamRequest request = MakeRequest(o, robot);
+  imp.streams = io::rosbag2::ReadBagStreams(o.bag, request);
+  imp.notes = imp.streams.notes;
+  for (std::string& note : UnwrapWrappedWheels(robot, request.joints, &imp.streams)) {
+    imp.notes.push_back(std::move(note));
+  }
   const std::vector<double> rows = ChannelRows(robot, imp.streams);
   std::vector<IndexSpan> spans;
   if (!o.runs.empty()) {
@@ -450,6 +521,7 @@ int RunImportRosbag2Command(const ImportRosbag2Options& o) {
   try {
     const Rosbag2Import imp = ImportRosbag2(o);
     if (!o.quiet) {
+      for (const std::string& note : imp.notes) std::printf("%s\n", note.c_str());
       const RobotModelPtr model = ReadRobotModelFile(o.robot);
       const FinalPoseErrors nominal =
           EvaluateFinalPoseErrors(*model, model->robot().nominal, AlignRuns(imp.runs));

@@ -25,6 +25,14 @@
 // `<label>-NN`, trajectory label <label> (default: the bag's name) and repetition i, so
 // `fitcal fit --train-reps` chooses runs by number.
 //
+// Real recordings. Messages on the encoder topic that carry none of the robot's joints (another
+// node's JointState) are skipped. Wheel positions wrapped to one turn are unwrapped (or refused
+// when too fast to unwrap). A ground-truth orientation that is not a unit quaternion is refused
+// naming topic and time. With --stamp recorded, a recording clock that steps back (seen as
+// header stamps going back in recorded order) is refused at that instant. The data set is read
+// back with the loader `fit` uses before it is committed: the import never writes a data set
+// `fit` refuses.
+//
 // Nothing is written unless every run is good: the data set is built in a temporary sibling of
 // --out and renamed into place (io/staged_directory.h).
 
@@ -64,6 +72,7 @@ struct Rosbag2Import {
   // robot channel (robot channel order).
   std::vector<std::vector<double>> encoder_t_s;
   std::vector<std::vector<double>> encoder_values;
+  std::vector<std::string> notes;  // what the import repaired (wrapped joint positions), one line each
 };
 
 // Reads the bag and cuts the runs, writing nothing. Throws io::InputError for a bad bag or bad

@@ -1,5 +1,6 @@
 #include "io/rosbag2/bag_reader.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <limits>
 
@@ -142,6 +143,18 @@ std::uint64_t BagReader::message_count() const {
 bool BagReader::Advance(std::size_t file_index) {
   has_pending_[file_index] = storages_[file_index]->Next(&pending_[file_index]);
   return has_pending_[file_index];
+}
+
+std::optional<ClockStepBack> BagReader::RecordingClockStepBack(std::string* file) {
+  std::map<std::string, std::int64_t> latest_ns;  // by topic, over the files in split order
+  for (std::size_t i = 0; i < storages_.size(); ++i) {
+    *file = files_[i];
+    if (const std::optional<ClockStepBack> step =
+            storages_[i]->RecordingClockStepBack(&latest_ns)) {
+      return step;
+    }
+  }
+  return std::nullopt;
 }
 
 // A k-way merge of the files, each already in time order. Only the file whose message went out

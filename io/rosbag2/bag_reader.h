@@ -58,6 +58,11 @@ class BagReader {
   // The next message by time (ties: earlier file first, then file order); false at the end.
   bool ReadNext(BagMessage* message);
 
+  // The first step back of the recording clock by more than kClockStepBackToleranceNs in the
+  // order the recorder wrote each topic's messages (file by file, and from one split file to
+  // the next), with the file it is in. Reads the bag once more.
+  std::optional<ClockStepBack> RecordingClockStepBack(std::string* file);
+
  private:
   void OpenFromMetadata(const std::string& metadata_path);
   void OpenStorages();

@@ -1,8 +1,10 @@
 #include "io/rosbag2/bag_streams.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 
 #include "io/input_error.h"
 #include "io/rosbag2/bag_reader.h"
@@ -43,17 +45,75 @@ const TopicInfo& RequireTopic(const BagReader& bag, const std::string& bag_path,
   return *topic;
 }
 
-// Appends the stamp of a stream sample after checking that it increases strictly.
-void PushStamp(std::vector<std::int64_t>* stamps, std::int64_t t_ns, const BagMessage& m,
-               StampSource source) {
-  if (!stamps->empty() && t_ns <= stamps->back()) {
-    ThrowBagError(
-        InputErrorKind::kNonIncreasingTime, Describe(m),
+// Appends the stamp of a stream sample, remembering the first one that does not increase
+// strictly: ReadBagStreams decides at the end whether that is bad input (it is, unless the
+// recording clock stepped back and the header stamps put the messages in order again).
+class StampOrder {
+ public:
+  void Push(std::vector<std::int64_t>* stamps, std::int64_t t_ns, const BagMessage& m,
+            StampSource source) {
+    if (!first_file_.empty() || stamps->empty() || t_ns > stamps->back()) {
+      stamps->push_back(t_ns);
+      return;
+    }
+    first_file_ = Describe(m);
+    first_what_ =
         std::string(source == StampSource::kHeader ? "header stamp " : "time ") + Seconds(t_ns) +
-            " is not after the previous one (" + Seconds(stamps->back()) + ")" +
-            (source == StampSource::kHeader ? "; --stamp recorded uses the recording time" : ""));
+        " is not after the previous one (" + Seconds(stamps->back()) + ")" +
+        (source == StampSource::kHeader ? "; --stamp recorded uses the recording time" : "");
+    stamps->push_back(t_ns);
   }
-  stamps->push_back(t_ns);
+  bool violated() const { return !first_file_.empty(); }
+  void ThrowIfViolated() const {
+    if (violated()) ThrowBagError(InputErrorKind::kNonIncreasingTime, first_file_, first_what_);
+  }
+
+ private:
+  std::string first_file_, first_what_;
+};
+
+bool StrictlyIncreasing(const std::vector<std::int64_t>& t) {
+  return std::adjacent_find(t.begin(), t.end(), [](std::int64_t a, std::int64_t b) {
+           return b <= a;
+         }) == t.end();
+}
+
+// The order of `t` by value (stable).
+std::vector<std::size_t> OrderByStamp(const std::vector<std::int64_t>& t) {
+  std::vector<std::size_t> order(t.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return t[a] < t[b]; });
+  return order;
+}
+
+void SortByStamp(JointStream* s, std::size_t joints) {
+  const std::vector<std::size_t> order = OrderByStamp(s->t_ns);
+  std::vector<std::int64_t> t;
+  std::vector<double> v;
+  for (std::size_t i : order) {
+    t.push_back(s->t_ns[i]);
+    v.insert(v.end(), s->values.begin() + static_cast<std::ptrdiff_t>(i * joints),
+             s->values.begin() + static_cast<std::ptrdiff_t>((i + 1) * joints));
+  }
+  s->t_ns = std::move(t);
+  s->values = std::move(v);
+}
+
+void SortByStamp(PoseStream* s) {
+  const std::vector<std::size_t> order = OrderByStamp(s->t_ns);
+  std::vector<std::int64_t> t;
+  std::vector<Pose2d> poses;
+  for (std::size_t i : order) {
+    t.push_back(s->t_ns[i]);
+    poses.push_back(s->world_T_robot[i]);
+    if (poses.size() > 1) {  // unwrapped again in the new order
+      const double previous = poses[poses.size() - 2].theta;
+      poses.back().theta = previous + WrapAngle(poses.back().theta - previous);
+    }
+  }
+  s->t_ns = std::move(t);
+  s->world_T_robot = std::move(poses);
 }
 
 class JointCollector {
@@ -63,7 +123,13 @@ class JointCollector {
 
   void Add(const BagMessage& m) {
     const JointState js = DecodeJointState(m.payload, Describe(m));
-    if (js.name != names_) MapNames(js, m);
+    if (js.name != names_ && !MapNames(js, m)) {
+      // Another node's joints on the same topic (a gripper, a pan-tilt head publishing its own
+      // JointState): normal in ROS 2, skipped. Its name list is not remembered, so the robot's
+      // next message maps its names again.
+      ++skipped_;
+      return;
+    }
     const std::vector<double>& field = out_->positions ? js.position : js.velocity;
     if (field.size() != js.name.size()) {
       ThrowBagError(InputErrorKind::kWrongColumnCount, Describe(m),
@@ -83,13 +149,38 @@ class JointCollector {
     }
     const std::int64_t t_ns =
         request_.stamp == StampSource::kHeader ? js.header.stamp.ToNanoseconds() : m.time_ns;
-    PushStamp(&out_->t_ns, t_ns, m, request_.stamp);
+    order.Push(&out_->t_ns, t_ns, m, request_.stamp);
+  }
+
+  StampOrder order;
+
+  // After the last message: a topic on which no message carried the robot's joints.
+  void Finish(const std::string& bag_path) const {
+    if (!out_->t_ns.empty() || skipped_ == 0) return;
+    std::string have;
+    for (const std::string& n : first_skipped_names_) have += (have.empty() ? "" : ", ") + n;
+    ThrowBagError(InputErrorKind::kMissingKey, bag_path,
+                  "joint " + Printable(request_.joints[0]) + " is not in the message (none of the " +
+                      std::to_string(skipped_) + " messages on " + Printable(request_.joint_topic) +
+                      " carries the robot's joints; names: " + Printable(have, 160) +
+                      "); --joints names them in the robot's order");
   }
 
  private:
   // A message whose name list differs from the previous one: find each requested joint again
   // (joint_state_broadcaster keeps the order fixed, so this runs once per bag in practice).
-  void MapNames(const JointState& js, const BagMessage& m) {
+  // False for a message that carries none of the requested joints (another node's); a message
+  // that carries some but not all of them is bad input.
+  bool MapNames(const JointState& js, const BagMessage& m) {
+    std::size_t carried = 0;
+    for (const std::string& joint : request_.joints) {
+      carried += std::find(js.name.begin(), js.name.end(), joint) != js.name.end();
+    }
+    if (carried == 0) {
+      if (skipped_ == 0) first_skipped_names_ = js.name;
+      names_.clear();
+      return false;
+    }
     index_.assign(request_.joints.size(), 0);
     for (std::size_t j = 0; j < request_.joints.size(); ++j) {
       std::size_t k = 0;
@@ -103,8 +194,10 @@ class JointCollector {
       }
       index_[j] = k;
     }
-    if (names_.empty()) ChooseField(js, m);
+    if (!field_chosen_) ChooseField(js, m);
+    field_chosen_ = true;
     names_ = js.name;
+    return true;
   }
 
   // Positions (cumulative angles: exact wheel-angle advance per interval) when the first message
@@ -129,9 +222,29 @@ class JointCollector {
   JointStream* out_;
   std::vector<std::string> names_;
   std::vector<std::size_t> index_;
+  bool field_chosen_ = false;
+  std::size_t skipped_ = 0;
+  std::vector<std::string> first_skipped_names_;
 };
 
-Pose2d PlanarPose(const Point& p, const Quaternion& q) {
+// A rotation is a unit quaternion. A zero one (an uninitialised message, a tracker that lost the
+// body) or one far from unit length (a corrupted field, a hand-written message) has no yaw:
+// atan2 of it returns a number all the same (0 for the zero quaternion), so it is refused, with
+// the topic, the time and the norm. Tolerance 1e-3 on the norm: float32 trackers normalise to
+// ~1e-7, and a quaternion off by 1e-3 moves the yaw by at most ~1e-3 rad.
+constexpr double kUnitQuaternionTolerance = 1e-3;
+
+Pose2d PlanarPose(const Point& p, const Quaternion& q, const Header& header, const BagMessage& m) {
+  const double norm = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
+  if (!(std::abs(norm - 1.0) <= kUnitQuaternionTolerance)) {
+    char what[200];
+    std::snprintf(what, sizeof what,
+                  "orientation (x %.6g, y %.6g, z %.6g, w %.6g) is %s quaternion (norm %.6g), "
+                  "not a rotation; header stamp ",
+                  q.x, q.y, q.z, q.w, norm == 0.0 ? "a zero" : "not a unit", norm);
+    ThrowBagError(InputErrorKind::kBadValue, Describe(m),
+                  what + Seconds(header.stamp.ToNanoseconds()));
+  }
   return {p.x, p.y, YawOfQuaternion(q.x, q.y, q.z, q.w)};
 }
 
@@ -143,10 +256,10 @@ class PoseCollector {
   void Add(const BagMessage& m) {
     if (type_ == kPoseStampedType) {
       const PoseStamped p = DecodePoseStamped(m.payload, Describe(m));
-      Push(m, p.header, PlanarPose(p.pose.position, p.pose.orientation));
+      Push(m, p.header, PlanarPose(p.pose.position, p.pose.orientation, p.header, m));
     } else if (type_ == kOdometryType) {
       const Odometry o = DecodeOdometry(m.payload, Describe(m));
-      Push(m, o.header, PlanarPose(o.pose.pose.position, o.pose.pose.orientation));
+      Push(m, o.header, PlanarPose(o.pose.pose.position, o.pose.pose.orientation, o.header, m));
     } else {
       for (const TransformStamped& t : DecodeTfMessage(m.payload, Describe(m)).transforms) {
         if (StripSlash(t.header.frame_id) != request_.parent_frame ||
@@ -154,7 +267,7 @@ class PoseCollector {
           continue;
         }
         const Vector3& v = t.transform.translation;
-        Push(m, t.header, PlanarPose(Point{v.x, v.y, v.z}, t.transform.rotation));
+        Push(m, t.header, PlanarPose(Point{v.x, v.y, v.z}, t.transform.rotation, t.header, m));
       }
     }
   }
@@ -169,12 +282,16 @@ class PoseCollector {
       const double previous = out_->world_T_robot.back().theta;
       pose.theta = previous + WrapAngle(pose.theta - previous);
     }
-    PushStamp(&out_->t_ns,
-              request_.stamp == StampSource::kHeader ? header.stamp.ToNanoseconds() : m.time_ns, m,
-              request_.stamp);
+    order.Push(&out_->t_ns,
+               request_.stamp == StampSource::kHeader ? header.stamp.ToNanoseconds() : m.time_ns,
+               m, request_.stamp);
     out_->world_T_robot.push_back(pose);
   }
 
+ public:
+  StampOrder order;
+
+ private:
   const BagStreamRequest& request_;
   std::string type_;
   PoseStream* out_;
@@ -201,6 +318,41 @@ void CheckTypes(const BagReader& bag, const std::string& bag_path, const BagStre
                       " is a TFMessage: name the transform with --ground-truth-frames "
                       "parent:child (e.g. world:base_link)");
   }
+}
+
+// --stamp recorded: the reader orders messages by recording time. A recording clock that steps
+// back (NTP, a resumed machine) gives the messages after the step earlier times, and ordering by
+// them interleaves two stretches of the recording: wheel angles jump to and fro, a data set
+// `fit` then refuses or, worse, fits. Refused naming the instant (the header stamps, the
+// default, do not depend on the recorder's clock).
+void RefuseRecordingClockStepBack(BagReader* bag, const BagStreams& out) {
+  std::string file;
+  const std::optional<ClockStepBack> step = bag->RecordingClockStepBack(&file);
+  if (!step) return;
+  ThrowBagError(InputErrorKind::kNonIncreasingTime, file,
+                "the recording clock steps back by " + Seconds(step->before_ns - step->after_ns) +
+                    " after " + Seconds(step->before_ns) + " (" +
+                    Seconds(step->before_ns - out.start_time_ns) +
+                    " into the bag): recording times do not order the messages; import with "
+                    "--stamp header");
+}
+
+// Header stamps out of order in the reader's (recording-time) order. When the recording clock
+// stepped back the recording times interleave two stretches of the recording, while the
+// drivers' stamps still order every stream: the streams are put in header-stamp order, with a
+// note saying so. Otherwise (a driver reusing stamps, merged recordings) nothing changes and the
+// first stamp out of order is reported by the caller.
+void OrderByHeaderStamps(BagReader* bag, const BagStreamRequest& request, BagStreams* out) {
+  if (request.stamp != StampSource::kHeader) return;
+  std::string file;
+  const std::optional<ClockStepBack> step = bag->RecordingClockStepBack(&file);
+  if (!step) return;
+  SortByStamp(&out->joints, request.joints.size());
+  SortByStamp(&out->poses);
+  out->notes.push_back(file + ": the recording clock steps back by " +
+                       Seconds(step->before_ns - step->after_ns) + " after " +
+                       Seconds(step->before_ns - out->start_time_ns) +
+                       " into the bag: the messages are put in the order of their header stamps");
 }
 
 }  // namespace
@@ -234,6 +386,13 @@ BagStreams ReadBagStreams(const std::string& bag_path, const BagStreamRequest& r
     } else if (m.topic == pose_topic) {
       poses.Add(m);
     }
+  }
+  joints.Finish(bag_path);
+  if (request.stamp == StampSource::kRecorded) RefuseRecordingClockStepBack(&bag, out);
+  if (joints.order.violated() || poses.order.violated()) {
+    OrderByHeaderStamps(&bag, request, &out);
+    if (!StrictlyIncreasing(out.joints.t_ns)) joints.order.ThrowIfViolated();
+    if (!StrictlyIncreasing(out.poses.t_ns)) poses.order.ThrowIfViolated();
   }
   if (out.joints.t_ns.size() < 2) {
     ThrowBagError(InputErrorKind::kTooFewSamples, bag_path,

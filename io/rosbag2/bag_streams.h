@@ -8,7 +8,11 @@
 // it) or with the bag's recording time (when the recorder received it; late by the transport
 // latency and its jitter, which differ between topics), as the request says. Either way a
 // stream's stamps must increase strictly; anything else is bad input (a driver that reuses a
-// stamp, a bag of merged recordings), not something to sort away silently.
+// stamp, a bag of merged recordings), not something to sort away silently. One exception, said
+// in a note: the recording clock stepped back (the recording times, in the order the recorder
+// wrote them, go back by more than 10 ms). Then the reader's order by recording time interleaves
+// two stretches of the recording; with header stamps each stream is put back in stamp order,
+// and with recording times (--stamp recorded) the bag is refused at the instant of the step.
 //
 // Bad input (a topic missing or of the wrong type, a joint missing from a message, a message
 // without the position or velocity of every joint, a non-finite value, a non-increasing stamp, no
@@ -54,6 +58,7 @@ struct BagStreams {
   std::string pose_type;           // the ground-truth topic's message type
   JointStream joints;
   PoseStream poses;
+  std::vector<std::string> notes;  // what the reader repaired, one line each
 };
 
 // Reads both streams; throws io::InputError (see above).

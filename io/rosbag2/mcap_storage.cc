@@ -4,6 +4,7 @@
 #include <cstring>
 #include <limits>
 #include <map>
+#include <optional>
 #include <queue>
 
 #include "io/rosbag2/binary_file.h"
@@ -99,6 +100,21 @@ class McapStorage : public StorageReader {
   std::int64_t end_time_ns() const override { return end_ns_; }
   const std::string& path() const override { return file_.path(); }
   bool Next(StoredMessage* message) override;
+  // The blocks in file order, each one's messages in file order (before LoadBlock sorts them).
+  std::optional<ClockStepBack> RecordingClockStepBack(
+      std::map<std::string, std::int64_t>* latest_ns) override {
+    for (std::size_t seq = 0; seq < blocks_.size(); ++seq) {
+      if (blocks_[seq].message_count == 0) continue;
+      for (const Entry& e : LoadBlock(seq, /*sorted=*/false)->entries) {
+        const auto [it, first] = latest_ns->emplace(topics_[e.topic_index].name, e.time_ns);
+        if (!first && e.time_ns < it->second - kClockStepBackToleranceNs) {
+          return ClockStepBack{it->second, e.time_ns};
+        }
+        it->second = std::max(it->second, e.time_ns);
+      }
+    }
+    return std::nullopt;
+  }
 
  private:
   // Opening: one pass over the file.
@@ -128,7 +144,7 @@ class McapStorage : public StorageReader {
 
   // Iteration.
   void OpenBlocksUpTo(std::int64_t time_ns);
-  std::unique_ptr<OpenBlock> LoadBlock(std::size_t seq);
+  std::unique_ptr<OpenBlock> LoadBlock(std::size_t seq, bool sorted = true);
 
   [[noreturn]] void Fail(InputErrorKind kind, std::uint64_t offset, const std::string& what) const {
     ThrowBagError(kind, file_.path(), AtByte(offset) + what);
@@ -147,6 +163,7 @@ class McapStorage : public StorageReader {
   std::int64_t start_ns_ = 0;
   std::int64_t end_ns_ = 0;
   std::vector<std::uint8_t> scratch_;
+
 
   // Iteration state: blocks in order of their first message time, the next one to open, and a
   // heap of open blocks by their next message. `retired_` keeps the block of the message last
@@ -522,7 +539,7 @@ void McapStorage::FinishScan() {
 
 // Reads a block again (the scan checked it; a file changed since is still caught by the bounds
 // checks) and lists its messages by time.
-std::unique_ptr<OpenBlock> McapStorage::LoadBlock(std::size_t seq) {
+std::unique_ptr<OpenBlock> McapStorage::LoadBlock(std::size_t seq, bool sorted) {
   const Block& block = blocks_[seq];
   auto open = std::make_unique<OpenBlock>();
   open->seq = seq;
@@ -546,7 +563,7 @@ std::unique_ptr<OpenBlock> McapStorage::LoadBlock(std::size_t seq) {
                      m.data.size, static_cast<std::size_t>(topic_of_channel_[m.channel_id])});
               });
   const auto by_time = [](const Entry& a, const Entry& b) { return a.time_ns < b.time_ns; };
-  if (!std::is_sorted(open->entries.begin(), open->entries.end(), by_time)) {
+  if (sorted && !std::is_sorted(open->entries.begin(), open->entries.end(), by_time)) {
     std::stable_sort(open->entries.begin(), open->entries.end(), by_time);
   }
   return open;

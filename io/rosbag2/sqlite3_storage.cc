@@ -2,8 +2,13 @@
 
 #include <sqlite3.h>
 
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 
 #include "io/rosbag2/errors.h"
@@ -24,6 +29,41 @@ void CheckSqliteMagic(const std::string& path) {
     ThrowBagError(InputErrorKind::kBadHeader, path,
                   "bad magic: not an SQLite database (truncated or not a .db3 file)");
   }
+}
+
+// A reader must not write next to its input, and must work on a read-only copy. SQLite opens a
+// WAL-mode database (the recorder's resilient preset) by creating <db>-shm and <db>-wal beside
+// it even with SQLITE_OPEN_READONLY, and fails where it cannot. A finished bag does not change
+// while it is read: the URI parameter immutable=1 (sqlite.org/uri.html) makes SQLite take no
+// lock and create no file. What an unfinished recording left in a -wal file is not in the
+// database proper and immutable reads skip it: refused, so that no message is lost silently.
+void CheckNoPendingWal(const std::string& path) {
+  std::error_code ec;
+  const auto wal_bytes = std::filesystem::file_size(path + "-wal", ec);
+  if (!ec && wal_bytes > 0) {
+    ThrowBagError(InputErrorKind::kBadValue, path,
+                  "its write-ahead log " + path + "-wal holds " + std::to_string(wal_bytes) +
+                      " bytes not yet in the database (a recording that did not finish); "
+                      "checkpoint a copy first (sqlite3 <copy> 'PRAGMA wal_checkpoint')");
+  }
+}
+
+// file: URI of `path` (sqlite.org/uri.html 3.1): absolute, every byte outside the unreserved
+// set and '/' percent-encoded ('?', '#' and '%' would otherwise end or escape the path).
+std::string ImmutableUri(const std::string& path) {
+  const std::string absolute = std::filesystem::absolute(path).string();
+  std::string uri = "file:";
+  for (const char c : absolute) {
+    const unsigned char u = static_cast<unsigned char>(c);
+    if (std::isalnum(u) || std::strchr("/-._~", c) != nullptr) {
+      uri += c;
+    } else {
+      char hex[4];
+      std::snprintf(hex, sizeof hex, "%%%02X", u);
+      uri += hex;
+    }
+  }
+  return uri + "?immutable=1";
 }
 
 // SQLite's complaint, with what it means for a bag: a damaged file, or a database that is not
@@ -72,8 +112,10 @@ class Sqlite3Storage : public StorageReader {
  public:
   explicit Sqlite3Storage(const std::string& path) : path_(path) {
     CheckSqliteMagic(path);
+    CheckNoPendingWal(path);
     sqlite3* db = nullptr;
-    const int rc = sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr);
+    const int rc = sqlite3_open_v2(ImmutableUri(path).c_str(), &db,
+                                   SQLITE_OPEN_READONLY | SQLITE_OPEN_URI, nullptr);
     db_.reset(db);
     if (rc != SQLITE_OK) {
       ThrowBagError(InputErrorKind::kMissingFile, path,
@@ -90,6 +132,21 @@ class Sqlite3Storage : public StorageReader {
   std::int64_t end_time_ns() const override { return end_ns_; }
   const std::string& path() const override { return path_; }
   bool Next(StoredMessage* message) override;
+  // Write order is the messages table's id order (rosbag2 inserts them as they arrive).
+  std::optional<ClockStepBack> RecordingClockStepBack(
+      std::map<std::string, std::int64_t>* latest_ns) override {
+    Statement in_write_order(db_.get(), "SELECT topic_id, timestamp FROM messages ORDER BY id",
+                             path_);
+    while (in_write_order.Step()) {
+      const std::string& topic =
+          topics_[TopicIndex(sqlite3_column_int64(in_write_order.get(), 0))].name;
+      const std::int64_t t = sqlite3_column_int64(in_write_order.get(), 1);
+      const auto [it, first] = latest_ns->emplace(topic, t);
+      if (!first && t < it->second - kClockStepBackToleranceNs) return ClockStepBack{it->second, t};
+      it->second = std::max(it->second, t);
+    }
+    return std::nullopt;
+  }
 
  private:
   void ReadTopics();

@@ -1,0 +1,91 @@
+// `fitcal fleet`: calibrations of two robots over eight weeks. Robot r1's left wheel wears (its
+// radius shrinks 0.1 mm a week, beside a night-to-night scatter of 0.02 mm): a trend; its
+// separation only scatters: none. Robot r2 is stable but one night's calibration went wrong
+// (radius 2 mm off): an outlier, and not a trend.
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cstdio>
+#include <random>
+
+#include "io/input_error.h"
+#include "models/model_registry.h"
+#include "tests/test_files.h"
+#include "tools/fleet_command.h"
+
+namespace fitcal {
+namespace {
+
+const char* kRobotYaml = R"(model: diff_drive
+name: NAME
+wheels:
+  - {name: right, radius_m: 0.042}
+  - {name: left, radius_m: 0.042}
+wheel_separation_m: 0.200
+bounds: {radius_m: [0.030, 0.050], wheel_separation_m: [0.180, 0.220]}
+)";
+
+const tools::FleetSeries& Find(const std::vector<tools::FleetSeries>& all, const std::string& robot,
+                               const std::string& parameter) {
+  for (const tools::FleetSeries& s : all) {
+    if (s.robot == robot && s.parameter == parameter) return s;
+  }
+  throw std::runtime_error("no series " + robot + " " + parameter);
+}
+
+TEST(Fleet, FlagsTrendsAndOutliers) {
+  testing::TempDir tmp;
+  std::mt19937 rng(7);
+  std::normal_distribution<double> scatter(0.0, 0.00002);
+  for (const std::string robot : {"r1", "r2"}) {
+    std::string yaml = kRobotYaml;
+    yaml.replace(yaml.find("NAME"), 4, robot);
+    const RobotModelPtr model = ReadRobotModel(YAML::Load(yaml), "robot.yaml");
+    for (int week = 0; week < 8; ++week) {
+      std::vector<double> p = {0.0420 + scatter(rng), 0.0420 + scatter(rng), 0.2 + scatter(rng)};
+      if (robot == "r1") p[1] -= 0.0001 * week;
+      if (robot == "r2" && week == 5) p[0] += 0.002;
+      char date[16];
+      std::snprintf(date, sizeof date, "2026-%02d-%02d", 3 + week / 4, 1 + 7 * (week % 4));
+      const std::string block =
+          "calibration:\n  training_repetitions: [1]\n  cf_validation: {before: 0.05, after: 0.01}\n";
+      tmp.Write("fleet/" + robot + "/" + date + "/cal.yaml", model->RobotYaml(p, block));
+    }
+  }
+  tmp.Write("fleet/notes.yaml", "just: notes\n");  // found by the search, not a calibration
+  const std::vector<tools::FleetSeries> all = tools::ReadFleet({tmp.Path("fleet")});
+  const tools::FleetSeries& worn = Find(all, "r1", "r_left");
+  EXPECT_EQ(worn.values.size(), 8u);
+  EXPECT_TRUE(worn.trend);
+  // 0.1 mm a week: -0.43 mm per 30 days, to the scatter's standard error (~0.01 mm).
+  EXPECT_NEAR(worn.slope_per_30_days, -0.0001 * 30 / 7, 0.00005);
+  EXPECT_TRUE(worn.outliers.empty());
+  EXPECT_FALSE(Find(all, "r1", "wheel_separation").trend);
+  const tools::FleetSeries& bad_night = Find(all, "r2", "r_right");
+  ASSERT_EQ(bad_night.outliers.size(), 1u);
+  EXPECT_EQ(bad_night.outliers[0], "2026-04-08");
+  EXPECT_FALSE(bad_night.trend);
+  EXPECT_FALSE(Find(all, "r2", "r_left").trend);
+  const std::string table = tools::FleetTable(all);
+  EXPECT_NE(table.find("TREND"), std::string::npos) << table;
+  EXPECT_NE(table.find("OUTLIER 2026-04-08"), std::string::npos) << table;
+  EXPECT_NE(table.find("cf_validation_after"), std::string::npos) << table;
+
+  // A report's metrics.json is read too; beside its calibration of the same date it counts once.
+  tmp.Write("fleet/r1/2026-04-22/report/metrics.json",
+            R"({"robot": "r1", "parameters": [{"name": "r_left", "calibrated_m": 0.0412},
+                {"name": "wheel_separation", "calibrated_m": 0.2}],
+               "summary": [{"group": "all validation runs", "after": {"cf": 0.01}}]})");
+  tmp.Write("fleet/r1/2026-04-29/report/metrics.json",
+            R"({"robot": "r1", "parameters": [{"name": "r_left", "calibrated_m": 0.0411}]})");
+  const std::vector<tools::FleetSeries> with_reports = tools::ReadFleet({tmp.Path("fleet")});
+  EXPECT_EQ(Find(with_reports, "r1", "r_left").values.size(), 9u);  // + 2026-04-29 only
+  EXPECT_EQ(Find(with_reports, "r1", "r_left").values.back(), 0.0411);
+
+  tmp.Write("undated/cal.yaml", testing::ReadFileBytes(worn.files[0]));
+  EXPECT_THROW(tools::ReadFleet({tmp.Path("undated/cal.yaml")}), io::InputError);
+}
+
+}  // namespace
+}  // namespace fitcal

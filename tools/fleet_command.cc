@@ -1,0 +1,273 @@
+#include "tools/fleet_command.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <regex>
+#include <stdexcept>
+
+#include "io/input_error.h"
+#include "io/yaml_reader.h"
+#include "models/model_registry.h"
+
+namespace fitcal::tools {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A calibration further than this many robust sigmas from the robot's median is an outlier
+// (a Gaussian value lies beyond 5 sigma once in 1.7 million).
+constexpr double kOutlierRobustZ = 5.0;
+constexpr std::size_t kMinForOutlier = 5;
+// A slope this many standard errors from zero is a trend (|t| > 3: p < 0.01 for n >= 6).
+constexpr double kTrendT = 3.0;
+constexpr std::size_t kMinForTrend = 4;
+constexpr const char* kCfRow = "cf_validation_after";
+
+struct Calibration {
+  std::string file, robot, date;
+  std::vector<std::pair<std::string, double>> values;  // parameter name -> value
+};
+
+// Days since 1970-01-01 of a proleptic Gregorian YYYY-MM-DD (Howard Hinnant's days_from_civil).
+long DaysFromCivil(int y, int m, int d) {
+  y -= m <= 2;
+  const long era = (y >= 0 ? y : y - 399) / 400;
+  const long yoe = y - era * 400;
+  const long doy = (153 * (m + (m > 2 ? -3 : 9)) + 2) / 5 + d - 1;
+  const long doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+  return era * 146097 + doe - 719468;
+}
+
+long Days(const std::string& date) {
+  return DaysFromCivil(std::stoi(date.substr(0, 4)), std::stoi(date.substr(5, 2)),
+                       std::stoi(date.substr(8, 2)));
+}
+
+std::string DateOf(const std::string& path) {
+  static const std::regex kDate("(19|20)[0-9]{2}-(0[1-9]|1[0-2])-(0[1-9]|[12][0-9]|3[01])");
+  std::smatch m;
+  if (!std::regex_search(path, m, kDate)) {
+    throw io::InputError(io::InputErrorKind::kBadPath, path, 0,
+                         "no date (YYYY-MM-DD) in its path; fleet dates each calibration by its "
+                         "path, e.g. robots/r1/2026-05-01/cal.yaml");
+  }
+  return m.str();
+}
+
+Calibration ReadCalibration(const std::string& path) {
+  const YAML::Node root = io::LoadYamlFile(path);
+  const RobotModelPtr model = ReadRobotModel(root, path);
+  Calibration c;
+  c.file = path;
+  c.robot = model->robot().name;
+  c.date = DateOf(path);
+  const Robot& robot = model->robot();
+  for (std::size_t k = 0; k < robot.parameters.size(); ++k) {
+    c.values.emplace_back(robot.parameters[k].name, robot.nominal[k]);
+  }
+  const YAML::Node cf = root["calibration"]["cf_validation"];
+  if (cf && cf.IsMap() && cf["after"]) {
+    c.values.emplace_back(kCfRow, io::YamlDouble(cf["after"], path, "calibration.cf_validation"));
+  }
+  return c;
+}
+
+// A report's metrics.json (tools/report_command.h): the robot, each parameter's calibrated value
+// (key calibrated_<unit>; degrees turned to radians, as the model holds angles) and the held-out
+// CF of "all validation runs". JSON is YAML: yaml-cpp reads it.
+Calibration ReadMetricsJson(const std::string& path) {
+  const YAML::Node root = io::LoadYamlFile(path);
+  Calibration c;
+  c.file = path;
+  c.date = DateOf(path);
+  if (!root.IsMap() || !root["robot"] || !root["parameters"].IsSequence()) {
+    throw io::InputError(io::InputErrorKind::kMissingKey, path, 1,
+                         "not a fitcal report's metrics.json (robot, parameters)");
+  }
+  c.robot = root["robot"].as<std::string>();
+  for (const YAML::Node& p : root["parameters"]) {
+    for (const auto& kv : p) {
+      const std::string key = kv.first.as<std::string>();
+      if (key.rfind("calibrated_", 0) != 0) continue;
+      const double v = io::YamlDouble(kv.second, path, "parameters." + key);
+      const bool degrees = key.size() > 4 && key.compare(key.size() - 4, 4, "_deg") == 0;
+      c.values.emplace_back(p["name"].as<std::string>(), degrees ? v * M_PI / 180.0 : v);
+    }
+  }
+  for (const YAML::Node& g : root["summary"]) {
+    if (g["group"] && g["group"].as<std::string>() == "all validation runs" && g["after"]) {
+      c.values.emplace_back(kCfRow, io::YamlDouble(g["after"]["cf"], path, "summary.after.cf"));
+    }
+  }
+  return c;
+}
+
+bool IsMetricsJson(const fs::path& p) { return p.filename() == "metrics.json"; }
+
+bool IsCalibrationYaml(const fs::path& p) {
+  if (p.extension() != ".yaml" && p.extension() != ".yml") return false;
+  try {
+    return static_cast<bool>(YAML::LoadFile(p.string())["calibration"]);
+  } catch (const YAML::Exception&) {
+    return false;  // not ours to judge when found by searching
+  }
+}
+
+std::vector<std::string> Files(const std::vector<std::string>& inputs) {
+  std::vector<std::string> files;
+  for (const std::string& in : inputs) {
+    if (!fs::is_directory(in)) {
+      files.push_back(in);
+      continue;
+    }
+    for (const auto& e : fs::recursive_directory_iterator(in)) {
+      if (e.is_regular_file() && (IsCalibrationYaml(e.path()) || IsMetricsJson(e.path()))) {
+        files.push_back(e.path().string());
+      }
+    }
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+void FlagOutliers(FleetSeries* s) {
+  if (s->values.size() < kMinForOutlier) return;
+  const double median = Median(s->values);
+  std::vector<double> deviation;
+  for (double v : s->values) deviation.push_back(std::abs(v - median));
+  const double sigma = 1.4826 * Median(deviation);
+  if (!(sigma > 0.0)) return;
+  for (std::size_t i = 0; i < s->values.size(); ++i) {
+    if (std::abs(s->values[i] - median) > kOutlierRobustZ * sigma) {
+      s->outliers.push_back(s->dates[i]);
+    }
+  }
+}
+
+// Ordinary least squares of value on days, outliers left out (one bad night is not a trend).
+void FlagTrend(FleetSeries* s) {
+  std::vector<double> x, y;
+  for (std::size_t i = 0; i < s->values.size(); ++i) {
+    if (std::find(s->outliers.begin(), s->outliers.end(), s->dates[i]) != s->outliers.end()) {
+      continue;
+    }
+    x.push_back(static_cast<double>(Days(s->dates[i])));
+    y.push_back(s->values[i]);
+  }
+  const std::size_t n = x.size();
+  if (n < kMinForTrend) return;
+  double mx = 0, my = 0;
+  for (std::size_t i = 0; i < n; ++i) mx += x[i] / n, my += y[i] / n;
+  double sxx = 0, sxy = 0;
+  for (std::size_t i = 0; i < n; ++i) sxx += (x[i] - mx) * (x[i] - mx), sxy += (x[i] - mx) * (y[i] - my);
+  if (!(sxx > 0)) return;
+  const double slope = sxy / sxx;
+  double rss = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double r = y[i] - my - slope * (x[i] - mx);
+    rss += r * r;
+  }
+  const double scatter = std::sqrt(rss / static_cast<double>(n - 2));
+  const double standard_error = scatter / std::sqrt(sxx);
+  const double span_days = *std::max_element(x.begin(), x.end()) - *std::min_element(x.begin(), x.end());
+  s->slope_per_30_days = 30.0 * slope;
+  s->has_slope = true;
+  s->trend = std::abs(slope) > kTrendT * standard_error &&
+             std::abs(slope) * span_days > scatter;
+}
+
+}  // namespace
+
+std::vector<FleetSeries> ReadFleet(const std::vector<std::string>& inputs) {
+  std::vector<Calibration> all;
+  for (const std::string& f : Files(inputs)) {
+    all.push_back(IsMetricsJson(f) ? ReadMetricsJson(f) : ReadCalibration(f));
+  }
+  if (all.empty()) throw std::invalid_argument("no calibrated YAML found in the inputs");
+  std::stable_sort(all.begin(), all.end(), [](const Calibration& a, const Calibration& b) {
+    return std::tie(a.robot, a.date) < std::tie(b.robot, b.date);
+  });
+  std::vector<FleetSeries> out;
+  std::map<std::pair<std::string, std::string>, std::size_t> index;
+  for (const Calibration& c : all) {
+    for (const auto& [name, value] : c.values) {
+      const auto key = std::make_pair(c.robot, name);
+      auto it = index.find(key);
+      if (it == index.end()) {
+        it = index.emplace(key, out.size()).first;
+        out.push_back({c.robot, name, {}, {}, {}, {}, false, false, 0.0});
+      }
+      FleetSeries& s = out[it->second];
+      // A calibration and its report (metrics.json) on the same date are one result.
+      if (!s.dates.empty() && s.dates.back() == c.date) continue;
+      s.dates.push_back(c.date);
+      s.values.push_back(value);
+      s.files.push_back(c.file);
+    }
+  }
+  for (FleetSeries& s : out) {
+    FlagOutliers(&s);
+    FlagTrend(&s);
+  }
+  return out;
+}
+
+std::string FleetTable(const std::vector<FleetSeries>& series) {
+  std::string out, robot;
+  char line[400];
+  for (const FleetSeries& s : series) {
+    if (s.robot != robot) {
+      robot = s.robot;
+      std::snprintf(line, sizeof line, "\n%s\n  %-22s %3s  %-10s %12s  %-10s %12s %12s %14s  %s\n",
+                    robot.c_str(), "parameter", "n", "first", "value", "last", "value", "median",
+                    "slope/30 d", "flags");
+      out += line;
+    }
+    std::string flags = s.trend ? "TREND" : "";
+    for (const std::string& d : s.outliers) flags += (flags.empty() ? "" : " ") + ("OUTLIER " + d);
+    char slope[32] = "-";
+    if (s.has_slope) std::snprintf(slope, sizeof slope, "%+.4g", s.slope_per_30_days);
+    std::snprintf(line, sizeof line, "  %-22s %3zu  %-10s %12.6g  %-10s %12.6g %12.6g %14s  %s\n",
+                  s.parameter.c_str(), s.values.size(), s.dates.front().c_str(), s.values.front(),
+                  s.dates.back().c_str(), s.values.back(), Median(s.values), slope,
+                  flags.c_str());
+    out += line;
+  }
+  return out;
+}
+
+void AddFleetOptions(CLI::App& app, FleetOptions& o) {
+  app.add_option("inputs", o.inputs,
+                 "Calibrated robot YAMLs, or directories searched for them (the date: the first "
+                 "YYYY-MM-DD in each path)")
+      ->required();
+}
+
+int RunFleetCommand(const FleetOptions& o) {
+  constexpr const char* kPrefix = "fitcal fleet: ";
+  try {
+    std::cout << FleetTable(ReadFleet(o.inputs)).substr(1);
+    return 0;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << kPrefix << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << kPrefix << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace fitcal::tools
