@@ -145,10 +145,10 @@ std::vector<Point2> Thinned(const std::vector<Point2>& line, std::size_t most) {
   return out;
 }
 
-// Points per polyline of the figure of every run: ~60,000 points in all (~1 MB of SVG), at
+// Points per polyline of the figure of every run: ~40,000 points in all (~0.6 MB of SVG), at
 // least 40 per run so that a circle still looks round.
 std::size_t PointsPerRun(std::size_t runs, std::size_t lines_per_run) {
-  const std::size_t total = 60000;
+  const std::size_t total = 40000;
   return std::max<std::size_t>(
       40, std::min<std::size_t>(400, total / std::max<std::size_t>(1, runs * lines_per_run)));
 }
@@ -606,7 +606,8 @@ const char* const kStyle =
     // A phone (a 390 px screen): figures keep their drawn size, so that their 11-15 px text
     // stays readable, and scroll sideways in their box instead of shrinking to a third.
     "@media (max-width:700px){body{padding:8px}svg{max-width:none}"
-    ".figs,figure{overflow-x:auto;max-width:100%}figure.wide svg{min-width:0}}\n"
+    ".figs,figure{overflow-x:auto;max-width:100%}.figs>svg{flex-shrink:0}"
+    "figure.wide svg{min-width:0}}\n"
     ".figs.flagged{border-left:4px solid #b00020;padding-left:6px}\n";
 
 // A table inside a horizontally scrolling box: wide tables scroll on a phone instead of pushing
