@@ -517,13 +517,14 @@ std::string HeatMapSvg(const std::string& title, const std::vector<std::string>&
       const double y = top + static_cast<double>(i) * cell_px;
       out << "<rect x=\"" << Num(x) << "\" y=\"" << Num(y) << "\" width=\"" << cell_px
           << "\" height=\"" << cell_px << "\" fill=\"" << colour(v) << "\" stroke=\"#fff\"/>";
-      // Two decimals, three where two would round a correlation that is not exactly 1 to
-      // 1.00 (a strongly correlated pair must not read as the diagonal).
+      // Two decimals, four (smaller) where two would round a correlation that is not exactly 1
+      // to 1.00: a strongly correlated pair (0.9993 on a differential drive's circles) must not
+      // read as the diagonal.
       char buf[16];
       const bool near_one = i != j && std::abs(v) >= 0.995 && std::abs(v) < 1.0;
-      std::snprintf(buf, sizeof buf, near_one ? "%.3f" : "%.2f", v);
+      std::snprintf(buf, sizeof buf, near_one ? "%.4f" : "%.2f", v);
       const bool dark = std::abs((v - lo) / (hi - lo) * 2.0 - 1.0) > 0.6;
-      Text(out, x + cell_px / 2.0, y + cell_px / 2.0 + 4, buf, "middle", 11,
+      Text(out, x + cell_px / 2.0, y + cell_px / 2.0 + 4, buf, "middle", near_one ? 10 : 11,
            dark ? " fill=\"#fff\"" : "");
     }
   }

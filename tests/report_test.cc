@@ -420,17 +420,17 @@ TEST(SvgPlotTest, BarLabelsNeverOverlap) {
 }
 
 // The defect seen on three-parameter robots: the heat map was narrower than its title (clipped),
-// and correlations of 0.998 read 1.00 like the diagonal.
+// and the diff drive's correlations of 0.9993-0.9999 read 1.00 like the diagonal.
 TEST(SvgPlotTest, ThreeParameterHeatMapIsWholeAndReadable) {
   const std::string title = "Correlation of the fitted parameters (-1 blue, +1 red)";
-  const std::vector<std::vector<double>> c = {{1.0, 0.998, -0.9991}, {0.998, 1.0, 0.5},
+  const std::vector<std::vector<double>> c = {{1.0, 0.9999, -0.9991}, {0.9999, 1.0, 0.5},
                                               {-0.9991, 0.5, 1.0}};
   const std::string svg = HeatMapSvg(title, {"r_R", "r_L", "b"}, c);
   std::smatch m;
   ASSERT_TRUE(std::regex_search(svg, m, std::regex("viewBox=\"0 0 ([0-9]+) ")));
   EXPECT_GE(std::stod(m[1]), TextWidthPx(title, 15));
-  EXPECT_NE(svg.find(">0.998<"), std::string::npos);
-  EXPECT_NE(svg.find(">-0.999<"), std::string::npos);
+  EXPECT_NE(svg.find(">0.9999<"), std::string::npos);  // the recorded 4 digits, not 1.00
+  EXPECT_NE(svg.find(">-0.9991<"), std::string::npos);
   EXPECT_NE(svg.find(">1.00<"), std::string::npos);  // the diagonal
   EXPECT_NE(svg.find(">0.50<"), std::string::npos);
 }
