@@ -115,7 +115,8 @@ void HtmlStructure(std::ostringstream& h, const DiagnosePageData& d) {
   OpenTable(h);
   h << "<tr><th>test</th><th>statistic</th><th>p</th><th>result</th><th>what it says</th></tr>\n";
   for (const DiagnoseStructureTest& t : d.structure) {
-    h << "<tr><td>" << EscapeXml(t.name) << "</td><td>" << EscapeXml(t.detail) << "</td><td>"
+    h << "<tr><td>" << EscapeXml(t.name) << "</td><td class=\"k\">" << EscapeXml(t.detail)
+      << "</td><td>"
       << Fmt("%.2g", t.p_value) << "</td><td" << (t.significant ? " class=\"worse\">structure" : ">none found")
       << "</td><td class=\"k\">" << EscapeXml(t.significant ? t.meaning : "") << "</td></tr>\n";
   }
@@ -137,7 +138,7 @@ void HtmlCandidates(std::ostringstream& h, const DiagnosePageData& d) {
        "improvement</th><th>p</th><th>threshold</th><th>&Delta;BIC</th><th>explains</th>"
        "<th>decision</th></tr>\n";
   for (const DiagnoseCandidate& c : d.candidates) {
-    h << "<tr><td>" << c.round << "</td><td>" << EscapeXml(c.effect) << "</td><td>"
+    h << "<tr><td>" << c.round << "</td><td class=\"k\">" << EscapeXml(c.effect) << "</td><td>"
       << Fmt("%.3f", c.separable_fraction) << (c.resolvable ? "" : " (not resolvable)")
       << "</td><td>" << (c.fitted ? "yes" : "no") << "</td><td>"
       << (c.fitted ? Fmt("%.3g", c.mean_improvement) : "-") << "</td><td>"
@@ -162,13 +163,17 @@ void HtmlHeldOut(std::ostringstream& h, const DiagnosePageData& d) {
   const double ate_b = HeldOutMean(d.held_out, &DiagnoseHeldOutRun::ate_before_m);
   const double ate_a = HeldOutMean(d.held_out, &DiagnoseHeldOutRun::ate_after_m);
   int worse = 0;
-  for (const DiagnoseHeldOutRun& r : d.held_out) worse += r.cf_after > r.cf_before ? 1 : 0;
+  // As the report's GotWorse: the CF or the ATE rose.
+  for (const DiagnoseHeldOutRun& r : d.held_out) {
+    worse += r.cf_after > r.cf_before || r.ate_after_m > r.ate_before_m ? 1 : 0;
+  }
   h << "<h2 id=\"heldout\">Before and after on the held-out runs</h2>\n<ul class=\"key\">"
     << "<li>CF (Eq. 14, mean over " << d.held_out.size() << " runs): <b>" << Fmt("%.4f", cf_b)
     << " &rarr; " << Fmt("%.4f", cf_a) << "</b> (" << ChangeText(cf_b, cf_a) << ")</li>"
     << "<li>ATE RMSE (no alignment): <b>" << Fmt("%.1f", 1e3 * ate_b) << " &rarr; "
     << Fmt("%.1f mm", 1e3 * ate_a) << "</b> (" << ChangeText(ate_b, ate_a) << ")</li><li"
-    << (worse > 0 ? " class=\"worse\"" : "") << ">held-out runs whose CF rose: " << worse
+    << (worse > 0 ? " class=\"worse\"" : "") << ">held-out runs that got worse (CF or ATE rose): "
+    << worse
     << " of " << d.held_out.size() << "</li></ul>\n<p>These are computed as <code>fitcal "
        "report</code> computes them (the odometry replayed from the window's start and sampled "
        "at the ground-truth times, Palacin Eq. 8-14), so <code>report</code> on "

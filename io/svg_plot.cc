@@ -485,12 +485,18 @@ std::string HeatMapSvg(const std::string& title, const std::vector<std::string>&
                        const std::vector<std::vector<double>>& values, double lo, double hi,
                        int cell_px) {
   const double n = static_cast<double>(labels.size());
-  const double left = 70, top = 40, bar_w = 18, bar_gap = 30;
+  const double top = 40, bar_w = 18, bar_gap = 30;
   const double grid = n * cell_px;
+  // Room for the longest row label on the left ("wheel_separation" was cut at 70 px); column
+  // labels upright under their cells when they do not fit a cell's width (they overlapped).
+  double widest = 0.0;
+  for (const std::string& l : labels) widest = std::max(widest, TextWidthPx(l, 12));
+  const double left = std::max(70.0, widest + 12);
+  const CategoryLabels columns = LayOutCategoryLabels(labels, cell_px);
   // As wide as the title needs: a three-parameter matrix is narrower than its title.
   const int width = static_cast<int>(
       std::max(left + grid + bar_gap + bar_w + 50, TextWidthPx(title, 15) + 20));
-  const int height = static_cast<int>(top + grid + 20);
+  const int height = static_cast<int>(top + grid + 20 + columns.extra_height);
   auto colour = [&](double v) {
     // Diverging blue (lo) - white (middle) - red (hi).
     double u = (v - lo) / (hi - lo);
@@ -510,7 +516,7 @@ std::string HeatMapSvg(const std::string& title, const std::vector<std::string>&
   for (std::size_t i = 0; i < labels.size(); ++i) {
     const double c = static_cast<double>(i) * cell_px + cell_px / 2.0;
     Text(out, left - 6, top + c + 4, labels[i], "end", 12);
-    Text(out, left + c, top + grid + 15, labels[i], "middle", 12);
+    CategoryLabel(out, columns, left + c, top + grid, labels[i]);
     for (std::size_t j = 0; j < labels.size(); ++j) {
       const double v = i < values.size() && j < values[i].size() ? values[i][j] : 0.0;
       const double x = left + static_cast<double>(j) * cell_px;

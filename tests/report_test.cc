@@ -429,6 +429,17 @@ TEST(SvgPlotTest, ThreeParameterHeatMapIsWholeAndReadable) {
   std::smatch m;
   ASSERT_TRUE(std::regex_search(svg, m, std::regex("viewBox=\"0 0 ([0-9]+) ")));
   EXPECT_GE(std::stod(m[1]), TextWidthPx(title, 15));
+  // Row labels start inside the figure; column labels do not overlap (the diff drive's
+  // "wheel_separation" was cut on the left and ran into "r_left" below).
+  const std::vector<std::string> labels = {"r_right", "r_left", "wheel_separation"};
+  const std::string named = HeatMapSvg(title, labels, c);
+  std::smatch row;
+  ASSERT_TRUE(std::regex_search(named, row, std::regex("<text x=\"([0-9.]+)\"[^>]*text-anchor=\"end\""
+                                                       "[^>]*>wheel_separation<")));
+  EXPECT_GE(std::stod(row[1]), TextWidthPx("wheel_separation", 12));
+  const std::string columns_only =
+      std::regex_replace(named, std::regex("<text [^>]*text-anchor=\"end\">[^<]*</text>"), "");
+  EXPECT_EQ(LabelOverlap(columns_only, labels), "");
   EXPECT_NE(svg.find(">0.9999<"), std::string::npos);  // the recorded 4 digits, not 1.00
   EXPECT_NE(svg.find(">-0.9991<"), std::string::npos);
   EXPECT_NE(svg.find(">1.00<"), std::string::npos);  // the diagonal
@@ -532,7 +543,7 @@ TEST(DiagnosePageTest, PageAndMetricsJson) {
   EXPECT_EQ(CheckWellFormed(html), "");
   for (const char* id : {"id=\"structure\"", "id=\"effects\"", "id=\"heldout\"",
                          "id=\"unexplained\"", "held at nominal", "&lt;but&gt;",
-                         "held-out runs whose CF rose: 1 of 2"}) {
+                         "held-out runs that got worse (CF or ATE rose): 1 of 2"}) {
     EXPECT_NE(html.find(id), std::string::npos) << id;
   }
   std::size_t svgs = 0;
