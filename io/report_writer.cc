@@ -585,6 +585,9 @@ const char* const kStyle =
     "table{border-collapse:collapse;margin:8px 0 16px}\n"
     "th,td{border:1px solid #bbb;padding:3px 8px;text-align:right}\n"
     "th:first-child,td:first-child,td.k{text-align:left}\n"
+    // Numbers never break ("4.7e-" / "14"); text cells keep a readable measure on a phone and
+    // the table scrolls instead of squeezing them to one word a line.
+    "td:not(:first-child):not(.k){white-space:nowrap}td.k{min-width:12em}\n"
     "th{background:#f0f0f0}\n"
     "code{overflow-wrap:anywhere}\n"
     ".warn{background:#fff3cd;border:1px solid #e0b000;padding:8px 12px;white-space:pre-wrap;"
