@@ -1156,6 +1156,21 @@ void MdVerdict(std::ostringstream& m, const ReportData& d) {
     m << "- **" << r.level << "** " << r.check << ": " << r.message << "\n";
   }
   m << "\n";
+  if (d.summary.empty()) return;
+  // The key numbers of the page (HtmlKeyNumbers), in the same words.
+  const ReportSummaryRow& all = d.summary.back();
+  m << "- ATE RMSE (mean over " << all.runs << " held-out runs, no alignment): "
+    << Fmt("%.1f", 1e3 * all.before.rms_distance_m) << " -> "
+    << Fmt("%.1f mm", 1e3 * all.after.rms_distance_m) << " ("
+    << ChangePercentText(all.before.rms_distance_m, all.after.rms_distance_m) << ")\n";
+  std::string worse;
+  int n = 0;
+  for (const ReportRun& r : d.runs) {
+    if (!GotWorse(r)) continue;
+    worse += (n++ ? ", " : "") + r.id;
+  }
+  m << "- held-out runs that got worse: " << n << " of " << d.runs.size()
+    << (n > 0 ? " (" + worse + ")" : "") << "\n\n";
 }
 
 void MdSummary(std::ostringstream& m, const ReportData& d) {

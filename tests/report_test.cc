@@ -474,6 +474,8 @@ TEST(ReportTest, HeldOutRunsThatGotWorseAreFlagged) {
   const std::string html = ReportHtml(d);
   EXPECT_NE(html.find("1 of 3 held-out runs got worse"), std::string::npos);
   EXPECT_NE(html.find("held-out runs that got worse: 1 of 3"), std::string::npos);
+  EXPECT_NE(ReportMarkdown(d).find("held-out runs that got worse: 1 of 3 (" + d.runs[1].id + ")"),
+            std::string::npos);
   const std::size_t section = html.find("id=\"worse\"");
   ASSERT_NE(section, std::string::npos);
   EXPECT_NE(html.find("<td>" + d.runs[1].id + "</td>", section), std::string::npos);
