@@ -116,9 +116,9 @@ void HtmlStructure(std::ostringstream& h, const DiagnosePageData& d) {
   h << "<tr><th>test</th><th>statistic</th><th>p</th><th>result</th><th>what it says</th></tr>\n";
   for (const DiagnoseStructureTest& t : d.structure) {
     h << "<tr><td>" << EscapeXml(t.name) << "</td><td class=\"k\">" << EscapeXml(t.detail)
-      << "</td><td>"
-      << Fmt("%.2g", t.p_value) << "</td><td" << (t.significant ? " class=\"worse\">structure" : ">none found")
-      << "</td><td class=\"k\">" << EscapeXml(t.significant ? t.meaning : "") << "</td></tr>\n";
+      << "</td><td>" << Fmt("%.2g", t.p_value) << "</td><td"
+      << (t.significant ? " class=\"worse\">structure" : ">none found") << "</td><td class=\"k\">"
+      << EscapeXml(t.significant ? t.meaning : "") << "</td></tr>\n";
   }
   CloseTable(h);
   h << "<figure>" << FinalErrorsSvg(d)
@@ -145,8 +145,7 @@ void HtmlCandidates(std::ostringstream& h, const DiagnosePageData& d) {
       << (c.fitted ? Fmt("%.2g", c.p_value) : "-") << "</td><td>" << Fmt("%.2g", c.threshold)
       << "</td><td>" << (c.fitted ? Fmt("%+.1f", c.delta_bic) : "-") << "</td><td>"
       << (c.explains ? "yes" : "no") << "</td><td class=\"k" << (c.accepted ? " better" : "")
-      << "\">" << (c.accepted ? "<b>accepted</b> " : "") << EscapeXml(c.decision)
-      << "</td></tr>\n";
+      << "\">" << (c.accepted ? "<b>accepted</b> " : "") << EscapeXml(c.decision) << "</td></tr>\n";
   }
   CloseTable(h);
   const std::string evidence = EvidenceSvg(d);
@@ -172,9 +171,9 @@ void HtmlHeldOut(std::ostringstream& h, const DiagnosePageData& d) {
     << " &rarr; " << Fmt("%.4f", cf_a) << "</b> (" << ChangeText(cf_b, cf_a) << ")</li>"
     << "<li>ATE RMSE (no alignment): <b>" << Fmt("%.1f", 1e3 * ate_b) << " &rarr; "
     << Fmt("%.1f mm", 1e3 * ate_a) << "</b> (" << ChangeText(ate_b, ate_a) << ")</li><li"
-    << (worse > 0 ? " class=\"worse\"" : "") << ">held-out runs that got worse (CF or ATE rose): "
-    << worse
-    << " of " << d.held_out.size() << "</li></ul>\n<p>These are computed as <code>fitcal "
+    << (worse > 0 ? " class=\"worse\"" : "")
+    << ">held-out runs that got worse (CF or ATE rose): " << worse << " of " << d.held_out.size()
+    << "</li></ul>\n<p>These are computed as <code>fitcal "
        "report</code> computes them (the odometry replayed from the window's start and sampled "
        "at the ground-truth times, Palacin Eq. 8-14), so <code>report</code> on "
        "<code>calibrated.yaml</code> and the same runs prints the same CF. The result gate below "
@@ -219,8 +218,7 @@ void HtmlCalibration(std::ostringstream& h, const DiagnosePageData& d) {
 
 }  // namespace
 
-double HeldOutMean(const std::vector<DiagnoseHeldOutRun>& runs,
-                   double DiagnoseHeldOutRun::*field) {
+double HeldOutMean(const std::vector<DiagnoseHeldOutRun>& runs, double DiagnoseHeldOutRun::*field) {
   double sum = 0.0;
   for (const DiagnoseHeldOutRun& r : runs) sum += r.*field;
   return runs.empty() ? 0.0 : sum / static_cast<double>(runs.size());
@@ -263,7 +261,8 @@ std::string DiagnoseMetricsJson(const DiagnosePageData& d) {
   std::ostringstream j;
   j << "{\n  \"version\": " << kMetricsJsonVersion << ",\n  \"kind\": \"diagnose\""
     << ",\n  \"tool_version\": " << JsonStringOf(d.tool_version)
-    << ",\n  \"dataset\": " << JsonStringOf(d.dataset) << ",\n  \"split\": " << JsonStringOf(d.split)
+    << ",\n  \"dataset\": " << JsonStringOf(d.dataset)
+    << ",\n  \"split\": " << JsonStringOf(d.split)
     << ",\n  \"robot\": " << JsonStringOf(d.robot_name)
     << ",\n  \"verdict\": {\"level\": " << JsonStringOf(d.level)
     << ", \"message\": " << JsonStringOf(d.conclusion) << "}"
@@ -300,7 +299,8 @@ std::string DiagnoseMetricsJson(const DiagnosePageData& d) {
   j << "],\n  \"candidates\": [";
   for (std::size_t i = 0; i < d.candidates.size(); ++i) {
     const DiagnoseCandidate& c = d.candidates[i];
-    j << (i ? "," : "") << "\n    {\"round\": " << c.round << ", \"effect\": " << JsonStringOf(c.effect)
+    j << (i ? "," : "") << "\n    {\"round\": " << c.round
+      << ", \"effect\": " << JsonStringOf(c.effect)
       << ", \"fitted\": " << (c.fitted ? "true" : "false")
       << ", \"p_value\": " << (c.fitted ? JsonNumberOf(c.p_value) : "null")
       << ", \"accepted\": " << (c.accepted ? "true" : "false") << "}";

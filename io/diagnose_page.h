@@ -14,8 +14,8 @@ namespace fitcal::io {
 
 // One statistical test of the residual's structure.
 struct DiagnoseStructureTest {
-  std::string name;     // "lack of fit, declared fit"
-  std::string detail;   // "F = 3.2 on (9, 40) dof"
+  std::string name;    // "lack of fit, declared fit"
+  std::string detail;  // "F = 3.2 on (9, 40) dof"
   double p_value = 1.0;
   bool significant = false;
   std::string meaning;  // what a significant result says
@@ -47,8 +47,8 @@ struct DiagnoseGateRow {
 // A held-out run, nominal and the written calibration, computed as `report` does.
 struct DiagnoseHeldOutRun {
   std::string id;
-  double cf_before = 0.0, cf_after = 0.0;    // Eq. 14
-  double ate_before_m = 0.0, ate_after_m = 0.0;  // Eq. 12, no alignment
+  double cf_before = 0.0, cf_after = 0.0;            // Eq. 14
+  double ate_before_m = 0.0, ate_after_m = 0.0;      // Eq. 12, no alignment
   Point2 final_error_before_m, final_error_after_m;  // in the run's start frame
 };
 
@@ -70,8 +70,7 @@ struct DiagnosePageData {
 };
 
 // The mean of one field over the held-out runs (0 for none): the page's and metrics.json's figure.
-double HeldOutMean(const std::vector<DiagnoseHeldOutRun>& runs,
-                   double DiagnoseHeldOutRun::*field);
+double HeldOutMean(const std::vector<DiagnoseHeldOutRun>& runs, double DiagnoseHeldOutRun::*field);
 
 std::string DiagnoseHtml(const DiagnosePageData& data);
 std::string DiagnoseMetricsJson(const DiagnosePageData& data);

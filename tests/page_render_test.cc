@@ -90,15 +90,18 @@ Probe Render(const TempDir& dir, const std::string& html, int width) {
   const std::string cmd = Chromium() +
                           " --headless --no-sandbox --disable-gpu --disable-background-networking"
                           " --disable-component-update --disable-sync --no-first-run"
-                          " --user-data-dir=" + dir.Path("profile") + " --window-size=" +
-                          std::to_string(width + 40) + ",2100 --virtual-time-budget=5000 --dump-dom"
-                          " file://" + path + " > " + out + " 2>/dev/null";
+                          " --user-data-dir=" +
+                          dir.Path("profile") + " --window-size=" + std::to_string(width + 40) +
+                          ",2100 --virtual-time-budget=5000 --dump-dom"
+                          " file://" +
+                          path + " > " + out + " 2>/dev/null";
   Probe p;
   if (std::system(cmd.c_str()) != 0) return p;
   std::smatch m;
   const std::string dom = ReadFileBytes(out);
-  if (std::regex_search(dom, m, std::regex("PROBE min_font=([0-9.e+]+) scroll_width=([0-9.]+) "
-                                           "window=([0-9.]+) zero_svgs=([0-9]+) svg_font=([0-9.e+]+)"))) {
+  if (std::regex_search(dom, m,
+                        std::regex("PROBE min_font=([0-9.e+]+) scroll_width=([0-9.]+) "
+                                   "window=([0-9.]+) zero_svgs=([0-9]+) svg_font=([0-9.e+]+)"))) {
     p = {std::stod(m[1]), std::stod(m[2]), std::stod(m[3]), std::stod(m[4]), std::stod(m[5])};
   }
   return p;

@@ -48,8 +48,10 @@ void AddWindows(const GroundTruthTrack& gt, const GroundTruthTrack& odo, double 
       ++j;
     }
     if (path < length_m) return;
-    const Eigen::Isometry2d truth = Rigid(gt.world_T_robot[i]).inverse() * Rigid(gt.world_T_robot[j]);
-    const Eigen::Isometry2d est = Rigid(odo.world_T_robot[i]).inverse() * Rigid(odo.world_T_robot[j]);
+    const Eigen::Isometry2d truth =
+        Rigid(gt.world_T_robot[i]).inverse() * Rigid(gt.world_T_robot[j]);
+    const Eigen::Isometry2d est =
+        Rigid(odo.world_T_robot[i]).inverse() * Rigid(odo.world_T_robot[j]);
     const Eigen::Isometry2d e = truth.inverse() * est;
     sums->translation_percent += 100.0 * e.translation().norm() / length_m;
     sums->rotation_deg_per_m +=
