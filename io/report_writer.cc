@@ -285,8 +285,8 @@ std::string ErrorAlongDistancePanel(const ReportData& d, const ErrorQuantity& q,
   runs.opacity = 0.25;
   runs.line_width = 1.0;
   // The thin lines are the background of the band: ~6000 points a panel in all, 30 to 150 a run.
-  const std::size_t per_run = std::clamp<std::size_t>(6000 / std::max<std::size_t>(1, d.runs.size()),
-                                                      30, 150);
+  const std::size_t per_run =
+      std::clamp<std::size_t>(6000 / std::max<std::size_t>(1, d.runs.size()), 30, 150);
   std::vector<double> ends;
   for (const ReportRun& r : d.runs) {
     const std::vector<double>& e = r.*(after ? q.after : q.before);

@@ -79,7 +79,8 @@ void ColouredLine(std::ostringstream& out, const std::vector<Point2>& line,
     out << "<polyline fill=\"none\" stroke=\""
         << SequentialColour((step + 0.5) / kColourSteps) << "\" stroke-width=\"" << s.line_width
         << "\" stroke-linejoin=\"round\" points=\"";
-    for (std::size_t k = i; k <= j; ++k) out << Num(px(line[k].x)) << "," << Num(py(line[k].y)) << " ";
+    for (std::size_t k = i; k <= j; ++k)
+      out << Num(px(line[k].x)) << "," << Num(py(line[k].y)) << " ";
     out << "\"/>";
     i = j;
   }
@@ -282,7 +283,8 @@ std::string XYPlotSvg(const XYPlotOptions& o, const std::vector<SvgSeries>& seri
     const double ly = ly0 + 22.0 * static_cast<double>(i / per_row);
     const SvgSeries& s = series[i];
     if (!s.fill.empty()) {
-      out << "<rect x=\"" << Num(lx) << "\" y=\"" << Num(ly - 10) << "\" width=\"24\" height=\"12\" "
+      out << "<rect x=\"" << Num(lx) << "\" y=\"" << Num(ly - 10)
+          << "\" width=\"24\" height=\"12\" "
           << "fill=\"" << s.fill << "\" opacity=\"" << s.opacity << "\"/>";
     } else if (s.draw_lines) {
       const std::string colour = s.values.empty() ? s.color : SequentialColour(0.5);
@@ -314,7 +316,8 @@ constexpr double kCategoryFontPx = 11.0;
 
 CategoryLabels LayOutCategoryLabels(const std::vector<std::string>& categories, double group_w) {
   double widest = 0.0;
-  for (const std::string& c : categories) widest = std::max(widest, TextWidthPx(c, kCategoryFontPx));
+  for (const std::string& c : categories)
+    widest = std::max(widest, TextWidthPx(c, kCategoryFontPx));
   CategoryLabels out;
   // Level labels need a gap of one character between neighbours; upright ones only one line
   // height per group, and take their length in height.
@@ -366,13 +369,14 @@ void Box(std::ostringstream& out, std::vector<double> v, double x0, double w,
     if (x <= q3 + reach) hi = std::max(hi, x);
   }
   const double xm = x0 + 0.5 * w;
-  out << "<line x1=\"" << Num(xm) << "\" y1=\"" << Num(py(lo)) << "\" x2=\"" << Num(xm) << "\" y2=\""
-      << Num(py(hi)) << "\" stroke=\"" << colour << "\"/><rect x=\"" << Num(x0) << "\" y=\""
-      << Num(py(q3)) << "\" width=\"" << Num(w) << "\" height=\"" << Num(py(q1) - py(q3))
-      << "\" fill=\"" << colour << "\" fill-opacity=\"0.35\" stroke=\"" << colour
-      << "\"/><line x1=\"" << Num(x0) << "\" y1=\"" << Num(py(q2)) << "\" x2=\"" << Num(x0 + w)
-      << "\" y2=\"" << Num(py(q2)) << "\" stroke=\"" << colour << "\" stroke-width=\"2.5\"/>";
-  // Outliers: at most 40 per box (evenly strided, the extremes kept by the sort's order),
+  out << "<line x1=\"" << Num(xm) << "\" y1=\"" << Num(py(lo)) << "\" x2=\"" << Num(xm)
+      << "\" y2=\"" << Num(py(hi)) << "\" stroke=\"" << colour << "\"/><rect x=\"" << Num(x0)
+      << "\" y=\"" << Num(py(q3)) << "\" width=\"" << Num(w) << "\" height=\""
+      << Num(py(q1) - py(q3)) << "\" fill=\"" << colour << "\" fill-opacity=\"0.35\" stroke=\""
+      << colour << "\"/><line x1=\"" << Num(x0) << "\" y1=\"" << Num(py(q2)) << "\" x2=\""
+      << Num(x0 + w) << "\" y2=\"" << Num(py(q2)) << "\" stroke=\"" << colour
+      << "\" stroke-width=\"2.5\"/>";
+  // Outliers: at most 40 per box (evenly strided over the sorted values, both ends kept),
   // enough to show the tail; a real data set has thousands of windows and the page a budget.
   std::vector<double> outliers;
   for (double x : v) {
@@ -380,7 +384,9 @@ void Box(std::ostringstream& out, std::vector<double> v, double x0, double w,
   }
   const std::size_t stride = outliers.size() / 40 + 1;
   for (std::size_t i = 0; i < outliers.size(); i += stride) {
-    out << "<circle cx=\"" << Num(xm) << "\" cy=\"" << Num(py(outliers[i])) << "\" r=\"1.8\" fill=\""
+    // The last (the largest) always: the tail's extent is what the dots are for.
+    const double x = i + stride >= outliers.size() ? outliers.back() : outliers[i];
+    out << "<circle cx=\"" << Num(xm) << "\" cy=\"" << Num(py(x)) << "\" r=\"1.8\" fill=\""
         << colour << "\" fill-opacity=\"0.5\"/>";
   }
   out << "\n";

@@ -434,8 +434,9 @@ TEST(SvgPlotTest, ThreeParameterHeatMapIsWholeAndReadable) {
   const std::vector<std::string> labels = {"r_right", "r_left", "wheel_separation"};
   const std::string named = HeatMapSvg(title, labels, c);
   std::smatch row;
-  ASSERT_TRUE(std::regex_search(named, row, std::regex("<text x=\"([0-9.]+)\"[^>]*text-anchor=\"end\""
-                                                       "[^>]*>wheel_separation<")));
+  ASSERT_TRUE(std::regex_search(named, row,
+                                std::regex("<text x=\"([0-9.]+)\"[^>]*text-anchor=\"end\""
+                                           "[^>]*>wheel_separation<")));
   EXPECT_GE(std::stod(row[1]), TextWidthPx("wheel_separation", 12));
   const std::string columns_only =
       std::regex_replace(named, std::regex("<text [^>]*text-anchor=\"end\">[^<]*</text>"), "");

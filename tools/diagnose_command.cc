@@ -369,7 +369,8 @@ io::DiagnosePageData MakePage(const DiagnoseCommandOptions& options,
   SetConclusion(result, &page);
   AddStructureTests(result, &page);
   AddCandidates(result, options.alpha, &page);
-  for (const DiagnoseChoice& c : gate) page.gate.push_back({c.name, c.cf_after, c.name == choice.name});
+  for (const DiagnoseChoice& c : gate)
+    page.gate.push_back({c.name, c.cf_after, c.name == choice.name});
   AddHeldOut(model, split, choice, &page);
   page.unexplained = result.not_identifiable;
   for (const CovariateTest& t : result.covariates.tests) {
@@ -486,7 +487,8 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
     const std::string yaml =
         omni3 ? Omni3CalibratedYaml(options, index.robot_path, runs, split, result, choice)
               : ModelCalibratedYaml(options, *model, runs, split, result, choice);
-    const io::DiagnosePageData page = MakePage(options, *model, split, result, gate, choice, report);
+    const io::DiagnosePageData page =
+        MakePage(options, *model, split, result, gate, choice, report);
     WriteOutputs(options, inputs, report, result, page, yaml);
     std::printf("\nheld-out runs as `report` computes them: CF %.4f -> %.4f\n",
                 io::HeldOutMean(page.held_out, &io::DiagnoseHeldOutRun::cf_before),

@@ -654,7 +654,8 @@ void PrintReport(const ReportCommandOptions& options, const io::ReportData& data
               -ImprovementPercent(all.before.rms_distance_m, all.after.rms_distance_m));
   int worse = 0;
   for (const io::ReportRun& r : data.runs) worse += io::GotWorse(r) ? 1 : 0;
-  if (worse > 0) std::printf("  held-out runs that got worse: %d of %zu\n", worse, data.runs.size());
+  if (worse > 0)
+    std::printf("  held-out runs that got worse: %d of %zu\n", worse, data.runs.size());
   for (const std::string& line : data.identifiability_lines) std::printf("%s\n", line.c_str());
   if (cv) {
     std::printf("cross-validation: %zu folds, validation CF %.4f +- %.4f (min %.4f, max %.4f)\n",

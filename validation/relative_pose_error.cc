@@ -16,9 +16,8 @@ Pose2d Between(const Pose2d& a, const Pose2d& b) {
 
 }  // namespace
 
-std::vector<RelativePoseErrorWindow> RelativePoseErrorWindows(const std::vector<Pose2d>& ground_truth,
-                                                              const std::vector<Pose2d>& odometry,
-                                                              double length_m) {
+std::vector<RelativePoseErrorWindow> RelativePoseErrorWindows(
+    const std::vector<Pose2d>& ground_truth, const std::vector<Pose2d>& odometry, double length_m) {
   std::vector<RelativePoseErrorWindow> out;
   const std::size_t n = std::min(ground_truth.size(), odometry.size());
   if (n < 2 || !(length_m > 0.0)) return out;
@@ -43,7 +42,8 @@ std::vector<RelativePoseErrorWindow> RelativePoseErrorWindows(const std::vector<
 void AddRelativePoseErrors(const std::vector<Pose2d>& ground_truth,
                            const std::vector<Pose2d>& odometry, double length_m,
                            RelativePoseErrorSum* sum) {
-  for (const RelativePoseErrorWindow& w : RelativePoseErrorWindows(ground_truth, odometry, length_m)) {
+  for (const RelativePoseErrorWindow& w :
+       RelativePoseErrorWindows(ground_truth, odometry, length_m)) {
     sum->translation_ratio_sum += w.translation_ratio;
     sum->rotation_rad_per_m_sum += w.rotation_rad_per_m;
     ++sum->windows;

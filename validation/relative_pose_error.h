@@ -36,9 +36,8 @@ struct RelativePoseErrorWindow {
 };
 
 // Every window of one run (the pictures draw them one by one; the sum below is their mean).
-std::vector<RelativePoseErrorWindow> RelativePoseErrorWindows(const std::vector<Pose2d>& ground_truth,
-                                                              const std::vector<Pose2d>& odometry,
-                                                              double length_m);
+std::vector<RelativePoseErrorWindow> RelativePoseErrorWindows(
+    const std::vector<Pose2d>& ground_truth, const std::vector<Pose2d>& odometry, double length_m);
 
 // Adds the windows of one run: `ground_truth` and `odometry` are poses at the same times, in any
 // one world frame each. Runs shorter than length_m add nothing.
