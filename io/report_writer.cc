@@ -550,7 +550,10 @@ ReportFigures MakeReportFigures(const ReportData& data) {
   }
   if (data.has_correlation) {
     std::vector<std::string> labels;
-    for (const ReportParameter& p : data.parameters) labels.push_back(p.name);
+    // A held parameter has no correlation (its row is 0): its label says why.
+    for (const ReportParameter& p : data.parameters) {
+      labels.push_back(p.name + (p.held ? " (held)" : ""));
+    }
     f.correlation = HeatMapSvg("Correlation of the fitted parameters (-1 blue, +1 red)", labels,
                                data.correlation);
   }

@@ -456,6 +456,7 @@ TEST(ReportTest, HeldParametersAreMarkedHeld) {
   const std::string html = ReportHtml(d);
   EXPECT_NE(html.find("<td class=\"held\">held at nominal</td>"), std::string::npos);
   EXPECT_NE(ReportMarkdown(d).find("held at nominal"), std::string::npos);
+  EXPECT_NE(MakeReportFigures(d).correlation.find(">delta_c (held)<"), std::string::npos);
   const YAML::Node j = YAML::Load(MetricsJson(d));
   EXPECT_TRUE(j["parameters"][8]["held"].as<bool>());
   EXPECT_TRUE(j["parameters"][8]["sigma"].IsNull());
