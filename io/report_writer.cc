@@ -28,6 +28,13 @@ double Improvement(double before, double after) {
   return before > 0.0 ? 100.0 * (before - after) / before : 0.0;
 }
 
+// Every % change on the page and in summary.md has one sign: 100 (after - before) / before, so
+// an error that shrank is negative (and green), a parameter that grew positive. metrics.json's
+// improvement_percent keeps Palacin Table 6's sign (positive = better) and says so in its name.
+std::string ChangePercentText(double before, double after) {
+  return Fmt("%+.1f %%", -Improvement(before, after));
+}
+
 // Table 6 columns: (label, unit, getter, is angle).
 struct Column {
   const char* key;    // machine name, SI
@@ -138,22 +145,22 @@ std::vector<Point2> Thinned(const std::vector<Point2>& line, std::size_t most) {
   return out;
 }
 
-// Points per polyline of the figure of every run: ~60,000 points in all (~1 MB of SVG), at
+// Points per polyline of the figure of every run: ~40,000 points in all (~0.6 MB of SVG), at
 // least 40 per run so that a circle still looks round.
 std::size_t PointsPerRun(std::size_t runs, std::size_t lines_per_run) {
-  const std::size_t total = 60000;
+  const std::size_t total = 40000;
   return std::max<std::size_t>(
       40, std::min<std::size_t>(400, total / std::max<std::size_t>(1, runs * lines_per_run)));
 }
 
 // The runs the error-along-time figures show: largest calibrated CF first.
-std::vector<std::size_t> WorstRuns(const ReportData& data) {
+std::vector<std::size_t> WorstRuns(const ReportData& data, std::size_t most) {
   std::vector<std::size_t> order(data.runs.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
     return data.runs[a].after.cf > data.runs[b].after.cf;
   });
-  order.resize(std::min<std::size_t>(order.size(), std::max(0, data.worst_runs_drawn)));
+  order.resize(std::min(order.size(), most));
   return order;
 }
 
@@ -217,7 +224,241 @@ std::string ResidualHistogramSvg(const ReportData& data) {
   return BarChartSvg(o, categories, {before, after});
 }
 
+// The t_s samples of a track drawn as ReportRun holds it: the start pose and the final pose
+// around them when the track is longer than t_s (MakeReportRun), else the samples alone.
+std::size_t SampleOffset(const std::vector<Point2>& xy, const std::vector<double>& t_s) {
+  return xy.size() >= t_s.size() + 2 ? 1 : 0;
+}
+
+// Indices 0..n-1 thinned to at most `most`, first and last kept (as Thinned).
+std::vector<std::size_t> ThinnedIndices(std::size_t n, std::size_t most) {
+  std::vector<std::size_t> out;
+  if (n <= most || most < 2) {
+    for (std::size_t i = 0; i < n; ++i) out.push_back(i);
+    return out;
+  }
+  const double step = static_cast<double>(n - 1) / static_cast<double>(most - 1);
+  for (std::size_t i = 0; i < most; ++i) {
+    out.push_back(static_cast<std::size_t>(std::lround(step * static_cast<double>(i))));
+  }
+  return out;
+}
+
+// Linear interpolation of y(x) at x0 along non-decreasing x; NaN outside [x.front(), x.back()].
+double InterpolateAt(const std::vector<double>& x, const std::vector<double>& y, double x0) {
+  if (x.empty() || x0 < x.front() || x0 > x.back()) return std::nan("");
+  const std::size_t j = static_cast<std::size_t>(std::lower_bound(x.begin(), x.end(), x0) -
+                                                 x.begin());
+  if (j == 0) return y[0];
+  const double span = x[j] - x[j - 1];
+  const double f = span > 0.0 ? (x0 - x[j - 1]) / span : 1.0;
+  return y[j - 1] + f * (y[j] - y[j - 1]);
+}
+
+double QuantileOf(std::vector<double> v, double q) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  const double at = q * static_cast<double>(v.size() - 1);
+  const std::size_t lo = static_cast<std::size_t>(std::floor(at));
+  const std::size_t hi = std::min(v.size() - 1, lo + 1);
+  return v[lo] + (at - static_cast<double>(lo)) * (v[hi] - v[lo]);
+}
+
+// Which error of a run a distance figure shows, and how it is scaled for display.
+struct ErrorQuantity {
+  const char* label;  // y axis
+  double scale;       // SI or rad -> display unit
+  const std::vector<double> ReportRun::*before;
+  const std::vector<double> ReportRun::*after;
+};
+const ErrorQuantity kPositionError = {"position error [mm]", 1e3, &ReportRun::before_distance_m,
+                                      &ReportRun::after_distance_m};
+const ErrorQuantity kHeadingError = {"|heading error| [deg]", kDeg, &ReportRun::before_angle_rad,
+                                     &ReportRun::after_angle_rad};
+
+// One panel: every run thin, and over the runs that reach each distance the median (thick) and
+// the band between the quartiles, on a grid of 80 distances up to where half the runs still go.
+std::string ErrorAlongDistancePanel(const ReportData& d, const ErrorQuantity& q, bool after,
+                                    double y_hi, const std::string& id) {
+  const char* colour = after ? kAfterColour : kBeforeColour;
+  SvgSeries runs = Series("each held-out run", colour);
+  runs.opacity = 0.25;
+  runs.line_width = 1.0;
+  // The thin lines are the background of the band: ~6000 points a panel in all, 30 to 150 a run.
+  const std::size_t per_run =
+      std::clamp<std::size_t>(6000 / std::max<std::size_t>(1, d.runs.size()), 30, 150);
+  std::vector<double> ends;
+  for (const ReportRun& r : d.runs) {
+    const std::vector<double>& e = r.*(after ? q.after : q.before);
+    if (r.along_m.size() != e.size() || e.empty()) continue;
+    ends.push_back(r.along_m.back());
+    std::vector<Point2> line;
+    for (std::size_t i : ThinnedIndices(e.size(), per_run)) {
+      line.push_back({r.along_m[i], q.scale * e[i]});
+    }
+    runs.lines.push_back(line);
+  }
+  SvgSeries band = Series("quartiles over runs", colour), median = Series("median", colour);
+  band.fill = colour;
+  band.opacity = 0.3;
+  median.line_width = 3.0;
+  const double reach = QuantileOf(ends, 0.5);
+  std::vector<Point2> upper, lower, mid;
+  for (int k = 0; k <= 80 && reach > 0.0; ++k) {
+    const double at = reach * k / 80.0;
+    std::vector<double> v;
+    for (const ReportRun& r : d.runs) {
+      const std::vector<double>& e = r.*(after ? q.after : q.before);
+      if (r.along_m.size() != e.size()) continue;
+      const double y = InterpolateAt(r.along_m, e, at);
+      if (std::isfinite(y)) v.push_back(q.scale * y);
+    }
+    if (v.empty()) continue;
+    lower.push_back({at, QuantileOf(v, 0.25)});
+    mid.push_back({at, QuantileOf(v, 0.5)});
+    upper.push_back({at, QuantileOf(v, 0.75)});
+  }
+  band.lines.push_back(upper);
+  band.lines.back().insert(band.lines.back().end(), lower.rbegin(), lower.rend());
+  median.lines.push_back(mid);
+  XYPlotOptions o;
+  o.id = id;
+  o.width = 480;
+  o.height = 360;
+  o.title = after ? "calibrated parameters" : "nominal parameters";
+  o.x_label = "distance travelled (ground truth) [m]";
+  o.y_label = q.label;
+  o.include_origin = true;
+  o.y_lo = 0.0;
+  o.y_hi = y_hi;
+  return XYPlotSvg(o, {runs, band, median});
+}
+
+// Both panels of one quantity on one y range, wide enough for the larger of the two medians'
+// worst quartile and at least 95 % of every run's samples.
+std::string ErrorAlongDistanceSvgs(const ReportData& d, const ErrorQuantity& q,
+                                   const std::string& id) {
+  std::vector<double> all;
+  for (const ReportRun& r : d.runs) {
+    if (r.along_m.empty()) continue;
+    for (const auto* e : {&(r.*q.before), &(r.*q.after)}) {
+      for (double v : *e) all.push_back(q.scale * v);
+    }
+  }
+  if (all.empty()) return "";
+  const double y_hi = 1.05 * std::max(QuantileOf(all, 0.95), 1e-9);
+  return ErrorAlongDistancePanel(d, q, false, y_hi, id + "-nominal") +
+         ErrorAlongDistancePanel(d, q, true, y_hi, id + "-calibrated");
+}
+
+// Box plots of the drift of every window, one box per drift length and parameter set.
+std::string DriftBoxesSvg(const ReportData& d, bool rotation) {
+  std::vector<std::string> categories;
+  BoxSeries before{"nominal parameters", kBeforeColour, {}};
+  BoxSeries after{"calibrated parameters", kAfterColour, {}};
+  for (const ReportDriftRow& r : d.drift) {
+    if (r.before_translation_percent_windows.empty()) continue;
+    categories.push_back(Fmt("%g m", r.length_m) + " (" + std::to_string(r.windows) + ")");
+    const auto scaled = [&](const std::vector<double>& v) {
+      std::vector<double> out;
+      for (double x : v) out.push_back(rotation ? kDeg * x : x);
+      return out;
+    };
+    before.samples.push_back(scaled(rotation ? r.before_rotation_rad_per_m_windows
+                                             : r.before_translation_percent_windows));
+    after.samples.push_back(scaled(rotation ? r.after_rotation_rad_per_m_windows
+                                            : r.after_translation_percent_windows));
+  }
+  if (categories.empty()) return "";
+  BarChartOptions o;
+  o.width = 480;
+  o.height = 360;
+  o.title = rotation ? "Rotation drift per window" : "Translation drift per window";
+  o.x_label = "window along the ground truth (windows)";
+  o.y_label = rotation ? "rotation error [deg/m]" : "translation error [% of distance]";
+  return BoxPlotSvg(o, categories, {before, after});
+}
+
+// The held-out runs whose odometry is drawn coloured by its error: every run up to this many,
+// else the worst by calibrated CF (the size budget of the page).
+constexpr std::size_t kMostColouredTracks = 30;
+
+// The colour scale of one run's pair of panels: 0 to its largest position error, nominal or
+// calibrated (so the two panels compare, and a good run is not all dark beside a bad one).
+double ColouredTrackScale(const ReportRun& r) {
+  const double hi = std::max(r.before.max_distance_m, r.after.max_distance_m);
+  double samples = 0.0;
+  for (const auto* e : {&r.before_distance_m, &r.after_distance_m}) {
+    for (double v : *e) samples = std::max(samples, v);
+  }
+  const double out = std::max(hi, samples);
+  return out > 0.0 ? out : 1.0;
+}
+
+// One run, nominal beside calibrated: the odometry coloured by its position error on the run's
+// scale (ColouredTrackScale), the ground truth grey beneath it, both panels on one range.
+std::string ColouredTrackSvgs(const ReportRun& r, std::size_t k) {
+  const double error_hi_m = ColouredTrackScale(r);
+  const std::size_t off = SampleOffset(r.ground_truth_xy, r.t_s);
+  if (r.t_s.empty() || r.ground_truth_xy.size() < r.t_s.size() + off ||
+      r.before_xy.size() < r.t_s.size() + off || r.after_xy.size() < r.t_s.size() + off ||
+      r.before_distance_m.size() != r.t_s.size() || r.after_distance_m.size() != r.t_s.size()) {
+    return "";
+  }
+  const std::vector<std::size_t> keep = ThinnedIndices(r.t_s.size(), 120);
+  SvgSeries gt = Series("ground truth", kGroundTruthColour);
+  gt.line_width = 4.0;
+  gt.lines.emplace_back();
+  for (std::size_t i : keep) gt.lines[0].push_back(r.ground_truth_xy[i + off]);
+  double x_lo = 0, x_hi = 0, y_lo = 0, y_hi = 0;
+  bool first = true;
+  for (const auto* xy : {&r.ground_truth_xy, &r.before_xy, &r.after_xy}) {
+    for (const Point2& p : *xy) {
+      x_lo = first ? p.x : std::min(x_lo, p.x);
+      x_hi = first ? p.x : std::max(x_hi, p.x);
+      y_lo = first ? p.y : std::min(y_lo, p.y);
+      y_hi = first ? p.y : std::max(y_hi, p.y);
+      first = false;
+    }
+  }
+  const double pad = 0.05 * std::max({x_hi - x_lo, y_hi - y_lo, 1e-3});
+  std::string out;
+  for (bool after : {false, true}) {
+    SvgSeries odo = Series(after ? "calibrated odometry" : "nominal odometry", "#000000");
+    odo.line_width = 2.0;
+    odo.value_lo = 0.0;
+    odo.value_hi = error_hi_m;
+    odo.lines.emplace_back();
+    odo.values.emplace_back();
+    const std::vector<Point2>& xy = after ? r.after_xy : r.before_xy;
+    const std::vector<double>& e = after ? r.after_distance_m : r.before_distance_m;
+    for (std::size_t i : keep) {
+      odo.lines[0].push_back(xy[i + off]);
+      odo.values[0].push_back(e[i]);
+    }
+    XYPlotOptions o;
+    o.id = "track" + std::to_string(k) + (after ? "-calibrated" : "-nominal");
+    o.width = 340;
+    o.height = 360;
+    o.equal_aspect = true;
+    o.x_lo = x_lo - pad;
+    o.x_hi = x_hi + pad;
+    o.y_lo = y_lo - pad;
+    o.y_hi = y_hi + pad;
+    o.title = std::string(after ? "calibrated" : "nominal") + ", ATE " +
+              Fmt("%.0f mm", 1e3 * (after ? r.after : r.before).rms_distance_m);
+    o.x_label = "x [m]";
+    o.y_label = "y [m]";
+    out += XYPlotSvg(o, {gt, odo});
+  }
+  return out;
+}
+
 }  // namespace
+
+bool GotWorse(const ReportRun& run) {
+  return run.after.cf > run.before.cf || run.after.rms_distance_m > run.before.rms_distance_m;
+}
 
 ReportFigures MakeReportFigures(const ReportData& data) {
   ReportFigures f;
@@ -309,15 +550,29 @@ ReportFigures MakeReportFigures(const ReportData& data) {
   }
   if (data.has_correlation) {
     std::vector<std::string> labels;
-    for (const ReportParameter& p : data.parameters) labels.push_back(p.name);
+    // A held parameter has no correlation (its row is 0): its label says why.
+    for (const ReportParameter& p : data.parameters) {
+      labels.push_back(p.name + (p.held ? " (held)" : ""));
+    }
     f.correlation = HeatMapSvg("Correlation of the fitted parameters (-1 blue, +1 red)", labels,
                                data.correlation);
   }
-  for (std::size_t k : WorstRuns(data)) {
+  for (std::size_t k :
+       WorstRuns(data, static_cast<std::size_t>(std::max(0, data.worst_runs_drawn)))) {
     f.error_along_time.push_back(ErrorAlongTimeSvgs(data.runs[k], k));
     f.error_along_time_runs.push_back(k);
   }
   f.residual_histogram = ResidualHistogramSvg(data);
+  f.position_error_along_distance = ErrorAlongDistanceSvgs(data, kPositionError, "dist-pos");
+  f.heading_error_along_distance = ErrorAlongDistanceSvgs(data, kHeadingError, "dist-head");
+  f.drift_translation_boxes = DriftBoxesSvg(data, false);
+  f.drift_rotation_boxes = DriftBoxesSvg(data, true);
+  for (std::size_t k : WorstRuns(data, kMostColouredTracks)) {
+    std::string svgs = ColouredTrackSvgs(data.runs[k], k);
+    if (svgs.empty()) continue;
+    f.coloured_tracks.push_back(std::move(svgs));
+    f.coloured_track_runs.push_back(k);
+  }
   return f;
 }
 
@@ -333,6 +588,9 @@ const char* const kStyle =
     "table{border-collapse:collapse;margin:8px 0 16px}\n"
     "th,td{border:1px solid #bbb;padding:3px 8px;text-align:right}\n"
     "th:first-child,td:first-child,td.k{text-align:left}\n"
+    // Numbers never break ("4.7e-" / "14"); text cells keep a readable measure on a phone and
+    // the table scrolls instead of squeezing them to one word a line.
+    "td:not(:first-child):not(.k){white-space:nowrap}td.k{min-width:12em}\n"
     "th{background:#f0f0f0}\n"
     "code{overflow-wrap:anywhere}\n"
     ".warn{background:#fff3cd;border:1px solid #e0b000;padding:8px 12px;white-space:pre-wrap;"
@@ -347,7 +605,16 @@ const char* const kStyle =
     ".figs{display:flex;flex-wrap:wrap;gap:12px}\n"
     "figure{margin:0 0 12px;max-width:100%}figcaption{font-size:13px;color:#555;"
     "max-width:640px}\n"
-    ".better{color:#060}.worse{color:#a00;font-weight:bold}\n";
+    ".better{color:#060}.worse{color:#a00;font-weight:bold}\n"
+    ".flag{color:#a00;background:#fde2e1;border:1px solid #b00020;padding:6px 10px}\n"
+    ".held{color:#555;font-style:italic}ul.key{font-size:16px}\n"
+    "pre{white-space:pre-wrap;font-size:13px}\n"
+    // A phone (a 390 px screen): figures keep their drawn size, so that their 11-15 px text
+    // stays readable, and scroll sideways in their box instead of shrinking to a third.
+    "@media (max-width:700px){body{padding:8px}svg{max-width:none}"
+    ".figs,figure{overflow-x:auto;max-width:100%}.figs>svg{flex-shrink:0}"
+    "figure.wide svg{min-width:0}}\n"
+    ".figs.flagged{border-left:4px solid #b00020;padding-left:6px}\n";
 
 // A table inside a horizontally scrolling box: wide tables scroll on a phone instead of pushing
 // the page wider than the screen.
@@ -365,6 +632,28 @@ void HtmlVerdict(std::ostringstream& h, const ReportData& d) {
       << EscapeXml(r.section) << "\">" << EscapeXml(r.section) << "</a>)</li>\n";
   }
   h << "</ul>\n</div>\n";
+}
+
+// The numbers an engineer looks for first, in one line each: ATE, drift, the runs that got worse.
+void HtmlKeyNumbers(std::ostringstream& h, const ReportData& d) {
+  if (d.summary.empty()) return;
+  const ReportSummaryRow& all = d.summary.back();
+  int worse = 0;
+  for (const ReportRun& r : d.runs) worse += GotWorse(r) ? 1 : 0;
+  h << "<ul class=\"key\" id=\"key\">\n<li>ATE RMSE (mean over " << all.runs
+    << " held-out runs, no alignment): <b>" << Fmt("%.1f", 1e3 * all.before.rms_distance_m)
+    << " &rarr; " << Fmt("%.1f mm", 1e3 * all.after.rms_distance_m) << "</b> ("
+    << ChangePercentText(all.before.rms_distance_m, all.after.rms_distance_m) << ")</li>\n";
+  for (const ReportDriftRow& r : d.drift) {
+    h << "<li>drift over " << Fmt("%g m", r.length_m) << ": <b>"
+      << Fmt("%.2f", r.before_translation_percent) << " &rarr; "
+      << Fmt("%.2f %%", r.after_translation_percent) << "</b>, "
+      << Fmt("%.3f", kDeg * r.before_rotation_rad_per_m) << " &rarr; "
+      << Fmt("%.3f deg/m", kDeg * r.after_rotation_rad_per_m) << "</li>\n";
+  }
+  h << "<li" << (worse > 0 ? " class=\"worse\"" : "") << ">held-out runs that got worse: "
+    << worse << " of " << d.runs.size() << (worse > 0 ? " (<a href=\"#worse\">list</a>)" : "")
+    << "</li>\n</ul>\n";
 }
 
 void HtmlHeader(std::ostringstream& h, const ReportData& d) {
@@ -391,13 +680,12 @@ void HtmlSummaryRows(std::ostringstream& h, const ReportSummaryRow& row) {
     h << "<td class=\"k\">"
       << (part == 0   ? "before"
           : part == 1 ? "after"
-                      : "improvement")
+                      : "change")
       << "</td>";
     for (const Column& c : kColumns) {
       const double b = ValueOf(c, row.before), a = ValueOf(c, row.after);
       if (part == 2) {
-        const double imp = Improvement(b, a);
-        h << "<td class=\"" << (imp >= 0 ? "better" : "worse") << "\">" << Fmt("%+.1f %%", imp)
+        h << "<td class=\"" << (a <= b ? "better" : "worse") << "\">" << ChangePercentText(b, a)
           << "</td>";
       } else {
         h << "<td>" << Fmt(FormatOf(c), part == 0 ? b : a) << "</td>";
@@ -409,7 +697,8 @@ void HtmlSummaryRows(std::ostringstream& h, const ReportSummaryRow& row) {
 
 void HtmlSummary(std::ostringstream& h, const ReportData& d) {
   h << "<h2 id=\"summary\">Summary (Palacin Table 6)</h2>\n<p>Averages over the validation runs; "
-       "improvement = 100 (before &minus; after) / before, positive is better.</p>\n";
+       "change = 100 (after &minus; before) / before: negative (green) is a smaller error, as "
+       "in every table of this page. The RMS distance error is the ATE RMSE.</p>\n";
   OpenTable(h);
   h << "<tr><th>group</th><th>runs</th><th></th>";
   for (const Column& c : kColumns) h << "<th>" << EscapeXml(c.label) << "</th>";
@@ -465,15 +754,24 @@ void HtmlDrift(std::ostringstream& h, const ReportData& d) {
        "over every window of every validation run.</p>\n";
   OpenTable(h);
   h << "<tr><th>path length [m]</th><th>windows</th><th>translation before [%]</th>"
-       "<th>after [%]</th><th>rotation before [deg/m]</th><th>after [deg/m]</th></tr>\n";
+       "<th>after [%]</th><th>rotation before [deg/m]</th><th>after [deg/m]</th>"
+       "<th>windows worse after</th></tr>\n";
   for (const ReportDriftRow& r : d.drift) {
+    const bool worse = r.after_translation_percent > r.before_translation_percent;
+    const bool rot_worse = r.after_rotation_rad_per_m > r.before_rotation_rad_per_m;
     h << "<tr><td>" << Fmt("%g", r.length_m) << "</td><td>" << r.windows << "</td><td>"
-      << Fmt("%.2f", r.before_translation_percent) << "</td><td>"
-      << Fmt("%.2f", r.after_translation_percent) << "</td><td>"
-      << Fmt("%.3f", kDeg * r.before_rotation_rad_per_m) << "</td><td>"
-      << Fmt("%.3f", kDeg * r.after_rotation_rad_per_m) << "</td></tr>\n";
+      << Fmt("%.2f", r.before_translation_percent) << "</td><td"
+      << (worse ? " class=\"worse\"" : "") << ">" << Fmt("%.2f", r.after_translation_percent)
+      << "</td><td>" << Fmt("%.3f", kDeg * r.before_rotation_rad_per_m) << "</td><td"
+      << (rot_worse ? " class=\"worse\"" : "") << ">"
+      << Fmt("%.3f", kDeg * r.after_rotation_rad_per_m) << "</td><td"
+      << (r.windows_worse > 0 ? " class=\"worse\"" : "") << ">" << r.windows_worse << " of "
+      << r.windows << "</td></tr>\n";
   }
   CloseTable(h);
+  h << "<p>A window is worse when its translation error is larger with the calibrated "
+       "parameters than with the nominal (the windows are chosen on the ground truth, so each "
+       "is the same stretch of road before and after).</p>\n";
   h << "<p>Signed mean final error (bias) over the validation runs, in each run's start "
        "frame:</p>\n";
   OpenTable(h);
@@ -508,6 +806,80 @@ void HtmlFigures(std::ostringstream& h, const ReportData& d, const ReportFigures
        "and in metrics.csv.</p>\n";
   for (const std::string& svgs : f.error_along_time) {
     h << "<div class=\"figs\">\n" << svgs << "</div>\n";
+  }
+}
+
+void HtmlDistanceFigures(std::ostringstream& h, const ReportFigures& f) {
+  if (f.position_error_along_distance.empty() && f.drift_translation_boxes.empty()) return;
+  h << "<h2 id=\"distance\">Error against distance travelled</h2>\n<p>Every held-out run "
+       "(thin), the median over the runs (thick) and the band between their quartiles, against "
+       "the distance the ground truth travelled; the odometry starts at the ground truth's "
+       "start pose, nothing else is aligned. Nominal left, calibrated right, on one scale. The "
+       "median and band stop where half the runs have ended.</p>\n";
+  for (const std::string* svgs : {&f.position_error_along_distance,
+                                  &f.heading_error_along_distance}) {
+    if (!svgs->empty()) h << "<div class=\"figs\">\n" << *svgs << "</div>\n";
+  }
+  if (f.drift_translation_boxes.empty()) return;
+  h << "<p>Drift of every window of each length along the ground truth (the table above is "
+       "their mean): box from the first to the third quartile, the median across it, whiskers "
+       "to 1.5 interquartile ranges, dots beyond. The number of windows is in brackets.</p>\n"
+    << "<div class=\"figs\">\n" << f.drift_translation_boxes << f.drift_rotation_boxes
+    << "</div>\n";
+}
+
+// The held-out runs that got worse with the calibration (GotWorse), flagged by name.
+void HtmlWorseRuns(std::ostringstream& h, const ReportData& d) {
+  std::vector<const ReportRun*> worse;
+  for (const ReportRun& r : d.runs) {
+    if (GotWorse(r)) worse.push_back(&r);
+  }
+  h << "<h2 id=\"worse\">Held-out runs that got worse</h2>\n";
+  if (worse.empty()) {
+    h << "<p class=\"ok\">None: every one of the " << d.runs.size()
+      << " held-out runs has a lower CF (Eq. 14) and a lower ATE RMSE with the calibrated "
+         "parameters.</p>\n";
+    return;
+  }
+  h << "<p class=\"flag\"><b>" << worse.size() << " of " << d.runs.size()
+    << " held-out runs got worse</b> with the calibration: their CF (Eq. 14) or their ATE RMSE "
+       "(RMS position error, Eq. 12) rose.</p>\n";
+  OpenTable(h);
+  h << "<tr><th>run</th><th>CF before</th><th>CF after</th><th>ATE RMSE before [mm]</th>"
+       "<th>after [mm]</th></tr>\n";
+  for (const ReportRun* r : worse) {
+    const auto cell = [&](double before, double after, const char* format, double scale) {
+      h << "<td>" << Fmt(format, scale * before) << "</td><td"
+        << (after > before ? " class=\"worse\"" : "") << ">" << Fmt(format, scale * after)
+        << "</td>";
+    };
+    h << "<tr><td>" << EscapeXml(r->id) << "</td>";
+    cell(r->before.cf, r->after.cf, "%.4f", 1.0);
+    cell(r->before.rms_distance_m, r->after.rms_distance_m, "%.1f", 1e3);
+    h << "</tr>\n";
+  }
+  CloseTable(h);
+}
+
+void HtmlColouredTracks(std::ostringstream& h, const ReportData& d, const ReportFigures& f) {
+  if (f.coloured_tracks.empty()) return;
+  h << "<h2 id=\"tracks\">Held-out runs coloured by their error</h2>\n<p>"
+    << (f.coloured_tracks.size() == d.runs.size()
+            ? std::string("Every held-out run")
+            : "The " + std::to_string(f.coloured_tracks.size()) + " held-out runs (of " +
+                  std::to_string(d.runs.size()) + ") with the largest calibrated CF")
+    << ", worst calibrated CF first, in its start frame: the odometry coloured by its position "
+       "error at each ground-truth time, the ground truth grey beneath it; nominal left, "
+       "calibrated right. Each run has its own scale, from 0 to its largest error (nominal or "
+       "calibrated, given beside its name):</p>\n<figure>"
+    << ColourBarSvg("position error, fraction of the run's largest", 0.0, 1.0) << "</figure>\n";
+  for (std::size_t i = 0; i < f.coloured_tracks.size(); ++i) {
+    const ReportRun& r = d.runs[f.coloured_track_runs[i]];
+    const bool worse = GotWorse(r);
+    h << "<h3" << (worse ? " class=\"worse\"" : "") << ">" << EscapeXml(r.id) << " (scale 0-"
+      << Fmt("%.0f mm", 1e3 * ColouredTrackScale(r)) << ")" << (worse ? ": got worse" : "")
+      << "</h3>\n<div class=\"figs" << (worse ? " flagged" : "") << "\">\n"
+      << f.coloured_tracks[i] << "</div>\n";
   }
 }
 
@@ -566,7 +938,7 @@ void HtmlParameters(std::ostringstream& h, const ReportData& d) {
   h << "<h2 id=\"parameters\">Parameters</h2>\n<p>" << EscapeXml(d.uncertainty_note) << "</p>\n";
   OpenTable(h);
   h << "<tr><th>parameter</th><th>unit</th><th>nominal</th><th>calibrated</th>"
-       "<th>&plusmn;1 sigma</th><th>change</th><th>bound</th>"
+       "<th>&plusmn;1 sigma</th><th>change</th><th>status</th>"
     << (d.has_cv ? "<th>CV mean</th><th>CV std</th><th>CV min</th><th>CV max</th>" : "")
     << "</tr>\n";
   for (const ReportParameter& p : d.parameters) {
@@ -574,8 +946,12 @@ void HtmlParameters(std::ostringstream& h, const ReportData& d) {
     const char* fmt = p.is_angle ? "%.4f" : "%.6f";
     h << "<tr><td>" << EscapeXml(p.name) << "</td><td>" << EscapeXml(p.unit) << "</td><td>"
       << Fmt(fmt, p.nominal * s) << "</td><td>" << Fmt(fmt, p.calibrated * s) << "</td><td>"
-      << (p.has_sigma ? Fmt("%.2g", p.sigma * s) : "-") << "</td><td>" << ChangeText(p)
-      << "</td><td" << (p.at_bound ? " class=\"worse\">AT BOUND" : ">") << "</td>";
+      << (p.has_sigma ? Fmt("%.2g", p.sigma * s) : "-") << "</td><td>"
+      << (p.held ? "-" : ChangeText(p)) << "</td><td"
+      << (p.held       ? " class=\"held\">held at nominal"
+          : p.at_bound ? " class=\"worse\">AT BOUND"
+                       : ">fitted")
+      << "</td>";
     if (d.has_cv) {
       h << "<td>" << Fmt(fmt, p.cv_mean * s) << "</td><td>" << Fmt("%.2g", p.cv_std * s)
         << "</td><td>" << Fmt(fmt, p.cv_min * s) << "</td><td>" << Fmt(fmt, p.cv_max * s)
@@ -722,11 +1098,15 @@ std::string ReportHtml(const ReportData& d) {
     << "<title>fitcal validation report: " << EscapeXml(d.verdict) << "</title>\n<style>\n"
     << kStyle << "</style>\n</head>\n<body>\n<h1>fitcal validation report</h1>\n";
   HtmlVerdict(h, d);
+  HtmlKeyNumbers(h, d);
   HtmlHeader(h, d);
   HtmlComparison(h, d);
   HtmlSummary(h, d);
   HtmlTrajectoryGroups(h, d);
+  HtmlWorseRuns(h, d);
   HtmlDrift(h, d);
+  HtmlDistanceFigures(h, f);
+  HtmlColouredTracks(h, d, f);
   HtmlFigures(h, d, f);
   HtmlResiduals(h, d, f);
   HtmlStatistics(h, d);
@@ -779,10 +1159,26 @@ void MdVerdict(std::ostringstream& m, const ReportData& d) {
     m << "- **" << r.level << "** " << r.check << ": " << r.message << "\n";
   }
   m << "\n";
+  if (d.summary.empty()) return;
+  // The key numbers of the page (HtmlKeyNumbers), in the same words.
+  const ReportSummaryRow& all = d.summary.back();
+  m << "- ATE RMSE (mean over " << all.runs << " held-out runs, no alignment): "
+    << Fmt("%.1f", 1e3 * all.before.rms_distance_m) << " -> "
+    << Fmt("%.1f mm", 1e3 * all.after.rms_distance_m) << " ("
+    << ChangePercentText(all.before.rms_distance_m, all.after.rms_distance_m) << ")\n";
+  std::string worse;
+  int n = 0;
+  for (const ReportRun& r : d.runs) {
+    if (!GotWorse(r)) continue;
+    worse += (n++ ? ", " : "") + r.id;
+  }
+  m << "- held-out runs that got worse: " << n << " of " << d.runs.size()
+    << (n > 0 ? " (" + worse + ")" : "") << "\n\n";
 }
 
 void MdSummary(std::ostringstream& m, const ReportData& d) {
-  m << "## Summary (Palacin Table 6)\n\n";
+  m << "## Summary (Palacin Table 6)\n\nchange = 100 (after - before) / before: negative is a "
+       "smaller error, as in every table here.\n\n";
   std::vector<std::string> header = {"group", "runs", ""};
   for (const Column& c : kColumns) header.push_back(c.label);
   m << MdRow(header) << MdRule(header.size(), 3);
@@ -792,10 +1188,10 @@ void MdSummary(std::ostringstream& m, const ReportData& d) {
                                         part == 0 ? std::to_string(row.runs) : "",
                                         part == 0   ? "before"
                                         : part == 1 ? "after"
-                                                    : "improvement"};
+                                                    : "change"};
       for (const Column& c : kColumns) {
         const double b = ValueOf(c, row.before), a = ValueOf(c, row.after);
-        cells.push_back(part == 2 ? Fmt("%+.1f %%", Improvement(b, a))
+        cells.push_back(part == 2 ? ChangePercentText(b, a)
                                   : Fmt(FormatOf(c), part == 0 ? b : a));
       }
       m << MdRow(cells);
@@ -858,7 +1254,7 @@ void MdStatistics(std::ostringstream& m, const ReportData& d) {
 void MdParameters(std::ostringstream& m, const ReportData& d) {
   m << "\n## Parameters\n\n" << d.uncertainty_note << "\n\n";
   std::vector<std::string> header = {"parameter", "unit",   "nominal", "calibrated",
-                                     "+-1 sigma", "change", "bound"};
+                                     "+-1 sigma", "change", "status"};
   if (d.has_cv) header.insert(header.end(), {"CV std", "CV min", "CV max"});
   m << MdRow(header) << MdRule(header.size(), 2);
   for (const ReportParameter& p : d.parameters) {
@@ -869,8 +1265,10 @@ void MdParameters(std::ostringstream& m, const ReportData& d) {
                                       Fmt(fmt, p.nominal * s),
                                       Fmt(fmt, p.calibrated * s),
                                       p.has_sigma ? Fmt("%.2g", p.sigma * s) : "-",
-                                      ChangeText(p),
-                                      p.at_bound ? "AT BOUND" : ""};
+                                      p.held ? "-" : ChangeText(p),
+                                      p.held       ? "held at nominal"
+                                      : p.at_bound ? "AT BOUND"
+                                                   : "fitted"};
     if (d.has_cv) {
       cells.insert(cells.end(),
                    {Fmt("%.2g", p.cv_std * s), Fmt(fmt, p.cv_min * s), Fmt(fmt, p.cv_max * s)});
@@ -1021,6 +1419,16 @@ std::string JsonTrajectories(const ReportData& d) {
   return out + "]";
 }
 
+std::string JsonBeforeAfter(double before, double after) {
+  return "{\"before\": " + JsonNumber(before) + ", \"after\": " + JsonNumber(after) + "}";
+}
+
+int WorseCount(const ReportData& d) {
+  int n = 0;
+  for (const ReportRun& r : d.runs) n += GotWorse(r) ? 1 : 0;
+  return n;
+}
+
 std::string JsonDrift(const ReportData& d) {
   std::string out = "[";
   for (std::size_t i = 0; i < d.drift.size(); ++i) {
@@ -1031,7 +1439,8 @@ std::string JsonDrift(const ReportData& d) {
            ", \"after\": " + JsonNumber(r.after_translation_percent) +
            "}, \"rotation_deg_per_m\": {\"before\": " +
            JsonNumber(kDeg * r.before_rotation_rad_per_m) +
-           ", \"after\": " + JsonNumber(kDeg * r.after_rotation_rad_per_m) + "}}";
+           ", \"after\": " + JsonNumber(kDeg * r.after_rotation_rad_per_m) +
+           "}, \"windows_worse\": " + std::to_string(r.windows_worse) + "}";
   }
   return out + "]";
 }
@@ -1075,9 +1484,15 @@ std::string JsonComparison(const ReportData& d) {
 
 }  // namespace
 
+std::string PageStyleSheet() { return kStyle; }
+std::string JsonStringOf(const std::string& text) { return JsonString(text); }
+std::string JsonNumberOf(double value) { return JsonNumber(value); }
+
 std::string MetricsJson(const ReportData& d) {
   std::ostringstream j;
-  j << "{\n  \"tool_version\": " << JsonString(d.tool_version)
+  const ReportSummaryRow* all = d.summary.empty() ? nullptr : &d.summary.back();
+  j << "{\n  \"version\": " << kMetricsJsonVersion << ",\n  \"kind\": \"report\""
+    << ",\n  \"tool_version\": " << JsonString(d.tool_version)
     << ",\n  \"dataset\": " << JsonString(d.dataset)
     << ",\n  \"calibration\": " << JsonString(d.calibration)
     << ",\n  \"robot\": " << JsonString(d.robot_name)
@@ -1085,6 +1500,11 @@ std::string MetricsJson(const ReportData& d) {
     << ",\n  \"verdict\": " << JsonVerdict(d)
     << ",\n  \"training_source\": " << JsonString(d.training_source)
     << ",\n  \"effects\": " << JsonEffects(d) << ",\n  \"per_trajectory\": " << JsonTrajectories(d)
+    << ",\n  \"held_out_runs\": " << d.runs.size()
+    << ",\n  \"held_out_runs_worse\": " << WorseCount(d)
+    << ",\n  \"ate_rmse_m\": "
+    << (all ? JsonBeforeAfter(all->before.rms_distance_m, all->after.rms_distance_m) : "null")
+    << ",\n  \"cf\": " << (all ? JsonBeforeAfter(all->before.cf, all->after.cf) : "null")
     << ",\n  \"drift\": " << JsonDrift(d) << ",\n  \"comparison\": " << JsonComparison(d)
     << ",\n  \"bias\": " << JsonBias(d) << ",\n  \"noise_floor\": " << JsonNoiseFloor(d)
     << ",\n  \"training_repetitions\": " << JsonString(d.training_repetitions)
@@ -1120,7 +1540,10 @@ std::string MetricsJson(const ReportData& d) {
       << "\": " << JsonNumber(p.nominal * s) << ", \"calibrated" << u
       << "\": " << JsonNumber(p.calibrated * s) << ", \"sigma" << u
       << "\": " << (p.has_sigma ? JsonNumber(p.sigma * s) : "null")
-      << ", \"at_bound\": " << (p.at_bound ? "true" : "false");
+      << ", \"at_bound\": " << (p.at_bound ? "true" : "false")
+      << ", \"unit\": " << JsonString(p.unit) << ", \"value\": " << JsonNumber(p.calibrated * s)
+      << ", \"sigma\": " << (p.has_sigma ? JsonNumber(p.sigma * s) : "null")
+      << ", \"held\": " << (p.held ? "true" : "false");
     if (p.has_cv) {
       j << ", \"cv_std" << u << "\": " << JsonNumber(p.cv_std * s) << ", \"cv_min" << u
         << "\": " << JsonNumber(p.cv_min * s) << ", \"cv_max" << u
@@ -1168,7 +1591,8 @@ std::string MetricsJson(const ReportData& d) {
     j << (i ? "," : "") << "\n    {\"run\": " << JsonString(r.id)
       << ", \"trajectory\": " << JsonString(r.trajectory) << ", \"repetition\": " << r.repetition
       << ", \"before\": " << JsonMetrics(r.before) << ", \"after\": " << JsonMetrics(r.after)
-      << "}";
+      << ", \"ate_rmse_m\": " << JsonBeforeAfter(r.before.rms_distance_m, r.after.rms_distance_m)
+      << ", \"got_worse\": " << (GotWorse(r) ? "true" : "false") << "}";
   }
   j << "\n  ]\n}\n";
   return j.str();

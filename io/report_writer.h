@@ -31,6 +31,9 @@ struct ReportRun {
   // Along the run at the ground-truth times, in the run's start frame (start pose at the origin,
   // heading along +x) so that all runs draw the flower of Palacin Fig. 9.
   std::vector<double> t_s;  // since the start of the window
+  // Ground-truth distance travelled from the start of the window to each t_s sample (m): the
+  // x axis of the error-against-distance figures. Empty: the run is left out of them.
+  std::vector<double> along_m;
   std::vector<Point2> ground_truth_xy, before_xy, after_xy;
   std::vector<double> before_distance_m, after_distance_m;  // Eq. 8
   std::vector<double> before_angle_rad, after_angle_rad;    // Eq. 9
@@ -38,8 +41,13 @@ struct ReportRun {
   // error wrap(theta_odometry - theta_ground_truth) (rad).
   Point2 before_final_error, after_final_error;
   double before_final_heading_rad = 0.0, after_final_heading_rad = 0.0;
-  ReportMetrics before, after;
+  ReportMetrics before, after;  // before.rms_distance_m is the run's ATE RMSE (no alignment)
 };
+
+// A held-out run got worse with the calibration: its CF (Eq. 14) or its ATE RMSE (Eq. 12, the
+// odometry started at the ground truth's start pose, no other alignment) rose. The page flags
+// it, metrics.json carries it per run.
+bool GotWorse(const ReportRun& run);
 
 // Table 6 rows: one per trajectory family and one overall.
 struct ReportSummaryRow {
@@ -63,6 +71,7 @@ struct ReportParameter {
   bool at_bound = false;  // resting on a bound of the robot's box
   std::string unit;       // "m" or "deg" (display unit; values below are in SI + rad)
   bool is_angle = false;
+  bool held = false;  // held at its nominal value by the robot YAML: not fitted, no sigma
   double nominal = 0.0;
   double calibrated = 0.0;
   bool has_sigma = false;
@@ -102,6 +111,11 @@ struct ReportDriftRow {
   int windows = 0;
   double before_translation_percent = 0.0, after_translation_percent = 0.0;
   double before_rotation_rad_per_m = 0.0, after_rotation_rad_per_m = 0.0;
+  // Every window, for the box plots (same windows before and after: they are chosen on the
+  // ground truth); empty when only the means are known.
+  std::vector<double> before_translation_percent_windows, after_translation_percent_windows;
+  std::vector<double> before_rotation_rad_per_m_windows, after_rotation_rad_per_m_windows;
+  int windows_worse = 0;  // windows whose translation error rose with the calibration
 };
 
 // The repeatability test of the calibrated final position errors (validation/verdict.h).
@@ -180,6 +194,17 @@ struct ReportFigures {
   // The worst runs (largest calibrated CF, at most worst_runs_drawn), worst first.
   std::vector<std::string> error_along_time;
   std::vector<std::size_t> error_along_time_runs;  // their indices in ReportData::runs
+  // Error against distance travelled: position, then heading; each nominal beside calibrated
+  // (every held-out run thin, the median and quartile band over runs thick).
+  std::string position_error_along_distance;
+  std::string heading_error_along_distance;
+  // Drift per window (every drift length), translation % and rotation deg/m, as box plots.
+  std::string drift_translation_boxes;
+  std::string drift_rotation_boxes;
+  // Held-out runs drawn with their odometry coloured by its position error (evo's picture),
+  // nominal beside calibrated with the ground truth in each; worst calibrated CF first.
+  std::vector<std::string> coloured_tracks;
+  std::vector<std::size_t> coloured_track_runs;
 };
 ReportFigures MakeReportFigures(const ReportData& data);
 
@@ -187,5 +212,15 @@ std::string ReportHtml(const ReportData& data);
 std::string ReportMarkdown(const ReportData& data);
 std::string MetricsCsv(const ReportData& data);
 std::string MetricsJson(const ReportData& data);
+
+// Shared by the pages of `report` and `diagnose` (io/diagnose_page.h): one style sheet (readable
+// from a 390 px phone to a 1400 px desktop), JSON scalars.
+std::string PageStyleSheet();
+std::string JsonStringOf(const std::string& text);
+std::string JsonNumberOf(double value);  // null when not finite
+
+// The layout version of metrics.json (docs/metrics_json.md): raised when a key changes meaning
+// or disappears; keys may be added within a version.
+constexpr int kMetricsJsonVersion = 2;
 
 }  // namespace fitcal::io

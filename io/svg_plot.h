@@ -31,7 +31,21 @@ struct SvgSeries {
   double marker_radius = 3.0;
   double opacity = 1.0;
   std::string dash;  // SVG stroke-dasharray, e.g. "4 3"; empty = solid
+  // Non-empty: each line is a closed polygon filled with this colour (at `opacity`), e.g. the
+  // band between two quantiles; no stroke.
+  std::string fill;
+  // Non-empty (one value per point of each line): the line is drawn in pieces coloured by the
+  // value on SequentialColour's scale from value_lo to value_hi (evo's error-coloured track).
+  std::vector<std::vector<double>> values;
+  double value_lo = 0.0, value_hi = 1.0;
 };
+
+// A colour-blind-safe sequential scale (viridis stops) at u in [0, 1], clamped: dark blue for
+// small values, yellow for large ones.
+std::string SequentialColour(double u);
+
+// A horizontal colour bar of SequentialColour from lo to hi, labelled, `width` pixels wide.
+std::string ColourBarSvg(const std::string& label, double lo, double hi, int width = 360);
 
 struct XYPlotOptions {
   std::string title;
@@ -63,9 +77,25 @@ struct BarChartOptions {
   int height = 360;
 };
 
-// Grouped bars: for each category one bar per series, side by side.
+// Grouped bars: for each category one bar per series, side by side. Category labels that do not
+// fit their group's width side by side are written slanted, with the figure grown to hold them.
 std::string BarChartSvg(const BarChartOptions& options, const std::vector<std::string>& categories,
                         const std::vector<BarSeries>& series);
+
+// Box plots: for each category one box per series, side by side: the box from the first to the
+// third quartile, the median a line across it, whiskers to the farthest value within 1.5
+// interquartile ranges, values beyond them as dots (at most a few hundred drawn).
+struct BoxSeries {
+  std::string name;
+  std::string color;
+  std::vector<std::vector<double>> samples;  // one vector per category
+};
+std::string BoxPlotSvg(const BarChartOptions& options, const std::vector<std::string>& categories,
+                       const std::vector<BoxSeries>& series);
+
+// Estimated width in pixels of `text` at `font_px` in a sans-serif font (0.6 em per character,
+// a little wide for most glyphs): for laying out labels that must not overlap.
+double TextWidthPx(const std::string& text, double font_px);
 
 // Square matrix as coloured cells with the value printed in each: blue for lo, white for the
 // middle, red for hi; a colour bar explains the scale.

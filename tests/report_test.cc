@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "io/diagnose_page.h"
 #include "io/report_writer.h"
 #include "io/svg_plot.h"
 #include "validation/trajectory_family.h"
@@ -81,6 +82,7 @@ ReportData SmallReport() {
     for (int i = 0; i <= 4; ++i) {
       const double t = 0.25 * i;
       r.t_s.push_back(t);
+      r.along_m.push_back(t);
       r.ground_truth_xy.push_back({t, 0.1 * k * t * t});
       r.before_xy.push_back({t, 0.1 * k * t * t + 0.02 * t});
       r.after_xy.push_back({t, 0.1 * k * t * t + 0.002 * t});
@@ -134,7 +136,17 @@ ReportData SmallReport() {
                        {"PASS", "improvement", "summary", "held-out CF 0.06 -> 0.005"}};
   d.training_source = "3 runs of this data set, recorded by id";
   d.trajectories = {all};
-  d.drift = {{1.0, 12, 2.0, 0.2, 0.01, 0.001}};
+  d.drift.resize(1);
+  d.drift[0].length_m = 1.0;
+  d.drift[0].windows = 12;
+  d.drift[0].before_translation_percent = 2.0;
+  d.drift[0].after_translation_percent = 0.2;
+  d.drift[0].before_rotation_rad_per_m = 0.01;
+  d.drift[0].after_rotation_rad_per_m = 0.001;
+  d.drift[0].before_translation_percent_windows = {1.0, 2.0, 3.0};
+  d.drift[0].after_translation_percent_windows = {0.1, 0.2, 0.3};
+  d.drift[0].before_rotation_rad_per_m_windows = {0.01, 0.01, 0.01};
+  d.drift[0].after_rotation_rad_per_m_windows = {0.001, 0.001, 0.001};
   d.effects = {{"time_offset", {"latency_s"}, {0.08}, {0.002}}};
   d.cf_parameters_only = 0.007;
   return d;
@@ -164,12 +176,23 @@ TEST(ReportTest, HtmlIsWellFormedAndEmbedsEveryFigure) {
   }
   ASSERT_FALSE(f.residual_histogram.empty());
   EXPECT_NE(html.find(f.residual_histogram), std::string::npos);
-  // One <svg> per figure: 6 single figures and two (distance, heading) per run drawn (all three
-  // here: fewer than worst_runs_drawn).
+  // The distance pictures: error against distance (position, heading; nominal beside
+  // calibrated), drift boxes (translation, rotation), every run coloured by its error.
+  for (const std::string* fig : {&f.position_error_along_distance, &f.heading_error_along_distance,
+                                 &f.drift_translation_boxes, &f.drift_rotation_boxes}) {
+    ASSERT_FALSE(fig->empty());
+    EXPECT_EQ(CheckWellFormed("<!DOCTYPE html>" + *fig), "");
+    EXPECT_NE(html.find(*fig), std::string::npos);
+  }
+  ASSERT_EQ(f.coloured_tracks.size(), d.runs.size());
+  for (const std::string& fig : f.coloured_tracks) EXPECT_NE(html.find(fig), std::string::npos);
+  // One <svg> per figure: 6 single figures, two (distance, heading) per run drawn (all three
+  // here: fewer than worst_runs_drawn), 2 x 2 error-against-distance panels, 2 drift box plots,
+  // two coloured tracks per run and their colour bar.
   std::size_t svgs = 0;
   for (std::size_t p = html.find("<svg"); p != std::string::npos; p = html.find("<svg", p + 1))
     ++svgs;
-  EXPECT_EQ(svgs, 6 + 2 * d.runs.size());
+  EXPECT_EQ(svgs, 6 + 2 * d.runs.size() + 4 + 2 + 2 * d.runs.size() + 1);
   // Clip-path ids must be unique within the document.
   std::set<std::string> ids;
   const std::regex id_re("id=\"([^\"]+)\"");
@@ -345,6 +368,202 @@ TEST(SvgPlotTest, TicksEscapingAndLabels) {
   const double dx = std::stod(m[3]) - std::stod(m[1]);
   const double dy = std::stod(m[2]) - std::stod(m[4]);
   EXPECT_NEAR(dy / dx, 2.0, 0.01);  // the segment (1, 2) keeps its slope on screen
+}
+
+// Category labels under a bar chart: the horizontal extent of each (level: its estimated width;
+// upright: one line height) must not reach into its neighbour's. Returns "" or the first overlap.
+std::string LabelOverlap(const std::string& svg, const std::vector<std::string>& labels) {
+  std::vector<std::pair<double, double>> spans;
+  for (const std::string& label : labels) {
+    const std::string needle = ">" + label + "</text>";
+    const std::size_t end = svg.find(needle);
+    if (end == std::string::npos) return "label " + label + " missing";
+    const std::size_t start = svg.rfind("<text", end);
+    const std::string tag = svg.substr(start, end - start);
+    std::smatch m;
+    if (!std::regex_search(tag, m, std::regex("x=\"([-0-9.]+)\".*font-size=\"([0-9]+)\""))) {
+      return "unparsed " + tag;
+    }
+    const double x = std::stod(m[1]), font = std::stod(m[2]);
+    const bool upright = tag.find("rotate(-90") != std::string::npos;
+    const double half = upright ? 0.5 * font : 0.5 * TextWidthPx(label, font);
+    spans.push_back({x - half, x + half});
+  }
+  for (std::size_t i = 1; i < spans.size(); ++i) {
+    if (spans[i].first < spans[i - 1].second) return labels[i - 1] + " overlaps " + labels[i];
+  }
+  return "";
+}
+
+// The defect seen on the differential drive: 21 session-stamped trajectory labels under 1100 px
+// of bars were written level and overlapped. Short labels stay level.
+TEST(SvgPlotTest, BarLabelsNeverOverlap) {
+  std::vector<std::string> labels;
+  BarSeries a{"nominal", "#d55e00", {}}, b{"calibrated", "#0072b2", {}};
+  for (int k = 0; k < 21; ++k) {
+    labels.push_back("circular_2306202021" + std::to_string(10 + k));
+    a.values.push_back(1.0 + k);
+    b.values.push_back(0.5 + k);
+  }
+  BarChartOptions o;
+  o.title = "T";
+  const std::string svg = BarChartSvg(o, labels, {a, b});
+  EXPECT_EQ(LabelOverlap(svg, labels), "");
+  EXPECT_EQ(CheckWellFormed("<!DOCTYPE html>" + svg), "");
+  const std::vector<std::string> few = {"R1", "G1", "B1"};
+  const std::string level = BarChartSvg(o, few, {a, b});
+  EXPECT_EQ(LabelOverlap(level, few), "");
+  EXPECT_EQ(level.find("rotate(-90 "), level.rfind("rotate(-90 "));  // only the y-axis title
+  // Box plots share the layout.
+  const std::string boxes = BoxPlotSvg(o, labels, {{"n", "#d55e00", {{1, 2, 3, 10}}}});
+  EXPECT_EQ(LabelOverlap(boxes, labels), "");
+}
+
+// The defect seen on three-parameter robots: the heat map was narrower than its title (clipped),
+// and the diff drive's correlations of 0.9993-0.9999 read 1.00 like the diagonal.
+TEST(SvgPlotTest, ThreeParameterHeatMapIsWholeAndReadable) {
+  const std::string title = "Correlation of the fitted parameters (-1 blue, +1 red)";
+  const std::vector<std::vector<double>> c = {{1.0, 0.9999, -0.9991}, {0.9999, 1.0, 0.5},
+                                              {-0.9991, 0.5, 1.0}};
+  const std::string svg = HeatMapSvg(title, {"r_R", "r_L", "b"}, c);
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(svg, m, std::regex("viewBox=\"0 0 ([0-9]+) ")));
+  EXPECT_GE(std::stod(m[1]), TextWidthPx(title, 15));
+  // Row labels start inside the figure; column labels do not overlap (the diff drive's
+  // "wheel_separation" was cut on the left and ran into "r_left" below).
+  const std::vector<std::string> labels = {"r_right", "r_left", "wheel_separation"};
+  const std::string named = HeatMapSvg(title, labels, c);
+  std::smatch row;
+  ASSERT_TRUE(std::regex_search(named, row,
+                                std::regex("<text x=\"([0-9.]+)\"[^>]*text-anchor=\"end\""
+                                           "[^>]*>wheel_separation<")));
+  EXPECT_GE(std::stod(row[1]), TextWidthPx("wheel_separation", 12));
+  const std::string columns_only =
+      std::regex_replace(named, std::regex("<text [^>]*text-anchor=\"end\">[^<]*</text>"), "");
+  EXPECT_EQ(LabelOverlap(columns_only, labels), "");
+  EXPECT_NE(svg.find(">0.9999<"), std::string::npos);  // the recorded 4 digits, not 1.00
+  EXPECT_NE(svg.find(">-0.9991<"), std::string::npos);
+  EXPECT_NE(svg.find(">1.00<"), std::string::npos);  // the diagonal
+  EXPECT_NE(svg.find(">0.50<"), std::string::npos);
+}
+
+// Parameters a robot YAML holds at nominal (omni4's) say so on the page and in metrics.json.
+TEST(ReportTest, HeldParametersAreMarkedHeld) {
+  ReportData d = SmallReport();
+  d.parameters[8].held = true;
+  d.parameters[8].has_sigma = false;
+  d.parameters[8].calibrated = d.parameters[8].nominal;
+  const std::string html = ReportHtml(d);
+  EXPECT_NE(html.find("<td class=\"held\">held at nominal</td>"), std::string::npos);
+  EXPECT_NE(ReportMarkdown(d).find("held at nominal"), std::string::npos);
+  EXPECT_NE(MakeReportFigures(d).correlation.find(">delta_c (held)<"), std::string::npos);
+  const YAML::Node j = YAML::Load(MetricsJson(d));
+  EXPECT_TRUE(j["parameters"][8]["held"].as<bool>());
+  EXPECT_TRUE(j["parameters"][8]["sigma"].IsNull());
+  EXPECT_FALSE(j["parameters"][0]["held"].as<bool>());
+  EXPECT_NEAR(j["parameters"][0]["value"].as<double>(), 0.195 * 1.01, 1e-12);
+  EXPECT_NEAR(j["parameters"][0]["sigma"].as<double>(), 1e-4, 1e-15);
+}
+
+// A held-out run whose error rose is flagged by name on the page, counted in the key numbers and
+// marked in metrics.json; with none, the page says none.
+TEST(ReportTest, HeldOutRunsThatGotWorseAreFlagged) {
+  ReportData d = SmallReport();
+  EXPECT_NE(ReportHtml(d).find("None: every one of the 3 held-out runs"), std::string::npos);
+  d.runs[1].after.cf = 0.2;  // worse than its 0.06
+  d.runs[1].after.rms_distance_m = 0.05;
+  d.runs[1].before.rms_distance_m = 0.01;
+  const std::string html = ReportHtml(d);
+  EXPECT_NE(html.find("1 of 3 held-out runs got worse"), std::string::npos);
+  EXPECT_NE(html.find("held-out runs that got worse: 1 of 3"), std::string::npos);
+  EXPECT_NE(ReportMarkdown(d).find("held-out runs that got worse: 1 of 3 (" + d.runs[1].id + ")"),
+            std::string::npos);
+  const std::size_t section = html.find("id=\"worse\"");
+  ASSERT_NE(section, std::string::npos);
+  EXPECT_NE(html.find("<td>" + d.runs[1].id + "</td>", section), std::string::npos);
+  EXPECT_NE(html.find(": got worse</h3>"), std::string::npos);  // above its coloured track
+  EXPECT_EQ(CheckWellFormed(html), "");
+  const YAML::Node j = YAML::Load(MetricsJson(d));
+  EXPECT_EQ(j["held_out_runs_worse"].as<int>(), 1);
+  EXPECT_TRUE(j["runs"][1]["got_worse"].as<bool>());
+  EXPECT_FALSE(j["runs"][0]["got_worse"].as<bool>());
+  EXPECT_NEAR(j["runs"][1]["ate_rmse_m"]["after"].as<double>(), 0.05, 1e-12);
+}
+
+// Every % change of the page has one sign (after - before): the CF that fell from 0.06 to 0.005
+// reads -91.7 % in the summary of the page and of summary.md, and a parameter that grew by 1 %
+// reads +1.00 %.
+TEST(ReportTest, PercentChangesHaveOneSign) {
+  const ReportData d = SmallReport();
+  const std::string html = ReportHtml(d);
+  EXPECT_NE(html.find("<td class=\"better\">-91.7 %</td>"), std::string::npos);
+  EXPECT_EQ(html.find("+91.7 %"), std::string::npos);
+  EXPECT_NE(html.find("+1.00 %"), std::string::npos);
+  const std::string md = ReportMarkdown(d);
+  EXPECT_NE(md.find("| -91.7 % |"), std::string::npos);
+  EXPECT_EQ(md.find("+91.7 %"), std::string::npos);
+}
+
+// metrics.json is a contract (docs/metrics_json.md): its version, the ATE and the drift.
+TEST(ReportTest, MetricsJsonCarriesTheContract) {
+  ReportData d = SmallReport();
+  d.summary.back().before.rms_distance_m = 0.03;
+  d.summary.back().after.rms_distance_m = 0.004;
+  d.drift[0].windows_worse = 1;
+  const YAML::Node j = YAML::Load(MetricsJson(d));
+  EXPECT_EQ(j["version"].as<int>(), kMetricsJsonVersion);
+  EXPECT_EQ(j["kind"].as<std::string>(), "report");
+  EXPECT_NEAR(j["ate_rmse_m"]["before"].as<double>(), 0.03, 1e-12);
+  EXPECT_NEAR(j["ate_rmse_m"]["after"].as<double>(), 0.004, 1e-12);
+  EXPECT_NEAR(j["drift"][0]["length_m"].as<double>(), 1.0, 1e-12);
+  EXPECT_EQ(j["drift"][0]["windows"].as<int>(), 12);
+  EXPECT_EQ(j["drift"][0]["windows_worse"].as<int>(), 1);
+  EXPECT_NEAR(j["drift"][0]["rotation_deg_per_m"]["before"].as<double>(), 0.01 * 180 / M_PI, 1e-9);
+  EXPECT_EQ(j["verdict"]["level"].as<std::string>(), "WARN");
+}
+
+// The diagnose page: well formed, every section and picture there, metrics.json with the same
+// held-out CF the page prints (computed the report's way) and the gate's own CF beside it.
+TEST(DiagnosePageTest, PageAndMetricsJson) {
+  DiagnosePageData d;
+  d.level = "PARTIAL";
+  d.conclusion = "Effects accepted <but> structure remains.";
+  d.dataset = "data";
+  d.structure = {{"lack of fit, declared fit", "F = 3 on (9, 40) dof", 1e-5, true, "structure"},
+                 {"lack of fit, final model", "F = 1.1 on (9, 40) dof", 0.4, false, "structure"}};
+  d.candidates = {{1, "yaw_rate_slip", 0.4, true, true, 0.01, 1e-6, 0.001, -12, true, true, "ok"},
+                  {1, "time_offset", 0.01, false, false, 0, 1, 0.001, 0, false, false, "no"}};
+  d.gate = {{"nominal", 0.05, false}, {"track fit + effects", 0.011, true}};
+  d.selected = "track fit + effects";
+  d.held_out = {{"run1", 0.04, 0.01, 0.02, 0.004, {0.01, 0.02}, {0.001, 0.002}},
+                {"run2", 0.06, 0.07, 0.03, 0.005, {0.01, 0.02}, {0.001, 0.002}}};
+  d.unexplained = {"the residual drifts with run order"};
+  ReportParameter held;
+  held.name = "L2";
+  held.unit = "m";
+  held.held = true;
+  d.parameters = {held};
+  const std::string html = DiagnoseHtml(d);
+  EXPECT_EQ(CheckWellFormed(html), "");
+  for (const char* id : {"id=\"structure\"", "id=\"effects\"", "id=\"heldout\"",
+                         "id=\"unexplained\"", "held at nominal", "&lt;but&gt;",
+                         "held-out runs that got worse (CF or ATE rose): 1 of 2"}) {
+    EXPECT_NE(html.find(id), std::string::npos) << id;
+  }
+  std::size_t svgs = 0;
+  for (std::size_t p = html.find("<svg"); p != std::string::npos; p = html.find("<svg", p + 1))
+    ++svgs;
+  EXPECT_EQ(svgs, 3u);  // residual, evidence, before/after
+  const YAML::Node j = YAML::Load(DiagnoseMetricsJson(d));
+  EXPECT_EQ(j["version"].as<int>(), kMetricsJsonVersion);
+  EXPECT_EQ(j["kind"].as<std::string>(), "diagnose");
+  EXPECT_EQ(j["verdict"]["level"].as<std::string>(), "PARTIAL");
+  EXPECT_NEAR(j["cf"]["before"].as<double>(), 0.05, 1e-12);
+  EXPECT_NEAR(j["cf"]["after"].as<double>(), 0.04, 1e-12);
+  EXPECT_NEAR(j["ate_rmse_m"]["after"].as<double>(), 0.0045, 1e-12);
+  EXPECT_NEAR(j["gate_cf"][1]["cf"].as<double>(), 0.011, 1e-12);
+  EXPECT_TRUE(j["parameters"][0]["held"].as<bool>());
+  EXPECT_TRUE(j["parameters"][0]["sigma"].IsNull());
 }
 
 // The family the report's summary rows and the residual statistics group runs by: the flower's

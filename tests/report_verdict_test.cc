@@ -158,6 +158,18 @@ TEST(VerdictTest, NoiseFloorTestSeesASystematicResidual) {
   EXPECT_EQ(Find(JudgeCalibration(in), "noise_floor")->level, VerdictLevel::kWarn);
   EXPECT_EQ(JudgeCalibration(in).level, VerdictLevel::kWarn);
 
+  // Significant (p = 3e-5, as seen on a real robot) but smaller than one run's own noise: PASS,
+  // and the message says the residual is detectable, never "at the noise floor" beside a tiny p.
+  NoiseFloorTest small = a;
+  small.p_value = 3e-5;
+  small.systematic_rms_m = 1.2 * small.noise_sigma_m;
+  in.noise_floor = small;
+  const VerdictReason* r = Find(JudgeCalibration(in), "noise_floor");
+  EXPECT_EQ(r->level, VerdictLevel::kPass);
+  EXPECT_EQ(r->message.find("at the noise floor"), std::string::npos) << r->message;
+  EXPECT_NE(r->message.find("detectable"), std::string::npos) << r->message;
+  EXPECT_NE(r->message.find("p = 3e-05"), std::string::npos) << r->message;
+
   // One run per trajectory: no scatter to compare with.
   EXPECT_FALSE(TestAgainstNoiseFloor({{"A", 0.01, 0.0}, {"B", 0.0, 0.01}}).available);
 }

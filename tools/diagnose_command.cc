@@ -14,6 +14,7 @@
 #include "io/atomic_file.h"
 #include "io/calibration_block.h"
 #include "io/dataset.h"
+#include "io/diagnose_page.h"
 #include "io/input_error.h"
 #include "io/robot_yaml.h"
 #include "io/robot_yaml_blocks.h"
@@ -24,6 +25,7 @@
 #include "tools/output_guard.h"
 #include "validation/run_split.h"
 #include "validation/training_runs.h"
+#include "validation/trajectory_metrics.h"
 #include "validation/trajectory_split.h"
 
 namespace fitcal::tools {
@@ -39,8 +41,11 @@ void AddDiagnoseOptions(CLI::App& cmd, DiagnoseCommandOptions& o) {
                  "(e.g. ^circular); matching runs train, the others validate");
   cmd.add_flag("--clock-map", o.clock_map,
                "Re-stamp each run's ground truth on the encoder clock (speed-profile match)");
-  cmd.add_option("--out", o.out, "Output directory (diagnose.md, residuals.csv, calibrated.yaml)")
+  cmd.add_option("--out", o.out,
+                 "Output directory (index.html, metrics.json, diagnose.md, calibrated.yaml)")
       ->capture_default_str();
+  cmd.add_flag("--csv", o.csv,
+               "Also write residuals.csv and residuals_declared.csv (every ground-truth sample)");
   cmd.add_option("--max-effects", o.max_effects, "Most effects to add")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
@@ -51,7 +56,8 @@ void AddDiagnoseOptions(CLI::App& cmd, DiagnoseCommandOptions& o) {
 
 namespace {
 
-const std::set<std::string> kDiagnoseFiles = {"diagnose.md", "residuals.csv",
+const std::set<std::string> kDiagnoseFiles = {"index.html",    "metrics.json",
+                                              "diagnose.md",   "residuals.csv",
                                               "residuals_declared.csv", "calibrated.yaml"};
 
 struct DiagnoseSplit {
@@ -125,7 +131,8 @@ DiagnoseChoice FitChoice(const std::string& name, const std::vector<double>& par
 }
 
 DiagnoseChoice GateDiagnosis(const RobotModelInterface& model, const DiagnoseSplit& split,
-                             const DiagnoseResult& result, int threads) {
+                             const DiagnoseResult& result, int threads,
+                             std::vector<DiagnoseChoice>* gate) {
   const std::vector<double>& nominal = model.robot().nominal;
   const auto cf = [&](const std::vector<double>& p, const EffectModel& e) {
     return ScoreModel(model, p, e, split.validation, {}, threads).cf;
@@ -159,6 +166,7 @@ DiagnoseChoice GateDiagnosis(const RobotModelInterface& model, const DiagnoseSpl
   };
   candidates[best].cf_training_before = cf_training(candidates[0]);
   candidates[best].cf_training_after = cf_training(candidates[best]);
+  *gate = candidates;
   return candidates[best];
 }
 
@@ -259,18 +267,162 @@ void MapClocks(const std::string& robot_path, const RobotModelInterface& model, 
   *runs = ApplyClockChoice(choice, std::move(*runs), mapped);
 }
 
+std::string Format(const char* format, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, format, v);
+  return buf;
+}
+
+// The verdict of the page: effects named as causes, effects that only describe part of a
+// structure, structure and no effect, or nothing at all.
+void SetConclusion(const DiagnoseResult& r, io::DiagnosePageData* page) {
+  const bool any_effect = !r.final_fit.effects.empty();
+  if (r.effects_named) {
+    page->level = "EFFECTS_NAMED";
+    page->conclusion = "The residual is explained by the effect(s) accepted below; nothing "
+                       "structured remains.";
+  } else if (any_effect) {
+    page->level = "PARTIAL";
+    page->conclusion = "Effects were accepted, but structure remains: they describe part of it "
+                       "and may stand in for an effect outside the library.";
+  } else if (r.unexplained_structure) {
+    page->level = "UNEXPLAINED";
+    page->conclusion = "The residual has structure that no candidate effect explains.";
+  } else {
+    page->level = "NOTHING_FOUND";
+    page->conclusion = "No structure beyond the noise and no effect that earns its place: the "
+                       "model's parameters are enough for these runs.";
+  }
+}
+
+void AddStructureTests(const DiagnoseResult& r, io::DiagnosePageData* page) {
+  const auto lof = [&](const char* name, const LackOfFit& l) {
+    if (!l.available) return;
+    page->structure.push_back(
+        {name, "F = " + Format("%.2f", l.f) + " on (" + Format("%.0f", l.df_lof) + ", " +
+                   Format("%.0f", l.df_pe) + ") dof",
+         l.p_value, l.p_value < DiagnoseOptions{}.lof_alpha,
+         "the repetitions of a trajectory agree with each other better than with the model"});
+  };
+  lof("lack of fit, declared fit", r.before.lack_of_fit);
+  lof("lack of fit, final model", r.after.lack_of_fit);
+  const SensorFloorTest& floor = r.after.sensor_floor;
+  if (floor.available) {
+    page->structure.push_back({"residual against the sensors' noise, final model",
+                               Format("%.2f x the floor", floor.ratio), floor.p_value,
+                               r.above_sensor_floor,
+                               "the residual is larger than the sensors' own noise explains"});
+  }
+  for (const CovariateTest& t : r.covariates.tests) {
+    if (!t.tested) continue;
+    page->structure.push_back({"residual against " + t.name, "F = " + Format("%.2f", t.f),
+                               t.p_value, t.significant, CovariateFinding(t)});
+  }
+}
+
+void AddCandidates(const DiagnoseResult& r, double alpha, io::DiagnosePageData* page) {
+  for (std::size_t k = 0; k < r.rounds.size(); ++k) {
+    const double threshold = alpha / std::max<double>(1.0, r.rounds[k].candidates.size());
+    for (const CandidateResult& c : r.rounds[k].candidates) {
+      page->candidates.push_back({static_cast<int>(k) + 1, effects::Info(c.id).name,
+                                  c.separable_fraction, c.resolvable, c.fitted,
+                                  c.mean_improvement, c.p_value, threshold, c.delta_bic,
+                                  c.explains, c.accepted, c.verdict});
+    }
+  }
+}
+
+// Nominal and the written calibration on each held-out run, as `report` computes them
+// (validation/trajectory_metrics.h), so that both commands print one CF for one calibration.
+void AddHeldOut(const RobotModelInterface& model, const DiagnoseSplit& split,
+                const DiagnoseChoice& choice, io::DiagnosePageData* page) {
+  for (const TrackRun& run : split.validation) {
+    const TrajectoryErrors b =
+        EvaluateTrajectory(model, run.aligned, run.track, model.robot().nominal, {});
+    const TrajectoryErrors a =
+        EvaluateTrajectory(model, run.aligned, run.track, choice.parameters, choice.effects);
+    const auto start_frame = [&](const TrajectoryErrors& e) {
+      const double c = std::cos(run.aligned.start.theta), s = std::sin(run.aligned.start.theta);
+      const double dx = e.final_odometry.x - e.final_ground_truth.x;
+      const double dy = e.final_odometry.y - e.final_ground_truth.y;
+      return io::Point2{c * dx + s * dy, -s * dx + c * dy};
+    };
+    page->held_out.push_back({run.aligned.id, b.cf, a.cf, b.rms_distance_m, a.rms_distance_m,
+                              start_frame(b), start_frame(a)});
+  }
+}
+
+io::DiagnosePageData MakePage(const DiagnoseCommandOptions& options,
+                              const RobotModelInterface& model, const DiagnoseSplit& split,
+                              const DiagnoseResult& result, const std::vector<DiagnoseChoice>& gate,
+                              const DiagnoseChoice& choice, const std::string& report) {
+  io::DiagnosePageData page;
+  const Robot& robot = model.robot();
+  page.tool_version = kVersion;
+  page.dataset = options.logs;
+  page.split = split.text;
+  page.robot_name = robot.name;
+  page.model = robot.model;
+  page.selected = choice.name;
+  page.text_report = report;
+  page.csv_written = options.csv;
+  SetConclusion(result, &page);
+  AddStructureTests(result, &page);
+  AddCandidates(result, options.alpha, &page);
+  for (const DiagnoseChoice& c : gate)
+    page.gate.push_back({c.name, c.cf_after, c.name == choice.name});
+  AddHeldOut(model, split, choice, &page);
+  page.unexplained = result.not_identifiable;
+  for (const CovariateTest& t : result.covariates.tests) {
+    if (t.significant) page.unexplained.push_back(CovariateFinding(t));
+  }
+  if (result.unexplained_structure && page.unexplained.empty()) {
+    page.unexplained.push_back("structure in the residual that no candidate effect explains "
+                               "(see the tests above)");
+  }
+  for (const std::string& line : result.record_next) page.unexplained.push_back(line);
+  const bool has_sigma = static_cast<int>(choice.sigma.size()) == robot.NumParameters();
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    io::ReportParameter p;
+    p.name = robot.parameters[k].name;
+    p.is_angle = robot.parameters[k].unit == ParameterUnit::kAngle;
+    p.unit = robot.parameters[k].DisplayUnit();
+    p.held = robot.IsHeld(k);
+    p.nominal = robot.nominal[k];
+    p.calibrated = choice.parameters[k];
+    p.has_sigma = has_sigma && !p.held;
+    p.sigma = has_sigma ? choice.sigma[k] : 0.0;
+    page.parameters.push_back(p);
+  }
+  for (const effects::EffectValue& value : choice.effects) {
+    const effects::EffectInfo& info = effects::Info(value.id);
+    io::ReportEffect e;
+    e.name = info.name;
+    for (int k = 0; k < info.num_parameters; ++k) {
+      e.parameter_names.push_back(info.parameter_names[k]);
+      e.values.push_back(value.value[k]);
+      e.sigmas.push_back(value.sigma[k]);
+    }
+    page.effects.push_back(e);
+  }
+  return page;
+}
+
 void WriteOutputs(const DiagnoseCommandOptions& options, const std::vector<std::string>& inputs,
                   const std::string& report, const DiagnoseResult& result,
-                  const std::string& yaml) {
-  const std::string csv = ResidualSamplesCsv(result.after);
-  const std::string csv_declared = ResidualSamplesCsv(result.before);
+                  const io::DiagnosePageData& page, const std::string& yaml) {
   // Written as a set: staged, then renamed over the previous output (report_command.cc).
   io::StagedDirectory staged(options.out);
   const std::filesystem::path dir(staged.path());
   io::WriteFileAtomically((dir / "diagnose.md").string(), report);
-  io::WriteFileAtomically((dir / "residuals.csv").string(), csv);
-  io::WriteFileAtomically((dir / "residuals_declared.csv").string(), csv_declared);
+  io::WriteFileAtomically((dir / "index.html").string(), io::DiagnoseHtml(page));
+  if (options.csv) {
+    io::WriteFileAtomically((dir / "residuals.csv").string(), ResidualSamplesCsv(result.after));
+    io::WriteFileAtomically((dir / "residuals_declared.csv").string(),
+                            ResidualSamplesCsv(result.before));
+  }
   io::StopHereForTests("diagnose-staged");
+  io::WriteFileAtomically((dir / "metrics.json").string(), io::DiagnoseMetricsJson(page));
   io::WriteFileAtomically((dir / "calibrated.yaml").string(), yaml);
   CommitOutputDirectory(staged, options.out, inputs, kDiagnoseFiles);
 }
@@ -325,7 +477,8 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
                                ", fitcal " + kVersion + "\n\n" +
                                FormatDiagnoseReport(result, *model);
     std::printf("%s", report.c_str());
-    const DiagnoseChoice choice = GateDiagnosis(*model, split, result, options.threads);
+    std::vector<DiagnoseChoice> gate;
+    const DiagnoseChoice choice = GateDiagnosis(*model, split, result, options.threads, &gate);
     if (choice.name == "nominal") {
       std::cerr << "fitcal: no calibration beats the nominal robot on the held-out runs; nothing "
                    "written\n";
@@ -334,10 +487,14 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
     const std::string yaml =
         omni3 ? Omni3CalibratedYaml(options, index.robot_path, runs, split, result, choice)
               : ModelCalibratedYaml(options, *model, runs, split, result, choice);
-    WriteOutputs(options, inputs, report, result, yaml);
-    std::printf(
-        "\nwrote %s/{diagnose.md, residuals.csv, residuals_declared.csv, calibrated.yaml}\n",
-        options.out.c_str());
+    const io::DiagnosePageData page =
+        MakePage(options, *model, split, result, gate, choice, report);
+    WriteOutputs(options, inputs, report, result, page, yaml);
+    std::printf("\nheld-out runs as `report` computes them: CF %.4f -> %.4f\n",
+                io::HeldOutMean(page.held_out, &io::DiagnoseHeldOutRun::cf_before),
+                io::HeldOutMean(page.held_out, &io::DiagnoseHeldOutRun::cf_after));
+    std::printf("\nwrote %s/{index.html, metrics.json, diagnose.md, calibrated.yaml%s}\n",
+                options.out.c_str(), options.csv ? ", residuals.csv, residuals_declared.csv" : "");
     return 0;
   });
 }

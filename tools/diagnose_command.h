@@ -2,10 +2,13 @@
 // `fitcal diagnose --logs <dir>`: the declared nine-parameter fit, its residual, the tracing of
 // that residual to library effects (diagnosis/diagnose.h), the error before and after on held-out
 // repetitions. Prints the report and writes, into --out (a directory):
+//   index.html      the page (io/diagnose_page.h): structure tested, effects tried, before and
+//                   after on the held-out runs as `report` computes them, what stays unexplained
+//   metrics.json    its numbers (docs/metrics_json.md, kind "diagnose")
 //   diagnose.md     the report (Markdown)
-//   residuals.csv   the pose error at every ground-truth sample of every run, after the tracing
-//                   (world and robot frame); residuals_declared.csv the same for the declared fit
 //   calibrated.yaml the calibrated robot; carries the `effects:` list when effects were named
+//   with --csv also residuals.csv (the pose error at every ground-truth sample of every run,
+//                   after the tracing) and residuals_declared.csv (the declared fit's)
 
 #include <string>
 
@@ -29,6 +32,7 @@ struct DiagnoseCommandOptions : DatasetCommandOptions {
   std::string out = "diagnose";
   int max_effects = 3;
   double alpha = 0.01;
+  bool csv = false;  // also write the residual CSVs (large: every ground-truth sample)
 };
 
 // Declares every flag of `diagnose` on its subcommand `cmd`, bound to `options`.

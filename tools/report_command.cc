@@ -24,6 +24,7 @@
 #include "io/report_writer.h"
 #include "io/robot_yaml.h"
 #include "io/staged_directory.h"
+#include "io/tum_file.h"
 #include "models/model_registry.h"
 #include "odometry/effects.h"
 #include "tools/cli_validators.h"
@@ -42,7 +43,7 @@ namespace fitcal::tools {
 namespace {
 
 const std::set<std::string> kReportFiles = {"index.html", "summary.md", "metrics.csv",
-                                            "metrics.json"};
+                                            "metrics.json", "tum"};
 
 // TrajectoryErrors (one run) and Table6Averages (a group) carry the same Eq. 8-14 fields.
 template <typename Metrics>
@@ -237,6 +238,12 @@ io::ReportRun MakeReportRun(const AlignedRun& run, const TrajectoryErrors& b,
     r.path_length_m += std::hypot(r.ground_truth_xy[i].x - r.ground_truth_xy[i - 1].x,
                                   r.ground_truth_xy[i].y - r.ground_truth_xy[i - 1].y);
   }
+  // Distance travelled along the ground truth at each sample (the drift windows' measure).
+  r.along_m.assign(b.ground_truth.size(), 0.0);
+  for (std::size_t i = 1; i < b.ground_truth.size(); ++i) {
+    r.along_m[i] = r.along_m[i - 1] + std::hypot(b.ground_truth[i].x - b.ground_truth[i - 1].x,
+                                                 b.ground_truth[i].y - b.ground_truth[i - 1].y);
+  }
   r.before_distance_m = b.distance_error_m;
   r.after_distance_m = a.distance_error_m;
   r.before_angle_rad = b.angle_error_rad;
@@ -310,19 +317,52 @@ void AddStatistics(const EvaluatedRuns& e, io::ReportData* data) {
   }
 }
 
-// Relative pose error over path lengths suited to these runs (validation/relative_pose_error.h).
-void AddDrift(const EvaluatedRuns& e, io::ReportData* data) {
+// The drift lengths of the report: those suited to these runs (RelativePoseErrorLengths of the
+// median path length) and the everyday 1, 2 and 5 m wherever some run is long enough for them.
+std::vector<double> DriftLengths(const EvaluatedRuns& e, const io::ReportData& data) {
   std::vector<double> lengths;
-  for (const io::ReportRun& r : data->runs) lengths.push_back(r.path_length_m);
-  for (double length : RelativePoseErrorLengths(Summarize(lengths).median)) {
+  for (const io::ReportRun& r : data.runs) lengths.push_back(r.path_length_m);
+  std::set<double> out;
+  for (double l : RelativePoseErrorLengths(Summarize(lengths).median)) out.insert(l);
+  for (double l : {1.0, 2.0, 5.0}) {
+    for (const TrajectoryErrors& b : e.before) {
+      if (!RelativePoseErrorWindows(b.ground_truth, b.odometry, l).empty()) {
+        out.insert(l);
+        break;
+      }
+    }
+  }
+  return {out.begin(), out.end()};
+}
+
+// Relative pose error (validation/relative_pose_error.h): the mean over every window of every
+// validation run, and each window for the box plots.
+void AddDrift(const EvaluatedRuns& e, io::ReportData* data) {
+  for (double length : DriftLengths(e, *data)) {
+    io::ReportDriftRow row;
+    row.length_m = length;
     RelativePoseErrorSum before, after;
     for (std::size_t i = 0; i < e.before.size(); ++i) {
       AddRelativePoseErrors(e.before[i].ground_truth, e.before[i].odometry, length, &before);
       AddRelativePoseErrors(e.after[i].ground_truth, e.after[i].odometry, length, &after);
+      const auto wb = RelativePoseErrorWindows(e.before[i].ground_truth, e.before[i].odometry,
+                                               length);
+      const auto wa = RelativePoseErrorWindows(e.after[i].ground_truth, e.after[i].odometry,
+                                               length);
+      for (std::size_t k = 0; k < std::min(wb.size(), wa.size()); ++k) {
+        row.before_translation_percent_windows.push_back(100.0 * wb[k].translation_ratio);
+        row.after_translation_percent_windows.push_back(100.0 * wa[k].translation_ratio);
+        row.before_rotation_rad_per_m_windows.push_back(wb[k].rotation_rad_per_m);
+        row.after_rotation_rad_per_m_windows.push_back(wa[k].rotation_rad_per_m);
+        row.windows_worse += wa[k].translation_ratio > wb[k].translation_ratio ? 1 : 0;
+      }
     }
-    data->drift.push_back({length, before.windows, before.MeanTranslationPercent(),
-                           after.MeanTranslationPercent(), before.MeanRotationRadPerM(),
-                           after.MeanRotationRadPerM()});
+    row.windows = before.windows;
+    row.before_translation_percent = before.MeanTranslationPercent();
+    row.after_translation_percent = after.MeanTranslationPercent();
+    row.before_rotation_rad_per_m = before.MeanRotationRadPerM();
+    row.after_rotation_rad_per_m = after.MeanRotationRadPerM();
+    data->drift.push_back(std::move(row));
   }
 }
 
@@ -478,6 +518,7 @@ void AddParameters(const ReportInputs& in, const CalibrationInput& cal,
     rp.name = robot.parameters[k].name;
     rp.is_angle = robot.parameters[k].unit == ParameterUnit::kAngle;
     rp.unit = robot.parameters[k].DisplayUnit();
+    rp.held = robot.IsHeld(k);
     rp.nominal = robot.nominal[k];
     rp.calibrated = cal.calibrated.nominal[k];
     rp.has_sigma = has_sigma && !robot.IsHeld(k);
@@ -564,8 +605,26 @@ std::string CalibrationNote(const CalibrationInput& cal) {
          ", trained on data set " + (p.dataset.empty() ? "not recorded" : p.dataset);
 }
 
+// tum/<run>.{ground_truth,nominal,calibrated}.tum: the world poses at the ground-truth times on
+// which the report's ATE (Eq. 12) and drift are computed, the odometry started at the ground
+// truth's start pose (docs/tum.md gives the evo commands that reproduce the figures).
+void WriteTumFiles(const std::string& dir, const EvaluatedRuns& e) {
+  namespace fs = std::filesystem;
+  fs::create_directories(fs::path(dir) / "tum");
+  for (std::size_t i = 0; i < e.before.size(); ++i) {
+    const std::string stem =
+        (fs::path(dir) / "tum" / io::FileNameOf(e.split.split.validation[i].id)).string();
+    io::WriteFileAtomically(stem + ".ground_truth.tum",
+                            io::TumText(e.before[i].t_s, e.before[i].ground_truth));
+    io::WriteFileAtomically(stem + ".nominal.tum",
+                            io::TumText(e.before[i].t_s, e.before[i].odometry));
+    io::WriteFileAtomically(stem + ".calibrated.tum",
+                            io::TumText(e.after[i].t_s, e.after[i].odometry));
+  }
+}
+
 void WriteReport(const ReportCommandOptions& options, const ReportInputs& in,
-                 const io::ReportData& data) {
+                 const io::ReportData& data, const EvaluatedRuns& evaluated) {
   // Everything is computed; only now touch the output directory, as a set (README, "Nothing
   // lost"): the files go into a staged sibling renamed over the previous report, so a signal,
   // a full disk or a second writer never leaves a mix of old and new files.
@@ -575,6 +634,7 @@ void WriteReport(const ReportCommandOptions& options, const ReportInputs& in,
   io::WriteFileAtomically((out / "index.html").string(), io::ReportHtml(data));
   io::WriteFileAtomically((out / "summary.md").string(), io::ReportMarkdown(data));
   io::WriteFileAtomically((out / "metrics.csv").string(), io::MetricsCsv(data));
+  if (options.tum) WriteTumFiles(out.string(), evaluated);
   io::StopHereForTests("report-staged");
   io::WriteFileAtomically((out / "metrics.json").string(), io::MetricsJson(data));
   CommitOutputDirectory(staged, options.out, in.inputs, kReportFiles);
@@ -586,11 +646,16 @@ void PrintReport(const ReportCommandOptions& options, const io::ReportData& data
   std::printf("validation: %zu runs (repetitions %s), odometry sampled by %s time\n",
               data.runs.size(), data.validation_repetitions.c_str(), data.sampling.c_str());
   std::printf("training: %s\n", data.training_source.c_str());
-  std::printf("  CF (Eq. 14)            %.4f -> %.4f  (%+.1f %%)\n", all.before.cf, all.after.cf,
-              ImprovementPercent(all.before.cf, all.after.cf));
-  std::printf("  RMS distance error [m] %.4f -> %.4f  (%+.1f %%)\n", all.before.rms_distance_m,
-              all.after.rms_distance_m,
-              ImprovementPercent(all.before.rms_distance_m, all.after.rms_distance_m));
+  // change = 100 (after - before) / before, the one sign of every % change of the report.
+  std::printf("  CF (Eq. 14)            %.4f -> %.4f  (change %+.1f %%)\n", all.before.cf,
+              all.after.cf, -ImprovementPercent(all.before.cf, all.after.cf));
+  std::printf("  ATE RMSE [m] (Eq. 12)  %.4f -> %.4f  (change %+.1f %%)\n",
+              all.before.rms_distance_m, all.after.rms_distance_m,
+              -ImprovementPercent(all.before.rms_distance_m, all.after.rms_distance_m));
+  int worse = 0;
+  for (const io::ReportRun& r : data.runs) worse += io::GotWorse(r) ? 1 : 0;
+  if (worse > 0)
+    std::printf("  held-out runs that got worse: %d of %zu\n", worse, data.runs.size());
   for (const std::string& line : data.identifiability_lines) std::printf("%s\n", line.c_str());
   if (cv) {
     std::printf("cross-validation: %zu folds, validation CF %.4f +- %.4f (min %.4f, max %.4f)\n",
@@ -605,8 +670,8 @@ void PrintReport(const ReportCommandOptions& options, const io::ReportData& data
   for (const io::ReportVerdictReason& r : data.verdict_reasons) {
     std::printf("  %s %s: %s\n", r.level.c_str(), r.check.c_str(), r.message.c_str());
   }
-  std::printf("wrote %s/{index.html, summary.md, metrics.csv, metrics.json}\n",
-              options.out.c_str());
+  std::printf("wrote %s/{index.html, summary.md, metrics.csv, metrics.json%s}\n",
+              options.out.c_str(), options.tum ? ", tum/" : "");
 }
 
 // --strict: the verdict as the exit status, for CI pipelines (README, exit codes).
@@ -645,8 +710,10 @@ std::optional<CrossValidationResult> AddCrossValidation(const ReportCommandOptio
 io::ReportData BuildReportData(const ReportCommandOptions& options, const ReportInputs& in,
                                const CalibrationInput& cal, TrainingSplit split,
                                OdometrySampling sampling,
-                               std::optional<CrossValidationResult>* cv) {
+                               std::optional<CrossValidationResult>* cv,
+                               EvaluatedRuns* evaluated = nullptr) {
   const EvaluatedRuns e = EvaluateRuns(in, cal, std::move(split), sampling);
+  if (evaluated != nullptr) *evaluated = e;
   const std::vector<AlignedRun>& training = e.split.split.training;
   io::ReportData data;
   data.tool_version = kVersion;
@@ -709,6 +776,9 @@ void AddReportOptions(CLI::App& app, ReportCommandOptions& o) {
   app.add_flag("--strict", o.strict,
                "Exit 7 when the verdict is FAIL and 8 when it is WARN (the report is "
                "written either way), for CI pipelines");
+  app.add_flag("--tum", o.tum,
+               "Also write tum/<run>.{ground_truth,nominal,calibrated}.tum of every judged run "
+               "(for evo_ape / evo_rpe; docs/tum.md)");
   app.add_option("--worst-runs", o.worst_runs,
                  "Draw the error along time of this many of the worst validation runs")
       ->capture_default_str()
@@ -743,14 +813,15 @@ int RunReportCommand(const ReportCommandOptions& options) {
       return 2;
     }
     std::optional<CrossValidationResult> cv;
+    EvaluatedRuns evaluated;
     io::ReportData data = BuildReportData(options, in, in.calibrations.front(),
-                                          std::move(splits.front()), sampling, &cv);
+                                          std::move(splits.front()), sampling, &cv, &evaluated);
     for (std::size_t i = 1; i < in.calibrations.size(); ++i) {
       if (i == 1) data.comparison.push_back(ComparisonRowOf(data));
       data.comparison.push_back(ComparisonRowOf(BuildReportData(
           options, in, in.calibrations[i], std::move(splits[i]), sampling, nullptr)));
     }
-    WriteReport(options, in, data);
+    WriteReport(options, in, data, evaluated);
     PrintReport(options, data, cv);
     return ExitStatus(options, data.verdict);
   });

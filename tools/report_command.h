@@ -27,6 +27,9 @@ struct ReportCommandOptions : DatasetCommandOptions {
   // Exit status from the verdict (kReportFailExit, kReportWarnExit) instead of 0, for CI.
   bool strict = false;
   int worst_runs = 8;  // error-along-time figures drawn for this many of the worst runs
+  // Also write tum/<run>.{ground_truth,nominal,calibrated}.tum for every judged run (io/tum_file.h,
+  // docs/tum.md): the samples the drift and ATE figures of metrics.json are computed on.
+  bool tum = false;
 };
 
 // Exit statuses of `report --strict` (README, exit codes): the report is written either way.

@@ -16,11 +16,11 @@ Pose2d Between(const Pose2d& a, const Pose2d& b) {
 
 }  // namespace
 
-void AddRelativePoseErrors(const std::vector<Pose2d>& ground_truth,
-                           const std::vector<Pose2d>& odometry, double length_m,
-                           RelativePoseErrorSum* sum) {
+std::vector<RelativePoseErrorWindow> RelativePoseErrorWindows(
+    const std::vector<Pose2d>& ground_truth, const std::vector<Pose2d>& odometry, double length_m) {
+  std::vector<RelativePoseErrorWindow> out;
   const std::size_t n = std::min(ground_truth.size(), odometry.size());
-  if (n < 2 || !(length_m > 0.0)) return;
+  if (n < 2 || !(length_m > 0.0)) return out;
   std::vector<double> s(n, 0.0);  // ground-truth path length from sample 0
   for (std::size_t k = 1; k < n; ++k) {
     s[k] = s[k - 1] + std::hypot(ground_truth[k].x - ground_truth[k - 1].x,
@@ -34,8 +34,18 @@ void AddRelativePoseErrors(const std::vector<Pose2d>& ground_truth,
     const Pose2d truth = Between(ground_truth[i], ground_truth[j]);
     const Pose2d odo = Between(odometry[i], odometry[j]);
     const Pose2d e = Between(truth, odo);
-    sum->translation_ratio_sum += std::hypot(e.x, e.y) / length_m;
-    sum->rotation_rad_per_m_sum += std::abs(e.theta) / length_m;
+    out.push_back({i, j, std::hypot(e.x, e.y) / length_m, std::abs(e.theta) / length_m});
+  }
+  return out;
+}
+
+void AddRelativePoseErrors(const std::vector<Pose2d>& ground_truth,
+                           const std::vector<Pose2d>& odometry, double length_m,
+                           RelativePoseErrorSum* sum) {
+  for (const RelativePoseErrorWindow& w :
+       RelativePoseErrorWindows(ground_truth, odometry, length_m)) {
+    sum->translation_ratio_sum += w.translation_ratio;
+    sum->rotation_rad_per_m_sum += w.rotation_rad_per_m;
     ++sum->windows;
   }
 }

@@ -9,6 +9,7 @@
 // A window starts at every sample (KITTI: every 10th frame at 10 Hz, i.e. once a second); the
 // means weigh every window alike.
 
+#include <cstddef>
 #include <vector>
 
 #include "odometry/pose2.h"
@@ -26,6 +27,17 @@ struct RelativePoseErrorSum {
     return windows > 0 ? rotation_rad_per_m_sum / windows : 0.0;
   }
 };
+
+// One window of one run: samples start..end of the run, the errors of E above.
+struct RelativePoseErrorWindow {
+  std::size_t start = 0, end = 0;
+  double translation_ratio = 0.0;  // |t(E)| / length (unitless; x 100 for %)
+  double rotation_rad_per_m = 0.0;  // |wrap(theta(E))| / length
+};
+
+// Every window of one run (the pictures draw them one by one; the sum below is their mean).
+std::vector<RelativePoseErrorWindow> RelativePoseErrorWindows(
+    const std::vector<Pose2d>& ground_truth, const std::vector<Pose2d>& odometry, double length_m);
 
 // Adds the windows of one run: `ground_truth` and `odometry` are poses at the same times, in any
 // one world frame each. Runs shorter than length_m add nothing.

@@ -99,8 +99,17 @@ VerdictReason NoiseFloorReason(const NoiseFloorTest& t) {
                   "the residual is above the noise floor: " + numbers +
                       "; the model lacks an effect (try fitcal diagnose)");
   }
+  // Significant but smaller than one run's noise: detectable, not worth a model change. Said
+  // so, so that a PASS never stands beside a tiny p unexplained.
+  if (t.p_value < kNoiseFloorAlpha) {
+    return Reason(VerdictLevel::kPass, "noise_floor", "residuals",
+                  "a systematic residual is detectable but smaller than one run's own noise "
+                  "(sqrt(2) sigma): " +
+                      numbers + "; not worth a model change");
+  }
   return Reason(VerdictLevel::kPass, "noise_floor", "residuals",
-                "the residual is at the noise floor: " + numbers);
+                "the residual is at the noise floor (no significant systematic part): " +
+                    numbers);
 }
 
 }  // namespace
