@@ -1,5 +1,7 @@
 #!/usr/bin/env bash
 # Installs fitcal's build and test dependencies from Debian 12 packages (run as root or with sudo).
+#   tools/install_deps.sh [--tests]   --tests adds what only the test suite uses: Chromium, in which
+#                                     page_render_test lays the report out at phone and desktop widths
 set -euo pipefail
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
@@ -7,6 +9,7 @@ PACKAGES=(build-essential cmake ninja-build pkg-config mold
           libceres-dev libeigen3-dev libnlopt-cxx-dev libnlopt-dev libyaml-cpp-dev libcli11-dev
           libgtest-dev libgmock-dev libbenchmark-dev
           libsqlite3-dev libzstd-dev liblz4-dev libfastcdr-dev)
+if [ "${1:-}" = "--tests" ]; then PACKAGES+=(chromium); fi
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -3,7 +3,7 @@
 #   tools/test.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
-tools/install_deps.sh
+tools/install_deps.sh --tests
 jobs=$(nproc)
 start=$SECONDS
 
