@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "io/input_error.h"
+#include "io/sample_checks.h"
 #include "io/text_file.h"
 #include "io/warnings.h"
 
@@ -407,6 +408,47 @@ EncoderLog ReadEncoderRows(TextFileReader& lines, const Robot& robot) {
 
 }  // namespace
 
+namespace {
+
+// A running tick counter that wraps inside a run (a 16-bit count passing 65535 -> 0) turns one
+// interval into a jump of about -2^bits ticks: a rate thousands of times its neighbours'. Such an
+// interval, whose tick count lies within 5 % of a power of two from 2^8 to 2^32 and is over a
+// hundred times the run's median moving interval, is a wrap: refused with its line (fitcal does
+// not guess the counter's width). Returns the sample index, or samples.size().
+std::size_t FindCounterWrap(const EncoderLog& log, const Robot& robot, int* bits) {
+  const EncoderSamples& samples = log.samples;
+  if (!robot.encoder || !robot.encoder->cumulative || samples.size() < 3) return samples.size();
+  const double ticks_per_rad = robot.encoder->ticks_per_rev / (2.0 * M_PI);
+  std::vector<double> moving;
+  for (std::size_t k = 0; k < samples.size(); k += std::max<std::size_t>(1, samples.size() / 20000)) {
+    for (int c = 0; c < robot.NumChannels(); ++c) {
+      const double ticks = std::abs(samples[k].value[c] * samples[k].dt_s * ticks_per_rad);
+      if (robot.channels[c].kind == ChannelKind::kWheelRate && ticks > 0.0) moving.push_back(ticks);
+    }
+  }
+  if (moving.empty()) return samples.size();
+  std::nth_element(moving.begin(), moving.begin() + static_cast<std::ptrdiff_t>(moving.size() / 2),
+                   moving.end());
+  const double median = moving[moving.size() / 2];
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    for (int c = 0; c < robot.NumChannels(); ++c) {
+      if (robot.channels[c].kind != ChannelKind::kWheelRate) continue;
+      const double ticks = std::abs(samples[k].value[c] * samples[k].dt_s * ticks_per_rad);
+      if (ticks < 128.0 || ticks < 100.0 * median) continue;
+      for (int b = 8; b <= 32; ++b) {
+        const double wrap = std::ldexp(1.0, b);
+        if (std::abs(ticks - wrap) <= 0.05 * wrap) {
+          *bits = b;
+          return k;
+        }
+      }
+    }
+  }
+  return samples.size();
+}
+
+}  // namespace
+
 EncoderLog ReadEncoderCsv(const std::string& path, const Robot& robot) {
   EncoderLog log = ReportingOutOfMemory(path, [&] {
     TextFileReader lines(path);
@@ -426,6 +468,17 @@ EncoderLog ReadEncoderCsv(const std::string& path, const Robot& robot) {
                          " s) while the wheels turn: a clock step or lost rows inside a moving "
                          "stretch; refused (cut the run into two runs there)");
   }
+  int bits = 0;
+  const std::size_t wrap = FindCounterWrap(log, robot, &bits);
+  if (wrap < log.samples.size()) {
+    throw InputError(InputErrorKind::kImplausibleValue, path, LineOfDataRow(path, wrap + 1),
+                     "the tick counter jumps by about 2^" + std::to_string(bits) +
+                         " ticks in one interval: a " + std::to_string(bits) +
+                         "-bit counter that wraps inside the run; unwrap the counts (add 2^" +
+                         std::to_string(bits) + " after each wrap) before importing");
+  }
+  // The model's own checks of what its channels hold (a steering angle in degrees or ticks, ...).
+  RunSampleCheck(robot.model, log, path);
   return log;
 }
 

@@ -14,6 +14,7 @@
 #include "io/atomic_file.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
+#include "io/staged_directory.h"
 #include "models/asoc/asoc_geometric.h"
 #include "odometry/parallel_for.h"
 #include "tools/output_guard.h"
@@ -100,12 +101,15 @@ std::vector<asoc::RunLog> UmbmarkCircuits(const asoc::Vehicle& truth,
 
 int RunAsocSimulate(const AsocSimulateOptions& options) {
   try {
-    const fs::path out(options.out);
-    if (fs::exists(out / "dataset.yaml") && !options.force) {
-      std::cerr << "fitcal: " << (out / "dataset.yaml").string()
-                << " exists; use --force to overwrite\n";
+    if (const std::string refusal =
+            DirectoryOutputRefusal(options.out, kDatasetKind, options.force, {});
+        !refusal.empty()) {
+      std::cerr << "fitcal: " << refusal << "\n";
       return 2;
     }
+    // Written whole or not at all: staged beside --out, renamed over it once complete.
+    io::StagedDirectory staged(options.out);
+    const fs::path out(staged.path());
     fs::create_directories(out / "runs");
     std::mt19937_64 rng(SplitMix(options.seed));
     const asoc::Vehicle nominal = sim::AsocPrototypeVehicle();
@@ -136,6 +140,7 @@ int RunAsocSimulate(const AsocSimulateOptions& options) {
                             io::AsocRobotYaml(RobotFromVehicle("asoc-truth", truth)));
     io::WriteFileAtomically((out / "dataset.yaml").string(),
                             io::DatasetYaml("robot.yaml", entries));
+    CommitDirectoryOutput(staged, options.out, kDatasetKind, options.force, {});
     std::printf(
         "wrote %zu ASOC runs (6 calibration holds, 10 UMBmark, %d excursions) to %s; the "
         "true parameters are in truth.yaml\n",
@@ -169,8 +174,9 @@ int RunAsocGeometric(const AsocGeometricOptions& options) {
     }
     if (result.usable) std::printf("  %s\n", result.message.c_str());
     if (!result.usable) {
+      // Too few or inconsistent hold runs: the data's fault, not a fit that did not converge.
       std::cerr << "fitcal: closed form not usable: " << result.message << " nothing written\n";
-      return 3;
+      return 1;
     }
     if (!options.no_output) {
       if (const std::string refusal = OverwriteRefusal(options.out, robot.name);

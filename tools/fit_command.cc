@@ -30,6 +30,7 @@
 #include "tools/model_fit_command.h"
 #include "tools/output_guard.h"
 #include "tools/sim/flower_candidates.h"
+#include "validation/residual_dof.h"
 #include "validation/run_split.h"
 #include "validation/training_runs.h"
 
@@ -170,6 +171,12 @@ int RunFitCommand(const FitCommandOptions& options) {
       return 2;
     }
 
+    if (const std::string refusal =
+            FinalPoseDofRefusal(split.training.size(), robot.nominal.ToArray().size());
+        !refusal.empty()) {
+      std::cerr << "fitcal: " << options.logs << ": " << refusal << "\n";
+      return 1;
+    }
     // Before fitting, as a fit would not notice them: rates in the wrong unit, miswired encoder
     // columns, data that cannot determine the parameters.
     const RateUnitsReport units = CheckRateUnits(dataset.runs, robot);
