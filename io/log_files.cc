@@ -286,6 +286,24 @@ void CheckTimePlausible(double t_s, const std::string& path, int line_number) {
   }
 }
 
+// The width in bits of a counter whose wrap would make a jump of `ticks` (within 5 % of 2^bits,
+// from 8 to 32 bits), 0 when none.
+int WrapBitsOf(double ticks) {
+  if (std::abs(ticks) < 128.0) return 0;
+  for (int bits = 8; bits <= 32; ++bits) {
+    const double wrap = std::ldexp(1.0, bits);
+    if (std::abs(std::abs(ticks) - wrap) <= 0.05 * wrap) return bits;
+  }
+  return 0;
+}
+
+std::string CounterWrapMessage(int bits) {
+  const std::string b = std::to_string(bits);
+  return "the tick counter jumps by about 2^" + b + " ticks in one interval: a " + b +
+         "-bit counter that wraps inside the run; unwrap the counts (add 2^" + b +
+         " after each wrap) before importing";
+}
+
 // The last interval's channel values against the limits above.
 void CheckSamplePlausible(const EncoderSamples& samples, const Robot& robot,
                           const std::string& path, int line_number) {
@@ -295,6 +313,14 @@ void CheckSamplePlausible(const EncoderSamples& samples, const Robot& robot,
     const bool angle = robot.channels[c].kind == ChannelKind::kAngle;
     const double limit = angle ? kMaxAngleRad : kMaxWheelRateRadPerS;
     if (std::abs(s.value[c]) <= limit) continue;
+    if (!angle && robot.encoder && robot.encoder->cumulative) {  // a wrap, not a rate
+      const int bits =
+          WrapBitsOf(s.value[c] * s.dt_s * robot.encoder->ticks_per_rev / (2.0 * M_PI));
+      if (bits > 0) {
+        throw InputError(InputErrorKind::kImplausibleValue, path, line_number,
+                         CounterWrapMessage(bits));
+      }
+    }
     throw InputError(InputErrorKind::kImplausibleValue, path, line_number,
                      "channel '" + robot.channels[c].name + "': " + Number(s.value[c]) +
                          (angle ? " rad is not a physical angle (limit "
@@ -434,14 +460,9 @@ std::size_t FindCounterWrap(const EncoderLog& log, const Robot& robot, int* bits
     for (int c = 0; c < robot.NumChannels(); ++c) {
       if (robot.channels[c].kind != ChannelKind::kWheelRate) continue;
       const double ticks = std::abs(samples[k].value[c] * samples[k].dt_s * ticks_per_rad);
-      if (ticks < 128.0 || ticks < 100.0 * median) continue;
-      for (int b = 8; b <= 32; ++b) {
-        const double wrap = std::ldexp(1.0, b);
-        if (std::abs(ticks - wrap) <= 0.05 * wrap) {
-          *bits = b;
-          return k;
-        }
-      }
+      if (ticks < 100.0 * median) continue;
+      *bits = WrapBitsOf(ticks);
+      if (*bits > 0) return k;
     }
   }
   return samples.size();
@@ -472,10 +493,7 @@ EncoderLog ReadEncoderCsv(const std::string& path, const Robot& robot) {
   const std::size_t wrap = FindCounterWrap(log, robot, &bits);
   if (wrap < log.samples.size()) {
     throw InputError(InputErrorKind::kImplausibleValue, path, LineOfDataRow(path, wrap + 1),
-                     "the tick counter jumps by about 2^" + std::to_string(bits) +
-                         " ticks in one interval: a " + std::to_string(bits) +
-                         "-bit counter that wraps inside the run; unwrap the counts (add 2^" +
-                         std::to_string(bits) + " after each wrap) before importing");
+                     CounterWrapMessage(bits));
   }
   // The model's own checks of what its channels hold (a steering angle in degrees or ticks, ...).
   RunSampleCheck(robot.model, log, path);

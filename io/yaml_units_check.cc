@@ -70,7 +70,9 @@ void CheckListAngles(const YAML::Node& list, const std::string& list_key, const 
       hi = std::max(hi, v);
       largest = std::max(largest, std::abs(v));
     }
-    if (largest > 2.0 * M_PI + 1e-9 || hi - lo <= 1.0) continue;
+    // Wheels mounted around a robot spread over more than pi (half a turn) in radians; small
+    // angles in degrees (drive-angle offsets of a degree or two) do not.
+    if (largest > 2.0 * M_PI + 1e-9 || hi - lo <= M_PI) continue;
     std::string as_degrees;
     for (const auto& [v, line] : values) {
       as_degrees += (as_degrees.empty() ? "" : ", ") + Text(std::round(v * 180.0 / M_PI * 100) / 100);

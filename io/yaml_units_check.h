@@ -6,8 +6,9 @@
 // degrees apart (reported as "no calibration beats the nominal"):
 //   - a length in millimetres: any `_m` value beyond kMaxRobotLengthM;
 //   - angles in radians: the same `_deg` key of three or more list entries (wheels, castors) whose
-//     values all lie within one radian-sized turn (|v| <= 2 pi) yet differ by more than a degree:
-//     wheel mounting angles in degrees are tens of degrees apart, in radians they are not.
+//     values all lie within one radian-sized turn (|v| <= 2 pi) yet spread over more than pi:
+//     wheels mounted around a robot, in radians (60, 180, 300 deg written 1.05, 3.14, 5.24);
+//     small offsets in degrees (a calibrated drive angle of -0.6 deg) spread less.
 // Each is an io::InputError naming the file, the key's line and the likely unit.
 
 #include <yaml-cpp/yaml.h>
