@@ -51,13 +51,24 @@ void CheckLengths(const std::string& key, const YAML::Node& value, const std::st
   }
 }
 
-// The `_deg` keys of the maps in one list (wheels, castors): radians where degrees are meant.
+// Where a wheel or castor sits around the robot ("angle_deg", "pivot_angle_deg"): spread around
+// the robot by construction. Offsets, biases, drive, roller and steering angles are small or
+// equal for every wheel and tell nothing about their unit.
+bool IsMountingAngleKey(const std::string& key) {
+  if (key != "angle_deg" && !EndsWith(key, "_angle_deg")) return false;
+  for (const char* other : {"offset", "bias", "drive", "roller", "steering"}) {
+    if (key.find(other) != std::string::npos) return false;
+  }
+  return true;
+}
+
+// The mounting-angle keys of the maps in one list (wheels, castors): radians where degrees are meant.
 void CheckListAngles(const YAML::Node& list, const std::string& list_key, const std::string& path) {
   std::map<std::string, std::vector<std::pair<double, int>>> by_key;
   for (const YAML::Node& item : list) {
     if (!item.IsMap()) continue;
     for (const auto& entry : item) {
-      if (!entry.first.IsScalar() || !EndsWith(entry.first.Scalar(), "_deg")) continue;
+      if (!entry.first.IsScalar() || !IsMountingAngleKey(entry.first.Scalar())) continue;
       if (!entry.second.IsScalar()) continue;
       for (const auto& number : Numbers(entry.second)) by_key[entry.first.Scalar()].push_back(number);
     }

@@ -5,7 +5,8 @@
 // thousand times too large (reported later as "miswired encoders") or with its wheels a few
 // degrees apart (reported as "no calibration beats the nominal"):
 //   - a length in millimetres: any `_m` value beyond kMaxRobotLengthM;
-//   - angles in radians: the same `_deg` key of three or more list entries (wheels, castors) whose
+//   - angles in radians: the same mounting-angle key ("angle_deg", "pivot_angle_deg"; not an
+//     offset, bias, drive, roller or steering angle) of three or more list entries whose
 //     values all lie within one radian-sized turn (|v| <= 2 pi) yet spread over more than pi:
 //     wheels mounted around a robot, in radians (60, 180, 300 deg written 1.05, 3.14, 5.24);
 //     small offsets in degrees (a calibrated drive angle of -0.6 deg) spread less.
