@@ -15,6 +15,7 @@
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/staged_directory.h"
+#include "io/yaml_text.h"
 #include "models/asoc/asoc_geometric.h"
 #include "odometry/parallel_for.h"
 #include "tools/output_guard.h"
@@ -52,26 +53,51 @@ void PrintCastors(const io::AsocRobot& robot, const asoc::Vehicle& estimate, con
   }
 }
 
-// The calibration record of the written YAML: how it was made. Emitted by yaml-cpp so that any
-// path is quoted correctly.
-std::string AsocCalibrationRecord(const std::string& method, const std::string& dataset) {
+// The calibration record of the written YAML: how it was made, and the uncertainty of each
+// castor's estimate. Each castor is the mean of its pair estimates (Doebbler Eq. 1-9 on each CW x
+// CCW hold pair); with two, the standard error of their mean is their half-difference, the
+// spread over independent hold runs (a bootstrap over runs in its smallest form). Emitted by
+// yaml-cpp so that any path is quoted correctly.
+std::string AsocCalibrationRecord(const std::string& method, const std::string& dataset,
+                                  const io::AsocRobot& robot, const asoc::GeometricResult& result) {
   YAML::Emitter out;
   out.SetMapFormat(YAML::Flow);
   out << YAML::BeginMap << YAML::Key << "method" << YAML::Value << method << YAML::Key << "dataset"
-      << YAML::Value << dataset << YAML::Key << "tool_version" << YAML::Value << kVersion
-      << YAML::EndMap;
+      << YAML::Value << io::YamlText(dataset) << YAML::Key << "tool_version" << YAML::Value
+      << kVersion;
+  out << YAML::Key << "sigma" << YAML::Value << YAML::BeginMap;
+  for (int i = 0; i < asoc::kNumCastors; ++i) {
+    const asoc::CastorParameters& h = result.half_spread[i];
+    out << YAML::Key << io::YamlText(robot.castor_names[i]) << YAML::Value << YAML::BeginMap
+        << YAML::Key << "offset_m" << YAML::Value << h.offset_m << YAML::Key << "wheel_radius_m"
+        << YAML::Value << YAML::BeginSeq << h.wheel_radius_m[0] << h.wheel_radius_m[1]
+        << YAML::EndSeq << YAML::Key << "wheel_offset_m" << YAML::Value << YAML::BeginSeq
+        << h.wheel_offset_m[0] << h.wheel_offset_m[1] << YAML::EndSeq << YAML::Key
+        << "encoder_bias_deg" << YAML::Value << RadToDeg(h.encoder_bias_rad) << YAML::EndMap;
+  }
+  out << YAML::EndMap << YAML::EndMap;
   return out.c_str();
 }
 
-// Writes `robot` with the calibrated castors `estimate` and the record above to `out`
-// (atomically), and says so.
+// Writes `robot` with the calibrated castors and the record above to `out` (atomically), and says
+// so. Refuses (std::runtime_error) when a castor has fewer than two estimates: nothing would say
+// how well it is known, and a written calibration always carries its uncertainty.
 void WriteAsocCalibration(const std::string& out, const io::AsocRobot& robot,
-                          const asoc::Vehicle& estimate, const std::string& method,
+                          const asoc::GeometricResult& result, const std::string& method,
                           const std::string& dataset) {
+  for (int i = 0; i < asoc::kNumCastors; ++i) {
+    if (result.num_estimates[i] < 2) {
+      throw std::runtime_error(
+          dataset + ": castor " + robot.castor_names[i] + " has " +
+          std::to_string(result.num_estimates[i]) +
+          " closed-form estimate(s): no uncertainty for it; nothing written (record two CW and "
+          "two CCW hold runs of each castor)");
+    }
+  }
   io::AsocRobot calibrated = robot;
-  calibrated.nominal = estimate;
-  io::WriteFileAtomically(out,
-                          io::AsocRobotYaml(calibrated, AsocCalibrationRecord(method, dataset)));
+  calibrated.nominal = result.estimate;
+  io::WriteFileAtomically(
+      out, io::AsocRobotYaml(calibrated, AsocCalibrationRecord(method, dataset, robot, result)));
   std::printf("wrote %s\n", out.c_str());
 }
 
@@ -184,7 +210,7 @@ int RunAsocGeometric(const AsocGeometricOptions& options) {
         std::cerr << "fitcal: " << refusal << "\n";
         return 2;
       }
-      WriteAsocCalibration(options.out, robot, result.estimate, "closed-form Doebbler Eq. 1-9",
+      WriteAsocCalibration(options.out, robot, result, "closed-form Doebbler Eq. 1-9",
                            options.logs);
     }
     return 0;
