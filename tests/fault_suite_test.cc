@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
 #include <filesystem>
 #include <map>
 #include <random>
@@ -343,42 +344,97 @@ TEST(FaultSuiteTest, AReadOnlyOutputDirectoryIsOneLineAndExitOne) {
   EXPECT_TRUE(fs::is_empty(ro));
 }
 
+// Puts `files` back as the whole content of `out` (a directory) or as `out` itself (a file, key "").
+void Restore(const fs::path& out, const std::map<std::string, std::string>& files) {
+  fs::remove_all(out);
+  for (const auto& [name, bytes] : files) {
+    const fs::path p = name.empty() ? out : out / name;
+    fs::create_directories(p.parent_path());
+    WriteFileBytes(p, bytes);
+  }
+}
+
+std::map<std::string, std::string> OutputSnapshot(const fs::path& out) {
+  if (fs::is_directory(out)) return Snapshot(out);
+  return {{"", ReadFileBytes(out)}};
+}
+
+// One writer of each kind: a data set (simulate; import optiodom when the recordings are there),
+// a calibration file (fit) and a report directory. `old_args` writes the previous output,
+// `new_args` a different one over it; `complete` says whether an output is a whole new one.
+struct KilledWriter {
+  std::string name;
+  std::vector<std::string> old_args, new_args;
+  std::function<bool(const fs::path&)> complete;
+};
+
 // SIGKILL after delays from nothing to past the end of the write: at every point the output is
-// the previous data set byte for byte or the new one complete; a temporary left by the kill is
-// hidden, and the next writer removes it.
+// the previous one byte for byte or the new one complete; a temporary left by the kill is hidden,
+// and the next writer of the same output removes it.
 TEST(FaultSuiteTest, AWriterKilledAtAnyMomentLeavesTheOldOutputOrTheNew) {
   const TempDir dir;
+  const fs::path data = SimulatedDataset(dir, "input", "diff_drive");
   const fs::path work = dir.path() / "work";
   fs::create_directories(work);
-  const fs::path out = work / "data";
-  const std::vector<std::string> args = {"simulate",      "--model", "diff_drive", "--repetitions",
-                                         "2",             "--seed",  "7",          "--force",
-                                         "--out",         out.string()};
-  ASSERT_EQ(RunChild(args, dir.path()).code, 0);
-  // The next writer's output differs (another seed), so a mix of the two would show.
-  std::vector<std::string> next = args;
-  next[6] = "8";
-  const auto old_output = Snapshot(out);
-  bool saw_new = false;
-  for (int delay_ms : {0, 1, 2, 5, 10, 20, 40, 80, 160, 320}) {
-    SCOPED_TRACE("SIGKILL after " + std::to_string(delay_ms) + " ms");
-    for (const auto& [name, bytes] : old_output) WriteFileBytes(out / name, bytes);  // reset
-    RunChild(next, dir.path(), 0, std::chrono::milliseconds(delay_ms));
-    EXPECT_EQ(VisibleNames(work), std::set<std::string>{"data"});
-    const auto now = Snapshot(out);
-    if (now != old_output) {
-      saw_new = true;
-      EXPECT_NO_THROW(LoadEverything(out)) << "a mixed or partial data set";
-      EXPECT_EQ(now.count("dataset.yaml"), 1u);
+  const fs::path out = work / "out";
+  const std::string o = out.string(), d = data.string();
+  const auto loads = [](const fs::path& p) {
+    try {
+      LoadEverything(p);
+      return true;
+    } catch (const std::exception&) {
+      return false;
     }
-    // Reset to the old data set through fitcal itself: it must also clear the leftovers.
-    fs::remove_all(out);
-    ASSERT_EQ(RunChild(args, dir.path()).code, 0);
-    EXPECT_EQ(AllNames(work), std::set<std::string>{"data"}) << "a stale temporary was kept";
+  };
+  std::vector<KilledWriter> writers = {
+      {"simulate",
+       {"simulate", "--model", "diff_drive", "--repetitions", "2", "--seed", "7", "--out", o},
+       {"simulate", "--model", "diff_drive", "--repetitions", "2", "--seed", "8", "--force",
+        "--out", o},
+       loads},
+      {"fit",
+       {"fit", "--logs", d, "--train-reps", "1", "--out", o},
+       {"fit", "--logs", d, "--train-reps", "1-2", "--out", o},
+       [](const fs::path& p) { return ReadFileBytes(p).find("calibration:") != std::string::npos; }},
+      {"report",
+       {"report", "--logs", d, "--calibration", (dir.path() / "cal.yaml").string(), "--out", o,
+        "--train-reps", "1"},
+       {"report", "--logs", d, "--calibration", (dir.path() / "cal.yaml").string(), "--out", o,
+        "--train-reps", "2"},
+       [](const fs::path& p) { return fs::exists(p / "index.html") && fs::exists(p / "metrics.csv"); }},
+  };
+  const fs::path sessions = fs::path(FITCAL_SHARED_DIR) / "data/optiodom/diff/free";
+  if (fs::is_directory(sessions)) {
+    std::vector<std::string> import = {"import", "optiodom"};
+    for (const auto& e : fs::directory_iterator(sessions)) import.push_back(e.path().string());
+    import.insert(import.end(), {"--out", o});
+    std::vector<std::string> again = import;
+    again.push_back("--force");
+    writers.push_back({"import optiodom", import, again, loads});
   }
-  RunChild(next, dir.path());
-  EXPECT_NO_THROW(LoadEverything(out));
-  (void)saw_new;  // whether a delay landed after the rename depends on the machine's speed
+  ASSERT_EQ(RunFitcal(dir, "fit --logs " + d + " --out " + (dir.path() / "cal.yaml").string())
+                .exit_code,
+            0);
+  for (const KilledWriter& w : writers) {
+    SCOPED_TRACE(w.name);
+    fs::remove_all(out);
+    ASSERT_EQ(RunChild(w.old_args, dir.path()).code, 0) << ReadFileBytes(dir.path() / "child.err");
+    const auto old_output = OutputSnapshot(out);
+    for (int delay_ms : {0, 2, 8, 30, 100, 300}) {
+      SCOPED_TRACE("SIGKILL after " + std::to_string(delay_ms) + " ms");
+      Restore(out, old_output);
+      RunChild(w.new_args, dir.path(), 0, std::chrono::milliseconds(delay_ms));
+      EXPECT_EQ(VisibleNames(work), std::set<std::string>{"out"});
+      if (OutputSnapshot(out) != old_output) {
+        EXPECT_TRUE(w.complete(out)) << "a partial output";
+      }
+    }
+    // Uninterrupted, the next writer replaces the output and removes what the kills left.
+    Restore(out, old_output);
+    EXPECT_EQ(RunChild(w.new_args, dir.path()).code, 0) << ReadFileBytes(dir.path() / "child.err");
+    EXPECT_TRUE(w.complete(out));
+    EXPECT_EQ(AllNames(work), std::set<std::string>{"out"}) << "a stale temporary was kept";
+  }
 }
 
 TEST(FaultSuiteTest, TwoWritersOfOneOutputLeaveOneCompleteOutput) {
