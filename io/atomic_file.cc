@@ -69,6 +69,13 @@ bool RemoveTreeFromHandler(int parent_fd, const char* name, int depth) {
   return unlinkat(parent_fd, name, AT_REMOVEDIR) == 0;
 }
 
+// True when `path` lies below the directory being staged.
+bool InStagingDirectory(const std::string& path) {
+  if (!g_has_staging_dir) return false;
+  const std::size_t n = std::strlen(g_staging_dir);
+  return path.size() > n + 1 && path.compare(0, n, g_staging_dir) == 0 && path[n] == '/';
+}
+
 void RemoveInFlightAndReraise(int signal_number) {
   if (g_has_in_flight) unlink(g_in_flight_path);
   if (g_has_staging_dir) RemoveTreeFromHandler(AT_FDCWD, g_staging_dir, /*depth=*/4);
@@ -148,7 +155,9 @@ std::string WriteTemporary(const std::string& path, std::string_view contents) {
   if (const std::string overlap = OutputOverlapsInput(path); !overlap.empty()) {
     throw std::runtime_error(path + ": " + overlap);
   }
-  RemoveStaleTemporaries(path);
+  // A staged directory is new and ours: nothing stale in it (and a data set writer would list it
+  // once per file).
+  if (!InStagingDirectory(path)) RemoveStaleTemporaries(path);
   std::string tmp_path;
   const int fd = CreateTemporary(path, &tmp_path);
   const char* data = contents.data();

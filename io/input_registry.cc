@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <filesystem>
+#include <map>
 #include <mutex>
 
 #include "io/input_error.h"
@@ -13,38 +14,81 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// One input, resolved once when it is recorded (a data set writer checks hundreds of outputs
+// against hundreds of inputs: no path is resolved twice).
+struct Input {
+  std::string given;  // as the command named it, for messages
+  std::string resolved;
+  bool is_directory = false;
+  bool has_inode = false;
+  dev_t device = 0;
+  ino_t inode = 0;
+};
+
 std::atomic<bool> g_enabled{false};
 std::mutex g_mutex;
-std::vector<std::string> g_inputs;  // guarded by g_mutex
+std::map<std::string, Input> g_inputs;  // by the given path; guarded by g_mutex
 thread_local bool t_probing = false;
 
 // The absolute path with links and ".." resolved as far as the path exists: two spellings of
 // one place compare equal.
-fs::path Resolved(const std::string& path) {
+std::string Resolved(const std::string& path) {
   std::error_code ec;
   fs::path p = fs::weakly_canonical(fs::absolute(path, ec), ec);
   if (ec) p = fs::absolute(path, ec).lexically_normal();
-  return p;
+  std::string s = p.string();
+  while (s.size() > 1 && s.back() == '/') s.pop_back();
+  return s;
+}
+
+Input Describe(const std::string& path) {
+  Input input;
+  input.given = path;
+  input.resolved = Resolved(path);
+  struct stat info {};
+  if (::stat(path.c_str(), &info) == 0) {
+    input.has_inode = true;
+    input.device = info.st_dev;
+    input.inode = info.st_ino;
+    input.is_directory = S_ISDIR(info.st_mode);
+  }
+  return input;
 }
 
 // True when `inner` is `outer` or lies below it (component by component: /a/bc is not in /a/b).
-bool IsWithin(const fs::path& inner, const fs::path& outer) {
-  std::string o = outer.string();
-  while (o.size() > 1 && o.back() == '/') o.pop_back();
-  const std::string i = inner.string();
-  return i == o || (i.size() > o.size() && i.compare(0, o.size(), o) == 0 &&
-                    (o == "/" || i[o.size()] == '/'));
+bool IsWithin(const std::string& inner, const std::string& outer) {
+  return inner == outer || (inner.size() > outer.size() &&
+                            inner.compare(0, outer.size(), outer) == 0 &&
+                            (outer == "/" || inner[outer.size()] == '/'));
 }
 
-bool SameInode(const std::string& a, const std::string& b) {
-  struct stat sa {}, sb {};
-  return ::stat(a.c_str(), &sa) == 0 && ::stat(b.c_str(), &sb) == 0 && sa.st_dev == sb.st_dev &&
-         sa.st_ino == sb.st_ino;
-}
-
-bool IsDirectory(const std::string& path) {
-  struct stat s {};
-  return ::stat(path.c_str(), &s) == 0 && S_ISDIR(s.st_mode);
+// Three passes, so that the most direct relation is named: the output is an input file, holds
+// an input (or is an input directory), sits inside an input directory.
+std::string Overlap(const std::string& out, const std::vector<Input>& inputs) {
+  if (out.empty()) return "";
+  const Input output = Describe(out);
+  for (const Input& in : inputs) {
+    if (in.is_directory) continue;
+    if (in.resolved == output.resolved ||
+        (in.has_inode && output.has_inode && in.device == output.device &&
+         in.inode == output.inode)) {
+      return "is the input file " + OneLine(in.given, 200) +
+             "; writing the output there would destroy it (choose another --out)";
+    }
+  }
+  for (const Input& in : inputs) {
+    if (IsWithin(in.resolved, output.resolved)) {
+      return "holds the input " + OneLine(in.given, 200) +
+             "; the output would replace it (choose another --out)";
+    }
+  }
+  for (const Input& in : inputs) {
+    if (in.is_directory && IsWithin(output.resolved, in.resolved)) {
+      return "sits inside the input directory " + OneLine(in.given, 200) +
+             "; write outputs outside the inputs (choose another --out)";
+    }
+  }
+  return "";
 }
 
 }  // namespace
@@ -56,47 +100,33 @@ NotAnInput::~NotAnInput() { t_probing = previous_; }
 
 void RegisterInputFile(const std::string& path) {
   if (!g_enabled || t_probing || path.empty()) return;
+  {
+    const std::lock_guard<std::mutex> lock(g_mutex);
+    if (g_inputs.count(path) > 0) return;
+  }
+  Input input = Describe(path);  // outside the lock: system calls
   const std::lock_guard<std::mutex> lock(g_mutex);
-  g_inputs.push_back(path);
+  g_inputs.emplace(path, std::move(input));
 }
 
 void RegisterInputDirectory(const std::string& path) { RegisterInputFile(path); }
 
 std::string OutputOverlapsInputs(const std::string& out, const std::vector<std::string>& inputs) {
-  if (out.empty()) return "";
-  const fs::path out_path = Resolved(out);
-  // Three passes, so that the most direct relation is named: the output is an input file, holds
-  // an input (or is an input directory), sits inside an input directory.
-  for (const std::string& input : inputs) {
-    if (input.empty() || IsDirectory(input)) continue;
-    if (Resolved(input) == out_path || SameInode(out, input)) {
-      return "is the input file " + OneLine(input, 200) +
-             "; writing the output there would destroy it (choose another --out)";
-    }
+  std::vector<Input> described;
+  for (const std::string& path : inputs) {
+    if (!path.empty()) described.push_back(Describe(path));
   }
-  for (const std::string& input : inputs) {
-    if (!input.empty() && IsWithin(Resolved(input), out_path)) {
-      return "holds the input " + OneLine(input, 200) +
-             "; the output would replace it (choose another --out)";
-    }
-  }
-  for (const std::string& input : inputs) {
-    if (!input.empty() && IsDirectory(input) && IsWithin(out_path, Resolved(input))) {
-      return "sits inside the input directory " + OneLine(input, 200) +
-             "; write outputs outside the inputs (choose another --out)";
-    }
-  }
-  return "";
+  return Overlap(out, described);
 }
 
 std::string OutputOverlapsInput(const std::string& out) {
   if (!g_enabled) return "";
-  std::vector<std::string> inputs;
+  std::vector<Input> inputs;
   {
     const std::lock_guard<std::mutex> lock(g_mutex);
-    inputs = g_inputs;
+    for (const auto& [path, input] : g_inputs) inputs.push_back(input);
   }
-  return OutputOverlapsInputs(out, inputs);
+  return Overlap(out, inputs);
 }
 
 }  // namespace fitcal::io
