@@ -409,7 +409,7 @@ Rosbag2Import ImportRosbag2(const ImportRosbag2Options& o) {
   io::RegisterInputDirectory(o.bag);  // no data set in, over or holding the bag
   if (const std::string refusal = DirectoryOutputRefusal(o.out, kDatasetKind, o.force, {o.bag});
       !refusal.empty()) {
-    throw std::runtime_error(refusal);
+    throw std::invalid_argument(refusal);  // exit 2, as every writer refuses its --out
   }
   Rosbag2Import imp = ReadRosbag2Import(o);
   WriteDataset(o, ReadRobotModelFile(o.robot)->robot(), imp);
