@@ -117,6 +117,25 @@ TEST_F(InputClassesTest, RatesInRpmAreNamed) {
   ExpectFitRefused(1, {"not in rad/s", "rpm"});
 }
 
+TEST_F(InputClassesTest, GroundTruthInMillimetresIsNamed) {
+  for (const auto& e : fs::directory_iterator(data_ / "runs")) {
+    if (!Has(e.path().filename().string(), "_ground_truth.csv")) continue;
+    std::istringstream in(ReadFileBytes(e.path()));
+    std::string line, out;
+    std::getline(in, line);
+    out = line + "\n";
+    while (std::getline(in, line)) {
+      double t = 0, x = 0, y = 0, theta = 0;
+      if (std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf", &t, &x, &y, &theta) != 4) continue;
+      char row[160];
+      std::snprintf(row, sizeof row, "%.9g,%.9g,%.9g,%.9g\n", t, x * 1000, y * 1000, theta);
+      out += row;
+    }
+    WriteFileBytes(e.path(), out);
+  }
+  ExpectFitRefused(1, {"millimetres", "ground-truth positions"});
+}
+
 TEST_F(InputClassesTest, LengthsInMillimetresAreNamedWithTheirLine) {
   SetRobotYaml(Replace(Replace(Replace(RobotYaml(), "wheel_separation_m: 0.2",
                                        "wheel_separation_m: 200"),

@@ -63,6 +63,17 @@ RateUnitsFinding CheckModelRateUnits(const RobotModelInterface& model,
     }
   }
   char line[400];
+  // Ground-truth positions in millimetres scale the other way, by 1/1000 (turns count less there,
+  // so the pooled ratio lies a little above it).
+  if (std::abs(std::log(finding.scale / 1e-3)) < std::log(3.0)) {
+    finding.likely_unit = "ground truth in mm";
+    std::snprintf(line, sizeof line,
+                  "the ground truth's path is %.3g times the nominal robot's odometry: ground-truth "
+                  "positions in millimetres, not metres?; nothing fitted",
+                  1.0 / finding.scale);
+    finding.message = line;
+    return finding;
+  }
   std::snprintf(line, sizeof line,
                 "the nominal robot's odometry travels %.3g times the ground truth's path: the "
                 "encoder rates are not in rad/s%s%s%s (or the robot file's wheel sizes or "
