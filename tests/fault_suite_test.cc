@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <functional>
 #include <filesystem>
 #include <map>
@@ -434,6 +435,35 @@ TEST(FaultSuiteTest, AWriterKilledAtAnyMomentLeavesTheOldOutputOrTheNew) {
     EXPECT_EQ(RunChild(w.new_args, dir.path()).code, 0) << ReadFileBytes(dir.path() / "child.err");
     EXPECT_TRUE(w.complete(out));
     EXPECT_EQ(AllNames(work), std::set<std::string>{"out"}) << "a stale temporary was kept";
+  }
+}
+
+// A catchable signal while a data set (a directory with runs/ below it) is being staged removes
+// the whole staged tree: the handler walks it with system calls only.
+TEST(FaultSuiteTest, ASignalWhileADataSetIsStagedLeavesNothing) {
+  const TempDir dir;
+  const fs::path work = dir.path() / "work";
+  fs::create_directories(work);
+  for (int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+    SCOPED_TRACE(strsignal(signal_number));
+    const pid_t pid = fork();
+    if (pid == 0) {
+      std::freopen("/dev/null", "w", stdout);
+      setenv("FITCAL_TEST_STOP_AT", "temporary-written", 1);
+      const std::string out = (work / "out").string();
+      execl(kFitcal.c_str(), "fitcal", "simulate", "--model", "diff_drive", "--out", out.c_str(),
+            static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    int status = 0;
+    ASSERT_EQ(waitpid(pid, &status, WUNTRACED), pid);
+    ASSERT_TRUE(WIFSTOPPED(status)) << "fitcal ended before writing";
+    EXPECT_EQ(AllNames(work).size(), 1u) << "no staged directory";
+    kill(pid, signal_number);
+    kill(pid, SIGCONT);
+    ASSERT_EQ(waitpid(pid, &status, 0), pid);
+    EXPECT_TRUE(WIFSIGNALED(status));
+    EXPECT_EQ(AllNames(work), std::set<std::string>{}) << "the staged data set was left";
   }
 }
 
