@@ -98,7 +98,9 @@ void RefuseEffectsTheChannelsCannotShow(const Robot& robot, const YAML::Node& ro
 RobotModelPtr ReadRobotModel(const YAML::Node& root, const std::string& path) {
   io::ExpectYamlType(root, YAML::NodeType::Map, path, "robot file");
   if (!root["model"]) {
-    throw io::InputError(io::InputErrorKind::kMissingKey, path, 1, "robot has no 'model'");
+    // A misspelt key is named on its own line (YamlMap::Required), else the missing one.
+    io::YamlMap robot(root, path, "robot");
+    robot.Required("model");
   }
   const std::string model = io::YamlString(root["model"], path, "robot.model");
   const ModelRegistration* registration = FindModel(model);
