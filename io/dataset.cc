@@ -153,6 +153,12 @@ DatasetIndex ReadDatasetIndex(const std::string& directory, const DatasetOptions
       entry.start_pose = Pose2d{YamlDouble(start[0], yaml_path, "start_pose x"),
                                 YamlDouble(start[1], yaml_path, "start_pose y"),
                                 YamlDouble(start[2], yaml_path, "start_pose theta")};
+      // A heading beyond a full turn is degrees written where radians are meant.
+      if (std::abs(entry.start_pose->theta) > 2.0 * M_PI + 1e-9) {
+        throw InputError(InputErrorKind::kImplausibleValue, yaml_path, LineOf(start[2]),
+                         "start_pose theta " + start[2].Scalar() +
+                             " is beyond a full turn in rad: degrees? theta is in radians");
+      }
     }
     run.RejectUnread();
   }

@@ -163,6 +163,13 @@ TEST_F(InputClassesTest, NegativeRepetitionNumbersAreRefused) {
   ExpectFitRefused(1, {"dataset.yaml:3:", "repetition -1 is negative"});
 }
 
+TEST_F(InputClassesTest, AStartHeadingInDegreesIsRefused) {
+  const std::string yaml = ReadFileBytes(data_ / "dataset.yaml");
+  WriteFileBytes(data_ / "dataset.yaml", Replace(yaml, "repetition: 1, encoders",
+                                                 "repetition: 1, start_pose: [0, 0, 90], encoders"));
+  ExpectFitRefused(1, {"dataset.yaml:3:", "start_pose theta 90", "degrees?"});
+}
+
 // Cumulative 16-bit tick counts that pass 65535 inside a run.
 TEST_F(InputClassesTest, ATickCounterThatWrapsIsRefusedAtItsLine) {
   SetRobotYaml(RobotYaml() + "encoder: {ticks_per_rev: 4096, cumulative: true}\n");
