@@ -31,6 +31,8 @@
 #include <thread>
 #include <vector>
 
+#include "io/asoc_files.h"
+#include "io/calibration_yaml.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/yaml_reader.h"
@@ -129,6 +131,47 @@ TEST(FaultSuiteTest, TruncatedAndGarbledFilesOfEveryFormatFailInOneLine) {
       }
       WriteFileBytes(file, original);
     }
+  }
+}
+
+// The calibration a fit writes (a robot YAML with its calibration block, read by report and
+// export) and the ASOC data set's own formats (robot YAML, three-castor encoder CSV).
+TEST(FaultSuiteTest, TruncatedAndGarbledCalibrationsAndAsocFilesFailInOneLine) {
+  const TempDir dir;
+  const fs::path data = SimulatedDataset(dir, "ds", "diff_drive");
+  const fs::path cal = dir.path() / "cal.yaml";
+  ASSERT_EQ(RunFitcal(dir, "fit --logs " + data.string() + " --out " + cal.string()).exit_code, 0);
+  const fs::path asoc = dir.path() / "asoc";
+  ASSERT_EQ(RunFitcal(dir, "asoc-simulate --out " + asoc.string()).exit_code, 0);
+  const io::DatasetIndex asoc_index = io::ReadDatasetIndex(asoc.string(), {});
+  const auto expect_one_line = [](const std::function<void()>& read) {
+    try {
+      read();
+    } catch (const std::exception& e) {
+      const std::string what = e.what();
+      EXPECT_FALSE(what.empty());
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+  };
+  const std::vector<std::pair<std::string, std::function<void()>>> files = {
+      {cal.string(),
+       [&] {
+         ReadRobotModelFile(cal.string());
+         io::ReadCalibrationProvenance(cal.string());
+         io::ReadCalibrationTrainingRepetitions(cal.string());
+       }},
+      {asoc_index.robot_path, [&] { io::ReadAsocRobot(asoc_index.robot_path); }},
+      {asoc_index.runs.front().encoders_path, [&] { io::LoadAsocDataset(asoc.string()); }},
+  };
+  std::uint32_t seed = 100;
+  for (const auto& [file, read] : files) {
+    SCOPED_TRACE(file);
+    const std::string original = ReadFileBytes(file);
+    for (const std::string& mutant : Mutants(original, seed++)) {
+      WriteFileBytes(file, mutant);
+      expect_one_line(read);
+    }
+    WriteFileBytes(file, original);
   }
 }
 
