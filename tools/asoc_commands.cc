@@ -182,6 +182,14 @@ int RunAsocGeometric(const AsocGeometricOptions& options) {
   try {
     io::DatasetOptions dataset_options;
     dataset_options.allow_paths_outside = options.allow_outside_paths;
+    if (!options.no_output) {  // before the work: never over one of the data set's files
+      const std::string refusal = OutputFileRefusal(
+          options.out, DatasetInputs(io::ReadDatasetIndex(options.logs, dataset_options)));
+      if (!refusal.empty()) {
+        std::cerr << "fitcal: " << refusal << "\n";
+        return 2;
+      }
+    }
     const io::AsocDataset dataset = io::LoadAsocDataset(options.logs, dataset_options);
     const io::AsocRobot robot = io::ReadAsocRobot(dataset.robot_path);
     const asoc::GeometricResult result = asoc::CalibrateGeometric(dataset.runs, robot.nominal);
