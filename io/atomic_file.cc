@@ -108,7 +108,7 @@ int CreateTemporary(const std::string& path, std::string* tmp_path) {
   const CleanupSignalsBlocked blocked;
   const int fd = mkstemp(name.data());
   if (fd < 0) {
-    throw std::runtime_error(path + ": cannot create temporary file: " + std::strerror(errno));
+    throw std::runtime_error(path + ": cannot create a file beside it: " + std::strerror(errno));
   }
   *tmp_path = name.data();
   if (tmp_path->size() < sizeof(g_in_flight_path)) {

@@ -20,12 +20,13 @@ namespace fs = std::filesystem;
 
 // mkdtemp on `<prefix>XXXXXX`: the name is unique and the directory is ours (mode 0700 until the
 // files are in; the rename keeps it, so it is widened to the usual 0755 before).
-std::string MakeUniqueDirectory(const std::string& prefix) {
+std::string MakeUniqueDirectory(const std::string& prefix, const std::string& target) {
   std::string pattern = prefix + "XXXXXX";
   std::vector<char> name(pattern.begin(), pattern.end());
   name.push_back('\0');
   if (mkdtemp(name.data()) == nullptr) {
-    throw std::runtime_error(prefix + ": cannot create a directory: " + std::strerror(errno));
+    throw std::runtime_error(target + ": cannot create a directory beside it: " +
+                             std::strerror(errno));
   }
   return name.data();
 }
@@ -49,7 +50,7 @@ StagedDirectory::StagedDirectory(const std::string& target) {
   if (t.has_parent_path()) fs::create_directories(t.parent_path(), ec);
   if (ec) throw std::runtime_error(target_ + ": cannot create its parent: " + ec.message());
   RemoveStaleTemporaries(target_);  // a writer killed before (SIGKILL) left its staging behind
-  staging_ = MakeUniqueDirectory(TemporaryPrefix(target_));
+  staging_ = MakeUniqueDirectory(TemporaryPrefix(target_), target_);
   SetStagingDirectoryForSignals(staging_);
   fs::permissions(staging_,
                   fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec |
@@ -84,7 +85,7 @@ void StagedDirectory::Commit(bool replace_existing) {
       fs::remove_all(staging_, ec);  // now the previous directory
       return;
     }
-    aside = MakeUniqueDirectory(TemporaryPrefix(target_) + "old-");
+    aside = MakeUniqueDirectory(TemporaryPrefix(target_) + "old-", target_);
     fs::remove(aside, ec);  // only the unique name is wanted: rename needs it free or empty
     fs::rename(target_, aside, ec);
     if (ec) throw std::runtime_error(target_ + ": cannot move it aside: " + ec.message());

@@ -375,6 +375,23 @@ TEST(FaultSuiteTest, AFileSizeLimitIsOneLineAndExitOneWithNothingLeft) {
   EXPECT_EQ(AllNames(work), std::set<std::string>{"cal.yaml"});
 }
 
+// A place nobody may write, root included (procfs): one line naming --out, exit 1, no signal.
+TEST(FaultSuiteTest, AnUnwritableLocationIsOneLineNamingTheOutput) {
+  const TempDir dir;
+  const fs::path data = SimulatedDataset(dir, "ds", "diff_drive");
+  for (const std::string& args :
+       {std::string("simulate --model diff_drive --out /proc/self/fitcal_data"),
+        "fit --logs " + data.string() + " --out /proc/self/fitcal_cal.yaml",
+        "report --logs " + data.string() + " --calibration " + (data / "robot.yaml").string() +
+            " --out /proc/self/fitcal_report"}) {
+    const auto r = RunFitcal(dir, args);
+    EXPECT_EQ(r.exit_code, 1) << args << ": " << r.err;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find("/proc/self/fitcal_"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find(".tmp-"), std::string::npos) << "names a temporary: " << r.err;
+  }
+}
+
 TEST(FaultSuiteTest, AReadOnlyOutputDirectoryIsOneLineAndExitOne) {
   if (geteuid() == 0) GTEST_SKIP() << "root writes into read-only directories";
   const TempDir dir;
