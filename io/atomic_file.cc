@@ -60,7 +60,8 @@ bool RemoveTreeFromHandler(int parent_fd, const char* name, int depth) {
       for (long at = 0; at < n;) {
         const char* child = buffer + at + offsetof(DirentHeader, name);
         at += reinterpret_cast<const DirentHeader*>(buffer + at)->reclen;
-        if (child[0] == '.' && (child[1] == '\0' || (child[1] == '.' && child[2] == '\0'))) continue;
+        if (child[0] == '.' && (child[1] == '\0' || (child[1] == '.' && child[2] == '\0')))
+          continue;
         removed = RemoveTreeFromHandler(fd, child, depth - 1) || removed;
       }
     }
@@ -209,7 +210,8 @@ void WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>
     for (std::size_t k = first; k < temporaries.size(); ++k) unlink(temporaries[k].c_str());
   };
   try {
-    for (const auto& [path, contents] : files) temporaries.push_back(WriteTemporary(path, contents));
+    for (const auto& [path, contents] : files)
+      temporaries.push_back(WriteTemporary(path, contents));
   } catch (...) {
     remove_from(0);
     throw;

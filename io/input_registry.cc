@@ -57,9 +57,9 @@ Input Describe(const std::string& path) {
 
 // True when `inner` is `outer` or lies below it (component by component: /a/bc is not in /a/b).
 bool IsWithin(const std::string& inner, const std::string& outer) {
-  return inner == outer || (inner.size() > outer.size() &&
-                            inner.compare(0, outer.size(), outer) == 0 &&
-                            (outer == "/" || inner[outer.size()] == '/'));
+  return inner == outer ||
+         (inner.size() > outer.size() && inner.compare(0, outer.size(), outer) == 0 &&
+          (outer == "/" || inner[outer.size()] == '/'));
 }
 
 // Three passes, so that the most direct relation is named: the output is an input file, holds

@@ -446,7 +446,8 @@ std::size_t FindCounterWrap(const EncoderLog& log, const Robot& robot, int* bits
   if (!robot.encoder || !robot.encoder->cumulative || samples.size() < 3) return samples.size();
   const double ticks_per_rad = robot.encoder->ticks_per_rev / (2.0 * M_PI);
   std::vector<double> moving;
-  for (std::size_t k = 0; k < samples.size(); k += std::max<std::size_t>(1, samples.size() / 20000)) {
+  for (std::size_t k = 0; k < samples.size();
+       k += std::max<std::size_t>(1, samples.size() / 20000)) {
     for (int c = 0; c < robot.NumChannels(); ++c) {
       const double ticks = std::abs(samples[k].value[c] * samples[k].dt_s * ticks_per_rad);
       if (robot.channels[c].kind == ChannelKind::kWheelRate && ticks > 0.0) moving.push_back(ticks);

@@ -25,8 +25,8 @@ std::string MakeUniqueDirectory(const std::string& prefix, const std::string& ta
   std::vector<char> name(pattern.begin(), pattern.end());
   name.push_back('\0');
   if (mkdtemp(name.data()) == nullptr) {
-    throw std::runtime_error(target + ": cannot create a directory beside it: " +
-                             std::strerror(errno));
+    throw std::runtime_error(target +
+                             ": cannot create a directory beside it: " + std::strerror(errno));
   }
   return name.data();
 }

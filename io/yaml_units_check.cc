@@ -14,7 +14,8 @@ namespace fitcal::io {
 namespace {
 
 bool EndsWith(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 // The numbers of a scalar or a list of scalars (a bounds pair); non-numbers are skipped (their
@@ -45,9 +46,10 @@ void CheckLengths(const std::string& key, const YAML::Node& value, const std::st
   for (const auto& [v, line] : Numbers(value)) {
     if (std::abs(v) <= kMaxRobotLengthM) continue;
     throw InputError(InputErrorKind::kImplausibleValue, path, line,
-                     key + " = " + Text(v) + " is not a plausible length in metres for a wheeled "
-                     "robot (limit " + Text(kMaxRobotLengthM) + " m): millimetres? write " +
-                         Text(v / 1000.0));
+                     key + " = " + Text(v) +
+                         " is not a plausible length in metres for a wheeled "
+                         "robot (limit " +
+                         Text(kMaxRobotLengthM) + " m): millimetres? write " + Text(v / 1000.0));
   }
 }
 
@@ -62,7 +64,8 @@ bool IsMountingAngleKey(const std::string& key) {
   return true;
 }
 
-// The mounting-angle keys of the maps in one list (wheels, castors): radians where degrees are meant.
+// The mounting-angle keys of the maps in one list (wheels, castors): radians where degrees are
+// meant.
 void CheckListAngles(const YAML::Node& list, const std::string& list_key, const std::string& path) {
   std::map<std::string, std::vector<std::pair<double, int>>> by_key;
   for (const YAML::Node& item : list) {
@@ -70,7 +73,8 @@ void CheckListAngles(const YAML::Node& list, const std::string& list_key, const 
     for (const auto& entry : item) {
       if (!entry.first.IsScalar() || !IsMountingAngleKey(entry.first.Scalar())) continue;
       if (!entry.second.IsScalar()) continue;
-      for (const auto& number : Numbers(entry.second)) by_key[entry.first.Scalar()].push_back(number);
+      for (const auto& number : Numbers(entry.second))
+        by_key[entry.first.Scalar()].push_back(number);
     }
   }
   for (const auto& [key, values] : by_key) {
@@ -86,12 +90,15 @@ void CheckListAngles(const YAML::Node& list, const std::string& list_key, const 
     if (largest > 2.0 * M_PI + 1e-9 || hi - lo <= M_PI) continue;
     std::string as_degrees;
     for (const auto& [v, line] : values) {
-      as_degrees += (as_degrees.empty() ? "" : ", ") + Text(std::round(v * 180.0 / M_PI * 100) / 100);
+      as_degrees +=
+          (as_degrees.empty() ? "" : ", ") + Text(std::round(v * 180.0 / M_PI * 100) / 100);
     }
     throw InputError(InputErrorKind::kImplausibleValue, path, values.front().second,
                      list_key + ": " + key + " values lie within 2 pi of each other (" + Text(lo) +
-                         " to " + Text(hi) + "): radians where the key says degrees? in degrees "
-                         "they would be " + as_degrees);
+                         " to " + Text(hi) +
+                         "): radians where the key says degrees? in degrees "
+                         "they would be " +
+                         as_degrees);
   }
 }
 

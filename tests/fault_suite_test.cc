@@ -22,8 +22,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cstring>
-#include <functional>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <random>
 #include <set>
@@ -208,9 +208,9 @@ TEST(FaultSuiteTest, NoOutputMayBeHoldOrSitInsideAnInputForceOrNot) {
   const TempDir dir;
   const fs::path data = SimulatedDataset(dir, "data", "diff_drive");
   const fs::path cal = dir.path() / "cal.yaml";
-  ASSERT_EQ(RunFitcal(dir, "fit --logs '" + data.string() + "' --out '" + cal.string() + "'")
-                .exit_code,
-            0);
+  ASSERT_EQ(
+      RunFitcal(dir, "fit --logs '" + data.string() + "' --out '" + cal.string() + "'").exit_code,
+      0);
   const io::DatasetIndex index = io::ReadDatasetIndex(data.string(), {});
   const std::string enc = index.runs.front().encoders_path;
   const std::string enc_prefix = enc.substr(0, enc.size() - 4);  // compare adds ".csv"
@@ -238,9 +238,8 @@ TEST(FaultSuiteTest, NoOutputMayBeHoldOrSitInsideAnInputForceOrNot) {
   for (const OutputCase& c : cases) {
     SCOPED_TRACE(c.what);
     std::string args = c.args;
-    for (const auto& [key, value] :
-         std::vector<std::pair<std::string, std::string>>{{"{data}", data.string()},
-                                                           {"{cal}", cal.string()}}) {
+    for (const auto& [key, value] : std::vector<std::pair<std::string, std::string>>{
+             {"{data}", data.string()}, {"{cal}", cal.string()}}) {
       for (std::size_t at; (at = args.find(key)) != std::string::npos;) {
         args.replace(at, key.size(), value);
       }
@@ -281,10 +280,10 @@ TEST(FaultSuiteTest, ForceReplacesOnlyWhatFitcalWroteAsTheSameKind) {
             0);
   WriteFileBytes(data / "my_notes.txt", "keep\n");
   const auto with_notes = Snapshot(data);
-  EXPECT_EQ(RunFitcal(dir, "simulate --model diff_drive --repetitions 2 --force --out " +
-                               data.string())
-                .exit_code,
-            2);
+  EXPECT_EQ(
+      RunFitcal(dir, "simulate --model diff_drive --repetitions 2 --force --out " + data.string())
+          .exit_code,
+      2);
   EXPECT_EQ(Snapshot(data), with_notes);
 }
 
@@ -353,9 +352,9 @@ TEST(FaultSuiteTest, AFileSizeLimitIsOneLineAndExitOneWithNothingLeft) {
   fs::create_directories(work);
   // A data set (a directory of files) and a calibration (one file), each larger than 2 kB.
   const fs::path data = work / "data";
-  ChildResult r = RunChild({"simulate", "--model", "diff_drive", "--repetitions", "2", "--out",
-                            data.string()},
-                           dir.path(), 2048);
+  ChildResult r =
+      RunChild({"simulate", "--model", "diff_drive", "--repetitions", "2", "--out", data.string()},
+               dir.path(), 2048);
   EXPECT_TRUE(r.exited) << "killed by signal " << r.signal;
   EXPECT_EQ(r.code, 1);
   const std::string err = ReadFileBytes(dir.path() / "child.err");
@@ -398,14 +397,16 @@ TEST(FaultSuiteTest, AReadOnlyOutputDirectoryIsOneLineAndExitOne) {
   const fs::path ro = dir.path() / "ro";
   fs::create_directories(ro);
   fs::permissions(ro, fs::perms::owner_read | fs::perms::owner_exec);
-  const auto r = RunFitcal(dir, "simulate --model diff_drive --out '" + (ro / "data").string() + "'");
+  const auto r =
+      RunFitcal(dir, "simulate --model diff_drive --out '" + (ro / "data").string() + "'");
   fs::permissions(ro, fs::perms::owner_all);
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_EQ(Lines(r.err), 1) << r.err;
   EXPECT_TRUE(fs::is_empty(ro));
 }
 
-// Puts `files` back as the whole content of `out` (a directory) or as `out` itself (a file, key "").
+// Puts `files` back as the whole content of `out` (a directory) or as `out` itself (a file, key
+// "").
 void Restore(const fs::path& out, const std::map<std::string, std::string>& files) {
   fs::remove_all(out);
   for (const auto& [name, bytes] : files) {
@@ -456,13 +457,17 @@ TEST(FaultSuiteTest, AWriterKilledAtAnyMomentLeavesTheOldOutputOrTheNew) {
       {"fit",
        {"fit", "--logs", d, "--train-reps", "1", "--out", o},
        {"fit", "--logs", d, "--train-reps", "1-2", "--out", o},
-       [](const fs::path& p) { return ReadFileBytes(p).find("calibration:") != std::string::npos; }},
+       [](const fs::path& p) {
+         return ReadFileBytes(p).find("calibration:") != std::string::npos;
+       }},
       {"report",
        {"report", "--logs", d, "--calibration", (dir.path() / "cal.yaml").string(), "--out", o,
         "--train-reps", "1"},
        {"report", "--logs", d, "--calibration", (dir.path() / "cal.yaml").string(), "--out", o,
         "--train-reps", "2"},
-       [](const fs::path& p) { return fs::exists(p / "index.html") && fs::exists(p / "metrics.csv"); }},
+       [](const fs::path& p) {
+         return fs::exists(p / "index.html") && fs::exists(p / "metrics.csv");
+       }},
   };
   const fs::path sessions = fs::path(FITCAL_SHARED_DIR) / "data/optiodom/diff/free";
   if (fs::is_directory(sessions)) {
@@ -473,9 +478,9 @@ TEST(FaultSuiteTest, AWriterKilledAtAnyMomentLeavesTheOldOutputOrTheNew) {
     again.push_back("--force");
     writers.push_back({"import optiodom", import, again, loads});
   }
-  ASSERT_EQ(RunFitcal(dir, "fit --logs " + d + " --out " + (dir.path() / "cal.yaml").string())
-                .exit_code,
-            0);
+  ASSERT_EQ(
+      RunFitcal(dir, "fit --logs " + d + " --out " + (dir.path() / "cal.yaml").string()).exit_code,
+      0);
   for (const KilledWriter& w : writers) {
     SCOPED_TRACE(w.name);
     fs::remove_all(out);
@@ -553,13 +558,13 @@ TEST(FaultSuiteTest, TwoWritersOfOneOutputLeaveOneCompleteOutput) {
 // Names any YAML reader reads back the same.
 
 TEST(FaultSuiteTest, RunIdsAndNamesRoundTripThroughAnyYamlReader) {
-  const std::vector<std::string> names = {"007",  "1e3",  "0x1F", "yes",  "No",   "on",
-                                          "null", "~",    "a: b", "#tag", "it's", "say \"hi\"",
-                                          "-",    "12:30", "[x]", "{y}",  "plain_name", ".inf"};
+  const std::vector<std::string> names = {
+      "007",  "1e3",  "0x1F",       "yes", "No",    "on",  "null", "~",          "a: b",
+      "#tag", "it's", "say \"hi\"", "-",   "12:30", "[x]", "{y}",  "plain_name", ".inf"};
   std::vector<io::DatasetEntry> runs;
   for (std::size_t i = 0; i < names.size(); ++i) {
-    runs.push_back({names[i], names[i], static_cast<int>(i), "runs/" + names[i] + ".csv",
-                    "runs/gt.csv"});
+    runs.push_back(
+        {names[i], names[i], static_cast<int>(i), "runs/" + names[i] + ".csv", "runs/gt.csv"});
   }
   const YAML::Node root = YAML::Load(io::DatasetYaml("robot: x.yaml", runs));
   EXPECT_EQ(root["robot"].as<std::string>(), "robot: x.yaml");

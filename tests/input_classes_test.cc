@@ -46,8 +46,8 @@ class InputClassesTest : public ::testing::Test {
   // write nothing.
   void ExpectFitRefused(int exit_code, const std::vector<std::string>& parts,
                         const std::string& extra = "") {
-    const auto r = RunFitcal(dir_, "fit --logs '" + data_.string() + "' --out '" + out_.string() +
-                                       "' " + extra);
+    const auto r = RunFitcal(
+        dir_, "fit --logs '" + data_.string() + "' --out '" + out_.string() + "' " + extra);
     EXPECT_EQ(r.exit_code, exit_code) << r.err << r.out;
     EXPECT_EQ(Lines(r.err), 1) << r.err;
     for (const std::string& part : parts) EXPECT_TRUE(Has(r.err, part)) << part << " in " << r.err;
@@ -87,7 +87,8 @@ class InputClassesTest : public ::testing::Test {
 };
 
 TEST_F(InputClassesTest, TheDataSetItselfFitsAndCarriesSigmas) {
-  const auto r = RunFitcal(dir_, "fit --logs '" + data_.string() + "' --out '" + out_.string() + "'");
+  const auto r =
+      RunFitcal(dir_, "fit --logs '" + data_.string() + "' --out '" + out_.string() + "'");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string cal = ReadFileBytes(out_);
   EXPECT_TRUE(Has(cal, "sigma:")) << cal;
@@ -137,10 +138,10 @@ TEST_F(InputClassesTest, GroundTruthInMillimetresIsNamed) {
 }
 
 TEST_F(InputClassesTest, LengthsInMillimetresAreNamedWithTheirLine) {
-  SetRobotYaml(Replace(Replace(Replace(RobotYaml(), "wheel_separation_m: 0.2",
-                                       "wheel_separation_m: 200"),
-                               "radius_m: [0.038, 0.046]", "radius_m: [38, 46]"),
-                       "wheel_separation_m: [0.18, 0.22]", "wheel_separation_m: [180, 220]"));
+  SetRobotYaml(
+      Replace(Replace(Replace(RobotYaml(), "wheel_separation_m: 0.2", "wheel_separation_m: 200"),
+                      "radius_m: [0.038, 0.046]", "radius_m: [38, 46]"),
+              "wheel_separation_m: [0.18, 0.22]", "wheel_separation_m: [180, 220]"));
   ExpectFitRefused(1, {"robot.yaml:6:", "wheel_separation_m = 200", "millimetres"});
 }
 
@@ -165,8 +166,9 @@ TEST_F(InputClassesTest, NegativeRepetitionNumbersAreRefused) {
 
 TEST_F(InputClassesTest, AStartHeadingInDegreesIsRefused) {
   const std::string yaml = ReadFileBytes(data_ / "dataset.yaml");
-  WriteFileBytes(data_ / "dataset.yaml", Replace(yaml, "repetition: 1, encoders",
-                                                 "repetition: 1, start_pose: [0, 0, 90], encoders"));
+  WriteFileBytes(
+      data_ / "dataset.yaml",
+      Replace(yaml, "repetition: 1, encoders", "repetition: 1, start_pose: [0, 0, 90], encoders"));
   ExpectFitRefused(1, {"dataset.yaml:3:", "start_pose theta 90", "degrees?"});
 }
 
@@ -199,9 +201,9 @@ TEST_F(InputClassesTest, ATickCounterThatWrapsIsRefusedAtItsLine) {
 TEST(InputClassesCli, ASteeringAngleInDegreesIsRefused) {
   const TempDir dir;
   const fs::path data = dir.path() / "tri";
-  ASSERT_EQ(RunFitcal(dir, "simulate --model tricycle --repetitions 2 --out " + data.string())
-                .exit_code,
-            0);
+  ASSERT_EQ(
+      RunFitcal(dir, "simulate --model tricycle --repetitions 2 --out " + data.string()).exit_code,
+      0);
   for (const auto& e : fs::directory_iterator(data / "runs")) {
     if (!Has(e.path().filename().string(), "_encoders.csv")) continue;
     std::istringstream in(ReadFileBytes(e.path()));
@@ -233,8 +235,8 @@ wheels:
   - {name: c, distance_m: 0.2, angle_deg: 5.2360, radius_m: 0.05, drive_angle_deg: 90, roller_angle_deg: 0}
 bounds: {distance_m: [0.18, 0.22], radius_m: [0.045, 0.055], angle_offset_deg: [-2, 2]}
 )");
-  const auto r = RunFitcal(dir, "simulate --model omni --robot " + robot + " --out " +
-                                    dir.Path("data"));
+  const auto r =
+      RunFitcal(dir, "simulate --model omni --robot " + robot + " --out " + dir.Path("data"));
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_EQ(Lines(r.err), 1) << r.err;
   EXPECT_TRUE(Has(r.err, "omni.yaml:4:") && Has(r.err, "angle_deg") && Has(r.err, "radians"))

@@ -3,7 +3,6 @@
 // runs it. `fitcal --logs <dir> --method ceres` without a subcommand runs `fit`.
 
 #include <glog/logging.h>
-
 #include <signal.h>
 
 #include <CLI/CLI.hpp>

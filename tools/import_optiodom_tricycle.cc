@@ -325,7 +325,8 @@ ImportOptiOdomTricycleSummary ImportOptiOdomTricycle(const std::vector<std::stri
                                                      const std::string& out,
                                                      const ImportOptiOdomTricycleOptions& options) {
   if (sessions.empty()) throw std::invalid_argument("import needs at least one session");
-  if (const std::string refusal = DirectoryOutputRefusal(out, kDatasetKind, options.force, sessions);
+  if (const std::string refusal =
+          DirectoryOutputRefusal(out, kDatasetKind, options.force, sessions);
       !refusal.empty()) {
     throw std::runtime_error(refusal);
   }

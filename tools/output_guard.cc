@@ -164,8 +164,9 @@ std::string DirectoryOutputRefusal(const std::string& out, const std::string& ki
   }
   if (fs::is_empty(out, ec)) return "";
   if (const std::string foreign = ForeignFile(out, kind); !foreign.empty()) {
-    return Refusal(out, "holds '" + io::OneLine(foreign, 80) + "', which fitcal did not write as a " +
-                            kind + "; refusing to replace the directory, --force or not (choose "
+    return Refusal(out, "holds '" + io::OneLine(foreign, 80) +
+                            "', which fitcal did not write as a " + kind +
+                            "; refusing to replace the directory, --force or not (choose "
                             "an empty or new --out)");
   }
   if (!force) return Refusal(out, "already holds a " + kind + "; --force to replace it");

@@ -164,7 +164,8 @@ int RunSimulateCommand(const SimulateCommandOptions& options) {
                               io::GroundTruthCsv(log.ground_truth));
     });
     io::WriteFileAtomically((out / "robot.yaml").string(), io::Omni3RobotYaml(nominal, nullptr));
-    io::WriteFileAtomically((out / "dataset.yaml").string(), io::DatasetYaml("robot.yaml", entries));
+    io::WriteFileAtomically((out / "dataset.yaml").string(),
+                            io::DatasetYaml("robot.yaml", entries));
     CommitDirectoryOutput(staged, options.out, kDatasetKind, options.force, {});
     std::printf("wrote %zu runs (%zu trajectories x %d repetitions, seed %llu) to %s\n",
                 runs.size(), sim_options.trajectories.size(), sim_options.repetitions,

@@ -10,10 +10,9 @@
 // form's point) it is the spread the same residuals would allow around it, the linearised answer
 // to "how well do these runs pin the parameters down" - said so where it is printed.
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "models/model_interface.h"
 #include "odometry/aligned_run.h"

@@ -53,7 +53,8 @@ RateUnitsFinding CheckModelRateUnits(const RobotModelInterface& model,
     const char* name;
     double factor;  // logged value / rad/s
   };
-  static const Unit kUnits[] = {{"deg/s", 180.0 / M_PI}, {"rpm", 30.0 / M_PI}, {"rev/s", 0.5 / M_PI}};
+  static const Unit kUnits[] = {
+      {"deg/s", 180.0 / M_PI}, {"rpm", 30.0 / M_PI}, {"rev/s", 0.5 / M_PI}};
   double best = std::numeric_limits<double>::infinity();
   for (const Unit& u : kUnits) {
     const double misfit = std::abs(std::log(finding.scale / u.factor));
@@ -67,10 +68,11 @@ RateUnitsFinding CheckModelRateUnits(const RobotModelInterface& model,
   // so the pooled ratio lies a little above it).
   if (std::abs(std::log(finding.scale / 1e-3)) < std::log(3.0)) {
     finding.likely_unit = "ground truth in mm";
-    std::snprintf(line, sizeof line,
-                  "the ground truth's path is %.3g times the nominal robot's odometry: ground-truth "
-                  "positions in millimetres, not metres?; nothing fitted",
-                  1.0 / finding.scale);
+    std::snprintf(
+        line, sizeof line,
+        "the ground truth's path is %.3g times the nominal robot's odometry: ground-truth "
+        "positions in millimetres, not metres?; nothing fitted",
+        1.0 / finding.scale);
     finding.message = line;
     return finding;
   }

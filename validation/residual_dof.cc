@@ -12,9 +12,9 @@ std::string ResidualDofRefusal(std::size_t num_residuals, std::size_t num_parame
   auto count = [](std::size_t n, const char* noun) {
     return std::to_string(n) + " " + noun + (n == 1 ? "" : "s");
   };
-  return count(num_training_runs, "training run") + " give" + (num_training_runs == 1 ? "s " : " ") +
-         std::to_string(num_residuals) + " " + residual_kind + " residuals for " +
-         count(num_parameters, "free parameter") +
+  return count(num_training_runs, "training run") + " give" +
+         (num_training_runs == 1 ? "s " : " ") + std::to_string(num_residuals) + " " +
+         residual_kind + " residuals for " + count(num_parameters, "free parameter") +
          ": no residual degrees of freedom, so the fit reproduces any data exactly and nothing "
          "judges it (no calibration, no uncertainty); nothing written. Record at least " +
          count(runs_needed, "training run") +
