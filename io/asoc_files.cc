@@ -12,6 +12,7 @@
 #include "io/robot_yaml_blocks.h"
 #include "io/text_file.h"
 #include "io/yaml_reader.h"
+#include "io/yaml_text.h"
 #include "odometry/parallel_for.h"
 #include "odometry/pose2.h"
 
@@ -228,10 +229,12 @@ AsocRobot ReadAsocRobotNode(const YAML::Node& root, const std::string& path) {
   const std::string model = map.String("model");
   if (model != "asoc") {
     throw InputError(InputErrorKind::kUnknownModel, path, map.line(map.Required("model")),
-                     "model '" + model + "' is not asoc");
+                     "model '" + model +
+                         "' is not asoc: the asoc commands read asoc robots only (fitcal fit "
+                         "calibrates every model)");
   }
   AsocRobot robot;
-  robot.name = map.String("name");
+  robot.name = map.Name("name");
   robot.pivot_distance_m = map.Double("pivot_distance_m");
   if (!(robot.pivot_distance_m > 0.0)) {
     throw InputError(InputErrorKind::kBadValue, path, map.line(map.Required("pivot_distance_m")),
@@ -247,7 +250,7 @@ AsocRobot ReadAsocRobotNode(const YAML::Node& root, const std::string& path) {
   for (int i = 0; i < asoc::kNumCastors; ++i) {
     const std::string what = "castor " + std::to_string(i + 1);
     YamlMap c(castors[i], path, what);
-    robot.castor_names[i] = c.String("name");
+    robot.castor_names[i] = c.Name("name");
     if (!names.insert(robot.castor_names[i]).second) {
       throw InputError(InputErrorKind::kBadValue, path, LineOf(castors[i]),
                        "castor name '" + robot.castor_names[i] + "' is used twice");
@@ -293,13 +296,13 @@ std::string AsocRobotYaml(const AsocRobot& robot, const std::string& calibration
   out.SetDoublePrecision(10);
   out << YAML::BeginMap;
   out << YAML::Key << "model" << YAML::Value << "asoc";
-  out << YAML::Key << "name" << YAML::Value << robot.name;
+  out << YAML::Key << "name" << YAML::Value << YamlText(robot.name);
   out << YAML::Key << "pivot_distance_m" << YAML::Value << robot.pivot_distance_m;
   out << YAML::Key << "castors" << YAML::Value << YAML::BeginSeq;
   for (int i = 0; i < asoc::kNumCastors; ++i) {
     const asoc::CastorParameters& c = robot.nominal.castors[i];
     out << YAML::Flow << YAML::BeginMap;
-    out << YAML::Key << "name" << YAML::Value << robot.castor_names[i];
+    out << YAML::Key << "name" << YAML::Value << YamlText(robot.castor_names[i]);
     out << YAML::Key << "pivot_radius_m" << YAML::Value << robot.nominal.pivots[i].radius_m;
     out << YAML::Key << "pivot_angle_deg" << YAML::Value
         << RadToDeg(robot.nominal.pivots[i].angle_rad);
@@ -338,6 +341,8 @@ std::string AsocRobotYaml(const AsocRobot& robot, const std::string& calibration
 
 AsocDataset LoadAsocDataset(const std::string& directory, const DatasetOptions& options) {
   const DatasetIndex index = ReadDatasetIndex(directory, options);
+  // The robot first: a data set of another model is named as such, not as a bad log header.
+  ReadAsocRobot(index.robot_path);
   AsocDataset dataset;
   dataset.directory = index.directory;
   dataset.robot_path = index.robot_path;

@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "io/robot_yaml_blocks.h"
+#include "io/yaml_text.h"
 
 namespace fitcal::io {
 
@@ -11,7 +12,9 @@ namespace {
 void EmitRuns(YAML::Emitter& out, const CalibrationBlock& c) {
   EmitCalibrationRunCounts(out, c);
   if (!c.training_run_ids.empty()) {
-    out << YAML::Key << "training_run_ids" << YAML::Value << YAML::Flow << c.training_run_ids;
+    out << YAML::Key << "training_run_ids" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+    for (const std::string& id : c.training_run_ids) out << YamlText(id);
+    out << YAML::EndSeq;
   }
   if (!c.training_fingerprint.empty()) {
     out << YAML::Key << "training_fingerprint" << YAML::Value << YAML::DoubleQuoted
@@ -48,7 +51,7 @@ void EmitUncertainty(YAML::Emitter& out, const CalibrationBlock& c, const Robot&
 void EmitCalibrationOrigin(YAML::Emitter& out, const CalibrationSource& c) {
   out << YAML::Key << "method" << YAML::Value << c.method;
   out << YAML::Key << "objective" << YAML::Value << c.objective;
-  out << YAML::Key << "dataset" << YAML::Value << c.dataset;
+  out << YAML::Key << "dataset" << YAML::Value << YamlText(c.dataset);
   out << YAML::Key << "tool_version" << YAML::Value << c.tool_version;
   out << YAML::Key << "termination" << YAML::Value << c.termination;
 }

@@ -16,9 +16,11 @@
 
 #include "io/asoc_files.h"
 #include "io/input_error.h"
+#include "io/input_registry.h"
 #include "io/log_files.h"
 #include "io/robot_yaml.h"
 #include "io/yaml_reader.h"
+#include "io/yaml_text.h"
 #include "odometry/parallel_for.h"
 
 namespace fitcal::io {
@@ -97,6 +99,7 @@ DatasetIndex ReadDatasetIndex(const std::string& directory, const DatasetOptions
   if (!fs::is_directory(directory, fs_error)) {
     throw InputError(InputErrorKind::kMissingFile, directory, 0, "not a directory");
   }
+  RegisterInputDirectory(directory);  // no output inside the data set (io/input_registry.h)
   const YAML::Node root = LoadYamlFile(yaml_path);
   YamlMap top(root, yaml_path, "dataset");
   const YAML::Node robot_node = top.Required("robot");
@@ -122,13 +125,18 @@ DatasetIndex ReadDatasetIndex(const std::string& directory, const DatasetOptions
     const YAML::Node node = runs[i];
     YamlMap run(node, yaml_path, "run " + std::to_string(i + 1));
     DatasetIndexEntry& entry = index.runs[i];
-    entry.id = run.String("id");
+    entry.id = run.Name("id");
     if (!ids.insert(entry.id).second) {
       throw InputError(InputErrorKind::kDuplicateRunId, yaml_path, LineOf(node),
                        "run id '" + entry.id + "' is used twice");
     }
-    entry.trajectory = run.String("trajectory");
+    entry.trajectory = run.Name("trajectory");
     entry.repetition = run.Int("repetition");
+    if (entry.repetition < 0) {
+      throw InputError(InputErrorKind::kBadValue, yaml_path, LineOf(node["repetition"]),
+                       "run '" + entry.id + "': repetition " + std::to_string(entry.repetition) +
+                           " is negative; repetitions count 0, 1, 2, ...");
+    }
     entry.encoders_path =
         ResolvePath(directory, run.String("encoders"), options, yaml_path, node["encoders"]);
     entry.ground_truth_path = ResolvePath(directory, run.String("ground_truth"), options, yaml_path,
@@ -145,6 +153,12 @@ DatasetIndex ReadDatasetIndex(const std::string& directory, const DatasetOptions
       entry.start_pose = Pose2d{YamlDouble(start[0], yaml_path, "start_pose x"),
                                 YamlDouble(start[1], yaml_path, "start_pose y"),
                                 YamlDouble(start[2], yaml_path, "start_pose theta")};
+      // A heading beyond a full turn is degrees written where radians are meant.
+      if (std::abs(entry.start_pose->theta) > 2.0 * M_PI + 1e-9) {
+        throw InputError(InputErrorKind::kImplausibleValue, yaml_path, LineOf(start[2]),
+                         "start_pose theta " + start[2].Scalar() +
+                             " is beyond a full turn in rad: degrees? theta is in radians");
+      }
     }
     run.RejectUnread();
   }
@@ -313,15 +327,15 @@ Dataset LoadDataset(const DatasetIndex& index, const Robot& robot, const Dataset
 std::string DatasetYaml(const std::string& robot_path, const std::vector<DatasetEntry>& runs) {
   YAML::Emitter out;
   out << YAML::BeginMap;
-  out << YAML::Key << "robot" << YAML::Value << robot_path;
+  out << YAML::Key << "robot" << YAML::Value << YamlText(robot_path);
   out << YAML::Key << "runs" << YAML::Value << YAML::BeginSeq;
   for (const DatasetEntry& run : runs) {
     out << YAML::Flow << YAML::BeginMap;
-    out << YAML::Key << "id" << YAML::Value << run.id;
-    out << YAML::Key << "trajectory" << YAML::Value << run.trajectory;
+    out << YAML::Key << "id" << YAML::Value << YamlText(run.id);
+    out << YAML::Key << "trajectory" << YAML::Value << YamlText(run.trajectory);
     out << YAML::Key << "repetition" << YAML::Value << run.repetition;
-    out << YAML::Key << "encoders" << YAML::Value << run.encoders;
-    out << YAML::Key << "ground_truth" << YAML::Value << run.ground_truth;
+    out << YAML::Key << "encoders" << YAML::Value << YamlText(run.encoders);
+    out << YAML::Key << "ground_truth" << YAML::Value << YamlText(run.ground_truth);
     out << YAML::EndMap;
   }
   out << YAML::EndSeq << YAML::EndMap;

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "io/input_error.h"
+#include "io/sample_checks.h"
 #include "io/text_file.h"
 #include "io/warnings.h"
 
@@ -285,6 +286,24 @@ void CheckTimePlausible(double t_s, const std::string& path, int line_number) {
   }
 }
 
+// The width in bits of a counter whose wrap would make a jump of `ticks` (within 5 % of 2^bits,
+// from 8 to 32 bits), 0 when none.
+int WrapBitsOf(double ticks) {
+  if (std::abs(ticks) < 128.0) return 0;
+  for (int bits = 8; bits <= 32; ++bits) {
+    const double wrap = std::ldexp(1.0, bits);
+    if (std::abs(std::abs(ticks) - wrap) <= 0.05 * wrap) return bits;
+  }
+  return 0;
+}
+
+std::string CounterWrapMessage(int bits) {
+  const std::string b = std::to_string(bits);
+  return "the tick counter jumps by about 2^" + b + " ticks in one interval: a " + b +
+         "-bit counter that wraps inside the run; unwrap the counts (add 2^" + b +
+         " after each wrap) before importing";
+}
+
 // The last interval's channel values against the limits above.
 void CheckSamplePlausible(const EncoderSamples& samples, const Robot& robot,
                           const std::string& path, int line_number) {
@@ -294,6 +313,14 @@ void CheckSamplePlausible(const EncoderSamples& samples, const Robot& robot,
     const bool angle = robot.channels[c].kind == ChannelKind::kAngle;
     const double limit = angle ? kMaxAngleRad : kMaxWheelRateRadPerS;
     if (std::abs(s.value[c]) <= limit) continue;
+    if (!angle && robot.encoder && robot.encoder->cumulative) {  // a wrap, not a rate
+      const int bits =
+          WrapBitsOf(s.value[c] * s.dt_s * robot.encoder->ticks_per_rev / (2.0 * M_PI));
+      if (bits > 0) {
+        throw InputError(InputErrorKind::kImplausibleValue, path, line_number,
+                         CounterWrapMessage(bits));
+      }
+    }
     throw InputError(InputErrorKind::kImplausibleValue, path, line_number,
                      "channel '" + robot.channels[c].name + "': " + Number(s.value[c]) +
                          (angle ? " rad is not a physical angle (limit "
@@ -407,6 +434,43 @@ EncoderLog ReadEncoderRows(TextFileReader& lines, const Robot& robot) {
 
 }  // namespace
 
+namespace {
+
+// A running tick counter that wraps inside a run (a 16-bit count passing 65535 -> 0) turns one
+// interval into a jump of about -2^bits ticks: a rate thousands of times its neighbours'. Such an
+// interval, whose tick count lies within 5 % of a power of two from 2^8 to 2^32 and is over a
+// hundred times the run's median moving interval, is a wrap: refused with its line (fitcal does
+// not guess the counter's width). Returns the sample index, or samples.size().
+std::size_t FindCounterWrap(const EncoderLog& log, const Robot& robot, int* bits) {
+  const EncoderSamples& samples = log.samples;
+  if (!robot.encoder || !robot.encoder->cumulative || samples.size() < 3) return samples.size();
+  const double ticks_per_rad = robot.encoder->ticks_per_rev / (2.0 * M_PI);
+  std::vector<double> moving;
+  for (std::size_t k = 0; k < samples.size();
+       k += std::max<std::size_t>(1, samples.size() / 20000)) {
+    for (int c = 0; c < robot.NumChannels(); ++c) {
+      const double ticks = std::abs(samples[k].value[c] * samples[k].dt_s * ticks_per_rad);
+      if (robot.channels[c].kind == ChannelKind::kWheelRate && ticks > 0.0) moving.push_back(ticks);
+    }
+  }
+  if (moving.empty()) return samples.size();
+  std::nth_element(moving.begin(), moving.begin() + static_cast<std::ptrdiff_t>(moving.size() / 2),
+                   moving.end());
+  const double median = moving[moving.size() / 2];
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    for (int c = 0; c < robot.NumChannels(); ++c) {
+      if (robot.channels[c].kind != ChannelKind::kWheelRate) continue;
+      const double ticks = std::abs(samples[k].value[c] * samples[k].dt_s * ticks_per_rad);
+      if (ticks < 100.0 * median) continue;
+      *bits = WrapBitsOf(ticks);
+      if (*bits > 0) return k;
+    }
+  }
+  return samples.size();
+}
+
+}  // namespace
+
 EncoderLog ReadEncoderCsv(const std::string& path, const Robot& robot) {
   EncoderLog log = ReportingOutOfMemory(path, [&] {
     TextFileReader lines(path);
@@ -426,6 +490,14 @@ EncoderLog ReadEncoderCsv(const std::string& path, const Robot& robot) {
                          " s) while the wheels turn: a clock step or lost rows inside a moving "
                          "stretch; refused (cut the run into two runs there)");
   }
+  int bits = 0;
+  const std::size_t wrap = FindCounterWrap(log, robot, &bits);
+  if (wrap < log.samples.size()) {
+    throw InputError(InputErrorKind::kImplausibleValue, path, LineOfDataRow(path, wrap + 1),
+                     CounterWrapMessage(bits));
+  }
+  // The model's own checks of what its channels hold (a steering angle in degrees or ticks, ...).
+  RunSampleCheck(robot.model, log, path);
   return log;
 }
 

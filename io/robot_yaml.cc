@@ -10,6 +10,8 @@
 #include "io/input_error.h"
 #include "io/robot_yaml_blocks.h"
 #include "io/yaml_reader.h"
+#include "io/yaml_text.h"
+#include "io/yaml_units_check.h"
 #include "odometry/pose2.h"
 
 namespace fitcal::io {
@@ -30,6 +32,7 @@ std::string ReadRobotModel(const std::string& path) {
 
 Omni3Robot ReadOmni3Robot(const std::string& path) {
   const YAML::Node root = LoadYamlFile(path);
+  CheckRobotYamlUnits(root, path);
   YamlMap robot_map(root, path, "robot");
   const std::string model = robot_map.String("model");
   if (model != "omni3") {
@@ -38,7 +41,7 @@ Omni3Robot ReadOmni3Robot(const std::string& path) {
                      "model '" + model + "' is not omni3 (known: omni3)");
   }
   Omni3Robot robot;
-  robot.name = robot_map.String("name");
+  robot.name = robot_map.Name("name");
   const YAML::Node wheels = robot_map.Required("wheels");
   ExpectYamlType(wheels, YAML::NodeType::Sequence, path, "robot.wheels");
   if (wheels.size() != omni3::kNumWheels) {
@@ -49,7 +52,7 @@ Omni3Robot ReadOmni3Robot(const std::string& path) {
   for (int i = 0; i < omni3::kNumWheels; ++i) {
     const std::string what = "wheel " + std::to_string(i + 1);
     YamlMap wheel(wheels[i], path, what);
-    robot.wheel_names[i] = wheel.String("name");
+    robot.wheel_names[i] = wheel.Name("name");
     if (!names.insert(robot.wheel_names[i]).second) {
       throw InputError(InputErrorKind::kBadValue, path, LineOf(wheels[i]),
                        "wheel name '" + robot.wheel_names[i] + "' is used twice");
@@ -119,7 +122,7 @@ std::string Omni3RobotYaml(const Omni3Robot& robot, const CalibrationRecord* cal
   out.SetDoublePrecision(10);
   out << YAML::BeginMap;
   out << YAML::Key << "model" << YAML::Value << "omni3";
-  out << YAML::Key << "name" << YAML::Value << robot.name;
+  out << YAML::Key << "name" << YAML::Value << YamlText(robot.name);
   out << YAML::Key << "wheels" << YAML::Value << YAML::BeginSeq;
   for (int i = 0; i < omni3::kNumWheels; ++i) {
     out << YAML::Flow << YAML::BeginMap;

@@ -43,7 +43,7 @@ std::vector<effects::EffectValue> ReadEffectsNode(const YAML::Node& node, const 
   ExpectYamlType(node, YAML::NodeType::Sequence, path, "robot.effects");
   for (std::size_t i = 0; i < node.size(); ++i) {
     YamlMap map(node[i], path, "effect " + std::to_string(i + 1));
-    const std::string name = map.String("name");
+    const std::string name = map.Name("name");
     effects::EffectValue e;
     try {
       e.id = effects::EffectIdFromName(name);

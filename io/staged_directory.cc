@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "io/atomic_file.h"
+#include "io/input_registry.h"
 
 namespace fitcal::io {
 namespace {
@@ -19,14 +20,23 @@ namespace fs = std::filesystem;
 
 // mkdtemp on `<prefix>XXXXXX`: the name is unique and the directory is ours (mode 0700 until the
 // files are in; the rename keeps it, so it is widened to the usual 0755 before).
-std::string MakeUniqueDirectory(const std::string& prefix) {
+std::string MakeUniqueDirectory(const std::string& prefix, const std::string& target) {
   std::string pattern = prefix + "XXXXXX";
   std::vector<char> name(pattern.begin(), pattern.end());
   name.push_back('\0');
   if (mkdtemp(name.data()) == nullptr) {
-    throw std::runtime_error(prefix + ": cannot create a directory: " + std::strerror(errno));
+    throw std::runtime_error(target +
+                             ": cannot create a directory beside it: " + std::strerror(errno));
   }
   return name.data();
+}
+
+// Whatever the command checked, a directory never replaces, holds or sits inside what was read
+// (io/input_registry.h).
+void ThrowIfAnInput(const std::string& target) {
+  if (const std::string overlap = OutputOverlapsInput(target); !overlap.empty()) {
+    throw std::runtime_error(target + ": " + overlap);
+  }
 }
 
 }  // namespace
@@ -35,10 +45,12 @@ StagedDirectory::StagedDirectory(const std::string& target) {
   fs::path t = fs::path(target).lexically_normal();
   if (!t.has_filename()) t = t.parent_path();  // "out/" names the directory "out"
   target_ = t.string();
+  ThrowIfAnInput(target_);
   std::error_code ec;
   if (t.has_parent_path()) fs::create_directories(t.parent_path(), ec);
   if (ec) throw std::runtime_error(target_ + ": cannot create its parent: " + ec.message());
-  staging_ = MakeUniqueDirectory(target_ + ".tmp-");
+  RemoveStaleTemporaries(target_);  // a writer killed before (SIGKILL) left its staging behind
+  staging_ = MakeUniqueDirectory(TemporaryPrefix(target_), target_);
   SetStagingDirectoryForSignals(staging_);
   fs::permissions(staging_,
                   fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec |
@@ -57,6 +69,7 @@ void StagedDirectory::Commit(bool replace_existing) {
   // From here a signal leaves the complete staged directory (and perhaps the previous one moved
   // aside), never a removed staging directory with the target moved away.
   SetStagingDirectoryForSignals("");
+  ThrowIfAnInput(target_);
   std::error_code ec;
   const bool exists = fs::exists(target_, ec);
   if (exists && !replace_existing) {
@@ -72,7 +85,7 @@ void StagedDirectory::Commit(bool replace_existing) {
       fs::remove_all(staging_, ec);  // now the previous directory
       return;
     }
-    aside = MakeUniqueDirectory(target_ + ".old-");
+    aside = MakeUniqueDirectory(TemporaryPrefix(target_) + "old-", target_);
     fs::remove(aside, ec);  // only the unique name is wanted: rename needs it free or empty
     fs::rename(target_, aside, ec);
     if (ec) throw std::runtime_error(target_ + ": cannot move it aside: " + ec.message());

@@ -11,6 +11,7 @@
 #include <new>
 
 #include "io/input_error.h"
+#include "io/input_registry.h"
 
 namespace fitcal::io {
 
@@ -64,6 +65,7 @@ int OpenRegularFile(const std::string& path, std::uint64_t* size_bytes) {
                          " bytes is larger than half of the free memory; split the log");
   }
   *size_bytes = size;
+  RegisterInputFile(path);  // an output must never replace what was read (io/input_registry.h)
   return fd;
 }
 

@@ -30,6 +30,11 @@ class YamlMap {
   YAML::Node Optional(const std::string& key);  // null node when absent
 
   std::string String(const std::string& key);
+  // A name (robot, wheel, run id, trajectory): a non-empty string of at most kMaxNameBytes
+  // without control characters, which would break the one-line messages and the files it is
+  // written into.
+  static constexpr std::size_t kMaxNameBytes = 200;
+  std::string Name(const std::string& key);
   double Double(const std::string& key);
   int Int(const std::string& key);
   // A two-element list [lo, hi] of numbers.

@@ -1,11 +1,14 @@
 #include "models/model_registry.h"
 
 #include "io/input_error.h"
+#include "io/sample_checks.h"
 #include "io/yaml_reader.h"
+#include "io/yaml_units_check.h"
 #include "models/asoc/asoc_robot_model.h"
 #include "models/diff_drive/diff_drive_model.h"
 #include "models/omni/omni_model.h"
 #include "models/omni3/omni3_robot_model.h"
+#include "models/tricycle/tricycle_checks.h"
 #include "models/tricycle/tricycle_model.h"
 
 namespace fitcal {
@@ -26,6 +29,12 @@ std::vector<ModelRegistration>& Registry() {
       {"asoc", "three active split offset castors, Doebbler et al. (18 parameters)", &ReadAsocModel,
        kAsocExampleYaml},
   };
+  // What each model's channels must hold, checked by the loader on every log (io/sample_checks.h).
+  static const bool sample_checks_registered = [] {
+    io::RegisterSampleCheck("tricycle", &tricycle::CheckSteeringSamples);
+    return true;
+  }();
+  (void)sample_checks_registered;
   return registry;
 }
 
@@ -89,7 +98,9 @@ void RefuseEffectsTheChannelsCannotShow(const Robot& robot, const YAML::Node& ro
 RobotModelPtr ReadRobotModel(const YAML::Node& root, const std::string& path) {
   io::ExpectYamlType(root, YAML::NodeType::Map, path, "robot file");
   if (!root["model"]) {
-    throw io::InputError(io::InputErrorKind::kMissingKey, path, 1, "robot has no 'model'");
+    // A misspelt key is named on its own line (YamlMap::Required), else the missing one.
+    io::YamlMap robot(root, path, "robot");
+    robot.Required("model");
   }
   const std::string model = io::YamlString(root["model"], path, "robot.model");
   const ModelRegistration* registration = FindModel(model);
@@ -97,6 +108,7 @@ RobotModelPtr ReadRobotModel(const YAML::Node& root, const std::string& path) {
     throw io::InputError(io::InputErrorKind::kUnknownModel, path, root["model"].Mark().line + 1,
                          "unknown model '" + model + "' (known: " + RegisteredModelNames() + ")");
   }
+  io::CheckRobotYamlUnits(root, path);  // millimetres, radians: before any model reads a value
   RobotModelPtr robot_model = registration->read(root, path);
   RefuseEffectsTheChannelsCannotShow(robot_model->robot(), root, path);
   return robot_model;

@@ -117,7 +117,7 @@ TEST(NothingLostTest, SignalAtEveryStageLeavesThePreviousOutputUntouched) {
       if (signal_number == SIGKILL && std::string(stage) == "temporary-written") {
         // Uncatchable: the temporary stays (named after the output), the output is intact.
         ASSERT_EQ(temporaries.size(), 1u);
-        EXPECT_EQ(temporaries[0].rfind("calibrated.yaml.tmp-", 0), 0u) << temporaries[0];
+        EXPECT_EQ(temporaries[0].rfind(".calibrated.yaml.tmp-", 0), 0u) << temporaries[0];
         fs::remove(out_dir / temporaries[0]);
       } else {
         EXPECT_TRUE(temporaries.empty()) << "temporary file left: " << temporaries[0];
@@ -270,7 +270,7 @@ TEST(NothingLostTest, ReportDirectoryIsReplacedWholeOrNotAtAll) {
     EXPECT_EQ(DirectoryBytes(report), previous) << "the previous report was changed";
     if (signal_number == SIGKILL) {  // uncatchable: the staged sibling stays, named after it
       ASSERT_EQ(siblings().size(), 1u);
-      EXPECT_EQ(siblings()[0].rfind("report.tmp-", 0), 0u) << siblings()[0];
+      EXPECT_EQ(siblings()[0].rfind(".report.tmp-", 0), 0u) << siblings()[0];
       fs::remove_all(scratch.path() / siblings()[0]);
     } else {
       EXPECT_TRUE(siblings().empty()) << siblings()[0];

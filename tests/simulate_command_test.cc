@@ -89,8 +89,9 @@ INSTANTIATE_TEST_SUITE_P(EveryModel, SimulatedModel,
                                            RecoveryCase{"omni", 3, 3, ""}),
                          [](const auto& test) { return std::string(test.param.model); });
 
-// The directory appears whole: an existing one is refused without --force and replaced entirely
-// with it (a stale file does not survive), and no temporary sibling is left behind.
+// The directory appears whole: an existing data set is refused without --force and replaced
+// entirely with it; a file fitcal did not write there is never deleted, --force or not (the whole
+// directory is refused: tools/output_guard.h); no temporary sibling is left behind.
 TEST(SimulateCommand, WritesTheDataSetDirectoryAtomically) {
   TempDir dir;
   const std::string data = dir.Path("data");
@@ -103,10 +104,15 @@ TEST(SimulateCommand, WritesTheDataSetDirectoryAtomically) {
   EXPECT_NE(refused.err.find("--force"), std::string::npos) << refused.err;
   EXPECT_TRUE(fs::exists(data + "/stale.txt"));
   EXPECT_EQ(ReadFileBytes(data + "/dataset.yaml"), dataset);
+  const Result forced =
+      RunFitcal(dir, "simulate --model tricycle --repetitions 1 --force --out " + data);
+  EXPECT_EQ(forced.exit_code, 2);
+  EXPECT_NE(forced.err.find("stale.txt"), std::string::npos) << forced.err;
+  EXPECT_EQ(ReadFileBytes(data + "/stale.txt"), "left from before");
+  fs::remove(data + "/stale.txt");
   ASSERT_EQ(
       RunFitcal(dir, "simulate --model tricycle --repetitions 1 --force --out " + data).exit_code,
       0);
-  EXPECT_FALSE(fs::exists(data + "/stale.txt"));
   EXPECT_NE(ReadFileBytes(data + "/robot.yaml").find("model: tricycle"), std::string::npos);
   for (const auto& entry : fs::directory_iterator(dir.Path(""))) {
     EXPECT_EQ(entry.path().filename().string().find(".tmp-"), std::string::npos) << entry.path();

@@ -14,6 +14,8 @@
 #include "io/atomic_file.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
+#include "io/staged_directory.h"
+#include "io/yaml_text.h"
 #include "models/asoc/asoc_geometric.h"
 #include "odometry/parallel_for.h"
 #include "tools/output_guard.h"
@@ -51,26 +53,51 @@ void PrintCastors(const io::AsocRobot& robot, const asoc::Vehicle& estimate, con
   }
 }
 
-// The calibration record of the written YAML: how it was made. Emitted by yaml-cpp so that any
-// path is quoted correctly.
-std::string AsocCalibrationRecord(const std::string& method, const std::string& dataset) {
+// The calibration record of the written YAML: how it was made, and the uncertainty of each
+// castor's estimate. Each castor is the mean of its pair estimates (Doebbler Eq. 1-9 on each CW x
+// CCW hold pair); with two, the standard error of their mean is their half-difference, the
+// spread over independent hold runs (a bootstrap over runs in its smallest form). Emitted by
+// yaml-cpp so that any path is quoted correctly.
+std::string AsocCalibrationRecord(const std::string& method, const std::string& dataset,
+                                  const io::AsocRobot& robot, const asoc::GeometricResult& result) {
   YAML::Emitter out;
   out.SetMapFormat(YAML::Flow);
   out << YAML::BeginMap << YAML::Key << "method" << YAML::Value << method << YAML::Key << "dataset"
-      << YAML::Value << dataset << YAML::Key << "tool_version" << YAML::Value << kVersion
-      << YAML::EndMap;
+      << YAML::Value << io::YamlText(dataset) << YAML::Key << "tool_version" << YAML::Value
+      << kVersion;
+  out << YAML::Key << "sigma" << YAML::Value << YAML::BeginMap;
+  for (int i = 0; i < asoc::kNumCastors; ++i) {
+    const asoc::CastorParameters& h = result.half_spread[i];
+    out << YAML::Key << io::YamlText(robot.castor_names[i]) << YAML::Value << YAML::BeginMap
+        << YAML::Key << "offset_m" << YAML::Value << h.offset_m << YAML::Key << "wheel_radius_m"
+        << YAML::Value << YAML::BeginSeq << h.wheel_radius_m[0] << h.wheel_radius_m[1]
+        << YAML::EndSeq << YAML::Key << "wheel_offset_m" << YAML::Value << YAML::BeginSeq
+        << h.wheel_offset_m[0] << h.wheel_offset_m[1] << YAML::EndSeq << YAML::Key
+        << "encoder_bias_deg" << YAML::Value << RadToDeg(h.encoder_bias_rad) << YAML::EndMap;
+  }
+  out << YAML::EndMap << YAML::EndMap;
   return out.c_str();
 }
 
-// Writes `robot` with the calibrated castors `estimate` and the record above to `out`
-// (atomically), and says so.
+// Writes `robot` with the calibrated castors and the record above to `out` (atomically), and says
+// so. Refuses (std::runtime_error) when a castor has fewer than two estimates: nothing would say
+// how well it is known, and a written calibration always carries its uncertainty.
 void WriteAsocCalibration(const std::string& out, const io::AsocRobot& robot,
-                          const asoc::Vehicle& estimate, const std::string& method,
+                          const asoc::GeometricResult& result, const std::string& method,
                           const std::string& dataset) {
+  for (int i = 0; i < asoc::kNumCastors; ++i) {
+    if (result.num_estimates[i] < 2) {
+      throw std::runtime_error(
+          dataset + ": castor " + robot.castor_names[i] + " has " +
+          std::to_string(result.num_estimates[i]) +
+          " closed-form estimate(s): no uncertainty for it; nothing written (record two CW and "
+          "two CCW hold runs of each castor)");
+    }
+  }
   io::AsocRobot calibrated = robot;
-  calibrated.nominal = estimate;
-  io::WriteFileAtomically(out,
-                          io::AsocRobotYaml(calibrated, AsocCalibrationRecord(method, dataset)));
+  calibrated.nominal = result.estimate;
+  io::WriteFileAtomically(
+      out, io::AsocRobotYaml(calibrated, AsocCalibrationRecord(method, dataset, robot, result)));
   std::printf("wrote %s\n", out.c_str());
 }
 
@@ -100,12 +127,15 @@ std::vector<asoc::RunLog> UmbmarkCircuits(const asoc::Vehicle& truth,
 
 int RunAsocSimulate(const AsocSimulateOptions& options) {
   try {
-    const fs::path out(options.out);
-    if (fs::exists(out / "dataset.yaml") && !options.force) {
-      std::cerr << "fitcal: " << (out / "dataset.yaml").string()
-                << " exists; use --force to overwrite\n";
+    if (const std::string refusal =
+            DirectoryOutputRefusal(options.out, kDatasetKind, options.force, {});
+        !refusal.empty()) {
+      std::cerr << "fitcal: " << refusal << "\n";
       return 2;
     }
+    // Written whole or not at all: staged beside --out, renamed over it once complete.
+    io::StagedDirectory staged(options.out);
+    const fs::path out(staged.path());
     fs::create_directories(out / "runs");
     std::mt19937_64 rng(SplitMix(options.seed));
     const asoc::Vehicle nominal = sim::AsocPrototypeVehicle();
@@ -136,6 +166,7 @@ int RunAsocSimulate(const AsocSimulateOptions& options) {
                             io::AsocRobotYaml(RobotFromVehicle("asoc-truth", truth)));
     io::WriteFileAtomically((out / "dataset.yaml").string(),
                             io::DatasetYaml("robot.yaml", entries));
+    CommitDirectoryOutput(staged, options.out, kDatasetKind, options.force, {});
     std::printf(
         "wrote %zu ASOC runs (6 calibration holds, 10 UMBmark, %d excursions) to %s; the "
         "true parameters are in truth.yaml\n",
@@ -151,6 +182,14 @@ int RunAsocGeometric(const AsocGeometricOptions& options) {
   try {
     io::DatasetOptions dataset_options;
     dataset_options.allow_paths_outside = options.allow_outside_paths;
+    if (!options.no_output) {  // before the work: never over one of the data set's files
+      const std::string refusal = OutputFileRefusal(
+          options.out, DatasetInputs(io::ReadDatasetIndex(options.logs, dataset_options)));
+      if (!refusal.empty()) {
+        std::cerr << "fitcal: " << refusal << "\n";
+        return 2;
+      }
+    }
     const io::AsocDataset dataset = io::LoadAsocDataset(options.logs, dataset_options);
     const io::AsocRobot robot = io::ReadAsocRobot(dataset.robot_path);
     const asoc::GeometricResult result = asoc::CalibrateGeometric(dataset.runs, robot.nominal);
@@ -169,8 +208,9 @@ int RunAsocGeometric(const AsocGeometricOptions& options) {
     }
     if (result.usable) std::printf("  %s\n", result.message.c_str());
     if (!result.usable) {
+      // Too few or inconsistent hold runs: the data's fault, not a fit that did not converge.
       std::cerr << "fitcal: closed form not usable: " << result.message << " nothing written\n";
-      return 3;
+      return 1;
     }
     if (!options.no_output) {
       if (const std::string refusal = OverwriteRefusal(options.out, robot.name);
@@ -178,7 +218,7 @@ int RunAsocGeometric(const AsocGeometricOptions& options) {
         std::cerr << "fitcal: " << refusal << "\n";
         return 2;
       }
-      WriteAsocCalibration(options.out, robot, result.estimate, "closed-form Doebbler Eq. 1-9",
+      WriteAsocCalibration(options.out, robot, result, "closed-form Doebbler Eq. 1-9",
                            options.logs);
     }
     return 0;

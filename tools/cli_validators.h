@@ -25,4 +25,48 @@ inline CLI::Validator RepetitionListValidator(bool allow_auto = false) {
       "REPS", "repetition list");
 }
 
+// --threads: a whole number from 0 (all cores) to kMaxThreads, said in fitcal's words instead of
+// the parser's ("could not be converted").
+inline constexpr int kMaxThreads = 1024;
+inline CLI::Validator ThreadCountValidator() {
+  return CLI::Validator(
+      [](std::string& text) {
+        std::size_t used = 0;
+        long value = -1;
+        try {
+          value = std::stol(text, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used == 0 || used != text.size() || value < 0 || value > kMaxThreads) {
+          return "must be a whole number of worker threads from 0 (all cores) to " +
+                 std::to_string(kMaxThreads) + ", found '" + text.substr(0, 40) + "'";
+        }
+        return std::string();
+      },
+      "THREADS", "thread count");
+}
+
+// --out: a path, never the empty string (found before any work, not after a whole fit).
+inline CLI::Validator NonEmptyPathValidator() {
+  return CLI::Validator(
+      [](std::string& text) {
+        return text.empty() ? std::string("is empty; name the file or directory to write")
+                            : std::string();
+      },
+      "PATH", "non-empty path");
+}
+
+// Adds the validators above to every --threads and --out option of `app` and its subcommands,
+// so that every command refuses these alike.
+inline void AddCommonValidators(CLI::App& app) {
+  if (CLI::Option* threads = app.get_option_no_throw("--threads")) {
+    threads->check(ThreadCountValidator());
+  }
+  if (CLI::Option* out = app.get_option_no_throw("--out")) out->check(NonEmptyPathValidator());
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
+    AddCommonValidators(*sub);
+  }
+}
+
 }  // namespace fitcal::tools

@@ -24,6 +24,7 @@
 #include "models/omni3/omni3_robot_model.h"
 #include "tools/cli_validators.h"
 #include "tools/fit_methods.h"
+#include "tools/output_guard.h"
 #include "validation/run_split.h"
 
 namespace fitcal::tools {
@@ -412,9 +413,9 @@ void PrintAndWrite(const CompareCommandOptions& options, const CompareRequest& r
       options.logs.c_str(), counts.c_str(), FormatRepetitionList(validation_reps).c_str(),
       num_validation, markdown.c_str());
   if (!options.no_output) {
-    io::WriteFileAtomically(options.out + ".csv", Csv(rows, columns));
-    io::WriteFileAtomically(options.out + ".md", markdown);
-    io::WriteFileAtomically(options.out + "_trace.csv", TraceCsv(rows));
+    io::WriteFilesAtomically({{options.out + ".csv", Csv(rows, columns)},
+                              {options.out + ".md", markdown},
+                              {options.out + "_trace.csv", TraceCsv(rows)}});
     std::printf("\nwrote %s.csv, %s.md, %s_trace.csv\n", options.out.c_str(), options.out.c_str(),
                 options.out.c_str());
   }
@@ -452,6 +453,13 @@ int RunCompareCommand(const CompareCommandOptions& options) {
   }
   const bool show_progress = !options.quiet && isatty(STDERR_FILENO);
   return RunReportingErrors("fitcal compare", [&]() -> int {
+    if (!options.no_output) {  // before the work: no output file may replace an input
+      const std::vector<std::string> inputs = OpenDataset(options).inputs;
+      for (const char* suffix : {".csv", ".md", "_trace.csv"}) {
+        const std::string refusal = OutputFileRefusal(options.out + suffix, inputs);
+        if (!refusal.empty()) return Refuse(refusal);
+      }
+    }
     const CompareData d = LoadCompareData(options);
     if (!d.omni3 && !options.strategies_given) {
       request.strategies = DefaultStrategiesFor(d.runs, request.strategies);

@@ -32,13 +32,15 @@ namespace fitcal::tools {
 
 void AddDiagnoseOptions(CLI::App& cmd, DiagnoseCommandOptions& o) {
   AddDatasetOptions(cmd, o);
-  cmd.add_option("--train-reps", o.train_reps,
-                 "Training repetitions (e.g. 1-5); auto = the first half; the rest validate")
-      ->capture_default_str()
-      ->check(RepetitionListValidator(/*allow_auto=*/true));
+  CLI::Option* reps =
+      cmd.add_option("--train-reps", o.train_reps,
+                     "Training repetitions (e.g. 1-5); auto = the first half; the rest validate")
+          ->capture_default_str()
+          ->check(RepetitionListValidator(/*allow_auto=*/true));
   cmd.add_option("--train-trajectories", o.train_trajectories,
                  "Split by trajectory label instead: a list of labels or a regular expression "
-                 "(e.g. ^circular); matching runs train, the others validate");
+                 "(e.g. ^circular); matching runs train, the others validate")
+      ->excludes(reps);  // as fit: one split, not two that contradict each other
   cmd.add_flag("--clock-map", o.clock_map,
                "Re-stamp each run's ground truth on the encoder clock (speed-profile match)");
   cmd.add_option("--out", o.out,

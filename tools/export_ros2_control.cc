@@ -26,6 +26,7 @@
 #include "io/text_file.h"
 #include "validation/odometry_covariance.h"
 #include "validation/training_runs.h"
+#include "tools/output_guard.h"
 
 namespace fitcal::tools {
 namespace {
@@ -773,6 +774,10 @@ void AddExportRos2ControlOptions(CLI::App& app, ExportRos2ControlOptions& o) {
 int RunExportRos2ControlCommand(const ExportRos2ControlOptions& o) {
   constexpr const char* kPrefix = "fitcal export ros2-control: ";
   try {
+    if (!o.out.empty()) {  // never over its calibration or the data set (tools/output_guard.h)
+      const std::string refusal = OutputFileRefusal(o.out, {o.calibration, o.logs});
+      if (!refusal.empty()) throw std::invalid_argument(refusal);
+    }
     if (!o.out.empty() && std::filesystem::exists(o.out) && !o.force) {
       throw std::runtime_error(o.out + ": exists; refusing to overwrite it (--force)");
     }

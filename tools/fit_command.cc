@@ -14,6 +14,7 @@
 #include "diagnosis/degenerate_data.h"
 #include "diagnosis/identifiability.h"
 #include "diagnosis/wheel_order_check.h"
+#include "fit/correlation.h"
 #include "fit/final_pose_cost.h"
 #include "fit/omni3_ceres_fit.h"
 #include "fit/result_gate.h"
@@ -30,6 +31,8 @@
 #include "tools/model_fit_command.h"
 #include "tools/output_guard.h"
 #include "tools/sim/flower_candidates.h"
+#include "validation/propagated_uncertainty.h"
+#include "validation/residual_dof.h"
 #include "validation/run_split.h"
 #include "validation/training_runs.h"
 
@@ -170,6 +173,12 @@ int RunFitCommand(const FitCommandOptions& options) {
       return 2;
     }
 
+    if (const std::string refusal =
+            FinalPoseDofRefusal(split.training.size(), robot.nominal.ToArray().size());
+        !refusal.empty()) {
+      std::cerr << "fitcal: " << options.logs << ": " << refusal << "\n";
+      return 1;
+    }
     // Before fitting, as a fit would not notice them: rates in the wrong unit, miswired encoder
     // columns, data that cannot determine the parameters.
     const RateUnitsReport units = CheckRateUnits(dataset.runs, robot);
@@ -323,6 +332,18 @@ int RunFitCommand(const FitCommandOptions& options) {
       record.has_uncertainty = fit.has_covariance && fit_won;
       record.sigma = fit.sigma;
       record.correlation = fit.correlation;
+      if (!record.has_uncertainty) {  // never sigma: null (validation/propagated_uncertainty.h)
+        const PropagatedUncertainty u = PropagateFinalPoseUncertainty(
+            *Omni3ModelOf(robot), candidates[gate.selected].parameters, split.training);
+        if (!u.ok) {
+          std::cerr << "fitcal: no uncertainty for the selected calibration (" << u.message
+                    << "); nothing written\n";
+          return 1;
+        }
+        record.has_uncertainty = true;
+        std::copy(u.sigma.begin(), u.sigma.end(), record.sigma.begin());
+        record.correlation = CorrelationOf(u.covariance);
+      }
       record.inverse_kinematic_matrix = omni3::InverseKinematicMatrix(selected);
       io::StopHereForTests("fitted");
       io::WriteFileAtomically(options.out, io::Omni3RobotYaml(calibrated, &record));

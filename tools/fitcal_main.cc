@@ -3,6 +3,7 @@
 // runs it. `fitcal --logs <dir> --method ceres` without a subcommand runs `fit`.
 
 #include <glog/logging.h>
+#include <signal.h>
 
 #include <CLI/CLI.hpp>
 #include <cstdlib>
@@ -16,7 +17,9 @@
 #include "fitcal/version.h"
 #include "io/atomic_file.h"
 #include "io/input_error.h"
+#include "io/input_registry.h"
 #include "tools/asoc_commands.h"
+#include "tools/cli_validators.h"
 #include "tools/compare_command.h"
 #include "tools/diagnose_command.h"
 #include "tools/export_ros2_control.h"
@@ -165,6 +168,11 @@ int main(int argc, char** argv) {
   SilenceLibraryLogging(argv[0]);
   // Ctrl-C or a scheduler's SIGTERM while an output is being written leaves no temporary behind.
   fitcal::io::RemoveTemporaryFilesOnSignals();
+  // A file-size limit (ulimit -f) makes write() fail with EFBIG instead of killing fitcal: the
+  // writer then removes its temporary file and says so in one line (io/atomic_file.h).
+  signal(SIGXFSZ, SIG_IGN);
+  // Nothing written may replace, hold or sit inside what the command reads (io/input_registry.h).
+  fitcal::io::EnableInputGuard();
   CLI::App app{"fitcal " + std::string(fitcal::kVersion) +
                ": calibrate the kinematic parameters of a wheeled robot's odometry from encoder "
                "logs and ground truth"};
@@ -181,6 +189,7 @@ int main(int argc, char** argv) {
     parsers.push_back(cmd);
   }
 
+  AddCommonValidators(app);
   if (const int usage_rc = ParseCommandLine(app, argc, argv); usage_rc >= 0) return usage_rc;
   for (std::size_t i = 0; i < commands.size(); ++i) {
     if (parsers[i]->parsed()) return commands[i].run();

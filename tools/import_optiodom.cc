@@ -16,13 +16,17 @@
 #include "io/atomic_file.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
+#include "io/input_registry.h"
 #include "io/robot_yaml.h"
+#include "io/staged_directory.h"
 #include "io/text_file.h"
 #include "odometry/aligned_run.h"
 #include "odometry/parallel_for.h"
 #include "tools/import_optiodom_models.h"
 #include "tools/import_optiodom_omni4.h"
 #include "tools/import_optiodom_tricycle.h"
+#include "tools/miswired_error.h"
+#include "tools/output_guard.h"
 
 namespace fitcal::tools {
 
@@ -313,12 +317,7 @@ int ImportOtherOptiOdomRobot(const std::string& type, const ImportOptiOdomOption
                 s.runs.size(), s.num_sessions, options.out.c_str(), s.nominal_cf);
     return 0;
   }
-  if (fs::exists(fs::path(options.out) / "dataset.yaml") && !options.force) {
-    std::cerr << "fitcal: " << options.out
-              << " already holds a data set; use --force to overwrite it\n";
-    return 2;
-  }
-  const Omni4ImportResult s = ImportOptiOdomOmni4(options.sessions, options.out);
+  const Omni4ImportResult s = ImportOptiOdomOmni4(options.sessions, options.out, options.force);
   for (const std::string& note : s.notes) std::printf("note: %s\n", note.c_str());
   std::printf("imported %d runs of %d omni4 sessions into %s; nominal CF (Eq. 14) %.4f\n",
               s.num_runs, s.num_sessions, options.out.c_str(), s.nominal_mean_cf);
@@ -351,13 +350,16 @@ int RunImportOptiOdomCommand(const ImportOptiOdomOptions& options) {
         return 2;
       }
     }
+    // The recordings are inputs: no data set may replace, hold or sit inside one.
+    for (const std::string& dir : options.sessions) io::RegisterInputDirectory(dir);
+    if (const std::string refusal =
+            DirectoryOutputRefusal(options.out, kDatasetKind, options.force, options.sessions);
+        !refusal.empty()) {
+      std::cerr << "fitcal: " << refusal << "\n";
+      return 2;
+    }
     if (type == "diff" || type == "tricyc" || type == "omni4") {
       return ImportOtherOptiOdomRobot(type, options);
-    }
-    if (fs::exists(fs::path(options.out) / "dataset.yaml") && !options.force) {
-      std::cerr << "fitcal: " << options.out
-                << " already holds a data set; use --force to overwrite it\n";
-      return 2;
     }
     // Read and check everything before writing anything.
     std::vector<OptiOdomSession> sessions;
@@ -406,10 +408,12 @@ int RunImportOptiOdomCommand(const ImportOptiOdomOptions& options) {
                 << DescribeWheelMapping(ranking.front().mapping) << " does (CF "
                 << ranking.front().mean_cf
                 << "); nothing written (--skip-mapping-check to write anyway)\n";
-      if (!options.skip_mapping_check) return 3;
+      if (!options.skip_mapping_check) return kMiswiredExitCode;
     }
 
-    const fs::path out(options.out);
+    // Whole or not at all: staged beside --out, renamed over it once complete.
+    io::StagedDirectory staged(options.out);
+    const fs::path out(staged.path());
     fs::create_directories(out / "runs");
     std::vector<io::DatasetEntry> entries(logs.size());
     ParallelFor(logs.size(), 0, [&](std::size_t i) {
@@ -426,9 +430,13 @@ int RunImportOptiOdomCommand(const ImportOptiOdomOptions& options) {
     io::WriteFileAtomically((out / "robot.yaml").string(), io::Omni3RobotYaml(robot, nullptr));
     io::WriteFileAtomically((out / "dataset.yaml").string(),
                             io::DatasetYaml("robot.yaml", entries));
+    CommitDirectoryOutput(staged, options.out, kDatasetKind, options.force, options.sessions);
     std::printf("wrote %zu runs of %zu sessions to %s\n", logs.size(), sessions.size(),
                 options.out.c_str());
     return 0;
+  } catch (const MiswiredError& e) {
+    std::cerr << "fitcal: " << e.what() << "\n";
+    return kMiswiredExitCode;
   } catch (const std::exception& e) {
     std::cerr << "fitcal: " << e.what() << "\n";
     return 1;

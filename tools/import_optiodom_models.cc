@@ -15,9 +15,12 @@
 #include "io/atomic_file.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
+#include "io/staged_directory.h"
 #include "io/text_file.h"
 #include "models/diff_drive/diff_drive_model.h"
 #include "odometry/aligned_run.h"
+#include "tools/miswired_error.h"
+#include "tools/output_guard.h"
 
 namespace fitcal::tools {
 
@@ -307,7 +310,7 @@ void CheckWheelMapping(const RobotModelInterface& model, const std::vector<RunLo
   for (std::size_t j = 1; j < mappings.size(); ++j) {
     const double other = MeanTrackError(model, logs, mappings[j]);
     if (other <= identity && !options.skip_mapping_check) {
-      throw std::runtime_error(
+      throw MiswiredError(
           "the documented wheel order (ticks right, left; positive forward) does not explain the "
           "ground truth best: mean track error " +
           std::to_string(identity) + " m, miswiring " + std::to_string(j) + " " +
@@ -405,8 +408,10 @@ OptiOdomDiffImportSummary ImportOptiOdomDiff(const std::vector<std::string>& ses
   if (session_dirs.empty()) {
     throw std::invalid_argument("import needs at least one session directory");
   }
-  if (fs::exists(fs::path(out_dir) / "dataset.yaml") && !options.force) {
-    throw std::runtime_error(out_dir + " already holds a data set (force to overwrite)");
+  if (const std::string refusal =
+          DirectoryOutputRefusal(out_dir, kDatasetKind, options.force, session_dirs);
+      !refusal.empty()) {
+    throw std::runtime_error(refusal);
   }
   // Read and check everything before writing anything.
   std::vector<DiffSession> sessions;
@@ -427,7 +432,11 @@ OptiOdomDiffImportSummary ImportOptiOdomDiff(const std::vector<std::string>& ses
   summary.nominal_cf = nominal.cf;
   summary.nominal_mean_position_error_m = nominal.mean_position_error_m;
   summary.nominal_mean_heading_error_rad = nominal.mean_abs_heading_error_rad;
-  WriteDiffDataset(out_dir, *model, summary, runs);
+  {  // whole or not at all: staged beside out_dir, renamed over it once complete
+    io::StagedDirectory staged(out_dir);
+    WriteDiffDataset(staged.path(), *model, summary, runs);
+    CommitDirectoryOutput(staged, out_dir, kDatasetKind, options.force, session_dirs);
+  }
   if (!options.quiet) {
     std::printf(
         "wrote %d runs of %d sessions to %s; nominal CF (Eq. 14) %.4f, mean final "

@@ -14,9 +14,12 @@
 #include "io/atomic_file.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
+#include "io/staged_directory.h"
 #include "io/text_file.h"
 #include "models/omni/omni_model.h"
 #include "odometry/parallel_for.h"
+#include "tools/miswired_error.h"
+#include "tools/output_guard.h"
 
 namespace fitcal::tools {
 
@@ -446,8 +449,13 @@ std::vector<Omni4LayoutScore> CheckOmni4Layout(const std::vector<OptiOdomOmni4Se
 }
 
 Omni4ImportResult ImportOptiOdomOmni4(const std::vector<std::string>& session_dirs,
-                                      const std::string& out_dir) {
+                                      const std::string& out_dir, bool force) {
   if (session_dirs.empty()) throw std::invalid_argument("no OptiOdom omni4 session to import");
+  if (const std::string refusal =
+          DirectoryOutputRefusal(out_dir, kDatasetKind, force, session_dirs);
+      !refusal.empty()) {
+    throw std::runtime_error(refusal);
+  }
   std::vector<OptiOdomOmni4Session> sessions;
   for (const std::string& dir : session_dirs) sessions.push_back(ReadOptiOdomOmni4Session(dir));
   std::vector<OptiOdomOmni4Metadata> declared;
@@ -464,7 +472,7 @@ Omni4ImportResult ImportOptiOdomOmni4(const std::vector<std::string>& session_di
   const RobotModelPtr model = OptiOdomOmni4NominalModel(nominal);
   result.layout = CheckOmni4Layout(sessions, *model);
   if (!result.layout.front().mapping.IsIdentity()) {
-    throw std::runtime_error(
+    throw MiswiredError(
         "the documented omni4 wheel layout does not explain the ground truth best; nothing "
         "written");
   }
@@ -475,7 +483,9 @@ Omni4ImportResult ImportOptiOdomOmni4(const std::vector<std::string>& session_di
   const std::vector<double>& p = model->robot().nominal;
   std::vector<double> cf(logs.size());
   std::vector<io::DatasetEntry> entries(logs.size());
-  fs::create_directories(fs::path(out_dir) / "runs");
+  // Whole or not at all: staged beside out_dir, renamed over it once complete.
+  io::StagedDirectory staged(out_dir);
+  fs::create_directories(fs::path(staged.path()) / "runs");
   ParallelFor(logs.size(), 0, [&](std::size_t i) {
     const RunLog& log = *logs[i];
     const Pose2d final_pose =
@@ -489,13 +499,15 @@ Omni4ImportResult ImportOptiOdomOmni4(const std::vector<std::string>& session_di
     e.repetition = log.repetition;
     e.encoders = "runs/" + e.id + "_encoders.csv";
     e.ground_truth = "runs/" + e.id + "_ground_truth.csv";
-    const fs::path out(out_dir);
+    const fs::path out(staged.path());
     io::WriteFileAtomically((out / e.encoders).string(), EncoderCsvText(log, model->robot()));
     io::WriteFileAtomically((out / e.ground_truth).string(), GroundTruthCsvText(log.ground_truth));
   });
-  io::WriteFileAtomically((fs::path(out_dir) / "robot.yaml").string(), model->RobotYaml(p, ""));
-  io::WriteFileAtomically((fs::path(out_dir) / "dataset.yaml").string(),
+  io::WriteFileAtomically((fs::path(staged.path()) / "robot.yaml").string(),
+                          model->RobotYaml(p, ""));
+  io::WriteFileAtomically((fs::path(staged.path()) / "dataset.yaml").string(),
                           io::DatasetYaml("robot.yaml", entries));
+  CommitDirectoryOutput(staged, out_dir, kDatasetKind, force, session_dirs);
   result.num_sessions = static_cast<int>(sessions.size());
   result.num_runs = static_cast<int>(logs.size());
   for (double c : cf) result.nominal_mean_cf += c / static_cast<double>(cf.size());

@@ -106,6 +106,6 @@ struct Omni4ImportResult {
 // interval ending at t) and runs/<id>_ground_truth.csv (`t,x,y,theta`). Throws io::InputError for
 // bad input and std::runtime_error when the layout check fails (nothing is written then).
 Omni4ImportResult ImportOptiOdomOmni4(const std::vector<std::string>& session_dirs,
-                                      const std::string& out_dir);
+                                      const std::string& out_dir, bool force = false);
 
 }  // namespace fitcal::tools

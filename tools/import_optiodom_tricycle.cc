@@ -13,10 +13,13 @@
 #include "io/atomic_file.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
+#include "io/staged_directory.h"
 #include "io/text_file.h"
 #include "models/tricycle/tricycle_checks.h"
 #include "models/tricycle/tricycle_model.h"
 #include "odometry/aligned_run.h"
+#include "tools/miswired_error.h"
+#include "tools/output_guard.h"
 
 namespace fitcal::tools {
 
@@ -322,8 +325,10 @@ ImportOptiOdomTricycleSummary ImportOptiOdomTricycle(const std::vector<std::stri
                                                      const std::string& out,
                                                      const ImportOptiOdomTricycleOptions& options) {
   if (sessions.empty()) throw std::invalid_argument("import needs at least one session");
-  if (fs::exists(fs::path(out) / "dataset.yaml") && !options.force) {
-    throw std::runtime_error(out + " already holds a data set; use --force to overwrite it");
+  if (const std::string refusal =
+          DirectoryOutputRefusal(out, kDatasetKind, options.force, sessions);
+      !refusal.empty()) {
+    throw std::runtime_error(refusal);
   }
   // Read and check everything before writing anything.
   std::vector<OptiOdomTricycleSession> read;
@@ -353,14 +358,16 @@ ImportOptiOdomTricycleSummary ImportOptiOdomTricycle(const std::vector<std::stri
                   "the ground truth contradicts the channel signs (correlation of traction ticks "
                   "with forward motion %.2f, of steering with turning %.2f); nothing written",
                   summary.signs.traction_correlation, summary.signs.steering_correlation);
-    throw std::runtime_error(message);
+    throw MiswiredError(message);
   }
   const FinalPoseErrors nominal =
       EvaluateFinalPoseErrors(*model, model->robot().nominal, AlignRuns(summary.runs), 1);
   summary.nominal_final_error = nominal.per_run_cf;
   summary.nominal_cf = nominal.cf;
 
-  const fs::path dir(out);
+  // Whole or not at all: staged beside `out`, renamed over it once complete.
+  io::StagedDirectory staged(out);
+  const fs::path dir(staged.path());
   fs::create_directories(dir / "runs");
   std::vector<io::DatasetEntry> entries;
   for (std::size_t i = 0; i < summary.runs.size(); ++i) {
@@ -374,6 +381,7 @@ ImportOptiOdomTricycleSummary ImportOptiOdomTricycle(const std::vector<std::stri
   io::WriteFileAtomically((dir / "robot.yaml").string(),
                           model->RobotYaml(model->robot().nominal, ""));
   io::WriteFileAtomically((dir / "dataset.yaml").string(), io::DatasetYaml("robot.yaml", entries));
+  CommitDirectoryOutput(staged, out, kDatasetKind, options.force, sessions);
   return summary;
 }
 

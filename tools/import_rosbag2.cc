@@ -16,11 +16,13 @@
 #include "io/atomic_file.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
+#include "io/input_registry.h"
 #include "io/log_files.h"
 #include "io/staged_directory.h"
 #include "io/text_file.h"
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
+#include "tools/output_guard.h"
 
 namespace fitcal::tools {
 namespace {
@@ -431,7 +433,7 @@ void WriteDataset(const ImportRosbag2Options& o, const Robot& robot, const Rosba
                           header + io::DatasetYaml("robot.yaml", entries));
   RefuseWhatFitRefuses(o, staged.path(), robot);
   io::StopHereForTests("import-rosbag2-before-rename");
-  staged.Commit(o.force);
+  CommitDirectoryOutput(staged, o.out, kDatasetKind, o.force, {o.bag});
 }
 
 }  // namespace
@@ -475,8 +477,10 @@ Rosbag2Import ReadRosbag2Import(const ImportRosbag2Options& o) {
 
 Rosbag2Import ImportRosbag2(const ImportRosbag2Options& o) {
   if (o.out.empty()) throw std::invalid_argument("--out <data set directory> is required");
-  if (fs::exists(o.out) && !o.force) {
-    throw std::runtime_error(o.out + ": exists; refusing to replace it (--force to replace it)");
+  io::RegisterInputDirectory(o.bag);  // no data set in, over or holding the bag
+  if (const std::string refusal = DirectoryOutputRefusal(o.out, kDatasetKind, o.force, {o.bag});
+      !refusal.empty()) {
+    throw std::invalid_argument(refusal);  // exit 2, as every writer refuses its --out
   }
   Rosbag2Import imp = ReadRosbag2Import(o);
   WriteDataset(o, ReadRobotModelFile(o.robot)->robot(), imp);

@@ -13,6 +13,7 @@
 #include "diagnosis/channel_order_check.h"
 #include "diagnosis/effect_fit.h"
 #include "diagnosis/statistics.h"
+#include "fit/correlation.h"
 #include "fit/final_pose_errors.h"
 #include "fit/model_fit.h"
 #include "fit/result_gate.h"
@@ -23,6 +24,9 @@
 #include "tools/effect_list.h"
 #include "tools/fit_methods.h"
 #include "tools/output_guard.h"
+#include "validation/propagated_uncertainty.h"
+#include "validation/rate_units.h"
+#include "validation/residual_dof.h"
 #include "validation/run_split.h"
 #include "validation/training_runs.h"
 #include "validation/trajectory_metrics.h"
@@ -150,6 +154,25 @@ SelectedFit DescribeSelected(const Robot& robot,
     out.at_bound = fit.at_bound;
   }
   return out;
+}
+
+// A selected candidate without a covariance of its own (a closed form, a fit without its holds)
+// gets the one propagated through the training runs' final-pose residuals at its point
+// (validation/propagated_uncertainty.h): a written calibration never has sigma: null. False, with
+// the reason on stderr, when even that is not possible (nothing may then be written).
+bool AddPropagatedUncertainty(const RobotModelInterface& model, const std::vector<double>& p,
+                              const std::vector<AlignedRun>& training, SelectedFit* fit) {
+  if (fit->has_covariance) return true;
+  const PropagatedUncertainty u = PropagateFinalPoseUncertainty(model, p, training, fit->held);
+  if (!u.ok) {
+    std::cerr << "fitcal: no uncertainty for the selected calibration (" << u.message
+              << "); nothing written (record more runs, or runs that excite every parameter)\n";
+    return false;
+  }
+  fit->has_covariance = true;
+  fit->sigma = u.sigma;
+  fit->correlation = CorrelationOf(u.covariance);
+  return true;
 }
 
 void PrintParameters(const Robot& robot, const std::vector<double>& p, const SelectedFit& fit) {
@@ -508,6 +531,16 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
               << TrainingSelection(options) << ")\n";
     return 2;
   }
+  if (const RateUnitsFinding units = CheckModelRateUnits(*model, dataset.runs); units.suspicious) {
+    std::cerr << "fitcal: " << options.logs << ": " << units.message << "\n";
+    return 1;
+  }
+  if (const std::string refusal = FinalPoseDofRefusal(
+          split.training.size(), robot.NumFree() + (effects_to_fit ? effects_to_fit->size() : 0));
+      !refusal.empty()) {
+    std::cerr << "fitcal: " << options.logs << ": " << refusal << "\n";
+    return 1;
+  }
   if (!options.skip_wheel_order_check &&
       ChannelsLookMiswired(options, *model, split.training, dataset.runs)) {
     return 4;
@@ -538,8 +571,12 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
       track_fits ? RequireEffectsToEarnTheirPlace(candidates, split, errors, *track_fits, &gate)
                  : "";
   const CalibrationCandidate& selected = candidates[gate.selected];
-  const SelectedFit selected_fit = DescribeSelected(
-      robot, candidates, gate.selected, options.method, outcome.objective, fit, track_fits);
+  SelectedFit selected_fit = DescribeSelected(robot, candidates, gate.selected, options.method,
+                                              outcome.objective, fit, track_fits);
+  if (gate.selected != 0 && !options.no_output &&
+      !AddPropagatedUncertainty(*model, selected.parameters, split.training, &selected_fit)) {
+    return 1;
+  }
 
   PrintFit(options, *model, split, candidates, gate, selected_fit, errors, *method, outcome,
            track_fits);

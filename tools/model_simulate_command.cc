@@ -9,6 +9,7 @@
 #include "io/atomic_file.h"
 #include "io/staged_directory.h"
 #include "models/model_registry.h"
+#include "tools/output_guard.h"
 #include "tools/sim/model_scenarios.h"
 #include "tools/sim/model_simulator.h"
 
@@ -62,8 +63,10 @@ int RunModelSimulateCommand(const ModelSimulateOptions& options) {
               << " (README \"Simulator\")\n";
     return 2;
   }
-  if (fs::exists(options.out) && !options.force) {
-    std::cerr << "fitcal simulate: " << options.out << " exists; use --force to replace it\n";
+  if (const std::string refusal =
+          DirectoryOutputRefusal(options.out, kDatasetKind, options.force, {});
+      !refusal.empty()) {
+    std::cerr << "fitcal simulate: " << refusal << "\n";
     return 2;
   }
   try {
@@ -84,7 +87,7 @@ int RunModelSimulateCommand(const ModelSimulateOptions& options) {
       sim::WriteSimulatedDataset(staged.path(), model->RobotYaml(robot.nominal, ""), runs);
       io::WriteFileAtomically((fs::path(staged.path()) / "true_robot.yaml").string(),
                               model->RobotYaml(truth, ""));
-      staged.Commit(options.force);
+      CommitDirectoryOutput(staged, options.out, kDatasetKind, options.force, {});
     }
     std::printf("wrote %zu runs of the %s robot '%s' (%d repetitions, seed %llu) to %s\n",
                 runs.size(), robot.model.c_str(), robot.name.c_str(), noise.repetitions,

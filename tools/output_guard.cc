@@ -4,9 +4,13 @@
 
 #include <exception>
 #include <filesystem>
+#include <fstream>
+#include <optional>
 #include <stdexcept>
 
+#include "io/atomic_file.h"
 #include "io/input_error.h"
+#include "io/input_registry.h"
 #include "io/yaml_reader.h"
 
 namespace fitcal::tools {
@@ -15,23 +19,73 @@ namespace fs = std::filesystem;
 
 namespace {
 
-bool SameFile(const struct stat& a, const std::string& path) {
-  struct stat b {};
-  return ::stat(path.c_str(), &b) == 0 && a.st_dev == b.st_dev && a.st_ino == b.st_ino;
-}
-
-// The input that `out` is (by device and inode, so links and "./a" count), or "".
-std::string InputAt(const std::string& out, const std::vector<std::string>& inputs) {
-  struct stat info {};
-  if (::stat(out.c_str(), &info) != 0) return "";
-  for (const std::string& input : inputs) {
-    if (SameFile(info, input)) return input;
-  }
-  return "";
-}
-
 std::string Refusal(const std::string& out, const std::string& why) {
   return io::OneLine(out, 200) + ": " + why;
+}
+
+// The refusal when `out` is, holds or sits inside one of `inputs` or of what was read.
+std::string InputOverlap(const std::string& out, const std::vector<std::string>& inputs) {
+  std::string why = io::OutputOverlapsInputs(out, inputs);
+  if (why.empty()) why = io::OutputOverlapsInput(out);
+  return why.empty() ? "" : Refusal(out, why);
+}
+
+// Every file below `dir`, relative to it ("runs/a_encoders.csv"); directories are not listed.
+std::set<std::string> FilesUnder(const fs::path& dir) {
+  std::set<std::string> files;
+  std::error_code ec;
+  for (fs::recursive_directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    if (!it->is_directory(ec)) files.insert(it->path().lexically_relative(dir).string());
+  }
+  return files;
+}
+
+// The marker of a directory fitcal wrote: "fitcal output: <kind>", then one file per line.
+void WriteMarker(const std::string& staged_dir, const std::string& kind) {
+  std::string text = std::string("fitcal output: ") + kind + "\n";
+  for (const std::string& file : FilesUnder(staged_dir)) text += file + "\n";
+  io::WriteFileAtomically((fs::path(staged_dir) / kOutputMarker).string(), text);
+}
+
+// The files the marker of `dir` lists when it names `kind`; nullopt without such a marker.
+std::optional<std::set<std::string>> MarkedFiles(const fs::path& dir, const std::string& kind) {
+  std::ifstream in(dir / kOutputMarker);
+  std::string line;
+  if (!std::getline(in, line) || line != "fitcal output: " + kind) return std::nullopt;
+  std::set<std::string> files{kOutputMarker};
+  while (std::getline(in, line)) files.insert(line);
+  return files;
+}
+
+// A data set written before the marker existed: dataset.yaml, the files it names, and the robot
+// and truth YAMLs the simulators write beside it.
+std::optional<std::set<std::string>> LegacyDatasetFiles(const fs::path& dir) {
+  std::set<std::string> files{"dataset.yaml", "robot.yaml", "truth.yaml", "true_robot.yaml"};
+  try {
+    const io::NotAnInput probe;
+    const YAML::Node root = io::LoadYamlFile((dir / "dataset.yaml").string());
+    if (root["robot"] && root["robot"].IsScalar()) files.insert(root["robot"].Scalar());
+    for (const YAML::Node& run : root["runs"]) {
+      for (const char* key : {"encoders", "ground_truth"}) {
+        if (run[key] && run[key].IsScalar()) {
+          files.insert(fs::path(run[key].Scalar()).lexically_normal().string());
+        }
+      }
+    }
+  } catch (const std::exception&) {
+    return std::nullopt;  // no readable dataset.yaml: not recognisably a data set
+  }
+  return files;
+}
+
+// The first file below `dir` that a fitcal output of `kind` does not hold, "" when none.
+std::string ForeignFile(const fs::path& dir, const std::string& kind) {
+  std::optional<std::set<std::string>> own = MarkedFiles(dir, kind);
+  if (!own && kind == kDatasetKind) own = LegacyDatasetFiles(dir);
+  for (const std::string& file : FilesUnder(dir)) {
+    if (!own || own->count(file) == 0) return file;
+  }
+  return "";
 }
 
 }  // namespace
@@ -42,6 +96,7 @@ std::string OverwriteRefusal(const std::string& out, const std::string& robot_na
   if (::stat(out.c_str(), &info) != 0) return "";
   std::string existing;
   try {
+    const io::NotAnInput probe;  // the previous output, read to see whose it is
     const YAML::Node root = io::LoadYamlFile(out);
     if (root.IsMap() && root["name"] && root["name"].IsScalar()) existing = root["name"].Scalar();
   } catch (const std::exception&) {
@@ -56,6 +111,8 @@ std::string OverwriteRefusal(const std::string& out, const std::string& robot_na
 }
 
 std::string OutputFileRefusal(const std::string& out, const std::vector<std::string>& inputs) {
+  if (out.empty()) return "--out is empty; name the file to write";
+  if (const std::string overlap = InputOverlap(out, inputs); !overlap.empty()) return overlap;
   struct stat info {};
   if (::stat(out.c_str(), &info) != 0) return "";
   if (!S_ISREG(info.st_mode)) {
@@ -63,35 +120,22 @@ std::string OutputFileRefusal(const std::string& out, const std::vector<std::str
                    "exists and is not a regular file (a directory, FIFO or device); "
                    "--out must name a file to write");
   }
-  const std::string input = InputAt(out, inputs);
-  if (!input.empty()) {
-    return Refusal(out, "is the input file " + io::OneLine(input, 200) +
-                            "; writing the output there would destroy it (choose another --out)");
-  }
-  return "";
+  return InputOverlap(out, inputs);
 }
 
 std::string OutputDirectoryRefusal(const std::string& out, const std::vector<std::string>& inputs,
                                    const std::set<std::string>& own_names) {
+  if (out.empty()) return "--out is empty; name the directory to write";
+  if (const std::string overlap = InputOverlap(out, inputs); !overlap.empty()) return overlap;
   std::error_code ec;
   const fs::file_status status = fs::symlink_status(out, ec);
   if (!fs::exists(status)) return "";
   if (!fs::is_directory(status)) {
     return Refusal(out, "exists and is not a directory; --out must name a directory");
   }
-  for (const std::string& input : inputs) {
-    fs::path p = fs::weakly_canonical(input, ec);
-    const fs::path dir = fs::weakly_canonical(out, ec);
-    for (; !p.empty() && p != p.parent_path(); p = p.parent_path()) {
-      if (p == dir) {
-        return Refusal(out, "holds the input " + io::OneLine(input, 200) +
-                                "; the output directory would replace it (choose another --out)");
-      }
-    }
-  }
   for (const auto& entry : fs::directory_iterator(out, ec)) {
     const std::string name = entry.path().filename().string();
-    if (own_names.count(name) == 0) {
+    if (own_names.count(name) == 0 && name != kOutputMarker) {
       return Refusal(out, "holds '" + io::OneLine(name, 80) +
                               "', which this command does not write; refusing to replace the "
                               "directory (choose an empty or new --out)");
@@ -108,8 +152,38 @@ void CommitOutputDirectory(io::StagedDirectory& staged, const std::string& out,
   staged.Commit(/*replace_existing=*/true);
 }
 
+std::string DirectoryOutputRefusal(const std::string& out, const std::string& kind, bool force,
+                                   const std::vector<std::string>& inputs) {
+  if (out.empty()) return "--out is empty; name the directory to write the " + kind + " to";
+  if (const std::string overlap = InputOverlap(out, inputs); !overlap.empty()) return overlap;
+  std::error_code ec;
+  const fs::file_status status = fs::symlink_status(out, ec);
+  if (!fs::exists(status)) return "";
+  if (!fs::is_directory(status)) {
+    return Refusal(out, "exists and is not a directory; --out must name a directory");
+  }
+  if (fs::is_empty(out, ec)) return "";
+  if (const std::string foreign = ForeignFile(out, kind); !foreign.empty()) {
+    return Refusal(out, "holds '" + io::OneLine(foreign, 80) +
+                            "', which fitcal did not write as a " + kind +
+                            "; refusing to replace the directory, --force or not (choose "
+                            "an empty or new --out)");
+  }
+  if (!force) return Refusal(out, "already holds a " + kind + "; --force to replace it");
+  return "";
+}
+
+void CommitDirectoryOutput(io::StagedDirectory& staged, const std::string& out,
+                           const std::string& kind, bool force,
+                           const std::vector<std::string>& inputs) {
+  const std::string refusal = DirectoryOutputRefusal(out, kind, force, inputs);
+  if (!refusal.empty()) throw std::runtime_error(refusal);
+  WriteMarker(staged.path(), kind);
+  staged.Commit(/*replace_existing=*/true);
+}
+
 std::vector<std::string> DatasetInputs(const io::DatasetIndex& index) {
-  std::vector<std::string> inputs{index.yaml_path, index.robot_path};
+  std::vector<std::string> inputs{index.directory, index.yaml_path, index.robot_path};
   for (const io::DatasetIndexEntry& run : index.runs) {
     inputs.push_back(run.encoders_path);
     inputs.push_back(run.ground_truth_path);

@@ -36,6 +36,26 @@ void CommitOutputDirectory(io::StagedDirectory& staged, const std::string& out,
                            const std::vector<std::string>& inputs,
                            const std::set<std::string>& own_names);
 
+// Directory outputs that only `--force` replaces (a data set: imports and simulators). Each such
+// output carries the marker file kOutputMarker naming its kind and every file written, so a later
+// writer recognises it as its own; a data set without one (written before the marker existed) is
+// recognised by its dataset.yaml listing every file there. Empty when `out` may be written:
+// `out` does not exist, is an empty directory, or (with `force`) is a recognised output of the
+// same kind. Refuses, `force` or not: an empty `out`, an `out` that is, holds or sits inside one
+// of `inputs` or of what the process has read (io/input_registry.h), a file, a directory holding
+// anything fitcal did not write there.
+inline constexpr char kOutputMarker[] = ".fitcal-output";
+inline constexpr char kDatasetKind[] = "data set";
+std::string DirectoryOutputRefusal(const std::string& out, const std::string& kind, bool force,
+                                   const std::vector<std::string>& inputs);
+
+// Writes the marker into the complete staged directory, checks DirectoryOutputRefusal once more
+// (another writer may have been there meanwhile) and renames the staged directory over `out`;
+// throws std::runtime_error otherwise (the staged directory is then removed by its destructor).
+void CommitDirectoryOutput(io::StagedDirectory& staged, const std::string& out,
+                           const std::string& kind, bool force,
+                           const std::vector<std::string>& inputs);
+
 // Every file a data set run reads: dataset.yaml, the robot YAML, each run's logs.
 std::vector<std::string> DatasetInputs(const io::DatasetIndex& index);
 

@@ -10,8 +10,10 @@
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/robot_yaml.h"
+#include "io/staged_directory.h"
 #include "odometry/parallel_for.h"
 #include "tools/model_simulate_command.h"
+#include "tools/output_guard.h"
 
 namespace fitcal::tools {
 
@@ -136,14 +138,18 @@ int RunSimulateCommand(const SimulateCommandOptions& options) {
       sim_options.injected_effects.push_back(ParseInjectedEffect(text));
     }
 
-    if (fs::exists(fs::path(options.out) / "dataset.yaml") && !options.force) {
-      std::cerr << "fitcal: " << options.out
-                << " already holds a data set; use --force to overwrite it\n";
+    if (const std::string refusal =
+            DirectoryOutputRefusal(options.out, kDatasetKind, options.force, {});
+        !refusal.empty()) {
+      std::cerr << "fitcal: " << refusal << "\n";
       return 2;
     }
     const std::vector<sim::SimulatedRun> runs = sim::SimulateOmni3(sim_options);
 
-    fs::create_directories(fs::path(options.out) / "runs");
+    // Written whole or not at all: staged beside --out, renamed over it once complete.
+    io::StagedDirectory staged(options.out);
+    const fs::path out(staged.path());
+    fs::create_directories(out / "runs");
     std::vector<io::DatasetEntry> entries(runs.size());
     ParallelFor(runs.size(), 0, [&](std::size_t i) {
       const RunLog& log = runs[i].log;
@@ -153,16 +159,14 @@ int RunSimulateCommand(const SimulateCommandOptions& options) {
       e.repetition = log.repetition;
       e.encoders = "runs/" + log.id + "_encoders.csv";
       e.ground_truth = "runs/" + log.id + "_ground_truth.csv";
-      io::WriteFileAtomically((fs::path(options.out) / e.encoders).string(),
-                              io::EncoderCsv(log.encoders));
-      io::WriteFileAtomically((fs::path(options.out) / e.ground_truth).string(),
+      io::WriteFileAtomically((out / e.encoders).string(), io::EncoderCsv(log.encoders));
+      io::WriteFileAtomically((out / e.ground_truth).string(),
                               io::GroundTruthCsv(log.ground_truth));
     });
-    io::WriteFileAtomically((fs::path(options.out) / "robot.yaml").string(),
-                            io::Omni3RobotYaml(nominal, nullptr));
-    // dataset.yaml last: a data set is only complete once it exists.
-    io::WriteFileAtomically((fs::path(options.out) / "dataset.yaml").string(),
+    io::WriteFileAtomically((out / "robot.yaml").string(), io::Omni3RobotYaml(nominal, nullptr));
+    io::WriteFileAtomically((out / "dataset.yaml").string(),
                             io::DatasetYaml("robot.yaml", entries));
+    CommitDirectoryOutput(staged, options.out, kDatasetKind, options.force, {});
     std::printf("wrote %zu runs (%zu trajectories x %d repetitions, seed %llu) to %s\n",
                 runs.size(), sim_options.trajectories.size(), sim_options.repetitions,
                 static_cast<unsigned long long>(sim_options.seed), options.out.c_str());

@@ -7,6 +7,7 @@
 #include "io/input_error.h"
 #include "io/robot_yaml_blocks.h"
 #include "io/yaml_reader.h"
+#include "io/yaml_text.h"
 #include "models/diff_drive/umbmark.h"
 
 namespace fitcal {
@@ -29,7 +30,7 @@ DiffDriveWheel ReadWheel(const YAML::Node& node, const std::string& path, int in
   io::YamlMap wheel(node, path, what);
   DiffDriveWheel w;
   w.line = LineOf(node);
-  w.name = wheel.String("name");
+  w.name = wheel.Name("name");
   const bool named_by_side = w.name == "right" || w.name == "left";
   w.side = wheel.Has("side") ? wheel.String("side") : named_by_side ? w.name : "";
   if (w.side != "right" && w.side != "left") {
@@ -117,7 +118,7 @@ Robot DiffDriveRobotDescription(const std::string& name,
 RobotModelPtr ReadDiffDriveModel(const YAML::Node& root, const std::string& path) {
   io::YamlMap robot_map(root, path, "robot");
   robot_map.String("model");
-  const std::string name = robot_map.String("name");
+  const std::string name = robot_map.Name("name");
   const std::vector<DiffDriveWheel> wheels = ReadWheels(robot_map, path);
   const YAML::Node separation_node = robot_map.Required("wheel_separation_m");
   const double separation_m = robot_map.Double("wheel_separation_m");
@@ -156,7 +157,7 @@ std::string DiffDriveRobotYaml(const Robot& robot, int right_channel, const std:
   out.SetDoublePrecision(10);
   out << YAML::BeginMap;
   out << YAML::Key << "model" << YAML::Value << "diff_drive";
-  out << YAML::Key << "name" << YAML::Value << robot.name;
+  out << YAML::Key << "name" << YAML::Value << io::YamlText(robot.name);
   out << YAML::Key << "wheels" << YAML::Value << YAML::BeginSeq;
   for (int i = 0; i < diff_drive::kNumWheels; ++i) {
     const std::string& name = robot.channels[i].name;

@@ -13,6 +13,7 @@
 #include "io/input_error.h"
 #include "io/robot_yaml_blocks.h"
 #include "io/yaml_reader.h"
+#include "io/yaml_text.h"
 #include "models/kinematic_model.h"
 #include "models/omni/omni_kinematics.h"
 
@@ -65,12 +66,12 @@ std::string OmniModel<N>::RobotYaml(const std::vector<double>& p,
   out.SetDoublePrecision(10);
   out << YAML::BeginMap;
   out << YAML::Key << "model" << YAML::Value << "omni";
-  out << YAML::Key << "name" << YAML::Value << robot.name;
+  out << YAML::Key << "name" << YAML::Value << io::YamlText(robot.name);
   out << YAML::Key << "wheels" << YAML::Value << YAML::BeginSeq;
   for (int i = 0; i < N; ++i) {
     const double angle_rad = p[K::kAngleIndex + i];
     out << YAML::Flow << YAML::BeginMap;
-    out << YAML::Key << "name" << YAML::Value << robot.channels[i].name;
+    out << YAML::Key << "name" << YAML::Value << io::YamlText(robot.channels[i].name);
     out << YAML::Key << "distance_m" << YAML::Value << p[K::kDistanceIndex + i];
     out << YAML::Key << "angle_deg" << YAML::Value << RadToDeg(angle_rad);
     out << YAML::Key << "radius_m" << YAML::Value << p[K::kRadiusIndex + i];
@@ -303,7 +304,7 @@ RobotModelPtr MakeOmniModelWithEffects(const std::string& name,
 OmniWheel ReadWheel(const YAML::Node& node, const std::string& path, int index) {
   io::YamlMap map(node, path, "wheel " + std::to_string(index + 1));
   OmniWheel w;
-  w.name = map.String("name");
+  w.name = map.Name("name");
   w.distance_m = map.Double("distance_m");
   w.angle_rad = DegToRad(map.Double("angle_deg"));
   w.radius_m = map.Double("radius_m");
@@ -338,7 +339,7 @@ RobotModelPtr MakeOmniModel(const std::string& name, const std::vector<OmniWheel
 RobotModelPtr ReadOmniModel(const YAML::Node& root, const std::string& path) {
   io::YamlMap robot_map(root, path, "robot");
   robot_map.String("model");
-  const std::string name = robot_map.String("name");
+  const std::string name = robot_map.Name("name");
   const YAML::Node wheel_list = robot_map.Required("wheels");
   io::ExpectYamlType(wheel_list, YAML::NodeType::Sequence, path, "robot.wheels");
   std::vector<OmniWheel> wheels;

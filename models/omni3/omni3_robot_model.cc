@@ -7,6 +7,7 @@
 #include "io/input_error.h"
 #include "io/robot_yaml_blocks.h"
 #include "io/yaml_reader.h"
+#include "io/yaml_text.h"
 #include "models/omni/omni_model.h"
 
 namespace fitcal {
@@ -42,7 +43,7 @@ Robot Omni3RobotDescription(const std::string& name, const std::vector<std::stri
 RobotModelPtr ReadOmni3Model(const YAML::Node& root, const std::string& path) {
   io::YamlMap robot_map(root, path, "robot");
   robot_map.String("model");
-  const std::string name = robot_map.String("name");
+  const std::string name = robot_map.Name("name");
   const YAML::Node wheels = robot_map.Required("wheels");
   io::ExpectYamlType(wheels, YAML::NodeType::Sequence, path, "robot.wheels");
   if (wheels.size() != omni3::kNumWheels) {
@@ -54,7 +55,7 @@ RobotModelPtr ReadOmni3Model(const YAML::Node& root, const std::string& path) {
   for (int i = 0; i < omni3::kNumWheels; ++i) {
     const std::string what = "wheel " + std::to_string(i + 1);
     io::YamlMap wheel(wheels[i], path, what);
-    names.push_back(wheel.String("name"));
+    names.push_back(wheel.Name("name"));
     if (std::count(names.begin(), names.end(), names.back()) > 1) {
       throw InputError(InputErrorKind::kBadValue, path, LineOf(wheels[i]),
                        "wheel name '" + names.back() + "' is used twice");
@@ -118,11 +119,11 @@ std::string Omni3Model::RobotYaml(const std::vector<double>& p,
   out.SetDoublePrecision(10);
   out << YAML::BeginMap;
   out << YAML::Key << "model" << YAML::Value << "omni3";
-  out << YAML::Key << "name" << YAML::Value << robot_.name;
+  out << YAML::Key << "name" << YAML::Value << io::YamlText(robot_.name);
   out << YAML::Key << "wheels" << YAML::Value << YAML::BeginSeq;
   for (int i = 0; i < omni3::kNumWheels; ++i) {
     out << YAML::Flow << YAML::BeginMap;
-    out << YAML::Key << "name" << YAML::Value << robot_.channels[i].name;
+    out << YAML::Key << "name" << YAML::Value << io::YamlText(robot_.channels[i].name);
     out << YAML::Key << "distance_m" << YAML::Value << p[omni3::kDistanceIndex + i];
     out << YAML::Key << "radius_m" << YAML::Value << p[omni3::kRadiusIndex + i];
     out << YAML::Key << "angle_deg" << YAML::Value << RadToDeg(p[omni3::kAngleIndex + i]);

@@ -7,6 +7,7 @@
 #include "io/input_error.h"
 #include "io/robot_yaml_blocks.h"
 #include "io/yaml_reader.h"
+#include "io/yaml_text.h"
 #include "models/tricycle/tricycle_checks.h"
 
 namespace fitcal {
@@ -82,11 +83,11 @@ Robot TricycleRobotDescription(const std::string& name, const std::string& tract
 RobotModelPtr ReadTricycleModel(const YAML::Node& root, const std::string& path) {
   io::YamlMap robot_map(root, path, "robot");
   robot_map.String("model");
-  const std::string name = robot_map.String("name");
+  const std::string name = robot_map.Name("name");
   const YAML::Node wheel_node = robot_map.Required("traction_wheel");
   io::YamlMap wheel(wheel_node, path, "traction_wheel");
   const std::string traction_name =
-      wheel.Has("name") ? wheel.String("name") : std::string(kDefaultTractionName);
+      wheel.Has("name") ? wheel.Name("name") : std::string(kDefaultTractionName);
   if (!IsColumnSafe(traction_name) || traction_name == kSteeringColumn) {
     throw InputError(InputErrorKind::kBadValue, path, LineOf(wheel_node),
                      "traction_wheel.name '" + traction_name +
@@ -119,7 +120,7 @@ std::string TricycleModel::RobotYaml(const std::vector<double>& p,
   out.SetDoublePrecision(10);
   out << YAML::BeginMap;
   out << YAML::Key << "model" << YAML::Value << "tricycle";
-  out << YAML::Key << "name" << YAML::Value << robot_.name;
+  out << YAML::Key << "name" << YAML::Value << io::YamlText(robot_.name);
   out << YAML::Key << "traction_wheel" << YAML::Value << YAML::Flow << YAML::BeginMap;
   if (traction_name != kDefaultTractionName) {
     out << YAML::Key << "name" << YAML::Value << traction_name;

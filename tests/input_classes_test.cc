@@ -1,0 +1,262 @@
+// Input classes (issue 31, item 3), each through the command a user runs, on a small simulated
+// data set of a model other than omni3 (omni3 has its own tests in refusal_test): one line naming
+// the file (and the line or key) and what is wrong, the exit status the README gives, nothing
+// written. And the fit that has nothing to judge it (item 1): refused, not written with exit 0.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "io/input_error.h"
+#include "io/yaml_reader.h"
+#include "tests/test_files.h"
+
+namespace fitcal {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::ReadFileBytes;
+using testing::RunFitcal;
+using testing::TempDir;
+using testing::WriteFileBytes;
+
+int Lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+
+bool Has(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+class InputClassesTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    data_ = dir_.path() / "data";
+    const auto r = RunFitcal(dir_, "simulate --model diff_drive --repetitions 3 --seed 4 --out '" +
+                                       data_.string() + "'");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    out_ = dir_.path() / "cal.yaml";
+  }
+
+  // `fit` on the data set: must fail with `exit_code` and one line holding every `parts`, and
+  // write nothing.
+  void ExpectFitRefused(int exit_code, const std::vector<std::string>& parts,
+                        const std::string& extra = "") {
+    const auto r = RunFitcal(
+        dir_, "fit --logs '" + data_.string() + "' --out '" + out_.string() + "' " + extra);
+    EXPECT_EQ(r.exit_code, exit_code) << r.err << r.out;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
+    for (const std::string& part : parts) EXPECT_TRUE(Has(r.err, part)) << part << " in " << r.err;
+    EXPECT_FALSE(fs::exists(out_));
+  }
+
+  std::string RobotYaml() const { return ReadFileBytes(data_ / "robot.yaml"); }
+  void SetRobotYaml(const std::string& text) const { WriteFileBytes(data_ / "robot.yaml", text); }
+  static std::string Replace(std::string text, const std::string& from, const std::string& to) {
+    const std::size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+    return text;
+  }
+
+  // Every encoder log, its value columns multiplied by `factor` (a unit slip).
+  void ScaleRates(double factor) const {
+    for (const auto& e : fs::directory_iterator(data_ / "runs")) {
+      if (!Has(e.path().filename().string(), "_encoders.csv")) continue;
+      std::istringstream in(ReadFileBytes(e.path()));
+      std::string line, out;
+      std::getline(in, line);
+      out = line + "\n";
+      while (std::getline(in, line)) {
+        double t = 0, a = 0, b = 0;
+        if (std::sscanf(line.c_str(), "%lf,%lf,%lf", &t, &a, &b) != 3) continue;
+        char row[128];
+        std::snprintf(row, sizeof row, "%.9g,%.9g,%.9g\n", t, a * factor, b * factor);
+        out += row;
+      }
+      WriteFileBytes(e.path(), out);
+    }
+  }
+
+  TempDir dir_;
+  fs::path data_, out_;
+};
+
+TEST_F(InputClassesTest, TheDataSetItselfFitsAndCarriesSigmas) {
+  const auto r =
+      RunFitcal(dir_, "fit --logs '" + data_.string() + "' --out '" + out_.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string cal = ReadFileBytes(out_);
+  EXPECT_TRUE(Has(cal, "sigma:")) << cal;
+  EXPECT_FALSE(Has(cal, "sigma: ~")) << cal;
+  EXPECT_FALSE(Has(cal, "sigma: null")) << cal;
+}
+
+// One run: three final-pose residuals for three parameters, fitted exactly whatever the robot.
+TEST_F(InputClassesTest, AFitWithNoResidualDegreesOfFreedomIsRefused) {
+  std::istringstream in(ReadFileBytes(data_ / "dataset.yaml"));
+  std::string robot, runs, first;
+  std::getline(in, robot);
+  std::getline(in, runs);
+  std::getline(in, first);
+  WriteFileBytes(data_ / "dataset.yaml", robot + "\n" + runs + "\n" + first + "\n");
+  ExpectFitRefused(1, {"1 training run gives 3 final-pose residuals for 3 free parameters",
+                       "Record at least 2 training runs"});
+}
+
+TEST_F(InputClassesTest, RatesInDegreesPerSecondAreNamed) {
+  ScaleRates(180.0 / M_PI);
+  ExpectFitRefused(1, {"not in rad/s", "deg/s"});
+}
+
+TEST_F(InputClassesTest, RatesInRpmAreNamed) {
+  ScaleRates(30.0 / M_PI);
+  ExpectFitRefused(1, {"not in rad/s", "rpm"});
+}
+
+TEST_F(InputClassesTest, GroundTruthInMillimetresIsNamed) {
+  for (const auto& e : fs::directory_iterator(data_ / "runs")) {
+    if (!Has(e.path().filename().string(), "_ground_truth.csv")) continue;
+    std::istringstream in(ReadFileBytes(e.path()));
+    std::string line, out;
+    std::getline(in, line);
+    out = line + "\n";
+    while (std::getline(in, line)) {
+      double t = 0, x = 0, y = 0, theta = 0;
+      if (std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf", &t, &x, &y, &theta) != 4) continue;
+      char row[160];
+      std::snprintf(row, sizeof row, "%.9g,%.9g,%.9g,%.9g\n", t, x * 1000, y * 1000, theta);
+      out += row;
+    }
+    WriteFileBytes(e.path(), out);
+  }
+  ExpectFitRefused(1, {"millimetres", "ground-truth positions"});
+}
+
+TEST_F(InputClassesTest, LengthsInMillimetresAreNamedWithTheirLine) {
+  SetRobotYaml(
+      Replace(Replace(Replace(RobotYaml(), "wheel_separation_m: 0.2", "wheel_separation_m: 200"),
+                      "radius_m: [0.038, 0.046]", "radius_m: [38, 46]"),
+              "wheel_separation_m: [0.18, 0.22]", "wheel_separation_m: [180, 220]"));
+  ExpectFitRefused(1, {"robot.yaml:6:", "wheel_separation_m = 200", "millimetres"});
+}
+
+TEST_F(InputClassesTest, AMisspeltKeyIsNamedOnItsOwnLine) {
+  SetRobotYaml(Replace(RobotYaml(), "wheel_separation_m: 0.2", "wheel_separaton_m: 0.2"));
+  ExpectFitRefused(1, {"robot.yaml:6:", "wheel_separaton_m", "misspelt 'wheel_separation_m'"});
+}
+
+TEST_F(InputClassesTest, EmptyOrControlCharacterNamesAreRefused) {
+  const std::string original = RobotYaml();
+  SetRobotYaml(Replace(original, "name: example_diff_drive", "name: \"\""));
+  ExpectFitRefused(1, {"robot.yaml:2:", "name is empty"});
+  SetRobotYaml(Replace(original, "name: example_diff_drive", "name: \"a\\tb\""));
+  ExpectFitRefused(1, {"robot.yaml:2:", "control character"});
+}
+
+TEST_F(InputClassesTest, NegativeRepetitionNumbersAreRefused) {
+  const std::string yaml = ReadFileBytes(data_ / "dataset.yaml");
+  WriteFileBytes(data_ / "dataset.yaml", Replace(yaml, "repetition: 1,", "repetition: -1,"));
+  ExpectFitRefused(1, {"dataset.yaml:3:", "repetition -1 is negative"});
+}
+
+TEST_F(InputClassesTest, AStartHeadingInDegreesIsRefused) {
+  const std::string yaml = ReadFileBytes(data_ / "dataset.yaml");
+  WriteFileBytes(
+      data_ / "dataset.yaml",
+      Replace(yaml, "repetition: 1, encoders", "repetition: 1, start_pose: [0, 0, 90], encoders"));
+  ExpectFitRefused(1, {"dataset.yaml:3:", "start_pose theta 90", "degrees?"});
+}
+
+// Cumulative 16-bit tick counts that pass 65535 inside a run.
+TEST_F(InputClassesTest, ATickCounterThatWrapsIsRefusedAtItsLine) {
+  SetRobotYaml(RobotYaml() + "encoder: {ticks_per_rev: 4096, cumulative: true}\n");
+  for (const auto& e : fs::directory_iterator(data_ / "runs")) {
+    if (!Has(e.path().filename().string(), "_encoders.csv")) continue;
+    std::istringstream in(ReadFileBytes(e.path()));
+    std::string line, out = "t,ticks_right,ticks_left\n";
+    std::getline(in, line);
+    double count[2] = {65000.0, 65000.0}, previous_t = 0.0;
+    bool first = true;
+    while (std::getline(in, line)) {
+      double t = 0, w[2] = {0, 0};
+      if (std::sscanf(line.c_str(), "%lf,%lf,%lf", &t, &w[0], &w[1]) != 3) continue;
+      for (int k = 0; k < 2 && !first; ++k) count[k] += w[k] * (t - previous_t) * 4096 / (2 * M_PI);
+      first = false;
+      previous_t = t;
+      char row[128];
+      std::snprintf(row, sizeof row, "%.6f,%.0f,%.0f\n", t, std::fmod(std::round(count[0]), 65536),
+                    std::fmod(std::round(count[1]), 65536));
+      out += row;
+    }
+    WriteFileBytes(e.path(), out);
+  }
+  ExpectFitRefused(1, {"_encoders.csv:", "2^16", "wraps inside the run"});
+}
+
+TEST(InputClassesCli, ASteeringAngleInDegreesIsRefused) {
+  const TempDir dir;
+  const fs::path data = dir.path() / "tri";
+  ASSERT_EQ(
+      RunFitcal(dir, "simulate --model tricycle --repetitions 2 --out " + data.string()).exit_code,
+      0);
+  for (const auto& e : fs::directory_iterator(data / "runs")) {
+    if (!Has(e.path().filename().string(), "_encoders.csv")) continue;
+    std::istringstream in(ReadFileBytes(e.path()));
+    std::string line, out;
+    std::getline(in, line);
+    out = line + "\n";
+    while (std::getline(in, line)) {
+      double t = 0, w = 0, steering = 0;
+      if (std::sscanf(line.c_str(), "%lf,%lf,%lf", &t, &w, &steering) != 3) continue;
+      char row[128];
+      std::snprintf(row, sizeof row, "%.9g,%.9g,%.9g\n", t, w, steering * 180.0 / M_PI);
+      out += row;
+    }
+    WriteFileBytes(e.path(), out);
+  }
+  const auto r = RunFitcal(dir, "fit --logs " + data.string() + " --no-output");
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_EQ(Lines(r.err), 1) << r.err;
+  EXPECT_TRUE(Has(r.err, "_encoders.csv:") && Has(r.err, "steering")) << r.err;
+}
+
+TEST(InputClassesCli, RobotAnglesInRadiansNameTheFileAndKey) {
+  const TempDir dir;
+  const std::string robot = dir.Write("omni.yaml", R"(model: omni
+name: radians
+wheels:
+  - {name: a, distance_m: 0.2, angle_deg: 1.0472, radius_m: 0.05, drive_angle_deg: 90, roller_angle_deg: 0}
+  - {name: b, distance_m: 0.2, angle_deg: 3.1416, radius_m: 0.05, drive_angle_deg: 90, roller_angle_deg: 0}
+  - {name: c, distance_m: 0.2, angle_deg: 5.2360, radius_m: 0.05, drive_angle_deg: 90, roller_angle_deg: 0}
+bounds: {distance_m: [0.18, 0.22], radius_m: [0.045, 0.055], angle_offset_deg: [-2, 2]}
+)");
+  const auto r =
+      RunFitcal(dir, "simulate --model omni --robot " + robot + " --out " + dir.Path("data"));
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_EQ(Lines(r.err), 1) << r.err;
+  EXPECT_TRUE(Has(r.err, "omni.yaml:4:") && Has(r.err, "angle_deg") && Has(r.err, "radians"))
+      << r.err;
+}
+
+TEST(InputClassesCli, UsageErrorsAreOneLineExitTwoBeforeAnyWork) {
+  const TempDir dir;
+  for (const std::string& args :
+       {std::string("fit --logs . --threads abc"), std::string("fit --logs . --threads -2"),
+        std::string("diagnose --logs . --threads 1.5"), std::string("fit --logs . --out ''"),
+        std::string("report --logs . --calibration x --out ''"),
+        std::string("diagnose --logs . --train-reps 1-2 --train-trajectories x"),
+        std::string("fit --logs . --train-reps 1-2 --train-trajectories x")}) {
+    const auto r = RunFitcal(dir, args);
+    EXPECT_EQ(r.exit_code, 2) << args << ": " << r.err;
+    EXPECT_EQ(Lines(r.err), 1) << args << ": " << r.err;
+    EXPECT_FALSE(Has(r.err, "could not be converted")) << r.err;
+  }
+}
+
+}  // namespace
+}  // namespace fitcal
