@@ -39,6 +39,7 @@
 // scale, which equals a common radius scale) are never fitted; their separable fraction is
 // computed and reported to show that the data agree.
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -79,13 +80,21 @@ struct CandidateResult {
   double p_value = 1.0;
   double delta_bic = 0.0;
   double lof_f = 0.0;  // lack of fit with the candidate (all runs)
-  bool significant = false;
+  // The rules, in the order they are applied (see the procedure above); the verdict names the
+  // one that decided.
+  bool significant = false;  // the held-out paired test: p_value < DiagnoseRound::threshold
+  bool improves = false;     // mean_improvement > 0
+  bool bic_falls = false;    // delta_bic < 0
+  // Fraction of the base's lack-of-fit excess F - 1 the candidate removes, in [0, 1]; NaN when
+  // not evaluated (no significant lack of fit, or the candidate failed an earlier rule).
+  double explained_fraction = std::numeric_limits<double>::quiet_NaN();
   bool explains = false;
   bool accepted = false;
   std::string verdict;
 };
 
 struct DiagnoseRound {
+  double threshold = 0.0;  // of the held-out test: alpha / (candidates fitted), Bonferroni
   double base_validation_objective = 0.0;
   bool base_lof_available = false;  // some trajectory has repetitions
   double base_lof_f = 0.0;
@@ -126,6 +135,13 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
 DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
                         const std::vector<TrackRun>& validation, const Omni3Robot& robot,
                         const DiagnoseOptions& options = {});
+
+// A fitted candidate's verdict: the held-out test as it came out - "significant (p < threshold)"
+// or "not significant (p >= threshold)", never the one for the other - then the rule that decided,
+// stated ("but explains only 31 % of the lack of fit (rule: >= 50 %)"). accepted_name: the
+// candidate accepted in its round (empty when none). Diagnose sets CandidateResult::verdict so.
+std::string CandidateVerdict(const CandidateResult& c, double threshold,
+                             double min_explained_fraction, const std::string& accepted_name);
 
 // The report (Markdown): pattern, effect chosen with value and uncertainty, parameters before
 // and after, held-out error before and after, candidate table, what to record next.
