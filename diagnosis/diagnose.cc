@@ -136,25 +136,24 @@ int DecideRound(const RobotModelInterface& model, const std::vector<TrackRun>& a
 // The residual against the sensors' noise floor (sensor_noise_floor.h). The floor models the
 // ground truth's white noise and the odometry's random walk; when the repetitions of a trajectory
 // scatter above it, the runs carry noise the floor lacks (random slip that changes from run to
-// run), and a residual above the floor by that same ratio is that noise, not structure a model
-// could remove: the simulated backlash and acceleration slip, fitted within two sigmas, were
-// "partial" for a residual 1.15 times the floor whose repetitions scattered 1.15 times it. So the
-// residual must then also exceed the measured scatter: F = ratio / repetition_ratio, compared
-// with F(df, repetition_df) at lof_alpha. Without repetitions, or when they scatter within the
-// floor, the floor's own chi-square test decides, as before.
+// run), and a residual above the floor by that same ratio is that noise, which the lack-of-fit
+// and covariate tests (their noise is the repetitions' scatter) judge; the simulated backlash and
+// acceleration slip, fitted within two sigmas, were "partial" for a residual 1.15 times the floor
+// whose repetitions scattered 1.15 times it. So the residual must then also exceed the measured
+// scatter: F = ratio / repetition_ratio, compared with F(df, repetition_df) at lof_alpha. Without
+// repetitions, or when they scatter within the floor, the floor's own chi-square test decides, as
+// before.
 void JudgeAgainstSensorFloor(const SensorFloorTest& floor, double lof_alpha, DiagnoseResult* out) {
-  const bool above_floor = floor.available && floor.p_value < lof_alpha;
+  out->above_sensor_floor = floor.available && floor.p_value < lof_alpha;
   out->floor_below_repetitions = floor.available && floor.has_repetition_check &&
                                  floor.repetition_ratio > 1.0 && floor.repetition_df > 0.0;
-  if (!out->floor_below_repetitions) {
-    out->above_sensor_floor = above_floor;
-    return;
-  }
+  out->floor_shows_structure = out->above_sensor_floor;
+  if (!out->floor_below_repetitions) return;
   out->floor_vs_repetitions_f = floor.ratio / floor.repetition_ratio;
   out->floor_vs_repetitions_p =
       stats::FUpperTail(out->floor_vs_repetitions_f, floor.df, floor.repetition_df);
-  out->above_sensor_floor = above_floor && out->floor_vs_repetitions_p < lof_alpha;
-  out->floor_excess_is_run_to_run_noise = above_floor && !out->above_sensor_floor;
+  out->floor_shows_structure = out->above_sensor_floor && out->floor_vs_repetitions_p < lof_alpha;
+  out->floor_excess_is_run_to_run_noise = out->above_sensor_floor && !out->floor_shows_structure;
 }
 
 }  // namespace
@@ -351,7 +350,7 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
       out.after.lack_of_fit.available && out.after.lack_of_fit.p_value < options.lof_alpha;
   JudgeAgainstSensorFloor(out.after.sensor_floor, options.lof_alpha, &out);
   out.unexplained_structure =
-      out.lack_of_fit || out.covariates.any_significant || out.above_sensor_floor;
+      out.lack_of_fit || out.covariates.any_significant || out.floor_shows_structure;
   out.effects_named = !out.unexplained_structure && !current.effects.empty();
   for (const CovariateTest& t : out.covariates.tests) {
     if (t.significant) {
@@ -359,7 +358,7 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
                                 " within repetitions of one trajectory, to model what drifts");
     }
   }
-  if (out.above_sensor_floor && !out.lack_of_fit) {
+  if (out.floor_shows_structure && !out.lack_of_fit) {
     out.record_next.push_back(
         "the runs differ from the model by more than the sensors' noise, but no repeatable "
         "pattern is established: record repetitions of each motion, at other times, headings "
@@ -436,15 +435,15 @@ std::string FormatDiagnoseReport(const DiagnoseResult& r, const RobotModelInterf
             "(lack of fit F = %.2f, p = %.2g) that no candidate explains; see the tables above.\n",
             r.after.lack_of_fit.f, r.after.lack_of_fit.p_value);
   }
-  if (r.above_sensor_floor) out += "- " + SensorFloorFinding(r.after.sensor_floor) + "\n";
+  if (r.floor_shows_structure) out += "- " + SensorFloorFinding(r.after.sensor_floor) + "\n";
   if (r.floor_excess_is_run_to_run_noise) {
     const SensorFloorTest& f = r.after.sensor_floor;
     out += Fmt("- the residual is %.2f times the sensors' noise floor (p = %.2g) and the "
                "repetitions scatter %.2f times it: ",
                f.ratio, f.p_value, f.repetition_ratio) +
-           Fmt("the runs differ from run to run beyond the sensors' noise, not by structure a "
-               "model could remove (residual against the repetitions' scatter: F = %.2f, p = "
-               "%.2g)\n",
+           Fmt("something changes from run to run beyond the sensors' noise; against that "
+               "scatter the residual is F = %.2f (p = %.2g), so the lack-of-fit and covariate "
+               "tests, which take it as noise, judge the structure\n",
                r.floor_vs_repetitions_f, r.floor_vs_repetitions_p);
   }
   if (!r.unexplained_structure) {

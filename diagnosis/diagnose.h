@@ -115,18 +115,20 @@ struct DiagnoseResult {
   bool lack_of_fit = false;       // significant lack of fit of `after` (p < lof_alpha)
   // `after` significantly above the sensors' own noise (sensor_noise_floor.h, p < lof_alpha):
   // seen without repetitions, and when what differs between repetitions hides in their scatter.
-  // Where the repetitions themselves scatter above the floor (ratio > 1: noise the floor's model
-  // lacks, e.g. random slip), the residual must also exceed that measured scatter: F = residual
-  // ratio / repetition ratio on (df, repetition df), p < lof_alpha (floor_vs_repetitions_p).
   bool above_sensor_floor = false;
+  // The floor's excess counts as structure (floor_shows_structure) unless the repetitions
+  // themselves scatter above the floor (ratio > 1: noise the floor's model lacks, e.g. random slip
+  // that changes from run to run) and the residual does not exceed that measured scatter:
+  // F = residual ratio / repetition ratio on (df, repetition df), p < lof_alpha.
   bool floor_below_repetitions = false;  // the repetitions scatter above the floor (ratio > 1)
   double floor_vs_repetitions_f = 0.0;
   double floor_vs_repetitions_p = 1.0;
-  // Above the floor by its own test, but not above the repetitions' scatter: reported, not
-  // structure.
+  bool floor_shows_structure = false;
+  // Above the floor by its own test, but not above the repetitions' scatter: reported, and left
+  // to the lack-of-fit and covariate tests, which take that scatter as noise.
   bool floor_excess_is_run_to_run_noise = false;
-  // Significant lack of fit, residual above the sensor floor, or a covariate the residual
-  // significantly depends on.
+  // Significant lack of fit, floor_shows_structure, or a covariate the residual significantly
+  // depends on.
   bool unexplained_structure = false;
   // The accepted effects are named as causes only when nothing structured remains; otherwise
   // they are a partial description (they may stand in for an effect outside the library).
