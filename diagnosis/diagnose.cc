@@ -70,16 +70,12 @@ void PairedImprovement(const ModelScore& base, const ModelScore& candidate, Cand
   c->p_value = test.p;
 }
 
-// The verdict of a significant candidate that removes too little of the lack-of-fit excess
-// F - 1: the fraction it removes, in [0, 100] % ("none" when it leaves the excess as large or
-// larger; a negative percentage, or "-0%" from rounding, said nothing a reader could use).
-std::string ExplainedText(double base_lof_f, double candidate_lof_f) {
+// The fraction of the base's lack-of-fit excess F - 1 that a candidate removes, in [0, 1] (0 when
+// it leaves the excess as large or larger).
+double ExplainedFraction(double base_lof_f, double candidate_lof_f) {
   const double excess_before = base_lof_f - 1.0;
-  const double fraction =
-      excess_before > 0.0 ? 1.0 - std::max(0.0, candidate_lof_f - 1.0) / excess_before : 0.0;
-  const double percent = std::clamp(100.0 * fraction, 0.0, 100.0);
-  if (percent < 0.5) return "significant but explains none of the structure";
-  return Fmt("significant but explains only %.0f%% of the structure", percent);
+  if (!(excess_before > 0.0)) return 0.0;
+  return std::clamp(1.0 - std::max(0.0, candidate_lof_f - 1.0) / excess_before, 0.0, 1.0);
 }
 
 // Every identifiable effect of the registry that this robot's channels can show.
@@ -89,6 +85,75 @@ std::vector<EffectId> DefaultCandidates(const Robot& robot) {
     if (info.identifiable && robot.CanShow(info.id)) out.push_back(info.id);
   }
   return out;
+}
+
+// Applies the rules to the fitted candidates of a round (see diagnose.h, step 3): the held-out
+// test at round->threshold, a mean improvement, a falling BIC; then, in order of mean
+// improvement, the explanation of the lack of fit (only where the base leaves significant lack
+// of fit); the first candidate passing all is accepted. Sets every fitted candidate's rule flags
+// and verdict; returns the accepted candidate's index, or -1.
+int DecideRound(const RobotModelInterface& model, const std::vector<TrackRun>& all, bool base_lof,
+                const DiagnoseOptions& options, int threads, DiagnoseRound* round) {
+  std::vector<int> order;
+  for (int i = 0; i < static_cast<int>(round->candidates.size()); ++i) {
+    CandidateResult& c = round->candidates[i];
+    if (!c.fitted) continue;
+    c.significant = c.p_value < round->threshold;
+    c.improves = c.mean_improvement > 0.0;
+    c.bic_falls = c.delta_bic < 0.0;
+    if (c.significant && c.improves && c.bic_falls) order.push_back(i);
+  }
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    return round->candidates[a].mean_improvement > round->candidates[b].mean_improvement;
+  });
+  int best = -1;
+  for (int i : order) {
+    CandidateResult& c = round->candidates[i];
+    c.explains = true;
+    if (base_lof) {
+      const ResidualAnalysis with =
+          AnalyzeResiduals(model, c.fit.parameters, c.fit.effects, all, threads);
+      c.lof_f = with.lack_of_fit.f;
+      c.explained_fraction = ExplainedFraction(round->base_lof_f, c.lof_f);
+      c.explains = c.explained_fraction >= options.min_explained_fraction;
+    }
+    if (c.explains) {
+      best = i;
+      break;
+    }
+  }
+  if (best >= 0) round->candidates[best].accepted = true;
+  const std::string accepted_name = best >= 0 ? effects::Info(round->candidates[best].id).name : "";
+  for (CandidateResult& c : round->candidates) {
+    if (c.fitted) {
+      c.verdict =
+          CandidateVerdict(c, round->threshold, options.min_explained_fraction, accepted_name);
+    }
+  }
+  return best;
+}
+
+// The residual against the sensors' noise floor (sensor_noise_floor.h). The floor models the
+// ground truth's white noise and the odometry's random walk; when the repetitions of a trajectory
+// scatter above it, the runs carry noise the floor lacks (random slip that changes from run to
+// run), and a residual above the floor by that same ratio is that noise, which the lack-of-fit
+// and covariate tests (their noise is the repetitions' scatter) judge; the simulated backlash and
+// acceleration slip, fitted within two sigmas, were "partial" for a residual 1.15 times the floor
+// whose repetitions scattered 1.15 times it. So the residual must then also exceed the measured
+// scatter: F = ratio / repetition_ratio, compared with F(df, repetition_df) at lof_alpha. Without
+// repetitions, or when they scatter within the floor, the floor's own chi-square test decides, as
+// before.
+void JudgeAgainstSensorFloor(const SensorFloorTest& floor, double lof_alpha, DiagnoseResult* out) {
+  out->above_sensor_floor = floor.available && floor.p_value < lof_alpha;
+  out->floor_below_repetitions = floor.available && floor.has_repetition_check &&
+                                 floor.repetition_ratio > 1.0 && floor.repetition_df > 0.0;
+  out->floor_shows_structure = out->above_sensor_floor;
+  if (!out->floor_below_repetitions) return;
+  out->floor_vs_repetitions_f = floor.ratio / floor.repetition_ratio;
+  out->floor_vs_repetitions_p =
+      stats::FUpperTail(out->floor_vs_repetitions_f, floor.df, floor.repetition_df);
+  out->floor_shows_structure = out->above_sensor_floor && out->floor_vs_repetitions_p < lof_alpha;
+  out->floor_excess_is_run_to_run_noise = out->above_sensor_floor && !out->floor_shows_structure;
 }
 
 }  // namespace
@@ -109,6 +174,30 @@ bool DiagnoseOptions::IsValid(std::string* error) const {
     return false;
   }
   return true;
+}
+
+std::string CandidateVerdict(const CandidateResult& c, double threshold,
+                             double min_explained_fraction, const std::string& accepted_name) {
+  if (!c.significant) return Fmt("not significant (p %.2g >= %.2g)", c.p_value, threshold);
+  const std::string test = Fmt("significant (p %.2g < %.2g)", c.p_value, threshold);
+  const bool evaluated = !std::isnan(c.explained_fraction);
+  // Rounded down, so that a fraction just below the rule never reads as the rule itself.
+  const double percent = std::floor(100.0 * c.explained_fraction);
+  const std::string rule =
+      Fmt(" of the lack of fit (rule: >= %.0f %%)", 100.0 * min_explained_fraction);
+  if (c.accepted) {
+    return "ACCEPTED: " + test + (evaluated ? Fmt(", explains %.0f %%", percent) + rule : "");
+  }
+  if (!c.improves) {
+    return test + Fmt(" but the mean held-out error does not fall (mean d %.3g; rule: mean d > 0)",
+                      c.mean_improvement);
+  }
+  if (!c.bic_falls) {
+    return test + Fmt(" but BIC on the training runs rises by %.1f (rule: dBIC < 0)", c.delta_bic);
+  }
+  if (evaluated && !c.explains) return test + Fmt(" but explains only %.0f %%", percent) + rule;
+  return test + " but " + accepted_name +
+         " lowers the held-out error more (rule: the largest mean d is accepted)";
 }
 
 DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
@@ -226,40 +315,8 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
                     base_bic;
       round.candidates.push_back(c);
     }
-    // Decide with the Bonferroni threshold, then check the explanation of the best ones.
-    const double threshold = options.alpha / std::max(1, num_tried);
-    int best = -1;
-    std::vector<int> order;
-    for (int i = 0; i < static_cast<int>(round.candidates.size()); ++i) {
-      CandidateResult& c = round.candidates[i];
-      if (!c.fitted) continue;
-      c.significant = c.p_value < threshold && c.delta_bic < 0.0 && c.mean_improvement > 0.0;
-      c.verdict = c.significant ? "significant"
-                                : Fmt("not significant (p %.2g vs %.2g)", c.p_value, threshold);
-      if (c.significant) order.push_back(i);
-    }
-    std::sort(order.begin(), order.end(), [&](int a, int b) {
-      return round.candidates[a].mean_improvement > round.candidates[b].mean_improvement;
-    });
-    for (int i : order) {
-      CandidateResult& c = round.candidates[i];
-      if (base_lof) {
-        const ResidualAnalysis with =
-            AnalyzeResiduals(model, c.fit.parameters, c.fit.effects, all, threads);
-        c.lof_f = with.lack_of_fit.f;
-        const double excess_before = round.base_lof_f - 1.0;
-        const double excess_after = std::max(0.0, c.lof_f - 1.0);
-        c.explains = excess_after <= (1.0 - options.min_explained_fraction) * excess_before;
-      } else {
-        c.explains = true;
-      }
-      if (!c.explains) {
-        c.verdict = ExplainedText(round.base_lof_f, c.lof_f);
-        continue;
-      }
-      best = i;
-      break;
-    }
+    round.threshold = options.alpha / std::max(1, num_tried);
+    const int best = DecideRound(model, all, base_lof, options, threads, &round);
     for (const CandidateResult& c : round.candidates) {
       if (!c.resolvable) {
         const auto& info = effects::Info(c.id);
@@ -275,8 +332,6 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
       out.rounds.push_back(std::move(round));
       break;
     }
-    round.candidates[best].accepted = true;
-    round.candidates[best].verdict = "ACCEPTED";
     current = round.candidates[best].fit;
     out.rounds.push_back(std::move(round));
   }
@@ -293,10 +348,9 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
   out.covariates = AnalyzeCovariates(out.after, options.covariate_alpha);
   out.lack_of_fit =
       out.after.lack_of_fit.available && out.after.lack_of_fit.p_value < options.lof_alpha;
-  out.above_sensor_floor =
-      out.after.sensor_floor.available && out.after.sensor_floor.p_value < options.lof_alpha;
+  JudgeAgainstSensorFloor(out.after.sensor_floor, options.lof_alpha, &out);
   out.unexplained_structure =
-      out.lack_of_fit || out.covariates.any_significant || out.above_sensor_floor;
+      out.lack_of_fit || out.covariates.any_significant || out.floor_shows_structure;
   out.effects_named = !out.unexplained_structure && !current.effects.empty();
   for (const CovariateTest& t : out.covariates.tests) {
     if (t.significant) {
@@ -304,7 +358,7 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
                                 " within repetitions of one trajectory, to model what drifts");
     }
   }
-  if (out.above_sensor_floor && !out.lack_of_fit) {
+  if (out.floor_shows_structure && !out.lack_of_fit) {
     out.record_next.push_back(
         "the runs differ from the model by more than the sensors' noise, but no repeatable "
         "pattern is established: record repetitions of each motion, at other times, headings "
@@ -381,7 +435,17 @@ std::string FormatDiagnoseReport(const DiagnoseResult& r, const RobotModelInterf
             "(lack of fit F = %.2f, p = %.2g) that no candidate explains; see the tables above.\n",
             r.after.lack_of_fit.f, r.after.lack_of_fit.p_value);
   }
-  if (r.above_sensor_floor) out += "- " + SensorFloorFinding(r.after.sensor_floor) + "\n";
+  if (r.floor_shows_structure) out += "- " + SensorFloorFinding(r.after.sensor_floor) + "\n";
+  if (r.floor_excess_is_run_to_run_noise) {
+    const SensorFloorTest& f = r.after.sensor_floor;
+    out += Fmt("- the residual is %.2f times the sensors' noise floor (p = %.2g) and the "
+               "repetitions scatter %.2f times it: ",
+               f.ratio, f.p_value, f.repetition_ratio) +
+           Fmt("something changes from run to run beyond the sensors' noise; against that "
+               "scatter the residual is F = %.2f (p = %.2g), so the lack-of-fit and covariate "
+               "tests, which take it as noise, judge the structure\n",
+               r.floor_vs_repetitions_f, r.floor_vs_repetitions_p);
+  }
   if (!r.unexplained_structure) {
     out += (r.after.lack_of_fit.available
                 ? Fmt("- the remaining residual is consistent with the noise floor (lack of fit "
@@ -392,7 +456,10 @@ std::string FormatDiagnoseReport(const DiagnoseResult& r, const RobotModelInterf
                               "repetitions for a lack of fit")) +
            (r.after.sensor_floor.available
                 ? Fmt("; %.2f times the sensors' noise, ", r.after.sensor_floor.ratio) +
-                      Fmt("p = %.2g)\n", r.after.sensor_floor.p_value)
+                      Fmt("p = %.2g", r.after.sensor_floor.p_value) +
+                      (r.floor_excess_is_run_to_run_noise
+                           ? std::string(", as much as the repetitions scatter: see above)\n")
+                           : std::string(")\n"))
                 : std::string(")\n"));
   }
   for (const std::string& line : r.not_identifiable) out += "- " + line + "\n";

@@ -39,6 +39,7 @@
 // scale, which equals a common radius scale) are never fitted; their separable fraction is
 // computed and reported to show that the data agree.
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -79,13 +80,21 @@ struct CandidateResult {
   double p_value = 1.0;
   double delta_bic = 0.0;
   double lof_f = 0.0;  // lack of fit with the candidate (all runs)
-  bool significant = false;
+  // The rules, in the order they are applied (see the procedure above); the verdict names the
+  // one that decided.
+  bool significant = false;  // the held-out paired test: p_value < DiagnoseRound::threshold
+  bool improves = false;     // mean_improvement > 0
+  bool bic_falls = false;    // delta_bic < 0
+  // Fraction of the base's lack-of-fit excess F - 1 the candidate removes, in [0, 1]; NaN when
+  // not evaluated (no significant lack of fit, or the candidate failed an earlier rule).
+  double explained_fraction = std::numeric_limits<double>::quiet_NaN();
   bool explains = false;
   bool accepted = false;
   std::string verdict;
 };
 
 struct DiagnoseRound {
+  double threshold = 0.0;  // of the held-out test: alpha / (candidates fitted), Bonferroni
   double base_validation_objective = 0.0;
   bool base_lof_available = false;  // some trajectory has repetitions
   double base_lof_f = 0.0;
@@ -107,8 +116,19 @@ struct DiagnoseResult {
   // `after` significantly above the sensors' own noise (sensor_noise_floor.h, p < lof_alpha):
   // seen without repetitions, and when what differs between repetitions hides in their scatter.
   bool above_sensor_floor = false;
-  // Significant lack of fit, residual above the sensor floor, or a covariate the residual
-  // significantly depends on.
+  // The floor's excess counts as structure (floor_shows_structure) unless the repetitions
+  // themselves scatter above the floor (ratio > 1: noise the floor's model lacks, e.g. random slip
+  // that changes from run to run) and the residual does not exceed that measured scatter:
+  // F = residual ratio / repetition ratio on (df, repetition df), p < lof_alpha.
+  bool floor_below_repetitions = false;  // the repetitions scatter above the floor (ratio > 1)
+  double floor_vs_repetitions_f = 0.0;
+  double floor_vs_repetitions_p = 1.0;
+  bool floor_shows_structure = false;
+  // Above the floor by its own test, but not above the repetitions' scatter: reported, and left
+  // to the lack-of-fit and covariate tests, which take that scatter as noise.
+  bool floor_excess_is_run_to_run_noise = false;
+  // Significant lack of fit, floor_shows_structure, or a covariate the residual significantly
+  // depends on.
   bool unexplained_structure = false;
   // The accepted effects are named as causes only when nothing structured remains; otherwise
   // they are a partial description (they may stand in for an effect outside the library).
@@ -126,6 +146,13 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
 DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
                         const std::vector<TrackRun>& validation, const Omni3Robot& robot,
                         const DiagnoseOptions& options = {});
+
+// A fitted candidate's verdict: the held-out test as it came out - "significant (p < threshold)"
+// or "not significant (p >= threshold)", never the one for the other - then the rule that decided,
+// stated ("but explains only 31 % of the lack of fit (rule: >= 50 %)"). accepted_name: the
+// candidate accepted in its round (empty when none). Diagnose sets CandidateResult::verdict so.
+std::string CandidateVerdict(const CandidateResult& c, double threshold,
+                             double min_explained_fraction, const std::string& accepted_name);
 
 // The report (Markdown): pattern, effect chosen with value and uncertainty, parameters before
 // and after, held-out error before and after, candidate table, what to record next.

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "diagnosis/diagnose.h"
 #include "diagnosis/effect_fit.h"
 #include "diagnosis/statistics.h"
 #include "io/input_error.h"
@@ -270,6 +271,53 @@ TEST(RobotYamlEffects, RoundTripAndBadInput) {
   expect_bad("  - {name: backlash, backlash_rad: 0.1, colour: red}\n", "colour");
   expect_bad("  - {name: floor_slope, creep_x_m_s: 0.01}\n", "creep_y_m_s");
   std::filesystem::remove(path);
+}
+
+// The verdict diagnose prints for a fitted candidate (CandidateVerdict) reports the held-out test
+// as it came out: a p below its threshold is "significant" whatever rule then decides, and the
+// deciding rule is named. The case of the acceleration slip that was printed "not significant
+// (p 2.8e-09 vs 0.0011)", and every other way a significant candidate can be turned down.
+TEST(DiagnoseVerdict, SaysTheTestItReportsAndTheRuleThatDecided) {
+  constexpr double kThreshold = 0.0011, kRule = 0.5;
+  CandidateResult c;
+  c.p_value = 2.8e-9;
+  c.significant = true;
+  c.improves = true;
+  c.bic_falls = true;
+  c.mean_improvement = 4e-5;
+  c.delta_bic = -12.0;
+  c.explained_fraction = 0.31;
+  c.explains = false;
+  const auto verdict = [&] { return CandidateVerdict(c, kThreshold, kRule, "wheel_speed_slip"); };
+  EXPECT_EQ(verdict(),
+            "significant (p 2.8e-09 < 0.0011) but explains only 31 % of the lack of fit "
+            "(rule: >= 50 %)");
+  // Just below the rule reads below it (rounded down), not as the rule itself.
+  c.explained_fraction = 0.4996;
+  EXPECT_NE(verdict().find("explains only 49 %"), std::string::npos) << verdict();
+  c.explained_fraction = 0.8;
+  c.explains = true;
+  EXPECT_EQ(verdict(),
+            "significant (p 2.8e-09 < 0.0011) but wheel_speed_slip lowers the held-out error "
+            "more (rule: the largest mean d is accepted)");
+  c.accepted = true;
+  EXPECT_EQ(verdict(),
+            "ACCEPTED: significant (p 2.8e-09 < 0.0011), explains 80 % of the lack of fit "
+            "(rule: >= 50 %)");
+  c.accepted = false;
+  c.bic_falls = false;
+  c.delta_bic = 4.0;
+  EXPECT_EQ(verdict(),
+            "significant (p 2.8e-09 < 0.0011) but BIC on the training runs rises by 4.0 "
+            "(rule: dBIC < 0)");
+  c.improves = false;
+  c.mean_improvement = -2e-7;
+  EXPECT_EQ(verdict(),
+            "significant (p 2.8e-09 < 0.0011) but the mean held-out error does not fall "
+            "(mean d -2e-07; rule: mean d > 0)");
+  c.significant = false;
+  c.p_value = 0.22;
+  EXPECT_EQ(verdict(), "not significant (p 0.22 >= 0.0011)");
 }
 
 }  // namespace
