@@ -65,7 +65,7 @@ std::string FinalErrorsSvg(const DiagnosePageData& d) {
 std::string EvidenceSvg(const DiagnosePageData& d) {
   std::vector<std::string> names;
   BarSeries p{"-log10 p (paired t test on held-out runs)", kAfterColour, {}};
-  BarSeries t{"-log10 threshold (alpha / candidates)", "#999999", {}};
+  BarSeries t{"-log10 threshold (alpha / candidates fitted)", "#999999", {}};
   for (const DiagnoseCandidate& c : d.candidates) {
     if (!c.fitted) continue;
     names.push_back("r" + std::to_string(c.round) + " " + c.effect);

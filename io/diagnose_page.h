@@ -30,7 +30,7 @@ struct DiagnoseCandidate {
   bool fitted = false;
   double mean_improvement = 0.0;  // mean over held-out runs of the objective's fall
   double p_value = 1.0;           // one-sided paired t test
-  double threshold = 0.0;         // alpha / candidates (Bonferroni)
+  double threshold = 0.0;         // alpha / candidates fitted in the round (Bonferroni)
   double delta_bic = 0.0;
   bool explains = false;
   bool accepted = false;

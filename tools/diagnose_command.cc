@@ -312,8 +312,9 @@ void AddStructureTests(const DiagnoseResult& r, io::DiagnosePageData* page) {
   if (floor.available) {
     page->structure.push_back({"residual against the sensors' noise, final model",
                                Format("%.2f x the floor", floor.ratio), floor.p_value,
-                               r.above_sensor_floor,
-                               "the residual is larger than the sensors' own noise explains"});
+                               r.floor_shows_structure,
+                               "the residual is larger than the sensors' own noise and the "
+                               "repetitions' own scatter explain"});
   }
   for (const CovariateTest& t : r.covariates.tests) {
     if (!t.tested) continue;
@@ -322,9 +323,9 @@ void AddStructureTests(const DiagnoseResult& r, io::DiagnosePageData* page) {
   }
 }
 
-void AddCandidates(const DiagnoseResult& r, double alpha, io::DiagnosePageData* page) {
+void AddCandidates(const DiagnoseResult& r, io::DiagnosePageData* page) {
   for (std::size_t k = 0; k < r.rounds.size(); ++k) {
-    const double threshold = alpha / std::max<double>(1.0, r.rounds[k].candidates.size());
+    const double threshold = r.rounds[k].threshold;  // alpha / (candidates fitted)
     for (const CandidateResult& c : r.rounds[k].candidates) {
       page->candidates.push_back({static_cast<int>(k) + 1, effects::Info(c.id).name,
                                   c.separable_fraction, c.resolvable, c.fitted,
@@ -370,7 +371,7 @@ io::DiagnosePageData MakePage(const DiagnoseCommandOptions& options,
   page.csv_written = options.csv;
   SetConclusion(result, &page);
   AddStructureTests(result, &page);
-  AddCandidates(result, options.alpha, &page);
+  AddCandidates(result, &page);
   for (const DiagnoseChoice& c : gate)
     page.gate.push_back({c.name, c.cf_after, c.name == choice.name});
   AddHeldOut(model, split, choice, &page);
