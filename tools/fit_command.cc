@@ -143,10 +143,11 @@ int RunFitCommand(const FitCommandOptions& options) {
       if (!refusal.empty()) return Refuse(refusal);
     }
     // Every model on the seam except omni3, whose fit (with its NLopt methods and fast kernel)
-    // still has its own path below - which fits Eq. 4 alone: omni3 with effects takes the seam's.
+    // still has its own path below - which fits Eq. 4 to final poses alone: omni3 with effects
+    // or with track residuals takes the seam's.
     const RobotModelPtr model = ReadRobotModelFile(index.robot_path);
     if (model->robot().model != "omni3" || !options.effects.empty() ||
-        !model->robot().effects.empty()) {
+        !model->robot().effects.empty() || settings.residuals != ResidualKind::kFinalPose) {
       return RunModelFitCommand(options, index, model);
     }
     const io::Dataset dataset = LoadRuns(options, index, /*robot=*/nullptr);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <tuple>
 
 #include "fit/final_pose_cost.h"
@@ -89,17 +90,36 @@ FitMethodOutcome RunNlopt(NloptMethod method, const std::vector<AlignedRun>& tra
   return out;
 }
 
+// What the residuals compare, in words, before the final poses' objective ("" for final poses
+// alone, whose text is unchanged).
+std::string ResidualsText(const FitMethodSettings& settings) {
+  if (settings.residuals == ResidualKind::kFinalPose || settings.track == nullptr) return "";
+  const TrackResidualOptions& t = settings.track->options;
+  char text[300];
+  std::snprintf(text, sizeof text,
+                "track residuals (pose from the run's start every %.2g m of ground-truth path and "
+                "at the end, Huber %.2g, runs weighed alike; clock offset per %s)%s",
+                t.checkpoint_spacing_m, t.huber_scale, ToString(settings.clock_grouping),
+                settings.residuals == ResidualKind::kBoth ? " and final poses: " : "");
+  return text;
+}
+
 ModelFitMethodOutcome RunModelCeres(CeresTrustRegion trust_region,
                                     const std::vector<AlignedRun>& training,
                                     const RobotModelInterface& model,
                                     const FitMethodSettings& settings) {
   ModelFitOptions options;
   options.ceres = CeresOptionsFor(trust_region, settings);
+  options.residuals = settings.residuals;
+  options.track = settings.track;
   ModelFitMethodOutcome out;
   out.fit = FitModel(training, model, options);
   out.evaluations = out.fit.num_residual_evaluations + out.fit.num_jacobian_evaluations;
-  out.objective =
-      ObjectiveText(options.ceres.objective, options.ceres.loss, options.ceres.loss_scale);
+  out.objective = ResidualsText(settings);
+  if (options.residuals != ResidualKind::kTrack) {
+    out.objective +=
+        ObjectiveText(options.ceres.objective, options.ceres.loss, options.ceres.loss_scale);
+  }
   // Ceres reports no per-evaluation CF: the trace holds the start and the end.
   out.trace.push_back(
       {1, EvaluateFinalPoseErrors(model, model.robot().nominal, training, settings.threads).cf,
@@ -194,6 +214,14 @@ bool MakeFitMethodSettings(const SolverOptions& o, int threads, FitMethodSetting
   s->objective_set = !o.objective.empty();
   if (s->objective_set && !ParseFinalPoseObjective(o.objective, &s->objective)) {
     *error = "unknown --objective '" + o.objective + "' (available: squares, eq14)";
+    return false;
+  }
+  if (!ParseResidualKind(o.residuals, &s->residuals)) {
+    *error = "unknown --residuals '" + o.residuals + "' (available: final-pose, track, both)";
+    return false;
+  }
+  if (!ParseClockGrouping(o.clock_offsets, &s->clock_grouping)) {
+    *error = "unknown --clock-offsets '" + o.clock_offsets + "' (available: session, run, dataset, none)";
     return false;
   }
   if (!ParseCeresRobustLoss(o.loss, &s->loss)) {

@@ -27,6 +27,11 @@ struct FitMethodSettings {
   // Ceres: kSumOfSquares by default; NLopt: Eq. 14 by default (see the option docs).
   bool objective_set = false;
   FinalPoseObjective objective = FinalPoseObjective::kSumOfSquares;
+  // Ceres only: what the residuals compare; kTrack and kBoth need `track` (the training runs'
+  // tracks, set by the command that has the ground truth).
+  ResidualKind residuals = ResidualKind::kFinalPose;
+  ClockGrouping clock_grouping = ClockGrouping::kPerSession;
+  const TrackFitData* track = nullptr;
   CeresRobustLoss loss = CeresRobustLoss::kNone;  // Ceres only
   double loss_scale = 0.05;
   std::uint64_t seed = 1;                              // NLopt only

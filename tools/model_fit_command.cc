@@ -25,6 +25,7 @@
 #include "tools/output_guard.h"
 #include "validation/run_split.h"
 #include "validation/training_runs.h"
+#include "validation/everyday_driving.h"
 #include "validation/trajectory_metrics.h"
 
 namespace fitcal::tools {
@@ -462,6 +463,75 @@ void WarnOfEffects(const std::vector<CalibrationCandidate>& candidates, const Ga
                "robot YAML)\n";
 }
 
+// The training runs' tracks for --residuals track/both (settings->track points into *data); false
+// after one line on stderr when the method cannot fit them.
+bool PrepareTrackResiduals(const FitCommandOptions& options, const std::vector<RunLog>& logs,
+                           const RunSplit& split, FitMethodSettings* settings,
+                           std::optional<TrackFitData>* data) {
+  if (settings->residuals == ResidualKind::kFinalPose) return true;
+  if (options.method != "ceres" && options.method != "ceres-dogleg") {
+    std::cerr << "fitcal: --residuals " << ToString(settings->residuals)
+              << " needs a Ceres method (--method ceres or ceres-dogleg); " << options.method
+              << " fits final poses only\n";
+    return false;
+  }
+  std::unordered_map<std::string, const GroundTruthTrack*> track_of;
+  for (const RunLog& log : logs) track_of[log.id] = &log.ground_truth;
+  std::vector<const GroundTruthTrack*> tracks;
+  for (const AlignedRun& run : split.training) tracks.push_back(track_of.at(run.id));
+  data->emplace(MakeTrackFitData(split.training, tracks, settings->clock_grouping));
+  settings->track = &**data;
+  return true;
+}
+
+// The clock offsets the track fit estimated, with their sigmas: every group up to a dozen, their
+// range beyond.
+void PrintClockOffsets(const ModelFitResult& fit, const TrackFitData& track) {
+  if (!track.estimate_clock_offsets || track.clock_groups.empty()) return;
+  const std::size_t n = track.clock_groups.size();
+  const auto sigma = [&](std::size_t g) {
+    return g < fit.clock_offset_sigma_s.size() ? fit.clock_offset_sigma_s[g] : 0.0;
+  };
+  std::printf("clock offsets (ground truth at encoder time + dt, |dt| <= %.2g s), %zu %s:\n",
+              track.options.max_clock_offset_s, n, n == 1 ? "group" : "groups");
+  constexpr std::size_t kMaxListed = 12;
+  if (n <= kMaxListed) {
+    for (std::size_t g = 0; g < n; ++g) {
+      std::printf("  %-36s %+8.3f s +- %.3f\n", track.clock_groups[g].c_str(),
+                  fit.clock_offsets_s[g], sigma(g));
+    }
+    return;
+  }
+  std::vector<double> sorted(fit.clock_offsets_s.begin(), fit.clock_offsets_s.begin() + n);
+  std::sort(sorted.begin(), sorted.end());
+  double mean_sigma = 0.0;
+  for (std::size_t g = 0; g < n; ++g) mean_sigma += sigma(g) / n;
+  std::printf("  median %+.3f s, range [%+.3f, %+.3f] s, mean sigma %.3f s\n", sorted[n / 2],
+              sorted.front(), sorted.back(), mean_sigma);
+}
+
+// Drift per 1, 2, 5 m and ATE RMSE (validation/everyday_driving.h) of the nominal and the
+// selected calibration on the held-out runs (the training runs when none is held out).
+void PrintEverydayDriving(const RobotModelInterface& model, const std::vector<RunLog>& logs,
+                          const RunSplit& split, const CalibrationCandidate& nominal,
+                          const CalibrationCandidate& selected, int threads) {
+  const bool held_out = !split.validation.empty();
+  const std::vector<AlignedRun>& runs = held_out ? split.validation : split.training;
+  std::unordered_map<std::string, const GroundTruthTrack*> track_of;
+  for (const RunLog& log : logs) track_of[log.id] = &log.ground_truth;
+  std::vector<const GroundTruthTrack*> tracks;
+  for (const AlignedRun& run : runs) tracks.push_back(track_of.at(run.id));
+  const std::vector<double> lengths = EverydayDriftLengths();
+  const EverydayDrivingMetrics before = EvaluateEverydayDriving(
+      model, nominal.parameters, nominal.effects, runs, tracks, lengths, threads);
+  const EverydayDrivingMetrics after = EvaluateEverydayDriving(
+      model, selected.parameters, selected.effects, runs, tracks, lengths, threads);
+  std::printf("\n  %-30s %10s %10s %9s\n",
+              held_out ? "everyday driving, validation" : "everyday driving, training", "nominal",
+              "calibrated", "change");
+  for (const std::string& row : EverydayDrivingRows(before, after)) std::printf("%s\n", row.c_str());
+}
+
 }  // namespace
 
 int StoppedEarlyExit(bool selected_fit_stopped_early, const std::string& termination) {
@@ -517,6 +587,8 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
     training_tracks = TrainingTracks(options, robot, dataset.runs, split);
     if (!training_tracks) return 2;
   }
+  std::optional<TrackFitData> track_data;
+  if (!PrepareTrackResiduals(options, dataset.runs, split, &settings, &track_data)) return 2;
   const ModelFitMethodOutcome outcome = method->run_model(split.training, *model, settings);
   const ModelFitResult& fit = outcome.fit;
   std::vector<CalibrationCandidate> candidates = Candidates(*model, split, fit, options.method);
@@ -543,6 +615,8 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
 
   PrintFit(options, *model, split, candidates, gate, selected_fit, errors, *method, outcome,
            track_fits);
+  if (track_data) PrintClockOffsets(fit, *track_data);
+  PrintEverydayDriving(*model, dataset.runs, split, candidates[0], selected, options.threads);
   if (!fit.has_covariance) std::printf("uncertainty: %s\n", fit.covariance_message.c_str());
   for (const UndeterminedDirection& d : fit.held_directions) PrintHeldAtNominal(d.description);
   if (!PrintGate(candidates, gate, effects_line)) return 5;

@@ -14,6 +14,9 @@ namespace fitcal::tools {
 
 struct SolverOptions {
   std::string objective;        // "" = the method's default; "squares" or "eq14"
+  // What the residuals compare (fit/model_fit.h ResidualKind): final-pose, track, both.
+  std::string residuals = "final-pose";
+  std::string clock_offsets = "session";  // track residuals: one per session, run, or none
   std::string loss = "none";    // Ceres: none, huber, cauchy
   double loss_scale = 0.05;     // Ceres robust loss scale, residual units
   unsigned long seed = 1;       // NLopt
