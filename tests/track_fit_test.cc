@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "fit/model_fit.h"
+#include "fit/residual_choice.h"
 #include "fit/track_residual.h"
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
@@ -173,6 +174,47 @@ TEST(TrackFit, RecoversCommonScaleAndClockOffsetThatFinalPosesCannotSee) {
   const ModelFitResult both = FitModel(s.aligned, *model, FitOptions(ResidualKind::kBoth, &data));
   ASSERT_TRUE(both.usable);
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(both.parameters[k] / truth[k], 1.0, 0.002);
+}
+
+// --residuals auto: the simulated loops (10 Hz ground truth at 0.2 m/s: a sample every 2 cm, 4 m
+// and more of path per run) are a dense track; the same runs with only every 30th ground-truth
+// sample kept (one every 0.6 m) are not, and neither are runs cut to their first 1.5 m of path.
+TEST(ResidualChoice, DenseLongTracksCallForTrackResiduals) {
+  const RobotModelPtr model = Model();
+  Simulated s = SimulateLoops(*model, 1);
+  const TrackDensity dense = MeasureTrackDensity(s.aligned, s.tracks);
+  EXPECT_TRUE(dense.dense) << dense.median_sample_spacing_m << " m, " << dense.median_path_m;
+  EXPECT_LT(dense.median_sample_spacing_m, 0.03);
+
+  std::vector<GroundTruthTrack> sparse;
+  for (const GroundTruthTrack* track : s.tracks) {
+    GroundTruthTrack thin;
+    for (std::size_t k = 0; k < track->t_s.size(); k += 30) {
+      thin.t_s.push_back(track->t_s[k]);
+      thin.world_T_robot.push_back(track->world_T_robot[k]);
+    }
+    sparse.push_back(thin);
+  }
+  std::vector<const GroundTruthTrack*> sparse_tracks;
+  for (const GroundTruthTrack& t : sparse) sparse_tracks.push_back(&t);
+  EXPECT_FALSE(MeasureTrackDensity(s.aligned, sparse_tracks).dense);
+
+  std::vector<AlignedRun> short_runs = s.aligned;
+  for (std::size_t i = 0; i < short_runs.size(); ++i) {
+    // End each run's window when 1.5 m of ground-truth path lie behind it.
+    const GroundTruthTrack& t = *s.tracks[i];
+    double path_m = 0.0;
+    for (std::size_t k = 1; k < t.t_s.size(); ++k) {
+      if (t.t_s[k - 1] < short_runs[i].t_start_s) continue;
+      path_m += std::hypot(t.world_T_robot[k].x - t.world_T_robot[k - 1].x,
+                           t.world_T_robot[k].y - t.world_T_robot[k - 1].y);
+      if (path_m > 1.5) {
+        short_runs[i].t_final_s = t.t_s[k];
+        break;
+      }
+    }
+  }
+  EXPECT_FALSE(MeasureTrackDensity(short_runs, s.tracks).dense);
 }
 
 // A straight run of 6 m replayed with a wheel radius 1 % small: every window is 1 % short, so the

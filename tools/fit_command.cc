@@ -115,6 +115,25 @@ void AddFitOptions(CLI::App& app, FitCommandOptions& o) {
       ->delimiter(',');
 }
 
+namespace {
+
+// --residuals auto on omni3's own path: whether the training runs call for track residuals (then
+// the seam's fit takes over; it resolves auto the same way).
+bool ResolvesToTrack(const FitCommandOptions& options, const io::Dataset& dataset,
+                     FitMethodSettings* settings) {
+  const RunSplit split =
+      SplitForFit(AlignRuns(dataset.runs), options.train_reps, options.train_trajectories);
+  std::unordered_map<std::string, const GroundTruthTrack*> track_of;
+  for (const RunLog& log : dataset.runs) track_of[log.id] = &log.ground_truth;
+  std::vector<const GroundTruthTrack*> tracks;
+  for (const AlignedRun& run : split.training) tracks.push_back(track_of.at(run.id));
+  FitMethodSettings resolved = *settings;
+  ResolveAutoResiduals(split.training, tracks, options.method, &resolved);
+  return resolved.residuals != ResidualKind::kFinalPose;
+}
+
+}  // namespace
+
 int RunFitCommand(const FitCommandOptions& options) {
   if (options.logs.empty()) {
     std::cerr << "fitcal: --logs <data set directory> is required (see fitcal --help)\n";
@@ -147,10 +166,14 @@ int RunFitCommand(const FitCommandOptions& options) {
     // or with track residuals takes the seam's.
     const RobotModelPtr model = ReadRobotModelFile(index.robot_path);
     if (model->robot().model != "omni3" || !options.effects.empty() ||
-        !model->robot().effects.empty() || settings.residuals != ResidualKind::kFinalPose) {
+        !model->robot().effects.empty() ||
+        (!settings.residuals_auto && settings.residuals != ResidualKind::kFinalPose)) {
       return RunModelFitCommand(options, index, model);
     }
     const io::Dataset dataset = LoadRuns(options, index, /*robot=*/nullptr);
+    if (settings.residuals_auto && ResolvesToTrack(options, dataset, &settings)) {
+      return RunModelFitCommand(options, index, model);
+    }
     io::StopHereForTests("loaded");
     const Omni3Robot robot = io::ReadOmni3Robot(dataset.robot_path);
     if (!options.no_output && !options.force) {

@@ -8,6 +8,7 @@
 #include "fit/final_pose_cost.h"
 #include "fit/final_pose_errors.h"
 #include "fit/model_nlopt_fit.h"
+#include "fit/residual_choice.h"
 
 namespace fitcal::tools {
 
@@ -206,6 +207,16 @@ std::string FitMethodNames() {
   return out;
 }
 
+void ResolveAutoResiduals(const std::vector<AlignedRun>& training,
+                          const std::vector<const GroundTruthTrack*>& tracks,
+                          const std::string& method, FitMethodSettings* settings) {
+  if (!settings->residuals_auto) return;
+  const bool ceres = method == "ceres" || method == "ceres-dogleg";
+  settings->residuals = ceres && MeasureTrackDensity(training, tracks).dense
+                            ? ResidualKind::kTrack
+                            : ResidualKind::kFinalPose;
+}
+
 bool MakeFitMethodSettings(const SolverOptions& o, int threads, FitMethodSettings* s,
                            std::string* error) {
   s->threads = threads;
@@ -216,8 +227,10 @@ bool MakeFitMethodSettings(const SolverOptions& o, int threads, FitMethodSetting
     *error = "unknown --objective '" + o.objective + "' (available: squares, eq14)";
     return false;
   }
-  if (!ParseResidualKind(o.residuals, &s->residuals)) {
-    *error = "unknown --residuals '" + o.residuals + "' (available: final-pose, track, both)";
+  s->residuals_auto = o.residuals == "auto";
+  if (!s->residuals_auto && !ParseResidualKind(o.residuals, &s->residuals)) {
+    *error =
+        "unknown --residuals '" + o.residuals + "' (available: auto, final-pose, track, both)";
     return false;
   }
   if (!ParseClockGrouping(o.clock_offsets, &s->clock_grouping)) {

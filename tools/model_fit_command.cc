@@ -463,11 +463,16 @@ void WarnOfEffects(const std::vector<CalibrationCandidate>& candidates, const Ga
                "robot YAML)\n";
 }
 
-// The training runs' tracks for --residuals track/both (settings->track points into *data); false
-// after one line on stderr when the method cannot fit them.
+// The training runs' tracks for --residuals track/both, and auto resolved (settings->track points
+// into *data); false after one line on stderr when the method cannot fit them.
 bool PrepareTrackResiduals(const FitCommandOptions& options, const std::vector<RunLog>& logs,
                            const RunSplit& split, FitMethodSettings* settings,
                            std::optional<TrackFitData>* data) {
+  std::unordered_map<std::string, const GroundTruthTrack*> track_of;
+  for (const RunLog& log : logs) track_of[log.id] = &log.ground_truth;
+  std::vector<const GroundTruthTrack*> tracks;
+  for (const AlignedRun& run : split.training) tracks.push_back(track_of.at(run.id));
+  ResolveAutoResiduals(split.training, tracks, options.method, settings);
   if (settings->residuals == ResidualKind::kFinalPose) return true;
   if (options.method != "ceres" && options.method != "ceres-dogleg") {
     std::cerr << "fitcal: --residuals " << ToString(settings->residuals)
@@ -475,10 +480,6 @@ bool PrepareTrackResiduals(const FitCommandOptions& options, const std::vector<R
               << " fits final poses only\n";
     return false;
   }
-  std::unordered_map<std::string, const GroundTruthTrack*> track_of;
-  for (const RunLog& log : logs) track_of[log.id] = &log.ground_truth;
-  std::vector<const GroundTruthTrack*> tracks;
-  for (const AlignedRun& run : split.training) tracks.push_back(track_of.at(run.id));
   data->emplace(MakeTrackFitData(split.training, tracks, settings->clock_grouping));
   settings->track = &**data;
   return true;
@@ -615,6 +616,8 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
 
   PrintFit(options, *model, split, candidates, gate, selected_fit, errors, *method, outcome,
            track_fits);
+  std::printf("residuals: %s%s\n", ToString(settings.residuals),
+              settings.residuals_auto ? " (--residuals auto)" : "");
   if (track_data) PrintClockOffsets(fit, *track_data);
   PrintEverydayDriving(*model, dataset.runs, split, candidates[0], selected, options.threads);
   if (!fit.has_covariance) std::printf("uncertainty: %s\n", fit.covariance_message.c_str());

@@ -18,7 +18,10 @@ void AddSolverOptions(CLI::App& app, SolverOptions& o) {
   app.add_option("--residuals", o.residuals,
                  "What the fit compares with the ground truth: final-pose (each run's end, "
                  "Palacin Eq. 14), track (the pose from the run's start every 0.5 m of "
-                 "ground-truth path and at the end) or both; track and both need a Ceres method")
+                 "ground-truth path and at the end), both, or auto: track where the ground truth "
+                 "samples the path at least every 0.1 m on runs of 2 m or more and the method is "
+                 "Ceres, final-pose otherwise (docs/everyday_driving.md); track and both need a "
+                 "Ceres method")
       ->capture_default_str();
   app.add_option("--clock-offsets", o.clock_offsets,
                  "Track residuals: estimate the ground-truth clock's offset per session (the "
