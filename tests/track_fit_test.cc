@@ -23,6 +23,7 @@
 #include "tools/sim/diff_drive_trajectories.h"
 #include "tools/sim/model_simulator.h"
 #include "validation/everyday_driving.h"
+#include "validation/time_blocks.h"
 
 namespace fitcal {
 namespace {
@@ -251,6 +252,34 @@ TEST(EverydayDriving, DriftOfAStraightRunWithAScaleErrorAndAHeadingRateError) {
   // d theta / d s = (v_R' - v_L') / (b v) = 0.01 / b per metre of ground-truth path.
   const double expected_deg_per_m = RadToDeg(0.01 / nominal[2]);
   EXPECT_NEAR(turn.drift[0].rotation_deg_per_m, expected_deg_per_m, 0.02 * expected_deg_per_m);
+}
+
+// A straight run of 6 m at 0.2 m/s cut into four blocks: contiguous, every sample once, each
+// 1.5 m of path to within one encoder interval (1 cm), each started and ended on the ground truth.
+TEST(TimeBlocks, CutARunIntoBlocksOfEqualPath) {
+  const RobotModelPtr model = Model();
+  const auto sim = sim::SimulateRuns(*model, model->robot().nominal,
+                                     {{"free", 1, {{{0.2, 0.0, 0.0}, 30.0}}}}, {});
+  const std::vector<RunLog> logs = {sim[0].log};
+  const AlignedRun run = AlignRuns(logs)[0];
+  const std::vector<AlignedRun> blocks = CutIntoTimeBlocks(run, logs[0].ground_truth, 4);
+  ASSERT_EQ(blocks.size(), 4u);
+  std::size_t samples = 0;
+  double t = run.t_start_s;
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    const AlignedRun& block = blocks[b];
+    EXPECT_EQ(block.repetition, static_cast<int>(b) + 1);
+    EXPECT_NEAR(block.t_start_s, t, 1e-9);
+    samples += block.samples.size();
+    t = block.t_final_s;
+    const double path_m = std::hypot(block.final_ground_truth.x - block.start.x,
+                                     block.final_ground_truth.y - block.start.y);
+    // The first and last blocks include the ramps and rests; each holds 1.5 m of path.
+    EXPECT_NEAR(path_m, 1.5, 0.011) << block.id;
+  }
+  EXPECT_EQ(samples, run.samples.size());
+  EXPECT_NEAR(t, run.t_final_s, 1e-9);
+  EXPECT_THROW(CutIntoTimeBlocks(run, logs[0].ground_truth, 0), std::invalid_argument);
 }
 
 }  // namespace
