@@ -99,8 +99,11 @@ std::string ResidualsText(const FitMethodSettings& settings) {
   char text[300];
   std::snprintf(text, sizeof text,
                 "track residuals (pose from the run's start every %.2g m of ground-truth path and "
-                "at the end, Huber %.2g, runs weighed alike; clock offset per %s)%s",
-                t.checkpoint_spacing_m, t.huber_scale, ToString(settings.clock_grouping),
+                "at the end, Huber %.2g, runs weighed alike; clock offsets: %s)%s",
+                t.checkpoint_spacing_m, t.huber_scale,
+                settings.clock_grouping == ClockGrouping::kNone
+                    ? "none"
+                    : (std::string("one per ") + ToString(settings.clock_grouping)).c_str(),
                 settings.residuals == ResidualKind::kBoth ? " and final poses: " : "");
   return text;
 }
