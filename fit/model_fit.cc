@@ -17,6 +17,11 @@ namespace fitcal {
 
 namespace {
 
+// Whether the problem has track residuals (and so clock offsets).
+bool UsesTracks(const ModelFitOptions& options) {
+  return options.segments == nullptr && options.residuals != ResidualKind::kFinalPose;
+}
+
 // Rounds of the active set: one per parameter that comes to rest on a bound, and releases.
 constexpr int kMaxActiveSetRounds = 16;
 
@@ -69,21 +74,34 @@ class FitProblem {
  public:
   FitProblem(const std::vector<AlignedRun>& training, const RobotModelInterface& model,
              const ModelFitOptions& fit_options, const std::vector<bool>& fixed, double* p,
-             const HeldDirections& holds = {}) {
+             double* clock_offsets, const HeldDirections& holds = {}) {
     const CeresFitOptions& options = fit_options.ceres;
     ceres::Problem::Options problem_options;
     problem_options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
     problem_ = std::make_unique<ceres::Problem>(problem_options);
+    const bool final_poses = fit_options.residuals != ResidualKind::kTrack;
+    const bool tracks = fit_options.residuals != ResidualKind::kFinalPose;
     for (std::size_t i = 0; i < training.size(); ++i) {
       const AlignedRun& run = training[i];
-      if (fit_options.segments == nullptr) {
-        data_blocks_.push_back(problem_->AddResidualBlock(model.FinalPoseCost(run, options.weights),
-                                                          MakeLoss(options), p));
-      } else if (!(*fit_options.segments)[i].empty()) {
+      if (fit_options.segments != nullptr) {
+        if ((*fit_options.segments)[i].empty()) continue;
         data_blocks_.push_back(problem_->AddResidualBlock(
             model.SegmentCost(run, (*fit_options.segments)[i], options.weights), nullptr, p));
+        continue;
+      }
+      if (final_poses) {
+        data_blocks_.push_back(problem_->AddResidualBlock(model.FinalPoseCost(run, options.weights),
+                                                          MakeLoss(options), p));
+      }
+      if (!tracks) continue;
+      const TrackCheckpoints& track = fit_options.track->runs[i];
+      if (!track.segments.empty()) {
+        data_blocks_.push_back(problem_->AddResidualBlock(
+            TrackResidual::Create(track, model, options.weights, fit_options.track->options),
+            nullptr, p, clock_offsets + track.clock_group));
       }
     }
+    if (tracks && fit_options.segments == nullptr) BoundClockOffsets(fit_options, clock_offsets);
     if (!holds.directions.empty()) {
       problem_->AddResidualBlock(
           new HoldDirectionsCost(holds.directions, model.robot(), holds.weight), nullptr, p);
@@ -102,6 +120,22 @@ class FitProblem {
     for (int k = 0; k < n; ++k) {
       problem_->SetParameterLowerBound(p, k, robot.bounds[k].lo);
       problem_->SetParameterUpperBound(p, k, robot.bounds[k].hi);
+    }
+  }
+
+  // Each clock offset in [-max, max], or held at its value when not estimated.
+  void BoundClockOffsets(const ModelFitOptions& fit_options, double* clock_offsets) {
+    const TrackFitData& track = *fit_options.track;
+    const double bound = track.options.max_clock_offset_s;
+    for (std::size_t g = 0; g < track.clock_groups.size(); ++g) {
+      double* offset = clock_offsets + g;
+      if (!problem_->HasParameterBlock(offset)) continue;
+      if (!track.estimate_clock_offsets || bound == 0.0) {
+        problem_->SetParameterBlockConstant(offset);
+        continue;
+      }
+      problem_->SetParameterLowerBound(offset, 0, -bound);
+      problem_->SetParameterUpperBound(offset, 0, bound);
     }
   }
 
@@ -219,7 +253,8 @@ ceres::Solver::Summary RefineWithActiveSet(const std::vector<AlignedRun>& traini
   FixParametersAtBound(robot, &p, &fixed);
   for (int round = 0; round < kMaxActiveSetRounds; ++round) {
     ++result->active_set_rounds;
-    FitProblem fit(training, model, options, fixed, p.data(), holds);
+    FitProblem fit(training, model, options, fixed, p.data(), result->clock_offsets_s.data(),
+                   holds);
     const bool contact =
         SolveUntilBoundContact(robot, options, fixed, p.data(), &fit.problem(), &summary);
     Accumulate(summary, result);
@@ -229,7 +264,8 @@ ceres::Solver::Summary RefineWithActiveSet(const std::vector<AlignedRun>& traini
     }
     if (summary.termination_type != ceres::CONVERGENCE) break;
     // Release a bound parameter whose descent direction points into the box.
-    FitProblem all_free(training, model, options, result->held, p.data(), holds);
+    FitProblem all_free(training, model, options, result->held, p.data(),
+                        result->clock_offsets_s.data(), holds);
     const std::vector<double> g = all_free.FullGradient();
     bool released = false;
     for (int k = 0; k < n; ++k) {
@@ -245,6 +281,22 @@ ceres::Solver::Summary RefineWithActiveSet(const std::vector<AlignedRun>& traini
   return summary;
 }
 
+// The residuals the runs contribute (not the holds): 3 per final pose, 3 per checkpoint or window.
+int NumDataResiduals(const std::vector<AlignedRun>& training, const ModelFitOptions& options) {
+  int num_residuals = 0;
+  if (options.segments != nullptr) {
+    for (const auto& windows : *options.segments)
+      num_residuals += 3 * static_cast<int>(windows.size());
+    return num_residuals;
+  }
+  if (options.residuals != ResidualKind::kTrack) num_residuals += 3 * static_cast<int>(training.size());
+  if (UsesTracks(options)) {
+    for (const TrackCheckpoints& t : options.track->runs)
+      num_residuals += 3 * static_cast<int>(t.segments.size());
+  }
+  return num_residuals;
+}
+
 void ComputeCovariance(const std::vector<AlignedRun>& training, const RobotModelInterface& model,
                        const ModelFitOptions& options, const HeldDirections& holds,
                        ModelFitResult* result) {
@@ -252,13 +304,10 @@ void ComputeCovariance(const std::vector<AlignedRun>& training, const RobotModel
   const int num_free =
       n - static_cast<int>(std::count(result->held.begin(), result->held.end(), true)) -
       static_cast<int>(holds.directions.size());
-  int num_residuals = 3 * static_cast<int>(training.size());
-  if (options.segments != nullptr) {
-    num_residuals = 0;
-    for (const auto& windows : *options.segments)
-      num_residuals += 3 * static_cast<int>(windows.size());
-  }
-  const int dof = num_residuals - num_free;
+  const int num_offsets = UsesTracks(options) && options.track->estimate_clock_offsets
+                              ? static_cast<int>(options.track->clock_groups.size())
+                              : 0;
+  const int dof = NumDataResiduals(training, options) - num_free - num_offsets;
   if (!result->usable || dof <= 0) {
     result->covariance_message = dof <= 0 ? "too few runs for a covariance (need more than " +
                                                 std::to_string(num_free / 3) + ")"
@@ -266,7 +315,8 @@ void ComputeCovariance(const std::vector<AlignedRun>& training, const RobotModel
     return;
   }
   std::vector<double> p = result->parameters;
-  FitProblem fit(training, model, options, result->held, p.data(), holds);
+  std::vector<double> offsets = result->clock_offsets_s;
+  FitProblem fit(training, model, options, result->held, p.data(), offsets.data(), holds);
   // s^2 from the plain sum of squares of the runs, whatever loss shaped the objective.
   double sum_of_squares_half = 0.0;
   ceres::Problem::EvaluateOptions evaluate_options;
@@ -278,7 +328,10 @@ void ComputeCovariance(const std::vector<AlignedRun>& training, const RobotModel
   cov_options.algorithm_type = ceres::DENSE_SVD;
   cov_options.num_threads = SolverOptionsFor(options.ceres).num_threads;
   ceres::Covariance covariance(cov_options);
-  const std::vector<std::pair<const double*, const double*>> blocks = {{p.data(), p.data()}};
+  std::vector<std::pair<const double*, const double*>> blocks = {{p.data(), p.data()}};
+  for (int g = 0; g < num_offsets; ++g) {
+    if (fit.problem().HasParameterBlock(&offsets[g])) blocks.push_back({&offsets[g], &offsets[g]});
+  }
   if (!covariance.Compute(blocks, &fit.problem())) {
     result->covariance_message =
         "covariance is rank deficient: the runs cannot determine all free parameters";
@@ -292,9 +345,38 @@ void ComputeCovariance(const std::vector<AlignedRun>& training, const RobotModel
   for (int k = 0; k < n; ++k) result->sigma[k] = std::sqrt(std::max(0.0, result->covariance(k, k)));
   result->correlation = CorrelationOf(result->covariance);
   result->has_covariance = true;
+  result->clock_offset_sigma_s.assign(result->clock_offsets_s.size(), 0.0);
+  for (std::size_t b = 1; b < blocks.size(); ++b) {
+    double variance = 0.0;
+    covariance.GetCovarianceBlock(blocks[b].first, blocks[b].first, &variance);
+    result->clock_offset_sigma_s[blocks[b].first - offsets.data()] =
+        std::sqrt(std::max(0.0, s2 * variance));
+  }
 }
 
 }  // namespace
+
+const char* ToString(ResidualKind kind) {
+  switch (kind) {
+    case ResidualKind::kFinalPose:
+      return "final-pose";
+    case ResidualKind::kTrack:
+      return "track";
+    case ResidualKind::kBoth:
+      return "both";
+  }
+  return "?";
+}
+
+bool ParseResidualKind(const std::string& text, ResidualKind* out) {
+  for (ResidualKind kind : {ResidualKind::kFinalPose, ResidualKind::kTrack, ResidualKind::kBoth}) {
+    if (text == ToString(kind)) {
+      *out = kind;
+      return true;
+    }
+  }
+  return false;
+}
 
 bool AtBound(double value, const Interval& box) {
   const double tolerance = 1e-6 * box.Width();
@@ -317,6 +399,9 @@ ModelFitResult SolveFrom(const std::vector<AlignedRun>& training, const RobotMod
   ModelFitResult result;
   result.parameters = start;
   result.held.assign(robot.NumParameters(), false);
+  // One slot even without tracks: the problem takes a pointer it never uses then.
+  result.clock_offsets_s.assign(
+      UsesTracks(options) ? std::max<std::size_t>(1, options.track->clock_groups.size()) : 1, 0.0);
   for (const HeldParameter& h : robot.held) {
     result.held[h.index] = true;
     result.parameters[h.index] = robot.nominal[h.index];
@@ -324,7 +409,8 @@ ModelFitResult SolveFrom(const std::vector<AlignedRun>& training, const RobotMod
   const auto t0 = std::chrono::steady_clock::now();
   ceres::Solver::Summary summary;
   {
-    FitProblem fit(training, model, options, result.held, result.parameters.data(), holds);
+    FitProblem fit(training, model, options, result.held, result.parameters.data(),
+                   result.clock_offsets_s.data(), holds);
     SolveUntilBoundContact(robot, options, result.held, result.parameters.data(), &fit.problem(),
                            &summary);
   }
@@ -370,6 +456,24 @@ ModelFitResult FitModelFrom(const std::vector<AlignedRun>& training,
   }
   const int n = model.robot().NumParameters();
   if (static_cast<int>(start.size()) != n) throw std::invalid_argument("FitModel: bad start");
+  if (UsesTracks(options)) {
+    if (options.track == nullptr || options.track->runs.size() != training.size()) {
+      throw std::invalid_argument("FitModel: track residuals need one track per training run");
+    }
+    if (!options.track->options.IsValid(&error)) throw std::invalid_argument(error);
+    for (const TrackCheckpoints& t : options.track->runs) {
+      if (t.clock_group < 0 || t.clock_group >= static_cast<int>(options.track->clock_groups.size()))
+        throw std::invalid_argument("FitModel: a track's clock group is out of range");
+    }
+  }
+  // What the direction analysis sees: with tracks, their checkpoints at the start's clock offsets
+  // (the last checkpoint is the final pose relative to the start, so "both" adds nothing to it).
+  std::vector<std::vector<Segment>> checkpoints;
+  if (UsesTracks(options)) {
+    for (const TrackCheckpoints& t : options.track->runs) checkpoints.push_back(t.segments);
+  }
+  const std::vector<std::vector<Segment>>* analysed =
+      UsesTracks(options) ? &checkpoints : options.segments;
 
   ModelFitResult result = SolveFrom(training, model, start, options, {});
   HeldDirections holds;
@@ -377,8 +481,8 @@ ModelFitResult FitModelFrom(const std::vector<AlignedRun>& training,
     bool finite = true;
     for (double v : result.parameters) finite = finite && std::isfinite(v);
     const DirectionAnalysis analysis = AnalyseDeterminedDirections(
-        training, model, finite ? result.parameters : start, options.ceres.weights,
-        options.segments, options.ceres.num_threads);
+        training, model, finite ? result.parameters : start, options.ceres.weights, analysed,
+        options.ceres.num_threads);
     if (analysis.ok && !analysis.undetermined.empty()) {
       holds.directions = analysis.undetermined;
       holds.weight = HoldWeight(analysis);

@@ -29,6 +29,7 @@
 
 #include "fit/determined_directions.h"
 #include "fit/solver_options.h"
+#include "fit/track_residual.h"
 #include "models/model_interface.h"
 #include "odometry/aligned_run.h"
 
@@ -63,13 +64,29 @@ struct ModelFitResult {
   Eigen::MatrixXd covariance;   // n x n, zero rows/columns for held parameters
   std::vector<double> sigma;
   Eigen::MatrixXd correlation;
+
+  // Track residuals (ModelFitOptions::track): the clock offset of each group (seconds, added to
+  // the encoder time to find the ground truth's) and its sigma (0 without a covariance).
+  std::vector<double> clock_offsets_s;
+  std::vector<double> clock_offset_sigma_s;
 };
+
+// What the fit compares with the ground truth (fit/track_residual.h):
+//   kFinalPose  each run's final pose (Palacin Eq. 14), blind to a common scale on closed loops;
+//   kTrack      each run's pose from its start at checkpoints along the ground-truth path;
+//   kBoth       both, each run's final pose and its mean track error weighing alike.
+enum class ResidualKind { kFinalPose, kTrack, kBoth };
+const char* ToString(ResidualKind kind);  // "final-pose", "track", "both"
+bool ParseResidualKind(const std::string& text, ResidualKind* out);
 
 struct ModelFitOptions {
   CeresFitOptions ceres;
   // When set, one window list per training run: the fit minimises the segment residuals
   // (relative pose error over windows, fit/pose_errors.h) instead of the final poses.
   const std::vector<std::vector<Segment>>* segments = nullptr;
+  // Which residuals (ignored when `segments` is set); kTrack and kBoth need `track`.
+  ResidualKind residuals = ResidualKind::kFinalPose;
+  const TrackFitData* track = nullptr;
   // Use the active set above (false: one plain bounded Ceres solve, as before; kept for tests
   // that show the difference).
   bool active_set_bounds = true;

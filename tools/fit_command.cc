@@ -109,6 +109,12 @@ void AddFitOptions(CLI::App& app, FitCommandOptions& o) {
       ->capture_default_str();
   app.add_flag("--no-output", o.no_output, "Do not write the calibrated YAML");
   app.add_flag("--force", o.force, "Overwrite --out even if it holds another robot's calibration");
+  app.add_option("--time-blocks", o.time_blocks,
+                 "With one or two runs fitted on their tracks and none held out, cut each into "
+                 "this many blocks of equal path: odd blocks train, even ones validate and the "
+                 "fit of the odd ones is written (0: fit the whole runs, not validated)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 100));
   app.add_flag("--skip-wheel-order-check", o.skip_wheel_order_check,
                "Fit even if another encoder column order/sign explains the data far better");
   app.add_option("--effects", o.effects,
@@ -117,6 +123,25 @@ void AddFitOptions(CLI::App& app, FitCommandOptions& o) {
                  "YAML declares is refitted without naming it")
       ->delimiter(',');
 }
+
+namespace {
+
+// --residuals auto on omni3's own path: whether the training runs call for track residuals (then
+// the seam's fit takes over; it resolves auto the same way).
+bool ResolvesToTrack(const FitCommandOptions& options, const io::Dataset& dataset,
+                     FitMethodSettings* settings) {
+  const RunSplit split =
+      SplitForFit(AlignRuns(dataset.runs), options.train_reps, options.train_trajectories);
+  std::unordered_map<std::string, const GroundTruthTrack*> track_of;
+  for (const RunLog& log : dataset.runs) track_of[log.id] = &log.ground_truth;
+  std::vector<const GroundTruthTrack*> tracks;
+  for (const AlignedRun& run : split.training) tracks.push_back(track_of.at(run.id));
+  FitMethodSettings resolved = *settings;
+  ResolveAutoResiduals(split.training, tracks, options.method, &resolved);
+  return resolved.residuals != ResidualKind::kFinalPose;
+}
+
+}  // namespace
 
 int RunFitCommand(const FitCommandOptions& options) {
   if (options.logs.empty()) {
@@ -146,13 +171,18 @@ int RunFitCommand(const FitCommandOptions& options) {
       if (!refusal.empty()) return Refuse(refusal);
     }
     // Every model on the seam except omni3, whose fit (with its NLopt methods and fast kernel)
-    // still has its own path below - which fits Eq. 4 alone: omni3 with effects takes the seam's.
+    // still has its own path below - which fits Eq. 4 to final poses alone: omni3 with effects
+    // or with track residuals takes the seam's.
     const RobotModelPtr model = ReadRobotModelFile(index.robot_path);
     if (model->robot().model != "omni3" || !options.effects.empty() ||
-        !model->robot().effects.empty()) {
+        !model->robot().effects.empty() ||
+        (!settings.residuals_auto && settings.residuals != ResidualKind::kFinalPose)) {
       return RunModelFitCommand(options, index, model);
     }
     const io::Dataset dataset = LoadRuns(options, index, /*robot=*/nullptr);
+    if (settings.residuals_auto && ResolvesToTrack(options, dataset, &settings)) {
+      return RunModelFitCommand(options, index, model);
+    }
     io::StopHereForTests("loaded");
     const Omni3Robot robot = io::ReadOmni3Robot(dataset.robot_path);
     if (!options.no_output && !options.force) {

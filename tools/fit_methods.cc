@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <tuple>
 
 #include "fit/final_pose_cost.h"
 #include "fit/final_pose_errors.h"
 #include "fit/model_nlopt_fit.h"
+#include "fit/residual_choice.h"
 
 namespace fitcal::tools {
 
@@ -89,17 +91,39 @@ FitMethodOutcome RunNlopt(NloptMethod method, const std::vector<AlignedRun>& tra
   return out;
 }
 
+// What the residuals compare, in words, before the final poses' objective ("" for final poses
+// alone, whose text is unchanged).
+std::string ResidualsText(const FitMethodSettings& settings) {
+  if (settings.residuals == ResidualKind::kFinalPose || settings.track == nullptr) return "";
+  const TrackResidualOptions& t = settings.track->options;
+  char text[300];
+  std::snprintf(text, sizeof text,
+                "track residuals (pose from the run's start every %.2g m of ground-truth path and "
+                "at the end, Huber %.2g, runs weighed alike; clock offsets: %s)%s",
+                t.checkpoint_spacing_m, t.huber_scale,
+                settings.clock_grouping == ClockGrouping::kNone
+                    ? "none"
+                    : (std::string("one per ") + ToString(settings.clock_grouping)).c_str(),
+                settings.residuals == ResidualKind::kBoth ? " and final poses: " : "");
+  return text;
+}
+
 ModelFitMethodOutcome RunModelCeres(CeresTrustRegion trust_region,
                                     const std::vector<AlignedRun>& training,
                                     const RobotModelInterface& model,
                                     const FitMethodSettings& settings) {
   ModelFitOptions options;
   options.ceres = CeresOptionsFor(trust_region, settings);
+  options.residuals = settings.residuals;
+  options.track = settings.track;
   ModelFitMethodOutcome out;
   out.fit = FitModel(training, model, options);
   out.evaluations = out.fit.num_residual_evaluations + out.fit.num_jacobian_evaluations;
-  out.objective =
-      ObjectiveText(options.ceres.objective, options.ceres.loss, options.ceres.loss_scale);
+  out.objective = ResidualsText(settings);
+  if (options.residuals != ResidualKind::kTrack) {
+    out.objective +=
+        ObjectiveText(options.ceres.objective, options.ceres.loss, options.ceres.loss_scale);
+  }
   // Ceres reports no per-evaluation CF: the trace holds the start and the end.
   out.trace.push_back(
       {1, EvaluateFinalPoseErrors(model, model.robot().nominal, training, settings.threads).cf,
@@ -186,6 +210,16 @@ std::string FitMethodNames() {
   return out;
 }
 
+void ResolveAutoResiduals(const std::vector<AlignedRun>& training,
+                          const std::vector<const GroundTruthTrack*>& tracks,
+                          const std::string& method, FitMethodSettings* settings) {
+  if (!settings->residuals_auto) return;
+  const bool ceres = method == "ceres" || method == "ceres-dogleg";
+  settings->residuals = ceres && MeasureTrackDensity(training, tracks).dense
+                            ? ResidualKind::kTrack
+                            : ResidualKind::kFinalPose;
+}
+
 bool MakeFitMethodSettings(const SolverOptions& o, int threads, FitMethodSettings* s,
                            std::string* error) {
   s->threads = threads;
@@ -194,6 +228,16 @@ bool MakeFitMethodSettings(const SolverOptions& o, int threads, FitMethodSetting
   s->objective_set = !o.objective.empty();
   if (s->objective_set && !ParseFinalPoseObjective(o.objective, &s->objective)) {
     *error = "unknown --objective '" + o.objective + "' (available: squares, eq14)";
+    return false;
+  }
+  s->residuals_auto = o.residuals == "auto";
+  if (!s->residuals_auto && !ParseResidualKind(o.residuals, &s->residuals)) {
+    *error =
+        "unknown --residuals '" + o.residuals + "' (available: auto, final-pose, track, both)";
+    return false;
+  }
+  if (!ParseClockGrouping(o.clock_offsets, &s->clock_grouping)) {
+    *error = "unknown --clock-offsets '" + o.clock_offsets + "' (available: session, run, dataset, none)";
     return false;
   }
   if (!ParseCeresRobustLoss(o.loss, &s->loss)) {

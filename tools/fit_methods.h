@@ -27,6 +27,12 @@ struct FitMethodSettings {
   // Ceres: kSumOfSquares by default; NLopt: Eq. 14 by default (see the option docs).
   bool objective_set = false;
   FinalPoseObjective objective = FinalPoseObjective::kSumOfSquares;
+  // Ceres only: what the residuals compare; kTrack and kBoth need `track` (the training runs'
+  // tracks, set by the command that has the ground truth).
+  ResidualKind residuals = ResidualKind::kFinalPose;
+  bool residuals_auto = false;  // --residuals auto: ResolveAutoResiduals sets `residuals`
+  ClockGrouping clock_grouping = ClockGrouping::kPerSession;
+  const TrackFitData* track = nullptr;
   CeresRobustLoss loss = CeresRobustLoss::kNone;  // Ceres only
   double loss_scale = 0.05;
   std::uint64_t seed = 1;                              // NLopt only
@@ -66,6 +72,13 @@ struct FitMethod {
 const std::vector<FitMethod>& FitMethods();
 const FitMethod* FindFitMethod(const std::string& name);  // nullptr if unknown
 std::string FitMethodNames();                             // "ceres, ceres-dogleg, crs2lm, ..."
+
+// --residuals auto (fit/residual_choice.h): kTrack when the training runs' ground truth is a dense
+// track and `method` is a Ceres one, kFinalPose otherwise; nothing without residuals_auto.
+// tracks[i] is training[i]'s ground truth.
+void ResolveAutoResiduals(const std::vector<AlignedRun>& training,
+                          const std::vector<const GroundTruthTrack*>& tracks,
+                          const std::string& method, FitMethodSettings* settings);
 
 // The solver flags (tools/solver_options.h) checked and turned into settings; false with a
 // one-line message when a name is unknown or a value out of range.

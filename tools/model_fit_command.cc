@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <map>
 #include <optional>
 #include <string>
 #include <unordered_map>
@@ -24,10 +25,13 @@
 #include "tools/effect_list.h"
 #include "tools/fit_methods.h"
 #include "tools/output_guard.h"
+#include "validation/everyday_driving.h"
+#include "validation/generalisation.h"
 #include "validation/propagated_uncertainty.h"
 #include "validation/rate_units.h"
 #include "validation/residual_dof.h"
 #include "validation/run_split.h"
+#include "validation/time_blocks.h"
 #include "validation/training_runs.h"
 #include "validation/trajectory_metrics.h"
 
@@ -485,6 +489,159 @@ void WarnOfEffects(const std::vector<CalibrationCandidate>& candidates, const Ga
                "robot YAML)\n";
 }
 
+// The training runs' tracks for --residuals track/both, and auto resolved (settings->track points
+// into *data); false after one line on stderr when the method cannot fit them.
+bool PrepareTrackResiduals(const FitCommandOptions& options, const std::vector<RunLog>& logs,
+                           const RunSplit& split, FitMethodSettings* settings,
+                           std::optional<TrackFitData>* data) {
+  std::unordered_map<std::string, const GroundTruthTrack*> track_of;
+  for (const RunLog& log : logs) track_of[log.id] = &log.ground_truth;
+  std::vector<const GroundTruthTrack*> tracks;
+  for (const AlignedRun& run : split.training) tracks.push_back(track_of.at(run.id));
+  ResolveAutoResiduals(split.training, tracks, options.method, settings);
+  if (settings->residuals == ResidualKind::kFinalPose) return true;
+  if (options.method != "ceres" && options.method != "ceres-dogleg") {
+    std::cerr << "fitcal: --residuals " << ToString(settings->residuals)
+              << " needs a Ceres method (--method ceres or ceres-dogleg); " << options.method
+              << " fits final poses only\n";
+    return false;
+  }
+  data->emplace(MakeTrackFitData(split.training, tracks, settings->clock_grouping));
+  settings->track = &**data;
+  return true;
+}
+
+// The fit's residual degrees of freedom (validation/residual_dof.h), counted for the residuals
+// it will minimise: three final-pose residuals per training run, three per track checkpoint
+// (plus the final poses with `both`), and the clock offsets as parameters when estimated. A
+// single long free run thus calibrates on its track, where its final pose alone could not.
+std::string DegreesOfFreedomRefusal(const RunSplit& split, const FitMethodSettings& settings,
+                                    const std::optional<TrackFitData>& track,
+                                    std::size_t num_parameters) {
+  if (!track) return FinalPoseDofRefusal(split.training.size(), num_parameters);
+  std::size_t checkpoints = 0;
+  for (const TrackCheckpoints& run : track->runs) checkpoints += run.segments.size();
+  std::size_t residuals = 3 * checkpoints;
+  if (settings.residuals == ResidualKind::kBoth) residuals += 3 * split.training.size();
+  if (track->estimate_clock_offsets) num_parameters += track->clock_groups.size();
+  const std::size_t runs = std::max<std::size_t>(1, split.training.size());
+  return ResidualDofRefusal(residuals, num_parameters, split.training.size(), "track",
+                            residuals / runs);
+}
+
+// The clock offsets the track fit estimated, with their sigmas: every group up to a dozen, their
+// range beyond.
+void PrintClockOffsets(const ModelFitResult& fit, const TrackFitData& track) {
+  if (!track.estimate_clock_offsets || track.clock_groups.empty()) return;
+  const std::size_t n = track.clock_groups.size();
+  const auto sigma = [&](std::size_t g) {
+    return g < fit.clock_offset_sigma_s.size() ? fit.clock_offset_sigma_s[g] : 0.0;
+  };
+  std::printf("clock offsets (ground truth at encoder time + dt, |dt| <= %.2g s), %zu %s:\n",
+              track.options.max_clock_offset_s, n, n == 1 ? "group" : "groups");
+  constexpr std::size_t kMaxListed = 12;
+  if (n <= kMaxListed) {
+    for (std::size_t g = 0; g < n; ++g) {
+      std::printf("  %-36s %+8.3f s +- %.3f\n", track.clock_groups[g].c_str(),
+                  fit.clock_offsets_s[g], sigma(g));
+    }
+    return;
+  }
+  std::vector<double> sorted(fit.clock_offsets_s.begin(), fit.clock_offsets_s.begin() + n);
+  std::sort(sorted.begin(), sorted.end());
+  double mean_sigma = 0.0;
+  for (std::size_t g = 0; g < n; ++g) mean_sigma += sigma(g) / n;
+  std::printf("  median %+.3f s, range [%+.3f, %+.3f] s, mean sigma %.3f s\n", sorted[n / 2],
+              sorted.front(), sorted.back(), mean_sigma);
+}
+
+// Drift per 1, 2, 5 m and ATE RMSE (validation/everyday_driving.h) of the nominal and the
+// selected calibration on the held-out runs (the training runs when none is held out).
+void PrintEverydayDriving(const RobotModelInterface& model, const std::vector<RunLog>& logs,
+                          const RunSplit& split, const CalibrationCandidate& nominal,
+                          const CalibrationCandidate& selected, int threads) {
+  const bool held_out = !split.validation.empty();
+  const std::vector<AlignedRun>& runs = held_out ? split.validation : split.training;
+  std::unordered_map<std::string, const GroundTruthTrack*> track_of;
+  for (const RunLog& log : logs) track_of[log.id] = &log.ground_truth;
+  std::vector<const GroundTruthTrack*> tracks;
+  for (const AlignedRun& run : runs) tracks.push_back(track_of.at(run.id));
+  const std::vector<double> lengths = EverydayDriftLengths();
+  const EverydayDrivingMetrics before = EvaluateEverydayDriving(
+      model, nominal.parameters, nominal.effects, runs, tracks, lengths, threads);
+  const EverydayDrivingMetrics after = EvaluateEverydayDriving(
+      model, selected.parameters, selected.effects, runs, tracks, lengths, threads);
+  std::printf("\n  %-30s %10s %10s %9s\n",
+              held_out ? "everyday driving, validation" : "everyday driving, training", "nominal",
+              "calibrated", "change");
+  for (const std::string& row : EverydayDrivingRows(before, after))
+    std::printf("%s\n", row.c_str());
+}
+
+// A calibration better than the nominal on the held-out runs as a whole may still be worse on one
+// kind of run (circles, squares, free driving: the path type, validation/generalisation.h); it is
+// then not written. True after one line per such kind on stderr.
+bool WorseThanNominalOnSomeKind(const std::vector<CalibrationCandidate>& candidates,
+                                const GateDecision& gate, const RunSplit& split,
+                                const CandidateErrors& errors) {
+  if (!gate.judged_on_held_out || gate.selected == 0) return false;
+  std::map<std::string, std::vector<AlignedRun>> by_kind;
+  for (const AlignedRun& run : split.validation) by_kind[PathTypeOf(run.trajectory)].push_back(run);
+  if (by_kind.size() < 2) return false;  // the gate judged this one kind already
+  bool worse = false;
+  for (const auto& [kind, runs] : by_kind) {
+    const double before = errors(candidates[0], runs).cf;
+    const double after = errors(candidates[gate.selected], runs).cf;
+    if (after <= before) continue;
+    std::cerr << "fitcal: '" << candidates[gate.selected].name << "' is worse than the nominal on "
+              << "the held-out '" << kind << "' runs (" << runs.size() << "): CF " << before
+              << " -> " << after << "; nothing written\n";
+    worse = true;
+  }
+  return worse;
+}
+
+// A data set of free driving may hold one or two long runs and nothing to validate on. When they
+// are fitted on their tracks (--residuals track/both, or auto resolving to track), each is cut into
+// --time-blocks blocks of equal ground-truth path (validation/time_blocks.h): the odd blocks train,
+// the even ones are held out, and the gate judges on them. Resolves --residuals auto.
+constexpr std::size_t kMaxRunsForTimeBlocks = 2;
+
+void ValidateOnTimeBlocks(const std::string& method, int num_blocks, FitMethodSettings* settings,
+                          RunSplit* split, std::vector<RunLog>* logs) {
+  std::unordered_map<std::string, const RunLog*> log_of;
+  for (const RunLog& log : *logs) log_of[log.id] = &log;
+  std::vector<const GroundTruthTrack*> tracks;
+  for (const AlignedRun& run : split->training) tracks.push_back(&log_of.at(run.id)->ground_truth);
+  ResolveAutoResiduals(split->training, tracks, method, settings);
+  settings->residuals_auto = false;
+  if (num_blocks < 2 || settings->residuals == ResidualKind::kFinalPose ||
+      !split->validation.empty() || split->training.empty() ||
+      split->training.size() > kMaxRunsForTimeBlocks) {
+    return;
+  }
+  RunSplit blocks;
+  std::vector<RunLog> block_logs;
+  for (const AlignedRun& run : split->training) {
+    const RunLog& log = *log_of.at(run.id);
+    for (AlignedRun& block : CutIntoTimeBlocks(run, log.ground_truth, num_blocks)) {
+      block_logs.push_back(log);
+      block_logs.back().id = block.id;
+      (block.repetition % 2 == 1 ? blocks.training : blocks.validation).push_back(std::move(block));
+    }
+  }
+  if (blocks.training.empty() || blocks.validation.empty()) return;
+  for (int k = 1; k <= num_blocks; ++k) {
+    (k % 2 == 1 ? blocks.training_repetitions : blocks.validation_repetitions).push_back(k);
+  }
+  std::printf(
+      "no held-out runs: each run cut into %d blocks of equal ground-truth path; the odd ones "
+      "train, the even ones are held out (--time-blocks)\n",
+      num_blocks);
+  *split = std::move(blocks);
+  logs->insert(logs->end(), block_logs.begin(), block_logs.end());
+}
+
 }  // namespace
 
 int StoppedEarlyExit(bool selected_fit_stopped_early, const std::string& termination) {
@@ -523,8 +680,12 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   }
   const io::Dataset dataset = LoadRuns(options, index, &robot);
   io::StopHereForTests("loaded");
-  const RunSplit split =
+  RunSplit split =
       SplitForFit(AlignRuns(dataset.runs), options.train_reps, options.train_trajectories);
+  // The runs by id, with the time blocks' when a single long run is cut (ValidateOnTimeBlocks).
+  std::vector<RunLog> logs = dataset.runs;
+  const bool residuals_auto = settings.residuals_auto;
+  ValidateOnTimeBlocks(options.method, options.time_blocks, &settings, &split, &logs);
   const double load_s = Seconds(t_total);
   if (split.training.empty()) {
     std::cerr << "fitcal: no run of " << options.logs << " is a training run ("
@@ -535,20 +696,23 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
     std::cerr << "fitcal: " << options.logs << ": " << units.message << "\n";
     return 1;
   }
-  if (const std::string refusal = FinalPoseDofRefusal(
-          split.training.size(), robot.NumFree() + (effects_to_fit ? effects_to_fit->size() : 0));
-      !refusal.empty()) {
-    std::cerr << "fitcal: " << options.logs << ": " << refusal << "\n";
-    return 1;
-  }
   if (!options.skip_wheel_order_check &&
-      ChannelsLookMiswired(options, *model, split.training, dataset.runs)) {
+      ChannelsLookMiswired(options, *model, split.training, logs)) {
     return 4;
   }
   std::optional<std::vector<TrackRun>> training_tracks;
   if (!effects_to_fit->empty()) {
-    training_tracks = TrainingTracks(options, robot, dataset.runs, split);
+    training_tracks = TrainingTracks(options, robot, logs, split);
     if (!training_tracks) return 2;
+  }
+  std::optional<TrackFitData> track_data;
+  if (!PrepareTrackResiduals(options, logs, split, &settings, &track_data)) return 2;
+  if (const std::string refusal = DegreesOfFreedomRefusal(
+          split, settings, track_data,
+          robot.NumFree() + (effects_to_fit ? effects_to_fit->size() : 0));
+      !refusal.empty()) {
+    std::cerr << "fitcal: " << options.logs << ": " << refusal << "\n";
+    return 1;
   }
   const ModelFitMethodOutcome outcome = method->run_model(split.training, *model, settings);
   const ModelFitResult& fit = outcome.fit;
@@ -564,7 +728,7 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
     candidates.push_back({"track fit + " + EffectNames(*effects_to_fit), t.with_effects.parameters,
                           t.with_effects.usable, t.with_effects.effects});
   }
-  const CandidateErrors errors(*model, dataset.runs, options.threads);
+  const CandidateErrors errors(*model, logs, options.threads);
   GateDecision gate = SelectCalibration(*model, candidates, split.training, split.validation,
                                         options.threads, errors.Cf());
   const std::string effects_line =
@@ -580,13 +744,18 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
 
   PrintFit(options, *model, split, candidates, gate, selected_fit, errors, *method, outcome,
            track_fits);
+  std::printf("residuals: %s%s\n", ToString(settings.residuals),
+              residuals_auto ? " (--residuals auto)" : "");
+  if (track_data) PrintClockOffsets(fit, *track_data);
+  PrintEverydayDriving(*model, logs, split, candidates[0], selected, options.threads);
   if (!fit.has_covariance) std::printf("uncertainty: %s\n", fit.covariance_message.c_str());
   for (const UndeterminedDirection& d : fit.held_directions) PrintHeldAtNominal(d.description);
   if (!PrintGate(candidates, gate, effects_line)) return 5;
+  if (WorseThanNominalOnSomeKind(candidates, gate, split, errors)) return 5;
   WarnOfEffects(candidates, gate, split, errors);
   if (!options.no_output) {
     const io::CalibrationBlock record =
-        MakeRecord(options, *model, dataset.runs, split, candidates, gate, selected_fit, errors);
+        MakeRecord(options, *model, logs, split, candidates, gate, selected_fit, errors);
     io::StopHereForTests("fitted");
     io::WriteFileAtomically(options.out, model->RobotYaml(selected.parameters, selected.effects,
                                                           io::CalibrationBlockYaml(record, robot)));

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "diagnosis/effect_fit.h"
+#include "fit/residual_choice.h"
 #include "fit/segment_cost.h"
 #include "tools/effect_list.h"
 #include "validation/generalisation.h"
@@ -149,6 +150,11 @@ int RunModelGeneraliseCommand(const GeneraliseCommandOptions& options,
     track_candidates.tracks = &tracks;
     track_candidates.effects = *effect_list;
   }
+  // On dense ground-truth tracks (fit/residual_choice.h, as fit --residuals auto decides) the
+  // track fit competes too.
+  std::vector<const GroundTruthTrack*> ground_truth;
+  for (const RunLog& log : dataset.runs) ground_truth.push_back(&log.ground_truth);
+  if (MeasureTrackDensity(runs, ground_truth).dense) track_candidates.ground_truth = &ground_truth;
   ModelFitOptions fit_options;
   fit_options.ceres.num_threads = options.threads;
 

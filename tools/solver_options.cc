@@ -15,6 +15,19 @@ void AddSolverOptions(CLI::App& app, SolverOptions& o) {
   app.add_option("--objective", o.objective,
                  "squares (sum of squared residuals; Ceres default) or eq14 (sum of per-run "
                  "norms, Palacin Eq. 14; NLopt default)");
+  app.add_option("--residuals", o.residuals,
+                 "What the fit compares with the ground truth: final-pose (each run's end, "
+                 "Palacin Eq. 14), track (the pose from the run's start every 0.5 m of "
+                 "ground-truth path and at the end), both, or auto: track where the ground truth "
+                 "samples the path at least every 0.1 m on runs of 2 m or more and the method is "
+                 "Ceres, final-pose otherwise (docs/everyday_driving.md); track and both need a "
+                 "Ceres method")
+      ->capture_default_str();
+  app.add_option("--clock-offsets", o.clock_offsets,
+                 "Track residuals: estimate the ground-truth clock's offset per session (the "
+                 "run's trajectory label; import optiodom: the recording folder), per run, one "
+                 "for the whole data set, or none (held at 0)")
+      ->capture_default_str();
   app.add_option("--loss", o.loss, "Ceres robust loss: none, huber, cauchy")->capture_default_str();
   app.add_option("--loss-scale", o.loss_scale, "Robust loss scale (residual units: m and rad)")
       ->capture_default_str();

@@ -14,6 +14,11 @@ namespace fitcal::tools {
 
 struct SolverOptions {
   std::string objective;        // "" = the method's default; "squares" or "eq14"
+  // What the residuals compare (fit/model_fit.h ResidualKind): final-pose, track, both, or auto
+  // (fit/residual_choice.h: track on dense ground-truth tracks with a Ceres method).
+  std::string residuals = "auto";
+  // Track residuals: one clock offset per session, run, data set, or none (all held at 0).
+  std::string clock_offsets = "none";
   std::string loss = "none";    // Ceres: none, huber, cauchy
   double loss_scale = 0.05;     // Ceres robust loss scale, residual units
   unsigned long seed = 1;       // NLopt

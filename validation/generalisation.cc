@@ -159,6 +159,23 @@ SplitScores EvaluateSplit(const RobotModelInterface& model, const std::vector<Al
     free.is_fit = true;
     out.candidates.push_back(std::move(free));
   }
+  if (const auto* ground_truth = track_candidates.ground_truth) {
+    if (ground_truth->size() != runs.size()) {
+      throw std::invalid_argument("EvaluateSplit: not one ground truth per run");
+    }
+    const TrackFitData data =
+        MakeTrackFitData(train, PickEach(*ground_truth, split.train), ClockGrouping::kNone);
+    ModelFitOptions track_options = options;
+    track_options.residuals = ResidualKind::kTrack;
+    track_options.track = &data;
+    const ModelFitResult track_fit = FitModel(train, model, track_options);
+    CandidateScore scored =
+        Score(model, "fit (track)", track_fit.parameters, track_fit.usable, train, test, threads);
+    scored.is_fit = true;
+    scored.held_directions = static_cast<int>(track_fit.held_directions.size());
+    for (bool b : track_fit.at_bound) scored.at_bound += b;
+    out.candidates.push_back(std::move(scored));
+  }
   if (const auto* checkpoints = track_candidates.optiodom_checkpoints) {
     if (checkpoints->size() != runs.size()) {
       throw std::invalid_argument("EvaluateSplit: not one checkpoint list per run");

@@ -95,6 +95,10 @@ struct TrackCandidates {
   // empty.
   const std::vector<TrackRun>* tracks = nullptr;
   EffectModel effects;
+  // The bounded fit on the training runs' track residuals (fit/track_residual.h, no clock
+  // offsets), "fit (track)", beside the final-pose "fit": what `fit --residuals auto` writes on
+  // dense ground-truth tracks. One ground truth per run of `runs`.
+  const std::vector<const GroundTruthTrack*>* ground_truth = nullptr;
 };
 
 // Fits on split.train (options.ceres.num_threads also drives the evaluation) and scores every

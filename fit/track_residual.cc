@@ -1,0 +1,218 @@
+#include "fit/track_residual.h"
+
+#include <ceres/jet.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+#include "fit/segment_cost.h"
+
+namespace fitcal {
+
+bool TrackResidualOptions::IsValid(std::string* error) const {
+  if (!(checkpoint_spacing_m > 0.0) || !(huber_scale > 0.0) || !(max_clock_offset_s >= 0.0)) {
+    *error = "track: checkpoint spacing and loss scale must be positive, the offset bound >= 0";
+    return false;
+  }
+  return true;
+}
+
+TrackCheckpoints MakeTrackCheckpoints(const AlignedRun& run, const GroundTruthTrack& ground_truth,
+                                      const TrackResidualOptions& options) {
+  TrackCheckpoints out;
+  out.run = &run;
+  out.ground_truth = &ground_truth;
+  out.t_start_s = run.t_start_s;
+  out.segments = MakeCheckpointsFromStart(run, ground_truth, options.checkpoint_spacing_m);
+  double t = run.t_start_s;
+  std::size_t done = 0;
+  for (const Segment& s : out.segments) {
+    for (; done < s.end; ++done) t += run.samples[done].dt_s;
+    out.t_s.push_back(t);
+  }
+  return out;
+}
+
+const char* ToString(ClockGrouping grouping) {
+  switch (grouping) {
+    case ClockGrouping::kPerSession:
+      return "session";
+    case ClockGrouping::kPerRun:
+      return "run";
+    case ClockGrouping::kDataset:
+      return "dataset";
+    case ClockGrouping::kNone:
+      return "none";
+  }
+  return "?";
+}
+
+bool ParseClockGrouping(const std::string& text, ClockGrouping* out) {
+  for (ClockGrouping g : {ClockGrouping::kPerSession, ClockGrouping::kPerRun,
+                          ClockGrouping::kDataset, ClockGrouping::kNone}) {
+    if (text == ToString(g)) {
+      *out = g;
+      return true;
+    }
+  }
+  return false;
+}
+
+TrackFitData MakeTrackFitData(const std::vector<AlignedRun>& runs,
+                              const std::vector<const GroundTruthTrack*>& ground_truth,
+                              ClockGrouping grouping, const TrackResidualOptions& options) {
+  if (runs.size() != ground_truth.size()) {
+    throw std::invalid_argument("MakeTrackFitData: not one ground truth per run");
+  }
+  TrackFitData out;
+  out.options = options;
+  out.estimate_clock_offsets = grouping != ClockGrouping::kNone;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    TrackCheckpoints t = MakeTrackCheckpoints(runs[i], *ground_truth[i], options);
+    const std::string group = grouping == ClockGrouping::kPerRun       ? runs[i].id
+                              : grouping == ClockGrouping::kPerSession ? runs[i].trajectory
+                                                                       : "all";
+    const auto found = std::find(out.clock_groups.begin(), out.clock_groups.end(), group);
+    t.clock_group = static_cast<int>(found - out.clock_groups.begin());
+    if (found == out.clock_groups.end()) out.clock_groups.push_back(group);
+    out.runs.push_back(std::move(t));
+  }
+  return out;
+}
+
+namespace {
+
+// The ground truth at time t (a Jet in the clock offset): linear interpolation between the
+// samples around t's value, clamped outside the track (InterpolateGroundTruth with a Jet time).
+template <typename T>
+Pose2<T> InterpolateAt(const GroundTruthTrack& track, const T& t) {
+  const std::vector<double>& ts = track.t_s;
+  const double v = ScalarPart(t);
+  if (v <= ts.front()) {
+    const Pose2d& a = track.world_T_robot.front();
+    return {T(a.x), T(a.y), T(a.theta)};
+  }
+  if (v >= ts.back()) {
+    const Pose2d& b = track.world_T_robot.back();
+    return {T(b.x), T(b.y), T(b.theta)};
+  }
+  const std::size_t hi =
+      static_cast<std::size_t>(std::upper_bound(ts.begin(), ts.end(), v) - ts.begin());
+  const std::size_t lo = hi - 1;
+  const T u = (t - ts[lo]) / (ts[hi] - ts[lo]);
+  const Pose2d& a = track.world_T_robot[lo];
+  const Pose2d& b = track.world_T_robot[hi];
+  return {a.x + u * (b.x - a.x), a.y + u * (b.y - a.y), a.theta + u * WrapAngle(b.theta - a.theta)};
+}
+
+// a^-1 b
+template <typename T>
+Pose2<T> Between(const Pose2<T>& a, const Pose2<T>& b) {
+  using std::cos;
+  using std::sin;
+  const T c = cos(a.theta), s = sin(a.theta);
+  const T dx = b.x - a.x, dy = b.y - a.y;
+  return {c * dx + s * dy, -s * dx + c * dy, b.theta - a.theta};
+}
+
+// sqrt(rho(s) / s) for Huber's rho of scale c (header): 1 in the quadratic zone.
+template <typename T>
+T HuberFactor(const T& s, double c) {
+  using std::sqrt;
+  if (ScalarPart(s) <= c * c) return T(1.0);
+  return sqrt((2.0 * c * sqrt(s) - c * c) / s);
+}
+
+// Jet dimensions: the odometry pose (x, y, theta) and the clock offset.
+using ErrorJet = ceres::Jet<double, 4>;
+
+}  // namespace
+
+Pose2d GroundTruthFromStart(const TrackCheckpoints& track, std::size_t k, double dt_s) {
+  return Between(InterpolateAt(*track.ground_truth, track.t_start_s + dt_s),
+                 InterpolateAt(*track.ground_truth, track.t_s[k] + dt_s));
+}
+
+TrackResidual::TrackResidual(const TrackCheckpoints& track, const RobotModelInterface& model,
+                             const ResidualWeights& weights, const TrackResidualOptions& options)
+    : track_(track),
+      weights_(weights),
+      huber_scale_(options.huber_scale),
+      run_weight_(1.0 /
+                  std::sqrt(static_cast<double>(std::max<std::size_t>(1, track.segments.size())))),
+      num_parameters_(model.robot().NumParameters()) {
+  for (const Segment& s : track.segments) {
+    Segment identity = s;
+    identity.ground_truth_start_T_end = Pose2d{0.0, 0.0, 0.0};
+    from_start_.push_back(identity);
+  }
+  // Unit weights: the inner residual is P_k itself (SegmentError with Q = identity).
+  odometry_.reset(model.SegmentCost(*track.run, from_start_, ResidualWeights{}));
+  set_num_residuals(3 * static_cast<int>(from_start_.size()));
+  mutable_parameter_block_sizes()->push_back(num_parameters_);
+  mutable_parameter_block_sizes()->push_back(1);
+}
+
+ceres::CostFunction* TrackResidual::Create(const TrackCheckpoints& track,
+                                           const RobotModelInterface& model,
+                                           const ResidualWeights& weights,
+                                           const TrackResidualOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw std::invalid_argument(error);
+  if (track.segments.empty() || track.t_s.size() != track.segments.size()) {
+    throw std::invalid_argument("TrackResidual: run " + track.run->id + " has no checkpoints");
+  }
+  return new TrackResidual(track, model, weights, options);
+}
+
+bool TrackResidual::Evaluate(double const* const* parameters, double* residuals,
+                             double** jacobians) const {
+  const int m = num_residuals();
+  const int n = num_parameters_;
+  std::vector<double> pose(m);
+  std::vector<double> pose_jacobian;  // m x n, row-major: dP/dp
+  const bool want_p = jacobians != nullptr && jacobians[0] != nullptr;
+  if (want_p) pose_jacobian.assign(static_cast<std::size_t>(m) * n, 0.0);
+  double* inner_jacobians[1] = {want_p ? pose_jacobian.data() : nullptr};
+  if (!odometry_->Evaluate(parameters, pose.data(), want_p ? inner_jacobians : nullptr)) {
+    return false;
+  }
+  const double dt_s = parameters[1][0];
+  const ErrorJet t0 = ErrorJet(track_.t_start_s + dt_s, 3);
+  const Pose2<ErrorJet> q0 = InterpolateAt(*track_.ground_truth, t0);
+  const double inv_xy = 1.0 / weights_.position_sigma_m;
+  const double inv_th = 1.0 / weights_.heading_sigma_rad;
+  for (int k = 0; k < m / 3; ++k) {
+    const Pose2<ErrorJet> p{ErrorJet(pose[3 * k], 0), ErrorJet(pose[3 * k + 1], 1),
+                            ErrorJet(pose[3 * k + 2], 2)};
+    const Pose2<ErrorJet> q =
+        Between(q0, InterpolateAt(*track_.ground_truth, ErrorJet(track_.t_s[k] + dt_s, 3)));
+    using std::cos;
+    using std::sin;
+    const ErrorJet cq = cos(q.theta), sq = sin(q.theta);
+    const ErrorJet ex = p.x - q.x, ey = p.y - q.y;
+    ErrorJet e[3] = {(cq * ex + sq * ey) * inv_xy, (-sq * ex + cq * ey) * inv_xy,
+                     WrapAngle(p.theta - q.theta) * inv_th};
+    const ErrorJet factor =
+        run_weight_ * HuberFactor(e[0] * e[0] + e[1] * e[1] + e[2] * e[2], huber_scale_);
+    for (int i = 0; i < 3; ++i) {
+      const ErrorJet r = factor * e[i];
+      const int row = 3 * k + i;
+      residuals[row] = r.a;
+      if (jacobians == nullptr) continue;
+      if (want_p) {  // dr/dp = dr/dP_k dP_k/dp
+        for (int j = 0; j < n; ++j) {
+          double sum = 0.0;
+          for (int c = 0; c < 3; ++c) sum += r.v[c] * pose_jacobian[(3 * k + c) * n + j];
+          jacobians[0][row * n + j] = sum;
+        }
+      }
+      if (jacobians[1] != nullptr) jacobians[1][row] = r.v[3];
+    }
+  }
+  return true;
+}
+
+}  // namespace fitcal

@@ -1,0 +1,111 @@
+#pragma once
+// The track residual of one run: the odometry's pose relative to the run's start at checkpoints
+// along the ground-truth path, against the ground truth's, with the ground-truth clock shifted by
+// an estimated offset. It is OptiOdom's cost (Sousa et al., J. Intell. Robot. Syst. 2022: the
+// position from the run's start every 0.5 m of path and at the end, fit/segment_cost.h
+// MakeCheckpointsFromStart) with the heading added as in Palacin Eq. 14, one clock offset per
+// session, a robust loss per checkpoint and a weight per run.
+//
+// For checkpoint k at encoder time t_k (the run starts at t_0), with the odometry replayed from
+// the identity, P_k = P_0^-1 P_k (Palacin Eq. 4), and the ground truth interpolated at t + dt,
+//   Q_k(dt) = Q(t_0 + dt)^-1 Q(t_k + dt),
+//   e_k = [ R(-theta_Qk) (t_Pk - t_Qk) / sigma_xy,  wrap(theta_Pk - theta_Qk) / sigma_th ]
+// (the segment error of fit/pose_errors.h with the window [0, k]), and the residual is
+//   r_k = w sqrt(rho(|e_k|^2) / |e_k|^2) e_k,  w = 1 / sqrt(K),
+// so |r_k|^2 = w^2 rho(|e_k|^2) exactly: each run adds the mean over its K checkpoints of the
+// Huber loss rho(s) = s below c^2, 2 c sqrt(s) - c^2 above (Ceres' convention). A run of 40 m
+// weighs what a run of 4 m does; a ground-truth glitch at one checkpoint grows the cost linearly.
+//
+// Why the clock offset: the encoders and the ground truth are on different clocks (OptiOdom's
+// are mapped by hand-picked instants); a lag dt moves each checkpoint by |v| dt. The final pose,
+// at rest, does not see it; the track does. dt is one more parameter block, bounded, shared by
+// the runs of one session.
+//
+// Derivatives are exact: the model's own autodiff through the replay (its SegmentCost on windows
+// [0, k] with an identity ground truth gives P_k and dP_k/dp), chained with Jets through the
+// error, the interpolation in time and the loss.
+
+#include <ceres/cost_function.h>
+
+#include <cstddef>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "models/model_interface.h"
+#include "odometry/aligned_run.h"
+#include "odometry/run_log.h"
+
+namespace fitcal {
+
+struct TrackResidualOptions {
+  double checkpoint_spacing_m = 0.5;  // OptiOdom's
+  double huber_scale = 0.1;           // c, residual units (m and rad): a few times a clean error
+  double max_clock_offset_s = 0.5;    // |dt| bound
+  bool IsValid(std::string* error) const;
+};
+
+// One run prepared for the track residual: checkpoint sample counts and their encoder times.
+struct TrackCheckpoints {
+  const AlignedRun* run = nullptr;                 // must outlive the cost
+  const GroundTruthTrack* ground_truth = nullptr;  // must outlive the cost
+  std::vector<Segment> segments;  // windows [0, end_k] with the ground truth at dt = 0
+  std::vector<double> t_s;        // encoder time of each checkpoint
+  double t_start_s = 0.0;
+  int clock_group = 0;  // index of the run's clock offset
+};
+
+// How runs share clock offsets: one per session (runs recorded together; the run's trajectory
+// label, which `import optiodom` sets to the session), one per run, one for the whole data set (a
+// latency common to every recording), or none (held at 0).
+enum class ClockGrouping { kPerSession, kPerRun, kDataset, kNone };
+const char* ToString(ClockGrouping grouping);  // "session", "run", "dataset", "none"
+bool ParseClockGrouping(const std::string& text, ClockGrouping* out);
+
+// The training runs' tracks for the track residuals: one TrackCheckpoints per training run (same
+// order), each naming its clock group (0 .. clock_groups.size() - 1).
+struct TrackFitData {
+  std::vector<TrackCheckpoints> runs;
+  std::vector<std::string> clock_groups;  // names: the session or the run
+  bool estimate_clock_offsets = true;     // false: every offset held at 0
+  TrackResidualOptions options;
+};
+
+// ground_truth[i] is runs[i]'s track (both must outlive the result).
+TrackFitData MakeTrackFitData(const std::vector<AlignedRun>& runs,
+                              const std::vector<const GroundTruthTrack*>& ground_truth,
+                              ClockGrouping grouping, const TrackResidualOptions& options = {});
+
+// Checkpoints every options.checkpoint_spacing_m of ground-truth path and at the end.
+TrackCheckpoints MakeTrackCheckpoints(const AlignedRun& run, const GroundTruthTrack& ground_truth,
+                                      const TrackResidualOptions& options);
+
+// The ground truth's pose at t_k + dt relative to its pose at t_0 + dt (Q_k(dt) above), on
+// double: for metrics and tests.
+Pose2d GroundTruthFromStart(const TrackCheckpoints& track, std::size_t k, double dt_s);
+
+class TrackResidual : public ceres::CostFunction {
+ public:
+  // Parameter blocks: the model's parameters, then the run's clock offset dt (1 value, seconds).
+  static ceres::CostFunction* Create(const TrackCheckpoints& track,
+                                     const RobotModelInterface& model,
+                                     const ResidualWeights& weights,
+                                     const TrackResidualOptions& options);
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  TrackResidual(const TrackCheckpoints& track, const RobotModelInterface& model,
+                const ResidualWeights& weights, const TrackResidualOptions& options);
+
+  const TrackCheckpoints& track_;
+  std::unique_ptr<ceres::CostFunction> odometry_;  // P_k and dP_k/dp: 3 values per checkpoint
+  std::vector<Segment> from_start_;                // windows [0, k] with an identity ground truth
+  ResidualWeights weights_;
+  double huber_scale_;
+  double run_weight_;  // 1 / sqrt(K)
+  int num_parameters_;
+};
+
+}  // namespace fitcal

@@ -1,0 +1,286 @@
+// The track residuals (fit/track_residual.h) and the everyday-driving metrics
+// (validation/everyday_driving.h) on a simulated differential drive whose wheels and track are
+// all 2 % larger than the nominal (a common scale) and whose ground-truth clock runs 0.15 s late:
+//   - the residual's Jacobians (model autodiff chained with Jets) against central differences;
+//   - final poses of closed loops cannot see the common scale: the fit holds it at the nominal
+//     and says so; the track fit recovers the scale and the clock offset;
+//   - drift per metre of a straight run with a 1 % scale error is 1 %, and a constant heading-rate
+//     error shows as its deg/m.
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <vector>
+
+#include "fit/model_fit.h"
+#include "fit/residual_choice.h"
+#include "fit/track_residual.h"
+#include "models/model_registry.h"
+#include "odometry/aligned_run.h"
+#include "tools/sim/diff_drive_trajectories.h"
+#include "tools/sim/model_simulator.h"
+#include "validation/everyday_driving.h"
+#include "validation/time_blocks.h"
+
+namespace fitcal {
+namespace {
+
+const char* kNominalYaml = R"(model: diff_drive
+name: track_test
+wheels:
+  - {name: right, radius_m: 0.042}
+  - {name: left, radius_m: 0.042}
+wheel_separation_m: 0.200
+bounds: {radius_m: [0.038, 0.046], wheel_separation_m: [0.180, 0.220]}
+)";
+
+constexpr double kCommonScale = 1.02;   // true wheels and track / nominal
+constexpr double kClockOffsetS = 0.15;  // ground truth stamped this late
+constexpr double kGtPositionSigmaM = 0.001;
+
+RobotModelPtr Model() { return ReadRobotModel(YAML::Load(kNominalYaml), "robot.yaml"); }
+
+std::vector<double> TrueParameters(const RobotModelInterface& model) {
+  std::vector<double> p = model.robot().nominal;
+  for (double& v : p) v *= kCommonScale;
+  return p;
+}
+
+// Closed calibration loops (UMBmark squares and full circles, both directions), simulated with
+// ground-truth noise and the ground-truth clock shifted: the sample of the pose at encoder time t
+// is stamped t + kClockOffsetS.
+struct Simulated {
+  std::vector<RunLog> logs;
+  std::vector<AlignedRun> aligned;
+  std::vector<const GroundTruthTrack*> tracks;
+};
+
+Simulated SimulateLoops(const RobotModelInterface& model, int repetitions) {
+  sim::SimulationOptions o;
+  o.gt_position_sigma_m = kGtPositionSigmaM;
+  o.gt_heading_sigma_rad = 0.002;
+  o.wheel_rate_sigma_rad_s = 0.01;
+  o.rest_before_s = 1.0;  // longer than the clock offset: the window starts at rest
+  o.rest_after_s = 1.0;
+  Simulated s;
+  for (const auto& run : sim::SimulateRuns(model, TrueParameters(model),
+                                           sim::DiffDriveCalibrationTrajectories(repetitions), o)) {
+    s.logs.push_back(run.log);
+    for (double& t : s.logs.back().ground_truth.t_s) t += kClockOffsetS;
+  }
+  s.aligned = AlignRuns(s.logs);
+  for (const RunLog& log : s.logs) s.tracks.push_back(&log.ground_truth);
+  return s;
+}
+
+ModelFitOptions FitOptions(ResidualKind kind, const TrackFitData* track) {
+  ModelFitOptions o;
+  o.residuals = kind;
+  o.track = track;
+  o.ceres.num_threads = 1;
+  return o;
+}
+
+TEST(TrackResidual, JacobiansMatchCentralDifferences) {
+  const RobotModelPtr model = Model();
+  const Simulated s = SimulateLoops(*model, 1);
+  const TrackFitData data = MakeTrackFitData(s.aligned, s.tracks, ClockGrouping::kPerRun);
+  std::vector<double> p = {0.0425, 0.0418, 0.203};
+  double dt = 0.1234;  // between ground-truth samples (0.1 s apart): the interpolant is smooth
+  for (const TrackCheckpoints& track : data.runs) {
+    std::unique_ptr<ceres::CostFunction> cost(
+        TrackResidual::Create(track, *model, ResidualWeights{}, data.options));
+    const int m = cost->num_residuals();
+    std::vector<double> r(m), j_p(m * 3), j_dt(m);
+    const double* parameters[] = {p.data(), &dt};
+    double* jacobians[] = {j_p.data(), j_dt.data()};
+    ASSERT_TRUE(cost->Evaluate(parameters, r.data(), jacobians));
+    const auto residuals_at = [&](const std::vector<double>& q, double t) {
+      std::vector<double> out(m);
+      const double* at[] = {q.data(), &t};
+      cost->Evaluate(at, out.data(), nullptr);
+      return out;
+    };
+    // h: truncation O(h^2) and rounding O(1e-16 / h) both far below the 1e-5 relative tolerance
+    // (a Huber kink crossed by the step would show as a gross mismatch, not within it).
+    for (int k = 0; k < 4; ++k) {
+      const double h = k < 3 ? 1e-7 : 1e-6;
+      std::vector<double> plus = p, minus = p;
+      double dt_plus = dt, dt_minus = dt;
+      if (k < 3) {
+        plus[k] += h;
+        minus[k] -= h;
+      } else {
+        dt_plus += h;
+        dt_minus -= h;
+      }
+      const std::vector<double> rp = residuals_at(plus, dt_plus);
+      const std::vector<double> rm = residuals_at(minus, dt_minus);
+      for (int i = 0; i < m; ++i) {
+        const double numeric = (rp[i] - rm[i]) / (2.0 * h);
+        const double analytic = k < 3 ? j_p[i * 3 + k] : j_dt[i];
+        EXPECT_NEAR(analytic, numeric, 1e-5 * (1.0 + std::abs(numeric)))
+            << track.run->id << " residual " << i << " parameter " << k;
+      }
+    }
+  }
+}
+
+// The common scale s multiplies every distance the odometry replays and leaves every heading as
+// it is, so a closed loop ends where it started whatever s: the final-pose fit holds that
+// direction at the nominal. The track sees it at every checkpoint (1 % of the path from the start,
+// ~4 cm after 4 m) and recovers the scale and the clock offset.
+TEST(TrackFit, RecoversCommonScaleAndClockOffsetThatFinalPosesCannotSee) {
+  const RobotModelPtr model = Model();
+  const Simulated s = SimulateLoops(*model, 2);
+  const std::vector<double> truth = TrueParameters(*model);
+
+  const ModelFitResult final_pose =
+      FitModel(s.aligned, *model, FitOptions(ResidualKind::kFinalPose, nullptr));
+  ASSERT_TRUE(final_pose.usable);
+  ASSERT_FALSE(final_pose.held_directions.empty()) << "the common scale should be undetermined";
+  // Held at the nominal: the mean scale of the three lengths stays within a tenth of the 2 %.
+  double mean_scale = 0.0;
+  for (int k = 0; k < 3; ++k)
+    mean_scale += final_pose.parameters[k] / model->robot().nominal[k] / 3;
+  EXPECT_NEAR(mean_scale, 1.0, 0.002);
+
+  const TrackFitData data = MakeTrackFitData(s.aligned, s.tracks, ClockGrouping::kPerSession);
+  const ModelFitResult track = FitModel(s.aligned, *model, FitOptions(ResidualKind::kTrack, &data));
+  ASSERT_TRUE(track.usable) << track.termination << ": " << track.message;
+  EXPECT_TRUE(track.held_directions.empty());
+  // Tolerances from the noise: ground-truth noise of 1 mm per sample over hundreds of checkpoints
+  // of 1-6 m from the start bounds the scale to ~1e-4; the simulator's 50 ms encoder steps and the
+  // linear interpolation of the 10 Hz ground truth on 0.5 m circles (chord error v^2 dt^2 / 8 r
+  // = 0.1 mm) add less. 0.2 % is a tenth of the injected error.
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(track.parameters[k] / truth[k], 1.0, 0.002) << model->robot().LabelOf(k);
+  }
+  ASSERT_EQ(track.clock_offsets_s.size(), data.clock_groups.size());
+  for (std::size_t g = 0; g < data.clock_groups.size(); ++g) {
+    // Each session's offset within four of its own sigmas (from the residuals' scatter), and
+    // those sigmas small: 10 ms is 2 mm of motion at 0.2 m/s, twice the ground truth's noise.
+    ASSERT_TRUE(track.has_covariance);
+    const double sigma = track.clock_offset_sigma_s[g];
+    EXPECT_GT(sigma, 0.0);
+    EXPECT_LT(sigma, 0.01);
+    EXPECT_NEAR(track.clock_offsets_s[g], kClockOffsetS, 4.0 * sigma) << data.clock_groups[g];
+  }
+
+  // Without the clock offsets the track residuals are biased by |v| * 0.15 s = 3 cm per checkpoint,
+  // and "both" recovers the scale as well.
+  const ModelFitResult both = FitModel(s.aligned, *model, FitOptions(ResidualKind::kBoth, &data));
+  ASSERT_TRUE(both.usable);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(both.parameters[k] / truth[k], 1.0, 0.002);
+}
+
+// --residuals auto: the simulated loops (10 Hz ground truth at 0.2 m/s: a sample every 2 cm, 4 m
+// and more of path per run) are a dense track; the same runs with only every 30th ground-truth
+// sample kept (one every 0.6 m) are not, and neither are runs cut to their first 1.5 m of path.
+TEST(ResidualChoice, DenseLongTracksCallForTrackResiduals) {
+  const RobotModelPtr model = Model();
+  Simulated s = SimulateLoops(*model, 1);
+  const TrackDensity dense = MeasureTrackDensity(s.aligned, s.tracks);
+  EXPECT_TRUE(dense.dense) << dense.median_sample_spacing_m << " m, " << dense.median_path_m;
+  EXPECT_LT(dense.median_sample_spacing_m, 0.03);
+
+  std::vector<GroundTruthTrack> sparse;
+  for (const GroundTruthTrack* track : s.tracks) {
+    GroundTruthTrack thin;
+    for (std::size_t k = 0; k < track->t_s.size(); k += 30) {
+      thin.t_s.push_back(track->t_s[k]);
+      thin.world_T_robot.push_back(track->world_T_robot[k]);
+    }
+    sparse.push_back(thin);
+  }
+  std::vector<const GroundTruthTrack*> sparse_tracks;
+  for (const GroundTruthTrack& t : sparse) sparse_tracks.push_back(&t);
+  EXPECT_FALSE(MeasureTrackDensity(s.aligned, sparse_tracks).dense);
+
+  std::vector<AlignedRun> short_runs = s.aligned;
+  for (std::size_t i = 0; i < short_runs.size(); ++i) {
+    // End each run's window when 1.5 m of ground-truth path lie behind it.
+    const GroundTruthTrack& t = *s.tracks[i];
+    double path_m = 0.0;
+    for (std::size_t k = 1; k < t.t_s.size(); ++k) {
+      if (t.t_s[k - 1] < short_runs[i].t_start_s) continue;
+      path_m += std::hypot(t.world_T_robot[k].x - t.world_T_robot[k - 1].x,
+                           t.world_T_robot[k].y - t.world_T_robot[k - 1].y);
+      if (path_m > 1.5) {
+        short_runs[i].t_final_s = t.t_s[k];
+        break;
+      }
+    }
+  }
+  EXPECT_FALSE(MeasureTrackDensity(short_runs, s.tracks).dense);
+}
+
+// A straight run of 6 m replayed with a wheel radius 1 % small: every window is 1 % short, so the
+// drift is 1 % at every length and no rotation; a 1 % difference between the wheels instead turns
+// the robot by (dr / r) (1 m) / b per metre.
+TEST(EverydayDriving, DriftOfAStraightRunWithAScaleErrorAndAHeadingRateError) {
+  const RobotModelPtr model = Model();
+  const std::vector<double> nominal = model->robot().nominal;
+  sim::SimulationOptions o;
+  const auto runs =
+      sim::SimulateRuns(*model, nominal, {{"straight", 1, {{{0.2, 0.0, 0.0}, 30.0}}}}, o);
+  std::vector<RunLog> logs = {runs[0].log};
+  const std::vector<AlignedRun> aligned = AlignRuns(logs);
+  const std::vector<const GroundTruthTrack*> tracks = {&logs[0].ground_truth};
+
+  std::vector<double> small = nominal;
+  small[0] *= 0.99;
+  small[1] *= 0.99;
+  const EverydayDrivingMetrics scale =
+      EvaluateEverydayDriving(*model, small, {}, aligned, tracks, {1.0, 2.0, 5.0}, 1);
+  for (const DriftAtLength& d : scale.drift) {
+    ASSERT_GT(d.windows, 0);
+    // The odometry is sampled at the nearest encoder time (50 ms, 1 cm at 0.2 m/s) to each
+    // ground-truth time, on both ends of a window: the window's odometry length is off by at most
+    // that, 1 % of 1 m; the mean over windows cancels most of it.
+    EXPECT_NEAR(d.translation_percent, 1.0, 0.05) << d.length_m;
+    EXPECT_NEAR(d.rotation_deg_per_m, 0.0, 1e-6) << d.length_m;
+  }
+
+  std::vector<double> uneven = nominal;
+  uneven[0] *= 1.01;  // one wheel 1 % larger: the odometry turns at 0.01 v / b
+  const EverydayDrivingMetrics turn =
+      EvaluateEverydayDriving(*model, uneven, {}, aligned, tracks, {1.0}, 1);
+  // d theta / d s = (v_R' - v_L') / (b v) = 0.01 / b per metre of ground-truth path.
+  const double expected_deg_per_m = RadToDeg(0.01 / nominal[2]);
+  EXPECT_NEAR(turn.drift[0].rotation_deg_per_m, expected_deg_per_m, 0.02 * expected_deg_per_m);
+}
+
+// A straight run of 6 m at 0.2 m/s cut into four blocks: contiguous, every sample once, each
+// 1.5 m of path to within one encoder interval (1 cm), each started and ended on the ground truth.
+TEST(TimeBlocks, CutARunIntoBlocksOfEqualPath) {
+  const RobotModelPtr model = Model();
+  const auto sim = sim::SimulateRuns(*model, model->robot().nominal,
+                                     {{"free", 1, {{{0.2, 0.0, 0.0}, 30.0}}}}, {});
+  const std::vector<RunLog> logs = {sim[0].log};
+  const AlignedRun run = AlignRuns(logs)[0];
+  const std::vector<AlignedRun> blocks = CutIntoTimeBlocks(run, logs[0].ground_truth, 4);
+  ASSERT_EQ(blocks.size(), 4u);
+  std::size_t samples = 0;
+  double t = run.t_start_s;
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    const AlignedRun& block = blocks[b];
+    EXPECT_EQ(block.repetition, static_cast<int>(b) + 1);
+    EXPECT_NEAR(block.t_start_s, t, 1e-9);
+    samples += block.samples.size();
+    t = block.t_final_s;
+    const double path_m = std::hypot(block.final_ground_truth.x - block.start.x,
+                                     block.final_ground_truth.y - block.start.y);
+    // The first and last blocks include the ramps and rests; each holds 1.5 m of path.
+    EXPECT_NEAR(path_m, 1.5, 0.011) << block.id;
+  }
+  EXPECT_EQ(samples, run.samples.size());
+  EXPECT_NEAR(t, run.t_final_s, 1e-9);
+  EXPECT_THROW(CutIntoTimeBlocks(run, logs[0].ground_truth, 0), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace fitcal

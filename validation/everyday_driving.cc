@@ -1,0 +1,75 @@
+#include "validation/everyday_driving.h"
+
+#include <cstdio>
+#include <stdexcept>
+
+#include "odometry/parallel_for.h"
+#include "validation/relative_pose_error.h"
+#include "validation/trajectory_metrics.h"
+
+namespace fitcal {
+
+std::vector<double> EverydayDriftLengths() { return {1.0, 2.0, 5.0}; }
+
+EverydayDrivingMetrics EvaluateEverydayDriving(const RobotModelInterface& model,
+                                               const std::vector<double>& p,
+                                               const std::vector<effects::EffectValue>& effects,
+                                               const std::vector<AlignedRun>& runs,
+                                               const std::vector<const GroundTruthTrack*>& tracks,
+                                               const std::vector<double>& lengths_m,
+                                               int num_threads) {
+  if (runs.size() != tracks.size()) {
+    throw std::invalid_argument("EvaluateEverydayDriving: not one ground truth per run");
+  }
+  std::vector<TrajectoryErrors> per_run(runs.size());
+  ParallelFor(runs.size(), num_threads, [&](std::size_t i) {
+    per_run[i] = EvaluateTrajectory(model, runs[i], *tracks[i], p, effects);
+  });
+  EverydayDrivingMetrics out;
+  out.runs = static_cast<int>(runs.size());
+  for (const TrajectoryErrors& e : per_run) {
+    out.cf += e.cf;
+    out.mean_ate_rmse_m += e.rms_distance_m;
+  }
+  if (out.runs > 0) {
+    out.cf /= out.runs;
+    out.mean_ate_rmse_m /= out.runs;
+  }
+  for (double length : lengths_m) {
+    RelativePoseErrorSum sum;
+    for (const TrajectoryErrors& e : per_run) {
+      AddRelativePoseErrors(e.ground_truth, e.odometry, length, &sum);
+    }
+    out.drift.push_back(
+        {length, sum.windows, sum.MeanTranslationPercent(), RadToDeg(sum.MeanRotationRadPerM())});
+  }
+  return out;
+}
+
+std::vector<std::string> EverydayDrivingRows(const EverydayDrivingMetrics& before,
+                                             const EverydayDrivingMetrics& after) {
+  std::vector<std::string> rows;
+  char line[200];
+  const auto row = [&](const std::string& name, double a, double b, const char* format) {
+    const double change = a > 0.0 ? 100.0 * (b - a) / a : 0.0;
+    char values[100];
+    std::snprintf(values, sizeof values, format, a, b);
+    std::snprintf(line, sizeof line, "  %-30s %s %+8.1f%%", name.c_str(), values, change);
+    rows.push_back(line);
+  };
+  row("ATE RMSE [m] (mean of runs)", before.mean_ate_rmse_m, after.mean_ate_rmse_m,
+      "%10.4f %10.4f");
+  for (std::size_t k = 0; k < before.drift.size() && k < after.drift.size(); ++k) {
+    const DriftAtLength& a = before.drift[k];
+    const DriftAtLength& b = after.drift[k];
+    if (a.windows == 0) continue;
+    char name[64];
+    std::snprintf(name, sizeof name, "drift %g m [%%] (%d windows)", a.length_m, a.windows);
+    row(name, a.translation_percent, b.translation_percent, "%10.3f %10.3f");
+    std::snprintf(name, sizeof name, "drift %g m [deg/m]", a.length_m);
+    row(name, a.rotation_deg_per_m, b.rotation_deg_per_m, "%10.3f %10.3f");
+  }
+  return rows;
+}
+
+}  // namespace fitcal

@@ -1,0 +1,52 @@
+#pragma once
+// Measures of everyday driving for a set of runs replayed with one calibration: what a robot's
+// dead reckoning does between closed-loop ends, beside Palacin's final-pose CF (Eq. 14).
+//   - drift per distance travelled (relative_pose_error.h: KITTI's translation error in % of the
+//     window's length and rotation error per metre) over windows of 1, 2 and 5 m of ground-truth
+//     path, every window of every run weighing alike;
+//   - ATE RMSE: each run's RMS position error over its ground-truth samples (Palacin Eq. 12,
+//     trajectory_metrics.h), the odometry started at the ground truth's start pose, no other
+//     alignment and never a scale (a scale alignment would absorb the wheel radius); the mean
+//     over runs.
+
+#include <string>
+#include <vector>
+
+#include "models/model_interface.h"
+#include "odometry/aligned_run.h"
+#include "odometry/effects.h"
+#include "odometry/run_log.h"
+
+namespace fitcal {
+
+struct DriftAtLength {
+  double length_m = 0.0;
+  int windows = 0;
+  double translation_percent = 0.0;
+  double rotation_deg_per_m = 0.0;
+};
+
+struct EverydayDrivingMetrics {
+  int runs = 0;
+  double cf = 0.0;               // mean per-run Eq. 14 (m and rad)
+  double mean_ate_rmse_m = 0.0;  // mean over runs of Eq. 12
+  std::vector<DriftAtLength> drift;
+};
+
+// The lengths printed by default: 1, 2 and 5 m.
+std::vector<double> EverydayDriftLengths();
+
+// tracks[i] is runs[i]'s ground truth. Runs shorter than a window add nothing to its drift.
+EverydayDrivingMetrics EvaluateEverydayDriving(const RobotModelInterface& model,
+                                               const std::vector<double>& p,
+                                               const std::vector<effects::EffectValue>& effects,
+                                               const std::vector<AlignedRun>& runs,
+                                               const std::vector<const GroundTruthTrack*>& tracks,
+                                               const std::vector<double>& lengths_m,
+                                               int num_threads = 0);
+
+// Table rows "  drift 1 m [%]  nominal  calibrated" etc. for two calibrations on the same runs.
+std::vector<std::string> EverydayDrivingRows(const EverydayDrivingMetrics& before,
+                                             const EverydayDrivingMetrics& after);
+
+}  // namespace fitcal

@@ -1,0 +1,20 @@
+#pragma once
+// Held-out time blocks of a long run: a data set of free driving may hold a single run, and a
+// calibration from it must still be judged on driving it was not fitted on. The run is cut at
+// encoder sample boundaries into blocks of equal ground-truth path length; each block is a run of
+// its own, started at the ground truth's pose at its first instant and ended at its last, so its
+// final pose (Palacin Eq. 14) judges an open path that sees the scale as well as the heading.
+
+#include <vector>
+
+#include "odometry/aligned_run.h"
+#include "odometry/run_log.h"
+
+namespace fitcal {
+
+// Blocks k = 1..num_blocks of `run`: id "<id>-block<k>", the run's trajectory label, repetition k.
+// Throws std::invalid_argument when num_blocks < 1 or the run has fewer samples than blocks.
+std::vector<AlignedRun> CutIntoTimeBlocks(const AlignedRun& run, const GroundTruthTrack& track,
+                                          int num_blocks);
+
+}  // namespace fitcal
