@@ -46,7 +46,7 @@ TEST(Fleet, FlagsTrendsAndOutliers) {
       std::vector<double> p = {0.0420 + scatter(rng), 0.0420 + scatter(rng), 0.2 + scatter(rng)};
       if (robot == "r1") p[1] -= 0.0001 * week;
       if (robot == "r2" && week == 5) p[0] += 0.002;
-      char date[16];
+      char date[32];
       std::snprintf(date, sizeof date, "2026-%02d-%02d", 3 + week / 4, 1 + 7 * (week % 4));
       const std::string block =
           "calibration:\n  training_repetitions: [1]\n  cf_validation: {before: 0.05, after: 0.01}\n";

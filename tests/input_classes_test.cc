@@ -104,8 +104,18 @@ TEST_F(InputClassesTest, AFitWithNoResidualDegreesOfFreedomIsRefused) {
   std::getline(in, runs);
   std::getline(in, first);
   WriteFileBytes(data_ / "dataset.yaml", robot + "\n" + runs + "\n" + first + "\n");
-  ExpectFitRefused(1, {"1 training run gives 3 final-pose residuals for 3 free parameters",
-                       "Record at least 2 training runs"});
+  ExpectFitRefused(1,
+                   {"1 training run gives 3 final-pose residuals for 3 free parameters",
+                    "Record at least 2 training runs"},
+                   "--residuals final-pose");
+  // Fitted on its track (the default where the ground truth is dense), the same run has
+  // residuals to spare: it is judged on its own held-out time blocks, and the fit of the whole
+  // run is written with its sigmas.
+  const auto r = RunFitcal(dir_, "fit --logs '" + data_.string() + "' --out '" + out_.string() + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err << r.out;
+  EXPECT_TRUE(Has(r.out, "judged on held-out time blocks")) << r.out;
+  EXPECT_TRUE(Has(ReadFileBytes(out_), "held-out time blocks")) << ReadFileBytes(out_);
+  EXPECT_FALSE(Has(ReadFileBytes(out_), "null")) << ReadFileBytes(out_);
 }
 
 TEST_F(InputClassesTest, RatesInDegreesPerSecondAreNamed) {

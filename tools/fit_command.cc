@@ -110,11 +110,12 @@ void AddFitOptions(CLI::App& app, FitCommandOptions& o) {
   app.add_flag("--no-output", o.no_output, "Do not write the calibrated YAML");
   app.add_flag("--force", o.force, "Overwrite --out even if it holds another robot's calibration");
   app.add_option("--time-blocks", o.time_blocks,
-                 "With one or two runs fitted on their tracks and none held out, cut each into "
-                 "this many blocks of equal path: odd blocks train, even ones validate and the "
-                 "fit of the odd ones is written (0: fit the whole runs, not validated)")
+                 "With one or two runs fitted on their tracks and none held out, judge on time: "
+                 "cut each into this many blocks of equal path, fit the odd blocks and judge on "
+                 "the even ones and back; the whole runs' fit is written only when that beats "
+                 "the nominal")
       ->capture_default_str()
-      ->check(CLI::Range(0, 100));
+      ->check(CLI::Range(2, 100));
   app.add_flag("--skip-wheel-order-check", o.skip_wheel_order_check,
                "Fit even if another encoder column order/sign explains the data far better");
   app.add_option("--effects", o.effects,

@@ -29,7 +29,7 @@ struct FitCommandOptions : DatasetCommandOptions, SolverOptions {
   // of equal path, the odd ones train and the even ones validate (0, the default: fit the whole
   // runs; measured on the OptiOdom free runs, half a run calibrates worse,
   // docs/everyday_driving.md).
-  int time_blocks = 0;
+  int time_blocks = 4;
 };
 
 // Declares every flag of `fit` on `app` (the `fit` subcommand, and the top level: `fitcal --logs
