@@ -9,6 +9,7 @@
 
 #include "diagnosis/clock_choice.h"
 #include "diagnosis/diagnose.h"
+#include "fit/correlation.h"
 #include "fit/segment_cost.h"
 #include "fitcal/version.h"
 #include "io/atomic_file.h"
@@ -23,6 +24,7 @@
 #include "odometry/parallel_for.h"
 #include "tools/cli_validators.h"
 #include "tools/output_guard.h"
+#include "validation/propagated_uncertainty.h"
 #include "validation/run_split.h"
 #include "validation/training_runs.h"
 #include "validation/trajectory_metrics.h"
@@ -170,6 +172,29 @@ DiagnoseChoice GateDiagnosis(const RobotModelInterface& model, const DiagnoseSpl
   candidates[best].cf_training_after = cf_training(candidates[best]);
   *gate = candidates;
   return candidates[best];
+}
+
+// A written calibration never carries sigma: null. When the fit that made the chosen parameters
+// had no covariance of its own, they get the one propagated through the training runs' final
+// poses (validation/propagated_uncertainty.h); false, after one line, when even that is not
+// possible (nothing is written then).
+bool WithUncertainty(const RobotModelInterface& model, const DiagnoseSplit& split,
+                     DiagnoseChoice* choice) {
+  const std::size_t n = model.robot().parameters.size();
+  if (choice->sigma.size() == n) return true;
+  std::vector<AlignedRun> training;
+  for (const TrackRun& r : split.training) training.push_back(r.aligned);
+  const PropagatedUncertainty u = PropagateFinalPoseUncertainty(model, choice->parameters, training);
+  if (!u.ok || u.sigma.size() != n) {
+    std::cerr << "fitcal: the chosen calibration ('" << choice->name
+              << "') has no uncertainty: " << u.message << "; nothing written\n";
+    return false;
+  }
+  choice->sigma = u.sigma;
+  choice->correlation = CorrelationOf(u.covariance);
+  std::printf("uncertainty of '%s': propagated through the training runs' final poses\n",
+              choice->name.c_str());
+  return true;
 }
 
 std::string ObjectiveOf(const DiagnoseChoice& choice) {
@@ -481,12 +506,13 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
                                FormatDiagnoseReport(result, *model);
     std::printf("%s", report.c_str());
     std::vector<DiagnoseChoice> gate;
-    const DiagnoseChoice choice = GateDiagnosis(*model, split, result, options.threads, &gate);
+    DiagnoseChoice choice = GateDiagnosis(*model, split, result, options.threads, &gate);
     if (choice.name == "nominal") {
       std::cerr << "fitcal: no calibration beats the nominal robot on the held-out runs; nothing "
                    "written\n";
       return 5;
     }
+    if (!WithUncertainty(*model, split, &choice)) return 1;
     const std::string yaml =
         omni3 ? Omni3CalibratedYaml(options, index.robot_path, runs, split, result, choice)
               : ModelCalibratedYaml(options, *model, runs, split, result, choice);
