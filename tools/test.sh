@@ -15,7 +15,17 @@ slowest_steps() {
   awk 'NR > 1 { printf "%8.1f  %s\n", ($2 - $1) / 1000, $4 }' "$1/.ninja_log" | sort -rn | sed -n 1,8p
 }
 
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DFITCAL_WERROR=ON
+# ccache, when installed (install_deps.sh installs it), keeps compiled objects across clones of
+# the repository on one machine: paths are taken relative to the clone, and the precompiled
+# headers' defines and time stamps are allowed to differ. A fresh machine builds cold.
+launcher=()
+if command -v ccache > /dev/null; then
+  export CCACHE_BASEDIR="$PWD"
+  export CCACHE_SLOPPINESS=pch_defines,time_macros,include_file_mtime,include_file_ctime
+  launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+fi
+
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DFITCAL_WERROR=ON "${launcher[@]}"
 cmake --build build -j "$jobs"
 slowest_steps build
 echo "release build: $((SECONDS - start)) s"
@@ -29,7 +39,7 @@ echo "release tests done: $((SECONDS - start)) s"
 asan_dir=${FITCAL_ASAN_BUILD_DIR:-build-asan}
 cmake -S . -B "$asan_dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DFITCAL_SANITIZE=ON -DFITCAL_WERROR=ON \
-  -DFITCAL_BUILD_BENCHMARKS=OFF
+  -DFITCAL_BUILD_BENCHMARKS=OFF "${launcher[@]}"
 cmake --build "$asan_dir" -j "$jobs"
 slowest_steps "$asan_dir"
 echo "sanitizer build: $((SECONDS - start)) s"

@@ -105,7 +105,9 @@ class McapStorage : public StorageReader {
       std::map<std::string, std::int64_t>* latest_ns) override {
     for (std::size_t seq = 0; seq < blocks_.size(); ++seq) {
       if (blocks_[seq].message_count == 0) continue;
-      for (const Entry& e : LoadBlock(seq, /*sorted=*/false)->entries) {
+      // Held here: a range-for over a member of the temporary would outlive the block.
+      const auto block = LoadBlock(seq, /*sorted=*/false);
+      for (const Entry& e : block->entries) {
         const auto [it, first] = latest_ns->emplace(topics_[e.topic_index].name, e.time_ns);
         if (!first && e.time_ns < it->second - kClockStepBackToleranceNs) {
           return ClockStepBack{it->second, e.time_ns};
