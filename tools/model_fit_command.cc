@@ -603,21 +603,23 @@ bool WorseThanNominalOnSomeKind(const std::vector<CalibrationCandidate>& candida
   return worse;
 }
 
-// A data set of free driving may hold one or two long runs and nothing to validate on. When they
-// are fitted on their tracks (--residuals track/both, or auto resolving to track), the procedure
-// is judged on the runs' own time: each run is cut into --time-blocks blocks of equal
-// ground-truth path (validation/time_blocks.h), the fit made on the odd blocks is judged on the
-// even ones and the fit made on the even blocks on the odd ones, against the nominal (a two-fold
-// cross-validation in time). The calibration written is the fit of the whole runs, which was
-// measured to transfer better than a fit of half of them (docs/everyday_driving.md); the
-// judgement says whether the runs determine the parameters at all.
+// With nothing held out (every run trains: --train-reps 1-99, or a data set of free driving), the
+// procedure is judged by two folds before the fit of all the training runs is written: a fit of
+// one half is judged on the other half and back, against the nominal (two-fold cross-validation).
+// - More than two runs: every other run trains, the rest is held out.
+// - One or two long runs fitted on their tracks (--residuals track/both, or auto resolving to
+//   track): each is cut into --time-blocks blocks of equal ground-truth path
+//   (validation/time_blocks.h), odd blocks against even ones.
+// The calibration written is the fit of everything, which was measured to transfer better than a
+// fit of half of it (docs/everyday_driving.md); the judgement says whether the runs determine the
+// parameters at all, and nothing is written when the halves do not beat the nominal.
 constexpr std::size_t kMaxRunsForTimeBlocks = 2;
 
-struct TimeBlockJudgement {
+struct HalvesJudgement {
   bool judged = false;
-  int folds = 0;
-  double nominal_cf = 0.0;     // mean CF (Eq. 14) of the held-out blocks, both folds
-  double calibrated_cf = 0.0;  // of each fold's fit on its held-out blocks
+  bool by_time = false;        // time blocks of one or two runs (else halves of the runs)
+  double nominal_cf = 0.0;     // mean CF (Eq. 14) of the held-out halves, both folds
+  double calibrated_cf = 0.0;  // of each fold's fit on its held-out half
   bool Beats() const { return judged && calibrated_cf < nominal_cf; }
 };
 
@@ -639,34 +641,43 @@ RunSplit TimeBlockFold(const RunSplit& whole, const std::vector<RunLog>& logs, i
   return blocks;
 }
 
-TimeBlockJudgement JudgeOnTimeBlocks(const FitCommandOptions& options, const FitMethod& method,
+// Every other training run (in data-set order, so each session gives to both halves).
+RunSplit RunsFold(const RunSplit& whole, int fold) {
+  RunSplit half;
+  for (std::size_t i = 0; i < whole.training.size(); ++i) {
+    (static_cast<int>(i % 2) == fold ? half.training : half.validation)
+        .push_back(whole.training[i]);
+  }
+  return half;
+}
+
+HalvesJudgement JudgeOnHeldOutHalves(const FitCommandOptions& options, const FitMethod& method,
                                      const FitMethodSettings& settings,
                                      const RobotModelInterface& model, const RunSplit& split,
                                      const std::vector<RunLog>& logs) {
-  TimeBlockJudgement j;
-  if (options.time_blocks < 2 || settings.residuals == ResidualKind::kFinalPose ||
-      !split.validation.empty() || split.training.empty() ||
-      split.training.size() > kMaxRunsForTimeBlocks) {
-    return j;
-  }
+  HalvesJudgement j;
+  if (!split.validation.empty() || split.training.empty()) return j;
+  j.by_time = split.training.size() <= kMaxRunsForTimeBlocks;
+  if (j.by_time && settings.residuals == ResidualKind::kFinalPose) return j;
   double nominal_sum = 0.0, calibrated_sum = 0.0;
   std::size_t held_out = 0;
   for (int fold = 0; fold < 2; ++fold) {
-    std::vector<RunLog> block_logs = logs;
-    const RunSplit blocks = TimeBlockFold(split, logs, options.time_blocks, fold, &block_logs);
-    if (blocks.training.empty() || blocks.validation.empty()) return j;
+    std::vector<RunLog> fold_logs = logs;
+    const RunSplit half = j.by_time
+                              ? TimeBlockFold(split, logs, options.time_blocks, fold, &fold_logs)
+                              : RunsFold(split, fold);
+    if (half.training.empty() || half.validation.empty()) return j;
     FitMethodSettings fold_settings = settings;
-    fold_settings.residuals_auto = false;  // the whole runs' choice holds for their blocks
+    fold_settings.residuals_auto = false;  // the whole data's choice holds for its halves
     std::optional<TrackFitData> track_data;
-    if (!PrepareTrackResiduals(options, block_logs, blocks, &fold_settings, &track_data)) return j;
-    const ModelFitResult fit = method.run_model(blocks.training, model, fold_settings).fit;
+    if (!PrepareTrackResiduals(options, fold_logs, half, &fold_settings, &track_data)) return j;
+    const ModelFitResult fit = method.run_model(half.training, model, fold_settings).fit;
     if (!(fit.usable || fit.stopped_early)) return j;
-    const CandidateErrors errors(model, block_logs, options.threads);
-    const double n = static_cast<double>(blocks.validation.size());
-    nominal_sum += n * errors({"nominal", model.robot().nominal, true}, blocks.validation).cf;
-    calibrated_sum += n * errors({"fold", fit.parameters, true}, blocks.validation).cf;
-    held_out += blocks.validation.size();
-    ++j.folds;
+    const CandidateErrors errors(model, fold_logs, options.threads);
+    const double n = static_cast<double>(half.validation.size());
+    nominal_sum += n * errors({"nominal", model.robot().nominal, true}, half.validation).cf;
+    calibrated_sum += n * errors({"fold", fit.parameters, true}, half.validation).cf;
+    held_out += half.validation.size();
   }
   j.judged = held_out > 0;
   j.nominal_cf = nominal_sum / std::max<std::size_t>(1, held_out);
@@ -674,20 +685,29 @@ TimeBlockJudgement JudgeOnTimeBlocks(const FitCommandOptions& options, const Fit
   return j;
 }
 
-// Prints the judgement; false (exit 5, nothing written) when the fits of half the time do not
-// beat the nominal on the other half.
-bool ReportTimeBlocks(const TimeBlockJudgement& j, int num_blocks) {
+// What the halves were, for the output and the file's selected_on.
+std::string HalvesDescription(const HalvesJudgement& j, int num_blocks) {
+  char cf[64];
+  std::snprintf(cf, sizeof(cf), "CF %.4f -> %.4f", j.nominal_cf, j.calibrated_cf);
+  return j.by_time ? "held-out time blocks of the training runs (two folds of " +
+                         std::to_string(num_blocks) + " blocks of equal path, odd against even; " +
+                         cf + ")"
+                   : "held-out halves of the training runs (two folds, every other run against "
+                     "the rest; " +
+                         std::string(cf) + ")";
+}
+
+// Prints the judgement; false (exit 5, nothing written) when the fits of one half do not beat the
+// nominal on the other.
+bool ReportHalves(const HalvesJudgement& j, int num_blocks) {
   if (!j.judged) return true;
-  std::printf(
-      "no held-out runs: judged on held-out time blocks (each run cut into %d blocks of equal "
-      "ground-truth path; fitted on the odd blocks, judged on the even ones, and back): CF %.4f "
-      "-> %.4f; the calibration written is fitted on the whole runs\n",
-      num_blocks, j.nominal_cf, j.calibrated_cf);
+  std::printf("no held-out runs: judged on %s; the calibration written is fitted on all of them\n",
+              HalvesDescription(j, num_blocks).c_str());
   if (j.Beats()) return true;
-  std::cerr << "fitcal: fitted on half of the run's time, the calibration does not beat the "
-               "nominal on the other half (CF "
-            << j.nominal_cf << " -> " << j.calibrated_cf
-            << "): the run does not determine the parameters; record more driving; nothing "
+  std::cerr << "fitcal: fitted on half of the " << (j.by_time ? "run's time" : "training runs")
+            << ", the calibration does not beat the nominal on the other half (CF " << j.nominal_cf
+            << " -> " << j.calibrated_cf
+            << "): the runs do not determine the parameters; record more driving; nothing "
                "written\n";
   return false;
 }
@@ -756,8 +776,8 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   }
   std::optional<TrackFitData> track_data;
   if (!PrepareTrackResiduals(options, logs, split, &settings, &track_data)) return 2;
-  const TimeBlockJudgement time_blocks =
-      JudgeOnTimeBlocks(options, *method, settings, *model, split, logs);
+  const HalvesJudgement halves =
+      JudgeOnHeldOutHalves(options, *method, settings, *model, split, logs);
   if (const std::string refusal = DegreesOfFreedomRefusal(
           split, settings, track_data,
           robot.NumFree() + (effects_to_fit ? effects_to_fit->size() : 0));
@@ -801,15 +821,14 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   PrintEverydayDriving(*model, logs, split, candidates[0], selected, options.threads);
   if (!fit.has_covariance) std::printf("uncertainty: %s\n", fit.covariance_message.c_str());
   for (const UndeterminedDirection& d : fit.held_directions) PrintHeldAtNominal(d.description);
-  if (!PrintGate(candidates, gate, effects_line)) return 5;
-  if (!ReportTimeBlocks(time_blocks, options.time_blocks)) return 5;
-  if (time_blocks.judged) {
-    char cf[64];
-    std::snprintf(cf, sizeof(cf), "CF %.4f -> %.4f", time_blocks.nominal_cf,
-                  time_blocks.calibrated_cf);
-    gate.judged_on = "held-out time blocks of the training runs (two folds of " +
-                     std::to_string(options.time_blocks) + " blocks; " + cf + ")";
+  if (halves.judged) {  // the gate's table is on the training runs; the halves judge (below)
+    gate.judged_on = "training runs (" + std::to_string(split.training.size()) +
+                     "; no held-out runs: judged on held-out " +
+                     (halves.by_time ? "time blocks" : "halves") + ", below)";
   }
+  if (!PrintGate(candidates, gate, effects_line)) return 5;
+  if (!ReportHalves(halves, options.time_blocks)) return 5;
+  if (halves.judged) gate.judged_on = HalvesDescription(halves, options.time_blocks);
   if (WorseThanNominalOnSomeKind(candidates, gate, split, errors)) return 5;
   WarnOfEffects(candidates, gate, split, errors);
   if (!options.no_output) {
