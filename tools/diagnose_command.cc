@@ -24,6 +24,7 @@
 #include "odometry/parallel_for.h"
 #include "tools/cli_validators.h"
 #include "tools/output_guard.h"
+#include "tools/report_command.h"
 #include "validation/propagated_uncertainty.h"
 #include "validation/run_split.h"
 #include "validation/training_runs.h"
@@ -411,27 +412,11 @@ io::DiagnosePageData MakePage(const DiagnoseCommandOptions& options,
   for (const std::string& line : result.record_next) page.unexplained.push_back(line);
   const bool has_sigma = static_cast<int>(choice.sigma.size()) == robot.NumParameters();
   for (int k = 0; k < robot.NumParameters(); ++k) {
-    io::ReportParameter p;
-    p.name = robot.parameters[k].name;
-    p.is_angle = robot.parameters[k].unit == ParameterUnit::kAngle;
-    p.unit = robot.parameters[k].DisplayUnit();
-    p.held = robot.IsHeld(k);
-    p.nominal = robot.nominal[k];
-    p.calibrated = choice.parameters[k];
-    p.has_sigma = has_sigma && !p.held;
-    p.sigma = has_sigma ? choice.sigma[k] : 0.0;
-    page.parameters.push_back(p);
+    page.parameters.push_back(ReportParameterOf(robot, k, choice.parameters[k], has_sigma,
+                                                has_sigma ? choice.sigma[k] : 0.0));
   }
   for (const effects::EffectValue& value : choice.effects) {
-    const effects::EffectInfo& info = effects::Info(value.id);
-    io::ReportEffect e;
-    e.name = info.name;
-    for (int k = 0; k < info.num_parameters; ++k) {
-      e.parameter_names.push_back(info.parameter_names[k]);
-      e.values.push_back(value.value[k]);
-      e.sigmas.push_back(value.sigma[k]);
-    }
-    page.effects.push_back(e);
+    page.effects.push_back(ReportEffectOf(value));
   }
   return page;
 }

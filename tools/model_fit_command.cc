@@ -26,7 +26,6 @@
 #include "tools/fit_methods.h"
 #include "tools/output_guard.h"
 #include "validation/everyday_driving.h"
-#include "validation/generalisation.h"
 #include "validation/propagated_uncertainty.h"
 #include "validation/rate_units.h"
 #include "validation/residual_dof.h"

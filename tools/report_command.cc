@@ -514,15 +514,8 @@ void AddParameters(const ReportInputs& in, const CalibrationInput& cal,
     recorded_at_bound.insert(cal.provenance->at_bound.begin(), cal.provenance->at_bound.end());
   }
   for (int k = 0; k < robot.NumParameters(); ++k) {
-    io::ReportParameter rp;
-    rp.name = robot.parameters[k].name;
-    rp.is_angle = robot.parameters[k].unit == ParameterUnit::kAngle;
-    rp.unit = robot.parameters[k].DisplayUnit();
-    rp.held = robot.IsHeld(k);
-    rp.nominal = robot.nominal[k];
-    rp.calibrated = cal.calibrated.nominal[k];
-    rp.has_sigma = has_sigma && !robot.IsHeld(k);
-    rp.sigma = has_sigma ? sigma[k] : 0.0;
+    io::ReportParameter rp = ReportParameterOf(robot, k, cal.calibrated.nominal[k], has_sigma,
+                                               has_sigma ? sigma[k] : 0.0);
     rp.at_bound = recorded_at_bound.count(rp.name) > 0 ||
                   (!robot.IsHeld(k) && AtBound(rp.calibrated, robot.bounds[k]));
     if (cv) {
@@ -539,15 +532,7 @@ void AddParameters(const ReportInputs& in, const CalibrationInput& cal,
 
 void AddEffects(const CalibrationInput& cal, const EvaluatedRuns& e, io::ReportData* data) {
   for (const effects::EffectValue& value : cal.calibrated.effects) {
-    const effects::EffectInfo& info = effects::Info(value.id);
-    io::ReportEffect effect;
-    effect.name = info.name;
-    for (int k = 0; k < info.num_parameters; ++k) {
-      effect.parameter_names.push_back(info.parameter_names[k]);
-      effect.values.push_back(value.value[k]);
-      effect.sigmas.push_back(value.sigma[k]);
-    }
-    data->effects.push_back(effect);
+    data->effects.push_back(ReportEffectOf(value));
   }
   double sum = 0.0;
   for (double cf : e.cf_parameters_only) sum += cf;
@@ -825,6 +810,32 @@ int RunReportCommand(const ReportCommandOptions& options) {
     PrintReport(options, data, cv);
     return ExitStatus(options, data.verdict);
   });
+}
+
+io::ReportParameter ReportParameterOf(const Robot& robot, int k, double calibrated,
+                                      bool has_sigma, double sigma) {
+  io::ReportParameter p;
+  p.name = robot.parameters[k].name;
+  p.is_angle = robot.parameters[k].unit == ParameterUnit::kAngle;
+  p.unit = robot.parameters[k].DisplayUnit();
+  p.held = robot.IsHeld(k);
+  p.nominal = robot.nominal[k];
+  p.calibrated = calibrated;
+  p.has_sigma = has_sigma && !p.held;
+  p.sigma = sigma;
+  return p;
+}
+
+io::ReportEffect ReportEffectOf(const effects::EffectValue& value) {
+  const effects::EffectInfo& info = effects::Info(value.id);
+  io::ReportEffect effect;
+  effect.name = info.name;
+  for (int k = 0; k < info.num_parameters; ++k) {
+    effect.parameter_names.push_back(info.parameter_names[k]);
+    effect.values.push_back(value.value[k]);
+    effect.sigmas.push_back(value.sigma[k]);
+  }
+  return effect;
 }
 
 }  // namespace fitcal::tools
