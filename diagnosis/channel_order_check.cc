@@ -9,7 +9,7 @@
 
 #include "diagnosis/wheel_order_check.h"
 #include "fit/model_fit.h"
-#include "fit/pose_errors.h"
+#include "models/pose_errors.h"
 #include "odometry/parallel_for.h"
 
 namespace fitcal {

@@ -2,7 +2,7 @@
 
 #include <stdexcept>
 
-#include "diagnosis/effect_fit.h"
+#include "fit/effect_fit.h"
 
 namespace fitcal {
 

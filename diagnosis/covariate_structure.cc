@@ -8,7 +8,7 @@
 #include <numeric>
 #include <random>
 
-#include "diagnosis/statistics.h"
+#include "validation/statistics.h"
 
 namespace fitcal {
 

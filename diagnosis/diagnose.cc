@@ -6,8 +6,8 @@
 #include <limits>
 #include <stdexcept>
 
-#include "diagnosis/statistics.h"
 #include "models/omni3/omni3_robot_model.h"
+#include "validation/statistics.h"
 
 namespace fitcal {
 

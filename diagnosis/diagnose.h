@@ -44,8 +44,8 @@
 #include <vector>
 
 #include "diagnosis/covariate_structure.h"
-#include "diagnosis/effect_fit.h"
 #include "diagnosis/residual_analysis.h"
+#include "fit/effect_fit.h"
 #include "fit/model_fit.h"
 #include "fit/omni3_ceres_fit.h"
 

@@ -6,9 +6,9 @@
 #include <cstdio>
 #include <map>
 
-#include "diagnosis/statistics.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "odometry/parallel_for.h"
+#include "validation/statistics.h"
 #include "validation/trajectory_family.h"
 
 namespace fitcal {

@@ -28,8 +28,8 @@
 #include <string>
 #include <vector>
 
-#include "diagnosis/effect_fit.h"
 #include "diagnosis/sensor_noise_floor.h"
+#include "fit/effect_fit.h"
 
 namespace fitcal {
 

@@ -44,7 +44,7 @@
 #include <string>
 #include <vector>
 
-#include "diagnosis/effect_fit.h"
+#include "fit/effect_fit.h"
 
 namespace fitcal {
 

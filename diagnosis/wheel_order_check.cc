@@ -7,11 +7,11 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "diagnosis/statistics.h"
 #include "fit/omni3_ceres_fit.h"
 #include "fit/segment_cost.h"
 #include "odometry/omni3_replay.h"
 #include "odometry/parallel_for.h"
+#include "validation/statistics.h"
 
 namespace fitcal {
 

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "fit/pose_errors.h"
+#include "models/pose_errors.h"
 #include "odometry/parallel_for.h"
 
 namespace fitcal {

@@ -19,7 +19,7 @@ struct FinalPoseErrors {
   std::vector<double> per_run_cf;
 };
 
-// Per-run final-pose residuals (fit/pose_errors.h, weights 1) reduced to Eq. 14 and the mean
+// Per-run final-pose residuals (models/pose_errors.h, weights 1) reduced to Eq. 14 and the mean
 // position and heading errors.
 FinalPoseErrors SummariseFinalPoseResiduals(const std::vector<std::array<double, 3>>& residuals);
 

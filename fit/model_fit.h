@@ -1,7 +1,7 @@
 #pragma once
 // Fits a robot model's parameters to the final poses of a set of runs with Ceres (Palacin
 // Sec. 2.6 for omni3, the same for every model): one residual block per run (the model's
-// FinalPoseCost, fit/pose_errors.h), autodiff through the replay, started from the robot's
+// FinalPoseCost, models/pose_errors.h), autodiff through the replay, started from the robot's
 // nominal parameters (Palacin Eq. 15) and bounded by its box (Eq. 16). Parameters the model
 // holds by construction (Robot::held, gauge) stay at their nominal values.
 //
@@ -82,7 +82,7 @@ bool ParseResidualKind(const std::string& text, ResidualKind* out);
 struct ModelFitOptions {
   CeresFitOptions ceres;
   // When set, one window list per training run: the fit minimises the segment residuals
-  // (relative pose error over windows, fit/pose_errors.h) instead of the final poses.
+  // (relative pose error over windows, models/pose_errors.h) instead of the final poses.
   const std::vector<std::vector<Segment>>* segments = nullptr;
   // Which residuals (ignored when `segments` is set); kTrack and kBoth need `track`.
   ResidualKind residuals = ResidualKind::kFinalPose;

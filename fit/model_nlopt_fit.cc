@@ -5,7 +5,7 @@
 #include <memory>
 #include <stdexcept>
 
-#include "fit/pose_errors.h"
+#include "models/pose_errors.h"
 
 namespace fitcal {
 

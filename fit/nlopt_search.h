@@ -3,7 +3,7 @@
 // fit/omni3_nlopt_fit.h, for any model in fit/model_nlopt_fit.h): global methods (the analogues
 // of the genetic algorithm of Palacin Sec. 2.6 / Table 4), local derivative-free methods, and
 // bounded gradient methods (the analogue of MATLAB's fmincon), over per-run final-pose residuals
-// (fit/pose_errors.h) that a RunResiduals supplies - in doubles for the value, with the autodiff
+// (models/pose_errors.h) that a RunResiduals supplies - in doubles for the value, with the autodiff
 // Jacobian of the same residual for the gradient. Runs are evaluated in parallel on a pool of
 // threads that lives for the whole search.
 //
@@ -29,7 +29,7 @@
 #include <vector>
 
 #include "fit/solver_options.h"
-#include "models/robot.h"
+#include "odometry/robot.h"
 
 namespace fitcal {
 

@@ -10,7 +10,7 @@
 // the identity, P_k = P_0^-1 P_k (Palacin Eq. 4), and the ground truth interpolated at t + dt,
 //   Q_k(dt) = Q(t_0 + dt)^-1 Q(t_k + dt),
 //   e_k = [ R(-theta_Qk) (t_Pk - t_Qk) / sigma_xy,  wrap(theta_Pk - theta_Qk) / sigma_th ]
-// (the segment error of fit/pose_errors.h with the window [0, k]), and the residual is
+// (the segment error of models/pose_errors.h with the window [0, k]), and the residual is
 //   r_k = w sqrt(rho(|e_k|^2) / |e_k|^2) e_k,  w = 1 / sqrt(K),
 // so |r_k|^2 = w^2 rho(|e_k|^2) exactly: each run adds the mean over its K checkpoints of the
 // Huber loss rho(s) = s below c^2, 2 c sqrt(s) - c^2 above (Ceres' convention). A run of 40 m

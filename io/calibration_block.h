@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "models/robot.h"
+#include "odometry/robot.h"
 
 namespace fitcal::io {
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "models/robot.h"
+#include "odometry/robot.h"
 #include "odometry/run_log.h"
 
 namespace fitcal::io {

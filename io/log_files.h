@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "models/robot.h"
+#include "odometry/robot.h"
 #include "odometry/run_log.h"
 
 namespace fitcal::io {
@@ -17,7 +17,7 @@ namespace fitcal::io {
 // are ignored (counted before the start); cumulative: running totals, row 0 is the reference,
 // and its count gives each wheel's absolute angle at the start (EncoderLog::start_angle_rad).
 // Either way w_i(k) = 2 pi dticks_i(k) / (ticks_per_rev dt(k)).
-// Any robot (models/robot.h): header `t,<column per channel>`, each channel's rate (or angle)
+// Any robot (odometry/robot.h): header `t,<column per channel>`, each channel's rate (or angle)
 // column or its ticks column, in any order, matched by name; angle channels hold the reading at
 // the row time and become the mean over each interval. A three-channel robot also accepts the
 // positional legacy header above whatever its wheel names.

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "io/yaml_reader.h"
-#include "models/robot.h"
+#include "odometry/robot.h"
 
 namespace fitcal::io {
 

@@ -38,8 +38,8 @@
 #include <cstddef>
 #include <type_traits>
 
-#include "fit/pose_errors.h"
 #include "models/model_interface.h"
+#include "models/pose_errors.h"
 #include "models/replay_kinematics.h"
 #include "odometry/aligned_run.h"
 #include "odometry/replay.h"

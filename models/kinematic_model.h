@@ -23,7 +23,7 @@
 // default-constructed, so both kinds go through the same code.
 //
 // KinematicModel<K> turns it into a RobotModelInterface: the generic replay (odometry/replay.h),
-// the final-pose and segment residuals (fit/pose_errors.h) as autodiff cost functions. A model's
+// the final-pose and segment residuals (models/pose_errors.h) as autodiff cost functions. A model's
 // own class derives from it and adds its YAML and anything model-specific.
 
 #include <ceres/autodiff_cost_function.h>
@@ -35,9 +35,9 @@
 #include <utility>
 #include <vector>
 
-#include "fit/pose_errors.h"
 #include "models/final_pose_jacobian.h"
 #include "models/model_interface.h"
+#include "models/pose_errors.h"
 #include "models/replay_kinematics.h"
 #include "odometry/aligned_run.h"
 #include "odometry/replay.h"
@@ -73,7 +73,7 @@ class ModelFinalPoseResidual {
   K kinematics_;
 };
 
-// Segment residuals (fit/pose_errors.h) of one run for the kinematics K: the run is replayed once
+// Segment residuals (models/pose_errors.h) of one run for the kinematics K: the run is replayed once
 // from the identity, keeping the pose at every window start and end.
 template <class K>
 class ModelSegmentResidual {

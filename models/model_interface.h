@@ -22,9 +22,9 @@
 #include <string>
 #include <vector>
 
-#include "models/robot.h"
 #include "odometry/encoder_samples.h"
 #include "odometry/pose2.h"
+#include "odometry/robot.h"
 
 namespace fitcal {
 
@@ -92,7 +92,7 @@ enum class FinalPoseJacobianKind {
   kLinearInChannels,  // the step is dt M(p) w: dM/dp once per evaluation, sums over the channels
 };
 
-// The scalar of the effect fit's dynamic autodiff (diagnosis/effect_fit.cc differentiates four
+// The scalar of the effect fit's dynamic autodiff (fit/effect_fit.cc differentiates four
 // parameters per pass).
 using EffectJet = ceres::Jet<double, 4>;
 

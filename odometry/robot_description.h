@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "models/robot.h"
 #include "odometry/effects.h"
 #include "odometry/omni3_model.h"
+#include "odometry/robot.h"
 
 namespace fitcal {
 

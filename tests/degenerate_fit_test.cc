@@ -10,8 +10,8 @@
 #include "diagnosis/degenerate_data.h"
 #include "fit/final_pose_cost.h"
 #include "fit/omni3_ceres_fit.h"
+#include "fit/run_split.h"
 #include "tools/sim/omni3_simulator.h"
-#include "validation/run_split.h"
 
 namespace fitcal {
 namespace {

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "diagnosis/diagnose.h"
-#include "diagnosis/effect_fit.h"
+#include "fit/effect_fit.h"
 #include "odometry/effects.h"
 
 namespace fitcal::testing {

@@ -16,7 +16,8 @@
 #include <vector>
 
 #include "diagnosis/diagnose.h"
-#include "diagnosis/effect_fit.h"
+#include "fit/effect_fit.h"
+#include "fit/run_split.h"
 #include "io/dataset.h"
 #include "models/diff_drive/diff_drive_model.h"
 #include "models/model_registry.h"
@@ -25,7 +26,6 @@
 #include "tests/test_files.h"
 #include "tools/sim/diff_drive_trajectories.h"
 #include "tools/sim/model_simulator.h"
-#include "validation/run_split.h"
 #include "validation/trajectory_metrics.h"
 
 namespace fitcal {

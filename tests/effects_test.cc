@@ -1,5 +1,5 @@
 // Tests of the effect library (odometry/effects.h), the effect fit's building blocks
-// (diagnosis/effect_fit.h), the tail probabilities (diagnosis/statistics.h) and the robot YAML's
+// (fit/effect_fit.h), the tail probabilities (validation/statistics.h) and the robot YAML's
 // `effects:` list.
 #include <ceres/jet.h>
 #include <gtest/gtest.h>
@@ -10,12 +10,12 @@
 #include <fstream>
 
 #include "diagnosis/diagnose.h"
-#include "diagnosis/effect_fit.h"
-#include "diagnosis/statistics.h"
+#include "fit/effect_fit.h"
 #include "io/input_error.h"
 #include "io/robot_yaml.h"
 #include "odometry/omni3_replay.h"
 #include "tools/sim/omni3_simulator.h"
+#include "validation/statistics.h"
 
 namespace fitcal {
 namespace {

@@ -1,5 +1,5 @@
 // Tests of the pieces added to close the loop on measured data: the
-// trajectory-label split (validation/trajectory_split.h) and the translation-dependent yaw gain
+// trajectory-label split (fit/trajectory_split.h) and the translation-dependent yaw gain
 // (odometry/effects.h TranslationYawGain). Recovery of the effect by diagnose on simulated data and
 // the clean-data false-positive rate are covered for every registry effect by diagnose_test.cc.
 #include <gtest/gtest.h>
@@ -7,10 +7,10 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "fit/trajectory_split.h"
 #include "odometry/effects.h"
 #include "odometry/omni3_replay.h"
 #include "tools/sim/omni3_simulator.h"
-#include "validation/trajectory_split.h"
 
 namespace fitcal {
 namespace {

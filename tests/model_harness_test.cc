@@ -17,8 +17,8 @@
 #include <vector>
 
 #include "fit/model_fit.h"
-#include "fit/pose_errors.h"
 #include "models/model_registry.h"
+#include "models/pose_errors.h"
 #include "odometry/aligned_run.h"
 #include "tests/models/unicycle_test_model.h"
 

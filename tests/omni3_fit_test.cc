@@ -7,8 +7,8 @@
 
 #include "fit/final_pose_cost.h"
 #include "fit/omni3_ceres_fit.h"
+#include "fit/run_split.h"
 #include "tools/sim/omni3_simulator.h"
-#include "validation/run_split.h"
 
 namespace fitcal {
 namespace {

@@ -18,13 +18,13 @@
 #include <sstream>
 
 #include "fit/model_fit.h"
-#include "fit/pose_errors.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "models/kinematic_model.h"
 #include "models/model_registry.h"
 #include "models/omni/omni_kinematics.h"
 #include "models/omni3/omni3_kinematics.h"
+#include "models/pose_errors.h"
 #include "odometry/aligned_run.h"
 #include "tools/import_optiodom_omni4.h"
 #include "tools/sim/model_simulator.h"

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <random>
 
-#include "diagnosis/statistics.h"
+#include "validation/statistics.h"
 
 namespace fitcal {
 namespace {

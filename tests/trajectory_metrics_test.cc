@@ -7,7 +7,7 @@
 
 #include <cmath>
 
-#include "diagnosis/effect_fit.h"
+#include "fit/effect_fit.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "tools/sim/omni3_simulator.h"
 

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "diagnosis/diagnose.h"
-#include "diagnosis/effect_fit.h"
+#include "fit/effect_fit.h"
 #include "models/tricycle/tricycle_model.h"
 #include "tests/diagnose_expectations.h"
 #include "tools/sim/model_simulator.h"

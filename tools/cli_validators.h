@@ -6,11 +6,11 @@
 #include <stdexcept>
 #include <string>
 
-#include "validation/run_split.h"
+#include "fit/run_split.h"
 
 namespace fitcal::tools {
 
-// A repetition list such as "1-5" or "1,3,7" (validation/run_split.h); "auto" too when allowed.
+// A repetition list such as "1-5" or "1,3,7" (fit/run_split.h); "auto" too when allowed.
 inline CLI::Validator RepetitionListValidator(bool allow_auto = false) {
   return CLI::Validator(
       [allow_auto](std::string& text) {

@@ -15,6 +15,7 @@
 #include <stdexcept>
 
 #include "fit/final_pose_cost.h"
+#include "fit/run_split.h"
 #include "fit/strategies.h"
 #include "io/atomic_file.h"
 #include "io/dataset.h"
@@ -25,7 +26,6 @@
 #include "tools/cli_validators.h"
 #include "tools/fit_methods.h"
 #include "tools/output_guard.h"
-#include "validation/run_split.h"
 
 namespace fitcal::tools {
 

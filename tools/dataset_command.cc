@@ -4,7 +4,7 @@
 #include <iostream>
 
 #include "io/input_error.h"
-#include "models/robot.h"
+#include "odometry/robot.h"
 #include "tools/output_guard.h"
 
 namespace fitcal::tools {

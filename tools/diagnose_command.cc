@@ -10,7 +10,9 @@
 #include "diagnosis/clock_choice.h"
 #include "diagnosis/diagnose.h"
 #include "fit/correlation.h"
+#include "fit/run_split.h"
 #include "fit/segment_cost.h"
+#include "fit/trajectory_split.h"
 #include "fitcal/version.h"
 #include "io/atomic_file.h"
 #include "io/calibration_block.h"
@@ -26,10 +28,8 @@
 #include "tools/output_guard.h"
 #include "tools/report_command.h"
 #include "validation/propagated_uncertainty.h"
-#include "validation/run_split.h"
 #include "validation/training_runs.h"
 #include "validation/trajectory_metrics.h"
-#include "validation/trajectory_split.h"
 
 namespace fitcal::tools {
 

@@ -23,7 +23,7 @@ namespace fitcal::tools {
 // --logs, --threads and --allow-outside-paths come from DatasetCommandOptions.
 struct DiagnoseCommandOptions : DatasetCommandOptions {
   std::string train_reps = "auto";  // "auto": the first half of the repetitions present
-  // Non-empty: split by trajectory label instead (validation/trajectory_split.h): matching runs
+  // Non-empty: split by trajectory label instead (fit/trajectory_split.h): matching runs
   // train, the others validate (e.g. "^circular" trains on circles and validates on squares).
   std::string train_trajectories;
   // Re-stamp each run's ground truth on the encoder clock first (fit/segment_cost.h,

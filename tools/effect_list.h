@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "diagnosis/effect_fit.h"
-#include "models/robot.h"
+#include "fit/effect_fit.h"
+#include "odometry/robot.h"
 
 namespace fitcal::tools {
 

@@ -18,6 +18,7 @@
 #include "fit/final_pose_cost.h"
 #include "fit/omni3_ceres_fit.h"
 #include "fit/result_gate.h"
+#include "fit/run_split.h"
 #include "fitcal/version.h"
 #include "io/atomic_file.h"
 #include "io/dataset.h"
@@ -33,7 +34,6 @@
 #include "tools/sim/flower_candidates.h"
 #include "validation/propagated_uncertainty.h"
 #include "validation/residual_dof.h"
-#include "validation/run_split.h"
 #include "validation/training_runs.h"
 
 namespace fitcal::tools {

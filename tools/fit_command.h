@@ -15,7 +15,7 @@ namespace fitcal::tools {
 struct FitCommandOptions : DatasetCommandOptions, SolverOptions {
   std::string method = "ceres";
   std::string train_reps = "1-5";
-  // Non-empty: train on the runs whose trajectory label matches (validation/trajectory_split.h),
+  // Non-empty: train on the runs whose trajectory label matches (fit/trajectory_split.h),
   // validate on the others; replaces train_reps.
   std::string train_trajectories;
   std::string out = "calibrated.yaml";

@@ -7,9 +7,10 @@
 #include <map>
 #include <set>
 
-#include "diagnosis/effect_fit.h"
+#include "fit/effect_fit.h"
 #include "fit/final_pose_cost.h"
 #include "fit/segment_cost.h"
+#include "fit/trajectory_split.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/robot_yaml.h"
@@ -17,7 +18,6 @@
 #include "odometry/aligned_run.h"
 #include "odometry/parallel_for.h"
 #include "tools/model_generalise_command.h"
-#include "validation/trajectory_split.h"
 
 namespace fitcal::tools {
 
@@ -36,7 +36,7 @@ struct Model {
   std::string name;
   bool fit = true;
   FitOptions options;
-  bool track = false;  // fit nine + `effects` on the ground-truth tracks (diagnosis/effect_fit.h)
+  bool track = false;  // fit nine + `effects` on the ground-truth tracks (fit/effect_fit.h)
   EffectModel effects;
 };
 

@@ -23,11 +23,11 @@ struct GeneraliseCommandOptions : DatasetCommandOptions {
   bool clock_map = true;  // refine each run's ground-truth clock before cutting segments
   bool leave_one_session_out = true;
   // Non-empty: instead of every pair of path types, train on the runs whose trajectory label
-  // matches (validation/trajectory_split.h: a list of labels or a regular expression) and test on
+  // matches (fit/trajectory_split.h: a list of labels or a regular expression) and test on
   // the others, then the other way round.
   std::string train_trajectories;
   // Library effects (odometry/effects.h names) to add as a further model: "nine + effects",
-  // fitted to the training runs' ground-truth tracks (diagnosis/effect_fit.h) and scored on the
+  // fitted to the training runs' ground-truth tracks (fit/effect_fit.h) and scored on the
   // test runs' final poses (Eq. 14, replayed with the effects). "nine, track cost" is the same fit
   // without effects, the like-for-like baseline.
   std::vector<std::string> effects;

@@ -10,13 +10,13 @@
 #include <mutex>
 #include <regex>
 
-#include "fit/pose_errors.h"
 #include "io/atomic_file.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/staged_directory.h"
 #include "io/text_file.h"
 #include "models/omni/omni_model.h"
+#include "models/pose_errors.h"
 #include "odometry/parallel_for.h"
 #include "tools/miswired_error.h"
 #include "tools/output_guard.h"

@@ -12,12 +12,12 @@
 #include <vector>
 
 #include "diagnosis/channel_order_check.h"
-#include "diagnosis/effect_fit.h"
-#include "diagnosis/statistics.h"
 #include "fit/correlation.h"
+#include "fit/effect_fit.h"
 #include "fit/final_pose_errors.h"
 #include "fit/model_fit.h"
 #include "fit/result_gate.h"
+#include "fit/run_split.h"
 #include "fit/segment_cost.h"
 #include "fitcal/version.h"
 #include "io/atomic_file.h"
@@ -29,7 +29,8 @@
 #include "validation/propagated_uncertainty.h"
 #include "validation/rate_units.h"
 #include "validation/residual_dof.h"
-#include "validation/run_split.h"
+#include "validation/residual_kind_transfer.h"
+#include "validation/statistics.h"
 #include "validation/time_blocks.h"
 #include "validation/training_runs.h"
 #include "validation/trajectory_family.h"
@@ -110,7 +111,7 @@ struct SelectedFit {
 
 constexpr const char* kTrackObjective = "sum over runs of the mean squared track error (m and rad)";
 
-// The fits on the training tracks when effects are fitted (diagnosis/effect_fit.h): the
+// The fits on the training tracks when effects are fitted (fit/effect_fit.h): the
 // parameters alone and with the effects, on one objective, so that the effects are judged like
 // for like; with their indices among the gate's candidates.
 struct TrackFits {
@@ -411,7 +412,7 @@ std::optional<std::vector<TrackRun>> TrainingTracks(const FitCommandOptions& opt
   }
 }
 
-// The model's parameters and `effects` fitted on the training tracks (diagnosis/effect_fit.h),
+// The model's parameters and `effects` fitted on the training tracks (fit/effect_fit.h),
 // from the nominal, as `diagnose` and `generalise --effects` fit them.
 EffectFitResult FitEffects(const FitCommandOptions& options, const RobotModelInterface& model,
                            const std::vector<TrackRun>& training, const EffectModel& effects) {
@@ -576,6 +577,50 @@ void PrintEverydayDriving(const RobotModelInterface& model, const std::vector<Ru
               "calibrated", "change");
   for (const std::string& row : EverydayDrivingRows(before, after))
     std::printf("%s\n", row.c_str());
+}
+
+// --residuals auto proposing the track: the track and the final pose are fitted and judged on
+// kinds of run they were not fitted on (validation/residual_kind_transfer.h); the final pose
+// replaces the track when that judgement says so (settings and *track_data follow). The lines
+// for the terminal; none when nothing could be judged.
+std::vector<std::string> ChooseResidualsByTransfer(const FitCommandOptions& options,
+                                                   const FitMethod& method,
+                                                   const RobotModelInterface& model,
+                                                   const RunSplit& split,
+                                                   const std::vector<RunLog>& logs,
+                                                   FitMethodSettings* settings,
+                                                   std::optional<TrackFitData>* track_data) {
+  if (!settings->residuals_auto || settings->residuals != ResidualKind::kTrack) return {};
+  const FitByKind fit_on = [&](ResidualKind kind, const std::vector<AlignedRun>& training)
+      -> std::optional<std::vector<double>> {
+    FitMethodSettings s = *settings;
+    s.residuals_auto = false;
+    s.residuals = kind;
+    s.track = nullptr;
+    RunSplit part;
+    part.training = training;
+    std::optional<TrackFitData> data;
+    if (!PrepareTrackResiduals(options, logs, part, &s, &data)) return std::nullopt;
+    const ModelFitResult fit = method.run_model(training, model, s).fit;
+    if (!(fit.usable || fit.stopped_early)) return std::nullopt;
+    return fit.parameters;
+  };
+  std::unordered_map<std::string, const GroundTruthTrack*> track_of;
+  for (const RunLog& log : logs) track_of[log.id] = &log.ground_truth;
+  const ScoreOnRuns score = [&](const std::vector<double>& p, const std::vector<AlignedRun>& runs) {
+    std::vector<const GroundTruthTrack*> tracks;
+    for (const AlignedRun& run : runs) tracks.push_back(track_of.at(run.id));
+    return EvaluateEverydayDriving(model, p, {}, runs, tracks, EverydayDriftLengths(),
+                                   options.threads);
+  };
+  const ResidualKindJudgement judgement = JudgeResidualKindsByTransfer(
+      ResidualKind::kTrack, ResidualKind::kFinalPose, split, fit_on, score);
+  if (judgement.chosen != settings->residuals) {
+    settings->residuals = judgement.chosen;
+    settings->track = nullptr;
+    track_data->reset();
+  }
+  return ResidualKindJudgementLines(judgement);
 }
 
 // A calibration better than the nominal on the held-out runs as a whole may still be worse on one
@@ -775,6 +820,10 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   }
   std::optional<TrackFitData> track_data;
   if (!PrepareTrackResiduals(options, logs, split, &settings, &track_data)) return 2;
+  const std::vector<std::string> residual_choice =
+      effects_to_fit->empty()
+          ? ChooseResidualsByTransfer(options, *method, *model, split, logs, &settings, &track_data)
+          : std::vector<std::string>{};
   const HalvesJudgement halves =
       JudgeOnHeldOutHalves(options, *method, settings, *model, split, logs);
   if (const std::string refusal = DegreesOfFreedomRefusal(
@@ -816,6 +865,7 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
            track_fits);
   std::printf("residuals: %s%s\n", ToString(settings.residuals),
               residuals_auto ? " (--residuals auto)" : "");
+  for (const std::string& line : residual_choice) std::printf("%s\n", line.c_str());
   if (track_data) PrintClockOffsets(fit, *track_data);
   PrintEverydayDriving(*model, logs, split, candidates[0], selected, options.threads);
   if (!fit.has_covariance) std::printf("uncertainty: %s\n", fit.covariance_message.c_str());

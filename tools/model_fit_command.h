@@ -9,11 +9,11 @@
 #include <string>
 
 #include "fit/result_gate.h"
+#include "fit/run_split.h"
 #include "io/calibration_block.h"
 #include "io/dataset.h"
 #include "models/model_interface.h"
 #include "tools/fit_command.h"
-#include "validation/run_split.h"
 
 namespace fitcal::tools {
 

@@ -7,13 +7,13 @@
 #include <stdexcept>
 #include <string>
 
-#include "diagnosis/effect_fit.h"
+#include "fit/effect_fit.h"
 #include "fit/residual_choice.h"
+#include "fit/run_split.h"
 #include "fit/segment_cost.h"
+#include "fit/trajectory_split.h"
 #include "tools/effect_list.h"
 #include "validation/generalisation.h"
-#include "validation/run_split.h"
-#include "validation/trajectory_split.h"
 
 namespace fitcal::tools {
 

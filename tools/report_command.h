@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "io/report_writer.h"
-#include "models/robot.h"
 #include "odometry/effects.h"
+#include "odometry/robot.h"
 #include "tools/dataset_command.h"
 
 namespace fitcal::tools {

@@ -23,7 +23,7 @@
 #include <string>
 #include <vector>
 
-#include "diagnosis/effect_fit.h"
+#include "fit/effect_fit.h"
 #include "fit/final_pose_errors.h"
 #include "fit/model_fit.h"
 #include "models/model_interface.h"
@@ -89,7 +89,7 @@ struct TrackCandidates {
   // back-propagation searches for, found here by the fit's own Ceres solve. One list per run of
   // `runs` (fit/segment_cost.h MakeCheckpointsFromStart).
   const std::vector<std::vector<Segment>>* optiodom_checkpoints = nullptr;
-  // The model's parameters fitted on the training tracks (diagnosis/effect_fit.h) alone, "track
+  // The model's parameters fitted on the training tracks (fit/effect_fit.h) alone, "track
   // fit", and with these library effects, "track fit + <names>": what closing the loop gains on
   // the held-out runs, like for like. One TrackRun per run of `runs`; used when `effects` is not
   // empty.

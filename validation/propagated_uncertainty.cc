@@ -7,7 +7,7 @@
 #include <cmath>
 #include <memory>
 
-#include "fit/pose_errors.h"
+#include "models/pose_errors.h"
 
 namespace fitcal {
 namespace {

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "fit/run_split.h"
 #include "odometry/run_log.h"
-#include "validation/run_split.h"
 
 namespace fitcal {
 

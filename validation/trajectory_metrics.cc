@@ -4,7 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "diagnosis/effect_fit.h"
+#include "fit/effect_fit.h"
 #include "odometry/omni3_replay.h"
 #include "odometry/parallel_for.h"
 

@@ -71,7 +71,7 @@ TrajectoryErrors EvaluateTrajectory(const AlignedRun& run, const GroundTruthTrac
 
 // Any model through the seam (models/model_interface.h): the same metrics with the model's own
 // replay at parameters p (robot().parameters order), and its effects replayed through the model's
-// kinematics as the effect fit does (diagnosis/effect_fit.h). For omni3 it equals the overloads
+// kinematics as the effect fit does (fit/effect_fit.h). For omni3 it equals the overloads
 // above to rounding.
 TrajectoryErrors EvaluateTrajectory(const RobotModelInterface& model, const AlignedRun& run,
                                     const GroundTruthTrack& track, const std::vector<double>& p,

@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <map>
 
-#include "diagnosis/statistics.h"
+#include "validation/statistics.h"
 
 namespace fitcal {
 

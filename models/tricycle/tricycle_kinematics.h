@@ -10,7 +10,7 @@
 //          counter-clockwise positive, 0 = straight ahead)
 // Channels: 0 the traction wheel's mean rate w over the interval (rad/s), 1 the steering angle
 // phi over the interval (rad; the loader gives the mean of the readings at the interval's ends,
-// the midpoint rule, models/robot.h).
+// the midpoint rule, odometry/robot.h).
 //
 // Body motion, reference point at the rear axle's centre (the ground truth of OptiOdom's tricycle
 // is that point, the midpoint of the rear wheels' markers). Rigid body: the velocity of the

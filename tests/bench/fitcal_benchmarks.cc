@@ -10,12 +10,12 @@
 #include <random>
 
 #include "fit/omni3_ceres_fit.h"
+#include "fit/run_split.h"
 #include "io/dataset.h"
 #include "io/robot_yaml.h"
 #include "odometry/omni3_final_pose_kernel.h"
 #include "odometry/omni3_replay.h"
 #include "tools/sim/omni3_simulator.h"
-#include "validation/run_split.h"
 
 namespace fitcal {
 namespace {

@@ -1,4 +1,4 @@
-#include "diagnosis/statistics.h"
+#include "validation/statistics.h"
 
 #include <algorithm>
 #include <cmath>

@@ -23,7 +23,7 @@ struct RunSplit {
 RunSplit SplitByRepetition(std::vector<AlignedRun> runs, const std::vector<int>& training_reps);
 
 // By trajectory label instead: the runs whose label the selector matches train (a list of labels
-// or a regular expression, validation/trajectory_split.h); the repetition lists name what is
+// or a regular expression, fit/trajectory_split.h); the repetition lists name what is
 // present on each side. Throws std::invalid_argument for an invalid selector.
 RunSplit SplitByTrajectory(std::vector<AlignedRun> runs, const std::string& selector);
 

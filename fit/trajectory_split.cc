@@ -1,4 +1,4 @@
-#include "validation/trajectory_split.h"
+#include "fit/trajectory_split.h"
 
 #include <algorithm>
 #include <regex>

@@ -130,7 +130,7 @@ std::vector<TrackRun> PrepareTrackRuns(const std::vector<RunLog>& runs, unsigned
                                        const TrackOptions& options = {});
 // Bit i set when the robot's channel i is a wheel rate (effects::SampleContext::wheel_mask).
 unsigned WheelChannelMask(const Robot& robot);
-// Training/validation by repetition (as validation/run_split.h).
+// Training/validation by repetition (as fit/run_split.h).
 void SplitTrackRuns(std::vector<TrackRun> runs, const std::vector<int>& training_reps,
                     std::vector<TrackRun>* training, std::vector<TrackRun>* validation);
 

@@ -1,10 +1,10 @@
-#include "validation/run_split.h"
+#include "fit/run_split.h"
 
 #include <algorithm>
 #include <set>
 #include <stdexcept>
 
-#include "validation/trajectory_split.h"
+#include "fit/trajectory_split.h"
 
 namespace fitcal {
 

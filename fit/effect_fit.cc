@@ -1,4 +1,4 @@
-#include "diagnosis/effect_fit.h"
+#include "fit/effect_fit.h"
 
 #include <ceres/ceres.h>
 #include <ceres/dynamic_autodiff_cost_function.h>
@@ -12,9 +12,9 @@
 
 #include "fit/correlation.h"
 #include "fit/dense_solver_options.h"
+#include "fit/run_split.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "odometry/parallel_for.h"
-#include "validation/run_split.h"
 
 namespace fitcal {
 

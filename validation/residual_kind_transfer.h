@@ -1,0 +1,65 @@
+#pragma once
+// `fit --residuals auto`: which residual kind transfers, judged on kinds of run the fits did not
+// see (issue 29 item 4). The auto rule (fit/residual_choice.h) proposes the track wherever the
+// ground truth is dense; the final pose (Palacin Eq. 14) is the alternative. Each kind is fitted
+// and judged on runs of a kind it was not fitted on, on the final-pose CF and on everyday driving
+// (drift per 2 m, ATE RMSE; validation/everyday_driving.h):
+//   - held-out free driving (trajectory family "free") present: both kinds fitted on all the
+//     training runs and judged on it - free driving is the judge that counts, so the alternative
+//     replaces the proposal when it is better on most of the three measures there;
+//   - else training runs of two or more kinds (circles, squares, ...): leave one kind out - fitted
+//     on the others, judged on it, for every kind. Closed loops were measured to be a weak judge
+//     of what transfers to free driving (on the real OptiOdom robots circles against squares tied
+//     between the two kinds while the free runs sided with the track, docs/everyday_driving.md),
+//     so the alternative replaces the proposal only when it is better on every comparison.
+// The choice is a policy over fits the caller makes (`fit_on`) and scores it computes (`score`):
+// any model, any fitter.
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fit/model_fit.h"
+#include "fit/run_split.h"
+#include "odometry/aligned_run.h"
+#include "validation/everyday_driving.h"
+
+namespace fitcal {
+
+// The parameters `kind` gives when fitted on `training`; nullopt when that fit is not usable.
+using FitByKind = std::function<std::optional<std::vector<double>>(
+    ResidualKind kind, const std::vector<AlignedRun>& training)>;
+// Everyday-driving measures (CF, drift, ATE) of parameters on some runs.
+using ScoreOnRuns = std::function<EverydayDrivingMetrics(const std::vector<double>& parameters,
+                                                         const std::vector<AlignedRun>& runs)>;
+
+// One kind of run judged: each residual kind's measures on it, fitted without it.
+struct KindComparison {
+  std::string judged_on;   // the trajectory family judged on ("free", "circular", ...)
+  std::string fitted_on;   // what the fits saw, in words
+  int runs = 0;
+  EverydayDrivingMetrics proposed, alternative;
+};
+
+struct ResidualKindJudgement {
+  bool judged = false;
+  bool on_free_driving = false;
+  ResidualKind proposed = ResidualKind::kTrack;
+  ResidualKind alternative = ResidualKind::kFinalPose;
+  ResidualKind chosen = ResidualKind::kTrack;
+  std::vector<KindComparison> comparisons;
+  int alternative_wins = 0;  // comparisons the alternative is better on
+  int total = 0;             // comparisons made (a measure with no windows is not one)
+};
+
+// Not judged (chosen = proposed) when there is neither held-out free driving nor two kinds of
+// training run, or when a fit is not usable.
+ResidualKindJudgement JudgeResidualKindsByTransfer(ResidualKind proposed, ResidualKind alternative,
+                                                   const RunSplit& split, const FitByKind& fit_on,
+                                                   const ScoreOnRuns& score);
+
+// The table and the verdict for the terminal, one line each.
+std::vector<std::string> ResidualKindJudgementLines(const ResidualKindJudgement& judgement);
+
+}  // namespace fitcal
