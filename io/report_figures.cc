@@ -122,17 +122,7 @@ std::vector<std::size_t> ThinnedIndices(std::size_t n, std::size_t most) {
   return out;
 }
 
-// Linear interpolation of y(x) at x0 along non-decreasing x; NaN outside [x.front(), x.back()].
-double InterpolateAt(const std::vector<double>& x, const std::vector<double>& y, double x0) {
-  if (x.empty() || x0 < x.front() || x0 > x.back()) return std::nan("");
-  const std::size_t j =
-      static_cast<std::size_t>(std::lower_bound(x.begin(), x.end(), x0) - x.begin());
-  if (j == 0) return y[0];
-  const double span = x[j] - x[j - 1];
-  const double f = span > 0.0 ? (x0 - x[j - 1]) / span : 1.0;
-  return y[j - 1] + f * (y[j] - y[j - 1]);
-}
-
+// The q-quantile of v, linear between order statistics (the y range of the distance figures).
 double QuantileOf(std::vector<double> v, double q) {
   if (v.empty()) return std::nan("");
   std::sort(v.begin(), v.end());
@@ -148,14 +138,22 @@ struct ErrorQuantity {
   double scale;       // SI or rad -> display unit
   const std::vector<double> ReportRun::*before;
   const std::vector<double> ReportRun::*after;
+  const ReportErrorBand ReportErrorBands::*before_band;
+  const ReportErrorBand ReportErrorBands::*after_band;
 };
-const ErrorQuantity kPositionError = {"position error [mm]", 1e3, &ReportRun::before_distance_m,
-                                      &ReportRun::after_distance_m};
-const ErrorQuantity kHeadingError = {"|heading error| [deg]", kDeg, &ReportRun::before_angle_rad,
-                                     &ReportRun::after_angle_rad};
+const ErrorQuantity kPositionError = {"position error [mm]",
+                                      1e3,
+                                      &ReportRun::before_distance_m,
+                                      &ReportRun::after_distance_m,
+                                      &ReportErrorBands::position_before,
+                                      &ReportErrorBands::position_after};
+const ErrorQuantity kHeadingError = {
+    "|heading error| [deg]",           kDeg,
+    &ReportRun::before_angle_rad,      &ReportRun::after_angle_rad,
+    &ReportErrorBands::heading_before, &ReportErrorBands::heading_after};
 
-// One panel: every run thin, and over the runs that reach each distance the median (thick) and
-// the band between the quartiles, on a grid of 80 distances up to where half the runs still go.
+// One panel: every run thin, and the model's band over the runs (ReportErrorBand): the median
+// (thick) and the band between the quartiles.
 std::string ErrorAlongDistancePanel(const ReportData& d, const ErrorQuantity& q, bool after,
                                     double y_hi, const std::string& id) {
   const char* colour = after ? kAfterColour : kBeforeColour;
@@ -165,11 +163,9 @@ std::string ErrorAlongDistancePanel(const ReportData& d, const ErrorQuantity& q,
   // The thin lines are the background of the band: ~6000 points a panel in all, 30 to 150 a run.
   const std::size_t per_run =
       std::clamp<std::size_t>(6000 / std::max<std::size_t>(1, d.runs.size()), 30, 150);
-  std::vector<double> ends;
   for (const ReportRun& r : d.runs) {
     const std::vector<double>& e = r.*(after ? q.after : q.before);
     if (r.along_m.size() != e.size() || e.empty()) continue;
-    ends.push_back(r.along_m.back());
     std::vector<Point2> line;
     for (std::size_t i : ThinnedIndices(e.size(), per_run)) {
       line.push_back({r.along_m[i], q.scale * e[i]});
@@ -180,21 +176,12 @@ std::string ErrorAlongDistancePanel(const ReportData& d, const ErrorQuantity& q,
   band.fill = colour;
   band.opacity = 0.3;
   median.line_width = 3.0;
-  const double reach = QuantileOf(ends, 0.5);
+  const ReportErrorBand& b = d.error_bands.*(after ? q.after_band : q.before_band);
   std::vector<Point2> upper, lower, mid;
-  for (int k = 0; k <= 80 && reach > 0.0; ++k) {
-    const double at = reach * k / 80.0;
-    std::vector<double> v;
-    for (const ReportRun& r : d.runs) {
-      const std::vector<double>& e = r.*(after ? q.after : q.before);
-      if (r.along_m.size() != e.size()) continue;
-      const double y = InterpolateAt(r.along_m, e, at);
-      if (std::isfinite(y)) v.push_back(q.scale * y);
-    }
-    if (v.empty()) continue;
-    lower.push_back({at, QuantileOf(v, 0.25)});
-    mid.push_back({at, QuantileOf(v, 0.5)});
-    upper.push_back({at, QuantileOf(v, 0.75)});
+  for (std::size_t k = 0; k < b.distance_m.size(); ++k) {
+    lower.push_back({b.distance_m[k], q.scale * b.lower_quartile[k]});
+    mid.push_back({b.distance_m[k], q.scale * b.median[k]});
+    upper.push_back({b.distance_m[k], q.scale * b.upper_quartile[k]});
   }
   band.lines.push_back(upper);
   band.lines.back().insert(band.lines.back().end(), lower.rbegin(), lower.rend());
@@ -364,27 +351,18 @@ std::string EndPointsSvg(const ReportData& data) {
   return FinalErrorScatterSvg(s);
 }
 
-// Per-trajectory final errors, mean over the validation repetitions.
+// Per-trajectory final errors, mean over the validation repetitions (the model's rows).
 void AddFinalErrorBars(const ReportData& data, ReportFigures* f) {
-  const std::vector<std::string> order = TrajectoryOrder(data.runs);
+  std::vector<std::string> order;
   BarSeries bd{"nominal parameters", kBeforeColour, {}},
       ad{"calibrated parameters", kAfterColour, {}};
   BarSeries ba = bd, aa = ad;
-  for (const std::string& t : order) {
-    double sbd = 0, sad = 0, sba = 0, saa = 0;
-    int n = 0;
-    for (const ReportRun& r : data.runs) {
-      if (r.trajectory != t) continue;
-      sbd += r.before.final_distance_m;
-      sad += r.after.final_distance_m;
-      sba += r.before.final_angle_rad;
-      saa += r.after.final_angle_rad;
-      ++n;
-    }
-    bd.values.push_back(1e3 * sbd / n);
-    ad.values.push_back(1e3 * sad / n);
-    ba.values.push_back(kDeg * sba / n);
-    aa.values.push_back(kDeg * saa / n);
+  for (const ReportSummaryRow& t : data.trajectories) {
+    order.push_back(t.group);
+    bd.values.push_back(1e3 * t.before.final_distance_m);
+    ad.values.push_back(1e3 * t.after.final_distance_m);
+    ba.values.push_back(kDeg * t.before.final_angle_rad);
+    aa.values.push_back(kDeg * t.after.final_angle_rad);
   }
   BarChartOptions o;
   o.title = "Final position error per trajectory (mean over validation repetitions)";

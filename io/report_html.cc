@@ -191,7 +191,7 @@ void HtmlDrift(std::ostringstream& h, const ReportData& d) {
   OpenTable(h);
   h << "<tr><th></th><th>x [mm]</th><th>y [mm]</th><th>heading [deg]</th></tr>\n";
   for (bool after : {false, true}) {
-    const Bias b = MeanFinalError(d, after);
+    const ReportBias& b = after ? d.bias_after : d.bias_before;
     h << "<tr><td>" << (after ? "after" : "before") << "</td><td>" << Fmt("%+.1f", 1e3 * b.x_m)
       << "</td><td>" << Fmt("%+.1f", 1e3 * b.y_m) << "</td><td>"
       << Fmt("%+.3f", kDeg * b.heading_rad) << "</td></tr>\n";

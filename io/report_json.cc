@@ -97,7 +97,7 @@ std::string JsonDrift(const ReportData& d) {
 std::string JsonBias(const ReportData& d) {
   std::string out = "{";
   for (bool after : {false, true}) {
-    const Bias b = MeanFinalError(d, after);
+    const ReportBias& b = after ? d.bias_after : d.bias_before;
     out += std::string(after ? ", \"after\": " : "\"before\": ") +
            "{\"x_m\": " + JsonNumber(b.x_m) + ", \"y_m\": " + JsonNumber(b.y_m) +
            ", \"heading_deg\": " + JsonNumber(kDeg * b.heading_rad) + "}";

@@ -113,7 +113,7 @@ void MdDrift(std::ostringstream& m, const ReportData& d) {
                                          "heading [deg]"};
   m << MdRow(bias) << MdRule(bias.size(), 1);
   for (bool after : {false, true}) {
-    const Bias b = MeanFinalError(d, after);
+    const ReportBias& b = after ? d.bias_after : d.bias_before;
     m << MdRow({after ? "after" : "before", Fmt("%+.1f", 1e3 * b.x_m), Fmt("%+.1f", 1e3 * b.y_m),
                 Fmt("%+.3f", kDeg * b.heading_rad)});
   }

@@ -121,6 +121,24 @@ struct ReportDriftRow {
   int windows_worse = 0;  // windows whose translation error rose with the calibration
 };
 
+// Mean signed final error (bias) over the validation runs in each run's start frame: what a
+// constant offset of the odometry looks like, which the absolute errors hide.
+struct ReportBias {
+  double x_m = 0.0, y_m = 0.0, heading_rad = 0.0;
+};
+
+// The error of the runs against the distance the ground truth travelled, summarised over the
+// runs that reach each distance: the quartiles and the median on a grid of distances up to
+// where half the runs still go (the band of the error-against-distance figures). Values in the
+// error's unit (m, or rad for the heading).
+struct ReportErrorBand {
+  std::vector<double> distance_m, lower_quartile, median, upper_quartile;
+};
+struct ReportErrorBands {
+  ReportErrorBand position_before, position_after;  // Eq. 8
+  ReportErrorBand heading_before, heading_after;    // Eq. 9, |heading error|
+};
+
 // The repeatability test of the calibrated final position errors (validation/verdict.h).
 struct ReportNoiseFloor {
   bool available = false;
@@ -178,6 +196,8 @@ struct ReportData {
   std::vector<ReportSummaryRow> summary;
   std::vector<ReportSummaryRow> trajectories;  // one row per trajectory label
   std::vector<ReportDriftRow> drift;
+  ReportBias bias_before, bias_after;
+  ReportErrorBands error_bands;
   ReportNoiseFloor noise_floor;
   std::vector<ReportStatisticsRow> statistics;
   std::vector<ReportParameter> parameters;

@@ -42,16 +42,6 @@ double ValueOf(const Column& c, const ReportMetrics& m) {
 }
 const char* FormatOf(const Column& c) { return c.is_angle ? "%.3f" : "%.4f"; }
 
-std::vector<std::string> TrajectoryOrder(const std::vector<ReportRun>& runs) {
-  std::vector<std::string> order;
-  for (const ReportRun& r : runs) {
-    bool seen = false;
-    for (const std::string& t : order) seen = seen || t == r.trajectory;
-    if (!seen) order.push_back(r.trajectory);
-  }
-  return order;
-}
-
 std::string JsonString(const std::string& s) {
   std::string out = "\"";
   for (char c : s) {
@@ -113,18 +103,6 @@ double ColouredTrackScale(const ReportRun& r) {
   }
   const double out = std::max(hi, samples);
   return out > 0.0 ? out : 1.0;
-}
-
-Bias MeanFinalError(const ReportData& d, bool after) {
-  Bias b;
-  for (const ReportRun& r : d.runs) {
-    const Point2& e = after ? r.after_final_error : r.before_final_error;
-    b.x_m += e.x;
-    b.y_m += e.y;
-    b.heading_rad += after ? r.after_final_heading_rad : r.before_final_heading_rad;
-  }
-  const double n = std::max<double>(1.0, static_cast<double>(d.runs.size()));
-  return {b.x_m / n, b.y_m / n, b.heading_rad / n};
 }
 
 }  // namespace fitcal::io::report_text

@@ -1,7 +1,8 @@
 #pragma once
 // What the report's renderers share (io/report_html.cc, report_markdown.cc, report_json.cc,
 // report_csv.cc, report_figures.cc): number formats, the Table 6 columns, the colours and names
-// of nominal and calibrated, and the few display figures derived from the model. Internal to
+// of nominal and calibrated, and the display choices derived from the model (which runs to
+// draw, each coloured track's scale). Internal to
 // those renderers: include it from nowhere else.
 
 #include <cmath>
@@ -46,9 +47,6 @@ std::string KeyOf(const Column& c);
 double ValueOf(const Column& c, const ReportMetrics& m);
 const char* FormatOf(const Column& c);
 
-// The trajectory labels of the runs, in their first appearance.
-std::vector<std::string> TrajectoryOrder(const std::vector<ReportRun>& runs);
-
 // JSON scalars (also the CSV's numbers): a quoted, escaped string; %.10g or null.
 std::string JsonString(const std::string& s);
 std::string JsonNumber(double v);
@@ -69,12 +67,5 @@ constexpr std::size_t kMostColouredTracks = 30;
 // nominal or calibrated (so the two panels compare, and a good run is not all dark beside a bad
 // one).
 double ColouredTrackScale(const ReportRun& r);
-
-// Mean signed final error (bias) in the start frame: what a constant offset of the odometry
-// looks like, which the absolute errors hide.
-struct Bias {
-  double x_m = 0.0, y_m = 0.0, heading_rad = 0.0;
-};
-Bias MeanFinalError(const ReportData& d, bool after);
 
 }  // namespace fitcal::io::report_text

@@ -525,6 +525,80 @@ void AddWorldTracks(const EvaluatedRuns& e, io::ReportData* data) {
   }
 }
 
+// Mean signed final error (bias) of the runs in their start frames, nominal or calibrated.
+io::ReportBias MeanFinalError(const std::vector<io::ReportRun>& runs, bool after) {
+  io::ReportBias b;
+  for (const io::ReportRun& r : runs) {
+    const io::Point2& e = after ? r.after_final_error : r.before_final_error;
+    b.x_m += e.x;
+    b.y_m += e.y;
+    b.heading_rad += after ? r.after_final_heading_rad : r.before_final_heading_rad;
+  }
+  const double n = std::max<double>(1.0, static_cast<double>(runs.size()));
+  return {b.x_m / n, b.y_m / n, b.heading_rad / n};
+}
+
+// Linear interpolation of y(x) at x0 along non-decreasing x; NaN outside [x.front(), x.back()].
+double InterpolateAt(const std::vector<double>& x, const std::vector<double>& y, double x0) {
+  if (x.empty() || x0 < x.front() || x0 > x.back()) return std::nan("");
+  const std::size_t j =
+      static_cast<std::size_t>(std::lower_bound(x.begin(), x.end(), x0) - x.begin());
+  if (j == 0) return y[0];
+  const double span = x[j] - x[j - 1];
+  const double f = span > 0.0 ? (x0 - x[j - 1]) / span : 1.0;
+  return y[j - 1] + f * (y[j] - y[j - 1]);
+}
+
+// The q-quantile of v, linear between order statistics; NaN for none.
+double QuantileOf(std::vector<double> v, double q) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  const double at = q * static_cast<double>(v.size() - 1);
+  const std::size_t lo = static_cast<std::size_t>(std::floor(at));
+  const std::size_t hi = std::min(v.size() - 1, lo + 1);
+  return v[lo] + (at - static_cast<double>(lo)) * (v[hi] - v[lo]);
+}
+
+// One error of the runs (`error`, sampled at their along_m) over the runs that reach each
+// distance: quartiles and median on a grid of 80 distances up to where half the runs still go
+// (the median of the runs' lengths).
+io::ReportErrorBand ErrorBandOf(const std::vector<io::ReportRun>& runs,
+                                const std::vector<double> io::ReportRun::*error) {
+  std::vector<double> ends;
+  for (const io::ReportRun& r : runs) {
+    const std::vector<double>& e = r.*error;
+    if (r.along_m.size() == e.size() && !e.empty()) ends.push_back(r.along_m.back());
+  }
+  const double reach = QuantileOf(ends, 0.5);
+  io::ReportErrorBand band;
+  for (int k = 0; k <= 80 && reach > 0.0; ++k) {
+    const double at = reach * k / 80.0;
+    std::vector<double> v;
+    for (const io::ReportRun& r : runs) {
+      const std::vector<double>& e = r.*error;
+      if (r.along_m.size() != e.size()) continue;
+      const double y = InterpolateAt(r.along_m, e, at);
+      if (std::isfinite(y)) v.push_back(y);
+    }
+    if (v.empty()) continue;
+    band.distance_m.push_back(at);
+    band.lower_quartile.push_back(QuantileOf(v, 0.25));
+    band.median.push_back(QuantileOf(v, 0.5));
+    band.upper_quartile.push_back(QuantileOf(v, 0.75));
+  }
+  return band;
+}
+
+void AddBiasAndErrorBands(io::ReportData* data) {
+  data->bias_before = MeanFinalError(data->runs, false);
+  data->bias_after = MeanFinalError(data->runs, true);
+  io::ReportErrorBands& b = data->error_bands;
+  b.position_before = ErrorBandOf(data->runs, &io::ReportRun::before_distance_m);
+  b.position_after = ErrorBandOf(data->runs, &io::ReportRun::after_distance_m);
+  b.heading_before = ErrorBandOf(data->runs, &io::ReportRun::before_angle_rad);
+  b.heading_after = ErrorBandOf(data->runs, &io::ReportRun::after_angle_rad);
+}
+
 // The whole report of one calibration on its validation runs, with the cross-validation when
 // `with_cv` and it is asked for (the first calibration's only: it does not depend on the
 // calibration).
@@ -548,6 +622,7 @@ io::ReportData BuildReportData(const ReportBuildOptions& options, const ReportIn
     data.runs.push_back(MakeReportRun(e.split.split.validation[i], e.before[i], e.after[i]));
   }
   AddWorldTracks(e, &data);
+  AddBiasAndErrorBands(&data);
   AddGroupRows(e, &data);
   AddStatistics(e, &data);
   AddDrift(e, &data);
