@@ -206,169 +206,228 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
   return Diagnose(training, validation, *Omni3ModelOf(robot), options);
 }
 
-DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
-                        const std::vector<TrackRun>& validation, const RobotModelInterface& model,
-                        const DiagnoseOptions& options) {
-  const Robot& robot = model.robot();
-  std::string error;
-  if (!options.IsValid(&error)) throw std::invalid_argument("DiagnoseOptions: " + error);
-  if (training.empty()) throw std::invalid_argument("Diagnose: no training runs");
-  const int threads = options.fit.num_threads;
-  DiagnoseResult out;
-  out.num_validation_runs = static_cast<int>(validation.size());
-  std::vector<TrackRun> all = training;
-  all.insert(all.end(), validation.begin(), validation.end());
+namespace {
 
-  // 1. The declared fit and its residual.
+// What every step of one diagnosis reads.
+struct DiagnoseContext {
+  const std::vector<TrackRun>& training;
+  const std::vector<TrackRun>& validation;
+  const std::vector<TrackRun>& all;  // training then validation
+  const RobotModelInterface& model;
+  const DiagnoseOptions& options;
+  int threads;
+};
+
+// 1. The declared fit (the model's parameters, final pose) and its residual.
+void FitDeclared(const DiagnoseContext& x, DiagnoseResult* out) {
   ModelFitOptions declared_options;
-  declared_options.ceres.num_threads = threads;
-  declared_options.ceres.weights = options.fit.weights;
-  out.declared = FitModel(AlignedOf(training), model, declared_options);
-  out.declared_validation =
-      ScoreModel(model, out.declared.parameters, {}, validation, options.fit.weights, threads);
-  out.before = AnalyzeResiduals(model, out.declared.parameters, {}, all, threads);
+  declared_options.ceres.num_threads = x.threads;
+  declared_options.ceres.weights = x.options.fit.weights;
+  out->declared = FitModel(AlignedOf(x.training), x.model, declared_options);
+  out->declared_validation = ScoreModel(x.model, out->declared.parameters, {}, x.validation,
+                                        x.options.fit.weights, x.threads);
+  out->before = AnalyzeResiduals(x.model, out->declared.parameters, {}, x.all, x.threads);
+}
 
-  // 2. The base: the model's parameters on the tracks.
-  out.base = FitEffectModel(training, model, out.declared.parameters, {}, options.fit);
-  EffectFitResult current = out.base;
-
+// The effects to try: the options' list or the robot's defaults. The registry's "not
+// identifiable" holds for omni3 (e.g. a tracked-point offset is exactly a change of its wheel
+// distances); another model may separate the effect (a differential drive cannot move sideways,
+// so the same offset shows). Checked numerically here: an effect whose separable fraction reaches
+// min_separable_fraction becomes a candidate like the others; the rest are reported.
+std::vector<EffectId> CandidateEffects(const DiagnoseContext& x, const EffectFitResult& base,
+                                       std::vector<std::string>* not_identifiable) {
   std::vector<EffectId> candidates =
-      options.candidates.empty() ? DefaultCandidates(robot) : options.candidates;
-  // The registry's "not identifiable" holds for omni3 (e.g. a tracked-point offset is exactly a
-  // change of its wheel distances); another model may separate the effect (a differential drive
-  // cannot move sideways, so the same offset shows). Checked numerically here: an effect whose
-  // separable fraction reaches min_separable_fraction becomes a candidate like the others.
+      x.options.candidates.empty() ? DefaultCandidates(x.model.robot()) : x.options.candidates;
   for (const auto& info : effects::EffectTable()) {
     if (info.identifiable) continue;
     const double sep =
-        SeparableFraction(training, model, current.parameters, {}, info.id, options.fit.weights);
-    if (options.candidates.empty() && sep >= options.min_separable_fraction) {
+        SeparableFraction(x.training, x.model, base.parameters, {}, info.id, x.options.fit.weights);
+    if (x.options.candidates.empty() && sep >= x.options.min_separable_fraction) {
       candidates.push_back(info.id);
       continue;
     }
-    out.not_identifiable.push_back(
+    not_identifiable->push_back(
         std::string(info.name) + ": not identifiable - " + info.aliased_with +
         Fmt(" (separable fraction on these runs %.1e); ", sep) + info.separating_runs);
   }
+  return candidates;
+}
 
-  // 3. Tracing.
+// The base of a round: the current model's held-out score and training BIC, and the residual
+// RMS per degree of freedom that predicts how well a candidate could be determined.
+struct RoundBase {
+  ModelScore validation;
+  double bic = 0.0;
+  double residual_rms = 0.0;
+};
+
+// One candidate added to the current model: whether the runs can separate it, its fit, its
+// held-out paired improvement and BIC change. *tried: it was resolvable, so it counts in the
+// round's Bonferroni threshold.
+CandidateResult TryCandidate(const DiagnoseContext& x, const EffectFitResult& current,
+                             const RoundBase& base, EffectId id, bool* tried) {
+  const Robot& robot = x.model.robot();
+  CandidateResult c;
+  c.id = id;
+  double unexplained = 0.0;
+  c.separable_fraction = SeparableFraction(x.training, x.model, current.parameters, current.effects,
+                                           id, x.options.fit.weights, &unexplained);
+  c.predicted_sigma =
+      unexplained > 0.0 ? base.residual_rms / unexplained : std::numeric_limits<double>::infinity();
+  const auto& info = effects::Info(id);
+  double typical = 0.0;
+  for (int j = 0; j < info.num_parameters; ++j)
+    typical = std::max(typical, std::abs(info.typical[j]));
+  c.resolvable = c.separable_fraction >= x.options.min_separable_fraction &&
+                 typical >= x.options.min_resolvable_sigmas * c.predicted_sigma;
+  *tried = c.resolvable;
+  if (!c.resolvable) {
+    c.verdict = "cannot be told apart from the model on these runs";
+    return c;
+  }
+  EffectModel start = current.effects;
+  effects::EffectValue neutral;
+  neutral.id = id;
+  start.push_back(neutral);
+  c.fit = FitEffectModel(x.training, x.model, current.parameters, start, x.options.fit);
+  c.fitted = c.fit.usable;
+  if (!c.fitted) {
+    c.verdict = "fit failed: " + c.fit.termination;
+    return c;
+  }
+  const ModelScore val = ScoreModel(x.model, c.fit.parameters, c.fit.effects, x.validation,
+                                    x.options.fit.weights, x.threads);
+  c.validation_objective = val.objective;
+  PairedImprovement(base.validation, val, &c);
+  c.delta_bic = Bic(2.0 * c.fit.final_cost, static_cast<int>(x.training.size()),
+                    NumParameters(robot, c.fit.effects)) -
+                base.bic;
+  return c;
+}
+
+// One round of the tracing: every candidate not yet in the model tried on top of `current`, then
+// decided (DecideRound); *best is the accepted candidate's index, or -1.
+DiagnoseRound RunRound(const DiagnoseContext& x, const EffectFitResult& current,
+                       const std::vector<EffectId>& candidates, int* best) {
+  const Robot& robot = x.model.robot();
+  DiagnoseRound round;
+  RoundBase base;
+  base.validation = ScoreModel(x.model, current.parameters, current.effects, x.validation,
+                               x.options.fit.weights, x.threads);
+  round.base_validation_objective = base.validation.objective;
+  const ResidualAnalysis base_all =
+      AnalyzeResiduals(x.model, current.parameters, current.effects, x.all, x.threads);
+  round.base_lof_available = base_all.lack_of_fit.available;
+  round.base_lof_f = base_all.lack_of_fit.f;
+  round.base_lof_p = base_all.lack_of_fit.p_value;
+  const bool base_lof =
+      base_all.lack_of_fit.available && base_all.lack_of_fit.p_value < x.options.lof_alpha;
+  base.bic = Bic(2.0 * current.final_cost, static_cast<int>(x.training.size()),
+                 NumParameters(robot, current.effects));
+  const int dof_base =
+      3 * static_cast<int>(x.training.size()) - NumParameters(robot, current.effects);
+  base.residual_rms = std::sqrt(2.0 * current.final_cost / std::max(1, dof_base));
+  int num_tried = 0;
+  for (EffectId id : candidates) {
+    const bool in_model = std::any_of(current.effects.begin(), current.effects.end(),
+                                      [&](const effects::EffectValue& e) { return e.id == id; });
+    if (in_model) continue;
+    bool tried = false;
+    round.candidates.push_back(TryCandidate(x, current, base, id, &tried));
+    num_tried += tried ? 1 : 0;
+  }
+  round.threshold = x.options.alpha / std::max(1, num_tried);
+  *best = DecideRound(x.model, x.all, base_lof, x.options, x.threads, &round);
+  return round;
+}
+
+// The candidates of a round the runs cannot separate from the model: what to record next.
+void NoteUnresolvable(const DiagnoseRound& round, std::vector<std::string>* practically_aliased) {
+  for (const CandidateResult& c : round.candidates) {
+    if (c.resolvable) continue;
+    const auto& info = effects::Info(c.id);
+    practically_aliased->push_back(
+        std::string(info.name) +
+        Fmt(" cannot be told apart from the model on these runs "
+            "(separable fraction %.2g, predicted sigma %.2g; it trades off with ",
+            c.separable_fraction, c.predicted_sigma) +
+        info.aliased_with + "); record: " + info.separating_runs);
+  }
+}
+
+// 3. Tracing: rounds until no candidate is accepted or max_effects are in the model; returns the
+// final model.
+EffectFitResult Trace(const DiagnoseContext& x, const std::vector<EffectId>& candidates,
+                      DiagnoseResult* out) {
+  EffectFitResult current = out->base;
   std::vector<std::string> practically_aliased;
-  const bool have_validation = !validation.empty();
-  while (have_validation && static_cast<int>(current.effects.size()) < options.max_effects) {
-    DiagnoseRound round;
-    const ModelScore base_val = ScoreModel(model, current.parameters, current.effects, validation,
-                                           options.fit.weights, threads);
-    round.base_validation_objective = base_val.objective;
-    const ResidualAnalysis base_all =
-        AnalyzeResiduals(model, current.parameters, current.effects, all, threads);
-    round.base_lof_available = base_all.lack_of_fit.available;
-    round.base_lof_f = base_all.lack_of_fit.f;
-    round.base_lof_p = base_all.lack_of_fit.p_value;
-    const bool base_lof =
-        base_all.lack_of_fit.available && base_all.lack_of_fit.p_value < options.lof_alpha;
-    const double base_bic = Bic(2.0 * current.final_cost, static_cast<int>(training.size()),
-                                NumParameters(robot, current.effects));
-    const int dof_base =
-        3 * static_cast<int>(training.size()) - NumParameters(robot, current.effects);
-    const double residual_rms = std::sqrt(2.0 * current.final_cost / std::max(1, dof_base));
-    int num_tried = 0;
-    for (EffectId id : candidates) {
-      const bool in_model = std::any_of(current.effects.begin(), current.effects.end(),
-                                        [&](const effects::EffectValue& e) { return e.id == id; });
-      if (in_model) continue;
-      CandidateResult c;
-      c.id = id;
-      double unexplained = 0.0;
-      c.separable_fraction = SeparableFraction(training, model, current.parameters, current.effects,
-                                               id, options.fit.weights, &unexplained);
-      c.predicted_sigma =
-          unexplained > 0.0 ? residual_rms / unexplained : std::numeric_limits<double>::infinity();
-      const auto& info = effects::Info(id);
-      double typical = 0.0;
-      for (int j = 0; j < info.num_parameters; ++j)
-        typical = std::max(typical, std::abs(info.typical[j]));
-      c.resolvable = c.separable_fraction >= options.min_separable_fraction &&
-                     typical >= options.min_resolvable_sigmas * c.predicted_sigma;
-      if (!c.resolvable) {
-        c.verdict = "cannot be told apart from the model on these runs";
-        round.candidates.push_back(c);
-        continue;
-      }
-      ++num_tried;
-      EffectModel start = current.effects;
-      effects::EffectValue neutral;
-      neutral.id = id;
-      start.push_back(neutral);
-      c.fit = FitEffectModel(training, model, current.parameters, start, options.fit);
-      c.fitted = c.fit.usable;
-      if (!c.fitted) {
-        c.verdict = "fit failed: " + c.fit.termination;
-        round.candidates.push_back(c);
-        continue;
-      }
-      const ModelScore val = ScoreModel(model, c.fit.parameters, c.fit.effects, validation,
-                                        options.fit.weights, threads);
-      c.validation_objective = val.objective;
-      PairedImprovement(base_val, val, &c);
-      c.delta_bic = Bic(2.0 * c.fit.final_cost, static_cast<int>(training.size()),
-                        NumParameters(robot, c.fit.effects)) -
-                    base_bic;
-      round.candidates.push_back(c);
-    }
-    round.threshold = options.alpha / std::max(1, num_tried);
-    const int best = DecideRound(model, all, base_lof, options, threads, &round);
-    for (const CandidateResult& c : round.candidates) {
-      if (!c.resolvable) {
-        const auto& info = effects::Info(c.id);
-        practically_aliased.push_back(
-            std::string(info.name) +
-            Fmt(" cannot be told apart from the model on these runs "
-                "(separable fraction %.2g, predicted sigma %.2g; it trades off with ",
-                c.separable_fraction, c.predicted_sigma) +
-            info.aliased_with + "); record: " + info.separating_runs);
-      }
-    }
-    if (best < 0) {
-      out.rounds.push_back(std::move(round));
-      break;
-    }
-    current = round.candidates[best].fit;
-    out.rounds.push_back(std::move(round));
+  const bool have_validation = !x.validation.empty();
+  while (have_validation && static_cast<int>(current.effects.size()) < x.options.max_effects) {
+    int best = -1;
+    DiagnoseRound round = RunRound(x, current, candidates, &best);
+    NoteUnresolvable(round, &practically_aliased);
+    if (best >= 0) current = round.candidates[best].fit;
+    out->rounds.push_back(std::move(round));
+    if (best < 0) break;
   }
   std::sort(practically_aliased.begin(), practically_aliased.end());
   practically_aliased.erase(std::unique(practically_aliased.begin(), practically_aliased.end()),
                             practically_aliased.end());
-  out.record_next = practically_aliased;
+  out->record_next = practically_aliased;
+  return current;
+}
 
-  // 4. After.
-  out.final_fit = current;
-  out.final_validation = ScoreModel(model, current.parameters, current.effects, validation,
-                                    options.fit.weights, threads);
-  out.after = AnalyzeResiduals(model, current.parameters, current.effects, all, threads);
-  out.covariates = AnalyzeCovariates(out.after, options.covariate_alpha);
-  out.lack_of_fit =
-      out.after.lack_of_fit.available && out.after.lack_of_fit.p_value < options.lof_alpha;
-  JudgeAgainstSensorFloor(out.after.sensor_floor, options.lof_alpha, &out);
-  out.unexplained_structure =
-      out.lack_of_fit || out.covariates.any_significant || out.floor_shows_structure;
-  out.effects_named = !out.unexplained_structure && !current.effects.empty();
-  for (const CovariateTest& t : out.covariates.tests) {
+// 4. After: the final model's residual, its tests, and what to record next.
+void Conclude(const DiagnoseContext& x, const EffectFitResult& current, DiagnoseResult* out) {
+  out->final_fit = current;
+  out->final_validation = ScoreModel(x.model, current.parameters, current.effects, x.validation,
+                                     x.options.fit.weights, x.threads);
+  out->after = AnalyzeResiduals(x.model, current.parameters, current.effects, x.all, x.threads);
+  out->covariates = AnalyzeCovariates(out->after, x.options.covariate_alpha);
+  out->lack_of_fit =
+      out->after.lack_of_fit.available && out->after.lack_of_fit.p_value < x.options.lof_alpha;
+  JudgeAgainstSensorFloor(out->after.sensor_floor, x.options.lof_alpha, out);
+  out->unexplained_structure =
+      out->lack_of_fit || out->covariates.any_significant || out->floor_shows_structure;
+  out->effects_named = !out->unexplained_structure && !current.effects.empty();
+  for (const CovariateTest& t : out->covariates.tests) {
     if (t.significant) {
-      out.record_next.push_back("runs that vary " + t.name +
-                                " within repetitions of one trajectory, to model what drifts");
+      out->record_next.push_back("runs that vary " + t.name +
+                                 " within repetitions of one trajectory, to model what drifts");
     }
   }
-  if (out.floor_shows_structure && !out.lack_of_fit) {
-    out.record_next.push_back(
+  if (out->floor_shows_structure && !out->lack_of_fit) {
+    out->record_next.push_back(
         "the runs differ from the model by more than the sensors' noise, but no repeatable "
         "pattern is established: record repetitions of each motion, at other times, headings "
         "and wheel angles, so that the lack-of-fit and covariate tests can name what it follows");
   }
-  if (out.lack_of_fit) {
-    out.record_next.push_back(
+  if (out->lack_of_fit) {
+    out->record_next.push_back(
         "structured residual remains that no candidate explains: record runs that vary what the "
         "pattern depends on (speed, yaw rate, run length, start heading) to narrow it down");
   }
+}
+
+}  // namespace
+
+DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
+                        const std::vector<TrackRun>& validation, const RobotModelInterface& model,
+                        const DiagnoseOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw std::invalid_argument("DiagnoseOptions: " + error);
+  if (training.empty()) throw std::invalid_argument("Diagnose: no training runs");
+  DiagnoseResult out;
+  out.num_validation_runs = static_cast<int>(validation.size());
+  std::vector<TrackRun> all = training;
+  all.insert(all.end(), validation.begin(), validation.end());
+  const DiagnoseContext x{training, validation, all, model, options, options.fit.num_threads};
+  FitDeclared(x, &out);
+  // 2. The base: the model's parameters on the tracks.
+  out.base = FitEffectModel(training, model, out.declared.parameters, {}, options.fit);
+  const std::vector<EffectId> candidates = CandidateEffects(x, out.base, &out.not_identifiable);
+  const EffectFitResult final_fit = Trace(x, candidates, &out);
+  Conclude(x, final_fit, &out);
   return out;
 }
 
@@ -376,12 +435,11 @@ std::string FormatDiagnoseReport(const DiagnoseResult& r, const Omni3Robot& robo
   return FormatDiagnoseReport(r, *Omni3ModelOf(robot));
 }
 
-std::string FormatDiagnoseReport(const DiagnoseResult& r, const RobotModelInterface& model) {
-  const Robot& robot = model.robot();
-  std::string out = "# fitcal diagnose\n\n## Residual of the declared fit of the " +
-                    std::to_string(robot.NumFree()) + " free parameters\n\n";
-  out += FormatResidualAnalysis(r.before);
-  out += "\n## Tracing\n\n";
+namespace {
+
+// "## Tracing": each round's base and every candidate tried, one table row each.
+std::string TracingText(const DiagnoseResult& r) {
+  std::string out;
   for (std::size_t k = 0; k < r.rounds.size(); ++k) {
     const DiagnoseRound& round = r.rounds[k];
     out +=
@@ -416,7 +474,12 @@ std::string FormatDiagnoseReport(const DiagnoseResult& r, const RobotModelInterf
     }
     out += "\n";
   }
-  out += "## Result\n\n";
+  return out;
+}
+
+// "## Result": what was accepted, what stays unexplained, what to record next.
+std::string ResultText(const DiagnoseResult& r) {
+  std::string out;
   if (r.final_fit.effects.empty()) {
     out += "No effect accepted.\n";
   } else {
@@ -465,8 +528,12 @@ std::string FormatDiagnoseReport(const DiagnoseResult& r, const RobotModelInterf
   for (const std::string& line : r.not_identifiable) out += "- " + line + "\n";
   for (const std::string& line : r.record_next) out += "- record next: " + line + "\n";
 
-  out += "\n## Residual of the final model against covariates\n\n" +
-         FormatCovariateStructure(r.covariates);
+  return out;
+}
+
+// "## Held-out error": the declared parameters and the final model on the validation runs.
+std::string HeldOutText(const DiagnoseResult& r) {
+  std::string out;
   out += Fmt("\n## Held-out error (%.0f validation runs)\n\n", r.num_validation_runs);
   out += "| model | CF (Eq. 14) | track RMSE [m] | track RMSE [deg] |\n|---|---|---|---|\n";
   out += Fmt("| declared parameters | %.5f | %.5f | %.4f |\n", r.declared_validation.cf,
@@ -478,7 +545,12 @@ std::string FormatDiagnoseReport(const DiagnoseResult& r, const RobotModelInterf
                                       : "| parameters + accepted effects | %.5f | %.5f | %.4f |\n",
           r.final_validation.cf, r.final_validation.track_rmse_m,
           RadToDeg(r.final_validation.track_rmse_rad));
+  return out;
+}
 
+// "## Parameters before / after", in display units.
+std::string ParametersText(const DiagnoseResult& r, const Robot& robot) {
+  std::string out;
   out +=
       "\n## Parameters before / after\n\n| parameter | nominal | declared fit | with effects "
       "| sigma |\n|---|---|---|---|---|\n";
@@ -492,6 +564,24 @@ std::string FormatDiagnoseReport(const DiagnoseResult& r, const RobotModelInterf
                   r.declared.parameters[k] * s, r.final_fit.parameters[k] * s, sigma * s);
     out += line;
   }
+  return out;
+}
+
+}  // namespace
+
+std::string FormatDiagnoseReport(const DiagnoseResult& r, const RobotModelInterface& model) {
+  const Robot& robot = model.robot();
+  std::string out = "# fitcal diagnose\n\n## Residual of the declared fit of the " +
+                    std::to_string(robot.NumFree()) + " free parameters\n\n";
+  out += FormatResidualAnalysis(r.before);
+  out += "\n## Tracing\n\n";
+  out += TracingText(r);
+  out += "## Result\n\n";
+  out += ResultText(r);
+  out += "\n## Residual of the final model against covariates\n\n" +
+         FormatCovariateStructure(r.covariates);
+  out += HeldOutText(r);
+  out += ParametersText(r, robot);
   return out;
 }
 

@@ -235,47 +235,55 @@ void AddSensorFloor(const std::vector<TrackRun>& runs, const std::vector<Lof>& l
   out->sensor_floor = TestAgainstSensorFloor(e_used, jacobian_used, covariance_used, group_used);
 }
 
-}  // namespace
-
-ResidualAnalysis AnalyzeResiduals(const Omni3ParameterArray& p, const EffectModel& model,
-                                  const std::vector<TrackRun>& runs, int num_threads) {
-  return AnalyzeResiduals(DefaultOmni3Model(), {p.begin(), p.end()}, model, runs, num_threads);
-}
-
-ResidualAnalysis AnalyzeResiduals(const RobotModelInterface& robot_model,
-                                  const std::vector<double>& p, const EffectModel& model,
-                                  const std::vector<TrackRun>& runs, int num_threads) {
-  ResidualAnalysis out;
+// Per run: its features, track errors (every sample), final error in the start frame, the
+// checkpoint times (fractions of its motion) and its lack-of-fit components there.
+struct RunComponents {
+  std::vector<Lof> lof;
+  std::vector<std::array<double, 3>> checkpoint_times;
+};
+RunComponents AddRunResiduals(const RobotModelInterface& robot_model, const std::vector<double>& p,
+                              const EffectModel& model, const std::vector<TrackRun>& runs,
+                              int num_threads, ResidualAnalysis* out) {
   const std::size_t n = runs.size();
-  out.runs.resize(n);
-  out.track.resize(n);
-  out.final_start_frame.resize(n);
-  std::vector<Lof> lof(n);
-  std::vector<std::array<double, 3>> checkpoint_times(n);
+  out->runs.resize(n);
+  out->track.resize(n);
+  out->final_start_frame.resize(n);
+  RunComponents rc;
+  rc.lof.resize(n);
+  rc.checkpoint_times.resize(n);
   ParallelFor(n, num_threads, [&](std::size_t i) {
     const TrackRun& run = runs[i];
-    out.runs[i] = Features(robot_model, p, run);
-    out.track[i] = ComputeTrackErrors(robot_model, p, model, run, /*all_samples=*/true);
+    out->runs[i] = Features(robot_model, p, run);
+    out->track[i] = ComputeTrackErrors(robot_model, p, model, run, /*all_samples=*/true);
     const double theta0 = run.aligned.start.theta;
-    out.final_start_frame[i] = ToFrame(out.track[i].final_error, theta0);
-    const RunFeatures& f = out.runs[i];
+    out->final_start_frame[i] = ToFrame(out->track[i].final_error, theta0);
+    const RunFeatures& f = out->runs[i];
     for (int c = 0; c < 3; ++c) {
-      checkpoint_times[i][c] = run.aligned.t_start_s + f.motion_begin_s +
-                               kCheckpointFractions[c] * (f.motion_end_s - f.motion_begin_s);
+      rc.checkpoint_times[i][c] = run.aligned.t_start_s + f.motion_begin_s +
+                                  kCheckpointFractions[c] * (f.motion_end_s - f.motion_begin_s);
     }
-    lof[i] = LofComponents(out.track[i], checkpoint_times[i], theta0);
+    rc.lof[i] = LofComponents(out->track[i], rc.checkpoint_times[i], theta0);
   });
-  // How the components move with each fitted parameter (forward differences, the checkpoint
-  // times held): the lack of fit is what no change of the fitted parameters can remove.
-  std::vector<std::vector<Lof>> lof_jacobian;  // [parameter][run]
+  return rc;
+}
+
+// How the components move with each fitted parameter (forward differences, the checkpoint times
+// held): the lack of fit is what no change of the fitted parameters can remove. [parameter][run]:
+// the model's free parameters, then every parameter of every effect.
+std::vector<std::vector<Lof>> LofJacobian(const RobotModelInterface& robot_model,
+                                          const std::vector<double>& p, const EffectModel& model,
+                                          const std::vector<TrackRun>& runs,
+                                          const RunComponents& rc, int num_threads) {
+  const std::size_t n = runs.size();
+  std::vector<std::vector<Lof>> lof_jacobian;
   // One column: the components' change per unit of the parameter that p_k / model_k moved by h.
   const auto add_column = [&](const std::vector<double>& p_k, const EffectModel& model_k,
                               double h) {
     std::vector<Lof> column(n);
     ParallelFor(n, num_threads, [&](std::size_t i) {
       const TrackErrors moved = ComputeTrackErrors(robot_model, p_k, model_k, runs[i], true);
-      const Lof x = LofComponents(moved, checkpoint_times[i], runs[i].aligned.start.theta);
-      for (int c = 0; c < kLofComponents; ++c) column[i][c] = (x[c] - lof[i][c]) / h;
+      const Lof x = LofComponents(moved, rc.checkpoint_times[i], runs[i].aligned.start.theta);
+      for (int c = 0; c < kLofComponents; ++c) column[i][c] = (x[c] - rc.lof[i][c]) / h;
     });
     lof_jacobian.push_back(std::move(column));
   };
@@ -296,179 +304,238 @@ ResidualAnalysis AnalyzeResiduals(const RobotModelInterface& robot_model,
       add_column(p, model_k, h);
     }
   }
+  return lof_jacobian;
+}
 
-  out.final_jacobian.assign(n, Eigen::MatrixXd::Zero(3, static_cast<int>(lof_jacobian.size())));
+// The final-pose rows (components 9-11) of the lack-of-fit Jacobian, one 3 x parameters matrix
+// per run.
+void AddFinalJacobian(const std::vector<std::vector<Lof>>& lof_jacobian, std::size_t n,
+                      ResidualAnalysis* out) {
+  out->final_jacobian.assign(n, Eigen::MatrixXd::Zero(3, static_cast<int>(lof_jacobian.size())));
   for (std::size_t k = 0; k < lof_jacobian.size(); ++k) {
     for (std::size_t i = 0; i < n; ++i) {
       for (int c = 0; c < 3; ++c)
-        out.final_jacobian[i](c, static_cast<int>(k)) = lof_jacobian[k][i][9 + c];
+        out->final_jacobian[i](c, static_cast<int>(k)) = lof_jacobian[k][i][9 + c];
     }
   }
+}
 
+void AddWheelAngleJacobians(const RobotModelInterface& robot_model, const std::vector<double>& p,
+                            const EffectModel& model, const std::vector<TrackRun>& runs,
+                            int num_threads, ResidualAnalysis* out) {
   const std::vector<int> angle_wheels = WheelsWithAbsoluteAngle(runs);
-  if (!angle_wheels.empty()) {
-    out.wheel_angle_jacobian.resize(n);
-    ParallelFor(n, num_threads, [&](std::size_t i) {
-      out.wheel_angle_jacobian[i] =
-          WheelAngleJacobian(robot_model, p, model, runs[i], angle_wheels);
-    });
-  }
+  if (angle_wheels.empty()) return;
+  out->wheel_angle_jacobian.resize(runs.size());
+  ParallelFor(runs.size(), num_threads, [&](std::size_t i) {
+    out->wheel_angle_jacobian[i] = WheelAngleJacobian(robot_model, p, model, runs[i], angle_wheels);
+  });
+}
 
-  // Systematic / non-systematic split and the lack-of-fit test, over trajectories with reps.
-  // The 12 components of a run (errors at three checkpoints and at the end, x, y, theta) are
-  // strongly correlated (an error at half way persists to the end), so each trajectory's mean is
-  // weighed with the inverse of their pooled within-trajectory covariance (a Hotelling-type
-  // statistic): weighing each component by its own variance alone counts one deviation up to 12
-  // times and makes F far more variable than F(df_lof, df_pe) (clean simulated data then read as
-  // "structure" for some seeds).
-  AssignRepetitionGroups(&out.runs);
-  AddSensorFloor(runs, lof, lof_jacobian, checkpoint_times, num_threads, &out);
-  std::map<std::string, std::vector<std::size_t>> by_trajectory;
-  for (std::size_t i = 0; i < n; ++i) by_trajectory[out.runs[i].repetition_group].push_back(i);
-  using Vec = Eigen::Matrix<double, kLofComponents, 1>;
-  using Mat = Eigen::Matrix<double, kLofComponents, kLofComponents>;
-  Mat scatter = Mat::Zero();
-  struct TrajectoryMean {
-    double m;
-    Vec mean;
-    Eigen::Matrix<double, kLofComponents, Eigen::Dynamic> jacobian;  // mean over its runs
-  };
-  const int num_parameters = static_cast<int>(lof_jacobian.size());
-  std::vector<TrajectoryMean> trajectory_means;
+using LofVector = Eigen::Matrix<double, kLofComponents, 1>;
+using LofMatrix = Eigen::Matrix<double, kLofComponents, kLofComponents>;
+
+// One trajectory with repetitions: the mean of its runs' components and of their Jacobians.
+struct TrajectoryMean {
+  double m;  // runs
+  LofVector mean;
+  Eigen::Matrix<double, kLofComponents, Eigen::Dynamic> jacobian;  // mean over its runs
+};
+
+// The runs of every trajectory with repetitions around their trajectory's mean: the pooled
+// scatter (pure error) and the systematic / non-systematic sums of the final pose.
+struct RepetitionScatter {
+  std::vector<TrajectoryMean> means;
+  LofMatrix scatter = LofMatrix::Zero();
   double sys_m = 0.0, sys_rad = 0.0, non_m = 0.0, non_rad = 0.0;
   int num_traj = 0, num_runs = 0;
   double df_pe_per_component = 0.0;
+};
+RepetitionScatter ScatterOverRepetitions(const ResidualAnalysis& a, const std::vector<Lof>& lof,
+                                         const std::vector<std::vector<Lof>>& lof_jacobian) {
+  std::map<std::string, std::vector<std::size_t>> by_trajectory;
+  for (std::size_t i = 0; i < a.runs.size(); ++i) {
+    by_trajectory[a.runs[i].repetition_group].push_back(i);
+  }
+  const int num_parameters = static_cast<int>(lof_jacobian.size());
+  RepetitionScatter r;
   for (const auto& [label, members] : by_trajectory) {
     if (members.size() < 2) continue;
-    ++num_traj;
+    ++r.num_traj;
     const double m = static_cast<double>(members.size());
-    df_pe_per_component += m - 1.0;
-    TrajectoryMean t{m, Vec::Zero(),
+    r.df_pe_per_component += m - 1.0;
+    TrajectoryMean t{m, LofVector::Zero(),
                      Eigen::Matrix<double, kLofComponents, Eigen::Dynamic>::Zero(kLofComponents,
                                                                                  num_parameters)};
     for (std::size_t i : members) {
-      t.mean += Vec(lof[i].data()) / m;
+      t.mean += LofVector(lof[i].data()) / m;
       for (int k = 0; k < num_parameters; ++k)
-        t.jacobian.col(k) += Vec(lof_jacobian[k][i].data()) / m;
+        t.jacobian.col(k) += LofVector(lof_jacobian[k][i].data()) / m;
     }
     for (std::size_t i : members) {
-      ++num_runs;
-      const Vec d = Vec(lof[i].data()) - t.mean;
-      scatter += d * d.transpose();
-      sys_m += t.mean[9] * t.mean[9] + t.mean[10] * t.mean[10];
-      sys_rad += t.mean[11] * t.mean[11];
-      non_m += d[9] * d[9] + d[10] * d[10];
-      non_rad += d[11] * d[11];
+      ++r.num_runs;
+      const LofVector d = LofVector(lof[i].data()) - t.mean;
+      r.scatter += d * d.transpose();
+      r.sys_m += t.mean[9] * t.mean[9] + t.mean[10] * t.mean[10];
+      r.sys_rad += t.mean[11] * t.mean[11];
+      r.non_m += d[9] * d[9] + d[10] * d[10];
+      r.non_rad += d[11] * d[11];
     }
-    trajectory_means.push_back(std::move(t));
+    r.means.push_back(std::move(t));
   }
-  if (num_traj > 0 && df_pe_per_component > 0.0) {
-    const double runs_d = static_cast<double>(num_runs);
-    out.systematic_rms_m = std::sqrt(sys_m / runs_d);
-    out.systematic_rms_rad = std::sqrt(sys_rad / runs_d);
-    // Scatter around a mean of m values: divide by (m - 1) per trajectory, not m.
-    out.nonsystematic_rms_m = std::sqrt(non_m / df_pe_per_component);
-    out.nonsystematic_rms_rad = std::sqrt(non_rad / df_pe_per_component);
-    // Whitening by the pure-error covariance; directions without scatter (noise-free data) are
-    // left out.
-    const Eigen::SelfAdjointEigenSolver<Mat> eig(scatter / df_pe_per_component);
-    const double largest = eig.eigenvalues().maxCoeff();
-    Mat whiten = Mat::Zero();
-    int rank = 0;
-    for (int c = 0; c < kLofComponents; ++c) {
-      const double lambda = eig.eigenvalues()[c];
-      if (!(lambda > 1e-12 * largest)) continue;
-      whiten.row(rank++) = eig.eigenvectors().col(c).transpose() / std::sqrt(lambda);
-    }
-    // Weighted least squares over the trajectory means: the linearised refit of the parameters
-    // on all runs. lof_w is its residual, ~ chi^2(rank * trajectories - identifiable parameters)
-    // when what is left is noise.
-    Eigen::MatrixXd a = Eigen::MatrixXd::Zero(num_parameters, num_parameters);
-    Eigen::VectorXd b = Eigen::VectorXd::Zero(num_parameters);
-    double total = 0.0;
-    for (const TrajectoryMean& t : trajectory_means) {
-      const Eigen::VectorXd z = whiten.topRows(rank) * t.mean;
-      const Eigen::MatrixXd jz = whiten.topRows(rank) * t.jacobian;
-      total += t.m * z.squaredNorm();
-      a += t.m * jz.transpose() * jz;
-      b += t.m * jz.transpose() * z;
-    }
-    int identifiable = 0;
-    const double explained = ExplainedByLinearisedRefit(a, b, &identifiable);
-    const double lof_w = std::max(0.0, total - explained);
-    // The covariance is estimated on df_pe_per_component degrees of freedom; the Hotelling
-    // correction leaves df_pe_per_component - rank + 1 for the denominator.
-    if (rank > 0 && df_pe_per_component - rank + 1.0 > 0.0) {
-      LackOfFit& l = out.lack_of_fit;
-      l.trajectories_with_repetitions = num_traj;
-      l.df_pe = df_pe_per_component - rank + 1.0;
-      l.df_lof = std::max(1.0, static_cast<double>(rank * num_traj - identifiable));
-      l.f = lof_w / l.df_lof;
-      l.p_value = stats::FUpperTail(l.f, l.df_lof, l.df_pe);
-      l.available = true;
-    }
-  }
+  return r;
+}
 
-  // Group statistics.
-  std::map<std::string, GroupStat> groups;
-  for (std::size_t i = 0; i < n; ++i) {
-    const RunFeatures& f = out.runs[i];
-    const Pose2d& e = out.final_start_frame[i];
-    const double v[3] = {e.x, e.y, e.theta};
-    Accumulate(groups, "family", f.family, v);
-    char bin[32];
-    const double alpha_deg = std::fmod(RadToDeg(f.alpha_rad) + 360.0 + 15.0, 360.0) - 15.0;
-    std::snprintf(bin, sizeof bin, "%+04.0f", 30.0 * std::round(alpha_deg / 30.0) + 0.0);
-    Accumulate(groups, "alpha_deg", bin, v);
-    Accumulate(groups, "rotation",
-               f.rotation_sign > 0 ? "ccw" : (f.rotation_sign < 0 ? "cw" : "none"), v);
-    std::snprintf(bin, sizeof bin, "%.2f", 0.05 * std::round(f.speed_m_s / 0.05));
-    Accumulate(groups, "speed_m_s", bin, v);
-    // Error growth rate between consecutive ground-truth samples, robot frame.
-    const TrackErrors& t = out.track[i];
-    const TrackRun& run = runs[i];
-    for (std::size_t j = 1; j < t.t_s.size(); ++j) {
-      const double dt = t.t_s[j] - t.t_s[j - 1];
-      if (!(dt > 0.0)) continue;
-      const Pose2d de{t.error[j].x - t.error[j - 1].x, t.error[j].y - t.error[j - 1].y,
-                      t.error[j].theta - t.error[j - 1].theta};
-      const Pose2d r = ToFrame(de, t.ground_truth[j - 1].theta);
-      const double rate[3] = {r.x / dt, r.y / dt, r.theta / dt};
-      const double mid = 0.5 * (t.t_s[j] + t.t_s[j - 1]) - run.aligned.t_start_s;
-      // Phase from the sample context at mid.
-      std::size_t k = 0;
-      while (k + 1 < run.contexts.size() && run.contexts[k + 1].t_s <= mid) ++k;
-      const auto& c = run.contexts[k];
-      double accel = 0.0, dir = 0.0;
-      for (int w = 0; w < c.num_channels; ++w) {
-        if (c.IsWheel(w) && std::abs(c.accel_rad_s2(w)) > std::abs(accel)) {
-          accel = c.accel_rad_s2(w);
-          dir = run.aligned.samples[k].value[w];
-        }
-      }
-      const char* phase = !c.moving ? "rest"
-                          : std::abs(accel) < kAccelerationPhaseRadS2
-                              ? "cruise"
-                              : (accel * dir > 0.0 ? "accelerate" : "decelerate");
-      Accumulate(groups, "phase", phase, rate);
-      const double span = f.motion_end_s - f.motion_begin_s;
-      const double frac = span > 0.0 ? (mid - f.motion_begin_s) / span : 0.0;
-      const char* when = frac < 0.0    ? "before motion"
-                         : frac < 0.25 ? "0-25%"
-                         : frac < 0.5  ? "25-50%"
-                         : frac < 0.75 ? "50-75%"
-                         : frac <= 1.0 ? "75-100%"
-                                       : "after motion";
-      Accumulate(groups, "time_in_run", when, rate);
+// Systematic / non-systematic split and the lack-of-fit test, over trajectories with reps.
+// The 12 components of a run (errors at three checkpoints and at the end, x, y, theta) are
+// strongly correlated (an error at half way persists to the end), so each trajectory's mean is
+// weighed with the inverse of their pooled within-trajectory covariance (a Hotelling-type
+// statistic): weighing each component by its own variance alone counts one deviation up to 12
+// times and makes F far more variable than F(df_lof, df_pe) (clean simulated data then read as
+// "structure" for some seeds).
+void AddLackOfFit(const RepetitionScatter& r, int num_parameters, ResidualAnalysis* out) {
+  if (r.num_traj == 0 || !(r.df_pe_per_component > 0.0)) return;
+  const double runs_d = static_cast<double>(r.num_runs);
+  out->systematic_rms_m = std::sqrt(r.sys_m / runs_d);
+  out->systematic_rms_rad = std::sqrt(r.sys_rad / runs_d);
+  // Scatter around a mean of m values: divide by (m - 1) per trajectory, not m.
+  out->nonsystematic_rms_m = std::sqrt(r.non_m / r.df_pe_per_component);
+  out->nonsystematic_rms_rad = std::sqrt(r.non_rad / r.df_pe_per_component);
+  // Whitening by the pure-error covariance; directions without scatter (noise-free data) are
+  // left out.
+  const Eigen::SelfAdjointEigenSolver<LofMatrix> eig(r.scatter / r.df_pe_per_component);
+  const double largest = eig.eigenvalues().maxCoeff();
+  LofMatrix whiten = LofMatrix::Zero();
+  int rank = 0;
+  for (int c = 0; c < kLofComponents; ++c) {
+    const double lambda = eig.eigenvalues()[c];
+    if (!(lambda > 1e-12 * largest)) continue;
+    whiten.row(rank++) = eig.eigenvectors().col(c).transpose() / std::sqrt(lambda);
+  }
+  // Weighted least squares over the trajectory means: the linearised refit of the parameters
+  // on all runs. lof_w is its residual, ~ chi^2(rank * trajectories - identifiable parameters)
+  // when what is left is noise.
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(num_parameters, num_parameters);
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(num_parameters);
+  double total = 0.0;
+  for (const TrajectoryMean& t : r.means) {
+    const Eigen::VectorXd z = whiten.topRows(rank) * t.mean;
+    const Eigen::MatrixXd jz = whiten.topRows(rank) * t.jacobian;
+    total += t.m * z.squaredNorm();
+    a += t.m * jz.transpose() * jz;
+    b += t.m * jz.transpose() * z;
+  }
+  int identifiable = 0;
+  const double explained = ExplainedByLinearisedRefit(a, b, &identifiable);
+  const double lof_w = std::max(0.0, total - explained);
+  // The covariance is estimated on df_pe_per_component degrees of freedom; the Hotelling
+  // correction leaves df_pe_per_component - rank + 1 for the denominator.
+  if (rank > 0 && r.df_pe_per_component - rank + 1.0 > 0.0) {
+    LackOfFit& l = out->lack_of_fit;
+    l.trajectories_with_repetitions = r.num_traj;
+    l.df_pe = r.df_pe_per_component - rank + 1.0;
+    l.df_lof = std::max(1.0, static_cast<double>(rank * r.num_traj - identifiable));
+    l.f = lof_w / l.df_lof;
+    l.p_value = stats::FUpperTail(l.f, l.df_lof, l.df_pe);
+    l.available = true;
+  }
+}
+
+// The final error of a run binned by its features: family, direction, rotation, speed.
+void AccumulateByFeatures(const RunFeatures& f, const Pose2d& e,
+                          std::map<std::string, GroupStat>& groups) {
+  const double v[3] = {e.x, e.y, e.theta};
+  Accumulate(groups, "family", f.family, v);
+  char bin[32];
+  const double alpha_deg = std::fmod(RadToDeg(f.alpha_rad) + 360.0 + 15.0, 360.0) - 15.0;
+  std::snprintf(bin, sizeof bin, "%+04.0f", 30.0 * std::round(alpha_deg / 30.0) + 0.0);
+  Accumulate(groups, "alpha_deg", bin, v);
+  Accumulate(groups, "rotation",
+             f.rotation_sign > 0 ? "ccw" : (f.rotation_sign < 0 ? "cw" : "none"), v);
+  std::snprintf(bin, sizeof bin, "%.2f", 0.05 * std::round(f.speed_m_s / 0.05));
+  Accumulate(groups, "speed_m_s", bin, v);
+}
+
+// The phase of the motion at `mid` (s since the window's start), from the sample context:
+// rest, cruise, accelerate or decelerate by the largest wheel acceleration.
+const char* PhaseAt(const TrackRun& run, double mid) {
+  std::size_t k = 0;
+  while (k + 1 < run.contexts.size() && run.contexts[k + 1].t_s <= mid) ++k;
+  const auto& c = run.contexts[k];
+  double accel = 0.0, dir = 0.0;
+  for (int w = 0; w < c.num_channels; ++w) {
+    if (c.IsWheel(w) && std::abs(c.accel_rad_s2(w)) > std::abs(accel)) {
+      accel = c.accel_rad_s2(w);
+      dir = run.aligned.samples[k].value[w];
     }
+  }
+  return !c.moving ? "rest"
+         : std::abs(accel) < kAccelerationPhaseRadS2
+             ? "cruise"
+             : (accel * dir > 0.0 ? "accelerate" : "decelerate");
+}
+
+// Error growth rate between consecutive ground-truth samples, robot frame, binned by the phase of
+// the motion and by the time in the run.
+void AccumulateErrorGrowth(const TrackRun& run, const TrackErrors& t, const RunFeatures& f,
+                           std::map<std::string, GroupStat>& groups) {
+  for (std::size_t j = 1; j < t.t_s.size(); ++j) {
+    const double dt = t.t_s[j] - t.t_s[j - 1];
+    if (!(dt > 0.0)) continue;
+    const Pose2d de{t.error[j].x - t.error[j - 1].x, t.error[j].y - t.error[j - 1].y,
+                    t.error[j].theta - t.error[j - 1].theta};
+    const Pose2d r = ToFrame(de, t.ground_truth[j - 1].theta);
+    const double rate[3] = {r.x / dt, r.y / dt, r.theta / dt};
+    const double mid = 0.5 * (t.t_s[j] + t.t_s[j - 1]) - run.aligned.t_start_s;
+    Accumulate(groups, "phase", PhaseAt(run, mid), rate);
+    const double span = f.motion_end_s - f.motion_begin_s;
+    const double frac = span > 0.0 ? (mid - f.motion_begin_s) / span : 0.0;
+    const char* when = frac < 0.0    ? "before motion"
+                       : frac < 0.25 ? "0-25%"
+                       : frac < 0.5  ? "25-50%"
+                       : frac < 0.75 ? "50-75%"
+                       : frac <= 1.0 ? "75-100%"
+                                     : "after motion";
+    Accumulate(groups, "time_in_run", when, rate);
+  }
+}
+
+// Group statistics: mean and RMS of each bin.
+void AddGroupStatistics(const std::vector<TrackRun>& runs, ResidualAnalysis* out) {
+  std::map<std::string, GroupStat> groups;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    AccumulateByFeatures(out->runs[i], out->final_start_frame[i], groups);
+    AccumulateErrorGrowth(runs[i], out->track[i], out->runs[i], groups);
   }
   for (auto& [key, g] : groups) {
     for (int c = 0; c < 3; ++c) {
       g.mean[c] /= g.count;
       g.rms[c] = std::sqrt(g.rms[c] / g.count);
     }
-    out.groups.push_back(g);
+    out->groups.push_back(g);
   }
+}
+
+}  // namespace
+
+ResidualAnalysis AnalyzeResiduals(const Omni3ParameterArray& p, const EffectModel& model,
+                                  const std::vector<TrackRun>& runs, int num_threads) {
+  return AnalyzeResiduals(DefaultOmni3Model(), {p.begin(), p.end()}, model, runs, num_threads);
+}
+
+ResidualAnalysis AnalyzeResiduals(const RobotModelInterface& robot_model,
+                                  const std::vector<double>& p, const EffectModel& model,
+                                  const std::vector<TrackRun>& runs, int num_threads) {
+  ResidualAnalysis out;
+  const RunComponents rc = AddRunResiduals(robot_model, p, model, runs, num_threads, &out);
+  const std::vector<std::vector<Lof>> lof_jacobian =
+      LofJacobian(robot_model, p, model, runs, rc, num_threads);
+  AddFinalJacobian(lof_jacobian, runs.size(), &out);
+  AddWheelAngleJacobians(robot_model, p, model, runs, num_threads, &out);
+  AssignRepetitionGroups(&out.runs);
+  AddSensorFloor(runs, rc.lof, lof_jacobian, rc.checkpoint_times, num_threads, &out);
+  AddLackOfFit(ScatterOverRepetitions(out, rc.lof, lof_jacobian),
+               static_cast<int>(lof_jacobian.size()), &out);
+  AddGroupStatistics(runs, &out);
   return out;
 }
 

@@ -5,6 +5,9 @@
 #include <cstdio>
 #include <sstream>
 
+#include "io/final_error_plot.h"
+#include "io/report_html.h"
+#include "io/report_json.h"
 #include "io/svg_plot.h"
 
 namespace fitcal::io {
@@ -12,8 +15,7 @@ namespace fitcal::io {
 namespace {
 
 constexpr double kDeg = 180.0 / M_PI;
-const char* const kBeforeColour = "#d55e00";  // as the report: nominal
-const char* const kAfterColour = "#0072b2";   // calibrated
+const char* const kAfterColour = "#0072b2";  // calibrated
 
 std::string Fmt(const char* format, double v) {
   if (!std::isfinite(v)) return "-";
@@ -31,34 +33,23 @@ void CloseTable(std::ostringstream& h) { h << "</table>\n</div>\n"; }
 
 // The residual: each held-out run's final position error in its start frame, before and after.
 std::string FinalErrorsSvg(const DiagnosePageData& d) {
-  SvgSeries before, after, origin;
-  before.name = "nominal parameters";
-  before.color = kBeforeColour;
-  after.name = "written calibration";
-  after.color = kAfterColour;
-  origin.name = "ground truth end point";
-  origin.lines = {{Point2{0.0, 0.0}}};
-  for (SvgSeries* s : {&before, &after, &origin}) {
-    s->draw_lines = false;
-    s->draw_markers = true;
-    s->opacity = 0.75;
-  }
-  before.lines.emplace_back();
-  after.lines.emplace_back();
+  FinalErrorScatter s;
+  s.before_name = "nominal parameters";
+  s.after_name = "written calibration";
+  s.origin_name = "ground truth end point";
+  s.run_opacity = 0.75;
+  s.origin_opacity = 0.75;
   for (const DiagnoseHeldOutRun& r : d.held_out) {
-    before.lines[0].push_back({1e3 * r.final_error_before_m.x, 1e3 * r.final_error_before_m.y});
-    after.lines[0].push_back({1e3 * r.final_error_after_m.x, 1e3 * r.final_error_after_m.y});
+    s.before_m.push_back(r.final_error_before_m);
+    s.after_m.push_back(r.final_error_after_m);
   }
-  XYPlotOptions o;
-  o.id = "diag-final";
-  o.title = "Held-out final position errors";
-  o.x_label = "along start-frame x [mm]";
-  o.y_label = "along start-frame y [mm]";
-  o.width = 480;
-  o.height = 480;
-  o.equal_aspect = true;
-  o.include_origin = true;
-  return XYPlotSvg(o, {before, after, origin});
+  s.plot.id = "diag-final";
+  s.plot.title = "Held-out final position errors";
+  s.plot.x_label = "along start-frame x [mm]";
+  s.plot.y_label = "along start-frame y [mm]";
+  s.plot.width = 480;
+  s.plot.height = 480;
+  return FinalErrorScatterSvg(s);
 }
 
 // The evidence of each fitted candidate: -log10 p against the Bonferroni threshold.

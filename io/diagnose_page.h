@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "io/report_writer.h"
+#include "io/report_model.h"
 
 namespace fitcal::io {
 

@@ -68,17 +68,16 @@ void ColouredLine(std::ostringstream& out, const std::vector<Point2>& line,
                   const Py& py) {
   const auto step_of = [&](double v) {
     const double u = (v - s.value_lo) / (s.value_hi - s.value_lo);
-    return std::clamp(static_cast<int>(std::floor((std::isfinite(u) ? u : 0.0) * kColourSteps)),
-                      0, kColourSteps - 1);
+    return std::clamp(static_cast<int>(std::floor((std::isfinite(u) ? u : 0.0) * kColourSteps)), 0,
+                      kColourSteps - 1);
   };
   std::size_t i = 0;
   while (i + 1 < line.size()) {
     const int step = step_of(values[i + 1]);
     std::size_t j = i + 1;
     while (j + 1 < line.size() && step_of(values[j + 1]) == step) ++j;
-    out << "<polyline fill=\"none\" stroke=\""
-        << SequentialColour((step + 0.5) / kColourSteps) << "\" stroke-width=\"" << s.line_width
-        << "\" stroke-linejoin=\"round\" points=\"";
+    out << "<polyline fill=\"none\" stroke=\"" << SequentialColour((step + 0.5) / kColourSteps)
+        << "\" stroke-width=\"" << s.line_width << "\" stroke-linejoin=\"round\" points=\"";
     for (std::size_t k = i; k <= j; ++k)
       out << Num(px(line[k].x)) << "," << Num(py(line[k].y)) << " ";
     out << "\"/>";
@@ -180,50 +179,65 @@ std::vector<double> NiceTicks(double lo, double hi, int max_ticks) {
   return ticks;
 }
 
-std::string XYPlotSvg(const XYPlotOptions& o, const std::vector<SvgSeries>& series) {
+namespace {
+
+// Where an x-y plot draws: the plot area in pixels, the data ranges it shows, and how many
+// legend entries fit a row.
+struct XYFrame {
+  double left = 70, right = 20, top = 34, bottom = 50;
+  double pw = 0.0, ph = 0.0;  // plot area
   Range xr, yr;
+  std::size_t per_row = 1;  // legend entries per row
+  double px(double x) const { return left + (x - xr.lo) / (xr.hi - xr.lo) * pw; }
+  double py(double y) const { return top + ph - (y - yr.lo) / (yr.hi - yr.lo) * ph; }
+};
+
+XYFrame XYFrameOf(const XYPlotOptions& o, const std::vector<SvgSeries>& series) {
+  XYFrame f;
   for (const SvgSeries& s : series) {
     for (const auto& line : s.lines) {
       for (const Point2& p : line) {
-        xr.Add(p.x);
-        yr.Add(p.y);
+        f.xr.Add(p.x);
+        f.yr.Add(p.y);
       }
     }
   }
   if (o.include_origin) {
-    xr.Add(0.0);
-    yr.Add(0.0);
+    f.xr.Add(0.0);
+    f.yr.Add(0.0);
   }
-  xr.Pad(0.05);
-  yr.Pad(0.05);
-  if (o.x_lo < o.x_hi) xr = Range{o.x_lo, o.x_hi};
-  if (o.y_lo < o.y_hi) yr = Range{o.y_lo, o.y_hi};
-  const double left = 70, right = 20, top = 34, bottom = 50;
-  const double pw = o.width - left - right;
+  f.xr.Pad(0.05);
+  f.yr.Pad(0.05);
+  if (o.x_lo < o.x_hi) f.xr = Range{o.x_lo, o.x_hi};
+  if (o.y_lo < o.y_hi) f.yr = Range{o.y_lo, o.y_hi};
+  f.pw = o.width - f.left - f.right;
   // Legend below the plot: as many entries per row as their longest name allows.
   std::size_t longest = 1;
   for (const SvgSeries& s : series) longest = std::max(longest, s.name.size());
-  const std::size_t per_row = std::max<std::size_t>(
-      1, static_cast<std::size_t>(pw / (40.0 + 6.5 * static_cast<double>(longest))));
-  const double legend_h = 22.0 * static_cast<double>((series.size() + per_row - 1) / per_row);
-  const double ph = o.height - top - bottom - legend_h;
+  f.per_row = std::max<std::size_t>(
+      1, static_cast<std::size_t>(f.pw / (40.0 + 6.5 * static_cast<double>(longest))));
+  const double legend_h = 22.0 * static_cast<double>((series.size() + f.per_row - 1) / f.per_row);
+  f.ph = o.height - f.top - f.bottom - legend_h;
   if (o.equal_aspect) {
     // Widen the smaller span so one unit has the same length on both axes.
-    const double scale = std::max((xr.hi - xr.lo) / pw, (yr.hi - yr.lo) / ph);
-    const double xc = 0.5 * (xr.lo + xr.hi), yc = 0.5 * (yr.lo + yr.hi);
-    xr = Range{xc - 0.5 * scale * pw, xc + 0.5 * scale * pw};
-    yr = Range{yc - 0.5 * scale * ph, yc + 0.5 * scale * ph};
+    const double scale = std::max((f.xr.hi - f.xr.lo) / f.pw, (f.yr.hi - f.yr.lo) / f.ph);
+    const double xc = 0.5 * (f.xr.lo + f.xr.hi), yc = 0.5 * (f.yr.lo + f.yr.hi);
+    f.xr = Range{xc - 0.5 * scale * f.pw, xc + 0.5 * scale * f.pw};
+    f.yr = Range{yc - 0.5 * scale * f.ph, yc + 0.5 * scale * f.ph};
   }
-  auto px = [&](double x) { return left + (x - xr.lo) / (xr.hi - xr.lo) * pw; };
-  auto py = [&](double y) { return top + ph - (y - yr.lo) / (yr.hi - yr.lo) * ph; };
+  return f;
+}
 
-  std::ostringstream out;
-  Open(out, o.width, o.height, o.title);
+// Title, frame, grid, tick labels and axis labels.
+void XYAxes(std::ostringstream& out, const XYPlotOptions& o, const XYFrame& f) {
+  const double left = f.left, top = f.top, pw = f.pw, ph = f.ph;
+  const auto px = [&](double x) { return f.px(x); };
+  const auto py = [&](double y) { return f.py(y); };
   Text(out, o.width / 2.0, 20, o.title, "middle", 15, " font-weight=\"bold\"");
   out << "<rect x=\"" << Num(left) << "\" y=\"" << Num(top) << "\" width=\"" << Num(pw)
       << "\" height=\"" << Num(ph) << "\" fill=\"none\" stroke=\"#333\"/>\n";
-  const auto xt = NiceTicks(xr.lo, xr.hi, std::max(3, static_cast<int>(pw / 80)));
-  const auto yt = NiceTicks(yr.lo, yr.hi, std::max(3, static_cast<int>(ph / 50)));
+  const auto xt = NiceTicks(f.xr.lo, f.xr.hi, std::max(3, static_cast<int>(pw / 80)));
+  const auto yt = NiceTicks(f.yr.lo, f.yr.hi, std::max(3, static_cast<int>(ph / 50)));
   const double xstep = xt.size() > 1 ? xt[1] - xt[0] : 1.0;
   const double ystep = yt.size() > 1 ? yt[1] - yt[0] : 1.0;
   for (double t : xt) {
@@ -240,47 +254,48 @@ std::string XYPlotSvg(const XYPlotOptions& o, const std::vector<SvgSeries>& seri
   const double ylx = 18, yly = top + ph / 2;
   Text(out, ylx, yly, o.y_label, "middle", 13,
        (" transform=\"rotate(-90 " + Num(ylx) + " " + Num(yly) + ")\"").c_str());
-  // Ids must be unique in a document that embeds several plots.
-  static std::atomic<int> next_clip_id{0};
-  const std::string clip_id =
-      "clip-" + (o.id.empty() ? std::to_string(next_clip_id++) : EscapeXml(o.id));
-  out << "<clipPath id=\"" << clip_id << "\"><rect x=\"" << Num(left) << "\" y=\"" << Num(top)
-      << "\" width=\"" << Num(pw) << "\" height=\"" << Num(ph) << "\"/></clipPath>\n";
-  out << "<g clip-path=\"url(#" << clip_id << ")\">\n";
-  for (const SvgSeries& s : series) {
-    out << "<g opacity=\"" << s.opacity << "\">";
-    for (std::size_t li = 0; li < s.lines.size(); ++li) {
-      const std::vector<Point2>& line = s.lines[li];
-      if (!s.fill.empty()) {
-        out << "<polygon fill=\"" << s.fill << "\" stroke=\"none\" points=\"";
-        for (const Point2& p : line) out << Num(px(p.x)) << "," << Num(py(p.y)) << " ";
-        out << "\"/>";
-        continue;
-      }
-      if (li < s.values.size() && s.values[li].size() == line.size()) {
-        ColouredLine(out, line, s.values[li], s, px, py);
-      } else if (s.draw_lines && line.size() > 1) {
-        out << "<polyline fill=\"none\" stroke=\"" << s.color << "\" stroke-width=\""
-            << s.line_width << "\"";
-        if (!s.dash.empty()) out << " stroke-dasharray=\"" << s.dash << "\"";
-        out << " points=\"";
-        for (const Point2& p : line) out << Num(px(p.x)) << "," << Num(py(p.y)) << " ";
-        out << "\"/>";
-      }
-      if (s.draw_markers) {
-        for (const Point2& p : line) {
-          out << "<circle cx=\"" << Num(px(p.x)) << "\" cy=\"" << Num(py(p.y)) << "\" r=\""
-              << s.marker_radius << "\" fill=\"" << s.color << "\"/>";
-        }
+}
+
+// One series inside the plot area: filled polygons, lines (plain or coloured by value), markers.
+void XYSeries(std::ostringstream& out, const SvgSeries& s, const XYFrame& f) {
+  const auto px = [&](double x) { return f.px(x); };
+  const auto py = [&](double y) { return f.py(y); };
+  out << "<g opacity=\"" << s.opacity << "\">";
+  for (std::size_t li = 0; li < s.lines.size(); ++li) {
+    const std::vector<Point2>& line = s.lines[li];
+    if (!s.fill.empty()) {
+      out << "<polygon fill=\"" << s.fill << "\" stroke=\"none\" points=\"";
+      for (const Point2& p : line) out << Num(px(p.x)) << "," << Num(py(p.y)) << " ";
+      out << "\"/>";
+      continue;
+    }
+    if (li < s.values.size() && s.values[li].size() == line.size()) {
+      ColouredLine(out, line, s.values[li], s, px, py);
+    } else if (s.draw_lines && line.size() > 1) {
+      out << "<polyline fill=\"none\" stroke=\"" << s.color << "\" stroke-width=\"" << s.line_width
+          << "\"";
+      if (!s.dash.empty()) out << " stroke-dasharray=\"" << s.dash << "\"";
+      out << " points=\"";
+      for (const Point2& p : line) out << Num(px(p.x)) << "," << Num(py(p.y)) << " ";
+      out << "\"/>";
+    }
+    if (s.draw_markers) {
+      for (const Point2& p : line) {
+        out << "<circle cx=\"" << Num(px(p.x)) << "\" cy=\"" << Num(py(p.y)) << "\" r=\""
+            << s.marker_radius << "\" fill=\"" << s.color << "\"/>";
       }
     }
-    out << "</g>\n";
   }
   out << "</g>\n";
-  const double ly0 = top + ph + 56;
+}
+
+// The legend below the plot, per_row entries a row.
+void XYLegend(std::ostringstream& out, const std::vector<SvgSeries>& series, const XYFrame& f) {
+  const double ly0 = f.top + f.ph + 56;
   for (std::size_t i = 0; i < series.size(); ++i) {
-    const double lx = left + static_cast<double>(i % per_row) * (pw / static_cast<double>(per_row));
-    const double ly = ly0 + 22.0 * static_cast<double>(i / per_row);
+    const double lx =
+        f.left + static_cast<double>(i % f.per_row) * (f.pw / static_cast<double>(f.per_row));
+    const double ly = ly0 + 22.0 * static_cast<double>(i / f.per_row);
     const SvgSeries& s = series[i];
     if (!s.fill.empty()) {
       out << "<rect x=\"" << Num(lx) << "\" y=\"" << Num(ly - 10)
@@ -299,6 +314,25 @@ std::string XYPlotSvg(const XYPlotOptions& o, const std::vector<SvgSeries>& seri
     }
     Text(out, lx + 30, ly, s.name, "start", 12);
   }
+}
+
+}  // namespace
+
+std::string XYPlotSvg(const XYPlotOptions& o, const std::vector<SvgSeries>& series) {
+  const XYFrame f = XYFrameOf(o, series);
+  std::ostringstream out;
+  Open(out, o.width, o.height, o.title);
+  XYAxes(out, o, f);
+  // Ids must be unique in a document that embeds several plots.
+  static std::atomic<int> next_clip_id{0};
+  const std::string clip_id =
+      "clip-" + (o.id.empty() ? std::to_string(next_clip_id++) : EscapeXml(o.id));
+  out << "<clipPath id=\"" << clip_id << "\"><rect x=\"" << Num(f.left) << "\" y=\"" << Num(f.top)
+      << "\" width=\"" << Num(f.pw) << "\" height=\"" << Num(f.ph) << "\"/></clipPath>\n";
+  out << "<g clip-path=\"url(#" << clip_id << ")\">\n";
+  for (const SvgSeries& s : series) XYSeries(out, s, f);
+  out << "</g>\n";
+  XYLegend(out, series, f);
   out << "</svg>\n";
   return out.str();
 }
@@ -326,8 +360,8 @@ CategoryLabels LayOutCategoryLabels(const std::vector<std::string>& categories, 
   return out;
 }
 
-void CategoryLabel(std::ostringstream& out, const CategoryLabels& labels, double cx,
-                   double axis_y, const std::string& text) {
+void CategoryLabel(std::ostringstream& out, const CategoryLabels& labels, double cx, double axis_y,
+                   const std::string& text) {
   if (!labels.slanted) {
     Text(out, cx, axis_y + 15, text, "middle", static_cast<int>(kCategoryFontPx));
     return;
@@ -471,8 +505,8 @@ std::string BoxPlotSvg(const BarChartOptions& o, const std::vector<std::string>&
   for (std::size_t c = 0; c < categories.size(); ++c) {
     for (std::size_t k = 0; k < series.size(); ++k) {
       if (c >= series[k].samples.size() || series[k].samples[c].empty()) continue;
-      const double x0 = left + static_cast<double>(c) * group_w + 0.15 * group_w +
-                        static_cast<double>(k) * box_w;
+      const double x0 =
+          left + static_cast<double>(c) * group_w + 0.15 * group_w + static_cast<double>(k) * box_w;
       Box(out, series[k].samples[c], x0 + 0.1 * box_w, 0.8 * box_w, series[k].color, py);
     }
     CategoryLabel(out, labels, left + (static_cast<double>(c) + 0.5) * group_w, top + ph,
@@ -500,8 +534,8 @@ std::string HeatMapSvg(const std::string& title, const std::vector<std::string>&
   const double left = std::max(70.0, widest + 12);
   const CategoryLabels columns = LayOutCategoryLabels(labels, cell_px);
   // As wide as the title needs: a three-parameter matrix is narrower than its title.
-  const int width = static_cast<int>(
-      std::max(left + grid + bar_gap + bar_w + 50, TextWidthPx(title, 15) + 20));
+  const int width =
+      static_cast<int>(std::max(left + grid + bar_gap + bar_w + 50, TextWidthPx(title, 15) + 20));
   const int height = static_cast<int>(top + grid + 20 + columns.extra_height);
   auto colour = [&](double v) {
     // Diverging blue (lo) - white (middle) - red (hi).

@@ -1,42 +1,28 @@
 #include "tools/report_command.h"
 
 #include <CLI/CLI.hpp>
-#include <Eigen/Dense>
-#include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <functional>
 #include <iostream>
-#include <map>
-#include <optional>
-#include <regex>
 #include <set>
 
-#include "diagnosis/identifiability.h"
-#include "fit/determined_directions.h"
-#include "fit/model_fit.h"
 #include "fit/run_split.h"
-#include "fitcal/version.h"
 #include "io/atomic_file.h"
 #include "io/calibration_yaml.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
-#include "io/report_writer.h"
+#include "io/report_csv.h"
+#include "io/report_html.h"
+#include "io/report_json.h"
+#include "io/report_markdown.h"
+#include "io/report_tum.h"
 #include "io/robot_yaml.h"
 #include "io/staged_directory.h"
-#include "io/tum_file.h"
 #include "models/model_registry.h"
-#include "odometry/effects.h"
 #include "tools/cli_validators.h"
 #include "tools/output_guard.h"
-#include "tools/sim/flower_candidates.h"
-#include "validation/cross_validation.h"
-#include "validation/relative_pose_error.h"
-#include "validation/training_runs.h"
-#include "validation/trajectory_family.h"
+#include "tools/report_builder.h"
 #include "validation/trajectory_metrics.h"
-#include "validation/verdict.h"
 
 namespace fitcal::tools {
 
@@ -44,95 +30,6 @@ namespace {
 
 const std::set<std::string> kReportFiles = {"index.html", "summary.md", "metrics.csv",
                                             "metrics.json", "tum"};
-
-// TrajectoryErrors (one run) and Table6Averages (a group) carry the same Eq. 8-14 fields.
-template <typename Metrics>
-io::ReportMetrics MetricsOf(const Metrics& e) {
-  io::ReportMetrics m;
-  m.rms_distance_m = e.rms_distance_m;
-  m.rms_angle_rad = e.rms_angle_rad;
-  m.max_distance_m = e.max_distance_m;
-  m.max_angle_rad = e.max_angle_rad;
-  m.final_distance_m = e.final_distance_m;
-  m.final_angle_rad = e.final_angle_rad;
-  m.cf = e.cf;
-  return m;
-}
-
-io::ReportStatistics StatsOf(const SummaryStatistics& s) {
-  return {s.rmse, s.mean, s.median, s.std, s.min, s.max};
-}
-
-// A world vector in the frame of `start` (+x along its heading).
-io::Point2 VectorInStartFrame(const Pose2d& start, double dx, double dy) {
-  const double c = std::cos(start.theta), s = std::sin(start.theta);
-  return {c * dx + s * dy, -s * dx + c * dy};
-}
-// A world point in the frame of `start` (origin at the start position).
-io::Point2 InStartFrame(const Pose2d& start, double x, double y) {
-  return VectorInStartFrame(start, x - start.x, y - start.y);
-}
-
-Omni3ParameterArray ArrayOf(const std::vector<double>& p) {
-  Omni3ParameterArray a{};
-  std::copy(p.begin(), p.begin() + omni3::kNumParameters, a.begin());
-  return a;
-}
-
-// One calibration to judge: the calibrated robot and what its YAML records.
-struct CalibrationInput {
-  std::string path;
-  Robot calibrated;  // its nominal values are the calibrated parameters
-  std::optional<io::CalibrationProvenance> provenance;
-};
-
-// Everything the report reads, loaded and checked before anything is computed.
-struct ReportInputs {
-  io::DatasetIndex index;
-  std::vector<std::string> inputs;  // files the output must not overwrite
-  io::Dataset dataset;
-  RobotModelPtr model;  // the data set's robot (nominal parameters, absolute bounds), any model
-  bool omni3 = false;
-  Omni3Robot omni3_robot;  // omni3 only: its identifiability analysis and cross-validation fit
-  std::vector<CalibrationInput> calibrations;  // the first is the report's; others compared
-};
-
-// The validation runs of one report, each replayed with the nominal and the calibrated model.
-struct EvaluatedRuns {
-  TrainingSplit split;
-  std::vector<TrajectoryErrors> before, after;
-  std::vector<double> cf_parameters_only;  // calibrated parameters without the effects
-};
-
-TrainingSplit SplitForReport(const ReportCommandOptions& options, const ReportInputs& in,
-                             const CalibrationInput& cal) {
-  std::vector<AlignedRun> aligned = AlignRuns(in.dataset.runs);
-  if (!options.train_reps.empty()) {
-    return {SplitByRepetition(std::move(aligned), ParseRepetitionList(options.train_reps)),
-            "by repetition (--train-reps)"};
-  }
-  RecordedTraining recorded;
-  if (cal.provenance) {
-    recorded.run_ids = cal.provenance->training_run_ids;
-    recorded.fingerprint = cal.provenance->training_fingerprint;
-    recorded.repetitions = cal.provenance->training_repetitions;
-  }
-  return SplitAsRecorded(in.dataset.runs, std::move(aligned), recorded);
-}
-
-std::string TrainingSource(const CalibrationInput& cal, const TrainingSplit& t) {
-  const std::string n = std::to_string(t.split.training.size());
-  const std::string reps = FormatRepetitionList(t.split.training_repetitions);
-  if (t.how == "by id") {
-    const std::string& selector = cal.provenance->training_trajectories;
-    return n + " runs of this data set, recorded by id (repetitions " + reps +
-           (selector.empty() ? "" : "; trajectories matching '" + selector + "'") + ")";
-  }
-  if (t.how != "none")
-    return n + " runs of this data set, " + t.how + " (repetitions " + reps + ")";
-  if (!cal.provenance) return "none recorded (a robot YAML without a calibration block)";
-  return "another data set (" + cal.provenance->dataset + "): every run here validates";
-}
 
 ReportInputs LoadInputs(const ReportCommandOptions& options, std::string* refusal) {
   ReportInputs in;
@@ -161,455 +58,8 @@ ReportInputs LoadInputs(const ReportCommandOptions& options, std::string* refusa
   return in;
 }
 
-// Each calibration's split, the validation runs restricted to those every calibration left out:
-// several calibrations are compared on the same runs, the ones none of them trained on.
-std::vector<TrainingSplit> CommonSplits(const ReportCommandOptions& options,
-                                        const ReportInputs& in) {
-  std::vector<TrainingSplit> splits;
-  std::map<std::string, int> validating;  // run id -> calibrations it validates
-  for (const CalibrationInput& cal : in.calibrations) {
-    splits.push_back(SplitForReport(options, in, cal));
-    for (const AlignedRun& run : splits.back().split.validation) ++validating[run.id];
-  }
-  const int all = static_cast<int>(in.calibrations.size());
-  for (TrainingSplit& t : splits) {
-    std::vector<AlignedRun> kept;
-    std::set<int> reps;
-    for (AlignedRun& run : t.split.validation) {
-      if (validating[run.id] != all) continue;
-      reps.insert(run.repetition);
-      kept.push_back(std::move(run));
-    }
-    t.split.validation = std::move(kept);
-    t.split.validation_repetitions.assign(reps.begin(), reps.end());
-  }
-  return splits;
-}
-
-EvaluatedRuns EvaluateRuns(const ReportInputs& in, const CalibrationInput& cal, TrainingSplit split,
-                           OdometrySampling sampling) {
-  EvaluatedRuns e;
-  e.split = std::move(split);
-  std::map<std::string, const RunLog*> logs_by_id;
-  for (const RunLog& log : in.dataset.runs) logs_by_id[log.id] = &log;
-  const std::vector<double>& nominal = in.model->robot().nominal;
-  const std::vector<double>& p = cal.calibrated.nominal;
-  const std::vector<effects::EffectValue>& effects = cal.calibrated.effects;
-  // omni3 keeps its own replay (Eq. 4 with M^-1), whose CF `fit` records; every other model
-  // replays through the seam.
-  const auto evaluate = [&](const AlignedRun& run, const GroundTruthTrack& track,
-                            const std::vector<double>& q,
-                            const std::vector<effects::EffectValue>& with) {
-    return in.omni3 ? EvaluateTrajectory(run, track, ArrayOf(q), with, sampling)
-                    : EvaluateTrajectory(*in.model, run, track, q, with, sampling);
-  };
-  for (const AlignedRun& run : e.split.split.validation) {
-    const GroundTruthTrack& track = logs_by_id.at(run.id)->ground_truth;
-    e.before.push_back(evaluate(run, track, nominal, {}));
-    // The calibrated model as the YAML describes it: the parameters and any effects `fitcal
-    // diagnose` accepted (the replay honours them, latency included).
-    e.after.push_back(evaluate(run, track, p, effects));
-    e.cf_parameters_only.push_back(effects.empty() ? e.after.back().cf
-                                                   : evaluate(run, track, p, {}).cf);
-  }
-  return e;
-}
-
-io::ReportRun MakeReportRun(const AlignedRun& run, const TrajectoryErrors& b,
-                            const TrajectoryErrors& a) {
-  io::ReportRun r;
-  r.id = run.id;
-  r.trajectory = run.trajectory;
-  r.repetition = run.repetition;
-  r.ground_truth_xy.push_back({0.0, 0.0});
-  r.before_xy.push_back({0.0, 0.0});
-  r.after_xy.push_back({0.0, 0.0});
-  for (std::size_t i = 0; i < b.t_s.size(); ++i) {
-    r.t_s.push_back(b.t_s[i] - run.t_start_s);
-    r.ground_truth_xy.push_back(InStartFrame(run.start, b.ground_truth[i].x, b.ground_truth[i].y));
-    r.before_xy.push_back(InStartFrame(run.start, b.odometry[i].x, b.odometry[i].y));
-    r.after_xy.push_back(InStartFrame(run.start, a.odometry[i].x, a.odometry[i].y));
-  }
-  r.ground_truth_xy.push_back(
-      InStartFrame(run.start, run.final_ground_truth.x, run.final_ground_truth.y));
-  r.before_xy.push_back(InStartFrame(run.start, b.final_odometry.x, b.final_odometry.y));
-  r.after_xy.push_back(InStartFrame(run.start, a.final_odometry.x, a.final_odometry.y));
-  for (std::size_t i = 1; i < r.ground_truth_xy.size(); ++i) {
-    r.path_length_m += std::hypot(r.ground_truth_xy[i].x - r.ground_truth_xy[i - 1].x,
-                                  r.ground_truth_xy[i].y - r.ground_truth_xy[i - 1].y);
-  }
-  // Distance travelled along the ground truth at each sample (the drift windows' measure).
-  r.along_m.assign(b.ground_truth.size(), 0.0);
-  for (std::size_t i = 1; i < b.ground_truth.size(); ++i) {
-    r.along_m[i] = r.along_m[i - 1] + std::hypot(b.ground_truth[i].x - b.ground_truth[i - 1].x,
-                                                 b.ground_truth[i].y - b.ground_truth[i - 1].y);
-  }
-  r.before_distance_m = b.distance_error_m;
-  r.after_distance_m = a.distance_error_m;
-  r.before_angle_rad = b.angle_error_rad;
-  r.after_angle_rad = a.angle_error_rad;
-  r.before_final_error = VectorInStartFrame(run.start, b.final_odometry.x - b.final_ground_truth.x,
-                                            b.final_odometry.y - b.final_ground_truth.y);
-  r.after_final_error = VectorInStartFrame(run.start, a.final_odometry.x - a.final_ground_truth.x,
-                                           a.final_odometry.y - a.final_ground_truth.y);
-  r.before_final_heading_rad = WrapAngle(b.final_odometry.theta - b.final_ground_truth.theta);
-  r.after_final_heading_rad = WrapAngle(a.final_odometry.theta - a.final_ground_truth.theta);
-  r.before = MetricsOf(b);
-  r.after = MetricsOf(a);
-  return r;
-}
-
-// Table 6 rows (per family when there are several, then all runs) and one row per trajectory.
-void AddGroupRows(const EvaluatedRuns& e, io::ReportData* data) {
-  const std::vector<AlignedRun>& runs = e.split.split.validation;
-  const auto row = [&](const std::string& name, const std::function<bool(const AlignedRun&)>& in) {
-    std::vector<const TrajectoryErrors*> b, a;
-    for (std::size_t i = 0; i < runs.size(); ++i) {
-      if (!in(runs[i])) continue;
-      b.push_back(&e.before[i]);
-      a.push_back(&e.after[i]);
-    }
-    return io::ReportSummaryRow{name, static_cast<int>(b.size()), MetricsOf(AverageOf(b)),
-                                MetricsOf(AverageOf(a))};
-  };
-  std::vector<std::string> families, labels;
-  for (const AlignedRun& run : runs) {
-    const std::string f = TrajectoryFamily(run.trajectory);
-    if (std::find(families.begin(), families.end(), f) == families.end()) families.push_back(f);
-    if (std::find(labels.begin(), labels.end(), run.trajectory) == labels.end()) {
-      labels.push_back(run.trajectory);
-    }
-  }
-  if (families.size() > 1) {
-    for (const std::string& f : families) {
-      data->summary.push_back(row("trajectories " + f + "*", [&](const AlignedRun& r) {
-        return TrajectoryFamily(r.trajectory) == f;
-      }));
-    }
-  }
-  data->summary.push_back(row("all validation runs", [](const AlignedRun&) { return true; }));
-  for (const std::string& label : labels) {
-    data->trajectories.push_back(
-        row(label, [&](const AlignedRun& r) { return r.trajectory == label; }));
-  }
-}
-
-// evo-style statistics of the per-run quantities.
-void AddStatistics(const EvaluatedRuns& e, io::ReportData* data) {
-  struct StatDef {
-    const char* name;
-    bool is_angle;
-    double TrajectoryErrors::*field;
-  };
-  const StatDef stat_defs[] = {{"rms_distance_m", false, &TrajectoryErrors::rms_distance_m},
-                               {"rms_angle", true, &TrajectoryErrors::rms_angle_rad},
-                               {"final_distance_m", false, &TrajectoryErrors::final_distance_m},
-                               {"final_angle", true, &TrajectoryErrors::final_angle_rad},
-                               {"cf", false, &TrajectoryErrors::cf}};
-  for (const StatDef& s : stat_defs) {
-    std::vector<double> vb, va;
-    for (std::size_t i = 0; i < e.before.size(); ++i) {
-      vb.push_back(e.before[i].*s.field);
-      va.push_back(e.after[i].*s.field);
-    }
-    data->statistics.push_back(io::ReportStatisticsRow{s.name, s.is_angle, StatsOf(Summarize(vb)),
-                                                       StatsOf(Summarize(va))});
-  }
-}
-
-// The drift lengths of the report: those suited to these runs (RelativePoseErrorLengths of the
-// median path length) and the everyday 1, 2 and 5 m wherever some run is long enough for them.
-std::vector<double> DriftLengths(const EvaluatedRuns& e, const io::ReportData& data) {
-  std::vector<double> lengths;
-  for (const io::ReportRun& r : data.runs) lengths.push_back(r.path_length_m);
-  std::set<double> out;
-  for (double l : RelativePoseErrorLengths(Summarize(lengths).median)) out.insert(l);
-  for (double l : {1.0, 2.0, 5.0}) {
-    for (const TrajectoryErrors& b : e.before) {
-      if (!RelativePoseErrorWindows(b.ground_truth, b.odometry, l).empty()) {
-        out.insert(l);
-        break;
-      }
-    }
-  }
-  return {out.begin(), out.end()};
-}
-
-// Relative pose error (validation/relative_pose_error.h): the mean over every window of every
-// validation run, and each window for the box plots.
-void AddDrift(const EvaluatedRuns& e, io::ReportData* data) {
-  for (double length : DriftLengths(e, *data)) {
-    io::ReportDriftRow row;
-    row.length_m = length;
-    RelativePoseErrorSum before, after;
-    for (std::size_t i = 0; i < e.before.size(); ++i) {
-      AddRelativePoseErrors(e.before[i].ground_truth, e.before[i].odometry, length, &before);
-      AddRelativePoseErrors(e.after[i].ground_truth, e.after[i].odometry, length, &after);
-      const auto wb = RelativePoseErrorWindows(e.before[i].ground_truth, e.before[i].odometry,
-                                               length);
-      const auto wa = RelativePoseErrorWindows(e.after[i].ground_truth, e.after[i].odometry,
-                                               length);
-      for (std::size_t k = 0; k < std::min(wb.size(), wa.size()); ++k) {
-        row.before_translation_percent_windows.push_back(100.0 * wb[k].translation_ratio);
-        row.after_translation_percent_windows.push_back(100.0 * wa[k].translation_ratio);
-        row.before_rotation_rad_per_m_windows.push_back(wb[k].rotation_rad_per_m);
-        row.after_rotation_rad_per_m_windows.push_back(wa[k].rotation_rad_per_m);
-        row.windows_worse += wa[k].translation_ratio > wb[k].translation_ratio ? 1 : 0;
-      }
-    }
-    row.windows = before.windows;
-    row.before_translation_percent = before.MeanTranslationPercent();
-    row.after_translation_percent = after.MeanTranslationPercent();
-    row.before_rotation_rad_per_m = before.MeanRotationRadPerM();
-    row.after_rotation_rad_per_m = after.MeanRotationRadPerM();
-    data->drift.push_back(std::move(row));
-  }
-}
-
-// Uncertainty and identifiability at the calibrated parameters from the training runs, when they
-// are in this data set: covariance s^2 (J^T J)^-1 with s^2 = |r|^2 / (3 N - 9), the fit's
-// (omni3_ceres_fit.h). Advice on trajectories only for training runs of the flower, whose
-// candidate runs the analysis knows; never for another data set's trajectory family.
-void AddOmni3Uncertainty(const ReportInputs& in, const CalibrationInput& cal,
-                         const std::vector<AlignedRun>& training, int threads, io::ReportData* data,
-                         std::vector<double>* sigma, bool* has_sigma) {
-  const Omni3ParameterArray nominal = ArrayOf(in.model->robot().nominal);
-  const Omni3ParameterArray p = ArrayOf(cal.calibrated.nominal);
-  const bool flower = std::any_of(training.begin(), training.end(), [](const AlignedRun& run) {
-    return std::regex_match(run.trajectory, std::regex("[RGB][0-9]+"));
-  });
-  const Eigen::MatrixXd jacobian = FinalPoseJacobian(p, training, ResidualWeights{}, threads);
-  const IdentifiabilityReport ident = AnalyseIdentifiability(
-      jacobian, p, flower ? sim::FlowerCandidateMotions() : std::vector<CandidateMotion>{},
-      nominal);
-  data->identifiable = ident.identifiable;
-  data->condition_number = ident.condition_number;
-  data->identifiability_lines = IdentifiabilityLines(ident);
-  const int dof = 3 * static_cast<int>(training.size()) - omni3::kNumParameters;
-  if (dof <= 0 || ident.rank_deficient) {
-    data->uncertainty_note = dof <= 0 ? "No uncertainty: too few training runs (need more than 3)."
-                                      : "No uncertainty: the covariance is rank deficient (see "
-                                        "Identifiability below).";
-    return;
-  }
-  if (!cal.calibrated.effects.empty()) {
-    // The covariance of the parameters alone would describe another model than the one used
-    // (the effects move with them); the effects' own sigmas are in the Effects table.
-    data->uncertainty_note =
-        "No parameter sigma: the calibration carries effects, and the covariance of the "
-        "parameters without them describes another model than the one replayed here.";
-    return;
-  }
-  double sum_r2 = 0.0;
-  for (const AlignedRun& run : training) {
-    double r[3];
-    Omni3FinalPoseResidual(run, ResidualWeights{})(p.data(), r);
-    sum_r2 += r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-  }
-  const Eigen::MatrixXd jtj = jacobian.transpose() * jacobian;
-  const Eigen::MatrixXd cov =
-      (sum_r2 / dof) * jtj.ldlt().solve(Eigen::MatrixXd::Identity(jtj.rows(), jtj.cols()));
-  *has_sigma = true;
-  data->has_correlation = true;
-  data->correlation.assign(omni3::kNumParameters, std::vector<double>(omni3::kNumParameters));
-  sigma->assign(omni3::kNumParameters, 0.0);
-  for (int k = 0; k < omni3::kNumParameters; ++k) (*sigma)[k] = std::sqrt(std::max(0.0, cov(k, k)));
-  for (int a = 0; a < omni3::kNumParameters; ++a) {
-    for (int b = 0; b < omni3::kNumParameters; ++b) {
-      const double den = (*sigma)[a] * (*sigma)[b];
-      data->correlation[a][b] = den > 0.0 ? cov(a, b) / den : (a == b ? 1.0 : 0.0);
-    }
-  }
-  char note[320];
-  std::snprintf(note, sizeof note,
-                "One sigma from the covariance s^2 (J^T J)^-1 of the final-pose residuals of the "
-                "%zu training runs at the calibrated parameters, scaled by their residual variance "
-                "(s = %.3g, metres and radians weighed 1:1 as Eq. 14).",
-                training.size(), std::sqrt(sum_r2 / dof));
-  data->uncertainty_note = note;
-}
-
-// Any other model: which directions of its parameter space the training runs determine
-// (fit/determined_directions.h, as `fit` holds them), named in parameter terms with the training
-// trajectory that sees each most. The covariance is the fit's (`fitcal fit` prints it).
-void AddModelIdentifiability(const ReportInputs& in, const CalibrationInput& cal,
-                             const std::vector<AlignedRun>& training, int threads,
-                             io::ReportData* data) {
-  const DirectionAnalysis d = AnalyseDeterminedDirections(
-      training, *in.model, cal.calibrated.nominal, ResidualWeights{}, nullptr, threads);
-  data->identifiable = d.ok && d.undetermined.empty();
-  for (const UndeterminedDirection& u : d.undetermined) {
-    data->identifiability_lines.push_back("not determined by the training runs: " + u.description);
-  }
-  if (!d.ok) data->identifiability_lines.push_back("no Jacobian at the calibrated parameters");
-  data->uncertainty_note = "No parameter sigma here: this report does not refit a " +
-                           in.model->robot().model + " robot, and the calibration records none.";
-}
-
-// A recorded sigma's key names its parameter and display unit: "<name>_<unit>", or for the omni3
-// file, which writes one list per quantity in the parameters' order, "<quantity>_<unit>[i]".
-bool RecordedKeyMatches(const std::string& key, const ParameterInfo& info) {
-  const std::string unit = std::string("_") + info.DisplayUnit();
-  if (key == info.name + unit) return true;
-  const std::size_t bracket = key.find('[');
-  if (bracket == std::string::npos || bracket < unit.size()) return false;
-  return key.compare(bracket - unit.size(), unit.size(), unit) == 0;
-}
-
-// The sigmas and correlation the fit recorded in the calibration's YAML, matched to this robot's
-// parameters by their written key; false (nothing set) unless every parameter has one. They are
-// the fit's, from its own training runs, so they hold whichever data set this report validates on.
-bool AddRecordedUncertainty(const CalibrationInput& cal, io::ReportData* data,
-                            std::vector<double>* sigma, bool* has_sigma) {
-  if (!cal.provenance || cal.provenance->sigma.empty()) return false;
-  const Robot& robot = cal.calibrated;
-  const auto& recorded = cal.provenance->sigma;
-  if (static_cast<int>(recorded.size()) != robot.NumParameters()) return false;
-  std::vector<double> values(robot.NumParameters());
-  for (int k = 0; k < robot.NumParameters(); ++k) {
-    if (!RecordedKeyMatches(recorded[k].first, robot.parameters[k])) return false;
-    values[k] = recorded[k].second / robot.parameters[k].DisplayScale();
-  }
-  *sigma = std::move(values);
-  *has_sigma = true;
-  data->has_correlation = !cal.provenance->correlation.empty();
-  data->correlation = cal.provenance->correlation;
-  const std::string& method = cal.provenance->method;
-  data->uncertainty_note = "One sigma as the fit" + (method.empty() ? "" : " (" + method + ")") +
-                           " recorded it in the calibration: the covariance of its residuals on "
-                           "its own training runs at the calibrated parameters.";
-  return true;
-}
-
-// Uncertainty and identifiability from the training runs, only when they are in this data set.
-void AddUncertainty(const ReportInputs& in, const CalibrationInput& cal,
-                    const std::vector<AlignedRun>& training, int threads, io::ReportData* data,
-                    std::vector<double>* sigma, bool* has_sigma) {
-  *has_sigma = false;
-  data->identifiability_checked = !training.empty();
-  if (training.empty()) {
-    data->uncertainty_note =
-        "No uncertainty from this data set: the calibration's training runs are not in it.";
-    AddRecordedUncertainty(cal, data, sigma, has_sigma);
-    return;
-  }
-  if (in.omni3) {
-    AddOmni3Uncertainty(in, cal, training, threads, data, sigma, has_sigma);
-    // With effects, only the fit that carried them knows the parameters' covariance.
-    if (!*has_sigma && !cal.calibrated.effects.empty()) {
-      AddRecordedUncertainty(cal, data, sigma, has_sigma);
-    }
-  } else {
-    AddModelIdentifiability(in, cal, training, threads, data);
-    AddRecordedUncertainty(cal, data, sigma, has_sigma);
-  }
-}
-
-void AddParameters(const ReportInputs& in, const CalibrationInput& cal,
-                   const std::optional<CrossValidationResult>& cv, const std::vector<double>& sigma,
-                   bool has_sigma, io::ReportData* data) {
-  const Robot& robot = in.model->robot();
-  std::set<std::string> recorded_at_bound;
-  if (cal.provenance) {
-    recorded_at_bound.insert(cal.provenance->at_bound.begin(), cal.provenance->at_bound.end());
-  }
-  for (int k = 0; k < robot.NumParameters(); ++k) {
-    io::ReportParameter rp = ReportParameterOf(robot, k, cal.calibrated.nominal[k], has_sigma,
-                                               has_sigma ? sigma[k] : 0.0);
-    rp.at_bound = recorded_at_bound.count(rp.name) > 0 ||
-                  (!robot.IsHeld(k) && AtBound(rp.calibrated, robot.bounds[k]));
-    if (cv) {
-      const SummaryStatistics& s = cv->parameter_spread[k];
-      rp.has_cv = s.count > 0;
-      rp.cv_mean = s.mean;
-      rp.cv_std = s.std;
-      rp.cv_min = s.min;
-      rp.cv_max = s.max;
-    }
-    data->parameters.push_back(rp);
-  }
-}
-
-void AddEffects(const CalibrationInput& cal, const EvaluatedRuns& e, io::ReportData* data) {
-  for (const effects::EffectValue& value : cal.calibrated.effects) {
-    data->effects.push_back(ReportEffectOf(value));
-  }
-  double sum = 0.0;
-  for (double cf : e.cf_parameters_only) sum += cf;
-  data->cf_parameters_only = e.cf_parameters_only.empty() ? 0.0 : sum / e.cf_parameters_only.size();
-}
-
-GroupOutcome OutcomeOf(const io::ReportSummaryRow& row) {
-  return {row.group,
-          row.runs,
-          row.before.cf,
-          row.after.cf,
-          row.before.final_distance_m,
-          row.after.final_distance_m};
-}
-
-void AddVerdict(const CalibrationInput& cal, io::ReportData* data) {
-  VerdictInputs v;
-  if (cal.provenance) {
-    v.termination = cal.provenance->termination;
-    v.has_training_cf = cal.provenance->has_training_cf;
-    v.training_cf_after = cal.provenance->cf_training_after;
-  }
-  for (const io::ReportParameter& p : data->parameters) {
-    if (p.at_bound) v.at_bound.push_back(p.name);
-  }
-  v.overall = OutcomeOf(data->summary.back());
-  for (std::size_t i = 0; i + 1 < data->summary.size(); ++i) {
-    v.families.push_back(OutcomeOf(data->summary[i]));
-  }
-  for (const io::ReportSummaryRow& row : data->trajectories) {
-    v.trajectories.push_back(OutcomeOf(row));
-  }
-  std::vector<FinalErrorSample> errors;
-  for (const io::ReportRun& r : data->runs) {
-    errors.push_back({r.trajectory, r.after_final_error.x, r.after_final_error.y});
-  }
-  v.noise_floor = TestAgainstNoiseFloor(errors);
-  data->noise_floor = {v.noise_floor.available, v.noise_floor.noise_sigma_m,
-                       v.noise_floor.systematic_rms_m, v.noise_floor.f_statistic,
-                       v.noise_floor.p_value};
-  v.identifiability_checked = data->identifiability_checked;
-  v.identifiable = data->identifiable;
-  const Verdict verdict = JudgeCalibration(v);
-  data->verdict = ToString(verdict.level);
-  for (const VerdictReason& r : verdict.reasons) {
-    data->verdict_reasons.push_back({ToString(r.level), r.check, r.section, r.message});
-  }
-}
-
-std::string CalibrationNote(const CalibrationInput& cal) {
-  if (!cal.provenance) return "a robot YAML without a calibration block";
-  const io::CalibrationProvenance& p = *cal.provenance;
-  return "method " + (p.method.empty() ? std::string("not recorded") : p.method) +
-         ", solver termination " + (p.termination.empty() ? "not recorded" : p.termination) +
-         ", trained on data set " + (p.dataset.empty() ? "not recorded" : p.dataset);
-}
-
-// tum/<run>.{ground_truth,nominal,calibrated}.tum: the world poses at the ground-truth times on
-// which the report's ATE (Eq. 12) and drift are computed, the odometry started at the ground
-// truth's start pose (docs/tum.md gives the evo commands that reproduce the figures).
-void WriteTumFiles(const std::string& dir, const EvaluatedRuns& e) {
-  namespace fs = std::filesystem;
-  fs::create_directories(fs::path(dir) / "tum");
-  for (std::size_t i = 0; i < e.before.size(); ++i) {
-    const std::string stem =
-        (fs::path(dir) / "tum" / io::FileNameOf(e.split.split.validation[i].id)).string();
-    io::WriteFileAtomically(stem + ".ground_truth.tum",
-                            io::TumText(e.before[i].t_s, e.before[i].ground_truth));
-    io::WriteFileAtomically(stem + ".nominal.tum",
-                            io::TumText(e.before[i].t_s, e.before[i].odometry));
-    io::WriteFileAtomically(stem + ".calibrated.tum",
-                            io::TumText(e.after[i].t_s, e.after[i].odometry));
-  }
-}
-
 void WriteReport(const ReportCommandOptions& options, const ReportInputs& in,
-                 const io::ReportData& data, const EvaluatedRuns& evaluated) {
+                 const io::ReportData& data) {
   // Everything is computed; only now touch the output directory, as a set (README, "Nothing
   // lost"): the files go into a staged sibling renamed over the previous report, so a signal,
   // a full disk or a second writer never leaves a mix of old and new files.
@@ -619,14 +69,18 @@ void WriteReport(const ReportCommandOptions& options, const ReportInputs& in,
   io::WriteFileAtomically((out / "index.html").string(), io::ReportHtml(data));
   io::WriteFileAtomically((out / "summary.md").string(), io::ReportMarkdown(data));
   io::WriteFileAtomically((out / "metrics.csv").string(), io::MetricsCsv(data));
-  if (options.tum) WriteTumFiles(out.string(), evaluated);
+  if (options.tum) {
+    fs::create_directories(out / "tum");
+    for (const io::ReportFile& file : io::ReportTumFiles(data)) {
+      io::WriteFileAtomically((out / file.relative_path).string(), file.text);
+    }
+  }
   io::StopHereForTests("report-staged");
   io::WriteFileAtomically((out / "metrics.json").string(), io::MetricsJson(data));
   CommitOutputDirectory(staged, options.out, in.inputs, kReportFiles);
 }
 
-void PrintReport(const ReportCommandOptions& options, const io::ReportData& data,
-                 const std::optional<CrossValidationResult>& cv) {
+void PrintReport(const ReportCommandOptions& options, const io::ReportData& data) {
   const io::ReportSummaryRow& all = data.summary.back();
   std::printf("validation: %zu runs (repetitions %s), odometry sampled by %s time\n",
               data.runs.size(), data.validation_repetitions.c_str(), data.sampling.c_str());
@@ -642,10 +96,10 @@ void PrintReport(const ReportCommandOptions& options, const io::ReportData& data
   if (worse > 0)
     std::printf("  held-out runs that got worse: %d of %zu\n", worse, data.runs.size());
   for (const std::string& line : data.identifiability_lines) std::printf("%s\n", line.c_str());
-  if (cv) {
+  if (data.has_cv) {
     std::printf("cross-validation: %zu folds, validation CF %.4f +- %.4f (min %.4f, max %.4f)\n",
-                cv->folds.size(), cv->cf_validation_after.mean, cv->cf_validation_after.std,
-                cv->cf_validation_after.min, cv->cf_validation_after.max);
+                data.folds.size(), data.cv_cf_after.mean, data.cv_cf_after.std,
+                data.cv_cf_after.min, data.cv_cf_after.max);
   }
   for (const io::ReportComparisonRow& c : data.comparison) {
     std::printf("  compared: %-40s %s  held-out CF %.4f -> %.4f\n", c.calibration.c_str(),
@@ -663,81 +117,6 @@ void PrintReport(const ReportCommandOptions& options, const io::ReportData& data
 int ExitStatus(const ReportCommandOptions& options, const std::string& verdict) {
   if (!options.strict || verdict == "PASS") return 0;
   return verdict == "FAIL" ? kReportFailExit : kReportWarnExit;
-}
-
-std::optional<CrossValidationResult> AddCrossValidation(const ReportCommandOptions& options,
-                                                        const ReportInputs& in,
-                                                        io::ReportData* data) {
-  if (!options.cross_validate) return std::nullopt;
-  // The refit `fitcal fit` makes for this model: the paper's for omni3, the seam's otherwise.
-  CrossValidationResult cv;
-  if (in.omni3) {
-    CeresFitOptions fit_options;
-    fit_options.num_threads = options.threads;
-    cv = LeaveOneRepetitionOut(AlignRuns(in.dataset.runs), in.omni3_robot, fit_options);
-  } else {
-    ModelFitOptions fit_options;
-    fit_options.ceres.num_threads = options.threads;
-    cv = LeaveOneRepetitionOut(AlignRuns(in.dataset.runs), *in.model, fit_options);
-  }
-  data->has_cv = true;
-  data->cv_cf_after = StatsOf(cv.cf_validation_after);
-  data->cv_cf_before = StatsOf(cv.cf_validation_before);
-  for (const CrossValidationFold& f : cv.folds) {
-    data->folds.push_back(io::ReportFold{f.held_out_repetition, f.usable, f.cf_training,
-                                         f.cf_validation_before, f.cf_validation_after});
-  }
-  return cv;
-}
-
-// The whole report of one calibration on its validation runs; `cv` (the first calibration's
-// only: it does not depend on the calibration) receives the cross-validation when asked for.
-io::ReportData BuildReportData(const ReportCommandOptions& options, const ReportInputs& in,
-                               const CalibrationInput& cal, TrainingSplit split,
-                               OdometrySampling sampling,
-                               std::optional<CrossValidationResult>* cv,
-                               EvaluatedRuns* evaluated = nullptr) {
-  const EvaluatedRuns e = EvaluateRuns(in, cal, std::move(split), sampling);
-  if (evaluated != nullptr) *evaluated = e;
-  const std::vector<AlignedRun>& training = e.split.split.training;
-  io::ReportData data;
-  data.tool_version = kVersion;
-  data.dataset = options.logs;
-  data.calibration = cal.path;
-  data.robot_name = cal.calibrated.name;
-  data.sampling = ToString(sampling);
-  data.worst_runs_drawn = options.worst_runs;
-  data.training_source = TrainingSource(cal, e.split);
-  data.calibration_note = CalibrationNote(cal);
-  data.training_repetitions = FormatRepetitionList(e.split.split.training_repetitions);
-  data.validation_repetitions = FormatRepetitionList(e.split.split.validation_repetitions);
-  data.training_runs = static_cast<int>(training.size());
-  for (std::size_t i = 0; i < e.before.size(); ++i) {
-    data.runs.push_back(MakeReportRun(e.split.split.validation[i], e.before[i], e.after[i]));
-  }
-  AddGroupRows(e, &data);
-  AddStatistics(e, &data);
-  AddDrift(e, &data);
-  std::vector<double> sigma;
-  bool has_sigma = false;
-  AddUncertainty(in, cal, training, options.threads, &data, &sigma, &has_sigma);
-  if (cv != nullptr) *cv = AddCrossValidation(options, in, &data);
-  AddParameters(in, cal, cv != nullptr ? *cv : std::nullopt, sigma, has_sigma, &data);
-  AddEffects(cal, e, &data);
-  AddVerdict(cal, &data);
-  return data;
-}
-
-io::ReportComparisonRow ComparisonRowOf(const io::ReportData& d) {
-  io::ReportComparisonRow row;
-  row.calibration = d.calibration;
-  row.verdict = d.verdict;
-  row.training_source = d.training_source;
-  row.all = d.summary.back();
-  for (const io::ReportSummaryRow& t : d.trajectories)
-    row.trajectory_cf_after.push_back(t.after.cf);
-  if (!d.drift.empty()) row.drift = d.drift.back();
-  return row;
 }
 
 }  // namespace
@@ -787,7 +166,7 @@ int RunReportCommand(const ReportCommandOptions& options) {
     if (!refusal.empty()) {
       return Refuse(refusal);
     }
-    std::vector<TrainingSplit> splits = CommonSplits(options, in);
+    std::vector<TrainingSplit> splits = CommonSplits(options.train_reps, in);
     if (splits.front().split.validation.empty()) {
       std::cerr << "fitcal report: every run of " << options.logs
                 << (splits.size() > 1
@@ -797,45 +176,18 @@ int RunReportCommand(const ReportCommandOptions& options) {
                 << "; nothing to validate on\n";
       return 2;
     }
-    std::optional<CrossValidationResult> cv;
-    EvaluatedRuns evaluated;
-    io::ReportData data = BuildReportData(options, in, in.calibrations.front(),
-                                          std::move(splits.front()), sampling, &cv, &evaluated);
-    for (std::size_t i = 1; i < in.calibrations.size(); ++i) {
-      if (i == 1) data.comparison.push_back(ComparisonRowOf(data));
-      data.comparison.push_back(ComparisonRowOf(BuildReportData(
-          options, in, in.calibrations[i], std::move(splits[i]), sampling, nullptr)));
-    }
-    WriteReport(options, in, data, evaluated);
-    PrintReport(options, data, cv);
+    ReportBuildOptions build;
+    build.dataset = options.logs;
+    build.train_reps = options.train_reps;
+    build.sampling = sampling;
+    build.cross_validate = options.cross_validate;
+    build.threads = options.threads;
+    build.worst_runs = options.worst_runs;
+    const io::ReportData data = BuildReport(in, std::move(splits), build);
+    WriteReport(options, in, data);
+    PrintReport(options, data);
     return ExitStatus(options, data.verdict);
   });
-}
-
-io::ReportParameter ReportParameterOf(const Robot& robot, int k, double calibrated,
-                                      bool has_sigma, double sigma) {
-  io::ReportParameter p;
-  p.name = robot.parameters[k].name;
-  p.is_angle = robot.parameters[k].unit == ParameterUnit::kAngle;
-  p.unit = robot.parameters[k].DisplayUnit();
-  p.held = robot.IsHeld(k);
-  p.nominal = robot.nominal[k];
-  p.calibrated = calibrated;
-  p.has_sigma = has_sigma && !p.held;
-  p.sigma = sigma;
-  return p;
-}
-
-io::ReportEffect ReportEffectOf(const effects::EffectValue& value) {
-  const effects::EffectInfo& info = effects::Info(value.id);
-  io::ReportEffect effect;
-  effect.name = info.name;
-  for (int k = 0; k < info.num_parameters; ++k) {
-    effect.parameter_names.push_back(info.parameter_names[k]);
-    effect.values.push_back(value.value[k]);
-    effect.sigmas.push_back(value.sigma[k]);
-  }
-  return effect;
 }
 
 }  // namespace fitcal::tools

@@ -10,10 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "io/report_writer.h"
-#include "odometry/effects.h"
-#include "odometry/robot.h"
 #include "tools/dataset_command.h"
+#include "tools/report_builder.h"
 
 namespace fitcal::tools {
 
@@ -45,10 +43,7 @@ void AddReportOptions(CLI::App& app, ReportCommandOptions& options);
 
 int RunReportCommand(const ReportCommandOptions& options);
 
-// Parameter k of `robot` and an effect, as the report and diagnose pages show them (the page
-// fields a calibration fills; at-bound flags and cross-validation are the report's own).
-io::ReportParameter ReportParameterOf(const Robot& robot, int k, double calibrated,
-                                      bool has_sigma, double sigma);
-io::ReportEffect ReportEffectOf(const effects::EffectValue& value);
+// ReportParameterOf and ReportEffectOf (the page rows diagnose shares) are in
+// tools/report_builder.h.
 
 }  // namespace fitcal::tools

@@ -1,0 +1,12 @@
+#pragma once
+// The Markdown renderer of the report: summary.md, the page's tables in GitHub-flavoured Markdown.
+
+#include <string>
+
+#include "io/report_model.h"
+
+namespace fitcal::io {
+
+std::string ReportMarkdown(const ReportData& data);
+
+}  // namespace fitcal::io

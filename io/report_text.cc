@@ -1,0 +1,108 @@
+#include "io/report_text.h"
+
+#include <algorithm>
+#include <cstdio>
+
+namespace fitcal::io::report_text {
+
+const char* const kGroundTruthColour = "#9a9a9a";
+const char* const kBeforeColour = "#d55e00";
+const char* const kAfterColour = "#0072b2";
+const char* const kBeforeName = "odometry, nominal parameters";
+const char* const kAfterName = "odometry, calibrated parameters";
+
+std::string Fmt(const char* format, double v) {
+  if (!std::isfinite(v)) return "-";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, format, v);
+  return buf;
+}
+
+double Improvement(double before, double after) {
+  return before > 0.0 ? 100.0 * (before - after) / before : 0.0;
+}
+
+std::string ChangePercentText(double before, double after) {
+  return Fmt("%+.1f %%", -Improvement(before, after));
+}
+
+const Column kColumns[7] = {
+    {"rms_distance_m", "RMS distance error [m] (Eq. 12)", false, &ReportMetrics::rms_distance_m},
+    {"rms_angle", "RMS |angle| error [deg] (Eq. 13)", true, &ReportMetrics::rms_angle_rad},
+    {"max_distance_m", "max distance error [m] (Eq. 10)", false, &ReportMetrics::max_distance_m},
+    {"max_angle", "max |angle| error [deg] (Eq. 11)", true, &ReportMetrics::max_angle_rad},
+    {"final_distance_m", "final position error [m]", false, &ReportMetrics::final_distance_m},
+    {"final_angle", "final |angle| error [deg]", true, &ReportMetrics::final_angle_rad},
+    {"cf", "CF (Eq. 14, m and rad)", false, &ReportMetrics::cf},
+};
+
+std::string KeyOf(const Column& c) { return std::string(c.key) + (c.is_angle ? "_deg" : ""); }
+double ValueOf(const Column& c, const ReportMetrics& m) {
+  return m.*c.field * (c.is_angle ? kDeg : 1.0);
+}
+const char* FormatOf(const Column& c) { return c.is_angle ? "%.3f" : "%.4f"; }
+
+std::string JsonString(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    switch (c) {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", c);
+          out += buf;
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+std::string JsonNumber(double v) {
+  if (!std::isfinite(v)) return "null";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
+double ParamScale(const ReportParameter& p) { return p.is_angle ? kDeg : 1.0; }
+
+std::string ChangeText(const ReportParameter& p) {
+  if (p.is_angle) return Fmt("%+.3f deg", (p.calibrated - p.nominal) * kDeg);
+  return Fmt("%+.2f %%", p.nominal != 0.0 ? 100.0 * (p.calibrated - p.nominal) / p.nominal : 0.0);
+}
+
+std::vector<std::size_t> WorstRuns(const ReportData& data, std::size_t most) {
+  std::vector<std::size_t> order(data.runs.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return data.runs[a].after.cf > data.runs[b].after.cf;
+  });
+  order.resize(std::min(order.size(), most));
+  return order;
+}
+
+double ColouredTrackScale(const ReportRun& r) {
+  const double hi = std::max(r.before.max_distance_m, r.after.max_distance_m);
+  double samples = 0.0;
+  for (const auto* e : {&r.before_distance_m, &r.after_distance_m}) {
+    for (double v : *e) samples = std::max(samples, v);
+  }
+  const double out = std::max(hi, samples);
+  return out > 0.0 ? out : 1.0;
+}
+
+}  // namespace fitcal::io::report_text
