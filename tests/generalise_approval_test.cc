@@ -78,21 +78,25 @@ TEST(GeneraliseApproval, FlowerFigures) {
   const auto r =
       RunFitcal(dir, "generalise --logs " + data + " --train-trajectories '^R' --no-loso");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  ExpectLines(r.out, {
-      "| '^R' -> others | nominal | 120 | 240 | 0.0420 | 0.0880 | 0.053 | 3.98 | - | - |",
-      "| '^R' -> others | fit | 120 | 240 | 0.0075 | 0.1155 | 0.050 | 5.95 | 3 | 0 |",
-      "| '^R' -> others | fit without holds | 120 | 240 | 0.0075 | 0.0176 | 0.010 | 0.81 | - | - |",
-      "| others -> '^R' | nominal | 240 | 120 | 0.0880 | 0.0420 | 0.039 | 0.80 | - | - |",
-      "| others -> '^R' | fit | 240 | 120 | 0.0077 | 0.0076 | 0.005 | 0.27 | 0 | 0 |",
-      "| every path type, reps 1-5 -> the other reps | nominal | 180 | 180 | 0.0728 | 0.0726 | "
-      "0.048 | 2.92 | - | - |",
-      "| every path type, reps 1-5 -> the other reps | fit | 180 | 180 | 0.0076 | 0.0078 | 0.005 "
-      "| 0.28 | 0 | 0 |",
-      "  others -> '^R': fit               nominal calibrated    change",
-      "  ATE RMSE [m] (mean of runs)        0.0269     0.0048    -82.0%",
-      "  drift 1 m [%] (342 windows)         3.834      0.535    -86.0%",
-      "  drift 1 m [deg/m]                   0.772      0.278    -64.0%",
-  });
+  ExpectLines(
+      r.out,
+      {
+          "| '^R' -> others | nominal | 120 | 240 | 0.0420 | 0.0880 | 0.053 | 3.98 | - | - |",
+          "| '^R' -> others | fit | 120 | 240 | 0.0075 | 0.1155 | 0.050 | 5.95 | 3 | 0 |",
+          "| '^R' -> others | fit without holds | 120 | 240 | 0.0075 | 0.0176 | 0.010 | 0.81 | - | "
+          "- |",
+          "| others -> '^R' | nominal | 240 | 120 | 0.0880 | 0.0420 | 0.039 | 0.80 | - | - |",
+          "| others -> '^R' | fit | 240 | 120 | 0.0077 | 0.0076 | 0.005 | 0.27 | 0 | 0 |",
+          "| every path type, reps 1-5 -> the other reps | nominal | 180 | 180 | 0.0728 | 0.0726 | "
+          "0.048 | 2.92 | - | - |",
+          "| every path type, reps 1-5 -> the other reps | fit | 180 | 180 | 0.0076 | 0.0078 | "
+          "0.005 "
+          "| 0.28 | 0 | 0 |",
+          "  others -> '^R': fit               nominal calibrated    change",
+          "  ATE RMSE [m] (mean of runs)        0.0269     0.0048    -82.0%",
+          "  drift 1 m [%] (342 windows)         3.834      0.535    -86.0%",
+          "  drift 1 m [deg/m]                   0.772      0.278    -64.0%",
+      });
 }
 
 // The drift row of `name` (e.g. "drift 1 m [%]") in the everyday-driving block titled `title`:
@@ -124,8 +128,8 @@ TEST(GeneraliseApproval, EverydayDrivingShowsACommonScaleError) {
   const auto sim = RunFitcal(dir, "simulate --model diff_drive --truth " + truth + " --out " +
                                       data + " --repetitions 2 --seed 7");
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
-  const auto r = RunFitcal(
-      dir, "generalise --logs " + data + " --train-trajectories '^square' --no-loso");
+  const auto r =
+      RunFitcal(dir, "generalise --logs " + data + " --train-trajectories '^square' --no-loso");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::vector<double> fit = EverydayRow(r.out, "'^square' -> others: fit", "drift 1 m [%]");
   const std::vector<double> track =
