@@ -18,14 +18,71 @@
 // would show by chance, the false-alarm probability alpha spread over the H - 1 alternatives
 // (Bonferroni). With too few residuals to fit, the nominal SSRs are compared with d = residuals.
 
+#include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
-#include "diagnosis/wheel_order_check.h"
+#include "fit/final_pose_residual.h"
 #include "models/model_interface.h"
 #include "odometry/aligned_run.h"
+#include "odometry/parallel_for.h"
+#include "odometry/run_log.h"
 
 namespace fitcal {
+
+// The scores and the decision of the test above (also those of the omni3-only
+// diagnosis/wheel_order_check.h, until it is retired).
+struct MiswiringScores {
+  bool likely_miswired = false;  // another mapping explains the data far better
+  double recorded_nominal_ssr = 0.0;
+  double best_nominal_ssr = 0.0;
+  bool fitted = false;         // SSRs below are after a bounded fit of both hypotheses
+  double recorded_ssr = 0.0;   // SSR of the recorded order (fitted when `fitted`)
+  double best_ssr = 0.0;       // SSR of the best other mapping (fitted when `fitted`)
+  double threshold = 0.0;      // the F quantile the ratio recorded/best had to exceed
+  int degrees_of_freedom = 0;  // 0: nothing was decided (too few windows)
+  std::string message;         // one line when likely_miswired
+};
+
+// What the decision needs besides the nominal SSRs: how many residuals the SSRs sum and how many
+// parameters a fit frees (d above), how many other mappings were scored (Bonferroni), the fit of
+// a hypothesis, and the words of the message.
+struct MiswiringTest {
+  int num_residuals = 0;
+  int num_free_parameters = 0;
+  std::size_t num_alternatives = 0;
+  double false_alarm_probability = 0.0;
+  // The SSR after a bounded fit of the best other mapping (true) or of the recorded one (false).
+  std::function<double(bool best_other)> fitted_ssr;
+  std::function<std::string()> describe_best;  // the best other mapping in words
+  std::string evidence;                        // e.g. "final-pose SSR"
+  std::string sample;                          // e.g. "36 runs"
+  std::string order;                           // what to fix in the robot YAML, e.g. "wheel order"
+};
+
+// The options this check and the channel-order check share: alpha in (0, 1), positive weights.
+bool IsValidMiswiringOptions(double false_alarm_probability, const ResidualWeights& weights,
+                             std::string* error);
+
+// The decision of the header on scores whose recorded_nominal_ssr and best_nominal_ssr are set:
+// fills the rest of *scores (both hypotheses fitted when the other beats the recorded one at the
+// nominal and d allows it).
+void DecideMiswiring(const MiswiringTest& test, MiswiringScores* scores);
+
+// sum_i ssr(i) over n runs: each run's term computed in parallel, the sum taken in run order (the
+// same bits on any number of threads).
+template <typename Fn>
+double SumOverRuns(std::size_t n, int num_threads, Fn&& ssr) {
+  std::vector<double> per_run(n, 0.0);
+  ParallelFor(n, num_threads, [&](std::size_t i) { per_run[i] = ssr(i); });
+  double sum = 0.0;
+  for (double v : per_run) sum += v;
+  return sum;
+}
+
+// The p-quantile of Fisher's F(d1, d2) (the threshold above), by bisection on statistics.h.
+double FDistributionQuantile(double p, double d1, double d2);
 
 // Copies of the runs with the mapping applied to every sample.
 std::vector<AlignedRun> ApplyChannelMapping(const std::vector<AlignedRun>& runs,
@@ -42,9 +99,9 @@ struct ChannelOrderOptions {
   bool IsValid(std::string* error) const;
 };
 
-// The scores and decision as in wheel_order_check.h.
 struct ChannelOrderReport : MiswiringScores {
-  ChannelMapping best;  // the best other mapping when likely_miswired
+  ChannelMapping best;      // the best other mapping when likely_miswired
+  bool on_windows = false;  // scored on windows of the ground-truth track, not final poses
 };
 
 // segments: empty for the final-pose test, else one window list per run (segment test).
@@ -52,5 +109,14 @@ ChannelOrderReport CheckChannelOrder(const std::vector<AlignedRun>& runs,
                                      const std::vector<std::vector<Segment>>& segments,
                                      const RobotModelInterface& model,
                                      const ChannelOrderOptions& options = {});
+
+// The check of recorded runs against their ground truth, as the importers run it: on disjoint
+// windows of 0.5 m of ground-truth path when the ground truth has poses between the ends (at
+// least 4 windows; closed paths hide some miswirings from final poses), on the final poses
+// otherwise. tracks[i] is the ground truth of runs[i].
+ChannelOrderReport CheckRecordedChannelOrder(const std::vector<AlignedRun>& runs,
+                                             const std::vector<const GroundTruthTrack*>& tracks,
+                                             const RobotModelInterface& model,
+                                             const ChannelOrderOptions& options = {});
 
 }  // namespace fitcal

@@ -68,51 +68,6 @@ double FittedSumOfSquares(const std::vector<AlignedRun>& runs, const Omni3Robot&
 
 }  // namespace
 
-double FDistributionQuantile(double p, double d1, double d2) {
-  // Bisection on log x: the CDF is monotone; 200 halvings of [1e-12, 1e12] are ample.
-  double lo = std::log(1e-12), hi = std::log(1e12);
-  for (int i = 0; i < 200; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (stats::FUpperTail(std::exp(mid), d1, d2) > 1.0 - p ? lo : hi) = mid;
-  }
-  return std::exp(0.5 * (lo + hi));
-}
-
-void DecideMiswiring(const MiswiringTest& test, MiswiringScores* scores) {
-  MiswiringScores& s = *scores;
-  const int n = test.num_residuals;
-  s.fitted = n - test.num_free_parameters >= 3;
-  s.degrees_of_freedom = s.fitted ? n - test.num_free_parameters : n;
-  const double alpha = test.false_alarm_probability /
-                       static_cast<double>(std::max<std::size_t>(1, test.num_alternatives));
-  s.threshold = FDistributionQuantile(1.0 - alpha, s.degrees_of_freedom, s.degrees_of_freedom);
-  s.recorded_ssr = s.recorded_nominal_ssr;
-  s.best_ssr = s.best_nominal_ssr;
-  // The recorded order is already at least as good at the nominal: nothing to fit.
-  if (!(s.best_nominal_ssr < s.recorded_nominal_ssr)) {
-    s.fitted = false;
-    return;
-  }
-  if (s.fitted) {
-    s.recorded_ssr = test.fitted_ssr(false);
-    s.best_ssr = test.fitted_ssr(true);
-  }
-  // A perfect fit of the other order (ssr 0) is "far better" as long as the recorded one is not
-  // perfect too.
-  const double ratio = s.best_ssr > 0.0       ? s.recorded_ssr / s.best_ssr
-                       : s.recorded_ssr > 0.0 ? std::numeric_limits<double>::infinity()
-                                              : 1.0;
-  if (!(ratio > s.threshold)) return;
-  s.likely_miswired = true;
-  std::ostringstream msg;
-  msg.precision(3);
-  msg << "the encoder columns look miswired: with " << test.describe_best()
-      << " the runs are explained " << ratio << "x better (" << test.evidence << " " << s.best_ssr
-      << " vs " << s.recorded_ssr << " as recorded; threshold " << s.threshold << " for "
-      << test.sample << "); fix the log or the robot YAML's " << test.order;
-  s.message = msg.str();
-}
-
 std::vector<WheelMapping> AllWheelMappings() {
   std::vector<WheelMapping> out;
   std::array<int, 3> perm{0, 1, 2};
@@ -158,19 +113,6 @@ std::string DescribeWheelMapping(const WheelMapping& m) {
     if (m.column[i] == i) out += " (sign flipped)";
   }
   return out.empty() ? "recorded order" : out;
-}
-
-bool IsValidMiswiringOptions(double false_alarm_probability, const ResidualWeights& weights,
-                             std::string* error) {
-  if (!(false_alarm_probability > 0.0 && false_alarm_probability < 1.0)) {
-    *error = "false_alarm_probability must be in (0, 1)";
-    return false;
-  }
-  if (!(weights.position_sigma_m > 0.0) || !(weights.heading_sigma_rad > 0.0)) {
-    *error = "weights must be positive";
-    return false;
-  }
-  return true;
 }
 
 bool WheelOrderOptions::IsValid(std::string* error) const {

@@ -1,4 +1,8 @@
 #pragma once
+// RETIRED for every caller but tools/fit_command.cc's omni3 path: the one check of which encoder
+// column is which channel is diagnosis/channel_order_check.h (the importers, `fit` and every model
+// call it). Delete this file, its .cc and tests/wheel_order_check_test.cc with that path.
+//
 // Checks, before fitting, that the encoder columns are the wheels the robot YAML says they are,
 // and that the rates are in rad/s. The most common silent failure of odometry calibration is a
 // swapped or sign-flipped encoder column (wiring, driver config): the fit then "converges" to
@@ -31,6 +35,7 @@
 #include <string>
 #include <vector>
 
+#include "diagnosis/channel_order_check.h"
 #include "fit/final_pose_residual.h"
 #include "odometry/aligned_run.h"
 #include "odometry/parallel_for.h"
@@ -67,59 +72,9 @@ struct WheelOrderOptions {
   bool IsValid(std::string* error) const;
 };
 
-// The scores and the decision of the test above, for this check and for the channel-order check
-// of any model (channel_order_check.h); each report adds the mapping it found.
-struct MiswiringScores {
-  bool likely_miswired = false;  // another mapping explains the data far better
-  double recorded_nominal_ssr = 0.0;
-  double best_nominal_ssr = 0.0;
-  bool fitted = false;         // SSRs below are after a bounded fit of both hypotheses
-  double recorded_ssr = 0.0;   // SSR of the recorded order (fitted when `fitted`)
-  double best_ssr = 0.0;       // SSR of the best other mapping (fitted when `fitted`)
-  double threshold = 0.0;      // the F quantile the ratio recorded/best had to exceed
-  int degrees_of_freedom = 0;  // 0: nothing was decided (too few windows)
-  std::string message;         // one line when likely_miswired
-};
-
 struct WheelOrderReport : MiswiringScores {
   WheelMapping best;  // the best-scoring mapping (identity when not miswired)
 };
-
-// What the decision needs besides the nominal SSRs: how many residuals the SSRs sum and how many
-// parameters a fit frees (d above), how many other mappings were scored (Bonferroni), the fit of
-// a hypothesis, and the words of the message.
-struct MiswiringTest {
-  int num_residuals = 0;
-  int num_free_parameters = 0;
-  std::size_t num_alternatives = 0;
-  double false_alarm_probability = 0.0;
-  // The SSR after a bounded fit of the best other mapping (true) or of the recorded one (false).
-  std::function<double(bool best_other)> fitted_ssr;
-  std::function<std::string()> describe_best;  // the best other mapping in words
-  std::string evidence;                        // e.g. "final-pose SSR"
-  std::string sample;                          // e.g. "36 runs"
-  std::string order;                           // what to fix in the robot YAML, e.g. "wheel order"
-};
-
-// The options this check and the channel-order check share: alpha in (0, 1), positive weights.
-bool IsValidMiswiringOptions(double false_alarm_probability, const ResidualWeights& weights,
-                             std::string* error);
-
-// The decision of the header on scores whose recorded_nominal_ssr and best_nominal_ssr are set:
-// fills the rest of *scores (both hypotheses fitted when the other beats the recorded one at the
-// nominal and d allows it).
-void DecideMiswiring(const MiswiringTest& test, MiswiringScores* scores);
-
-// sum_i ssr(i) over n runs: each run's term computed in parallel, the sum taken in run order (the
-// same bits on any number of threads).
-template <typename Fn>
-double SumOverRuns(std::size_t n, int num_threads, Fn&& ssr) {
-  std::vector<double> per_run(n, 0.0);
-  ParallelFor(n, num_threads, [&](std::size_t i) { per_run[i] = ssr(i); });
-  double sum = 0.0;
-  for (double v : per_run) sum += v;
-  return sum;
-}
 
 // Throws std::invalid_argument for invalid options or no runs.
 WheelOrderReport CheckWheelOrder(const std::vector<AlignedRun>& runs, const Omni3Robot& robot,
@@ -144,8 +99,5 @@ struct RateUnitsReport {
 };
 
 RateUnitsReport CheckRateUnits(const std::vector<RunLog>& runs, const Omni3Robot& robot);
-
-// The p-quantile of Fisher's F(d1, d2) (the threshold above), by bisection on statistics.h.
-double FDistributionQuantile(double p, double d1, double d2);
 
 }  // namespace fitcal

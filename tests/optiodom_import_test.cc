@@ -6,12 +6,14 @@
 #include <filesystem>
 #include <fstream>
 
+#include "diagnosis/channel_order_check.h"
 #include "fit/final_pose_cost.h"
 #include "fit/segment_cost.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/log_files.h"
 #include "io/robot_yaml.h"
+#include "models/omni3/omni3_robot_model.h"
 #include "odometry/aligned_run.h"
 #include "tools/import_optiodom.h"
 
@@ -55,23 +57,33 @@ TEST(OptiOdomImport, ReadsMetadataAndMapsTheAuthorsWheelsToOurs) {
   EXPECT_EQ(s.runs[0].ticks[1][2], -1.0);
 }
 
-// The documented mapping must beat all 47 other wheel orders/signs by a wide margin on the
-// intermediate ground truth (segments), where a wrong sign cannot hide behind a closed path.
+// The one channel-order check (diagnosis/channel_order_check.h, as the importer runs it) keeps
+// the documented mapping on each single session, and finds two columns swapped on the windows of
+// the ground-truth track, where a wrong order cannot hide behind a closed path.
 TEST(OptiOdomImport, DocumentedWheelMappingIsTheOneTheGroundTruthSupports) {
   SKIP_WITHOUT_DATA();
   for (const fs::path& dir : {kCircleSession, kSquareSession}) {
     const tools::OptiOdomSession s = tools::ReadOptiOdomSession(dir.string());
-    const Omni3Robot robot = tools::OptiOdomNominalRobot(s.metadata);
+    const auto model = Omni3ModelOf(tools::OptiOdomNominalRobot(s.metadata));
     std::vector<RunLog> logs;
     for (const auto& run : s.runs) logs.push_back(tools::OptiOdomRunLog(s, run));
-    const auto ranking = tools::RankWheelMappings(logs, robot);
-    ASSERT_EQ(ranking.size(), 48u);
-    EXPECT_TRUE(ranking.front().IsIdentity()) << dir;
-
-    // Nominal parameters over 1 m windows: a few cm and degrees. Any wrong sign or order moves a
-    // window by tens of cm, so every alternative must be at least 3x worse.
-    EXPECT_LT(ranking[0].mean_cf, 0.15) << dir;
-    EXPECT_GT(ranking[1].mean_cf, 3.0 * ranking[0].mean_cf) << dir;
+    std::vector<const GroundTruthTrack*> tracks;
+    for (const RunLog& log : logs) tracks.push_back(&log.ground_truth);
+    const std::vector<AlignedRun> runs = AlignRuns(logs);
+    const ChannelOrderReport documented = CheckRecordedChannelOrder(runs, tracks, *model);
+    EXPECT_FALSE(documented.likely_miswired) << dir << ": " << documented.message;
+    EXPECT_TRUE(documented.on_windows) << dir;
+    // Nominal parameters: every other order/sign at least 3x worse over the windows (a wrong
+    // sign or order moves a 0.5 m window by tens of cm, the nominal by a few cm).
+    EXPECT_GT(documented.best_nominal_ssr, 3.0 * documented.recorded_nominal_ssr) << dir;
+    ChannelMapping swap;
+    swap.column = {1, 0, 2};
+    swap.sign = {1, 1, 1};
+    const ChannelOrderReport swapped =
+        CheckRecordedChannelOrder(ApplyChannelMapping(runs, swap), tracks, *model);
+    ASSERT_TRUE(swapped.likely_miswired) << dir;
+    EXPECT_EQ(swapped.best.column, swap.column);
+    EXPECT_EQ(swapped.best.sign, swap.sign);
   }
 }
 

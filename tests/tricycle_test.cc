@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -25,6 +26,7 @@
 #include "odometry/aligned_run.h"
 #include "tests/test_files.h"
 #include "tools/import_optiodom_tricycle.h"
+#include "tools/miswired_error.h"
 #include "tools/sim/model_simulator.h"
 #include "tools/sim/tricycle_trajectories.h"
 
@@ -488,25 +490,40 @@ TEST(OptiOdomTricycleImport, BadSteeringGivesOneLineAndWritesNothing) {
             "t,ticks_traction,steering\n0.000000,0,-0.1\n0.050000,10,-0.1\n0.100000,10,-0.1\n");
 }
 
-// A steering column of the wrong sign (the ground truth turns clockwise while the steering says
-// left) is refused by the sign check, nothing written; skip_sign_check writes it anyway.
+// A real session with its steering column negated (the ground truth turns one way while the
+// steering says the other) is refused by the channel-order check, nothing written; with the check
+// skipped it is written anyway and says so.
 TEST(OptiOdomTricycleImport, SteeringOfTheWrongSignIsRefused) {
-  const std::string flipped =
-      "0,0,0,0,0,0.1\n0.05,0.00128,0,-0.00085,10,0.1\n0.1,0.00255,-1e-6,-0.0017,10,0.1\n";
+  const fs::path real = kTricyc / "circular" / "140120211415";
+  if (!fs::is_directory(real)) GTEST_SKIP() << "no " << real;
   TempDir dir;
-  const std::string session = WriteSession(dir, flipped);
+  const std::string name = real.filename().string();
+  fs::create_directories(dir.Path("circular/" + name));
+  fs::copy_file(real / (name + "_metadata.csv"),
+                dir.Path("circular/" + name + "/" + name + "_metadata.csv"));
+  for (const char* run : {"_run-01.csv", "_run-02.csv"}) {
+    std::ifstream in(real / (name + run));
+    std::ofstream out(dir.Path("circular/" + name + "/" + name + run));
+    for (std::string line; std::getline(in, line);) {
+      const std::size_t comma = line.rfind(',');
+      const double steering = std::stod(line.substr(comma + 1));
+      out << line.substr(0, comma + 1) << std::setprecision(17) << -steering << "\n";
+    }
+  }
+  const std::string session = dir.Path("circular/" + name);
   try {
     tools::ImportOptiOdomTricycle({session}, dir.Path("out"));
     ADD_FAILURE() << "imported";
-  } catch (const std::runtime_error& e) {
+  } catch (const tools::MiswiredError& e) {
+    EXPECT_NE(std::string(e.what()).find("steering = -steering"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("nothing written"), std::string::npos) << e.what();
   }
   EXPECT_FALSE(fs::exists(dir.Path("out")));
   tools::ImportOptiOdomTricycleOptions options;
   options.skip_sign_check = true;
   const auto summary = tools::ImportOptiOdomTricycle({session}, dir.Path("out"), options);
-  EXPECT_LT(summary.signs.steering_correlation, -0.9);
-  EXPECT_GT(summary.signs.traction_correlation, 0.9);
+  EXPECT_NE(summary.channel_order.find("written anyway"), std::string::npos)
+      << summary.channel_order;
   EXPECT_TRUE(fs::exists(dir.Path("out/dataset.yaml")));
 }
 
@@ -541,9 +558,9 @@ TEST(OptiOdomTricycleImport, RealSessionReproducesItsNominalFinalErrors) {
   ASSERT_EQ(summary.runs.size(), 2u);
   EXPECT_EQ(summary.runs[0].trajectory, "circular_cw");
   EXPECT_EQ(summary.runs[1].trajectory, "circular_ccw");
-  // Per-run correlations computed by hand on the raw files: 0.93 / 0.86 and 0.93 / 0.84.
-  EXPECT_GT(summary.signs.traction_correlation, 0.8);
-  EXPECT_GT(summary.signs.steering_correlation, 0.7);
+  // The channel-order check kept the documented signs (it throws otherwise).
+  EXPECT_NE(summary.channel_order.find("documented order"), std::string::npos)
+      << summary.channel_order;
   for (int run = 1; run <= 2; ++run) {
     const auto rows = ReadRawRun(session / ("140120211415_run-0" + std::to_string(run) + ".csv"));
     ASSERT_GT(rows.size(), 1000u);

@@ -7,6 +7,7 @@
 #include <iostream>
 #include <set>
 
+#include "diagnosis/channel_order_check.h"
 #include "diagnosis/clock_choice.h"
 #include "diagnosis/diagnose.h"
 #include "fit/correlation.h"
@@ -25,6 +26,7 @@
 #include "models/model_registry.h"
 #include "odometry/parallel_for.h"
 #include "tools/cli_validators.h"
+#include "tools/miswired_error.h"
 #include "tools/output_guard.h"
 #include "tools/report_command.h"
 #include "validation/propagated_uncertainty.h"
@@ -49,6 +51,8 @@ void AddDiagnoseOptions(CLI::App& cmd, DiagnoseCommandOptions& o) {
   cmd.add_option("--out", o.out,
                  "Output directory (index.html, metrics.json, diagnose.md, calibrated.yaml)")
       ->capture_default_str();
+  cmd.add_flag("--skip-wheel-order-check", o.skip_wheel_order_check,
+               "Diagnose even if another channel order explains the runs far better");
   cmd.add_flag("--csv", o.csv,
                "Also write residuals.csv and residuals_declared.csv (every ground-truth sample)");
   cmd.add_option("--max-effects", o.max_effects, "Most effects to add")
@@ -295,6 +299,23 @@ void MapClocks(const std::string& robot_path, const RobotModelInterface& model, 
   *runs = ApplyClockChoice(choice, std::move(*runs), mapped);
 }
 
+// The one channel-order check (diagnosis/channel_order_check.h), as `fit` and the importers run
+// it: a swapped or sign-flipped column would send the diagnosis after effects that are a wiring
+// fault. True after one line on stderr when another order explains the runs far better.
+bool ChannelsLookMiswired(const DiagnoseCommandOptions& options, const RobotModelInterface& model,
+                          const std::vector<RunLog>& runs) {
+  std::vector<const GroundTruthTrack*> tracks;
+  for (const RunLog& run : runs) tracks.push_back(&run.ground_truth);
+  ChannelOrderOptions order_options;
+  order_options.num_threads = options.threads;
+  const ChannelOrderReport order =
+      CheckRecordedChannelOrder(AlignRuns(runs), tracks, model, order_options);
+  if (!order.likely_miswired) return false;
+  std::cerr << "fitcal: " << options.logs << ": " << order.message
+            << "; nothing written (--skip-wheel-order-check to diagnose anyway)\n";
+  return true;
+}
+
 std::string Format(const char* format, double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, format, v);
@@ -467,6 +488,9 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
     }
     std::vector<RunLog> runs = LoadRuns(options, index, &robot).runs;
     if (options.clock_map) MapClocks(index.robot_path, *model, options.threads, &runs);
+    if (!options.skip_wheel_order_check && ChannelsLookMiswired(options, *model, runs)) {
+      return kMiswiredExitCode;
+    }
     const DiagnoseSplit split = SplitRuns(options, runs, WheelChannelMask(robot));
     if (split.training.empty() || split.validation.empty()) {
       std::cerr << "fitcal: diagnose needs training and held-out runs; got "

@@ -33,6 +33,7 @@ struct DiagnoseCommandOptions : DatasetCommandOptions {
   int max_effects = 3;
   double alpha = 0.01;
   bool csv = false;  // also write the residual CSVs (large: every ground-truth sample)
+  bool skip_wheel_order_check = false;  // diagnose even if another channel order fits far better
 };
 
 // Declares every flag of `diagnose` on its subcommand `cmd`, bound to `options`.

@@ -23,11 +23,11 @@
 #include "tools/compare_command.h"
 #include "tools/diagnose_command.h"
 #include "tools/export_ros2_control.h"
-#include "tools/fleet_command.h"
 #include "tools/fit_command.h"
-#include "tools/generalisation_command.h"
+#include "tools/fleet_command.h"
 #include "tools/import_optiodom.h"
 #include "tools/import_rosbag2.h"
+#include "tools/model_generalise_command.h"
 #include "tools/report_command.h"
 #include "tools/simulate_command.h"
 
@@ -100,7 +100,7 @@ std::vector<Command> Commands() {
                   &AddDiagnoseOptions, &RunDiagnoseCommand),
       MakeCommand("", "generalise",
                   "Train on one path type / session, test on the others "
-                  "(tools/generalisation_command.h)",
+                  "(tools/model_generalise_command.h)",
                   &AddGeneraliseOptions, &RunGeneraliseCommand),
       MakeCommand("", "simulate",
                   "Write a simulated data set: omni3 flower, or --model's trajectories "

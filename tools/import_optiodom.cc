@@ -20,8 +20,10 @@
 #include "io/robot_yaml.h"
 #include "io/staged_directory.h"
 #include "io/text_file.h"
+#include "models/omni3/omni3_robot_model.h"
 #include "odometry/aligned_run.h"
 #include "odometry/parallel_for.h"
+#include "tools/import_channel_order.h"
 #include "tools/import_optiodom_models.h"
 #include "tools/import_optiodom_omni4.h"
 #include "tools/import_optiodom_tricycle.h"
@@ -243,24 +245,6 @@ RunLog OptiOdomRunLog(const OptiOdomSession& session, const OptiOdomRun& run) {
   return log;
 }
 
-std::vector<WheelMappingScore> RankWheelMappings(const std::vector<RunLog>& runs,
-                                                 const Omni3Robot& robot) {
-  const std::vector<AlignedRun> aligned = AlignRuns(runs);
-  const auto nominal = robot.nominal.ToArray();
-  std::vector<WheelMappingScore> scores;
-  for (const WheelMapping& mapping : AllWheelMappings()) {
-    const std::vector<AlignedRun> mapped = ApplyWheelMapping(aligned, mapping);
-    std::vector<SegmentedRun> segmented(mapped.size());
-    for (std::size_t r = 0; r < mapped.size(); ++r) {
-      segmented[r] = {&mapped[r], MakeSegments(mapped[r], runs[r].ground_truth, SegmentOptions{})};
-    }
-    scores.push_back({mapping, EvaluateSegmentErrors(nominal, segmented).cf});
-  }
-  std::stable_sort(scores.begin(), scores.end(),
-                   [](const auto& a, const auto& b) { return a.mean_cf < b.mean_cf; });
-  return scores;
-}
-
 namespace {
 
 std::string TicksCsv(const OptiOdomRun& run) {
@@ -313,12 +297,15 @@ int ImportOtherOptiOdomRobot(const std::string& type, const ImportOptiOdomOption
     tricycle.skip_sign_check = options.skip_mapping_check;
     const ImportOptiOdomTricycleSummary s =
         ImportOptiOdomTricycle(options.sessions, options.out, tricycle);
+    std::printf("%s\n", s.channel_order.c_str());
     std::printf("imported %zu runs of %d tricycle sessions into %s; nominal CF (Eq. 14) %.4f\n",
                 s.runs.size(), s.num_sessions, options.out.c_str(), s.nominal_cf);
     return 0;
   }
-  const Omni4ImportResult s = ImportOptiOdomOmni4(options.sessions, options.out, options.force);
+  const Omni4ImportResult s =
+      ImportOptiOdomOmni4(options.sessions, options.out, options.force, options.skip_mapping_check);
   for (const std::string& note : s.notes) std::printf("note: %s\n", note.c_str());
+  std::printf("%s\n", s.channel_order.c_str());
   std::printf("imported %d runs of %d omni4 sessions into %s; nominal CF (Eq. 14) %.4f\n",
               s.num_runs, s.num_sessions, options.out.c_str(), s.nominal_mean_cf);
   return 0;
@@ -392,24 +379,9 @@ int RunImportOptiOdomCommand(const ImportOptiOdomOptions& options) {
       }
     }
 
-    const std::vector<WheelMappingScore> ranking = RankWheelMappings(logs, robot);
     std::printf(
-        "wheel order/sign check (nominal parameters, mean segment CF, 1 m windows, %zu runs):\n",
-        logs.size());
-    for (std::size_t i = 0; i < 3; ++i) {
-      std::printf("  %s %-12s CF %.4f%s\n", i == 0 ? "best" : "    ",
-                  DescribeWheelMapping(ranking[i].mapping).c_str(), ranking[i].mean_cf,
-                  ranking[i].IsIdentity() ? "  <- documented mapping" : "");
-    }
-    if (!ranking.front().IsIdentity()) {
-      std::cerr << "fitcal: the documented wheel mapping (a,b,c) = (-1,-2,-3) does not explain the "
-                   "ground "
-                   "truth best; "
-                << DescribeWheelMapping(ranking.front().mapping) << " does (CF "
-                << ranking.front().mean_cf
-                << "); nothing written (--skip-mapping-check to write anyway)\n";
-      if (!options.skip_mapping_check) return kMiswiredExitCode;
-    }
+        "%s\n",
+        CheckImportedChannelOrder(logs, *Omni3ModelOf(robot), options.skip_mapping_check).c_str());
 
     // Whole or not at all: staged beside --out, renamed over it once complete.
     io::StagedDirectory staged(options.out);

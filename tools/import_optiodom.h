@@ -16,14 +16,14 @@
 // delta_i = (300, 60, 180) deg, -sin(delta_i) = -cos(phi_i) and cos(delta_i) = -sin(phi_i), so our
 // wheel a, b, c is the authors' 1, 2, 3 with the sign of the ticks flipped:
 //   ticks_a = -ticks_1,  ticks_b = -ticks_2,  ticks_c = -ticks_3.
-// The importer verifies this numerically (CheckWheelMapping) and refuses to write a data set whose
-// ground truth another wheel order/sign explains better.
+// The importer verifies this numerically (tools/import_channel_order.h, the one channel-order
+// check) and refuses to write a data set whose ground truth another wheel order/sign explains far
+// better.
 
 #include <array>
 #include <string>
 #include <vector>
 
-#include "diagnosis/wheel_order_check.h"
 #include "odometry/robot_description.h"
 #include "odometry/run_log.h"
 
@@ -69,20 +69,6 @@ Omni3Robot OptiOdomNominalRobot(const OptiOdomMetadata& metadata);
 
 // The run as fitcal replays it (wheel rates from the ticks, ground truth on the same clock).
 RunLog OptiOdomRunLog(const OptiOdomSession& session, const OptiOdomRun& run);
-
-// The wheel order/sign check: replays every run with the nominal parameters under each of the 48
-// assignments of input channels to wheels (3! orders x 2^3 signs) applied on top of the importer's
-// mapping, and ranks them by the mean segment CF over 1 m windows (fit/segment_cost.h). The
-// intermediate ground truth is used because the final pose of a closed path hides sign errors (on
-// single OptiOdom sessions the final-pose CF does not rank the right mapping first). The identity
-// must come first for the documented mapping to be right.
-struct WheelMappingScore {
-  WheelMapping mapping;  // diagnosis/wheel_order_check.h: wheel i = sign[i] * channel column[i]
-  double mean_cf = 0.0;  // mean segment CF (m and rad per 1 m window)
-  bool IsIdentity() const { return mapping.IsIdentity(); }
-};
-std::vector<WheelMappingScore> RankWheelMappings(const std::vector<RunLog>& runs,
-                                                 const Omni3Robot& robot);
 
 struct ImportOptiOdomOptions {
   std::vector<std::string> sessions;

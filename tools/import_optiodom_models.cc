@@ -19,6 +19,7 @@
 #include "io/text_file.h"
 #include "models/diff_drive/diff_drive_model.h"
 #include "odometry/aligned_run.h"
+#include "tools/import_channel_order.h"
 #include "tools/miswired_error.h"
 #include "tools/output_guard.h"
 
@@ -281,50 +282,6 @@ RobotModelPtr NominalDiffDriveModel(const DiffMetadata& m) {
   return std::make_shared<DiffDriveModel>(std::move(robot));
 }
 
-// Mean over runs of the mean distance between odometry and ground truth at every row.
-double MeanTrackError(const RobotModelInterface& model, const std::vector<RunLog>& logs,
-                      const ChannelMapping& mapping) {
-  const std::vector<double>& p = model.robot().nominal;
-  double sum = 0.0;
-  for (const RunLog& log : logs) {
-    EncoderSamples mapped(2);
-    for (const auto& s : log.encoders.samples) {
-      mapped.push_back(s.dt_s, {mapping.sign[0] * s.value[mapping.column[0]],
-                                mapping.sign[1] * s.value[mapping.column[1]]});
-    }
-    double run_sum = 0.0;
-    const auto& gt = log.ground_truth.world_T_robot;
-    model.Replay(p.data(), mapped, 0, mapped.size(), gt.front(),
-                 [&](std::size_t k, const Pose2d& pose) {
-                   run_sum += std::hypot(pose.x - gt[k + 1].x, pose.y - gt[k + 1].y);
-                 });
-    sum += run_sum / static_cast<double>(mapped.size());
-  }
-  return sum / static_cast<double>(logs.size());
-}
-
-void CheckWheelMapping(const RobotModelInterface& model, const std::vector<RunLog>& logs,
-                       const ImportOptiOdomDiffOptions& options) {
-  const std::vector<ChannelMapping> mappings = model.CandidateMiswirings();
-  const double identity = MeanTrackError(model, logs, mappings.front());
-  for (std::size_t j = 1; j < mappings.size(); ++j) {
-    const double other = MeanTrackError(model, logs, mappings[j]);
-    if (other <= identity && !options.skip_mapping_check) {
-      throw MiswiredError(
-          "the documented wheel order (ticks right, left; positive forward) does not explain the "
-          "ground truth best: mean track error " +
-          std::to_string(identity) + " m, miswiring " + std::to_string(j) + " " +
-          std::to_string(other) + " m; nothing written");
-    }
-  }
-  if (!options.quiet) {
-    std::printf(
-        "wheel order check: documented order mean track error %.4f m, every other "
-        "order/sign worse\n",
-        identity);
-  }
-}
-
 // The runs to write, session by session; notes sessions that declare other values and runs left
 // out.
 struct CollectedRuns {
@@ -426,7 +383,9 @@ OptiOdomDiffImportSummary ImportOptiOdomDiff(const std::vector<std::string>& ses
   const CollectedRuns runs = CollectRuns(sessions, robot, options, out_dir, &summary);
   summary.num_runs = static_cast<int>(runs.entries.size());
   const RobotModelPtr model = NominalDiffDriveModel(robot);
-  CheckWheelMapping(*model, summary.runs, options);
+  const std::string order_check =
+      CheckImportedChannelOrder(summary.runs, *model, options.skip_mapping_check);
+  if (!options.quiet) std::printf("%s\n", order_check.c_str());
   const FinalPoseErrors nominal =
       EvaluateFinalPoseErrors(*model, model->robot().nominal, AlignRuns(summary.runs));
   summary.nominal_cf = nominal.cf;

@@ -11,10 +11,9 @@
 //   <s>_run-NN.csv    no header, `t_s, x_gt_m, y_gt_m, theta_gt_rad, ticks_right, ticks_left`,
 //                     ticks = increments over the 50 ms cycle ending at t, positive forward; the
 //                     ground truth in the start frame (first row 0, 0, 0; heading unwrapped)
-// The importer checks the wheel order and signs on the data: under every candidate miswiring of
-// the model (right/left swapped, signs flipped) the nominal odometry's mean track error against
-// the ground truth (same rows) must be larger than with the documented order, or nothing is
-// written.
+// The importer checks the wheel order and signs on the data (tools/import_channel_order.h, the one
+// channel-order check): when a candidate miswiring of the model (right/left swapped, signs flipped)
+// explains the ground truth far better than the documented order, nothing is written.
 //
 // What it writes (README.md "Data set format"): robot.yaml (model diff_drive, wheels right then
 // left, the nominal values most sessions declare - some sessions declare perturbed values on

@@ -7,7 +7,6 @@
 #include <filesystem>
 #include <limits>
 #include <map>
-#include <mutex>
 #include <regex>
 
 #include "io/atomic_file.h"
@@ -18,7 +17,7 @@
 #include "models/omni/omni_model.h"
 #include "models/pose_errors.h"
 #include "odometry/parallel_for.h"
-#include "tools/miswired_error.h"
+#include "tools/import_channel_order.h"
 #include "tools/output_guard.h"
 
 namespace fitcal::tools {
@@ -45,10 +44,6 @@ constexpr int kFieldsPerRow = 4 + kWheels;
 constexpr double kDistanceBound_m = 0.025;
 constexpr double kRadiusBound = 0.15;
 constexpr double kAngleBound_deg = 5.0;
-// Layout check: kMerge cycles replayed as one interval (their mean rates), poses every
-// kWindowStride merged intervals (1 s at 10 ms cycles), windows of two strides.
-constexpr std::size_t kMerge = 10;
-constexpr std::size_t kWindowStride = 10;
 
 // Parses one number at p (std::from_chars: no locale, no allocation); advances p past it and one
 // separator. False when the field is not a number.
@@ -234,111 +229,6 @@ std::string GroundTruthCsvText(const GroundTruthTrack& track) {
   return out;
 }
 
-// a^-1 b.
-Pose2d RelativePose(const Pose2d& a, const Pose2d& b) {
-  const double c = std::cos(a.theta), s = std::sin(a.theta);
-  const double dx = b.x - a.x, dy = b.y - a.y;
-  return {c * dx + s * dy, -s * dx + c * dy, b.theta - a.theta};
-}
-
-// The run's samples with every kMerge consecutive intervals merged into one (mean rates).
-EncoderSamples Merged(const EncoderSamples& samples) {
-  EncoderSamples out(kWheels);
-  out.reserve(samples.size() / kMerge + 1);
-  for (std::size_t k0 = 0; k0 < samples.size(); k0 += kMerge) {
-    double dt = 0.0, angle[kWheels] = {};
-    for (std::size_t k = k0; k < std::min(k0 + kMerge, samples.size()); ++k) {
-      dt += samples[k].dt_s;
-      for (int i = 0; i < kWheels; ++i) angle[i] += samples[k].value[i] * samples[k].dt_s;
-    }
-    for (double& a : angle) a /= dt;
-    out.push_back(dt, angle);
-  }
-  return out;
-}
-
-// Whether merged interval k ends a window stride: a complete one (all kMerge cycles in the log),
-// so the ground-truth row (k + 1) * kMerge closes it. The odometry and the ground truth of a
-// window must use the same ends.
-bool EndsWindowStride(std::size_t k, std::size_t num_cycles) {
-  return (k + 1) % kWindowStride == 0 && (k + 1) * kMerge <= num_cycles;
-}
-
-// What the layout check needs of a run besides the mapping: the merged samples, the rows of the
-// ground truth that end every kWindowStride-th merged interval, and the ground truth's relative
-// poses Q_i^-1 Q_{i+2} between them. Computed once, not once per candidate mapping.
-struct LayoutRun {
-  const RunLog* log = nullptr;
-  EncoderSamples merged{kWheels};
-  std::vector<Pose2d> truth_window;  // Q_i^-1 Q_{i+2}
-};
-
-LayoutRun MakeLayoutRun(const RunLog& log) {
-  LayoutRun run;
-  run.log = &log;
-  run.merged = Merged(log.encoders.samples);
-  std::vector<std::size_t> row(1, 0);
-  for (std::size_t k = 0; k < run.merged.size(); ++k) {
-    if (EndsWindowStride(k, log.encoders.samples.size())) row.push_back((k + 1) * kMerge);
-  }
-  const std::vector<Pose2d>& truth = log.ground_truth.world_T_robot;
-  for (std::size_t i = 0; i + 2 < row.size(); ++i) {
-    run.truth_window.push_back(RelativePose(truth[row[i]], truth[row[i + 2]]));
-  }
-  return run;
-}
-
-// Mean over windows (i, i + 2 strides) of |t_P - t_Q| + |wrap(theta_P - theta_Q)| of the relative
-// poses P_i^-1 P_j (odometry of the merged samples remapped into *mapped, a buffer the caller
-// keeps) and Q_i^-1 Q_j (ground truth, the rows that end those merged intervals).
-void AddWindowErrors(const LayoutRun& run, const RobotModelInterface& model,
-                     const ChannelMapping& mapping, EncoderSamples* mapped,
-                     std::vector<Pose2d>* odometry, double* sum, int* count) {
-  mapped->resize(run.merged.size());
-  for (std::size_t k = 0; k < run.merged.size(); ++k) {
-    const auto from = run.merged[k];
-    auto to = (*mapped)[k];
-    to.dt_s = from.dt_s;
-    for (int i = 0; i < kWheels; ++i) to.value[i] = mapping.sign[i] * from.value[mapping.column[i]];
-  }
-  const RunLog& log = *run.log;
-  odometry->assign(1, log.ground_truth.world_T_robot.front());
-  model.Replay(model.robot().nominal.data(), *mapped, 0, mapped->size(), odometry->front(),
-               [&](std::size_t k, const Pose2d& pose) {
-                 if (EndsWindowStride(k, log.encoders.samples.size())) odometry->push_back(pose);
-               });
-  for (std::size_t i = 0; i + 2 < odometry->size(); ++i) {
-    double r[3];
-    SegmentError((*odometry)[i], (*odometry)[i + 2], run.truth_window[i], ResidualWeights{}, r);
-    *sum += std::hypot(r[0], r[1]) + std::abs(r[2]);
-    ++*count;
-  }
-}
-
-// The two smallest complete window-error sums seen so far, shared by the threads of the layout
-// check.
-class SmallestTwoSums {
- public:
-  double Second() const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return second_;
-  }
-  void Offer(double sum) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (sum < first_) {
-      second_ = first_;
-      first_ = sum;
-    } else if (sum < second_) {
-      second_ = sum;
-    }
-  }
-
- private:
-  mutable std::mutex mutex_;
-  double first_ = std::numeric_limits<double>::infinity();
-  double second_ = std::numeric_limits<double>::infinity();
-};
-
 }  // namespace
 
 OptiOdomOmni4Session ReadOptiOdomOmni4Session(const std::string& directory) {
@@ -407,49 +297,9 @@ RobotModelPtr OptiOdomOmni4NominalModel(const OptiOdomOmni4Metadata& metadata) {
   return MakeOmniModel("optiodom_omni4", wheels, bounds);
 }
 
-std::vector<Omni4LayoutScore> CheckOmni4Layout(const std::vector<OptiOdomOmni4Session>& sessions,
-                                               const RobotModelInterface& model,
-                                               LayoutSearch search) {
-  std::vector<const RunLog*> logs;
-  for (const OptiOdomOmni4Session& s : sessions) {
-    for (const RunLog& log : s.runs) logs.push_back(&log);
-  }
-  std::vector<LayoutRun> runs(logs.size());
-  ParallelFor(logs.size(), 0, [&](std::size_t r) { runs[r] = MakeLayoutRun(*logs[r]); });
-  const std::vector<ChannelMapping> candidates = model.CandidateMiswirings();
-  SmallestTwoSums smallest;
-  std::vector<Omni4LayoutScore> scores(candidates.size());
-  std::vector<char> complete(candidates.size(), 0);
-  ParallelFor(candidates.size(), 0, [&](std::size_t m) {
-    double sum = 0.0;
-    int count = 0;
-    EncoderSamples mapped(kWheels);
-    std::vector<Pose2d> odometry;
-    for (const LayoutRun& run : runs) {
-      // Window errors are non-negative: past the second smallest complete sum, this candidate
-      // cannot be among the best two.
-      if (search == LayoutSearch::kPruned && sum > smallest.Second()) return;
-      AddWindowErrors(run, model, candidates[m], &mapped, &odometry, &sum, &count);
-    }
-    smallest.Offer(sum);
-    scores[m] = {candidates[m], count > 0 ? sum / count : 0.0};
-    complete[m] = 1;
-  });
-  std::vector<Omni4LayoutScore> best;
-  for (std::size_t m = 0; m < candidates.size(); ++m) {
-    if (complete[m]) best.push_back(scores[m]);
-  }
-  std::stable_sort(best.begin(), best.end(), [](const auto& a, const auto& b) {
-    return a.mean_window_error < b.mean_window_error;
-  });
-  // Which other candidates ran to the end depends on the threads' timing: keep the two that are
-  // exact whatever it was.
-  if (best.size() > 2) best.resize(2);
-  return best;
-}
-
 Omni4ImportResult ImportOptiOdomOmni4(const std::vector<std::string>& session_dirs,
-                                      const std::string& out_dir, bool force) {
+                                      const std::string& out_dir, bool force,
+                                      bool skip_mapping_check) {
   if (session_dirs.empty()) throw std::invalid_argument("no OptiOdom omni4 session to import");
   if (const std::string refusal =
           DirectoryOutputRefusal(out_dir, kDatasetKind, force, session_dirs);
@@ -470,12 +320,9 @@ Omni4ImportResult ImportOptiOdomOmni4(const std::vector<std::string>& session_di
     }
   }
   const RobotModelPtr model = OptiOdomOmni4NominalModel(nominal);
-  result.layout = CheckOmni4Layout(sessions, *model);
-  if (!result.layout.front().mapping.IsIdentity()) {
-    throw MiswiredError(
-        "the documented omni4 wheel layout does not explain the ground truth best; nothing "
-        "written");
-  }
+  std::vector<RunLog> all_runs;
+  for (const auto& s : sessions) all_runs.insert(all_runs.end(), s.runs.begin(), s.runs.end());
+  result.channel_order = CheckImportedChannelOrder(all_runs, *model, skip_mapping_check);
   std::vector<const RunLog*> logs;
   for (const auto& s : sessions) {
     for (const RunLog& log : s.runs) logs.push_back(&log);

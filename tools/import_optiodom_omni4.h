@@ -32,7 +32,8 @@
 // Regressing the ground truth's body steps on the counts confirms the pattern (translation
 // 0.27 per pair instead of 0.25, yaw 1.28 instead of 1.25 per metre of wheel travel); an omni
 // wheel X layout (0.35) does not fit. The importer checks the layout against the ground truth
-// (CheckOmni4Layout) and refuses to write when another wheel order or sign fits better.
+// (tools/import_channel_order.h, the one channel-order check) and refuses to write when another
+// wheel order or sign fits far better.
 //
 // Two sessions (square/231220200521, square/231220200550) declare L1, L2 = 0.205, 0.215 m: the
 // authors perturbed their starting values; the robot is the same. The nominal robot takes each
@@ -75,37 +76,20 @@ OptiOdomOmni4Session ReadOptiOdomOmni4Session(const std::string& directory);
 // m, r +- 15 %, delta +- 5 deg (wider than Palacin Eq. 16; the .cc says why).
 RobotModelPtr OptiOdomOmni4NominalModel(const OptiOdomOmni4Metadata& metadata);
 
-// The layout check: every candidate miswiring (model->CandidateMiswirings(), 4! orders x 2^4
-// signs) scored by the mean relative pose error over 2 s windows (1 s apart) at the nominal
-// parameters, over every run (replayed at 100 ms: ten cycles merged, their mean rates). Single
-// runs can be blind to a swap (a spin turns every wheel alike), so all runs are used. The
-// identity must come first. Returns the best two, exact, best first: a candidate stops being
-// replayed once its partial sum exceeds the second smallest complete one (the errors are
-// non-negative, so it cannot be among the two), which rules out most of the 384 within a few runs.
-struct Omni4LayoutScore {
-  ChannelMapping mapping;
-  double mean_window_error = 0.0;  // |translation error| (m) + |heading error| (rad) per window
-};
-// kExhaustive replays every candidate over every run (for the test that the pruning changes
-// nothing).
-enum class LayoutSearch { kPruned, kExhaustive };
-std::vector<Omni4LayoutScore> CheckOmni4Layout(const std::vector<OptiOdomOmni4Session>& sessions,
-                                               const RobotModelInterface& model,
-                                               LayoutSearch search = LayoutSearch::kPruned);
-
 struct Omni4ImportResult {
   int num_sessions = 0;
   int num_runs = 0;
-  std::vector<Omni4LayoutScore> layout;  // the best two, best first
-  double nominal_mean_cf = 0.0;          // mean over runs of |final-pose residual| (Eq. 14)
-  std::vector<std::string> notes;        // e.g. sessions that declare perturbed nominal values
+  std::string channel_order;       // the channel-order check's line (tools/import_channel_order.h)
+  double nominal_mean_cf = 0.0;    // mean over runs of |final-pose residual| (Eq. 14)
+  std::vector<std::string> notes;  // e.g. sessions that declare perturbed nominal values
 };
 
 // Reads the sessions, checks the layout, and writes <out>/dataset.yaml, <out>/robot.yaml (the
 // nominal omni robot) and per run runs/<id>_encoders.csv (`t,w_fl,w_fr,w_rl,w_rr`, rad/s over the
 // interval ending at t) and runs/<id>_ground_truth.csv (`t,x,y,theta`). Throws io::InputError for
-// bad input and std::runtime_error when the layout check fails (nothing is written then).
+// bad input and MiswiredError when the channel-order check fails (nothing is written then).
 Omni4ImportResult ImportOptiOdomOmni4(const std::vector<std::string>& session_dirs,
-                                      const std::string& out_dir, bool force = false);
+                                      const std::string& out_dir, bool force = false,
+                                      bool skip_mapping_check = false);
 
 }  // namespace fitcal::tools

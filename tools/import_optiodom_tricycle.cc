@@ -18,6 +18,7 @@
 #include "models/tricycle/tricycle_checks.h"
 #include "models/tricycle/tricycle_model.h"
 #include "odometry/aligned_run.h"
+#include "tools/import_channel_order.h"
 #include "tools/miswired_error.h"
 #include "tools/output_guard.h"
 
@@ -246,34 +247,6 @@ RunLog OptiOdomTricycleRunLog(const OptiOdomTricycleSession& session,
   return log;
 }
 
-TricycleSignCheck CheckTricycleSigns(const std::vector<OptiOdomTricycleSession>& sessions) {
-  double traction_ab = 0.0, traction_aa = 0.0, traction_bb = 0.0;
-  double steering_ab = 0.0, steering_aa = 0.0, steering_bb = 0.0;
-  for (const OptiOdomTricycleSession& session : sessions) {
-    for (const OptiOdomTricycleRun& run : session.runs) {
-      const std::vector<Pose2d>& gt = run.ground_truth.world_T_robot;
-      for (std::size_t k = 1; k < run.t_s.size(); ++k) {
-        const double forward_m = std::cos(gt[k - 1].theta) * (gt[k].x - gt[k - 1].x) +
-                                 std::sin(gt[k - 1].theta) * (gt[k].y - gt[k - 1].y);
-        traction_ab += run.ticks[k] * forward_m;
-        traction_aa += run.ticks[k] * run.ticks[k];
-        traction_bb += forward_m * forward_m;
-        const double turning =
-            run.ticks[k] * std::sin(0.5 * (run.steering_rad[k - 1] + run.steering_rad[k]));
-        const double turn_rad = gt[k].theta - gt[k - 1].theta;
-        steering_ab += turning * turn_rad;
-        steering_aa += turning * turning;
-        steering_bb += turn_rad * turn_rad;
-      }
-    }
-  }
-  const auto correlation = [](double ab, double aa, double bb) {
-    return aa > 0.0 && bb > 0.0 ? ab / std::sqrt(aa * bb) : 0.0;
-  };
-  return {correlation(traction_ab, traction_aa, traction_bb),
-          correlation(steering_ab, steering_aa, steering_bb)};
-}
-
 namespace {
 
 // Encoder CSV as the recorder logged it: ticks per interval (row 0 zero: counts before the
@@ -351,15 +324,7 @@ ImportOptiOdomTricycleSummary ImportOptiOdomTricycle(const std::vector<std::stri
       }
     }
   }
-  summary.signs = CheckTricycleSigns(read);
-  if (!summary.signs.Documented() && !options.skip_sign_check) {
-    char message[200];
-    std::snprintf(message, sizeof message,
-                  "the ground truth contradicts the channel signs (correlation of traction ticks "
-                  "with forward motion %.2f, of steering with turning %.2f); nothing written",
-                  summary.signs.traction_correlation, summary.signs.steering_correlation);
-    throw MiswiredError(message);
-  }
+  summary.channel_order = CheckImportedChannelOrder(summary.runs, *model, options.skip_sign_check);
   const FinalPoseErrors nominal =
       EvaluateFinalPoseErrors(*model, model->robot().nominal, AlignRuns(summary.runs), 1);
   summary.nominal_final_error = nominal.per_run_cf;

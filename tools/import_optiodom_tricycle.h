@@ -16,7 +16,7 @@
 //                     steering angle read at t (radians, not ticks, despite the upstream README).
 //
 // Conventions, checked against the ground truth (tests/tricycle_test.cc, and the importer's
-// own sign check below):
+// channel-order check, tools/import_channel_order.h):
 //   - steering sign: positive = counter-clockwise turn, as ours; replaying with the column negated
 //     explains the ground truth far worse (fitted SSR 19.2 vs 0.30 over the 28 runs);
 //   - traction ticks positive = forward;
@@ -82,21 +82,6 @@ RobotModelPtr OptiOdomTricycleNominalModel(const OptiOdomTricycleMetadata& metad
 RunLog OptiOdomTricycleRunLog(const OptiOdomTricycleSession& session,
                               const OptiOdomTricycleRun& run, int session_repetition);
 
-// Signs of the two channels against the ground truth, without any robot parameter: over every
-// cycle k of every run (ground truth on the same rows),
-//   traction: ticks_k against the ground truth's forward motion R(theta_{k-1})^T (p_k - p_{k-1})
-//   steering: ticks_k sin(mean steering_k) against the ground truth's turn theta_k - theta_{k-1}
-// as correlation coefficients sum(a b) / sqrt(sum a^2 sum b^2). The documented signs give both
-// positive (OptiOdom: 0.88-0.94 and 0.73-0.89 per run); a flipped channel makes its correlation
-// negative. A final-pose comparison at nominal parameters is no test: the nominal is so far off
-// (CF 1.2) that driving backwards with the steering flipped (same turning) comes within 25 % of it.
-struct TricycleSignCheck {
-  double traction_correlation = 0.0;
-  double steering_correlation = 0.0;
-  bool Documented() const { return traction_correlation > 0.0 && steering_correlation > 0.0; }
-};
-TricycleSignCheck CheckTricycleSigns(const std::vector<OptiOdomTricycleSession>& sessions);
-
 struct ImportOptiOdomTricycleOptions {
   bool force = false;            // overwrite a data set already in `out`
   bool skip_sign_check = false;  // write even if other channel signs explain the data better
@@ -104,16 +89,16 @@ struct ImportOptiOdomTricycleOptions {
 
 struct ImportOptiOdomTricycleSummary {
   int num_sessions = 0;
-  std::vector<RunLog> runs;  // as written, in dataset.yaml order
-  TricycleSignCheck signs;
+  std::vector<RunLog> runs;   // as written, in dataset.yaml order
+  std::string channel_order;  // the channel-order check's line (tools/import_channel_order.h)
   std::vector<double> nominal_final_error;  // per run: |(dx, dy, wrap dtheta)| (Palacin Eq. 14)
   double nominal_cf = 0.0;                  // their mean
 };
 
-// Reads every session, checks them (one robot, steering in rad within [-pi, pi], signs), and
-// only then writes the data set to `out`. Throws io::InputError for bad input and
-// std::runtime_error when `out` already holds a data set (without force) or the signs fail;
-// nothing is written then.
+// Reads every session, checks them (one robot, steering in rad within [-pi, pi], the channel
+// order and signs: tools/import_channel_order.h), and only then writes the data set to `out`.
+// Throws io::InputError for bad input, std::runtime_error when `out` already holds a data set
+// (without force) and MiswiredError when the channel check fails; nothing is written then.
 ImportOptiOdomTricycleSummary ImportOptiOdomTricycle(
     const std::vector<std::string>& sessions, const std::string& out,
     const ImportOptiOdomTricycleOptions& options = {});

@@ -23,9 +23,9 @@
 #include "io/atomic_file.h"
 #include "io/calibration_block.h"
 #include "tools/effect_list.h"
+#include "tools/everyday_driving_table.h"
 #include "tools/fit_methods.h"
 #include "tools/output_guard.h"
-#include "validation/everyday_driving.h"
 #include "validation/propagated_uncertainty.h"
 #include "validation/rate_units.h"
 #include "validation/residual_dof.h"
@@ -556,7 +556,7 @@ void PrintClockOffsets(const ModelFitResult& fit, const TrackFitData& track) {
               sorted.front(), sorted.back(), mean_sigma);
 }
 
-// Drift per 1, 2, 5 m and ATE RMSE (validation/everyday_driving.h) of the nominal and the
+// Drift per 1, 2, 5 m and ATE RMSE (tools/everyday_driving_table.h) of the nominal and the
 // selected calibration on the held-out runs (the training runs when none is held out).
 void PrintEverydayDriving(const RobotModelInterface& model, const std::vector<RunLog>& logs,
                           const RunSplit& split, const CalibrationCandidate& nominal,
@@ -567,16 +567,9 @@ void PrintEverydayDriving(const RobotModelInterface& model, const std::vector<Ru
   for (const RunLog& log : logs) track_of[log.id] = &log.ground_truth;
   std::vector<const GroundTruthTrack*> tracks;
   for (const AlignedRun& run : runs) tracks.push_back(track_of.at(run.id));
-  const std::vector<double> lengths = EverydayDriftLengths();
-  const EverydayDrivingMetrics before = EvaluateEverydayDriving(
-      model, nominal.parameters, nominal.effects, runs, tracks, lengths, threads);
-  const EverydayDrivingMetrics after = EvaluateEverydayDriving(
-      model, selected.parameters, selected.effects, runs, tracks, lengths, threads);
-  std::printf("\n  %-30s %10s %10s %9s\n",
-              held_out ? "everyday driving, validation" : "everyday driving, training", "nominal",
-              "calibrated", "change");
-  for (const std::string& row : EverydayDrivingRows(before, after))
-    std::printf("%s\n", row.c_str());
+  PrintEverydayDrivingTable(
+      model, runs, tracks, held_out ? "everyday driving, validation" : "everyday driving, training",
+      {&nominal.parameters, &nominal.effects}, {&selected.parameters, &selected.effects}, threads);
 }
 
 // --residuals auto proposing the track: the track and the final pose are fitted and judged on

@@ -12,7 +12,9 @@
 #include "fit/run_split.h"
 #include "fit/segment_cost.h"
 #include "fit/trajectory_split.h"
+#include "models/model_registry.h"
 #include "tools/effect_list.h"
+#include "tools/everyday_driving_table.h"
 #include "validation/generalisation.h"
 
 namespace fitcal::tools {
@@ -87,18 +89,6 @@ void PrintLeaveOneSessionOut(const std::vector<SplitScores>& folds) {
   }
 }
 
-// Refuses the omni3-only flags in one line rather than ignoring them.
-bool RefuseOmni3OnlyOptions(const GeneraliseCommandOptions& o, const std::string& model) {
-  std::string flag;
-  if (!o.clock_map) flag = "--no-clock-map";
-  const GeneraliseCommandOptions defaults;
-  if (o.segment_length_m != defaults.segment_length_m) flag = "--segment-length-m";
-  if (flag.empty()) return false;
-  std::cerr << "fitcal: generalise " << flag << " belongs to the omni3 table (segment cost); "
-            << "not available for model " << model << "\n";
-  return true;
-}
-
 // OptiOdom's checkpoints (every 0.5 m of path, as Sousa et al.) for every run, or nothing when
 // some run's ground truth holds no pose between its start and end (their cost needs the track).
 std::optional<std::vector<std::vector<Segment>>> OptiOdomCheckpoints(
@@ -113,51 +103,62 @@ std::optional<std::vector<std::vector<Segment>>> OptiOdomCheckpoints(
   return out;
 }
 
-}  // namespace
-
-int RunModelGeneraliseCommand(const GeneraliseCommandOptions& options,
-                              const io::DatasetIndex& index, const RobotModelPtr& model) {
-  const Robot& robot = model->robot();
-  if (RefuseOmni3OnlyOptions(options, robot.model)) return 2;
-  SessionKey session_key = SessionKey::kLabel;
-  if (options.sessions == "repetition") {
-    session_key = SessionKey::kPathTypeAndRepetition;
-  } else if (options.sessions != "label") {
-    std::cerr << "fitcal: unknown --sessions '" << options.sessions
-              << "' (available: label, repetition)\n";
-    return 2;
+// What a leave-one-session-out session is (--sessions); false after one line on stderr.
+bool ParseSessionKey(const std::string& text, SessionKey* key) {
+  if (text == "label" || text == "repetition") {
+    *key = text == "label" ? SessionKey::kLabel : SessionKey::kPathTypeAndRepetition;
+    return true;
   }
-  const io::Dataset dataset = LoadRuns(options, index, &robot);
-  const std::vector<AlignedRun> runs = AlignRuns(dataset.runs);
-  TrackCandidates track_candidates;
+  std::cerr << "fitcal: unknown --sessions '" << text << "' (available: label, repetition)\n";
+  return false;
+}
+
+// What the candidates beyond nominal, closed forms and the final-pose fit need, kept alive while
+// `candidates` points into it (never copied or moved once filled).
+struct CandidateInputs {
   std::optional<std::vector<std::vector<Segment>>> checkpoints;
+  std::vector<TrackRun> tracks;
+  std::vector<const GroundTruthTrack*> ground_truth;  // one per run; also for everyday driving
+  TrackCandidates candidates;
+};
+
+// Fills *in for --optiodom, --effects and, on dense ground-truth tracks, the track fit; false
+// after one line on stderr.
+bool PrepareCandidates(const GeneraliseCommandOptions& options, const Robot& robot,
+                       const std::vector<RunLog>& logs, const std::vector<AlignedRun>& runs,
+                       CandidateInputs* in) {
   if (options.optiodom) {
-    checkpoints = OptiOdomCheckpoints(runs, dataset.runs);
-    if (!checkpoints) {
+    in->checkpoints = OptiOdomCheckpoints(runs, logs);
+    if (!in->checkpoints) {
       std::cerr << "fitcal: generalise --optiodom: " << options.logs
                 << ": OptiOdom's method needs a ground-truth track (poses between each run's "
                    "start and end), and some run has only its ends\n";
-      return 2;
+      return false;
     }
-    track_candidates.optiodom_checkpoints = &*checkpoints;
+    in->candidates.optiodom_checkpoints = &*in->checkpoints;
   }
   const std::optional<EffectModel> effect_list =
       ReadEffectList(options.effects, robot, "generalise");
-  if (!effect_list) return 2;
-  std::vector<TrackRun> tracks;
+  if (!effect_list) return false;
   if (!effect_list->empty()) {
-    tracks = PrepareTrackRuns(dataset.runs, WheelChannelMask(robot));
-    track_candidates.tracks = &tracks;
-    track_candidates.effects = *effect_list;
+    in->tracks = PrepareTrackRuns(logs, WheelChannelMask(robot));
+    in->candidates.tracks = &in->tracks;
+    in->candidates.effects = *effect_list;
   }
   // On dense ground-truth tracks (fit/residual_choice.h, as fit --residuals auto decides) the
   // track fit competes too.
-  std::vector<const GroundTruthTrack*> ground_truth;
-  for (const RunLog& log : dataset.runs) ground_truth.push_back(&log.ground_truth);
-  if (MeasureTrackDensity(runs, ground_truth).dense) track_candidates.ground_truth = &ground_truth;
-  ModelFitOptions fit_options;
-  fit_options.ceres.num_threads = options.threads;
+  for (const RunLog& log : logs) in->ground_truth.push_back(&log.ground_truth);
+  if (MeasureTrackDensity(runs, in->ground_truth).dense) {
+    in->candidates.ground_truth = &in->ground_truth;
+  }
+  return true;
+}
 
+// The splits of the table: every ordered pair of path types (or the --train-trajectories
+// selection against the rest, both ways), then the training repetitions of every path type
+// against the others. nullopt after one line on stderr when the selection leaves a side empty.
+std::optional<std::vector<GeneralisationSplit>> TableSplits(const GeneraliseCommandOptions& options,
+                                                            const std::vector<AlignedRun>& runs) {
   std::vector<GeneralisationSplit> splits;
   if (!options.train_trajectories.empty()) {
     std::vector<std::string> labels;
@@ -169,7 +170,7 @@ int RunModelGeneraliseCommand(const GeneraliseCommandOptions& options,
     if (splits.empty()) {
       std::cerr << "fitcal: --train-trajectories '" << options.train_trajectories
                 << "' must select some runs and leave some out\n";
-      return 2;
+      return std::nullopt;
     }
   } else {
     splits = PathTypeSplits(runs);
@@ -182,22 +183,98 @@ int RunModelGeneraliseCommand(const GeneraliseCommandOptions& options,
     splits.push_back(std::move(s));
     break;  // the other direction would train on what was meant to be held out
   }
+  return splits;
+}
+
+// The everyday-driving table `fit` prints (tools/everyday_driving_table.h), nominal against each
+// fit of the split ("fit", "fit (track)": the calibrations `fit` writes), on its held-out runs.
+void PrintEverydayDrivingOfSplit(const RobotModelInterface& model,
+                                 const std::vector<AlignedRun>& runs,
+                                 const std::vector<const GroundTruthTrack*>& ground_truth,
+                                 const SplitScores& scores, int threads) {
+  std::vector<AlignedRun> held_out;
+  std::vector<const GroundTruthTrack*> tracks;
+  for (std::size_t i : scores.split.test) {
+    held_out.push_back(runs[i]);
+    tracks.push_back(ground_truth[i]);
+  }
+  const EffectModel no_effects;
+  const CandidateScore& nominal = scores.candidates.front();
+  for (const CandidateScore& c : scores.candidates) {
+    if (c.name != "fit" && c.name != "fit (track)") continue;
+    PrintEverydayDrivingTable(
+        model, held_out, tracks,
+        scores.split.train_name + " -> " + scores.split.test_name + ": " + c.name,
+        {&nominal.parameters, &no_effects}, {&c.parameters, &no_effects}, threads);
+  }
+}
+
+int Generalise(const GeneraliseCommandOptions& options) {
+  const io::DatasetIndex index = OpenDataset(options).index;
+  const RobotModelPtr model = ReadRobotModelFile(index.robot_path);
+  const Robot& robot = model->robot();
+  SessionKey session_key = SessionKey::kLabel;
+  if (!ParseSessionKey(options.sessions, &session_key)) return 2;
+  const io::Dataset dataset = LoadRuns(options, index, &robot);
+  const std::vector<AlignedRun> runs = AlignRuns(dataset.runs);
+  CandidateInputs inputs;
+  if (!PrepareCandidates(options, robot, dataset.runs, runs, &inputs)) return 2;
+  const std::optional<std::vector<GeneralisationSplit>> splits = TableSplits(options, runs);
+  if (!splits) return 2;
+  ModelFitOptions fit_options;
+  fit_options.ceres.num_threads = options.threads;
 
   std::printf("fitcal generalise: %s robot '%s', data set %s: %zu runs\n\n", robot.model.c_str(),
               robot.name.c_str(), options.logs.c_str(), runs.size());
   PrintSplitTableHeader();
-  for (const GeneralisationSplit& split : splits) {
-    PrintSplitRows(EvaluateSplit(*model, runs, split, fit_options, track_candidates));
+  std::vector<SplitScores> scores;
+  for (const GeneralisationSplit& split : *splits) {
+    scores.push_back(EvaluateSplit(*model, runs, split, fit_options, inputs.candidates));
+    PrintSplitRows(scores.back());
     std::fflush(stdout);
+  }
+  std::printf(
+      "\neveryday driving on each split's held-out runs (ATE RMSE: each run's start pose "
+      "aligned, no scale; drift per window of ground-truth path, validation/everyday_driving.h)"
+      "\n");
+  for (const SplitScores& s : scores) {
+    PrintEverydayDrivingOfSplit(*model, runs, inputs.ground_truth, s, options.threads);
   }
   if (options.leave_one_session_out) {
     std::vector<SplitScores> folds;
     for (const GeneralisationSplit& split : LeaveOneSessionOutSplits(runs, session_key)) {
-      folds.push_back(EvaluateSplit(*model, runs, split, fit_options, track_candidates));
+      folds.push_back(EvaluateSplit(*model, runs, split, fit_options, inputs.candidates));
     }
     if (!folds.empty()) PrintLeaveOneSessionOut(folds);
   }
   return 0;
+}
+
+}  // namespace
+
+void AddGeneraliseOptions(CLI::App& app, GeneraliseCommandOptions& o) {
+  AddDatasetOptions(app, o);
+  app.add_flag("!--no-loso", o.leave_one_session_out, "Skip leave-one-session-out");
+  app.add_option("--train-trajectories", o.train_trajectories,
+                 "Train on labels matching (list or regular expression), test on the rest, "
+                 "and the other way round");
+  app.add_option("--effects", o.effects,
+                 "Library effects: add the track fit alone and with these effects as candidates")
+      ->delimiter(',');
+  app.add_option("--train-reps", o.train_reps,
+                 "Repetitions of every path type that train the split against the other "
+                 "repetitions (default: the first half present)");
+  app.add_option("--sessions", o.sessions,
+                 "A leave-one-session-out session is a trajectory label (label) or a path "
+                 "type + repetition number (repetition)")
+      ->capture_default_str();
+  app.add_flag("--optiodom", o.optiodom,
+               "Also score OptiOdom's method (Sousa et al. 2022: position from the start every "
+               "0.5 m of path) on the same splits");
+}
+
+int RunGeneraliseCommand(const GeneraliseCommandOptions& options) {
+  return RunReportingErrors("fitcal", [&]() -> int { return Generalise(options); });
 }
 
 }  // namespace fitcal::tools

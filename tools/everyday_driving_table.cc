@@ -1,0 +1,24 @@
+#include "tools/everyday_driving_table.h"
+
+#include <cstdio>
+
+#include "validation/everyday_driving.h"
+
+namespace fitcal::tools {
+
+void PrintEverydayDrivingTable(const RobotModelInterface& model,
+                               const std::vector<AlignedRun>& runs,
+                               const std::vector<const GroundTruthTrack*>& tracks,
+                               const std::string& title, const EverydayDrivingColumn& nominal,
+                               const EverydayDrivingColumn& calibrated, int threads) {
+  const std::vector<double> lengths = EverydayDriftLengths();
+  const EverydayDrivingMetrics before = EvaluateEverydayDriving(
+      model, *nominal.parameters, *nominal.effects, runs, tracks, lengths, threads);
+  const EverydayDrivingMetrics after = EvaluateEverydayDriving(
+      model, *calibrated.parameters, *calibrated.effects, runs, tracks, lengths, threads);
+  std::printf("\n  %-30s %10s %10s %9s\n", title.c_str(), "nominal", "calibrated", "change");
+  for (const std::string& row : EverydayDrivingRows(before, after))
+    std::printf("%s\n", row.c_str());
+}
+
+}  // namespace fitcal::tools
