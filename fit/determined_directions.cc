@@ -185,6 +185,7 @@ DirectionAnalysis AnalyseDeterminedDirections(const std::vector<AlignedRun>& tra
     UndeterminedDirection d;
     d.prior_units = v;
     d.posterior_fraction = fraction;
+    d.residual_sigma = out.residual_sigma;
     // One posterior sigma along v, capped at the box's own sigma (beyond it the bounds know more).
     d.one_sigma_step = prior_sigma.cwiseProduct(v) * std::min(fraction, 1.0);
     d.description =
@@ -193,6 +194,21 @@ DirectionAnalysis AnalyseDeterminedDirections(const std::vector<AlignedRun>& tra
   }
   out.ok = true;
   return out;
+}
+
+double PosteriorFractionWith(const UndeterminedDirection& d, const std::vector<AlignedRun>& extra,
+                             const RobotModelInterface& model, const std::vector<double>& p,
+                             const ResidualWeights& weights) {
+  // one_sigma_step = sigma_prior . v * min(f, 1) (AnalyseDeterminedDirections).
+  const Eigen::VectorXd prior_step =
+      d.one_sigma_step / std::max(std::min(d.posterior_fraction, 1.0), 1e-300);
+  const double s2 = std::max(d.residual_sigma * d.residual_sigma, 1e-300);
+  double information = 1.0 / std::max(d.posterior_fraction * d.posterior_fraction, 1e-300);
+  for (const RunJacobian& run : EvaluateRuns(extra, model, p, weights, nullptr, 1)) {
+    if (run.finite && run.jacobian.size() > 0)
+      information += (run.jacobian * prior_step).squaredNorm() / s2;
+  }
+  return 1.0 / std::sqrt(information);
 }
 
 }  // namespace fitcal

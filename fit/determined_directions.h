@@ -33,6 +33,7 @@ struct UndeterminedDirection {
   // together by this much changes the training residuals by one standard deviation.
   Eigen::VectorXd one_sigma_step;
   double posterior_fraction = 0.0;  // posterior sigma / prior sigma along the direction
+  double residual_sigma = 0.0;      // s of the analysis that found it (weighted residual units)
   std::string description;          // the combination in parameter terms, and who sees it most
 };
 
@@ -52,5 +53,13 @@ DirectionAnalysis AnalyseDeterminedDirections(const std::vector<AlignedRun>& tra
                                               const ResidualWeights& weights,
                                               const std::vector<std::vector<Segment>>* segments,
                                               int num_threads);
+
+// Along `d`, the posterior fraction the training runs would give with `extra` runs added, judged
+// at their final poses (Eq. 14, `weights`) with the training residuals' noise s: the data's
+// information 1 / f^2 along the direction plus sum_i |J_i (sigma_prior . v)|^2 / s^2. What the
+// motion advice (fit/motion_advice.h) asks of a run the user could drive.
+double PosteriorFractionWith(const UndeterminedDirection& d, const std::vector<AlignedRun>& extra,
+                             const RobotModelInterface& model, const std::vector<double>& p,
+                             const ResidualWeights& weights);
 
 }  // namespace fitcal

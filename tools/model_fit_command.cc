@@ -16,6 +16,7 @@
 #include "fit/effect_fit.h"
 #include "fit/final_pose_errors.h"
 #include "fit/model_fit.h"
+#include "fit/motion_advice.h"
 #include "fit/result_gate.h"
 #include "fit/run_split.h"
 #include "fit/segment_cost.h"
@@ -862,7 +863,12 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   if (track_data) PrintClockOffsets(fit, *track_data);
   PrintEverydayDriving(*model, logs, split, candidates[0], selected, options.threads);
   if (!fit.has_covariance) std::printf("uncertainty: %s\n", fit.covariance_message.c_str());
-  for (const UndeterminedDirection& d : fit.held_directions) PrintHeldAtNominal(d.description);
+  for (const UndeterminedDirection& d : fit.held_directions) {
+    PrintHeldAtNominal(d.description);
+    const std::vector<MotionThatDetermines> motions =
+        MotionsThatDetermine(d, *model, fit.parameters, settings.weights);
+    std::printf("  %s\n", MotionAdviceLine(motions).c_str());
+  }
   if (halves.judged) {  // the gate's table is on the training runs; the halves judge (below)
     gate.judged_on = "training runs (" + std::to_string(split.training.size()) +
                      "; no held-out runs: judged on held-out " +
