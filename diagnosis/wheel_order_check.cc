@@ -8,7 +8,8 @@
 #include <stdexcept>
 
 #include "diagnosis/statistics.h"
-#include "fit/omni3_ceres_fit.h"
+#include "fit/model_fit.h"
+#include "models/omni3/omni3_robot_model.h"
 #include "fit/segment_cost.h"
 #include "odometry/omni3_replay.h"
 #include "odometry/parallel_for.h"
@@ -57,12 +58,12 @@ Eigen::Matrix3d MappingMatrix(const WheelMapping& m) {
 
 double FittedSumOfSquares(const std::vector<AlignedRun>& runs, const Omni3Robot& robot,
                           const WheelOrderOptions& options) {
-  CeresFitOptions fit;
-  fit.weights = options.weights;
-  fit.num_threads = options.num_threads;
-  fit.compute_covariance = false;
-  fit.max_num_iterations = 50;
-  const Omni3FitResult result = FitOmni3Ceres(runs, robot, fit);
+  ModelFitOptions fit;
+  fit.ceres.weights = options.weights;
+  fit.ceres.num_threads = options.num_threads;
+  fit.ceres.compute_covariance = false;
+  fit.ceres.max_num_iterations = 50;
+  const ModelFitResult result = FitModel(runs, *Omni3ModelOf(robot), fit);
   return 2.0 * result.final_cost;
 }
 

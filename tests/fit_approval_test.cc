@@ -30,9 +30,18 @@ constexpr const char* kFlowerCeresLines[] = {
     "  at_bound: []",
     "  cf_training: {before: 0.0727613984, after: 0.007619401906}",
     "  cf_validation: {before: 0.07260223942, after: 0.007842772719}",
-    "    distance_m: [0.0005307746265, 0.0005342887409, 0.0005318928477]",
-    "    radius_m: [8.174740739e-05, 8.231970382e-05, 8.19659072e-05]",
-    "    angle_deg: [0.03113920202, 0.03018882245, 0.03058191495]",
+    // The sigmas of omni3's own path, in the calibration block every model writes (one key per
+    // parameter with its unit; omni3's path grouped them as distance_m/radius_m/angle_deg
+    // triples): the same digits.
+    "    R_a_m: 0.0005307746265",
+    "    R_b_m: 0.0005342887409",
+    "    R_c_m: 0.0005318928477",
+    "    r_a_m: 8.174740739e-05",
+    "    r_b_m: 8.231970382e-05",
+    "    r_c_m: 8.19659072e-05",
+    "    delta_a_deg: 0.03113920202",
+    "    delta_b_deg: 0.03018882245",
+    "    delta_c_deg: 0.03058191495",
     "  inverse_kinematic_matrix:",
     "    - [-0.0907109481143395, 0.001563791926711912, 0.08878153875422096]",
     "    - [0.05096867034743491, -0.1002874686141022, 0.0503741807584078]",
