@@ -31,8 +31,7 @@
 
 namespace fitcal {
 
-// The scores and the decision of the test above (also those of the omni3-only
-// diagnosis/wheel_order_check.h, until it is retired).
+// The scores and the decision of the test above.
 struct MiswiringScores {
   bool likely_miswired = false;  // another mapping explains the data far better
   double recorded_nominal_ssr = 0.0;

@@ -34,20 +34,21 @@ double ChiSquare1Quantile(double p) {
 }
 
 std::vector<std::string> FindDegenerateData(const std::vector<AlignedRun>& runs,
-                                            const Omni3Robot& robot) {
+                                            const Robot& robot) {
   std::vector<std::string> problems;
-  // A wheel that never turns: every rate exactly zero (an encoder that counts nothing).
-  for (int i = 0; i < omni3::kNumWheels; ++i) {
+  // A wheel that never turns: every rate exactly zero (an encoder that counts nothing). Angle
+  // channels (steering) may rest at zero on straight runs.
+  for (std::size_t i = 0; i < robot.channels.size(); ++i) {
+    if (robot.channels[i].kind != ChannelKind::kWheelRate) continue;
     bool turns = false;
     for (const AlignedRun& run : runs) {
       for (const auto& s : run.samples) turns = turns || s.value[i] != 0.0;
     }
     if (!turns && !runs.empty()) {
-      problems.push_back("wheel " + robot.wheel_names[i] +
-                         " never turns in any run (disconnected encoder or stuck wheel?): its "
-                         "radius r_" +
-                         robot.wheel_names[i] +
-                         " is not determined by the data and stays at the nominal");
+      problems.push_back("wheel " + robot.channels[i].name +
+                         " never turns in any run (disconnected encoder or stuck wheel?): what "
+                         "only it measures (its radius) is not determined by the data and stays "
+                         "at the nominal");
     }
   }
   // Copies: group runs with bitwise-identical encoder samples.
@@ -73,7 +74,9 @@ std::vector<std::string> FindDegenerateData(const std::vector<AlignedRun>& runs,
   if (runs.size() > 1 && distinct == 1) {
     problems.push_back("all " + std::to_string(runs.size()) +
                        " runs have identical encoder logs: one run's 3 final-pose residuals "
-                       "cannot determine the 9 parameters; the fit is underdetermined");
+                       "cannot determine the " +
+                       std::to_string(robot.NumFree()) +
+                       " free parameters; the fit is underdetermined");
   }
   return problems;
 }

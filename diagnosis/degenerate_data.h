@@ -1,10 +1,10 @@
 #pragma once
 // Data that let a fit "converge" without saying anything about some parameters, found and said
-// out loud (STYLE.md habit 8):
+// out loud (STYLE.md habit 8), for every model on the seam:
 //   - a wheel that never turns in any run (disconnected encoder, stuck wheel): its radius has no
 //     influence on any residual, the fit leaves it at the nominal;
 //   - runs with identical encoder logs (a file copied for another run): they add no information,
-//     and when all runs are one, 3 residuals cannot determine 9 parameters;
+//     and when all runs are one, 3 residuals cannot determine the free parameters;
 //   - after the fit, runs whose final-pose error is far beyond the others (gross wheel slip, a
 //     ground-truth file of another run): with a least-squares loss they pull every parameter.
 //
@@ -20,13 +20,14 @@
 #include <vector>
 
 #include "odometry/aligned_run.h"
-#include "odometry/robot_description.h"
+#include "odometry/robot.h"
 
 namespace fitcal {
 
-// One sentence per problem found in the runs before fitting (empty: none).
+// One sentence per problem found in the runs before fitting (empty: none); the runs' channels are
+// the robot's (robot.channels order).
 std::vector<std::string> FindDegenerateData(const std::vector<AlignedRun>& runs,
-                                            const Omni3Robot& robot);
+                                            const Robot& robot);
 
 struct OutlierRun {
   std::string id;

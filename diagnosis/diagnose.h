@@ -4,7 +4,7 @@
 // on held-out repetitions.
 //
 // Procedure (stated once, implemented in Diagnose()):
-//  1. The declared fit: nine parameters on the training final poses (omni3_ceres_fit.h), and its
+//  1. The declared fit: nine parameters on the training final poses (fit/model_fit.h), and its
 //     residual analysis (residual_analysis.h) over all runs.
 //  2. The base of the tracing: the nine parameters refitted on the training tracks
 //     (effect_fit.h), so that every candidate is compared under the same objective.
@@ -46,8 +46,8 @@
 #include "diagnosis/covariate_structure.h"
 #include "diagnosis/residual_analysis.h"
 #include "fit/effect_fit.h"
+#include "fit/final_pose_cost.h"
 #include "fit/model_fit.h"
-#include "fit/omni3_ceres_fit.h"
 
 namespace fitcal {
 

@@ -1,6 +1,6 @@
 #pragma once
-// The NLopt search behind every model's NLopt methods (`--method crs2lm`, ... for omni3 in
-// fit/omni3_nlopt_fit.h, for any model in fit/model_nlopt_fit.h): global methods (the analogues
+// The NLopt search behind every model's NLopt methods (`--method crs2lm`, ...,
+// fit/model_nlopt_fit.h): global methods (the analogues
 // of the genetic algorithm of Palacin Sec. 2.6 / Table 4), local derivative-free methods, and
 // bounded gradient methods (the analogue of MATLAB's fmincon), over per-run final-pose residuals
 // (models/pose_errors.h) that a RunResiduals supplies - in doubles for the value, with the autodiff
@@ -115,8 +115,7 @@ class RunResiduals {
                                    double* jacobian) const = 0;
 };
 
-// How a search went, whatever holds its parameters: NloptSearchResult here, omni3's
-// NloptFitResult (fit/omni3_nlopt_fit.h) with its nine.
+// How a search went (NloptSearchResult adds the parameters).
 struct NloptSearchSummary {
   bool usable = false;           // finite parameters and NLopt stopped on a success code
   std::string termination;       // NLopt's result, e.g. "NLOPT_MAXEVAL_REACHED"

@@ -29,6 +29,7 @@
 #include <ceres/autodiff_cost_function.h>
 
 #include <algorithm>
+#include <array>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -188,6 +189,22 @@ class KinematicModel : public RobotModelInterface {
       throw std::invalid_argument("samples with " + std::to_string(samples.num_channels()) +
                                   " channels replayed by a " + robot_.model + " robot with " +
                                   std::to_string(robot_.NumChannels()));
+    }
+  }
+
+  bool StepMatrix(const double* p, double* m) const override {
+    if constexpr (FinalPoseJacobianKindOf<K>::value != FinalPoseJacobianKind::kLinearInChannels) {
+      return RobotModelInterface::StepMatrix(p, m);
+    } else {
+      // Column i of M: the step of a unit rate on channel i over 1 s (exact: the step is linear).
+      constexpr int N = K::kNumChannels;
+      const auto prepared = kinematics_.Prepare(p);
+      for (int i = 0; i < N; ++i) {
+        std::array<double, N> unit{};
+        unit[i] = 1.0;
+        kinematics_.BodyStep(prepared, unit.data(), 1.0, &m[i], &m[N + i], &m[2 * N + i]);
+      }
+      return true;
     }
   }
 

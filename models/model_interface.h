@@ -130,6 +130,11 @@ class RobotModelInterface {
   virtual std::unique_ptr<const PreparedKinematics<EffectJet>> PrepareKinematics(
       const EffectJet* p) const = 0;
 
+  // For a body step linear in the channel values, dt M(p) w (kLinearInChannels above): M at p,
+  // 3 x robot().NumChannels() row-major (rows x, y, theta), for the final-pose kernel of the NLopt
+  // search (odometry/linear_final_pose_kernel.h); false for other kinematics.
+  virtual bool StepMatrix(const double* /*p*/, double* /*m*/) const { return false; }
+
   // Channel values (robot().channels order) that realise the body twist with parameters p, or
   // false when the model cannot drive that twist (e.g. a sideways motion of a differential drive).
   virtual bool ChannelsForTwist(const double* p, const Twist& twist, double* values) const = 0;

@@ -12,11 +12,15 @@
 
 #include <cmath>
 
-#include "fit/omni3_ceres_fit.h"
+#include "tests/omni3_fit_support.h"
 #include "tools/sim/omni3_simulator.h"
 
 namespace fitcal {
 namespace {
+
+using testing::FitOmni3;
+using testing::FitOmni3Nlopt;
+using testing::Omni3Errors;
 
 struct HonestyCount {
   int inside = 0;
@@ -37,7 +41,7 @@ HonestyCount CountInside(int seeds) {
     for (const auto& run : sim::SimulateOmni3(options)) runs.push_back(AlignRun(run.log));
     CeresFitOptions fit_options;
     fit_options.num_threads = 1;
-    const Omni3FitResult fit = FitOmni3Ceres(runs, robot, fit_options);
+    const ModelFitResult fit = FitOmni3(runs, robot, fit_options);
     EXPECT_TRUE(fit.usable) << "seed " << seed;
     EXPECT_TRUE(fit.has_covariance) << "seed " << seed;
     for (int k = 0; k < omni3::kNumParameters; ++k) {

@@ -9,12 +9,17 @@
 
 #include "diagnosis/degenerate_data.h"
 #include "fit/final_pose_cost.h"
-#include "fit/omni3_ceres_fit.h"
 #include "fit/run_split.h"
+#include "odometry/omni3_replay.h"
+#include "tests/omni3_fit_support.h"
 #include "tools/sim/omni3_simulator.h"
 
 namespace fitcal {
 namespace {
+
+using testing::FitOmni3;
+using testing::FitOmni3Nlopt;
+using testing::Omni3Errors;
 
 std::vector<AlignedRun> Simulate(std::uint64_t seed, int repetitions) {
   sim::Omni3SimulationOptions options;  // documented default noise
@@ -25,6 +30,9 @@ std::vector<AlignedRun> Simulate(std::uint64_t seed, int repetitions) {
   return AlignRuns(logs);
 }
 
+// The simulator's robot as the seam describes it (FindDegenerateData serves every model).
+Robot PalacinRobot() { return Omni3ModelOf(sim::PalacinApr02Robot())->robot(); }
+
 bool Mentions(const std::vector<std::string>& lines, const std::string& text) {
   for (const std::string& line : lines) {
     if (line.find(text) != std::string::npos) return true;
@@ -34,7 +42,7 @@ bool Mentions(const std::vector<std::string>& lines, const std::string& text) {
 
 TEST(DegenerateFit, CleanDataRaiseNoProblem) {
   const std::vector<AlignedRun> runs = Simulate(1, 1);
-  EXPECT_TRUE(FindDegenerateData(runs, sim::PalacinApr02Robot()).empty());
+  EXPECT_TRUE(FindDegenerateData(runs, PalacinRobot()).empty());
 }
 
 TEST(DegenerateFit, WheelThatNeverTurnsIsNamedAndTheFitFinishes) {
@@ -42,10 +50,10 @@ TEST(DegenerateFit, WheelThatNeverTurnsIsNamedAndTheFitFinishes) {
   for (AlignedRun& run : runs) {
     for (auto&& s : run.samples) s.value[2] = 0.0;  // encoder c disconnected
   }
-  const std::vector<std::string> problems = FindDegenerateData(runs, sim::PalacinApr02Robot());
+  const std::vector<std::string> problems = FindDegenerateData(runs, PalacinRobot());
   ASSERT_EQ(problems.size(), 1u);
   EXPECT_NE(problems[0].find("wheel c never turns"), std::string::npos) << problems[0];
-  const Omni3FitResult fit = FitOmni3Ceres(runs, sim::PalacinApr02Robot());
+  const ModelFitResult fit = FitOmni3(runs, sim::PalacinApr02Robot());
   EXPECT_FALSE(fit.termination.empty());
   // r_c has no influence on any residual: the fit cannot move it from the nominal.
   EXPECT_EQ(fit.parameters[omni3::kRadiusIndex + 2], sim::PalacinApr02Robot().nominal.radius_m[2]);
@@ -55,9 +63,9 @@ TEST(DegenerateFit, IdenticalRunsAreNamedAndTheFitFinishes) {
   const std::vector<AlignedRun> simulated = Simulate(1, 1);
   std::vector<AlignedRun> runs(6, simulated[3]);
   for (std::size_t i = 0; i < runs.size(); ++i) runs[i].id = "copy" + std::to_string(i);
-  const std::vector<std::string> problems = FindDegenerateData(runs, sim::PalacinApr02Robot());
+  const std::vector<std::string> problems = FindDegenerateData(runs, PalacinRobot());
   EXPECT_TRUE(Mentions(problems, "all 6 runs have identical encoder logs")) << problems.size();
-  const Omni3FitResult fit = FitOmni3Ceres(runs, sim::PalacinApr02Robot());
+  const ModelFitResult fit = FitOmni3(runs, sim::PalacinApr02Robot());
   EXPECT_FALSE(fit.termination.empty());
   // 3 residuals for 9 parameters: no honest covariance exists, and the fit says so.
   EXPECT_FALSE(fit.has_covariance) << "a covariance was claimed for an underdetermined fit";
@@ -67,7 +75,7 @@ TEST(DegenerateFit, IdenticalRunsAreNamedAndTheFitFinishes) {
   std::vector<AlignedRun> some = simulated;
   some.push_back(simulated[0]);
   some.back().id = "copy-of-" + simulated[0].id;
-  const std::vector<std::string> copies = FindDegenerateData(some, sim::PalacinApr02Robot());
+  const std::vector<std::string> copies = FindDegenerateData(some, PalacinRobot());
   ASSERT_EQ(copies.size(), 1u);
   EXPECT_NE(copies[0].find(simulated[0].id + " and copy-of-" + simulated[0].id), std::string::npos)
       << copies[0];
@@ -95,9 +103,9 @@ TEST(DegenerateFit, OutlierTestThresholdIsTheChiSquareQuantile) {
 TEST(DegenerateFit, GrossSlipIsFlaggedAndTheRobustLossKeepsTheParameters) {
   const std::vector<AlignedRun> all = Simulate(7, 1);
   const Omni3ParameterArray truth = sim::PalacinTable5Parameters().ToArray();
-  const Omni3FitResult clean = FitOmni3Ceres(all, sim::PalacinApr02Robot());
+  const ModelFitResult clean = FitOmni3(all, sim::PalacinApr02Robot());
   ASSERT_TRUE(clean.usable && clean.has_covariance) << clean.covariance_message;
-  const FinalPoseErrors clean_errors = EvaluateFinalPoseErrors(clean.parameters, all);
+  const FinalPoseErrors clean_errors = Omni3Errors(clean.parameters, all);
   std::vector<double> sorted = clean_errors.per_run_cf;
   std::sort(sorted.begin(), sorted.end());
   const double typical = sorted[sorted.size() / 2];
@@ -116,19 +124,19 @@ TEST(DegenerateFit, GrossSlipIsFlaggedAndTheRobustLossKeepsTheParameters) {
   for (auto&& s : slipped[victim].samples) s.value[0] *= 1.0 + slip;
   ASSERT_NEAR(shift_for(1.0 + slip) / typical, 10.0, 1.0);
 
-  const Omni3FitResult least_squares = FitOmni3Ceres(slipped, sim::PalacinApr02Robot());
+  const ModelFitResult least_squares = FitOmni3(slipped, sim::PalacinApr02Robot());
   ASSERT_TRUE(least_squares.usable);
   std::vector<std::string> ids;
   for (const AlignedRun& run : slipped) ids.push_back(run.id);
   const std::vector<OutlierRun> outliers =
-      FindOutlierRuns(ids, EvaluateFinalPoseErrors(least_squares.parameters, slipped).per_run_cf);
+      FindOutlierRuns(ids, Omni3Errors(least_squares.parameters, slipped).per_run_cf);
   ASSERT_EQ(outliers.size(), 1u);
   EXPECT_EQ(outliers[0].id, all[victim].id);
 
   CeresFitOptions robust_options;
   robust_options.loss = CeresRobustLoss::kCauchy;
   robust_options.loss_scale = 3.0 * typical;  // a few times the clean runs' error
-  const Omni3FitResult robust = FitOmni3Ceres(slipped, sim::PalacinApr02Robot(), robust_options);
+  const ModelFitResult robust = FitOmni3(slipped, sim::PalacinApr02Robot(), robust_options);
   ASSERT_TRUE(robust.usable);
   // Tolerance: the clean fit's own uncertainty (4.5 sigma, as tests/omni3_fit_test.cc) around
   // the truth; the slipping run must not push any parameter out of it.

@@ -348,7 +348,8 @@ TEST(FitcalCli, BadInputGivesOneLineAndWritesNothing) {
   TempDir dir;
   const std::string data = MakeDataset(dir);
   const std::string out = dir.Path("calibrated.yaml");
-  const std::string previous = "# a previous calibration that must survive\n";
+  // A robot file of the same robot, so that the fit would overwrite it: what stops it is the data.
+  const std::string previous = ReadFileBytes(kRobot) + "# a previous calibration that must survive\n";
   dir.Write("calibrated.yaml", previous);
 
   // A non-numeric field on line 5 of one encoder file.

@@ -1,4 +1,4 @@
-// End-to-end recovery of known parameters by the Ceres fit (fit/omni3_ceres_fit.h) on data from
+// End-to-end recovery of known parameters by the Ceres fit (fit/model_fit.h) on data from
 // the simulator (tools/sim/omni3_simulator.h), with tolerances derived from the noise.
 
 #include <gtest/gtest.h>
@@ -6,12 +6,17 @@
 #include <cmath>
 
 #include "fit/final_pose_cost.h"
-#include "fit/omni3_ceres_fit.h"
 #include "fit/run_split.h"
+#include "odometry/omni3_replay.h"
+#include "tests/omni3_fit_support.h"
 #include "tools/sim/omni3_simulator.h"
 
 namespace fitcal {
 namespace {
+
+using testing::FitOmni3;
+using testing::FitOmni3Nlopt;
+using testing::Omni3Errors;
 
 using ParameterArray = std::array<double, omni3::kNumParameters>;
 
@@ -36,8 +41,8 @@ TEST(Omni3Fit, NoiseFreeDataLeaveOnlyTheDiscretisationOfEq4) {
   double shift_R[2] = {0.0, 0.0};
   const double periods[2] = {0.010, 0.005};
   for (int i = 0; i < 2; ++i) {
-    const Omni3FitResult fit =
-        FitOmni3Ceres(Simulate(NoiseFree(periods[i])), sim::PalacinApr02Robot());
+    const ModelFitResult fit =
+        FitOmni3(Simulate(NoiseFree(periods[i])), sim::PalacinApr02Robot());
     ASSERT_TRUE(fit.usable) << fit.termination << " " << fit.message;
     for (int w = 0; w < 3; ++w) {
       shift_R[i] +=
@@ -57,7 +62,7 @@ TEST(Omni3Fit, NoiseFreeDataLeaveOnlyTheDiscretisationOfEq4) {
 
 struct NoisyFit {
   RunSplit split;
-  Omni3FitResult fit;
+  ModelFitResult fit;
 };
 
 NoisyFit FitDefaultNoise(std::uint64_t seed, bool swap_columns_a_b = false) {
@@ -72,7 +77,7 @@ NoisyFit FitDefaultNoise(std::uint64_t seed, bool swap_columns_a_b = false) {
   }
   NoisyFit out;
   out.split = SplitByRepetition(AlignRuns(logs), {1, 2, 3, 4, 5});
-  out.fit = FitOmni3Ceres(out.split.training, sim::PalacinApr02Robot());
+  out.fit = FitOmni3(out.split.training, sim::PalacinApr02Robot());
   return out;
 }
 
@@ -83,7 +88,7 @@ constexpr double kSigmas = 4.5;
 
 TEST(Omni3Fit, RecoversTheTrueParametersWithinTheirUncertainty) {
   const NoisyFit result = FitDefaultNoise(1);
-  const Omni3FitResult& fit = result.fit;
+  const ModelFitResult& fit = result.fit;
   ASSERT_TRUE(fit.usable) << fit.termination << " " << fit.message;
   ASSERT_TRUE(fit.has_covariance) << fit.covariance_message;
   const ParameterArray truth = sim::PalacinTable5Parameters().ToArray();
@@ -103,7 +108,7 @@ TEST(Omni3Fit, ValidationCfIsWithinTenPercentOfTheTrueParameters) {
   ASSERT_TRUE(result.fit.usable);
   const ParameterArray truth = sim::PalacinTable5Parameters().ToArray();
   const ParameterArray nominal = sim::PalacinNominalParameters().ToArray();
-  const double cf_fit = EvaluateFinalPoseErrors(result.fit.parameters, result.split.validation).cf;
+  const double cf_fit = Omni3Errors(result.fit.parameters, result.split.validation).cf;
   const double cf_true = EvaluateFinalPoseErrors(truth, result.split.validation).cf;
   const double cf_nominal = EvaluateFinalPoseErrors(nominal, result.split.validation).cf;
   EXPECT_LE(cf_fit, 1.10 * cf_true);
@@ -145,7 +150,7 @@ TEST(Omni3Fit, RejectsInvalidOptions) {
   options.weights.position_sigma_m = 0.0;
   std::string error;
   EXPECT_FALSE(options.IsValid(&error));
-  EXPECT_THROW(FitOmni3Ceres({}, sim::PalacinApr02Robot()), std::invalid_argument);
+  EXPECT_THROW(FitOmni3({}, sim::PalacinApr02Robot()), std::invalid_argument);
 }
 
 }  // namespace

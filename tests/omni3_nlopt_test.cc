@@ -1,4 +1,4 @@
-// The NLopt back end (fit/omni3_nlopt_fit.h) against the Ceres fit on simulated flower data,
+// The NLopt back end (fit/model_nlopt_fit.h) on omni3 against the Ceres fit on simulated flower data,
 // seed reproducibility, the Ceres objective/loss options, and what strategy STA cannot determine.
 
 #include <gtest/gtest.h>
@@ -6,17 +6,20 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <memory>
 
 #include "fit/final_pose_cost.h"
-#include "fit/omni3_ceres_fit.h"
-#include "fit/omni3_nlopt_fit.h"
+#include "fit/final_pose_residual.h"
 #include "fit/strategies.h"
+#include "tests/omni3_fit_support.h"
 #include "tools/sim/omni3_simulator.h"
 
 namespace fitcal {
 namespace {
+
+using testing::FitOmni3;
+using testing::FitOmni3Nlopt;
+using testing::Omni3Errors;
 
 std::vector<AlignedRun> Simulate(const sim::Omni3SimulationOptions& options) {
   std::vector<RunLog> logs;
@@ -39,17 +42,17 @@ const std::vector<AlignedRun>& CleanFlower() {
 double CeresOptimumCf(const std::vector<AlignedRun>& runs) {
   CeresFitOptions options;
   options.compute_covariance = false;
-  const Omni3FitResult squares = FitOmni3Ceres(runs, sim::PalacinApr02Robot(), options);
+  const ModelFitResult squares = FitOmni3(runs, sim::PalacinApr02Robot(), options);
   options.objective = FinalPoseObjective::kSumOfNorms;
-  const Omni3FitResult norms = FitOmni3Ceres(runs, sim::PalacinApr02Robot(), options);
+  const ModelFitResult norms = FitOmni3(runs, sim::PalacinApr02Robot(), options);
   EXPECT_TRUE(squares.usable && norms.usable);
-  return std::min(EvaluateFinalPoseErrors(squares.parameters, runs).cf,
-                  EvaluateFinalPoseErrors(norms.parameters, runs).cf);
+  return std::min(Omni3Errors(squares.parameters, runs).cf,
+                  Omni3Errors(norms.parameters, runs).cf);
 }
 
 // J^T J of the stacked final-pose residuals at p (autodiff through the same functor).
 Eigen::Matrix<double, 9, 9> GaussNewtonMatrix(const std::vector<AlignedRun>& runs,
-                                              const Omni3ParameterArray& p) {
+                                              const std::vector<double>& p) {
   Eigen::Matrix<double, 9, 9> jtj = Eigen::Matrix<double, 9, 9>::Zero();
   for (const AlignedRun& run : runs) {
     std::unique_ptr<ceres::CostFunction> cost(Omni3FinalPoseResidual::Create(run, {}));
@@ -73,8 +76,8 @@ TEST(StrategySta, CannotPinDownTheWheelDistances) {
   const std::vector<AlignedRun> sta = SelectRuns(all, ParseStrategy("STA"), {1});
   ASSERT_EQ(sta.size(), 3u);
   CeresFitOptions options;
-  const Omni3FitResult fit = FitOmni3Ceres(sta, sim::PalacinApr02Robot(), options);
-  const Omni3FitResult fit_ste = FitOmni3Ceres(all, sim::PalacinApr02Robot(), options);
+  const ModelFitResult fit = FitOmni3(sta, sim::PalacinApr02Robot(), options);
+  const ModelFitResult fit_ste = FitOmni3(all, sim::PalacinApr02Robot(), options);
   ASSERT_TRUE(fit_ste.usable);
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 9, 9>> eig_sta(
       GaussNewtonMatrix(sta, fit.parameters));
@@ -112,9 +115,9 @@ TEST_P(EveryMethod, ReachesTheCeresOptimumOnCleanData) {
   options.local_polish = info.global;
   options.local_polish_evaluations = 2000;
   const std::vector<AlignedRun> runs = SelectRuns(CleanFlower(), ParseStrategy("STB"), {1});
-  const NloptFitResult fit = FitOmni3Nlopt(runs, sim::PalacinApr02Robot(), options);
+  const NloptSearchResult fit = FitOmni3Nlopt(runs, sim::PalacinApr02Robot(), options);
   ASSERT_TRUE(fit.usable) << fit.message;
-  const double cf = EvaluateFinalPoseErrors(fit.parameters, runs).cf;
+  const double cf = Omni3Errors(fit.parameters, runs).cf;
   EXPECT_NEAR(cf, fit.final_cf, 1e-9 * fit.initial_cf) << "objective and CF evaluation disagree";
   ASSERT_FALSE(fit.trace.empty());
   for (std::size_t i = 1; i < fit.trace.size(); ++i) {
@@ -143,19 +146,19 @@ TEST(NloptSeeds, SameSeedSameBitsOnAnyThreadCountOtherSeedOtherPath) {
   options.max_evaluations = 1500;
   options.seed = 7;
   options.num_threads = 1;
-  const NloptFitResult a = FitOmni3Nlopt(runs, sim::PalacinApr02Robot(), options);
+  const NloptSearchResult a = FitOmni3Nlopt(runs, sim::PalacinApr02Robot(), options);
   options.num_threads = 2;
-  const NloptFitResult b = FitOmni3Nlopt(runs, sim::PalacinApr02Robot(), options);
+  const NloptSearchResult b = FitOmni3Nlopt(runs, sim::PalacinApr02Robot(), options);
   options.seed = 8;
-  const NloptFitResult c = FitOmni3Nlopt(runs, sim::PalacinApr02Robot(), options);
-  EXPECT_EQ(0, std::memcmp(a.parameters.data(), b.parameters.data(), sizeof(a.parameters)));
+  const NloptSearchResult c = FitOmni3Nlopt(runs, sim::PalacinApr02Robot(), options);
+  EXPECT_EQ(a.parameters, b.parameters);  // bit for bit (no NaN, no -0 here)
   EXPECT_EQ(a.evaluations, b.evaluations);
   ASSERT_EQ(a.trace.size(), b.trace.size());
   for (std::size_t i = 0; i < a.trace.size(); ++i) {
     EXPECT_EQ(a.trace[i].evaluation, b.trace[i].evaluation);
     EXPECT_EQ(a.trace[i].best_cf, b.trace[i].best_cf);
   }
-  EXPECT_NE(0, std::memcmp(a.parameters.data(), c.parameters.data(), sizeof(a.parameters)))
+  EXPECT_NE(a.parameters, c.parameters)
       << "seed 8 followed exactly the path of seed 7: the seed is not used";
 }
 
@@ -181,16 +184,16 @@ TEST(CeresOptions, DoglegAndEq14AndRobustLossesAgainstOneSlippingRun) {
   std::vector<AlignedRun> runs = CleanFlower();
   CeresFitOptions options;
   options.compute_covariance = false;
-  const Omni3FitResult clean = FitOmni3Ceres(runs, sim::PalacinApr02Robot(), options);
+  const ModelFitResult clean = FitOmni3(runs, sim::PalacinApr02Robot(), options);
   options.trust_region = CeresTrustRegion::kDogleg;
-  const Omni3FitResult dogleg = FitOmni3Ceres(runs, sim::PalacinApr02Robot(), options);
+  const ModelFitResult dogleg = FitOmni3(runs, sim::PalacinApr02Robot(), options);
   ASSERT_TRUE(clean.usable && dogleg.usable);
   for (int k = 0; k < omni3::kNumParameters; ++k) {
     // Both converge to function tolerance 1e-12 on a well-conditioned problem.
     EXPECT_NEAR(dogleg.parameters[k], clean.parameters[k], 1e-6) << k;
   }
   runs[4].final_ground_truth.x += 0.3;
-  auto error = [&](const Omni3FitResult& f) {
+  auto error = [&](const ModelFitResult& f) {
     double e = 0.0;
     for (int k = 0; k < omni3::kNumParameters; ++k) {
       e += std::pow(f.parameters[k] - clean.parameters[k], 2);
@@ -198,25 +201,23 @@ TEST(CeresOptions, DoglegAndEq14AndRobustLossesAgainstOneSlippingRun) {
     return std::sqrt(e);
   };
   options.trust_region = CeresTrustRegion::kLevenbergMarquardt;
-  const double plain = error(FitOmni3Ceres(runs, sim::PalacinApr02Robot(), options));
+  const double plain = error(FitOmni3(runs, sim::PalacinApr02Robot(), options));
   for (CeresRobustLoss loss : {CeresRobustLoss::kHuber, CeresRobustLoss::kCauchy}) {
     CeresFitOptions robust = options;
     robust.loss = loss;
     robust.loss_scale = 0.01;
-    const Omni3FitResult fit = FitOmni3Ceres(runs, sim::PalacinApr02Robot(), robust);
+    const ModelFitResult fit = FitOmni3(runs, sim::PalacinApr02Robot(), robust);
     EXPECT_TRUE(fit.usable) << ToString(loss);
     EXPECT_LT(error(fit), plain / 3.0) << ToString(loss);
   }
   CeresFitOptions eq14 = options;
   eq14.objective = FinalPoseObjective::kSumOfNorms;
-  const Omni3FitResult fit14 = FitOmni3Ceres(runs, sim::PalacinApr02Robot(), eq14);
+  const ModelFitResult fit14 = FitOmni3(runs, sim::PalacinApr02Robot(), eq14);
   EXPECT_TRUE(fit14.usable) << fit14.message;
   EXPECT_LT(error(fit14), plain / 3.0);
   // Eq. 14's objective must minimise Eq. 14 at least as well as least squares does.
-  EXPECT_LE(EvaluateFinalPoseErrors(fit14.parameters, runs).cf,
-            EvaluateFinalPoseErrors(
-                FitOmni3Ceres(runs, sim::PalacinApr02Robot(), options).parameters, runs)
-                .cf);
+  EXPECT_LE(Omni3Errors(fit14.parameters, runs).cf,
+            Omni3Errors(FitOmni3(runs, sim::PalacinApr02Robot(), options).parameters, runs).cf);
   std::string why;
   eq14.loss = CeresRobustLoss::kHuber;
   EXPECT_FALSE(eq14.IsValid(&why));

@@ -176,8 +176,8 @@ std::string TraceCsv(const std::vector<Row>& rows) {
   return o.str();
 }
 
-// The robot and runs of a data set, for any model; omni3 keeps its own loader, CF and fit path
-// (its NLopt methods search on its fast final-pose kernel), so its tables stay as they were.
+// The robot and runs of a data set, for any model; omni3 keeps its own loader and CF (its tables'
+// CFs stay as they were); every model fits through the seam (tools/fit_methods.h).
 struct CompareData {
   RobotModelPtr model;
   std::optional<Omni3Robot> omni3;
@@ -219,19 +219,8 @@ struct FitOutcome {
 
 FitOutcome RunMethod(const FitMethod& method, const std::vector<AlignedRun>& training,
                      const CompareData& d, const FitMethodSettings& s) {
-  FitOutcome out;
-  if (d.omni3) {
-    const FitMethodOutcome o = method.run(training, *d.omni3, s);
-    out = {{o.fit.parameters.begin(), o.fit.parameters.end()},
-           o.evaluations,
-           o.fit.termination,
-           o.fit.usable,
-           o.trace};
-  } else {
-    const ModelFitMethodOutcome o = method.run_model(training, *d.model, s);
-    out = {o.fit.parameters, o.evaluations, o.fit.termination, o.fit.usable, o.trace};
-  }
-  return out;
+  const ModelFitMethodOutcome o = method.run_model(training, *d.model, s);
+  return {o.fit.parameters, o.evaluations, o.fit.termination, o.fit.usable, o.trace};
 }
 
 // "all" (every trajectory of the data set) and "<prefix>*" (the labels starting with prefix, e.g.

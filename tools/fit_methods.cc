@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <tuple>
 
-#include "fit/final_pose_cost.h"
 #include "fit/final_pose_errors.h"
 #include "fit/model_nlopt_fit.h"
 #include "fit/residual_choice.h"
@@ -36,23 +35,7 @@ CeresFitOptions CeresOptionsFor(CeresTrustRegion trust_region, const FitMethodSe
   return options;
 }
 
-FitMethodOutcome RunCeres(CeresTrustRegion trust_region, const std::vector<AlignedRun>& training,
-                          const Omni3Robot& robot, const FitMethodSettings& settings) {
-  const CeresFitOptions options = CeresOptionsFor(trust_region, settings);
-  FitMethodOutcome out;
-  out.fit = FitOmni3Ceres(training, robot, options);
-  out.evaluations = out.fit.num_residual_evaluations + out.fit.num_jacobian_evaluations;
-  out.objective = ObjectiveText(options.objective, options.loss, options.loss_scale);
-  // Ceres reports no per-evaluation CF: the trace holds the start and the end.
-  out.trace.push_back(
-      {1, EvaluateFinalPoseErrors(robot.nominal.ToArray(), training, settings.threads).cf, 0.0});
-  out.trace.push_back({out.evaluations,
-                       EvaluateFinalPoseErrors(out.fit.parameters, training, settings.threads).cf,
-                       out.fit.solve_time_s});
-  return out;
-}
-
-// The NLopt options of a method for these settings, shared by omni3 and every other model.
+// The NLopt options of a method for these settings.
 NloptFitOptions NloptOptionsFor(NloptMethod method, const FitMethodSettings& settings) {
   NloptFitOptions options;
   options.method = method;
@@ -67,28 +50,6 @@ NloptFitOptions NloptOptionsFor(NloptMethod method, const FitMethodSettings& set
     options.local_polish_evaluations = std::min(2000, std::max(1, options.max_evaluations / 5));
   }
   return options;
-}
-
-FitMethodOutcome RunNlopt(NloptMethod method, const std::vector<AlignedRun>& training,
-                          const Omni3Robot& robot, const FitMethodSettings& settings) {
-  const NloptFitOptions options = NloptOptionsFor(method, settings);
-  const NloptFitResult r = FitOmni3Nlopt(training, robot, options);
-  FitMethodOutcome out;
-  out.fit.usable = r.usable;
-  out.fit.termination = r.termination;
-  out.fit.message = r.message;
-  out.fit.iterations = r.evaluations;
-  out.fit.num_residual_evaluations = r.evaluations - r.gradient_evaluations;
-  out.fit.num_jacobian_evaluations = r.gradient_evaluations;
-  out.fit.solve_time_s = r.solve_time_s;
-  out.fit.parameters = r.parameters;
-  out.fit.at_bound = r.at_bound;
-  out.fit.covariance_message = "no covariance from NLopt methods (the ceres method computes one)";
-  out.evaluations = r.evaluations;
-  out.objective = ObjectiveText(options.objective, CeresRobustLoss::kNone, 0.0) + ", seed " +
-                  std::to_string(options.seed);
-  out.trace = r.trace;
-  return out;
 }
 
 // What the residuals compare, in words, before the final poses' objective ("" for final poses
@@ -170,9 +131,6 @@ std::vector<FitMethod> MakeMethods() {
         std::tuple{"ceres-dogleg", "Ceres dogleg", CeresTrustRegion::kDogleg}}) {
     const CeresTrustRegion trust_region = region;
     methods.push_back({name, description,
-                       [trust_region](const auto& t, const auto& r, const auto& s) {
-                         return RunCeres(trust_region, t, r, s);
-                       },
                        [trust_region](const auto& t, const auto& m, const auto& s) {
                          return RunModelCeres(trust_region, t, m, s);
                        }});
@@ -180,9 +138,6 @@ std::vector<FitMethod> MakeMethods() {
   for (const NloptMethodInfo& info : NloptMethods()) {
     const NloptMethod method = info.method;
     methods.push_back({info.name, info.description,
-                       [method](const auto& t, const auto& r, const auto& s) {
-                         return RunNlopt(method, t, r, s);
-                       },
                        [method](const auto& t, const auto& m, const auto& s) {
                          return RunModelNlopt(method, t, m, s);
                        }});

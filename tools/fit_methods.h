@@ -2,8 +2,7 @@
 // The registry of fit methods behind `--method` (fit) and `--methods` (compare): Ceres
 // (Levenberg-Marquardt or dogleg) and every NLopt method of fit/nlopt_search.h, one entry each,
 // for every robot model: `run_model` fits any model through the seam (fit/model_fit.h,
-// fit/model_nlopt_fit.h), `run` is omni3's own path (its Ceres fit and the NLopt search on its
-// fast final-pose kernel, fit/omni3_nlopt_fit.h), which the omni3 commands keep.
+// fit/model_nlopt_fit.h).
 
 #include <cstdint>
 #include <functional>
@@ -11,8 +10,7 @@
 #include <vector>
 
 #include "fit/model_fit.h"
-#include "fit/omni3_ceres_fit.h"
-#include "fit/omni3_nlopt_fit.h"
+#include "fit/nlopt_search.h"
 #include "models/model_interface.h"
 #include "tools/solver_options.h"
 
@@ -41,16 +39,9 @@ struct FitMethodSettings {
   std::function<void(const NloptProgress&)> progress;  // NLopt only
 };
 
-struct FitMethodOutcome {
-  Omni3FitResult fit;     // parameters, termination, usable, (Ceres) covariance
-  int evaluations = 0;    // objective evaluations over all training runs (Ceres: residual +
-                          // Jacobian evaluations)
-  std::string objective;  // what was minimised, in words
-  std::vector<ConvergencePoint> trace;  // best CF vs evaluations
-};
-
-// The same for any model: the fit's result shape is the generic Ceres fit's (NLopt methods leave
-// the covariance out and say so in covariance_message).
+// A method's fit: the generic Ceres fit's result shape (NLopt methods leave the covariance out and
+// say so in covariance_message), the objective evaluations over all training runs (Ceres: residual
+// + Jacobian evaluations), what was minimised in words, and the best CF vs evaluations.
 struct ModelFitMethodOutcome {
   ModelFitResult fit;
   int evaluations = 0;
@@ -61,9 +52,6 @@ struct ModelFitMethodOutcome {
 struct FitMethod {
   std::string name;
   std::string description;
-  std::function<FitMethodOutcome(const std::vector<AlignedRun>&, const Omni3Robot&,
-                                 const FitMethodSettings&)>
-      run;
   std::function<ModelFitMethodOutcome(const std::vector<AlignedRun>&, const RobotModelInterface&,
                                       const FitMethodSettings&)>
       run_model;

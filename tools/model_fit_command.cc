@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "diagnosis/channel_order_check.h"
+#include "diagnosis/degenerate_data.h"
 #include "fit/correlation.h"
 #include "fit/effect_fit.h"
 #include "fit/final_pose_errors.h"
@@ -226,8 +227,6 @@ std::vector<CalibrationCandidate> Candidates(const RobotModelInterface& model,
   return out;
 }
 
-}  // namespace
-
 bool PrintGate(const std::vector<CalibrationCandidate>& candidates, const GateDecision& gate,
                const std::string& effects_line) {
   std::printf("\nresult gate, CF on %s:\n", gate.judged_on.c_str());
@@ -257,8 +256,6 @@ void RecordFitSource(const FitCommandOptions& options, const std::vector<RunLog>
   s.training_runs = static_cast<int>(split.training.size());
   s.validation_runs = static_cast<int>(split.validation.size());
 }
-
-namespace {
 
 io::CalibrationBlock MakeRecord(const FitCommandOptions& options, const RobotModelInterface& model,
                                 const std::vector<RunLog>& logs, const RunSplit& split,
@@ -750,7 +747,30 @@ bool ReportHalves(const HalvesJudgement& j, int num_blocks) {
   return false;
 }
 
-}  // namespace
+// What the fit itself cannot notice, said after it: training runs whose final-pose error under
+// the fit is far beyond the others' (diagnosis/degenerate_data.h: gross slip, a ground truth of
+// another run), and parameters that stopped on their bounds.
+void PrintFitWarnings(const FitCommandOptions& options, const RobotModelInterface& model,
+                      const RunSplit& split, const ModelFitResult& fit) {
+  if (fit.usable || fit.stopped_early) {
+    std::vector<std::string> ids;
+    for (const AlignedRun& run : split.training) ids.push_back(run.id);
+    const FinalPoseErrors errors =
+        EvaluateFinalPoseErrors(model, fit.parameters, split.training, options.threads);
+    for (const OutlierRun& o : FindOutlierRuns(ids, errors.per_run_cf)) {
+      std::printf(
+          "warning: run %s: final-pose error %.1fx the median run's (gross wheel slip or a "
+          "ground truth of another run?); a robust loss limits its pull\n",
+          o.id.c_str(), o.error_ratio);
+    }
+  }
+  if (std::find(fit.at_bound.begin(), fit.at_bound.end(), true) != fit.at_bound.end()) {
+    std::printf(
+        "warning: a parameter stopped on its bound; the model may be absorbing an effect it "
+        "does not contain, or the bounds are too tight\n");
+  }
+}
+
 
 int StoppedEarlyExit(bool selected_fit_stopped_early, const std::string& termination) {
   if (!selected_fit_stopped_early) return 0;
@@ -764,6 +784,8 @@ int StoppedEarlyExit(bool selected_fit_stopped_early, const std::string& termina
 void PrintHeldAtNominal(const std::string& direction) {
   std::printf("held at nominal, not determined by the training runs: %s\n", direction.c_str());
 }
+
+}  // namespace
 
 int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex& index,
                        const RobotModelPtr& model) {
@@ -806,6 +828,9 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   if (!options.skip_wheel_order_check &&
       ChannelsLookMiswired(options, *model, split.training, logs)) {
     return 4;
+  }
+  for (const std::string& problem : FindDegenerateData(split.training, robot)) {
+    std::printf("warning: %s\n", problem.c_str());
   }
   std::optional<std::vector<TrackRun>> training_tracks;
   if (!effects_to_fit->empty()) {
@@ -869,6 +894,7 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
         MotionsThatDetermine(d, *model, fit.parameters, settings.weights);
     std::printf("  %s\n", MotionAdviceLine(motions).c_str());
   }
+  PrintFitWarnings(options, *model, split, fit);
   if (halves.judged) {  // the gate's table is on the training runs; the halves judge (below)
     gate.judged_on = "training runs (" + std::to_string(split.training.size()) +
                      "; no held-out runs: judged on held-out " +

@@ -4,7 +4,9 @@
 #include <set>
 #include <stdexcept>
 
+#include "fit/final_pose_cost.h"
 #include "fit/final_pose_errors.h"
+#include "models/omni3/omni3_robot_model.h"
 
 namespace fitcal {
 namespace {
@@ -83,8 +85,10 @@ CrossValidationResult LeaveOneRepetitionOut(const std::vector<AlignedRun>& runs,
 CrossValidationResult LeaveOneRepetitionOut(const std::vector<AlignedRun>& runs,
                                             const Omni3Robot& robot,
                                             const CeresFitOptions& options) {
-  CeresFitOptions fold_options = options;
-  fold_options.compute_covariance = false;
+  ModelFitOptions fold_options;
+  fold_options.ceres = options;
+  fold_options.ceres.compute_covariance = false;
+  const std::shared_ptr<const Omni3Model> model = Omni3ModelOf(robot);
   const Omni3ParameterArray nominal = robot.nominal.ToArray();
   const auto as_array = [](const std::vector<double>& p) {
     Omni3ParameterArray a{};
@@ -94,9 +98,8 @@ CrossValidationResult LeaveOneRepetitionOut(const std::vector<AlignedRun>& runs,
   return CrossValidate(
       runs, std::vector<double>(nominal.begin(), nominal.end()),
       [&](const std::vector<AlignedRun>& training) {
-        const Omni3FitResult fit = FitOmni3Ceres(training, robot, fold_options);
-        return FoldFit{fit.usable, fit.termination,
-                       std::vector<double>(fit.parameters.begin(), fit.parameters.end())};
+        const ModelFitResult fit = FitModel(training, *model, fold_options);
+        return FoldFit{fit.usable, fit.termination, fit.parameters};
       },
       [&](const std::vector<double>& p, const std::vector<AlignedRun>& on) {
         return EvaluateFinalPoseErrors(as_array(p), on, options.num_threads).cf;

@@ -5,14 +5,13 @@
 // repetitions it saw; the spread of the validation CF shows how well it generalises.
 //
 // Any model on the seam refits with the bounded final-pose fit (fit/model_fit.h, undetermined
-// directions held as `fitcal fit` holds them); omni3 robots refit with the paper's Ceres fit
-// (fit/omni3_ceres_fit.h), as `fitcal fit` does for them.
+// directions held as `fitcal fit` holds them); the omni3 overload takes the omni3 loader's robot
+// and scores with omni3's own CF (fit/final_pose_cost.h).
 
 #include <string>
 #include <vector>
 
 #include "fit/model_fit.h"
-#include "fit/omni3_ceres_fit.h"
 #include "models/model_interface.h"
 #include "odometry/aligned_run.h"
 #include "odometry/robot_description.h"

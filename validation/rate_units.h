@@ -1,7 +1,6 @@
 #pragma once
-// The likely-units check for every model (the omni3 fit has its own,
-// diagnosis/wheel_order_check.h): encoder rates logged in deg/s, rpm or rev/s and read as rad/s
-// scale every wheel's travel by the same factor, which no calibration inside the bounds can undo -
+// The likely-units check for every model: encoder rates logged in deg/s, rpm or rev/s and read
+// as rad/s scale every wheel's travel by the same factor, which no calibration inside the bounds can undo -
 // and which the fit would otherwise absorb into absurd parameters or blame on the wiring. The
 // nominal robot's odometry path length (translation + kTurnLengthM x rotation, replayed through the
 // model's own kinematics) against the ground truth's over the same windows tells it: a ratio near 1

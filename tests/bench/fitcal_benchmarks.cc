@@ -9,11 +9,12 @@
 #include <cstdlib>
 #include <random>
 
-#include "fit/omni3_ceres_fit.h"
+#include "fit/model_fit.h"
 #include "fit/run_split.h"
 #include "io/dataset.h"
-#include "io/robot_yaml.h"
-#include "odometry/omni3_final_pose_kernel.h"
+#include "models/model_registry.h"
+#include "models/omni3/omni3_robot_model.h"
+#include "odometry/linear_final_pose_kernel.h"
 #include "odometry/omni3_replay.h"
 #include "tools/sim/omni3_simulator.h"
 
@@ -61,32 +62,36 @@ void BM_ReplayJet9(benchmark::State& state) {
 BENCHMARK(BM_ReplayJet9)->Arg(400);
 
 // The final pose of every training run of data/flower (180 runs): the unit of an NLopt
-// evaluation, by the replay (/0) and by the final-pose kernel (/1), on one core.
+// evaluation, by the model's replay (/0) and by the final-pose kernel of a model linear in its
+// channels (/1, odometry/linear_final_pose_kernel.h, what fit/model_nlopt_fit.h evaluates), on one
+// core.
 void BM_FinalPoses180Runs(benchmark::State& state) {
   const io::Dataset dataset = io::LoadDataset(kData);
   const RunSplit split = SplitByRepetition(AlignRuns(dataset.runs), {1, 2, 3, 4, 5});
-  std::vector<omni3::FinalPoseKernel> kernels;
+  std::vector<LinearFinalPoseKernel> kernels;
   std::size_t samples = 0;
   for (const AlignedRun& run : split.training) {
     kernels.emplace_back(run.samples);
     samples += run.samples.size();
   }
-  const auto p = sim::PalacinTable5Parameters().ToArray();
+  const auto table5 = sim::PalacinTable5Parameters().ToArray();
+  const std::vector<double> p(table5.begin(), table5.end());
+  const Omni3Model& model = DefaultOmni3Model();
   const bool use_kernel = state.range(0) != 0;
+  std::vector<double> m(9);
   for (auto _ : state) {
-    const Eigen::Matrix3d m_inv = omni3::InverseKinematicMatrix(p.data());
+    model.StepMatrix(p.data(), m.data());
     double sum = 0.0;
     for (std::size_t i = 0; i < kernels.size(); ++i) {
       const AlignedRun& run = split.training[i];
-      const Pose2d end = use_kernel ? kernels[i].FinalPose(m_inv, run.start)
-                                    : omni3::ReplayWithMatrix(m_inv, run.samples, 0,
-                                                              run.samples.size(), run.start);
+      const Pose2d end = use_kernel ? kernels[i].FinalPose(m.data(), run.start)
+                                    : model.ReplayFinalPose(p.data(), run.samples, run.start);
       sum += end.x + end.y + end.theta;
     }
     benchmark::DoNotOptimize(sum);
   }
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(samples));
-  state.SetLabel(use_kernel ? "FinalPoseKernel" : "ReplayWithMatrix");
+  state.SetLabel(use_kernel ? "LinearFinalPoseKernel" : "model replay");
 }
 BENCHMARK(BM_FinalPoses180Runs)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
@@ -101,16 +106,16 @@ BENCHMARK(BM_LoadFlowerDataset)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_CeresFitFlower180Runs(benchmark::State& state) {
   const io::Dataset dataset = io::LoadDataset(kData);
-  const Omni3Robot robot = io::ReadOmni3Robot(dataset.robot_path);
+  const RobotModelPtr model = ReadRobotModelFile(dataset.robot_path);
   const RunSplit split = SplitByRepetition(AlignRuns(dataset.runs), {1, 2, 3, 4, 5});
-  CeresFitOptions options;
-  options.compute_covariance = state.range(0) != 0;
+  ModelFitOptions options;
+  options.ceres.compute_covariance = state.range(0) != 0;
   for (auto _ : state) {
-    const Omni3FitResult fit = FitOmni3Ceres(split.training, robot, options);
+    const ModelFitResult fit = FitModel(split.training, *model, options);
     if (!fit.usable) state.SkipWithError("fit not usable");
     benchmark::DoNotOptimize(fit);
   }
-  state.SetLabel(options.compute_covariance ? "fit + covariance" : "fit only");
+  state.SetLabel(options.ceres.compute_covariance ? "fit + covariance" : "fit only");
 }
 BENCHMARK(BM_CeresFitFlower180Runs)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 

@@ -1,4 +1,4 @@
-// Speed of the NLopt back end. The budgets are the paper's and the SciPy reference's:
+// Speed of the NLopt back end (fit/model_nlopt_fit.h, the fit of every model, on omni3). The budgets are the paper's and the SciPy reference's:
 //   - 37,545 cost evaluations, Palacin Table 4's STE-GA5 (180 training runs); target < 5 s on
 //     2 cores;
 //   - 25,000 evaluations on 36 runs, where SciPy's differential evolution needs about 68 s.
@@ -10,7 +10,8 @@
 
 #include <vector>
 
-#include "fit/omni3_nlopt_fit.h"
+#include "fit/model_nlopt_fit.h"
+#include "models/omni3/omni3_robot_model.h"
 #include "odometry/aligned_run.h"
 #include "tools/sim/omni3_simulator.h"
 
@@ -43,7 +44,7 @@ const std::vector<AlignedRun>& Runs(int repetitions) {
 
 void RunBudget(benchmark::State& state, NloptMethod method, int repetitions, int evaluations) {
   const std::vector<AlignedRun>& runs = Runs(repetitions);
-  const Omni3Robot robot = NominalRobot();
+  const std::shared_ptr<const Omni3Model> model = Omni3ModelOf(NominalRobot());
   NloptFitOptions options;
   options.method = method;
   options.max_evaluations = evaluations;
@@ -51,11 +52,11 @@ void RunBudget(benchmark::State& state, NloptMethod method, int repetitions, int
   options.xtol_rel = 0.0;
   options.record_trace = false;
   options.seed = 1;
-  NloptFitResult result;
+  NloptSearchResult result;
   for (auto _ : state) {
     // The result feeds the counters, which keeps the fit from being optimised away (wrapping
     // result.final_cf in DoNotOptimize made GCC 12 report it as garbage with benchmark 1.7.1).
-    result = FitOmni3Nlopt(runs, robot, options);
+    result = FitModelNlopt(runs, *model, options);
   }
   state.counters["runs"] = static_cast<double>(runs.size());
   state.counters["evaluations"] = result.evaluations;
@@ -89,8 +90,9 @@ void BM_OneEvaluation180Runs(benchmark::State& state) {
   options.method = state.range(0) ? NloptMethod::kSlsqp : NloptMethod::kBobyqa;
   options.max_evaluations = 1;
   options.record_trace = false;
+  const std::shared_ptr<const Omni3Model> model = Omni3ModelOf(NominalRobot());
   for (auto _ : state) {
-    benchmark::DoNotOptimize(FitOmni3Nlopt(runs, NominalRobot(), options).final_cf);
+    benchmark::DoNotOptimize(FitModelNlopt(runs, *model, options).final_cf);
   }
 }
 BENCHMARK(BM_OneEvaluation180Runs)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
