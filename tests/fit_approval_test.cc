@@ -9,6 +9,7 @@
 
 #include <string>
 
+#include "models/model_registry.h"
 #include "tests/test_files.h"
 
 namespace fitcal {
@@ -61,6 +62,42 @@ TEST(FitApproval, FlowerCeresFitWritesTheRecordedCalibration) {
   EXPECT_NE(r.out.find("validation                         0.0726     0.0078    -89.2%"),
             std::string::npos)
       << r.out;
+}
+
+// The YAML reader keeps the omni3 layout: the shipped robot, and a calibration written by omni3's
+// own fit path (sigma triples per group, main a0be7a1) whose block is informational when read.
+TEST(FitApproval, TheOmni3LayoutsStillLoad) {
+  const RobotModelPtr shipped = ReadRobotModelFile(kFlower + "/robot.yaml");
+  EXPECT_EQ(shipped->robot().model, "omni3");
+  EXPECT_EQ(shipped->robot().nominal[0], 0.195);
+  TempDir dir;
+  dir.Write("old.yaml", R"(model: omni3
+name: apr02
+wheels:
+  - {name: a, distance_m: 0.2182155469, radius_m: 0.1551166988, angle_deg: 59.7764792}
+  - {name: b, distance_m: 0.2158641842, radius_m: 0.1515536071, angle_deg: 179.7229843}
+  - {name: c, distance_m: 0.2157896058, radius_m: 0.1527965891, angle_deg: 301.6264867}
+bounds:
+  distance_m: [0.17, 0.22]
+  radius_m: [0.138, 0.158]
+  angle_offset_deg: [-2, 2]
+calibration:
+  method: ceres
+  training_repetitions: [1, 2, 3, 4, 5]
+  at_bound: []
+  cf_validation: {before: 0.07260223942, after: 0.007842772719}
+  sigma:
+    distance_m: [0.0005307746265, 0.0005342887409, 0.0005318928477]
+    radius_m: [8.174740739e-05, 8.231970382e-05, 8.19659072e-05]
+    angle_deg: [0.03113920202, 0.03018882245, 0.03058191495]
+  inverse_kinematic_matrix:
+    - [-0.0907109481143395, 0.001563791926711912, 0.08878153875422096]
+    - [0.05096867034743491, -0.1002874686141022, 0.0503741807584078]
+    - [0.2340800722689612, 0.2375330187314411, 0.2353462880553444]
+)");
+  const RobotModelPtr old = ReadRobotModelFile(dir.Path("old.yaml"));
+  EXPECT_EQ(old->robot().nominal[0], 0.2182155469);
+  EXPECT_EQ(old->robot().nominal[5], 0.1527965891);
 }
 
 }  // namespace

@@ -84,6 +84,36 @@ TEST(LinearFinalPoseKernel, EqualsTheReplayInEverySeriesTierForEveryLinearModel)
   EXPECT_GE(linear_models, 2) << "omni3 and omni declare kLinearInChannels";
 }
 
+// Six wheels take the loops over a run-time channel count (3 and 4 have fused ones).
+TEST(LinearFinalPoseKernel, EqualsTheReplayForSixChannels) {
+  const RobotModelPtr model = ReadRobotModel(YAML::Load(R"(model: omni
+name: six_mecanum
+wheels:
+  - {name: fl, distance_m: 0.25, angle_deg: 36.86989765, radius_m: 0.05, drive_angle_deg: 0, roller_angle_deg: -45}
+  - {name: fr, distance_m: 0.25, angle_deg: -36.86989765, radius_m: 0.05, drive_angle_deg: 0, roller_angle_deg: 45}
+  - {name: ml, distance_m: 0.15, angle_deg: 90, radius_m: 0.05, drive_angle_deg: 0, roller_angle_deg: 45}
+  - {name: mr, distance_m: 0.15, angle_deg: -90, radius_m: 0.05, drive_angle_deg: 0, roller_angle_deg: -45}
+  - {name: rl, distance_m: 0.25, angle_deg: 143.13010235, radius_m: 0.05, drive_angle_deg: 0, roller_angle_deg: 45}
+  - {name: rr, distance_m: 0.25, angle_deg: -143.13010235, radius_m: 0.05, drive_angle_deg: 0, roller_angle_deg: -45}
+bounds:
+  distance_m: [0.12, 0.28]
+  radius_m: [0.045, 0.055]
+  angle_offset_deg: [-2.0, 2.0]
+)"),
+                                                "six.yaml");
+  const Robot& robot = model->robot();
+  ASSERT_EQ(robot.NumChannels(), 6);
+  const std::vector<double> m = StepMatrixOf(*model, robot.nominal.data());
+  for (double spin : {0.0, 5.0, 150.0}) {
+    SCOPED_TRACE("spin " + std::to_string(spin));
+    const EncoderSamples log = SpinningLog(6, 1000, spin, 5);
+    const Pose2d start{0.4, -1.2, 2.9};
+    ExpectSamePose(LinearFinalPoseKernel(log).FinalPose(m.data(), start),
+                   model->Replay(robot.nominal.data(), log, 0, log.size(), start),
+                   PathLength(*model, robot.nominal.data(), log));
+  }
+}
+
 TEST(LinearFinalPoseKernel, EqualsTheReplayOnFlowerRunsOverTheParameterBox) {
   sim::Omni3SimulationOptions options;
   options.repetitions = 1;
