@@ -69,6 +69,11 @@ struct ModelFitResult {
   // the encoder time to find the ground truth's) and its sigma (0 without a covariance).
   std::vector<double> clock_offsets_s;
   std::vector<double> clock_offset_sigma_s;
+  // The offsets stayed within 0.1 ms of the last ones when solved again for the final parameters
+  // (they are estimated by turns with the parameters, model_fit.cc); a fit whose offsets still
+  // moved is not usable (stopped_early).
+  bool clock_offsets_settled = false;
+  int clock_offset_iterations = 0;  // of the offsets' own small problems (not in `iterations`)
 };
 
 // What the fit compares with the ground truth (fit/track_residual.h):
