@@ -594,6 +594,40 @@ ModelFitResult FitModelFrom(const std::vector<AlignedRun>& training,
   return result;
 }
 
+ClockOffsetEstimate EstimateClockOffsets(const RobotModelInterface& model,
+                                         const std::vector<double>& p,
+                                         const ModelFitOptions& options) {
+  if (options.track == nullptr) throw std::invalid_argument("EstimateClockOffsets: no tracks");
+  const TrackFitData& track = *options.track;
+  ClockOffsetEstimate out;
+  out.offsets_s.assign(track.clock_groups.size(), 0.0);
+  out.sigma_s.assign(track.clock_groups.size(), 0.0);
+  ModelFitResult counts;
+  SolveClockOffsetsAt(model, options, p, &out.offsets_s, &counts);
+  std::vector<double> sum_squares(out.offsets_s.size(), 0.0), information(out.offsets_s.size(), 0.0);
+  std::vector<int> residuals(out.offsets_s.size(), 0);
+  for (const TrackCheckpoints& run : track.runs) {
+    if (run.segments.empty()) continue;
+    const std::unique_ptr<ceres::CostFunction> cost(
+        TrackResidual::Create(run, model, options.ceres.weights, track.options));
+    const int m = cost->num_residuals();
+    std::vector<double> r(m), j_dt(m);
+    const double* parameters[] = {p.data(), &out.offsets_s[run.clock_group]};
+    double* jacobians[] = {nullptr, j_dt.data()};
+    if (!cost->Evaluate(parameters, r.data(), jacobians)) continue;
+    for (int i = 0; i < m; ++i) {
+      sum_squares[run.clock_group] += r[i] * r[i];
+      information[run.clock_group] += j_dt[i] * j_dt[i];
+    }
+    residuals[run.clock_group] += m;
+  }
+  for (std::size_t g = 0; g < out.sigma_s.size(); ++g) {
+    if (residuals[g] < 2 || !(information[g] > 0.0)) continue;
+    out.sigma_s[g] = std::sqrt(sum_squares[g] / (residuals[g] - 1) / information[g]);
+  }
+  return out;
+}
+
 ModelFitResult FitModel(const std::vector<AlignedRun>& training, const RobotModelInterface& model,
                         const ModelFitOptions& options) {
   return FitModelFrom(training, model, model.robot().nominal, options);

@@ -107,6 +107,18 @@ bool AtBound(double value, const Interval& box);
 // Which parameters (robot().parameters order) rest on a bound of the robot's box (AtBound).
 std::vector<bool> ParametersAtBound(const Robot& robot, const std::vector<double>& p);
 
+// The clock offsets of `options.track`'s groups with the parameters held at `p` (each group's
+// own bounded problem, as FitModel solves them), with each offset's sigma from its group's
+// residual scatter, s^2 / sum (dr/ddt)^2, s^2 = |r|^2 / (residuals - 1). For `report` and
+// `diagnose`, which replay given parameters against a ground truth on another clock.
+struct ClockOffsetEstimate {
+  std::vector<double> offsets_s;
+  std::vector<double> sigma_s;
+};
+ClockOffsetEstimate EstimateClockOffsets(const RobotModelInterface& model,
+                                         const std::vector<double>& p,
+                                         const ModelFitOptions& options);
+
 // Throws std::invalid_argument for invalid options or no runs.
 ModelFitResult FitModel(const std::vector<AlignedRun>& training, const RobotModelInterface& model,
                         const ModelFitOptions& options = {});

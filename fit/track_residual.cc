@@ -71,6 +71,28 @@ bool ParseClockGrouping(const std::string& text, ClockGrouping* out) {
   return false;
 }
 
+std::string ClockGroupOf(const std::string& run_id, const std::string& trajectory,
+                         ClockGrouping grouping) {
+  if (grouping == ClockGrouping::kPerRun) return run_id;
+  if (grouping == ClockGrouping::kPerSession) return trajectory;
+  return "all";
+}
+
+int ShiftGroundTruthClocks(const std::vector<std::pair<std::string, double>>& offset_of_group,
+                           ClockGrouping grouping, std::vector<RunLog>* logs) {
+  int moved = 0;
+  for (RunLog& log : *logs) {
+    const std::string group = ClockGroupOf(log.id, log.trajectory, grouping);
+    for (const auto& [name, offset_s] : offset_of_group) {
+      if (name != group) continue;
+      for (double& t : log.ground_truth.t_s) t -= offset_s;
+      ++moved;
+      break;
+    }
+  }
+  return moved;
+}
+
 TrackFitData MakeTrackFitData(const std::vector<AlignedRun>& runs,
                               const std::vector<const GroundTruthTrack*>& ground_truth,
                               ClockGrouping grouping, const TrackResidualOptions& options) {
@@ -82,9 +104,7 @@ TrackFitData MakeTrackFitData(const std::vector<AlignedRun>& runs,
   out.estimate_clock_offsets = grouping != ClockGrouping::kNone;
   for (std::size_t i = 0; i < runs.size(); ++i) {
     TrackCheckpoints t = MakeTrackCheckpoints(runs[i], *ground_truth[i], options);
-    const std::string group = grouping == ClockGrouping::kPerRun       ? runs[i].id
-                              : grouping == ClockGrouping::kPerSession ? runs[i].trajectory
-                                                                       : "all";
+    const std::string group = ClockGroupOf(runs[i].id, runs[i].trajectory, grouping);
     const auto found = std::find(out.clock_groups.begin(), out.clock_groups.end(), group);
     t.clock_group = static_cast<int>(found - out.clock_groups.begin());
     if (found == out.clock_groups.end()) out.clock_groups.push_back(group);

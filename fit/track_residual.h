@@ -43,6 +43,7 @@
 #include <cstddef>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "models/model_interface.h"
@@ -78,6 +79,19 @@ struct TrackCheckpoints {
 enum class ClockGrouping { kPerSession, kPerRun, kDataset, kNone };
 const char* ToString(ClockGrouping grouping);  // "session", "run", "dataset", "none"
 bool ParseClockGrouping(const std::string& text, ClockGrouping* out);
+
+// The clock group a run belongs to under `grouping`: its trajectory label (session), its id
+// (run), or "all" (dataset, and none).
+std::string ClockGroupOf(const std::string& run_id, const std::string& trajectory,
+                         ClockGrouping grouping);
+
+// Applies clock offsets to recorded runs: every ground-truth stamp of a run whose clock group
+// (ClockGroupOf) has an offset dt moves to t - dt, so that the ground truth read at encoder time
+// t is the one stamped t + dt (the offsets' meaning, header). Returns how many runs moved. The
+// fit itself moves the checkpoints by a smoothed track's motion (TrackResidual); read at the
+// shifted stamps, the interpolated ground truth agrees with it to the samples' noise.
+int ShiftGroundTruthClocks(const std::vector<std::pair<std::string, double>>& offset_of_group,
+                           ClockGrouping grouping, std::vector<RunLog>* logs);
 
 // The training runs' tracks for the track residuals: one TrackCheckpoints per training run (same
 // order), each naming its clock group (0 .. clock_groups.size() - 1).
