@@ -391,32 +391,76 @@ std::vector<bool> ParametersAtBound(const Robot& robot, const std::vector<double
 
 namespace {
 
-// The clock offsets of every group with the parameters `p` held: one small problem per group
-// (its runs' track residuals alone; the replay is the parameters' and does not change).
+// The clock offsets of every group with the parameters `p` held, each the minimum of its group's
+// exact track cost (the ground truth interpolated linearly at t + dt, TrackResidual): a scan of
+// the bounded interval every kOffsetScanStepS, then a golden-section search of the best step's
+// neighbourhood to kOffsetSearchToleranceS. Why a search and not Gauss-Newton: the cost is
+// piecewise smooth with kinks at sample crossings (fit/track_residual.h), and on circles an
+// offset is seen mostly through the start and stop transients, where the cost's curvature in dt
+// is up to 10 times Gauss-Newton's model of it (the OptiOdom diff circles): the joint
+// Levenberg-Marquardt solve zigzagged for 46-118 iterations. The scan also keeps a weakly
+// determined offset from a local minimum. Each evaluation replays the group's runs once,
+// without derivatives.
+constexpr double kOffsetScanStepS = 0.025;
+constexpr double kOffsetSearchToleranceS = 1e-5;
+
 void SolveClockOffsetsAt(const RobotModelInterface& model, const ModelFitOptions& options,
                          const std::vector<double>& p, std::vector<double>* offsets_s,
                          ModelFitResult* result) {
   const TrackFitData& track = *options.track;
   const double bound = track.options.max_clock_offset_s;
-  std::vector<double> p_held = p;
   for (std::size_t g = 0; g < track.clock_groups.size(); ++g) {
-    ceres::Problem::Options problem_options;
-    problem_options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
-    ceres::Problem problem(problem_options);
-    double* offset = &(*offsets_s)[g];
+    std::vector<std::unique_ptr<ceres::CostFunction>> costs;
     for (const TrackCheckpoints& run : track.runs) {
       if (run.clock_group != static_cast<int>(g) || run.segments.empty()) continue;
-      problem.AddResidualBlock(
-          TrackResidual::Create(run, model, options.ceres.weights, track.options), nullptr,
-          p_held.data(), offset);
+      costs.emplace_back(
+          TrackResidual::Create(run, model, options.ceres.weights, track.options));
     }
-    if (!problem.HasParameterBlock(offset)) continue;
-    problem.SetParameterBlockConstant(p_held.data());
-    problem.SetParameterLowerBound(offset, 0, -bound);
-    problem.SetParameterUpperBound(offset, 0, bound);
-    ceres::Solver::Summary summary;
-    ceres::Solve(SolverOptionsFor(options.ceres), &problem, &summary);
-    result->clock_offset_iterations += static_cast<int>(summary.iterations.size());
+    if (costs.empty() || bound == 0.0) continue;
+    const auto cost_at = [&](double dt) {
+      ++result->clock_offset_iterations;
+      double sum = 0.0;
+      for (const auto& cost : costs) {
+        std::vector<double> r(cost->num_residuals());
+        const double* parameters[] = {p.data(), &dt};
+        if (!cost->Evaluate(parameters, r.data(), nullptr)) return HUGE_VAL;
+        for (double v : r) sum += v * v;
+      }
+      return sum;
+    };
+    const int steps = static_cast<int>(std::ceil(bound / kOffsetScanStepS));
+    double best = 0.0, best_cost = HUGE_VAL;
+    for (int i = -steps; i <= steps; ++i) {
+      const double dt = std::clamp(i * kOffsetScanStepS, -bound, bound);
+      const double c = cost_at(dt);
+      if (c < best_cost) {
+        best = dt;
+        best_cost = c;
+      }
+    }
+    // Golden section on [best - step, best + step] within the bounds.
+    double lo = std::max(-bound, best - kOffsetScanStepS);
+    double hi = std::min(bound, best + kOffsetScanStepS);
+    const double ratio = 0.5 * (std::sqrt(5.0) - 1.0);
+    double x1 = hi - ratio * (hi - lo), x2 = lo + ratio * (hi - lo);
+    double c1 = cost_at(x1), c2 = cost_at(x2);
+    while (hi - lo > kOffsetSearchToleranceS) {
+      if (c1 < c2) {
+        hi = x2;
+        x2 = x1;
+        c2 = c1;
+        x1 = hi - ratio * (hi - lo);
+        c1 = cost_at(x1);
+      } else {
+        lo = x1;
+        x1 = x2;
+        c1 = c2;
+        x2 = lo + ratio * (hi - lo);
+        c2 = cost_at(x2);
+      }
+    }
+    const double found = 0.5 * (lo + hi);
+    (*offsets_s)[g] = cost_at(found) <= best_cost ? found : best;
   }
 }
 
@@ -429,17 +473,14 @@ double LargestChange(const std::vector<double>& before, const std::vector<double
 }
 
 // Clock offsets are estimated by turns (block coordinate descent): the offsets with the
-// parameters held, then the parameters with the offsets held, until the offsets move by less
-// than kClockOffsetToleranceS. Why not one joint Levenberg-Marquardt solve: on circles a
-// session's offset is seen mostly through the start and stop transients (a steady circle's
-// relative poses do not change with dt, to first order), and there the residuals' curvature in
-// dt is up to 10 times Gauss-Newton's model of it (measured on the OptiOdom diff circles); the
-// joint solve zigzags, each step replaying every run with derivatives: 46-118 iterations,
-// 1.2-2.9 s on one thread, against 5 iterations and 0.13 s without offsets. An offset's own
-// problem replays only its group's runs, without derivatives; the parameters' problem with the
-// offsets held converges as fast as without offsets. At the end the offsets are optimal for the
-// parameters and the parameters for the offsets: the joint minimum's conditions, to the
-// tolerance (the covariance is then the joint one, ComputeCovariance).
+// parameters held (SolveClockOffsetsAt: a search on the exact cost), then the parameters with
+// the offsets held, until the offsets move by less than kClockOffsetToleranceS. A joint
+// Levenberg-Marquardt solve took 46-118 iterations on the OptiOdom diff circles + squares
+// (1.2-2.9 s on one thread, against 5 iterations and 0.13 s without offsets; reasons above); an
+// offset's search replays only its group's runs, without derivatives, and the parameters'
+// problem with the offsets held converges as fast as without offsets. At the end the offsets are
+// the minimum for the parameters and the parameters for the offsets (the covariance is then the
+// joint one, ComputeCovariance, with the interpolant's piecewise derivative in dt).
 constexpr int kMaxClockOffsetRounds = 12;
 constexpr double kClockOffsetToleranceS = 1e-4;  // 0.1 ms: 20 um at 0.2 m/s, << every sigma
 constexpr int kParameterStepsPerRound = 2;       // the parameters' steps between offset solves

@@ -19,23 +19,12 @@ bool TrackResidualOptions::IsValid(std::string* error) const {
   return true;
 }
 
-// H: kMinSmoothingHalfWidthS, or two median sample intervals where the ground truth is sparser,
-// so that a few samples always share the window.
-double SmoothingHalfWidth(const GroundTruthTrack& track) {
-  std::vector<double> intervals;
-  for (std::size_t k = 1; k < track.t_s.size(); ++k) intervals.push_back(track.t_s[k] - track.t_s[k - 1]);
-  if (intervals.empty()) return kMinSmoothingHalfWidthS;
-  std::nth_element(intervals.begin(), intervals.begin() + intervals.size() / 2, intervals.end());
-  return std::max(kMinSmoothingHalfWidthS, 2.0 * intervals[intervals.size() / 2]);
-}
-
 TrackCheckpoints MakeTrackCheckpoints(const AlignedRun& run, const GroundTruthTrack& ground_truth,
                                       const TrackResidualOptions& options) {
   TrackCheckpoints out;
   out.run = &run;
   out.ground_truth = &ground_truth;
   out.t_start_s = run.t_start_s;
-  out.smoothing_half_width_s = SmoothingHalfWidth(ground_truth);
   out.segments = MakeCheckpointsFromStart(run, ground_truth, options.checkpoint_spacing_m);
   double t = run.t_start_s;
   std::size_t done = 0;
@@ -115,45 +104,27 @@ TrackFitData MakeTrackFitData(const std::vector<AlignedRun>& runs,
 
 namespace {
 
-// The smoothed ground truth S(t) of the header: a kernel-weighted mean of the samples within
-// +-H of t (Nadaraya-Watson) with the triweight kernel w(u) = (1 - u^2)^3, u = (t - t_j) / H,
-// whose weight and first two derivatives vanish at |u| = 1, so S is twice continuously
-// differentiable in t wherever a sample lies within H (beyond the track's ends it settles on the
-// end sample). Headings are averaged unwrapped about the sample nearest t.
+// The ground truth at time t (a Jet in the clock offset): linear interpolation between the
+// samples around t's value, clamped outside the track (InterpolateGroundTruth with a Jet time).
 template <typename T>
-Pose2<T> SmoothedAt(const GroundTruthTrack& track, const T& t, double half_width_s) {
+Pose2<T> InterpolateAt(const GroundTruthTrack& track, const T& t) {
   const std::vector<double>& ts = track.t_s;
-  const std::vector<Pose2d>& q = track.world_T_robot;
   const double v = ScalarPart(t);
-  const auto first = std::upper_bound(ts.begin(), ts.end(), v - half_width_s);
-  const auto last = std::lower_bound(ts.begin(), ts.end(), v + half_width_s);
-  if (first >= last) {  // no sample strictly inside the window: the nearest end's sample
-    const Pose2d& e = v <= ts.front() ? q.front() : q.back();
-    return {T(e.x), T(e.y), T(e.theta)};
+  if (v <= ts.front()) {
+    const Pose2d& a = track.world_T_robot.front();
+    return {T(a.x), T(a.y), T(a.theta)};
   }
-  const double reference_theta = q[static_cast<std::size_t>(first - ts.begin())].theta;
-  T sum_w(0.0), sum_x(0.0), sum_y(0.0), sum_theta(0.0);
-  for (auto it = first; it != last; ++it) {
-    const std::size_t j = static_cast<std::size_t>(it - ts.begin());
-    const T u = (t - ts[j]) / half_width_s;
-    const T one_minus = 1.0 - u * u;
-    const T w = one_minus * one_minus * one_minus;
-    sum_w += w;
-    sum_x += w * q[j].x;
-    sum_y += w * q[j].y;
-    sum_theta += w * (reference_theta + WrapAngle(q[j].theta - reference_theta));
+  if (v >= ts.back()) {
+    const Pose2d& b = track.world_T_robot.back();
+    return {T(b.x), T(b.y), T(b.theta)};
   }
-  return {sum_x / sum_w, sum_y / sum_w, sum_theta / sum_w};
-}
-
-// Q(t + dt) = Q(t) + S(t + dt) - S(t) (header): `at` holds Q(t) and S(t) at the checkpoint.
-template <typename T>
-Pose2<T> ShiftedGroundTruth(const GroundTruthTrack& track, double t_s, const T& dt_s,
-                            const Pose2d& q_at_t, const Pose2d& smoothed_at_t,
-                            double half_width_s) {
-  const Pose2<T> s = SmoothedAt(track, t_s + dt_s, half_width_s);
-  return {q_at_t.x + (s.x - smoothed_at_t.x), q_at_t.y + (s.y - smoothed_at_t.y),
-          q_at_t.theta + (s.theta - smoothed_at_t.theta)};
+  const std::size_t hi =
+      static_cast<std::size_t>(std::upper_bound(ts.begin(), ts.end(), v) - ts.begin());
+  const std::size_t lo = hi - 1;
+  const T u = (t - ts[lo]) / (ts[hi] - ts[lo]);
+  const Pose2d& a = track.world_T_robot[lo];
+  const Pose2d& b = track.world_T_robot[hi];
+  return {a.x + u * (b.x - a.x), a.y + u * (b.y - a.y), a.theta + u * WrapAngle(b.theta - a.theta)};
 }
 
 // a^-1 b
@@ -180,12 +151,8 @@ using ErrorJet = ceres::Jet<double, 4>;
 }  // namespace
 
 Pose2d GroundTruthFromStart(const TrackCheckpoints& track, std::size_t k, double dt_s) {
-  const GroundTruthTrack& g = *track.ground_truth;
-  const double h = track.smoothing_half_width_s;
-  const auto shifted = [&](double t) {
-    return ShiftedGroundTruth(g, t, dt_s, InterpolateGroundTruth(g, t), SmoothedAt(g, t, h), h);
-  };
-  return Between(shifted(track.t_start_s), shifted(track.t_s[k]));
+  return Between(InterpolateAt(*track.ground_truth, track.t_start_s + dt_s),
+                 InterpolateAt(*track.ground_truth, track.t_s[k] + dt_s));
 }
 
 TrackResidual::TrackResidual(const TrackCheckpoints& track, const RobotModelInterface& model,
@@ -201,10 +168,6 @@ TrackResidual::TrackResidual(const TrackCheckpoints& track, const RobotModelInte
     identity.ground_truth_start_T_end = Pose2d{0.0, 0.0, 0.0};
     from_start_.push_back(identity);
   }
-  const GroundTruthTrack& g = *track.ground_truth;
-  const double h = track.smoothing_half_width_s;
-  start_ = {InterpolateGroundTruth(g, track.t_start_s), SmoothedAt(g, track.t_start_s, h)};
-  for (double t : track.t_s) checkpoints_.push_back({InterpolateGroundTruth(g, t), SmoothedAt(g, t, h)});
   // Unit weights: the inner residual is P_k itself (SegmentError with Q = identity).
   odometry_.reset(model.SegmentCost(*track.run, from_start_, ResidualWeights{}));
   set_num_residuals(3 * static_cast<int>(from_start_.size()));
@@ -236,19 +199,16 @@ bool TrackResidual::Evaluate(double const* const* parameters, double* residuals,
   if (!odometry_->Evaluate(parameters, pose.data(), want_p ? inner_jacobians : nullptr)) {
     return false;
   }
-  const ErrorJet dt_s = ErrorJet(parameters[1][0], 3);
-  const GroundTruthTrack& g = *track_.ground_truth;
-  const double h = track_.smoothing_half_width_s;
-  const Pose2<ErrorJet> q0 =
-      ShiftedGroundTruth(g, track_.t_start_s, dt_s, start_.pose, start_.smoothed, h);
+  const double dt_s = parameters[1][0];
+  const ErrorJet t0 = ErrorJet(track_.t_start_s + dt_s, 3);
+  const Pose2<ErrorJet> q0 = InterpolateAt(*track_.ground_truth, t0);
   const double inv_xy = 1.0 / weights_.position_sigma_m;
   const double inv_th = 1.0 / weights_.heading_sigma_rad;
   for (int k = 0; k < m / 3; ++k) {
     const Pose2<ErrorJet> p{ErrorJet(pose[3 * k], 0), ErrorJet(pose[3 * k + 1], 1),
                             ErrorJet(pose[3 * k + 2], 2)};
-    const GroundTruthPoint& at_k = checkpoints_[k];
     const Pose2<ErrorJet> q =
-        Between(q0, ShiftedGroundTruth(g, track_.t_s[k], dt_s, at_k.pose, at_k.smoothed, h));
+        Between(q0, InterpolateAt(*track_.ground_truth, ErrorJet(track_.t_s[k] + dt_s, 3)));
     using std::cos;
     using std::sin;
     const ErrorJet cq = cos(q.theta), sq = sin(q.theta);

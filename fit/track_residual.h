@@ -16,18 +16,12 @@
 // Huber loss rho(s) = s below c^2, 2 c sqrt(s) - c^2 above (Ceres' convention). A run of 40 m
 // weighs what a run of 4 m does; a ground-truth glitch at one checkpoint grows the cost linearly.
 //
-// The ground truth at t + dt: Q(t + dt) = Q(t) + S(t + dt) - S(t), where Q(t) is the track
-// interpolated linearly at the checkpoint's own time (InterpolateGroundTruth, as without offsets)
-// and S a smoothed track (a triweight kernel over +-H of samples, H = 0.25 s or two sample
-// intervals, twice continuously differentiable): the checkpoint is moved by the motion the
-// smoothed track makes in dt. At dt = 0 it is the sample itself, bit for bit. Why not the
-// interpolant at t + dt: a synchronised file (OptiOdom) samples the ground truth at the encoder
-// times where the checkpoints lie, so every checkpoint crosses a sample at the same dt; a linear
-// interpolant puts a kink there and a spline a curvature made of the samples' noise (the OptiOdom
-// diff's heading jitters by ~0.01 rad per 50 ms sample: 0.2 rad/s of "rate" from noise alone),
-// and Gauss-Newton's model of the cost in dt was wrong by more than half (46-64 iterations on the
-// diff circles + squares, against 5 without offsets; some sessions ended on a kink at dt = 0).
-// Beyond the track's ends S settles on the end sample (no extrapolation).
+// The ground truth at t + dt is interpolated linearly between its samples, as everywhere else.
+// Its derivative in dt is piecewise constant (the sample interval's velocity) and the cost has a
+// kink wherever a checkpoint crosses a sample - on a synchronised file (OptiOdom), where the
+// ground truth is sampled at the encoder times the checkpoints lie on, every checkpoint at once.
+// FitModel therefore does not let Gauss-Newton step in dt: it estimates the offsets by turns with
+// the parameters, each offset by a search on this exact cost (fit/model_fit.cc).
 //
 // Why the clock offset: the encoders and the ground truth are on different clocks (OptiOdom's
 // are mapped by hand-picked instants); a lag dt moves each checkpoint by |v| dt. The final pose,
@@ -36,7 +30,7 @@
 //
 // Derivatives are exact: the model's own autodiff through the replay (its SegmentCost on windows
 // [0, k] with an identity ground truth gives P_k and dP_k/dp), chained with Jets through the
-// error, the smoothed track's motion in dt and the loss.
+// error, the interpolation in time and the loss.
 
 #include <ceres/cost_function.h>
 
@@ -52,9 +46,6 @@
 
 namespace fitcal {
 
-// The smallest half-width H of the smoothed track that moves checkpoints in time (header).
-inline constexpr double kMinSmoothingHalfWidthS = 0.25;
-
 struct TrackResidualOptions {
   double checkpoint_spacing_m = 0.5;  // OptiOdom's
   double huber_scale = 0.1;           // c, residual units (m and rad): a few times a clean error
@@ -69,8 +60,7 @@ struct TrackCheckpoints {
   std::vector<Segment> segments;  // windows [0, end_k] with the ground truth at dt = 0
   std::vector<double> t_s;        // encoder time of each checkpoint
   double t_start_s = 0.0;
-  double smoothing_half_width_s = 0.25;  // H of the smoothed track S (header)
-  int clock_group = 0;                   // index of the run's clock offset
+  int clock_group = 0;  // index of the run's clock offset
 };
 
 // How runs share clock offsets: one per session (runs recorded together; the run's trajectory
@@ -87,9 +77,8 @@ std::string ClockGroupOf(const std::string& run_id, const std::string& trajector
 
 // Applies clock offsets to recorded runs: every ground-truth stamp of a run whose clock group
 // (ClockGroupOf) has an offset dt moves to t - dt, so that the ground truth read at encoder time
-// t is the one stamped t + dt (the offsets' meaning, header). Returns how many runs moved. The
-// fit itself moves the checkpoints by a smoothed track's motion (TrackResidual); read at the
-// shifted stamps, the interpolated ground truth agrees with it to the samples' noise.
+// t is the one stamped t + dt (the offsets' meaning, header): the values the track residual
+// interpolates at t + dt. Returns how many runs moved.
 int ShiftGroundTruthClocks(const std::vector<std::pair<std::string, double>>& offset_of_group,
                            ClockGrouping grouping, std::vector<RunLog>* logs);
 
@@ -111,8 +100,8 @@ TrackFitData MakeTrackFitData(const std::vector<AlignedRun>& runs,
 TrackCheckpoints MakeTrackCheckpoints(const AlignedRun& run, const GroundTruthTrack& ground_truth,
                                       const TrackResidualOptions& options);
 
-// The ground truth's pose at t_k + dt relative to its pose at t_0 + dt (Q_k(dt) above, the
-// smoothed track's motion in dt added to the samples), on double: for metrics and tests.
+// The ground truth's pose at t_k + dt relative to its pose at t_0 + dt (Q_k(dt) above), on
+// double: for metrics and tests.
 Pose2d GroundTruthFromStart(const TrackCheckpoints& track, std::size_t k, double dt_s);
 
 class TrackResidual : public ceres::CostFunction {
@@ -130,15 +119,7 @@ class TrackResidual : public ceres::CostFunction {
   TrackResidual(const TrackCheckpoints& track, const RobotModelInterface& model,
                 const ResidualWeights& weights, const TrackResidualOptions& options);
 
-  // The ground truth at a checkpoint's time: interpolated Q(t) and smoothed S(t).
-  struct GroundTruthPoint {
-    Pose2d pose;
-    Pose2d smoothed;
-  };
-
   const TrackCheckpoints& track_;
-  GroundTruthPoint start_;
-  std::vector<GroundTruthPoint> checkpoints_;
   std::unique_ptr<ceres::CostFunction> odometry_;  // P_k and dP_k/dp: 3 values per checkpoint
   std::vector<Segment> from_start_;                // windows [0, k] with an identity ground truth
   ResidualWeights weights_;
