@@ -394,7 +394,8 @@ namespace {
 // The clock offsets of every group with the parameters `p` held, each the minimum of its group's
 // exact track cost (the ground truth interpolated linearly at t + dt, TrackResidual): a scan of
 // the bounded interval every kOffsetScanStepS, then a golden-section search of the best step's
-// neighbourhood to kOffsetSearchToleranceS. Why a search and not Gauss-Newton: the cost is
+// neighbourhood to kOffsetSearchToleranceS (without `scan`, the scan covers kLocalScanSteps steps
+// either side of the current offset: after the first round the parameters move little). Why a search and not Gauss-Newton: the cost is
 // piecewise smooth with kinks at sample crossings (fit/track_residual.h), and on circles an
 // offset is seen mostly through the start and stop transients, where the cost's curvature in dt
 // is up to 10 times Gauss-Newton's model of it (the OptiOdom diff circles): the joint
@@ -403,10 +404,11 @@ namespace {
 // without derivatives.
 constexpr double kOffsetScanStepS = 0.025;
 constexpr double kOffsetSearchToleranceS = 1e-5;
+constexpr int kLocalScanSteps = 3;
 
 void SolveClockOffsetsAt(const RobotModelInterface& model, const ModelFitOptions& options,
                          const std::vector<double>& p, std::vector<double>* offsets_s,
-                         ModelFitResult* result) {
+                         ModelFitResult* result, bool scan = true) {
   const TrackFitData& track = *options.track;
   const double bound = track.options.max_clock_offset_s;
   for (std::size_t g = 0; g < track.clock_groups.size(); ++g) {
@@ -428,10 +430,12 @@ void SolveClockOffsetsAt(const RobotModelInterface& model, const ModelFitOptions
       }
       return sum;
     };
-    const int steps = static_cast<int>(std::ceil(bound / kOffsetScanStepS));
-    double best = 0.0, best_cost = HUGE_VAL;
+    // The whole interval, or kLocalScanSteps either side of the current offset.
+    const int steps = scan ? static_cast<int>(std::ceil(bound / kOffsetScanStepS)) : kLocalScanSteps;
+    const double centre = scan ? 0.0 : (*offsets_s)[g];
+    double best = centre, best_cost = HUGE_VAL;
     for (int i = -steps; i <= steps; ++i) {
-      const double dt = std::clamp(i * kOffsetScanStepS, -bound, bound);
+      const double dt = std::clamp(centre + i * kOffsetScanStepS, -bound, bound);
       const double c = cost_at(dt);
       if (c < best_cost) {
         best = dt;
@@ -494,7 +498,8 @@ void AlternateWithClockOffsets(const std::vector<AlignedRun>& training,
   few_steps.ceres.max_num_iterations = kParameterStepsPerRound;
   for (int round = 0; round < kMaxClockOffsetRounds; ++round) {
     const std::vector<double> before = result->clock_offsets_s;
-    SolveClockOffsetsAt(model, options, result->parameters, &result->clock_offsets_s, result);
+    SolveClockOffsetsAt(model, options, result->parameters, &result->clock_offsets_s, result,
+                        /*scan=*/round == 0);
     if (round > 0 && LargestChange(before, result->clock_offsets_s) < kClockOffsetToleranceS) {
       return;
     }
@@ -549,7 +554,8 @@ ModelFitResult SolveFrom(const std::vector<AlignedRun>& training, const RobotMod
     if (!offsets) break;
     // The offsets for the parameters found; done when they stay (the joint minimum).
     const std::vector<double> before = result.clock_offsets_s;
-    SolveClockOffsetsAt(model, options, result.parameters, &result.clock_offsets_s, &result);
+    SolveClockOffsetsAt(model, options, result.parameters, &result.clock_offsets_s, &result,
+                        /*scan=*/false);
     result.clock_offsets_settled =
         LargestChange(before, result.clock_offsets_s) < kClockOffsetToleranceS;
     if (result.clock_offsets_settled) break;
