@@ -400,8 +400,8 @@ namespace {
 // offset is seen mostly through the start and stop transients, where the cost's curvature in dt
 // is up to 10 times Gauss-Newton's model of it (the OptiOdom diff circles): the joint
 // Levenberg-Marquardt solve zigzagged for 46-118 iterations. The scan also keeps a weakly
-// determined offset from a local minimum. Each evaluation replays the group's runs once,
-// without derivatives.
+// determined offset from a local minimum. The group's runs are replayed once per call (the
+// odometry does not depend on dt); each evaluation interpolates the ground truth only.
 constexpr double kOffsetScanStepS = 0.025;
 constexpr double kOffsetSearchToleranceS = 1e-5;
 constexpr int kLocalScanSteps = 3;
@@ -412,22 +412,20 @@ void SolveClockOffsetsAt(const RobotModelInterface& model, const ModelFitOptions
   const TrackFitData& track = *options.track;
   const double bound = track.options.max_clock_offset_s;
   for (std::size_t g = 0; g < track.clock_groups.size(); ++g) {
-    std::vector<std::unique_ptr<ceres::CostFunction>> costs;
+    // Each run's odometry from its start, replayed once: it does not depend on dt.
+    std::vector<std::pair<std::unique_ptr<TrackResidual>, std::vector<double>>> runs;
     for (const TrackCheckpoints& run : track.runs) {
       if (run.clock_group != static_cast<int>(g) || run.segments.empty()) continue;
-      costs.emplace_back(
-          TrackResidual::Create(run, model, options.ceres.weights, track.options));
+      std::unique_ptr<TrackResidual> cost(static_cast<TrackResidual*>(
+          TrackResidual::Create(run, model, options.ceres.weights, track.options)));
+      std::vector<double> poses = cost->OdometryFromStart(p.data());
+      runs.emplace_back(std::move(cost), std::move(poses));
     }
-    if (costs.empty() || bound == 0.0) continue;
+    if (runs.empty() || bound == 0.0) continue;
     const auto cost_at = [&](double dt) {
       ++result->clock_offset_iterations;
       double sum = 0.0;
-      for (const auto& cost : costs) {
-        std::vector<double> r(cost->num_residuals());
-        const double* parameters[] = {p.data(), &dt};
-        if (!cost->Evaluate(parameters, r.data(), nullptr)) return HUGE_VAL;
-        for (double v : r) sum += v * v;
-      }
+      for (const auto& [cost, poses] : runs) sum += cost->SquaredNormAt(poses, dt);
       return sum;
     };
     // The whole interval, or kLocalScanSteps either side of the current offset.

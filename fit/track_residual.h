@@ -33,7 +33,9 @@
 // error, the interpolation in time and the loss.
 
 #include <ceres/cost_function.h>
+#include <ceres/jet.h>
 
+#include <array>
 #include <cstddef>
 #include <memory>
 #include <string>
@@ -115,7 +117,19 @@ class TrackResidual : public ceres::CostFunction {
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
+  // The same residuals in two steps, for a search over dt with the parameters held (the replay
+  // does not depend on dt): the odometry's pose at every checkpoint from the run's start (3
+  // values each; HUGE_VAL when the replay fails), then |r|^2 for those poses at dt.
+  std::vector<double> OdometryFromStart(const double* p) const;
+  double SquaredNormAt(const std::vector<double>& pose_from_start, double dt_s) const;
+
  private:
+  // Jet dimensions: the odometry pose (x, y, theta) and the clock offset.
+  using ErrorJet = ceres::Jet<double, 4>;
+  Pose2<ErrorJet> GroundTruthAtStart(double dt_s) const;
+  std::array<ErrorJet, 3> CheckpointResidual(const std::vector<double>& pose, int k,
+                                             const Pose2<ErrorJet>& q0, double dt_s) const;
+
   TrackResidual(const TrackCheckpoints& track, const RobotModelInterface& model,
                 const ResidualWeights& weights, const TrackResidualOptions& options);
 
