@@ -104,6 +104,24 @@ std::string MostInformativeTrajectory(const std::vector<AlignedRun>& training,
 
 // A held direction in words: its one-sigma step in parameter terms, how much of the bounds'
 // range that is, and which of the data set's own trajectories would determine it.
+// How far the direction v (prior units) is along the common scale of every free length (wheels
+// and track together: every length times s): |cos| of the angle between them. Under that scale a
+// twist's translation grows by s and its rotation does not, so a closed loop ends where it
+// started whatever s: final poses of closed loops cannot see it (issue 29).
+double AlongCommonScale(const Robot& robot, const Eigen::VectorXd& prior_sigma,
+                        const Eigen::VectorXd& v) {
+  Eigen::VectorXd scale = Eigen::VectorXd::Zero(v.size());
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    if (robot.IsHeld(k) || robot.parameters[k].unit != ParameterUnit::kLength) continue;
+    scale[k] = robot.nominal[k] / prior_sigma[k];
+  }
+  const double norm = scale.norm() * v.norm();
+  return norm > 0.0 ? std::abs(scale.dot(v)) / norm : 0.0;
+}
+
+// Directions this close to the common scale are named as it (cos 0.9: within 26 degrees).
+constexpr double kCommonScaleCosine = 0.9;
+
 std::string DescribeDirection(const std::vector<AlignedRun>& training,
                               const std::vector<RunJacobian>& runs, const Robot& robot,
                               const Eigen::VectorXd& v, const Eigen::VectorXd& prior_sigma,
@@ -190,6 +208,11 @@ DirectionAnalysis AnalyseDeterminedDirections(const std::vector<AlignedRun>& tra
     d.one_sigma_step = prior_sigma.cwiseProduct(v) * std::min(fraction, 1.0);
     d.description =
         DescribeDirection(training, runs, robot, v, prior_sigma, fraction, d.one_sigma_step);
+    if (AlongCommonScale(robot, prior_sigma, v) > kCommonScaleCosine) {
+      d.description = "the common scale of wheels and track (" + d.description +
+                      "): closed loops judged at their end cannot see it; add a straight run of "
+                      "known length, or fit the track (--residuals track)";
+    }
     out.undetermined.push_back(d);
   }
   out.ok = true;

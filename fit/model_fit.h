@@ -69,6 +69,11 @@ struct ModelFitResult {
   // the encoder time to find the ground truth's) and its sigma (0 without a covariance).
   std::vector<double> clock_offsets_s;
   std::vector<double> clock_offset_sigma_s;
+  // The offsets stayed within 0.1 ms of the last ones when solved again for the final parameters
+  // (they are estimated by turns with the parameters, model_fit.cc); a fit whose offsets still
+  // moved is not usable (stopped_early).
+  bool clock_offsets_settled = false;
+  int clock_offset_iterations = 0;  // of the offsets' own small problems (not in `iterations`)
 };
 
 // What the fit compares with the ground truth (fit/track_residual.h):
@@ -101,6 +106,18 @@ struct ModelFitOptions {
 bool AtBound(double value, const Interval& box);
 // Which parameters (robot().parameters order) rest on a bound of the robot's box (AtBound).
 std::vector<bool> ParametersAtBound(const Robot& robot, const std::vector<double>& p);
+
+// The clock offsets of `options.track`'s groups with the parameters held at `p` (each group's
+// own bounded problem, as FitModel solves them), with each offset's sigma from its group's
+// residual scatter, s^2 / sum (dr/ddt)^2, s^2 = |r|^2 / (residuals - 1). For `report` and
+// `diagnose`, which replay given parameters against a ground truth on another clock.
+struct ClockOffsetEstimate {
+  std::vector<double> offsets_s;
+  std::vector<double> sigma_s;
+};
+ClockOffsetEstimate EstimateClockOffsets(const RobotModelInterface& model,
+                                         const std::vector<double>& p,
+                                         const ModelFitOptions& options);
 
 // Throws std::invalid_argument for invalid options or no runs.
 ModelFitResult FitModel(const std::vector<AlignedRun>& training, const RobotModelInterface& model,

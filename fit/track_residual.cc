@@ -3,6 +3,7 @@
 #include <ceres/jet.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <utility>
@@ -60,6 +61,28 @@ bool ParseClockGrouping(const std::string& text, ClockGrouping* out) {
   return false;
 }
 
+std::string ClockGroupOf(const std::string& run_id, const std::string& trajectory,
+                         ClockGrouping grouping) {
+  if (grouping == ClockGrouping::kPerRun) return run_id;
+  if (grouping == ClockGrouping::kPerSession) return trajectory;
+  return "all";
+}
+
+int ShiftGroundTruthClocks(const std::vector<std::pair<std::string, double>>& offset_of_group,
+                           ClockGrouping grouping, std::vector<RunLog>* logs) {
+  int moved = 0;
+  for (RunLog& log : *logs) {
+    const std::string group = ClockGroupOf(log.id, log.trajectory, grouping);
+    for (const auto& [name, offset_s] : offset_of_group) {
+      if (name != group) continue;
+      for (double& t : log.ground_truth.t_s) t -= offset_s;
+      ++moved;
+      break;
+    }
+  }
+  return moved;
+}
+
 TrackFitData MakeTrackFitData(const std::vector<AlignedRun>& runs,
                               const std::vector<const GroundTruthTrack*>& ground_truth,
                               ClockGrouping grouping, const TrackResidualOptions& options) {
@@ -71,9 +94,7 @@ TrackFitData MakeTrackFitData(const std::vector<AlignedRun>& runs,
   out.estimate_clock_offsets = grouping != ClockGrouping::kNone;
   for (std::size_t i = 0; i < runs.size(); ++i) {
     TrackCheckpoints t = MakeTrackCheckpoints(runs[i], *ground_truth[i], options);
-    const std::string group = grouping == ClockGrouping::kPerRun       ? runs[i].id
-                              : grouping == ClockGrouping::kPerSession ? runs[i].trajectory
-                                                                       : "all";
+    const std::string group = ClockGroupOf(runs[i].id, runs[i].trajectory, grouping);
     const auto found = std::find(out.clock_groups.begin(), out.clock_groups.end(), group);
     t.clock_group = static_cast<int>(found - out.clock_groups.begin());
     if (found == out.clock_groups.end()) out.clock_groups.push_back(group);
@@ -125,8 +146,6 @@ T HuberFactor(const T& s, double c) {
   return sqrt((2.0 * c * sqrt(s) - c * c) / s);
 }
 
-// Jet dimensions: the odometry pose (x, y, theta) and the clock offset.
-using ErrorJet = ceres::Jet<double, 4>;
 
 }  // namespace
 
@@ -167,6 +186,46 @@ ceres::CostFunction* TrackResidual::Create(const TrackCheckpoints& track,
   return new TrackResidual(track, model, weights, options);
 }
 
+Pose2<TrackResidual::ErrorJet> TrackResidual::GroundTruthAtStart(double dt_s) const {
+  return InterpolateAt(*track_.ground_truth, ErrorJet(track_.t_start_s + dt_s, 3));
+}
+
+// r_k of the header for the odometry poses `pose` (3 per checkpoint), as Jets in (P_k, dt).
+std::array<TrackResidual::ErrorJet, 3> TrackResidual::CheckpointResidual(
+    const std::vector<double>& pose, int k, const Pose2<ErrorJet>& q0, double dt_s) const {
+  using std::cos;
+  using std::sin;
+  const Pose2<ErrorJet> p{ErrorJet(pose[3 * k], 0), ErrorJet(pose[3 * k + 1], 1),
+                          ErrorJet(pose[3 * k + 2], 2)};
+  const Pose2<ErrorJet> q =
+      Between(q0, InterpolateAt(*track_.ground_truth, ErrorJet(track_.t_s[k] + dt_s, 3)));
+  const double inv_xy = 1.0 / weights_.position_sigma_m;
+  const double inv_th = 1.0 / weights_.heading_sigma_rad;
+  const ErrorJet cq = cos(q.theta), sq = sin(q.theta);
+  const ErrorJet ex = p.x - q.x, ey = p.y - q.y;
+  const ErrorJet e[3] = {(cq * ex + sq * ey) * inv_xy, (-sq * ex + cq * ey) * inv_xy,
+                         WrapAngle(p.theta - q.theta) * inv_th};
+  const ErrorJet factor =
+      run_weight_ * HuberFactor(e[0] * e[0] + e[1] * e[1] + e[2] * e[2], huber_scale_);
+  return {factor * e[0], factor * e[1], factor * e[2]};
+}
+
+std::vector<double> TrackResidual::OdometryFromStart(const double* p) const {
+  std::vector<double> pose(num_residuals());
+  const double* parameters[] = {p};
+  if (!odometry_->Evaluate(parameters, pose.data(), nullptr)) pose.assign(pose.size(), HUGE_VAL);
+  return pose;
+}
+
+double TrackResidual::SquaredNormAt(const std::vector<double>& pose, double dt_s) const {
+  const Pose2<ErrorJet> q0 = GroundTruthAtStart(dt_s);
+  double sum = 0.0;
+  for (int k = 0; k < num_residuals() / 3; ++k) {
+    for (const ErrorJet& r : CheckpointResidual(pose, k, q0, dt_s)) sum += r.a * r.a;
+  }
+  return sum;
+}
+
 bool TrackResidual::Evaluate(double const* const* parameters, double* residuals,
                              double** jacobians) const {
   const int m = num_residuals();
@@ -180,25 +239,11 @@ bool TrackResidual::Evaluate(double const* const* parameters, double* residuals,
     return false;
   }
   const double dt_s = parameters[1][0];
-  const ErrorJet t0 = ErrorJet(track_.t_start_s + dt_s, 3);
-  const Pose2<ErrorJet> q0 = InterpolateAt(*track_.ground_truth, t0);
-  const double inv_xy = 1.0 / weights_.position_sigma_m;
-  const double inv_th = 1.0 / weights_.heading_sigma_rad;
+  const Pose2<ErrorJet> q0 = GroundTruthAtStart(dt_s);
   for (int k = 0; k < m / 3; ++k) {
-    const Pose2<ErrorJet> p{ErrorJet(pose[3 * k], 0), ErrorJet(pose[3 * k + 1], 1),
-                            ErrorJet(pose[3 * k + 2], 2)};
-    const Pose2<ErrorJet> q =
-        Between(q0, InterpolateAt(*track_.ground_truth, ErrorJet(track_.t_s[k] + dt_s, 3)));
-    using std::cos;
-    using std::sin;
-    const ErrorJet cq = cos(q.theta), sq = sin(q.theta);
-    const ErrorJet ex = p.x - q.x, ey = p.y - q.y;
-    ErrorJet e[3] = {(cq * ex + sq * ey) * inv_xy, (-sq * ex + cq * ey) * inv_xy,
-                     WrapAngle(p.theta - q.theta) * inv_th};
-    const ErrorJet factor =
-        run_weight_ * HuberFactor(e[0] * e[0] + e[1] * e[1] + e[2] * e[2], huber_scale_);
+    const std::array<ErrorJet, 3> rk = CheckpointResidual(pose, k, q0, dt_s);
     for (int i = 0; i < 3; ++i) {
-      const ErrorJet r = factor * e[i];
+      const ErrorJet& r = rk[i];
       const int row = 3 * k + i;
       residuals[row] = r.a;
       if (jacobians == nullptr) continue;

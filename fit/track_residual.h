@@ -16,6 +16,13 @@
 // Huber loss rho(s) = s below c^2, 2 c sqrt(s) - c^2 above (Ceres' convention). A run of 40 m
 // weighs what a run of 4 m does; a ground-truth glitch at one checkpoint grows the cost linearly.
 //
+// The ground truth at t + dt is interpolated linearly between its samples, as everywhere else.
+// Its derivative in dt is piecewise constant (the sample interval's velocity) and the cost has a
+// kink wherever a checkpoint crosses a sample - on a synchronised file (OptiOdom), where the
+// ground truth is sampled at the encoder times the checkpoints lie on, every checkpoint at once.
+// FitModel therefore does not let Gauss-Newton step in dt: it estimates the offsets by turns with
+// the parameters, each offset by a search on this exact cost (fit/model_fit.cc).
+//
 // Why the clock offset: the encoders and the ground truth are on different clocks (OptiOdom's
 // are mapped by hand-picked instants); a lag dt moves each checkpoint by |v| dt. The final pose,
 // at rest, does not see it; the track does. dt is one more parameter block, bounded, shared by
@@ -26,10 +33,13 @@
 // error, the interpolation in time and the loss.
 
 #include <ceres/cost_function.h>
+#include <ceres/jet.h>
 
+#include <array>
 #include <cstddef>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "models/model_interface.h"
@@ -61,6 +71,18 @@ struct TrackCheckpoints {
 enum class ClockGrouping { kPerSession, kPerRun, kDataset, kNone };
 const char* ToString(ClockGrouping grouping);  // "session", "run", "dataset", "none"
 bool ParseClockGrouping(const std::string& text, ClockGrouping* out);
+
+// The clock group a run belongs to under `grouping`: its trajectory label (session), its id
+// (run), or "all" (dataset, and none).
+std::string ClockGroupOf(const std::string& run_id, const std::string& trajectory,
+                         ClockGrouping grouping);
+
+// Applies clock offsets to recorded runs: every ground-truth stamp of a run whose clock group
+// (ClockGroupOf) has an offset dt moves to t - dt, so that the ground truth read at encoder time
+// t is the one stamped t + dt (the offsets' meaning, header): the values the track residual
+// interpolates at t + dt. Returns how many runs moved.
+int ShiftGroundTruthClocks(const std::vector<std::pair<std::string, double>>& offset_of_group,
+                           ClockGrouping grouping, std::vector<RunLog>* logs);
 
 // The training runs' tracks for the track residuals: one TrackCheckpoints per training run (same
 // order), each naming its clock group (0 .. clock_groups.size() - 1).
@@ -95,7 +117,19 @@ class TrackResidual : public ceres::CostFunction {
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
+  // The same residuals in two steps, for a search over dt with the parameters held (the replay
+  // does not depend on dt): the odometry's pose at every checkpoint from the run's start (3
+  // values each; HUGE_VAL when the replay fails), then |r|^2 for those poses at dt.
+  std::vector<double> OdometryFromStart(const double* p) const;
+  double SquaredNormAt(const std::vector<double>& pose_from_start, double dt_s) const;
+
  private:
+  // Jet dimensions: the odometry pose (x, y, theta) and the clock offset.
+  using ErrorJet = ceres::Jet<double, 4>;
+  Pose2<ErrorJet> GroundTruthAtStart(double dt_s) const;
+  std::array<ErrorJet, 3> CheckpointResidual(const std::vector<double>& pose, int k,
+                                             const Pose2<ErrorJet>& q0, double dt_s) const;
+
   TrackResidual(const TrackCheckpoints& track, const RobotModelInterface& model,
                 const ResidualWeights& weights, const TrackResidualOptions& options);
 

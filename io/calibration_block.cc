@@ -46,6 +46,25 @@ void EmitUncertainty(YAML::Emitter& out, const CalibrationBlock& c, const Robot&
   out.SetDoublePrecision(10);
 }
 
+// clock_offsets: {grouping, meaning, groups: [{group, offset_s, sigma_s}]}
+void EmitClockOffsets(YAML::Emitter& out, const CalibrationBlock& c) {
+  if (c.clock_offsets.empty()) return;
+  out << YAML::Key << "clock_offsets" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "grouping" << YAML::Value << c.clock_offset_grouping;
+  out << YAML::Key << "meaning" << YAML::Value
+      << "ground truth stamped t + offset_s belongs to encoder time t: subtract offset_s from "
+         "the ground truth's stamps of the group's runs to align them";
+  out << YAML::Key << "groups" << YAML::Value << YAML::BeginSeq;
+  out.SetDoublePrecision(6);
+  for (const ClockOffsetRecord& r : c.clock_offsets) {
+    out << YAML::Flow << YAML::BeginMap << YAML::Key << "group" << YAML::Value << YamlText(r.group)
+        << YAML::Key << "offset_s" << YAML::Value << r.offset_s << YAML::Key << "sigma_s"
+        << YAML::Value << r.sigma_s << YAML::EndMap;
+  }
+  out.SetDoublePrecision(10);
+  out << YAML::EndSeq << YAML::EndMap;
+}
+
 }  // namespace
 
 void EmitCalibrationOrigin(YAML::Emitter& out, const CalibrationSource& c) {
@@ -89,6 +108,7 @@ std::string CalibrationBlockYaml(const CalibrationBlock& c, const Robot& robot) 
   out << YAML::Key << "held" << YAML::Value << YAML::Flow << c.held;
   out << YAML::Key << "at_bound" << YAML::Value << YAML::Flow << c.at_bound;
   EmitUncertainty(out, c, robot);
+  EmitClockOffsets(out, c);
   out << YAML::EndMap << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }

@@ -38,6 +38,15 @@ struct CalibrationSource {
   std::vector<std::string> at_bound;  // parameter names resting on a bound
 };
 
+// A clock offset the track fit estimated (fit/track_residual.h): the ground truth stamped
+// t + offset_s belongs to encoder time t, for the runs of `group` (a session: the runs'
+// trajectory label; a run id; or "all").
+struct ClockOffsetRecord {
+  std::string group;
+  double offset_s = 0.0;
+  double sigma_s = 0.0;  // 0: no covariance
+};
+
 struct CalibrationBlock : CalibrationSource {
   // The result gate (which candidate won, on which runs it was judged).
   std::string selected;
@@ -46,6 +55,10 @@ struct CalibrationBlock : CalibrationSource {
   bool has_uncertainty = false;
   std::vector<double> sigma;  // one sigma per parameter, SI and rad
   Eigen::MatrixXd correlation;
+  // The clock offsets fitted with the parameters (`clock_offsets:`; none when not estimated) and
+  // how runs were grouped ("session", "run", "dataset").
+  std::string clock_offset_grouping;
+  std::vector<ClockOffsetRecord> clock_offsets;
 };
 
 // YAML text of the block, starting with "calibration:\n" and indented two spaces; angles' sigmas

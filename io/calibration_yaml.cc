@@ -96,6 +96,30 @@ void ReadUncertainty(const YAML::Node& block, const std::string& path, Calibrati
   }
 }
 
+// calibration.clock_offsets, when present.
+void ReadClockOffsets(const YAML::Node& block, const std::string& path, CalibrationProvenance* p) {
+  const YAML::Node node = block["clock_offsets"];
+  if (!node || node.IsNull()) return;
+  ExpectYamlType(node, YAML::NodeType::Map, path, "calibration.clock_offsets");
+  p->clock_offset_grouping = OptionalString(node, "grouping", path);
+  const YAML::Node groups = node["groups"];
+  if (!groups) return;
+  ExpectYamlType(groups, YAML::NodeType::Sequence, path, "calibration.clock_offsets.groups");
+  for (const YAML::Node& g : groups) {
+    ExpectYamlType(g, YAML::NodeType::Map, path, "calibration.clock_offsets.groups");
+    CalibrationProvenance::ClockOffset c;
+    c.group = YamlString(g["group"], path, "calibration.clock_offsets.groups.group");
+    c.offset_s = YamlDouble(g["offset_s"], path, "calibration.clock_offsets.groups.offset_s");
+    c.sigma_s = YamlDouble(g["sigma_s"], path, "calibration.clock_offsets.groups.sigma_s");
+    if (!std::isfinite(c.offset_s) || !std::isfinite(c.sigma_s) || c.sigma_s < 0.0) {
+      throw InputError(InputErrorKind::kBadValue, path, g.Mark().line + 1,
+                       "calibration.clock_offsets: offset_s and sigma_s must be finite, sigma_s "
+                       ">= 0");
+    }
+    p->clock_offsets.push_back(c);
+  }
+}
+
 }  // namespace
 
 std::optional<std::vector<int>> ReadCalibrationTrainingRepetitions(const std::string& path) {
@@ -131,6 +155,7 @@ std::optional<CalibrationProvenance> ReadCalibrationProvenance(const std::string
     p.has_training_cf = true;
   }
   ReadUncertainty(block, path, &p);
+  ReadClockOffsets(block, path, &p);
   return p;
 }
 

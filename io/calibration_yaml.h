@@ -32,6 +32,15 @@ struct CalibrationProvenance {
   // file records `sigma: ~`.
   std::vector<std::pair<std::string, double>> sigma;
   std::vector<std::vector<double>> correlation;
+  // `clock_offsets:` (io/calibration_block.h): how runs were grouped, and each group's offset
+  // (seconds; the ground truth stamped t + offset belongs to encoder time t) and sigma.
+  std::string clock_offset_grouping;
+  struct ClockOffset {
+    std::string group;
+    double offset_s = 0.0;
+    double sigma_s = 0.0;
+  };
+  std::vector<ClockOffset> clock_offsets;
 };
 
 // nullopt for a plain robot YAML; InputError (file, line) for a malformed block.

@@ -21,6 +21,7 @@
 
 #include "fit/final_pose_errors.h"
 #include "fit/model_fit.h"
+#include "fit/track_residual.h"
 #include "io/calibration_yaml.h"
 #include "io/dataset.h"
 #include "io/rosbag2/bag_reader.h"
@@ -276,6 +277,42 @@ INSTANTIATE_TEST_SUITE_P(
                       BagCase{"mcap_zstd_rests", StorageFormat::kMcap, Compression::kZstd, true},
                       BagCase{"mcap_lz4_runs", StorageFormat::kMcap, Compression::kLz4, false}),
     [](const ::testing::TestParamInfo<BagCase>& p) { return p.param.name; });
+
+// A ground truth whose headers are stamped 0.15 s late (a motion-capture bridge's latency),
+// imported as it is: the runs of one bag share its label, so `--clock-offsets session` is one
+// offset for the bag, and the track fit recovers it like any other data set's (within 4 of its
+// sigmas plus half an encoder period, the replay's timing convention: tests/clock_offset_test.cc).
+TEST(ImportRosbag2ClockOffset, OneOffsetPerBagRecoversAPoseLatency) {
+  constexpr std::int64_t kLatencyNs = 150000000;
+  testing::TempDir tmp;
+  const RobotModelPtr model = ReadRobotModel(YAML::Load(kRobotYaml), "robot.yaml");
+  BagEdits edits;
+  edits.pose = [](std::size_t, PoseStamped* p) {
+    const std::int64_t ns = static_cast<std::int64_t>(p->header.stamp.sec) * 1000000000 +
+                            p->header.stamp.nanosec + kLatencyNs;
+    p->header.stamp = {static_cast<std::int32_t>(ns / 1000000000),
+                       static_cast<std::uint32_t>(ns % 1000000000)};
+  };
+  WriteRobotBag(tmp.path() / "bag", SimulatedRuns(*model), BagWriterOptions{}, edits);
+  tools::ImportRosbag2Options o = ImportOptions(tmp, tmp.path() / "bag");
+  o.split_at_rest_s = 2.0;
+  tools::ImportRosbag2(o);
+  const io::Dataset imported = io::LoadDataset(io::ReadDatasetIndex(o.out), model->robot());
+  const std::vector<AlignedRun> runs = AlignRuns(imported.runs);
+  std::vector<const GroundTruthTrack*> tracks;
+  for (const RunLog& log : imported.runs) tracks.push_back(&log.ground_truth);
+  const TrackFitData data = MakeTrackFitData(runs, tracks, ClockGrouping::kPerSession);
+  ASSERT_EQ(data.clock_groups.size(), 1u);
+  ModelFitOptions options;
+  options.residuals = ResidualKind::kTrack;
+  options.track = &data;
+  options.ceres.num_threads = 1;
+  const ModelFitResult fit = FitModel(runs, *model, options);
+  ASSERT_TRUE(fit.usable && fit.has_covariance) << fit.termination << fit.covariance_message;
+  EXPECT_NEAR(fit.clock_offsets_s[0], 1e-9 * kLatencyNs,
+              4.0 * fit.clock_offset_sigma_s[0] + 0.5 * kEncoderPeriodS);
+  EXPECT_LT(fit.clock_offset_sigma_s[0], 0.01);
+}
 
 // ---------------------------------------------------------------------------------------------
 // Malformed bags: one line, non-zero exit, nothing written (no data set, no temporary sibling).

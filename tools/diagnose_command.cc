@@ -26,6 +26,7 @@
 #include "models/model_registry.h"
 #include "odometry/parallel_for.h"
 #include "tools/cli_validators.h"
+#include "tools/clock_alignment.h"
 #include "tools/miswired_error.h"
 #include "tools/output_guard.h"
 #include "tools/report_command.h"
@@ -48,6 +49,11 @@ void AddDiagnoseOptions(CLI::App& cmd, DiagnoseCommandOptions& o) {
       ->excludes(reps);  // as fit: one split, not two that contradict each other
   cmd.add_flag("--clock-map", o.clock_map,
                "Re-stamp each run's ground truth on the encoder clock (speed-profile match)");
+  cmd.add_option("--clock-offsets", o.clock_offsets,
+                 "Re-stamp the ground truth by clock offsets estimated first per session, run or "
+                 "dataset (a track fit of the parameters on every run; only the offsets are kept)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"none", "session", "run", "dataset"}));
   cmd.add_option("--out", o.out,
                  "Output directory (index.html, metrics.json, diagnose.md, calibrated.yaml)")
       ->capture_default_str();
@@ -487,6 +493,9 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
       return 2;
     }
     std::vector<RunLog> runs = LoadRuns(options, index, &robot).runs;
+    const std::string aligned = AlignGroundTruthClocks(options.clock_offsets, *model, nullptr,
+                                                       std::nullopt, options.threads, &runs);
+    if (!aligned.empty()) std::printf("%s\n", aligned.c_str());
     if (options.clock_map) MapClocks(index.robot_path, *model, options.threads, &runs);
     if (!options.skip_wheel_order_check && ChannelsLookMiswired(options, *model, runs)) {
       return kMiswiredExitCode;

@@ -29,6 +29,10 @@ struct DiagnoseCommandOptions : DatasetCommandOptions {
   // Re-stamp each run's ground truth on the encoder clock first (fit/segment_cost.h,
   // EstimateClockMap): for recordings whose clocks were only mapped by hand.
   bool clock_map = false;
+  // Re-stamp each clock group's ground truth by an offset estimated first (tools/clock_alignment.h:
+  // a track fit of the parameters with one offset per session, run or the data set, on every
+  // run; only the offsets are kept); "none" keeps the stamps.
+  std::string clock_offsets = "none";
   std::string out = "diagnose";
   int max_effects = 3;
   double alpha = 0.01;

@@ -528,6 +528,18 @@ std::string DegreesOfFreedomRefusal(const RunSplit& split, const FitMethodSettin
                             residuals / runs);
 }
 
+// The clock offsets the track fit estimated, into the calibrated YAML's `clock_offsets:` (the
+// report and diagnose apply them to runs of the same groups).
+void RecordClockOffsets(const ModelFitResult& fit, const TrackFitData& track,
+                        ClockGrouping grouping, io::CalibrationBlock* record) {
+  if (!track.estimate_clock_offsets) return;
+  record->clock_offset_grouping = ToString(grouping);
+  for (std::size_t g = 0; g < track.clock_groups.size() && g < fit.clock_offsets_s.size(); ++g) {
+    const double sigma = g < fit.clock_offset_sigma_s.size() ? fit.clock_offset_sigma_s[g] : 0.0;
+    record->clock_offsets.push_back({track.clock_groups[g], fit.clock_offsets_s[g], sigma});
+  }
+}
+
 // The clock offsets the track fit estimated, with their sigmas: every group up to a dozen, their
 // range beyond.
 void PrintClockOffsets(const ModelFitResult& fit, const TrackFitData& track) {
@@ -906,8 +918,11 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   if (WorseThanNominalOnSomeKind(candidates, gate, split, errors)) return 5;
   WarnOfEffects(candidates, gate, split, errors);
   if (!options.no_output) {
-    const io::CalibrationBlock record =
+    io::CalibrationBlock record =
         MakeRecord(options, *model, logs, split, candidates, gate, selected_fit, errors);
+    if (track_data && selected.name == options.method) {
+      RecordClockOffsets(fit, *track_data, settings.clock_grouping, &record);
+    }
     io::StopHereForTests("fitted");
     io::WriteFileAtomically(options.out, model->RobotYaml(selected.parameters, selected.effects,
                                                           io::CalibrationBlockYaml(record, robot)));

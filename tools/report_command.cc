@@ -19,7 +19,9 @@
 #include "io/robot_yaml.h"
 #include "io/staged_directory.h"
 #include "models/model_registry.h"
+#include "odometry/effects.h"
 #include "tools/cli_validators.h"
+#include "tools/clock_alignment.h"
 #include "tools/output_guard.h"
 #include "tools/report_builder.h"
 #include "validation/trajectory_metrics.h"
@@ -55,6 +57,11 @@ ReportInputs LoadInputs(const ReportCommandOptions& options, std::string* refusa
     }
     in.calibrations.push_back({path, std::move(calibrated), io::ReadCalibrationProvenance(path)});
   }
+  const CalibrationInput& first = in.calibrations.front();
+  const std::string aligned =
+      AlignGroundTruthClocks(options.clock_offsets, *in.model, &first.calibrated.nominal,
+                             first.provenance, options.threads, &in.dataset.runs);
+  if (!aligned.empty()) std::printf("%s\n", aligned.c_str());
   return in;
 }
 
@@ -143,6 +150,12 @@ void AddReportOptions(CLI::App& app, ReportCommandOptions& o) {
   app.add_flag("--tum", o.tum,
                "Also write tum/<run>.{ground_truth,nominal,calibrated}.tum of every judged run "
                "(for evo_ape / evo_rpe; docs/tum.md)");
+  app.add_option("--clock-offsets", o.clock_offsets,
+                 "Ground-truth clock: the offsets the calibration records (recorded), none, or "
+                 "estimated here per session, run or dataset with the calibrated parameters "
+                 "held (docs/everyday_driving.md)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"recorded", "none", "session", "run", "dataset"}));
   app.add_option("--worst-runs", o.worst_runs,
                  "Draw the error along time of this many of the worst validation runs")
       ->capture_default_str()

@@ -31,6 +31,9 @@ struct ReportCommandOptions : DatasetCommandOptions {
   // Also write tum/<run>.{ground_truth,nominal,calibrated}.tum for every judged run (io/tum_file.h,
   // docs/tum.md): the samples the drift and ATE figures of metrics.json are computed on.
   bool tum = false;
+  // The ground truth's clock (tools/clock_alignment.h): the calibration's recorded offsets, none,
+  // or offsets estimated here per session, run or data set with the calibrated parameters held.
+  std::string clock_offsets = "recorded";
 };
 
 // Exit statuses of `report --strict` (README, exit codes): the report is written either way.
