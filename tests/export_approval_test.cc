@@ -74,16 +74,20 @@ const Export kExports[] = {
 
 class ExportApproval : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() {
+  // In SetUp, not SetUpTestSuite: a failure there fails the test (a suite's set-up failure
+  // only skips it, and ctest counts a skip as a pass).
+  void SetUp() override {
     dir_ = new TempDir();
     const std::string omni_robot = dir_->Write("tangential4.yaml", kTangentialOmniYaml);
     Prepare("diff", "--model diff_drive --repetitions 2", "--train-reps 1");
     Prepare("tricycle", "--model tricycle --repetitions 2", "--train-reps 1");
     Prepare("mecanum", "--model omni --repetitions 2", "--train-reps 1");
     Prepare("omni", "--model omni --robot " + omni_robot + " --repetitions 2", "--train-reps 1");
-    Prepare("omni3", "--repetitions 1", "");
+    Prepare("omni3", "--repetitions 1 --robot " + std::string(FITCAL_SOURCE_DIR) +
+                         "/data/robots/apr02.yaml",
+            "");
   }
-  static void TearDownTestSuite() {
+  void TearDown() override {
     delete dir_;
     dir_ = nullptr;
   }
