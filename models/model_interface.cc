@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <numeric>
+#include <stdexcept>
 
 namespace fitcal {
 
@@ -72,6 +73,22 @@ std::vector<ChannelMapping> RobotModelInterface::CandidateMiswirings() const {
   std::stable_partition(out.begin(), out.end(),
                         [](const ChannelMapping& m) { return m.IsIdentity(); });
   return out;
+}
+
+std::optional<int> ParameterIndex(const Robot& robot, const std::string& name) {
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    if (robot.parameters[k].name == name) return k;
+  }
+  return std::nullopt;
+}
+
+int RequireParameterIndex(const Robot& robot, const std::string& name) {
+  const std::optional<int> k = ParameterIndex(robot, name);
+  if (!k) {
+    throw std::logic_error("robot '" + robot.name + "' (model " + robot.model +
+                           ") has no parameter '" + name + "'");
+  }
+  return *k;
 }
 
 }  // namespace fitcal

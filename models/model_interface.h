@@ -19,6 +19,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -163,5 +164,12 @@ class RobotModelInterface {
 };
 
 using RobotModelPtr = std::shared_ptr<const RobotModelInterface>;
+
+// The name <-> index table of a model's parameters (issue 30): robot.parameters[k].name names
+// p[k] ("r_left", "wheel_separation", "R_a", "delta_a"; per-wheel names end in the channel's
+// name). Code outside models/ finds a parameter by its name, never by its position in p.
+std::optional<int> ParameterIndex(const Robot& robot, const std::string& name);
+// The same for a parameter the caller knows the model has: std::logic_error when it has not.
+int RequireParameterIndex(const Robot& robot, const std::string& name);
 
 }  // namespace fitcal

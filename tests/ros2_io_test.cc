@@ -582,7 +582,10 @@ TEST(Rosbag2ReadOnly, BagDirectoryUnchanged) {
 struct Exported {
   YAML::Node params;
   tools::Ros2ControlExport e;
-  RobotModelPtr back;
+  // What the controller computes (e.model at e.parameters), by parameter name.
+  double Back(const std::string& name) const {
+    return e.parameters[RequireParameterIndex(e.model->robot(), name)];
+  }
 };
 
 Exported ExportAndRead(const std::string& cal, const std::string& controller) {
@@ -592,12 +595,43 @@ Exported ExportAndRead(const std::string& cal, const std::string& controller) {
   EXPECT_TRUE(root[controller]) << x.e.parameters_yaml;
   x.params = root[controller]["ros__parameters"];
   EXPECT_TRUE(x.params.IsMap()) << x.e.parameters_yaml;
-  x.back = tools::ReadRos2ControlYaml(x.e.parameters_yaml, "exported", cal, {});
+  EXPECT_EQ(x.e.parameters.size(), x.e.model->robot().parameters.size());
   return x;
 }
 
-// Round trips go through 12-digit decimals: 1e-11 relative.
+// The controller reads 12-digit decimals: 1e-11 relative.
 constexpr double kRoundTrip = 1e-11;
+
+// The tables the export reads the calibration through (models/model_interface.h,
+// models/omni/omni_model.h): parameters by name, an omni robot's wheels with their fixed geometry.
+TEST(ExportRos2Control, ParametersByNameAndOmniWheelsFromTheModel) {
+  const RobotModelPtr diff = ReadRobotModel(YAML::Load(kRobotYaml), "robot.yaml");
+  EXPECT_EQ(ParameterIndex(diff->robot(), "r_left"), 1);
+  EXPECT_EQ(ParameterIndex(diff->robot(), "wheel_separation"), 2);
+  EXPECT_FALSE(ParameterIndex(diff->robot(), "R_left"));
+  EXPECT_THROW(RequireParameterIndex(diff->robot(), "wheelbase"), std::logic_error);
+  EXPECT_FALSE(OmniWheelsOf(*diff, diff->robot().nominal));
+
+  const RobotModelPtr mecanum = ReadRobotModel(YAML::Load(kOmniExampleYaml), "robot.yaml");
+  std::vector<double> p = mecanum->robot().nominal;
+  p[RequireParameterIndex(mecanum->robot(), "r_rl")] = 0.052;
+  const std::vector<OmniWheel> wheels = *OmniWheelsOf(*mecanum, p);
+  ASSERT_EQ(wheels.size(), 4u);
+  EXPECT_EQ(wheels[2].name, "rl");
+  EXPECT_EQ(wheels[2].radius_m, 0.052);
+  EXPECT_NEAR(wheels[1].angle_rad, -36.86989765 * M_PI / 180, 1e-12);
+  for (const OmniWheel& w : wheels) EXPECT_NEAR(w.drive_angle_rad, 0.0, 1e-12) << w.name;
+  EXPECT_NEAR(wheels[1].roller_angle_rad, M_PI / 4, 1e-12);
+
+  const RobotModelPtr omni3 = ReadRobotModel(YAML::Load(kOmni3ExampleYaml), "robot.yaml");
+  const std::optional<std::vector<OmniWheel>> omni3_wheels =
+      OmniWheelsOf(*omni3, omni3->robot().nominal);
+  ASSERT_TRUE(omni3_wheels);
+  for (const OmniWheel& w : *omni3_wheels) {
+    EXPECT_EQ(w.drive_angle_rad, w.angle_rad + M_PI / 2) << w.name;  // tangential, CCW
+    EXPECT_EQ(w.roller_angle_rad, 0.0);
+  }
+}
 
 TEST(ExportRos2Control, DiffDriveIsExact) {
   testing::TempDir tmp;
@@ -612,8 +646,9 @@ TEST(ExportRos2Control, DiffDriveIsExact) {
   EXPECT_TRUE(x.e.notes.empty());
   const double r = x.params["wheel_radius"].as<double>();
   EXPECT_NEAR(r * x.params["right_wheel_radius_multiplier"].as<double>(), kTruth[0], 1e-12);
+  const char* const names[] = {"r_right", "r_left", "wheel_separation"};  // kTruth's order
   for (int k = 0; k < 3; ++k) {
-    EXPECT_NEAR(x.back->robot().nominal[k], kTruth[k], kRoundTrip * kTruth[k]) << k;
+    EXPECT_NEAR(x.Back(names[k]), kTruth[k], kRoundTrip * kTruth[k]) << names[k];
   }
   EXPECT_THROW(tools::ExportRos2Control(cal, "tricycle_controller", "", {}), std::invalid_argument);
   EXPECT_THROW(tools::ExportRos2Control(cal, "ackermann_controller", "", {}),
@@ -640,7 +675,9 @@ TEST(ExportRos2Control, MecanumTakesMeans) {
       0.26 * (std::cos(36.86989765 * M_PI / 180) + std::sin(36.86989765 * M_PI / 180));
   EXPECT_NEAR(k["sum_of_robot_center_projection_on_X_Y_axis"].as<double>(), (fl + 3 * 0.35) / 4,
               1e-9);
-  for (int i = 0; i < 4; ++i) EXPECT_NEAR(x.back->robot().nominal[4 + i], mean_r, kRoundTrip);
+  for (const char* wheel : {"fl", "fr", "rl", "rr"}) {
+    EXPECT_NEAR(x.Back(std::string("r_") + wheel), mean_r, kRoundTrip);
+  }
 }
 
 TEST(ExportRos2Control, OmniWheelsEquallySpacedAndSignNoted) {
@@ -661,11 +698,12 @@ TEST(ExportRos2Control, OmniWheelsEquallySpacedAndSignNoted) {
   const double offset = x.params["wheel_offset"].as<double>();
   // The circular mean of the angles' offsets (0, 0, -0.01 rad): -0.01 / 3 to O(0.01^3).
   EXPECT_NEAR(offset, 60 * M_PI / 180 - 0.01 / 3, 1e-6);
-  const std::vector<double>& back = x.back->robot().nominal;
+  const char* const wheels[] = {"a", "b", "c"};
   for (int i = 0; i < 3; ++i) {
-    EXPECT_NEAR(back[i], (0.197 + 2 * 0.195) / 3, kRoundTrip);
-    EXPECT_NEAR(back[3 + i], (0.150 + 2 * 0.148) / 3, kRoundTrip);
-    EXPECT_NEAR(WrapAngle(back[6 + i] - offset - 2 * M_PI * i / 3), 0.0, 1e-9);
+    const std::string w = wheels[i];
+    EXPECT_NEAR(x.Back("R_" + w), (0.197 + 2 * 0.195) / 3, kRoundTrip);
+    EXPECT_NEAR(x.Back("r_" + w), (0.150 + 2 * 0.148) / 3, kRoundTrip);
+    EXPECT_NEAR(WrapAngle(x.Back("delta_" + w) - offset - 2 * M_PI * i / 3), 0.0, 1e-9);
   }
 }
 
@@ -680,9 +718,10 @@ TEST(ExportRos2Control, TricycleDropsTheSteeringOffset) {
   EXPECT_EQ(x.params["steering_joint_name"].as<std::string>(), "steering");
   ASSERT_EQ(x.e.notes.size(), 1u);
   EXPECT_NE(x.e.notes[0].find("+1.500000 deg"), std::string::npos) << x.e.notes[0];
-  EXPECT_NEAR(x.back->robot().nominal[0], 0.0331, kRoundTrip);
-  EXPECT_NEAR(x.back->robot().nominal[1], 0.152, kRoundTrip);
-  EXPECT_EQ(x.back->robot().nominal[2], 0.0);
+  const std::string traction = "r_" + x.e.model->robot().channels[0].name;
+  EXPECT_NEAR(x.Back(traction), 0.0331, kRoundTrip);
+  EXPECT_NEAR(x.Back("wheelbase"), 0.152, kRoundTrip);
+  EXPECT_EQ(x.Back("steering_offset"), 0.0);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -830,14 +869,13 @@ TEST(ExportRos2Control, TricycleOffsetStatedWithSignAndPlace) {
        sim::SimulateRuns(*model, truth, sim::TricycleTrajectories(shapes), o)) {
     runs.push_back(AlignRun(r.log));
   }
-  const RobotModelPtr exported = tools::ReadRos2ControlYaml(e.parameters_yaml, "exported", cal, {});
   const double added_rad = std::stod(note.substr(note.find("add ") + 4));
   const auto moved = [&](double by_rad) {
     std::vector<AlignedRun> out = runs;
     for (AlignedRun& r : out) {
       for (std::size_t k = 0; k < r.samples.size(); ++k) r.samples[k].value[1] += by_rad;
     }
-    return EvaluateFinalPoseErrors(*exported, exported->robot().nominal, out).cf;
+    return EvaluateFinalPoseErrors(*e.model, e.parameters, out).cf;
   };
   const double cf_exact = EvaluateFinalPoseErrors(*model, truth, runs).cf;
   EXPECT_NEAR(moved(added_rad), cf_exact, 1e-9);  // noise-free runs: both ~0

@@ -1,11 +1,10 @@
 #include "tools/export_ros2_control.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <numeric>
@@ -17,22 +16,19 @@
 #include "io/atomic_file.h"
 #include "io/calibration_yaml.h"
 #include "io/dataset.h"
-#include "io/input_error.h"
-#include "io/yaml_reader.h"
+#include "io/text_file.h"
 #include "models/diff_drive/diff_drive_model.h"
 #include "models/model_registry.h"
+#include "models/omni/omni_model.h"
+#include "models/tricycle/tricycle_kinematics.h"
 #include "odometry/aligned_run.h"
 #include "odometry/effects.h"
-#include "io/text_file.h"
+#include "tools/output_guard.h"
 #include "validation/odometry_covariance.h"
 #include "validation/training_runs.h"
-#include "tools/output_guard.h"
 
 namespace fitcal::tools {
 namespace {
-
-using io::InputError;
-using io::InputErrorKind;
 
 constexpr double kDeg = M_PI / 180.0;
 // Fixed geometry (drive and roller angles) is written by fitcal with 10 significant digits: a
@@ -57,19 +53,25 @@ std::string NameList(const std::vector<std::string>& names) {
   return out + "]";
 }
 
+// A value as the controller reads it back from the YAML Num wrote (12 significant digits): the
+// replay runs the parameters the controller will run.
+double AsWritten(double v) { return std::strtod(Num(v).c_str(), nullptr); }
+
+// The calibrated robot, read once through the model registry, and the joint of each channel.
 struct Calibrated {
   RobotModelPtr model;
-  YAML::Node root;
   std::vector<std::string> joints;  // robot channel order
   const Robot& robot() const { return model->robot(); }
-  const std::vector<double>& p() const { return model->robot().nominal; }
+  // The calibrated value of a parameter, found by name in the model's parameter table.
+  int Index(const std::string& name) const { return RequireParameterIndex(robot(), name); }
+  double Value(const std::string& name) const { return robot().nominal[Index(name)]; }
+  const std::string& ChannelName(int i) const { return robot().channels[i].name; }
 };
 
-Calibrated ReadCalibrated(const std::string& path, const std::vector<std::string>& joints) {
+Calibrated WithJoints(RobotModelPtr model, const std::vector<std::string>& joints) {
   Calibrated c;
-  c.root = io::LoadYamlFile(path);
-  c.model = ReadRobotModel(c.root, path);
-  const Robot& robot = c.model->robot();
+  c.model = std::move(model);
+  const Robot& robot = c.robot();
   if (!joints.empty() && joints.size() != robot.channels.size()) {
     throw std::invalid_argument("--joints names " + std::to_string(joints.size()) +
                                 " joints; robot '" + robot.name + "' has " +
@@ -81,27 +83,12 @@ Calibrated ReadCalibrated(const std::string& path, const std::vector<std::string
   return c;
 }
 
-// One wheel of an omni / omni3 robot: position, radius and fixed geometry (omni_kinematics.h).
-struct OmniWheelGeometry {
-  double distance_m, angle_rad, radius_m, drive_rad, roller_rad;
-};
-
-std::vector<OmniWheelGeometry> OmniGeometry(const Calibrated& c) {
-  const int n = c.robot().NumChannels();
-  std::vector<OmniWheelGeometry> out;
-  for (int i = 0; i < n; ++i) {
-    OmniWheelGeometry w{c.p()[i], c.p()[2 * n + i], c.p()[n + i], 0.0, 0.0};
-    w.drive_rad = w.angle_rad + M_PI / 2.0;  // omni3 and the omni default: tangential, CCW
-    const YAML::Node yaml = c.root["wheels"][i];
-    if (c.robot().model == "omni" && yaml["drive_angle_deg"]) {
-      w.drive_rad = yaml["drive_angle_deg"].as<double>() * kDeg;
-    }
-    if (c.robot().model == "omni" && yaml["roller_angle_deg"]) {
-      w.roller_rad = yaml["roller_angle_deg"].as<double>() * kDeg;
-    }
-    out.push_back(w);
-  }
-  return out;
+// The wheels of an omni / omni3 robot at its calibrated values (models/omni/omni_model.h).
+std::vector<OmniWheel> OmniGeometry(const Calibrated& c) {
+  const std::optional<std::vector<OmniWheel>> wheels =
+      OmniWheelsOf(*c.model, c.robot().nominal);
+  if (!wheels) throw std::logic_error("robot '" + c.robot().name + "' has no omni wheels");
+  return *wheels;
 }
 
 double Mean(const std::vector<double>& v) {
@@ -121,20 +108,29 @@ void NoteSpread(const std::vector<double>& v, const std::string& what, const std
   notes->push_back(text);
 }
 
-std::string DiffDriveParameters(const Calibrated& c, const std::string& distro,
-                                std::vector<std::string>*) {
+void DiffDriveParameters(const Calibrated& c, const std::string& distro, Ros2ControlExport* out) {
   const int right = DiffDriveRightChannel(*c.model), left = 1 - right;
-  const double r_right = c.p()[right], r_left = c.p()[left];
-  const double radius = 0.5 * (r_right + r_left);
-  return "    left_wheel_names: " + NameList({c.joints[left]}) +
-         "\n    right_wheel_names: " + NameList({c.joints[right]}) +
-         // humble declares wheels_per_side (and overwrites it with the names' count); jazzy and
-         // rolling no longer declare it, and an undeclared key is ignored there.
-         (distro == "humble" ? "\n    wheels_per_side: 1" : "") + "\n    wheel_separation: " +
-         Num(c.p()[diff_drive::kSeparationIndex]) + "\n    wheel_radius: " + Num(radius) +
-         "\n    wheel_separation_multiplier: 1.0" +
-         "\n    left_wheel_radius_multiplier: " + Num(r_left / radius) +
-         "\n    right_wheel_radius_multiplier: " + Num(r_right / radius) + "\n";
+  const int k_right = c.Index("r_" + c.ChannelName(right));
+  const int k_left = c.Index("r_" + c.ChannelName(left));
+  const int k_separation = c.Index("wheel_separation");
+  const std::vector<double>& p = c.robot().nominal;
+  const double radius = 0.5 * (p[k_right] + p[k_left]);
+  out->parameters_yaml +=
+      "    left_wheel_names: " + NameList({c.joints[left]}) +
+      "\n    right_wheel_names: " + NameList({c.joints[right]}) +
+      // humble declares wheels_per_side (and overwrites it with the names' count); jazzy and
+      // rolling no longer declare it, and an undeclared key is ignored there.
+      (distro == "humble" ? "\n    wheels_per_side: 1" : "") + "\n    wheel_separation: " +
+      Num(p[k_separation]) + "\n    wheel_radius: " + Num(radius) +
+      "\n    wheel_separation_multiplier: 1.0" +
+      "\n    left_wheel_radius_multiplier: " + Num(p[k_left] / radius) +
+      "\n    right_wheel_radius_multiplier: " + Num(p[k_right] / radius) + "\n";
+  // The controller's wheels: wheel_radius times each side's multiplier, the separation times 1.
+  out->model = c.model;
+  out->parameters = p;
+  out->parameters[k_right] = AsWritten(radius) * AsWritten(p[k_right] / radius);
+  out->parameters[k_left] = AsWritten(radius) * AsWritten(p[k_left] / radius);
+  out->parameters[k_separation] = AsWritten(p[k_separation]);
 }
 
 // ros2_controllers' mecanum layout (its odometry: vx = r/4 (fl + rl + rr + fr), vy = r/4 (-fl +
@@ -150,7 +146,7 @@ constexpr MecanumCorner kCorners[] = {{"front_left", 1, 1, -45},
                                       {"rear_right", -1, -1, -45}};
 
 // The channel at each corner (kCorners order); std::invalid_argument when the layout differs.
-std::vector<int> MecanumCorners(const std::vector<OmniWheelGeometry>& wheels, const Robot& robot) {
+std::vector<int> MecanumCorners(const std::vector<OmniWheel>& wheels, const Robot& robot) {
   std::vector<int> at(4, -1);
   for (std::size_t i = 0; i < wheels.size(); ++i) {
     const double x = wheels[i].distance_m * std::cos(wheels[i].angle_rad);
@@ -158,8 +154,8 @@ std::vector<int> MecanumCorners(const std::vector<OmniWheelGeometry>& wheels, co
     for (int k = 0; k < 4; ++k) {
       if (x * kCorners[k].sign_x > 0 && y * kCorners[k].sign_y > 0) {
         const bool layout =
-            std::abs(WrapAngle(wheels[i].drive_rad)) < 15.0 * kDeg &&
-            std::abs(wheels[i].roller_rad - kCorners[k].roller_deg * kDeg) < kSameAngleRad;
+            std::abs(WrapAngle(wheels[i].drive_angle_rad)) < 15.0 * kDeg &&
+            std::abs(wheels[i].roller_angle_rad - kCorners[k].roller_deg * kDeg) < kSameAngleRad;
         if (!layout || at[k] >= 0) {
           throw std::invalid_argument(
               "wheel '" + robot.channels[i].name + "' (" + kCorners[k].key +
@@ -179,23 +175,43 @@ std::vector<int> MecanumCorners(const std::vector<OmniWheelGeometry>& wheels, co
   return at;
 }
 
-std::string MecanumParameters(const Calibrated& c, const std::string&,
-                              std::vector<std::string>* notes) {
+// Bounds of a robot built from a controller's values: its values lie inside (the replay never
+// fits it).
+OmniBounds ControllerBounds(double distance_m, double radius_m) {
+  return {{0.5 * distance_m, 2 * distance_m}, {0.5 * radius_m, 2 * radius_m},
+          {DegToRad(-2.0), DegToRad(2.0)}};
+}
+
+// What mecanum_drive_controller computes: its layout with one radius and lx = ly (any point with
+// |x| + |y| = lx + ly gives the controller's yaw row).
+RobotModelPtr MecanumKinematics(const Calibrated& c, const std::vector<int>& corner,
+                                double radius_m, double sum_m) {
+  const double distance_m = AsWritten(sum_m) / std::sqrt(2.0);
+  std::vector<OmniWheel> wheels(4);
+  for (int k = 0; k < 4; ++k) {
+    wheels[corner[k]] = {c.ChannelName(corner[k]), distance_m,
+                         std::atan2(kCorners[k].sign_y, kCorners[k].sign_x), AsWritten(radius_m),
+                         0.0, DegToRad(kCorners[k].roller_deg)};
+  }
+  return MakeOmniModel(c.robot().name, wheels, ControllerBounds(distance_m, AsWritten(radius_m)));
+}
+
+void MecanumParameters(const Calibrated& c, const std::string&, Ros2ControlExport* out) {
   if (c.robot().model != "omni" || c.robot().NumChannels() != 4) {
     throw std::invalid_argument("mecanum_drive_controller takes an omni robot of 4 mecanum wheels");
   }
-  const std::vector<OmniWheelGeometry> wheels = OmniGeometry(c);
+  const std::vector<OmniWheel> wheels = OmniGeometry(c);
   const std::vector<int> corner = MecanumCorners(wheels, c.robot());
   std::vector<double> radii, sums, drives;
-  for (const OmniWheelGeometry& w : wheels) {
+  for (const OmniWheel& w : wheels) {
     radii.push_back(w.radius_m);
     sums.push_back(std::abs(w.distance_m * std::cos(w.angle_rad)) +
                    std::abs(w.distance_m * std::sin(w.angle_rad)));
-    drives.push_back(std::abs(WrapAngle(w.drive_rad)));
+    drives.push_back(std::abs(WrapAngle(w.drive_angle_rad)));
   }
-  NoteSpread(radii, "radius", "kinematics.wheels_radius", 1.0, "m", notes);
+  NoteSpread(radii, "radius", "kinematics.wheels_radius", 1.0, "m", &out->notes);
   NoteSpread(sums, "lx + ly", "kinematics.sum_of_robot_center_projection_on_X_Y_axis", 1.0, "m",
-             notes);
+             &out->notes);
   const double worst_drive = *std::max_element(drives.begin(), drives.end());
   if (worst_drive > kSameAngleRad) {
     char text[200];
@@ -203,27 +219,29 @@ std::string MecanumParameters(const Calibrated& c, const std::string&,
                   "mecanum_drive_controller drives every wheel straight ahead: "
                   "calibrated drive directions up to %.4g deg off it are written as 0",
                   worst_drive / kDeg);
-    notes->push_back(text);
+    out->notes.push_back(text);
   }
-  std::string out;
   for (int k = 0; k < 4; ++k) {
-    out += std::string("    ") + kCorners[k].key +
-           "_wheel_command_joint_name: " + Quoted(c.joints[corner[k]]) + "\n";
+    out->parameters_yaml += std::string("    ") + kCorners[k].key +
+                            "_wheel_command_joint_name: " + Quoted(c.joints[corner[k]]) + "\n";
   }
-  return out + "    kinematics:\n      wheels_radius: " + Num(Mean(radii)) +
-         "\n      sum_of_robot_center_projection_on_X_Y_axis: " + Num(Mean(sums)) + "\n";
+  out->parameters_yaml += "    kinematics:\n      wheels_radius: " + Num(Mean(radii)) +
+                          "\n      sum_of_robot_center_projection_on_X_Y_axis: " +
+                          Num(Mean(sums)) + "\n";
+  out->model = MecanumKinematics(c, corner, Mean(radii), Mean(sums));
+  out->parameters = out->model->robot().nominal;
 }
 
 // Which way a positive wheel rate pushes the robot: +1 counter-clockwise (tangential drive, the
 // fitcal default), -1 clockwise (omni_wheel_drive_controller's convention).
-int OmniDriveSense(const std::vector<OmniWheelGeometry>& wheels, const Robot& robot) {
+int OmniDriveSense(const std::vector<OmniWheel>& wheels, const Robot& robot) {
   int sense = 0;
   for (std::size_t i = 0; i < wheels.size(); ++i) {
-    const double offset = WrapAngle(wheels[i].drive_rad - wheels[i].angle_rad);
+    const double offset = WrapAngle(wheels[i].drive_angle_rad - wheels[i].angle_rad);
     const int s = std::abs(offset - M_PI / 2) < kSameAngleRad   ? 1
                   : std::abs(offset + M_PI / 2) < kSameAngleRad ? -1
                                                                 : 0;
-    if (s == 0 || (sense != 0 && s != sense) || std::abs(wheels[i].roller_rad) > kSameAngleRad) {
+    if (s == 0 || (sense != 0 && s != sense) || std::abs(wheels[i].roller_angle_rad) > kSameAngleRad) {
       throw std::invalid_argument("wheel '" + robot.channels[i].name +
                                   "' is not an omni wheel driven tangentially like the others: "
                                   "omni_wheel_drive_controller cannot describe it");
@@ -235,7 +253,7 @@ int OmniDriveSense(const std::vector<OmniWheelGeometry>& wheels, const Robot& ro
 
 // The wheels in omni_wheel_drive_controller's order: anticlockwise from the one nearest the x
 // axis; returns the order and the offset (circular mean of angle_j - 2 pi j / n).
-std::vector<int> OmniOrder(const std::vector<OmniWheelGeometry>& wheels, double* offset_rad) {
+std::vector<int> OmniOrder(const std::vector<OmniWheel>& wheels, double* offset_rad) {
   const int n = static_cast<int>(wheels.size());
   int first = 0;
   for (int i = 1; i < n; ++i) {
@@ -261,12 +279,38 @@ std::vector<int> OmniOrder(const std::vector<OmniWheelGeometry>& wheels, double*
   return order;
 }
 
-std::string OmniWheelParameters(const Calibrated& c, const std::string&,
-                               std::vector<std::string>* notes) {
+// What omni_wheel_drive_controller computes: one distance, one radius, the wheels equally spaced
+// from the offset in `order`, each driven as the calibrated ones (sense). An `omni` robot gets a
+// model of these wheels; omni3 (tangential wheels by construction) its own model at these values.
+void OmniWheelKinematics(const Calibrated& c, const std::vector<int>& order, double offset_rad,
+                         double distance_m, double radius_m, int sense, Ros2ControlExport* out) {
+  const int n = static_cast<int>(order.size());
+  std::vector<OmniWheel> wheels(n);
+  for (int j = 0; j < n; ++j) {
+    const double angle = AsWritten(offset_rad) + 2 * M_PI * j / n;
+    wheels[order[j]] = {c.ChannelName(order[j]), AsWritten(distance_m), angle,
+                        AsWritten(radius_m), angle + sense * M_PI / 2, 0.0};
+  }
+  if (c.robot().model == "omni") {
+    out->model = MakeOmniModel(c.robot().name, wheels,
+                               ControllerBounds(AsWritten(distance_m), AsWritten(radius_m)));
+    out->parameters = out->model->robot().nominal;
+    return;
+  }
+  out->model = c.model;
+  out->parameters = c.robot().nominal;
+  for (const OmniWheel& w : wheels) {
+    out->parameters[c.Index("R_" + w.name)] = w.distance_m;
+    out->parameters[c.Index("r_" + w.name)] = w.radius_m;
+    out->parameters[c.Index("delta_" + w.name)] = w.angle_rad;
+  }
+}
+
+void OmniWheelParameters(const Calibrated& c, const std::string&, Ros2ControlExport* out) {
   if (c.robot().model != "omni3" && c.robot().model != "omni") {
     throw std::invalid_argument("omni_wheel_drive_controller takes an omni3 or omni robot");
   }
-  const std::vector<OmniWheelGeometry> wheels = OmniGeometry(c);
+  const std::vector<OmniWheel> wheels = OmniGeometry(c);
   const int sense = OmniDriveSense(wheels, c.robot());
   double offset = 0.0;
   const std::vector<int> order = OmniOrder(wheels, &offset);
@@ -275,36 +319,43 @@ std::string OmniWheelParameters(const Calibrated& c, const std::string&,
   double worst = 0.0;
   std::vector<std::string> names;
   for (int j = 0; j < n; ++j) {
-    const OmniWheelGeometry& w = wheels[order[j]];
+    const OmniWheel& w = wheels[order[j]];
     radii.push_back(w.radius_m);
     distances.push_back(w.distance_m);
     worst = std::max(worst, std::abs(WrapAngle(w.angle_rad - offset - 2 * M_PI * j / n)));
     names.push_back(c.joints[order[j]]);
   }
-  NoteSpread(radii, "radius", "wheel_radius", 1.0, "m", notes);
-  NoteSpread(distances, "distance", "robot_radius", 1.0, "m", notes);
+  NoteSpread(radii, "radius", "wheel_radius", 1.0, "m", &out->notes);
+  NoteSpread(distances, "distance", "robot_radius", 1.0, "m", &out->notes);
   if (worst > kSameAngleRad) {
     char text[200];
     std::snprintf(text, sizeof text,
                   "omni_wheel_drive_controller spaces the wheels equally (%.4g "
                   "deg apart): the calibrated wheel angles are up to %.4g deg off that",
                   360.0 / n, worst / kDeg);
-    notes->push_back(text);
+    out->notes.push_back(text);
   }
   if (sense > 0) {
-    notes->push_back(
+    out->notes.push_back(
         "omni_wheel_drive_controller counts a wheel positive when it turns the robot clockwise "
         "(w r = sin(a) vx - cos(a) vy - R omega), this robot's wheels counter-clockwise: invert "
         "the wheel joints' axes in the URDF (or their sign in the hardware interface)");
   }
-  return "    wheel_names: " + NameList(names) + "\n    wheel_offset: " + Num(offset) +
-         "\n    robot_radius: " + Num(Mean(distances)) + "\n    wheel_radius: " + Num(Mean(radii)) +
-         "\n";
+  out->parameters_yaml += "    wheel_names: " + NameList(names) +
+                          "\n    wheel_offset: " + Num(offset) +
+                          "\n    robot_radius: " + Num(Mean(distances)) +
+                          "\n    wheel_radius: " + Num(Mean(radii)) + "\n";
+  OmniWheelKinematics(c, order, offset, Mean(distances), Mean(radii), sense, out);
 }
 
-std::string TricycleParameters(const Calibrated& c, const std::string&,
-                               std::vector<std::string>* notes) {
-  const double offset_rad = c.p()[2];
+void TricycleParameters(const Calibrated& c, const std::string&, Ros2ControlExport* out) {
+  using K = TricycleKinematics;
+  const std::string& traction = c.joints[K::kTractionChannel];
+  const std::string& steering = c.joints[K::kSteeringChannel];
+  const int k_radius = c.Index("r_" + c.ChannelName(K::kTractionChannel));
+  const int k_wheelbase = c.Index("wheelbase"), k_offset = c.Index("steering_offset");
+  const std::vector<double>& p = c.robot().nominal;
+  const double offset_rad = p[k_offset];
   if (offset_rad != 0.0) {
     // models/tricycle/tricycle_kinematics.h: true steering = measured + phi_0. The controller
     // reads the steering joint's state as the true angle, so the joint must report phi_0 more:
@@ -316,20 +367,27 @@ std::string TricycleParameters(const Calibrated& c, const std::string&,
                   "the steering joint '%s' position (true steering = measured %+.6f deg), e.g. "
                   "<offset>%.9g</offset> in its SimpleTransmission <joint> in the URDF "
                   "(joint = actuator / reduction + offset), or zero the steering encoder there",
-                  offset_rad, offset_rad / kDeg, c.joints[1].c_str(), offset_rad / kDeg,
-                  offset_rad);
-    notes->push_back(text);
+                  offset_rad, offset_rad / kDeg, steering.c_str(), offset_rad / kDeg, offset_rad);
+    out->notes.push_back(text);
   }
-  return "    traction_joint_name: " + Quoted(c.joints[0]) +
-         "\n    steering_joint_name: " + Quoted(c.joints[1]) + "\n    wheelbase: " + Num(c.p()[1]) +
-         "\n    wheel_radius: " + Num(c.p()[0]) + "\n";
+  out->parameters_yaml += "    traction_joint_name: " + Quoted(traction) +
+                          "\n    steering_joint_name: " + Quoted(steering) +
+                          "\n    wheelbase: " + Num(p[k_wheelbase]) +
+                          "\n    wheel_radius: " + Num(p[k_radius]) + "\n";
+  // The controller's tricycle: these values, no steering offset.
+  out->model = c.model;
+  out->parameters = p;
+  out->parameters[k_radius] = AsWritten(p[k_radius]);
+  out->parameters[k_wheelbase] = AsWritten(p[k_wheelbase]);
+  out->parameters[k_offset] = 0.0;
 }
 
 struct ControllerEntry {
   const char* name;
   const char* model;    // the fitcal model(s) it takes, for the mismatch message
   const char* distros;  // the distributions that ship it (tests/data/ros2_controllers/)
-  std::string (*write)(const Calibrated&, const std::string& distro, std::vector<std::string>*);
+  // Appends the parameter lines and notes and sets the controller's kinematics.
+  void (*write)(const Calibrated&, const std::string& distro, Ros2ControlExport*);
 };
 const ControllerEntry kControllers[] = {
     {"diff_drive_controller", "diff_drive", "humble jazzy rolling", DiffDriveParameters},
@@ -369,138 +427,6 @@ void CheckDistro(const ControllerEntry& e, const std::string& distro) {
   }
 }
 
-// ---------------------------------------------------------------------------------------------
-// The reader: controller parameters -> the fitcal robot YAML of the same kinematics.
-
-YAML::Node Require(const YAML::Node& map, const std::string& key, const std::string& what) {
-  const YAML::Node node = map[key];
-  if (!node) {
-    throw InputError(InputErrorKind::kMissingKey, what, map.Mark().line + 1,
-                     "ros__parameters has no '" + key + "'");
-  }
-  return node;
-}
-
-double RequireDouble(const YAML::Node& map, const std::string& key, const std::string& what) {
-  const YAML::Node node = Require(map, key, what);
-  try {
-    return node.as<double>();
-  } catch (const YAML::Exception&) {
-    throw InputError(InputErrorKind::kNonNumeric, what, node.Mark().line + 1,
-                     "'" + key + "' is not a number");
-  }
-}
-
-int ChannelOfJoint(const Calibrated& c, const YAML::Node& node, const std::string& what) {
-  const std::string joint =
-      node.IsSequence() && node.size() == 1 ? node[0].as<std::string>() : node.as<std::string>();
-  for (std::size_t j = 0; j < c.joints.size(); ++j) {
-    if (c.joints[j] == joint) return static_cast<int>(j);
-  }
-  throw InputError(InputErrorKind::kBadValue, what, node.Mark().line + 1,
-                   "joint '" + joint + "' is not one of the robot's (--joints)");
-}
-
-std::string Bounds(const char* key, double lo, double hi) {
-  return std::string(key) + ": [" + Num(lo) + ", " + Num(hi) + "]";
-}
-
-std::string DiffDriveRobotText(const Calibrated& c, const YAML::Node& p, const std::string& what) {
-  const double radius = RequireDouble(p, "wheel_radius", what);
-  const double multiplier = p["wheel_separation_multiplier"]
-                                ? RequireDouble(p, "wheel_separation_multiplier", what)
-                                : 1.0;
-  const double b = RequireDouble(p, "wheel_separation", what) * multiplier;
-  double r[2] = {0, 0};
-  const char* side[2] = {"", ""};
-  for (const char* s : {"left", "right"}) {
-    const int ch = ChannelOfJoint(c, Require(p, std::string(s) + "_wheel_names", what), what);
-    const std::string key = std::string(s) + "_wheel_radius_multiplier";
-    r[ch] = radius * (p[key] ? RequireDouble(p, key, what) : 1.0);
-    side[ch] = s;
-  }
-  std::string text = "model: diff_drive\nname: " + c.robot().name + "\nwheels:\n";
-  for (int i = 0; i < 2; ++i) {
-    text += "  - {name: " + c.robot().channels[i].name + ", side: " + side[i] +
-            ", radius_m: " + Num(r[i]) + "}\n";
-  }
-  return text + "wheel_separation_m: " + Num(b) + "\nbounds: {" +
-         Bounds("radius_m", 0.5 * std::min(r[0], r[1]), 2 * std::max(r[0], r[1])) + ", " +
-         Bounds("wheel_separation_m", 0.5 * b, 2 * b) + "}\n";
-}
-
-std::string OmniWheelLine(const std::string& name, double distance, double angle_rad, double radius,
-                          const std::string& extra) {
-  return "  - {name: " + name + ", distance_m: " + Num(distance) +
-         ", angle_deg: " + Num(angle_rad / kDeg) + ", radius_m: " + Num(radius) + extra + "}\n";
-}
-
-std::string OmniBounds(double distance, double radius) {
-  return "bounds: {" + Bounds("distance_m", 0.5 * distance, 2 * distance) + ", " +
-         Bounds("radius_m", 0.5 * radius, 2 * radius) + ", angle_offset_deg: [-2.0, 2.0]}\n";
-}
-
-std::string MecanumRobotText(const Calibrated& c, const YAML::Node& p, const std::string& what) {
-  const YAML::Node k = Require(p, "kinematics", what);
-  const double radius = RequireDouble(k, "wheels_radius", what);
-  const double sum = RequireDouble(k, "sum_of_robot_center_projection_on_X_Y_axis", what);
-  std::vector<std::string> lines(4);
-  for (const MecanumCorner& corner : kCorners) {
-    const int ch = ChannelOfJoint(
-        c, Require(p, std::string(corner.key) + "_wheel_command_joint_name", what), what);
-    // Any point with |x| + |y| = lx + ly gives the controller's yaw row; take lx = ly.
-    const double angle = std::atan2(corner.sign_y, corner.sign_x);
-    lines[ch] =
-        OmniWheelLine(c.robot().channels[ch].name, sum / std::sqrt(2.0), angle, radius,
-                      ", drive_angle_deg: 0.0, roller_angle_deg: " + Num(corner.roller_deg));
-  }
-  std::string text = "model: omni\nname: " + c.robot().name + "\nwheels:\n";
-  for (const std::string& l : lines) text += l;
-  return text + OmniBounds(sum / std::sqrt(2.0), radius);
-}
-
-std::string OmniRobotText(const Calibrated& c, const YAML::Node& p, const std::string& what) {
-  const double radius = RequireDouble(p, "wheel_radius", what);
-  const double distance = RequireDouble(p, "robot_radius", what);
-  const double offset = RequireDouble(p, "wheel_offset", what);
-  const YAML::Node names = Require(p, "wheel_names", what);
-  const int n = c.robot().NumChannels();
-  if (!names.IsSequence() || static_cast<int>(names.size()) != n) {
-    throw InputError(InputErrorKind::kBadValue, what, names.Mark().line + 1,
-                     "wheel_names must list the robot's " + std::to_string(n) + " wheels");
-  }
-  const int sense = OmniDriveSense(OmniGeometry(c), c.robot());
-  std::vector<std::string> lines(n);
-  for (int j = 0; j < n; ++j) {
-    const int ch = ChannelOfJoint(c, names[j], what);
-    const double angle = offset + 2 * M_PI * j / n;
-    const std::string extra = c.robot().model == "omni3"
-                                  ? ""
-                                  : ", drive_angle_deg: " + Num((angle + sense * M_PI / 2) / kDeg) +
-                                        ", roller_angle_deg: 0.0";
-    lines[ch] = OmniWheelLine(c.robot().channels[ch].name, distance, angle, radius, extra);
-  }
-  std::string text = "model: " + c.robot().model + "\nname: " + c.robot().name + "\nwheels:\n";
-  for (const std::string& l : lines) text += l;
-  return text + OmniBounds(distance, radius);
-}
-
-std::string TricycleRobotText(const Calibrated& c, const YAML::Node& p, const std::string& what) {
-  const double radius = RequireDouble(p, "wheel_radius", what);
-  const double wheelbase = RequireDouble(p, "wheelbase", what);
-  if (ChannelOfJoint(c, Require(p, "traction_joint_name", what), what) != 0 ||
-      ChannelOfJoint(c, Require(p, "steering_joint_name", what), what) != 1) {
-    throw InputError(InputErrorKind::kBadValue, what, p.Mark().line + 1,
-                     "traction and steering joints are swapped");
-  }
-  return "model: tricycle\nname: " + c.robot().name +
-         "\ntraction_wheel: {name: " + c.robot().channels[0].name + ", radius_m: " + Num(radius) +
-         "}\nwheelbase_m: " + Num(wheelbase) + "\nsteering_offset_deg: 0.0\nbounds: {" +
-         Bounds("radius_m", 0.5 * radius, 2 * radius) + ", " +
-         Bounds("wheelbase_m", 0.5 * wheelbase, 2 * wheelbase) +
-         ", steering_offset_deg: [-10.0, 10.0]}\n";
-}
-
 }  // namespace
 
 const std::vector<std::string>& RosDistros() {
@@ -517,13 +443,14 @@ const std::vector<std::string>& Ros2Controllers() {
   return names;
 }
 
-Ros2ControlExport ExportRos2Control(const std::string& calibration_path,
+Ros2ControlExport ExportRos2Control(const RobotModelPtr& calibrated,
+                                    const std::string& calibration_path,
                                     const std::string& controller, const std::string& node_name,
                                     const std::vector<std::string>& joints,
                                     const std::string& ros_distro) {
   const ControllerEntry& entry = FindController(controller);
   CheckDistro(entry, ros_distro);
-  const Calibrated c = ReadCalibrated(calibration_path, joints);
+  const Calibrated c = WithJoints(calibrated, joints);
   if (!TakesModel(entry, c.robot().model)) {
     throw std::invalid_argument(calibration_path + ": robot model '" + c.robot().model +
                                 "' does not fit " + controller + " (it takes model " + entry.model +
@@ -541,57 +468,30 @@ Ros2ControlExport ExportRos2Control(const std::string& calibration_path,
                                 " cannot apply; export a calibration fitted without effects");
   }
   Ros2ControlExport out;
-  out.parameters_yaml = (node_name.empty() ? controller : node_name) + ":\n  ros__parameters:\n" +
-                        entry.write(c, ros_distro, &out.notes);
+  out.parameters_yaml = (node_name.empty() ? controller : node_name) + ":\n  ros__parameters:\n";
+  entry.write(c, ros_distro, &out);
   return out;
 }
 
-}  // namespace fitcal::tools
-
-namespace fitcal::tools {
-
-RobotModelPtr ReadRos2ControlYaml(const std::string& yaml_text, const std::string& what,
-                                  const std::string& calibration_path,
-                                  const std::vector<std::string>& joints) {
-  const Calibrated c = ReadCalibrated(calibration_path, joints);
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    throw InputError(InputErrorKind::kYamlSyntax, what, e.mark.line + 1, e.msg);
-  }
-  if (!root.IsMap() || root.size() != 1 || !root.begin()->second.IsMap() ||
-      !root.begin()->second["ros__parameters"]) {
-    throw InputError(InputErrorKind::kWrongYamlType, what, 1,
-                     "expected one '<controller>: ros__parameters:' map");
-  }
-  const YAML::Node p = root.begin()->second["ros__parameters"];
-  std::string robot_text;
-  const std::string& model = c.robot().model;
-  if (p["wheel_separation"] && model == "diff_drive") {
-    robot_text = DiffDriveRobotText(c, p, what);
-  } else if (p["kinematics"] && model == "omni") {
-    robot_text = MecanumRobotText(c, p, what);
-  } else if (p["robot_radius"] && (model == "omni" || model == "omni3")) {
-    robot_text = OmniRobotText(c, p, what);
-  } else if (p["wheelbase"] && model == "tricycle") {
-    robot_text = TricycleRobotText(c, p, what);
-  } else {
-    throw InputError(InputErrorKind::kBadValue, what, 1,
-                     "not the parameters of a controller for robot model '" + model + "'");
-  }
-  return ReadRobotModel(YAML::Load(robot_text), what + " (as a " + model + " robot)");
+Ros2ControlExport ExportRos2Control(const std::string& calibration_path,
+                                    const std::string& controller, const std::string& node_name,
+                                    const std::vector<std::string>& joints,
+                                    const std::string& ros_distro) {
+  const ControllerEntry& entry = FindController(controller);
+  CheckDistro(entry, ros_distro);
+  return ExportRos2Control(ReadRobotModelFile(calibration_path), calibration_path, controller,
+                           node_name, joints, ros_distro);
 }
 
 }  // namespace fitcal::tools
 
 namespace fitcal::tools {
 
-std::vector<AlignedRun> ExportHeldOutRuns(const std::string& calibration_path,
-                                          const std::string& logs, const Robot& robot,
-                                          std::string* which,
-                                          std::vector<RunLog>* held_out_logs) {
-  const io::Dataset data = io::LoadDataset(io::ReadDatasetIndex(logs), robot);
+namespace {
+
+// The held-out runs of a loaded data set (ExportHeldOutRuns); `held_out_logs` takes theirs.
+std::vector<AlignedRun> HeldOutRuns(const std::string& calibration_path, io::Dataset data,
+                                    std::string* which, std::vector<RunLog>* held_out_logs) {
   // The rule `report` uses (tools/report_command.cc, SplitForReport): the recorded training run
   // ids (and fingerprint) when this data set holds them, by repetition for older files.
   RecordedTraining recorded;
@@ -614,11 +514,21 @@ std::vector<AlignedRun> ExportHeldOutRuns(const std::string& calibration_path,
   if (held_out_logs != nullptr) {
     std::set<std::string> ids;
     for (const AlignedRun& r : runs) ids.insert(r.id);
-    for (const RunLog& r : data.runs) {
-      if (ids.count(r.id) > 0) held_out_logs->push_back(r);
+    for (RunLog& r : data.runs) {
+      if (ids.count(r.id) > 0) held_out_logs->push_back(std::move(r));
     }
   }
   return runs;
+}
+
+}  // namespace
+
+std::vector<AlignedRun> ExportHeldOutRuns(const std::string& calibration_path,
+                                          const std::string& logs, const Robot& robot,
+                                          std::string* which,
+                                          std::vector<RunLog>* held_out_logs) {
+  return HeldOutRuns(calibration_path, io::LoadDataset(io::ReadDatasetIndex(logs), robot), which,
+                     held_out_logs);
 }
 
 namespace {
@@ -637,10 +547,10 @@ struct Replay {
 // ground truth's own noise is small beside the odometry's drift, short beside a run).
 constexpr double kCovarianceWindowS = 1.0;
 
-Replay ReplayOnHeldOutRuns(const ExportRos2ControlOptions& o, const std::string& parameters_yaml) {
-  const RobotModelPtr exact = ReadRobotModelFile(o.calibration);
-  const RobotModelPtr exported =
-      ReadRos2ControlYaml(parameters_yaml, o.controller, o.calibration, o.joints);
+// `exact` is the calibration as read, `exported` what the controller computes from the export;
+// the data set is read once.
+Replay ReplayOnHeldOutRuns(const ExportRos2ControlOptions& o, const RobotModelPtr& exact,
+                           const Ros2ControlExport& exported) {
   const io::DatasetIndex index = io::ReadDatasetIndex(o.logs);
   const RobotModelPtr nominal = ReadRobotModelFile(index.robot_path);
   if (nominal->robot().model != exact->robot().model) {
@@ -649,18 +559,18 @@ Replay ReplayOnHeldOutRuns(const ExportRos2ControlOptions& o, const std::string&
   }
   Replay r;
   std::vector<RunLog> logs;
-  const std::vector<AlignedRun> runs =
-      ExportHeldOutRuns(o.calibration, o.logs, exact->robot(), &r.which, &logs);
+  const std::vector<AlignedRun> runs = HeldOutRuns(
+      o.calibration, io::LoadDataset(index, exact->robot()), &r.which, &logs);
   r.runs = runs.size();
   r.cf_nominal = EvaluateFinalPoseErrors(*nominal, nominal->robot().nominal, runs).cf;
   r.cf_exact = EvaluateFinalPoseErrors(*exact, exact->robot().nominal, runs).cf;
-  r.cf_exported = EvaluateFinalPoseErrors(*exported, exported->robot().nominal, runs).cf;
-  for (auto [model, covariance] : {std::make_pair(exported.get(), &r.exported_covariance),
-                                   std::make_pair(exact.get(), &r.exact_covariance)}) {
-    *covariance = EstimateOdometryCovariance(
-        CollectOdometryErrors(*model, model->robot().nominal, logs, kCovarianceWindowS),
-        kCovarianceWindowS);
-  }
+  r.cf_exported = EvaluateFinalPoseErrors(*exported.model, exported.parameters, runs).cf;
+  const auto covariance = [&](const RobotModelInterface& model, const std::vector<double>& p) {
+    return EstimateOdometryCovariance(CollectOdometryErrors(model, p, logs, kCovarianceWindowS),
+                                      kCovarianceWindowS);
+  };
+  r.exported_covariance = covariance(*exported.model, exported.parameters);
+  r.exact_covariance = covariance(*exact, exact->robot().nominal);
   return r;
 }
 
@@ -771,54 +681,78 @@ void AddExportRos2ControlOptions(CLI::App& app, ExportRos2ControlOptions& o) {
   app.add_flag("--force", o.force, "Overwrite --out");
 }
 
+namespace {
+
+// --out never over its calibration or the data set (tools/output_guard.h), nor over a file
+// without --force.
+void CheckOut(const ExportRos2ControlOptions& o) {
+  if (o.out.empty()) return;
+  const std::string refusal = OutputFileRefusal(o.out, {o.calibration, o.logs});
+  if (!refusal.empty()) throw std::invalid_argument(refusal);
+  if (std::filesystem::exists(o.out) && !o.force) {
+    throw std::runtime_error(o.out + ": exists; refusing to overwrite it (--force)");
+  }
+}
+
+void CheckCalibrationOut(const ExportRos2ControlOptions& o) {
+  if (o.calibration_out.empty()) return;
+  if (o.logs.empty()) {
+    throw std::invalid_argument("--calibration-out needs --logs (the covariance comes from "
+                                "the held-out runs)");
+  }
+  if (std::filesystem::exists(o.calibration_out) && !o.force) {
+    throw std::runtime_error(o.calibration_out + ": exists; refusing to overwrite it (--force)");
+  }
+}
+
+// The replay's verdict (WorseThanNominal unless --allow-worse), its lines (on stdout beside a
+// written file; in the YAML's comments either way: stdout stays YAML), the covariance keys and
+// the calibration with its covariance (--calibration-out).
+void AddReplay(const ExportRos2ControlOptions& o, const RobotModelPtr& exact,
+               const Ros2ControlExport& e, std::string* text, std::string* parameters,
+               std::string* calibration_text) {
+  const Replay replay = ReplayOnHeldOutRuns(o, exact, e);
+  const std::string line = ReplayLine(o, replay);
+  if (!o.out.empty()) std::printf("%s\n", line.c_str());
+  if (replay.Worse() && !o.allow_worse) {
+    char text_worse[300];
+    std::snprintf(text_worse, sizeof text_worse,
+                  "these parameters replay worse than the nominal robot (CF %.6f > %.6f on "
+                  "%zu runs); nothing written (--allow-worse writes them%s)",
+                  replay.cf_exported, replay.cf_nominal, replay.runs,
+                  e.notes.empty() ? ""
+                                  : ", with notes on what the controller leaves out: "
+                                    "apply that first, e.g. a steering offset");
+    throw WorseThanNominal(text_worse);
+  }
+  *text += "# " + line + "\n";
+  const std::string covariance = CovarianceLine(replay.exported_covariance);
+  if (!o.out.empty()) std::printf("%s\n", covariance.c_str());
+  *text += "# " + covariance + " (docs/ros2.md)\n";
+  *parameters += Ros2CovarianceParameters(o.controller, replay.exported_covariance);
+  if (!o.calibration_out.empty()) {
+    *calibration_text = CalibrationWithCovariance(o.calibration, replay.exact_covariance);
+  }
+}
+
+}  // namespace
+
 int RunExportRos2ControlCommand(const ExportRos2ControlOptions& o) {
   constexpr const char* kPrefix = "fitcal export ros2-control: ";
   try {
-    if (!o.out.empty()) {  // never over its calibration or the data set (tools/output_guard.h)
-      const std::string refusal = OutputFileRefusal(o.out, {o.calibration, o.logs});
-      if (!refusal.empty()) throw std::invalid_argument(refusal);
-    }
-    if (!o.out.empty() && std::filesystem::exists(o.out) && !o.force) {
-      throw std::runtime_error(o.out + ": exists; refusing to overwrite it (--force)");
-    }
-    const Ros2ControlExport e =
-        ExportRos2Control(o.calibration, o.controller, o.node_name, o.joints, o.ros_distro);
+    CheckOut(o);
+    const ControllerEntry& entry = FindController(o.controller);
+    CheckDistro(entry, o.ros_distro);
+    // The calibration is read once: the export and the replay share its model.
+    const RobotModelPtr calibrated = ReadRobotModelFile(o.calibration);
+    const Ros2ControlExport e = ExportRos2Control(calibrated, o.calibration, o.controller,
+                                                  o.node_name, o.joints, o.ros_distro);
     std::string text = "# " + o.controller + " parameters (ros2_controllers, ROS 2 " +
                        o.ros_distro + ") from the fitcal calibration " + o.calibration + "\n";
     for (const std::string& note : e.notes) text += "# not representable: " + note + "\n";
-    if (!o.calibration_out.empty() && o.logs.empty()) {
-      throw std::invalid_argument("--calibration-out needs --logs (the covariance comes from "
-                                  "the held-out runs)");
-    }
-    if (!o.calibration_out.empty() && std::filesystem::exists(o.calibration_out) && !o.force) {
-      throw std::runtime_error(o.calibration_out + ": exists; refusing to overwrite it (--force)");
-    }
+    CheckCalibrationOut(o);
     std::string parameters = e.parameters_yaml, calibration_text;
-    if (!o.logs.empty()) {
-      const Replay replay = ReplayOnHeldOutRuns(o, e.parameters_yaml);
-      // On stdout beside a written file; in the YAML's comments either way (stdout stays YAML).
-      const std::string line = ReplayLine(o, replay);
-      if (!o.out.empty()) std::printf("%s\n", line.c_str());
-      if (replay.Worse() && !o.allow_worse) {
-        char text_worse[300];
-        std::snprintf(text_worse, sizeof text_worse,
-                      "these parameters replay worse than the nominal robot (CF %.6f > %.6f on "
-                      "%zu runs); nothing written (--allow-worse writes them%s)",
-                      replay.cf_exported, replay.cf_nominal, replay.runs,
-                      e.notes.empty() ? ""
-                                      : ", with notes on what the controller leaves out: "
-                                        "apply that first, e.g. a steering offset");
-        throw WorseThanNominal(text_worse);
-      }
-      text += "# " + line + "\n";
-      const std::string covariance = CovarianceLine(replay.exported_covariance);
-      if (!o.out.empty()) std::printf("%s\n", covariance.c_str());
-      text += "# " + covariance + " (docs/ros2.md)\n";
-      parameters += Ros2CovarianceParameters(o.controller, replay.exported_covariance);
-      if (!o.calibration_out.empty()) {
-        calibration_text = CalibrationWithCovariance(o.calibration, replay.exact_covariance);
-      }
-    }
+    if (!o.logs.empty()) AddReplay(o, calibrated, e, &text, &parameters, &calibration_text);
     text += parameters;
     // The notes after the verdict: a refusal is one line.
     for (const std::string& note : e.notes) std::cerr << kPrefix << "note: " << note << "\n";

@@ -41,6 +41,11 @@
 // get kUnmeasuredVariance. --calibration-out writes the exact calibration's own covariance into
 // a copy of the calibration file (calibration.odometry_covariance).
 //
+// The calibrated parameters are taken from the model by name (its parameter table,
+// models/model_interface.h: ParameterIndex), and the replay runs what the controller computes
+// from the values as written (Ros2ControlExport::model, ::parameters): no YAML is written to be
+// read back.
+//
 // With a data set (--logs) the exported parameters are replayed on its held-out runs - the runs
 // the calibration did not train on, found as `report` finds them (validation/training_runs.h:
 // by run id and fingerprint) - beside the nominal robot (the data set's robot.yaml) and the exact
@@ -67,6 +72,11 @@ namespace fitcal::tools {
 struct Ros2ControlExport {
   std::string parameters_yaml;     // `<node>:\n  ros__parameters:\n    ...` without the comments
   std::vector<std::string> notes;  // one line per parameter the controller cannot represent
+  // What the controller computes from these parameters as written (12 significant digits), for
+  // the replay: the calibrated model at the representable values (diff drive, tricycle, omni3),
+  // or a model of the controller's own geometry (mecanum layout, equally spaced omni wheels).
+  RobotModelPtr model;
+  std::vector<double> parameters;  // model->robot().parameters order
 };
 
 // The controllers above, by name.
@@ -75,22 +85,22 @@ const std::vector<std::string>& Ros2Controllers();
 // The ROS 2 distributions the export knows, oldest first; the default is the last (newest).
 const std::vector<std::string>& RosDistros();
 
-// Throws io::InputError for a bad calibration file, std::invalid_argument (one line) for an
-// unknown controller, a model/controller mismatch, a geometry the controller cannot describe at
-// all (e.g. mecanum rollers the wrong way) or --joints of the wrong length.
-// std::invalid_argument too for an unknown distribution or a controller it does not ship.
+// The export of a calibrated robot (read through the model registry; its values are the
+// calibration; calibration_path names it in errors). The parameters are taken from the model by
+// name (its parameter table, models/model_interface.h), never by position. Throws
+// std::invalid_argument (one line) for an unknown controller, a model/controller mismatch, a
+// geometry the controller cannot describe at all (e.g. mecanum rollers the wrong way), --joints of
+// the wrong length, an unknown distribution or a controller it does not ship.
+Ros2ControlExport ExportRos2Control(const RobotModelPtr& calibrated,
+                                    const std::string& calibration_path,
+                                    const std::string& controller, const std::string& node_name,
+                                    const std::vector<std::string>& joints,
+                                    const std::string& ros_distro = RosDistros().back());
+// The same from the calibration file; io::InputError for a bad one.
 Ros2ControlExport ExportRos2Control(const std::string& calibration_path,
                                     const std::string& controller, const std::string& node_name,
                                     const std::vector<std::string>& joints,
                                     const std::string& ros_distro = RosDistros().back());
-
-// fitcal's reader of such a YAML: the robot model (the calibrated robot's model, channels and
-// names) whose nominal parameters are the kinematics the controller computes from it. `what`
-// names the text in errors. Throws io::InputError for a missing key or a joint that is not the
-// robot's.
-RobotModelPtr ReadRos2ControlYaml(const std::string& yaml_text, const std::string& what,
-                                  const std::string& calibration_path,
-                                  const std::vector<std::string>& joints);
 
 // The covariance keys of `controller` (ros__parameters lines, 4-space indent) holding `c`.
 std::string Ros2CovarianceParameters(const std::string& controller, const OdometryCovariance& c);

@@ -360,4 +360,49 @@ RobotModelPtr ReadOmniModel(const YAML::Node& root, const std::string& path) {
   }
 }
 
+namespace {
+
+// The mounts of an `omni` model of N wheels, or nullptr when `model` is not one.
+template <int N>
+const std::array<OmniWheelMount, N>* MountsOf(const RobotModelInterface& model) {
+  const auto* omni = dynamic_cast<const OmniModel<N>*>(&model);
+  return omni == nullptr ? nullptr : &omni->kinematics().mount;
+}
+
+template <int N>
+bool FillMounts(const RobotModelInterface& model, std::vector<OmniWheel>* wheels) {
+  const std::array<OmniWheelMount, N>* mount = MountsOf<N>(model);
+  if (mount == nullptr) return false;
+  for (int i = 0; i < N; ++i) {
+    OmniWheel& w = (*wheels)[i];
+    w.drive_angle_rad = w.angle_rad + (*mount)[i].drive_offset_rad;
+    w.roller_angle_rad = (*mount)[i].roller_rad;
+  }
+  return true;
+}
+
+}  // namespace
+
+std::optional<std::vector<OmniWheel>> OmniWheelsOf(const RobotModelInterface& model,
+                                                   const std::vector<double>& p) {
+  const Robot& robot = model.robot();
+  std::vector<OmniWheel> wheels;
+  for (const ChannelInfo& channel : robot.channels) {
+    const std::optional<int> distance = ParameterIndex(robot, "R_" + channel.name);
+    const std::optional<int> radius = ParameterIndex(robot, "r_" + channel.name);
+    const std::optional<int> angle = ParameterIndex(robot, "delta_" + channel.name);
+    if (!distance || !radius || !angle) return std::nullopt;
+    OmniWheel w{channel.name, p[*distance], p[*angle], p[*radius], 0.0, 0.0};
+    w.drive_angle_rad = TangentialDriveAngle(w.angle_rad);  // Palacin's omni3 and the default
+    wheels.push_back(w);
+  }
+  using Filler = bool (*)(const RobotModelInterface&, std::vector<OmniWheel>*);
+  static constexpr Filler kFillers[] = {&FillMounts<3>, &FillMounts<4>, &FillMounts<5>,
+                                        &FillMounts<6>, &FillMounts<7>, &FillMounts<8>};
+  for (Filler fill : kFillers) {
+    if (fill(model, &wheels)) break;
+  }
+  return wheels;
+}
+
 }  // namespace fitcal

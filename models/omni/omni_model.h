@@ -87,6 +87,13 @@ RobotModelPtr MakeOmniModel(const std::string& name, const std::vector<OmniWheel
                             const OmniBounds& bounds,
                             const std::optional<EncoderTicks>& encoder = std::nullopt);
 
+// The wheels of an omni-wheeled robot at parameters p: distance, angle and radius found in p by
+// the parameter table (R_<wheel>, delta_<wheel>, r_<wheel>), drive and roller directions from an
+// `omni` model's fixed geometry, or tangential omni wheels (Palacin's, counter-clockwise) for any
+// other model with these parameters (omni3). nullopt for a model without them.
+std::optional<std::vector<OmniWheel>> OmniWheelsOf(const RobotModelInterface& model,
+                                                   const std::vector<double>& p);
+
 // The reader registered as `omni` (models/model_registry.cc); io::InputError with file and line.
 RobotModelPtr ReadOmniModel(const YAML::Node& root, const std::string& path);
 
