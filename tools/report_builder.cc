@@ -6,16 +6,12 @@
 #include <cstdio>
 #include <functional>
 #include <map>
-#include <regex>
 #include <set>
 
-#include "diagnosis/identifiability.h"
 #include "fit/determined_directions.h"
 #include "fit/model_fit.h"
 #include "fit/run_split.h"
 #include "fitcal/version.h"
-#include "tools/sim/flower_candidates.h"
-#include "validation/parameter_covariance.h"
 #include "validation/relative_pose_error.h"
 #include "validation/trajectory_family.h"
 #include "validation/verdict.h"
@@ -275,61 +271,7 @@ void AddDrift(const EvaluatedRuns& e, io::ReportData* data) {
   }
 }
 
-// Uncertainty and identifiability at the calibrated parameters from the training runs, when they
-// are in this data set: covariance s^2 (J^T J)^-1 with s^2 = |r|^2 / (3 N - 9), the fit's
-// (omni3_ceres_fit.h). Advice on trajectories only for training runs of the flower, whose
-// candidate runs the analysis knows; never for another data set's trajectory family.
-void AddOmni3Uncertainty(const ReportInputs& in, const CalibrationInput& cal,
-                         const std::vector<AlignedRun>& training, int threads, io::ReportData* data,
-                         std::vector<double>* sigma, bool* has_sigma) {
-  const Omni3ParameterArray nominal = ArrayOf(in.model->robot().nominal);
-  const Omni3ParameterArray p = ArrayOf(cal.calibrated.nominal);
-  const bool flower = std::any_of(training.begin(), training.end(), [](const AlignedRun& run) {
-    return std::regex_match(run.trajectory, std::regex("[RGB][0-9]+"));
-  });
-  const Eigen::MatrixXd jacobian = FinalPoseJacobian(p, training, ResidualWeights{}, threads);
-  const IdentifiabilityReport ident = AnalyseIdentifiability(
-      jacobian, p, flower ? sim::FlowerCandidateMotions() : std::vector<CandidateMotion>{},
-      nominal);
-  data->identifiable = ident.identifiable;
-  data->condition_number = ident.condition_number;
-  data->identifiability_lines = IdentifiabilityLines(ident);
-  const int dof = 3 * static_cast<int>(training.size()) - omni3::kNumParameters;
-  if (dof <= 0 || ident.rank_deficient) {
-    data->uncertainty_note = dof <= 0 ? "No uncertainty: too few training runs (need more than 3)."
-                                      : "No uncertainty: the covariance is rank deficient (see "
-                                        "Identifiability below).";
-    return;
-  }
-  if (!cal.calibrated.effects.empty()) {
-    // The covariance of the parameters alone would describe another model than the one used
-    // (the effects move with them); the effects' own sigmas are in the Effects table.
-    data->uncertainty_note =
-        "No parameter sigma: the calibration carries effects, and the covariance of the "
-        "parameters without them describes another model than the one replayed here.";
-    return;
-  }
-  double sum_r2 = 0.0;
-  for (const AlignedRun& run : training) {
-    double r[3];
-    Omni3FinalPoseResidual(run, ResidualWeights{})(p.data(), r);
-    sum_r2 += r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-  }
-  ParameterCovariance covariance = CovarianceFromJacobian(jacobian, sum_r2, dof);
-  *has_sigma = true;
-  data->has_correlation = true;
-  data->correlation = std::move(covariance.correlation);
-  *sigma = std::move(covariance.sigma);
-  char note[320];
-  std::snprintf(note, sizeof note,
-                "One sigma from the covariance s^2 (J^T J)^-1 of the final-pose residuals of the "
-                "%zu training runs at the calibrated parameters, scaled by their residual variance "
-                "(s = %.3g, metres and radians weighed 1:1 as Eq. 14).",
-                training.size(), covariance.residual_sigma);
-  data->uncertainty_note = note;
-}
-
-// Any other model: which directions of its parameter space the training runs determine
+// Which directions of the model's parameter space the training runs determine
 // (fit/determined_directions.h, as `fit` holds them), named in parameter terms with the training
 // trajectory that sees each most. The covariance is the fit's (`fitcal fit` prints it).
 void AddModelIdentifiability(const ReportInputs& in, const CalibrationInput& cal,
@@ -393,16 +335,8 @@ void AddUncertainty(const ReportInputs& in, const CalibrationInput& cal,
     AddRecordedUncertainty(cal, data, sigma, has_sigma);
     return;
   }
-  if (in.omni3) {
-    AddOmni3Uncertainty(in, cal, training, threads, data, sigma, has_sigma);
-    // With effects, only the fit that carried them knows the parameters' covariance.
-    if (!*has_sigma && !cal.calibrated.effects.empty()) {
-      AddRecordedUncertainty(cal, data, sigma, has_sigma);
-    }
-  } else {
-    AddModelIdentifiability(in, cal, training, threads, data);
-    AddRecordedUncertainty(cal, data, sigma, has_sigma);
-  }
+  AddModelIdentifiability(in, cal, training, threads, data);
+  AddRecordedUncertainty(cal, data, sigma, has_sigma);
 }
 
 void AddParameters(const ReportInputs& in, const CalibrationInput& cal,
