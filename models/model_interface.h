@@ -14,15 +14,13 @@
 //   - the miswirings the wheel-order check should try (generated from its channels);
 //   - optionally classical calibrations (closed forms) that compete with the fits.
 
-#include <ceres/cost_function.h>
-#include <ceres/jet.h>
-
 #include <functional>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "models/ceres_fwd.h"
 #include "odometry/encoder_samples.h"
 #include "odometry/pose2.h"
 #include "odometry/robot.h"

@@ -12,7 +12,7 @@ start=$SECONDS
 slowest_steps() {
   echo "slowest build steps in $1 (s):"
   # (sed, not head: head would close the pipe early and pipefail would end the script)
-  awk 'NR > 1 { printf "%8.1f  %s\n", ($2 - $1) / 1000, $4 }' "$1/.ninja_log" | sort -rn | sed -n 1,8p
+  awk 'NR > 1 { printf "%8.1f  %s\n", ($2 - $1) / 1000, $4 }' "$1/.ninja_log" | sort -rn | sed -n 1,10p
 }
 
 # ccache, when installed (install_deps.sh installs it), keeps compiled objects across clones of
@@ -46,3 +46,6 @@ echo "sanitizer build: $((SECONDS - start)) s"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir "$asan_dir" --output-on-failure -j "$jobs" -L sanitize
 echo "tools/test.sh: $((SECONDS - start)) s"
+# CPU time of the whole run (user, system; the shell, then its children): on a loaded machine the
+# wall time above says little, this does not.
+times

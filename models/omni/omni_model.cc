@@ -1,21 +1,14 @@
 #include "models/omni/omni_model.h"
 
-#include <ceres/jet.h>
-
-#include <Eigen/LU>
-#include <Eigen/SVD>
-#include <algorithm>
-#include <array>
 #include <cmath>
-#include <cstdio>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "io/input_error.h"
 #include "io/robot_yaml_blocks.h"
 #include "io/yaml_reader.h"
-#include "io/yaml_text.h"
-#include "models/kinematic_model.h"
-#include "models/omni/omni_kinematics.h"
+#include "models/omni/omni_model_build.h"
 
 namespace fitcal {
 
@@ -24,196 +17,6 @@ namespace {
 using io::InputError;
 using io::InputErrorKind;
 using io::LineOf;
-
-// Singular values below this fraction of the largest count as zero: the kinematic matrix's
-// (geometry check) and the parameter Jacobian's (gauge). Both are computed in units where every
-// entry is O(1), so 1e-9 separates rounding (1e-15) from a real direction by orders of magnitude.
-constexpr double kRankTolerance = 1e-9;
-
-template <int N>
-class OmniModel : public KinematicModel<OmniKinematics<N>> {
- public:
-  OmniModel(Robot robot, const OmniKinematics<N>& kinematics, Interval angle_offset_rad)
-      : KinematicModel<OmniKinematics<N>>(std::move(robot), kinematics),
-        angle_offset_rad_(angle_offset_rad) {}
-
-  using RobotModelInterface::RobotYaml;
-  std::string RobotYaml(const std::vector<double>& p,
-                        const std::vector<effects::EffectValue>& effects,
-                        const std::string& calibration_block) const override;
-
- private:
-  Interval angle_offset_rad_;
-};
-
-std::string Indented(const std::string& text) {
-  std::string out;
-  for (char c : "  " + text) {
-    out += c;
-    if (c == '\n') out += "  ";
-  }
-  return out;
-}
-
-template <int N>
-std::string OmniModel<N>::RobotYaml(const std::vector<double>& p,
-                                    const std::vector<effects::EffectValue>& effects,
-                                    const std::string& calibration_block) const {
-  using K = OmniKinematics<N>;
-  const Robot& robot = this->robot_;
-  const K& kinematics = this->kinematics_;
-  YAML::Emitter out;
-  out.SetDoublePrecision(10);
-  out << YAML::BeginMap;
-  out << YAML::Key << "model" << YAML::Value << "omni";
-  out << YAML::Key << "name" << YAML::Value << io::YamlText(robot.name);
-  out << YAML::Key << "wheels" << YAML::Value << YAML::BeginSeq;
-  for (int i = 0; i < N; ++i) {
-    const double angle_rad = p[K::kAngleIndex + i];
-    out << YAML::Flow << YAML::BeginMap;
-    out << YAML::Key << "name" << YAML::Value << io::YamlText(robot.channels[i].name);
-    out << YAML::Key << "distance_m" << YAML::Value << p[K::kDistanceIndex + i];
-    out << YAML::Key << "angle_deg" << YAML::Value << RadToDeg(angle_rad);
-    out << YAML::Key << "radius_m" << YAML::Value << p[K::kRadiusIndex + i];
-    out << YAML::Key << "drive_angle_deg" << YAML::Value
-        << RadToDeg(angle_rad + kinematics.mount[i].drive_offset_rad);
-    out << YAML::Key << "roller_angle_deg" << YAML::Value
-        << RadToDeg(kinematics.mount[i].roller_rad);
-    out << YAML::EndMap;
-  }
-  out << YAML::EndSeq;
-  out << YAML::Key << "bounds" << YAML::Value << YAML::BeginMap;
-  io::EmitBoundsPair(out, "distance_m", robot.bounds[K::kDistanceIndex], 1.0);
-  io::EmitBoundsPair(out, "radius_m", robot.bounds[K::kRadiusIndex], 1.0);
-  io::EmitBoundsPair(out, "angle_offset_deg", angle_offset_rad_, 180.0 / M_PI);
-  out << YAML::EndMap;
-  io::EmitEncoderAndEffects(out, robot, effects);
-  out << YAML::EndMap;
-  std::string text = std::string(out.c_str()) + "\n";
-  if (calibration_block.empty()) return text;
-  // The forward matrix F (v = F w, rad/s in, m/s and rad/s out) for firmware that takes it.
-  const typename K::template ForwardMatrixT<double> f = kinematics.Prepare(p.data());
-  YAML::Emitter matrix;
-  matrix.SetDoublePrecision(16);
-  matrix << YAML::BeginMap << YAML::Key << "forward_kinematic_matrix" << YAML::Value
-         << YAML::BeginSeq;
-  for (int r = 0; r < 3; ++r) {
-    matrix << YAML::Flow << YAML::BeginSeq;
-    for (int c = 0; c < N; ++c) matrix << f(r, c);
-    matrix << YAML::EndSeq;
-  }
-  matrix << YAML::EndSeq << YAML::EndMap;
-  return text + calibration_block + Indented(matrix.c_str()) + "\n";
-}
-
-// The wheels' kinematic matrix at the nominal must have rank 3, else some motion turns no wheel.
-// The yaw column is scaled by the mean distance so that the three columns share a unit.
-template <int N>
-void CheckFullRank(const OmniKinematics<N>& kinematics, const std::vector<double>& nominal,
-                   const std::vector<OmniWheel>& wheels) {
-  Eigen::Matrix<double, N, 3> j = kinematics.KinematicMatrix(nominal.data());
-  double mean_distance_m = 0.0;
-  for (const OmniWheel& w : wheels) mean_distance_m += w.distance_m / N;
-  j.col(2) /= mean_distance_m;
-  const Eigen::JacobiSVD<Eigen::Matrix<double, N, 3>> svd(j, Eigen::ComputeFullV);
-  const Eigen::Vector3d s = svd.singularValues();
-  if (s(2) > kRankTolerance * s(0)) return;
-  const Eigen::Vector3d v = svd.matrixV().col(2);
-  std::string names;
-  for (const OmniWheel& w : wheels) names += (names.empty() ? "" : ", ") + w.name;
-  char motion[160];
-  std::snprintf(motion, sizeof motion, "(vx, vy, omega R) = (%.3g, %.3g, %.3g)", v(0), v(1), v(2));
-  throw std::invalid_argument("wheels " + names +
-                              ": the kinematic matrix is not of full rank; no wheel senses the "
-                              "motion " +
-                              motion);
-}
-
-// The Jacobian of vec(F(p) J(p0)) with respect to p at p = p0, columns scaled by each
-// parameter's RelativeScale (robot.h): 9 x 3N.
-template <int N>
-Eigen::MatrixXd TwistJacobian(const OmniKinematics<N>& kinematics, const Robot& robot) {
-  constexpr int kP = 3 * N;
-  using Jet = ceres::Jet<double, kP>;
-  std::array<Jet, kP> p;
-  for (int k = 0; k < kP; ++k) p[k] = Jet(robot.nominal[k], k);
-  const auto f = kinematics.Prepare(p.data());
-  const Eigen::Matrix<double, N, 3> j0 = kinematics.KinematicMatrix(robot.nominal.data());
-  Eigen::MatrixXd g(9, kP);
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) {
-      Jet e(0.0);
-      for (int i = 0; i < N; ++i) e += f(r, i) * j0(i, c);
-      for (int k = 0; k < kP; ++k) {
-        g(3 * r + c, k) = e.v[k] * robot.parameters[k].RelativeScale(robot.nominal[k]);
-      }
-    }
-  }
-  return g;
-}
-
-std::string GaugeReason(const Robot& robot, int held, const Eigen::VectorXd& direction) {
-  const ParameterInfo& h = robot.parameters[held];
-  std::string with;
-  char item[96];
-  for (int k = 0; k < robot.NumParameters(); ++k) {
-    if (k == held || std::abs(direction(k)) < 1e-9) continue;
-    const ParameterInfo& q = robot.parameters[k];
-    std::snprintf(item, sizeof item, "%s%s %+.3g %s/%s", with.empty() ? "" : ", ", q.name.c_str(),
-                  direction(k) * q.DisplayScale() / h.DisplayScale(), q.DisplayUnit(),
-                  h.DisplayUnit());
-    with += item;
-  }
-  return "wheels that agree replay the same when " + h.name + " changes together with " +
-         (with.empty() ? std::string("nothing else") : with) +
-         ", so the odometry cannot determine it; held at its nominal to fix that direction";
-}
-
-// The gauge: a basis Z of the directions the odometry cannot see, the held parameters chosen
-// greedily (order below) while each pins a further direction, and the reason from Z re-expressed
-// so that each column moves exactly one held parameter by one unit.
-template <int N>
-std::vector<HeldParameter> OmniGauge(const OmniKinematics<N>& kinematics, const Robot& robot) {
-  using K = OmniKinematics<N>;
-  const Eigen::MatrixXd g = TwistJacobian(kinematics, robot);
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(g, Eigen::ComputeFullV);
-  const Eigen::VectorXd s = svd.singularValues();
-  int rank = 0;
-  while (rank < s.size() && s(rank) > kRankTolerance * s(0)) ++rank;
-  const int nullity = K::kNumParameters - rank;
-  if (nullity == 0) return {};
-  const Eigen::MatrixXd z = svd.matrixV().rightCols(nullity);
-  // Candidates: angles, then distances, then radii, each from the last wheel backwards. Angles
-  // pin the rows' translation directions, distances their yaw terms; radii carry the robot's
-  // scale, which is what wears and what a box around the nominal should leave free (a radius
-  // held at a wrong nominal would push the other wheels' angles by degrees per millimetre).
-  std::vector<int> candidates;
-  for (int first : {K::kAngleIndex, K::kDistanceIndex, K::kRadiusIndex}) {
-    for (int i = N - 1; i >= 0; --i) candidates.push_back(first + i);
-  }
-  std::vector<int> held;
-  for (int k : candidates) {
-    if (static_cast<int>(held.size()) == nullity) break;
-    Eigen::MatrixXd rows(held.size() + 1, nullity);
-    for (std::size_t h = 0; h < held.size(); ++h) rows.row(h) = z.row(held[h]);
-    rows.row(held.size()) = z.row(k);
-    const Eigen::JacobiSVD<Eigen::MatrixXd> sub(rows);
-    if (sub.singularValues().minCoeff() > 1e-6) held.push_back(k);
-  }
-  Eigen::MatrixXd zh(nullity, nullity);
-  for (int h = 0; h < nullity; ++h) zh.row(h) = z.row(held[h]);
-  Eigen::MatrixXd unit = z * zh.inverse();  // column h: held[h] moves by 1, other held by 0
-  for (int k = 0; k < K::kNumParameters; ++k) {
-    unit.row(k) *= robot.parameters[k].RelativeScale(robot.nominal[k]);  // to physical units
-  }
-  std::vector<HeldParameter> out;
-  for (int h = 0; h < nullity; ++h) {
-    const Eigen::VectorXd direction = unit.col(h) / unit(held[h], h);
-    out.push_back({held[h], GaugeReason(robot, held[h], direction)});
-  }
-  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.index < b.index; });
-  return out;
-}
 
 void CheckWheels(const std::vector<OmniWheel>& wheels) {
   if (wheels.size() < kOmniMinWheels || wheels.size() > kOmniMaxWheels) {
@@ -270,19 +73,6 @@ Robot OmniRobotDescription(const std::string& name, const std::vector<OmniWheel>
     }
   }
   return robot;
-}
-
-template <int N>
-RobotModelPtr BuildOmniModel(Robot robot, const std::vector<OmniWheel>& wheels,
-                             const OmniBounds& box) {
-  OmniKinematics<N> kinematics;
-  for (int i = 0; i < N; ++i) {
-    kinematics.mount[i].drive_offset_rad = wheels[i].drive_angle_rad - wheels[i].angle_rad;
-    kinematics.mount[i].roller_rad = wheels[i].roller_angle_rad;
-  }
-  CheckFullRank(kinematics, robot.nominal, wheels);
-  robot.held = OmniGauge(kinematics, robot);
-  return std::make_shared<OmniModel<N>>(std::move(robot), kinematics, box.angle_offset_rad);
 }
 
 RobotModelPtr MakeOmniModelWithEffects(const std::string& name,

@@ -1,0 +1,6 @@
+// The omni model of 5 wheels in its own translation unit (omni_model_n.h says why).
+#include "models/omni/omni_model_n.h"
+
+namespace fitcal {
+template RobotModelPtr BuildOmniModel<5>(Robot, const std::vector<OmniWheel>&, const OmniBounds&);
+}  // namespace fitcal
