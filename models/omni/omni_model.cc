@@ -150,29 +150,6 @@ RobotModelPtr ReadOmniModel(const YAML::Node& root, const std::string& path) {
   }
 }
 
-namespace {
-
-// The mounts of an `omni` model of N wheels, or nullptr when `model` is not one.
-template <int N>
-const std::array<OmniWheelMount, N>* MountsOf(const RobotModelInterface& model) {
-  const auto* omni = dynamic_cast<const OmniModel<N>*>(&model);
-  return omni == nullptr ? nullptr : &omni->kinematics().mount;
-}
-
-template <int N>
-bool FillMounts(const RobotModelInterface& model, std::vector<OmniWheel>* wheels) {
-  const std::array<OmniWheelMount, N>* mount = MountsOf<N>(model);
-  if (mount == nullptr) return false;
-  for (int i = 0; i < N; ++i) {
-    OmniWheel& w = (*wheels)[i];
-    w.drive_angle_rad = w.angle_rad + (*mount)[i].drive_offset_rad;
-    w.roller_angle_rad = (*mount)[i].roller_rad;
-  }
-  return true;
-}
-
-}  // namespace
-
 std::optional<std::vector<OmniWheel>> OmniWheelsOf(const RobotModelInterface& model,
                                                    const std::vector<double>& p) {
   const Robot& robot = model.robot();
@@ -187,8 +164,9 @@ std::optional<std::vector<OmniWheel>> OmniWheelsOf(const RobotModelInterface& mo
     wheels.push_back(w);
   }
   using Filler = bool (*)(const RobotModelInterface&, std::vector<OmniWheel>*);
-  static constexpr Filler kFillers[] = {&FillMounts<3>, &FillMounts<4>, &FillMounts<5>,
-                                        &FillMounts<6>, &FillMounts<7>, &FillMounts<8>};
+  static constexpr Filler kFillers[] = {&FillOmniWheelMounts<3>, &FillOmniWheelMounts<4>,
+                                        &FillOmniWheelMounts<5>, &FillOmniWheelMounts<6>,
+                                        &FillOmniWheelMounts<7>, &FillOmniWheelMounts<8>};
   for (Filler fill : kFillers) {
     if (fill(model, &wheels)) break;
   }

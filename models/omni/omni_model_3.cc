@@ -3,4 +3,5 @@
 
 namespace fitcal {
 template RobotModelPtr BuildOmniModel<3>(Robot, const std::vector<OmniWheel>&, const OmniBounds&);
+template bool FillOmniWheelMounts<3>(const RobotModelInterface&, std::vector<OmniWheel>*);
 }  // namespace fitcal

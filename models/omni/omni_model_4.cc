@@ -3,4 +3,5 @@
 
 namespace fitcal {
 template RobotModelPtr BuildOmniModel<4>(Robot, const std::vector<OmniWheel>&, const OmniBounds&);
+template bool FillOmniWheelMounts<4>(const RobotModelInterface&, std::vector<OmniWheel>*);
 }  // namespace fitcal

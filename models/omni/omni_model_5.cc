@@ -3,4 +3,5 @@
 
 namespace fitcal {
 template RobotModelPtr BuildOmniModel<5>(Robot, const std::vector<OmniWheel>&, const OmniBounds&);
+template bool FillOmniWheelMounts<5>(const RobotModelInterface&, std::vector<OmniWheel>*);
 }  // namespace fitcal

@@ -3,4 +3,5 @@
 
 namespace fitcal {
 template RobotModelPtr BuildOmniModel<7>(Robot, const std::vector<OmniWheel>&, const OmniBounds&);
+template bool FillOmniWheelMounts<7>(const RobotModelInterface&, std::vector<OmniWheel>*);
 }  // namespace fitcal

@@ -3,4 +3,5 @@
 
 namespace fitcal {
 template RobotModelPtr BuildOmniModel<8>(Robot, const std::vector<OmniWheel>&, const OmniBounds&);
+template bool FillOmniWheelMounts<8>(const RobotModelInterface&, std::vector<OmniWheel>*);
 }  // namespace fitcal

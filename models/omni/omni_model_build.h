@@ -14,4 +14,9 @@ template <int N>
 RobotModelPtr BuildOmniModel(Robot robot, const std::vector<OmniWheel>& wheels,
                              const OmniBounds& box);
 
+// Each wheel's drive offset and roller angle from an omni model of N wheels into (*wheels)[i];
+// false when `model` is not one (OmniWheelsOf, omni_model.h).
+template <int N>
+bool FillOmniWheelMounts(const RobotModelInterface& model, std::vector<OmniWheel>* wheels);
+
 }  // namespace fitcal

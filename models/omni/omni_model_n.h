@@ -234,4 +234,17 @@ RobotModelPtr BuildOmniModel(Robot robot, const std::vector<OmniWheel>& wheels,
                                                              box.angle_offset_rad);
 }
 
+template <int N>
+bool FillOmniWheelMounts(const RobotModelInterface& model, std::vector<OmniWheel>* wheels) {
+  const auto* omni = dynamic_cast<const omni_model_internal::OmniModel<N>*>(&model);
+  if (omni == nullptr) return false;
+  const auto& mount = omni->kinematics().mount;
+  for (int i = 0; i < N; ++i) {
+    OmniWheel& w = (*wheels)[i];
+    w.drive_angle_rad = w.angle_rad + mount[i].drive_offset_rad;
+    w.roller_angle_rad = mount[i].roller_rad;
+  }
+  return true;
+}
+
 }  // namespace fitcal
