@@ -783,7 +783,6 @@ void PrintFitWarnings(const FitCommandOptions& options, const RobotModelInterfac
   }
 }
 
-
 int StoppedEarlyExit(bool selected_fit_stopped_early, const std::string& termination) {
   if (!selected_fit_stopped_early) return 0;
   std::cerr << "fitcal: warning: the written calibration is the solver's last point ("
@@ -795,6 +794,60 @@ int StoppedEarlyExit(bool selected_fit_stopped_early, const std::string& termina
 
 void PrintHeldAtNominal(const std::string& direction) {
   std::printf("held at nominal, not determined by the training runs: %s\n", direction.c_str());
+}
+
+// Before fitting, as a fit would not notice them: rates in the wrong unit (exit 1), miswired
+// channels (exit 4), data that cannot determine the parameters (warnings). 0 to go on.
+int CheckBeforeFitting(const FitCommandOptions& options, const RobotModelInterface& model,
+                       const RunSplit& split, const std::vector<RunLog>& logs) {
+  if (const RateUnitsFinding units = CheckModelRateUnits(model, logs); units.suspicious) {
+    std::cerr << "fitcal: " << options.logs << ": " << units.message << "\n";
+    return 1;
+  }
+  if (!options.skip_wheel_order_check &&
+      ChannelsLookMiswired(options, model, split.training, logs)) {
+    return 4;
+  }
+  for (const std::string& problem : FindDegenerateData(split.training, model.robot())) {
+    std::printf("warning: %s\n", problem.c_str());
+  }
+  return 0;
+}
+
+// The track fits without and with the effects to fit, appended to the gate's candidates.
+TrackFits AddTrackFitCandidates(const FitCommandOptions& options, const RobotModelInterface& model,
+                                const std::vector<TrackRun>& training_tracks,
+                                const EffectModel& effects_to_fit,
+                                std::vector<CalibrationCandidate>* candidates) {
+  TrackFits t;
+  t.without_effects = FitEffects(options, model, training_tracks, {});
+  t.with_effects = FitEffects(options, model, training_tracks, effects_to_fit);
+  t.without_index = static_cast<int>(candidates->size());
+  candidates->push_back({"track fit", t.without_effects.parameters, t.without_effects.usable});
+  t.with_index = static_cast<int>(candidates->size());
+  candidates->push_back({"track fit + " + EffectNames(effects_to_fit), t.with_effects.parameters,
+                         t.with_effects.usable, t.with_effects.effects});
+  return t;
+}
+
+// Each direction held at the nominal, and what to drive to determine it (fit/motion_advice.h).
+void PrintHeldDirections(const RobotModelInterface& model, const ModelFitResult& fit,
+                         const ResidualWeights& weights) {
+  for (const UndeterminedDirection& d : fit.held_directions) {
+    PrintHeldAtNominal(d.description);
+    const std::vector<MotionThatDetermines> motions =
+        MotionsThatDetermine(d, model, fit.parameters, weights);
+    std::printf("  %s\n", MotionAdviceLine(motions).c_str());
+  }
+}
+
+void WriteCalibration(const FitCommandOptions& options, const RobotModelInterface& model,
+                      const CalibrationCandidate& selected, const io::CalibrationBlock& record) {
+  io::StopHereForTests("fitted");
+  io::WriteFileAtomically(options.out,
+                          model.RobotYaml(selected.parameters, selected.effects,
+                                          io::CalibrationBlockYaml(record, model.robot())));
+  std::printf("wrote %s\n", options.out.c_str());
 }
 
 }  // namespace
@@ -833,16 +886,8 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
               << TrainingSelection(options) << ")\n";
     return 2;
   }
-  if (const RateUnitsFinding units = CheckModelRateUnits(*model, dataset.runs); units.suspicious) {
-    std::cerr << "fitcal: " << options.logs << ": " << units.message << "\n";
-    return 1;
-  }
-  if (!options.skip_wheel_order_check &&
-      ChannelsLookMiswired(options, *model, split.training, logs)) {
-    return 4;
-  }
-  for (const std::string& problem : FindDegenerateData(split.training, robot)) {
-    std::printf("warning: %s\n", problem.c_str());
+  if (const int refused = CheckBeforeFitting(options, *model, split, logs); refused != 0) {
+    return refused;
   }
   std::optional<std::vector<TrackRun>> training_tracks;
   if (!effects_to_fit->empty()) {
@@ -867,17 +912,10 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   const ModelFitMethodOutcome outcome = method->run_model(split.training, *model, settings);
   const ModelFitResult& fit = outcome.fit;
   std::vector<CalibrationCandidate> candidates = Candidates(*model, split, fit, options.method);
-  std::optional<TrackFits> track_fits;
-  if (training_tracks) {
-    TrackFits& t = track_fits.emplace();
-    t.without_effects = FitEffects(options, *model, *training_tracks, {});
-    t.with_effects = FitEffects(options, *model, *training_tracks, *effects_to_fit);
-    t.without_index = static_cast<int>(candidates.size());
-    candidates.push_back({"track fit", t.without_effects.parameters, t.without_effects.usable});
-    t.with_index = static_cast<int>(candidates.size());
-    candidates.push_back({"track fit + " + EffectNames(*effects_to_fit), t.with_effects.parameters,
-                          t.with_effects.usable, t.with_effects.effects});
-  }
+  const std::optional<TrackFits> track_fits =
+      training_tracks ? std::optional<TrackFits>(AddTrackFitCandidates(
+                            options, *model, *training_tracks, *effects_to_fit, &candidates))
+                      : std::nullopt;
   const CandidateErrors errors(*model, logs, options.threads);
   GateDecision gate = SelectCalibration(*model, candidates, split.training, split.validation,
                                         options.threads, errors.Cf());
@@ -900,12 +938,7 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   if (track_data) PrintClockOffsets(fit, *track_data);
   PrintEverydayDriving(*model, logs, split, candidates[0], selected, options.threads);
   if (!fit.has_covariance) std::printf("uncertainty: %s\n", fit.covariance_message.c_str());
-  for (const UndeterminedDirection& d : fit.held_directions) {
-    PrintHeldAtNominal(d.description);
-    const std::vector<MotionThatDetermines> motions =
-        MotionsThatDetermine(d, *model, fit.parameters, settings.weights);
-    std::printf("  %s\n", MotionAdviceLine(motions).c_str());
-  }
+  PrintHeldDirections(*model, fit, settings.weights);
   PrintFitWarnings(options, *model, split, fit);
   if (halves.judged) {  // the gate's table is on the training runs; the halves judge (below)
     gate.judged_on = "training runs (" + std::to_string(split.training.size()) +
@@ -923,10 +956,7 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
     if (track_data && selected.name == options.method) {
       RecordClockOffsets(fit, *track_data, settings.clock_grouping, &record);
     }
-    io::StopHereForTests("fitted");
-    io::WriteFileAtomically(options.out, model->RobotYaml(selected.parameters, selected.effects,
-                                                          io::CalibrationBlockYaml(record, robot)));
-    std::printf("wrote %s\n", options.out.c_str());
+    WriteCalibration(options, *model, selected, record);
   }
   std::printf("time: load %.3f s, total %.3f s\n", load_s, Seconds(t_total));
   return StoppedEarlyExit(fit.stopped_early && candidates[gate.selected].name == options.method,
