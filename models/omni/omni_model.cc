@@ -1,6 +1,11 @@
 #include "models/omni/omni_model.h"
 
+#include <Eigen/LU>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -11,6 +16,76 @@
 #include "models/omni/omni_model_build.h"
 
 namespace fitcal {
+
+namespace omni_model_internal {
+
+namespace {
+
+std::string GaugeReason(const Robot& robot, int held, const Eigen::VectorXd& direction) {
+  const ParameterInfo& h = robot.parameters[held];
+  std::string with;
+  char item[96];
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    if (k == held || std::abs(direction(k)) < 1e-9) continue;
+    const ParameterInfo& q = robot.parameters[k];
+    std::snprintf(item, sizeof item, "%s%s %+.3g %s/%s", with.empty() ? "" : ", ", q.name.c_str(),
+                  direction(k) * q.DisplayScale() / h.DisplayScale(), q.DisplayUnit(),
+                  h.DisplayUnit());
+    with += item;
+  }
+  return "wheels that agree replay the same when " + h.name + " changes together with " +
+         (with.empty() ? std::string("nothing else") : with) +
+         ", so the odometry cannot determine it; held at its nominal to fix that direction";
+}
+
+}  // namespace
+
+// The gauge: a basis Z of the directions the odometry cannot see, the held parameters chosen
+// greedily (order below) while each pins a further direction, and the reason from Z re-expressed
+// so that each column moves exactly one held parameter by one unit.
+std::vector<HeldParameter> GaugeOfTwistJacobian(const Eigen::MatrixXd& g, const Robot& robot,
+                                                const std::array<int, 3>& candidate_firsts,
+                                                int wheels) {
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(g, Eigen::ComputeFullV);
+  const Eigen::VectorXd s = svd.singularValues();
+  int rank = 0;
+  while (rank < s.size() && s(rank) > kRankTolerance * s(0)) ++rank;
+  const int nullity = static_cast<int>(g.cols()) - rank;
+  if (nullity == 0) return {};
+  const Eigen::MatrixXd z = svd.matrixV().rightCols(nullity);
+  // Candidates: angles, then distances, then radii, each from the last wheel backwards. Angles
+  // pin the rows' translation directions, distances their yaw terms; radii carry the robot's
+  // scale, which is what wears and what a box around the nominal should leave free (a radius
+  // held at a wrong nominal would push the other wheels' angles by degrees per millimetre).
+  std::vector<int> candidates;
+  for (int first : candidate_firsts) {
+    for (int i = wheels - 1; i >= 0; --i) candidates.push_back(first + i);
+  }
+  std::vector<int> held;
+  for (int k : candidates) {
+    if (static_cast<int>(held.size()) == nullity) break;
+    Eigen::MatrixXd rows(held.size() + 1, nullity);
+    for (std::size_t h = 0; h < held.size(); ++h) rows.row(h) = z.row(held[h]);
+    rows.row(held.size()) = z.row(k);
+    const Eigen::JacobiSVD<Eigen::MatrixXd> sub(rows);
+    if (sub.singularValues().minCoeff() > 1e-6) held.push_back(k);
+  }
+  Eigen::MatrixXd zh(nullity, nullity);
+  for (int h = 0; h < nullity; ++h) zh.row(h) = z.row(held[h]);
+  Eigen::MatrixXd unit = z * zh.inverse();  // column h: held[h] moves by 1, other held by 0
+  for (int k = 0; k < g.cols(); ++k) {
+    unit.row(k) *= robot.parameters[k].RelativeScale(robot.nominal[k]);  // to physical units
+  }
+  std::vector<HeldParameter> out;
+  for (int h = 0; h < nullity; ++h) {
+    const Eigen::VectorXd direction = unit.col(h) / unit(held[h], h);
+    out.push_back({held[h], GaugeReason(robot, held[h], direction)});
+  }
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.index < b.index; });
+  return out;
+}
+
+}  // namespace omni_model_internal
 
 namespace {
 

@@ -4,11 +4,11 @@
 // per wheel count: each KinematicModel<OmniKinematics<N>> instantiates the replay, the final-pose
 // and segment costs and the effect replay on Jets of 3 N parameters, and the six of them in one
 // file were its longest compile step (108 s in Release, 210 s under the sanitizers), which one
-// core had to do alone.
+// core had to do alone. What does not depend on N is compiled once, in omni_model.cc
+// (docs/tests.md: the CPU times).
 
 #include <ceres/jet.h>
 
-#include <Eigen/LU>
 #include <Eigen/SVD>
 #include <algorithm>
 #include <array>
@@ -27,11 +27,6 @@
 
 namespace fitcal {
 namespace omni_model_internal {
-
-// Singular values below this fraction of the largest count as zero: the kinematic matrix's
-// (geometry check) and the parameter Jacobian's (gauge). Both are computed in units where every
-// entry is O(1), so 1e-9 separates rounding (1e-15) from a real direction by orders of magnitude.
-inline constexpr double kRankTolerance = 1e-9;
 
 template <int N>
 class OmniModel : public KinematicModel<OmniKinematics<N>> {
@@ -155,67 +150,13 @@ Eigen::MatrixXd TwistJacobian(const OmniKinematics<N>& kinematics, const Robot& 
   return g;
 }
 
-inline std::string GaugeReason(const Robot& robot, int held, const Eigen::VectorXd& direction) {
-  const ParameterInfo& h = robot.parameters[held];
-  std::string with;
-  char item[96];
-  for (int k = 0; k < robot.NumParameters(); ++k) {
-    if (k == held || std::abs(direction(k)) < 1e-9) continue;
-    const ParameterInfo& q = robot.parameters[k];
-    std::snprintf(item, sizeof item, "%s%s %+.3g %s/%s", with.empty() ? "" : ", ", q.name.c_str(),
-                  direction(k) * q.DisplayScale() / h.DisplayScale(), q.DisplayUnit(),
-                  h.DisplayUnit());
-    with += item;
-  }
-  return "wheels that agree replay the same when " + h.name + " changes together with " +
-         (with.empty() ? std::string("nothing else") : with) +
-         ", so the odometry cannot determine it; held at its nominal to fix that direction";
-}
-
-// The gauge: a basis Z of the directions the odometry cannot see, the held parameters chosen
-// greedily (order below) while each pins a further direction, and the reason from Z re-expressed
-// so that each column moves exactly one held parameter by one unit.
+// The gauge of N wheels (omni_model.cc: GaugeOfTwistJacobian): what does not depend on N is
+// compiled once there, not in each of the six translation units.
 template <int N>
 std::vector<HeldParameter> OmniGauge(const OmniKinematics<N>& kinematics, const Robot& robot) {
   using K = OmniKinematics<N>;
-  const Eigen::MatrixXd g = TwistJacobian(kinematics, robot);
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(g, Eigen::ComputeFullV);
-  const Eigen::VectorXd s = svd.singularValues();
-  int rank = 0;
-  while (rank < s.size() && s(rank) > kRankTolerance * s(0)) ++rank;
-  const int nullity = K::kNumParameters - rank;
-  if (nullity == 0) return {};
-  const Eigen::MatrixXd z = svd.matrixV().rightCols(nullity);
-  // Candidates: angles, then distances, then radii, each from the last wheel backwards. Angles
-  // pin the rows' translation directions, distances their yaw terms; radii carry the robot's
-  // scale, which is what wears and what a box around the nominal should leave free (a radius
-  // held at a wrong nominal would push the other wheels' angles by degrees per millimetre).
-  std::vector<int> candidates;
-  for (int first : {K::kAngleIndex, K::kDistanceIndex, K::kRadiusIndex}) {
-    for (int i = N - 1; i >= 0; --i) candidates.push_back(first + i);
-  }
-  std::vector<int> held;
-  for (int k : candidates) {
-    if (static_cast<int>(held.size()) == nullity) break;
-    Eigen::MatrixXd rows(held.size() + 1, nullity);
-    for (std::size_t h = 0; h < held.size(); ++h) rows.row(h) = z.row(held[h]);
-    rows.row(held.size()) = z.row(k);
-    const Eigen::JacobiSVD<Eigen::MatrixXd> sub(rows);
-    if (sub.singularValues().minCoeff() > 1e-6) held.push_back(k);
-  }
-  Eigen::MatrixXd zh(nullity, nullity);
-  for (int h = 0; h < nullity; ++h) zh.row(h) = z.row(held[h]);
-  Eigen::MatrixXd unit = z * zh.inverse();  // column h: held[h] moves by 1, other held by 0
-  for (int k = 0; k < K::kNumParameters; ++k) {
-    unit.row(k) *= robot.parameters[k].RelativeScale(robot.nominal[k]);  // to physical units
-  }
-  std::vector<HeldParameter> out;
-  for (int h = 0; h < nullity; ++h) {
-    const Eigen::VectorXd direction = unit.col(h) / unit(held[h], h);
-    out.push_back({held[h], GaugeReason(robot, held[h], direction)});
-  }
-  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.index < b.index; });
-  return out;
+  return GaugeOfTwistJacobian(TwistJacobian(kinematics, robot), robot,
+                              {K::kAngleIndex, K::kDistanceIndex, K::kRadiusIndex}, N);
 }
 
 }  // namespace omni_model_internal
