@@ -122,16 +122,6 @@ std::vector<std::size_t> ThinnedIndices(std::size_t n, std::size_t most) {
   return out;
 }
 
-// The q-quantile of v, linear between order statistics (the y range of the distance figures).
-double QuantileOf(std::vector<double> v, double q) {
-  if (v.empty()) return std::nan("");
-  std::sort(v.begin(), v.end());
-  const double at = q * static_cast<double>(v.size() - 1);
-  const std::size_t lo = static_cast<std::size_t>(std::floor(at));
-  const std::size_t hi = std::min(v.size() - 1, lo + 1);
-  return v[lo] + (at - static_cast<double>(lo)) * (v[hi] - v[lo]);
-}
-
 // Which error of a run a distance figure shows, and how it is scaled for display.
 struct ErrorQuantity {
   const char* label;  // y axis
@@ -211,7 +201,7 @@ std::string ErrorAlongDistanceSvgs(const ReportData& d, const ErrorQuantity& q,
     }
   }
   if (all.empty()) return "";
-  const double y_hi = 1.05 * std::max(QuantileOf(all, 0.95), 1e-9);
+  const double y_hi = 1.05 * std::max(Quantile(all, 0.95), 1e-9);
   return ErrorAlongDistancePanel(d, q, false, y_hi, id + "-nominal") +
          ErrorAlongDistancePanel(d, q, true, y_hi, id + "-calibrated");
 }

@@ -15,6 +15,10 @@ std::string EscapeXml(const std::string& text);
 // "Nice" tick positions (1, 2, 5 x 10^n steps) covering [lo, hi], at most about max_ticks.
 std::vector<double> NiceTicks(double lo, double hi, int max_ticks = 7);
 
+// The q-quantile of v, linear between order statistics; NaN for none. What the report's figures
+// range their axes by and its error-against-distance bands are drawn from.
+double Quantile(std::vector<double> v, double q);
+
 struct Point2 {
   double x = 0.0;
   double y = 0.0;

@@ -483,16 +483,6 @@ double InterpolateAt(const std::vector<double>& x, const std::vector<double>& y,
   return y[j - 1] + f * (y[j] - y[j - 1]);
 }
 
-// The q-quantile of v, linear between order statistics; NaN for none.
-double QuantileOf(std::vector<double> v, double q) {
-  if (v.empty()) return std::nan("");
-  std::sort(v.begin(), v.end());
-  const double at = q * static_cast<double>(v.size() - 1);
-  const std::size_t lo = static_cast<std::size_t>(std::floor(at));
-  const std::size_t hi = std::min(v.size() - 1, lo + 1);
-  return v[lo] + (at - static_cast<double>(lo)) * (v[hi] - v[lo]);
-}
-
 // One error of the runs (`error`, sampled at their along_m) over the runs that reach each
 // distance: quartiles and median on a grid of 80 distances up to where half the runs still go
 // (the median of the runs' lengths).
@@ -503,7 +493,7 @@ io::ReportErrorBand ErrorBandOf(const std::vector<io::ReportRun>& runs,
     const std::vector<double>& e = r.*error;
     if (r.along_m.size() == e.size() && !e.empty()) ends.push_back(r.along_m.back());
   }
-  const double reach = QuantileOf(ends, 0.5);
+  const double reach = io::Quantile(ends, 0.5);
   io::ReportErrorBand band;
   for (int k = 0; k <= 80 && reach > 0.0; ++k) {
     const double at = reach * k / 80.0;
@@ -516,9 +506,9 @@ io::ReportErrorBand ErrorBandOf(const std::vector<io::ReportRun>& runs,
     }
     if (v.empty()) continue;
     band.distance_m.push_back(at);
-    band.lower_quartile.push_back(QuantileOf(v, 0.25));
-    band.median.push_back(QuantileOf(v, 0.5));
-    band.upper_quartile.push_back(QuantileOf(v, 0.75));
+    band.lower_quartile.push_back(io::Quantile(v, 0.25));
+    band.median.push_back(io::Quantile(v, 0.5));
+    band.upper_quartile.push_back(io::Quantile(v, 0.75));
   }
   return band;
 }
