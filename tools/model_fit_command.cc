@@ -634,8 +634,7 @@ bool WorseThanNominalOnSomeKind(const std::vector<CalibrationCandidate>& candida
                                 const GateDecision& gate, const RunSplit& split,
                                 const CandidateErrors& errors) {
   if (!gate.judged_on_held_out || gate.selected == 0) return false;
-  std::map<std::string, std::vector<AlignedRun>> by_kind;
-  for (const AlignedRun& run : split.validation) by_kind[TrajectoryFamily(run.trajectory)].push_back(run);
+  const std::map<std::string, std::vector<AlignedRun>> by_kind = RunsByFamily(split.validation);
   if (by_kind.size() < 2) return false;  // the gate judged this one kind already
   bool worse = false;
   for (const auto& [kind, runs] : by_kind) {

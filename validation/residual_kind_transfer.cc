@@ -12,12 +12,6 @@ namespace {
 constexpr const char* kFreeDriving = "free";
 constexpr double kJudgedDriftLength_m = 2.0;  // the everyday window between 1 and 5 m
 
-std::map<std::string, std::vector<AlignedRun>> ByFamily(const std::vector<AlignedRun>& runs) {
-  std::map<std::string, std::vector<AlignedRun>> by;
-  for (const AlignedRun& run : runs) by[TrajectoryFamily(run.trajectory)].push_back(run);
-  return by;
-}
-
 const DriftAtLength* DriftAt(const EverydayDrivingMetrics& m, double length_m) {
   for (const DriftAtLength& d : m.drift)
     if (std::abs(d.length_m - length_m) < 1e-9 && d.windows > 0) return &d;
@@ -75,7 +69,7 @@ ResidualKindJudgement JudgeResidualKindsByTransfer(ResidualKind proposed, Residu
   j.proposed = j.chosen = proposed;
   j.alternative = alternative;
   const Judge judge{proposed, alternative, fit_on, score};
-  const auto held_out = ByFamily(split.validation);
+  const auto held_out = RunsByFamily(split.validation);
   if (const auto free = held_out.find(kFreeDriving); free != held_out.end()) {
     KindComparison c;
     c.judged_on = kFreeDriving;
@@ -84,7 +78,7 @@ ResidualKindJudgement JudgeResidualKindsByTransfer(ResidualKind proposed, Residu
     j.on_free_driving = true;
     j.comparisons.push_back(std::move(c));
   } else {
-    const auto training = ByFamily(split.training);
+    const auto training = RunsByFamily(split.training);
     if (training.size() < 2) return j;
     for (const auto& [family, runs] : training) {
       std::vector<AlignedRun> others;

@@ -11,4 +11,10 @@ std::string TrajectoryFamily(const std::string& label) {
   return label.empty() ? "-" : label;
 }
 
+std::map<std::string, std::vector<AlignedRun>> RunsByFamily(const std::vector<AlignedRun>& runs) {
+  std::map<std::string, std::vector<AlignedRun>> by;
+  for (const AlignedRun& run : runs) by[TrajectoryFamily(run.trajectory)].push_back(run);
+  return by;
+}
+
 }  // namespace fitcal
