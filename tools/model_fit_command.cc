@@ -52,6 +52,16 @@ std::string TrainingSelection(const FitCommandOptions& o) {
   return "repetitions " + o.train_reps;
 }
 
+// Each run's ground-truth track, found by run id among the logs the runs were aligned from.
+std::vector<const GroundTruthTrack*> TracksOf(const std::vector<RunLog>& logs,
+                                              const std::vector<AlignedRun>& runs) {
+  std::unordered_map<std::string, const GroundTruthTrack*> track_of;
+  for (const RunLog& log : logs) track_of[log.id] = &log.ground_truth;
+  std::vector<const GroundTruthTrack*> tracks;
+  for (const AlignedRun& run : runs) tracks.push_back(track_of.at(run.id));
+  return tracks;
+}
+
 // The final-pose errors of a candidate of the gate on some runs: replayed by the model alone, or
 // with its effects against each run's ground-truth track (the same Eq. 14 at the same poses).
 class CandidateErrors {
@@ -493,10 +503,7 @@ void WarnOfEffects(const std::vector<CalibrationCandidate>& candidates, const Ga
 bool PrepareTrackResiduals(const FitCommandOptions& options, const std::vector<RunLog>& logs,
                            const RunSplit& split, FitMethodSettings* settings,
                            std::optional<TrackFitData>* data) {
-  std::unordered_map<std::string, const GroundTruthTrack*> track_of;
-  for (const RunLog& log : logs) track_of[log.id] = &log.ground_truth;
-  std::vector<const GroundTruthTrack*> tracks;
-  for (const AlignedRun& run : split.training) tracks.push_back(track_of.at(run.id));
+  const std::vector<const GroundTruthTrack*> tracks = TracksOf(logs, split.training);
   ResolveAutoResiduals(split.training, tracks, options.method, settings);
   if (settings->residuals == ResidualKind::kFinalPose) return true;
   if (options.method != "ceres" && options.method != "ceres-dogleg") {
@@ -573,12 +580,8 @@ void PrintEverydayDriving(const RobotModelInterface& model, const std::vector<Ru
                           const CalibrationCandidate& selected, int threads) {
   const bool held_out = !split.validation.empty();
   const std::vector<AlignedRun>& runs = held_out ? split.validation : split.training;
-  std::unordered_map<std::string, const GroundTruthTrack*> track_of;
-  for (const RunLog& log : logs) track_of[log.id] = &log.ground_truth;
-  std::vector<const GroundTruthTrack*> tracks;
-  for (const AlignedRun& run : runs) tracks.push_back(track_of.at(run.id));
   PrintEverydayDrivingTable(
-      model, runs, tracks, held_out ? "everyday driving, validation" : "everyday driving, training",
+      model, runs, TracksOf(logs, runs), held_out ? "everyday driving, validation" : "everyday driving, training",
       {&nominal.parameters, &nominal.effects}, {&selected.parameters, &selected.effects}, threads);
 }
 
@@ -608,12 +611,8 @@ std::vector<std::string> ChooseResidualsByTransfer(const FitCommandOptions& opti
     if (!(fit.usable || fit.stopped_early)) return std::nullopt;
     return fit.parameters;
   };
-  std::unordered_map<std::string, const GroundTruthTrack*> track_of;
-  for (const RunLog& log : logs) track_of[log.id] = &log.ground_truth;
   const ScoreOnRuns score = [&](const std::vector<double>& p, const std::vector<AlignedRun>& runs) {
-    std::vector<const GroundTruthTrack*> tracks;
-    for (const AlignedRun& run : runs) tracks.push_back(track_of.at(run.id));
-    return EvaluateEverydayDriving(model, p, {}, runs, tracks, EverydayDriftLengths(),
+    return EvaluateEverydayDriving(model, p, {}, runs, TracksOf(logs, runs), EverydayDriftLengths(),
                                    options.threads);
   };
   const ResidualKindJudgement judgement = JudgeResidualKindsByTransfer(
