@@ -1,13 +1,13 @@
 #pragma once
-// The paper's cost CF (Palacin Eq. 14) over a set of runs: the mean over runs of
-// sqrt(dx^2 + dy^2 + dtheta^2) at the final pose, angle in radians. This is what fitcal reports,
-// whatever objective a solver minimises (see seeds/README.md: the paper's Table 6 only agrees
-// with the angle term in radians).
+// Transitional: the omni3 overload of the paper's CF (Palacin Eq. 14) for the callers in
+// validation/ and diagnosis/ that still hold omni3 parameter arrays; it forwards to the seam
+// (fit/final_pose_errors.h with the omni3 model). Delete with those callers.
 
 #include <array>
 #include <vector>
 
 #include "fit/final_pose_errors.h"
+#include "models/omni3/omni3_robot_model.h"
 #include "odometry/aligned_run.h"
 #include "odometry/omni3_model.h"
 
@@ -15,8 +15,11 @@ namespace fitcal {
 
 using Omni3ParameterArray = std::array<double, omni3::kNumParameters>;
 
-// Evaluates every run in parallel (num_threads 0 = all cores).
-FinalPoseErrors EvaluateFinalPoseErrors(const Omni3ParameterArray& p,
-                                        const std::vector<AlignedRun>& runs, int num_threads = 0);
+inline FinalPoseErrors EvaluateFinalPoseErrors(const Omni3ParameterArray& p,
+                                               const std::vector<AlignedRun>& runs,
+                                               int num_threads = 0) {
+  return EvaluateFinalPoseErrors(DefaultOmni3Model(), std::vector<double>(p.begin(), p.end()),
+                                 runs, num_threads);
+}
 
 }  // namespace fitcal

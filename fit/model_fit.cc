@@ -7,6 +7,7 @@
 #include <cmath>
 #include <memory>
 #include <stdexcept>
+#include <type_traits>
 #include <utility>
 
 #include "fit/correlation.h"
@@ -596,6 +597,12 @@ ModelFitResult FitModelFrom(const std::vector<AlignedRun>& training,
   }
   const int n = model.robot().NumParameters();
   if (static_cast<int>(start.size()) != n) throw std::invalid_argument("FitModel: bad start");
+  if (options.tying != nullptr && !options.tying->empty()) {
+    const TiedModel tied(model, *options.tying);
+    ModelFitOptions untied = options;
+    untied.tying = nullptr;
+    return ExpandTiedResult(tied, FitModelFrom(training, tied, tied.Reduce(start), untied));
+  }
   if (UsesTracks(options)) {
     if (options.track == nullptr || options.track->runs.size() != training.size()) {
       throw std::invalid_argument("FitModel: track residuals need one track per training run");
@@ -637,6 +644,32 @@ ModelFitResult FitModelFrom(const std::vector<AlignedRun>& training,
   }
   if (options.ceres.compute_covariance) ComputeCovariance(training, model, options, holds, &result);
   return result;
+}
+
+ModelFitResult ExpandTiedResult(const TiedModel& tied, const ModelFitResult& fit) {
+  const int n = tied.inner().robot().NumParameters();
+  const auto per_member = [&](const auto& of_q) {
+    std::remove_const_t<std::remove_reference_t<decltype(of_q)>> out(n);
+    for (int k = 0; k < n; ++k) out[k] = of_q[tied.GroupOf(k)];
+    return out;
+  };
+  ModelFitResult out = fit;
+  out.parameters = tied.Expand(fit.parameters.data());
+  out.at_bound = per_member(fit.at_bound);
+  out.held = per_member(fit.held);
+  if (!fit.unconstrained_parameters.empty())
+    out.unconstrained_parameters = tied.Expand(fit.unconstrained_parameters.data());
+  for (UndeterminedDirection& d : out.held_directions) {
+    d.prior_units = per_member(d.prior_units);
+    d.one_sigma_step = per_member(d.one_sigma_step);
+  }
+  if (fit.sigma.size() == fit.parameters.size()) out.sigma = per_member(fit.sigma);
+  if (fit.has_covariance) {
+    const Eigen::MatrixXd a = tied.Basis();
+    out.covariance = a * fit.covariance * a.transpose();
+    out.correlation = CorrelationOf(out.covariance);
+  }
+  return out;
 }
 
 ClockOffsetEstimate EstimateClockOffsets(const RobotModelInterface& model,

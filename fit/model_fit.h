@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "fit/determined_directions.h"
+#include "fit/parameter_tying.h"
 #include "fit/solver_options.h"
 #include "fit/track_residual.h"
 #include "models/model_interface.h"
@@ -99,6 +100,10 @@ struct ModelFitOptions {
   // after the fit, the information the runs carry along every direction is weighed against the
   // bounds; when some direction stays undetermined the fit is repeated with it held.
   bool hold_undetermined = true;
+  // When set and not empty: groups of parameters sharing one value and parameters held at the
+  // nominal (fit/parameter_tying.h). The fit runs on the tied model and its result is mapped back
+  // (ExpandTiedResult); every residual kind above works with it.
+  const ParameterTying* tying = nullptr;
 };
 
 // A value rests on a bound when it is within 1e-6 of the box's width of it: far above the YAML's
@@ -122,6 +127,11 @@ ClockOffsetEstimate EstimateClockOffsets(const RobotModelInterface& model,
 // Throws std::invalid_argument for invalid options or no runs.
 ModelFitResult FitModel(const std::vector<AlignedRun>& training, const RobotModelInterface& model,
                         const ModelFitOptions& options = {});
+
+// A fit of `tied` (parameters q) in the inner model's parameters p = A q: parameters, at_bound,
+// held and the held directions per member of each group, the covariance A C_q A^T (a tied
+// parameter's sigma is its shared value's; members correlate with 1).
+ModelFitResult ExpandTiedResult(const TiedModel& tied, const ModelFitResult& fit);
 
 // The same started from `start` instead of the robot's nominal (e.g. a closed-form calibration).
 ModelFitResult FitModelFrom(const std::vector<AlignedRun>& training,

@@ -1,14 +1,11 @@
 #include "fit/segment_cost.h"
 
-#include <ceres/ceres.h>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 
-#include "fit/dense_solver_options.h"
-#include "odometry/parallel_for.h"
 
 namespace fitcal {
 
@@ -109,53 +106,44 @@ std::vector<Segment> MakeCheckpointsFromStart(const AlignedRun& run,
   return out;
 }
 
-SegmentErrors EvaluateSegmentErrors(const Omni3ParameterArray& p,
-                                    const std::vector<SegmentedRun>& runs, int num_threads) {
-  std::vector<SegmentErrors> per_run(runs.size());
-  ParallelFor(runs.size(), num_threads, [&](std::size_t i) {
-    const Omni3SegmentResidual residual(runs[i], ResidualWeights{});
-    std::vector<double> r(static_cast<std::size_t>(residual.NumResiduals()));
-    residual(p.data(), r.data());
-    SegmentErrors& e = per_run[i];
-    for (std::size_t k = 0; k < runs[i].segments.size(); ++k) {
-      const double* rk = &r[3 * k];
-      e.cf += std::sqrt(rk[0] * rk[0] + rk[1] * rk[1] + rk[2] * rk[2]);
-      e.mean_translation_error_m += std::hypot(rk[0], rk[1]);
-      e.mean_abs_heading_error_rad += std::abs(rk[2]);
-      ++e.num_segments;
-    }
-  });
-  SegmentErrors out;
-  for (const SegmentErrors& e : per_run) {
-    out.cf += e.cf;
-    out.mean_translation_error_m += e.mean_translation_error_m;
-    out.mean_abs_heading_error_rad += e.mean_abs_heading_error_rad;
-    out.num_segments += e.num_segments;
+double ClockMapLeverArm(const RobotModelInterface& model, const double* p) {
+  constexpr double kFallbackM = 1.0;
+  const Robot& robot = model.robot();
+  for (const ChannelInfo& c : robot.channels) {
+    if (c.kind == ChannelKind::kAngle) return kFallbackM;
   }
-  if (out.num_segments > 0) {
-    const double n = out.num_segments;
-    out.cf /= n;
-    out.mean_translation_error_m /= n;
-    out.mean_abs_heading_error_rad /= n;
+  const auto squared_norm = [&](const Twist& twist, double* out) {
+    std::vector<double> w(robot.NumChannels());
+    if (!model.ChannelsForTwist(p, twist, w.data())) return false;
+    *out = 0.0;
+    for (double v : w) *out += v * v;
+    return true;
+  };
+  double rotation = 0.0, forward = 0.0, sideways = 0.0;
+  if (!squared_norm({0.0, 0.0, 1.0}, &rotation) || !squared_norm({1.0, 0.0, 0.0}, &forward) ||
+      !(forward > 0.0)) {
+    return kFallbackM;
   }
-  return out;
+  if (!squared_norm({0.0, 1.0, 0.0}, &sideways)) sideways = 0.0;
+  return std::sqrt(rotation / (forward + sideways));
 }
 
-ClockMap EstimateClockMap(const AlignedRun& run, const GroundTruthTrack& ground_truth,
-                          const Omni3ParameterArray& p, const ClockMapOptions& options) {
+ClockMap EstimateClockMap(const RobotModelInterface& model, const double* p, const AlignedRun& run,
+                          const GroundTruthTrack& ground_truth, const ClockMapOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) throw std::invalid_argument("ClockMapOptions: " + error);
   const std::vector<double> t = BoundaryTimes(run);
-  const omni3::Matrix3<double> m_inv = omni3::InverseKinematicMatrix(p.data());
-  const double lever_m = (p[0] + p[1] + p[2]) / 3.0;  // weighs omega like a wheel's speed
+  const std::unique_ptr<const PreparedKinematics<double>> kinematics = model.PrepareKinematics(p);
+  const double lever_m = ClockMapLeverArm(model, p);  // weighs omega like a wheel's speed
   const std::size_t n = run.samples.size();
   std::vector<double> speed(n), omega(n);
   for (std::size_t k = 0; k < n; ++k) {
-    const Eigen::Vector3d w(run.samples[k].value[0], run.samples[k].value[1],
-                            run.samples[k].value[2]);
-    const Eigen::Vector3d v = m_inv * w;
-    speed[k] = std::hypot(v[0], v[1]);
-    omega[k] = v[2];
+    // The body step of the sample over its interval: the odometry's body velocity.
+    const double dt = run.samples[k].dt_s;
+    double dx = 0.0, dy = 0.0, dtheta = 0.0;
+    kinematics->Step(run.samples[k].value, dt, &dx, &dy, &dtheta);
+    speed[k] = std::hypot(dx, dy) / dt;
+    omega[k] = dtheta / dt;
   }
   ClockMap best;
   best.t_mid_s = 0.5 * (t.front() + t.back());
@@ -195,152 +183,6 @@ GroundTruthTrack ApplyClockMap(const GroundTruthTrack& ground_truth, const Clock
   GroundTruthTrack out = ground_truth;
   for (double& t : out.t_s) t = (t - map.offset_s + map.rate * map.t_mid_s) / (1.0 + map.rate);
   return out;
-}
-
-int ParameterTying::NumFree() const { return 1 + *std::max_element(group.begin(), group.end()); }
-
-ParameterTying ParameterTying::Nine() { return ParameterTying{}; }
-
-ParameterTying ParameterTying::CommonDistanceThreeRadii() {
-  ParameterTying t;
-  t.name = "reduced (common R, r_a..r_c)";
-  t.group = {0, 0, 0, 1, 2, 3, -1, -1, -1};
-  return t;
-}
-
-bool FitOptions::IsValid(std::string* error) const {
-  if (!(weights.position_sigma_m > 0.0) || !(weights.heading_sigma_rad > 0.0)) {
-    *error = "residual sigmas must be positive";
-    return false;
-  }
-  if (max_num_iterations < 1 || num_threads < 0) {
-    *error = "max_num_iterations must be >= 1 and num_threads >= 0";
-    return false;
-  }
-  if (tying.NumFree() < 1) {
-    *error = "the parameter tying leaves nothing free";
-    return false;
-  }
-  for (int j = 0; j < tying.NumFree(); ++j) {
-    if (std::find(tying.group.begin(), tying.group.end(), j) == tying.group.end()) {
-      *error = "free parameter " + std::to_string(j) + " is tied to nothing";
-      return false;
-    }
-  }
-  return true;
-}
-
-int FitResult::NumAtBound() const {
-  return static_cast<int>(std::count(at_bound.begin(), at_bound.end(), true));
-}
-
-namespace {
-
-// p = nominal with p_k replaced by q_{group[k]}: the tied/fixed model seen by a residual on the
-// nine parameters.
-template <typename Inner>
-class TiedResidual {
- public:
-  TiedResidual(Inner* inner, const ParameterTying& tying, const Omni3ParameterArray& nominal)
-      : inner_(inner), tying_(tying), nominal_(nominal) {}
-  template <typename T>
-  bool operator()(T const* const* q, T* residual) const {
-    T p[omni3::kNumParameters];
-    for (int k = 0; k < omni3::kNumParameters; ++k) {
-      p[k] = tying_.group[k] >= 0 ? q[0][tying_.group[k]] : T(nominal_[k]);
-    }
-    return (*inner_)(p, residual);
-  }
-
- private:
-  std::unique_ptr<Inner> inner_;
-  ParameterTying tying_;
-  Omni3ParameterArray nominal_;
-};
-
-template <typename Inner>
-ceres::CostFunction* MakeTied(Inner* inner, int num_residuals, const ParameterTying& tying,
-                              const Omni3ParameterArray& nominal) {
-  auto* cost = new ceres::DynamicAutoDiffCostFunction<TiedResidual<Inner>, 9>(
-      new TiedResidual<Inner>(inner, tying, nominal));
-  cost->AddParameterBlock(tying.NumFree());
-  cost->SetNumResiduals(num_residuals);
-  return cost;
-}
-
-}  // namespace
-
-FitResult FitOmni3(const std::vector<AlignedRun>& final_runs,
-                   const std::vector<SegmentedRun>& segmented, const Omni3Robot& robot,
-                   const FitOptions& options) {
-  std::string error;
-  if (!options.IsValid(&error)) throw std::invalid_argument("FitOptions: " + error);
-  const Omni3ParameterArray nominal = robot.nominal.ToArray();
-  const auto box = robot.ParameterBounds();
-  const int num_free = options.tying.NumFree();
-  // Start at the mean nominal of each group; bounds = the intersection of its members' boxes.
-  std::vector<double> q(num_free, 0.0), lo(num_free, -1e300), hi(num_free, 1e300);
-  std::vector<int> count(num_free, 0);
-  for (int k = 0; k < omni3::kNumParameters; ++k) {
-    const int j = options.tying.group[k];
-    if (j < 0) continue;
-    q[j] += nominal[k];
-    ++count[j];
-    lo[j] = std::max(lo[j], box[k].lo);
-    hi[j] = std::min(hi[j], box[k].hi);
-  }
-  for (int j = 0; j < num_free; ++j) {
-    q[j] /= count[j];
-    if (!(lo[j] <= q[j] && q[j] <= hi[j])) {
-      throw std::invalid_argument("FitOmni3: tied parameters have disjoint bounds");
-    }
-  }
-
-  ceres::Problem::Options problem_options;
-  ceres::Problem problem(problem_options);
-  int num_blocks = 0;
-  if (options.cost == CostKind::kFinalPose) {
-    for (const AlignedRun& run : final_runs) {
-      problem.AddResidualBlock(
-          MakeTied(new Omni3FinalPoseResidual(run, options.weights), 3, options.tying, nominal),
-          nullptr, q.data());
-      ++num_blocks;
-    }
-  } else {
-    for (const SegmentedRun& run : segmented) {
-      if (run.segments.empty()) continue;
-      auto* inner = new Omni3SegmentResidual(run, options.weights);
-      const int m = inner->NumResiduals();
-      problem.AddResidualBlock(MakeTied(inner, m, options.tying, nominal), nullptr, q.data());
-      ++num_blocks;
-    }
-  }
-  if (num_blocks == 0) throw std::invalid_argument("FitOmni3: no training runs (or no segments)");
-  for (int j = 0; j < num_free; ++j) {
-    problem.SetParameterLowerBound(q.data(), j, lo[j]);
-    problem.SetParameterUpperBound(q.data(), j, hi[j]);
-  }
-  const ceres::Solver::Options solver_options =
-      DenseSolverOptions(options.max_num_iterations, options.num_threads);
-  ceres::Solver::Summary summary;
-  ceres::Solve(solver_options, &problem, &summary);
-
-  FitResult result;
-  result.termination = ceres::TerminationTypeToString(summary.termination_type);
-  result.message = summary.message;
-  result.iterations = static_cast<int>(summary.iterations.size());
-  bool finite = true;
-  for (int k = 0; k < omni3::kNumParameters; ++k) {
-    const int j = options.tying.group[k];
-    result.parameters[k] = j >= 0 ? q[j] : nominal[k];
-    finite = finite && std::isfinite(result.parameters[k]);
-    if (j >= 0) {
-      const double tol = 1e-6 * (hi[j] - lo[j]);
-      result.at_bound[k] = q[j] <= lo[j] + tol || q[j] >= hi[j] - tol;
-    }
-  }
-  result.usable = finite && summary.termination_type == ceres::CONVERGENCE;
-  return result;
 }
 
 }  // namespace fitcal

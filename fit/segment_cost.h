@@ -1,8 +1,10 @@
 #pragma once
-// Costs for long runs and the fit that minimises them.
+// Windows of long runs and the clock map.
 //
-// 1. Segments (segment_residual.h): windows of a set ground-truth path length, started every
-//    stride_fraction * length along the path (evo/KITTI-style relative pose error).
+// 1. Segments: windows of a set ground-truth path length, started every stride_fraction * length
+//    along the path (evo/KITTI-style relative pose error); each model's SegmentCost
+//    (models/model_interface.h, models/pose_errors.h) compares them, FitModel (fit/model_fit.h,
+//    ModelFitOptions::segments) minimises them.
 // 2. Clock mapping. Encoders and ground truth are often on different clocks linearly mapped by
 //    hand (OptiOdom: start/end instants picked in each stream; the mapped spans differ by ~2 %).
 //    Final poses (robot at rest) do not care, but a window's end points do: a misalignment of
@@ -11,19 +13,12 @@
 //    (both independent of where the robot is, so robust to the calibration errors being fitted);
 //    ApplyClockMap re-stamps the ground truth. Windows are also long (default 1 m) so that a
 //    residual dt of a few 10 ms costs |v| dt / L ~ 1 %.
-// 3. FitOmni3 minimises either cost over the nine parameters or a tied/fixed subset of them
-//    (ParameterTying: e.g. OptiOdom's reduced model, one common distance + three radii, angles
-//    fixed at nominal).
 
-#include <array>
 #include <string>
 #include <vector>
 
-#include "fit/final_pose_cost.h"
-#include "fit/final_pose_residual.h"
-#include "fit/segment_residual.h"
+#include "models/model_interface.h"
 #include "odometry/aligned_run.h"
-#include "odometry/robot_description.h"
 
 namespace fitcal {
 
@@ -48,15 +43,6 @@ std::vector<Segment> MakeCheckpointsFromStart(const AlignedRun& run,
                                               const GroundTruthTrack& ground_truth,
                                               double spacing_m);
 
-struct SegmentErrors {
-  double cf = 0.0;  // mean over windows of |r| (metres and radians, Eq. 14 per window)
-  double mean_translation_error_m = 0.0;
-  double mean_abs_heading_error_rad = 0.0;
-  int num_segments = 0;
-};
-SegmentErrors EvaluateSegmentErrors(const Omni3ParameterArray& p,
-                                    const std::vector<SegmentedRun>& runs, int num_threads = 0);
-
 struct ClockMap {
   double offset_s = 0.0;  // a
   double rate = 0.0;      // b: relative rate error of the ground-truth clock
@@ -70,47 +56,19 @@ struct ClockMapOptions {
   double rate_step = 0.0025;
   bool IsValid(std::string* error) const;
 };
-// The map that makes the ground truth's speed profile match the odometry's (replayed with p).
-ClockMap EstimateClockMap(const AlignedRun& run, const GroundTruthTrack& ground_truth,
-                          const Omni3ParameterArray& p, const ClockMapOptions& options = {});
+// The map that makes the ground truth's speed profile match the odometry's: the body velocities
+// of `model` at p (its body step of each sample over dt), any model.
+ClockMap EstimateClockMap(const RobotModelInterface& model, const double* p, const AlignedRun& run,
+                          const GroundTruthTrack& ground_truth,
+                          const ClockMapOptions& options = {});
+// How EstimateClockMap weighs a yaw-rate mismatch against a speed mismatch: the distance from the
+// centre at which a turn moves the wheels as fast as a translation of the same speed,
+// |w(rotation 1 rad/s)| / |w(translation 1 m/s)| with w the channel values (ChannelsForTwist; the
+// translation forward and, when drivable, sideways, in quadrature). That is R for a symmetric
+// omni3 (every wheel at distance R) and half the wheel separation for a differential drive. 1 m
+// when the model has angle channels or cannot turn on the spot or drive forward.
+double ClockMapLeverArm(const RobotModelInterface& model, const double* p);
 // The ground truth re-stamped on the encoder clock: sample at t_gt moves to t with Map(t) = t_gt.
 GroundTruthTrack ApplyClockMap(const GroundTruthTrack& ground_truth, const ClockMap& map);
-
-// Which parameters the fit moves: group[k] = j >= 0 ties flat parameter k to free parameter j;
-// -1 holds it at the nominal. The nine-parameter model is {0, 1, ..., 8}.
-struct ParameterTying {
-  std::string name = "nine";
-  std::array<int, omni3::kNumParameters> group{0, 1, 2, 3, 4, 5, 6, 7, 8};
-  int NumFree() const;
-  static ParameterTying Nine();
-  // OptiOdom's reduced model (Sousa et al. 2022): common R, three r_i, angles fixed.
-  static ParameterTying CommonDistanceThreeRadii();
-};
-
-enum class CostKind { kFinalPose, kSegment };
-
-struct FitOptions {
-  CostKind cost = CostKind::kFinalPose;
-  ResidualWeights weights;
-  ParameterTying tying;
-  int max_num_iterations = 100;
-  int num_threads = 0;
-  bool IsValid(std::string* error) const;
-};
-
-struct FitResult {
-  bool usable = false;
-  std::string termination;
-  std::string message;
-  int iterations = 0;
-  Omni3ParameterArray parameters{};
-  std::array<bool, omni3::kNumParameters> at_bound{};  // only free parameters can be at a bound
-  int NumAtBound() const;
-};
-
-// `segmented` is used for CostKind::kSegment, `final_runs` for kFinalPose.
-FitResult FitOmni3(const std::vector<AlignedRun>& final_runs,
-                   const std::vector<SegmentedRun>& segmented, const Omni3Robot& robot,
-                   const FitOptions& options);
 
 }  // namespace fitcal

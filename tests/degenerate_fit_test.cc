@@ -8,7 +8,7 @@
 #include <cmath>
 
 #include "diagnosis/degenerate_data.h"
-#include "fit/final_pose_cost.h"
+#include "fit/final_pose_errors.h"
 #include "fit/run_split.h"
 #include "odometry/omni3_replay.h"
 #include "tests/omni3_fit_support.h"
@@ -102,7 +102,7 @@ TEST(DegenerateFit, OutlierTestThresholdIsTheChiSquareQuantile) {
 // clean data put them.
 TEST(DegenerateFit, GrossSlipIsFlaggedAndTheRobustLossKeepsTheParameters) {
   const std::vector<AlignedRun> all = Simulate(7, 1);
-  const Omni3ParameterArray truth = sim::PalacinTable5Parameters().ToArray();
+  const auto truth = sim::PalacinTable5Parameters().ToArray();
   const ModelFitResult clean = FitOmni3(all, sim::PalacinApr02Robot());
   ASSERT_TRUE(clean.usable && clean.has_covariance) << clean.covariance_message;
   const FinalPoseErrors clean_errors = Omni3Errors(clean.parameters, all);

@@ -116,7 +116,8 @@ TEST(HiddenStructure, ClockMapKeepsTheIdentityOnCorrectlyClockedData) {
   const auto model = Omni3ModelOf(robot);
   std::vector<RunLog> mapped = logs;
   for (RunLog& run : mapped) {
-    const ClockMap map = EstimateClockMap(AlignRun(run), run.ground_truth, robot.nominal.ToArray());
+    const ClockMap map = EstimateClockMap(*model, model->robot().nominal.data(), AlignRun(run),
+                                          run.ground_truth);
     run.ground_truth = ApplyClockMap(run.ground_truth, map);
   }
   const ModelFitResult declared = FitModel(AlignRuns(logs), *model);

@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "fit/final_pose_cost.h"
+#include "fit/final_pose_errors.h"
 #include "fit/run_split.h"
 #include "odometry/omni3_replay.h"
 #include "tests/omni3_fit_support.h"
@@ -109,8 +109,9 @@ TEST(Omni3Fit, ValidationCfIsWithinTenPercentOfTheTrueParameters) {
   const ParameterArray truth = sim::PalacinTable5Parameters().ToArray();
   const ParameterArray nominal = sim::PalacinNominalParameters().ToArray();
   const double cf_fit = Omni3Errors(result.fit.parameters, result.split.validation).cf;
-  const double cf_true = EvaluateFinalPoseErrors(truth, result.split.validation).cf;
-  const double cf_nominal = EvaluateFinalPoseErrors(nominal, result.split.validation).cf;
+  const double cf_true = Omni3Errors({truth.begin(), truth.end()}, result.split.validation).cf;
+  const double cf_nominal =
+      Omni3Errors({nominal.begin(), nominal.end()}, result.split.validation).cf;
   EXPECT_LE(cf_fit, 1.10 * cf_true);
   EXPECT_LT(cf_fit, 0.3 * cf_nominal);  // and calibration is worth it at all
 }
@@ -134,7 +135,7 @@ TEST(Omni3Fit, CfIsTheMeanOfPerRunNorms) {
   options.repetitions = 1;
   const std::vector<AlignedRun> runs = Simulate(options);
   const ParameterArray nominal = sim::PalacinNominalParameters().ToArray();
-  const FinalPoseErrors e = EvaluateFinalPoseErrors(nominal, runs);
+  const FinalPoseErrors e = Omni3Errors({nominal.begin(), nominal.end()}, runs);
   double sum = 0.0;
   for (const AlignedRun& run : runs) {
     const Pose2d end = omni3::ReplayFinalPose(nominal.data(), run.samples, run.start);

@@ -8,8 +8,7 @@
 #include <cmath>
 #include <memory>
 
-#include "fit/final_pose_cost.h"
-#include "fit/final_pose_residual.h"
+#include "fit/final_pose_errors.h"
 #include "fit/strategies.h"
 #include "tests/omni3_fit_support.h"
 #include "tools/sim/omni3_simulator.h"
@@ -55,7 +54,7 @@ Eigen::Matrix<double, 9, 9> GaussNewtonMatrix(const std::vector<AlignedRun>& run
                                               const std::vector<double>& p) {
   Eigen::Matrix<double, 9, 9> jtj = Eigen::Matrix<double, 9, 9>::Zero();
   for (const AlignedRun& run : runs) {
-    std::unique_ptr<ceres::CostFunction> cost(Omni3FinalPoseResidual::Create(run, {}));
+    std::unique_ptr<ceres::CostFunction> cost(DefaultOmni3Model().FinalPoseCost(run, {}));
     Eigen::Matrix<double, 3, 9, Eigen::RowMajor> j;
     double r[3];
     const double* parameters[] = {p.data()};

@@ -7,7 +7,7 @@
 #include <fstream>
 
 #include "diagnosis/channel_order_check.h"
-#include "fit/final_pose_cost.h"
+#include "fit/final_pose_errors.h"
 #include "fit/segment_cost.h"
 #include "io/dataset.h"
 #include "io/input_error.h"

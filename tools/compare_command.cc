@@ -14,7 +14,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "fit/final_pose_cost.h"
+#include "fit/final_pose_errors.h"
 #include "fit/run_split.h"
 #include "fit/strategies.h"
 #include "io/atomic_file.h"
@@ -176,19 +176,14 @@ std::string TraceCsv(const std::vector<Row>& rows) {
   return o.str();
 }
 
-// The robot and runs of a data set, for any model; omni3 keeps its own loader and CF (its tables'
-// CFs stay as they were); every model fits through the seam (tools/fit_methods.h).
+// The robot and runs of a data set, for any model; omni3 keeps its own loader; every model fits
+// and is scored through the seam (tools/fit_methods.h, fit/final_pose_errors.h).
 struct CompareData {
   RobotModelPtr model;
   std::optional<Omni3Robot> omni3;
   std::vector<AlignedRun> runs;
 
   double Cf(const std::vector<double>& p, const std::vector<AlignedRun>& on, int threads) const {
-    if (omni3) {
-      Omni3ParameterArray a{};
-      std::copy(p.begin(), p.end(), a.begin());
-      return EvaluateFinalPoseErrors(a, on, threads).cf;
-    }
     return EvaluateFinalPoseErrors(*model, p, on, threads).cf;
   }
 };

@@ -282,16 +282,16 @@ std::string ModelCalibratedYaml(const DiagnoseCommandOptions& options,
   return model.RobotYaml(choice.parameters, choice.effects, io::CalibrationBlockYaml(block, robot));
 }
 
-// Re-stamps each run's ground truth on the encoder clock (omni3's speed-profile match), keeping
-// the map only on the runs whose track error under the final-pose fit it lowers
-// (diagnosis/clock_choice.h): a correctly clocked data set keeps the identity.
-void MapClocks(const std::string& robot_path, const RobotModelInterface& model, int threads,
-               std::vector<RunLog>* runs) {
-  const auto nominal = io::ReadOmni3Robot(robot_path).nominal.ToArray();
+// Re-stamps each run's ground truth on the encoder clock (the speed-profile match of the
+// model's body velocities at the nominal, fit/segment_cost.h), keeping the map only on the runs
+// whose track error under the final-pose fit it lowers (diagnosis/clock_choice.h): a correctly
+// clocked data set keeps the identity.
+void MapClocks(const RobotModelInterface& model, int threads, std::vector<RunLog>* runs) {
+  const std::vector<double>& nominal = model.robot().nominal;
   std::vector<RunLog> mapped = *runs;
   ParallelFor(mapped.size(), threads, [&](std::size_t i) {
     RunLog& run = mapped[i];
-    const ClockMap map = EstimateClockMap(AlignRun(run), run.ground_truth, nominal);
+    const ClockMap map = EstimateClockMap(model, nominal.data(), AlignRun(run), run.ground_truth);
     run.ground_truth = ApplyClockMap(run.ground_truth, map);
   });
   ModelFitOptions fit_options;
@@ -481,11 +481,6 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
     const RobotModelPtr model = ReadRobotModelFile(index.robot_path);
     const Robot& robot = model->robot();
     const bool omni3 = robot.model == "omni3";
-    if (!omni3 && options.clock_map) {
-      std::cerr << "fitcal: --clock-map matches omni3 speed profiles only; the robot is a "
-                << robot.model << "\n";
-      return 2;
-    }
     if (!omni3 && !robot.effects.empty()) {
       std::cerr << "fitcal: " << index.robot_path
                 << ": the robot already declares effects; diagnose starts from a robot YAML "
@@ -496,7 +491,7 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
     const std::string aligned = AlignGroundTruthClocks(options.clock_offsets, *model, nullptr,
                                                        std::nullopt, options.threads, &runs);
     if (!aligned.empty()) std::printf("%s\n", aligned.c_str());
-    if (options.clock_map) MapClocks(index.robot_path, *model, options.threads, &runs);
+    if (options.clock_map) MapClocks(*model, options.threads, &runs);
     if (!options.skip_wheel_order_check && ChannelsLookMiswired(options, *model, runs)) {
       return kMiswiredExitCode;
     }

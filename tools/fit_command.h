@@ -30,6 +30,10 @@ struct FitCommandOptions : DatasetCommandOptions, SolverOptions {
   // runs; measured on the OptiOdom free runs, half a run calibrates worse,
   // docs/everyday_driving.md).
   int time_blocks = 4;
+  // --tie "R_a,R_b,R_c" (repeatable): each a group of parameters sharing one value; --hold
+  // "delta_a,delta_b": parameters held at their nominal values (fit/parameter_tying.h).
+  std::vector<std::string> tie;
+  std::vector<std::string> hold;
 };
 
 // Declares every flag of `fit` on `app` (the `fit` subcommand, and the top level: `fitcal --logs

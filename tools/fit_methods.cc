@@ -77,6 +77,7 @@ ModelFitMethodOutcome RunModelCeres(CeresTrustRegion trust_region,
   options.ceres = CeresOptionsFor(trust_region, settings);
   options.residuals = settings.residuals;
   options.track = settings.track;
+  options.tying = &settings.tying;
   ModelFitMethodOutcome out;
   out.fit = FitModel(training, model, options);
   out.evaluations = out.fit.num_residual_evaluations + out.fit.num_jacobian_evaluations;
@@ -98,7 +99,24 @@ ModelFitMethodOutcome RunModelCeres(CeresTrustRegion trust_region,
 
 ModelFitMethodOutcome RunModelNlopt(NloptMethod method, const std::vector<AlignedRun>& training,
                                     const RobotModelInterface& model,
+                                    const FitMethodSettings& settings);
+
+// The NLopt search of the tied model (fit/parameter_tying.h), mapped back to the parameters.
+ModelFitMethodOutcome RunTiedModelNlopt(NloptMethod method, const std::vector<AlignedRun>& training,
+                                        const RobotModelInterface& model,
+                                        const FitMethodSettings& settings) {
+  const TiedModel tied(model, settings.tying);
+  FitMethodSettings untied = settings;
+  untied.tying = {};
+  ModelFitMethodOutcome out = RunModelNlopt(method, training, tied, untied);
+  out.fit = ExpandTiedResult(tied, out.fit);
+  return out;
+}
+
+ModelFitMethodOutcome RunModelNlopt(NloptMethod method, const std::vector<AlignedRun>& training,
+                                    const RobotModelInterface& model,
                                     const FitMethodSettings& settings) {
+  if (!settings.tying.empty()) return RunTiedModelNlopt(method, training, model, settings);
   const NloptFitOptions options = NloptOptionsFor(method, settings);
   const NloptSearchResult r = FitModelNlopt(training, model, options);
   const Robot& robot = model.robot();

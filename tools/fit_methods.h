@@ -37,6 +37,8 @@ struct FitMethodSettings {
   int max_evaluations = 20000;                         // NLopt only
   bool local_polish = false;                           // NLopt global methods only
   std::function<void(const NloptProgress&)> progress;  // NLopt only
+  // Groups of parameters sharing one value and parameters held at the nominal (every method).
+  ParameterTying tying;
 };
 
 // A method's fit: the generic Ceres fit's result shape (NLopt methods leave the covariance out and

@@ -11,7 +11,7 @@
 #include <regex>
 #include <set>
 
-#include "fit/final_pose_cost.h"
+#include "fit/final_pose_errors.h"
 #include "fit/segment_cost.h"
 #include "io/atomic_file.h"
 #include "io/dataset.h"

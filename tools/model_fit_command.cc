@@ -848,6 +848,34 @@ void WriteCalibration(const FitCommandOptions& options, const RobotModelInterfac
   std::printf("wrote %s\n", options.out.c_str());
 }
 
+// --tie and --hold (fit/parameter_tying.h) into the settings; "" or why they do not apply.
+std::string SetTying(const FitCommandOptions& options, const Robot& robot,
+                     FitMethodSettings* settings) {
+  for (const std::string& group : options.tie)
+    settings->tying.groups.push_back(SplitParameterNames(group));
+  for (const std::string& name : options.hold) {
+    for (const std::string& n : SplitParameterNames(name)) settings->tying.held.push_back(n);
+  }
+  return CheckTying(robot, settings->tying);
+}
+
+std::size_t NumFreeWithTying(const RobotModelInterface& model, const ParameterTying& tying) {
+  if (tying.empty()) return model.robot().NumFree();
+  return TiedModel(model, tying).robot().NumFree();
+}
+
+void PrintTying(const ParameterTying& tying) {
+  for (const std::vector<std::string>& group : tying.groups) {
+    std::string names;
+    for (const std::string& name : group) names += (names.empty() ? "" : "=") + name;
+    std::printf("tied (one value): %s\n", names.c_str());
+  }
+  if (tying.held.empty()) return;
+  std::string names;
+  for (const std::string& name : tying.held) names += (names.empty() ? "" : ", ") + name;
+  std::printf("held at nominal (--hold): %s\n", names.c_str());
+}
+
 }  // namespace
 
 int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex& index,
@@ -862,6 +890,9 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
     std::cerr << "fitcal: " << (method == nullptr ? "unknown --method " + options.method : error)
               << "\n";
     return 2;
+  }
+  if (const std::string refusal = SetTying(options, robot, &settings); !refusal.empty()) {
+    return Refuse(refusal);
   }
   const std::optional<EffectModel> effects_to_fit = EffectsToFit(options, robot);
   if (!effects_to_fit) return 2;
@@ -902,7 +933,7 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
       JudgeOnHeldOutHalves(options, *method, settings, *model, split, logs);
   if (const std::string refusal = DegreesOfFreedomRefusal(
           split, settings, track_data,
-          robot.NumFree() + (effects_to_fit ? effects_to_fit->size() : 0));
+          NumFreeWithTying(*model, settings.tying) + (effects_to_fit ? effects_to_fit->size() : 0));
       !refusal.empty()) {
     std::cerr << "fitcal: " << options.logs << ": " << refusal << "\n";
     return 1;
@@ -930,6 +961,7 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
 
   PrintFit(options, *model, split, candidates, gate, selected_fit, errors, *method, outcome,
            track_fits);
+  PrintTying(settings.tying);
   std::printf("residuals: %s%s\n", ToString(settings.residuals),
               residuals_auto ? " (--residuals auto)" : "");
   for (const std::string& line : residual_choice) std::printf("%s\n", line.c_str());
