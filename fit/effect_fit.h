@@ -1,9 +1,8 @@
 #pragma once
-// A robot model's parameters (models/model_interface.h; the nine of omni3 in the overloads that
-// take an Omni3ParameterArray) plus candidate effects (odometry/effects.h), fitted to the whole
-// ground-truth track of each run. The final pose alone cannot see every effect (a clock latency
-// vanishes when runs end at rest), so the residual of a run is the pose error at every
-// ground-truth sample of its window ("checkpoints"):
+// A robot model's parameters (models/model_interface.h) plus candidate effects
+// (odometry/effects.h), fitted to the whole ground-truth track of each run. The final pose alone
+// cannot see every effect (a clock latency vanishes when runs end at rest), so the residual of a
+// run is the pose error at every ground-truth sample of its window ("checkpoints"):
 //
 //   r_j = [ (x(t_j - tau) - x_gt_j) / sigma_xy, (y(...) - y_gt_j) / sigma_xy,
 //           wrap(theta(...) - theta_gt_j) / sigma_theta ] / sqrt(n_checkpoints)
@@ -20,9 +19,9 @@
 #include <string>
 #include <vector>
 
+// Transitional: Omni3ParameterArray for diagnosis/residual_analysis.h, which reaches it here.
 #include "fit/final_pose_cost.h"
 #include "fit/final_pose_errors.h"
-#include "fit/final_pose_residual.h"
 #include "models/model_interface.h"
 #include "odometry/aligned_run.h"
 #include "odometry/effects.h"
@@ -160,9 +159,6 @@ FinalPoseErrors FinalPoseErrorsOf(const ModelScore& score);
 ModelScore ScoreModel(const RobotModelInterface& robot_model, const std::vector<double>& p,
                       const EffectModel& model, const std::vector<TrackRun>& runs,
                       const ResidualWeights& weights = {}, int num_threads = 0);
-ModelScore ScoreModel(const Omni3ParameterArray& p, const EffectModel& model,
-                      const std::vector<TrackRun>& runs, const ResidualWeights& weights = {},
-                      int num_threads = 0);
 
 // Pose error of the replay at every checkpoint of a run (world frame, replay minus ground
 // truth), with the checkpoint times and ground-truth poses; for residual analysis.
@@ -174,8 +170,6 @@ struct TrackErrors {
 };
 TrackErrors ComputeTrackErrors(const RobotModelInterface& robot_model, const std::vector<double>& p,
                                const EffectModel& model, const TrackRun& run, bool all_samples);
-TrackErrors ComputeTrackErrors(const Omni3ParameterArray& p, const EffectModel& model,
-                               const TrackRun& run, bool all_samples);
 
 struct EffectFitOptions {
   ResidualWeights weights;
@@ -213,9 +207,6 @@ EffectFitResult FitEffectModel(const std::vector<TrackRun>& training,
                                const RobotModelInterface& robot_model,
                                const std::vector<double>& start_p, const EffectModel& start,
                                const EffectFitOptions& options = {});
-EffectFitResult FitEffectModel(const std::vector<TrackRun>& training, const Omni3Robot& robot,
-                               const Omni3ParameterArray& start_p, const EffectModel& start,
-                               const EffectFitOptions& options = {});
 
 // How much of a candidate's influence on the training residuals lies outside what the nine
 // parameters (and the effects already in `model`) can produce: |(I - P) J_c| / |J_c| for the
@@ -227,9 +218,6 @@ EffectFitResult FitEffectModel(const std::vector<TrackRun>& training, const Omni
 // candidate before fitting it.
 double SeparableFraction(const std::vector<TrackRun>& training,
                          const RobotModelInterface& robot_model, const std::vector<double>& p,
-                         const EffectModel& model, effects::EffectId candidate,
-                         const ResidualWeights& weights = {}, double* unexplained_norm = nullptr);
-double SeparableFraction(const std::vector<TrackRun>& training, const Omni3ParameterArray& p,
                          const EffectModel& model, effects::EffectId candidate,
                          const ResidualWeights& weights = {}, double* unexplained_norm = nullptr);
 

@@ -18,8 +18,8 @@ using Omni3ParameterArray = std::array<double, omni3::kNumParameters>;
 inline FinalPoseErrors EvaluateFinalPoseErrors(const Omni3ParameterArray& p,
                                                const std::vector<AlignedRun>& runs,
                                                int num_threads = 0) {
-  return EvaluateFinalPoseErrors(DefaultOmni3Model(), std::vector<double>(p.begin(), p.end()),
-                                 runs, num_threads);
+  return EvaluateFinalPoseErrors(DefaultOmni3Model(), std::vector<double>(p.begin(), p.end()), runs,
+                                 num_threads);
 }
 
 }  // namespace fitcal

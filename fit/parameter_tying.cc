@@ -145,7 +145,8 @@ std::string CheckTying(const Robot& robot, const ParameterTying& tying) {
   for (const std::vector<int>& members : groups) {
     const Interval box = Intersection(robot, members);
     if (!(box.lo <= box.hi)) {
-      return "parameter tying: the bounds of " + robot.parameters[members[0]].name + " and the "
+      return "parameter tying: the bounds of " + robot.parameters[members[0]].name +
+             " and the "
              "parameters tied to it do not overlap";
     }
   }
@@ -195,9 +196,10 @@ TiedModel::TiedModel(const RobotModelInterface& inner, const ParameterTying& tyi
 }
 
 Eigen::MatrixXd TiedModel::Basis() const {
-  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(group_of_.size()),
-                                            robot_.NumParameters());
-  for (std::size_t k = 0; k < group_of_.size(); ++k) a(static_cast<Eigen::Index>(k), group_of_[k]) = 1.0;
+  Eigen::MatrixXd a =
+      Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(group_of_.size()), robot_.NumParameters());
+  for (std::size_t k = 0; k < group_of_.size(); ++k)
+    a(static_cast<Eigen::Index>(k), group_of_[k]) = 1.0;
   return a;
 }
 

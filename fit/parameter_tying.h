@@ -55,9 +55,8 @@ class TiedModel final : public RobotModelInterface {
   // The mean of each group's members (a tied start, e.g. the nominal, becomes one value).
   std::vector<double> Reduce(const std::vector<double>& p) const;
 
-  Pose2d Replay(const double* q, const EncoderSamples& samples, std::size_t begin,
-                std::size_t end, const Pose2d& start,
-                const PoseVisitor& visit = nullptr) const override;
+  Pose2d Replay(const double* q, const EncoderSamples& samples, std::size_t begin, std::size_t end,
+                const Pose2d& start, const PoseVisitor& visit = nullptr) const override;
   ceres::CostFunction* FinalPoseCost(const AlignedRun& run,
                                      const ResidualWeights& weights) const override;
   ceres::CostFunction* SegmentCost(const AlignedRun& run, const std::vector<Segment>& segments,

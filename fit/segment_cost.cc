@@ -6,7 +6,6 @@
 #include <memory>
 #include <stdexcept>
 
-
 namespace fitcal {
 
 bool SegmentOptions::IsValid(std::string* error) const {

@@ -30,7 +30,7 @@
 #include <vector>
 
 #include "odometry/encoder_samples.h"
-#include "odometry/omni3_model.h"
+#include "odometry/pose2.h"
 #include "odometry/pose2.h"
 
 namespace fitcal::effects {
@@ -461,22 +461,6 @@ Pose2<T> ReplayStepsWithEffects(const Step& step, const std::vector<ActiveEffect
     pose = next;
   }
   return pose;
-}
-
-// The omni3 replay with effects: the step of Palacin Eq. 4, dt M^-1 w.
-template <typename T, typename Visitor>
-Pose2<T> ReplayWithEffects(const T* p, const std::vector<ActiveEffect<T>>& active,
-                           const EncoderSamples& samples,
-                           const std::vector<SampleContext>& contexts, const Pose2<T>& start,
-                           Visitor&& visit) {
-  const omni3::Matrix3<T> m_inv = omni3::InverseKinematicMatrix(p);
-  const auto step = [&m_inv](const T* w, double dt, T* dx, T* dy, T* dtheta) {
-    *dx = (m_inv(0, 0) * w[0] + m_inv(0, 1) * w[1] + m_inv(0, 2) * w[2]) * dt;
-    *dy = (m_inv(1, 0) * w[0] + m_inv(1, 1) * w[1] + m_inv(1, 2) * w[2]) * dt;
-    *dtheta = (m_inv(2, 0) * w[0] + m_inv(2, 1) * w[1] + m_inv(2, 2) * w[2]) * dt;
-  };
-  return ReplayStepsWithEffects(step, active, samples, contexts, start,
-                                std::forward<Visitor>(visit));
 }
 
 }  // namespace fitcal::effects

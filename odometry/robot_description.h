@@ -26,7 +26,7 @@ struct Omni3Robot {
   Omni3Bounds bounds;
   std::optional<EncoderTicks> encoder;  // set when the encoder logs are in ticks
   // Effects beyond the nine parameters (robot YAML `effects:`, written by `fitcal diagnose`);
-  // replayed by odometry/effects.h ReplayWithEffects.
+  // replayed by odometry/effects.h ReplayStepsWithEffects.
   std::vector<effects::EffectValue> effects;
 
   // Per-parameter [lo, hi] in the flat order of omni3_model.h.

@@ -87,8 +87,8 @@ TEST(HiddenStructure, LatencyIsRecoveredWhetherTheLogStartsAtRestOrMoving) {
     effects::EffectValue start;
     start.id = effects::EffectId::kTimeOffset;
     const Omni3Robot robot = NominalRobot();
-    const EffectFitResult fit =
-        FitEffectModel(PrepareTrackRuns(logs), robot, robot.nominal.ToArray(), {start});
+    const EffectFitResult fit = FitEffectModel(PrepareTrackRuns(logs), *Omni3ModelOf(robot),
+                                               Omni3ModelOf(robot)->robot().nominal, {start});
     ASSERT_TRUE(fit.usable) << c.name << ": " << fit.message;
     ASSERT_TRUE(fit.has_covariance) << c.name;
     const double tau = fit.effects[0].value[0];
@@ -116,8 +116,8 @@ TEST(HiddenStructure, ClockMapKeepsTheIdentityOnCorrectlyClockedData) {
   const auto model = Omni3ModelOf(robot);
   std::vector<RunLog> mapped = logs;
   for (RunLog& run : mapped) {
-    const ClockMap map = EstimateClockMap(*model, model->robot().nominal.data(), AlignRun(run),
-                                          run.ground_truth);
+    const ClockMap map =
+        EstimateClockMap(*model, model->robot().nominal.data(), AlignRun(run), run.ground_truth);
     run.ground_truth = ApplyClockMap(run.ground_truth, map);
   }
   const ModelFitResult declared = FitModel(AlignRuns(logs), *model);

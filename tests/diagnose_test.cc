@@ -12,6 +12,7 @@
 
 #include "io/robot_yaml.h"
 #include "models/omni3/omni3_robot_model.h"
+#include "tests/omni3_fit_support.h"
 #include "tools/sim/omni3_simulator.h"
 
 namespace fitcal {
@@ -83,7 +84,8 @@ TEST_P(LibraryEffectTest, DiagnosePicksRecoversAndMatchesTrueModel) {
     const double tol = std::max(4.0 * got.sigma[k], 0.1 * std::abs(info.typical[k]));
     EXPECT_NEAR(got.value[k], info.typical[k], tol) << info.parameter_names[k];
   }
-  const ModelScore true_model = ScoreModel(o.true_robot.ToArray(), {truth}, d.validation);
+  const ModelScore true_model =
+      ScoreModel(DefaultOmni3Model(), testing::Omni3Vector(o.true_robot), {truth}, d.validation);
   std::printf(
       "%s: true %g, fitted %g +- %g; validation CF declared %.5f, with effect %.5f, true model "
       "%.5f\n",
@@ -105,7 +107,8 @@ TEST_P(LibraryEffectTest, DiagnosePicksRecoversAndMatchesTrueModel) {
   }
   const Omni3Robot back = io::ReadOmni3Robot(path);
   ASSERT_EQ(back.effects.size(), 1u);
-  const ModelScore replayed = ScoreModel(back.nominal.ToArray(), back.effects, d.validation);
+  const ModelScore replayed = ScoreModel(DefaultOmni3Model(), testing::Omni3Vector(back.nominal),
+                                         back.effects, d.validation);
   // The YAML keeps 10 significant digits: the CF agrees to far better than its noise.
   EXPECT_NEAR(replayed.cf, r.final_validation.cf, 1e-6 * r.final_validation.cf);
   std::remove(path.c_str());
@@ -161,7 +164,8 @@ TEST_P(TransientEffectTest, IsNamedAndRecoveredWithinFourSigmas) {
   EXPECT_TRUE(r.effects_named);
   EXPECT_GT(got.sigma[0], 0.0);
   EXPECT_LT(std::abs(got.value[0] - info.typical[0]), 4.0 * got.sigma[0]);
-  const ModelScore true_model = ScoreModel(o.true_robot.ToArray(), {truth}, d.validation);
+  const ModelScore true_model =
+      ScoreModel(DefaultOmni3Model(), testing::Omni3Vector(o.true_robot), {truth}, d.validation);
   std::printf("%s: injected %g, fitted %g +- %g; validation CF %.5f (true model %.5f)\n", info.name,
               info.typical[0], got.value[0], got.sigma[0], r.final_validation.cf, true_model.cf);
   EXPECT_LE(r.final_validation.cf, 1.15 * true_model.cf);
@@ -302,7 +306,8 @@ TEST(Diagnose, ClockScaleIsReportedNotIdentifiable) {
   // The numerical check agrees with the registry: nothing of its column is separable.
   EXPECT_LT(SeparableFraction(d.training, *Omni3ModelOf(robot), r.base.parameters, {}, truth.id),
             1e-6);
-  const ModelScore true_model = ScoreModel(o.true_robot.ToArray(), {truth}, d.validation);
+  const ModelScore true_model =
+      ScoreModel(DefaultOmni3Model(), testing::Omni3Vector(o.true_robot), {truth}, d.validation);
   EXPECT_LE(r.declared_validation.cf, 1.15 * true_model.cf);
   // The radii absorb the scale: r_i(fitted) ~ r_i(true) (1 + s).
   for (int i = 0; i < 3; ++i) {
@@ -347,8 +352,8 @@ TEST(Diagnose, SecondSpeedFlowerSeparatesSpeedSlip) {
     std::vector<TrackRun> all = d.training;
     all.insert(all.end(), d.validation.begin(), d.validation.end());
     double norm = 0.0;
-    SeparableFraction(all, o.true_robot.ToArray(), {}, effects::EffectId::kWheelSpeedSlip, {},
-                      &norm);
+    SeparableFraction(all, DefaultOmni3Model(), testing::Omni3Vector(o.true_robot), {},
+                      effects::EffectId::kWheelSpeedSlip, {}, &norm);
     return norm;
   };
   const double one_speed = unexplained(sim::FlowerTrajectories(0.35), 2);

@@ -13,6 +13,7 @@
 #include "fit/effect_fit.h"
 #include "io/input_error.h"
 #include "io/robot_yaml.h"
+#include "models/omni3/omni3_kinematics.h"
 #include "odometry/omni3_replay.h"
 #include "tools/sim/omni3_simulator.h"
 #include "validation/statistics.h"
@@ -41,8 +42,14 @@ template <typename T>
 Pose2<T> Replay(const T* p, EffectId id, const T* q, const EncoderSamples& samples,
                 const std::vector<effects::SampleContext>& contexts) {
   std::vector<effects::ActiveEffect<T>> active = {{id, q}};
-  return effects::ReplayWithEffects(p, active, samples, contexts, Pose2<T>{T(0.3), T(-0.2), T(0.5)},
-                                    [](std::size_t, const Pose2<T>&, const Pose2<T>&) {});
+  // The omni3 model's body step (Palacin Eq. 4, dt M^-1 w) through the generic effect replay.
+  const auto m_inv = Omni3Kinematics::Prepare(p);
+  const auto step = [&m_inv](const T* w, double dt, T* dx, T* dy, T* dtheta) {
+    Omni3Kinematics::BodyStep(m_inv, w, dt, dx, dy, dtheta);
+  };
+  return effects::ReplayStepsWithEffects(step, active, samples, contexts,
+                                         Pose2<T>{T(0.3), T(-0.2), T(0.5)},
+                                         [](std::size_t, const Pose2<T>&, const Pose2<T>&) {});
 }
 
 TEST(EffectTable, OrderMatchesIdsAndNamesRoundTrip) {

@@ -9,6 +9,7 @@
 
 #include "fit/trajectory_split.h"
 #include "odometry/effects.h"
+#include "models/omni3/omni3_kinematics.h"
 #include "odometry/omni3_replay.h"
 #include "tools/sim/omni3_simulator.h"
 
@@ -83,8 +84,13 @@ TEST(GroundTruthOffset, EqualsShiftedDistancesExactly) {
   const double e[2] = {0.021, -0.013};
   const Pose2d start{0.3, -0.2, 0.5};
   std::vector<effects::ActiveEffect<double>> active = {{effects::EffectId::kGroundTruthOffset, e}};
-  const Pose2d with = effects::ReplayWithEffects(p.data(), active, samples, contexts, start,
-                                                 [](std::size_t, const Pose2d&, const Pose2d&) {});
+  // The omni3 model's body step (Palacin Eq. 4) through the generic effect replay.
+  const omni3::Matrix3<double> m_inv = Omni3Kinematics::Prepare(p.data());
+  const auto step = [&m_inv](const double* w, double dt, double* dx, double* dy, double* dtheta) {
+    Omni3Kinematics::BodyStep(m_inv, w, dt, dx, dy, dtheta);
+  };
+  const Pose2d with = effects::ReplayStepsWithEffects(
+      step, active, samples, contexts, start, [](std::size_t, const Pose2d&, const Pose2d&) {});
   for (int i = 0; i < 3; ++i) {
     const double d = p[omni3::kAngleIndex + i];
     p[omni3::kDistanceIndex + i] -= e[0] * std::cos(d) + e[1] * std::sin(d);

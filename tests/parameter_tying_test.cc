@@ -8,6 +8,8 @@
 //   - a wrong name is refused by the library and by `fitcal fit --tie` (one line, exit 2);
 //   - the clock map of a simulated differential drive whose ground truth is 0.15 s late.
 
+#include "fit/parameter_tying.h"
+
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
@@ -16,7 +18,6 @@
 #include <vector>
 
 #include "fit/model_fit.h"
-#include "fit/parameter_tying.h"
 #include "fit/segment_cost.h"
 #include "fit/track_residual.h"
 #include "models/model_registry.h"
@@ -133,8 +134,8 @@ bounds: {radius_m: [0.038, 0.046], wheel_separation_m: [0.180, 0.220]}
   const Robot& robot = model->robot();
   std::vector<double> truth = robot.nominal;
   for (double& v : truth) v *= 1.02;  // equal radii, 2 % larger, and the track with them
-  const std::vector<RunLog> logs = Logs(sim::SimulateRuns(
-      *model, truth, sim::DiffDriveCalibrationTrajectories(2), NoisyOptions()));
+  const std::vector<RunLog> logs = Logs(
+      sim::SimulateRuns(*model, truth, sim::DiffDriveCalibrationTrajectories(2), NoisyOptions()));
   const std::vector<AlignedRun> runs = AlignRuns(logs);
   std::vector<const GroundTruthTrack*> tracks;
   for (const RunLog& log : logs) tracks.push_back(&log.ground_truth);
@@ -195,9 +196,9 @@ TEST(ParameterTying, WrongNamesAreRefused) {
 TEST(ParameterTying, FitCommandTiesAndRefusesUnknownNames) {
   testing::TempDir dir;
   const std::string data = dir.Path("diff");
-  ASSERT_EQ(testing::RunFitcal(dir, "simulate --model diff_drive --out " + data + " --seed 3")
-                .exit_code,
-            0);
+  ASSERT_EQ(
+      testing::RunFitcal(dir, "simulate --model diff_drive --out " + data + " --seed 3").exit_code,
+      0);
   const auto tied =
       testing::RunFitcal(dir, "fit --logs " + data + " --tie r_left,r_right --no-output");
   EXPECT_NE(tied.exit_code, 2) << tied.err;
@@ -238,7 +239,8 @@ bounds: {radius_m: [0.038, 0.046], wheel_separation_m: [0.180, 0.220]}
   o.gt_position_sigma_m = 0.0;
   o.gt_heading_sigma_rad = 0.0;
   o.wheel_rate_sigma_rad_s = 0.0;
-  for (const auto& run : sim::SimulateRuns(*model, p, sim::DiffDriveCalibrationTrajectories(1), o)) {
+  for (const auto& run :
+       sim::SimulateRuns(*model, p, sim::DiffDriveCalibrationTrajectories(1), o)) {
     RunLog log = run.log;
     for (double& t : log.ground_truth.t_s) t += kLateS;
     const ClockMap map = EstimateClockMap(*model, p.data(), AlignRun(run.log), log.ground_truth);

@@ -8,9 +8,9 @@
 #include <ceres/cost_function.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
-#include <algorithm>
 #include <random>
 
 #include "fit/model_fit.h"
@@ -128,7 +128,7 @@ TEST(SegmentCost, ZeroAtTruthAndWindowsHaveTheSetLength) {
       EXPECT_LT(s.path_length_m, 1.02);
     }
   }
-  EXPECT_LT(SegmentCf(truth, p), 1e-9);  // exact replay: rounding only
+  EXPECT_LT(SegmentCf(truth, p), 1e-9);      // exact replay: rounding only
   EXPECT_GT(SegmentCf(Nominal(), p), 1e-3);  // 3 % radius and 1 deg angle errors over 1 m windows
 }
 

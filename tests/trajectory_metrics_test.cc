@@ -112,7 +112,8 @@ TEST(TrajectoryMetricsTest, EffectsAreReplayedAsTheEffectFitScoresThem) {
   for (auto& run : sim::SimulateOmni3(options)) logs.push_back(std::move(run.log));
   const Omni3ParameterArray p = sim::PalacinTable5Parameters().ToArray();
   const EffectModel model = {latency, slip};
-  const ModelScore scores = ScoreModel(p, model, PrepareTrackRuns(logs));
+  const ModelScore scores =
+      ScoreModel(DefaultOmni3Model(), {p.begin(), p.end()}, model, PrepareTrackRuns(logs));
   double with_effects = 0.0, without = 0.0;
   for (std::size_t i = 0; i < logs.size(); ++i) {
     const AlignedRun run = AlignRun(logs[i]);
