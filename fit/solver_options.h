@@ -1,7 +1,7 @@
 #pragma once
-// The settings of a Ceres fit, shared by every model's fit (fit/model_fit.h) and by the omni3
-// fit: trust region, objective, robust loss, iteration limit and tolerances, in one options
-// struct with its defaults, validated once (IsValid).
+// The settings of a Ceres fit of any model (fit/model_fit.h): trust region, objective, robust
+// loss, iteration limit and tolerances, in one options struct with its defaults, validated once
+// (IsValid).
 
 #include <ceres/loss_function.h>
 
