@@ -169,6 +169,7 @@ SelectedFit DescribeSelected(const Robot& robot,
     out.held = fit.held;
   } else if (selected.name == method + " without holds") {
     out.at_bound = fit.at_bound;
+    out.held = fit.held;  // the parameters' holds (gauge, --hold) stay; the directions' go
   }
   return out;
 }
@@ -285,6 +286,10 @@ io::CalibrationBlock MakeRecord(const FitCommandOptions& options, const RobotMod
   r.selected = selected.name;
   r.selected_on = gate.judged_on;
   for (const HeldParameter& h : robot.held) r.held.push_back(robot.parameters[h.index].name);
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    // Held by --hold (fit/parameter_tying.h) beside the model's own holds.
+    if (selected_fit.held[k] && !robot.IsHeld(k)) r.held.push_back(robot.parameters[k].name);
+  }
   for (int k = 0; k < robot.NumParameters(); ++k) {
     if (selected_fit.at_bound[k]) r.at_bound.push_back(robot.parameters[k].name);
   }
