@@ -5,7 +5,8 @@
 //     sigmas of the truth, that sigma shared by the three, the held angles at the nominal;
 //   - a differential drive whose true radii are equal, fitted on its tracks with r_left and
 //     r_right tied: equal radii within 4 sigmas;
-//   - a wrong name is refused by the library and by `fitcal fit --tie` (one line, exit 2);
+//   - a wrong name is refused by the library and by `fitcal fit --tie` (one line, exit 2), and so
+//     is a tie with the effect fit;
 //   - the clock map of a simulated differential drive whose ground truth is 0.15 s late.
 
 #include "fit/parameter_tying.h"
@@ -13,6 +14,7 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <vector>
@@ -209,6 +211,11 @@ TEST(ParameterTying, FitCommandTiesAndRefusesUnknownNames) {
   EXPECT_EQ(std::count(wrong.err.begin(), wrong.err.end(), '\n'), 1) << wrong.err;
   EXPECT_NE(wrong.err.find("'r_nope'"), std::string::npos) << wrong.err;
   EXPECT_EQ(wrong.out, "");
+  // The effect fit moves every parameter: a tie cannot apply to it.
+  const auto effects = testing::RunFitcal(
+      dir, "fit --logs " + data + " --tie r_left,r_right --effects pivot_yaw_gain --no-output");
+  EXPECT_EQ(effects.exit_code, 2) << effects.err;
+  EXPECT_EQ(std::count(effects.err.begin(), effects.err.end(), '\n'), 1) << effects.err;
 }
 
 // Ground truth stamped 0.15 s late on a simulated differential drive: the speed-profile match of

@@ -221,13 +221,15 @@ void PrintParameters(const Robot& robot, const std::vector<double>& p, const Sel
 
 // Nominal (with the effects the robot declares), closed forms, the fit; and when the fit held
 // undetermined directions and held-out runs can judge it, the fit without the holds too (on the
-// training runs alone it would always win, by fitting what the data cannot tell apart).
+// training runs alone it would always win, by fitting what the data cannot tell apart). Under
+// --tie/--hold the closed forms stay out: they fit the full model, not the one asked for.
 std::vector<CalibrationCandidate> Candidates(const RobotModelInterface& model,
                                              const RunSplit& split, const ModelFitResult& fit,
-                                             const std::string& method) {
+                                             const std::string& method, bool closed_forms) {
   std::vector<CalibrationCandidate> out = {
       {"nominal", model.robot().nominal, true, model.robot().effects}};
-  for (const ClosedFormCalibration& c : model.ClosedForms(split.training)) {
+  for (const ClosedFormCalibration& c :
+       closed_forms ? model.ClosedForms(split.training) : std::vector<ClosedFormCalibration>{}) {
     out.push_back({c.method, c.parameters, true});
   }
   out.push_back({method, fit.parameters, fit.usable || fit.stopped_early});
@@ -901,6 +903,10 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   }
   const std::optional<EffectModel> effects_to_fit = EffectsToFit(options, robot);
   if (!effects_to_fit) return 2;
+  if (!settings.tying.empty() && !effects_to_fit->empty()) {
+    return Refuse("--tie and --hold apply to the parameters' fit, not to the effect fit (--effects "
+                  "or effects the robot YAML declares), which moves every parameter");
+  }
   if (!options.no_output && !options.force) {
     const std::string refusal = OverwriteRefusal(options.out, robot.name);
     if (!refusal.empty()) {
@@ -945,7 +951,8 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   }
   const ModelFitMethodOutcome outcome = method->run_model(split.training, *model, settings);
   const ModelFitResult& fit = outcome.fit;
-  std::vector<CalibrationCandidate> candidates = Candidates(*model, split, fit, options.method);
+  std::vector<CalibrationCandidate> candidates =
+      Candidates(*model, split, fit, options.method, settings.tying.empty());
   const std::optional<TrackFits> track_fits =
       training_tracks ? std::optional<TrackFits>(AddTrackFitCandidates(
                             options, *model, *training_tracks, *effects_to_fit, &candidates))
