@@ -7,7 +7,7 @@
 //   r_j = [ (x(t_j - tau) - x_gt_j) / sigma_xy, (y(...) - y_gt_j) / sigma_xy,
 //           wrap(theta(...) - theta_gt_j) / sigma_theta ] / sqrt(n_checkpoints)
 //
-// with the replay of odometry/effects.h (the model's steps, Palacin Eq. 4, + effect stages) started
+// with the replay of odometry/effects.h (the model's body steps + effect stages) started
 // at the rest pose (TrackStartsAtRest) or moved rigidly through the anchor ground-truth sample at
 // the encoder time it shows (StartAnchorIndices);
 // tau is the time-offset effect's latency (0 without it). The
@@ -19,13 +19,10 @@
 #include <string>
 #include <vector>
 
-// Transitional: Omni3ParameterArray for diagnosis/residual_analysis.h, which reaches it here.
-#include "fit/final_pose_cost.h"
 #include "fit/final_pose_errors.h"
 #include "models/model_interface.h"
 #include "odometry/aligned_run.h"
 #include "odometry/effects.h"
-#include "odometry/robot_description.h"
 #include "odometry/run_log.h"
 
 namespace fitcal {
@@ -208,7 +205,7 @@ EffectFitResult FitEffectModel(const std::vector<TrackRun>& training,
                                const std::vector<double>& start_p, const EffectModel& start,
                                const EffectFitOptions& options = {});
 
-// How much of a candidate's influence on the training residuals lies outside what the nine
+// How much of a candidate's influence on the training residuals lies outside what the model's
 // parameters (and the effects already in `model`) can produce: |(I - P) J_c| / |J_c| for the
 // candidate's Jacobian column J_c (the smallest over its parameters) at the given solution, P the
 // projection on the other columns. 0: the data cannot tell the candidate from the others.

@@ -24,12 +24,6 @@ inline NloptSearchResult FitOmni3Nlopt(const std::vector<AlignedRun>& runs,
   return FitModelNlopt(runs, *Omni3ModelOf(robot), options);
 }
 
-// Omni3 parameters (Eq. 15 order) as the seam takes them.
-inline std::vector<double> Omni3Vector(const omni3::Parameters& p) {
-  const auto a = p.ToArray();
-  return {a.begin(), a.end()};
-}
-
 // Eq. 14 errors of omni3 parameters (Eq. 15 order) through the model's replay.
 inline FinalPoseErrors Omni3Errors(const std::vector<double>& p,
                                    const std::vector<AlignedRun>& runs) {

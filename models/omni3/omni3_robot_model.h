@@ -50,8 +50,8 @@ RobotModelPtr ReadOmni3Model(const YAML::Node& root, const std::string& path);
 // for the omni3 code paths that predate the seam.
 std::shared_ptr<const Omni3Model> Omni3ModelOf(const Omni3Robot& robot);
 
-// The omni3 model of the default Omni3Robot, made once: the kinematics for the overloads that take
-// an Omni3ParameterArray (the parameters come with each call, the robot's values are not used).
+// The omni3 model of the default Omni3Robot, made once: the kinematics for callers that hold omni3
+// parameters without a robot (the parameters come with each call, the robot's values are not used).
 const Omni3Model& DefaultOmni3Model();
 
 }  // namespace fitcal
