@@ -36,15 +36,6 @@ std::uint64_t SplitMix(std::uint64_t x) {
   return x ^ (x >> 31);
 }
 
-omni3::Parameters Make(double r_a, double r_b, double r_c, double wr_a, double wr_b, double wr_c,
-                       double d_a_deg, double d_b_deg, double d_c_deg) {
-  omni3::Parameters p;
-  p.distance_m = {r_a, r_b, r_c};
-  p.radius_m = {wr_a, wr_b, wr_c};
-  p.angle_rad = {d_a_deg * M_PI / 180.0, d_b_deg * M_PI / 180.0, d_c_deg * M_PI / 180.0};
-  return p;
-}
-
 void Validate(const Omni3SimulationOptions& o) {
   const auto fail = [](const char* what) {
     throw std::invalid_argument(std::string("simulation: ") + what);
@@ -225,15 +216,6 @@ SimulatedRun SimulateRun(const Omni3SimulationOptions& o, const MotionCommand& c
 
 }  // namespace
 
-omni3::Parameters PalacinTable5Parameters() {
-  return Make(0.218643, 0.215735, 0.216287, 0.155068, 0.151534, 0.152728, 59.7397, 179.6820,
-              301.5735);
-}
-
-omni3::Parameters PalacinNominalParameters() {
-  return Make(0.195, 0.195, 0.195, 0.148, 0.148, 0.148, 60.0, 180.0, 300.0);
-}
-
 Omni3SimulationOptions NoiseFreeSimulationOptions() {
   Omni3SimulationOptions options;
   options.repetitions = 1;
@@ -243,16 +225,6 @@ Omni3SimulationOptions NoiseFreeSimulationOptions() {
   options.encoder_counts_per_rev = 1 << 22;
   options.encoder_jitter_s = 0.0;
   return options;
-}
-
-Omni3Robot PalacinApr02Robot() {
-  Omni3Robot robot;
-  robot.name = "apr02";
-  robot.nominal = PalacinNominalParameters();
-  robot.bounds.distance_m = {0.170, 0.220};  // Palacin Eq. 16
-  robot.bounds.radius_m = {0.138, 0.158};
-  robot.bounds.angle_offset_rad = {-2.0 * M_PI / 180.0, 2.0 * M_PI / 180.0};
-  return robot;
 }
 
 std::vector<SimulatedRun> SimulateOmni3(const Omni3SimulationOptions& options) {

@@ -28,16 +28,10 @@
 #include "odometry/omni3_model.h"
 #include "odometry/robot_description.h"
 #include "odometry/run_log.h"
-#include "tools/sim/flower_trajectories.h"
+#include "tools/sim/flower_scenario.h"
 
 namespace fitcal::sim {
 
-// Palacin Table 5: the STE-GA5 calibrated parameters of APR-02, the default simulated truth.
-omni3::Parameters PalacinTable5Parameters();
-// Palacin Eq. 15: the nominal parameters.
-omni3::Parameters PalacinNominalParameters();
-// APR-02 as data/robots/apr02.yaml describes it: Eq. 15 nominal, Eq. 16 bounds.
-Omni3Robot PalacinApr02Robot();
 
 struct Omni3SimulationOptions {
   omni3::Parameters true_robot = PalacinTable5Parameters();
