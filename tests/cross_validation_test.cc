@@ -12,7 +12,7 @@
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
 #include "tools/sim/model_scenarios.h"
-#include "tools/sim/omni3_simulator.h"
+#include "tools/sim/flower_scenario.h"
 
 namespace fitcal {
 namespace {

@@ -14,7 +14,7 @@
 #include "io/input_error.h"
 #include "io/robot_yaml.h"
 #include "odometry/omni3_replay.h"
-#include "tools/sim/omni3_simulator.h"
+#include "tools/sim/flower_scenario.h"
 #include "validation/statistics.h"
 
 namespace fitcal {

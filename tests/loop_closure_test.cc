@@ -10,7 +10,7 @@
 #include "fit/trajectory_split.h"
 #include "odometry/effects.h"
 #include "odometry/omni3_replay.h"
-#include "tools/sim/omni3_simulator.h"
+#include "tools/sim/flower_scenario.h"
 
 namespace fitcal {
 namespace {

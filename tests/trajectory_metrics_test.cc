@@ -9,7 +9,7 @@
 
 #include "fit/effect_fit.h"
 #include "models/omni3/omni3_robot_model.h"
-#include "tools/sim/omni3_simulator.h"
+#include "tools/sim/flower_scenario.h"
 
 namespace fitcal {
 namespace {
@@ -100,16 +100,16 @@ TEST(TrajectoryMetricsTest, NoGroundTruthInsideTheWindowIsAnError) {
 // latency-shifted start and end), the true effects explain the data better than none, and an
 // empty list is the plain replay bit for bit.
 TEST(TrajectoryMetricsTest, EffectsAreReplayedAsTheEffectFitScoresThem) {
-  sim::Omni3SimulationOptions options;
+  sim::FlowerSimulation options = sim::PalacinFlower();
   options.repetitions = 1;
   effects::EffectValue latency, slip;
   latency.id = effects::EffectId::kTimeOffset;
   latency.value[0] = 0.08;  // s
   slip.id = effects::EffectId::kWheelSpeedSlip;
   slip.value[0] = effects::Info(slip.id).typical[0];
-  options.injected_effects = {latency, slip};
+  options.options.stepped->injected_effects = {latency, slip};
   std::vector<RunLog> logs;
-  for (auto& run : sim::SimulateOmni3(options)) logs.push_back(std::move(run.log));
+  for (auto& run : sim::SimulateFlower(options)) logs.push_back(std::move(run.log));
   const Omni3ParameterArray p = sim::PalacinTable5Parameters().ToArray();
   const EffectModel model = {latency, slip};
   const ModelScore scores = ScoreModel(p, model, PrepareTrackRuns(logs));
@@ -136,13 +136,13 @@ TEST(TrajectoryMetricsTest, EffectsAreReplayedAsTheEffectFitScoresThem) {
 // 256 samples, README "Kinematics": 1e-11 m from a literal Eq. 4); 1e-9 (m and rad) is a hundred
 // times that, far below anything the report prints.
 TEST(TrajectoryMetricsTest, TheModelSeamGivesTheOmni3Metrics) {
-  sim::Omni3SimulationOptions options;
+  sim::FlowerSimulation options = sim::PalacinFlower();
   options.repetitions = 1;
   effects::EffectValue slip;
   slip.id = effects::EffectId::kWheelSpeedSlip;
   slip.value[0] = effects::Info(slip.id).typical[0];
   std::vector<RunLog> logs;
-  for (auto& run : sim::SimulateOmni3(options)) logs.push_back(std::move(run.log));
+  for (auto& run : sim::SimulateFlower(options)) logs.push_back(std::move(run.log));
   const Omni3ParameterArray p = sim::PalacinTable5Parameters().ToArray();
   const std::vector<double> q(p.begin(), p.end());
   const auto model = Omni3ModelOf(sim::PalacinApr02Robot());
