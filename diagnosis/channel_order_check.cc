@@ -293,10 +293,11 @@ ChannelOrderReport CheckRecordedChannelOrder(const std::vector<AlignedRun>& runs
     segments[i] = MakeSegments(runs[i], *tracks[i], windows);
     total += segments[i].size();
   }
-  if (total < 4) return CheckChannelOrder(runs, {}, model, options);
-  ChannelOrderReport report = CheckChannelOrder(runs, segments, model, options);
-  report.on_windows = true;
-  return report;
+  ChannelOrderReport final_poses = CheckChannelOrder(runs, {}, model, options);
+  if (total < 4 || final_poses.likely_miswired) return final_poses;
+  ChannelOrderReport on_windows = CheckChannelOrder(runs, segments, model, options);
+  on_windows.on_windows = true;
+  return on_windows;
 }
 
 }  // namespace fitcal

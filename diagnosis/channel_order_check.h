@@ -111,8 +111,10 @@ ChannelOrderReport CheckChannelOrder(const std::vector<AlignedRun>& runs,
 
 // The check of recorded runs against their ground truth, as the importers run it: on disjoint
 // windows of 0.5 m of ground-truth path when the ground truth has poses between the ends (at
-// least 4 windows; closed paths hide some miswirings from final poses), on the final poses
-// otherwise. tracks[i] is the ground truth of runs[i].
+// least 4 windows; closed paths hide some miswirings from final poses), then, unless the windows
+// found a miswiring, on the final poses (a slow drift the windows' noise hides shows at the end of
+// a long run; each test keeps its false-alarm probability, so the pair has at most twice it).
+// tracks[i] is the ground truth of runs[i]. Used by the importers, `fit` and `diagnose`.
 ChannelOrderReport CheckRecordedChannelOrder(const std::vector<AlignedRun>& runs,
                                              const std::vector<const GroundTruthTrack*>& tracks,
                                              const RobotModelInterface& model,

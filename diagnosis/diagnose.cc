@@ -6,7 +6,6 @@
 #include <limits>
 #include <stdexcept>
 
-#include "models/omni3/omni3_robot_model.h"
 #include "validation/statistics.h"
 
 namespace fitcal {
@@ -198,12 +197,6 @@ std::string CandidateVerdict(const CandidateResult& c, double threshold,
   if (evaluated && !c.explains) return test + Fmt(" but explains only %.0f %%", percent) + rule;
   return test + " but " + accepted_name +
          " lowers the held-out error more (rule: the largest mean d is accepted)";
-}
-
-DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
-                        const std::vector<TrackRun>& validation, const Omni3Robot& robot,
-                        const DiagnoseOptions& options) {
-  return Diagnose(training, validation, *Omni3ModelOf(robot), options);
 }
 
 namespace {
@@ -429,10 +422,6 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
   const EffectFitResult final_fit = Trace(x, candidates, &out);
   Conclude(x, final_fit, &out);
   return out;
-}
-
-std::string FormatDiagnoseReport(const DiagnoseResult& r, const Omni3Robot& robot) {
-  return FormatDiagnoseReport(r, *Omni3ModelOf(robot));
 }
 
 namespace {

@@ -46,7 +46,6 @@
 #include "diagnosis/covariate_structure.h"
 #include "diagnosis/residual_analysis.h"
 #include "fit/effect_fit.h"
-#include "fit/final_pose_cost.h"
 #include "fit/model_fit.h"
 
 namespace fitcal {
@@ -143,9 +142,6 @@ struct DiagnoseResult {
 DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
                         const std::vector<TrackRun>& validation, const RobotModelInterface& model,
                         const DiagnoseOptions& options = {});
-DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
-                        const std::vector<TrackRun>& validation, const Omni3Robot& robot,
-                        const DiagnoseOptions& options = {});
 
 // A fitted candidate's verdict: the held-out test as it came out - "significant (p < threshold)"
 // or "not significant (p >= threshold)", never the one for the other - then the rule that decided,
@@ -157,6 +153,5 @@ std::string CandidateVerdict(const CandidateResult& c, double threshold,
 // The report (Markdown): pattern, effect chosen with value and uncertainty, parameters before
 // and after, held-out error before and after, candidate table, what to record next.
 std::string FormatDiagnoseReport(const DiagnoseResult& result, const RobotModelInterface& model);
-std::string FormatDiagnoseReport(const DiagnoseResult& result, const Omni3Robot& robot);
 
 }  // namespace fitcal

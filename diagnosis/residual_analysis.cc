@@ -6,7 +6,6 @@
 #include <cstdio>
 #include <map>
 
-#include "models/omni3/omni3_robot_model.h"
 #include "odometry/parallel_for.h"
 #include "validation/statistics.h"
 #include "validation/trajectory_family.h"
@@ -516,11 +515,6 @@ void AddGroupStatistics(const std::vector<TrackRun>& runs, ResidualAnalysis* out
 }
 
 }  // namespace
-
-ResidualAnalysis AnalyzeResiduals(const Omni3ParameterArray& p, const EffectModel& model,
-                                  const std::vector<TrackRun>& runs, int num_threads) {
-  return AnalyzeResiduals(DefaultOmni3Model(), {p.begin(), p.end()}, model, runs, num_threads);
-}
 
 ResidualAnalysis AnalyzeResiduals(const RobotModelInterface& robot_model,
                                   const std::vector<double>& p, const EffectModel& model,

@@ -104,8 +104,6 @@ struct ResidualAnalysis {
 ResidualAnalysis AnalyzeResiduals(const RobotModelInterface& robot_model,
                                   const std::vector<double>& p, const EffectModel& model,
                                   const std::vector<TrackRun>& runs, int num_threads = 0);
-ResidualAnalysis AnalyzeResiduals(const Omni3ParameterArray& p, const EffectModel& model,
-                                  const std::vector<TrackRun>& runs, int num_threads = 0);
 
 // Human-readable tables (Markdown).
 std::string FormatResidualAnalysis(const ResidualAnalysis& analysis);

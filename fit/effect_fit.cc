@@ -13,7 +13,6 @@
 #include "fit/correlation.h"
 #include "fit/dense_solver_options.h"
 #include "fit/run_split.h"
-#include "models/omni3/omni3_robot_model.h"
 #include "odometry/parallel_for.h"
 
 namespace fitcal {
@@ -185,8 +184,6 @@ std::vector<EffectId> IdsOf(const EffectModel& model) {
   return ids;
 }
 
-std::vector<double> Vector(const Omni3ParameterArray& p) { return {p.begin(), p.end()}; }
-
 }  // namespace
 
 unsigned WheelChannelMask(const Robot& robot) {
@@ -316,12 +313,6 @@ FinalPoseErrors FinalPoseErrorsOf(const ModelScore& score) {
   return e;
 }
 
-ModelScore ScoreModel(const Omni3ParameterArray& p, const EffectModel& model,
-                      const std::vector<TrackRun>& runs, const ResidualWeights& weights,
-                      int num_threads) {
-  return ScoreModel(DefaultOmni3Model(), Vector(p), model, runs, weights, num_threads);
-}
-
 ModelScore ScoreModel(const RobotModelInterface& robot_model, const std::vector<double>& p,
                       const EffectModel& model, const std::vector<TrackRun>& runs,
                       const ResidualWeights& weights, int num_threads) {
@@ -363,11 +354,6 @@ ModelScore ScoreModel(const RobotModelInterface& robot_model, const std::vector<
     out.track_rmse_rad = std::sqrt(out.track_rmse_rad / n);
   }
   return out;
-}
-
-TrackErrors ComputeTrackErrors(const Omni3ParameterArray& p, const EffectModel& model,
-                               const TrackRun& run, bool all_samples) {
-  return ComputeTrackErrors(DefaultOmni3Model(), Vector(p), model, run, all_samples);
 }
 
 TrackErrors ComputeTrackErrors(const RobotModelInterface& robot_model, const std::vector<double>& p,
@@ -499,12 +485,6 @@ void ComputeEffectCovariance(ceres::Problem* problem, const std::vector<double*>
 
 }  // namespace
 
-EffectFitResult FitEffectModel(const std::vector<TrackRun>& training, const Omni3Robot& robot,
-                               const Omni3ParameterArray& start_p, const EffectModel& start,
-                               const EffectFitOptions& options) {
-  return FitEffectModel(training, *Omni3ModelOf(robot), Vector(start_p), start, options);
-}
-
 EffectFitResult FitEffectModel(const std::vector<TrackRun>& training,
                                const RobotModelInterface& robot_model,
                                const std::vector<double>& start_p, const EffectModel& start,
@@ -552,13 +532,6 @@ EffectFitResult FitEffectModel(const std::vector<TrackRun>& training,
     ComputeEffectCovariance(&problem, blocks, 2.0 * summary.final_cost / dof, &result);
   }
   return result;
-}
-
-double SeparableFraction(const std::vector<TrackRun>& training, const Omni3ParameterArray& p,
-                         const EffectModel& model, EffectId candidate,
-                         const ResidualWeights& weights, double* unexplained_norm) {
-  return SeparableFraction(training, DefaultOmni3Model(), Vector(p), model, candidate, weights,
-                           unexplained_norm);
 }
 
 double SeparableFraction(const std::vector<TrackRun>& training,

@@ -1,14 +1,13 @@
 #pragma once
-// A robot model's parameters (models/model_interface.h; the nine of omni3 in the overloads that
-// take an Omni3ParameterArray) plus candidate effects (odometry/effects.h), fitted to the whole
-// ground-truth track of each run. The final pose alone cannot see every effect (a clock latency
-// vanishes when runs end at rest), so the residual of a run is the pose error at every
-// ground-truth sample of its window ("checkpoints"):
+// A robot model's parameters (models/model_interface.h) plus candidate effects
+// (odometry/effects.h), fitted to the whole ground-truth track of each run. The final pose alone
+// cannot see every effect (a clock latency vanishes when runs end at rest), so the residual of a
+// run is the pose error at every ground-truth sample of its window ("checkpoints"):
 //
 //   r_j = [ (x(t_j - tau) - x_gt_j) / sigma_xy, (y(...) - y_gt_j) / sigma_xy,
 //           wrap(theta(...) - theta_gt_j) / sigma_theta ] / sqrt(n_checkpoints)
 //
-// with the replay of odometry/effects.h (the model's steps, Palacin Eq. 4, + effect stages) started
+// with the replay of odometry/effects.h (the model's body steps + effect stages) started
 // at the rest pose (TrackStartsAtRest) or moved rigidly through the anchor ground-truth sample at
 // the encoder time it shows (StartAnchorIndices);
 // tau is the time-offset effect's latency (0 without it). The
@@ -20,13 +19,11 @@
 #include <string>
 #include <vector>
 
-#include "fit/final_pose_cost.h"
 #include "fit/final_pose_errors.h"
 #include "fit/final_pose_residual.h"
 #include "models/model_interface.h"
 #include "odometry/aligned_run.h"
 #include "odometry/effects.h"
-#include "odometry/robot_description.h"
 #include "odometry/run_log.h"
 
 namespace fitcal {
@@ -160,9 +157,6 @@ FinalPoseErrors FinalPoseErrorsOf(const ModelScore& score);
 ModelScore ScoreModel(const RobotModelInterface& robot_model, const std::vector<double>& p,
                       const EffectModel& model, const std::vector<TrackRun>& runs,
                       const ResidualWeights& weights = {}, int num_threads = 0);
-ModelScore ScoreModel(const Omni3ParameterArray& p, const EffectModel& model,
-                      const std::vector<TrackRun>& runs, const ResidualWeights& weights = {},
-                      int num_threads = 0);
 
 // Pose error of the replay at every checkpoint of a run (world frame, replay minus ground
 // truth), with the checkpoint times and ground-truth poses; for residual analysis.
@@ -174,8 +168,6 @@ struct TrackErrors {
 };
 TrackErrors ComputeTrackErrors(const RobotModelInterface& robot_model, const std::vector<double>& p,
                                const EffectModel& model, const TrackRun& run, bool all_samples);
-TrackErrors ComputeTrackErrors(const Omni3ParameterArray& p, const EffectModel& model,
-                               const TrackRun& run, bool all_samples);
 
 struct EffectFitOptions {
   ResidualWeights weights;
@@ -213,11 +205,8 @@ EffectFitResult FitEffectModel(const std::vector<TrackRun>& training,
                                const RobotModelInterface& robot_model,
                                const std::vector<double>& start_p, const EffectModel& start,
                                const EffectFitOptions& options = {});
-EffectFitResult FitEffectModel(const std::vector<TrackRun>& training, const Omni3Robot& robot,
-                               const Omni3ParameterArray& start_p, const EffectModel& start,
-                               const EffectFitOptions& options = {});
 
-// How much of a candidate's influence on the training residuals lies outside what the nine
+// How much of a candidate's influence on the training residuals lies outside what the model's
 // parameters (and the effects already in `model`) can produce: |(I - P) J_c| / |J_c| for the
 // candidate's Jacobian column J_c (the smallest over its parameters) at the given solution, P the
 // projection on the other columns. 0: the data cannot tell the candidate from the others.
@@ -227,9 +216,6 @@ EffectFitResult FitEffectModel(const std::vector<TrackRun>& training, const Omni
 // candidate before fitting it.
 double SeparableFraction(const std::vector<TrackRun>& training,
                          const RobotModelInterface& robot_model, const std::vector<double>& p,
-                         const EffectModel& model, effects::EffectId candidate,
-                         const ResidualWeights& weights = {}, double* unexplained_norm = nullptr);
-double SeparableFraction(const std::vector<TrackRun>& training, const Omni3ParameterArray& p,
                          const EffectModel& model, effects::EffectId candidate,
                          const ResidualWeights& weights = {}, double* unexplained_norm = nullptr);
 

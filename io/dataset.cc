@@ -14,7 +14,6 @@
 #include <string_view>
 #include <unordered_map>
 
-#include "io/asoc_files.h"
 #include "io/input_error.h"
 #include "io/input_registry.h"
 #include "io/log_files.h"
@@ -290,13 +289,12 @@ void RejectDataSetWithoutMotion(const DatasetIndex& index, const std::vector<Run
   }
 }
 
-// ASOC data sets keep their own encoder files (io/asoc_files.h: cumulative wheel angles and pivot
-// readings); an asoc robot's run in that format is converted to the model's channels here, so
-// that every command sees the same runs. Any other file goes through the generic reader.
+// A model may record its encoders in a format of its own (Robot::read_own_encoder_file: ASOC's
+// cumulative wheel angles and pivot readings), converted to the model's channels there, so that
+// every command sees the same runs. Any other file goes through the generic reader.
 EncoderLog ReadRunEncoders(const std::string& path, const Robot& robot) {
-  if (robot.model == "asoc" && IsAsocEncoderCsv(path)) {
-    return AsocEncoderLogAsChannels(ReadAsocEncoderCsv(path));
-  }
+  EncoderLog log;
+  if (robot.read_own_encoder_file && robot.read_own_encoder_file(path, &log)) return log;
   return ReadEncoderCsv(path, robot);
 }
 

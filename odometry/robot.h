@@ -5,6 +5,7 @@
 // model's YAML reader (models/<model>/..._yaml.cc); read by every generic algorithm.
 
 #include <cmath>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -12,6 +13,8 @@
 #include "odometry/effects.h"
 
 namespace fitcal {
+
+struct EncoderLog;  // odometry/run_log.h
 
 struct Interval {
   double lo = 0.0;
@@ -79,6 +82,11 @@ struct Robot {
   std::optional<EncoderTicks> encoder;  // set when the encoder logs are in ticks
   // Effects beyond the model's parameters (robot YAML `effects:`, written by `fitcal diagnose`).
   std::vector<effects::EffectValue> effects;
+  // A model whose robots record their encoders in a file format of their own (ASOC's cumulative
+  // wheel angles and pivot readings) reads it here, as the model's channels: true when `path` is
+  // in that format and *log was filled; false sends the file to the generic encoder CSV reader.
+  // The data-set loader (io/dataset.cc) calls it without knowing any model.
+  std::function<bool(const std::string& path, EncoderLog* log)> read_own_encoder_file;
 
   int NumParameters() const { return static_cast<int>(parameters.size()); }
   int NumChannels() const { return static_cast<int>(channels.size()); }

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <random>
 
-#include "io/asoc_files.h"
+#include "models/asoc/asoc_files.h"
 #include "io/atomic_file.h"
 #include "io/input_error.h"
 #include "models/asoc/asoc_geometric.h"

@@ -11,7 +11,7 @@
 
 #include "fit/final_pose_errors.h"
 #include "fit/model_fit.h"
-#include "io/asoc_files.h"
+#include "models/asoc/asoc_files.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/log_files.h"
@@ -59,7 +59,7 @@ double PositionError(const Pose2d& a, const Pose2d& b) { return std::hypot(a.x -
 // UMBmark circuits of a drawn vehicle (6 m each, encoders quantised as the prototype's), replayed
 // with the true parameters. The paper's CAST-0 linearises about the heading before each 20 Hz
 // update; the seam's body step solves Eq. 13-14 about the interval's middle (exact for a rigid
-// step) from the pivot angles at the intervals' middles (io/asoc_files.h). Both leave only the
+// step) from the pivot angles at the intervals' middles (models/asoc/asoc_files.h). Both leave only the
 // update and quantisation error of a few mm after 6 m (measured: seam 0.03 / 3.3 mm, silo 0.5 /
 // 2.8 mm for CW / CCW, 0.5 mm apart; heading within 3e-3 rad); bounds with margin: 5 mm and
 // 4e-3 rad from the truth, 1 mm between the two.

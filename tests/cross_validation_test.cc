@@ -1,5 +1,5 @@
-// Leave-one-repetition-out cross-validation (validation/cross_validation.h), for a model on the
-// seam (the simulated differential drive) and for omni3 (the paper's fit).
+// Leave-one-repetition-out cross-validation (validation/cross_validation.h), for any model on the
+// seam (here the simulated differential drive).
 #include "validation/cross_validation.h"
 
 #include <gtest/gtest.h>
@@ -12,7 +12,6 @@
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
 #include "tools/sim/model_scenarios.h"
-#include "tools/sim/flower_scenario.h"
 
 namespace fitcal {
 namespace {

@@ -86,9 +86,9 @@ TEST(HiddenStructure, LatencyIsRecoveredWhetherTheLogStartsAtRestOrMoving) {
     }
     effects::EffectValue start;
     start.id = effects::EffectId::kTimeOffset;
-    const Omni3Robot robot = NominalRobot();
+    const auto model = Omni3ModelOf(NominalRobot());
     const EffectFitResult fit =
-        FitEffectModel(PrepareTrackRuns(logs), robot, robot.nominal.ToArray(), {start});
+        FitEffectModel(PrepareTrackRuns(logs), *model, model->robot().nominal, {start});
     ASSERT_TRUE(fit.usable) << c.name << ": " << fit.message;
     ASSERT_TRUE(fit.has_covariance) << c.name;
     const double tau = fit.effects[0].value[0];
@@ -306,11 +306,11 @@ const CovariateTest* Find(const CovariateStructure& s, const std::string& name) 
 // floor, raised by the systematic residual (sensor_noise_floor.h), stays above that scatter.
 void ExpectNamedCovariate(const HiddenData& d, const std::string& covariate,
                           bool varies_between_runs) {
-  const Omni3Robot robot = NominalRobot();
+  const auto model = Omni3ModelOf(NominalRobot());
   DiagnoseOptions options;
   options.max_effects = 1;
-  const DiagnoseResult r = Diagnose(d.training, d.validation, robot, options);
-  const std::string report = FormatDiagnoseReport(r, robot);
+  const DiagnoseResult r = Diagnose(d.training, d.validation, *model, options);
+  const std::string report = FormatDiagnoseReport(r, *model);
   SCOPED_TRACE(report);
   EXPECT_TRUE(r.unexplained_structure);
   EXPECT_FALSE(r.effects_named);

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "io/robot_yaml.h"
+#include "models/model_registry.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "tools/sim/flower_scenario.h"
 
@@ -21,6 +22,9 @@ namespace {
 Omni3Robot NominalRobot() {
   return io::ReadOmni3Robot(FITCAL_SOURCE_DIR "/data/robots/apr02.yaml");
 }
+
+// The nominal robot on the model seam, which Diagnose works through.
+std::shared_ptr<const Omni3Model> NominalModel() { return Omni3ModelOf(NominalRobot()); }
 
 struct Data {
   std::vector<TrackRun> training, validation;
@@ -69,9 +73,9 @@ TEST_P(LibraryEffectTest, DiagnosePicksRecoversAndMatchesTrueModel) {
   truth.value = info.typical;
   o.options.stepped->injected_effects = {truth};
   const Data d = Simulate(o);
-  const Omni3Robot robot = NominalRobot();
-  const DiagnoseResult r = Diagnose(d.training, d.validation, robot);
-  SCOPED_TRACE(FormatDiagnoseReport(r, robot));
+  const auto model = NominalModel();
+  const DiagnoseResult r = Diagnose(d.training, d.validation, *model);
+  SCOPED_TRACE(FormatDiagnoseReport(r, *model));
   ASSERT_GE(r.final_fit.effects.size(), 1u);
   EXPECT_EQ(r.final_fit.effects.front().id, info.id)
       << effects::Info(r.final_fit.effects.front().id).name;
@@ -85,7 +89,7 @@ TEST_P(LibraryEffectTest, DiagnosePicksRecoversAndMatchesTrueModel) {
     EXPECT_NEAR(got.value[k], info.typical[k], tol) << info.parameter_names[k];
   }
   const ModelScore true_model =
-      ScoreModel(sim::PalacinTable5Parameters().ToArray(), {truth}, d.validation);
+      ScoreModel(DefaultOmni3Model(), o.true_parameters, {truth}, d.validation);
   std::printf(
       "%s: true %g, fitted %g +- %g; validation CF declared %.5f, with effect %.5f, true model "
       "%.5f\n",
@@ -96,18 +100,17 @@ TEST_P(LibraryEffectTest, DiagnosePicksRecoversAndMatchesTrueModel) {
   EXPECT_FALSE(r.unexplained_structure);
   ExpectVerdictsMatchTheirTests(r);
 
-  // The calibrated YAML carries the effect and the replay honours it when read back.
-  Omni3Robot calibrated = robot;
-  calibrated.nominal = omni3::Parameters::FromArray(r.final_fit.parameters.data());
-  calibrated.effects = r.final_fit.effects;
+  // The calibrated YAML (the model's, as diagnose writes it) carries the effect and the replay
+  // honours it when read back.
   const std::string path = ::testing::TempDir() + "/fitcal_diagnose_" + info.name + ".yaml";
   {
     std::ofstream f(path);
-    f << io::Omni3RobotYaml(calibrated, nullptr);
+    f << model->RobotYaml(r.final_fit.parameters, r.final_fit.effects, "");
   }
-  const Omni3Robot back = io::ReadOmni3Robot(path);
-  ASSERT_EQ(back.effects.size(), 1u);
-  const ModelScore replayed = ScoreModel(back.nominal.ToArray(), back.effects, d.validation);
+  const RobotModelPtr back = ReadRobotModelFile(path);
+  ASSERT_EQ(back->robot().effects.size(), 1u);
+  const ModelScore replayed =
+      ScoreModel(*back, back->robot().nominal, back->robot().effects, d.validation);
   // The YAML keeps 10 significant digits: the CF agrees to far better than its noise.
   EXPECT_NEAR(replayed.cf, r.final_validation.cf, 1e-6 * r.final_validation.cf);
   std::remove(path.c_str());
@@ -152,11 +155,11 @@ TEST_P(TransientEffectTest, IsNamedAndRecoveredWithinFourSigmas) {
   for (auto& run : sim::SimulateFlower(o)) logs.push_back(std::move(run.log));
   Data d;
   SplitTrackRuns(PrepareTrackRuns(logs), {1, 2}, &d.training, &d.validation);
-  const Omni3Robot robot = NominalRobot();
+  const auto model = NominalModel();
   DiagnoseOptions options;
   options.fit.num_threads = 2;
-  const DiagnoseResult r = Diagnose(d.training, d.validation, robot, options);
-  SCOPED_TRACE(FormatDiagnoseReport(r, robot));
+  const DiagnoseResult r = Diagnose(d.training, d.validation, *model, options);
+  SCOPED_TRACE(FormatDiagnoseReport(r, *model));
   ASSERT_EQ(r.final_fit.effects.size(), 1u);
   const effects::EffectValue& got = r.final_fit.effects.front();
   EXPECT_EQ(got.id, info.id) << effects::Info(got.id).name;
@@ -164,7 +167,7 @@ TEST_P(TransientEffectTest, IsNamedAndRecoveredWithinFourSigmas) {
   EXPECT_GT(got.sigma[0], 0.0);
   EXPECT_LT(std::abs(got.value[0] - info.typical[0]), 4.0 * got.sigma[0]);
   const ModelScore true_model =
-      ScoreModel(sim::PalacinTable5Parameters().ToArray(), {truth}, d.validation);
+      ScoreModel(DefaultOmni3Model(), o.true_parameters, {truth}, d.validation);
   std::printf("%s: injected %g, fitted %g +- %g; validation CF %.5f (true model %.5f)\n", info.name,
               info.typical[0], got.value[0], got.sigma[0], r.final_validation.cf, true_model.cf);
   EXPECT_LE(r.final_validation.cf, 1.15 * true_model.cf);
@@ -185,7 +188,7 @@ TEST(Diagnose, CleanDataAcceptsNoEffectOverTwentySeeds) {
   const auto flower = sim::FlowerTrajectories();
   std::vector<sim::MotionCommand> subset;
   for (std::size_t i = 0; i < flower.size(); i += 3) subset.push_back(flower[i]);
-  const Omni3Robot robot = NominalRobot();
+  const auto model = NominalModel();
   int false_positives = 0;
   int structure_false_positives = 0;  // lack of fit or a covariate
   constexpr int kSeeds = 20;
@@ -199,7 +202,7 @@ TEST(Diagnose, CleanDataAcceptsNoEffectOverTwentySeeds) {
     const Data d = Simulate(o);
     DiagnoseOptions options;
     options.max_effects = 1;  // the first acceptance is the false positive
-    const DiagnoseResult r = Diagnose(d.training, d.validation, robot, options);
+    const DiagnoseResult r = Diagnose(d.training, d.validation, *model, options);
     if (!r.final_fit.effects.empty()) {
       ++false_positives;
       std::printf("seed %d: false positive %s\n", seed,
@@ -235,7 +238,7 @@ TEST(Diagnose, LackOfFitIsCalibratedOnCleanDataWithManyRepetitions) {
   const Data d = Simulate(o);
   DiagnoseOptions options;
   options.max_effects = 0;  // the residual of the nine parameters alone
-  const DiagnoseResult r = Diagnose(d.training, d.validation, NominalRobot(), options);
+  const DiagnoseResult r = Diagnose(d.training, d.validation, *NominalModel(), options);
   ASSERT_TRUE(r.after.lack_of_fit.available);
   EXPECT_GT(r.after.lack_of_fit.p_value, options.lof_alpha) << "F = " << r.after.lack_of_fit.f;
   EXPECT_FALSE(r.unexplained_structure);
@@ -253,7 +256,7 @@ TEST(Diagnose, LatencyIsNamedWithManyRepetitions) {
   latency.value[0] = 0.08;
   o.options.stepped->injected_effects = {latency};
   const Data d = Simulate(o);
-  const DiagnoseResult r = Diagnose(d.training, d.validation, NominalRobot());
+  const DiagnoseResult r = Diagnose(d.training, d.validation, *NominalModel());
   ASSERT_EQ(r.final_fit.effects.size(), 1u);
   EXPECT_EQ(r.final_fit.effects[0].id, effects::EffectId::kTimeOffset);
   EXPECT_NEAR(r.final_fit.effects[0].value[0], 0.08, 4.0 * r.final_fit.effects[0].sigma[0]);
@@ -277,9 +280,9 @@ TEST(Diagnose, EffectOutsideLibraryIsReportedAsUnexplainedStructure) {
     }
   };
   const Data d = Simulate(o);
-  const Omni3Robot robot = NominalRobot();
-  const DiagnoseResult r = Diagnose(d.training, d.validation, robot);
-  SCOPED_TRACE(FormatDiagnoseReport(r, robot));
+  const auto model = NominalModel();
+  const DiagnoseResult r = Diagnose(d.training, d.validation, *model);
+  SCOPED_TRACE(FormatDiagnoseReport(r, *model));
   // A candidate may stand in for part of it (and lower the held-out error), but none is named.
   EXPECT_FALSE(r.effects_named);
   EXPECT_TRUE(r.unexplained_structure);
@@ -298,17 +301,16 @@ TEST(Diagnose, ClockScaleIsReportedNotIdentifiable) {
   truth.value = effects::Info(truth.id).typical;
   o.options.stepped->injected_effects = {truth};
   const Data d = Simulate(o);
-  const Omni3Robot robot = NominalRobot();
-  const DiagnoseResult r = Diagnose(d.training, d.validation, robot);
-  const std::string report = FormatDiagnoseReport(r, robot);
+  const auto model = NominalModel();
+  const DiagnoseResult r = Diagnose(d.training, d.validation, *model);
+  const std::string report = FormatDiagnoseReport(r, *model);
   SCOPED_TRACE(report);
   EXPECT_TRUE(r.final_fit.effects.empty());
   EXPECT_NE(report.find("encoder_clock_scale: not identifiable"), std::string::npos);
   // The numerical check agrees with the registry: nothing of its column is separable.
-  EXPECT_LT(SeparableFraction(d.training, *Omni3ModelOf(robot), r.base.parameters, {}, truth.id),
-            1e-6);
+  EXPECT_LT(SeparableFraction(d.training, *model, r.base.parameters, {}, truth.id), 1e-6);
   const ModelScore true_model =
-      ScoreModel(sim::PalacinTable5Parameters().ToArray(), {truth}, d.validation);
+      ScoreModel(DefaultOmni3Model(), o.true_parameters, {truth}, d.validation);
   EXPECT_LE(r.declared_validation.cf, 1.15 * true_model.cf);
   // The radii absorb the scale: r_i(fitted) ~ r_i(true) (1 + s).
   for (int i = 0; i < 3; ++i) {
@@ -329,9 +331,9 @@ TEST(Diagnose, SaysWhichRunsWouldSeparateAnUnidentifiableCandidate) {
   const Data d = Simulate(o);
   DiagnoseOptions options;
   options.candidates = {effects::EffectId::kYawRateSlip, effects::EffectId::kWheelSpeedSlip};
-  const Omni3Robot robot = NominalRobot();
-  const DiagnoseResult r = Diagnose(d.training, d.validation, robot, options);
-  const std::string report = FormatDiagnoseReport(r, robot);
+  const auto model = NominalModel();
+  const DiagnoseResult r = Diagnose(d.training, d.validation, *model, options);
+  const std::string report = FormatDiagnoseReport(r, *model);
   SCOPED_TRACE(report);
   EXPECT_TRUE(r.final_fit.effects.empty());
   EXPECT_NE(report.find("yaw_rate_slip cannot be told apart"), std::string::npos);
@@ -353,7 +355,7 @@ TEST(Diagnose, SecondSpeedFlowerSeparatesSpeedSlip) {
     std::vector<TrackRun> all = d.training;
     all.insert(all.end(), d.validation.begin(), d.validation.end());
     double norm = 0.0;
-    SeparableFraction(all, sim::PalacinTable5Parameters().ToArray(), {},
+    SeparableFraction(all, DefaultOmni3Model(), o.true_parameters, {},
                       effects::EffectId::kWheelSpeedSlip, {}, &norm);
     return norm;
   };

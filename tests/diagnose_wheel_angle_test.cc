@@ -39,7 +39,7 @@ DiagnoseResult DiagnoseEccentric(double eccentricity, std::uint64_t seed) {
   SplitTrackRuns(PrepareTrackRuns(logs), {1, 2}, &training, &validation);
   DiagnoseOptions options;
   options.max_effects = 1;
-  return Diagnose(training, validation, robot, options);
+  return Diagnose(training, validation, *Omni3ModelOf(robot), options);
 }
 
 const CovariateTest& WheelAngleTest(const DiagnoseResult& r) {
@@ -57,7 +57,7 @@ const CovariateTest& WheelAngleTest(const DiagnoseResult& r) {
 // 12 at 1.5 %; clean, 0 of 12 report any structure.
 TEST(WheelAngle, EccentricWheelIsNamedAsTheAbsoluteWheelAngle) {
   const DiagnoseResult r = DiagnoseEccentric(0.02, 1);
-  const std::string report = FormatDiagnoseReport(r, NominalRobot());
+  const std::string report = FormatDiagnoseReport(r, *Omni3ModelOf(NominalRobot()));
   SCOPED_TRACE(report);
   const CovariateTest& t = WheelAngleTest(r);
   std::printf(
@@ -81,7 +81,7 @@ TEST(WheelAngle, RoundWheelsStaySilent) {
   const CovariateTest& t = WheelAngleTest(r);
   ASSERT_TRUE(t.tested) << t.why_not;
   EXPECT_FALSE(t.significant) << "p = " << t.p_value;
-  EXPECT_FALSE(r.unexplained_structure) << FormatDiagnoseReport(r, NominalRobot());
+  EXPECT_FALSE(r.unexplained_structure) << FormatDiagnoseReport(r, *Omni3ModelOf(NominalRobot()));
 }
 
 }  // namespace

@@ -31,7 +31,7 @@
 #include <thread>
 #include <vector>
 
-#include "io/asoc_files.h"
+#include "models/asoc/asoc_files.h"
 #include "io/calibration_yaml.h"
 #include "io/dataset.h"
 #include "io/input_error.h"

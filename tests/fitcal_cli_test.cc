@@ -11,7 +11,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "io/asoc_files.h"
+#include "models/asoc/asoc_files.h"
 #include "io/robot_yaml.h"
 #include "tests/test_files.h"
 

@@ -10,7 +10,7 @@
 #include <stdexcept>
 
 #include "fitcal/version.h"
-#include "io/asoc_files.h"
+#include "models/asoc/asoc_files.h"
 #include "io/atomic_file.h"
 #include "io/dataset.h"
 #include "io/input_error.h"

@@ -220,7 +220,7 @@ std::vector<int> ValidationRepetitions(const DiagnoseSplit& split) {
   return {reps.begin(), reps.end()};
 }
 
-// What both calibrated YAMLs record of the diagnosis: the chosen candidate, its objective, the
+// What the calibrated YAML records of the diagnosis: the chosen candidate, its objective, the
 // training and held-out runs, and the CF before and after on both.
 void RecordSource(const DiagnoseCommandOptions& options, const std::vector<RunLog>& logs,
                   const DiagnoseSplit& split, const DiagnoseResult& result,
@@ -244,26 +244,8 @@ void RecordSource(const DiagnoseCommandOptions& options, const std::vector<RunLo
   s.cf_validation_after = choice.cf_after;
 }
 
-// The calibrated omni3 YAML as before the seam (with M^-1 in the record).
-std::string Omni3CalibratedYaml(const DiagnoseCommandOptions& options, const std::string& path,
-                                const std::vector<RunLog>& logs, const DiagnoseSplit& split,
-                                const DiagnoseResult& result, const DiagnoseChoice& choice) {
-  const Omni3Robot robot = io::ReadOmni3Robot(path);
-  Omni3Robot calibrated = robot;
-  calibrated.nominal = omni3::Parameters::FromArray(choice.parameters.data());
-  calibrated.effects = choice.effects;
-  io::CalibrationRecord record;
-  RecordSource(options, logs, split, result, choice, &record);
-  record.has_uncertainty = choice.sigma.size() == record.sigma.size();
-  if (record.has_uncertainty) {
-    std::copy(choice.sigma.begin(), choice.sigma.end(), record.sigma.begin());
-    record.correlation = choice.correlation;
-  }
-  record.inverse_kinematic_matrix = omni3::InverseKinematicMatrix(choice.parameters.data());
-  return io::Omni3RobotYaml(calibrated, &record);
-}
-
-// Any other model: its own YAML with the accepted effects and the calibration block.
+// The model's own YAML (RobotYaml) with the accepted effects and the calibration block, the layout
+// `fit` writes.
 std::string ModelCalibratedYaml(const DiagnoseCommandOptions& options,
                                 const RobotModelInterface& model, const std::vector<RunLog>& logs,
                                 const DiagnoseSplit& split, const DiagnoseResult& result,
@@ -486,7 +468,7 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
                 << robot.model << "\n";
       return 2;
     }
-    if (!omni3 && !robot.effects.empty()) {
+    if (!robot.effects.empty()) {
       std::cerr << "fitcal: " << index.robot_path
                 << ": the robot already declares effects; diagnose starts from a robot YAML "
                    "without an effects: list\n";
@@ -531,9 +513,7 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
       return 5;
     }
     if (!WithUncertainty(*model, split, &choice)) return 1;
-    const std::string yaml =
-        omni3 ? Omni3CalibratedYaml(options, index.robot_path, runs, split, result, choice)
-              : ModelCalibratedYaml(options, *model, runs, split, result, choice);
+    const std::string yaml = ModelCalibratedYaml(options, *model, runs, split, result, choice);
     const io::DiagnosePageData page =
         MakePage(options, *model, split, result, gate, choice, report);
     WriteOutputs(options, inputs, report, result, page, yaml);

@@ -296,25 +296,6 @@ io::CalibrationBlock MakeRecord(const FitCommandOptions& options, const RobotMod
   return r;
 }
 
-// Windows of 0.5 m of ground-truth path for the runs whose ground truth has intermediate poses
-// (segments see miswirings that closed paths hide from final poses); empty lists otherwise.
-std::vector<std::vector<Segment>> OrderCheckWindows(const std::vector<AlignedRun>& training,
-                                                    const std::vector<RunLog>& logs) {
-  std::unordered_map<std::string, const RunLog*> by_id;
-  for (const RunLog& log : logs) by_id[log.id] = &log;
-  SegmentOptions windows;
-  windows.length_m = 0.5;
-  windows.stride_fraction = 1.0;  // disjoint: independent residuals for the F test
-  std::vector<std::vector<Segment>> out(training.size());
-  int total = 0;
-  for (std::size_t i = 0; i < training.size(); ++i) {
-    out[i] = MakeSegments(training[i], by_id.at(training[i].id)->ground_truth, windows);
-    total += static_cast<int>(out[i].size());
-  }
-  if (total < 4) out.clear();
-  return out;
-}
-
 // Exit code 4 with one line when another channel order explains the runs far better.
 bool ChannelsLookMiswired(const FitCommandOptions& options, const RobotModelInterface& model,
                           const std::vector<AlignedRun>& training,
@@ -323,11 +304,8 @@ bool ChannelsLookMiswired(const FitCommandOptions& options, const RobotModelInte
   order_options.weights.position_sigma_m = options.position_sigma_m;
   order_options.weights.heading_sigma_rad = DegToRad(options.heading_sigma_deg);
   order_options.num_threads = options.threads;
-  const std::vector<std::vector<Segment>> windows = OrderCheckWindows(training, logs);
-  ChannelOrderReport order = CheckChannelOrder(training, windows, model, order_options);
-  if (!order.likely_miswired && !windows.empty()) {
-    order = CheckChannelOrder(training, {}, model, order_options);
-  }
+  const ChannelOrderReport order =
+      CheckRecordedChannelOrder(training, TracksOf(logs, training), model, order_options);
   if (!order.likely_miswired) return false;
   std::cerr << "fitcal: " << options.logs << ": " << order.message
             << "; nothing written (--skip-wheel-order-check to fit anyway)\n";
@@ -848,29 +826,65 @@ void WriteCalibration(const FitCommandOptions& options, const RobotModelInterfac
   std::printf("wrote %s\n", options.out.c_str());
 }
 
+// The method, its settings and the effects to fit, checked before anything is loaded.
+struct FitSetup {
+  const FitMethod* method = nullptr;
+  FitMethodSettings settings;
+  EffectModel effects_to_fit;
+};
+
+// Fills `setup`; else one line on stderr and the exit code (2 for a flag, the overwrite refusal's
+// for an output fitcal did not write).
+int SetUpFit(const FitCommandOptions& options, const Robot& robot, FitSetup* setup) {
+  // Validated by RunFitCommand: a known method, settings in range.
+  setup->method = FindFitMethod(options.method);
+  std::string error;
+  if (setup->method == nullptr ||
+      !MakeFitMethodSettings(options, options.threads, &setup->settings, &error)) {
+    std::cerr << "fitcal: "
+              << (setup->method == nullptr ? "unknown --method " + options.method : error) << "\n";
+    return 2;
+  }
+  const std::optional<EffectModel> effects_to_fit = EffectsToFit(options, robot);
+  if (!effects_to_fit) return 2;
+  setup->effects_to_fit = *effects_to_fit;
+  if (!options.no_output && !options.force) {
+    const std::string refusal = OverwriteRefusal(options.out, robot.name);
+    if (!refusal.empty()) return Refuse(refusal);
+  }
+  return 0;
+}
+
+// The residuals fitted, how they were chosen, and the clock offsets fitted with them.
+void PrintResiduals(const FitMethodSettings& settings, bool residuals_auto,
+                    const std::vector<std::string>& residual_choice, const ModelFitResult& fit,
+                    const std::optional<TrackFitData>& track_data) {
+  std::printf("residuals: %s%s\n", ToString(settings.residuals),
+              residuals_auto ? " (--residuals auto)" : "");
+  for (const std::string& line : residual_choice) std::printf("%s\n", line.c_str());
+  if (track_data) PrintClockOffsets(fit, *track_data);
+}
+
+// What the fit could not determine and what looks wrong with it.
+void PrintUncertaintyAndWarnings(const FitCommandOptions& options,
+                                 const RobotModelInterface& model, const RunSplit& split,
+                                 const ModelFitResult& fit, const ResidualWeights& weights) {
+  if (!fit.has_covariance) std::printf("uncertainty: %s\n", fit.covariance_message.c_str());
+  PrintHeldDirections(model, fit, weights);
+  PrintFitWarnings(options, model, split, fit);
+}
+
 }  // namespace
 
 int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex& index,
                        const RobotModelPtr& model) {
   const auto t_total = std::chrono::steady_clock::now();
   const Robot& robot = model->robot();
-  // Validated by RunFitCommand: a known method, settings in range.
-  const FitMethod* method = FindFitMethod(options.method);
-  FitMethodSettings settings;
-  std::string error;
-  if (method == nullptr || !MakeFitMethodSettings(options, options.threads, &settings, &error)) {
-    std::cerr << "fitcal: " << (method == nullptr ? "unknown --method " + options.method : error)
-              << "\n";
-    return 2;
-  }
-  const std::optional<EffectModel> effects_to_fit = EffectsToFit(options, robot);
-  if (!effects_to_fit) return 2;
-  if (!options.no_output && !options.force) {
-    const std::string refusal = OverwriteRefusal(options.out, robot.name);
-    if (!refusal.empty()) {
-      return Refuse(refusal);
-    }
-  }
+  FitSetup setup;
+  if (const int refused = SetUpFit(options, robot, &setup); refused != 0) return refused;
+  const FitMethod* method = setup.method;
+  FitMethodSettings& settings = setup.settings;
+  const std::optional<EffectModel> effects_to_fit = setup.effects_to_fit;
   const io::Dataset dataset = LoadRuns(options, index, &robot);
   io::StopHereForTests("loaded");
   RunSplit split =
@@ -930,14 +944,9 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
 
   PrintFit(options, *model, split, candidates, gate, selected_fit, errors, *method, outcome,
            track_fits);
-  std::printf("residuals: %s%s\n", ToString(settings.residuals),
-              residuals_auto ? " (--residuals auto)" : "");
-  for (const std::string& line : residual_choice) std::printf("%s\n", line.c_str());
-  if (track_data) PrintClockOffsets(fit, *track_data);
+  PrintResiduals(settings, residuals_auto, residual_choice, fit, track_data);
   PrintEverydayDriving(*model, logs, split, candidates[0], selected, options.threads);
-  if (!fit.has_covariance) std::printf("uncertainty: %s\n", fit.covariance_message.c_str());
-  PrintHeldDirections(*model, fit, settings.weights);
-  PrintFitWarnings(options, *model, split, fit);
+  PrintUncertaintyAndWarnings(options, *model, split, fit, settings.weights);
   if (halves.judged) {  // the gate's table is on the training runs; the halves judge (below)
     gate.judged_on = "training runs (" + std::to_string(split.training.size()) +
                      "; no held-out runs: judged on held-out " +

@@ -48,12 +48,6 @@ io::Point2 InStartFrame(const Pose2d& start, double x, double y) {
   return VectorInStartFrame(start, x - start.x, y - start.y);
 }
 
-Omni3ParameterArray ArrayOf(const std::vector<double>& p) {
-  Omni3ParameterArray a{};
-  std::copy(p.begin(), p.begin() + omni3::kNumParameters, a.begin());
-  return a;
-}
-
 // The validation runs of one report, each replayed with the nominal and the calibrated model.
 struct EvaluatedRuns {
   TrainingSplit split;
@@ -100,13 +94,10 @@ EvaluatedRuns EvaluateRuns(const ReportInputs& in, const CalibrationInput& cal, 
   const std::vector<double>& nominal = in.model->robot().nominal;
   const std::vector<double>& p = cal.calibrated.nominal;
   const std::vector<effects::EffectValue>& effects = cal.calibrated.effects;
-  // omni3 keeps its own replay (Eq. 4 with M^-1), whose CF `fit` records; every other model
-  // replays through the seam.
   const auto evaluate = [&](const AlignedRun& run, const GroundTruthTrack& track,
                             const std::vector<double>& q,
                             const std::vector<effects::EffectValue>& with) {
-    return in.omni3 ? EvaluateTrajectory(run, track, ArrayOf(q), with, sampling)
-                    : EvaluateTrajectory(*in.model, run, track, q, with, sampling);
+    return EvaluateTrajectory(*in.model, run, track, q, with, sampling);
   };
   for (const AlignedRun& run : e.split.split.validation) {
     const GroundTruthTrack& track = logs_by_id.at(run.id)->ground_truth;
@@ -428,17 +419,11 @@ std::optional<CrossValidationResult> AddCrossValidation(const ReportBuildOptions
                                                         const ReportInputs& in,
                                                         io::ReportData* data) {
   if (!options.cross_validate) return std::nullopt;
-  // The refit `fitcal fit` makes for this model: the paper's for omni3, the seam's otherwise.
-  CrossValidationResult cv;
-  if (in.omni3) {
-    CeresFitOptions fit_options;
-    fit_options.num_threads = options.threads;
-    cv = LeaveOneRepetitionOut(AlignRuns(in.dataset.runs), in.omni3_robot, fit_options);
-  } else {
-    ModelFitOptions fit_options;
-    fit_options.ceres.num_threads = options.threads;
-    cv = LeaveOneRepetitionOut(AlignRuns(in.dataset.runs), *in.model, fit_options);
-  }
+  // The refit `fitcal fit` makes for this model (fit/model_fit.h).
+  ModelFitOptions fit_options;
+  fit_options.ceres.num_threads = options.threads;
+  const CrossValidationResult cv =
+      LeaveOneRepetitionOut(AlignRuns(in.dataset.runs), *in.model, fit_options);
   data->has_cv = true;
   data->cv_cf_after = StatsOf(cv.cf_validation_after);
   data->cv_cf_before = StatsOf(cv.cf_validation_before);

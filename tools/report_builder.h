@@ -37,8 +37,6 @@ struct ReportInputs {
   std::vector<std::string> inputs;  // files the output must not overwrite
   io::Dataset dataset;
   RobotModelPtr model;  // the data set's robot (nominal parameters, absolute bounds), any model
-  bool omni3 = false;
-  Omni3Robot omni3_robot;  // omni3 only: its identifiability analysis and cross-validation fit
   std::vector<CalibrationInput> calibrations;  // the first is the report's; others compared
 };
 

@@ -16,7 +16,6 @@
 #include "io/report_json.h"
 #include "io/report_markdown.h"
 #include "io/report_tum.h"
-#include "io/robot_yaml.h"
 #include "io/staged_directory.h"
 #include "models/model_registry.h"
 #include "odometry/effects.h"
@@ -42,10 +41,8 @@ ReportInputs LoadInputs(const ReportCommandOptions& options, std::string* refusa
   *refusal = OutputDirectoryRefusal(options.out, in.inputs, kReportFiles);
   if (!refusal->empty()) return in;
   in.model = ReadRobotModelFile(in.index.robot_path);
-  in.omni3 = in.model->robot().model == "omni3";
-  // omni3 data sets load as `fit` loads them (their runs' fingerprints must agree).
-  in.dataset = LoadRuns(options, in.index, in.omni3 ? nullptr : &in.model->robot());
-  if (in.omni3) in.omni3_robot = io::ReadOmni3Robot(in.dataset.robot_path);
+  // Loaded as `fit` loads them, with the robot's channels (their runs' fingerprints must agree).
+  in.dataset = LoadRuns(options, in.index, &in.model->robot());
   for (const std::string& path : options.calibrations) {
     Robot calibrated = ReadRobotModelFile(path)->robot();
     if (calibrated.model != in.model->robot().model ||

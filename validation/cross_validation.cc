@@ -4,9 +4,7 @@
 #include <set>
 #include <stdexcept>
 
-#include "fit/final_pose_cost.h"
 #include "fit/final_pose_errors.h"
-#include "models/omni3/omni3_robot_model.h"
 
 namespace fitcal {
 namespace {
@@ -79,30 +77,6 @@ CrossValidationResult LeaveOneRepetitionOut(const std::vector<AlignedRun>& runs,
       },
       [&](const std::vector<double>& p, const std::vector<AlignedRun>& on) {
         return EvaluateFinalPoseErrors(model, p, on, threads).cf;
-      });
-}
-
-CrossValidationResult LeaveOneRepetitionOut(const std::vector<AlignedRun>& runs,
-                                            const Omni3Robot& robot,
-                                            const CeresFitOptions& options) {
-  ModelFitOptions fold_options;
-  fold_options.ceres = options;
-  fold_options.ceres.compute_covariance = false;
-  const std::shared_ptr<const Omni3Model> model = Omni3ModelOf(robot);
-  const Omni3ParameterArray nominal = robot.nominal.ToArray();
-  const auto as_array = [](const std::vector<double>& p) {
-    Omni3ParameterArray a{};
-    std::copy(p.begin(), p.end(), a.begin());
-    return a;
-  };
-  return CrossValidate(
-      runs, std::vector<double>(nominal.begin(), nominal.end()),
-      [&](const std::vector<AlignedRun>& training) {
-        const ModelFitResult fit = FitModel(training, *model, fold_options);
-        return FoldFit{fit.usable, fit.termination, fit.parameters};
-      },
-      [&](const std::vector<double>& p, const std::vector<AlignedRun>& on) {
-        return EvaluateFinalPoseErrors(as_array(p), on, options.num_threads).cf;
       });
 }
 

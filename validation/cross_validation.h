@@ -5,8 +5,7 @@
 // repetitions it saw; the spread of the validation CF shows how well it generalises.
 //
 // Any model on the seam refits with the bounded final-pose fit (fit/model_fit.h, undetermined
-// directions held as `fitcal fit` holds them); the omni3 overload takes the omni3 loader's robot
-// and scores with omni3's own CF (fit/final_pose_cost.h).
+// directions held as `fitcal fit` holds them) and scores with the model's replay (Eq. 14).
 
 #include <string>
 #include <vector>
@@ -14,7 +13,6 @@
 #include "fit/model_fit.h"
 #include "models/model_interface.h"
 #include "odometry/aligned_run.h"
-#include "odometry/robot_description.h"
 #include "validation/trajectory_metrics.h"
 
 namespace fitcal {
@@ -40,12 +38,9 @@ struct CrossValidationResult {
   SummaryStatistics cf_validation_before;
 };
 
-// Both need runs of at least two repetitions and throw std::invalid_argument otherwise.
+// Needs runs of at least two repetitions and throws std::invalid_argument otherwise.
 CrossValidationResult LeaveOneRepetitionOut(const std::vector<AlignedRun>& runs,
                                             const RobotModelInterface& model,
                                             const ModelFitOptions& options = {});
-CrossValidationResult LeaveOneRepetitionOut(const std::vector<AlignedRun>& runs,
-                                            const Omni3Robot& robot,
-                                            const CeresFitOptions& options = {});
 
 }  // namespace fitcal

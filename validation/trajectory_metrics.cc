@@ -5,7 +5,6 @@
 #include <stdexcept>
 
 #include "fit/effect_fit.h"
-#include "odometry/omni3_replay.h"
 #include "odometry/parallel_for.h"
 
 namespace fitcal {
@@ -51,15 +50,6 @@ Pose2d CarryThroughAnchors(const AlignedRun& run,
   for (Pose2d& q : *poses) q = carried(q);
   return carried(final_pose);
 }
-
-}  // namespace
-
-TrajectoryErrors EvaluateTrajectory(const AlignedRun& run, const GroundTruthTrack& track,
-                                    const Omni3ParameterArray& p, OdometrySampling sampling) {
-  return EvaluateTrajectory(run, track, p, {}, sampling);
-}
-
-namespace {
 
 // The odometry at every encoder time of a run's window: times[0] = t_start with the start pose,
 // times[k + 1] after sample k. Heading stays unwrapped here; only errors are wrapped.
@@ -110,28 +100,6 @@ TrajectoryErrors ErrorsAlongTrack(const AlignedRun& run, const GroundTruthTrack&
                                   const ReplayedRun& replayed, OdometrySampling sampling);
 
 }  // namespace
-
-TrajectoryErrors EvaluateTrajectory(const AlignedRun& run, const GroundTruthTrack& track,
-                                    const Omni3ParameterArray& p,
-                                    const std::vector<effects::EffectValue>& effects,
-                                    OdometrySampling sampling) {
-  ReplayedRun r = PrepareReplay(run);
-  if (effects.empty()) {
-    r.poses[0] = run.start;
-    r.final_pose = omni3::ReplayWithMatrix(
-        omni3::InverseKinematicMatrix(p.data()), run.samples, 0, run.samples.size(), run.start,
-        [&r](std::size_t k, const Pose2d& pose) { r.poses[k + 1] = pose; });
-  } else {
-    const omni3::Matrix3<double> m_inv = omni3::InverseKinematicMatrix(p.data());
-    const auto step = [&m_inv](const double* w, double dt, double* dx, double* dy, double* dth) {
-      *dx = (m_inv(0, 0) * w[0] + m_inv(0, 1) * w[1] + m_inv(0, 2) * w[2]) * dt;
-      *dy = (m_inv(1, 0) * w[0] + m_inv(1, 1) * w[1] + m_inv(1, 2) * w[2]) * dt;
-      *dth = (m_inv(2, 0) * w[0] + m_inv(2, 1) * w[1] + m_inv(2, 2) * w[2]) * dt;
-    };
-    ReplayWithEffectList(step, run, track, effects, ~0u, &r);
-  }
-  return ErrorsAlongTrack(run, track, r, sampling);
-}
 
 TrajectoryErrors EvaluateTrajectory(const RobotModelInterface& model, const AlignedRun& run,
                                     const GroundTruthTrack& track, const std::vector<double>& p,

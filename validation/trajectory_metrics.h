@@ -18,7 +18,6 @@
 #include <string>
 #include <vector>
 
-#include "fit/final_pose_cost.h"
 #include "fit/final_pose_errors.h"
 #include "models/model_interface.h"
 #include "odometry/aligned_run.h"
@@ -52,34 +51,22 @@ struct TrajectoryErrors {
   double cf = 0.0;                       // Eq. 14 of this run (m and rad)
 };
 
-// `track` is the run's ground truth (RunLog::ground_truth); `run` its AlignRun(). Throws
-// std::invalid_argument if no ground-truth sample lies inside the window.
-TrajectoryErrors EvaluateTrajectory(const AlignedRun& run, const GroundTruthTrack& track,
-                                    const Omni3ParameterArray& p,
-                                    OdometrySampling sampling = OdometrySampling::kNearestTime);
-
-// The same for a model with effects (odometry/effects.h, as a calibrated robot YAML carries them
-// after `fitcal diagnose`), with the semantics of the effect fit (effect_fit.h): the replay
-// applies every effect, and a ground-truth latency tau makes the ground-truth sample stamped t
-// show the odometry at encoder time t - tau (the replay is carried through the anchor samples of
-// StartAnchorIndices, the final pose is compared with the ground truth at t_final + tau). With no
-// effects it equals the overload above.
-TrajectoryErrors EvaluateTrajectory(const AlignedRun& run, const GroundTruthTrack& track,
-                                    const Omni3ParameterArray& p,
-                                    const std::vector<effects::EffectValue>& effects,
-                                    OdometrySampling sampling = OdometrySampling::kNearestTime);
-
-// Any model through the seam (models/model_interface.h): the same metrics with the model's own
-// replay at parameters p (robot().parameters order), and its effects replayed through the model's
-// kinematics as the effect fit does (fit/effect_fit.h). For omni3 it equals the overloads
-// above to rounding.
+// Any model through the seam (models/model_interface.h), replayed with its own kinematics at
+// parameters p (robot().parameters order). `track` is the run's ground truth
+// (RunLog::ground_truth); `run` its AlignRun(). Throws std::invalid_argument if no ground-truth
+// sample lies inside the window.
+// With effects (odometry/effects.h, as a calibrated robot YAML carries them after `fitcal
+// diagnose`) the semantics are the effect fit's (fit/effect_fit.h): the replay applies every
+// effect, and a ground-truth latency tau makes the ground-truth sample stamped t show the odometry
+// at encoder time t - tau (the replay is carried through the anchor samples of
+// StartAnchorIndices, the final pose is compared with the ground truth at t_final + tau).
 TrajectoryErrors EvaluateTrajectory(const RobotModelInterface& model, const AlignedRun& run,
                                     const GroundTruthTrack& track, const std::vector<double>& p,
                                     const std::vector<effects::EffectValue>& effects,
                                     OdometrySampling sampling = OdometrySampling::kNearestTime);
 
 // The final-pose errors (fit/final_pose_errors.h: Eq. 14 and the mean position and |heading|
-// errors) of the model at p with `effects`, each run replayed by the overload above against its
+// errors) of the model at p with `effects`, each run replayed by EvaluateTrajectory against its
 // ground truth (tracks[i] is runs[i]'s), in parallel. Without effects it equals
 // EvaluateFinalPoseErrors, which needs no track.
 FinalPoseErrors EvaluateFinalPoseErrors(const RobotModelInterface& model,

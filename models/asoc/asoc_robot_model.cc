@@ -88,6 +88,11 @@ Robot AsocRobotDescription(const std::string& name,
   Robot robot;
   robot.model = "asoc";
   robot.name = name;
+  robot.read_own_encoder_file = [](const std::string& path, EncoderLog* log) {
+    if (!io::IsAsocEncoderCsv(path)) return false;
+    *log = io::AsocEncoderLogAsChannels(io::ReadAsocEncoderCsv(path));
+    return true;
+  };
   robot.channels.resize(asoc::kNumChannels);
   robot.parameters.resize(asoc::kNumParameters);
   for (int i = 0; i < asoc::kNumCastors; ++i) {

@@ -1,13 +1,13 @@
 #pragma once
 // An ASOC vehicle (Doebbler et al.: three active split offset castors) on the model seam: the
-// kinematics of asoc_kinematics.h, the robot YAML of io/asoc_files.h (`model: asoc`), the
+// kinematics of asoc_kinematics.h, the robot YAML of models/asoc/asoc_files.h (`model: asoc`), the
 // closed-form calibration of Eq. 1-9 (asoc_geometric.h) as a candidate of the result gate, and the
 // miswirings an ASOC base can have.
 //
 // Channels, castor by castor (castor names from the YAML): `<castor>_a`, `<castor>_b` (wheel
 // rates, CSV columns `w_<castor>_a` or `ticks_<castor>_a`), `pivot_<castor>` (pivot encoder angle,
 // rad, a reading per row). ASOC's own encoder files (cumulative wheel angles) are converted to
-// these on load (io/asoc_files.h AsocEncoderLogAsChannels).
+// these on load (models/asoc/asoc_files.h AsocEncoderLogAsChannels).
 // Parameters, castor by castor: r_c_<castor>, r_w1_<castor>, r_w2_<castor>, d_1_<castor>,
 // d_2_<castor>, beta_<castor> (asoc::Vehicle::ToArray order). The known pivot layout fixes the
 // body frame (asoc_kinematics.h); each castor's r_c and beta are held, since odometry sees a castor
@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "io/asoc_files.h"
+#include "models/asoc/asoc_files.h"
 #include "models/asoc/asoc_geometric.h"
 #include "models/asoc/asoc_kinematics.h"
 #include "models/kinematic_model.h"

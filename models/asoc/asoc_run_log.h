@@ -1,7 +1,7 @@
 #pragma once
 // The recorded data of one ASOC run (Doebbler Sec. III): cumulative wheel angles of the six
 // wheels and the absolute pivot encoder angles of the three castors, sampled together, plus the
-// ground truth. No file knowledge here (io/asoc_files.h fills these).
+// ground truth. No file knowledge here (models/asoc/asoc_files.h fills these).
 
 #include <optional>
 #include <string>

@@ -10,7 +10,7 @@
 #include <optional>
 #include <stdexcept>
 
-#include "io/asoc_files.h"
+#include "models/asoc/asoc_files.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/log_files.h"

@@ -1,4 +1,4 @@
-#include "io/asoc_files.h"
+#include "models/asoc/asoc_files.h"
 
 #include <yaml-cpp/yaml.h>
 
