@@ -3,7 +3,9 @@
 // list of body twists held for given durations; the simulator turns it into what a recorder
 // would log (encoder channels, ground truth) for a robot whose true parameters are known.
 //
-// The motion and noise model:
+// Two motion and noise models. With SimulationOptions::stepped, the flower's time-stepped physics
+// (SteppedOptions below: controller lag, slip, jittered encoders, irregular ground truth; the
+// shipped data/flower is made so, tools/sim/flower_scenario.h). Without it, perfect tracking:
 //
 // - Commanded twist. Segments follow each other with raised-cosine ramps of ramp_time_s centred
 //   on every segment boundary (also from rest into the first segment and back to rest after the
