@@ -335,9 +335,9 @@ std::string CheckSteppedOptions(const SteppedOptions& s, double encoder_period_s
   for (double e : s.wheel_eccentricity) {
     if (!(std::abs(e) < 0.5)) return "wheel_eccentricity must be in (-0.5, 0.5)";
   }
-  if (num_channels > effects::kMaxEffectChannels && !s.injected_effects.empty()) {
-    return "injected effects handle at most " + std::to_string(effects::kMaxEffectChannels) +
-           " channels";
+  if (num_channels > effects::kMaxEffectChannels && (!s.injected_effects.empty() || s.hook)) {
+    return "injected effects and the hook handle at most " +
+           std::to_string(effects::kMaxEffectChannels) + " channels";
   }
   return "";
 }
