@@ -25,8 +25,7 @@ std::vector<AlignedRun> Simulate(std::uint64_t seed, int repetitions) {
   sim::FlowerSimulation options = sim::PalacinFlower();  // documented default noise
   options.options.seed = seed;
   options.repetitions = repetitions;
-  std::vector<RunLog> logs;
-  for (auto& run : sim::SimulateFlower(options)) logs.push_back(std::move(run.log));
+  std::vector<RunLog> logs = sim::SimulateFlowerLogs(options);
   return AlignRuns(logs);
 }
 

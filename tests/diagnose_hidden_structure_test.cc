@@ -32,8 +32,7 @@ std::vector<sim::MotionCommand> FlowerSubset() {
 
 std::vector<RunLog> SimulateLogs(sim::FlowerSimulation o) {
   o.options.stepped->commanded_parameters = sim::ParameterVector(NominalRobot().nominal);
-  std::vector<RunLog> logs;
-  for (auto& run : sim::SimulateFlower(o)) logs.push_back(std::move(run.log));
+  std::vector<RunLog> logs = sim::SimulateFlowerLogs(o);
   return logs;
 }
 

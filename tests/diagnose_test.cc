@@ -32,8 +32,7 @@ struct Data {
 
 Data Simulate(sim::FlowerSimulation o) {
   o.options.stepped->commanded_parameters = sim::ParameterVector(NominalRobot().nominal);
-  std::vector<RunLog> logs;
-  for (auto& run : sim::SimulateFlower(o)) logs.push_back(std::move(run.log));
+  std::vector<RunLog> logs = sim::SimulateFlowerLogs(o);
   Data d;
   SplitTrackRuns(PrepareTrackRuns(logs), {1}, &d.training, &d.validation);
   return d;

@@ -33,8 +33,7 @@ DiagnoseResult DiagnoseEccentric(double eccentricity, std::uint64_t seed) {
   o.options.stepped->wheel_eccentricity = {eccentricity, 0.0, 0.0};
   const Omni3Robot robot = NominalRobot();
   o.options.stepped->commanded_parameters = sim::ParameterVector(robot.nominal);
-  std::vector<RunLog> logs;
-  for (auto& run : sim::SimulateFlower(o)) logs.push_back(std::move(run.log));
+  std::vector<RunLog> logs = sim::SimulateFlowerLogs(o);
   std::vector<TrackRun> training, validation;
   SplitTrackRuns(PrepareTrackRuns(logs), {1, 2}, &training, &validation);
   DiagnoseOptions options;

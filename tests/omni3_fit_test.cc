@@ -21,8 +21,7 @@ using testing::Omni3Errors;
 using ParameterArray = std::array<double, omni3::kNumParameters>;
 
 std::vector<AlignedRun> Simulate(const sim::FlowerSimulation& options) {
-  std::vector<RunLog> logs;
-  for (auto& run : sim::SimulateFlower(options)) logs.push_back(std::move(run.log));
+  std::vector<RunLog> logs = sim::SimulateFlowerLogs(options);
   return AlignRuns(logs);
 }
 
@@ -67,8 +66,7 @@ struct NoisyFit {
 NoisyFit FitDefaultNoise(std::uint64_t seed, bool swap_columns_a_b = false) {
   sim::FlowerSimulation options = sim::PalacinFlower();  // documented default noise, 10 repetitions
   options.options.seed = seed;
-  std::vector<RunLog> logs;
-  for (auto& run : sim::SimulateFlower(options)) logs.push_back(std::move(run.log));
+  std::vector<RunLog> logs = sim::SimulateFlowerLogs(options);
   if (swap_columns_a_b) {
     for (RunLog& log : logs) {
       for (auto&& s : log.encoders.samples) std::swap(s.value[0], s.value[1]);

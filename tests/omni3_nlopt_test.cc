@@ -22,8 +22,7 @@ using testing::FitOmni3Nlopt;
 using testing::Omni3Errors;
 
 std::vector<AlignedRun> Simulate(const sim::FlowerSimulation& options) {
-  std::vector<RunLog> logs;
-  for (auto& run : sim::SimulateFlower(options)) logs.push_back(std::move(run.log));
+  std::vector<RunLog> logs = sim::SimulateFlowerLogs(options);
   return AlignRuns(logs);
 }
 

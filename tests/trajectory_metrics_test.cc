@@ -120,8 +120,7 @@ TEST(TrajectoryMetricsTest, EffectsAreReplayedAsTheEffectFitScoresThem) {
   slip.id = effects::EffectId::kWheelSpeedSlip;
   slip.value[0] = effects::Info(slip.id).typical[0];
   options.options.stepped->injected_effects = {latency, slip};
-  std::vector<RunLog> logs;
-  for (auto& run : sim::SimulateFlower(options)) logs.push_back(std::move(run.log));
+  std::vector<RunLog> logs = sim::SimulateFlowerLogs(options);
   const std::vector<double> p = ParametersOf(sim::PalacinTable5Parameters());
   const EffectModel model = {latency, slip};
   const ModelScore scores = ScoreModel(DefaultOmni3Model(), p, model, PrepareTrackRuns(logs));
