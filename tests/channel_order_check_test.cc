@@ -15,17 +15,16 @@
 
 #include "models/omni3/omni3_robot_model.h"
 #include "tests/test_files.h"
-#include "tools/sim/omni3_simulator.h"
+#include "tools/sim/flower_scenario.h"
 
 namespace fitcal {
 namespace {
 
 std::vector<RunLog> SimulateLogs(std::uint64_t seed, int repetitions) {
-  sim::Omni3SimulationOptions options;
-  options.seed = seed;
+  sim::FlowerSimulation options = sim::PalacinFlower();
+  options.options.seed = seed;
   options.repetitions = repetitions;
-  std::vector<RunLog> logs;
-  for (auto& run : sim::SimulateOmni3(options)) logs.push_back(std::move(run.log));
+  std::vector<RunLog> logs = sim::SimulateFlowerLogs(options);
   return logs;
 }
 
@@ -106,8 +105,8 @@ struct CircleRuns {
   std::vector<const GroundTruthTrack*> tracks;
 };
 CircleRuns SimulateCircles(std::uint64_t seed) {
-  sim::Omni3SimulationOptions options;
-  options.seed = seed;
+  sim::FlowerSimulation options = sim::PalacinFlower();
+  options.options.seed = seed;
   options.repetitions = 1;
   options.trajectories.clear();
   const double speed = 0.3, omega = 0.5;
@@ -121,7 +120,7 @@ CircleRuns SimulateCircles(std::uint64_t seed) {
     options.trajectories.push_back(c);
   }
   CircleRuns out;
-  for (auto& run : sim::SimulateOmni3(options)) out.logs.push_back(std::move(run.log));
+  for (auto& run : sim::SimulateFlower(options)) out.logs.push_back(std::move(run.log));
   out.runs = AlignRuns(out.logs);
   for (const RunLog& log : out.logs) out.tracks.push_back(&log.ground_truth);
   return out;

@@ -13,7 +13,7 @@
 #include <cmath>
 
 #include "tests/omni3_fit_support.h"
-#include "tools/sim/omni3_simulator.h"
+#include "tools/sim/flower_scenario.h"
 
 namespace fitcal {
 namespace {
@@ -34,11 +34,11 @@ HonestyCount CountInside(int seeds) {
   const Omni3Robot robot = sim::PalacinApr02Robot();
   const auto truth = sim::PalacinTable5Parameters().ToArray();
   for (int seed = 1; seed <= seeds; ++seed) {
-    sim::Omni3SimulationOptions options;
-    options.seed = static_cast<std::uint64_t>(seed);
+    sim::FlowerSimulation options = sim::PalacinFlower();
+    options.options.seed = static_cast<std::uint64_t>(seed);
     options.repetitions = 1;  // one repetition of the whole flower (36 runs): STE-1
     std::vector<AlignedRun> runs;
-    for (const auto& run : sim::SimulateOmni3(options)) runs.push_back(AlignRun(run.log));
+    for (const auto& run : sim::SimulateFlower(options)) runs.push_back(AlignRun(run.log));
     CeresFitOptions fit_options;
     fit_options.num_threads = 1;
     const ModelFitResult fit = FitOmni3(runs, robot, fit_options);

@@ -12,7 +12,7 @@
 #include "fit/run_split.h"
 #include "odometry/omni3_replay.h"
 #include "tests/omni3_fit_support.h"
-#include "tools/sim/omni3_simulator.h"
+#include "tools/sim/flower_scenario.h"
 
 namespace fitcal {
 namespace {
@@ -22,11 +22,10 @@ using testing::FitOmni3Nlopt;
 using testing::Omni3Errors;
 
 std::vector<AlignedRun> Simulate(std::uint64_t seed, int repetitions) {
-  sim::Omni3SimulationOptions options;  // documented default noise
-  options.seed = seed;
+  sim::FlowerSimulation options = sim::PalacinFlower();  // documented default noise
+  options.options.seed = seed;
   options.repetitions = repetitions;
-  std::vector<RunLog> logs;
-  for (auto& run : sim::SimulateOmni3(options)) logs.push_back(std::move(run.log));
+  std::vector<RunLog> logs = sim::SimulateFlowerLogs(options);
   return AlignRuns(logs);
 }
 

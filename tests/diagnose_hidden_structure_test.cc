@@ -13,7 +13,7 @@
 #include "fit/segment_cost.h"
 #include "io/robot_yaml.h"
 #include "models/omni3/omni3_robot_model.h"
-#include "tools/sim/omni3_simulator.h"
+#include "tools/sim/flower_scenario.h"
 
 namespace fitcal {
 namespace {
@@ -30,10 +30,9 @@ std::vector<sim::MotionCommand> FlowerSubset() {
   return out;
 }
 
-std::vector<RunLog> SimulateLogs(sim::Omni3SimulationOptions o) {
-  o.commanded_robot = NominalRobot().nominal;
-  std::vector<RunLog> logs;
-  for (auto& run : sim::SimulateOmni3(o)) logs.push_back(std::move(run.log));
+std::vector<RunLog> SimulateLogs(sim::FlowerSimulation o) {
+  o.options.stepped->commanded_parameters = sim::ParameterVector(NominalRobot().nominal);
+  std::vector<RunLog> logs = sim::SimulateFlowerLogs(o);
   return logs;
 }
 
@@ -72,14 +71,14 @@ TEST(HiddenStructure, LatencyIsRecoveredWhetherTheLogStartsAtRestOrMoving) {
   };
   for (const Case& c : {Case{"at rest", 0.5, -1.0}, Case{"starting to move", 0.0, -1.0},
                         Case{"moving", 0.0, 1.0}}) {
-    sim::Omni3SimulationOptions o;  // the 36 flower trajectories
+    sim::FlowerSimulation o = sim::PalacinFlower();  // the 36 flower trajectories
     o.repetitions = 2;
-    o.seed = 16;
-    o.rest_before_s = c.rest_before_s;
+    o.options.seed = 16;
+    o.options.rest_before_s = c.rest_before_s;
     effects::EffectValue latency;
     latency.id = effects::EffectId::kTimeOffset;
     latency.value[0] = kLatencyS;
-    o.injected_effects = {latency};
+    o.options.stepped->injected_effects = {latency};
     std::vector<RunLog> logs = SimulateLogs(o);
     if (c.cut_s > 0.0) {
       for (RunLog& log : logs) log = CutStart(log, c.cut_s);
@@ -107,10 +106,10 @@ TEST(HiddenStructure, LatencyIsRecoveredWhetherTheLogStartsAtRestOrMoving) {
 // the chosen clocks vs the original ones, paired over the held-out runs: the mean change must be
 // below two of its standard errors.
 TEST(HiddenStructure, ClockMapKeepsTheIdentityOnCorrectlyClockedData) {
-  sim::Omni3SimulationOptions o;
+  sim::FlowerSimulation o = sim::PalacinFlower();
   o.trajectories = FlowerSubset();
   o.repetitions = 2;
-  o.seed = 29;
+  o.options.seed = 29;
   const std::vector<RunLog> logs = SimulateLogs(o);
   const Omni3Robot robot = NominalRobot();
   const auto model = Omni3ModelOf(robot);
@@ -161,14 +160,13 @@ struct HiddenData {
 // Four repetitions of FlowerSubset(), simulated one at a time (all trajectories of repetition r
 // recorded before those of r + 1) with `configure` applied to repetition r's options; two train.
 HiddenData SimulateRepetitions(
-    std::uint64_t seed,
-    const std::function<void(int rep, sim::Omni3SimulationOptions*)>& configure) {
+    std::uint64_t seed, const std::function<void(int rep, sim::FlowerSimulation*)>& configure) {
   std::vector<RunLog> logs;
   for (int rep = 1; rep <= 4; ++rep) {
-    sim::Omni3SimulationOptions o;
+    sim::FlowerSimulation o = sim::PalacinFlower();
     o.trajectories = FlowerSubset();
     o.repetitions = 1;
-    o.seed = seed * 100 + static_cast<std::uint64_t>(rep);
+    o.options.seed = seed * 100 + static_cast<std::uint64_t>(rep);
     configure(rep, &o);
     for (RunLog& log : SimulateLogs(o)) {
       log.repetition = rep;
@@ -184,9 +182,10 @@ HiddenData SimulateRepetitions(
 // Wear over a session: the wheel radii shrink by kWearPerRepetition with every repetition.
 HiddenData SimulateWear(std::uint64_t seed) {
   constexpr double kWearPerRepetition = 0.004;
-  return SimulateRepetitions(seed, [](int rep, sim::Omni3SimulationOptions* o) {
+  return SimulateRepetitions(seed, [](int rep, sim::FlowerSimulation* o) {
     const double scale = 1.0 - kWearPerRepetition * (rep - 1);
-    for (double& r : o->true_robot.radius_m) r *= scale;
+    for (int i = 0; i < omni3::kNumWheels; ++i)
+      o->true_parameters[omni3::kRadiusIndex + i] *= scale;
   });
 }
 
@@ -195,17 +194,16 @@ HiddenData SimulateWear(std::uint64_t seed) {
 // at another heading, so repetitions of a trajectory travel in different world directions.
 HiddenData SimulateCarpet(std::uint64_t seed) {
   constexpr double kPile = 0.02;
-  sim::Omni3SimulationOptions o;
+  sim::FlowerSimulation o = sim::PalacinFlower();
   o.trajectories = FlowerSubset();
   o.repetitions = 4;
-  o.seed = seed;
-  o.injection_hook = [](const sim::Omni3SimulationOptions::InjectionState& s, Eigen::Vector3d*,
-                        Eigen::Vector3d* v_body, Eigen::Vector2d*) {
-    const double speed = std::hypot((*v_body)[0], (*v_body)[1]);
+  o.options.seed = seed;
+  o.options.stepped->hook = [](const sim::SteppedState& s, double*, Twist* v, double*) {
+    const double speed = std::hypot(v->vx_m_s, v->vy_m_s);
     if (speed < 1e-6) return;
-    const double psi = s.pose.theta + std::atan2((*v_body)[1], (*v_body)[0]);
-    (*v_body)[0] *= 1.0 + kPile * std::cos(psi);
-    (*v_body)[1] *= 1.0 + kPile * std::cos(psi);
+    const double psi = s.pose.theta + std::atan2(v->vy_m_s, v->vx_m_s);
+    v->vx_m_s *= 1.0 + kPile * std::cos(psi);
+    v->vy_m_s *= 1.0 + kPile * std::cos(psi);
   };
   HiddenData d;
   SplitTrackRuns(PrepareTrackRuns(SimulateLogs(o)), {1, 2}, &d.training, &d.validation);
@@ -223,14 +221,14 @@ TEST(HiddenStructure, WithoutRepetitionsTheSensorFloorSeesAnUndeclaredEffect) {
   const auto model = Omni3ModelOf(robot);
   for (const bool inject : {false, true}) {
     SCOPED_TRACE(inject ? "wheel_speed_slip injected" : "clean");
-    sim::Omni3SimulationOptions o;
+    sim::FlowerSimulation o = sim::PalacinFlower();
     o.repetitions = 1;
-    o.seed = 4;
+    o.options.seed = 4;
     if (inject) {
       effects::EffectValue slip;
       slip.id = effects::EffectId::kWheelSpeedSlip;
       slip.value[0] = 0.01;
-      o.injected_effects.push_back(slip);
+      o.options.stepped->injected_effects.push_back(slip);
     }
     const std::vector<RunLog> logs = SimulateLogs(o);
     const ModelFitResult declared = FitModel(AlignRuns(logs), *model);
@@ -262,10 +260,10 @@ constexpr double kRepetitionFactors[4] = {1.03, 0.9, 1.1, 0.96};
 // `hook` as the effect nobody declared.
 HiddenData SimulateVaried(std::uint64_t seed,
                           const std::function<void(double factor, sim::MotionCommand*)>& vary,
-                          const decltype(sim::Omni3SimulationOptions::injection_hook)& hook) {
-  return SimulateRepetitions(seed, [&](int rep, sim::Omni3SimulationOptions* o) {
+                          const sim::SteppedHook& hook) {
+  return SimulateRepetitions(seed, [&](int rep, sim::FlowerSimulation* o) {
     for (sim::MotionCommand& m : o->trajectories) vary(kRepetitionFactors[rep - 1], &m);
-    o->injection_hook = hook;
+    o->options.stepped->hook = hook;
   });
 }
 
@@ -276,9 +274,8 @@ HiddenData SimulateSpeedSkid(std::uint64_t seed) {
   constexpr double kSkidSPerM = 0.3;
   return SimulateVaried(
       seed, [](double f, sim::MotionCommand* m) { m->speed_m_s *= f; },
-      [](const sim::Omni3SimulationOptions::InjectionState&, Eigen::Vector3d*,
-         Eigen::Vector3d* v_body, Eigen::Vector2d*) {
-        (*v_body)[1] += kSkidSPerM * ((*v_body)[0] * (*v_body)[0] + (*v_body)[1] * (*v_body)[1]);
+      [](const sim::SteppedState&, double*, Twist* v, double*) {
+        v->vy_m_s += kSkidSPerM * (v->vx_m_s * v->vx_m_s + v->vy_m_s * v->vy_m_s);
       });
 }
 
@@ -289,11 +286,10 @@ HiddenData SimulateDistanceDrift(std::uint64_t seed) {
   constexpr double kGainRadPerSM = 0.08;
   return SimulateVaried(
       seed, [](double f, sim::MotionCommand* m) { m->distance_m *= f; },
-      [](const sim::Omni3SimulationOptions::InjectionState& s, Eigen::Vector3d*,
-         Eigen::Vector3d* v_body, Eigen::Vector2d*) {
+      [](const sim::SteppedState& s, double*, Twist* v, double*) {
         if (s.time_since_motion_s <= 0.0) return;
-        const double speed = std::hypot((*v_body)[0], (*v_body)[1]);
-        (*v_body)[2] += kGainRadPerSM * speed * s.time_since_motion_s;
+        const double speed = std::hypot(v->vx_m_s, v->vy_m_s);
+        v->omega_rad_s += kGainRadPerSM * speed * s.time_since_motion_s;
       });
 }
 

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -13,7 +14,7 @@
 #include "io/robot_yaml.h"
 #include "models/model_registry.h"
 #include "models/omni3/omni3_robot_model.h"
-#include "tools/sim/omni3_simulator.h"
+#include "tools/sim/flower_scenario.h"
 
 namespace fitcal {
 namespace {
@@ -25,20 +26,13 @@ Omni3Robot NominalRobot() {
 // The nominal robot on the model seam, which Diagnose works through.
 std::shared_ptr<const Omni3Model> NominalModel() { return Omni3ModelOf(NominalRobot()); }
 
-// The simulator's true parameters in the model's order (Eq. 15).
-std::vector<double> ParametersOf(const omni3::Parameters& p) {
-  const auto a = p.ToArray();
-  return {a.begin(), a.end()};
-}
-
 struct Data {
   std::vector<TrackRun> training, validation;
 };
 
-Data Simulate(sim::Omni3SimulationOptions o) {
-  o.commanded_robot = NominalRobot().nominal;
-  std::vector<RunLog> logs;
-  for (auto& run : sim::SimulateOmni3(o)) logs.push_back(std::move(run.log));
+Data Simulate(sim::FlowerSimulation o) {
+  o.options.stepped->commanded_parameters = sim::ParameterVector(NominalRobot().nominal);
+  std::vector<RunLog> logs = sim::SimulateFlowerLogs(o);
   Data d;
   SplitTrackRuns(PrepareTrackRuns(logs), {1}, &d.training, &d.validation);
   return d;
@@ -70,13 +64,13 @@ class LibraryEffectTest : public ::testing::TestWithParam<effects::EffectId> {};
 
 TEST_P(LibraryEffectTest, DiagnosePicksRecoversAndMatchesTrueModel) {
   const effects::EffectInfo& info = effects::Info(GetParam());
-  sim::Omni3SimulationOptions o;
+  sim::FlowerSimulation o = sim::PalacinFlower();
   o.repetitions = 2;
-  o.seed = 11;
+  o.options.seed = 11;
   effects::EffectValue truth;
   truth.id = info.id;
   truth.value = info.typical;
-  o.injected_effects = {truth};
+  o.options.stepped->injected_effects = {truth};
   const Data d = Simulate(o);
   const auto model = NominalModel();
   const DiagnoseResult r = Diagnose(d.training, d.validation, *model);
@@ -94,7 +88,7 @@ TEST_P(LibraryEffectTest, DiagnosePicksRecoversAndMatchesTrueModel) {
     EXPECT_NEAR(got.value[k], info.typical[k], tol) << info.parameter_names[k];
   }
   const ModelScore true_model =
-      ScoreModel(DefaultOmni3Model(), ParametersOf(o.true_robot), {truth}, d.validation);
+      ScoreModel(DefaultOmni3Model(), o.true_parameters, {truth}, d.validation);
   std::printf(
       "%s: true %g, fitted %g +- %g; validation CF declared %.5f, with effect %.5f, true model "
       "%.5f\n",
@@ -148,16 +142,16 @@ class TransientEffectTest : public ::testing::TestWithParam<effects::EffectId> {
 
 TEST_P(TransientEffectTest, IsNamedAndRecoveredWithinFourSigmas) {
   const effects::EffectInfo& info = effects::Info(GetParam());
-  sim::Omni3SimulationOptions o;
+  sim::FlowerSimulation o = sim::PalacinFlower();
   o.repetitions = 4;
-  o.seed = 3;
+  o.options.seed = 3;
   effects::EffectValue truth;
   truth.id = info.id;
   truth.value = info.typical;
-  o.injected_effects = {truth};
+  o.options.stepped->injected_effects = {truth};
   std::vector<RunLog> logs;
-  o.commanded_robot = NominalRobot().nominal;
-  for (auto& run : sim::SimulateOmni3(o)) logs.push_back(std::move(run.log));
+  o.options.stepped->commanded_parameters = sim::ParameterVector(NominalRobot().nominal);
+  for (auto& run : sim::SimulateFlower(o)) logs.push_back(std::move(run.log));
   Data d;
   SplitTrackRuns(PrepareTrackRuns(logs), {1, 2}, &d.training, &d.validation);
   const auto model = NominalModel();
@@ -172,7 +166,7 @@ TEST_P(TransientEffectTest, IsNamedAndRecoveredWithinFourSigmas) {
   EXPECT_GT(got.sigma[0], 0.0);
   EXPECT_LT(std::abs(got.value[0] - info.typical[0]), 4.0 * got.sigma[0]);
   const ModelScore true_model =
-      ScoreModel(DefaultOmni3Model(), ParametersOf(o.true_robot), {truth}, d.validation);
+      ScoreModel(DefaultOmni3Model(), o.true_parameters, {truth}, d.validation);
   std::printf("%s: injected %g, fitted %g +- %g; validation CF %.5f (true model %.5f)\n", info.name,
               info.typical[0], got.value[0], got.sigma[0], r.final_validation.cf, true_model.cf);
   EXPECT_LE(r.final_validation.cf, 1.15 * true_model.cf);
@@ -198,11 +192,12 @@ TEST(Diagnose, CleanDataAcceptsNoEffectOverTwentySeeds) {
   int structure_false_positives = 0;  // lack of fit or a covariate
   constexpr int kSeeds = 20;
   for (int seed = 1; seed <= kSeeds; ++seed) {
-    sim::Omni3SimulationOptions o;
+    sim::FlowerSimulation o = sim::PalacinFlower();
     o.repetitions = 2;
-    o.seed = static_cast<std::uint64_t>(seed) * 7919;
+    o.options.seed = static_cast<std::uint64_t>(seed) * 7919;
     o.trajectories = subset;
-    o.random_wheel_start_angle = true;  // every covariate tested, the absolute wheel angle too
+    o.options.stepped->random_wheel_start_angle =
+        true;  // every covariate tested, the absolute wheel angle too
     const Data d = Simulate(o);
     DiagnoseOptions options;
     options.max_effects = 1;  // the first acceptance is the false positive
@@ -236,9 +231,9 @@ TEST(Diagnose, CleanDataAcceptsNoEffectOverTwentySeeds) {
 // strongly correlated; weighing each by its own variance alone read this data set as structure
 // (F = 1.39 on (423, 3888) df, p = 8e-7). With the pooled covariance: F = 1.15, p = 0.1.
 TEST(Diagnose, LackOfFitIsCalibratedOnCleanDataWithManyRepetitions) {
-  sim::Omni3SimulationOptions o;
+  sim::FlowerSimulation o = sim::PalacinFlower();
   o.repetitions = 10;
-  o.seed = 1;
+  o.options.seed = 1;
   const Data d = Simulate(o);
   DiagnoseOptions options;
   options.max_effects = 0;  // the residual of the nine parameters alone
@@ -252,13 +247,13 @@ TEST(Diagnose, LackOfFitIsCalibratedOnCleanDataWithManyRepetitions) {
 // taken from a ground-truth sample that shows the robot at rest, interpolating the ground truth
 // at t_start + latency blended the rest pose with a moving one and left structure).
 TEST(Diagnose, LatencyIsNamedWithManyRepetitions) {
-  sim::Omni3SimulationOptions o;
+  sim::FlowerSimulation o = sim::PalacinFlower();
   o.repetitions = 6;
-  o.seed = 1;
+  o.options.seed = 1;
   effects::EffectValue latency;
   latency.id = effects::EffectId::kTimeOffset;
   latency.value[0] = 0.08;
-  o.injected_effects = {latency};
+  o.options.stepped->injected_effects = {latency};
   const Data d = Simulate(o);
   const DiagnoseResult r = Diagnose(d.training, d.validation, *NominalModel());
   ASSERT_EQ(r.final_fit.effects.size(), 1u);
@@ -272,14 +267,15 @@ TEST(Diagnose, LatencyIsNamedWithManyRepetitions) {
 // started (omega += k t, e.g. a castor or a roller warming up). No candidate has this shape; the
 // tracing must report unexplained structure rather than name the nearest candidate.
 TEST(Diagnose, EffectOutsideLibraryIsReportedAsUnexplainedStructure) {
-  sim::Omni3SimulationOptions o;
+  sim::FlowerSimulation o = sim::PalacinFlower();
   o.repetitions = 2;
-  o.seed = 5;
+  o.options.seed = 5;
   constexpr double kDriftRadS2 = 0.006;
-  o.injection_hook = [](const sim::Omni3SimulationOptions::InjectionState& s, Eigen::Vector3d*,
-                        Eigen::Vector3d* v_body, Eigen::Vector2d*) {
-    if (s.time_since_motion_s >= 0.0 && s.wheel_rate.cwiseAbs().maxCoeff() > 0.05) {
-      (*v_body)[2] += kDriftRadS2 * s.time_since_motion_s;
+  o.options.stepped->hook = [](const sim::SteppedState& s, double*, Twist* v, double*) {
+    const double* w = s.channel_value;
+    if (s.time_since_motion_s >= 0.0 &&
+        std::max({std::abs(w[0]), std::abs(w[1]), std::abs(w[2])}) > 0.05) {
+      v->omega_rad_s += kDriftRadS2 * s.time_since_motion_s;
     }
   };
   const Data d = Simulate(o);
@@ -296,13 +292,13 @@ TEST(Diagnose, EffectOutsideLibraryIsReportedAsUnexplainedStructure) {
 // tracing must say it is not identifiable, accept nothing, and the declared fit must already be
 // as good as the true model.
 TEST(Diagnose, ClockScaleIsReportedNotIdentifiable) {
-  sim::Omni3SimulationOptions o;
+  sim::FlowerSimulation o = sim::PalacinFlower();
   o.repetitions = 2;
-  o.seed = 9;
+  o.options.seed = 9;
   effects::EffectValue truth;
   truth.id = effects::EffectId::kEncoderClockScale;
   truth.value = effects::Info(truth.id).typical;
-  o.injected_effects = {truth};
+  o.options.stepped->injected_effects = {truth};
   const Data d = Simulate(o);
   const auto model = NominalModel();
   const DiagnoseResult r = Diagnose(d.training, d.validation, *model);
@@ -313,11 +309,11 @@ TEST(Diagnose, ClockScaleIsReportedNotIdentifiable) {
   // The numerical check agrees with the registry: nothing of its column is separable.
   EXPECT_LT(SeparableFraction(d.training, *model, r.base.parameters, {}, truth.id), 1e-6);
   const ModelScore true_model =
-      ScoreModel(DefaultOmni3Model(), ParametersOf(o.true_robot), {truth}, d.validation);
+      ScoreModel(DefaultOmni3Model(), o.true_parameters, {truth}, d.validation);
   EXPECT_LE(r.declared_validation.cf, 1.15 * true_model.cf);
   // The radii absorb the scale: r_i(fitted) ~ r_i(true) (1 + s).
   for (int i = 0; i < 3; ++i) {
-    const double expected = o.true_robot.radius_m[i] * (1.0 + truth.value[0]);
+    const double expected = sim::PalacinTable5Parameters().radius_m[i] * (1.0 + truth.value[0]);
     EXPECT_NEAR(r.declared.parameters[omni3::kRadiusIndex + i], expected, 0.003 * expected);
   }
 }
@@ -327,9 +323,9 @@ TEST(Diagnose, ClockScaleIsReportedNotIdentifiable) {
 // the runs that would separate it, rather than fit it.
 TEST(Diagnose, SaysWhichRunsWouldSeparateAnUnidentifiableCandidate) {
   const auto flower = sim::FlowerTrajectories();
-  sim::Omni3SimulationOptions o;
+  sim::FlowerSimulation o = sim::PalacinFlower();
   o.repetitions = 2;
-  o.seed = 21;
+  o.options.seed = 21;
   o.trajectories.assign(flower.begin(), flower.begin() + 12);  // R1..R12
   const Data d = Simulate(o);
   DiagnoseOptions options;
@@ -350,15 +346,15 @@ TEST(Diagnose, SaysWhichRunsWouldSeparateAnUnidentifiableCandidate) {
 // influence that the nine parameters cannot mimic must grow clearly (measured: printed).
 TEST(Diagnose, SecondSpeedFlowerSeparatesSpeedSlip) {
   const auto unexplained = [](std::vector<sim::MotionCommand> trajectories, int repetitions) {
-    sim::Omni3SimulationOptions o;
+    sim::FlowerSimulation o = sim::PalacinFlower();
     o.repetitions = repetitions;
-    o.seed = 4;
+    o.options.seed = 4;
     o.trajectories = std::move(trajectories);
     const Data d = Simulate(o);
     std::vector<TrackRun> all = d.training;
     all.insert(all.end(), d.validation.begin(), d.validation.end());
     double norm = 0.0;
-    SeparableFraction(all, DefaultOmni3Model(), ParametersOf(o.true_robot), {},
+    SeparableFraction(all, DefaultOmni3Model(), o.true_parameters, {},
                       effects::EffectId::kWheelSpeedSlip, {}, &norm);
     return norm;
   };

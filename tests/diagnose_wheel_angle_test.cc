@@ -11,7 +11,7 @@
 #include "diagnosis/diagnose.h"
 #include "io/robot_yaml.h"
 #include "models/omni3/omni3_robot_model.h"
-#include "tools/sim/omni3_simulator.h"
+#include "tools/sim/flower_scenario.h"
 
 namespace fitcal {
 namespace {
@@ -23,18 +23,17 @@ Omni3Robot NominalRobot() {
 // Every third flower trajectory (12 of 36), four repetitions (1-2 train, 3-4 validate), each run
 // at random absolute wheel angles; wheel a's rolling radius r_a (1 + e cos A_a).
 DiagnoseResult DiagnoseEccentric(double eccentricity, std::uint64_t seed) {
-  sim::Omni3SimulationOptions o;
+  sim::FlowerSimulation o = sim::PalacinFlower();
   const auto flower = sim::FlowerTrajectories();
   o.trajectories.clear();
   for (std::size_t i = 0; i < flower.size(); i += 3) o.trajectories.push_back(flower[i]);
   o.repetitions = 4;
-  o.seed = seed;
-  o.random_wheel_start_angle = true;
-  o.wheel_eccentricity = {eccentricity, 0.0, 0.0};
+  o.options.seed = seed;
+  o.options.stepped->random_wheel_start_angle = true;
+  o.options.stepped->wheel_eccentricity = {eccentricity, 0.0, 0.0};
   const Omni3Robot robot = NominalRobot();
-  o.commanded_robot = robot.nominal;
-  std::vector<RunLog> logs;
-  for (auto& run : sim::SimulateOmni3(o)) logs.push_back(std::move(run.log));
+  o.options.stepped->commanded_parameters = sim::ParameterVector(robot.nominal);
+  std::vector<RunLog> logs = sim::SimulateFlowerLogs(o);
   std::vector<TrackRun> training, validation;
   SplitTrackRuns(PrepareTrackRuns(logs), {1, 2}, &training, &validation);
   DiagnoseOptions options;

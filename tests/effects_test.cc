@@ -15,7 +15,7 @@
 #include "io/robot_yaml.h"
 #include "models/omni3/omni3_kinematics.h"
 #include "odometry/omni3_replay.h"
-#include "tools/sim/omni3_simulator.h"
+#include "tools/sim/flower_scenario.h"
 #include "validation/statistics.h"
 
 namespace fitcal {

@@ -14,7 +14,7 @@
 
 #include "models/model_registry.h"
 #include "models/omni3/omni3_robot_model.h"
-#include "tools/sim/omni3_simulator.h"
+#include "tools/sim/flower_scenario.h"
 
 namespace fitcal {
 namespace {
@@ -115,9 +115,9 @@ bounds:
 }
 
 TEST(LinearFinalPoseKernel, EqualsTheReplayOnFlowerRunsOverTheParameterBox) {
-  sim::Omni3SimulationOptions options;
+  sim::FlowerSimulation options = sim::PalacinFlower();
   options.repetitions = 1;
-  const std::vector<sim::SimulatedRun> runs = sim::SimulateOmni3(options);
+  const std::vector<sim::ModelSimulatedRun> runs = sim::SimulateFlower(options);
   const Omni3Model& model = DefaultOmni3Model();
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> distance(0.170, 0.220), radius(0.138, 0.158),
@@ -131,7 +131,7 @@ TEST(LinearFinalPoseKernel, EqualsTheReplayOnFlowerRunsOverTheParameterBox) {
       p[6 + i] += angle(rng);
     }
     const std::vector<double> m = StepMatrixOf(model, p.data());
-    for (const sim::SimulatedRun& run : runs) {
+    for (const sim::ModelSimulatedRun& run : runs) {
       const EncoderSamples& log = run.log.encoders.samples;
       const Pose2d start{0.0, 0.0, 0.3};
       ExpectSamePose(LinearFinalPoseKernel(log).FinalPose(m.data(), start),

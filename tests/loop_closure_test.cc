@@ -11,7 +11,7 @@
 #include "odometry/effects.h"
 #include "models/omni3/omni3_kinematics.h"
 #include "odometry/omni3_replay.h"
-#include "tools/sim/omni3_simulator.h"
+#include "tools/sim/flower_scenario.h"
 
 namespace fitcal {
 namespace {

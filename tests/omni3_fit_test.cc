@@ -1,5 +1,5 @@
 // End-to-end recovery of known parameters by the Ceres fit (fit/model_fit.h) on data from
-// the simulator (tools/sim/omni3_simulator.h), with tolerances derived from the noise.
+// the flower simulation (tools/sim/flower_scenario.h), with tolerances derived from the noise.
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 #include "fit/run_split.h"
 #include "odometry/omni3_replay.h"
 #include "tests/omni3_fit_support.h"
-#include "tools/sim/omni3_simulator.h"
+#include "tools/sim/flower_scenario.h"
 
 namespace fitcal {
 namespace {
@@ -20,15 +20,14 @@ using testing::Omni3Errors;
 
 using ParameterArray = std::array<double, omni3::kNumParameters>;
 
-std::vector<AlignedRun> Simulate(const sim::Omni3SimulationOptions& options) {
-  std::vector<RunLog> logs;
-  for (auto& run : sim::SimulateOmni3(options)) logs.push_back(std::move(run.log));
+std::vector<AlignedRun> Simulate(const sim::FlowerSimulation& options) {
+  std::vector<RunLog> logs = sim::SimulateFlowerLogs(options);
   return AlignRuns(logs);
 }
 
-sim::Omni3SimulationOptions NoiseFree(double encoder_period_s) {
-  sim::Omni3SimulationOptions options = sim::NoiseFreeSimulationOptions();
-  options.encoder_period_s = encoder_period_s;
+sim::FlowerSimulation NoiseFree(double encoder_period_s) {
+  sim::FlowerSimulation options = sim::NoiseFreePalacinFlower();
+  options.options.encoder_period_s = encoder_period_s;
   return options;
 }
 
@@ -41,8 +40,7 @@ TEST(Omni3Fit, NoiseFreeDataLeaveOnlyTheDiscretisationOfEq4) {
   double shift_R[2] = {0.0, 0.0};
   const double periods[2] = {0.010, 0.005};
   for (int i = 0; i < 2; ++i) {
-    const ModelFitResult fit =
-        FitOmni3(Simulate(NoiseFree(periods[i])), sim::PalacinApr02Robot());
+    const ModelFitResult fit = FitOmni3(Simulate(NoiseFree(periods[i])), sim::PalacinApr02Robot());
     ASSERT_TRUE(fit.usable) << fit.termination << " " << fit.message;
     for (int w = 0; w < 3; ++w) {
       shift_R[i] +=
@@ -66,10 +64,9 @@ struct NoisyFit {
 };
 
 NoisyFit FitDefaultNoise(std::uint64_t seed, bool swap_columns_a_b = false) {
-  sim::Omni3SimulationOptions options;  // documented default noise, 10 repetitions
-  options.seed = seed;
-  std::vector<RunLog> logs;
-  for (auto& run : sim::SimulateOmni3(options)) logs.push_back(std::move(run.log));
+  sim::FlowerSimulation options = sim::PalacinFlower();  // documented default noise, 10 repetitions
+  options.options.seed = seed;
+  std::vector<RunLog> logs = sim::SimulateFlowerLogs(options);
   if (swap_columns_a_b) {
     for (RunLog& log : logs) {
       for (auto&& s : log.encoders.samples) std::swap(s.value[0], s.value[1]);
@@ -131,7 +128,7 @@ TEST(Omni3Fit, SwappedEncoderColumnsAreNotMistakenForTheTruth) {
 
 TEST(Omni3Fit, CfIsTheMeanOfPerRunNorms) {
   // Eq. 14 reported as defined: mean over runs of sqrt(dx^2 + dy^2 + dtheta^2).
-  sim::Omni3SimulationOptions options;
+  sim::FlowerSimulation options = sim::PalacinFlower();
   options.repetitions = 1;
   const std::vector<AlignedRun> runs = Simulate(options);
   const ParameterArray nominal = sim::PalacinNominalParameters().ToArray();

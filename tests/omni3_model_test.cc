@@ -13,7 +13,7 @@
 
 #include "odometry/pose2.h"
 #include "tools/sim/flower_trajectories.h"
-#include "tools/sim/omni3_simulator.h"
+#include "tools/sim/flower_scenario.h"
 
 namespace fitcal::omni3 {
 namespace {

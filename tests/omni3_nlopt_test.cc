@@ -11,7 +11,7 @@
 #include "fit/final_pose_errors.h"
 #include "fit/strategies.h"
 #include "tests/omni3_fit_support.h"
-#include "tools/sim/omni3_simulator.h"
+#include "tools/sim/flower_scenario.h"
 
 namespace fitcal {
 namespace {
@@ -20,15 +20,14 @@ using testing::FitOmni3;
 using testing::FitOmni3Nlopt;
 using testing::Omni3Errors;
 
-std::vector<AlignedRun> Simulate(const sim::Omni3SimulationOptions& options) {
-  std::vector<RunLog> logs;
-  for (auto& run : sim::SimulateOmni3(options)) logs.push_back(std::move(run.log));
+std::vector<AlignedRun> Simulate(const sim::FlowerSimulation& options) {
+  std::vector<RunLog> logs = sim::SimulateFlowerLogs(options);
   return AlignRuns(logs);
 }
 
 // Clean data: no slip, no ground-truth noise, near-ideal encoders. What remains between the
 // simulator and Eq. 4 is the replay's discretisation (see omni3_fit_test.cc).
-sim::Omni3SimulationOptions Clean() { return sim::NoiseFreeSimulationOptions(); }
+sim::FlowerSimulation Clean() { return sim::NoiseFreePalacinFlower(); }
 
 // The whole flower once, shared by the tests (simulated once).
 const std::vector<AlignedRun>& CleanFlower() {

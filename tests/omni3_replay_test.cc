@@ -10,7 +10,7 @@
 #include <complex>
 #include <random>
 
-#include "tools/sim/omni3_simulator.h"
+#include "tools/sim/flower_scenario.h"
 
 namespace fitcal::omni3 {
 namespace {

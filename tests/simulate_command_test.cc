@@ -1,7 +1,8 @@
 // `fitcal simulate --model <name>` end to end, through the command line: the data set of every
 // model with calibration trajectories is written atomically, and `fitcal fit` on it recovers the
 // true robot it names (true_robot.yaml) within the sigmas the fit derives from the data's noise.
-// Without --model the omni3 flower simulator is unchanged (the shipped data/flower, bit for bit).
+// Without --model the flower (omni3, stepped physics) regenerates the shipped data/flower byte for
+// byte.
 // The models' own recovery tests (diff_drive_test, tricycle_test, omni_model_test) call the
 // library; these go through the files and the commands a user runs.
 
@@ -139,14 +140,17 @@ TEST(SimulateCommand, RefusesWhatTheModelSimulatorDoesNotTake) {
 }
 
 // data/flower was written by `fitcal simulate --out data/flower --robot data/robots/apr02.yaml
-// --repetitions 10 --seed 1` (README "Simulator"); run i draws from its own generator seeded by
-// (seed, i), so one repetition with the same seed must reproduce its repetition-1 files exactly.
-TEST(SimulateCommand, WithoutModelTheFlowerIsUnchanged) {
+// --repetitions 10 --seed 1` (docs/simulate.md) with the omni3-only simulator this command no
+// longer has; the generic simulator (the omni3 model through the seam, the flower's stepped
+// physics: tools/sim/flower_scenario.h) regenerates it. Run i draws from its own generator seeded
+// by (seed, i), so two repetitions with the same seed must reproduce the first 72 runs' files,
+// the robot and the first 72 entries of dataset.yaml exactly.
+TEST(SimulateCommand, RegeneratesTheShippedFlowerByteForByte) {
   TempDir dir;
   const std::string data = dir.Path("flower");
   const std::string source = std::string(FITCAL_SOURCE_DIR) + "/data/";
   ASSERT_EQ(RunFitcal(dir, "simulate --out " + data + " --robot " + source +
-                               "robots/apr02.yaml --repetitions 1 --seed 1")
+                               "robots/apr02.yaml --repetitions 2 --seed 1")
                 .exit_code,
             0);
   int files = 0;
@@ -156,8 +160,11 @@ TEST(SimulateCommand, WithoutModelTheFlowerIsUnchanged) {
               ReadFileBytes(source + "flower/runs/" + entry.path().filename().string()));
     ++files;
   }
-  EXPECT_EQ(files, 72);
+  EXPECT_EQ(files, 144);
   EXPECT_EQ(ReadFileBytes(data + "/robot.yaml"), ReadFileBytes(source + "flower/robot.yaml"));
+  const std::string index = ReadFileBytes(data + "/dataset.yaml");
+  EXPECT_EQ(std::count(index.begin(), index.end(), '\n'), 2 + 72);
+  EXPECT_EQ(index, ReadFileBytes(source + "flower/dataset.yaml").substr(0, index.size()));
 }
 
 }  // namespace

@@ -9,7 +9,7 @@
 
 #include "fit/effect_fit.h"
 #include "models/omni3/omni3_robot_model.h"
-#include "tools/sim/omni3_simulator.h"
+#include "tools/sim/flower_scenario.h"
 
 namespace fitcal {
 namespace {
@@ -112,16 +112,15 @@ TEST(TrajectoryMetricsTest, NoGroundTruthInsideTheWindowIsAnError) {
 // the effect replay with the effect fit's semantics: the per-run CF equals ScoreModel's (same
 // latency-shifted start and end), and the true effects explain the data better than none.
 TEST(TrajectoryMetricsTest, EffectsAreReplayedAsTheEffectFitScoresThem) {
-  sim::Omni3SimulationOptions options;
+  sim::FlowerSimulation options = sim::PalacinFlower();
   options.repetitions = 1;
   effects::EffectValue latency, slip;
   latency.id = effects::EffectId::kTimeOffset;
   latency.value[0] = 0.08;  // s
   slip.id = effects::EffectId::kWheelSpeedSlip;
   slip.value[0] = effects::Info(slip.id).typical[0];
-  options.injected_effects = {latency, slip};
-  std::vector<RunLog> logs;
-  for (auto& run : sim::SimulateOmni3(options)) logs.push_back(std::move(run.log));
+  options.options.stepped->injected_effects = {latency, slip};
+  std::vector<RunLog> logs = sim::SimulateFlowerLogs(options);
   const std::vector<double> p = ParametersOf(sim::PalacinTable5Parameters());
   const EffectModel model = {latency, slip};
   const ModelScore scores = ScoreModel(DefaultOmni3Model(), p, model, PrepareTrackRuns(logs));

@@ -2,22 +2,17 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
-#include <filesystem>
 #include <iostream>
 #include <stdexcept>
 
-#include "io/atomic_file.h"
-#include "io/dataset.h"
 #include "io/input_error.h"
-#include "io/robot_yaml.h"
 #include "io/staged_directory.h"
-#include "odometry/parallel_for.h"
+#include "models/model_registry.h"
 #include "tools/model_simulate_command.h"
 #include "tools/output_guard.h"
+#include "tools/sim/flower_scenario.h"
 
 namespace fitcal::tools {
-
-namespace fs = std::filesystem;
 
 namespace {
 
@@ -71,15 +66,44 @@ int RunModelSimulate(const SimulateCommandOptions& options) {
   o.robot = options.robot_given ? options.robot : "";
   o.truth = options.truth;
   o.force = options.force;
-  o.noise.repetitions = options.sim.repetitions;
-  o.noise.seed = options.sim.seed;
-  o.noise.ticks_per_rev = options.sim.encoder_counts_per_rev;
+  o.noise.repetitions = options.repetitions;
+  o.noise.seed = options.seed;
+  o.noise.ticks_per_rev = options.encoder_counts_per_rev;
   o.noise.wheel_rate_sigma_rad_s = options.wheel_rate_sigma_rad_s;
   o.noise.angle_sigma_rad = options.angle_sigma_deg * M_PI / 180.0;
-  o.noise.gt_position_sigma_m = options.sim.gt_position_sigma_m;
-  o.noise.gt_heading_sigma_rad = options.sim.gt_heading_sigma_rad;
+  o.noise.gt_position_sigma_m = options.gt_position_sigma_m;
+  o.noise.gt_heading_sigma_rad = options.gt_heading_sigma_deg * M_PI / 180.0;
   o.omni3_only_flags = options.omni3_only_flags;
   return RunModelSimulateCommand(o);
+}
+
+// The flower of the flags: the nominal robot commands, the truth (--truth or Table 5) moves.
+sim::FlowerSimulation FlowerOf(const SimulateCommandOptions& options) {
+  sim::FlowerSimulation flower = sim::PalacinFlower();
+  flower.model = ReadRobotModelFile(options.robot);
+  const Robot& robot = flower.model->robot();
+  if (robot.model != "omni3") {
+    throw std::invalid_argument(options.robot +
+                                ": the flower simulator drives an omni3 robot, not " + robot.model +
+                                " (simulate --model " + robot.model + ")");
+  }
+  if (!options.truth.empty())
+    flower.true_parameters = ReadRobotModelFile(options.truth)->robot().nominal;
+  if (flower.true_parameters.size() != robot.nominal.size()) {
+    throw std::invalid_argument(options.truth + ": the true robot must be an omni3 robot");
+  }
+  flower.repetitions = options.repetitions;
+  sim::SimulationOptions& o = flower.options;
+  o = sim::FlowerSimulationOptions(robot.nominal);
+  o.seed = options.seed;
+  o.ticks_per_rev.assign(robot.channels.size(), options.encoder_counts_per_rev);
+  o.gt_position_sigma_m = options.gt_position_sigma_m;
+  o.gt_heading_sigma_rad = options.gt_heading_sigma_deg * M_PI / 180.0;
+  o.stepped->slip.sigma = options.slip_sigma;
+  for (const std::string& text : options.inject) {
+    o.stepped->injected_effects.push_back(ParseInjectedEffect(text));
+  }
+  return flower;
 }
 
 }  // namespace
@@ -94,20 +118,18 @@ void AddSimulateOptions(CLI::App& app, SimulateCommandOptions& o) {
       ->check(CLI::ExistingFile);
   app.add_option("--truth", o.truth, "Robot YAML of the true robot (default: Palacin Table 5)")
       ->check(CLI::ExistingFile);
-  app.add_option("--repetitions", o.sim.repetitions, "Repetitions of each trajectory")
+  app.add_option("--repetitions", o.repetitions, "Repetitions of each trajectory")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
-  app.add_option("--seed", o.sim.seed, "Random seed")->capture_default_str();
-  app.add_option("--encoder-counts-per-rev", o.sim.encoder_counts_per_rev, "Encoder resolution")
+  app.add_option("--seed", o.seed, "Random seed")->capture_default_str();
+  app.add_option("--encoder-counts-per-rev", o.encoder_counts_per_rev, "Encoder resolution")
       ->capture_default_str();
-  app.add_option("--gt-position-sigma-m", o.sim.gt_position_sigma_m,
-                 "Ground-truth position noise (m)")
+  app.add_option("--gt-position-sigma-m", o.gt_position_sigma_m, "Ground-truth position noise (m)")
       ->capture_default_str();
   app.add_option("--gt-heading-sigma-deg", o.gt_heading_sigma_deg,
                  "Ground-truth heading noise (deg)")
       ->capture_default_str();
-  app.add_option("--slip-sigma", o.sim.slip_sigma, "Relative wheel slip noise")
-      ->capture_default_str();
+  app.add_option("--slip-sigma", o.slip_sigma, "Relative wheel slip noise")->capture_default_str();
   app.add_option("--wheel-rate-sigma-rad-s", o.wheel_rate_sigma_rad_s,
                  "--model: white noise on each interval's mean wheel rate (rad/s)")
       ->capture_default_str();
@@ -119,7 +141,6 @@ void AddSimulateOptions(CLI::App& app, SimulateCommandOptions& o) {
                  "Inject a library effect, name=value[,value] (odometry/effects.h); repeatable; "
                  "the data set does not name it");
   app.callback([&app, &o] {
-    o.sim.gt_heading_sigma_rad = o.gt_heading_sigma_deg * M_PI / 180.0;
     o.robot_given = app.count("--robot") > 0;
     for (const char* flag : {"--slip-sigma", "--inject"}) {
       if (app.count(flag) > 0) o.omni3_only_flags.push_back(flag);
@@ -130,46 +151,23 @@ void AddSimulateOptions(CLI::App& app, SimulateCommandOptions& o) {
 int RunSimulateCommand(const SimulateCommandOptions& options) {
   if (!options.model.empty() && options.model != "omni3") return RunModelSimulate(options);
   try {
-    const Omni3Robot nominal = io::ReadOmni3Robot(options.robot);
-    sim::Omni3SimulationOptions sim_options = options.sim;
-    sim_options.commanded_robot = nominal.nominal;
-    if (!options.truth.empty()) sim_options.true_robot = io::ReadOmni3Robot(options.truth).nominal;
-    for (const std::string& text : options.inject) {
-      sim_options.injected_effects.push_back(ParseInjectedEffect(text));
-    }
-
+    const sim::FlowerSimulation flower = FlowerOf(options);
     if (const std::string refusal =
             DirectoryOutputRefusal(options.out, kDatasetKind, options.force, {});
         !refusal.empty()) {
       std::cerr << "fitcal: " << refusal << "\n";
       return 2;
     }
-    const std::vector<sim::SimulatedRun> runs = sim::SimulateOmni3(sim_options);
-
+    const std::vector<sim::ModelSimulatedRun> runs = sim::SimulateFlower(flower);
     // Written whole or not at all: staged beside --out, renamed over it once complete.
     io::StagedDirectory staged(options.out);
-    const fs::path out(staged.path());
-    fs::create_directories(out / "runs");
-    std::vector<io::DatasetEntry> entries(runs.size());
-    ParallelFor(runs.size(), 0, [&](std::size_t i) {
-      const RunLog& log = runs[i].log;
-      io::DatasetEntry& e = entries[i];
-      e.id = log.id;
-      e.trajectory = log.trajectory;
-      e.repetition = log.repetition;
-      e.encoders = "runs/" + log.id + "_encoders.csv";
-      e.ground_truth = "runs/" + log.id + "_ground_truth.csv";
-      io::WriteFileAtomically((out / e.encoders).string(), io::EncoderCsv(log.encoders));
-      io::WriteFileAtomically((out / e.ground_truth).string(),
-                              io::GroundTruthCsv(log.ground_truth));
-    });
-    io::WriteFileAtomically((out / "robot.yaml").string(), io::Omni3RobotYaml(nominal, nullptr));
-    io::WriteFileAtomically((out / "dataset.yaml").string(),
-                            io::DatasetYaml("robot.yaml", entries));
+    const RobotModelInterface& model = *flower.model;
+    sim::WriteSimulatedDataset(staged.path(), model.RobotYaml(model.robot().nominal, ""), runs,
+                               sim::EncoderCsvDigits::kRecorder);
     CommitDirectoryOutput(staged, options.out, kDatasetKind, options.force, {});
     std::printf("wrote %zu runs (%zu trajectories x %d repetitions, seed %llu) to %s\n",
-                runs.size(), sim_options.trajectories.size(), sim_options.repetitions,
-                static_cast<unsigned long long>(sim_options.seed), options.out.c_str());
+                runs.size(), flower.trajectories.size(), flower.repetitions,
+                static_cast<unsigned long long>(flower.options.seed), options.out.c_str());
     return 0;
   } catch (const std::exception& e) {
     std::cerr << "fitcal: " << e.what() << "\n";

@@ -16,7 +16,7 @@
 #include "models/omni3/omni3_robot_model.h"
 #include "odometry/linear_final_pose_kernel.h"
 #include "odometry/omni3_replay.h"
-#include "tools/sim/omni3_simulator.h"
+#include "tools/sim/flower_scenario.h"
 
 namespace fitcal {
 namespace {

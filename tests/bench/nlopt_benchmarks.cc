@@ -1,4 +1,5 @@
-// Speed of the NLopt back end (fit/model_nlopt_fit.h, the fit of every model, on omni3). The budgets are the paper's and the SciPy reference's:
+// Speed of the NLopt back end (fit/model_nlopt_fit.h, the fit of every model, on omni3). The
+// budgets are the paper's and the SciPy reference's:
 //   - 37,545 cost evaluations, Palacin Table 4's STE-GA5 (180 training runs); target < 5 s on
 //     2 cores;
 //   - 25,000 evaluations on 36 runs, where SciPy's differential evolution needs about 68 s.
@@ -13,7 +14,7 @@
 #include "fit/model_nlopt_fit.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "odometry/aligned_run.h"
-#include "tools/sim/omni3_simulator.h"
+#include "tools/sim/flower_scenario.h"
 
 namespace fitcal {
 namespace {
@@ -32,10 +33,10 @@ const std::vector<AlignedRun>& Runs(int repetitions) {
   static std::vector<AlignedRun> runs_1, runs_5;
   std::vector<AlignedRun>& runs = repetitions == 1 ? runs_1 : runs_5;
   if (runs.empty()) {
-    sim::Omni3SimulationOptions sim_options;
+    sim::FlowerSimulation sim_options = sim::PalacinFlower();
     sim_options.repetitions = repetitions;
-    sim_options.seed = 7;
-    for (const sim::SimulatedRun& run : sim::SimulateOmni3(sim_options)) {
+    sim_options.options.seed = 7;
+    for (const sim::ModelSimulatedRun& run : sim::SimulateFlower(sim_options)) {
       runs.push_back(AlignRun(run.log));
     }
   }

@@ -8,6 +8,8 @@
 
 #include "io/atomic_file.h"
 #include "io/dataset.h"
+#include "odometry/parallel_for.h"
+#include "tools/sim/stepped_run.h"
 
 namespace fitcal::sim {
 
@@ -212,7 +214,7 @@ void RecordEncoders(const RobotModelInterface& model, const double* p, const Twi
 }
 
 ModelSimulatedRun SimulateRun(const RobotModelInterface& model, const std::vector<double>& p,
-                         const TrajectorySpec& spec, const SimulationOptions& o, Rng& rng) {
+                              const TrajectorySpec& spec, const SimulationOptions& o, Rng& rng) {
   const TwistProfile profile(spec.segments, o);
   const FineGrid grid = MakeGrid(profile.end_s(), o);
   const EncoderSamples fine = FineChannels(model, p.data(), profile, grid);
@@ -250,7 +252,9 @@ std::string SimulationOptions::Check(int num_channels) const {
     return "encoder_period_s, ground_truth_period_s and substep_s must be positive";
   }
   if (!(ramp_time_s > 0.0)) return "ramp_time_s must be positive";
-  if (!(rest_before_s >= 0.5 * ramp_time_s) || !(rest_after_s >= 0.5 * ramp_time_s)) {
+  // The stepped physics has no ramps (the controller lag smooths the commands).
+  const double half_ramp_s = stepped ? 0.0 : 0.5 * ramp_time_s;
+  if (!(rest_before_s >= half_ramp_s) || !(rest_after_s >= half_ramp_s)) {
     return "rest_before_s and rest_after_s must hold half a ramp";
   }
   if (!ticks_per_rev.empty() && static_cast<int>(ticks_per_rev.size()) != num_channels) {
@@ -258,6 +262,10 @@ std::string SimulationOptions::Check(int num_channels) const {
   }
   for (double t : ticks_per_rev) {
     if (!(t >= 0.0)) return "ticks_per_rev must be >= 0";
+  }
+  if (stepped) {
+    const std::string problem = CheckSteppedOptions(*stepped, encoder_period_s, num_channels);
+    if (!problem.empty()) return problem;
   }
   if (!(wheel_rate_sigma_rad_s >= 0.0) || !(angle_sigma_rad >= 0.0) ||
       !(gt_position_sigma_m >= 0.0) || !(gt_heading_sigma_rad >= 0.0) ||
@@ -268,32 +276,43 @@ std::string SimulationOptions::Check(int num_channels) const {
 }
 
 std::vector<ModelSimulatedRun> SimulateRuns(const RobotModelInterface& model,
-                                       const std::vector<double>& true_parameters,
-                                       const std::vector<TrajectorySpec>& trajectories,
-                                       const SimulationOptions& options) {
+                                            const std::vector<double>& true_parameters,
+                                            const std::vector<TrajectorySpec>& trajectories,
+                                            const SimulationOptions& options) {
   const std::string problem = options.Check(model.robot().NumChannels());
   if (!problem.empty()) throw std::invalid_argument("simulation options: " + problem);
   if (static_cast<int>(true_parameters.size()) != model.robot().NumParameters()) {
     throw std::invalid_argument("the true parameter vector has the wrong length");
   }
-  std::vector<ModelSimulatedRun> runs;
-  for (std::size_t i = 0; i < trajectories.size(); ++i) {
-    Rng rng(options.seed, i);
-    runs.push_back(SimulateRun(model, true_parameters, trajectories[i], options, rng));
+  if (options.stepped && !options.stepped->commanded_parameters.empty() &&
+      options.stepped->commanded_parameters.size() != true_parameters.size()) {
+    throw std::invalid_argument("the commanded parameter vector has the wrong length");
   }
+  // Runs are independent (each draws from its own generator): the output does not depend on the
+  // number of threads.
+  std::vector<ModelSimulatedRun> runs(trajectories.size());
+  ParallelFor(runs.size(), 0, [&](std::size_t i) {
+    if (options.stepped) {
+      runs[i] = SimulateSteppedRun(model, true_parameters, trajectories[i], options, i);
+      return;
+    }
+    Rng rng(options.seed, i);
+    runs[i] = SimulateRun(model, true_parameters, trajectories[i], options, rng);
+  });
   return runs;
 }
 
-std::string SimulatedEncoderCsv(const ModelSimulatedRun& run) {
+std::string SimulatedEncoderCsv(const ModelSimulatedRun& run, EncoderCsvDigits digits) {
+  const bool round_trip = digits == EncoderCsvDigits::kRoundTrip;
   std::string out = "t";
   for (const std::string& column : run.encoder_columns) out += "," + column;
   out += "\n";
   char field[64];
   for (std::size_t k = 0; k < run.recorded.size(); ++k) {
-    std::snprintf(field, sizeof field, "%.17g", run.log.encoders.t_s[k]);
+    std::snprintf(field, sizeof field, round_trip ? "%.17g" : "%.6f", run.log.encoders.t_s[k]);
     out += field;
     for (double v : run.recorded[k]) {
-      std::snprintf(field, sizeof field, ",%.17g", v + 0.0);
+      std::snprintf(field, sizeof field, round_trip ? ",%.17g" : ",%.9g", v + 0.0);
       out += field;
     }
     out += "\n";
@@ -302,7 +321,7 @@ std::string SimulatedEncoderCsv(const ModelSimulatedRun& run) {
 }
 
 void WriteSimulatedDataset(const std::string& dir, const std::string& robot_yaml_text,
-                           const std::vector<ModelSimulatedRun>& runs) {
+                           const std::vector<ModelSimulatedRun>& runs, EncoderCsvDigits digits) {
   namespace fs = std::filesystem;
   const fs::path out(dir);
   fs::create_directories(out / "runs");
@@ -314,7 +333,7 @@ void WriteSimulatedDataset(const std::string& dir, const std::string& robot_yaml
     e.repetition = run.log.repetition;
     e.encoders = "runs/" + e.id + "_encoders.csv";
     e.ground_truth = "runs/" + e.id + "_ground_truth.csv";
-    io::WriteFileAtomically((out / e.encoders).string(), SimulatedEncoderCsv(run));
+    io::WriteFileAtomically((out / e.encoders).string(), SimulatedEncoderCsv(run, digits));
     io::WriteFileAtomically((out / e.ground_truth).string(),
                             io::GroundTruthCsv(run.log.ground_truth));
     entries.push_back(e);

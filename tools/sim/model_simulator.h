@@ -3,7 +3,9 @@
 // list of body twists held for given durations; the simulator turns it into what a recorder
 // would log (encoder channels, ground truth) for a robot whose true parameters are known.
 //
-// The motion and noise model:
+// Two motion and noise models. With SimulationOptions::stepped, the flower's time-stepped physics
+// (SteppedOptions below: controller lag, slip, jittered encoders, irregular ground truth; the
+// shipped data/flower is made so, tools/sim/flower_scenario.h). Without it, perfect tracking:
 //
 // - Commanded twist. Segments follow each other with raised-cosine ramps of ramp_time_s centred
 //   on every segment boundary (also from rest into the first segment and back to rest after the
@@ -36,10 +38,13 @@
 // Box-Muller normal, so the output does not depend on the standard library or thread count.
 
 #include <cstdint>
+#include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "models/model_interface.h"
+#include "odometry/effects.h"
 #include "odometry/run_log.h"
 
 namespace fitcal::sim {
@@ -53,6 +58,73 @@ struct TrajectorySpec {
   std::string label;  // the data set's trajectory label; repetitions share it
   int repetition = 1;
   std::vector<TwistSegment> segments;
+};
+
+// The flower simulator's physics (Palacin's APR-02 as data/flower was made; stepped_run.h): a
+// time-stepped run in which a wheel controller follows the NOMINAL robot's inverse kinematics
+// with a first-order lag, the wheels slip, the encoders latch with jitter and the ground truth
+// comes at irregular times. Selected by SimulationOptions::stepped; the defaults are the
+// flower's (docs/simulate.md).
+struct ControllerLagOptions {
+  // Each channel follows its target through a first-order lag, rest to rest (start/stop
+  // transients): x += (1 - exp(-h / tau)) (target - x) per substep h.
+  double time_constant_s = 0.12;
+};
+struct SlipOptions {
+  // Contact rate = wheel rate (1 + s), s a per-wheel Ornstein-Uhlenbeck process of stationary
+  // sigma `sigma` and correlation time `correlation_time_s`: the non-systematic error that makes
+  // repetitions scatter. Wheel-rate channels only.
+  double sigma = 0.003;
+  double correlation_time_s = 0.5;
+};
+struct EncoderLatchOptions {
+  // Counts latched every encoder period (SimulationOptions::encoder_period_s) plus a uniform
+  // jitter in [-jitter_s, jitter_s] (APR-02's 10 ms PID period), at the first substep end at or
+  // after the scheduled time; quantised by SimulationOptions::ticks_per_rev.
+  double jitter_s = 0.0005;
+};
+struct IrregularGroundTruthOptions {
+  // Samples at intervals uniform in [period_min_s, period_max_s] (Palacin Sec. 2.5: SLAM every
+  // 200-300 ms), the first within period_max_s of the start.
+  double period_min_s = 0.2;
+  double period_max_s = 0.3;
+};
+
+// What a test may change at every substep of a stepped run, after the library effects: the
+// channels' contact rates (rad/s, robot order; angle channels as they are), the body twist and
+// an additive world velocity (m/s).
+struct SteppedState {
+  double t_s = 0.0;                         // since the run's start
+  double time_since_motion_s = -1.0;        // < 0 before the first segment starts
+  const double* channel_value = nullptr;    // the controller's state, robot order
+  const double* wheel_angle_rad = nullptr;  // integrated channel values since the start
+  Pose2d pose;
+};
+using SteppedHook = std::function<void(const SteppedState&, double* contact_rate, Twist* v_body,
+                                       double* v_world_xy)>;
+
+struct SteppedOptions {
+  // The robot the controller commands with (ChannelsForTwist); empty = the true robot.
+  std::vector<double> commanded_parameters;
+  ControllerLagOptions controller;
+  SlipOptions slip;
+  EncoderLatchOptions encoder;
+  IrregularGroundTruthOptions ground_truth;
+  double substep_s = 0.0005;  // integration step of the true motion (midpoint heading)
+
+  // Wheels' absolute angles: with random_wheel_start_angle each run starts at uniformly random
+  // absolute wheel angles (a robot whose counts run on between runs), drawn from a generator of
+  // their own (the other draws stay as without it), carried in EncoderLog::start_angle_rad.
+  // wheel_eccentricity[i] e makes wheel i roll on r (1 + e cos A): an error periodic in the
+  // wheel's revolution. Empty = none.
+  bool random_wheel_start_angle = false;
+  std::vector<double> wheel_eccentricity;
+
+  // Library effects (odometry/effects.h) at every substep with the true channel state: rate
+  // effects on the contact rates, body effects on the twist, world effects on the world
+  // velocity; a time offset shifts every ground-truth stamp by +latency. The data set names none.
+  std::vector<effects::EffectValue> injected_effects;
+  SteppedHook hook;  // anything else, after the library effects
 };
 
 struct SimulationOptions {
@@ -77,12 +149,14 @@ struct SimulationOptions {
 
   std::uint64_t seed = 1;
 
+  // Set: the flower's time-stepped physics (above) in place of perfect tracking; ramp_time_s,
+  // ground_truth_period_s and wheel_rate_sigma_rad_s are then unused.
+  std::optional<SteppedOptions> stepped;
+
   // Empty when valid, else what is wrong.
   std::string Check(int num_channels) const;
 };
 
-// (Not "SimulatedRun": that is omni3_simulator.h's, in the same namespace; two classes of one
-// name in one program break the one-definition rule.)
 struct ModelSimulatedRun {
   RunLog log;  // what the loader hands over (interval values, robot channel order)
   // What the recorder writes: the encoder CSV's channel columns (the robot's rate_column names,
@@ -101,14 +175,20 @@ std::vector<ModelSimulatedRun> SimulateRuns(const RobotModelInterface& model,
                                             const std::vector<TrajectorySpec>& trajectories,
                                             const SimulationOptions& options);
 
-// The encoder CSV of a run: header `t,<encoder_columns>`, then the recorded rows at full
-// precision (%.17g: the loader reads back the same doubles).
-std::string SimulatedEncoderCsv(const ModelSimulatedRun& run);
+// How the encoder CSV writes its numbers: kRoundTrip at full precision (%.17g: the loader reads
+// back the same doubles); kRecorder as a recorder would and as data/flower holds them (times
+// %.6f, values %.9g: io::EncoderCsv).
+enum class EncoderCsvDigits { kRoundTrip, kRecorder };
+
+// The encoder CSV of a run: header `t,<encoder_columns>`, then the recorded rows.
+std::string SimulatedEncoderCsv(const ModelSimulatedRun& run,
+                                EncoderCsvDigits digits = EncoderCsvDigits::kRoundTrip);
 
 // Writes a data set: <dir>/dataset.yaml, <dir>/robot.yaml (robot_yaml_text as given) and
 // runs/<id>_encoders.csv, runs/<id>_ground_truth.csv per run, each file atomically. Creates the
 // directories; throws std::runtime_error when a file cannot be written.
 void WriteSimulatedDataset(const std::string& dir, const std::string& robot_yaml_text,
-                           const std::vector<ModelSimulatedRun>& runs);
+                           const std::vector<ModelSimulatedRun>& runs,
+                           EncoderCsvDigits digits = EncoderCsvDigits::kRoundTrip);
 
 }  // namespace fitcal::sim

@@ -1,7 +1,6 @@
 #pragma once
 // The noise settings of a simulated data set of a model on the seam (model_scenarios.h describes
-// each and why these defaults); apart from the simulator so that the omni3 simulate command can
-// carry them without the generic simulator's types.
+// each and why these defaults), as `simulate --model` takes them.
 
 #include <cmath>
 #include <cstdint>
