@@ -44,7 +44,7 @@ struct Twist {
 };
 
 // A window [begin, end) of a run's samples and the ground truth's motion over it
-// (segment_residual.h: the relative pose error of trajectory-evaluation tools).
+// (models/pose_errors.h: the relative pose error of trajectory-evaluation tools).
 struct Segment {
   std::size_t begin = 0;
   std::size_t end = 0;
