@@ -23,7 +23,6 @@
 #include <string>
 #include <vector>
 
-#include "fit/final_pose_residual.h"
 #include "models/model_interface.h"
 #include "odometry/aligned_run.h"
 #include "odometry/parallel_for.h"

@@ -172,7 +172,7 @@ TrajectoryErrors ErrorsAlongTrack(const AlignedRun& run, const GroundTruthTrack&
   out.rms_distance_m = std::sqrt(sum_d2 / m);  // Eq. 12
   out.rms_angle_rad = std::sqrt(sum_a2 / m);   // Eq. 13
 
-  // Final errors and CF exactly as Eq. 14 / final_pose_residual.h.
+  // Final errors and CF exactly as Eq. 14 / models/pose_errors.h.
   out.final_odometry = final_pose;
   out.final_ground_truth = final_ground_truth;
   const double dx = final_pose.x - final_ground_truth.x;

@@ -13,7 +13,7 @@
 // (the paper's Sec. 2.5: the odometry is sub-sampled at the ground-truth times); linear
 // interpolation between the two bracketing encoder times is the alternative. The final errors are
 // those of Eq. 14 (replay to t_final against the ground truth interpolated at t_final), so the
-// per-run CF here equals final_pose_cost.h's.
+// per-run CF here equals EvaluateFinalPoseErrors' (fit/final_pose_errors.h).
 
 #include <string>
 #include <vector>
