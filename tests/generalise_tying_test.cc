@@ -6,7 +6,9 @@
 //     would give the full fit's unequal radii; one that leaked into the full fit, equal ones there.
 //   - command: with --tie the table, the leave-one-session-out summary and the everyday-driving
 //     tables carry the tied fits; without it nothing says "tied"; an unknown name is refused by the
-//     same code as `fit` (one line, exit 2, nothing on stdout).
+//     same code as `fit` (one line, exit 2, nothing on stdout);
+//   - `compare --tie/--hold` on data/flower: a "<method> (tied)" row after each method's, whose
+//     M^-1 has the structure of equal distances and nominal angles.
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
@@ -139,6 +141,43 @@ TEST(GeneraliseTying, CommandPrintsTiedFitsAndRefusesUnknownNames) {
   EXPECT_EQ(wrong.exit_code, 2);
   EXPECT_EQ(std::count(wrong.err.begin(), wrong.err.end(), '\n'), 1) << wrong.err;
   EXPECT_NE(wrong.err.find("'r_nope'"), std::string::npos) << wrong.err;
+  EXPECT_EQ(wrong.out, "");
+}
+
+// The second entry of the first row of a compare row's M^-1 (Palacin Eq. 6), as printed (four
+// decimals). With R_a = R_b = R_c and the angles at their nominal 300/60/180 deg it prints 0.0000
+// (wheel b's share of the body's x velocity vanishes); the full fit on the flower prints 0.0013.
+double FirstRowSecondEntry(const std::string& out, const std::string& row_start) {
+  const std::size_t row = out.find(row_start);
+  if (row == std::string::npos) return NAN;
+  const std::size_t space = out.find(' ', out.find('[', row));
+  return std::stod(out.substr(space + 1));
+}
+
+TEST(GeneraliseTying, CompareAddsATiedRowPerMethodThroughTheSameFlags) {
+  testing::TempDir dir;
+  const std::string compare = "compare --logs " + std::string(FITCAL_SOURCE_DIR) +
+                              "/data/flower --methods ceres slsqp --strategies STE "
+                              "--repetitions 1 --no-output --quiet";
+  const auto tied =
+      testing::RunFitcal(dir, compare + " --tie R_a,R_b,R_c --hold delta_a,delta_b,delta_c");
+  ASSERT_EQ(tied.exit_code, 0) << tied.err;
+  EXPECT_NE(tied.out.find("tied (one value): R_a=R_b=R_c\n"), std::string::npos) << tied.out;
+  for (const char* method : {"ceres", "slsqp"}) {
+    const std::string full = std::string("| STE | ") + method + " | 1 | [";
+    const std::string reduced = std::string("| STE | ") + method + " (tied) | 1 | [";
+    // Printed with four decimals: the full fit's 0.0013 is 13 units, the tied one's 0.
+    EXPECT_GT(std::abs(FirstRowSecondEntry(tied.out, full)), 5e-4) << tied.out;
+    EXPECT_EQ(FirstRowSecondEntry(tied.out, reduced), 0.0) << tied.out;
+  }
+  const auto plain = testing::RunFitcal(dir, compare);
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_EQ(plain.out.find("tied"), std::string::npos) << plain.out;
+
+  const auto wrong = testing::RunFitcal(dir, compare + " --hold delta_x");
+  EXPECT_EQ(wrong.exit_code, 2);
+  EXPECT_EQ(std::count(wrong.err.begin(), wrong.err.end(), '\n'), 1) << wrong.err;
+  EXPECT_NE(wrong.err.find("'delta_x'"), std::string::npos) << wrong.err;
   EXPECT_EQ(wrong.out, "");
 }
 
