@@ -84,8 +84,8 @@ TEST(GeneraliseTying, TiedFitsShareOneValueBesideTheFullFits) {
   const SplitScores scores = EvaluateSplit(
       *model, runs, split, options, TrackCandidates{nullptr, nullptr, {}, &ground_truth}, tying);
 
-  // The full fits see the radii apart: 1 mm of ground-truth noise over metres of path determines
-  // each radius to ~1e-5 m, the truth's difference is 1e-3 m.
+  // The full fits see the radii apart: the truth's difference is 1e-3 m, twice the margin below;
+  // these fits find -0.99e-3 and -1.00e-3 m (seed 5), far from it.
   for (const char* full : {"fit", "fit (track)"}) {
     const CandidateScore* c = Find(scores, full);
     ASSERT_NE(c, nullptr) << full;
