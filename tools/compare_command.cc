@@ -347,11 +347,12 @@ std::string SplitRepetitions(const CompareCommandOptions& options, const Compare
   return "";
 }
 
-Row FitRow(const FitMethod& method, const std::string& strategy, int k,
+// `name`: the method's, or "<method> (tied)" for its fit of the reduced model (s.tying).
+Row FitRow(const FitMethod& method, const std::string& name, const std::string& strategy, int k,
            const std::vector<AlignedRun>& training, const std::vector<AlignedRun>& validation,
            double cf_nominal, const CompareData& d, FitMethodSettings s, bool show_progress,
            int threads) {
-  const std::string label = strategy + " " + method.name + " x" + std::to_string(k);
+  const std::string label = strategy + " " + name + " x" + std::to_string(k);
   if (show_progress) {
     s.progress = [&label](const NloptProgress& p) {
       std::fprintf(stderr, "\r[%s] %d evaluations, best CF %.5f, %.1f s   ", label.c_str(),
@@ -363,7 +364,7 @@ Row FitRow(const FitMethod& method, const std::string& strategy, int k,
   const FitOutcome outcome = RunMethod(method, training, d, s);
   Row row;
   row.strategy = strategy;
-  row.method = method.name;
+  row.method = name;
   row.repetitions = k;
   row.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   row.parameters = outcome.parameters;
@@ -386,22 +387,57 @@ Row FitRow(const FitMethod& method, const std::string& strategy, int k,
 
 void PrintAndWrite(const CompareCommandOptions& options, const CompareRequest& r,
                    const std::vector<int>& validation_reps, std::size_t num_validation,
-                   const std::vector<Row>& rows, const ParameterColumns& columns) {
+                   const std::vector<Row>& rows, const ParameterColumns& columns,
+                   const ParameterTying& tying) {
   const std::string markdown = Markdown(rows, columns);
   std::string counts;
   for (int k : r.counts) counts += (counts.empty() ? "" : " or ") + std::to_string(k);
   std::printf(
       "Palacin Table 4 on %s: training on the first %s repetition(s) of each strategy's "
       "trajectories, validation on every trajectory of repetitions %s (%zu runs); CF "
-      "is Eq. 14 (m and rad)\n\n%s",
+      "is Eq. 14 (m and rad)\n\n",
       options.logs.c_str(), counts.c_str(), FormatRepetitionList(validation_reps).c_str(),
-      num_validation, markdown.c_str());
+      num_validation);
+  if (!tying.empty()) {  // what the "(tied)" rows fit
+    PrintTying(tying);
+    std::printf("\n");
+  }
+  std::printf("%s", markdown.c_str());
   if (!options.no_output) {
     io::WriteFilesAtomically({{options.out + ".csv", Csv(rows, columns)},
                               {options.out + ".md", markdown},
                               {options.out + "_trace.csv", TraceCsv(rows)}});
     std::printf("\nwrote %s.csv, %s.md, %s_trace.csv\n", options.out.c_str(), options.out.c_str(),
                 options.out.c_str());
+  }
+}
+
+// For every strategy and training count k: the closed forms' rows, then each method's fit and,
+// with a tying, its fit of the reduced model right after it ("<method> (tied)").
+void AddStrategyRows(const CompareRequest& request, const CompareData& d,
+                     const std::vector<int>& present, const std::vector<AlignedRun>& validation,
+                     const ParameterTying& tying, bool show_progress, int threads,
+                     std::vector<Row>* rows) {
+  const double cf_nominal = rows->front().cf_validation;  // the uncalibrated reference row
+  FitMethodSettings tied = request.settings;
+  tied.tying = tying;
+  for (const TrajectoryStrategy& strategy : request.strategies) {
+    for (int k : request.counts) {
+      const std::vector<int> reps(present.begin(), present.begin() + k);
+      const std::vector<AlignedRun> training = SelectRuns(d.runs, strategy, reps);
+      AddClosedFormRows(d, strategy.name, k, training, validation, cf_nominal, threads, rows);
+    }
+    for (const FitMethod* method : request.methods) {
+      for (int k : request.counts) {
+        const std::vector<int> reps(present.begin(), present.begin() + k);
+        const std::vector<AlignedRun> training = SelectRuns(d.runs, strategy, reps);
+        rows->push_back(FitRow(*method, method->name, strategy.name, k, training, validation,
+                               cf_nominal, d, request.settings, show_progress, threads));
+        if (tying.empty()) continue;
+        rows->push_back(FitRow(*method, method->name + " (tied)", strategy.name, k, training,
+                               validation, cf_nominal, d, tied, show_progress, threads));
+      }
+    }
   }
 }
 
@@ -427,6 +463,7 @@ void AddCompareOptions(CLI::App& app, CompareCommandOptions& o) {
   app.add_flag("--no-output", o.no_output, "Print the table only");
   app.add_flag("--quiet", o.quiet, "No progress on stderr");
   AddSolverOptions(app, o);
+  AddTyingFlags(app, o);
 }
 
 int RunCompareCommand(const CompareCommandOptions& options) {
@@ -445,6 +482,12 @@ int RunCompareCommand(const CompareCommandOptions& options) {
       }
     }
     const CompareData d = LoadCompareData(options);
+    ParameterTying tying;
+    if (const std::string refusal = ReadTying(options, d.model->robot(), &tying);
+        !refusal.empty()) {
+      std::cerr << "fitcal compare: " << refusal << "\n";
+      return 2;
+    }
     if (!d.omni3 && !options.strategies_given) {
       request.strategies = DefaultStrategiesFor(d.runs, request.strategies);
     }
@@ -467,24 +510,9 @@ int RunCompareCommand(const CompareCommandOptions& options) {
         validation.empty() ? NAN : d.Cf(d.model->robot().nominal, validation, options.threads);
     none.termination = "uncalibrated";
     rows.push_back(none);
-    for (const TrajectoryStrategy& strategy : request.strategies) {
-      for (int k : request.counts) {
-        const std::vector<int> reps(present.begin(), present.begin() + k);
-        const std::vector<AlignedRun> training = SelectRuns(d.runs, strategy, reps);
-        AddClosedFormRows(d, strategy.name, k, training, validation, none.cf_validation,
-                          options.threads, &rows);
-      }
-      for (const FitMethod* method : request.methods) {
-        for (int k : request.counts) {
-          const std::vector<int> reps(present.begin(), present.begin() + k);
-          rows.push_back(FitRow(*method, strategy.name, k, SelectRuns(d.runs, strategy, reps),
-                                validation, none.cf_validation, d, request.settings, show_progress,
-                                options.threads));
-        }
-      }
-    }
+    AddStrategyRows(request, d, present, validation, tying, show_progress, options.threads, &rows);
     PrintAndWrite(options, request, validation_reps, validation.size(), rows,
-                  ColumnsFor(d.model->robot()));
+                  ColumnsFor(d.model->robot()), tying);
     return 0;
   });
 }

@@ -6,19 +6,22 @@
 // repetitions of the whole flower). The model's closed forms (UMBmark for a differential drive)
 // are rows beside the fits, computed from the same training runs. Prints the
 // table as Markdown and writes <out>.csv, <out>.md and <out>_trace.csv (best CF vs evaluations
-// per fit), each atomically, after every fit has finished.
+// per fit), each atomically, after every fit has finished. With --tie/--hold
+// (fit/parameter_tying.h, read as `fit` reads them) every method also fits the reduced model, a
+// "<method> (tied)" row beside its full fit.
 
 #include <string>
 #include <vector>
 
 #include "tools/dataset_command.h"
 #include "tools/solver_options.h"
+#include "tools/tying_flags.h"
 
 namespace fitcal::tools {
 
 // --logs, --threads and --allow-outside-paths come from DatasetCommandOptions, the solver flags
-// from SolverOptions (the same as fit's).
-struct CompareCommandOptions : DatasetCommandOptions, SolverOptions {
+// from SolverOptions and --tie/--hold from TyingFlags (the same as fit's).
+struct CompareCommandOptions : DatasetCommandOptions, SolverOptions, TyingFlags {
   // Palacin's STA..STE, trajectory lists, "all" or "<prefix>*" (compare_command.cc). For a model
   // other than omni3 without strategies_given: those of STA..STE the data set has, else "all".
   std::vector<std::string> strategies = {"STA", "STB", "STC", "STD", "STE"};

@@ -43,12 +43,7 @@ void AddFitOptions(CLI::App& app, FitCommandOptions& o) {
                  "pivot_yaw_gain), one more candidate of the result gate; an effect the robot "
                  "YAML declares is refitted without naming it")
       ->delimiter(',');
-  app.add_option("--tie", o.tie,
-                 "Parameters sharing one value, named as the robot's parameters (e.g. "
-                 "\"R_a,R_b,R_c\" or \"r_left,r_right\"); repeat for more groups");
-  app.add_option("--hold", o.hold,
-                 "Parameters held at their nominal values (e.g. delta_a,delta_b,delta_c)")
-      ->delimiter(',');
+  AddTyingFlags(app, o);
 }
 
 int RunFitCommand(const FitCommandOptions& options) {

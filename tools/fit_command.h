@@ -7,12 +7,13 @@
 
 #include "tools/dataset_command.h"
 #include "tools/solver_options.h"
+#include "tools/tying_flags.h"
 
 namespace fitcal::tools {
 
 // --logs, --threads and --allow-outside-paths come from DatasetCommandOptions, the solver flags
-// from SolverOptions.
-struct FitCommandOptions : DatasetCommandOptions, SolverOptions {
+// from SolverOptions, --tie and --hold (fit/parameter_tying.h) from TyingFlags.
+struct FitCommandOptions : DatasetCommandOptions, SolverOptions, TyingFlags {
   std::string method = "ceres";
   std::string train_reps = "1-5";
   // Non-empty: train on the runs whose trajectory label matches (fit/trajectory_split.h),
@@ -30,10 +31,6 @@ struct FitCommandOptions : DatasetCommandOptions, SolverOptions {
   // runs; measured on the OptiOdom free runs, half a run calibrates worse,
   // docs/everyday_driving.md).
   int time_blocks = 4;
-  // --tie "R_a,R_b,R_c" (repeatable): each a group of parameters sharing one value; --hold
-  // "delta_a,delta_b": parameters held at their nominal values (fit/parameter_tying.h).
-  std::vector<std::string> tie;
-  std::vector<std::string> hold;
 };
 
 // Declares every flag of `fit` on `app` (the `fit` subcommand, and the top level: `fitcal --logs

@@ -28,6 +28,7 @@
 #include "tools/everyday_driving_table.h"
 #include "tools/fit_methods.h"
 #include "tools/output_guard.h"
+#include "tools/tying_flags.h"
 #include "validation/propagated_uncertainty.h"
 #include "validation/rate_units.h"
 #include "validation/residual_dof.h"
@@ -833,32 +834,9 @@ void WriteCalibration(const FitCommandOptions& options, const RobotModelInterfac
   std::printf("wrote %s\n", options.out.c_str());
 }
 
-// --tie and --hold (fit/parameter_tying.h) into the settings; "" or why they do not apply.
-std::string SetTying(const FitCommandOptions& options, const Robot& robot,
-                     FitMethodSettings* settings) {
-  for (const std::string& group : options.tie)
-    settings->tying.groups.push_back(SplitParameterNames(group));
-  for (const std::string& name : options.hold) {
-    for (const std::string& n : SplitParameterNames(name)) settings->tying.held.push_back(n);
-  }
-  return CheckTying(robot, settings->tying);
-}
-
 std::size_t NumFreeWithTying(const RobotModelInterface& model, const ParameterTying& tying) {
   if (tying.empty()) return model.robot().NumFree();
   return TiedModel(model, tying).robot().NumFree();
-}
-
-void PrintTying(const ParameterTying& tying) {
-  for (const std::vector<std::string>& group : tying.groups) {
-    std::string names;
-    for (const std::string& name : group) names += (names.empty() ? "" : "=") + name;
-    std::printf("tied (one value): %s\n", names.c_str());
-  }
-  if (tying.held.empty()) return;
-  std::string names;
-  for (const std::string& name : tying.held) names += (names.empty() ? "" : ", ") + name;
-  std::printf("held at nominal (--hold): %s\n", names.c_str());
 }
 
 // The method, its settings and the effects to fit, checked before anything is loaded.
@@ -880,7 +858,8 @@ int SetUpFit(const FitCommandOptions& options, const Robot& robot, FitSetup* set
               << (setup->method == nullptr ? "unknown --method " + options.method : error) << "\n";
     return 2;
   }
-  if (const std::string refusal = SetTying(options, robot, &setup->settings); !refusal.empty()) {
+  if (const std::string refusal = ReadTying(options, robot, &setup->settings.tying);
+      !refusal.empty()) {
     return Refuse(refusal);
   }
   const std::optional<EffectModel> effects_to_fit = EffectsToFit(options, robot);

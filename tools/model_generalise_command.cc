@@ -40,7 +40,7 @@ void PrintSplitTableHeader() {
 void PrintSplitRows(const SplitScores& s) {
   for (const CandidateScore& c : s.candidates) {
     char held[16] = "-", bound[16] = "-";
-    if (c.is_fit && c.name == "fit") {
+    if (c.is_fit && (c.name == "fit" || c.name == kTiedFitName)) {
       std::snprintf(held, sizeof held, "%d", c.held_directions);
       std::snprintf(bound, sizeof bound, "%d", c.at_bound);
     }
@@ -187,7 +187,8 @@ std::optional<std::vector<GeneralisationSplit>> TableSplits(const GeneraliseComm
 }
 
 // The everyday-driving table `fit` prints (tools/everyday_driving_table.h), nominal against each
-// fit of the split ("fit", "fit (track)": the calibrations `fit` writes), on its held-out runs.
+// fit of the split ("fit", "fit (track)": the calibrations `fit` writes, and their tied twins
+// with --tie/--hold), on its held-out runs.
 void PrintEverydayDrivingOfSplit(const RobotModelInterface& model,
                                  const std::vector<AlignedRun>& runs,
                                  const std::vector<const GroundTruthTrack*>& ground_truth,
@@ -201,7 +202,10 @@ void PrintEverydayDrivingOfSplit(const RobotModelInterface& model,
   const EffectModel no_effects;
   const CandidateScore& nominal = scores.candidates.front();
   for (const CandidateScore& c : scores.candidates) {
-    if (c.name != "fit" && c.name != "fit (track)") continue;
+    if (c.name != "fit" && c.name != "fit (track)" && c.name != kTiedFitName &&
+        c.name != kTiedTrackFitName) {
+      continue;
+    }
     PrintEverydayDrivingTable(
         model, held_out, tracks,
         scores.split.train_name + " -> " + scores.split.test_name + ": " + c.name,
@@ -213,6 +217,10 @@ int Generalise(const GeneraliseCommandOptions& options) {
   const io::DatasetIndex index = OpenDataset(options).index;
   const RobotModelPtr model = ReadRobotModelFile(index.robot_path);
   const Robot& robot = model->robot();
+  ParameterTying tying;
+  if (const std::string refusal = ReadTying(options, robot, &tying); !refusal.empty()) {
+    return Refuse(refusal);
+  }
   SessionKey session_key = SessionKey::kLabel;
   if (!ParseSessionKey(options.sessions, &session_key)) return 2;
   const io::Dataset dataset = LoadRuns(options, index, &robot);
@@ -226,10 +234,14 @@ int Generalise(const GeneraliseCommandOptions& options) {
 
   std::printf("fitcal generalise: %s robot '%s', data set %s: %zu runs\n\n", robot.model.c_str(),
               robot.name.c_str(), options.logs.c_str(), runs.size());
+  if (!tying.empty()) {
+    PrintTying(tying);
+    std::printf("\n");
+  }
   PrintSplitTableHeader();
   std::vector<SplitScores> scores;
   for (const GeneralisationSplit& split : *splits) {
-    scores.push_back(EvaluateSplit(*model, runs, split, fit_options, inputs.candidates));
+    scores.push_back(EvaluateSplit(*model, runs, split, fit_options, inputs.candidates, tying));
     PrintSplitRows(scores.back());
     std::fflush(stdout);
   }
@@ -243,7 +255,7 @@ int Generalise(const GeneraliseCommandOptions& options) {
   if (options.leave_one_session_out) {
     std::vector<SplitScores> folds;
     for (const GeneralisationSplit& split : LeaveOneSessionOutSplits(runs, session_key)) {
-      folds.push_back(EvaluateSplit(*model, runs, split, fit_options, inputs.candidates));
+      folds.push_back(EvaluateSplit(*model, runs, split, fit_options, inputs.candidates, tying));
     }
     if (!folds.empty()) PrintLeaveOneSessionOut(folds);
   }
@@ -271,6 +283,7 @@ void AddGeneraliseOptions(CLI::App& app, GeneraliseCommandOptions& o) {
   app.add_flag("--optiodom", o.optiodom,
                "Also score OptiOdom's method (Sousa et al. 2022: position from the start every "
                "0.5 m of path) on the same splits");
+  AddTyingFlags(app, o);
 }
 
 int RunGeneraliseCommand(const GeneraliseCommandOptions& options) {

@@ -8,18 +8,22 @@
 // Markdown tables (train CF, held-out CF (Palacin Eq. 14), mean position and heading errors, held
 // directions, parameters at a bound), then the everyday-driving measures `fit` prints
 // (tools/everyday_driving_table.h: ATE RMSE, drift per 1, 2, 5 m) of the nominal and each fit on
-// every split's held-out runs.
+// every split's held-out runs. With --tie/--hold (fit/parameter_tying.h, as `fit` takes them)
+// each fit is made once more on the reduced model and judged beside the full one: "fit (tied)"
+// and "fit (track, tied)" rows, columns of leave-one-session-out and everyday-driving tables.
 
 #include <CLI/CLI.hpp>
 #include <string>
 #include <vector>
 
 #include "tools/dataset_command.h"
+#include "tools/tying_flags.h"
 
 namespace fitcal::tools {
 
-// --logs, --threads and --allow-outside-paths come from DatasetCommandOptions.
-struct GeneraliseCommandOptions : DatasetCommandOptions {
+// --logs, --threads and --allow-outside-paths come from DatasetCommandOptions; --tie and --hold
+// (TyingFlags, read as `fit` reads them) add the reduced model's fits beside the full ones.
+struct GeneraliseCommandOptions : DatasetCommandOptions, TyingFlags {
   bool leave_one_session_out = true;
   // Non-empty: instead of every pair of path types, train on the runs whose trajectory label
   // matches (fit/trajectory_split.h: a list of labels or a regular expression) and test on

@@ -65,6 +65,46 @@ CandidateScore TrackFitCandidate(const RobotModelInterface& model, const std::st
   return s;
 }
 
+// A fit of the split's training runs, scored, with what it held and where it hit a bound.
+CandidateScore FitCandidate(const RobotModelInterface& model, const std::string& name,
+                            const ModelFitResult& fit, const std::vector<AlignedRun>& train,
+                            const std::vector<AlignedRun>& test, int threads) {
+  CandidateScore s = Score(model, name, fit.parameters, fit.usable, train, test, threads);
+  s.is_fit = true;
+  s.held_directions = static_cast<int>(fit.held_directions.size());
+  for (bool b : fit.at_bound) s.at_bound += b;
+  return s;
+}
+
+// The bounded final-pose fit `name` and, when it held directions the training runs do not
+// determine, the gate's "<name> without holds" candidate: what fitting those directions too
+// would have given, so the table shows what holding them gained or cost on the held-out runs.
+void AddFinalPoseFits(const RobotModelInterface& model, const std::string& name,
+                      const ModelFitOptions& options, const std::vector<AlignedRun>& train,
+                      const std::vector<AlignedRun>& test, std::vector<CandidateScore>* out) {
+  const int threads = options.ceres.num_threads;
+  const ModelFitResult fit = FitModel(train, model, options);
+  out->push_back(FitCandidate(model, name, fit, train, test, threads));
+  if (fit.held_directions.empty()) return;
+  CandidateScore free = Score(model, name + " without holds", fit.unconstrained_parameters,
+                              fit.unconstrained_usable, train, test, threads);
+  free.is_fit = true;
+  out->push_back(std::move(free));
+}
+
+// The bounded fit `name` on the training runs' track residuals (fit/track_residual.h, no clock
+// offsets): what `fit --residuals auto` writes on dense ground-truth tracks.
+void AddTrackFit(const RobotModelInterface& model, const std::string& name,
+                 const ModelFitOptions& options, const TrackFitData& data,
+                 const std::vector<AlignedRun>& train, const std::vector<AlignedRun>& test,
+                 std::vector<CandidateScore>* out) {
+  ModelFitOptions track_options = options;
+  track_options.residuals = ResidualKind::kTrack;
+  track_options.track = &data;
+  const ModelFitResult fit = FitModel(train, model, track_options);
+  out->push_back(FitCandidate(model, name, fit, train, test, options.ceres.num_threads));
+}
+
 template <typename T>
 std::vector<T> PickEach(const std::vector<T>& all, const std::vector<std::size_t>& indices) {
   std::vector<T> out;
@@ -130,7 +170,7 @@ std::vector<GeneralisationSplit> LeaveOneSessionOutSplits(const std::vector<Alig
 
 SplitScores EvaluateSplit(const RobotModelInterface& model, const std::vector<AlignedRun>& runs,
                           const GeneralisationSplit& split, const ModelFitOptions& options,
-                          const TrackCandidates& track_candidates) {
+                          const TrackCandidates& track_candidates, const ParameterTying& tying) {
   if (split.train.empty() || split.test.empty()) {
     throw std::invalid_argument("generalisation split '" + split.train_name + "' -> '" +
                                 split.test_name + "' has no training or no held-out run");
@@ -145,43 +185,28 @@ SplitScores EvaluateSplit(const RobotModelInterface& model, const std::vector<Al
   for (const ClosedFormCalibration& c : model.ClosedForms(train)) {
     out.candidates.push_back(Score(model, c.method, c.parameters, true, train, test, threads));
   }
-  const ModelFitResult fit = FitModel(train, model, options);
-  CandidateScore fitted = Score(model, "fit", fit.parameters, fit.usable, train, test, threads);
-  fitted.is_fit = true;
-  fitted.held_directions = static_cast<int>(fit.held_directions.size());
-  for (bool b : fit.at_bound) fitted.at_bound += b;
-  out.candidates.push_back(std::move(fitted));
-  // The gate's "without holds" candidate: what fitting the undetermined directions too would
-  // have given, so the table shows what holding them gained or cost on these held-out runs.
-  if (!fit.held_directions.empty()) {
-    CandidateScore free = Score(model, "fit without holds", fit.unconstrained_parameters,
-                                fit.unconstrained_usable, train, test, threads);
-    free.is_fit = true;
-    out.candidates.push_back(std::move(free));
-  }
+  ModelFitOptions full = options;
+  full.tying = nullptr;
+  AddFinalPoseFits(model, "fit", full, train, test, &out.candidates);
+  ModelFitOptions tied = full;
+  tied.tying = &tying;
+  if (!tying.empty()) AddFinalPoseFits(model, kTiedFitName, tied, train, test, &out.candidates);
   if (const auto* ground_truth = track_candidates.ground_truth) {
     if (ground_truth->size() != runs.size()) {
       throw std::invalid_argument("EvaluateSplit: not one ground truth per run");
     }
     const TrackFitData data =
         MakeTrackFitData(train, PickEach(*ground_truth, split.train), ClockGrouping::kNone);
-    ModelFitOptions track_options = options;
-    track_options.residuals = ResidualKind::kTrack;
-    track_options.track = &data;
-    const ModelFitResult track_fit = FitModel(train, model, track_options);
-    CandidateScore scored =
-        Score(model, "fit (track)", track_fit.parameters, track_fit.usable, train, test, threads);
-    scored.is_fit = true;
-    scored.held_directions = static_cast<int>(track_fit.held_directions.size());
-    for (bool b : track_fit.at_bound) scored.at_bound += b;
-    out.candidates.push_back(std::move(scored));
+    AddTrackFit(model, "fit (track)", full, data, train, test, &out.candidates);
+    if (!tying.empty())
+      AddTrackFit(model, kTiedTrackFitName, tied, data, train, test, &out.candidates);
   }
   if (const auto* checkpoints = track_candidates.optiodom_checkpoints) {
     if (checkpoints->size() != runs.size()) {
       throw std::invalid_argument("EvaluateSplit: not one checkpoint list per run");
     }
     const std::vector<std::vector<Segment>> train_checkpoints = PickEach(*checkpoints, split.train);
-    out.candidates.push_back(OptiOdomCandidate(model, train, test, train_checkpoints, options));
+    out.candidates.push_back(OptiOdomCandidate(model, train, test, train_checkpoints, full));
   }
   if (track_candidates.tracks != nullptr && !track_candidates.effects.empty()) {
     const std::vector<TrackRun>& tracks = *track_candidates.tracks;

@@ -66,7 +66,7 @@ std::vector<GeneralisationSplit> LeaveOneSessionOutSplits(const std::vector<Alig
                                                           SessionKey key);
 
 struct CandidateScore {
-  std::string name;  // "nominal", "umbmark", "fit", "fit without holds"
+  std::string name;  // "nominal", "umbmark", "fit", "fit without holds", "fit (tied)", ...
   bool usable = true;
   std::vector<double> parameters;
   FinalPoseErrors train;
@@ -101,11 +101,20 @@ struct TrackCandidates {
   const std::vector<const GroundTruthTrack*>* ground_truth = nullptr;
 };
 
+// The names of the tied fits' candidates (EvaluateSplit with a tying).
+inline constexpr const char* kTiedFitName = "fit (tied)";
+inline constexpr const char* kTiedTrackFitName = "fit (track, tied)";
+
 // Fits on split.train (options.ceres.num_threads also drives the evaluation) and scores every
-// candidate on split.test. Throws std::invalid_argument when either side is empty.
+// candidate on split.test. With a non-empty `tying` (fit/parameter_tying.h: a reduced model such
+// as OptiOdom's omni3, `--tie`/`--hold`), each fit of the full model is made once more on the
+// tied model and scored right after it: "fit (tied)" (and "fit (tied) without holds" when it
+// held directions) after "fit", "fit (track, tied)" after "fit (track)". options.tying is
+// ignored: the full fits stay full. Throws std::invalid_argument when either side is empty.
 SplitScores EvaluateSplit(const RobotModelInterface& model, const std::vector<AlignedRun>& runs,
                           const GeneralisationSplit& split, const ModelFitOptions& options,
-                          const TrackCandidates& track_candidates = {});
+                          const TrackCandidates& track_candidates = {},
+                          const ParameterTying& tying = {});
 
 // One candidate over the folds of leave-one-session-out (candidates are matched by name; a closed
 // form may exist in some folds only).
