@@ -142,6 +142,12 @@ TEST(RobotYaml, RoundTripsThroughTheCalibratedSchema) {
   EXPECT_EQ(robot.name, "test");
   EXPECT_NEAR(robot.nominal.angle_rad[1], M_PI, 1e-15);
   const std::shared_ptr<const Omni3Model> model = Omni3ModelOf(robot);
+  // The named view and the model's are one robot both ways.
+  const Omni3Robot same = Omni3RobotOf(*model);
+  EXPECT_EQ(same.wheel_names, robot.wheel_names);
+  EXPECT_EQ(same.nominal.ToArray(), robot.nominal.ToArray());
+  EXPECT_EQ(same.ParameterBounds()[7].hi, robot.ParameterBounds()[7].hi);
+  EXPECT_EQ(same.bounds.angle_offset_rad.lo, robot.bounds.angle_offset_rad.lo);
   CalibrationBlock record;
   record.method = "ceres";
   record.has_uncertainty = true;
