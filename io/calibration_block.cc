@@ -2,12 +2,39 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "io/robot_yaml_blocks.h"
 #include "io/yaml_text.h"
 
 namespace fitcal::io {
 
 namespace {
+
+void EmitCalibrationOrigin(YAML::Emitter& out, const CalibrationSource& c) {
+  out << YAML::Key << "method" << YAML::Value << c.method;
+  out << YAML::Key << "objective" << YAML::Value << c.objective;
+  out << YAML::Key << "dataset" << YAML::Value << YamlText(c.dataset);
+  out << YAML::Key << "tool_version" << YAML::Value << c.tool_version;
+  out << YAML::Key << "termination" << YAML::Value << c.termination;
+}
+
+void EmitCalibrationRunCounts(YAML::Emitter& out, const CalibrationSource& c) {
+  out << YAML::Key << "training_repetitions" << YAML::Value << YAML::Flow << c.training_repetitions;
+  out << YAML::Key << "validation_repetitions" << YAML::Value << YAML::Flow
+      << c.validation_repetitions;
+  out << YAML::Key << "training_runs" << YAML::Value << c.training_runs;
+  out << YAML::Key << "validation_runs" << YAML::Value << c.validation_runs;
+  if (!c.training_trajectories.empty()) {
+    out << YAML::Key << "training_trajectories" << YAML::Value << c.training_trajectories;
+  }
+}
+
+void EmitCalibrationCf(YAML::Emitter& out, const CalibrationSource& c) {
+  const auto before_after = [&](const char* key, double before, double after) {
+    out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "before"
+        << YAML::Value << before << YAML::Key << "after" << YAML::Value << after << YAML::EndMap;
+  };
+  before_after("cf_training", c.cf_training_before, c.cf_training_after);
+  before_after("cf_validation", c.cf_validation_before, c.cf_validation_after);
+}
 
 void EmitRuns(YAML::Emitter& out, const CalibrationBlock& c) {
   EmitCalibrationRunCounts(out, c);
@@ -66,34 +93,6 @@ void EmitClockOffsets(YAML::Emitter& out, const CalibrationBlock& c) {
 }
 
 }  // namespace
-
-void EmitCalibrationOrigin(YAML::Emitter& out, const CalibrationSource& c) {
-  out << YAML::Key << "method" << YAML::Value << c.method;
-  out << YAML::Key << "objective" << YAML::Value << c.objective;
-  out << YAML::Key << "dataset" << YAML::Value << YamlText(c.dataset);
-  out << YAML::Key << "tool_version" << YAML::Value << c.tool_version;
-  out << YAML::Key << "termination" << YAML::Value << c.termination;
-}
-
-void EmitCalibrationRunCounts(YAML::Emitter& out, const CalibrationSource& c) {
-  out << YAML::Key << "training_repetitions" << YAML::Value << YAML::Flow << c.training_repetitions;
-  out << YAML::Key << "validation_repetitions" << YAML::Value << YAML::Flow
-      << c.validation_repetitions;
-  out << YAML::Key << "training_runs" << YAML::Value << c.training_runs;
-  out << YAML::Key << "validation_runs" << YAML::Value << c.validation_runs;
-  if (!c.training_trajectories.empty()) {
-    out << YAML::Key << "training_trajectories" << YAML::Value << c.training_trajectories;
-  }
-}
-
-void EmitCalibrationCf(YAML::Emitter& out, const CalibrationSource& c) {
-  const auto before_after = [&](const char* key, double before, double after) {
-    out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "before"
-        << YAML::Value << before << YAML::Key << "after" << YAML::Value << after << YAML::EndMap;
-  };
-  before_after("cf_training", c.cf_training_before, c.cf_training_after);
-  before_after("cf_validation", c.cf_validation_before, c.cf_validation_after);
-}
 
 std::string CalibrationBlockYaml(const CalibrationBlock& c, const Robot& robot) {
   YAML::Emitter out;

@@ -15,8 +15,7 @@
 namespace fitcal::io {
 
 // What produced a calibration and on which runs, with the CF before and after on both: the keys
-// the omni3 YAML's `calibration:` block (io/robot_yaml.h, its own pre-seam layout) shares with
-// every other model's, filled once by each command for both.
+// every command fills the same way (fit, diagnose).
 struct CalibrationSource {
   std::string method;
   std::string objective;

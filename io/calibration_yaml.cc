@@ -68,7 +68,7 @@ void ReadUncertainty(const YAML::Node& block, const std::string& path, Calibrati
       add(key, entry.second);
       continue;
     }
-    // The omni3 file writes one list per quantity (`distance_m: [a, b, c]`).
+    // omni3 files from before the model seam: one list per quantity (`distance_m: [a, b, c]`).
     for (std::size_t i = 0; i < entry.second.size(); ++i) {
       add(key + "[" + std::to_string(i) + "]", entry.second[i]);
     }

@@ -1,6 +1,6 @@
 #pragma once
 // Reads back what `fitcal fit` and `fitcal diagnose` recorded in the `calibration:` block of a
-// calibrated robot YAML (io/robot_yaml.h, io/calibration_block.h write it): what the report needs
+// calibrated robot YAML (each model writes it with io/calibration_block.h): what the report needs
 // to know which runs trained the calibration and how the solver ended.
 
 #include <optional>

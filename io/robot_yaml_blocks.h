@@ -14,8 +14,6 @@
 
 namespace fitcal::io {
 
-struct CalibrationSource;  // io/calibration_block.h
-
 // [lo, hi] of `key` times `scale`; InputError when lo > hi.
 Interval ReadBoundsPair(YamlMap& map, const std::string& key, double scale);
 
@@ -36,13 +34,5 @@ void EmitEncoderAndEffects(YAML::Emitter& out, const Robot& robot);
 // The robot's encoder block with `effects` in place of the ones it declares.
 void EmitEncoderAndEffects(YAML::Emitter& out, const Robot& robot,
                            const std::vector<effects::EffectValue>& effects);
-
-// Keys of the `calibration:` block (inside its open map) that the omni3 layout and every other
-// model's write alike: what produced the calibration (method .. termination); the repetitions and
-// run counts, with the --train-trajectories selector when split so; the CF (Palacin Eq. 14)
-// before and after on the training and validation runs.
-void EmitCalibrationOrigin(YAML::Emitter& out, const CalibrationSource& c);
-void EmitCalibrationRunCounts(YAML::Emitter& out, const CalibrationSource& c);
-void EmitCalibrationCf(YAML::Emitter& out, const CalibrationSource& c);
 
 }  // namespace fitcal::io

@@ -84,12 +84,13 @@ void RefuseEffectsTheChannelsCannotShow(const Robot& robot, const YAML::Node& ro
     const int line = list && list.IsSequence() && i < list.size() ? list[i].Mark().line + 1
                      : list                                       ? list.Mark().line + 1
                                                                   : 1;
+    const bool vowel = std::string("aeiou").find(robot.model.substr(0, 1)) != std::string::npos;
     throw io::InputError(
         io::InputErrorKind::kBadValue, path, line,
         std::string("effect ") + effects::Info(id).name + " needs " +
             (effects::NeedsWheelPair(id) ? "exactly two wheel channels and no other"
                                          : "an angle channel (a steering angle)") +
-            "; a " + robot.model + " robot cannot carry it");
+            (vowel ? "; an " : "; a ") + robot.model + " robot cannot carry it");
   }
 }
 

@@ -14,8 +14,8 @@
 // The table EffectTable() lists every effect's description (names, units, bounds, a realistic
 // magnitude, whether the final poses of a flower can separate it from the nine parameters) and
 // EffectOpsTable<T>() its transforms; both are indexed by EffectId. Adding an effect = one
-// struct + one row in each table. The plain replay (omni3_replay.h) is untouched: the effect
-// replay below is a separate, slower path.
+// struct + one row in each table. The plain replay (replay.h) is untouched: the effect replay
+// below is a separate, slower path.
 //
 // Sign conventions: w_i is the encoder's wheel rate (rad/s), positive as in Palacin Eq. 1; the
 // "effective" rate is what actually moves the robot over the ground.
@@ -30,7 +30,6 @@
 #include <vector>
 
 #include "odometry/encoder_samples.h"
-#include "odometry/pose2.h"
 #include "odometry/pose2.h"
 
 namespace fitcal::effects {

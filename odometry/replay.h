@@ -17,7 +17,7 @@
 // kSeriesMaxAngle. A second, sequential pass accumulates the world pose and advances the
 // heading's unit vector (c, s) by those rotations; (c, s) is recomputed exactly from theta every
 // kReanchorInterval samples so rounding cannot accumulate. The result equals a literal Eq. 4 to
-// rounding (tests/omni3_replay_test.cc, tests/model_harness_test.cc).
+// rounding (tests/model_harness_test.cc; for Palacin's robot, against the test oracle of tests/).
 
 #include <cmath>
 #include <cstddef>

@@ -11,16 +11,13 @@
 #include "diagnosis/clock_choice.h"
 #include "diagnosis/diagnose.h"
 #include "fit/segment_cost.h"
-#include "io/robot_yaml.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "tools/sim/flower_scenario.h"
 
 namespace fitcal {
 namespace {
 
-Omni3Robot NominalRobot() {
-  return io::ReadOmni3Robot(FITCAL_SOURCE_DIR "/data/robots/apr02.yaml");
-}
+Omni3Robot NominalRobot() { return ReadOmni3Robot(FITCAL_SOURCE_DIR "/data/robots/apr02.yaml"); }
 
 // Every third flower trajectory (12 of 36): R, G and B alike, enough to separate the nine.
 std::vector<sim::MotionCommand> FlowerSubset() {

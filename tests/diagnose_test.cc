@@ -11,7 +11,6 @@
 #include <fstream>
 #include <string>
 
-#include "io/robot_yaml.h"
 #include "models/model_registry.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "tools/sim/flower_scenario.h"
@@ -19,9 +18,7 @@
 namespace fitcal {
 namespace {
 
-Omni3Robot NominalRobot() {
-  return io::ReadOmni3Robot(FITCAL_SOURCE_DIR "/data/robots/apr02.yaml");
-}
+Omni3Robot NominalRobot() { return ReadOmni3Robot(FITCAL_SOURCE_DIR "/data/robots/apr02.yaml"); }
 
 // The nominal robot on the model seam, which Diagnose works through.
 std::shared_ptr<const Omni3Model> NominalModel() { return Omni3ModelOf(NominalRobot()); }

@@ -9,16 +9,13 @@
 #include <cstdio>
 
 #include "diagnosis/diagnose.h"
-#include "io/robot_yaml.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "tools/sim/flower_scenario.h"
 
 namespace fitcal {
 namespace {
 
-Omni3Robot NominalRobot() {
-  return io::ReadOmni3Robot(FITCAL_SOURCE_DIR "/data/robots/apr02.yaml");
-}
+Omni3Robot NominalRobot() { return ReadOmni3Robot(FITCAL_SOURCE_DIR "/data/robots/apr02.yaml"); }
 
 // Every third flower trajectory (12 of 36), four repetitions (1-2 train, 3-4 validate), each run
 // at random absolute wheel angles; wheel a's rolling radius r_a (1 + e cos A_a).

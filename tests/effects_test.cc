@@ -12,9 +12,10 @@
 #include "diagnosis/diagnose.h"
 #include "fit/effect_fit.h"
 #include "io/input_error.h"
-#include "io/robot_yaml.h"
+#include "models/model_registry.h"
 #include "models/omni3/omni3_kinematics.h"
-#include "odometry/omni3_replay.h"
+#include "models/omni3/omni3_robot_model.h"
+#include "tests/omni3_reference_replay.h"
 #include "tools/sim/flower_scenario.h"
 #include "validation/statistics.h"
 
@@ -236,7 +237,7 @@ std::string TempPath(const std::string& name) {
 
 // The calibrated YAML carries the effects and gives them back.
 TEST(RobotYamlEffects, RoundTripAndBadInput) {
-  Omni3Robot robot = io::ReadOmni3Robot(FITCAL_SOURCE_DIR "/data/robots/apr02.yaml");
+  Omni3Robot robot = ReadOmni3Robot(FITCAL_SOURCE_DIR "/data/robots/apr02.yaml");
   effects::EffectValue slip;
   slip.id = EffectId::kWheelSpeedSlip;
   slip.value[0] = 0.0123;
@@ -248,9 +249,10 @@ TEST(RobotYamlEffects, RoundTripAndBadInput) {
   const std::string path = TempPath("robot.yaml");
   {
     std::ofstream f(path);
-    f << io::Omni3RobotYaml(robot, nullptr);
+    const std::shared_ptr<const Omni3Model> model = Omni3ModelOf(robot);
+    f << model->RobotYaml(model->robot().nominal, "");
   }
-  const Omni3Robot back = io::ReadOmni3Robot(path);
+  const Omni3Robot back = ReadOmni3Robot(path);
   ASSERT_EQ(back.effects.size(), 2u);
   EXPECT_EQ(back.effects[0].id, EffectId::kWheelSpeedSlip);
   EXPECT_DOUBLE_EQ(back.effects[0].value[0], 0.0123);
@@ -259,15 +261,15 @@ TEST(RobotYamlEffects, RoundTripAndBadInput) {
   EXPECT_DOUBLE_EQ(back.effects[1].value[1], -0.002);
 
   const auto expect_bad = [&](const std::string& effects_text, const std::string& what) {
-    std::string yaml = io::Omni3RobotYaml(
-        io::ReadOmni3Robot(FITCAL_SOURCE_DIR "/data/robots/apr02.yaml"), nullptr);
+    const RobotModelPtr model = ReadRobotModelFile(FITCAL_SOURCE_DIR "/data/robots/apr02.yaml");
+    std::string yaml = model->RobotYaml(model->robot().nominal, "");
     yaml += "effects:\n" + effects_text;
     {
       std::ofstream f(path);
       f << yaml;
     }
     try {
-      io::ReadOmni3Robot(path);
+      ReadOmni3Robot(path);
       ADD_FAILURE() << "accepted " << effects_text;
     } catch (const io::InputError& e) {
       EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();

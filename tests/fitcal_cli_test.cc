@@ -12,7 +12,7 @@
 #include <sstream>
 
 #include "models/asoc/asoc_files.h"
-#include "io/robot_yaml.h"
+#include "models/omni3/omni3_robot_model.h"
 #include "tests/test_files.h"
 
 namespace fitcal {
@@ -49,7 +49,7 @@ TEST(FitcalCli, FitsWritesAndReadsBackTheCalibration) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("validation"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("CONVERGENCE"), std::string::npos) << r.out;
-  const Omni3Robot calibrated = io::ReadOmni3Robot(out);  // the output is a valid robot file
+  const Omni3Robot calibrated = ReadOmni3Robot(out);  // the output is a valid robot file
   // Table 5 (the simulated truth) has R_a = 0.2186 m, far from the nominal 0.195 m.
   EXPECT_NEAR(calibrated.nominal.distance_m[0], 0.2186, 0.003);
   const std::string yaml = ReadFileBytes(out);

@@ -8,11 +8,13 @@
 #include <cstring>
 #include <optional>
 
+#include "io/calibration_block.h"
 #include "io/calibration_yaml.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/log_files.h"
-#include "io/robot_yaml.h"
+#include "models/model_registry.h"
+#include "models/omni3/omni3_robot_model.h"
 #include "tests/test_files.h"
 
 namespace fitcal::io {
@@ -132,17 +134,28 @@ TEST(GroundTruth, BadInputs) {
   check("0 1 2 0 0 0 0 1\n1 1 2 0 0 0\n", InputErrorKind::kWrongColumnCount, 2);
 }
 
+// The calibrated YAML an omni3 model writes (its schema + the generic calibration block) reads back
+// as the same robot.
 TEST(RobotYaml, RoundTripsThroughTheCalibratedSchema) {
   TempDir dir;
   const Omni3Robot robot = ReadOmni3Robot(dir.Write("robot.yaml", kRobot));
   EXPECT_EQ(robot.name, "test");
   EXPECT_NEAR(robot.nominal.angle_rad[1], M_PI, 1e-15);
-  CalibrationRecord record;
+  const std::shared_ptr<const Omni3Model> model = Omni3ModelOf(robot);
+  // The named view and the model's are one robot both ways.
+  const Omni3Robot same = Omni3RobotOf(*model);
+  EXPECT_EQ(same.wheel_names, robot.wheel_names);
+  EXPECT_EQ(same.nominal.ToArray(), robot.nominal.ToArray());
+  EXPECT_EQ(same.ParameterBounds()[7].hi, robot.ParameterBounds()[7].hi);
+  EXPECT_EQ(same.bounds.angle_offset_rad.lo, robot.bounds.angle_offset_rad.lo);
+  CalibrationBlock record;
   record.method = "ceres";
   record.has_uncertainty = true;
-  record.sigma.fill(1e-4);
-  const Omni3Robot back =
-      ReadOmni3Robot(dir.Write("calibrated.yaml", Omni3RobotYaml(robot, &record)));
+  record.sigma.assign(omni3::kNumParameters, 1e-4);
+  record.correlation = Eigen::MatrixXd::Identity(omni3::kNumParameters, omni3::kNumParameters);
+  const Omni3Robot back = ReadOmni3Robot(dir.Write(
+      "calibrated.yaml",
+      model->RobotYaml(model->robot().nominal, CalibrationBlockYaml(record, model->robot()))));
   EXPECT_EQ(back.name, robot.name);
   for (int i = 0; i < 3; ++i) {
     EXPECT_NEAR(back.nominal.distance_m[i], robot.nominal.distance_m[i], 1e-10);
@@ -155,9 +168,9 @@ TEST(RobotYaml, RoundTripsThroughTheCalibratedSchema) {
 // (io/calibration_yaml.h); a plain robot YAML records nothing; a malformed list names its line.
 TEST(RobotYaml, CalibrationProvenanceRoundTrips) {
   TempDir dir;
-  const Omni3Robot robot = ReadOmni3Robot(dir.Write("robot.yaml", kRobot));
+  const RobotModelPtr model = ReadRobotModelFile(dir.Write("robot.yaml", kRobot));
   EXPECT_FALSE(ReadCalibrationProvenance(dir.Path("robot.yaml")).has_value());
-  CalibrationRecord record;
+  CalibrationBlock record;
   record.method = "ceres";
   record.termination = "NO_CONVERGENCE";
   record.training_repetitions = {1, 2};
@@ -167,8 +180,11 @@ TEST(RobotYaml, CalibrationProvenanceRoundTrips) {
   record.at_bound = {"R_a"};
   record.cf_training_after = 0.0125;
   record.has_uncertainty = true;
-  record.sigma.fill(1e-4);
-  const std::string path = dir.Write("calibrated.yaml", Omni3RobotYaml(robot, &record));
+  record.sigma.assign(omni3::kNumParameters, 1e-4);
+  record.correlation = Eigen::MatrixXd::Identity(omni3::kNumParameters, omni3::kNumParameters);
+  const std::string path = dir.Write(
+      "calibrated.yaml",
+      model->RobotYaml(model->robot().nominal, CalibrationBlockYaml(record, model->robot())));
   const std::optional<CalibrationProvenance> p = ReadCalibrationProvenance(path);
   ASSERT_TRUE(p.has_value());
   EXPECT_EQ(p->termination, "NO_CONVERGENCE");
@@ -179,10 +195,21 @@ TEST(RobotYaml, CalibrationProvenanceRoundTrips) {
   EXPECT_EQ(p->at_bound, record.at_bound);
   ASSERT_TRUE(p->has_training_cf);
   EXPECT_DOUBLE_EQ(p->cf_training_after, 0.0125);
-  ASSERT_EQ(p->sigma.size(), 9u);  // omni3 writes one list of three per quantity
-  EXPECT_EQ(p->sigma[3].first, "radius_m[0]");
+  ASSERT_EQ(p->sigma.size(), 9u);  // one per parameter, named with its unit
+  EXPECT_EQ(p->sigma[3].first, "r_a_m");
   EXPECT_DOUBLE_EQ(p->sigma[3].second, 1e-4);
   EXPECT_EQ(p->correlation.size(), 9u);
+  // The omni3 layout before the model seam (one list of three per quantity) still reads.
+  const std::string legacy = dir.Write(
+      "legacy.yaml", std::string(kRobot) +
+                         "calibration:\n  training_repetitions: [1]\n"
+                         "  sigma: {distance_m: [1e-4, 1e-4, 1e-4], radius_m: [2e-4, 2e-4, 2e-4],"
+                         " angle_deg: [0.1, 0.1, 0.1]}\n");
+  const std::optional<CalibrationProvenance> old = ReadCalibrationProvenance(legacy);
+  ASSERT_TRUE(old.has_value());
+  ASSERT_EQ(old->sigma.size(), 9u);
+  EXPECT_EQ(old->sigma[3].first, "radius_m[0]");
+  EXPECT_DOUBLE_EQ(old->sigma[3].second, 2e-4);
   const std::string uneven =
       dir.Write("uneven.yaml", std::string(kRobot) +
                                    "calibration:\n  training_repetitions: [1]\n"

@@ -8,9 +8,9 @@
 #include <stdexcept>
 
 #include "fit/trajectory_split.h"
-#include "odometry/effects.h"
 #include "models/omni3/omni3_kinematics.h"
-#include "odometry/omni3_replay.h"
+#include "odometry/effects.h"
+#include "tests/omni3_reference_replay.h"
 #include "tools/sim/flower_scenario.h"
 
 namespace fitcal {

@@ -18,8 +18,8 @@
 
 #include "io/dataset.h"
 #include "io/input_error.h"
-#include "io/robot_yaml.h"
 #include "io/text_file.h"
+#include "models/omni3/omni3_robot_model.h"
 #include "tests/test_files.h"
 
 namespace fitcal {
@@ -132,10 +132,10 @@ class DatasetDir {
   fs::path dir_;
 };
 
-// What `fitcal fit` loads before it fits.
+// What `fitcal fit` loads before it fits (the registry's reader, through omni3's named view).
 void LoadForFit(const fs::path& dir, const io::DatasetOptions& options = {}) {
   const io::Dataset dataset = io::LoadDataset(dir.string(), options);
-  io::ReadOmni3Robot(dataset.robot_path);
+  ReadOmni3Robot(dataset.robot_path);
 }
 
 std::set<std::string> ListFiles(const fs::path& root) {

@@ -15,9 +15,10 @@
 #include <string>
 #include <vector>
 
+#include "io/calibration_block.h"
 #include "io/dataset.h"
 #include "io/log_files.h"
-#include "io/robot_yaml.h"
+#include "models/omni3/omni3_robot_model.h"
 #include "tests/test_files.h"
 
 namespace fitcal {
@@ -56,12 +57,13 @@ std::vector<std::string> Leftovers(const fs::path& dir, const std::vector<std::s
 
 // A calibrated YAML of robot `name` to be preserved.
 std::string PreviousOutput(const std::string& name) {
-  Omni3Robot robot = io::ReadOmni3Robot(kRobot);
+  Omni3Robot robot = ReadOmni3Robot(kRobot);
   robot.name = name;
-  io::CalibrationRecord record;
+  const std::shared_ptr<const Omni3Model> model = Omni3ModelOf(robot);
+  io::CalibrationBlock record;
   record.method = "ceres";
   record.termination = "CONVERGENCE";
-  return io::Omni3RobotYaml(robot, &record);
+  return model->RobotYaml(model->robot().nominal, io::CalibrationBlockYaml(record, model->robot()));
 }
 
 // Starts `fitcal --logs data --out out`, stopped (SIGSTOP) at `stage` by io::StopHereForTests.
@@ -130,7 +132,7 @@ TEST(NothingLostTest, SignalAtEveryStageLeavesThePreviousOutputUntouched) {
                      "' > /dev/null"),
             0);
   EXPECT_NE(ReadFileBytes(out), previous);
-  EXPECT_NO_THROW(io::ReadOmni3Robot(out.string()));
+  EXPECT_NO_THROW(ReadOmni3Robot(out.string()));
   EXPECT_TRUE(TemporaryFiles(out_dir).empty());
 }
 
@@ -182,7 +184,7 @@ TEST(NothingLostTest, OutRefusesAnotherRobotsCalibrationUnlessForced) {
 
   WriteFileBytes(out, other);
   EXPECT_EQ(RunShell(fit + " --force" + quiet), 0) << ReadFileBytes(err);
-  EXPECT_EQ(io::ReadOmni3Robot(out.string()).name, "apr02");
+  EXPECT_EQ(ReadOmni3Robot(out.string()).name, "apr02");
 
   // The same robot's previous calibration is replaced without --force.
   const std::string same = PreviousOutput("apr02");

@@ -7,8 +7,8 @@
 
 #include "fit/final_pose_errors.h"
 #include "fit/run_split.h"
-#include "odometry/omni3_replay.h"
 #include "tests/omni3_fit_support.h"
+#include "tests/omni3_reference_replay.h"
 #include "tools/sim/flower_scenario.h"
 
 namespace fitcal {

@@ -1,8 +1,8 @@
-// Golden numbers of Palacin et al. 2022 for the omni3 model (odometry/omni3_model.h), and the
-// identities the model must satisfy (closed-form vs numeric inverse, matrix <-> parameter round
-// trips, autodiff vs finite-difference derivatives).
+// Golden numbers of Palacin et al. 2022 for the omni3 model (models/omni3/omni3_parameters.h), and
+// the identities the model must satisfy (closed-form vs numeric inverse, matrix <-> parameter
+// round trips, autodiff vs finite-difference derivatives).
 
-#include "odometry/omni3_model.h"
+#include "models/omni3/omni3_parameters.h"
 
 #include <ceres/jet.h>
 #include <gtest/gtest.h>

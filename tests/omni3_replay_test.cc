@@ -1,8 +1,8 @@
-// The replay of Palacin Eq. 4 (odometry/omni3_replay.h) against exact references: the closed
+// The replay of Palacin Eq. 4 (tests/omni3_reference_replay.h) against exact references: the closed
 // form of Eq. 4 for a constant-rate log, the analytic arc it converges to, a naive step-by-step
 // implementation that calls sin/cos at every sample, and Jet vs double evaluation.
 
-#include "odometry/omni3_replay.h"
+#include "tests/omni3_reference_replay.h"
 
 #include <ceres/jet.h>
 #include <gtest/gtest.h>

@@ -12,7 +12,6 @@
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/log_files.h"
-#include "io/robot_yaml.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "odometry/aligned_run.h"
 #include "tools/import_optiodom.h"
@@ -95,7 +94,7 @@ TEST(OptiOdomImport, WritesATicksDataSetThatLoadsBackToTheSameRuns) {
   options.out = (out / "ds").string();
   ASSERT_EQ(tools::RunImportOptiOdomCommand(options), 0);
   const io::Dataset ds = io::LoadDataset(options.out);
-  const Omni3Robot robot = io::ReadOmni3Robot(ds.robot_path);
+  const Omni3Robot robot = ReadOmni3Robot(ds.robot_path);
   ASSERT_TRUE(robot.encoder.has_value());
   EXPECT_EQ(robot.encoder->ticks_per_rev, 12288.0);
   EXPECT_FALSE(robot.encoder->cumulative);

@@ -14,8 +14,8 @@
 #include <random>
 
 #include "fit/model_fit.h"
+#include "models/omni3/omni3_robot.h"
 #include "models/omni3/omni3_robot_model.h"
-#include "odometry/robot_description.h"
 
 namespace fitcal {
 namespace {

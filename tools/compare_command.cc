@@ -9,7 +9,6 @@
 #include <cstdio>
 #include <functional>
 #include <iostream>
-#include <optional>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -22,7 +21,7 @@
 #include "io/input_error.h"
 #include "io/robot_yaml.h"
 #include "models/model_registry.h"
-#include "models/omni3/omni3_robot_model.h"
+#include "models/omni3/omni3_parameters.h"
 #include "tools/cli_validators.h"
 #include "tools/fit_methods.h"
 #include "tools/output_guard.h"
@@ -176,11 +175,11 @@ std::string TraceCsv(const std::vector<Row>& rows) {
   return o.str();
 }
 
-// The robot and runs of a data set, for any model; omni3 keeps its own loader; every model fits
-// and is scored through the seam (tools/fit_methods.h, fit/final_pose_errors.h).
+// The robot and runs of a data set, for any model; omni3's runs keep their own loader; every model
+// fits and is scored through the seam (tools/fit_methods.h, fit/final_pose_errors.h).
 struct CompareData {
   RobotModelPtr model;
-  std::optional<Omni3Robot> omni3;
+  bool omni3 = false;  // Palacin's robot: his strategies STA..STE by default
   std::vector<AlignedRun> runs;
 
   double Cf(const std::vector<double>& p, const std::vector<AlignedRun>& on, int threads) const {
@@ -194,8 +193,8 @@ CompareData LoadCompareData(const CompareCommandOptions& options) {
   CompareData d;
   if (model_name == "omni3") {
     const io::Dataset dataset = LoadRuns(options, index, /*robot=*/nullptr);
-    d.omni3 = io::ReadOmni3Robot(dataset.robot_path);
-    d.model = Omni3ModelOf(*d.omni3);
+    d.omni3 = true;
+    d.model = ReadRobotModelFile(dataset.robot_path);
     d.runs = AlignRuns(dataset.runs);
   } else {
     d.model = ReadRobotModelFile(index.robot_path);

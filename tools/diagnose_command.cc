@@ -20,7 +20,6 @@
 #include "io/dataset.h"
 #include "io/diagnose_page.h"
 #include "io/input_error.h"
-#include "io/robot_yaml.h"
 #include "io/robot_yaml_blocks.h"
 #include "io/staged_directory.h"
 #include "models/model_registry.h"

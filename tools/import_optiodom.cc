@@ -17,7 +17,6 @@
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/input_registry.h"
-#include "io/robot_yaml.h"
 #include "io/staged_directory.h"
 #include "io/text_file.h"
 #include "models/omni3/omni3_robot_model.h"
@@ -362,7 +361,7 @@ int RunImportOptiOdomCommand(const ImportOptiOdomOptions& options) {
                              "'s; import sessions of one robot together");
       }
     }
-    const Omni3Robot robot = OptiOdomNominalRobot(first);
+    const std::shared_ptr<const Omni3Model> robot = Omni3ModelOf(OptiOdomNominalRobot(first));
     std::vector<RunLog> logs;
     std::vector<const OptiOdomRun*> sources;
     for (const OptiOdomSession& s : sessions) {
@@ -379,9 +378,8 @@ int RunImportOptiOdomCommand(const ImportOptiOdomOptions& options) {
       }
     }
 
-    std::printf(
-        "%s\n",
-        CheckImportedChannelOrder(logs, *Omni3ModelOf(robot), options.skip_mapping_check).c_str());
+    std::printf("%s\n",
+                CheckImportedChannelOrder(logs, *robot, options.skip_mapping_check).c_str());
 
     // Whole or not at all: staged beside --out, renamed over it once complete.
     io::StagedDirectory staged(options.out);
@@ -399,7 +397,8 @@ int RunImportOptiOdomCommand(const ImportOptiOdomOptions& options) {
       io::WriteFileAtomically((out / e.ground_truth).string(),
                               io::GroundTruthCsv(logs[i].ground_truth));
     });
-    io::WriteFileAtomically((out / "robot.yaml").string(), io::Omni3RobotYaml(robot, nullptr));
+    io::WriteFileAtomically((out / "robot.yaml").string(),
+                            robot->RobotYaml(robot->robot().nominal, /*calibration_block=*/""));
     io::WriteFileAtomically((out / "dataset.yaml").string(),
                             io::DatasetYaml("robot.yaml", entries));
     CommitDirectoryOutput(staged, options.out, kDatasetKind, options.force, options.sessions);

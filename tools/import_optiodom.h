@@ -24,7 +24,7 @@
 #include <string>
 #include <vector>
 
-#include "odometry/robot_description.h"
+#include "models/omni3/omni3_robot.h"
 #include "odometry/run_log.h"
 
 namespace CLI {

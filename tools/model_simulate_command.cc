@@ -57,10 +57,10 @@ void PrintTruth(const Robot& robot, const std::vector<double>& truth) {
 }  // namespace
 
 int RunModelSimulateCommand(const ModelSimulateOptions& options) {
-  if (!options.omni3_only_flags.empty()) {
-    std::cerr << "fitcal simulate: " << options.omni3_only_flags.front()
-              << " belongs to the omni3 flower simulator, not to --model " << options.model
-              << " (README \"Simulator\")\n";
+  if (!options.flower_only_flags.empty()) {
+    std::cerr << "fitcal simulate: " << options.flower_only_flags.front()
+              << " belongs to the flower simulation (simulate without --model), not to --model "
+              << options.model << " (docs/simulate.md)\n";
     return 2;
   }
   if (const std::string refusal =

@@ -20,11 +20,11 @@ struct ModelSimulateOptions {
   std::string truth;  // "" = the default true robot (model_scenarios.h)
   bool force = false;
   sim::ScenarioNoise noise;
-  std::vector<std::string> omni3_only_flags;  // given flags that only the omni3 simulator takes
+  std::vector<std::string> flower_only_flags;  // given flags that only the flower simulation takes
 };
 
 // Exit codes: 0 written; 1 bad input (one line); 2 usage (an existing --out without --force, a
-// flag of the omni3 simulator, a robot of another model).
+// flag only the flower simulation takes, a robot of another model).
 int RunModelSimulateCommand(const ModelSimulateOptions& options);
 
 }  // namespace fitcal::tools

@@ -73,7 +73,7 @@ int RunModelSimulate(const SimulateCommandOptions& options) {
   o.noise.angle_sigma_rad = options.angle_sigma_deg * M_PI / 180.0;
   o.noise.gt_position_sigma_m = options.gt_position_sigma_m;
   o.noise.gt_heading_sigma_rad = options.gt_heading_sigma_deg * M_PI / 180.0;
-  o.omni3_only_flags = options.omni3_only_flags;
+  o.flower_only_flags = options.flower_only_flags;
   return RunModelSimulateCommand(o);
 }
 
@@ -143,7 +143,7 @@ void AddSimulateOptions(CLI::App& app, SimulateCommandOptions& o) {
   app.callback([&app, &o] {
     o.robot_given = app.count("--robot") > 0;
     for (const char* flag : {"--slip-sigma", "--inject"}) {
-      if (app.count(flag) > 0) o.omni3_only_flags.push_back(flag);
+      if (app.count(flag) > 0) o.flower_only_flags.push_back(flag);
     }
   });
 }

@@ -36,7 +36,7 @@ struct SimulateCommandOptions {
   // --model only (the flower has slip instead): tools/sim/model_scenarios.h.
   double wheel_rate_sigma_rad_s = sim::ScenarioNoise{}.wheel_rate_sigma_rad_s;
   double angle_sigma_deg = sim::ScenarioNoise{}.angle_sigma_rad * 180.0 / M_PI;
-  std::vector<std::string> omni3_only_flags;  // given flags that only the flower takes
+  std::vector<std::string> flower_only_flags;  // given flags that only the flower takes
 };
 
 // Declares every flag of `simulate` on its subcommand `app`, bound to `options`; once parsed, the

@@ -2,10 +2,10 @@
 // Palacin et al. 2022 on the model seam (kinematic_model.h): nine parameters in the order of
 // Eq. 15, p = (R_a, R_b, R_c, r_a, r_b, r_c, delta_a, delta_b, delta_c), the body step of one
 // encoder interval dt M^-1 w (Eq. 4) with M^-1 in the closed form of Eq. 6
-// (odometry/omni3_model.h), and the inverse kinematics w = M v (Eq. 1 and 3).
+// (models/omni3/omni3_parameters.h), and the inverse kinematics w = M v (Eq. 1 and 3).
 
 #include "models/model_interface.h"
-#include "odometry/omni3_model.h"
+#include "models/omni3/omni3_parameters.h"
 #include "odometry/replay.h"
 
 namespace fitcal {

@@ -8,6 +8,7 @@
 #include "io/robot_yaml_blocks.h"
 #include "io/yaml_reader.h"
 #include "io/yaml_text.h"
+#include "models/model_registry.h"
 #include "models/omni/omni_model.h"
 
 namespace fitcal {
@@ -105,6 +106,36 @@ std::shared_ptr<const Omni3Model> Omni3ModelOf(const Omni3Robot& omni3_robot) {
   robot.encoder = omni3_robot.encoder;
   robot.effects = omni3_robot.effects;
   return std::make_shared<Omni3Model>(std::move(robot), omni3_robot.bounds.angle_offset_rad);
+}
+
+Omni3Robot Omni3RobotOf(const Omni3Model& model) {
+  const Robot& robot = model.robot();
+  Omni3Robot out;
+  out.name = robot.name;
+  for (int i = 0; i < omni3::kNumWheels; ++i) out.wheel_names[i] = robot.channels[i].name;
+  out.nominal = omni3::Parameters::FromArray(robot.nominal.data());
+  // One box per group (the YAML's schema; both constructors above fill every wheel alike).
+  out.bounds.distance_m = robot.bounds[omni3::kDistanceIndex];
+  out.bounds.radius_m = robot.bounds[omni3::kRadiusIndex];
+  out.bounds.angle_offset_rad = model.angle_offset_rad();
+  out.encoder = robot.encoder;
+  out.effects = robot.effects;
+  return out;
+}
+
+Omni3Robot ReadOmni3Robot(const std::string& path) {
+  const YAML::Node root = io::LoadYamlFile(path);
+  io::ExpectYamlType(root, YAML::NodeType::Map, path, "robot file");
+  // Another model's schema would fail on its first key; name the model instead.
+  if (root["model"]) {
+    const std::string model = io::YamlString(root["model"], path, "robot.model");
+    if (model != "omni3") {
+      throw InputError(InputErrorKind::kUnknownModel, path, LineOf(root["model"]),
+                       "model '" + model + "' is not omni3 (an omni3 robot is expected here)");
+    }
+  }
+  const RobotModelPtr model = ReadRobotModel(root, path);
+  return Omni3RobotOf(dynamic_cast<const Omni3Model&>(*model));
 }
 
 const Omni3Model& DefaultOmni3Model() {

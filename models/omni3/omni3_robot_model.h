@@ -9,7 +9,7 @@
 
 #include "models/kinematic_model.h"
 #include "models/omni3/omni3_kinematics.h"
-#include "odometry/robot_description.h"
+#include "models/omni3/omni3_robot.h"
 
 namespace fitcal {
 
@@ -18,6 +18,9 @@ class Omni3Model : public KinematicModel<Omni3Kinematics> {
   // angle_offset: the YAML's angle bounds relative to the nominal angles (kept to write back).
   Omni3Model(Robot robot, Interval angle_offset_rad)
       : KinematicModel(std::move(robot)), angle_offset_rad_(angle_offset_rad) {}
+
+  // The angle bounds relative to the nominal angles (Eq. 16), as the YAML states them.
+  const Interval& angle_offset_rad() const { return angle_offset_rad_; }
 
   using RobotModelInterface::RobotYaml;
   std::string RobotYaml(const std::vector<double>& p,
@@ -46,9 +49,14 @@ bounds:
 
 RobotModelPtr ReadOmni3Model(const YAML::Node& root, const std::string& path);
 
-// The seam's view of a robot read by the omni3-specific loader (odometry/robot_description.h),
-// for the omni3 code paths that predate the seam.
+// The seam's view of an omni3 robot held in named fields (models/omni3/omni3_robot.h), for the
+// paper-reproduction code and the OptiOdom importer, and its inverse.
 std::shared_ptr<const Omni3Model> Omni3ModelOf(const Omni3Robot& robot);
+Omni3Robot Omni3RobotOf(const Omni3Model& model);
+
+// An omni3 robot YAML read as the registry reads every robot (ReadOmni3Model and the registry's
+// checks), in named fields. InputError, at the `model:` line, for a robot of another model.
+Omni3Robot ReadOmni3Robot(const std::string& path);
 
 // The omni3 model of the default Omni3Robot, made once: the kinematics for callers that hold omni3
 // parameters without a robot (the parameters come with each call, the robot's values are not used).

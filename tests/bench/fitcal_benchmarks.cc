@@ -15,7 +15,7 @@
 #include "models/model_registry.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "odometry/linear_final_pose_kernel.h"
-#include "odometry/omni3_replay.h"
+#include "tests/omni3_reference_replay.h"
 #include "tools/sim/flower_scenario.h"
 
 namespace fitcal {

@@ -10,11 +10,12 @@
 #include <optional>
 #include <stdexcept>
 
-#include "models/asoc/asoc_files.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/log_files.h"
 #include "io/robot_yaml.h"
+#include "models/asoc/asoc_files.h"
+#include "models/omni3/omni3_robot_model.h"
 #include "tools/import_rosbag2.h"
 
 namespace fitcal::fuzz {
@@ -111,12 +112,12 @@ void FuzzDataset(const std::string& dir) {
 
 void FuzzOmni3Robot(const std::string& path) {
   if (io::ReadRobotModel(path) != "omni3") return;
-  const Omni3Robot robot = io::ReadOmni3Robot(path);
+  const std::shared_ptr<const Omni3Model> model = Omni3ModelOf(ReadOmni3Robot(path));
   // Round trip: what fitcal writes, fitcal must read back.
   const std::string again = path + ".out.yaml";
-  WriteFile(again, io::Omni3RobotYaml(robot, nullptr));
+  WriteFile(again, model->RobotYaml(model->robot().nominal, ""));
   try {
-    io::ReadOmni3Robot(again);
+    ReadOmni3Robot(again);
   } catch (const io::InputError& e) {
     throw std::logic_error(std::string("written robot YAML does not read back: ") + e.what());
   }

@@ -15,8 +15,8 @@
 
 #include <vector>
 
+#include "models/omni3/omni3_robot.h"
 #include "models/omni3/omni3_robot_model.h"
-#include "odometry/robot_description.h"
 #include "tools/sim/flower_trajectories.h"
 #include "tools/sim/model_simulator.h"
 

@@ -1,8 +1,10 @@
 #pragma once
-// Dead reckoning of a three-wheeled omni robot, Palacin et al. 2022 Eq. 4:
+// The test oracle of the omni3 replay: dead reckoning of a three-wheeled omni robot written as
+// Palacin et al. 2022 Eq. 4 for one robot,
 //   pose(k) = pose(k-1) + dt_k * R(theta(k-1))^-1 * M^-1 * w(k)
-// with R^-1 of Eq. 5 and M^-1 of Eq. 6 (omni3_model.h). Templated on the scalar: the Ceres fit
-// differentiates through it with ceres::Jet, everything else runs it on double.
+// with R^-1 of Eq. 5 and M^-1 of Eq. 6 (models/omni3/omni3_parameters.h). fitcal replays every
+// model through the seam (odometry/replay.h, models/omni3/omni3_kinematics.h); the tests and one
+// benchmark check that replay against this one. Templated on the scalar (double and ceres::Jet).
 //
 // Speed: the replay runs in chunks of kChunk samples. A first pass computes every sample's
 // robot-frame step M^-1 w dt and the rotation (cos, sin) over its interval; these do not depend on
@@ -18,8 +20,8 @@
 #include <cstddef>
 #include <type_traits>
 
+#include "models/omni3/omni3_parameters.h"
 #include "odometry/encoder_samples.h"
-#include "odometry/omni3_model.h"
 #include "odometry/pose2.h"
 #include "odometry/replay.h"
 

@@ -1,14 +1,16 @@
 #pragma once
-// What fitcal knows about a robot before fitting: its nominal geometry (Palacin Eq. 15) and the
-// box within which the fit may move each parameter (Eq. 16). Filled from the robot YAML by io/.
+// An omni3 robot in named fields: its nominal geometry (Palacin Eq. 15) and the box within which
+// the fit may move each parameter (Eq. 16), as the paper-reproduction code and the OptiOdom
+// importer hold it. Read with ReadOmni3Robot and put on the model seam with Omni3ModelOf
+// (omni3_robot_model.h); every fit runs through the seam.
 
 #include <array>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "models/omni3/omni3_parameters.h"
 #include "odometry/effects.h"
-#include "odometry/omni3_model.h"
 #include "odometry/robot.h"
 
 namespace fitcal {
@@ -29,7 +31,7 @@ struct Omni3Robot {
   // replayed by odometry/effects.h ReplayStepsWithEffects.
   std::vector<effects::EffectValue> effects;
 
-  // Per-parameter [lo, hi] in the flat order of omni3_model.h.
+  // Per-parameter [lo, hi] in the flat order of omni3_parameters.h.
   std::array<Interval, omni3::kNumParameters> ParameterBounds() const {
     std::array<Interval, omni3::kNumParameters> out{};
     for (int i = 0; i < omni3::kNumWheels; ++i) {
