@@ -6,9 +6,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
-#include <map>
-#include <numeric>
-#include <regex>
 #include <set>
 
 #include "fit/final_pose_errors.h"
@@ -18,7 +15,6 @@
 #include "io/input_error.h"
 #include "io/input_registry.h"
 #include "io/staged_directory.h"
-#include "io/text_file.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "odometry/aligned_run.h"
 #include "odometry/parallel_for.h"
@@ -27,6 +23,7 @@
 #include "tools/import_optiodom_omni4.h"
 #include "tools/import_optiodom_tricycle.h"
 #include "tools/miswired_error.h"
+#include "tools/optiodom_format.h"
 #include "tools/output_guard.h"
 
 namespace fitcal::tools {
@@ -42,156 +39,50 @@ constexpr double kWheelAngleDeg[3] = {300.0, 60.0, 180.0};
 // Our wheel rate = kTickSign * the authors' (the header derives it).
 constexpr double kTickSign = -1.0;
 
-std::vector<std::string> SplitCsv(std::string_view line) {
-  std::vector<std::string> out;
-  std::size_t pos = 0;
-  while (true) {
-    const std::size_t end = line.find(',', pos);
-    out.emplace_back(io::Trim(line.substr(pos, end == std::string_view::npos ? end : end - pos)));
-    if (end == std::string_view::npos) break;
-    pos = end + 1;
-  }
-  return out;
-}
-
-double ParseNumber(const std::string& field, const std::string& path, int line,
-                   const std::string& what) {
-  double v = 0.0;
-  bool finite = true;
-  if (!io::ParseDouble(field, &v, &finite) || !finite) {
-    throw InputError(InputErrorKind::kNonNumeric, path, line,
-                     what + " is not a finite number: '" + field + "'");
-  }
-  return v;
-}
-
 OptiOdomMetadata ReadMetadata(const std::string& path) {
-  const std::string text = io::ReadTextFile(path);
-  io::LineScanner lines(text);
-  std::string_view line;
-  std::map<std::string, std::pair<int, std::vector<double>>> rows;  // key -> (line, numbers)
+  const optiodom::Metadata rows = optiodom::ReadMetadata(path, "omni3");
   OptiOdomMetadata meta;
-  while (lines.Next(&line)) {
-    if (io::Trim(line).empty()) continue;
-    std::vector<std::string> fields = SplitCsv(line);
-    const std::string key = fields[0];
-    if (key == "type") {
-      meta.type = fields.size() > 1 ? fields[1] : "";
-      continue;
-    }
-    std::vector<double> values;
-    for (std::size_t i = 1; i < fields.size(); ++i) {
-      if (fields[i].empty()) continue;  // the file pads every row to the widest one
-      values.push_back(
-          ParseNumber(fields[i], path, lines.line_number(), key + " value " + std::to_string(i)));
-    }
-    rows[key] = {lines.line_number(), values};
-  }
-  if (meta.type != "omni3") {
-    throw InputError(
-        InputErrorKind::kUnknownModel, path, 1,
-        "type '" + meta.type + "' is not omni3 (the only OptiOdom robot fitcal imports)");
-  }
-  const auto get = [&](const std::string& key, std::size_t count, bool exact) {
-    const auto it = rows.find(key);
-    if (it == rows.end())
-      throw InputError(InputErrorKind::kMissingKey, path, 0, "no row '" + key + "'");
-    const auto& [line_number, values] = it->second;
-    if (exact ? values.size() != count : values.size() < count) {
-      throw InputError(InputErrorKind::kWrongColumnCount, path, line_number,
-                       key + " needs " + std::to_string(count) + " value(s), found " +
-                           std::to_string(values.size()));
-    }
-    for (double v : values) {
-      if (key.rfind("gt_", 0) != 0 && key.rfind("odo_", 0) != 0 && !(v > 0.0)) {
-        throw InputError(InputErrorKind::kBadValue, path, line_number, key + " must be positive");
-      }
-    }
-    return values;
-  };
-  meta.gear_ratio = get("ngear", 1, true)[0];
-  meta.encoder_counts_per_rev = get("encRes", 1, true)[0];
-  meta.distance_m = get("Li", 1, true)[0];
-  const std::vector<double> d = get("Di", 3, true);
+  meta.type = rows.type;
+  meta.gear_ratio = rows.Value("ngear", true);
+  meta.encoder_counts_per_rev = rows.Value("encRes", true);
+  meta.distance_m = rows.Value("Li", true);
+  const std::vector<double> d = rows.Values("Di", 3, true);
   std::copy(d.begin(), d.end(), meta.diameter_m.begin());
-  const double n = get("N", 1, true)[0];
-  if (n != std::floor(n))
-    throw InputError(InputErrorKind::kBadValue, path, rows["N"].first, "N is not a whole number");
-  meta.num_runs = static_cast<int>(n);
+  meta.num_runs = rows.NumRuns();
   const std::size_t runs = static_cast<std::size_t>(meta.num_runs);
-  meta.gt_ti_s = get("gt_ti", runs, true);
-  meta.gt_tf_s = get("gt_tf", runs, true);
-  meta.odo_ti_s = get("odo_ti", runs, true);
-  meta.odo_tf_s = get("odo_tf", runs, true);
+  meta.gt_ti_s = rows.Values("gt_ti", runs, false);
+  meta.gt_tf_s = rows.Values("gt_tf", runs, false);
+  meta.odo_ti_s = rows.Values("odo_ti", runs, false);
+  meta.odo_tf_s = rows.Values("odo_tf", runs, false);
   return meta;
 }
 
 OptiOdomRun ReadRun(const std::string& path, int number) {
-  const std::string text = io::ReadTextFile(path);
-  io::LineScanner lines(text);
-  std::string_view line;
+  optiodom::RunRows rows = optiodom::ReadRun(path, number, 3, "ticks_1, ticks_2, ticks_3");
   OptiOdomRun run;
   run.number = number;
-  while (lines.Next(&line)) {
-    if (io::Trim(line).empty()) continue;
-    const std::vector<std::string> fields = SplitCsv(line);
-    if (fields.size() != 7) {
-      throw InputError(InputErrorKind::kWrongColumnCount, path, lines.line_number(),
-                       "expected 7 fields (t, x, y, theta, ticks_1, ticks_2, ticks_3), found " +
-                           std::to_string(fields.size()));
-    }
-    double v[7];
-    for (int i = 0; i < 7; ++i) {
-      v[i] = ParseNumber(fields[i], path, lines.line_number(), "field " + std::to_string(i + 1));
-    }
-    if (!run.t_s.empty() && !(v[0] > run.t_s.back())) {
-      throw InputError(InputErrorKind::kNonIncreasingTime, path, lines.line_number(),
-                       "time " + fields[0] + " s is not after the previous row's");
-    }
-    run.t_s.push_back(v[0]);
-    // + 0.0 turns the file's "-0" into 0.
-    run.ticks.push_back({kTickSign * v[4] + 0.0, kTickSign * v[5] + 0.0, kTickSign * v[6] + 0.0});
-    run.ground_truth.t_s.push_back(v[0]);
-    run.ground_truth.world_T_robot.push_back(Pose2d{v[1], v[2], v[3]});
+  run.t_s = std::move(rows.t_s);
+  for (const std::vector<double>& e : rows.encoder) {
+    // + 0.0 keeps a flipped 0 at 0.
+    run.ticks.push_back({kTickSign * e[0] + 0.0, kTickSign * e[1] + 0.0, kTickSign * e[2] + 0.0});
   }
-  if (run.t_s.size() < 2) {
-    throw InputError(InputErrorKind::kTooFewSamples, path, 0,
-                     "needs at least two rows, found " + std::to_string(run.t_s.size()));
-  }
+  run.ground_truth = std::move(rows.ground_truth);
   return run;
 }
 
 }  // namespace
 
 OptiOdomSession ReadOptiOdomSession(const std::string& directory) {
-  const fs::path dir = fs::path(directory).lexically_normal();
-  if (!fs::is_directory(dir))
-    throw InputError(InputErrorKind::kMissingFile, directory, 0, "not a directory");
+  const optiodom::SessionFiles files = optiodom::ListSession(directory);
   OptiOdomSession session;
-  session.name = (dir.has_filename() ? dir : dir.parent_path()).filename().string();
-  session.path_type =
-      (dir.has_filename() ? dir : dir.parent_path()).parent_path().filename().string();
-  if (session.path_type.empty()) session.path_type = "path";
-  session.metadata = ReadMetadata((dir / (session.name + "_metadata.csv")).string());
-
-  const std::regex run_name(session.name + "_run-([0-9]+)\\.csv");
-  std::vector<std::pair<int, std::string>> files;
-  for (const auto& entry : fs::directory_iterator(dir)) {
-    std::smatch m;
-    const std::string name = entry.path().filename().string();
-    if (std::regex_match(name, m, run_name))
-      files.emplace_back(std::stoi(m[1]), entry.path().string());
-  }
-  std::sort(files.begin(), files.end());
-  if (static_cast<int>(files.size()) != session.metadata.num_runs) {
-    throw InputError(
-        InputErrorKind::kBadValue, (dir / (session.name + "_metadata.csv")).string(), 0,
-        "N = " + std::to_string(session.metadata.num_runs) + " runs, but the directory holds " +
-            std::to_string(files.size()) + " run files");
-  }
-  session.runs.resize(files.size());
-  ParallelFor(files.size(), 0,
-              [&](std::size_t i) { session.runs[i] = ReadRun(files[i].second, files[i].first); });
+  session.name = files.name;
+  session.path_type = files.path_type;
+  session.metadata = ReadMetadata(files.metadata_path);
+  optiodom::CheckRunCount(files, session.metadata.num_runs);
+  session.runs.resize(files.runs.size());
+  ParallelFor(files.runs.size(), 0, [&](std::size_t i) {
+    session.runs[i] = ReadRun(files.runs[i].second, files.runs[i].first);
+  });
   return session;
 }
 
@@ -263,24 +154,6 @@ std::string TicksCsv(const OptiOdomRun& run) {
 
 namespace {
 
-// The `type` row of a session's metadata (diff, tricyc, omni3, omni4).
-std::string OptiOdomSessionType(const std::string& directory) {
-  const fs::path dir(directory);
-  const std::string name =
-      dir.filename().empty() ? dir.parent_path().filename().string() : dir.filename().string();
-  const std::string path = (dir / (name + "_metadata.csv")).string();
-  const std::string text = io::ReadTextFile(path);
-  io::LineScanner lines(text);
-  std::string_view line;
-  while (lines.Next(&line)) {
-    const std::string_view t = io::Trim(line);
-    if (t.substr(0, 5) != "type,") continue;
-    const std::string_view rest = t.substr(5);
-    return std::string(io::Trim(rest.substr(0, rest.find(','))));
-  }
-  throw InputError(InputErrorKind::kMissingKey, path, 0, "no 'type' row");
-}
-
 // The other robots of the OptiOdom study, each with its own importer.
 int ImportOtherOptiOdomRobot(const std::string& type, const ImportOptiOdomOptions& options) {
   if (type == "diff") {
@@ -328,10 +201,10 @@ int RunImportOptiOdomCommand(const ImportOptiOdomOptions& options) {
       std::cerr << "fitcal: import optiodom needs at least one session directory\n";
       return 2;
     }
-    const std::string type = OptiOdomSessionType(options.sessions.front());
+    const std::string type = optiodom::SessionType(options.sessions.front());
     for (const std::string& dir : options.sessions) {
-      if (OptiOdomSessionType(dir) != type) {
-        std::cerr << "fitcal: " << dir << ": a " << OptiOdomSessionType(dir) << " session among "
+      if (optiodom::SessionType(dir) != type) {
+        std::cerr << "fitcal: " << dir << ": a " << optiodom::SessionType(dir) << " session among "
                   << type << " sessions; import one robot at a time\n";
         return 2;
       }

@@ -6,8 +6,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
-#include <map>
-#include <regex>
 #include <set>
 #include <stdexcept>
 
@@ -21,6 +19,7 @@
 #include "odometry/aligned_run.h"
 #include "tools/import_channel_order.h"
 #include "tools/miswired_error.h"
+#include "tools/optiodom_format.h"
 #include "tools/output_guard.h"
 
 namespace fitcal::tools {
@@ -42,29 +41,6 @@ constexpr FlaggedRun kFlaggedDiffRuns[] = {
     {"square", "231220200029", 2, "flagged as a bad run by the OptiOdom authors"},
 };
 
-std::vector<std::string> SplitCsv(std::string_view line) {
-  std::vector<std::string> out;
-  std::size_t pos = 0;
-  while (true) {
-    const std::size_t end = line.find(',', pos);
-    out.emplace_back(io::Trim(line.substr(pos, end == std::string_view::npos ? end : end - pos)));
-    if (end == std::string_view::npos) break;
-    pos = end + 1;
-  }
-  return out;
-}
-
-double ParseNumber(const std::string& field, const std::string& path, int line,
-                   const std::string& what) {
-  double v = 0.0;
-  bool finite = true;
-  if (!io::ParseDouble(field, &v, &finite) || !finite) {
-    throw InputError(InputErrorKind::kNonNumeric, path, line,
-                     what + " is not a finite number: '" + field + "'");
-  }
-  return v;
-}
-
 struct DiffMetadata {
   double gear_ratio = 0.0;            // ngear
   double counts_per_motor_rev = 0.0;  // encRes
@@ -80,57 +56,15 @@ struct DiffMetadata {
 };
 
 DiffMetadata ReadDiffMetadata(const std::string& path) {
-  const std::string text = io::ReadTextFile(path);
-  io::LineScanner lines(text);
-  std::string_view line;
-  std::map<std::string, std::pair<int, std::vector<double>>> rows;  // key -> (line, numbers)
-  std::string type;
-  while (lines.Next(&line)) {
-    if (io::Trim(line).empty()) continue;
-    const std::vector<std::string> fields = SplitCsv(line);
-    if (fields[0] == "type") {
-      type = fields.size() > 1 ? fields[1] : "";
-      continue;
-    }
-    std::vector<double> values;
-    for (std::size_t i = 1; i < fields.size(); ++i) {
-      if (fields[i].empty()) continue;  // rows are padded to the widest one
-      values.push_back(ParseNumber(fields[i], path, lines.line_number(), fields[0]));
-    }
-    rows[fields[0]] = {lines.line_number(), values};
-  }
-  if (type != "diff") {
-    throw InputError(InputErrorKind::kUnknownModel, path, 1,
-                     "type '" + type + "' is not diff (a differential-drive session)");
-  }
-  const auto get = [&](const std::string& key, std::size_t count) {
-    const auto it = rows.find(key);
-    if (it == rows.end())
-      throw InputError(InputErrorKind::kMissingKey, path, 0, "no row '" + key + "'");
-    const auto& [line_number, values] = it->second;
-    if (values.size() != count) {
-      throw InputError(InputErrorKind::kWrongColumnCount, path, line_number,
-                       key + " needs " + std::to_string(count) + " value(s), found " +
-                           std::to_string(values.size()));
-    }
-    for (double v : values) {
-      if (!(v > 0.0))
-        throw InputError(InputErrorKind::kBadValue, path, line_number, key + " must be positive");
-    }
-    return values;
-  };
+  const optiodom::Metadata rows = optiodom::ReadMetadata(path, "diff");
   DiffMetadata m;
-  m.gear_ratio = get("ngear", 1)[0];
-  m.counts_per_motor_rev = get("encRes", 1)[0];
-  m.separation_m = get("Li", 1)[0];
-  const std::vector<double> d = get("Di", 2);
+  m.gear_ratio = rows.Value("ngear", true);
+  m.counts_per_motor_rev = rows.Value("encRes", true);
+  m.separation_m = rows.Value("Li", true);
+  const std::vector<double> d = rows.Values("Di", 2, true);
   m.diameter_right_m = d[0];
   m.diameter_left_m = d[1];
-  const double n = get("N", 1)[0];
-  if (n != std::floor(n)) {
-    throw InputError(InputErrorKind::kBadValue, path, rows["N"].first, "N is not a whole number");
-  }
-  m.num_runs = static_cast<int>(n);
+  m.num_runs = rows.NumRuns();
   return m;
 }
 
@@ -143,36 +77,12 @@ struct DiffRun {
 };
 
 DiffRun ReadDiffRun(const std::string& path, int number) {
-  const std::string text = io::ReadTextFile(path);
-  io::LineScanner lines(text);
-  std::string_view line;
+  optiodom::RunRows rows = optiodom::ReadRun(path, number, 2, "ticks_right, ticks_left");
   DiffRun run;
   run.number = number;
-  while (lines.Next(&line)) {
-    if (io::Trim(line).empty()) continue;
-    const std::vector<std::string> fields = SplitCsv(line);
-    if (fields.size() != 6) {
-      throw InputError(InputErrorKind::kWrongColumnCount, path, lines.line_number(),
-                       "expected 6 fields (t, x, y, theta, ticks_right, ticks_left), found " +
-                           std::to_string(fields.size()));
-    }
-    double v[6];
-    for (int i = 0; i < 6; ++i) {
-      v[i] = ParseNumber(fields[i], path, lines.line_number(), "field " + std::to_string(i + 1));
-    }
-    if (!run.t_s.empty() && !(v[0] > run.t_s.back())) {
-      throw InputError(InputErrorKind::kNonIncreasingTime, path, lines.line_number(),
-                       "time " + fields[0] + " s is not after the previous row's");
-    }
-    run.t_s.push_back(v[0]);
-    run.ticks.push_back({v[4] + 0.0, v[5] + 0.0});  // + 0.0: "-0" -> 0
-    run.ground_truth.t_s.push_back(v[0]);
-    run.ground_truth.world_T_robot.push_back(Pose2d{v[1], v[2], v[3]});
-  }
-  if (run.t_s.size() < 2) {
-    throw InputError(InputErrorKind::kTooFewSamples, path, 0,
-                     "needs at least two rows, found " + std::to_string(run.t_s.size()));
-  }
+  run.t_s = std::move(rows.t_s);
+  for (const std::vector<double>& e : rows.encoder) run.ticks.push_back({e[0], e[1]});
+  run.ground_truth = std::move(rows.ground_truth);
   return run;
 }
 
@@ -185,32 +95,14 @@ struct DiffSession {
 };
 
 DiffSession ReadDiffSession(const std::string& directory) {
-  fs::path dir = fs::path(directory).lexically_normal();
-  if (!dir.has_filename()) dir = dir.parent_path();
-  if (!fs::is_directory(dir))
-    throw InputError(InputErrorKind::kMissingFile, directory, 0, "not a directory");
+  const optiodom::SessionFiles files = optiodom::ListSession(directory);
   DiffSession s;
-  s.name = dir.filename().string();
-  s.path_type = dir.parent_path().filename().string();
-  if (s.path_type.empty()) s.path_type = "path";
-  s.metadata_path = (dir / (s.name + "_metadata.csv")).string();
+  s.name = files.name;
+  s.path_type = files.path_type;
+  s.metadata_path = files.metadata_path;
   s.metadata = ReadDiffMetadata(s.metadata_path);
-  const std::regex run_name(s.name + "_run-([0-9]+)\\.csv");
-  std::vector<std::pair<int, std::string>> files;
-  for (const auto& entry : fs::directory_iterator(dir)) {
-    std::smatch m;
-    const std::string name = entry.path().filename().string();
-    if (std::regex_match(name, m, run_name))
-      files.emplace_back(std::stoi(m[1]), entry.path().string());
-  }
-  std::sort(files.begin(), files.end());
-  if (static_cast<int>(files.size()) != s.metadata.num_runs) {
-    throw InputError(InputErrorKind::kBadValue, s.metadata_path, 0,
-                     "N = " + std::to_string(s.metadata.num_runs) +
-                         " runs, but the directory holds " + std::to_string(files.size()) +
-                         " run files");
-  }
-  for (const auto& [number, path] : files) s.runs.push_back(ReadDiffRun(path, number));
+  optiodom::CheckRunCount(files, s.metadata.num_runs);
+  for (const auto& [number, path] : files.runs) s.runs.push_back(ReadDiffRun(path, number));
   return s;
 }
 

@@ -5,19 +5,16 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <limits>
-#include <map>
-#include <regex>
 
 #include "io/atomic_file.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/staged_directory.h"
-#include "io/text_file.h"
 #include "models/omni/omni_model.h"
 #include "models/pose_errors.h"
 #include "odometry/parallel_for.h"
 #include "tools/import_channel_order.h"
+#include "tools/optiodom_format.h"
 #include "tools/output_guard.h"
 
 namespace fitcal::tools {
@@ -36,7 +33,6 @@ constexpr struct {
   double x_sign, y_sign, drive_angle_deg, roller_angle_deg;
 } kLayout[kWheels] = {
     {"fl", 1, 1, 0, -45}, {"fr", 1, -1, 180, 45}, {"rl", -1, 1, 0, 45}, {"rr", -1, -1, 180, -45}};
-constexpr int kFieldsPerRow = 4 + kWheels;
 // The box the fit may search. Palacin Eq. 16's (R +- 0.025 m, r +- 6.8 %, delta +- 2 deg) is too
 // tight for these mecanum wheels: regressing the ground truth's steps on the counts gives a
 // translation 8 % above the nominal radius (header), and a fit in Eq. 16's box rests on the r and
@@ -45,137 +41,35 @@ constexpr double kDistanceBound_m = 0.025;
 constexpr double kRadiusBound = 0.15;
 constexpr double kAngleBound_deg = 5.0;
 
-// Parses one number at p (std::from_chars: no locale, no allocation); advances p past it and one
-// separator. False when the field is not a number.
-bool NextNumber(const char*& p, const char* end, double* value) {
-  while (p < end && (*p == ' ' || *p == '\t')) ++p;
-  if (p < end && *p == '+') ++p;
-  const auto [next, ec] = std::from_chars(p, end, *value);
-  if (ec != std::errc() || !std::isfinite(*value)) return false;
-  p = next;
-  while (p < end && (*p == ' ' || *p == '\t' || *p == '\r')) ++p;
-  if (p < end && *p == ',') ++p;
-  return true;
-}
-
 OptiOdomOmni4Metadata ReadMetadata(const std::string& path) {
-  const std::string text = io::ReadTextFile(path);
-  std::map<std::string, std::pair<int, std::vector<double>>> rows;  // key -> (line, values)
-  std::string type;
-  int line_number = 0;
-  std::size_t pos = 0;
-  while (pos < text.size()) {
-    std::size_t eol = text.find('\n', pos);
-    if (eol == std::string::npos) eol = text.size();
-    const std::string line = text.substr(pos, eol - pos);
-    pos = eol + 1;
-    ++line_number;
-    const std::size_t comma = line.find(',');
-    const std::string key(io::Trim(line.substr(0, comma)));
-    if (key.empty()) continue;
-    std::vector<double> values;
-    std::size_t at = comma == std::string::npos ? line.size() : comma + 1;
-    while (at < line.size()) {
-      std::size_t next = line.find(',', at);
-      if (next == std::string::npos) next = line.size();
-      const std::string field(io::Trim(line.substr(at, next - at)));
-      at = next + 1;
-      if (field.empty()) continue;  // rows are padded to the widest one
-      if (key == "type") {
-        type = field;
-        continue;
-      }
-      double v = 0.0;
-      const char* p = field.data();
-      if (!NextNumber(p, field.data() + field.size(), &v) || p != field.data() + field.size()) {
-        throw InputError(InputErrorKind::kNonNumeric, path, line_number,
-                         key + " holds '" + field + "', not a finite number");
-      }
-      values.push_back(v);
-    }
-    rows[key] = {line_number, values};
-  }
-  if (type != "omni4") {
-    throw InputError(InputErrorKind::kUnknownModel, path, 1, "type '" + type + "' is not omni4");
-  }
-  const auto get = [&](const std::string& key, std::size_t count) {
-    const auto it = rows.find(key);
-    if (it == rows.end()) throw InputError(InputErrorKind::kMissingKey, path, 0, "no row " + key);
-    const std::vector<double>& v = it->second.second;
-    if (v.size() != count || *std::min_element(v.begin(), v.end()) <= 0.0) {
-      throw InputError(InputErrorKind::kBadValue, path, it->second.first,
-                       key + " needs " + std::to_string(count) + " positive value(s)");
-    }
-    return v;
-  };
+  const optiodom::Metadata rows = optiodom::ReadMetadata(path, "omni4");
   OptiOdomOmni4Metadata meta;
-  meta.gear_ratio = get("ngear", 1)[0];
-  meta.encoder_counts_per_rev = get("encRes", 1)[0];
-  const std::vector<double> l = get("Li", 2);
+  meta.gear_ratio = rows.Value("ngear", true);
+  meta.encoder_counts_per_rev = rows.Value("encRes", true);
+  const std::vector<double> l = rows.Values("Li", 2, true);
   std::copy(l.begin(), l.end(), meta.length_m.begin());
-  const std::vector<double> d = get("Di", kWheels);
+  const std::vector<double> d = rows.Values("Di", kWheels, true);
   std::copy(d.begin(), d.end(), meta.diameter_m.begin());
-  const double n = get("N", 1)[0];
-  if (n != std::floor(n)) {
-    throw InputError(InputErrorKind::kBadValue, path, rows["N"].first, "N is not a whole number");
-  }
-  meta.num_runs = static_cast<int>(n);
+  meta.num_runs = rows.NumRuns();
   return meta;
 }
 
 // One run file as a RunLog: wheel rates w_i = 2 pi enc_i / (counts per rev dt) over the interval
 // ending at each row, ground truth from the same rows.
-RunLog ReadRun(const std::string& path, const OptiOdomOmni4Metadata& meta) {
-  const std::string text = io::ReadTextFile(path);
+RunLog ReadRun(const std::string& path, int number, const OptiOdomOmni4Metadata& meta) {
+  const optiodom::RunRows rows =
+      optiodom::ReadRun(path, number, kWheels, "enc_1, enc_2, enc_3, enc_4");
   RunLog log;
   log.encoders.samples = EncoderSamples(kWheels);
-  const std::size_t rows_estimate = text.size() / 60 + 1;
-  log.encoders.t_s.reserve(rows_estimate);
-  log.encoders.samples.reserve(rows_estimate);
-  log.ground_truth.t_s.reserve(rows_estimate);
-  log.ground_truth.world_T_robot.reserve(rows_estimate);
   const double rad_per_count = 2.0 * M_PI / meta.CountsPerWheelRev();
-  const char* p = text.data();
-  const char* end = p + text.size();
-  int line = 0;
-  while (p < end) {
-    ++line;
-    const char* eol = std::find(p, end, '\n');
-    if (eol == p || (eol == p + 1 && *p == '\r')) {
-      p = eol + 1;
-      continue;
-    }
-    double v[kFieldsPerRow];
-    for (int f = 0; f < kFieldsPerRow; ++f) {
-      if (p >= eol || !NextNumber(p, eol, &v[f])) {
-        throw InputError(InputErrorKind::kNonNumeric, path, line,
-                         "field " + std::to_string(f + 1) + " of " + std::to_string(kFieldsPerRow) +
-                             " is missing or not a number");
-      }
-    }
-    if (p != eol) {
-      throw InputError(InputErrorKind::kWrongColumnCount, path, line,
-                       "more than " + std::to_string(kFieldsPerRow) + " fields");
-    }
-    p = eol + 1;
-    std::vector<double>& t = log.encoders.t_s;
-    if (!t.empty()) {
-      const double dt = v[0] - t.back();
-      if (!(dt > 0.0)) {
-        throw InputError(InputErrorKind::kNonIncreasingTime, path, line,
-                         "time is not after the previous row's");
-      }
-      double w[kWheels];
-      for (int i = 0; i < kWheels; ++i) w[i] = rad_per_count * v[4 + i] / dt + 0.0;  // "-0" -> 0
-      log.encoders.samples.push_back(dt, w);
-    }
-    t.push_back(v[0]);
-    log.ground_truth.t_s.push_back(v[0]);
-    log.ground_truth.world_T_robot.push_back(Pose2d{v[1], v[2], v[3]});
+  for (std::size_t k = 1; k < rows.t_s.size(); ++k) {
+    const double dt = rows.t_s[k] - rows.t_s[k - 1];
+    double w[kWheels];
+    for (int i = 0; i < kWheels; ++i) w[i] = rad_per_count * rows.encoder[k][i] / dt + 0.0;
+    log.encoders.samples.push_back(dt, w);
   }
-  if (log.encoders.t_s.size() < 2) {
-    throw InputError(InputErrorKind::kTooFewSamples, path, 0, "needs at least two rows");
-  }
+  log.encoders.t_s = rows.t_s;
+  log.ground_truth = rows.ground_truth;
   // The ground truth is in the robot's start frame and the robot is at rest at the start.
   log.start_pose = log.ground_truth.world_T_robot.front();
   return log;
@@ -232,35 +126,17 @@ std::string GroundTruthCsvText(const GroundTruthTrack& track) {
 }  // namespace
 
 OptiOdomOmni4Session ReadOptiOdomOmni4Session(const std::string& directory) {
-  const fs::path dir = fs::path(directory).lexically_normal();
-  if (!fs::is_directory(dir)) {
-    throw InputError(InputErrorKind::kMissingFile, directory, 0, "not a directory");
-  }
-  const fs::path named = dir.has_filename() ? dir : dir.parent_path();
+  const optiodom::SessionFiles read = optiodom::ListSession(directory);
   OptiOdomOmni4Session session;
-  session.name = named.filename().string();
-  session.path_type = named.parent_path().filename().string();
-  if (session.path_type.empty()) session.path_type = "path";
-  const std::string metadata_path = (dir / (session.name + "_metadata.csv")).string();
-  session.metadata = ReadMetadata(metadata_path);
-
-  const std::regex run_name(session.name + "_run-([0-9]+)\\.csv");
-  std::vector<std::pair<int, std::string>> files;
-  for (const auto& entry : fs::directory_iterator(dir)) {
-    std::smatch m;
-    const std::string name = entry.path().filename().string();
-    if (std::regex_match(name, m, run_name)) files.emplace_back(std::stoi(m[1]), entry.path());
-  }
-  std::sort(files.begin(), files.end());
-  if (static_cast<int>(files.size()) != session.metadata.num_runs) {
-    throw InputError(InputErrorKind::kBadValue, metadata_path, 0,
-                     "N = " + std::to_string(session.metadata.num_runs) +
-                         " runs, but the directory holds " + std::to_string(files.size()));
-  }
+  session.name = read.name;
+  session.path_type = read.path_type;
+  session.metadata = ReadMetadata(read.metadata_path);
+  optiodom::CheckRunCount(read, session.metadata.num_runs);
+  const auto& files = read.runs;
   session.runs.resize(files.size());
   ParallelFor(files.size(), 0, [&](std::size_t i) {
     RunLog& log = session.runs[i];
-    log = ReadRun(files[i].second, session.metadata);
+    log = ReadRun(files[i].second, files[i].first, session.metadata);
     char id[96];
     std::snprintf(id, sizeof id, "%s_%s_run%02d", session.path_type.c_str(), session.name.c_str(),
                   files[i].first);

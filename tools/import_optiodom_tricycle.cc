@@ -4,8 +4,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <map>
-#include <regex>
 #include <set>
 #include <stdexcept>
 
@@ -14,12 +12,12 @@
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/staged_directory.h"
-#include "io/text_file.h"
 #include "models/tricycle/tricycle_checks.h"
 #include "models/tricycle/tricycle_model.h"
 #include "odometry/aligned_run.h"
 #include "tools/import_channel_order.h"
 #include "tools/miswired_error.h"
+#include "tools/optiodom_format.h"
 #include "tools/output_guard.h"
 
 namespace fitcal::tools {
@@ -31,177 +29,43 @@ using K = TricycleKinematics;
 
 namespace {
 
-constexpr int kRunFields = 6;  // t, x, y, theta, ticks, steering
-// Every key of the published metadata; any other is a format fitcal does not know.
-const std::set<std::string> kMetadataKeys = {"type",  "ngear",  "encRes", "Li",       "Di",
-                                             "Thi",   "N",      "L",      "imarkers", "gt_ti",
-                                             "gt_tf", "odo_ti", "odo_tf"};
-
-std::vector<std::string> SplitCsv(std::string_view line) {
-  std::vector<std::string> out;
-  std::size_t pos = 0;
-  while (true) {
-    const std::size_t end = line.find(',', pos);
-    out.emplace_back(io::Trim(line.substr(pos, end == std::string_view::npos ? end : end - pos)));
-    if (end == std::string_view::npos) break;
-    pos = end + 1;
-  }
-  return out;
-}
-
-double ParseNumber(const std::string& field, const std::string& path, int line,
-                   const std::string& what) {
-  double v = 0.0;
-  bool finite = true;
-  if (!io::ParseDouble(field, &v, &finite) || !finite) {
-    throw InputError(InputErrorKind::kNonNumeric, path, line,
-                     what + " is not a finite number: '" + field + "'");
-  }
-  return v;
-}
-
-// key -> (line, numbers); empty fields (the file pads rows to the widest) are skipped.
-using MetadataRows = std::map<std::string, std::pair<int, std::vector<double>>>;
-
-MetadataRows ReadMetadataRows(const std::string& path, std::string* type) {
-  const std::string text = io::ReadTextFile(path);
-  io::LineScanner lines(text);
-  std::string_view line;
-  MetadataRows rows;
-  while (lines.Next(&line)) {
-    if (io::Trim(line).empty()) continue;
-    const std::vector<std::string> fields = SplitCsv(line);
-    const std::string& key = fields[0];
-    if (kMetadataKeys.count(key) == 0) {
-      throw InputError(InputErrorKind::kUnknownKey, path, lines.line_number(),
-                       "unknown metadata row '" + key + "'");
-    }
-    if (key == "type") {
-      *type = fields.size() > 1 ? fields[1] : "";
-      continue;
-    }
-    std::vector<double> values;
-    for (std::size_t i = 1; i < fields.size(); ++i) {
-      if (fields[i].empty()) continue;
-      values.push_back(
-          ParseNumber(fields[i], path, lines.line_number(), key + " value " + std::to_string(i)));
-    }
-    rows[key] = {lines.line_number(), values};
-  }
-  return rows;
-}
-
-// The single value of row `key`, positive unless it may be any number.
-double MetadataValue(const MetadataRows& rows, const std::string& key, const std::string& path,
-                     bool positive) {
-  const auto it = rows.find(key);
-  if (it == rows.end()) {
-    throw InputError(InputErrorKind::kMissingKey, path, 0, "no row '" + key + "'");
-  }
-  const auto& [line, values] = it->second;
-  if (values.size() != 1) {
-    throw InputError(InputErrorKind::kWrongColumnCount, path, line,
-                     key + " needs 1 value, found " + std::to_string(values.size()));
-  }
-  if (positive && !(values[0] > 0.0)) {
-    throw InputError(InputErrorKind::kBadValue, path, line, key + " must be positive");
-  }
-  return values[0];
-}
-
 OptiOdomTricycleMetadata ReadMetadata(const std::string& path) {
-  std::string type;
-  const MetadataRows rows = ReadMetadataRows(path, &type);
-  if (type != "tricyc") {
-    throw InputError(InputErrorKind::kUnknownModel, path, 1,
-                     "type '" + type + "' is not tricyc (this importer reads tricycles)");
-  }
+  const optiodom::Metadata rows = optiodom::ReadMetadata(path, "tricyc");
   OptiOdomTricycleMetadata meta;
-  meta.gear_ratio = MetadataValue(rows, "ngear", path, true);
-  meta.encoder_counts_per_rev = MetadataValue(rows, "encRes", path, true);
-  meta.wheelbase_m = MetadataValue(rows, "Li", path, true);
-  meta.diameter_m = MetadataValue(rows, "Di", path, true);
-  meta.steering_offset_rad = MetadataValue(rows, "Thi", path, false);
-  const double n = MetadataValue(rows, "N", path, true);
-  if (n != std::floor(n)) {
-    throw InputError(InputErrorKind::kBadValue, path, rows.at("N").first,
-                     "N is not a whole number");
-  }
-  meta.num_runs = static_cast<int>(n);
+  meta.gear_ratio = rows.Value("ngear", true);
+  meta.encoder_counts_per_rev = rows.Value("encRes", true);
+  meta.wheelbase_m = rows.Value("Li", true);
+  meta.diameter_m = rows.Value("Di", true);
+  meta.steering_offset_rad = rows.Value("Thi", false);
+  meta.num_runs = rows.NumRuns();
   return meta;
 }
 
 OptiOdomTricycleRun ReadRun(const std::string& path, int number) {
-  const std::string text = io::ReadTextFile(path);
-  io::LineScanner lines(text);
-  std::string_view line;
+  optiodom::RunRows rows =
+      optiodom::ReadRun(path, number, 2, "ticks, steering", ": no steering column");
   OptiOdomTricycleRun run;
   run.number = number;
-  int first_line = 0;
-  while (lines.Next(&line)) {
-    if (io::Trim(line).empty()) continue;
-    const std::vector<std::string> fields = SplitCsv(line);
-    if (fields.size() != kRunFields) {
-      throw InputError(InputErrorKind::kWrongColumnCount, path, lines.line_number(),
-                       "expected 6 fields (t, x, y, theta, ticks, steering), found " +
-                           std::to_string(fields.size()) +
-                           (fields.size() == kRunFields - 1 ? ": no steering column" : ""));
-    }
-    double v[kRunFields];
-    for (int i = 0; i < kRunFields; ++i) {
-      v[i] = ParseNumber(fields[i], path, lines.line_number(), "field " + std::to_string(i + 1));
-    }
-    if (!run.t_s.empty() && !(v[0] > run.t_s.back())) {
-      throw InputError(InputErrorKind::kNonIncreasingTime, path, lines.line_number(),
-                       "time " + fields[0] + " s is not after the previous row's");
-    }
-    if (first_line == 0) first_line = lines.line_number();
-    run.t_s.push_back(v[0]);
-    run.ground_truth.t_s.push_back(v[0]);
-    run.ground_truth.world_T_robot.push_back(Pose2d{v[1], v[2], v[3]});
-    run.ticks.push_back(v[4] + 0.0);  // + 0.0 turns "-0" into 0
-    run.steering_rad.push_back(v[5] + 0.0);
+  run.t_s = std::move(rows.t_s);
+  for (const std::vector<double>& e : rows.encoder) {
+    run.ticks.push_back(e[0]);
+    run.steering_rad.push_back(e[1]);
   }
-  if (run.t_s.size() < 2) {
-    throw InputError(InputErrorKind::kTooFewSamples, path, 0,
-                     "needs at least two rows, found " + std::to_string(run.t_s.size()));
-  }
-  tricycle::CheckSteeringReadings(run.steering_rad, path, first_line);
+  run.ground_truth = std::move(rows.ground_truth);
+  tricycle::CheckSteeringReadings(run.steering_rad, path, rows.first_line);
   return run;
 }
 
 }  // namespace
 
 OptiOdomTricycleSession ReadOptiOdomTricycleSession(const std::string& directory) {
-  const fs::path dir = fs::path(directory).lexically_normal();
-  if (!fs::is_directory(dir)) {
-    throw InputError(InputErrorKind::kMissingFile, directory, 0, "not a directory");
-  }
-  const fs::path named = dir.has_filename() ? dir : dir.parent_path();
+  const optiodom::SessionFiles files = optiodom::ListSession(directory);
   OptiOdomTricycleSession session;
-  session.name = named.filename().string();
-  session.path_type = named.parent_path().filename().string();
-  if (session.path_type.empty()) session.path_type = "path";
-  const std::string metadata_path = (dir / (session.name + "_metadata.csv")).string();
-  session.metadata = ReadMetadata(metadata_path);
-
-  const std::regex run_name(session.name + "_run-([0-9]+)\\.csv");
-  std::vector<std::pair<int, std::string>> files;
-  for (const auto& entry : fs::directory_iterator(dir)) {
-    std::smatch m;
-    const std::string name = entry.path().filename().string();
-    if (std::regex_match(name, m, run_name)) {
-      files.emplace_back(std::stoi(m[1]), entry.path().string());
-    }
-  }
-  std::sort(files.begin(), files.end());
-  if (static_cast<int>(files.size()) != session.metadata.num_runs) {
-    throw InputError(InputErrorKind::kBadValue, metadata_path, 0,
-                     "N = " + std::to_string(session.metadata.num_runs) +
-                         " runs, but the directory holds " + std::to_string(files.size()) +
-                         " run files");
-  }
-  for (const auto& [number, path] : files) session.runs.push_back(ReadRun(path, number));
+  session.name = files.name;
+  session.path_type = files.path_type;
+  session.metadata = ReadMetadata(files.metadata_path);
+  optiodom::CheckRunCount(files, session.metadata.num_runs);
+  for (const auto& [number, path] : files.runs) session.runs.push_back(ReadRun(path, number));
   return session;
 }
 

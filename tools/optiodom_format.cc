@@ -1,0 +1,200 @@
+#include "tools/optiodom_format.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <regex>
+#include <set>
+
+#include "io/input_error.h"
+#include "io/text_file.h"
+
+namespace fitcal::tools::optiodom {
+
+namespace fs = std::filesystem;
+using io::InputError;
+using io::InputErrorKind;
+
+namespace {
+
+// Every key of the published metadata; any other is a format fitcal does not know.
+const std::set<std::string> kMetadataKeys = {"type",  "ngear",  "encRes", "Li",       "Di",
+                                             "Thi",   "N",      "L",      "imarkers", "gt_ti",
+                                             "gt_tf", "odo_ti", "odo_tf"};
+
+}  // namespace
+
+std::vector<std::string> SplitCsv(std::string_view line) {
+  std::vector<std::string> out;
+  std::size_t pos = 0;
+  while (true) {
+    const std::size_t end = line.find(',', pos);
+    out.emplace_back(io::Trim(line.substr(pos, end == std::string_view::npos ? end : end - pos)));
+    if (end == std::string_view::npos) break;
+    pos = end + 1;
+  }
+  return out;
+}
+
+double ParseNumber(const std::string& field, const std::string& path, int line,
+                   const std::string& what) {
+  double v = 0.0;
+  bool finite = true;
+  if (!io::ParseDouble(field, &v, &finite) || !finite) {
+    throw InputError(InputErrorKind::kNonNumeric, path, line,
+                     what + " is not a finite number: '" + field + "'");
+  }
+  return v;
+}
+
+std::vector<double> Metadata::Values(const std::string& key, std::size_t count,
+                                     bool positive) const {
+  const auto it = rows.find(key);
+  if (it == rows.end()) {
+    throw InputError(InputErrorKind::kMissingKey, path, 0, "no row '" + key + "'");
+  }
+  const auto& [line, values] = it->second;
+  if (values.size() != count) {
+    throw InputError(InputErrorKind::kWrongColumnCount, path, line,
+                     key + " needs " + std::to_string(count) + " value(s), found " +
+                         std::to_string(values.size()));
+  }
+  for (double v : values) {
+    if (positive && !(v > 0.0)) {
+      throw InputError(InputErrorKind::kBadValue, path, line, key + " must be positive");
+    }
+  }
+  return values;
+}
+
+int Metadata::NumRuns() const {
+  const double n = Value("N", true);
+  if (n != std::floor(n)) {
+    throw InputError(InputErrorKind::kBadValue, path, rows.at("N").first,
+                     "N is not a whole number");
+  }
+  return static_cast<int>(n);
+}
+
+Metadata ReadMetadata(const std::string& path, const std::string& expected_type) {
+  const std::string text = io::ReadTextFile(path);
+  io::LineScanner lines(text);
+  std::string_view line;
+  Metadata meta;
+  meta.path = path;
+  while (lines.Next(&line)) {
+    if (io::Trim(line).empty()) continue;
+    const std::vector<std::string> fields = SplitCsv(line);
+    const std::string& key = fields[0];
+    if (kMetadataKeys.count(key) == 0) {
+      throw InputError(InputErrorKind::kUnknownKey, path, lines.line_number(),
+                       "unknown metadata row '" + key + "'");
+    }
+    if (key == "type") {
+      meta.type = fields.size() > 1 ? fields[1] : "";
+      continue;
+    }
+    std::vector<double> values;
+    for (std::size_t i = 1; i < fields.size(); ++i) {
+      if (fields[i].empty()) continue;  // the file pads every row to the widest one
+      values.push_back(
+          ParseNumber(fields[i], path, lines.line_number(), key + " value " + std::to_string(i)));
+    }
+    meta.rows[key] = {lines.line_number(), values};
+  }
+  if (meta.type != expected_type) {
+    throw InputError(InputErrorKind::kUnknownModel, path, 1,
+                     "type '" + meta.type + "' is not " + expected_type);
+  }
+  return meta;
+}
+
+SessionFiles ListSession(const std::string& directory) {
+  const fs::path dir = fs::path(directory).lexically_normal();
+  if (!fs::is_directory(dir)) {
+    throw InputError(InputErrorKind::kMissingFile, directory, 0, "not a directory");
+  }
+  const fs::path named = dir.has_filename() ? dir : dir.parent_path();
+  SessionFiles files;
+  files.name = named.filename().string();
+  files.path_type = named.parent_path().filename().string();
+  if (files.path_type.empty()) files.path_type = "path";
+  files.metadata_path = (dir / (files.name + "_metadata.csv")).string();
+  const std::regex run_name(files.name + "_run-([0-9]+)\\.csv");
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    std::smatch m;
+    const std::string name = entry.path().filename().string();
+    if (std::regex_match(name, m, run_name)) {
+      files.runs.emplace_back(std::stoi(m[1]), entry.path().string());
+    }
+  }
+  std::sort(files.runs.begin(), files.runs.end());
+  return files;
+}
+
+void CheckRunCount(const SessionFiles& files, int num_runs) {
+  if (static_cast<int>(files.runs.size()) != num_runs) {
+    throw InputError(InputErrorKind::kBadValue, files.metadata_path, 0,
+                     "N = " + std::to_string(num_runs) + " runs, but the directory holds " +
+                         std::to_string(files.runs.size()) + " run files");
+  }
+}
+
+std::string SessionType(const std::string& directory) {
+  const fs::path dir(directory);
+  const std::string name =
+      dir.filename().empty() ? dir.parent_path().filename().string() : dir.filename().string();
+  const std::string path = (dir / (name + "_metadata.csv")).string();
+  const std::string text = io::ReadTextFile(path);
+  io::LineScanner lines(text);
+  std::string_view line;
+  while (lines.Next(&line)) {
+    const std::string_view t = io::Trim(line);
+    if (t.substr(0, 5) != "type,") continue;
+    const std::string_view rest = t.substr(5);
+    return std::string(io::Trim(rest.substr(0, rest.find(','))));
+  }
+  throw InputError(InputErrorKind::kMissingKey, path, 0, "no 'type' row");
+}
+
+RunRows ReadRun(const std::string& path, int number, int encoder_columns,
+                const std::string& column_names, const std::string& short_row_hint) {
+  const std::string text = io::ReadTextFile(path);
+  io::LineScanner lines(text);
+  std::string_view line;
+  RunRows run;
+  run.number = number;
+  const std::size_t num_fields = 4 + static_cast<std::size_t>(encoder_columns);
+  std::vector<double> v(num_fields);
+  while (lines.Next(&line)) {
+    if (io::Trim(line).empty()) continue;
+    const std::vector<std::string> fields = SplitCsv(line);
+    if (fields.size() != num_fields) {
+      throw InputError(InputErrorKind::kWrongColumnCount, path, lines.line_number(),
+                       "expected " + std::to_string(num_fields) + " fields (t, x, y, theta, " +
+                           column_names + "), found " + std::to_string(fields.size()) +
+                           (fields.size() + 1 == num_fields ? short_row_hint : ""));
+    }
+    for (std::size_t i = 0; i < num_fields; ++i) {
+      v[i] = ParseNumber(fields[i], path, lines.line_number(), "field " + std::to_string(i + 1));
+    }
+    if (!run.t_s.empty() && !(v[0] > run.t_s.back())) {
+      throw InputError(InputErrorKind::kNonIncreasingTime, path, lines.line_number(),
+                       "time " + fields[0] + " s is not after the previous row's");
+    }
+    if (run.first_line == 0) run.first_line = lines.line_number();
+    run.t_s.push_back(v[0]);
+    run.ground_truth.t_s.push_back(v[0]);
+    run.ground_truth.world_T_robot.push_back(Pose2d{v[1], v[2], v[3]});
+    // + 0.0 turns the file's "-0" into 0.
+    std::vector<double>& row = run.encoder.emplace_back(v.begin() + 4, v.end());
+    for (double& x : row) x += 0.0;
+  }
+  if (run.t_s.size() < 2) {
+    throw InputError(InputErrorKind::kTooFewSamples, path, 0,
+                     "needs at least two rows, found " + std::to_string(run.t_s.size()));
+  }
+  return run;
+}
+
+}  // namespace fitcal::tools::optiodom

@@ -1,0 +1,77 @@
+#pragma once
+// The published OptiOdom file format (Sousa et al., "OptiOdom: a Generic Approach for Odometry
+// Calibration of Wheeled Mobile Robots", J. Intell. Robot. Syst. 105, 39, 2022; MIT licence;
+// ../shared/data/optiodom/README.md), read once for every robot of the study:
+//   <s>/<s>_metadata.csv  rows `key,v1,v2,...` (type, ngear, encRes, Li, Di, Thi, N, L, imarkers,
+//                         gt_ti, gt_tf, odo_ti, odo_tf), padded with empty fields to the widest
+//   <s>/<s>_run-NN.csv    no header, `t_s, x_gt_m, y_gt_m, theta_gt_rad, enc_1, ..., enc_m`
+// Only the meaning of the encoder columns and of Li / Di differs between robots; that lives in the
+// per-robot importers. Every function throws io::InputError (file, line, cause) on bad input.
+
+#include <map>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "odometry/run_log.h"
+
+namespace fitcal::tools::optiodom {
+
+// The comma-separated fields of one line, each trimmed.
+std::vector<std::string> SplitCsv(std::string_view line);
+
+// A finite number, or InputError(path:line: `what` is not a finite number: '<field>').
+double ParseNumber(const std::string& field, const std::string& path, int line,
+                   const std::string& what);
+
+// <s>_metadata.csv: the `type` row and every numeric row, key -> (line, values).
+struct Metadata {
+  std::string path;
+  std::string type;
+  std::map<std::string, std::pair<int, std::vector<double>>> rows;
+
+  // Exactly `count` values of row `key`, each > 0 when `positive`.
+  std::vector<double> Values(const std::string& key, std::size_t count, bool positive) const;
+  double Value(const std::string& key, bool positive) const {
+    return Values(key, 1, positive)[0];
+  }
+  // N, a whole number of runs.
+  int NumRuns() const;
+  // ngear * encRes: encoder ticks per wheel revolution.
+  double TicksPerWheelRev() const { return Value("ngear", true) * Value("encRes", true); }
+};
+
+// Reads the metadata and checks its type is `expected_type`; an unknown key is an error.
+Metadata ReadMetadata(const std::string& path, const std::string& expected_type);
+
+// The files of one session directory <path type>/<session>/.
+struct SessionFiles {
+  std::string name;       // directory name, e.g. 221220201643
+  std::string path_type;  // parent directory name, e.g. circular, square ("path" if none)
+  std::string metadata_path;
+  std::vector<std::pair<int, std::string>> runs;  // (NN, path), sorted by NN
+};
+
+// Lists a session directory's run files; CheckRunCount holds them against the metadata's N.
+SessionFiles ListSession(const std::string& directory);
+void CheckRunCount(const SessionFiles& files, int num_runs);
+
+// The `type` row of a session's metadata (diff, tricyc, omni3, omni4).
+std::string SessionType(const std::string& directory);
+
+// One run file: time, ground truth (start frame) and the encoder columns as written ("-0" -> 0).
+struct RunRows {
+  int number = 0;
+  int first_line = 0;  // line of the first row
+  std::vector<double> t_s;
+  std::vector<std::vector<double>> encoder;  // encoder[k][j]: column j of row k
+  GroundTruthTrack ground_truth;
+};
+
+// Reads a run file with `encoder_columns` encoder columns named `column_names` in messages
+// ("ticks_right, ticks_left"); `short_row_hint` is added when a row lacks one field.
+RunRows ReadRun(const std::string& path, int number, int encoder_columns,
+                const std::string& column_names, const std::string& short_row_hint = "");
+
+}  // namespace fitcal::tools::optiodom
