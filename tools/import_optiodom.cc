@@ -4,17 +4,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <iostream>
-#include <set>
 
 #include "fit/final_pose_errors.h"
 #include "fit/segment_cost.h"
-#include "io/atomic_file.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/input_registry.h"
-#include "io/staged_directory.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "odometry/aligned_run.h"
 #include "odometry/parallel_for.h"
@@ -28,7 +24,6 @@
 
 namespace fitcal::tools {
 
-namespace fs = std::filesystem;
 using io::InputError;
 using io::InputErrorKind;
 
@@ -243,38 +238,12 @@ int RunImportOptiOdomCommand(const ImportOptiOdomOptions& options) {
         sources.push_back(&run);
       }
     }
-    std::set<std::string> ids;
-    for (const RunLog& log : logs) {
-      if (!ids.insert(log.id).second) {
-        throw InputError(InputErrorKind::kDuplicateRunId, options.out, 0,
-                         "run " + log.id + " is imported twice");
-      }
-    }
-
+    optiodom::CheckUniqueRunIds(logs, options.out);
     std::printf("%s\n",
                 CheckImportedChannelOrder(logs, *robot, options.skip_mapping_check).c_str());
-
-    // Whole or not at all: staged beside --out, renamed over it once complete.
-    io::StagedDirectory staged(options.out);
-    const fs::path out(staged.path());
-    fs::create_directories(out / "runs");
-    std::vector<io::DatasetEntry> entries(logs.size());
-    ParallelFor(logs.size(), 0, [&](std::size_t i) {
-      io::DatasetEntry& e = entries[i];
-      e.id = logs[i].id;
-      e.trajectory = logs[i].trajectory;
-      e.repetition = logs[i].repetition;
-      e.encoders = "runs/" + e.id + "_encoders.csv";
-      e.ground_truth = "runs/" + e.id + "_ground_truth.csv";
-      io::WriteFileAtomically((out / e.encoders).string(), TicksCsv(*sources[i]));
-      io::WriteFileAtomically((out / e.ground_truth).string(),
-                              io::GroundTruthCsv(logs[i].ground_truth));
-    });
-    io::WriteFileAtomically((out / "robot.yaml").string(),
-                            robot->RobotYaml(robot->robot().nominal, /*calibration_block=*/""));
-    io::WriteFileAtomically((out / "dataset.yaml").string(),
-                            io::DatasetYaml("robot.yaml", entries));
-    CommitDirectoryOutput(staged, options.out, kDatasetKind, options.force, options.sessions);
+    optiodom::DatasetText text;
+    text.encoder_csv = [&](std::size_t i) { return TicksCsv(*sources[i]); };
+    optiodom::WriteDataset(logs, *robot, text, options.out, options.force, options.sessions);
     std::printf("wrote %zu runs of %zu sessions to %s\n", logs.size(), sessions.size(),
                 options.out.c_str());
     return 0;

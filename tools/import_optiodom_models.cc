@@ -4,16 +4,12 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <iostream>
-#include <set>
 #include <stdexcept>
 
 #include "fit/final_pose_errors.h"
-#include "io/atomic_file.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
-#include "io/staged_directory.h"
 #include "io/text_file.h"
 #include "models/diff_drive/diff_drive_model.h"
 #include "odometry/aligned_run.h"
@@ -24,7 +20,6 @@
 
 namespace fitcal::tools {
 
-namespace fs = std::filesystem;
 using io::InputError;
 using io::InputErrorKind;
 
@@ -176,20 +171,14 @@ RobotModelPtr NominalDiffDriveModel(const DiffMetadata& m) {
 
 // The runs to write, session by session; notes sessions that declare other values and runs left
 // out.
-struct CollectedRuns {
-  std::vector<io::DatasetEntry> entries;
-  std::vector<const DiffRun*> sources;
-};
-
-CollectedRuns CollectRuns(const std::vector<DiffSession>& sessions, const DiffMetadata& robot,
+std::vector<const DiffRun*> CollectRuns(const std::vector<DiffSession>& sessions, const DiffMetadata& robot,
                           const ImportOptiOdomDiffOptions& options, const std::string& out_dir,
                           OptiOdomDiffImportSummary* summary) {
   const auto note = [&](const std::string& text) {
     summary->notes.push_back(text);
     if (!options.quiet) std::printf("%s\n", text.c_str());
   };
-  CollectedRuns out;
-  std::set<std::string> ids;
+  std::vector<const DiffRun*> sources;
   for (const DiffSession& s : sessions) {
     if (s.metadata.TicksPerWheelRev() != robot.TicksPerWheelRev()) {
       throw InputError(
@@ -213,40 +202,22 @@ CollectedRuns CollectRuns(const std::vector<DiffSession>& sessions, const DiffMe
              flag->reason);
         if (!options.include_flagged) continue;
       }
-      if (!ids.insert(log.id).second) {
-        throw InputError(InputErrorKind::kDuplicateRunId, out_dir, 0,
-                         "run " + log.id + " is imported twice");
-      }
-      io::DatasetEntry e;
-      e.id = log.id;
-      e.trajectory = log.trajectory;
-      e.repetition = log.repetition;
-      e.encoders = "runs/" + e.id + "_encoders.csv";
-      e.ground_truth = "runs/" + e.id + "_ground_truth.csv";
-      out.entries.push_back(e);
-      out.sources.push_back(&run);
+      sources.push_back(&run);
       summary->runs.push_back(std::move(log));
     }
   }
-  return out;
+  optiodom::CheckUniqueRunIds(summary->runs, out_dir);
+  return sources;
 }
 
-void WriteDiffDataset(const std::string& out_dir, const RobotModelInterface& model,
-                      const OptiOdomDiffImportSummary& summary, const CollectedRuns& runs) {
-  const fs::path out(out_dir);
-  fs::create_directories(out / "runs");
-  for (std::size_t i = 0; i < runs.entries.size(); ++i) {
-    io::WriteFileAtomically((out / runs.entries[i].encoders).string(), TicksCsv(*runs.sources[i]));
-    io::WriteFileAtomically((out / runs.entries[i].ground_truth).string(),
-                            io::GroundTruthCsv(summary.runs[i].ground_truth));
-  }
-  std::string header =
+optiodom::DatasetText DiffDatasetText(const OptiOdomDiffImportSummary& summary,
+                                      const std::vector<const DiffRun*>& sources) {
+  optiodom::DatasetText text;
+  text.encoder_csv = [&sources](std::size_t i) { return TicksCsv(*sources[i]); };
+  text.header =
       "# OptiOdom differential drive (Sousa et al. 2022, MIT licence), imported by fitcal\n";
-  for (const std::string& n : summary.notes) header += "# " + n + "\n";
-  io::WriteFileAtomically((out / "robot.yaml").string(),
-                          header + model.RobotYaml(model.robot().nominal, ""));
-  io::WriteFileAtomically((out / "dataset.yaml").string(),
-                          header + io::DatasetYaml("robot.yaml", runs.entries));
+  for (const std::string& n : summary.notes) text.header += "# " + n + "\n";
+  return text;
 }
 
 }  // namespace
@@ -272,8 +243,8 @@ OptiOdomDiffImportSummary ImportOptiOdomDiff(const std::vector<std::string>& ses
   summary.diameter_right_m = robot.diameter_right_m;
   summary.diameter_left_m = robot.diameter_left_m;
   summary.ticks_per_rev = robot.TicksPerWheelRev();
-  const CollectedRuns runs = CollectRuns(sessions, robot, options, out_dir, &summary);
-  summary.num_runs = static_cast<int>(runs.entries.size());
+  const std::vector<const DiffRun*> sources = CollectRuns(sessions, robot, options, out_dir, &summary);
+  summary.num_runs = static_cast<int>(sources.size());
   const RobotModelPtr model = NominalDiffDriveModel(robot);
   const std::string order_check =
       CheckImportedChannelOrder(summary.runs, *model, options.skip_mapping_check);
@@ -283,11 +254,8 @@ OptiOdomDiffImportSummary ImportOptiOdomDiff(const std::vector<std::string>& ses
   summary.nominal_cf = nominal.cf;
   summary.nominal_mean_position_error_m = nominal.mean_position_error_m;
   summary.nominal_mean_heading_error_rad = nominal.mean_abs_heading_error_rad;
-  {  // whole or not at all: staged beside out_dir, renamed over it once complete
-    io::StagedDirectory staged(out_dir);
-    WriteDiffDataset(staged.path(), *model, summary, runs);
-    CommitDirectoryOutput(staged, out_dir, kDatasetKind, options.force, session_dirs);
-  }
+  optiodom::WriteDataset(summary.runs, *model, DiffDatasetText(summary, sources), out_dir,
+                         options.force, session_dirs);
   if (!options.quiet) {
     std::printf(
         "wrote %d runs of %d sessions to %s; nominal CF (Eq. 14) %.4f, mean final "

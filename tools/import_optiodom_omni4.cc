@@ -4,12 +4,8 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 
-#include "io/atomic_file.h"
 #include "io/dataset.h"
-#include "io/input_error.h"
-#include "io/staged_directory.h"
 #include "models/omni/omni_model.h"
 #include "models/pose_errors.h"
 #include "odometry/parallel_for.h"
@@ -19,9 +15,6 @@
 
 namespace fitcal::tools {
 
-namespace fs = std::filesystem;
-using io::InputError;
-using io::InputErrorKind;
 
 namespace {
 
@@ -199,40 +192,23 @@ Omni4ImportResult ImportOptiOdomOmni4(const std::vector<std::string>& session_di
   std::vector<RunLog> all_runs;
   for (const auto& s : sessions) all_runs.insert(all_runs.end(), s.runs.begin(), s.runs.end());
   result.channel_order = CheckImportedChannelOrder(all_runs, *model, skip_mapping_check);
-  std::vector<const RunLog*> logs;
-  for (const auto& s : sessions) {
-    for (const RunLog& log : s.runs) logs.push_back(&log);
-  }
+  optiodom::CheckUniqueRunIds(all_runs, out_dir);
   const std::vector<double>& p = model->robot().nominal;
-  std::vector<double> cf(logs.size());
-  std::vector<io::DatasetEntry> entries(logs.size());
-  // Whole or not at all: staged beside out_dir, renamed over it once complete.
-  io::StagedDirectory staged(out_dir);
-  fs::create_directories(fs::path(staged.path()) / "runs");
-  ParallelFor(logs.size(), 0, [&](std::size_t i) {
-    const RunLog& log = *logs[i];
+  std::vector<double> cf(all_runs.size());
+  ParallelFor(all_runs.size(), 0, [&](std::size_t i) {
+    const RunLog& log = all_runs[i];
     const Pose2d final_pose =
         model->ReplayFinalPose(p.data(), log.encoders.samples, *log.start_pose);
     double r[3];
     FinalPoseError(final_pose, log.ground_truth.world_T_robot.back(), ResidualWeights{}, r);
     cf[i] = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
-    io::DatasetEntry& e = entries[i];
-    e.id = log.id;
-    e.trajectory = log.trajectory;
-    e.repetition = log.repetition;
-    e.encoders = "runs/" + e.id + "_encoders.csv";
-    e.ground_truth = "runs/" + e.id + "_ground_truth.csv";
-    const fs::path out(staged.path());
-    io::WriteFileAtomically((out / e.encoders).string(), EncoderCsvText(log, model->robot()));
-    io::WriteFileAtomically((out / e.ground_truth).string(), GroundTruthCsvText(log.ground_truth));
   });
-  io::WriteFileAtomically((fs::path(staged.path()) / "robot.yaml").string(),
-                          model->RobotYaml(p, ""));
-  io::WriteFileAtomically((fs::path(staged.path()) / "dataset.yaml").string(),
-                          io::DatasetYaml("robot.yaml", entries));
-  CommitDirectoryOutput(staged, out_dir, kDatasetKind, force, session_dirs);
+  optiodom::DatasetText text;
+  text.encoder_csv = [&](std::size_t i) { return EncoderCsvText(all_runs[i], model->robot()); };
+  text.ground_truth_csv = GroundTruthCsvText;
+  optiodom::WriteDataset(all_runs, *model, text, out_dir, force, session_dirs);
   result.num_sessions = static_cast<int>(sessions.size());
-  result.num_runs = static_cast<int>(logs.size());
+  result.num_runs = static_cast<int>(all_runs.size());
   for (double c : cf) result.nominal_mean_cf += c / static_cast<double>(cf.size());
   return result;
 }

@@ -3,15 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <set>
 #include <stdexcept>
 
 #include "fit/final_pose_errors.h"
-#include "io/atomic_file.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
-#include "io/staged_directory.h"
 #include "models/tricycle/tricycle_checks.h"
 #include "models/tricycle/tricycle_model.h"
 #include "odometry/aligned_run.h"
@@ -22,7 +18,6 @@
 
 namespace fitcal::tools {
 
-namespace fs = std::filesystem;
 using io::InputError;
 using io::InputErrorKind;
 using K = TricycleKinematics;
@@ -177,40 +172,22 @@ ImportOptiOdomTricycleSummary ImportOptiOdomTricycle(const std::vector<std::stri
   ImportOptiOdomTricycleSummary summary;
   summary.num_sessions = static_cast<int>(read.size());
   std::vector<const OptiOdomTricycleRun*> sources;
-  std::set<std::string> ids;
   for (std::size_t i = 0; i < read.size(); ++i) {
     for (const OptiOdomTricycleRun& run : read[i].runs) {
       summary.runs.push_back(OptiOdomTricycleRunLog(read[i], run, repetition[i]));
       sources.push_back(&run);
-      if (!ids.insert(summary.runs.back().id).second) {
-        throw InputError(InputErrorKind::kDuplicateRunId, out, 0,
-                         "run " + summary.runs.back().id + " is imported twice");
-      }
     }
   }
+  optiodom::CheckUniqueRunIds(summary.runs, out);
   summary.channel_order = CheckImportedChannelOrder(summary.runs, *model, options.skip_sign_check);
   const FinalPoseErrors nominal =
       EvaluateFinalPoseErrors(*model, model->robot().nominal, AlignRuns(summary.runs), 1);
   summary.nominal_final_error = nominal.per_run_cf;
   summary.nominal_cf = nominal.cf;
 
-  // Whole or not at all: staged beside `out`, renamed over it once complete.
-  io::StagedDirectory staged(out);
-  const fs::path dir(staged.path());
-  fs::create_directories(dir / "runs");
-  std::vector<io::DatasetEntry> entries;
-  for (std::size_t i = 0; i < summary.runs.size(); ++i) {
-    const RunLog& log = summary.runs[i];
-    io::DatasetEntry e{log.id, log.trajectory, log.repetition, "runs/" + log.id + "_encoders.csv",
-                       "runs/" + log.id + "_ground_truth.csv"};
-    io::WriteFileAtomically((dir / e.encoders).string(), TricycleEncoderCsv(*sources[i]));
-    io::WriteFileAtomically((dir / e.ground_truth).string(), io::GroundTruthCsv(log.ground_truth));
-    entries.push_back(e);
-  }
-  io::WriteFileAtomically((dir / "robot.yaml").string(),
-                          model->RobotYaml(model->robot().nominal, ""));
-  io::WriteFileAtomically((dir / "dataset.yaml").string(), io::DatasetYaml("robot.yaml", entries));
-  CommitDirectoryOutput(staged, out, kDatasetKind, options.force, sessions);
+  optiodom::DatasetText text;
+  text.encoder_csv = [&](std::size_t i) { return TricycleEncoderCsv(*sources[i]); };
+  optiodom::WriteDataset(summary.runs, *model, text, out, options.force, sessions);
   return summary;
 }
 

@@ -6,8 +6,12 @@
 #include <regex>
 #include <set>
 
+#include "io/atomic_file.h"
 #include "io/input_error.h"
+#include "io/staged_directory.h"
 #include "io/text_file.h"
+#include "odometry/parallel_for.h"
+#include "tools/output_guard.h"
 
 namespace fitcal::tools::optiodom {
 
@@ -195,6 +199,38 @@ RunRows ReadRun(const std::string& path, int number, int encoder_columns,
                      "needs at least two rows, found " + std::to_string(run.t_s.size()));
   }
   return run;
+}
+
+void CheckUniqueRunIds(const std::vector<RunLog>& runs, const std::string& out) {
+  std::set<std::string> ids;
+  for (const RunLog& log : runs) {
+    if (!ids.insert(log.id).second) {
+      throw InputError(InputErrorKind::kDuplicateRunId, out, 0,
+                       "run " + log.id + " is imported twice");
+    }
+  }
+}
+
+void WriteDataset(const std::vector<RunLog>& runs, const RobotModelInterface& model,
+                  const DatasetText& text, const std::string& out, bool force,
+                  const std::vector<std::string>& session_dirs) {
+  io::StagedDirectory staged(out);
+  const fs::path dir(staged.path());
+  fs::create_directories(dir / "runs");
+  std::vector<io::DatasetEntry> entries(runs.size());
+  ParallelFor(runs.size(), 0, [&](std::size_t i) {
+    const RunLog& log = runs[i];
+    entries[i] = {log.id, log.trajectory, log.repetition, "runs/" + log.id + "_encoders.csv",
+                  "runs/" + log.id + "_ground_truth.csv"};
+    io::WriteFileAtomically((dir / entries[i].encoders).string(), text.encoder_csv(i));
+    io::WriteFileAtomically((dir / entries[i].ground_truth).string(),
+                            text.ground_truth_csv(log.ground_truth));
+  });
+  io::WriteFileAtomically((dir / "robot.yaml").string(),
+                          text.header + model.RobotYaml(model.robot().nominal, ""));
+  io::WriteFileAtomically((dir / "dataset.yaml").string(),
+                          text.header + io::DatasetYaml("robot.yaml", entries));
+  CommitDirectoryOutput(staged, out, kDatasetKind, force, session_dirs);
 }
 
 }  // namespace fitcal::tools::optiodom

@@ -8,12 +8,15 @@
 // Only the meaning of the encoder columns and of Li / Di differs between robots; that lives in the
 // per-robot importers. Every function throws io::InputError (file, line, cause) on bad input.
 
+#include <functional>
 #include <map>
 #include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
 
+#include "io/dataset.h"
+#include "models/model_interface.h"
 #include "odometry/run_log.h"
 
 namespace fitcal::tools::optiodom {
@@ -73,5 +76,25 @@ struct RunRows {
 // ("ticks_right, ticks_left"); `short_row_hint` is added when a row lacks one field.
 RunRows ReadRun(const std::string& path, int number, int encoder_columns,
                 const std::string& column_names, const std::string& short_row_hint = "");
+
+// ---- Writing the fitcal data set (README.md "Data set format").
+
+// Refuses a run id that two runs share (the same session given twice); `out` names the data set.
+void CheckUniqueRunIds(const std::vector<RunLog>& runs, const std::string& out);
+
+// How the data set's files read: each run's encoder CSV (ticks as logged, or rates), the
+// ground-truth CSV, and comment lines put at the top of robot.yaml and dataset.yaml.
+struct DatasetText {
+  std::function<std::string(std::size_t run)> encoder_csv;
+  std::function<std::string(const GroundTruthTrack&)> ground_truth_csv = io::GroundTruthCsv;
+  std::string header;
+};
+
+// Writes runs/<id>_encoders.csv, runs/<id>_ground_truth.csv, robot.yaml (the model's nominal)
+// and dataset.yaml (trajectory, repetition from each run) to `out`: staged beside it and renamed
+// over it once complete, so a failure leaves nothing (io/staged_directory.h).
+void WriteDataset(const std::vector<RunLog>& runs, const RobotModelInterface& model,
+                  const DatasetText& text, const std::string& out, bool force,
+                  const std::vector<std::string>& session_dirs);
 
 }  // namespace fitcal::tools::optiodom
