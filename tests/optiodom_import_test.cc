@@ -51,9 +51,9 @@ TEST(OptiOdomImport, ReadsMetadataAndMapsTheAuthorsWheelsToOurs) {
   EXPECT_DOUBLE_EQ(robot.nominal.distance_m[2], 0.195);
   EXPECT_NEAR(RadToDeg(robot.nominal.angle_rad[1]), 60.0, 1e-12);
   // Run 1, row 2 of the file holds ticks (-6, 24, 1): ours are their negatives, same order.
-  EXPECT_EQ(s.runs[0].ticks[1][0], 6.0);
-  EXPECT_EQ(s.runs[0].ticks[1][1], -24.0);
-  EXPECT_EQ(s.runs[0].ticks[1][2], -1.0);
+  EXPECT_EQ(s.runs[0].encoder[1][0], 6.0);
+  EXPECT_EQ(s.runs[0].encoder[1][1], -24.0);
+  EXPECT_EQ(s.runs[0].encoder[1][2], -1.0);
 }
 
 // The one channel-order check (diagnosis/channel_order_check.h, as the importer runs it) keeps

@@ -53,15 +53,10 @@ OptiOdomMetadata ReadMetadata(const std::string& path) {
 }
 
 OptiOdomRun ReadRun(const std::string& path, int number) {
-  optiodom::RunRows rows = optiodom::ReadRun(path, number, 3, "ticks_1, ticks_2, ticks_3");
-  OptiOdomRun run;
-  run.number = number;
-  run.t_s = std::move(rows.t_s);
-  for (const std::vector<double>& e : rows.encoder) {
-    // + 0.0 keeps a flipped 0 at 0.
-    run.ticks.push_back({kTickSign * e[0] + 0.0, kTickSign * e[1] + 0.0, kTickSign * e[2] + 0.0});
+  OptiOdomRun run = optiodom::ReadRun(path, number, 3, "ticks_1, ticks_2, ticks_3");
+  for (std::vector<double>& ticks : run.encoder) {
+    for (double& t : ticks) t = kTickSign * t + 0.0;  // + 0.0 keeps a flipped 0 at 0
   }
-  run.ground_truth = std::move(rows.ground_truth);
   return run;
 }
 
@@ -116,36 +111,13 @@ RunLog OptiOdomRunLog(const OptiOdomSession& session, const OptiOdomRun& run) {
   log.id = id;
   log.trajectory = session.path_type + "_" + session.name;
   log.repetition = run.number;
-  const double rad_per_tick = 2.0 * M_PI / session.metadata.TicksPerWheelRev();
-  log.encoders.t_s = run.t_s;
-  for (std::size_t k = 1; k < run.t_s.size(); ++k) {
-    const double dt = run.t_s[k] - run.t_s[k - 1];
-    double values[3];
-    for (int i = 0; i < 3; ++i) values[i] = rad_per_tick * run.ticks[k][i] / dt;
-    log.encoders.samples.push_back(dt, values);
-  }
+  log.encoders = optiodom::RatesOf(run, session.metadata.TicksPerWheelRev());
   log.ground_truth = run.ground_truth;
   // The robot is at rest at the start (the ground truth's frame is the start frame).
   log.start_pose = run.ground_truth.world_T_robot.front();
   return log;
 }
 
-namespace {
-
-std::string TicksCsv(const OptiOdomRun& run) {
-  std::string out = "t,ticks_a,ticks_b,ticks_c\n";
-  char line[128];
-  for (std::size_t k = 0; k < run.t_s.size(); ++k) {
-    // Row 0 only sets the start time (increments counted before it are not part of the run).
-    const auto& d = k == 0 ? std::array<double, 3>{0.0, 0.0, 0.0} : run.ticks[k];
-    const int n =
-        std::snprintf(line, sizeof line, "%.6f,%.10g,%.10g,%.10g\n", run.t_s[k], d[0], d[1], d[2]);
-    out.append(line, static_cast<std::size_t>(n));
-  }
-  return out;
-}
-
-}  // namespace
 
 namespace {
 
@@ -242,7 +214,7 @@ int RunImportOptiOdomCommand(const ImportOptiOdomOptions& options) {
     std::printf("%s\n",
                 CheckImportedChannelOrder(logs, *robot, options.skip_mapping_check).c_str());
     optiodom::DatasetText text;
-    text.encoder_csv = [&](std::size_t i) { return TicksCsv(*sources[i]); };
+    text.encoder_csv = [&](std::size_t i) { return optiodom::IncrementsCsv("t,ticks_a,ticks_b,ticks_c", *sources[i], 6); };
     optiodom::WriteDataset(logs, *robot, text, options.out, options.force, options.sessions);
     std::printf("wrote %zu runs of %zu sessions to %s\n", logs.size(), sessions.size(),
                 options.out.c_str());

@@ -26,6 +26,7 @@
 
 #include "models/omni3/omni3_robot.h"
 #include "odometry/run_log.h"
+#include "tools/optiodom_format.h"
 
 namespace CLI {
 class App;
@@ -44,13 +45,9 @@ struct OptiOdomMetadata {
   double TicksPerWheelRev() const { return gear_ratio * encoder_counts_per_rev; }
 };
 
-// One run in our convention: ticks already mapped to wheels a, b, c (see above).
-struct OptiOdomRun {
-  int number = 0;  // NN of the file name
-  std::vector<double> t_s;
-  std::vector<std::array<double, 3>> ticks;  // increments over (t(k-1), t(k)]
-  GroundTruthTrack ground_truth;
-};
+// One run in our convention: encoder[k] = ticks of wheels a, b, c over (t(k-1), t(k)], already
+// mapped from the authors' (see above).
+using OptiOdomRun = optiodom::RunRows;
 
 struct OptiOdomSession {
   std::string name;       // directory name, e.g. 221220201643

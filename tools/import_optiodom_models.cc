@@ -64,21 +64,10 @@ DiffMetadata ReadDiffMetadata(const std::string& path) {
 }
 
 // One run file: t, x, y, theta, ticks_right, ticks_left per row.
-struct DiffRun {
-  int number = 0;
-  std::vector<double> t_s;
-  std::vector<std::array<double, 2>> ticks;  // right, left; increments over (t(k-1), t(k)]
-  GroundTruthTrack ground_truth;
-};
+using DiffRun = optiodom::RunRows;
 
 DiffRun ReadDiffRun(const std::string& path, int number) {
-  optiodom::RunRows rows = optiodom::ReadRun(path, number, 2, "ticks_right, ticks_left");
-  DiffRun run;
-  run.number = number;
-  run.t_s = std::move(rows.t_s);
-  for (const std::vector<double>& e : rows.encoder) run.ticks.push_back({e[0], e[1]});
-  run.ground_truth = std::move(rows.ground_truth);
-  return run;
+  return optiodom::ReadRun(path, number, 2, "ticks_right, ticks_left");
 }
 
 struct DiffSession {
@@ -115,34 +104,9 @@ RunLog DiffRunLog(const DiffSession& s, const DiffRun& run, double ticks_per_rev
   log.id = id;
   log.trajectory = s.path_type + "/" + s.name;
   log.repetition = run.number;
-  const double rad_per_tick = 2.0 * M_PI / ticks_per_rev;
-  log.encoders.t_s = run.t_s;
-  log.encoders.samples = EncoderSamples(2);
-  for (std::size_t k = 1; k < run.t_s.size(); ++k) {
-    const double dt = run.t_s[k] - run.t_s[k - 1];
-    log.encoders.samples.push_back(
-        dt, {rad_per_tick * run.ticks[k][0] / dt, rad_per_tick * run.ticks[k][1] / dt});
-  }
+  log.encoders = optiodom::RatesOf(run, ticks_per_rev);
   log.ground_truth = run.ground_truth;
   return log;
-}
-
-std::string TicksCsv(const DiffRun& run) {
-  std::string out = "t,ticks_right,ticks_left\n";
-  out.reserve(40 * run.t_s.size() + out.size());
-  for (std::size_t k = 0; k < run.t_s.size(); ++k) {
-    // Row 0 only sets the start time (ticks counted before it are not part of the run).
-    const double right = k == 0 ? 0.0 : run.ticks[k][0];
-    const double left = k == 0 ? 0.0 : run.ticks[k][1];
-    // Text of "%.9f,%.10g,%.10g\n".
-    io::AppendFixed(&out, run.t_s[k], 9);
-    out += ',';
-    io::AppendGeneral(&out, right, 10);
-    out += ',';
-    io::AppendGeneral(&out, left, 10);
-    out += '\n';
-  }
-  return out;
 }
 
 // The value most sessions declare (ties: the earliest session's).
@@ -213,7 +177,7 @@ std::vector<const DiffRun*> CollectRuns(const std::vector<DiffSession>& sessions
 optiodom::DatasetText DiffDatasetText(const OptiOdomDiffImportSummary& summary,
                                       const std::vector<const DiffRun*>& sources) {
   optiodom::DatasetText text;
-  text.encoder_csv = [&sources](std::size_t i) { return TicksCsv(*sources[i]); };
+  text.encoder_csv = [&sources](std::size_t i) { return optiodom::IncrementsCsv("t,ticks_right,ticks_left", *sources[i], 9); };
   text.header =
       "# OptiOdom differential drive (Sousa et al. 2022, MIT licence), imported by fitcal\n";
   for (const std::string& n : summary.notes) text.header += "# " + n + "\n";

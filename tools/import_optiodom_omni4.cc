@@ -53,15 +53,7 @@ RunLog ReadRun(const std::string& path, int number, const OptiOdomOmni4Metadata&
   const optiodom::RunRows rows =
       optiodom::ReadRun(path, number, kWheels, "enc_1, enc_2, enc_3, enc_4");
   RunLog log;
-  log.encoders.samples = EncoderSamples(kWheels);
-  const double rad_per_count = 2.0 * M_PI / meta.CountsPerWheelRev();
-  for (std::size_t k = 1; k < rows.t_s.size(); ++k) {
-    const double dt = rows.t_s[k] - rows.t_s[k - 1];
-    double w[kWheels];
-    for (int i = 0; i < kWheels; ++i) w[i] = rad_per_count * rows.encoder[k][i] / dt + 0.0;
-    log.encoders.samples.push_back(dt, w);
-  }
-  log.encoders.t_s = rows.t_s;
+  log.encoders = optiodom::RatesOf(rows, meta.CountsPerWheelRev());
   log.ground_truth = rows.ground_truth;
   // The ground truth is in the robot's start frame and the robot is at rest at the start.
   log.start_pose = log.ground_truth.world_T_robot.front();

@@ -37,17 +37,12 @@ OptiOdomTricycleMetadata ReadMetadata(const std::string& path) {
 }
 
 OptiOdomTricycleRun ReadRun(const std::string& path, int number) {
-  optiodom::RunRows rows =
+  static_assert(K::kTractionChannel == 0 && K::kSteeringChannel == 1, "the file's column order");
+  OptiOdomTricycleRun run =
       optiodom::ReadRun(path, number, 2, "ticks, steering", ": no steering column");
-  OptiOdomTricycleRun run;
-  run.number = number;
-  run.t_s = std::move(rows.t_s);
-  for (const std::vector<double>& e : rows.encoder) {
-    run.ticks.push_back(e[0]);
-    run.steering_rad.push_back(e[1]);
-  }
-  run.ground_truth = std::move(rows.ground_truth);
-  tricycle::CheckSteeringReadings(run.steering_rad, path, rows.first_line);
+  std::vector<double> steering_rad;
+  for (const std::vector<double>& e : run.encoder) steering_rad.push_back(e[K::kSteeringChannel]);
+  tricycle::CheckSteeringReadings(steering_rad, path, run.first_line);
   return run;
 }
 
@@ -91,36 +86,14 @@ RunLog OptiOdomTricycleRunLog(const OptiOdomTricycleSession& session,
       run.ground_truth.world_T_robot.back().theta - run.ground_truth.world_T_robot.front().theta;
   log.trajectory = session.path_type + (turn_rad < 0.0 ? "_cw" : "_ccw");
   log.repetition = session_repetition;
-  const double rad_per_tick = 2.0 * M_PI / session.metadata.TicksPerWheelRev();
-  log.encoders.t_s = run.t_s;
-  log.encoders.samples = EncoderSamples(K::kNumChannels);
-  for (std::size_t k = 1; k < run.t_s.size(); ++k) {
-    const double dt = run.t_s[k] - run.t_s[k - 1];
-    double values[K::kNumChannels];
-    values[K::kTractionChannel] = rad_per_tick * run.ticks[k] / dt;
-    values[K::kSteeringChannel] = 0.5 * (run.steering_rad[k - 1] + run.steering_rad[k]);
-    log.encoders.samples.push_back(dt, values);
-  }
+  log.encoders =
+      optiodom::RatesOf(run, session.metadata.TicksPerWheelRev(), K::kSteeringChannel);
   log.ground_truth = run.ground_truth;
   log.start_pose = run.ground_truth.world_T_robot.front();  // at rest, the start frame
   return log;
 }
 
 namespace {
-
-// Encoder CSV as the recorder logged it: ticks per interval (row 0 zero: counts before the
-// start are not part of the run) and the steering reading at t.
-std::string TricycleEncoderCsv(const OptiOdomTricycleRun& run) {
-  std::string out = "t,ticks_traction,steering\n";
-  char line[128];
-  for (std::size_t k = 0; k < run.t_s.size(); ++k) {
-    const double ticks = k == 0 ? 0.0 : run.ticks[k];
-    const int n = std::snprintf(line, sizeof line, "%.6f,%.10g,%.10g\n", run.t_s[k], ticks,
-                                run.steering_rad[k]);
-    out.append(line, static_cast<std::size_t>(n));
-  }
-  return out;
-}
 
 void CheckOneRobot(const std::vector<OptiOdomTricycleSession>& sessions) {
   const OptiOdomTricycleMetadata& first = sessions.front().metadata;
@@ -186,7 +159,8 @@ ImportOptiOdomTricycleSummary ImportOptiOdomTricycle(const std::vector<std::stri
   summary.nominal_cf = nominal.cf;
 
   optiodom::DatasetText text;
-  text.encoder_csv = [&](std::size_t i) { return TricycleEncoderCsv(*sources[i]); };
+  text.encoder_csv = [&](std::size_t i) { return optiodom::IncrementsCsv("t,ticks_traction,steering", *sources[i], 6,
+                                  K::kSteeringChannel); };
   optiodom::WriteDataset(summary.runs, *model, text, out, options.force, sessions);
   return summary;
 }

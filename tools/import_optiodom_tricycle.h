@@ -39,6 +39,7 @@
 
 #include "models/model_interface.h"
 #include "odometry/run_log.h"
+#include "tools/optiodom_format.h"
 
 namespace fitcal::tools {
 
@@ -52,13 +53,8 @@ struct OptiOdomTricycleMetadata {
   double TicksPerWheelRev() const { return gear_ratio * encoder_counts_per_rev; }
 };
 
-struct OptiOdomTricycleRun {
-  int number = 0;  // NN of the file name
-  std::vector<double> t_s;
-  std::vector<double> ticks;         // traction increments over (t(k-1), t(k)]
-  std::vector<double> steering_rad;  // reading at t(k)
-  GroundTruthTrack ground_truth;
-};
+// encoder[k] = {traction ticks over (t(k-1), t(k)], steering reading at t(k) in rad}.
+using OptiOdomTricycleRun = optiodom::RunRows;
 
 struct OptiOdomTricycleSession {
   std::string name;       // directory name, e.g. 140120211415

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+
 #include <filesystem>
 #include <regex>
 #include <set>
@@ -199,6 +200,40 @@ RunRows ReadRun(const std::string& path, int number, int encoder_columns,
                      "needs at least two rows, found " + std::to_string(run.t_s.size()));
   }
   return run;
+}
+
+EncoderLog RatesOf(const RunRows& run, double ticks_per_rev, int reading_column) {
+  const int columns = static_cast<int>(run.encoder.front().size());
+  const double rad_per_tick = 2.0 * M_PI / ticks_per_rev;
+  EncoderLog log;
+  log.t_s = run.t_s;
+  log.samples = EncoderSamples(columns);
+  std::vector<double> values(static_cast<std::size_t>(columns));
+  for (std::size_t k = 1; k < run.t_s.size(); ++k) {
+    const double dt = run.t_s[k] - run.t_s[k - 1];
+    for (int j = 0; j < columns; ++j) {
+      values[j] = j == reading_column ? 0.5 * (run.encoder[k - 1][j] + run.encoder[k][j])
+                                      : rad_per_tick * run.encoder[k][j] / dt + 0.0;
+    }
+    log.samples.push_back(dt, values.data());
+  }
+  return log;
+}
+
+std::string IncrementsCsv(const std::string& header, const RunRows& run, int time_decimals,
+                          int reading_column) {
+  std::string out = header + "\n";
+  out.reserve(out.size() + 40 * run.t_s.size());
+  for (std::size_t k = 0; k < run.t_s.size(); ++k) {
+    io::AppendFixed(&out, run.t_s[k], time_decimals);
+    for (std::size_t j = 0; j < run.encoder[k].size(); ++j) {
+      const bool counted_before_start = k == 0 && static_cast<int>(j) != reading_column;
+      out += ',';
+      io::AppendGeneral(&out, counted_before_start ? 0.0 : run.encoder[k][j], 10);
+    }
+    out += '\n';
+  }
+  return out;
 }
 
 void CheckUniqueRunIds(const std::vector<RunLog>& runs, const std::string& out) {

@@ -77,6 +77,16 @@ struct RunRows {
 RunRows ReadRun(const std::string& path, int number, int encoder_columns,
                 const std::string& column_names, const std::string& short_row_hint = "");
 
+// Wheel rates over (t(k-1), t(k)]: 2 pi / ticks_per_rev * increment(k) / dt for every column but
+// `reading_column` (an angle read at t(k): tricycle steering), which gets the mean of its readings
+// at both ends of the interval.
+EncoderLog RatesOf(const RunRows& run, double ticks_per_rev, int reading_column = -1);
+
+// The encoder CSV as the robot logged it: `header`, then per row t (`time_decimals` fixed) and
+// every column as %.10g; increments are 0 at row 0 (counted before the run), readings as read.
+std::string IncrementsCsv(const std::string& header, const RunRows& run, int time_decimals,
+                          int reading_column = -1);
+
 // ---- Writing the fitcal data set (README.md "Data set format").
 
 // Refuses a run id that two runs share (the same session given twice); `out` names the data set.
