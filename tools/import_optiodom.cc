@@ -63,17 +63,10 @@ OptiOdomRun ReadRun(const std::string& path, int number) {
 }  // namespace
 
 OptiOdomSession ReadOptiOdomSession(const std::string& directory) {
-  const optiodom::SessionFiles files = optiodom::ListSession(directory);
-  OptiOdomSession session;
-  session.name = files.name;
-  session.path_type = files.path_type;
-  session.metadata = ReadMetadata(files.metadata_path);
-  optiodom::CheckRunCount(files, session.metadata.num_runs);
-  session.runs.resize(files.runs.size());
-  ParallelFor(files.runs.size(), 0, [&](std::size_t i) {
-    session.runs[i] = ReadRun(files.runs[i].second, files.runs[i].first);
-  });
-  return session;
+  return optiodom::ReadSession<OptiOdomMetadata, OptiOdomRun>(
+      directory, ReadMetadata, [](const std::string& path, int number, const OptiOdomMetadata&) {
+        return ReadRun(path, number);
+      });
 }
 
 Omni3Robot OptiOdomNominalRobot(const OptiOdomMetadata& metadata) {
@@ -117,7 +110,6 @@ RunLog OptiOdomRunLog(const OptiOdomSession& session, const OptiOdomRun& run) {
   log.start_pose = run.ground_truth.world_T_robot.front();
   return log;
 }
-
 
 namespace {
 
@@ -214,7 +206,9 @@ int RunImportOptiOdomCommand(const ImportOptiOdomOptions& options) {
     std::printf("%s\n",
                 CheckImportedChannelOrder(logs, *robot, options.skip_mapping_check).c_str());
     optiodom::DatasetText text;
-    text.encoder_csv = [&](std::size_t i) { return optiodom::IncrementsCsv("t,ticks_a,ticks_b,ticks_c", *sources[i], 6); };
+    text.encoder_csv = [&](std::size_t i) {
+      return optiodom::IncrementsCsv("t,ticks_a,ticks_b,ticks_c", *sources[i], 6);
+    };
     optiodom::WriteDataset(logs, *robot, text, options.out, options.force, options.sessions);
     std::printf("wrote %zu runs of %zu sessions to %s\n", logs.size(), sessions.size(),
                 options.out.c_str());

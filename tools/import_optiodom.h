@@ -49,12 +49,7 @@ struct OptiOdomMetadata {
 // mapped from the authors' (see above).
 using OptiOdomRun = optiodom::RunRows;
 
-struct OptiOdomSession {
-  std::string name;       // directory name, e.g. 221220201643
-  std::string path_type;  // parent directory name, e.g. circular, square
-  OptiOdomMetadata metadata;
-  std::vector<OptiOdomRun> runs;  // sorted by run number
-};
+using OptiOdomSession = optiodom::Session<OptiOdomMetadata, OptiOdomRun>;
 
 // Reads and checks one session directory; throws io::InputError (file, line, cause).
 OptiOdomSession ReadOptiOdomSession(const std::string& directory);

@@ -70,24 +70,13 @@ DiffRun ReadDiffRun(const std::string& path, int number) {
   return optiodom::ReadRun(path, number, 2, "ticks_right, ticks_left");
 }
 
-struct DiffSession {
-  std::string name;       // e.g. 231220200029
-  std::string path_type;  // circular, square
-  std::string metadata_path;
-  DiffMetadata metadata;
-  std::vector<DiffRun> runs;  // by run number
-};
+using DiffSession = optiodom::Session<DiffMetadata, DiffRun>;
 
 DiffSession ReadDiffSession(const std::string& directory) {
-  const optiodom::SessionFiles files = optiodom::ListSession(directory);
-  DiffSession s;
-  s.name = files.name;
-  s.path_type = files.path_type;
-  s.metadata_path = files.metadata_path;
-  s.metadata = ReadDiffMetadata(s.metadata_path);
-  optiodom::CheckRunCount(files, s.metadata.num_runs);
-  for (const auto& [number, path] : files.runs) s.runs.push_back(ReadDiffRun(path, number));
-  return s;
+  return optiodom::ReadSession<DiffMetadata, DiffRun>(
+      directory, ReadDiffMetadata, [](const std::string& path, int number, const DiffMetadata&) {
+        return ReadDiffRun(path, number);
+      });
 }
 
 const FlaggedRun* FindFlag(const DiffSession& s, int run) {
@@ -135,9 +124,11 @@ RobotModelPtr NominalDiffDriveModel(const DiffMetadata& m) {
 
 // The runs to write, session by session; notes sessions that declare other values and runs left
 // out.
-std::vector<const DiffRun*> CollectRuns(const std::vector<DiffSession>& sessions, const DiffMetadata& robot,
-                          const ImportOptiOdomDiffOptions& options, const std::string& out_dir,
-                          OptiOdomDiffImportSummary* summary) {
+std::vector<const DiffRun*> CollectRuns(const std::vector<DiffSession>& sessions,
+                                        const DiffMetadata& robot,
+                                        const ImportOptiOdomDiffOptions& options,
+                                        const std::string& out_dir,
+                                        OptiOdomDiffImportSummary* summary) {
   const auto note = [&](const std::string& text) {
     summary->notes.push_back(text);
     if (!options.quiet) std::printf("%s\n", text.c_str());
@@ -177,7 +168,9 @@ std::vector<const DiffRun*> CollectRuns(const std::vector<DiffSession>& sessions
 optiodom::DatasetText DiffDatasetText(const OptiOdomDiffImportSummary& summary,
                                       const std::vector<const DiffRun*>& sources) {
   optiodom::DatasetText text;
-  text.encoder_csv = [&sources](std::size_t i) { return optiodom::IncrementsCsv("t,ticks_right,ticks_left", *sources[i], 9); };
+  text.encoder_csv = [&sources](std::size_t i) {
+    return optiodom::IncrementsCsv("t,ticks_right,ticks_left", *sources[i], 9);
+  };
   text.header =
       "# OptiOdom differential drive (Sousa et al. 2022, MIT licence), imported by fitcal\n";
   for (const std::string& n : summary.notes) text.header += "# " + n + "\n";
@@ -207,7 +200,8 @@ OptiOdomDiffImportSummary ImportOptiOdomDiff(const std::vector<std::string>& ses
   summary.diameter_right_m = robot.diameter_right_m;
   summary.diameter_left_m = robot.diameter_left_m;
   summary.ticks_per_rev = robot.TicksPerWheelRev();
-  const std::vector<const DiffRun*> sources = CollectRuns(sessions, robot, options, out_dir, &summary);
+  const std::vector<const DiffRun*> sources =
+      CollectRuns(sessions, robot, options, out_dir, &summary);
   summary.num_runs = static_cast<int>(sources.size());
   const RobotModelPtr model = NominalDiffDriveModel(robot);
   const std::string order_check =

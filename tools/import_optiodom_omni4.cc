@@ -15,7 +15,6 @@
 
 namespace fitcal::tools {
 
-
 namespace {
 
 constexpr int kWheels = 4;
@@ -53,6 +52,7 @@ RunLog ReadRun(const std::string& path, int number, const OptiOdomOmni4Metadata&
   const optiodom::RunRows rows =
       optiodom::ReadRun(path, number, kWheels, "enc_1, enc_2, enc_3, enc_4");
   RunLog log;
+  log.repetition = number;
   log.encoders = optiodom::RatesOf(rows, meta.CountsPerWheelRev());
   log.ground_truth = rows.ground_truth;
   // The ground truth is in the robot's start frame and the robot is at rest at the start.
@@ -111,24 +111,15 @@ std::string GroundTruthCsvText(const GroundTruthTrack& track) {
 }  // namespace
 
 OptiOdomOmni4Session ReadOptiOdomOmni4Session(const std::string& directory) {
-  const optiodom::SessionFiles read = optiodom::ListSession(directory);
-  OptiOdomOmni4Session session;
-  session.name = read.name;
-  session.path_type = read.path_type;
-  session.metadata = ReadMetadata(read.metadata_path);
-  optiodom::CheckRunCount(read, session.metadata.num_runs);
-  const auto& files = read.runs;
-  session.runs.resize(files.size());
-  ParallelFor(files.size(), 0, [&](std::size_t i) {
-    RunLog& log = session.runs[i];
-    log = ReadRun(files[i].second, files[i].first, session.metadata);
+  OptiOdomOmni4Session session =
+      optiodom::ReadSession<OptiOdomOmni4Metadata, RunLog>(directory, ReadMetadata, ReadRun);
+  for (RunLog& log : session.runs) {
     char id[96];
     std::snprintf(id, sizeof id, "%s_%s_run%02d", session.path_type.c_str(), session.name.c_str(),
-                  files[i].first);
+                  log.repetition);
     log.id = id;
     log.trajectory = session.path_type + "_" + session.name;
-    log.repetition = files[i].first;
-  });
+  }
   return session;
 }
 

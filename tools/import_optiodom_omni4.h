@@ -45,6 +45,7 @@
 
 #include "models/model_interface.h"
 #include "odometry/run_log.h"
+#include "tools/optiodom_format.h"
 
 namespace fitcal::tools {
 
@@ -61,12 +62,8 @@ struct OptiOdomOmni4Metadata {
   }
 };
 
-struct OptiOdomOmni4Session {
-  std::string name;       // directory name, e.g. 080920201015
-  std::string path_type;  // parent directory name: circular, square
-  OptiOdomOmni4Metadata metadata;
-  std::vector<RunLog> runs;  // wheel rates in rad/s, wheels fl, fr, rl, rr; sorted by run number
-};
+// Runs as wheel rates in rad/s, wheels fl, fr, rl, rr.
+using OptiOdomOmni4Session = optiodom::Session<OptiOdomOmni4Metadata, RunLog>;
 
 // Reads one session directory (runs in parallel, numbers by std::from_chars); throws
 // io::InputError naming the file and line.

@@ -49,14 +49,11 @@ OptiOdomTricycleRun ReadRun(const std::string& path, int number) {
 }  // namespace
 
 OptiOdomTricycleSession ReadOptiOdomTricycleSession(const std::string& directory) {
-  const optiodom::SessionFiles files = optiodom::ListSession(directory);
-  OptiOdomTricycleSession session;
-  session.name = files.name;
-  session.path_type = files.path_type;
-  session.metadata = ReadMetadata(files.metadata_path);
-  optiodom::CheckRunCount(files, session.metadata.num_runs);
-  for (const auto& [number, path] : files.runs) session.runs.push_back(ReadRun(path, number));
-  return session;
+  return optiodom::ReadSession<OptiOdomTricycleMetadata, OptiOdomTricycleRun>(
+      directory, ReadMetadata,
+      [](const std::string& path, int number, const OptiOdomTricycleMetadata&) {
+        return ReadRun(path, number);
+      });
 }
 
 RobotModelPtr OptiOdomTricycleNominalModel(const OptiOdomTricycleMetadata& metadata) {
@@ -86,8 +83,7 @@ RunLog OptiOdomTricycleRunLog(const OptiOdomTricycleSession& session,
       run.ground_truth.world_T_robot.back().theta - run.ground_truth.world_T_robot.front().theta;
   log.trajectory = session.path_type + (turn_rad < 0.0 ? "_cw" : "_ccw");
   log.repetition = session_repetition;
-  log.encoders =
-      optiodom::RatesOf(run, session.metadata.TicksPerWheelRev(), K::kSteeringChannel);
+  log.encoders = optiodom::RatesOf(run, session.metadata.TicksPerWheelRev(), K::kSteeringChannel);
   log.ground_truth = run.ground_truth;
   log.start_pose = run.ground_truth.world_T_robot.front();  // at rest, the start frame
   return log;
@@ -159,8 +155,10 @@ ImportOptiOdomTricycleSummary ImportOptiOdomTricycle(const std::vector<std::stri
   summary.nominal_cf = nominal.cf;
 
   optiodom::DatasetText text;
-  text.encoder_csv = [&](std::size_t i) { return optiodom::IncrementsCsv("t,ticks_traction,steering", *sources[i], 6,
-                                  K::kSteeringChannel); };
+  text.encoder_csv = [&](std::size_t i) {
+    return optiodom::IncrementsCsv("t,ticks_traction,steering", *sources[i], 6,
+                                   K::kSteeringChannel);
+  };
   optiodom::WriteDataset(summary.runs, *model, text, out, options.force, sessions);
   return summary;
 }

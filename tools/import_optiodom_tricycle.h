@@ -56,12 +56,7 @@ struct OptiOdomTricycleMetadata {
 // encoder[k] = {traction ticks over (t(k-1), t(k)], steering reading at t(k) in rad}.
 using OptiOdomTricycleRun = optiodom::RunRows;
 
-struct OptiOdomTricycleSession {
-  std::string name;       // directory name, e.g. 140120211415
-  std::string path_type;  // parent directory name: circular, square
-  OptiOdomTricycleMetadata metadata;
-  std::vector<OptiOdomTricycleRun> runs;  // sorted by run number
-};
+using OptiOdomTricycleSession = optiodom::Session<OptiOdomTricycleMetadata, OptiOdomTricycleRun>;
 
 // Reads and checks one session directory (metadata, every run, the steering column:
 // models/tricycle/tricycle_checks.h); throws io::InputError (file, line, cause).

@@ -17,6 +17,7 @@
 
 #include "io/dataset.h"
 #include "models/model_interface.h"
+#include "odometry/parallel_for.h"
 #include "odometry/run_log.h"
 
 namespace fitcal::tools::optiodom {
@@ -36,9 +37,7 @@ struct Metadata {
 
   // Exactly `count` values of row `key`, each > 0 when `positive`.
   std::vector<double> Values(const std::string& key, std::size_t count, bool positive) const;
-  double Value(const std::string& key, bool positive) const {
-    return Values(key, 1, positive)[0];
-  }
+  double Value(const std::string& key, bool positive) const { return Values(key, 1, positive)[0]; }
   // N, a whole number of runs.
   int NumRuns() const;
   // ngear * encRes: encoder ticks per wheel revolution.
@@ -76,6 +75,32 @@ struct RunRows {
 // ("ticks_right, ticks_left"); `short_row_hint` is added when a row lacks one field.
 RunRows ReadRun(const std::string& path, int number, int encoder_columns,
                 const std::string& column_names, const std::string& short_row_hint = "");
+
+// One session of a robot: its names, its metadata as the robot reads it, its runs by number.
+template <typename Meta, typename Run>
+struct Session {
+  std::string name;       // directory name, e.g. 221220201643
+  std::string path_type;  // parent directory name, e.g. circular, square
+  std::string metadata_path;
+  Meta metadata;
+  std::vector<Run> runs;  // sorted by run number
+};
+
+// Reads a session with the robot's readers, read_metadata(path) -> Meta (with num_runs) and
+// read_run(path, number, metadata) -> Run, the runs in parallel.
+template <typename Meta, typename Run, typename ReadMetadataFn, typename ReadRunFn>
+Session<Meta, Run> ReadSession(const std::string& directory, ReadMetadataFn read_metadata,
+                               ReadRunFn read_run) {
+  const SessionFiles files = ListSession(directory);
+  Session<Meta, Run> s{
+      files.name, files.path_type, files.metadata_path, read_metadata(files.metadata_path), {}};
+  CheckRunCount(files, s.metadata.num_runs);
+  s.runs.resize(files.runs.size());
+  ParallelFor(files.runs.size(), 0, [&](std::size_t i) {
+    s.runs[i] = read_run(files.runs[i].second, files.runs[i].first, s.metadata);
+  });
+  return s;
+}
 
 // Wheel rates over (t(k-1), t(k)]: 2 pi / ticks_per_rev * increment(k) / dt for every column but
 // `reading_column` (an angle read at t(k): tricycle steering), which gets the mean of its readings
