@@ -182,17 +182,11 @@ int RunImportOptiOdomCommand(const ImportOptiOdomOptions& options) {
     // Read and check everything before writing anything.
     std::vector<OptiOdomSession> sessions;
     for (const std::string& dir : options.sessions) sessions.push_back(ReadOptiOdomSession(dir));
+    optiodom::CheckOneRobot(sessions, [](const OptiOdomMetadata& a, const OptiOdomMetadata& b) {
+      return a.gear_ratio == b.gear_ratio && a.encoder_counts_per_rev == b.encoder_counts_per_rev &&
+             a.distance_m == b.distance_m && a.diameter_m == b.diameter_m;
+    });
     const OptiOdomMetadata& first = sessions.front().metadata;
-    for (const OptiOdomSession& s : sessions) {
-      const OptiOdomMetadata& m = s.metadata;
-      if (m.gear_ratio != first.gear_ratio ||
-          m.encoder_counts_per_rev != first.encoder_counts_per_rev ||
-          m.distance_m != first.distance_m || m.diameter_m != first.diameter_m) {
-        throw InputError(InputErrorKind::kBadValue, s.name + "_metadata.csv", 0,
-                         "robot geometry or encoders differ from session " + sessions.front().name +
-                             "'s; import sessions of one robot together");
-      }
-    }
     const std::shared_ptr<const Omni3Model> robot = Omni3ModelOf(OptiOdomNominalRobot(first));
     std::vector<RunLog> logs;
     std::vector<const OptiOdomRun*> sources;

@@ -98,18 +98,6 @@ RunLog DiffRunLog(const DiffSession& s, const DiffRun& run, double ticks_per_rev
   return log;
 }
 
-// The value most sessions declare (ties: the earliest session's).
-const DiffMetadata& MajorityRobot(const std::vector<DiffSession>& sessions) {
-  std::size_t best = 0;
-  int best_count = 0;
-  for (std::size_t i = 0; i < sessions.size(); ++i) {
-    int count = 0;
-    for (const DiffSession& s : sessions) count += s.metadata.SameRobotAs(sessions[i].metadata);
-    if (count > best_count) best = i, best_count = count;
-  }
-  return sessions[best].metadata;
-}
-
 RobotModelPtr NominalDiffDriveModel(const DiffMetadata& m) {
   Robot robot = DiffDriveRobotDescription("optiodom_diff", {"right", "left"});
   const double r_right = 0.5 * m.diameter_right_m, r_left = 0.5 * m.diameter_left_m;
@@ -195,7 +183,10 @@ OptiOdomDiffImportSummary ImportOptiOdomDiff(const std::vector<std::string>& ses
   for (const std::string& dir : session_dirs) sessions.push_back(ReadDiffSession(dir));
   OptiOdomDiffImportSummary summary;
   summary.num_sessions = static_cast<int>(sessions.size());
-  const DiffMetadata& robot = MajorityRobot(sessions);
+  const DiffMetadata& robot =
+      optiodom::MajorityRobot(sessions, [](const DiffMetadata& a, const DiffMetadata& b) {
+        return a.SameRobotAs(b);
+      }).metadata;
   summary.separation_m = robot.separation_m;
   summary.diameter_right_m = robot.diameter_right_m;
   summary.diameter_left_m = robot.diameter_left_m;

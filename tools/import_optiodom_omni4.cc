@@ -60,18 +60,6 @@ RunLog ReadRun(const std::string& path, int number, const OptiOdomOmni4Metadata&
   return log;
 }
 
-// The value most sessions declare (ties: the first session's).
-template <typename T>
-T MostCommon(const std::vector<T>& values) {
-  std::size_t best = 0, best_count = 0;
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    const auto count =
-        static_cast<std::size_t>(std::count(values.begin(), values.end(), values[i]));
-    if (count > best_count) best = i, best_count = count;
-  }
-  return values[best];
-}
-
 void AppendNumber(std::string* out, double v) {
   char buffer[32];
   const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, v);  // shortest exact
@@ -160,9 +148,8 @@ Omni4ImportResult ImportOptiOdomOmni4(const std::vector<std::string>& session_di
   }
   std::vector<OptiOdomOmni4Session> sessions;
   for (const std::string& dir : session_dirs) sessions.push_back(ReadOptiOdomOmni4Session(dir));
-  std::vector<OptiOdomOmni4Metadata> declared;
-  for (const auto& s : sessions) declared.push_back(s.metadata);
-  const OptiOdomOmni4Metadata nominal = MostCommon(declared);
+  const OptiOdomOmni4Metadata nominal =
+      optiodom::MajorityRobot(sessions, std::equal_to<OptiOdomOmni4Metadata>()).metadata;
   Omni4ImportResult result;
   for (const auto& s : sessions) {
     if (!(s.metadata == nominal)) {

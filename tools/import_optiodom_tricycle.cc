@@ -91,21 +91,6 @@ RunLog OptiOdomTricycleRunLog(const OptiOdomTricycleSession& session,
 
 namespace {
 
-void CheckOneRobot(const std::vector<OptiOdomTricycleSession>& sessions) {
-  const OptiOdomTricycleMetadata& first = sessions.front().metadata;
-  for (const OptiOdomTricycleSession& s : sessions) {
-    const OptiOdomTricycleMetadata& m = s.metadata;
-    if (m.gear_ratio != first.gear_ratio ||
-        m.encoder_counts_per_rev != first.encoder_counts_per_rev ||
-        m.wheelbase_m != first.wheelbase_m || m.diameter_m != first.diameter_m ||
-        m.steering_offset_rad != first.steering_offset_rad) {
-      throw InputError(InputErrorKind::kBadValue, s.name + "_metadata.csv", 0,
-                       "robot geometry or encoders differ from session " + sessions.front().name +
-                           "'s; import sessions of one robot together");
-    }
-  }
-}
-
 // Repetition of each session: its place among the sessions of its path type, by name (the
 // names are timestamps, so 1 = earliest).
 std::vector<int> SessionRepetitions(const std::vector<OptiOdomTricycleSession>& sessions) {
@@ -134,7 +119,12 @@ ImportOptiOdomTricycleSummary ImportOptiOdomTricycle(const std::vector<std::stri
   // Read and check everything before writing anything.
   std::vector<OptiOdomTricycleSession> read;
   for (const std::string& dir : sessions) read.push_back(ReadOptiOdomTricycleSession(dir));
-  CheckOneRobot(read);
+  optiodom::CheckOneRobot(read, [](const OptiOdomTricycleMetadata& a,
+                                   const OptiOdomTricycleMetadata& b) {
+    return a.gear_ratio == b.gear_ratio && a.encoder_counts_per_rev == b.encoder_counts_per_rev &&
+           a.wheelbase_m == b.wheelbase_m && a.diameter_m == b.diameter_m &&
+           a.steering_offset_rad == b.steering_offset_rad;
+  });
   const RobotModelPtr model = OptiOdomTricycleNominalModel(read.front().metadata);
   const std::vector<int> repetition = SessionRepetitions(read);
 

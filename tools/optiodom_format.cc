@@ -201,6 +201,12 @@ RunRows ReadRun(const std::string& path, int number, int encoder_columns,
   return run;
 }
 
+void ThrowNotOneRobot(const std::string& session, const std::string& first) {
+  throw InputError(InputErrorKind::kBadValue, session + "_metadata.csv", 0,
+                   "robot geometry or encoders differ from session " + first +
+                       "'s; import sessions of one robot together");
+}
+
 EncoderLog RatesOf(const RunRows& run, double ticks_per_rev, int reading_column) {
   const int columns = static_cast<int>(run.encoder.front().size());
   const double rad_per_tick = 2.0 * M_PI / ticks_per_rev;

@@ -102,6 +102,31 @@ Session<Meta, Run> ReadSession(const std::string& directory, ReadMetadataFn read
   return s;
 }
 
+// The session whose robot most sessions declare (ties: the earliest); same(a, b) compares two
+// sessions' metadata. Some sessions declare perturbed values on purpose (README), the robot is
+// the same.
+template <typename Session, typename Same>
+const Session& MajorityRobot(const std::vector<Session>& sessions, Same same) {
+  std::size_t best = 0, best_count = 0;
+  for (std::size_t i = 0; i < sessions.size(); ++i) {
+    std::size_t count = 0;
+    for (const Session& s : sessions) count += same(s.metadata, sessions[i].metadata) ? 1 : 0;
+    if (count > best_count) best = i, best_count = count;
+  }
+  return sessions[best];
+}
+
+// Refuses sessions whose robot differs from the first session's (same(a, b) compares them).
+[[noreturn]] void ThrowNotOneRobot(const std::string& session, const std::string& first);
+template <typename Session, typename Same>
+void CheckOneRobot(const std::vector<Session>& sessions, Same same) {
+  for (const Session& s : sessions) {
+    if (!same(s.metadata, sessions.front().metadata)) {
+      ThrowNotOneRobot(s.name, sessions.front().name);
+    }
+  }
+}
+
 // Wheel rates over (t(k-1), t(k)]: 2 pi / ticks_per_rev * increment(k) / dt for every column but
 // `reading_column` (an angle read at t(k): tricycle steering), which gets the mean of its readings
 // at both ends of the interval.
