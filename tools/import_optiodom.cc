@@ -113,33 +113,81 @@ RunLog OptiOdomRunLog(const OptiOdomSession& session, const OptiOdomRun& run) {
 
 namespace {
 
-// The other robots of the OptiOdom study, each with its own importer.
-int ImportOtherOptiOdomRobot(const std::string& type, const ImportOptiOdomOptions& options) {
-  if (type == "diff") {
-    ImportOptiOdomDiffOptions diff;
-    diff.force = options.force;
-    diff.skip_mapping_check = options.skip_mapping_check;
-    ImportOptiOdomDiff(options.sessions, options.out, diff);  // prints its own summary
-    return 0;
+void ImportOmni3(const ImportOptiOdomOptions& options) {
+  std::vector<OptiOdomSession> sessions;
+  for (const std::string& dir : options.sessions) sessions.push_back(ReadOptiOdomSession(dir));
+  optiodom::CheckOneRobot(sessions, [](const OptiOdomMetadata& a, const OptiOdomMetadata& b) {
+    return a.gear_ratio == b.gear_ratio && a.encoder_counts_per_rev == b.encoder_counts_per_rev &&
+           a.distance_m == b.distance_m && a.diameter_m == b.diameter_m;
+  });
+  const std::shared_ptr<const Omni3Model> robot =
+      Omni3ModelOf(OptiOdomNominalRobot(sessions.front().metadata));
+  std::vector<RunLog> logs;
+  std::vector<const OptiOdomRun*> sources;
+  for (const OptiOdomSession& s : sessions) {
+    for (const OptiOdomRun& run : s.runs) {
+      logs.push_back(OptiOdomRunLog(s, run));
+      sources.push_back(&run);
+    }
   }
-  if (type == "tricyc") {
-    ImportOptiOdomTricycleOptions tricycle;
-    tricycle.force = options.force;
-    tricycle.skip_sign_check = options.skip_mapping_check;
-    const ImportOptiOdomTricycleSummary s =
-        ImportOptiOdomTricycle(options.sessions, options.out, tricycle);
-    std::printf("%s\n", s.channel_order.c_str());
-    std::printf("imported %zu runs of %d tricycle sessions into %s; nominal CF (Eq. 14) %.4f\n",
-                s.runs.size(), s.num_sessions, options.out.c_str(), s.nominal_cf);
-    return 0;
-  }
+  optiodom::CheckUniqueRunIds(logs, options.out);
+  std::printf("%s\n", CheckImportedChannelOrder(logs, *robot, options.skip_mapping_check).c_str());
+  optiodom::DatasetText text;
+  text.encoder_csv = [&](std::size_t i) {
+    return optiodom::IncrementsCsv("t,ticks_a,ticks_b,ticks_c", *sources[i], 6);
+  };
+  optiodom::WriteDataset(logs, *robot, text, options.out, options.force, options.sessions);
+  std::printf("wrote %zu runs of %zu sessions to %s\n", logs.size(), sessions.size(),
+              options.out.c_str());
+}
+
+void ImportDiff(const ImportOptiOdomOptions& options) {
+  ImportOptiOdomDiffOptions diff;
+  diff.force = options.force;
+  diff.skip_mapping_check = options.skip_mapping_check;
+  ImportOptiOdomDiff(options.sessions, options.out, diff);  // prints its own summary
+}
+
+void ImportTricycle(const ImportOptiOdomOptions& options) {
+  ImportOptiOdomTricycleOptions tricycle;
+  tricycle.force = options.force;
+  tricycle.skip_sign_check = options.skip_mapping_check;
+  const ImportOptiOdomTricycleSummary s =
+      ImportOptiOdomTricycle(options.sessions, options.out, tricycle);
+  std::printf("%s\n", s.channel_order.c_str());
+  std::printf("imported %zu runs of %d tricycle sessions into %s; nominal CF (Eq. 14) %.4f\n",
+              s.runs.size(), s.num_sessions, options.out.c_str(), s.nominal_cf);
+}
+
+void ImportOmni4(const ImportOptiOdomOptions& options) {
   const Omni4ImportResult s =
       ImportOptiOdomOmni4(options.sessions, options.out, options.force, options.skip_mapping_check);
   for (const std::string& note : s.notes) std::printf("note: %s\n", note.c_str());
   std::printf("%s\n", s.channel_order.c_str());
   std::printf("imported %d runs of %d omni4 sessions into %s; nominal CF (Eq. 14) %.4f\n",
               s.num_runs, s.num_sessions, options.out.c_str(), s.nominal_mean_cf);
-  return 0;
+}
+
+// The robots of the OptiOdom study by their metadata `type`. Each importer reads, checks and
+// writes through the one reader and writer (tools/optiodom_format.h) and prints its summary;
+// what differs is which metadata keys make the nominal robot and what the encoder columns are.
+struct OptiOdomRobot {
+  const char* type;
+  void (*import)(const ImportOptiOdomOptions&);
+};
+constexpr OptiOdomRobot kRobots[] = {{"omni3", ImportOmni3},
+                                     {"omni4", ImportOmni4},
+                                     {"diff", ImportDiff},
+                                     {"tricyc", ImportTricycle}};
+
+const OptiOdomRobot& RobotOfType(const std::string& type, const std::string& session) {
+  for (const OptiOdomRobot& robot : kRobots) {
+    if (type == robot.type) return robot;
+  }
+  throw InputError(InputErrorKind::kUnknownModel, session, 0,
+                   "type '" + type +
+                       "' is not an OptiOdom robot fitcal imports (omni3, omni4, "
+                       "diff, tricyc)");
 }
 
 }  // namespace
@@ -176,36 +224,7 @@ int RunImportOptiOdomCommand(const ImportOptiOdomOptions& options) {
       std::cerr << "fitcal: " << refusal << "\n";
       return 2;
     }
-    if (type == "diff" || type == "tricyc" || type == "omni4") {
-      return ImportOtherOptiOdomRobot(type, options);
-    }
-    // Read and check everything before writing anything.
-    std::vector<OptiOdomSession> sessions;
-    for (const std::string& dir : options.sessions) sessions.push_back(ReadOptiOdomSession(dir));
-    optiodom::CheckOneRobot(sessions, [](const OptiOdomMetadata& a, const OptiOdomMetadata& b) {
-      return a.gear_ratio == b.gear_ratio && a.encoder_counts_per_rev == b.encoder_counts_per_rev &&
-             a.distance_m == b.distance_m && a.diameter_m == b.diameter_m;
-    });
-    const OptiOdomMetadata& first = sessions.front().metadata;
-    const std::shared_ptr<const Omni3Model> robot = Omni3ModelOf(OptiOdomNominalRobot(first));
-    std::vector<RunLog> logs;
-    std::vector<const OptiOdomRun*> sources;
-    for (const OptiOdomSession& s : sessions) {
-      for (const OptiOdomRun& run : s.runs) {
-        logs.push_back(OptiOdomRunLog(s, run));
-        sources.push_back(&run);
-      }
-    }
-    optiodom::CheckUniqueRunIds(logs, options.out);
-    std::printf("%s\n",
-                CheckImportedChannelOrder(logs, *robot, options.skip_mapping_check).c_str());
-    optiodom::DatasetText text;
-    text.encoder_csv = [&](std::size_t i) {
-      return optiodom::IncrementsCsv("t,ticks_a,ticks_b,ticks_c", *sources[i], 6);
-    };
-    optiodom::WriteDataset(logs, *robot, text, options.out, options.force, options.sessions);
-    std::printf("wrote %zu runs of %zu sessions to %s\n", logs.size(), sessions.size(),
-                options.out.c_str());
+    RobotOfType(type, options.sessions.front()).import(options);
     return 0;
   } catch (const MiswiredError& e) {
     std::cerr << "fitcal: " << e.what() << "\n";
