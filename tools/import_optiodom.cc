@@ -64,9 +64,8 @@ OptiOdomRun ReadRun(const std::string& path, int number) {
 
 OptiOdomSession ReadOptiOdomSession(const std::string& directory) {
   return optiodom::ReadSession<OptiOdomMetadata, OptiOdomRun>(
-      directory, ReadMetadata, [](const std::string& path, int number, const OptiOdomMetadata&) {
-        return ReadRun(path, number);
-      });
+      directory, ReadMetadata,
+      [](const std::string& path, int number, const auto&) { return ReadRun(path, number); });
 }
 
 Omni3Robot OptiOdomNominalRobot(const OptiOdomMetadata& metadata) {
@@ -97,18 +96,8 @@ Omni3Robot OptiOdomNominalRobot(const OptiOdomMetadata& metadata) {
 }
 
 RunLog OptiOdomRunLog(const OptiOdomSession& session, const OptiOdomRun& run) {
-  RunLog log;
-  char id[64];
-  std::snprintf(id, sizeof id, "%s_%s_run%02d", session.path_type.c_str(), session.name.c_str(),
-                run.number);
-  log.id = id;
-  log.trajectory = session.path_type + "_" + session.name;
-  log.repetition = run.number;
-  log.encoders = optiodom::RatesOf(run, session.metadata.TicksPerWheelRev());
-  log.ground_truth = run.ground_truth;
-  // The robot is at rest at the start (the ground truth's frame is the start frame).
-  log.start_pose = run.ground_truth.world_T_robot.front();
-  return log;
+  return optiodom::RunLogOf(session.path_type, session.name, run,
+                            session.metadata.TicksPerWheelRev());
 }
 
 namespace {

@@ -74,9 +74,8 @@ using DiffSession = optiodom::Session<DiffMetadata, DiffRun>;
 
 DiffSession ReadDiffSession(const std::string& directory) {
   return optiodom::ReadSession<DiffMetadata, DiffRun>(
-      directory, ReadDiffMetadata, [](const std::string& path, int number, const DiffMetadata&) {
-        return ReadDiffRun(path, number);
-      });
+      directory, ReadDiffMetadata,
+      [](const std::string& path, int number, const auto&) { return ReadDiffRun(path, number); });
 }
 
 const FlaggedRun* FindFlag(const DiffSession& s, int run) {
@@ -87,14 +86,8 @@ const FlaggedRun* FindFlag(const DiffSession& s, int run) {
 }
 
 RunLog DiffRunLog(const DiffSession& s, const DiffRun& run, double ticks_per_rev) {
-  RunLog log;
-  char id[96];
-  std::snprintf(id, sizeof id, "%s-%s-run%02d", s.path_type.c_str(), s.name.c_str(), run.number);
-  log.id = id;
+  RunLog log = optiodom::RunLogOf(s.path_type, s.name, run, ticks_per_rev, -1, '-');
   log.trajectory = s.path_type + "/" + s.name;
-  log.repetition = run.number;
-  log.encoders = optiodom::RatesOf(run, ticks_per_rev);
-  log.ground_truth = run.ground_truth;
   return log;
 }
 

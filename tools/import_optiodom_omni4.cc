@@ -46,20 +46,6 @@ OptiOdomOmni4Metadata ReadMetadata(const std::string& path) {
   return meta;
 }
 
-// One run file as a RunLog: wheel rates w_i = 2 pi enc_i / (counts per rev dt) over the interval
-// ending at each row, ground truth from the same rows.
-RunLog ReadRun(const std::string& path, int number, const OptiOdomOmni4Metadata& meta) {
-  const optiodom::RunRows rows =
-      optiodom::ReadRun(path, number, kWheels, "enc_1, enc_2, enc_3, enc_4");
-  RunLog log;
-  log.repetition = number;
-  log.encoders = optiodom::RatesOf(rows, meta.CountsPerWheelRev());
-  log.ground_truth = rows.ground_truth;
-  // The ground truth is in the robot's start frame and the robot is at rest at the start.
-  log.start_pose = log.ground_truth.world_T_robot.front();
-  return log;
-}
-
 void AppendNumber(std::string* out, double v) {
   char buffer[32];
   const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, v);  // shortest exact
@@ -99,16 +85,15 @@ std::string GroundTruthCsvText(const GroundTruthTrack& track) {
 }  // namespace
 
 OptiOdomOmni4Session ReadOptiOdomOmni4Session(const std::string& directory) {
-  OptiOdomOmni4Session session =
-      optiodom::ReadSession<OptiOdomOmni4Metadata, RunLog>(directory, ReadMetadata, ReadRun);
-  for (RunLog& log : session.runs) {
-    char id[96];
-    std::snprintf(id, sizeof id, "%s_%s_run%02d", session.path_type.c_str(), session.name.c_str(),
-                  log.repetition);
-    log.id = id;
-    log.trajectory = session.path_type + "_" + session.name;
-  }
-  return session;
+  // Wheel rates w_i = 2 pi enc_i / (counts per rev dt) over the interval ending at each row.
+  return optiodom::ReadSession<OptiOdomOmni4Metadata, RunLog>(
+      directory, ReadMetadata,
+      [](const std::string& path, int number, const OptiOdomOmni4Session& session) {
+        const optiodom::RunRows rows =
+            optiodom::ReadRun(path, number, kWheels, "enc_1, enc_2, enc_3, enc_4");
+        return optiodom::RunLogOf(session.path_type, session.name, rows,
+                                  session.metadata.CountsPerWheelRev());
+      });
 }
 
 RobotModelPtr OptiOdomOmni4NominalModel(const OptiOdomOmni4Metadata& metadata) {

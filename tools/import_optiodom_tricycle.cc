@@ -51,9 +51,7 @@ OptiOdomTricycleRun ReadRun(const std::string& path, int number) {
 OptiOdomTricycleSession ReadOptiOdomTricycleSession(const std::string& directory) {
   return optiodom::ReadSession<OptiOdomTricycleMetadata, OptiOdomTricycleRun>(
       directory, ReadMetadata,
-      [](const std::string& path, int number, const OptiOdomTricycleMetadata&) {
-        return ReadRun(path, number);
-      });
+      [](const std::string& path, int number, const auto&) { return ReadRun(path, number); });
 }
 
 RobotModelPtr OptiOdomTricycleNominalModel(const OptiOdomTricycleMetadata& metadata) {
@@ -74,18 +72,12 @@ RobotModelPtr OptiOdomTricycleNominalModel(const OptiOdomTricycleMetadata& metad
 
 RunLog OptiOdomTricycleRunLog(const OptiOdomTricycleSession& session,
                               const OptiOdomTricycleRun& run, int session_repetition) {
-  RunLog log;
-  char id[96];
-  std::snprintf(id, sizeof id, "%s_%s_run%02d", session.path_type.c_str(), session.name.c_str(),
-                run.number);
-  log.id = id;
+  RunLog log = optiodom::RunLogOf(session.path_type, session.name, run,
+                                  session.metadata.TicksPerWheelRev(), K::kSteeringChannel);
   const double turn_rad =
       run.ground_truth.world_T_robot.back().theta - run.ground_truth.world_T_robot.front().theta;
   log.trajectory = session.path_type + (turn_rad < 0.0 ? "_cw" : "_ccw");
   log.repetition = session_repetition;
-  log.encoders = optiodom::RatesOf(run, session.metadata.TicksPerWheelRev(), K::kSteeringChannel);
-  log.ground_truth = run.ground_truth;
-  log.start_pose = run.ground_truth.world_T_robot.front();  // at rest, the start frame
   return log;
 }
 

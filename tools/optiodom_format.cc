@@ -225,6 +225,20 @@ EncoderLog RatesOf(const RunRows& run, double ticks_per_rev, int reading_column)
   return log;
 }
 
+RunLog RunLogOf(const std::string& path_type, const std::string& session, const RunRows& run,
+                double ticks_per_rev, int reading_column, char separator) {
+  RunLog log;
+  const std::string number = std::to_string(run.number);
+  log.id = path_type + separator + session + separator + "run" +
+           (number.size() < 2 ? "0" + number : number);  // %02d
+  log.trajectory = path_type + "_" + session;
+  log.repetition = run.number;
+  log.encoders = RatesOf(run, ticks_per_rev, reading_column);
+  log.ground_truth = run.ground_truth;
+  log.start_pose = run.ground_truth.world_T_robot.front();
+  return log;
+}
+
 std::string IncrementsCsv(const std::string& header, const RunRows& run, int time_decimals,
                           int reading_column) {
   std::string out = header + "\n";

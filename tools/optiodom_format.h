@@ -87,7 +87,8 @@ struct Session {
 };
 
 // Reads a session with the robot's readers, read_metadata(path) -> Meta (with num_runs) and
-// read_run(path, number, metadata) -> Run, the runs in parallel.
+// read_run(path, number, session) -> Run (the session's names and metadata already read), the
+// runs in parallel.
 template <typename Meta, typename Run, typename ReadMetadataFn, typename ReadRunFn>
 Session<Meta, Run> ReadSession(const std::string& directory, ReadMetadataFn read_metadata,
                                ReadRunFn read_run) {
@@ -97,7 +98,7 @@ Session<Meta, Run> ReadSession(const std::string& directory, ReadMetadataFn read
   CheckRunCount(files, s.metadata.num_runs);
   s.runs.resize(files.runs.size());
   ParallelFor(files.runs.size(), 0, [&](std::size_t i) {
-    s.runs[i] = read_run(files.runs[i].second, files.runs[i].first, s.metadata);
+    s.runs[i] = read_run(files.runs[i].second, files.runs[i].first, s);
   });
   return s;
 }
@@ -131,6 +132,13 @@ void CheckOneRobot(const std::vector<Session>& sessions, Same same) {
 // `reading_column` (an angle read at t(k): tricycle steering), which gets the mean of its readings
 // at both ends of the interval.
 EncoderLog RatesOf(const RunRows& run, double ticks_per_rev, int reading_column = -1);
+
+// A run as fitcal replays it: id `<path type><sep><session><sep>runNN`, trajectory
+// `<path type>_<session>` and repetition NN (a robot may relabel), wheel rates (RatesOf), the
+// ground truth, and the start pose: the robot is at rest at the start, the ground truth in its
+// start frame.
+RunLog RunLogOf(const std::string& path_type, const std::string& session, const RunRows& run,
+                double ticks_per_rev, int reading_column = -1, char separator = '_');
 
 // The encoder CSV as the robot logged it: `header`, then per row t (`time_decimals` fixed) and
 // every column as %.10g; increments are 0 at row 0 (counted before the run), readings as read.
