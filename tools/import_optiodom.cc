@@ -13,7 +13,6 @@
 #include "io/input_registry.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "odometry/aligned_run.h"
-#include "odometry/parallel_for.h"
 #include "tools/import_channel_order.h"
 #include "tools/import_optiodom_models.h"
 #include "tools/import_optiodom_omni4.h"

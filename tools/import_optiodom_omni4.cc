@@ -5,10 +5,10 @@
 #include <cmath>
 #include <cstdio>
 
+#include "fit/final_pose_errors.h"
 #include "io/dataset.h"
 #include "models/omni/omni_model.h"
-#include "models/pose_errors.h"
-#include "odometry/parallel_for.h"
+#include "odometry/aligned_run.h"
 #include "tools/import_channel_order.h"
 #include "tools/optiodom_format.h"
 #include "tools/output_guard.h"
@@ -148,23 +148,15 @@ Omni4ImportResult ImportOptiOdomOmni4(const std::vector<std::string>& session_di
   for (const auto& s : sessions) all_runs.insert(all_runs.end(), s.runs.begin(), s.runs.end());
   result.channel_order = CheckImportedChannelOrder(all_runs, *model, skip_mapping_check);
   optiodom::CheckUniqueRunIds(all_runs, out_dir);
-  const std::vector<double>& p = model->robot().nominal;
-  std::vector<double> cf(all_runs.size());
-  ParallelFor(all_runs.size(), 0, [&](std::size_t i) {
-    const RunLog& log = all_runs[i];
-    const Pose2d final_pose =
-        model->ReplayFinalPose(p.data(), log.encoders.samples, *log.start_pose);
-    double r[3];
-    FinalPoseError(final_pose, log.ground_truth.world_T_robot.back(), ResidualWeights{}, r);
-    cf[i] = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
-  });
+  const FinalPoseErrors nominal_errors =
+      EvaluateFinalPoseErrors(*model, model->robot().nominal, AlignRuns(all_runs));
   optiodom::DatasetText text;
   text.encoder_csv = [&](std::size_t i) { return EncoderCsvText(all_runs[i], model->robot()); };
   text.ground_truth_csv = GroundTruthCsvText;
   optiodom::WriteDataset(all_runs, *model, text, out_dir, force, session_dirs);
   result.num_sessions = static_cast<int>(sessions.size());
   result.num_runs = static_cast<int>(all_runs.size());
-  for (double c : cf) result.nominal_mean_cf += c / static_cast<double>(cf.size());
+  result.nominal_mean_cf = nominal_errors.cf;
   return result;
 }
 
