@@ -102,8 +102,8 @@ RunLog OptiOdomRunLog(const OptiOdomSession& session, const OptiOdomRun& run) {
 namespace {
 
 void ImportOmni3(const ImportOptiOdomOptions& options) {
-  std::vector<OptiOdomSession> sessions;
-  for (const std::string& dir : options.sessions) sessions.push_back(ReadOptiOdomSession(dir));
+  const std::vector<OptiOdomSession> sessions = optiodom::ReadSessions<OptiOdomSession>(
+      options.sessions, options.out, options.force, ReadOptiOdomSession);
   optiodom::CheckOneRobot(sessions, [](const OptiOdomMetadata& a, const OptiOdomMetadata& b) {
     return a.gear_ratio == b.gear_ratio && a.encoder_counts_per_rev == b.encoder_counts_per_rev &&
            a.distance_m == b.distance_m && a.diameter_m == b.diameter_m;

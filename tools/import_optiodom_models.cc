@@ -163,17 +163,8 @@ optiodom::DatasetText DiffDatasetText(const OptiOdomDiffImportSummary& summary,
 OptiOdomDiffImportSummary ImportOptiOdomDiff(const std::vector<std::string>& session_dirs,
                                              const std::string& out_dir,
                                              const ImportOptiOdomDiffOptions& options) {
-  if (session_dirs.empty()) {
-    throw std::invalid_argument("import needs at least one session directory");
-  }
-  if (const std::string refusal =
-          DirectoryOutputRefusal(out_dir, kDatasetKind, options.force, session_dirs);
-      !refusal.empty()) {
-    throw std::runtime_error(refusal);
-  }
-  // Read and check everything before writing anything.
-  std::vector<DiffSession> sessions;
-  for (const std::string& dir : session_dirs) sessions.push_back(ReadDiffSession(dir));
+  const std::vector<DiffSession> sessions =
+      optiodom::ReadSessions<DiffSession>(session_dirs, out_dir, options.force, ReadDiffSession);
   OptiOdomDiffImportSummary summary;
   summary.num_sessions = static_cast<int>(sessions.size());
   const DiffMetadata& robot =

@@ -125,14 +125,8 @@ RobotModelPtr OptiOdomOmni4NominalModel(const OptiOdomOmni4Metadata& metadata) {
 Omni4ImportResult ImportOptiOdomOmni4(const std::vector<std::string>& session_dirs,
                                       const std::string& out_dir, bool force,
                                       bool skip_mapping_check) {
-  if (session_dirs.empty()) throw std::invalid_argument("no OptiOdom omni4 session to import");
-  if (const std::string refusal =
-          DirectoryOutputRefusal(out_dir, kDatasetKind, force, session_dirs);
-      !refusal.empty()) {
-    throw std::runtime_error(refusal);
-  }
-  std::vector<OptiOdomOmni4Session> sessions;
-  for (const std::string& dir : session_dirs) sessions.push_back(ReadOptiOdomOmni4Session(dir));
+  const std::vector<OptiOdomOmni4Session> sessions = optiodom::ReadSessions<OptiOdomOmni4Session>(
+      session_dirs, out_dir, force, ReadOptiOdomOmni4Session);
   const OptiOdomOmni4Metadata nominal =
       optiodom::MajorityRobot(sessions, std::equal_to<OptiOdomOmni4Metadata>()).metadata;
   Omni4ImportResult result;

@@ -102,15 +102,8 @@ std::vector<int> SessionRepetitions(const std::vector<OptiOdomTricycleSession>& 
 ImportOptiOdomTricycleSummary ImportOptiOdomTricycle(const std::vector<std::string>& sessions,
                                                      const std::string& out,
                                                      const ImportOptiOdomTricycleOptions& options) {
-  if (sessions.empty()) throw std::invalid_argument("import needs at least one session");
-  if (const std::string refusal =
-          DirectoryOutputRefusal(out, kDatasetKind, options.force, sessions);
-      !refusal.empty()) {
-    throw std::runtime_error(refusal);
-  }
-  // Read and check everything before writing anything.
-  std::vector<OptiOdomTricycleSession> read;
-  for (const std::string& dir : sessions) read.push_back(ReadOptiOdomTricycleSession(dir));
+  const std::vector<OptiOdomTricycleSession> read = optiodom::ReadSessions<OptiOdomTricycleSession>(
+      sessions, out, options.force, ReadOptiOdomTricycleSession);
   optiodom::CheckOneRobot(read, [](const OptiOdomTricycleMetadata& a,
                                    const OptiOdomTricycleMetadata& b) {
     return a.gear_ratio == b.gear_ratio && a.encoder_counts_per_rev == b.encoder_counts_per_rev &&

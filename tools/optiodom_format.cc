@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <regex>
 #include <set>
+#include <stdexcept>
 
 #include "io/atomic_file.h"
 #include "io/input_error.h"
@@ -199,6 +200,17 @@ RunRows ReadRun(const std::string& path, int number, int encoder_columns,
                      "needs at least two rows, found " + std::to_string(run.t_s.size()));
   }
   return run;
+}
+
+void CheckImportArguments(const std::vector<std::string>& session_dirs, const std::string& out,
+                          bool force) {
+  if (session_dirs.empty()) {
+    throw std::invalid_argument("import needs at least one OptiOdom session directory");
+  }
+  if (const std::string refusal = DirectoryOutputRefusal(out, kDatasetKind, force, session_dirs);
+      !refusal.empty()) {
+    throw std::runtime_error(refusal);
+  }
 }
 
 void ThrowNotOneRobot(const std::string& session, const std::string& first) {

@@ -103,6 +103,19 @@ Session<Meta, Run> ReadSession(const std::string& directory, ReadMetadataFn read
   return s;
 }
 
+// Refuses no session and an `out` the output guard refuses (tools/output_guard.h), then reads
+// every session with read(directory): all input is read and checked before anything is written.
+void CheckImportArguments(const std::vector<std::string>& session_dirs, const std::string& out,
+                          bool force);
+template <typename Session, typename ReadFn>
+std::vector<Session> ReadSessions(const std::vector<std::string>& session_dirs,
+                                  const std::string& out, bool force, ReadFn read) {
+  CheckImportArguments(session_dirs, out, force);
+  std::vector<Session> sessions;
+  for (const std::string& dir : session_dirs) sessions.push_back(read(dir));
+  return sessions;
+}
+
 // The session whose robot most sessions declare (ties: the earliest); same(a, b) compares two
 // sessions' metadata. Some sessions declare perturbed values on purpose (README), the robot is
 // the same.
