@@ -1,9 +1,12 @@
 #pragma once
 // `fitcal import optiodom <session-dir>... --out <dataset-dir>`: converts the published OptiOdom
-// omni3 recordings (Sousa et al., "OptiOdom: a Generic Approach for Odometry Calibration of
-// Wheeled Mobile Robots", J. Intell. Robot. Syst. 105, 39, 2022; MIT licence) into a fitcal data
-// set: per-run encoder ticks + ground-truth CSVs, dataset.yaml and a nominal robot YAML.
+// recordings (Sousa et al., "OptiOdom: a Generic Approach for Odometry Calibration of Wheeled
+// Mobile Robots", J. Intell. Robot. Syst. 105, 39, 2022; MIT licence) into a fitcal data set:
+// per-run encoder + ground-truth CSVs, dataset.yaml and a nominal robot YAML. The command picks
+// the robot by the sessions' metadata `type` (omni3 here; omni4, diff and tricyc in their
+// import_optiodom_*.h); every robot reads and writes through tools/optiodom_format.h.
 //
+// The omni3 robot:
 // Published format, per session directory <s>/:
 //   <s>_metadata.csv  rows `key,v1,v2,...`: type (omni3), ngear, encRes, Li (m), Di (m, three),
 //                     N (runs), gt_ti/gt_tf/odo_ti/odo_tf (clock-mapping instants per run)
