@@ -119,4 +119,22 @@ void EmitEncoderAndEffects(YAML::Emitter& out, const Robot& robot,
   out << YAML::EndSeq;
 }
 
+std::string CalibrationMatrixYaml(const std::string& key, const Eigen::MatrixXd& matrix) {
+  YAML::Emitter out;
+  out.SetDoublePrecision(16);
+  out << YAML::BeginMap << YAML::Key << key << YAML::Value << YAML::BeginSeq;
+  for (Eigen::Index r = 0; r < matrix.rows(); ++r) {
+    out << YAML::Flow << YAML::BeginSeq;
+    for (Eigen::Index c = 0; c < matrix.cols(); ++c) out << matrix(r, c);
+    out << YAML::EndSeq;
+  }
+  out << YAML::EndSeq << YAML::EndMap;
+  std::string indented;
+  for (char ch : "  " + std::string(out.c_str())) {
+    indented += ch;
+    if (ch == '\n') indented += "  ";
+  }
+  return indented;
+}
+
 }  // namespace fitcal::io

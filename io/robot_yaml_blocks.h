@@ -3,6 +3,7 @@
 // and the `effects:` list, read strictly (unknown keys are errors) and written back in the same
 // schema. Each model's reader (models/<model>/) uses these for the common keys.
 
+#include <Eigen/Core>
 #include <yaml-cpp/yaml.h>
 
 #include <optional>
@@ -34,5 +35,10 @@ void EmitEncoderAndEffects(YAML::Emitter& out, const Robot& robot);
 // The robot's encoder block with `effects` in place of the ones it declares.
 void EmitEncoderAndEffects(YAML::Emitter& out, const Robot& robot,
                            const std::vector<effects::EffectValue>& effects);
+
+// `key: [[row 0], [row 1], ...]` at full precision (16 digits), indented as one key of the
+// calibration block it follows: the matrix a model adds for firmware that takes it (omni3's M^-1
+// of Palacin Eq. 6, the omni model's forward matrix). Ends without a newline.
+std::string CalibrationMatrixYaml(const std::string& key, const Eigen::MatrixXd& matrix);
 
 }  // namespace fitcal::io

@@ -44,15 +44,6 @@ class OmniModel : public KinematicModel<OmniKinematics<N>> {
   Interval angle_offset_rad_;
 };
 
-inline std::string Indented(const std::string& text) {
-  std::string out;
-  for (char c : "  " + text) {
-    out += c;
-    if (c == '\n') out += "  ";
-  }
-  return out;
-}
-
 template <int N>
 std::string OmniModel<N>::RobotYaml(const std::vector<double>& p,
                                     const std::vector<effects::EffectValue>& effects,
@@ -91,17 +82,7 @@ std::string OmniModel<N>::RobotYaml(const std::vector<double>& p,
   if (calibration_block.empty()) return text;
   // The forward matrix F (v = F w, rad/s in, m/s and rad/s out) for firmware that takes it.
   const typename K::template ForwardMatrixT<double> f = kinematics.Prepare(p.data());
-  YAML::Emitter matrix;
-  matrix.SetDoublePrecision(16);
-  matrix << YAML::BeginMap << YAML::Key << "forward_kinematic_matrix" << YAML::Value
-         << YAML::BeginSeq;
-  for (int r = 0; r < 3; ++r) {
-    matrix << YAML::Flow << YAML::BeginSeq;
-    for (int c = 0; c < N; ++c) matrix << f(r, c);
-    matrix << YAML::EndSeq;
-  }
-  matrix << YAML::EndSeq << YAML::EndMap;
-  return text + calibration_block + Indented(matrix.c_str()) + "\n";
+  return text + calibration_block + io::CalibrationMatrixYaml("forward_kinematic_matrix", f) + "\n";
 }
 
 // The wheels' kinematic matrix at the nominal must have rank 3, else some motion turns no wheel.

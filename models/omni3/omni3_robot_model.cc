@@ -170,23 +170,10 @@ std::string Omni3Model::RobotYaml(const std::vector<double>& p,
   out << YAML::EndMap;
   std::string text = std::string(out.c_str()) + "\n";
   if (calibration_block.empty()) return text;
-  // M^-1 of Eq. 6 for firmware that takes the matrix, at full precision.
-  const omni3::Matrix3<double> m_inv = omni3::InverseKinematicMatrix(p.data());
-  YAML::Emitter matrix;
-  matrix.SetDoublePrecision(16);
-  matrix << YAML::BeginMap << YAML::Key << "inverse_kinematic_matrix" << YAML::Value
-         << YAML::BeginSeq;
-  for (int r = 0; r < 3; ++r) {
-    matrix << YAML::Flow << YAML::BeginSeq << m_inv(r, 0) << m_inv(r, 1) << m_inv(r, 2)
-           << YAML::EndSeq;
-  }
-  matrix << YAML::EndSeq << YAML::EndMap;
-  std::string indented;
-  for (char c : "  " + std::string(matrix.c_str())) {
-    indented += c;
-    if (c == '\n') indented += "  ";
-  }
-  return text + calibration_block + indented + "\n";
+  // M^-1 of Eq. 6 for firmware that takes the matrix.
+  const Eigen::Matrix3d m_inv = omni3::InverseKinematicMatrix(p.data());
+  return text + calibration_block + io::CalibrationMatrixYaml("inverse_kinematic_matrix", m_inv) +
+         "\n";
 }
 
 }  // namespace fitcal
