@@ -27,6 +27,7 @@
 #include "models/model_registry.h"
 #include "models/pose_errors.h"
 #include "odometry/aligned_run.h"
+#include "tests/jacobian_check.h"
 #include "tests/test_files.h"
 #include "tools/import_optiodom_models.h"
 #include "tools/sim/diff_drive_trajectories.h"
@@ -123,39 +124,19 @@ std::vector<AlignedRun> Aligned(const std::vector<sim::ModelSimulatedRun>& runs)
 }
 
 TEST(DiffDriveModel, AutodiffMatchesCentralDifferences) {
-  const RobotModelPtr model = ModelFromYaml(kRightFirstYaml);
+  const RobotModelPtr model = ModelFromYaml(kDiffDriveExampleYaml);
   const auto runs = Aligned(sim::SimulateRuns(
       *model, TrueRobot(), {sim::UmbmarkSquare(true, 1), sim::CircleTrajectory(0.5, false, 1)},
       sim::SimulationOptions{}));
   const std::vector<double> p = {0.0425, 0.0418, 0.203};
+  // h = 1e-7 m: truncation O(h^2 f''') and rounding O(1e-16 / h) both < 1e-8 relative.
   for (const AlignedRun& run : runs) {
-    std::unique_ptr<ceres::CostFunction> cost(model->FinalPoseCost(run, ResidualWeights{}));
-    double r[3], jacobian[9];
-    const double* parameters[] = {p.data()};
-    double* jacobians[] = {jacobian};
-    ASSERT_TRUE(cost->Evaluate(parameters, r, jacobians));
-    for (int k = 0; k < 3; ++k) {
-      // h = 1e-7 m: truncation O(h^2 f''') and rounding O(1e-16 / h) both < 1e-8 relative.
-      const double h = 1e-7;
-      std::vector<double> plus = p, minus = p;
-      plus[k] += h;
-      minus[k] -= h;
-      double rp[3], rm[3];
-      FinalPoseError(model->ReplayFinalPose(plus.data(), run.samples, run.start),
-                     run.final_ground_truth, ResidualWeights{}, rp);
-      FinalPoseError(model->ReplayFinalPose(minus.data(), run.samples, run.start),
-                     run.final_ground_truth, ResidualWeights{}, rm);
-      for (int i = 0; i < 3; ++i) {
-        const double numeric = (rp[i] - rm[i]) / (2.0 * h);
-        EXPECT_NEAR(jacobian[i * 3 + k], numeric, 1e-6 * (1.0 + std::abs(numeric)))
-            << run.id << " d r" << i << " / d p" << k;
-      }
-    }
+    testing::ExpectFinalPoseJacobianMatchesCentralDifferences(*model, run, p, 1e-7);
   }
 }
 
 TEST(ModelSimulator, RampsKeepTheSegmentsAndTheEncodersReplayTheTruth) {
-  const RobotModelPtr model = ModelFromYaml(kRightFirstYaml);
+  const RobotModelPtr model = ModelFromYaml(kDiffDriveExampleYaml);
   sim::DiffDriveTrajectoryOptions shape;
   shape.square_side_m = 1.5;
   const auto runs =

@@ -16,10 +16,12 @@
 #include <cmath>
 #include <vector>
 
+#include "diagnosis/channel_order_check.h"
 #include "fit/model_fit.h"
 #include "models/model_registry.h"
 #include "models/pose_errors.h"
 #include "odometry/aligned_run.h"
+#include "tests/jacobian_check.h"
 #include "tests/models/unicycle_test_model.h"
 
 namespace fitcal {
@@ -88,33 +90,9 @@ TEST(ModelHarness, AutodiffMatchesCentralDifferences) {
     SCOPED_TRACE(m.name);
     const RobotModelPtr model = ExampleModel(m);
     const Robot& robot = model->robot();
-    const int n = robot.NumParameters();
     const std::vector<double> p = Shifted(robot, 0.3);
     for (const AlignedRun& run : SyntheticRuns(*model, Shifted(robot, 0.6))) {
-      std::unique_ptr<ceres::CostFunction> cost(model->FinalPoseCost(run, ResidualWeights{}));
-      double r[3];
-      std::vector<double> jacobian(3 * n);
-      const double* parameters[] = {p.data()};
-      double* jacobians[] = {jacobian.data()};
-      ASSERT_TRUE(cost->Evaluate(parameters, r, jacobians));
-      for (int k = 0; k < n; ++k) {
-        // h = 1e-6 of the parameter's scale: truncation O(h^2) and rounding O(eps / h) both stay
-        // below 1e-8 of a derivative of order one.
-        const double h = 1e-6 * robot.parameters[k].RelativeScale(p[k]);
-        std::vector<double> plus = p, minus = p;
-        plus[k] += h;
-        minus[k] -= h;
-        double r_plus[3], r_minus[3];
-        FinalPoseError(model->ReplayFinalPose(plus.data(), run.samples, run.start),
-                       run.final_ground_truth, ResidualWeights{}, r_plus);
-        FinalPoseError(model->ReplayFinalPose(minus.data(), run.samples, run.start),
-                       run.final_ground_truth, ResidualWeights{}, r_minus);
-        for (int i = 0; i < 3; ++i) {
-          const double numeric = (r_plus[i] - r_minus[i]) / (2.0 * h);
-          EXPECT_NEAR(jacobian[i * n + k], numeric, 1e-6 * (1.0 + std::abs(numeric)))
-              << run.id << " d r" << i << " / d " << robot.parameters[k].name;
-        }
-      }
+      testing::ExpectFinalPoseJacobianMatchesCentralDifferences(*model, run, p);
     }
   }
 }

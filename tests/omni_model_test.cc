@@ -26,6 +26,8 @@
 #include "models/omni3/omni3_kinematics.h"
 #include "models/pose_errors.h"
 #include "odometry/aligned_run.h"
+#include "tests/jacobian_check.h"
+#include "tests/test_files.h"
 #include "tools/import_optiodom_omni4.h"
 #include "tools/sim/model_simulator.h"
 #include "tools/sim/omni_trajectories.h"
@@ -210,36 +212,14 @@ wheels:
   - {name: e, distance_m: 0.2, angle_deg: 290, radius_m: 0.049}
 bounds: {distance_m: [0.15, 0.25], radius_m: [0.04, 0.06], angle_offset_deg: [-3, 3]}
 )");
-  const Robot& robot = model->robot();
-  const int n = robot.NumParameters();
   AlignedRun run;
   run.samples = RandomSamples(5, 500, 8.0, 5);
   run.start = {0.1, 0.0, 0.4};
   run.final_ground_truth = {0.5, -0.3, 1.0};
-  std::unique_ptr<ceres::CostFunction> cost(model->FinalPoseCost(run, ResidualWeights{}));
-  std::vector<double> p = robot.nominal;
+  std::vector<double> p = model->robot().nominal;
   p[0] += 0.003;
-  p[n - 1] += 0.01;
-  double r[3];
-  std::vector<double> jacobian(3 * n);
-  const double* parameters[] = {p.data()};
-  double* jacobians[] = {jacobian.data()};
-  ASSERT_TRUE(cost->Evaluate(parameters, r, jacobians));
-  for (int k = 0; k < n; ++k) {
-    // h = 1e-6 of the parameter's scale: truncation O(h^2) and rounding O(eps / h) < 1e-8.
-    const double h = 1e-6 * robot.parameters[k].RelativeScale(p[k]);
-    std::vector<double> plus = p, minus = p;
-    plus[k] += h;
-    minus[k] -= h;
-    const Pose2d a = model->ReplayFinalPose(plus.data(), run.samples, run.start);
-    const Pose2d b = model->ReplayFinalPose(minus.data(), run.samples, run.start);
-    const double numeric[3] = {(a.x - b.x) / (2 * h), (a.y - b.y) / (2 * h),
-                               (a.theta - b.theta) / (2 * h)};
-    for (int i = 0; i < 3; ++i) {
-      EXPECT_NEAR(jacobian[i * n + k], numeric[i], 1e-6 * (1.0 + std::abs(numeric[i])))
-          << robot.parameters[k].name;
-    }
-  }
+  p.back() += 0.01;
+  testing::ExpectFinalPoseJacobianMatchesCentralDifferences(*model, run, p);
 }
 
 TEST(OmniModel, YamlRoundTripKeepsGeometryAndDefaults) {

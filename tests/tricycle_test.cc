@@ -20,10 +20,10 @@
 #include "fit/model_fit.h"
 #include "io/input_error.h"
 #include "models/model_registry.h"
-#include "models/pose_errors.h"
 #include "models/tricycle/tricycle_checks.h"
 #include "models/tricycle/tricycle_model.h"
 #include "odometry/aligned_run.h"
+#include "tests/jacobian_check.h"
 #include "tests/test_files.h"
 #include "tools/import_optiodom_tricycle.h"
 #include "tools/miswired_error.h"
@@ -137,8 +137,7 @@ TEST(TricycleKinematics, ChannelsForTwistInvertsTheBodyStep) {
 }
 
 // The final-pose cost's autodiff Jacobian against central differences of the double replay, on
-// a simulated run that turns both ways (h = 1e-6 of the parameter's scale: truncation and
-// rounding below 1e-8 of a derivative of order one).
+// a simulated run that turns both ways.
 TEST(TricycleKinematics, AutodiffMatchesCentralDifferences) {
   const auto model = ExampleModel();
   sim::TricycleTrajectoryOptions trajectories;
@@ -149,28 +148,7 @@ TEST(TricycleKinematics, AutodiffMatchesCentralDifferences) {
       sim::SimulateRuns(*model, truth, sim::TricycleTrajectories(trajectories), options);
   const std::vector<double> p = {0.0321, 0.149, DegToRad(0.7)};
   for (const auto& simulated : runs) {
-    const AlignedRun run = AlignRun(simulated.log);
-    std::unique_ptr<ceres::CostFunction> cost(model->FinalPoseCost(run, ResidualWeights{}));
-    double r[3], jacobian[9];
-    const double* parameters[] = {p.data()};
-    double* jacobians[] = {jacobian};
-    ASSERT_TRUE(cost->Evaluate(parameters, r, jacobians));
-    for (int j = 0; j < 3; ++j) {
-      const double h = 1e-6 * model->robot().parameters[j].RelativeScale(p[j]);
-      std::vector<double> plus = p, minus = p;
-      plus[j] += h;
-      minus[j] -= h;
-      double r_plus[3], r_minus[3];
-      FinalPoseError(model->ReplayFinalPose(plus.data(), run.samples, run.start),
-                     run.final_ground_truth, ResidualWeights{}, r_plus);
-      FinalPoseError(model->ReplayFinalPose(minus.data(), run.samples, run.start),
-                     run.final_ground_truth, ResidualWeights{}, r_minus);
-      for (int i = 0; i < 3; ++i) {
-        const double numeric = (r_plus[i] - r_minus[i]) / (2.0 * h);
-        EXPECT_NEAR(jacobian[i * 3 + j], numeric, 1e-6 * (1.0 + std::abs(numeric)))
-            << run.id << " d r" << i << " / d p" << j;
-      }
-    }
+    testing::ExpectFinalPoseJacobianMatchesCentralDifferences(*model, AlignRun(simulated.log), p);
   }
 }
 
