@@ -189,10 +189,7 @@ TEST(ChannelOrderCheck, DiagnoseRefusesSwappedColumns) {
   for (const auto& entry : fs::directory_iterator(data + "/runs")) {
     const std::string path = entry.path().string();
     if (path.find("_encoders.csv") == std::string::npos) continue;
-    std::ifstream in(path);
-    std::stringstream text;
-    text << in.rdbuf();
-    std::string csv = text.str();
+    std::string csv = fitcal::testing::ReadFileBytes(path);
     ASSERT_EQ(csv.rfind("t,w_a,w_b,w_c\n", 0), 0u) << path;
     csv.replace(0, 13, "t,w_b,w_a,w_c");
     std::ofstream(path) << csv;

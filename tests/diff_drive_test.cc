@@ -15,7 +15,6 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <sstream>
 
 #include "fit/final_pose_errors.h"
 #include "fit/model_fit.h"
@@ -211,15 +210,11 @@ TEST(ModelSimulator, WritesADataSetTheLoadersReadBack) {
   EXPECT_EQ(line, "t,w_right,w_left");
   std::size_t row = 0;
   while (std::getline(csv, line)) {
-    std::stringstream fields(line);
-    std::string t, right, left;
-    std::getline(fields, t, ',');
-    std::getline(fields, right, ',');
-    std::getline(fields, left, ',');
-    ASSERT_EQ(std::stod(t), runs[0].log.encoders.t_s[row]);
+    const std::vector<double> t_right_left = testing::CsvNumbers(line, 3);
+    ASSERT_EQ(t_right_left[0], runs[0].log.encoders.t_s[row]);
     if (row > 0) {
-      ASSERT_EQ(std::stod(right), runs[0].log.encoders.samples[row - 1].value[0]);
-      ASSERT_EQ(std::stod(left), runs[0].log.encoders.samples[row - 1].value[1]);
+      ASSERT_EQ(t_right_left[1], runs[0].log.encoders.samples[row - 1].value[0]);
+      ASSERT_EQ(t_right_left[2], runs[0].log.encoders.samples[row - 1].value[1]);
     }
     ++row;
   }
@@ -465,13 +460,7 @@ std::array<double, 3> HandFinalError(const fs::path& run_csv) {
   double x = 0.0, y = 0.0, theta = 0.0, gt[3] = {0.0, 0.0, 0.0};
   bool first = true;
   while (std::getline(in, line)) {
-    double v[6];
-    std::stringstream fields(line);
-    std::string f;
-    for (double& value : v) {
-      std::getline(fields, f, ',');
-      value = std::stod(f);
-    }
+    const std::vector<double> v = testing::CsvNumbers(line, 6);
     gt[0] = v[1], gt[1] = v[2], gt[2] = v[3];
     if (first) {
       first = false;
@@ -497,13 +486,7 @@ EncoderLog ReadTicksCsv(const std::string& path, double ticks_per_rev) {
   EncoderLog log;
   log.samples = EncoderSamples(2);
   while (std::getline(in, line)) {
-    double v[3];
-    std::stringstream fields(line);
-    std::string f;
-    for (double& value : v) {
-      std::getline(fields, f, ',');
-      value = std::stod(f);
-    }
+    const std::vector<double> v = testing::CsvNumbers(line, 3);
     if (!log.t_s.empty()) {
       const double dt = v[0] - log.t_s.back();
       const double k = 2.0 * M_PI / ticks_per_rev / dt;

@@ -44,6 +44,7 @@ namespace fitcal {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::Lines;
 using testing::ReadFileBytes;
 using testing::RunFitcal;
 using testing::TempDir;
@@ -62,8 +63,6 @@ std::map<std::string, std::string> Snapshot(const fs::path& dir) {
   }
   return files;
 }
-
-int Lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
 
 // A small simulated data set of `model` (2 repetitions; a second or so to write).
 fs::path SimulatedDataset(const TempDir& dir, const std::string& name, const std::string& model,

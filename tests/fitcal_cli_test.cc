@@ -18,6 +18,7 @@
 namespace fitcal {
 namespace {
 
+using fitcal::testing::Lines;
 using fitcal::testing::ReadFileBytes;
 using fitcal::testing::TempDir;
 
@@ -25,12 +26,6 @@ const std::string kRobot = std::string(FITCAL_SOURCE_DIR) + "/data/robots/apr02.
 
 using Result = fitcal::testing::FitcalRun;
 using fitcal::testing::RunFitcal;
-
-int CountLines(const std::string& s) {
-  int n = 0;
-  for (char c : s) n += c == '\n';
-  return n;
-}
 
 // A small simulated data set (2 repetitions of the 36 trajectories), made once per test.
 std::string MakeDataset(const TempDir& dir) {
@@ -73,7 +68,7 @@ TEST(FitcalCli, FitStoppedAtTheIterationLimitIsWrittenAndFlagged) {
   const Result r =
       RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --max-iterations 1 --out " + out);
   EXPECT_EQ(r.exit_code, 6) << r.out << r.err;
-  EXPECT_EQ(CountLines(r.err), 1) << r.err;
+  EXPECT_EQ(Lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find("iteration limit"), std::string::npos) << r.err;
   EXPECT_NE(ReadFileBytes(out).find("termination: NO_CONVERGENCE"), std::string::npos);
   // Converged, the same command exits 0.
@@ -363,7 +358,7 @@ TEST(FitcalCli, BadInputGivesOneLineAndWritesNothing) {
 
   const Result r = RunFitcal(dir, "--logs " + data + " --method ceres --out " + out);
   EXPECT_NE(r.exit_code, 0);
-  EXPECT_EQ(CountLines(r.err), 1) << r.err;
+  EXPECT_EQ(Lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find(enc + ":5:"), std::string::npos) << r.err;
   EXPECT_EQ(ReadFileBytes(out), previous);
 
@@ -374,7 +369,7 @@ TEST(FitcalCli, BadInputGivesOneLineAndWritesNothing) {
   dir.Write("flower/robot.yaml", robot);
   const Result m = RunFitcal(dir, "--logs " + data + " --out " + out);
   EXPECT_NE(m.exit_code, 0);
-  EXPECT_EQ(CountLines(m.err), 1) << m.err;
+  EXPECT_EQ(Lines(m.err), 1) << m.err;
   EXPECT_NE(m.err.find("omni4"), std::string::npos) << m.err;
   EXPECT_EQ(ReadFileBytes(out), previous);
 }
@@ -410,7 +405,7 @@ TEST(FitcalCli, SubcommandRefusalsGiveOneLineAndWriteNothing) {
     SCOPED_TRACE(c.args);
     const Result r = RunFitcal(dir, c.args);
     EXPECT_NE(r.exit_code, 0);
-    EXPECT_EQ(CountLines(r.err), 1) << r.err;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
     EXPECT_NE(r.err.find(c.expected), std::string::npos) << r.err;
     for (const char* suffix : {"", ".csv", ".md", "_trace.csv"}) {
       EXPECT_FALSE(std::ifstream(out + suffix).good()) << out + suffix << " was written";
@@ -440,7 +435,7 @@ TEST(FitcalCli, EffectsNeedTheGroundTruthAlongTheRuns) {
   std::filesystem::remove(out);
   const Result r = RunFitcal(dir, "fit --logs " + data + " --effects time_offset --out " + out);
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_EQ(CountLines(r.err), 1) << r.err;
+  EXPECT_EQ(Lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find("effects are fitted on the ground truth along each run"), std::string::npos)
       << r.err;
   EXPECT_FALSE(std::filesystem::exists(out));

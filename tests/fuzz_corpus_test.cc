@@ -15,23 +15,19 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <random>
 #include <string>
 
 #include "io/rosbag2/bag_writer.h"
 #include "io/rosbag2/ros_messages.h"
 #include "tests/fuzz/fuzz_support.h"
+#include "tests/test_files.h"
 
 namespace fitcal::fuzz {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string ReadBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
+using fitcal::testing::ReadFileBytes;
 
 int ReplayDirectory(const std::string& target, const fs::path& dir) {
   int count = 0;
@@ -39,7 +35,7 @@ int ReplayDirectory(const std::string& target, const fs::path& dir) {
   for (const auto& entry : fs::directory_iterator(dir)) {
     if (!entry.is_regular_file()) continue;
     SCOPED_TRACE(entry.path().string());
-    EXPECT_NO_THROW(RunFuzzTarget(target, ReadBytes(entry.path())));
+    EXPECT_NO_THROW(RunFuzzTarget(target, ReadFileBytes(entry.path())));
     ++count;
   }
   return count;
@@ -57,28 +53,31 @@ TEST(FuzzCorpusTest, EveryTargetHasSeedsAndAllReplayWithoutCrash) {
 // The seeds are not just noise: the well-formed ones load.
 TEST(FuzzCorpusTest, WellFormedSeedsLoad) {
   const fs::path root = fs::path(FITCAL_SOURCE_DIR) / "tests" / "fuzz" / "corpus";
-  EXPECT_TRUE(RunFuzzTarget("encoder_csv", ReadBytes(root / "encoder_csv" / "basic.csv")));
-  EXPECT_TRUE(RunFuzzTarget("encoder_csv", ReadBytes(root / "encoder_csv" / "bom_crlf.csv")));
-  EXPECT_FALSE(RunFuzzTarget("encoder_csv", ReadBytes(root / "encoder_csv" / "nan.csv")));
+  EXPECT_TRUE(RunFuzzTarget("encoder_csv", ReadFileBytes(root / "encoder_csv" / "basic.csv")));
+  EXPECT_TRUE(RunFuzzTarget("encoder_csv", ReadFileBytes(root / "encoder_csv" / "bom_crlf.csv")));
+  EXPECT_FALSE(RunFuzzTarget("encoder_csv", ReadFileBytes(root / "encoder_csv" / "nan.csv")));
   EXPECT_TRUE(
-      RunFuzzTarget("ground_truth_csv", ReadBytes(root / "ground_truth_csv" / "basic.csv")));
-  EXPECT_TRUE(RunFuzzTarget("tum", ReadBytes(root / "tum" / "basic.tum")));
-  EXPECT_FALSE(RunFuzzTarget("tum", ReadBytes(root / "tum" / "bad_quaternion.tum")));
-  EXPECT_TRUE(RunFuzzTarget("dataset_yaml", ReadBytes(root / "dataset_yaml" / "two_runs.yaml")));
-  EXPECT_FALSE(RunFuzzTarget("dataset_yaml", ReadBytes(root / "dataset_yaml" / "outside.yaml")));
-  EXPECT_FALSE(
-      RunFuzzTarget("dataset_yaml", ReadBytes(root / "dataset_yaml" / "same_file_twice.yaml")));
-  EXPECT_TRUE(RunFuzzTarget("robot_yaml", ReadBytes(root / "robot_yaml" / "apr02.yaml")));
-  EXPECT_FALSE(RunFuzzTarget("robot_yaml", ReadBytes(root / "robot_yaml" / "lo_gt_hi.yaml")));
+      RunFuzzTarget("ground_truth_csv", ReadFileBytes(root / "ground_truth_csv" / "basic.csv")));
+  EXPECT_TRUE(RunFuzzTarget("tum", ReadFileBytes(root / "tum" / "basic.tum")));
+  EXPECT_FALSE(RunFuzzTarget("tum", ReadFileBytes(root / "tum" / "bad_quaternion.tum")));
   EXPECT_TRUE(
-      RunFuzzTarget("encoder_ticks_csv", ReadBytes(root / "encoder_ticks_csv" / "cumulative.csv")));
+      RunFuzzTarget("dataset_yaml", ReadFileBytes(root / "dataset_yaml" / "two_runs.yaml")));
+  EXPECT_FALSE(
+      RunFuzzTarget("dataset_yaml", ReadFileBytes(root / "dataset_yaml" / "outside.yaml")));
+  EXPECT_FALSE(
+      RunFuzzTarget("dataset_yaml", ReadFileBytes(root / "dataset_yaml" / "same_file_twice.yaml")));
+  EXPECT_TRUE(RunFuzzTarget("robot_yaml", ReadFileBytes(root / "robot_yaml" / "apr02.yaml")));
+  EXPECT_FALSE(RunFuzzTarget("robot_yaml", ReadFileBytes(root / "robot_yaml" / "lo_gt_hi.yaml")));
+  EXPECT_TRUE(RunFuzzTarget("encoder_ticks_csv",
+                            ReadFileBytes(root / "encoder_ticks_csv" / "cumulative.csv")));
   EXPECT_TRUE(
-      RunFuzzTarget("asoc_encoder_csv", ReadBytes(root / "asoc_encoder_csv" / "basic.csv")));
+      RunFuzzTarget("asoc_encoder_csv", ReadFileBytes(root / "asoc_encoder_csv" / "basic.csv")));
+  EXPECT_FALSE(RunFuzzTarget("asoc_encoder_csv",
+                             ReadFileBytes(root / "asoc_encoder_csv" / "omni3_file.csv")));
+  EXPECT_TRUE(
+      RunFuzzTarget("asoc_robot_yaml", ReadFileBytes(root / "asoc_robot_yaml" / "proto.yaml")));
   EXPECT_FALSE(
-      RunFuzzTarget("asoc_encoder_csv", ReadBytes(root / "asoc_encoder_csv" / "omni3_file.csv")));
-  EXPECT_TRUE(RunFuzzTarget("asoc_robot_yaml", ReadBytes(root / "asoc_robot_yaml" / "proto.yaml")));
-  EXPECT_FALSE(
-      RunFuzzTarget("asoc_robot_yaml", ReadBytes(root / "asoc_robot_yaml" / "negative.yaml")));
+      RunFuzzTarget("asoc_robot_yaml", ReadFileBytes(root / "asoc_robot_yaml" / "negative.yaml")));
 }
 
 // A tiny bag as a robot records it: JointState (an extra joint, not the robot's order) at 20 Hz,
@@ -137,8 +136,8 @@ TEST(FuzzCorpusTest, Rosbag2SeedsAreTinyBags) {
   const bool write = std::getenv("FITCAL_WRITE_ROSBAG2_SEEDS") != nullptr;
   for (std::size_t i = 0; i < seeds.size(); ++i) {
     SCOPED_TRACE(seeds[i].name);
-    const std::string bytes =
-        ReadBytes(TinyBag(tmp / ("bag" + std::to_string(i)), seeds[i].options, seeds[i].messages));
+    const std::string bytes = ReadFileBytes(
+        TinyBag(tmp / ("bag" + std::to_string(i)), seeds[i].options, seeds[i].messages));
     EXPECT_TRUE(RunFuzzTarget(seeds[i].target, bytes));  // what the writer makes imports
     const fs::path seed = root / seeds[i].target / seeds[i].name;
     if (write) {
@@ -146,7 +145,7 @@ TEST(FuzzCorpusTest, Rosbag2SeedsAreTinyBags) {
       std::ofstream(seed, std::ios::binary) << bytes;
     }
     EXPECT_LT(fs::file_size(seed), 20000u) << "keep checked-in seeds tiny";
-    EXPECT_TRUE(RunFuzzTarget(seeds[i].target, ReadBytes(seed)));
+    EXPECT_TRUE(RunFuzzTarget(seeds[i].target, ReadFileBytes(seed)));
   }
   std::error_code ignored;
   fs::remove_all(tmp, ignored);
@@ -160,7 +159,7 @@ TEST(FuzzCorpusTest, MutatedBagsFailCleanly) {
   int inputs = 0, rejected = 0;
   for (const char* target : {"rosbag2_mcap", "rosbag2_db3"}) {
     for (const auto& entry : fs::directory_iterator(root / target)) {
-      const std::string seed = ReadBytes(entry.path());
+      const std::string seed = ReadFileBytes(entry.path());
       ASSERT_FALSE(seed.empty());
       const auto run = [&](const std::string& bytes, const std::string& how) {
         SCOPED_TRACE(entry.path().filename().string() + ": " + how);

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -21,15 +22,35 @@ namespace fitcal {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::Has;
+using testing::Lines;
 using testing::ReadFileBytes;
 using testing::RunFitcal;
 using testing::TempDir;
 using testing::WriteFileBytes;
 
-int Lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
-
-bool Has(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
+// Every run file of the data set in `data` whose name holds `suffix`: each row's numbers passed
+// through `edit` and written back (%.9g), the header kept.
+void EditRows(const fs::path& data, const std::string& suffix,
+              const std::function<void(std::vector<double>&)>& edit) {
+  for (const auto& e : fs::directory_iterator(data / "runs")) {
+    if (!Has(e.path().filename().string(), suffix)) continue;
+    std::istringstream in(ReadFileBytes(e.path()));
+    std::string line, out;
+    std::getline(in, line);
+    out = line + "\n";
+    while (std::getline(in, line)) {
+      std::vector<double> row =
+          testing::CsvNumbers(line, 1 + std::count(line.begin(), line.end(), ','));
+      edit(row);
+      for (std::size_t k = 0; k < row.size(); ++k) {
+        char number[32];
+        std::snprintf(number, sizeof number, k + 1 < row.size() ? "%.9g," : "%.9g\n", row[k]);
+        out += number;
+      }
+    }
+    WriteFileBytes(e.path(), out);
+  }
 }
 
 class InputClassesTest : public ::testing::Test {
@@ -65,21 +86,10 @@ class InputClassesTest : public ::testing::Test {
 
   // Every encoder log, its value columns multiplied by `factor` (a unit slip).
   void ScaleRates(double factor) const {
-    for (const auto& e : fs::directory_iterator(data_ / "runs")) {
-      if (!Has(e.path().filename().string(), "_encoders.csv")) continue;
-      std::istringstream in(ReadFileBytes(e.path()));
-      std::string line, out;
-      std::getline(in, line);
-      out = line + "\n";
-      while (std::getline(in, line)) {
-        double t = 0, a = 0, b = 0;
-        if (std::sscanf(line.c_str(), "%lf,%lf,%lf", &t, &a, &b) != 3) continue;
-        char row[128];
-        std::snprintf(row, sizeof row, "%.9g,%.9g,%.9g\n", t, a * factor, b * factor);
-        out += row;
-      }
-      WriteFileBytes(e.path(), out);
-    }
+    EditRows(data_, "_encoders.csv", [&](std::vector<double>& t_a_b) {
+      t_a_b[1] *= factor;
+      t_a_b[2] *= factor;
+    });
   }
 
   TempDir dir_;
@@ -129,21 +139,10 @@ TEST_F(InputClassesTest, RatesInRpmAreNamed) {
 }
 
 TEST_F(InputClassesTest, GroundTruthInMillimetresIsNamed) {
-  for (const auto& e : fs::directory_iterator(data_ / "runs")) {
-    if (!Has(e.path().filename().string(), "_ground_truth.csv")) continue;
-    std::istringstream in(ReadFileBytes(e.path()));
-    std::string line, out;
-    std::getline(in, line);
-    out = line + "\n";
-    while (std::getline(in, line)) {
-      double t = 0, x = 0, y = 0, theta = 0;
-      if (std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf", &t, &x, &y, &theta) != 4) continue;
-      char row[160];
-      std::snprintf(row, sizeof row, "%.9g,%.9g,%.9g,%.9g\n", t, x * 1000, y * 1000, theta);
-      out += row;
-    }
-    WriteFileBytes(e.path(), out);
-  }
+  EditRows(data_, "_ground_truth.csv", [](std::vector<double>& t_x_y_theta) {
+    t_x_y_theta[1] *= 1000;
+    t_x_y_theta[2] *= 1000;
+  });
   ExpectFitRefused(1, {"millimetres", "ground-truth positions"});
 }
 
@@ -214,21 +213,8 @@ TEST(InputClassesCli, ASteeringAngleInDegreesIsRefused) {
   ASSERT_EQ(
       RunFitcal(dir, "simulate --model tricycle --repetitions 2 --out " + data.string()).exit_code,
       0);
-  for (const auto& e : fs::directory_iterator(data / "runs")) {
-    if (!Has(e.path().filename().string(), "_encoders.csv")) continue;
-    std::istringstream in(ReadFileBytes(e.path()));
-    std::string line, out;
-    std::getline(in, line);
-    out = line + "\n";
-    while (std::getline(in, line)) {
-      double t = 0, w = 0, steering = 0;
-      if (std::sscanf(line.c_str(), "%lf,%lf,%lf", &t, &w, &steering) != 3) continue;
-      char row[128];
-      std::snprintf(row, sizeof row, "%.9g,%.9g,%.9g\n", t, w, steering * 180.0 / M_PI);
-      out += row;
-    }
-    WriteFileBytes(e.path(), out);
-  }
+  EditRows(data, "_encoders.csv",
+           [](std::vector<double>& t_w_steering) { t_w_steering[2] *= 180.0 / M_PI; });
   const auto r = RunFitcal(dir, "fit --logs " + data.string() + " --no-output");
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_EQ(Lines(r.err), 1) << r.err;

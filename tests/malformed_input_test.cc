@@ -8,10 +8,8 @@
 // ok_* files (Windows line endings, UTF-8 byte-order mark) must load.
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <algorithm>
-#include <cstdlib>
 #include <filesystem>
 #include <set>
 #include <string>
@@ -27,7 +25,11 @@ namespace {
 
 namespace fs = std::filesystem;
 using io::InputErrorKind;
+using testing::FitcalRun;
+using testing::Lines;
+using testing::ListFiles;
 using testing::ReadFileBytes;
+using testing::RunFitcalOutside;
 using testing::TempDir;
 using testing::WriteFileBytes;
 
@@ -138,29 +140,6 @@ void LoadForFit(const fs::path& dir, const io::DatasetOptions& options = {}) {
   ReadOmni3Robot(dataset.robot_path);
 }
 
-std::set<std::string> ListFiles(const fs::path& root) {
-  std::set<std::string> out;
-  for (const auto& e : fs::recursive_directory_iterator(root)) out.insert(e.path().string());
-  return out;
-}
-
-struct CliResult {
-  int exit_code = -1;
-  std::string stderr_text;
-};
-
-CliResult RunFitcal(const std::string& args, const fs::path& scratch) {
-  const fs::path err = scratch / "stderr.txt";
-  const std::string command = std::string(FITCAL_BINARY_DIR) + "/tools/fitcal " + args +
-                              " > /dev/null 2> '" + err.string() + "'";
-  const int status = std::system(command.c_str());
-  CliResult result;
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128;
-  result.stderr_text = ReadFileBytes(err);
-  fs::remove(err);
-  return result;
-}
-
 TEST(MalformedInputTest, CorpusHasAtLeastThirtyCasesAndEveryFileIsListed) {
   std::set<std::string> listed;
   for (const MalformedCase& c : kCases) listed.insert(c.file);
@@ -199,17 +178,17 @@ TEST(MalformedInputTest, CliPrintsOneLineExitsNonZeroAndWritesNothing) {
     const DatasetDir data(c.file);
     const fs::path out = data.root() / "calibrated.yaml";
     const std::set<std::string> before = ListFiles(data.root());
-    const CliResult r =
-        RunFitcal("--logs '" + data.dir().string() + "' --out '" + out.string() + "' --threads 1",
-                  data.root());
+    const FitcalRun r =
+        RunFitcalOutside(data.root(), "--logs '" + data.dir().string() + "' --out '" +
+                                          out.string() + "' --threads 1");
     EXPECT_NE(r.exit_code, 0);
-    EXPECT_EQ(std::count(r.stderr_text.begin(), r.stderr_text.end(), '\n'), 1) << r.stderr_text;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
     // The CLI checks the model before it parses the rest of the robot (fit_command.cc), so it
     // names the file only for an unknown model.
     const int line = c.kind == InputErrorKind::kUnknownModel ? 0 : c.line;
     const std::string where =
         std::string(c.error_file) + (line > 0 ? ":" + std::to_string(line) + ":" : ":");
-    EXPECT_NE(r.stderr_text.find(where), std::string::npos) << r.stderr_text;
+    EXPECT_NE(r.err.find(where), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(out));
     EXPECT_EQ(ListFiles(data.root()), before) << "a file was created";
   }
@@ -251,11 +230,10 @@ TEST(MalformedInputTest, FileLargerThanMemoryIsRefusedWithAMessage) {
     EXPECT_NE(std::string(e.what()).find("free memory"), std::string::npos) << e.what();
   }
   const fs::path out = data.root() / "calibrated.yaml";
-  const CliResult r =
-      RunFitcal("--logs '" + data.dir().string() + "' --out '" + out.string() + "'", data.root());
+  const FitcalRun r = RunFitcalOutside(
+      data.root(), "--logs '" + data.dir().string() + "' --out '" + out.string() + "'");
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.stderr_text.find("enc.csv: file of 1099511627776 bytes"), std::string::npos)
-      << r.stderr_text;
+  EXPECT_NE(r.err.find("enc.csv: file of 1099511627776 bytes"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out));
 }
 

@@ -5,7 +5,6 @@
 // model's closed form (UMBmark) as a row.
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <algorithm>
 #include <cctype>
@@ -25,6 +24,7 @@ namespace fitcal {
 namespace {
 
 using fitcal::testing::ReadFileBytes;
+using fitcal::testing::RunFitcal;
 using fitcal::testing::TempDir;
 
 RobotModelPtr ExampleModel(const std::string& name) {
@@ -127,41 +127,25 @@ TEST(ModelNlopt, SameSeedSameBitsOnAnyThreadCountOtherSeedOtherPath) {
 
 // ---- the command line ----
 
-const std::string kFitcal = std::string(FITCAL_BINARY_DIR) + "/tools/fitcal";
-
-int RunFitcal(const TempDir& dir, const std::string& args, std::string* out, std::string* err) {
-  const std::string o = dir.Path("stdout.txt"), e = dir.Path("stderr.txt");
-  const int status = std::system((kFitcal + " " + args + " >" + o + " 2>" + e).c_str());
-  *out = ReadFileBytes(o);
-  *err = ReadFileBytes(e);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
 TEST(ModelNloptCli, FitAndCompareWorkForADifferentialDrive) {
   TempDir dir;
   const std::string data = dir.Path("data");
-  std::string out, err;
-  ASSERT_EQ(RunFitcal(dir, "simulate --model diff_drive --repetitions 3 --seed 2 --out " + data,
-                      &out, &err),
-            0)
-      << err;
+  const auto simulated =
+      RunFitcal(dir, "simulate --model diff_drive --repetitions 3 --seed 2 --out " + data);
+  ASSERT_EQ(simulated.exit_code, 0) << simulated.err;
   const std::string cal = dir.Path("cal.yaml");
-  ASSERT_EQ(RunFitcal(dir,
-                      "fit --logs " + data + " --method crs2lm --polish --max-evaluations 3000 " +
-                          "--train-reps 1-2 --out " + cal,
-                      &out, &err),
-            0)
-      << err << out;
-  EXPECT_NE(out.find("NLopt CRS2-LM"), std::string::npos) << out;
+  const auto fit =
+      RunFitcal(dir, "fit --logs " + data + " --method crs2lm --polish --max-evaluations 3000 " +
+                         "--train-reps 1-2 --out " + cal);
+  ASSERT_EQ(fit.exit_code, 0) << fit.err << fit.out;
+  EXPECT_NE(fit.out.find("NLopt CRS2-LM"), std::string::npos) << fit.out;
   EXPECT_NE(ReadFileBytes(cal).find("method: crs2lm"), std::string::npos);
 
   const std::string prefix = dir.Path("cmp");
-  ASSERT_EQ(RunFitcal(dir,
-                      "compare --logs " + data +
-                          " --methods ceres slsqp --repetitions 1 2 --quiet --out " + prefix,
-                      &out, &err),
-            0)
-      << err << out;
+  const auto compared =
+      RunFitcal(dir, "compare --logs " + data +
+                         " --methods ceres slsqp --repetitions 1 2 --quiet --out " + prefix);
+  ASSERT_EQ(compared.exit_code, 0) << compared.err << compared.out;
   const std::string csv = ReadFileBytes(prefix + ".csv");
   // The default strategy of a model without flower labels is "all"; UMBmark is a row per k.
   EXPECT_NE(csv.find("r_right_m,r_left_m,wheel_separation_m"), std::string::npos) << csv;
@@ -169,10 +153,10 @@ TEST(ModelNloptCli, FitAndCompareWorkForADifferentialDrive) {
   EXPECT_NE(csv.find("all,umbmark,2,"), std::string::npos) << csv;
   EXPECT_NE(csv.find("all,slsqp,2,"), std::string::npos) << csv;
   // A flower strategy on squares and circles is refused in one line.
-  EXPECT_EQ(RunFitcal(dir, "compare --logs " + data + " --strategies STA --quiet --no-output", &out,
-                      &err),
-            2);
-  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  const auto refused =
+      RunFitcal(dir, "compare --logs " + data + " --strategies STA --quiet --no-output");
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_EQ(testing::Lines(refused.err), 1) << refused.err;
 }
 
 }  // namespace

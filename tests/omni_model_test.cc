@@ -15,7 +15,6 @@
 #include <fstream>
 #include <memory>
 #include <random>
-#include <sstream>
 
 #include "fit/model_fit.h"
 #include "io/dataset.h"
@@ -419,13 +418,7 @@ Pose2d AuthorsFinalPose(const fs::path& file, double diameter_m, double l1_plus_
   Pose2d pose;
   bool first = true;
   while (std::getline(in, line)) {
-    double v[8];
-    std::stringstream fields(line);
-    std::string field;
-    for (double& x : v) {
-      std::getline(fields, field, ',');
-      x = std::stod(field);
-    }
+    const std::vector<double> v = testing::CsvNumbers(line, 8);
     if (first) {
       first = false;
       continue;
@@ -484,13 +477,7 @@ TEST(OptiOdomOmni4, ImportedSessionReproducesTheAuthorsNominalOdometry) {
   EXPECT_EQ(header, "t,w_fl,w_fr,w_rl,w_rr");
   std::getline(csv, row);
   std::getline(csv, row);
-  double first[5];
-  std::stringstream fields(row);
-  std::string field;
-  for (double& x : first) {
-    std::getline(fields, field, ',');
-    x = std::stod(field);
-  }
+  const std::vector<double> first = testing::CsvNumbers(row, 5);
   for (int i = 0; i < 4; ++i) EXPECT_EQ(first[1 + i], session.runs[0].encoders.samples[0].value[i]);
   std::printf("omni4 %s: nominal mean final-pose CF %.4f; %s\n", kSession.filename().c_str(),
               mean_cf, result.channel_order.c_str());

@@ -32,11 +32,14 @@ namespace {
 
 namespace fs = std::filesystem;
 using io::InputErrorKind;
+using testing::FitcalRun;
+using testing::Lines;
+using testing::ListFiles;
 using testing::ReadFileBytes;
+using testing::RunFitcalOutside;
 using testing::TempDir;
 using testing::WriteFileBytes;
 
-const std::string kFitcal = std::string(FITCAL_BINARY_DIR) + "/tools/fitcal";
 const fs::path kSource = FITCAL_SOURCE_DIR;
 
 // An encoder log of constant rates (rad/s) at 100 Hz from t0 for `seconds`, and a ground truth
@@ -88,40 +91,16 @@ class Fixture {
   fs::path dir_;
 };
 
-struct CliResult {
-  int exit_code = -1;
-  std::string err;
-};
-
-// Runs fitcal (with a timeout: a refusal must never block) and collects stderr.
-CliResult RunFitcal(const std::string& args, const fs::path& scratch) {
-  const fs::path err = scratch.parent_path() / (scratch.filename().string() + ".stderr");
-  const int status = std::system(
-      ("timeout 60 " + kFitcal + " " + args + " > /dev/null 2> '" + err.string() + "'").c_str());
-  CliResult r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128;
-  r.err = ReadFileBytes(err);
-  fs::remove(err);
-  return r;
-}
-
-std::set<std::string> ListFiles(const fs::path& root) {
-  std::set<std::string> out;
-  for (const auto& e : fs::recursive_directory_iterator(root)) out.insert(e.path().string());
-  return out;
-}
-
 // The fit command on the fixture must refuse: `exit_code`, exactly one stderr line that starts
 // `fitcal: `, names `where` (file[:line]) and says `what`; nothing written or created.
 void ExpectFitRefused(const Fixture& f, const std::string& where, const std::string& what,
                       int exit_code = 1, const std::string& out = "") {
   const std::string out_path = out.empty() ? f.out().string() : out;
   const std::set<std::string> before = ListFiles(f.root());
-  const CliResult r = RunFitcal(
-      "fit --logs '" + f.dir().string() + "' --out '" + out_path + "' --threads 1 --train-reps 1-2",
-      f.root());
+  const FitcalRun r = RunFitcalOutside(f.root(), "fit --logs '" + f.dir().string() + "' --out '" +
+                                                     out_path + "' --threads 1 --train-reps 1-2");
   EXPECT_EQ(r.exit_code, exit_code) << r.err;
-  ASSERT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  ASSERT_EQ(Lines(r.err), 1) << r.err;
   EXPECT_EQ(r.err.rfind("fitcal: ", 0), 0u) << r.err;
   EXPECT_NE(r.err.find(where), std::string::npos) << "expected '" << where << "' in " << r.err;
   EXPECT_NE(r.err.find(what), std::string::npos) << "expected '" << what << "' in " << r.err;
@@ -148,10 +127,10 @@ InputErrorKind LoadKind(const Fixture& f) {
 TEST(RefusalTest, TheFixtureItselfIsRefusedOnlyForItsDegreesOfFreedom) {
   const Fixture f;
   EXPECT_NO_THROW(io::LoadDataset(f.dir().string()));
-  const CliResult r = RunFitcal(
-      "fit --logs '" + f.dir().string() + "' --no-output --threads 1 --train-reps 1-2", f.root());
+  const FitcalRun r = RunFitcalOutside(
+      f.root(), "fit --logs '" + f.dir().string() + "' --no-output --threads 1 --train-reps 1-2");
   EXPECT_EQ(r.exit_code, 1) << r.err;
-  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_EQ(Lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find("2 training runs give 6 final-pose residuals for 9 free parameters"),
             std::string::npos)
       << r.err;
@@ -256,9 +235,8 @@ TEST(RefusalTest, DuplicateKeysInAnyYaml) {
     std::string robot = ReadFileBytes(f.dir() / "robot.yaml");
     robot.insert(robot.find("name:"), "name: twice\n");
     f.Write("robot.yaml", robot);
-    const CliResult r = RunFitcal(
-        "fit --logs '" + f.dir().string() + "' --out '" + f.out().string() + "' --train-reps 1-2",
-        f.root());
+    const FitcalRun r = RunFitcalOutside(f.root(), "fit --logs '" + f.dir().string() + "' --out '" +
+                                                       f.out().string() + "' --train-reps 1-2");
     EXPECT_EQ(r.exit_code, 1) << r.err;
     EXPECT_NE(r.err.find("robot.yaml:"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("key 'name' appears twice"), std::string::npos) << r.err;
@@ -289,10 +267,9 @@ TEST(RefusalTest, OutputThatIsAnInput) {
   EXPECT_EQ(ReadFileBytes(f.dir() / "robot.yaml"), robot_before);
   // A directory output over the data set directory: refused, the data set untouched.
   const std::set<std::string> before = ListFiles(f.root());
-  const CliResult r =
-      RunFitcal("report --logs '" + f.dir().string() + "' --calibration '" +
-                    (f.dir() / "robot.yaml").string() + "' --out '" + f.dir().string() + "'",
-                f.root());
+  const FitcalRun r = RunFitcalOutside(
+      f.root(), "report --logs '" + f.dir().string() + "' --calibration '" +
+                    (f.dir() / "robot.yaml").string() + "' --out '" + f.dir().string() + "'");
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("ds: holds the input"), std::string::npos) << r.err;
   EXPECT_EQ(ListFiles(f.root()), before);
@@ -310,9 +287,9 @@ TEST(RefusalTest, SpecialFilesAreRefusedWithoutBlocking) {
           "robot: robot.yaml\nruns:\n"
           "  - {id: r1, trajectory: R1, repetition: 1, encoders: /dev/zero, ground_truth: "
           "gt1.csv}\n");
-  const CliResult dev = RunFitcal("fit --logs '" + f.dir().string() +
-                                      "' --allow-outside-paths --out '" + f.out().string() + "'",
-                                  f.root());
+  const FitcalRun dev =
+      RunFitcalOutside(f.root(), "fit --logs '" + f.dir().string() +
+                                     "' --allow-outside-paths --out '" + f.out().string() + "'");
   EXPECT_EQ(dev.exit_code, 1) << dev.err;
   EXPECT_NE(dev.err.find("/dev/zero: is a character device"), std::string::npos) << dev.err;
   const fs::path fifo_out = f.root() / "out.fifo";
@@ -395,13 +372,13 @@ TEST(RefusalTest, UsageErrorsExitTwoInOneLine) {
                                   std::string("fit --no-such-flag")}) {
     SCOPED_TRACE(args);
     const std::set<std::string> before = ListFiles(f.root());
-    const CliResult r = RunFitcal(args, f.root());
+    const FitcalRun r = RunFitcalOutside(f.root(), args);
     EXPECT_EQ(r.exit_code, 2) << r.err;
-    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
     EXPECT_EQ(r.err.rfind("fitcal: ", 0), 0u) << r.err;
     EXPECT_EQ(ListFiles(f.root()), before);
   }
-  EXPECT_NE(RunFitcal("fit --logs '" + f.dir().string() + "' --train-reps 5-1", f.root())
+  EXPECT_NE(RunFitcalOutside(f.root(), "fit --logs '" + f.dir().string() + "' --train-reps 5-1")
                 .err.find("range 5-1 is reversed"),
             std::string::npos);
 }
@@ -414,17 +391,16 @@ TEST(RefusalTest, UsageErrorsExitTwoInOneLine) {
 TEST(RefusalTest, NoLibraryLogLinesOnStderr) {
   const Fixture f;
   const std::regex glog_line("(^|\n)[IWEF][0-9]{4}");
-  const CliResult r =
-      RunFitcal("fit --logs '" + f.dir().string() +
-                    "' --no-output --threads 1 --train-reps 1-2 --skip-wheel-order-check",
-                f.root());
+  const FitcalRun r = RunFitcalOutside(
+      f.root(), "fit --logs '" + f.dir().string() +
+                    "' --no-output --threads 1 --train-reps 1-2 --skip-wheel-order-check");
   EXPECT_FALSE(std::regex_search(r.err, glog_line)) << r.err;
   EXPECT_EQ(r.err.find("InitGoogleLogging"), std::string::npos) << r.err;
-  const CliResult hooked = RunFitcal(
-      "fit --logs '" + f.dir().string() + "' --no-output --threads 1 --train-reps 1-2", f.root());
+  const FitcalRun hooked = RunFitcalOutside(
+      f.root(), "fit --logs '" + f.dir().string() + "' --no-output --threads 1 --train-reps 1-2");
   ASSERT_EQ(setenv("FITCAL_TEST_LIBRARY_LOG", "1", 1), 0);
-  const CliResult logged = RunFitcal(
-      "fit --logs '" + f.dir().string() + "' --no-output --threads 1 --train-reps 1-2", f.root());
+  const FitcalRun logged = RunFitcalOutside(
+      f.root(), "fit --logs '" + f.dir().string() + "' --no-output --threads 1 --train-reps 1-2");
   unsetenv("FITCAL_TEST_LIBRARY_LOG");
   EXPECT_EQ(logged.exit_code, hooked.exit_code);
   EXPECT_FALSE(std::regex_search(logged.err, glog_line)) << logged.err;
