@@ -42,15 +42,6 @@ RobotModelPtr ModelFromYaml(const std::string& text) {
   return ReadRobotModel(YAML::Load(text), "robot.yaml");
 }
 
-const char* kRightFirstYaml = R"(model: diff_drive
-name: test
-wheels:
-  - {name: right, radius_m: 0.042}
-  - {name: left, radius_m: 0.042}
-wheel_separation_m: 0.200
-bounds: {radius_m: [0.038, 0.046], wheel_separation_m: [0.180, 0.220]}
-)";
-
 // Left wheel first, wheels named by their motor, sides given explicitly.
 const char* kLeftFirstYaml = R"(model: diff_drive
 name: test_left_first
@@ -163,7 +154,7 @@ TEST(ModelSimulator, RampsKeepTheSegmentsAndTheEncodersReplayTheTruth) {
 }
 
 TEST(ModelSimulator, QuantisationNoiseAndSeeds) {
-  const RobotModelPtr model = ModelFromYaml(kRightFirstYaml);
+  const RobotModelPtr model = ModelFromYaml(kDiffDriveExampleYaml);
   sim::SimulationOptions o;
   o.ticks_per_rev = {1000.0, 1000.0};
   o.gt_position_sigma_m = 0.001;
@@ -194,7 +185,7 @@ TEST(ModelSimulator, QuantisationNoiseAndSeeds) {
 
 TEST(ModelSimulator, WritesADataSetTheLoadersReadBack) {
   testing::TempDir dir;
-  const RobotModelPtr model = ModelFromYaml(kRightFirstYaml);
+  const RobotModelPtr model = ModelFromYaml(kDiffDriveExampleYaml);
   sim::SimulationOptions o;
   o.gt_position_sigma_m = 0.001;
   const auto runs = sim::SimulateRuns(*model, TrueRobot(), {sim::UmbmarkSquare(true, 3)}, o);
@@ -231,7 +222,7 @@ TEST(ModelSimulator, WritesADataSetTheLoadersReadBack) {
 // Robot YAML
 
 TEST(DiffDriveYaml, RoundTripKeepsValuesSidesAndBlocks) {
-  for (const char* text : {kRightFirstYaml, kLeftFirstYaml}) {
+  for (const char* text : {kDiffDriveExampleYaml, kLeftFirstYaml}) {
     const RobotModelPtr model = ModelFromYaml(text);
     const Robot& robot = model->robot();
     ASSERT_EQ(robot.NumParameters(), 3);
@@ -255,19 +246,19 @@ TEST(DiffDriveYaml, RoundTripKeepsValuesSidesAndBlocks) {
   EXPECT_EQ(left_first->robot().parameters[0].name, "r_m1");
   EXPECT_EQ(left_first->robot().parameters[2].name, "wheel_separation");
   EXPECT_EQ(left_first->robot().channels[1].rate_column, "w_m2");
-  EXPECT_EQ(DiffDriveRightChannel(*ModelFromYaml(kRightFirstYaml)), 0);
+  EXPECT_EQ(DiffDriveRightChannel(*ModelFromYaml(kDiffDriveExampleYaml)), 0);
 }
 
 struct Malformed {
   const char* what;
-  std::string from;  // replaced in kRightFirstYaml
+  std::string from;  // replaced in kDiffDriveExampleYaml
   std::string to;
   io::InputErrorKind kind;
   int line;
 };
 
 TEST(DiffDriveYaml, MalformedRobotsAreOneLineInputErrors) {
-  const std::string good = kRightFirstYaml;
+  const std::string good = kDiffDriveExampleYaml;
   const std::string right = "  - {name: right, radius_m: 0.042}\n";
   const std::vector<Malformed> cases = {
       {"missing wheel", right, "", io::InputErrorKind::kBadValue, 4},
@@ -281,8 +272,8 @@ TEST(DiffDriveYaml, MalformedRobotsAreOneLineInputErrors) {
        io::InputErrorKind::kBadValue, 5},
       {"zero separation", "wheel_separation_m: 0.200", "wheel_separation_m: 0.0",
        io::InputErrorKind::kBadValue, 6},
-      {"unknown key", "name: test", "name: test\nwheel_base: 0.2", io::InputErrorKind::kUnknownKey,
-       0},
+      {"unknown key", "name: example_diff_drive", "name: example_diff_drive\nwheel_base: 0.2",
+       io::InputErrorKind::kUnknownKey, 0},
       {"unknown wheel key", "{name: left, radius_m: 0.042}",
        "{name: left, radius_m: 0.042, offset_m: 0.0}", io::InputErrorKind::kUnknownKey, 0},
       {"no side", "{name: left,", "{name: port,", io::InputErrorKind::kMissingKey, 5},
@@ -294,8 +285,8 @@ TEST(DiffDriveYaml, MalformedRobotsAreOneLineInputErrors) {
       {"non-positive bounds", "radius_m: [0.038, 0.046]", "radius_m: [0.0, 0.046]",
        io::InputErrorKind::kBadValue, 7},
       // A wheel pair carries the pivot yaw gain (line 4), not a steering effect (line 5).
-      {"steering effect", "name: test\n",
-       "name: test\neffects:\n  - {name: pivot_yaw_gain, gain: 0.0}\n"
+      {"steering effect", "name: example_diff_drive\n",
+       "name: example_diff_drive\neffects:\n  - {name: pivot_yaw_gain, gain: 0.0}\n"
        "  - {name: steering_scale, scale: 0.01}\n",
        io::InputErrorKind::kBadValue, 5},
   };
@@ -364,7 +355,7 @@ TEST(Umbmark, WorkedExampleFromThePapersEquations) {
 // of the error itself (measured: 6 % of the wheel-ratio error, 2.5 % of the separation error);
 // 12 % allowed. A wrong sign would double the error instead.
 TEST(Umbmark, RecoversASimulatedRobotFromNoiseFreeSquares) {
-  const RobotModelPtr model = ModelFromYaml(kRightFirstYaml);
+  const RobotModelPtr model = ModelFromYaml(kDiffDriveExampleYaml);
   const std::vector<double> truth = {0.042 * 1.004, 0.042 * 0.996, 0.206};
   std::vector<sim::TrajectorySpec> specs = {sim::UmbmarkSquare(true, 1),
                                             sim::UmbmarkSquare(false, 1),
@@ -400,7 +391,7 @@ TEST(Umbmark, RecoversASimulatedRobotFromNoiseFreeSquares) {
 // (mean radius with the separation) shows only in their open counterparts: three-quarter
 // circles and the open arc of a 1.25-lap circle are added.
 TEST(DiffDriveFit, RecoversASimulatedRobotWithinItsSigmas) {
-  const RobotModelPtr model = ModelFromYaml(kRightFirstYaml);
+  const RobotModelPtr model = ModelFromYaml(kDiffDriveExampleYaml);
   const std::vector<double> truth = TrueRobot();
   sim::DiffDriveTrajectoryOptions open;
   open.circle_laps = 0.75;

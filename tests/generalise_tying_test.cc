@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "fit/parameter_tying.h"
+#include "models/diff_drive/diff_drive_model.h"
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
 #include "tests/test_files.h"
@@ -28,15 +29,6 @@
 
 namespace fitcal {
 namespace {
-
-constexpr const char* kDiffDriveYaml = R"(model: diff_drive
-name: tying_test
-wheels:
-  - {name: right, radius_m: 0.042}
-  - {name: left, radius_m: 0.042}
-wheel_separation_m: 0.200
-bounds: {radius_m: [0.038, 0.046], wheel_separation_m: [0.180, 0.220]}
-)";
 
 const CandidateScore* Find(const SplitScores& s, const std::string& name) {
   for (const CandidateScore& c : s.candidates)
@@ -51,7 +43,7 @@ std::size_t Position(const SplitScores& s, const std::string& name) {
 }
 
 TEST(GeneraliseTying, TiedFitsShareOneValueBesideTheFullFits) {
-  const RobotModelPtr model = ReadRobotModel(YAML::Load(kDiffDriveYaml), "robot.yaml");
+  const RobotModelPtr model = ReadRobotModel(YAML::Load(kDiffDriveExampleYaml), "robot.yaml");
   const Robot& robot = model->robot();
   const int r_left = RequireParameterIndex(robot, "r_left");
   const int r_right = RequireParameterIndex(robot, "r_right");

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <optional>
 
 #include "io/calibration_block.h"
@@ -21,18 +20,6 @@ namespace fitcal::io {
 namespace {
 
 using fitcal::testing::TempDir;
-
-const char* kRobot = R"(model: omni3
-name: test
-wheels:
-  - {name: a, distance_m: 0.195, radius_m: 0.148, angle_deg: 60.0}
-  - {name: b, distance_m: 0.195, radius_m: 0.148, angle_deg: 180.0}
-  - {name: c, distance_m: 0.195, radius_m: 0.148, angle_deg: 300.0}
-bounds:
-  distance_m: [0.170, 0.220]
-  radius_m: [0.138, 0.158]
-  angle_offset_deg: [-2.0, 2.0]
-)";
 
 const char* kEncoders = "t,w_a,w_b,w_c\n0,0,0,0\n0.01,1,2,3\n0.02,1,2,3\n";
 const char* kGroundTruth = "t,x,y,theta\n0,0,0,0\n0.02,0.1,0.2,0.3\n";
@@ -138,8 +125,8 @@ TEST(GroundTruth, BadInputs) {
 // as the same robot.
 TEST(RobotYaml, RoundTripsThroughTheCalibratedSchema) {
   TempDir dir;
-  const Omni3Robot robot = ReadOmni3Robot(dir.Write("robot.yaml", kRobot));
-  EXPECT_EQ(robot.name, "test");
+  const Omni3Robot robot = ReadOmni3Robot(dir.Write("robot.yaml", kOmni3ExampleYaml));
+  EXPECT_EQ(robot.name, "example_omni3");
   EXPECT_NEAR(robot.nominal.angle_rad[1], M_PI, 1e-15);
   const std::shared_ptr<const Omni3Model> model = Omni3ModelOf(robot);
   // The named view and the model's are one robot both ways.
@@ -168,7 +155,7 @@ TEST(RobotYaml, RoundTripsThroughTheCalibratedSchema) {
 // (io/calibration_yaml.h); a plain robot YAML records nothing; a malformed list names its line.
 TEST(RobotYaml, CalibrationProvenanceRoundTrips) {
   TempDir dir;
-  const RobotModelPtr model = ReadRobotModelFile(dir.Write("robot.yaml", kRobot));
+  const RobotModelPtr model = ReadRobotModelFile(dir.Write("robot.yaml", kOmni3ExampleYaml));
   EXPECT_FALSE(ReadCalibrationProvenance(dir.Path("robot.yaml")).has_value());
   CalibrationBlock record;
   record.method = "ceres";
@@ -201,7 +188,7 @@ TEST(RobotYaml, CalibrationProvenanceRoundTrips) {
   EXPECT_EQ(p->correlation.size(), 9u);
   // The omni3 layout before the model seam (one list of three per quantity) still reads.
   const std::string legacy = dir.Write(
-      "legacy.yaml", std::string(kRobot) +
+      "legacy.yaml", std::string(kOmni3ExampleYaml) +
                          "calibration:\n  training_repetitions: [1]\n"
                          "  sigma: {distance_m: [1e-4, 1e-4, 1e-4], radius_m: [2e-4, 2e-4, 2e-4],"
                          " angle_deg: [0.1, 0.1, 0.1]}\n");
@@ -211,17 +198,18 @@ TEST(RobotYaml, CalibrationProvenanceRoundTrips) {
   EXPECT_EQ(old->sigma[3].first, "radius_m[0]");
   EXPECT_DOUBLE_EQ(old->sigma[3].second, 2e-4);
   const std::string uneven =
-      dir.Write("uneven.yaml", std::string(kRobot) +
+      dir.Write("uneven.yaml", std::string(kOmni3ExampleYaml) +
                                    "calibration:\n  training_repetitions: [1]\n"
                                    "  sigma: {r_m: 0.001, b_m: 0.002}\n"
                                    "  correlation:\n    - [1, 0.5]\n    - [0.5]\n");
+  const int robot_lines = fitcal::testing::Lines(kOmni3ExampleYaml);
   ExpectInputError([&] { ReadCalibrationProvenance(uneven); }, InputErrorKind::kBadValue, uneven,
-                   static_cast<int>(std::count(kRobot, kRobot + std::strlen(kRobot), '\n')) + 6);
-  const std::string bad = dir.Write("bad.yaml", std::string(kRobot) +
+                   robot_lines + 6);
+  const std::string bad = dir.Write("bad.yaml", std::string(kOmni3ExampleYaml) +
                                                     "calibration:\n  training_repetitions: [1]\n"
                                                     "  training_run_ids: 5\n");
   ExpectInputError([&] { ReadCalibrationProvenance(bad); }, InputErrorKind::kWrongYamlType, bad,
-                   static_cast<int>(std::count(kRobot, kRobot + std::strlen(kRobot), '\n')) + 3);
+                   robot_lines + 3);
 }
 
 TEST(RobotYaml, BadInputs) {
@@ -230,14 +218,14 @@ TEST(RobotYaml, BadInputs) {
     const std::string path = dir.Write("bad_robot.yaml", text);
     ExpectInputError([&] { ReadOmni3Robot(path); }, kind, path, line);
   };
-  std::string robot = kRobot;
+  std::string robot = kOmni3ExampleYaml;
   const auto replace = [&](const std::string& from, const std::string& to) {
     std::string s = robot;
     s.replace(s.find(from), from.size(), to);
     return s;
   };
   check(replace("model: omni3", "model: tricycle"), InputErrorKind::kUnknownModel, 1);
-  check(replace("name: test", "name: [a, b]"), InputErrorKind::kWrongYamlType, 2);
+  check(replace("name: example_omni3", "name: [a, b]"), InputErrorKind::kWrongYamlType, 2);
   check(replace("wheels:\n", "wheels: 3\nx:\n"), InputErrorKind::kWrongYamlType, 3);
   check(replace("radius_m: 0.148, angle_deg: 180.0", "radius_m: abc, angle_deg: 180.0"),
         InputErrorKind::kNonNumeric, 5);
@@ -246,14 +234,15 @@ TEST(RobotYaml, BadInputs) {
   // The nominal is the fit's start and must lie inside the bounds (angle bounds are relative).
   check(replace("radius_m: 0.148, angle_deg: 300.0", "radius_m: 0.160, angle_deg: 300.0"),
         InputErrorKind::kBadValue, 6);
-  check(replace("name: test", "name: test\ncolour: red"), InputErrorKind::kUnknownKey, 3);
-  check(replace("name: test\n", ""), InputErrorKind::kMissingKey, 1);
+  check(replace("name: example_omni3", "name: example_omni3\ncolour: red"),
+        InputErrorKind::kUnknownKey, 3);
+  check(replace("name: example_omni3\n", ""), InputErrorKind::kMissingKey, 1);
   check("model: omni3\nwheels: [\n", InputErrorKind::kYamlSyntax, 3);
 }
 
 // A one-run data set in `dir`, with `dataset_yaml` as its index.
 void WriteDataset(const TempDir& dir, const std::string& dataset_yaml) {
-  dir.Write("robot.yaml", kRobot);
+  dir.Write("robot.yaml", kOmni3ExampleYaml);
   dir.Write("runs/e.csv", kEncoders);
   dir.Write("runs/g.csv", kGroundTruth);
   dir.Write("dataset.yaml", dataset_yaml);

@@ -17,31 +17,24 @@
 // the per-metre pose covariance is the weaker of the two (docs/ros2.md). The seeds are fixed: the
 // test is deterministic.
 
+#include "validation/odometry_covariance.h"
+
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
 
 #include "fit/model_fit.h"
+#include "models/diff_drive/diff_drive_model.h"
 #include "models/model_registry.h"
 #include "models/tricycle/tricycle_model.h"
 #include "odometry/aligned_run.h"
 #include "tools/sim/diff_drive_trajectories.h"
 #include "tools/sim/model_simulator.h"
 #include "tools/sim/tricycle_trajectories.h"
-#include "validation/odometry_covariance.h"
 
 namespace fitcal {
 namespace {
-
-const char* kDiffDriveYaml = R"(model: diff_drive
-name: covbot
-wheels:
-  - {name: right, radius_m: 0.042}
-  - {name: left, radius_m: 0.042}
-wheel_separation_m: 0.200
-bounds: {radius_m: [0.038, 0.046], wheel_separation_m: [0.180, 0.220]}
-)";
 
 struct RobotCase {
   const char* name;
@@ -113,9 +106,9 @@ TEST_P(Coverage, HeldOutErrorsInsideOneAndTwoSigma) {
 
 INSTANTIATE_TEST_SUITE_P(
     Robots, Coverage,
-    ::testing::Values(RobotCase{"diff_drive", kDiffDriveYaml, {0.0426, 0.0414, 0.2065}, DiffDrive},
-                      RobotCase{"tricycle", kTricycleExampleYaml,
-                                {0.0331, 0.152, 1.5 * M_PI / 180}, Tricycle}),
+    ::testing::Values(
+        RobotCase{"diff_drive", kDiffDriveExampleYaml, {0.0426, 0.0414, 0.2065}, DiffDrive},
+        RobotCase{"tricycle", kTricycleExampleYaml, {0.0331, 0.152, 1.5 * M_PI / 180}, Tricycle}),
     [](const ::testing::TestParamInfo<RobotCase>& p) { return std::string(p.param.name); });
 
 // The estimate itself: errors of known variance give it back.

@@ -22,6 +22,7 @@
 #include "fit/model_fit.h"
 #include "fit/segment_cost.h"
 #include "fit/track_residual.h"
+#include "models/diff_drive/diff_drive_model.h"
 #include "models/model_registry.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "odometry/aligned_run.h"
@@ -124,15 +125,7 @@ TEST(ParameterTying, EqualWheelDistancesRecoveredAsOneValueWithItsSigma) {
 }
 
 TEST(ParameterTying, DiffDriveRadiiTiedOnTracksComeOutEqual) {
-  const RobotModelPtr model = ReadRobotModel(YAML::Load(R"(model: diff_drive
-name: tying_test
-wheels:
-  - {name: right, radius_m: 0.042}
-  - {name: left, radius_m: 0.042}
-wheel_separation_m: 0.200
-bounds: {radius_m: [0.038, 0.046], wheel_separation_m: [0.180, 0.220]}
-)"),
-                                             "robot.yaml");
+  const RobotModelPtr model = ReadRobotModel(YAML::Load(kDiffDriveExampleYaml), "robot.yaml");
   const Robot& robot = model->robot();
   std::vector<double> truth = robot.nominal;
   for (double& v : truth) v *= 1.02;  // equal radii, 2 % larger, and the track with them
@@ -225,15 +218,7 @@ TEST(ParameterTying, FitCommandTiesAndRefusesUnknownNames) {
 // per 50 ms interval against a 0.005 m/s mismatch per 10 ms of offset during a ramp) moves it
 // by ~0.01 s, one step.
 TEST(ClockMap, FindsAGroundTruthOffsetOfADiffDrive) {
-  const RobotModelPtr model = ReadRobotModel(YAML::Load(R"(model: diff_drive
-name: clock_test
-wheels:
-  - {name: right, radius_m: 0.042}
-  - {name: left, radius_m: 0.042}
-wheel_separation_m: 0.200
-bounds: {radius_m: [0.038, 0.046], wheel_separation_m: [0.180, 0.220]}
-)"),
-                                             "robot.yaml");
+  const RobotModelPtr model = ReadRobotModel(YAML::Load(kDiffDriveExampleYaml), "robot.yaml");
   const std::vector<double>& p = model->robot().nominal;
   // Half the wheel separation: a turn moves the wheels as fast as that lever arm.
   EXPECT_NEAR(ClockMapLeverArm(*model, p.data()), 0.100, 1e-12);

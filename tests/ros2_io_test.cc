@@ -27,6 +27,7 @@
 #include "io/rosbag2/bag_reader.h"
 #include "io/rosbag2/bag_writer.h"
 #include "io/rosbag2/ros_messages.h"
+#include "models/diff_drive/diff_drive_model.h"
 #include "models/model_registry.h"
 #include "models/omni/omni_model.h"
 #include "models/omni3/omni3_robot_model.h"
@@ -45,14 +46,6 @@ namespace {
 namespace fs = std::filesystem;
 using namespace io::rosbag2;
 
-const char* kRobotYaml = R"(model: diff_drive
-name: bagbot
-wheels:
-  - {name: right, radius_m: 0.042}
-  - {name: left, radius_m: 0.042}
-wheel_separation_m: 0.200
-bounds: {radius_m: [0.038, 0.046], wheel_separation_m: [0.180, 0.220]}
-)";
 const std::vector<double> kTruth = {0.0426, 0.0414, 0.2065};  // r_right, r_left, b
 constexpr std::int64_t kEpochNs = 1700000000000000000;        // the bags' clock origin
 constexpr double kGapS = 3.0;                                 // rest between runs
@@ -164,7 +157,7 @@ tools::ImportRosbag2Options ImportOptions(const testing::TempDir& tmp, const fs:
   tools::ImportRosbag2Options o;
   o.bag = bag.string();
   o.out = tmp.Path("imported");
-  o.robot = tmp.Write("robot.yaml", kRobotYaml);
+  o.robot = tmp.Write("robot.yaml", kDiffDriveExampleYaml);
   o.joints = {"right_wheel_joint", "left_wheel_joint"};
   o.ground_truth = "/mocap/pose";
   o.quiet = true;
@@ -198,7 +191,7 @@ constexpr double kSigmaFraction = 1e-3;
 TEST_P(ImportEqualsCsv, SameFitAsTheSimulatorsCsv) {
   const BagCase& c = GetParam();
   testing::TempDir tmp;
-  const RobotModelPtr model = ReadRobotModel(YAML::Load(kRobotYaml), "robot.yaml");
+  const RobotModelPtr model = ReadRobotModel(YAML::Load(kDiffDriveExampleYaml), "robot.yaml");
   const std::vector<sim::ModelSimulatedRun> sim_runs = SimulatedRuns(*model);
   BagWriterOptions bag_options;
   bag_options.storage = c.storage;
@@ -285,7 +278,7 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(ImportRosbag2ClockOffset, OneOffsetPerBagRecoversAPoseLatency) {
   constexpr std::int64_t kLatencyNs = 150000000;
   testing::TempDir tmp;
-  const RobotModelPtr model = ReadRobotModel(YAML::Load(kRobotYaml), "robot.yaml");
+  const RobotModelPtr model = ReadRobotModel(YAML::Load(kDiffDriveExampleYaml), "robot.yaml");
   BagEdits edits;
   edits.pose = [](std::size_t, PoseStamped* p) {
     const std::int64_t ns = static_cast<std::int64_t>(p->header.stamp.sec) * 1000000000 +
@@ -352,7 +345,7 @@ void ExpectRefused(const tools::ImportRosbag2Options& o, const std::string& what
 class MalformedImport : public ::testing::Test {
  protected:
   void SetUp() override {
-    const RobotModelPtr model = ReadRobotModel(YAML::Load(kRobotYaml), "robot.yaml");
+    const RobotModelPtr model = ReadRobotModel(YAML::Load(kDiffDriveExampleYaml), "robot.yaml");
     runs_ = SimulatedRuns(*model);
     runs_.resize(2);
   }
@@ -605,7 +598,7 @@ constexpr double kRoundTrip = 1e-11;
 // The tables the export reads the calibration through (models/model_interface.h,
 // models/omni/omni_model.h): parameters by name, an omni robot's wheels with their fixed geometry.
 TEST(ExportRos2Control, ParametersByNameAndOmniWheelsFromTheModel) {
-  const RobotModelPtr diff = ReadRobotModel(YAML::Load(kRobotYaml), "robot.yaml");
+  const RobotModelPtr diff = ReadRobotModel(YAML::Load(kDiffDriveExampleYaml), "robot.yaml");
   EXPECT_EQ(ParameterIndex(diff->robot(), "r_left"), 1);
   EXPECT_EQ(ParameterIndex(diff->robot(), "wheel_separation"), 2);
   EXPECT_FALSE(ParameterIndex(diff->robot(), "R_left"));
@@ -635,7 +628,7 @@ TEST(ExportRos2Control, ParametersByNameAndOmniWheelsFromTheModel) {
 
 TEST(ExportRos2Control, DiffDriveIsExact) {
   testing::TempDir tmp;
-  const RobotModelPtr model = ReadRobotModel(YAML::Load(kRobotYaml), "robot.yaml");
+  const RobotModelPtr model = ReadRobotModel(YAML::Load(kDiffDriveExampleYaml), "robot.yaml");
   const std::string cal = tmp.Write("cal.yaml", model->RobotYaml(kTruth, ""));
   const Exported x = ExportAndRead(cal, "diff_drive_controller");
   for (const char* key : {"wheel_separation", "wheel_radius", "left_wheel_radius_multiplier",
@@ -794,7 +787,7 @@ struct ControllerCase {
 
 TEST(ExportRos2Control, EveryKeyDeclaredOnItsDistribution) {
   testing::TempDir tmp;
-  const std::vector<ControllerCase> cases = {{"diff_drive_controller", kRobotYaml},
+  const std::vector<ControllerCase> cases = {{"diff_drive_controller", kDiffDriveExampleYaml},
                                              {"mecanum_drive_controller", kOmniExampleYaml},
                                              {"omni_wheel_drive_controller", kOmni3ExampleYaml},
                                              {"tricycle_controller", kTricycleExampleYaml}};

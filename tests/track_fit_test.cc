@@ -18,6 +18,7 @@
 #include "fit/model_fit.h"
 #include "fit/residual_choice.h"
 #include "fit/track_residual.h"
+#include "models/diff_drive/diff_drive_model.h"
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
 #include "tools/sim/diff_drive_trajectories.h"
@@ -28,20 +29,11 @@
 namespace fitcal {
 namespace {
 
-const char* kNominalYaml = R"(model: diff_drive
-name: track_test
-wheels:
-  - {name: right, radius_m: 0.042}
-  - {name: left, radius_m: 0.042}
-wheel_separation_m: 0.200
-bounds: {radius_m: [0.038, 0.046], wheel_separation_m: [0.180, 0.220]}
-)";
-
 constexpr double kCommonScale = 1.02;   // true wheels and track / nominal
 constexpr double kClockOffsetS = 0.15;  // ground truth stamped this late
 constexpr double kGtPositionSigmaM = 0.001;
 
-RobotModelPtr Model() { return ReadRobotModel(YAML::Load(kNominalYaml), "robot.yaml"); }
+RobotModelPtr Model() { return ReadRobotModel(YAML::Load(kDiffDriveExampleYaml), "robot.yaml"); }
 
 std::vector<double> TrueParameters(const RobotModelInterface& model) {
   std::vector<double> p = model.robot().nominal;

@@ -15,6 +15,7 @@
 #include "io/log_files.h"
 #include "io/robot_yaml.h"
 #include "models/asoc/asoc_files.h"
+#include "models/diff_drive/diff_drive_model.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "tools/import_rosbag2.h"
 
@@ -24,29 +25,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Valid neighbours for the data set loader: a robot and two runs.
-constexpr const char* kRobotYaml =
-    "model: omni3\n"
-    "name: fuzz\n"
-    "wheels:\n"
-    "  - {name: a, distance_m: 0.195, radius_m: 0.148, angle_deg: 60.0}\n"
-    "  - {name: b, distance_m: 0.195, radius_m: 0.148, angle_deg: 180.0}\n"
-    "  - {name: c, distance_m: 0.195, radius_m: 0.148, angle_deg: 300.0}\n"
-    "bounds:\n"
-    "  distance_m: [0.170, 0.220]\n"
-    "  radius_m: [0.138, 0.158]\n"
-    "  angle_offset_deg: [-2.0, 2.0]\n";
+// Valid neighbours for the data set loader: two runs (the robot is kOmni3ExampleYaml).
 constexpr const char* kEncoderCsv = "t,w_a,w_b,w_c\n0,0,0,0\n0.01,1,2,3\n0.02,1,2,3\n";
 constexpr const char* kGroundTruthCsv = "t,x,y,theta\n0,0,0,0\n0.02,0.001,0,0\n";
-// The rosbag2 seeds' robot (tests/fuzz_corpus_test.cc writes the seed bags).
-constexpr const char* kDiffDriveYaml =
-    "model: diff_drive\n"
-    "name: fuzz\n"
-    "wheels:\n"
-    "  - {name: right, radius_m: 0.042}\n"
-    "  - {name: left, radius_m: 0.042}\n"
-    "wheel_separation_m: 0.200\n"
-    "bounds: {radius_m: [0.038, 0.046], wheel_separation_m: [0.180, 0.220]}\n";
 // A second run of its own: one file listed for two runs is refused as a duplicated run.
 constexpr const char* kEncoderCsv2 = "t,w_a,w_b,w_c\n0,0,0,0\n0.01,1,2,3\n0.02,1,2,4\n";
 constexpr const char* kGroundTruthCsv2 = "t,x,y,theta\n0,0,0,0\n0.02,0.002,0,0\n";
@@ -64,10 +45,11 @@ class ScratchDir {
     std::string tmpl = (fs::temp_directory_path() / "fitcal-fuzz-XXXXXX").string();
     if (mkdtemp(tmpl.data()) == nullptr) throw std::runtime_error("fuzz: mkdtemp failed");
     path_ = tmpl;
-    WriteFile(path_ + "/robot.yaml", kRobotYaml);
+    WriteFile(path_ + "/robot.yaml", kOmni3ExampleYaml);
     WriteFile(path_ + "/enc.csv", kEncoderCsv);
     WriteFile(path_ + "/gt.csv", kGroundTruthCsv);
-    WriteFile(path_ + "/diff_drive.yaml", kDiffDriveYaml);
+    // The rosbag2 seeds' robot (tests/fuzz_corpus_test.cc writes the seed bags).
+    WriteFile(path_ + "/diff_drive.yaml", kDiffDriveExampleYaml);
     WriteFile(path_ + "/enc2.csv", kEncoderCsv2);
     WriteFile(path_ + "/gt2.csv", kGroundTruthCsv2);
   }
