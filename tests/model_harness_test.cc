@@ -169,19 +169,6 @@ TEST(ModelHarness, EffectsRoundTripThroughTheRobotYaml) {
   }
 }
 
-// Samples with channel i read as sign[i] * column[i].
-EncoderSamples Mapped(const EncoderSamples& samples, const ChannelMapping& mapping) {
-  EncoderSamples out(samples.num_channels());
-  std::vector<double> values(samples.num_channels());
-  for (const auto& s : samples) {
-    for (int i = 0; i < samples.num_channels(); ++i) {
-      values[i] = mapping.sign[i] * s.value[mapping.column[i]];
-    }
-    out.push_back(s.dt_s, values.data());
-  }
-  return out;
-}
-
 TEST(ModelHarness, EveryMiswiringChangesTheFinalPoses) {
   for (const ModelRegistration& m : RegisteredModels()) {
     SCOPED_TRACE(m.name);
@@ -193,10 +180,9 @@ TEST(ModelHarness, EveryMiswiringChangesTheFinalPoses) {
     EXPECT_TRUE(mappings.front().IsIdentity());
     for (std::size_t j = 1; j < mappings.size(); ++j) {
       double ssr = 0.0;
-      for (const AlignedRun& run : runs) {
+      for (const AlignedRun& run : ApplyChannelMapping(runs, mappings[j])) {
         double r[3];
-        const Pose2d f = model->ReplayFinalPose(robot.nominal.data(),
-                                                Mapped(run.samples, mappings[j]), run.start);
+        const Pose2d f = model->ReplayFinalPose(robot.nominal.data(), run.samples, run.start);
         FinalPoseError(f, run.final_ground_truth, ResidualWeights{}, r);
         ssr += r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
       }

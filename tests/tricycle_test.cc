@@ -358,26 +358,13 @@ TEST(TricycleSimulation, FitRecoversTheTruthWithinNoiseDerivedSigmas) {
   }
 }
 
-// Samples with channel i read as sign[i] * column[i].
-EncoderSamples Mapped(const EncoderSamples& samples, const ChannelMapping& mapping) {
-  EncoderSamples out(samples.num_channels());
-  double values[K::kNumChannels];
-  for (const auto& s : samples) {
-    for (int i = 0; i < K::kNumChannels; ++i)
-      values[i] = mapping.sign[i] * s.value[mapping.column[i]];
-    out.push_back(s.dt_s, values);
-  }
-  return out;
-}
-
 // Final-pose SSR (weights 1) after fitting the runs read through `mapping`.
-double FittedSsr(const RobotModelInterface& model, std::vector<AlignedRun> runs,
+double FittedSsr(const RobotModelInterface& model, const std::vector<AlignedRun>& runs,
                  const ChannelMapping& mapping) {
-  for (AlignedRun& run : runs) run.samples = Mapped(run.samples, mapping);
   ModelFitOptions options;
   options.ceres.num_threads = 1;
   options.ceres.compute_covariance = false;
-  const ModelFitResult fit = FitModel(runs, model, options);
+  const ModelFitResult fit = FitModel(ApplyChannelMapping(runs, mapping), model, options);
   return 2.0 * fit.final_cost;
 }
 
