@@ -27,11 +27,30 @@ struct Data {
   std::vector<TrackRun> training, validation;
 };
 
-Data Simulate(sim::FlowerSimulation o) {
+// Palacin's flower with `repetitions` of every trajectory on simulator seed `seed`.
+sim::FlowerSimulation Flower(int repetitions, std::uint64_t seed) {
+  sim::FlowerSimulation o = sim::PalacinFlower();
+  o.repetitions = repetitions;
+  o.options.seed = seed;
+  return o;
+}
+
+// Injects the library effect `id` at its registry's realistic magnitude; returns it.
+effects::EffectValue InjectTypical(effects::EffectId id, sim::FlowerSimulation* o) {
+  effects::EffectValue truth;
+  truth.id = id;
+  truth.value = effects::Info(id).typical;
+  o->options.stepped->injected_effects = {truth};
+  return truth;
+}
+
+// The runs of `o`, commanded with the nominal robot; `training_repetitions` train, the rest
+// validate.
+Data Simulate(sim::FlowerSimulation o, const std::vector<int>& training_repetitions = {1}) {
   o.options.stepped->commanded_parameters = sim::ParameterVector(NominalRobot().nominal);
   std::vector<RunLog> logs = sim::SimulateFlowerLogs(o);
   Data d;
-  SplitTrackRuns(PrepareTrackRuns(logs), {1}, &d.training, &d.validation);
+  SplitTrackRuns(PrepareTrackRuns(logs), training_repetitions, &d.training, &d.validation);
   return d;
 }
 
@@ -61,13 +80,8 @@ class LibraryEffectTest : public ::testing::TestWithParam<effects::EffectId> {};
 
 TEST_P(LibraryEffectTest, DiagnosePicksRecoversAndMatchesTrueModel) {
   const effects::EffectInfo& info = effects::Info(GetParam());
-  sim::FlowerSimulation o = sim::PalacinFlower();
-  o.repetitions = 2;
-  o.options.seed = 11;
-  effects::EffectValue truth;
-  truth.id = info.id;
-  truth.value = info.typical;
-  o.options.stepped->injected_effects = {truth};
+  sim::FlowerSimulation o = Flower(2, 11);
+  const effects::EffectValue truth = InjectTypical(info.id, &o);
   const Data d = Simulate(o);
   const auto model = NominalModel();
   const DiagnoseResult r = Diagnose(d.training, d.validation, *model);
@@ -139,18 +153,9 @@ class TransientEffectTest : public ::testing::TestWithParam<effects::EffectId> {
 
 TEST_P(TransientEffectTest, IsNamedAndRecoveredWithinFourSigmas) {
   const effects::EffectInfo& info = effects::Info(GetParam());
-  sim::FlowerSimulation o = sim::PalacinFlower();
-  o.repetitions = 4;
-  o.options.seed = 3;
-  effects::EffectValue truth;
-  truth.id = info.id;
-  truth.value = info.typical;
-  o.options.stepped->injected_effects = {truth};
-  std::vector<RunLog> logs;
-  o.options.stepped->commanded_parameters = sim::ParameterVector(NominalRobot().nominal);
-  for (auto& run : sim::SimulateFlower(o)) logs.push_back(std::move(run.log));
-  Data d;
-  SplitTrackRuns(PrepareTrackRuns(logs), {1, 2}, &d.training, &d.validation);
+  sim::FlowerSimulation o = Flower(4, 3);
+  const effects::EffectValue truth = InjectTypical(info.id, &o);
+  const Data d = Simulate(o, {1, 2});
   const auto model = NominalModel();
   DiagnoseOptions options;
   options.fit.num_threads = 2;
@@ -189,9 +194,7 @@ TEST(Diagnose, CleanDataAcceptsNoEffectOverTwentySeeds) {
   int structure_false_positives = 0;  // lack of fit or a covariate
   constexpr int kSeeds = 20;
   for (int seed = 1; seed <= kSeeds; ++seed) {
-    sim::FlowerSimulation o = sim::PalacinFlower();
-    o.repetitions = 2;
-    o.options.seed = static_cast<std::uint64_t>(seed) * 7919;
+    sim::FlowerSimulation o = Flower(2, static_cast<std::uint64_t>(seed) * 7919);
     o.trajectories = subset;
     o.options.stepped->random_wheel_start_angle =
         true;  // every covariate tested, the absolute wheel angle too
@@ -228,9 +231,7 @@ TEST(Diagnose, CleanDataAcceptsNoEffectOverTwentySeeds) {
 // strongly correlated; weighing each by its own variance alone read this data set as structure
 // (F = 1.39 on (423, 3888) df, p = 8e-7). With the pooled covariance: F = 1.15, p = 0.1.
 TEST(Diagnose, LackOfFitIsCalibratedOnCleanDataWithManyRepetitions) {
-  sim::FlowerSimulation o = sim::PalacinFlower();
-  o.repetitions = 10;
-  o.options.seed = 1;
+  sim::FlowerSimulation o = Flower(10, 1);
   const Data d = Simulate(o);
   DiagnoseOptions options;
   options.max_effects = 0;  // the residual of the nine parameters alone
@@ -244,9 +245,7 @@ TEST(Diagnose, LackOfFitIsCalibratedOnCleanDataWithManyRepetitions) {
 // taken from a ground-truth sample that shows the robot at rest, interpolating the ground truth
 // at t_start + latency blended the rest pose with a moving one and left structure).
 TEST(Diagnose, LatencyIsNamedWithManyRepetitions) {
-  sim::FlowerSimulation o = sim::PalacinFlower();
-  o.repetitions = 6;
-  o.options.seed = 1;
+  sim::FlowerSimulation o = Flower(6, 1);
   effects::EffectValue latency;
   latency.id = effects::EffectId::kTimeOffset;
   latency.value[0] = 0.08;
@@ -264,9 +263,7 @@ TEST(Diagnose, LatencyIsNamedWithManyRepetitions) {
 // started (omega += k t, e.g. a castor or a roller warming up). No candidate has this shape; the
 // tracing must report unexplained structure rather than name the nearest candidate.
 TEST(Diagnose, EffectOutsideLibraryIsReportedAsUnexplainedStructure) {
-  sim::FlowerSimulation o = sim::PalacinFlower();
-  o.repetitions = 2;
-  o.options.seed = 5;
+  sim::FlowerSimulation o = Flower(2, 5);
   constexpr double kDriftRadS2 = 0.006;
   o.options.stepped->hook = [](const sim::SteppedState& s, double*, Twist* v, double*) {
     const double* w = s.channel_value;
@@ -289,13 +286,8 @@ TEST(Diagnose, EffectOutsideLibraryIsReportedAsUnexplainedStructure) {
 // tracing must say it is not identifiable, accept nothing, and the declared fit must already be
 // as good as the true model.
 TEST(Diagnose, ClockScaleIsReportedNotIdentifiable) {
-  sim::FlowerSimulation o = sim::PalacinFlower();
-  o.repetitions = 2;
-  o.options.seed = 9;
-  effects::EffectValue truth;
-  truth.id = effects::EffectId::kEncoderClockScale;
-  truth.value = effects::Info(truth.id).typical;
-  o.options.stepped->injected_effects = {truth};
+  sim::FlowerSimulation o = Flower(2, 9);
+  const effects::EffectValue truth = InjectTypical(effects::EffectId::kEncoderClockScale, &o);
   const Data d = Simulate(o);
   const auto model = NominalModel();
   const DiagnoseResult r = Diagnose(d.training, d.validation, *model);
@@ -320,9 +312,7 @@ TEST(Diagnose, ClockScaleIsReportedNotIdentifiable) {
 // the runs that would separate it, rather than fit it.
 TEST(Diagnose, SaysWhichRunsWouldSeparateAnUnidentifiableCandidate) {
   const auto flower = sim::FlowerTrajectories();
-  sim::FlowerSimulation o = sim::PalacinFlower();
-  o.repetitions = 2;
-  o.options.seed = 21;
+  sim::FlowerSimulation o = Flower(2, 21);
   o.trajectories.assign(flower.begin(), flower.begin() + 12);  // R1..R12
   const Data d = Simulate(o);
   DiagnoseOptions options;
@@ -343,9 +333,7 @@ TEST(Diagnose, SaysWhichRunsWouldSeparateAnUnidentifiableCandidate) {
 // influence that the nine parameters cannot mimic must grow clearly (measured: printed).
 TEST(Diagnose, SecondSpeedFlowerSeparatesSpeedSlip) {
   const auto unexplained = [](std::vector<sim::MotionCommand> trajectories, int repetitions) {
-    sim::FlowerSimulation o = sim::PalacinFlower();
-    o.repetitions = repetitions;
-    o.options.seed = 4;
+    sim::FlowerSimulation o = Flower(repetitions, 4);
     o.trajectories = std::move(trajectories);
     const Data d = Simulate(o);
     std::vector<TrackRun> all = d.training;

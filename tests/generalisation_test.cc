@@ -69,6 +69,13 @@ double MeanExpectedCf(const std::vector<int>& shapes, double r, double k) {
   return sum / shapes.size();
 }
 
+const CandidateScore& Find(const SplitScores& s, const std::string& name) {
+  for (const CandidateScore& c : s.candidates)
+    if (c.name == name) return c;
+  ADD_FAILURE() << "no candidate " << name;
+  return s.candidates.front();
+}
+
 class GeneralisationTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -79,13 +86,6 @@ class GeneralisationTest : public ::testing::Test {
          sim::SimulateRuns(*model_, {kTrueRadius, kTrueGain}, specs, sim::SimulationOptions{})) {
       runs_.push_back(AlignRun(run.log));
     }
-  }
-
-  const CandidateScore& Find(const SplitScores& s, const std::string& name) {
-    for (const CandidateScore& c : s.candidates)
-      if (c.name == name) return c;
-    ADD_FAILURE() << "no candidate " << name;
-    return s.candidates.front();
   }
 
   RobotModelPtr model_;
@@ -186,14 +186,8 @@ TEST(GeneralisationOptiOdom, CheckpointsSeeWhatAClosedPathHidesFromItsFinalPose)
   const double r0 = model->robot().nominal[0], k0 = model->robot().nominal[1];
   const double nominal_cf = MeanExpectedCf({0, 1}, r0, k0);
   ASSERT_GT(nominal_cf, 0.05);
-  const auto find = [&](const std::string& name) {
-    for (const CandidateScore& c : scores.candidates)
-      if (c.name == name) return c;
-    ADD_FAILURE() << "no candidate " << name;
-    return CandidateScore{};
-  };
-  EXPECT_NEAR(find("fit").test.cf, nominal_cf, kCfTolerance);
-  const CandidateScore optiodom = find("optiodom");
+  EXPECT_NEAR(Find(scores, "fit").test.cf, nominal_cf, kCfTolerance);
+  const CandidateScore optiodom = Find(scores, "optiodom");
   ASSERT_TRUE(optiodom.usable);
   EXPECT_NEAR(optiodom.parameters[0], kTrueRadius, 1e-8);
   EXPECT_NEAR(optiodom.test.cf, 0.0, kCfTolerance);

@@ -66,16 +66,17 @@ std::string PreviousOutput(const std::string& name) {
   return model->RobotYaml(model->robot().nominal, io::CalibrationBlockYaml(record, model->robot()));
 }
 
-// Starts `fitcal --logs data --out out`, stopped (SIGSTOP) at `stage` by io::StopHereForTests.
-// Returns the child's pid, or -1 when it ended without reaching the stage.
-pid_t StartFitStoppedAt(const fs::path& data, const fs::path& out, const char* stage) {
+// Starts `fitcal args...`, stopped (SIGSTOP) at `stage` by io::StopHereForTests. Returns the
+// child's pid, or -1 when it ended without reaching the stage.
+pid_t StartStoppedAt(const std::vector<std::string>& args, const char* stage) {
   const pid_t pid = fork();
   if (pid == 0) {
-    const std::string logs = data.string(), out_arg = out.string();
     std::freopen("/dev/null", "w", stdout);
     setenv("FITCAL_TEST_STOP_AT", stage, 1);
-    execl(kFitcal.c_str(), "fitcal", "--logs", logs.c_str(), "--out", out_arg.c_str(),
-          static_cast<char*>(nullptr));
+    std::vector<char*> argv{const_cast<char*>("fitcal")};
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execv(kFitcal.c_str(), argv.data());
     _exit(127);
   }
   int status = 0;
@@ -103,7 +104,7 @@ TEST(NothingLostTest, SignalAtEveryStageLeavesThePreviousOutputUntouched) {
     for (int signal_number : {SIGINT, SIGTERM, SIGHUP, SIGKILL}) {
       SCOPED_TRACE(std::string("signal ") + strsignal(signal_number) + " at stage " + stage);
       WriteFileBytes(out, previous);
-      const pid_t pid = StartFitStoppedAt(data, out, stage);
+      const pid_t pid = StartStoppedAt({"--logs", data.string(), "--out", out.string()}, stage);
       ASSERT_GT(pid, 0) << "fitcal ended before reaching the stage";
       if (std::string(stage) == "temporary-written") {
         ASSERT_EQ(TemporaryFiles(out_dir).size(), 1u) << "the stage is not where it claims";
@@ -226,22 +227,6 @@ std::map<std::string, std::string> DirectoryBytes(const fs::path& dir) {
   return out;
 }
 
-pid_t StartReportStoppedAt(const std::vector<std::string>& args, const char* stage) {
-  const pid_t pid = fork();
-  if (pid == 0) {
-    std::freopen("/dev/null", "w", stdout);
-    setenv("FITCAL_TEST_STOP_AT", stage, 1);
-    std::vector<char*> argv{const_cast<char*>("fitcal")};
-    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    execv(kFitcal.c_str(), argv.data());
-    _exit(127);
-  }
-  int status = 0;
-  if (pid < 0 || waitpid(pid, &status, WUNTRACED) != pid || !WIFSTOPPED(status)) return -1;
-  return pid;
-}
-
 TEST(NothingLostTest, ReportDirectoryIsReplacedWholeOrNotAtAll) {
   const TempDir scratch;
   const fs::path data = Simulate(scratch.path(), 2);
@@ -260,10 +245,9 @@ TEST(NothingLostTest, ReportDirectoryIsReplacedWholeOrNotAtAll) {
   // The next report differs (another training split), so a mix would show.
   for (int signal_number : {SIGTERM, SIGKILL}) {
     SCOPED_TRACE(strsignal(signal_number));
-    const pid_t pid =
-        StartReportStoppedAt({"report", "--logs", data.string(), "--calibration", cal.string(),
-                              "--out", report.string(), "--train-reps", "2"},
-                             "report-staged");
+    const pid_t pid = StartStoppedAt({"report", "--logs", data.string(), "--calibration",
+                                      cal.string(), "--out", report.string(), "--train-reps", "2"},
+                                     "report-staged");
     ASSERT_GT(pid, 0);
     ASSERT_EQ(siblings().size(), 1u) << "no staged directory beside the report";
     kill(pid, signal_number);

@@ -328,6 +328,22 @@ void WriteBag(const fs::path& dir, const BagWriterOptions& options,
   bag.Close();
 }
 
+// Expects `bag` to hand out the `written` messages in time order, each decoding to what was
+// written.
+void ExpectReadBackInTimeOrder(BagReader& bag, std::vector<Written> written) {
+  std::stable_sort(written.begin(), written.end(),
+                   [](const Written& a, const Written& b) { return a.time_ns < b.time_ns; });
+  const std::vector<ReadMessage> read = ReadAll(bag);
+  ASSERT_EQ(read.size(), written.size());
+  for (std::size_t i = 0; i < read.size(); ++i) {
+    ASSERT_EQ(read[i].topic, written[i].topic) << i;
+    EXPECT_EQ(read[i].time_ns, written[i].time_ns) << i;
+    EXPECT_EQ(DecodeMessage(read[i].type, ByteView(read[i].payload), read[i].what),
+              written[i].message)
+        << i;
+  }
+}
+
 struct RoundTripCase {
   const char* name;
   StorageFormat storage;
@@ -346,10 +362,8 @@ TEST_P(RoundTrip, WrittenMessagesReadBackEqualInTimeOrder) {
   options.mcap.compression = c.compression;
   options.mcap.chunk_bytes = 4096;  // many chunks
   options.split_after_messages = c.split ? 90 : 0;
-  std::vector<Written> expected = MakeMessages();
+  const std::vector<Written> expected = MakeMessages();
   WriteBag(dir, options, expected);
-  std::stable_sort(expected.begin(), expected.end(),
-                   [](const Written& a, const Written& b) { return a.time_ns < b.time_ns; });
 
   BagReader bag(dir.string());
   EXPECT_EQ(bag.files().size(), c.split ? 2u : 1u);
@@ -359,15 +373,7 @@ TEST_P(RoundTrip, WrittenMessagesReadBackEqualInTimeOrder) {
   EXPECT_EQ(bag.FindTopic("/tf")->type, "tf2_msgs/msg/TFMessage");
   EXPECT_EQ(bag.start_time_ns(), bag.metadata()->starting_time_ns);
   EXPECT_EQ(bag.end_time_ns() - bag.start_time_ns(), bag.metadata()->duration_ns);
-  const std::vector<ReadMessage> read = ReadAll(bag);
-  ASSERT_EQ(read.size(), expected.size());
-  for (std::size_t i = 0; i < read.size(); ++i) {
-    ASSERT_EQ(read[i].topic, expected[i].topic) << i;
-    EXPECT_EQ(read[i].time_ns, expected[i].time_ns) << i;
-    EXPECT_EQ(DecodeMessage(read[i].type, ByteView(read[i].payload), read[i].what),
-              expected[i].message)
-        << i;
-  }
+  ExpectReadBackInTimeOrder(bag, expected);
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -401,20 +407,11 @@ TEST(RoundTrip, McapWithoutChunksReads) {
   BagWriterOptions options;
   options.mcap.chunked = false;
   options.split_after_messages = 100;
-  std::vector<Written> expected = MakeMessages();
+  const std::vector<Written> expected = MakeMessages();
   WriteBag(tmp.path() / "bag", options, expected);
-  std::stable_sort(expected.begin(), expected.end(),
-                   [](const Written& a, const Written& b) { return a.time_ns < b.time_ns; });
   BagReader bag((tmp.path() / "bag").string());
   EXPECT_EQ(bag.files().size(), 2u);
-  const std::vector<ReadMessage> read = ReadAll(bag);
-  ASSERT_EQ(read.size(), expected.size());
-  for (std::size_t i = 0; i < read.size(); ++i) {
-    EXPECT_EQ(read[i].time_ns, expected[i].time_ns) << i;
-    EXPECT_EQ(DecodeMessage(read[i].type, ByteView(read[i].payload), read[i].what),
-              expected[i].message)
-        << i;
-  }
+  ExpectReadBackInTimeOrder(bag, expected);
 }
 
 // Times written as a permutation, so every chunk (or block of loose messages, 4 MiB each)
