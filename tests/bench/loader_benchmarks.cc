@@ -9,10 +9,8 @@
 //   build/tests/loader_benchmarks --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 
 #include <benchmark/benchmark.h>
-#include <unistd.h>
 
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <random>
 #include <string>
@@ -20,32 +18,14 @@
 #include "io/dataset.h"
 #include "io/log_files.h"
 #include "io/text_file.h"
+#include "tests/bench/bench_support.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-long EnvOr(const char* name, long fallback) {
-  const char* v = std::getenv(name);
-  return v != nullptr ? std::atol(v) : fallback;
-}
-
-class TempDir {
- public:
-  TempDir() {
-    std::string tmpl = (fs::temp_directory_path() / "fitcal-bench-XXXXXX").string();
-    if (mkdtemp(tmpl.data()) == nullptr) std::abort();
-    path_ = tmpl;
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
+using fitcal::bench::EnvOr;
+using fitcal::bench::ScratchDir;
 
 // Rows as the simulator writes them (io::EncoderCsv): 100 Hz, rates with 9 significant digits.
 void WriteEncoderCsv(const fs::path& path, std::size_t target_bytes, std::size_t max_rows) {
@@ -62,11 +42,20 @@ void WriteEncoderCsv(const fs::path& path, std::size_t target_bytes, std::size_t
   std::fclose(f);
 }
 
+// The large encoder log, written at the first call.
+const fs::path& BigEncoderCsv() {
+  static const ScratchDir dir;
+  static const fs::path path = [] {
+    const fs::path p = dir.path() / "big_encoders.csv";
+    WriteEncoderCsv(p, fitcal::bench::EnvBytes("FITCAL_BENCH_ENCODER_MB", 200),
+                    static_cast<std::size_t>(-1));
+    return p;
+  }();
+  return path;
+}
+
 void BM_ReadEncoderCsv(benchmark::State& state) {
-  static TempDir dir;
-  const fs::path path = dir.path() / "big_encoders.csv";
-  const std::size_t target = static_cast<std::size_t>(EnvOr("FITCAL_BENCH_ENCODER_MB", 200)) << 20;
-  if (!fs::exists(path)) WriteEncoderCsv(path, target, static_cast<std::size_t>(-1));
+  const fs::path& path = BigEncoderCsv();
   const std::size_t file_bytes = fs::file_size(path);
   double bytes_per_sample = 0.0;
   std::size_t samples = 0;
@@ -89,10 +78,7 @@ BENCHMARK(BM_ReadEncoderCsv)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // The share of BM_ReadEncoderCsv that is reading the file into memory (no parsing).
 void BM_ReadTextFileOnly(benchmark::State& state) {
-  static TempDir dir;
-  const fs::path path = dir.path() / "big_encoders.csv";
-  const std::size_t target = static_cast<std::size_t>(EnvOr("FITCAL_BENCH_ENCODER_MB", 200)) << 20;
-  if (!fs::exists(path)) WriteEncoderCsv(path, target, static_cast<std::size_t>(-1));
+  const fs::path& path = BigEncoderCsv();
   for (auto _ : state) {
     const std::string text = fitcal::io::ReadTextFile(path.string());
     benchmark::DoNotOptimize(text.data());
@@ -101,21 +87,34 @@ void BM_ReadTextFileOnly(benchmark::State& state) {
 }
 BENCHMARK(BM_ReadTextFileOnly)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// Run i of a data set, its files in runs/.
+fitcal::io::DatasetEntry Entry(long i, const std::string& trajectory, int repetition) {
+  fitcal::io::DatasetEntry e;
+  e.id = "run" + std::to_string(i);
+  e.trajectory = trajectory;
+  e.repetition = repetition;
+  e.encoders = "runs/" + e.id + "_enc.csv";
+  e.ground_truth = "runs/" + e.id + "_gt.csv";
+  return e;
+}
+
+// dataset.yaml of `entries` in `dir` and its robot (Palacin's apr02).
+void WriteIndex(const fs::path& dir, const std::vector<fitcal::io::DatasetEntry>& entries) {
+  fs::copy_file(fs::path(FITCAL_SOURCE_DIR) / "data" / "robots" / "apr02.yaml", dir / "robot.yaml");
+  std::FILE* f = std::fopen((dir / "dataset.yaml").c_str(), "wb");
+  std::fputs(fitcal::io::DatasetYaml("robot.yaml", entries).c_str(), f);
+  std::fclose(f);
+}
+
 void BM_LoadDataset(benchmark::State& state) {
-  static TempDir dir;
+  static ScratchDir dir;
   const long runs = EnvOr("FITCAL_BENCH_RUNS", 10000);
   if (!fs::exists(dir.path() / "dataset.yaml")) {
-    fs::copy_file(fs::path(FITCAL_SOURCE_DIR) / "data" / "robots" / "apr02.yaml",
-                  dir.path() / "robot.yaml");
     fs::create_directories(dir.path() / "runs");
     std::vector<fitcal::io::DatasetEntry> entries;
     for (long i = 0; i < runs; ++i) {
-      fitcal::io::DatasetEntry e;
-      e.id = "run" + std::to_string(i);
-      e.trajectory = "T" + std::to_string(i % 36);
-      e.repetition = static_cast<int>(i / 36) + 1;
-      e.encoders = "runs/" + e.id + "_enc.csv";
-      e.ground_truth = "runs/" + e.id + "_gt.csv";
+      const fitcal::io::DatasetEntry e =
+          Entry(i, "T" + std::to_string(i % 36), static_cast<int>(i / 36) + 1);
       WriteEncoderCsv(dir.path() / e.encoders, static_cast<std::size_t>(-1), 100);
       std::FILE* f = std::fopen((dir.path() / e.ground_truth).c_str(), "wb");
       std::fputs("t,x,y,theta\n", f);
@@ -123,9 +122,7 @@ void BM_LoadDataset(benchmark::State& state) {
       std::fclose(f);
       entries.push_back(e);
     }
-    std::FILE* f = std::fopen((dir.path() / "dataset.yaml").c_str(), "wb");
-    std::fputs(fitcal::io::DatasetYaml("robot.yaml", entries).c_str(), f);
-    std::fclose(f);
+    WriteIndex(dir.path(), entries);
   }
   for (auto _ : state) {
     const fitcal::io::Dataset dataset = fitcal::io::LoadDataset(dir.path().string());
@@ -137,23 +134,12 @@ BENCHMARK(BM_LoadDataset)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_ReadDatasetIndex(benchmark::State& state) {
   // Only dataset.yaml of the data set above (yaml-cpp parse + path checks).
-  static TempDir dir;
+  static ScratchDir dir;
   const long runs = EnvOr("FITCAL_BENCH_RUNS", 10000);
   if (!fs::exists(dir.path() / "dataset.yaml")) {
-    fs::copy_file(fs::path(FITCAL_SOURCE_DIR) / "data" / "robots" / "apr02.yaml",
-                  dir.path() / "robot.yaml");
-    std::vector<fitcal::io::DatasetEntry> entries(static_cast<std::size_t>(runs));
-    for (long i = 0; i < runs; ++i) {
-      auto& e = entries[static_cast<std::size_t>(i)];
-      e.id = "run" + std::to_string(i);
-      e.trajectory = "T";
-      e.repetition = 1;
-      e.encoders = "runs/" + e.id + "_enc.csv";
-      e.ground_truth = "runs/" + e.id + "_gt.csv";
-    }
-    std::FILE* f = std::fopen((dir.path() / "dataset.yaml").c_str(), "wb");
-    std::fputs(fitcal::io::DatasetYaml("robot.yaml", entries).c_str(), f);
-    std::fclose(f);
+    std::vector<fitcal::io::DatasetEntry> entries;
+    for (long i = 0; i < runs; ++i) entries.push_back(Entry(i, "T", 1));
+    WriteIndex(dir.path(), entries);
   }
   for (auto _ : state) {
     const fitcal::io::DatasetIndex index = fitcal::io::ReadDatasetIndex(dir.path().string());

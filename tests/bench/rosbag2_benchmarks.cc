@@ -14,9 +14,7 @@
 //   --benchmark_report_aggregates_only=true
 
 #include <benchmark/benchmark.h>
-#include <unistd.h>
 
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -25,6 +23,7 @@
 #include "io/rosbag2/bag_reader.h"
 #include "io/rosbag2/bag_writer.h"
 #include "io/rosbag2/ros_messages.h"
+#include "tests/bench/bench_support.h"
 #include "tools/import_rosbag2.h"
 
 namespace {
@@ -32,27 +31,8 @@ namespace {
 namespace fs = std::filesystem;
 namespace rb = fitcal::io::rosbag2;
 
-long EnvOr(const char* name, long fallback) {
-  const char* v = std::getenv(name);
-  return v != nullptr ? std::atol(v) : fallback;
-}
-
-class TempDir {
- public:
-  TempDir() {
-    std::string tmpl = (fs::temp_directory_path() / "fitcal-rosbag2-bench-XXXXXX").string();
-    if (mkdtemp(tmpl.data()) == nullptr) std::abort();
-    path_ = tmpl;
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
+using fitcal::bench::EnvBytes;
+using fitcal::bench::ScratchDir;
 
 rb::JointState Sample(long i) {
   rb::JointState js;
@@ -74,21 +54,30 @@ struct Bag {
   std::uint64_t file_bytes = 0;
 };
 
-Bag MakeBag(const std::string& name, rb::StorageFormat storage, rb::Compression compression) {
-  static TempDir tmp;
-  const std::uint64_t target_bytes = static_cast<std::uint64_t>(EnvOr("FITCAL_BENCH_BAG_MB", 50))
-                                     << 20;
-  rb::BagWriterOptions options;
-  options.storage = storage;
-  options.mcap.compression = compression;
+// About FITCAL_BENCH_BAG_MB (default 50) MB of JointState messages at 100 Hz in a bag `name` of
+// the scratch directory; with `ground_truth`, a PoseStamped on /mocap/pose at a tenth of the rate.
+Bag WriteBag(const std::string& name, const rb::BagWriterOptions& options, bool ground_truth) {
+  static const ScratchDir tmp("fitcal-rosbag2-bench");
+  const std::uint64_t target_bytes = EnvBytes("FITCAL_BENCH_BAG_MB", 50);
   Bag bag{tmp.path() / name, 0};
   rb::BagWriter writer(bag.dir.string(), options);
   writer.AddTopic("/joint_states", "sensor_msgs/msg/JointState");
+  if (ground_truth) writer.AddTopic("/mocap/pose", "geometry_msgs/msg/PoseStamped");
   std::uint64_t written = 0;
   for (long i = 0; written < target_bytes; ++i) {
-    const std::vector<std::uint8_t> payload = rb::EncodeJointState(Sample(i));
-    writer.Write("/joint_states", 1700000000000000000 + i * 10000000, rb::ByteView(payload));
+    const rb::JointState js = Sample(i);
+    const std::vector<std::uint8_t> payload = rb::EncodeJointState(js);
+    const std::int64_t t_ns = 1700000000000000000 + i * 10000000;
+    writer.Write("/joint_states", t_ns, rb::ByteView(payload));
     written += payload.size() + 31;  // + MCAP Message record prefix and fields
+    if (ground_truth && i % 10 == 0) {
+      rb::PoseStamped p;
+      p.header = js.header;
+      p.pose.position.x = 0.001 * static_cast<double>(i);
+      const std::vector<std::uint8_t> pose = rb::EncodePoseStamped(p);
+      writer.Write("/mocap/pose", t_ns + 1000, rb::ByteView(pose));
+      written += pose.size() + 31;
+    }
   }
   writer.Close();
   for (const std::string& file : writer.files()) bag.file_bytes += fs::file_size(file);
@@ -104,7 +93,10 @@ const Bag& GetBag(const std::string& name) {
   const rb::Compression compression = name == "mcap_zstd"  ? rb::Compression::kZstd
                                       : name == "mcap_lz4" ? rb::Compression::kLz4
                                                            : rb::Compression::kNone;
-  return bags.emplace(name, MakeBag(name, storage, compression)).first->second;
+  rb::BagWriterOptions options;
+  options.storage = storage;
+  options.mcap.compression = compression;
+  return bags.emplace(name, WriteBag(name, options, false)).first->second;
 }
 
 void Report(benchmark::State& state, const Bag& bag, std::uint64_t payload_bytes) {
@@ -160,32 +152,8 @@ BENCHMARK_CAPTURE(ReadAndDecode, mcap, std::string("mcap"))->Unit(benchmark::kMi
 // written (CSV text, files renamed into place).
 const Bag& ImportBag() {
   static const Bag bag = [] {
-    static TempDir tmp;
-    const std::uint64_t target_bytes = static_cast<std::uint64_t>(EnvOr("FITCAL_BENCH_BAG_MB", 50))
-                                       << 20;
-    Bag b{tmp.path() / "import", 0};
-    rb::BagWriter writer(b.dir.string(), {});
-    writer.AddTopic("/joint_states", "sensor_msgs/msg/JointState");
-    writer.AddTopic("/mocap/pose", "geometry_msgs/msg/PoseStamped");
-    std::uint64_t written = 0;
-    for (long i = 0; written < target_bytes; ++i) {
-      const rb::JointState js = Sample(i);
-      const std::vector<std::uint8_t> payload = rb::EncodeJointState(js);
-      const std::int64_t t_ns = 1700000000000000000 + i * 10000000;
-      writer.Write("/joint_states", t_ns, rb::ByteView(payload));
-      written += payload.size() + 31;
-      if (i % 10 == 0) {
-        rb::PoseStamped p;
-        p.header = js.header;
-        p.pose.position.x = 0.001 * static_cast<double>(i);
-        const std::vector<std::uint8_t> pose = rb::EncodePoseStamped(p);
-        writer.Write("/mocap/pose", t_ns + 1000, rb::ByteView(pose));
-        written += pose.size() + 31;
-      }
-    }
-    writer.Close();
-    for (const std::string& file : writer.files()) b.file_bytes += fs::file_size(file);
-    std::ofstream(tmp.path() / "robot.yaml")
+    Bag b = WriteBag("import", {}, true);
+    std::ofstream(b.dir.parent_path() / "robot.yaml")
         << "model: diff_drive\nname: bench\nwheels:\n  - {name: wheel_0, side: right, radius_m: "
            "0.05}\n  - {name: wheel_1, side: left, radius_m: 0.05}\nwheel_separation_m: 0.3\n"
            "bounds: {radius_m: [0.04, 0.06], wheel_separation_m: [0.2, 0.4]}\n";
