@@ -27,11 +27,13 @@ namespace fs = std::filesystem;
 using fitcal::bench::EnvOr;
 using fitcal::bench::ScratchDir;
 
-// Rows as the simulator writes them (io::EncoderCsv): 100 Hz, rates with 9 significant digits.
-void WriteEncoderCsv(const fs::path& path, std::size_t target_bytes, std::size_t max_rows) {
+// Rows as the simulator writes them (io::EncoderCsv): 100 Hz, rates with 9 significant digits,
+// random from `seed` (the loader refuses two runs with the same log as a duplicated run).
+void WriteEncoderCsv(const fs::path& path, std::size_t target_bytes, std::size_t max_rows,
+                     std::uint64_t seed = 1) {
   std::FILE* f = std::fopen(path.c_str(), "wb");
   std::fputs("t,w_a,w_b,w_c\n", f);
-  std::mt19937_64 rng(1);
+  std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> rate(-12.0, 12.0);
   std::size_t bytes = 14;
   for (std::size_t k = 0; bytes < target_bytes && k < max_rows; ++k) {
@@ -115,10 +117,13 @@ void BM_LoadDataset(benchmark::State& state) {
     for (long i = 0; i < runs; ++i) {
       const fitcal::io::DatasetEntry e =
           Entry(i, "T" + std::to_string(i % 36), static_cast<int>(i / 36) + 1);
-      WriteEncoderCsv(dir.path() / e.encoders, static_cast<std::size_t>(-1), 100);
+      WriteEncoderCsv(dir.path() / e.encoders, static_cast<std::size_t>(-1), 100,
+                      static_cast<std::uint64_t>(i) + 1);
       std::FILE* f = std::fopen((dir.path() / e.ground_truth).c_str(), "wb");
       std::fputs("t,x,y,theta\n", f);
-      for (int k = 0; k < 5; ++k) std::fprintf(f, "%.3f,%.4f,0,0\n", 0.25 * k, 0.01 * k);
+      for (int k = 0; k < 5; ++k) {
+        std::fprintf(f, "%.3f,%.4f,%.4f,0\n", 0.25 * k, 0.01 * k, 1e-4 * static_cast<double>(i));
+      }
       std::fclose(f);
       entries.push_back(e);
     }
