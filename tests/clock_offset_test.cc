@@ -21,6 +21,7 @@
 #include "fit/track_residual.h"
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
+#include "tests/model_support.h"
 #include "tests/test_files.h"
 #include "tools/fit_command.h"
 #include "tools/sim/model_simulator.h"
@@ -32,10 +33,6 @@ constexpr double kCommonScale = 1.02;   // every true length / nominal
 constexpr double kClockOffsetS = 0.15;  // ground truth stamped this late
 constexpr double kGtPositionSigmaM = 0.001;
 constexpr double kGtHeadingSigmaRad = 0.002;
-
-RobotModelPtr ModelNamed(const std::string& name) {
-  return ReadRobotModel(YAML::Load(FindModel(name)->example_yaml), "robot.yaml");
-}
 
 // Every free length times kCommonScale; angles and held parameters as nominal.
 std::vector<double> ScaledTruth(const Robot& robot) {
@@ -125,7 +122,7 @@ class EveryModel : public ::testing::TestWithParam<const char*> {};
 // so every closed loop ends where it started whatever s. The final-pose fit must hold that
 // direction at the nominal and say so in words.
 TEST_P(EveryModel, FinalPosesOfClosedLoopsNameTheCommonScaleUndetermined) {
-  const RobotModelPtr model = ModelNamed(GetParam());
+  const RobotModelPtr model = testing::ExampleModel(GetParam());
   const Robot& robot = model->robot();
   const std::vector<RunLog> logs = SimulateLate(*model, ClosedLoops(robot, 2), Noise(3));
   const ModelFitResult fit =
@@ -154,7 +151,7 @@ TEST_P(EveryModel, FinalPosesOfClosedLoopsNameTheCommonScaleUndetermined) {
 // while the truth moves within the interval, a timing convention the offset absorbs (noise-free,
 // the tricycle's and omni's offsets land 14-21 ms from 0.15 s; the differential drive's on it).
 TEST_P(EveryModel, TrackRecoversTheCommonScaleAndTheClockOffset) {
-  const RobotModelPtr model = ModelNamed(GetParam());
+  const RobotModelPtr model = testing::ExampleModel(GetParam());
   const Robot& robot = model->robot();
   const std::vector<double> truth = ScaledTruth(robot);
   const std::vector<RunLog> logs = SimulateLate(*model, ClosedLoops(robot, 1), Noise(4));
@@ -191,7 +188,7 @@ TEST_P(EveryModel, TrackRecoversTheCommonScaleAndTheClockOffset) {
 // track, nothing held out) judges it on held-out time blocks and writes a calibration whose
 // lengths are closer to the truth than the nominal's 2 %.
 TEST_P(EveryModel, FreeRunAloneCalibratesJudgedByTimeBlocks) {
-  const RobotModelPtr model = ModelNamed(GetParam());
+  const RobotModelPtr model = testing::ExampleModel(GetParam());
   const Robot& robot = model->robot();
   std::vector<sim::TwistSegment> free;
   for (int i = 0; i < 24; ++i) {

@@ -11,6 +11,7 @@
 #include "fit/model_fit.h"
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
+#include "tests/model_support.h"
 #include "tools/sim/model_scenarios.h"
 
 namespace fitcal {
@@ -31,17 +32,13 @@ std::vector<AlignedRun> SimulatedDiffDrive(const RobotModelInterface& model, int
   return AlignRuns(logs);
 }
 
-RobotModelPtr DiffDrive() {
-  return ReadRobotModel(YAML::Load(FindModel("diff_drive")->example_yaml), "robot.yaml");
-}
-
 // Three repetitions give three folds; each holds out exactly one repetition's runs and trains on
 // the others; every fold's fit lands on the true robot within the noise: its error is measured
 // against the sigma of a fit on two repetitions (the covariance of a fit on all three, scaled by
 // sqrt(3/2)), and 4 of those sigmas is allowed (a swapped wheel or a wrong sign moves a radius by
 // percent, hundreds of sigmas).
 TEST(CrossValidation, EveryModelRefitsEachFoldOnTheOtherRepetitions) {
-  const RobotModelPtr model = DiffDrive();
+  const RobotModelPtr model = testing::ExampleModel("diff_drive");
   std::vector<double> truth;
   const std::vector<AlignedRun> runs = SimulatedDiffDrive(*model, 3, &truth);
   const ModelFitResult all = FitModel(runs, *model);
@@ -67,7 +64,7 @@ TEST(CrossValidation, EveryModelRefitsEachFoldOnTheOtherRepetitions) {
 }
 
 TEST(CrossValidation, RefusesASingleRepetition) {
-  const RobotModelPtr model = DiffDrive();
+  const RobotModelPtr model = testing::ExampleModel("diff_drive");
   std::vector<double> truth;
   const std::vector<AlignedRun> runs = SimulatedDiffDrive(*model, 1, &truth);
   EXPECT_THROW(LeaveOneRepetitionOut(runs, *model), std::invalid_argument);

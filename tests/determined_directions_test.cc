@@ -15,15 +15,12 @@
 #include "fit/model_fit.h"
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
+#include "tests/model_support.h"
 #include "tools/sim/model_simulator.h"
 #include "tools/sim/omni_trajectories.h"
 
 namespace fitcal {
 namespace {
-
-RobotModelPtr ExampleMecanum() {
-  return ReadRobotModel(YAML::Load(FindModel("omni")->example_yaml), "example.yaml");
-}
 
 // The example mecanum robot with every free parameter moved by a realistic amount (about 3% of
 // a length, 0.7 deg of a wheel angle), simulated with encoder and ground-truth noise.
@@ -65,7 +62,7 @@ std::vector<sim::TrajectorySpec> StraightRunsOnly() {
 }
 
 TEST(DeterminedDirections, StraightRunsLeaveTheYawGeometryUndeterminedAndItIsHeld) {
-  const RobotModelPtr model = ExampleMecanum();
+  const RobotModelPtr model = testing::ExampleModel("omni");
   const Robot& robot = model->robot();
   std::vector<double> truth;
   const std::vector<AlignedRun> training = Simulate(*model, StraightRunsOnly(), 7, &truth);
@@ -115,7 +112,7 @@ TEST(DeterminedDirections, StraightRunsLeaveTheYawGeometryUndeterminedAndItIsHel
 TEST(DeterminedDirections, TheWholeFlowerDeterminesEveryDirection) {
   // The generalised flower with spins determines all nine free parameters: nothing is held, and
   // the fit is the plain one (the holds never touch a well-posed problem).
-  const RobotModelPtr model = ExampleMecanum();
+  const RobotModelPtr model = testing::ExampleModel("omni");
   sim::OmniTrajectoryOptions shapes;
   shapes.spin_angle_rad = 2.0 * M_PI;
   std::vector<double> truth;

@@ -26,7 +26,7 @@
 #include "models/model_registry.h"
 #include "models/pose_errors.h"
 #include "odometry/aligned_run.h"
-#include "tests/jacobian_check.h"
+#include "tests/model_support.h"
 #include "tests/test_files.h"
 #include "tools/import_optiodom_models.h"
 #include "tools/sim/diff_drive_trajectories.h"

@@ -20,6 +20,7 @@
 
 #include "fit/segment_cost.h"
 #include "models/model_registry.h"
+#include "tests/model_support.h"
 #include "tests/models/unicycle_test_model.h"
 #include "tools/sim/model_simulator.h"
 
@@ -79,7 +80,7 @@ const CandidateScore& Find(const SplitScores& s, const std::string& name) {
 class GeneralisationTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    model_ = ReadRobotModel(YAML::Load(FindModel("test_unicycle")->example_yaml), "example");
+    model_ = testing::ExampleModel("test_unicycle");
     std::vector<sim::TrajectorySpec> specs;
     for (const Shape& s : kShapes) specs.push_back(Spec(s));
     for (const sim::ModelSimulatedRun& run :
@@ -150,8 +151,7 @@ TEST_F(GeneralisationTest, LeaveOneSessionOutHoldsOutEverySessionOnce) {
 // D' = r D / r_t from the start. Trained on such runs, the final-pose fit learns nothing about r
 // (and holds it), the OptiOdom candidate recovers the true radius - which the lines then confirm.
 TEST(GeneralisationOptiOdom, CheckpointsSeeWhatAClosedPathHidesFromItsFinalPose) {
-  const RobotModelPtr model =
-      ReadRobotModel(YAML::Load(FindModel("test_unicycle")->example_yaml), "example");
+  const RobotModelPtr model = testing::ExampleModel("test_unicycle");
   std::vector<sim::TrajectorySpec> specs;
   for (const char* label : {"outback_a", "outback_b"}) {
     sim::TrajectorySpec spec;
@@ -200,8 +200,7 @@ TEST(GeneralisationOptiOdom, CheckpointsSeeWhatAClosedPathHidesFromItsFinalPose)
 // Checkpoints begin at the start, end after every `spacing` of ground-truth path since the last
 // one, and at the run's end.
 TEST(GeneralisationOptiOdom, CheckpointsFollowTheGroundTruthPath) {
-  const RobotModelPtr model =
-      ReadRobotModel(YAML::Load(FindModel("test_unicycle")->example_yaml), "example");
+  const RobotModelPtr model = testing::ExampleModel("test_unicycle");
   sim::SimulationOptions sim_options;
   sim_options.ground_truth_period_s = sim_options.encoder_period_s;
   const sim::ModelSimulatedRun run =

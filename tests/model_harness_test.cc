@@ -21,7 +21,7 @@
 #include "models/model_registry.h"
 #include "models/pose_errors.h"
 #include "odometry/aligned_run.h"
-#include "tests/jacobian_check.h"
+#include "tests/model_support.h"
 #include "tests/models/unicycle_test_model.h"
 
 namespace fitcal {
@@ -36,10 +36,6 @@ const std::vector<Twist>& Motions() {
                                              {-0.2, 0.0, 0.3}, {0.0, 0.0, 0.9},   {0.2, 0.2, 0.4},
                                              {0.0, 0.3, 0.0},  {0.15, -0.1, -0.6}};
   return motions;
-}
-
-RobotModelPtr ExampleModel(const ModelRegistration& m) {
-  return ReadRobotModel(YAML::Load(m.example_yaml), m.name + " example");
 }
 
 // The nominal moved `fraction` of the way to each upper bound (held parameters stay).
@@ -76,7 +72,7 @@ TEST(ModelHarness, EveryModelHasAnExampleThatParses) {
   for (const ModelRegistration& m : RegisteredModels()) {
     SCOPED_TRACE(m.name);
     ASSERT_FALSE(m.example_yaml.empty());
-    const RobotModelPtr model = ExampleModel(m);
+    const RobotModelPtr model = testing::ExampleModel(m.name);
     const Robot& robot = model->robot();
     EXPECT_EQ(robot.model, m.name);
     EXPECT_EQ(static_cast<int>(robot.nominal.size()), robot.NumParameters());
@@ -88,7 +84,7 @@ TEST(ModelHarness, EveryModelHasAnExampleThatParses) {
 TEST(ModelHarness, AutodiffMatchesCentralDifferences) {
   for (const ModelRegistration& m : RegisteredModels()) {
     SCOPED_TRACE(m.name);
-    const RobotModelPtr model = ExampleModel(m);
+    const RobotModelPtr model = testing::ExampleModel(m.name);
     const Robot& robot = model->robot();
     const std::vector<double> p = Shifted(robot, 0.3);
     for (const AlignedRun& run : SyntheticRuns(*model, Shifted(robot, 0.6))) {
@@ -110,7 +106,7 @@ TEST(ModelHarness, ConstantTwistReplaysTheAnalyticArc) {
   constexpr int kSteps = 2000;
   for (const ModelRegistration& m : RegisteredModels()) {
     SCOPED_TRACE(m.name);
-    const RobotModelPtr model = ExampleModel(m);
+    const RobotModelPtr model = testing::ExampleModel(m.name);
     const Robot& robot = model->robot();
     std::vector<double> values(robot.NumChannels());
     for (const Twist& twist : Motions()) {
@@ -133,7 +129,7 @@ TEST(ModelHarness, ConstantTwistReplaysTheAnalyticArc) {
 TEST(ModelHarness, ParametersRoundTripThroughTheRobotYaml) {
   for (const ModelRegistration& m : RegisteredModels()) {
     SCOPED_TRACE(m.name);
-    const RobotModelPtr model = ExampleModel(m);
+    const RobotModelPtr model = testing::ExampleModel(m.name);
     const std::vector<double> p = Shifted(model->robot(), 0.4);
     const std::string text = model->RobotYaml(p, "");
     const RobotModelPtr back = ReadRobotModel(YAML::Load(text), "round trip");
@@ -156,7 +152,7 @@ TEST(ModelHarness, EffectsRoundTripThroughTheRobotYaml) {
   latency.sigma[0] = 0.0011;
   for (const ModelRegistration& m : RegisteredModels()) {
     SCOPED_TRACE(m.name);
-    const RobotModelPtr model = ExampleModel(m);
+    const RobotModelPtr model = testing::ExampleModel(m.name);
     ASSERT_TRUE(model->robot().effects.empty());
     const RobotModelPtr back =
         ReadRobotModel(YAML::Load(model->RobotYaml(model->robot().nominal, {latency}, "")), "rt");
@@ -172,7 +168,7 @@ TEST(ModelHarness, EffectsRoundTripThroughTheRobotYaml) {
 TEST(ModelHarness, EveryMiswiringChangesTheFinalPoses) {
   for (const ModelRegistration& m : RegisteredModels()) {
     SCOPED_TRACE(m.name);
-    const RobotModelPtr model = ExampleModel(m);
+    const RobotModelPtr model = testing::ExampleModel(m.name);
     const Robot& robot = model->robot();
     const std::vector<AlignedRun> runs = SyntheticRuns(*model, robot.nominal);
     const std::vector<ChannelMapping> mappings = model->CandidateMiswirings();
@@ -196,7 +192,7 @@ TEST(ModelHarness, EveryMiswiringChangesTheFinalPoses) {
 TEST(ModelHarness, BoundedFitRecoversTheTruthFromNoiseFreeRuns) {
   for (const ModelRegistration& m : RegisteredModels()) {
     SCOPED_TRACE(m.name);
-    const RobotModelPtr model = ExampleModel(m);
+    const RobotModelPtr model = testing::ExampleModel(m.name);
     const Robot& robot = model->robot();
     const std::vector<double> truth = Shifted(robot, 0.5);
     const ModelFitResult fit = FitModel(SyntheticRuns(*model, truth), *model);

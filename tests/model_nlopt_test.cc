@@ -17,19 +17,17 @@
 #include "fit/model_nlopt_fit.h"
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
+#include "tests/model_support.h"
 #include "tests/test_files.h"
 #include "tools/sim/model_scenarios.h"
 
 namespace fitcal {
 namespace {
 
+using fitcal::testing::ExampleModel;
 using fitcal::testing::ReadFileBytes;
 using fitcal::testing::RunFitcal;
 using fitcal::testing::TempDir;
-
-RobotModelPtr ExampleModel(const std::string& name) {
-  return ReadRobotModel(YAML::Load(FindModel(name)->example_yaml), name);
-}
 
 // One repetition of the model's calibration trajectories, driven by its default true robot, with
 // the default noise (model_scenarios.h).

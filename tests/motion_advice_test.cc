@@ -13,13 +13,10 @@
 #include <cmath>
 
 #include "models/model_registry.h"
+#include "tests/model_support.h"
 
 namespace fitcal {
 namespace {
-
-RobotModelPtr ExampleDiffDrive() {
-  return ReadRobotModel(YAML::Load(FindModel("diff_drive")->example_yaml), "example.yaml");
-}
 
 // A noise-free run of `motion` at the nominal, its end moved by a deterministic error of 2 mm and
 // 0.2 deg (the order of a motion-capture pose): the residuals' noise the analysis reads.
@@ -49,7 +46,7 @@ const UndeterminedDirection* CommonScale(const DirectionAnalysis& analysis) {
 }
 
 TEST(MotionAdvice, ClosedCirclesOfADiffDriveAreAdvisedAStraightRun) {
-  const RobotModelPtr model = ExampleDiffDrive();
+  const RobotModelPtr model = testing::ExampleModel("diff_drive");
   const std::vector<double>& p = model->robot().nominal;
   std::vector<AlignedRun> circles;
   for (int i = 0; i < 6; ++i) circles.push_back(NoisyRun(*model, Circle(i % 2 ? -1.0 : 1.0), i));
@@ -86,7 +83,7 @@ TEST(MotionAdvice, ClosedCirclesOfADiffDriveAreAdvisedAStraightRun) {
 }
 
 TEST(MotionAdvice, MotionsAModelCannotDriveAreSkipped) {
-  const RobotModelPtr model = ExampleDiffDrive();
+  const RobotModelPtr model = testing::ExampleModel("diff_drive");
   AlignedRun run;
   EXPECT_FALSE(RunOfMotion(*model, model->robot().nominal, StandardMotions()[1], &run));
   ASSERT_TRUE(RunOfMotion(*model, model->robot().nominal, StandardMotions()[0], &run));

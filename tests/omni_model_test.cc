@@ -25,7 +25,7 @@
 #include "models/omni3/omni3_kinematics.h"
 #include "models/pose_errors.h"
 #include "odometry/aligned_run.h"
-#include "tests/jacobian_check.h"
+#include "tests/model_support.h"
 #include "tests/test_files.h"
 #include "tools/import_optiodom_omni4.h"
 #include "tools/sim/model_simulator.h"

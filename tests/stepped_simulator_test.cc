@@ -14,6 +14,7 @@
 #include <stdexcept>
 
 #include "models/model_registry.h"
+#include "tests/model_support.h"
 #include "tools/sim/flower_scenario.h"
 #include "tools/sim/model_scenarios.h"
 #include "tools/sim/model_simulator.h"
@@ -21,9 +22,7 @@
 namespace fitcal {
 namespace {
 
-RobotModelPtr ExampleModel(const std::string& name) {
-  return ReadRobotModel(YAML::Load(FindModel(name)->example_yaml), name + " example");
-}
+using testing::ExampleModel;
 
 // Each model's calibration trajectories (one repetition) under the stepped physics with no noise
 // at all: no slip, no jitter, no ground-truth noise, 2^22-tick encoders.

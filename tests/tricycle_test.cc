@@ -23,7 +23,7 @@
 #include "models/tricycle/tricycle_checks.h"
 #include "models/tricycle/tricycle_model.h"
 #include "odometry/aligned_run.h"
-#include "tests/jacobian_check.h"
+#include "tests/model_support.h"
 #include "tests/test_files.h"
 #include "tools/import_optiodom_tricycle.h"
 #include "tools/miswired_error.h"

@@ -1,20 +1,29 @@
 #pragma once
-// The final-pose cost's autodiff Jacobian against central differences of the double replay: the
-// check the harness makes for every registered model (tests/model_harness_test.cc) and each
-// model's own tests make on their robots and runs.
+// What the model tests share: the registry's example robots, and the final-pose cost's autodiff
+// Jacobian against central differences of the double replay (the check the harness makes for
+// every registered model, tests/model_harness_test.cc, and each model's own tests on their
+// robots and runs).
 
 #include <ceres/cost_function.h>
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <cmath>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "models/model_interface.h"
+#include "models/model_registry.h"
 #include "models/pose_errors.h"
 #include "odometry/aligned_run.h"
 
 namespace fitcal::testing {
+
+// The registry's example robot of model `name` (models/model_registry.h).
+inline RobotModelPtr ExampleModel(const std::string& name) {
+  return ReadRobotModel(YAML::Load(FindModel(name)->example_yaml), name + " example");
+}
 
 // Expects d r / d p_k of model.FinalPoseCost(run) at p to equal (r(p + h e_k) - r(p - h e_k)) / 2h
 // within 1e-6 (1 + |numeric|), r the FinalPoseError of the replay (unit weights). h = 1e-6 of
