@@ -9,6 +9,7 @@
 #include "io/atomic_file.h"
 #include "io/staged_directory.h"
 #include "models/model_registry.h"
+#include "tools/dataset_command.h"
 #include "tools/output_guard.h"
 #include "tools/sim/model_scenarios.h"
 #include "tools/sim/model_simulator.h"
@@ -69,7 +70,7 @@ int RunModelSimulateCommand(const ModelSimulateOptions& options) {
     std::cerr << "fitcal simulate: " << refusal << "\n";
     return 2;
   }
-  try {
+  return RunReportingErrors("fitcal simulate", [&]() -> int {
     const RobotModelPtr model = NominalModel(options);
     const Robot& robot = model->robot();
     if (robot.model != options.model) {
@@ -94,10 +95,7 @@ int RunModelSimulateCommand(const ModelSimulateOptions& options) {
                 static_cast<unsigned long long>(noise.seed), options.out.c_str());
     PrintTruth(robot, truth);
     return 0;
-  } catch (const std::exception& e) {  // io::InputError too: what() is its file:line message
-    std::cerr << "fitcal simulate: " << e.what() << "\n";
-    return 1;
-  }
+  });
 }
 
 }  // namespace fitcal::tools
