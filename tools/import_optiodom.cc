@@ -2,7 +2,6 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
-#include <iostream>
 #include <stdexcept>
 
 #include "io/input_error.h"
@@ -10,8 +9,9 @@
 #include "models/tricycle/tricycle_checks.h"
 #include "odometry/aligned_run.h"
 #include "odometry/parallel_for.h"
+#include "tools/command_failure.h"
+#include "tools/dataset_command.h"
 #include "tools/import_channel_order.h"
-#include "tools/miswired_error.h"
 #include "tools/optiodom_robots.h"
 #include "tools/output_guard.h"
 
@@ -241,17 +241,15 @@ void AddImportOptiOdomOptions(CLI::App& app, ImportOptiOdomOptions& o) {
 }
 
 int RunImportOptiOdomCommand(const ImportOptiOdomOptions& options) {
-  try {
+  return RunReportingErrors("fitcal", [&]() -> int {
     if (options.sessions.empty()) {
-      std::cerr << "fitcal: import optiodom needs at least one session directory\n";
-      return 2;
+      throw UsageError("import optiodom needs at least one session directory");
     }
     const std::string type = optiodom::SessionType(options.sessions.front());
     for (const std::string& dir : options.sessions) {
-      if (optiodom::SessionType(dir) != type) {
-        std::cerr << "fitcal: " << dir << ": a " << optiodom::SessionType(dir) << " session among "
-                  << type << " sessions; import one robot at a time\n";
-        return 2;
+      if (const std::string other = optiodom::SessionType(dir); other != type) {
+        throw UsageError(dir + ": a " + other + " session among " + type +
+                         " sessions; import one robot at a time");
       }
     }
     // The recordings are inputs: no data set may replace, hold or sit inside one.
@@ -259,18 +257,11 @@ int RunImportOptiOdomCommand(const ImportOptiOdomOptions& options) {
     if (const std::string refusal =
             DirectoryOutputRefusal(options.out, kDatasetKind, options.force, options.sessions);
         !refusal.empty()) {
-      std::cerr << "fitcal: " << refusal << "\n";
-      return 2;
+      throw UsageError(refusal);
     }
     ImportOptiOdom(options);
     return 0;
-  } catch (const MiswiredError& e) {
-    std::cerr << "fitcal: " << e.what() << "\n";
-    return kMiswiredExitCode;
-  } catch (const std::exception& e) {
-    std::cerr << "fitcal: " << e.what() << "\n";
-    return 1;
-  }
+  });
 }
 
 }  // namespace fitcal::tools
