@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <regex>
 #include <set>
-#include <stdexcept>
+#include <string_view>
 
 #include "io/atomic_file.h"
 #include "io/input_error.h"
@@ -28,8 +28,7 @@ const std::set<std::string> kMetadataKeys = {"type",  "ngear",  "encRes", "Li", 
                                              "Thi",   "N",      "L",      "imarkers", "gt_ti",
                                              "gt_tf", "odo_ti", "odo_tf"};
 
-}  // namespace
-
+// The comma-separated fields of one line, each trimmed.
 std::vector<std::string> SplitCsv(std::string_view line) {
   std::vector<std::string> out;
   std::size_t pos = 0;
@@ -42,6 +41,7 @@ std::vector<std::string> SplitCsv(std::string_view line) {
   return out;
 }
 
+// A finite number, or InputError(path:line: `what` is not a finite number: '<field>').
 double ParseNumber(const std::string& field, const std::string& path, int line,
                    const std::string& what) {
   double v = 0.0;
@@ -52,6 +52,8 @@ double ParseNumber(const std::string& field, const std::string& path, int line,
   }
   return v;
 }
+
+}  // namespace
 
 std::vector<double> Metadata::Values(const std::string& key, std::size_t count,
                                      bool positive) const {

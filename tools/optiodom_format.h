@@ -12,7 +12,6 @@
 #include <functional>
 #include <map>
 #include <string>
-#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -21,13 +20,6 @@
 #include "odometry/run_log.h"
 
 namespace fitcal::tools::optiodom {
-
-// The comma-separated fields of one line, each trimmed.
-std::vector<std::string> SplitCsv(std::string_view line);
-
-// A finite number, or InputError(path:line: `what` is not a finite number: '<field>').
-double ParseNumber(const std::string& field, const std::string& path, int line,
-                   const std::string& what);
 
 // <s>_metadata.csv: the `type` row and every numeric row, key -> (line, values).
 struct Metadata {
