@@ -31,11 +31,9 @@ TEST(BoundedFit, RealOmni3InEq16sBoxConvergesOnTheBoundOnlyWithTheActiveSet) {
     for (const auto& entry : fs::directory_iterator(root / kind)) sessions.push_back(entry.path());
     std::sort(sessions.begin(), sessions.end());
     for (const fs::path& dir : sessions) {
-      const tools::OptiOdomSession session = tools::ReadOptiOdomSession(dir.string());
-      robot = tools::OptiOdomNominalRobot(session.metadata);
-      for (const auto& run : session.runs) {
-        runs.push_back(AlignRun(tools::OptiOdomRunLog(session, run)));
-      }
+      const tools::OptiOdomImport session = tools::ReadOptiOdomSessions({dir.string()});
+      robot = Omni3RobotOf(dynamic_cast<const Omni3Model&>(*session.model));
+      for (const RunLog& run : session.runs) runs.push_back(AlignRun(run));
     }
   }
   ASSERT_EQ(runs.size(), 67u);

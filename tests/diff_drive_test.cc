@@ -28,7 +28,7 @@
 #include "odometry/aligned_run.h"
 #include "tests/model_support.h"
 #include "tests/test_files.h"
-#include "tools/import_optiodom_models.h"
+#include "tools/import_optiodom.h"
 #include "tools/sim/diff_drive_trajectories.h"
 #include "tools/sim/model_simulator.h"
 #include "validation/generalisation.h"
@@ -493,12 +493,13 @@ TEST(OptiOdomDiffImport, ReproducesTheNominalFinalErrorsOfRealSessions) {
     GTEST_SKIP() << "no " << kDiff;
   }
   testing::TempDir dir;
-  tools::ImportOptiOdomDiffOptions options;
+  tools::ImportOptiOdomOptions options;
+  options.sessions = {kFlaggedSession.string(), kCircleSession.string()};
+  options.out = dir.Path("diff");
   options.quiet = true;
-  const auto summary = tools::ImportOptiOdomDiff(
-      {kFlaggedSession.string(), kCircleSession.string()}, dir.Path("diff"), options);
+  const auto summary = tools::ImportOptiOdom(options);
   // 6 + 6 runs, the flagged square run 02 left out and said so.
-  EXPECT_EQ(summary.num_runs, 11);
+  EXPECT_EQ(summary.runs.size(), 11u);
   ASSERT_EQ(summary.notes.size(), 1u);
   EXPECT_NE(summary.notes[0].find("square-231220200029-run02"), std::string::npos);
   const std::string index = testing::ReadFileBytes(dir.Path("diff/dataset.yaml"));
@@ -566,12 +567,14 @@ TEST(OptiOdomDiffImport, EverySessionNominalUmbmarkAndFit) {
     sessions.insert(sessions.end(), names.begin(), names.end());
   }
   testing::TempDir dir;
-  tools::ImportOptiOdomDiffOptions options;
+  tools::ImportOptiOdomOptions options;
+  options.sessions = sessions;
+  options.out = dir.Path("diff");
   options.quiet = true;
-  const auto summary = tools::ImportOptiOdomDiff(sessions, dir.Path("diff"), options);
+  const auto summary = tools::ImportOptiOdom(options);
   // README: 13 + 8 sessions, 54 + 44 runs, one flagged; four sessions declare perturbed values.
   EXPECT_EQ(summary.num_sessions, 21);
-  EXPECT_EQ(summary.num_runs, 97);
+  EXPECT_EQ(summary.runs.size(), 97u);
   EXPECT_EQ(summary.notes.size(), 5u);
   for (const std::string& n : summary.notes) std::printf("  note: %s\n", n.c_str());
   const RobotModelPtr model = ReadRobotModelFile(dir.Path("diff/robot.yaml"));
@@ -583,8 +586,8 @@ TEST(OptiOdomDiffImport, EverySessionNominalUmbmarkAndFit) {
   std::printf(
       "nominal CF all %.4f (mean position %.4f m, heading %.3f deg); circles %.4f, "
       "squares %.4f\n",
-      summary.nominal_cf, summary.nominal_mean_position_error_m,
-      summary.nominal_mean_heading_error_rad * 180.0 / M_PI,
+      summary.nominal.cf, summary.nominal.mean_position_error_m,
+      summary.nominal.mean_abs_heading_error_rad * 180.0 / M_PI,
       cf(nominal, Select(all, true, "circular")).cf, cf(nominal, Select(all, true, "square")).cf);
   // UMBmark from all squares, and from one square session at a time, scored on every circle.
   std::vector<AlignedRun> circles;

@@ -27,7 +27,7 @@
 #include "odometry/aligned_run.h"
 #include "tests/model_support.h"
 #include "tests/test_files.h"
-#include "tools/import_optiodom_omni4.h"
+#include "tools/import_optiodom.h"
 #include "tools/sim/model_simulator.h"
 #include "tools/sim/omni_trajectories.h"
 
@@ -439,14 +439,17 @@ TEST(OptiOdomOmni4, ImportedSessionReproducesTheAuthorsNominalOdometry) {
   if (!fs::is_directory(kSession)) GTEST_SKIP() << "no " << kSession;
   const fs::path out = fs::temp_directory_path() / ("fitcal_omni4_" + std::to_string(::getpid()));
   fs::remove_all(out);
-  const tools::Omni4ImportResult result = tools::ImportOptiOdomOmni4({kSession.string()}, out);
-  EXPECT_EQ(result.num_runs, 4);
+  tools::ImportOptiOdomOptions options;
+  options.sessions = {kSession.string()};
+  options.out = out.string();
+  const tools::OptiOdomImport result = tools::ImportOptiOdom(options);
+  EXPECT_EQ(result.runs.size(), 4u);
   // The channel-order check kept the documented layout (it throws otherwise) on the track's
   // windows.
   EXPECT_NE(result.channel_order.find("0.5 m windows"), std::string::npos) << result.channel_order;
 
-  const tools::OptiOdomOmni4Session session = tools::ReadOptiOdomOmni4Session(kSession.string());
-  const RobotModelPtr model = tools::OptiOdomOmni4NominalModel(session.metadata);
+  const tools::OptiOdomImport session = tools::ReadOptiOdomSessions({kSession.string()});
+  const RobotModelPtr model = session.model;
   // The written robot YAML (10 significant digits) is the same robot.
   const RobotModelPtr written = ReadRobotModelFile((out / "robot.yaml").string());
   ASSERT_EQ(written->robot().NumChannels(), 4);
@@ -469,7 +472,7 @@ TEST(OptiOdomOmni4, ImportedSessionReproducesTheAuthorsNominalOdometry) {
                          std::pow(WrapAngle(authors.theta - gt.theta), 2)) /
                4.0;
   }
-  EXPECT_NEAR(result.nominal_mean_cf, mean_cf, 1e-9);
+  EXPECT_NEAR(result.nominal.cf, mean_cf, 1e-9);
   // The written encoder CSV holds the same rates (shortest exact decimal form).
   std::ifstream csv(out / "runs" / (session.runs[0].id + "_encoders.csv"));
   std::string header, row;

@@ -41,19 +41,19 @@ void WriteText(const fs::path& path, const std::string& text) { std::ofstream(pa
 
 TEST(OptiOdomImport, ReadsMetadataAndMapsTheAuthorsWheelsToOurs) {
   SKIP_WITHOUT_DATA();
-  const tools::OptiOdomSession s = tools::ReadOptiOdomSession(kCircleSession.string());
-  EXPECT_EQ(s.path_type, "circular");
-  EXPECT_EQ(s.metadata.num_runs, 4);
+  const tools::OptiOdomImport s = tools::ReadOptiOdomSessions({kCircleSession.string()});
   ASSERT_EQ(s.runs.size(), 4u);
-  EXPECT_EQ(s.metadata.TicksPerWheelRev(), 12.0 * 1024.0);  // README: 12:1 gear, 1024 counts
-  const Omni3Robot robot = tools::OptiOdomNominalRobot(s.metadata);
+  EXPECT_EQ(s.runs[0].trajectory, "circular_221220201643");
+  ASSERT_TRUE(s.model->robot().encoder.has_value());
+  EXPECT_EQ(s.model->robot().encoder->ticks_per_rev, 12.0 * 1024.0);  // README: 12:1, 1024 counts
+  const Omni3Robot robot = Omni3RobotOf(dynamic_cast<const Omni3Model&>(*s.model));
   EXPECT_DOUBLE_EQ(robot.nominal.radius_m[0], 0.051);  // Di = 0.102 m
   EXPECT_DOUBLE_EQ(robot.nominal.distance_m[2], 0.195);
   EXPECT_NEAR(RadToDeg(robot.nominal.angle_rad[1]), 60.0, 1e-12);
   // Run 1, row 2 of the file holds ticks (-6, 24, 1): ours are their negatives, same order.
-  EXPECT_EQ(s.runs[0].encoder[1][0], 6.0);
-  EXPECT_EQ(s.runs[0].encoder[1][1], -24.0);
-  EXPECT_EQ(s.runs[0].encoder[1][2], -1.0);
+  EXPECT_EQ(s.rows[0].encoder[1][0], 6.0);
+  EXPECT_EQ(s.rows[0].encoder[1][1], -24.0);
+  EXPECT_EQ(s.rows[0].encoder[1][2], -1.0);
 }
 
 // The one channel-order check (diagnosis/channel_order_check.h, as the importer runs it) keeps
@@ -62,10 +62,9 @@ TEST(OptiOdomImport, ReadsMetadataAndMapsTheAuthorsWheelsToOurs) {
 TEST(OptiOdomImport, DocumentedWheelMappingIsTheOneTheGroundTruthSupports) {
   SKIP_WITHOUT_DATA();
   for (const fs::path& dir : {kCircleSession, kSquareSession}) {
-    const tools::OptiOdomSession s = tools::ReadOptiOdomSession(dir.string());
-    const auto model = Omni3ModelOf(tools::OptiOdomNominalRobot(s.metadata));
-    std::vector<RunLog> logs;
-    for (const auto& run : s.runs) logs.push_back(tools::OptiOdomRunLog(s, run));
+    const tools::OptiOdomImport s = tools::ReadOptiOdomSessions({dir.string()});
+    const auto& model = s.model;
+    const std::vector<RunLog>& logs = s.runs;
     std::vector<const GroundTruthTrack*> tracks;
     for (const RunLog& log : logs) tracks.push_back(&log.ground_truth);
     const std::vector<AlignedRun> runs = AlignRuns(logs);
@@ -98,12 +97,12 @@ TEST(OptiOdomImport, WritesATicksDataSetThatLoadsBackToTheSameRuns) {
   ASSERT_TRUE(robot.encoder.has_value());
   EXPECT_EQ(robot.encoder->ticks_per_rev, 12288.0);
   EXPECT_FALSE(robot.encoder->cumulative);
-  const tools::OptiOdomSession s = tools::ReadOptiOdomSession(kCircleSession.string());
+  const tools::OptiOdomImport s = tools::ReadOptiOdomSessions({kCircleSession.string()});
   ASSERT_EQ(ds.runs.size(), 4u);
   for (std::size_t i = 0; i < 4; ++i) {
-    const RunLog direct = tools::OptiOdomRunLog(s, s.runs[i]);
+    const RunLog& direct = s.runs[i];
     EXPECT_EQ(ds.runs[i].trajectory, "circular_221220201643");
-    EXPECT_EQ(ds.runs[i].repetition, s.runs[i].number);
+    EXPECT_EQ(ds.runs[i].repetition, s.rows[i].number);
     ASSERT_EQ(ds.runs[i].encoders.samples.size(), direct.encoders.samples.size());
     // Times are written with 1 us resolution: rates (ticks / dt) agree to ~1e-6 / 0.04 relative.
     for (std::size_t k = 0; k < direct.encoders.samples.size(); ++k) {
@@ -128,7 +127,7 @@ TEST(OptiOdomImport, BadSessionIsOneErrorAndWritesNothing) {
                 session / "221220201643_metadata.csv");
   fs::copy_file(kCircleSession / "221220201643_run-01.csv", session / "221220201643_run-01.csv");
   try {
-    tools::ReadOptiOdomSession(session.string());
+    tools::ReadOptiOdomSessions({session.string()});
     FAIL() << "expected an InputError";
   } catch (const io::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("N = 4"), std::string::npos) << e.what();

@@ -34,6 +34,7 @@
 #include "models/tricycle/tricycle_model.h"
 #include "odometry/aligned_run.h"
 #include "tests/test_files.h"
+#include "tools/command_failure.h"
 #include "tools/export_ros2_control.h"
 #include "tools/import_rosbag2.h"
 #include "tools/sim/diff_drive_trajectories.h"
@@ -643,9 +644,8 @@ TEST(ExportRos2Control, DiffDriveIsExact) {
   for (int k = 0; k < 3; ++k) {
     EXPECT_NEAR(x.Back(names[k]), kTruth[k], kRoundTrip * kTruth[k]) << names[k];
   }
-  EXPECT_THROW(tools::ExportRos2Control(cal, "tricycle_controller", "", {}), std::invalid_argument);
-  EXPECT_THROW(tools::ExportRos2Control(cal, "ackermann_controller", "", {}),
-               std::invalid_argument);
+  EXPECT_THROW(tools::ExportRos2Control(cal, "tricycle_controller", "", {}), tools::UsageError);
+  EXPECT_THROW(tools::ExportRos2Control(cal, "ackermann_controller", "", {}), tools::UsageError);
 }
 
 TEST(ExportRos2Control, MecanumTakesMeans) {
@@ -802,7 +802,7 @@ TEST(ExportRos2Control, EveryKeyDeclaredOnItsDistribution) {
       const KeyTypes declared = DeclaredKeys(distro, c.controller);
       if (declared.empty()) {  // the distribution does not ship it: refused in one line
         EXPECT_THROW(tools::ExportRos2Control(cal, c.controller, "", {}, distro),
-                     std::invalid_argument);
+                     tools::UsageError);
         continue;
       }
       const tools::Ros2ControlExport e = tools::ExportRos2Control(cal, c.controller, "", {}, distro);
@@ -830,9 +830,9 @@ TEST(ExportRos2Control, EveryKeyDeclaredOnItsDistribution) {
   EXPECT_EQ(DeclaredKeys("humble", "diff_drive_controller").count("wheels_per_side"), 1u);
   EXPECT_EQ(DeclaredKeys("jazzy", "diff_drive_controller").count("wheels_per_side"), 0u);
   EXPECT_EQ(DeclaredKeys("rolling", "diff_drive_controller").count("wheels_per_side"), 0u);
-  EXPECT_THROW(tools::ExportRos2Control(tmp.Path("cal.yaml"), "tricycle_controller", "", {},
-                                        "iron"),
-               std::invalid_argument);
+  EXPECT_THROW(
+      tools::ExportRos2Control(tmp.Path("cal.yaml"), "tricycle_controller", "", {}, "iron"),
+      tools::UsageError);
 }
 
 TEST(ExportRos2Control, TricycleOffsetStatedWithSignAndPlace) {

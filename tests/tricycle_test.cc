@@ -25,7 +25,7 @@
 #include "odometry/aligned_run.h"
 #include "tests/model_support.h"
 #include "tests/test_files.h"
-#include "tools/import_optiodom_tricycle.h"
+#include "tools/import_optiodom.h"
 #include "tools/miswired_error.h"
 #include "tools/sim/model_simulator.h"
 #include "tools/sim/tricycle_trajectories.h"
@@ -412,6 +412,17 @@ TEST(TricycleSimulation, WrongSteeringSignIsCaughtByTheMiswiringScores) {
 // ---------------------------------------------------------------------------------------------
 // OptiOdom import: synthetic sessions for bad input, a real session when ../shared has it
 
+// `fitcal import optiodom` of these sessions into `out`, printing nothing.
+tools::OptiOdomImport Import(const std::vector<std::string>& sessions, const std::string& out,
+                             bool skip_mapping_check = false) {
+  tools::ImportOptiOdomOptions options;
+  options.sessions = sessions;
+  options.out = out;
+  options.skip_mapping_check = skip_mapping_check;
+  options.quiet = true;
+  return tools::ImportOptiOdom(options);
+}
+
 // A session directory <root>/<type>/<name>/ with one run file of the given rows.
 std::string WriteSession(const TempDir& dir, const std::string& rows, int num_runs = 1) {
   const std::string name = "100000000000";
@@ -439,7 +450,7 @@ TEST(OptiOdomTricycleImport, BadSteeringGivesOneLineAndWritesNothing) {
     const std::string session = WriteSession(dir, rows);
     const std::string out = dir.Path("out");
     try {
-      tools::ImportOptiOdomTricycle({session}, out);
+      Import({session}, out);
       ADD_FAILURE() << what << ": imported";
     } catch (const io::InputError& e) {
       EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << what;
@@ -449,7 +460,7 @@ TEST(OptiOdomTricycleImport, BadSteeringGivesOneLineAndWritesNothing) {
   }
   TempDir dir;
   const std::string out = dir.Path("out");
-  const auto summary = tools::ImportOptiOdomTricycle({WriteSession(dir, good)}, out);
+  const auto summary = Import({WriteSession(dir, good)}, out);
   EXPECT_EQ(summary.runs.size(), 1u);
   EXPECT_EQ(testing::ReadFileBytes(fs::path(out) / "runs" / (summary.runs[0].id + "_encoders.csv")),
             "t,ticks_traction,steering\n0.000000,0,-0.1\n0.050000,10,-0.1\n0.100000,10,-0.1\n");
@@ -477,16 +488,14 @@ TEST(OptiOdomTricycleImport, SteeringOfTheWrongSignIsRefused) {
   }
   const std::string session = dir.Path("circular/" + name);
   try {
-    tools::ImportOptiOdomTricycle({session}, dir.Path("out"));
+    Import({session}, dir.Path("out"));
     ADD_FAILURE() << "imported";
   } catch (const tools::MiswiredError& e) {
     EXPECT_NE(std::string(e.what()).find("steering = -steering"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("nothing written"), std::string::npos) << e.what();
   }
   EXPECT_FALSE(fs::exists(dir.Path("out")));
-  tools::ImportOptiOdomTricycleOptions options;
-  options.skip_sign_check = true;
-  const auto summary = tools::ImportOptiOdomTricycle({session}, dir.Path("out"), options);
+  const auto summary = Import({session}, dir.Path("out"), true);
   EXPECT_NE(summary.channel_order.find("written anyway"), std::string::npos)
       << summary.channel_order;
   EXPECT_TRUE(fs::exists(dir.Path("out/dataset.yaml")));
@@ -519,7 +528,7 @@ TEST(OptiOdomTricycleImport, RealSessionReproducesItsNominalFinalErrors) {
   const fs::path session = kTricyc / "circular" / "140120211415";
   if (!fs::is_directory(session)) GTEST_SKIP() << "no " << session;
   TempDir dir;
-  const auto summary = tools::ImportOptiOdomTricycle({session.string()}, dir.Path("out"));
+  const auto summary = Import({session.string()}, dir.Path("out"));
   ASSERT_EQ(summary.runs.size(), 2u);
   EXPECT_EQ(summary.runs[0].trajectory, "circular_cw");
   EXPECT_EQ(summary.runs[1].trajectory, "circular_ccw");
@@ -541,7 +550,7 @@ TEST(OptiOdomTricycleImport, RealSessionReproducesItsNominalFinalErrors) {
     const double dtheta = std::remainder(theta - last.theta, 2.0 * M_PI);
     const double expected =
         std::sqrt(std::pow(x - last.x, 2) + std::pow(y - last.y, 2) + dtheta * dtheta);
-    EXPECT_NEAR(summary.nominal_final_error[run - 1], expected, 1e-9) << "run " << run;
+    EXPECT_NEAR(summary.nominal.per_run_cf[run - 1], expected, 1e-9) << "run " << run;
     EXPECT_GT(expected, 0.3) << "the nominal robot is not expected to be this good";
   }
   // The written data set names the robot and lists the runs.
@@ -577,7 +586,7 @@ TEST(OptiOdomTricycleImport, RealCirclesAndSquaresFit) {
   std::vector<std::string> sessions = RealSessions("circular");
   for (const std::string& s : RealSessions("square")) sessions.push_back(s);
   TempDir dir;
-  const auto summary = tools::ImportOptiOdomTricycle(sessions, dir.Path("out"));
+  const auto summary = Import(sessions, dir.Path("out"));
   ASSERT_EQ(summary.runs.size(), 28u);
   const std::vector<AlignedRun> all = AlignRuns(summary.runs);
   const RobotModelPtr model = ReadRobotModelFile(dir.Path("out/robot.yaml"));
@@ -587,7 +596,7 @@ TEST(OptiOdomTricycleImport, RealCirclesAndSquaresFit) {
   ASSERT_TRUE(fit.usable) << fit.message;
   const double fitted_cf = EvaluateFinalPoseErrors(*model, fit.parameters, all, 1).cf;
   std::printf(
-      "nominal CF %.4f (circles %.4f, squares %.4f)\n", summary.nominal_cf,
+      "nominal CF %.4f (circles %.4f, squares %.4f)\n", summary.nominal.cf,
       EvaluateFinalPoseErrors(*model, model->robot().nominal, RunsOf(all, "circular"), 1).cf,
       EvaluateFinalPoseErrors(*model, model->robot().nominal, RunsOf(all, "square"), 1).cf);
   for (int k = 0; k < 3; ++k) {
@@ -606,7 +615,7 @@ TEST(OptiOdomTricycleImport, RealCirclesAndSquaresFit) {
   EXPECT_NEAR(fit.parameters[0], 0.03153, 0.02 * 0.03153);
   EXPECT_NEAR(fit.parameters[1], 0.15365, 0.02 * 0.15365);
   EXPECT_NEAR(RadToDeg(fit.parameters[2]), -1.11, 1.0);
-  EXPECT_LT(fitted_cf, 0.1 * summary.nominal_cf);
+  EXPECT_LT(fitted_cf, 0.1 * summary.nominal.cf);
 }
 
 }  // namespace

@@ -10,14 +10,15 @@
 #include <stdexcept>
 
 #include "fitcal/version.h"
-#include "models/asoc/asoc_files.h"
 #include "io/atomic_file.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/staged_directory.h"
 #include "io/yaml_text.h"
+#include "models/asoc/asoc_files.h"
 #include "models/asoc/asoc_geometric.h"
 #include "odometry/parallel_for.h"
+#include "tools/dataset_command.h"
 #include "tools/output_guard.h"
 #include "tools/sim/asoc_simulator.h"
 
@@ -126,7 +127,7 @@ std::vector<asoc::RunLog> UmbmarkCircuits(const asoc::Vehicle& truth,
 }  // namespace
 
 int RunAsocSimulate(const AsocSimulateOptions& options) {
-  try {
+  return RunReportingErrors("fitcal", [&]() -> int {
     if (const std::string refusal =
             DirectoryOutputRefusal(options.out, kDatasetKind, options.force, {});
         !refusal.empty()) {
@@ -172,14 +173,11 @@ int RunAsocSimulate(const AsocSimulateOptions& options) {
         "true parameters are in truth.yaml\n",
         runs.size(), options.excursions, options.out.c_str());
     return 0;
-  } catch (const std::exception& e) {
-    std::cerr << "fitcal: " << e.what() << "\n";
-    return 1;
-  }
+  });
 }
 
 int RunAsocGeometric(const AsocGeometricOptions& options) {
-  try {
+  return RunReportingErrors("fitcal", [&]() -> int {
     io::DatasetOptions dataset_options;
     dataset_options.allow_paths_outside = options.allow_outside_paths;
     if (!options.no_output) {  // before the work: never over one of the data set's files
@@ -222,10 +220,7 @@ int RunAsocGeometric(const AsocGeometricOptions& options) {
                            options.logs);
     }
     return 0;
-  } catch (const std::exception& e) {
-    std::cerr << "fitcal: " << e.what() << "\n";
-    return 1;
-  }
+  });
 }
 
 int RunAsocTables(const AsocTablesOptions& options) {

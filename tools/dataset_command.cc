@@ -5,6 +5,7 @@
 
 #include "io/input_error.h"
 #include "odometry/robot.h"
+#include "tools/command_failure.h"
 #include "tools/output_guard.h"
 
 namespace fitcal::tools {
@@ -48,6 +49,9 @@ int Refuse(const std::string& why) {
 int RunReportingErrors(const std::string& prefix, const std::function<int()>& command) {
   try {
     return command();
+  } catch (const CommandFailure& e) {
+    std::cerr << prefix << ": " << io::OneLine(e.what(), 500) << "\n";
+    return e.exit_status();
   } catch (const std::exception& e) {
     std::cerr << prefix << ": " << io::OneLine(e.what(), 500) << "\n";
     return 1;

@@ -50,7 +50,8 @@ io::Dataset LoadRuns(const DatasetCommandOptions& options, const io::DatasetInde
 int Refuse(const std::string& why);
 
 // The tool's edge: runs `command` and turns an exception (io::InputError carries file:line in
-// what()) into `<prefix>: <what>` on one line of stderr and exit status 1.
+// what()) into `<prefix>: <what>` on one line of stderr and exit status 1, or the status a
+// CommandFailure (tools/command_failure.h) carries.
 int RunReportingErrors(const std::string& prefix, const std::function<int()>& command);
 
 }  // namespace fitcal::tools

@@ -23,6 +23,8 @@
 #include "models/tricycle/tricycle_kinematics.h"
 #include "odometry/aligned_run.h"
 #include "odometry/effects.h"
+#include "tools/command_failure.h"
+#include "tools/dataset_command.h"
 #include "tools/output_guard.h"
 #include "validation/odometry_covariance.h"
 #include "validation/training_runs.h"
@@ -73,9 +75,8 @@ Calibrated WithJoints(RobotModelPtr model, const std::vector<std::string>& joint
   c.model = std::move(model);
   const Robot& robot = c.robot();
   if (!joints.empty() && joints.size() != robot.channels.size()) {
-    throw std::invalid_argument("--joints names " + std::to_string(joints.size()) +
-                                " joints; robot '" + robot.name + "' has " +
-                                std::to_string(robot.channels.size()) + " channels");
+    throw UsageError("--joints names " + std::to_string(joints.size()) + " joints; robot '" +
+                     robot.name + "' has " + std::to_string(robot.channels.size()) + " channels");
   }
   for (std::size_t j = 0; j < robot.channels.size(); ++j) {
     c.joints.push_back(joints.empty() ? robot.channels[j].name : joints[j]);
@@ -157,7 +158,7 @@ std::vector<int> MecanumCorners(const std::vector<OmniWheel>& wheels, const Robo
             std::abs(WrapAngle(wheels[i].drive_angle_rad)) < 15.0 * kDeg &&
             std::abs(wheels[i].roller_angle_rad - kCorners[k].roller_deg * kDeg) < kSameAngleRad;
         if (!layout || at[k] >= 0) {
-          throw std::invalid_argument(
+          throw UsageError(
               "wheel '" + robot.channels[i].name + "' (" + kCorners[k].key +
               ") is not in mecanum_drive_controller's layout (driven straight ahead, rollers -45 "
               "deg front-left/rear-right, +45 deg front-right/rear-left, one wheel per corner)");
@@ -168,8 +169,8 @@ std::vector<int> MecanumCorners(const std::vector<OmniWheel>& wheels, const Robo
   }
   for (int k = 0; k < 4; ++k) {
     if (at[k] < 0) {
-      throw std::invalid_argument(std::string("no wheel at the ") + kCorners[k].key +
-                                  " corner: not mecanum_drive_controller's layout");
+      throw UsageError(std::string("no wheel at the ") + kCorners[k].key +
+                       " corner: not mecanum_drive_controller's layout");
     }
   }
   return at;
@@ -198,7 +199,7 @@ RobotModelPtr MecanumKinematics(const Calibrated& c, const std::vector<int>& cor
 
 void MecanumParameters(const Calibrated& c, const std::string&, Ros2ControlExport* out) {
   if (c.robot().model != "omni" || c.robot().NumChannels() != 4) {
-    throw std::invalid_argument("mecanum_drive_controller takes an omni robot of 4 mecanum wheels");
+    throw UsageError("mecanum_drive_controller takes an omni robot of 4 mecanum wheels");
   }
   const std::vector<OmniWheel> wheels = OmniGeometry(c);
   const std::vector<int> corner = MecanumCorners(wheels, c.robot());
@@ -242,9 +243,9 @@ int OmniDriveSense(const std::vector<OmniWheel>& wheels, const Robot& robot) {
                   : std::abs(offset + M_PI / 2) < kSameAngleRad ? -1
                                                                 : 0;
     if (s == 0 || (sense != 0 && s != sense) || std::abs(wheels[i].roller_angle_rad) > kSameAngleRad) {
-      throw std::invalid_argument("wheel '" + robot.channels[i].name +
-                                  "' is not an omni wheel driven tangentially like the others: "
-                                  "omni_wheel_drive_controller cannot describe it");
+      throw UsageError("wheel '" + robot.channels[i].name +
+                       "' is not an omni wheel driven tangentially like the others: "
+                       "omni_wheel_drive_controller cannot describe it");
     }
     sense = s;
   }
@@ -308,7 +309,7 @@ void OmniWheelKinematics(const Calibrated& c, const std::vector<int>& order, dou
 
 void OmniWheelParameters(const Calibrated& c, const std::string&, Ros2ControlExport* out) {
   if (c.robot().model != "omni3" && c.robot().model != "omni") {
-    throw std::invalid_argument("omni_wheel_drive_controller takes an omni3 or omni robot");
+    throw UsageError("omni_wheel_drive_controller takes an omni3 or omni robot");
   }
   const std::vector<OmniWheel> wheels = OmniGeometry(c);
   const int sense = OmniDriveSense(wheels, c.robot());
@@ -403,7 +404,7 @@ const ControllerEntry& FindController(const std::string& name) {
   std::string known;
   for (const ControllerEntry& e : kControllers)
     known += (known.empty() ? "" : ", ") + std::string(e.name);
-  throw std::invalid_argument("unknown controller '" + name + "' (fitcal writes " + known + ")");
+  throw UsageError("unknown controller '" + name + "' (fitcal writes " + known + ")");
 }
 
 bool InList(const char* list, const std::string& word) {
@@ -419,11 +420,11 @@ void CheckDistro(const ControllerEntry& e, const std::string& distro) {
   if (std::find(all.begin(), all.end(), distro) == all.end()) {
     std::string known;
     for (const std::string& d : all) known += (known.empty() ? "" : ", ") + d;
-    throw std::invalid_argument("--ros-distro '" + distro + "' is not one of " + known);
+    throw UsageError("--ros-distro '" + distro + "' is not one of " + known);
   }
   if (!InList(e.distros, distro)) {
-    throw std::invalid_argument(std::string(e.name) + " is not in ROS 2 " + distro +
-                                " (it ships in " + e.distros + ")");
+    throw UsageError(std::string(e.name) + " is not in ROS 2 " + distro + " (it ships in " +
+                     e.distros + ")");
   }
 }
 
@@ -452,9 +453,8 @@ Ros2ControlExport ExportRos2Control(const RobotModelPtr& calibrated,
   CheckDistro(entry, ros_distro);
   const Calibrated c = WithJoints(calibrated, joints);
   if (!TakesModel(entry, c.robot().model)) {
-    throw std::invalid_argument(calibration_path + ": robot model '" + c.robot().model +
-                                "' does not fit " + controller + " (it takes model " + entry.model +
-                                ")");
+    throw UsageError(calibration_path + ": robot model '" + c.robot().model + "' does not fit " +
+                     controller + " (it takes model " + entry.model + ")");
   }
   if (!c.robot().effects.empty()) {
     // Its parameters were fitted together with the effects, which the controller cannot apply:
@@ -463,9 +463,8 @@ Ros2ControlExport ExportRos2Control(const RobotModelPtr& calibrated,
     for (const effects::EffectValue& e : c.robot().effects) {
       names += (names.empty() ? "" : ", ") + std::string(effects::Info(e.id).name);
     }
-    throw std::invalid_argument(calibration_path + ": the calibration carries effects (" + names +
-                                ") that " + controller +
-                                " cannot apply; export a calibration fitted without effects");
+    throw UsageError(calibration_path + ": the calibration carries effects (" + names + ") that " +
+                     controller + " cannot apply; export a calibration fitted without effects");
   }
   Ros2ControlExport out;
   out.parameters_yaml = (node_name.empty() ? controller : node_name) + ":\n  ros__parameters:\n";
@@ -554,8 +553,8 @@ Replay ReplayOnHeldOutRuns(const ExportRos2ControlOptions& o, const RobotModelPt
   const io::DatasetIndex index = io::ReadDatasetIndex(o.logs);
   const RobotModelPtr nominal = ReadRobotModelFile(index.robot_path);
   if (nominal->robot().model != exact->robot().model) {
-    throw std::invalid_argument(o.logs + ": its robot is a " + nominal->robot().model +
-                                ", the calibration a " + exact->robot().model);
+    throw UsageError(o.logs + ": its robot is a " + nominal->robot().model +
+                     ", the calibration a " + exact->robot().model);
   }
   Replay r;
   std::vector<RunLog> logs;
@@ -640,16 +639,12 @@ std::string CalibrationWithCovariance(const std::string& path, const OdometryCov
     }
   }
   if (!found) {
-    throw std::invalid_argument(path + ": no calibration: block (a calibration written by fit) "
-                                "to hold the odometry covariance (--calibration-out)");
+    throw UsageError(path +
+                     ": no calibration: block (a calibration written by fit) "
+                     "to hold the odometry covariance (--calibration-out)");
   }
   return out;
 }
-
-// Thrown when the exported parameters would make the robot worse: exit 5, nothing written.
-struct WorseThanNominal : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
 
 }  // namespace
 
@@ -688,7 +683,7 @@ namespace {
 void CheckOut(const ExportRos2ControlOptions& o) {
   if (o.out.empty()) return;
   const std::string refusal = OutputFileRefusal(o.out, {o.calibration, o.logs});
-  if (!refusal.empty()) throw std::invalid_argument(refusal);
+  if (!refusal.empty()) throw UsageError(refusal);
   if (std::filesystem::exists(o.out) && !o.force) {
     throw std::runtime_error(o.out + ": exists; refusing to overwrite it (--force)");
   }
@@ -697,17 +692,18 @@ void CheckOut(const ExportRos2ControlOptions& o) {
 void CheckCalibrationOut(const ExportRos2ControlOptions& o) {
   if (o.calibration_out.empty()) return;
   if (o.logs.empty()) {
-    throw std::invalid_argument("--calibration-out needs --logs (the covariance comes from "
-                                "the held-out runs)");
+    throw UsageError(
+        "--calibration-out needs --logs (the covariance comes from "
+        "the held-out runs)");
   }
   if (std::filesystem::exists(o.calibration_out) && !o.force) {
     throw std::runtime_error(o.calibration_out + ": exists; refusing to overwrite it (--force)");
   }
 }
 
-// The replay's verdict (WorseThanNominal unless --allow-worse), its lines (on stdout beside a
-// written file; in the YAML's comments either way: stdout stays YAML), the covariance keys and
-// the calibration with its covariance (--calibration-out).
+// The replay's verdict (WorseThanNominalError, exit 5, unless --allow-worse), its lines (on stdout
+// beside a written file; in the YAML's comments either way: stdout stays YAML), the covariance keys
+// and the calibration with its covariance (--calibration-out).
 void AddReplay(const ExportRos2ControlOptions& o, const RobotModelPtr& exact,
                const Ros2ControlExport& e, std::string* text, std::string* parameters,
                std::string* calibration_text) {
@@ -723,7 +719,7 @@ void AddReplay(const ExportRos2ControlOptions& o, const RobotModelPtr& exact,
                   e.notes.empty() ? ""
                                   : ", with notes on what the controller leaves out: "
                                     "apply that first, e.g. a steering offset");
-    throw WorseThanNominal(text_worse);
+    throw WorseThanNominalError(text_worse);
   }
   *text += "# " + line + "\n";
   const std::string covariance = CovarianceLine(replay.exported_covariance);
@@ -738,8 +734,7 @@ void AddReplay(const ExportRos2ControlOptions& o, const RobotModelPtr& exact,
 }  // namespace
 
 int RunExportRos2ControlCommand(const ExportRos2ControlOptions& o) {
-  constexpr const char* kPrefix = "fitcal export ros2-control: ";
-  try {
+  return RunReportingErrors("fitcal export ros2-control", [&]() -> int {
     CheckOut(o);
     const ControllerEntry& entry = FindController(o.controller);
     CheckDistro(entry, o.ros_distro);
@@ -755,7 +750,8 @@ int RunExportRos2ControlCommand(const ExportRos2ControlOptions& o) {
     if (!o.logs.empty()) AddReplay(o, calibrated, e, &text, &parameters, &calibration_text);
     text += parameters;
     // The notes after the verdict: a refusal is one line.
-    for (const std::string& note : e.notes) std::cerr << kPrefix << "note: " << note << "\n";
+    for (const std::string& note : e.notes)
+      std::cerr << "fitcal export ros2-control: note: " << note << "\n";
     if (o.out.empty()) {
       std::cout << text;
     } else {
@@ -763,16 +759,7 @@ int RunExportRos2ControlCommand(const ExportRos2ControlOptions& o) {
     }
     if (!calibration_text.empty()) io::WriteFileAtomically(o.calibration_out, calibration_text);
     return 0;
-  } catch (const WorseThanNominal& e) {
-    std::cerr << kPrefix << e.what() << "\n";
-    return 5;
-  } catch (const std::invalid_argument& e) {
-    std::cerr << kPrefix << e.what() << "\n";
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << kPrefix << e.what() << "\n";
-    return 1;
-  }
+  });
 }
 
 }  // namespace fitcal::tools

@@ -15,6 +15,8 @@
 #include "io/input_error.h"
 #include "io/yaml_reader.h"
 #include "models/model_registry.h"
+#include "tools/command_failure.h"
+#include "tools/dataset_command.h"
 
 namespace fitcal::tools {
 namespace {
@@ -196,7 +198,7 @@ std::vector<FleetSeries> ReadFleet(const std::vector<std::string>& inputs) {
   for (const std::string& f : Files(inputs)) {
     all.push_back(IsMetricsJson(f) ? ReadMetricsJson(f) : ReadCalibration(f));
   }
-  if (all.empty()) throw std::invalid_argument("no calibrated YAML found in the inputs");
+  if (all.empty()) throw UsageError("no calibrated YAML found in the inputs");
   std::stable_sort(all.begin(), all.end(), [](const Calibration& a, const Calibration& b) {
     return std::tie(a.robot, a.date) < std::tie(b.robot, b.date);
   });
@@ -257,17 +259,10 @@ void AddFleetOptions(CLI::App& app, FleetOptions& o) {
 }
 
 int RunFleetCommand(const FleetOptions& o) {
-  constexpr const char* kPrefix = "fitcal fleet: ";
-  try {
+  return RunReportingErrors("fitcal fleet", [&]() -> int {
     std::cout << FleetTable(ReadFleet(o.inputs)).substr(1);
     return 0;
-  } catch (const std::invalid_argument& e) {
-    std::cerr << kPrefix << e.what() << "\n";
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << kPrefix << e.what() << "\n";
-    return 1;
-  }
+  });
 }
 
 }  // namespace fitcal::tools

@@ -1,184 +1,234 @@
 #include "tools/import_optiodom.h"
 
 #include <CLI/CLI.hpp>
-#include <algorithm>
-#include <cmath>
 #include <cstdio>
-#include <iostream>
+#include <stdexcept>
 
-#include "fit/final_pose_errors.h"
-#include "fit/segment_cost.h"
-#include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/input_registry.h"
-#include "models/omni3/omni3_robot_model.h"
+#include "models/tricycle/tricycle_checks.h"
 #include "odometry/aligned_run.h"
+#include "odometry/parallel_for.h"
+#include "tools/command_failure.h"
+#include "tools/dataset_command.h"
 #include "tools/import_channel_order.h"
-#include "tools/import_optiodom_models.h"
-#include "tools/import_optiodom_omni4.h"
-#include "tools/import_optiodom_tricycle.h"
-#include "tools/miswired_error.h"
-#include "tools/optiodom_format.h"
+#include "tools/optiodom_robots.h"
 #include "tools/output_guard.h"
 
 namespace fitcal::tools {
 
-using io::InputError;
-using io::InputErrorKind;
+using optiodom::RobotKind;
 
 namespace {
 
-// Our wheel angles (deg) for the authors' wheels 1, 2, 3; see the header.
-constexpr double kWheelAngleDeg[3] = {300.0, 60.0, 180.0};
-// Our wheel rate = kTickSign * the authors' (the header derives it).
-constexpr double kTickSign = -1.0;
+// One session directory before its runs are read: its files, its metadata and the values of the
+// robot kind's geometry rows.
+struct SessionHead {
+  optiodom::SessionFiles files;
+  optiodom::Metadata metadata;
+  std::vector<std::vector<double>> geometry;
+};
 
-OptiOdomMetadata ReadMetadata(const std::string& path) {
-  const optiodom::Metadata rows = optiodom::ReadMetadata(path, "omni3");
-  OptiOdomMetadata meta;
-  meta.type = rows.type;
-  meta.gear_ratio = rows.Value("ngear", true);
-  meta.encoder_counts_per_rev = rows.Value("encRes", true);
-  meta.distance_m = rows.Value("Li", true);
-  const std::vector<double> d = rows.Values("Di", 3, true);
-  std::copy(d.begin(), d.end(), meta.diameter_m.begin());
-  meta.num_runs = rows.NumRuns();
-  const std::size_t runs = static_cast<std::size_t>(meta.num_runs);
-  meta.gt_ti_s = rows.Values("gt_ti", runs, false);
-  meta.gt_tf_s = rows.Values("gt_tf", runs, false);
-  meta.odo_ti_s = rows.Values("odo_ti", runs, false);
-  meta.odo_tf_s = rows.Values("odo_tf", runs, false);
-  return meta;
+SessionHead ReadSessionHead(const std::string& directory, const RobotKind& kind) {
+  SessionHead s{optiodom::ListSession(directory), {}, {}};
+  s.metadata = optiodom::ReadMetadata(s.files.metadata_path, kind.type);
+  s.metadata.TicksPerWheelRev();  // ngear and encRes are read, and checked, first
+  for (const optiodom::GeometryRow& row : kind.geometry) {
+    s.geometry.push_back(s.metadata.Values(row.key, row.count, row.positive));
+  }
+  optiodom::CheckRunCount(s.files, s.metadata.NumRuns());
+  return s;
 }
 
-OptiOdomRun ReadRun(const std::string& path, int number) {
-  OptiOdomRun run = optiodom::ReadRun(path, number, 3, "ticks_1, ticks_2, ticks_3");
-  for (std::vector<double>& ticks : run.encoder) {
-    for (double& t : ticks) t = kTickSign * t + 0.0;  // + 0.0 keeps a flipped 0 at 0
+// The session whose geometry most sessions declare (ties: the earliest).
+std::size_t MajoritySession(const std::vector<SessionHead>& sessions) {
+  std::size_t best = 0, best_count = 0;
+  for (std::size_t i = 0; i < sessions.size(); ++i) {
+    std::size_t count = 0;
+    for (const SessionHead& s : sessions) count += s.geometry == sessions[i].geometry ? 1 : 0;
+    if (count > best_count) best = i, best_count = count;
   }
+  return best;
+}
+
+// "b = 0.205 m, D = 0.084 / 0.084 m".
+std::string DescribeGeometry(const RobotKind& kind, const SessionHead& s) {
+  std::string out;
+  char value[40];
+  for (std::size_t r = 0; r < s.geometry.size(); ++r) {
+    out += (r == 0 ? "" : ", ") + std::string(kind.geometry[r].label) + " =";
+    for (std::size_t i = 0; i < s.geometry[r].size(); ++i) {
+      std::snprintf(value, sizeof value, "%s%g", i == 0 ? " " : " / ", s.geometry[r][i]);
+      out += value;
+    }
+    out += " " + std::string(kind.geometry[r].unit);
+  }
+  return out;
+}
+
+// <path><sep><session><sep>runNN.
+std::string RunId(const RobotKind& kind, const SessionHead& s, int number) {
+  char run[16];
+  std::snprintf(run, sizeof run, "run%02d", number);
+  return s.files.path_type + kind.id_separator + s.files.name + kind.id_separator + run;
+}
+
+// A run file to read: its session (index), its number and its path.
+struct RunFile {
+  std::size_t session;
+  int number;
+  std::string path;
+};
+
+// Refuses a session whose encoders differ from the majority's (robot.yaml holds one
+// ticks_per_rev for every ticks CSV); notes the sessions that declare another geometry and the
+// runs the authors flagged, which are left out. Returns the run files to read.
+std::vector<RunFile> CheckAndNote(const RobotKind& kind, const std::vector<SessionHead>& sessions,
+                                  const SessionHead& robot, std::vector<std::string>* notes) {
+  std::vector<RunFile> files;
+  for (std::size_t i = 0; i < sessions.size(); ++i) {
+    const SessionHead& s = sessions[i];
+    if (s.metadata.TicksPerWheelRev() != robot.metadata.TicksPerWheelRev()) {
+      throw io::InputError(
+          io::InputErrorKind::kBadValue, s.files.metadata_path, 0,
+          "ngear * encRes differs from the other sessions'; import one robot at a time");
+    }
+    if (s.geometry != robot.geometry) {
+      notes->push_back("session " + s.files.path_type + "/" + s.files.name + " declares " +
+                       DescribeGeometry(kind, s) + " (the robot YAML keeps the majority's " +
+                       DescribeGeometry(kind, robot) + ")");
+    }
+    for (const auto& [number, path] : s.files.runs) {
+      const char* flag = optiodom::FlaggedRunReason(s.files.path_type, s.files.name, number);
+      if (flag != nullptr) {
+        notes->push_back("left out " + RunId(kind, s, number) + ": " + flag);
+      } else {
+        files.push_back({i, number, path});
+      }
+    }
+  }
+  return files;
+}
+
+// The channel read as an angle at each row (tricycle steering), or -1.
+int ReadingColumn(const Robot& robot) {
+  for (int j = 0; j < robot.NumChannels(); ++j) {
+    if (robot.channels[j].kind == ChannelKind::kAngle) return j;
+  }
+  return -1;
+}
+
+// Each session's place among the sessions of its path type, by name (timestamps: 1 = earliest).
+int SessionPlace(const std::vector<SessionHead>& sessions, const SessionHead& s) {
+  int earlier = 0;
+  for (const SessionHead& other : sessions) {
+    earlier += other.files.path_type == s.files.path_type && other.files.name < s.files.name;
+  }
+  return earlier + 1;
+}
+
+// Reads one run file in our channel signs; an angle column must hold readings in rad.
+optiodom::RunRows ReadRunRows(const RobotKind& kind, const RunFile& file, int reading_column) {
+  optiodom::RunRows run = optiodom::ReadRun(file.path, file.number, kind.file_columns);
+  std::vector<double> readings;
+  for (std::vector<double>& row : run.encoder) {
+    for (std::size_t j = 0; j < row.size(); ++j) {
+      if (static_cast<int>(j) == reading_column) {
+        readings.push_back(row[j]);
+      } else {
+        row[j] = kind.tick_sign * row[j] + 0.0;  // + 0.0 keeps a flipped 0 at 0
+      }
+    }
+  }
+  if (reading_column >= 0) tricycle::CheckSteeringReadings(readings, file.path, run.first_line);
   return run;
 }
 
+// The run's id, trajectory and repetition as the robot kind labels them.
+void Label(const RobotKind& kind, const std::vector<SessionHead>& sessions, const RunFile& file,
+           RunLog* log) {
+  const SessionHead& s = sessions[file.session];
+  log->id = RunId(kind, s, file.number);
+  log->trajectory = s.files.path_type + kind.trajectory_separator + s.files.name;
+  log->repetition = file.number;
+  if (kind.label_by_direction) {
+    const auto& track = log->ground_truth.world_T_robot;
+    const double turn_rad = track.back().theta - track.front().theta;
+    log->trajectory = s.files.path_type + (turn_rad < 0.0 ? "_cw" : "_ccw");
+    log->repetition = SessionPlace(sessions, s);
+  }
+}
+
 }  // namespace
 
-OptiOdomSession ReadOptiOdomSession(const std::string& directory) {
-  return optiodom::ReadSession<OptiOdomMetadata, OptiOdomRun>(
-      directory, ReadMetadata,
-      [](const std::string& path, int number, const auto&) { return ReadRun(path, number); });
-}
-
-Omni3Robot OptiOdomNominalRobot(const OptiOdomMetadata& metadata) {
-  Omni3Robot robot;
-  robot.name = "optiodom_omni3";
-  robot.wheel_names = {"a", "b", "c"};
-  for (int i = 0; i < 3; ++i) {
-    robot.nominal.distance_m[i] = metadata.distance_m;
-    robot.nominal.radius_m[i] = 0.5 * metadata.diameter_m[i];
-    robot.nominal.angle_rad[i] = DegToRad(kWheelAngleDeg[i]);
+OptiOdomImport ReadOptiOdomSessions(const std::vector<std::string>& session_dirs) {
+  if (session_dirs.empty()) {
+    throw std::invalid_argument("import needs at least one OptiOdom session directory");
   }
-  // Palacin Eq. 16 gives R +- 0.025 m, r +- 0.010 m on r = 0.148 m (6.8 %), delta +- 2 deg: the
-  // same physical box scaled to this robot's wheels, with R widened by kTrackedPointOffset_m: the
-  // ground truth tracks the marker centroid, not the kinematic centre, and an offset e shifts
-  // every fitted R_i by up to |e| (README, "Why the distances run into their bounds"; ~3 cm on
-  // this robot, which left a distance on Eq. 16's bound and the fit without convergence).
-  constexpr double kTrackedPointOffset_m = 0.025;
-  const double r_min =
-      *std::min_element(robot.nominal.radius_m.begin(), robot.nominal.radius_m.end());
-  const double r_max =
-      *std::max_element(robot.nominal.radius_m.begin(), robot.nominal.radius_m.end());
-  robot.bounds.distance_m = {metadata.distance_m - 0.025 - kTrackedPointOffset_m,
-                             metadata.distance_m + 0.025 + kTrackedPointOffset_m};
-  robot.bounds.radius_m = {r_min * (1.0 - 0.01 / 0.148), r_max * (1.0 + 0.01 / 0.148)};
-  robot.bounds.angle_offset_rad = {DegToRad(-2.0), DegToRad(2.0)};
-  robot.encoder = EncoderTicks{metadata.TicksPerWheelRev(), false};
-  return robot;
-}
-
-RunLog OptiOdomRunLog(const OptiOdomSession& session, const OptiOdomRun& run) {
-  return optiodom::RunLogOf(session.path_type, session.name, run,
-                            session.metadata.TicksPerWheelRev());
+  const RobotKind& kind =
+      optiodom::RobotKindOf(optiodom::SessionType(session_dirs.front()), session_dirs.front());
+  std::vector<SessionHead> sessions;
+  for (const std::string& dir : session_dirs) sessions.push_back(ReadSessionHead(dir, kind));
+  const SessionHead& robot = sessions[MajoritySession(sessions)];
+  OptiOdomImport in;
+  in.kind = &kind;
+  in.num_sessions = static_cast<int>(sessions.size());
+  in.model = kind.nominal_model(robot.metadata);
+  const std::vector<RunFile> files = CheckAndNote(kind, sessions, robot, &in.notes);
+  const int reading_column = ReadingColumn(in.model->robot());
+  in.rows.resize(files.size());
+  in.runs.resize(files.size());
+  ParallelFor(files.size(), 0, [&](std::size_t i) {
+    in.rows[i] = ReadRunRows(kind, files[i], reading_column);
+    in.runs[i] = optiodom::RunLogOf(in.rows[i], robot.metadata.TicksPerWheelRev(), reading_column);
+    Label(kind, sessions, files[i], &in.runs[i]);
+    if (!in.model->robot().encoder) in.rows[i] = {};  // written from runs (omni4: -130 MB)
+  });
+  return in;
 }
 
 namespace {
 
-void ImportOmni3(const ImportOptiOdomOptions& options) {
-  const std::vector<OptiOdomSession> sessions = optiodom::ReadSessions<OptiOdomSession>(
-      options.sessions, options.out, options.force, ReadOptiOdomSession);
-  optiodom::CheckOneRobot(sessions, [](const OptiOdomMetadata& a, const OptiOdomMetadata& b) {
-    return a.gear_ratio == b.gear_ratio && a.encoder_counts_per_rev == b.encoder_counts_per_rev &&
-           a.distance_m == b.distance_m && a.diameter_m == b.diameter_m;
-  });
-  const std::shared_ptr<const Omni3Model> robot =
-      Omni3ModelOf(OptiOdomNominalRobot(sessions.front().metadata));
-  std::vector<RunLog> logs;
-  std::vector<const OptiOdomRun*> sources;
-  for (const OptiOdomSession& s : sessions) {
-    for (const OptiOdomRun& run : s.runs) {
-      logs.push_back(OptiOdomRunLog(s, run));
-      sources.push_back(&run);
-    }
-  }
-  optiodom::CheckUniqueRunIds(logs, options.out);
-  std::printf("%s\n", CheckImportedChannelOrder(logs, *robot, options.skip_mapping_check).c_str());
+// Ticks as logged when the robot counts ticks, else the rates exactly (optiodom_format.h).
+optiodom::DatasetText DatasetTextOf(const OptiOdomImport& in) {
+  const Robot& robot = in.model->robot();
   optiodom::DatasetText text;
-  text.encoder_csv = [&](std::size_t i) {
-    return optiodom::IncrementsCsv("t,ticks_a,ticks_b,ticks_c", *sources[i], 6);
+  text.encoder_csv = [&in, &robot](std::size_t i) {
+    return robot.encoder
+               ? optiodom::TicksCsv(robot, in.rows[i], in.kind->time_decimals, ReadingColumn(robot))
+               : optiodom::ExactRatesCsv(robot, in.runs[i]);
   };
-  optiodom::WriteDataset(logs, *robot, text, options.out, options.force, options.sessions);
-  std::printf("wrote %zu runs of %zu sessions to %s\n", logs.size(), sessions.size(),
-              options.out.c_str());
-}
-
-void ImportDiff(const ImportOptiOdomOptions& options) {
-  ImportOptiOdomDiffOptions diff;
-  diff.force = options.force;
-  diff.skip_mapping_check = options.skip_mapping_check;
-  ImportOptiOdomDiff(options.sessions, options.out, diff);  // prints its own summary
-}
-
-void ImportTricycle(const ImportOptiOdomOptions& options) {
-  ImportOptiOdomTricycleOptions tricycle;
-  tricycle.force = options.force;
-  tricycle.skip_sign_check = options.skip_mapping_check;
-  const ImportOptiOdomTricycleSummary s =
-      ImportOptiOdomTricycle(options.sessions, options.out, tricycle);
-  std::printf("%s\n", s.channel_order.c_str());
-  std::printf("imported %zu runs of %d tricycle sessions into %s; nominal CF (Eq. 14) %.4f\n",
-              s.runs.size(), s.num_sessions, options.out.c_str(), s.nominal_cf);
-}
-
-void ImportOmni4(const ImportOptiOdomOptions& options) {
-  const Omni4ImportResult s =
-      ImportOptiOdomOmni4(options.sessions, options.out, options.force, options.skip_mapping_check);
-  for (const std::string& note : s.notes) std::printf("note: %s\n", note.c_str());
-  std::printf("%s\n", s.channel_order.c_str());
-  std::printf("imported %d runs of %d omni4 sessions into %s; nominal CF (Eq. 14) %.4f\n",
-              s.num_runs, s.num_sessions, options.out.c_str(), s.nominal_mean_cf);
-}
-
-// The robots of the OptiOdom study by their metadata `type`. Each importer reads, checks and
-// writes through the one reader and writer (tools/optiodom_format.h) and prints its summary;
-// what differs is which metadata keys make the nominal robot and what the encoder columns are.
-struct OptiOdomRobot {
-  const char* type;
-  void (*import)(const ImportOptiOdomOptions&);
-};
-constexpr OptiOdomRobot kRobots[] = {{"omni3", ImportOmni3},
-                                     {"omni4", ImportOmni4},
-                                     {"diff", ImportDiff},
-                                     {"tricyc", ImportTricycle}};
-
-const OptiOdomRobot& RobotOfType(const std::string& type, const std::string& session) {
-  for (const OptiOdomRobot& robot : kRobots) {
-    if (type == robot.type) return robot;
+  if (!robot.encoder) text.ground_truth_csv = optiodom::ExactGroundTruthCsv;
+  if (in.kind->file_comment != nullptr) {
+    text.header = in.kind->file_comment;
+    for (const std::string& n : in.notes) text.header += "# " + n + "\n";
   }
-  throw InputError(InputErrorKind::kUnknownModel, session, 0,
-                   "type '" + type +
-                       "' is not an OptiOdom robot fitcal imports (omni3, omni4, "
-                       "diff, tricyc)");
+  return text;
 }
 
 }  // namespace
+
+OptiOdomImport ImportOptiOdom(const ImportOptiOdomOptions& options) {
+  OptiOdomImport in = ReadOptiOdomSessions(options.sessions);
+  const auto say = [&options](const std::string& line) {
+    if (!options.quiet) std::printf("%s\n", line.c_str());
+  };
+  for (const std::string& note : in.notes) say(note);
+  optiodom::CheckUniqueRunIds(in.runs, options.out);
+  in.channel_order = CheckImportedChannelOrder(in.runs, *in.model, options.skip_mapping_check);
+  say(in.channel_order);
+  in.nominal = EvaluateFinalPoseErrors(*in.model, in.model->robot().nominal, AlignRuns(in.runs));
+  optiodom::WriteDataset(in.runs, *in.model, DatasetTextOf(in), options.out, options.force,
+                         options.sessions);
+  if (!options.quiet) {
+    std::printf(
+        "wrote %zu runs of %d sessions to %s; nominal CF (Eq. 14) %.4f, mean final position "
+        "error %.4f m, heading %.3f deg\n",
+        in.runs.size(), in.num_sessions, options.out.c_str(), in.nominal.cf,
+        in.nominal.mean_position_error_m, in.nominal.mean_abs_heading_error_rad * 180.0 / M_PI);
+  }
+  return in;
+}
 
 void AddImportOptiOdomOptions(CLI::App& app, ImportOptiOdomOptions& o) {
   app.add_option("sessions", o.sessions, "Session directories")
@@ -191,17 +241,15 @@ void AddImportOptiOdomOptions(CLI::App& app, ImportOptiOdomOptions& o) {
 }
 
 int RunImportOptiOdomCommand(const ImportOptiOdomOptions& options) {
-  try {
+  return RunReportingErrors("fitcal", [&]() -> int {
     if (options.sessions.empty()) {
-      std::cerr << "fitcal: import optiodom needs at least one session directory\n";
-      return 2;
+      throw UsageError("import optiodom needs at least one session directory");
     }
     const std::string type = optiodom::SessionType(options.sessions.front());
     for (const std::string& dir : options.sessions) {
-      if (optiodom::SessionType(dir) != type) {
-        std::cerr << "fitcal: " << dir << ": a " << optiodom::SessionType(dir) << " session among "
-                  << type << " sessions; import one robot at a time\n";
-        return 2;
+      if (const std::string other = optiodom::SessionType(dir); other != type) {
+        throw UsageError(dir + ": a " + other + " session among " + type +
+                         " sessions; import one robot at a time");
       }
     }
     // The recordings are inputs: no data set may replace, hold or sit inside one.
@@ -209,18 +257,11 @@ int RunImportOptiOdomCommand(const ImportOptiOdomOptions& options) {
     if (const std::string refusal =
             DirectoryOutputRefusal(options.out, kDatasetKind, options.force, options.sessions);
         !refusal.empty()) {
-      std::cerr << "fitcal: " << refusal << "\n";
-      return 2;
+      throw UsageError(refusal);
     }
-    RobotOfType(type, options.sessions.front()).import(options);
+    ImportOptiOdom(options);
     return 0;
-  } catch (const MiswiredError& e) {
-    std::cerr << "fitcal: " << e.what() << "\n";
-    return kMiswiredExitCode;
-  } catch (const std::exception& e) {
-    std::cerr << "fitcal: " << e.what() << "\n";
-    return 1;
-  }
+  });
 }
 
 }  // namespace fitcal::tools

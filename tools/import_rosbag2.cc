@@ -22,6 +22,8 @@
 #include "io/text_file.h"
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
+#include "tools/command_failure.h"
+#include "tools/dataset_command.h"
 #include "tools/output_guard.h"
 
 namespace fitcal::tools {
@@ -41,7 +43,7 @@ double ParseSeconds(const std::string& text, const std::string& what) {
   double v = 0.0;
   bool finite = true;
   if (!io::ParseDouble(io::Trim(text), &v, &finite) || !finite) {
-    throw std::invalid_argument(what + ": '" + text + "' is not a number of seconds");
+    throw UsageError(what + ": '" + text + "' is not a number of seconds");
   }
   return v;
 }
@@ -55,12 +57,11 @@ std::vector<std::pair<double, double>> ParseRunSpans(const std::string& text) {
     const std::string item = text.substr(pos, end - pos);
     const std::size_t colon = item.find(':');
     if (colon == std::string::npos) {
-      throw std::invalid_argument("--runs: '" + item + "' is not t0:t1");
+      throw UsageError("--runs: '" + item + "' is not t0:t1");
     }
     const double t0 = ParseSeconds(item.substr(0, colon), "--runs");
     const double t1 = ParseSeconds(item.substr(colon + 1), "--runs");
-    if (!(t1 > t0))
-      throw std::invalid_argument("--runs: '" + item + "' does not end after it starts");
+    if (!(t1 > t0)) throw UsageError("--runs: '" + item + "' does not end after it starts");
     spans.emplace_back(t0, t1);
     pos = end + 1;
   }
@@ -274,15 +275,14 @@ io::rosbag2::BagStreamRequest MakeRequest(const ImportRosbag2Options& o, const R
   r.joint_topic = o.encoders;
   r.pose_topic = o.ground_truth;
   if (o.stamp != "header" && o.stamp != "recorded") {
-    throw std::invalid_argument("--stamp must be header or recorded, not '" + o.stamp + "'");
+    throw UsageError("--stamp must be header or recorded, not '" + o.stamp + "'");
   }
   r.stamp =
       o.stamp == "header" ? io::rosbag2::StampSource::kHeader : io::rosbag2::StampSource::kRecorded;
   if (!o.ground_truth_frames.empty()) {
     const std::size_t colon = o.ground_truth_frames.find(':');
     if (colon == std::string::npos || colon == 0 || colon + 1 == o.ground_truth_frames.size()) {
-      throw std::invalid_argument(
-          "--ground-truth-frames must be parent:child, e.g. world:base_link");
+      throw UsageError("--ground-truth-frames must be parent:child, e.g. world:base_link");
     }
     r.parent_frame = o.ground_truth_frames.substr(0, colon);
     r.child_frame = o.ground_truth_frames.substr(colon + 1);
@@ -291,9 +291,8 @@ io::rosbag2::BagStreamRequest MakeRequest(const ImportRosbag2Options& o, const R
     }
   }
   if (!o.joints.empty() && o.joints.size() != robot.channels.size()) {
-    throw std::invalid_argument("--joints names " + std::to_string(o.joints.size()) +
-                                " joints; robot '" + robot.name + "' has " +
-                                std::to_string(robot.channels.size()) + " channels");
+    throw UsageError("--joints names " + std::to_string(o.joints.size()) + " joints; robot '" +
+                     robot.name + "' has " + std::to_string(robot.channels.size()) + " channels");
   }
   for (std::size_t j = 0; j < robot.channels.size(); ++j) {
     r.joints.push_back(o.joints.empty() ? robot.channels[j].name : o.joints[j]);
@@ -440,9 +439,9 @@ void WriteDataset(const ImportRosbag2Options& o, const Robot& robot, const Rosba
 
 Rosbag2Import ReadRosbag2Import(const ImportRosbag2Options& o) {
   if (o.split_at_rest_s > 0.0 && !o.runs.empty()) {
-    throw std::invalid_argument("--runs and --split-at-rest exclude each other");
+    throw UsageError("--runs and --split-at-rest exclude each other");
   }
-  if (o.ground_truth.empty()) throw std::invalid_argument("--ground-truth <topic> is required");
+  if (o.ground_truth.empty()) throw UsageError("--ground-truth <topic> is required");
   const RobotModelPtr model = ReadRobotModelFile(o.robot);
   const Robot& robot = model->robot();
   Rosbag2Import imp;
@@ -476,11 +475,11 @@ Rosbag2Import ReadRosbag2Import(const ImportRosbag2Options& o) {
 }
 
 Rosbag2Import ImportRosbag2(const ImportRosbag2Options& o) {
-  if (o.out.empty()) throw std::invalid_argument("--out <data set directory> is required");
+  if (o.out.empty()) throw UsageError("--out <data set directory> is required");
   io::RegisterInputDirectory(o.bag);  // no data set in, over or holding the bag
   if (const std::string refusal = DirectoryOutputRefusal(o.out, kDatasetKind, o.force, {o.bag});
       !refusal.empty()) {
-    throw std::invalid_argument(refusal);  // exit 2, as every writer refuses its --out
+    throw UsageError(refusal);  // exit 2, as every writer refuses its --out
   }
   Rosbag2Import imp = ReadRosbag2Import(o);
   WriteDataset(o, ReadRobotModelFile(o.robot)->robot(), imp);
@@ -521,8 +520,7 @@ void AddImportRosbag2Options(CLI::App& app, ImportRosbag2Options& o) {
 }
 
 int RunImportRosbag2Command(const ImportRosbag2Options& o) {
-  constexpr const char* kPrefix = "fitcal import rosbag2: ";
-  try {
+  return RunReportingErrors("fitcal import rosbag2", [&]() -> int {
     const Rosbag2Import imp = ImportRosbag2(o);
     if (!o.quiet) {
       for (const std::string& note : imp.notes) std::printf("%s\n", note.c_str());
@@ -536,13 +534,7 @@ int RunImportRosbag2Command(const ImportRosbag2Options& o) {
           imp.streams.joints.t_ns.size(), imp.streams.poses.t_ns.size(), nominal.cf);
     }
     return 0;
-  } catch (const std::invalid_argument& e) {
-    std::cerr << kPrefix << e.what() << "\n";
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << kPrefix << e.what() << "\n";
-    return 1;
-  }
+  });
 }
 
 }  // namespace fitcal::tools

@@ -9,6 +9,8 @@
 #include "io/atomic_file.h"
 #include "io/staged_directory.h"
 #include "models/model_registry.h"
+#include "tools/command_failure.h"
+#include "tools/dataset_command.h"
 #include "tools/output_guard.h"
 #include "tools/sim/model_scenarios.h"
 #include "tools/sim/model_simulator.h"
@@ -57,25 +59,21 @@ void PrintTruth(const Robot& robot, const std::vector<double>& truth) {
 }  // namespace
 
 int RunModelSimulateCommand(const ModelSimulateOptions& options) {
-  if (!options.flower_only_flags.empty()) {
-    std::cerr << "fitcal simulate: " << options.flower_only_flags.front()
-              << " belongs to the flower simulation (simulate without --model), not to --model "
-              << options.model << " (docs/simulate.md)\n";
-    return 2;
-  }
-  if (const std::string refusal =
-          DirectoryOutputRefusal(options.out, kDatasetKind, options.force, {});
-      !refusal.empty()) {
-    std::cerr << "fitcal simulate: " << refusal << "\n";
-    return 2;
-  }
-  try {
+  return RunReportingErrors("fitcal simulate", [&]() -> int {
+    if (!options.flower_only_flags.empty()) {
+      throw UsageError(options.flower_only_flags.front() +
+                       " belongs to the flower simulation (simulate without --model), not to "
+                       "--model " + options.model + " (docs/simulate.md)");
+    }
+    if (const std::string refusal =
+            DirectoryOutputRefusal(options.out, kDatasetKind, options.force, {});
+        !refusal.empty()) {
+      throw UsageError(refusal);
+    }
     const RobotModelPtr model = NominalModel(options);
     const Robot& robot = model->robot();
     if (robot.model != options.model) {
-      std::cerr << "fitcal simulate: " << options.robot << " is a " << robot.model << " robot, not "
-                << options.model << "\n";
-      return 2;
+      throw UsageError(options.robot + " is a " + robot.model + " robot, not " + options.model);
     }
     const std::vector<double> truth = TrueParameters(options, *model);
     const sim::ScenarioNoise& noise = options.noise;
@@ -94,10 +92,7 @@ int RunModelSimulateCommand(const ModelSimulateOptions& options) {
                 static_cast<unsigned long long>(noise.seed), options.out.c_str());
     PrintTruth(robot, truth);
     return 0;
-  } catch (const std::exception& e) {  // io::InputError too: what() is its file:line message
-    std::cerr << "fitcal simulate: " << e.what() << "\n";
-    return 1;
-  }
+  });
 }
 
 }  // namespace fitcal::tools

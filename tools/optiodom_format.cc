@@ -1,11 +1,12 @@
 #include "tools/optiodom_format.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <regex>
 #include <set>
-#include <stdexcept>
+#include <string_view>
 
 #include "io/atomic_file.h"
 #include "io/input_error.h"
@@ -27,8 +28,7 @@ const std::set<std::string> kMetadataKeys = {"type",  "ngear",  "encRes", "Li", 
                                              "Thi",   "N",      "L",      "imarkers", "gt_ti",
                                              "gt_tf", "odo_ti", "odo_tf"};
 
-}  // namespace
-
+// The comma-separated fields of one line, each trimmed.
 std::vector<std::string> SplitCsv(std::string_view line) {
   std::vector<std::string> out;
   std::size_t pos = 0;
@@ -41,6 +41,7 @@ std::vector<std::string> SplitCsv(std::string_view line) {
   return out;
 }
 
+// A finite number, or InputError(path:line: `what` is not a finite number: '<field>').
 double ParseNumber(const std::string& field, const std::string& path, int line,
                    const std::string& what) {
   double v = 0.0;
@@ -51,6 +52,8 @@ double ParseNumber(const std::string& field, const std::string& path, int line,
   }
   return v;
 }
+
+}  // namespace
 
 std::vector<double> Metadata::Values(const std::string& key, std::size_t count,
                                      bool positive) const {
@@ -162,8 +165,12 @@ std::string SessionType(const std::string& directory) {
   throw InputError(InputErrorKind::kMissingKey, path, 0, "no 'type' row");
 }
 
-RunRows ReadRun(const std::string& path, int number, int encoder_columns,
-                const std::string& column_names, const std::string& short_row_hint) {
+RunRows ReadRun(const std::string& path, int number, const std::string& column_names) {
+  const std::size_t last = column_names.rfind(", ");
+  const std::string short_row_hint =
+      ": no " + column_names.substr(last == std::string::npos ? 0 : last + 2) + " column";
+  const int encoder_columns =
+      1 + static_cast<int>(std::count(column_names.begin(), column_names.end(), ','));
   const std::string text = io::ReadTextFile(path);
   io::LineScanner lines(text);
   std::string_view line;
@@ -202,23 +209,9 @@ RunRows ReadRun(const std::string& path, int number, int encoder_columns,
   return run;
 }
 
-void CheckImportArguments(const std::vector<std::string>& session_dirs, const std::string& out,
-                          bool force) {
-  if (session_dirs.empty()) {
-    throw std::invalid_argument("import needs at least one OptiOdom session directory");
-  }
-  if (const std::string refusal = DirectoryOutputRefusal(out, kDatasetKind, force, session_dirs);
-      !refusal.empty()) {
-    throw std::runtime_error(refusal);
-  }
-}
+namespace {
 
-void ThrowNotOneRobot(const std::string& session, const std::string& first) {
-  throw InputError(InputErrorKind::kBadValue, session + "_metadata.csv", 0,
-                   "robot geometry or encoders differ from session " + first +
-                       "'s; import sessions of one robot together");
-}
-
+// Rates over (t(k-1), t(k)], the reading column the mean of its ends (header).
 EncoderLog RatesOf(const RunRows& run, double ticks_per_rev, int reading_column) {
   const int columns = static_cast<int>(run.encoder.front().size());
   const double rad_per_tick = 2.0 * M_PI / ticks_per_rev;
@@ -237,23 +230,29 @@ EncoderLog RatesOf(const RunRows& run, double ticks_per_rev, int reading_column)
   return log;
 }
 
-RunLog RunLogOf(const std::string& path_type, const std::string& session, const RunRows& run,
-                double ticks_per_rev, int reading_column, char separator) {
+void AppendShortest(std::string* out, double v) {
+  char buffer[32];
+  const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, v);  // shortest exact
+  out->append(buffer, end);
+}
+
+}  // namespace
+
+RunLog RunLogOf(const RunRows& run, double ticks_per_rev, int reading_column) {
   RunLog log;
-  const std::string number = std::to_string(run.number);
-  log.id = path_type + separator + session + separator + "run" +
-           (number.size() < 2 ? "0" + number : number);  // %02d
-  log.trajectory = path_type + "_" + session;
-  log.repetition = run.number;
   log.encoders = RatesOf(run, ticks_per_rev, reading_column);
   log.ground_truth = run.ground_truth;
   log.start_pose = run.ground_truth.world_T_robot.front();
   return log;
 }
 
-std::string IncrementsCsv(const std::string& header, const RunRows& run, int time_decimals,
-                          int reading_column) {
-  std::string out = header + "\n";
+std::string TicksCsv(const Robot& robot, const RunRows& run, int time_decimals,
+                     int reading_column) {
+  std::string out = "t";
+  for (const ChannelInfo& c : robot.channels) {
+    out += "," + (c.ticks_column.empty() ? c.rate_column : c.ticks_column);
+  }
+  out += "\n";
   out.reserve(out.size() + 40 * run.t_s.size());
   for (std::size_t k = 0; k < run.t_s.size(); ++k) {
     io::AppendFixed(&out, run.t_s[k], time_decimals);
@@ -263,6 +262,36 @@ std::string IncrementsCsv(const std::string& header, const RunRows& run, int tim
       io::AppendGeneral(&out, counted_before_start ? 0.0 : run.encoder[k][j], 10);
     }
     out += '\n';
+  }
+  return out;
+}
+
+std::string ExactRatesCsv(const Robot& robot, const RunLog& log) {
+  std::string out = "t";
+  for (const ChannelInfo& c : robot.channels) out += "," + c.rate_column;
+  out += "\n";
+  out.reserve(log.encoders.t_s.size() * 64);
+  for (std::size_t k = 0; k < log.encoders.t_s.size(); ++k) {
+    AppendShortest(&out, log.encoders.t_s[k]);
+    for (int i = 0; i < robot.NumChannels(); ++i) {
+      out += ',';
+      AppendShortest(&out, k == 0 ? 0.0 : log.encoders.samples[k - 1].value[i]);
+    }
+    out += '\n';
+  }
+  return out;
+}
+
+std::string ExactGroundTruthCsv(const GroundTruthTrack& track) {
+  std::string out = "t,x,y,theta\n";
+  out.reserve(track.t_s.size() * 64);
+  for (std::size_t k = 0; k < track.t_s.size(); ++k) {
+    const Pose2d& pose = track.world_T_robot[k];
+    for (double v : {track.t_s[k], pose.x, pose.y, pose.theta}) {
+      AppendShortest(&out, v);
+      out += ',';
+    }
+    out.back() = '\n';
   }
   return out;
 }

@@ -6,28 +6,20 @@
 //                         gt_ti, gt_tf, odo_ti, odo_tf), padded with empty fields to the widest
 //   <s>/<s>_run-NN.csv    no header, `t_s, x_gt_m, y_gt_m, theta_gt_rad, enc_1, ..., enc_m`
 // Only the meaning of the encoder columns and of Li / Di differs between robots; that lives in the
-// per-robot importers. Every function throws io::InputError (file, line, cause) on bad input.
+// table of robots (tools/optiodom_robots.h). Every function throws io::InputError (file, line,
+// cause) on bad input.
 
 #include <functional>
 #include <map>
 #include <string>
-#include <string_view>
 #include <utility>
 #include <vector>
 
 #include "io/dataset.h"
 #include "models/model_interface.h"
-#include "odometry/parallel_for.h"
 #include "odometry/run_log.h"
 
 namespace fitcal::tools::optiodom {
-
-// The comma-separated fields of one line, each trimmed.
-std::vector<std::string> SplitCsv(std::string_view line);
-
-// A finite number, or InputError(path:line: `what` is not a finite number: '<field>').
-double ParseNumber(const std::string& field, const std::string& path, int line,
-                   const std::string& what);
 
 // <s>_metadata.csv: the `type` row and every numeric row, key -> (line, values).
 struct Metadata {
@@ -71,92 +63,27 @@ struct RunRows {
   GroundTruthTrack ground_truth;
 };
 
-// Reads a run file with `encoder_columns` encoder columns named `column_names` in messages
-// ("ticks_right, ticks_left"); `short_row_hint` is added when a row lacks one field.
-RunRows ReadRun(const std::string& path, int number, int encoder_columns,
-                const std::string& column_names, const std::string& short_row_hint = "");
+// Reads a run file whose encoder columns are `column_names` ("ticks_right, ticks_left": their
+// number, and their names in messages; a row one field short lacks the last of them).
+RunRows ReadRun(const std::string& path, int number, const std::string& column_names);
 
-// One session of a robot: its names, its metadata as the robot reads it, its runs by number.
-template <typename Meta, typename Run>
-struct Session {
-  std::string name;       // directory name, e.g. 221220201643
-  std::string path_type;  // parent directory name, e.g. circular, square
-  std::string metadata_path;
-  Meta metadata;
-  std::vector<Run> runs;  // sorted by run number
-};
-
-// Reads a session with the robot's readers, read_metadata(path) -> Meta (with num_runs) and
-// read_run(path, number, session) -> Run (the session's names and metadata already read), the
-// runs in parallel.
-template <typename Meta, typename Run, typename ReadMetadataFn, typename ReadRunFn>
-Session<Meta, Run> ReadSession(const std::string& directory, ReadMetadataFn read_metadata,
-                               ReadRunFn read_run) {
-  const SessionFiles files = ListSession(directory);
-  Session<Meta, Run> s{
-      files.name, files.path_type, files.metadata_path, read_metadata(files.metadata_path), {}};
-  CheckRunCount(files, s.metadata.num_runs);
-  s.runs.resize(files.runs.size());
-  ParallelFor(files.runs.size(), 0, [&](std::size_t i) {
-    s.runs[i] = read_run(files.runs[i].second, files.runs[i].first, s);
-  });
-  return s;
-}
-
-// Refuses no session and an `out` the output guard refuses (tools/output_guard.h), then reads
-// every session with read(directory): all input is read and checked before anything is written.
-void CheckImportArguments(const std::vector<std::string>& session_dirs, const std::string& out,
-                          bool force);
-template <typename Session, typename ReadFn>
-std::vector<Session> ReadSessions(const std::vector<std::string>& session_dirs,
-                                  const std::string& out, bool force, ReadFn read) {
-  CheckImportArguments(session_dirs, out, force);
-  std::vector<Session> sessions;
-  for (const std::string& dir : session_dirs) sessions.push_back(read(dir));
-  return sessions;
-}
-
-// The session whose robot most sessions declare (ties: the earliest); same(a, b) compares two
-// sessions' metadata. Some sessions declare perturbed values on purpose (README), the robot is
-// the same.
-template <typename Session, typename Same>
-const Session& MajorityRobot(const std::vector<Session>& sessions, Same same) {
-  std::size_t best = 0, best_count = 0;
-  for (std::size_t i = 0; i < sessions.size(); ++i) {
-    std::size_t count = 0;
-    for (const Session& s : sessions) count += same(s.metadata, sessions[i].metadata) ? 1 : 0;
-    if (count > best_count) best = i, best_count = count;
-  }
-  return sessions[best];
-}
-
-// Refuses sessions whose robot differs from the first session's (same(a, b) compares them).
-[[noreturn]] void ThrowNotOneRobot(const std::string& session, const std::string& first);
-template <typename Session, typename Same>
-void CheckOneRobot(const std::vector<Session>& sessions, Same same) {
-  for (const Session& s : sessions) {
-    if (!same(s.metadata, sessions.front().metadata)) {
-      ThrowNotOneRobot(s.name, sessions.front().name);
-    }
-  }
-}
-
-// Wheel rates over (t(k-1), t(k)]: 2 pi / ticks_per_rev * increment(k) / dt for every column but
+// A run as fitcal replays it (the robot labels it: id, trajectory, repetition): wheel rates
+// 2 pi / ticks_per_rev * increment(k) / dt over (t(k-1), t(k)] for every column but
 // `reading_column` (an angle read at t(k): tricycle steering), which gets the mean of its readings
-// at both ends of the interval.
-EncoderLog RatesOf(const RunRows& run, double ticks_per_rev, int reading_column = -1);
+// at both ends of the interval; the ground truth, and the start pose: the robot is at rest at the
+// start, the ground truth in its start frame.
+RunLog RunLogOf(const RunRows& run, double ticks_per_rev, int reading_column);
 
-// A run as fitcal replays it: id `<path type><sep><session><sep>runNN`, trajectory
-// `<path type>_<session>` and repetition NN (a robot may relabel), wheel rates (RatesOf), the
-// ground truth, and the start pose: the robot is at rest at the start, the ground truth in its
-// start frame.
-RunLog RunLogOf(const std::string& path_type, const std::string& session, const RunRows& run,
-                double ticks_per_rev, int reading_column = -1, char separator = '_');
+// The encoder CSV of ticks as the robot logged them: header `t,<ticks column of each channel, or
+// its rate column for an angle>`, then per row t (`time_decimals` fixed) and every column as
+// %.10g; increments are 0 at row 0 (counted before the run), readings as read.
+std::string TicksCsv(const Robot& robot, const RunRows& run, int time_decimals, int reading_column);
 
-// The encoder CSV as the robot logged it: `header`, then per row t (`time_decimals` fixed) and
-// every column as %.10g; increments are 0 at row 0 (counted before the run), readings as read.
-std::string IncrementsCsv(const std::string& header, const RunRows& run, int time_decimals,
-                          int reading_column = -1);
+// The encoder CSV of wheel rates (header `t,<rate column of each channel>`, row 0 zero) and the
+// ground-truth CSV (`t,x,y,theta`), every number in its shortest exact form (std::to_chars): for
+// logs that are not ticks, nothing was rounded to a resolution on the way in.
+std::string ExactRatesCsv(const Robot& robot, const RunLog& log);
+std::string ExactGroundTruthCsv(const GroundTruthTrack& track);
 
 // ---- Writing the fitcal data set (README.md "Data set format").
 

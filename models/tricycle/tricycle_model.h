@@ -45,7 +45,7 @@ class TricycleModel : public KinematicModel<TricycleKinematics> {
 // nominal and bounds empty.
 Robot TricycleRobotDescription(const std::string& name, const std::string& traction_name);
 
-// The OptiOdom tricycle's nominal robot (data sheet values, tools/import_optiodom_tricycle.h).
+// The OptiOdom tricycle's nominal robot (data sheet values, tools/optiodom_robots.cc).
 inline constexpr const char* kTricycleExampleYaml = R"(model: tricycle
 name: example_tricycle
 traction_wheel: {radius_m: 0.0325}

@@ -42,25 +42,6 @@ std::vector<double> ParameterVector(const omni3::Parameters& p) {
   return {a.begin(), a.end()};
 }
 
-std::vector<TrajectorySpec> FlowerSpecs(const std::vector<MotionCommand>& commands,
-                                        int repetitions) {
-  if (repetitions < 1) throw std::invalid_argument("simulation: repetitions must be >= 1");
-  if (commands.empty()) throw std::invalid_argument("simulation: no trajectories");
-  std::vector<TrajectorySpec> out;
-  for (int rep = 1; rep <= repetitions; ++rep) {
-    for (const MotionCommand& c : commands) {
-      if (!(c.speed_m_s > 0.0 && c.distance_m > 0.0)) {
-        throw std::invalid_argument("simulation: trajectory needs speed > 0 and distance > 0");
-      }
-      // Eq. 1 / Table A1: speed v in direction alpha of the robot frame while turning at omega.
-      const Twist twist{c.speed_m_s * std::cos(c.alpha_rad), c.speed_m_s * std::sin(c.alpha_rad),
-                        c.omega_rad_s};
-      out.push_back({c.label, rep, {{twist, c.distance_m / c.speed_m_s}}});
-    }
-  }
-  return out;
-}
-
 SimulationOptions FlowerSimulationOptions(const std::vector<double>& commanded_parameters) {
   SimulationOptions o;
   o.encoder_period_s = 0.010;  // APR-02: 10 ms PID period

@@ -31,12 +31,6 @@ Omni3Robot PalacinApr02Robot();
 // The nine parameters in the seam's order (Eq. 15: R_i, r_i, delta_i).
 std::vector<double> ParameterVector(const omni3::Parameters& p);
 
-// The motion commands as trajectories of one twist segment each (v cos alpha, v sin alpha,
-// omega) held for distance / v, for repetitions 1..repetitions (ordered by repetition, then
-// command).
-std::vector<TrajectorySpec> FlowerSpecs(const std::vector<MotionCommand>& commands,
-                                        int repetitions);
-
 // The flower's options (header) with the robot the controller commands.
 SimulationOptions FlowerSimulationOptions(const std::vector<double>& commanded_parameters);
 

@@ -2,10 +2,13 @@
 // The 36 "flower" calibration trajectories of Palacin et al. 2022, Fig. 9 and Table A1: straight
 // runs R1..R12, counter-clockwise curves G1..G12 and clockwise curves B1..B12, each a motion
 // command held until the robot has covered distance_m: speed v in direction alpha (robot frame,
-// alpha = 30 (i - 1) deg for trajectory i) while turning at omega.
+// alpha = 30 (i - 1) deg for trajectory i) while turning at omega. The same shapes in n
+// directions (alpha = 360 (i - 1) / n deg) serve every holonomic robot (omni_trajectories.h).
 
 #include <string>
 #include <vector>
+
+#include "tools/sim/model_simulator.h"
 
 namespace fitcal::sim {
 
@@ -18,9 +21,15 @@ struct MotionCommand {
 };
 
 // Table A1 in its printed order (R1..R12, G1..G12, B1..B12); speed_m_s and omega_abs_rad_s let
-// the simulator record the same flower at another speed.
+// the simulator record the same flower at another speed, num_directions in other directions.
 std::vector<MotionCommand> FlowerTrajectories(double speed_m_s = 0.35,
                                               double omega_abs_rad_s = 0.35,
-                                              double distance_m = 1.0);
+                                              double distance_m = 1.0, int num_directions = 12);
+
+// The motion commands as trajectories of one twist segment each (v cos alpha, v sin alpha,
+// omega) held for distance / v, for repetitions 1..repetitions (ordered by repetition, then
+// command).
+std::vector<TrajectorySpec> FlowerSpecs(const std::vector<MotionCommand>& commands,
+                                        int repetitions);
 
 }  // namespace fitcal::sim

@@ -1,11 +1,9 @@
 #pragma once
 // Palacin et al. 2022's "flower" calibration trajectories (Fig. 9, Table A1;
-// tools/sim/flower_trajectories.h) for any holonomic robot and the generic simulator
-// (model_simulator.h): straight runs R1..Rn in n directions alpha_i = 360 deg (i - 1) / n of the
-// robot frame, counter-clockwise curves G1..Gn and clockwise curves B1..Bn in the same directions.
-// Each holds the body twist (v cos alpha, v sin alpha, omega) until the robot has covered
-// distance_m (for a curve: an arc of radius v / |omega|). With n = 12 and the defaults these are
-// Table A1's 36 trajectories. Optional spins on the spot (S-ccw, S-cw) excite the yaw alone.
+// tools/sim/flower_trajectories.h, which defines them) for any holonomic robot and the generic
+// simulator (model_simulator.h): the R, G and B families in n directions of the robot frame, each
+// run as one twist segment (FlowerSpecs). With n = 12 and the defaults these are Table A1's 36
+// trajectories. Optional spins on the spot (S-ccw, S-cw) excite the yaw alone.
 
 #include <vector>
 

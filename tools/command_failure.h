@@ -1,0 +1,34 @@
+#pragma once
+// A command's failure that has an exit status of its own (README, exit codes): thrown where it is
+// found, turned into one line `<prefix>: <what>` and that status by RunReportingErrors
+// (tools/dataset_command.h), the one edge every command shares. Any other exception is bad
+// input: status 1.
+
+#include <stdexcept>
+#include <string>
+
+namespace fitcal::tools {
+
+class CommandFailure : public std::runtime_error {
+ public:
+  CommandFailure(int exit_status, const std::string& what)
+      : std::runtime_error(what), exit_status_(exit_status) {}
+  int exit_status() const { return exit_status_; }
+
+ private:
+  int exit_status_;
+};
+
+// Status 2: a flag, a combination of flags or an output the command refuses.
+class UsageError : public CommandFailure {
+ public:
+  explicit UsageError(const std::string& what) : CommandFailure(2, what) {}
+};
+
+// Status 5: no calibration beats the nominal robot on the judging runs.
+class WorseThanNominalError : public CommandFailure {
+ public:
+  explicit WorseThanNominalError(const std::string& what) : CommandFailure(5, what) {}
+};
+
+}  // namespace fitcal::tools
