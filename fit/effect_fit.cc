@@ -250,12 +250,6 @@ std::vector<double> WindowStartWheelAngles(const EncoderLog& log, double t_start
   return angle;
 }
 
-}  // namespace
-
-TrackRun PrepareTrackRun(const RunLog& run, const TrackOptions& options) {
-  return PrepareTrackRun(run, ~0u, options);
-}
-
 TrackRun PrepareTrackRun(const RunLog& run, unsigned wheel_mask, const TrackOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) throw std::invalid_argument("TrackOptions: " + error);
@@ -277,10 +271,7 @@ TrackRun PrepareTrackRun(const RunLog& run, unsigned wheel_mask, const TrackOpti
   return out;
 }
 
-std::vector<TrackRun> PrepareTrackRuns(const std::vector<RunLog>& runs,
-                                       const TrackOptions& options) {
-  return PrepareTrackRuns(runs, ~0u, options);
-}
+}  // namespace
 
 std::vector<TrackRun> PrepareTrackRuns(const std::vector<RunLog>& runs, unsigned wheel_mask,
                                        const TrackOptions& options) {
@@ -288,17 +279,6 @@ std::vector<TrackRun> PrepareTrackRuns(const std::vector<RunLog>& runs, unsigned
   ParallelFor(runs.size(), 0,
               [&](std::size_t i) { out[i] = PrepareTrackRun(runs[i], wheel_mask, options); });
   return out;
-}
-
-void SplitTrackRuns(std::vector<TrackRun> runs, const std::vector<int>& training_reps,
-                    std::vector<TrackRun>* training, std::vector<TrackRun>* validation) {
-  training->clear();
-  validation->clear();
-  for (TrackRun& run : runs) {
-    const bool train = std::find(training_reps.begin(), training_reps.end(),
-                                 run.aligned.repetition) != training_reps.end();
-    (train ? training : validation)->push_back(std::move(run));
-  }
 }
 
 FinalPoseErrors FinalPoseErrorsOf(const ModelScore& score) {

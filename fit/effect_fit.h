@@ -117,18 +117,14 @@ struct TrackOptions {
   bool IsValid(std::string* error) const;
 };
 
-// Every channel a wheel rate (omni3's three), or those of wheel_mask (WheelChannelMask).
-TrackRun PrepareTrackRun(const RunLog& run, const TrackOptions& options = {});
-TrackRun PrepareTrackRun(const RunLog& run, unsigned wheel_mask, const TrackOptions& options = {});
-std::vector<TrackRun> PrepareTrackRuns(const std::vector<RunLog>& runs,
-                                       const TrackOptions& options = {});
-std::vector<TrackRun> PrepareTrackRuns(const std::vector<RunLog>& runs, unsigned wheel_mask,
+// wheel_mask: bit i set when channel i is a wheel rate (WheelChannelMask); the default, every
+// channel, suits a robot whose channels are all wheels (omni3's three).
+std::vector<TrackRun> PrepareTrackRuns(const std::vector<RunLog>& runs, unsigned wheel_mask = ~0u,
                                        const TrackOptions& options = {});
 // Bit i set when the robot's channel i is a wheel rate (effects::SampleContext::wheel_mask).
 unsigned WheelChannelMask(const Robot& robot);
-// Training/validation by repetition (as fit/run_split.h).
-void SplitTrackRuns(std::vector<TrackRun> runs, const std::vector<int>& training_reps,
-                    std::vector<TrackRun>* training, std::vector<TrackRun>* validation);
+// The split of track runs (fit/run_split.h) reads each run's aligned part.
+inline const AlignedRun& AlignedOf(const TrackRun& run) { return run.aligned; }
 
 using EffectModel = std::vector<effects::EffectValue>;
 

@@ -1,10 +1,7 @@
 #include "fit/run_split.h"
 
-#include <algorithm>
 #include <set>
 #include <stdexcept>
-
-#include "fit/trajectory_split.h"
 
 namespace fitcal {
 
@@ -54,44 +51,10 @@ std::string FormatRepetitionList(const std::vector<int>& reps) {
   return out.empty() ? "none" : out;
 }
 
-RunSplit SplitByRepetition(std::vector<AlignedRun> runs, const std::vector<int>& training_reps) {
-  RunSplit split;
-  std::set<int> train_set(training_reps.begin(), training_reps.end());
-  std::set<int> seen_train, seen_validation;
-  for (AlignedRun& run : runs) {
-    if (train_set.count(run.repetition)) {
-      seen_train.insert(run.repetition);
-      split.training.push_back(std::move(run));
-    } else {
-      seen_validation.insert(run.repetition);
-      split.validation.push_back(std::move(run));
-    }
-  }
-  split.training_repetitions.assign(seen_train.begin(), seen_train.end());
-  split.validation_repetitions.assign(seen_validation.begin(), seen_validation.end());
-  return split;
-}
-
-RunSplit SplitByTrajectory(std::vector<AlignedRun> runs, const std::string& selector_text) {
-  std::vector<std::string> labels;
-  for (const AlignedRun& run : runs) labels.push_back(run.trajectory);
-  const TrajectorySelector selector(selector_text, labels);
-  RunSplit split;
-  std::set<int> seen_train, seen_validation;
-  for (AlignedRun& run : runs) {
-    const bool trains = selector.Matches(run.trajectory);
-    (trains ? seen_train : seen_validation).insert(run.repetition);
-    (trains ? split.training : split.validation).push_back(std::move(run));
-  }
-  split.training_repetitions.assign(seen_train.begin(), seen_train.end());
-  split.validation_repetitions.assign(seen_validation.begin(), seen_validation.end());
-  return split;
-}
-
-RunSplit SplitForFit(std::vector<AlignedRun> runs, const std::string& train_reps,
-                     const std::string& train_trajectories) {
-  if (!train_trajectories.empty()) return SplitByTrajectory(std::move(runs), train_trajectories);
-  return SplitByRepetition(std::move(runs), ParseRepetitionList(train_reps));
+std::vector<int> ResolveRepetitionList(const std::string& text, const std::set<int>& present) {
+  if (text != "auto") return ParseRepetitionList(text);
+  const std::vector<int> all(present.begin(), present.end());
+  return std::vector<int>(all.begin(), all.begin() + static_cast<long>((all.size() + 1) / 2));
 }
 
 }  // namespace fitcal

@@ -10,6 +10,7 @@
 
 #include "diagnosis/clock_choice.h"
 #include "diagnosis/diagnose.h"
+#include "fit/run_split.h"
 #include "fit/segment_cost.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "tools/sim/flower_scenario.h"
@@ -126,11 +127,10 @@ TEST(HiddenStructure, ClockMapKeepsTheIdentityOnCorrectlyClockedData) {
   }
   const std::vector<RunLog> chosen = ApplyClockChoice(choice, logs, mapped);
   const auto score = [&](const std::vector<RunLog>& runs) {
-    std::vector<TrackRun> training, validation;
-    SplitTrackRuns(PrepareTrackRuns(runs), {1}, &training, &validation);
+    const SplitOf<TrackRun> split = SplitByRepetition(PrepareTrackRuns(runs), {1});
     DiagnoseOptions options;
     options.max_effects = 0;
-    return Diagnose(training, validation, *model, options).final_validation;
+    return Diagnose(split.training, split.validation, *model, options).final_validation;
   };
   const ModelScore identity = score(logs);
   const ModelScore with_choice = score(chosen);
@@ -171,9 +171,8 @@ HiddenData SimulateRepetitions(
       logs.push_back(std::move(log));
     }
   }
-  HiddenData d;
-  SplitTrackRuns(PrepareTrackRuns(logs), {1, 2}, &d.training, &d.validation);
-  return d;
+  SplitOf<TrackRun> split = SplitByRepetition(PrepareTrackRuns(logs), {1, 2});
+  return {std::move(split.training), std::move(split.validation)};
 }
 
 // Wear over a session: the wheel radii shrink by kWearPerRepetition with every repetition.
@@ -202,9 +201,8 @@ HiddenData SimulateCarpet(std::uint64_t seed) {
     v->vx_m_s *= 1.0 + kPile * std::cos(psi);
     v->vy_m_s *= 1.0 + kPile * std::cos(psi);
   };
-  HiddenData d;
-  SplitTrackRuns(PrepareTrackRuns(SimulateLogs(o)), {1, 2}, &d.training, &d.validation);
-  return d;
+  SplitOf<TrackRun> split = SplitByRepetition(PrepareTrackRuns(SimulateLogs(o)), {1, 2});
+  return {std::move(split.training), std::move(split.validation)};
 }
 
 // No repetitions at all (one run of each of the 36 flower trajectories; free driving has none):

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <string>
 
+#include "fit/run_split.h"
 #include "models/model_registry.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "tools/sim/flower_scenario.h"
@@ -49,9 +50,8 @@ effects::EffectValue InjectTypical(effects::EffectId id, sim::FlowerSimulation* 
 Data Simulate(sim::FlowerSimulation o, const std::vector<int>& training_repetitions = {1}) {
   o.options.stepped->commanded_parameters = sim::ParameterVector(NominalRobot().nominal);
   std::vector<RunLog> logs = sim::SimulateFlowerLogs(o);
-  Data d;
-  SplitTrackRuns(PrepareTrackRuns(logs), training_repetitions, &d.training, &d.validation);
-  return d;
+  SplitOf<TrackRun> split = SplitByRepetition(PrepareTrackRuns(logs), training_repetitions);
+  return {std::move(split.training), std::move(split.validation)};
 }
 
 // Every fitted candidate's verdict reports its held-out test as it came out: "not significant"

@@ -9,6 +9,7 @@
 #include <cstdio>
 
 #include "diagnosis/diagnose.h"
+#include "fit/run_split.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "tools/sim/flower_scenario.h"
 
@@ -31,11 +32,10 @@ DiagnoseResult DiagnoseEccentric(double eccentricity, std::uint64_t seed) {
   const Omni3Robot robot = NominalRobot();
   o.options.stepped->commanded_parameters = sim::ParameterVector(robot.nominal);
   std::vector<RunLog> logs = sim::SimulateFlowerLogs(o);
-  std::vector<TrackRun> training, validation;
-  SplitTrackRuns(PrepareTrackRuns(logs), {1, 2}, &training, &validation);
+  const SplitOf<TrackRun> split = SplitByRepetition(PrepareTrackRuns(logs), {1, 2});
   DiagnoseOptions options;
   options.max_effects = 1;
-  return Diagnose(training, validation, *Omni3ModelOf(robot), options);
+  return Diagnose(split.training, split.validation, *Omni3ModelOf(robot), options);
 }
 
 const CovariateTest& WheelAngleTest(const DiagnoseResult& r) {

@@ -107,10 +107,9 @@ Split Simulate(const RobotModelInterface& model, double pivot_gain, std::uint64_
   for (const sim::ModelSimulatedRun& run : SimulatePivotRuns(model, pivot_gain, seed)) {
     logs.push_back(run.log);
   }
-  Split out;
-  SplitTrackRuns(PrepareTrackRuns(logs, WheelChannelMask(model.robot())), {1, 2}, &out.training,
-                 &out.validation);
-  return out;
+  SplitOf<TrackRun> split =
+      SplitByRepetition(PrepareTrackRuns(logs, WheelChannelMask(model.robot())), {1, 2});
+  return {std::move(split.training), std::move(split.validation)};
 }
 
 RobotModelPtr DiffDrive() { return ReadDiffDriveModel(YAML::Load(kDiffDriveExampleYaml), "ex"); }

@@ -11,6 +11,7 @@
 
 #include "diagnosis/diagnose.h"
 #include "fit/effect_fit.h"
+#include "fit/run_split.h"
 #include "models/tricycle/tricycle_model.h"
 #include "tests/diagnose_expectations.h"
 #include "tools/sim/model_simulator.h"
@@ -55,10 +56,9 @@ Split Simulate(const RobotModelInterface& model, double steering_scale, std::uin
     log.encoders.samples = scaled;
     logs.push_back(log);
   }
-  Split out;
-  SplitTrackRuns(PrepareTrackRuns(logs, WheelChannelMask(model.robot())), {1}, &out.training,
-                 &out.validation);
-  return out;
+  SplitOf<TrackRun> split =
+      SplitByRepetition(PrepareTrackRuns(logs, WheelChannelMask(model.robot())), {1});
+  return {std::move(split.training), std::move(split.validation)};
 }
 
 std::shared_ptr<const RobotModelInterface> Tricycle() {

@@ -13,7 +13,6 @@
 #include "fit/correlation.h"
 #include "fit/run_split.h"
 #include "fit/segment_cost.h"
-#include "fit/trajectory_split.h"
 #include "fitcal/version.h"
 #include "io/atomic_file.h"
 #include "io/calibration_block.h"
@@ -74,42 +73,21 @@ const std::set<std::string> kDiagnoseFiles = {"index.html",    "metrics.json",
                                               "diagnose.md",   "residuals.csv",
                                               "residuals_declared.csv", "calibrated.yaml"};
 
-struct DiagnoseSplit {
-  std::vector<TrackRun> training, validation;
-  std::vector<int> train_reps;
+// The track runs on each side (fit/run_split.h: by --train-trajectories, else by --train-reps,
+// "auto" the first half of the repetitions present), and the split in words for the page.
+struct DiagnoseSplit : SplitOf<TrackRun> {
   std::string text;
 };
 
-// Training and held-out track runs, by --train-trajectories or by --train-reps ("auto": the
-// first half of the repetitions present). wheel_mask marks the robot's wheel-rate channels.
+// wheel_mask marks the robot's wheel-rate channels.
 DiagnoseSplit SplitRuns(const DiagnoseCommandOptions& options, const std::vector<RunLog>& runs,
                         unsigned wheel_mask) {
-  DiagnoseSplit out;
-  if (!options.train_trajectories.empty()) {
-    std::vector<std::string> labels;
-    for (const RunLog& run : runs) labels.push_back(run.trajectory);
-    const TrajectorySelector selector(options.train_trajectories, labels);
-    std::set<int> reps;
-    for (TrackRun& run : PrepareTrackRuns(runs, wheel_mask)) {
-      const bool train = selector.Matches(run.aligned.trajectory);
-      if (train) reps.insert(run.aligned.repetition);
-      (train ? out.training : out.validation).push_back(std::move(run));
-    }
-    out.train_reps.assign(reps.begin(), reps.end());
-    out.text = "training trajectories matching '" + options.train_trajectories + "'";
-    return out;
-  }
-  if (options.train_reps == "auto") {
-    std::set<int> reps;
-    for (const RunLog& run : runs) reps.insert(run.repetition);
-    const std::vector<int> all(reps.begin(), reps.end());
-    out.train_reps.assign(all.begin(), all.begin() + static_cast<long>((all.size() + 1) / 2));
-  } else {
-    out.train_reps = ParseRepetitionList(options.train_reps);
-  }
-  SplitTrackRuns(PrepareTrackRuns(runs, wheel_mask), out.train_reps, &out.training,
-                 &out.validation);
-  out.text = "training repetitions " + FormatRepetitionList(out.train_reps);
+  DiagnoseSplit out{SplitForFit(PrepareTrackRuns(runs, wheel_mask), options.train_reps,
+                                options.train_trajectories),
+                    ""};
+  out.text = options.train_trajectories.empty()
+                 ? "training repetitions " + FormatRepetitionList(out.training_repetitions)
+                 : "training trajectories matching '" + options.train_trajectories + "'";
   return out;
 }
 
@@ -213,12 +191,6 @@ std::string ObjectiveOf(const DiagnoseChoice& choice) {
              : "sum over runs of the mean squared track error (m and rad)";
 }
 
-std::vector<int> ValidationRepetitions(const DiagnoseSplit& split) {
-  std::set<int> reps;
-  for (const TrackRun& r : split.validation) reps.insert(r.aligned.repetition);
-  return {reps.begin(), reps.end()};
-}
-
 // What the calibrated YAML records of the diagnosis: the chosen candidate, its objective, the
 // training and held-out runs, and the CF before and after on both.
 void RecordSource(const DiagnoseCommandOptions& options, const std::vector<RunLog>& logs,
@@ -230,8 +202,8 @@ void RecordSource(const DiagnoseCommandOptions& options, const std::vector<RunLo
   s.dataset = options.logs;
   s.tool_version = kVersion;
   s.termination = result.final_fit.termination;
-  s.training_repetitions = split.train_reps;
-  s.validation_repetitions = ValidationRepetitions(split);
+  s.training_repetitions = split.training_repetitions;
+  s.validation_repetitions = split.validation_repetitions;
   for (const TrackRun& r : split.training) s.training_run_ids.push_back(r.aligned.id);
   s.training_trajectories = options.train_trajectories;
   s.training_fingerprint = TrainingFingerprint(logs, s.training_run_ids);

@@ -21,15 +21,6 @@ namespace fitcal::tools {
 
 namespace {
 
-// "auto": the first half of the repetitions present (rounded up), as `diagnose` splits.
-std::vector<int> TrainingRepetitions(const std::string& text, const std::vector<AlignedRun>& runs) {
-  if (!text.empty() && text != "auto") return ParseRepetitionList(text);
-  std::set<int> present;
-  for (const AlignedRun& run : runs) present.insert(run.repetition);
-  const std::vector<int> all(present.begin(), present.end());
-  return std::vector<int>(all.begin(), all.begin() + static_cast<long>((all.size() + 1) / 2));
-}
-
 void PrintSplitTableHeader() {
   std::printf(
       "| trained on -> tested on | candidate | train runs | held-out runs | train CF | held-out "
@@ -175,7 +166,9 @@ std::optional<std::vector<GeneralisationSplit>> TableSplits(const GeneraliseComm
   } else {
     splits = PathTypeSplits(runs);
   }
-  const std::vector<int> reps = TrainingRepetitions(options.train_reps, runs);
+  std::set<int> present;
+  for (const AlignedRun& run : runs) present.insert(run.repetition);
+  const std::vector<int> reps = ResolveRepetitionList(options.train_reps, present);
   const std::set<int> rep_set(reps.begin(), reps.end());
   for (GeneralisationSplit& s : PredicateSplits(
            runs, [&](const AlignedRun& run) { return rep_set.count(run.repetition) > 0; },

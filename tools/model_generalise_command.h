@@ -32,11 +32,11 @@ struct GeneraliseCommandOptions : DatasetCommandOptions, TyingFlags {
   // Library effects (odometry/effects.h names): "track fit" and "track fit + effects", fitted to
   // the training runs' ground-truth tracks (fit/effect_fit.h), join the candidates.
   std::vector<std::string> effects;
-  // The repetitions that train the "every path type" split ("" or "auto": the first half of
-  // those present), and what a session of leave-one-session-out is: "label" (the trajectory
-  // label) or "repetition" (path type + repetition number, as the OptiOdom tricycle import
-  // numbers its sessions).
-  std::string train_reps;
+  // The repetitions that train the "every path type" split ("auto": the first half of those
+  // present, fit/run_split.h), and what a session of leave-one-session-out is: "label" (the
+  // trajectory label) or "repetition" (path type + repetition number, as the OptiOdom tricycle
+  // import numbers its sessions).
+  std::string train_reps = "auto";
   std::string sessions = "label";
   // Score the method published with the OptiOdom recordings as one more candidate
   // (validation/generalisation.h TrackCandidates; needs ground-truth tracks). Off by default: its

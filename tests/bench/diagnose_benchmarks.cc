@@ -12,6 +12,7 @@
 #include <filesystem>
 
 #include "diagnosis/diagnose.h"
+#include "fit/run_split.h"
 #include "io/dataset.h"
 #include "models/model_registry.h"
 #include "tools/import_optiodom.h"
@@ -64,10 +65,9 @@ void BM_DiagnoseOptiOdomOmni3(benchmark::State& state) {
     const RobotModelPtr model = ReadRobotModelFile(index.robot_path);
     const io::Dataset dataset = io::LoadDataset(index, model->robot());
     runs = dataset.runs.size();
-    std::vector<TrackRun> training, validation;
-    SplitTrackRuns(PrepareTrackRuns(dataset.runs, WheelChannelMask(model->robot())), {1, 2, 3},
-                   &training, &validation);
-    const DiagnoseResult result = Diagnose(training, validation, *model);
+    const SplitOf<TrackRun> split = SplitByRepetition(
+        PrepareTrackRuns(dataset.runs, WheelChannelMask(model->robot())), {1, 2, 3});
+    const DiagnoseResult result = Diagnose(split.training, split.validation, *model);
     benchmark::DoNotOptimize(result.final_validation.cf);
   }
   state.counters["runs"] = static_cast<double>(runs);
