@@ -22,34 +22,6 @@ namespace {
 using effects::ActiveEffect;
 using effects::EffectId;
 
-template <typename T>
-double Value(const T& x) {
-  if constexpr (std::is_same_v<T, double>) {
-    return x;
-  } else {
-    return x.a;
-  }
-}
-
-// Ground truth at a (possibly differentiated) time, linear interpolation as
-// InterpolateGroundTruth; the bracket is chosen on the value, the fraction keeps derivatives.
-template <typename T>
-Pose2<T> InterpolateTrack(const GroundTruthTrack& track, const T& t_s) {
-  const auto& t = track.t_s;
-  const double tv = Value(t_s);
-  const auto& poses = track.world_T_robot;
-  if (tv <= t.front()) return {T(poses.front().x), T(poses.front().y), T(poses.front().theta)};
-  if (tv >= t.back()) return {T(poses.back().x), T(poses.back().y), T(poses.back().theta)};
-  const std::size_t hi =
-      static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), tv) - t.begin());
-  const std::size_t lo = hi - 1;
-  const T u = (t_s - T(t[lo])) / T(t[hi] - t[lo]);
-  const Pose2d& a = poses[lo];
-  const Pose2d& b = poses[hi];
-  return {T(a.x) + u * T(b.x - a.x), T(a.y) + u * T(b.y - a.y),
-          T(a.theta) + u * T(WrapAngle(b.theta - a.theta))};
-}
-
 // Pose errors (replay - ground truth) at the ground-truth samples `indices` of the run, and at
 // the window's end. err holds 3 values per index, then 3 for the end.
 //
@@ -91,12 +63,12 @@ void TrackPoseErrors(const RobotModelInterface& robot_model, const TrackRun& run
     const bool last = k + 1 == run.contexts.size();
     while (next_anchor < anchors.size()) {
       const T e = encoder_time(anchors[next_anchor]);
-      if (Value(e) > t1 && !last) break;
+      if (ScalarPart(e) > t1 && !last) break;
       anchor_pose[next_anchor++] = lerp(before, after, (e - T(t0)) / T(t1 - t0));
     }
     while (next < n) {
       const T e = encoder_time(indices[next]);
-      if (Value(e) > t1 && !last) break;
+      if (ScalarPart(e) > t1 && !last) break;
       replayed[next++] = lerp(before, after, (e - T(t0)) / T(t1 - t0));
     }
   };
@@ -116,7 +88,7 @@ void TrackPoseErrors(const RobotModelInterface& robot_model, const TrackRun& run
     err[3 * j + 2] = WrapAngle(pose.theta - T(gt.theta));
   }
   final_pose = carried(final_pose);
-  const Pose2<T> gt_end = InterpolateTrack(run.track, T(a.t_final_s) + tau);
+  const Pose2<T> gt_end = InterpolateGroundTruth(run.track, T(a.t_final_s) + tau);
   err[3 * n + 0] = final_pose.x - gt_end.x;
   err[3 * n + 1] = final_pose.y - gt_end.y;
   err[3 * n + 2] = WrapAngle(final_pose.theta - gt_end.theta);

@@ -105,29 +105,6 @@ TrackFitData MakeTrackFitData(const std::vector<AlignedRun>& runs,
 
 namespace {
 
-// The ground truth at time t (a Jet in the clock offset): linear interpolation between the
-// samples around t's value, clamped outside the track (InterpolateGroundTruth with a Jet time).
-template <typename T>
-Pose2<T> InterpolateAt(const GroundTruthTrack& track, const T& t) {
-  const std::vector<double>& ts = track.t_s;
-  const double v = ScalarPart(t);
-  if (v <= ts.front()) {
-    const Pose2d& a = track.world_T_robot.front();
-    return {T(a.x), T(a.y), T(a.theta)};
-  }
-  if (v >= ts.back()) {
-    const Pose2d& b = track.world_T_robot.back();
-    return {T(b.x), T(b.y), T(b.theta)};
-  }
-  const std::size_t hi =
-      static_cast<std::size_t>(std::upper_bound(ts.begin(), ts.end(), v) - ts.begin());
-  const std::size_t lo = hi - 1;
-  const T u = (t - ts[lo]) / (ts[hi] - ts[lo]);
-  const Pose2d& a = track.world_T_robot[lo];
-  const Pose2d& b = track.world_T_robot[hi];
-  return {a.x + u * (b.x - a.x), a.y + u * (b.y - a.y), a.theta + u * WrapAngle(b.theta - a.theta)};
-}
-
 // a^-1 b
 template <typename T>
 Pose2<T> Between(const Pose2<T>& a, const Pose2<T>& b) {
@@ -150,8 +127,8 @@ T HuberFactor(const T& s, double c) {
 }  // namespace
 
 Pose2d GroundTruthFromStart(const TrackCheckpoints& track, std::size_t k, double dt_s) {
-  return Between(InterpolateAt(*track.ground_truth, track.t_start_s + dt_s),
-                 InterpolateAt(*track.ground_truth, track.t_s[k] + dt_s));
+  return Between(InterpolateGroundTruth(*track.ground_truth, track.t_start_s + dt_s),
+                 InterpolateGroundTruth(*track.ground_truth, track.t_s[k] + dt_s));
 }
 
 TrackResidual::TrackResidual(const TrackCheckpoints& track, const RobotModelInterface& model,
@@ -187,7 +164,7 @@ ceres::CostFunction* TrackResidual::Create(const TrackCheckpoints& track,
 }
 
 Pose2<TrackResidual::ErrorJet> TrackResidual::GroundTruthAtStart(double dt_s) const {
-  return InterpolateAt(*track_.ground_truth, ErrorJet(track_.t_start_s + dt_s, 3));
+  return InterpolateGroundTruth(*track_.ground_truth, ErrorJet(track_.t_start_s + dt_s, 3));
 }
 
 // r_k of the header for the odometry poses `pose` (3 per checkpoint), as Jets in (P_k, dt).
@@ -198,7 +175,7 @@ std::array<TrackResidual::ErrorJet, 3> TrackResidual::CheckpointResidual(
   const Pose2<ErrorJet> p{ErrorJet(pose[3 * k], 0), ErrorJet(pose[3 * k + 1], 1),
                           ErrorJet(pose[3 * k + 2], 2)};
   const Pose2<ErrorJet> q =
-      Between(q0, InterpolateAt(*track_.ground_truth, ErrorJet(track_.t_s[k] + dt_s, 3)));
+      Between(q0, InterpolateGroundTruth(*track_.ground_truth, ErrorJet(track_.t_s[k] + dt_s, 3)));
   const double inv_xy = 1.0 / weights_.position_sigma_m;
   const double inv_th = 1.0 / weights_.heading_sigma_rad;
   const ErrorJet cq = cos(q.theta), sq = sin(q.theta);

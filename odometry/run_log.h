@@ -2,6 +2,8 @@
 // The recorded data of one calibration run, as the loaders hand it over: encoder wheel rates and
 // the ground-truth track on the same clock. No file knowledge here (io/ fills these).
 
+#include <algorithm>
+#include <cstddef>
 #include <optional>
 #include <string>
 #include <vector>
@@ -39,7 +41,23 @@ struct RunLog {
 };
 
 // Ground truth at time t_s by linear interpolation (heading along the shorter arc); clamps to the
-// first/last sample outside the track. The track must hold at least one sample.
-Pose2d InterpolateGroundTruth(const GroundTruthTrack& track, double t_s);
+// first/last sample outside the track. The track must hold at least one sample. T is double or a
+// ceres::Jet (a time differentiated in a clock offset or a latency): the bracket is chosen on the
+// value, the fraction keeps the derivatives.
+template <typename T>
+Pose2<T> InterpolateGroundTruth(const GroundTruthTrack& track, const T& t_s) {
+  const std::vector<double>& t = track.t_s;
+  const double v = ScalarPart(t_s);
+  const auto sample = [](const Pose2d& q) { return Pose2<T>{T(q.x), T(q.y), T(q.theta)}; };
+  if (v <= t.front()) return sample(track.world_T_robot.front());
+  if (v >= t.back()) return sample(track.world_T_robot.back());
+  const std::size_t hi =
+      static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), v) - t.begin());
+  const std::size_t lo = hi - 1;
+  const T u = (t_s - t[lo]) / (t[hi] - t[lo]);
+  const Pose2d& a = track.world_T_robot[lo];
+  const Pose2d& b = track.world_T_robot[hi];
+  return {a.x + u * (b.x - a.x), a.y + u * (b.y - a.y), a.theta + u * WrapAngle(b.theta - a.theta)};
+}
 
 }  // namespace fitcal
