@@ -1,11 +1,23 @@
 #pragma once
-// The correlation matrix of a covariance, corr(r, c) = cov(r, c) / (sigma_r sigma_c). A parameter
-// without variance (held at nominal, or not determined) correlates with nothing but itself.
+// The sigmas and the correlation matrix of a covariance, corr(r, c) = cov(r, c) / (sigma_r
+// sigma_c). A parameter without variance (held at nominal, or not determined) correlates with
+// nothing but itself.
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace fitcal {
+
+// One sigma per parameter: the square roots of the diagonal (a round-off negative variance
+// counts as 0).
+inline std::vector<double> SigmasOf(const Eigen::MatrixXd& covariance) {
+  std::vector<double> sigma(static_cast<std::size_t>(covariance.rows()));
+  for (Eigen::Index k = 0; k < covariance.rows(); ++k)
+    sigma[k] = std::sqrt(std::max(0.0, covariance(k, k)));
+  return sigma;
+}
 
 inline Eigen::MatrixXd CorrelationOf(const Eigen::MatrixXd& covariance) {
   const Eigen::Index n = covariance.rows();

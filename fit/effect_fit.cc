@@ -10,9 +10,9 @@
 #include <memory>
 #include <stdexcept>
 
+#include "fit/ceres_problem.h"
 #include "fit/correlation.h"
-#include "fit/dense_solver_options.h"
-#include "fit/run_split.h"
+#include "fit/model_fit.h"
 #include "odometry/parallel_for.h"
 
 namespace fitcal {
@@ -342,36 +342,7 @@ TrackErrors ComputeTrackErrors(const RobotModelInterface& robot_model, const std
   return out;
 }
 
-bool EffectFitOptions::IsValid(std::string* error) const {
-  if (!(weights.position_sigma_m > 0.0) || !(weights.heading_sigma_rad > 0.0)) {
-    *error = "residual sigmas must be positive";
-    return false;
-  }
-  if (max_num_iterations < 1 || num_threads < 0) {
-    *error = "max_num_iterations must be >= 1 and num_threads >= 0";
-    return false;
-  }
-  return true;
-}
-
 namespace {
-
-// The model's box (and its held parameters, at the nominal) on block p.
-void BoundModelParameters(const Robot& robot, double* p, ceres::Problem* problem) {
-  std::vector<int> held;
-  for (int k = 0; k < robot.NumParameters(); ++k) {
-    if (robot.IsHeld(k)) {
-      p[k] = robot.nominal[k];
-      held.push_back(k);
-    }
-    p[k] = std::clamp(p[k], robot.bounds[k].lo, robot.bounds[k].hi);
-    problem->SetParameterLowerBound(p, k, robot.bounds[k].lo);
-    problem->SetParameterUpperBound(p, k, robot.bounds[k].hi);
-  }
-  if (!held.empty()) {
-    problem->SetManifold(p, new ceres::SubsetManifold(robot.NumParameters(), held));
-  }
-}
 
 // The registry's box on every effect's parameters; returns how many there are.
 int BoundEffectParameters(EffectModel* model, ceres::Problem* problem) {
@@ -390,49 +361,18 @@ int BoundEffectParameters(EffectModel* model, ceres::Problem* problem) {
 
 // Finite values, and whether an effect parameter rests on a bound that is not its neutral value.
 bool CheckEffectValues(const std::vector<double>& p, EffectFitResult* result) {
-  bool finite = true;
-  for (double v : p) finite = finite && std::isfinite(v);
+  bool finite = std::all_of(p.begin(), p.end(), [](double v) { return std::isfinite(v); });
   for (auto& e : result->effects) {
     const auto& info = effects::Info(e.id);
     for (int k = 0; k < info.num_parameters; ++k) {
       finite = finite && std::isfinite(e.value[k]);
-      const double tol = 1e-6 * (info.upper[k] - info.lower[k]);
+      const Interval box{info.lower[k], info.upper[k]};
       // A one-sided bound at the neutral value (backlash >= 0) is a legitimate "no effect".
-      const bool neutral_bound = info.lower[k] == 0.0 && e.value[k] <= tol;
-      if (!neutral_bound &&
-          (e.value[k] <= info.lower[k] + tol || e.value[k] >= info.upper[k] - tol)) {
-        result->any_at_bound = true;
-      }
+      const bool neutral_bound = box.lo == 0.0 && e.value[k] <= 1e-6 * box.Width();
+      if (!neutral_bound && AtBound(e.value[k], box)) result->any_at_bound = true;
     }
   }
   return finite;
-}
-
-// Sigmas of the model's and the effects' parameters (header: s^2 per run-residual).
-void ComputeEffectCovariance(ceres::Problem* problem, const std::vector<double*>& blocks, double s2,
-                             EffectFitResult* result) {
-  ceres::Covariance::Options cov_options;
-  cov_options.algorithm_type = ceres::DENSE_SVD;
-  cov_options.null_space_rank = -1;  // pseudo-inverse: aliased directions are reported, not fatal
-  ceres::Covariance covariance(cov_options);
-  std::vector<std::pair<const double*, const double*>> pairs;
-  for (double* b : blocks) pairs.emplace_back(b, b);
-  if (!covariance.Compute(pairs, problem)) return;
-  const int n = static_cast<int>(result->parameters.size());
-  // In ambient coordinates: a held parameter (SubsetManifold) gets zero variance.
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> c(n, n);
-  result->sigma.assign(n, 0.0);
-  covariance.GetCovarianceBlock(blocks[0], blocks[0], c.data());
-  for (int k = 0; k < n; ++k) result->sigma[k] = std::sqrt(std::max(0.0, s2 * c(k, k)));
-  result->correlation = CorrelationOf(c);
-  for (auto& e : result->effects) {
-    const int m = effects::Info(e.id).num_parameters;
-    std::vector<double> ce(static_cast<std::size_t>(m * m));
-    covariance.GetCovarianceBlock(e.value.data(), e.value.data(), ce.data());
-    for (int k = 0; k < m; ++k)
-      e.sigma[k] = std::sqrt(std::max(0.0, s2 * ce[static_cast<std::size_t>(k * m + k)]));
-  }
-  result->has_covariance = true;
 }
 
 }  // namespace
@@ -457,20 +397,17 @@ EffectFitResult FitEffectModel(const std::vector<TrackRun>& training,
   ceres::Problem problem;
   std::vector<double*> blocks = {p};
   for (auto& e : result.effects) blocks.push_back(e.value.data());
+  std::vector<ceres::ResidualBlockId> runs;
   for (const TrackRun& run : training) {
-    problem.AddResidualBlock(EffectTrackResidual::Create(robot_model, run, ids, options.weights),
-                             nullptr, blocks);
+    runs.push_back(problem.AddResidualBlock(
+        EffectTrackResidual::Create(robot_model, run, ids, options.weights), MakeLoss(options),
+        blocks));
   }
-  BoundModelParameters(robot, p, &problem);
+  BoundModelBlock(robot, HoldAtNominal(robot, p), p, &problem);
   const int num_effect_parameters = BoundEffectParameters(&result.effects, &problem);
 
-  DenseSolverTolerances tolerances;
-  tolerances.function = options.function_tolerance;
-  tolerances.parameter = options.parameter_tolerance;
-  const ceres::Solver::Options solver_options =
-      DenseSolverOptions(options.max_num_iterations, options.num_threads, tolerances);
   ceres::Solver::Summary summary;
-  ceres::Solve(solver_options, &problem, &summary);
+  ceres::Solve(SolverOptionsFor(options), &problem, &summary);
   result.termination = ceres::TerminationTypeToString(summary.termination_type);
   result.message = summary.message;
   result.iterations = static_cast<int>(summary.iterations.size());
@@ -480,9 +417,21 @@ EffectFitResult FitEffectModel(const std::vector<TrackRun>& training,
                              summary.termination_type == ceres::NO_CONVERGENCE);
 
   const int dof = 3 * static_cast<int>(training.size()) - robot.NumFree() - num_effect_parameters;
-  if (options.compute_covariance && result.usable && dof > 0) {
-    ComputeEffectCovariance(&problem, blocks, 2.0 * summary.final_cost / dof, &result);
+  if (!options.compute_covariance || !result.usable || dof <= 0) return result;
+  // s^2 per run-residual (header). A pseudo-inverse: an effect aliased with the model gets its
+  // (large) sigma rather than no covariance for the whole fit; SeparableFraction says which
+  // candidates the runs cannot tell apart.
+  const std::vector<Eigen::MatrixXd> covariance =
+      ScaledCovariance(&problem, {blocks.begin(), blocks.end()}, SumOfSquares(&problem, runs) / dof,
+                       /*pseudo_inverse=*/true, options.num_threads);
+  if (covariance.empty()) return result;
+  result.sigma = SigmasOf(covariance[0]);
+  result.correlation = CorrelationOf(covariance[0]);
+  for (std::size_t j = 0; j < result.effects.size(); ++j) {
+    const std::vector<double> sigma = SigmasOf(covariance[1 + j]);
+    std::copy(sigma.begin(), sigma.end(), result.effects[j].sigma.begin());
   }
+  result.has_covariance = true;
   return result;
 }
 

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "fit/final_pose_errors.h"
+#include "fit/solver_options.h"
 #include "models/model_interface.h"
 #include "odometry/aligned_run.h"
 #include "odometry/effects.h"
@@ -164,14 +165,15 @@ struct TrackErrors {
 TrackErrors ComputeTrackErrors(const RobotModelInterface& robot_model, const std::vector<double>& p,
                                const EffectModel& model, const TrackRun& run, bool all_samples);
 
-struct EffectFitOptions {
-  ResidualWeights weights;
-  int max_num_iterations = 50;
-  int num_threads = 0;
-  double function_tolerance = 1e-10;
-  double parameter_tolerance = 1e-10;
-  bool compute_covariance = true;
-  bool IsValid(std::string* error) const;
+// The shared Ceres settings (fit/solver_options.h) with the tracing's iteration limit and
+// tolerances: it fits every candidate effect and judges each fit on held-out runs, so a fit still
+// creeping after 50 iterations is scored there rather than polished.
+struct EffectFitOptions : CeresFitOptions {
+  EffectFitOptions() {
+    max_num_iterations = 50;
+    function_tolerance = 1e-10;
+    parameter_tolerance = 1e-10;
+  }
 };
 
 struct EffectFitResult {
@@ -181,7 +183,7 @@ struct EffectFitResult {
   std::string termination;
   std::string message;
   int iterations = 0;
-  double final_cost = 0.0;         // 0.5 * sum of per-run objectives
+  double final_cost = 0.0;         // 0.5 * sum of per-run objectives (under the options' loss)
   std::vector<double> parameters;  // the model's (robot().parameters order)
   std::vector<double> sigma;       // one sigma of each (when has_covariance; 0 when held)
   Eigen::MatrixXd correlation;     // of the model's parameters, with the effects in the fit
@@ -193,9 +195,10 @@ struct EffectFitResult {
 // Fits the model's parameters (started at start_p, bounded by the robot's box, held parameters
 // at their nominal) and the effects' parameters (started at the values in `start`, bounded by
 // the registry) to the training runs.
-// Covariance: Ceres' covariance scaled by s^2 = sum of run objectives / (3 N_runs - k), i.e. each
-// run counts as three independent residuals (a run's checkpoints are correlated through the
-// drift, so counting them all would understate the uncertainty).
+// Each run's residual block carries the options' loss (MakeLoss), as the final-pose fit's do.
+// Covariance: Ceres' covariance scaled by s^2 = sum of run objectives (without the loss) /
+// (3 N_runs - k), i.e. each run counts as three independent residuals (a run's checkpoints are
+// correlated through the drift, so counting them all would understate the uncertainty).
 EffectFitResult FitEffectModel(const std::vector<TrackRun>& training,
                                const RobotModelInterface& robot_model,
                                const std::vector<double>& start_p, const EffectModel& start,

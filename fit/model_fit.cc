@@ -10,8 +10,8 @@
 #include <type_traits>
 #include <utility>
 
+#include "fit/ceres_problem.h"
 #include "fit/correlation.h"
-#include "fit/dense_solver_options.h"
 #include "fit/determined_directions.h"
 
 namespace fitcal {
@@ -107,21 +107,7 @@ class FitProblem {
       problem_->AddResidualBlock(
           new HoldDirectionsCost(holds.directions, model.robot(), holds.weight), nullptr, p);
     }
-    const Robot& robot = model.robot();
-    const int n = robot.NumParameters();
-    std::vector<int> constant;
-    for (int k = 0; k < n; ++k) {
-      if (fixed[k]) constant.push_back(k);
-    }
-    if (static_cast<int>(constant.size()) == n) {
-      problem_->SetParameterBlockConstant(p);
-    } else if (!constant.empty()) {
-      problem_->SetManifold(p, new ceres::SubsetManifold(n, constant));
-    }
-    for (int k = 0; k < n; ++k) {
-      problem_->SetParameterLowerBound(p, k, robot.bounds[k].lo);
-      problem_->SetParameterUpperBound(p, k, robot.bounds[k].hi);
-    }
+    BoundModelBlock(model.robot(), fixed, p, problem_.get());
   }
 
   // Each clock offset in [-max, max], or held at its value when not estimated.
@@ -187,19 +173,6 @@ class BoundContactStop : public ceres::IterationCallback {
   int contact_steps_ = 0;
   bool fired_ = false;
 };
-
-ceres::Solver::Options SolverOptionsFor(const CeresFitOptions& options) {
-  DenseSolverTolerances tolerances;
-  tolerances.function = options.function_tolerance;
-  tolerances.gradient = options.gradient_tolerance;
-  tolerances.parameter = options.parameter_tolerance;
-  ceres::Solver::Options solver_options =
-      DenseSolverOptions(options.max_num_iterations, options.num_threads, tolerances);
-  solver_options.trust_region_strategy_type = options.trust_region == CeresTrustRegion::kDogleg
-                                                  ? ceres::DOGLEG
-                                                  : ceres::LEVENBERG_MARQUARDT;
-  return solver_options;
-}
 
 void Accumulate(const ceres::Solver::Summary& summary, ModelFitResult* result) {
   result->termination = ceres::TerminationTypeToString(summary.termination_type);
@@ -319,39 +292,26 @@ void ComputeCovariance(const std::vector<AlignedRun>& training, const RobotModel
   std::vector<double> offsets = result->clock_offsets_s;
   FitProblem fit(training, model, options, result->held, p.data(), offsets.data(), holds);
   // s^2 from the plain sum of squares of the runs, whatever loss shaped the objective.
-  double sum_of_squares_half = 0.0;
-  ceres::Problem::EvaluateOptions evaluate_options;
-  evaluate_options.apply_loss_function = false;
-  evaluate_options.residual_blocks = fit.data_blocks();
-  fit.problem().Evaluate(evaluate_options, &sum_of_squares_half, nullptr, nullptr, nullptr);
-  result->residual_sigma = std::sqrt(2.0 * sum_of_squares_half / dof);
-  ceres::Covariance::Options cov_options;
-  cov_options.algorithm_type = ceres::DENSE_SVD;
-  cov_options.num_threads = SolverOptionsFor(options.ceres).num_threads;
-  ceres::Covariance covariance(cov_options);
-  std::vector<std::pair<const double*, const double*>> blocks = {{p.data(), p.data()}};
+  result->residual_sigma = std::sqrt(SumOfSquares(&fit.problem(), fit.data_blocks()) / dof);
+  const double s2 = result->residual_sigma * result->residual_sigma;
+  std::vector<const double*> blocks = {p.data()};
   for (int g = 0; g < num_offsets; ++g) {
-    if (fit.problem().HasParameterBlock(&offsets[g])) blocks.push_back({&offsets[g], &offsets[g]});
+    if (fit.problem().HasParameterBlock(&offsets[g])) blocks.push_back(&offsets[g]);
   }
-  if (!covariance.Compute(blocks, &fit.problem())) {
+  const std::vector<Eigen::MatrixXd> covariance = ScaledCovariance(
+      &fit.problem(), blocks, s2, /*pseudo_inverse=*/false, options.ceres.num_threads);
+  if (covariance.empty()) {
     result->covariance_message =
         "covariance is rank deficient: the runs cannot determine all free parameters";
     return;
   }
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> raw(n, n);
-  covariance.GetCovarianceBlock(p.data(), p.data(), raw.data());
-  const double s2 = result->residual_sigma * result->residual_sigma;
-  result->covariance = s2 * raw;
-  result->sigma.assign(n, 0.0);
-  for (int k = 0; k < n; ++k) result->sigma[k] = std::sqrt(std::max(0.0, result->covariance(k, k)));
+  result->covariance = covariance[0];
+  result->sigma = SigmasOf(result->covariance);
   result->correlation = CorrelationOf(result->covariance);
   result->has_covariance = true;
   result->clock_offset_sigma_s.assign(result->clock_offsets_s.size(), 0.0);
   for (std::size_t b = 1; b < blocks.size(); ++b) {
-    double variance = 0.0;
-    covariance.GetCovarianceBlock(blocks[b].first, blocks[b].first, &variance);
-    result->clock_offset_sigma_s[blocks[b].first - offsets.data()] =
-        std::sqrt(std::max(0.0, s2 * variance));
+    result->clock_offset_sigma_s[blocks[b] - offsets.data()] = SigmasOf(covariance[b])[0];
   }
 }
 
@@ -517,14 +477,10 @@ ModelFitResult SolveFrom(const std::vector<AlignedRun>& training, const RobotMod
   const Robot& robot = model.robot();
   ModelFitResult result;
   result.parameters = start;
-  result.held.assign(robot.NumParameters(), false);
+  result.held = HoldAtNominal(robot, result.parameters.data());
   // One slot even without tracks: the problem takes a pointer it never uses then.
   result.clock_offsets_s.assign(
       UsesTracks(options) ? std::max<std::size_t>(1, options.track->clock_groups.size()) : 1, 0.0);
-  for (const HeldParameter& h : robot.held) {
-    result.held[h.index] = true;
-    result.parameters[h.index] = robot.nominal[h.index];
-  }
   const auto t0 = std::chrono::steady_clock::now();
   // With estimated offsets, the parameters' solves below hold them (AlternateWithClockOffsets).
   const bool offsets = UsesTracks(options) && options.track->estimate_clock_offsets;

@@ -1,0 +1,84 @@
+#include "fit/ceres_problem.h"
+
+#include <ceres/covariance.h>
+#include <ceres/manifold.h>
+
+#include <algorithm>
+#include <utility>
+
+#include "odometry/parallel_for.h"
+
+namespace fitcal {
+
+ceres::Solver::Options SolverOptionsFor(const CeresFitOptions& options) {
+  ceres::Solver::Options o;
+  o.linear_solver_type = ceres::DENSE_QR;
+  o.trust_region_strategy_type = options.trust_region == CeresTrustRegion::kDogleg
+                                     ? ceres::DOGLEG
+                                     : ceres::LEVENBERG_MARQUARDT;
+  o.max_num_iterations = options.max_num_iterations;
+  o.num_threads = ResolveThreadCount(options.num_threads);
+  o.function_tolerance = options.function_tolerance;
+  o.gradient_tolerance = options.gradient_tolerance;
+  o.parameter_tolerance = options.parameter_tolerance;
+  o.logging_type = ceres::SILENT;
+  return o;
+}
+
+std::vector<bool> HoldAtNominal(const Robot& robot, double* p) {
+  std::vector<bool> held(robot.NumParameters(), false);
+  for (const HeldParameter& h : robot.held) {
+    held[h.index] = true;
+    p[h.index] = robot.nominal[h.index];
+  }
+  return held;
+}
+
+void BoundModelBlock(const Robot& robot, const std::vector<bool>& fixed, double* p,
+                     ceres::Problem* problem) {
+  const int n = robot.NumParameters();
+  std::vector<int> constant;
+  for (int k = 0; k < n; ++k) {
+    if (fixed[k]) constant.push_back(k);
+    p[k] = std::clamp(p[k], robot.bounds[k].lo, robot.bounds[k].hi);
+    problem->SetParameterLowerBound(p, k, robot.bounds[k].lo);
+    problem->SetParameterUpperBound(p, k, robot.bounds[k].hi);
+  }
+  if (static_cast<int>(constant.size()) == n) {
+    problem->SetParameterBlockConstant(p);
+  } else if (!constant.empty()) {
+    problem->SetManifold(p, new ceres::SubsetManifold(n, constant));
+  }
+}
+
+double SumOfSquares(ceres::Problem* problem, const std::vector<ceres::ResidualBlockId>& blocks) {
+  ceres::Problem::EvaluateOptions options;
+  options.apply_loss_function = false;
+  options.residual_blocks = blocks;
+  double half_sum_of_squares = 0.0;  // Ceres' cost
+  problem->Evaluate(options, &half_sum_of_squares, nullptr, nullptr, nullptr);
+  return 2.0 * half_sum_of_squares;
+}
+
+std::vector<Eigen::MatrixXd> ScaledCovariance(ceres::Problem* problem,
+                                              const std::vector<const double*>& blocks, double s2,
+                                              bool pseudo_inverse, int num_threads) {
+  ceres::Covariance::Options options;
+  options.algorithm_type = ceres::DENSE_SVD;
+  options.num_threads = ResolveThreadCount(num_threads);
+  if (pseudo_inverse) options.null_space_rank = -1;
+  ceres::Covariance covariance(options);
+  std::vector<std::pair<const double*, const double*>> pairs;
+  for (const double* b : blocks) pairs.emplace_back(b, b);
+  if (!covariance.Compute(pairs, problem)) return {};
+  std::vector<Eigen::MatrixXd> out;
+  for (const double* b : blocks) {
+    const int size = problem->ParameterBlockSize(b);
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> raw(size, size);
+    covariance.GetCovarianceBlock(b, b, raw.data());
+    out.push_back(s2 * raw);
+  }
+  return out;
+}
+
+}  // namespace fitcal
