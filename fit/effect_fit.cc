@@ -4,10 +4,10 @@
 #include <ceres/dynamic_autodiff_cost_function.h>
 
 #include <Eigen/QR>
+#include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <memory>
 #include <stdexcept>
 
 #include "fit/ceres_problem.h"
@@ -439,45 +439,30 @@ double SeparableFraction(const std::vector<TrackRun>& training,
                          const RobotModelInterface& robot_model, const std::vector<double>& p,
                          const EffectModel& model, EffectId candidate,
                          const ResidualWeights& weights, double* unexplained_norm) {
-  const int num_parameters = robot_model.robot().NumParameters();
   EffectModel with = model;
   effects::EffectValue c;
   c.id = candidate;
   with.push_back(c);
   const std::vector<EffectId> ids = IdsOf(with);
-  int cols = num_parameters;
-  for (EffectId id : ids) cols += effects::Info(id).num_parameters;
   const int m_c = effects::Info(candidate).num_parameters;
-  int rows = 0;
-  for (const TrackRun& run : training) rows += 3 * static_cast<int>(run.checkpoints.size());
-  Eigen::MatrixXd jac(rows, cols);
-  int row = 0;
+  // The runs' residuals stacked, their Jacobian's columns in block order (model, then effects).
+  std::vector<double> p_at = p;
+  std::vector<double*> blocks = {p_at.data()};
+  for (auto& e : with) blocks.push_back(e.value.data());
+  ceres::Problem problem;
   for (const TrackRun& run : training) {
-    std::unique_ptr<ceres::CostFunction> cost(
-        EffectTrackResidual::Create(robot_model, run, ids, weights));
-    const int n = cost->num_residuals();
-    std::vector<const double*> params = {p.data()};
-    for (const auto& e : with) params.push_back(e.value.data());
-    std::vector<double> residual(static_cast<std::size_t>(n));
-    std::vector<std::vector<double>> jb(params.size());
-    std::vector<double*> jptr(params.size());
-    for (std::size_t b = 0; b < params.size(); ++b) {
-      const int size = b == 0 ? num_parameters : effects::Info(ids[b - 1]).num_parameters;
-      jb[b].resize(static_cast<std::size_t>(n * size));
-      jptr[b] = jb[b].data();
-    }
-    cost->Evaluate(params.data(), residual.data(), jptr.data());
-    int col = 0;
-    for (std::size_t b = 0; b < params.size(); ++b) {
-      const int size = b == 0 ? num_parameters : effects::Info(ids[b - 1]).num_parameters;
-      for (int r = 0; r < n; ++r) {
-        for (int k = 0; k < size; ++k)
-          jac(row + r, col + k) = jb[b][static_cast<std::size_t>(r * size + k)];
-      }
-      col += size;
-    }
-    row += n;
+    problem.AddResidualBlock(EffectTrackResidual::Create(robot_model, run, ids, weights), nullptr,
+                             blocks);
   }
+  ceres::Problem::EvaluateOptions evaluate;
+  evaluate.parameter_blocks = blocks;
+  ceres::CRSMatrix crs;
+  problem.Evaluate(evaluate, nullptr, nullptr, nullptr, &crs);
+  const Eigen::MatrixXd jac = Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>>(
+                                  crs.num_rows, crs.num_cols, static_cast<int>(crs.values.size()),
+                                  crs.rows.data(), crs.cols.data(), crs.values.data())
+                                  .toDense();
+  const int cols = crs.num_cols;
   const Eigen::MatrixXd others = jac.leftCols(cols - m_c);
   const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(others);
   double fraction = 1.0;
