@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
-#include <map>
 #include <optional>
 #include <string>
 #include <unordered_map>
@@ -29,14 +28,14 @@
 #include "tools/fit_methods.h"
 #include "tools/output_guard.h"
 #include "tools/tying_flags.h"
+#include "validation/held_out_families.h"
+#include "validation/held_out_halves.h"
 #include "validation/propagated_uncertainty.h"
 #include "validation/rate_units.h"
 #include "validation/residual_dof.h"
 #include "validation/residual_kind_transfer.h"
 #include "validation/statistics.h"
-#include "validation/time_blocks.h"
 #include "validation/training_runs.h"
-#include "validation/trajectory_family.h"
 #include "validation/trajectory_metrics.h"
 
 namespace fitcal::tools {
@@ -612,120 +611,46 @@ std::vector<std::string> ChooseResidualsByTransfer(const FitCommandOptions& opti
 }
 
 // A calibration better than the nominal on the held-out runs as a whole may still be worse on one
-// kind of run (circles, squares, free driving: the trajectory family, the label's leading letters,
-// validation/trajectory_family.h, as the report groups runs); it is then not written. True after
-// one line per such kind on stderr.
+// kind of run (validation/held_out_families.h); it is then not written. True after one line per
+// such kind on stderr.
 bool WorseThanNominalOnSomeKind(const std::vector<CalibrationCandidate>& candidates,
                                 const GateDecision& gate, const RunSplit& split,
                                 const CandidateErrors& errors) {
-  if (!gate.judged_on_held_out || gate.selected == 0) return false;
-  const std::map<std::string, std::vector<AlignedRun>> by_kind = RunsByFamily(split.validation);
-  if (by_kind.size() < 2) return false;  // the gate judged this one kind already
   bool worse = false;
-  for (const auto& [kind, runs] : by_kind) {
-    const double before = errors(candidates[0], runs).cf;
-    const double after = errors(candidates[gate.selected], runs).cf;
-    if (after <= before) continue;
+  for (const FamilyComparison& c :
+       CompareHeldOutFamiliesWithNominal(candidates, gate, split, errors.Cf())) {
+    if (!c.SelectedIsWorse()) continue;
     std::cerr << "fitcal: '" << candidates[gate.selected].name << "' is worse than the nominal on "
-              << "the held-out '" << kind << "' runs (" << runs.size() << "): CF " << before
-              << " -> " << after << "; nothing written\n";
+              << "the held-out '" << c.family << "' runs (" << c.runs << "): CF " << c.nominal_cf
+              << " -> " << c.selected_cf << "; nothing written\n";
     worse = true;
   }
   return worse;
 }
 
-// With nothing held out (every run trains: --train-reps 1-99, or a data set of free driving), the
-// procedure is judged by two folds before the fit of all the training runs is written: a fit of
-// one half is judged on the other half and back, against the nominal (two-fold cross-validation).
-// - More than two runs: every other run trains, the rest is held out.
-// - One or two long runs fitted on their tracks (--residuals track/both, or auto resolving to
-//   track): each is cut into --time-blocks blocks of equal ground-truth path
-//   (validation/time_blocks.h), odd blocks against even ones.
-// The calibration written is the fit of everything, which was measured to transfer better than a
-// fit of half of it (docs/everyday_driving.md); the judgement says whether the runs determine the
-// parameters at all, and nothing is written when the halves do not beat the nominal.
-constexpr std::size_t kMaxRunsForTimeBlocks = 2;
-
-struct HalvesJudgement {
-  bool judged = false;
-  bool by_time = false;        // time blocks of one or two runs (else halves of the runs)
-  double nominal_cf = 0.0;     // mean CF (Eq. 14) of the held-out halves, both folds
-  double calibrated_cf = 0.0;  // of each fold's fit on its held-out half
-  bool Beats() const { return judged && calibrated_cf < nominal_cf; }
-};
-
-// The blocks of the training runs, fold 0 training on the odd blocks and fold 1 on the even.
-RunSplit TimeBlockFold(const RunSplit& whole, const std::vector<RunLog>& logs, int num_blocks,
-                       int fold, std::vector<RunLog>* block_logs) {
-  std::unordered_map<std::string, const RunLog*> log_of;
-  for (const RunLog& log : logs) log_of[log.id] = &log;
-  RunSplit blocks;
-  for (const AlignedRun& run : whole.training) {
-    const RunLog& log = *log_of.at(run.id);
-    for (AlignedRun& block : CutIntoTimeBlocks(run, log.ground_truth, num_blocks)) {
-      block_logs->push_back(log);
-      block_logs->back().id = block.id;
-      const bool trains = (block.repetition % 2) == (fold == 0 ? 1 : 0);
-      (trains ? blocks.training : blocks.validation).push_back(std::move(block));
-    }
-  }
-  return blocks;
-}
-
-// Every other training run (in data-set order, so each session gives to both halves).
-RunSplit RunsFold(const RunSplit& whole, int fold) {
-  RunSplit half;
-  for (std::size_t i = 0; i < whole.training.size(); ++i) {
-    (static_cast<int>(i % 2) == fold ? half.training : half.validation)
-        .push_back(whole.training[i]);
-  }
-  return half;
-}
-
-HalvesJudgement JudgeOnHeldOutHalves(const FitCommandOptions& options, const FitMethod& method,
-                                     const FitMethodSettings& settings,
-                                     const RobotModelInterface& model, const RunSplit& split,
-                                     const std::vector<RunLog>& logs) {
-  HalvesJudgement j;
-  if (!split.validation.empty() || split.training.empty()) return j;
-  j.by_time = split.training.size() <= kMaxRunsForTimeBlocks;
-  if (j.by_time && settings.residuals == ResidualKind::kFinalPose) return j;
-  double nominal_sum = 0.0, calibrated_sum = 0.0;
-  std::size_t held_out = 0;
-  for (int fold = 0; fold < 2; ++fold) {
-    std::vector<RunLog> fold_logs = logs;
-    const RunSplit half = j.by_time
-                              ? TimeBlockFold(split, logs, options.time_blocks, fold, &fold_logs)
-                              : RunsFold(split, fold);
-    if (half.training.empty() || half.validation.empty()) return j;
+// With nothing held out, the two-fold judgement of validation/held_out_halves.h, each fold fitted
+// by the command's method with the whole data's settings and scored on the final pose (Eq. 14).
+HalvesJudgement JudgeMethodOnHeldOutHalves(const FitCommandOptions& options,
+                                           const FitMethod& method,
+                                           const FitMethodSettings& settings,
+                                           const RobotModelInterface& model, const RunSplit& split,
+                                           const std::vector<RunLog>& logs) {
+  const FitOnFold fit_on = [&](const HalvesFold& fold) -> std::optional<std::vector<double>> {
     FitMethodSettings fold_settings = settings;
     fold_settings.residuals_auto = false;  // the whole data's choice holds for its halves
     std::optional<TrackFitData> track_data;
-    if (!PrepareTrackResiduals(options, fold_logs, half, &fold_settings, &track_data)) return j;
-    const ModelFitResult fit = method.run_model(half.training, model, fold_settings).fit;
-    if (!(fit.usable || fit.stopped_early)) return j;
-    const CandidateErrors errors(model, fold_logs, options.threads);
-    const double n = static_cast<double>(half.validation.size());
-    nominal_sum += n * errors({"nominal", model.robot().nominal, true}, half.validation).cf;
-    calibrated_sum += n * errors({"fold", fit.parameters, true}, half.validation).cf;
-    held_out += half.validation.size();
-  }
-  j.judged = held_out > 0;
-  j.nominal_cf = nominal_sum / std::max<std::size_t>(1, held_out);
-  j.calibrated_cf = calibrated_sum / std::max<std::size_t>(1, held_out);
-  return j;
-}
-
-// What the halves were, for the output and the file's selected_on.
-std::string HalvesDescription(const HalvesJudgement& j, int num_blocks) {
-  char cf[64];
-  std::snprintf(cf, sizeof(cf), "CF %.4f -> %.4f", j.nominal_cf, j.calibrated_cf);
-  return j.by_time ? "held-out time blocks of the training runs (two folds of " +
-                         std::to_string(num_blocks) + " blocks of equal path, odd against even; " +
-                         cf + ")"
-                   : "held-out halves of the training runs (two folds, every other run against "
-                     "the rest; " +
-                         std::string(cf) + ")";
+    if (!PrepareTrackResiduals(options, fold.logs, fold.split, &fold_settings, &track_data)) {
+      return std::nullopt;
+    }
+    const ModelFitResult fit = method.run_model(fold.split.training, model, fold_settings).fit;
+    if (!(fit.usable || fit.stopped_early)) return std::nullopt;
+    return fit.parameters;
+  };
+  const CfOnRuns cf = [&](const std::vector<double>& p, const std::vector<AlignedRun>& runs) {
+    return EvaluateFinalPoseErrors(model, p, runs, options.threads).cf;
+  };
+  return fitcal::JudgeOnHeldOutHalves(split, logs, settings.residuals, options.time_blocks,
+                                      model.robot().nominal, fit_on, cf);
 }
 
 // Prints the judgement; false (exit 5, nothing written) when the fits of one half do not beat the
@@ -934,7 +859,7 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
           ? ChooseResidualsByTransfer(options, *method, *model, split, logs, &settings, &track_data)
           : std::vector<std::string>{};
   const HalvesJudgement halves =
-      JudgeOnHeldOutHalves(options, *method, settings, *model, split, logs);
+      JudgeMethodOnHeldOutHalves(options, *method, settings, *model, split, logs);
   if (const std::string refusal = DegreesOfFreedomRefusal(
           split, settings, track_data,
           NumFreeWithTying(*model, settings.tying) + (effects_to_fit ? effects_to_fit->size() : 0));

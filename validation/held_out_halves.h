@@ -1,0 +1,75 @@
+#pragma once
+// With nothing held out (every run trains: `fit --train-reps 1-99`, or a data set of free
+// driving), the calibration procedure is judged by two folds before the fit of all the training
+// runs is written: a fit of one half is judged on the other half and back, against the nominal
+// (two-fold cross-validation).
+// - More than two runs: every other run trains, the rest is held out.
+// - One or two long runs fitted on their tracks (--residuals track/both, or auto resolving to
+//   track): each is cut into `num_blocks` blocks of equal ground-truth path
+//   (validation/time_blocks.h), odd blocks against even ones. One or two runs fitted on their
+//   final poses are not judged: the blocks were measured for track fits only.
+// The calibration written is the fit of everything, which was measured to transfer better than a
+// fit of half of it (docs/everyday_driving.md); the judgement says whether the runs determine the
+// parameters at all, and the caller writes nothing when the halves do not beat the nominal.
+// Like validation/residual_kind_transfer.h, the judgement is a policy over fits the caller makes
+// (`fit_on`) and scores it computes (`cf`): any model, any fitter.
+
+#include <cstddef>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fit/model_fit.h"
+#include "fit/run_split.h"
+#include "odometry/aligned_run.h"
+#include "odometry/run_log.h"
+
+namespace fitcal {
+
+// Up to this many training runs are cut into time blocks; more are halved.
+constexpr std::size_t kMaxRunsForTimeBlocks = 2;
+
+// One fold: the runs it trains on and is judged on, and the logs by run id that hold their
+// ground-truth tracks (the data set's, plus each time block's under the block's id).
+struct HalvesFold {
+  RunSplit split;
+  std::vector<RunLog> logs;
+};
+
+// The time blocks of the training runs, fold 0 training on the odd blocks and fold 1 on the even.
+HalvesFold TimeBlockFold(const RunSplit& whole, const std::vector<RunLog>& logs, int num_blocks,
+                         int fold);
+
+// Every other training run (in data-set order, so each session gives to both halves): fold 0
+// trains on runs 0, 2, 4, ..., fold 1 on runs 1, 3, 5, ...
+RunSplit RunsFold(const RunSplit& whole, int fold);
+
+// The parameters fitted on a fold's training runs; nullopt when that fit cannot be made or is not
+// usable (the judgement is then not made).
+using FitOnFold = std::function<std::optional<std::vector<double>>(const HalvesFold& fold)>;
+// The CF (Palacin Eq. 14, mean over `runs`) of parameters on some runs.
+using CfOnRuns = std::function<double(const std::vector<double>& parameters,
+                                      const std::vector<AlignedRun>& runs)>;
+
+struct HalvesJudgement {
+  bool judged = false;
+  bool by_time = false;        // time blocks of one or two runs (else halves of the runs)
+  double nominal_cf = 0.0;     // mean CF (Eq. 14) of the held-out halves, both folds
+  double calibrated_cf = 0.0;  // of each fold's fit on its held-out half
+  bool Beats() const { return judged && calibrated_cf < nominal_cf; }
+};
+
+// Not judged when runs are held out (the gate judges on them), when nothing trains, when one or
+// two runs are fitted on their final poses, or when a fold is empty or its fit fails. `residuals`
+// is the kind the whole data is fitted with (auto already resolved); `nominal` the model's nominal
+// parameters. The CFs are means over the held-out runs of both folds, each run weighing alike.
+HalvesJudgement JudgeOnHeldOutHalves(const RunSplit& split, const std::vector<RunLog>& logs,
+                                     ResidualKind residuals, int num_blocks,
+                                     const std::vector<double>& nominal, const FitOnFold& fit_on,
+                                     const CfOnRuns& cf);
+
+// What the halves were, for the terminal and the calibration file's selected_on.
+std::string HalvesDescription(const HalvesJudgement& j, int num_blocks);
+
+}  // namespace fitcal
