@@ -10,22 +10,15 @@
 #include <map>
 #include <set>
 
+#include "tests/model_support.h"
 #include "validation/held_out_families.h"
 
 namespace fitcal {
 namespace {
 
-AlignedRun MakeRun(const std::string& trajectory, int repetition) {
-  AlignedRun run;
-  run.trajectory = trajectory;
-  run.repetition = repetition;
-  run.id = trajectory + "-" + std::to_string(repetition);
-  return run;
-}
-
 RunSplit Training(int num_runs) {
   RunSplit split;
-  for (int i = 1; i <= num_runs; ++i) split.training.push_back(MakeRun("free", i));
+  for (int i = 1; i <= num_runs; ++i) split.training.push_back(testing::LabelledRun("free", i));
   return split;
 }
 
@@ -66,7 +59,7 @@ TEST(HeldOutHalves, TimeBlocksOddAgainstEven) {
   log.repetition = 1;
   log.ground_truth.t_s = {0.0, 4.0};
   log.ground_truth.world_T_robot = {{0.0, 0.0, 0.0}, {4.0, 0.0, 0.0}};
-  AlignedRun run = MakeRun("free", 1);
+  AlignedRun run = testing::LabelledRun("free", 1);
   for (int k = 0; k < 40; ++k) run.samples.push_back(0.1, {0.0, 0.0, 0.0});
   RunSplit whole;
   whole.training = {run};
@@ -126,7 +119,7 @@ TEST(HeldOutHalves, CasesNotJudged) {
     return p[0];
   };
   RunSplit held_out = Training(4);
-  held_out.validation.push_back(MakeRun("circle", 1));
+  held_out.validation.push_back(testing::LabelledRun("circle", 1));
   EXPECT_FALSE(
       JudgeOnHeldOutHalves(held_out, {}, ResidualKind::kTrack, 4, kNominal, fit, cf).judged);
   const HalvesJudgement one_final_pose =
@@ -144,7 +137,7 @@ TEST(HeldOutFamilies, ComparesTheSelectedWithTheNominalPerFamily) {
   const std::vector<CalibrationCandidate> candidates = {{"nominal", kNominal},
                                                         {"ceres", kCalibrated}};
   RunSplit split;
-  split.validation = {MakeRun("square", 1), MakeRun("circular", 1), MakeRun("square", 2)};
+  split.validation = {testing::LabelledRun("square", 1), testing::LabelledRun("circular", 1), testing::LabelledRun("square", 2)};
   const EffectCandidateCf cf = [](const CalibrationCandidate& c,
                                   const std::vector<AlignedRun>& runs) {
     // The calibration is better on squares, worse on circles.

@@ -1,5 +1,5 @@
 #pragma once
-// What the model tests share: the registry's example robots, and the final-pose cost's autodiff
+// What the model tests share: labelled runs, the registry's example robots, and the final-pose cost's autodiff
 // Jacobian against central differences of the double replay (the check the harness makes for
 // every registered model, tests/model_harness_test.cc, and each model's own tests on their
 // robots and runs).
@@ -19,6 +19,15 @@
 #include "odometry/aligned_run.h"
 
 namespace fitcal::testing {
+
+// A run with only its labels, for the tests of splits and groupings: id "<trajectory>-<repetition>".
+inline AlignedRun LabelledRun(const std::string& trajectory, int repetition) {
+  AlignedRun run;
+  run.trajectory = trajectory;
+  run.repetition = repetition;
+  run.id = trajectory + "-" + std::to_string(repetition);
+  return run;
+}
 
 // The registry's example robot of model `name` (models/model_registry.h).
 inline RobotModelPtr ExampleModel(const std::string& name) {

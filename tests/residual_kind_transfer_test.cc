@@ -10,18 +10,11 @@
 #include <map>
 #include <set>
 
+#include "tests/model_support.h"
 #include "validation/trajectory_family.h"
 
 namespace fitcal {
 namespace {
-
-AlignedRun MakeRun(const std::string& trajectory, int repetition) {
-  AlignedRun run;
-  run.trajectory = trajectory;
-  run.repetition = repetition;
-  run.id = trajectory + "-" + std::to_string(repetition);
-  return run;
-}
 
 // Scores per kind of run and residual kind: {cf, drift 2 m %, ate}.
 using Measures = std::array<double, 3>;
@@ -64,8 +57,8 @@ struct Harness {
 RunSplit CirclesAndSquares() {
   RunSplit split;
   for (int rep = 1; rep <= 3; ++rep) {
-    split.training.push_back(MakeRun("circular_1", rep));
-    split.training.push_back(MakeRun("square_1", rep));
+    split.training.push_back(testing::LabelledRun("circular_1", rep));
+    split.training.push_back(testing::LabelledRun("square_1", rep));
   }
   return split;
 }
@@ -97,7 +90,7 @@ TEST(ResidualKindTransfer, LeavesEachKindOutAndKeepsTheTrackUnlessTheFinalPoseWi
 TEST(ResidualKindTransfer, HeldOutFreeDrivingHasTheLastWordByMajority) {
   Harness h;
   RunSplit split = CirclesAndSquares();
-  split.validation.push_back(MakeRun("free/0201", 1));
+  split.validation.push_back(testing::LabelledRun("free/0201", 1));
   // Closed loops would say final pose everywhere; free driving is asked alone.
   h.table.track = {{"free", {0.05, 2.0, 0.030}}};
   h.table.final_pose = {{"free", {0.06, 1.9, 0.025}}};  // better on 2 of 3
@@ -116,7 +109,7 @@ TEST(ResidualKindTransfer, HeldOutFreeDrivingHasTheLastWordByMajority) {
 TEST(ResidualKindTransfer, NothingToJudgeKeepsTheProposal) {
   Harness h;
   RunSplit one_kind;
-  for (int rep = 1; rep <= 4; ++rep) one_kind.training.push_back(MakeRun("circular_1", rep));
+  for (int rep = 1; rep <= 4; ++rep) one_kind.training.push_back(testing::LabelledRun("circular_1", rep));
   ResidualKindJudgement j = h.Judge(one_kind);
   EXPECT_FALSE(j.judged);
   EXPECT_EQ(j.chosen, ResidualKind::kTrack);

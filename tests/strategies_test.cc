@@ -7,6 +7,8 @@
 
 #include <stdexcept>
 
+#include "tests/model_support.h"
+
 namespace fitcal {
 namespace {
 
@@ -48,18 +50,10 @@ TEST(Strategies, RejectsMalformedLists) {
   }
 }
 
-AlignedRun MakeRun(const std::string& trajectory, int repetition) {
-  AlignedRun run;
-  run.trajectory = trajectory;
-  run.repetition = repetition;
-  run.id = trajectory + "-" + std::to_string(repetition);
-  return run;
-}
-
 TEST(Strategies, SelectsByTrajectoryAndRepetitionInDataOrder) {
   std::vector<AlignedRun> runs;
   for (int rep = 1; rep <= 3; ++rep) {
-    for (const char* label : {"R1", "R2", "R5", "R9", "G4"}) runs.push_back(MakeRun(label, rep));
+    for (const char* label : {"R1", "R2", "R5", "R9", "G4"}) runs.push_back(testing::LabelledRun(label, rep));
   }
   const TrajectoryStrategy sta = ParseStrategy("STA");
   const std::vector<AlignedRun> selected = SelectRuns(runs, sta, {1, 3});
