@@ -9,6 +9,7 @@
 #include "models/tricycle/tricycle_checks.h"
 #include "odometry/aligned_run.h"
 #include "odometry/parallel_for.h"
+#include "odometry/pose2.h"
 #include "tools/command_failure.h"
 #include "tools/dataset_command.h"
 #include "tools/import_channel_order.h"
@@ -225,7 +226,7 @@ OptiOdomImport ImportOptiOdom(const ImportOptiOdomOptions& options) {
         "wrote %zu runs of %d sessions to %s; nominal CF (Eq. 14) %.4f, mean final position "
         "error %.4f m, heading %.3f deg\n",
         in.runs.size(), in.num_sessions, options.out.c_str(), in.nominal.cf,
-        in.nominal.mean_position_error_m, in.nominal.mean_abs_heading_error_rad * 180.0 / M_PI);
+        in.nominal.mean_position_error_m, RadToDeg(in.nominal.mean_abs_heading_error_rad));
   }
   return in;
 }
