@@ -6,6 +6,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "odometry/text_format.h"
 #include "validation/statistics.h"
 
 namespace fitcal {
@@ -30,12 +31,6 @@ std::vector<AlignedRun> AlignedOf(const std::vector<TrackRun>& runs) {
   out.reserve(runs.size());
   for (const TrackRun& r : runs) out.push_back(r.aligned);
   return out;
-}
-
-std::string Fmt(const char* format, double a, double b = 0.0, double c = 0.0) {
-  char buf[256];
-  std::snprintf(buf, sizeof buf, format, a, b, c);
-  return buf;
 }
 
 std::string EffectValueText(const effects::EffectValue& e) {
@@ -177,24 +172,27 @@ bool DiagnoseOptions::IsValid(std::string* error) const {
 
 std::string CandidateVerdict(const CandidateResult& c, double threshold,
                              double min_explained_fraction, const std::string& accepted_name) {
-  if (!c.significant) return Fmt("not significant (p %.2g >= %.2g)", c.p_value, threshold);
-  const std::string test = Fmt("significant (p %.2g < %.2g)", c.p_value, threshold);
+  if (!c.significant) return StrFormat("not significant (p %.2g >= %.2g)", c.p_value, threshold);
+  const std::string test = StrFormat("significant (p %.2g < %.2g)", c.p_value, threshold);
   const bool evaluated = !std::isnan(c.explained_fraction);
   // Rounded down, so that a fraction just below the rule never reads as the rule itself.
   const double percent = std::floor(100.0 * c.explained_fraction);
   const std::string rule =
-      Fmt(" of the lack of fit (rule: >= %.0f %%)", 100.0 * min_explained_fraction);
+      StrFormat(" of the lack of fit (rule: >= %.0f %%)", 100.0 * min_explained_fraction);
   if (c.accepted) {
-    return "ACCEPTED: " + test + (evaluated ? Fmt(", explains %.0f %%", percent) + rule : "");
+    return "ACCEPTED: " + test + (evaluated ? StrFormat(", explains %.0f %%", percent) + rule : "");
   }
   if (!c.improves) {
-    return test + Fmt(" but the mean held-out error does not fall (mean d %.3g; rule: mean d > 0)",
-                      c.mean_improvement);
+    return test +
+           StrFormat(" but the mean held-out error does not fall (mean d %.3g; rule: mean d > 0)",
+                     c.mean_improvement);
   }
   if (!c.bic_falls) {
-    return test + Fmt(" but BIC on the training runs rises by %.1f (rule: dBIC < 0)", c.delta_bic);
+    return test +
+           StrFormat(" but BIC on the training runs rises by %.1f (rule: dBIC < 0)", c.delta_bic);
   }
-  if (evaluated && !c.explains) return test + Fmt(" but explains only %.0f %%", percent) + rule;
+  if (evaluated && !c.explains)
+    return test + StrFormat(" but explains only %.0f %%", percent) + rule;
   return test + " but " + accepted_name +
          " lowers the held-out error more (rule: the largest mean d is accepted)";
 }
@@ -241,7 +239,7 @@ std::vector<EffectId> CandidateEffects(const DiagnoseContext& x, const EffectFit
     }
     not_identifiable->push_back(
         std::string(info.name) + ": not identifiable - " + info.aliased_with +
-        Fmt(" (separable fraction on these runs %.1e); ", sep) + info.separating_runs);
+        StrFormat(" (separable fraction on these runs %.1e); ", sep) + info.separating_runs);
   }
   return candidates;
 }
@@ -341,9 +339,9 @@ void NoteUnresolvable(const DiagnoseRound& round, std::vector<std::string>* prac
     const auto& info = effects::Info(c.id);
     practically_aliased->push_back(
         std::string(info.name) +
-        Fmt(" cannot be told apart from the model on these runs "
-            "(separable fraction %.2g, predicted sigma %.2g; it trades off with ",
-            c.separable_fraction, c.predicted_sigma) +
+        StrFormat(" cannot be told apart from the model on these runs "
+                  "(separable fraction %.2g, predicted sigma %.2g; it trades off with ",
+                  c.separable_fraction, c.predicted_sigma) +
         info.aliased_with + "); record: " + info.separating_runs);
   }
 }
@@ -432,10 +430,10 @@ std::string TracingText(const DiagnoseResult& r) {
   for (std::size_t k = 0; k < r.rounds.size(); ++k) {
     const DiagnoseRound& round = r.rounds[k];
     out +=
-        Fmt("Round %.0f: base validation objective %.4g, ", static_cast<double>(k + 1),
-            round.base_validation_objective) +
-        (round.base_lof_available ? Fmt("lack of fit F = %.2f", round.base_lof_f) +
-                                        Fmt(" (p = %.2g)\n\n", round.base_lof_p)
+        StrFormat("Round %.0f: base validation objective %.4g, ", static_cast<double>(k + 1),
+                  round.base_validation_objective) +
+        (round.base_lof_available ? StrFormat("lack of fit F = %.2f", round.base_lof_f) +
+                                        StrFormat(" (p = %.2g)\n\n", round.base_lof_p)
                                   : std::string("lack of fit not available (no repetitions)\n\n"));
     out +=
         "| candidate | separable | predicted sigma | value +- sigma | validation objective | mean "
@@ -448,7 +446,7 @@ std::string TracingText(const DiagnoseResult& r) {
         for (const auto& e : c.fit.effects) {
           if (e.id == c.id) {
             for (int j = 0; j < effects::Info(e.id).num_parameters; ++j) {
-              value += Fmt("%.4g +- %.2g ", e.value[j], e.sigma[j]);
+              value += StrFormat("%.4g +- %.2g ", e.value[j], e.sigma[j]);
             }
           }
         }
@@ -482,37 +480,40 @@ std::string ResultText(const DiagnoseResult& r) {
     if (t.significant) out += "- " + CovariateFinding(t) + "\n";
   }
   if (r.lack_of_fit) {
-    out +=
-        Fmt("- UNEXPLAINED STRUCTURE: the residual still shows repeatable structure "
-            "(lack of fit F = %.2f, p = %.2g) that no candidate explains; see the tables above.\n",
-            r.after.lack_of_fit.f, r.after.lack_of_fit.p_value);
+    out += StrFormat(
+        "- UNEXPLAINED STRUCTURE: the residual still shows repeatable structure "
+        "(lack of fit F = %.2f, p = %.2g) that no candidate explains; see the tables above.\n",
+        r.after.lack_of_fit.f, r.after.lack_of_fit.p_value);
   }
   if (r.floor_shows_structure) out += "- " + SensorFloorFinding(r.after.sensor_floor) + "\n";
   if (r.floor_excess_is_run_to_run_noise) {
     const SensorFloorTest& f = r.after.sensor_floor;
-    out += Fmt("- the residual is %.2f times the sensors' noise floor (p = %.2g) and the "
+    out += StrFormat(
+               "- the residual is %.2f times the sensors' noise floor (p = %.2g) and the "
                "repetitions scatter %.2f times it: ",
                f.ratio, f.p_value, f.repetition_ratio) +
-           Fmt("something changes from run to run beyond the sensors' noise; against that "
+           StrFormat(
+               "something changes from run to run beyond the sensors' noise; against that "
                "scatter the residual is F = %.2f (p = %.2g), so the lack-of-fit and covariate "
                "tests, which take it as noise, judge the structure\n",
                r.floor_vs_repetitions_f, r.floor_vs_repetitions_p);
   }
   if (!r.unexplained_structure) {
-    out += (r.after.lack_of_fit.available
-                ? Fmt("- the remaining residual is consistent with the noise floor (lack of fit "
-                      "F = %.2f, ",
-                      r.after.lack_of_fit.f) +
-                      Fmt("p = %.2g", r.after.lack_of_fit.p_value)
-                : std::string("- the remaining residual is consistent with the noise floor (no "
-                              "repetitions for a lack of fit")) +
-           (r.after.sensor_floor.available
-                ? Fmt("; %.2f times the sensors' noise, ", r.after.sensor_floor.ratio) +
-                      Fmt("p = %.2g", r.after.sensor_floor.p_value) +
-                      (r.floor_excess_is_run_to_run_noise
-                           ? std::string(", as much as the repetitions scatter: see above)\n")
-                           : std::string(")\n"))
-                : std::string(")\n"));
+    out +=
+        (r.after.lack_of_fit.available
+             ? StrFormat("- the remaining residual is consistent with the noise floor (lack of fit "
+                         "F = %.2f, ",
+                         r.after.lack_of_fit.f) +
+                   StrFormat("p = %.2g", r.after.lack_of_fit.p_value)
+             : std::string("- the remaining residual is consistent with the noise floor (no "
+                           "repetitions for a lack of fit")) +
+        (r.after.sensor_floor.available
+             ? StrFormat("; %.2f times the sensors' noise, ", r.after.sensor_floor.ratio) +
+                   StrFormat("p = %.2g", r.after.sensor_floor.p_value) +
+                   (r.floor_excess_is_run_to_run_noise
+                        ? std::string(", as much as the repetitions scatter: see above)\n")
+                        : std::string(")\n"))
+             : std::string(")\n"));
   }
   for (const std::string& line : r.not_identifiable) out += "- " + line + "\n";
   for (const std::string& line : r.record_next) out += "- record next: " + line + "\n";
@@ -523,35 +524,35 @@ std::string ResultText(const DiagnoseResult& r) {
 // "## Held-out error": the declared parameters and the final model on the validation runs.
 std::string HeldOutText(const DiagnoseResult& r) {
   std::string out;
-  out += Fmt("\n## Held-out error (%.0f validation runs)\n\n", r.num_validation_runs);
+  out += StrFormat("\n## Held-out error (%d validation runs)\n\n", r.num_validation_runs);
   out += "| model | CF (Eq. 14) | track RMSE [m] | track RMSE [deg] |\n|---|---|---|---|\n";
-  out += Fmt("| declared parameters | %.5f | %.5f | %.4f |\n", r.declared_validation.cf,
-             r.declared_validation.track_rmse_m, RadToDeg(r.declared_validation.track_rmse_rad));
-  // The second row is the track fit; "+ accepted effects" only when there are some.
   out +=
-      Fmt(r.final_fit.effects.empty() ? "| parameters, track fit (no effect accepted) | %.5f | "
-                                        "%.5f | %.4f |\n"
-                                      : "| parameters + accepted effects | %.5f | %.5f | %.4f |\n",
-          r.final_validation.cf, r.final_validation.track_rmse_m,
-          RadToDeg(r.final_validation.track_rmse_rad));
+      StrFormat("| declared parameters | %.5f | %.5f | %.4f |\n", r.declared_validation.cf,
+                r.declared_validation.track_rmse_m, RadToDeg(r.declared_validation.track_rmse_rad));
+  // The second row is the track fit; "+ accepted effects" only when there are some.
+  out += StrFormat(r.final_fit.effects.empty()
+                       ? "| parameters, track fit (no effect accepted) | %.5f | "
+                         "%.5f | %.4f |\n"
+                       : "| parameters + accepted effects | %.5f | %.5f | %.4f |\n",
+                   r.final_validation.cf, r.final_validation.track_rmse_m,
+                   RadToDeg(r.final_validation.track_rmse_rad));
   return out;
 }
 
-// "## Parameters before / after", in display units.
+// "## Parameters before / after", in display units. No sigma here: which fit is written is the
+// result gate's choice after this table, and the written calibration's table carries its sigma
+// (one number for the terminal, diagnose.md and calibrated.yaml). The last column is the track
+// fit, named "+ effects" only when an effect was accepted.
 std::string ParametersText(const DiagnoseResult& r, const Robot& robot) {
-  std::string out;
-  out +=
-      "\n## Parameters before / after\n\n| parameter | nominal | declared fit | with effects "
-      "| sigma |\n|---|---|---|---|---|\n";
+  std::string out = StrFormat(
+      "\n## Parameters before / after\n\n| parameter | nominal | declared fit | %s |\n"
+      "|---|---|---|---|\n",
+      r.final_fit.effects.empty() ? "track fit" : "track fit + effects");
   for (int k = 0; k < robot.NumParameters(); ++k) {
     const double s = robot.parameters[k].DisplayScale();
-    const double sigma =
-        k < static_cast<int>(r.final_fit.sigma.size()) ? r.final_fit.sigma[k] : 0.0;
-    char line[256];
-    std::snprintf(line, sizeof line, "| %s%s | %.6f | %.6f | %.6f | %.2g |\n",
-                  robot.LabelOf(k).c_str(), robot.IsHeld(k) ? " (held)" : "", robot.nominal[k] * s,
-                  r.declared.parameters[k] * s, r.final_fit.parameters[k] * s, sigma * s);
-    out += line;
+    out += StrFormat("| %s%s | %.6f | %.6f | %.6f |\n", robot.LabelOf(k).c_str(),
+                     robot.IsHeld(k) ? " (held)" : "", robot.nominal[k] * s,
+                     r.declared.parameters[k] * s, r.final_fit.parameters[k] * s);
   }
   return out;
 }

@@ -3,12 +3,14 @@
 #include <ceres/cost_function.h>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
 #include <memory>
 
+#include "fit/correlation.h"
 #include "odometry/parallel_for.h"
 
 namespace fitcal {
@@ -155,6 +157,34 @@ double RobustSigma(std::vector<double> magnitudes, int num_free) {
   return mad_sigma * std::sqrt(static_cast<double>(m) / dof);
 }
 
+// Condition number and strongest correlation of J^T J over the free parameters, in relative units
+// (see DirectionAnalysis).
+void MeasureConditioning(const Robot& robot, const std::vector<double>& p,
+                         const std::vector<int>& free, const Eigen::MatrixXd& jtj,
+                         DirectionAnalysis* out) {
+  const int f = static_cast<int>(free.size());
+  Eigen::MatrixXd relative(f, f);
+  for (int a = 0; a < f; ++a) {
+    for (int b = 0; b < f; ++b) {
+      relative(a, b) = robot.parameters[free[a]].RelativeScale(p[free[a]]) * jtj(free[a], free[b]) *
+                       robot.parameters[free[b]].RelativeScale(p[free[b]]);
+    }
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(relative);
+  const double smallest = eigen.eigenvalues().minCoeff(), largest = eigen.eigenvalues().maxCoeff();
+  if (f == 0 || !(smallest > 0.0)) return;  // singular: rank deficiency is reported as such
+  out->condition_number = largest / smallest;
+  const Eigen::MatrixXd correlation = CorrelationOf(relative.inverse());
+  for (int a = 0; a < f; ++a) {
+    for (int b = a + 1; b < f; ++b) {
+      if (std::abs(correlation(a, b)) <= out->max_abs_correlation) continue;
+      out->max_abs_correlation = std::abs(correlation(a, b));
+      out->correlated_a = free[a];
+      out->correlated_b = free[b];
+    }
+  }
+}
+
 }  // namespace
 
 DirectionAnalysis AnalyseDeterminedDirections(const std::vector<AlignedRun>& training,
@@ -193,6 +223,7 @@ DirectionAnalysis AnalyseDeterminedDirections(const std::vector<AlignedRun>& tra
       information(a, b) = prior_sigma[free[a]] * jtj(free[a], free[b]) * prior_sigma[free[b]] / s2;
     }
   }
+  MeasureConditioning(robot, p, free, jtj, &out);
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(information);
   for (int i = 0; i < f; ++i) {
     Eigen::VectorXd v = Eigen::VectorXd::Zero(n);

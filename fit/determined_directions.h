@@ -42,7 +42,19 @@ struct DirectionAnalysis {
   double residual_sigma = 0;  // s, in the objective's weighted units
   std::vector<double> posterior_fractions;  // every eigen-direction, ascending information
   std::vector<UndeterminedDirection> undetermined;
+  // The conditioning docs/report.md promises to judge, over the free parameters with lengths as
+  // relative changes and angles in radians (ParameterInfo::RelativeScale at `p`): the condition
+  // number of J^T J (0 when it is singular) and the largest |correlation| of its inverse with the
+  // pair's indices into the robot's parameters (-1 when fewer than two are free).
+  double condition_number = 0.0;
+  double max_abs_correlation = 0.0;
+  int correlated_a = -1, correlated_b = -1;
 };
+
+// Identifiability thresholds of the report (docs/report.md): beyond either, a parameter moves
+// with another or with a combination the runs hardly see.
+inline constexpr double kMaxConditionNumber = 1000.0;
+inline constexpr double kMaxAbsCorrelation = 0.99;
 
 // The analysis at `p` over the training runs (final poses, or `segments` when given: one window
 // list per run). `trajectory_of_run` names each run's trajectory for the description (may be

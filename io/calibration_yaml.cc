@@ -159,4 +159,28 @@ std::optional<CalibrationProvenance> ReadCalibrationProvenance(const std::string
   return p;
 }
 
+namespace {
+
+bool RecordedKeyMatches(const std::string& key, const ParameterInfo& info) {
+  const std::string unit = std::string("_") + info.DisplayUnit();
+  if (key == info.name + unit) return true;
+  const std::size_t bracket = key.find('[');
+  if (bracket == std::string::npos || bracket < unit.size()) return false;
+  return key.compare(bracket - unit.size(), unit.size(), unit) == 0;
+}
+
+}  // namespace
+
+std::vector<double> RecordedSigmas(const CalibrationProvenance& provenance,
+                                   const std::vector<ParameterInfo>& parameters) {
+  const auto& recorded = provenance.sigma;
+  if (recorded.size() != parameters.size()) return {};
+  std::vector<double> sigma(parameters.size());
+  for (std::size_t k = 0; k < parameters.size(); ++k) {
+    if (!RecordedKeyMatches(recorded[k].first, parameters[k])) return {};
+    sigma[k] = recorded[k].second / parameters[k].DisplayScale();
+  }
+  return sigma;
+}
+
 }  // namespace fitcal::io

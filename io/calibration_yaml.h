@@ -8,6 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include "odometry/robot.h"
+
 namespace fitcal::io {
 
 // The recorded training repetitions, or nullopt when the file has no calibration block (a plain
@@ -45,5 +47,12 @@ struct CalibrationProvenance {
 
 // nullopt for a plain robot YAML; InputError (file, line) for a malformed block.
 std::optional<CalibrationProvenance> ReadCalibrationProvenance(const std::string& path);
+
+// The recorded sigmas matched to `parameters` by their written key, in SI units and rad: a
+// recorded key names its parameter and display unit, "<name>_<unit>", or for the omni3 file,
+// which writes one list per quantity in the parameters' order, "<quantity>_<unit>[i]". Empty
+// unless every parameter has one.
+std::vector<double> RecordedSigmas(const CalibrationProvenance& provenance,
+                                   const std::vector<ParameterInfo>& parameters);
 
 }  // namespace fitcal::io

@@ -28,6 +28,38 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// Whether `dir` or a folder up to two levels below it holds a file whose name ends with `suffix`
+// (recordings a newcomer passes as --logs before importing them).
+bool HoldsFileEndingIn(const fs::path& dir, const std::string& suffix, int depth = 2) {
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (entry.is_regular_file(ec) && name.size() >= suffix.size() &&
+        name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0) {
+      return true;
+    }
+    if (depth > 0 && entry.is_directory(ec) && HoldsFileEndingIn(entry.path(), suffix, depth - 1)) {
+      return true;
+    }
+  }
+  return false;
+}
+
+// What to do about a --logs directory without dataset.yaml: import the recordings it holds first.
+std::string NoDatasetHint(const fs::path& dir) {
+  if (HoldsFileEndingIn(dir, "_metadata.csv")) {
+    return "these look like OptiOdom recordings: import them first (fitcal import optiodom "
+           "<session folders> --out <data set>) and pass the data set as --logs";
+  }
+  if (HoldsFileEndingIn(dir, ".db3", 0) || HoldsFileEndingIn(dir, ".mcap", 0)) {
+    return "this looks like a ROS 2 bag: import it first (fitcal import rosbag2 <bag> --robot "
+           "<robot YAML> "
+           "--out <data set>) and pass the data set as --logs";
+  }
+  return "--logs takes a data set directory: dataset.yaml, a robot YAML and the runs' logs "
+         "(docs/dataset-format.md)";
+}
+
 // Resolves a path from dataset.yaml against the data set directory, refusing absolute paths and
 // '..' escapes unless allowed: a data set is a self-contained directory.
 std::string ResolvePath(const std::string& directory, const std::string& relative,
@@ -99,6 +131,10 @@ DatasetIndex ReadDatasetIndex(const std::string& directory, const DatasetOptions
     throw InputError(InputErrorKind::kMissingFile, directory, 0, "not a directory");
   }
   RegisterInputDirectory(directory);  // no output inside the data set (io/input_registry.h)
+  if (!fs::exists(yaml_path, fs_error)) {
+    throw InputError(InputErrorKind::kMissingFile, yaml_path, 0,
+                     "no such file: not a data set; " + NoDatasetHint(directory));
+  }
   const YAML::Node root = LoadYamlFile(yaml_path);
   YamlMap top(root, yaml_path, "dataset");
   const YAML::Node robot_node = top.Required("robot");

@@ -9,6 +9,7 @@
 #include "io/report_html.h"
 #include "io/report_json.h"
 #include "io/svg_plot.h"
+#include "odometry/text_format.h"
 
 namespace fitcal::io {
 
@@ -17,18 +18,15 @@ namespace {
 constexpr double kDeg = 180.0 / M_PI;
 const char* const kAfterColour = "#0072b2";  // calibrated
 
-std::string Fmt(const char* format, double v) {
-  if (!std::isfinite(v)) return "-";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
+std::string Fmt(const char* format, double v) { return FormatDouble(format, v); }
 
 std::string ChangeText(double before, double after) {
   return before > 0.0 ? Fmt("%+.1f %%", 100.0 * (after - before) / before) : "-";
 }
 
-void OpenTable(std::ostringstream& h) { h << "<div class=\"scroll\">\n<table>\n"; }
+void OpenTable(std::ostringstream& h, bool stacked = false) {
+  h << "<div class=\"scroll\">\n<table" << (stacked ? " class=\"stack\"" : "") << ">\n";
+}
 void CloseTable(std::ostringstream& h) { h << "</table>\n</div>\n"; }
 
 // The residual: each held-out run's final position error in its start frame, before and after.
@@ -103,12 +101,15 @@ std::string HeldOutSvg(const DiagnosePageData& d) {
 
 void HtmlStructure(std::ostringstream& h, const DiagnosePageData& d) {
   h << "<h2 id=\"structure\">Residual structure tested</h2>\n";
-  OpenTable(h);
+  OpenTable(h, /*stacked=*/true);
   h << "<tr><th>test</th><th>statistic</th><th>p</th><th>result</th><th>what it says</th></tr>\n";
   for (const DiagnoseStructureTest& t : d.structure) {
-    h << "<tr><td>" << EscapeXml(t.name) << "</td><td class=\"k\">" << EscapeXml(t.detail)
-      << "</td><td>" << Fmt("%.2g", t.p_value) << "</td><td"
-      << (t.significant ? " class=\"worse\">structure" : ">none found") << "</td><td class=\"k\">"
+    h << "<tr><td data-label=\"test\">" << EscapeXml(t.name)
+      << "</td><td data-label=\"statistic\" class=\"k\">" << EscapeXml(t.detail)
+      << "</td><td data-label=\"p\">" << Fmt("%.2g", t.p_value)
+      << "</td><td data-label=\"result\" class=\"v"
+      << (t.significant ? " worse\">structure" : "\">none found")
+      << "</td><td data-label=\"what it says\" class=\"k\">"
       << EscapeXml(t.significant ? t.meaning : "") << "</td></tr>\n";
   }
   CloseTable(h);
@@ -124,19 +125,23 @@ void HtmlCandidates(std::ostringstream& h, const DiagnosePageData& d) {
     h << "<p>No candidate effect was tried.</p>\n";
     return;
   }
-  OpenTable(h);
+  OpenTable(h, /*stacked=*/true);
   h << "<tr><th>round</th><th>effect</th><th>separable</th><th>fitted</th><th>mean "
        "improvement</th><th>p</th><th>threshold</th><th>&Delta;BIC</th><th>explains</th>"
        "<th>decision</th></tr>\n";
   for (const DiagnoseCandidate& c : d.candidates) {
-    h << "<tr><td>" << c.round << "</td><td class=\"k\">" << EscapeXml(c.effect) << "</td><td>"
+    h << "<tr><td data-label=\"round\">" << c.round << "</td><td data-label=\"effect\" "
+      << "class=\"k\">" << EscapeXml(c.effect) << "</td><td data-label=\"separable\">"
       << Fmt("%.3f", c.separable_fraction) << (c.resolvable ? "" : " (not resolvable)")
-      << "</td><td>" << (c.fitted ? "yes" : "no") << "</td><td>"
-      << (c.fitted ? Fmt("%.3g", c.mean_improvement) : "-") << "</td><td>"
-      << (c.fitted ? Fmt("%.2g", c.p_value) : "-") << "</td><td>" << Fmt("%.2g", c.threshold)
-      << "</td><td>" << (c.fitted ? Fmt("%+.1f", c.delta_bic) : "-") << "</td><td>"
-      << (c.explains ? "yes" : "no") << "</td><td class=\"k" << (c.accepted ? " better" : "")
-      << "\">" << (c.accepted ? "<b>accepted</b> " : "") << EscapeXml(c.decision) << "</td></tr>\n";
+      << "</td><td data-label=\"fitted\">" << (c.fitted ? "yes" : "no")
+      << "</td><td data-label=\"mean improvement\">"
+      << (c.fitted ? Fmt("%.3g", c.mean_improvement) : "-") << "</td><td data-label=\"p\">"
+      << (c.fitted ? Fmt("%.2g", c.p_value) : "-") << "</td><td data-label=\"threshold\">"
+      << Fmt("%.2g", c.threshold) << "</td><td data-label=\"&Delta;BIC\">"
+      << (c.fitted ? Fmt("%+.1f", c.delta_bic) : "-") << "</td><td data-label=\"explains\">"
+      << (c.explains ? "yes" : "no") << "</td><td data-label=\"decision\" class=\"k v"
+      << (c.accepted ? " better" : "") << "\">" << (c.accepted ? "<b>accepted</b> " : "")
+      << EscapeXml(c.decision) << "</td></tr>\n";
   }
   CloseTable(h);
   const std::string evidence = EvidenceSvg(d);

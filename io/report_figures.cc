@@ -6,6 +6,7 @@
 #include "io/final_error_plot.h"
 #include "io/report_text.h"
 #include "io/svg_plot.h"
+#include "odometry/text_format.h"
 
 namespace fitcal::io {
 
@@ -125,6 +126,7 @@ std::vector<std::size_t> ThinnedIndices(std::size_t n, std::size_t most) {
 // Which error of a run a distance figure shows, and how it is scaled for display.
 struct ErrorQuantity {
   const char* label;  // y axis
+  const char* unit;   // display unit
   double scale;       // SI or rad -> display unit
   const std::vector<double> ReportRun::*before;
   const std::vector<double> ReportRun::*after;
@@ -132,15 +134,19 @@ struct ErrorQuantity {
   const ReportErrorBand ReportErrorBands::*after_band;
 };
 const ErrorQuantity kPositionError = {"position error [mm]",
+                                      "mm",
                                       1e3,
                                       &ReportRun::before_distance_m,
                                       &ReportRun::after_distance_m,
                                       &ReportErrorBands::position_before,
                                       &ReportErrorBands::position_after};
-const ErrorQuantity kHeadingError = {
-    "|heading error| [deg]",           kDeg,
-    &ReportRun::before_angle_rad,      &ReportRun::after_angle_rad,
-    &ReportErrorBands::heading_before, &ReportErrorBands::heading_after};
+const ErrorQuantity kHeadingError = {"|heading error| [deg]",
+                                     "deg",
+                                     kDeg,
+                                     &ReportRun::before_angle_rad,
+                                     &ReportRun::after_angle_rad,
+                                     &ReportErrorBands::heading_before,
+                                     &ReportErrorBands::heading_after};
 
 // One panel: every run thin, and the model's band over the runs (ReportErrorBand): the median
 // (thick) and the band between the quartiles.
@@ -150,6 +156,13 @@ std::string ErrorAlongDistancePanel(const ReportData& d, const ErrorQuantity& q,
   SvgSeries runs = Series("each held-out run", colour);
   runs.opacity = 0.25;
   runs.line_width = 1.0;
+  // A run whose error leaves the top of the shared scale gets a marker at its peak's distance on
+  // the top edge, and the legend names the largest peak: no extreme is cut off unsaid.
+  SvgSeries beyond = Series("", "#000000");
+  beyond.draw_lines = false;
+  beyond.draw_markers = true;
+  beyond.marker_radius = 4.0;
+  double peak = 0.0;
   // The thin lines are the background of the band: ~6000 points a panel in all, 30 to 150 a run.
   const std::size_t per_run =
       std::clamp<std::size_t>(6000 / std::max<std::size_t>(1, d.runs.size()), 30, 150);
@@ -161,7 +174,15 @@ std::string ErrorAlongDistancePanel(const ReportData& d, const ErrorQuantity& q,
       line.push_back({r.along_m[i], q.scale * e[i]});
     }
     runs.lines.push_back(line);
+    const std::size_t top =
+        static_cast<std::size_t>(std::max_element(e.begin(), e.end()) - e.begin());
+    if (q.scale * e[top] > y_hi) {
+      beyond.lines.push_back({{r.along_m[top], 0.97 * y_hi}});
+      peak = std::max(peak, q.scale * e[top]);
+    }
   }
+  beyond.name =
+      StrFormat("beyond the top: %zu run(s), peak %.4g %s", beyond.lines.size(), peak, q.unit);
   SvgSeries band = Series("quartiles over runs", colour), median = Series("median", colour);
   band.fill = colour;
   band.opacity = 0.3;
@@ -186,11 +207,13 @@ std::string ErrorAlongDistancePanel(const ReportData& d, const ErrorQuantity& q,
   o.include_origin = true;
   o.y_lo = 0.0;
   o.y_hi = y_hi;
-  return XYPlotSvg(o, {runs, band, median});
+  if (beyond.lines.empty()) return XYPlotSvg(o, {runs, band, median});
+  return XYPlotSvg(o, {runs, band, median, beyond});
 }
 
-// Both panels of one quantity on one y range, wide enough for the larger of the two medians'
-// worst quartile and at least 95 % of every run's samples.
+// Both panels of one quantity on one y range, wide enough for both bands (median and upper
+// quartile never run off the top) and at least 95 % of every run's samples; a run beyond it is
+// marked at the top edge (ErrorAlongDistancePanel).
 std::string ErrorAlongDistanceSvgs(const ReportData& d, const ErrorQuantity& q,
                                    const std::string& id) {
   std::vector<double> all;
@@ -201,7 +224,13 @@ std::string ErrorAlongDistanceSvgs(const ReportData& d, const ErrorQuantity& q,
     }
   }
   if (all.empty()) return "";
-  const double y_hi = 1.05 * std::max(Quantile(all, 0.95), 1e-9);
+  double band_top = 0.0;
+  for (const ReportErrorBand* b :
+       {&(d.error_bands.*q.before_band), &(d.error_bands.*q.after_band)}) {
+    for (double v : b->upper_quartile) band_top = std::max(band_top, q.scale * v);
+    for (double v : b->median) band_top = std::max(band_top, q.scale * v);
+  }
+  const double y_hi = 1.05 * std::max({Quantile(all, 0.95), band_top, 1e-9});
   return ErrorAlongDistancePanel(d, q, false, y_hi, id + "-nominal") +
          ErrorAlongDistancePanel(d, q, true, y_hi, id + "-calibrated");
 }

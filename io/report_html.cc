@@ -37,6 +37,7 @@ const char* const kStyle =
     ".WARN{background:#fff3cd;border-color:#b08000}\n"
     ".FAIL{background:#fde2e1;border-color:#b00020}\n"
     ".banner li.PASS,.banner li.WARN,.banner li.FAIL{background:none;border:none}\n"
+    ".banner li.SKIP{color:#555}\n"
     ".figs{display:flex;flex-wrap:wrap;gap:12px}\n"
     "figure{margin:0 0 12px;max-width:100%}figcaption{font-size:13px;color:#555;"
     "max-width:640px}\n"
@@ -49,12 +50,21 @@ const char* const kStyle =
     "@media (max-width:700px){body{padding:8px}svg{max-width:none}"
     ".figs,figure{overflow-x:auto;max-width:100%}.figs>svg{flex-shrink:0}"
     "figure.wide svg{min-width:0}}\n"
-    ".figs.flagged{border-left:4px solid #b00020;padding-left:6px}\n";
+    ".figs.flagged{border-left:4px solid #b00020;padding-left:6px}\n"
+    // A table whose columns carry a verdict (the runs that got worse, diagnose's tests and
+    // effects) becomes one card per row on a phone, each cell under its column's name: no column
+    // hides beyond the right edge (the "after" that explains the flag, the decision).
+    "@media (max-width:700px){table.stack,table.stack tbody,table.stack tr,table.stack td"
+    "{display:block}table.stack tr:first-child{display:none}table.stack tr{border:1px solid #bbb;"
+    "margin:0 0 8px;padding:2px 0}table.stack td{border:none;text-align:left;white-space:normal;"
+    "min-width:0;overflow-wrap:anywhere}table.stack td::before{content:attr(data-label) \": \";"
+    "font-weight:bold;color:#333}}\n";
 
 // A table inside a horizontally scrolling box: wide tables scroll on a phone instead of pushing
 // the page wider than the screen.
-void OpenTable(std::ostringstream& h, const std::string& id = "") {
-  h << "<div class=\"scroll\"" << (id.empty() ? "" : " id=\"" + id + "\"") << ">\n<table>\n";
+void OpenTable(std::ostringstream& h, const std::string& id = "", bool stacked = false) {
+  h << "<div class=\"scroll\"" << (id.empty() ? "" : " id=\"" + id + "\"") << ">\n<table"
+    << (stacked ? " class=\"stack\"" : "") << ">\n";
 }
 void CloseTable(std::ostringstream& h) { h << "</table>\n</div>\n"; }
 
@@ -258,18 +268,20 @@ void HtmlWorseRuns(std::ostringstream& h, const ReportData& d) {
   h << "<p class=\"flag\"><b>" << worse.size() << " of " << d.runs.size()
     << " held-out runs got worse</b> with the calibration: their CF (Eq. 14) or their ATE RMSE "
        "(RMS position error, Eq. 12) rose.</p>\n";
-  OpenTable(h);
+  OpenTable(h, "", /*stacked=*/true);
   h << "<tr><th>run</th><th>CF before</th><th>CF after</th><th>ATE RMSE before [mm]</th>"
-       "<th>after [mm]</th></tr>\n";
+       "<th>ATE RMSE after [mm]</th></tr>\n";
   for (const ReportRun* r : worse) {
-    const auto cell = [&](double before, double after, const char* format, double scale) {
-      h << "<td>" << Fmt(format, scale * before) << "</td><td"
-        << (after > before ? " class=\"worse\"" : "") << ">" << Fmt(format, scale * after)
-        << "</td>";
+    // The "after" cells carry the flag (class v: page_render_test keeps them on the screen).
+    const auto cell = [&](const char* name, double before, double after, const char* format,
+                          double scale) {
+      h << "<td data-label=\"" << name << " before\">" << Fmt(format, scale * before)
+        << "</td><td data-label=\"" << name << " after\" class=\"v"
+        << (after > before ? " worse" : "") << "\">" << Fmt(format, scale * after) << "</td>";
     };
-    h << "<tr><td>" << EscapeXml(r->id) << "</td>";
-    cell(r->before.cf, r->after.cf, "%.4f", 1.0);
-    cell(r->before.rms_distance_m, r->after.rms_distance_m, "%.1f", 1e3);
+    h << "<tr><td data-label=\"run\">" << EscapeXml(r->id) << "</td>";
+    cell("CF", r->before.cf, r->after.cf, "%.4f", 1.0);
+    cell("ATE RMSE [mm]", r->before.rms_distance_m, r->after.rms_distance_m, "%.1f", 1e3);
     h << "</tr>\n";
   }
   CloseTable(h);

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "odometry/text_format.h"
+
 namespace fitcal::io::report_text {
 
 const char* const kGroundTruthColour = "#9a9a9a";
@@ -11,12 +13,7 @@ const char* const kAfterColour = "#0072b2";
 const char* const kBeforeName = "odometry, nominal parameters";
 const char* const kAfterName = "odometry, calibrated parameters";
 
-std::string Fmt(const char* format, double v) {
-  if (!std::isfinite(v)) return "-";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
+std::string Fmt(const char* format, double v) { return FormatDouble(format, v); }
 
 double Improvement(double before, double after) {
   return before > 0.0 ? 100.0 * (before - after) / before : 0.0;

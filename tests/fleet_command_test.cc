@@ -3,6 +3,8 @@
 // separation only scatters: none. Robot r2 is stable but one night's calibration went wrong
 // (radius 2 mm off): an outlier, and not a trend.
 
+#include "tools/fleet_command.h"
+
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
@@ -11,8 +13,8 @@
 
 #include "io/input_error.h"
 #include "models/model_registry.h"
+#include "tests/model_support.h"
 #include "tests/test_files.h"
-#include "tools/fleet_command.h"
 
 namespace fitcal {
 namespace {
@@ -85,6 +87,59 @@ TEST(Fleet, FlagsTrendsAndOutliers) {
 
   tmp.Write("undated/cal.yaml", testing::ReadFileBytes(worn.files[0]));
   EXPECT_THROW(tools::ReadFleet({tmp.Path("undated/cal.yaml")}), io::InputError);
+}
+
+// Issue 42: fleet printed angles in rad where fit prints degrees, no sigma, and compared held-out
+// CFs judged on different runs without a word. A tricycle (one angle, its steering offset) with
+// sigmas recorded as fit writes them (<name>_<display unit>, display units), judged on two data
+// sets: each row carries its unit, the value and sigma in it, and a note names both data sets.
+TEST(Fleet, PrintsUnitsAndSigmasAndNotesCfsJudgedOnDifferentRuns) {
+  testing::TempDir tmp;
+  const RobotModelPtr model = testing::ExampleModel("tricycle");
+  const Robot& robot = model->robot();
+  std::string sigmas;
+  int angle = -1;
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    const ParameterInfo& info = robot.parameters[k];
+    if (info.unit == ParameterUnit::kAngle) angle = k;
+    sigmas += (k ? ", " : "") + info.name + "_" + info.DisplayUnit() + ": 0.0137";
+  }
+  ASSERT_GE(angle, 0);
+  for (const std::string data : {"/data/week1", "/data/week2"}) {
+    const std::string block = "calibration:\n  dataset: " + data +
+                              "\n  training_repetitions: [1, 2, 3]\n  cf_validation: {before: "
+                              "0.05, after: 0.01}\n  sigma: {" +
+                              sigmas + "}\n";
+    tmp.Write(
+        "fleet/" + std::string(data == "/data/week1" ? "2026-05-01" : "2026-05-08") + "/cal.yaml",
+        model->RobotYaml(robot.nominal, block));
+  }
+  const std::vector<tools::FleetSeries> all = tools::ReadFleet({tmp.Path("fleet")});
+  const std::string table = tools::FleetTable(all);
+  const std::string& name = robot.parameters[angle].name;
+  const tools::FleetSeries& steering = Find(all, robot.name, name);
+  EXPECT_EQ(steering.unit, "deg");
+  ASSERT_EQ(steering.sigmas.size(), 2u);
+  EXPECT_NEAR(steering.sigmas.back(), 0.0137 * M_PI / 180.0, 1e-15);  // held in rad
+  char row[128];
+  std::snprintf(row, sizeof row, "%-22s %-6s %3d  %-10s %12.6g", name.c_str(), "deg", 2,
+                "2026-05-01", robot.nominal[angle] * 180.0 / M_PI);
+  EXPECT_NE(table.find(row), std::string::npos) << row << "\n" << table;
+  EXPECT_NE(table.find(" 0.014 "), std::string::npos) << table;  // the sigma, %.2g, in deg
+  EXPECT_NE(table.find("cf_validation_after    Eq. 14"), std::string::npos) << table;
+  EXPECT_NE(table.find("judged on 2 different sets of held-out runs"), std::string::npos) << table;
+  EXPECT_NE(table.find("/data/week1 (training repetitions 1,2,3)"), std::string::npos) << table;
+
+  // Judged on the same runs: no note.
+  testing::TempDir same;
+  for (const char* date : {"2026-05-01", "2026-05-08"}) {
+    same.Write(std::string("fleet/") + date + "/cal.yaml",
+               model->RobotYaml(robot.nominal,
+                                "calibration:\n  dataset: /data/one\n"
+                                "  cf_validation: {before: 0.05, after: 0.01}\n"));
+  }
+  EXPECT_EQ(tools::FleetTable(tools::ReadFleet({same.Path("fleet")})).find("note:"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -112,8 +112,9 @@ TEST(OptiOdomImport, WritesATicksDataSetThatLoadsBackToTheSameRuns) {
       }
     }
   }
-  // Refuses to overwrite without --force.
-  EXPECT_EQ(tools::RunImportOptiOdomCommand(options), 2);
+  // Running the import again replaces the data set it wrote (README, Outputs: issue 42).
+  EXPECT_EQ(tools::RunImportOptiOdomCommand(options), 0);
+  EXPECT_TRUE(fs::exists(out / "dataset.yaml"));
   fs::remove_all(out);
 }
 

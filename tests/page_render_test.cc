@@ -50,17 +50,26 @@ window.addEventListener('load', function () {
       svg_min = Math.min(svg_min, parseFloat(t.getAttribute('font-size')) * scale);
     });
   });
+  // Cells that carry a verdict (class v: a run's "after", a test's result, an effect's decision)
+  // must be on the screen without scrolling: a cell beyond the right edge is cut.
+  var verdicts = 0, cut = 0;
+  document.querySelectorAll('td.v').forEach(function (c) {
+    verdicts++;
+    var r = c.getBoundingClientRect();
+    if (r.width < 1 || r.right > window.innerWidth + 0.5) cut++;
+  });
   var out = document.createElement('pre');
   out.id = 'probe';
   out.textContent = 'PROBE min_font=' + min + ' scroll_width=' +
       document.documentElement.scrollWidth + ' window=' + window.innerWidth + ' zero_svgs=' + zero +
-      ' svg_font=' + svg_min;
+      ' svg_font=' + svg_min + ' verdict_cells=' + verdicts + ' cut=' + cut;
   window.parent.document.body.appendChild(out);  // the host page's DOM is the one printed
 });
 </script>)";
 
 struct Probe {
   double min_font = 0, scroll_width = 0, window = 0, zero_svgs = -1, svg_font = 0;
+  double verdict_cells = 0, cut = -1;
 };
 
 // Headless Chromium lays a window out at least 500 px wide whatever --window-size says, so the
@@ -101,8 +110,10 @@ Probe Render(const TempDir& dir, const std::string& html, int width) {
   const std::string dom = ReadFileBytes(out);
   if (std::regex_search(dom, m,
                         std::regex("PROBE min_font=([0-9.e+]+) scroll_width=([0-9.]+) "
-                                   "window=([0-9.]+) zero_svgs=([0-9]+) svg_font=([0-9.e+]+)"))) {
-    p = {std::stod(m[1]), std::stod(m[2]), std::stod(m[3]), std::stod(m[4]), std::stod(m[5])};
+                                   "window=([0-9.]+) zero_svgs=([0-9]+) svg_font=([0-9.e+]+) "
+                                   "verdict_cells=([0-9]+) cut=([0-9]+)"))) {
+    p = {std::stod(m[1]), std::stod(m[2]), std::stod(m[3]), std::stod(m[4]),
+         std::stod(m[5]), std::stod(m[6]), std::stod(m[7])};
   }
   return p;
 }
@@ -135,6 +146,18 @@ ReportData SmallReport() {
     r.after.cf = 0.01;
     d.runs.push_back(r);
   }
+  // Two runs that got worse, with the long ids of real sessions: the "after" columns that explain
+  // the flag are the ones a phone cut (issue 42).
+  for (int k : {3, 7}) {
+    d.runs[k].id = "square_231220200029_calibration_session-run" + std::to_string(k);
+    d.runs[k].after.cf = 0.06;
+    d.runs[k].after.rms_distance_m = 0.4;
+  }
+  // One run whose error runs far above the others (the nominal's 277 mm peak of the issue): beyond
+  // the figure's 95 % scale, it must be marked, not clipped unsaid.
+  for (std::size_t i = 0; i < d.runs[0].before_distance_m.size(); ++i) {
+    d.runs[0].before_distance_m[i] = 0.0277 * static_cast<double>(i);  // peak 1108 mm
+  }
   ReportSummaryRow all{"all validation runs", 12, {}, {}};
   all.before.cf = 0.05;
   all.after.cf = 0.01;
@@ -156,7 +179,22 @@ void ExpectReadable(const TempDir& dir, const std::string& html, const std::stri
     // Figure text as drawn on the screen: the tick labels (11 px) never shrink with their figure
     // (the defect: 1100 px charts scaled to a phone's 358 px printed 4-6 px text).
     EXPECT_GE(p.svg_font, 10.0);
+    // Every cell that carries a verdict is on the screen, none cut at the right edge.
+    EXPECT_GT(p.verdict_cells, 0);
+    EXPECT_EQ(p.cut, 0);
   }
+}
+
+// The error-against-distance figure's scale holds 95 % of the samples; a run beyond its top is
+// marked there and named in the legend with its peak, never clipped unsaid (issue 42: the
+// nominal's 277 mm peak drawn at ~229 mm).
+TEST(PageRender, AnExtremeBeyondTheScaleIsMarked) {
+  const std::string html = ReportHtml(SmallReport());
+  // The peak: 0.0277 m x 40 samples = 1108 mm.
+  EXPECT_NE(html.find("beyond the top: 1 run(s), peak 1108 mm"), std::string::npos);
+  ReportData calm = SmallReport();
+  calm.runs[0].before_distance_m = calm.runs[1].before_distance_m;
+  EXPECT_EQ(ReportHtml(calm).find("beyond the top"), std::string::npos);
 }
 
 TEST(PageRender, ReportAndDiagnoseReadableOnPhoneAndDesktop) {
@@ -168,7 +206,8 @@ TEST(PageRender, ReportAndDiagnoseReadableOnPhoneAndDesktop) {
   d.conclusion = "One effect.";
   d.dataset = "data";
   d.structure = {{"lack of fit, declared fit", "F = 3 on (9, 40) dof", 1e-5, true, "structure"}};
-  d.candidates = {{1, "yaw_rate_slip", 0.4, true, true, 0.01, 1e-6, 0.001, -12, true, true, "ok"}};
+  d.candidates = {{1, "yaw_rate_slip", 0.4, true, true, 0.01, 1e-6, 0.001, -12, true, true,
+                   "significant (p 1e-06 < 0.001) but explains only 12 % of the lack of fit"}};
   d.gate = {{"nominal", 0.05, false}, {"track fit + effects", 0.01, true}};
   d.held_out = {{"run1", 0.05, 0.01, 0.02, 0.004, {0.01, 0.02}, {0.001, 0.002}}};
   d.text_report = std::string(300, 'x');

@@ -101,6 +101,44 @@ TEST(VerdictTest, NoHeldOutImprovementFails) {
   EXPECT_EQ(JudgeCalibration(in).level, VerdictLevel::kFail);
 }
 
+// Issue 42: a copy of the diff drive's calibration with wheel_separation_m 0.215 judged on its 20
+// held-out runs printed "no improvement on the 1488919704 held-out runs: CF 20.0000 with the
+// calibration, 0.6691 with the nominal" (an int formatted as a double). The numbers of the message
+// are the inputs, each in its place.
+TEST(VerdictTest, NoImprovementMessageQuotesTheRightNumbers) {
+  VerdictInputs in = GoodCase();
+  in.overall.runs = 20;
+  in.overall.cf_before = 0.1366;
+  in.overall.cf_after = 0.6691;
+  const VerdictReason* r = Find(JudgeCalibration(in), "improvement");
+  ASSERT_NE(r, nullptr);
+  EXPECT_EQ(r->level, VerdictLevel::kFail);
+  EXPECT_EQ(r->message,
+            "no improvement on the 20 held-out runs: CF 0.6691 with the calibration, 0.1366 with "
+            "the nominal");
+  // The nominal passed as its own calibration: equal CFs, the same message with its numbers.
+  in.overall.runs = 1;
+  in.overall.cf_after = in.overall.cf_before;
+  EXPECT_EQ(Find(JudgeCalibration(in), "improvement")->message,
+            "no improvement on the 1 held-out runs: CF 0.1366 with the calibration, 0.1366 with "
+            "the nominal");
+}
+
+// A check that could not run is SKIP, not PASS, and leaves the overall level alone (issue 42:
+// "PASS noise_floor: ... the noise floor is not measured").
+TEST(VerdictTest, NoiseFloorNotMeasuredIsSkippedNotPassed) {
+  VerdictInputs in = GoodCase();
+  in.noise_floor = NoiseFloorTest{};  // no trajectory with two validation runs
+  const Verdict v = JudgeCalibration(in);
+  const VerdictReason* r = Find(v, "noise_floor");
+  ASSERT_NE(r, nullptr);
+  EXPECT_EQ(r->level, VerdictLevel::kSkip);
+  EXPECT_STREQ(ToString(r->level), "SKIP");
+  EXPECT_NE(r->message.find("not measured"), std::string::npos) << r->message;
+  EXPECT_EQ(v.level, VerdictLevel::kPass);
+  EXPECT_EQ(v.reasons.back().check, "noise_floor");  // after every check that ran
+}
+
 TEST(VerdictTest, ConvergenceGapAndIdentifiability) {
   VerdictInputs in = GoodCase();
   in.termination = "NO_CONVERGENCE";

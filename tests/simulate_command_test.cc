@@ -90,9 +90,9 @@ INSTANTIATE_TEST_SUITE_P(EveryModel, SimulatedModel,
                                            RecoveryCase{"omni", 3, 3, ""}),
                          [](const auto& test) { return std::string(test.param.model); });
 
-// The directory appears whole: an existing data set is refused without --force and replaced
-// entirely with it; a file fitcal did not write there is never deleted, --force or not (the whole
-// directory is refused: tools/output_guard.h); no temporary sibling is left behind.
+// The directory appears whole: a data set fitcal wrote is replaced entirely by the next run; a
+// file fitcal did not write there is never deleted, --force or not (the whole directory is
+// refused: tools/output_guard.h); no temporary sibling is left behind.
 TEST(SimulateCommand, WritesTheDataSetDirectoryAtomically) {
   TempDir dir;
   const std::string data = dir.Path("data");

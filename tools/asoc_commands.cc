@@ -331,7 +331,7 @@ void AddAsocSimulateOptions(CLI::App& app, AsocSimulateOptions& simulate) {
                  "Relative wheel-encoder noise per 20 Hz sample")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
-  app.add_flag("--force", simulate.force, "Overwrite an existing data set");
+  app.add_flag("--force", simulate.force, kForceDirectoryHelp);
 }
 
 void AddAsocGeometricOptions(CLI::App& app, AsocGeometricOptions& geometric) {
@@ -341,8 +341,7 @@ void AddAsocGeometricOptions(CLI::App& app, AsocGeometricOptions& geometric) {
   app.add_option("--out", geometric.out, "Calibrated robot YAML (atomically)")
       ->capture_default_str();
   app.add_flag("--no-output", geometric.no_output, "Do not write the YAML");
-  app.add_flag("--force", geometric.force,
-               "Replace an --out that holds another robot's calibration");
+  app.add_flag("--force", geometric.force, kForceFileHelp);
   app.add_flag("--allow-outside-paths", geometric.allow_outside_paths,
                "Allow dataset.yaml paths outside the data set directory");
 }

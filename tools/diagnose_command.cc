@@ -23,6 +23,7 @@
 #include "io/staged_directory.h"
 #include "models/model_registry.h"
 #include "odometry/parallel_for.h"
+#include "odometry/text_format.h"
 #include "tools/cli_validators.h"
 #include "tools/clock_alignment.h"
 #include "tools/miswired_error.h"
@@ -185,6 +186,21 @@ bool WithUncertainty(const RobotModelInterface& model, const DiagnoseSplit& spli
   return true;
 }
 
+// "## Written calibration": the chosen candidate's parameters with the sigma calibrated.yaml
+// records, in display units.
+std::string WrittenCalibrationText(const Robot& robot, const DiagnoseChoice& choice) {
+  std::string out = "\n## Written calibration: " + choice.name +
+                    "\n\n| parameter | unit | value | +-1 sigma |\n|---|---|---|---|\n";
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    const ParameterInfo& info = robot.parameters[k];
+    const double s = info.DisplayScale();
+    out += StrFormat("| %s%s | %s | %.6f | %.2g |\n", robot.LabelOf(k).c_str(),
+                     robot.IsHeld(k) ? " (held)" : "", info.DisplayUnit(), choice.parameters[k] * s,
+                     choice.sigma[k] * s);
+  }
+  return out;
+}
+
 std::string ObjectiveOf(const DiagnoseChoice& choice) {
   return choice.name == "declared final-pose fit"
              ? "sum over runs of the squared final-pose error (m and rad)"
@@ -275,11 +291,7 @@ bool ChannelsLookMiswired(const DiagnoseCommandOptions& options, const RobotMode
   return true;
 }
 
-std::string Format(const char* format, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
+std::string Format(const char* format, double v) { return FormatDouble(format, v); }
 
 // The verdict of the page: effects named as causes, effects that only describe part of a
 // structure, structure and no effect, or nothing at all.
@@ -478,10 +490,12 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
       return 5;
     }
     if (!WithUncertainty(*model, split, &choice)) return 1;
+    const std::string written = WrittenCalibrationText(robot, choice);
+    std::printf("%s", written.c_str());
     const std::string yaml = ModelCalibratedYaml(options, *model, runs, split, result, choice);
     const io::DiagnosePageData page =
         MakePage(options, *model, split, result, gate, choice, report);
-    WriteOutputs(options, inputs, report, result, page, yaml);
+    WriteOutputs(options, inputs, report + written, result, page, yaml);
     std::printf("\nheld-out runs as `report` computes them: CF %.4f -> %.4f\n",
                 io::HeldOutMean(page.held_out, &io::DiagnoseHeldOutRun::cf_before),
                 io::HeldOutMean(page.held_out, &io::DiagnoseHeldOutRun::cf_after));

@@ -673,32 +673,34 @@ void AddExportRos2ControlOptions(CLI::App& app, ExportRos2ControlOptions& o) {
                "Write the parameters even when they replay worse than the nominal robot");
   app.add_option("--calibration-out", o.calibration_out,
                  "With --logs: write the calibration with its odometry covariance here");
-  app.add_flag("--force", o.force, "Overwrite --out");
+  app.add_flag("--force", o.force, kForceFileHelp);
 }
 
 namespace {
 
-// --out never over its calibration or the data set (tools/output_guard.h), nor over a file
-// without --force.
+// The overwrite rule (tools/output_guard.h): --out never over its calibration or the data set;
+// over the parameter file of the same node (a previous export) freely, over any other file only
+// with --force.
 void CheckOut(const ExportRos2ControlOptions& o) {
   if (o.out.empty()) return;
-  const std::string refusal = OutputFileRefusal(o.out, {o.calibration, o.logs});
+  std::string refusal = OutputFileRefusal(o.out, {o.calibration, o.logs});
   if (!refusal.empty()) throw UsageError(refusal);
-  if (std::filesystem::exists(o.out) && !o.force) {
-    throw std::runtime_error(o.out + ": exists; refusing to overwrite it (--force)");
-  }
+  refusal = ParameterFileOverwriteRefusal(o.out, o.node_name.empty() ? o.controller : o.node_name);
+  if (!refusal.empty() && !o.force) throw UsageError(refusal);
 }
 
-void CheckCalibrationOut(const ExportRos2ControlOptions& o) {
+// --calibration-out like fit's --out: a calibration of the same robot is replaced.
+void CheckCalibrationOut(const ExportRos2ControlOptions& o, const std::string& robot_name) {
   if (o.calibration_out.empty()) return;
   if (o.logs.empty()) {
     throw UsageError(
         "--calibration-out needs --logs (the covariance comes from "
         "the held-out runs)");
   }
-  if (std::filesystem::exists(o.calibration_out) && !o.force) {
-    throw std::runtime_error(o.calibration_out + ": exists; refusing to overwrite it (--force)");
-  }
+  std::string refusal = OutputFileRefusal(o.calibration_out, {o.calibration, o.logs});
+  if (!refusal.empty()) throw UsageError(refusal);
+  refusal = OverwriteRefusal(o.calibration_out, robot_name);
+  if (!refusal.empty() && !o.force) throw UsageError(refusal);
 }
 
 // The replay's verdict (WorseThanNominalError, exit 5, unless --allow-worse), its lines (on stdout
@@ -745,7 +747,7 @@ int RunExportRos2ControlCommand(const ExportRos2ControlOptions& o) {
     std::string text = "# " + o.controller + " parameters (ros2_controllers, ROS 2 " +
                        o.ros_distro + ") from the fitcal calibration " + o.calibration + "\n";
     for (const std::string& note : e.notes) text += "# not representable: " + note + "\n";
-    CheckCalibrationOut(o);
+    CheckCalibrationOut(o, calibrated->robot().name);
     std::string parameters = e.parameters_yaml, calibration_text;
     if (!o.logs.empty()) AddReplay(o, calibrated, e, &text, &parameters, &calibration_text);
     text += parameters;

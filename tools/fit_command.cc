@@ -28,7 +28,7 @@ void AddFitOptions(CLI::App& app, FitCommandOptions& o) {
   app.add_option("--out", o.out, "Calibrated robot YAML to write (atomically)")
       ->capture_default_str();
   app.add_flag("--no-output", o.no_output, "Do not write the calibrated YAML");
-  app.add_flag("--force", o.force, "Overwrite --out even if it holds another robot's calibration");
+  app.add_flag("--force", o.force, kForceFileHelp);
   app.add_option("--time-blocks", o.time_blocks,
                  "With one or two runs fitted on their tracks and none held out, judge on time: "
                  "cut each into this many blocks of equal path, fit the odd blocks and judge on "

@@ -7,9 +7,11 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdlib>
+#include <filesystem>
 #include <functional>
 #include <iostream>
 #include <memory>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -20,6 +22,7 @@
 #include "io/input_registry.h"
 #include "tools/asoc_commands.h"
 #include "tools/cli_validators.h"
+#include "tools/command_failure.h"
 #include "tools/compare_command.h"
 #include "tools/diagnose_command.h"
 #include "tools/export_ros2_control.h"
@@ -75,6 +78,7 @@ CLI::App* GroupOf(CLI::App& app, const std::string& group) {
     if (group == g.name) {
       CLI::App* parent = app.add_subcommand(g.name, g.description);
       parent->require_subcommand(1);
+      parent->footer(kExitStatusHelp);
       return parent;
     }
   }
@@ -96,15 +100,15 @@ std::vector<Command> Commands() {
                   &AddReportOptions, &RunReportCommand),
       MakeCommand("", "diagnose",
                   "Trace the residual of the model's fit to missing effects, any model "
-                  "(diagnosis/diagnose.h)",
+                  "(docs/diagnose.md)",
                   &AddDiagnoseOptions, &RunDiagnoseCommand),
       MakeCommand("", "generalise",
                   "Train on one path type / session, test on the others "
-                  "(tools/model_generalise_command.h)",
+                  "(docs/optiodom.md)",
                   &AddGeneraliseOptions, &RunGeneraliseCommand),
       MakeCommand("", "simulate",
                   "Write a simulated data set: omni3 flower, or --model's trajectories "
-                  "(README.md, Simulator)",
+                  "(docs/simulate.md)",
                   &AddSimulateOptions, &RunSimulateCommand),
       MakeCommand("import", "optiodom",
                   "OptiOdom sessions of one robot: omni3, omni4, diff or tricyc (Sousa et al. "
@@ -130,6 +134,23 @@ std::vector<Command> Commands() {
   };
 }
 
+// For an argument CLI11 did not expect: a directory given without its flag (`fitcal fit DIR`)
+// is a data set meant for --logs; "" for anything else.
+std::string UnexpectedArgumentHint(const CLI::ParseError& e) {
+  if (dynamic_cast<const CLI::ExtrasError*>(&e) == nullptr) return "";
+  const std::string what = e.what();
+  const std::size_t colon = what.rfind(": ");
+  std::istringstream arguments(colon == std::string::npos ? "" : what.substr(colon + 2));
+  std::string argument;
+  std::error_code ec;
+  while (arguments >> argument) {
+    if (std::filesystem::is_directory(argument, ec)) {
+      return "; a data set directory is given as --logs " + argument;
+    }
+  }
+  return "";
+}
+
 // Usage errors exit 2 in one line, as the README says; CLI11's own codes (105 for a validation,
 // 106 for a missing option, ...) and its second "Run with --help" line would say otherwise.
 // Help and version requests keep CLI11's output and exit 0. Returns -1 when parsing succeeded.
@@ -138,7 +159,8 @@ int ParseCommandLine(CLI::App& app, int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);
-    std::cerr << "fitcal: " << fitcal::io::OneLine(e.what(), 300) << " (see fitcal --help)\n";
+    std::cerr << "fitcal: " << fitcal::io::OneLine(e.what(), 300) << UnexpectedArgumentHint(e)
+              << " (see fitcal --help)\n";
     return 2;
   }
   return -1;
@@ -178,6 +200,7 @@ int main(int argc, char** argv) {
                "logs and ground truth"};
   app.set_version_flag("--version", std::string(fitcal::kVersion));
   app.require_subcommand(0, 1);
+  app.footer(kExitStatusHelp);
 
   const std::vector<Command> commands = Commands();
   // fit's flags on the top level too, bound to the same options: `fitcal --logs DIR` fits.
@@ -186,6 +209,10 @@ int main(int argc, char** argv) {
   for (const Command& command : commands) {
     CLI::App* cmd = GroupOf(app, command.group)->add_subcommand(command.name, command.description);
     command.add_options(*cmd);
+    // A command's own footer (what it prints, e.g. fleet's columns) first, then the one list of
+    // exit statuses every command shares.
+    const std::string own = cmd->get_footer();
+    cmd->footer(own.empty() ? kExitStatusHelp : own + "\n\n" + kExitStatusHelp);
     parsers.push_back(cmd);
   }
 

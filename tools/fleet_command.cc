@@ -8,13 +8,17 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <map>
+#include <optional>
 #include <regex>
 #include <stdexcept>
 
+#include "io/calibration_yaml.h"
 #include "io/input_error.h"
 #include "io/yaml_reader.h"
 #include "models/model_registry.h"
+#include "odometry/text_format.h"
 #include "tools/command_failure.h"
 #include "tools/dataset_command.h"
 
@@ -32,10 +36,33 @@ constexpr double kTrendT = 3.0;
 constexpr std::size_t kMinForTrend = 4;
 constexpr const char* kCfRow = "cf_validation_after";
 
+// One row's value in one calibration: SI units and rad, printed in `unit` (value x scale).
+struct FleetValue {
+  std::string name, unit;
+  double value = 0.0, display_scale = 1.0;
+  double sigma = std::numeric_limits<double>::quiet_NaN();  // as recorded; NaN when not
+};
+
 struct Calibration {
   std::string file, robot, date;
-  std::vector<std::pair<std::string, double>> values;  // parameter name -> value
+  std::vector<FleetValue> values;
+  // Which runs judged its held-out CF: the data set and the split it was fitted with. Two
+  // calibrations with different keys report CFs of different runs.
+  std::string judged_on;
 };
+
+constexpr const char* kCfUnit = "Eq. 14";
+
+// The data set and the training split a calibration's provenance records; "" without one.
+std::string JudgedOn(const std::optional<io::CalibrationProvenance>& p) {
+  if (!p) return "";
+  std::string reps;
+  for (int r : p->training_repetitions) reps += (reps.empty() ? "" : ",") + std::to_string(r);
+  return p->dataset + " (training " +
+         (p->training_trajectories.empty() ? "repetitions " + reps
+                                           : "trajectories " + p->training_trajectories) +
+         ")";
+}
 
 // Days since 1970-01-01 of a proleptic Gregorian YYYY-MM-DD (Howard Hinnant's days_from_civil).
 long DaysFromCivil(int y, int m, int d) {
@@ -71,12 +98,19 @@ Calibration ReadCalibration(const std::string& path) {
   c.robot = model->robot().name;
   c.date = DateOf(path);
   const Robot& robot = model->robot();
+  const std::optional<io::CalibrationProvenance> provenance = io::ReadCalibrationProvenance(path);
+  const std::vector<double> sigma =
+      provenance ? io::RecordedSigmas(*provenance, robot.parameters) : std::vector<double>{};
   for (std::size_t k = 0; k < robot.parameters.size(); ++k) {
-    c.values.emplace_back(robot.parameters[k].name, robot.nominal[k]);
+    const ParameterInfo& info = robot.parameters[k];
+    c.values.push_back({info.name, info.DisplayUnit(), robot.nominal[k], info.DisplayScale(),
+                        sigma.empty() ? std::numeric_limits<double>::quiet_NaN() : sigma[k]});
   }
   const YAML::Node cf = root["calibration"]["cf_validation"];
   if (cf && cf.IsMap() && cf["after"]) {
-    c.values.emplace_back(kCfRow, io::YamlDouble(cf["after"], path, "calibration.cf_validation"));
+    c.values.push_back(
+        {kCfRow, kCfUnit, io::YamlDouble(cf["after"], path, "calibration.cf_validation")});
+    c.judged_on = JudgedOn(provenance);
   }
   return c;
 }
@@ -100,12 +134,23 @@ Calibration ReadMetricsJson(const std::string& path) {
       if (key.rfind("calibrated_", 0) != 0) continue;
       const double v = io::YamlDouble(kv.second, path, "parameters." + key);
       const bool degrees = key.size() > 4 && key.compare(key.size() - 4, 4, "_deg") == 0;
-      c.values.emplace_back(p["name"].as<std::string>(), degrees ? v * M_PI / 180.0 : v);
+      const double scale = degrees ? 180.0 / M_PI : 1.0;
+      double sigma = std::numeric_limits<double>::quiet_NaN();
+      if (p["sigma"] && p["sigma"].IsScalar() && p["sigma"].Scalar() != "null") {
+        sigma = io::YamlDouble(p["sigma"], path, "parameters.sigma") / scale;
+      }
+      c.values.push_back(
+          {p["name"].as<std::string>(), degrees ? "deg" : "m", v / scale, scale, sigma});
     }
   }
   for (const YAML::Node& g : root["summary"]) {
     if (g["group"] && g["group"].as<std::string>() == "all validation runs" && g["after"]) {
-      c.values.emplace_back(kCfRow, io::YamlDouble(g["after"]["cf"], path, "summary.after.cf"));
+      c.values.push_back(
+          {kCfRow, kCfUnit, io::YamlDouble(g["after"]["cf"], path, "summary.after.cf")});
+      // A report judges on the runs of the data set it was given.
+      c.judged_on = root["dataset"] && root["dataset"].IsScalar()
+                        ? root["dataset"].Scalar() + " (report)"
+                        : path;
     }
   }
   return c;
@@ -205,19 +250,26 @@ std::vector<FleetSeries> ReadFleet(const std::vector<std::string>& inputs) {
   std::vector<FleetSeries> out;
   std::map<std::pair<std::string, std::string>, std::size_t> index;
   for (const Calibration& c : all) {
-    for (const auto& [name, value] : c.values) {
-      const auto key = std::make_pair(c.robot, name);
+    for (const FleetValue& v : c.values) {
+      const auto key = std::make_pair(c.robot, v.name);
       auto it = index.find(key);
       if (it == index.end()) {
         it = index.emplace(key, out.size()).first;
-        out.push_back({c.robot, name, {}, {}, {}, {}, false, false, 0.0});
+        FleetSeries s;
+        s.robot = c.robot;
+        s.parameter = v.name;
+        s.unit = v.unit;
+        s.display_scale = v.display_scale;
+        out.push_back(std::move(s));
       }
       FleetSeries& s = out[it->second];
       // A calibration and its report (metrics.json) on the same date are one result.
       if (!s.dates.empty() && s.dates.back() == c.date) continue;
       s.dates.push_back(c.date);
-      s.values.push_back(value);
+      s.values.push_back(v.value);
+      s.sigmas.push_back(v.sigma);
       s.files.push_back(c.file);
+      if (v.name == kCfRow) s.judged_on.push_back(c.judged_on);
     }
   }
   for (FleetSeries& s : out) {
@@ -227,35 +279,68 @@ std::vector<FleetSeries> ReadFleet(const std::vector<std::string>& inputs) {
   return out;
 }
 
+// The note under a robot's table when its held-out CFs were judged on different runs: a change
+// in CF may then be the runs', not the robot's.
+std::string DifferentJudgesNote(const FleetSeries& s) {
+  std::vector<std::string> distinct;
+  for (const std::string& j : s.judged_on) {
+    if (std::find(distinct.begin(), distinct.end(), j) == distinct.end()) distinct.push_back(j);
+  }
+  if (distinct.size() < 2) return "";
+  std::string note = "  note: " + std::string(kCfRow) + " was judged on " +
+                     std::to_string(distinct.size()) +
+                     " different sets of held-out runs, so its values do not compare like for "
+                     "like:";
+  for (const std::string& j : distinct) note += "\n    " + (j.empty() ? "(not recorded)" : j);
+  return note + "\n";
+}
+
 std::string FleetTable(const std::vector<FleetSeries>& series) {
-  std::string out, robot;
-  char line[400];
+  std::string out, robot, note;
+  const auto close_robot = [&] {
+    out += note;
+    note.clear();
+  };
   for (const FleetSeries& s : series) {
     if (s.robot != robot) {
+      close_robot();
       robot = s.robot;
-      std::snprintf(line, sizeof line, "\n%s\n  %-22s %3s  %-10s %12s  %-10s %12s %12s %14s  %s\n",
-                    robot.c_str(), "parameter", "n", "first", "value", "last", "value", "median",
-                    "slope/30 d", "flags");
-      out += line;
+      out += StrFormat("\n%s\n  %-22s %-6s %3s  %-10s %12s  %-10s %12s %10s %12s %14s  %s\n",
+                       robot.c_str(), "parameter", "unit", "n", "first", "value", "last", "value",
+                       "+-1 sigma", "median", "slope/30 d", "flags");
     }
     std::string flags = s.trend ? "TREND" : "";
     for (const std::string& d : s.outliers) flags += (flags.empty() ? "" : " ") + ("OUTLIER " + d);
-    char slope[32] = "-";
-    if (s.has_slope) std::snprintf(slope, sizeof slope, "%+.4g", s.slope_per_30_days);
-    std::snprintf(line, sizeof line, "  %-22s %3zu  %-10s %12.6g  %-10s %12.6g %12.6g %14s  %s\n",
-                  s.parameter.c_str(), s.values.size(), s.dates.front().c_str(), s.values.front(),
-                  s.dates.back().c_str(), s.values.back(), Median(s.values), slope,
-                  flags.c_str());
-    out += line;
+    const double k = s.display_scale;
+    const std::string slope = s.has_slope ? StrFormat("%+.4g", k * s.slope_per_30_days) : "-";
+    const std::string sigma = StrFormatFinite(s.sigmas.back(), "%.2g", k * s.sigmas.back());
+    out += StrFormat("  %-22s %-6s %3zu  %-10s %12.6g  %-10s %12.6g %10s %12.6g %14s  %s\n",
+                     s.parameter.c_str(), s.unit.c_str(), s.values.size(), s.dates.front().c_str(),
+                     k * s.values.front(), s.dates.back().c_str(), k * s.values.back(),
+                     sigma.c_str(), k * Median(s.values), slope.c_str(), flags.c_str());
+    if (s.parameter == kCfRow) note += DifferentJudgesNote(s);
   }
+  close_robot();
   return out;
 }
 
 void AddFleetOptions(CLI::App& app, FleetOptions& o) {
   app.add_option("inputs", o.inputs,
-                 "Calibrated robot YAMLs, or directories searched for them (the date: the first "
-                 "YYYY-MM-DD in each path)")
+                 "Calibrated robot YAMLs or reports' metrics.json, or directories searched for "
+                 "them (the date: the first YYYY-MM-DD in each path)")
       ->required();
+  app.footer(
+      "Output: per robot (the YAML's name), one row per parameter and one for the held-out CF\n"
+      "(cf_validation_after, Palacin Eq. 14: final position error in m plus heading error in rad,\n"
+      "lower is better). Columns: unit (m, deg; the CF in Eq. 14 units), n calibrations, the "
+      "first\n"
+      "and last date and value, +-1 sigma as the last calibration recorded it ('-': none), the\n"
+      "median, the least-squares slope per 30 days, and flags: OUTLIER <date> (more than 5 robust\n"
+      "sigmas from the robot's median, >= 5 calibrations), TREND (slope 3 standard errors from 0\n"
+      "and larger than the scatter over the span, >= 4 calibrations). A note follows when a "
+      "robot's\n"
+      "CFs were judged on different held-out runs (data set or split): they do not compare.\n"
+      "Guide: docs/ros2.md (fleet).");
 }
 
 int RunFleetCommand(const FleetOptions& o) {

@@ -29,9 +29,14 @@ struct FleetOptions {
 // One parameter of one robot over its calibrations, in date order.
 struct FleetSeries {
   std::string robot, parameter;
+  std::string unit;                // printed unit: "m", "deg", or "Eq. 14" for the held-out CF
+  double display_scale = 1.0;      // printed value = value x display_scale (rad -> deg)
   std::vector<std::string> dates;  // YYYY-MM-DD
   std::vector<double> values;      // SI units and rad, as the model holds them
+  std::vector<double> sigmas;      // one sigma each calibration recorded (SI, rad); NaN: none
   std::vector<std::string> files;
+  // The held-out CF's row only: the data set and split that judged each calibration.
+  std::vector<std::string> judged_on;
   std::vector<std::string> outliers;  // dates of the flagged calibrations
   bool trend = false;
   bool has_slope = false;  // enough calibrations (kMinForTrend) for a line

@@ -236,7 +236,7 @@ void AddImportOptiOdomOptions(CLI::App& app, ImportOptiOdomOptions& o) {
       ->required()
       ->check(CLI::ExistingDirectory);
   app.add_option("--out", o.out, "Output data set directory")->required();
-  app.add_flag("--force", o.force, "Overwrite an existing data set");
+  app.add_flag("--force", o.force, kForceDirectoryHelp);
   app.add_flag("--skip-mapping-check", o.skip_mapping_check,
                "Write even if another wheel order/sign explains the ground truth better");
 }

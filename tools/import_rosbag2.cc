@@ -516,7 +516,7 @@ void AddImportRosbag2Options(CLI::App& app, ImportRosbag2Options& o) {
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   app.add_option("--label", o.label, "Trajectory label of the runs (default: the bag's name)");
-  app.add_flag("--force", o.force, "Replace an existing data set");
+  app.add_flag("--force", o.force, kForceDirectoryHelp);
 }
 
 int RunImportRosbag2Command(const ImportRosbag2Options& o) {

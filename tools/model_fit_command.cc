@@ -36,6 +36,7 @@
 #include "validation/residual_kind_transfer.h"
 #include "validation/statistics.h"
 #include "validation/training_runs.h"
+#include "validation/trajectory_family.h"
 #include "validation/trajectory_metrics.h"
 
 namespace fitcal::tools {
@@ -333,9 +334,16 @@ void PrintFit(const FitCommandOptions& options, const RobotModelInterface& model
   const std::string selection = options.train_trajectories.empty()
                                     ? "repetitions " + reps
                                     : TrainingSelection(options) + "; repetitions " + reps;
-  std::printf("runs: %zu training (%s), %zu validation (repetitions %s)\n\n", split.training.size(),
+  std::printf("runs: %zu training (%s), %zu validation (repetitions %s)\n", split.training.size(),
               selection.c_str(), split.validation.size(),
               FormatRepetitionList(split.validation_repetitions).c_str());
+  // A split by trajectory holds families out on purpose; one by repetition may hold none out.
+  if (options.train_trajectories.empty()) {
+    for (const std::string& note : UnjudgedFamilyNotes(split.training, split.validation)) {
+      std::printf("%s\n", note.c_str());
+    }
+  }
+  std::printf("\n");
   const CalibrationCandidate& selected = candidates[gate.selected];
   PrintCfTable(candidates[0], selected, split, errors);
   PrintParameters(robot, selected.parameters, selected_fit);

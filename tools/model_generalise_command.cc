@@ -259,7 +259,9 @@ int Generalise(const GeneraliseCommandOptions& options) {
 
 void AddGeneraliseOptions(CLI::App& app, GeneraliseCommandOptions& o) {
   AddDatasetOptions(app, o);
-  app.add_flag("!--no-loso", o.leave_one_session_out, "Skip leave-one-session-out");
+  // A plain flag that clears the option: CLI11 prints a negated flag as "--no-loso{false}".
+  app.add_flag_callback(
+      "--no-loso", [&o] { o.leave_one_session_out = false; }, "Skip leave-one-session-out");
   app.add_option("--train-trajectories", o.train_trajectories,
                  "Train on labels matching (list or regular expression), test on the rest, "
                  "and the other way round");

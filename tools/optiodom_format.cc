@@ -117,11 +117,58 @@ Metadata ReadMetadata(const std::string& path, const std::string& expected_type)
   return meta;
 }
 
+namespace {
+
+// The session name of a folder: its last component ("…/circular/231220200121/" too).
+std::string SessionName(const fs::path& dir) {
+  return dir.filename().empty() ? dir.parent_path().filename().string() : dir.filename().string();
+}
+
+bool IsSessionFolder(const fs::path& dir) {
+  std::error_code ec;
+  return fs::is_regular_file(dir / (SessionName(dir) + "_metadata.csv"), ec);
+}
+
+// A folder that is not a session: the robot's folder (diff/) or a path type's (diff/circular/),
+// as a newcomer passes them. The error names the session folders below it to pass instead.
+void RequireSessionFolder(const std::string& directory) {
+  const fs::path dir(directory);
+  if (IsSessionFolder(dir)) return;
+  std::vector<std::string> below;  // path-type folders (circular, square) or sessions
+  std::error_code ec;
+  for (const auto& child : fs::directory_iterator(dir, ec)) {
+    if (!child.is_directory(ec)) continue;
+    if (IsSessionFolder(child.path())) {
+      below.push_back((fs::path(directory) / "*").string());
+      break;
+    }
+    for (const auto& grandchild : fs::directory_iterator(child.path(), ec)) {
+      if (grandchild.is_directory(ec) && IsSessionFolder(grandchild.path())) {
+        below.push_back((child.path() / "*").string());
+        break;
+      }
+    }
+  }
+  std::sort(below.begin(), below.end());
+  std::string hint = "; pass session folders, each holding <session>_metadata.csv";
+  if (!below.empty()) {
+    hint = "; it holds session folders: pass them, e.g. fitcal import optiodom";
+    for (const std::string& b : below) hint += " " + b;
+    hint += " --out <data set>";
+  }
+  throw InputError(
+      InputErrorKind::kMissingFile, directory, 0,
+      "not an OptiOdom session folder (no " + SessionName(dir) + "_metadata.csv)" + hint);
+}
+
+}  // namespace
+
 SessionFiles ListSession(const std::string& directory) {
   const fs::path dir = fs::path(directory).lexically_normal();
   if (!fs::is_directory(dir)) {
     throw InputError(InputErrorKind::kMissingFile, directory, 0, "not a directory");
   }
+  RequireSessionFolder(directory);
   const fs::path named = dir.has_filename() ? dir : dir.parent_path();
   SessionFiles files;
   files.name = named.filename().string();
@@ -149,6 +196,7 @@ void CheckRunCount(const SessionFiles& files, int num_runs) {
 }
 
 std::string SessionType(const std::string& directory) {
+  if (fs::is_directory(directory)) RequireSessionFolder(directory);
   const fs::path dir(directory);
   const std::string name =
       dir.filename().empty() ? dir.parent_path().filename().string() : dir.filename().string();

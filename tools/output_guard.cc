@@ -78,6 +78,15 @@ std::optional<std::set<std::string>> LegacyDatasetFiles(const fs::path& dir) {
   return files;
 }
 
+// The kind the marker of `dir` names ("data set"), "" without a marker.
+std::string MarkedKind(const fs::path& dir) {
+  std::ifstream in(dir / kOutputMarker);
+  std::string line;
+  const std::string prefix = "fitcal output: ";
+  if (!std::getline(in, line) || line.compare(0, prefix.size(), prefix) != 0) return "";
+  return line.substr(prefix.size());
+}
+
 // The first file below `dir` that a fitcal output of `kind` does not hold, "" when none.
 std::string ForeignFile(const fs::path& dir, const std::string& kind) {
   std::optional<std::set<std::string>> own = MarkedFiles(dir, kind);
@@ -90,17 +99,26 @@ std::string ForeignFile(const fs::path& dir, const std::string& kind) {
 
 }  // namespace
 
-std::string OverwriteRefusal(const std::string& out, const std::string& robot_name) {
+// The previous output at `out` read as YAML to see whose it is; nullopt when `out` does not
+// exist, a Null node when it is not YAML.
+std::optional<YAML::Node> PreviousYaml(const std::string& out) {
   // stat, not fopen: opening a FIFO to probe it would wait for a writer.
   struct stat info {};
-  if (::stat(out.c_str(), &info) != 0) return "";
-  std::string existing;
+  if (::stat(out.c_str(), &info) != 0) return std::nullopt;
   try {
-    const io::NotAnInput probe;  // the previous output, read to see whose it is
-    const YAML::Node root = io::LoadYamlFile(out);
-    if (root.IsMap() && root["name"] && root["name"].IsScalar()) existing = root["name"].Scalar();
+    const io::NotAnInput probe;
+    return io::LoadYamlFile(out);
   } catch (const std::exception&) {
-    // Not YAML at all: refused below like any file that is not a robot YAML.
+    return YAML::Node();  // not YAML at all: refused like any file the command did not write
+  }
+}
+
+std::string OverwriteRefusal(const std::string& out, const std::string& robot_name) {
+  const std::optional<YAML::Node> root = PreviousYaml(out);
+  if (!root) return "";
+  std::string existing;
+  if (root->IsMap() && (*root)["name"] && (*root)["name"].IsScalar()) {
+    existing = (*root)["name"].Scalar();
   }
   if (existing == robot_name) return "";
   return out + ": " +
@@ -108,6 +126,17 @@ std::string OverwriteRefusal(const std::string& out, const std::string& robot_na
               ? std::string("exists and is not a robot YAML")
               : "holds the calibration of robot '" + existing + "', not '" + robot_name + "'") +
          "; refusing to overwrite it (--force to replace it)";
+}
+
+std::string ParameterFileOverwriteRefusal(const std::string& out, const std::string& node_name) {
+  const std::optional<YAML::Node> root = PreviousYaml(out);
+  if (!root) return "";
+  if (root->IsMap() && root->size() == 1 && (*root)[node_name] &&
+      (*root)[node_name]["ros__parameters"]) {
+    return "";
+  }
+  return out + ": exists and is not the parameter file of '" + node_name +
+         "'; refusing to overwrite it (--force to replace it)";
 }
 
 std::string OutputFileRefusal(const std::string& out, const std::vector<std::string>& inputs) {
@@ -163,14 +192,18 @@ std::string DirectoryOutputRefusal(const std::string& out, const std::string& ki
     return Refusal(out, "exists and is not a directory; --out must name a directory");
   }
   if (fs::is_empty(out, ec)) return "";
-  if (const std::string foreign = ForeignFile(out, kind); !foreign.empty()) {
-    return Refusal(out, "holds '" + io::OneLine(foreign, 80) +
-                            "', which fitcal did not write as a " + kind +
-                            "; refusing to replace the directory, --force or not (choose "
-                            "an empty or new --out)");
+  if (ForeignFile(out, kind).empty()) return "";  // its own previous output (rule 1)
+  const std::string other_kind = MarkedKind(out);
+  if (!other_kind.empty() && ForeignFile(out, other_kind).empty()) {
+    if (force) return "";
+    return Refusal(
+        out, "holds a " + other_kind + " fitcal wrote, not a " + kind + "; --force to replace it");
   }
-  if (!force) return Refusal(out, "already holds a " + kind + "; --force to replace it");
-  return "";
+  const std::string foreign = ForeignFile(out, kind);
+  return Refusal(out, "holds '" + io::OneLine(foreign, 80) + "', which fitcal did not write as a " +
+                          kind +
+                          "; refusing to replace the directory, --force or not (choose an empty "
+                          "or new --out)");
 }
 
 void CommitDirectoryOutput(io::StagedDirectory& staged, const std::string& out,

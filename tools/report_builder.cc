@@ -12,6 +12,7 @@
 #include "fit/model_fit.h"
 #include "fit/run_split.h"
 #include "fitcal/version.h"
+#include "odometry/text_format.h"
 #include "validation/relative_pose_error.h"
 #include "validation/trajectory_family.h"
 #include "validation/verdict.h"
@@ -270,23 +271,28 @@ void AddModelIdentifiability(const ReportInputs& in, const CalibrationInput& cal
                              io::ReportData* data) {
   const DirectionAnalysis d = AnalyseDeterminedDirections(
       training, *in.model, cal.calibrated.nominal, ResidualWeights{}, nullptr, threads);
-  data->identifiable = d.ok && d.undetermined.empty();
+  data->condition_number = d.condition_number;
   for (const UndeterminedDirection& u : d.undetermined) {
     data->identifiability_lines.push_back("not determined by the training runs: " + u.description);
   }
   if (!d.ok) data->identifiability_lines.push_back("no Jacobian at the calibrated parameters");
+  const std::vector<ParameterInfo>& names = in.model->robot().parameters;
+  if (d.ok && d.max_abs_correlation > kMaxAbsCorrelation) {
+    data->identifiability_lines.push_back(StrFormat(
+        "%s and %s correlate %.4f on the training runs (above %.2f): the runs see mostly their "
+        "combination, each alone is less certain than its sigma suggests",
+        names[d.correlated_a].name.c_str(), names[d.correlated_b].name.c_str(),
+        d.max_abs_correlation, kMaxAbsCorrelation));
+  }
+  if (d.ok && d.condition_number > kMaxConditionNumber) {
+    data->identifiability_lines.push_back(
+        StrFormat("condition number %.3g of the training runs' J^T J in relative units (above "
+                  "%.0f): some combination of parameters is barely seen",
+                  d.condition_number, kMaxConditionNumber));
+  }
+  data->identifiable = data->identifiability_lines.empty();
   data->uncertainty_note = "No parameter sigma here: this report does not refit a " +
                            in.model->robot().model + " robot, and the calibration records none.";
-}
-
-// A recorded sigma's key names its parameter and display unit: "<name>_<unit>", or for the omni3
-// file, which writes one list per quantity in the parameters' order, "<quantity>_<unit>[i]".
-bool RecordedKeyMatches(const std::string& key, const ParameterInfo& info) {
-  const std::string unit = std::string("_") + info.DisplayUnit();
-  if (key == info.name + unit) return true;
-  const std::size_t bracket = key.find('[');
-  if (bracket == std::string::npos || bracket < unit.size()) return false;
-  return key.compare(bracket - unit.size(), unit.size(), unit) == 0;
 }
 
 // The sigmas and correlation the fit recorded in the calibration's YAML, matched to this robot's
@@ -295,14 +301,8 @@ bool RecordedKeyMatches(const std::string& key, const ParameterInfo& info) {
 bool AddRecordedUncertainty(const CalibrationInput& cal, io::ReportData* data,
                             std::vector<double>* sigma, bool* has_sigma) {
   if (!cal.provenance || cal.provenance->sigma.empty()) return false;
-  const Robot& robot = cal.calibrated;
-  const auto& recorded = cal.provenance->sigma;
-  if (static_cast<int>(recorded.size()) != robot.NumParameters()) return false;
-  std::vector<double> values(robot.NumParameters());
-  for (int k = 0; k < robot.NumParameters(); ++k) {
-    if (!RecordedKeyMatches(recorded[k].first, robot.parameters[k])) return false;
-    values[k] = recorded[k].second / robot.parameters[k].DisplayScale();
-  }
+  std::vector<double> values = io::RecordedSigmas(*cal.provenance, cal.calibrated.parameters);
+  if (values.empty()) return false;
   *sigma = std::move(values);
   *has_sigma = true;
   data->has_correlation = !cal.provenance->correlation.empty();

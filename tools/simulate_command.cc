@@ -136,7 +136,7 @@ void AddSimulateOptions(CLI::App& app, SimulateCommandOptions& o) {
   app.add_option("--angle-sigma-deg", o.angle_sigma_deg,
                  "--model: noise of an angle channel's readings, e.g. steering (deg)")
       ->capture_default_str();
-  app.add_flag("--force", o.force, "Overwrite an existing data set");
+  app.add_flag("--force", o.force, kForceDirectoryHelp);
   app.add_option("--inject", o.inject,
                  "Inject a library effect, name=value[,value] (odometry/effects.h); repeatable; "
                  "the data set does not name it");

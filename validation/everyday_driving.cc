@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "odometry/parallel_for.h"
+#include "odometry/text_format.h"
 #include "validation/relative_pose_error.h"
 #include "validation/trajectory_metrics.h"
 
@@ -49,25 +50,23 @@ EverydayDrivingMetrics EvaluateEverydayDriving(const RobotModelInterface& model,
 std::vector<std::string> EverydayDrivingRows(const EverydayDrivingMetrics& before,
                                              const EverydayDrivingMetrics& after) {
   std::vector<std::string> rows;
-  char line[200];
-  const auto row = [&](const std::string& name, double a, double b, const char* format) {
+  const auto row = [&](const std::string& name, double a, double b, const std::string& values) {
     const double change = a > 0.0 ? 100.0 * (b - a) / a : 0.0;
-    char values[100];
-    std::snprintf(values, sizeof values, format, a, b);
-    std::snprintf(line, sizeof line, "  %-30s %s %+8.1f%%", name.c_str(), values, change);
-    rows.push_back(line);
+    rows.push_back(StrFormat("  %-30s %s %+8.1f%%", name.c_str(), values.c_str(), change));
   };
   row("ATE RMSE [m] (mean of runs)", before.mean_ate_rmse_m, after.mean_ate_rmse_m,
-      "%10.4f %10.4f");
+      StrFormat("%10.4f %10.4f", before.mean_ate_rmse_m, after.mean_ate_rmse_m));
   for (std::size_t k = 0; k < before.drift.size() && k < after.drift.size(); ++k) {
     const DriftAtLength& a = before.drift[k];
     const DriftAtLength& b = after.drift[k];
     if (a.windows == 0) continue;
     char name[64];
     std::snprintf(name, sizeof name, "drift %g m [%%] (%d windows)", a.length_m, a.windows);
-    row(name, a.translation_percent, b.translation_percent, "%10.3f %10.3f");
+    row(name, a.translation_percent, b.translation_percent,
+        StrFormat("%10.3f %10.3f", a.translation_percent, b.translation_percent));
     std::snprintf(name, sizeof name, "drift %g m [deg/m]", a.length_m);
-    row(name, a.rotation_deg_per_m, b.rotation_deg_per_m, "%10.3f %10.3f");
+    row(name, a.rotation_deg_per_m, b.rotation_deg_per_m,
+        StrFormat("%10.3f %10.3f", a.rotation_deg_per_m, b.rotation_deg_per_m));
   }
   return rows;
 }

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <map>
 
+#include "odometry/text_format.h"
 #include "validation/trajectory_family.h"
 
 namespace fitcal {
@@ -123,12 +124,15 @@ std::vector<std::string> ResidualKindJudgementLines(const ResidualKindJudgement&
                   c.proposed.mean_ate_rmse_m, c.alternative.mean_ate_rmse_m);
     lines.push_back(line);
   }
-  const char* rule = j.on_free_driving ? "most of them on free driving"
-                                       : "all of them on closed loops, a weak judge";
-  std::snprintf(line, sizeof(line), "  %s chosen: %s is better on %d of %d (it replaces %s on %s)",
-                ToString(j.chosen), ToString(j.alternative), j.alternative_wins, j.total,
-                ToString(j.proposed), rule);
-  lines.push_back(line);
+  // Said in full: "better on 2 of 6" alone did not tell a reader what was counted or what it takes.
+  const char* rule = j.on_free_driving
+                         ? "most of them (free driving is the judge that counts)"
+                         : "all of them (closed loops are a weak judge of everyday driving)";
+  lines.push_back(StrFormat(
+      "  %s chosen: %s is better on %d of the %d comparisons above (CF, drift, ATE in each row); "
+      "it replaces %s only when better on %s",
+      ToString(j.chosen), ToString(j.alternative), j.alternative_wins, j.total,
+      ToString(j.proposed), rule));
   return lines;
 }
 

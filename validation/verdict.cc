@@ -2,20 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <map>
 
+#include "odometry/text_format.h"
 #include "validation/statistics.h"
 
 namespace fitcal {
 
 namespace {
-
-std::string Format(const char* format, double a, double b = 0.0, double c = 0.0) {
-  char buf[256];
-  std::snprintf(buf, sizeof buf, format, a, b, c);
-  return buf;
-}
 
 VerdictReason Reason(VerdictLevel level, const char* check, const char* section,
                      std::string message) {
@@ -58,9 +52,9 @@ bool Regressed(const GroupOutcome& g) {
 
 std::string RegressionText(const GroupOutcome& g) {
   return g.name + " (CF " +
-         Format("%.4f -> %.4f, final position %.0f", g.cf_before, g.cf_after,
-                1e3 * g.final_position_before_m) +
-         Format(" -> %.0f mm)", 1e3 * g.final_position_after_m);
+         StrFormat("%.4f -> %.4f, final position %.0f", g.cf_before, g.cf_after,
+                   1e3 * g.final_position_before_m) +
+         StrFormat(" -> %.0f mm)", 1e3 * g.final_position_after_m);
 }
 
 VerdictReason RegressionReason(const VerdictInputs& in) {
@@ -83,15 +77,15 @@ VerdictReason RegressionReason(const VerdictInputs& in) {
 
 VerdictReason NoiseFloorReason(const NoiseFloorTest& t) {
   if (!t.available) {
-    return Reason(VerdictLevel::kPass, "noise_floor", "residuals",
-                  "no trajectory has two validation runs: the noise floor is not measured");
+    return Reason(VerdictLevel::kSkip, "noise_floor", "residuals",
+                  "not measured: no trajectory has two validation runs");
   }
   const std::string numbers =
-      Format(
+      StrFormat(
           "systematic final position error %.1f mm RMS against a repetition noise of %.1f mm "
           "per axis",
           1e3 * t.systematic_rms_m, 1e3 * t.noise_sigma_m) +
-      Format(" (F = %.2f, p = %.2g)", t.f_statistic, t.p_value);
+      StrFormat(" (F = %.2f, p = %.2g)", t.f_statistic, t.p_value);
   // Significant and larger than one run's own noise (sqrt(2) sigma in the plane): a model that
   // lacks an effect, not a noisy data set.
   if (t.p_value < kNoiseFloorAlpha && t.systematic_rms_m > std::sqrt(2.0) * t.noise_sigma_m) {
@@ -116,6 +110,8 @@ VerdictReason NoiseFloorReason(const NoiseFloorTest& t) {
 
 const char* ToString(VerdictLevel level) {
   switch (level) {
+    case VerdictLevel::kSkip:
+      return "SKIP";
     case VerdictLevel::kPass:
       return "PASS";
     case VerdictLevel::kWarn:
@@ -170,14 +166,14 @@ Verdict JudgeCalibration(const VerdictInputs& in) {
   if (all.cf_after >= all.cf_before) {
     v.reasons.push_back(Reason(
         VerdictLevel::kFail, "improvement", "summary",
-        Format("no improvement on the %d held-out runs: CF %.4f with the calibration, %.4f with "
-               "the nominal",
-               all.runs, all.cf_after, all.cf_before)));
+        StrFormat("no improvement on the %d held-out runs: CF %.4f with the calibration, %.4f with "
+                  "the nominal",
+                  all.runs, all.cf_after, all.cf_before)));
   } else {
     v.reasons.push_back(
         Reason(VerdictLevel::kPass, "improvement", "summary",
-               Format("held-out CF %.4f -> %.4f (%.0f %% lower)", all.cf_before, all.cf_after,
-                      100.0 * (all.cf_before - all.cf_after) / all.cf_before) +
+               StrFormat("held-out CF %.4f -> %.4f (%.0f %% lower)", all.cf_before, all.cf_after,
+                         100.0 * (all.cf_before - all.cf_after) / all.cf_before) +
                    " on " + std::to_string(all.runs) + " runs"));
   }
   v.reasons.push_back(RegressionReason(in));
@@ -191,8 +187,9 @@ Verdict JudgeCalibration(const VerdictInputs& in) {
                        "data, decided the value"));
   if (in.has_training_cf && in.training_cf_after > 0.0) {
     const double ratio = all.cf_after / in.training_cf_after;
-    const std::string numbers = Format("held-out CF %.4f against %.4f on the training runs (%.1fx)",
-                                       all.cf_after, in.training_cf_after, ratio);
+    const std::string numbers =
+        StrFormat("held-out CF %.4f against %.4f on the training runs (%.1fx)", all.cf_after,
+                  in.training_cf_after, ratio);
     v.reasons.push_back(ratio > kGapFactor
                             ? Reason(VerdictLevel::kWarn, "generalisation", "summary",
                                      numbers + ": the calibration fits its training runs much "

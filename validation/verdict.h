@@ -19,15 +19,20 @@
 //                    is significant against the repeatability of the repetitions (F test,
 //                    p < kNoiseFloorAlpha) and larger than one run's noise -> WARN: the model
 //                    lacks an effect (`fitcal diagnose`).
-//   identifiability  the training runs do not determine every parameter -> WARN.
+//   identifiability  the training runs do not determine every parameter, or two parameters
+//                    correlate beyond 0.99, or the condition number exceeds 1000 -> WARN.
+// A check without the data to run on (no trajectory with two validation runs for the noise
+// floor) is SKIP, with the reason.
 
 #include <string>
 #include <vector>
 
 namespace fitcal {
 
-enum class VerdictLevel { kPass = 0, kWarn = 1, kFail = 2 };
-const char* ToString(VerdictLevel level);  // "PASS", "WARN", "FAIL"
+// kSkip: a check that could not run on these data (said so, never counted as a pass); it does not
+// change the overall level, which is the worst of the checks that ran.
+enum class VerdictLevel { kSkip = -1, kPass = 0, kWarn = 1, kFail = 2 };
+const char* ToString(VerdictLevel level);  // "SKIP", "PASS", "WARN", "FAIL"
 
 // Held-out numbers of one group of runs (a trajectory family, one trajectory, or all runs).
 struct GroupOutcome {
