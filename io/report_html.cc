@@ -28,6 +28,9 @@ const char* const kStyle =
     "td:not(:first-child):not(.k){white-space:nowrap}td.k{min-width:12em}\n"
     "th{background:#f0f0f0}\n"
     "code{overflow-wrap:anywhere}\n"
+    // A run id is one long word (rosbag imports name runs by topic and time): it breaks rather
+    // than push a phone's page wider than the screen.
+    "h1,h2,h3{overflow-wrap:anywhere}\n"
     ".warn{background:#fff3cd;border:1px solid #e0b000;padding:8px 12px;white-space:pre-wrap;"
     "font-family:monospace;overflow-x:auto}\n"
     ".ok{background:#e6f4ea;border:1px solid #5a5;padding:8px 12px}\n"

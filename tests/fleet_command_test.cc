@@ -135,7 +135,7 @@ TEST(Fleet, PrintsUnitsAndSigmasAndNotesCfsJudgedOnDifferentRuns) {
   for (const char* date : {"2026-05-01", "2026-05-08"}) {
     same.Write(std::string("fleet/") + date + "/cal.yaml",
                model->RobotYaml(robot.nominal,
-                                "calibration:\n  dataset: /data/one\n"
+                                "calibration:\n  dataset: /data/one\n  training_repetitions: [1]\n"
                                 "  cf_validation: {before: 0.05, after: 0.01}\n"));
   }
   EXPECT_EQ(tools::FleetTable(tools::ReadFleet({same.Path("fleet")})).find("note:"),

@@ -109,7 +109,8 @@ Calibration ReadCalibration(const std::string& path) {
   const YAML::Node cf = root["calibration"]["cf_validation"];
   if (cf && cf.IsMap() && cf["after"]) {
     c.values.push_back(
-        {kCfRow, kCfUnit, io::YamlDouble(cf["after"], path, "calibration.cf_validation")});
+        {kCfRow, kCfUnit, io::YamlDouble(cf["after"], path, "calibration.cf_validation"), 1.0,
+         std::numeric_limits<double>::quiet_NaN()});
     c.judged_on = JudgedOn(provenance);
   }
   return c;
@@ -146,7 +147,8 @@ Calibration ReadMetricsJson(const std::string& path) {
   for (const YAML::Node& g : root["summary"]) {
     if (g["group"] && g["group"].as<std::string>() == "all validation runs" && g["after"]) {
       c.values.push_back(
-          {kCfRow, kCfUnit, io::YamlDouble(g["after"]["cf"], path, "summary.after.cf")});
+          {kCfRow, kCfUnit, io::YamlDouble(g["after"]["cf"], path, "summary.after.cf"), 1.0,
+           std::numeric_limits<double>::quiet_NaN()});
       // A report judges on the runs of the data set it was given.
       c.judged_on = root["dataset"] && root["dataset"].IsScalar()
                         ? root["dataset"].Scalar() + " (report)"

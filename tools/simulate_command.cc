@@ -138,7 +138,7 @@ void AddSimulateOptions(CLI::App& app, SimulateCommandOptions& o) {
       ->capture_default_str();
   app.add_flag("--force", o.force, kForceDirectoryHelp);
   app.add_option("--inject", o.inject,
-                 "Inject a library effect, name=value[,value] (odometry/effects.h); repeatable; "
+                 "Inject a library effect, name=value[,value] (docs/simulate.md); repeatable; "
                  "the data set does not name it");
   app.callback([&app, &o] {
     o.robot_given = app.count("--robot") > 0;

@@ -129,10 +129,9 @@ std::vector<std::string> ResidualKindJudgementLines(const ResidualKindJudgement&
                          ? "most of them (free driving is the judge that counts)"
                          : "all of them (closed loops are a weak judge of everyday driving)";
   lines.push_back(StrFormat(
-      "  %s chosen: %s is better on %d of the %d comparisons above (CF, drift, ATE in each row); "
-      "it replaces %s only when better on %s",
-      ToString(j.chosen), ToString(j.alternative), j.alternative_wins, j.total,
-      ToString(j.proposed), rule));
+      "  %s chosen: %s is better on %d of the %d comparisons above (CF, drift, ATE in each row);",
+      ToString(j.chosen), ToString(j.alternative), j.alternative_wins, j.total));
+  lines.push_back(StrFormat("  it replaces %s only when better on %s", ToString(j.proposed), rule));
   return lines;
 }
 

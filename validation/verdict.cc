@@ -202,7 +202,8 @@ Verdict JudgeCalibration(const VerdictInputs& in) {
                             ? Reason(VerdictLevel::kPass, "identifiability", "identifiability",
                                      "the training runs determine every parameter")
                             : Reason(VerdictLevel::kWarn, "identifiability", "identifiability",
-                                     "the training runs do not determine every parameter"));
+                                     "the training runs do not determine every parameter on its own "
+                                     "(undetermined, correlated or ill-conditioned)"));
   }
   std::stable_sort(
       v.reasons.begin(), v.reasons.end(),
