@@ -47,7 +47,7 @@ FitcalRun RunIndex(const TempDir& dir, const fs::path& fleet, int index) {
   const std::string log = dir.Path("index" + std::to_string(index) + ".txt");
   const std::string command = "env JOB_COMPLETION_INDEX=" + std::to_string(index) +
                               " RUN_ID=test-run RUN_DATE=" + kDate + " FLEET_DIR=" +
-                              fleet.string() + " FLEET_POLL_S=1 FLEET_WAIT_S=600 PATH=" +
+                              fleet.string() + " FLEET_POLL_S=1 FLEET_WAIT_S=240 PATH=" +
                               FITCAL_BINARY_DIR + "/tools:/usr/bin:/bin sh " + kScript + " > " +
                               log + " 2>&1";
   const int status = std::system(command.c_str());

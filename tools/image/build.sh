@@ -17,6 +17,7 @@
 # build-image/apt-cache (FITCAL_IMAGE_CACHE): with it warm, only the archives' signed release
 # files are downloaded again. docs/image.md has the figures.
 set -euo pipefail
+caller_dir=$PWD
 cd "$(dirname "$0")/../.."
 
 # The packages owning the libraries fitcal names (DT_NEEDED): ctest image_packages_check fails
@@ -30,6 +31,9 @@ RUNTIME_PACKAGES=(libc6 libgcc-s1 libstdc++6 libgoogle-glog0v6 libspqr2 libcholm
 SUITE=bookworm
 
 die() { echo "tools/image/build.sh: $*" >&2; exit 1; }
+
+# A path given on the command line, relative to where the script was started.
+absolute() { (cd "$caller_dir" && realpath -m "$1"); }
 
 version() { sed -n 's/^project(fitcal VERSION \([0-9.]*\).*/\1/p' CMakeLists.txt; }
 
@@ -80,7 +84,8 @@ install_tools() {
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
 }
 
-# The project's own Release build of fitcal alone, in its own directory (ccache as tools/test.sh).
+# The project's own Release build of fitcal alone, in its own directory, with CI's flags and ccache
+# as tools/test.sh (so a machine that ran the tests compiles little).
 build_binary() {
   local launcher=()
   if command -v ccache > /dev/null; then
@@ -88,8 +93,8 @@ build_binary() {
     export CCACHE_SLOPPINESS=pch_defines,time_macros,include_file_mtime,include_file_ctime
     launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
   fi
-  cmake -S . -B build-image/build -G Ninja -DCMAKE_BUILD_TYPE=Release -DFITCAL_BUILD_TESTS=OFF \
-    -DFITCAL_BUILD_BENCHMARKS=OFF "${launcher[@]}" > /dev/null
+  cmake -S . -B build-image/build -G Ninja -DCMAKE_BUILD_TYPE=Release -DFITCAL_WERROR=ON \
+    -DFITCAL_BUILD_TESTS=OFF -DFITCAL_BUILD_BENCHMARKS=OFF "${launcher[@]}" > /dev/null
   cmake --build build-image/build --target fitcal > /dev/null
   echo build-image/build/tools/fitcal
 }
@@ -187,10 +192,10 @@ main() {
   local binary="" root="" smoke_test=0 version archive
   while [ $# -gt 0 ]; do
     case $1 in
-      --binary) binary=$(readlink -f "$2"); shift 2 ;;
-      --root) root=$2; shift 2 ;;
+      --binary) binary=$(absolute "$2"); shift 2 ;;
+      --root) root=$(absolute "$2"); shift 2 ;;
       --smoke) smoke_test=1; shift ;;
-      --check-packages) check_packages "$2"; return ;;
+      --check-packages) check_packages "$(absolute "$2")"; return ;;
       *) die "unknown argument $1 (see the comment at the top of this script)" ;;
     esac
   done
