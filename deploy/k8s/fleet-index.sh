@@ -11,7 +11,8 @@
 # Environment: JOB_COMPLETION_INDEX (set by Kubernetes), RUN_ID (the Job's uid: which statuses
 # belong to this run), FLEET_DIR (default /fleet), RUN_DATE (default today, UTC), FLEET_WAIT_S
 # (how long the summary waits for the others, default 6 h), FLEET_POLL_S (default 10).
-# POSIX sh: the image runs it with busybox sh.
+# POSIX sh: the image runs it with busybox sh. No `set -e`: fitcal's exit statuses are results to
+# record, not errors to stop at.
 set -u
 
 fleet=${FLEET_DIR:-/fleet}

@@ -1,9 +1,9 @@
 // ctest k8s_manifest_check: every document of the given manifests against the Kubernetes OpenAPI
-// schema of its kind (npm kubernetes-models 5.1.0: the schemas of Kubernetes 1.33, compiled to
-// ajv validators), with what that schema does not say:
+// schema of its kind (npm kubernetes-models 5.1.0, pinned by package-lock.json: the upstream
+// OpenAPI definitions compiled to ajv validators), with what that schema does not say:
 //  - unknown fields: the schema leaves them open, the API server refuses them (strict field
-//    validation, kubectl's default since 1.27); a misspelt backoffLimitPerIndex would otherwise
-//    pass here and be dropped there;
+//    validation, kubectl's default --validate=strict); a misspelt backoffLimitPerIndex would
+//    otherwise pass here and be refused there;
 //  - the Job rules the API server adds (k8s.io/kubernetes pkg/apis/batch/validation) for the
 //    fields the fleet Job relies on, and what docs/ros2.md promises of it.
 // Before the manifests, each check is shown to fail on a copy with one defect (a check that
