@@ -114,6 +114,9 @@ struct ExportRos2ControlOptions {
   std::string logs;  // optional data set: held-out CF nominal vs exact vs exported
   std::string ros_distro = RosDistros().back();
   bool allow_worse = false;  // write parameters that replay worse than the nominal robot
+  // The interval the controller publishes its twist on (1 / its publish_rate); 0: the data set's
+  // encoder period (a controller publishing on every encoder update).
+  double publish_period_s = 0.0;
   // With logs: a copy of the calibration with its odometry covariance (validation/
   // odometry_covariance.h) in the calibration block; may be the calibration itself with force.
   std::string calibration_out;
