@@ -123,6 +123,31 @@ std::array<double, 3> QuantisationVariance(const RobotModelInterface& model,
   return out;
 }
 
+// The ground truth's own noise variance per axis (m^2, m^2, rad^2) from its second differences
+// at its own rate: for a smooth motion x(t-h) - 2 x(t) + x(t+h) is the noise, of variance 6 s^2
+// (the motion adds a h^2, small at motion-capture rates; it can only make the estimate larger).
+std::array<double, 3> GroundTruthNoise(const std::vector<RunLog>& runs) {
+  std::array<double, 3> sum{};
+  std::size_t count = 0;
+  for (const RunLog& log : runs) {
+    const std::vector<Pose2d>& q = log.ground_truth.world_T_robot;
+    for (std::size_t k = 1; k + 1 < q.size(); ++k) {
+      const double dx = q[k - 1].x - 2.0 * q[k].x + q[k + 1].x;
+      const double dy = q[k - 1].y - 2.0 * q[k].y + q[k + 1].y;
+      const double dth = WrapAngle(q[k - 1].theta - q[k].theta) + WrapAngle(q[k + 1].theta - q[k].theta);
+      // Position noise is isotropic: either world axis serves for both body axes.
+      sum[0] += 0.5 * (dx * dx + dy * dy);
+      sum[2] += dth * dth;
+      ++count;
+    }
+  }
+  if (count == 0) return sum;
+  sum[0] /= 6.0 * count;
+  sum[2] /= 6.0 * count;
+  sum[1] = sum[0];
+  return sum;
+}
+
 double MedianInterval(const std::vector<AlignedRun>& runs) {
   std::vector<double> dt;
   for (const AlignedRun& run : runs) {
@@ -160,12 +185,15 @@ std::pair<double, double> PowerLaw(const std::vector<double>& d, const std::vect
 
 }  // namespace
 
-std::array<double, 3> FitStructureFunction(const std::vector<double>& t,
-                                           const std::vector<double>& v,
-                                           const std::vector<double>& w) {
+namespace {
+
+// The best non-negative fit of V(T) = sum of the terms c, beta T, alpha T^2 in `allowed` (bits 0-2).
+std::array<double, 3> FitTerms(const std::vector<double>& t, const std::vector<double>& v,
+                               const std::vector<double>& w, int allowed) {
   std::array<double, 3> best{};
   double best_cost = HUGE_VAL;
   for (int subset = 1; subset < 8; ++subset) {
+    if ((subset & ~allowed) != 0) continue;
     std::vector<int> columns;
     for (int c = 0; c < 3; ++c) {
       if (subset & (1 << c)) columns.push_back(c);
@@ -186,6 +214,23 @@ std::array<double, 3> FitStructureFunction(const std::vector<double>& t,
     for (std::size_t c = 0; c < columns.size(); ++c) best[columns[c]] = x(c);
   }
   return best;
+}
+
+// beta T + alpha T^2 only (the intercept known); alpha T^2 alone when the encoders count ticks:
+// their white error is the quantisation, known, and a beta fitted on top would be the intercept's
+// error / T, which beta / dt multiplies by T / dt (a 0.5 % error in the ground truth's noise
+// variance made the per-message vx sigma 5x too large on the independent simulator).
+std::array<double, 3> FitGrowth(const std::vector<double>& t, const std::vector<double>& v,
+                                const std::vector<double>& w, bool ticks) {
+  return FitTerms(t, v, w, ticks ? 0b100 : 0b110);
+}
+
+}  // namespace
+
+std::array<double, 3> FitStructureFunction(const std::vector<double>& t,
+                                           const std::vector<double>& v,
+                                           const std::vector<double>& w) {
+  return FitTerms(t, v, w, 0b111);
 }
 
 OdometryCovariance EstimateOdometryCovariance(const RobotModelInterface& model,
@@ -213,6 +258,8 @@ OdometryCovariance EstimateOdometryCovariance(const RobotModelInterface& model,
   if (by_lag.empty() || !(out.interval_s > 0.0)) return out;
   out.windows = by_lag.front().count;
   const double dt = out.interval_s;
+  const std::array<double, 3> noise = GroundTruthNoise(runs);
+  const bool ticks = model.robot().encoder && model.robot().encoder->ticks_per_rev > 0.0;
   for (int a = 0; a < 3; ++a) {
     std::vector<double> t, v, w;
     for (const MeanSquares& m : by_lag) {
@@ -221,13 +268,23 @@ OdometryCovariance EstimateOdometryCovariance(const RobotModelInterface& model,
       // A mean square of n Gaussian errors has variance 2 V^2 / n.
       w.push_back(m.Mean(a) > 0.0 ? m.count / (m.Mean(a) * m.Mean(a)) : 0.0);
     }
-    const std::array<double, 3> f = FitStructureFunction(t, v, w);
-    out.ground_truth_variance[a] = std::max(0.0, f[0] - out.quantisation_variance[a]) / 2.0;
+    // The intercept c: the ground truth's noise, the smaller of its own estimate and what the
+    // structure function says, plus the quantisation. Only beta and alpha are then fitted, on
+    // what remains: at one message the odometry's error is far below the ground truth's noise,
+    // so an intercept fitted freely would leak its error into beta / dt.
+    const std::array<double, 3> free = FitStructureFunction(t, v, w);
+    out.ground_truth_variance[a] = std::min(
+        noise[a], std::max(0.0, free[0] - out.quantisation_variance[a]) / 2.0);
+    const double c = 2.0 * out.ground_truth_variance[a] + out.quantisation_variance[a];
+    std::vector<double> remaining;
+    for (double x : v) remaining.push_back(x - c);
+    const std::array<double, 3> f = FitGrowth(t, remaining, w, ticks);
     out.twist_variance[a] = (f[1] * dt + f[2] * dt * dt + out.quantisation_variance[a]) / (dt * dt);
   }
   // The pose law over path windows, the ground truth's noise removed.
   std::vector<double> d;
   std::array<std::vector<double>, 3> v;
+  bool measured_at_1m = false;
   for (double length : kPathWindowsM) {
     MeanSquares m;
     for (const ReplayedRun& r : replayed) {
@@ -241,10 +298,14 @@ OdometryCovariance EstimateOdometryCovariance(const RobotModelInterface& model,
     if (m.count < kMinWindows) continue;
     d.push_back(m.extent / m.count);  // the windows' mean path
     for (int a = 0; a < 3; ++a) v[a].push_back(m.Mean(a) - 2.0 * out.ground_truth_variance[a]);
+    if (length == 1.0) {  // the controller's constant, where the data measure it directly
+      measured_at_1m = true;
+      for (int a = 0; a < 3; ++a) out.pose_variance_1m[a] = v[a].back();
+    }
   }
   for (int a = 0; a < 3; ++a) {
     const auto [at_1m, exponent] = PowerLaw(d, v[a]);
-    out.pose_variance_1m[a] = at_1m;
+    if (!measured_at_1m || !(out.pose_variance_1m[a] > 0.0)) out.pose_variance_1m[a] = at_1m;
     out.pose_growth_exponent[a] = exponent;
   }
   return out;

@@ -42,8 +42,8 @@ struct DiffDriveGeometry {
 };
 
 struct ContactPhysics {
-  double traction_slip_per_m_s2 = 0.01;  // k_a: slip per m/s^2 of the wheel's acceleration
-  double walk_sigma = 0.002;             // stationary sigma of the wandering slip
+  double traction_slip_per_m_s2 = 0.005; // k_a: slip per m/s^2 of the wheel's acceleration
+  double walk_sigma = 0.0005;            // stationary sigma of the wandering slip
   double walk_tau_s = 3.0;
   double backlash_rad = 0.0;  // dead band of the gear train (wheel angle)
   double motor_tau_s = 0.08;
