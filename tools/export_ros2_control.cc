@@ -604,7 +604,7 @@ namespace {
 std::string CovarianceLine(const OdometryCovariance& c) {
   char text[600];
   std::snprintf(text, sizeof text,
-                "odometry covariance from %zu held-out runs (%zu messages of %.4g s): twist sigma "
+                "odometry covariance from %zu held-out runs (%zu windows; twist per message of %.4g s): twist sigma "
                 "vx %.4g m/s, vy %.4g m/s, omega %.4g rad/s; pose sigma after 1 m x %.4g m, "
                 "y %.4g m, theta %.4g rad, growing as d^%.2f, d^%.2f, d^%.2f; ground truth's own "
                 "noise removed: %.3g m, %.3g m, %.3g rad",
@@ -633,7 +633,7 @@ std::string CalibrationWithCovariance(const std::string& path, const OdometryCov
         return "[" + Num(v[0]) + ", " + Num(v[1]) + ", " + Num(v[2]) + "]";
       };
       out += "  odometry_covariance: {interval_s: " + Num(c.interval_s) +
-             ", held_out_runs: " + std::to_string(c.runs) + ", messages: " +
+             ", held_out_runs: " + std::to_string(c.runs) + ", windows: " +
              std::to_string(c.windows) + ", twist_variance: " + list(c.twist_variance) +
              ", pose_variance_1m: " + list(c.pose_variance_1m) +
              ", pose_growth_exponent: " + list(c.pose_growth_exponent) +

@@ -14,7 +14,7 @@ namespace {
 constexpr double kHeadingSmoothingS = 0.05;
 constexpr int kHeadingSmoothingSteps = 5;
 // Lags of the structure function (encoder samples) and the path windows of the pose law (m).
-constexpr int kLags[] = {1, 2, 4, 8, 16, 32, 64};
+constexpr int kLags[] = {1, 2, 4, 8, 16, 32, 64, 128, 256};
 constexpr double kPathWindowsM[] = {0.25, 0.5, 1.0, 2.0, 4.0};
 // A mean square over fewer windows than this does not enter a fit.
 constexpr std::size_t kMinWindows = 10;
@@ -148,6 +148,17 @@ std::array<double, 3> GroundTruthNoise(const std::vector<RunLog>& runs) {
   return sum;
 }
 
+double MedianGroundTruthInterval(const std::vector<RunLog>& runs) {
+  std::vector<double> dt;
+  for (const RunLog& log : runs) {
+    const std::vector<double>& t = log.ground_truth.t_s;
+    for (std::size_t k = 1; k < t.size(); ++k) dt.push_back(t[k] - t[k - 1]);
+  }
+  if (dt.empty()) return 0.0;
+  std::nth_element(dt.begin(), dt.begin() + dt.size() / 2, dt.end());
+  return dt[dt.size() / 2];
+}
+
 double MedianInterval(const std::vector<AlignedRun>& runs) {
   std::vector<double> dt;
   for (const AlignedRun& run : runs) {
@@ -247,13 +258,17 @@ OdometryCovariance EstimateOdometryCovariance(const RobotModelInterface& model,
   out.quantisation_variance = QuantisationVariance(model, p, aligned);
   // The structure function over time lags.
   std::vector<MeanSquares> by_lag;
+  const double shortest_s = 2.0 * MedianGroundTruthInterval(runs);
   for (int lag : kLags) {
     MeanSquares m;
     for (const ReplayedRun& r : replayed) {
       for (std::size_t b = 0; b + lag < r.pose.size(); b += lag)
         m.Add(WindowError(r, b, b + lag), r.t_s[b + lag] - r.t_s[b]);
     }
-    if (m.count >= kMinWindows) by_lag.push_back(m);
+    // A window shorter than two ground-truth intervals reads the ground truth between the same
+    // few samples at both ends: their noise cancels there, and would pass for growth.
+    if (m.count >= kMinWindows && m.extent / m.count >= shortest_s)
+      by_lag.push_back(m);
   }
   if (by_lag.empty() || !(out.interval_s > 0.0)) return out;
   out.windows = by_lag.front().count;
