@@ -13,6 +13,7 @@
 #include "fit/ceres_problem.h"
 #include "fit/correlation.h"
 #include "fit/determined_directions.h"
+#include "fit/serial_covariance.h"
 
 namespace fitcal {
 
@@ -271,6 +272,135 @@ int NumDataResiduals(const std::vector<AlignedRun>& training, const ModelFitOpti
   return num_residuals;
 }
 
+// A cost's residuals and its Jacobian in every estimated unknown (the model's parameters, then
+// the clock offsets; m columns), evaluated at `parameters` (Jacobians of blocks in order).
+struct EvaluatedBlock {
+  Eigen::VectorXd residuals;
+  Eigen::MatrixXd jacobian;
+};
+EvaluatedBlock EvaluateBlock(const ceres::CostFunction& cost,
+                             const std::vector<const double*>& parameters,
+                             const std::vector<int>& first_column, int m) {
+  const int rows = cost.num_residuals();
+  EvaluatedBlock out{Eigen::VectorXd::Zero(rows), Eigen::MatrixXd::Zero(rows, m)};
+  std::vector<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> j;
+  std::vector<double*> jacobians;
+  for (int size : cost.parameter_block_sizes()) {
+    j.emplace_back(rows, size);
+    jacobians.push_back(j.back().data());
+  }
+  if (!cost.Evaluate(parameters.data(), out.residuals.data(), jacobians.data())) {
+    out.jacobian.resize(0, 0);
+    return out;
+  }
+  for (std::size_t b = 0; b < j.size(); ++b) {
+    if (first_column[b] >= 0) out.jacobian.middleCols(first_column[b], j[b].cols()) += j[b];
+  }
+  return out;
+}
+
+// One run's track errors at the solution for the random-walk covariance (fit/serial_covariance.h).
+TrackErrorChain TrackChainOf(const TrackCheckpoints& track, const RobotModelInterface& model,
+                             const ModelFitOptions& options, const std::vector<double>& p,
+                             double offset_s, int offset_column, int m) {
+  const std::unique_ptr<TrackResidual> cost(static_cast<TrackResidual*>(
+      TrackResidual::Create(track, model, options.ceres.weights, options.track->options)));
+  const EvaluatedBlock block =
+      EvaluateBlock(*cost, {p.data(), &offset_s}, {0, offset_column}, m);
+  TrackErrorChain chain;
+  if (block.jacobian.size() == 0) return chain;
+  const std::vector<double> pose = cost->OdometryFromStart(p.data());
+  const Eigen::Vector3d w(1.0 / options.ceres.weights.position_sigma_m,
+                          1.0 / options.ceres.weights.position_sigma_m,
+                          1.0 / options.ceres.weights.heading_sigma_rad);
+  for (std::size_t k = 0; k < track.segments.size(); ++k) {
+    const Pose2d q = GroundTruthFromStart(track, k, offset_s);
+    const double c = std::cos(q.theta), s = std::sin(q.theta);
+    const double ex = pose[3 * k] - q.x, ey = pose[3 * k + 1] - q.y;
+    const Eigen::Vector3d e(c * ex + s * ey, -s * ex + c * ey, WrapAngle(pose[3 * k + 2] - q.theta));
+    // r_k = factor W e_k: the factor (run weight, loss) from the residual itself.
+    const Eigen::Vector3d r = block.residuals.segment<3>(3 * static_cast<Eigen::Index>(k));
+    const double weighted = w.cwiseProduct(e).norm();
+    const double factor = weighted > 0.0 ? r.norm() / weighted : 0.0;
+    chain.jacobian.push_back(block.jacobian.middleRows(3 * static_cast<Eigen::Index>(k), 3));
+    chain.residual_per_error.push_back(factor * w.asDiagonal().toDenseMatrix());
+    chain.error.push_back(e);
+    chain.ground_truth_from_start.push_back(q);
+  }
+  return chain;
+}
+
+// The covariance of a fit with track residuals: the sandwich of fit/serial_covariance.h over
+// the free parameters and the estimated clock offsets. With final poses as well (kBoth), a run's
+// final pose and its track share one random walk; their scores are added with the bound
+// Var(a + b) <= 2 Var(a) + 2 Var(b) (final poses: s^2 J^T J, independent across runs), which errs
+// on the wide side by at most sqrt(2) in sigma.
+void TrackSandwichCovariance(const std::vector<AlignedRun>& training,
+                             const RobotModelInterface& model, const ModelFitOptions& options,
+                             const HeldDirections& holds, int num_offsets,
+                             ModelFitResult* result) {
+  const int n = model.robot().NumParameters();
+  const int m = n + num_offsets;
+  const std::vector<double>& p = result->parameters;
+  Eigen::MatrixXd information = Eigen::MatrixXd::Zero(m, m);
+  std::vector<TrackErrorChain> chains;
+  Eigen::MatrixXd final_pose_information = Eigen::MatrixXd::Zero(m, m);
+  double final_pose_squares = 0.0;
+  int final_pose_residuals = 0;
+  for (std::size_t i = 0; i < training.size(); ++i) {
+    const TrackCheckpoints& track = options.track->runs[i];
+    if (options.residuals == ResidualKind::kBoth) {
+      const std::unique_ptr<ceres::CostFunction> cost(
+          model.FinalPoseCost(training[i], options.ceres.weights));
+      const EvaluatedBlock block = EvaluateBlock(*cost, {p.data()}, {0}, m);
+      if (block.jacobian.size() > 0) {
+        final_pose_information += block.jacobian.transpose() * block.jacobian;
+        final_pose_squares += block.residuals.squaredNorm();
+        final_pose_residuals += static_cast<int>(block.residuals.size());
+      }
+    }
+    if (track.segments.empty()) continue;
+    const int column = num_offsets > 0 ? n + track.clock_group : -1;
+    chains.push_back(TrackChainOf(track, model, options, p,
+                                  result->clock_offsets_s[track.clock_group], column, m));
+    for (const Eigen::MatrixXd& j : chains.back().jacobian) information += j.transpose() * j;
+  }
+  information += final_pose_information;
+  Eigen::MatrixXd meat = RandomWalkScoreCovariance(chains, m);
+  if (final_pose_residuals > 0) {
+    const double s2 = final_pose_squares / std::max(1, final_pose_residuals - n);
+    meat = 2.0 * meat + 2.0 * s2 * final_pose_information;
+  }
+  if (!holds.directions.empty()) {
+    const HoldDirectionsCost hold(holds.directions, model.robot(), holds.weight);
+    const Eigen::MatrixXd j = EvaluateBlock(hold, {p.data()}, {0}, m).jacobian;
+    information += j.transpose() * j;
+  }
+  // Only the free unknowns: held parameters (and offsets of groups without a track) keep zero
+  // rows and columns.
+  std::vector<int> free;
+  for (int k = 0; k < m; ++k) {
+    if (k < n ? !result->held[k] : information(k, k) > 0.0) free.push_back(k);
+  }
+  const Eigen::MatrixXd covariance =
+      SandwichCovariance(information(free, free), meat(free, free));
+  if (covariance.size() == 0) {
+    result->covariance_message =
+        "covariance is rank deficient: the runs cannot determine all free parameters";
+    return;
+  }
+  Eigen::MatrixXd full = Eigen::MatrixXd::Zero(m, m);
+  full(free, free) = covariance;
+  result->covariance = full.topLeftCorner(n, n);
+  result->sigma = SigmasOf(result->covariance);
+  result->correlation = CorrelationOf(result->covariance);
+  result->has_covariance = true;
+  result->clock_offset_sigma_s.assign(result->clock_offsets_s.size(), 0.0);
+  for (int g = 0; g < num_offsets; ++g) {
+    result->clock_offset_sigma_s[g] = std::sqrt(std::max(0.0, full(n + g, n + g)));
+  }
+}
+
 void ComputeCovariance(const std::vector<AlignedRun>& training, const RobotModelInterface& model,
                        const ModelFitOptions& options, const HeldDirections& holds,
                        ModelFitResult* result) {
@@ -294,6 +424,10 @@ void ComputeCovariance(const std::vector<AlignedRun>& training, const RobotModel
   // s^2 from the plain sum of squares of the runs, whatever loss shaped the objective.
   result->residual_sigma = std::sqrt(SumOfSquares(&fit.problem(), fit.data_blocks()) / dof);
   const double s2 = result->residual_sigma * result->residual_sigma;
+  if (UsesTracks(options)) {
+    TrackSandwichCovariance(training, model, options, holds, num_offsets, result);
+    return;
+  }
   std::vector<const double*> blocks = {p.data()};
   for (int g = 0; g < num_offsets; ++g) {
     if (fit.problem().HasParameterBlock(&offsets[g])) blocks.push_back(&offsets[g]);

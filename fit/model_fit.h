@@ -19,8 +19,10 @@
 //
 // Fit what the data determine: see ModelFitOptions::hold_undetermined.
 //
-// Uncertainty: the Ceres covariance of the free parameters scaled by the residual variance
-// s^2 = |r|^2 / (3 N - n_free). Parameters at a bound are flagged; their sigma then describes
+// Uncertainty: final poses and segments, the Ceres covariance of the free parameters scaled by
+// the residual variance s^2 = |r|^2 / (3 N - n_free) (runs and windows are independent). Tracks
+// (and both), the sandwich H^-1 M H^-1 of fit/serial_covariance.h: a run's checkpoint errors are
+// a random walk, not independent. Parameters at a bound are flagged; their sigma then describes
 // the unconstrained problem only.
 
 #include <Eigen/Core>

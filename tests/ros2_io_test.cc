@@ -808,7 +808,7 @@ TEST(ExportRos2Control, EveryKeyDeclaredOnItsDistribution) {
       const tools::Ros2ControlExport e = tools::ExportRos2Control(cal, c.controller, "", {}, distro);
       OdometryCovariance covariance;  // as written with --logs
       covariance.twist_variance = {1e-4, 2e-5, 3e-4};
-      covariance.pose_variance_per_m = {1e-5, 2e-6, 3e-5};
+      covariance.pose_variance_1m = {1e-5, 2e-6, 3e-5};
       const std::string yaml =
           e.parameters_yaml + tools::Ros2CovarianceParameters(c.controller, covariance);
       std::vector<std::pair<std::string, YAML::Node>> written;

@@ -153,12 +153,13 @@ TEST(TrackFit, RecoversCommonScaleAndClockOffsetThatFinalPosesCannotSee) {
   }
   ASSERT_EQ(track.clock_offsets_s.size(), data.clock_groups.size());
   for (std::size_t g = 0; g < data.clock_groups.size(); ++g) {
-    // Each session's offset within four of its own sigmas (from the residuals' scatter), and
-    // those sigmas small: 10 ms is 2 mm of motion at 0.2 m/s, twice the ground truth's noise.
+    // Each session's offset within four of its own sigmas, and those sigmas small: 20 ms is 4 mm
+    // of motion at 0.2 m/s. (The random-walk covariance, fit/serial_covariance.h, gives 10.8 ms
+    // here; counting every checkpoint as independent gave under 10.)
     ASSERT_TRUE(track.has_covariance);
     const double sigma = track.clock_offset_sigma_s[g];
     EXPECT_GT(sigma, 0.0);
-    EXPECT_LT(sigma, 0.01);
+    EXPECT_LT(sigma, 0.02);
     EXPECT_NEAR(track.clock_offsets_s[g], kClockOffsetS, 4.0 * sigma) << data.clock_groups[g];
   }
 

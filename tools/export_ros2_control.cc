@@ -542,10 +542,6 @@ struct Replay {
   bool Worse() const { return cf_exported > cf_nominal; }
 };
 
-// Twist errors are taken over windows of this length (docs/ros2.md: long enough that the
-// ground truth's own noise is small beside the odometry's drift, short beside a run).
-constexpr double kCovarianceWindowS = 1.0;
-
 // `exact` is the calibration as read, `exported` what the controller computes from the export;
 // the data set is read once.
 Replay ReplayOnHeldOutRuns(const ExportRos2ControlOptions& o, const RobotModelPtr& exact,
@@ -565,8 +561,7 @@ Replay ReplayOnHeldOutRuns(const ExportRos2ControlOptions& o, const RobotModelPt
   r.cf_exact = EvaluateFinalPoseErrors(*exact, exact->robot().nominal, runs).cf;
   r.cf_exported = EvaluateFinalPoseErrors(*exported.model, exported.parameters, runs).cf;
   const auto covariance = [&](const RobotModelInterface& model, const std::vector<double>& p) {
-    return EstimateOdometryCovariance(CollectOdometryErrors(model, p, logs, kCovarianceWindowS),
-                                      kCovarianceWindowS);
+    return EstimateOdometryCovariance(model, p, logs, o.publish_period_s);
   };
   r.exported_covariance = covariance(*exported.model, exported.parameters);
   r.exact_covariance = covariance(*exact, exact->robot().nominal);
@@ -597,25 +592,29 @@ std::string Diagonal(const std::array<double, 3>& planar) {
 
 std::string Ros2CovarianceParameters(const std::string& controller, const OdometryCovariance& c) {
   if (controller == "omni_wheel_drive_controller") {
-    return "    diagonal_covariance:\n      pose: " + Diagonal(c.pose_variance_per_m) +
+    return "    diagonal_covariance:\n      pose: " + Diagonal(c.pose_variance_1m) +
            "\n      twist: " + Diagonal(c.twist_variance) + "\n";
   }
-  return "    pose_covariance_diagonal: " + Diagonal(c.pose_variance_per_m) +
+  return "    pose_covariance_diagonal: " + Diagonal(c.pose_variance_1m) +
          "\n    twist_covariance_diagonal: " + Diagonal(c.twist_variance) + "\n";
 }
 
 namespace {
 
 std::string CovarianceLine(const OdometryCovariance& c) {
-  char text[400];
+  char text[600];
   std::snprintf(text, sizeof text,
-                "odometry covariance from %zu held-out runs (%zu windows of %.1f s): twist sigma "
-                "vx %.4g m/s, vy %.4g m/s, omega %.4g rad/s; pose sigma per sqrt(m) x %.4g m, "
-                "y %.4g m, theta %.4g rad",
-                c.runs, c.windows, c.window_s, std::sqrt(c.twist_variance[0]),
+                "odometry covariance from %zu held-out runs (%zu windows; twist per message of %.4g s): twist sigma "
+                "vx %.4g m/s, vy %.4g m/s, omega %.4g rad/s; pose sigma after 1 m x %.4g m, "
+                "y %.4g m, theta %.4g rad, growing as d^%.2f, d^%.2f, d^%.2f; ground truth's own "
+                "noise removed: %.3g m, %.3g m, %.3g rad",
+                c.runs, c.windows, c.interval_s, std::sqrt(c.twist_variance[0]),
                 std::sqrt(c.twist_variance[1]), std::sqrt(c.twist_variance[2]),
-                std::sqrt(c.pose_variance_per_m[0]), std::sqrt(c.pose_variance_per_m[1]),
-                std::sqrt(c.pose_variance_per_m[2]));
+                std::sqrt(c.pose_variance_1m[0]), std::sqrt(c.pose_variance_1m[1]),
+                std::sqrt(c.pose_variance_1m[2]), 0.5 * c.pose_growth_exponent[0],
+                0.5 * c.pose_growth_exponent[1], 0.5 * c.pose_growth_exponent[2],
+                std::sqrt(c.ground_truth_variance[0]), std::sqrt(c.ground_truth_variance[1]),
+                std::sqrt(c.ground_truth_variance[2]));
   return text;
 }
 
@@ -630,12 +629,15 @@ std::string CalibrationWithCovariance(const std::string& path, const OdometryCov
     out += line + "\n";
     if (line == "calibration:") {
       found = true;
-      out += "  odometry_covariance: {window_s: " + Num(c.window_s) +
+      const auto list = [](const std::array<double, 3>& v) {
+        return "[" + Num(v[0]) + ", " + Num(v[1]) + ", " + Num(v[2]) + "]";
+      };
+      out += "  odometry_covariance: {interval_s: " + Num(c.interval_s) +
              ", held_out_runs: " + std::to_string(c.runs) + ", windows: " +
-             std::to_string(c.windows) + ", twist_variance: [" + Num(c.twist_variance[0]) +
-             ", " + Num(c.twist_variance[1]) + ", " + Num(c.twist_variance[2]) +
-             "], pose_variance_per_m: [" + Num(c.pose_variance_per_m[0]) + ", " +
-             Num(c.pose_variance_per_m[1]) + ", " + Num(c.pose_variance_per_m[2]) + "]}\n";
+             std::to_string(c.windows) + ", twist_variance: " + list(c.twist_variance) +
+             ", pose_variance_1m: " + list(c.pose_variance_1m) +
+             ", pose_growth_exponent: " + list(c.pose_growth_exponent) +
+             ", ground_truth_variance: " + list(c.ground_truth_variance) + "}\n";
     }
   }
   if (!found) {
@@ -671,6 +673,11 @@ void AddExportRos2ControlOptions(CLI::App& app, ExportRos2ControlOptions& o) {
       ->capture_default_str();
   app.add_flag("--allow-worse", o.allow_worse,
                "Write the parameters even when they replay worse than the nominal robot");
+  app.add_option_function<double>(
+         "--publish-rate", [&o](double hz) { o.publish_period_s = 1.0 / hz; },
+         "With --logs: the controller's publish_rate (Hz), the interval its twist covariance is "
+         "for (default: the encoder period)")
+      ->check(CLI::PositiveNumber);
   app.add_option("--calibration-out", o.calibration_out,
                  "With --logs: write the calibration with its odometry covariance here");
   app.add_flag("--force", o.force, kForceFileHelp);

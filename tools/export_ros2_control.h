@@ -34,9 +34,10 @@
 // every approximation in one line, with the exact value, its sign and where it goes.
 //
 // Covariance (validation/odometry_covariance.h, docs/ros2.md): with a data set, the errors of
-// the exported parameters on the held-out runs give twist_covariance_diagonal (twist variance
-// per axis over 1 s windows) and pose_covariance_diagonal (variance per metre travelled: the
-// covariance after 1 m), written where the controller declares them (diagonal_covariance.twist /
+// the exported parameters on the held-out runs give twist_covariance_diagonal (the twist's
+// variance per message of --publish-rate, default the encoder period, the ground truth's own
+// noise removed) and pose_covariance_diagonal (the variance after 1 m, with its growth law in
+// --calibration-out), written where the controller declares them (diagonal_covariance.twist /
 // .pose for omni_wheel_drive_controller); axes a planar robot does not measure (z, roll, pitch)
 // get kUnmeasuredVariance. --calibration-out writes the exact calibration's own covariance into
 // a copy of the calibration file (calibration.odometry_covariance).
@@ -114,6 +115,9 @@ struct ExportRos2ControlOptions {
   std::string logs;  // optional data set: held-out CF nominal vs exact vs exported
   std::string ros_distro = RosDistros().back();
   bool allow_worse = false;  // write parameters that replay worse than the nominal robot
+  // The interval the controller publishes its twist on (1 / its publish_rate); 0: the data set's
+  // encoder period (a controller publishing on every encoder update).
+  double publish_period_s = 0.0;
   // With logs: a copy of the calibration with its odometry covariance (validation/
   // odometry_covariance.h) in the calibration block; may be the calibration itself with force.
   std::string calibration_out;

@@ -1,22 +1,32 @@
 #pragma once
-// An honest odometry covariance for a robot's EKF (robot_localization, Nav2), from the errors of
+// An odometry covariance a robot's EKF (robot_localization, Nav2) can trust, from the errors of
 // the calibrated odometry on runs the calibration did not train on (docs/ros2.md derives it).
 //
-// Twist. Each held-out run is cut into consecutive windows of `window_s` of encoder time. In a
-// window from t0 to t1 the odometry replays from the ground-truth pose at t0; its error is the
-// pose difference at t1 in the robot frame at t0,
-//   e = R(-theta_gt(t0)) (p_odo(t1) - p_gt(t1)),   e_theta = wrap(theta_odo(t1) - theta_gt(t1)),
-// and the error of the mean body twist over the window is (e_x, e_y, e_theta) / (t1 - t0). The
-// twist variance per axis is the mean square of that over every window (vx, vy in m^2/s^2,
-// omega in rad^2/s^2): the variance of the twist the odometry reports, averaged over window_s.
+// The controller publishes its twist on every message: the twist over one publish interval
+// (`interval_s`: the controller's publish period, or the encoder period), and its pose as a
+// constant covariance. The errors against the ground truth hold two things: the odometry's own
+// error and the ground truth's noise. The latter does not grow with the window; the former does.
 //
-// Pose. The final pose error of each held-out run, in the robot frame at its start (Palacin
-// Eq. 14's residual), grows with the path: its variance per metre travelled is the mean over the
-// runs of e_i^2 / d, d the run's odometry path length (m), per axis (m^2/m for x and y, rad^2/m
-// for the heading): the covariance after d metres is d times it (a random walk in distance).
+// Structure function. Each held-out run is cut into non-overlapping windows of L encoder samples
+// for L = 1, 2, 4, ..., 256, of at least two ground-truth intervals (shorter ones read the ground
+// truth between the same samples at both ends, where its noise cancels). In a window [t0, t1] the odometry's displacement, replayed from the
+// identity, is compared with the ground truth's, expressed in its frame at t0 (its heading there
+// averaged over +-kHeadingSmoothingS, so the ground truth's heading noise does not rotate the
+// displacement); the mean square error per axis against the window's duration T is fitted by
+//   V(T) = c + beta T + alpha T^2,   c, beta, alpha >= 0,
+// where c is what does not grow with T: twice the ground truth's noise variance plus the encoder
+// quantisation (a tick's uncertainty at either end, known from the robot's encoder ticks; zero for
+// encoders logged as rates), beta T an error white in time (rate noise) and alpha T^2 one that
+// stays put over the windows (slip, calibration error). The ground truth's noise,
+// (c - quantisation) / 2, is removed: the twist variance per message is
+//   (beta dt + alpha dt^2 + quantisation) / dt^2,   dt = interval_s.
 //
-// Both include the ground truth's own noise (it cannot be told apart from the odometry's here):
-// they err on the side of a larger covariance.
+// Pose. The same errors over windows of odometry path d = 0.25, 0.5, 1, 2, 4 m, the ground
+// truth's noise (2 x its variance) removed, are fitted per axis by the law the data show,
+//   V(d) = a d^p   (least squares in log V against log d),
+// and the controller's constant is V(1 m) = a. Dead reckoning's heading error is a random walk in
+// distance (p near 1), its position error grows faster (the heading error rotates what follows:
+// p up to 3): a per-metre law would make position too wide at 1 m.
 
 #include <array>
 #include <cstddef>
@@ -27,38 +37,31 @@
 
 namespace fitcal {
 
-// The errors the covariance is made of, kept apart so that one set can estimate it and another
-// check it (OdometryCoverage).
-struct OdometryErrors {
-  std::vector<std::array<double, 3>> twist;  // per window: vx (m/s), vy (m/s), omega (rad/s)
-  std::vector<std::array<double, 3>> pose;   // per run: x (m), y (m), theta (rad), start frame
-  std::vector<double> path_m;                // per run: odometry path length (m)
-};
-
 struct OdometryCovariance {
-  std::array<double, 3> twist_variance{};        // m^2/s^2, m^2/s^2, rad^2/s^2
-  std::array<double, 3> pose_variance_per_m{};   // m^2/m, m^2/m, rad^2/m
-  double window_s = 1.0;
+  double interval_s = 0.0;                       // the twist's interval (one message)
+  std::array<double, 3> twist_variance{};        // per message: m^2/s^2, m^2/s^2, rad^2/s^2
+  std::array<double, 3> pose_variance_1m{};      // after 1 m of path: m^2, m^2, rad^2
+  std::array<double, 3> pose_growth_exponent{};  // p of V(d) = V(1 m) d^p
+  // The ground truth's own noise variance found and removed (m^2, m^2, rad^2), and the encoder
+  // quantisation's part of a window's error (same units).
+  std::array<double, 3> ground_truth_variance{};
+  std::array<double, 3> quantisation_variance{};
   std::size_t windows = 0, runs = 0;
 };
 
-// Replays every run with the model at p. Runs shorter than one window add no twist error; a run
-// whose odometry path is shorter than 1 cm adds no pose error (nothing travelled to scale by).
-OdometryErrors CollectOdometryErrors(const RobotModelInterface& model,
-                                     const std::vector<double>& p,
-                                     const std::vector<RunLog>& runs, double window_s = 1.0);
+// Estimates it from `runs` replayed with the model at p; interval_s <= 0 takes the median encoder
+// interval. Zeros where the runs hold no windows.
+OdometryCovariance EstimateOdometryCovariance(const RobotModelInterface& model,
+                                              const std::vector<double>& p,
+                                              const std::vector<RunLog>& runs, double interval_s);
 
-// Mean squares as above; zeros where there are no errors.
-OdometryCovariance EstimateOdometryCovariance(const OdometryErrors& errors, double window_s);
+// The pose variance the law gives after d metres (m^2, m^2, rad^2).
+std::array<double, 3> PoseVarianceAfter(const OdometryCovariance& c, double distance_m);
 
-// The share of errors (every axis of every window or run) inside k sigma of `covariance`
-// (sigma of a run's pose error: sqrt(variance per metre x its path)); near 0.683 and 0.954 for
-// k = 1, 2 when the errors are Gaussian and the covariance right.
-struct OdometryCoverage {
-  double twist_within_1_sigma = 0.0, twist_within_2_sigma = 0.0;
-  double pose_within_1_sigma = 0.0, pose_within_2_sigma = 0.0;
-  std::size_t twist_samples = 0, pose_samples = 0;
-};
-OdometryCoverage CoverageOf(const OdometryCovariance& covariance, const OdometryErrors& errors);
+// V(T) = c + beta T + alpha T^2 fitted to mean squares `v` at durations `t` with weights `w`,
+// every coefficient >= 0 (the best of the non-negative subsets): {c, beta, alpha}.
+std::array<double, 3> FitStructureFunction(const std::vector<double>& t,
+                                           const std::vector<double>& v,
+                                           const std::vector<double>& w);
 
 }  // namespace fitcal
