@@ -5,6 +5,7 @@
 #include <atomic>
 #include <filesystem>
 #include <map>
+#include <set>
 #include <mutex>
 
 #include "io/input_error.h"
@@ -28,6 +29,7 @@ struct Input {
 std::atomic<bool> g_enabled{false};
 std::mutex g_mutex;
 std::map<std::string, Input> g_inputs;  // by the given path; guarded by g_mutex
+std::multiset<std::string> g_staged_outputs;  // resolved staging directories; guarded by g_mutex
 thread_local bool t_probing = false;
 
 // The absolute path with links and ".." resolved as far as the path exists: two spellings of
@@ -106,7 +108,24 @@ void RegisterInputFile(const std::string& path) {
   }
   Input input = Describe(path);  // outside the lock: system calls
   const std::lock_guard<std::mutex> lock(g_mutex);
+  for (const std::string& staged : g_staged_outputs) {
+    if (IsWithin(input.resolved, staged)) return;  // the process's own output, read back
+  }
   g_inputs.emplace(path, std::move(input));
+}
+
+void BeginStagedOutput(const std::string& staging_dir) {
+  std::string resolved = Resolved(staging_dir);
+  const std::lock_guard<std::mutex> lock(g_mutex);
+  g_staged_outputs.insert(std::move(resolved));
+}
+
+void EndStagedOutput(const std::string& staging_dir) {
+  std::string resolved = Resolved(staging_dir);
+  const std::lock_guard<std::mutex> lock(g_mutex);
+  if (const auto it = g_staged_outputs.find(resolved); it != g_staged_outputs.end()) {
+    g_staged_outputs.erase(it);
+  }
 }
 
 void RegisterInputDirectory(const std::string& path) { RegisterInputFile(path); }

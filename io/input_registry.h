@@ -16,9 +16,17 @@ namespace fitcal::io {
 
 void EnableInputGuard();
 
-// Record an input file or directory (no effect unless the guard is enabled; thread-safe).
+// Record an input file or directory (no effect unless the guard is enabled; thread-safe). A path
+// inside a staged output of this process (BeginStagedOutput) is not recorded.
 void RegisterInputFile(const std::string& path);
 void RegisterInputDirectory(const std::string& path);
+
+// What the process is writing is not what it read: between these two calls, files read inside
+// `staging_dir` (a staged directory before its rename, io/staged_directory.h) are not inputs. A
+// command may read its own output back before committing it (import rosbag2 checks the data set
+// through fit's loader) and still write the rest of it (its marker) and rename it into place.
+void BeginStagedOutput(const std::string& staging_dir);
+void EndStagedOutput(const std::string& staging_dir);
 
 // "" when `out` may be written; otherwise why not, without the path ("is the input file X", "holds
 // the input X", "sits inside the input directory X"). Checks the recorded inputs.

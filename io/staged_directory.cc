@@ -51,6 +51,7 @@ StagedDirectory::StagedDirectory(const std::string& target) {
   if (ec) throw std::runtime_error(target_ + ": cannot create its parent: " + ec.message());
   RemoveStaleTemporaries(target_);  // a writer killed before (SIGKILL) left its staging behind
   staging_ = MakeUniqueDirectory(TemporaryPrefix(target_), target_);
+  BeginStagedOutput(staging_);  // read back before the rename, it is still not an input
   SetStagingDirectoryForSignals(staging_);
   fs::permissions(staging_,
                   fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec |
@@ -60,6 +61,7 @@ StagedDirectory::StagedDirectory(const std::string& target) {
 
 StagedDirectory::~StagedDirectory() {
   SetStagingDirectoryForSignals("");
+  EndStagedOutput(staging_);
   if (committed_) return;
   std::error_code ec;
   fs::remove_all(staging_, ec);

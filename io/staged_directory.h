@@ -9,7 +9,8 @@
 // in, then the old one removed (a crash in between leaves a hidden `...tmp-<pid>-old-XXXXXX`
 // beside the complete new directory). SIGKILL before Commit leaves the hidden sibling and the
 // target as it was; the next writer of the same target removes it (RemoveStaleTemporaries).
-// The target must not be, hold or sit inside an input of the process (io/input_registry.h).
+// The target must not be, hold or sit inside an input of the process (io/input_registry.h); what
+// the process reads back from the sibling before Commit is its own output, not an input.
 
 #include <string>
 

@@ -2,7 +2,8 @@
 # Installs fitcal's build and test dependencies from Debian 12 packages (run as root or with sudo).
 #   tools/install_deps.sh [--tests]   --tests adds what only the test suite uses: Chromium, in which
 #                                     page_render_test lays the report out at phone and desktop widths,
-#                                     and the npm packages of k8s_manifest_check (tests/k8s)
+#                                     the npm packages of k8s_manifest_check (tests/k8s), and jq,
+#                                     which a documented command runs (docs_commands_test)
 set -euo pipefail
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
@@ -11,7 +12,7 @@ PACKAGES=(build-essential cmake ninja-build pkg-config mold ccache
           libgtest-dev libgmock-dev libbenchmark-dev
           libsqlite3-dev libzstd-dev liblz4-dev libfastcdr-dev)
 if [ "${1:-}" = "--tests" ]; then
-  PACKAGES+=(chromium)
+  PACKAGES+=(chromium jq)
   command -v npm > /dev/null || PACKAGES+=(nodejs npm)
 fi
 missing=()

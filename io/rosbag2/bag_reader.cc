@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <iterator>
 #include <limits>
+#include <string>
 
 #include "io/rosbag2/errors.h"
 #include "io/rosbag2/mcap_storage.h"
@@ -21,9 +23,12 @@ std::string StorageOfFile(const fs::path& file) {
                 "not a bag: expected a bag directory, metadata.yaml, .db3 or .mcap file");
 }
 
-// A relative_file_paths entry resolved against the bag directory. Bags of metadata version < 4
-// stored "<bag dir name>/<file>", relative to the directory above the bag.
-std::string ResolveBagFile(const fs::path& bag_dir, const std::string& relative,
+// A relative_file_paths entry resolved inside the bag directory, never outside it. rosbag2 wrote
+// "<bag directory name>/<file>" in metadata versions 1-3 (relative to the directory above the
+// bag) and "<file>" from version 4 on; for the old versions the first component is dropped,
+// whatever the directory is called now (a bag copied under another name). A listed file that is
+// not in the bag is refused: a file of the same name beside the bag belongs to another recording.
+std::string ResolveBagFile(const fs::path& bag_dir, const std::string& relative, int version,
                            const std::string& metadata_path) {
   const fs::path rel(relative);
   for (const fs::path& part : rel) {
@@ -36,10 +41,23 @@ std::string ResolveBagFile(const fs::path& bag_dir, const std::string& relative,
     ThrowBagError(InputErrorKind::kBadPath, metadata_path,
                   "file " + Printable(relative) + " is not a path relative to the bag");
   }
-  const fs::path direct = bag_dir / rel;
-  const fs::path old_style = bag_dir.parent_path() / rel;
-  if (!fs::exists(direct) && fs::exists(old_style)) return old_style.string();
-  return direct.string();
+  fs::path in_bag;
+  for (auto part = version < 4 ? std::next(rel.begin()) : rel.begin(); part != rel.end(); ++part) {
+    in_bag /= *part;
+  }
+  if (in_bag.empty() || !in_bag.has_filename()) {
+    ThrowBagError(InputErrorKind::kBadPath, metadata_path,
+                  "file " + Printable(relative) + " of a version " + std::to_string(version) +
+                      " bag names no file inside its directory (<bag directory>/<file>)");
+  }
+  const fs::path path = bag_dir / in_bag;
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) {
+    ThrowBagError(InputErrorKind::kMissingFile, metadata_path,
+                  "lists file " + Printable(relative) + ", which is not in the bag directory " +
+                      Printable(bag_dir.string(), 200));
+  }
+  return path.string();
 }
 
 }  // namespace
@@ -85,7 +103,7 @@ void BagReader::OpenFromMetadata(const std::string& metadata_path) {
   }
   const fs::path bag_dir = fs::path(metadata_path).parent_path();
   for (const std::string& relative : metadata_->relative_file_paths) {
-    files_.push_back(ResolveBagFile(bag_dir, relative, metadata_path));
+    files_.push_back(ResolveBagFile(bag_dir, relative, metadata_->version, metadata_path));
   }
 }
 

@@ -1,6 +1,6 @@
 #pragma once
-// What the benchmarks share: sizes from the environment and a scratch directory for the inputs
-// they write once.
+// What the benchmarks share: sizes from the environment, where the shared data are (also for the
+// tests that read them) and a scratch directory for the inputs they write once.
 
 #include <unistd.h>
 
@@ -20,6 +20,13 @@ inline long EnvOr(const char* name, long fallback) {
 // The environment variable `name` (megabytes, `fallback_mb` when not set) in bytes.
 inline std::uint64_t EnvBytes(const char* name, long fallback_mb) {
   return static_cast<std::uint64_t>(EnvOr(name, fallback_mb)) << 20;
+}
+
+// The shared data (../shared beside the checkout, `built_in`), or $FITCAL_SHARED_DIR where the
+// checkout has none beside it (a git worktree elsewhere).
+inline std::filesystem::path SharedDir(const char* built_in) {
+  const char* env = std::getenv("FITCAL_SHARED_DIR");
+  return env != nullptr && *env != '\0' ? env : built_in;
 }
 
 // A fresh directory under the system's temporary directory, removed with everything in it.

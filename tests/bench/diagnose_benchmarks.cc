@@ -15,6 +15,7 @@
 #include "fit/run_split.h"
 #include "io/dataset.h"
 #include "models/model_registry.h"
+#include "tests/bench/bench_support.h"
 #include "tools/import_optiodom.h"
 
 namespace fitcal {
@@ -35,7 +36,7 @@ struct RemovedAtExit {
 const std::string& ImportedOmni3() {
   static RemovedAtExit cleanup;
   static const std::string directory = [] {
-    const fs::path root = fs::path(FITCAL_SHARED_DIR) / "data" / "optiodom" / "omni3";
+    const fs::path root = fitcal::bench::SharedDir(FITCAL_SHARED_DIR) / "data" / "optiodom" / "omni3";
     tools::ImportOptiOdomOptions options;
     for (const char* type : {"circular", "square"}) {
       if (!fs::is_directory(root / type)) return std::string();

@@ -5,7 +5,8 @@
 // (counter child_cpu_s, from getrusage). The import's wall time includes an fsync per written
 // file (io/atomic_file.h), which depends on the disk, not on fitcal.
 //
-// Skipped with an error when ../shared is missing (a checkout without the shared data).
+// Skipped with an error when ../shared is missing (a checkout without the shared data);
+// FITCAL_SHARED_DIR in the environment points elsewhere.
 
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
@@ -14,6 +15,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+
+#include "tests/bench/bench_support.h"
 
 namespace fitcal {
 namespace {
@@ -30,7 +33,7 @@ double ChildrenCpuSeconds() {
 // robot: a folder of ../shared/data/optiodom; fit_flags: what `fit` gets besides the data set.
 void BM_ImportAndFit(benchmark::State& state, const std::string& robot,
                      const std::string& fit_flags) {
-  const fs::path source = fs::path(FITCAL_SHARED_DIR) / "data" / "optiodom" / robot;
+  const fs::path source = fitcal::bench::SharedDir(FITCAL_SHARED_DIR) / "data" / "optiodom" / robot;
   if (!fs::is_directory(source / "circular") || !fs::is_directory(source / "square")) {
     state.SkipWithError(("no shared data at " + source.string()).c_str());
     return;

@@ -24,6 +24,7 @@
 #include "io/dataset.h"
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
+#include "tests/bench/bench_support.h"
 
 namespace fitcal {
 namespace {
@@ -41,10 +42,7 @@ struct ImportedLoops {
 
 ImportedLoops ImportLoops(const std::string& robot) {
   ImportedLoops out;
-  // ../shared beside the checkout, or $FITCAL_SHARED_DIR (a worktree elsewhere).
-  const char* shared = std::getenv("FITCAL_SHARED_DIR");
-  const fs::path source =
-      fs::path(shared != nullptr ? shared : FITCAL_SHARED_DIR) / "data" / "optiodom" / robot;
+  const fs::path source = bench::SharedDir(FITCAL_SHARED_DIR) / "data" / "optiodom" / robot;
   if (!fs::is_directory(source / "circular") || !fs::is_directory(source / "square")) {
     out.error = "no shared data at " + source.string();
     return out;
