@@ -358,6 +358,53 @@ TEST(TricycleSimulation, FitRecoversTheTruthWithinNoiseDerivedSigmas) {
   }
 }
 
+// The steering gain (tricycle_kinematics.h T3): an absolute encoder on the steering column of a
+// linkage that turns the wheel 0.4 times the column's angle. Circles at 10-45 deg of wheel angle
+// both ways (the squares' in-place turns would need a column beyond +-180 deg), the nominal's
+// gain 1 (2.5 times the truth), noise and sigmas as in the test above; the gain must land within
+// 4 sigma of 0.4 and the other parameters too.
+TEST(TricycleSimulation, FitRecoversASteeringGainFarFromTheNominal) {
+  const RobotModelPtr model = ReadRobotModel(
+      YAML::Load(std::string(kTricycleExampleYaml) + "steering_gain: 1.0\n"), "gain.yaml");
+  ASSERT_EQ(model->robot().NumParameters(), 4);
+  EXPECT_EQ(model->robot().parameters[3].name, "steering_gain");
+  const std::vector<double> truth = {0.0316, 0.154, DegToRad(-1.1), 0.4};
+  sim::TricycleTrajectoryOptions trajectories;
+  trajectories.repetitions = 2;
+  std::vector<sim::TrajectorySpec> circles;
+  for (const sim::TrajectorySpec& t : sim::TricycleTrajectories(trajectories)) {
+    if (t.label.rfind("circle", 0) == 0) circles.push_back(t);
+  }
+  sim::SimulationOptions options;
+  options.encoder_period_s = 0.01;
+  options.ticks_per_rev = {1600.0, 0.0};
+  options.gt_position_sigma_m = 0.002;
+  options.gt_heading_sigma_rad = 0.002;
+  options.record_start_pose = true;
+  options.seed = 15;
+  const auto simulated = sim::SimulateRuns(*model, truth, circles, options);
+  std::vector<AlignedRun> runs;
+  for (const auto& s : simulated) runs.push_back(AlignRun(s.log));
+  ModelFitOptions fit_options;
+  fit_options.ceres.weights = {0.002, 0.002};
+  fit_options.ceres.num_threads = 1;
+  const ModelFitResult fit = FitModel(runs, *model, fit_options);
+  ASSERT_TRUE(fit.usable) << fit.termination << ": " << fit.message;
+  ASSERT_TRUE(fit.has_covariance) << fit.covariance_message;
+  for (int k = 0; k < 4; ++k) {
+    SCOPED_TRACE(model->robot().parameters[k].name);
+    std::printf("%-16s true %.7f fit %.7f sigma %.2e\n", model->robot().parameters[k].name.c_str(),
+                truth[k], fit.parameters[k], fit.sigma[k]);
+    EXPECT_LT(std::abs(fit.parameters[k] - truth[k]), 4.0 * fit.sigma[k]);
+  }
+  // The calibrated YAML carries the gain and its box back.
+  const RobotModelPtr back =
+      ReadRobotModel(YAML::Load(model->RobotYaml(fit.parameters, "")), "calibrated.yaml");
+  EXPECT_NEAR(back->robot().nominal[3], fit.parameters[3], 1e-9);
+  EXPECT_DOUBLE_EQ(back->robot().bounds[3].lo, 0.1);
+  EXPECT_DOUBLE_EQ(back->robot().bounds[3].hi, 10.0);
+}
+
 // Final-pose SSR (weights 1) after fitting the runs read through `mapping`.
 double FittedSsr(const RobotModelInterface& model, const std::vector<AlignedRun>& runs,
                  const ChannelMapping& mapping) {

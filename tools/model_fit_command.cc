@@ -23,6 +23,7 @@
 #include "fitcal/version.h"
 #include "io/atomic_file.h"
 #include "io/calibration_block.h"
+#include "models/mounted_model.h"
 #include "tools/effect_list.h"
 #include "tools/everyday_driving_table.h"
 #include "tools/fit_methods.h"
@@ -217,6 +218,9 @@ void PrintParameters(const Robot& robot, const std::vector<double>& p, const Sel
   for (const HeldParameter& h : robot.held) {
     std::printf("  held: %s (%s)\n", robot.parameters[h.index].name.c_str(), h.reason.c_str());
   }
+  if (const std::string frame = GroundTruthFrameLine(robot, fit.held); !frame.empty()) {
+    std::printf("  %s\n", frame.c_str());
+  }
 }
 
 // Nominal (with the effects the robot declares), closed forms, the fit; and when the fit held
@@ -354,6 +358,7 @@ void PrintFit(const FitCommandOptions& options, const RobotModelInterface& model
   std::printf("\nsolver: %s, %s after %d iterations (%d evaluations%s), %.3f s (%s)\n",
               method.description.c_str(), fit.termination.c_str(), fit.iterations,
               outcome.evaluations, rounds.c_str(), fit.solve_time_s, fit.message.c_str());
+  if (!fit.global_start.empty()) std::printf("global start: %s\n", fit.global_start.c_str());
   if (track_fits) {
     std::printf(
         "track fits (training tracks): parameters alone %s after %d iterations, with the "
