@@ -55,7 +55,11 @@ TEST_P(MountedFit, RecoversTheSensorsMountWithinThreeSigma) {
                               dir.Path("nominal.yaml") + " --truth " + dir.Path("truth.yaml") +
                               " --out " + data + " --seed 5 --repetitions 3");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  r = RunFitcal(dir, "fit --logs " + data + " --train-reps 1-2 --out " + cal);
+  // Final poses: simulate's ground truth comes every 0.2 s and is interpolated linearly between
+  // samples; a sensor 1.5 m off a robot turning at 0.7 rad/s moves on arcs whose chords cut 3 mm
+  // inside them, a bias of the track residual's checkpoints (measured: the tricycle's r and L
+  // 0.27 % small, 7 sigma) that the final pose, taken at rest, does not have.
+  r = RunFitcal(dir, "fit --logs " + data + " --train-reps 1-2 --residuals final-pose --out " + cal);
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
   std::printf("%s", r.out.c_str());
   EXPECT_TRUE(Has(r.out, "ground_truth_frame: x, y and yaw determined")) << r.out;
@@ -97,7 +101,8 @@ INSTANTIATE_TEST_SUITE_P(
     [](const auto& test) { return std::string(test.param.model); });
 
 // An omni robot's x and y trade with its wheel distances: held at the guess, said with the
-// reason; its yaw is fitted.
+// reason; its yaw is fitted (and trades with a common turn of the wheel angles: left to the
+// direction analysis, not asserted).
 TEST(MountedFit, AnOmniRobotsXAndYAreHeldWithTheReason) {
   TempDir dir;
   const std::string data = dir.Path("data"), cal = dir.Path("calibrated.yaml");
@@ -105,9 +110,9 @@ TEST(MountedFit, AnOmniRobotsXAndYAreHeldWithTheReason) {
   auto r = RunFitcal(dir, "simulate --model omni --robot " + dir.Path("nominal.yaml") + " --out " +
                               data + " --seed 5 --repetitions 2");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  r = RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --out " + cal);
+  r = RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --residuals final-pose --out " + cal);
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
-  EXPECT_TRUE(Has(r.out, "ground_truth_frame: yaw determined; x and y held")) << r.out;
+  EXPECT_TRUE(Has(r.out, "ground_truth_frame: yaw determined by the runs; x and y held")) << r.out;
   EXPECT_TRUE(Has(r.out, "wheel distances")) << r.out;
   const YAML::Node frame = YAML::LoadFile(cal)["ground_truth_frame"];
   EXPECT_EQ(frame["x_m"].as<double>(), 1.5);

@@ -88,7 +88,9 @@ TEST(MountedModel, AnOmniRobotsXAndYAreHeldWithTheReason) {
   ASSERT_TRUE(robot.IsHeld(x + 1));
   EXPECT_FALSE(robot.IsHeld(x + 2));
   for (const HeldParameter& h : robot.held) {
-    if (h.index == x) EXPECT_NE(h.reason.find("wheel distances"), std::string::npos) << h.reason;
+    if (h.index == x) {
+      EXPECT_NE(h.reason.find("wheel distances"), std::string::npos) << h.reason;
+    }
   }
   EXPECT_TRUE(Read(std::string(kDiffDriveExampleYaml) + kFrame)->robot().held.empty());
 }
@@ -103,7 +105,7 @@ TEST(MountedModel, RefusesAMalformedFrameWithFileAndLine) {
     }
     return std::string("accepted");
   };
-  EXPECT_NE(message(base + "ground_truth_frame: {x_m: 1.5, y_m: 0.0}\n").find("robot.yaml:7"),
+  EXPECT_NE(message(base + "ground_truth_frame: {x_m: 1.5, y_m: 0.0}\n").find("robot.yaml:8"),
             std::string::npos);
   EXPECT_NE(message(base + "ground_truth_frame: {x_m: 1, y_m: 0, yaw_deg: 0, z_m: 1}\n")
                 .find("z_m"),

@@ -207,6 +207,8 @@ void PrintParameters(const Robot& robot, const std::vector<double>& p, const Sel
     char change[32];
     if (info.unit == ParameterUnit::kAngle) {
       std::snprintf(change, sizeof change, "%+.3f deg", (p[k] - robot.nominal[k]) * s);
+    } else if (robot.nominal[k] == 0.0) {  // no percentage of nothing (a frame's y of 0)
+      std::snprintf(change, sizeof change, "%+.4g m", p[k] - robot.nominal[k]);
     } else {
       std::snprintf(change, sizeof change, "%+.2f%%",
                     100.0 * (p[k] - robot.nominal[k]) / robot.nominal[k]);
