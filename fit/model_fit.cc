@@ -7,6 +7,7 @@
 #include <cmath>
 #include <memory>
 #include <stdexcept>
+#include <string>
 #include <type_traits>
 #include <utility>
 
@@ -796,9 +797,75 @@ ClockOffsetEstimate EstimateClockOffsets(const RobotModelInterface& model,
   return out;
 }
 
+namespace {
+
+// Held by the model (gauge) or by --hold (the tying's held names).
+bool HeldInFit(const Robot& robot, int k, const ModelFitOptions& options) {
+  if (robot.IsHeld(k)) return true;
+  if (options.tying == nullptr) return false;
+  const std::vector<std::string>& held = options.tying->held;
+  return std::find(held.begin(), held.end(), robot.parameters[k].name) != held.end();
+}
+
+// The free parameters a fit left on a bound.
+std::vector<std::string> FreeParametersOnABound(const Robot& robot, const ModelFitResult& fit,
+                                                const ModelFitOptions& options) {
+  std::vector<std::string> out;
+  for (int k = 0; k < robot.NumParameters() && k < static_cast<int>(fit.at_bound.size()); ++k) {
+    if (!HeldInFit(robot, k, options) && fit.at_bound[k]) out.push_back(robot.parameters[k].name);
+  }
+  return out;
+}
+
+// ModelFitOptions::global_start: the starts spread across the box, the lowest cost kept.
+ModelFitResult WithGlobalStart(const std::vector<AlignedRun>& training,
+                               const RobotModelInterface& model, const ModelFitOptions& options,
+                               ModelFitResult local) {
+  const Robot& robot = model.robot();
+  const std::vector<std::string> on_bound = FreeParametersOnABound(robot, local, options);
+  if (on_bound.empty()) return local;
+  std::string names;
+  for (const std::string& n : on_bound) names += (names.empty() ? "" : ", ") + n;
+  const double local_cost = local.usable ? local.final_cost : HUGE_VAL;
+  ModelFitResult best = std::move(local);
+  double best_cost = local_cost;
+  double best_fraction = -1.0;
+  for (double fraction : {0.5, 0.25, 0.75}) {
+    std::vector<double> start = robot.nominal;
+    for (int k = 0; k < robot.NumParameters(); ++k) {
+      if (!HeldInFit(robot, k, options)) {
+        start[k] = robot.bounds[k].lo + fraction * robot.bounds[k].Width();
+      }
+    }
+    ModelFitResult fit = FitModelFrom(training, model, start, options);
+    if (!fit.usable || !(fit.final_cost < best_cost)) continue;
+    best_cost = fit.final_cost;
+    best_fraction = fraction;
+    best = std::move(fit);
+  }
+  char text[400];
+  if (best_fraction < 0.0) {
+    std::snprintf(text, sizeof text,
+                  "the fit from the nominal ended on a bound (%s); fits from the box's centre and "
+                  "quarters found no lower cost: kept",
+                  names.c_str());
+  } else {
+    std::snprintf(text, sizeof text,
+                  "the fit from the nominal ended on a bound (%s, cost %.6g); the fit from %.0f %% "
+                  "of the way across the box found cost %.6g: kept that one",
+                  names.c_str(), local_cost, 100.0 * best_fraction, best_cost);
+  }
+  best.global_start = text;
+  return best;
+}
+
+}  // namespace
+
 ModelFitResult FitModel(const std::vector<AlignedRun>& training, const RobotModelInterface& model,
                         const ModelFitOptions& options) {
-  return FitModelFrom(training, model, model.robot().nominal, options);
+  ModelFitResult local = FitModelFrom(training, model, model.robot().nominal, options);
+  if (!options.global_start) return local;
+  return WithGlobalStart(training, model, options, std::move(local));
 }
 
 }  // namespace fitcal

@@ -77,6 +77,9 @@ struct ModelFitResult {
   // moved is not usable (stopped_early).
   bool clock_offsets_settled = false;
   int clock_offset_iterations = 0;  // of the offsets' own small problems (not in `iterations`)
+  // What the global start did (ModelFitOptions::global_start), in words; empty when the fit from
+  // the nominal ended on no bound.
+  std::string global_start;
 };
 
 // What the fit compares with the ground truth (fit/track_residual.h):
@@ -106,6 +109,12 @@ struct ModelFitOptions {
   // nominal (fit/parameter_tying.h). The fit runs on the tied model and its result is mapped back
   // (ExpandTiedResult); every residual kind above works with it.
   const ParameterTying* tying = nullptr;
+  // Far from the guess: when the fit from the nominal ends with a free parameter on a bound of
+  // its box (a nominal several times off pulls the others there), fit again from points spread
+  // across the box (its centre, a quarter and three quarters of the way from each free
+  // parameter's lower bound) and keep the lowest cost. FitModel only; FitModelFrom fits from its
+  // start.
+  bool global_start = true;
 };
 
 // A value rests on a bound when it is within 1e-6 of the box's width of it: far above the YAML's

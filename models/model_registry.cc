@@ -6,6 +6,7 @@
 #include "io/yaml_units_check.h"
 #include "models/asoc/asoc_robot_model.h"
 #include "models/diff_drive/diff_drive_model.h"
+#include "models/mounted_model.h"
 #include "models/omni/omni_model.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "models/tricycle/tricycle_checks.h"
@@ -110,7 +111,9 @@ RobotModelPtr ReadRobotModel(const YAML::Node& root, const std::string& path) {
                          "unknown model '" + model + "' (known: " + RegisteredModelNames() + ")");
   }
   io::CheckRobotYamlUnits(root, path);  // millimetres, radians: before any model reads a value
-  RobotModelPtr robot_model = registration->read(root, path);
+  // A pose source on a mount wraps any model (models/mounted_model.h).
+  RobotModelPtr robot_model = ApplyGroundTruthFrame(
+      root, path, [&](const YAML::Node& schema) { return registration->read(schema, path); });
   RefuseEffectsTheChannelsCannotShow(robot_model->robot(), root, path);
   return robot_model;
 }

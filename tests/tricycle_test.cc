@@ -358,6 +358,94 @@ TEST(TricycleSimulation, FitRecoversTheTruthWithinNoiseDerivedSigmas) {
   }
 }
 
+// The steering gain (tricycle_kinematics.h T3): the wheel turns k times the measured angle, so
+// the body step with gain k of a reading phi is the gainless step (T1) of the reading k phi,
+// written out by hand here; ChannelsForTwist inverts it.
+TEST(TricycleKinematics, SteeringGainScalesTheMeasuredAngle) {
+  const double p[4] = {0.0316, 0.154, DegToRad(-1.1), 0.4};
+  const auto k = TricycleGainKinematics::Prepare(p);
+  const double values[2] = {7.0, 1.3};  // rad/s, rad (the column's angle)
+  double dx, dy, dtheta;
+  TricycleGainKinematics::BodyStep(k, values, 0.01, &dx, &dy, &dtheta);
+  const double wheel_rad = 0.4 * 1.3 + DegToRad(-1.1), d = 0.0316 * 7.0 * 0.01;
+  EXPECT_NEAR(dx, d * std::cos(wheel_rad), 1e-15);
+  EXPECT_EQ(dy, 0.0);
+  EXPECT_NEAR(dtheta, d * std::sin(wheel_rad) / 0.154, 1e-15);
+  double back[2];
+  ASSERT_TRUE(TricycleGainKinematics::ChannelsForTwist(p, Twist{dx / 0.01, 0.0, dtheta / 0.01},
+                                                       back));
+  EXPECT_NEAR(back[0], 7.0, 1e-9);
+  EXPECT_NEAR(back[1], 1.3, 1e-9);
+}
+
+// `steering_gain:` adds a fourth parameter with its box (default a factor 10 either way of the
+// nominal, or bounds.steering_gain), written back by the calibrated YAML; without it the robot
+// keeps its three parameters.
+TEST(TricycleYaml, SteeringGainIsAFourthParameterWithItsBox) {
+  const std::string base =
+      "model: tricycle\nname: g\ntraction_wheel: {radius_m: 0.0325}\nwheelbase_m: 0.15\n"
+      "steering_offset_deg: 0.0\nsteering_gain: 0.5\n";
+  const RobotModelPtr model = ReadRobotModel(
+      YAML::Load(base + "bounds: {radius_m: [0.030, 0.035], wheelbase_m: [0.13, 0.17], "
+                        "steering_offset_deg: [-10.0, 10.0]}\n"),
+      "gain.yaml");
+  const Robot& robot = model->robot();
+  ASSERT_EQ(robot.NumParameters(), 4);
+  EXPECT_EQ(robot.parameters[3].name, "steering_gain");
+  EXPECT_DOUBLE_EQ(robot.nominal[3], 0.5);
+  EXPECT_DOUBLE_EQ(robot.bounds[3].lo, 0.05);
+  EXPECT_DOUBLE_EQ(robot.bounds[3].hi, 5.0);
+  std::vector<double> p = robot.nominal;
+  p[3] = 0.4;
+  const Robot back =
+      ReadRobotModel(YAML::Load(model->RobotYaml(p, "")), "calibrated.yaml")->robot();
+  EXPECT_DOUBLE_EQ(back.nominal[3], 0.4);
+  EXPECT_DOUBLE_EQ(back.bounds[3].lo, 0.05);
+  const Robot boxed =
+      ReadRobotModel(YAML::Load(base + "bounds: {radius_m: [0.030, 0.035], wheelbase_m: [0.13, "
+                                       "0.17], steering_offset_deg: [-10.0, 10.0], "
+                                       "steering_gain: [0.2, 2.5]}\n"),
+                     "gain.yaml")
+          ->robot();
+  EXPECT_DOUBLE_EQ(boxed.bounds[3].hi, 2.5);
+  EXPECT_THROW(ReadRobotModel(YAML::Load(base + "bounds: {radius_m: [0.030, 0.035], wheelbase_m: "
+                                                "[0.13, 0.17], steering_offset_deg: [-10, 10], "
+                                                "steering_gain: [0.6, 2.5]}\n"),
+                              "gain.yaml"),
+               io::InputError);  // the nominal outside its box
+  EXPECT_EQ(ExampleModel()->robot().NumParameters(), 3);
+}
+
+// FitModel's global start (fit/model_fit.h): a true wheelbase of 0.18 m beyond the box's 0.17 m
+// leaves the fit from the nominal on that bound (measured: the radius on its bound too, their
+// ratio being what the turns see); the fits from the box's centre and quarters end
+// there too (the box holds no lower cost), so the fit is kept and the result says so.
+TEST(TricycleSimulation, AFitOnABoundIsStartedAgainAcrossTheBox) {
+  const auto model = ExampleModel();
+  const std::vector<double> truth = {0.0316, 0.18, DegToRad(-1.1)};
+  sim::SimulationOptions options;
+  options.encoder_period_s = 0.01;
+  options.gt_position_sigma_m = 0.002;
+  options.gt_heading_sigma_rad = 0.002;
+  options.record_start_pose = true;
+  options.seed = 16;
+  const auto simulated = sim::SimulateRuns(*model, truth, sim::TricycleTrajectories(), options);
+  std::vector<AlignedRun> runs;
+  for (const auto& s : simulated) runs.push_back(AlignRun(s.log));
+  ModelFitOptions fit_options;
+  fit_options.ceres.num_threads = 1;
+  fit_options.ceres.compute_covariance = false;
+  const ModelFitResult fit = FitModel(runs, *model, fit_options);
+  std::printf("global start: %s\n", fit.global_start.c_str());
+  EXPECT_NE(fit.global_start.find("ended on a bound ("), std::string::npos);
+  EXPECT_NE(fit.global_start.find("wheelbase"), std::string::npos);
+  EXPECT_NE(fit.global_start.find("kept"), std::string::npos);
+  EXPECT_TRUE(fit.at_bound[1]);
+  EXPECT_NEAR(fit.parameters[1], 0.17, 1e-8);
+  fit_options.global_start = false;
+  EXPECT_TRUE(FitModel(runs, *model, fit_options).global_start.empty());
+}
+
 // Final-pose SSR (weights 1) after fitting the runs read through `mapping`.
 double FittedSsr(const RobotModelInterface& model, const std::vector<AlignedRun>& runs,
                  const ChannelMapping& mapping) {

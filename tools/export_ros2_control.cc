@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <iostream>
 #include <numeric>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -19,6 +20,7 @@
 #include "io/text_file.h"
 #include "models/diff_drive/diff_drive_model.h"
 #include "models/model_registry.h"
+#include "models/mounted_model.h"
 #include "models/omni/omni_model.h"
 #include "models/tricycle/tricycle_kinematics.h"
 #include "odometry/aligned_run.h"
@@ -375,12 +377,25 @@ void TricycleParameters(const Calibrated& c, const std::string&, Ros2ControlExpo
                           "\n    steering_joint_name: " + Quoted(steering) +
                           "\n    wheelbase: " + Num(p[k_wheelbase]) +
                           "\n    wheel_radius: " + Num(p[k_radius]) + "\n";
-  // The controller's tricycle: these values, no steering offset.
+  // The controller's tricycle: these values, no steering offset and no steering gain.
   out->model = c.model;
   out->parameters = p;
   out->parameters[k_radius] = AsWritten(p[k_radius]);
   out->parameters[k_wheelbase] = AsWritten(p[k_wheelbase]);
   out->parameters[k_offset] = 0.0;
+  if (const std::optional<int> k_gain = ParameterIndex(c.robot(), "steering_gain")) {
+    // Wheel angle = k x measured + phi_0 (tricycle_kinematics.h T3). The controller reads the
+    // steering joint as the wheel's angle; a SimpleTransmission's joint = actuator / reduction.
+    char text[400];
+    std::snprintf(text, sizeof text,
+                  "tricycle_controller has no steering gain: the steering joint '%s' must report "
+                  "%.9g times the measured angle, e.g. <mechanicalReduction>%.9g"
+                  "</mechanicalReduction> in its SimpleTransmission (joint = actuator / "
+                  "reduction), before the offset above",
+                  steering.c_str(), p[*k_gain], 1.0 / p[*k_gain]);
+    out->notes.push_back(text);
+    out->parameters[*k_gain] = 1.0;
+  }
 }
 
 struct ControllerEntry {
@@ -428,6 +443,20 @@ void CheckDistro(const ControllerEntry& e, const std::string& distro) {
   }
 }
 
+// The controller's parameters describe the base; a controller model that replaced the calibrated
+// one (omni, mecanum) is replayed against the ground truth through the calibrated frame still
+// (models/mounted_model.h), or its held-out check would compare the base with the sensor.
+void KeepGroundTruthFrame(const Calibrated& c, Ros2ControlExport* out) {
+  const auto* mounted = dynamic_cast<const MountedModel*>(c.model.get());
+  if (mounted == nullptr || out->model == c.model) return;
+  const int k = mounted->MountIndex();
+  const std::vector<double>& p = c.robot().nominal;
+  const std::vector<Interval> bounds(c.robot().bounds.begin() + k, c.robot().bounds.end());
+  out->model = std::make_shared<MountedModel>(out->model, GroundTruthFrame{p[k], p[k + 1], p[k + 2]},
+                                              bounds);
+  out->parameters.insert(out->parameters.end(), p.begin() + k, p.end());
+}
+
 }  // namespace
 
 const std::vector<std::string>& RosDistros() {
@@ -469,6 +498,7 @@ Ros2ControlExport ExportRos2Control(const RobotModelPtr& calibrated,
   Ros2ControlExport out;
   out.parameters_yaml = (node_name.empty() ? controller : node_name) + ":\n  ros__parameters:\n";
   entry.write(c, ros_distro, &out);
+  KeepGroundTruthFrame(c, &out);
   return out;
 }
 

@@ -23,6 +23,7 @@
 #include "fitcal/version.h"
 #include "io/atomic_file.h"
 #include "io/calibration_block.h"
+#include "models/mounted_model.h"
 #include "tools/effect_list.h"
 #include "tools/everyday_driving_table.h"
 #include "tools/fit_methods.h"
@@ -207,6 +208,8 @@ void PrintParameters(const Robot& robot, const std::vector<double>& p, const Sel
     char change[32];
     if (info.unit == ParameterUnit::kAngle) {
       std::snprintf(change, sizeof change, "%+.3f deg", (p[k] - robot.nominal[k]) * s);
+    } else if (robot.nominal[k] == 0.0) {  // no percentage of nothing (a frame's y of 0)
+      std::snprintf(change, sizeof change, "%+.4g m", p[k] - robot.nominal[k]);
     } else {
       std::snprintf(change, sizeof change, "%+.2f%%",
                     100.0 * (p[k] - robot.nominal[k]) / robot.nominal[k]);
@@ -217,6 +220,9 @@ void PrintParameters(const Robot& robot, const std::vector<double>& p, const Sel
   }
   for (const HeldParameter& h : robot.held) {
     std::printf("  held: %s (%s)\n", robot.parameters[h.index].name.c_str(), h.reason.c_str());
+  }
+  if (const std::string frame = GroundTruthFrameLine(robot, fit.held); !frame.empty()) {
+    std::printf("  %s\n", frame.c_str());
   }
 }
 
@@ -362,6 +368,7 @@ void PrintFit(const FitCommandOptions& options, const RobotModelInterface& model
   std::printf("\nsolver: %s, %s after %d iterations (%d evaluations%s), %.3f s (%s)\n",
               method.description.c_str(), fit.termination.c_str(), fit.iterations,
               outcome.evaluations, rounds.c_str(), fit.solve_time_s, fit.message.c_str());
+  if (!fit.global_start.empty()) std::printf("global start: %s\n", fit.global_start.c_str());
   if (track_fits) {
     std::printf(
         "track fits (training tracks): parameters alone %s after %d iterations, with the "

@@ -9,6 +9,7 @@
 #include "io/yaml_reader.h"
 #include "io/yaml_text.h"
 #include "models/diff_drive/umbmark.h"
+#include "models/mounted_model.h"
 
 namespace fitcal {
 
@@ -144,7 +145,8 @@ RobotModelPtr ReadDiffDriveModel(const YAML::Node& root, const std::string& path
                                    : MakeModel<1>(std::move(robot));
 }
 
-int DiffDriveRightChannel(const RobotModelInterface& model) {
+int DiffDriveRightChannel(const RobotModelInterface& mounted_or_base) {
+  const RobotModelInterface& model = BaseModel(mounted_or_base);
   if (dynamic_cast<const DiffDriveModelT<0>*>(&model) != nullptr) return 0;
   if (dynamic_cast<const DiffDriveModelT<1>*>(&model) != nullptr) return 1;
   return -1;

@@ -14,6 +14,7 @@
 #include "io/robot_yaml_blocks.h"
 #include "io/yaml_reader.h"
 #include "models/omni/omni_model_build.h"
+#include "models/mounted_model.h"
 
 namespace fitcal {
 
@@ -243,7 +244,7 @@ std::optional<std::vector<OmniWheel>> OmniWheelsOf(const RobotModelInterface& mo
                                         &FillOmniWheelMounts<5>, &FillOmniWheelMounts<6>,
                                         &FillOmniWheelMounts<7>, &FillOmniWheelMounts<8>};
   for (Filler fill : kFillers) {
-    if (fill(model, &wheels)) break;
+    if (fill(BaseModel(model), &wheels)) break;
   }
   return wheels;
 }

@@ -41,12 +41,21 @@
 
 namespace fitcal {
 
-struct TricycleKinematics {
-  static constexpr int kNumParameters = 3;
+// kHasGain: the robot YAML declares `steering_gain` (k below), a fourth parameter; without it the
+// parameters are the three above and k = 1 (the robots and outputs of before, unchanged).
+//   phi' = k phi + phi_0                                                             (T3)
+// Why k: an absolute encoder on the steering column reads the column's angle, and a linkage or a
+// gear between column and wheel turns the wheel a fraction of it. k and L are told apart only by
+// the shape of the turns (sin and cos of phi' in T1 are not linear in k phi): runs at large
+// steering angles, both ways, determine both; near straight driving sees k / L alone.
+template <bool kHasGain>
+struct TricycleKinematicsT {
+  static constexpr int kNumParameters = kHasGain ? 4 : 3;
   static constexpr int kNumChannels = 2;
   static constexpr int kRadiusIndex = 0;
   static constexpr int kWheelbaseIndex = 1;
   static constexpr int kSteeringOffsetIndex = 2;
+  static constexpr int kSteeringGainIndex = 3;  // with kHasGain only
   static constexpr int kTractionChannel = 0;
   static constexpr int kSteeringChannel = 1;
   // |vy| above this (m/s) is a twist a tricycle cannot drive (ChannelsForTwist).
@@ -57,21 +66,28 @@ struct TricycleKinematics {
     T radius_m;
     T inverse_wheelbase_per_m;
     T steering_offset_rad;
+    T steering_gain;
   };
 
   template <typename T>
   static Prepared<T> Prepare(const T* p) {
-    return {p[kRadiusIndex], T(1.0) / p[kWheelbaseIndex], p[kSteeringOffsetIndex]};
+    return {p[kRadiusIndex], T(1.0) / p[kWheelbaseIndex], p[kSteeringOffsetIndex],
+            kHasGain ? p[kSteeringGainIndex] : T(1.0)};
   }
 
-  // (T1). C is the channel scalar: double for recorded channels, T when an effect makes the
-  // channel values depend on parameters.
+  // (T1) with (T3). C is the channel scalar: double for recorded channels, T when an effect
+  // makes the channel values depend on parameters.
   template <typename T, typename C>
   static void BodyStep(const Prepared<T>& k, const C* values, double dt, T* dx, T* dy, T* dtheta) {
     using std::cos;
     using std::sin;
     const T distance_m = k.radius_m * values[kTractionChannel] * dt;
-    const T steering_rad = k.steering_offset_rad + values[kSteeringChannel];
+    T steering_rad = k.steering_offset_rad;
+    if constexpr (kHasGain) {
+      steering_rad += k.steering_gain * values[kSteeringChannel];
+    } else {
+      steering_rad += values[kSteeringChannel];
+    }
     *dx = distance_m * cos(steering_rad);
     *dy = T(0.0);
     *dtheta = distance_m * sin(steering_rad) * k.inverse_wheelbase_per_m;
@@ -85,7 +101,7 @@ struct TricycleKinematics {
   // reverse (vx < 0) keeps the wheel within (-pi/2, pi/2) and rolls it backwards,
   //   phi' = atan2(-omega L, -vx),  v = -sqrt(vx^2 + (omega L)^2)
   // (the other branch, phi' beyond +-pi/2 with v > 0, is the same motion, but real steering
-  // stops at about +-90 deg). Then phi = phi' - phi_0 and w = v / r. At rest phi' = 0.
+  // stops at about +-90 deg). Then phi = (phi' - phi_0) / k and w = v / r. At rest phi' = 0.
   static bool ChannelsForTwist(const double* p, const Twist& twist, double* values) {
     if (std::abs(twist.vy_m_s) > kMaxSidewaysSpeed_m_s) return false;
     const double lateral_m_s = twist.omega_rad_s * p[kWheelbaseIndex];  // omega L
@@ -93,10 +109,15 @@ struct TricycleKinematics {
     const bool reverse = twist.vx_m_s < 0.0;
     const double steering_rad =
         reverse ? std::atan2(-lateral_m_s, -twist.vx_m_s) : std::atan2(lateral_m_s, twist.vx_m_s);
+    const double gain = kHasGain ? p[kSteeringGainIndex] : 1.0;
+    if (gain == 0.0) return false;
     values[kTractionChannel] = (reverse ? -speed_m_s : speed_m_s) / p[kRadiusIndex];
-    values[kSteeringChannel] = steering_rad - p[kSteeringOffsetIndex];
+    values[kSteeringChannel] = (steering_rad - p[kSteeringOffsetIndex]) / gain;
     return true;
   }
 };
+
+using TricycleKinematics = TricycleKinematicsT<false>;
+using TricycleGainKinematics = TricycleKinematicsT<true>;
 
 }  // namespace fitcal

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <optional>
 
 #include "io/input_error.h"
 #include "io/robot_yaml_blocks.h"
@@ -24,6 +25,8 @@ constexpr const char* kSteeringColumn = "steering";
 // A steering offset is a small mounting/zeroing error; beyond a right angle the "offset" would
 // swap forward and sideways.
 constexpr double kMaxSteeringOffsetDeg = 90.0;
+constexpr const char* kGainKey = "steering_gain";
+constexpr double kDefaultGainFactor = 10.0;
 
 // A CSV column name is built from the traction wheel's name: letters, digits, '_' only.
 bool IsColumnSafe(const std::string& name) {
@@ -42,13 +45,26 @@ void RequirePositive(double v, const YAML::Node& node, const std::string& path,
 }
 
 // `bounds:` - absolute boxes, lengths positive, the offset within +-90 deg.
-std::vector<Interval> ReadTricycleBounds(io::YamlMap& robot_map, const std::string& path) {
+// With a steering gain (`gain`), its box too: bounds.steering_gain, or by default a factor of
+// 10 either way of the nominal (a linkage's ratio is known to that; the maker's guess of it can
+// be off several times).
+std::vector<Interval> ReadTricycleBounds(io::YamlMap& robot_map, const std::string& path,
+                                         std::optional<double> gain) {
   const YAML::Node node = robot_map.Required("bounds");
   io::YamlMap bounds(node, path, "bounds");
-  std::vector<Interval> box(K::kNumParameters);
+  std::vector<Interval> box(gain ? TricycleGainKinematics::kNumParameters : K::kNumParameters);
   box[K::kRadiusIndex] = io::ReadBoundsPair(bounds, "radius_m", 1.0);
   box[K::kWheelbaseIndex] = io::ReadBoundsPair(bounds, "wheelbase_m", 1.0);
   box[K::kSteeringOffsetIndex] = io::ReadBoundsPair(bounds, "steering_offset_deg", M_PI / 180.0);
+  if (gain) {
+    Interval& g = box[TricycleGainKinematics::kSteeringGainIndex];
+    g = bounds.Has(kGainKey) ? io::ReadBoundsPair(bounds, kGainKey, 1.0)
+                             : Interval{*gain / kDefaultGainFactor, *gain * kDefaultGainFactor};
+    if (!(g.lo > 0.0)) {
+      throw InputError(InputErrorKind::kBadValue, path, LineOf(node),
+                       "bounds.steering_gain must be positive");
+    }
+  }
   bounds.RejectUnread();
   if (!(box[K::kRadiusIndex].lo > 0.0) || !(box[K::kWheelbaseIndex].lo > 0.0)) {
     throw InputError(InputErrorKind::kBadValue, path, LineOf(node),
@@ -64,7 +80,8 @@ std::vector<Interval> ReadTricycleBounds(io::YamlMap& robot_map, const std::stri
 
 }  // namespace
 
-Robot TricycleRobotDescription(const std::string& name, const std::string& traction_name) {
+Robot TricycleRobotDescription(const std::string& name, const std::string& traction_name,
+                               bool with_gain) {
   Robot robot;
   robot.model = "tricycle";
   robot.name = name;
@@ -77,6 +94,9 @@ Robot TricycleRobotDescription(const std::string& name, const std::string& tract
   robot.parameters[K::kWheelbaseIndex] = {"wheelbase", "wheelbase_m", ParameterUnit::kLength};
   robot.parameters[K::kSteeringOffsetIndex] = {"steering_offset", "steering_offset_deg",
                                                ParameterUnit::kAngle};
+  // A ratio; printed under the length unit until odometry/robot.h has a unit for ratios (its
+  // change is printed in %, as a length's).
+  if (with_gain) robot.parameters.push_back({kGainKey, kGainKey, ParameterUnit::kLength});
   return robot;
 }
 
@@ -100,27 +120,35 @@ RobotModelPtr ReadTricycleModel(const YAML::Node& root, const std::string& path)
   p[K::kWheelbaseIndex] = robot_map.Double("wheelbase_m");
   RequirePositive(p[K::kWheelbaseIndex], robot_map.Required("wheelbase_m"), path, "wheelbase_m");
   p[K::kSteeringOffsetIndex] = DegToRad(robot_map.Double("steering_offset_deg"));
+  std::optional<double> gain;
+  if (robot_map.Has(kGainKey)) {
+    gain = robot_map.Double(kGainKey);
+    RequirePositive(*gain, robot_map.Required(kGainKey), path, kGainKey);
+    p.push_back(*gain);
+  }
 
-  Robot robot = TricycleRobotDescription(name, traction_name);
+  Robot robot = TricycleRobotDescription(name, traction_name, gain.has_value());
   robot.nominal = p;
-  robot.bounds = ReadTricycleBounds(robot_map, path);
+  robot.bounds = ReadTricycleBounds(robot_map, path, gain);
   io::CheckNominalInsideBounds(robot, path, LineOf(robot_map.Required("bounds")));
   robot.encoder = io::ReadEncoderTicksNode(robot_map.Optional("encoder"), path);
   robot.effects = io::ReadEffectsNode(robot_map.Optional("effects"), path);
   robot_map.Optional("calibration");  // written by fitcal; informational when read back
   robot_map.RejectUnread();
+  if (gain) return std::make_shared<TricycleGainModel>(std::move(robot));
   return std::make_shared<TricycleModel>(std::move(robot));
 }
 
-std::string TricycleModel::RobotYaml(const std::vector<double>& p,
-                                     const std::vector<effects::EffectValue>& effects,
-                                     const std::string& calibration_block) const {
-  const std::string& traction_name = robot_.channels[K::kTractionChannel].name;
+std::string TricycleRobotYaml(const Robot& robot, const std::vector<double>& p,
+                              const std::vector<effects::EffectValue>& effects,
+                              const std::string& calibration_block) {
+  const bool with_gain = robot.NumParameters() == TricycleGainKinematics::kNumParameters;
+  const std::string& traction_name = robot.channels[K::kTractionChannel].name;
   YAML::Emitter out;
   out.SetDoublePrecision(10);
   out << YAML::BeginMap;
   out << YAML::Key << "model" << YAML::Value << "tricycle";
-  out << YAML::Key << "name" << YAML::Value << io::YamlText(robot_.name);
+  out << YAML::Key << "name" << YAML::Value << io::YamlText(robot.name);
   out << YAML::Key << "traction_wheel" << YAML::Value << YAML::Flow << YAML::BeginMap;
   if (traction_name != kDefaultTractionName) {
     out << YAML::Key << "name" << YAML::Value << traction_name;
@@ -128,19 +156,30 @@ std::string TricycleModel::RobotYaml(const std::vector<double>& p,
   out << YAML::Key << "radius_m" << YAML::Value << p[K::kRadiusIndex] << YAML::EndMap;
   out << YAML::Key << "wheelbase_m" << YAML::Value << p[K::kWheelbaseIndex];
   out << YAML::Key << "steering_offset_deg" << YAML::Value << RadToDeg(p[K::kSteeringOffsetIndex]);
+  if (with_gain) {
+    out << YAML::Key << kGainKey << YAML::Value << p[TricycleGainKinematics::kSteeringGainIndex];
+  }
   out << YAML::Key << "bounds" << YAML::Value << YAML::BeginMap;
-  io::EmitBoundsPair(out, "radius_m", robot_.bounds[K::kRadiusIndex], 1.0);
-  io::EmitBoundsPair(out, "wheelbase_m", robot_.bounds[K::kWheelbaseIndex], 1.0);
-  io::EmitBoundsPair(out, "steering_offset_deg", robot_.bounds[K::kSteeringOffsetIndex],
+  io::EmitBoundsPair(out, "radius_m", robot.bounds[K::kRadiusIndex], 1.0);
+  io::EmitBoundsPair(out, "wheelbase_m", robot.bounds[K::kWheelbaseIndex], 1.0);
+  io::EmitBoundsPair(out, "steering_offset_deg", robot.bounds[K::kSteeringOffsetIndex],
                      180.0 / M_PI);
+  if (with_gain) {
+    io::EmitBoundsPair(out, kGainKey, robot.bounds[TricycleGainKinematics::kSteeringGainIndex],
+                       1.0);
+  }
   out << YAML::EndMap;
-  io::EmitEncoderAndEffects(out, robot_, effects);
+  io::EmitEncoderAndEffects(out, robot, effects);
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n" + calibration_block;
 }
 
-void TricycleModel::CheckSamples(const EncoderLog& log, const std::string& path) const {
+template <bool kHasGain>
+void TricycleModelT<kHasGain>::CheckSamples(const EncoderLog& log, const std::string& path) const {
   tricycle::CheckSteeringSamples(log, path);
 }
+
+template class TricycleModelT<false>;
+template class TricycleModelT<true>;
 
 }  // namespace fitcal

@@ -5,7 +5,9 @@
 //   name: forklift_3
 //   traction_wheel: {radius_m: 0.0325}      # optional `name:` (default "traction")
 //   wheelbase_m: 0.15                        # traction wheel to the rear axle's centre
-//   steering_offset_deg: 0.0                 # true steering = measured + offset
+//   steering_offset_deg: 0.0                 # true steering = gain x measured + offset
+//   steering_gain: 1.0                       # optional: a fourth parameter (bounds key
+//                                            # steering_gain, default [gain / 10, gain x 10])
 //   bounds: {radius_m: [lo, hi], wheelbase_m: [lo, hi], steering_offset_deg: [lo, hi]}
 //   encoder: {ticks_per_rev: 1600, cumulative: false}   # optional, for the traction ticks
 //   effects: [...]                           # optional (io/robot_yaml_blocks.h)
@@ -25,14 +27,24 @@
 
 namespace fitcal {
 
-class TricycleModel : public KinematicModel<TricycleKinematics> {
+// The calibrated YAML of either kind (tricycle_model.cc).
+std::string TricycleRobotYaml(const Robot& robot, const std::vector<double>& p,
+                              const std::vector<effects::EffectValue>& effects,
+                              const std::string& calibration_block);
+
+// kHasGain: the robot YAML declares `steering_gain` (TricycleKinematicsT).
+template <bool kHasGain>
+class TricycleModelT : public KinematicModel<TricycleKinematicsT<kHasGain>> {
  public:
-  explicit TricycleModel(Robot robot) : KinematicModel(std::move(robot)) {}
+  explicit TricycleModelT(Robot robot)
+      : KinematicModel<TricycleKinematicsT<kHasGain>>(std::move(robot)) {}
 
   using RobotModelInterface::RobotYaml;
   std::string RobotYaml(const std::vector<double>& p,
                         const std::vector<effects::EffectValue>& effects,
-                        const std::string& calibration_block) const override;
+                        const std::string& calibration_block) const override {
+    return TricycleRobotYaml(this->robot_, p, effects, calibration_block);
+  }
 
   // The loader's hook for model-specific checks of a log (proposed as a virtual of
   // RobotModelInterface): the steering channel is present, in [-pi, pi] and not ticks
@@ -40,10 +52,14 @@ class TricycleModel : public KinematicModel<TricycleKinematics> {
   void CheckSamples(const EncoderLog& log, const std::string& path) const;
 };
 
+using TricycleModel = TricycleModelT<false>;
+using TricycleGainModel = TricycleModelT<true>;
+
 // The generic description of a tricycle: channels (traction `w_<name>`/`ticks_<name>`, steering
-// `steering`) and parameters r_<name>, wheelbase, steering_offset in TricycleKinematics order;
-// nominal and bounds empty.
-Robot TricycleRobotDescription(const std::string& name, const std::string& traction_name);
+// `steering`) and parameters r_<name>, wheelbase, steering_offset (and steering_gain with
+// `with_gain`) in TricycleKinematicsT order; nominal and bounds empty.
+Robot TricycleRobotDescription(const std::string& name, const std::string& traction_name,
+                               bool with_gain = false);
 
 // The OptiOdom tricycle's nominal robot (data sheet values, tools/optiodom_robots.cc).
 inline constexpr const char* kTricycleExampleYaml = R"(model: tricycle
