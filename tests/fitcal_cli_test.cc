@@ -155,7 +155,18 @@ TEST(FitcalCli, ReportValidatesOnAnyDataSetWithAVerdict) {
           .exit_code,
       0);
   const std::string cal = dir.Path("cal.yaml");
-  ASSERT_EQ(RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --out " + cal).exit_code, 0);
+  // This seed's single training repetition puts R_a on its bound: refused (exit 5, nothing
+  // written, the parameter and its bounds named) unless the user says the bounds were widened on
+  // purpose (issue 39 item 5).
+  const auto at_bound = RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --out " + cal);
+  EXPECT_EQ(at_bound.exit_code, 5) << at_bound.out << at_bound.err;
+  EXPECT_NE(at_bound.err.find("R_a"), std::string::npos) << at_bound.err;
+  EXPECT_NE(at_bound.err.find("--bounds-widened"), std::string::npos) << at_bound.err;
+  EXPECT_FALSE(std::filesystem::exists(cal));
+  ASSERT_EQ(
+      RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --bounds-widened --out " + cal)
+          .exit_code,
+      0);
   const YAML::Node block = YAML::LoadFile(cal)["calibration"];
   EXPECT_EQ(block["training_run_ids"].size(), 36u);
   EXPECT_EQ(block["training_fingerprint"].as<std::string>().size(), 16u);
