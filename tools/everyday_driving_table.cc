@@ -22,12 +22,15 @@ void PrintEverydayDrivingTable(const RobotModelInterface& model,
   for (const std::string& row : EverydayDrivingRows(before, after))
     std::printf("%s\n", row.c_str());
   if (!judge) return;
-  const std::vector<std::string> worse =
-      NeverWorseRefusals("the calibration", JudgeNeverWorse(runs, before, after));
+  const std::vector<NeverWorseJudgement> judged = JudgeNeverWorse(runs, before, after);
+  const std::vector<std::string> worse = NeverWorseRefusals("the calibration", judged);
   if (worse.empty()) {
     std::printf("  never worse than the nominal beyond the runs' scatter (docs/never_worse.md)\n");
   }
   for (const std::string& line : worse) std::printf("  refused as fit would: %s\n", line.c_str());
+  for (const std::string& line : NeverWorseRefusals("the calibration", judged, false)) {
+    std::printf("  warning: %s\n", line.c_str());
+  }
 }
 
 }  // namespace fitcal::tools

@@ -617,10 +617,14 @@ bool WorseThanNominalBeyondNoise(const RobotModelInterface& model, const std::ve
                                  const std::vector<CalibrationCandidate>& candidates,
                                  const GateDecision& gate, const RunSplit& split, int threads) {
   if (!gate.judged_on_held_out || gate.selected == 0) return false;
-  const std::vector<std::string> refusals = NeverWorseRefusals(
-      candidates[gate.selected].name,
+  const std::vector<NeverWorseJudgement> judged =
       JudgeCalibrationNeverWorse(model, candidates[0], candidates[gate.selected], split.validation,
-                                 TracksOf(logs, split.validation), threads));
+                                 TracksOf(logs, split.validation), threads);
+  const std::string& name = candidates[gate.selected].name;
+  for (const std::string& line : NeverWorseRefusals(name, judged, /*refusing=*/false)) {
+    std::printf("warning: %s\n", line.c_str());
+  }
+  const std::vector<std::string> refusals = NeverWorseRefusals(name, judged);
   for (const std::string& line : refusals) std::cerr << "fitcal: " << line << "; nothing written\n";
   return !refusals.empty();
 }

@@ -47,7 +47,7 @@ std::vector<int> TimeBlockCounts(int num_blocks) {
 
 bool HalvesJudgement::NoMeasureWorse() const {
   return std::none_of(never_worse.begin(), never_worse.end(),
-                      [](const NeverWorseJudgement& n) { return n.Worse(); });
+                      [](const NeverWorseJudgement& n) { return n.Refuses(); });
 }
 
 namespace {
