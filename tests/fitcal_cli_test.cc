@@ -69,7 +69,7 @@ TEST(FitcalCli, FitStoppedAtTheIterationLimitIsWrittenAndFlagged) {
   const std::string data = MakeDataset(dir);
   const std::string out = dir.Path("cut.yaml");
   const Result r =
-      RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --max-iterations 1 --out " + out);
+      RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --max-iterations 1 --bounds-widened --out " + out);
   EXPECT_EQ(r.exit_code, 6) << r.out << r.err;
   EXPECT_EQ(Lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find("iteration limit"), std::string::npos) << r.err;

@@ -95,7 +95,7 @@ TEST(GateCli, TheTimeBlockVerdictDoesNotFlipWithTheCount) {
   for (const char* count : {"2", "4", "8"}) {
     const auto r =
         RunFitcal(dir, "fit --logs " + data + " --no-output --time-blocks " + std::string(count));
-    const std::size_t at = r.out.find("judged on held-out time blocks");
+    const std::size_t at = r.out.find("no held-out runs: judged on held-out time blocks");
     ASSERT_NE(at, std::string::npos) << r.out << r.err;
     const std::string line = r.out.substr(at, r.out.find('\n', at) - at);
     if (exit_code < 0) {
@@ -105,6 +105,7 @@ TEST(GateCli, TheTimeBlockVerdictDoesNotFlipWithTheCount) {
     EXPECT_EQ(r.exit_code, exit_code) << count << "\n" << r.out << r.err;
     EXPECT_EQ(line, judged) << count;
     EXPECT_TRUE(Has(line, "2, 4, 8 blocks")) << line;
+    EXPECT_TRUE(Has(line, "of 3 counts")) << line;
   }
   EXPECT_EQ(exit_code, 0);  // the simulated run calibrates
 }

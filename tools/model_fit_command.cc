@@ -664,13 +664,18 @@ bool ReportHalves(const HalvesJudgement& j) {
               HalvesDescription(j).c_str());
   if (j.Beats()) return true;
   const std::string half = j.by_time ? "the run's time" : "the training runs";
-  if (!(j.calibrated_cf < j.nominal_cf)) {
-    std::cerr << "fitcal: fitted on half of " << half
-              << ", the calibration does not beat the nominal on the other half (CF "
-              << j.nominal_cf << " -> " << j.calibrated_cf << ")\n";
-  }
-  for (const std::string& line : NeverWorseRefusals("the fit of one half", j.never_worse)) {
-    std::cerr << "fitcal: " << line << "\n";
+  for (const HalvesGroup& g : j.groups) {
+    if (g.Beats()) continue;
+    const std::string which =
+        g.block_count > 0 ? " (" + std::to_string(g.block_count) + " blocks)" : "";
+    if (!(g.calibrated_cf < g.nominal_cf)) {
+      std::cerr << "fitcal: fitted on half of " << half << which
+                << ", the calibration does not beat the nominal on the other half (CF "
+                << g.nominal_cf << " -> " << g.calibrated_cf << ")\n";
+    }
+    for (const std::string& line : NeverWorseRefusals("the fit of one half" + which, g.never_worse)) {
+      std::cerr << "fitcal: " << line << "\n";
+    }
   }
   std::cerr << "fitcal: the runs do not determine the parameters; record more driving; nothing "
                "written\n";

@@ -45,9 +45,16 @@ std::vector<int> TimeBlockCounts(int num_blocks) {
   return {counts.begin(), counts.end()};
 }
 
-bool HalvesJudgement::NoMeasureWorse() const {
-  return std::none_of(never_worse.begin(), never_worse.end(),
+bool HalvesGroup::Beats() const {
+  return calibrated_cf < nominal_cf &&
+         std::none_of(never_worse.begin(), never_worse.end(),
                       [](const NeverWorseJudgement& n) { return n.Refuses(); });
+}
+
+bool HalvesJudgement::Beats() const {
+  int beat = 0;
+  for (const HalvesGroup& g : groups) beat += g.Beats() ? 1 : 0;
+  return judged && 2 * beat > static_cast<int>(groups.size());
 }
 
 namespace {
@@ -109,21 +116,37 @@ HalvesJudgement JudgeOnHeldOutHalves(const RunSplit& split, const std::vector<Ru
   if (!split.validation.empty() || split.training.empty()) return j;
   j.by_time = split.training.size() <= kMaxRunsForTimeBlocks;
   if (j.by_time && residuals == ResidualKind::kFinalPose) return j;
-  if (j.by_time) j.block_counts = TimeBlockCounts(num_blocks);
-  EverydayDrivingMetrics nominal_all, calibrated_all;
-  std::vector<AlignedRun> held_out;
-  for (const HalvesFold& half : Folds(split, logs, j.block_counts)) {
-    if (half.split.training.empty() || half.split.validation.empty()) return j;
-    const std::optional<std::vector<double>> fitted = fit_on(half);
-    if (!fitted) return j;
-    AppendRuns(score(nominal, half), &nominal_all);
-    AppendRuns(score(*fitted, half), &calibrated_all);
-    held_out.insert(held_out.end(), half.split.validation.begin(), half.split.validation.end());
+  // One group of folds per block count (one group, the halves of the runs, otherwise).
+  std::vector<std::vector<int>> groups = {{}};
+  if (j.by_time) {
+    j.block_counts = TimeBlockCounts(num_blocks);
+    groups.clear();
+    for (int count : j.block_counts) groups.push_back({count});
   }
-  j.judged = !held_out.empty();
-  j.nominal_cf = MeanOf(nominal_all.per_run_cf);
-  j.calibrated_cf = MeanOf(calibrated_all.per_run_cf);
-  j.never_worse = JudgeNeverWorse(held_out, nominal_all, calibrated_all);
+  for (const std::vector<int>& group : groups) {
+    EverydayDrivingMetrics nominal_all, calibrated_all;
+    std::vector<AlignedRun> held_out;
+    for (const HalvesFold& half : Folds(split, logs, group)) {
+      if (half.split.training.empty() || half.split.validation.empty()) return j;
+      const std::optional<std::vector<double>> fitted = fit_on(half);
+      if (!fitted) return j;
+      AppendRuns(score(nominal, half), &nominal_all);
+      AppendRuns(score(*fitted, half), &calibrated_all);
+      held_out.insert(held_out.end(), half.split.validation.begin(), half.split.validation.end());
+    }
+    HalvesGroup g;
+    g.block_count = group.empty() ? 0 : group.front();
+    g.nominal_cf = MeanOf(nominal_all.per_run_cf);
+    g.calibrated_cf = MeanOf(calibrated_all.per_run_cf);
+    g.never_worse = JudgeNeverWorse(held_out, nominal_all, calibrated_all);
+    j.groups.push_back(std::move(g));
+  }
+  j.judged = true;
+  // The counts weigh alike: the mean of their means.
+  for (const HalvesGroup& g : j.groups) {
+    j.nominal_cf += g.nominal_cf / static_cast<double>(j.groups.size());
+    j.calibrated_cf += g.calibrated_cf / static_cast<double>(j.groups.size());
+  }
   return j;
 }
 
@@ -136,8 +159,12 @@ std::string HalvesDescription(const HalvesJudgement& j) {
   }
   std::string counts;
   for (int c : j.block_counts) counts += (counts.empty() ? "" : ", ") + std::to_string(c);
+  int beat = 0;
+  for (const HalvesGroup& g : j.groups) beat += g.Beats() ? 1 : 0;
   return "held-out time blocks of the training runs (two folds each of " + counts +
-         " blocks of equal path, odd against even, pooled; " + cf + ")";
+         " blocks of equal path, odd against even; the fits beat the nominal for " +
+         std::to_string(beat) + " of " + std::to_string(j.groups.size()) +
+         " counts; mean over the counts " + cf + ")";
 }
 
 }  // namespace fitcal
