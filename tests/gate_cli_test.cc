@@ -95,7 +95,7 @@ TEST(GateCli, TheTimeBlockVerdictDoesNotFlipWithTheCount) {
   for (const char* count : {"2", "4", "8"}) {
     const auto r =
         RunFitcal(dir, "fit --logs " + data + " --no-output --time-blocks " + std::string(count));
-    const std::size_t at = r.out.find("no held-out runs: judged on held-out time blocks");
+    const std::size_t at = r.out.find("judged on held-out time blocks of the training runs");
     ASSERT_NE(at, std::string::npos) << r.out << r.err;
     const std::string line = r.out.substr(at, r.out.find('\n', at) - at);
     if (exit_code < 0) {
