@@ -45,6 +45,27 @@ GateDecision SelectCalibration(const RobotModelInterface& model,
   return decision;
 }
 
+std::string AtBoundRefusal(const Robot& robot, const std::string& name,
+                           const std::vector<double>& parameters,
+                           const std::vector<bool>& at_bound) {
+  std::string which;
+  for (int k = 0; k < robot.NumParameters() && k < static_cast<int>(at_bound.size()); ++k) {
+    if (!at_bound[k]) continue;
+    const ParameterInfo& info = robot.parameters[k];
+    const double s = info.DisplayScale();
+    char text[200];
+    std::snprintf(text, sizeof text, "%s%s %.6g %s in [%.6g, %.6g]", which.empty() ? "" : ", ",
+                  info.name.c_str(), s * parameters[k], info.DisplayUnit(), s * robot.bounds[k].lo,
+                  s * robot.bounds[k].hi);
+    which += text;
+  }
+  if (which.empty()) return "";
+  return "'" + name + "' leaves a parameter on its bound (" + which +
+         "): the model may be absorbing an effect it does not contain, or the bounds are too "
+         "tight; widen them under `bounds:` in the robot YAML and fit again (--bounds-widened "
+         "writes a calibration that still ends on a widened bound)";
+}
+
 std::vector<std::string> GateLines(const std::vector<CalibrationCandidate>& candidates,
                                    const GateDecision& decision) {
   std::vector<std::string> out;

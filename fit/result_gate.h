@@ -45,6 +45,16 @@ GateDecision SelectCalibration(const RobotModelInterface& model,
                                const std::vector<AlignedRun>& validation, int num_threads = 0,
                                const EffectCandidateCf& effect_cf = {});
 
+// A calibration with a parameter on a bound of the robot's box (at_bound, robot().parameters
+// order) is not written unless the user says the bounds were widened on purpose (`fit
+// --bounds-widened`): the data pushed the value as far as the box allows, so the model absorbs an
+// effect it lacks or the box is too tight (issue 39: a traction radius and a steering offset on
+// their bounds, written with exit 0, drifted 3 % per metre worse). Empty when no parameter is on a
+// bound; else the reason, naming each parameter with its value and bounds.
+std::string AtBoundRefusal(const Robot& robot, const std::string& name,
+                           const std::vector<double>& parameters,
+                           const std::vector<bool>& at_bound);
+
 // One line per candidate for the terminal: name, CF, change against nominal, and which won.
 std::vector<std::string> GateLines(const std::vector<CalibrationCandidate>& candidates,
                                    const GateDecision& decision);

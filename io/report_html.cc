@@ -93,11 +93,15 @@ void HtmlKeyNumbers(std::ostringstream& h, const ReportData& d) {
     << " &rarr; " << Fmt("%.1f mm", 1e3 * all.after.rms_distance_m) << "</b> ("
     << ChangePercentText(all.before.rms_distance_m, all.after.rms_distance_m) << ")</li>\n";
   for (const ReportDriftRow& r : d.drift) {
-    h << "<li>drift over " << Fmt("%g m", r.length_m) << ": <b>"
-      << Fmt("%.2f", r.before_translation_percent) << " &rarr; "
-      << Fmt("%.2f %%", r.after_translation_percent) << "</b>, "
+    // Coloured and said like the runs that got worse (issue 42: a worse 0.5 m drift went unmarked).
+    const bool drift_worse = r.after_translation_percent > r.before_translation_percent ||
+                             r.after_rotation_rad_per_m > r.before_rotation_rad_per_m;
+    h << "<li" << (drift_worse ? " class=\"worse\"" : "") << ">drift over "
+      << Fmt("%g m", r.length_m) << ": <b>" << Fmt("%.2f", r.before_translation_percent)
+      << " &rarr; " << Fmt("%.2f %%", r.after_translation_percent) << "</b>, "
       << Fmt("%.3f", kDeg * r.before_rotation_rad_per_m) << " &rarr; "
-      << Fmt("%.3f deg/m", kDeg * r.after_rotation_rad_per_m) << "</li>\n";
+      << Fmt("%.3f deg/m", kDeg * r.after_rotation_rad_per_m) << (drift_worse ? " (worse)" : "")
+      << "</li>\n";
   }
   h << "<li" << (worse > 0 ? " class=\"worse\"" : "") << ">held-out runs that got worse: " << worse
     << " of " << d.runs.size() << (worse > 0 ? " (<a href=\"#worse\">list</a>)" : "")

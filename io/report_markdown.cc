@@ -103,10 +103,17 @@ void MdDrift(std::ostringstream& m, const ReportData& d) {
                                            "rotation before [deg/m]", "after [deg/m]"};
   m << MdRow(header) << MdRule(header.size(), 0);
   for (const ReportDriftRow& r : d.drift) {
+    // A drift that rose is flagged like a run that got worse: short windows show a wrong
+    // calibration first (issue 42: 0.5 m, 0.71 -> 0.86 %, went unmarked).
+    const auto flagged = [](double before, double after, const char* format) {
+      return Fmt(format, after) + (after > before ? " (worse)" : "");
+    };
     m << MdRow({Fmt("%g", r.length_m), std::to_string(r.windows),
-                Fmt("%.2f", r.before_translation_percent), Fmt("%.2f", r.after_translation_percent),
+                Fmt("%.2f", r.before_translation_percent),
+                flagged(r.before_translation_percent, r.after_translation_percent, "%.2f"),
                 Fmt("%.3f", kDeg * r.before_rotation_rad_per_m),
-                Fmt("%.3f", kDeg * r.after_rotation_rad_per_m)});
+                flagged(kDeg * r.before_rotation_rad_per_m, kDeg * r.after_rotation_rad_per_m,
+                        "%.3f")});
   }
   m << "\n";
   const std::vector<std::string> bias = {"signed mean final error", "x [mm]", "y [mm]",

@@ -40,7 +40,10 @@ TEST(FitcalCli, FitsWritesAndReadsBackTheCalibration) {
   TempDir dir;
   const std::string data = MakeDataset(dir);
   const std::string out = dir.Path("calibrated.yaml");
-  const Result r = RunFitcal(dir, "--logs " + data + " --method ceres --train-reps 1 --out " + out);
+  // One training repetition of this seed puts R_a on its bound (0.22 m, the truth 0.2186 m): the
+  // bounds are as the user meant them here.
+  const Result r = RunFitcal(
+      dir, "--logs " + data + " --method ceres --train-reps 1 --bounds-widened --out " + out);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("validation"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("CONVERGENCE"), std::string::npos) << r.out;
@@ -53,7 +56,7 @@ TEST(FitcalCli, FitsWritesAndReadsBackTheCalibration) {
     EXPECT_NE(yaml.find(key), std::string::npos) << key;
   }
   // `fitcal fit` is the same command.
-  const Result again = RunFitcal(dir, "fit --logs " + data + " --no-output");
+  const Result again = RunFitcal(dir, "fit --logs " + data + " --no-output --bounds-widened");
   EXPECT_EQ(again.exit_code, 0) << again.err;
 }
 
@@ -66,13 +69,14 @@ TEST(FitcalCli, FitStoppedAtTheIterationLimitIsWrittenAndFlagged) {
   const std::string data = MakeDataset(dir);
   const std::string out = dir.Path("cut.yaml");
   const Result r =
-      RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --max-iterations 1 --out " + out);
+      RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --max-iterations 1 --bounds-widened --out " + out);
   EXPECT_EQ(r.exit_code, 6) << r.out << r.err;
   EXPECT_EQ(Lines(r.err), 1) << r.err;
   EXPECT_NE(r.err.find("iteration limit"), std::string::npos) << r.err;
   EXPECT_NE(ReadFileBytes(out).find("termination: NO_CONVERGENCE"), std::string::npos);
   // Converged, the same command exits 0.
-  const Result full = RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --no-output");
+  const Result full =
+      RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --no-output --bounds-widened");
   EXPECT_EQ(full.exit_code, 0) << full.err;
 
   const std::string diff = dir.Path("diff");
@@ -122,7 +126,10 @@ TEST(FitcalCli, RecordedCfIsTheOneReportMeasures) {
   TempDir dir;
   const std::string data = MakeDataset(dir);
   const std::string cal = dir.Path("cal.yaml");
-  ASSERT_EQ(RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --out " + cal).exit_code, 0);
+  ASSERT_EQ(
+      RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --bounds-widened --out " + cal)
+          .exit_code,
+      0);
   const std::string report = dir.Path("report");
   const Result r =
       RunFitcal(dir, "report --logs " + data + " --calibration " + cal + " --out " + report);
@@ -155,7 +162,18 @@ TEST(FitcalCli, ReportValidatesOnAnyDataSetWithAVerdict) {
           .exit_code,
       0);
   const std::string cal = dir.Path("cal.yaml");
-  ASSERT_EQ(RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --out " + cal).exit_code, 0);
+  // This seed's single training repetition puts R_a on its bound: refused (exit 5, nothing
+  // written, the parameter and its bounds named) unless the user says the bounds were widened on
+  // purpose (issue 39 item 5).
+  const auto at_bound = RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --out " + cal);
+  EXPECT_EQ(at_bound.exit_code, 5) << at_bound.out << at_bound.err;
+  EXPECT_NE(at_bound.err.find("R_a"), std::string::npos) << at_bound.err;
+  EXPECT_NE(at_bound.err.find("--bounds-widened"), std::string::npos) << at_bound.err;
+  EXPECT_FALSE(std::filesystem::exists(cal));
+  ASSERT_EQ(
+      RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --bounds-widened --out " + cal)
+          .exit_code,
+      0);
   const YAML::Node block = YAML::LoadFile(cal)["calibration"];
   EXPECT_EQ(block["training_run_ids"].size(), 36u);
   EXPECT_EQ(block["training_fingerprint"].as<std::string>().size(), 16u);

@@ -29,6 +29,7 @@
 #include "tools/miswired_error.h"
 #include "tools/output_guard.h"
 #include "tools/report_command.h"
+#include "validation/never_worse.h"
 #include "validation/propagated_uncertainty.h"
 #include "validation/training_runs.h"
 #include "validation/trajectory_metrics.h"
@@ -161,6 +162,27 @@ DiagnoseChoice GateDiagnosis(const RobotModelInterface& model, const DiagnoseSpl
   candidates[best].cf_training_after = cf_training(candidates[best]);
   *gate = candidates;
   return candidates[best];
+}
+
+// The chosen calibration beats the nominal on the held-out runs as a whole; it must not be worse
+// on a kind of run, in drift or ATE beyond the runs' scatter either (validation/never_worse.h,
+// the rule fit applies). True after one line per such measure on stderr.
+bool WorseThanNominalBeyondNoise(const RobotModelInterface& model, const DiagnoseSplit& split,
+                                 const DiagnoseChoice& nominal, const DiagnoseChoice& choice,
+                                 int threads) {
+  std::vector<AlignedRun> runs;
+  std::vector<const GroundTruthTrack*> tracks;
+  for (const TrackRun& r : split.validation) {
+    runs.push_back(r.aligned);
+    tracks.push_back(&r.track);
+  }
+  const std::vector<std::string> refusals = NeverWorseRefusals(
+      choice.name, JudgeCalibrationNeverWorse(
+                       model, {nominal.name, nominal.parameters, true, nominal.effects},
+                       {choice.name, choice.parameters, true, choice.effects}, runs, tracks,
+                       threads));
+  for (const std::string& line : refusals) std::cerr << "fitcal: " << line << "; nothing written\n";
+  return !refusals.empty();
 }
 
 // A written calibration never carries sigma: null. When the fit that made the chosen parameters
@@ -487,6 +509,9 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
     if (choice.name == "nominal") {
       std::cerr << "fitcal: no calibration beats the nominal robot on the held-out runs; nothing "
                    "written\n";
+      return 5;
+    }
+    if (WorseThanNominalBeyondNoise(*model, split, gate.front(), choice, options.threads)) {
       return 5;
     }
     if (!WithUncertainty(*model, split, &choice)) return 1;

@@ -21,11 +21,14 @@ struct EverydayDrivingColumn {
 };
 
 // Prints "\n  <title>  nominal  calibrated  change" and one row per measure. tracks[i] is the
-// ground truth of runs[i].
+// ground truth of runs[i]. With `judge`, then the never-worse judgement of the calibration on
+// these runs (validation/never_worse.h, the rule fit, diagnose and export refuse by): one line
+// when it passes, one per measure that is worse beyond the runs' scatter.
 void PrintEverydayDrivingTable(const RobotModelInterface& model,
                                const std::vector<AlignedRun>& runs,
                                const std::vector<const GroundTruthTrack*>& tracks,
                                const std::string& title, const EverydayDrivingColumn& nominal,
-                               const EverydayDrivingColumn& calibrated, int threads);
+                               const EverydayDrivingColumn& calibrated, int threads,
+                               bool judge = false);
 
 }  // namespace fitcal::tools

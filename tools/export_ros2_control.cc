@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <numeric>
 #include <optional>
 #include <set>
@@ -28,6 +29,8 @@
 #include "tools/command_failure.h"
 #include "tools/dataset_command.h"
 #include "tools/output_guard.h"
+#include "validation/everyday_driving.h"
+#include "validation/never_worse.h"
 #include "validation/odometry_covariance.h"
 #include "validation/training_runs.h"
 
@@ -569,8 +572,30 @@ struct Replay {
   std::string which;
   double cf_nominal = 0.0, cf_exact = 0.0, cf_exported = 0.0;
   OdometryCovariance exported_covariance, exact_covariance;
-  bool Worse() const { return cf_exported > cf_nominal; }
+  // The exported parameters worse than the nominal on a kind of run, in drift or ATE, beyond the
+  // runs' scatter (validation/never_worse.h, the rule fit applies): one line each.
+  std::vector<std::string> worse_beyond_noise;
+  bool Worse() const { return cf_exported > cf_nominal || !worse_beyond_noise.empty(); }
 };
+
+// The never-worse judgement of the exported parameters against the nominal robot on `runs`.
+std::vector<std::string> WorseBeyondNoise(const RobotModelInterface& nominal,
+                                          const Ros2ControlExport& exported,
+                                          const std::vector<AlignedRun>& runs,
+                                          const std::vector<RunLog>& logs) {
+  std::map<std::string, const GroundTruthTrack*> track_of;
+  for (const RunLog& log : logs) track_of[log.id] = &log.ground_truth;
+  std::vector<const GroundTruthTrack*> tracks;
+  for (const AlignedRun& run : runs) tracks.push_back(track_of.at(run.id));
+  const std::vector<double> lengths = EverydayDriftLengths();
+  return NeverWorseRefusals(
+      "the exported parameters",
+      JudgeNeverWorse(runs,
+                      EvaluateEverydayDriving(nominal, nominal.robot().nominal, {}, runs, tracks,
+                                              lengths),
+                      EvaluateEverydayDriving(*exported.model, exported.parameters, {}, runs,
+                                              tracks, lengths)));
+}
 
 // `exact` is the calibration as read, `exported` what the controller computes from the export;
 // the data set is read once.
@@ -590,6 +615,7 @@ Replay ReplayOnHeldOutRuns(const ExportRos2ControlOptions& o, const RobotModelPt
   r.cf_nominal = EvaluateFinalPoseErrors(*nominal, nominal->robot().nominal, runs).cf;
   r.cf_exact = EvaluateFinalPoseErrors(*exact, exact->robot().nominal, runs).cf;
   r.cf_exported = EvaluateFinalPoseErrors(*exported.model, exported.parameters, runs).cf;
+  r.worse_beyond_noise = WorseBeyondNoise(*nominal, exported, runs, logs);
   const auto covariance = [&](const RobotModelInterface& model, const std::vector<double>& p) {
     return EstimateOdometryCovariance(model, p, logs, o.publish_period_s);
   };
@@ -751,14 +777,18 @@ void AddReplay(const ExportRos2ControlOptions& o, const RobotModelPtr& exact,
   if (!o.out.empty()) std::printf("%s\n", line.c_str());
   if (replay.Worse() && !o.allow_worse) {
     char text_worse[300];
-    std::snprintf(text_worse, sizeof text_worse,
-                  "these parameters replay worse than the nominal robot (CF %.6f > %.6f on "
-                  "%zu runs); nothing written (--allow-worse writes them%s)",
-                  replay.cf_exported, replay.cf_nominal, replay.runs,
-                  e.notes.empty() ? ""
-                                  : ", with notes on what the controller leaves out: "
-                                    "apply that first, e.g. a steering offset");
-    throw WorseThanNominalError(text_worse);
+    std::snprintf(text_worse, sizeof text_worse, "CF %.6f > %.6f on %zu runs",
+                  replay.cf_exported, replay.cf_nominal, replay.runs);
+    const std::string what = replay.cf_exported > replay.cf_nominal
+                                 ? std::string(text_worse)
+                                 : replay.worse_beyond_noise.front();
+    throw WorseThanNominalError("these parameters replay worse than the nominal robot (" + what +
+                                "); nothing written (--allow-worse writes them" +
+                                (e.notes.empty() ? ""
+                                                 : ", with notes on what the controller leaves "
+                                                   "out: apply that first, e.g. a steering "
+                                                   "offset") +
+                                ")");
   }
   *text += "# " + line + "\n";
   const std::string covariance = CovarianceLine(replay.exported_covariance);

@@ -32,10 +32,13 @@ void AddFitOptions(CLI::App& app, FitCommandOptions& o) {
   app.add_option("--time-blocks", o.time_blocks,
                  "With one or two runs fitted on their tracks and none held out, judge on time: "
                  "cut each into this many blocks of equal path, fit the odd blocks and judge on "
-                 "the even ones and back; the whole runs' fit is written only when that beats "
-                 "the nominal")
+                 "the even ones and back, pooled with 2, 4 and 8 blocks; the whole runs' fit is "
+                 "written only when that beats the nominal")
       ->capture_default_str()
       ->check(CLI::Range(2, 100));
+  app.add_flag("--bounds-widened", o.bounds_widened,
+               "Write a calibration even when a parameter ends on its bound (after widening the "
+               "robot YAML's bounds on purpose); without it such a fit is refused (exit 5)");
   app.add_flag("--skip-wheel-order-check", o.skip_wheel_order_check,
                "Fit even if another encoder column order/sign explains the data far better");
   app.add_option("--effects", o.effects,

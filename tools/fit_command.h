@@ -31,6 +31,9 @@ struct FitCommandOptions : DatasetCommandOptions, SolverOptions, TyingFlags {
   // runs; measured on the OptiOdom free runs, half a run calibrates worse,
   // docs/everyday_driving.md).
   int time_blocks = 4;
+  // Write a calibration with a parameter on its bound (fit/result_gate.h AtBoundRefusal): the user
+  // widened the bounds on purpose and accepts a value that still ends on one.
+  bool bounds_widened = false;
 };
 
 // Declares every flag of `fit` on `app` (the `fit` subcommand, and the top level: `fitcal --logs

@@ -29,8 +29,8 @@
 #include "tools/fit_methods.h"
 #include "tools/output_guard.h"
 #include "tools/tying_flags.h"
-#include "validation/held_out_families.h"
 #include "validation/held_out_halves.h"
+#include "validation/never_worse.h"
 #include "validation/propagated_uncertainty.h"
 #include "validation/rate_units.h"
 #include "validation/residual_dof.h"
@@ -625,22 +625,23 @@ std::vector<std::string> ChooseResidualsByTransfer(const FitCommandOptions& opti
   return ResidualKindJudgementLines(judgement);
 }
 
-// A calibration better than the nominal on the held-out runs as a whole may still be worse on one
-// kind of run (validation/held_out_families.h); it is then not written. True after one line per
-// such kind on stderr.
-bool WorseThanNominalOnSomeKind(const std::vector<CalibrationCandidate>& candidates,
-                                const GateDecision& gate, const RunSplit& split,
-                                const CandidateErrors& errors) {
-  bool worse = false;
-  for (const FamilyComparison& c :
-       CompareHeldOutFamiliesWithNominal(candidates, gate, split, errors.Cf())) {
-    if (!c.SelectedIsWorse()) continue;
-    std::cerr << "fitcal: '" << candidates[gate.selected].name << "' is worse than the nominal on "
-              << "the held-out '" << c.family << "' runs (" << c.runs << "): CF " << c.nominal_cf
-              << " -> " << c.selected_cf << "; nothing written\n";
-    worse = true;
+// A calibration better than the nominal on the held-out runs as a whole may still be worse on
+// one kind of run, or in drift or ATE, beyond the runs' own scatter (validation/never_worse.h);
+// it is then not written. True after one line per such measure on stderr.
+bool WorseThanNominalBeyondNoise(const RobotModelInterface& model, const std::vector<RunLog>& logs,
+                                 const std::vector<CalibrationCandidate>& candidates,
+                                 const GateDecision& gate, const RunSplit& split, int threads) {
+  if (!gate.judged_on_held_out || gate.selected == 0) return false;
+  const std::vector<NeverWorseJudgement> judged =
+      JudgeCalibrationNeverWorse(model, candidates[0], candidates[gate.selected], split.validation,
+                                 TracksOf(logs, split.validation), threads);
+  const std::string& name = candidates[gate.selected].name;
+  for (const std::string& line : NeverWorseRefusals(name, judged, /*refusing=*/false)) {
+    std::printf("warning: %s\n", line.c_str());
   }
-  return worse;
+  const std::vector<std::string> refusals = NeverWorseRefusals(name, judged);
+  for (const std::string& line : refusals) std::cerr << "fitcal: " << line << "; nothing written\n";
+  return !refusals.empty();
 }
 
 // With nothing held out, the two-fold judgement of validation/held_out_halves.h, each fold fitted
@@ -661,24 +662,37 @@ HalvesJudgement JudgeMethodOnHeldOutHalves(const FitCommandOptions& options,
     if (!(fit.usable || fit.stopped_early)) return std::nullopt;
     return fit.parameters;
   };
-  const CfOnRuns cf = [&](const std::vector<double>& p, const std::vector<AlignedRun>& runs) {
-    return EvaluateFinalPoseErrors(model, p, runs, options.threads).cf;
+  const MetricsOnFold score = [&](const std::vector<double>& p, const HalvesFold& fold) {
+    const std::vector<AlignedRun>& runs = fold.split.validation;
+    return EvaluateEverydayDriving(model, p, {}, runs, TracksOf(fold.logs, runs),
+                                   EverydayDriftLengths(), options.threads);
   };
   return fitcal::JudgeOnHeldOutHalves(split, logs, settings.residuals, options.time_blocks,
-                                      model.robot().nominal, fit_on, cf);
+                                      model.robot().nominal, fit_on, score);
 }
 
 // Prints the judgement; false (exit 5, nothing written) when the fits of one half do not beat the
-// nominal on the other.
-bool ReportHalves(const HalvesJudgement& j, int num_blocks) {
+// nominal on the other, or are worse in some measure beyond the noise.
+bool ReportHalves(const HalvesJudgement& j) {
   if (!j.judged) return true;
   std::printf("no held-out runs: judged on %s; the calibration written is fitted on all of them\n",
-              HalvesDescription(j, num_blocks).c_str());
+              HalvesDescription(j).c_str());
   if (j.Beats()) return true;
-  std::cerr << "fitcal: fitted on half of the " << (j.by_time ? "run's time" : "training runs")
-            << ", the calibration does not beat the nominal on the other half (CF " << j.nominal_cf
-            << " -> " << j.calibrated_cf
-            << "): the runs do not determine the parameters; record more driving; nothing "
+  const std::string half = j.by_time ? "the run's time" : "the training runs";
+  for (const HalvesGroup& g : j.groups) {
+    if (g.Beats()) continue;
+    const std::string which =
+        g.block_count > 0 ? " (" + std::to_string(g.block_count) + " blocks)" : "";
+    if (!(g.calibrated_cf < g.nominal_cf)) {
+      std::cerr << "fitcal: fitted on half of " << half << which
+                << ", the calibration does not beat the nominal on the other half (CF "
+                << g.nominal_cf << " -> " << g.calibrated_cf << ")\n";
+    }
+    for (const std::string& line : NeverWorseRefusals("the fit of one half" + which, g.never_worse)) {
+      std::cerr << "fitcal: " << line << "\n";
+    }
+  }
+  std::cerr << "fitcal: the runs do not determine the parameters; record more driving; nothing "
                "written\n";
   return false;
 }
@@ -916,9 +930,18 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
                      (halves.by_time ? "time blocks" : "halves") + ", below)";
   }
   if (!PrintGate(candidates, gate, effects_line)) return 5;
-  if (!ReportHalves(halves, options.time_blocks)) return 5;
-  if (halves.judged) gate.judged_on = HalvesDescription(halves, options.time_blocks);
-  if (WorseThanNominalOnSomeKind(candidates, gate, split, errors)) return 5;
+  if (!ReportHalves(halves)) return 5;
+  if (halves.judged) gate.judged_on = HalvesDescription(halves);
+  if (WorseThanNominalBeyondNoise(*model, logs, candidates, gate, split, options.threads)) return 5;
+  if (const std::string refusal =
+          AtBoundRefusal(robot, selected.name, selected.parameters, selected_fit.at_bound);
+      !refusal.empty() && gate.selected != 0) {
+    if (!options.bounds_widened) {
+      std::cerr << "fitcal: " << refusal << "; nothing written\n";
+      return 5;
+    }
+    std::printf("warning: %s; written as --bounds-widened asks\n", refusal.c_str());
+  }
   WarnOfEffects(candidates, gate, split, errors);
   if (!options.no_output) {
     io::CalibrationBlock record =

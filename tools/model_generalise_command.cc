@@ -202,7 +202,8 @@ void PrintEverydayDrivingOfSplit(const RobotModelInterface& model,
     PrintEverydayDrivingTable(
         model, held_out, tracks,
         scores.split.train_name + " -> " + scores.split.test_name + ": " + c.name,
-        {&nominal.parameters, &no_effects}, {&c.parameters, &no_effects}, threads);
+        {&nominal.parameters, &no_effects}, {&c.parameters, &no_effects}, threads,
+        /*judge=*/true);
   }
 }
 

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <stdexcept>
+#include <utility>
 
 #include "odometry/parallel_for.h"
 #include "odometry/text_format.h"
@@ -10,7 +11,7 @@
 
 namespace fitcal {
 
-std::vector<double> EverydayDriftLengths() { return {1.0, 2.0, 5.0}; }
+std::vector<double> EverydayDriftLengths() { return {0.5, 1.0, 2.0, 5.0}; }
 
 EverydayDrivingMetrics EvaluateEverydayDriving(const RobotModelInterface& model,
                                                const std::vector<double>& p,
@@ -31,6 +32,8 @@ EverydayDrivingMetrics EvaluateEverydayDriving(const RobotModelInterface& model,
   for (const TrajectoryErrors& e : per_run) {
     out.cf += e.cf;
     out.mean_ate_rmse_m += e.rms_distance_m;
+    out.per_run_cf.push_back(e.cf);
+    out.per_run_ate_m.push_back(e.rms_distance_m);
   }
   if (out.runs > 0) {
     out.cf /= out.runs;
@@ -38,11 +41,21 @@ EverydayDrivingMetrics EvaluateEverydayDriving(const RobotModelInterface& model,
   }
   for (double length : lengths_m) {
     RelativePoseErrorSum sum;
+    DriftAtLength drift;
     for (const TrajectoryErrors& e : per_run) {
-      AddRelativePoseErrors(e.ground_truth, e.odometry, length, &sum);
+      RelativePoseErrorSum run;
+      AddRelativePoseErrors(e.ground_truth, e.odometry, length, &run);
+      drift.per_run_translation_percent.push_back(run.MeanTranslationPercent());
+      drift.per_run_windows.push_back(run.windows);
+      sum.windows += run.windows;
+      sum.translation_ratio_sum += run.translation_ratio_sum;
+      sum.rotation_rad_per_m_sum += run.rotation_rad_per_m_sum;
     }
-    out.drift.push_back(
-        {length, sum.windows, sum.MeanTranslationPercent(), RadToDeg(sum.MeanRotationRadPerM())});
+    drift.length_m = length;
+    drift.windows = sum.windows;
+    drift.translation_percent = sum.MeanTranslationPercent();
+    drift.rotation_deg_per_m = RadToDeg(sum.MeanRotationRadPerM());
+    out.drift.push_back(std::move(drift));
   }
   return out;
 }

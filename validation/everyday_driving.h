@@ -24,6 +24,11 @@ struct DriftAtLength {
   int windows = 0;
   double translation_percent = 0.0;
   double rotation_deg_per_m = 0.0;
+  // Each run's own mean over its windows and its number of windows (0 for a run shorter than
+  // the window): the scatter between repetitions the never-worse judgement reads
+  // (validation/never_worse.h); translation_percent is their mean weighted by the windows.
+  std::vector<double> per_run_translation_percent = {};
+  std::vector<int> per_run_windows = {};
 };
 
 struct EverydayDrivingMetrics {
@@ -31,9 +36,12 @@ struct EverydayDrivingMetrics {
   double cf = 0.0;               // mean per-run Eq. 14 (m and rad)
   double mean_ate_rmse_m = 0.0;  // mean over runs of Eq. 12
   std::vector<DriftAtLength> drift;
+  std::vector<double> per_run_cf = {};     // in the order of the runs
+  std::vector<double> per_run_ate_m = {};  // each run's Eq. 12
 };
 
-// The lengths printed by default: 1, 2 and 5 m.
+// The lengths printed by default: 0.5 (the track residual's checkpoint spacing, where short-range
+// drift shows first), 1, 2 and 5 m.
 std::vector<double> EverydayDriftLengths();
 
 // tracks[i] is runs[i]'s ground truth. Runs shorter than a window add nothing to its drift.

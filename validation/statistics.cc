@@ -59,6 +59,16 @@ double StudentTUpperTail(double t, double df) {
   return t >= 0.0 ? 0.5 * two_sided : 1.0 - 0.5 * two_sided;
 }
 
+double StudentTUpperQuantile(double upper_tail, double df) {
+  // P(T > t) falls monotonically in t; 1e6 bounds every quantile used (df >= 1, tail >= 1e-6).
+  double lo = 0.0, hi = 1e6;
+  for (int i = 0; i < 200 && hi - lo > 1e-10 * hi; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (StudentTUpperTail(mid, df) > upper_tail ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
 double FUpperTail(double f, double d1, double d2) {
   if (!(f > 0.0)) return 1.0;
   return RegularizedIncompleteBeta(0.5 * d2, 0.5 * d1, d2 / (d2 + d1 * f));

@@ -12,6 +12,8 @@ namespace fitcal::stats {
 double RegularizedIncompleteBeta(double a, double b, double x);
 // P(T > t) for Student's t with df degrees of freedom.
 double StudentTUpperTail(double t, double df);
+// The t with P(T > t) = upper_tail (0 < upper_tail < 0.5), by bisection on StudentTUpperTail.
+double StudentTUpperQuantile(double upper_tail, double df);
 // P(F > f) for Fisher's F(d1, d2).
 double FUpperTail(double f, double d1, double d2);
 // Q(a, x) = Gamma(a, x) / Gamma(a), a > 0, x >= 0.
