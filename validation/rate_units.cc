@@ -14,11 +14,39 @@ namespace {
 constexpr double kTurnLengthM = 0.2;
 // Below this much ground-truth travel there is no evidence either way.
 constexpr double kMinEvidenceM = 0.5;
-constexpr std::size_t kChunk = 10;  // samples per replayed step of the path
 
 double StepLength(const Pose2d& a, const Pose2d& b) {
   return std::hypot(b.x - a.x, b.y - a.y) +
          kTurnLengthM * std::abs(std::remainder(b.theta - a.theta, 2.0 * M_PI));
+}
+
+// Both paths measured between the same instants: the window's start, every ground-truth sample
+// inside the window, and its end. A ground truth of start and end poses only measures the straight
+// line between them, and the odometry is then measured the same way (its pose at those instants),
+// so sparse ground truth is never mistaken for wheels that travel too far.
+void AddPathLengths(const RobotModelInterface& model, const RunLog& log, double* odometry_m,
+                    double* truth_m) {
+  const std::vector<double>& p = model.robot().nominal;
+  const AlignedRun run = AlignRun(log);
+  const GroundTruthTrack& gt = log.ground_truth;
+  Pose2d odometry = run.start, truth = run.start;
+  double t_s = run.t_start_s;
+  std::size_t k = 0;
+  const auto advance_to = [&](double instant_s, const Pose2d& truth_there) {
+    const std::size_t first = k;
+    while (k < run.samples.size() && t_s < instant_s) t_s += run.samples[k++].dt_s;
+    const Pose2d next = model.Replay(p.data(), run.samples, first, k, odometry);
+    *odometry_m += StepLength(odometry, next);
+    *truth_m += StepLength(truth, truth_there);
+    odometry = next;
+    truth = truth_there;
+  };
+  for (std::size_t g = 0; g < gt.t_s.size(); ++g) {
+    if (gt.t_s[g] > run.t_start_s && gt.t_s[g] < run.t_final_s) {
+      advance_to(gt.t_s[g], gt.world_T_robot[g]);
+    }
+  }
+  advance_to(run.t_final_s + 1.0, run.final_ground_truth);  // every remaining sample
 }
 
 }  // namespace
@@ -26,23 +54,8 @@ double StepLength(const Pose2d& a, const Pose2d& b) {
 RateUnitsFinding CheckModelRateUnits(const RobotModelInterface& model,
                                      const std::vector<RunLog>& runs) {
   RateUnitsFinding finding;
-  const std::vector<double>& p = model.robot().nominal;
   double odometry_m = 0.0, truth_m = 0.0;
-  for (const RunLog& log : runs) {
-    const AlignedRun run = AlignRun(log);
-    Pose2d pose = run.start;
-    for (std::size_t k = 0; k < run.samples.size(); k += kChunk) {
-      const std::size_t end = std::min(run.samples.size(), k + kChunk);
-      const Pose2d next = model.Replay(p.data(), run.samples, k, end, pose);
-      odometry_m += StepLength(pose, next);
-      pose = next;
-    }
-    const GroundTruthTrack& gt = log.ground_truth;
-    for (std::size_t k = 1; k < gt.t_s.size(); ++k) {
-      if (gt.t_s[k - 1] < run.t_start_s || gt.t_s[k] > run.t_final_s) continue;
-      truth_m += StepLength(gt.world_T_robot[k - 1], gt.world_T_robot[k]);
-    }
-  }
+  for (const RunLog& log : runs) AddPathLengths(model, log, &odometry_m, &truth_m);
   if (!(truth_m > kMinEvidenceM) || !std::isfinite(odometry_m)) return finding;
   finding.scale = odometry_m / truth_m;
   if (finding.scale >= 1.0 / kMaxPlausibleScale && finding.scale <= kMaxPlausibleScale) {
