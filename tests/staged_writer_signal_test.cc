@@ -91,7 +91,9 @@ void ExpectSigtermLeavesNothing(const Writer& w, const fs::path& work,
     SCOPED_TRACE(w.name + ", SIGTERM at write " + std::to_string(n));
     fs::remove_all(work);
     fs::create_directories(work);
-    const pid_t pid = Start(w.args, "temporary-written#" + std::to_string(n));
+    // The first point as the older tests name it (no count), the others counted.
+    const pid_t pid = Start(w.args, n == 1 ? std::string("temporary-written")
+                                           : "temporary-written#" + std::to_string(n));
     ASSERT_GT(pid, 0);
     const std::optional<int> stopped = WaitFor(pid, std::chrono::seconds(120), true);
     if (!stopped) {
@@ -99,6 +101,8 @@ void ExpectSigtermLeavesNothing(const Writer& w, const fs::path& work,
       FAIL() << "neither stopped nor ended within 120 s";
     }
     if (WIFEXITED(*stopped)) {
+      // Every writer writes at least one temporary: the first point is always reached.
+      EXPECT_GT(n, 1) << "ended (status " << *stopped << ") without reaching the stop point";
       EXPECT_EQ(WEXITSTATUS(*stopped), 0);
       EXPECT_EQ(Names(work), std::set<std::string>{"out"}) << "a temporary left beside it";
       return;  // fewer writes than n: the later points are past the end too
@@ -140,7 +144,8 @@ TEST(StagedWriterSignal, ReportEndsPromptlyAndLeavesNothing) {
 }
 
 // The writer that hung: its runs are written by several threads at once. Each point is tried
-// several times (the threads' order differs from trial to trial).
+// several times (the threads' order differs from trial to trial): on a46dc0c the first point,
+// tried 20 times, ends in a hang with probability ~1 - (10/11)^20 = 85 % at the corpus' rate.
 TEST(StagedWriterSignal, ImportOptiodomEndsPromptlyAndLeavesNothing) {
   const std::string session = std::string(FITCAL_SHARED_DIR) + "/data/optiodom/diff/circular";
   if (!fs::exists(session)) GTEST_SKIP() << "needs " << session;
@@ -150,8 +155,8 @@ TEST(StagedWriterSignal, ImportOptiodomEndsPromptlyAndLeavesNothing) {
   const fs::path work = dir.path() / "work";
   args.push_back("--out");
   args.push_back((work / "out").string());
-  for (int trial = 0; trial < 4; ++trial) {
-    ExpectSigtermLeavesNothing({"import optiodom", args}, work, {1, 1, 2, 3, 4, 7, 16, 40});
+  for (int trial = 0; trial < 5; ++trial) {
+    ExpectSigtermLeavesNothing({"import optiodom", args}, work, {1, 1, 1, 1, 2, 3, 5, 16, 40});
   }
 }
 
