@@ -323,8 +323,8 @@ std::string TumStem(const std::string& id) {
   return out;
 }
 
-// Held-out runs named "loop/1", "loop_1" and ".loop" (one file each, none hidden), each file holding
-// its own run's ground truth: its first pose is the input's row at that time.
+// Held-out runs named "loop/1", "loop_1" and ".loop" (one file each, none hidden), each file
+// holding its own run's ground truth: its first pose is the input's row at that time.
 TEST(CorpusClasses, TumFilesAreOnePerRunWhateverTheIds) {
   const TempDir dir;
   const std::string data = SimulateDiffDrive(dir, "data");

@@ -747,7 +747,8 @@ int RunExportRos2ControlCommand(const ExportRos2ControlOptions& o) {
     const Ros2ControlExport e = ExportRos2Control(calibrated, o.calibration, o.controller,
                                                   o.node_name, o.joints, o.ros_distro);
     std::string text = "# " + o.controller + " parameters (ros2_controllers, ROS 2 " +
-                       o.ros_distro + ") from the fitcal calibration " + io::YamlCommentText(o.calibration) + "\n";
+                       o.ros_distro + ") from the fitcal calibration " +
+                       io::YamlCommentText(o.calibration) + "\n";
     for (const std::string& note : e.notes) {
       text += "# not representable: " + io::YamlCommentText(note) + "\n";
     }

@@ -100,7 +100,9 @@ Calibration ReadMetricsJson(const std::string& path) {
   // read only the versions whose keys this fleet knows, never a file it would half-read.
   const YAML::Node version = root["version"];
   const std::string current = std::to_string(io::kMetricsJsonVersion);
-  if (version && !(version.IsScalar() && (version.Scalar() == "1" || version.Scalar() == current))) {
+  const bool known =
+      !version || (version.IsScalar() && (version.Scalar() == "1" || version.Scalar() == current));
+  if (!known) {
     throw io::InputError(io::InputErrorKind::kBadValue, path, version.Mark().line + 1,
                          "metrics.json version " + (version.IsScalar() ? version.Scalar() : "?") +
                              " is not one this fitcal reads (1 to " + current +

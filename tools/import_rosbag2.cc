@@ -428,7 +428,8 @@ void WriteDataset(const ImportRosbag2Options& o, const Robot& robot, const Rosba
       "# imported by fitcal import rosbag2 from " + io::YamlCommentText(o.bag) + "\n# encoders " +
       io::YamlCommentText(o.encoders) + " (" +
       (imp.streams.joints.positions ? "positions" : "velocities") + "), ground truth " +
-      io::YamlCommentText(o.ground_truth) + " (" + imp.streams.pose_type + "), " + o.stamp + " stamps; t = 0 at " +
+      io::YamlCommentText(o.ground_truth) + " (" + imp.streams.pose_type + "), " + o.stamp +
+      " stamps; t = 0 at " +
       std::to_string(imp.streams.start_time_ns) + " ns since the epoch\n";
   io::WriteFileAtomically((dir / "dataset.yaml").string(),
                           header + io::DatasetYaml("robot.yaml", entries));

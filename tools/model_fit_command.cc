@@ -726,7 +726,8 @@ void PrintHeldAtNominal(const std::string& direction) {
 }
 
 // Before fitting, as a fit would not notice them: runs that stand still and rates in the wrong
-// unit (exit 1), miswired channels (exit 4), data that cannot determine the parameters (warnings). 0 to go on.
+// unit (exit 1), miswired channels (exit 4), data that cannot determine the parameters
+// (warnings). 0 to go on.
 int CheckBeforeFitting(const FitCommandOptions& options, const RobotModelInterface& model,
                        const RunSplit& split, const std::vector<RunLog>& logs) {
   std::vector<RunLog> training_logs;
