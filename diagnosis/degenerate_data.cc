@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 #include <sstream>
+#include <utility>
 
 namespace fitcal {
 
@@ -21,6 +22,54 @@ double Median(std::vector<double> v) {
 }
 
 }  // namespace
+
+namespace {
+
+// How far a run's ground truth spreads about its median pose: the 90th percentile of the
+// distances and of the heading differences, so that a motion capture's noise (a few of its
+// samples far out) does not count as motion, and a run that moves for a tenth of its time does.
+std::pair<double, double> GroundTruthSpread(const GroundTruthTrack& track) {
+  const std::vector<Pose2d>& poses = track.world_T_robot;
+  std::vector<double> x, y, heading;
+  for (const Pose2d& pose : poses) {
+    x.push_back(pose.x);
+    y.push_back(pose.y);
+    heading.push_back(std::remainder(pose.theta - poses.front().theta, 2.0 * M_PI));
+  }
+  const double mx = Median(x), my = Median(y), mh = Median(heading);
+  std::vector<double> distance_m, turn_rad;
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    distance_m.push_back(std::hypot(x[k] - mx, y[k] - my));
+    turn_rad.push_back(std::abs(std::remainder(heading[k] - mh, 2.0 * M_PI)));
+  }
+  const auto p90 = [](std::vector<double> v) {
+    const std::size_t at = v.size() * 9 / 10;
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(at), v.end());
+    return v[at];
+  };
+  return {p90(distance_m), p90(turn_rad)};
+}
+
+}  // namespace
+
+std::string StillRunsRefusal(const std::vector<RunLog>& runs) {
+  double most_m = 0.0, most_rad = 0.0;
+  for (const RunLog& run : runs) {
+    if (run.ground_truth.world_T_robot.empty()) continue;
+    const auto [spread_m, spread_rad] = GroundTruthSpread(run.ground_truth);
+    most_m = std::max(most_m, spread_m);
+    most_rad = std::max(most_rad, spread_rad);
+  }
+  if (runs.empty() || most_m > kStillPositionM || most_rad > kStillHeadingRad) return "";
+  std::ostringstream line;
+  line.precision(3);
+  line << "the training runs stand still: no run's ground truth moves more than "
+       << kStillPositionM << " m or turns more than " << RadToDeg(kStillHeadingRad)
+       << " deg from where it mostly is (at most " << most_m << " m, " << RadToDeg(most_rad)
+       << " deg, 90th percentile, over " << runs.size()
+       << " runs); without motion no parameter is determined; drive the robot; nothing fitted";
+  return line.str();
+}
 
 double ChiSquare1Quantile(double p) {
   // chi^2_1 = Z^2: P(chi^2_1 <= x) = erf(sqrt(x / 2)); bisection on sqrt(x) in [0, 40].

@@ -21,6 +21,7 @@
 
 #include "odometry/aligned_run.h"
 #include "odometry/robot.h"
+#include "odometry/run_log.h"
 
 namespace fitcal {
 
@@ -28,6 +29,17 @@ namespace fitcal {
 // the robot's (robot.channels order).
 std::vector<std::string> FindDegenerateData(const std::vector<AlignedRun>& runs,
                                             const Robot& robot);
+
+// Runs that stand still teach nothing: every parameter scales motion, and without motion any value
+// explains the runs (the fit stays at the nominal and its covariance is the noise's alone, sigmas
+// of micrometres that claim a precision the data never had). A run moves when the 90th percentile
+// of its ground truth's distance from its median position exceeds kStillPositionM, or that of its
+// heading's difference from its median heading exceeds kStillHeadingRad (far above motion-capture
+// noise, far below any calibration drive). One line naming why when no run moves ("" otherwise):
+// the caller refuses to fit (exit 1).
+inline constexpr double kStillPositionM = 0.05;
+inline constexpr double kStillHeadingRad = 0.05;
+std::string StillRunsRefusal(const std::vector<RunLog>& runs);
 
 struct OutlierRun {
   std::string id;

@@ -7,6 +7,7 @@
 #include <sys/syscall.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
 #include <cstddef>
 #include <cstdint>
@@ -24,15 +25,29 @@ namespace {
 
 constexpr int kCleanupSignals[] = {SIGINT, SIGTERM, SIGHUP};
 
-// The temporary file of the write in flight, readable from a signal handler: a fixed buffer and a
-// flag, set and cleared with the cleanup signals blocked so the handler never sees half a name.
-char g_in_flight_path[PATH_MAX + 16];
-volatile sig_atomic_t g_has_in_flight = 0;
+// The temporary files of the writes in flight, readable from a signal handler: fixed buffers, one
+// per writer thread at a time (a data set's runs are written by several threads at once), each
+// claimed and released through its atomic state, so the handler never sees half a name. A write
+// finding every slot taken still happens; its temporary is then left to RemoveStaleTemporaries
+// (or to the staged directory's removal, where nearly all parallel writes go).
+constexpr int kInFlightSlots = 64;
+struct InFlightSlot {
+  std::atomic<int> state{0};  // 0 free, 1 being filled or emptied, 2 holds a name
+  char path[PATH_MAX + 16];
+};
+InFlightSlot g_in_flight[kInFlightSlots];
 
 // A directory being staged (staged_directory.h), so that a cleanup signal removes it and all it
-// holds (a data set's runs/ too).
+// holds (a data set's runs/ too), and the name it is first moved to: writer threads that go on
+// while the handler runs then find no directory to add files to (their paths name the old one),
+// and the handler removes a tree nobody writes into.
 char g_staging_dir[PATH_MAX + 16];
+char g_staging_dir_aside[PATH_MAX + 32];
 volatile sig_atomic_t g_has_staging_dir = 0;
+
+// One cleanup per process: a second signal (another thread, another kind) while the first is
+// handled leaves it to the first, which ends the process.
+std::atomic_flag g_cleaning_up = ATOMIC_FLAG_INIT;
 
 // One record of getdents64 (linux_dirent64): the name starts at a fixed offset.
 struct DirentHeader {
@@ -78,10 +93,37 @@ bool InStagingDirectory(const std::string& path) {
 }
 
 void RemoveInFlightAndReraise(int signal_number) {
-  if (g_has_in_flight) unlink(g_in_flight_path);
-  if (g_has_staging_dir) RemoveTreeFromHandler(AT_FDCWD, g_staging_dir, /*depth=*/4);
+  if (g_cleaning_up.test_and_set()) return;
+  for (InFlightSlot& slot : g_in_flight) {
+    if (slot.state.load() == 2) unlink(slot.path);
+  }
+  if (g_has_staging_dir) {
+    const bool aside = renameat(AT_FDCWD, g_staging_dir, AT_FDCWD, g_staging_dir_aside) == 0;
+    const char* tree = aside ? g_staging_dir_aside : g_staging_dir;
+    // A writer's open file may still gain an entry just as the tree is listed: a bounded number
+    // of passes, never a loop that waits on other threads.
+    for (int pass = 0; pass < 8 && !RemoveTreeFromHandler(AT_FDCWD, tree, /*depth=*/4); ++pass) {
+    }
+  }
   signal(signal_number, SIG_DFL);
   raise(signal_number);
+}
+
+// Claims a slot for `path` (-1 when all are taken).
+int ClaimInFlightSlot(const std::string& path) {
+  if (path.size() >= sizeof(InFlightSlot::path)) return -1;
+  for (int k = 0; k < kInFlightSlots; ++k) {
+    int expected = 0;
+    if (!g_in_flight[k].state.compare_exchange_strong(expected, 1)) continue;
+    std::memcpy(g_in_flight[k].path, path.c_str(), path.size() + 1);
+    g_in_flight[k].state.store(2);
+    return k;
+  }
+  return -1;
+}
+
+void ReleaseInFlightSlot(int slot) {
+  if (slot >= 0) g_in_flight[slot].state.store(0);
 }
 
 // Blocks the cleanup signals for its lifetime.
@@ -101,8 +143,8 @@ class CleanupSignalsBlocked {
   sigset_t previous_;
 };
 
-// Creates the temporary file and records it as in flight; returns its descriptor and path.
-int CreateTemporary(const std::string& path, std::string* tmp_path) {
+// Creates the temporary file and records it as in flight (*slot); returns its descriptor and path.
+int CreateTemporary(const std::string& path, std::string* tmp_path, int* slot) {
   std::string tmpl = TemporaryPrefix(path) + "XXXXXX";
   std::vector<char> name(tmpl.begin(), tmpl.end());
   name.push_back('\0');
@@ -112,10 +154,7 @@ int CreateTemporary(const std::string& path, std::string* tmp_path) {
     throw std::runtime_error(path + ": cannot create a file beside it: " + std::strerror(errno));
   }
   *tmp_path = name.data();
-  if (tmp_path->size() < sizeof(g_in_flight_path)) {
-    std::memcpy(g_in_flight_path, tmp_path->c_str(), tmp_path->size() + 1);
-    g_has_in_flight = 1;
-  }
+  *slot = ClaimInFlightSlot(*tmp_path);
   return fd;
 }
 
@@ -150,9 +189,15 @@ void RemoveStaleTemporaries(const std::string& path) {
 
 namespace {
 
-// Writes `contents` to a new temporary beside `path` (flushed to disk) and returns its name;
-// throws std::runtime_error, the temporary removed, when the output may not or cannot be written.
-std::string WriteTemporary(const std::string& path, std::string_view contents) {
+// A temporary written and not yet renamed: its name and its in-flight slot.
+struct Temporary {
+  std::string path;
+  int slot = -1;
+};
+
+// Writes `contents` to a new temporary beside `path` (flushed to disk) and returns it; throws
+// std::runtime_error, the temporary removed, when the output may not or cannot be written.
+Temporary WriteTemporary(const std::string& path, std::string_view contents) {
   if (const std::string overlap = OutputOverlapsInput(path); !overlap.empty()) {
     throw std::runtime_error(path + ": " + overlap);
   }
@@ -160,7 +205,8 @@ std::string WriteTemporary(const std::string& path, std::string_view contents) {
   // once per file).
   if (!InStagingDirectory(path)) RemoveStaleTemporaries(path);
   std::string tmp_path;
-  const int fd = CreateTemporary(path, &tmp_path);
+  int slot = -1;
+  const int fd = CreateTemporary(path, &tmp_path, &slot);
   const char* data = contents.data();
   std::size_t left = contents.size();
   int error = 0;
@@ -178,20 +224,20 @@ std::string WriteTemporary(const std::string& path, std::string_view contents) {
   if (close(fd) != 0 && error == 0) error = errno;
   if (error != 0) {
     const CleanupSignalsBlocked blocked;
-    g_has_in_flight = 0;
+    ReleaseInFlightSlot(slot);
     unlink(tmp_path.c_str());
     throw std::runtime_error(path + ": cannot write: " + std::strerror(error));
   }
-  return tmp_path;
+  return {tmp_path, slot};
 }
 
 // Renames the temporary over `path`; throws std::runtime_error (the temporary removed).
-void RenameTemporary(const std::string& tmp_path, const std::string& path) {
+void RenameTemporary(const Temporary& tmp, const std::string& path) {
   const CleanupSignalsBlocked blocked;
-  g_has_in_flight = 0;
-  if (std::rename(tmp_path.c_str(), path.c_str()) != 0) {
+  ReleaseInFlightSlot(tmp.slot);
+  if (std::rename(tmp.path.c_str(), path.c_str()) != 0) {
     const std::string reason = std::strerror(errno);
-    unlink(tmp_path.c_str());
+    unlink(tmp.path.c_str());
     throw std::runtime_error(path + ": cannot write: " + reason);
   }
 }
@@ -199,15 +245,19 @@ void RenameTemporary(const std::string& tmp_path, const std::string& path) {
 }  // namespace
 
 void WriteFileAtomically(const std::string& path, std::string_view contents) {
-  const std::string tmp_path = WriteTemporary(path, contents);
+  const Temporary tmp = WriteTemporary(path, contents);
   StopHereForTests("temporary-written");
-  RenameTemporary(tmp_path, path);
+  RenameTemporary(tmp, path);
 }
 
 void WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>& files) {
-  std::vector<std::string> temporaries;
+  std::vector<Temporary> temporaries;
   auto remove_from = [&](std::size_t first) {
-    for (std::size_t k = first; k < temporaries.size(); ++k) unlink(temporaries[k].c_str());
+    for (std::size_t k = first; k < temporaries.size(); ++k) {
+      const CleanupSignalsBlocked blocked;
+      ReleaseInFlightSlot(temporaries[k].slot);
+      unlink(temporaries[k].path.c_str());
+    }
   };
   try {
     for (const auto& [path, contents] : files)
@@ -230,8 +280,12 @@ void WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>
 void SetStagingDirectoryForSignals(const std::string& dir) {
   const CleanupSignalsBlocked blocked;
   g_has_staging_dir = 0;
-  if (!dir.empty() && dir.size() < sizeof(g_staging_dir)) {
+  // "<staging>-x": still ".<name>.tmp-<pid>-...", so a SIGKILL during the cleanup leaves what
+  // the next writer removes (RemoveStaleTemporaries).
+  const std::string aside = dir + "-x";
+  if (!dir.empty() && aside.size() < sizeof(g_staging_dir)) {
     std::memcpy(g_staging_dir, dir.c_str(), dir.size() + 1);
+    std::memcpy(g_staging_dir_aside, aside.c_str(), aside.size() + 1);
     g_has_staging_dir = 1;
   }
 }
@@ -251,7 +305,16 @@ void RemoveTemporaryFilesOnSignals() {
 
 void StopHereForTests(const char* stage) {
   const char* wanted = std::getenv("FITCAL_TEST_STOP_AT");
-  if (wanted != nullptr && std::strcmp(wanted, stage) == 0) raise(SIGSTOP);
+  if (wanted == nullptr) return;
+  // "<stage>" or "<stage>#<n>": the n-th time any thread passes the stage (1 by default), once
+  // per process, so that threads passing it after the test resumed the process cannot stop it
+  // again (the stop would outlast the signal the test delivers).
+  const char* hash = std::strchr(wanted, '#');
+  const std::size_t length = hash ? static_cast<std::size_t>(hash - wanted) : std::strlen(wanted);
+  if (length != std::strlen(stage) || std::strncmp(wanted, stage, length) != 0) return;
+  static std::atomic<long> passes{0};
+  const long n = hash ? std::strtol(hash + 1, nullptr, 10) : 1;
+  if (++passes == n) raise(SIGSTOP);
 }
 
 }  // namespace fitcal::io

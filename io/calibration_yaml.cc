@@ -9,6 +9,11 @@ namespace fitcal::io {
 
 namespace {
 
+// The bound of the track fit's clock offsets (fit/track_residual.h, TrackResidualOptions::
+// max_clock_offset_s; io/ sits below fit/ and cannot include it): a recorded offset beyond it was
+// not written by fit. The last digit of a written value may round past it.
+constexpr double kMaxRecordedClockOffsetS = 0.5 + 1e-9;
+
 // The block, or a null node for a plain robot YAML.
 YAML::Node CalibrationNode(const std::string& path) {
   const YAML::Node root = LoadYamlFile(path);
@@ -115,6 +120,21 @@ void ReadClockOffsets(const YAML::Node& block, const std::string& path, Calibrat
       throw InputError(InputErrorKind::kBadValue, path, g.Mark().line + 1,
                        "calibration.clock_offsets: offset_s and sigma_s must be finite, sigma_s "
                        ">= 0");
+    }
+    const int line = g.Mark().line + 1;
+    for (const CalibrationProvenance::ClockOffset& earlier : p->clock_offsets) {
+      if (earlier.group == c.group) {
+        throw InputError(InputErrorKind::kBadValue, path, line,
+                         "calibration.clock_offsets: group '" + c.group +
+                             "' is listed twice (which offset applies?)");
+      }
+    }
+    if (std::abs(c.offset_s) > kMaxRecordedClockOffsetS) {
+      throw InputError(InputErrorKind::kBadValue, path, line,
+                       "calibration.clock_offsets: group '" + c.group + "' offset " +
+                           std::to_string(c.offset_s) + " s is beyond the fit's bound of " +
+                           std::to_string(kMaxRecordedClockOffsetS) +
+                           " s (an edited file? fit never writes one)");
     }
     p->clock_offsets.push_back(c);
   }

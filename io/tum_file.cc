@@ -22,13 +22,21 @@ std::string TumText(const std::vector<double>& t_s, const std::vector<Pose2d>& p
 }
 
 std::string FileNameOf(const std::string& id) {
-  std::string out = id;
-  for (char& c : out) {
-    const bool ok = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') ||
-                    c == '.' || c == '_' || c == '-';
-    if (!ok) c = '_';
+  static const char kHex[] = "0123456789ABCDEF";
+  std::string out;
+  for (std::size_t i = 0; i < id.size(); ++i) {
+    const auto c = static_cast<unsigned char>(id[i]);
+    const bool kept = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') ||
+                      c == '_' || c == '-' || (c == '.' && i > 0);
+    if (kept) {
+      out += static_cast<char>(c);
+    } else {
+      out += '%';
+      out += kHex[c >> 4];
+      out += kHex[c & 15];
+    }
   }
-  return out.empty() || out[0] == '.' ? "_" + out : out;
+  return out.empty() ? "%" : out;  // "%" alone decodes to no id: distinct from every other
 }
 
 }  // namespace fitcal::io

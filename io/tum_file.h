@@ -17,7 +17,9 @@ namespace fitcal::io {
 // (io/log_files.h ReadGroundTruth reads TUM too) gets the poses back to rounding.
 std::string TumText(const std::vector<double>& t_s, const std::vector<Pose2d>& poses);
 
-// A run id as a file name: every character outside [A-Za-z0-9._-] becomes '_'.
+// A run id as a file name, one to one (two runs never share a file): the id's bytes, with every
+// byte outside [A-Za-z0-9._-] and a leading '.' written as %XX (two upper-case hex digits, as in
+// URLs), so '%' itself becomes %25: "loop/1" -> "loop%2F1", "loop_1" -> "loop_1", ".a" -> "%2Ea".
 std::string FileNameOf(const std::string& id);
 
 }  // namespace fitcal::io

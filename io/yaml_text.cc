@@ -26,3 +26,29 @@ bool IsSafePlainYaml(const std::string& s) {
 }
 
 }  // namespace fitcal::io
+
+#include "io/yaml_scalar.h"
+
+namespace fitcal::io {
+
+std::string YamlScalar(const std::string& s) {
+  YAML::Emitter out;
+  out << YamlText(s);
+  return out.c_str();
+}
+
+std::string YamlDoubleQuoted(const std::string& s) {
+  YAML::Emitter out;
+  out << YAML::DoubleQuoted << s;
+  return out.c_str();
+}
+
+std::string YamlCommentText(const std::string& s) {
+  std::string out = s;
+  for (char& c : out) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  }
+  return out;
+}
+
+}  // namespace fitcal::io

@@ -19,6 +19,7 @@
 #include "io/calibration_yaml.h"
 #include "io/dataset.h"
 #include "io/text_file.h"
+#include "io/yaml_scalar.h"
 #include "models/diff_drive/diff_drive_model.h"
 #include "models/model_registry.h"
 #include "models/mounted_model.h"
@@ -52,7 +53,8 @@ std::string Num(double v) {
   return s;
 }
 
-std::string Quoted(const std::string& s) { return "\"" + s + "\""; }
+// Joint names double-quoted and escaped (io/yaml_scalar.h): a quote in a URDF name stays YAML.
+std::string Quoted(const std::string& s) { return io::YamlDoubleQuoted(s); }
 
 std::string NameList(const std::vector<std::string>& names) {
   std::string out = "[";
@@ -499,7 +501,8 @@ Ros2ControlExport ExportRos2Control(const RobotModelPtr& calibrated,
                      controller + " cannot apply; export a calibration fitted without effects");
   }
   Ros2ControlExport out;
-  out.parameters_yaml = (node_name.empty() ? controller : node_name) + ":\n  ros__parameters:\n";
+  out.parameters_yaml =
+      io::YamlScalar(node_name.empty() ? controller : node_name) + ":\n  ros__parameters:\n";
   entry.write(c, ros_distro, &out);
   KeepGroundTruthFrame(c, &out);
   return out;
@@ -534,15 +537,16 @@ std::vector<AlignedRun> HeldOutRuns(const std::string& calibration_path, io::Dat
     recorded.repetitions = p->training_repetitions;
   }
   TrainingSplit t = SplitAsRecorded(data.runs, AlignRuns(data.runs), recorded);
-  std::vector<AlignedRun> runs;
+  // As `report` refuses it (exit 2): runs the calibration was fitted on cannot judge it, and the
+  // covariance of its own residuals there would be the fit's, smaller than the robot will see.
   if (t.split.validation.empty()) {
-    *which = "(the calibration trained on every run of this data set)";
-    runs = std::move(t.split.training);
-  } else {
-    *which = t.how == "none" ? "(none of them trained the calibration)"
-                             : "held out from the calibration";
-    runs = std::move(t.split.validation);
+    throw UsageError("every run of " + data.directory +
+                     " trained the calibration; nothing held out to replay it on or to take "
+                     "the odometry covariance from (--logs a data set with runs it did not fit)");
   }
+  *which = t.how == "none" ? "(none of them trained the calibration)"
+                           : "held out from the calibration";
+  std::vector<AlignedRun> runs = std::move(t.split.validation);
   if (held_out_logs != nullptr) {
     std::set<std::string> ids;
     for (const AlignedRun& r : runs) ids.insert(r.id);
@@ -790,7 +794,7 @@ void AddReplay(const ExportRos2ControlOptions& o, const RobotModelPtr& exact,
                                                    "offset") +
                                 ")");
   }
-  *text += "# " + line + "\n";
+  *text += "# " + io::YamlCommentText(line) + "\n";
   const std::string covariance = CovarianceLine(replay.exported_covariance);
   if (!o.out.empty()) std::printf("%s\n", covariance.c_str());
   *text += "# " + covariance + " (docs/ros2.md)\n";
@@ -812,8 +816,11 @@ int RunExportRos2ControlCommand(const ExportRos2ControlOptions& o) {
     const Ros2ControlExport e = ExportRos2Control(calibrated, o.calibration, o.controller,
                                                   o.node_name, o.joints, o.ros_distro);
     std::string text = "# " + o.controller + " parameters (ros2_controllers, ROS 2 " +
-                       o.ros_distro + ") from the fitcal calibration " + o.calibration + "\n";
-    for (const std::string& note : e.notes) text += "# not representable: " + note + "\n";
+                       o.ros_distro + ") from the fitcal calibration " +
+                       io::YamlCommentText(o.calibration) + "\n";
+    for (const std::string& note : e.notes) {
+      text += "# not representable: " + io::YamlCommentText(note) + "\n";
+    }
     CheckCalibrationOut(o, calibrated->robot().name);
     std::string parameters = e.parameters_yaml, calibration_text;
     if (!o.logs.empty()) AddReplay(o, calibrated, e, &text, &parameters, &calibration_text);

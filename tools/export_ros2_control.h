@@ -125,8 +125,9 @@ struct ExportRos2ControlOptions {
 };
 
 // The runs of `logs` that validate `calibration_path`: those it did not train on (by recorded run
-// id, as `report` splits), or every run when it trained on all of them or records none; `*which`
-// says which. Throws io::InputError for a bad data set or calibration block.
+// id, as `report` splits; every run when it records none); `*which` says which. Throws
+// io::InputError for a bad data set or calibration block, and UsageError (exit 2, as `report`)
+// when it trained on every run.
 // `held_out_logs`, when given, receives the same runs as loaded (ground-truth tracks included).
 std::vector<AlignedRun> ExportHeldOutRuns(const std::string& calibration_path,
                                           const std::string& logs, const Robot& robot,

@@ -16,6 +16,7 @@
 
 #include "io/calibration_yaml.h"
 #include "io/input_error.h"
+#include "io/report_json.h"
 #include "io/yaml_reader.h"
 #include "models/model_registry.h"
 #include "odometry/text_format.h"
@@ -49,6 +50,7 @@ struct Calibration {
   // Which runs judged its held-out CF: the data set and the split it was fitted with. Two
   // calibrations with different keys report CFs of different runs.
   std::string judged_on;
+  std::string model;  // "" for a metrics.json, which does not name it
 };
 
 constexpr const char* kCfUnit = "Eq. 14";
@@ -96,6 +98,7 @@ Calibration ReadCalibration(const std::string& path) {
   Calibration c;
   c.file = path;
   c.robot = model->robot().name;
+  c.model = model->robot().model;
   c.date = DateOf(path);
   const Robot& robot = model->robot();
   const std::optional<io::CalibrationProvenance> provenance = io::ReadCalibrationProvenance(path);
@@ -127,6 +130,18 @@ Calibration ReadMetricsJson(const std::string& path) {
   if (!root.IsMap() || !root["robot"] || !root["parameters"].IsSequence()) {
     throw io::InputError(io::InputErrorKind::kMissingKey, path, 1,
                          "not a fitcal report's metrics.json (robot, parameters)");
+  }
+  // Version 1 had no key; a later layout may have moved the parameters (docs/metrics_json.md):
+  // read only the versions whose keys this fleet knows, never a file it would half-read.
+  const YAML::Node version = root["version"];
+  const std::string current = std::to_string(io::kMetricsJsonVersion);
+  const bool known =
+      !version || (version.IsScalar() && (version.Scalar() == "1" || version.Scalar() == current));
+  if (!known) {
+    throw io::InputError(io::InputErrorKind::kBadValue, path, version.Mark().line + 1,
+                         "metrics.json version " + (version.IsScalar() ? version.Scalar() : "?") +
+                             " is not one this fitcal reads (1 to " + current +
+                             "); read it with the fitcal that wrote it");
   }
   c.robot = root["robot"].as<std::string>();
   for (const YAML::Node& p : root["parameters"]) {
@@ -238,6 +253,23 @@ void FlagTrend(FleetSeries* s) {
              std::abs(slope) * span_days > scatter;
 }
 
+// A robot is its name: two calibrations of one name and different models are two robots
+// (a renamed copy, a rebuilt robot), whose parameters must not be merged into one series.
+void RefuseOneNameForTwoModels(const std::vector<Calibration>& all) {
+  std::map<std::string, const Calibration*> first_of;
+  for (const Calibration& c : all) {
+    if (c.model.empty()) continue;
+    const auto [it, inserted] = first_of.emplace(c.robot, &c);
+    if (!inserted && it->second->model != c.model) {
+      throw io::InputError(io::InputErrorKind::kBadValue, c.file, 0,
+                           "robot '" + c.robot + "' is a " + c.model + " here and a " +
+                               it->second->model + " in " + it->second->file +
+                               "; fleet keeps one series per robot name: give the robots "
+                               "different names");
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<FleetSeries> ReadFleet(const std::vector<std::string>& inputs) {
@@ -246,6 +278,7 @@ std::vector<FleetSeries> ReadFleet(const std::vector<std::string>& inputs) {
     all.push_back(IsMetricsJson(f) ? ReadMetricsJson(f) : ReadCalibration(f));
   }
   if (all.empty()) throw UsageError("no calibrated YAML found in the inputs");
+  RefuseOneNameForTwoModels(all);
   std::stable_sort(all.begin(), all.end(), [](const Calibration& a, const Calibration& b) {
     return std::tie(a.robot, a.date) < std::tie(b.robot, b.date);
   });

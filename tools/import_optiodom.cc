@@ -6,6 +6,7 @@
 
 #include "io/input_error.h"
 #include "io/input_registry.h"
+#include "io/yaml_scalar.h"
 #include "models/tricycle/tricycle_checks.h"
 #include "odometry/aligned_run.h"
 #include "odometry/parallel_for.h"
@@ -202,7 +203,7 @@ optiodom::DatasetText DatasetTextOf(const OptiOdomImport& in) {
   if (!robot.encoder) text.ground_truth_csv = optiodom::ExactGroundTruthCsv;
   if (in.kind->file_comment != nullptr) {
     text.header = in.kind->file_comment;
-    for (const std::string& n : in.notes) text.header += "# " + n + "\n";
+    for (const std::string& n : in.notes) text.header += "# " + io::YamlCommentText(n) + "\n";
   }
   return text;
 }

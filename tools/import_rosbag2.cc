@@ -20,6 +20,7 @@
 #include "io/log_files.h"
 #include "io/staged_directory.h"
 #include "io/text_file.h"
+#include "io/yaml_scalar.h"
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
 #include "tools/command_failure.h"
@@ -424,9 +425,11 @@ void WriteDataset(const ImportRosbag2Options& o, const Robot& robot, const Rosba
   }
   io::WriteFileAtomically((dir / "robot.yaml").string(), io::ReadTextFile(o.robot));
   const std::string header =
-      "# imported by fitcal import rosbag2 from " + o.bag + "\n# encoders " + o.encoders + " (" +
+      "# imported by fitcal import rosbag2 from " + io::YamlCommentText(o.bag) + "\n# encoders " +
+      io::YamlCommentText(o.encoders) + " (" +
       (imp.streams.joints.positions ? "positions" : "velocities") + "), ground truth " +
-      o.ground_truth + " (" + imp.streams.pose_type + "), " + o.stamp + " stamps; t = 0 at " +
+      io::YamlCommentText(o.ground_truth) + " (" + imp.streams.pose_type + "), " + o.stamp +
+      " stamps; t = 0 at " +
       std::to_string(imp.streams.start_time_ns) + " ns since the epoch\n";
   io::WriteFileAtomically((dir / "dataset.yaml").string(),
                           header + io::DatasetYaml("robot.yaml", entries));

@@ -558,11 +558,30 @@ void PrintClockOffsets(const ModelFitResult& fit, const TrackFitData& track) {
   std::printf("clock offsets (ground truth at encoder time + dt, |dt| <= %.2g s), %zu %s:\n",
               track.options.max_clock_offset_s, n, n == 1 ? "group" : "groups");
   constexpr std::size_t kMaxListed = 12;
+  // An offset on its bound is where the fit was stopped, not a measured lag: said, with the
+  // groups, so that it is not read as one.
+  const double bound = track.options.max_clock_offset_s;
+  std::string on_bound;
+  std::size_t num_on_bound = 0;
+  for (std::size_t g = 0; g < n; ++g) {
+    if (std::abs(fit.clock_offsets_s[g]) < bound * (1.0 - 1e-3)) continue;
+    ++num_on_bound;
+    if (num_on_bound <= 3) on_bound += (on_bound.empty() ? "" : ", ") + track.clock_groups[g];
+  }
+  const auto warn_on_bound = [&] {
+    if (num_on_bound == 0) return;
+    std::printf("warning: %zu clock offset%s rest%s on the +-%.2g s bound (%s%s): not a measured "
+                "lag; the clocks differ by more, or the offset absorbs a mismatch of the runs "
+                "(--clock-offsets none, or check the ground truth's time stamps)\n",
+                num_on_bound, num_on_bound == 1 ? "" : "s", num_on_bound == 1 ? "s" : "", bound,
+                on_bound.c_str(), num_on_bound > 3 ? ", ..." : "");
+  };
   if (n <= kMaxListed) {
     for (std::size_t g = 0; g < n; ++g) {
       std::printf("  %-36s %+8.3f s +- %.3f\n", track.clock_groups[g].c_str(),
                   fit.clock_offsets_s[g], sigma(g));
     }
+    warn_on_bound();
     return;
   }
   std::vector<double> sorted(fit.clock_offsets_s.begin(), fit.clock_offsets_s.begin() + n);
@@ -571,6 +590,7 @@ void PrintClockOffsets(const ModelFitResult& fit, const TrackFitData& track) {
   for (std::size_t g = 0; g < n; ++g) mean_sigma += sigma(g) / n;
   std::printf("  median %+.3f s, range [%+.3f, %+.3f] s, mean sigma %.3f s\n", sorted[n / 2],
               sorted.front(), sorted.back(), mean_sigma);
+  warn_on_bound();
 }
 
 // Drift per 1, 2, 5 m and ATE RMSE (tools/everyday_driving_table.h) of the nominal and the
@@ -734,10 +754,21 @@ void PrintHeldAtNominal(const std::string& direction) {
   std::printf("held at nominal, not determined by the training runs: %s\n", direction.c_str());
 }
 
-// Before fitting, as a fit would not notice them: rates in the wrong unit (exit 1), miswired
-// channels (exit 4), data that cannot determine the parameters (warnings). 0 to go on.
+// Before fitting, as a fit would not notice them: runs that stand still and rates in the wrong
+// unit (exit 1), miswired channels (exit 4), data that cannot determine the parameters
+// (warnings). 0 to go on.
 int CheckBeforeFitting(const FitCommandOptions& options, const RobotModelInterface& model,
                        const RunSplit& split, const std::vector<RunLog>& logs) {
+  std::vector<RunLog> training_logs;
+  for (const AlignedRun& run : split.training) {
+    for (const RunLog& log : logs) {
+      if (log.id == run.id) training_logs.push_back(log);
+    }
+  }
+  if (const std::string still = StillRunsRefusal(training_logs); !still.empty()) {
+    std::cerr << "fitcal: " << options.logs << ": " << still << "\n";
+    return 1;
+  }
   if (const RateUnitsFinding units = CheckModelRateUnits(model, logs); units.suspicious) {
     std::cerr << "fitcal: " << options.logs << ": " << units.message << "\n";
     return 1;
@@ -800,11 +831,75 @@ struct FitSetup {
   EffectModel effects_to_fit;
 };
 
+// A flag the fit asked for would not use: "" or the refusal's one line (exit 2), so that nothing
+// the user set is dropped without a word. Defaults are those of SolverOptions (a flag given at its
+// default changes nothing either way).
+std::string FlagThatDoesNotApply(const FitCommandOptions& o) {
+  const SolverOptions defaults;
+  const bool ceres = o.method == "ceres" || o.method == "ceres-dogleg";
+  const bool loss = o.loss != defaults.loss;
+  if (!ceres && (loss || o.loss_scale != defaults.loss_scale)) {
+    return "--loss and --loss-scale shape the Ceres methods' final-pose residuals; --method " +
+           o.method + " does not use them";
+  }
+  if (!ceres && o.max_iterations != defaults.max_iterations) {
+    return "--max-iterations bounds the Ceres methods; --method " + o.method +
+           " has --max-evaluations";
+  }
+  if (ceres && (o.seed != defaults.seed || o.max_evaluations != defaults.max_evaluations ||
+                o.polish)) {
+    return "--seed, --max-evaluations and --polish apply to the NLopt methods; --method " +
+           o.method + " does not use them";
+  }
+  if (!loss && o.loss_scale != defaults.loss_scale) {
+    return "--loss-scale without --loss (huber or cauchy) has no loss to scale";
+  }
+  if (o.residuals == "final-pose" && o.clock_offsets != defaults.clock_offsets) {
+    return "--clock-offsets " + o.clock_offsets +
+           " is estimated on track residuals; --residuals final-pose compares final poses, "
+           "where no clock offset is estimated (--residuals track or both)";
+  }
+  if (o.residuals == "track" && (loss || !o.objective.empty())) {
+    return std::string(loss ? "--loss" : "--objective") +
+           " shapes final-pose residuals; the track residual has its own fixed Huber loss "
+           "(--residuals both fits final poses too)";
+  }
+  return "";
+}
+
+// What --residuals auto's choice leaves unused of the flags given, said beside the residuals:
+// the clock offsets belong to the track, the loss and the objective to the final poses.
+std::vector<std::string> FlagsTheChoiceLeavesUnused(const FitCommandOptions& o,
+                                                    const FitMethodSettings& settings) {
+  if (!settings.residuals_auto) return {};
+  const SolverOptions defaults;
+  std::vector<std::string> notes;
+  if (settings.residuals == ResidualKind::kFinalPose && o.clock_offsets != defaults.clock_offsets) {
+    notes.push_back("note: --clock-offsets " + o.clock_offsets +
+                    " not applied: final-pose residuals were chosen, on which no clock offset "
+                    "is estimated (--residuals track estimates it on dense ground truth)");
+  }
+  if (settings.residuals == ResidualKind::kTrack && o.loss != defaults.loss) {
+    notes.push_back("note: --loss " + o.loss +
+                    " not applied: track residuals were chosen, which carry their own fixed "
+                    "Huber loss (--residuals final-pose or both use --loss)");
+  }
+  if (settings.residuals == ResidualKind::kTrack && !o.objective.empty()) {
+    notes.push_back("note: --objective " + o.objective +
+                    " not applied: track residuals were chosen (it shapes final-pose residuals)");
+  }
+  return notes;
+}
+
 // Fills `setup`; else one line on stderr and the exit code (2 for a flag, the overwrite refusal's
 // for an output fitcal did not write).
 int SetUpFit(const FitCommandOptions& options, const Robot& robot, FitSetup* setup) {
   // Validated by RunFitCommand: a known method, settings in range.
   setup->method = FindFitMethod(options.method);
+  if (const std::string unused = FlagThatDoesNotApply(options); !unused.empty()) {
+    std::cerr << "fitcal: " << unused << "\n";
+    return 2;
+  }
   std::string error;
   if (setup->method == nullptr ||
       !MakeFitMethodSettings(options, options.threads, &setup->settings, &error)) {
@@ -887,6 +982,10 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
       effects_to_fit->empty()
           ? ChooseResidualsByTransfer(options, *method, *model, split, logs, &settings, &track_data)
           : std::vector<std::string>{};
+  std::vector<std::string> residual_lines = residual_choice;
+  for (const std::string& note : FlagsTheChoiceLeavesUnused(options, settings)) {
+    residual_lines.push_back(note);
+  }
   const HalvesJudgement halves =
       JudgeMethodOnHeldOutHalves(options, *method, settings, *model, split, logs);
   if (const std::string refusal = DegreesOfFreedomRefusal(
@@ -921,7 +1020,7 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   PrintFit(options, *model, split, candidates, gate, selected_fit, errors, *method, outcome,
            track_fits);
   PrintTying(settings.tying);
-  PrintResiduals(settings, residuals_auto, residual_choice, fit, track_data);
+  PrintResiduals(settings, residuals_auto, residual_lines, fit, track_data);
   PrintEverydayDriving(*model, logs, split, candidates[0], selected, options.threads);
   PrintUncertaintyAndWarnings(options, *model, split, fit, settings.weights);
   if (halves.judged) {  // the gate's table is on the training runs; the halves judge (below)

@@ -12,13 +12,54 @@ namespace {
 
 // Rotation counted as travel at this radius, so that turning in place counts too.
 constexpr double kTurnLengthM = 0.2;
+// Ground-truth intervals longer than this are not a measured path (a robot drives far and turns
+// much in a second); shorter ones are, at any speed a calibration drive has.
+constexpr double kMaxMeasuredIntervalS = 1.0;
+constexpr std::size_t kChunk = 10;  // samples per replayed step of the odometry's path
 // Below this much ground-truth travel there is no evidence either way.
 constexpr double kMinEvidenceM = 0.5;
-constexpr std::size_t kChunk = 10;  // samples per replayed step of the path
 
 double StepLength(const Pose2d& a, const Pose2d& b) {
   return std::hypot(b.x - a.x, b.y - a.y) +
          kTurnLengthM * std::abs(std::remainder(b.theta - a.theta, 2.0 * M_PI));
+}
+
+// Both paths over the same intervals between consecutive ground-truth instants (the window's
+// start, every sample inside it, its end), and only over those short enough that the ground truth
+// measures the path there (kMaxMeasuredIntervalS): a ground truth of start and end poses only
+// measures the straight line between them, not the path the wheels drove, so it is no evidence
+// of a unit error. The odometry is replayed in steps of kChunk samples inside an interval, so that
+// rates 57x too large (deg/s), which spin the odometry round many times, count in full.
+void AddPathLengths(const RobotModelInterface& model, const RunLog& log, double* odometry_m,
+                    double* truth_m) {
+  const std::vector<double>& p = model.robot().nominal;
+  const AlignedRun run = AlignRun(log);
+  const GroundTruthTrack& gt = log.ground_truth;
+  Pose2d truth = run.start;
+  double t_s = run.t_start_s, t_last_s = run.t_start_s;
+  std::size_t k = 0;
+  const auto interval_to = [&](double instant_s, const Pose2d& truth_there) {
+    const bool measured = instant_s - t_last_s <= kMaxMeasuredIntervalS;
+    Pose2d odometry;
+    while (k < run.samples.size() && t_s < instant_s) {
+      const std::size_t first = k;
+      while (k < run.samples.size() && t_s < instant_s && k - first < kChunk) {
+        t_s += run.samples[k++].dt_s;
+      }
+      const Pose2d next = model.Replay(p.data(), run.samples, first, k, odometry);
+      if (measured) *odometry_m += StepLength(odometry, next);
+      odometry = next;
+    }
+    if (measured) *truth_m += StepLength(truth, truth_there);
+    truth = truth_there;
+    t_last_s = instant_s;
+  };
+  for (std::size_t g = 0; g < gt.t_s.size(); ++g) {
+    if (gt.t_s[g] > run.t_start_s && gt.t_s[g] < run.t_final_s) {
+      interval_to(gt.t_s[g], gt.world_T_robot[g]);
+    }
+  }
+  interval_to(run.t_final_s, run.final_ground_truth);
 }
 
 }  // namespace
@@ -26,23 +67,8 @@ double StepLength(const Pose2d& a, const Pose2d& b) {
 RateUnitsFinding CheckModelRateUnits(const RobotModelInterface& model,
                                      const std::vector<RunLog>& runs) {
   RateUnitsFinding finding;
-  const std::vector<double>& p = model.robot().nominal;
   double odometry_m = 0.0, truth_m = 0.0;
-  for (const RunLog& log : runs) {
-    const AlignedRun run = AlignRun(log);
-    Pose2d pose = run.start;
-    for (std::size_t k = 0; k < run.samples.size(); k += kChunk) {
-      const std::size_t end = std::min(run.samples.size(), k + kChunk);
-      const Pose2d next = model.Replay(p.data(), run.samples, k, end, pose);
-      odometry_m += StepLength(pose, next);
-      pose = next;
-    }
-    const GroundTruthTrack& gt = log.ground_truth;
-    for (std::size_t k = 1; k < gt.t_s.size(); ++k) {
-      if (gt.t_s[k - 1] < run.t_start_s || gt.t_s[k] > run.t_final_s) continue;
-      truth_m += StepLength(gt.world_T_robot[k - 1], gt.world_T_robot[k]);
-    }
-  }
+  for (const RunLog& log : runs) AddPathLengths(model, log, &odometry_m, &truth_m);
   if (!(truth_m > kMinEvidenceM) || !std::isfinite(odometry_m)) return finding;
   finding.scale = odometry_m / truth_m;
   if (finding.scale >= 1.0 / kMaxPlausibleScale && finding.scale <= kMaxPlausibleScale) {

@@ -1,10 +1,12 @@
 #pragma once
 // The likely-units check for every model: encoder rates logged in deg/s, rpm or rev/s and read
-// as rad/s scale every wheel's travel by the same factor, which no calibration inside the bounds can undo -
-// and which the fit would otherwise absorb into absurd parameters or blame on the wiring. The
-// nominal robot's odometry path length (translation + kTurnLengthM x rotation, replayed through the
-// model's own kinematics) against the ground truth's over the same windows tells it: a ratio near 1
-// is rad/s; near 57.3 deg/s, 9.55 rpm, 0.159 rev/s.
+// as rad/s scale every wheel's travel by the same factor, which no calibration inside the bounds
+// can undo - and which the fit would otherwise absorb into absurd parameters or blame on the
+// wiring. The nominal robot's odometry path length (translation + kTurnLengthM x rotation,
+// replayed through the model's own kinematics) against the ground truth's, both measured between
+// the same instants (the ground truth's samples: a ground truth of start and end poses only
+// compares the straight line with the straight line), tells it: a ratio near 1 is rad/s; near
+// 57.3 deg/s, 9.55 rpm, 0.159 rev/s.
 
 #include <string>
 #include <vector>
