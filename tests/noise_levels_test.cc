@@ -30,8 +30,12 @@ constexpr double kPositionSigmaM = 0.004;
 constexpr double kHeadingSigmaRad = 0.02;  // 1.15 deg: far from 1 m : 1 rad's ratio
 constexpr double kCommonScale = 1.02;      // true lengths / nominal
 
-std::vector<sim::ModelSimulatedRun> Simulate(const RobotModelInterface& model, int repetitions) {
+// wheel_rate_sigma: encoder noise (the data set on disk needs some: identical repetitions are
+// refused as copied files); 0 keeps the odometry exact.
+std::vector<sim::ModelSimulatedRun> Simulate(const RobotModelInterface& model, int repetitions,
+                                             double wheel_rate_sigma_rad_s = 0.0) {
   sim::SimulationOptions o;
+  o.wheel_rate_sigma_rad_s = wheel_rate_sigma_rad_s;
   o.encoder_period_s = 0.05;
   o.ground_truth_period_s = 0.05;  // a sample at every encoder time
   std::vector<double> truth = model.robot().nominal;
@@ -110,7 +114,7 @@ TEST(NoiseLevels, FitCommandEstimatesWeightsUnlessASigmaIsGiven) {
   const RobotModelPtr model = testing::ExampleModel("diff_drive");
   testing::TempDir tmp;
   const std::string dir = tmp.Path("loops");
-  sim::WriteSimulatedDataset(dir, FindModel("diff_drive")->example_yaml, Simulate(*model, 2));
+  sim::WriteSimulatedDataset(dir, FindModel("diff_drive")->example_yaml, Simulate(*model, 2, 0.01));
   const std::string fit = "fit --logs " + dir + " --residuals track --threads 1 --train-reps 1-99";
 
   const testing::FitcalRun estimated = testing::RunFitcal(tmp, fit + " --out " + tmp.Path("a.yaml"));
@@ -121,11 +125,11 @@ TEST(NoiseLevels, FitCommandEstimatesWeightsUnlessASigmaIsGiven) {
   EXPECT_TRUE(testing::Has(a, "weights from the data: track position")) << a;
 
   const testing::FitcalRun given =
-      testing::RunFitcal(tmp, fit + " --heading-sigma-deg 2 --out " + tmp.Path("b.yaml"));
+      testing::RunFitcal(tmp, fit + " --position-sigma-m 0.004 --heading-sigma-deg 1.15 --out " + tmp.Path("b.yaml"));
   ASSERT_EQ(given.exit_code, 0) << given.out << given.err;
   EXPECT_FALSE(testing::Has(given.out, "weights from the data")) << given.out;
   const std::string b = testing::ReadFileBytes(tmp.Path("b.yaml"));
-  EXPECT_TRUE(testing::Has(b, "sigma_xy 1.000000 m, sigma_theta 2.000000 deg")) << b;
+  EXPECT_TRUE(testing::Has(b, "sigma_xy 0.004000 m, sigma_theta 1.150000 deg")) << b;
 
   const testing::FitcalRun bad =
       testing::RunFitcal(tmp, fit + " --track-heading sideways --out " + tmp.Path("c.yaml"));
