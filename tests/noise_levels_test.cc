@@ -42,8 +42,8 @@ std::vector<sim::ModelSimulatedRun> Simulate(const RobotModelInterface& model, i
   for (double& v : truth) v *= kCommonScale;
   sim::DiffDriveTrajectoryOptions shapes;
   shapes.circle_laps = 1.25;  // open arcs: their tracks see every parameter
-  std::vector<sim::ModelSimulatedRun> runs =
-      sim::SimulateRuns(model, truth, sim::DiffDriveCalibrationTrajectories(repetitions, shapes), o);
+  std::vector<sim::ModelSimulatedRun> runs = sim::SimulateRuns(
+      model, truth, sim::DiffDriveCalibrationTrajectories(repetitions, shapes), o);
   std::mt19937 rng(7);
   std::normal_distribution<double> normal(0.0, 1.0);
   for (sim::ModelSimulatedRun& run : runs) {
@@ -78,7 +78,8 @@ TEST(NoiseLevels, TrackFitRecoversKnownPositionAndHeadingNoise) {
   for (const RunLog& log : logs) tracks.push_back(&log.ground_truth);
   const TrackFitData data = MakeTrackFitData(runs, tracks, ClockGrouping::kNone);
   std::vector<int> checkpoints;
-  for (const TrackCheckpoints& t : data.runs) checkpoints.push_back(static_cast<int>(t.segments.size()));
+  for (const TrackCheckpoints& t : data.runs)
+    checkpoints.push_back(static_cast<int>(t.segments.size()));
 
   for (ResidualKind kind : {ResidualKind::kTrack, ResidualKind::kBoth}) {
     ModelFitOptions o;
@@ -100,7 +101,8 @@ TEST(NoiseLevels, TrackFitRecoversKnownPositionAndHeadingNoise) {
     if (kind != ResidualKind::kBoth) continue;
     // One final pose per run: K = 1.
     const std::vector<int> ones(runs.size(), 1);
-    EXPECT_NEAR(levels.final_position_m / kPositionSigmaM, 1.0, 4.0 * RelativeStandardError(ones, 2))
+    EXPECT_NEAR(levels.final_position_m / kPositionSigmaM, 1.0,
+                4.0 * RelativeStandardError(ones, 2))
         << NoiseLevelsText(levels);
     EXPECT_NEAR(levels.final_heading_rad / kHeadingSigmaRad, 1.0,
                 4.0 * RelativeStandardError(ones, 1))
@@ -117,15 +119,16 @@ TEST(NoiseLevels, FitCommandEstimatesWeightsUnlessASigmaIsGiven) {
   sim::WriteSimulatedDataset(dir, FindModel("diff_drive")->example_yaml, Simulate(*model, 2, 0.01));
   const std::string fit = "fit --logs " + dir + " --residuals track --threads 1 --train-reps 1-99";
 
-  const testing::FitcalRun estimated = testing::RunFitcal(tmp, fit + " --out " + tmp.Path("a.yaml"));
+  const testing::FitcalRun estimated =
+      testing::RunFitcal(tmp, fit + " --out " + tmp.Path("a.yaml"));
   ASSERT_EQ(estimated.exit_code, 0) << estimated.out << estimated.err;
   EXPECT_TRUE(testing::Has(estimated.out, "weights from the data (variance components"))
       << estimated.out;
   const std::string a = testing::ReadFileBytes(tmp.Path("a.yaml"));
   EXPECT_TRUE(testing::Has(a, "weights from the data: track position")) << a;
 
-  const testing::FitcalRun given =
-      testing::RunFitcal(tmp, fit + " --position-sigma-m 0.004 --heading-sigma-deg 1.15 --out " + tmp.Path("b.yaml"));
+  const testing::FitcalRun given = testing::RunFitcal(
+      tmp, fit + " --position-sigma-m 0.004 --heading-sigma-deg 1.15 --out " + tmp.Path("b.yaml"));
   ASSERT_EQ(given.exit_code, 0) << given.out << given.err;
   EXPECT_FALSE(testing::Has(given.out, "weights from the data")) << given.out;
   const std::string b = testing::ReadFileBytes(tmp.Path("b.yaml"));

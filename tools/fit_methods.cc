@@ -217,7 +217,8 @@ bool MakeFitMethodSettings(const SolverOptions& o, int threads, FitMethodSetting
     return false;
   }
   if (!ParseTrackHeading(o.track_heading, &s->track_heading)) {
-    *error = "unknown --track-heading '" + o.track_heading + "' (available: from-start, increments)";
+    *error = "unknown --track-heading '" + o.track_heading +
+             "' (available: from-start, increments)";
     return false;
   }
   if (!ParseCeresRobustLoss(o.loss, &s->loss)) {

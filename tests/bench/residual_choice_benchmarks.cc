@@ -41,8 +41,8 @@ const std::string& Fitcal() {
 std::string DataSet(const std::string& name, std::string* error) {
   static std::map<std::string, std::string> made;
   if (const auto found = made.find(name); found != made.end()) return found->second;
-  const fs::path dir =
-      fs::temp_directory_path() / ("fitcal_choice_bench_" + name + "_" + std::to_string(::getpid()));
+  const fs::path dir = fs::temp_directory_path() /
+                       ("fitcal_choice_bench_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   std::string command;
   if (name == "asoc") {
@@ -65,7 +65,8 @@ std::string DataSet(const std::string& name, std::string* error) {
   return made[name] = dir.string();
 }
 
-void BM_FitResiduals(benchmark::State& state, const std::string& data, const std::string& residuals) {
+void BM_FitResiduals(benchmark::State& state, const std::string& data,
+                     const std::string& residuals) {
   std::string error;
   const std::string dir = DataSet(data, &error);
   if (dir.empty()) {
