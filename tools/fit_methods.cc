@@ -78,6 +78,7 @@ ModelFitMethodOutcome RunModelCeres(CeresTrustRegion trust_region,
   options.residuals = settings.residuals;
   options.track = settings.track;
   options.estimate_weights = settings.estimate_weights;
+  options.track_weights = settings.track_weights;
   options.tying = &settings.tying;
   ModelFitMethodOutcome out;
   out.fit = FitModelFrom(training, model,

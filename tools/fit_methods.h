@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,9 @@ struct FitMethodSettings {
   std::function<void(const NloptProgress&)> progress;  // NLopt only
   // Groups of parameters sharing one value and parameters held at the nominal (every method).
   ParameterTying tying;
+  // Ceres with track residuals: the first fit's track weights when they differ from `weights`
+  // (e.g. the noise levels a fit of more runs settled on, so that a fold's estimate settles fast).
+  std::optional<ResidualWeights> track_weights;
   // Ceres: where the fit starts (empty: the robot's nominal), e.g. a fit of more runs whose
   // neighbourhood a fold's fit will end in. NLopt methods search their box and ignore it.
   std::vector<double> start;

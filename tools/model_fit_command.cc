@@ -609,6 +609,9 @@ std::vector<std::string> ChooseResidualsByTransfer(const FitCommandOptions& opti
     s.residuals = kind;
     s.track = nullptr;
     s.start = start;
+    if (whole.noise_levels.estimated) {
+      s.track_weights = WeightsFromNoiseLevels(whole.noise_levels).track;
+    }
     RunSplit part;
     part.training = training;
     std::optional<TrackFitData> data;
