@@ -25,6 +25,11 @@ bool UsesTracks(const ModelFitOptions& options) {
   return options.segments == nullptr && options.residuals != ResidualKind::kFinalPose;
 }
 
+// The weights of the track residuals (ModelFitOptions::track_weights, else the final poses').
+ResidualWeights TrackWeightsOf(const ModelFitOptions& options) {
+  return options.track_weights.value_or(options.ceres.weights);
+}
+
 // Rounds of the active set: one per parameter that comes to rest on a bound, and releases.
 constexpr int kMaxActiveSetRounds = 16;
 
@@ -100,7 +105,8 @@ class FitProblem {
       const TrackCheckpoints& track = fit_options.track->runs[i];
       if (!track.segments.empty()) {
         data_blocks_.push_back(problem_->AddResidualBlock(
-            TrackResidual::Create(track, model, options.weights, fit_options.track->options),
+            TrackResidual::Create(track, model, TrackWeightsOf(fit_options),
+                                  fit_options.track->options),
             nullptr, p, clock_offsets + track.clock_group));
       }
     }
@@ -513,7 +519,7 @@ void SolveClockOffsetsAt(const RobotModelInterface& model, const ModelFitOptions
     for (const TrackCheckpoints& run : track.runs) {
       if (run.clock_group != static_cast<int>(g) || run.segments.empty()) continue;
       std::unique_ptr<TrackResidual> cost(static_cast<TrackResidual*>(
-          TrackResidual::Create(run, model, options.ceres.weights, track.options)));
+          TrackResidual::Create(run, model, TrackWeightsOf(options), track.options)));
       std::vector<double> poses = cost->OdometryFromStart(p.data());
       runs.emplace_back(std::move(cost), std::move(poses));
     }
@@ -675,6 +681,50 @@ double HoldWeight(const DirectionAnalysis& analysis) {
   return w > 0.0 && std::isfinite(w) ? w : 1.0;
 }
 
+// ModelFitOptions::estimate_weights (fit/noise_levels.h): fit, estimate the noise levels at the
+// solution, reweight, refit from there, until two estimates agree. The fit returned is the last
+// one, made with weights that agree with the estimate at its solution.
+ModelFitResult FitWithNoiseLevels(const std::vector<AlignedRun>& training,
+                                  const RobotModelInterface& model,
+                                  const std::vector<double>& start,
+                                  const ModelFitOptions& options) {
+  ModelFitOptions weighted = options;
+  weighted.estimate_weights = false;
+  std::vector<double> from = start;
+  NoiseLevels levels;
+  ModelFitResult fit;
+  int iterations = 0;
+  double solve_time_s = 0.0;
+  for (int round = 1; round <= kMaxNoiseLevelIterations; ++round) {
+    fit = FitModelFrom(training, model, from, weighted);
+    iterations += fit.iterations;
+    solve_time_s += fit.solve_time_s;
+    if (!(fit.usable || fit.stopped_early)) break;
+    const int held = static_cast<int>(std::count(fit.held.begin(), fit.held.end(), true));
+    const int offsets = options.track->estimate_clock_offsets
+                            ? static_cast<int>(options.track->clock_groups.size())
+                            : 0;
+    const int estimated = model.robot().NumParameters() - held -
+                          static_cast<int>(fit.held_directions.size()) + offsets;
+    NoiseLevels next =
+        EstimateNoiseLevels(training, model, fit.parameters, fit.clock_offsets_s, *options.track,
+                            options.residuals == ResidualKind::kBoth, estimated);
+    if (!next.estimated) break;
+    next.iterations = round;
+    next.settled = NoiseLevelsAgree(levels, next);
+    levels = next;
+    if (levels.settled) break;
+    const FitWeights w = WeightsFromNoiseLevels(levels);
+    weighted.track_weights = w.track;
+    if (levels.with_final_poses) weighted.ceres.weights = w.final_pose;
+    from = fit.parameters;
+  }
+  fit.noise_levels = levels;
+  fit.iterations = iterations;
+  fit.solve_time_s = solve_time_s;
+  return fit;
+}
+
 }  // namespace
 
 ModelFitResult FitModelFrom(const std::vector<AlignedRun>& training,
@@ -704,6 +754,9 @@ ModelFitResult FitModelFrom(const std::vector<AlignedRun>& training,
         throw std::invalid_argument("FitModel: a track's clock group is out of range");
     }
   }
+  if (options.estimate_weights && UsesTracks(options)) {
+    return FitWithNoiseLevels(training, model, start, options);
+  }
   // What the direction analysis sees: with tracks, their checkpoints at the start's clock offsets
   // (the last checkpoint is the final pose relative to the start, so "both" adds nothing to it).
   std::vector<std::vector<Segment>> checkpoints;
@@ -719,7 +772,8 @@ ModelFitResult FitModelFrom(const std::vector<AlignedRun>& training,
     bool finite = true;
     for (double v : result.parameters) finite = finite && std::isfinite(v);
     const DirectionAnalysis analysis = AnalyseDeterminedDirections(
-        training, model, finite ? result.parameters : start, options.ceres.weights, analysed,
+        training, model, finite ? result.parameters : start,
+        UsesTracks(options) ? TrackWeightsOf(options) : options.ceres.weights, analysed,
         options.ceres.num_threads);
     if (analysis.ok && !analysis.undetermined.empty()) {
       holds.directions = analysis.undetermined;
@@ -778,7 +832,7 @@ ClockOffsetEstimate EstimateClockOffsets(const RobotModelInterface& model,
   for (const TrackCheckpoints& run : track.runs) {
     if (run.segments.empty()) continue;
     const std::unique_ptr<ceres::CostFunction> cost(
-        TrackResidual::Create(run, model, options.ceres.weights, track.options));
+        TrackResidual::Create(run, model, TrackWeightsOf(options), track.options));
     const int m = cost->num_residuals();
     std::vector<double> r(m), j_dt(m);
     const double* parameters[] = {p.data(), &out.offsets_s[run.clock_group]};

@@ -26,10 +26,12 @@
 // the unconstrained problem only.
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "fit/determined_directions.h"
+#include "fit/noise_levels.h"
 #include "fit/parameter_tying.h"
 #include "fit/solver_options.h"
 #include "fit/track_residual.h"
@@ -80,6 +82,9 @@ struct ModelFitResult {
   // What the global start did (ModelFitOptions::global_start), in words; empty when the fit from
   // the nominal ended on no bound.
   std::string global_start;
+
+  // ModelFitOptions::estimate_weights: the noise levels the weights came from (fit/noise_levels.h).
+  NoiseLevels noise_levels;
 };
 
 // What the fit compares with the ground truth (fit/track_residual.h):
@@ -98,6 +103,14 @@ struct ModelFitOptions {
   // Which residuals (ignored when `segments` is set); kTrack and kBoth need `track`.
   ResidualKind residuals = ResidualKind::kFinalPose;
   const TrackFitData* track = nullptr;
+  // The track residuals' weights when they differ from the final poses' (ceres.weights, which
+  // they share when unset).
+  std::optional<ResidualWeights> track_weights;
+  // With track residuals: weigh the residual components by noise levels estimated from the fit
+  // itself (fit/noise_levels.h: variance components re-estimated at the solution, each fit
+  // warm-started from the last, until they settle); ceres.weights and track_weights are then
+  // only the first fit's. Final poses alone keep ceres.weights (Palacin Eq. 14's 1 m : 1 rad).
+  bool estimate_weights = false;
   // Use the active set above (false: one plain bounded Ceres solve, as before; kept for tests
   // that show the difference).
   bool active_set_bounds = true;

@@ -36,6 +36,20 @@ TrackCheckpoints MakeTrackCheckpoints(const AlignedRun& run, const GroundTruthTr
   return out;
 }
 
+const char* ToString(TrackHeading heading) {
+  return heading == TrackHeading::kIncrements ? "increments" : "from-start";
+}
+
+bool ParseTrackHeading(const std::string& text, TrackHeading* out) {
+  for (TrackHeading h : {TrackHeading::kFromStart, TrackHeading::kIncrements}) {
+    if (text == ToString(h)) {
+      *out = h;
+      return true;
+    }
+  }
+  return false;
+}
+
 const char* ToString(ClockGrouping grouping) {
   switch (grouping) {
     case ClockGrouping::kPerSession:
@@ -136,6 +150,7 @@ TrackResidual::TrackResidual(const TrackCheckpoints& track, const RobotModelInte
     : track_(track),
       weights_(weights),
       huber_scale_(options.huber_scale),
+      heading_(options.heading),
       run_weight_(1.0 /
                   std::sqrt(static_cast<double>(std::max<std::size_t>(1, track.segments.size())))),
       num_parameters_(model.robot().NumParameters()) {
@@ -180,8 +195,17 @@ std::array<TrackResidual::ErrorJet, 3> TrackResidual::CheckpointResidual(
   const double inv_th = 1.0 / weights_.heading_sigma_rad;
   const ErrorJet cq = cos(q.theta), sq = sin(q.theta);
   const ErrorJet ex = p.x - q.x, ey = p.y - q.y;
+  ErrorJet heading_error = p.theta - q.theta;
+  if (heading_ == TrackHeading::kIncrements && k > 0) {
+    // Minus the same error at checkpoint k - 1: the odometry's heading there (Jet dimension 4)
+    // against the ground truth's.
+    const ErrorJet p_before(pose[3 * (k - 1) + 2], 4);
+    const Pose2<ErrorJet> q_before = Between(
+        q0, InterpolateGroundTruth(*track_.ground_truth, ErrorJet(track_.t_s[k - 1] + dt_s, 3)));
+    heading_error = heading_error - (p_before - q_before.theta);
+  }
   const ErrorJet e[3] = {(cq * ex + sq * ey) * inv_xy, (-sq * ex + cq * ey) * inv_xy,
-                         WrapAngle(p.theta - q.theta) * inv_th};
+                         WrapAngle(heading_error) * inv_th};
   const ErrorJet factor =
       run_weight_ * HuberFactor(e[0] * e[0] + e[1] * e[1] + e[2] * e[2], huber_scale_);
   return {factor * e[0], factor * e[1], factor * e[2]};
@@ -224,10 +248,11 @@ bool TrackResidual::Evaluate(double const* const* parameters, double* residuals,
       const int row = 3 * k + i;
       residuals[row] = r.a;
       if (jacobians == nullptr) continue;
-      if (want_p) {  // dr/dp = dr/dP_k dP_k/dp
+      if (want_p) {  // dr/dp = dr/dP_k dP_k/dp (+ dr/dtheta_Pk-1 dtheta_Pk-1/dp)
         for (int j = 0; j < n; ++j) {
           double sum = 0.0;
           for (int c = 0; c < 3; ++c) sum += r.v[c] * pose_jacobian[(3 * k + c) * n + j];
+          if (k > 0) sum += r.v[4] * pose_jacobian[(3 * (k - 1) + 2) * n + j];
           jacobians[0][row * n + j] = sum;
         }
       }

@@ -48,8 +48,17 @@
 
 namespace fitcal {
 
+// The heading term of checkpoint k: the heading from the run's start (theta_Pk - theta_Qk, as
+// Palacin Eq. 14 at every checkpoint), or its increment over the last checkpoint spacing
+// ((theta_Pk - theta_Pk-1) - (theta_Qk - theta_Qk-1); k = 0 against the start), which counts each
+// stretch's heading error once instead of carrying it into every later checkpoint.
+enum class TrackHeading { kFromStart, kIncrements };
+const char* ToString(TrackHeading heading);  // "from-start", "increments"
+bool ParseTrackHeading(const std::string& text, TrackHeading* out);
+
 struct TrackResidualOptions {
   double checkpoint_spacing_m = 0.5;  // OptiOdom's
+  TrackHeading heading = TrackHeading::kFromStart;
   double huber_scale = 0.1;           // c, residual units (m and rad): a few times a clean error
   double max_clock_offset_s = 0.5;    // |dt| bound
   bool IsValid(std::string* error) const;
@@ -124,8 +133,9 @@ class TrackResidual : public ceres::CostFunction {
   double SquaredNormAt(const std::vector<double>& pose_from_start, double dt_s) const;
 
  private:
-  // Jet dimensions: the odometry pose (x, y, theta) and the clock offset.
-  using ErrorJet = ceres::Jet<double, 4>;
+  // Jet dimensions: the odometry pose (x, y, theta), the clock offset, and the odometry's heading
+  // at the checkpoint before (TrackHeading::kIncrements).
+  using ErrorJet = ceres::Jet<double, 5>;
   Pose2<ErrorJet> GroundTruthAtStart(double dt_s) const;
   std::array<ErrorJet, 3> CheckpointResidual(const std::vector<double>& pose, int k,
                                              const Pose2<ErrorJet>& q0, double dt_s) const;
@@ -138,6 +148,7 @@ class TrackResidual : public ceres::CostFunction {
   std::vector<Segment> from_start_;                // windows [0, k] with an identity ground truth
   ResidualWeights weights_;
   double huber_scale_;
+  TrackHeading heading_;
   double run_weight_;  // 1 / sqrt(K)
   int num_parameters_;
 };

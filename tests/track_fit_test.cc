@@ -79,43 +79,51 @@ ModelFitOptions FitOptions(ResidualKind kind, const TrackFitData* track) {
 TEST(TrackResidual, JacobiansMatchCentralDifferences) {
   const RobotModelPtr model = Model();
   const Simulated s = SimulateLoops(*model, 1);
-  const TrackFitData data = MakeTrackFitData(s.aligned, s.tracks, ClockGrouping::kPerRun);
-  std::vector<double> p = {0.0425, 0.0418, 0.203};
-  double dt = 0.1234;  // between ground-truth samples (0.1 s apart): the interpolant is smooth
-  for (const TrackCheckpoints& track : data.runs) {
-    std::unique_ptr<ceres::CostFunction> cost(
-        TrackResidual::Create(track, *model, ResidualWeights{}, data.options));
-    const int m = cost->num_residuals();
-    std::vector<double> r(m), j_p(m * 3), j_dt(m);
-    const double* parameters[] = {p.data(), &dt};
-    double* jacobians[] = {j_p.data(), j_dt.data()};
-    ASSERT_TRUE(cost->Evaluate(parameters, r.data(), jacobians));
-    const auto residuals_at = [&](const std::vector<double>& q, double t) {
-      std::vector<double> out(m);
-      const double* at[] = {q.data(), &t};
-      cost->Evaluate(at, out.data(), nullptr);
-      return out;
-    };
-    // h: truncation O(h^2) and rounding O(1e-16 / h) both far below the 1e-5 relative tolerance
-    // (a Huber kink crossed by the step would show as a gross mismatch, not within it).
-    for (int k = 0; k < 4; ++k) {
-      const double h = k < 3 ? 1e-7 : 1e-6;
-      std::vector<double> plus = p, minus = p;
-      double dt_plus = dt, dt_minus = dt;
-      if (k < 3) {
-        plus[k] += h;
-        minus[k] -= h;
-      } else {
-        dt_plus += h;
-        dt_minus -= h;
-      }
-      const std::vector<double> rp = residuals_at(plus, dt_plus);
-      const std::vector<double> rm = residuals_at(minus, dt_minus);
-      for (int i = 0; i < m; ++i) {
-        const double numeric = (rp[i] - rm[i]) / (2.0 * h);
-        const double analytic = k < 3 ? j_p[i * 3 + k] : j_dt[i];
-        EXPECT_NEAR(analytic, numeric, 1e-5 * (1.0 + std::abs(numeric)))
-            << track.run->id << " residual " << i << " parameter " << k;
+  // Both heading forms: from the run's start, and increments between checkpoints (whose
+  // residual also depends on the odometry at the checkpoint before).
+  for (TrackHeading heading : {TrackHeading::kFromStart, TrackHeading::kIncrements}) {
+    TrackResidualOptions track_options;
+    track_options.heading = heading;
+    const TrackFitData data =
+        MakeTrackFitData(s.aligned, s.tracks, ClockGrouping::kPerRun, track_options);
+    std::vector<double> p = {0.0425, 0.0418, 0.203};
+    double dt = 0.1234;  // between ground-truth samples (0.1 s apart): the interpolant is smooth
+    for (const TrackCheckpoints& track : data.runs) {
+      std::unique_ptr<ceres::CostFunction> cost(
+          TrackResidual::Create(track, *model, ResidualWeights{}, data.options));
+      const int m = cost->num_residuals();
+      std::vector<double> r(m), j_p(m * 3), j_dt(m);
+      const double* parameters[] = {p.data(), &dt};
+      double* jacobians[] = {j_p.data(), j_dt.data()};
+      ASSERT_TRUE(cost->Evaluate(parameters, r.data(), jacobians));
+      const auto residuals_at = [&](const std::vector<double>& q, double t) {
+        std::vector<double> out(m);
+        const double* at[] = {q.data(), &t};
+        cost->Evaluate(at, out.data(), nullptr);
+        return out;
+      };
+      // h: truncation O(h^2) and rounding O(1e-16 / h) both far below the 1e-5 relative tolerance
+      // (a Huber kink crossed by the step would show as a gross mismatch, not within it).
+      for (int k = 0; k < 4; ++k) {
+        const double h = k < 3 ? 1e-7 : 1e-6;
+        std::vector<double> plus = p, minus = p;
+        double dt_plus = dt, dt_minus = dt;
+        if (k < 3) {
+          plus[k] += h;
+          minus[k] -= h;
+        } else {
+          dt_plus += h;
+          dt_minus -= h;
+        }
+        const std::vector<double> rp = residuals_at(plus, dt_plus);
+        const std::vector<double> rm = residuals_at(minus, dt_minus);
+        for (int i = 0; i < m; ++i) {
+          const double numeric = (rp[i] - rm[i]) / (2.0 * h);
+          const double analytic = k < 3 ? j_p[i * 3 + k] : j_dt[i];
+          EXPECT_NEAR(analytic, numeric, 1e-5 * (1.0 + std::abs(numeric)))
+              << ToString(heading) << " " << track.run->id << " residual " << i << " parameter "
+              << k;
+        }
       }
     }
   }

@@ -60,8 +60,8 @@ std::string ResidualsText(const FitMethodSettings& settings) {
   char text[300];
   std::snprintf(text, sizeof text,
                 "track residuals (pose from the run's start every %.2g m of ground-truth path and "
-                "at the end, Huber %.2g, runs weighed alike; clock offsets: %s)%s",
-                t.checkpoint_spacing_m, t.huber_scale,
+                "at the end, heading %s, Huber %.2g, runs weighed alike; clock offsets: %s)%s",
+                t.checkpoint_spacing_m, ToString(t.heading), t.huber_scale,
                 settings.clock_grouping == ClockGrouping::kNone
                     ? "none"
                     : (std::string("one per ") + ToString(settings.clock_grouping)).c_str(),
@@ -77,9 +77,12 @@ ModelFitMethodOutcome RunModelCeres(CeresTrustRegion trust_region,
   options.ceres = CeresOptionsFor(trust_region, settings);
   options.residuals = settings.residuals;
   options.track = settings.track;
+  options.estimate_weights = settings.estimate_weights;
+  options.track_weights = settings.track_weights;
   options.tying = &settings.tying;
   ModelFitMethodOutcome out;
-  out.fit = FitModel(training, model, options);
+  out.fit = FitModelFrom(training, model,
+                         settings.start.empty() ? model.robot().nominal : settings.start, options);
   out.evaluations = out.fit.num_residual_evaluations + out.fit.num_jacobian_evaluations;
   out.objective = ResidualsText(settings);
   if (options.residuals != ResidualKind::kTrack) {
@@ -198,6 +201,7 @@ bool MakeFitMethodSettings(const SolverOptions& o, int threads, FitMethodSetting
   s->threads = threads;
   s->max_iterations = o.max_iterations;
   s->weights = o.Weights();
+  s->estimate_weights = !o.sigmas_given;
   s->objective_set = !o.objective.empty();
   if (s->objective_set && !ParseFinalPoseObjective(o.objective, &s->objective)) {
     *error = "unknown --objective '" + o.objective + "' (available: squares, eq14)";
@@ -211,6 +215,11 @@ bool MakeFitMethodSettings(const SolverOptions& o, int threads, FitMethodSetting
   }
   if (!ParseClockGrouping(o.clock_offsets, &s->clock_grouping)) {
     *error = "unknown --clock-offsets '" + o.clock_offsets + "' (available: session, run, dataset, none)";
+    return false;
+  }
+  if (!ParseTrackHeading(o.track_heading, &s->track_heading)) {
+    *error = "unknown --track-heading '" + o.track_heading +
+             "' (available: from-start, increments)";
     return false;
   }
   if (!ParseCeresRobustLoss(o.loss, &s->loss)) {

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,9 @@ struct FitMethodSettings {
   int threads = 0;
   int max_iterations = 100;  // Ceres iterations per solve
   ResidualWeights weights;
+  // Ceres with track residuals: weights from noise levels estimated by the fit (fit/noise_levels.h);
+  // `weights` start it. Off when the user gave a sigma.
+  bool estimate_weights = true;
   // Ceres: kSumOfSquares by default; NLopt: Eq. 14 by default (see the option docs).
   bool objective_set = false;
   FinalPoseObjective objective = FinalPoseObjective::kSumOfSquares;
@@ -30,6 +34,7 @@ struct FitMethodSettings {
   ResidualKind residuals = ResidualKind::kFinalPose;
   bool residuals_auto = false;  // --residuals auto: ResolveAutoResiduals sets `residuals`
   ClockGrouping clock_grouping = ClockGrouping::kPerSession;
+  TrackHeading track_heading = TrackHeading::kFromStart;
   const TrackFitData* track = nullptr;
   CeresRobustLoss loss = CeresRobustLoss::kNone;  // Ceres only
   double loss_scale = 0.05;
@@ -39,6 +44,12 @@ struct FitMethodSettings {
   std::function<void(const NloptProgress&)> progress;  // NLopt only
   // Groups of parameters sharing one value and parameters held at the nominal (every method).
   ParameterTying tying;
+  // Ceres with track residuals: the first fit's track weights when they differ from `weights`
+  // (e.g. the noise levels a fit of more runs settled on, so that a fold's estimate settles fast).
+  std::optional<ResidualWeights> track_weights;
+  // Ceres: where the fit starts (empty: the robot's nominal), e.g. a fit of more runs whose
+  // neighbourhood a fold's fit will end in. NLopt methods search their box and ignore it.
+  std::vector<double> start;
 };
 
 // A method's fit: the generic Ceres fit's result shape (NLopt methods leave the covariance out and

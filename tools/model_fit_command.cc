@@ -121,6 +121,8 @@ struct SelectedFit {
   Eigen::MatrixXd correlation;
   std::vector<bool> at_bound, held;  // per parameter
   std::string objective, termination;
+  // The weights' noise levels when the fit estimated them (fit/noise_levels.h); else not estimated.
+  NoiseLevels noise_levels;
 };
 
 constexpr const char* kTrackObjective = "sum over runs of the mean squared track error (m and rad)";
@@ -146,7 +148,8 @@ SelectedFit DescribeSelected(const Robot& robot,
                   std::vector<bool>(n, false),
                   std::vector<bool>(n, false),
                   method_objective,
-                  fit.termination};
+                  fit.termination,
+                  {}};
   const EffectFitResult* track_fit = nullptr;
   if (track_fits && selected_index == track_fits->with_index) {
     track_fit = &track_fits->with_effects;
@@ -164,6 +167,7 @@ SelectedFit DescribeSelected(const Robot& robot,
     out.objective = kTrackObjective;
     out.termination = track_fit->termination;
   } else if (selected.name == method) {
+    out.noise_levels = fit.noise_levels;
     out.has_covariance = fit.has_covariance;
     out.sigma = fit.sigma;
     out.correlation = fit.correlation;
@@ -258,13 +262,20 @@ bool PrintGate(const std::vector<CalibrationCandidate>& candidates, const GateDe
   return false;
 }
 
+// The weights in words: the noise levels the fit estimated, or the sigmas it was given.
+std::string WeightsText(const FitCommandOptions& options, const NoiseLevels& levels) {
+  if (levels.estimated) return "weights from the data: " + NoiseLevelsText(levels);
+  return "sigma_xy " + std::to_string(options.position_sigma_m) + " m, sigma_theta " +
+         std::to_string(options.heading_sigma_deg) + " deg";
+}
+
 void RecordFitSource(const FitCommandOptions& options, const std::vector<RunLog>& logs,
                      const RunSplit& split, const std::string& method, const std::string& objective,
-                     const std::string& termination, io::CalibrationSource* source) {
+                     const std::string& termination, const NoiseLevels& levels,
+                     io::CalibrationSource* source) {
   io::CalibrationSource& s = *source;
   s.method = method;
-  s.objective = objective + " (sigma_xy " + std::to_string(options.position_sigma_m) +
-                " m, sigma_theta " + std::to_string(options.heading_sigma_deg) + " deg)";
+  s.objective = objective + " (" + WeightsText(options, levels) + ")";
   s.dataset = options.logs;
   s.tool_version = kVersion;
   s.termination = termination;
@@ -287,7 +298,7 @@ io::CalibrationBlock MakeRecord(const FitCommandOptions& options, const RobotMod
   const CalibrationCandidate& selected = candidates[gate.selected];
   io::CalibrationBlock r;
   RecordFitSource(options, logs, split, selected.name, selected_fit.objective,
-                  selected_fit.termination, &r);
+                  selected_fit.termination, selected_fit.noise_levels, &r);
   r.cf_training_before = errors(nominal, split.training).cf;
   r.cf_training_after = errors(selected, split.training).cf;
   r.cf_validation_before = errors(nominal, split.validation).cf;
@@ -512,7 +523,9 @@ bool PrepareTrackResiduals(const FitCommandOptions& options, const std::vector<R
               << " fits final poses only\n";
     return false;
   }
-  data->emplace(MakeTrackFitData(split.training, tracks, settings->clock_grouping));
+  TrackResidualOptions track_options;
+  track_options.heading = settings->track_heading;
+  data->emplace(MakeTrackFitData(split.training, tracks, settings->clock_grouping, track_options));
   settings->track = &**data;
   return true;
 }
@@ -607,22 +620,33 @@ void PrintEverydayDriving(const RobotModelInterface& model, const std::vector<Ru
 
 // --residuals auto proposing the track: the track and the final pose are fitted and judged on
 // kinds of run they were not fitted on (validation/residual_kind_transfer.h); the final pose
-// replaces the track when that judgement says so (settings and *track_data follow). The lines
-// for the terminal; none when nothing could be judged.
+// replaces the track when that judgement says so (settings and *track_data follow). The folds'
+// fits start from the track fit of all the training runs (`full`, the fit the command writes
+// when the track stays), so each ends in a few steps, and run in parallel. The lines for the
+// terminal; none when nothing could be judged.
 std::vector<std::string> ChooseResidualsByTransfer(const FitCommandOptions& options,
                                                    const FitMethod& method,
                                                    const RobotModelInterface& model,
                                                    const RunSplit& split,
                                                    const std::vector<RunLog>& logs,
                                                    FitMethodSettings* settings,
-                                                   std::optional<TrackFitData>* track_data) {
+                                                   std::optional<TrackFitData>* track_data,
+                                                   std::optional<ModelFitMethodOutcome>* full) {
   if (!settings->residuals_auto || settings->residuals != ResidualKind::kTrack) return {};
+  full->emplace(method.run_model(split.training, model, *settings));
+  const ModelFitResult& whole = (*full)->fit;
+  const std::vector<double> start =
+      whole.usable || whole.stopped_early ? whole.parameters : std::vector<double>{};
   const FitByKind fit_on = [&](ResidualKind kind, const std::vector<AlignedRun>& training)
       -> std::optional<std::vector<double>> {
     FitMethodSettings s = *settings;
     s.residuals_auto = false;
     s.residuals = kind;
     s.track = nullptr;
+    s.start = start;
+    if (whole.noise_levels.estimated) {
+      s.track_weights = WeightsFromNoiseLevels(whole.noise_levels).track;
+    }
     RunSplit part;
     part.training = training;
     std::optional<TrackFitData> data;
@@ -641,6 +665,7 @@ std::vector<std::string> ChooseResidualsByTransfer(const FitCommandOptions& opti
     settings->residuals = judgement.chosen;
     settings->track = nullptr;
     track_data->reset();
+    full->reset();
   }
   return ResidualKindJudgementLines(judgement);
 }
@@ -932,6 +957,11 @@ void PrintResiduals(const FitMethodSettings& settings, bool residuals_auto,
   std::printf("residuals: %s%s\n", ToString(settings.residuals),
               residuals_auto ? " (--residuals auto)" : "");
   for (const std::string& line : residual_choice) std::printf("%s\n", line.c_str());
+  if (fit.noise_levels.estimated) {
+    std::printf("weights from the data (variance components at the solution; "
+                "--position-sigma-m/--heading-sigma-deg override): %s\n",
+                NoiseLevelsText(fit.noise_levels).c_str());
+  }
   if (track_data) PrintClockOffsets(fit, *track_data);
 }
 
@@ -978,10 +1008,12 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   }
   std::optional<TrackFitData> track_data;
   if (!PrepareTrackResiduals(options, logs, split, &settings, &track_data)) return 2;
+  // The fit of all the training runs when the choice by transfer made it (and kept its kind).
+  std::optional<ModelFitMethodOutcome> chosen_fit;
   const std::vector<std::string> residual_choice =
-      effects_to_fit->empty()
-          ? ChooseResidualsByTransfer(options, *method, *model, split, logs, &settings, &track_data)
-          : std::vector<std::string>{};
+      effects_to_fit->empty() ? ChooseResidualsByTransfer(options, *method, *model, split, logs,
+                                                          &settings, &track_data, &chosen_fit)
+                              : std::vector<std::string>{};
   std::vector<std::string> residual_lines = residual_choice;
   for (const std::string& note : FlagsTheChoiceLeavesUnused(options, settings)) {
     residual_lines.push_back(note);
@@ -995,7 +1027,8 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
     std::cerr << "fitcal: " << options.logs << ": " << refusal << "\n";
     return 1;
   }
-  const ModelFitMethodOutcome outcome = method->run_model(split.training, *model, settings);
+  const ModelFitMethodOutcome outcome =
+      chosen_fit ? std::move(*chosen_fit) : method->run_model(split.training, *model, settings);
   const ModelFitResult& fit = outcome.fit;
   std::vector<CalibrationCandidate> candidates =
       Candidates(*model, split, fit, options.method, settings.tying.empty());

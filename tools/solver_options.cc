@@ -28,6 +28,10 @@ void AddSolverOptions(CLI::App& app, SolverOptions& o) {
                  "run's trajectory label; import optiodom: the recording folder), per run, one "
                  "for the whole data set, or none (held at 0)")
       ->capture_default_str();
+  app.add_option("--track-heading", o.track_heading,
+                 "Track residuals: the heading compared from the run's start (from-start) or as "
+                 "its increment over each checkpoint spacing (increments)")
+      ->capture_default_str();
   app.add_option("--loss", o.loss, "Ceres robust loss: none, huber, cauchy")->capture_default_str();
   app.add_option("--loss-scale", o.loss_scale, "Robust loss scale (residual units: m and rad)")
       ->capture_default_str();
@@ -40,15 +44,20 @@ void AddSolverOptions(CLI::App& app, SolverOptions& o) {
       ->check(CLI::PositiveNumber);
   app.add_flag("--polish", o.polish,
                "NLopt global methods: polish the best point with SLSQP (autodiff gradient)");
+  const auto given = [&o](const std::string&) { o.sigmas_given = true; };
   app.add_option("--position-sigma-m", o.position_sigma_m,
                  "Weight of the position residual as a standard deviation (m); with the default "
-                 "1 m and 57.3 deg the objective weighs metres and radians as Eq. 14")
+                 "1 m and 57.3 deg the objective weighs metres and radians as Eq. 14. Track "
+                 "residuals (and both) are weighed by noise levels estimated from the fit unless "
+                 "this or --heading-sigma-deg is given")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::PositiveNumber)
+      ->each(given);
   app.add_option("--heading-sigma-deg", o.heading_sigma_deg,
                  "Weight of the heading residual as a standard deviation (deg)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::PositiveNumber)
+      ->each(given);
 }
 
 }  // namespace fitcal::tools

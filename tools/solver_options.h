@@ -19,6 +19,8 @@ struct SolverOptions {
   std::string residuals = "auto";
   // Track residuals: one clock offset per session, run, data set, or none (all held at 0).
   std::string clock_offsets = "none";
+  // Track residuals: the heading from the run's start, or its increments between checkpoints.
+  std::string track_heading = "from-start";
   std::string loss = "none";    // Ceres: none, huber, cauchy
   double loss_scale = 0.05;     // Ceres robust loss scale, residual units
   unsigned long seed = 1;       // NLopt
@@ -26,9 +28,12 @@ struct SolverOptions {
   int max_iterations = 100;     // Ceres iterations per solve
   bool polish = false;          // NLopt global methods: SLSQP polish of the best point
   // The residual's weights as standard deviations; 1 m and 1 rad weigh metres and radians as
-  // Palacin Eq. 14's CF does.
+  // Palacin Eq. 14's CF does. Track residuals (and `both`) are weighed by noise levels estimated
+  // from the fit (fit/noise_levels.h) unless a sigma is given (sigmas_given).
   double position_sigma_m = 1.0;
   double heading_sigma_deg = 180.0 / 3.14159265358979323846;
+  // Set when either sigma is given: the weights are then these, not estimated from the data.
+  bool sigmas_given = false;
 
   ResidualWeights Weights() const;  // the sigmas in SI units (the heading's in radians)
 };

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <future>
 #include <map>
 
 #include "odometry/text_format.h"
@@ -33,23 +34,36 @@ void CountWins(const KindComparison& c, int* wins, int* total) {
   count(c.proposed.mean_ate_rmse_m, c.alternative.mean_ate_rmse_m);
 }
 
-struct Judge {
-  ResidualKind proposed, alternative;
-  const FitByKind& fit_on;
-  const ScoreOnRuns& score;
-
-  // Both kinds fitted on `training`, judged on `judged`; false when a fit is not usable.
-  bool Compare(const std::vector<AlignedRun>& training, const std::vector<AlignedRun>& judged,
-               KindComparison* out) const {
-    const std::optional<std::vector<double>> p = fit_on(proposed, training);
-    const std::optional<std::vector<double>> a = fit_on(alternative, training);
-    if (!p || !a) return false;
-    out->runs = static_cast<int>(judged.size());
-    out->proposed = score(*p, judged);
-    out->alternative = score(*a, judged);
-    return true;
-  }
+// One comparison to make: both kinds fitted on `training`, judged on `judged`.
+struct PendingComparison {
+  KindComparison comparison;
+  std::vector<AlignedRun> training, judged;
+  std::future<std::optional<std::vector<double>>> proposed, alternative;
 };
+
+// Every fit of every comparison at once, each on a thread of its own (the folds are independent;
+// the caller's fits may start from a fit of all runs, so each ends in a few steps), then the
+// scores; false when a fit is not usable.
+bool FitAndScore(ResidualKind proposed, ResidualKind alternative, const FitByKind& fit_on,
+                 const ScoreOnRuns& score, std::vector<PendingComparison>* pending,
+                 std::vector<KindComparison>* out) {
+  for (PendingComparison& c : *pending) {
+    c.proposed = std::async(std::launch::async, fit_on, proposed, std::cref(c.training));
+    c.alternative = std::async(std::launch::async, fit_on, alternative, std::cref(c.training));
+  }
+  bool usable = true;
+  for (PendingComparison& c : *pending) {
+    const std::optional<std::vector<double>> p = c.proposed.get();
+    const std::optional<std::vector<double>> a = c.alternative.get();
+    if (!p || !a) usable = false;
+    if (!usable) continue;
+    c.comparison.runs = static_cast<int>(c.judged.size());
+    c.comparison.proposed = score(*p, c.judged);
+    c.comparison.alternative = score(*a, c.judged);
+    out->push_back(std::move(c.comparison));
+  }
+  return usable;
+}
 
 std::string FamiliesExcept(const std::map<std::string, std::vector<AlignedRun>>& by,
                            const std::string& left_out) {
@@ -69,28 +83,33 @@ ResidualKindJudgement JudgeResidualKindsByTransfer(ResidualKind proposed, Residu
   ResidualKindJudgement j;
   j.proposed = j.chosen = proposed;
   j.alternative = alternative;
-  const Judge judge{proposed, alternative, fit_on, score};
+  std::vector<PendingComparison> pending;
   const auto held_out = RunsByFamily(split.validation);
   if (const auto free = held_out.find(kFreeDriving); free != held_out.end()) {
-    KindComparison c;
-    c.judged_on = kFreeDriving;
-    c.fitted_on = "all training runs";
-    if (!judge.Compare(split.training, free->second, &c)) return j;
+    PendingComparison c;
+    c.comparison.judged_on = kFreeDriving;
+    c.comparison.fitted_on = "all training runs";
+    c.training = split.training;
+    c.judged = free->second;
+    pending.push_back(std::move(c));
     j.on_free_driving = true;
-    j.comparisons.push_back(std::move(c));
   } else {
     const auto training = RunsByFamily(split.training);
     if (training.size() < 2) return j;
     for (const auto& [family, runs] : training) {
-      std::vector<AlignedRun> others;
+      PendingComparison c;
       for (const AlignedRun& run : split.training)
-        if (TrajectoryFamily(run.trajectory) != family) others.push_back(run);
-      KindComparison c;
-      c.judged_on = family;
-      c.fitted_on = FamiliesExcept(training, family);
-      if (!judge.Compare(others, runs, &c)) return j;
-      j.comparisons.push_back(std::move(c));
+        if (TrajectoryFamily(run.trajectory) != family) c.training.push_back(run);
+      c.comparison.judged_on = family;
+      c.comparison.fitted_on = FamiliesExcept(training, family);
+      c.judged = runs;
+      pending.push_back(std::move(c));
     }
+  }
+  if (!FitAndScore(proposed, alternative, fit_on, score, &pending, &j.comparisons)) {
+    j.comparisons.clear();
+    j.on_free_driving = false;
+    return j;
   }
   for (const KindComparison& c : j.comparisons) CountWins(c, &j.alternative_wins, &j.total);
   j.judged = j.total > 0;

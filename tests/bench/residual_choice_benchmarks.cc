@@ -1,0 +1,108 @@
+// What `fitcal fit --residuals auto` costs against the single fit it selects (issue 40: auto must
+// cost at most twice that fit). `auto` proposes the track on dense ground truth and judges it
+// against the final pose by leave-one-kind-out fits (validation/residual_kind_transfer.h); the
+// benchmark runs the fit command as a user does, once with `--residuals auto` and once with the
+// kind it selects, on
+//   - asoc: the ASOC example of `fitcal asoc-simulate --seed 3` (36 runs, simulated, always here);
+//   - diff: the OptiOdom differential drive's circles + squares (97 runs; needs ../shared, skipped
+//     without it; FITCAL_SHARED_DIR points elsewhere).
+// Both commands run as child processes on the machine's cores (the folds run in parallel): the
+// benchmark reports wall time (UseRealTime) and the children's CPU time per iteration
+// (child_cpu_s). Data sets are written once per process, outside the timing.
+
+#include <benchmark/benchmark.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <string>
+
+namespace fitcal {
+namespace {
+
+namespace fs = std::filesystem;
+
+double ChildrenCpuSeconds() {
+  rusage usage{};
+  getrusage(RUSAGE_CHILDREN, &usage);
+  return static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+}
+
+const std::string& Fitcal() {
+  static const std::string path = std::string(FITCAL_BINARY_DIR) + "/tools/fitcal";
+  return path;
+}
+
+// The data set's directory, written on first use; "" after `error` when it cannot be made.
+std::string DataSet(const std::string& name, std::string* error) {
+  static std::map<std::string, std::string> made;
+  if (const auto found = made.find(name); found != made.end()) return found->second;
+  const fs::path dir = fs::temp_directory_path() /
+                       ("fitcal_choice_bench_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  std::string command;
+  if (name == "asoc") {
+    command = Fitcal() + " asoc-simulate --seed 3 --out " + dir.string();
+  } else {
+    const char* shared = std::getenv("FITCAL_SHARED_DIR");
+    const fs::path source =
+        fs::path(shared != nullptr ? shared : FITCAL_SHARED_DIR) / "data" / "optiodom" / name;
+    if (!fs::is_directory(source / "circular")) {
+      *error = "no shared data at " + source.string();
+      return "";
+    }
+    command = Fitcal() + " import optiodom " + (source / "circular").string() + "/* " +
+              (source / "square").string() + "/* --out " + dir.string();
+  }
+  if (std::system((command + " > /dev/null").c_str()) != 0) {
+    *error = "could not write the data set: " + command;
+    return "";
+  }
+  return made[name] = dir.string();
+}
+
+void BM_FitResiduals(benchmark::State& state, const std::string& data,
+                     const std::string& residuals) {
+  std::string error;
+  const std::string dir = DataSet(data, &error);
+  if (dir.empty()) {
+    state.SkipWithError(error.c_str());
+    return;
+  }
+  const std::string fit =
+      Fitcal() + " fit --logs " + dir + " --no-output --residuals " + residuals + " > /dev/null";
+  double cpu_s = 0.0;
+  for (auto _ : state) {
+    const double before = ChildrenCpuSeconds();
+    // Exit 5 (nothing beats the nominal) still timed the whole fit; other failures do not count.
+    const int status = std::system(fit.c_str());
+    if (!WIFEXITED(status) || (WEXITSTATUS(status) != 0 && WEXITSTATUS(status) != 5)) {
+      state.SkipWithError(("fitcal fit failed: " + fit).c_str());
+      break;
+    }
+    cpu_s += ChildrenCpuSeconds() - before;
+  }
+  state.counters["child_cpu_s"] = benchmark::Counter(cpu_s, benchmark::Counter::kAvgIterations);
+  state.SetLabel(data + ": fit --residuals " + residuals);
+}
+BENCHMARK_CAPTURE(BM_FitResiduals, asoc_auto, std::string("asoc"), std::string("auto"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_FitResiduals, asoc_track, std::string("asoc"), std::string("track"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_FitResiduals, diff_auto, std::string("diff"), std::string("auto"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_FitResiduals, diff_track, std::string("diff"), std::string("track"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+}  // namespace
+}  // namespace fitcal
+
+BENCHMARK_MAIN();
