@@ -110,14 +110,16 @@ TEST(NoiseLevels, TrackFitRecoversKnownPositionAndHeadingNoise) {
   }
 }
 
-// Through the command line: by default the track fit prints its estimated weights and records them
-// in the calibration's objective; a given sigma overrides the estimate and is recorded instead.
+// Through the command line: with --weights estimated the track fit prints its estimated weights and
+// records them in the calibration's objective; a given sigma overrides the estimate and is recorded
+// instead; by default (fixed) nothing is estimated.
 TEST(NoiseLevels, FitCommandEstimatesWeightsUnlessASigmaIsGiven) {
   const RobotModelPtr model = testing::ExampleModel("diff_drive");
   testing::TempDir tmp;
   const std::string dir = tmp.Path("loops");
   sim::WriteSimulatedDataset(dir, FindModel("diff_drive")->example_yaml, Simulate(*model, 2, 0.01));
-  const std::string fit = "fit --logs " + dir + " --residuals track --threads 1 --train-reps 1-99";
+  const std::string fit = "fit --logs " + dir +
+                          " --residuals track --threads 1 --train-reps 1-99 --weights estimated";
 
   const testing::FitcalRun estimated =
       testing::RunFitcal(tmp, fit + " --out " + tmp.Path("a.yaml"));
@@ -133,6 +135,11 @@ TEST(NoiseLevels, FitCommandEstimatesWeightsUnlessASigmaIsGiven) {
   EXPECT_FALSE(testing::Has(given.out, "weights from the data")) << given.out;
   const std::string b = testing::ReadFileBytes(tmp.Path("b.yaml"));
   EXPECT_TRUE(testing::Has(b, "sigma_xy 0.004000 m, sigma_theta 1.150000 deg")) << b;
+
+  const std::string plain = "fit --logs " + dir + " --residuals track --threads 1 --train-reps 1-99";
+  const testing::FitcalRun fixed = testing::RunFitcal(tmp, plain + " --out " + tmp.Path("d.yaml"));
+  ASSERT_EQ(fixed.exit_code, 0) << fixed.out << fixed.err;
+  EXPECT_FALSE(testing::Has(fixed.out, "weights from the data")) << fixed.out;
 
   const testing::FitcalRun bad =
       testing::RunFitcal(tmp, fit + " --track-heading sideways --out " + tmp.Path("c.yaml"));

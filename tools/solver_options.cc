@@ -44,12 +44,17 @@ void AddSolverOptions(CLI::App& app, SolverOptions& o) {
       ->check(CLI::PositiveNumber);
   app.add_flag("--polish", o.polish,
                "NLopt global methods: polish the best point with SLSQP (autodiff gradient)");
+  app.add_option("--weights", o.weights,
+                 "Track residuals: fixed (the sigmas below) or estimated (noise levels of "
+                 "position and heading estimated from the fit itself, printed and written into "
+                 "the calibration's objective; docs/everyday_driving.md)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"fixed", "estimated"}));
   const auto given = [&o](const std::string&) { o.sigmas_given = true; };
   app.add_option("--position-sigma-m", o.position_sigma_m,
                  "Weight of the position residual as a standard deviation (m); with the default "
-                 "1 m and 57.3 deg the objective weighs metres and radians as Eq. 14. Track "
-                 "residuals (and both) are weighed by noise levels estimated from the fit unless "
-                 "this or --heading-sigma-deg is given")
+                 "1 m and 57.3 deg the objective weighs metres and radians as Eq. 14. With "
+                 "--weights estimated, giving this or --heading-sigma-deg fixes the weights")
       ->capture_default_str()
       ->check(CLI::PositiveNumber)
       ->each(given);
