@@ -201,7 +201,7 @@ bool MakeFitMethodSettings(const SolverOptions& o, int threads, FitMethodSetting
   s->threads = threads;
   s->max_iterations = o.max_iterations;
   s->weights = o.Weights();
-  s->estimate_weights = o.weights == "estimated" && !o.sigmas_given;
+  s->estimate_weights = o.weight_mode == "estimated" && !o.sigmas_given;
   s->objective_set = !o.objective.empty();
   if (s->objective_set && !ParseFinalPoseObjective(o.objective, &s->objective)) {
     *error = "unknown --objective '" + o.objective + "' (available: squares, eq14)";

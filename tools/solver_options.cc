@@ -44,7 +44,7 @@ void AddSolverOptions(CLI::App& app, SolverOptions& o) {
       ->check(CLI::PositiveNumber);
   app.add_flag("--polish", o.polish,
                "NLopt global methods: polish the best point with SLSQP (autodiff gradient)");
-  app.add_option("--weights", o.weights,
+  app.add_option("--weights", o.weight_mode,
                  "Track residuals: fixed (the sigmas below) or estimated (noise levels of "
                  "position and heading estimated from the fit itself, printed and written into "
                  "the calibration's objective; docs/everyday_driving.md)")

@@ -28,12 +28,12 @@ struct SolverOptions {
   int max_iterations = 100;     // Ceres iterations per solve
   bool polish = false;          // NLopt global methods: SLSQP polish of the best point
   // The residual's weights as standard deviations; 1 m and 1 rad weigh metres and radians as
-  // Palacin Eq. 14's CF does. With weights = "estimated", track residuals (and `both`) are
+  // Palacin Eq. 14's CF does. With weight_mode = "estimated", track residuals (and `both`) are
   // weighed by noise levels estimated from the fit (fit/noise_levels.h) unless a sigma is given
   // (sigmas_given). Default "fixed": on the shared OptiOdom free runs the estimate helped the
   // differential drive and cost omni3 more (docs/everyday_driving.md), so it is opt-in until the
   // choice is made by transfer.
-  std::string weights = "fixed";
+  std::string weight_mode = "fixed";
   double position_sigma_m = 1.0;
   double heading_sigma_deg = 180.0 / 3.14159265358979323846;
   // Set when either sigma is given: the weights are then these, not estimated from the data.
