@@ -145,17 +145,21 @@ INSTANTIATE_TEST_SUITE_P(
 
 // An import over its own previous output is replaced only with --force (the marker is what lets
 // it recognise the data set as its own).
-TEST(ImportThroughTheCommandLine, ReplacesItsOwnDataSetWithForceOnly) {
+TEST(ImportThroughTheCommandLine, ReplacesItsOwnDataSetAndRefusesAForeignDirectory) {
+  // The one overwrite rule (tools/output_guard.h): running the import again replaces the data set
+  // it wrote; a directory holding other files is never replaced, --force or not.
   TempDir tmp;
   WriteBag(tmp, "bag", StorageFormat::kMcap, true);
   const std::string out = tmp.Path("imported");
   ASSERT_EQ(RunFitcal(tmp, ImportArgs(tmp, tmp.Path("bag"), out)).exit_code, 0);
   const testing::FitcalRun again = RunFitcal(tmp, ImportArgs(tmp, tmp.Path("bag"), out));
-  EXPECT_EQ(again.exit_code, 2);
-  EXPECT_TRUE(Has(again.err, "--force")) << again.err;
-  const testing::FitcalRun forced = RunFitcal(tmp, ImportArgs(tmp, tmp.Path("bag"), out) + " --force");
-  EXPECT_EQ(forced.exit_code, 0) << forced.err;
+  EXPECT_EQ(again.exit_code, 0) << again.err;
   ExpectNoStagingLeft(out);
+  tmp.Write("foreign/notes.txt", "not a data set");
+  const testing::FitcalRun foreign =
+      RunFitcal(tmp, ImportArgs(tmp, tmp.Path("bag"), tmp.Path("foreign")) + " --force");
+  EXPECT_EQ(foreign.exit_code, 2) << foreign.err;
+  EXPECT_EQ(testing::ReadFileBytes(tmp.Path("foreign/notes.txt")), "not a data set");
 }
 
 // The bags ROS 2's own recorder wrote (../shared/data/rosbag2, README there): no JointState
