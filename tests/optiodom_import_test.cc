@@ -114,7 +114,7 @@ TEST(OptiOdomImport, WritesATicksDataSetThatLoadsBackToTheSameRuns) {
   }
   // Running the import again replaces the data set it wrote (README, Outputs: issue 42).
   EXPECT_EQ(tools::RunImportOptiOdomCommand(options), 0);
-  EXPECT_TRUE(fs::exists(out / "dataset.yaml"));
+  EXPECT_TRUE(fs::exists(out / "ds" / "dataset.yaml"));
   fs::remove_all(out);
 }
 
