@@ -2,6 +2,7 @@
 // What the benchmarks share: sizes from the environment, where the shared data are (also for the
 // tests that read them) and a scratch directory for the inputs they write once.
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <cstdint>
@@ -10,6 +11,15 @@
 #include <string>
 
 namespace fitcal::bench {
+
+// CPU seconds (user + system) of the children this process has waited for: the fitcal processes a
+// benchmark ran, whatever else the machine was doing.
+inline double ChildrenCpuSeconds() {
+  rusage usage{};
+  getrusage(RUSAGE_CHILDREN, &usage);
+  return static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+}
 
 // The environment variable `name` as a number, `fallback` when it is not set.
 inline long EnvOr(const char* name, long fallback) {

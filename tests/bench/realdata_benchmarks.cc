@@ -23,13 +23,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-double ChildrenCpuSeconds() {
-  rusage usage{};
-  getrusage(RUSAGE_CHILDREN, &usage);
-  return static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
-         1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
-}
-
 // robot: a folder of ../shared/data/optiodom; fit_flags: what `fit` gets besides the data set.
 void BM_ImportAndFit(benchmark::State& state, const std::string& robot,
                      const std::string& fit_flags) {
@@ -51,12 +44,12 @@ void BM_ImportAndFit(benchmark::State& state, const std::string& robot,
     state.PauseTiming();
     fs::remove_all(out);
     state.ResumeTiming();
-    const double cpu_before = ChildrenCpuSeconds();
+    const double cpu_before = bench::ChildrenCpuSeconds();
     if (std::system(import.c_str()) != 0 || std::system(fit.c_str()) != 0) {
       state.SkipWithError("fitcal import or fit failed");
       break;
     }
-    cpu_s += ChildrenCpuSeconds() - cpu_before;
+    cpu_s += bench::ChildrenCpuSeconds() - cpu_before;
   }
   fs::remove_all(out);
   state.counters["child_cpu_s"] = benchmark::Counter(cpu_s, benchmark::Counter::kAvgIterations);

@@ -20,17 +20,12 @@
 #include <map>
 #include <string>
 
+#include "tests/bench/bench_support.h"
+
 namespace fitcal {
 namespace {
 
 namespace fs = std::filesystem;
-
-double ChildrenCpuSeconds() {
-  rusage usage{};
-  getrusage(RUSAGE_CHILDREN, &usage);
-  return static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
-         1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
-}
 
 const std::string& Fitcal() {
   static const std::string path = std::string(FITCAL_BINARY_DIR) + "/tools/fitcal";
@@ -77,14 +72,14 @@ void BM_FitResiduals(benchmark::State& state, const std::string& data,
       Fitcal() + " fit --logs " + dir + " --no-output --residuals " + residuals + " > /dev/null";
   double cpu_s = 0.0;
   for (auto _ : state) {
-    const double before = ChildrenCpuSeconds();
+    const double before = bench::ChildrenCpuSeconds();
     // Exit 5 (nothing beats the nominal) still timed the whole fit; other failures do not count.
     const int status = std::system(fit.c_str());
     if (!WIFEXITED(status) || (WEXITSTATUS(status) != 0 && WEXITSTATUS(status) != 5)) {
       state.SkipWithError(("fitcal fit failed: " + fit).c_str());
       break;
     }
-    cpu_s += ChildrenCpuSeconds() - before;
+    cpu_s += bench::ChildrenCpuSeconds() - before;
   }
   state.counters["child_cpu_s"] = benchmark::Counter(cpu_s, benchmark::Counter::kAvgIterations);
   state.SetLabel(data + ": fit --residuals " + residuals);
