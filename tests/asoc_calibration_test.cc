@@ -10,6 +10,7 @@
 #include "io/input_error.h"
 #include "models/asoc/asoc_geometric.h"
 #include "tools/sim/asoc_simulator.h"
+#include "tests/test_paths.h"
 
 namespace fitcal::asoc {
 namespace {

@@ -15,6 +15,7 @@
 #include "models/omni3/omni3_robot_model.h"
 #include "odometry/aligned_run.h"
 #include "tools/import_optiodom.h"
+#include "tests/test_paths.h"
 
 namespace fitcal {
 namespace {

@@ -14,11 +14,12 @@
 #include "fit/segment_cost.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "tools/sim/flower_scenario.h"
+#include "tests/test_paths.h"
 
 namespace fitcal {
 namespace {
 
-Omni3Robot NominalRobot() { return ReadOmni3Robot(FITCAL_SOURCE_DIR "/data/robots/apr02.yaml"); }
+Omni3Robot NominalRobot() { return ReadOmni3Robot(FITCAL_SOURCE_DIR + "/data/robots/apr02.yaml"); }
 
 // Every third flower trajectory (12 of 36): R, G and B alike, enough to separate the nine.
 std::vector<sim::MotionCommand> FlowerSubset() {

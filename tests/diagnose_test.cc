@@ -15,11 +15,12 @@
 #include "models/model_registry.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "tools/sim/flower_scenario.h"
+#include "tests/test_paths.h"
 
 namespace fitcal {
 namespace {
 
-Omni3Robot NominalRobot() { return ReadOmni3Robot(FITCAL_SOURCE_DIR "/data/robots/apr02.yaml"); }
+Omni3Robot NominalRobot() { return ReadOmni3Robot(FITCAL_SOURCE_DIR + "/data/robots/apr02.yaml"); }
 
 // The nominal robot on the model seam, which Diagnose works through.
 std::shared_ptr<const Omni3Model> NominalModel() { return Omni3ModelOf(NominalRobot()); }

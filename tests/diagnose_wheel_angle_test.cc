@@ -12,11 +12,12 @@
 #include "fit/run_split.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "tools/sim/flower_scenario.h"
+#include "tests/test_paths.h"
 
 namespace fitcal {
 namespace {
 
-Omni3Robot NominalRobot() { return ReadOmni3Robot(FITCAL_SOURCE_DIR "/data/robots/apr02.yaml"); }
+Omni3Robot NominalRobot() { return ReadOmni3Robot(FITCAL_SOURCE_DIR + "/data/robots/apr02.yaml"); }
 
 // Every third flower trajectory (12 of 36), four repetitions (1-2 train, 3-4 validate), each run
 // at random absolute wheel angles; wheel a's rolling radius r_a (1 + e cos A_a).

@@ -18,6 +18,7 @@
 #include "tests/omni3_reference_replay.h"
 #include "tools/sim/flower_scenario.h"
 #include "validation/statistics.h"
+#include "tests/test_paths.h"
 
 namespace fitcal {
 namespace {
@@ -237,7 +238,7 @@ std::string TempPath(const std::string& name) {
 
 // The calibrated YAML carries the effects and gives them back.
 TEST(RobotYamlEffects, RoundTripAndBadInput) {
-  Omni3Robot robot = ReadOmni3Robot(FITCAL_SOURCE_DIR "/data/robots/apr02.yaml");
+  Omni3Robot robot = ReadOmni3Robot(FITCAL_SOURCE_DIR + "/data/robots/apr02.yaml");
   effects::EffectValue slip;
   slip.id = EffectId::kWheelSpeedSlip;
   slip.value[0] = 0.0123;
@@ -261,7 +262,7 @@ TEST(RobotYamlEffects, RoundTripAndBadInput) {
   EXPECT_DOUBLE_EQ(back.effects[1].value[1], -0.002);
 
   const auto expect_bad = [&](const std::string& effects_text, const std::string& what) {
-    const RobotModelPtr model = ReadRobotModelFile(FITCAL_SOURCE_DIR "/data/robots/apr02.yaml");
+    const RobotModelPtr model = ReadRobotModelFile(FITCAL_SOURCE_DIR + "/data/robots/apr02.yaml");
     std::string yaml = model->RobotYaml(model->robot().nominal, "");
     yaml += "effects:\n" + effects_text;
     {

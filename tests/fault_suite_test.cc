@@ -260,7 +260,7 @@ TEST(FaultSuiteTest, ForceReplacesOnlyWhatFitcalWroteAsTheSameKind) {
   const auto before = Snapshot(user);
   for (const std::string& command :
        {std::string("simulate --model diff_drive --repetitions 2"), std::string("asoc-simulate"),
-        std::string("simulate --repetitions 1 --robot " FITCAL_SOURCE_DIR "/data/robots/apr02.yaml")}) {
+        std::string("simulate --repetitions 1 --robot ") + FITCAL_SOURCE_DIR + "/data/robots/apr02.yaml"}) {
     for (const char* force : {"", " --force"}) {
       const auto r = RunFitcal(dir, command + force + " --out '" + user.string() + "'");
       EXPECT_EQ(r.exit_code, 2) << command << force << ": " << r.err;

@@ -20,8 +20,8 @@ using testing::ReadFileBytes;
 using testing::RunFitcal;
 using testing::TempDir;
 
-const std::string kFlower = FITCAL_SOURCE_DIR "/data/flower";
-const std::string kDiff = FITCAL_SHARED_DIR "/data/optiodom/diff";
+const std::string kFlower = FITCAL_SOURCE_DIR + "/data/flower";
+const std::string kDiff = FITCAL_SHARED_DIR + "/data/optiodom/diff";
 
 // Rule 1: every command that writes replaces its own previous output when run again; rule 2: a
 // file it did not write is refused with exit 2, nothing written, the message naming --force, and
@@ -82,7 +82,7 @@ TEST(NewcomerCli, RawRecordingsAsLogsAreToldToImportFirst) {
   EXPECT_TRUE(Has(r.err, "fitcal import optiodom")) << r.err;
   const auto robot_folder =
       RunFitcal(dir, "report --logs " + dir.Path("raw") +
-                         " --calibration " FITCAL_SOURCE_DIR "/data/robots/apr02.yaml --out " +
+                         " --calibration " + FITCAL_SOURCE_DIR + "/data/robots/apr02.yaml --out " +
                          dir.Path("rep"));
   EXPECT_TRUE(Has(robot_folder.err, "fitcal import optiodom")) << robot_folder.err;
   dir.Write("bag/metadata.yaml", "rosbag2_bagfile_information: {}\n");

@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "tests/test_paths.h"
+
 namespace fitcal::testing {
 
 // The whole file as bytes ("" when it cannot be read).
@@ -88,7 +90,6 @@ class TempDir {
   std::filesystem::path path_;
 };
 
-#ifdef FITCAL_BINARY_DIR
 // The fitcal binary run as a user runs it: its exit code and what it printed.
 struct FitcalRun {
   int exit_code = -1;
@@ -120,6 +121,5 @@ inline FitcalRun RunFitcalOutside(const std::filesystem::path& scratch, const st
   std::filesystem::remove(err);
   return r;
 }
-#endif
 
 }  // namespace fitcal::testing

@@ -10,6 +10,8 @@
 #include <filesystem>
 #include <string>
 
+#include "tests/test_paths.h"
+
 namespace fitcal::bench {
 
 // CPU seconds (user + system) of the children this process has waited for: the fitcal processes a
@@ -34,9 +36,9 @@ inline std::uint64_t EnvBytes(const char* name, long fallback_mb) {
 
 // The shared data (../shared beside the checkout, `built_in`), or $FITCAL_SHARED_DIR where the
 // checkout has none beside it (a git worktree elsewhere).
-inline std::filesystem::path SharedDir(const char* built_in) {
+inline std::filesystem::path SharedDir(const std::string& built_in) {
   const char* env = std::getenv("FITCAL_SHARED_DIR");
-  return env != nullptr && *env != '\0' ? env : built_in;
+  return env != nullptr && *env != '\0' ? std::filesystem::path(env) : std::filesystem::path(built_in);
 }
 
 // A fresh directory under the system's temporary directory, removed with everything in it.

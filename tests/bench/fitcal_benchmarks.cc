@@ -17,6 +17,7 @@
 #include "odometry/linear_final_pose_kernel.h"
 #include "tests/omni3_reference_replay.h"
 #include "tools/sim/flower_scenario.h"
+#include "tests/test_paths.h"
 
 namespace fitcal {
 namespace {
