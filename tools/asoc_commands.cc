@@ -198,7 +198,17 @@ int RunAsocGeometric(const AsocGeometricOptions& options) {
                 kVersion, robot.name.c_str(), options.logs.c_str());
     PrintCastors(robot, robot.nominal.castors, "nominal");
     PrintCastors(robot, result.estimate.castors, "calibrated");
-    PrintCastors(robot, result.sigma, "+-1 sigma, spread over hold runs");
+    std::printf(
+        "\n  %-8s %10s %10s %10s %10s %10s %12s   (+-1 sigma: spread over hold runs and "
+        "the pivot step)\n",
+        "castor", "r_c [m]", "r_w1 [m]", "r_w2 [m]", "d_1 [m]", "d_2 [m]", "beta [deg]");
+    for (int i = 0; i < asoc::kNumCastors; ++i) {
+      const asoc::CastorParameters& s = result.sigma[i];
+      std::printf("  %-8s %10.2g %10.2g %10.2g %10.2g %10.2g %12.2g\n",
+                  robot.castor_names[i].c_str(), s.offset_m, s.wheel_radius_m[0],
+                  s.wheel_radius_m[1], s.wheel_offset_m[0], s.wheel_offset_m[1],
+                  RadToDeg(s.encoder_bias_rad));
+    }
     std::printf(
         "\n  sigmas from %d degrees of freedom; half-difference of the estimates per "
         "castor (repeatability):\n",
