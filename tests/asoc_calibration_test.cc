@@ -2,12 +2,13 @@
 // the seam's generic one: asoc_model_test).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
-#include "models/asoc/asoc_files.h"
 #include "io/atomic_file.h"
 #include "io/input_error.h"
+#include "models/asoc/asoc_files.h"
 #include "models/asoc/asoc_geometric.h"
 #include "tools/sim/asoc_simulator.h"
 
@@ -100,6 +101,36 @@ TEST(AsocFilesTest, RobotYamlRoundTrip) {
   const auto a = robot.nominal.ToArray(), b = back.nominal.ToArray();
   // Ten significant digits are written: 1e-9 relative.
   for (int k = 0; k < kNumParameters; ++k) EXPECT_NEAR(a[k], b[k], 1e-9 * (std::abs(a[k]) + 1e-3));
+}
+
+// pivot_resolution_deg (the closed form's sigmas propagate it): written and read back; a value
+// that is no step (0, negative, half a turn) refused with the file and its line.
+TEST(AsocFilesTest, PivotResolutionRoundTripAndBadValues) {
+  io::AsocRobot robot;
+  robot.name = "proto";
+  robot.nominal = sim::AsocPrototypeVehicle();
+  robot.pivot_distance_m = robot.nominal.PivotDistance(0, 1);
+  robot.pivot_resolution_rad = 0.07 * M_PI / 180.0;
+  const std::string path = TempPath("resolution.yaml");
+  const std::string text = io::AsocRobotYaml(robot);
+  io::WriteFileAtomically(path, text);
+  EXPECT_NEAR(io::ReadAsocRobot(path).pivot_resolution_rad, robot.pivot_resolution_rad, 1e-12);
+  const std::size_t at = text.find("pivot_resolution_deg: 0.07\n");
+  ASSERT_NE(at, std::string::npos) << text;
+  const int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + at, '\n'));
+  for (const char* bad : {"0", "-0.07", "180"}) {
+    std::string edited = text;
+    edited.replace(at, std::string("pivot_resolution_deg: 0.07").size(),
+                   std::string("pivot_resolution_deg: ") + bad);
+    io::WriteFileAtomically(path, edited);
+    try {
+      io::ReadAsocRobot(path);
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const io::InputError& e) {
+      EXPECT_EQ(e.line(), line) << e.what();
+      EXPECT_NE(std::string(e.what()).find("pivot_resolution_deg"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(AsocFilesTest, EncoderCsvRoundTripAndBadInput) {
