@@ -21,6 +21,9 @@ struct CalibrationCandidate {
   bool usable = true;  // a fit that did not converge to a usable point competes not
   // Effects (odometry/effects.h) the candidate's odometry applies on top of the parameters.
   std::vector<effects::EffectValue> effects = {};
+  // The candidate's own 1-sigma per parameter, when it carries one (a closed form's,
+  // ClosedFormCalibration::sigma); empty otherwise.
+  std::vector<double> sigma = {};
 };
 
 // The CF (Eq. 14, mean over `runs`) of a candidate that carries effects: their replay needs each

@@ -70,6 +70,10 @@ struct ClosedFormCalibration {
   std::string method;  // "umbmark", "asoc-geometric"
   std::vector<double> parameters;
   std::string note;  // e.g. which runs it used
+  // Its own 1-sigma per parameter where it measures one (ASOC: the spread of its estimates over
+  // hold runs); empty, or NaN for a parameter it does not measure (left to the propagated
+  // uncertainty, validation/propagated_uncertainty.h).
+  std::vector<double> sigma = {};
 };
 
 // A model's kinematics at fixed parameters, for replays that transform the channel values or the

@@ -4,6 +4,7 @@
 #include <ceres/jet.h>
 
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -249,6 +250,10 @@ std::vector<ClosedFormCalibration> MountedModel::ClosedForms(
   for (ClosedFormCalibration& c : out) {
     c.parameters.insert(c.parameters.end(), robot_.nominal.begin() + MountIndex(),
                         robot_.nominal.end());
+    // The frame is not measured by it: NaN leaves its sigma to the propagated uncertainty.
+    if (!c.sigma.empty()) {
+      c.sigma.resize(c.parameters.size(), std::numeric_limits<double>::quiet_NaN());
+    }
   }
   return out;
 }

@@ -108,6 +108,10 @@ TEST(GateCli, TheTimeBlockVerdictDoesNotFlipWithTheCount) {
     EXPECT_TRUE(Has(line, "of 3 counts")) << line;
   }
   EXPECT_EQ(exit_code, 0);  // the simulated run calibrates
+  // A count beside 2, 4 and 8 joins them: the judgement pools four counts, 6 among them.
+  const auto six = RunFitcal(dir, "fit --logs " + data + " --no-output --time-blocks 6");
+  EXPECT_TRUE(Has(six.out, "two folds each of 2, 4, 6, 8 blocks")) << six.out;
+  EXPECT_TRUE(Has(six.out, "of 4 counts")) << six.out;
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "tests/approval_lines.h"
 #include "tests/test_files.h"
 
 namespace fitcal {
@@ -19,52 +20,22 @@ namespace {
 using fitcal::testing::RunFitcal;
 using fitcal::testing::TempDir;
 
-std::vector<std::string> Tokens(const std::string& line) {
-  std::istringstream in(line);
-  std::vector<std::string> out;
-  for (std::string t; in >> t;) out.push_back(t);
-  return out;
-}
+using fitcal::testing::MissingFromBlock;
+using fitcal::testing::Tokens;
 
-// A printed number ("0.0176", "-9.1%", "+49.9%"): its value and one unit in its last printed
-// decimal place; false for any other token.
-bool PrintedNumber(std::string token, double* value, double* last_digit) {
-  if (!token.empty() && token.back() == '%') token.pop_back();
-  char* end = nullptr;
-  *value = std::strtod(token.c_str(), &end);
-  if (token.empty() || end != token.c_str() + token.size()) return false;
-  const std::size_t dot = token.find('.');
-  const int decimals = dot == std::string::npos ? 0 : static_cast<int>(token.size() - dot - 1);
-  *last_digit = std::pow(10.0, -decimals);
-  return true;
-}
-
-// Every expected line appears in `out` with the same words and the same numbers to one unit in
-// their last printed digit. Tolerance: the figures are sums over runs evaluated in parallel and
-// fits that stop on Ceres' tolerances (function 1e-6 relative and below); the last bits may
-// differ between builds and thread counts, never the fourth decimal of a CF by more than the
-// rounding of the print, which one unit in the last printed place covers.
-void ExpectLines(const std::string& out, const std::vector<std::string>& expected) {
-  std::istringstream lines(out);
-  std::vector<std::vector<std::string>> printed;
-  for (std::string line; std::getline(lines, line);) printed.push_back(Tokens(line));
-  for (const std::string& line : expected) {
-    const std::vector<std::string> want = Tokens(line);
-    bool found = false;
-    for (const auto& got : printed) {
-      if (got.size() != want.size()) continue;
-      bool same = true;
-      for (std::size_t k = 0; k < want.size() && same; ++k) {
-        double a, b, unit, unused;
-        if (PrintedNumber(want[k], &a, &unit) && PrintedNumber(got[k], &b, &unused)) {
-          same = std::abs(a - b) <= unit * (1.0 + 1e-9);
-        } else {
-          same = want[k] == got[k];
-        }
-      }
-      found = found || same;
+// Every expected block is printed, each line with the same words and numbers
+// (tests/approval_lines.h: whole numbers exactly, others to one unit in their last printed digit).
+// Tolerance: the figures are sums over runs evaluated in parallel and fits that stop on Ceres'
+// tolerances (function 1e-6 relative and below); the last bits may differ between builds and thread
+// counts, never the fourth decimal of a CF by more than the rounding of the print, which one unit
+// in the last printed place covers.
+void ExpectBlocks(const std::string& out, const std::vector<std::vector<std::string>>& expected) {
+  for (const std::vector<std::string>& block : expected) {
+    for (const std::string& line : MissingFromBlock(out, block)) {
+      ADD_FAILURE() << "missing from its block (first line: " << block.front() << "): " << line
+                    << "\nprinted:\n"
+                    << out;
     }
-    EXPECT_TRUE(found) << "missing: " << line << "\nprinted:\n" << out;
   }
 }
 
@@ -78,24 +49,26 @@ TEST(GeneraliseApproval, FlowerFigures) {
   const auto r =
       RunFitcal(dir, "generalise --logs " + data + " --train-trajectories '^R' --no-loso");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  ExpectLines(
+  ExpectBlocks(
       r.out,
       {
-          "| '^R' -> others | nominal | 120 | 240 | 0.0420 | 0.0880 | 0.053 | 3.98 | - | - |",
-          "| '^R' -> others | fit | 120 | 240 | 0.0075 | 0.1155 | 0.050 | 5.95 | 3 | 0 |",
-          "| '^R' -> others | fit without holds | 120 | 240 | 0.0075 | 0.0176 | 0.010 | 0.81 | - | "
-          "- |",
-          "| others -> '^R' | nominal | 240 | 120 | 0.0880 | 0.0420 | 0.039 | 0.80 | - | - |",
-          "| others -> '^R' | fit | 240 | 120 | 0.0077 | 0.0076 | 0.005 | 0.27 | 0 | 0 |",
-          "| every path type, reps 1-5 -> the other reps | nominal | 180 | 180 | 0.0728 | 0.0726 | "
-          "0.048 | 2.92 | - | - |",
-          "| every path type, reps 1-5 -> the other reps | fit | 180 | 180 | 0.0076 | 0.0078 | "
-          "0.005 "
-          "| 0.28 | 0 | 0 |",
-          "  others -> '^R': fit               nominal calibrated    change",
-          "  ATE RMSE [m] (mean of runs)        0.0269     0.0048    -82.0%",
-          "  drift 1 m [%] (342 windows)         3.834      0.535    -86.0%",
-          "  drift 1 m [deg/m]                   0.772      0.278    -64.0%",
+          {"| '^R' -> others | nominal | 120 | 240 | 0.0420 | 0.0880 | 0.053 | 3.98 | - | - |",
+           "| '^R' -> others | fit | 120 | 240 | 0.0075 | 0.1155 | 0.050 | 5.95 | 3 | 0 |",
+           "| '^R' -> others | fit without holds | 120 | 240 | 0.0075 | 0.0176 | 0.010 | 0.81 | - "
+           "| "
+           "- |",
+           "| others -> '^R' | nominal | 240 | 120 | 0.0880 | 0.0420 | 0.039 | 0.80 | - | - |",
+           "| others -> '^R' | fit | 240 | 120 | 0.0077 | 0.0076 | 0.005 | 0.27 | 0 | 0 |",
+           "| every path type, reps 1-5 -> the other reps | nominal | 180 | 180 | 0.0728 | 0.0726 "
+           "| "
+           "0.048 | 2.92 | - | - |",
+           "| every path type, reps 1-5 -> the other reps | fit | 180 | 180 | 0.0076 | 0.0078 | "
+           "0.005 "
+           "| 0.28 | 0 | 0 |"},
+          {"  others -> '^R': fit               nominal calibrated    change",
+           "  ATE RMSE [m] (mean of runs)        0.0269     0.0048    -82.0%",
+           "  drift 1 m [%] (342 windows)         3.834      0.535    -86.0%",
+           "  drift 1 m [deg/m]                   0.772      0.278    -64.0%"},
       });
 }
 

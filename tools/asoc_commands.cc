@@ -35,40 +35,42 @@ std::uint64_t SplitMix(std::uint64_t x) {
   return x ^ (x >> 31);
 }
 
+// The simulated pivot encoders' step is stated, as a user states their encoders'.
 io::AsocRobot RobotFromVehicle(const std::string& name, const asoc::Vehicle& v) {
   io::AsocRobot robot;
   robot.name = name;
+  robot.pivot_resolution_rad = sim::AsocSimulationOptions{}.pivot_quantum_rad;
   robot.pivot_distance_m = v.PivotDistance(0, 1);
   robot.nominal = v;
   return robot;
 }
 
-void PrintCastors(const io::AsocRobot& robot, const asoc::Vehicle& estimate, const char* label) {
+void PrintCastors(const io::AsocRobot& robot,
+                  const std::array<asoc::CastorParameters, asoc::kNumCastors>& castors,
+                  const char* label) {
   std::printf("\n  %-8s %10s %10s %10s %10s %10s %12s   (%s)\n", "castor", "r_c [m]", "r_w1 [m]",
               "r_w2 [m]", "d_1 [m]", "d_2 [m]", "beta [deg]", label);
   for (int i = 0; i < asoc::kNumCastors; ++i) {
-    const asoc::CastorParameters& c = estimate.castors[i];
+    const asoc::CastorParameters& c = castors[i];
     std::printf("  %-8s %10.6f %10.6f %10.6f %10.6f %10.6f %12.4f\n", robot.castor_names[i].c_str(),
                 c.offset_m, c.wheel_radius_m[0], c.wheel_radius_m[1], c.wheel_offset_m[0],
                 c.wheel_offset_m[1], RadToDeg(c.encoder_bias_rad));
   }
 }
 
-// The calibration record of the written YAML: how it was made, and the uncertainty of each
-// castor's estimate. Each castor is the mean of its pair estimates (Doebbler Eq. 1-9 on each CW x
-// CCW hold pair); with two, the standard error of their mean is their half-difference, the
-// spread over independent hold runs (a bootstrap over runs in its smallest form). Emitted by
-// yaml-cpp so that any path is quoted correctly.
+// The calibration record of the written YAML: how it was made, and the 1-sigma uncertainty of
+// each castor's parameters from the spread of its estimates over hold runs
+// (asoc::GeometricResult::sigma). Emitted by yaml-cpp so that any path is quoted correctly.
 std::string AsocCalibrationRecord(const std::string& method, const std::string& dataset,
                                   const io::AsocRobot& robot, const asoc::GeometricResult& result) {
   YAML::Emitter out;
   out.SetMapFormat(YAML::Flow);
   out << YAML::BeginMap << YAML::Key << "method" << YAML::Value << method << YAML::Key << "dataset"
       << YAML::Value << io::YamlText(dataset) << YAML::Key << "tool_version" << YAML::Value
-      << kVersion;
+      << kVersion << YAML::Key << "sigma_dof" << YAML::Value << result.sigma_dof;
   out << YAML::Key << "sigma" << YAML::Value << YAML::BeginMap;
   for (int i = 0; i < asoc::kNumCastors; ++i) {
-    const asoc::CastorParameters& h = result.half_spread[i];
+    const asoc::CastorParameters& h = result.sigma[i];
     out << YAML::Key << io::YamlText(robot.castor_names[i]) << YAML::Value << YAML::BeginMap
         << YAML::Key << "offset_m" << YAML::Value << h.offset_m << YAML::Key << "wheel_radius_m"
         << YAML::Value << YAML::BeginSeq << h.wheel_radius_m[0] << h.wheel_radius_m[1]
@@ -81,19 +83,17 @@ std::string AsocCalibrationRecord(const std::string& method, const std::string& 
 }
 
 // Writes `robot` with the calibrated castors and the record above to `out` (atomically), and says
-// so. Refuses (std::runtime_error) when a castor has fewer than two estimates: nothing would say
-// how well it is known, and a written calibration always carries its uncertainty.
+// so. Refuses (std::runtime_error) when no castor has two independent estimates (hold runs of two
+// different held castors): nothing would say how well it is known, and a written calibration
+// always carries its uncertainty.
 void WriteAsocCalibration(const std::string& out, const io::AsocRobot& robot,
                           const asoc::GeometricResult& result, const std::string& method,
                           const std::string& dataset) {
-  for (int i = 0; i < asoc::kNumCastors; ++i) {
-    if (result.num_estimates[i] < 2) {
-      throw std::runtime_error(
-          dataset + ": castor " + robot.castor_names[i] + " has " +
-          std::to_string(result.num_estimates[i]) +
-          " closed-form estimate(s): no uncertainty for it; nothing written (record two CW and "
-          "two CCW hold runs of each castor)");
-    }
+  if (result.sigma_dof < 1) {
+    throw std::runtime_error(dataset +
+                             ": no castor has two independent closed-form estimates: no "
+                             "uncertainty; nothing written (record a CW and a CCW hold run of "
+                             "each castor)");
   }
   io::AsocRobot calibrated = robot;
   calibrated.nominal = result.estimate;
@@ -190,12 +190,29 @@ int RunAsocGeometric(const AsocGeometricOptions& options) {
     }
     const io::AsocDataset dataset = io::LoadAsocDataset(options.logs, dataset_options);
     const io::AsocRobot robot = io::ReadAsocRobot(dataset.robot_path);
-    const asoc::GeometricResult result = asoc::CalibrateGeometric(dataset.runs, robot.nominal);
+    asoc::GeometricOptions geometric;
+    geometric.pivot_resolution_rad = robot.pivot_resolution_rad;
+    const asoc::GeometricResult result =
+        asoc::CalibrateGeometric(dataset.runs, robot.nominal, geometric);
     std::printf("fitcal %s  asoc robot '%s'  closed-form calibration (Doebbler Eq. 1-9)  %s\n",
                 kVersion, robot.name.c_str(), options.logs.c_str());
-    PrintCastors(robot, robot.nominal, "nominal");
-    PrintCastors(robot, result.estimate, "calibrated");
-    std::printf("\n  half-difference of the two estimates per castor (repeatability):\n");
+    PrintCastors(robot, robot.nominal.castors, "nominal");
+    PrintCastors(robot, result.estimate.castors, "calibrated");
+    std::printf(
+        "\n  %-8s %10s %10s %10s %10s %10s %12s   (+-1 sigma: spread over hold runs and "
+        "the pivot step)\n",
+        "castor", "r_c [m]", "r_w1 [m]", "r_w2 [m]", "d_1 [m]", "d_2 [m]", "beta [deg]");
+    for (int i = 0; i < asoc::kNumCastors; ++i) {
+      const asoc::CastorParameters& s = result.sigma[i];
+      std::printf("  %-8s %10.2g %10.2g %10.2g %10.2g %10.2g %12.2g\n",
+                  robot.castor_names[i].c_str(), s.offset_m, s.wheel_radius_m[0],
+                  s.wheel_radius_m[1], s.wheel_offset_m[0], s.wheel_offset_m[1],
+                  RadToDeg(s.encoder_bias_rad));
+    }
+    std::printf(
+        "\n  sigmas from %d degrees of freedom; half-difference of the estimates per "
+        "castor (repeatability):\n",
+        result.sigma_dof);
     for (int i = 0; i < asoc::kNumCastors; ++i) {
       const asoc::CastorParameters& h = result.half_spread[i];
       std::printf(

@@ -180,14 +180,44 @@ SelectedFit DescribeSelected(const Robot& robot,
   return out;
 }
 
+// A closed form's own sigmas (ClosedFormCalibration::sigma, e.g. ASOC's spread over hold runs)
+// for the parameters it measures, r_c and beta included, which the final-pose residuals cannot
+// see (the robot holds them). Their correlation with the others is not estimated: written as 0.
+// True when it measured every parameter.
+bool UseOwnSigmas(const std::vector<double>& own, SelectedFit* fit) {
+  if (own.empty()) return false;
+  const auto n = static_cast<Eigen::Index>(own.size());
+  if (!fit->has_covariance) {
+    fit->sigma.assign(own.size(), 0.0);
+    fit->correlation = Eigen::MatrixXd::Identity(n, n);
+  }
+  bool all = true;
+  for (Eigen::Index k = 0; k < n; ++k) {
+    if (!std::isfinite(own[k])) {
+      all = false;
+      continue;
+    }
+    fit->sigma[k] = own[k];
+    fit->correlation.row(k).setZero();
+    fit->correlation.col(k).setZero();
+    fit->correlation(k, k) = 1.0;
+  }
+  fit->has_covariance = fit->has_covariance || all;
+  return all;
+}
+
 // A selected candidate without a covariance of its own (a closed form, a fit without its holds)
 // gets the one propagated through the training runs' final-pose residuals at its point
-// (validation/propagated_uncertainty.h): a written calibration never has sigma: null. False, with
-// the reason on stderr, when even that is not possible (nothing may then be written).
-bool AddPropagatedUncertainty(const RobotModelInterface& model, const std::vector<double>& p,
+// (validation/propagated_uncertainty.h), with a closed form's own sigmas where it has them
+// (UseOwnSigmas): a written calibration never has sigma: null. False, with the reason on stderr,
+// when even that is not possible (nothing may then be written).
+bool AddPropagatedUncertainty(const RobotModelInterface& model,
+                              const CalibrationCandidate& selected,
                               const std::vector<AlignedRun>& training, SelectedFit* fit) {
   if (fit->has_covariance) return true;
-  const PropagatedUncertainty u = PropagateFinalPoseUncertainty(model, p, training, fit->held);
+  if (UseOwnSigmas(selected.sigma, fit)) return true;
+  const PropagatedUncertainty u =
+      PropagateFinalPoseUncertainty(model, selected.parameters, training, fit->held);
   if (!u.ok) {
     std::cerr << "fitcal: no uncertainty for the selected calibration (" << u.message
               << "); nothing written (record more runs, or runs that excite every parameter)\n";
@@ -196,6 +226,7 @@ bool AddPropagatedUncertainty(const RobotModelInterface& model, const std::vecto
   fit->has_covariance = true;
   fit->sigma = u.sigma;
   fit->correlation = CorrelationOf(u.covariance);
+  UseOwnSigmas(selected.sigma, fit);
   return true;
 }
 
@@ -241,7 +272,7 @@ std::vector<CalibrationCandidate> Candidates(const RobotModelInterface& model,
       {"nominal", model.robot().nominal, true, model.robot().effects}};
   for (const ClosedFormCalibration& c :
        closed_forms ? model.ClosedForms(split.training) : std::vector<ClosedFormCalibration>{}) {
-    out.push_back({c.method, c.parameters, true});
+    out.push_back({c.method, c.parameters, true, {}, c.sigma});
   }
   out.push_back({method, fit.parameters, fit.usable || fit.stopped_early});
   if (!fit.held_directions.empty() && !split.validation.empty()) {
@@ -1046,7 +1077,7 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   SelectedFit selected_fit = DescribeSelected(robot, candidates, gate.selected, options.method,
                                               outcome.objective, fit, track_fits);
   if (gate.selected != 0 && !options.no_output &&
-      !AddPropagatedUncertainty(*model, selected.parameters, split.training, &selected_fit)) {
+      !AddPropagatedUncertainty(*model, selected, split.training, &selected_fit)) {
     return 1;
   }
 

@@ -216,6 +216,14 @@ void ReadAsocOptionalBlocks(YamlMap& map, const std::string& path, AsocRobot* ro
   }
   robot->encoder = ReadEncoderTicksNode(map.Optional("encoder"), path);
   robot->effects = ReadEffectsNode(map.Optional("effects"), path);
+  if (map.Has("pivot_resolution_deg")) {
+    robot->pivot_resolution_rad = DegToRad(map.Double("pivot_resolution_deg"));
+    if (!(robot->pivot_resolution_rad > 0.0 && robot->pivot_resolution_rad < M_PI)) {
+      throw InputError(InputErrorKind::kBadValue, path,
+                       map.line(map.Required("pivot_resolution_deg")),
+                       "pivot_resolution_deg must be in (0, 180)");
+    }
+  }
 }
 
 }  // namespace
@@ -328,6 +336,10 @@ std::string AsocRobotYaml(const AsocRobot& robot, const std::string& calibration
     out << YAML::Key << "algorithm" << YAML::Value << robot.odometry;
     out << YAML::Key << "redundancy_check" << YAML::Value << robot.redundancy_check;
     out << YAML::EndMap;
+  }
+  if (robot.pivot_resolution_rad > 0.0) {
+    out << YAML::Key << "pivot_resolution_deg" << YAML::Value
+        << RadToDeg(robot.pivot_resolution_rad);
   }
   Robot blocks;  // the shared encoder: and effects: blocks
   blocks.encoder = robot.encoder;

@@ -66,6 +66,10 @@ struct AsocRobot {
   bool redundancy_check = false;
   std::optional<EncoderTicks> encoder;
   std::vector<effects::EffectValue> effects;
+  // `pivot_resolution_deg` (optional): the pivot encoders' step. The closed form's sigmas
+  // propagate it (asoc_geometric.h): two hold runs whose quantised readings agree show no spread.
+  // 0: not given.
+  double pivot_resolution_rad = 0.0;
 };
 
 // Throws InputError (file, line, cause) on anything malformed or physically impossible.

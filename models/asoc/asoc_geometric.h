@@ -18,8 +18,17 @@
 // Runs are found by trajectory label "hold_<j>_cw" / "hold_<j>_ccw" (j 1-based). The steady
 // castor angle is the circular mean of the readings over the middle `steady_fraction` of the run,
 // which skips start/stop transients when the castors were not perfectly pre-aligned. Every hold run
-// is used: each CW run of castor j is paired with each CCW run of castor j, and all the pair
-// estimates of a castor are averaged.
+// is used: each CW run of castor j is paired with each CCW run of castor j; a castor's estimate is
+// the mean over its held castors of the mean of their pair estimates.
+//
+// Uncertainty: the estimates of castor i with castor j held and with castor k held come from
+// different runs, so their spread measures what the encoders' quantisation and noise do to
+// Eq. 1-9 (mostly the pivot readings for r_c and beta, Eq. 2-3). Each parameter's variance is
+// pooled over the three castors and widened by Student's t for its few degrees of freedom, and
+// the variance the pivot encoders' step propagates through Eq. 1-9 is added: quantised readings
+// of two hold runs often agree exactly, and their spread is then 0 although each is off by up to
+// half a step (SpreadSigmas, QuantisationVariance in the .cc); checked against the simulator's
+// truth in docs/asoc.md.
 
 #include <array>
 #include <string>
@@ -32,6 +41,7 @@ namespace fitcal::asoc {
 
 struct GeometricOptions {
   double steady_fraction = 0.5;
+  double pivot_resolution_rad = 0.0;  // the pivot encoders' step (0: unknown), for the sigmas
   bool IsValid(std::string* error) const;
 };
 
@@ -71,11 +81,22 @@ struct GeometricResult {
   // the repeatability: the two estimates of one castor should agree to quantisation level).
   std::array<int, kNumCastors> num_estimates{};
   std::array<CastorParameters, kNumCastors> half_spread{};
+  // Per castor, the 1-sigma uncertainty of every estimated parameter from the spread over runs
+  // (above), with sigma_dof degrees of freedom; sigma_dof 0: no castor has two independent
+  // estimates, and the sigmas are 0 (unknown, not exact).
+  std::array<CastorParameters, kNumCastors> sigma{};
+  int sigma_dof = 0;
 };
+
+// The factor t with P(|T| < t) = 68.27 % for Student's t with `dof` degrees of freedom: a
+// standard error from dof degrees of freedom times t covers the error as often as one normal
+// sigma does. Infinity for dof < 1.
+double OneSigmaStudentFactor(int dof);
 
 // Eq. 1-9 on every CW x CCW pair of hold runs of each held castor, averaged per castor. Castors
 // without any usable hold pair keep their nominal parameters and make the result unusable.
-GeometricResult CalibrateFromHoldRuns(const std::vector<HoldRun>& runs, const Vehicle& nominal);
+GeometricResult CalibrateFromHoldRuns(const std::vector<HoldRun>& runs, const Vehicle& nominal,
+                                      double pivot_resolution_rad = 0.0);
 
 // The hold runs among `runs` (by label, >= 4 samples) through CalibrateFromHoldRuns. Throws
 // std::invalid_argument for invalid options.

@@ -192,10 +192,19 @@ std::vector<ClosedFormCalibration> AsocModel::ClosedForms(
     holds.push_back(MeasureHoldRun(run.samples, held, direction, kSteadyFraction));
   }
   if (holds.empty()) return {};
-  const asoc::GeometricResult result = asoc::CalibrateFromHoldRuns(holds, asoc_.nominal);
+  const asoc::GeometricResult result =
+      asoc::CalibrateFromHoldRuns(holds, asoc_.nominal, asoc_.pivot_resolution_rad);
   if (!result.usable) return {};
   const auto p = result.estimate.ToArray();
-  return {{"asoc-geometric", std::vector<double>(p.begin(), p.end()), result.message}};
+  ClosedFormCalibration out{"asoc-geometric", std::vector<double>(p.begin(), p.end()),
+                            result.message};
+  if (result.sigma_dof >= 1) {  // every parameter is measured (Eq. 1-9): all 18 get a sigma
+    asoc::Vehicle sigma = result.estimate;
+    sigma.castors = result.sigma;
+    const auto s = sigma.ToArray();
+    out.sigma.assign(s.begin(), s.end());
+  }
+  return {out};
 }
 
 std::vector<ChannelMapping> AsocModel::CandidateMiswirings() const {
