@@ -73,6 +73,11 @@ struct Mechanisms {
   // Turn scrub: the tyres twist on the floor as the body turns, loading both wheels; slip ratio
   // scrub_slip_s_per_rad * |body yaw rate|.
   double scrub_slip_s_per_rad = 0.0;
+  // Traction creep (brush tyre, small slip): the slip ratio is proportional to the traction
+  // force, i.e. to the wheel's acceleration along its motion: traction_creep_s2_per_m * a * sign of
+  // the rate (speeding up loses ground, braking overruns; ContactPhysics' traction_slip_per_m_s2
+  // keeps the other tests' data and ignores the sign of the rate).
+  double traction_creep_s2_per_m = 0.0;
   // Traction limit (friction mu g): the contact point's speed changes by at most this much per
   // second; faster spin-up slides (the body lags the wheel), faster braking skids (it overruns).
   double traction_limit_m_s2 = 0.0;
@@ -298,6 +303,7 @@ inline SimulatedRun SimulateCommands(const DiffDriveGeometry& g, const ContactPh
                               (1.0 + m.hub_eccentricity * std::cos(s.wheel_angle + m.hub_phase_rad));
         rim_speed[w] = radius * rate;
         const double slip = physics.traction_slip_per_m_s2 * acceleration_m_s2 + s.walk +
+                            m.traction_creep_s2_per_m * acceleration_m_s2 * detail::Sign(rate) +
                             m.speed_slip_s_per_m * std::abs(rim_speed[w]) +
                             m.scrub_slip_s_per_rad * std::abs(omega) +
                             m.carpet_grain * std::cos(pose.theta - m.grain_direction_rad);
