@@ -260,17 +260,22 @@ CandidateResult TryCandidate(const DiagnoseContext& x, const EffectFitResult& cu
   const Robot& robot = x.model.robot();
   CandidateResult c;
   c.id = id;
-  double unexplained = 0.0;
+  double unexplained = 0.0, asked = 0.0;
   c.separable_fraction = SeparableFraction(x.training, x.model, current.parameters, current.effects,
-                                           id, x.options.fit.weights, &unexplained);
+                                           id, x.options.fit.weights, &unexplained, &asked);
   c.predicted_sigma =
       unexplained > 0.0 ? base.residual_rms / unexplained : std::numeric_limits<double>::infinity();
   const auto& info = effects::Info(id);
-  double typical = 0.0;
-  for (int j = 0; j < info.num_parameters; ++j)
-    typical = std::max(typical, std::abs(info.typical[j]));
+  // The size to resolve: the registry's realistic magnitude, or the size the residual asks of
+  // the candidate when larger (a linearised step). Why both: on an independent simulator a
+  // contact patch that moved 1.5 mm inward in pivots (pivot_yaw_gain 0.015, twice the registry's
+  // 0.007) and an eccentric hub were "cannot be told apart" at 2 predicted sigmas of the
+  // realistic size, though the runs resolved what the residual showed; the held-out test still
+  // decides whether it is accepted.
+  double size = asked;
+  for (int j = 0; j < info.num_parameters; ++j) size = std::max(size, std::abs(info.typical[j]));
   c.resolvable = c.separable_fraction >= x.options.min_separable_fraction &&
-                 typical >= x.options.min_resolvable_sigmas * c.predicted_sigma;
+                 size >= x.options.min_resolvable_sigmas * c.predicted_sigma;
   *tried = c.resolvable;
   if (!c.resolvable) {
     c.verdict = "cannot be told apart from the model on these runs";

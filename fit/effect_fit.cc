@@ -438,7 +438,8 @@ EffectFitResult FitEffectModel(const std::vector<TrackRun>& training,
 double SeparableFraction(const std::vector<TrackRun>& training,
                          const RobotModelInterface& robot_model, const std::vector<double>& p,
                          const EffectModel& model, EffectId candidate,
-                         const ResidualWeights& weights, double* unexplained_norm) {
+                         const ResidualWeights& weights, double* unexplained_norm,
+                         double* linearized_size) {
   EffectModel with = model;
   effects::EffectValue c;
   c.id = candidate;
@@ -457,7 +458,9 @@ double SeparableFraction(const std::vector<TrackRun>& training,
   ceres::Problem::EvaluateOptions evaluate;
   evaluate.parameter_blocks = blocks;
   ceres::CRSMatrix crs;
-  problem.Evaluate(evaluate, nullptr, nullptr, nullptr, &crs);
+  std::vector<double> residuals;
+  problem.Evaluate(evaluate, nullptr, linearized_size != nullptr ? &residuals : nullptr, nullptr,
+                   &crs);
   const Eigen::MatrixXd jac = Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>>(
                                   crs.num_rows, crs.num_cols, static_cast<int>(crs.values.size()),
                                   crs.rows.data(), crs.cols.data(), crs.values.data())
@@ -475,6 +478,11 @@ double SeparableFraction(const std::vector<TrackRun>& training,
     fraction = std::min(fraction, norm > 0.0 ? left / norm : 0.0);
   }
   if (unexplained_norm != nullptr) *unexplained_norm = smallest;
+  if (linearized_size != nullptr) {
+    const Eigen::VectorXd step = jac.colPivHouseholderQr().solve(
+        -Eigen::Map<const Eigen::VectorXd>(residuals.data(), static_cast<Eigen::Index>(residuals.size())));
+    *linearized_size = step.tail(m_c).cwiseAbs().maxCoeff();
+  }
   return fraction;
 }
 

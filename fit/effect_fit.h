@@ -211,10 +211,14 @@ EffectFitResult FitEffectModel(const std::vector<TrackRun>& training,
 // The fraction says nothing of size: an effect with almost no influence can still be
 // "separable"; *unexplained_norm (optional) gets |(I - P) J_c| itself, so that
 // sigma_c ~ s / |(I - P) J_c| (s the residual RMS) predicts how well the runs could determine the
-// candidate before fitting it.
+// candidate before fitting it. *linearized_size (optional) gets the size the residual itself
+// asks of the candidate: the largest |delta_c| of one Gauss-Newton step of every column from the
+// given solution (min |r + J delta|), so an effect larger than the registry's realistic
+// magnitude is seen as such before it is fitted.
 double SeparableFraction(const std::vector<TrackRun>& training,
                          const RobotModelInterface& robot_model, const std::vector<double>& p,
                          const EffectModel& model, effects::EffectId candidate,
-                         const ResidualWeights& weights = {}, double* unexplained_norm = nullptr);
+                         const ResidualWeights& weights = {}, double* unexplained_norm = nullptr,
+                         double* linearized_size = nullptr);
 
 }  // namespace fitcal

@@ -143,6 +143,17 @@ struct EffectValue {
 // ---------------------------------------------------------------------------------------------
 // The transforms. Every function is pure.
 
+// The value of a double or of a Ceres Jet (its scalar part), for decisions that do not depend on
+// the parameters being differentiated.
+template <typename T>
+double ScalarOf(const T& x) {
+  if constexpr (std::is_same_v<T, double>) {
+    return x;
+  } else {
+    return x.a;
+  }
+}
+
 template <typename T>
 inline T Sign(double x) {
   return T(x > 0.0 ? 1.0 : (x < 0.0 ? -1.0 : 0.0));
@@ -180,46 +191,63 @@ struct DirectionRadius {
   }
 };
 
-// Slip during acceleration: effective rate w_i (1 - c |dw_i/dt|), c in s^2/rad; the wheel
-// loses ground in start and stop transients.
+// Slip during acceleration, two parts (c, k in s^2/rad):
+//   w' = w (1 - c |dw/dt| - k sign(w) dw/dt).
+// c: ground lost in every start and stop transient (a wheel that hops or spins either way).
+// k: traction slip - the tyre's slip ratio is proportional to the traction force it carries,
+// i.e. to the wheel's acceleration in its direction of motion (brush tyre model, linear creep):
+// speeding up the wheel loses ground, braking it overruns (the body keeps going while the wheel
+// slows). Over a start and a stop k loses nothing (the lag, k w |w| / 2 of wheel angle, is
+// given back), but the lag is taken along the heading at the start and returned along the
+// heading at the stop, so every arc and every turn between them leaves its mark. Why k: with c
+// alone a traction-limited contact (an independent simulator's wheels sliding when asked for
+// more than mu g; tests/independent_diagnose_test) was "unexplained structure", since c loses
+// ground at the stop where the physics overruns.
 struct AccelerationSlip {
   template <typename T>
   static void Rates(const T* q, const SampleContext& c, T* w) {
     for (int i = 0; i < c.num_channels; ++i) {
-      if (c.IsWheel(i)) w[i] = w[i] * (T(1.0) - q[0] * T(std::abs(c.accel_rad_s2(i))));
+      if (!c.IsWheel(i)) continue;
+      const double a = c.accel_rad_s2(i);
+      const double along = ScalarOf(w[i]) >= 0.0 ? a : -a;
+      w[i] = w[i] * (T(1.0) - q[0] * T(std::abs(a)) - q[1] * T(along));
     }
   }
 };
 
-// Gear backlash beta (rad) eaten at the start of a run: the first beta of each wheel's encoder
-// angle does not turn the wheel. Transmitted angle phi(A) = sign(A) max(0, |A| - beta) with A
-// the encoder angle since the window start (runs start at rest).
+// What a replay carries from one encoder interval to the next for the effects with memory: the
+// wheel's place in its gear play (Backlash), per channel. A replay starts with a fresh one.
+template <typename T>
+struct EffectMemory {
+  T play_rad[kMaxEffectChannels] = {};  // wheel angle - encoder angle, in [-beta, beta]
+};
+
+// Gear backlash: the encoder sits on the motor side of a gear train whose play is 2 beta (rad at
+// the wheel); the wheel follows the encoder angle A only when the motor pushes it at an edge of
+// the play (the play, or backlash, operator of hysteresis models):
+//   phi_k = clamp(phi_{k-1}, A_k - beta, A_k + beta),
+// kept as the offset o = phi - A in [-beta, beta] (EffectMemory), o_k = clamp(o_{k-1} - dA, -beta,
+// beta), so the transmitted angle of an interval is dA + o_k - o_{k-1}. The wheel starts centred
+// (o = 0): a run's first motion loses beta, and every reversal of the motor loses 2 beta while
+// the play is crossed. Why the memory: the first version lost beta at the start of a run only
+// (phi = sign(A) max(0, |A| - beta)); on a simulator whose gear play is physical (the wheel
+// follows the motor through a dead band; tests/independent_sim) every reversal - an inner wheel
+// in a turn in place, reverse driving - crosses the play again, and that backlash went unnamed.
+// For a wheel that turns one way only the two agree exactly.
 struct Backlash {
   template <typename T>
-  static T Transmitted(const T& beta, double angle) {
-    const T excess = T(std::abs(angle)) - beta;
-    return excess > T(0.0) ? T(angle > 0.0 ? 1.0 : -1.0) * excess : T(0.0);
-  }
-  template <typename T>
-  static void Rates(const T* q, const SampleContext& c, T* w) {
+  static void Rates(const T* q, const SampleContext& c, T* w, EffectMemory<T>* memory) {
     if (!(c.dt_s > 0.0)) return;
     for (int i = 0; i < c.num_channels; ++i) {
       if (!c.IsWheel(i)) continue;
-      const double a0 = c.angle_rad[i];
-      // The interval's encoder angle; w is the measured rate here (rates effects run first).
-      const double a1 = a0 + ToDouble(w[i]) * c.dt_s;
-      const T transmitted = Transmitted(q[0], a1) - Transmitted(q[0], a0);
-      const double moved = a1 - a0;
-      // w * transmitted / moved keeps the derivative chain through w for later effects.
-      w[i] = std::abs(moved) > 0.0 ? w[i] * transmitted / T(moved) : w[i];
-    }
-  }
-  template <typename T>
-  static double ToDouble(const T& x) {
-    if constexpr (std::is_same_v<T, double>) {
-      return x;
-    } else {
-      return x.a;
+      // w is the measured rate here (backlash runs first among the rate effects).
+      const T moved = w[i] * c.dt_s;
+      T& play = memory->play_rad[i];
+      T next = play - moved;
+      if (next > q[0]) next = q[0];
+      if (next < -q[0]) next = -q[0];
+      w[i] = w[i] + (next - play) / c.dt_s;
+      play = next;
     }
   }
 };
@@ -252,7 +280,7 @@ struct OncePerRevolution {
   static void Rates(const T* q, const SampleContext& c, T* w) {
     for (int i = 0; i < c.num_channels; ++i) {
       if (!c.IsWheel(i)) continue;
-      const double a = c.angle_rad[i] + 0.5 * Backlash::ToDouble(w[i]) * c.dt_s;
+      const double a = c.angle_rad[i] + 0.5 * ScalarOf(w[i]) * c.dt_s;
       w[i] = w[i] * (T(1.0) + q[0] * T(std::cos(a)) + q[1] * T(std::sin(a)));
     }
   }
@@ -359,7 +387,7 @@ const std::array<EffectOps<T>, kNumEffects>& EffectOpsTable() {
       {&WheelSpeedSlip::Rates<T>, nullptr, nullptr, nullptr},
       {&DirectionRadius::Rates<T>, nullptr, nullptr, nullptr},
       {&AccelerationSlip::Rates<T>, nullptr, nullptr, nullptr},
-      {&Backlash::Rates<T>, nullptr, nullptr, nullptr},
+      {nullptr, nullptr, nullptr, nullptr},  // Backlash: ApplyRateEffects, with its memory
       {nullptr, nullptr, &FloorSlope::World<T>, nullptr},
       {nullptr, &YawRateSlip::Body<T>, nullptr, nullptr},
       {&OncePerRevolution::Rates<T>, nullptr, nullptr, nullptr},
@@ -381,16 +409,18 @@ struct ActiveEffect {
 };
 
 // Applies the rate stage of every active effect, in list order; backlash first, since it works
-// on the measured encoder angle.
+// on the measured encoder angle. `memory` is the replay's (one per run, carried across its
+// samples).
 template <typename T>
-void ApplyRateEffects(const std::vector<ActiveEffect<T>>& active, const SampleContext& c, T* w) {
+void ApplyRateEffects(const std::vector<ActiveEffect<T>>& active, const SampleContext& c, T* w,
+                      EffectMemory<T>* memory) {
   const auto& table = EffectOpsTable<T>();
   for (const auto& e : active) {
-    if (e.id == EffectId::kBacklash) table[static_cast<int>(e.id)].rates(e.q, c, w);
+    if (e.id == EffectId::kBacklash) Backlash::Rates(e.q, c, w, memory);
   }
   for (const auto& e : active) {
     const auto& ops = table[static_cast<int>(e.id)];
-    if (ops.rates != nullptr && e.id != EffectId::kBacklash) ops.rates(e.q, c, w);
+    if (ops.rates != nullptr) ops.rates(e.q, c, w);
   }
 }
 
@@ -429,12 +459,13 @@ Pose2<T> ReplayStepsWithEffects(const Step& step, const std::vector<ActiveEffect
                                 std::to_string(kMaxEffectChannels) + " channels");
   }
   T w[kMaxEffectChannels];
+  EffectMemory<T> memory;
   Pose2<T> pose = start;
   for (std::size_t k = 0; k < samples.size(); ++k) {
     const SampleContext& c = contexts[k];
     const double dt = samples[k].dt_s;
     for (int i = 0; i < n; ++i) w[i] = T(samples[k].value[i]);
-    ApplyRateEffects(active, c, w);
+    ApplyRateEffects(active, c, w, &memory);
     T d[3];
     step(w, dt, &d[0], &d[1], &d[2]);
     T v_world[2] = {T(0.0), T(0.0)};

@@ -133,14 +133,46 @@ TEST(EffectTransforms, BacklashLosesBetaOfEachWheel) {
   const EncoderSamples samples = TestSamples();
   const auto contexts = effects::MakeSampleContexts(samples);
   const double beta[1] = {0.07};
+  effects::EffectMemory<double> memory;
   double measured = 0.0, transmitted = 0.0;
   for (std::size_t k = 0; k < samples.size(); ++k) {
     double w[3] = {samples[k].value[0], samples[k].value[1], samples[k].value[2]};
-    effects::Backlash::Rates(beta, contexts[k], w);
+    effects::Backlash::Rates(beta, contexts[k], w, &memory);
     measured += samples[k].value[0] * samples[k].dt_s;
     transmitted += w[0] * samples[k].dt_s;
   }
   EXPECT_NEAR(measured - transmitted, beta[0], 1e-12);
+}
+
+// Gear play is crossed again on every reversal: a wheel that turns 1 rad forward, 0.5 rad back
+// and 0.3 rad forward again transmits 1 - beta, -(0.5 - 2 beta), 0.3 - 2 beta (the play
+// operator, worked by hand); a back-and-forth smaller than the play (2 beta) transmits nothing.
+TEST(EffectTransforms, BacklashCrossesThePlayOnEveryReversal) {
+  const double beta[1] = {0.05};
+  const auto transmitted = [&](const std::vector<double>& moves) {
+    EncoderSamples samples(1);
+    for (double move : moves) {
+      const double rate[1] = {move / 0.01};
+      for (int k = 0; k < 100; ++k) samples.push_back(0.0001, rate);
+    }
+    const auto contexts = effects::MakeSampleContexts(samples);
+    effects::EffectMemory<double> memory;
+    std::vector<double> per_move;
+    for (std::size_t k = 0; k < samples.size(); ++k) {
+      double w[1] = {samples[k].value[0]};
+      effects::Backlash::Rates(beta, contexts[k], w, &memory);
+      if (k % 100 == 0) per_move.push_back(0.0);
+      per_move.back() += w[0] * samples[k].dt_s;
+    }
+    return per_move;
+  };
+  const std::vector<double> three = transmitted({1.0, -0.5, 0.3});
+  EXPECT_NEAR(three[0], 1.0 - beta[0], 1e-12);
+  EXPECT_NEAR(three[1], -(0.5 - 2.0 * beta[0]), 1e-12);
+  EXPECT_NEAR(three[2], 0.3 - 2.0 * beta[0], 1e-12);
+  const std::vector<double> wiggle = transmitted({1.0, -0.08, 0.08});
+  EXPECT_NEAR(wiggle[1], 0.0, 1e-12);
+  EXPECT_NEAR(wiggle[2], 0.0, 1e-12);
 }
 
 // A wheel pair's turn fraction (SampleContext) and the pivot yaw gain that scales the yaw by it.

@@ -73,6 +73,7 @@ class SteppedRun {
   std::vector<double> x_, slip_, angle_, wheel_start_, contact_, counts_, last_counts_;
   std::vector<double> last_reading_;
   std::vector<effects::ActiveEffect<double>> active_;
+  effects::EffectMemory<double> memory_;  // the injected effects' memory (gear play), one run
   double latency_s_ = 0.0;
   bool injecting_ = false, eccentric_ = false;
   Pose2d pose_;
@@ -243,7 +244,7 @@ void SteppedRun::ApplyEffects(double t, double t_mid, const std::vector<double>&
     const double sum = std::abs(x_[0]) + std::abs(x_[1]);
     c.turn_fraction = sum > 0.0 ? std::abs(x_[0] - x_[1]) / sum : 0.0;
   }
-  effects::ApplyRateEffects(active_, c, contact_.data());
+  effects::ApplyRateEffects(active_, c, contact_.data(), &memory_);
   *v = BodyTwist();
   double body[3] = {v->vx_m_s, v->vy_m_s, v->omega_rad_s};
   const auto& table = effects::EffectOpsTable<double>();
