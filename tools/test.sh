@@ -33,7 +33,7 @@ ctest --test-dir build --output-on-failure -j "$jobs"
 echo "release tests done: $((SECONDS - start)) s"
 
 # Sanitizers by purpose: AddressSanitizer + UndefinedBehaviorSanitizer instrument the code that
-# reads, parses and writes (io, odometry, validation, the commands; CMakeLists.txt says why) and
+# reads, parses and writes (io and the commands; CMakeLists.txt says why) and
 # run the executables marked SANITIZE in tests/CMakeLists.txt (parsers, writers, the command line,
 # the model harness), in their own build directory. Everything else compiles exactly as in the
 # Release build above, so ccache hands it over instead of compiling it again.
