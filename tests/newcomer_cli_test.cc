@@ -47,6 +47,10 @@ TEST(NewcomerCli, RunningEveryCommandAgainReplacesItsOwnOutput) {
         RunFitcal(dir, "export ros2-control --calibration " + cal +
                            " --controller diff_drive_controller --out " + dir.Path("ctrl.yaml"));
     EXPECT_EQ(exported.exit_code, 0) << exported.err;
+    const auto compared = RunFitcal(dir, "compare --logs " + data +
+                                             " --methods ceres --repetitions 1 --quiet --out " +
+                                             dir.Path("cmp"));
+    EXPECT_EQ(compared.exit_code, 0) << compared.err;
   }
   // Not this command's output: refused with 2 and the file untouched, then replaced with --force.
   const std::string mine = dir.Write("mine.yaml", "my: notes\n");
@@ -58,6 +62,19 @@ TEST(NewcomerCli, RunningEveryCommandAgainReplacesItsOwnOutput) {
   const auto fit_refused = RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --out " + mine);
   EXPECT_EQ(fit_refused.exit_code, 2) << fit_refused.err;
   EXPECT_EQ(ReadFileBytes(mine), "my: notes\n");
+  // compare writes three files from one prefix: one that is not its own stops all three.
+  const std::string compare = "compare --logs " + data + " --methods ceres --repetitions 1 --quiet";
+  dir.Write("mine.md", "my notes\n");
+  const auto compare_refused = RunFitcal(dir, compare + " --out " + dir.Path("mine"));
+  EXPECT_EQ(compare_refused.exit_code, 2) << compare_refused.err;
+  EXPECT_EQ(testing::Lines(compare_refused.err), 1) << compare_refused.err;
+  EXPECT_TRUE(Has(compare_refused.err, "mine.md") && Has(compare_refused.err, "--force"))
+      << compare_refused.err;
+  EXPECT_EQ(ReadFileBytes(dir.Path("mine.md")), "my notes\n");
+  EXPECT_FALSE(fs::exists(dir.Path("mine.csv")));
+  const auto compare_forced = RunFitcal(dir, compare + " --force --out " + dir.Path("mine"));
+  EXPECT_EQ(compare_forced.exit_code, 0) << compare_forced.err;
+  EXPECT_TRUE(Has(ReadFileBytes(dir.Path("mine.md")), "| Strategy | Method |"));
   const auto forced =
       RunFitcal(dir, "export ros2-control --calibration " + cal +
                          " --controller diff_drive_controller --force --out " + mine);
