@@ -27,7 +27,9 @@ const char* const kStyle =
     // the table scrolls instead of squeezing them to one word a line.
     "td:not(:first-child):not(.k){white-space:nowrap}td.k{min-width:12em}\n"
     "th{background:#f0f0f0}\n"
-    "code{overflow-wrap:anywhere}\n"
+    // A path is one long word (a data set in a temporary directory, "trained on data set
+    // /tmp/..."), in code or in prose: it breaks rather than push a phone's page sideways.
+    "code,p,li{overflow-wrap:anywhere}\n"
     // A run id is one long word (rosbag imports name runs by topic and time): it breaks rather
     // than push a phone's page wider than the screen.
     "h1,h2,h3{overflow-wrap:anywhere}\n"
