@@ -47,9 +47,9 @@ TEST(NewcomerCli, RunningEveryCommandAgainReplacesItsOwnOutput) {
         RunFitcal(dir, "export ros2-control --calibration " + cal +
                            " --controller diff_drive_controller --out " + dir.Path("ctrl.yaml"));
     EXPECT_EQ(exported.exit_code, 0) << exported.err;
-    const auto compared = RunFitcal(dir, "compare --logs " + data +
-                                             " --methods ceres --repetitions 1 --quiet --out " +
-                                             dir.Path("cmp"));
+    const auto compared =
+        RunFitcal(dir, "compare --logs " + data +
+                           " --methods ceres --repetitions 1 --quiet --out " + dir.Path("cmp"));
     EXPECT_EQ(compared.exit_code, 0) << compared.err;
   }
   // Not this command's output: refused with 2 and the file untouched, then replaced with --force.
@@ -183,8 +183,8 @@ TEST(NewcomerCli, EveryHelpListsTheExitStatusesAndNoArtefacts) {
     EXPECT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(Occurrences(r.out, "Exit status: 0 success; 1 bad input"), 1) << r.out;
     EXPECT_TRUE(Has(r.out, "5 no calibration beats the nominal robot")) << r.out;
-    for (const char* artefact : {"{false}", "{true}", "Excludes:", "Needs:", ".h)",
-                                 "README.md, Simulator"}) {
+    for (const char* artefact :
+         {"{false}", "{true}", "Excludes:", "Needs:", ".h)", "README.md, Simulator"}) {
       EXPECT_FALSE(Has(r.out, artefact)) << artefact << " in\n" << r.out;
     }
     for (const std::string& sub : SubcommandsIn(r.out)) {

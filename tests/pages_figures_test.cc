@@ -37,9 +37,9 @@ std::vector<std::string> DocRow(const std::string& name) {
     std::string cell;
     while (std::getline(row, cell, '|')) {
       const std::size_t first = cell.find_first_not_of(' ');
-      cells.push_back(first == std::string::npos ? ""
-                                                 : cell.substr(first, cell.find_last_not_of(' ') -
-                                                                          first + 1));
+      cells.push_back(first == std::string::npos
+                          ? ""
+                          : cell.substr(first, cell.find_last_not_of(' ') - first + 1));
     }
     return cells;
   }
@@ -79,8 +79,8 @@ void MeasureRobot(const std::string& robot, const std::string& free_session) {
   if (!fs::is_directory(sessions)) GTEST_SKIP() << "no " << sessions;
   TempDir dir;
   const std::string data = dir.Path("D"), cal = dir.Path("cal.yaml");
-  const auto import = RunFitcal(dir, "import optiodom " + sessions + "/circular/* " + sessions +
-                                         "/square/* --out " + data);
+  const auto import = RunFitcal(
+      dir, "import optiodom " + sessions + "/circular/* " + sessions + "/square/* --out " + data);
   ASSERT_EQ(import.exit_code, 0) << import.err;
   const auto fit = RunFitcal(dir, "fit --logs " + data + " --out " + cal);
   ASSERT_EQ(fit.exit_code, 0) << fit.err;
@@ -92,8 +92,8 @@ void MeasureRobot(const std::string& robot, const std::string& free_session) {
   const auto free_import = RunFitcal(
       dir, "import optiodom " + sessions + "/" + free_session + "/* --out " + dir.Path("F"));
   ASSERT_EQ(free_import.exit_code, 0) << free_import.err;
-  const auto free_report = RunFitcal(dir, "report --logs " + dir.Path("F") + " --calibration " +
-                                              cal + " --out " + dir.Path("f"));
+  const auto free_report = RunFitcal(
+      dir, "report --logs " + dir.Path("F") + " --calibration " + cal + " --out " + dir.Path("f"));
   ASSERT_EQ(free_report.exit_code, 0) << free_report.err;
   ExpectRowMatches(robot + "/" + free_session, dir.Path("f"));
 }

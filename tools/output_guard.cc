@@ -150,8 +150,9 @@ std::string TextOutputOverwriteRefusal(const std::string& out, const std::string
     std::getline(in, line);
   }
   if (line.compare(0, first_line.size(), first_line) == 0) return "";
-  return Refusal(out, "exists and is not this command's previous output; refusing to overwrite it "
-                      "(--force to replace it)");
+  return Refusal(out,
+                 "exists and is not this command's previous output; refusing to overwrite it "
+                 "(--force to replace it)");
 }
 
 std::string OutputFileRefusal(const std::string& out, const std::vector<std::string>& inputs) {

@@ -3,8 +3,9 @@
 //   1. Running a command again replaces its own previous output at --out: a calibration of the
 //      same robot (fit, diagnose, asoc-geometric, export --calibration-out), the parameter file of
 //      the same controller node (export), compare's tables, a data set fitcal wrote (import,
-//      simulate), a report or page directory holding only the files the command writes. Each is recreated from inputs
-//      that still exist (an output never overlaps an input), so replacing it loses nothing.
+//      simulate), a report or page directory holding only the files the command writes. Each is
+//      recreated from inputs that still exist (an output never overlaps an input), so replacing it
+//      loses nothing.
 //   2. Anything else at --out is refused with exit status 2 (UsageError) and nothing written.
 //      --force replaces it when it is a regular file (another robot's calibration, another YAML)
 //      or a directory fitcal wrote as another kind of output.
