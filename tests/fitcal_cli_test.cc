@@ -323,7 +323,9 @@ TEST(FitcalCli, DiagnoseRecordsTheWrittenFitsSigmasAndTheReportShowsThem) {
   // Issue 42: the terminal printed another fit's sigma (7.3e-05) than the file (2.2e-04), and a
   // "+ effects" column when no effect was accepted. The written calibration's row on stdout
   // carries the file's sigma to the two digits it prints (half a unit of the second digit).
-  const std::size_t row = r.out.find("| wheel_separation [m] | m | ", r.out.find("## Written"));
+  // The unit once, in its own column (issue 42: "| r_right [m] | m |").
+  EXPECT_EQ(r.out.find(" [m] | m |"), std::string::npos) << r.out;
+  const std::size_t row = r.out.find("| wheel_separation | m | ", r.out.find("## Written"));
   ASSERT_NE(row, std::string::npos) << r.out;
   const std::string cells = r.out.substr(row, r.out.find('\n', row) - row);
   const double printed = std::stod(cells.substr(cells.rfind("| ", cells.size() - 3) + 2));

@@ -116,5 +116,23 @@ TEST(ReadmeExcerpts, WorkedExampleOnTheDiffDrive) {
   ExpectExcerptOf(Excerpt(std::string("fitcal ") + kVersion + "  diff_drive robot"), output);
 }
 
+// Issue 42: a newcomer met "CF" in the first example with its meaning further down, and found no
+// word on where the OptiOdom recordings come from. The first "CF" of the README is its definition,
+// and the worked example names the upstream repository.
+TEST(ReadmeExcerpts, DefinesCfWhereFirstUsedAndNamesTheDataSource) {
+  const std::string readme = ReadFileBytes(FITCAL_SOURCE_DIR "/README.md");
+  std::smatch first;
+  ASSERT_TRUE(std::regex_search(readme, first, std::regex("\\bCF\\b")));
+  std::smatch defined;  // "**CF** (Palacin Eq. 14) is ...", wrapped anywhere
+  ASSERT_TRUE(std::regex_search(readme, defined, std::regex("\\*\\*CF\\*\\*\\s+\\(Palac")))
+      << "no \"**CF** (Palacin Eq. 14) is ...\" in README.md";
+  const std::size_t definition = defined.position(0);
+  EXPECT_EQ(static_cast<std::size_t>(first.position(0)), definition + 2)
+      << "README.md uses CF before it says what it is: "
+      << readme.substr(first.position(0) > 80 ? first.position(0) - 80 : 0, 160);
+  EXPECT_TRUE(std::regex_search(readme, std::regex("come from\\s+github\\.com/sousarbarb/optiodom")))
+      << "README.md no longer names where the OptiOdom data come from";
+}
+
 }  // namespace
 }  // namespace fitcal
