@@ -121,7 +121,7 @@ struct ReportDriftRow {
   int windows_worse = 0;  // windows whose translation error rose with the calibration
   // When the translation drift rose: whether the runs' scatter explains it, as fit says it
   // (validation/never_worse.h: "worse, within the scatter: margin 0.124"); empty otherwise.
-  std::string never_worse_note;
+  std::string never_worse_note = {};
 };
 
 // Mean signed final error (bias) over the validation runs in each run's start frame: what a

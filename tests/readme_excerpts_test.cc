@@ -114,6 +114,17 @@ TEST(ReadmeExcerpts, WorkedExampleOnTheDiffDrive) {
   // The README's data set is /tmp/od_diff, this one is the test's own directory.
   output = ReplaceAll(ReplaceAll(output, dir.Path("diff.yaml"), "diff.yaml"), data, "/tmp/od_diff");
   ExpectExcerptOf(Excerpt(std::string("fitcal ") + kVersion + "  diff_drive robot"), output);
+  // The report on the free run (issue 42: it printed "validation: 1 runs").
+  const std::string free = dir.Path("od_diff_free");
+  Stdout(".", kFitcal + " import optiodom " + diff + "/free/* --out " + free, dir);
+  std::string report = Stdout(".",
+                              kFitcal + " report --logs " + free + " --calibration " +
+                                  dir.Path("diff.yaml") + " --out " +
+                                  dir.Path("diff_free_report") + " --tum",
+                              dir);
+  report = ReplaceAll(ReplaceAll(report, dir.Path("diff_free_report"), "diff_free_report"), data,
+                      "/tmp/od_diff");
+  ExpectExcerptOf(Excerpt("validation: 1 run ("), report);
 }
 
 // Issue 42: a newcomer met "CF" in the first example with its meaning further down, and found no
