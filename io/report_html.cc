@@ -27,7 +27,9 @@ const char* const kStyle =
     // the table scrolls instead of squeezing them to one word a line.
     "td:not(:first-child):not(.k){white-space:nowrap}td.k{min-width:12em}\n"
     "th{background:#f0f0f0}\n"
-    "code{overflow-wrap:anywhere}\n"
+    // A path is one long word (a data set in a temporary directory, "trained on data set
+    // /tmp/..."), in code or in prose: it breaks rather than push a phone's page sideways.
+    "code,p,li{overflow-wrap:anywhere}\n"
     // A run id is one long word (rosbag imports name runs by topic and time): it breaks rather
     // than push a phone's page wider than the screen.
     "h1,h2,h3{overflow-wrap:anywhere}\n"
@@ -94,14 +96,21 @@ void HtmlKeyNumbers(std::ostringstream& h, const ReportData& d) {
     << ChangePercentText(all.before.rms_distance_m, all.after.rms_distance_m) << ")</li>\n";
   for (const ReportDriftRow& r : d.drift) {
     // Coloured and said like the runs that got worse (issue 42: a worse 0.5 m drift went unmarked).
-    const bool drift_worse = r.after_translation_percent > r.before_translation_percent ||
-                             r.after_rotation_rad_per_m > r.before_rotation_rad_per_m;
+    const bool translation_worse = r.after_translation_percent > r.before_translation_percent;
+    const bool drift_worse =
+        translation_worse || r.after_rotation_rad_per_m > r.before_rotation_rad_per_m;
+    // fit's judgement of a translation rise: within the runs' scatter or beyond it.
+    const std::string said =
+        translation_worse && !r.never_worse_note.empty() ? r.never_worse_note : "worse";
     h << "<li" << (drift_worse ? " class=\"worse\"" : "") << ">drift over "
       << Fmt("%g m", r.length_m) << ": <b>" << Fmt("%.2f", r.before_translation_percent)
       << " &rarr; " << Fmt("%.2f %%", r.after_translation_percent) << "</b>, "
       << Fmt("%.3f", kDeg * r.before_rotation_rad_per_m) << " &rarr; "
-      << Fmt("%.3f deg/m", kDeg * r.after_rotation_rad_per_m) << (drift_worse ? " (worse)" : "")
-      << "</li>\n";
+      << Fmt("%.3f deg/m", kDeg * r.after_rotation_rad_per_m)
+      << (drift_worse ? " (" + EscapeXml(said) + ")" : "") << "</li>\n";
+  }
+  for (const std::string& line : d.never_worse_lines) {
+    h << "<li class=\"worse\">" << EscapeXml(line) << "</li>\n";
   }
   h << "<li" << (worse > 0 ? " class=\"worse\"" : "") << ">held-out runs that got worse: " << worse
     << " of " << d.runs.size() << (worse > 0 ? " (<a href=\"#worse\">list</a>)" : "")
@@ -112,7 +121,7 @@ void HtmlHeader(std::ostringstream& h, const ReportData& d) {
   h << "<p>Robot <b>" << EscapeXml(d.robot_name) << "</b>, data set <code>" << EscapeXml(d.dataset)
     << "</code>, calibration <code>" << EscapeXml(d.calibration) << "</code>, fitcal "
     << EscapeXml(d.tool_version) << ".<br>"
-    << "Validation: " << d.runs.size() << " runs (repetitions "
+    << "Validation: " << RunsText(d.runs.size()) << " (repetitions "
     << EscapeXml(d.validation_repetitions)
     << ") that the calibration did not train on; training: " << EscapeXml(d.training_source)
     << ".<br>"

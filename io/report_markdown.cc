@@ -61,7 +61,9 @@ void MdVerdict(std::ostringstream& m, const ReportData& d) {
     worse += (n++ ? ", " : "") + r.id;
   }
   m << "- held-out runs that got worse: " << n << " of " << d.runs.size()
-    << (n > 0 ? " (" + worse + ")" : "") << "\n\n";
+    << (n > 0 ? " (" + worse + ")" : "") << "\n";
+  for (const std::string& line : d.never_worse_lines) m << "- **worse:** " << line << "\n";
+  m << "\n";
 }
 
 void MdSummary(std::ostringstream& m, const ReportData& d) {
@@ -105,12 +107,16 @@ void MdDrift(std::ostringstream& m, const ReportData& d) {
   for (const ReportDriftRow& r : d.drift) {
     // A drift that rose is flagged like a run that got worse: short windows show a wrong
     // calibration first (issue 42: 0.5 m, 0.71 -> 0.86 %, went unmarked).
-    const auto flagged = [](double before, double after, const char* format) {
-      return Fmt(format, after) + (after > before ? " (worse)" : "");
+    // The translation rows carry fit's judgement of the rise (within the runs' scatter or not).
+    const auto flagged = [](double before, double after, const char* format,
+                            const std::string& note = "") {
+      return Fmt(format, after) +
+             (after > before ? " (" + (note.empty() ? std::string("worse") : note) + ")" : "");
     };
     m << MdRow({Fmt("%g", r.length_m), std::to_string(r.windows),
                 Fmt("%.2f", r.before_translation_percent),
-                flagged(r.before_translation_percent, r.after_translation_percent, "%.2f"),
+                flagged(r.before_translation_percent, r.after_translation_percent, "%.2f",
+                        r.never_worse_note),
                 Fmt("%.3f", kDeg * r.before_rotation_rad_per_m),
                 flagged(kDeg * r.before_rotation_rad_per_m, kDeg * r.after_rotation_rad_per_m,
                         "%.3f")});
@@ -214,7 +220,7 @@ std::string ReportMarkdown(const ReportData& d) {
   MdVerdict(m, d);
   m << "- robot: " << d.robot_name << "\n- data set: `" << d.dataset << "`\n- calibration: `"
     << d.calibration << "` (" << d.calibration_note << ")\n- fitcal " << d.tool_version
-    << "\n- validation: " << d.runs.size() << " runs (repetitions " << d.validation_repetitions
+    << "\n- validation: " << RunsText(d.runs.size()) << " (repetitions " << d.validation_repetitions
     << "); training: " << d.training_source << "\n- odometry sampled at the "
     << "ground-truth times by " << d.sampling << " time\n\n";
   MdComparison(m, d);

@@ -119,6 +119,9 @@ struct ReportDriftRow {
   std::vector<double> before_translation_percent_windows, after_translation_percent_windows;
   std::vector<double> before_rotation_rad_per_m_windows, after_rotation_rad_per_m_windows;
   int windows_worse = 0;  // windows whose translation error rose with the calibration
+  // When the translation drift rose: whether the runs' scatter explains it, as fit says it
+  // (validation/never_worse.h: "worse, within the scatter: margin 0.124"); empty otherwise.
+  std::string never_worse_note = {};
 };
 
 // Mean signed final error (bias) over the validation runs in each run's start frame: what a
@@ -196,6 +199,9 @@ struct ReportData {
   std::vector<ReportSummaryRow> summary;
   std::vector<ReportSummaryRow> trajectories;  // one row per trajectory label
   std::vector<ReportDriftRow> drift;
+  // fit's never-worse judgement on these runs: each measure (CF, ATE, drift) and family that is
+  // worse than the nominal, beyond the runs' scatter or more than 5 % within it, in one line.
+  std::vector<std::string> never_worse_lines;
   ReportBias bias_before, bias_after;
   ReportErrorBands error_bands;
   ReportNoiseFloor noise_floor;

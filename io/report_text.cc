@@ -23,6 +23,8 @@ std::string ChangePercentText(double before, double after) {
   return Fmt("%+.1f %%", -Improvement(before, after));
 }
 
+std::string RunsText(std::size_t n) { return std::to_string(n) + (n == 1 ? " run" : " runs"); }
+
 const Column kColumns[7] = {
     {"rms_distance_m", "RMS distance error [m] (Eq. 12)", false, &ReportMetrics::rms_distance_m},
     {"rms_angle", "RMS |angle| error [deg] (Eq. 13)", true, &ReportMetrics::rms_angle_rad},

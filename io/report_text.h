@@ -33,6 +33,9 @@ double Improvement(double before, double after);
 // improvement_percent keeps Palacin Table 6's sign (positive = better) and says so in its name.
 std::string ChangePercentText(double before, double after);
 
+// "1 run", "3 runs" (issue 42: "validation: 1 runs").
+std::string RunsText(std::size_t n);
+
 // Table 6 columns: (label, unit, getter, is angle).
 struct Column {
   const char* key;    // machine name, SI

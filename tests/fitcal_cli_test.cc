@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -319,6 +320,21 @@ TEST(FitcalCli, DiagnoseRecordsTheWrittenFitsSigmasAndTheReportShowsThem) {
   EXPECT_GT(block["sigma"]["wheel_separation_m"].as<double>(), 0.0);
   ASSERT_EQ(block["correlation"].size(), 3u);
   EXPECT_DOUBLE_EQ(block["correlation"][1][1].as<double>(), 1.0);
+  // Issue 42: the terminal printed another fit's sigma (7.3e-05) than the file (2.2e-04), and a
+  // "+ effects" column when no effect was accepted. The written calibration's row on stdout
+  // carries the file's sigma to the two digits it prints (half a unit of the second digit).
+  // The unit once, in its own column (issue 42: "| r_right [m] | m |").
+  EXPECT_EQ(r.out.find(" [m] | m |"), std::string::npos) << r.out;
+  const std::size_t row = r.out.find("| wheel_separation | m | ", r.out.find("## Written"));
+  ASSERT_NE(row, std::string::npos) << r.out;
+  const std::string cells = r.out.substr(row, r.out.find('\n', row) - row);
+  const double printed = std::stod(cells.substr(cells.rfind("| ", cells.size() - 3) + 2));
+  const double written = block["sigma"]["wheel_separation_m"].as<double>();
+  EXPECT_NEAR(printed, written, 0.5 * std::pow(10.0, std::floor(std::log10(written)) - 1)) << cells;
+  if (r.out.find("No effect accepted.") != std::string::npos) {
+    EXPECT_EQ(r.out.find("+ effects"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("accepted effects"), std::string::npos) << r.out;
+  }
   const std::string out = dir.Path("report");
   r = RunFitcal(dir, "report --logs " + data + " --calibration " + cal + " --out " + out);
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;

@@ -80,7 +80,9 @@ std::vector<double> EverydayRow(const std::string& out, const std::string& title
   if (block == std::string::npos) return {};
   const std::size_t row = out.find("  " + name, block);
   if (row == std::string::npos) return {};
-  const std::vector<std::string> t = Tokens(out.substr(row, out.find('\n', row) - row));
+  std::string line = out.substr(row, out.find('\n', row) - row);
+  line = line.substr(0, line.find("  worse"));  // the never-worse note after the change
+  const std::vector<std::string> t = Tokens(line);
   if (t.size() < 3) return {};
   return {std::stod(t[t.size() - 3]), std::stod(t[t.size() - 2])};
 }

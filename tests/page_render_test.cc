@@ -123,6 +123,10 @@ ReportData SmallReport() {
   d.tool_version = "test";
   d.dataset = "data/some/long/path/of/a/data/set/that/must/wrap/on/a/phone";
   d.calibration = "calibrated.yaml";
+  // A path in prose, one long word (the real report's "trained on data set /tmp/...", which
+  // pushed a phone's page to 628 px).
+  d.calibration_note = "method ceres, trained on data set "
+                       "/tmp/fitcal_RealDiffDriveReportReadableOnPhoneAndDesktop_1234567890/D";
   d.robot_name = "robot";
   d.sampling = "nearest";
   d.verdict = "PASS";
@@ -213,6 +217,31 @@ TEST(PageRender, ReportAndDiagnoseReadableOnPhoneAndDesktop) {
   d.held_out = {{"run1", 0.05, 0.01, 0.02, 0.004, {0.01, 0.02}, {0.001, 0.002}}};
   d.text_report = std::string(300, 'x');
   ExpectReadable(dir, DiagnoseHtml(d), "diagnose");
+}
+
+// The report of the worked example on the real differential drive (README: 20 held-out runs, 4
+// worse, 1.1 MB), as a newcomer opens it: readable at both widths, the worse runs' "after" cells
+// on the screen, and the nominal's extremes beyond the error figure's top marked. Skipped without
+// chromium or ../shared.
+TEST(PageRender, RealDiffDriveReportReadableOnPhoneAndDesktop) {
+  const std::string diff = FITCAL_SHARED_DIR "/data/optiodom/diff";
+  if (Chromium().empty() || !std::filesystem::is_directory(diff)) {
+    GTEST_SKIP() << "no chromium or no " << diff;
+  }
+  TempDir dir;
+  const std::string data = dir.Path("D"), cal = dir.Path("cal.yaml"), rep = dir.Path("rep");
+  using fitcal::testing::RunFitcal;
+  ASSERT_EQ(
+      RunFitcal(dir, "import optiodom " + diff + "/circular/* " + diff + "/square/* --out " + data)
+          .exit_code,
+      0);
+  ASSERT_EQ(RunFitcal(dir, "fit --logs " + data + " --out " + cal).exit_code, 0);
+  ASSERT_EQ(
+      RunFitcal(dir, "report --logs " + data + " --calibration " + cal + " --out " + rep).exit_code,
+      0);
+  const std::string html = ReadFileBytes(rep + "/index.html");
+  EXPECT_NE(html.find("beyond the top: "), std::string::npos);
+  ExpectReadable(dir, html, "real report");
 }
 
 }  // namespace

@@ -490,6 +490,29 @@ TEST(ReportTest, HeldOutRunsThatGotWorseAreFlagged) {
   EXPECT_NEAR(j["runs"][1]["ate_rmse_m"]["after"].as<double>(), 0.05, 1e-12);
 }
 
+// Issue 42: "validation: 1 runs"; and a drift that rose inside the runs' scatter went unsaid. The
+// count agrees with its noun, and fit's judgement of a rise (the row's note, the lines) is shown
+// on the page and in summary.md as given.
+TEST(ReportTest, RunCountsAndRisesInsideTheScatterAreSaid) {
+  ReportData d = SmallReport();
+  EXPECT_NE(ReportMarkdown(d).find("- validation: 3 runs (repetitions"), std::string::npos);
+  d.runs.resize(1);
+  EXPECT_NE(ReportMarkdown(d).find("- validation: 1 run (repetitions"), std::string::npos);
+  EXPECT_NE(ReportHtml(d).find("Validation: 1 run (repetitions"), std::string::npos);
+  d.drift[0].after_translation_percent = 2.2;  // rose from 2.0
+  d.drift[0].never_worse_note = "worse, within the scatter: margin 0.5";
+  d.never_worse_lines = {"'the calibration' is worse than the nominal on the held-out runs (1), "
+                         "within the runs' scatter: drift 1 m [%] 2 -> 2.2 (+10.0 %)"};
+  const std::string md = ReportMarkdown(d);
+  EXPECT_NE(md.find("| 2.20 (worse, within the scatter: margin 0.5) |"), std::string::npos) << md;
+  EXPECT_NE(md.find("- **worse:** " + d.never_worse_lines[0] + "\n"), std::string::npos) << md;
+  const std::string html = ReportHtml(d);
+  EXPECT_NE(html.find("(worse, within the scatter: margin 0.5)</li>"), std::string::npos);
+  EXPECT_NE(html.find("<li class=\"worse\">&#39;the calibration&#39; is worse"), std::string::npos)
+      << html.substr(html.find("id=\"key\""), 2000);
+  EXPECT_EQ(CheckWellFormed(html), "");
+}
+
 // Every % change of the page has one sign (after - before): the CF that fell from 0.06 to 0.005
 // reads -91.7 % in the summary of the page and of summary.md, and a parameter that grew by 1 %
 // reads +1.00 %.

@@ -53,6 +53,18 @@ TEST(VerdictTest, GoodCalibrationPasses) {
   EXPECT_NE(Find(v, "improvement")->message.find("0.0700 -> 0.0080"), std::string::npos);
 }
 
+// Issue 42: "... (74 % lower) on 1 runs" on the README's one free run.
+TEST(VerdictTest, TheRunCountAgreesWithItsNoun) {
+  VerdictInputs in = GoodCase();
+  in.overall.runs = 1;
+  EXPECT_NE(Find(JudgeCalibration(in), "improvement")->message.find("lower) on 1 run"),
+            std::string::npos);
+  EXPECT_EQ(Find(JudgeCalibration(in), "improvement")->message.find("1 runs"), std::string::npos);
+  in.overall.runs = 2;
+  EXPECT_NE(Find(JudgeCalibration(in), "improvement")->message.find("lower) on 2 runs"),
+            std::string::npos);
+}
+
 TEST(VerdictTest, ParameterOnABoundWarns) {
   VerdictInputs in = GoodCase();
   in.at_bound = {"R_a"};

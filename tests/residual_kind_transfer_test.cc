@@ -95,7 +95,10 @@ TEST(ResidualKindTransfer, LeavesEachKindOutAndKeepsTheTrackUnlessTheFinalPoseWi
   j = h.Judge(CirclesAndSquares());
   EXPECT_EQ(j.alternative_wins, 6);
   EXPECT_EQ(j.chosen, ResidualKind::kFinalPose);
-  EXPECT_FALSE(ResidualKindJudgementLines(j).empty());
+  const std::vector<std::string> lines = ResidualKindJudgementLines(j);
+  EXPECT_FALSE(lines.empty());
+  // No line padded with trailing spaces (issue 42: the rows ended in the last column's padding).
+  for (const std::string& line : lines) EXPECT_NE(line.back(), ' ') << "'" << line << "'";
 }
 
 TEST(ResidualKindTransfer, HeldOutFreeDrivingHasTheLastWordByMajority) {

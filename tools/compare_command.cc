@@ -12,6 +12,7 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include "fit/final_pose_errors.h"
 #include "fit/run_split.h"
@@ -123,6 +124,15 @@ std::string CsvField(const std::string& s) {
   return out + "\"";
 }
 
+// How each of compare's files starts, whatever the model: how a later run recognises them as its
+// own previous output (tools/output_guard.h, rule 1).
+constexpr char kCsvStart[] = "strategy,method,repetitions,";
+constexpr char kMarkdownStart[] = "| Strategy | Method | Reps | ";
+constexpr char kTraceStart[] = "strategy,method,repetitions,evaluation,best_cf,elapsed_s";
+// Each file as <out><suffix> and how it starts.
+constexpr std::pair<const char*, const char*> kOutputFiles[] = {
+    {".csv", kCsvStart}, {".md", kMarkdownStart}, {"_trace.csv", kTraceStart}};
+
 std::string Csv(const std::vector<Row>& rows, const ParameterColumns& columns) {
   std::ostringstream o;
   o << "strategy,method,repetitions";
@@ -146,7 +156,7 @@ std::string Csv(const std::vector<Row>& rows, const ParameterColumns& columns) {
 
 std::string Markdown(const std::vector<Row>& rows, const ParameterColumns& columns) {
   std::ostringstream o;
-  o << "| Strategy | Method | Reps | " << columns.markdown_header
+  o << kMarkdownStart << columns.markdown_header
     << " | CF calibration | CF validation | Improvement | "
        "Evaluations | Wall [s] | Termination |\n"
     << "|---|---|---|---|---|---|---|---|---|---|\n";
@@ -165,7 +175,7 @@ std::string Markdown(const std::vector<Row>& rows, const ParameterColumns& colum
 
 std::string TraceCsv(const std::vector<Row>& rows) {
   std::ostringstream o;
-  o << "strategy,method,repetitions,evaluation,best_cf,elapsed_s\n";
+  o << kTraceStart << "\n";
   for (const Row& row : rows) {
     for (const ConvergencePoint& p : row.trace) {
       o << CsvField(row.strategy) << "," << row.method << "," << row.repetitions << ","
@@ -460,6 +470,7 @@ void AddCompareOptions(CLI::App& app, CompareCommandOptions& o) {
   app.add_option("--out", o.out, "Output prefix: <out>.csv, <out>.md, <out>_trace.csv")
       ->capture_default_str();
   app.add_flag("--no-output", o.no_output, "Print the table only");
+  app.add_flag("--force", o.force, kForceFileHelp);
   app.add_flag("--quiet", o.quiet, "No progress on stderr");
   AddSolverOptions(app, o);
   AddTyingFlags(app, o);
@@ -473,10 +484,13 @@ int RunCompareCommand(const CompareCommandOptions& options) {
   }
   const bool show_progress = !options.quiet && isatty(STDERR_FILENO);
   return RunReportingErrors("fitcal compare", [&]() -> int {
-    if (!options.no_output) {  // before the work: no output file may replace an input
+    if (!options.no_output) {  // before the work: the one overwrite rule, tools/output_guard.h
       const std::vector<std::string> inputs = OpenDataset(options).inputs;
-      for (const char* suffix : {".csv", ".md", "_trace.csv"}) {
-        const std::string refusal = OutputFileRefusal(options.out + suffix, inputs);
+      for (const auto& [suffix, start] : kOutputFiles) {
+        std::string refusal = OutputFileRefusal(options.out + suffix, inputs);
+        if (refusal.empty() && !options.force) {
+          refusal = TextOutputOverwriteRefusal(options.out + suffix, start);
+        }
         if (!refusal.empty()) return Refuse(refusal);
       }
     }

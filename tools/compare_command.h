@@ -6,7 +6,8 @@
 // repetitions of the whole flower). The model's closed forms (UMBmark for a differential drive)
 // are rows beside the fits, computed from the same training runs. Prints the
 // table as Markdown and writes <out>.csv, <out>.md and <out>_trace.csv (best CF vs evaluations
-// per fit), each atomically, after every fit has finished. With --tie/--hold
+// per fit), each atomically, after every fit has finished; a file there that is not compare's
+// previous output is refused (exit 2) unless --force (tools/output_guard.h). With --tie/--hold
 // (fit/parameter_tying.h, read as `fit` reads them) every method also fits the reduced model, a
 // "<method> (tied)" row beside its full fit.
 
@@ -31,6 +32,7 @@ struct CompareCommandOptions : DatasetCommandOptions, SolverOptions, TyingFlags 
   std::string validation_reps;            // "" = every repetition after the largest k
   std::string out = "compare";            // prefix of the output files
   bool no_output = false;
+  bool force = false;  // replace files at <out>.* that compare did not write (output_guard.h)
   bool quiet = false;
 
   // Each of the many fits compare runs gets half the NLopt budget of a single `fit`.

@@ -216,7 +216,8 @@ std::string WrittenCalibrationText(const Robot& robot, const DiagnoseChoice& cho
   for (int k = 0; k < robot.NumParameters(); ++k) {
     const ParameterInfo& info = robot.parameters[k];
     const double s = info.DisplayScale();
-    out += StrFormat("| %s%s | %s | %.6f | %.2g |\n", robot.LabelOf(k).c_str(),
+    // The unit has its own column (issue 42: "r_right [m] | m" said it twice).
+    out += StrFormat("| %s%s | %s | %.6f | %.2g |\n", info.name.c_str(),
                      robot.IsHeld(k) ? " (held)" : "", info.DisplayUnit(), choice.parameters[k] * s,
                      choice.sigma[k] * s);
   }

@@ -78,7 +78,6 @@ CLI::App* GroupOf(CLI::App& app, const std::string& group) {
     if (group == g.name) {
       CLI::App* parent = app.add_subcommand(g.name, g.description);
       parent->require_subcommand(1);
-      parent->footer(kExitStatusHelp);
       return parent;
     }
   }
@@ -133,6 +132,47 @@ std::vector<Command> Commands() {
                   &AddAsocTablesOptions, &RunAsocTables),
   };
 }
+
+// fitcal's --help. CLI11 2.1 writes an option's exclusions as " Excludes: --x" after its name,
+// which overruns the name column and glues onto the description; here the description says it
+// ("not with --x") and the parser still refuses both (exit 2). Every help ends with the command's
+// own footer (fleet's columns), then the one list of exit statuses - once, whatever footer a
+// subcommand inherited from its parent.
+class HelpFormatter : public CLI::Formatter {
+ public:
+  // CLI11's make_option_opts without its "Needs:" and "Excludes:" lists.
+  std::string make_option_opts(const CLI::Option* opt) const override {
+    if (!opt->get_option_text().empty()) return " " + opt->get_option_text();
+    std::ostringstream out;
+    if (opt->get_type_size() != 0) {
+      if (!opt->get_type_name().empty()) out << " " << get_label(opt->get_type_name());
+      if (!opt->get_default_str().empty()) out << "=" << opt->get_default_str();
+      if (opt->get_expected_max() == CLI::detail::expected_max_vector_size) {
+        out << " ...";
+      } else if (opt->get_expected_min() > 1) {
+        out << " x " << opt->get_expected();
+      }
+      if (opt->get_required()) out << " " << get_label("REQUIRED");
+    }
+    if (!opt->get_envname().empty()) {
+      out << " (" << get_label("Env") << ":" << opt->get_envname() << ")";
+    }
+    return out.str();
+  }
+
+  std::string make_option_desc(const CLI::Option* opt) const override {
+    std::string description = opt->get_description();
+    for (const CLI::Option* other : opt->get_excludes()) {
+      description += " (not with " + other->get_name() + ")";
+    }
+    return description;
+  }
+
+  std::string make_footer(const CLI::App* app) const override {
+    const std::string own = app->get_footer();
+    return (own.empty() ? "" : own + "\n\n") + kExitStatusHelp + "\n";
+  }
+};
 
 // For an argument CLI11 did not expect: a directory given without its flag (`fitcal fit DIR`)
 // is a data set meant for --logs; "" for anything else.
@@ -200,7 +240,8 @@ int main(int argc, char** argv) {
                "logs and ground truth"};
   app.set_version_flag("--version", std::string(fitcal::kVersion));
   app.require_subcommand(0, 1);
-  app.footer(kExitStatusHelp);
+  // Before any subcommand is added: each takes its parent's formatter when it is created.
+  app.formatter(std::make_shared<HelpFormatter>());
 
   const std::vector<Command> commands = Commands();
   // fit's flags on the top level too, bound to the same options: `fitcal --logs DIR` fits.
@@ -209,10 +250,6 @@ int main(int argc, char** argv) {
   for (const Command& command : commands) {
     CLI::App* cmd = GroupOf(app, command.group)->add_subcommand(command.name, command.description);
     command.add_options(*cmd);
-    // A command's own footer (what it prints, e.g. fleet's columns) first, then the one list of
-    // exit statuses every command shares.
-    const std::string own = cmd->get_footer();
-    cmd->footer(own.empty() ? kExitStatusHelp : own + "\n\n" + kExitStatusHelp);
     parsers.push_back(cmd);
   }
 

@@ -715,6 +715,9 @@ bool WorseThanNominalBeyondNoise(const RobotModelInterface& model, const std::ve
   for (const std::string& line : NeverWorseRefusals(name, judged, /*refusing=*/false)) {
     std::printf("warning: %s\n", line.c_str());
   }
+  for (const std::string& line : NeverWorseWithinScatter(name, judged)) {
+    std::printf("warning: %s\n", line.c_str());
+  }
   const std::vector<std::string> refusals = NeverWorseRefusals(name, judged);
   for (const std::string& line : refusals) std::cerr << "fitcal: " << line << "; nothing written\n";
   return !refusals.empty();

@@ -139,6 +139,22 @@ std::string ParameterFileOverwriteRefusal(const std::string& out, const std::str
          "'; refusing to overwrite it (--force to replace it)";
 }
 
+std::string TextOutputOverwriteRefusal(const std::string& out, const std::string& first_line) {
+  // stat first: a FIFO or device is refused by OutputFileRefusal, never opened here.
+  struct stat info {};
+  if (::stat(out.c_str(), &info) != 0) return "";
+  std::string line;
+  if (S_ISREG(info.st_mode)) {
+    const io::NotAnInput probe;
+    std::ifstream in(out);
+    std::getline(in, line);
+  }
+  if (line.compare(0, first_line.size(), first_line) == 0) return "";
+  return Refusal(out,
+                 "exists and is not this command's previous output; refusing to overwrite it "
+                 "(--force to replace it)");
+}
+
 std::string OutputFileRefusal(const std::string& out, const std::vector<std::string>& inputs) {
   if (out.empty()) return "--out is empty; name the file to write";
   if (const std::string overlap = InputOverlap(out, inputs); !overlap.empty()) return overlap;

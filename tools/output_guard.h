@@ -2,9 +2,10 @@
 // What an output may replace: the one rule of every command that writes (README, "Outputs").
 //   1. Running a command again replaces its own previous output at --out: a calibration of the
 //      same robot (fit, diagnose, asoc-geometric, export --calibration-out), the parameter file of
-//      the same controller node (export), a data set fitcal wrote (import, simulate), a report or
-//      page directory holding only the files the command writes. Each is recreated from inputs
-//      that still exist (an output never overlaps an input), so replacing it loses nothing.
+//      the same controller node (export), compare's tables, a data set fitcal wrote (import,
+//      simulate), a report or page directory holding only the files the command writes. Each is
+//      recreated from inputs that still exist (an output never overlaps an input), so replacing it
+//      loses nothing.
 //   2. Anything else at --out is refused with exit status 2 (UsageError) and nothing written.
 //      --force replaces it when it is a regular file (another robot's calibration, another YAML)
 //      or a directory fitcal wrote as another kind of output.
@@ -35,6 +36,10 @@ std::string OverwriteRefusal(const std::string& out, const std::string& robot_na
 // The same for a ROS 2 parameter file: empty when `out` does not exist or is the parameter file
 // of the same top-level node (`node_name: {ros__parameters: ...}`).
 std::string ParameterFileOverwriteRefusal(const std::string& out, const std::string& node_name);
+
+// The same for a text output recognised by how it starts (compare's tables): empty when `out`
+// does not exist or its first line starts with `first_line` (the command's previous output).
+std::string TextOutputOverwriteRefusal(const std::string& out, const std::string& first_line);
 
 // Empty when `out` may be written as a file. Refuses (not even --force: a usage error) a path that
 // exists and is not a regular file (a directory; a FIFO or a device: renaming over /dev/null as

@@ -86,8 +86,9 @@ void WriteReport(const ReportCommandOptions& options, const ReportInputs& in,
 
 void PrintReport(const ReportCommandOptions& options, const io::ReportData& data) {
   const io::ReportSummaryRow& all = data.summary.back();
-  std::printf("validation: %zu runs (repetitions %s), odometry sampled by %s time\n",
-              data.runs.size(), data.validation_repetitions.c_str(), data.sampling.c_str());
+  std::printf("validation: %zu run%s (repetitions %s), odometry sampled by %s time\n",
+              data.runs.size(), data.runs.size() == 1 ? "" : "s",
+              data.validation_repetitions.c_str(), data.sampling.c_str());
   std::printf("training: %s\n", data.training_source.c_str());
   // change = 100 (after - before) / before, the one sign of every % change of the report.
   std::printf("  CF (Eq. 14)            %.4f -> %.4f  (change %+.1f %%)\n", all.before.cf,

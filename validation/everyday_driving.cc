@@ -61,14 +61,18 @@ EverydayDrivingMetrics EvaluateEverydayDriving(const RobotModelInterface& model,
 }
 
 std::vector<std::string> EverydayDrivingRows(const EverydayDrivingMetrics& before,
-                                             const EverydayDrivingMetrics& after) {
+                                             const EverydayDrivingMetrics& after,
+                                             const std::map<std::string, std::string>& notes) {
   std::vector<std::string> rows;
-  const auto row = [&](const std::string& name, double a, double b, const std::string& values) {
+  const auto row = [&](const std::string& name, double a, double b, const std::string& values,
+                       const std::string& measure = "") {
     const double change = a > 0.0 ? 100.0 * (b - a) / a : 0.0;
-    rows.push_back(StrFormat("  %-30s %s %+8.1f%%", name.c_str(), values.c_str(), change));
+    const auto note = notes.find(measure);
+    rows.push_back(StrFormat("  %-30s %s %+8.1f%%%s", name.c_str(), values.c_str(), change,
+                             note == notes.end() ? "" : ("  " + note->second).c_str()));
   };
   row("ATE RMSE [m] (mean of runs)", before.mean_ate_rmse_m, after.mean_ate_rmse_m,
-      StrFormat("%10.4f %10.4f", before.mean_ate_rmse_m, after.mean_ate_rmse_m));
+      StrFormat("%10.4f %10.4f", before.mean_ate_rmse_m, after.mean_ate_rmse_m), "ATE RMSE [m]");
   for (std::size_t k = 0; k < before.drift.size() && k < after.drift.size(); ++k) {
     const DriftAtLength& a = before.drift[k];
     const DriftAtLength& b = after.drift[k];
@@ -76,7 +80,8 @@ std::vector<std::string> EverydayDrivingRows(const EverydayDrivingMetrics& befor
     char name[64];
     std::snprintf(name, sizeof name, "drift %g m [%%] (%d windows)", a.length_m, a.windows);
     row(name, a.translation_percent, b.translation_percent,
-        StrFormat("%10.3f %10.3f", a.translation_percent, b.translation_percent));
+        StrFormat("%10.3f %10.3f", a.translation_percent, b.translation_percent),
+        StrFormat("drift %g m [%%]", a.length_m));
     std::snprintf(name, sizeof name, "drift %g m [deg/m]", a.length_m);
     row(name, a.rotation_deg_per_m, b.rotation_deg_per_m,
         StrFormat("%10.3f %10.3f", a.rotation_deg_per_m, b.rotation_deg_per_m));

@@ -9,6 +9,7 @@
 //     alignment and never a scale (a scale alignment would absorb the wheel radius); the mean
 //     over runs.
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -53,8 +54,11 @@ EverydayDrivingMetrics EvaluateEverydayDriving(const RobotModelInterface& model,
                                                const std::vector<double>& lengths_m,
                                                int num_threads = 0);
 
-// Table rows "  drift 1 m [%]  nominal  calibrated" etc. for two calibrations on the same runs.
+// Table rows "  drift 1 m [%]  nominal  calibrated  change" etc. for two calibrations on the same
+// runs; a measure named in `notes` ("ATE RMSE [m]", "drift 1 m [%]") has its note after the
+// change (the never-worse judgement's, validation/never_worse.h: NeverWorseRowNotes).
 std::vector<std::string> EverydayDrivingRows(const EverydayDrivingMetrics& before,
-                                             const EverydayDrivingMetrics& after);
+                                             const EverydayDrivingMetrics& after,
+                                             const std::map<std::string, std::string>& notes = {});
 
 }  // namespace fitcal

@@ -46,7 +46,11 @@ std::vector<RunSet> RunSets(const std::vector<AlignedRun>& runs) {
     sets[0].index.push_back(i);
     by_family[TrajectoryFamily(runs[i].trajectory)].push_back(i);
   }
-  if (by_family.size() < 2) return sets;  // the family is the whole
+  if (by_family.size() == 1) {  // the family is the whole: named, so a line says which kind
+    sets[0].name = "held-out runs (" + std::to_string(runs.size()) + ", all '" +
+                   by_family.begin()->first + "')";
+  }
+  if (by_family.size() < 2) return sets;
   for (auto& [family, index] : by_family) {
     sets.push_back({"held-out '" + family + "' runs (" + std::to_string(index.size()) + ")",
                     std::move(index)});
@@ -111,7 +115,8 @@ std::vector<NeverWorseJudgement> JudgeAll(const std::vector<AlignedRun>& runs,
       out.push_back(JudgeMeasure(m.name, set.name, Pick(labels, set.index),
                                  Pick(m.weights, set.index), Pick(m.nominal, set.index),
                                  Pick(m.calibrated, set.index), all, k));
-      out.back().refuses = &set == &sets.front() ? m.refuses_on_all : m.refuses_per_family;
+      out.back().all_runs = &set == &sets.front();
+      out.back().refuses = out.back().all_runs ? m.refuses_on_all : m.refuses_per_family;
     }
   }
   return out;
@@ -171,9 +176,10 @@ std::string NeverWorseJudgement::Description() const {
                   measure.c_str(), nominal, calibrated);
   } else {
     std::snprintf(text, sizeof text,
-                  "%s %.6g -> %.6g, more than the margin %.3g (t %.2f x spread %.3g %% of a "
+                  "%s %.6g -> %.6g, %s the margin %.3g (t %.2f x spread %.3g %% of a "
                   "run's value between repetitions, %d dof)",
-                  measure.c_str(), nominal, calibrated, margin, t, 100.0 * spread.relative_sd,
+                  measure.c_str(), nominal, calibrated, Worse() ? "more than" : "within", margin,
+                  t, 100.0 * spread.relative_sd,
                   spread.dof);
   }
   return text;
@@ -215,6 +221,34 @@ std::vector<std::string> NeverWorseRefusals(const std::string& name,
     }
   }
   return out;
+}
+
+std::vector<std::string> NeverWorseWithinScatter(const std::string& name,
+                                                 const std::vector<NeverWorseJudgement>& judgements) {
+  std::vector<std::string> out;
+  for (const NeverWorseJudgement& j : judgements) {
+    if (!j.WorseWithinScatter()) continue;
+    char change[32];
+    std::snprintf(change, sizeof change, " (%+.1f %%)", 100.0 * (j.calibrated / j.nominal - 1.0));
+    std::string text = j.Description();
+    text.insert(text.find(','), change);
+    out.push_back("'" + name + "' is worse than the nominal on the " + j.runs +
+                  ", within the runs' scatter: " + text);
+  }
+  return out;
+}
+
+std::map<std::string, std::string> NeverWorseRowNotes(
+    const std::vector<NeverWorseJudgement>& judgements) {
+  std::map<std::string, std::string> notes;
+  for (const NeverWorseJudgement& j : judgements) {
+    if (!j.all_runs || !(j.calibrated > j.nominal)) continue;
+    char note[96];
+    std::snprintf(note, sizeof note, "worse%s: margin %.3g",
+                  j.Worse() ? " beyond the scatter" : ", within the scatter", j.margin);
+    notes[j.measure] = note;
+  }
+  return notes;
 }
 
 }  // namespace fitcal

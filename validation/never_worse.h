@@ -26,6 +26,7 @@
 // comparison of before).
 
 #include <cstddef>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,7 @@
 #include "odometry/aligned_run.h"
 #include "odometry/run_log.h"
 #include "validation/everyday_driving.h"
+#include "validation/verdict.h"
 
 namespace fitcal {
 
@@ -63,10 +65,17 @@ struct NeverWorseJudgement {
   // Whether being worse refuses the calibration (else a warning): drift per family and over
   // windows shorter than 1 m warn only.
   bool refuses = true;
+  bool all_runs = false;  // judged on all the held-out runs, not on one family of them
   bool Worse() const { return calibrated > nominal + margin; }
   bool Refuses() const { return refuses && Worse(); }
-  // "CF 0.0032 -> 0.0036 (margin 0.0012: t 4.5 x spread 11 % of a run's value between
-  // repetitions, 2 dof)".
+  // Risen by more than kRegressionTolerance (the report's 5 %) of the nominal's value, yet inside
+  // the margin: written, and said, so that a rise is not read as a pass (issue 42: the circles-only
+  // diff fit's squares, drift 1 m 0.740 -> 0.836 %, +13 %, margin 0.16, went unsaid).
+  bool WorseWithinScatter() const {
+    return !Worse() && calibrated > nominal * (1.0 + kRegressionTolerance);
+  }
+  // "CF 0.0032 -> 0.0036, more than the margin 0.0012 (t 4.5 x spread 11 % of a run's value
+  // between repetitions, 2 dof)"; "within the margin" when not Worse().
   std::string Description() const;
 };
 
@@ -104,5 +113,16 @@ std::vector<NeverWorseJudgement> JudgeNeverWorseOnCf(const std::vector<AlignedRu
 std::vector<std::string> NeverWorseRefusals(const std::string& name,
                                             const std::vector<NeverWorseJudgement>& judgements,
                                             bool refusing = true);
+
+// The judgements WorseWithinScatter(), as lines "'<name>' is worse than the nominal on the
+// <runs>, within the runs' scatter: drift 1 m [%] 0.74 -> 0.836 (+13.0 %), within the margin ...".
+std::vector<std::string> NeverWorseWithinScatter(const std::string& name,
+                                                 const std::vector<NeverWorseJudgement>& judgements);
+
+// What a table row of all the held-out runs says beside a measure that rose, keyed by the
+// measure's name ("ATE RMSE [m]", "drift 1 m [%]"): "worse, within the scatter: margin 0.119" or
+// "worse beyond the scatter: margin 0.119"; measures that did not rise are absent.
+std::map<std::string, std::string> NeverWorseRowNotes(
+    const std::vector<NeverWorseJudgement>& judgements);
 
 }  // namespace fitcal

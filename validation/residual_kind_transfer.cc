@@ -141,7 +141,10 @@ std::vector<std::string> ResidualKindJudgementLines(const ResidualKindJudgement&
     std::snprintf(line, sizeof(line), "  %-22s %-22s %10.4f | %-8.4f %21s %10.4f | %-8.4f",
                   judged.c_str(), c.fitted_on.c_str(), c.proposed.cf, c.alternative.cf, drift,
                   c.proposed.mean_ate_rmse_m, c.alternative.mean_ate_rmse_m);
-    lines.push_back(line);
+    // The last column is left-aligned: its padding would end the line in spaces (issue 42).
+    std::string row = line;
+    row.erase(row.find_last_not_of(' ') + 1);
+    lines.push_back(row);
   }
   // Said in full: "better on 2 of 6" alone did not tell a reader what was counted or what it takes.
   const char* rule = j.on_free_driving

@@ -174,7 +174,7 @@ Verdict JudgeCalibration(const VerdictInputs& in) {
         Reason(VerdictLevel::kPass, "improvement", "summary",
                StrFormat("held-out CF %.4f -> %.4f (%.0f %% lower)", all.cf_before, all.cf_after,
                          100.0 * (all.cf_before - all.cf_after) / all.cf_before) +
-                   " on " + std::to_string(all.runs) + " runs"));
+                   " on " + std::to_string(all.runs) + (all.runs == 1 ? " run" : " runs")));
   }
   v.reasons.push_back(RegressionReason(in));
   if (!in.termination.empty()) v.reasons.push_back(ConvergenceReason(in.termination));
