@@ -52,6 +52,8 @@ std::vector<effects::EffectValue> ReadEffectsNode(const YAML::Node& node, const 
     }
     const effects::EffectInfo& info = effects::Info(e.id);
     for (int k = 0; k < info.num_parameters; ++k) {
+      const bool optional = info.parameters_required > 0 && k >= info.parameters_required;
+      if (optional && !map.Has(info.parameter_names[k])) continue;  // value 0: neutral
       e.value[k] = map.Double(info.parameter_names[k]);
       if (!(e.value[k] >= info.lower[k] && e.value[k] <= info.upper[k])) {
         throw InputError(InputErrorKind::kBadValue, path, node[i].Mark().line + 1,

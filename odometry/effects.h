@@ -111,6 +111,9 @@ struct EffectInfo {
   bool identifiable;
   const char* aliased_with;     // what the effect trades off with
   const char* separating_runs;  // which extra runs separate it from the nine parameters
+  // Parameters a calibration file must give; the others were added later, and a file written
+  // before them reads them as 0 (neutral). 0: every parameter.
+  int parameters_required = 0;
 };
 
 const std::array<EffectInfo, kNumEffects>& EffectTable();

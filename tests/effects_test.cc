@@ -312,6 +312,20 @@ TEST(RobotYamlEffects, RoundTripAndBadInput) {
   expect_bad("  - {name: backlash, backlash_rad: 2.0}\n", "outside");
   expect_bad("  - {name: backlash, backlash_rad: 0.1, colour: red}\n", "colour");
   expect_bad("  - {name: floor_slope, creep_x_m_s: 0.01}\n", "creep_y_m_s");
+  expect_bad("  - {name: acceleration_slip, traction_s2_per_rad: 0.01}\n", "slip_s2_per_rad");
+
+  // A calibration written before acceleration_slip gained its traction term still loads: the
+  // term reads as 0, the effect as it was then.
+  {
+    const RobotModelPtr model = ReadRobotModelFile(FITCAL_SOURCE_DIR + "/data/robots/apr02.yaml");
+    std::ofstream f(path);
+    f << model->RobotYaml(model->robot().nominal, "")
+      << "effects:\n  - {name: acceleration_slip, slip_s2_per_rad: 0.012}\n";
+  }
+  const Omni3Robot old = ReadOmni3Robot(path);
+  ASSERT_EQ(old.effects.size(), 1u);
+  EXPECT_DOUBLE_EQ(old.effects[0].value[0], 0.012);
+  EXPECT_EQ(old.effects[0].value[1], 0.0);
   std::filesystem::remove(path);
 }
 

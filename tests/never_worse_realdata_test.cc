@@ -25,7 +25,7 @@ using testing::ReadFileBytes;
 using testing::RunFitcal;
 using testing::TempDir;
 
-const std::string kDiff = FITCAL_SHARED_DIR "/data/optiodom/diff";
+const std::string kDiff = FITCAL_SHARED_DIR + "/data/optiodom/diff";
 
 // The line of `text` holding `needle`; empty when none.
 std::string LineWith(const std::string& text, const std::string& needle) {

@@ -224,7 +224,7 @@ TEST(PageRender, ReportAndDiagnoseReadableOnPhoneAndDesktop) {
 // on the screen, and the nominal's extremes beyond the error figure's top marked. Skipped without
 // chromium or ../shared.
 TEST(PageRender, RealDiffDriveReportReadableOnPhoneAndDesktop) {
-  const std::string diff = FITCAL_SHARED_DIR "/data/optiodom/diff";
+  const std::string diff = FITCAL_SHARED_DIR + "/data/optiodom/diff";
   if (Chromium().empty() || !std::filesystem::is_directory(diff)) {
     GTEST_SKIP() << "no chromium or no " << diff;
   }

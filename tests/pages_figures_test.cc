@@ -24,11 +24,11 @@ using testing::ReadFileBytes;
 using testing::RunFitcal;
 using testing::TempDir;
 
-const std::string kOptiOdom = FITCAL_SHARED_DIR "/data/optiodom";
+const std::string kOptiOdom = FITCAL_SHARED_DIR + "/data/optiodom";
 
 // The cells of the row of docs/pages.md's table whose first cell is `name`; empty when none.
 std::vector<std::string> DocRow(const std::string& name) {
-  std::istringstream lines(ReadFileBytes(FITCAL_SOURCE_DIR "/docs/pages.md"));
+  std::istringstream lines(ReadFileBytes(FITCAL_SOURCE_DIR + "/docs/pages.md"));
   std::string line;
   while (std::getline(lines, line)) {
     if (line.rfind("| " + name + " |", 0) != 0) continue;

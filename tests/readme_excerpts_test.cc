@@ -25,7 +25,7 @@ namespace fs = std::filesystem;
 using testing::ReadFileBytes;
 using testing::TempDir;
 
-const std::string kFitcal = FITCAL_BINARY_DIR "/tools/fitcal";
+const std::string kFitcal = FITCAL_BINARY_DIR + "/tools/fitcal";
 
 std::vector<std::string> LinesOf(const std::string& text) {
   std::vector<std::string> lines;
@@ -36,7 +36,7 @@ std::vector<std::string> LinesOf(const std::string& text) {
 
 // The README's output block whose banner (first line) starts with `banner`; empty when none.
 std::vector<std::string> Excerpt(const std::string& banner) {
-  const std::vector<std::string> lines = LinesOf(ReadFileBytes(FITCAL_SOURCE_DIR "/README.md"));
+  const std::vector<std::string> lines = LinesOf(ReadFileBytes(FITCAL_SOURCE_DIR + "/README.md"));
   for (std::size_t i = 0; i + 1 < lines.size(); ++i) {
     if (lines[i] != "```" || lines[i + 1].rfind(banner, 0) != 0) continue;
     std::vector<std::string> block;
@@ -102,7 +102,7 @@ TEST(ReadmeExcerpts, RunShOnTheFlower) {
 }
 
 TEST(ReadmeExcerpts, WorkedExampleOnTheDiffDrive) {
-  const std::string diff = FITCAL_SHARED_DIR "/data/optiodom/diff";
+  const std::string diff = FITCAL_SHARED_DIR + "/data/optiodom/diff";
   if (!fs::is_directory(diff)) GTEST_SKIP() << "no " << diff;
   TempDir dir;
   const std::string data = dir.Path("od_diff");
@@ -131,7 +131,7 @@ TEST(ReadmeExcerpts, WorkedExampleOnTheDiffDrive) {
 // word on where the OptiOdom recordings come from. The first "CF" of the README is its definition,
 // and the worked example names the upstream repository.
 TEST(ReadmeExcerpts, DefinesCfWhereFirstUsedAndNamesTheDataSource) {
-  const std::string readme = ReadFileBytes(FITCAL_SOURCE_DIR "/README.md");
+  const std::string readme = ReadFileBytes(FITCAL_SOURCE_DIR + "/README.md");
   std::smatch first;
   ASSERT_TRUE(std::regex_search(readme, first, std::regex("\\bCF\\b")));
   std::smatch defined;  // "**CF** (Palacin Eq. 14) is ...", wrapped anywhere
