@@ -104,7 +104,7 @@ RobotModelPtr DiffNominal(const Metadata& metadata) {
   const Interval radius{0.9 * std::min(r_right, r_left), 1.1 * std::max(r_right, r_left)};
   robot.bounds = {radius, radius, {0.9 * separation_m, 1.1 * separation_m}};
   robot.encoder = EncoderTicks{metadata.TicksPerWheelRev(), false};
-  return std::make_shared<DiffDriveModel>(std::move(robot));
+  return MakeDiffDriveModel(std::move(robot));
 }
 
 // tricyc: `t, x, y, theta, ticks, steering_rad`: ground truth of the rear axle's centre, traction
@@ -137,7 +137,7 @@ RobotModelPtr TricycleNominal(const Metadata& metadata) {
   robot.bounds[K::kSteeringOffsetIndex] = {offset_rad - DegToRad(10.0),
                                            offset_rad + DegToRad(10.0)};
   robot.encoder = EncoderTicks{metadata.TicksPerWheelRev(), false};
-  return std::make_shared<TricycleModel>(std::move(robot));
+  return MakeTricycleModel(std::move(robot));
 }
 
 // The trajectory labels, run ids and time decimals are those earlier imports wrote (data sets

@@ -145,6 +145,8 @@ RobotModelPtr ReadDiffDriveModel(const YAML::Node& root, const std::string& path
                                    : MakeModel<1>(std::move(robot));
 }
 
+RobotModelPtr MakeDiffDriveModel(Robot robot) { return MakeModel<0>(std::move(robot)); }
+
 int DiffDriveRightChannel(const RobotModelInterface& mounted_or_base) {
   const RobotModelInterface& model = BaseModel(mounted_or_base);
   if (dynamic_cast<const DiffDriveModelT<0>*>(&model) != nullptr) return 0;

@@ -91,4 +91,11 @@ int DiffDriveRightChannel(const RobotModelInterface& model);
 
 RobotModelPtr ReadDiffDriveModel(const YAML::Node& root, const std::string& path);
 
+// The model of a described robot whose wheels are right then left. Made here, not by the caller:
+// the model's templates (its replay on Jets, the residual functors) are then instantiated in the
+// models library only; a command file that instantiated them gave the sanitizer build's fitcal
+// its instrumented -O1 copies of the fit's inner loop (30x slower; CMakeLists.txt,
+// fitcal_sanitized).
+RobotModelPtr MakeDiffDriveModel(Robot robot);
+
 }  // namespace fitcal

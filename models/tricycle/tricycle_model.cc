@@ -135,7 +135,11 @@ RobotModelPtr ReadTricycleModel(const YAML::Node& root, const std::string& path)
   robot.effects = io::ReadEffectsNode(robot_map.Optional("effects"), path);
   robot_map.Optional("calibration");  // written by fitcal; informational when read back
   robot_map.RejectUnread();
-  if (gain) return std::make_shared<TricycleGainModel>(std::move(robot));
+  return MakeTricycleModel(std::move(robot));
+}
+
+RobotModelPtr MakeTricycleModel(Robot robot) {
+  if (ParameterIndex(robot, kGainKey)) return std::make_shared<TricycleGainModel>(std::move(robot));
   return std::make_shared<TricycleModel>(std::move(robot));
 }
 

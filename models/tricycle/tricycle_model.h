@@ -72,4 +72,9 @@ bounds: {radius_m: [0.030, 0.035], wheelbase_m: [0.13, 0.17], steering_offset_de
 
 RobotModelPtr ReadTricycleModel(const YAML::Node& root, const std::string& path);
 
+// The model of a robot described by TricycleRobotDescription (with or without the steering
+// gain). Made in the models library so that the model's templates are instantiated there only
+// (models/diff_drive/diff_drive_model.h, MakeDiffDriveModel, says why).
+RobotModelPtr MakeTricycleModel(Robot robot);
+
 }  // namespace fitcal
