@@ -6,7 +6,8 @@
 // noise, so it is not refused; it must not pass unsaid either: fit's everyday-driving row and
 // report's summary.md drift row carry the judgement, and one warning line names the runs, the
 // measure, before -> after and the margin. The line's numbers are checked against the table row
-// fit prints beside it and against the rule (a rise over 5 %, under the margin).
+// fit prints beside it and against the rule (a rise over 5 %, under the margin); export and
+// diagnose, which judge by the same rule, say it too.
 
 #include <gtest/gtest.h>
 
@@ -86,6 +87,32 @@ TEST(NeverWorseRealData, ACirclesOnlyFitSaysItsSquaresDriftMoreWithinTheScatter)
   EXPECT_TRUE(Has(summary, "- **worse:** 'the calibration' is worse than the nominal on the "
                            "held-out runs (43, all 'square'), within the runs' scatter: drift 1 m"))
       << summary;
+
+  // export and diagnose say it by the same rule (validation/never_worse.h SayNeverWorse): the
+  // exported parameters are the fit's (the same drift to the digit), on stdout and in the YAML's
+  // comments; diagnose's own choice from the same split, on stdout.
+  const std::string said_by_export =
+      "warning: 'the exported parameters' is worse than the nominal on the held-out runs (43, all "
+      "'square'), within the runs' scatter: drift 1 m [%] ";
+  const auto exported =
+      RunFitcal(dir, "export ros2-control --controller diff_drive_controller --calibration " + cal +
+                         " --logs " + data + " --out " + dir.Path("controller.yaml"));
+  ASSERT_EQ(exported.exit_code, 0) << exported.out << exported.err;
+  EXPECT_NE(LineWith(exported.out, said_by_export).find(w[1].str() + " -> " + w[2].str()),
+            std::string::npos)
+      << exported.out;
+  EXPECT_TRUE(Has(ReadFileBytes(dir.Path("controller.yaml")), "# " + said_by_export))
+      << ReadFileBytes(dir.Path("controller.yaml"));
+  const auto diagnosed = RunFitcal(dir, "diagnose --logs " + data +
+                                            " --train-trajectories '^circular' --out " +
+                                            dir.Path("diagnose"));
+  ASSERT_EQ(diagnosed.exit_code, 0) << diagnosed.out << diagnosed.err;
+  EXPECT_TRUE(std::regex_search(
+      diagnosed.out,
+      std::regex("\\nwarning: '[^']+' is worse than the nominal on the held-out runs \\(43, all "
+                 "'square'\\), within the runs' scatter: drift 1 m \\[%\\] 0\\.7[0-9]+ -> "
+                 "0\\.8[0-9]+ \\(\\+1[0-9]\\.[0-9] %\\)")))
+      << diagnosed.out;
 }
 
 }  // namespace

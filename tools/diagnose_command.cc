@@ -166,7 +166,8 @@ DiagnoseChoice GateDiagnosis(const RobotModelInterface& model, const DiagnoseSpl
 
 // The chosen calibration beats the nominal on the held-out runs as a whole; it must not be worse
 // on a kind of run, in drift or ATE beyond the runs' scatter either (validation/never_worse.h,
-// the rule fit applies). True after one line per such measure on stderr.
+// the rule fit applies). True after one line per such measure on stderr; what rose without
+// refusing is said in "warning:" lines, as fit says it.
 bool WorseThanNominalBeyondNoise(const RobotModelInterface& model, const DiagnoseSplit& split,
                                  const DiagnoseChoice& nominal, const DiagnoseChoice& choice,
                                  int threads) {
@@ -176,13 +177,14 @@ bool WorseThanNominalBeyondNoise(const RobotModelInterface& model, const Diagnos
     runs.push_back(r.aligned);
     tracks.push_back(&r.track);
   }
-  const std::vector<std::string> refusals = NeverWorseRefusals(
+  const NeverWorseSaid said = SayNeverWorse(
       choice.name, JudgeCalibrationNeverWorse(
                        model, {nominal.name, nominal.parameters, true, nominal.effects},
                        {choice.name, choice.parameters, true, choice.effects}, runs, tracks,
                        threads));
-  for (const std::string& line : refusals) std::cerr << "fitcal: " << line << "; nothing written\n";
-  return !refusals.empty();
+  for (const std::string& line : said.warnings) std::printf("warning: %s\n", line.c_str());
+  for (const std::string& line : said.refusals) std::cerr << "fitcal: " << line << "; nothing written\n";
+  return !said.refusals.empty();
 }
 
 // A written calibration never carries sigma: null. When the fit that made the chosen parameters

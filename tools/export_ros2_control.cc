@@ -576,23 +576,24 @@ struct Replay {
   std::string which;
   double cf_nominal = 0.0, cf_exact = 0.0, cf_exported = 0.0;
   OdometryCovariance exported_covariance, exact_covariance;
-  // The exported parameters worse than the nominal on a kind of run, in drift or ATE, beyond the
-  // runs' scatter (validation/never_worse.h, the rule fit applies): one line each.
-  std::vector<std::string> worse_beyond_noise;
-  bool Worse() const { return cf_exported > cf_nominal || !worse_beyond_noise.empty(); }
+  // The never-worse judgement of the exported parameters against the nominal (validation/
+  // never_worse.h, the rule fit applies): worse on a kind of run, in drift or ATE, beyond the
+  // runs' scatter refuses; what only warns is said beside the replay line.
+  NeverWorseSaid never_worse;
+  bool Worse() const { return cf_exported > cf_nominal || !never_worse.refusals.empty(); }
 };
 
 // The never-worse judgement of the exported parameters against the nominal robot on `runs`.
-std::vector<std::string> WorseBeyondNoise(const RobotModelInterface& nominal,
-                                          const Ros2ControlExport& exported,
-                                          const std::vector<AlignedRun>& runs,
-                                          const std::vector<RunLog>& logs) {
+NeverWorseSaid ExportNeverWorse(const RobotModelInterface& nominal,
+                                const Ros2ControlExport& exported,
+                                const std::vector<AlignedRun>& runs,
+                                const std::vector<RunLog>& logs) {
   std::map<std::string, const GroundTruthTrack*> track_of;
   for (const RunLog& log : logs) track_of[log.id] = &log.ground_truth;
   std::vector<const GroundTruthTrack*> tracks;
   for (const AlignedRun& run : runs) tracks.push_back(track_of.at(run.id));
   const std::vector<double> lengths = EverydayDriftLengths();
-  return NeverWorseRefusals(
+  return SayNeverWorse(
       "the exported parameters",
       JudgeNeverWorse(runs,
                       EvaluateEverydayDriving(nominal, nominal.robot().nominal, {}, runs, tracks,
@@ -619,7 +620,7 @@ Replay ReplayOnHeldOutRuns(const ExportRos2ControlOptions& o, const RobotModelPt
   r.cf_nominal = EvaluateFinalPoseErrors(*nominal, nominal->robot().nominal, runs).cf;
   r.cf_exact = EvaluateFinalPoseErrors(*exact, exact->robot().nominal, runs).cf;
   r.cf_exported = EvaluateFinalPoseErrors(*exported.model, exported.parameters, runs).cf;
-  r.worse_beyond_noise = WorseBeyondNoise(*nominal, exported, runs, logs);
+  r.never_worse = ExportNeverWorse(*nominal, exported, runs, logs);
   const auto covariance = [&](const RobotModelInterface& model, const std::vector<double>& p) {
     return EstimateOdometryCovariance(model, p, logs, o.publish_period_s);
   };
@@ -785,7 +786,7 @@ void AddReplay(const ExportRos2ControlOptions& o, const RobotModelPtr& exact,
                   replay.cf_exported, replay.cf_nominal, replay.runs);
     const std::string what = replay.cf_exported > replay.cf_nominal
                                  ? std::string(text_worse)
-                                 : replay.worse_beyond_noise.front();
+                                 : replay.never_worse.refusals.front();
     throw WorseThanNominalError("these parameters replay worse than the nominal robot (" + what +
                                 "); nothing written (--allow-worse writes them" +
                                 (e.notes.empty() ? ""
@@ -795,6 +796,10 @@ void AddReplay(const ExportRos2ControlOptions& o, const RobotModelPtr& exact,
                                 ")");
   }
   *text += "# " + io::YamlCommentText(line) + "\n";
+  for (const std::string& warning : replay.never_worse.warnings) {
+    if (!o.out.empty()) std::printf("warning: %s\n", warning.c_str());
+    *text += "# warning: " + io::YamlCommentText(warning) + "\n";
+  }
   const std::string covariance = CovarianceLine(replay.exported_covariance);
   if (!o.out.empty()) std::printf("%s\n", covariance.c_str());
   *text += "# " + covariance + " (docs/ros2.md)\n";

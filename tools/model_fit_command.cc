@@ -711,16 +711,10 @@ bool WorseThanNominalBeyondNoise(const RobotModelInterface& model, const std::ve
   const std::vector<NeverWorseJudgement> judged =
       JudgeCalibrationNeverWorse(model, candidates[0], candidates[gate.selected], split.validation,
                                  TracksOf(logs, split.validation), threads);
-  const std::string& name = candidates[gate.selected].name;
-  for (const std::string& line : NeverWorseRefusals(name, judged, /*refusing=*/false)) {
-    std::printf("warning: %s\n", line.c_str());
-  }
-  for (const std::string& line : NeverWorseWithinScatter(name, judged)) {
-    std::printf("warning: %s\n", line.c_str());
-  }
-  const std::vector<std::string> refusals = NeverWorseRefusals(name, judged);
-  for (const std::string& line : refusals) std::cerr << "fitcal: " << line << "; nothing written\n";
-  return !refusals.empty();
+  const NeverWorseSaid said = SayNeverWorse(candidates[gate.selected].name, judged);
+  for (const std::string& line : said.warnings) std::printf("warning: %s\n", line.c_str());
+  for (const std::string& line : said.refusals) std::cerr << "fitcal: " << line << "; nothing written\n";
+  return !said.refusals.empty();
 }
 
 // With nothing held out, the two-fold judgement of validation/held_out_halves.h, each fold fitted

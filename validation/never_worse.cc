@@ -238,6 +238,17 @@ std::vector<std::string> NeverWorseWithinScatter(const std::string& name,
   return out;
 }
 
+NeverWorseSaid SayNeverWorse(const std::string& name,
+                             const std::vector<NeverWorseJudgement>& judgements) {
+  NeverWorseSaid said;
+  said.warnings = NeverWorseRefusals(name, judgements, /*refusing=*/false);
+  for (std::string& line : NeverWorseWithinScatter(name, judgements)) {
+    said.warnings.push_back(std::move(line));
+  }
+  said.refusals = NeverWorseRefusals(name, judgements);
+  return said;
+}
+
 std::map<std::string, std::string> NeverWorseRowNotes(
     const std::vector<NeverWorseJudgement>& judgements) {
   std::map<std::string, std::string> notes;

@@ -119,6 +119,17 @@ std::vector<std::string> NeverWorseRefusals(const std::string& name,
 std::vector<std::string> NeverWorseWithinScatter(const std::string& name,
                                                  const std::vector<NeverWorseJudgement>& judgements);
 
+// What a command that writes a calibration says of its never-worse judgements, one rule for fit,
+// diagnose and export: `warnings` (worse where worse only warns, then risen by more than 5 %
+// within the scatter), each a line to print as "warning: ...", and `refusals`, each a reason
+// the calibration is not written.
+struct NeverWorseSaid {
+  std::vector<std::string> warnings;
+  std::vector<std::string> refusals;
+};
+NeverWorseSaid SayNeverWorse(const std::string& name,
+                             const std::vector<NeverWorseJudgement>& judgements);
+
 // What a table row of all the held-out runs says beside a measure that rose, keyed by the
 // measure's name ("ATE RMSE [m]", "drift 1 m [%]"): "worse, within the scatter: margin 0.119" or
 // "worse beyond the scatter: margin 0.119"; measures that did not rise are absent.
