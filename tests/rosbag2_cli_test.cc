@@ -314,6 +314,17 @@ TEST(StaticTransforms, ComposeAlongTheTreeInThreeDimensions) {
                         StaticTransform("odom", "laser", 0, 0, 0, 0)},
                        "base_link", "laser")
                    .base_T_sensor.has_value());
+  // A ground truth of base_footprint, 0.1 m under base_link: the base in the plane, no frame.
+  io::rosbag2::BagStreams streams;
+  streams.pose_type = "nav_msgs/msg/Odometry";
+  streams.pose_frame = "base_footprint";
+  streams.has_tf_static = true;
+  streams.static_transforms = {StaticTransform("base_link", "base_footprint", 0, 0, -0.1, 0)};
+  const io::rosbag2::GroundTruthMountFromBag mount =
+      io::rosbag2::MountFromTfStatic(streams, "/odom", "base_link");
+  EXPECT_FALSE(mount.base_T_sensor.has_value());
+  EXPECT_TRUE(Has(mount.note, "the ground truth tracks the base, no ground_truth_frame written"))
+      << mount.note;
 }
 
 // The bags ROS 2's own recorder wrote (../shared/data/rosbag2, README there): no JointState

@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <map>
 
@@ -16,7 +17,12 @@ struct Edge {
 };
 
 // A tree deeper than this is a cycle (a bag that publishes a -> b and b -> a).
-constexpr int kMaxDepth = 64;
+constexpr std::size_t kMaxDepth = 64;
+
+// A frame within a micrometre and a microradian of the base in the plane (base_footprint under
+// base_link, a z offset only) is the base: fitting a mount there adds three parameters for none.
+constexpr double kOnTheBaseM = 1e-6;
+constexpr double kOnTheBaseRad = 1e-6;
 
 // The frames from `frame` up to its root, and root_T_frame.
 std::vector<std::string> Ancestors(const std::map<std::string, Edge>& parent_of,
@@ -101,6 +107,12 @@ GroundTruthMountFromBag MountFromTfStatic(const BagStreams& streams, const std::
     return out;
   }
   const Pose2d& p = *mount.base_T_sensor;
+  if (std::hypot(p.x, p.y) < kOnTheBaseM && std::abs(p.theta) < kOnTheBaseRad) {
+    out.note = what + ", which /tf_static (" + mount.chain +
+               ") puts on it in the plane: the ground truth tracks the base, no ground_truth_frame "
+               "written";
+    return out;
+  }
   out.base_T_sensor = p;
   out.note = what + ": ground_truth_frame: {x_m: " + Number(p.x) + ", y_m: " + Number(p.y) +
              ", yaw_deg: " + Number(p.theta * 180.0 / M_PI) + "} from /tf_static (" + mount.chain +

@@ -28,7 +28,8 @@ StaticMount StaticTransformBetween(const std::vector<TransformStamped>& transfor
 // What an import writes for the frame the ground truth tracks (streams.pose_frame): a nominal
 // `ground_truth_frame` from /tf_static when the bag links base_frame to it, and one line in
 // words saying what was done (empty when the ground truth tracks base_frame itself, or names no
-// frame and the bag has no /tf_static: nothing to say).
+// frame and the bag has no /tf_static: nothing to say). A frame /tf_static puts on the base in the
+// plane (base_footprint: a z offset) is the base: said, nothing written.
 struct GroundTruthMountFromBag {
   std::optional<Pose2d> base_T_sensor;
   std::string note;
