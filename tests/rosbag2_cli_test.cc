@@ -286,6 +286,33 @@ TEST(ImportALidarOnAMount, ATfStaticWithoutTheFrameWritesNothingForIt) {
   EXPECT_EQ(testing::ReadFileBytes(out + "/robot.yaml"), kDiffDriveExampleYaml);
 }
 
+// A PoseStamped's header.frame_id is the world's: it names no tracked frame, and with /tf_static
+// in the bag the import says so; --ground-truth-frames <parent>:<frame> names it, and the frame
+// then comes from /tf_static as an Odometry's child frame does.
+TEST(ImportALidarOnAMount, APoseStampedsFrameIsNamedByGroundTruthFrames) {
+  TempDir tmp;
+  const RobotModelPtr model = ReadRobotModel(YAML::Load(kDiffDriveExampleYaml), "robot.yaml");
+  BagWriterOptions options;
+  options.storage = StorageFormat::kSqlite3;
+  BagEdits edits;
+  edits.tf_static = LidarTfStatic();
+  WriteRobotBag(tmp.path() / "bag", SimulatedRuns(*model), options, edits);
+  tmp.Write("robot.yaml", kDiffDriveExampleYaml);
+  testing::FitcalRun r = RunFitcal(tmp, ImportArgs(tmp, tmp.Path("bag"), tmp.Path("a")));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(Has(r.out, "ground truth /mocap/pose (geometry_msgs/msg/PoseStamped) names no frame "
+                         "of its own"))
+      << r.out;
+  EXPECT_EQ(testing::ReadFileBytes(tmp.Path("a/robot.yaml")), kDiffDriveExampleYaml);
+  r = RunFitcal(tmp, ImportArgs(tmp, tmp.Path("bag"), tmp.Path("b")) +
+                         " --ground-truth-frames world:lidar");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(Has(r.out, "tracks frame 'lidar', not 'base_link': ground_truth_frame: {x_m: 0.4"))
+      << r.out;
+  EXPECT_NEAR(YAML::LoadFile(tmp.Path("b/robot.yaml"))["ground_truth_frame"]["x_m"].as<double>(),
+              0.4, 1e-12);
+}
+
 // The composition through a common ancestor, by hand: base_footprint -> base_link (0, 0, 0.1)
 // and base_footprint -> laser (0.5, 0.2, 0.3; yaw 30 deg) put the laser at (0.5, 0.2) and 30 deg
 // in base_link; a laser under base_link turned 30 deg, then a camera 0.2 m along its x, sits at
