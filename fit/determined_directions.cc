@@ -75,6 +75,8 @@ std::string DescribeStep(const Robot& robot, const Eigen::VectorXd& prior_units,
     char text[96];
     if (info.unit == ParameterUnit::kAngle) {
       std::snprintf(text, sizeof text, "%s %+.2g deg", info.name.c_str(), step[k] * 180.0 / M_PI);
+    } else if (info.unit == ParameterUnit::kRatio) {
+      std::snprintf(text, sizeof text, "%s %+.2g", info.name.c_str(), step[k]);
     } else {
       std::snprintf(text, sizeof text, "%s %+.2g mm", info.name.c_str(), step[k] * 1e3);
     }

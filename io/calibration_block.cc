@@ -58,7 +58,7 @@ void EmitUncertainty(YAML::Emitter& out, const CalibrationBlock& c, const Robot&
   out << YAML::Key << "sigma" << YAML::Value << YAML::BeginMap;
   for (int k = 0; k < robot.NumParameters(); ++k) {
     const ParameterInfo& info = robot.parameters[k];
-    out << YAML::Key << info.name + "_" + info.DisplayUnit() << YAML::Value
+    out << YAML::Key << info.KeyName() << YAML::Value
         << c.sigma[k] * info.DisplayScale();
   }
   out << YAML::EndMap;

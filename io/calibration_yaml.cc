@@ -182,8 +182,9 @@ std::optional<CalibrationProvenance> ReadCalibrationProvenance(const std::string
 namespace {
 
 bool RecordedKeyMatches(const std::string& key, const ParameterInfo& info) {
-  const std::string unit = std::string("_") + info.DisplayUnit();
-  if (key == info.name + unit) return true;
+  if (key == info.KeyName()) return true;
+  const std::string unit = info.KeyName().substr(info.name.size());
+  if (unit.empty()) return false;  // a ratio's key is its name alone
   const std::size_t bracket = key.find('[');
   if (bracket == std::string::npos || bracket < unit.size()) return false;
   return key.compare(bracket - unit.size(), unit.size(), unit) == 0;

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <limits>
 #include <new>
+#include <stdexcept>
 #include <string_view>
 #include <utility>
 #include <vector>
@@ -114,6 +115,9 @@ void CheckIncreasing(double previous, double t, const std::string& path, int lin
 
 bool IsBlank(std::string_view line) { return Trim(line).empty(); }
 
+// An angle in (-pi, pi] (WrapAngle's interval mirrored: a reading of exactly half a turn is +pi).
+double WrapToPi(double angle_rad) { return -WrapAngle(-angle_rad); }
+
 }  // namespace
 
 namespace {
@@ -186,13 +190,22 @@ ColumnPlan PlanColumns(std::string_view header, const Robot& robot, const std::s
         ticks = names[col] == info.ticks_column;
       }
     }
-    if (found < 0)
+    if (found < 0) {
+      for (const ChannelInfo& info : robot.channels) {
+        if (info.kind == ChannelKind::kAngle && names[col] == "ticks_" + info.name) {
+          throw bad_header("column '" + names[col] + "' holds counts of the angle channel '" +
+                           info.name + "': declare " + info.name +
+                           "_encoder: {ticks_per_rev: N, zero_tick: Z} in the robot YAML");
+        }
+      }
       throw bad_header("column '" + names[col].substr(0, 40) + "' is no channel of the robot");
+    }
     if (seen[found]) throw bad_header("channel '" + robot.channels[found].name + "' appears twice");
     seen[found] = true;
     plan.channel_of_column.push_back(found);
     plan.ticks.push_back(ticks);
-    plan.any_ticks = plan.any_ticks || ticks;
+    // An angle channel's counts are converted by its own `<channel>_encoder:` block.
+    plan.any_ticks = plan.any_ticks || (ticks && robot.channels[found].kind != ChannelKind::kAngle);
   }
   for (int c = 0; c < robot.NumChannels(); ++c) {
     if (!seen[c]) throw bad_header("channel '" + robot.channels[c].name + "' is missing");
@@ -209,11 +222,29 @@ EncoderRowConverter::EncoderRowConverter(const Robot& robot, std::vector<int> ch
       ticks_column_(std::move(ticks_column)),
       previous_(channel_of_column_.size(), 0.0) {
   log_.samples = EncoderSamples(robot.NumChannels());
-  for (bool t : ticks_column_) any_ticks_ = any_ticks_ || t;
+  angle_encoder_.assign(channel_of_column_.size(), nullptr);
+  for (std::size_t j = 0; j < channel_of_column_.size(); ++j) {
+    if (!ticks_column_[j]) continue;
+    const ChannelInfo& channel = robot.channels[channel_of_column_[j]];
+    if (channel.kind == ChannelKind::kWheelRate) any_ticks_ = true;
+    for (const AngleEncoder& e : robot.angle_encoders) {
+      if (e.channel == channel.name) angle_encoder_[j] = &e;
+    }
+    if (channel.kind == ChannelKind::kAngle && angle_encoder_[j] == nullptr) {
+      throw std::logic_error("angle channel '" + channel.name + "' in counts without its encoder");
+    }
+  }
   if (any_ticks_ && robot.encoder) {
     rad_per_tick_ = 2.0 * M_PI / robot.encoder->ticks_per_rev;
     cumulative_ = robot.encoder->cumulative;
+    if (robot.encoder->counter_bits > 0) {
+      counter_modulus_ = std::ldexp(1.0, robot.encoder->counter_bits);
+    }
   }
+}
+
+double AngleOfCount(const AngleEncoder& encoder, double count) {
+  return WrapToPi(2.0 * M_PI * (count - encoder.zero_tick) / encoder.ticks_per_rev);
 }
 
 namespace {
@@ -246,8 +277,19 @@ void EncoderRowConverter::Add(double t_s, const double* row) {
     double values[kMaxChannels];
     for (std::size_t j = 0; j < n; ++j) {
       const int c = channel_of_column_[j];
-      if (ticks_column_[j]) {
-        const double dticks = cumulative_ ? row[j] - previous_[j] : row[j];
+      if (angle_encoder_[j] != nullptr) {
+        // Counts of an absolute encoder: the mean of the interval's two readings (robot.h),
+        // taken across the +-pi seam the short way.
+        const double a0 = AngleOfCount(*angle_encoder_[j], previous_[j]);
+        const double a1 = AngleOfCount(*angle_encoder_[j], row[j]);
+        values[c] = WrapToPi(a0 + 0.5 * std::remainder(a1 - a0, 2.0 * M_PI));
+      } else if (ticks_column_[j]) {
+        double dticks = cumulative_ ? row[j] - previous_[j] : row[j];
+        // A counter of declared width counts modulo 2^bits: the increment is the residue nearest
+        // zero (a running total past 2^bits - 1, or a negative count stored unsigned).
+        if (counter_modulus_ > 0.0) {
+          dticks -= counter_modulus_ * std::round(dticks / counter_modulus_);
+        }
         values[c] = rad_per_tick_ * dticks / dt;
       } else if (robot_.channels[c].kind == ChannelKind::kAngle) {
         values[c] = 0.5 * (previous_[j] + row[j]);  // mean over the interval (robot.h)
@@ -299,21 +341,30 @@ int WrapBitsOf(double ticks) {
 
 std::string CounterWrapMessage(int bits) {
   const std::string b = std::to_string(bits);
+  const std::string fix =
+      bits == 16 || bits == 32
+          ? "declare its width in the robot YAML (encoder: {..., "
+            "counter_bits: " +
+                b + "}) and fitcal unwraps it"
+          : "unwrap the counts (add 2^" + b + " after each wrap) before importing";
   return "the tick counter jumps by about 2^" + b + " ticks in one interval: a " + b +
-         "-bit counter that wraps inside the run; unwrap the counts (add 2^" + b +
-         " after each wrap) before importing";
+         "-bit counter that wraps inside the run; " + fix;
 }
 
-// The last interval's channel values against the limits above.
+// The last interval's channel values against the limits above. A wheel's counts that the glitch
+// screen below reads (screened[c]) are left to it, unless they are the wrap of an undeclared
+// counter width.
 void CheckSamplePlausible(const EncoderSamples& samples, const Robot& robot,
-                          const std::string& path, int line_number) {
+                          const std::vector<bool>& screened, const std::string& path,
+                          int line_number) {
   if (samples.empty()) return;
   const ConstSampleView s = samples.back();
   for (int c = 0; c < robot.NumChannels(); ++c) {
     const bool angle = robot.channels[c].kind == ChannelKind::kAngle;
     const double limit = angle ? kMaxAngleRad : kMaxWheelRateRadPerS;
     if (std::abs(s.value[c]) <= limit) continue;
-    if (!angle && robot.encoder && robot.encoder->cumulative) {  // a wrap, not a rate
+    if (!angle && robot.encoder && robot.encoder->cumulative &&
+        robot.encoder->counter_bits == 0) {  // a wrap, not a rate
       const int bits =
           WrapBitsOf(s.value[c] * s.dt_s * robot.encoder->ticks_per_rev / (2.0 * M_PI));
       if (bits > 0) {
@@ -321,6 +372,7 @@ void CheckSamplePlausible(const EncoderSamples& samples, const Robot& robot,
                          CounterWrapMessage(bits));
       }
     }
+    if (screened[static_cast<std::size_t>(c)]) continue;
     throw InputError(InputErrorKind::kImplausibleValue, path, line_number,
                      "channel '" + robot.channels[c].name + "': " + Number(s.value[c]) +
                          (angle ? " rad is not a physical angle (limit "
@@ -397,7 +449,247 @@ auto ReportingOutOfMemory(const std::string& path, Fn&& fn) -> decltype(fn()) {
   }
 }
 
-EncoderLog ReadEncoderRows(TextFileReader& lines, const Robot& robot) {
+// Counter glitches. A recorder's counter sometimes delivers one wrong count (a stale read, a
+// torn 32-bit read, a bit flip): one interval, or the two a wrong running total bounds, then the
+// counter goes on. Replayed, it is a jump of the robot; named instead, and bridged.
+// - Too fast: a rim speed beyond kMaxRimSpeedMps on the robot's smallest nominal wheel radius.
+//   20 m/s (72 km/h) is over three times the top speed of the fastest wheeled mobile robots
+//   fitcal calibrates (warehouse AGVs ~2 m/s, forklifts and tuggers ~6 m/s, outdoor delivery and
+//   field robots <= 6 m/s): no robot with wheels of that size turns them that fast, while a torn
+//   or flipped count of a 16- or 32-bit counter is thousands of times a real interval's.
+// - Backwards inside forward motion: a count of the opposite sign to the wheel's motion, beyond
+//   kJitterTicks (a quadrature count flickers by one at an edge), while the medians of the
+//   kGlitchWindow intervals before and of those after both move the same way by more than
+//   kJitterTicks over its duration, and departing from that motion by more than kSpreadFactor
+//   times the scatter of those neighbours about it (plus the jitter). A wheel that really slows,
+//   stops or oscillates does so over several intervals, and its neighbours scatter with it: the
+//   OptiOdom robots' real counts dip to -3 ticks among +11 (diff drive) and swing through -38
+//   among +15 (omni3), none of them glitches; the largest departure of their 4 robots' logs is
+//   6.8 times it (omni3; diff drive 5.8), a third of kSpreadFactor. A counter glitch departs by
+//   hundreds of ticks from neighbours that scatter by one or two.
+// A wrong running total (cumulative counts) bounds two intervals whose sum moves as the wheel
+// around them does: both get their mean rate, exact in travel. Otherwise the interval takes the
+// rate around it. More than kMaxGlitchShare of a log's intervals is not a glitch but a wrong
+// encoder block: refused.
+constexpr double kMaxRimSpeedMps = 20.0;
+constexpr double kJitterTicks = 2.0;
+constexpr std::size_t kGlitchWindow = 5;
+constexpr double kSpreadFactor = 20.0;
+constexpr double kMaxGlitchShare = 0.01;
+
+// rad/s above which a wheel's count is a glitch: kMaxRimSpeedMps over the smallest nominal wheel
+// radius (parameters of a `..radius_m` bounds group); the loader's own limit when none is named.
+double GlitchRateLimit(const Robot& robot) {
+  double r_min = std::numeric_limits<double>::infinity();
+  const std::string suffix = "radius_m";
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    const std::string& group = robot.parameters[k].group;
+    if (group.size() >= suffix.size() &&
+        group.compare(group.size() - suffix.size(), suffix.size(), suffix) == 0 &&
+        robot.nominal[k] > 0.0)
+      r_min = std::min(r_min, robot.nominal[k]);
+  }
+  if (!std::isfinite(r_min)) return kMaxWheelRateRadPerS;
+  return std::min(kMaxRimSpeedMps / r_min, kMaxWheelRateRadPerS);
+}
+
+// The wheel's motion around interval k: the medians of up to kGlitchWindow rates before and
+// after it (bridged intervals skipped; NaN with fewer than 3), their mean, and the scatter of
+// those rates about that mean (their median absolute deviation). Fixed arrays: this runs on
+// every suspicious interval of logs of millions of rows.
+struct Neighbourhood {
+  double before = std::numeric_limits<double>::quiet_NaN();
+  double after = std::numeric_limits<double>::quiet_NaN();
+  double around = 0.0;
+  double scatter = 0.0;
+};
+
+double MedianOf(double* v, std::size_t n) {
+  std::nth_element(v, v + n / 2, v + n);
+  return v[n / 2];
+}
+
+Neighbourhood NeighbourhoodOf(const EncoderSamples& samples, int c, std::size_t k,
+                              const std::vector<bool>& bridged) {
+  std::array<double, 2 * kGlitchWindow> all{};
+  std::size_t n_all = 0;
+  Neighbourhood out;
+  for (int side : {-1, +1}) {
+    std::array<double, kGlitchWindow> rates{};
+    std::size_t n = 0;
+    for (std::size_t step = 1; step <= 2 * kGlitchWindow && n < kGlitchWindow; ++step) {
+      if (side < 0 && step > k) break;
+      const std::size_t i = side < 0 ? k - step : k + step;
+      if (i >= samples.size()) break;
+      if (bridged[i]) continue;
+      rates[n++] = samples[i].value[c];
+      all[n_all++] = samples[i].value[c];
+    }
+    if (n >= 3) (side < 0 ? out.before : out.after) = MedianOf(rates.data(), n);
+  }
+  const bool has_before = std::isfinite(out.before), has_after = std::isfinite(out.after);
+  if (has_before || has_after) {
+    out.around = has_before && has_after ? 0.5 * (out.before + out.after)
+                                         : (has_before ? out.before : out.after);
+  }
+  for (std::size_t i = 0; i < n_all; ++i) all[i] = std::abs(all[i] - out.around);
+  if (n_all > 0) out.scatter = MedianOf(all.data(), n_all);
+  return out;
+}
+
+struct Glitch {
+  std::size_t row = 0;  // data row (0 = the first after the header) of the wrong count
+  std::string what;
+};
+
+class GlitchScreen {
+ public:
+  GlitchScreen(const Robot& robot, EncoderLog* log)
+      : robot_(robot),
+        samples_(log->samples),
+        rad_per_tick_(2.0 * M_PI / robot.encoder->ticks_per_rev),
+        rate_limit_(GlitchRateLimit(robot)),
+        bridged_(samples_.size(), false) {}
+
+  void Screen(int c) {
+    std::fill(bridged_.begin(), bridged_.end(), false);
+    for (std::size_t k = 0; k < samples_.size(); ++k) {
+      if (bridged_[k]) continue;
+      std::string what = TooFast(c, k);
+      if (what.empty() && !TurnsAgainstANeighbour(c, k)) continue;
+      const Neighbourhood around = NeighbourhoodOf(samples_, c, k, bridged_);
+      if (what.empty()) what = Backwards(c, k, around);
+      if (what.empty()) continue;
+      glitches_.push_back(Bridge(c, k, around.around, what));
+    }
+  }
+  const std::vector<Glitch>& glitches() const { return glitches_; }
+
+ private:
+  double Ticks(int c, std::size_t k) const {
+    return samples_[k].value[c] * samples_[k].dt_s / rad_per_tick_;
+  }
+  std::string Prefix(int c, std::size_t k) const {
+    char text[160];
+    std::snprintf(text, sizeof text, "channel '%s' counts %.0f ticks in %.4g s",
+                  robot_.channels[c].name.c_str(), Ticks(c, k), samples_[k].dt_s);
+    return text;
+  }
+  std::string TooFast(int c, std::size_t k) const {
+    if (!(std::abs(samples_[k].value[c]) > rate_limit_)) return "";
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  " (%.4g rad/s): beyond %.4g rad/s, a rim speed of %.0f m/s that no robot with "
+                  "wheels of its size reaches",
+                  samples_[k].value[c], rate_limit_, kMaxRimSpeedMps);
+    return Prefix(c, k) + text;
+  }
+  // Cheap first look: a count beyond the jitter whose sign differs from a neighbour's (most
+  // intervals turn as their neighbours do and are not looked at further).
+  bool TurnsAgainstANeighbour(int c, std::size_t k) const {
+    const double d = Ticks(c, k);
+    if (!(std::abs(d) > kJitterTicks)) return false;
+    return k == 0 || k + 1 == samples_.size() || d * Ticks(c, k - 1) <= 0.0 ||
+           d * Ticks(c, k + 1) <= 0.0;
+  }
+  std::string Backwards(int c, std::size_t k, const Neighbourhood& n) const {
+    if (!std::isfinite(n.before) || !std::isfinite(n.after) || (n.before > 0.0) != (n.after > 0.0))
+      return "";
+    const double dt = samples_[k].dt_s, jitter = kJitterTicks * rad_per_tick_ / dt;
+    const double v = samples_[k].value[c];
+    if (!(std::min(std::abs(n.before), std::abs(n.after)) > jitter)) return "";
+    if (!(v * (n.before > 0.0 ? 1.0 : -1.0) < -jitter)) return "";
+    if (!(std::abs(v - n.around) > kSpreadFactor * (n.scatter + jitter))) return "";
+    const double to_ticks = dt / rad_per_tick_;
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  ": backwards against the wheel's motion around it (%.1f and %.1f ticks per "
+                  "interval before and after, scattered by %.1f)",
+                  n.before * to_ticks, n.after * to_ticks, n.scatter * to_ticks);
+    return Prefix(c, k) + text;
+  }
+  // A wrong running total first (the pair of intervals it bounds, after then before k), else the
+  // interval alone.
+  Glitch Bridge(int c, std::size_t k, double around, const std::string& what) {
+    const double off = std::abs(samples_[k].value[c] - around);
+    if (robot_.encoder->cumulative) {
+      for (std::size_t a : {k, k - 1}) {
+        if (a >= samples_.size() || a + 1 >= samples_.size() || bridged_[a] || bridged_[a + 1])
+          continue;
+        const double span = samples_[a].dt_s + samples_[a + 1].dt_s;
+        const double merged = (samples_[a].value[c] * samples_[a].dt_s +
+                               samples_[a + 1].value[c] * samples_[a + 1].dt_s) /
+                              span;
+        if (!(std::abs(merged - around) < 0.25 * off)) continue;
+        samples_[a].value[c] = samples_[a + 1].value[c] = merged;
+        bridged_[a] = bridged_[a + 1] = true;
+        return {a + 1, what +
+                           "; the running total of this row dropped from the fit (the two "
+                           "intervals it bounds bridged, travel kept)"};
+      }
+    }
+    samples_[k].value[c] = around;
+    bridged_[k] = true;
+    char text[96];
+    std::snprintf(text, sizeof text, "%.4g rad/s", around);
+    return {k + 1, what + "; dropped from the fit (the interval takes the rate around it, " +
+                       std::string(text) + ")"};
+  }
+
+  const Robot& robot_;
+  EncoderSamples& samples_;
+  double rad_per_tick_;
+  double rate_limit_;
+  std::vector<bool> bridged_;
+  std::vector<Glitch> glitches_;
+};
+
+// The file lines of sorted data rows, in one pass (blank lines skipped as the reader skips them).
+std::vector<int> LinesOfDataRows(const std::string& path, const std::vector<std::size_t>& rows) {
+  std::vector<int> out;
+  TextFileReader lines(path);
+  std::string_view line;
+  lines.Next(&line);  // header
+  std::size_t seen = 0;
+  while (out.size() < rows.size() && lines.Next(&line)) {
+    if (IsBlank(line)) continue;
+    while (out.size() < rows.size() && rows[out.size()] == seen) out.push_back(lines.line_number());
+    ++seen;
+  }
+  out.resize(rows.size(), 0);
+  return out;
+}
+
+// Screens every wheel channel read as counts, names each glitch with its line (a warning) and
+// counts them in log->dropped_glitches.
+void DropCounterGlitches(const std::string& path, const Robot& robot,
+                         const std::vector<bool>& screened, EncoderLog* log) {
+  GlitchScreen screen(robot, log);
+  std::vector<Glitch> all;
+  for (int c = 0; c < robot.NumChannels(); ++c) {
+    if (!screened[static_cast<std::size_t>(c)]) continue;
+    screen.Screen(c);
+  }
+  all = screen.glitches();
+  if (all.empty()) return;
+  const double allowed = std::max(1.0, kMaxGlitchShare * static_cast<double>(log->samples.size()));
+  std::sort(all.begin(), all.end(), [](const Glitch& a, const Glitch& b) { return a.row < b.row; });
+  std::vector<std::size_t> rows;
+  for (const Glitch& g : all) rows.push_back(g.row);
+  const std::vector<int> lines = LinesOfDataRows(path, rows);
+  if (static_cast<double>(all.size()) > allowed) {
+    throw InputError(InputErrorKind::kImplausibleValue, path, lines.front(),
+                     std::to_string(all.size()) + " of " + std::to_string(log->samples.size()) +
+                         " intervals are counter glitches, the first here: " + all.front().what +
+                         "; more than 1 % is not a glitch but a wrong encoder block "
+                         "(ticks_per_rev, cumulative, counter_bits?)");
+  }
+  for (std::size_t i = 0; i < all.size(); ++i)
+    Warn(path, lines[i], "counter glitch: " + all[i].what);
+  log->dropped_glitches = static_cast<int>(all.size());
+}
+
+EncoderLog ReadEncoderRows(TextFileReader& lines, const Robot& robot, std::vector<bool>* screened) {
   const std::string& path = lines.path();
   std::string_view line;
   if (!lines.Next(&line) || IsBlank(line)) {
@@ -411,6 +703,13 @@ EncoderLog ReadEncoderRows(TextFileReader& lines, const Robot& robot) {
                      "in the robot YAML");
   }
   const int num_columns = 1 + robot.NumChannels();
+  // Wheels read as counts are screened for glitches after the whole log is read.
+  screened->assign(robot.channels.size(), false);
+  for (std::size_t j = 0; j < plan.ticks.size(); ++j) {
+    const int c = plan.channel_of_column[j];
+    (*screened)[static_cast<std::size_t>(c)] =
+        plan.ticks[j] && robot.channels[c].kind == ChannelKind::kWheelRate;
+  }
   EncoderRowConverter converter(robot, plan.channel_of_column, plan.ticks);
   // Reserve exactly once (one row per line, counted at memchr speed in a first pass) so that a
   // large log holds its samples (8 bytes of time + one row) and is never copied while growing.
@@ -425,7 +724,7 @@ EncoderLog ReadEncoderRows(TextFileReader& lines, const Robot& robot) {
     CheckTimePlausible(row[0], path, lines.line_number());
     if (!first) CheckIncreasing(previous_t, row[0], path, lines.line_number());
     converter.Add(row[0], row + 1);
-    CheckSamplePlausible(converter.samples(), robot, path, lines.line_number());
+    CheckSamplePlausible(converter.samples(), robot, *screened, path, lines.line_number());
     previous_t = row[0];
     first = false;
   }
@@ -443,7 +742,9 @@ namespace {
 // not guess the counter's width). Returns the sample index, or samples.size().
 std::size_t FindCounterWrap(const EncoderLog& log, const Robot& robot, int* bits) {
   const EncoderSamples& samples = log.samples;
-  if (!robot.encoder || !robot.encoder->cumulative || samples.size() < 3) return samples.size();
+  if (!robot.encoder || !robot.encoder->cumulative || robot.encoder->counter_bits > 0 ||
+      samples.size() < 3)
+    return samples.size();
   const double ticks_per_rad = robot.encoder->ticks_per_rev / (2.0 * M_PI);
   std::vector<double> moving;
   for (std::size_t k = 0; k < samples.size();
@@ -472,9 +773,10 @@ std::size_t FindCounterWrap(const EncoderLog& log, const Robot& robot, int* bits
 }  // namespace
 
 EncoderLog ReadEncoderCsv(const std::string& path, const Robot& robot) {
+  std::vector<bool> screened;
   EncoderLog log = ReportingOutOfMemory(path, [&] {
     TextFileReader lines(path);
-    return ReadEncoderRows(lines, robot);
+    return ReadEncoderRows(lines, robot, &screened);
   });
   if (log.t_s.size() < 2) {
     throw InputError(InputErrorKind::kTooFewSamples, path, 0,
@@ -496,6 +798,7 @@ EncoderLog ReadEncoderCsv(const std::string& path, const Robot& robot) {
     throw InputError(InputErrorKind::kImplausibleValue, path, LineOfDataRow(path, wrap + 1),
                      CounterWrapMessage(bits));
   }
+  DropCounterGlitches(path, robot, screened, &log);
   // The model's own checks of what its channels hold (a steering angle in degrees or ticks, ...).
   RunSampleCheck(robot.model, log, path);
   return log;

@@ -16,7 +16,13 @@ namespace fitcal::io {
 // `encoder:` block). Increments: row k holds the ticks counted over (t(k-1), t(k)] and row 0's
 // are ignored (counted before the start); cumulative: running totals, row 0 is the reference,
 // and its count gives each wheel's absolute angle at the start (EncoderLog::start_angle_rad).
-// Either way w_i(k) = 2 pi dticks_i(k) / (ticks_per_rev dt(k)).
+// Either way w_i(k) = 2 pi dticks_i(k) / (ticks_per_rev dt(k)). With `counter_bits: 16|32` the
+// counts are modulo 2^bits and each increment is taken as the residue nearest zero (unwrapped);
+// without it a wrap is refused. Glitches of a wheel's counter (a count no wheel of the robot's
+// size turns, a backwards jump inside forward motion) are named with their line, bridged by the
+// neighbouring counts and counted in EncoderLog::dropped_glitches.
+// An angle channel declared with `<channel>_encoder: {ticks_per_rev: N, zero_tick: Z}` may be
+// recorded as counts in `ticks_<channel>` (AngleOfCount).
 // Any robot (odometry/robot.h): header `t,<column per channel>`, each channel's rate (or angle)
 // column or its ticks column, in any order, matched by name; angle channels hold the reading at
 // the row time and become the mean over each interval. A three-channel robot also accepts the
@@ -54,8 +60,13 @@ class EncoderRowConverter {
   bool any_ticks_ = false;
   double rad_per_tick_ = 0.0;
   bool cumulative_ = false;
+  double counter_modulus_ = 0.0;  // 2^counter_bits; 0 when the width is not declared
+  std::vector<const AngleEncoder*> angle_encoder_;  // per column: an angle channel's counts
   EncoderLog log_;
 };
+
+// An absolute encoder's count as an angle (odometry/robot.h AngleEncoder), in (-pi, pi].
+double AngleOfCount(const AngleEncoder& encoder, double count);
 
 // Ground truth: CSV with header `t,x,y,theta` (s, m, m, rad), or a TUM trajectory
 // (`t x y z qx qy qz qw`, blank-separated, '#' comments) whose yaw is taken from the quaternion.

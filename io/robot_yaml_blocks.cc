@@ -33,8 +33,33 @@ std::optional<EncoderTicks> ReadEncoderTicksNode(const YAML::Node& node, const s
                      "encoder.cumulative must be true or false, found '" + text + "'");
   }
   ticks.cumulative = text == "true";
+  if (map.Has("counter_bits")) {
+    ticks.counter_bits = map.Int("counter_bits");
+    if (ticks.counter_bits != 16 && ticks.counter_bits != 32) {
+      throw InputError(InputErrorKind::kBadValue, path, map.line(map.Required("counter_bits")),
+                       "encoder.counter_bits must be 16 or 32, found " +
+                           std::to_string(ticks.counter_bits));
+    }
+  }
   map.RejectUnread();
   return ticks;
+}
+
+void ReadAngleEncoders(YamlMap& map, Robot* robot) {
+  for (ChannelInfo& channel : robot->channels) {
+    const std::string key = channel.name + "_encoder";
+    if (channel.kind != ChannelKind::kAngle || !map.Has(key)) continue;
+    YamlMap block(map.Required(key), map.path(), key);
+    const AngleEncoder e{channel.name, block.Double("ticks_per_rev"), block.Double("zero_tick")};
+    if (!(e.ticks_per_rev > 0.0)) {
+      throw InputError(InputErrorKind::kBadValue, map.path(),
+                       block.line(block.Required("ticks_per_rev")),
+                       key + ".ticks_per_rev must be positive");
+    }
+    block.RejectUnread();
+    channel.ticks_column = "ticks_" + channel.name;
+    robot->angle_encoders.push_back(e);
+  }
 }
 
 std::vector<effects::EffectValue> ReadEffectsNode(const YAML::Node& node, const std::string& path) {
@@ -104,7 +129,16 @@ void EmitEncoderAndEffects(YAML::Emitter& out, const Robot& robot,
   if (robot.encoder) {
     out << YAML::Key << "encoder" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key
         << "ticks_per_rev" << YAML::Value << robot.encoder->ticks_per_rev << YAML::Key
-        << "cumulative" << YAML::Value << robot.encoder->cumulative << YAML::EndMap;
+        << "cumulative" << YAML::Value << robot.encoder->cumulative;
+    if (robot.encoder->counter_bits > 0) {
+      out << YAML::Key << "counter_bits" << YAML::Value << robot.encoder->counter_bits;
+    }
+    out << YAML::EndMap;
+  }
+  for (const AngleEncoder& e : robot.angle_encoders) {
+    out << YAML::Key << e.channel + "_encoder" << YAML::Value << YAML::Flow << YAML::BeginMap
+        << YAML::Key << "ticks_per_rev" << YAML::Value << e.ticks_per_rev << YAML::Key
+        << "zero_tick" << YAML::Value << e.zero_tick << YAML::EndMap;
   }
   if (effects.empty()) return;
   out << YAML::Key << "effects" << YAML::Value << YAML::BeginSeq;

@@ -18,8 +18,14 @@ namespace fitcal::io {
 // [lo, hi] of `key` times `scale`; InputError when lo > hi.
 Interval ReadBoundsPair(YamlMap& map, const std::string& key, double scale);
 
-// `encoder: {ticks_per_rev: N, cumulative: false|true}`; nullopt for a null node.
+// `encoder: {ticks_per_rev: N, cumulative: false|true, counter_bits: 16|32}` (counter_bits
+// optional); nullopt for a null node.
 std::optional<EncoderTicks> ReadEncoderTicksNode(const YAML::Node& node, const std::string& path);
+
+// `<channel>_encoder: {ticks_per_rev: N, zero_tick: Z}` of each angle channel of `robot` that the
+// robot YAML declares: the channel may then be recorded as counts in the CSV column
+// `ticks_<channel>` (its ticks_column is set here; io/log_files.h converts them).
+void ReadAngleEncoders(YamlMap& map, Robot* robot);
 
 // `effects:` - a list of {name: <registry name>, <parameter>: value, ...} maps, each parameter
 // named as in odometry/effects.h (units in the name) and inside its bounds; optional

@@ -43,19 +43,41 @@ struct ChannelInfo {
 // How the encoders count, when the logs hold ticks instead of wheel rates (robot YAML `encoder:`):
 // ticks per wheel revolution (gear ratio x counts per motor revolution) and whether the log holds
 // running totals (cumulative) or increments since the previous row.
+// counter_bits (16 or 32; 0 = not declared): the width of the recorder's counter, whose counts
+// wrap modulo 2^bits (running totals and per-interval counts alike); declared, they are unwrapped
+// on load, undeclared a wrap is refused.
 struct EncoderTicks {
   double ticks_per_rev = 0.0;
   bool cumulative = false;
+  int counter_bits = 0;
 };
 
-enum class ParameterUnit { kLength, kAngle };
+// An angle channel recorded as counts of an absolute encoder (robot YAML
+// `<channel>_encoder: {ticks_per_rev: N, zero_tick: Z}`, CSV column `ticks_<channel>`):
+//   angle = 2 pi (count - zero_tick) / ticks_per_rev, wrapped to (-pi, pi].
+struct AngleEncoder {
+  std::string channel;
+  double ticks_per_rev = 0.0;
+  double zero_tick = 0.0;
+};
+
+// kRatio: a dimensionless factor (a steering gain): unit "1" (SI's unit of a dimensionless
+// quantity), changes printed in % like a length's.
+enum class ParameterUnit { kLength, kAngle, kRatio };
 
 struct ParameterInfo {
   std::string name;   // "R_a", "r_left", "wheelbase"
   std::string group;  // the YAML's bounds key the parameter belongs to ("distance_m", ...)
   ParameterUnit unit = ParameterUnit::kLength;
-  // Printed unit and factor: lengths in m, angles in deg (I/O edge only).
-  const char* DisplayUnit() const { return unit == ParameterUnit::kAngle ? "deg" : "m"; }
+  // Printed unit and factor: lengths in m, angles in deg (I/O edge only), ratios 1.
+  const char* DisplayUnit() const {
+    return unit == ParameterUnit::kAngle ? "deg" : unit == ParameterUnit::kRatio ? "1" : "m";
+  }
+  // The key of its value in a calibrated YAML's `sigma:` and in tables of values: the name with
+  // its unit ("r_left_m", "delta_a_deg"); a ratio's name alone, as its robot YAML key.
+  std::string KeyName() const {
+    return unit == ParameterUnit::kRatio ? name : name + "_" + DisplayUnit();
+  }
   double DisplayScale() const { return unit == ParameterUnit::kAngle ? 180.0 / M_PI : 1.0; }
   // Identifiability measures lengths as relative changes and angles in radians, so that one
   // number means the same for every parameter (a 1 % radius change ~ a 0.01 rad turn).
@@ -80,6 +102,7 @@ struct Robot {
   std::vector<Interval> bounds;  // absolute, per parameter (Palacin Eq. 16 for omni3)
   std::vector<HeldParameter> held;
   std::optional<EncoderTicks> encoder;  // set when the encoder logs are in ticks
+  std::vector<AngleEncoder> angle_encoders;  // angle channels that may be recorded as counts
   // Effects beyond the model's parameters (robot YAML `effects:`, written by `fitcal diagnose`).
   std::vector<effects::EffectValue> effects;
   // A model whose robots record their encoders in a file format of their own (ASOC's cumulative

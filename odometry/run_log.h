@@ -23,6 +23,9 @@ struct EncoderLog {
   // fixed mark on the wheel); NaN for a channel without it (angle channels, rate columns). Empty:
   // the log carries none. One value per channel per run: the per-sample memory is unchanged.
   std::vector<double> start_angle_rad;
+  // Intervals whose counts were glitches of the recorder's counter (io/log_files.h), named on
+  // load and bridged by their neighbours instead of replayed.
+  int dropped_glitches = 0;
 };
 
 // Ground truth (SLAM, motion capture): poses in the world frame at strictly increasing times.

@@ -102,7 +102,7 @@ TEST(Fleet, PrintsUnitsAndSigmasAndNotesCfsJudgedOnDifferentRuns) {
   for (int k = 0; k < robot.NumParameters(); ++k) {
     const ParameterInfo& info = robot.parameters[k];
     if (info.unit == ParameterUnit::kAngle) angle = k;
-    sigmas += (k ? ", " : "") + info.name + "_" + info.DisplayUnit() + ": 0.0137";
+    sigmas += (k ? ", " : "") + info.KeyName() + ": 0.0137";
   }
   ASSERT_GE(angle, 0);
   for (const std::string data : {"/data/week1", "/data/week2"}) {

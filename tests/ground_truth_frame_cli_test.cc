@@ -87,7 +87,7 @@ TEST_P(MountedFit, RecoversTheSensorsMountWithinThreeSigma) {
   const Robot truth = ReadRobotModelFile(dir.Path("truth.yaml"))->robot();
   for (int k = 0; k < fitted.NumParameters(); ++k) {
     const ParameterInfo& info = fitted.parameters[k];
-    const double s = sigma[info.name + "_" + info.DisplayUnit()].as<double>() / info.DisplayScale();
+    const double s = sigma[info.KeyName()].as<double>() / info.DisplayScale();
     EXPECT_LT(std::abs(fitted.nominal[k] - truth.nominal[k]), 3.0 * s) << info.name;
   }
 }

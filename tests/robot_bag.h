@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -52,7 +53,20 @@ struct BagEdits {
   bool other_node = false;  // a second node's JointState (other joints) after every 7th message
   std::int64_t clock_step_back_ns = 0;  // recording times of the second half moved back by this
   bool split_in_two = true;  // the recorder's --max-bag-size reached half way: two files
+  // A LiDAR odometry instead of the motion capture: nav_msgs/msg/Odometry on /lidar/odom whose
+  // child frame `lidar` sits at base_T_lidar (the base's poses carried there), and, when not
+  // empty, these transforms on /tf_static (one message at the start).
+  std::optional<Pose2d> base_T_lidar;
+  std::vector<TransformStamped> tf_static;
 };
+
+// world_T_base composed with base_T_sensor: the sensor's pose in the world.
+inline Pose2d SensorPose(const Pose2d& world_T_base, const Pose2d& base_T_sensor) {
+  const double c = std::cos(world_T_base.theta), s = std::sin(world_T_base.theta);
+  return {world_T_base.x + c * base_T_sensor.x - s * base_T_sensor.y,
+          world_T_base.y + s * base_T_sensor.x + c * base_T_sensor.y,
+          world_T_base.theta + base_T_sensor.theta};
+}
 
 // The bag: runs one after the other on one clock (run i starts where run i-1 ended + kGapS),
 // joint states at rest in the gaps, no ground truth there (the robot is carried back to the start).
@@ -64,7 +78,9 @@ inline std::vector<std::pair<double, double>> WriteRobotBag(
     bool joint;
     std::int64_t stamp_ns;
     std::vector<std::uint8_t> payload;
+    const char* topic = nullptr;  // other than the two streams (/tf_static)
   };
+  const char* pose_topic = edits.base_T_lidar ? "/lidar/odom" : "/mocap/pose";
   std::vector<Msg> msgs;
   std::vector<std::pair<double, double>> spans;
   double offset = 0.0, angle_right = 0.0, angle_left = 0.0;
@@ -103,12 +119,21 @@ inline std::vector<std::pair<double, double>> WriteRobotBag(
       const std::int64_t ns = Ns(offset + gt.t_s[k] - t.front());
       p.header.stamp = {static_cast<std::int32_t>(ns / 1000000000),
                         static_cast<std::uint32_t>(ns % 1000000000)};
-      p.pose.position = {gt.world_T_robot[k].x, gt.world_T_robot[k].y, 0.0};
-      const double yaw = gt.world_T_robot[k].theta;
-      p.pose.orientation = {0.0, 0.0, std::sin(yaw / 2), std::cos(yaw / 2)};
+      const Pose2d pose = edits.base_T_lidar ? SensorPose(gt.world_T_robot[k], *edits.base_T_lidar)
+                                             : gt.world_T_robot[k];
+      p.pose.position = {pose.x, pose.y, 0.0};
+      p.pose.orientation = {0.0, 0.0, std::sin(pose.theta / 2), std::cos(pose.theta / 2)};
       if (edits.pose) edits.pose(pose_count, &p);
       ++pose_count;
-      msgs.push_back({false, ns, EncodePoseStamped(p)});
+      if (edits.base_T_lidar) {
+        Odometry o;
+        o.header = {p.header.stamp, "odom"};
+        o.child_frame_id = "lidar";
+        o.pose.pose = p.pose;
+        msgs.push_back({false, ns, EncodeOdometry(o)});
+      } else {
+        msgs.push_back({false, ns, EncodePoseStamped(p)});
+      }
     }
     spans.emplace_back(offset, offset + t.back() - t.front());
     offset += t.back() - t.front();
@@ -116,11 +141,21 @@ inline std::vector<std::pair<double, double>> WriteRobotBag(
     for (int i = 1; i < gap_steps; ++i) joint(offset + i * kEncoderPeriodS);
     offset += kGapS;
   }
+  if (!edits.tf_static.empty()) {
+    TfMessage tf{edits.tf_static};
+    for (TransformStamped& t : tf.transforms) {
+      t.header.stamp = {static_cast<std::int32_t>(Ns(0.0) / 1000000000),
+                        static_cast<std::uint32_t>(Ns(0.0) % 1000000000)};
+    }
+    msgs.push_back({false, Ns(0.0), EncodeTfMessage(tf), "/tf_static"});
+  }
   options.split_after_messages = edits.split_in_two ? msgs.size() / 2 + 1 : 0;
   BagWriter bag(dir.string(), options);
   bag.AddTopic("/joint_states", "sensor_msgs/msg/JointState");
-  bag.AddTopic("/mocap/pose", "geometry_msgs/msg/PoseStamped");
+  bag.AddTopic(pose_topic, edits.base_T_lidar ? "nav_msgs/msg/Odometry"
+                                              : "geometry_msgs/msg/PoseStamped");
   bag.AddTopic("/chatter", "std_msgs/msg/String");
+  if (!edits.tf_static.empty()) bag.AddTopic("/tf_static", "tf2_msgs/msg/TFMessage");
   std::stable_sort(msgs.begin(), msgs.end(),
                    [](const Msg& a, const Msg& b) { return a.stamp_ns < b.stamp_ns; });
   for (std::size_t i = 0; i < msgs.size(); ++i) {
@@ -128,7 +163,10 @@ inline std::vector<std::pair<double, double>> WriteRobotBag(
     const std::int64_t recorded =
         msgs[i].stamp_ns + 2000000 + static_cast<std::int64_t>(i % 5) * 100000 -
         (i >= msgs.size() / 2 ? edits.clock_step_back_ns : 0);
-    bag.Write(msgs[i].joint ? "/joint_states" : "/mocap/pose", recorded, ByteView(msgs[i].payload));
+    const char* topic = msgs[i].topic ? msgs[i].topic
+                        : msgs[i].joint ? "/joint_states"
+                                        : pose_topic;
+    bag.Write(topic, recorded, ByteView(msgs[i].payload));
   }
   bag.Close();
   return spans;

@@ -20,6 +20,7 @@
 
 #include "io/calibration_yaml.h"
 #include "io/dataset.h"
+#include "io/rosbag2/static_transforms.h"
 #include "models/diff_drive/diff_drive_model.h"
 #include "models/model_registry.h"
 #include "tests/bench/bench_support.h"
@@ -160,6 +161,197 @@ TEST(ImportThroughTheCommandLine, ReplacesItsOwnDataSetAndRefusesAForeignDirecto
       RunFitcal(tmp, ImportArgs(tmp, tmp.Path("bag"), tmp.Path("foreign")) + " --force");
   EXPECT_EQ(foreign.exit_code, 2) << foreign.err;
   EXPECT_EQ(testing::ReadFileBytes(tmp.Path("foreign/notes.txt")), "not a data set");
+}
+
+// ---- a ground truth on a mount (issue 39 item 6) ---------------------------------------------
+
+TransformStamped StaticTransform(const char* parent, const char* child, double x, double y,
+                                 double z, double yaw_deg) {
+  TransformStamped t;
+  t.header.frame_id = parent;
+  t.child_frame_id = child;
+  t.transform.translation = {x, y, z};
+  const double half = yaw_deg * M_PI / 360.0;
+  t.transform.rotation = {0.0, 0.0, std::sin(half), std::cos(half)};
+  return t;
+}
+
+// The LiDAR 0.4 m ahead of the base, on /tf_static through a mount turned by 90 deg:
+// base_link -> lidar_mount (0.3, 0, 0.25; yaw 90 deg) -> lidar (0, -0.1, 0.05 in the mount, yaw
+// -90 deg), i.e. (0.3 + 0.1, 0, 0.3) and yaw 0 in the base by hand; an IMU beside it.
+std::vector<TransformStamped> LidarTfStatic() {
+  return {StaticTransform("base_link", "lidar_mount", 0.3, 0.0, 0.25, 90.0),
+          StaticTransform("/lidar_mount", "lidar", 0.0, -0.1, 0.05, -90.0),
+          StaticTransform("base_link", "imu", -0.05, 0.02, 0.1, 0.0)};
+}
+
+// The diff drive's bag with its ground truth from a LiDAR odometry (nav_msgs/msg/Odometry,
+// child_frame_id lidar) 0.4 m ahead of the base; /tf_static as given.
+void WriteLidarBag(const TempDir& tmp, std::vector<TransformStamped> tf_static) {
+  const RobotModelPtr model = ReadRobotModel(YAML::Load(kDiffDriveExampleYaml), "robot.yaml");
+  BagWriterOptions options;
+  options.storage = StorageFormat::kMcap;
+  BagEdits edits;
+  edits.base_T_lidar = Pose2d{0.4, 0.0, 0.0};
+  edits.tf_static = std::move(tf_static);
+  WriteRobotBag(tmp.path() / "bag", SimulatedRuns(*model), options, edits);
+  tmp.Write("robot.yaml", kDiffDriveExampleYaml);
+}
+
+std::string LidarImportArgs(const TempDir& tmp, const std::string& out) {
+  std::string args = ImportArgs(tmp, tmp.Path("bag"), out);
+  return args.replace(args.find("/mocap/pose"), 11, "/lidar/odom");
+}
+
+// Import -> fit -> export of the LiDAR bag: the import writes the mount /tf_static gives as the
+// nominal ground_truth_frame and says so; fit determines it (x within 3 of its sigmas of the
+// true 0.4 m, the noise being the simulator's: 1 mm and 0.2 deg on the poses, 0.01 rad/s on the
+// wheels) and the wheels as the base ones (5 sigmas, as the base's import above); the exported
+// controller parameters are the base's wheels, not the sensor's.
+TEST(ImportALidarOnAMount, TheFrameComesFromTfStaticAndRoundTripsThroughFitAndExport) {
+  TempDir tmp;
+  WriteLidarBag(tmp, LidarTfStatic());
+  const std::string out = tmp.Path("imported");
+  const testing::FitcalRun import = RunFitcal(tmp, LidarImportArgs(tmp, out));
+  ASSERT_EQ(import.exit_code, 0) << import.err;
+  EXPECT_TRUE(Has(import.out, "ground truth /lidar/odom tracks frame 'lidar', not 'base_link': "
+                              "ground_truth_frame: {x_m: 0.4, y_m: 0, yaw_deg: 0} from /tf_static "
+                              "(base_link -> lidar_mount -> lidar) written to the robot YAML"))
+      << import.out;
+  const YAML::Node frame = YAML::LoadFile(out + "/robot.yaml")["ground_truth_frame"];
+  ASSERT_TRUE(frame.IsMap()) << testing::ReadFileBytes(out + "/robot.yaml");
+  EXPECT_NEAR(frame["x_m"].as<double>(), 0.4, 1e-12);
+  EXPECT_EQ(frame["y_m"].as<double>(), 0.0);
+  EXPECT_EQ(frame["yaw_deg"].as<double>(), 0.0);
+
+  const std::string cal = tmp.Path("cal.yaml");
+  const testing::FitcalRun fit =
+      RunFitcal(tmp, "fit --logs " + Quoted(out) + " --train-reps 1-6 --out " + cal);
+  ASSERT_EQ(fit.exit_code, 0) << fit.err << fit.out;
+  EXPECT_TRUE(Has(fit.out, "ground_truth_frame: x, y and yaw determined")) << fit.out;
+  const YAML::Node written = YAML::LoadFile(cal);
+  const double x = written["ground_truth_frame"]["x_m"].as<double>();
+  const double sigma_x = written["calibration"]["sigma"]["ground_truth_x_m"].as<double>();
+  ASSERT_GT(sigma_x, 0.0);
+  EXPECT_LT(std::abs(x - 0.4), 3.0 * sigma_x) << x << " +- " << sigma_x;
+  std::printf("fitted ground_truth_x %.5f +- %.5f m (true 0.4)\n", x, sigma_x);
+  const RobotModelPtr calibrated = ReadRobotModelFile(cal);
+  const std::optional<io::CalibrationProvenance> provenance = io::ReadCalibrationProvenance(cal);
+  ASSERT_TRUE(provenance.has_value());
+  for (std::size_t k = 0; k < kTruth.size(); ++k) {  // r_right, r_left, wheel_separation [m]
+    EXPECT_NEAR(calibrated->robot().nominal[k], kTruth[k], 5.0 * provenance->sigma[k].second)
+        << provenance->sigma[k].first;
+  }
+
+  const std::string controller = tmp.Path("controller.yaml");
+  const testing::FitcalRun exported = RunFitcal(
+      tmp, "export ros2-control --calibration " + cal +
+               " --controller diff_drive_controller --joints right_wheel_joint,left_wheel_joint"
+               " --logs " + Quoted(out) + " --out " + controller);
+  ASSERT_EQ(exported.exit_code, 0) << exported.err << exported.out;
+  const YAML::Node p = YAML::LoadFile(controller)["diff_drive_controller"]["ros__parameters"];
+  const double radius = p["wheel_radius"].as<double>();
+  std::printf("exported wheel_separation %.5f wheel_radius %.5f (true %.4f, %.4f / %.4f)\n",
+              p["wheel_separation"].as<double>(), radius, kTruth[2], kTruth[0], kTruth[1]);
+  EXPECT_NEAR(p["wheel_separation"].as<double>() * p["wheel_separation_multiplier"].as<double>(),
+              kTruth[2], 5.0 * provenance->sigma[2].second);
+  EXPECT_NEAR(radius * p["right_wheel_radius_multiplier"].as<double>(), kTruth[0],
+              5.0 * provenance->sigma[0].second);
+  EXPECT_NEAR(radius * p["left_wheel_radius_multiplier"].as<double>(), kTruth[1],
+              5.0 * provenance->sigma[1].second);
+}
+
+// Without /tf_static the frame is said in words and nothing is written for it: the data set's
+// robot YAML is the one given, byte for byte.
+TEST(ImportALidarOnAMount, WithoutTfStaticNothingIsWrittenForTheFrame) {
+  TempDir tmp;
+  WriteLidarBag(tmp, {});
+  const std::string out = tmp.Path("imported");
+  const testing::FitcalRun import = RunFitcal(tmp, LidarImportArgs(tmp, out));
+  ASSERT_EQ(import.exit_code, 0) << import.err;
+  EXPECT_TRUE(Has(import.out, "ground truth /lidar/odom tracks frame 'lidar', not 'base_link': the "
+                              "bag has no /tf_static, so no ground_truth_frame is written"))
+      << import.out;
+  EXPECT_EQ(testing::ReadFileBytes(out + "/robot.yaml"), kDiffDriveExampleYaml);
+}
+
+// A /tf_static without a link between the two frames: said, nothing written.
+TEST(ImportALidarOnAMount, ATfStaticWithoutTheFrameWritesNothingForIt) {
+  TempDir tmp;
+  WriteLidarBag(tmp, {StaticTransform("base_link", "imu", -0.05, 0.02, 0.1, 0.0)});
+  const std::string out = tmp.Path("imported");
+  const testing::FitcalRun import = RunFitcal(tmp, LidarImportArgs(tmp, out));
+  ASSERT_EQ(import.exit_code, 0) << import.err;
+  EXPECT_TRUE(Has(import.out, "/tf_static has no transform between them")) << import.out;
+  EXPECT_EQ(testing::ReadFileBytes(out + "/robot.yaml"), kDiffDriveExampleYaml);
+}
+
+// A PoseStamped's header.frame_id is the world's: it names no tracked frame, and with /tf_static
+// in the bag the import says so; --ground-truth-frames <parent>:<frame> names it, and the frame
+// then comes from /tf_static as an Odometry's child frame does.
+TEST(ImportALidarOnAMount, APoseStampedsFrameIsNamedByGroundTruthFrames) {
+  TempDir tmp;
+  const RobotModelPtr model = ReadRobotModel(YAML::Load(kDiffDriveExampleYaml), "robot.yaml");
+  BagWriterOptions options;
+  options.storage = StorageFormat::kSqlite3;
+  BagEdits edits;
+  edits.tf_static = LidarTfStatic();
+  WriteRobotBag(tmp.path() / "bag", SimulatedRuns(*model), options, edits);
+  tmp.Write("robot.yaml", kDiffDriveExampleYaml);
+  testing::FitcalRun r = RunFitcal(tmp, ImportArgs(tmp, tmp.Path("bag"), tmp.Path("a")));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(Has(r.out, "ground truth /mocap/pose (geometry_msgs/msg/PoseStamped) names no frame "
+                         "of its own"))
+      << r.out;
+  EXPECT_EQ(testing::ReadFileBytes(tmp.Path("a/robot.yaml")), kDiffDriveExampleYaml);
+  r = RunFitcal(tmp, ImportArgs(tmp, tmp.Path("bag"), tmp.Path("b")) +
+                         " --ground-truth-frames world:lidar");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(Has(r.out, "tracks frame 'lidar', not 'base_link': ground_truth_frame: {x_m: 0.4"))
+      << r.out;
+  EXPECT_NEAR(YAML::LoadFile(tmp.Path("b/robot.yaml"))["ground_truth_frame"]["x_m"].as<double>(),
+              0.4, 1e-12);
+}
+
+// The composition through a common ancestor, by hand: base_footprint -> base_link (0, 0, 0.1)
+// and base_footprint -> laser (0.5, 0.2, 0.3; yaw 30 deg) put the laser at (0.5, 0.2) and 30 deg
+// in base_link; a laser under base_link turned 30 deg, then a camera 0.2 m along its x, sits at
+// (0.1 + 0.2 cos 30, 0.2 sin 30) and 30 + 45 deg. Frames in two trees are not linked.
+TEST(StaticTransforms, ComposeAlongTheTreeInThreeDimensions) {
+  const auto between = [](const std::vector<TransformStamped>& t, const char* a, const char* b) {
+    return io::rosbag2::StaticTransformBetween(t, a, b);
+  };
+  io::rosbag2::StaticMount m =
+      between({StaticTransform("base_footprint", "base_link", 0.0, 0.0, 0.1, 0.0),
+               StaticTransform("base_footprint", "laser", 0.5, 0.2, 0.3, 30.0)},
+              "base_link", "laser");
+  ASSERT_TRUE(m.base_T_sensor.has_value());
+  EXPECT_NEAR(m.base_T_sensor->x, 0.5, 1e-12);
+  EXPECT_NEAR(m.base_T_sensor->y, 0.2, 1e-12);
+  EXPECT_NEAR(m.base_T_sensor->theta, 30.0 * M_PI / 180.0, 1e-12);
+  EXPECT_EQ(m.chain, "base_link -> base_footprint -> laser");
+  m = between({StaticTransform("base_link", "laser", 0.1, 0.0, 0.2, 30.0),
+               StaticTransform("laser", "camera", 0.2, 0.0, 0.0, 45.0)},
+              "base_link", "camera");
+  ASSERT_TRUE(m.base_T_sensor.has_value());
+  EXPECT_NEAR(m.base_T_sensor->x, 0.1 + 0.2 * std::cos(M_PI / 6), 1e-12);
+  EXPECT_NEAR(m.base_T_sensor->y, 0.2 * std::sin(M_PI / 6), 1e-12);
+  EXPECT_NEAR(m.base_T_sensor->theta, 75.0 * M_PI / 180.0, 1e-12);
+  EXPECT_FALSE(between({StaticTransform("base_link", "imu", 0, 0, 0, 0),
+                        StaticTransform("odom", "laser", 0, 0, 0, 0)},
+                       "base_link", "laser")
+                   .base_T_sensor.has_value());
+  // A ground truth of base_footprint, 0.1 m under base_link: the base in the plane, no frame.
+  io::rosbag2::BagStreams streams;
+  streams.pose_type = "nav_msgs/msg/Odometry";
+  streams.pose_frame = "base_footprint";
+  streams.has_tf_static = true;
+  streams.static_transforms = {StaticTransform("base_link", "base_footprint", 0, 0, -0.1, 0)};
+  const io::rosbag2::GroundTruthMountFromBag mount =
+      io::rosbag2::MountFromTfStatic(streams, "/odom", "base_link");
+  EXPECT_FALSE(mount.base_T_sensor.has_value());
+  EXPECT_TRUE(Has(mount.note, "the ground truth tracks the base, no ground_truth_frame written"))
+      << mount.note;
 }
 
 // The bags ROS 2's own recorder wrote (../shared/data/rosbag2, README there): no JointState

@@ -71,7 +71,7 @@ TEST_P(SimulatedModel, FitCommandRecoversTheTrueRobotWithinItsSigmas) {
       EXPECT_EQ(fitted.nominal[k], nominal.nominal[k]);
       continue;
     }
-    const double s = sigma[info.name + "_" + info.DisplayUnit()].as<double>() / info.DisplayScale();
+    const double s = sigma[info.KeyName()].as<double>() / info.DisplayScale();
     ASSERT_GT(s, 0.0);
     EXPECT_LT(std::abs(fitted.nominal[k] - truth.nominal[k]), 4.0 * s);
     EXPECT_GT(std::abs(nominal.nominal[k] - truth.nominal[k]), 5.0 * s);

@@ -392,6 +392,11 @@ TEST(TricycleYaml, SteeringGainIsAFourthParameterWithItsBox) {
   const Robot& robot = model->robot();
   ASSERT_EQ(robot.NumParameters(), 4);
   EXPECT_EQ(robot.parameters[3].name, "steering_gain");
+  // A ratio of two angles: dimensionless, unit 1, its sigma keyed by its name alone (it was
+  // printed "steering_gain [m]" and keyed steering_gain_m).
+  EXPECT_EQ(robot.parameters[3].unit, ParameterUnit::kRatio);
+  EXPECT_EQ(robot.LabelOf(3), "steering_gain [1]");
+  EXPECT_EQ(robot.parameters[3].KeyName(), "steering_gain");
   EXPECT_DOUBLE_EQ(robot.nominal[3], 0.5);
   EXPECT_DOUBLE_EQ(robot.bounds[3].lo, 0.05);
   EXPECT_DOUBLE_EQ(robot.bounds[3].hi, 5.0);

@@ -94,7 +94,7 @@ ParameterColumns ColumnsFor(const Robot& robot) {
   }
   c.markdown_header = "Parameters";
   for (const ParameterInfo& info : robot.parameters) {
-    c.csv_names.push_back(info.name + "_" + info.DisplayUnit());
+    c.csv_names.push_back(info.KeyName());
   }
   c.csv_values = [robot](const std::vector<double>& p) {
     std::vector<double> out;

@@ -18,6 +18,7 @@
 #include "io/input_error.h"
 #include "io/input_registry.h"
 #include "io/log_files.h"
+#include "io/rosbag2/static_transforms.h"
 #include "io/staged_directory.h"
 #include "io/text_file.h"
 #include "io/yaml_scalar.h"
@@ -423,7 +424,13 @@ void WriteDataset(const ImportRosbag2Options& o, const Robot& robot, const Rosba
                             GroundTruthCsvText(imp.runs[i].ground_truth).view());
     entries.push_back(std::move(e));
   }
-  io::WriteFileAtomically((dir / "robot.yaml").string(), io::ReadTextFile(o.robot));
+  std::string robot_yaml = io::ReadTextFile(o.robot);
+  if (!imp.robot_yaml_addition.empty()) {
+    if (!robot_yaml.empty() && robot_yaml.back() != '\n') robot_yaml += '\n';
+    robot_yaml += imp.robot_yaml_addition;
+  }
+  io::WriteFileAtomically((dir / "robot.yaml").string(), robot_yaml);
+  ReadRobotModelFile((dir / "robot.yaml").string());  // the robot with its frame reads back
   const std::string header =
       "# imported by fitcal import rosbag2 from " + io::YamlCommentText(o.bag) + "\n# encoders " +
       io::YamlCommentText(o.encoders) + " (" +
@@ -436,6 +443,33 @@ void WriteDataset(const ImportRosbag2Options& o, const Robot& robot, const Rosba
   RefuseWhatFitRefuses(o, staged.path(), robot);
   io::StopHereForTests("import-rosbag2-before-rename");
   CommitDirectoryOutput(staged, o.out, kDatasetKind, o.force, {o.bag});
+}
+
+bool DeclaresGroundTruthFrame(const Robot& robot) {
+  return std::any_of(robot.parameters.begin(), robot.parameters.end(),
+                     [](const ParameterInfo& p) { return p.name == "ground_truth_x"; });
+}
+
+// The nominal ground_truth_frame from the bag's /tf_static, and the line that says so.
+void AddGroundTruthFrame(const ImportRosbag2Options& o, const Robot& robot, Rosbag2Import* imp) {
+  const io::rosbag2::GroundTruthMountFromBag mount =
+      io::rosbag2::MountFromTfStatic(imp->streams, o.ground_truth, o.base_frame);
+  if (mount.note.empty()) return;
+  if (mount.base_T_sensor && DeclaresGroundTruthFrame(robot)) {
+    imp->notes.push_back(mount.note.substr(0, mount.note.find(": ground_truth_frame")) +
+                         ": the robot YAML's own ground_truth_frame kept (/tf_static not used)");
+    return;
+  }
+  imp->notes.push_back(mount.note);
+  if (!mount.base_T_sensor) return;
+  // Rounding of the 3-D composition (1e-17 m where a chain cancels) printed as the 0 it is.
+  const auto clean = [](double v) { return std::abs(v) < 5e-13 ? 0.0 : v; };
+  char line[200];
+  std::snprintf(line, sizeof line, "ground_truth_frame: {x_m: %.9g, y_m: %.9g, yaw_deg: %.9g}\n",
+                clean(mount.base_T_sensor->x), clean(mount.base_T_sensor->y),
+                clean(mount.base_T_sensor->theta * 180.0 / M_PI));
+  imp->robot_yaml_addition = "# the ground truth's frame in " + o.base_frame +
+                             ", from the bag's /tf_static (fitcal import rosbag2)\n" + line;
 }
 
 }  // namespace
@@ -451,6 +485,7 @@ Rosbag2Import ReadRosbag2Import(const ImportRosbag2Options& o) {
   const io::rosbag2::BagStreamRequest request = MakeRequest(o, robot);
   imp.streams = io::rosbag2::ReadBagStreams(o.bag, request);
   imp.notes = imp.streams.notes;
+  AddGroundTruthFrame(o, robot, &imp);
   for (std::string& note : UnwrapWrappedWheels(robot, request.joints, &imp.streams)) {
     imp.notes.push_back(std::move(note));
   }
@@ -506,7 +541,12 @@ void AddImportRosbag2Options(CLI::App& app, ImportRosbag2Options& o) {
                  "tf2_msgs/msg/TFMessage")
       ->required();
   app.add_option("--ground-truth-frames", o.ground_truth_frames,
-                 "For a TFMessage topic: parent:child of the transform, e.g. world:base_link");
+                 "For a TFMessage topic: parent:child of the transform, e.g. world:base_link; for "
+                 "a PoseStamped: the child names the frame it tracks");
+  app.add_option("--base-frame", o.base_frame,
+                 "The robot's base frame in /tf_static: a ground truth tracking another frame "
+                 "gets its nominal ground_truth_frame from there")
+      ->capture_default_str();
   app.add_option("--stamp", o.stamp,
                  "header (default: when the driver measured; the recording time adds each "
                  "topic's own transport latency and jitter) or recorded")
@@ -527,7 +567,7 @@ int RunImportRosbag2Command(const ImportRosbag2Options& o) {
     const Rosbag2Import imp = ImportRosbag2(o);
     if (!o.quiet) {
       for (const std::string& note : imp.notes) std::printf("%s\n", note.c_str());
-      const RobotModelPtr model = ReadRobotModelFile(o.robot);
+      const RobotModelPtr model = ReadRobotModelFile((fs::path(o.out) / "robot.yaml").string());
       const FinalPoseErrors nominal =
           EvaluateFinalPoseErrors(*model, model->robot().nominal, AlignRuns(imp.runs));
       std::printf(

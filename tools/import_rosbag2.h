@@ -33,6 +33,13 @@
 // back with the loader `fit` uses before it is committed: the import never writes a data set
 // `fit` refuses.
 //
+// A pose source on a mount. When the ground truth tracks a frame other than --base-frame (an
+// Odometry's child_frame_id; a PoseStamped's frame named by --ground-truth-frames) and the bag's
+// /tf_static links the two (directly or along a chain), the data set's robot YAML gets that pose
+// as its nominal `ground_truth_frame: {x_m, y_m, yaw_deg}`, said on one line; without /tf_static
+// (or without a link) nothing is written for the frame, said in words. A robot YAML that declares
+// its own ground_truth_frame keeps it.
+//
 // Nothing is written unless every run is good: the data set is built in a temporary sibling of
 // --out and renamed into place (io/staged_directory.h).
 
@@ -55,7 +62,9 @@ struct ImportRosbag2Options {
   std::string encoders = "/joint_states";
   std::vector<std::string> joints;  // robot channel order; empty: the channel names
   std::string ground_truth;         // topic
-  std::string ground_truth_frames;  // "parent:child", for a tf2_msgs/msg/TFMessage topic
+  std::string ground_truth_frames;  // "parent:child", for a tf2_msgs/msg/TFMessage topic (and a
+                                    // PoseStamped's: the child names the frame it tracks)
+  std::string base_frame = "base_link";  // the robot's base frame in /tf_static
   std::string stamp = "header";     // header | recorded
   std::string runs;                 // "t0:t1,t2:t3" (s since the bag's start)
   double split_at_rest_s = 0.0;     // > 0: cut at rests at least this long
@@ -73,6 +82,9 @@ struct Rosbag2Import {
   std::vector<std::vector<double>> encoder_t_s;
   std::vector<std::vector<double>> encoder_values;
   std::vector<std::string> notes;  // what the import repaired (wrapped joint positions), one line each
+  // Appended to the robot YAML the data set holds: the nominal `ground_truth_frame:` of a ground
+  // truth that tracks a sensor, from the bag's /tf_static (io/rosbag2/static_transforms.h).
+  std::string robot_yaml_addition;
 };
 
 // Reads the bag and cuts the runs, writing nothing. Throws io::InputError for a bad bag or bad

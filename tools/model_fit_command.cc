@@ -993,6 +993,19 @@ void PrintResiduals(const FitMethodSettings& settings, bool residuals_auto,
   if (track_data) PrintClockOffsets(fit, *track_data);
 }
 
+// The counter glitches the loader dropped (io/log_files.h), each named above with its line.
+void PrintEncoderGlitches(const std::vector<RunLog>& runs) {
+  int glitches = 0, runs_with = 0;
+  for (const RunLog& run : runs) {
+    glitches += run.encoders.dropped_glitches;
+    runs_with += run.encoders.dropped_glitches > 0;
+  }
+  if (glitches == 0) return;
+  std::printf("encoder glitches: %d interval%s in %d run%s dropped from the fit (each named with "
+              "its file:line in the warnings)\n",
+              glitches, glitches == 1 ? "" : "s", runs_with, runs_with == 1 ? "" : "s");
+}
+
 // What the fit could not determine and what looks wrong with it.
 void PrintUncertaintyAndWarnings(const FitCommandOptions& options,
                                  const RobotModelInterface& model, const RunSplit& split,
@@ -1082,6 +1095,7 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
            track_fits);
   PrintTying(settings.tying);
   PrintResiduals(settings, residuals_auto, residual_lines, fit, track_data);
+  PrintEncoderGlitches(dataset.runs);
   PrintEverydayDriving(*model, logs, split, candidates[0], selected, options.threads);
   PrintUncertaintyAndWarnings(options, *model, split, fit, settings.weights);
   if (halves.judged) {  // the gate's table is on the training runs; the halves judge (below)

@@ -20,6 +20,7 @@ constexpr const char* kJointStateType = "sensor_msgs/msg/JointState";
 constexpr const char* kPoseStampedType = "geometry_msgs/msg/PoseStamped";
 constexpr const char* kOdometryType = "nav_msgs/msg/Odometry";
 constexpr const char* kTfType = "tf2_msgs/msg/TFMessage";
+constexpr const char* kTfStaticTopic = "/tf_static";
 
 std::string Seconds(std::int64_t t_ns) {
   char text[48];
@@ -259,6 +260,7 @@ class PoseCollector {
       Push(m, p.header, PlanarPose(p.pose.position, p.pose.orientation, p.header, m));
     } else if (type_ == kOdometryType) {
       const Odometry o = DecodeOdometry(m.payload, Describe(m));
+      if (out_->t_ns.empty()) child_frame = StripSlash(o.child_frame_id);
       Push(m, o.header, PlanarPose(o.pose.pose.position, o.pose.pose.orientation, o.header, m));
     } else {
       for (const TransformStamped& t : DecodeTfMessage(m.payload, Describe(m)).transforms) {
@@ -290,6 +292,7 @@ class PoseCollector {
 
  public:
   StampOrder order;
+  std::string child_frame;  // an Odometry's child_frame_id, from its first message
 
  private:
   const BagStreamRequest& request_;
@@ -379,14 +382,22 @@ BagStreams ReadBagStreams(const std::string& bag_path, const BagStreamRequest& r
   out.joints.values.reserve(joint_topic->message_count * request.joints.size());
   JointCollector joints(request, &out.joints);
   PoseCollector poses(request, pose_topic->type, &out.poses);
+  const TopicInfo* tf_static = bag.FindTopic(kTfStaticTopic);
+  if (tf_static != nullptr && tf_static->type != kTfType) tf_static = nullptr;
+  out.has_tf_static = tf_static != nullptr;
   BagMessage m;
   while (bag.ReadNext(&m)) {
     if (m.topic == joint_topic) {
       joints.Add(m);
     } else if (m.topic == pose_topic) {
       poses.Add(m);
+    } else if (m.topic == tf_static) {
+      for (TransformStamped& t : DecodeTfMessage(m.payload, Describe(m)).transforms) {
+        out.static_transforms.push_back(std::move(t));
+      }
     }
   }
+  out.pose_frame = out.pose_type == kOdometryType ? poses.child_frame : request.child_frame;
   joints.Finish(bag_path);
   if (request.stamp == StampSource::kRecorded) RefuseRecordingClockStepBack(&bag, out);
   if (joints.order.violated() || poses.order.violated()) {

@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "io/rosbag2/ros_messages.h"
 #include "odometry/pose2.h"
 
 namespace fitcal::io::rosbag2 {
@@ -34,7 +35,8 @@ struct BagStreamRequest {
   std::vector<bool> needs_position;  // per joint: an angle reading (position) is required
   std::string pose_topic;            // PoseStamped, Odometry or TFMessage
   std::string parent_frame;          // TFMessage only: header.frame_id of the transform
-  std::string child_frame;           // TFMessage only: its child_frame_id
+  std::string child_frame;           // TFMessage: its child_frame_id; PoseStamped: the frame
+                                     // it tracks (optional, BagStreams::pose_frame)
   StampSource stamp = StampSource::kHeader;
 };
 
@@ -56,6 +58,14 @@ struct BagStreams {
   std::int64_t start_time_ns = 0;  // the bag's first recording time: the data set's t = 0
   std::uint64_t bytes = 0;         // size of the bag's storage files
   std::string pose_type;           // the ground-truth topic's message type
+  // The frame whose pose the ground truth gives: an Odometry's child_frame_id (its first
+  // message's), the child of a TFMessage's transform (request.child_frame), and for a
+  // PoseStamped the child the request names (a PoseStamped's header.frame_id is the frame its
+  // pose is expressed in, the world's, so it names none); empty when unknown.
+  std::string pose_frame;
+  // The bag's /tf_static (tf2_msgs/msg/TFMessage): every transform in recording order.
+  bool has_tf_static = false;
+  std::vector<TransformStamped> static_transforms;
   JointStream joints;
   PoseStream poses;
   std::vector<std::string> notes;  // what the reader repaired, one line each

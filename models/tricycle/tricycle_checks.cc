@@ -48,7 +48,9 @@ void Check(const double* values, std::size_t n, std::size_t stride, double step,
     throw InputError(InputErrorKind::kBadValue, path, first_line + static_cast<int>(ticks),
                      std::string("the steering ") + what + " are whole numbers up to " +
                          Number(values[static_cast<std::size_t>(ticks) * stride]) +
-                         ": encoder ticks, not an angle in rad");
+                         ": encoder ticks, not an angle in rad (counts of an absolute encoder: "
+                         "name the column ticks_steering and declare steering_encoder: "
+                         "{ticks_per_rev: N, zero_tick: Z} in the robot YAML)");
   }
   for (std::size_t k = 0; k < n; ++k) {
     const double v = values[k * stride];

@@ -94,9 +94,8 @@ Robot TricycleRobotDescription(const std::string& name, const std::string& tract
   robot.parameters[K::kWheelbaseIndex] = {"wheelbase", "wheelbase_m", ParameterUnit::kLength};
   robot.parameters[K::kSteeringOffsetIndex] = {"steering_offset", "steering_offset_deg",
                                                ParameterUnit::kAngle};
-  // A ratio; printed under the length unit until odometry/robot.h has a unit for ratios (its
-  // change is printed in %, as a length's).
-  if (with_gain) robot.parameters.push_back({kGainKey, kGainKey, ParameterUnit::kLength});
+  // The wheel's angle per measured angle: dimensionless (its change is printed in %).
+  if (with_gain) robot.parameters.push_back({kGainKey, kGainKey, ParameterUnit::kRatio});
   return robot;
 }
 
@@ -132,6 +131,7 @@ RobotModelPtr ReadTricycleModel(const YAML::Node& root, const std::string& path)
   robot.bounds = ReadTricycleBounds(robot_map, path, gain);
   io::CheckNominalInsideBounds(robot, path, LineOf(robot_map.Required("bounds")));
   robot.encoder = io::ReadEncoderTicksNode(robot_map.Optional("encoder"), path);
+  io::ReadAngleEncoders(robot_map, &robot);
   robot.effects = io::ReadEffectsNode(robot_map.Optional("effects"), path);
   robot_map.Optional("calibration");  // written by fitcal; informational when read back
   robot_map.RejectUnread();
