@@ -17,7 +17,7 @@
 
 #include "models/omni3/omni3_robot.h"
 #include "models/omni3/omni3_robot_model.h"
-#include "tools/sim/flower_trajectories.h"
+#include "models/omni/flower_trajectories.h"
 #include "tools/sim/model_simulator.h"
 
 namespace fitcal::sim {
