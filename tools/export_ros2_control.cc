@@ -4,11 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <map>
-#include <numeric>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -77,8 +75,8 @@ ControllerEntry FindController(const std::string& name) {
   return entry;
 }
 
-bool InList(const char* list, const std::string& word) {
-  return (std::string(" ") + list + " ").find(" " + word + " ") != std::string::npos;
+bool InList(const std::string& list, const std::string& word) {
+  return (" " + list + " ").find(" " + word + " ") != std::string::npos;
 }
 
 // The writer of `model`; nullptr when the controller does not take it.
@@ -103,7 +101,7 @@ void CheckDistro(const ControllerEntry& e, const std::string& distro) {
     for (const std::string& d : all) known += (known.empty() ? "" : ", ") + d;
     throw UsageError("--ros-distro '" + distro + "' is not one of " + known);
   }
-  if (!InList(e.distros.c_str(), distro)) {
+  if (!InList(e.distros, distro)) {
     throw UsageError(e.name + " is not in ROS 2 " + distro + " (it ships in " +
                      e.distros + ")");
   }
