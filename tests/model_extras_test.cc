@@ -1,6 +1,6 @@
 // A model's extras are found through the registry alone (models/model_extras.h): a toy model,
-// registered here by one RegisterModel call with a controller writer and a simulation scenario,
-// is exported and simulated by the commands, which name no model.
+// registered here by one RegisterModel call with a controller writer, a simulation scenario and
+// its compare columns, is exported, simulated and compared by the commands, which name no model.
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
@@ -17,6 +17,7 @@
 #include "models/model_registry.h"
 #include "tests/models/unicycle_test_model.h"
 #include "tests/test_files.h"
+#include "tools/compare_command.h"
 #include "tools/export_ros2_control.h"
 #include "tools/sim/scenario_noise.h"
 #include "tools/simulate_command.h"
@@ -50,11 +51,22 @@ std::vector<sim::TrajectorySpec> ToyScenario(const Robot&, int repetitions) {
   return out;
 }
 
+// compare shows the toy's radius in millimetres, under a header of its own.
+ParameterDisplay ToyColumns(const Robot&) {
+  ParameterDisplay d;
+  d.markdown_header = "Toy radius";
+  d.csv_names = {"toy_radius_mm"};
+  d.csv_values = [](const std::vector<double>& p) { return std::vector<double>{1000.0 * p[0]}; };
+  d.markdown = [](const std::vector<double>& p) { return std::to_string(1000.0 * p[0]) + " mm"; };
+  return d;
+}
+
 // The toy model with its extras: one registration, as a model folder's one registry line.
 void RegisterToyWithExtras() {
   ModelRegistration toy = *FindModel(kToy);
   toy.extras.controllers = {{kController, "jazzy rolling", &ToyControllerParameters}};
   toy.extras.scenario = {&ToyScenario, kTruthFraction};
+  toy.extras.display = &ToyColumns;
   RegisterModel(toy);
 }
 
@@ -122,6 +134,28 @@ TEST(ModelExtras, SimulateFindsTheToysScenarioThroughTheRegistry) {
   const YAML::Node truth = YAML::LoadFile((std::filesystem::path(out) / "true_robot.yaml").string());
   EXPECT_NEAR(truth["radius_m"].as<double>(), 0.05 + kTruthFraction * (0.06 - 0.05), 1e-12);
   EXPECT_NEAR(truth["turn_gain"].as<double>(), 0.5 + kTruthFraction * (0.4 - 0.5), 1e-12);
+}
+
+TEST(ModelExtras, CompareShowsTheToysParametersAsTheToyRegisters) {
+  RegisterToyWithExtras();
+  TempDir dir;
+  const std::string data = dir.Path("toy_data");
+  ASSERT_EQ(RunCommand(&tools::AddSimulateOptions, &tools::RunSimulateCommand,
+                       {"--model", kToy, "--out", data, "--repetitions", "2"}),
+            0);
+  const std::string out = dir.Path("cmp");
+  ASSERT_EQ(RunCommand(&tools::AddCompareOptions, &tools::RunCompareCommand,
+                       {"--logs", data, "--methods", "ceres", "--repetitions", "1", "--out", out,
+                        "--quiet", "--threads", "1"}),
+            0);
+  const std::string csv = testing::ReadFileBytes(out + ".csv");
+  ASSERT_TRUE(testing::Has(csv, "repetitions,toy_radius_mm,cf_calibration")) << csv;
+  // The fitted row's radius in the toy's millimetres: inside the example's bounds, 0.04..0.06 m.
+  const std::string row = csv.substr(csv.find("\nall,ceres,1,") + 1);
+  const double radius_mm = testing::CsvNumbers(row.substr(row.find(",1,") + 3), 1)[0];
+  EXPECT_GE(radius_mm, 40.0) << row;
+  EXPECT_LE(radius_mm, 60.0) << row;
+  EXPECT_TRUE(testing::Has(testing::ReadFileBytes(out + ".md"), "Toy radius"));
 }
 
 }  // namespace
