@@ -10,7 +10,8 @@
 
 namespace fitcal::io {
 
-// The `model:` of a robot YAML ("omni3", ...); throws for a file that is not a robot YAML.
+// The `model:` of a robot YAML (a registered model's name); throws for a file that is not a
+// robot YAML.
 std::string ReadRobotModel(const std::string& path);
 
 // The optional `encoder: {ticks_per_rev: N, cumulative: false}` block of any robot YAML (needed

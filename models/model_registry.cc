@@ -5,11 +5,15 @@
 #include "io/yaml_reader.h"
 #include "io/yaml_units_check.h"
 #include "models/asoc/asoc_robot_model.h"
+#include "models/diff_drive/diff_drive_extras.h"
 #include "models/diff_drive/diff_drive_model.h"
 #include "models/mounted_model.h"
+#include "models/omni/omni_extras.h"
 #include "models/omni/omni_model.h"
+#include "models/omni3/omni3_extras.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "models/tricycle/tricycle_checks.h"
+#include "models/tricycle/tricycle_extras.h"
 #include "models/tricycle/tricycle_model.h"
 
 namespace fitcal {
@@ -20,15 +24,15 @@ namespace {
 std::vector<ModelRegistration>& Registry() {
   static std::vector<ModelRegistration> registry = {
       {"omni3", "three-wheeled omni robot, Palacin et al. 2022 (9 parameters)", &ReadOmni3Model,
-       kOmni3ExampleYaml},
+       kOmni3ExampleYaml, Omni3Extras()},
       {"omni", "3 to 8 omni or mecanum wheels (3 parameters per wheel)", &ReadOmniModel,
-       kOmniExampleYaml},
+       kOmniExampleYaml, OmniExtras()},
       {"tricycle", "steered, driven wheel and a rear axle (3 parameters)", &ReadTricycleModel,
-       kTricycleExampleYaml},
+       kTricycleExampleYaml, TricycleExtras()},
       {"diff_drive", "differential drive, Borenstein & Feng 1996 (3 parameters)",
-       &ReadDiffDriveModel, kDiffDriveExampleYaml},
+       &ReadDiffDriveModel, kDiffDriveExampleYaml, DiffDriveExtras()},
       {"asoc", "three active split offset castors, Doebbler et al. (18 parameters)", &ReadAsocModel,
-       kAsocExampleYaml},
+       kAsocExampleYaml, {}},
   };
   // What each model's channels must hold, checked by the loader on every log (io/sample_checks.h).
   static const bool sample_checks_registered = [] {
@@ -66,6 +70,12 @@ std::string RegisteredModelNames() {
   std::string out;
   for (const ModelRegistration& m : Registry()) out += (out.empty() ? "" : ", ") + m.name;
   return out;
+}
+
+const ModelExtras& ExtrasOf(const std::string& name) {
+  static const ModelExtras kNone;
+  const ModelRegistration* m = FindModel(name);
+  return m == nullptr ? kNone : m->extras;
 }
 
 RobotModelPtr ReadRobotModelFile(const std::string& path) {

@@ -1,7 +1,9 @@
 #pragma once
 // Robot models by name: the robot YAML's `model:` picks the reader that builds the robot's
-// RobotModelInterface. The built-in models are listed in model_registry.cc (one line each);
-// RegisterModel adds one at run time (a test's own model, a plug-in).
+// RobotModelInterface, and what the model offers beyond the seam (model_extras.h: controller
+// writers, a simulation scenario, ...) is found here by the commands. The built-in models are
+// listed in model_registry.cc (one line each); RegisterModel adds one at run time (a test's own
+// model, a plug-in).
 
 #include <yaml-cpp/yaml.h>
 
@@ -9,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "models/model_extras.h"
 #include "models/model_interface.h"
 
 namespace fitcal {
@@ -26,6 +29,7 @@ struct ModelRegistration {
   // A complete robot YAML of this model: documentation, and the robot every generic test
   // (tests/model_harness_test.cc) runs the model with.
   std::string example_yaml;
+  ModelExtras extras;  // from the model's folder, e.g. DiffDriveExtras()
 };
 
 // Adds (or replaces) a model; returns true so that it can initialise a static.
@@ -33,6 +37,8 @@ bool RegisterModel(ModelRegistration registration);
 const std::vector<ModelRegistration>& RegisteredModels();
 const ModelRegistration* FindModel(const std::string& name);  // nullptr when unknown
 std::string RegisteredModelNames();                           // "omni3, diff_drive, ..."
+// The extras of a model by name; none (every field empty) for an unknown name.
+const ModelExtras& ExtrasOf(const std::string& name);
 
 // Reads a robot YAML of any registered model; InputError for an unknown `model:`.
 RobotModelPtr ReadRobotModelFile(const std::string& path);

@@ -18,7 +18,7 @@
 #include "odometry/aligned_run.h"
 #include "tests/model_support.h"
 #include "tools/sim/model_simulator.h"
-#include "tools/sim/omni_trajectories.h"
+#include "models/omni/omni_trajectories.h"
 
 namespace fitcal {
 namespace {

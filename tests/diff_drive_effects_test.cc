@@ -24,7 +24,7 @@
 #include "odometry/effects.h"
 #include "tests/diagnose_expectations.h"
 #include "tests/test_files.h"
-#include "tools/sim/diff_drive_trajectories.h"
+#include "models/diff_drive/diff_drive_trajectories.h"
 #include "tools/sim/model_simulator.h"
 #include "validation/trajectory_metrics.h"
 

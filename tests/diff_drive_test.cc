@@ -29,7 +29,7 @@
 #include "tests/model_support.h"
 #include "tests/test_files.h"
 #include "tools/import_optiodom.h"
-#include "tools/sim/diff_drive_trajectories.h"
+#include "models/diff_drive/diff_drive_trajectories.h"
 #include "tools/sim/model_simulator.h"
 #include "validation/generalisation.h"
 

@@ -23,7 +23,7 @@
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
 #include "tests/test_files.h"
-#include "tools/sim/diff_drive_trajectories.h"
+#include "models/diff_drive/diff_drive_trajectories.h"
 #include "tools/sim/model_simulator.h"
 #include "validation/generalisation.h"
 

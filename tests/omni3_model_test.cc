@@ -12,7 +12,7 @@
 #include <random>
 
 #include "odometry/pose2.h"
-#include "tools/sim/flower_trajectories.h"
+#include "models/omni/flower_trajectories.h"
 #include "tools/sim/flower_scenario.h"
 
 namespace fitcal::omni3 {

@@ -29,7 +29,7 @@
 #include "tests/test_files.h"
 #include "tools/import_optiodom.h"
 #include "tools/sim/model_simulator.h"
-#include "tools/sim/omni_trajectories.h"
+#include "models/omni/omni_trajectories.h"
 
 namespace fitcal {
 namespace {

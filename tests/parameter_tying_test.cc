@@ -27,7 +27,7 @@
 #include "models/omni3/omni3_robot_model.h"
 #include "odometry/aligned_run.h"
 #include "tests/test_files.h"
-#include "tools/sim/diff_drive_trajectories.h"
+#include "models/diff_drive/diff_drive_trajectories.h"
 #include "tools/sim/model_simulator.h"
 
 namespace fitcal {

@@ -19,7 +19,7 @@
 #include "io/rosbag2/bag_writer.h"
 #include "io/rosbag2/ros_messages.h"
 #include "models/model_interface.h"
-#include "tools/sim/diff_drive_trajectories.h"
+#include "models/diff_drive/diff_drive_trajectories.h"
 #include "tools/sim/model_simulator.h"
 
 namespace fitcal::testing::robot_bag {

@@ -38,9 +38,9 @@
 #include "tools/command_failure.h"
 #include "tools/export_ros2_control.h"
 #include "tools/import_rosbag2.h"
-#include "tools/sim/diff_drive_trajectories.h"
+#include "models/diff_drive/diff_drive_trajectories.h"
 #include "tools/sim/model_simulator.h"
-#include "tools/sim/tricycle_trajectories.h"
+#include "models/tricycle/tricycle_trajectories.h"
 
 namespace fitcal {
 namespace {

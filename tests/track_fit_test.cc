@@ -21,7 +21,7 @@
 #include "models/diff_drive/diff_drive_model.h"
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
-#include "tools/sim/diff_drive_trajectories.h"
+#include "models/diff_drive/diff_drive_trajectories.h"
 #include "tools/sim/model_simulator.h"
 #include "validation/everyday_driving.h"
 #include "validation/time_blocks.h"

@@ -15,7 +15,7 @@
 #include "models/tricycle/tricycle_model.h"
 #include "tests/diagnose_expectations.h"
 #include "tools/sim/model_simulator.h"
-#include "tools/sim/tricycle_trajectories.h"
+#include "models/tricycle/tricycle_trajectories.h"
 
 namespace fitcal {
 namespace {

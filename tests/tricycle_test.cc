@@ -28,7 +28,7 @@
 #include "tools/import_optiodom.h"
 #include "tools/miswired_error.h"
 #include "tools/sim/model_simulator.h"
-#include "tools/sim/tricycle_trajectories.h"
+#include "models/tricycle/tricycle_trajectories.h"
 
 namespace fitcal {
 namespace {

@@ -22,7 +22,6 @@
 #include "io/input_error.h"
 #include "io/robot_yaml.h"
 #include "models/model_registry.h"
-#include "models/omni3/omni3_parameters.h"
 #include "tools/cli_validators.h"
 #include "tools/fit_methods.h"
 #include "tools/output_guard.h"
@@ -53,45 +52,13 @@ std::string Fixed(double v, int digits) {
   return buf;
 }
 
-std::string MatrixText(const Eigen::Matrix3d& m) {
-  std::string out = "[";
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) out += Fixed(m(r, c), 4) + (c < 2 ? " " : "");
-    out += r < 2 ? "; " : "]";
-  }
-  return out;
-}
-
-// How a row's parameters are shown: omni3 as the M^-1 of Palacin Eq. 6 (Table 4's column, and
-// what firmware takes), every other model as its parameters in display units (m, deg).
-struct ParameterColumns {
-  std::string markdown_header;
-  std::vector<std::string> csv_names;
-  std::function<std::vector<double>(const std::vector<double>&)> csv_values;
-  std::function<std::string(const std::vector<double>&)> markdown;
-};
+// How a row's parameters are shown: as the model registers it (ModelExtras::display: omni3 as
+// the M^-1 of Palacin Eq. 6), else its parameters in display units (m, deg).
+using ParameterColumns = ParameterDisplay;
 
 ParameterColumns ColumnsFor(const Robot& robot) {
   ParameterColumns c;
-  if (robot.model == "omni3") {
-    c.markdown_header = "M^-1";
-    for (int r = 0; r < 3; ++r) {
-      for (int k = 0; k < 3; ++k)
-        c.csv_names.push_back("m_inv_" + std::to_string(r) + std::to_string(k));
-    }
-    c.csv_values = [](const std::vector<double>& p) {
-      const Eigen::Matrix3d m = omni3::InverseKinematicMatrix(p.data());
-      std::vector<double> out;
-      for (int r = 0; r < 3; ++r) {
-        for (int k = 0; k < 3; ++k) out.push_back(m(r, k));
-      }
-      return out;
-    };
-    c.markdown = [](const std::vector<double>& p) {
-      return MatrixText(omni3::InverseKinematicMatrix(p.data()));
-    };
-    return c;
-  }
+  if (const auto& display = ExtrasOf(robot.model).display) return display(robot);
   c.markdown_header = "Parameters";
   for (const ParameterInfo& info : robot.parameters) {
     c.csv_names.push_back(info.KeyName());
@@ -185,11 +152,12 @@ std::string TraceCsv(const std::vector<Row>& rows) {
   return o.str();
 }
 
-// The robot and runs of a data set, for any model; omni3's runs keep their own loader; every model
-// fits and is scored through the seam (tools/fit_methods.h, fit/final_pose_errors.h).
+// The robot and runs of a data set, for any model; a model that registers the legacy loader
+// (ModelExtras::legacy_loader: omni3) keeps its own; every model fits and is scored through the
+// seam (tools/fit_methods.h, fit/final_pose_errors.h).
 struct CompareData {
   RobotModelPtr model;
-  bool omni3 = false;  // Palacin's robot: his strategies STA..STE by default
+  bool legacy = false;  // ModelExtras::legacy_loader: Palacin's strategies STA..STE by default
   std::vector<AlignedRun> runs;
 
   double Cf(const std::vector<double>& p, const std::vector<AlignedRun>& on, int threads) const {
@@ -201,9 +169,9 @@ CompareData LoadCompareData(const CompareCommandOptions& options) {
   const io::DatasetIndex index = OpenDataset(options).index;
   const std::string model_name = io::ReadRobotModel(index.robot_path);
   CompareData d;
-  if (model_name == "omni3") {
+  if (ExtrasOf(model_name).legacy_loader) {
     const io::Dataset dataset = LoadRuns(options, index, /*robot=*/nullptr);
-    d.omni3 = true;
+    d.legacy = true;
     d.model = ReadRobotModelFile(dataset.robot_path);
     d.runs = AlignRuns(dataset.runs);
   } else {
@@ -248,9 +216,10 @@ void ResolveStrategy(const std::vector<AlignedRun>& runs, TrajectoryStrategy* s)
   }
 }
 
-// Palacin's STA..STE need the flower's labels. For a model other than omni3 and no --strategies,
-// keep those the data set has (the omni model's generalised flower has them all) or, when it has
-// none, train on every trajectory ("all": the split is by repetitions only).
+// Palacin's STA..STE need the flower's labels. For a model without the legacy loader (omni3 has
+// it) and no --strategies, keep those the data set has (the omni model's generalised flower has
+// them all) or, when it has none, train on every trajectory ("all": the split is by repetitions
+// only).
 std::vector<TrajectoryStrategy> DefaultStrategiesFor(const std::vector<AlignedRun>& runs,
                                                      std::vector<TrajectoryStrategy> strategies) {
   std::vector<TrajectoryStrategy> present;
@@ -454,7 +423,7 @@ void AddStrategyRows(const CompareRequest& request, const CompareData& d,
 
 void AddCompareOptions(CLI::App& app, CompareCommandOptions& o) {
   AddDatasetOptions(app, o);
-  // A model other than omni3 takes the STA..STE it has unless --strategies names some.
+  // A model without the legacy loader takes the STA..STE it has unless --strategies names some.
   app.callback([&app, &o] { o.strategies_given = app.count("--strategies") > 0; });
   app.add_option("--strategies", o.strategies,
                  "STA..STE, trajectory lists such as R1,R5,G4 or B1-B12, all, or a label "
@@ -501,7 +470,7 @@ int RunCompareCommand(const CompareCommandOptions& options) {
       std::cerr << "fitcal compare: " << refusal << "\n";
       return 2;
     }
-    if (!d.omni3 && !options.strategies_given) {
+    if (!d.legacy && !options.strategies_given) {
       request.strategies = DefaultStrategiesFor(d.runs, request.strategies);
     }
     for (TrajectoryStrategy& s : request.strategies) ResolveStrategy(d.runs, &s);

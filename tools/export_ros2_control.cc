@@ -4,11 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <map>
-#include <numeric>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -18,13 +16,11 @@
 #include "io/atomic_file.h"
 #include "io/calibration_yaml.h"
 #include "io/dataset.h"
+#include "io/ros2_parameter_yaml.h"
 #include "io/text_file.h"
 #include "io/yaml_scalar.h"
-#include "models/diff_drive/diff_drive_model.h"
 #include "models/model_registry.h"
 #include "models/mounted_model.h"
-#include "models/omni/omni_model.h"
-#include "models/tricycle/tricycle_kinematics.h"
 #include "odometry/aligned_run.h"
 #include "odometry/effects.h"
 #include "tools/command_failure.h"
@@ -38,47 +34,10 @@
 namespace fitcal::tools {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
-// Fixed geometry (drive and roller angles) is written by fitcal with 10 significant digits: a
-// difference below this is the same angle.
-constexpr double kSameAngleRad = 1e-6;
+using io::Ros2Double;
 
-// A double as ROS 2 parameter YAML must hold it: with a decimal point, else rclcpp types it as an
-// integer and a double parameter refuses it.
-std::string Num(double v) {
-  char text[40];
-  std::snprintf(text, sizeof text, "%.12g", v);
-  std::string s = text;
-  if (s.find_first_of(".en") == std::string::npos) s += ".0";
-  return s;
-}
-
-// Joint names double-quoted and escaped (io/yaml_scalar.h): a quote in a URDF name stays YAML.
-std::string Quoted(const std::string& s) { return io::YamlDoubleQuoted(s); }
-
-std::string NameList(const std::vector<std::string>& names) {
-  std::string out = "[";
-  for (std::size_t i = 0; i < names.size(); ++i) out += (i ? ", " : "") + Quoted(names[i]);
-  return out + "]";
-}
-
-// A value as the controller reads it back from the YAML Num wrote (12 significant digits): the
-// replay runs the parameters the controller will run.
-double AsWritten(double v) { return std::strtod(Num(v).c_str(), nullptr); }
-
-// The calibrated robot, read once through the model registry, and the joint of each channel.
-struct Calibrated {
-  RobotModelPtr model;
-  std::vector<std::string> joints;  // robot channel order
-  const Robot& robot() const { return model->robot(); }
-  // The calibrated value of a parameter, found by name in the model's parameter table.
-  int Index(const std::string& name) const { return RequireParameterIndex(robot(), name); }
-  double Value(const std::string& name) const { return robot().nominal[Index(name)]; }
-  const std::string& ChannelName(int i) const { return robot().channels[i].name; }
-};
-
-Calibrated WithJoints(RobotModelPtr model, const std::vector<std::string>& joints) {
-  Calibrated c;
+CalibratedRobot WithJoints(RobotModelPtr model, const std::vector<std::string>& joints) {
+  CalibratedRobot c;
   c.model = std::move(model);
   const Robot& robot = c.robot();
   if (!joints.empty() && joints.size() != robot.channels.size()) {
@@ -91,348 +50,48 @@ Calibrated WithJoints(RobotModelPtr model, const std::vector<std::string>& joint
   return c;
 }
 
-// The wheels of an omni / omni3 robot at its calibrated values (models/omni/omni_model.h).
-std::vector<OmniWheel> OmniGeometry(const Calibrated& c) {
-  const std::optional<std::vector<OmniWheel>> wheels =
-      OmniWheelsOf(*c.model, c.robot().nominal);
-  if (!wheels) throw std::logic_error("robot '" + c.robot().name + "' has no omni wheels");
-  return *wheels;
-}
-
-double Mean(const std::vector<double>& v) {
-  return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
-}
-
-// "one value for all wheels" note when the values differ.
-void NoteSpread(const std::vector<double>& v, const std::string& what, const std::string& key,
-                double scale, const char* unit, std::vector<std::string>* notes) {
-  const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
-  if (*hi - *lo <= 1e-12 * std::abs(*hi)) return;
-  char text[256];
-  std::snprintf(text, sizeof text,
-                "%s takes one %s: the calibrated %.6g..%.6g %s are written as "
-                "their mean %.6g %s",
-                key.c_str(), what.c_str(), *lo * scale, *hi * scale, unit, Mean(v) * scale, unit);
-  notes->push_back(text);
-}
-
-void DiffDriveParameters(const Calibrated& c, const std::string& distro, Ros2ControlExport* out) {
-  const int right = DiffDriveRightChannel(*c.model), left = 1 - right;
-  const int k_right = c.Index("r_" + c.ChannelName(right));
-  const int k_left = c.Index("r_" + c.ChannelName(left));
-  const int k_separation = c.Index("wheel_separation");
-  const std::vector<double>& p = c.robot().nominal;
-  const double radius = 0.5 * (p[k_right] + p[k_left]);
-  out->parameters_yaml +=
-      "    left_wheel_names: " + NameList({c.joints[left]}) +
-      "\n    right_wheel_names: " + NameList({c.joints[right]}) +
-      // humble declares wheels_per_side (and overwrites it with the names' count); jazzy and
-      // rolling no longer declare it, and an undeclared key is ignored there.
-      (distro == "humble" ? "\n    wheels_per_side: 1" : "") + "\n    wheel_separation: " +
-      Num(p[k_separation]) + "\n    wheel_radius: " + Num(radius) +
-      "\n    wheel_separation_multiplier: 1.0" +
-      "\n    left_wheel_radius_multiplier: " + Num(p[k_left] / radius) +
-      "\n    right_wheel_radius_multiplier: " + Num(p[k_right] / radius) + "\n";
-  // The controller's wheels: wheel_radius times each side's multiplier, the separation times 1.
-  out->model = c.model;
-  out->parameters = p;
-  out->parameters[k_right] = AsWritten(radius) * AsWritten(p[k_right] / radius);
-  out->parameters[k_left] = AsWritten(radius) * AsWritten(p[k_left] / radius);
-  out->parameters[k_separation] = AsWritten(p[k_separation]);
-}
-
-// ros2_controllers' mecanum layout (its odometry: vx = r/4 (fl + rl + rr + fr), vy = r/4 (-fl +
-// rl - rr + fr), omega = r / (4 (lx + ly)) (-fl - rl + rr + fr)): wheels driven straight ahead,
-// rollers -45 deg on front-left and rear-right, +45 deg on front-right and rear-left.
-struct MecanumCorner {
-  const char* key;  // <key>_wheel_command_joint_name
-  double sign_x, sign_y, roller_deg;
-};
-constexpr MecanumCorner kCorners[] = {{"front_left", 1, 1, -45},
-                                      {"front_right", 1, -1, 45},
-                                      {"rear_left", -1, 1, 45},
-                                      {"rear_right", -1, -1, -45}};
-
-// The channel at each corner (kCorners order); std::invalid_argument when the layout differs.
-std::vector<int> MecanumCorners(const std::vector<OmniWheel>& wheels, const Robot& robot) {
-  std::vector<int> at(4, -1);
-  for (std::size_t i = 0; i < wheels.size(); ++i) {
-    const double x = wheels[i].distance_m * std::cos(wheels[i].angle_rad);
-    const double y = wheels[i].distance_m * std::sin(wheels[i].angle_rad);
-    for (int k = 0; k < 4; ++k) {
-      if (x * kCorners[k].sign_x > 0 && y * kCorners[k].sign_y > 0) {
-        const bool layout =
-            std::abs(WrapAngle(wheels[i].drive_angle_rad)) < 15.0 * kDeg &&
-            std::abs(wheels[i].roller_angle_rad - kCorners[k].roller_deg * kDeg) < kSameAngleRad;
-        if (!layout || at[k] >= 0) {
-          throw UsageError(
-              "wheel '" + robot.channels[i].name + "' (" + kCorners[k].key +
-              ") is not in mecanum_drive_controller's layout (driven straight ahead, rollers -45 "
-              "deg front-left/rear-right, +45 deg front-right/rear-left, one wheel per corner)");
-        }
-        at[k] = static_cast<int>(i);
-      }
-    }
-  }
-  for (int k = 0; k < 4; ++k) {
-    if (at[k] < 0) {
-      throw UsageError(std::string("no wheel at the ") + kCorners[k].key +
-                       " corner: not mecanum_drive_controller's layout");
-    }
-  }
-  return at;
-}
-
-// Bounds of a robot built from a controller's values: its values lie inside (the replay never
-// fits it).
-OmniBounds ControllerBounds(double distance_m, double radius_m) {
-  return {{0.5 * distance_m, 2 * distance_m}, {0.5 * radius_m, 2 * radius_m},
-          {DegToRad(-2.0), DegToRad(2.0)}};
-}
-
-// What mecanum_drive_controller computes: its layout with one radius and lx = ly (any point with
-// |x| + |y| = lx + ly gives the controller's yaw row).
-RobotModelPtr MecanumKinematics(const Calibrated& c, const std::vector<int>& corner,
-                                double radius_m, double sum_m) {
-  const double distance_m = AsWritten(sum_m) / std::sqrt(2.0);
-  std::vector<OmniWheel> wheels(4);
-  for (int k = 0; k < 4; ++k) {
-    wheels[corner[k]] = {c.ChannelName(corner[k]), distance_m,
-                         std::atan2(kCorners[k].sign_y, kCorners[k].sign_x), AsWritten(radius_m),
-                         0.0, DegToRad(kCorners[k].roller_deg)};
-  }
-  return MakeOmniModel(c.robot().name, wheels, ControllerBounds(distance_m, AsWritten(radius_m)));
-}
-
-void MecanumParameters(const Calibrated& c, const std::string&, Ros2ControlExport* out) {
-  if (c.robot().model != "omni" || c.robot().NumChannels() != 4) {
-    throw UsageError("mecanum_drive_controller takes an omni robot of 4 mecanum wheels");
-  }
-  const std::vector<OmniWheel> wheels = OmniGeometry(c);
-  const std::vector<int> corner = MecanumCorners(wheels, c.robot());
-  std::vector<double> radii, sums, drives;
-  for (const OmniWheel& w : wheels) {
-    radii.push_back(w.radius_m);
-    sums.push_back(std::abs(w.distance_m * std::cos(w.angle_rad)) +
-                   std::abs(w.distance_m * std::sin(w.angle_rad)));
-    drives.push_back(std::abs(WrapAngle(w.drive_angle_rad)));
-  }
-  NoteSpread(radii, "radius", "kinematics.wheels_radius", 1.0, "m", &out->notes);
-  NoteSpread(sums, "lx + ly", "kinematics.sum_of_robot_center_projection_on_X_Y_axis", 1.0, "m",
-             &out->notes);
-  const double worst_drive = *std::max_element(drives.begin(), drives.end());
-  if (worst_drive > kSameAngleRad) {
-    char text[200];
-    std::snprintf(text, sizeof text,
-                  "mecanum_drive_controller drives every wheel straight ahead: "
-                  "calibrated drive directions up to %.4g deg off it are written as 0",
-                  worst_drive / kDeg);
-    out->notes.push_back(text);
-  }
-  for (int k = 0; k < 4; ++k) {
-    out->parameters_yaml += std::string("    ") + kCorners[k].key +
-                            "_wheel_command_joint_name: " + Quoted(c.joints[corner[k]]) + "\n";
-  }
-  out->parameters_yaml += "    kinematics:\n      wheels_radius: " + Num(Mean(radii)) +
-                          "\n      sum_of_robot_center_projection_on_X_Y_axis: " +
-                          Num(Mean(sums)) + "\n";
-  out->model = MecanumKinematics(c, corner, Mean(radii), Mean(sums));
-  out->parameters = out->model->robot().nominal;
-}
-
-// Which way a positive wheel rate pushes the robot: +1 counter-clockwise (tangential drive, the
-// fitcal default), -1 clockwise (omni_wheel_drive_controller's convention).
-int OmniDriveSense(const std::vector<OmniWheel>& wheels, const Robot& robot) {
-  int sense = 0;
-  for (std::size_t i = 0; i < wheels.size(); ++i) {
-    const double offset = WrapAngle(wheels[i].drive_angle_rad - wheels[i].angle_rad);
-    const int s = std::abs(offset - M_PI / 2) < kSameAngleRad   ? 1
-                  : std::abs(offset + M_PI / 2) < kSameAngleRad ? -1
-                                                                : 0;
-    if (s == 0 || (sense != 0 && s != sense) || std::abs(wheels[i].roller_angle_rad) > kSameAngleRad) {
-      throw UsageError("wheel '" + robot.channels[i].name +
-                       "' is not an omni wheel driven tangentially like the others: "
-                       "omni_wheel_drive_controller cannot describe it");
-    }
-    sense = s;
-  }
-  return sense;
-}
-
-// The wheels in omni_wheel_drive_controller's order: anticlockwise from the one nearest the x
-// axis; returns the order and the offset (circular mean of angle_j - 2 pi j / n).
-std::vector<int> OmniOrder(const std::vector<OmniWheel>& wheels, double* offset_rad) {
-  const int n = static_cast<int>(wheels.size());
-  int first = 0;
-  for (int i = 1; i < n; ++i) {
-    if (std::abs(WrapAngle(wheels[i].angle_rad)) < std::abs(WrapAngle(wheels[first].angle_rad))) {
-      first = i;
-    }
-  }
-  const auto ccw_from_first = [&](int i) {
-    const double a = WrapAngle(wheels[i].angle_rad - wheels[first].angle_rad);
-    return a < 0 ? a + 2 * M_PI : a;
-  };
-  std::vector<int> order(n);
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(),
-            [&](int a, int b) { return ccw_from_first(a) < ccw_from_first(b); });
-  double s = 0.0, c = 0.0;
-  for (int j = 0; j < n; ++j) {
-    const double a = wheels[order[j]].angle_rad - 2 * M_PI * j / n;
-    s += std::sin(a);
-    c += std::cos(a);
-  }
-  *offset_rad = std::atan2(s, c);
-  return order;
-}
-
-// What omni_wheel_drive_controller computes: one distance, one radius, the wheels equally spaced
-// from the offset in `order`, each driven as the calibrated ones (sense). An `omni` robot gets a
-// model of these wheels; omni3 (tangential wheels by construction) its own model at these values.
-void OmniWheelKinematics(const Calibrated& c, const std::vector<int>& order, double offset_rad,
-                         double distance_m, double radius_m, int sense, Ros2ControlExport* out) {
-  const int n = static_cast<int>(order.size());
-  std::vector<OmniWheel> wheels(n);
-  for (int j = 0; j < n; ++j) {
-    const double angle = AsWritten(offset_rad) + 2 * M_PI * j / n;
-    wheels[order[j]] = {c.ChannelName(order[j]), AsWritten(distance_m), angle,
-                        AsWritten(radius_m), angle + sense * M_PI / 2, 0.0};
-  }
-  if (c.robot().model == "omni") {
-    out->model = MakeOmniModel(c.robot().name, wheels,
-                               ControllerBounds(AsWritten(distance_m), AsWritten(radius_m)));
-    out->parameters = out->model->robot().nominal;
-    return;
-  }
-  out->model = c.model;
-  out->parameters = c.robot().nominal;
-  for (const OmniWheel& w : wheels) {
-    out->parameters[c.Index("R_" + w.name)] = w.distance_m;
-    out->parameters[c.Index("r_" + w.name)] = w.radius_m;
-    out->parameters[c.Index("delta_" + w.name)] = w.angle_rad;
-  }
-}
-
-void OmniWheelParameters(const Calibrated& c, const std::string&, Ros2ControlExport* out) {
-  if (c.robot().model != "omni3" && c.robot().model != "omni") {
-    throw UsageError("omni_wheel_drive_controller takes an omni3 or omni robot");
-  }
-  const std::vector<OmniWheel> wheels = OmniGeometry(c);
-  const int sense = OmniDriveSense(wheels, c.robot());
-  double offset = 0.0;
-  const std::vector<int> order = OmniOrder(wheels, &offset);
-  const int n = static_cast<int>(wheels.size());
-  std::vector<double> radii, distances;
-  double worst = 0.0;
-  std::vector<std::string> names;
-  for (int j = 0; j < n; ++j) {
-    const OmniWheel& w = wheels[order[j]];
-    radii.push_back(w.radius_m);
-    distances.push_back(w.distance_m);
-    worst = std::max(worst, std::abs(WrapAngle(w.angle_rad - offset - 2 * M_PI * j / n)));
-    names.push_back(c.joints[order[j]]);
-  }
-  NoteSpread(radii, "radius", "wheel_radius", 1.0, "m", &out->notes);
-  NoteSpread(distances, "distance", "robot_radius", 1.0, "m", &out->notes);
-  if (worst > kSameAngleRad) {
-    char text[200];
-    std::snprintf(text, sizeof text,
-                  "omni_wheel_drive_controller spaces the wheels equally (%.4g "
-                  "deg apart): the calibrated wheel angles are up to %.4g deg off that",
-                  360.0 / n, worst / kDeg);
-    out->notes.push_back(text);
-  }
-  if (sense > 0) {
-    out->notes.push_back(
-        "omni_wheel_drive_controller counts a wheel positive when it turns the robot clockwise "
-        "(w r = sin(a) vx - cos(a) vy - R omega), this robot's wheels counter-clockwise: invert "
-        "the wheel joints' axes in the URDF (or their sign in the hardware interface)");
-  }
-  out->parameters_yaml += "    wheel_names: " + NameList(names) +
-                          "\n    wheel_offset: " + Num(offset) +
-                          "\n    robot_radius: " + Num(Mean(distances)) +
-                          "\n    wheel_radius: " + Num(Mean(radii)) + "\n";
-  OmniWheelKinematics(c, order, offset, Mean(distances), Mean(radii), sense, out);
-}
-
-void TricycleParameters(const Calibrated& c, const std::string&, Ros2ControlExport* out) {
-  using K = TricycleKinematics;
-  const std::string& traction = c.joints[K::kTractionChannel];
-  const std::string& steering = c.joints[K::kSteeringChannel];
-  const int k_radius = c.Index("r_" + c.ChannelName(K::kTractionChannel));
-  const int k_wheelbase = c.Index("wheelbase"), k_offset = c.Index("steering_offset");
-  const std::vector<double>& p = c.robot().nominal;
-  const double offset_rad = p[k_offset];
-  if (offset_rad != 0.0) {
-    // models/tricycle/tricycle_kinematics.h: true steering = measured + phi_0. The controller
-    // reads the steering joint's state as the true angle, so the joint must report phi_0 more:
-    // ros2_control's SimpleTransmission computes joint = actuator / reduction + offset, which
-    // also shifts the commands the same way.
-    char text[400];
-    std::snprintf(text, sizeof text,
-                  "tricycle_controller has no steering offset: add %+.9g rad (%+.6f deg) to "
-                  "the steering joint '%s' position (true steering = measured %+.6f deg), e.g. "
-                  "<offset>%.9g</offset> in its SimpleTransmission <joint> in the URDF "
-                  "(joint = actuator / reduction + offset), or zero the steering encoder there",
-                  offset_rad, offset_rad / kDeg, steering.c_str(), offset_rad / kDeg, offset_rad);
-    out->notes.push_back(text);
-  }
-  out->parameters_yaml += "    traction_joint_name: " + Quoted(traction) +
-                          "\n    steering_joint_name: " + Quoted(steering) +
-                          "\n    wheelbase: " + Num(p[k_wheelbase]) +
-                          "\n    wheel_radius: " + Num(p[k_radius]) + "\n";
-  // The controller's tricycle: these values, no steering offset and no steering gain.
-  out->model = c.model;
-  out->parameters = p;
-  out->parameters[k_radius] = AsWritten(p[k_radius]);
-  out->parameters[k_wheelbase] = AsWritten(p[k_wheelbase]);
-  out->parameters[k_offset] = 0.0;
-  if (const std::optional<int> k_gain = ParameterIndex(c.robot(), "steering_gain")) {
-    // Wheel angle = k x measured + phi_0 (tricycle_kinematics.h T3). The controller reads the
-    // steering joint as the wheel's angle; a SimpleTransmission's joint = actuator / reduction.
-    char text[400];
-    std::snprintf(text, sizeof text,
-                  "tricycle_controller has no steering gain: the steering joint '%s' must report "
-                  "%.9g times the measured angle, e.g. <mechanicalReduction>%.9g"
-                  "</mechanicalReduction> in its SimpleTransmission (joint = actuator / "
-                  "reduction), before the offset above",
-                  steering.c_str(), p[*k_gain], 1.0 / p[*k_gain]);
-    out->notes.push_back(text);
-    out->parameters[*k_gain] = 1.0;
-  }
-}
-
+// A controller as the registered models write it (ModelExtras::controllers): the distributions
+// that ship it and, for each model that takes it, that model's writer.
 struct ControllerEntry {
-  const char* name;
-  const char* model;    // the fitcal model(s) it takes, for the mismatch message
-  const char* distros;  // the distributions that ship it (tests/data/ros2_controllers/)
-  // Appends the parameter lines and notes and sets the controller's kinematics.
-  void (*write)(const Calibrated&, const std::string& distro, Ros2ControlExport*);
-};
-const ControllerEntry kControllers[] = {
-    {"diff_drive_controller", "diff_drive", "humble jazzy rolling", DiffDriveParameters},
-    {"mecanum_drive_controller", "omni", "humble jazzy rolling", MecanumParameters},
-    {"omni_wheel_drive_controller", "omni3 omni", "jazzy rolling", OmniWheelParameters},
-    {"tricycle_controller", "tricycle", "humble jazzy rolling", TricycleParameters},
+  std::string name;
+  std::string distros;
+  std::vector<std::pair<std::string, ControllerWriteFn>> writers;  // model name, writer
 };
 
-const ControllerEntry& FindController(const std::string& name) {
-  for (const ControllerEntry& e : kControllers) {
-    if (name == e.name) return e;
+ControllerEntry FindController(const std::string& name) {
+  ControllerEntry entry{name, "", {}};
+  for (const ModelRegistration& m : RegisteredModels()) {
+    for (const ControllerWriter& w : m.extras.controllers) {
+      if (w.controller != name) continue;
+      entry.distros = w.distros;
+      entry.writers.emplace_back(m.name, w.write);
+    }
   }
-  std::string known;
-  for (const ControllerEntry& e : kControllers)
-    known += (known.empty() ? "" : ", ") + std::string(e.name);
-  throw UsageError("unknown controller '" + name + "' (fitcal writes " + known + ")");
+  if (entry.writers.empty()) {
+    std::string known;
+    for (const std::string& c : Ros2Controllers()) known += (known.empty() ? "" : ", ") + c;
+    throw UsageError("unknown controller '" + name + "' (fitcal writes " + known + ")");
+  }
+  return entry;
 }
 
-bool InList(const char* list, const std::string& word) {
-  return (std::string(" ") + list + " ").find(" " + word + " ") != std::string::npos;
+bool InList(const std::string& list, const std::string& word) {
+  return (" " + list + " ").find(" " + word + " ") != std::string::npos;
 }
 
-bool TakesModel(const ControllerEntry& e, const std::string& model) {
-  return InList(e.model, model);
+// The writer of `model`; nullptr when the controller does not take it.
+const ControllerWriteFn* WriterFor(const ControllerEntry& e, const std::string& model) {
+  for (const auto& [name, write] : e.writers) {
+    if (name == model) return &write;
+  }
+  return nullptr;
+}
+
+// "omni3 omni": the models that take the controller, for the mismatch message.
+std::string ModelsTaking(const ControllerEntry& e) {
+  std::string out;
+  for (const auto& writer : e.writers) out += (out.empty() ? "" : " ") + writer.first;
+  return out;
 }
 
 void CheckDistro(const ControllerEntry& e, const std::string& distro) {
@@ -443,7 +102,7 @@ void CheckDistro(const ControllerEntry& e, const std::string& distro) {
     throw UsageError("--ros-distro '" + distro + "' is not one of " + known);
   }
   if (!InList(e.distros, distro)) {
-    throw UsageError(std::string(e.name) + " is not in ROS 2 " + distro + " (it ships in " +
+    throw UsageError(e.name + " is not in ROS 2 " + distro + " (it ships in " +
                      e.distros + ")");
   }
 }
@@ -451,7 +110,7 @@ void CheckDistro(const ControllerEntry& e, const std::string& distro) {
 // The controller's parameters describe the base; a controller model that replaced the calibrated
 // one (omni, mecanum) is replayed against the ground truth through the calibrated frame still
 // (models/mounted_model.h), or its held-out check would compare the base with the sensor.
-void KeepGroundTruthFrame(const Calibrated& c, Ros2ControlExport* out) {
+void KeepGroundTruthFrame(const CalibratedRobot& c, Ros2ControlExport* out) {
   const auto* mounted = dynamic_cast<const MountedModel*>(c.model.get());
   if (mounted == nullptr || out->model == c.model) return;
   const int k = mounted->MountIndex();
@@ -469,13 +128,12 @@ const std::vector<std::string>& RosDistros() {
   return names;
 }
 
-const std::vector<std::string>& Ros2Controllers() {
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> v;
-    for (const ControllerEntry& e : kControllers) v.push_back(e.name);
-    return v;
-  }();
-  return names;
+std::vector<std::string> Ros2Controllers() {
+  std::set<std::string> names;
+  for (const ModelRegistration& m : RegisteredModels()) {
+    for (const ControllerWriter& w : m.extras.controllers) names.insert(w.controller);
+  }
+  return {names.begin(), names.end()};
 }
 
 Ros2ControlExport ExportRos2Control(const RobotModelPtr& calibrated,
@@ -483,12 +141,13 @@ Ros2ControlExport ExportRos2Control(const RobotModelPtr& calibrated,
                                     const std::string& controller, const std::string& node_name,
                                     const std::vector<std::string>& joints,
                                     const std::string& ros_distro) {
-  const ControllerEntry& entry = FindController(controller);
+  const ControllerEntry entry = FindController(controller);
   CheckDistro(entry, ros_distro);
-  const Calibrated c = WithJoints(calibrated, joints);
-  if (!TakesModel(entry, c.robot().model)) {
+  const CalibratedRobot c = WithJoints(calibrated, joints);
+  const ControllerWriteFn* write = WriterFor(entry, c.robot().model);
+  if (write == nullptr) {
     throw UsageError(calibration_path + ": robot model '" + c.robot().model + "' does not fit " +
-                     controller + " (it takes model " + entry.model + ")");
+                     controller + " (it takes model " + ModelsTaking(entry) + ")");
   }
   if (!c.robot().effects.empty()) {
     // Its parameters were fitted together with the effects, which the controller cannot apply:
@@ -503,7 +162,11 @@ Ros2ControlExport ExportRos2Control(const RobotModelPtr& calibrated,
   Ros2ControlExport out;
   out.parameters_yaml =
       io::YamlScalar(node_name.empty() ? controller : node_name) + ":\n  ros__parameters:\n";
-  entry.write(c, ros_distro, &out);
+  try {
+    (*write)(c, ros_distro, &out);
+  } catch (const ControllerCannotDescribe& e) {
+    throw UsageError(e.what());
+  }
   KeepGroundTruthFrame(c, &out);
   return out;
 }
@@ -512,8 +175,7 @@ Ros2ControlExport ExportRos2Control(const std::string& calibration_path,
                                     const std::string& controller, const std::string& node_name,
                                     const std::vector<std::string>& joints,
                                     const std::string& ros_distro) {
-  const ControllerEntry& entry = FindController(controller);
-  CheckDistro(entry, ros_distro);
+  CheckDistro(FindController(controller), ros_distro);
   return ExportRos2Control(ReadRobotModelFile(calibration_path), calibration_path, controller,
                            node_name, joints, ros_distro);
 }
@@ -645,8 +307,8 @@ std::string ReplayLine(const ExportRos2ControlOptions& o, const Replay& r) {
 constexpr double kUnmeasuredVariance = 1e6;
 
 std::string Diagonal(const std::array<double, 3>& planar) {
-  return "[" + Num(planar[0]) + ", " + Num(planar[1]) + ", " + Num(kUnmeasuredVariance) + ", " +
-         Num(kUnmeasuredVariance) + ", " + Num(kUnmeasuredVariance) + ", " + Num(planar[2]) + "]";
+  return "[" + Ros2Double(planar[0]) + ", " + Ros2Double(planar[1]) + ", " + Ros2Double(kUnmeasuredVariance) + ", " +
+         Ros2Double(kUnmeasuredVariance) + ", " + Ros2Double(kUnmeasuredVariance) + ", " + Ros2Double(planar[2]) + "]";
 }
 
 }  // namespace
@@ -691,9 +353,9 @@ std::string CalibrationWithCovariance(const std::string& path, const OdometryCov
     if (line == "calibration:") {
       found = true;
       const auto list = [](const std::array<double, 3>& v) {
-        return "[" + Num(v[0]) + ", " + Num(v[1]) + ", " + Num(v[2]) + "]";
+        return "[" + Ros2Double(v[0]) + ", " + Ros2Double(v[1]) + ", " + Ros2Double(v[2]) + "]";
       };
-      out += "  odometry_covariance: {interval_s: " + Num(c.interval_s) +
+      out += "  odometry_covariance: {interval_s: " + Ros2Double(c.interval_s) +
              ", held_out_runs: " + std::to_string(c.runs) + ", windows: " +
              std::to_string(c.windows) + ", twist_variance: " + list(c.twist_variance) +
              ", pose_variance_1m: " + list(c.pose_variance_1m) +
@@ -814,8 +476,7 @@ void AddReplay(const ExportRos2ControlOptions& o, const RobotModelPtr& exact,
 int RunExportRos2ControlCommand(const ExportRos2ControlOptions& o) {
   return RunReportingErrors("fitcal export ros2-control", [&]() -> int {
     CheckOut(o);
-    const ControllerEntry& entry = FindController(o.controller);
-    CheckDistro(entry, o.ros_distro);
+    CheckDistro(FindController(o.controller), o.ros_distro);
     // The calibration is read once: the export and the replay share its model.
     const RobotModelPtr calibrated = ReadRobotModelFile(o.calibration);
     const Ros2ControlExport e = ExportRos2Control(calibrated, o.calibration, o.controller,

@@ -1,6 +1,9 @@
 #pragma once
 // `fitcal export ros2-control --calibration cal.yaml --controller <name> [--out file]`: the
-// parameter YAML a ros2_controllers controller reads, from a calibrated robot YAML:
+// parameter YAML a ros2_controllers controller reads, from a calibrated robot YAML. Each model
+// registers the controllers it can be written for, with their writers, from its own folder
+// (ModelExtras::controllers, models/model_extras.h; e.g. models/diff_drive/diff_drive_extras.cc);
+// this command finds them through the registry:
 //
 //   controller                   fitcal model               keys written (ros__parameters)
 //   diff_drive_controller        diff_drive                 wheel_separation, wheel_radius,
@@ -59,6 +62,7 @@
 #include <string>
 #include <vector>
 
+#include "models/model_extras.h"
 #include "models/model_interface.h"
 #include "odometry/aligned_run.h"
 #include "odometry/run_log.h"
@@ -70,18 +74,11 @@ class App;
 
 namespace fitcal::tools {
 
-struct Ros2ControlExport {
-  std::string parameters_yaml;     // `<node>:\n  ros__parameters:\n    ...` without the comments
-  std::vector<std::string> notes;  // one line per parameter the controller cannot represent
-  // What the controller computes from these parameters as written (12 significant digits), for
-  // the replay: the calibrated model at the representable values (diff drive, tricycle, omni3),
-  // or a model of the controller's own geometry (mecanum layout, equally spaced omni wheels).
-  RobotModelPtr model;
-  std::vector<double> parameters;  // model->robot().parameters order
-};
+// The parameters and what the controller computes from them (models/model_extras.h).
+using Ros2ControlExport = ControllerExport;
 
-// The controllers above, by name.
-const std::vector<std::string>& Ros2Controllers();
+// The controllers the registered models write (ModelExtras::controllers), by name, sorted.
+std::vector<std::string> Ros2Controllers();
 
 // The ROS 2 distributions the export knows, oldest first; the default is the last (newest).
 const std::vector<std::string>& RosDistros();

@@ -82,7 +82,7 @@ sim::FlowerSimulation FlowerOf(const SimulateCommandOptions& options) {
   sim::FlowerSimulation flower = sim::PalacinFlower();
   flower.model = ReadRobotModelFile(options.robot);
   const Robot& robot = flower.model->robot();
-  if (robot.model != "omni3") {
+  if (!ExtrasOf(robot.model).legacy_simulator) {
     throw std::invalid_argument(options.robot +
                                 ": the flower simulator drives an omni3 robot, not " + robot.model +
                                 " (simulate --model " + robot.model + ")");
@@ -149,7 +149,10 @@ void AddSimulateOptions(CLI::App& app, SimulateCommandOptions& o) {
 }
 
 int RunSimulateCommand(const SimulateCommandOptions& options) {
-  if (!options.model.empty() && options.model != "omni3") return RunModelSimulate(options);
+  // A model without a scenario of its own (ModelExtras::legacy_simulator: omni3) takes the flower.
+  if (!options.model.empty() && !ExtrasOf(options.model).legacy_simulator) {
+    return RunModelSimulate(options);
+  }
   try {
     const sim::FlowerSimulation flower = FlowerOf(options);
     if (const std::string refusal =

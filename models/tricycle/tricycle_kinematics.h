@@ -33,7 +33,7 @@
 // every common scale k of (r, L): the heading sees r / L, the path's shape scales with k, a
 // closed shape stays closed. OptiOdom's real runs are nearly closed (2.1 circles, squares ending
 // 0.3 m off): there r is known to 1.5 % only (tests/tricycle_test.cc), segments or open paths pin
-// it down (tools/sim/tricycle_trajectories.h).
+// it down (models/tricycle/tricycle_trajectories.h).
 
 #include <cmath>
 

@@ -88,6 +88,7 @@ inline RobotModelPtr ReadUnicycle(const YAML::Node& root, const std::string& pat
 inline const bool kUnicycleRegistered = RegisterModel(
     {"test_unicycle", "test-only unicycle (tests/models/unicycle_test_model.h)", &ReadUnicycle,
      "model: test_unicycle\nname: test\nradius_m: 0.05\nturn_gain: 0.5\n"
-     "bounds: {radius_m: [0.04, 0.06], turn_gain: [0.4, 0.6]}\n"});
+     "bounds: {radius_m: [0.04, 0.06], turn_gain: [0.4, 0.6]}\n",
+     {}});
 
 }  // namespace fitcal::testing

@@ -1,6 +1,6 @@
 #pragma once
-// Palacin et al. 2022's flower on the generic simulator (model_simulator.h): APR-02, a
-// three-wheeled omni robot (models/omni3), drives the 36 trajectories of Table A1
+// Palacin et al. 2022's flower (models/omni/) on the generic simulator (model_simulator.h):
+// APR-02, a three-wheeled omni robot (models/omni3), drives the 36 trajectories of Table A1
 // (flower_trajectories.h) commanded with its nominal parameters (Eq. 15) while it moves with the
 // true ones (Table 5 by default), under the flower's time-stepped physics (SteppedOptions:
 // controller lag, slip, jittered encoders, irregular ground truth). The defaults are the ones
@@ -17,7 +17,7 @@
 
 #include "models/omni3/omni3_robot.h"
 #include "models/omni3/omni3_robot_model.h"
-#include "tools/sim/flower_trajectories.h"
+#include "models/omni/flower_trajectories.h"
 #include "tools/sim/model_simulator.h"
 
 namespace fitcal::sim {

@@ -3,17 +3,19 @@
 // (README "Simulator"): which trajectories each model drives, how far the simulated "true" robot
 // is from the nominal one, and the noise, for the generic simulator (model_simulator.h).
 //
+// Each model registers its trajectories and truth fraction from its own folder
+// (ModelExtras::scenario, models/model_extras.h); this file finds them through the registry.
 // Trajectories, per model (labels as the data set's `trajectory`):
 //   diff_drive  Borenstein & Feng's UMBmark squares, clockwise and counter-clockwise, and circles
-//               of radius 0.5 and 1.0 m both ways (diff_drive_trajectories.h). The circles are
-//               1.25 laps: a closed path ends where it started for any common scale of the radii
-//               and the separation, so only open arcs tell the scale.
+//               of radius 0.5 and 1.0 m both ways (models/diff_drive/diff_drive_trajectories.h).
+//               The circles are 1.25 laps: a closed path ends where it started for any common
+//               scale of the radii and the separation, so only open arcs tell the scale.
 //   tricycle    circles at steering angles 10, 20, 30, 45 deg both ways (1.25 turns) and squares
-//               with in-place turns both ways, each with an extra side (tricycle_trajectories.h,
-//               "open on purpose").
-//   omni        Palacin's flower generalised to any wheel count (omni_trajectories.h): R1..R12,
-//               G1..G12, B1..B12 (v = 0.35 m/s, 1 m, |omega| 0.35 rad/s) and one turn on the spot
-//               each way (S-ccw, S-cw), which excites the yaw alone.
+//               with in-place turns both ways, each with an extra side
+//               (models/tricycle/tricycle_trajectories.h, "open on purpose").
+//   omni        Palacin's flower generalised to any wheel count (models/omni/omni_trajectories.h):
+//               R1..R12, G1..G12, B1..B12 (v = 0.35 m/s, 1 m, |omega| 0.35 rad/s) and one turn
+//               on the spot each way (S-ccw, S-cw), which excites the yaw alone.
 //
 // The true robot (DefaultTrueParameters): every free parameter moved from its nominal value a
 // fraction f of the way to its upper bound (1st, 3rd, ... free parameter) or to its lower bound

@@ -44,21 +44,11 @@
 #include <vector>
 
 #include "models/model_interface.h"
+#include "models/trajectory_spec.h"
 #include "odometry/effects.h"
 #include "odometry/run_log.h"
 
 namespace fitcal::sim {
-
-struct TwistSegment {
-  Twist twist;
-  double duration_s = 0.0;
-};
-
-struct TrajectorySpec {
-  std::string label;  // the data set's trajectory label; repetitions share it
-  int repetition = 1;
-  std::vector<TwistSegment> segments;
-};
 
 // The flower simulator's physics (Palacin's APR-02 as data/flower was made; stepped_run.h): a
 // time-stepped run in which a wheel controller follows the NOMINAL robot's inverse kinematics

@@ -21,7 +21,8 @@ struct ScenarioNoise {
   double start_position_range_m = 2.0;
 };
 
-// The models that have calibration trajectories (model_scenarios.cc): "diff_drive, omni, tricycle".
+// The registered models that have calibration trajectories (ModelExtras::scenario), sorted:
+// "diff_drive, omni, tricycle".
 std::string ScenarioModelNames();
 
 }  // namespace fitcal::sim

@@ -1,4 +1,4 @@
-#include "tools/sim/diff_drive_trajectories.h"
+#include "models/diff_drive/diff_drive_trajectories.h"
 
 #include <cmath>
 #include <cstdio>

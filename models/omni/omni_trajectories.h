@@ -1,13 +1,13 @@
 #pragma once
 // Palacin et al. 2022's "flower" calibration trajectories (Fig. 9, Table A1;
-// tools/sim/flower_trajectories.h, which defines them) for any holonomic robot and the generic
+// models/omni/flower_trajectories.h, which defines them) for any holonomic robot and the generic
 // simulator (model_simulator.h): the R, G and B families in n directions of the robot frame, each
 // run as one twist segment (FlowerSpecs). With n = 12 and the defaults these are Table A1's 36
 // trajectories. Optional spins on the spot (S-ccw, S-cw) excite the yaw alone.
 
 #include <vector>
 
-#include "tools/sim/model_simulator.h"
+#include "models/trajectory_spec.h"
 
 namespace fitcal::sim {
 

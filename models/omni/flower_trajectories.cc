@@ -1,4 +1,4 @@
-#include "tools/sim/flower_trajectories.h"
+#include "models/omni/flower_trajectories.h"
 
 #include <cmath>
 #include <stdexcept>

@@ -24,7 +24,7 @@
 
 #include <vector>
 
-#include "tools/sim/model_simulator.h"
+#include "models/trajectory_spec.h"
 
 namespace fitcal::sim {
 

@@ -1,4 +1,4 @@
-#include "tools/sim/tricycle_trajectories.h"
+#include "models/tricycle/tricycle_trajectories.h"
 
 #include <cmath>
 #include <cstdio>

@@ -1,8 +1,8 @@
-#include "tools/sim/omni_trajectories.h"
+#include "models/omni/omni_trajectories.h"
 
 #include <utility>
 
-#include "tools/sim/flower_trajectories.h"
+#include "models/omni/flower_trajectories.h"
 
 namespace fitcal::sim {
 

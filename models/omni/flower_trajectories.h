@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "tools/sim/model_simulator.h"
+#include "models/trajectory_spec.h"
 
 namespace fitcal::sim {
 

@@ -1,0 +1,92 @@
+#pragma once
+// What a model offers beyond the seam, registered with it (model_registry.h,
+// ModelRegistration::extras) from its own folder: the ROS 2 controllers it can be exported to,
+// the trajectories the simulator calibrates it on, how `compare` shows its parameters, and the
+// older paths two commands still take for it. Every field is optional. The commands ask the
+// registry for these and never compare a model's name (STYLE.md habit 14).
+
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "models/model_interface.h"
+#include "models/trajectory_spec.h"
+
+namespace fitcal {
+
+// What a controller's parameters are, and what the controller computes from them as written
+// (12 significant digits), for the export's replay: the calibrated model at the representable
+// values, or a model of the controller's own geometry (tools/export_ros2_control.h).
+struct ControllerExport {
+  std::string parameters_yaml;     // `<node>:\n  ros__parameters:\n    ...` without the comments
+  std::vector<std::string> notes;  // one line per parameter the controller cannot represent
+  RobotModelPtr model;
+  std::vector<double> parameters;  // model->robot().parameters order
+};
+
+// The calibrated robot a writer reads, and the joint of each channel.
+struct CalibratedRobot {
+  RobotModelPtr model;
+  std::vector<std::string> joints;  // robot channel order
+  const Robot& robot() const { return model->robot(); }
+  // The calibrated value of a parameter, found by name in the model's parameter table.
+  int Index(const std::string& name) const { return RequireParameterIndex(robot(), name); }
+  const std::string& ChannelName(int i) const { return robot().channels[i].name; }
+};
+
+// A geometry the controller cannot describe at all (mecanum rollers the wrong way): the command
+// refuses it as a usage error (exit 2).
+class ControllerCannotDescribe : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Appends the parameter lines and notes to `out` and sets the controller's kinematics; throws
+// ControllerCannotDescribe.
+using ControllerWriteFn =
+    std::function<void(const CalibratedRobot&, const std::string& distro, ControllerExport* out)>;
+
+struct ControllerWriter {
+  std::string controller;  // ros2_controllers' name, e.g. "diff_drive_controller"
+  std::string distros;     // the ROS 2 distributions that ship it, space-separated
+  ControllerWriteFn write;
+};
+
+// The trajectories `simulate --model` drives the model on (tools/sim/model_scenarios.h), and
+// how far its default true robot is from the nominal one (a fraction of the way to the bounds).
+struct SimulationScenario {
+  std::function<std::vector<sim::TrajectorySpec>(const Robot& nominal, int repetitions)>
+      trajectories;  // empty: the model has no scenario
+  double truth_fraction = 0.25;
+};
+
+// How `compare` shows a row's parameters (its Markdown column and CSV columns).
+struct ParameterDisplay {
+  std::string markdown_header;
+  std::vector<std::string> csv_names;
+  std::function<std::vector<double>(const std::vector<double>&)> csv_values;
+  std::function<std::string(const std::vector<double>&)> markdown;
+};
+
+struct ModelExtras {
+  std::vector<ControllerWriter> controllers;
+  SimulationScenario scenario;
+  // Empty: the parameters in display units (m, deg).
+  std::function<ParameterDisplay(const Robot&)> display;
+  // `simulate` without --model drives it with the stepped flower engine
+  // (tools/sim/flower_scenario.h) instead of a scenario: data/flower's bytes come from there.
+  bool legacy_simulator = false;
+  // `compare` loads its runs through the three-wheel encoder loader (io/dataset.h) and runs
+  // Palacin's strategies STA..STE by default.
+  bool legacy_loader = false;
+};
+
+// A controller writer's notes, shared by the writers of every model.
+double MeanValue(const std::vector<double>& v);
+// "<key> takes one <what>: the calibrated lo..hi <unit> are written as their mean" when the
+// values differ.
+void NoteSpread(const std::vector<double>& v, const std::string& what, const std::string& key,
+                double scale, const char* unit, std::vector<std::string>* notes);
+
+}  // namespace fitcal

@@ -1,0 +1,60 @@
+#include "models/omni3/omni3_extras.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "models/omni/omni_extras.h"
+#include "models/omni3/omni3_parameters.h"
+
+namespace fitcal {
+
+namespace {
+
+std::string MatrixText(const Eigen::Matrix3d& m) {
+  std::string out = "[";
+  char value[64];
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) {
+      std::snprintf(value, sizeof value, "%.4f", m(r, c));
+      out += std::string(std::isnan(m(r, c)) ? "-" : value) + (c < 2 ? " " : "");
+    }
+    out += r < 2 ? "; " : "]";
+  }
+  return out;
+}
+
+// The M^-1 of Palacin Eq. 6: Table 4's column, and what firmware takes.
+ParameterDisplay InverseKinematicMatrixColumns(const Robot& /*robot*/) {
+  ParameterDisplay c;
+  c.markdown_header = "M^-1";
+  for (int r = 0; r < 3; ++r) {
+    for (int k = 0; k < 3; ++k)
+      c.csv_names.push_back("m_inv_" + std::to_string(r) + std::to_string(k));
+  }
+  c.csv_values = [](const std::vector<double>& p) {
+    const Eigen::Matrix3d m = omni3::InverseKinematicMatrix(p.data());
+    std::vector<double> out;
+    for (int r = 0; r < 3; ++r) {
+      for (int k = 0; k < 3; ++k) out.push_back(m(r, k));
+    }
+    return out;
+  };
+  c.markdown = [](const std::vector<double>& p) {
+    return MatrixText(omni3::InverseKinematicMatrix(p.data()));
+  };
+  return c;
+}
+
+}  // namespace
+
+ModelExtras Omni3Extras() {
+  ModelExtras extras;
+  // Wheels tangential by construction: the replay sets its own R_, r_, delta_ by name.
+  extras.controllers = {OmniWheelController(OmniWheelReplay::kOwnModelByName)};
+  extras.display = &InverseKinematicMatrixColumns;
+  extras.legacy_simulator = true;
+  extras.legacy_loader = true;
+  return extras;
+}
+
+}  // namespace fitcal
