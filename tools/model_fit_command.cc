@@ -696,6 +696,16 @@ class FoldFits {
   std::map<std::string, std::optional<std::vector<double>>> done_;
 };
 
+// The fit of all the training runs with `settings` into *full; the folds' fits start from it.
+void FitAllTrainingRuns(const FitMethod& method, const RobotModelInterface& model,
+                        const RunSplit& split, const FitMethodSettings& settings,
+                        std::optional<ModelFitMethodOutcome>* full, FoldFits* fold_fits) {
+  full->emplace(method.run_model(split.training, model, settings));
+  const ModelFitResult& whole = (*full)->fit;
+  if (whole.usable || whole.stopped_early) fold_fits->start = whole.parameters;
+  fold_fits->seed_levels = whole.noise_levels;
+}
+
 // --residuals auto proposing the track: the track and the final pose are fitted and judged on
 // kinds of run they were not fitted on (validation/residual_kind_transfer.h); the final pose
 // replaces the track when that judgement says so (settings and *track_data follow). The folds'
@@ -712,10 +722,7 @@ std::vector<std::string> ChooseResidualsByTransfer(const FitCommandOptions& opti
                                                    std::optional<ModelFitMethodOutcome>* full,
                                                    FoldFits* fold_fits) {
   if (!settings->residuals_auto || settings->residuals != ResidualKind::kTrack) return {};
-  full->emplace(method.run_model(split.training, model, *settings));
-  const ModelFitResult& whole = (*full)->fit;
-  if (whole.usable || whole.stopped_early) fold_fits->start = whole.parameters;
-  fold_fits->seed_levels = whole.noise_levels;
+  FitAllTrainingRuns(method, model, split, *settings, full, fold_fits);
   const FitByKind fit_on = [&](ResidualKind kind, const std::vector<AlignedRun>& training) {
     FitMethodSettings s = *settings;
     s.residuals = kind;
@@ -764,6 +771,9 @@ std::vector<std::string> ChooseTrackObjectiveByTransfer(
     FoldFits* fold_fits, std::string* note) {
   if (!settings->weights_auto && !settings->track_heading_auto) return {};
   if (settings->residuals == ResidualKind::kFinalPose) return {};
+  // The default candidate's fit of all the runs (unless the residual choice made it): the folds'
+  // start, and the fit written when the default is kept.
+  if (!*full) FitAllTrainingRuns(method, model, split, *settings, full, fold_fits);
   const FitByTrackObjective fit_on = [&](const TrackObjective& objective,
                                          const std::vector<AlignedRun>& training) {
     FitMethodSettings s = *settings;
