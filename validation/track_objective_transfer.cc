@@ -75,11 +75,16 @@ std::string TrackObjectiveChoiceText(const TrackObjectiveJudgement& j) {
   if (!j.judged) return "";
   const PooledTransfer& d = j.pooled[0];
   const PooledTransfer& c = j.pooled[j.chosen];
-  return StrFormat("; %s %s by transfer (pooled over %s: CF %.4f -> %.4f, drift 2 m %.3f -> "
+  if (j.chosen == 0) {
+    return StrFormat("; %s kept by transfer (pooled over %s: CF %.4f, drift 2 m %.3f %%, ATE "
+                     "%.4f m; no other lower on all three)",
+                     ToString(j.candidates[0]).c_str(), j.judged_on.c_str(), d.cf, d.drift_percent,
+                     d.ate_rmse_m);
+  }
+  return StrFormat("; %s chosen by transfer (pooled over %s: CF %.4f -> %.4f, drift 2 m %.3f -> "
                    "%.3f %%, ATE %.4f -> %.4f m against the default)",
-                   ToString(j.candidates[j.chosen]).c_str(), j.chosen == 0 ? "kept" : "chosen",
-                   j.judged_on.c_str(), d.cf, c.cf, d.drift_percent, c.drift_percent,
-                   d.ate_rmse_m, c.ate_rmse_m);
+                   ToString(j.candidates[j.chosen]).c_str(), j.judged_on.c_str(), d.cf, c.cf,
+                   d.drift_percent, c.drift_percent, d.ate_rmse_m, c.ate_rmse_m);
 }
 
 std::vector<std::string> TrackObjectiveJudgementLines(const TrackObjectiveJudgement& j) {

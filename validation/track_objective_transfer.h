@@ -62,7 +62,7 @@ TrackObjectiveJudgement JudgeTrackObjectivesByTransfer(
 
 // What the calibration's objective records of the choice: "; weights fixed, heading increments
 // chosen by transfer (pooled over circular (44), square (33): CF 0.0521 -> 0.0513, ...)"; the
-// default "kept by transfer" likewise; empty when not judged.
+// default "kept by transfer (pooled over ...: CF 0.1545, ...)"; empty when not judged.
 std::string TrackObjectiveChoiceText(const TrackObjectiveJudgement& judgement);
 
 // The table and the verdict with its reason, one line each; none when not judged.
