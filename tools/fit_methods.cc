@@ -202,6 +202,7 @@ bool MakeFitMethodSettings(const SolverOptions& o, int threads, FitMethodSetting
   s->max_iterations = o.max_iterations;
   s->weights = o.Weights();
   s->estimate_weights = o.weight_mode == "estimated" && !o.sigmas_given;
+  s->weights_auto = o.weight_mode == "auto" && !o.sigmas_given;  // a sigma given fixes them
   s->objective_set = !o.objective.empty();
   if (s->objective_set && !ParseFinalPoseObjective(o.objective, &s->objective)) {
     *error = "unknown --objective '" + o.objective + "' (available: squares, eq14)";
@@ -217,9 +218,10 @@ bool MakeFitMethodSettings(const SolverOptions& o, int threads, FitMethodSetting
     *error = "unknown --clock-offsets '" + o.clock_offsets + "' (available: session, run, dataset, none)";
     return false;
   }
-  if (!ParseTrackHeading(o.track_heading, &s->track_heading)) {
+  s->track_heading_auto = o.track_heading == "auto";
+  if (!s->track_heading_auto && !ParseTrackHeading(o.track_heading, &s->track_heading)) {
     *error = "unknown --track-heading '" + o.track_heading +
-             "' (available: from-start, increments)";
+             "' (available: from-start, increments, auto)";
     return false;
   }
   if (!ParseCeresRobustLoss(o.loss, &s->loss)) {

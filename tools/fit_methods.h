@@ -26,6 +26,11 @@ struct FitMethodSettings {
   // Ceres with track residuals: weights from noise levels estimated by the fit (fit/noise_levels.h);
   // `weights` start it. Off when the user gave a sigma.
   bool estimate_weights = true;
+  // --weights auto / --track-heading auto: the track objective chosen by transfer among those the
+  // flags allow (validation/track_objective_transfer.h); estimate_weights and track_heading hold
+  // the default candidate's until the command chooses.
+  bool weights_auto = false;
+  bool track_heading_auto = false;
   // Ceres: kSumOfSquares by default; NLopt: Eq. 14 by default (see the option docs).
   bool objective_set = false;
   FinalPoseObjective objective = FinalPoseObjective::kSumOfSquares;

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <map>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <unordered_map>
@@ -36,6 +38,7 @@
 #include "validation/residual_dof.h"
 #include "validation/residual_kind_transfer.h"
 #include "validation/statistics.h"
+#include "validation/track_objective_transfer.h"
 #include "validation/training_runs.h"
 #include "validation/trajectory_family.h"
 #include "validation/trajectory_metrics.h"
@@ -649,6 +652,60 @@ void PrintEverydayDriving(const RobotModelInterface& model, const std::vector<Ru
       {&nominal.parameters, &nominal.effects}, {&selected.parameters, &selected.effects}, threads);
 }
 
+// The fits of the folds the choices by transfer make (residual kind, then track objective), each
+// made once: the track with the default objective on a fold is a candidate of both.
+class FoldFits {
+ public:
+  // `s` fitted on `training` from `start` (the fit of all the training runs), its weights seeded
+  // by that fit's noise levels when it estimated them; nullopt when not usable.
+  std::optional<std::vector<double>> Fit(const FitCommandOptions& options, const FitMethod& method,
+                                         const RobotModelInterface& model,
+                                         const std::vector<RunLog>& logs, FitMethodSettings s,
+                                         const std::vector<AlignedRun>& training) {
+    std::string key = std::string(ToString(s.residuals)) + (s.estimate_weights ? " est " : " fix ") +
+                      ToString(s.track_heading);
+    for (const AlignedRun& run : training) key += " " + run.id;
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      if (const auto found = done_.find(key); found != done_.end()) return found->second;
+    }
+    s.residuals_auto = false;
+    s.track = nullptr;
+    s.start = start;
+    if (s.estimate_weights && seed_levels.estimated) {
+      s.track_weights = WeightsFromNoiseLevels(seed_levels).track;
+    }
+    RunSplit part;
+    part.training = training;
+    std::optional<TrackFitData> data;
+    std::optional<std::vector<double>> out;
+    if (PrepareTrackResiduals(options, logs, part, &s, &data)) {
+      const ModelFitResult fit = method.run_model(training, model, s).fit;
+      if (fit.usable || fit.stopped_early) out = fit.parameters;
+    }
+    const std::lock_guard<std::mutex> lock(mutex_);
+    done_[key] = out;
+    return out;
+  }
+
+  std::vector<double> start;  // empty: the nominal
+  NoiseLevels seed_levels;
+
+ private:
+  std::mutex mutex_;
+  std::map<std::string, std::optional<std::vector<double>>> done_;
+};
+
+// The fit of all the training runs with `settings` into *full; the folds' fits start from it.
+void FitAllTrainingRuns(const FitMethod& method, const RobotModelInterface& model,
+                        const RunSplit& split, const FitMethodSettings& settings,
+                        std::optional<ModelFitMethodOutcome>* full, FoldFits* fold_fits) {
+  full->emplace(method.run_model(split.training, model, settings));
+  const ModelFitResult& whole = (*full)->fit;
+  if (whole.usable || whole.stopped_early) fold_fits->start = whole.parameters;
+  fold_fits->seed_levels = whole.noise_levels;
+}
+
 // --residuals auto proposing the track: the track and the final pose are fitted and judged on
 // kinds of run they were not fitted on (validation/residual_kind_transfer.h); the final pose
 // replaces the track when that judgement says so (settings and *track_data follow). The folds'
@@ -662,29 +719,14 @@ std::vector<std::string> ChooseResidualsByTransfer(const FitCommandOptions& opti
                                                    const std::vector<RunLog>& logs,
                                                    FitMethodSettings* settings,
                                                    std::optional<TrackFitData>* track_data,
-                                                   std::optional<ModelFitMethodOutcome>* full) {
+                                                   std::optional<ModelFitMethodOutcome>* full,
+                                                   FoldFits* fold_fits) {
   if (!settings->residuals_auto || settings->residuals != ResidualKind::kTrack) return {};
-  full->emplace(method.run_model(split.training, model, *settings));
-  const ModelFitResult& whole = (*full)->fit;
-  const std::vector<double> start =
-      whole.usable || whole.stopped_early ? whole.parameters : std::vector<double>{};
-  const FitByKind fit_on = [&](ResidualKind kind, const std::vector<AlignedRun>& training)
-      -> std::optional<std::vector<double>> {
+  FitAllTrainingRuns(method, model, split, *settings, full, fold_fits);
+  const FitByKind fit_on = [&](ResidualKind kind, const std::vector<AlignedRun>& training) {
     FitMethodSettings s = *settings;
-    s.residuals_auto = false;
     s.residuals = kind;
-    s.track = nullptr;
-    s.start = start;
-    if (whole.noise_levels.estimated) {
-      s.track_weights = WeightsFromNoiseLevels(whole.noise_levels).track;
-    }
-    RunSplit part;
-    part.training = training;
-    std::optional<TrackFitData> data;
-    if (!PrepareTrackResiduals(options, logs, part, &s, &data)) return std::nullopt;
-    const ModelFitResult fit = method.run_model(training, model, s).fit;
-    if (!(fit.usable || fit.stopped_early)) return std::nullopt;
-    return fit.parameters;
+    return fold_fits->Fit(options, method, model, logs, s, training);
   };
   const ScoreOnRuns score = [&](const std::vector<double>& p, const std::vector<AlignedRun>& runs) {
     return EvaluateEverydayDriving(model, p, {}, runs, TracksOf(logs, runs), EverydayDriftLengths(),
@@ -699,6 +741,63 @@ std::vector<std::string> ChooseResidualsByTransfer(const FitCommandOptions& opti
     full->reset();
   }
   return ResidualKindJudgementLines(judgement);
+}
+
+// The track objectives --weights auto / --track-heading auto allow, the default first (weights
+// fixed unless --weights estimated, heading from the start unless given).
+std::vector<TrackObjective> TrackObjectiveCandidates(const FitMethodSettings& settings) {
+  const std::vector<bool> weights =
+      settings.weights_auto ? std::vector<bool>{false, true}
+                            : std::vector<bool>{settings.estimate_weights};
+  const std::vector<TrackHeading> headings =
+      settings.track_heading_auto
+          ? std::vector<TrackHeading>{TrackHeading::kFromStart, TrackHeading::kIncrements}
+          : std::vector<TrackHeading>{settings.track_heading};
+  std::vector<TrackObjective> out;
+  for (TrackHeading heading : headings) {
+    for (bool estimate : weights) out.push_back({estimate, heading});
+  }
+  return out;
+}
+
+// --weights auto / --track-heading auto on track residuals: the candidates fitted and judged by
+// transfer (validation/track_objective_transfer.h), each fold's fit started from the fit of all
+// the training runs when the residual choice made one; settings, *track_data and *full follow the
+// choice. The lines for the terminal, and in *note what the calibration's objective records.
+std::vector<std::string> ChooseTrackObjectiveByTransfer(
+    const FitCommandOptions& options, const FitMethod& method, const RobotModelInterface& model,
+    const RunSplit& split, const std::vector<RunLog>& logs, FitMethodSettings* settings,
+    std::optional<TrackFitData>* track_data, std::optional<ModelFitMethodOutcome>* full,
+    FoldFits* fold_fits, std::string* note) {
+  if (!settings->weights_auto && !settings->track_heading_auto) return {};
+  if (settings->residuals == ResidualKind::kFinalPose) return {};
+  // The default candidate's fit of all the runs (unless the residual choice made it): the folds'
+  // start, and the fit written when the default is kept.
+  if (!*full) FitAllTrainingRuns(method, model, split, *settings, full, fold_fits);
+  const FitByTrackObjective fit_on = [&](const TrackObjective& objective,
+                                         const std::vector<AlignedRun>& training) {
+    FitMethodSettings s = *settings;
+    s.estimate_weights = objective.estimate_weights;
+    s.track_heading = objective.heading;
+    return fold_fits->Fit(options, method, model, logs, s, training);
+  };
+  const ScoreOnRuns score = [&](const std::vector<double>& p, const std::vector<AlignedRun>& runs) {
+    return EvaluateEverydayDriving(model, p, {}, runs, TracksOf(logs, runs), EverydayDriftLengths(),
+                                   options.threads);
+  };
+  const TrackObjectiveJudgement judgement = JudgeTrackObjectivesByTransfer(
+      TrackObjectiveCandidates(*settings), split, fit_on, score);
+  *note = TrackObjectiveChoiceText(judgement);
+  if (judgement.chosen != 0) {
+    const TrackObjective& chosen = judgement.candidates[judgement.chosen];
+    settings->estimate_weights = chosen.estimate_weights;
+    settings->track_heading = chosen.heading;
+    settings->track = nullptr;
+    track_data->reset();
+    full->reset();
+    if (!PrepareTrackResiduals(options, logs, split, settings, track_data)) return {};
+  }
+  return TrackObjectiveJudgementLines(judgement);
 }
 
 // A calibration better than the nominal on the held-out runs as a whole may still be worse on
@@ -1051,11 +1150,22 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   if (!PrepareTrackResiduals(options, logs, split, &settings, &track_data)) return 2;
   // The fit of all the training runs when the choice by transfer made it (and kept its kind).
   std::optional<ModelFitMethodOutcome> chosen_fit;
+  FoldFits fold_fits;
   const std::vector<std::string> residual_choice =
-      effects_to_fit->empty() ? ChooseResidualsByTransfer(options, *method, *model, split, logs,
-                                                          &settings, &track_data, &chosen_fit)
-                              : std::vector<std::string>{};
+      effects_to_fit->empty()
+          ? ChooseResidualsByTransfer(options, *method, *model, split, logs, &settings,
+                                      &track_data, &chosen_fit, &fold_fits)
+          : std::vector<std::string>{};
   std::vector<std::string> residual_lines = residual_choice;
+  std::string objective_note;
+  if (effects_to_fit->empty()) {
+    for (const std::string& line :
+         ChooseTrackObjectiveByTransfer(options, *method, *model, split, logs, &settings,
+                                        &track_data, &chosen_fit, &fold_fits,
+                                        &objective_note)) {
+      residual_lines.push_back(line);
+    }
+  }
   for (const std::string& note : FlagsTheChoiceLeavesUnused(options, settings)) {
     residual_lines.push_back(note);
   }
@@ -1085,7 +1195,8 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
                  : "";
   const CalibrationCandidate& selected = candidates[gate.selected];
   SelectedFit selected_fit = DescribeSelected(robot, candidates, gate.selected, options.method,
-                                              outcome.objective, fit, track_fits);
+                                              outcome.objective + objective_note, fit,
+                                              track_fits);
   if (gate.selected != 0 && !options.no_output &&
       !AddPropagatedUncertainty(*model, selected, split.training, &selected_fit)) {
     return 1;

@@ -30,7 +30,9 @@ void AddSolverOptions(CLI::App& app, SolverOptions& o) {
       ->capture_default_str();
   app.add_option("--track-heading", o.track_heading,
                  "Track residuals: the heading compared from the run's start (from-start) or as "
-                 "its increment over each checkpoint spacing (increments)")
+                 "its increment over each checkpoint spacing (increments), or auto: the one "
+                 "that transfers better to runs of a kind it was not fitted on "
+                 "(docs/everyday_driving.md)")
       ->capture_default_str();
   app.add_option("--loss", o.loss, "Ceres robust loss: none, huber, cauchy")->capture_default_str();
   app.add_option("--loss-scale", o.loss_scale, "Robust loss scale (residual units: m and rad)")
@@ -47,9 +49,10 @@ void AddSolverOptions(CLI::App& app, SolverOptions& o) {
   app.add_option("--weights", o.weight_mode,
                  "Track residuals: fixed (the sigmas below) or estimated (noise levels of "
                  "position and heading estimated from the fit itself, printed and written into "
-                 "the calibration's objective; docs/everyday_driving.md)")
+                 "the calibration's objective; docs/everyday_driving.md), or auto: the one that "
+                 "transfers better to runs of a kind it was not fitted on")
       ->capture_default_str()
-      ->check(CLI::IsMember({"fixed", "estimated"}));
+      ->check(CLI::IsMember({"fixed", "estimated", "auto"}));
   const auto given = [&o](const std::string&) { o.sigmas_given = true; };
   app.add_option("--position-sigma-m", o.position_sigma_m,
                  "Weight of the position residual as a standard deviation (m); with the default "

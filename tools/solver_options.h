@@ -19,8 +19,11 @@ struct SolverOptions {
   std::string residuals = "auto";
   // Track residuals: one clock offset per session, run, data set, or none (all held at 0).
   std::string clock_offsets = "none";
-  // Track residuals: the heading from the run's start, or its increments between checkpoints.
-  std::string track_heading = "from-start";
+  // Track residuals: the heading from the run's start, its increments between checkpoints, or
+  // auto: the one that transfers better to a kind of run it was not fitted on
+  // (validation/track_objective_transfer.h; from the start unless increments are better on the
+  // pooled CF, drift and ATE alike).
+  std::string track_heading = "auto";
   std::string loss = "none";    // Ceres: none, huber, cauchy
   double loss_scale = 0.05;     // Ceres robust loss scale, residual units
   unsigned long seed = 1;       // NLopt
@@ -31,8 +34,9 @@ struct SolverOptions {
   // Palacin Eq. 14's CF does. With weight_mode = "estimated", track residuals (and `both`) are
   // weighed by noise levels estimated from the fit (fit/noise_levels.h) unless a sigma is given
   // (sigmas_given). Default "fixed": on the shared OptiOdom free runs the estimate helped the
-  // differential drive and cost omni3 more (docs/everyday_driving.md), so it is opt-in until the
-  // choice is made by transfer.
+  // differential drive and cost omni3 more (docs/everyday_driving.md); "auto" chooses by
+  // transfer as --track-heading auto does, opt-in (on the shared OptiOdom loops it chose the fixed
+  // weights on every robot, at twice the candidate fits).
   std::string weight_mode = "fixed";
   double position_sigma_m = 1.0;
   double heading_sigma_deg = 180.0 / 3.14159265358979323846;

@@ -12,13 +12,6 @@ namespace fitcal {
 namespace {
 
 constexpr const char* kFreeDriving = "free";
-constexpr double kJudgedDriftLength_m = 2.0;  // the everyday window between 1 and 5 m
-
-const DriftAtLength* DriftAt(const EverydayDrivingMetrics& m, double length_m) {
-  for (const DriftAtLength& d : m.drift)
-    if (std::abs(d.length_m - length_m) < 1e-9 && d.windows > 0) return &d;
-  return nullptr;
-}
 
 // Counts the comparisons of one kind of run (CF, drift per 2 m where it has windows, ATE) and
 // those the alternative wins (strictly lower).
@@ -28,41 +21,10 @@ void CountWins(const KindComparison& c, int* wins, int* total) {
     if (alternative < proposed) ++*wins;
   };
   count(c.proposed.cf, c.alternative.cf);
-  const DriftAtLength* p = DriftAt(c.proposed, kJudgedDriftLength_m);
-  const DriftAtLength* a = DriftAt(c.alternative, kJudgedDriftLength_m);
+  const DriftAtLength* p = DriftAt(c.proposed, kTransferDriftLength_m);
+  const DriftAtLength* a = DriftAt(c.alternative, kTransferDriftLength_m);
   if (p != nullptr && a != nullptr) count(p->translation_percent, a->translation_percent);
   count(c.proposed.mean_ate_rmse_m, c.alternative.mean_ate_rmse_m);
-}
-
-// One comparison to make: both kinds fitted on `training`, judged on `judged`.
-struct PendingComparison {
-  KindComparison comparison;
-  std::vector<AlignedRun> training, judged;
-  std::future<std::optional<std::vector<double>>> proposed, alternative;
-};
-
-// Every fit of every comparison at once, each on a thread of its own (the folds are independent;
-// the caller's fits may start from a fit of all runs, so each ends in a few steps), then the
-// scores; false when a fit is not usable.
-bool FitAndScore(ResidualKind proposed, ResidualKind alternative, const FitByKind& fit_on,
-                 const ScoreOnRuns& score, std::vector<PendingComparison>* pending,
-                 std::vector<KindComparison>* out) {
-  for (PendingComparison& c : *pending) {
-    c.proposed = std::async(std::launch::async, fit_on, proposed, std::cref(c.training));
-    c.alternative = std::async(std::launch::async, fit_on, alternative, std::cref(c.training));
-  }
-  bool usable = true;
-  for (PendingComparison& c : *pending) {
-    const std::optional<std::vector<double>> p = c.proposed.get();
-    const std::optional<std::vector<double>> a = c.alternative.get();
-    if (!p || !a) usable = false;
-    if (!usable) continue;
-    c.comparison.runs = static_cast<int>(c.judged.size());
-    c.comparison.proposed = score(*p, c.judged);
-    c.comparison.alternative = score(*a, c.judged);
-    out->push_back(std::move(c.comparison));
-  }
-  return usable;
 }
 
 std::string FamiliesExcept(const std::map<std::string, std::vector<AlignedRun>>& by,
@@ -77,41 +39,79 @@ std::string FamiliesExcept(const std::map<std::string, std::vector<AlignedRun>>&
 
 }  // namespace
 
+const DriftAtLength* DriftAt(const EverydayDrivingMetrics& m, double length_m) {
+  for (const DriftAtLength& d : m.drift)
+    if (std::abs(d.length_m - length_m) < 1e-9 && d.windows > 0) return &d;
+  return nullptr;
+}
+
+TransferFolds MakeTransferFolds(const RunSplit& split) {
+  TransferFolds out;
+  const auto held_out = RunsByFamily(split.validation);
+  if (const auto free = held_out.find(kFreeDriving); free != held_out.end()) {
+    out.on_free_driving = true;
+    out.folds.push_back({kFreeDriving, "all training runs", split.training, free->second});
+    return out;
+  }
+  const auto training = RunsByFamily(split.training);
+  if (training.size() < 2) return out;
+  for (const auto& [family, runs] : training) {
+    TransferFold f;
+    for (const AlignedRun& run : split.training)
+      if (TrajectoryFamily(run.trajectory) != family) f.training.push_back(run);
+    f.judged_on = family;
+    f.fitted_on = FamiliesExcept(training, family);
+    f.judged = runs;
+    out.folds.push_back(std::move(f));
+  }
+  return out;
+}
+
+// The folds are independent and the caller's fits may start from a fit of all runs, so each ends
+// in a few steps: all of them at once.
+std::optional<std::vector<std::vector<EverydayDrivingMetrics>>> FitAndScoreFolds(
+    const std::vector<TransferFold>& folds, int candidates, const FitCandidate& fit_on,
+    const ScoreOnRuns& score) {
+  std::vector<std::vector<std::future<std::optional<std::vector<double>>>>> fits(folds.size());
+  for (std::size_t f = 0; f < folds.size(); ++f) {
+    for (int c = 0; c < candidates; ++c) {
+      fits[f].push_back(std::async(std::launch::async, fit_on, c, std::cref(folds[f].training)));
+    }
+  }
+  std::vector<std::vector<EverydayDrivingMetrics>> scores(folds.size());
+  bool usable = true;
+  for (std::size_t f = 0; f < folds.size(); ++f) {
+    for (auto& fit : fits[f]) {
+      const std::optional<std::vector<double>> p = fit.get();  // every thread joined
+      if (!p) usable = false;
+      if (usable) scores[f].push_back(score(*p, folds[f].judged));
+    }
+  }
+  if (!usable) return std::nullopt;
+  return scores;
+}
+
 ResidualKindJudgement JudgeResidualKindsByTransfer(ResidualKind proposed, ResidualKind alternative,
                                                    const RunSplit& split, const FitByKind& fit_on,
                                                    const ScoreOnRuns& score) {
   ResidualKindJudgement j;
   j.proposed = j.chosen = proposed;
   j.alternative = alternative;
-  std::vector<PendingComparison> pending;
-  const auto held_out = RunsByFamily(split.validation);
-  if (const auto free = held_out.find(kFreeDriving); free != held_out.end()) {
-    PendingComparison c;
-    c.comparison.judged_on = kFreeDriving;
-    c.comparison.fitted_on = "all training runs";
-    c.training = split.training;
-    c.judged = free->second;
-    pending.push_back(std::move(c));
-    j.on_free_driving = true;
-  } else {
-    const auto training = RunsByFamily(split.training);
-    if (training.size() < 2) return j;
-    for (const auto& [family, runs] : training) {
-      PendingComparison c;
-      for (const AlignedRun& run : split.training)
-        if (TrajectoryFamily(run.trajectory) != family) c.training.push_back(run);
-      c.comparison.judged_on = family;
-      c.comparison.fitted_on = FamiliesExcept(training, family);
-      c.judged = runs;
-      pending.push_back(std::move(c));
-    }
+  const TransferFolds folds = MakeTransferFolds(split);
+  if (folds.folds.empty()) return j;
+  const FitCandidate fit_candidate = [&](int c, const std::vector<AlignedRun>& training) {
+    return fit_on(c == 0 ? proposed : alternative, training);
+  };
+  const auto scores = FitAndScoreFolds(folds.folds, 2, fit_candidate, score);
+  if (!scores) return j;
+  j.on_free_driving = folds.on_free_driving;
+  for (std::size_t f = 0; f < folds.folds.size(); ++f) {
+    const TransferFold& fold = folds.folds[f];
+    KindComparison c{fold.judged_on, fold.fitted_on, static_cast<int>(fold.judged.size()),
+                     (*scores)[f][0], (*scores)[f][1]};
+    CountWins(c, &j.alternative_wins, &j.total);
+    j.comparisons.push_back(std::move(c));
   }
-  if (!FitAndScore(proposed, alternative, fit_on, score, &pending, &j.comparisons)) {
-    j.comparisons.clear();
-    j.on_free_driving = false;
-    return j;
-  }
-  for (const KindComparison& c : j.comparisons) CountWins(c, &j.alternative_wins, &j.total);
   j.judged = j.total > 0;
   const bool replaces = j.on_free_driving ? 2 * j.alternative_wins > j.total
                                           : j.alternative_wins == j.total;
@@ -131,8 +131,8 @@ std::vector<std::string> ResidualKindJudgementLines(const ResidualKindJudgement&
                 "CF", "drift 2 m [%]", "ATE RMSE [m]");
   lines.push_back(line);
   for (const KindComparison& c : j.comparisons) {
-    const DriftAtLength* p = DriftAt(c.proposed, kJudgedDriftLength_m);
-    const DriftAtLength* a = DriftAt(c.alternative, kJudgedDriftLength_m);
+    const DriftAtLength* p = DriftAt(c.proposed, kTransferDriftLength_m);
+    const DriftAtLength* a = DriftAt(c.alternative, kTransferDriftLength_m);
     char drift[64] = "-";
     if (p != nullptr && a != nullptr)
       std::snprintf(drift, sizeof(drift), "%.3f | %.3f", p->translation_percent,

@@ -37,6 +37,36 @@ using FitByKind = std::function<std::optional<std::vector<double>>(
 using ScoreOnRuns = std::function<EverydayDrivingMetrics(const std::vector<double>& parameters,
                                                          const std::vector<AlignedRun>& runs)>;
 
+// One comparison of candidate fits: the kind of run judged and the training runs the candidates
+// are fitted on - held-out free driving (one fold: every training run, judged on the free runs),
+// else one fold per kind of training run (fitted on the other kinds, judged on it).
+struct TransferFold {
+  std::string judged_on;  // the trajectory family judged on ("free", "circular", ...)
+  std::string fitted_on;  // what the fits saw, in words
+  std::vector<AlignedRun> training, judged;
+};
+struct TransferFolds {
+  bool on_free_driving = false;
+  std::vector<TransferFold> folds;  // empty: nothing to judge on
+};
+TransferFolds MakeTransferFolds(const RunSplit& split);
+
+// Candidate `candidate` (0 .. n-1) fitted on `training`; nullopt when that fit is not usable.
+using FitCandidate = std::function<std::optional<std::vector<double>>(
+    int candidate, const std::vector<AlignedRun>& training)>;
+// Every candidate fitted on every fold at once, each fit on a thread of its own (`fit_on` must be
+// safe to call concurrently), then scored on the fold's judged runs: [fold][candidate]. Nullopt
+// when some fit is not usable. Shared by every choice by transfer (residual kind, track
+// objective: validation/track_objective_transfer.h).
+std::optional<std::vector<std::vector<EverydayDrivingMetrics>>> FitAndScoreFolds(
+    const std::vector<TransferFold>& folds, int candidates, const FitCandidate& fit_on,
+    const ScoreOnRuns& score);
+
+// The drift per `length_m` of `m` when it has windows there, else nullptr.
+const DriftAtLength* DriftAt(const EverydayDrivingMetrics& m, double length_m);
+// The everyday window judged between 1 and 5 m.
+inline constexpr double kTransferDriftLength_m = 2.0;
+
 // One kind of run judged: each residual kind's measures on it, fitted without it.
 struct KindComparison {
   std::string judged_on;   // the trajectory family judged on ("free", "circular", ...)
