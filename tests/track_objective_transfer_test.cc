@@ -14,11 +14,11 @@
 #include <string>
 #include <vector>
 
+#include "models/diff_drive/diff_drive_trajectories.h"
 #include "models/model_registry.h"
 #include "tests/model_support.h"
 #include "tests/test_files.h"
 #include "tests/test_paths.h"
-#include "tools/sim/diff_drive_trajectories.h"
 #include "tools/sim/model_simulator.h"
 #include "validation/trajectory_family.h"
 
