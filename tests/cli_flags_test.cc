@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -385,6 +386,31 @@ TEST(ExportForce, ReplacesOnlyWhenAsked) {
   const FitcalRun forced = RunFitcal(tmp, args + " --node-name other --force");
   ASSERT_EQ(forced.exit_code, 0) << forced.err;
   EXPECT_TRUE(YAML::LoadFile(out)["other"]) << ReadFileBytes(out);
+}
+
+// compare fits final poses only: the track's flags are not its flags (issue 41: it declared them
+// and ignored them - `slsqp --residuals track` gave the final-pose table). Refused, one line,
+// exit 2, nothing written; the final-pose weights it does use (--heading-sigma-deg) still change
+// its fit: Eq. 14's 1 m : 1 rad against a heading weighed 100x more moves the flower's CF.
+TEST(CompareFlags, TrackFlagsAreRefusedAndTheFinalPoseWeightsApply) {
+  TempDir tmp;
+  const std::string base = "compare --logs " + kFlower + " --methods ceres --repetitions 2 ";
+  for (const std::string flag : {"--residuals track", "--clock-offsets run",
+                                 "--track-heading increments", "--weights estimated"}) {
+    const FitcalRun refused = RunFitcal(tmp, base + flag + " --out " + tmp.Path("c"));
+    EXPECT_EQ(refused.exit_code, 2) << flag << "\n" << refused.out;
+    EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+    EXPECT_TRUE(Has(refused.err, flag.substr(0, flag.find(' ')))) << refused.err;
+    for (const char* ext : {".csv", ".md", "_trace.csv"}) {
+      EXPECT_FALSE(fs::exists(tmp.Path(std::string("c") + ext))) << flag << ext;
+    }
+  }
+  const auto cf_of = [&](const std::string& extra) {
+    const FitcalRun run = RunFitcal(tmp, base + extra + " --no-output --quiet");
+    EXPECT_EQ(run.exit_code, 0) << run.err;
+    return run.out;
+  };
+  EXPECT_NE(cf_of(""), cf_of("--heading-sigma-deg 0.573"));
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -16,6 +16,7 @@ void AddFitOptions(CLI::App& app, FitCommandOptions& o) {
   AddDatasetOptions(app, o, LogsFlag::kCheckedByCommand);
   app.add_option("--method", o.method, "Solver: " + FitMethodNames())->capture_default_str();
   AddSolverOptions(app, o);
+  AddTrackResidualOptions(app, o);
   CLI::Option* reps =
       app.add_option("--train-reps", o.train_reps,
                      "Repetitions used for fitting, e.g. 1-5 or 1,3,5; the others validate")

@@ -15,6 +15,34 @@ void AddSolverOptions(CLI::App& app, SolverOptions& o) {
   app.add_option("--objective", o.objective,
                  "squares (sum of squared residuals; Ceres default) or eq14 (sum of per-run "
                  "norms, Palacin Eq. 14; NLopt default)");
+  app.add_option("--loss", o.loss, "Ceres robust loss: none, huber, cauchy")->capture_default_str();
+  app.add_option("--loss-scale", o.loss_scale, "Robust loss scale (residual units: m and rad)")
+      ->capture_default_str();
+  app.add_option("--seed", o.seed, "NLopt random seed (same seed, same result)")
+      ->capture_default_str();
+  app.add_option("--max-evaluations", o.max_evaluations, "NLopt evaluation budget per fit")
+      ->capture_default_str();
+  app.add_option("--max-iterations", o.max_iterations, "Ceres iterations per solve")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_flag("--polish", o.polish,
+               "NLopt global methods: polish the best point with SLSQP (autodiff gradient)");
+  const auto given = [&o](const std::string&) { o.sigmas_given = true; };
+  app.add_option("--position-sigma-m", o.position_sigma_m,
+                 "Weight of the position residual as a standard deviation (m); with the default "
+                 "1 m and 57.3 deg the objective weighs metres and radians as Eq. 14. With "
+                 "--weights estimated, giving this or --heading-sigma-deg fixes the weights")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber)
+      ->each(given);
+  app.add_option("--heading-sigma-deg", o.heading_sigma_deg,
+                 "Weight of the heading residual as a standard deviation (deg)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber)
+      ->each(given);
+}
+
+void AddTrackResidualOptions(CLI::App& app, SolverOptions& o) {
   app.add_option("--residuals", o.residuals,
                  "What the fit compares with the ground truth: final-pose (each run's end, "
                  "Palacin Eq. 14), track (the pose from the run's start every 0.5 m of "
@@ -34,38 +62,13 @@ void AddSolverOptions(CLI::App& app, SolverOptions& o) {
                  "that transfers better to runs of a kind it was not fitted on "
                  "(docs/everyday_driving.md)")
       ->capture_default_str();
-  app.add_option("--loss", o.loss, "Ceres robust loss: none, huber, cauchy")->capture_default_str();
-  app.add_option("--loss-scale", o.loss_scale, "Robust loss scale (residual units: m and rad)")
-      ->capture_default_str();
-  app.add_option("--seed", o.seed, "NLopt random seed (same seed, same result)")
-      ->capture_default_str();
-  app.add_option("--max-evaluations", o.max_evaluations, "NLopt evaluation budget per fit")
-      ->capture_default_str();
-  app.add_option("--max-iterations", o.max_iterations, "Ceres iterations per solve")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
-  app.add_flag("--polish", o.polish,
-               "NLopt global methods: polish the best point with SLSQP (autodiff gradient)");
   app.add_option("--weights", o.weight_mode,
-                 "Track residuals: fixed (the sigmas below) or estimated (noise levels of "
+                 "Track residuals: fixed (--position-sigma-m, --heading-sigma-deg) or estimated (noise levels of "
                  "position and heading estimated from the fit itself, printed and written into "
                  "the calibration's objective; docs/everyday_driving.md), or auto: the one that "
                  "transfers better to runs of a kind it was not fitted on")
       ->capture_default_str()
       ->check(CLI::IsMember({"fixed", "estimated", "auto"}));
-  const auto given = [&o](const std::string&) { o.sigmas_given = true; };
-  app.add_option("--position-sigma-m", o.position_sigma_m,
-                 "Weight of the position residual as a standard deviation (m); with the default "
-                 "1 m and 57.3 deg the objective weighs metres and radians as Eq. 14. With "
-                 "--weights estimated, giving this or --heading-sigma-deg fixes the weights")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber)
-      ->each(given);
-  app.add_option("--heading-sigma-deg", o.heading_sigma_deg,
-                 "Weight of the heading residual as a standard deviation (deg)")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber)
-      ->each(given);
 }
 
 }  // namespace fitcal::tools

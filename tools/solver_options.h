@@ -48,5 +48,9 @@ struct SolverOptions {
 
 // Declares the solver flags on `app`, bound to `options`; each shows its default.
 void AddSolverOptions(CLI::App& app, SolverOptions& options);
+// What the track residual needs beyond them (--residuals, --clock-offsets, --track-heading,
+// --weights): declared only by a command that fits tracks (fit), so that another (compare, which
+// fits final poses) refuses them as flags it does not take (exit 2) instead of ignoring them.
+void AddTrackResidualOptions(CLI::App& app, SolverOptions& options);
 
 }  // namespace fitcal::tools
