@@ -22,11 +22,13 @@
 #include "io/warnings.h"
 #include "models/model_registry.h"
 #include "models/tricycle/tricycle_model.h"
+#include "tests/recorded_counts.h"
 #include "tests/test_files.h"
 
 namespace fitcal {
 namespace {
 
+using testing::Glitches;
 using testing::Has;
 using testing::RunFitcal;
 using testing::TempDir;
@@ -254,63 +256,6 @@ TEST(EncoderCounts, ManyGlitchesAreAWrongEncoderBlock) {
 
 // ---- through the command line --------------------------------------------------------------
 
-constexpr double kCounterStart = 4294967296.0 - 30000.0;  // a 32-bit total that wraps early
-constexpr double kSteeringTicks = 8192.0, kSteeringZero = 5000.0;
-
-struct Glitches {
-  std::vector<int> lines;  // the file lines the three glitches are on
-};
-
-// Rewrites one simulated encoder CSV (t,w_traction,steering: rates quantised to 4096 ticks per
-// revolution by the simulator, steering angles at the row times) as a recorder writes it: a
-// 32-bit running total of traction ticks from kCounterStart (wrapping past 2^32), steering
-// counts of an absolute encoder, and, with `glitches`, three glitches in moving stretches.
-std::string AsCounts(const std::string& rates_csv, Glitches* glitches) {
-  std::istringstream in(rates_csv);
-  std::string line;
-  std::getline(in, line);
-  std::vector<double> t, total, steering;
-  double sum = 0.0;
-  while (std::getline(in, line)) {
-    const std::vector<double> v = testing::CsvNumbers(line, 3);
-    if (!t.empty()) sum += std::round(v[1] * (v[0] - t.back()) * 4096.0 / (2.0 * M_PI));
-    t.push_back(v[0]);
-    total.push_back(sum);
-    steering.push_back(v[2]);
-  }
-  std::vector<double> counts(total.size());
-  for (std::size_t k = 0; k < total.size(); ++k) counts[k] = total[k];
-  if (glitches != nullptr) {
-    // Rows inside forward motion (every one of the 6 intervals either side counts > 5 ticks),
-    // spread over the run.
-    std::vector<std::size_t> moving;
-    for (std::size_t k = 8; k + 8 < total.size(); ++k) {
-      bool ok = true;
-      for (std::size_t i = k - 6; i <= k + 6; ++i) ok = ok && total[i + 1] - total[i] > 5.0;
-      if (ok) moving.push_back(k);
-    }
-    EXPECT_GT(moving.size(), 100u);
-    const std::size_t a = moving[moving.size() / 5], b = moving[moving.size() / 2],
-                      c = moving[4 * moving.size() / 5];
-    counts[a] = 0x5A5A5A5A - kCounterStart;  // a torn read of the 32-bit counter
-    counts[b] = counts[b - 1];               // a stale read, then 400 ticks short
-    counts[b + 1] -= 400;
-    for (std::size_t k = c; k < counts.size(); ++k) counts[k] -= 1000;  // a jump back, kept
-    glitches->lines = {static_cast<int>(a) + 2, static_cast<int>(b) + 3, static_cast<int>(c) + 2};
-  }
-  std::ostringstream out;
-  out.precision(10);
-  out << "t,ticks_traction,ticks_steering\n";
-  for (std::size_t k = 0; k < counts.size(); ++k) {
-    const double total32 = std::fmod(kCounterStart + counts[k] + 4294967296.0, 4294967296.0);
-    const double s = std::fmod(
-        kSteeringZero + std::round(steering[k] * kSteeringTicks / (2.0 * M_PI)) + kSteeringTicks,
-        kSteeringTicks);
-    out << t[k] << "," << total32 << "," << s << "\n";
-  }
-  return out.str();
-}
-
 std::map<std::string, double> FittedValues(const std::string& calibrated, YAML::Node* sigma) {
   const Robot robot = ReadRobotModelFile(calibrated)->robot();
   *sigma = YAML::LoadFile(calibrated)["calibration"]["sigma"];
@@ -343,13 +288,12 @@ TEST(EncoderCountsCli, AWrappedGlitchedCounterCalibratesAsTheCleanRecording) {
   const std::string robot_file = index["robot"].as<std::string>();
   WriteFileBytes(counts + "/" + robot_file,
                  testing::ReadFileBytes(clean + "/" + robot_file) +
-                     "encoder: {ticks_per_rev: 4096, cumulative: true, counter_bits: 32}\n"
-                     "steering_encoder: {ticks_per_rev: 8192, zero_tick: 5000}\n");
+                     testing::kCountsEncoderYaml + "steering_encoder: {ticks_per_rev: 8192, zero_tick: 5000}\n");
   std::vector<std::string> expected_glitches;
   for (std::size_t i = 0; i < index["runs"].size(); ++i) {
     const std::string file = index["runs"][i]["encoders"].as<std::string>();
     Glitches glitches;
-    WriteFileBytes(counts + "/" + file, AsCounts(testing::ReadFileBytes(clean + "/" + file),
+    WriteFileBytes(counts + "/" + file, testing::AsCounts(testing::ReadFileBytes(clean + "/" + file), {"steering"},
                                                  i == 1 ? &glitches : nullptr));
     for (int line : glitches.lines) {
       expected_glitches.push_back(counts + "/" + file + ":" + std::to_string(line) +
