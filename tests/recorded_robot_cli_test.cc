@@ -54,7 +54,7 @@ constexpr const char* kTricycleGuess =
 // are the default (a factor of 10 either way of the nominal). The tricycle's true gain is 2.5,
 // not the 0.4: simulate's tricycle runs steer the wheel up to 93 deg, which a gain of 0.4
 // would read as 233 deg at the column, past what an absolute encoder (or the loader's [-pi, pi])
-// can hold; 2.5 is the same factor off the nominal the other way.
+// can hold; 2.5 is the same factor off the nominal the other way (refused, below), 2 passes.
 const RecordedCase kCases[] = {
     {"diff_drive_10pct", "diff_drive", kDiffDriveGuess,
      "model: diff_drive\nname: d\nwheels:\n  - {name: right, radius_m: 0.046}\n"
@@ -72,6 +72,12 @@ const RecordedCase kCases[] = {
      "start runs only when the local fit ends on a bound or the held-out judgement fails, and "
      "the judgement passes because the held-out CF is 38 % lower than the nominal's; a fit far "
      "above the noise floor does not trigger it. With separation 10 % off it passes (0.5 sigma)"},
+    {"tricycle_gain_2", "tricycle", kTricycleGuess,
+     "model: tricycle\nname: t\ntraction_wheel: {radius_m: 0.0357}\nwheelbase_m: 0.18\n"
+     "steering_offset_deg: 3.0\nsteering_gain: 2.0\n"
+     "bounds: {radius_m: [0.025, 0.045], wheelbase_m: [0.12, 0.25], "
+     "steering_offset_deg: [-10.0, 10.0]}\n",
+     {"steering"}, ""},
     {"tricycle_gain_2_5", "tricycle", kTricycleGuess,
      "model: tricycle\nname: t\ntraction_wheel: {radius_m: 0.0357}\nwheelbase_m: 0.18\n"
      "steering_offset_deg: 3.0\nsteering_gain: 2.5\n"
@@ -168,8 +174,8 @@ TEST_P(RecordedRobot, DefaultFitRecoversWheelsAndMountFromCountsFarFromTheGuess)
     EXPECT_GT(std::abs(guess.nominal[k] - truth.nominal[k]), 3.0 * s) << info.name;
   }
 
-  // Held-out drift per 1 m: the true model's is the noise floor (measured 0.47 % for the diff
-  // drive: ground-truth noise over 1 m windows); a calibration within its sigmas may add at most
+  // Held-out drift per 1 m: the true model's is the noise floor (measured 0.47 % for both
+  // models: ground-truth noise over 1 m windows); a calibration within its sigmas may add at most
   // as much again (3 sigma of a radius is ~0.3 % of scale, under that floor).
   const double fit_drift = HeldOutDriftPerMetre(dir, data, cal, dir.Path("report_fit"));
   const double true_drift =
