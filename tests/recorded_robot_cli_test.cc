@@ -71,7 +71,8 @@ const RecordedCase kCases[] = {
      "error 59 deg, drift per 1 m 20.5 % against the true model's 0.47 %). Cause: the global "
      "start runs only when the local fit ends on a bound or the held-out judgement fails, and "
      "the judgement passes because the held-out CF is 38 % lower than the nominal's; a fit far "
-     "above the noise floor does not trigger it. With separation 10 % off it passes (0.5 sigma)"},
+     "above the noise floor does not trigger it. A start at the box's centre (r 0.045, separation "
+     "0.225) reaches the truth, as does separation 12.5 % off; 10 % off passes (0.5 sigma)"},
     {"tricycle_gain_2", "tricycle", kTricycleGuess,
      "model: tricycle\nname: t\ntraction_wheel: {radius_m: 0.0357}\nwheelbase_m: 0.18\n"
      "steering_offset_deg: 3.0\nsteering_gain: 2.0\n"
@@ -86,8 +87,10 @@ const RecordedCase kCases[] = {
      {"steering"},
      "measured 2026-11-29: fit refuses with exit 4, 'the encoder columns look miswired: with "
      "traction = -w_traction (sign flipped) the runs are explained 2.55x better (final-pose SSR "
-     "69.3 vs 177)': the wheel-order check compares orders at the nominal guess, whose gain is "
-     "2.5x off. With --skip-wheel-order-check the fit recovers everything within 0.5 sigma (r "
+     "69.3 vs 177)': the wheel-order check fits both orders on final poses from the nominal, "
+     "and from a gain 2.5x off that objective has local minima (fit --residuals final-pose "
+     "ends with r_traction on its bound 0.025, wheelbase 0.25, exit 5); the flipped order "
+     "reaches a lower one. With --skip-wheel-order-check the fit recovers everything within 0.5 sigma (r "
      "-0.46, wheelbase -0.45, offset +0.20, gain +0.09, mount x -0.15, y -0.25, yaw -0.23)"},
 };
 
