@@ -35,6 +35,7 @@ AlignedRun AlignRun(const RunLog& run) {
     throw std::invalid_argument("run " + run.id + ": encoders and ground truth share no time");
   }
   out.final_ground_truth = InterpolateGroundTruth(gt, out.t_final_s);
+  out.track = std::make_shared<const GroundTruthTrack>(gt);
   const int channels = run.encoders.samples.num_channels();
   out.samples = EncoderSamples(channels);
   out.samples.reserve(run.encoders.samples.size());
@@ -62,6 +63,18 @@ std::vector<AlignedRun> AlignRuns(const std::vector<RunLog>& runs) {
   out.reserve(runs.size());
   for (const RunLog& run : runs) out.push_back(AlignRun(run));
   return out;
+}
+
+std::vector<const GroundTruthTrack*> TracksOf(const std::vector<AlignedRun>& runs) {
+  std::vector<const GroundTruthTrack*> tracks;
+  tracks.reserve(runs.size());
+  for (const AlignedRun& run : runs) {
+    if (run.track == nullptr) {
+      throw std::invalid_argument("run " + run.id + " was aligned without its ground-truth track");
+    }
+    tracks.push_back(run.track.get());
+  }
+  return tracks;
 }
 
 }  // namespace fitcal

@@ -9,6 +9,7 @@
 // replay covers exactly the span the ground truth measured. Consecutive intervals in which all
 // wheels are at rest are merged into one (they move nothing; the time line is kept).
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -25,10 +26,18 @@ struct AlignedRun {
   Pose2d start;               // world_T_robot at t_start
   Pose2d final_ground_truth;  // world_T_robot at t_final, from the ground truth
   EncoderSamples samples{3};  // clipped to the window
+  // The run's whole ground-truth track (not clipped), shared by the copies of the run, for the
+  // measures along it (drift, ATE, effects replayed against it); set by AlignRun, null for a run
+  // made without a log.
+  std::shared_ptr<const GroundTruthTrack> track;
 };
 
 // Throws std::invalid_argument if the two clocks share no time.
 AlignedRun AlignRun(const RunLog& run);
 std::vector<AlignedRun> AlignRuns(const std::vector<RunLog>& runs);
+
+// Each run's ground-truth track (AlignedRun::track), in the runs' order; throws
+// std::invalid_argument naming a run aligned without its log.
+std::vector<const GroundTruthTrack*> TracksOf(const std::vector<AlignedRun>& runs);
 
 }  // namespace fitcal

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <map>
+#include <memory>
 #include <set>
 
 #include "tests/model_support.h"
@@ -53,30 +54,25 @@ TEST(HeldOutHalves, FoldsOfFourRunsAlternate) {
 }
 
 // A straight run of 4 m over 4 s (40 encoder intervals of 0.1 s) cut into 4 blocks of 1 m: fold 0
-// trains on blocks 1 and 3, fold 1 on 2 and 4; each block's track is found under its own id.
+// trains on blocks 1 and 3, fold 1 on 2 and 4; each block keeps its run's track.
 TEST(HeldOutHalves, TimeBlocksOddAgainstEven) {
-  RunLog log;
-  log.id = "free-1";
-  log.trajectory = "free";
-  log.repetition = 1;
-  log.ground_truth.t_s = {0.0, 4.0};
-  log.ground_truth.world_T_robot = {{0.0, 0.0, 0.0}, {4.0, 0.0, 0.0}};
+  GroundTruthTrack track;
+  track.t_s = {0.0, 4.0};
+  track.world_T_robot = {{0.0, 0.0, 0.0}, {4.0, 0.0, 0.0}};
   AlignedRun run = testing::LabelledRun("free", 1);
+  run.track = std::make_shared<const GroundTruthTrack>(track);
   for (int k = 0; k < 40; ++k) run.samples.push_back(0.1, {0.0, 0.0, 0.0});
   RunSplit whole;
   whole.training = {run};
-  const HalvesFold fold0 = TimeBlockFold(whole, {log}, 4, 0);
-  const HalvesFold fold1 = TimeBlockFold(whole, {log}, 4, 1);
+  const HalvesFold fold0 = TimeBlockFold(whole, 4, 0);
+  const HalvesFold fold1 = TimeBlockFold(whole, 4, 1);
   EXPECT_EQ(Ids(fold0.split.training),
             (std::vector<std::string>{"free-1-block1", "free-1-block3"}));
   EXPECT_EQ(Ids(fold0.split.validation),
             (std::vector<std::string>{"free-1-block2", "free-1-block4"}));
   EXPECT_EQ(Ids(fold1.split.training), Ids(fold0.split.validation));
   EXPECT_EQ(Ids(fold1.split.validation), Ids(fold0.split.training));
-  std::set<std::string> log_ids;
-  for (const RunLog& l : fold0.logs) log_ids.insert(l.id);
-  for (const AlignedRun& block : fold0.split.validation) EXPECT_EQ(log_ids.count(block.id), 1u);
-  EXPECT_EQ(log_ids.count("free-1"), 1u);  // the run's own log stays
+  for (const AlignedRun& block : fold0.split.validation) EXPECT_EQ(block.track, run.track);
 }
 
 // One long run fitted on its track is judged on 2, 4 and 8 blocks, whatever --time-blocks says
@@ -85,12 +81,11 @@ TEST(HeldOutHalves, TimeBlocksOddAgainstEven) {
 // fit is worse than the nominal on the blocks of 4 only: it passes, identically for 2, 4 and 8;
 // worse on 4 and 8, it fails.
 TEST(HeldOutHalves, TimeBlockVerdictDoesNotFlipWithTheCount) {
-  RunLog log;
-  log.id = "free-1";
-  log.trajectory = "free";
-  log.ground_truth.t_s = {0.0, 8.0};
-  log.ground_truth.world_T_robot = {{0.0, 0.0, 0.0}, {8.0, 0.0, 0.0}};
+  GroundTruthTrack track;
+  track.t_s = {0.0, 8.0};
+  track.world_T_robot = {{0.0, 0.0, 0.0}, {8.0, 0.0, 0.0}};
   AlignedRun run = testing::LabelledRun("free", 1);
+  run.track = std::make_shared<const GroundTruthTrack>(track);
   for (int k = 0; k < 80; ++k) run.samples.push_back(0.1, {0.0, 0.0, 0.0});
   RunSplit whole;
   whole.training = {run};
@@ -110,7 +105,7 @@ TEST(HeldOutHalves, TimeBlockVerdictDoesNotFlipWithTheCount) {
   };
   std::vector<HalvesJudgement> j;
   for (int count : {2, 4, 8}) {
-    j.push_back(JudgeOnHeldOutHalves(whole, {log}, ResidualKind::kTrack, count, kNominal, fit,
+    j.push_back(JudgeOnHeldOutHalves(whole, ResidualKind::kTrack, count, kNominal, fit,
                                      score_worse_on({4})));
   }
   EXPECT_EQ(blocks_fitted, (std::vector<std::size_t>{2, 2, 4, 4, 8, 8, 2, 2, 4, 4, 8, 8, 2, 2, 4,
@@ -124,7 +119,7 @@ TEST(HeldOutHalves, TimeBlockVerdictDoesNotFlipWithTheCount) {
     EXPECT_TRUE(x.Beats());
   }
   EXPECT_FALSE(j[0].groups[1].Beats());
-  EXPECT_FALSE(JudgeOnHeldOutHalves(whole, {log}, ResidualKind::kTrack, 4, kNominal, fit,
+  EXPECT_FALSE(JudgeOnHeldOutHalves(whole, ResidualKind::kTrack, 4, kNominal, fit,
                                     score_worse_on({4, 8}))
                    .Beats());
   EXPECT_EQ(TimeBlockCounts(3), (std::vector<int>{2, 3, 4, 8}));
@@ -134,7 +129,7 @@ TEST(HeldOutHalves, TimeBlockVerdictDoesNotFlipWithTheCount) {
 TEST(HeldOutHalves, AFitReturningTheNominalDoesNotBeatIt) {
   const FitOnFold nominal_fit = [](const HalvesFold&) { return kNominal; };
   const HalvesJudgement j = JudgeOnHeldOutHalves(
-      Training(4), {}, ResidualKind::kFinalPose, 4, kNominal, nominal_fit,
+      Training(4), ResidualKind::kFinalPose, 4, kNominal, nominal_fit,
       CfPerRun({{"free-1", 0.1}, {"free-2", 0.2}, {"free-3", 0.3}, {"free-4", 0.4}}, {}));
   EXPECT_TRUE(j.judged);
   EXPECT_FALSE(j.by_time);
@@ -152,7 +147,7 @@ TEST(HeldOutHalves, HeldOutRunsWeighAlikeAcrossTheFolds) {
     return kCalibrated;
   };
   const HalvesJudgement j = JudgeOnHeldOutHalves(
-      Training(5), {}, ResidualKind::kFinalPose, 4, kNominal, fit,
+      Training(5), ResidualKind::kFinalPose, 4, kNominal, fit,
       CfPerRun(
           {{"free-1", 1.0}, {"free-2", 2.0}, {"free-3", 3.0}, {"free-4", 4.0}, {"free-5", 5.0}},
           {{"free-1", 0.0}, {"free-2", 0.0}, {"free-3", 0.0}, {"free-4", 1.0}, {"free-5", 0.5}}));
@@ -176,14 +171,14 @@ TEST(HeldOutHalves, CasesNotJudged) {
   RunSplit held_out = Training(4);
   held_out.validation.push_back(testing::LabelledRun("circle", 1));
   EXPECT_FALSE(
-      JudgeOnHeldOutHalves(held_out, {}, ResidualKind::kTrack, 4, kNominal, fit, cf).judged);
+      JudgeOnHeldOutHalves(held_out, ResidualKind::kTrack, 4, kNominal, fit, cf).judged);
   const HalvesJudgement one_final_pose =
-      JudgeOnHeldOutHalves(Training(2), {}, ResidualKind::kFinalPose, 4, kNominal, fit, cf);
+      JudgeOnHeldOutHalves(Training(2), ResidualKind::kFinalPose, 4, kNominal, fit, cf);
   EXPECT_FALSE(one_final_pose.judged);
   EXPECT_TRUE(one_final_pose.by_time);
   const FitOnFold fails = [](const HalvesFold&) { return std::optional<std::vector<double>>(); };
   EXPECT_FALSE(
-      JudgeOnHeldOutHalves(Training(4), {}, ResidualKind::kTrack, 4, kNominal, fails, cf).judged);
+      JudgeOnHeldOutHalves(Training(4), ResidualKind::kTrack, 4, kNominal, fails, cf).judged);
 }
 
 }  // namespace

@@ -263,13 +263,14 @@ TEST(TimeBlocks, CutARunIntoBlocksOfEqualPath) {
                                      {{"free", 1, {{{0.2, 0.0, 0.0}, 30.0}}}}, {});
   const std::vector<RunLog> logs = {sim[0].log};
   const AlignedRun run = AlignRuns(logs)[0];
-  const std::vector<AlignedRun> blocks = CutIntoTimeBlocks(run, logs[0].ground_truth, 4);
+  const std::vector<AlignedRun> blocks = CutIntoTimeBlocks(run, 4);
   ASSERT_EQ(blocks.size(), 4u);
   std::size_t samples = 0;
   double t = run.t_start_s;
   for (std::size_t b = 0; b < blocks.size(); ++b) {
     const AlignedRun& block = blocks[b];
     EXPECT_EQ(block.repetition, static_cast<int>(b) + 1);
+    EXPECT_EQ(block.track, run.track) << block.id;  // replayed against its run's track
     EXPECT_NEAR(block.t_start_s, t, 1e-9);
     samples += block.samples.size();
     t = block.t_final_s;
@@ -280,7 +281,7 @@ TEST(TimeBlocks, CutARunIntoBlocksOfEqualPath) {
   }
   EXPECT_EQ(samples, run.samples.size());
   EXPECT_NEAR(t, run.t_final_s, 1e-9);
-  EXPECT_THROW(CutIntoTimeBlocks(run, logs[0].ground_truth, 0), std::invalid_argument);
+  EXPECT_THROW(CutIntoTimeBlocks(run, 0), std::invalid_argument);
 }
 
 }  // namespace

@@ -248,12 +248,8 @@ struct Replay {
 // The never-worse judgement of the exported parameters against the nominal robot on `runs`.
 NeverWorseSaid ExportNeverWorse(const RobotModelInterface& nominal,
                                 const Ros2ControlExport& exported,
-                                const std::vector<AlignedRun>& runs,
-                                const std::vector<RunLog>& logs) {
-  std::map<std::string, const GroundTruthTrack*> track_of;
-  for (const RunLog& log : logs) track_of[log.id] = &log.ground_truth;
-  std::vector<const GroundTruthTrack*> tracks;
-  for (const AlignedRun& run : runs) tracks.push_back(track_of.at(run.id));
+                                const std::vector<AlignedRun>& runs) {
+  const std::vector<const GroundTruthTrack*> tracks = TracksOf(runs);
   const std::vector<double> lengths = EverydayDriftLengths();
   return SayNeverWorse(
       "the exported parameters",
@@ -282,7 +278,7 @@ Replay ReplayOnHeldOutRuns(const ExportRos2ControlOptions& o, const RobotModelPt
   r.cf_nominal = EvaluateFinalPoseErrors(*nominal, nominal->robot().nominal, runs).cf;
   r.cf_exact = EvaluateFinalPoseErrors(*exact, exact->robot().nominal, runs).cf;
   r.cf_exported = EvaluateFinalPoseErrors(*exported.model, exported.parameters, runs).cf;
-  r.never_worse = ExportNeverWorse(*nominal, exported, runs, logs);
+  r.never_worse = ExportNeverWorse(*nominal, exported, runs);
   const auto covariance = [&](const RobotModelInterface& model, const std::vector<double>& p) {
     return EstimateOdometryCovariance(model, p, logs, o.publish_period_s);
   };

@@ -57,31 +57,17 @@ std::string TrainingSelection(const FitCommandOptions& o) {
   return "repetitions " + o.train_reps;
 }
 
-// Each run's ground-truth track, found by run id among the logs the runs were aligned from.
-std::vector<const GroundTruthTrack*> TracksOf(const std::vector<RunLog>& logs,
-                                              const std::vector<AlignedRun>& runs) {
-  std::unordered_map<std::string, const GroundTruthTrack*> track_of;
-  for (const RunLog& log : logs) track_of[log.id] = &log.ground_truth;
-  std::vector<const GroundTruthTrack*> tracks;
-  for (const AlignedRun& run : runs) tracks.push_back(track_of.at(run.id));
-  return tracks;
-}
-
 // The final-pose errors of a candidate of the gate on some runs: replayed by the model alone, or
 // with its effects against each run's ground-truth track (the same Eq. 14 at the same poses).
 class CandidateErrors {
  public:
-  CandidateErrors(const RobotModelInterface& model, const std::vector<RunLog>& logs, int threads)
-      : model_(model), threads_(threads) {
-    for (const RunLog& log : logs) track_of_[log.id] = &log.ground_truth;
-  }
+  CandidateErrors(const RobotModelInterface& model, int threads)
+      : model_(model), threads_(threads) {}
 
   FinalPoseErrors operator()(const CalibrationCandidate& c,
                              const std::vector<AlignedRun>& runs) const {
     if (c.effects.empty()) return EvaluateFinalPoseErrors(model_, c.parameters, runs, threads_);
-    std::vector<const GroundTruthTrack*> tracks;
-    for (const AlignedRun& run : runs) tracks.push_back(track_of_.at(run.id));
-    return EvaluateFinalPoseErrors(model_, c.parameters, c.effects, runs, tracks, threads_);
+    return EvaluateFinalPoseErrors(model_, c.parameters, c.effects, runs, TracksOf(runs), threads_);
   }
 
   EffectCandidateCf Cf() const {
@@ -93,7 +79,6 @@ class CandidateErrors {
  private:
   const RobotModelInterface& model_;
   int threads_;
-  std::unordered_map<std::string, const GroundTruthTrack*> track_of_;
 };
 
 void PrintCfTable(const CalibrationCandidate& nominal, const CalibrationCandidate& selected,
@@ -357,14 +342,13 @@ io::CalibrationBlock MakeRecord(const FitCommandOptions& options, const RobotMod
 
 // Exit code 4 with one line when another channel order explains the runs far better.
 bool ChannelsLookMiswired(const FitCommandOptions& options, const RobotModelInterface& model,
-                          const std::vector<AlignedRun>& training,
-                          const std::vector<RunLog>& logs) {
+                          const std::vector<AlignedRun>& training) {
   ChannelOrderOptions order_options;
   order_options.weights.position_sigma_m = options.position_sigma_m;
   order_options.weights.heading_sigma_rad = DegToRad(options.heading_sigma_deg);
   order_options.num_threads = options.threads;
   const ChannelOrderReport order =
-      CheckRecordedChannelOrder(training, TracksOf(logs, training), model, order_options);
+      CheckRecordedChannelOrder(training, TracksOf(training), model, order_options);
   if (!order.likely_miswired) return false;
   std::cerr << "fitcal: " << options.logs << ": " << order.message
             << "; nothing written (--skip-wheel-order-check to fit anyway)\n";
@@ -545,10 +529,10 @@ void WarnOfEffects(const std::vector<CalibrationCandidate>& candidates, const Ga
 
 // The training runs' tracks for --residuals track/both, and auto resolved (settings->track points
 // into *data); false after one line on stderr when the method cannot fit them.
-bool PrepareTrackResiduals(const FitCommandOptions& options, const std::vector<RunLog>& logs,
-                           const RunSplit& split, FitMethodSettings* settings,
+bool PrepareTrackResiduals(const FitCommandOptions& options, const RunSplit& split,
+                           FitMethodSettings* settings,
                            std::optional<TrackFitData>* data) {
-  const std::vector<const GroundTruthTrack*> tracks = TracksOf(logs, split.training);
+  const std::vector<const GroundTruthTrack*> tracks = TracksOf(split.training);
   ResolveAutoResiduals(split.training, tracks, options.method, settings);
   if (settings->residuals == ResidualKind::kFinalPose) return true;
   if (options.method != "ceres" && options.method != "ceres-dogleg") {
@@ -642,13 +626,14 @@ void PrintClockOffsets(const ModelFitResult& fit, const TrackFitData& track) {
 
 // Drift per 1, 2, 5 m and ATE RMSE (tools/everyday_driving_table.h) of the nominal and the
 // selected calibration on the held-out runs (the training runs when none is held out).
-void PrintEverydayDriving(const RobotModelInterface& model, const std::vector<RunLog>& logs,
-                          const RunSplit& split, const CalibrationCandidate& nominal,
+void PrintEverydayDriving(const RobotModelInterface& model, const RunSplit& split,
+                          const CalibrationCandidate& nominal,
                           const CalibrationCandidate& selected, int threads) {
   const bool held_out = !split.validation.empty();
   const std::vector<AlignedRun>& runs = held_out ? split.validation : split.training;
   PrintEverydayDrivingTable(
-      model, runs, TracksOf(logs, runs), held_out ? "everyday driving, validation" : "everyday driving, training",
+      model, runs, TracksOf(runs),
+      held_out ? "everyday driving, validation" : "everyday driving, training",
       {&nominal.parameters, &nominal.effects}, {&selected.parameters, &selected.effects}, threads);
 }
 
@@ -659,8 +644,7 @@ class FoldFits {
   // `s` fitted on `training` from `start` (the fit of all the training runs), its weights seeded
   // by that fit's noise levels when it estimated them; nullopt when not usable.
   std::optional<std::vector<double>> Fit(const FitCommandOptions& options, const FitMethod& method,
-                                         const RobotModelInterface& model,
-                                         const std::vector<RunLog>& logs, FitMethodSettings s,
+                                         const RobotModelInterface& model, FitMethodSettings s,
                                          const std::vector<AlignedRun>& training) {
     std::string key = std::string(ToString(s.residuals)) + (s.estimate_weights ? " est " : " fix ") +
                       ToString(s.track_heading);
@@ -679,7 +663,7 @@ class FoldFits {
     part.training = training;
     std::optional<TrackFitData> data;
     std::optional<std::vector<double>> out;
-    if (PrepareTrackResiduals(options, logs, part, &s, &data)) {
+    if (PrepareTrackResiduals(options, part, &s, &data)) {
       const ModelFitResult fit = method.run_model(training, model, s).fit;
       if (fit.usable || fit.stopped_early) out = fit.parameters;
     }
@@ -716,7 +700,6 @@ std::vector<std::string> ChooseResidualsByTransfer(const FitCommandOptions& opti
                                                    const FitMethod& method,
                                                    const RobotModelInterface& model,
                                                    const RunSplit& split,
-                                                   const std::vector<RunLog>& logs,
                                                    FitMethodSettings* settings,
                                                    std::optional<TrackFitData>* track_data,
                                                    std::optional<ModelFitMethodOutcome>* full,
@@ -726,10 +709,10 @@ std::vector<std::string> ChooseResidualsByTransfer(const FitCommandOptions& opti
   const FitByKind fit_on = [&](ResidualKind kind, const std::vector<AlignedRun>& training) {
     FitMethodSettings s = *settings;
     s.residuals = kind;
-    return fold_fits->Fit(options, method, model, logs, s, training);
+    return fold_fits->Fit(options, method, model, s, training);
   };
   const ScoreOnRuns score = [&](const std::vector<double>& p, const std::vector<AlignedRun>& runs) {
-    return EvaluateEverydayDriving(model, p, {}, runs, TracksOf(logs, runs), EverydayDriftLengths(),
+    return EvaluateEverydayDriving(model, p, {}, runs, TracksOf(runs), EverydayDriftLengths(),
                                    options.threads);
   };
   const ResidualKindJudgement judgement = JudgeResidualKindsByTransfer(
@@ -766,7 +749,7 @@ std::vector<TrackObjective> TrackObjectiveCandidates(const FitMethodSettings& se
 // choice. The lines for the terminal, and in *note what the calibration's objective records.
 std::vector<std::string> ChooseTrackObjectiveByTransfer(
     const FitCommandOptions& options, const FitMethod& method, const RobotModelInterface& model,
-    const RunSplit& split, const std::vector<RunLog>& logs, FitMethodSettings* settings,
+    const RunSplit& split, FitMethodSettings* settings,
     std::optional<TrackFitData>* track_data, std::optional<ModelFitMethodOutcome>* full,
     FoldFits* fold_fits, std::string* note) {
   if (!settings->weights_auto && !settings->track_heading_auto) return {};
@@ -779,10 +762,10 @@ std::vector<std::string> ChooseTrackObjectiveByTransfer(
     FitMethodSettings s = *settings;
     s.estimate_weights = objective.estimate_weights;
     s.track_heading = objective.heading;
-    return fold_fits->Fit(options, method, model, logs, s, training);
+    return fold_fits->Fit(options, method, model, s, training);
   };
   const ScoreOnRuns score = [&](const std::vector<double>& p, const std::vector<AlignedRun>& runs) {
-    return EvaluateEverydayDriving(model, p, {}, runs, TracksOf(logs, runs), EverydayDriftLengths(),
+    return EvaluateEverydayDriving(model, p, {}, runs, TracksOf(runs), EverydayDriftLengths(),
                                    options.threads);
   };
   const TrackObjectiveJudgement judgement = JudgeTrackObjectivesByTransfer(
@@ -795,7 +778,7 @@ std::vector<std::string> ChooseTrackObjectiveByTransfer(
     settings->track = nullptr;
     track_data->reset();
     full->reset();
-    if (!PrepareTrackResiduals(options, logs, split, settings, track_data)) return {};
+    if (!PrepareTrackResiduals(options, split, settings, track_data)) return {};
   }
   return TrackObjectiveJudgementLines(judgement);
 }
@@ -803,13 +786,13 @@ std::vector<std::string> ChooseTrackObjectiveByTransfer(
 // A calibration better than the nominal on the held-out runs as a whole may still be worse on
 // one kind of run, or in drift or ATE, beyond the runs' own scatter (validation/never_worse.h);
 // it is then not written. True after one line per such measure on stderr.
-bool WorseThanNominalBeyondNoise(const RobotModelInterface& model, const std::vector<RunLog>& logs,
+bool WorseThanNominalBeyondNoise(const RobotModelInterface& model,
                                  const std::vector<CalibrationCandidate>& candidates,
                                  const GateDecision& gate, const RunSplit& split, int threads) {
   if (!gate.judged_on_held_out || gate.selected == 0) return false;
   const std::vector<NeverWorseJudgement> judged =
       JudgeCalibrationNeverWorse(model, candidates[0], candidates[gate.selected], split.validation,
-                                 TracksOf(logs, split.validation), threads);
+                                 TracksOf(split.validation), threads);
   const NeverWorseSaid said = SayNeverWorse(candidates[gate.selected].name, judged);
   for (const std::string& line : said.warnings) std::printf("warning: %s\n", line.c_str());
   for (const std::string& line : said.refusals) std::cerr << "fitcal: " << line << "; nothing written\n";
@@ -821,13 +804,13 @@ bool WorseThanNominalBeyondNoise(const RobotModelInterface& model, const std::ve
 HalvesJudgement JudgeMethodOnHeldOutHalves(const FitCommandOptions& options,
                                            const FitMethod& method,
                                            const FitMethodSettings& settings,
-                                           const RobotModelInterface& model, const RunSplit& split,
-                                           const std::vector<RunLog>& logs) {
+                                           const RobotModelInterface& model,
+                                           const RunSplit& split) {
   const FitOnFold fit_on = [&](const HalvesFold& fold) -> std::optional<std::vector<double>> {
     FitMethodSettings fold_settings = settings;
     fold_settings.residuals_auto = false;  // the whole data's choice holds for its halves
     std::optional<TrackFitData> track_data;
-    if (!PrepareTrackResiduals(options, fold.logs, fold.split, &fold_settings, &track_data)) {
+    if (!PrepareTrackResiduals(options, fold.split, &fold_settings, &track_data)) {
       return std::nullopt;
     }
     const ModelFitResult fit = method.run_model(fold.split.training, model, fold_settings).fit;
@@ -836,10 +819,10 @@ HalvesJudgement JudgeMethodOnHeldOutHalves(const FitCommandOptions& options,
   };
   const MetricsOnFold score = [&](const std::vector<double>& p, const HalvesFold& fold) {
     const std::vector<AlignedRun>& runs = fold.split.validation;
-    return EvaluateEverydayDriving(model, p, {}, runs, TracksOf(fold.logs, runs),
+    return EvaluateEverydayDriving(model, p, {}, runs, TracksOf(runs),
                                    EverydayDriftLengths(), options.threads);
   };
-  return fitcal::JudgeOnHeldOutHalves(split, logs, settings.residuals, options.time_blocks,
+  return fitcal::JudgeOnHeldOutHalves(split, settings.residuals, options.time_blocks,
                                       model.robot().nominal, fit_on, score);
 }
 
@@ -926,7 +909,7 @@ int CheckBeforeFitting(const FitCommandOptions& options, const RobotModelInterfa
     return 1;
   }
   if (!options.skip_wheel_order_check &&
-      ChannelsLookMiswired(options, model, split.training, logs)) {
+      ChannelsLookMiswired(options, model, split.training)) {
     return 4;
   }
   for (const std::string& problem : FindDegenerateData(split.training, model.robot())) {
@@ -1147,20 +1130,20 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
     if (!training_tracks) return 2;
   }
   std::optional<TrackFitData> track_data;
-  if (!PrepareTrackResiduals(options, logs, split, &settings, &track_data)) return 2;
+  if (!PrepareTrackResiduals(options, split, &settings, &track_data)) return 2;
   // The fit of all the training runs when the choice by transfer made it (and kept its kind).
   std::optional<ModelFitMethodOutcome> chosen_fit;
   FoldFits fold_fits;
   const std::vector<std::string> residual_choice =
       effects_to_fit->empty()
-          ? ChooseResidualsByTransfer(options, *method, *model, split, logs, &settings,
+          ? ChooseResidualsByTransfer(options, *method, *model, split, &settings,
                                       &track_data, &chosen_fit, &fold_fits)
           : std::vector<std::string>{};
   std::vector<std::string> residual_lines = residual_choice;
   std::string objective_note;
   if (effects_to_fit->empty()) {
     for (const std::string& line :
-         ChooseTrackObjectiveByTransfer(options, *method, *model, split, logs, &settings,
+         ChooseTrackObjectiveByTransfer(options, *method, *model, split, &settings,
                                         &track_data, &chosen_fit, &fold_fits,
                                         &objective_note)) {
       residual_lines.push_back(line);
@@ -1170,7 +1153,7 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
     residual_lines.push_back(note);
   }
   const HalvesJudgement halves =
-      JudgeMethodOnHeldOutHalves(options, *method, settings, *model, split, logs);
+      JudgeMethodOnHeldOutHalves(options, *method, settings, *model, split);
   if (const std::string refusal = DegreesOfFreedomRefusal(
           split, settings, track_data,
           NumFreeWithTying(*model, settings.tying) + (effects_to_fit ? effects_to_fit->size() : 0));
@@ -1187,7 +1170,7 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
       training_tracks ? std::optional<TrackFits>(AddTrackFitCandidates(
                             options, *model, *training_tracks, *effects_to_fit, &candidates))
                       : std::nullopt;
-  const CandidateErrors errors(*model, logs, options.threads);
+  const CandidateErrors errors(*model, options.threads);
   GateDecision gate = SelectCalibration(*model, candidates, split.training, split.validation,
                                         options.threads, errors.Cf());
   const std::string effects_line =
@@ -1207,7 +1190,7 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   PrintTying(settings.tying);
   PrintResiduals(settings, residuals_auto, residual_lines, fit, track_data);
   PrintEncoderGlitches(dataset.runs);
-  PrintEverydayDriving(*model, logs, split, candidates[0], selected, options.threads);
+  PrintEverydayDriving(*model, split, candidates[0], selected, options.threads);
   PrintUncertaintyAndWarnings(options, *model, split, fit, settings.weights);
   if (halves.judged) {  // the gate's table is on the training runs; the halves judge (below)
     gate.judged_on = "training runs (" + std::to_string(split.training.size()) +
@@ -1217,7 +1200,7 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   if (!PrintGate(candidates, gate, effects_line)) return 5;
   if (!ReportHalves(halves)) return 5;
   if (halves.judged) gate.judged_on = HalvesDescription(halves);
-  if (WorseThanNominalBeyondNoise(*model, logs, candidates, gate, split, options.threads)) return 5;
+  if (WorseThanNominalBeyondNoise(*model, candidates, gate, split, options.threads)) return 5;
   if (const std::string refusal =
           AtBoundRefusal(robot, selected.name, selected.parameters, selected_fit.at_bound);
       !refusal.empty() && gate.selected != 0) {

@@ -3,26 +3,16 @@
 #include <algorithm>
 #include <cstdio>
 #include <set>
-#include <unordered_map>
 #include <utility>
 
 #include "validation/time_blocks.h"
 
 namespace fitcal {
 
-HalvesFold TimeBlockFold(const RunSplit& whole, const std::vector<RunLog>& logs, int num_blocks,
-                         int fold) {
-  std::unordered_map<std::string, const RunLog*> log_of;
-  for (const RunLog& log : logs) log_of[log.id] = &log;
+HalvesFold TimeBlockFold(const RunSplit& whole, int num_blocks, int fold) {
   HalvesFold blocks;
-  blocks.logs = logs;
-  // The logs grow below; `log_of` points into the caller's, which stay put.
   for (const AlignedRun& run : whole.training) {
-    const RunLog& log = *log_of.at(run.id);
-    for (AlignedRun& block : CutIntoTimeBlocks(run, log.ground_truth, num_blocks)) {
-      // A block replays against its run's track, found under the block's own id.
-      blocks.logs.push_back(log);
-      blocks.logs.back().id = block.id;
+    for (AlignedRun& block : CutIntoTimeBlocks(run, num_blocks)) {
       const bool trains = (block.repetition % 2) == (fold == 0 ? 1 : 0);
       (trains ? blocks.split.training : blocks.split.validation).push_back(std::move(block));
     }
@@ -81,15 +71,14 @@ void AppendRuns(const EverydayDrivingMetrics& part, EverydayDrivingMetrics* all)
 }
 
 // The folds judged: the two halves of the runs, or the two of each block count.
-std::vector<HalvesFold> Folds(const RunSplit& split, const std::vector<RunLog>& logs,
-                              const std::vector<int>& block_counts) {
+std::vector<HalvesFold> Folds(const RunSplit& split, const std::vector<int>& block_counts) {
   std::vector<HalvesFold> folds;
   for (int fold = 0; fold < 2; ++fold) {
-    if (block_counts.empty()) folds.push_back({RunsFold(split, fold), logs});
+    if (block_counts.empty()) folds.push_back({RunsFold(split, fold)});
   }
   for (int count : block_counts) {
     for (int fold = 0; fold < 2; ++fold) {
-      folds.push_back(TimeBlockFold(split, logs, count, fold));
+      folds.push_back(TimeBlockFold(split, count, fold));
       // Blocks of one count repeat one another (their scatter is the noise of a block); blocks
       // of another length do not: the label carries the count, the family stays the run's.
       for (AlignedRun& block : folds.back().split.validation) {
@@ -108,8 +97,8 @@ double MeanOf(const std::vector<double>& v) {
 
 }  // namespace
 
-HalvesJudgement JudgeOnHeldOutHalves(const RunSplit& split, const std::vector<RunLog>& logs,
-                                     ResidualKind residuals, int num_blocks,
+HalvesJudgement JudgeOnHeldOutHalves(const RunSplit& split, ResidualKind residuals,
+                                     int num_blocks,
                                      const std::vector<double>& nominal, const FitOnFold& fit_on,
                                      const MetricsOnFold& score) {
   HalvesJudgement j;
@@ -126,7 +115,7 @@ HalvesJudgement JudgeOnHeldOutHalves(const RunSplit& split, const std::vector<Ru
   for (const std::vector<int>& group : groups) {
     EverydayDrivingMetrics nominal_all, calibrated_all;
     std::vector<AlignedRun> held_out;
-    for (const HalvesFold& half : Folds(split, logs, group)) {
+    for (const HalvesFold& half : Folds(split, group)) {
       if (half.split.training.empty() || half.split.validation.empty()) return j;
       const std::optional<std::vector<double>> fitted = fit_on(half);
       if (!fitted) return j;

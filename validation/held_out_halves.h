@@ -39,16 +39,13 @@ namespace fitcal {
 // Up to this many training runs are cut into time blocks; more are halved.
 constexpr std::size_t kMaxRunsForTimeBlocks = 2;
 
-// One fold: the runs it trains on and is judged on, and the logs by run id that hold their
-// ground-truth tracks (the data set's, plus each time block's under the block's id).
+// One fold: the runs it trains on and is judged on (each carries its ground-truth track).
 struct HalvesFold {
   RunSplit split;
-  std::vector<RunLog> logs;
 };
 
 // The time blocks of the training runs, fold 0 training on the odd blocks and fold 1 on the even.
-HalvesFold TimeBlockFold(const RunSplit& whole, const std::vector<RunLog>& logs, int num_blocks,
-                         int fold);
+HalvesFold TimeBlockFold(const RunSplit& whole, int num_blocks, int fold);
 
 // Every other training run (in data-set order, so each session gives to both halves): fold 0
 // trains on runs 0, 2, 4, ..., fold 1 on runs 1, 3, 5, ...
@@ -57,7 +54,7 @@ RunSplit RunsFold(const RunSplit& whole, int fold);
 // The parameters fitted on a fold's training runs; nullopt when that fit cannot be made or is not
 // usable (the judgement is then not made).
 using FitOnFold = std::function<std::optional<std::vector<double>>(const HalvesFold& fold)>;
-// Parameters replayed on a fold's held-out runs (their tracks in fold.logs): per-run CF (Palacin
+// Parameters replayed on a fold's held-out runs (against their tracks): per-run CF (Palacin
 // Eq. 14), ATE and drift (validation/everyday_driving.h) in the order of fold.split.validation.
 using MetricsOnFold = std::function<EverydayDrivingMetrics(const std::vector<double>& parameters,
                                                            const HalvesFold& fold)>;
@@ -91,8 +88,8 @@ struct HalvesJudgement {
 // two runs are fitted on their final poses, or when a fold is empty or its fit fails. `residuals`
 // is the kind the whole data is fitted with (auto already resolved); `nominal` the model's nominal
 // parameters. The CFs are means over the held-out runs of every fold, each run weighing alike.
-HalvesJudgement JudgeOnHeldOutHalves(const RunSplit& split, const std::vector<RunLog>& logs,
-                                     ResidualKind residuals, int num_blocks,
+HalvesJudgement JudgeOnHeldOutHalves(const RunSplit& split, ResidualKind residuals,
+                                     int num_blocks,
                                      const std::vector<double>& nominal, const FitOnFold& fit_on,
                                      const MetricsOnFold& score);
 

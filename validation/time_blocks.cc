@@ -6,12 +6,12 @@
 
 namespace fitcal {
 
-std::vector<AlignedRun> CutIntoTimeBlocks(const AlignedRun& run, const GroundTruthTrack& track,
-                                          int num_blocks) {
+std::vector<AlignedRun> CutIntoTimeBlocks(const AlignedRun& run, int num_blocks) {
   const std::size_t n = run.samples.size();
   if (num_blocks < 1 || n < static_cast<std::size_t>(num_blocks)) {
     throw std::invalid_argument("CutIntoTimeBlocks: run " + run.id + " has too few samples");
   }
+  const GroundTruthTrack& track = *TracksOf({run}).front();
   // Boundary b lies after b samples; its ground-truth path length from the start.
   std::vector<double> t(n + 1), s(n + 1, 0.0);
   t[0] = run.t_start_s;
@@ -42,6 +42,7 @@ std::vector<AlignedRun> CutIntoTimeBlocks(const AlignedRun& run, const GroundTru
     block.t_final_s = t[end];
     block.start = InterpolateGroundTruth(track, t[begin]);
     block.final_ground_truth = InterpolateGroundTruth(track, t[end]);
+    block.track = run.track;  // a block replays against its run's track
     block.samples = EncoderSamples(run.samples.num_channels());
     for (std::size_t k = begin; k < end; ++k) block.samples.push_back(run.samples[k]);
     blocks.push_back(std::move(block));

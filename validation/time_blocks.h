@@ -8,13 +8,12 @@
 #include <vector>
 
 #include "odometry/aligned_run.h"
-#include "odometry/run_log.h"
 
 namespace fitcal {
 
-// Blocks k = 1..num_blocks of `run`: id "<id>-block<k>", the run's trajectory label, repetition k.
-// Throws std::invalid_argument when num_blocks < 1 or the run has fewer samples than blocks.
-std::vector<AlignedRun> CutIntoTimeBlocks(const AlignedRun& run, const GroundTruthTrack& track,
-                                          int num_blocks);
+// Blocks k = 1..num_blocks of `run`, cut on its ground-truth track (AlignedRun::track), which
+// each block keeps: id "<id>-block<k>", the run's trajectory label, repetition k. Throws
+// std::invalid_argument when num_blocks < 1, the run has fewer samples than blocks or no track.
+std::vector<AlignedRun> CutIntoTimeBlocks(const AlignedRun& run, int num_blocks);
 
 }  // namespace fitcal
