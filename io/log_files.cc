@@ -665,12 +665,10 @@ std::vector<int> LinesOfDataRows(const std::string& path, const std::vector<std:
 void DropCounterGlitches(const std::string& path, const Robot& robot,
                          const std::vector<bool>& screened, EncoderLog* log) {
   GlitchScreen screen(robot, log);
-  std::vector<Glitch> all;
   for (int c = 0; c < robot.NumChannels(); ++c) {
-    if (!screened[static_cast<std::size_t>(c)]) continue;
-    screen.Screen(c);
+    if (screened[static_cast<std::size_t>(c)]) screen.Screen(c);
   }
-  all = screen.glitches();
+  std::vector<Glitch> all = screen.glitches();
   if (all.empty()) return;
   const double allowed = std::max(1.0, kMaxGlitchShare * static_cast<double>(log->samples.size()));
   std::sort(all.begin(), all.end(), [](const Glitch& a, const Glitch& b) { return a.row < b.row; });

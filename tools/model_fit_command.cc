@@ -637,6 +637,15 @@ void PrintEverydayDriving(const RobotModelInterface& model, const RunSplit& spli
       {&nominal.parameters, &nominal.effects}, {&selected.parameters, &selected.effects}, threads);
 }
 
+// How the choices by transfer and the held-out halves score a fit: the everyday-driving
+// measures (Eq. 14 CF, drift per length, ATE) of parameters `p` on runs, each against its track.
+ScoreOnRuns EverydayDrivingScore(const RobotModelInterface& model, int threads) {
+  return [&model, threads](const std::vector<double>& p, const std::vector<AlignedRun>& runs) {
+    return EvaluateEverydayDriving(model, p, {}, runs, TracksOf(runs), EverydayDriftLengths(),
+                                   threads);
+  };
+}
+
 // The fits of the folds the choices by transfer make (residual kind, then track objective), each
 // made once: the track with the default objective on a fold is a candidate of both.
 class FoldFits {
@@ -711,10 +720,7 @@ std::vector<std::string> ChooseResidualsByTransfer(const FitCommandOptions& opti
     s.residuals = kind;
     return fold_fits->Fit(options, method, model, s, training);
   };
-  const ScoreOnRuns score = [&](const std::vector<double>& p, const std::vector<AlignedRun>& runs) {
-    return EvaluateEverydayDriving(model, p, {}, runs, TracksOf(runs), EverydayDriftLengths(),
-                                   options.threads);
-  };
+  const ScoreOnRuns score = EverydayDrivingScore(model, options.threads);
   const ResidualKindJudgement judgement = JudgeResidualKindsByTransfer(
       ResidualKind::kTrack, ResidualKind::kFinalPose, split, fit_on, score);
   if (judgement.chosen != settings->residuals) {
@@ -764,10 +770,7 @@ std::vector<std::string> ChooseTrackObjectiveByTransfer(
     s.track_heading = objective.heading;
     return fold_fits->Fit(options, method, model, s, training);
   };
-  const ScoreOnRuns score = [&](const std::vector<double>& p, const std::vector<AlignedRun>& runs) {
-    return EvaluateEverydayDriving(model, p, {}, runs, TracksOf(runs), EverydayDriftLengths(),
-                                   options.threads);
-  };
+  const ScoreOnRuns score = EverydayDrivingScore(model, options.threads);
   const TrackObjectiveJudgement judgement = JudgeTrackObjectivesByTransfer(
       TrackObjectiveCandidates(*settings), split, fit_on, score);
   *note = TrackObjectiveChoiceText(judgement);
@@ -817,10 +820,9 @@ HalvesJudgement JudgeMethodOnHeldOutHalves(const FitCommandOptions& options,
     if (!(fit.usable || fit.stopped_early)) return std::nullopt;
     return fit.parameters;
   };
+  const ScoreOnRuns on_runs = EverydayDrivingScore(model, options.threads);
   const MetricsOnFold score = [&](const std::vector<double>& p, const HalvesFold& fold) {
-    const std::vector<AlignedRun>& runs = fold.split.validation;
-    return EvaluateEverydayDriving(model, p, {}, runs, TracksOf(runs),
-                                   EverydayDriftLengths(), options.threads);
+    return on_runs(p, fold.split.validation);
   };
   return fitcal::JudgeOnHeldOutHalves(split, settings.residuals, options.time_blocks,
                                       model.robot().nominal, fit_on, score);

@@ -11,7 +11,10 @@ std::vector<AlignedRun> CutIntoTimeBlocks(const AlignedRun& run, int num_blocks)
   if (num_blocks < 1 || n < static_cast<std::size_t>(num_blocks)) {
     throw std::invalid_argument("CutIntoTimeBlocks: run " + run.id + " has too few samples");
   }
-  const GroundTruthTrack& track = *TracksOf({run}).front();
+  if (run.track == nullptr) {
+    throw std::invalid_argument("CutIntoTimeBlocks: run " + run.id + " has no ground-truth track");
+  }
+  const GroundTruthTrack& track = *run.track;
   // Boundary b lies after b samples; its ground-truth path length from the start.
   std::vector<double> t(n + 1), s(n + 1, 0.0);
   t[0] = run.t_start_s;
