@@ -23,7 +23,7 @@
 #include "io/robot_yaml.h"
 #include "models/model_registry.h"
 #include "tools/cli_validators.h"
-#include "tools/fit_methods.h"
+#include "calibrate/fit_methods.h"
 #include "tools/output_guard.h"
 
 namespace fitcal::tools {
@@ -154,7 +154,7 @@ std::string TraceCsv(const std::vector<Row>& rows) {
 
 // The robot and runs of a data set, for any model; a model that registers the legacy loader
 // (ModelExtras::legacy_loader: omni3) keeps its own; every model fits and is scored through the
-// seam (tools/fit_methods.h, fit/final_pose_errors.h).
+// seam (calibrate/fit_methods.h, fit/final_pose_errors.h).
 struct CompareData {
   RobotModelPtr model;
   bool legacy = false;  // ModelExtras::legacy_loader: Palacin's strategies STA..STE by default

@@ -1,7 +1,7 @@
 #pragma once
 // `fitcal compare --logs <dir>`: Palacin Table 4 regenerated on the user's data, for any robot
 // model - every strategy (STA..STE or explicit trajectory lists, fit/strategies.h; "all" or a
-// label prefix) x every method (tools/fit_methods.h) x training on the first 1 or 5 repetitions,
+// label prefix) x every method (calibrate/fit_methods.h) x training on the first 1 or 5 repetitions,
 // validated on every trajectory of the held-out repetitions (Palacin Sec. 3.2: "five additional"
 // repetitions of the whole flower). The model's closed forms (UMBmark for a differential drive)
 // are rows beside the fits, computed from the same training runs. Prints the

@@ -6,7 +6,7 @@
 
 #include "models/model_registry.h"
 #include "tools/cli_validators.h"
-#include "tools/fit_methods.h"
+#include "calibrate/fit_methods.h"
 #include "tools/model_fit_command.h"
 #include "tools/output_guard.h"
 

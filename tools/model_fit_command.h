@@ -1,7 +1,7 @@
 #pragma once
 // `fitcal fit` for every robot model on the seam (models/model_interface.h), omni3 included: load
 // the data set with the robot's channels, check it (rate units, channel order, degenerate data),
-// fit on the training repetitions with any --method of tools/fit_methods.h (the bounded Ceres fit
+// fit on the training repetitions with any --method of calibrate/fit_methods.h (the bounded Ceres fit
 // with its active set, fit/model_fit.h, or an NLopt search, fit/model_nlopt_fit.h), put the fit
 // beside the nominal and the model's closed forms through the result gate (fit/result_gate.h),
 // print the table and write the winner as the model's calibrated YAML (with its paper outputs,

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "fit/residual_choice.h"
+
 namespace fitcal::tools {
 
 ResidualWeights SolverOptions::Weights() const {
@@ -69,6 +71,49 @@ void AddTrackResidualOptions(CLI::App& app, SolverOptions& o) {
                  "transfers better to runs of a kind it was not fitted on")
       ->capture_default_str()
       ->check(CLI::IsMember({"fixed", "estimated", "auto"}));
+}
+
+bool MakeFitMethodSettings(const SolverOptions& o, int threads, FitMethodSettings* s,
+                           std::string* error) {
+  s->threads = threads;
+  s->max_iterations = o.max_iterations;
+  s->weights = o.Weights();
+  s->estimate_weights = o.weight_mode == "estimated" && !o.sigmas_given;
+  s->weights_auto = o.weight_mode == "auto" && !o.sigmas_given;  // a sigma given fixes them
+  s->objective_set = !o.objective.empty();
+  if (s->objective_set && !ParseFinalPoseObjective(o.objective, &s->objective)) {
+    *error = "unknown --objective '" + o.objective + "' (available: squares, eq14)";
+    return false;
+  }
+  s->residuals_auto = o.residuals == "auto";
+  if (!s->residuals_auto && !ParseResidualKind(o.residuals, &s->residuals)) {
+    *error =
+        "unknown --residuals '" + o.residuals + "' (available: auto, final-pose, track, both)";
+    return false;
+  }
+  if (!ParseClockGrouping(o.clock_offsets, &s->clock_grouping)) {
+    *error = "unknown --clock-offsets '" + o.clock_offsets + "' (available: session, run, dataset, none)";
+    return false;
+  }
+  s->track_heading_auto = o.track_heading == "auto";
+  if (!s->track_heading_auto && !ParseTrackHeading(o.track_heading, &s->track_heading)) {
+    *error = "unknown --track-heading '" + o.track_heading +
+             "' (available: from-start, increments, auto)";
+    return false;
+  }
+  if (!ParseCeresRobustLoss(o.loss, &s->loss)) {
+    *error = "unknown --loss '" + o.loss + "' (available: none, huber, cauchy)";
+    return false;
+  }
+  s->loss_scale = o.loss_scale;
+  s->seed = o.seed;
+  s->max_evaluations = o.max_evaluations;
+  s->local_polish = o.polish;
+  if (o.max_evaluations < 1 || !(o.loss_scale > 0.0)) {
+    *error = "--max-evaluations and --loss-scale must be positive";
+    return false;
+  }
+  return true;
 }
 
 }  // namespace fitcal::tools

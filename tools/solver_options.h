@@ -1,13 +1,14 @@
 #pragma once
 // The solver settings of every command that fits (fit, compare), in one options struct with its
 // defaults in the class, declared as flags once (AddSolverOptions) and checked once
-// (MakeFitMethodSettings, tools/fit_methods.h) before anything is read. Each method uses the
+// (MakeFitMethodSettings, below) before anything is read. Each method uses the
 // settings that apply to it: Ceres the objective, loss and iterations; NLopt the objective, seed,
 // budget and polish; both the residual weights.
 
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include "calibrate/fit_methods.h"
 #include "models/model_interface.h"
 
 namespace fitcal::tools {
@@ -52,5 +53,10 @@ void AddSolverOptions(CLI::App& app, SolverOptions& options);
 // --weights): declared only by a command that fits tracks (fit), so that another (compare, which
 // fits final poses) refuses them as flags it does not take (exit 2) instead of ignoring them.
 void AddTrackResidualOptions(CLI::App& app, SolverOptions& options);
+
+// The solver flags (tools/solver_options.h) checked and turned into settings; false with a
+// one-line message when a name is unknown or a value out of range.
+bool MakeFitMethodSettings(const SolverOptions& options, int threads, FitMethodSettings* settings,
+                           std::string* error);
 
 }  // namespace fitcal::tools

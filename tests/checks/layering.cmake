@@ -8,14 +8,16 @@
 #   fit (3)       residuals, costs, fitters, the split into training and held-out runs
 #   validation (4) held-out judgement, metrics, statistics
 #   diagnosis (5) what the residual left after a fit says
-#   tools (6)     commands, simulators, importers
+#   calibrate (6) one calibration from a request: candidates, choices by transfer, the gate, the
+#                 held-out judgements, the record to write
+#   tools (7)     commands, simulators, importers
 # A new include against this order fails the check with the file, the line and the layers.
 cmake_minimum_required(VERSION 3.16)
 if(NOT SOURCE_DIR)
   message(FATAL_ERROR "layering.cmake: pass -DSOURCE_DIR=<checkout>")
 endif()
 
-set(LAYERS odometry io models fit validation diagnosis tools)
+set(LAYERS odometry io models fit validation diagnosis calibrate tools)
 # No exception: a model that reads files of its own (ASOC's encoder files, models/asoc/asoc_files.h)
 # hands the data-set loader a reader through its Robot (Robot::read_own_encoder_file).
 set(ALLOWED_EXCEPTIONS "")

@@ -13,12 +13,12 @@
 #include "fit/model_fit.h"
 #include "fit/nlopt_search.h"
 #include "models/model_interface.h"
-#include "tools/solver_options.h"
 
-namespace fitcal::tools {
+namespace fitcal {
 
-// SolverOptions checked and in the solvers' terms (enums, SI weights), with the worker threads and
-// a progress callback; each method uses the ones that apply to it.
+// The solver flags (tools/solver_options.h) checked and in the solvers' terms (enums, SI
+// weights), with the worker threads and a progress callback; each method uses the ones that apply
+// to it.
 struct FitMethodSettings {
   int threads = 0;
   int max_iterations = 100;  // Ceres iterations per solve
@@ -86,9 +86,4 @@ void ResolveAutoResiduals(const std::vector<AlignedRun>& training,
                           const std::vector<const GroundTruthTrack*>& tracks,
                           const std::string& method, FitMethodSettings* settings);
 
-// The solver flags (tools/solver_options.h) checked and turned into settings; false with a
-// one-line message when a name is unknown or a value out of range.
-bool MakeFitMethodSettings(const SolverOptions& options, int threads, FitMethodSettings* settings,
-                           std::string* error);
-
-}  // namespace fitcal::tools
+}  // namespace fitcal

@@ -1,0 +1,230 @@
+#include "calibrate/calibrate.h"
+
+#include <sstream>
+#include <utility>
+
+#include "calibrate/calibration_record.h"
+#include "calibrate/checks_before_fitting.h"
+#include "calibrate/choice_by_transfer.h"
+#include "calibrate/track_residuals.h"
+#include "validation/never_worse.h"
+
+namespace fitcal {
+
+int CalibrationOutcome::exit_code() const {
+  if (refusal.exit_code != 0) return refusal.exit_code;
+  return stopped_early.empty() ? 0 : 6;
+}
+
+namespace {
+
+// Sets the refusal; false, so that a stage ends with `return Refuse(...)`.
+bool Refuse(CalibrationOutcome* out, int exit_code, std::vector<std::string> reasons) {
+  out->refusal = {exit_code, std::move(reasons)};
+  return false;
+}
+
+// The training runs split off and checked, the effect fit's tracks and the method's track
+// residuals prepared (--residuals auto resolved).
+bool PrepareData(const CalibrationRequest& r, const RobotModelInterface& model,
+                 CalibrationOutcome* out, std::optional<std::vector<TrackRun>>* training_tracks) {
+  out->split = SplitForFit(AlignRuns(r.runs), r.train_reps, r.train_trajectories);
+  if (out->split.training.empty()) {
+    return Refuse(out, 2, {"no run of " + r.dataset + " is a training run (" +
+                           TrainingSelection(r) + ")"});
+  }
+  std::string reason;
+  if (const int code = CheckBeforeFitting(r, model, out->split, &out->data_warnings, &reason)) {
+    return Refuse(out, code, {reason});
+  }
+  if (!r.effects_to_fit.empty()) {
+    *training_tracks = TrainingTracks(r.dataset, model.robot(), r.runs, out->split, &reason);
+    if (!*training_tracks) return Refuse(out, 2, {reason});
+  }
+  reason = PrepareTrackResiduals(r.method->name, out->split, &out->settings, &out->track_data);
+  if (!reason.empty()) return Refuse(out, 2, {reason});
+  return true;
+}
+
+// The fit of all the training runs, with the residual kind and the track objective chosen by
+// transfer first when the request leaves them to the data (not with effects to fit).
+void FitTrainingRuns(const CalibrationRequest& r, const RobotModelInterface& model,
+                     CalibrationOutcome* out, std::string* objective_note) {
+  // The fit of all the training runs when a choice by transfer made it (and kept its kind).
+  std::optional<ModelFitMethodOutcome> chosen_fit;
+  if (r.effects_to_fit.empty()) {
+    FoldFits fold_fits;
+    out->choice_lines =
+        ChooseResidualsByTransfer(*r.method, r.threads, model, out->split, &out->settings,
+                                  &out->track_data, &chosen_fit, &fold_fits);
+    for (const std::string& line : ChooseTrackObjectiveByTransfer(
+             *r.method, r.threads, model, out->split, &out->settings, &out->track_data,
+             &chosen_fit, &fold_fits, objective_note)) {
+      out->choice_lines.push_back(line);
+    }
+  }
+  out->halves = JudgeMethodOnHeldOutHalves(*r.method, r.threads, r.time_blocks, out->settings,
+                                           model, out->split);
+  const std::string refusal = DegreesOfFreedomRefusal(
+      out->split, out->settings, out->track_data,
+      NumFreeWithTying(model, out->settings.tying) + r.effects_to_fit.size());
+  if (!refusal.empty()) {
+    Refuse(out, 1, {r.dataset + ": " + refusal});
+    return;
+  }
+  out->fit = chosen_fit ? std::move(*chosen_fit)
+                        : r.method->run_model(out->split.training, model, out->settings);
+}
+
+// The candidates fitted and judged by the gate, the effects' paired test, and what the selected
+// one carries; false when it has no uncertainty to write.
+bool SelectCandidate(const CalibrationRequest& r, const RobotModelInterface& model,
+                     const std::optional<std::vector<TrackRun>>& training_tracks,
+                     const CandidateErrors& errors, const std::string& objective_note,
+                     CalibrationOutcome* out) {
+  const RunSplit& split = out->split;
+  out->candidates =
+      Candidates(model, split, out->fit.fit, r.method->name, out->settings.tying.empty());
+  if (training_tracks) {
+    out->track_fits = AddTrackFitCandidates(r.settings.weights, r.threads, model,
+                                            *training_tracks, r.effects_to_fit, &out->candidates);
+  }
+  out->gate = SelectCalibration(model, out->candidates, split.training, split.validation,
+                                r.threads, errors.Cf());
+  if (out->track_fits) {
+    out->effects_line = RequireEffectsToEarnTheirPlace(out->candidates, split, errors,
+                                                       *out->track_fits, &out->gate);
+  }
+  out->selected_fit =
+      DescribeSelected(model.robot(), out->candidates, out->gate.selected, r.method->name,
+                       out->fit.objective + objective_note, out->fit.fit, out->track_fits);
+  if (out->gate.selected == 0 || !r.will_write) return true;
+  const std::string refusal =
+      AddPropagatedUncertainty(model, out->selected(), split.training, &out->selected_fit);
+  return refusal.empty() || Refuse(out, 1, {refusal});
+}
+
+// The gate's verdict; its table says it judged on the training runs when the halves judge.
+bool JudgeGate(CalibrationOutcome* out) {
+  out->reached = CalibrationStage::kGate;
+  if (out->halves.judged) {
+    out->gate.judged_on = "training runs (" + std::to_string(out->split.training.size()) +
+                          "; no held-out runs: judged on held-out " +
+                          (out->halves.by_time ? "time blocks" : "halves") + ", below)";
+  }
+  out->gate_judged_on = out->gate.judged_on;
+  if (out->gate.improves_on_nominal()) return true;
+  return Refuse(out, 5, {"no calibration beats the nominal robot on the " +
+                         out->gate.judged_on + "; nothing written"});
+}
+
+// Why the fits of one half do not beat the nominal on the other, one reason a line.
+std::vector<std::string> HalvesRefusalReasons(const HalvesJudgement& j) {
+  std::vector<std::string> reasons;
+  const std::string half = j.by_time ? "the run's time" : "the training runs";
+  for (const HalvesGroup& g : j.groups) {
+    if (g.Beats()) continue;
+    const std::string which =
+        g.block_count > 0 ? " (" + std::to_string(g.block_count) + " blocks)" : "";
+    if (!(g.calibrated_cf < g.nominal_cf)) {
+      std::ostringstream line;
+      line << "fitted on half of " << half << which
+           << ", the calibration does not beat the nominal on the other half (CF " << g.nominal_cf
+           << " -> " << g.calibrated_cf << ")";
+      reasons.push_back(line.str());
+    }
+    for (const std::string& line : NeverWorseRefusals("the fit of one half" + which, g.never_worse)) {
+      reasons.push_back(line);
+    }
+  }
+  reasons.push_back("the runs do not determine the parameters; record more driving; nothing "
+                    "written");
+  return reasons;
+}
+
+// With nothing held out: the fits of one half must beat the nominal on the other; the record
+// then says it was judged on them.
+bool JudgeHalves(CalibrationOutcome* out) {
+  out->reached = CalibrationStage::kHalves;
+  if (!out->halves.judged) return true;
+  if (!out->halves.Beats()) return Refuse(out, 5, HalvesRefusalReasons(out->halves));
+  out->gate.judged_on = HalvesDescription(out->halves);
+  return true;
+}
+
+// A calibration better than the nominal on the held-out runs as a whole may still be worse on
+// one kind of run, or in drift or ATE, beyond the runs' own scatter (validation/never_worse.h);
+// it is then not written.
+bool JudgeNeverWorse(const RobotModelInterface& model, int threads, CalibrationOutcome* out) {
+  out->reached = CalibrationStage::kNeverWorse;
+  if (!out->gate.judged_on_held_out || out->gate.selected == 0) return true;
+  const std::vector<AlignedRun>& held_out = out->split.validation;
+  const std::vector<NeverWorseJudgement> judged = JudgeCalibrationNeverWorse(
+      model, out->candidates[0], out->selected(), held_out, TracksOf(held_out), threads);
+  NeverWorseSaid said = SayNeverWorse(out->selected().name, judged);
+  out->never_worse_warnings = said.warnings;
+  if (said.refusals.empty()) return true;
+  for (std::string& line : said.refusals) line += "; nothing written";
+  return Refuse(out, 5, said.refusals);
+}
+
+// A parameter on its bound refuses the calibration, unless the bounds were widened on purpose.
+bool JudgeBounds(const CalibrationRequest& r, const Robot& robot, CalibrationOutcome* out) {
+  out->reached = CalibrationStage::kAtBound;
+  const CalibrationCandidate& selected = out->selected();
+  const std::string refusal =
+      AtBoundRefusal(robot, selected.name, selected.parameters, out->selected_fit.at_bound);
+  if (refusal.empty() || out->gate.selected == 0) return true;
+  if (!r.bounds_widened) return Refuse(out, 5, {refusal + "; nothing written"});
+  out->at_bound_warning = refusal;
+  return true;
+}
+
+// What is said of the selected calibration beyond the gate, and its record.
+void Conclude(const CalibrationRequest& r, const RobotModelInterface& model,
+              const CandidateErrors& errors, CalibrationOutcome* out) {
+  out->reached = CalibrationStage::kDone;
+  out->effects_note = EffectsNote(out->candidates, out->gate, out->split, errors);
+  const ModelFitResult& fit = out->fit.fit;
+  const bool selected_is_fit = out->selected().name == r.method->name;
+  if (r.will_write) {
+    out->record = MakeRecord(r, model, out->split, out->candidates, out->gate, out->selected_fit,
+                             errors);
+    if (out->track_data && selected_is_fit) {
+      RecordClockOffsets(fit, *out->track_data, out->settings.clock_grouping, &*out->record);
+    }
+  }
+  if (fit.stopped_early && selected_is_fit) {
+    out->stopped_early = "warning: the written calibration is the solver's last point (" +
+                         fit.termination +
+                         " at the iteration limit): it beats the nominal, but check it or raise "
+                         "--max-iterations";
+  }
+}
+
+void Run(const CalibrationRequest& r, const RobotModelInterface& model, CalibrationOutcome* out) {
+  out->settings = r.settings;
+  std::optional<std::vector<TrackRun>> training_tracks;
+  if (!PrepareData(r, model, out, &training_tracks)) return;
+  std::string objective_note;
+  FitTrainingRuns(r, model, out, &objective_note);
+  if (out->refusal.exit_code != 0) return;
+  const CandidateErrors errors(model, r.threads);
+  if (!SelectCandidate(r, model, training_tracks, errors, objective_note, out)) return;
+  if (!JudgeGate(out) || !JudgeHalves(out) || !JudgeNeverWorse(model, r.threads, out) ||
+      !JudgeBounds(r, model.robot(), out)) {
+    return;
+  }
+  Conclude(r, model, errors, out);
+}
+
+}  // namespace
+
+CalibrationOutcome Calibrate(const CalibrationRequest& request, const RobotModelInterface& model) {
+  CalibrationOutcome out;
+  Run(request, model, &out);
+  out.settings.track = nullptr;  // it pointed into out.track_data, which moves with the outcome
+  return out;
+}
+
+}  // namespace fitcal

@@ -1,0 +1,81 @@
+#include "calibrate/calibration_record.h"
+
+#include <string>
+
+#include "fitcal/version.h"
+#include "validation/training_runs.h"
+
+namespace fitcal {
+
+namespace {
+
+// The weights in words: the noise levels the fit estimated, or the sigmas it was given.
+std::string WeightsText(const CalibrationRequest& request, const NoiseLevels& levels) {
+  if (levels.estimated) return "weights from the data: " + NoiseLevelsText(levels);
+  return "sigma_xy " + std::to_string(request.position_sigma_m) + " m, sigma_theta " +
+         std::to_string(request.heading_sigma_deg) + " deg";
+}
+
+void RecordFitSource(const CalibrationRequest& request, const RunSplit& split,
+                     const std::string& method, const SelectedFit& fit,
+                     io::CalibrationSource* source) {
+  io::CalibrationSource& s = *source;
+  s.method = method;
+  s.objective = fit.objective + " (" + WeightsText(request, fit.noise_levels) + ")";
+  s.dataset = request.dataset;
+  s.tool_version = kVersion;
+  s.termination = fit.termination;
+  s.training_repetitions = split.training_repetitions;
+  s.validation_repetitions = split.validation_repetitions;
+  for (const AlignedRun& run : split.training) s.training_run_ids.push_back(run.id);
+  s.training_trajectories = request.train_trajectories;
+  s.training_fingerprint = TrainingFingerprint(request.runs, s.training_run_ids);
+  s.training_runs = static_cast<int>(split.training.size());
+  s.validation_runs = static_cast<int>(split.validation.size());
+}
+
+}  // namespace
+
+io::CalibrationBlock MakeRecord(const CalibrationRequest& request, const RobotModelInterface& model,
+                                const RunSplit& split,
+                                const std::vector<CalibrationCandidate>& candidates,
+                                const GateDecision& gate, const SelectedFit& selected_fit,
+                                const CandidateErrors& errors) {
+  const Robot& robot = model.robot();
+  const CalibrationCandidate& nominal = candidates[0];
+  const CalibrationCandidate& selected = candidates[gate.selected];
+  io::CalibrationBlock r;
+  RecordFitSource(request, split, selected.name, selected_fit, &r);
+  r.cf_training_before = errors(nominal, split.training).cf;
+  r.cf_training_after = errors(selected, split.training).cf;
+  r.cf_validation_before = errors(nominal, split.validation).cf;
+  r.cf_validation_after = errors(selected, split.validation).cf;
+  r.selected = selected.name;
+  r.selected_on = gate.judged_on;
+  for (const HeldParameter& h : robot.held) r.held.push_back(robot.parameters[h.index].name);
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    // Held by --hold (fit/parameter_tying.h) beside the model's own holds.
+    if (selected_fit.held[k] && !robot.IsHeld(k)) r.held.push_back(robot.parameters[k].name);
+  }
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    if (selected_fit.at_bound[k]) r.at_bound.push_back(robot.parameters[k].name);
+  }
+  // The uncertainty is the selected fit's (with its effects, when it carries some; the effects'
+  // own sigmas are written with them).
+  r.has_uncertainty = selected_fit.has_covariance;
+  r.sigma = selected_fit.sigma;
+  r.correlation = selected_fit.correlation;
+  return r;
+}
+
+void RecordClockOffsets(const ModelFitResult& fit, const TrackFitData& track,
+                        ClockGrouping grouping, io::CalibrationBlock* record) {
+  if (!track.estimate_clock_offsets) return;
+  record->clock_offset_grouping = ToString(grouping);
+  for (std::size_t g = 0; g < track.clock_groups.size() && g < fit.clock_offsets_s.size(); ++g) {
+    const double sigma = g < fit.clock_offset_sigma_s.size() ? fit.clock_offset_sigma_s[g] : 0.0;
+    record->clock_offsets.push_back({track.clock_groups[g], fit.clock_offsets_s[g], sigma});
+  }
+}
+
+}  // namespace fitcal

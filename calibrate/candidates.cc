@@ -1,0 +1,141 @@
+#include "calibrate/candidates.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "validation/statistics.h"
+#include "validation/trajectory_metrics.h"
+
+namespace fitcal {
+
+FinalPoseErrors CandidateErrors::operator()(const CalibrationCandidate& c,
+                                            const std::vector<AlignedRun>& runs) const {
+  if (c.effects.empty()) return EvaluateFinalPoseErrors(model_, c.parameters, runs, threads_);
+  return EvaluateFinalPoseErrors(model_, c.parameters, c.effects, runs, TracksOf(runs), threads_);
+}
+
+EffectCandidateCf CandidateErrors::Cf() const {
+  return [this](const CalibrationCandidate& c, const std::vector<AlignedRun>& runs) {
+    return (*this)(c, runs).cf;
+  };
+}
+
+std::vector<CalibrationCandidate> Candidates(const RobotModelInterface& model,
+                                             const RunSplit& split, const ModelFitResult& fit,
+                                             const std::string& method, bool closed_forms) {
+  std::vector<CalibrationCandidate> out = {
+      {"nominal", model.robot().nominal, true, model.robot().effects}};
+  for (const ClosedFormCalibration& c :
+       closed_forms ? model.ClosedForms(split.training) : std::vector<ClosedFormCalibration>{}) {
+    out.push_back({c.method, c.parameters, true, {}, c.sigma});
+  }
+  out.push_back({method, fit.parameters, fit.usable || fit.stopped_early});
+  if (!fit.held_directions.empty() && !split.validation.empty()) {
+    out.push_back(
+        {method + " without holds", fit.unconstrained_parameters, fit.unconstrained_usable});
+  }
+  return out;
+}
+
+std::string EffectNames(const EffectModel& effects) {
+  std::string out;
+  for (const effects::EffectValue& e : effects) {
+    out += std::string(out.empty() ? "" : ", ") + effects::Info(e.id).name;
+  }
+  return out;
+}
+
+namespace {
+
+// The model's parameters and `effects` fitted on the training tracks (fit/effect_fit.h),
+// from the nominal, as `diagnose` and `generalise --effects` fit them.
+EffectFitResult FitEffects(const ResidualWeights& weights, int threads,
+                           const RobotModelInterface& model, const std::vector<TrackRun>& training,
+                           const EffectModel& effects) {
+  EffectFitOptions o;
+  o.weights = weights;
+  o.num_threads = threads;
+  return FitEffectModel(training, model, model.robot().nominal, effects, o);
+}
+
+}  // namespace
+
+TrackFits AddTrackFitCandidates(const ResidualWeights& weights, int threads,
+                                const RobotModelInterface& model,
+                                const std::vector<TrackRun>& training_tracks,
+                                const EffectModel& effects_to_fit,
+                                std::vector<CalibrationCandidate>* candidates) {
+  TrackFits t;
+  t.without_effects = FitEffects(weights, threads, model, training_tracks, {});
+  t.with_effects = FitEffects(weights, threads, model, training_tracks, effects_to_fit);
+  t.without_index = static_cast<int>(candidates->size());
+  candidates->push_back({"track fit", t.without_effects.parameters, t.without_effects.usable});
+  t.with_index = static_cast<int>(candidates->size());
+  candidates->push_back({"track fit + " + EffectNames(effects_to_fit), t.with_effects.parameters,
+                         t.with_effects.usable, t.with_effects.effects});
+  return t;
+}
+
+int BestWithoutEffects(const std::vector<CalibrationCandidate>& candidates,
+                       const GateDecision& gate) {
+  int best = -1;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    if (!candidates[i].effects.empty() || !std::isfinite(gate.cf[i])) continue;
+    if (best < 0 || gate.cf[i] < gate.cf[best]) best = static_cast<int>(i);
+  }
+  return best;
+}
+
+std::string RequireEffectsToEarnTheirPlace(const std::vector<CalibrationCandidate>& candidates,
+                                           const RunSplit& split, const CandidateErrors& errors,
+                                           const TrackFits& track_fits, GateDecision* gate) {
+  const CalibrationCandidate& chosen = candidates[gate->selected];
+  if (chosen.effects.empty()) return "";
+  const CalibrationCandidate& without = candidates[track_fits.without_index];
+  const std::vector<AlignedRun>& runs =
+      gate->judged_on_held_out ? split.validation : split.training;
+  const stats::PairedTest test =
+      stats::PairedLogRatioTest(errors(without, runs).per_run_cf, errors(chosen, runs).per_run_cf);
+  char line[400];
+  if (test.p < kEffectAlpha) {
+    std::snprintf(line, sizeof line,
+                  "effects: '%s' beats '%s' run by run (paired log-ratio t = %.2f, p = %.2g < %g)",
+                  chosen.name.c_str(), without.name.c_str(), test.t, test.p, kEffectAlpha);
+    return line;
+  }
+  // The nominal carries effects only when the robot declares them; then some fit must stand in.
+  const int best = std::max(0, BestWithoutEffects(candidates, *gate));
+  std::snprintf(line, sizeof line,
+                "effects: '%s' is not significantly better than '%s' run by run (paired "
+                "log-ratio t = %.2f, p = %.2g >= %g): '%s' is selected",
+                chosen.name.c_str(), without.name.c_str(), test.t, test.p, kEffectAlpha,
+                candidates[best].name.c_str());
+  gate->selected = best;
+  return line;
+}
+
+std::string EffectsNote(const std::vector<CalibrationCandidate>& candidates,
+                        const GateDecision& gate, const RunSplit& split,
+                        const CandidateErrors& errors) {
+  const CalibrationCandidate& selected = candidates[gate.selected];
+  if (selected.effects.empty()) return "";
+  const std::vector<AlignedRun>& runs = gate.judged_on_held_out ? split.validation : split.training;
+  const double alone = errors({selected.name, selected.parameters, true, {}}, runs).cf;
+  const int best = BestWithoutEffects(candidates, gate);
+  std::ostringstream note;
+  note << "note: the calibration carries effects (" << EffectNames(selected.effects)
+       << ") that an odometry of the parameters alone (a ros2_controllers controller) does "
+          "not apply: there its parameters give CF "
+       << alone << " on the " << gate.judged_on;
+  if (best >= 0) {
+    note << ", the best calibration without effects ('" << candidates[best].name << "') "
+         << gate.cf[best];
+  }
+  note << "; for such a controller, fit without effects (no --effects, no effects: in the "
+          "robot YAML)";
+  return note.str();
+}
+
+}  // namespace fitcal

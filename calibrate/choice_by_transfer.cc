@@ -1,0 +1,160 @@
+#include "calibrate/choice_by_transfer.h"
+
+#include "calibrate/track_residuals.h"
+#include "validation/everyday_driving.h"
+#include "validation/track_objective_transfer.h"
+
+namespace fitcal {
+
+ScoreOnRuns EverydayDrivingScore(const RobotModelInterface& model, int threads) {
+  return [&model, threads](const std::vector<double>& p, const std::vector<AlignedRun>& runs) {
+    return EvaluateEverydayDriving(model, p, {}, runs, TracksOf(runs), EverydayDriftLengths(),
+                                   threads);
+  };
+}
+
+std::optional<std::vector<double>> FoldFits::Fit(const FitMethod& method,
+                                                 const RobotModelInterface& model,
+                                                 FitMethodSettings s,
+                                                 const std::vector<AlignedRun>& training) {
+  std::string key = std::string(ToString(s.residuals)) + (s.estimate_weights ? " est " : " fix ") +
+                    ToString(s.track_heading);
+  for (const AlignedRun& run : training) key += " " + run.id;
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (const auto found = done_.find(key); found != done_.end()) return found->second;
+  }
+  s.residuals_auto = false;
+  s.track = nullptr;
+  s.start = start;
+  if (s.estimate_weights && seed_levels.estimated) {
+    s.track_weights = WeightsFromNoiseLevels(seed_levels).track;
+  }
+  RunSplit part;
+  part.training = training;
+  std::optional<TrackFitData> data;
+  std::optional<std::vector<double>> out;
+  // The whole data's method fits this kind (checked before the choice): no refusal here.
+  if (PrepareTrackResiduals(method.name, part, &s, &data).empty()) {
+    const ModelFitResult fit = method.run_model(training, model, s).fit;
+    if (fit.usable || fit.stopped_early) out = fit.parameters;
+  }
+  const std::lock_guard<std::mutex> lock(mutex_);
+  done_[key] = out;
+  return out;
+}
+
+namespace {
+
+// The fit of all the training runs with `settings` into *full; the folds' fits start from it.
+void FitAllTrainingRuns(const FitMethod& method, const RobotModelInterface& model,
+                        const RunSplit& split, const FitMethodSettings& settings,
+                        std::optional<ModelFitMethodOutcome>* full, FoldFits* fold_fits) {
+  full->emplace(method.run_model(split.training, model, settings));
+  const ModelFitResult& whole = (*full)->fit;
+  if (whole.usable || whole.stopped_early) fold_fits->start = whole.parameters;
+  fold_fits->seed_levels = whole.noise_levels;
+}
+
+// The track objectives --weights auto / --track-heading auto allow, the default first (weights
+// fixed unless --weights estimated, heading from the start unless given).
+std::vector<TrackObjective> TrackObjectiveCandidates(const FitMethodSettings& settings) {
+  const std::vector<bool> weights =
+      settings.weights_auto ? std::vector<bool>{false, true}
+                            : std::vector<bool>{settings.estimate_weights};
+  const std::vector<TrackHeading> headings =
+      settings.track_heading_auto
+          ? std::vector<TrackHeading>{TrackHeading::kFromStart, TrackHeading::kIncrements}
+          : std::vector<TrackHeading>{settings.track_heading};
+  std::vector<TrackObjective> out;
+  for (TrackHeading heading : headings) {
+    for (bool estimate : weights) out.push_back({estimate, heading});
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::string> ChooseResidualsByTransfer(const FitMethod& method, int threads,
+                                                   const RobotModelInterface& model,
+                                                   const RunSplit& split,
+                                                   FitMethodSettings* settings,
+                                                   std::optional<TrackFitData>* track_data,
+                                                   std::optional<ModelFitMethodOutcome>* full,
+                                                   FoldFits* fold_fits) {
+  if (!settings->residuals_auto || settings->residuals != ResidualKind::kTrack) return {};
+  FitAllTrainingRuns(method, model, split, *settings, full, fold_fits);
+  const FitByKind fit_on = [&](ResidualKind kind, const std::vector<AlignedRun>& training) {
+    FitMethodSettings s = *settings;
+    s.residuals = kind;
+    return fold_fits->Fit(method, model, s, training);
+  };
+  const ScoreOnRuns score = EverydayDrivingScore(model, threads);
+  const ResidualKindJudgement judgement = JudgeResidualKindsByTransfer(
+      ResidualKind::kTrack, ResidualKind::kFinalPose, split, fit_on, score);
+  if (judgement.chosen != settings->residuals) {
+    settings->residuals = judgement.chosen;
+    settings->track = nullptr;
+    track_data->reset();
+    full->reset();
+  }
+  return ResidualKindJudgementLines(judgement);
+}
+
+std::vector<std::string> ChooseTrackObjectiveByTransfer(
+    const FitMethod& method, int threads, const RobotModelInterface& model, const RunSplit& split,
+    FitMethodSettings* settings, std::optional<TrackFitData>* track_data,
+    std::optional<ModelFitMethodOutcome>* full, FoldFits* fold_fits, std::string* note) {
+  if (!settings->weights_auto && !settings->track_heading_auto) return {};
+  if (settings->residuals == ResidualKind::kFinalPose) return {};
+  // The default candidate's fit of all the runs (unless the residual choice made it): the folds'
+  // start, and the fit written when the default is kept.
+  if (!*full) FitAllTrainingRuns(method, model, split, *settings, full, fold_fits);
+  const FitByTrackObjective fit_on = [&](const TrackObjective& objective,
+                                         const std::vector<AlignedRun>& training) {
+    FitMethodSettings s = *settings;
+    s.estimate_weights = objective.estimate_weights;
+    s.track_heading = objective.heading;
+    return fold_fits->Fit(method, model, s, training);
+  };
+  const ScoreOnRuns score = EverydayDrivingScore(model, threads);
+  const TrackObjectiveJudgement judgement = JudgeTrackObjectivesByTransfer(
+      TrackObjectiveCandidates(*settings), split, fit_on, score);
+  *note = TrackObjectiveChoiceText(judgement);
+  if (judgement.chosen != 0) {
+    const TrackObjective& chosen = judgement.candidates[judgement.chosen];
+    settings->estimate_weights = chosen.estimate_weights;
+    settings->track_heading = chosen.heading;
+    settings->track = nullptr;
+    track_data->reset();
+    full->reset();
+    // The method fits tracks (this choice is made on track residuals only): no refusal here.
+    if (!PrepareTrackResiduals(method.name, split, settings, track_data).empty()) return {};
+  }
+  return TrackObjectiveJudgementLines(judgement);
+}
+
+HalvesJudgement JudgeMethodOnHeldOutHalves(const FitMethod& method, int threads, int time_blocks,
+                                           const FitMethodSettings& settings,
+                                           const RobotModelInterface& model,
+                                           const RunSplit& split) {
+  const FitOnFold fit_on = [&](const HalvesFold& fold) -> std::optional<std::vector<double>> {
+    FitMethodSettings fold_settings = settings;
+    fold_settings.residuals_auto = false;  // the whole data's choice holds for its halves
+    std::optional<TrackFitData> track_data;
+    if (!PrepareTrackResiduals(method.name, fold.split, &fold_settings, &track_data).empty()) {
+      return std::nullopt;
+    }
+    const ModelFitResult fit = method.run_model(fold.split.training, model, fold_settings).fit;
+    if (!(fit.usable || fit.stopped_early)) return std::nullopt;
+    return fit.parameters;
+  };
+  const ScoreOnRuns on_runs = EverydayDrivingScore(model, threads);
+  const MetricsOnFold score = [&](const std::vector<double>& p, const HalvesFold& fold) {
+    return on_runs(p, fold.split.validation);
+  };
+  return fitcal::JudgeOnHeldOutHalves(split, settings.residuals, time_blocks,
+                                      model.robot().nominal, fit_on, score);
+}
+
+}  // namespace fitcal

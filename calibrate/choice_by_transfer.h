@@ -1,0 +1,72 @@
+#pragma once
+// The fit's choices made by transfer, each fold fitted by the request's method: the residual kind
+// (validation/residual_kind_transfer.h), the track's heading and weights
+// (validation/track_objective_transfer.h), and, with nothing held out, the two-fold judgement of
+// the method (validation/held_out_halves.h).
+
+#include <map>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "calibrate/fit_methods.h"
+#include "fit/run_split.h"
+#include "validation/held_out_halves.h"
+#include "validation/residual_kind_transfer.h"
+
+namespace fitcal {
+
+// How the choices by transfer and the held-out halves score a fit: the everyday-driving
+// measures (Eq. 14 CF, drift per length, ATE) of parameters `p` on runs, each against its track.
+ScoreOnRuns EverydayDrivingScore(const RobotModelInterface& model, int threads);
+
+// The fits of the folds the choices by transfer make (residual kind, then track objective), each
+// made once: the track with the default objective on a fold is a candidate of both.
+class FoldFits {
+ public:
+  // `s` fitted on `training` from `start` (the fit of all the training runs), its weights seeded
+  // by that fit's noise levels when it estimated them; nullopt when not usable.
+  std::optional<std::vector<double>> Fit(const FitMethod& method, const RobotModelInterface& model,
+                                         FitMethodSettings s,
+                                         const std::vector<AlignedRun>& training);
+
+  std::vector<double> start;  // empty: the nominal
+  NoiseLevels seed_levels;
+
+ private:
+  std::mutex mutex_;
+  std::map<std::string, std::optional<std::vector<double>>> done_;
+};
+
+// --residuals auto proposing the track: the track and the final pose are fitted and judged on
+// kinds of run they were not fitted on (validation/residual_kind_transfer.h); the final pose
+// replaces the track when that judgement says so (settings and *track_data follow). The folds'
+// fits start from the track fit of all the training runs (`full`, the fit the command writes
+// when the track stays), so each ends in a few steps, and run in parallel. The lines for the
+// terminal; none when nothing could be judged.
+std::vector<std::string> ChooseResidualsByTransfer(const FitMethod& method, int threads,
+                                                   const RobotModelInterface& model,
+                                                   const RunSplit& split,
+                                                   FitMethodSettings* settings,
+                                                   std::optional<TrackFitData>* track_data,
+                                                   std::optional<ModelFitMethodOutcome>* full,
+                                                   FoldFits* fold_fits);
+
+// --weights auto / --track-heading auto on track residuals: the candidates fitted and judged by
+// transfer (validation/track_objective_transfer.h), each fold's fit started from the fit of all
+// the training runs when the residual choice made one; settings, *track_data and *full follow the
+// choice. The lines for the terminal, and in *note what the calibration's objective records.
+std::vector<std::string> ChooseTrackObjectiveByTransfer(
+    const FitMethod& method, int threads, const RobotModelInterface& model, const RunSplit& split,
+    FitMethodSettings* settings, std::optional<TrackFitData>* track_data,
+    std::optional<ModelFitMethodOutcome>* full, FoldFits* fold_fits, std::string* note);
+
+// With nothing held out, the two-fold judgement of validation/held_out_halves.h, each fold fitted
+// by `method` with the whole data's settings and scored on the everyday-driving measures.
+HalvesJudgement JudgeMethodOnHeldOutHalves(const FitMethod& method, int threads, int time_blocks,
+                                           const FitMethodSettings& settings,
+                                           const RobotModelInterface& model,
+                                           const RunSplit& split);
+
+}  // namespace fitcal

@@ -1,0 +1,45 @@
+#pragma once
+// What the parameter table and the calibration record say of the selected candidate: the
+// uncertainty, bound contacts and holds of the fit that made it, and the uncertainty propagated
+// through the training runs for a candidate without one of its own.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "calibrate/candidates.h"
+
+namespace fitcal {
+
+// The uncertainty, bound contacts and holds of the fit that made the selected candidate (none for
+// the nominal or a closed form; a fit's bound contacts also for the fit without its holds).
+struct SelectedFit {
+  bool has_covariance = false;
+  std::vector<double> sigma;
+  Eigen::MatrixXd correlation;
+  std::vector<bool> at_bound, held;  // per parameter
+  std::string objective, termination;
+  // The weights' noise levels when the fit estimated them (fit/noise_levels.h); else not estimated.
+  NoiseLevels noise_levels;
+};
+
+// candidates[selected_index] described by the fit that made it: `fit` (the method's, minimising
+// `method_objective`) or one of the track fits.
+SelectedFit DescribeSelected(const Robot& robot,
+                             const std::vector<CalibrationCandidate>& candidates,
+                             int selected_index, const std::string& method,
+                             const std::string& method_objective, const ModelFitResult& fit,
+                             const std::optional<TrackFits>& track_fits);
+
+// A selected candidate without a covariance of its own (a closed form, a fit without its holds)
+// gets the one propagated through the training runs' final-pose residuals at its point
+// (validation/propagated_uncertainty.h), with a closed form's own sigmas where it has them: a
+// written calibration never has sigma: null. "" when done; else why even that is not possible
+// (nothing may then be written).
+std::string AddPropagatedUncertainty(const RobotModelInterface& model,
+                                     const CalibrationCandidate& selected,
+                                     const std::vector<AlignedRun>& training, SelectedFit* fit);
+
+}  // namespace fitcal
