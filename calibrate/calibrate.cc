@@ -6,6 +6,7 @@
 #include "calibrate/calibration_record.h"
 #include "calibrate/checks_before_fitting.h"
 #include "calibrate/choice_by_transfer.h"
+#include "calibrate/never_worse_gate.h"
 #include "calibrate/track_residuals.h"
 #include "validation/never_worse.h"
 
@@ -159,13 +160,10 @@ bool JudgeNeverWorse(const RobotModelInterface& model, int threads, CalibrationO
   out->reached = CalibrationStage::kNeverWorse;
   if (!out->gate.judged_on_held_out || out->gate.selected == 0) return true;
   const std::vector<AlignedRun>& held_out = out->split.validation;
-  const std::vector<NeverWorseJudgement> judged = JudgeCalibrationNeverWorse(
+  NeverWorseVerdict verdict = JudgeNeverWorseThanNominal(
       model, out->candidates[0], out->selected(), held_out, TracksOf(held_out), threads);
-  NeverWorseSaid said = SayNeverWorse(out->selected().name, judged);
-  out->never_worse_warnings = said.warnings;
-  if (said.refusals.empty()) return true;
-  for (std::string& line : said.refusals) line += "; nothing written";
-  return Refuse(out, 5, said.refusals);
+  out->never_worse_warnings = std::move(verdict.warnings);
+  return verdict.refusals.empty() || Refuse(out, 5, std::move(verdict.refusals));
 }
 
 // A parameter on its bound refuses the calibration, unless the bounds were widened on purpose.

@@ -7,6 +7,7 @@
 #include <iostream>
 #include <set>
 
+#include "calibrate/never_worse_gate.h"
 #include "diagnosis/channel_order_check.h"
 #include "diagnosis/clock_choice.h"
 #include "diagnosis/diagnose.h"
@@ -29,7 +30,6 @@
 #include "tools/miswired_error.h"
 #include "tools/output_guard.h"
 #include "tools/report_command.h"
-#include "validation/never_worse.h"
 #include "validation/propagated_uncertainty.h"
 #include "validation/training_runs.h"
 #include "validation/trajectory_metrics.h"
@@ -177,14 +177,12 @@ bool WorseThanNominalBeyondNoise(const RobotModelInterface& model, const Diagnos
     runs.push_back(r.aligned);
     tracks.push_back(&r.track);
   }
-  const NeverWorseSaid said = SayNeverWorse(
-      choice.name, JudgeCalibrationNeverWorse(
-                       model, {nominal.name, nominal.parameters, true, nominal.effects},
-                       {choice.name, choice.parameters, true, choice.effects}, runs, tracks,
-                       threads));
-  for (const std::string& line : said.warnings) std::printf("warning: %s\n", line.c_str());
-  for (const std::string& line : said.refusals) std::cerr << "fitcal: " << line << "; nothing written\n";
-  return !said.refusals.empty();
+  const NeverWorseVerdict verdict = JudgeNeverWorseThanNominal(
+      model, {nominal.name, nominal.parameters, true, nominal.effects},
+      {choice.name, choice.parameters, true, choice.effects}, runs, tracks, threads);
+  for (const std::string& line : verdict.warnings) std::printf("warning: %s\n", line.c_str());
+  for (const std::string& line : verdict.refusals) std::cerr << "fitcal: " << line << "\n";
+  return !verdict.refusals.empty();
 }
 
 // A written calibration never carries sigma: null. When the fit that made the chosen parameters

@@ -1,0 +1,122 @@
+// Calibrate(request) -> CalibrationOutcome (calibrate/calibrate.h) called as a library, without
+// the command: the refusals come back with their exit code, reason and stage, nothing is left to
+// the caller to decide, and the selected candidate is the gate's on the runs it says it judged
+// on. The CFs the outcome reports are checked against a replay of the selected parameters made
+// here (fit/final_pose_errors.h), not against the outcome's own numbers.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "calibrate/calibrate.h"
+#include "io/dataset.h"
+#include "models/model_registry.h"
+#include "tests/test_paths.h"
+
+namespace fitcal {
+namespace {
+
+struct Loaded {
+  RobotModelPtr model;
+  CalibrationRequest request;
+};
+
+// The shipped data set `name` loaded with its robot's channels, fitted on final poses by Ceres
+// (the command's defaults otherwise: fixed weights of 1 m and 1 rad).
+Loaded Load(const std::string& name) {
+  const std::string dir = FITCAL_SOURCE_DIR + "/data/" + name;
+  const io::DatasetIndex index = io::ReadDatasetIndex(dir);
+  Loaded out{ReadRobotModelFile(index.robot_path), {}};
+  CalibrationRequest& r = out.request;
+  r.dataset = dir;
+  r.method = FindFitMethod("ceres");
+  r.settings.threads = 2;
+  r.settings.estimate_weights = false;
+  r.settings.residuals = ResidualKind::kFinalPose;
+  r.runs = io::LoadDataset(index, out.model->robot()).runs;
+  r.threads = 2;
+  return out;
+}
+
+TEST(Calibrate, ATrainingSelectionThatMatchesNoRunIsRefusedWithUsageExitBeforeAnyFit) {
+  Loaded l = Load("flower");
+  l.request.train_reps = "40-50";
+  const CalibrationOutcome o = Calibrate(l.request, *l.model);
+  EXPECT_EQ(o.exit_code(), 2);
+  EXPECT_EQ(o.reached, CalibrationStage::kChecks);
+  ASSERT_EQ(o.refusal.reasons.size(), 1u);
+  EXPECT_EQ(o.refusal.reasons[0], "no run of " + l.request.dataset +
+                                      " is a training run (repetitions 40-50)");
+  EXPECT_TRUE(o.candidates.empty());
+  EXPECT_FALSE(o.record.has_value());
+}
+
+TEST(Calibrate, TrackResidualsWithAMethodThatFitsFinalPosesOnlyAreRefusedWithUsageExit) {
+  Loaded l = Load("flower");
+  l.request.method = FindFitMethod("sbplx");
+  l.request.settings.residuals = ResidualKind::kTrack;
+  const CalibrationOutcome o = Calibrate(l.request, *l.model);
+  EXPECT_EQ(o.exit_code(), 2);
+  ASSERT_EQ(o.refusal.reasons.size(), 1u);
+  EXPECT_EQ(o.refusal.reasons[0],
+            "--residuals track needs a Ceres method (--method ceres or ceres-dogleg); sbplx fits "
+            "final poses only");
+}
+
+TEST(Calibrate, TheSelectedCandidateIsTheLowestHeldOutCfAndItsRecordSaysSo) {
+  Loaded l = Load("flower");
+  const CalibrationOutcome o = Calibrate(l.request, *l.model);
+  ASSERT_EQ(o.exit_code(), 0);
+  EXPECT_EQ(o.reached, CalibrationStage::kDone);
+  ASSERT_FALSE(o.split.validation.empty());
+  ASSERT_TRUE(o.record.has_value());
+  EXPECT_EQ(o.candidates[0].name, "nominal");
+  EXPECT_EQ(o.record->selected, o.selected().name);
+  // The held-out CF of every candidate, replayed here; the selected one is the lowest, strictly
+  // below the nominal's, and the record's before/after are the nominal's and the selected one's.
+  std::vector<double> cf;
+  for (const CalibrationCandidate& c : o.candidates) {
+    cf.push_back(EvaluateFinalPoseErrors(*l.model, c.parameters, o.split.validation, 1).cf);
+  }
+  const auto lowest = std::min_element(cf.begin(), cf.end()) - cf.begin();
+  EXPECT_EQ(o.gate.selected, lowest);
+  EXPECT_LT(cf[o.gate.selected], cf[0]);
+  // Sums over runs in another thread order: equal to rounding.
+  EXPECT_NEAR(o.record->cf_validation_before, cf[0], 1e-12);
+  EXPECT_NEAR(o.record->cf_validation_after, cf[o.gate.selected], 1e-12);
+  EXPECT_TRUE(o.record->has_uncertainty);
+}
+
+TEST(Calibrate, ARequestThatDoesNotWriteGetsNoRecord) {
+  Loaded l = Load("flower");
+  l.request.will_write = false;
+  const CalibrationOutcome o = Calibrate(l.request, *l.model);
+  EXPECT_EQ(o.exit_code(), 0);
+  EXPECT_EQ(o.reached, CalibrationStage::kDone);
+  EXPECT_FALSE(o.record.has_value());
+}
+
+// data/undeclared_effect: a robot with an effect its model lacks; the fit pushes a radius onto
+// its bound. Refused at that stage (exit 5) unless the bounds were widened on purpose, when the
+// refusal becomes the warning and the record is made.
+TEST(Calibrate, AParameterOnItsBoundRefusesUnlessTheBoundsWereWidened) {
+  Loaded l = Load("undeclared_effect");
+  const CalibrationOutcome refused = Calibrate(l.request, *l.model);
+  EXPECT_EQ(refused.exit_code(), 5);
+  EXPECT_EQ(refused.reached, CalibrationStage::kAtBound);
+  ASSERT_EQ(refused.refusal.reasons.size(), 1u);
+  const std::string& reason = refused.refusal.reasons[0];
+  EXPECT_EQ(reason.rfind("'ceres' leaves a parameter on its bound (", 0), 0u) << reason;
+  EXPECT_FALSE(refused.record.has_value());
+
+  l.request.bounds_widened = true;
+  const CalibrationOutcome widened = Calibrate(l.request, *l.model);
+  EXPECT_EQ(widened.exit_code(), 0);
+  EXPECT_EQ(widened.reached, CalibrationStage::kDone);
+  EXPECT_EQ(widened.at_bound_warning + "; nothing written", reason);
+  EXPECT_TRUE(widened.record.has_value());
+}
+
+}  // namespace
+}  // namespace fitcal
