@@ -10,6 +10,7 @@
 #include <string>
 
 #include "calibrate/calibrate.h"
+#include "calibrate/diagnosis_calibration.h"
 #include "io/dataset.h"
 #include "models/model_registry.h"
 #include "tests/test_paths.h"
@@ -116,6 +117,55 @@ TEST(Calibrate, AParameterOnItsBoundRefusesUnlessTheBoundsWereWidened) {
   EXPECT_EQ(widened.reached, CalibrationStage::kDone);
   EXPECT_EQ(widened.at_bound_warning + "; nothing written", reason);
   EXPECT_TRUE(widened.record.has_value());
+}
+
+// CalibrateOnDiagnosis (calibrate/diagnosis_calibration.h) on diagnoses made up here: every fit
+// at the nominal ties with it, and the nominal wins ties (exit 5, nothing to write); a track fit
+// with the parameters a Ceres fit of the flower found, without a covariance of its own, is
+// selected, gets the uncertainty propagated through the training runs and is recorded.
+struct DiagnosisCase {
+  Loaded loaded = Load("flower");
+  SplitOf<TrackRun> split;
+  DiagnoseResult result;
+  DiagnosisCase() {
+    const Robot& robot = loaded.model->robot();
+    split = SplitForFit(PrepareTrackRuns(loaded.request.runs, WheelChannelMask(robot)), "1-5", "");
+    result.declared.parameters = robot.nominal;
+    result.declared_validation.cf = 1e9;  // worse than anything: never selected
+    result.base.parameters = robot.nominal;
+  }
+  DiagnosisCalibration Run() const {
+    return CalibrateOnDiagnosis({"flower", "", &loaded.request.runs, 2}, *loaded.model, split,
+                                result);
+  }
+};
+
+TEST(CalibrateOnDiagnosis, TheNominalWinsTiesAndIsRefusedWithExitFive) {
+  const DiagnosisCase c;
+  const DiagnosisCalibration d = c.Run();
+  EXPECT_EQ(d.refusal.exit_code, 5);
+  EXPECT_EQ(d.reached, CalibrationStage::kGate);
+  ASSERT_EQ(d.gate.size(), 3u);
+  EXPECT_EQ(d.gate[2].cf_after, d.gate[0].cf_after);  // the track fit at the nominal: a tie
+  EXPECT_EQ(d.choice.name, "nominal");
+}
+
+TEST(CalibrateOnDiagnosis, ATrackFitWithoutCovarianceGetsThePropagatedUncertaintyAndIsRecorded) {
+  DiagnosisCase c;
+  const CalibrationOutcome fit = Calibrate(c.loaded.request, *c.loaded.model);
+  ASSERT_EQ(fit.exit_code(), 0);
+  c.result.base.parameters = fit.selected().parameters;
+  const DiagnosisCalibration d = c.Run();
+  ASSERT_EQ(d.refusal.exit_code, 0) << d.refusal.reasons.front();
+  EXPECT_EQ(d.reached, CalibrationStage::kDone);
+  EXPECT_EQ(d.choice.name, "track fit");
+  EXPECT_LT(d.choice.cf_after, d.gate[0].cf_after);
+  EXPECT_TRUE(d.uncertainty_propagated);
+  EXPECT_EQ(d.record.selected, "track fit");
+  EXPECT_TRUE(d.record.has_uncertainty);
+  ASSERT_EQ(d.record.sigma.size(), c.loaded.model->robot().nominal.size());
+  for (double sigma : d.record.sigma) EXPECT_GT(sigma, 0.0);
+  EXPECT_EQ(d.record.cf_validation_after, d.choice.cf_after);
 }
 
 }  // namespace

@@ -7,11 +7,10 @@
 #include <iostream>
 #include <set>
 
-#include "calibrate/never_worse_gate.h"
+#include "calibrate/diagnosis_calibration.h"
 #include "diagnosis/channel_order_check.h"
 #include "diagnosis/clock_choice.h"
 #include "diagnosis/diagnose.h"
-#include "fit/correlation.h"
 #include "fit/run_split.h"
 #include "fit/segment_cost.h"
 #include "fitcal/version.h"
@@ -30,8 +29,6 @@
 #include "tools/miswired_error.h"
 #include "tools/output_guard.h"
 #include "tools/report_command.h"
-#include "validation/propagated_uncertainty.h"
-#include "validation/training_runs.h"
 #include "validation/trajectory_metrics.h"
 
 namespace fitcal::tools {
@@ -93,119 +90,20 @@ DiagnoseSplit SplitRuns(const DiagnoseCommandOptions& options, const std::vector
   return out;
 }
 
-// What diagnose may write, judged like the fit's result gate (fit/result_gate.h) on the
-// held-out runs by the track replay's final-pose CF: the nominal, the declared final-pose fit,
-// the track fit, and the track fit with its effects when they were named. A track fit with
-// effects that were not named is not a candidate: the file would claim a CF its parameters reach
-// only together with effects it does not carry.
-struct DiagnoseChoice {
-  std::string name;
-  std::vector<double> parameters;
-  EffectModel effects;
-  double cf_before = 0.0;  // nominal, held-out
-  double cf_after = 0.0;
-  double cf_training_before = 0.0;  // nominal, training runs (the same track-replay CF)
-  double cf_training_after = 0.0;
-  // The covariance of the fit that made these parameters, with its effects: empty for the
-  // nominal or when the fit had none.
-  std::vector<double> sigma = {};
-  Eigen::MatrixXd correlation = Eigen::MatrixXd();
-};
-
-// The candidate a fit makes, carrying that fit's own uncertainty.
-DiagnoseChoice FitChoice(const std::string& name, const std::vector<double>& parameters,
-                         const EffectModel& effects, double cf_after, bool has_covariance,
-                         const std::vector<double>& sigma, const Eigen::MatrixXd& correlation) {
-  DiagnoseChoice c{name, parameters, effects, 0.0, cf_after};
-  if (has_covariance && correlation.rows() == static_cast<Eigen::Index>(sigma.size())) {
-    c.sigma = sigma;
-    c.correlation = correlation;
+// The gate's table (calibrate/diagnosis_calibration.h), what the never-worse judgement and the
+// uncertainty said, and the refusal's reasons.
+void PrintDecision(const DiagnosisCalibration& c, std::size_t num_held_out) {
+  std::printf("\nresult gate, CF on the held-out runs (%zu):\n", num_held_out);
+  for (const DiagnoseChoice& d : c.gate) {
+    std::printf("  %-28s %10.5f%s\n", d.name.c_str(), d.cf_after,
+                d.name == c.choice.name ? "   <- selected" : "");
   }
-  return c;
-}
-
-DiagnoseChoice GateDiagnosis(const RobotModelInterface& model, const DiagnoseSplit& split,
-                             const DiagnoseResult& result, int threads,
-                             std::vector<DiagnoseChoice>* gate) {
-  const std::vector<double>& nominal = model.robot().nominal;
-  const auto cf = [&](const std::vector<double>& p, const EffectModel& e) {
-    return ScoreModel(model, p, e, split.validation, {}, threads).cf;
-  };
-  const ModelFitResult& declared = result.declared;
-  const EffectFitResult& base = result.base;
-  const EffectFitResult& final_fit = result.final_fit;
-  std::vector<DiagnoseChoice> candidates = {
-      {"nominal", nominal, {}, 0.0, cf(nominal, {})},
-      FitChoice("declared final-pose fit", declared.parameters, {}, result.declared_validation.cf,
-                declared.has_covariance, declared.sigma, declared.correlation),
-      FitChoice("track fit", base.parameters, {}, cf(base.parameters, {}), base.has_covariance,
-                base.sigma, base.correlation)};
-  if (result.effects_named) {
-    candidates.push_back(FitChoice("track fit + effects", final_fit.parameters, final_fit.effects,
-                                   result.final_validation.cf, final_fit.has_covariance,
-                                   final_fit.sigma, final_fit.correlation));
+  for (const std::string& line : c.never_worse_warnings) std::printf("warning: %s\n", line.c_str());
+  if (c.uncertainty_propagated) {
+    std::printf("uncertainty of '%s': propagated through the training runs' final poses\n",
+                c.choice.name.c_str());
   }
-  std::size_t best = 0;
-  std::printf("\nresult gate, CF on the held-out runs (%zu):\n", split.validation.size());
-  for (std::size_t i = 0; i < candidates.size(); ++i) {
-    if (candidates[i].cf_after < candidates[best].cf_after) best = i;
-  }
-  for (std::size_t i = 0; i < candidates.size(); ++i) {
-    std::printf("  %-28s %10.5f%s\n", candidates[i].name.c_str(), candidates[i].cf_after,
-                i == best ? "   <- selected" : "");
-  }
-  candidates[best].cf_before = candidates[0].cf_after;
-  const auto cf_training = [&](const DiagnoseChoice& c) {
-    return ScoreModel(model, c.parameters, c.effects, split.training, {}, threads).cf;
-  };
-  candidates[best].cf_training_before = cf_training(candidates[0]);
-  candidates[best].cf_training_after = cf_training(candidates[best]);
-  *gate = candidates;
-  return candidates[best];
-}
-
-// The chosen calibration beats the nominal on the held-out runs as a whole; it must not be worse
-// on a kind of run, in drift or ATE beyond the runs' scatter either (validation/never_worse.h,
-// the rule fit applies). True after one line per such measure on stderr; what rose without
-// refusing is said in "warning:" lines, as fit says it.
-bool WorseThanNominalBeyondNoise(const RobotModelInterface& model, const DiagnoseSplit& split,
-                                 const DiagnoseChoice& nominal, const DiagnoseChoice& choice,
-                                 int threads) {
-  std::vector<AlignedRun> runs;
-  std::vector<const GroundTruthTrack*> tracks;
-  for (const TrackRun& r : split.validation) {
-    runs.push_back(r.aligned);
-    tracks.push_back(&r.track);
-  }
-  const NeverWorseVerdict verdict = JudgeNeverWorseThanNominal(
-      model, {nominal.name, nominal.parameters, true, nominal.effects},
-      {choice.name, choice.parameters, true, choice.effects}, runs, tracks, threads);
-  for (const std::string& line : verdict.warnings) std::printf("warning: %s\n", line.c_str());
-  for (const std::string& line : verdict.refusals) std::cerr << "fitcal: " << line << "\n";
-  return !verdict.refusals.empty();
-}
-
-// A written calibration never carries sigma: null. When the fit that made the chosen parameters
-// had no covariance of its own, they get the one propagated through the training runs' final
-// poses (validation/propagated_uncertainty.h); false, after one line, when even that is not
-// possible (nothing is written then).
-bool WithUncertainty(const RobotModelInterface& model, const DiagnoseSplit& split,
-                     DiagnoseChoice* choice) {
-  const std::size_t n = model.robot().parameters.size();
-  if (choice->sigma.size() == n) return true;
-  std::vector<AlignedRun> training;
-  for (const TrackRun& r : split.training) training.push_back(r.aligned);
-  const PropagatedUncertainty u = PropagateFinalPoseUncertainty(model, choice->parameters, training);
-  if (!u.ok || u.sigma.size() != n) {
-    std::cerr << "fitcal: the chosen calibration ('" << choice->name
-              << "') has no uncertainty: " << u.message << "; nothing written\n";
-    return false;
-  }
-  choice->sigma = u.sigma;
-  choice->correlation = CorrelationOf(u.covariance);
-  std::printf("uncertainty of '%s': propagated through the training runs' final poses\n",
-              choice->name.c_str());
-  return true;
+  for (const std::string& reason : c.refusal.reasons) std::cerr << "fitcal: " << reason << "\n";
 }
 
 // "## Written calibration": the chosen candidate's parameters with the sigma calibrated.yaml
@@ -222,56 +120,6 @@ std::string WrittenCalibrationText(const Robot& robot, const DiagnoseChoice& cho
                      choice.sigma[k] * s);
   }
   return out;
-}
-
-std::string ObjectiveOf(const DiagnoseChoice& choice) {
-  return choice.name == "declared final-pose fit"
-             ? "sum over runs of the squared final-pose error (m and rad)"
-             : "sum over runs of the mean squared track error (m and rad)";
-}
-
-// What the calibrated YAML records of the diagnosis: the chosen candidate, its objective, the
-// training and held-out runs, and the CF before and after on both.
-void RecordSource(const DiagnoseCommandOptions& options, const std::vector<RunLog>& logs,
-                  const DiagnoseSplit& split, const DiagnoseResult& result,
-                  const DiagnoseChoice& choice, io::CalibrationSource* source) {
-  io::CalibrationSource& s = *source;
-  s.method = "diagnose: " + choice.name;
-  s.objective = ObjectiveOf(choice);
-  s.dataset = options.logs;
-  s.tool_version = kVersion;
-  s.termination = result.final_fit.termination;
-  s.training_repetitions = split.training_repetitions;
-  s.validation_repetitions = split.validation_repetitions;
-  for (const TrackRun& r : split.training) s.training_run_ids.push_back(r.aligned.id);
-  s.training_trajectories = options.train_trajectories;
-  s.training_fingerprint = TrainingFingerprint(logs, s.training_run_ids);
-  s.training_runs = static_cast<int>(split.training.size());
-  s.validation_runs = static_cast<int>(split.validation.size());
-  s.cf_training_before = choice.cf_training_before;
-  s.cf_training_after = choice.cf_training_after;
-  s.cf_validation_before = choice.cf_before;
-  s.cf_validation_after = choice.cf_after;
-}
-
-// The model's own YAML (RobotYaml) with the accepted effects and the calibration block, the layout
-// `fit` writes.
-std::string ModelCalibratedYaml(const DiagnoseCommandOptions& options,
-                                const RobotModelInterface& model, const std::vector<RunLog>& logs,
-                                const DiagnoseSplit& split, const DiagnoseResult& result,
-                                const DiagnoseChoice& choice) {
-  const Robot& robot = model.robot();
-  io::CalibrationBlock block;
-  RecordSource(options, logs, split, result, choice, &block);
-  block.selected = choice.name;
-  block.selected_on = "held-out runs (" + std::to_string(split.validation.size()) + ")";
-  for (const HeldParameter& h : robot.held) block.held.push_back(robot.parameters[h.index].name);
-  block.has_uncertainty = static_cast<int>(choice.sigma.size()) == robot.NumParameters();
-  if (block.has_uncertainty) {
-    block.sigma = choice.sigma;
-    block.correlation = choice.correlation;
-  }
-  return model.RobotYaml(choice.parameters, choice.effects, io::CalibrationBlockYaml(block, robot));
 }
 
 // Re-stamps each run's ground truth on the encoder clock (the speed-profile match of the
@@ -505,20 +353,17 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
                                ", fitcal " + kVersion + "\n\n" +
                                FormatDiagnoseReport(result, *model);
     std::printf("%s", report.c_str());
-    std::vector<DiagnoseChoice> gate;
-    DiagnoseChoice choice = GateDiagnosis(*model, split, result, options.threads, &gate);
-    if (choice.name == "nominal") {
-      std::cerr << "fitcal: no calibration beats the nominal robot on the held-out runs; nothing "
-                   "written\n";
-      return 5;
-    }
-    if (WorseThanNominalBeyondNoise(*model, split, gate.front(), choice, options.threads)) {
-      return 5;
-    }
-    if (!WithUncertainty(*model, split, &choice)) return 1;
+    const DiagnosisCalibration calibration = CalibrateOnDiagnosis(
+        {options.logs, options.train_trajectories, &runs, options.threads}, *model, split, result);
+    PrintDecision(calibration, split.validation.size());
+    if (calibration.refusal.exit_code != 0) return calibration.refusal.exit_code;
+    const DiagnoseChoice& choice = calibration.choice;
+    const std::vector<DiagnoseChoice>& gate = calibration.gate;
     const std::string written = WrittenCalibrationText(robot, choice);
     std::printf("%s", written.c_str());
-    const std::string yaml = ModelCalibratedYaml(options, *model, runs, split, result, choice);
+    // The model's own YAML with the accepted effects and the calibration block, as `fit` writes.
+    const std::string yaml = model->RobotYaml(choice.parameters, choice.effects,
+                                              io::CalibrationBlockYaml(calibration.record, robot));
     const io::DiagnosePageData page =
         MakePage(options, *model, split, result, gate, choice, report);
     WriteOutputs(options, inputs, report + written, result, page, yaml);

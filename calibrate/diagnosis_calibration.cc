@@ -1,0 +1,181 @@
+#include "calibrate/diagnosis_calibration.h"
+
+#include "fit/correlation.h"
+#include "fitcal/version.h"
+#include "validation/propagated_uncertainty.h"
+#include "validation/training_runs.h"
+
+namespace fitcal {
+
+namespace {
+
+// The candidate a fit makes, carrying that fit's own uncertainty.
+DiagnoseChoice FitChoice(const std::string& name, const std::vector<double>& parameters,
+                         const EffectModel& effects, double cf_after, bool has_covariance,
+                         const std::vector<double>& sigma, const Eigen::MatrixXd& correlation) {
+  DiagnoseChoice c{name, parameters, effects, 0.0, cf_after};
+  if (has_covariance && correlation.rows() == static_cast<Eigen::Index>(sigma.size())) {
+    c.sigma = sigma;
+    c.correlation = correlation;
+  }
+  return c;
+}
+
+// The candidates with their held-out CFs, the nominal first.
+std::vector<DiagnoseChoice> Candidates(const RobotModelInterface& model,
+                                       const SplitOf<TrackRun>& split,
+                                       const DiagnoseResult& result, int threads) {
+  const std::vector<double>& nominal = model.robot().nominal;
+  const auto cf = [&](const std::vector<double>& p, const EffectModel& e) {
+    return ScoreModel(model, p, e, split.validation, {}, threads).cf;
+  };
+  const ModelFitResult& declared = result.declared;
+  const EffectFitResult& base = result.base;
+  const EffectFitResult& final_fit = result.final_fit;
+  std::vector<DiagnoseChoice> candidates = {
+      {"nominal", nominal, {}, 0.0, cf(nominal, {})},
+      FitChoice("declared final-pose fit", declared.parameters, {}, result.declared_validation.cf,
+                declared.has_covariance, declared.sigma, declared.correlation),
+      FitChoice("track fit", base.parameters, {}, cf(base.parameters, {}), base.has_covariance,
+                base.sigma, base.correlation)};
+  if (result.effects_named) {
+    candidates.push_back(FitChoice("track fit + effects", final_fit.parameters, final_fit.effects,
+                                   result.final_validation.cf, final_fit.has_covariance,
+                                   final_fit.sigma, final_fit.correlation));
+  }
+  return candidates;
+}
+
+// The lowest held-out CF (the nominal first wins ties), with the CFs the record carries.
+DiagnoseChoice Select(const RobotModelInterface& model, const SplitOf<TrackRun>& split,
+                      int threads, std::vector<DiagnoseChoice>* candidates) {
+  std::vector<DiagnoseChoice>& c = *candidates;
+  std::size_t best = 0;
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    if (c[i].cf_after < c[best].cf_after) best = i;
+  }
+  c[best].cf_before = c[0].cf_after;
+  const auto cf_training = [&](const DiagnoseChoice& d) {
+    return ScoreModel(model, d.parameters, d.effects, split.training, {}, threads).cf;
+  };
+  c[best].cf_training_before = cf_training(c[0]);
+  c[best].cf_training_after = cf_training(c[best]);
+  return c[best];
+}
+
+// The chosen calibration beats the nominal on the held-out runs as a whole; it must not be worse
+// on a kind of run, in drift or ATE beyond the runs' scatter either (the rule fit applies).
+NeverWorseVerdict JudgeNeverWorse(const RobotModelInterface& model,
+                                  const SplitOf<TrackRun>& split, const DiagnoseChoice& nominal,
+                                  const DiagnoseChoice& choice, int threads) {
+  std::vector<AlignedRun> runs;
+  std::vector<const GroundTruthTrack*> tracks;
+  for (const TrackRun& r : split.validation) {
+    runs.push_back(r.aligned);
+    tracks.push_back(&r.track);
+  }
+  return JudgeNeverWorseThanNominal(
+      model, {nominal.name, nominal.parameters, true, nominal.effects},
+      {choice.name, choice.parameters, true, choice.effects}, runs, tracks, threads);
+}
+
+// A written calibration never carries sigma: null. When the fit that made the chosen parameters
+// had no covariance of its own, they get the one propagated through the training runs' final
+// poses (validation/propagated_uncertainty.h); "" when done, else why not (nothing is written).
+std::string AddUncertainty(const RobotModelInterface& model, const SplitOf<TrackRun>& split,
+                           DiagnoseChoice* choice, bool* propagated) {
+  const std::size_t n = model.robot().parameters.size();
+  if (choice->sigma.size() == n) return "";
+  std::vector<AlignedRun> training;
+  for (const TrackRun& r : split.training) training.push_back(r.aligned);
+  const PropagatedUncertainty u = PropagateFinalPoseUncertainty(model, choice->parameters, training);
+  if (!u.ok || u.sigma.size() != n) {
+    return "the chosen calibration ('" + choice->name + "') has no uncertainty: " + u.message +
+           "; nothing written";
+  }
+  choice->sigma = u.sigma;
+  choice->correlation = CorrelationOf(u.covariance);
+  *propagated = true;
+  return "";
+}
+
+std::string ObjectiveOf(const DiagnoseChoice& choice) {
+  return choice.name == "declared final-pose fit"
+             ? "sum over runs of the squared final-pose error (m and rad)"
+             : "sum over runs of the mean squared track error (m and rad)";
+}
+
+// What the calibrated YAML records of the diagnosis: the chosen candidate, its objective, the
+// training and held-out runs, and the CF before and after on both.
+void RecordSource(const DiagnosisCalibrationRequest& request, const SplitOf<TrackRun>& split,
+                  const DiagnoseResult& result, const DiagnoseChoice& choice,
+                  io::CalibrationSource* source) {
+  io::CalibrationSource& s = *source;
+  s.method = "diagnose: " + choice.name;
+  s.objective = ObjectiveOf(choice);
+  s.dataset = request.dataset;
+  s.tool_version = kVersion;
+  s.termination = result.final_fit.termination;
+  s.training_repetitions = split.training_repetitions;
+  s.validation_repetitions = split.validation_repetitions;
+  for (const TrackRun& r : split.training) s.training_run_ids.push_back(r.aligned.id);
+  s.training_trajectories = request.train_trajectories;
+  s.training_fingerprint = TrainingFingerprint(*request.runs, s.training_run_ids);
+  s.training_runs = static_cast<int>(split.training.size());
+  s.validation_runs = static_cast<int>(split.validation.size());
+  s.cf_training_before = choice.cf_training_before;
+  s.cf_training_after = choice.cf_training_after;
+  s.cf_validation_before = choice.cf_before;
+  s.cf_validation_after = choice.cf_after;
+}
+
+io::CalibrationBlock MakeRecord(const DiagnosisCalibrationRequest& request, const Robot& robot,
+                                const SplitOf<TrackRun>& split, const DiagnoseResult& result,
+                                const DiagnoseChoice& choice) {
+  io::CalibrationBlock block;
+  RecordSource(request, split, result, choice, &block);
+  block.selected = choice.name;
+  block.selected_on = "held-out runs (" + std::to_string(split.validation.size()) + ")";
+  for (const HeldParameter& h : robot.held) block.held.push_back(robot.parameters[h.index].name);
+  block.has_uncertainty = static_cast<int>(choice.sigma.size()) == robot.NumParameters();
+  if (block.has_uncertainty) {
+    block.sigma = choice.sigma;
+    block.correlation = choice.correlation;
+  }
+  return block;
+}
+
+}  // namespace
+
+DiagnosisCalibration CalibrateOnDiagnosis(const DiagnosisCalibrationRequest& request,
+                                          const RobotModelInterface& model,
+                                          const SplitOf<TrackRun>& split,
+                                          const DiagnoseResult& result) {
+  DiagnosisCalibration out;
+  out.gate = Candidates(model, split, result, request.threads);
+  out.choice = Select(model, split, request.threads, &out.gate);
+  if (out.choice.name == "nominal") {
+    out.refusal = {5, {"no calibration beats the nominal robot on the held-out runs; nothing "
+                       "written"}};
+    return out;
+  }
+  out.reached = CalibrationStage::kNeverWorse;
+  NeverWorseVerdict verdict =
+      JudgeNeverWorse(model, split, out.gate.front(), out.choice, request.threads);
+  out.never_worse_warnings = std::move(verdict.warnings);
+  if (!verdict.refusals.empty()) {
+    out.refusal = {5, std::move(verdict.refusals)};
+    return out;
+  }
+  const std::string refusal =
+      AddUncertainty(model, split, &out.choice, &out.uncertainty_propagated);
+  if (!refusal.empty()) {
+    out.refusal = {1, {refusal}};
+    return out;
+  }
+  out.reached = CalibrationStage::kDone;
+  out.record = MakeRecord(request, model.robot(), split, result, out.choice);
+  return out;
+}
+
+}  // namespace fitcal
