@@ -66,13 +66,7 @@ const RecordedCase kCases[] = {
      "  - {name: left, radius_m: 0.040}\nwheel_separation_m: 0.240\n"
      "bounds: {radius_m: [0.030, 0.060], wheel_separation_m: [0.150, 0.300]}\n",
      {},
-     "measured 2026-11-29: fit exits 0 in a local minimum off every bound (separation 0.1808 "
-     "for 0.24, mount x 0.708 y -0.671 yaw -25.6 deg for 1.5, -0.2, 5 deg; held-out heading "
-     "error 59 deg, drift per 1 m 20.5 % against the true model's 0.47 %). Cause: the global "
-     "start runs only when the local fit ends on a bound or the held-out judgement fails, and "
-     "the judgement passes because the held-out CF is 38 % lower than the nominal's; a fit far "
-     "above the noise floor does not trigger it. A start at the box's centre (r 0.045, separation "
-     "0.225) reaches the truth, as does separation 12.5 % off; 10 % off passes (0.5 sigma)"},
+     ""},
     {"tricycle_gain_2", "tricycle", kTricycleGuess,
      "model: tricycle\nname: t\ntraction_wheel: {radius_m: 0.0357}\nwheelbase_m: 0.18\n"
      "steering_offset_deg: 3.0\nsteering_gain: 2.0\n"

@@ -81,8 +81,8 @@ ModelFitMethodOutcome RunModelCeres(CeresTrustRegion trust_region,
   options.track_weights = settings.track_weights;
   options.tying = &settings.tying;
   ModelFitMethodOutcome out;
-  out.fit = FitModelFrom(training, model,
-                         settings.start.empty() ? model.robot().nominal : settings.start, options);
+  out.fit = FitModelFromGuess(
+      training, model, settings.start.empty() ? model.robot().nominal : settings.start, options);
   out.evaluations = out.fit.num_residual_evaluations + out.fit.num_jacobian_evaluations;
   out.objective = ResidualsText(settings);
   if (options.residuals != ResidualKind::kTrack) {
