@@ -79,13 +79,7 @@ const RecordedCase kCases[] = {
      "bounds: {radius_m: [0.025, 0.045], wheelbase_m: [0.12, 0.25], "
      "steering_offset_deg: [-10.0, 10.0]}\n",
      {"steering"},
-     "measured 2026-11-29: fit refuses with exit 4, 'the encoder columns look miswired: with "
-     "traction = -w_traction (sign flipped) the runs are explained 2.55x better (final-pose SSR "
-     "69.3 vs 177)': the wheel-order check fits both orders on final poses from the nominal, "
-     "and from a gain 2.5x off that objective has local minima (fit --residuals final-pose "
-     "ends with r_traction on its bound 0.025, wheelbase 0.25, exit 5); the flipped order "
-     "reaches a lower one. With --skip-wheel-order-check the fit recovers everything within 0.5 sigma (r "
-     "-0.46, wheelbase -0.45, offset +0.20, gain +0.09, mount x -0.15, y -0.25, yaw -0.23)"},
+     ""},
     // Not run: measured by hand with the same steps on simulate's rates (fitcal simulate --model
     // omni, seed 5, 6 repetitions; fit with defaults), before any counts.
     {"mecanum", "omni", "", "", {},
