@@ -142,7 +142,7 @@ double FittedSumOfSquares(const RobotModelInterface& model, const std::vector<Al
   on_windows.segments = start_windows;
   const ModelFitResult windows = FitModel(runs, model, on_windows);
   if (!(windows.usable || windows.stopped_early)) return ssr;
-  const ModelFitResult from_windows = FitModelFromGuess(runs, model, windows.parameters, fit);
+  const ModelFitResult from_windows = FitModelFrom(runs, model, windows.parameters, fit);
   return std::min(ssr, SumOfSquares(model, from_windows.parameters, runs, segments, options));
 }
 

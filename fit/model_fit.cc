@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <cmath>
 #include <memory>
 #include <stdexcept>
@@ -956,23 +957,17 @@ ModelFitResult WithGlobalStart(const std::vector<AlignedRun>& training,
                   reason.c_str(), local_cost, tried.c_str(), 100.0 * best_fraction, best_cost);
   }
   best.global_start = text;
+  if (std::getenv("FAR39B_DEBUG")) std::fprintf(stderr, "DBG runs %zu: %s\n", training.size(), text);
   return best;
 }
 
 }  // namespace
 
-ModelFitResult FitModelFromGuess(const std::vector<AlignedRun>& training,
-                                 const RobotModelInterface& model,
-                                 const std::vector<double>& guess,
-                                 const ModelFitOptions& options) {
-  ModelFitResult local = FitModelFrom(training, model, guess, options);
-  if (!options.global_start) return local;
-  return WithGlobalStart(training, model, options, std::move(local));
-}
-
 ModelFitResult FitModel(const std::vector<AlignedRun>& training, const RobotModelInterface& model,
                         const ModelFitOptions& options) {
-  return FitModelFromGuess(training, model, model.robot().nominal, options);
+  ModelFitResult local = FitModelFrom(training, model, model.robot().nominal, options);
+  if (!options.global_start) return local;
+  return WithGlobalStart(training, model, options, std::move(local));
 }
 
 }  // namespace fitcal

@@ -128,8 +128,7 @@ struct ModelFitOptions {
   // kGlobalStartSigmaRatio), fit again from points spread across the box (its centre, a quarter
   // and three quarters of the way from each free parameter's lower bound; the first whose fit
   // leaves neither ends the search) and keep the lowest cost. The sigma test needs the
-  // covariance (ceres.compute_covariance). FitModel and FitModelFromGuess only; FitModelFrom fits
-  // from its start.
+  // covariance (ceres.compute_covariance). FitModel only; FitModelFrom fits from its start.
   bool global_start = true;
 };
 
@@ -164,13 +163,6 @@ ModelFitResult FitModel(const std::vector<AlignedRun>& training, const RobotMode
 // held and the held directions per member of each group, the covariance A C_q A^T (a tied
 // parameter's sigma is its shared value's; members correlate with 1).
 ModelFitResult ExpandTiedResult(const TiedModel& tied, const ModelFitResult& fit);
-
-// FitModel from `guess` (the user's start, e.g. the fit of all runs for a fold) instead of the
-// nominal, with the global start of ModelFitOptions::global_start.
-ModelFitResult FitModelFromGuess(const std::vector<AlignedRun>& training,
-                                 const RobotModelInterface& model,
-                                 const std::vector<double>& guess,
-                                 const ModelFitOptions& options = {});
 
 // The fit from `start` alone (e.g. a closed-form calibration): no global start.
 ModelFitResult FitModelFrom(const std::vector<AlignedRun>& training,
