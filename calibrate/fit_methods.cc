@@ -81,8 +81,10 @@ ModelFitMethodOutcome RunModelCeres(CeresTrustRegion trust_region,
   options.track_weights = settings.track_weights;
   options.tying = &settings.tying;
   ModelFitMethodOutcome out;
-  out.fit = FitModelFrom(training, model,
-                         settings.start.empty() ? model.robot().nominal : settings.start, options);
+  // From the guess (the nominal), with FitModel's global start; a fit warm-started from a fitted
+  // point (a fold's, from the fit of all the training runs) starts from no guess and keeps it.
+  out.fit = settings.start.empty() ? FitModel(training, model, options)
+                                   : FitModelFrom(training, model, settings.start, options);
   out.evaluations = out.fit.num_residual_evaluations + out.fit.num_jacobian_evaluations;
   out.objective = ResidualsText(settings);
   if (options.residuals != ResidualKind::kTrack) {

@@ -122,13 +122,20 @@ struct ModelFitOptions {
   // nominal (fit/parameter_tying.h). The fit runs on the tied model and its result is mapped back
   // (ExpandTiedResult); every residual kind above works with it.
   const ParameterTying* tying = nullptr;
-  // Far from the guess: when the fit from the nominal ends with a free parameter on a bound of
-  // its box (a nominal several times off pulls the others there), fit again from points spread
-  // across the box (its centre, a quarter and three quarters of the way from each free
-  // parameter's lower bound) and keep the lowest cost. FitModel only; FitModelFrom fits from its
-  // start.
+  // Far from the guess: when the fit from the guess ends with a free parameter on a bound of
+  // its box (a guess several times off pulls the others there), or with residuals so far above
+  // the noise that its own sigma of a free parameter is wider than the box's (a local minimum:
+  // kGlobalStartSigmaRatio), fit again from points spread across the box (its centre, a quarter
+  // and three quarters of the way from each free parameter's lower bound; the first whose fit
+  // leaves neither ends the search) and keep the lowest cost. The sigma test needs the
+  // covariance (ceres.compute_covariance). FitModel only; FitModelFrom fits from its start.
   bool global_start = true;
 };
+
+// The global start's second trigger: a free parameter's sigma above this many times its box's
+// standard deviation (width / sqrt(12), the uniform prior of fit/determined_directions.h): at
+// the residual level the fit left, the runs would say less about it than its bounds do.
+inline constexpr double kGlobalStartSigmaRatio = 1.0;
 
 // A value rests on a bound when it is within 1e-6 of the box's width of it: far above the YAML's
 // 10 significant digits (1e-11 m on a 0.2 m distance), far below any meaningful change.
@@ -157,7 +164,7 @@ ModelFitResult FitModel(const std::vector<AlignedRun>& training, const RobotMode
 // parameter's sigma is its shared value's; members correlate with 1).
 ModelFitResult ExpandTiedResult(const TiedModel& tied, const ModelFitResult& fit);
 
-// The same started from `start` instead of the robot's nominal (e.g. a closed-form calibration).
+// The fit from `start` alone (e.g. a closed-form calibration): no global start.
 ModelFitResult FitModelFrom(const std::vector<AlignedRun>& training,
                             const RobotModelInterface& model, const std::vector<double>& start,
                             const ModelFitOptions& options = {});

@@ -38,6 +38,7 @@ struct RecordedCase {
   const char* truth;
   std::set<std::string> angle_columns;  // read as counts of an absolute encoder
   const char* known_failure;            // measured numbers and cause; empty when it passes
+  const char* fit_says;                 // a line fit must print ("" for none in particular)
 };
 
 constexpr const char* kDiffDriveGuess =
@@ -60,38 +61,25 @@ const RecordedCase kCases[] = {
      "model: diff_drive\nname: d\nwheels:\n  - {name: right, radius_m: 0.046}\n"
      "  - {name: left, radius_m: 0.040}\nwheel_separation_m: 0.220\n"
      "bounds: {radius_m: [0.030, 0.060], wheel_separation_m: [0.150, 0.300]}\n",
-     {}, ""},
+     {}, "", ""},
     {"diff_drive_20pct", "diff_drive", kDiffDriveGuess,
      "model: diff_drive\nname: d\nwheels:\n  - {name: right, radius_m: 0.046}\n"
      "  - {name: left, radius_m: 0.040}\nwheel_separation_m: 0.240\n"
      "bounds: {radius_m: [0.030, 0.060], wheel_separation_m: [0.150, 0.300]}\n",
-     {},
-     "measured 2026-11-29: fit exits 0 in a local minimum off every bound (separation 0.1808 "
-     "for 0.24, mount x 0.708 y -0.671 yaw -25.6 deg for 1.5, -0.2, 5 deg; held-out heading "
-     "error 59 deg, drift per 1 m 20.5 % against the true model's 0.47 %). Cause: the global "
-     "start runs only when the local fit ends on a bound or the held-out judgement fails, and "
-     "the judgement passes because the held-out CF is 38 % lower than the nominal's; a fit far "
-     "above the noise floor does not trigger it. A start at the box's centre (r 0.045, separation "
-     "0.225) reaches the truth, as does separation 12.5 % off; 10 % off passes (0.5 sigma)"},
+     {}, "",
+     "global start: the fit from the guess left residuals far above the noise"},
     {"tricycle_gain_2", "tricycle", kTricycleGuess,
      "model: tricycle\nname: t\ntraction_wheel: {radius_m: 0.0357}\nwheelbase_m: 0.18\n"
      "steering_offset_deg: 3.0\nsteering_gain: 2.0\n"
      "bounds: {radius_m: [0.025, 0.045], wheelbase_m: [0.12, 0.25], "
      "steering_offset_deg: [-10.0, 10.0]}\n",
-     {"steering"}, ""},
+     {"steering"}, "", ""},
     {"tricycle_gain_2_5", "tricycle", kTricycleGuess,
      "model: tricycle\nname: t\ntraction_wheel: {radius_m: 0.0357}\nwheelbase_m: 0.18\n"
      "steering_offset_deg: 3.0\nsteering_gain: 2.5\n"
      "bounds: {radius_m: [0.025, 0.045], wheelbase_m: [0.12, 0.25], "
      "steering_offset_deg: [-10.0, 10.0]}\n",
-     {"steering"},
-     "measured 2026-11-29: fit refuses with exit 4, 'the encoder columns look miswired: with "
-     "traction = -w_traction (sign flipped) the runs are explained 2.55x better (final-pose SSR "
-     "69.3 vs 177)': the wheel-order check fits both orders on final poses from the nominal, "
-     "and from a gain 2.5x off that objective has local minima (fit --residuals final-pose "
-     "ends with r_traction on its bound 0.025, wheelbase 0.25, exit 5); the flipped order "
-     "reaches a lower one. With --skip-wheel-order-check the fit recovers everything within 0.5 sigma (r "
-     "-0.46, wheelbase -0.45, offset +0.20, gain +0.09, mount x -0.15, y -0.25, yaw -0.23)"},
+     {"steering"}, "", ""},
     // Not run: measured by hand with the same steps on simulate's rates (fitcal simulate --model
     // omni, seed 5, 6 repetitions; fit with defaults), before any counts.
     {"mecanum", "omni", "", "", {},
@@ -102,7 +90,8 @@ const RecordedCase kCases[] = {
      "direction the runs do not determine (R_fl, R_fr, R_rl, r, delta_fl, delta_fr together, fit "
      "prints 'held at nominal, not determined by the training runs') is held at the nominal and "
      "the written sigmas leave it out; the test body would also need held parameters (R_rr, "
-     "delta_rl, delta_rr, mount x and y: sigma 0) compared for equality instead"},
+     "delta_rl, delta_rr, mount x and y: sigma 0) compared for equality instead",
+     ""},
 };
 
 std::string CountsYaml(const RecordedCase& c) {
@@ -166,6 +155,7 @@ TEST_P(RecordedRobot, DefaultFitRecoversWheelsAndMountFromCountsFarFromTheGuess)
   std::printf("%s%s", r.out.c_str(), r.err.c_str());
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
   for (const std::string& g : glitches) EXPECT_TRUE(Has(r.err, g)) << g;
+  EXPECT_TRUE(Has(r.out, c.fit_says)) << c.fit_says;
   EXPECT_TRUE(Has(r.out, "encoder glitches: 3 intervals in 1 run dropped from the fit")) << r.out;
 
   // Every parameter, the mount's three numbers included, within 3 of its written sigmas (the
