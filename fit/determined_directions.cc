@@ -5,12 +5,14 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <map>
 #include <memory>
 
 #include "fit/correlation.h"
+#include "fit/segment_cost.h"
 #include "odometry/parallel_for.h"
 
 namespace fitcal {
@@ -22,6 +24,7 @@ struct RunJacobian {
   Eigen::VectorXd residuals;
   Eigen::MatrixXd jacobian;
   bool finite = false;
+  bool innovations = false;  // rows: x, y, heading of the stretches between a track's checkpoints
 };
 
 RunJacobian EvaluateRun(const ceres::CostFunction& cost, const std::vector<double>& p) {
@@ -46,11 +49,22 @@ std::vector<RunJacobian> EvaluateRuns(const std::vector<AlignedRun>& training,
   std::vector<RunJacobian> out(training.size());
   ParallelFor(training.size(), num_threads, [&](std::size_t i) {
     if (segments != nullptr && (*segments)[i].empty()) return;
+    // A track's checkpoints are windows from the run's start: each carries every error made
+    // before it, so their errors are a random walk along the run (fit/serial_covariance.h), and
+    // counting them as independent counts one stretch's error once per later checkpoint - the
+    // information of a track then grows with its checkpoint count along the same path, and
+    // directions only noise moves look determined (issue 40: the fit of half the omni3 joystick run moved R_a by
+    // 24 % and lost to the nominal on the other half). Such windows are analysed as the stretches
+    // between the checkpoints, whose errors are independent.
+    const std::vector<Segment> stretches =
+        segments == nullptr ? std::vector<Segment>{} : StretchesBetweenCheckpoints((*segments)[i]);
     std::unique_ptr<ceres::CostFunction> cost(
         segments == nullptr ? model.FinalPoseCost(training[i], weights)
-                            : model.SegmentCost(training[i], (*segments)[i], weights));
+        : stretches.empty() ? model.SegmentCost(training[i], (*segments)[i], weights)
+                            : model.SegmentCost(training[i], stretches, weights));
     out[i] = EvaluateRun(*cost, p);
     out[i].finite = out[i].finite || out[i].residuals.size() == 0;
+    out[i].innovations = !stretches.empty();
   });
   return out;
 }
@@ -200,16 +214,38 @@ DirectionAnalysis AnalyseDeterminedDirections(const std::vector<AlignedRun>& tra
   DirectionAnalysis out;
   const std::vector<RunJacobian> runs =
       EvaluateRuns(training, model, p, weights, segments, num_threads);
-  Eigen::MatrixXd jtj = Eigen::MatrixXd::Zero(n, n);
   std::vector<double> magnitudes;
+  std::array<std::vector<double>, 3> innovation_magnitudes;  // x, y, heading of stretches
   for (const RunJacobian& run : runs) {
     if (!run.finite) return out;
-    if (run.jacobian.size() == 0) continue;
-    jtj += run.jacobian.transpose() * run.jacobian;
-    for (int i = 0; i < run.residuals.size(); ++i) magnitudes.push_back(std::abs(run.residuals[i]));
+    for (int i = 0; i < run.residuals.size(); ++i) {
+      magnitudes.push_back(std::abs(run.residuals[i]));
+      if (run.innovations) innovation_magnitudes[i % 3].push_back(std::abs(run.residuals[i]));
+    }
   }
   if (magnitudes.empty()) return out;
   out.residual_sigma = RobustSigma(magnitudes, robot.NumFree());
+  // A stretch's position and heading errors have noise levels of their own (a heading error made
+  // within a stretch shows in its position only as the stretch's length times it): each weighs
+  // by its own robust sigma, in the units of s (a row scaled by s / sigma_c), so that the
+  // information of a track does not depend on its checkpoint spacing.
+  Eigen::Vector3d innovation_scale = Eigen::Vector3d::Ones();
+  for (int c = 0; c < 3; ++c) {
+    if (innovation_magnitudes[c].empty()) continue;
+    const double sigma_c = RobustSigma(innovation_magnitudes[c], robot.NumFree());
+    if (sigma_c > 0.0) innovation_scale[c] = out.residual_sigma / sigma_c;
+  }
+  Eigen::MatrixXd jtj = Eigen::MatrixXd::Zero(n, n);
+  for (const RunJacobian& run : runs) {
+    if (run.jacobian.size() == 0) continue;
+    if (!run.innovations) {
+      jtj += run.jacobian.transpose() * run.jacobian;
+      continue;
+    }
+    Eigen::MatrixXd scaled = run.jacobian;
+    for (Eigen::Index i = 0; i < scaled.rows(); ++i) scaled.row(i) *= innovation_scale[i % 3];
+    jtj += scaled.transpose() * scaled;
+  }
   const Eigen::VectorXd prior_sigma = PriorSigma(robot);
   const double s2 = std::max(out.residual_sigma * out.residual_sigma, 1e-300);
   // Over the free parameters only, so that a held parameter's zero column cannot mix into the

@@ -105,6 +105,24 @@ std::vector<Segment> MakeCheckpointsFromStart(const AlignedRun& run,
   return out;
 }
 
+std::vector<Segment> StretchesBetweenCheckpoints(const std::vector<Segment>& from_start) {
+  std::vector<Segment> out;
+  for (std::size_t k = 0; k < from_start.size(); ++k) {
+    const Segment& to = from_start[k];
+    if (to.begin != from_start.front().begin) return {};
+    Segment stretch = to;
+    if (k > 0) {
+      const Segment& from = from_start[k - 1];
+      stretch.begin = from.end;
+      stretch.ground_truth_start_T_end =
+          Between(from.ground_truth_start_T_end, to.ground_truth_start_T_end);
+      stretch.path_length_m = to.path_length_m - from.path_length_m;
+    }
+    out.push_back(stretch);
+  }
+  return out;
+}
+
 double ClockMapLeverArm(const RobotModelInterface& model, const double* p) {
   constexpr double kFallbackM = 1.0;
   const Robot& robot = model.robot();

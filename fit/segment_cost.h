@@ -43,6 +43,13 @@ std::vector<Segment> MakeCheckpointsFromStart(const AlignedRun& run,
                                               const GroundTruthTrack& ground_truth,
                                               double spacing_m);
 
+// The windows between consecutive checkpoints of `from_start` (windows that all begin where the
+// first does, as MakeCheckpointsFromStart's): [begin, end_0], [end_0, end_1], ..., each with the
+// ground truth's motion over it. Their errors are the independent ones a track's checkpoints
+// accumulate (fit/serial_covariance.h: the innovations, here exact rather than linearised).
+// Empty when the windows do not all begin at the same sample.
+std::vector<Segment> StretchesBetweenCheckpoints(const std::vector<Segment>& from_start);
+
 struct ClockMap {
   double offset_s = 0.0;  // a
   double rate = 0.0;      // b: relative rate error of the ground-truth clock

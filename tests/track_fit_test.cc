@@ -284,5 +284,40 @@ TEST(TimeBlocks, CutARunIntoBlocksOfEqualPath) {
   EXPECT_THROW(CutIntoTimeBlocks(run, 0), std::invalid_argument);
 }
 
+// A run that turns, rests 3 s and turns back, with the ground truth stamped 0.3 s late: its
+// equal-path half falls 0.2 m into the second turn, where the lag moves the ground truth's pose
+// by 0.06 m and 0.09 rad. The boundary moves into the rest (within a quarter block, 0.5 m): every
+// ground-truth sample within the lag bound (0.5 s) of it shows the robot still, so the true
+// parameters replay both blocks to their ground truth (CF 0.108 with the cut mid-turn, measured).
+TEST(TimeBlocks, BoundaryMovesToWhereTheClockLagMovesNothing) {
+  const RobotModelPtr model = Model();
+  sim::SimulationOptions o;
+  o.rest_before_s = 1.0;
+  o.rest_after_s = 1.0;
+  const double turn_rad_s = 0.3, rest_s = 3.0;
+  const auto sim = sim::SimulateRuns(
+      *model, model->robot().nominal,
+      {{"free", 1, {{{0.2, 0.0, turn_rad_s}, 9.0}, {{0.0, 0.0, 0.0}, rest_s},
+                    {{0.2, 0.0, -turn_rad_s}, 11.0}}}},
+      o);
+  std::vector<RunLog> logs = {sim[0].log};
+  const double lag_s = 0.3;
+  for (double& t : logs[0].ground_truth.t_s) t += lag_s;
+  const AlignedRun run = AlignRuns(logs)[0];
+  const std::vector<AlignedRun> blocks = CutIntoTimeBlocks(run, 2);
+  ASSERT_EQ(blocks.size(), 2u);
+  // The rest spans [10, 13] s from the start with ramps of 0.2 s on each side, [10.5, 13.5] s on
+  // the ground truth's late clock; within the lag bound (0.5 s) of the cut: [11.0, 12.6] s.
+  const double cut_s = blocks[0].t_final_s - run.t_start_s;
+  EXPECT_GE(cut_s, 1.0 + 9.0 + 0.2 + lag_s + 0.5 - 1e-9);
+  EXPECT_LE(cut_s, 1.0 + 9.0 + rest_s - 0.2 + lag_s - 0.5 + 1e-9);
+  const EverydayDrivingMetrics m = EvaluateEverydayDriving(
+      *model, model->robot().nominal, {}, blocks, TracksOf(blocks), {1.0}, 1);
+  ASSERT_EQ(m.per_run_cf.size(), 2u);
+  // Noise-free encoders and ground truth: what is left is the replay's integration of the
+  // ramps on the encoder grid, far below the 0.06 m a cut in the turn costs.
+  for (double cf : m.per_run_cf) EXPECT_LT(cf, 1e-3);
+}
+
 }  // namespace
 }  // namespace fitcal
