@@ -157,8 +157,14 @@ void PrintClockOffsets(const ModelFitResult& fit, const TrackFitData& track) {
   };
   if (n <= kMaxListed) {
     for (std::size_t g = 0; g < n; ++g) {
-      std::printf("  %-36s %+8.3f s +- %.3f\n", track.clock_groups[g].c_str(),
-                  fit.clock_offsets_s[g], sigma(g));
+      // A sigma of exactly 0 is the covariance that could not be computed, not a sure offset.
+      if (sigma(g) > 0.0) {
+        std::printf("  %-36s %+8.3f s +- %.3f\n", track.clock_groups[g].c_str(),
+                    fit.clock_offsets_s[g], sigma(g));
+      } else {
+        std::printf("  %-36s %+8.3f s +- ? (no covariance)\n", track.clock_groups[g].c_str(),
+                    fit.clock_offsets_s[g]);
+      }
     }
     warn_on_bound();
     return;
