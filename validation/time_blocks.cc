@@ -5,6 +5,7 @@
 #include <string>
 
 #include "fit/track_residual.h"
+#include "odometry/pose2.h"
 
 namespace fitcal {
 namespace {
@@ -18,8 +19,8 @@ constexpr double kBoundaryReach = 0.25;
 double PoseChangeAround(const GroundTruthTrack& track, double t_s, double lag_s) {
   const Pose2d a = InterpolateGroundTruth(track, t_s - lag_s);
   const Pose2d b = InterpolateGroundTruth(track, t_s + lag_s);
-  return std::sqrt((b.x - a.x) * (b.x - a.x) + (b.y - a.y) * (b.y - a.y) +
-                   (b.theta - a.theta) * (b.theta - a.theta));
+  const double turn = WrapAngle(b.theta - a.theta);  // not 2 pi where the heading wraps
+  return std::sqrt((b.x - a.x) * (b.x - a.x) + (b.y - a.y) * (b.y - a.y) + turn * turn);
 }
 
 // The boundary (after sample k) near `at` whose ground-truth pose a clock error moves least,
