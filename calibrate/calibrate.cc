@@ -64,8 +64,7 @@ void FitTrainingRuns(const CalibrationRequest& r, const RobotModelInterface& mod
       out->choice_lines.push_back(line);
     }
   }
-  out->halves = JudgeMethodOnHeldOutHalves(*r.method, r.threads, r.time_blocks, out->settings,
-                                           model, out->split);
+  // The cheap count first: a data set with too few residuals pays for no halves' fits.
   const std::string refusal = DegreesOfFreedomRefusal(
       out->split, out->settings, out->track_data,
       NumFreeWithTying(model, out->settings.tying) + r.effects_to_fit.size());
@@ -73,6 +72,8 @@ void FitTrainingRuns(const CalibrationRequest& r, const RobotModelInterface& mod
     Refuse(out, 1, {r.dataset + ": " + refusal});
     return;
   }
+  out->halves = JudgeMethodOnHeldOutHalves(*r.method, r.threads, r.time_blocks, out->settings,
+                                           model, out->split);
   out->fit = chosen_fit ? std::move(*chosen_fit)
                         : r.method->run_model(out->split.training, model, out->settings);
 }
