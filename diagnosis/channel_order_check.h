@@ -10,8 +10,8 @@
 // windows of ground-truth path) when the ground truth has intermediate poses - closed paths hide
 // some miswirings from final poses. When another hypothesis beats the recorded one at the
 // nominal, both are fitted (fit/model_fit.h) so that neither is penalised for the nominal being
-// off - with a dense ground truth the final-pose fits of both orders also start from their fits of
-// the windows, whose objective has no local minima where final poses from a guess far off do -
+// off - with a dense ground truth the final-pose fits of both orders start from their fits of the
+// windows, whose objective has no local minima where final poses from a guess far off do -
 // and the other is declared "far better" when
 //
 //     SSR_recorded / SSR_other > F^-1(1 - alpha / (H - 1); d, d),   d = residuals - free params
