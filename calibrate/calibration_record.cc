@@ -62,6 +62,9 @@ io::CalibrationBlock MakeRecord(const CalibrationRequest& request, const RobotMo
   }
   // The uncertainty is the selected fit's (with its effects, when it carries some; the effects'
   // own sigmas are written with them).
+  for (std::size_t k = 0; k < selected_fit.not_determined.size(); ++k) {
+    if (selected_fit.not_determined[k]) r.not_determined.push_back(robot.parameters[k].name);
+  }
   r.has_uncertainty = selected_fit.has_covariance;
   r.sigma = selected_fit.sigma;
   r.correlation = selected_fit.correlation;
