@@ -115,7 +115,7 @@ struct TricycleGeometry {
 
 struct SteeringActuator {
   double tau_s = 0.15;
-  int counts_per_rev = 4096;  // the column's absolute encoder
+  int counts_per_rev = 16384;  // the column's absolute encoder (14 bits)
 };
 
 // Everyday driving of a tricycle: straights, arcs of 0.4-2 m radius either way, and sharp turns
