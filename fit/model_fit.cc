@@ -430,9 +430,9 @@ void TrackSandwichCovariance(const std::vector<AlignedRun>& training,
   result->covariance = full.topLeftCorner(n, n);
   if (!holds.directions.empty()) {
     Eigen::MatrixXd inverse = Eigen::MatrixXd::Zero(m, m);
-    inverse(free, free) = SandwichCovariance(
-        information(free, free), Eigen::MatrixXd::Identity(static_cast<Eigen::Index>(free.size()),
-                                                            static_cast<Eigen::Index>(free.size())));
+    const Eigen::Index f = static_cast<Eigen::Index>(free.size());
+    inverse(free, free) =
+        SandwichCovariance(information(free, free), Eigen::MatrixXd::Identity(f, f));
     AddHeldDirectionsCovariance(model.robot(), holds, inverse.topLeftCorner(n, n), result);
   }
   result->sigma = SigmasOf(result->covariance);
@@ -939,7 +939,8 @@ WiderThanItsBox SigmaWiderThanItsBox(const Robot& robot, const ModelFitResult& f
     const double held_part = fit.held_directions_covariance.size() > 0
                                  ? fit.held_directions_covariance(k, k)
                                  : 0.0;
-    const double ratio = std::sqrt(std::max(0.0, fit.sigma[k] * fit.sigma[k] - held_part)) / box_sigma;
+    const double own = std::sqrt(std::max(0.0, fit.sigma[k] * fit.sigma[k] - held_part));
+    const double ratio = own / box_sigma;
     if (ratio > kGlobalStartSigmaRatio && ratio > out.ratio) out = {k, ratio};
   }
   return out;

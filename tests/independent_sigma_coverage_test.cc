@@ -84,7 +84,8 @@ void ExpectCoverage(const Ratios& ratios, std::size_t expected_total) {
   int inside = 0;
   for (std::size_t i = 0; i < total; ++i) {
     inside += ratios.error_over_sigma[i] <= 3.0;
-    if (ratios.error_over_sigma[i] > 3.0) std::printf("outside 3 sigma: %s\n", ratios.labels[i].c_str());
+    if (ratios.error_over_sigma[i] > 3.0)
+      std::printf("outside 3 sigma: %s\n", ratios.labels[i].c_str());
   }
   std::vector<double> sorted = ratios.error_over_sigma;
   std::sort(sorted.begin(), sorted.end());
@@ -121,12 +122,12 @@ struct ModelCase {
 };
 
 void FitModelAndCompare(const ModelCase& c, const std::vector<sim::MultiChannelRun>& runs,
-                        const std::string& label, Ratios* out) {
+                        const std::string& flags, const std::string& label, Ratios* out) {
   TempDir dir;
   sim::WriteMultiChannelDataSet(dir.path() / "data", runs, c.nominal_yaml, c.columns);
   fitcal::testing::WriteFileBytes(dir.Path("truth.yaml"), c.truth_yaml);
-  const auto r = RunFitcal(dir, "fit --logs " + dir.Path("data") + " --out " +
-                                    dir.Path("cal.yaml"));
+  const auto r =
+      RunFitcal(dir, "fit --logs " + dir.Path("data") + " --out " + dir.Path("cal.yaml") + flags);
   ASSERT_EQ(r.exit_code, 0) << label << "\n" << r.out << r.err;
   const fitcal::Robot fitted = fitcal::ReadRobotModelFile(dir.Path("cal.yaml"))->robot();
   const fitcal::Robot truth = fitcal::ReadRobotModelFile(dir.Path("truth.yaml"))->robot();
@@ -195,7 +196,7 @@ ModelCase Omni3Case(const sim::Drive& drive) {
           }};
 }
 
-void ExpectModelCoverage(const ModelCase& c, int runs_per_seed) {
+void ExpectModelCoverage(const ModelCase& c, int runs_per_seed, const std::string& flags = "") {
   const int seeds = kSeeds;
   Ratios ratios;
   int parameters = 0;
@@ -203,7 +204,7 @@ void ExpectModelCoverage(const ModelCase& c, int runs_per_seed) {
     std::vector<sim::MultiChannelRun> runs;
     for (int i = 0; i < runs_per_seed; ++i) runs.push_back(c.simulate(1000 * seed + i));
     const std::size_t before = ratios.error_over_sigma.size();
-    FitModelAndCompare(c, runs, c.name + " seed " + std::to_string(seed), &ratios);
+    FitModelAndCompare(c, runs, flags, c.name + " seed " + std::to_string(seed), &ratios);
     parameters = static_cast<int>(ratios.error_over_sigma.size() - before);
   }
   ExpectCoverage(ratios, static_cast<std::size_t>(seeds * parameters));
@@ -221,6 +222,13 @@ TEST(IndependentSigmaCoverage, TricycleTrackFitSigmasCover) {
 }
 TEST(IndependentSigmaCoverage, Omni3TrackFitSigmasCover) {
   ExpectModelCoverage(Omni3Case(sim::Drive{}), 4);
+}
+
+TEST(IndependentSigmaCoverage, ExperimentTricycleFinalPoseShort) {
+  ExpectModelCoverage(TricycleCase(Length(5.0)), 16, " --residuals final-pose");
+}
+TEST(IndependentSigmaCoverage, ExperimentOmni3FinalPoseShort) {
+  ExpectModelCoverage(Omni3Case(Length(5.0)), 16, " --residuals final-pose");
 }
 
 }  // namespace

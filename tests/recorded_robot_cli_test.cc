@@ -64,7 +64,8 @@ constexpr const char* kMecanumGuess =
     "drive_angle_deg: 0, roller_angle_deg: 45}\n"
     "  - {name: rr, distance_m: 0.25, angle_deg: -143.13010235, radius_m: 0.05, "
     "drive_angle_deg: 0, roller_angle_deg: -45}\n"
-    "bounds: {distance_m: [0.22, 0.28], radius_m: [0.045, 0.055], angle_offset_deg: [-2.0, 2.0]}\n";
+    "bounds: {distance_m: [0.22, 0.28], radius_m: [0.045, 0.055], "
+    "angle_offset_deg: [-2.0, 2.0]}\n";
 
 // Bounds are the user's (documented keys), wide enough for a 20 % error; the steering gain's
 // are the default (a factor of 10 either way of the nominal). The tricycle's true gain is 2.5,
@@ -110,7 +111,8 @@ const RecordedCase kCases[] = {
      "drive_angle_deg: 0, roller_angle_deg: 45}\n"
      "  - {name: rr, distance_m: 0.25, angle_deg: -143.13010235, radius_m: 0.047, "
      "drive_angle_deg: 0, roller_angle_deg: -45}\n"
-     "bounds: {distance_m: [0.22, 0.28], radius_m: [0.045, 0.055], angle_offset_deg: [-2.0, 2.0]}\n",
+     "bounds: {distance_m: [0.22, 0.28], radius_m: [0.045, 0.055], "
+     "angle_offset_deg: [-2.0, 2.0]}\n",
      {}, "", "NOT DETERMINED: the training runs leave a direction",
      "ground_truth_frame: {x_m: 1.5, y_m: -0.2, yaw_deg: 0.0}\n"},
 };
@@ -198,7 +200,8 @@ TEST_P(RecordedRobot, DefaultFitRecoversWheelsAndMountFromCountsFarFromTheGuess)
   const YAML::Node sigma = block["sigma"];
   std::set<std::string> held, not_determined;
   for (const YAML::Node& name : block["held"]) held.insert(name.as<std::string>());
-  for (const YAML::Node& name : block["not_determined"]) not_determined.insert(name.as<std::string>());
+  for (const YAML::Node& name : block["not_determined"])
+    not_determined.insert(name.as<std::string>());
   ASSERT_EQ(fitted.NumParameters(), truth.NumParameters());
   for (int k = 0; k < fitted.NumParameters(); ++k) {
     const ParameterInfo& info = fitted.parameters[k];

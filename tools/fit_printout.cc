@@ -56,7 +56,8 @@ void PrintParameters(const Robot& robot, const std::vector<double>& p, const Sel
       std::snprintf(change, sizeof change, "%+.2f%%",
                     100.0 * (p[k] - robot.nominal[k]) / robot.nominal[k]);
     }
-    const bool not_determined = k < static_cast<int>(fit.not_determined.size()) && fit.not_determined[k];
+    const bool not_determined =
+        k < static_cast<int>(fit.not_determined.size()) && fit.not_determined[k];
     std::printf("  %-22s %12.6f %12.6f %12s %12s%s%s%s\n", robot.LabelOf(k).c_str(),
                 robot.nominal[k] * s, p[k] * s, sigma, change, fit.at_bound[k] ? "  AT BOUND" : "",
                 fit.held[k] ? "  HELD" : "", not_determined ? "  NOT DETERMINED" : "");

@@ -115,7 +115,10 @@ struct TricycleGeometry {
 
 struct SteeringActuator {
   double tau_s = 0.15;
-  int counts_per_rev = 16384;  // the column's absolute encoder (14 bits)
+  // The column's absolute encoder, 14 bits. At 12 bits the straight-ahead reading's rounding (the
+  // same count on every straight) biases the fitted offset beyond its sigma: a resolution limit
+  // of the truth, not noise (docs/everyday_driving.md, "Sigmas that cover").
+  int counts_per_rev = 16384;
 };
 
 // Everyday driving of a tricycle: straights, arcs of 0.4-2 m radius either way, and sharp turns
@@ -216,7 +219,8 @@ inline std::vector<TwistCommand> Omni3Commands(const Drive& drive, std::mt19937_
     const double pick = u(rng);
     const double sense = u(rng) < 0.5 ? -1.0 : 1.0;
     const double direction = kTwoPi * u(rng);
-    const double vx = drive.speed_m_s * std::cos(direction), vy = drive.speed_m_s * std::sin(direction);
+    const double vx = drive.speed_m_s * std::cos(direction),
+                 vy = drive.speed_m_s * std::sin(direction);
     if (pick < 0.3) {
       const double length = 1.0 + 2.0 * u(rng);
       out.push_back({vx, vy, 0.0, 0.0, length / drive.speed_m_s});
@@ -224,7 +228,8 @@ inline std::vector<TwistCommand> Omni3Commands(const Drive& drive, std::mt19937_
     } else if (pick < 0.6) {
       const double radius = 0.4 + 1.6 * u(rng);
       const double angle = (0.25 + 0.75 * u(rng)) * kTwoPi / 2.0;
-      out.push_back({vx, vy, sense * drive.speed_m_s / radius, 0.0, angle * radius / drive.speed_m_s});
+      out.push_back(
+          {vx, vy, sense * drive.speed_m_s / radius, 0.0, angle * radius / drive.speed_m_s});
       path += angle * radius;
     } else if (pick < 0.8) {
       const double length = 1.0 + 2.0 * u(rng);
@@ -304,9 +309,10 @@ inline MultiChannelRun SimulateOmni3(const Omni3Geometry& g, const ContactPhysic
     for (int i = 0; i < steps; ++i) {
       std::array<double, 3> ground{};
       for (int w = 0; w < 3; ++w) {
-        const double target = (-std::sin(g.angle_rad[w]) * c.v_m_s +
-                               std::cos(g.angle_rad[w]) * c.vy_m_s + g.distance_m[w] * c.omega_rad_s) /
-                              g.radius_m[w];
+        const double target =
+            (-std::sin(g.angle_rad[w]) * c.v_m_s + std::cos(g.angle_rad[w]) * c.vy_m_s +
+             g.distance_m[w] * c.omega_rad_s) /
+            g.radius_m[w];
         ground[w] = detail::DriveWheel(physics, g.radius_m[w], target, kStepS, walk_decay,
                                        walk_kick, normal, rng, &wheel[w]);
       }
