@@ -122,12 +122,12 @@ struct ModelCase {
 };
 
 void FitModelAndCompare(const ModelCase& c, const std::vector<sim::MultiChannelRun>& runs,
-                        const std::string& flags, const std::string& label, Ratios* out) {
+                        const std::string& label, Ratios* out) {
   TempDir dir;
   sim::WriteMultiChannelDataSet(dir.path() / "data", runs, c.nominal_yaml, c.columns);
   fitcal::testing::WriteFileBytes(dir.Path("truth.yaml"), c.truth_yaml);
   const auto r =
-      RunFitcal(dir, "fit --logs " + dir.Path("data") + " --out " + dir.Path("cal.yaml") + flags);
+      RunFitcal(dir, "fit --logs " + dir.Path("data") + " --out " + dir.Path("cal.yaml"));
   ASSERT_EQ(r.exit_code, 0) << label << "\n" << r.out << r.err;
   const fitcal::Robot fitted = fitcal::ReadRobotModelFile(dir.Path("cal.yaml"))->robot();
   const fitcal::Robot truth = fitcal::ReadRobotModelFile(dir.Path("truth.yaml"))->robot();
@@ -196,7 +196,7 @@ ModelCase Omni3Case(const sim::Drive& drive) {
           }};
 }
 
-void ExpectModelCoverage(const ModelCase& c, int runs_per_seed, const std::string& flags = "") {
+void ExpectModelCoverage(const ModelCase& c, int runs_per_seed) {
   const int seeds = kSeeds;
   Ratios ratios;
   int parameters = 0;
@@ -204,7 +204,7 @@ void ExpectModelCoverage(const ModelCase& c, int runs_per_seed, const std::strin
     std::vector<sim::MultiChannelRun> runs;
     for (int i = 0; i < runs_per_seed; ++i) runs.push_back(c.simulate(1000 * seed + i));
     const std::size_t before = ratios.error_over_sigma.size();
-    FitModelAndCompare(c, runs, flags, c.name + " seed " + std::to_string(seed), &ratios);
+    FitModelAndCompare(c, runs, c.name + " seed " + std::to_string(seed), &ratios);
     parameters = static_cast<int>(ratios.error_over_sigma.size() - before);
   }
   ExpectCoverage(ratios, static_cast<std::size_t>(seeds * parameters));
@@ -222,13 +222,6 @@ TEST(IndependentSigmaCoverage, TricycleTrackFitSigmasCover) {
 }
 TEST(IndependentSigmaCoverage, Omni3TrackFitSigmasCover) {
   ExpectModelCoverage(Omni3Case(sim::Drive{}), 4);
-}
-
-TEST(IndependentSigmaCoverage, ExperimentTricycleFinalPoseShort) {
-  ExpectModelCoverage(TricycleCase(Length(5.0)), 16, " --residuals final-pose");
-}
-TEST(IndependentSigmaCoverage, ExperimentOmni3FinalPoseShort) {
-  ExpectModelCoverage(Omni3Case(Length(5.0)), 16, " --residuals final-pose");
 }
 
 }  // namespace
