@@ -60,6 +60,9 @@ io::CalibrationBlock MakeRecord(const CalibrationRequest& request, const RobotMo
   for (int k = 0; k < robot.NumParameters(); ++k) {
     if (selected_fit.at_bound[k]) r.at_bound.push_back(robot.parameters[k].name);
   }
+  for (std::size_t k = 0; k < selected_fit.not_determined.size(); ++k) {
+    if (selected_fit.not_determined[k]) r.not_determined.push_back(robot.parameters[k].name);
+  }
   // The uncertainty is the selected fit's (with its effects, when it carries some; the effects'
   // own sigmas are written with them).
   r.has_uncertainty = selected_fit.has_covariance;

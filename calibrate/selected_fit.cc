@@ -60,6 +60,7 @@ SelectedFit DescribeSelected(const Robot& robot,
                   std::vector<bool>(n, false),
                   method_objective,
                   fit.termination,
+                  {},
                   {}};
   if (const EffectFitResult* track_fit = TrackFitOf(track_fits, selected_index)) {
     out.has_covariance = track_fit->has_covariance;
@@ -78,6 +79,7 @@ SelectedFit DescribeSelected(const Robot& robot,
     out.correlation = fit.correlation;
     out.at_bound = fit.at_bound;
     out.held = fit.held;
+    out.not_determined = NotDeterminedParameters(fit);
   } else if (selected.name == method + " without holds") {
     out.at_bound = fit.at_bound;
     out.held = fit.held;  // the parameters' holds (gauge, --hold) stay; the directions' go

@@ -23,6 +23,9 @@ struct SelectedFit {
   std::string objective, termination;
   // The weights' noise levels when the fit estimated them (fit/noise_levels.h); else not estimated.
   NoiseLevels noise_levels;
+  // Per parameter: not determined by the training runs, its sigma the bounds' along a held
+  // direction (NotDeterminedParameters, fit/model_fit.h).
+  std::vector<bool> not_determined;
 };
 
 // candidates[selected_index] described by the fit that made it: `fit` (the method's, minimising

@@ -311,6 +311,31 @@ EvaluatedBlock EvaluateBlock(const ceres::CostFunction& cost,
   return out;
 }
 
+// What a held direction leaves uncertain (header, "Uncertainty"). The held fit sits at the
+// nominal along each held direction, so its error there is the nominal's, u = nominal - truth, of
+// which nothing is known but the bounds (read as a uniform prior over the box, variance
+// width^2 / 12, as fit/determined_directions.h reads them). The hold is stiff, so the fit's own
+// covariance is near zero along it and excluded the truth (a mecanum robot's R_fl -6 sigma,
+// tests/recorded_robot_cli_test.cc). To first order the held fit's error moves with u as B u,
+// B = H^-1 J_h^T J_h (H the information with the hold, J_h the hold's Jacobian): the directions
+// themselves, and whatever the fit moved with them (the information's cross terms). Adds
+// B Cov(u) B^T to the covariance and keeps it apart in held_directions_covariance.
+void AddHeldDirectionsCovariance(const Robot& robot, const HeldDirections& holds,
+                                 const Eigen::MatrixXd& inverse_information,
+                                 ModelFitResult* result) {
+  const int n = robot.NumParameters();
+  const HoldDirectionsCost hold(holds.directions, robot, holds.weight);
+  const Eigen::MatrixXd j = EvaluateBlock(hold, {result->parameters.data()}, {0}, n).jacobian;
+  Eigen::VectorXd prior_variance = Eigen::VectorXd::Zero(n);
+  for (int k = 0; k < n; ++k) {
+    const double width = robot.bounds[k].Width();
+    if (!result->held[k]) prior_variance(k) = width * width / 12.0;
+  }
+  const Eigen::MatrixXd b = inverse_information * j.transpose() * j;
+  result->held_directions_covariance = b * prior_variance.asDiagonal() * b.transpose();
+  result->covariance += result->held_directions_covariance;
+}
+
 // One run's track errors at the solution for the random-walk covariance (fit/serial_covariance.h).
 TrackErrorChain TrackChainOf(const TrackCheckpoints& track, const RobotModelInterface& model,
                              const ModelFitOptions& options, const std::vector<double>& p,
@@ -403,6 +428,13 @@ void TrackSandwichCovariance(const std::vector<AlignedRun>& training,
   Eigen::MatrixXd full = Eigen::MatrixXd::Zero(m, m);
   full(free, free) = covariance;
   result->covariance = full.topLeftCorner(n, n);
+  if (!holds.directions.empty()) {
+    Eigen::MatrixXd inverse = Eigen::MatrixXd::Zero(m, m);
+    const Eigen::Index f = static_cast<Eigen::Index>(free.size());
+    inverse(free, free) =
+        SandwichCovariance(information(free, free), Eigen::MatrixXd::Identity(f, f));
+    AddHeldDirectionsCovariance(model.robot(), holds, inverse.topLeftCorner(n, n), result);
+  }
   result->sigma = SigmasOf(result->covariance);
   result->correlation = CorrelationOf(result->covariance);
   result->has_covariance = true;
@@ -450,6 +482,9 @@ void ComputeCovariance(const std::vector<AlignedRun>& training, const RobotModel
     return;
   }
   result->covariance = covariance[0];
+  if (!holds.directions.empty() && s2 > 0.0) {
+    AddHeldDirectionsCovariance(model.robot(), holds, covariance[0] / s2, result);
+  }
   result->sigma = SigmasOf(result->covariance);
   result->correlation = CorrelationOf(result->covariance);
   result->has_covariance = true;
@@ -794,6 +829,15 @@ ModelFitResult FitModelFrom(const std::vector<AlignedRun>& training,
   return result;
 }
 
+std::vector<bool> NotDeterminedParameters(const ModelFitResult& fit) {
+  const Eigen::Index n = static_cast<Eigen::Index>(fit.parameters.size());
+  std::vector<bool> out(fit.parameters.size(), false);
+  const Eigen::MatrixXd& held = fit.held_directions_covariance;
+  if (!fit.has_covariance || held.rows() != n || fit.covariance.rows() != n) return out;
+  for (Eigen::Index k = 0; k < n; ++k) out[k] = held(k, k) > 0.5 * fit.covariance(k, k);
+  return out;
+}
+
 ModelFitResult ExpandTiedResult(const TiedModel& tied, const ModelFitResult& fit) {
   const int n = tied.inner().robot().NumParameters();
   const auto per_member = [&](const auto& of_q) {
@@ -815,6 +859,8 @@ ModelFitResult ExpandTiedResult(const TiedModel& tied, const ModelFitResult& fit
   if (fit.has_covariance) {
     const Eigen::MatrixXd a = tied.Basis();
     out.covariance = a * fit.covariance * a.transpose();
+    if (fit.held_directions_covariance.size() > 0)
+      out.held_directions_covariance = a * fit.held_directions_covariance * a.transpose();
     out.correlation = CorrelationOf(out.covariance);
   }
   return out;
@@ -889,7 +935,12 @@ WiderThanItsBox SigmaWiderThanItsBox(const Robot& robot, const ModelFitResult& f
   for (int k = 0; k < robot.NumParameters(); ++k) {
     const double box_sigma = robot.bounds[k].Width() / std::sqrt(12.0);
     if (HeldInFit(robot, k, options) || !(box_sigma > 0.0)) continue;
-    const double ratio = fit.sigma[k] / box_sigma;
+    // The runs' own sigma: a held direction's part is the box's by construction.
+    const double held_part = fit.held_directions_covariance.size() > 0
+                                 ? fit.held_directions_covariance(k, k)
+                                 : 0.0;
+    const double own = std::sqrt(std::max(0.0, fit.sigma[k] * fit.sigma[k] - held_part));
+    const double ratio = own / box_sigma;
     if (ratio > kGlobalStartSigmaRatio && ratio > out.ratio) out = {k, ratio};
   }
   return out;

@@ -23,7 +23,10 @@
 // the residual variance s^2 = |r|^2 / (3 N - n_free) (runs and windows are independent). Tracks
 // (and both), the sandwich H^-1 M H^-1 of fit/serial_covariance.h: a run's checkpoint errors are
 // a random walk, not independent. Parameters at a bound are flagged; their sigma then describes
-// the unconstrained problem only.
+// the unconstrained problem only. Directions held because the runs do not determine them
+// (hold_undetermined) add what the bounds say about the nominal along them (the box as a
+// uniform prior, fit/determined_directions.h): a parameter that moves along a held direction is
+// written with the sigma of what the user knew, not the near-zero sigma of the stiff hold.
 
 #include <Eigen/Core>
 #include <optional>
@@ -67,6 +70,9 @@ struct ModelFitResult {
   std::string covariance_message;
   double residual_sigma = 0.0;  // sqrt(|r|^2 / (3 N - n_free)), in the objective's units
   Eigen::MatrixXd covariance;   // n x n, zero rows/columns for held parameters
+  // The part of `covariance` the held directions add (n x n; empty when none is held): where it
+  // dominates a parameter's variance, the runs did not determine that parameter.
+  Eigen::MatrixXd held_directions_covariance;
   std::vector<double> sigma;
   Eigen::MatrixXd correlation;
 
@@ -154,6 +160,11 @@ struct ClockOffsetEstimate {
 ClockOffsetEstimate EstimateClockOffsets(const RobotModelInterface& model,
                                          const std::vector<double>& p,
                                          const ModelFitOptions& options);
+
+// The parameters the training runs did not determine: the held directions (ModelFitResult::
+// held_directions_covariance) make more than half of their variance, so the bounds say more
+// about them than the runs do. Per parameter; all false without held directions.
+std::vector<bool> NotDeterminedParameters(const ModelFitResult& fit);
 
 // Throws std::invalid_argument for invalid options or no runs.
 ModelFitResult FitModel(const std::vector<AlignedRun>& training, const RobotModelInterface& model,

@@ -106,6 +106,9 @@ std::string CalibrationBlockYaml(const CalibrationBlock& c, const Robot& robot) 
   EmitRuns(out, c);
   out << YAML::Key << "held" << YAML::Value << YAML::Flow << c.held;
   out << YAML::Key << "at_bound" << YAML::Value << YAML::Flow << c.at_bound;
+  if (!c.not_determined.empty()) {
+    out << YAML::Key << "not_determined" << YAML::Value << YAML::Flow << c.not_determined;
+  }
   EmitUncertainty(out, c, robot);
   EmitClockOffsets(out, c);
   out << YAML::EndMap << YAML::EndMap;

@@ -51,6 +51,9 @@ struct CalibrationBlock : CalibrationSource {
   std::string selected;
   std::string selected_on;
   std::vector<std::string> held;  // parameter names held at nominal, with why
+  // Parameters the runs did not determine: their sigma is what the bounds allow along a direction
+  // held at the nominal (`not_determined:`, written only when there are some).
+  std::vector<std::string> not_determined;
   bool has_uncertainty = false;
   std::vector<double> sigma;  // one sigma per parameter, SI and rad
   Eigen::MatrixXd correlation;

@@ -56,9 +56,17 @@ void PrintParameters(const Robot& robot, const std::vector<double>& p, const Sel
       std::snprintf(change, sizeof change, "%+.2f%%",
                     100.0 * (p[k] - robot.nominal[k]) / robot.nominal[k]);
     }
-    std::printf("  %-22s %12.6f %12.6f %12s %12s%s%s\n", robot.LabelOf(k).c_str(),
+    const bool not_determined =
+        k < static_cast<int>(fit.not_determined.size()) && fit.not_determined[k];
+    std::printf("  %-22s %12.6f %12.6f %12s %12s%s%s%s\n", robot.LabelOf(k).c_str(),
                 robot.nominal[k] * s, p[k] * s, sigma, change, fit.at_bound[k] ? "  AT BOUND" : "",
-                fit.held[k] ? "  HELD" : "");
+                fit.held[k] ? "  HELD" : "", not_determined ? "  NOT DETERMINED" : "");
+  }
+  if (std::find(fit.not_determined.begin(), fit.not_determined.end(), true) !=
+      fit.not_determined.end()) {
+    std::printf("  NOT DETERMINED: the training runs leave a direction these parameters move along "
+                "(held at the nominal, below); their sigma is what the bounds allow along it, "
+                "read as a uniform prior: the value is as good as your nominal there\n");
   }
   for (const HeldParameter& h : robot.held) {
     std::printf("  held: %s (%s)\n", robot.parameters[h.index].name.c_str(), h.reason.c_str());
