@@ -20,7 +20,6 @@
 #include "io/atomic_file.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
-#include "io/robot_yaml.h"
 #include "models/model_registry.h"
 #include "tools/cli_validators.h"
 #include "calibrate/fit_methods.h"
@@ -152,12 +151,11 @@ std::string TraceCsv(const std::vector<Row>& rows) {
   return o.str();
 }
 
-// The robot and runs of a data set, for any model; a model that registers the legacy loader
-// (ModelExtras::legacy_loader: omni3) keeps its own; every model fits and is scored through the
-// seam (calibrate/fit_methods.h, fit/final_pose_errors.h).
+// The robot and runs of a data set, loaded through the model's own robot description like every
+// other command's; every model fits and is scored through the seam (calibrate/fit_methods.h,
+// fit/final_pose_errors.h).
 struct CompareData {
   RobotModelPtr model;
-  bool legacy = false;  // ModelExtras::legacy_loader: Palacin's strategies STA..STE by default
   std::vector<AlignedRun> runs;
 
   double Cf(const std::vector<double>& p, const std::vector<AlignedRun>& on, int threads) const {
@@ -167,17 +165,9 @@ struct CompareData {
 
 CompareData LoadCompareData(const CompareCommandOptions& options) {
   const io::DatasetIndex index = OpenDataset(options).index;
-  const std::string model_name = io::ReadRobotModel(index.robot_path);
   CompareData d;
-  if (ExtrasOf(model_name).legacy_loader) {
-    const io::Dataset dataset = LoadRuns(options, index, /*robot=*/nullptr);
-    d.legacy = true;
-    d.model = ReadRobotModelFile(dataset.robot_path);
-    d.runs = AlignRuns(dataset.runs);
-  } else {
-    d.model = ReadRobotModelFile(index.robot_path);
-    d.runs = AlignRuns(LoadRuns(options, index, &d.model->robot()).runs);
-  }
+  d.model = ReadRobotModelFile(index.robot_path);
+  d.runs = AlignRuns(LoadRuns(options, index, d.model->robot()).runs);
   return d;
 }
 
@@ -216,10 +206,9 @@ void ResolveStrategy(const std::vector<AlignedRun>& runs, TrajectoryStrategy* s)
   }
 }
 
-// Palacin's STA..STE need the flower's labels. For a model without the legacy loader (omni3 has
-// it) and no --strategies, keep those the data set has (the omni model's generalised flower has
-// them all) or, when it has none, train on every trajectory ("all": the split is by repetitions
-// only).
+// Palacin's STA..STE need the flower's labels. Without --strategies, keep those the data set has
+// (the flower of omni3 and the omni model's generalised flower have them all) or, when it has
+// none, train on every trajectory ("all": the split is by repetitions only).
 std::vector<TrajectoryStrategy> DefaultStrategiesFor(const std::vector<AlignedRun>& runs,
                                                      std::vector<TrajectoryStrategy> strategies) {
   std::vector<TrajectoryStrategy> present;
@@ -423,7 +412,7 @@ void AddStrategyRows(const CompareRequest& request, const CompareData& d,
 
 void AddCompareOptions(CLI::App& app, CompareCommandOptions& o) {
   AddDatasetOptions(app, o);
-  // A model without the legacy loader takes the STA..STE it has unless --strategies names some.
+  // A data set takes the STA..STE it has unless --strategies names some.
   app.callback([&app, &o] { o.strategies_given = app.count("--strategies") > 0; });
   app.add_option("--strategies", o.strategies,
                  "STA..STE, trajectory lists such as R1,R5,G4 or B1-B12, all, or a label "
@@ -470,7 +459,7 @@ int RunCompareCommand(const CompareCommandOptions& options) {
       std::cerr << "fitcal compare: " << refusal << "\n";
       return 2;
     }
-    if (!d.legacy && !options.strategies_given) {
+    if (!options.strategies_given) {
       request.strategies = DefaultStrategiesFor(d.runs, request.strategies);
     }
     for (TrajectoryStrategy& s : request.strategies) ResolveStrategy(d.runs, &s);

@@ -36,9 +36,8 @@ OpenedDataset OpenDataset(const DatasetCommandOptions& options) {
 }
 
 io::Dataset LoadRuns(const DatasetCommandOptions& options, const io::DatasetIndex& index,
-                     const Robot* robot) {
-  return robot == nullptr ? io::LoadDataset(index, options.Loading())
-                          : io::LoadDataset(index, *robot, options.Loading());
+                     const Robot& robot) {
+  return io::LoadDataset(index, robot, options.Loading());
 }
 
 int Refuse(const std::string& why) {

@@ -40,11 +40,9 @@ struct OpenedDataset {
 };
 OpenedDataset OpenDataset(const DatasetCommandOptions& options);
 
-// Every run of the data set. `robot` null: read as the omni3 commands always read their data sets
-// (three wheel columns; the runs' fingerprints recorded by `fit` depend on it); otherwise with
-// the robot's own channels.
+// Every run of the data set, read with the robot's own channels (the one loader of every command).
 io::Dataset LoadRuns(const DatasetCommandOptions& options, const io::DatasetIndex& index,
-                     const Robot* robot);
+                     const Robot& robot);
 
 // A refusal: `fitcal: <why>` on one line of stderr; returns the usage exit status 2.
 int Refuse(const std::string& why);

@@ -42,7 +42,7 @@ ReportInputs LoadInputs(const ReportCommandOptions& options, std::string* refusa
   if (!refusal->empty()) return in;
   in.model = ReadRobotModelFile(in.index.robot_path);
   // Loaded as `fit` loads them, with the robot's channels (their runs' fingerprints must agree).
-  in.dataset = LoadRuns(options, in.index, &in.model->robot());
+  in.dataset = LoadRuns(options, in.index, in.model->robot());
   for (const std::string& path : options.calibrations) {
     Robot calibrated = ReadRobotModelFile(path)->robot();
     if (calibrated.model != in.model->robot().model ||
