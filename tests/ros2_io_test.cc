@@ -35,7 +35,7 @@
 #include "odometry/aligned_run.h"
 #include "tests/robot_bag.h"
 #include "tests/test_files.h"
-#include "tools/command_failure.h"
+#include "io/command_failure.h"
 #include "tools/export_ros2_control.h"
 #include "tools/import_rosbag2.h"
 #include "models/diff_drive/diff_drive_trajectories.h"

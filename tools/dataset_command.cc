@@ -5,7 +5,7 @@
 
 #include "io/input_error.h"
 #include "odometry/robot.h"
-#include "tools/command_failure.h"
+#include "io/command_failure.h"
 #include "tools/output_guard.h"
 
 namespace fitcal::tools {

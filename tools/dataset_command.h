@@ -49,7 +49,7 @@ int Refuse(const std::string& why);
 
 // The tool's edge: runs `command` and turns an exception (io::InputError carries file:line in
 // what()) into `<prefix>: <what>` on one line of stderr and exit status 1, or the status a
-// CommandFailure (tools/command_failure.h) carries.
+// CommandFailure (io/command_failure.h) carries.
 int RunReportingErrors(const std::string& prefix, const std::function<int()>& command);
 
 }  // namespace fitcal::tools

@@ -23,7 +23,7 @@
 #include "models/mounted_model.h"
 #include "odometry/aligned_run.h"
 #include "odometry/effects.h"
-#include "tools/command_failure.h"
+#include "io/command_failure.h"
 #include "tools/dataset_command.h"
 #include "tools/output_guard.h"
 #include "validation/everyday_driving.h"

@@ -20,7 +20,7 @@
 #include "io/yaml_reader.h"
 #include "models/model_registry.h"
 #include "odometry/text_format.h"
-#include "tools/command_failure.h"
+#include "io/command_failure.h"
 #include "tools/dataset_command.h"
 
 namespace fitcal::tools {

@@ -24,7 +24,7 @@
 #include "io/yaml_scalar.h"
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
-#include "tools/command_failure.h"
+#include "io/command_failure.h"
 #include "tools/dataset_command.h"
 #include "tools/output_guard.h"
 
