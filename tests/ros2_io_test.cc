@@ -471,7 +471,7 @@ TEST(Rosbag2ReadOnly, BagDirectoryUnchanged) {
 
 struct Exported {
   YAML::Node params;
-  tools::Ros2ControlExport e;
+  Ros2ControlExport e;
   // What the controller computes (e.model at e.parameters), by parameter name.
   double Back(const std::string& name) const {
     return e.parameters[RequireParameterIndex(e.model->robot(), name)];
@@ -480,7 +480,7 @@ struct Exported {
 
 Exported ExportAndRead(const std::string& cal, const std::string& controller) {
   Exported x;
-  x.e = tools::ExportRos2Control(cal, controller, "", {});
+  x.e = ExportRos2Control(cal, controller, "", {});
   const YAML::Node root = YAML::Load(x.e.parameters_yaml);
   EXPECT_TRUE(root[controller]) << x.e.parameters_yaml;
   x.params = root[controller]["ros__parameters"];
@@ -540,8 +540,8 @@ TEST(ExportRos2Control, DiffDriveIsExact) {
   for (int k = 0; k < 3; ++k) {
     EXPECT_NEAR(x.Back(names[k]), kTruth[k], kRoundTrip * kTruth[k]) << names[k];
   }
-  EXPECT_THROW(tools::ExportRos2Control(cal, "tricycle_controller", "", {}), tools::UsageError);
-  EXPECT_THROW(tools::ExportRos2Control(cal, "ackermann_controller", "", {}), tools::UsageError);
+  EXPECT_THROW(ExportRos2Control(cal, "tricycle_controller", "", {}), UsageError);
+  EXPECT_THROW(ExportRos2Control(cal, "ackermann_controller", "", {}), UsageError);
 }
 
 TEST(ExportRos2Control, MecanumTakesMeans) {
@@ -688,7 +688,7 @@ TEST(ExportRos2Control, EveryKeyDeclaredOnItsDistribution) {
                                              {"omni_wheel_drive_controller", kOmni3ExampleYaml},
                                              {"tricycle_controller", kTricycleExampleYaml}};
   int checked = 0;
-  for (const std::string& distro : tools::RosDistros()) {
+  for (const std::string& distro : RosDistros()) {
     for (const ControllerCase& c : cases) {
       SCOPED_TRACE(distro + " " + c.controller);
       const RobotModelPtr model = ReadRobotModel(YAML::Load(c.robot_yaml), "robot.yaml");
@@ -697,16 +697,16 @@ TEST(ExportRos2Control, EveryKeyDeclaredOnItsDistribution) {
       const std::string cal = tmp.Write("cal.yaml", model->RobotYaml(p, ""));
       const KeyTypes declared = DeclaredKeys(distro, c.controller);
       if (declared.empty()) {  // the distribution does not ship it: refused in one line
-        EXPECT_THROW(tools::ExportRos2Control(cal, c.controller, "", {}, distro),
-                     tools::UsageError);
+        EXPECT_THROW(ExportRos2Control(cal, c.controller, "", {}, distro),
+                     UsageError);
         continue;
       }
-      const tools::Ros2ControlExport e = tools::ExportRos2Control(cal, c.controller, "", {}, distro);
+      const Ros2ControlExport e = ExportRos2Control(cal, c.controller, "", {}, distro);
       OdometryCovariance covariance;  // as written with --logs
       covariance.twist_variance = {1e-4, 2e-5, 3e-4};
       covariance.pose_variance_1m = {1e-5, 2e-6, 3e-5};
       const std::string yaml =
-          e.parameters_yaml + tools::Ros2CovarianceParameters(c.controller, covariance);
+          e.parameters_yaml + Ros2CovarianceParameters(c.controller, covariance);
       std::vector<std::pair<std::string, YAML::Node>> written;
       Flatten(YAML::Load(yaml)[c.controller]["ros__parameters"], "", &written);
       EXPECT_GE(written.size(), 4u);
@@ -727,8 +727,8 @@ TEST(ExportRos2Control, EveryKeyDeclaredOnItsDistribution) {
   EXPECT_EQ(DeclaredKeys("jazzy", "diff_drive_controller").count("wheels_per_side"), 0u);
   EXPECT_EQ(DeclaredKeys("rolling", "diff_drive_controller").count("wheels_per_side"), 0u);
   EXPECT_THROW(
-      tools::ExportRos2Control(tmp.Path("cal.yaml"), "tricycle_controller", "", {}, "iron"),
-      tools::UsageError);
+      ExportRos2Control(tmp.Path("cal.yaml"), "tricycle_controller", "", {}, "iron"),
+      UsageError);
 }
 
 TEST(ExportRos2Control, TricycleOffsetStatedWithSignAndPlace) {
@@ -736,7 +736,7 @@ TEST(ExportRos2Control, TricycleOffsetStatedWithSignAndPlace) {
   const RobotModelPtr model = ReadRobotModel(YAML::Load(kTricycleExampleYaml), "robot.yaml");
   const double offset_rad = -2.25 * M_PI / 180;
   const std::string cal = tmp.Write("cal.yaml", model->RobotYaml({0.0331, 0.152, offset_rad}, ""));
-  const tools::Ros2ControlExport e = tools::ExportRos2Control(cal, "tricycle_controller", "", {});
+  const Ros2ControlExport e = ExportRos2Control(cal, "tricycle_controller", "", {});
   ASSERT_EQ(e.notes.size(), 1u);
   const std::string& note = e.notes[0];
   char value[64];
@@ -819,7 +819,7 @@ TEST(ExportRos2Control, HeldOutRunsAreTheOnesReportTakes) {
   EXPECT_TRUE(io::ReadCalibrationProvenance(with_cov));
   std::string which;
   const RobotModelPtr model = ReadRobotModelFile(cal);
-  const std::vector<AlignedRun> runs = tools::ExportHeldOutRuns(cal, data, model->robot(), &which);
+  const std::vector<AlignedRun> runs = ExportHeldOutRuns(cal, data, model->robot(), &which);
   ASSERT_EQ(static_cast<int>(runs.size()), held_out);
   for (const AlignedRun& r : runs) EXPECT_EQ(r.trajectory.rfind("square", 0), std::string::npos);
 }

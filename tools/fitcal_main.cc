@@ -170,7 +170,7 @@ class HelpFormatter : public CLI::Formatter {
 
   std::string make_footer(const CLI::App* app) const override {
     const std::string own = app->get_footer();
-    return (own.empty() ? "" : own + "\n\n") + kExitStatusHelp + "\n";
+    return (own.empty() ? "" : own + "\n\n") + fitcal::kExitStatusHelp + "\n";
   }
 };
 
