@@ -50,8 +50,8 @@ using namespace io::rosbag2;
 
 using namespace testing::robot_bag;  // the simulated robot and its bag (tests/robot_bag.h)
 
-tools::ImportRosbag2Options ImportOptions(const testing::TempDir& tmp, const fs::path& bag) {
-  tools::ImportRosbag2Options o;
+ImportRosbag2Options ImportOptions(const testing::TempDir& tmp, const fs::path& bag) {
+  ImportRosbag2Options o;
   o.bag = bag.string();
   o.out = tmp.Path("imported");
   o.robot = tmp.Write("robot.yaml", kDiffDriveExampleYaml);
@@ -95,7 +95,7 @@ TEST_P(ImportEqualsCsv, SameFitAsTheSimulatorsCsv) {
   bag_options.mcap.compression = c.compression;
   bag_options.mcap.chunk_bytes = 64 * 1024;
   const auto spans = WriteRobotBag(tmp.path() / "bag", sim_runs, bag_options);
-  tools::ImportRosbag2Options o = ImportOptions(tmp, tmp.path() / "bag");
+  ImportRosbag2Options o = ImportOptions(tmp, tmp.path() / "bag");
   if (c.split_at_rest) {
     o.split_at_rest_s = 2.0;  // the gaps (3 s + the runs' rests), not the 0.6 s corner stops
   } else {
@@ -108,7 +108,7 @@ TEST_P(ImportEqualsCsv, SameFitAsTheSimulatorsCsv) {
       o.runs += text;
     }
   }
-  const tools::Rosbag2Import in_memory = tools::ImportRosbag2(o);
+  const Rosbag2Import in_memory = tools::ImportRosbag2(o);
   const io::Dataset imported = io::LoadDataset(io::ReadDatasetIndex(o.out),
                                                ReadRobotModelFile(o.out + "/robot.yaml")->robot());
   ASSERT_EQ(imported.runs.size(), sim_runs.size());
@@ -184,7 +184,7 @@ TEST(ImportRosbag2ClockOffset, OneOffsetPerBagRecoversAPoseLatency) {
                        static_cast<std::uint32_t>(ns % 1000000000)};
   };
   WriteRobotBag(tmp.path() / "bag", SimulatedRuns(*model), BagWriterOptions{}, edits);
-  tools::ImportRosbag2Options o = ImportOptions(tmp, tmp.path() / "bag");
+  ImportRosbag2Options o = ImportOptions(tmp, tmp.path() / "bag");
   o.split_at_rest_s = 2.0;
   tools::ImportRosbag2(o);
   const io::Dataset imported = io::LoadDataset(io::ReadDatasetIndex(o.out), model->robot());
@@ -218,7 +218,7 @@ class CaptureStderr {
   std::streambuf* old_;
 };
 
-void ExpectRefused(const tools::ImportRosbag2Options& o, const std::string& what) {
+void ExpectRefused(const ImportRosbag2Options& o, const std::string& what) {
   int rc = 0;
   std::string err;
   {
@@ -253,8 +253,8 @@ class MalformedImport : public ::testing::Test {
     return tmp_.path() / name;
   }
   // The bag imported (as the user would, split at the rests between runs).
-  tools::Rosbag2Import Import(const fs::path& bag, const std::string& out) {
-    tools::ImportRosbag2Options o = ImportOptions(tmp_, bag);
+  Rosbag2Import Import(const fs::path& bag, const std::string& out) {
+    ImportRosbag2Options o = ImportOptions(tmp_, bag);
     o.out = tmp_.Path(out);
     o.split_at_rest_s = 2.0;
     return tools::ImportRosbag2(o);
@@ -280,7 +280,7 @@ TEST_F(MalformedImport, TruncatedAndBadMagic) {
 
 TEST_F(MalformedImport, TopicTypeJointAndStamps) {
   const fs::path bag = Bag("b", StorageFormat::kMcap);
-  tools::ImportRosbag2Options o = ImportOptions(tmp_, bag);
+  ImportRosbag2Options o = ImportOptions(tmp_, bag);
   o.ground_truth = "/vicon/pose";
   ExpectRefused(o, "topic \"/vicon/pose\" is not in the bag");
   o.ground_truth = "/chatter";
@@ -326,7 +326,7 @@ TEST_F(MalformedImport, TopicTypeJointAndStamps) {
 
 // Same runs, same encoder rows to 1e-9 rad/s (an unwrapped angle is the cumulative one up to
 // the rounding of ~1e3 rad sums, ~1e-13 rad, over 0.05 s), same ground truth.
-void ExpectSameImport(const tools::Rosbag2Import& a, const tools::Rosbag2Import& b) {
+void ExpectSameImport(const Rosbag2Import& a, const Rosbag2Import& b) {
   ASSERT_EQ(a.runs.size(), b.runs.size());
   for (std::size_t i = 0; i < a.runs.size(); ++i) {
     ASSERT_EQ(a.encoder_t_s[i], b.encoder_t_s[i]) << "run " << i;
@@ -354,12 +354,12 @@ TEST_F(MalformedImport, ZeroOrNonUnitQuaternionRefusedWithTopicAndTime) {
 }
 
 TEST_F(MalformedImport, WrappedJointPositionsUnwrapped) {
-  const tools::Rosbag2Import clean = Import(Bag("clean", StorageFormat::kMcap), "clean_out");
+  const Rosbag2Import clean = Import(Bag("clean", StorageFormat::kMcap), "clean_out");
   BagEdits edits;
   edits.joint = [](std::size_t, JointState* js) {
     for (double& angle : js->position) angle = WrapAngle(angle);
   };
-  const tools::Rosbag2Import wrapped = Import(Bag("wrapped", StorageFormat::kMcap, edits), "w");
+  const Rosbag2Import wrapped = Import(Bag("wrapped", StorageFormat::kMcap, edits), "w");
   ExpectSameImport(clean, wrapped);
   ASSERT_EQ(wrapped.notes.size(), 2u);  // both wheels (the caster is not the robot's)
   EXPECT_NE(wrapped.notes[0].find("unwrapped"), std::string::npos) << wrapped.notes[0];
@@ -382,27 +382,27 @@ TEST_F(MalformedImport, WrappedJointPositionsUnwrapped) {
 }
 
 TEST_F(MalformedImport, OtherNodesJointStatesSkipped) {
-  const tools::Rosbag2Import clean = Import(Bag("clean", StorageFormat::kSqlite3), "clean_out");
+  const Rosbag2Import clean = Import(Bag("clean", StorageFormat::kSqlite3), "clean_out");
   BagEdits edits;
   edits.other_node = true;
-  const tools::Rosbag2Import mixed = Import(Bag("mixed", StorageFormat::kSqlite3, edits), "m");
+  const Rosbag2Import mixed = Import(Bag("mixed", StorageFormat::kSqlite3, edits), "m");
   ExpectSameImport(clean, mixed);
 }
 
 TEST_F(MalformedImport, RecordingClockSteppingBack) {
   for (StorageFormat storage : {StorageFormat::kMcap, StorageFormat::kSqlite3}) {
     const bool mcap = storage == StorageFormat::kMcap;
-    const tools::Rosbag2Import clean =
+    const Rosbag2Import clean =
         Import(Bag(mcap ? "clean_m" : "clean_s", storage), mcap ? "cm" : "cs");
     BagEdits edits;
     edits.clock_step_back_ns = 1500000000;  // 1.5 s, halfway through the recording
     const fs::path bag = Bag(mcap ? "step_m" : "step_s", storage, edits);
-    tools::ImportRosbag2Options o = ImportOptions(tmp_, bag);
+    ImportRosbag2Options o = ImportOptions(tmp_, bag);
     o.stamp = "recorded";
     // 1.5 s less the recorder's latency jitter (0.4 ms) between the messages either side.
     ExpectRefused(o, "the recording clock steps back by 1.4");
     // The header stamps still order every stream: imported as the clean bag, with a note.
-    const tools::Rosbag2Import stepped = Import(bag, mcap ? "sm" : "ss");
+    const Rosbag2Import stepped = Import(bag, mcap ? "sm" : "ss");
     ExpectSameImport(clean, stepped);
     ASSERT_EQ(stepped.notes.size(), 1u);
     EXPECT_NE(stepped.notes[0].find("order of their header stamps"), std::string::npos);
