@@ -22,7 +22,7 @@
 #include "tools/cli_validators.h"
 #include "tools/clock_alignment.h"
 #include "tools/output_guard.h"
-#include "tools/report_builder.h"
+#include "validation/report_builder.h"
 #include "validation/trajectory_metrics.h"
 
 namespace fitcal::tools {

@@ -1,4 +1,4 @@
-#include "tools/report_builder.h"
+#include "validation/report_builder.h"
 
 #include <Eigen/Dense>
 #include <algorithm>
