@@ -216,16 +216,6 @@ Dataset LoadDataset(const std::string& directory, const DatasetOptions& options)
 }
 
 Dataset LoadDataset(const DatasetIndex& index, const DatasetOptions& options) {
-  // The commands that call this form (compare, report, diagnose, generalise) still serve omni3
-  // robots only; say so rather than failing on the first encoder header.
-  const std::string model = ReadRobotModel(index.robot_path);
-  if (model != "omni3") {
-    const int line = LoadYamlFile(index.robot_path)["model"].Mark().line + 1;
-    throw InputError(InputErrorKind::kUnknownModel, index.robot_path, line,
-                     "model '" + model +
-                         "': this command serves omni3 robots only so far ('fitcal fit' serves "
-                         "every model)");
-  }
   return LoadDataset(index, LegacyThreeWheelRobot(ReadEncoderTicks(index.robot_path)), options);
 }
 

@@ -49,8 +49,10 @@ struct Dataset {
   std::vector<RunLog> runs;
 };
 
-// Loads dataset.yaml and every run it lists (omni3 encoder CSVs); throws InputError naming the
-// file and line.
+// Loads dataset.yaml and every run it lists as three wheel columns w_a, w_b, w_c (the shipped
+// flower's layout), whatever the robot YAML says: a shortcut for tests and benchmarks on such
+// files. Every command reads a data set with its robot's own channels (the overload below, through
+// the model registry: io, below it, names no model). Throws InputError naming the file and line.
 Dataset LoadDataset(const std::string& directory, const DatasetOptions& options = {});
 // The same from an index already read (dataset.yaml is then parsed once).
 Dataset LoadDataset(const DatasetIndex& index, const DatasetOptions& options = {});

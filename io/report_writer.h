@@ -1,6 +1,6 @@
 #pragma once
 // The validation report (`fitcal report`): its model (io/report_model.h, built by
-// tools/report_builder.h) and one renderer per output: index.html (report_html.h, figures in
+// validation/report_builder.h) and one renderer per output: index.html (report_html.h, figures in
 // report_figures.h), summary.md (report_markdown.h), metrics.csv (report_csv.h), metrics.json
 // (report_json.h) and tum/ (report_tum.h). Include the one you need; this header includes all.
 

@@ -2,7 +2,7 @@
 // What a model offers beyond the seam, registered with it (model_registry.h,
 // ModelRegistration::extras) from its own folder: the ROS 2 controllers it can be exported to,
 // the trajectories the simulator calibrates it on, how `compare` shows its parameters, and the
-// older paths two commands still take for it. Every field is optional. The commands ask the
+// older simulator `simulate` still takes for it. Every field is optional. The commands ask the
 // registry for these and never compare a model's name (STYLE.md habit 14).
 
 #include <functional>
@@ -77,9 +77,6 @@ struct ModelExtras {
   // `simulate` without --model drives it with the stepped flower engine
   // (tools/sim/flower_scenario.h) instead of a scenario: data/flower's bytes come from there.
   bool legacy_simulator = false;
-  // `compare` loads its runs through the three-wheel encoder loader (io/dataset.h) and runs
-  // Palacin's strategies STA..STE by default.
-  bool legacy_loader = false;
 };
 
 // A controller writer's notes, shared by the writers of every model.

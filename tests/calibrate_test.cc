@@ -11,6 +11,9 @@
 
 #include "calibrate/calibrate.h"
 #include "calibrate/diagnosis_calibration.h"
+#include "calibrate/method_comparison.h"
+#include "fit/final_pose_errors.h"
+#include "fit/run_split.h"
 #include "io/dataset.h"
 #include "models/model_registry.h"
 #include "tests/test_paths.h"
@@ -166,6 +169,83 @@ TEST(CalibrateOnDiagnosis, ATrackFitWithoutCovarianceGetsThePropagatedUncertaint
   ASSERT_EQ(d.record.sigma.size(), c.loaded.model->robot().nominal.size());
   for (double sigma : d.record.sigma) EXPECT_GT(sigma, 0.0);
   EXPECT_EQ(d.record.cf_validation_after, d.choice.cf_after);
+}
+
+// CompareMethods (calibrate/method_comparison.h, `fitcal compare` without the command): one
+// strategy (STB: curves both ways; STA's three straight runs do not determine the wheels'
+// angles, and their fit is worse held out, as in Palacin Table 4), Ceres on the first repetition
+// of the flower.
+ComparisonRequest FlowerComparison() {
+  const Loaded l = Load("flower");
+  ComparisonRequest r;
+  r.data_name = "data/flower";
+  r.model = l.model;
+  r.runs = AlignRuns(l.request.runs);
+  r.methods = {FindFitMethod("ceres")};
+  r.strategies = {ParseCompareStrategy("STB")};
+  r.counts = {1};
+  r.settings = l.request.settings;
+  r.threads = 2;
+  return r;
+}
+
+// The rows' CFs replayed here on the runs the comparison says it used: repetition 1 of STB's six
+// curves to train, every run of repetitions 2-10 to validate; the simulated flower's truth (Palacin
+// Table 5) is far from the nominal, so the fit must improve the held-out CF.
+TEST(CompareMethods, RowsAreTheReplayOfTheirParametersOnTheTrainingAndHeldOutRuns) {
+  const ComparisonRequest r = FlowerComparison();
+  const MethodComparison c = CompareMethods(r);
+  ASSERT_TRUE(c.refusal.empty()) << c.refusal;
+  EXPECT_EQ(c.validation_reps, (std::vector<int>{2, 3, 4, 5, 6, 7, 8, 9, 10}));
+  const std::vector<AlignedRun> held_out = SplitByRepetition(r.runs, c.validation_reps).training;
+  ASSERT_EQ(c.num_validation, 9u * 36u);
+  ASSERT_EQ(held_out.size(), c.num_validation);
+  const std::vector<AlignedRun> training = SelectRuns(r.runs, r.strategies[0], {1});
+  ASSERT_EQ(training.size(), 6u);
+  ASSERT_EQ(c.rows.size(), 2u);
+  const ComparisonRow& none = c.rows[0];
+  const ComparisonRow& ceres = c.rows[1];
+  EXPECT_EQ(none.method, "None");
+  EXPECT_DOUBLE_EQ(none.cf_validation,
+                   EvaluateFinalPoseErrors(*r.model, r.model->robot().nominal, held_out).cf);
+  EXPECT_EQ(ceres.strategy, "STB");
+  EXPECT_EQ(ceres.method, "ceres");
+  EXPECT_EQ(ceres.repetitions, 1);
+  EXPECT_DOUBLE_EQ(ceres.cf_calibration,
+                   EvaluateFinalPoseErrors(*r.model, ceres.parameters, training).cf);
+  EXPECT_DOUBLE_EQ(ceres.cf_validation,
+                   EvaluateFinalPoseErrors(*r.model, ceres.parameters, held_out).cf);
+  EXPECT_LT(ceres.cf_validation, none.cf_validation);
+  EXPECT_NEAR(ceres.improvement_percent,
+              100.0 * (none.cf_validation - ceres.cf_validation) / none.cf_validation, 1e-9);
+}
+
+TEST(CompareMethods, AValidationRepetitionThatTrainsIsRefusedBeforeAnyFit) {
+  ComparisonRequest r = FlowerComparison();
+  r.validation_reps = {1, 6};
+  const MethodComparison c = CompareMethods(r);
+  EXPECT_EQ(c.refusal, "validation repetition 1 is also a training repetition");
+  EXPECT_TRUE(c.rows.empty());
+}
+
+// Without --strategies, a data set without the flower's labels trains on every trajectory ("all"),
+// whatever the model (omni3 took STA..STE and was refused before the one loader).
+TEST(CompareMethods, WithoutTheFlowersLabelsTheDefaultStrategiesBecomeAll) {
+  ComparisonRequest r = FlowerComparison();
+  for (AlignedRun& run : r.runs) run.trajectory = "loop/" + run.trajectory;
+  r.strategies = {ParseCompareStrategy("STA"), ParseCompareStrategy("STE")};
+  r.strategies_given = false;
+  r.counts = {1};
+  r.validation_reps = {10};
+  const MethodComparison c = CompareMethods(r);
+  ASSERT_TRUE(c.refusal.empty()) << c.refusal;
+  ASSERT_EQ(c.rows.size(), 2u);
+  EXPECT_EQ(c.rows[1].strategy, "all");
+  r.strategies_given = true;  // named by the user: refused, saying which labels are missing
+  EXPECT_EQ(CompareMethods(r).refusal.rfind("strategy STA needs trajectories the data set "
+                                            "data/flower lacks: R1, R5, R9",
+                                            0),
+            0u);
 }
 
 }  // namespace

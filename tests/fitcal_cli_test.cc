@@ -383,6 +383,53 @@ TEST(FitcalCli, AsocDataSetGoesThroughTheGenericCommands) {
   EXPECT_EQ(YAML::LoadFile(diag + "/calibrated.yaml")["model"].as<std::string>(), "asoc");
 }
 
+// compare reads an omni3 data set as every other command does, through the robot's own channels
+// (one loader): wheels named l, m, r with encoder columns w_l, w_m, w_r give the table of the
+// same data with wheels a, b, c, row for row (the old three-wheel loader wanted w_a, w_b, w_c
+// and failed with exit 1 on the renamed set).
+TEST(FitcalCli, CompareReadsAnOmni3DataSetThroughItsRobotsChannels) {
+  TempDir dir;
+  const std::string data = MakeDataset(dir);
+  const std::string args = " --strategies STA --methods ceres --repetitions 1 --no-output --quiet";
+  const Result original = RunFitcal(dir, "compare --logs " + data + args);
+  ASSERT_EQ(original.exit_code, 0) << original.err;
+  const auto rename = [](std::string text, const std::string& from, const std::string& to) {
+    for (std::size_t at = text.find(from); at != std::string::npos; at = text.find(from, at))
+      text.replace(at, from.size(), to);
+    return text;
+  };
+  std::string robot = ReadFileBytes(data + "/robot.yaml");
+  for (const auto& [from, to] : {std::pair{"{name: a,", "{name: l,"}, std::pair{"{name: b,", "{name: m,"},
+                                 std::pair{"{name: c,", "{name: r,"}})
+    robot = rename(robot, from, to);
+  ASSERT_NE(robot.find("{name: l,"), std::string::npos) << robot;
+  dir.Write("flower/robot.yaml", robot);
+  for (const auto& entry : std::filesystem::directory_iterator(data + "/runs")) {
+    const std::string path = entry.path().string();
+    if (path.find("_encoders.csv") == std::string::npos) continue;
+    std::string csv = ReadFileBytes(path);
+    ASSERT_EQ(csv.rfind("t,w_a,w_b,w_c\n", 0), 0u) << path;
+    csv.replace(0, 13, "t,w_l,w_m,w_r");
+    std::ofstream(path, std::ios::binary) << csv;
+  }
+  const Result renamed = RunFitcal(dir, "compare --logs " + data + args);
+  ASSERT_EQ(renamed.exit_code, 0) << renamed.err;
+  // Every row but its wall time: the table's columns up to "Evaluations".
+  const auto rows = [](const std::string& out) {
+    std::istringstream in(out);
+    std::string line, kept;
+    while (std::getline(in, line)) {
+      if (line.rfind("| ", 0) != 0) continue;
+      std::size_t cut = 0;
+      for (int bar = 0; bar < 8 && cut != std::string::npos; ++bar) cut = line.find('|', cut + 1);
+      kept += line.substr(0, cut) + "\n";
+    }
+    return kept;
+  };
+  EXPECT_EQ(rows(renamed.out), rows(original.out)) << renamed.out;
+  EXPECT_NE(rows(original.out).find("| STA | ceres | 1 |"), std::string::npos) << original.out;
+}
+
 TEST(FitcalCli, BadInputGivesOneLineAndWritesNothing) {
   TempDir dir;
   const std::string data = MakeDataset(dir);

@@ -8,6 +8,8 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <random>
 
@@ -28,9 +30,9 @@ wheel_separation_m: 0.200
 bounds: {radius_m: [0.030, 0.050], wheel_separation_m: [0.180, 0.220]}
 )";
 
-const tools::FleetSeries& Find(const std::vector<tools::FleetSeries>& all, const std::string& robot,
+const FleetSeries& Find(const std::vector<FleetSeries>& all, const std::string& robot,
                                const std::string& parameter) {
-  for (const tools::FleetSeries& s : all) {
+  for (const FleetSeries& s : all) {
     if (s.robot == robot && s.parameter == parameter) return s;
   }
   throw std::runtime_error("no series " + robot + " " + parameter);
@@ -56,15 +58,15 @@ TEST(Fleet, FlagsTrendsAndOutliers) {
     }
   }
   tmp.Write("fleet/notes.yaml", "just: notes\n");  // found by the search, not a calibration
-  const std::vector<tools::FleetSeries> all = tools::ReadFleet({tmp.Path("fleet")});
-  const tools::FleetSeries& worn = Find(all, "r1", "r_left");
+  const std::vector<FleetSeries> all = tools::ReadFleet({tmp.Path("fleet")});
+  const FleetSeries& worn = Find(all, "r1", "r_left");
   EXPECT_EQ(worn.values.size(), 8u);
   EXPECT_TRUE(worn.trend);
   // 0.1 mm a week: -0.43 mm per 30 days, to the scatter's standard error (~0.01 mm).
   EXPECT_NEAR(worn.slope_per_30_days, -0.0001 * 30 / 7, 0.00005);
   EXPECT_TRUE(worn.outliers.empty());
   EXPECT_FALSE(Find(all, "r1", "wheel_separation").trend);
-  const tools::FleetSeries& bad_night = Find(all, "r2", "r_right");
+  const FleetSeries& bad_night = Find(all, "r2", "r_right");
   ASSERT_EQ(bad_night.outliers.size(), 1u);
   EXPECT_EQ(bad_night.outliers[0], "2026-04-08");
   EXPECT_FALSE(bad_night.trend);
@@ -81,7 +83,7 @@ TEST(Fleet, FlagsTrendsAndOutliers) {
                "summary": [{"group": "all validation runs", "after": {"cf": 0.01}}]})");
   tmp.Write("fleet/r1/2026-04-29/report/metrics.json",
             R"({"robot": "r1", "parameters": [{"name": "r_left", "calibrated_m": 0.0411}]})");
-  const std::vector<tools::FleetSeries> with_reports = tools::ReadFleet({tmp.Path("fleet")});
+  const std::vector<FleetSeries> with_reports = tools::ReadFleet({tmp.Path("fleet")});
   EXPECT_EQ(Find(with_reports, "r1", "r_left").values.size(), 9u);  // + 2026-04-29 only
   EXPECT_EQ(Find(with_reports, "r1", "r_left").values.back(), 0.0411);
 
@@ -114,10 +116,10 @@ TEST(Fleet, PrintsUnitsAndSigmasAndNotesCfsJudgedOnDifferentRuns) {
         "fleet/" + std::string(data == "/data/week1" ? "2026-05-01" : "2026-05-08") + "/cal.yaml",
         model->RobotYaml(robot.nominal, block));
   }
-  const std::vector<tools::FleetSeries> all = tools::ReadFleet({tmp.Path("fleet")});
+  const std::vector<FleetSeries> all = tools::ReadFleet({tmp.Path("fleet")});
   const std::string table = tools::FleetTable(all);
   const std::string& name = robot.parameters[angle].name;
-  const tools::FleetSeries& steering = Find(all, robot.name, name);
+  const FleetSeries& steering = Find(all, robot.name, name);
   EXPECT_EQ(steering.unit, "deg");
   ASSERT_EQ(steering.sigmas.size(), 2u);
   EXPECT_NEAR(steering.sigmas.back(), 0.0137 * M_PI / 180.0, 1e-15);  // held in rad
@@ -140,6 +142,42 @@ TEST(Fleet, PrintsUnitsAndSigmasAndNotesCfsJudgedOnDifferentRuns) {
   }
   EXPECT_EQ(tools::FleetTable(tools::ReadFleet({same.Path("fleet")})).find("note:"),
             std::string::npos);
+}
+
+// FleetSeriesOf (validation/fleet_statistics.h) without files: a radius shrinking by exactly
+// 0.1 mm a week, dates a week apart, has the slope 30/7 x 0.1 mm per 30 days to rounding and is a
+// trend (no scatter about the line); one value 2 mm off among six that alternate +-1 um is the
+// outlier (the robust sigma is 1.48 um), and the line leaves it out: with it the slope would be
+// 2.4e-4 m per 30 days, without it below 1e-5. One robot name with two models is refused.
+TEST(FleetStatistics, ExactDriftIsATrendAndOneJumpAnOutlier) {
+  std::vector<FleetCalibration> all;
+  const char* dates[] = {"2026-03-02", "2026-03-09", "2026-03-16",
+                         "2026-03-23", "2026-03-30", "2026-04-06"};
+  for (int week = 0; week < 6; ++week) {
+    FleetCalibration c;
+    c.file = std::string("cal") + std::to_string(week) + ".yaml";
+    c.robot = "r1";
+    c.model = "m";
+    c.date = dates[week];
+    c.values.push_back({"r_left", "m", 0.0420 - 0.0001 * week, 1.0});
+    const double alternate = week % 2 == 0 ? 1e-6 : -1e-6;
+    c.values.push_back({"r_right", "m", week == 3 ? 0.0440 : 0.0420 + alternate, 1.0});
+    all.push_back(c);
+  }
+  std::reverse(all.begin(), all.end());  // sorted by date, whatever the order read
+  const std::vector<FleetSeries> series = FleetSeriesOf(all);
+  const FleetSeries& left = Find(series, "r1", "r_left");
+  EXPECT_EQ(left.dates.front(), "2026-03-02");
+  ASSERT_TRUE(left.has_slope);
+  EXPECT_NEAR(left.slope_per_30_days, -0.0001 * 30.0 / 7.0, 1e-12);
+  EXPECT_TRUE(left.trend);
+  EXPECT_TRUE(left.outliers.empty());
+  const FleetSeries& right = Find(series, "r1", "r_right");
+  EXPECT_EQ(right.outliers, (std::vector<std::string>{"2026-03-23"}));
+  EXPECT_FALSE(right.trend);
+  EXPECT_LT(std::abs(right.slope_per_30_days), 1e-5);
+  all[0].model = "other";
+  EXPECT_THROW(FleetSeriesOf(all), io::InputError);
 }
 
 }  // namespace

@@ -84,7 +84,7 @@ int RunCommand(void (*add)(CLI::App&, Options&), int (*run)(const Options&),
 
 TEST(ModelExtras, ExportFindsTheToysControllerWriterThroughTheRegistry) {
   RegisterToyWithExtras();
-  const std::vector<std::string> controllers = tools::Ros2Controllers();
+  const std::vector<std::string> controllers = Ros2Controllers();
   EXPECT_NE(std::find(controllers.begin(), controllers.end(), kController), controllers.end());
 
   TempDir dir;
@@ -107,7 +107,7 @@ TEST(ModelExtras, ExportFindsTheToysControllerWriterThroughTheRegistry) {
                 {"--calibration", diff_drive, "--controller", kController}),
             2);
   try {
-    tools::ExportRos2Control(diff_drive, kController, "", {});
+    ExportRos2Control(diff_drive, kController, "", {});
     ADD_FAILURE() << "a diff_drive was exported as the toy's controller";
   } catch (const std::exception& e) {
     EXPECT_TRUE(testing::Has(e.what(), "(it takes model test_unicycle)")) << e.what();

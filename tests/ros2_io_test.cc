@@ -35,7 +35,7 @@
 #include "odometry/aligned_run.h"
 #include "tests/robot_bag.h"
 #include "tests/test_files.h"
-#include "tools/command_failure.h"
+#include "io/command_failure.h"
 #include "tools/export_ros2_control.h"
 #include "tools/import_rosbag2.h"
 #include "models/diff_drive/diff_drive_trajectories.h"
@@ -50,8 +50,8 @@ using namespace io::rosbag2;
 
 using namespace testing::robot_bag;  // the simulated robot and its bag (tests/robot_bag.h)
 
-tools::ImportRosbag2Options ImportOptions(const testing::TempDir& tmp, const fs::path& bag) {
-  tools::ImportRosbag2Options o;
+ImportRosbag2Options ImportOptions(const testing::TempDir& tmp, const fs::path& bag) {
+  ImportRosbag2Options o;
   o.bag = bag.string();
   o.out = tmp.Path("imported");
   o.robot = tmp.Write("robot.yaml", kDiffDriveExampleYaml);
@@ -95,7 +95,7 @@ TEST_P(ImportEqualsCsv, SameFitAsTheSimulatorsCsv) {
   bag_options.mcap.compression = c.compression;
   bag_options.mcap.chunk_bytes = 64 * 1024;
   const auto spans = WriteRobotBag(tmp.path() / "bag", sim_runs, bag_options);
-  tools::ImportRosbag2Options o = ImportOptions(tmp, tmp.path() / "bag");
+  ImportRosbag2Options o = ImportOptions(tmp, tmp.path() / "bag");
   if (c.split_at_rest) {
     o.split_at_rest_s = 2.0;  // the gaps (3 s + the runs' rests), not the 0.6 s corner stops
   } else {
@@ -108,7 +108,7 @@ TEST_P(ImportEqualsCsv, SameFitAsTheSimulatorsCsv) {
       o.runs += text;
     }
   }
-  const tools::Rosbag2Import in_memory = tools::ImportRosbag2(o);
+  const Rosbag2Import in_memory = tools::ImportRosbag2(o);
   const io::Dataset imported = io::LoadDataset(io::ReadDatasetIndex(o.out),
                                                ReadRobotModelFile(o.out + "/robot.yaml")->robot());
   ASSERT_EQ(imported.runs.size(), sim_runs.size());
@@ -184,7 +184,7 @@ TEST(ImportRosbag2ClockOffset, OneOffsetPerBagRecoversAPoseLatency) {
                        static_cast<std::uint32_t>(ns % 1000000000)};
   };
   WriteRobotBag(tmp.path() / "bag", SimulatedRuns(*model), BagWriterOptions{}, edits);
-  tools::ImportRosbag2Options o = ImportOptions(tmp, tmp.path() / "bag");
+  ImportRosbag2Options o = ImportOptions(tmp, tmp.path() / "bag");
   o.split_at_rest_s = 2.0;
   tools::ImportRosbag2(o);
   const io::Dataset imported = io::LoadDataset(io::ReadDatasetIndex(o.out), model->robot());
@@ -218,7 +218,7 @@ class CaptureStderr {
   std::streambuf* old_;
 };
 
-void ExpectRefused(const tools::ImportRosbag2Options& o, const std::string& what) {
+void ExpectRefused(const ImportRosbag2Options& o, const std::string& what) {
   int rc = 0;
   std::string err;
   {
@@ -253,8 +253,8 @@ class MalformedImport : public ::testing::Test {
     return tmp_.path() / name;
   }
   // The bag imported (as the user would, split at the rests between runs).
-  tools::Rosbag2Import Import(const fs::path& bag, const std::string& out) {
-    tools::ImportRosbag2Options o = ImportOptions(tmp_, bag);
+  Rosbag2Import Import(const fs::path& bag, const std::string& out) {
+    ImportRosbag2Options o = ImportOptions(tmp_, bag);
     o.out = tmp_.Path(out);
     o.split_at_rest_s = 2.0;
     return tools::ImportRosbag2(o);
@@ -280,7 +280,7 @@ TEST_F(MalformedImport, TruncatedAndBadMagic) {
 
 TEST_F(MalformedImport, TopicTypeJointAndStamps) {
   const fs::path bag = Bag("b", StorageFormat::kMcap);
-  tools::ImportRosbag2Options o = ImportOptions(tmp_, bag);
+  ImportRosbag2Options o = ImportOptions(tmp_, bag);
   o.ground_truth = "/vicon/pose";
   ExpectRefused(o, "topic \"/vicon/pose\" is not in the bag");
   o.ground_truth = "/chatter";
@@ -326,7 +326,7 @@ TEST_F(MalformedImport, TopicTypeJointAndStamps) {
 
 // Same runs, same encoder rows to 1e-9 rad/s (an unwrapped angle is the cumulative one up to
 // the rounding of ~1e3 rad sums, ~1e-13 rad, over 0.05 s), same ground truth.
-void ExpectSameImport(const tools::Rosbag2Import& a, const tools::Rosbag2Import& b) {
+void ExpectSameImport(const Rosbag2Import& a, const Rosbag2Import& b) {
   ASSERT_EQ(a.runs.size(), b.runs.size());
   for (std::size_t i = 0; i < a.runs.size(); ++i) {
     ASSERT_EQ(a.encoder_t_s[i], b.encoder_t_s[i]) << "run " << i;
@@ -354,12 +354,12 @@ TEST_F(MalformedImport, ZeroOrNonUnitQuaternionRefusedWithTopicAndTime) {
 }
 
 TEST_F(MalformedImport, WrappedJointPositionsUnwrapped) {
-  const tools::Rosbag2Import clean = Import(Bag("clean", StorageFormat::kMcap), "clean_out");
+  const Rosbag2Import clean = Import(Bag("clean", StorageFormat::kMcap), "clean_out");
   BagEdits edits;
   edits.joint = [](std::size_t, JointState* js) {
     for (double& angle : js->position) angle = WrapAngle(angle);
   };
-  const tools::Rosbag2Import wrapped = Import(Bag("wrapped", StorageFormat::kMcap, edits), "w");
+  const Rosbag2Import wrapped = Import(Bag("wrapped", StorageFormat::kMcap, edits), "w");
   ExpectSameImport(clean, wrapped);
   ASSERT_EQ(wrapped.notes.size(), 2u);  // both wheels (the caster is not the robot's)
   EXPECT_NE(wrapped.notes[0].find("unwrapped"), std::string::npos) << wrapped.notes[0];
@@ -382,27 +382,27 @@ TEST_F(MalformedImport, WrappedJointPositionsUnwrapped) {
 }
 
 TEST_F(MalformedImport, OtherNodesJointStatesSkipped) {
-  const tools::Rosbag2Import clean = Import(Bag("clean", StorageFormat::kSqlite3), "clean_out");
+  const Rosbag2Import clean = Import(Bag("clean", StorageFormat::kSqlite3), "clean_out");
   BagEdits edits;
   edits.other_node = true;
-  const tools::Rosbag2Import mixed = Import(Bag("mixed", StorageFormat::kSqlite3, edits), "m");
+  const Rosbag2Import mixed = Import(Bag("mixed", StorageFormat::kSqlite3, edits), "m");
   ExpectSameImport(clean, mixed);
 }
 
 TEST_F(MalformedImport, RecordingClockSteppingBack) {
   for (StorageFormat storage : {StorageFormat::kMcap, StorageFormat::kSqlite3}) {
     const bool mcap = storage == StorageFormat::kMcap;
-    const tools::Rosbag2Import clean =
+    const Rosbag2Import clean =
         Import(Bag(mcap ? "clean_m" : "clean_s", storage), mcap ? "cm" : "cs");
     BagEdits edits;
     edits.clock_step_back_ns = 1500000000;  // 1.5 s, halfway through the recording
     const fs::path bag = Bag(mcap ? "step_m" : "step_s", storage, edits);
-    tools::ImportRosbag2Options o = ImportOptions(tmp_, bag);
+    ImportRosbag2Options o = ImportOptions(tmp_, bag);
     o.stamp = "recorded";
     // 1.5 s less the recorder's latency jitter (0.4 ms) between the messages either side.
     ExpectRefused(o, "the recording clock steps back by 1.4");
     // The header stamps still order every stream: imported as the clean bag, with a note.
-    const tools::Rosbag2Import stepped = Import(bag, mcap ? "sm" : "ss");
+    const Rosbag2Import stepped = Import(bag, mcap ? "sm" : "ss");
     ExpectSameImport(clean, stepped);
     ASSERT_EQ(stepped.notes.size(), 1u);
     EXPECT_NE(stepped.notes[0].find("order of their header stamps"), std::string::npos);
@@ -471,7 +471,7 @@ TEST(Rosbag2ReadOnly, BagDirectoryUnchanged) {
 
 struct Exported {
   YAML::Node params;
-  tools::Ros2ControlExport e;
+  Ros2ControlExport e;
   // What the controller computes (e.model at e.parameters), by parameter name.
   double Back(const std::string& name) const {
     return e.parameters[RequireParameterIndex(e.model->robot(), name)];
@@ -480,7 +480,7 @@ struct Exported {
 
 Exported ExportAndRead(const std::string& cal, const std::string& controller) {
   Exported x;
-  x.e = tools::ExportRos2Control(cal, controller, "", {});
+  x.e = ExportRos2Control(cal, controller, "", {});
   const YAML::Node root = YAML::Load(x.e.parameters_yaml);
   EXPECT_TRUE(root[controller]) << x.e.parameters_yaml;
   x.params = root[controller]["ros__parameters"];
@@ -540,8 +540,8 @@ TEST(ExportRos2Control, DiffDriveIsExact) {
   for (int k = 0; k < 3; ++k) {
     EXPECT_NEAR(x.Back(names[k]), kTruth[k], kRoundTrip * kTruth[k]) << names[k];
   }
-  EXPECT_THROW(tools::ExportRos2Control(cal, "tricycle_controller", "", {}), tools::UsageError);
-  EXPECT_THROW(tools::ExportRos2Control(cal, "ackermann_controller", "", {}), tools::UsageError);
+  EXPECT_THROW(ExportRos2Control(cal, "tricycle_controller", "", {}), UsageError);
+  EXPECT_THROW(ExportRos2Control(cal, "ackermann_controller", "", {}), UsageError);
 }
 
 TEST(ExportRos2Control, MecanumTakesMeans) {
@@ -688,7 +688,7 @@ TEST(ExportRos2Control, EveryKeyDeclaredOnItsDistribution) {
                                              {"omni_wheel_drive_controller", kOmni3ExampleYaml},
                                              {"tricycle_controller", kTricycleExampleYaml}};
   int checked = 0;
-  for (const std::string& distro : tools::RosDistros()) {
+  for (const std::string& distro : RosDistros()) {
     for (const ControllerCase& c : cases) {
       SCOPED_TRACE(distro + " " + c.controller);
       const RobotModelPtr model = ReadRobotModel(YAML::Load(c.robot_yaml), "robot.yaml");
@@ -697,16 +697,16 @@ TEST(ExportRos2Control, EveryKeyDeclaredOnItsDistribution) {
       const std::string cal = tmp.Write("cal.yaml", model->RobotYaml(p, ""));
       const KeyTypes declared = DeclaredKeys(distro, c.controller);
       if (declared.empty()) {  // the distribution does not ship it: refused in one line
-        EXPECT_THROW(tools::ExportRos2Control(cal, c.controller, "", {}, distro),
-                     tools::UsageError);
+        EXPECT_THROW(ExportRos2Control(cal, c.controller, "", {}, distro),
+                     UsageError);
         continue;
       }
-      const tools::Ros2ControlExport e = tools::ExportRos2Control(cal, c.controller, "", {}, distro);
+      const Ros2ControlExport e = ExportRos2Control(cal, c.controller, "", {}, distro);
       OdometryCovariance covariance;  // as written with --logs
       covariance.twist_variance = {1e-4, 2e-5, 3e-4};
       covariance.pose_variance_1m = {1e-5, 2e-6, 3e-5};
       const std::string yaml =
-          e.parameters_yaml + tools::Ros2CovarianceParameters(c.controller, covariance);
+          e.parameters_yaml + Ros2CovarianceParameters(c.controller, covariance);
       std::vector<std::pair<std::string, YAML::Node>> written;
       Flatten(YAML::Load(yaml)[c.controller]["ros__parameters"], "", &written);
       EXPECT_GE(written.size(), 4u);
@@ -727,8 +727,8 @@ TEST(ExportRos2Control, EveryKeyDeclaredOnItsDistribution) {
   EXPECT_EQ(DeclaredKeys("jazzy", "diff_drive_controller").count("wheels_per_side"), 0u);
   EXPECT_EQ(DeclaredKeys("rolling", "diff_drive_controller").count("wheels_per_side"), 0u);
   EXPECT_THROW(
-      tools::ExportRos2Control(tmp.Path("cal.yaml"), "tricycle_controller", "", {}, "iron"),
-      tools::UsageError);
+      ExportRos2Control(tmp.Path("cal.yaml"), "tricycle_controller", "", {}, "iron"),
+      UsageError);
 }
 
 TEST(ExportRos2Control, TricycleOffsetStatedWithSignAndPlace) {
@@ -736,7 +736,7 @@ TEST(ExportRos2Control, TricycleOffsetStatedWithSignAndPlace) {
   const RobotModelPtr model = ReadRobotModel(YAML::Load(kTricycleExampleYaml), "robot.yaml");
   const double offset_rad = -2.25 * M_PI / 180;
   const std::string cal = tmp.Write("cal.yaml", model->RobotYaml({0.0331, 0.152, offset_rad}, ""));
-  const tools::Ros2ControlExport e = tools::ExportRos2Control(cal, "tricycle_controller", "", {});
+  const Ros2ControlExport e = ExportRos2Control(cal, "tricycle_controller", "", {});
   ASSERT_EQ(e.notes.size(), 1u);
   const std::string& note = e.notes[0];
   char value[64];
@@ -819,7 +819,7 @@ TEST(ExportRos2Control, HeldOutRunsAreTheOnesReportTakes) {
   EXPECT_TRUE(io::ReadCalibrationProvenance(with_cov));
   std::string which;
   const RobotModelPtr model = ReadRobotModelFile(cal);
-  const std::vector<AlignedRun> runs = tools::ExportHeldOutRuns(cal, data, model->robot(), &which);
+  const std::vector<AlignedRun> runs = ExportHeldOutRuns(cal, data, model->robot(), &which);
   ASSERT_EQ(static_cast<int>(runs.size()), held_out);
   for (const AlignedRun& r : runs) EXPECT_EQ(r.trajectory.rfind("square", 0), std::string::npos);
 }

@@ -6,7 +6,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
-#include <random>
 #include <stdexcept>
 
 #include "fitcal/version.h"
@@ -17,33 +16,15 @@
 #include "io/yaml_text.h"
 #include "models/asoc/asoc_files.h"
 #include "models/asoc/asoc_geometric.h"
-#include "odometry/parallel_for.h"
 #include "tools/dataset_command.h"
 #include "tools/output_guard.h"
-#include "tools/sim/asoc_simulator.h"
+#include "tools/sim/asoc_scenarios.h"
 
 namespace fitcal::tools {
 
 namespace fs = std::filesystem;
 
 namespace {
-
-std::uint64_t SplitMix(std::uint64_t x) {
-  x += 0x9e3779b97f4a7c15ULL;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
-  return x ^ (x >> 31);
-}
-
-// The simulated pivot encoders' step is stated, as a user states their encoders'.
-io::AsocRobot RobotFromVehicle(const std::string& name, const asoc::Vehicle& v) {
-  io::AsocRobot robot;
-  robot.name = name;
-  robot.pivot_resolution_rad = sim::AsocSimulationOptions{}.pivot_quantum_rad;
-  robot.pivot_distance_m = v.PivotDistance(0, 1);
-  robot.nominal = v;
-  return robot;
-}
 
 void PrintCastors(const io::AsocRobot& robot,
                   const std::array<asoc::CastorParameters, asoc::kNumCastors>& castors,
@@ -102,28 +83,6 @@ void WriteAsocCalibration(const std::string& out, const io::AsocRobot& robot,
   std::printf("wrote %s\n", out.c_str());
 }
 
-// UMBmark circuits, 5 CW and 5 CCW, as repetitions 6-10 so that the default --train-reps 1-5
-// validates on them. Each repetition drives at its own speed (0.30, 0.306, ... m/s): noise-free
-// identical circuits would be one recording copied, which the loader refuses (io/dataset.cc).
-std::vector<asoc::RunLog> UmbmarkCircuits(const asoc::Vehicle& truth,
-                                          const sim::AsocSimulationOptions& options,
-                                          std::mt19937_64& rng) {
-  std::vector<asoc::RunLog> runs;
-  for (int direction : {-1, +1}) {
-    for (int rep = 6; rep <= 10; ++rep) {
-      const double speed_m_s = 0.3 * (1.0 + 0.02 * (rep - 6));
-      const std::vector<sim::Segment> square = sim::UmbmarkSquare(direction, 1.5, speed_m_s);
-      asoc::RunLog run = sim::SimulateAsocRun(
-          truth, square, Pose2d{}, sim::SteadyCastorAngles(truth, square.front()), options, rng);
-      run.trajectory = direction < 0 ? "umbmark_cw" : "umbmark_ccw";
-      run.repetition = rep;
-      run.id = run.trajectory + "-rep" + std::to_string(rep);
-      runs.push_back(std::move(run));
-    }
-  }
-  return runs;
-}
-
 }  // namespace
 
 int RunAsocSimulate(const AsocSimulateOptions& options) {
@@ -138,21 +97,9 @@ int RunAsocSimulate(const AsocSimulateOptions& options) {
     io::StagedDirectory staged(options.out);
     const fs::path out(staged.path());
     fs::create_directories(out / "runs");
-    std::mt19937_64 rng(SplitMix(options.seed));
-    const asoc::Vehicle nominal = sim::AsocPrototypeVehicle();
-    const asoc::Vehicle truth = sim::DrawVehicle(nominal, sim::ParameterSpread{}, rng);
-    sim::AsocSimulationOptions sim_options;
-    sim_options.wheel_slip_sigma = options.wheel_slip_sigma;
-    std::vector<asoc::RunLog> runs = sim::SimulateCalibrationManoeuvre(truth, sim_options, rng);
-    for (asoc::RunLog& run : UmbmarkCircuits(truth, sim_options, rng))
-      runs.push_back(std::move(run));
-    for (int k = 1; k <= options.excursions; ++k) {
-      asoc::RunLog run = sim::SimulateRandomExcursion(truth, sim_options, rng);
-      run.trajectory = "excursion";
-      run.repetition = k;
-      run.id = "excursion-rep" + std::to_string(k);
-      runs.push_back(std::move(run));
-    }
+    const sim::AsocSimulatedDataset simulated =
+        sim::SimulateAsocDataset(options.seed, options.wheel_slip_sigma, options.excursions);
+    const std::vector<asoc::RunLog>& runs = simulated.runs;
     std::vector<io::DatasetEntry> entries;
     for (const asoc::RunLog& run : runs) {
       const std::string enc = "runs/" + run.id + "_encoders.csv";
@@ -161,10 +108,8 @@ int RunAsocSimulate(const AsocSimulateOptions& options) {
       io::WriteFileAtomically((out / gt).string(), io::GroundTruthCsv(run.ground_truth));
       entries.push_back({run.id, run.trajectory, run.repetition, enc, gt});
     }
-    io::WriteFileAtomically((out / "robot.yaml").string(),
-                            io::AsocRobotYaml(RobotFromVehicle("asoc-prototype", nominal)));
-    io::WriteFileAtomically((out / "truth.yaml").string(),
-                            io::AsocRobotYaml(RobotFromVehicle("asoc-truth", truth)));
+    io::WriteFileAtomically((out / "robot.yaml").string(), io::AsocRobotYaml(simulated.nominal));
+    io::WriteFileAtomically((out / "truth.yaml").string(), io::AsocRobotYaml(simulated.truth));
     io::WriteFileAtomically((out / "dataset.yaml").string(),
                             io::DatasetYaml("robot.yaml", entries));
     CommitDirectoryOutput(staged, options.out, kDatasetKind, options.force, {});
@@ -245,59 +190,8 @@ int RunAsocTables(const AsocTablesOptions& options) {
     std::cerr << "fitcal: --sets must be at least 1\n";
     return 2;
   }
-  const asoc::Vehicle nominal = sim::AsocPrototypeVehicle();
-  sim::AsocSimulationOptions sim_options;
-  sim_options.wheel_slip_sigma = options.wheel_slip_sigma;
-  const std::size_t n = static_cast<std::size_t>(options.sets);
-  // Per set: Table I errors [uncal, cal] x [r_c, r_w, d, beta]; Table II E_max [uncal, cal] x alg.
-  struct SetResult {
-    double param[2][4] = {{0, 0, 0, 0}, {0, 0, 0, 0}};
-    double emax[2][3] = {{0, 0, 0}, {0, 0, 0}};
-  };
-  std::vector<SetResult> results(n);
-  const int excluded[3] = {1, 1, 0};
-  ParallelFor(n, options.threads, [&](std::size_t s) {
-    std::mt19937_64 rng(SplitMix(options.seed ^ SplitMix(s)));
-    SetResult& r = results[s];
-    // Table I: 1000 random parameter sets through the calibration.
-    const asoc::Vehicle truth = sim::DrawVehicle(nominal, sim::ParameterSpread{}, rng);
-    asoc::GeometricResult cal = asoc::CalibrateGeometric(
-        sim::SimulateCalibrationManoeuvre(truth, sim_options, rng), nominal);
-    for (int which = 0; which < 2; ++which) {
-      const asoc::Vehicle& est = which == 0 ? nominal : cal.estimate;
-      for (int i = 0; i < asoc::kNumCastors; ++i) {
-        const asoc::CastorParameters& t = truth.castors[i];
-        const asoc::CastorParameters& e = est.castors[i];
-        r.param[which][0] += std::abs(e.offset_m / t.offset_m - 1.0) / 3.0;
-        for (int k = 0; k < 2; ++k) {
-          r.param[which][1] += std::abs(e.wheel_radius_m[k] / t.wheel_radius_m[k] - 1.0) / 6.0;
-          r.param[which][2] += std::abs(e.wheel_offset_m[k] / t.wheel_offset_m[k] - 1.0) / 6.0;
-        }
-        r.param[which][3] += std::abs(WrapAngle(e.encoder_bias_rad - t.encoder_bias_rad)) / 3.0;
-      }
-    }
-    // Table II: beta = 0 in the truth (Doebbler Sec. IV-B), UMBmark 5 x CW and CCW.
-    sim::ParameterSpread spread;
-    spread.bias_range_rad = 0.0;
-    const asoc::Vehicle truth2 = sim::DrawVehicle(nominal, spread, rng);
-    cal = asoc::CalibrateGeometric(sim::SimulateCalibrationManoeuvre(truth2, sim_options, rng),
-                                   nominal);
-    const auto runs = sim::SimulateUmbmark(truth2, sim_options, rng, 5);
-    for (int a = 0; a < 3; ++a) {
-      asoc::OdometryOptions o;
-      o.castors = asoc::MaskExcluding(excluded[a]);
-      if (a == 0) o.method = asoc::Method::kIpec;
-      r.emax[0][a] = sim::EvaluateUmbmark(runs, nominal, o).e_max_m;
-      r.emax[1][a] = sim::EvaluateUmbmark(runs, cal.estimate, o).e_max_m;
-    }
-  });
-  SetResult mean;
-  for (const SetResult& r : results) {
-    for (int w = 0; w < 2; ++w) {
-      for (int k = 0; k < 4; ++k) mean.param[w][k] += r.param[w][k] / n;
-      for (int a = 0; a < 3; ++a) mean.emax[w][a] += r.emax[w][a] / n;
-    }
-  }
+  const sim::DoebblerTables mean = sim::SimulateDoebblerTables(
+      options.sets, options.seed, options.wheel_slip_sigma, options.threads);
   std::printf(
       "Doebbler et al. Tables I and II, %d random parameter sets (seed %llu, wheel slip "
       "sigma %g per 20 Hz sample)\n\n",

@@ -4,46 +4,27 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <functional>
 #include <iostream>
-#include <set>
 #include <sstream>
 #include <stdexcept>
-#include <utility>
 
-#include "fit/final_pose_errors.h"
 #include "fit/run_split.h"
-#include "fit/strategies.h"
 #include "io/atomic_file.h"
 #include "io/dataset.h"
 #include "io/input_error.h"
-#include "io/robot_yaml.h"
 #include "models/model_registry.h"
 #include "tools/cli_validators.h"
 #include "calibrate/fit_methods.h"
+#include "calibrate/method_comparison.h"
 #include "tools/output_guard.h"
 
 namespace fitcal::tools {
 
 namespace {
 
-struct Row {
-  std::string strategy;
-  std::string method;
-  int repetitions = 0;             // 0 = the uncalibrated reference row
-  std::vector<double> parameters;  // empty for the uncalibrated reference row
-  double cf_calibration = NAN;
-  double cf_validation = NAN;
-  double improvement_percent = NAN;
-  int evaluations = 0;
-  double wall_s = 0.0;
-  std::string termination;
-  bool usable = true;
-  std::vector<ConvergencePoint> trace;
-};
+using Row = ComparisonRow;
 
 std::string Fixed(double v, int digits) {
   if (std::isnan(v)) return "-";
@@ -152,115 +133,9 @@ std::string TraceCsv(const std::vector<Row>& rows) {
   return o.str();
 }
 
-// The robot and runs of a data set, for any model; a model that registers the legacy loader
-// (ModelExtras::legacy_loader: omni3) keeps its own; every model fits and is scored through the
-// seam (calibrate/fit_methods.h, fit/final_pose_errors.h).
-struct CompareData {
-  RobotModelPtr model;
-  bool legacy = false;  // ModelExtras::legacy_loader: Palacin's strategies STA..STE by default
-  std::vector<AlignedRun> runs;
-
-  double Cf(const std::vector<double>& p, const std::vector<AlignedRun>& on, int threads) const {
-    return EvaluateFinalPoseErrors(*model, p, on, threads).cf;
-  }
-};
-
-CompareData LoadCompareData(const CompareCommandOptions& options) {
-  const io::DatasetIndex index = OpenDataset(options).index;
-  const std::string model_name = io::ReadRobotModel(index.robot_path);
-  CompareData d;
-  if (ExtrasOf(model_name).legacy_loader) {
-    const io::Dataset dataset = LoadRuns(options, index, /*robot=*/nullptr);
-    d.legacy = true;
-    d.model = ReadRobotModelFile(dataset.robot_path);
-    d.runs = AlignRuns(dataset.runs);
-  } else {
-    d.model = ReadRobotModelFile(index.robot_path);
-    d.runs = AlignRuns(LoadRuns(options, index, &d.model->robot()).runs);
-  }
-  return d;
-}
-
-struct FitOutcome {
-  std::vector<double> parameters;
-  int evaluations = 0;
-  std::string termination;
-  bool usable = false;
-  std::vector<ConvergencePoint> trace;
-};
-
-FitOutcome RunMethod(const FitMethod& method, const std::vector<AlignedRun>& training,
-                     const CompareData& d, const FitMethodSettings& s) {
-  const ModelFitMethodOutcome o = method.run_model(training, *d.model, s);
-  return {o.fit.parameters, o.evaluations, o.fit.termination, o.fit.usable, o.trace};
-}
-
-// "all" (every trajectory of the data set) and "<prefix>*" (the labels starting with prefix, e.g.
-// "circular/*") are resolved against the runs; anything else is fit/strategies.h's.
-TrajectoryStrategy ParseCompareStrategy(const std::string& text) {
-  if (text == "all" || (!text.empty() && text.back() == '*')) return {text, {}};
-  return ParseStrategy(text);
-}
-
-void ResolveStrategy(const std::vector<AlignedRun>& runs, TrajectoryStrategy* s) {
-  if (!s->labels.empty()) return;
-  const std::string prefix = s->name == "all" ? "" : s->name.substr(0, s->name.size() - 1);
-  for (const AlignedRun& run : runs) {
-    if (run.trajectory.compare(0, prefix.size(), prefix) == 0 &&
-        std::find(s->labels.begin(), s->labels.end(), run.trajectory) == s->labels.end()) {
-      s->labels.push_back(run.trajectory);
-    }
-  }
-  if (s->labels.empty()) {
-    throw std::invalid_argument("strategy " + s->name + " matches no trajectory of the data set");
-  }
-}
-
-// Palacin's STA..STE need the flower's labels. For a model without the legacy loader (omni3 has
-// it) and no --strategies, keep those the data set has (the omni model's generalised flower has
-// them all) or, when it has none, train on every trajectory ("all": the split is by repetitions
-// only).
-std::vector<TrajectoryStrategy> DefaultStrategiesFor(const std::vector<AlignedRun>& runs,
-                                                     std::vector<TrajectoryStrategy> strategies) {
-  std::vector<TrajectoryStrategy> present;
-  for (const TrajectoryStrategy& s : strategies) {
-    if (s.labels.empty() || MissingTrajectories(runs, s).empty()) present.push_back(s);
-  }
-  if (present.empty()) present.push_back({"all", {}});
-  return present;
-}
-
-// One row per closed-form calibration of the model (e.g. UMBmark) on these training runs.
-void AddClosedFormRows(const CompareData& d, const std::string& strategy, int k,
-                       const std::vector<AlignedRun>& training,
-                       const std::vector<AlignedRun>& validation, double cf_nominal, int threads,
-                       std::vector<Row>* rows) {
-  for (const ClosedFormCalibration& c : d.model->ClosedForms(training)) {
-    Row row;
-    row.strategy = strategy;
-    row.method = c.method;
-    row.repetitions = k;
-    row.parameters = c.parameters;
-    row.cf_calibration = d.Cf(c.parameters, training, threads);
-    if (!validation.empty()) {
-      row.cf_validation = d.Cf(c.parameters, validation, threads);
-      row.improvement_percent = 100.0 * (cf_nominal - row.cf_validation) / cf_nominal;
-    }
-    row.termination = "closed form";
-    rows->push_back(std::move(row));
-  }
-}
-
-// What the user typed, checked before any data is read or any fit runs.
-struct CompareRequest {
-  std::vector<const FitMethod*> methods;
-  std::vector<TrajectoryStrategy> strategies;
-  std::vector<int> counts;  // training repetitions k, sorted, unique
-  FitMethodSettings settings;
-};
-
-// Empty when valid, else the one-line reason (exit code 2).
-std::string ParseRequest(const CompareCommandOptions& options, CompareRequest* r) {
+// What the user typed, checked before any data is read or any fit runs: empty when valid, else
+// the one-line reason (exit code 2).
+std::string ParseRequest(const CompareCommandOptions& options, ComparisonRequest* r) {
   for (const std::string& name : options.methods) {
     if (name == "all") {
       for (const FitMethod& m : FitMethods()) r->methods.push_back(&m);
@@ -275,7 +150,6 @@ std::string ParseRequest(const CompareCommandOptions& options, CompareRequest* r
   r->counts = options.repetitions;
   std::sort(r->counts.begin(), r->counts.end());
   r->counts.erase(std::unique(r->counts.begin(), r->counts.end()), r->counts.end());
-  FitMethodSettings& settings = r->settings;
   try {
     for (const std::string& text : options.strategies)
       r->strategies.push_back(ParseCompareStrategy(text));
@@ -285,137 +159,55 @@ std::string ParseRequest(const CompareCommandOptions& options, CompareRequest* r
   } catch (const std::invalid_argument& e) {
     return e.what();
   }
+  r->data_name = options.logs;
+  r->strategies_given = options.strategies_given;
+  if (!options.validation_reps.empty()) {
+    r->validation_reps = ParseRepetitionList(options.validation_reps);
+  }
+  r->threads = options.threads;
   std::string error;
-  if (!MakeFitMethodSettings(options, options.threads, &settings, &error)) return error;
+  if (!MakeFitMethodSettings(options, options.threads, &r->settings, &error)) return error;
   return "";
 }
 
-// The repetitions present, the validation repetitions, and the check that no validation
-// repetition trains; empty when fine, else the one-line reason (exit code 2).
-std::string SplitRepetitions(const CompareCommandOptions& options, const CompareRequest& r,
-                             const std::vector<AlignedRun>& runs, std::vector<int>* present,
-                             std::vector<int>* validation_reps) {
-  std::set<int> present_set;
-  for (const AlignedRun& run : runs) present_set.insert(run.repetition);
-  present->assign(present_set.begin(), present_set.end());
-  if (static_cast<std::size_t>(r.counts.back()) > present->size()) {
-    return options.logs + " has " + std::to_string(present->size()) +
-           " repetitions; cannot train on " + std::to_string(r.counts.back());
-  }
-  for (const TrajectoryStrategy& s : r.strategies) {
-    const std::vector<std::string> missing = MissingTrajectories(runs, s);
-    if (missing.empty()) continue;
-    std::string list;
-    for (const std::string& label : missing) list += (list.empty() ? "" : ", ") + label;
-    return "strategy " + s.name + " needs trajectories the data set " + options.logs +
-           " lacks: " + list + " (choose --strategies from its trajectory labels)";
-  }
-  if (options.validation_reps.empty()) {
-    validation_reps->assign(present->begin() + r.counts.back(), present->end());
-  } else {
-    *validation_reps = ParseRepetitionList(options.validation_reps);
-  }
-  for (int rep : *validation_reps) {
-    for (int k : r.counts) {
-      if (std::find(present->begin(), present->begin() + k, rep) != present->begin() + k) {
-        return "validation repetition " + std::to_string(rep) + " is also a training repetition";
-      }
-    }
-  }
-  return "";
-}
-
-// `name`: the method's, or "<method> (tied)" for its fit of the reduced model (s.tying).
-Row FitRow(const FitMethod& method, const std::string& name, const std::string& strategy, int k,
-           const std::vector<AlignedRun>& training, const std::vector<AlignedRun>& validation,
-           double cf_nominal, const CompareData& d, FitMethodSettings s, bool show_progress,
-           int threads) {
-  const std::string label = strategy + " " + name + " x" + std::to_string(k);
-  if (show_progress) {
-    s.progress = [&label](const NloptProgress& p) {
-      std::fprintf(stderr, "\r[%s] %d evaluations, best CF %.5f, %.1f s   ", label.c_str(),
-                   p.evaluations, p.best_cf, p.elapsed_s);
-      std::fflush(stderr);
-    };
-  }
-  const auto t0 = std::chrono::steady_clock::now();
-  const FitOutcome outcome = RunMethod(method, training, d, s);
-  Row row;
-  row.strategy = strategy;
-  row.method = name;
-  row.repetitions = k;
-  row.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  row.parameters = outcome.parameters;
-  row.cf_calibration = d.Cf(outcome.parameters, training, threads);
-  if (!validation.empty()) {
-    row.cf_validation = d.Cf(outcome.parameters, validation, threads);
-    row.improvement_percent = 100.0 * (cf_nominal - row.cf_validation) / cf_nominal;
-  }
-  row.evaluations = outcome.evaluations;
-  row.termination = outcome.termination;
-  row.usable = outcome.usable;
-  row.trace = outcome.trace;
-  if (show_progress) {
+// Each fit's best CF as it improves, then its result, on one line of stderr.
+ComparisonProgress ProgressOnStderr() {
+  ComparisonProgress p;
+  p.during = [](const std::string& label, const NloptProgress& n) {
+    std::fprintf(stderr, "\r[%s] %d evaluations, best CF %.5f, %.1f s   ", label.c_str(),
+                 n.evaluations, n.best_cf, n.elapsed_s);
+    std::fflush(stderr);
+  };
+  p.done = [](const std::string& label, const Row& row) {
     std::fprintf(stderr, "\r[%s] CF %.5f -> validation %.5f, %d evaluations, %.2f s%20s\n",
                  label.c_str(), row.cf_calibration, row.cf_validation, row.evaluations, row.wall_s,
                  "");
-  }
-  return row;
+  };
+  return p;
 }
 
-void PrintAndWrite(const CompareCommandOptions& options, const CompareRequest& r,
-                   const std::vector<int>& validation_reps, std::size_t num_validation,
-                   const std::vector<Row>& rows, const ParameterColumns& columns,
-                   const ParameterTying& tying) {
-  const std::string markdown = Markdown(rows, columns);
+void PrintAndWrite(const CompareCommandOptions& options, const ComparisonRequest& r,
+                   const MethodComparison& c, const ParameterColumns& columns) {
+  const std::string markdown = Markdown(c.rows, columns);
   std::string counts;
   for (int k : r.counts) counts += (counts.empty() ? "" : " or ") + std::to_string(k);
   std::printf(
       "Palacin Table 4 on %s: training on the first %s repetition(s) of each strategy's "
       "trajectories, validation on every trajectory of repetitions %s (%zu runs); CF "
       "is Eq. 14 (m and rad)\n\n",
-      options.logs.c_str(), counts.c_str(), FormatRepetitionList(validation_reps).c_str(),
-      num_validation);
-  if (!tying.empty()) {  // what the "(tied)" rows fit
-    PrintTying(tying);
+      options.logs.c_str(), counts.c_str(), FormatRepetitionList(c.validation_reps).c_str(),
+      c.num_validation);
+  if (!r.tying.empty()) {  // what the "(tied)" rows fit
+    PrintTying(r.tying);
     std::printf("\n");
   }
   std::printf("%s", markdown.c_str());
   if (!options.no_output) {
-    io::WriteFilesAtomically({{options.out + ".csv", Csv(rows, columns)},
+    io::WriteFilesAtomically({{options.out + ".csv", Csv(c.rows, columns)},
                               {options.out + ".md", markdown},
-                              {options.out + "_trace.csv", TraceCsv(rows)}});
+                              {options.out + "_trace.csv", TraceCsv(c.rows)}});
     std::printf("\nwrote %s.csv, %s.md, %s_trace.csv\n", options.out.c_str(), options.out.c_str(),
                 options.out.c_str());
-  }
-}
-
-// For every strategy and training count k: the closed forms' rows, then each method's fit and,
-// with a tying, its fit of the reduced model right after it ("<method> (tied)").
-void AddStrategyRows(const CompareRequest& request, const CompareData& d,
-                     const std::vector<int>& present, const std::vector<AlignedRun>& validation,
-                     const ParameterTying& tying, bool show_progress, int threads,
-                     std::vector<Row>* rows) {
-  const double cf_nominal = rows->front().cf_validation;  // the uncalibrated reference row
-  FitMethodSettings tied = request.settings;
-  tied.tying = tying;
-  for (const TrajectoryStrategy& strategy : request.strategies) {
-    for (int k : request.counts) {
-      const std::vector<int> reps(present.begin(), present.begin() + k);
-      const std::vector<AlignedRun> training = SelectRuns(d.runs, strategy, reps);
-      AddClosedFormRows(d, strategy.name, k, training, validation, cf_nominal, threads, rows);
-    }
-    for (const FitMethod* method : request.methods) {
-      for (int k : request.counts) {
-        const std::vector<int> reps(present.begin(), present.begin() + k);
-        const std::vector<AlignedRun> training = SelectRuns(d.runs, strategy, reps);
-        rows->push_back(FitRow(*method, method->name, strategy.name, k, training, validation,
-                               cf_nominal, d, request.settings, show_progress, threads));
-        if (tying.empty()) continue;
-        rows->push_back(FitRow(*method, method->name + " (tied)", strategy.name, k, training,
-                               validation, cf_nominal, d, tied, show_progress, threads));
-      }
-    }
   }
 }
 
@@ -423,7 +215,7 @@ void AddStrategyRows(const CompareRequest& request, const CompareData& d,
 
 void AddCompareOptions(CLI::App& app, CompareCommandOptions& o) {
   AddDatasetOptions(app, o);
-  // A model without the legacy loader takes the STA..STE it has unless --strategies names some.
+  // A data set takes the STA..STE it has unless --strategies names some.
   app.callback([&app, &o] { o.strategies_given = app.count("--strategies") > 0; });
   app.add_option("--strategies", o.strategies,
                  "STA..STE, trajectory lists such as R1,R5,G4 or B1-B12, all, or a label "
@@ -446,12 +238,12 @@ void AddCompareOptions(CLI::App& app, CompareCommandOptions& o) {
 }
 
 int RunCompareCommand(const CompareCommandOptions& options) {
-  CompareRequest request;
+  ComparisonRequest request;
   if (const std::string error = ParseRequest(options, &request); !error.empty()) {
     std::cerr << "fitcal compare: " << error << "\n";
     return 2;
   }
-  const bool show_progress = !options.quiet && isatty(STDERR_FILENO);
+  if (!options.quiet && isatty(STDERR_FILENO)) request.progress = ProgressOnStderr();
   return RunReportingErrors("fitcal compare", [&]() -> int {
     if (!options.no_output) {  // before the work: the one overwrite rule, tools/output_guard.h
       const std::vector<std::string> inputs = OpenDataset(options).inputs;
@@ -463,38 +255,20 @@ int RunCompareCommand(const CompareCommandOptions& options) {
         if (!refusal.empty()) return Refuse(refusal);
       }
     }
-    const CompareData d = LoadCompareData(options);
-    ParameterTying tying;
-    if (const std::string refusal = ReadTying(options, d.model->robot(), &tying);
+    const io::DatasetIndex index = OpenDataset(options).index;
+    request.model = ReadRobotModelFile(index.robot_path);
+    request.runs = AlignRuns(LoadRuns(options, index, request.model->robot()).runs);
+    if (const std::string refusal = ReadTying(options, request.model->robot(), &request.tying);
         !refusal.empty()) {
       std::cerr << "fitcal compare: " << refusal << "\n";
       return 2;
     }
-    if (!d.legacy && !options.strategies_given) {
-      request.strategies = DefaultStrategiesFor(d.runs, request.strategies);
-    }
-    for (TrajectoryStrategy& s : request.strategies) ResolveStrategy(d.runs, &s);
-    std::vector<int> present, validation_reps;
-    if (const std::string error =
-            SplitRepetitions(options, request, d.runs, &present, &validation_reps);
-        !error.empty()) {
-      std::cerr << "fitcal compare: " << error << "\n";
+    const MethodComparison comparison = CompareMethods(request);
+    if (!comparison.refusal.empty()) {
+      std::cerr << "fitcal compare: " << comparison.refusal << "\n";
       return 2;
     }
-    const std::vector<AlignedRun> validation =
-        SplitByRepetition(d.runs, validation_reps).training;  // every trajectory of those reps
-
-    std::vector<Row> rows;
-    Row none;
-    none.strategy = "All";
-    none.method = "None";
-    none.cf_validation =
-        validation.empty() ? NAN : d.Cf(d.model->robot().nominal, validation, options.threads);
-    none.termination = "uncalibrated";
-    rows.push_back(none);
-    AddStrategyRows(request, d, present, validation, tying, show_progress, options.threads, &rows);
-    PrintAndWrite(options, request, validation_reps, validation.size(), rows,
-                  ColumnsFor(d.model->robot()), tying);
+    PrintAndWrite(options, request, comparison, ColumnsFor(request.model->robot()));
     return 0;
   });
 }

@@ -1,6 +1,6 @@
 #pragma once
 // `fitcal compare --logs <dir>`: Palacin Table 4 regenerated on the user's data, for any robot
-// model - every strategy (STA..STE or explicit trajectory lists, fit/strategies.h; "all" or a
+// model (the comparison itself is calibrate/method_comparison.h's CompareMethods) - every strategy (STA..STE or explicit trajectory lists, fit/strategies.h; "all" or a
 // label prefix) x every method (calibrate/fit_methods.h) x training on the first 1 or 5 repetitions,
 // validated on every trajectory of the held-out repetitions (Palacin Sec. 3.2: "five additional"
 // repetitions of the whole flower). The model's closed forms (UMBmark for a differential drive)
@@ -23,8 +23,8 @@ namespace fitcal::tools {
 // --logs, --threads and --allow-outside-paths come from DatasetCommandOptions, the solver flags
 // from SolverOptions and --tie/--hold from TyingFlags (the same as fit's).
 struct CompareCommandOptions : DatasetCommandOptions, SolverOptions, TyingFlags {
-  // Palacin's STA..STE, trajectory lists, "all" or "<prefix>*" (compare_command.cc). For a model
-  // other than omni3 without strategies_given: those of STA..STE the data set has, else "all".
+  // Palacin's STA..STE, trajectory lists, "all" or "<prefix>*" (calibrate/method_comparison.h).
+  // Without strategies_given: those of STA..STE the data set has, else "all".
   std::vector<std::string> strategies = {"STA", "STB", "STC", "STD", "STE"};
   bool strategies_given = false;
   std::vector<std::string> methods = {"ceres", "crs2lm", "esch", "slsqp"};  // or "all"

@@ -5,7 +5,7 @@
 
 #include "io/input_error.h"
 #include "odometry/robot.h"
-#include "tools/command_failure.h"
+#include "io/command_failure.h"
 #include "tools/output_guard.h"
 
 namespace fitcal::tools {
@@ -36,9 +36,8 @@ OpenedDataset OpenDataset(const DatasetCommandOptions& options) {
 }
 
 io::Dataset LoadRuns(const DatasetCommandOptions& options, const io::DatasetIndex& index,
-                     const Robot* robot) {
-  return robot == nullptr ? io::LoadDataset(index, options.Loading())
-                          : io::LoadDataset(index, *robot, options.Loading());
+                     const Robot& robot) {
+  return io::LoadDataset(index, robot, options.Loading());
 }
 
 int Refuse(const std::string& why) {

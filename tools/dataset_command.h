@@ -40,18 +40,16 @@ struct OpenedDataset {
 };
 OpenedDataset OpenDataset(const DatasetCommandOptions& options);
 
-// Every run of the data set. `robot` null: read as the omni3 commands always read their data sets
-// (three wheel columns; the runs' fingerprints recorded by `fit` depend on it); otherwise with
-// the robot's own channels.
+// Every run of the data set, read with the robot's own channels (the one loader of every command).
 io::Dataset LoadRuns(const DatasetCommandOptions& options, const io::DatasetIndex& index,
-                     const Robot* robot);
+                     const Robot& robot);
 
 // A refusal: `fitcal: <why>` on one line of stderr; returns the usage exit status 2.
 int Refuse(const std::string& why);
 
 // The tool's edge: runs `command` and turns an exception (io::InputError carries file:line in
 // what()) into `<prefix>: <what>` on one line of stderr and exit status 1, or the status a
-// CommandFailure (tools/command_failure.h) carries.
+// CommandFailure (io/command_failure.h) carries.
 int RunReportingErrors(const std::string& prefix, const std::function<int()>& command);
 
 }  // namespace fitcal::tools

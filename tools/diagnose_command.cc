@@ -201,7 +201,7 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
                    "without an effects: list\n";
       return 2;
     }
-    std::vector<RunLog> runs = LoadRuns(options, index, &robot).runs;
+    std::vector<RunLog> runs = LoadRuns(options, index, robot).runs;
     const std::string aligned = AlignGroundTruthClocks(options.clock_offsets, *model, nullptr,
                                                        std::nullopt, options.threads, &runs);
     if (!aligned.empty()) std::printf("%s\n", aligned.c_str());

@@ -4,7 +4,7 @@
 
 #include "fitcal/version.h"
 #include "odometry/text_format.h"
-#include "tools/report_builder.h"
+#include "validation/report_builder.h"
 #include "validation/trajectory_metrics.h"
 
 namespace fitcal::tools {

@@ -22,7 +22,7 @@
 #include "io/input_registry.h"
 #include "tools/asoc_commands.h"
 #include "tools/cli_validators.h"
-#include "tools/command_failure.h"
+#include "io/command_failure.h"
 #include "tools/compare_command.h"
 #include "tools/diagnose_command.h"
 #include "tools/export_ros2_control.h"
@@ -170,7 +170,7 @@ class HelpFormatter : public CLI::Formatter {
 
   std::string make_footer(const CLI::App* app) const override {
     const std::string own = app->get_footer();
-    return (own.empty() ? "" : own + "\n\n") + kExitStatusHelp + "\n";
+    return (own.empty() ? "" : own + "\n\n") + fitcal::kExitStatusHelp + "\n";
   }
 };
 

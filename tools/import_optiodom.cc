@@ -11,7 +11,7 @@
 #include "odometry/aligned_run.h"
 #include "odometry/parallel_for.h"
 #include "odometry/pose2.h"
-#include "tools/command_failure.h"
+#include "io/command_failure.h"
 #include "tools/dataset_command.h"
 #include "tools/import_channel_order.h"
 #include "tools/optiodom_robots.h"

@@ -3,7 +3,7 @@
 // the ground truth better): every import says so with exit status 4, as `fit` does for the same
 // finding (README, exit codes), not 1 (bad input) or 3 (which means a fit that did not converge).
 
-#include "tools/command_failure.h"
+#include "io/command_failure.h"
 
 namespace fitcal::tools {
 

@@ -172,7 +172,7 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   if (const int refused = MakeRequest(options, model->robot(), &request); refused != 0) {
     return refused;
   }
-  request.runs = LoadRuns(options, index, &model->robot()).runs;
+  request.runs = LoadRuns(options, index, model->robot()).runs;
   io::StopHereForTests("loaded");
   const double load_s = Seconds(t_total);
   const CalibrationOutcome outcome = Calibrate(request, *model);

@@ -217,7 +217,7 @@ int Generalise(const GeneraliseCommandOptions& options) {
   }
   SessionKey session_key = SessionKey::kLabel;
   if (!ParseSessionKey(options.sessions, &session_key)) return 2;
-  const io::Dataset dataset = LoadRuns(options, index, &robot);
+  const io::Dataset dataset = LoadRuns(options, index, robot);
   const std::vector<AlignedRun> runs = AlignRuns(dataset.runs);
   CandidateInputs inputs;
   if (!PrepareCandidates(options, robot, dataset.runs, runs, &inputs)) return 2;

@@ -9,7 +9,7 @@
 #include "io/atomic_file.h"
 #include "io/staged_directory.h"
 #include "models/model_registry.h"
-#include "tools/command_failure.h"
+#include "io/command_failure.h"
 #include "tools/dataset_command.h"
 #include "tools/output_guard.h"
 #include "tools/sim/model_scenarios.h"

@@ -22,7 +22,7 @@
 #include "tools/cli_validators.h"
 #include "tools/clock_alignment.h"
 #include "tools/output_guard.h"
-#include "tools/report_builder.h"
+#include "validation/report_builder.h"
 #include "validation/trajectory_metrics.h"
 
 namespace fitcal::tools {
@@ -42,7 +42,7 @@ ReportInputs LoadInputs(const ReportCommandOptions& options, std::string* refusa
   if (!refusal->empty()) return in;
   in.model = ReadRobotModelFile(in.index.robot_path);
   // Loaded as `fit` loads them, with the robot's channels (their runs' fingerprints must agree).
-  in.dataset = LoadRuns(options, in.index, &in.model->robot());
+  in.dataset = LoadRuns(options, in.index, in.model->robot());
   for (const std::string& path : options.calibrations) {
     Robot calibrated = ReadRobotModelFile(path)->robot();
     if (calibrated.model != in.model->robot().model ||

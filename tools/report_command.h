@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "tools/dataset_command.h"
-#include "tools/report_builder.h"
+#include "validation/report_builder.h"
 
 namespace fitcal::tools {
 
@@ -47,6 +47,6 @@ void AddReportOptions(CLI::App& app, ReportCommandOptions& options);
 int RunReportCommand(const ReportCommandOptions& options);
 
 // ReportParameterOf and ReportEffectOf (the page rows diagnose shares) are in
-// tools/report_builder.h.
+// validation/report_builder.h.
 
 }  // namespace fitcal::tools

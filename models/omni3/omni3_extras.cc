@@ -53,7 +53,6 @@ ModelExtras Omni3Extras() {
   extras.controllers = {OmniWheelController(OmniWheelReplay::kOwnModelByName)};
   extras.display = &InverseKinematicMatrixColumns;
   extras.legacy_simulator = true;
-  extras.legacy_loader = true;
   return extras;
 }
 

@@ -148,7 +148,7 @@ BENCHMARK_CAPTURE(ReadAndDecode, mcap, std::string("mcap"))->Unit(benchmark::kMi
 
 // `fitcal import rosbag2` on one core: a diff_drive robot on wheel_0 (right) and wheel_1 (left) of
 // the JointState bag above plus a PoseStamped ground truth at a tenth of its rate. ReadOnly: read,
-// decode, interval rates, run logs (tools::ReadRosbag2Import); EndToEnd: and the data set
+// decode, interval rates, run logs (ReadRosbag2Import); EndToEnd: and the data set
 // written (CSV text, files renamed into place).
 const Bag& ImportBag() {
   static const Bag bag = [] {
@@ -162,8 +162,8 @@ const Bag& ImportBag() {
   return bag;
 }
 
-fitcal::tools::ImportRosbag2Options ImportOptions() {
-  fitcal::tools::ImportRosbag2Options o;
+fitcal::ImportRosbag2Options ImportOptions() {
+  fitcal::ImportRosbag2Options o;
   o.bag = ImportBag().dir.string();
   o.robot = (ImportBag().dir.parent_path() / "robot.yaml").string();
   o.ground_truth = "/mocap/pose";
@@ -174,10 +174,10 @@ fitcal::tools::ImportRosbag2Options ImportOptions() {
 }
 
 void ImportRosbag2(benchmark::State& state, bool write) {
-  const fitcal::tools::ImportRosbag2Options o = ImportOptions();
+  const fitcal::ImportRosbag2Options o = ImportOptions();
   for (auto _ : state) {
     const auto imported =
-        write ? fitcal::tools::ImportRosbag2(o) : fitcal::tools::ReadRosbag2Import(o);
+        write ? fitcal::tools::ImportRosbag2(o) : fitcal::ReadRosbag2Import(o);
     benchmark::DoNotOptimize(imported.runs.size());
   }
   state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * ImportBag().file_bytes));

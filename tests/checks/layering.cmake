@@ -10,14 +10,15 @@
 #   diagnosis (5) what the residual left after a fit says
 #   calibrate (6) one calibration from a request: candidates, choices by transfer, the gate, the
 #                 held-out judgements, the record to write
-#   tools (7)     commands, simulators, importers
+#   ros2 (7)      ROS 2 interchange: controller parameters exported, replayed and their covariance
+#   tools (8)     commands, simulators, importers
 # A new include against this order fails the check with the file, the line and the layers.
 cmake_minimum_required(VERSION 3.16)
 if(NOT SOURCE_DIR)
   message(FATAL_ERROR "layering.cmake: pass -DSOURCE_DIR=<checkout>")
 endif()
 
-set(LAYERS odometry io models fit validation diagnosis calibrate tools)
+set(LAYERS odometry io models fit validation diagnosis calibrate ros2 tools)
 # No exception: a model that reads files of its own (ASOC's encoder files, models/asoc/asoc_files.h)
 # hands the data-set loader a reader through its Robot (Robot::read_own_encoder_file).
 set(ALLOWED_EXCEPTIONS "")

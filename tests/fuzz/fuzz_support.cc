@@ -119,13 +119,13 @@ void FuzzAsocRobot(const std::string& path) {
 
 // `fitcal import rosbag2` up to the data set it would write: bag file, topics, stamps, runs.
 void FuzzRosbag2Import(const std::string& path, const std::string& dir) {
-  tools::ImportRosbag2Options o;
+  ImportRosbag2Options o;
   o.bag = path;
   o.robot = dir + "/diff_drive.yaml";
   o.joints = {"right_wheel_joint", "left_wheel_joint"};
   o.ground_truth = "/mocap/pose";
   o.quiet = true;
-  const tools::Rosbag2Import imp = tools::ReadRosbag2Import(o);
+  const Rosbag2Import imp = ReadRosbag2Import(o);
   if (imp.runs.empty() || imp.encoder_t_s.size() != imp.runs.size()) {
     throw std::logic_error("import without runs accepted");
   }

@@ -8,6 +8,13 @@
 
 namespace fitcal::sim {
 
+std::uint64_t SplitMix(std::uint64_t x) {
+  x += 0x9E3779B97F4A7C15ull;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+  return x ^ (x >> 31);
+}
+
 namespace {
 
 // Portable random numbers: mt19937_64 is fully specified by the standard, the distributions on
@@ -27,13 +34,6 @@ class FlowerRandom {
  private:
   std::mt19937_64 engine_;
 };
-
-std::uint64_t SplitMix(std::uint64_t x) {
-  x += 0x9E3779B97F4A7C15ull;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-  return x ^ (x >> 31);
-}
 
 // The body twist of channel values: the model's body step over a probe interval, divided by it.
 // A power of two, so a step linear in dt (omni3's dt M^-1 w) gives the twist exactly; for a

@@ -26,6 +26,9 @@
 
 namespace fitcal::sim {
 
+// SplitMix64 (Steele, Lea, Flood 2014): a seed and a stream index mixed into one generator seed.
+std::uint64_t SplitMix(std::uint64_t x);
+
 // Empty when the stepped options are valid for a robot of num_channels channels, else what is
 // wrong.
 std::string CheckSteppedOptions(const SteppedOptions& stepped, double encoder_period_s,

@@ -1,4 +1,4 @@
-#include "tools/report_builder.h"
+#include "validation/report_builder.h"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -18,7 +18,7 @@
 #include "validation/trajectory_family.h"
 #include "validation/verdict.h"
 
-namespace fitcal::tools {
+namespace fitcal {
 
 namespace {
 
@@ -667,4 +667,4 @@ io::ReportData BuildReport(const ReportInputs& in, std::vector<TrainingSplit> sp
   return data;
 }
 
-}  // namespace fitcal::tools
+}  // namespace fitcal

@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace fitcal::tools {
+namespace fitcal {
 
 // The exit statuses of every command, as `--help` shows them under each command (one footer, so
 // that no command's help can drift from the README's list).
@@ -40,4 +40,4 @@ class WorseThanNominalError : public CommandFailure {
   explicit WorseThanNominalError(const std::string& what) : CommandFailure(5, what) {}
 };
 
-}  // namespace fitcal::tools
+}  // namespace fitcal

@@ -21,7 +21,7 @@
 #include "validation/training_runs.h"
 #include "validation/trajectory_metrics.h"
 
-namespace fitcal::tools {
+namespace fitcal {
 
 // One calibration to judge: the calibrated robot and what its YAML records.
 struct CalibrationInput {
@@ -64,4 +64,4 @@ io::ReportParameter ReportParameterOf(const Robot& robot, int k, double calibrat
                                       double sigma);
 io::ReportEffect ReportEffectOf(const effects::EffectValue& value);
 
-}  // namespace fitcal::tools
+}  // namespace fitcal
