@@ -18,7 +18,7 @@
 #include "tools/sim/flower_scenario.h"
 
 namespace fitcal {
-namespace {
+namespace channel_order_check_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)
 
 std::vector<RunLog> SimulateLogs(std::uint64_t seed, int repetitions) {
   sim::FlowerSimulation options = sim::PalacinFlower();

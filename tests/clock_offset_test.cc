@@ -27,7 +27,7 @@
 #include "tools/sim/model_simulator.h"
 
 namespace fitcal {
-namespace {
+namespace clock_offset_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)
 
 constexpr double kCommonScale = 1.02;   // every true length / nominal
 constexpr double kClockOffsetS = 0.15;  // ground truth stamped this late

@@ -17,7 +17,7 @@
 #include "tests/test_paths.h"
 
 namespace fitcal {
-namespace {
+namespace diagnose_hidden_structure_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)
 
 Omni3Robot NominalRobot() { return ReadOmni3Robot(FITCAL_SOURCE_DIR + "/data/robots/apr02.yaml"); }
 

@@ -29,7 +29,7 @@
 #include "validation/trajectory_metrics.h"
 
 namespace fitcal {
-namespace {
+namespace diff_drive_effects_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)
 
 using effects::EffectId;
 

@@ -34,7 +34,7 @@
 #include "validation/generalisation.h"
 
 namespace fitcal {
-namespace {
+namespace diff_drive_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)
 
 namespace fs = std::filesystem;
 

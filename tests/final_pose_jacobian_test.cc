@@ -33,7 +33,7 @@
 #include "odometry/aligned_run.h"
 
 namespace fitcal {
-namespace {
+namespace final_pose_jacobian_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)
 
 constexpr double kRelativeTolerance = 1e-9;
 

@@ -31,7 +31,7 @@
 #include "tests/independent_sim/everyday_drive_sim.h"
 #include "tests/test_files.h"
 
-namespace {
+namespace independent_diagnose_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)
 
 using fitcal::testing::RunFitcal;
 using fitcal::testing::TempDir;

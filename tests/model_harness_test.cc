@@ -25,7 +25,7 @@
 #include "tests/models/unicycle_test_model.h"
 
 namespace fitcal {
-namespace {
+namespace model_harness_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)
 
 constexpr double kDt = 0.01;
 constexpr int kSamplesPerRun = 300;  // 3 s per run

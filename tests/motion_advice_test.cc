@@ -16,7 +16,7 @@
 #include "tests/model_support.h"
 
 namespace fitcal {
-namespace {
+namespace motion_advice_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)
 
 // A noise-free run of `motion` at the nominal, its end moved by a deterministic error of 2 mm and
 // 0.2 deg (the order of a motion-capture pose): the residuals' noise the analysis reads.

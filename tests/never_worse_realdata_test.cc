@@ -18,7 +18,7 @@
 #include "tests/test_files.h"
 
 namespace fitcal {
-namespace {
+namespace never_worse_realdata_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)
 
 namespace fs = std::filesystem;
 using testing::Has;

@@ -22,7 +22,7 @@
 #include "tests/test_files.h"
 
 namespace fitcal {
-namespace {
+namespace nothing_lost_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)
 
 namespace fs = std::filesystem;
 using testing::ReadFileBytes;

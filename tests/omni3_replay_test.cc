@@ -13,7 +13,7 @@
 #include "tools/sim/flower_scenario.h"
 
 namespace fitcal::omni3 {
-namespace {
+namespace omni3_replay_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)
 
 using ParameterArray = std::array<double, kNumParameters>;
 

@@ -25,7 +25,7 @@
 #include "tests/test_files.h"
 
 namespace fitcal {
-namespace {
+namespace one_free_run_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)
 
 namespace fs = std::filesystem;
 using testing::RunFitcal;

@@ -16,7 +16,7 @@
 #include "validation/trajectory_family.h"
 
 namespace fitcal {
-namespace {
+namespace residual_kind_transfer_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)
 
 // Scores per kind of run and residual kind: {cf, drift 2 m %, ate}.
 using Measures = std::array<double, 3>;

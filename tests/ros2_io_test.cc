@@ -43,7 +43,7 @@
 #include "models/tricycle/tricycle_trajectories.h"
 
 namespace fitcal {
-namespace {
+namespace ros2_io_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)
 
 namespace fs = std::filesystem;
 using namespace io::rosbag2;

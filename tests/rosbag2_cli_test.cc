@@ -28,7 +28,7 @@
 #include "tests/test_files.h"
 
 namespace fitcal {
-namespace {
+namespace rosbag2_cli_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)
 
 namespace fs = std::filesystem;
 using testing::Has;

@@ -18,7 +18,7 @@
 #include "models/omni3/omni3_robot_model.h"
 
 namespace fitcal {
-namespace {
+namespace segment_cost_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)
 
 Omni3Robot NominalRobot() {
   Omni3Robot robot;

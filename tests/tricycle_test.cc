@@ -31,7 +31,7 @@
 #include "models/tricycle/tricycle_trajectories.h"
 
 namespace fitcal {
-namespace {
+namespace tricycle_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)
 
 namespace fs = std::filesystem;
 using K = TricycleKinematics;
