@@ -103,6 +103,22 @@ struct MultiChannelRun {
   double path_m = 0.0;
 };
 
+namespace detail {
+
+// The motion capture's samples due by time t (one every mocap_period_s from *next_mocap), each the
+// true pose with its noise; both robots record through it.
+inline void RecordMocapUntil(double t, const Pose& pose, const Sensors& sensors,
+                             std::normal_distribution<double>& normal, std::mt19937_64& rng,
+                             double* next_mocap, MultiChannelRun* run) {
+  while (t >= *next_mocap - 1e-12) {
+    run->mocap_t_s.push_back(*next_mocap);
+    run->mocap.push_back(NoisyPose(pose, sensors, normal, rng));
+    *next_mocap += sensors.mocap_period_s;
+  }
+}
+
+}  // namespace detail
+
 // ---------------------------------------------------------------------------------------------
 // Tricycle.
 
@@ -177,11 +193,7 @@ inline MultiChannelRun SimulateTricycle(const TricycleGeometry& g, const Contact
       run.steering_rad.push_back(count * kTwoPi / steering.counts_per_rev);
       next_encoder += sensors.encoder_period_s;
     }
-    while (t >= next_mocap - 1e-12) {
-      run.mocap_t_s.push_back(next_mocap);
-      run.mocap.push_back(detail::NoisyPose(pose, sensors, normal, rng));
-      next_mocap += sensors.mocap_period_s;
-    }
+    detail::RecordMocapUntil(t, pose, sensors, normal, rng, &next_mocap, &run);
   };
   record();
   for (const TwistCommand& c : commands) {
@@ -297,11 +309,7 @@ inline MultiChannelRun SimulateOmni3(const Omni3Geometry& g, const ContactPhysic
                            detail::Ticks(wheel[2].motor_angle, sensors)});
       next_encoder += sensors.encoder_period_s;
     }
-    while (t >= next_mocap - 1e-12) {
-      run.mocap_t_s.push_back(next_mocap);
-      run.mocap.push_back(detail::NoisyPose(pose, sensors, normal, rng));
-      next_mocap += sensors.mocap_period_s;
-    }
+    detail::RecordMocapUntil(t, pose, sensors, normal, rng, &next_mocap, &run);
   };
   record();
   for (const TwistCommand& c : commands) {
