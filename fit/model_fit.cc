@@ -419,21 +419,19 @@ void TrackSandwichCovariance(const std::vector<AlignedRun>& training,
   for (int k = 0; k < m; ++k) {
     if (k < n ? !result->held[k] : information(k, k) > 0.0) free.push_back(k);
   }
-  const Eigen::MatrixXd covariance =
-      SandwichCovariance(information(free, free), meat(free, free));
-  if (covariance.size() == 0) {
+  // H^-1 once: the sandwich's two factors, and what the held directions move with (B = H^-1 ...).
+  const Eigen::MatrixXd inverse = InverseInformation(information(free, free));
+  if (inverse.size() == 0) {
     result->covariance_message = kRankDeficient;
     return;
   }
   Eigen::MatrixXd full = Eigen::MatrixXd::Zero(m, m);
-  full(free, free) = covariance;
+  full(free, free) = inverse * meat(free, free) * inverse.transpose();
   result->covariance = full.topLeftCorner(n, n);
   if (!holds.directions.empty()) {
-    Eigen::MatrixXd inverse = Eigen::MatrixXd::Zero(m, m);
-    const Eigen::Index f = static_cast<Eigen::Index>(free.size());
-    inverse(free, free) =
-        SandwichCovariance(information(free, free), Eigen::MatrixXd::Identity(f, f));
-    AddHeldDirectionsCovariance(model.robot(), holds, inverse.topLeftCorner(n, n), result);
+    Eigen::MatrixXd full_inverse = Eigen::MatrixXd::Zero(m, m);
+    full_inverse(free, free) = inverse;
+    AddHeldDirectionsCovariance(model.robot(), holds, full_inverse.topLeftCorner(n, n), result);
   }
   result->sigma = SigmasOf(result->covariance);
   result->correlation = CorrelationOf(result->covariance);

@@ -83,12 +83,16 @@ Eigen::MatrixXd RandomWalkScoreCovariance(const std::vector<TrackErrorChain>& ru
   return eigen.eigenvalues().minCoeff() >= 0.0 ? with_lag1 : lag0;
 }
 
-Eigen::MatrixXd SandwichCovariance(const Eigen::MatrixXd& information, const Eigen::MatrixXd& meat) {
+Eigen::MatrixXd InverseInformation(const Eigen::MatrixXd& information) {
   const Eigen::JacobiSVD<Eigen::MatrixXd> svd(information, Eigen::ComputeFullU | Eigen::ComputeFullV);
   const Eigen::VectorXd& s = svd.singularValues();
   if (s.size() == 0 || !(s(s.size() - 1) > 1e-14 * s(0))) return {};
-  const Eigen::MatrixXd inverse =
-      svd.matrixV() * s.cwiseInverse().asDiagonal() * svd.matrixU().transpose();
+  return svd.matrixV() * s.cwiseInverse().asDiagonal() * svd.matrixU().transpose();
+}
+
+Eigen::MatrixXd SandwichCovariance(const Eigen::MatrixXd& information, const Eigen::MatrixXd& meat) {
+  const Eigen::MatrixXd inverse = InverseInformation(information);
+  if (inverse.size() == 0) return {};
   return inverse * meat * inverse.transpose();
 }
 

@@ -54,8 +54,11 @@ std::vector<Eigen::Vector3d> Innovations(const TrackErrorChain& run);
 // M of the header (m x m) over `runs`; empty runs are skipped.
 Eigen::MatrixXd RandomWalkScoreCovariance(const std::vector<TrackErrorChain>& runs, int m);
 
-// H^-1 M H^-1 for a symmetric positive definite H (m x m); empty when H is singular to within
-// a reciprocal condition number of 1e-14 (Ceres' DENSE_SVD default).
+// H^-1 for a symmetric positive definite H (m x m), by SVD; empty when H is singular to within a
+// reciprocal condition number of 1e-14 (Ceres' DENSE_SVD default).
+Eigen::MatrixXd InverseInformation(const Eigen::MatrixXd& information);
+
+// H^-1 M H^-1 (InverseInformation's H^-1); empty when H is singular.
 Eigen::MatrixXd SandwichCovariance(const Eigen::MatrixXd& information, const Eigen::MatrixXd& meat);
 
 }  // namespace fitcal
