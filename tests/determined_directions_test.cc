@@ -112,6 +112,69 @@ TEST(DeterminedDirections, StraightRunsLeaveTheYawGeometryUndeterminedAndItIsHel
   EXPECT_LT(cf_held, cf_free);
 }
 
+// The same straight runs fitted on their tracks: the held directions' part of the covariance
+// (fit/model_fit.cc, AddHeldDirectionsCovariance) on the track path, whose information is the
+// checkpoints' J^T J plus the hold's. Along a held direction the fit sits at the nominal, so its
+// error there is the nominal's, whose only knowledge is the bounds read as a uniform prior: in the
+// prior's units (sigma width / sqrt(12) per parameter, UndeterminedDirection::prior_units, a unit
+// vector) its variance is exactly 1, an independent value the covariance must reproduce. The data's
+// own part along a stiffly held direction is ~1e-8 of it; a B built with H^-2 instead of H^-1
+// scales the prior's part by the hold's stiffness (1e-4 or less), so 0.9-1.1 separates both.
+// And every free parameter's truth (each moved by ~3 %, 0.7 deg) lies within 3 sigma.
+TEST(DeterminedDirections, ATrackFitCarriesThePriorAlongItsHeldDirections) {
+  const RobotModelPtr model = testing::ExampleModel("omni");
+  const Robot& robot = model->robot();
+  std::vector<double> truth = robot.nominal;
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    if (robot.IsHeld(k)) continue;
+    truth[k] += (k % 2 == 0 ? 1.0 : -1.0) *
+                (robot.parameters[k].unit == ParameterUnit::kAngle ? 0.7 * M_PI / 180.0
+                                                                   : 0.03 * robot.nominal[k]);
+  }
+  sim::SimulationOptions options;
+  options.encoder_period_s = 0.02;
+  options.ground_truth_period_s = 0.05;
+  options.wheel_rate_sigma_rad_s = 0.2;
+  options.gt_position_sigma_m = 0.002;
+  options.gt_heading_sigma_rad = 0.004;
+  options.record_start_pose = true;
+  options.seed = 7;
+  std::vector<RunLog> logs;
+  for (const auto& s : sim::SimulateRuns(*model, truth, StraightRunsOnly(), options)) {
+    logs.push_back(s.log);
+  }
+  const std::vector<AlignedRun> runs = AlignRuns(logs);
+  std::vector<const GroundTruthTrack*> tracks;
+  for (const RunLog& log : logs) tracks.push_back(&log.ground_truth);
+  TrackFitData track = MakeTrackFitData(runs, tracks, ClockGrouping::kNone);
+  track.estimate_clock_offsets = false;
+  ModelFitOptions fit_options;
+  fit_options.residuals = ResidualKind::kTrack;
+  fit_options.track = &track;
+  fit_options.ceres.num_threads = 1;
+  const ModelFitResult fit = FitModel(runs, *model, fit_options);
+  ASSERT_TRUE(fit.usable) << fit.message;
+  ASSERT_TRUE(fit.has_covariance) << fit.covariance_message;
+  ASSERT_FALSE(fit.held_directions.empty());
+  const int n = robot.NumParameters();
+  Eigen::VectorXd prior_sigma = Eigen::VectorXd::Ones(n);
+  for (int k = 0; k < n; ++k) prior_sigma(k) = robot.bounds[k].Width() / std::sqrt(12.0);
+  const Eigen::MatrixXd in_prior_units = prior_sigma.asDiagonal().inverse() * fit.covariance *
+                                         prior_sigma.asDiagonal().inverse();
+  for (const UndeterminedDirection& d : fit.held_directions) {
+    const double variance = d.prior_units.dot(in_prior_units * d.prior_units);
+    std::printf("held direction, variance in prior units %.4f: %s\n", variance,
+                d.description.c_str());
+    EXPECT_NEAR(variance, 1.0, 0.1) << d.description;
+  }
+  for (int k = 0; k < n; ++k) {
+    if (robot.IsHeld(k)) continue;
+    ASSERT_GT(fit.sigma[k], 0.0) << robot.parameters[k].name;
+    EXPECT_LT(std::abs(fit.parameters[k] - truth[k]), 3.0 * fit.sigma[k])
+        << robot.parameters[k].name;
+  }
+}
+
 // The checkpoints of a track are poses from the run's start, so their errors are a random walk
 // (fit/serial_covariance.h): halving their spacing along the same run adds no information. A
 // differential drive's everyday run of ~145 m (turns both ways and straights) with encoder noise
