@@ -973,6 +973,18 @@ std::string ReasonToStartAcrossTheBox(const Robot& robot, const ModelFitResult& 
   return text;
 }
 
+// A point `fraction` of the way across a parameter's box. A ratio's box is a factor either way of
+// its nominal (a steering gain's default [g / 10, 10 g]), so its fractions are taken on the log
+// scale: the centre is the nominal, a quarter g / 3.2. On the linear scale every start of such a
+// box lay at 2.5 g or more, and a gain 2.5x below its guess was never reached (a tricycle of gain
+// 0.4 guessed 1: fit refused with the radius and the wheelbase on their bounds).
+double AcrossTheBox(const ParameterInfo& info, const Interval& box, double fraction) {
+  if (info.unit == ParameterUnit::kRatio && box.lo > 0.0) {
+    return box.lo * std::pow(box.hi / box.lo, fraction);
+  }
+  return box.lo + fraction * box.Width();
+}
+
 // ModelFitOptions::global_start: the starts spread across the box, the lowest cost kept; the
 // first start whose fit leaves no reason to go on ends the search.
 ModelFitResult WithGlobalStart(const std::vector<AlignedRun>& training,
@@ -990,7 +1002,7 @@ ModelFitResult WithGlobalStart(const std::vector<AlignedRun>& training,
     std::vector<double> start = robot.nominal;
     for (int k = 0; k < robot.NumParameters(); ++k) {
       if (!HeldInFit(robot, k, options)) {
-        start[k] = robot.bounds[k].lo + fraction * robot.bounds[k].Width();
+        start[k] = AcrossTheBox(robot.parameters[k], robot.bounds[k], fraction);
       }
     }
     ModelFitResult fit = FitModelFrom(training, model, start, options);

@@ -55,8 +55,11 @@ struct ControllerWriter {
 
 // The trajectories `simulate --model` drives the model on (tools/sim/model_scenarios.h), and
 // how far its default true robot is from the nominal one (a fraction of the way to the bounds).
+// The commands are the nominal robot's; the true parameters may only limit what the machine can
+// drive (a tricycle's readable steering range).
 struct SimulationScenario {
-  std::function<std::vector<sim::TrajectorySpec>(const Robot& nominal, int repetitions)>
+  std::function<std::vector<sim::TrajectorySpec>(
+      const Robot& nominal, const std::vector<double>& truth, int repetitions)>
       trajectories;  // empty: the model has no scenario
   double truth_fraction = 0.25;
 };

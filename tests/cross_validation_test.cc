@@ -22,8 +22,8 @@ std::vector<AlignedRun> SimulatedDiffDrive(const RobotModelInterface& model, int
   sim::ScenarioNoise noise;
   noise.repetitions = repetitions;
   noise.seed = 5;
-  const sim::ModelScenario scenario = sim::MakeModelScenario(model, noise);
   *truth = sim::DefaultTrueParameters(model.robot());
+  const sim::ModelScenario scenario = sim::MakeModelScenario(model, *truth, noise);
   std::vector<RunLog> logs;
   for (const sim::ModelSimulatedRun& r :
        sim::SimulateRuns(model, *truth, scenario.trajectories, scenario.options)) {

@@ -51,7 +51,7 @@ class FarFromTheGuess : public ::testing::Test {
     sim::ScenarioNoise noise;
     noise.repetitions = 3;
     noise.seed = 5;
-    const sim::ModelScenario scenario = sim::MakeModelScenario(*model_, noise);
+    const sim::ModelScenario scenario = sim::MakeModelScenario(*model_, truth_, noise);
     for (auto& run : sim::SimulateRuns(*model_, truth_, scenario.trajectories, scenario.options)) {
       logs_.push_back(std::move(run.log));
     }

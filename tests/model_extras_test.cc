@@ -42,7 +42,8 @@ void ToyControllerParameters(const CalibratedRobot& c, const std::string&, Contr
 }
 
 // Two trajectories the unicycle can drive (it has no sideways motion): 1 m ahead, a turn.
-std::vector<sim::TrajectorySpec> ToyScenario(const Robot&, int repetitions) {
+std::vector<sim::TrajectorySpec> ToyScenario(const Robot&, const std::vector<double>&,
+                                              int repetitions) {
   std::vector<sim::TrajectorySpec> out;
   for (int rep = 1; rep <= repetitions; ++rep) {
     out.push_back({"ahead", rep, {{{0.2, 0.0, 0.0}, 5.0}}});

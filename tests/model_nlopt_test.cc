@@ -35,10 +35,10 @@ std::vector<AlignedRun> SimulatedRuns(const RobotModelInterface& model) {
   sim::ScenarioNoise noise;
   noise.repetitions = 1;
   noise.seed = 7;
-  const sim::ModelScenario scenario = sim::MakeModelScenario(model, noise);
+  const std::vector<double> truth = sim::DefaultTrueParameters(model.robot());
+  const sim::ModelScenario scenario = sim::MakeModelScenario(model, truth, noise);
   std::vector<RunLog> logs;
-  for (auto& run : sim::SimulateRuns(model, sim::DefaultTrueParameters(model.robot()),
-                                     scenario.trajectories, scenario.options)) {
+  for (auto& run : sim::SimulateRuns(model, truth, scenario.trajectories, scenario.options)) {
     logs.push_back(std::move(run.log));
   }
   return AlignRuns(logs);

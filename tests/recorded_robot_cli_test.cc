@@ -68,10 +68,10 @@ constexpr const char* kMecanumGuess =
     "angle_offset_deg: [-2.0, 2.0]}\n";
 
 // Bounds are the user's (documented keys), wide enough for a 20 % error; the steering gain's
-// are the default (a factor of 10 either way of the nominal). The tricycle's true gain is 2.5,
-// not the 0.4: simulate's tricycle runs steer the wheel up to 93 deg, which a gain of 0.4
-// would read as 233 deg at the column, past what an absolute encoder (or the loader's [-pi, pi])
-// can hold; 2.5 is the same factor off the nominal the other way (refused, below), 2 passes.
+// are the default (a factor of 10 either way of the nominal). The tricycle's true gain is the
+// issue's 0.4, and 2.5 and 2 the other way. A gain of 0.4 reads a wheel at 90 deg as 225 deg at
+// the column, past what an absolute encoder holds: simulate drives that robot's squares on arcs
+// at the largest readable steering (61 deg here) instead of turning in place.
 const RecordedCase kCases[] = {
     {"diff_drive_10pct", "diff_drive", kDiffDriveGuess,
      "model: diff_drive\nname: d\nwheels:\n  - {name: right, radius_m: 0.046}\n"
@@ -87,6 +87,12 @@ const RecordedCase kCases[] = {
     {"tricycle_gain_2", "tricycle", kTricycleGuess,
      "model: tricycle\nname: t\ntraction_wheel: {radius_m: 0.0357}\nwheelbase_m: 0.18\n"
      "steering_offset_deg: 3.0\nsteering_gain: 2.0\n"
+     "bounds: {radius_m: [0.025, 0.045], wheelbase_m: [0.12, 0.25], "
+     "steering_offset_deg: [-10.0, 10.0]}\n",
+     {"steering"}, "", ""},
+    {"tricycle_gain_0_4", "tricycle", kTricycleGuess,
+     "model: tricycle\nname: t\ntraction_wheel: {radius_m: 0.0357}\nwheelbase_m: 0.18\n"
+     "steering_offset_deg: 3.0\nsteering_gain: 0.4\n"
      "bounds: {radius_m: [0.025, 0.045], wheelbase_m: [0.12, 0.25], "
      "steering_offset_deg: [-10.0, 10.0]}\n",
      {"steering"}, "", ""},

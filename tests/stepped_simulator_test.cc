@@ -26,10 +26,11 @@ using testing::ExampleModel;
 
 // Each model's calibration trajectories (one repetition) under the stepped physics with no noise
 // at all: no slip, no jitter, no ground-truth noise, 2^22-tick encoders.
-sim::ModelScenario NoiseFreeStepped(const RobotModelInterface& model) {
+sim::ModelScenario NoiseFreeStepped(const RobotModelInterface& model,
+                                    const std::vector<double>& truth) {
   sim::ScenarioNoise noise;
   noise.repetitions = 1;
-  sim::ModelScenario scenario = sim::MakeModelScenario(model, noise);
+  sim::ModelScenario scenario = sim::MakeModelScenario(model, truth, noise);
   sim::SimulationOptions& o = scenario.options;
   for (double& t : o.ticks_per_rev) t = t > 0.0 ? static_cast<double>(1 << 22) : 0.0;
   o.wheel_rate_sigma_rad_s = o.angle_sigma_rad = 0.0;
@@ -75,8 +76,8 @@ TEST(SteppedSimulator, NoiseFreeLogsReplayToTheTruthForEveryModel) {
   for (const char* name : {"diff_drive", "tricycle", "omni"}) {
     SCOPED_TRACE(name);
     const RobotModelPtr model = ExampleModel(name);
-    const sim::ModelScenario scenario = NoiseFreeStepped(*model);
     const std::vector<double> truth = sim::DefaultTrueParameters(model->robot());
+    const sim::ModelScenario scenario = NoiseFreeStepped(*model, truth);
     const auto runs = sim::SimulateRuns(*model, truth, scenario.trajectories, scenario.options);
     ASSERT_EQ(runs.size(), scenario.trajectories.size());
     for (std::size_t i = 0; i < runs.size(); ++i) {

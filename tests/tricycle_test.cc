@@ -314,6 +314,42 @@ TEST(TricycleTrajectories, CirclesBothWaysAndSquaresAreDrivable) {
   EXPECT_THROW(sim::TricycleTrajectories(bad), std::invalid_argument);
 }
 
+// A column read through a gain below 1 cannot report 90 deg of wheel steering (issue 39's gain of
+// 0.4 reads 90 deg as 225 deg): the readable range is |gain| x 160 deg less the offset, at most
+// 90 (0.4 x 160 - 3 = 61 deg), and below 90 the squares turn on arcs at that steering. Simulated
+// on the example robot: the steering channel never reads beyond the cap (plus 0.5 deg for the
+// reading's noise, 0.1 deg sigma) and each square still turns by a whole turn.
+TEST(TricycleTrajectories, SquaresTurnOnArcsWithinTheReadableSteering) {
+  EXPECT_DOUBLE_EQ(sim::TricycleReadableSteeringDeg(1.0, 0.0), 90.0);
+  EXPECT_DOUBLE_EQ(sim::TricycleReadableSteeringDeg(0.4, DegToRad(3.0)), 61.0);
+  EXPECT_DOUBLE_EQ(sim::TricycleReadableSteeringDeg(-0.4, DegToRad(-3.0)), 61.0);
+  const auto model = ExampleModel();
+  sim::TricycleTrajectoryOptions o;
+  o.max_steering_deg = 61.0;
+  const auto specs = sim::TricycleTrajectories(o);
+  ASSERT_EQ(specs.size(), 10u);
+  const auto runs =
+      sim::SimulateRuns(*model, model->robot().nominal, specs, sim::SimulationOptions{});
+  const Robot& robot = model->robot();
+  const int steering = static_cast<int>(
+      std::find_if(robot.channels.begin(), robot.channels.end(),
+                   [](const ChannelInfo& c) { return c.kind == ChannelKind::kAngle; }) -
+      robot.channels.begin());
+  for (std::size_t i = 8; i < runs.size(); ++i) {
+    SCOPED_TRACE(specs[i].label);
+    double widest = 0.0;
+    for (auto&& sample : runs[i].log.encoders.samples) {
+      widest = std::max(widest, std::abs(sample.value[steering]));
+    }
+    EXPECT_LT(RadToDeg(widest), 61.5);
+    EXPECT_GT(RadToDeg(widest), 60.0);  // the corners do steer to the cap
+    const double sign = specs[i].label.find("ccw") != std::string::npos ? 1.0 : -1.0;
+    EXPECT_NEAR(runs[i].true_final_pose.theta, sign * 2.0 * M_PI, 1e-6);
+  }
+  o.steering_deg = {10.0, 70.0};
+  EXPECT_THROW(sim::TricycleTrajectories(o), std::invalid_argument);  // a circle beyond the cap
+}
+
 // Noisy simulated calibration: ground-truth noise of sigma_xy = 2 mm and sigma_theta = 2 mrad at
 // the final pose (start pose recorded), traction ticks of 1600 per revolution (< 0.13 mm, not
 // accumulating), 3 repetitions of the 10 trajectories. Encoders at 100 Hz: the midpoint rule

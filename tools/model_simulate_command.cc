@@ -77,7 +77,7 @@ int RunModelSimulateCommand(const ModelSimulateOptions& options) {
     }
     const std::vector<double> truth = TrueParameters(options, *model);
     const sim::ScenarioNoise& noise = options.noise;
-    const sim::ModelScenario scenario = sim::MakeModelScenario(*model, noise);
+    const sim::ModelScenario scenario = sim::MakeModelScenario(*model, truth, noise);
     const std::vector<sim::ModelSimulatedRun> runs =
         sim::SimulateRuns(*model, truth, scenario.trajectories, scenario.options);
     {

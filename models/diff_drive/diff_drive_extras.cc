@@ -38,7 +38,9 @@ void DiffDriveParameters(const CalibratedRobot& c, const std::string& distro,
   out->parameters[k_separation] = Ros2AsWritten(p[k_separation]);
 }
 
-std::vector<sim::TrajectorySpec> DiffDriveScenario(const Robot& /*robot*/, int repetitions) {
+std::vector<sim::TrajectorySpec> DiffDriveScenario(const Robot& /*robot*/,
+                                                   const std::vector<double>& /*truth*/,
+                                                   int repetitions) {
   sim::DiffDriveTrajectoryOptions shapes;
   shapes.circle_laps = 1.25;  // open arcs: the scale (tools/sim/model_scenarios.h)
   return sim::DiffDriveCalibrationTrajectories(repetitions, shapes);

@@ -248,7 +248,9 @@ void OmniWheelParameters(const CalibratedRobot& c, OmniWheelReplay replay, Contr
   OmniWheelKinematics(c, order, offset, MeanValue(distances), MeanValue(radii), sense, replay, out);
 }
 
-std::vector<sim::TrajectorySpec> OmniScenario(const Robot& /*robot*/, int repetitions) {
+std::vector<sim::TrajectorySpec> OmniScenario(const Robot& /*robot*/,
+                                              const std::vector<double>& /*truth*/,
+                                              int repetitions) {
   sim::OmniTrajectoryOptions shapes;
   shapes.spin_angle_rad = 2.0 * M_PI;
   return sim::OmniFlowerTrajectories(repetitions, shapes);

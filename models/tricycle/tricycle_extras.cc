@@ -3,6 +3,9 @@
 #include <cmath>
 #include <cstdio>
 #include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "io/ros2_parameter_yaml.h"
 #include "io/yaml_scalar.h"
@@ -64,12 +67,31 @@ void TricycleParameters(const CalibratedRobot& c, const std::string&, Controller
   }
 }
 
-std::vector<sim::TrajectorySpec> TricycleScenario(const Robot& robot, int repetitions) {
+// Circles are commanded by steering angle through the nominal wheelbase (the robot's belief);
+// how far the wheel can steer is the true robot's: its column, read through the true gain, must
+// stay readable (sim::TricycleReadableSteeringDeg), so circles beyond that are left out and the
+// squares turn on arcs at that steering instead of in place.
+std::vector<sim::TrajectorySpec> TricycleScenario(const Robot& robot,
+                                                  const std::vector<double>& truth,
+                                                  int repetitions) {
   sim::TricycleTrajectoryOptions shapes;
-  // Circles are commanded by steering angle through the nominal wheelbase (the robot's belief).
   for (int k = 0; k < robot.NumParameters(); ++k) {
     if (robot.parameters[k].group == "wheelbase_m") shapes.wheelbase_m = robot.nominal[k];
   }
+  const std::optional<int> k_gain = ParameterIndex(robot, "steering_gain");
+  const std::optional<int> k_offset = ParameterIndex(robot, "steering_offset");
+  shapes.max_steering_deg = sim::TricycleReadableSteeringDeg(k_gain ? truth[*k_gain] : 1.0,
+                                                             k_offset ? truth[*k_offset] : 0.0);
+  std::vector<double> circles;
+  for (double deg : shapes.steering_deg) {
+    if (deg <= shapes.max_steering_deg) circles.push_back(deg);
+  }
+  if (circles.empty()) {
+    throw std::invalid_argument("the true steering gain reads at most " +
+                                std::to_string(shapes.max_steering_deg) +
+                                " deg of wheel steering: too little to drive the calibration circles");
+  }
+  shapes.steering_deg = circles;
   shapes.repetitions = repetitions;
   return sim::TricycleTrajectories(shapes);
 }

@@ -1,5 +1,6 @@
 #include "models/tricycle/tricycle_trajectories.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
@@ -15,12 +16,19 @@ TwistSegment Circle(const TricycleTrajectoryOptions& o, double steering_rad) {
   return {Twist{o.speed_m_s, 0.0, omega}, 2.0 * M_PI * o.circle_turns / std::abs(omega)};
 }
 
-// Four straight sides, each followed by an in-place quarter turn (sign +1 = ccw), and the first
-// side again.
+// A quarter turn (sign +1 = ccw): in place, or an arc at the largest steering the robot reads.
+TwistSegment Corner(const TricycleTrajectoryOptions& o, double sign) {
+  if (o.max_steering_deg >= 90.0) {
+    return {Twist{0.0, 0.0, sign * o.turn_rate_rad_s}, 0.5 * M_PI / o.turn_rate_rad_s};
+  }
+  const TwistSegment arc = Circle(o, sign * o.max_steering_deg * M_PI / 180.0);
+  return {arc.twist, 0.5 * M_PI / std::abs(arc.twist.omega_rad_s)};
+}
+
+// Four straight sides, each followed by a quarter turn (sign +1 = ccw), and the first side again.
 std::vector<TwistSegment> Square(const TricycleTrajectoryOptions& o, double sign) {
   const TwistSegment side{Twist{o.speed_m_s, 0.0, 0.0}, o.square_side_m / o.speed_m_s};
-  const TwistSegment corner{Twist{0.0, 0.0, sign * o.turn_rate_rad_s},
-                            0.5 * M_PI / o.turn_rate_rad_s};
+  const TwistSegment corner = Corner(o, sign);
   std::vector<TwistSegment> out;
   for (int i = 0; i < 4; ++i) {
     out.push_back(side);
@@ -39,8 +47,12 @@ std::string TricycleTrajectoryOptions::Check() const {
   if (!(square_side_m > 0.0)) return "square_side_m must be positive";
   if (!(turn_rate_rad_s > 0.0)) return "turn_rate_rad_s must be positive";
   if (repetitions < 1) return "repetitions must be at least 1";
+  if (!(max_steering_deg > 0.0 && max_steering_deg <= 90.0)) {
+    return "max_steering_deg must lie in (0, 90]";
+  }
   for (double deg : steering_deg) {
     if (!(deg > 0.0 && deg < 90.0)) return "circle steering angles must lie in (0, 90) deg";
+    if (deg > max_steering_deg) return "a circle steers beyond max_steering_deg";
   }
   return "";
 }
@@ -66,6 +78,13 @@ std::vector<TrajectorySpec> TricycleTrajectories(const TricycleTrajectoryOptions
     }
   }
   return out;
+}
+
+double TricycleReadableSteeringDeg(double steering_gain, double steering_offset_rad) {
+  constexpr double kReadableColumnDeg = 160.0;  // 180 less a margin for the reading's noise
+  const double readable =
+      std::abs(steering_gain) * kReadableColumnDeg - std::abs(steering_offset_rad) * 180.0 / M_PI;
+  return std::min(90.0, readable);
 }
 
 }  // namespace fitcal::sim

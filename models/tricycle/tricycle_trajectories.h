@@ -9,7 +9,8 @@
 //                       radius L / tan(phi') (tricycle_kinematics.h, T2) for 2 pi turns / |omega|;
 //   square_<dir>        a square of side square_side_m driven forward at v, with in-place turns
 //                       of 90 deg at the corners (steering at +-90 deg, vx = 0, omega = +-rate),
-//                       counter-clockwise and clockwise, then its first side once more.
+//                       counter-clockwise and clockwise, then its first side once more; with
+//                       max_steering_deg below 90 the corners are quarter arcs at that steering.
 // Circles at several steering angles both ways separate the wheelbase from the steering offset
 // (one angle in one direction sees only sin(phi + phi_0) / L); straight legs and in-place turns
 // separate the wheel radius (distance) from the wheelbase (turn per distance).
@@ -35,6 +36,10 @@ struct TricycleTrajectoryOptions {
   double circle_turns = 1.25;  // not a whole number: see "open on purpose" above
   double square_side_m = 1.0;
   double turn_rate_rad_s = 0.4;  // in-place turns at the square's corners
+  // The largest steering angle the robot can drive and read (0, 90] deg. Below 90 the square's
+  // corners are quarter arcs at this steering instead of turns in place (a column read through a
+  // gain below 1 cannot report 90 deg: TricycleReadableSteeringDeg).
+  double max_steering_deg = 90.0;
   int repetitions = 1;           // each trajectory this many times (repetition 1..n)
 
   // Empty when valid, else what is wrong.
@@ -45,5 +50,10 @@ struct TricycleTrajectoryOptions {
 // ccw and the cw square), then repetition 2, ... up to `repetitions`. Throws std::invalid_argument
 // for invalid options.
 std::vector<TrajectorySpec> TricycleTrajectories(const TricycleTrajectoryOptions& options = {});
+
+// The largest wheel steering angle (deg, at most 90) whose column reading an absolute encoder can
+// still hold: the column reads (phi - offset) / gain within (-180, 180] deg, kept 20 deg inside
+// that for the reading's noise. 90 for a gain of 0.56 or more at zero offset.
+double TricycleReadableSteeringDeg(double steering_gain, double steering_offset_rad);
 
 }  // namespace fitcal::sim

@@ -28,7 +28,8 @@ std::string ScenarioModelNames() {
   return ModelNamesWith([](const ModelExtras& e) { return bool(e.scenario.trajectories); });
 }
 
-ModelScenario MakeModelScenario(const RobotModelInterface& model, const ScenarioNoise& noise) {
+ModelScenario MakeModelScenario(const RobotModelInterface& model, const std::vector<double>& truth,
+                                const ScenarioNoise& noise) {
   const Robot& robot = model.robot();
   if (noise.repetitions < 1) throw std::invalid_argument("--repetitions must be at least 1");
   const SimulationScenario& scenario = ExtrasOf(robot.model).scenario;
@@ -40,7 +41,7 @@ ModelScenario MakeModelScenario(const RobotModelInterface& model, const Scenario
         " without --model)");
   }
   ModelScenario out;
-  out.trajectories = scenario.trajectories(robot, noise.repetitions);
+  out.trajectories = scenario.trajectories(robot, truth, noise.repetitions);
   SimulationOptions& o = out.options;
   o.encoder_period_s = noise.encoder_period_s;
   o.ground_truth_period_s = noise.ground_truth_period_s;

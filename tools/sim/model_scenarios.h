@@ -50,7 +50,8 @@ struct ModelScenario {
 
 // The scenario for the model's robot; std::invalid_argument naming the models that have one when
 // the robot's model has none (omni3 drives the flower: flower_scenario.h).
-ModelScenario MakeModelScenario(const RobotModelInterface& model, const ScenarioNoise& noise);
+ModelScenario MakeModelScenario(const RobotModelInterface& model, const std::vector<double>& truth,
+                                const ScenarioNoise& noise);
 
 // The default true robot of the header: nominal moved a fraction of the way to a bound.
 std::vector<double> DefaultTrueParameters(const Robot& robot);
