@@ -53,6 +53,12 @@ constexpr const char* kTricycleGuess =
     "steering_offset_deg: 0.0\nsteering_gain: 1.0\n"
     "bounds: {radius_m: [0.025, 0.045], wheelbase_m: [0.12, 0.25], "
     "steering_offset_deg: [-10.0, 10.0]}\n";
+// The same maker's guess with the steering gain 5x the true 0.4 below (its default box [0.2, 20]).
+constexpr const char* kTricycleGuessGain2 =
+    "model: tricycle\nname: t\ntraction_wheel: {radius_m: 0.0325}\nwheelbase_m: 0.15\n"
+    "steering_offset_deg: 0.0\nsteering_gain: 2.0\n"
+    "bounds: {radius_m: [0.025, 0.045], wheelbase_m: [0.12, 0.25], "
+    "steering_offset_deg: [-10.0, 10.0]}\n";
 
 constexpr const char* kMecanumGuess =
     "model: omni\nname: m\nwheels:\n"
@@ -69,9 +75,9 @@ constexpr const char* kMecanumGuess =
 
 // Bounds are the user's (documented keys), wide enough for a 20 % error; the steering gain's
 // are the default (a factor of 10 either way of the nominal). The tricycle's true gain is the
-// issue's 0.4, and 2.5 and 2 the other way. A gain of 0.4 reads a wheel at 90 deg as 225 deg at
-// the column, past what an absolute encoder holds: simulate drives that robot's squares on arcs
-// at the largest readable steering (61 deg here) instead of turning in place.
+// issue's 0.4 guessed 5x (2.0), and 2.5 and 2 guessed 1. A gain of 0.4 reads a wheel at 90 deg
+// as 225 deg at the column, past what an absolute encoder holds: simulate drives that robot's
+// squares on arcs at the largest readable steering (61 deg here) instead of turning in place.
 const RecordedCase kCases[] = {
     {"diff_drive_10pct", "diff_drive", kDiffDriveGuess,
      "model: diff_drive\nname: d\nwheels:\n  - {name: right, radius_m: 0.046}\n"
@@ -90,7 +96,7 @@ const RecordedCase kCases[] = {
      "bounds: {radius_m: [0.025, 0.045], wheelbase_m: [0.12, 0.25], "
      "steering_offset_deg: [-10.0, 10.0]}\n",
      {"steering"}, "", ""},
-    {"tricycle_gain_0_4", "tricycle", kTricycleGuess,
+    {"tricycle_gain_0_4_guessed_5x", "tricycle", kTricycleGuessGain2,
      "model: tricycle\nname: t\ntraction_wheel: {radius_m: 0.0357}\nwheelbase_m: 0.18\n"
      "steering_offset_deg: 3.0\nsteering_gain: 0.4\n"
      "bounds: {radius_m: [0.025, 0.045], wheelbase_m: [0.12, 0.25], "
