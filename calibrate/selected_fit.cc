@@ -81,7 +81,7 @@ SelectedFit DescribeSelected(const Robot& robot,
     out.held = fit.held;
     out.not_determined = NotDeterminedParameters(fit);
   } else if (selected.name == method + " without holds") {
-    out.at_bound = fit.at_bound;
+    out.at_bound = ParametersAtBound(robot, selected.parameters);  // its own point, not the held fit's
     out.held = fit.held;  // the parameters' holds (gauge, --hold) stay; the directions' go
   }
   return out;

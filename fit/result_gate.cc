@@ -77,8 +77,8 @@ std::vector<std::string> GateLines(const std::vector<CalibrationCandidate>& cand
   for (std::size_t i = 0; i < candidates.size(); ++i) {
     char line[512];
     if (!candidates[i].usable) {
-      std::snprintf(line, sizeof line, "  %-*s %10s   (not usable: did not converge)", width,
-                    candidates[i].name.c_str(), "-");
+      std::snprintf(line, sizeof line, "  %-*s %10s   (not usable: %s)", width,
+                    candidates[i].name.c_str(), "-", candidates[i].not_usable_because.c_str());
     } else {
       const double change = nominal > 0.0 ? 100.0 * (decision.cf[i] - nominal) / nominal : 0.0;
       std::snprintf(line, sizeof line, "  %-*s %10.4f %+8.1f%%%s", width,

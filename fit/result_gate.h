@@ -24,6 +24,8 @@ struct CalibrationCandidate {
   // The candidate's own 1-sigma per parameter, when it carries one (a closed form's,
   // ClosedFormCalibration::sigma); empty otherwise.
   std::vector<double> sigma = {};
+  // Why an unusable candidate does not compete, as the gate's table says it.
+  std::string not_usable_because = "did not converge";
 };
 
 // The CF (Eq. 14, mean over `runs`) of a candidate that carries effects: their replay needs each

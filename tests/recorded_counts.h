@@ -38,6 +38,7 @@ inline std::vector<std::string> CsvFields(const std::string& row) {
 // Three glitches of one running total (`counts`: ticks from the start) at rows inside forward
 // motion (every one of the 6 intervals either side counts > 5 ticks), spread over the run: a
 // torn 32-bit read, a stale read then 400 ticks short, and a jump back of 1000 ticks that stays.
+// A run whose wheel drives forward for fewer than 100 such rows gets none (glitches->lines empty).
 inline void AddThreeGlitches(std::vector<double>* counts, Glitches* glitches) {
   const std::vector<double> total = *counts;
   std::vector<std::size_t> moving;
@@ -46,8 +47,7 @@ inline void AddThreeGlitches(std::vector<double>* counts, Glitches* glitches) {
     for (std::size_t i = k - 6; i <= k + 6; ++i) ok = ok && total[i + 1] - total[i] > 5.0;
     if (ok) moving.push_back(k);
   }
-  EXPECT_GT(moving.size(), 100u);
-  if (moving.size() < 3) return;
+  if (moving.size() <= 100u) return;
   const std::size_t a = moving[moving.size() / 5], b = moving[moving.size() / 2],
                     c = moving[4 * moving.size() / 5];
   (*counts)[a] = 0x5A5A5A5A - kCounterStart;  // a torn read of the 32-bit counter
