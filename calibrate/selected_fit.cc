@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "fit/correlation.h"
+#include "models/mounted_model.h"
 #include "validation/propagated_uncertainty.h"
 
 namespace fitcal {
@@ -61,7 +62,8 @@ SelectedFit DescribeSelected(const Robot& robot,
                   method_objective,
                   fit.termination,
                   {},
-                  {}};
+                  {},
+                  ""};
   if (const EffectFitResult* track_fit = TrackFitOf(track_fits, selected_index)) {
     out.has_covariance = track_fit->has_covariance;
     out.sigma = track_fit->sigma;
@@ -83,6 +85,13 @@ SelectedFit DescribeSelected(const Robot& robot,
   } else if (selected.name == method + " without holds") {
     out.at_bound = ParametersAtBound(robot, selected.parameters);  // its own point, not the held fit's
     out.held = fit.held;  // the parameters' holds (gauge, --hold) stay; the directions' go
+  } else if (selected_index > 0) {
+    // A closed form measures the base; the pose source's frame is the nominal it was handed
+    // (MountedModel::ClosedForms), so it is held, not given a sigma the runs never measured
+    // (propagated through the final poses it came out 1.9e3 deg for an ASOC's yaw).
+    for (int k : MountParameterIndices(robot)) out.held[k] = true;
+    out.held_reason =
+        selected.name + " measures the base only: kept at the robot YAML's ground_truth_frame";
   }
   return out;
 }

@@ -26,6 +26,8 @@ struct SelectedFit {
   // Per parameter: not determined by the training runs, its sigma the bounds' along a held
   // direction (NotDeterminedParameters, fit/model_fit.h).
   std::vector<bool> not_determined;
+  // Why parameters beyond the robot's own holds are held when no fit chose them ("" for a fit).
+  std::string held_reason;
 };
 
 // candidates[selected_index] described by the fit that made it: `fit` (the method's, minimising

@@ -214,8 +214,9 @@ std::string MountedModel::RobotYaml(const std::vector<double>& p,
   const int n = MountIndex();
   std::string text =
       inner_->RobotYaml(std::vector<double>(p.begin(), p.begin() + n), effects, "");
-  // The frame's bounds join the inner model's `bounds:` block (every model writes one, as a
-  // top-level block map whose entries are indented two spaces).
+  // The frame's bounds join the inner model's `bounds:` block (a top-level block map whose
+  // entries are indented two spaces), or make one: ASOC writes its bounds only when its robot
+  // YAML declared them.
   YAML::Emitter bounds;
   bounds.SetDoublePrecision(10);
   bounds << YAML::BeginMap;
@@ -229,11 +230,13 @@ std::string MountedModel::RobotYaml(const std::vector<double>& p,
   for (std::string line; std::getline(lines, line);) indented += "  " + line + "\n";
   const std::size_t block = text.find("\nbounds:\n");
   if (block == std::string::npos) {
-    throw std::logic_error(robot_.model + " RobotYaml wrote no bounds: block");
+    if (!text.empty() && text.back() != '\n') text += "\n";
+    text += "bounds:\n" + indented;
+  } else {
+    std::size_t end = block + 9;
+    while (end < text.size() && text.compare(end, 2, "  ") == 0) end = text.find('\n', end) + 1;
+    text.insert(end, indented);
   }
-  std::size_t end = block + 9;
-  while (end < text.size() && text.compare(end, 2, "  ") == 0) end = text.find('\n', end) + 1;
-  text.insert(end, indented);
   YAML::Emitter frame;
   frame.SetDoublePrecision(10);
   frame << YAML::BeginMap << YAML::Key << kFrameKey << YAML::Value << YAML::Flow << YAML::BeginMap
@@ -276,19 +279,27 @@ std::string Enumerate(const std::vector<std::string>& names) {
 
 }  // namespace
 
-std::string GroundTruthFrameLine(const Robot& robot, const std::vector<bool>& held) {
+std::vector<int> MountParameterIndices(const Robot& robot) {
   const std::optional<int> first = ParameterIndex(robot, "ground_truth_x");
-  if (!first) return "";
+  if (!first) return {};
+  return {*first, *first + 1, *first + 2};
+}
+
+std::string GroundTruthFrameLine(const Robot& robot, const std::vector<bool>& held,
+                                 const std::string& held_reason) {
+  const std::vector<int> mount = MountParameterIndices(robot);
+  if (mount.empty()) return "";
   const char* const names[] = {"x", "y", "yaw"};
   std::vector<std::string> determined, fixed;
   std::string reason = "--hold, or a direction the runs do not determine";
   for (int i = 0; i < MountedModel::kNumMountParameters; ++i) {
-    const int k = *first + i;
+    const int k = mount[i];
     (held[k] ? fixed : determined).push_back(names[i]);
     for (const HeldParameter& h : robot.held) {
       if (h.index == k) reason = h.reason;
     }
   }
+  if (!held_reason.empty()) reason = held_reason;
   std::string line = "ground_truth_frame: ";
   if (!determined.empty()) line += Enumerate(determined) + " determined by the runs";
   if (!fixed.empty()) {
@@ -327,10 +338,12 @@ RobotModelPtr ApplyGroundTruthFrame(YAML::Node root, const std::string& path,
                            std::string("ground_truth_frame lies outside bounds.") + kBoundsKeys[i]);
     }
   }
-  // The model's reader knows its own schema only (it rejects keys it did not read).
+  // The model's reader knows its own schema only (it rejects keys it did not read); a block that
+  // held only the frame's bounds goes with them (ASOC reads a `bounds:` as all of its own).
   for (const char* key : kBoundsKeys) {
     if (bounds_node && bounds_node.IsMap()) bounds_node.remove(key);
   }
+  if (bounds_node && bounds_node.IsMap() && bounds_node.size() == 0) root.remove("bounds");
   root.remove(kFrameKey);
   RobotModelPtr inner = read(root);
   for (const effects::EffectValue& e : inner->robot().effects) {

@@ -103,9 +103,15 @@ class MountedModel final : public RobotModelInterface {
 // parameters are the first ones of the mounted model's).
 const RobotModelInterface& BaseModel(const RobotModelInterface& model);
 
+// The indices of the frame's three numbers (ground_truth_x, _y, _yaw); empty for a robot
+// without the frame.
+std::vector<int> MountParameterIndices(const Robot& robot);
+
 // One line saying which of the frame's numbers the fit determined and which it held (held: per
-// parameter, the fit's holds), with the model's reason; "" for a robot without the frame.
-std::string GroundTruthFrameLine(const Robot& robot, const std::vector<bool>& held);
+// parameter, the fit's holds), with `held_reason` (a closed form's), else the model's reason
+// (--hold or a held direction without one); "" for a robot without the frame.
+std::string GroundTruthFrameLine(const Robot& robot, const std::vector<bool>& held,
+                                 const std::string& held_reason = "");
 
 // The robot YAML's `ground_truth_frame:` (and its bounds under `bounds:`), read from `root` and
 // removed from it, so that the model's own reader sees its schema only. Returns `inner` itself

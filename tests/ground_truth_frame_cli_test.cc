@@ -6,6 +6,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <set>
 #include <string>
 
 #include "models/diff_drive/diff_drive_model.h"
@@ -117,6 +118,42 @@ TEST(MountedFit, AnOmniRobotsXAndYAreHeldWithTheReason) {
   const YAML::Node frame = YAML::LoadFile(cal)["ground_truth_frame"];
   EXPECT_EQ(frame["x_m"].as<double>(), 1.5);
   EXPECT_EQ(frame["y_m"].as<double>(), -0.2);
+}
+
+// A closed form measures the base only (MountedModel::ClosedForms hands it the nominal frame): an
+// ASOC robot whose frame is declared (here at its true place, the origin), calibrated by its
+// closed form (Doebbler's, selected by the gate on these runs), is written with the frame held
+// and the reason, not with a frame "determined by the runs" and a yaw sigma of 1.9e3 deg
+// propagated through final poses that never measured it; ASOC writes no `bounds:` of its own, and
+// the frame's bounds make one that reads back (before: exit 1, "asoc RobotYaml wrote no bounds:
+// block").
+TEST(MountedFit, AClosedFormKeepsTheFrameItWasGivenAndSaysSo) {
+  TempDir dir;
+  const std::string data = dir.Path("data"), cal = dir.Path("calibrated.yaml");
+  auto r = RunFitcal(dir, "asoc-simulate --out " + data + " --seed 3");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string robot = data + "/robot.yaml";
+  WriteFileBytes(robot, testing::ReadFileBytes(robot) +
+                            "ground_truth_frame: {x_m: 0.0, y_m: 0.0, yaw_deg: 0.0}\n");
+  r = RunFitcal(dir, "fit --logs " + data + " --out " + cal);
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  const std::size_t selected = r.out.find("<- selected");
+  ASSERT_NE(selected, std::string::npos) << r.out;
+  const std::size_t line = r.out.rfind('\n', selected) + 1;
+  EXPECT_EQ(r.out.compare(line, 16, "  asoc-geometric"), 0) << r.out.substr(line, selected - line);
+  EXPECT_TRUE(Has(r.out, "ground_truth_frame: x, y and yaw held (asoc-geometric measures the "
+                         "base only: kept at the robot YAML's ground_truth_frame)"))
+      << r.out;
+  const YAML::Node written = YAML::LoadFile(cal);
+  EXPECT_EQ(written["ground_truth_frame"]["yaw_deg"].as<double>(), 0.0);
+  std::set<std::string> held;
+  for (const YAML::Node& name : written["calibration"]["held"]) held.insert(name.as<std::string>());
+  for (const char* name : {"ground_truth_x", "ground_truth_y", "ground_truth_yaw"}) {
+    EXPECT_EQ(held.count(name), 1u) << name;
+  }
+  r = RunFitcal(dir, "report --logs " + data + " --calibration " + cal + " --out " +
+                         dir.Path("report"));
+  EXPECT_EQ(r.exit_code, 0) << r.err;
 }
 
 }  // namespace

@@ -71,7 +71,8 @@ void PrintParameters(const Robot& robot, const std::vector<double>& p, const Sel
   for (const HeldParameter& h : robot.held) {
     std::printf("  held: %s (%s)\n", robot.parameters[h.index].name.c_str(), h.reason.c_str());
   }
-  if (const std::string frame = GroundTruthFrameLine(robot, fit.held); !frame.empty()) {
+  if (const std::string frame = GroundTruthFrameLine(robot, fit.held, fit.held_reason);
+      !frame.empty()) {
     std::printf("  %s\n", frame.c_str());
   }
 }
