@@ -6,10 +6,11 @@
 
 namespace fitcal {
 
-ScoreOnRuns EverydayDrivingScore(const RobotModelInterface& model, int threads) {
-  return [&model, threads](const std::vector<double>& p, const std::vector<AlignedRun>& runs) {
-    return EvaluateEverydayDriving(model, p, {}, runs, TracksOf(runs), EverydayDriftLengths(),
-                                   threads);
+ScoreOnRuns EverydayDrivingScore(const RobotModelInterface& model, int threads,
+                                 std::vector<double> lengths_m) {
+  return [&model, threads, lengths_m = std::move(lengths_m)](const std::vector<double>& p,
+                                                             const std::vector<AlignedRun>& runs) {
+    return EvaluateEverydayDriving(model, p, {}, runs, TracksOf(runs), lengths_m, threads);
   };
 }
 
@@ -27,6 +28,7 @@ std::optional<std::vector<double>> FoldFits::Fit(const FitMethod& method,
   s.residuals_auto = false;
   s.track = nullptr;
   s.start = start;
+  s.judgement_fit = true;
   if (s.estimate_weights && seed_levels.estimated) {
     s.track_weights = WeightsFromNoiseLevels(seed_levels).track;
   }
@@ -89,7 +91,7 @@ std::vector<std::string> ChooseResidualsByTransfer(const FitMethod& method, int 
     s.residuals = kind;
     return fold_fits->Fit(method, model, s, training);
   };
-  const ScoreOnRuns score = EverydayDrivingScore(model, threads);
+  const ScoreOnRuns score = EverydayDrivingScore(model, threads, {kTransferDriftLength_m});
   const ResidualKindJudgement judgement = JudgeResidualKindsByTransfer(
       ResidualKind::kTrack, ResidualKind::kFinalPose, split, fit_on, score);
   if (judgement.chosen != settings->residuals) {
@@ -117,7 +119,7 @@ std::vector<std::string> ChooseTrackObjectiveByTransfer(
     s.track_heading = objective.heading;
     return fold_fits->Fit(method, model, s, training);
   };
-  const ScoreOnRuns score = EverydayDrivingScore(model, threads);
+  const ScoreOnRuns score = EverydayDrivingScore(model, threads, {kTransferDriftLength_m});
   const TrackObjectiveJudgement judgement = JudgeTrackObjectivesByTransfer(
       TrackObjectiveCandidates(*settings), split, fit_on, score);
   *note = TrackObjectiveChoiceText(judgement);
@@ -149,7 +151,7 @@ HalvesJudgement JudgeMethodOnHeldOutHalves(const FitMethod& method, int threads,
     if (!(fit.usable || fit.stopped_early)) return std::nullopt;
     return fit.parameters;
   };
-  const ScoreOnRuns on_runs = EverydayDrivingScore(model, threads);
+  const ScoreOnRuns on_runs = EverydayDrivingScore(model, threads, EverydayDriftLengths());
   const MetricsOnFold score = [&](const std::vector<double>& p, const HalvesFold& fold) {
     return on_runs(p, fold.split.validation);
   };

@@ -18,8 +18,10 @@
 namespace fitcal {
 
 // How the choices by transfer and the held-out halves score a fit: the everyday-driving
-// measures (Eq. 14 CF, drift per length, ATE) of parameters `p` on runs, each against its track.
-ScoreOnRuns EverydayDrivingScore(const RobotModelInterface& model, int threads);
+// measures (Eq. 14 CF, drift per each of `lengths_m`, ATE) of parameters `p` on runs, each
+// against its track. The choices by transfer read the drift per kTransferDriftLength_m only.
+ScoreOnRuns EverydayDrivingScore(const RobotModelInterface& model, int threads,
+                                 std::vector<double> lengths_m);
 
 // The fits of the folds the choices by transfer make (residual kind, then track objective), each
 // made once: the track with the default objective on a fold is a candidate of both.

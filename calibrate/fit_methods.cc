@@ -80,6 +80,8 @@ ModelFitMethodOutcome RunModelCeres(CeresTrustRegion trust_region,
   options.estimate_weights = settings.estimate_weights;
   options.track_weights = settings.track_weights;
   options.tying = &settings.tying;
+  options.ceres.compute_covariance = !settings.judgement_fit;
+  options.held_fit_from_projection = settings.judgement_fit;
   ModelFitMethodOutcome out;
   // From the guess (the nominal), with FitModel's global start; a fit warm-started from a fitted
   // point (a fold's, from the fit of all the training runs) starts from no guess and keeps it.
@@ -91,6 +93,7 @@ ModelFitMethodOutcome RunModelCeres(CeresTrustRegion trust_region,
     out.objective +=
         ObjectiveText(options.ceres.objective, options.ceres.loss, options.ceres.loss_scale);
   }
+  if (settings.judgement_fit) return out;
   // Ceres reports no per-evaluation CF: the trace holds the start and the end.
   out.trace.push_back(
       {1, EvaluateFinalPoseErrors(model, model.robot().nominal, training, settings.threads).cf,

@@ -55,6 +55,11 @@ struct FitMethodSettings {
   // Ceres: where the fit starts (empty: the robot's nominal), e.g. a fit of more runs whose
   // neighbourhood a fold's fit will end in. NLopt methods search their box and ignore it.
   std::vector<double> start;
+  // Ceres: a fold's fit for a choice by transfer (calibrate/choice_by_transfer.h), of which only
+  // the parameters are read: no covariance and no CF trace, and the fit with held directions
+  // starts from the fit without them moved onto the hold (ModelFitOptions::
+  // held_fit_from_projection).
+  bool judgement_fit = false;
 };
 
 // A method's fit: the generic Ceres fit's result shape (NLopt methods leave the covariance out and

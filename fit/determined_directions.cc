@@ -69,15 +69,6 @@ std::vector<RunJacobian> EvaluateRuns(const std::vector<AlignedRun>& training,
   return out;
 }
 
-// The box's standard deviation per parameter (uniform prior), 0 for held parameters.
-Eigen::VectorXd PriorSigma(const Robot& robot) {
-  Eigen::VectorXd sigma = Eigen::VectorXd::Zero(robot.NumParameters());
-  for (int k = 0; k < robot.NumParameters(); ++k) {
-    if (!robot.IsHeld(k)) sigma[k] = robot.bounds[k].Width() / std::sqrt(12.0);
-  }
-  return sigma;
-}
-
 // "R_fl +29 mm with R_rl -28 mm, delta_fl +3.1 deg": the one-sigma step's large components.
 std::string DescribeStep(const Robot& robot, const Eigen::VectorXd& prior_units,
                          const Eigen::VectorXd& step) {
@@ -202,6 +193,14 @@ void MeasureConditioning(const Robot& robot, const std::vector<double>& p,
 }
 
 }  // namespace
+
+Eigen::VectorXd PriorSigma(const Robot& robot) {
+  Eigen::VectorXd sigma = Eigen::VectorXd::Zero(robot.NumParameters());
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    if (!robot.IsHeld(k)) sigma[k] = robot.bounds[k].Width() / std::sqrt(12.0);
+  }
+  return sigma;
+}
 
 DirectionAnalysis AnalyseDeterminedDirections(const std::vector<AlignedRun>& training,
                                               const RobotModelInterface& model,

@@ -63,6 +63,10 @@ struct DirectionAnalysis {
 inline constexpr double kMaxConditionNumber = 1000.0;
 inline constexpr double kMaxAbsCorrelation = 0.99;
 
+// The box's standard deviation per parameter (the uniform prior, width / sqrt(12)), 0 for held
+// parameters: the unit of UndeterminedDirection::prior_units.
+Eigen::VectorXd PriorSigma(const Robot& robot);
+
 // The analysis at `p` over the training runs (final poses, or `segments` when given: one window
 // list per run). `trajectory_of_run` names each run's trajectory for the description (may be
 // empty).

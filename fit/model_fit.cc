@@ -719,6 +719,29 @@ double HoldWeight(const DirectionAnalysis& analysis) {
   return w > 0.0 && std::isfinite(w) ? w : 1.0;
 }
 
+// ModelFitOptions::held_fit_from_projection: `p` with its components along the held directions
+// set to the nominal's, where HoldDirectionsCost is zero. The directions are orthonormal in the
+// prior's units (fit/determined_directions.h), so q - sum_j u_j (u_j . q) with
+// q = (p - nominal) / prior sigma; clamped to the box, which the projection may leave.
+std::vector<double> ProjectOntoHold(const Robot& robot,
+                                    const std::vector<UndeterminedDirection>& held,
+                                    const std::vector<double>& p) {
+  const Eigen::VectorXd prior_sigma = PriorSigma(robot);
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(robot.NumParameters());
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    if (prior_sigma[k] > 0.0) q[k] = (p[k] - robot.nominal[k]) / prior_sigma[k];
+  }
+  for (const UndeterminedDirection& d : held) q -= d.prior_units * d.prior_units.dot(q);
+  std::vector<double> out = p;
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    if (prior_sigma[k] > 0.0) {
+      out[k] = std::clamp(robot.nominal[k] + q[k] * prior_sigma[k], robot.bounds[k].lo,
+                          robot.bounds[k].hi);
+    }
+  }
+  return out;
+}
+
 // ModelFitOptions::estimate_weights (fit/noise_levels.h): fit, estimate the noise levels at the
 // solution, reweight, refit from there, until two estimates agree. The fit returned is the last
 // one, made with weights that agree with the estimate at its solution.
@@ -816,7 +839,11 @@ ModelFitResult FitModelFrom(const std::vector<AlignedRun>& training,
     if (analysis.ok && !analysis.undetermined.empty()) {
       holds.directions = analysis.undetermined;
       holds.weight = HoldWeight(analysis);
-      ModelFitResult held = SolveFrom(training, model, start, options, holds);
+      const bool project = options.held_fit_from_projection && result.usable;
+      ModelFitResult held = SolveFrom(
+          training, model,
+          project ? ProjectOntoHold(model.robot(), holds.directions, result.parameters) : start,
+          options, holds);
       held.held_directions = analysis.undetermined;
       held.unconstrained_parameters = result.parameters;
       held.unconstrained_usable = result.usable;

@@ -124,6 +124,15 @@ struct ModelFitOptions {
   // after the fit, the information the runs carry along every direction is weighed against the
   // bounds; when some direction stays undetermined the fit is repeated with it held.
   bool hold_undetermined = true;
+  // Where that repeated fit starts: false, from the fit's own start (as every calibration is
+  // written); true, from the fit without the hold moved onto it (its components along the held
+  // directions set to the nominal's, ProjectOntoHold). The fit without the hold has already found
+  // the determined directions, so the held fit ends in a few steps there; from the start, the
+  // stiff hold made Levenberg-Marquardt crawl (the OptiOdom omni3 folds of the choice by
+  // transfer: 95-197 iterations, 4-16 active-set rounds, against 15-20 from the projection) and on
+  // the tricycle's final-pose fold stop on a bound at cost 103 where the projection's start finds
+  // 0.058 (docs/speed.md). The fits of the choices by transfer use it.
+  bool held_fit_from_projection = false;
   // When set and not empty: groups of parameters sharing one value and parameters held at the
   // nominal (fit/parameter_tying.h). The fit runs on the tied model and its result is mapped back
   // (ExpandTiedResult); every residual kind above works with it.

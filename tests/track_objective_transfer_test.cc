@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <filesystem>
 #include <map>
@@ -14,8 +15,11 @@
 #include <string>
 #include <vector>
 
+#include "calibrate/choice_by_transfer.h"
+#include "calibrate/track_residuals.h"
 #include "models/diff_drive/diff_drive_trajectories.h"
 #include "models/model_registry.h"
+#include "odometry/text_format.h"
 #include "tests/model_support.h"
 #include "tests/test_files.h"
 #include "tests/test_paths.h"
@@ -150,8 +154,8 @@ TEST(TrackObjectiveTransfer, HeldOutFreeDrivingIsTheOneFold) {
 }
 
 // A simulated differential drive (every length 2 % large, circles and squares, the ground truth
-// with white noise) through the command line.
-std::string SimulatedLoops(const testing::TempDir& tmp) {
+// with white noise): the runs, and through the command line their data set.
+std::vector<sim::ModelSimulatedRun> SimulatedLoopRuns() {
   const RobotModelPtr model = testing::ExampleModel("diff_drive");
   sim::SimulationOptions o;
   o.wheel_rate_sigma_rad_s = 0.01;
@@ -172,9 +176,86 @@ std::string SimulatedLoops(const testing::TempDir& tmp) {
       poses[i].theta += 0.01 * normal(rng);
     }
   }
+  return runs;
+}
+
+std::string SimulatedLoops(const testing::TempDir& tmp) {
+  const std::vector<sim::ModelSimulatedRun> runs = SimulatedLoopRuns();
   const std::string dir = tmp.Path("loops");
   sim::WriteSimulatedDataset(dir, FindModel("diff_drive")->example_yaml, runs);
   return dir;
+}
+
+// The folds of `fit --residuals auto` are judgement fits (FitMethodSettings::judgement_fit: no
+// covariance, the held fit started from the projection of the fit without the hold, drift scored
+// at 2 m only). On the simulated loops the truth makes the choice known: every length is 2 %
+// large, a common scale that a closed loop's final pose cannot see (docs/everyday_driving.md), so
+// the final-pose fit of one kind of loop holds that direction at the nominal and transfers worse
+// than the track, which sees it. The judgement fits choose the track, as the converged refits
+// with every measure (judgement_fit off, from the same start) do, and score each fold alike: both
+// are minima of the same problem, so the table's CF, drift and ATE are the refits' to the
+// decimals it prints.
+TEST(TrackObjectiveTransfer, JudgementFitsChooseWhatConvergedRefitsChooseWhereTheTruthIsKnown) {
+  const RobotModelPtr model = testing::ExampleModel("diff_drive");
+  RunSplit split;
+  for (const sim::ModelSimulatedRun& run : SimulatedLoopRuns()) split.training.push_back(AlignRun(run.log));
+  const FitMethod& method = *FindFitMethod("ceres");
+  FitMethodSettings settings;
+  settings.threads = 1;
+  settings.estimate_weights = false;
+  settings.residuals_auto = true;
+  std::optional<TrackFitData> data;
+  ASSERT_EQ(PrepareTrackResiduals(method.name, split, &settings, &data), "");
+  ASSERT_EQ(settings.residuals, ResidualKind::kTrack);
+  const FitMethodSettings proposed = settings;
+  std::optional<ModelFitMethodOutcome> full;
+  FoldFits fold_fits;
+  const std::vector<std::string> lines = ChooseResidualsByTransfer(
+      method, 1, *model, split, &settings, &data, &full, &fold_fits);
+  ASSERT_FALSE(lines.empty());
+  std::string table;
+  for (const std::string& line : lines) table += line + "\n";
+  EXPECT_EQ(settings.residuals, ResidualKind::kTrack) << table;
+  ASSERT_TRUE(full.has_value());
+
+  // The same folds refitted to convergence with everything a written fit computes.
+  std::vector<bool> held_a_direction;
+  const FitByKind converged = [&](ResidualKind kind, const std::vector<AlignedRun>& training) {
+    FitMethodSettings s = proposed;
+    s.residuals = kind;
+    s.residuals_auto = false;
+    s.start = full->fit.parameters;
+    RunSplit part;
+    part.training = training;
+    std::optional<TrackFitData> part_data;
+    EXPECT_EQ(PrepareTrackResiduals(method.name, part, &s, &part_data), "");
+    const ModelFitResult fit = method.run_model(training, *model, s).fit;
+    EXPECT_TRUE(fit.usable) << fit.message;
+    if (kind == ResidualKind::kFinalPose) held_a_direction.push_back(!fit.held_directions.empty());
+    return std::optional<std::vector<double>>(fit.parameters);
+  };
+  const ResidualKindJudgement reference = JudgeResidualKindsByTransfer(
+      ResidualKind::kTrack, ResidualKind::kFinalPose, split, converged,
+      EverydayDrivingScore(*model, 1, EverydayDriftLengths()));
+  ASSERT_TRUE(reference.judged);
+  EXPECT_EQ(reference.chosen, ResidualKind::kTrack);
+  // The case the projection serves: a final-pose fold holds the common scale.
+  EXPECT_NE(std::count(held_a_direction.begin(), held_a_direction.end(), true), 0);
+  // The judgement's table, row by row, against the converged refits' numbers.
+  ASSERT_EQ(lines.size(), 4 + reference.comparisons.size()) << table;
+  for (std::size_t f = 0; f < reference.comparisons.size(); ++f) {
+    const KindComparison& c = reference.comparisons[f];
+    const DriftAtLength* p = DriftAt(c.proposed, kTransferDriftLength_m);
+    const DriftAtLength* a = DriftAt(c.alternative, kTransferDriftLength_m);
+    ASSERT_TRUE(p != nullptr && a != nullptr);
+    const std::string row = lines[2 + f];
+    SCOPED_TRACE(row);
+    EXPECT_TRUE(testing::Has(row, StrFormat("%.4f | %-8.4f", c.proposed.cf, c.alternative.cf)));
+    EXPECT_TRUE(testing::Has(row, StrFormat("%.3f | %.3f", p->translation_percent,
+                                            a->translation_percent)));
+    EXPECT_TRUE(testing::Has(row, StrFormat("%.4f | %.4f", c.proposed.mean_ate_rmse_m,
+                                            c.alternative.mean_ate_rmse_m)));
+  }
 }
 
 // Everything of a calibration YAML but its `objective:` line (which records how it was chosen).
