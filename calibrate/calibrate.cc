@@ -29,7 +29,7 @@ bool Refuse(CalibrationOutcome* out, int exit_code, std::vector<std::string> rea
 // residuals prepared (--residuals auto resolved).
 bool PrepareData(const CalibrationRequest& r, const RobotModelInterface& model,
                  CalibrationOutcome* out, std::optional<std::vector<TrackRun>>* training_tracks) {
-  out->split = SplitForFit(AlignRuns(r.runs), r.train_reps, r.train_trajectories);
+  out->split = SplitOfRequest(r);
   if (out->split.training.empty()) {
     return Refuse(out, 2, {"no run of " + r.dataset + " is a training run (" +
                            TrainingSelection(r) + ")"});

@@ -19,6 +19,7 @@ namespace {
 
 using fitcal::testing::RunFitcal;
 using fitcal::testing::TempDir;
+using fitcal::testing::Has;
 
 using fitcal::testing::MissingFromBlock;
 using fitcal::testing::Tokens;
@@ -125,6 +126,45 @@ TEST(GeneraliseApproval, EverydayDrivingShowsACommonScaleError) {
   // ~5 mm error per 1 m window (Rayleigh mean 1.25 sigma ~ 0.5 %); 0.8 % leaves margin for the
   // fit's own scatter and stays far below the 1.9 % of the nominal.
   EXPECT_LT(track[1], 0.8);
+}
+
+// generalise judges a split as fit judges the same runs (calibrate/generalise_split.h: one
+// Calibrate): `fit --train-trajectories X` trains on X and validates on every other run, which is
+// generalise's "'X' -> others" split. The expected line is built from fit's own printout (its
+// gate's table, or its refusal on stderr), so it fails when generalise's fit, gate, never-worse
+// rule or bound check departs from fit's. '^R': fit writes its fit without holds; '^B1': fit
+// refuses (exit 5) because that candidate ends on a bound, although it beats the nominal.
+TEST(GeneraliseApproval, DecisionOnASplitIsFits) {
+  TempDir dir;
+  const std::string data = std::string(FITCAL_SOURCE_DIR) + "/data/flower";
+  for (const std::string selection : {"^R", "^B1"}) {
+    const std::string quoted = "'" + selection + "'";
+    const auto fit = RunFitcal(
+        dir, "fit --logs " + data + " --train-trajectories " + quoted + " --no-output");
+    std::string expected = quoted + " -> others: ";
+    if (fit.exit_code == 0) {
+      std::istringstream gate(fit.out.substr(fit.out.find("result gate, CF on held-out runs")));
+      std::string line, nominal_cf;
+      while (std::getline(gate, line) && !Has(line, "<- selected")) {
+        if (Has(line, "  nominal ")) nominal_cf = Tokens(line)[1];
+      }
+      const std::vector<std::string> selected = Tokens(line);  // name words, CF, change, <-, ...
+      std::string name = "fit";
+      for (std::size_t k = 1; k + 4 < selected.size(); ++k) name += " " + selected[k];
+      const std::string runs = fit.out.substr(fit.out.find("held-out runs (") + 15);
+      expected += "writes " + name + " (held-out runs (" + runs.substr(0, runs.find(')')) +
+                  "): CF " + nominal_cf + " -> " + selected[selected.size() - 4] + ")";
+    } else {
+      ASSERT_EQ(fit.exit_code, 5) << fit.err;
+      expected += "refuses (exit 5): " + fit.err.substr(8, fit.err.find('\n') - 8);
+    }
+    const auto generalise = RunFitcal(
+        dir, "generalise --logs " + data + " --train-trajectories " + quoted + " --no-loso");
+    ASSERT_EQ(generalise.exit_code, 0) << generalise.err;
+    EXPECT_TRUE(Has(generalise.out, "\n  " + expected + "\n"))
+        << "expected: " << expected << "\nfit printed:\n" << fit.out << fit.err
+        << "\ngeneralise printed:\n" << generalise.out;
+  }
 }
 
 }  // namespace

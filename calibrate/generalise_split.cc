@@ -1,0 +1,110 @@
+#include "calibrate/generalise_split.h"
+
+#include <cstdio>
+#include <map>
+#include <set>
+
+namespace fitcal {
+
+namespace {
+
+// The method `fit` uses by default, whose fit the table calls "fit".
+constexpr const char* kMethod = "ceres";
+
+// A gate candidate's name as the table writes it ("ceres ..." -> "fit ...").
+std::string TableName(const std::string& name) {
+  const std::string method = kMethod;
+  if (name.compare(0, method.size(), method) != 0) return name;
+  return "fit" + name.substr(method.size());
+}
+
+// The split as a calibration request: its runs (in the data set's order), its training runs by
+// id, fit's defaults, nothing written.
+CalibrationRequest SplitRequest(const std::vector<RunLog>& logs, const GeneralisationSplit& split,
+                                int threads) {
+  CalibrationRequest r;
+  r.dataset = "split " + split.train_name + " -> " + split.test_name;
+  r.method = FindFitMethod(kMethod);
+  r.settings.threads = threads;
+  r.threads = threads;
+  std::set<std::size_t> in_split(split.train.begin(), split.train.end());
+  in_split.insert(split.test.begin(), split.test.end());
+  for (std::size_t i : in_split) r.runs.push_back(logs.at(i));
+  for (std::size_t i : split.train) r.training_ids.push_back(logs.at(i).id);
+  r.check_channel_order = false;
+  r.will_write = false;
+  return r;
+}
+
+}  // namespace
+
+SplitCalibration CalibrateSplit(const RobotModelInterface& model, const std::vector<RunLog>& logs,
+                                const std::vector<AlignedRun>& runs,
+                                const GeneralisationSplit& split, const ModelFitOptions& options,
+                                const TrackCandidates& track_candidates,
+                                const ParameterTying& tying) {
+  SplitCalibration out;
+  out.outcome = Calibrate(SplitRequest(logs, split, options.ceres.num_threads), model);
+  // A refusal before the fit (the data's checks, too few residuals) leaves the table to fit the
+  // split itself; its decision line says why `fit` would not.
+  const ModelFitResult* fit = out.outcome.candidates.empty() ? nullptr : &out.outcome.fit.fit;
+  out.scores = EvaluateSplit(model, runs, split, options, track_candidates, tying, fit);
+  return out;
+}
+
+std::string DecisionLine(const CalibrationOutcome& outcome) {
+  if (outcome.refusal.exit_code != 0) {
+    std::string line = "refuses (exit " + std::to_string(outcome.refusal.exit_code) + "):";
+    for (std::size_t k = 0; k < outcome.refusal.reasons.size(); ++k) {
+      line += (k == 0 ? " " : "; ") + outcome.refusal.reasons[k];
+    }
+    return line;
+  }
+  const GateDecision& gate = outcome.gate;
+  char cf[80];
+  std::snprintf(cf, sizeof cf, "CF %.4f -> %.4f", gate.cf.front(), gate.cf.at(gate.selected));
+  return "writes " + TableName(outcome.selected().name) + " (" + gate.judged_on + ": " + cf + ")";
+}
+
+std::string FoldDecisionsLine(const std::vector<SplitCalibration>& folds) {
+  std::map<std::string, int> written, refused;
+  int writes = 0;
+  for (const SplitCalibration& fold : folds) {
+    const CalibrationOutcome& o = fold.outcome;
+    if (o.refusal.exit_code != 0) {
+      ++refused["exit " + std::to_string(o.refusal.exit_code)];
+    } else {
+      ++written[TableName(o.selected().name)];
+      ++writes;
+    }
+  }
+  const auto list = [](const std::map<std::string, int>& counts, const std::string& separator) {
+    std::string text;
+    for (const auto& [name, n] : counts) {
+      text += (text.empty() ? "" : ", ") + name + separator + std::to_string(n);
+    }
+    return text;
+  };
+  std::string line = "fit writes a calibration on " + std::to_string(writes) + " of " +
+                     std::to_string(folds.size()) + " folds";
+  if (writes > 0) line += " (" + list(written, " ") + ")";
+  const int refusals = static_cast<int>(folds.size()) - writes;
+  if (refusals > 0) {
+    line += " and refuses on " + std::to_string(refusals) + " (" + list(refused, ": ") + ")";
+  }
+  return line;
+}
+
+std::optional<std::vector<std::vector<Segment>>> OptiOdomCheckpoints(
+    const std::vector<AlignedRun>& runs, const std::vector<RunLog>& logs) {
+  constexpr double kSpacingM = 0.5;
+  std::vector<std::vector<Segment>> out;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const GroundTruthTrack& track = logs[i].ground_truth;
+    if (track.t_s.size() < 3) return std::nullopt;
+    out.push_back(MakeCheckpointsFromStart(runs[i], track, kSpacingM));
+  }
+  return out;
+}
+
+}  // namespace fitcal
