@@ -36,6 +36,7 @@
 
 #include "models/asoc/asoc_model.h"
 #include "models/asoc/asoc_run_log.h"
+#include "odometry/encoder_samples.h"
 
 namespace fitcal::asoc {
 
@@ -70,8 +71,12 @@ struct HoldRun {
 
 // "hold_<j>_cw" / "hold_<j>_ccw" (j = 1..3): the held castor (0-based) and the direction.
 bool ParseHoldLabel(const std::string& trajectory, int* held, int* direction);
-// A hold run of the silo's log (readings at sample times).
-HoldRun MeasureHoldRun(const EncoderLog& log, int held, int direction, double steady_fraction);
+// A hold run's Eq. 1-9 measurements from the model's channels: steady angles as the circular
+// mean over the middle `steady_fraction` of the intervals, the held pivot's turn from the
+// interval means (mid first to mid last interval) and each wheel's angle over the same span.
+HoldRun MeasureHoldRun(const EncoderSamples& samples, int held, int direction,
+                       double steady_fraction);
+
 
 struct GeometricResult {
   bool usable = false;
@@ -98,7 +103,8 @@ double OneSigmaStudentFactor(int dof);
 GeometricResult CalibrateFromHoldRuns(const std::vector<HoldRun>& runs, const Vehicle& nominal,
                                       double pivot_resolution_rad = 0.0);
 
-// The hold runs among `runs` (by label, >= 4 samples) through CalibrateFromHoldRuns. Throws
+// The hold runs among `runs` (by label, >= 4 samples), as the model's channels
+// (io::AsocEncoderLogAsChannels, the one measurement of a hold run), through CalibrateFromHoldRuns. Throws
 // std::invalid_argument for invalid options.
 GeometricResult CalibrateGeometric(const std::vector<RunLog>& runs, const Vehicle& nominal,
                                    const GeometricOptions& options = {});
