@@ -3,20 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <stdexcept>
 
 #include "models/asoc/asoc_files.h"
 #include "odometry/pose2.h"
 
 namespace fitcal::asoc {
-
-bool GeometricOptions::IsValid(std::string* error) const {
-  if (!(steady_fraction > 0.0 && steady_fraction <= 1.0)) {
-    *error = "steady_fraction must be in (0, 1]";
-    return false;
-  }
-  return true;
-}
 
 CastorParameters SolveHoldPair(const HoldMeasurement& m, double pivot_distance_m,
                                double theta_perp_rad) {
@@ -51,14 +42,13 @@ bool ParseHoldLabel(const std::string& trajectory, int* held, int* direction) {
   return false;
 }
 
-HoldRun MeasureHoldRun(const EncoderSamples& samples, int held, int direction,
-                       double steady_fraction) {
+std::optional<HoldRun> MeasureHoldRun(const std::string& trajectory,
+                                      const EncoderSamples& samples) {
   HoldRun run;
-  run.held = held;
-  run.direction = direction;
   const std::size_t n = samples.size();
-  const std::size_t skip = static_cast<std::size_t>(std::floor(0.5 * (1.0 - steady_fraction) * n));
-  const int held_pivot = held * kChannelsPerCastor + kPivotChannel;
+  if (!ParseHoldLabel(trajectory, &run.held, &run.direction) || n < 4) return std::nullopt;
+  const std::size_t skip = static_cast<std::size_t>(std::floor(0.5 * (1.0 - kSteadyFraction) * n));
+  const int held_pivot = run.held * kChannelsPerCastor + kPivotChannel;
   for (std::size_t k = 1; k < n; ++k) {
     run.rotation_rad += WrapAngle(samples[k].value[held_pivot] - samples[k - 1].value[held_pivot]);
   }
@@ -321,18 +311,13 @@ GeometricResult CalibrateFromHoldRuns(const std::vector<HoldRun>& runs, const Ve
 }
 
 GeometricResult CalibrateGeometric(const std::vector<RunLog>& runs, const Vehicle& nominal,
-                                   const GeometricOptions& options) {
-  std::string error;
-  if (!options.IsValid(&error)) throw std::invalid_argument("GeometricOptions: " + error);
+                                   double pivot_resolution_rad) {
   std::vector<HoldRun> holds;
   for (const RunLog& run : runs) {
-    int held = 0, direction = 0;
-    if (!ParseHoldLabel(run.trajectory, &held, &direction)) continue;
-    if (run.encoders.samples.size() < 4) continue;
-    holds.push_back(MeasureHoldRun(io::AsocEncoderLogAsChannels(run.encoders).samples, held,
-                                   direction, options.steady_fraction));
+    const fitcal::EncoderLog channels = io::AsocEncoderLogAsChannels(run.encoders);
+    if (const auto hold = MeasureHoldRun(run.trajectory, channels.samples)) holds.push_back(*hold);
   }
-  return CalibrateFromHoldRuns(holds, nominal, options.pivot_resolution_rad);
+  return CalibrateFromHoldRuns(holds, nominal, pivot_resolution_rad);
 }
 
 }  // namespace fitcal::asoc

@@ -39,8 +39,6 @@ constexpr const char* kOffsetHeldReason =
 constexpr const char* kBiasHeldReason =
     "a pivot bias is absorbed by the wheel parameters (Doebbler Fig. 3); the closed form measures "
     "it (Eq. 2)";
-// Eq. 1-9's steady castor angle: the middle half of a hold run (asoc_geometric.h).
-constexpr double kSteadyFraction = 0.5;
 
 bool IsColumnSafe(const std::string& name) {
   if (name.empty()) return false;
@@ -154,10 +152,7 @@ std::vector<ClosedFormCalibration> AsocModel::ClosedForms(
     const std::vector<AlignedRun>& training) const {
   std::vector<asoc::HoldRun> holds;
   for (const AlignedRun& run : training) {
-    int held = 0, direction = 0;
-    if (!asoc::ParseHoldLabel(run.trajectory, &held, &direction) || run.samples.size() < 4)
-      continue;
-    holds.push_back(asoc::MeasureHoldRun(run.samples, held, direction, kSteadyFraction));
+    if (const auto hold = asoc::MeasureHoldRun(run.trajectory, run.samples)) holds.push_back(*hold);
   }
   if (holds.empty()) return {};
   const asoc::GeometricResult result =
