@@ -19,10 +19,12 @@ std::string TableName(const std::string& name) {
 }
 
 // The split as a calibration request: its runs (in the data set's order), its training runs by
-// id, fit's defaults, nothing written.
-CalibrationRequest SplitRequest(const std::vector<RunLog>& logs, const GeneralisationSplit& split,
-                                int threads) {
+// id, fit's defaults (the effects the robot declares refitted, as fit refits them), nothing
+// written.
+CalibrationRequest SplitRequest(const Robot& robot, const std::vector<RunLog>& logs,
+                                const GeneralisationSplit& split, int threads) {
   CalibrationRequest r;
+  r.effects_to_fit = robot.effects;
   r.dataset = "split " + split.train_name + " -> " + split.test_name;
   r.method = FindFitMethod(kMethod);
   r.settings.threads = threads;
@@ -44,7 +46,8 @@ SplitCalibration CalibrateSplit(const RobotModelInterface& model, const std::vec
                                 const TrackCandidates& track_candidates,
                                 const ParameterTying& tying) {
   SplitCalibration out;
-  out.outcome = Calibrate(SplitRequest(logs, split, options.ceres.num_threads), model);
+  out.outcome =
+      Calibrate(SplitRequest(model.robot(), logs, split, options.ceres.num_threads), model);
   // A refusal before the fit (the data's checks, too few residuals) leaves the table to fit the
   // split itself; its decision line says why `fit` would not.
   const ModelFitResult* fit = out.outcome.candidates.empty() ? nullptr : &out.outcome.fit.fit;
