@@ -70,31 +70,16 @@ std::string DecisionLine(const CalibrationOutcome& outcome) {
 }
 
 std::string FoldDecisionsLine(const std::vector<SplitCalibration>& folds) {
-  std::map<std::string, int> written, refused;
-  int writes = 0;
+  std::map<std::string, int> count;  // per decision: "refuses (exit 5)", "writes fit", ...
   for (const SplitCalibration& fold : folds) {
     const CalibrationOutcome& o = fold.outcome;
-    if (o.refusal.exit_code != 0) {
-      ++refused["exit " + std::to_string(o.refusal.exit_code)];
-    } else {
-      ++written[TableName(o.selected().name)];
-      ++writes;
-    }
+    ++count[o.refusal.exit_code != 0 ? "refuses (exit " + std::to_string(o.refusal.exit_code) + ")"
+                                     : "writes " + TableName(o.selected().name)];
   }
-  const auto list = [](const std::map<std::string, int>& counts, const std::string& separator) {
-    std::string text;
-    for (const auto& [name, n] : counts) {
-      text += (text.empty() ? "" : ", ") + name + separator + std::to_string(n);
-    }
-    return text;
-  };
-  std::string line = "fit writes a calibration on " + std::to_string(writes) + " of " +
-                     std::to_string(folds.size()) + " folds";
-  if (writes > 0) line += " (" + list(written, " ") + ")";
-  const int refusals = static_cast<int>(folds.size()) - writes;
-  if (refusals > 0) {
-    line += " and refuses on " + std::to_string(refusals) + " (" + list(refused, ": ") + ")";
-  }
+  std::string line =
+      "fit --residuals final-pose on the " + std::to_string(folds.size()) + " folds:";
+  for (const auto& [decision, n] : count) line += " " + decision + " " + std::to_string(n) + ",";
+  line.pop_back();
   return line;
 }
 

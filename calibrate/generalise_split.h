@@ -1,6 +1,7 @@
 #pragma once
-// One split of `generalise` (validation/generalisation.h) calibrated as `fit` calibrates: the
-// split's training runs fitted by Calibrate (calibrate/calibrate.h; Ceres, final poses, no
+// One split of `generalise` (validation/generalisation.h) calibrated as `fit --residuals
+// final-pose` calibrates (the table's "fit" is a final-pose fit; on dense tracks `fit`'s default
+// fits the track): the split's training runs fitted by Calibrate (calibrate/calibrate.h; Ceres, no
 // record), its candidates judged by the same result gate, never-worse rule and bound check on the
 // split's held-out runs, and every candidate of the table scored on them with that same fit. The
 // table's scores stay blind (nothing is selected on the runs that score it); the decision says
@@ -34,7 +35,8 @@ SplitCalibration CalibrateSplit(const RobotModelInterface& model, const std::vec
 // "refuses (exit <code>): <reasons>"; the method's fit is named "fit" as in the table.
 std::string DecisionLine(const CalibrationOutcome& outcome);
 
-// Over the folds of leave-one-session-out: "fit writes a calibration on N of M folds (...)".
+// Over the folds of leave-one-session-out: "fit --residuals final-pose on the M folds: refuses
+// (exit 5) K, writes fit N, ..." (each decision and how often, sorted).
 std::string FoldDecisionsLine(const std::vector<SplitCalibration>& folds);
 
 // OptiOdom's checkpoints (every 0.5 m of path, as Sousa et al.) for every run (`--optiodom`), or

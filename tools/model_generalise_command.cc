@@ -46,8 +46,8 @@ void PrintSplitRows(const SplitScores& s) {
 // What `fit` would write, or why it would refuse, on each split of the table.
 void PrintDecisions(const std::vector<SplitCalibration>& calibrated) {
   std::printf(
-      "\nwhat fit decides on each split (the result gate, never worse than the nominal on the "
-      "held-out runs, no parameter on a bound; calibrate/calibrate.h)\n");
+      "\nwhat fit --residuals final-pose decides on each split (the result gate, never worse than "
+      "the nominal on the held-out runs, no parameter on a bound; calibrate/calibrate.h)\n");
   for (const SplitCalibration& s : calibrated) {
     std::printf("  %s -> %s: %s\n", s.scores.split.train_name.c_str(),
                 s.scores.split.test_name.c_str(), DecisionLine(s.outcome).c_str());
