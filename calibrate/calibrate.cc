@@ -29,7 +29,7 @@ bool Refuse(CalibrationOutcome* out, int exit_code, std::vector<std::string> rea
 // residuals prepared (--residuals auto resolved).
 bool PrepareData(const CalibrationRequest& r, const RobotModelInterface& model,
                  CalibrationOutcome* out, std::optional<std::vector<TrackRun>>* training_tracks) {
-  out->split = SplitForFit(AlignRuns(r.runs), r.train_reps, r.train_trajectories);
+  out->split = SplitOfRequest(r);
   if (out->split.training.empty()) {
     return Refuse(out, 2, {"no run of " + r.dataset + " is a training run (" +
                            TrainingSelection(r) + ")"});
@@ -51,6 +51,10 @@ bool PrepareData(const CalibrationRequest& r, const RobotModelInterface& model,
 // transfer first when the request leaves them to the data (not with effects to fit).
 void FitTrainingRuns(const CalibrationRequest& r, const RobotModelInterface& model,
                      CalibrationOutcome* out, std::string* objective_note) {
+  if (r.closed_forms_only) {
+    out->fit.objective = "the model's closed form, no fit";
+    return;
+  }
   // The fit of all the training runs when a choice by transfer made it (and kept its kind).
   std::optional<ModelFitMethodOutcome> chosen_fit;
   if (r.effects_to_fit.empty()) {
@@ -86,7 +90,13 @@ bool SelectCandidate(const CalibrationRequest& r, const RobotModelInterface& mod
                      CalibrationOutcome* out) {
   const RunSplit& split = out->split;
   out->candidates =
-      Candidates(model, split, out->fit.fit, r.method->name, out->settings.tying.empty());
+      r.closed_forms_only
+          ? NominalAndClosedForms(model, split, true)
+          : Candidates(model, split, out->fit.fit, r.method->name, out->settings.tying.empty());
+  if (out->candidates.size() == 1) {  // only with closed_forms_only: a fit is always a candidate
+    return Refuse(out, 1, {r.dataset + ": the robot's model computes no closed form from the "
+                           "training runs (" + TrainingSelection(r) + "); nothing written"});
+  }
   if (training_tracks) {
     out->track_fits = AddTrackFitCandidates(r.settings.weights, r.threads, model,
                                             *training_tracks, r.effects_to_fit, &out->candidates);

@@ -8,6 +8,7 @@
 
 #include "calibrate/fit_methods.h"
 #include "fit/effect_fit.h"
+#include "fit/run_split.h"
 #include "io/dataset.h"
 
 namespace fitcal {
@@ -21,6 +22,9 @@ struct CalibrationRequest {
   std::vector<RunLog> runs;  // every run of the data set
   std::string train_reps = "1-5";
   std::string train_trajectories;  // non-empty: replaces train_reps (fit/trajectory_split.h)
+  // Non-empty: exactly these runs train and the others judge, replacing both (generalise's
+  // splits, calibrate/generalise_split.h).
+  std::vector<std::string> training_ids;
   int threads = 0;
   int time_blocks = 4;  // with nothing held out: the time blocks of validation/held_out_halves.h
   // The sigmas as given (settings.weights holds them in SI units): the record's objective and
@@ -30,10 +34,16 @@ struct CalibrationRequest {
   bool check_channel_order = true;
   bool will_write = true;  // a record is made (and an uncertainty must exist) only then
   bool bounds_widened = false;  // a parameter on its bound is written, with a warning
+  // The model's closed forms alone against the nominal (asoc-geometric): no method fit, no choice
+  // by transfer, no halves; the same gate, never-worse rule, bound check and record.
+  bool closed_forms_only = false;
 };
 
 // How the training runs were chosen, for messages: "trajectories matching '...'" or
 // "repetitions 1-5".
 std::string TrainingSelection(const CalibrationRequest& request);
+
+// The request's runs split into training and validation (training_ids, else SplitForFit).
+RunSplit SplitOfRequest(const CalibrationRequest& request);
 
 }  // namespace fitcal

@@ -50,15 +50,21 @@ CalibrationCandidate WithoutHolds(const Robot& robot, const ModelFitResult& fit,
 
 }  // namespace
 
-std::vector<CalibrationCandidate> Candidates(const RobotModelInterface& model,
-                                             const RunSplit& split, const ModelFitResult& fit,
-                                             const std::string& method, bool closed_forms) {
+std::vector<CalibrationCandidate> NominalAndClosedForms(const RobotModelInterface& model,
+                                                       const RunSplit& split, bool closed_forms) {
   std::vector<CalibrationCandidate> out = {
       {"nominal", model.robot().nominal, true, model.robot().effects}};
   for (const ClosedFormCalibration& c :
        closed_forms ? model.ClosedForms(split.training) : std::vector<ClosedFormCalibration>{}) {
     out.push_back({c.method, c.parameters, true, {}, c.sigma});
   }
+  return out;
+}
+
+std::vector<CalibrationCandidate> Candidates(const RobotModelInterface& model,
+                                             const RunSplit& split, const ModelFitResult& fit,
+                                             const std::string& method, bool closed_forms) {
+  std::vector<CalibrationCandidate> out = NominalAndClosedForms(model, split, closed_forms);
   out.push_back({method, fit.parameters, fit.usable || fit.stopped_early});
   if (!fit.held_directions.empty() && !split.validation.empty()) {
     out.push_back(WithoutHolds(model.robot(), fit, method));

@@ -44,6 +44,11 @@ struct TrackFits {
 // undetermined directions and held-out runs can judge it, the fit without the holds too (on the
 // training runs alone it would always win, by fitting what the data cannot tell apart). Under
 // --tie/--hold the closed forms stay out: they fit the full model, not the one asked for.
+// The nominal (with the effects the robot declares) and, when `closed_forms`, the model's closed
+// forms computed from the training runs: the candidates before any fit.
+std::vector<CalibrationCandidate> NominalAndClosedForms(const RobotModelInterface& model,
+                                                       const RunSplit& split, bool closed_forms);
+
 std::vector<CalibrationCandidate> Candidates(const RobotModelInterface& model,
                                              const RunSplit& split, const ModelFitResult& fit,
                                              const std::string& method, bool closed_forms);

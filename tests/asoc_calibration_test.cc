@@ -202,10 +202,8 @@ Coverage ClosedFormCoverage(double wheel_slip_sigma, std::uint64_t seed, int set
   const int kind_of[kParametersPerCastor] = {0, 1, 1, 2, 2, 3};  // ToArray's order
   for (int set = 0; set < sets; ++set) {
     const Vehicle truth = sim::DrawVehicle(nominal, sim::ParameterSpread{}, rng);
-    GeometricOptions geometric;
-    geometric.pivot_resolution_rad = options.pivot_quantum_rad;
     const GeometricResult r = CalibrateGeometric(
-        sim::SimulateCalibrationManoeuvre(truth, options, rng), nominal, geometric);
+        sim::SimulateCalibrationManoeuvre(truth, options, rng), nominal, options.pivot_quantum_rad);
     EXPECT_TRUE(r.usable) << r.message;
     EXPECT_EQ(r.sigma_dof, 3);
     for (int i = 0; i < kNumCastors; ++i) {

@@ -82,33 +82,6 @@ TEST(AsocModelTest, BodyStepReplaysUmbmarkAsThePapersOdometry) {
   }
 }
 
-// The closed form through the seam (ClosedForms on the generic runs) and the silo's (native logs)
-// measure the same hold runs: the castors are steady in the middle half (interval means equal the
-// readings there) and the manoeuvre starts and ends at rest (the half intervals at either end of
-// the held pivot's turn move nothing). So the two agree to rounding (measured 4e-15), and the
-// paper's Table I (asoc-tables, on the silo's) describes the seam's closed form too.
-TEST(AsocModelTest, ClosedFormOnTheSeamMatchesTheSilo) {
-  const asoc::Vehicle nominal = sim::AsocPrototypeVehicle();
-  std::mt19937_64 rng(21);
-  const asoc::Vehicle truth = sim::DrawVehicle(nominal, sim::ParameterSpread{}, rng);
-  const auto runs = sim::SimulateCalibrationManoeuvre(truth, {}, rng);
-  const asoc::GeometricResult silo = asoc::CalibrateGeometric(runs, nominal);
-  ASSERT_TRUE(silo.usable) << silo.message;
-  std::vector<AlignedRun> generic;
-  for (const asoc::RunLog& run : runs) generic.push_back(Generic(run));
-  const auto closed = ModelOf(nominal)->ClosedForms(generic);
-  ASSERT_EQ(closed.size(), 1u);
-  EXPECT_EQ(closed[0].method, "asoc-geometric");
-  const auto expected = silo.estimate.ToArray();
-  for (int k = 0; k < asoc::kNumParameters; ++k) {
-    if (k % asoc::kParametersPerCastor == asoc::kBiasIndex) {
-      EXPECT_NEAR(closed[0].parameters[k], expected[k], 1e-12) << k;
-    } else {
-      EXPECT_NEAR(closed[0].parameters[k] / expected[k], 1.0, 1e-12) << k;
-    }
-  }
-}
-
 // Three repetitions of the manoeuvre: 18 hold runs, each castor estimated from every CW x CCW pair
 // of the two castors that can hold it (2 x 3 x 3 = 18 estimates), and the message counts them all
 // (before, a second repetition silently replaced the first: "from 6 hold runs").

@@ -160,7 +160,7 @@ TEST(FaultSuiteTest, TruncatedAndGarbledCalibrationsAndAsocFilesFailInOneLine) {
          io::ReadCalibrationTrainingRepetitions(cal.string());
        }},
       {asoc_index.robot_path, [&] { io::ReadAsocRobot(asoc_index.robot_path); }},
-      {asoc_index.runs.front().encoders_path, [&] { io::LoadAsocDataset(asoc.string()); }},
+      {asoc_index.runs.front().encoders_path, [&] { LoadEverything(asoc); }},
   };
   std::uint32_t seed = 100;
   for (const auto& [file, read] : files) {

@@ -6,19 +6,25 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "tests/approval_lines.h"
 #include "tests/test_files.h"
+#include "tests/test_paths.h"
 
 namespace fitcal {
 namespace {
 
+namespace fs = std::filesystem;
+
 using fitcal::testing::RunFitcal;
 using fitcal::testing::TempDir;
+using fitcal::testing::Has;
 
 using fitcal::testing::MissingFromBlock;
 using fitcal::testing::Tokens;
@@ -125,6 +131,95 @@ TEST(GeneraliseApproval, EverydayDrivingShowsACommonScaleError) {
   // ~5 mm error per 1 m window (Rayleigh mean 1.25 sigma ~ 0.5 %); 0.8 % leaves margin for the
   // fit's own scatter and stays far below the 1.9 % of the nominal.
   EXPECT_LT(track[1], 0.8);
+}
+
+// The candidate fit's result gate selected, as generalise names it ("ceres ..." -> "fit ..."),
+// and its held-out CF, from fit's printout; the nominal's CF beside it.
+struct GateChoice {
+  std::string name, cf, nominal_cf;
+};
+GateChoice SelectedByFit(const std::string& fit_out) {
+  std::istringstream gate(fit_out.substr(fit_out.find("result gate, CF on held-out runs")));
+  GateChoice choice;
+  std::string line;
+  while (std::getline(gate, line) && !Has(line, "<- selected")) {
+    if (Has(line, "  nominal ")) choice.nominal_cf = Tokens(line)[1];
+  }
+  const std::vector<std::string> words = Tokens(line);  // name words, CF, change, <-, selected
+  choice.name = words[0] == "ceres" ? "fit" : words[0];
+  for (std::size_t k = 1; k + 4 < words.size(); ++k) choice.name += " " + words[k];
+  choice.cf = words[words.size() - 4];
+  return choice;
+}
+
+// generalise judges a split as `fit --residuals final-pose` judges the same runs
+// (calibrate/generalise_split.h: one Calibrate): `fit --train-trajectories X` trains on X and
+// validates on every other run, which is generalise's "'X' -> others" split. The expected line is
+// built from fit's own printout (its gate's table, or its refusal on stderr), so it fails when
+// generalise's fit, gate, never-worse rule or bound check departs from fit's. '^R': fit writes its
+// fit without holds; '^B1': fit refuses (exit 5) because that candidate ends on a bound, although
+// it beats the nominal. (On the flower's final poses `--residuals auto` is final-pose.)
+TEST(GeneraliseApproval, DecisionOnASplitIsFits) {
+  TempDir dir;
+  const std::string data = std::string(FITCAL_SOURCE_DIR) + "/data/flower";
+  for (const std::string selection : {"^R", "^B1"}) {
+    const std::string quoted = "'" + selection + "'";
+    const auto fit = RunFitcal(dir, "fit --logs " + data + " --residuals final-pose " +
+                                        "--train-trajectories " + quoted + " --no-output");
+    std::string expected = quoted + " -> others: ";
+    if (fit.exit_code == 0) {
+      const GateChoice choice = SelectedByFit(fit.out);
+      const std::string runs = fit.out.substr(fit.out.find("held-out runs (") + 15);
+      expected += "writes " + choice.name + " (held-out runs (" + runs.substr(0, runs.find(')')) +
+                  "): CF " + choice.nominal_cf + " -> " + choice.cf + ")";
+    } else {
+      ASSERT_EQ(fit.exit_code, 5) << fit.err;
+      expected += "refuses (exit 5): " + fit.err.substr(8, fit.err.find('\n') - 8);
+    }
+    const auto generalise = RunFitcal(
+        dir, "generalise --logs " + data + " --train-trajectories " + quoted + " --no-loso");
+    ASSERT_EQ(generalise.exit_code, 0) << generalise.err;
+    EXPECT_TRUE(Has(generalise.out, "\n  " + expected + "\n"))
+        << "expected: " << expected << "\nfit printed:\n" << fit.out << fit.err
+        << "\ngeneralise printed:\n" << generalise.out;
+  }
+}
+
+// Leave-one-session-out's closing line counts fit's decisions on the folds. On the real OptiOdom
+// tricycle (circles and squares; each path and direction one session label: four folds), the fold
+// holding out label L is `fit --residuals final-pose --train-trajectories '^(?!L$)'`, run here
+// four times; the line built from those runs must be generalise's. On dense tracks `fit`'s default
+// fits the track, which is not the table's "fit": hence --residuals final-pose. Needs
+// ../shared/data/optiodom (skipped without it).
+TEST(GeneraliseApproval, FoldDecisionsAreFitsOnTheRealTricycle) {
+  const fs::path root = fs::path(FITCAL_SHARED_DIR) / "data" / "optiodom" / "tricyc";
+  if (!fs::is_directory(root)) GTEST_SKIP() << "no " << root;
+  TempDir dir;
+  std::string sessions;
+  for (const char* path : {"circular", "square"}) {
+    for (const auto& entry : fs::directory_iterator(root / path)) {
+      sessions += " " + entry.path().string();
+    }
+  }
+  const std::string data = dir.Path("tricyc");
+  ASSERT_EQ(RunFitcal(dir, "import optiodom" + sessions + " --out " + data).exit_code, 0);
+  const auto generalise = RunFitcal(dir, "generalise --logs " + data);
+  ASSERT_EQ(generalise.exit_code, 0) << generalise.err;
+  std::map<std::string, int> count;
+  for (const std::string label : {"circular_ccw", "circular_cw", "square_ccw", "square_cw"}) {
+    EXPECT_TRUE(Has(generalise.out, "\n| " + label + " | ")) << generalise.out;
+    const auto fit = RunFitcal(dir, "fit --logs " + data + " --residuals final-pose " +
+                                        "--train-trajectories '^(?!" + label + "$)' --no-output");
+    ++count[fit.exit_code == 0 ? "writes " + SelectedByFit(fit.out).name
+                               : "refuses (exit " + std::to_string(fit.exit_code) + ")"];
+  }
+  std::string expected = "fit --residuals final-pose on the 4 folds:";
+  for (const auto& [decision, n] : count) {
+    expected += " " + decision + " " + std::to_string(n) + ",";
+  }
+  expected.pop_back();
+  EXPECT_TRUE(Has(generalise.out, "\n" + expected + "\n"))
+      << "expected: " << expected << "\ngeneralise printed:\n" << generalise.out;
 }
 
 }  // namespace

@@ -1,12 +1,14 @@
 #pragma once
 // ASOC subcommands (Doebbler et al.): `asoc-simulate` writes an ASOC data set, `asoc-geometric`
-// runs the closed-form calibration (Eq. 1-9) on a calibration-manoeuvre data set,
+// writes the closed-form calibration (Eq. 1-9) through fit's gate (a thin wrapper of `fit`),
 // `asoc-tables` reproduces Tables I and II. Fitting, comparing, diagnosing and generalising an
 // ASOC data set go through the generic commands (the asoc model, models/asoc/asoc_robot_model.h).
 
 #include <CLI/CLI.hpp>
 #include <cstdint>
 #include <string>
+
+#include "tools/fit_command.h"
 
 namespace fitcal::tools {
 
@@ -18,14 +20,6 @@ struct AsocSimulateOptions {
   bool force = false;
 };
 
-struct AsocGeometricOptions {
-  std::string logs;
-  std::string out = "calibrated_asoc.yaml";
-  bool no_output = false;
-  bool force = false;  // replace an --out holding another robot's calibration
-  bool allow_outside_paths = false;
-};
-
 struct AsocTablesOptions {
   int sets = 1000;
   std::uint64_t seed = 1;
@@ -34,12 +28,14 @@ struct AsocTablesOptions {
 };
 
 int RunAsocSimulate(const AsocSimulateOptions& options);
-int RunAsocGeometric(const AsocGeometricOptions& options);
+// `fit` with the robot's closed forms alone as candidates (ASOC's Eq. 1-9; any model's closed
+// forms): the same request, gate, never-worse judgement, record and printout as `fit`.
+int RunAsocGeometric(const FitCommandOptions& options);
 int RunAsocTables(const AsocTablesOptions& options);
 
 // Declare every flag of each subcommand on it, bound to the options.
 void AddAsocSimulateOptions(CLI::App& app, AsocSimulateOptions& options);
-void AddAsocGeometricOptions(CLI::App& app, AsocGeometricOptions& options);
+void AddAsocGeometricOptions(CLI::App& app, FitCommandOptions& options);
 void AddAsocTablesOptions(CLI::App& app, AsocTablesOptions& options);
 
 }  // namespace fitcal::tools

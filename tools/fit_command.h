@@ -34,6 +34,9 @@ struct FitCommandOptions : DatasetCommandOptions, SolverOptions, TyingFlags {
   // Write a calibration with a parameter on its bound (fit/result_gate.h AtBoundRefusal): the user
   // widened the bounds on purpose and accepts a value that still ends on one.
   bool bounds_widened = false;
+  // Not a flag of `fit`: asoc-geometric's request, the robot's closed forms alone against the
+  // nominal (CalibrationRequest::closed_forms_only).
+  bool closed_forms_only = false;
 };
 
 // Declares every flag of `fit` on `app` (the `fit` subcommand, and the top level: `fitcal --logs

@@ -99,6 +99,10 @@ void PrintHeader(const CalibrationRequest& request, const Robot& robot, const Ru
 
 // The solvers' stop reasons: the method's fit and the track fits.
 void PrintSolver(const CalibrationRequest& request, const CalibrationOutcome& o) {
+  if (request.closed_forms_only) {
+    std::printf("\nno fit: the robot's closed forms alone against the nominal\n");
+    return;
+  }
   const ModelFitResult& fit = o.fit.fit;
   // Active-set rounds are the Ceres fit's (fit/model_fit.h); NLopt methods have none.
   const std::string rounds =
@@ -290,10 +294,10 @@ void PrintReport(const CalibrationRequest& request, const RobotModelInterface& m
   const CandidateErrors errors(model, request.threads);
   PrintFit(request, model, o, errors);
   PrintTying(o.settings.tying);
-  PrintResiduals(o, flag_notes);
+  if (!request.closed_forms_only) PrintResiduals(o, flag_notes);
   PrintEncoderGlitches(request.runs);
   PrintEverydayDriving(model, o, request.threads);
-  PrintUncertaintyAndWarnings(model, o, request.threads);
+  if (!request.closed_forms_only) PrintUncertaintyAndWarnings(model, o, request.threads);
   PrintGate(o);
 }
 

@@ -151,6 +151,7 @@ int MakeRequest(const FitCommandOptions& options, const Robot& robot,
   request->check_channel_order = !options.skip_wheel_order_check;
   request->will_write = !options.no_output;
   request->bounds_widened = options.bounds_widened;
+  request->closed_forms_only = options.closed_forms_only;
   return 0;
 }
 

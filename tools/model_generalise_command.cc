@@ -7,10 +7,10 @@
 #include <stdexcept>
 #include <string>
 
+#include "calibrate/generalise_split.h"
 #include "fit/effect_fit.h"
 #include "fit/residual_choice.h"
 #include "fit/run_split.h"
-#include "fit/segment_cost.h"
 #include "fit/trajectory_split.h"
 #include "models/model_registry.h"
 #include "tools/effect_list.h"
@@ -43,8 +43,22 @@ void PrintSplitRows(const SplitScores& s) {
   }
 }
 
-// The summary over the folds, then the held-out CF of every candidate per session.
-void PrintLeaveOneSessionOut(const std::vector<SplitScores>& folds) {
+// What `fit` would write, or why it would refuse, on each split of the table.
+void PrintDecisions(const std::vector<SplitCalibration>& calibrated) {
+  std::printf(
+      "\nwhat fit --residuals final-pose decides on each split (the result gate, never worse than "
+      "the nominal on the held-out runs, no parameter on a bound; calibrate/calibrate.h)\n");
+  for (const SplitCalibration& s : calibrated) {
+    std::printf("  %s -> %s: %s\n", s.scores.split.train_name.c_str(),
+                s.scores.split.test_name.c_str(), DecisionLine(s.outcome).c_str());
+  }
+}
+
+// The summary over the folds, the held-out CF of every candidate per session, and what `fit`
+// decides on the folds.
+void PrintLeaveOneSessionOut(const std::vector<SplitCalibration>& calibrated) {
+  std::vector<SplitScores> folds;
+  for (const SplitCalibration& c : calibrated) folds.push_back(c.scores);
   const std::vector<FoldSummary> summary = SummariseFolds(folds);
   std::printf(
       "\nleave-one-session-out (%zu sessions, each held out once)\n\n"
@@ -78,20 +92,7 @@ void PrintLeaveOneSessionOut(const std::vector<SplitScores>& folds) {
     }
     std::printf("\n");
   }
-}
-
-// OptiOdom's checkpoints (every 0.5 m of path, as Sousa et al.) for every run, or nothing when
-// some run's ground truth holds no pose between its start and end (their cost needs the track).
-std::optional<std::vector<std::vector<Segment>>> OptiOdomCheckpoints(
-    const std::vector<AlignedRun>& runs, const std::vector<RunLog>& logs) {
-  constexpr double kSpacingM = 0.5;
-  std::vector<std::vector<Segment>> out;
-  for (std::size_t i = 0; i < runs.size(); ++i) {  // runs = AlignRuns(logs), in the same order
-    const GroundTruthTrack& track = logs[i].ground_truth;
-    if (track.t_s.size() < 3) return std::nullopt;
-    out.push_back(MakeCheckpointsFromStart(runs[i], track, kSpacingM));
-  }
-  return out;
+  std::printf("\n%s\n", FoldDecisionsLine(calibrated).c_str());
 }
 
 // What a leave-one-session-out session is (--sessions); false after one line on stderr.
@@ -233,23 +234,26 @@ int Generalise(const GeneraliseCommandOptions& options) {
     std::printf("\n");
   }
   PrintSplitTableHeader();
-  std::vector<SplitScores> scores;
+  std::vector<SplitCalibration> calibrated;
   for (const GeneralisationSplit& split : *splits) {
-    scores.push_back(EvaluateSplit(*model, runs, split, fit_options, inputs.candidates, tying));
-    PrintSplitRows(scores.back());
+    calibrated.push_back(CalibrateSplit(*model, dataset.runs, runs, split, fit_options,
+                                        inputs.candidates, tying));
+    PrintSplitRows(calibrated.back().scores);
     std::fflush(stdout);
   }
+  PrintDecisions(calibrated);
   std::printf(
       "\neveryday driving on each split's held-out runs (ATE RMSE: each run's start pose "
       "aligned, no scale; drift per window of ground-truth path, validation/everyday_driving.h)"
       "\n");
-  for (const SplitScores& s : scores) {
-    PrintEverydayDrivingOfSplit(*model, runs, inputs.ground_truth, s, options.threads);
+  for (const SplitCalibration& s : calibrated) {
+    PrintEverydayDrivingOfSplit(*model, runs, inputs.ground_truth, s.scores, options.threads);
   }
   if (options.leave_one_session_out) {
-    std::vector<SplitScores> folds;
+    std::vector<SplitCalibration> folds;
     for (const GeneralisationSplit& split : LeaveOneSessionOutSplits(runs, session_key)) {
-      folds.push_back(EvaluateSplit(*model, runs, split, fit_options, inputs.candidates, tying));
+      folds.push_back(CalibrateSplit(*model, dataset.runs, runs, split, fit_options,
+                                     inputs.candidates, tying));
     }
     if (!folds.empty()) PrintLeaveOneSessionOut(folds);
   }

@@ -79,11 +79,13 @@ CandidateScore FitCandidate(const RobotModelInterface& model, const std::string&
 // The bounded final-pose fit `name` and, when it held directions the training runs do not
 // determine, the gate's "<name> without holds" candidate: what fitting those directions too
 // would have given, so the table shows what holding them gained or cost on the held-out runs.
+// `made`, when given, is that fit already made.
 void AddFinalPoseFits(const RobotModelInterface& model, const std::string& name,
                       const ModelFitOptions& options, const std::vector<AlignedRun>& train,
-                      const std::vector<AlignedRun>& test, std::vector<CandidateScore>* out) {
+                      const std::vector<AlignedRun>& test, std::vector<CandidateScore>* out,
+                      const ModelFitResult* made = nullptr) {
   const int threads = options.ceres.num_threads;
-  const ModelFitResult fit = FitModel(train, model, options);
+  const ModelFitResult fit = made != nullptr ? *made : FitModel(train, model, options);
   out->push_back(FitCandidate(model, name, fit, train, test, threads));
   if (fit.held_directions.empty()) return;
   CandidateScore free = Score(model, name + " without holds", fit.unconstrained_parameters,
@@ -170,7 +172,8 @@ std::vector<GeneralisationSplit> LeaveOneSessionOutSplits(const std::vector<Alig
 
 SplitScores EvaluateSplit(const RobotModelInterface& model, const std::vector<AlignedRun>& runs,
                           const GeneralisationSplit& split, const ModelFitOptions& options,
-                          const TrackCandidates& track_candidates, const ParameterTying& tying) {
+                          const TrackCandidates& track_candidates, const ParameterTying& tying,
+                          const ModelFitResult* fit) {
   if (split.train.empty() || split.test.empty()) {
     throw std::invalid_argument("generalisation split '" + split.train_name + "' -> '" +
                                 split.test_name + "' has no training or no held-out run");
@@ -187,7 +190,7 @@ SplitScores EvaluateSplit(const RobotModelInterface& model, const std::vector<Al
   }
   ModelFitOptions full = options;
   full.tying = nullptr;
-  AddFinalPoseFits(model, "fit", full, train, test, &out.candidates);
+  AddFinalPoseFits(model, "fit", full, train, test, &out.candidates, fit);
   ModelFitOptions tied = full;
   tied.tying = &tying;
   if (!tying.empty()) AddFinalPoseFits(model, kTiedFitName, tied, train, test, &out.candidates);

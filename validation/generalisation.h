@@ -111,10 +111,12 @@ inline constexpr const char* kTiedTrackFitName = "fit (track, tied)";
 // tied model and scored right after it: "fit (tied)" (and "fit (tied) without holds" when it
 // held directions) after "fit", "fit (track, tied)" after "fit (track)". options.tying is
 // ignored: the full fits stay full. Throws std::invalid_argument when either side is empty.
+// `fit`, when given, is the final-pose fit of split.train already made (by calibrate/
+// generalise_split.h, the fit `fit` makes and gates), scored as "fit" instead of fitting again.
 SplitScores EvaluateSplit(const RobotModelInterface& model, const std::vector<AlignedRun>& runs,
                           const GeneralisationSplit& split, const ModelFitOptions& options,
                           const TrackCandidates& track_candidates = {},
-                          const ParameterTying& tying = {});
+                          const ParameterTying& tying = {}, const ModelFitResult* fit = nullptr);
 
 // One candidate over the folds of leave-one-session-out (candidates are matched by name; a closed
 // form may exist in some folds only).

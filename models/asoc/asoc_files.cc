@@ -13,7 +13,6 @@
 #include "io/text_file.h"
 #include "io/yaml_reader.h"
 #include "io/yaml_text.h"
-#include "odometry/parallel_for.h"
 #include "odometry/pose2.h"
 
 namespace fitcal::io {
@@ -349,29 +348,6 @@ std::string AsocRobotYaml(const AsocRobot& robot, const std::string& calibration
   std::string text = std::string(out.c_str()) + "\n";
   if (!calibration_yaml.empty()) text += "calibration: " + calibration_yaml + "\n";
   return text;
-}
-
-AsocDataset LoadAsocDataset(const std::string& directory, const DatasetOptions& options) {
-  const DatasetIndex index = ReadDatasetIndex(directory, options);
-  // The robot first: a data set of another model is named as such, not as a bad log header.
-  ReadAsocRobot(index.robot_path);
-  AsocDataset dataset;
-  dataset.directory = index.directory;
-  dataset.robot_path = index.robot_path;
-  dataset.runs.resize(index.runs.size());
-  ParallelFor(index.runs.size(), options.num_threads, [&](std::size_t i) {
-    const DatasetIndexEntry& entry = index.runs[i];
-    asoc::RunLog& log = dataset.runs[i];
-    log.id = entry.id;
-    log.trajectory = entry.trajectory;
-    log.repetition = entry.repetition;
-    log.start_pose = entry.start_pose;
-    log.encoders = ReadAsocEncoderCsv(entry.encoders_path);
-    log.ground_truth = ReadGroundTruth(entry.ground_truth_path);
-    CheckGroundTruthOverlap(log.ground_truth, log.encoders.t_s.front(), log.encoders.t_s.back(),
-                            entry.ground_truth_path);
-  });
-  return dataset;
 }
 
 }  // namespace fitcal::io

@@ -81,13 +81,4 @@ AsocRobot ReadAsocRobotNode(const YAML::Node& root, const std::string& path);
 // default CAST-0).
 std::string AsocRobotYaml(const AsocRobot& robot, const std::string& calibration_yaml = "");
 
-struct AsocDataset {
-  std::string directory;
-  std::string robot_path;
-  std::vector<asoc::RunLog> runs;
-};
-
-// dataset.yaml via ReadDatasetIndex, ASOC encoder CSVs, ground truth as for omni3.
-AsocDataset LoadAsocDataset(const std::string& directory, const DatasetOptions& options = {});
-
 }  // namespace fitcal::io

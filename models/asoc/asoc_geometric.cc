@@ -3,44 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <stdexcept>
 
+#include "models/asoc/asoc_files.h"
 #include "odometry/pose2.h"
 
 namespace fitcal::asoc {
-
-namespace {
-
-// Circular mean of castor i's readings over the middle `fraction` of the run.
-double SteadyAngle(const EncoderLog& log, int castor, double fraction) {
-  const std::size_t n = log.samples.size();
-  const std::size_t skip = static_cast<std::size_t>(std::floor(0.5 * (1.0 - fraction) * n));
-  double s = 0.0, c = 0.0;
-  for (std::size_t k = skip; k < n - skip; ++k) {
-    s += std::sin(log.samples[k].pivot_rad[castor]);
-    c += std::cos(log.samples[k].pivot_rad[castor]);
-  }
-  return std::atan2(s, c);
-}
-
-// Total rotation of castor j's pivot encoder, unwrapped sample to sample.
-double PivotRotation(const EncoderLog& log, int castor) {
-  double total = 0.0;
-  for (std::size_t k = 1; k < log.samples.size(); ++k) {
-    total += WrapAngle(log.samples[k].pivot_rad[castor] - log.samples[k - 1].pivot_rad[castor]);
-  }
-  return total;
-}
-
-}  // namespace
-
-bool GeometricOptions::IsValid(std::string* error) const {
-  if (!(steady_fraction > 0.0 && steady_fraction <= 1.0)) {
-    *error = "steady_fraction must be in (0, 1]";
-    return false;
-  }
-  return true;
-}
 
 CastorParameters SolveHoldPair(const HoldMeasurement& m, double pivot_distance_m,
                                double theta_perp_rad) {
@@ -75,16 +42,32 @@ bool ParseHoldLabel(const std::string& trajectory, int* held, int* direction) {
   return false;
 }
 
-HoldRun MeasureHoldRun(const EncoderLog& log, int held, int direction, double steady_fraction) {
+std::optional<HoldRun> MeasureHoldRun(const std::string& trajectory,
+                                      const EncoderSamples& samples) {
   HoldRun run;
-  run.held = held;
-  run.direction = direction;
-  run.rotation_rad = PivotRotation(log, held);
+  const std::size_t n = samples.size();
+  if (!ParseHoldLabel(trajectory, &run.held, &run.direction) || n < 4) return std::nullopt;
+  const std::size_t skip = static_cast<std::size_t>(std::floor(0.5 * (1.0 - kSteadyFraction) * n));
+  const int held_pivot = run.held * kChannelsPerCastor + kPivotChannel;
+  for (std::size_t k = 1; k < n; ++k) {
+    run.rotation_rad += WrapAngle(samples[k].value[held_pivot] - samples[k - 1].value[held_pivot]);
+  }
   for (int i = 0; i < kNumCastors; ++i) {
-    run.steady_gamma_rad[i] = SteadyAngle(log, i, steady_fraction);
-    for (int k = 0; k < 2; ++k) {
-      run.wheel_rad[i][k] =
-          log.samples.back().wheel_rad[i][k] - log.samples.front().wheel_rad[i][k];
+    const int base = i * kChannelsPerCastor;
+    double s = 0.0, c = 0.0;
+    for (std::size_t k = skip; k < n - skip; ++k) {
+      s += std::sin(samples[k].value[base + kPivotChannel]);
+      c += std::cos(samples[k].value[base + kPivotChannel]);
+    }
+    run.steady_gamma_rad[i] = std::atan2(s, c);
+    for (int w = 0; w < 2; ++w) {
+      const int ch = base + (w == 0 ? kWheelAChannel : kWheelBChannel);
+      double angle = 0.0;
+      for (const auto& sample : samples) angle += sample.value[ch] * sample.dt_s;
+      // From the middle of the first interval to the middle of the last, as the pivot's turn.
+      angle -= 0.5 * (samples[0].value[ch] * samples[0].dt_s +
+                      samples[n - 1].value[ch] * samples[n - 1].dt_s);
+      run.wheel_rad[i][w] = angle;
     }
   }
   return run;
@@ -328,17 +311,13 @@ GeometricResult CalibrateFromHoldRuns(const std::vector<HoldRun>& runs, const Ve
 }
 
 GeometricResult CalibrateGeometric(const std::vector<RunLog>& runs, const Vehicle& nominal,
-                                   const GeometricOptions& options) {
-  std::string error;
-  if (!options.IsValid(&error)) throw std::invalid_argument("GeometricOptions: " + error);
+                                   double pivot_resolution_rad) {
   std::vector<HoldRun> holds;
   for (const RunLog& run : runs) {
-    int held = 0, direction = 0;
-    if (!ParseHoldLabel(run.trajectory, &held, &direction)) continue;
-    if (run.encoders.samples.size() < 4) continue;
-    holds.push_back(MeasureHoldRun(run.encoders, held, direction, options.steady_fraction));
+    const fitcal::EncoderLog channels = io::AsocEncoderLogAsChannels(run.encoders);
+    if (const auto hold = MeasureHoldRun(run.trajectory, channels.samples)) holds.push_back(*hold);
   }
-  return CalibrateFromHoldRuns(holds, nominal, options.pivot_resolution_rad);
+  return CalibrateFromHoldRuns(holds, nominal, pivot_resolution_rad);
 }
 
 }  // namespace fitcal::asoc

@@ -16,8 +16,8 @@
 // gives two estimates per castor; they are averaged (beta on the circle).
 //
 // Runs are found by trajectory label "hold_<j>_cw" / "hold_<j>_ccw" (j 1-based). The steady
-// castor angle is the circular mean of the readings over the middle `steady_fraction` of the run,
-// which skips start/stop transients when the castors were not perfectly pre-aligned. Every hold run
+// castor angle is the circular mean of the readings over the middle half of the run
+// (kSteadyFraction), which skips start/stop transients when the castors were not pre-aligned. Every hold run
 // is used: each CW run of castor j is paired with each CCW run of castor j; a castor's estimate is
 // the mean over its held castors of the mean of their pair estimates.
 //
@@ -31,19 +31,15 @@
 // truth in docs/asoc.md.
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "models/asoc/asoc_model.h"
 #include "models/asoc/asoc_run_log.h"
+#include "odometry/encoder_samples.h"
 
 namespace fitcal::asoc {
-
-struct GeometricOptions {
-  double steady_fraction = 0.5;
-  double pivot_resolution_rad = 0.0;  // the pivot encoders' step (0: unknown), for the sigmas
-  bool IsValid(std::string* error) const;
-};
 
 // The measurements Eq. 1-9 use for one (active castor i, held castor j) pair.
 struct HoldMeasurement {
@@ -70,8 +66,14 @@ struct HoldRun {
 
 // "hold_<j>_cw" / "hold_<j>_ccw" (j = 1..3): the held castor (0-based) and the direction.
 bool ParseHoldLabel(const std::string& trajectory, int* held, int* direction);
-// A hold run of the silo's log (readings at sample times).
-HoldRun MeasureHoldRun(const EncoderLog& log, int held, int direction, double steady_fraction);
+inline constexpr double kSteadyFraction = 0.5;
+// A hold run's Eq. 1-9 measurements from the model's channels, when `trajectory` names one and it
+// has at least 4 intervals: steady angles as the circular mean over the middle kSteadyFraction of
+// the intervals, the held pivot's turn from the interval means (mid first to mid last interval)
+// and each wheel's angle over the same span.
+std::optional<HoldRun> MeasureHoldRun(const std::string& trajectory,
+                                      const EncoderSamples& samples);
+
 
 struct GeometricResult {
   bool usable = false;
@@ -98,9 +100,9 @@ double OneSigmaStudentFactor(int dof);
 GeometricResult CalibrateFromHoldRuns(const std::vector<HoldRun>& runs, const Vehicle& nominal,
                                       double pivot_resolution_rad = 0.0);
 
-// The hold runs among `runs` (by label, >= 4 samples) through CalibrateFromHoldRuns. Throws
-// std::invalid_argument for invalid options.
+// The hold runs among `runs` (MeasureHoldRun on the model's channels,
+// io::AsocEncoderLogAsChannels) through CalibrateFromHoldRuns.
 GeometricResult CalibrateGeometric(const std::vector<RunLog>& runs, const Vehicle& nominal,
-                                   const GeometricOptions& options = {});
+                                   double pivot_resolution_rad = 0.0);
 
 }  // namespace fitcal::asoc

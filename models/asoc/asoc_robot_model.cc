@@ -39,8 +39,6 @@ constexpr const char* kOffsetHeldReason =
 constexpr const char* kBiasHeldReason =
     "a pivot bias is absorbed by the wheel parameters (Doebbler Fig. 3); the closed form measures "
     "it (Eq. 2)";
-// Eq. 1-9's steady castor angle: the middle half of a hold run (asoc_geometric.h).
-constexpr double kSteadyFraction = 0.5;
 
 bool IsColumnSafe(const std::string& name) {
   if (name.empty()) return false;
@@ -150,46 +148,11 @@ std::string AsocModel::RobotYaml(const std::vector<double>& p,
   return io::AsocRobotYaml(out) + calibration_block;
 }
 
-asoc::HoldRun MeasureHoldRun(const EncoderSamples& samples, int held, int direction,
-                             double steady_fraction) {
-  asoc::HoldRun run;
-  run.held = held;
-  run.direction = direction;
-  const std::size_t n = samples.size();
-  const std::size_t skip = static_cast<std::size_t>(std::floor(0.5 * (1.0 - steady_fraction) * n));
-  const int held_pivot = held * asoc::kChannelsPerCastor + asoc::kPivotChannel;
-  for (std::size_t k = 1; k < n; ++k) {
-    run.rotation_rad += WrapAngle(samples[k].value[held_pivot] - samples[k - 1].value[held_pivot]);
-  }
-  for (int i = 0; i < asoc::kNumCastors; ++i) {
-    const int base = i * asoc::kChannelsPerCastor;
-    double s = 0.0, c = 0.0;
-    for (std::size_t k = skip; k < n - skip; ++k) {
-      s += std::sin(samples[k].value[base + asoc::kPivotChannel]);
-      c += std::cos(samples[k].value[base + asoc::kPivotChannel]);
-    }
-    run.steady_gamma_rad[i] = std::atan2(s, c);
-    for (int w = 0; w < 2; ++w) {
-      const int ch = base + (w == 0 ? asoc::kWheelAChannel : asoc::kWheelBChannel);
-      double angle = 0.0;
-      for (const auto& sample : samples) angle += sample.value[ch] * sample.dt_s;
-      // From the middle of the first interval to the middle of the last, as the pivot's turn.
-      angle -= 0.5 * (samples[0].value[ch] * samples[0].dt_s +
-                      samples[n - 1].value[ch] * samples[n - 1].dt_s);
-      run.wheel_rad[i][w] = angle;
-    }
-  }
-  return run;
-}
-
 std::vector<ClosedFormCalibration> AsocModel::ClosedForms(
     const std::vector<AlignedRun>& training) const {
   std::vector<asoc::HoldRun> holds;
   for (const AlignedRun& run : training) {
-    int held = 0, direction = 0;
-    if (!asoc::ParseHoldLabel(run.trajectory, &held, &direction) || run.samples.size() < 4)
-      continue;
-    holds.push_back(MeasureHoldRun(run.samples, held, direction, kSteadyFraction));
+    if (const auto hold = asoc::MeasureHoldRun(run.trajectory, run.samples)) holds.push_back(*hold);
   }
   if (holds.empty()) return {};
   const asoc::GeometricResult result =

@@ -55,12 +55,6 @@ class AsocModel : public KinematicModel<AsocKinematics> {
 Robot AsocRobotDescription(const std::string& name,
                            const std::array<std::string, asoc::kNumCastors>& castor_names);
 
-// A hold run's Eq. 1-9 measurements from the model's channels: steady angles as the circular
-// mean over the middle `steady_fraction` of the intervals, the held pivot's turn from the
-// interval means (mid first to mid last interval) and each wheel's angle over the same span.
-asoc::HoldRun MeasureHoldRun(const EncoderSamples& samples, int held, int direction,
-                             double steady_fraction);
-
 // The simulated one-third-scale prototype (tools/sim/asoc_simulator.h AsocPrototypeVehicle).
 inline constexpr const char* kAsocExampleYaml = R"(model: asoc
 name: example_asoc
