@@ -1018,12 +1018,15 @@ double AcrossTheBox(const ParameterInfo& info, const Interval& box, double fract
 // nominal: a window's error does not accumulate along a run, so a guess far off meets none of the
 // minima a whole run's final pose or track has (diagnosis/channel_order_check.h measured a
 // tricycle's 2.5x gain: final poses fitted from the guess SSR 177, from the windows' fit 0.0056).
-// Empty when the fit is itself one of windows, a run was aligned without its track, or there are
-// fewer than 4 windows in all.
+// Only for a fit of tracks, which see all the windows see: a final-pose fit holds what its runs
+// leave undetermined at its start, and from the windows' fit that would be a value its own
+// residuals never measured (GeneralisationOptiOdom.CheckpointsSeeWhatAClosedPathHidesFromItsFinal-
+// Pose, generalisation_test).
+// Empty otherwise, when a run was aligned without its track, or with fewer than 4 windows in all.
 std::optional<std::vector<double>> WindowsStart(const std::vector<AlignedRun>& training,
                                                 const RobotModelInterface& model,
                                                 const ModelFitOptions& options) {
-  if (options.segments != nullptr) return std::nullopt;
+  if (!UsesTracks(options)) return std::nullopt;
   SegmentOptions windows;
   windows.length_m = 0.5;
   windows.stride_fraction = 1.0;
