@@ -64,6 +64,16 @@ std::vector<sim::TrajectorySpec> StraightRunsOnly() {
   return out;
 }
 
+// How far `p` moved from the nominal along held direction `d`, in the prior's units.
+double MovedAlong(const Robot& robot, const UndeterminedDirection& d, const std::vector<double>& p) {
+  double along = 0.0;
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    const double prior_sigma = robot.bounds[k].Width() / std::sqrt(12.0);
+    if (!robot.IsHeld(k)) along += d.prior_units[k] * (p[k] - robot.nominal[k]) / prior_sigma;
+  }
+  return along;
+}
+
 TEST(DeterminedDirections, StraightRunsLeaveTheYawGeometryUndeterminedAndItIsHeld) {
   const RobotModelPtr model = testing::ExampleModel("omni");
   const Robot& robot = model->robot();
@@ -94,14 +104,7 @@ TEST(DeterminedDirections, StraightRunsLeaveTheYawGeometryUndeterminedAndItIsHel
       EXPECT_NE(d.description.find("R_"), std::string::npos);
     }
     // Held: the fitted point has not moved along the direction (prior units, hold stiffness 1e4).
-    double along = 0.0;
-    for (int k = 0; k < robot.NumParameters(); ++k) {
-      const double prior_sigma = robot.bounds[k].Width() / std::sqrt(12.0);
-      if (!robot.IsHeld(k)) {
-        along += d.prior_units[k] * (held.parameters[k] - robot.nominal[k]) / prior_sigma;
-      }
-    }
-    EXPECT_LT(std::abs(along), 1e-3);
+    EXPECT_LT(std::abs(MovedAlong(robot, d, held.parameters)), 1e-3);
   }
   EXPECT_EQ(distance_directions, 3);
   // On the whole flower and the spins, the held fit beats the nominal and the unconstrained fit.
@@ -124,29 +127,9 @@ TEST(DeterminedDirections, StraightRunsLeaveTheYawGeometryUndeterminedAndItIsHel
 TEST(DeterminedDirections, ATrackFitCarriesThePriorAlongItsHeldDirections) {
   const RobotModelPtr model = testing::ExampleModel("omni");
   const Robot& robot = model->robot();
-  std::vector<double> truth = robot.nominal;
-  for (int k = 0; k < robot.NumParameters(); ++k) {
-    if (robot.IsHeld(k)) continue;
-    truth[k] += (k % 2 == 0 ? 1.0 : -1.0) *
-                (robot.parameters[k].unit == ParameterUnit::kAngle ? 0.7 * M_PI / 180.0
-                                                                   : 0.03 * robot.nominal[k]);
-  }
-  sim::SimulationOptions options;
-  options.encoder_period_s = 0.02;
-  options.ground_truth_period_s = 0.05;
-  options.wheel_rate_sigma_rad_s = 0.2;
-  options.gt_position_sigma_m = 0.002;
-  options.gt_heading_sigma_rad = 0.004;
-  options.record_start_pose = true;
-  options.seed = 7;
-  std::vector<RunLog> logs;
-  for (const auto& s : sim::SimulateRuns(*model, truth, StraightRunsOnly(), options)) {
-    logs.push_back(s.log);
-  }
-  const std::vector<AlignedRun> runs = AlignRuns(logs);
-  std::vector<const GroundTruthTrack*> tracks;
-  for (const RunLog& log : logs) tracks.push_back(&log.ground_truth);
-  TrackFitData track = MakeTrackFitData(runs, tracks, ClockGrouping::kNone);
+  std::vector<double> truth;
+  const std::vector<AlignedRun> runs = Simulate(*model, StraightRunsOnly(), 7, &truth);
+  TrackFitData track = MakeTrackFitData(runs, TracksOf(runs), ClockGrouping::kNone);
   track.estimate_clock_offsets = false;
   ModelFitOptions fit_options;
   fit_options.residuals = ResidualKind::kTrack;
@@ -201,14 +184,7 @@ TEST(DeterminedDirections, HeldFitFromTheProjectionEndsNoHigherAndStillGeneralis
   EXPECT_EQ(projected.held_directions.size(), from_start.held_directions.size());
   EXPECT_LE(projected.final_cost, from_start.final_cost * (1.0 + 1e-6));
   for (const UndeterminedDirection& d : projected.held_directions) {
-    double along = 0.0;
-    for (int k = 0; k < robot.NumParameters(); ++k) {
-      const double prior_sigma = robot.bounds[k].Width() / std::sqrt(12.0);
-      if (!robot.IsHeld(k)) {
-        along += d.prior_units[k] * (projected.parameters[k] - robot.nominal[k]) / prior_sigma;
-      }
-    }
-    EXPECT_LT(std::abs(along), 1e-3) << d.description;
+    EXPECT_LT(std::abs(MovedAlong(robot, d, projected.parameters)), 1e-3) << d.description;
   }
   const double cf_nominal = EvaluateFinalPoseErrors(*model, robot.nominal, validation).cf;
   const double cf_projected = EvaluateFinalPoseErrors(*model, projected.parameters, validation).cf;
