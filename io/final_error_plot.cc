@@ -3,16 +3,16 @@
 namespace fitcal::io {
 
 namespace {
-const char* const kBeforeColour = "#d55e00";  // vermillion: nominal parameters
-const char* const kAfterColour = "#0072b2";   // blue: calibrated parameters
+const char* const kNominalColour = "#d55e00";  // vermillion: nominal parameters
+const char* const kCalibratedColour = "#0072b2";  // blue: calibrated parameters
 }  // namespace
 
 std::string FinalErrorScatterSvg(const FinalErrorScatter& s) {
   SvgSeries before, after, origin;
   before.name = s.before_name;
-  before.color = kBeforeColour;
+  before.color = kNominalColour;
   after.name = s.after_name;
-  after.color = kAfterColour;
+  after.color = kCalibratedColour;
   origin.name = s.origin_name;
   origin.lines = {{Point2{0.0, 0.0}}};
   origin.opacity = s.origin_opacity;

@@ -8,7 +8,7 @@ namespace fitcal {
 namespace {
 
 // a^-1 b for planar poses.
-Pose2d Between(const Pose2d& a, const Pose2d& b) {
+Pose2d BetweenWrapped(const Pose2d& a, const Pose2d& b) {
   const double c = std::cos(a.theta), s = std::sin(a.theta);
   const double dx = b.x - a.x, dy = b.y - a.y;
   return {c * dx + s * dy, -s * dx + c * dy, WrapAngle(b.theta - a.theta)};
@@ -31,9 +31,9 @@ std::vector<RelativePoseErrorWindow> RelativePoseErrorWindows(
     if (j < i) j = i;
     while (j < n && s[j] - s[i] < length_m) ++j;
     if (j == n) break;  // no later start reaches the length either
-    const Pose2d truth = Between(ground_truth[i], ground_truth[j]);
-    const Pose2d odo = Between(odometry[i], odometry[j]);
-    const Pose2d e = Between(truth, odo);
+    const Pose2d truth = BetweenWrapped(ground_truth[i], ground_truth[j]);
+    const Pose2d odo = BetweenWrapped(odometry[i], odometry[j]);
+    const Pose2d e = BetweenWrapped(truth, odo);
     out.push_back({i, j, std::hypot(e.x, e.y) / length_m, std::abs(e.theta) / length_m});
   }
   return out;
