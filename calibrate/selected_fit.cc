@@ -83,7 +83,7 @@ SelectedFit DescribeSelected(const Robot& robot,
     out.held = fit.held;
     out.not_determined = NotDeterminedParameters(fit);
   } else if (selected.name == method + " without holds") {
-    out.at_bound = ParametersAtBound(robot, selected.parameters);  // its own point, not the held fit's
+    out.at_bound = ParametersAtBound(robot, selected.parameters);  // its own, not the held fit's
     out.held = fit.held;  // the parameters' holds (gauge, --hold) stay; the directions' go
   } else if (selected_index > 0) {
     // A closed form measures the base; the pose source's frame is the nominal it was handed

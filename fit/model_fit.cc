@@ -1058,8 +1058,8 @@ std::vector<double> StartAcrossTheBox(const Robot& robot, const ModelFitOptions&
   return start;
 }
 
-// ModelFitOptions::global_start: the starts spread across the box, then (with dense ground truth)
-// the fit of 0.5 m windows, the lowest cost kept; the first start whose fit leaves no reason to go
+// ModelFitOptions::global_start: the starts spread across the box, then (a fit of tracks) the fit
+// of 0.5 m windows, the lowest cost kept; the first start whose fit leaves no reason to go
 // on ends the search. The windows come last: where a start across the box suffices, nothing
 // changes (measured: a tricycle guessed with twice its steering gain on two 40 m free runs with a
 // mounted pose source ended with its radius on a bound from the guess and from every start across
@@ -1097,7 +1097,8 @@ ModelFitResult WithGlobalStart(const std::vector<AlignedRun>& training,
   const std::string tried = fractions + " of the way across the box" + windows;
   char text[700];
   if (best_start.empty()) {
-    std::snprintf(text, sizeof text, "the fit from the guess %s; fits from %s found no lower cost: kept",
+    std::snprintf(text, sizeof text,
+                  "the fit from the guess %s; fits from %s found no lower cost: kept",
                   reason.c_str(), tried.c_str());
   } else {
     std::snprintf(text, sizeof text,

@@ -75,7 +75,8 @@ TEST_P(FreeDriveFarGuess, TricycleAndItsSensorsMountFromTwoRuns) {
                                 {"ticks_traction", "steering"});
   fitcal::testing::WriteFileBytes(dir.Path("truth.yaml"),
                                   TricycleYaml(truth, kMountX, kMountY, kMountYawDeg));
-  const auto r = RunFitcal(dir, "fit --logs " + dir.Path("data") + " --out " + dir.Path("cal.yaml"));
+  const auto r =
+      RunFitcal(dir, "fit --logs " + dir.Path("data") + " --out " + dir.Path("cal.yaml"));
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   EXPECT_TRUE(Has(r.out, "the one from the windows' fit")) << r.out;
   const fitcal::Robot fitted = fitcal::ReadRobotModelFile(dir.Path("cal.yaml"))->robot();

@@ -87,9 +87,9 @@ std::vector<sim::TrajectorySpec> TricycleScenario(const Robot& robot,
     if (deg <= shapes.max_steering_deg) circles.push_back(deg);
   }
   if (circles.empty()) {
-    throw std::invalid_argument("the true steering gain reads at most " +
-                                std::to_string(shapes.max_steering_deg) +
-                                " deg of wheel steering: too little to drive the calibration circles");
+    throw std::invalid_argument(
+        "the true steering gain reads at most " + std::to_string(shapes.max_steering_deg) +
+        " deg of wheel steering: too little to drive the calibration circles");
   }
   shapes.steering_deg = circles;
   shapes.repetitions = repetitions;
