@@ -64,8 +64,17 @@ std::vector<sim::TrajectorySpec> StraightRunsOnly() {
   return out;
 }
 
+// The whole flower and a full turn on the spot each way (seed 8): what straight runs did not see.
+std::vector<AlignedRun> FlowerWithSpins(const RobotModelInterface& model,
+                                        std::vector<double>* truth) {
+  sim::OmniTrajectoryOptions shapes;
+  shapes.spin_angle_rad = 2.0 * M_PI;
+  return Simulate(model, sim::OmniFlowerTrajectories(1, shapes), 8, truth);
+}
+
 // How far `p` moved from the nominal along held direction `d`, in the prior's units.
-double MovedAlong(const Robot& robot, const UndeterminedDirection& d, const std::vector<double>& p) {
+double MovedAlong(const Robot& robot, const UndeterminedDirection& d,
+                  const std::vector<double>& p) {
   double along = 0.0;
   for (int k = 0; k < robot.NumParameters(); ++k) {
     const double prior_sigma = robot.bounds[k].Width() / std::sqrt(12.0);
@@ -79,10 +88,7 @@ TEST(DeterminedDirections, StraightRunsLeaveTheYawGeometryUndeterminedAndItIsHel
   const Robot& robot = model->robot();
   std::vector<double> truth;
   const std::vector<AlignedRun> training = Simulate(*model, StraightRunsOnly(), 7, &truth);
-  sim::OmniTrajectoryOptions shapes;
-  shapes.spin_angle_rad = 2.0 * M_PI;
-  const std::vector<AlignedRun> validation =
-      Simulate(*model, sim::OmniFlowerTrajectories(1, shapes), 8, &truth);
+  const std::vector<AlignedRun> validation = FlowerWithSpins(*model, &truth);
 
   ModelFitOptions unconstrained_options;
   unconstrained_options.hold_undetermined = false;
@@ -169,10 +175,7 @@ TEST(DeterminedDirections, HeldFitFromTheProjectionEndsNoHigherAndStillGeneralis
   const Robot& robot = model->robot();
   std::vector<double> truth;
   const std::vector<AlignedRun> training = Simulate(*model, StraightRunsOnly(), 7, &truth);
-  sim::OmniTrajectoryOptions shapes;
-  shapes.spin_angle_rad = 2.0 * M_PI;
-  const std::vector<AlignedRun> validation =
-      Simulate(*model, sim::OmniFlowerTrajectories(1, shapes), 8, &truth);
+  const std::vector<AlignedRun> validation = FlowerWithSpins(*model, &truth);
   ModelFitOptions options;
   options.ceres.compute_covariance = false;
   const ModelFitResult from_start = FitModelFrom(training, *model, robot.nominal, options);
