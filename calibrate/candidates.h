@@ -40,15 +40,16 @@ struct TrackFits {
   int without_index = -1, with_index = -1;
 };
 
-// Nominal (with the effects the robot declares), closed forms, the fit; and when the fit held
-// undetermined directions and held-out runs can judge it, the fit without the holds too (on the
-// training runs alone it would always win, by fitting what the data cannot tell apart). Under
-// --tie/--hold the closed forms stay out: they fit the full model, not the one asked for.
 // The nominal (with the effects the robot declares) and, when `closed_forms`, the model's closed
 // forms computed from the training runs: the candidates before any fit.
 std::vector<CalibrationCandidate> NominalAndClosedForms(const RobotModelInterface& model,
                                                        const RunSplit& split, bool closed_forms);
 
+// Nominal (with the effects the robot declares), closed forms, the fit; and when the fit held
+// undetermined directions and held-out runs can judge it, the fit without the holds too (on the
+// training runs alone it would always win, by fitting what the data cannot tell apart), not usable
+// when one of its free parameters ran onto a bound. Under --tie/--hold the closed forms stay out:
+// they fit the full model, not the one asked for.
 std::vector<CalibrationCandidate> Candidates(const RobotModelInterface& model,
                                              const RunSplit& split, const ModelFitResult& fit,
                                              const std::string& method, bool closed_forms);

@@ -317,15 +317,8 @@ ChannelOrderReport CheckRecordedChannelOrder(const std::vector<AlignedRun>& runs
   if (tracks.size() != runs.size()) {
     throw std::invalid_argument("CheckRecordedChannelOrder: not one ground truth per run");
   }
-  SegmentOptions windows;
-  windows.length_m = 0.5;
-  windows.stride_fraction = 1.0;  // disjoint: independent residuals for the F test
-  std::vector<std::vector<Segment>> segments(runs.size());
-  std::size_t total = 0;
-  for (std::size_t i = 0; i < runs.size(); ++i) {
-    segments[i] = MakeSegments(runs[i], *tracks[i], windows);
-    total += segments[i].size();
-  }
+  std::size_t total = 0;  // disjoint: independent residuals for the F test
+  const std::vector<std::vector<Segment>> segments = MakeDisjointWindows(runs, tracks, &total);
   ChannelOrderReport final_poses =
       CheckOrder(runs, {}, total < 4 ? nullptr : &segments, model, options);
   if (total < 4 || final_poses.likely_miswired) return final_poses;

@@ -1027,16 +1027,12 @@ std::optional<std::vector<double>> WindowsStart(const std::vector<AlignedRun>& t
                                                 const RobotModelInterface& model,
                                                 const ModelFitOptions& options) {
   if (!UsesTracks(options)) return std::nullopt;
-  SegmentOptions windows;
-  windows.length_m = 0.5;
-  windows.stride_fraction = 1.0;
-  std::vector<std::vector<Segment>> segments(training.size());
-  std::size_t total = 0;
-  for (std::size_t i = 0; i < training.size(); ++i) {
-    if (training[i].track == nullptr) return std::nullopt;
-    segments[i] = MakeSegments(training[i], *training[i].track, windows);
-    total += segments[i].size();
+  for (const AlignedRun& run : training) {
+    if (run.track == nullptr) return std::nullopt;
   }
+  std::size_t total = 0;
+  const std::vector<std::vector<Segment>> segments =
+      MakeDisjointWindows(training, TracksOf(training), &total);
   if (total < 4) return std::nullopt;
   ModelFitOptions on_windows = options;
   on_windows.segments = &segments;

@@ -47,6 +47,21 @@ Pose2d Between(const Pose2d& a, const Pose2d& b) {
 
 }  // namespace
 
+std::vector<std::vector<Segment>> MakeDisjointWindows(
+    const std::vector<AlignedRun>& runs, const std::vector<const GroundTruthTrack*>& tracks,
+    std::size_t* total) {
+  SegmentOptions windows;
+  windows.length_m = kDisjointWindowM;
+  windows.stride_fraction = 1.0;
+  std::vector<std::vector<Segment>> out(runs.size());
+  *total = 0;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    out[i] = MakeSegments(runs[i], *tracks[i], windows);
+    *total += out[i].size();
+  }
+  return out;
+}
+
 std::vector<Segment> MakeSegments(const AlignedRun& run, const GroundTruthTrack& ground_truth,
                                   const SegmentOptions& options) {
   std::string error;

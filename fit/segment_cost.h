@@ -14,6 +14,7 @@
 //    ApplyClockMap re-stamps the ground truth. Windows are also long (default 1 m) so that a
 //    residual dt of a few 10 ms costs |v| dt / L ~ 1 %.
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,14 @@ struct SegmentOptions {
 // Windows of `run` (aligned against `ground_truth`, which must cover the run's window).
 std::vector<Segment> MakeSegments(const AlignedRun& run, const GroundTruthTrack& ground_truth,
                                   const SegmentOptions& options);
+
+// Disjoint windows of kDisjointWindowM of every run (runs[i] against tracks[i]): independent
+// relative motions, which neither accumulate a run's error (the global start's last start,
+// fit/model_fit.h) nor share residuals (the wheel-order check's F test). `*total`: their count.
+constexpr double kDisjointWindowM = 0.5;
+std::vector<std::vector<Segment>> MakeDisjointWindows(
+    const std::vector<AlignedRun>& runs, const std::vector<const GroundTruthTrack*>& tracks,
+    std::size_t* total);
 
 // Sousa et al.'s OptiOdom cost ("OptiOdom: a Generic Approach for Odometry Calibration of Wheeled
 // Mobile Robots", J. Intell. Robot. Syst. 2022; their simulateRobot_*.m and Rprop_*.m): windows
