@@ -16,7 +16,7 @@
 
 namespace fitcal {
 
-// The solver flags (tools/solver_options.h) checked and in the solvers' terms (enums, SI
+// The solver flags (cli/solver_options.h) checked and in the solvers' terms (enums, SI
 // weights), with the worker threads and a progress callback; each method uses the ones that apply
 // to it.
 struct FitMethodSettings {

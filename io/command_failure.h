@@ -1,7 +1,7 @@
 #pragma once
 // A command's failure that has an exit status of its own (README, exit codes): thrown where it is
 // found, turned into one line `<prefix>: <what>` and that status by RunReportingErrors
-// (tools/dataset_command.h), the one edge every command shares. Any other exception is bad
+// (cli/dataset_command.h), the one edge every command shares. Any other exception is bad
 // input: status 1.
 
 #include <stdexcept>

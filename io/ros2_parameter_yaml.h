@@ -1,6 +1,6 @@
 #pragma once
 // Values as a ROS 2 parameter YAML (ros__parameters) must hold them: every controller writer
-// (models/model_extras.h) and the export command (tools/export_ros2_control.h) write through these.
+// (models/model_extras.h) and the export command (cli/export_ros2_control.h) write through these.
 
 #include <string>
 #include <vector>

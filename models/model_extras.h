@@ -17,7 +17,7 @@ namespace fitcal {
 
 // What a controller's parameters are, and what the controller computes from them as written
 // (12 significant digits), for the export's replay: the calibrated model at the representable
-// values, or a model of the controller's own geometry (tools/export_ros2_control.h).
+// values, or a model of the controller's own geometry (cli/export_ros2_control.h).
 struct ControllerExport {
   std::string parameters_yaml;     // `<node>:\n  ros__parameters:\n    ...` without the comments
   std::vector<std::string> notes;  // one line per parameter the controller cannot represent
@@ -53,7 +53,7 @@ struct ControllerWriter {
   ControllerWriteFn write;
 };
 
-// The trajectories `simulate --model` drives the model on (tools/sim/model_scenarios.h), and
+// The trajectories `simulate --model` drives the model on (sim/model_scenarios.h), and
 // how far its default true robot is from the nominal one (a fraction of the way to the bounds).
 // The commands are the nominal robot's; the true parameters may only limit what the machine can
 // drive (a tricycle's readable steering range).
@@ -78,7 +78,7 @@ struct ModelExtras {
   // Empty: the parameters in display units (m, deg).
   std::function<ParameterDisplay(const Robot&)> display;
   // `simulate` without --model drives it with the stepped flower engine
-  // (tools/sim/flower_scenario.h) instead of a scenario: data/flower's bytes come from there.
+  // (sim/flower_scenario.h) instead of a scenario: data/flower's bytes come from there.
   bool legacy_simulator = false;
 };
 

@@ -1,6 +1,6 @@
 #pragma once
 // A calibration trajectory as the simulator drives it: body twists held for given durations
-// (tools/sim/model_simulator.h turns one into encoder and ground-truth logs). Here, below the
+// (sim/model_simulator.h turns one into encoder and ground-truth logs). Here, below the
 // simulator, so that a model can register the trajectories it is calibrated on
 // (models/model_extras.h) without knowing the simulator.
 

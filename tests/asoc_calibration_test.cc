@@ -10,8 +10,8 @@
 #include "io/input_error.h"
 #include "models/asoc/asoc_files.h"
 #include "models/asoc/asoc_geometric.h"
-#include "tools/sim/asoc_scenarios.h"
-#include "tools/sim/asoc_simulator.h"
+#include "sim/asoc_scenarios.h"
+#include "sim/asoc_simulator.h"
 #include "tests/test_paths.h"
 
 namespace fitcal::asoc {
@@ -176,7 +176,7 @@ namespace {
 
 // The closed form's sigmas (GeometricResult::sigma: the spread of each castor's two estimates,
 // pooled over the castors, widened by Student's t for 3 degrees of freedom) against the truth of
-// the ASOC simulator (tools/sim/asoc_simulator.h: castor dynamics integrated with RK4 and
+// the ASOC simulator (sim/asoc_simulator.h: castor dynamics integrated with RK4 and
 // quantised encoders; it shares the castor kinematics of asoc_model.h with the library, not
 // Eq. 1-9 nor the replay), over 30 random vehicles per noise level: quantisation only, and 2 % and
 // 5 % random error on each wheel increment (the sigmas add the pivot step, 0.07 deg, propagated
@@ -246,7 +246,7 @@ TEST(AsocGeometricTest, SigmasCoverTheErrorOnSimulatedVehicles) {
   }
 }
 
-// asoc-simulate's data set (tools/sim/asoc_scenarios.h): 6 holds, 10 UMBmark circuits as
+// asoc-simulate's data set (sim/asoc_scenarios.h): 6 holds, 10 UMBmark circuits as
 // repetitions 6-10 and the excursions as 1..N, every id distinct; the closed form on its holds
 // lands nearer the drawn truth than the prototype is (noise-free encoders but the pivot step),
 // so the truth it writes is the one that drove the runs. The same seed gives the same runs.

@@ -20,7 +20,7 @@
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
 #include "tests/test_files.h"
-#include "tools/sim/asoc_simulator.h"
+#include "sim/asoc_simulator.h"
 
 namespace fitcal {
 namespace {

@@ -8,7 +8,7 @@
 #include <random>
 
 #include "models/asoc/asoc_model.h"
-#include "tools/sim/asoc_simulator.h"
+#include "sim/asoc_simulator.h"
 
 namespace fitcal::asoc {
 namespace {

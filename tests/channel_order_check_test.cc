@@ -1,6 +1,6 @@
 // The one channel-order check (diagnosis/channel_order_check.h) on omni3 through the model seam:
 // what tests/wheel_order_check_test.cc checks of the omni3-only check, ported - simulated runs
-// (tools/sim) with the documented default noise and the simulator's true robot (Palacin Table 5)
+// (sim/) with the documented default noise and the simulator's true robot (Palacin Table 5)
 // differing from the nominal (Eq. 15), as in a real calibration.
 
 #include "diagnosis/channel_order_check.h"
@@ -15,7 +15,7 @@
 
 #include "models/omni3/omni3_robot_model.h"
 #include "tests/test_files.h"
-#include "tools/sim/flower_scenario.h"
+#include "sim/flower_scenario.h"
 
 namespace fitcal {
 namespace channel_order_check_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)

@@ -23,8 +23,8 @@
 #include "odometry/aligned_run.h"
 #include "tests/model_support.h"
 #include "tests/test_files.h"
-#include "tools/fit_command.h"
-#include "tools/sim/model_simulator.h"
+#include "cli/fit_command.h"
+#include "sim/model_simulator.h"
 
 namespace fitcal {
 namespace clock_offset_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)

@@ -12,7 +12,7 @@
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
 #include "tests/model_support.h"
-#include "tools/sim/model_scenarios.h"
+#include "sim/model_scenarios.h"
 
 namespace fitcal {
 namespace {

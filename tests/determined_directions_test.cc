@@ -19,7 +19,7 @@
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
 #include "tests/model_support.h"
-#include "tools/sim/model_simulator.h"
+#include "sim/model_simulator.h"
 #include "models/omni/omni_trajectories.h"
 
 namespace fitcal {

@@ -25,7 +25,7 @@
 #include "tests/diagnose_expectations.h"
 #include "tests/test_files.h"
 #include "models/diff_drive/diff_drive_trajectories.h"
-#include "tools/sim/model_simulator.h"
+#include "sim/model_simulator.h"
 #include "validation/trajectory_metrics.h"
 
 namespace fitcal {

@@ -28,9 +28,9 @@
 #include "odometry/aligned_run.h"
 #include "tests/model_support.h"
 #include "tests/test_files.h"
-#include "tools/import_optiodom.h"
+#include "cli/import_optiodom.h"
 #include "models/diff_drive/diff_drive_trajectories.h"
-#include "tools/sim/model_simulator.h"
+#include "sim/model_simulator.h"
 #include "validation/generalisation.h"
 
 namespace fitcal {

@@ -3,7 +3,7 @@
 // separation only scatters: none. Robot r2 is stable but one night's calibration went wrong
 // (radius 2 mm off): an outlier, and not a trend.
 
-#include "tools/fleet_command.h"
+#include "cli/fleet_command.h"
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>

@@ -22,7 +22,7 @@
 #include "models/model_registry.h"
 #include "tests/model_support.h"
 #include "tests/models/unicycle_test_model.h"
-#include "tools/sim/model_simulator.h"
+#include "sim/model_simulator.h"
 
 namespace fitcal {
 namespace {

@@ -1,5 +1,5 @@
 // `generalise --tie/--hold` (validation/generalisation.h EvaluateSplit with a ParameterTying,
-// tools/tying_flags.h): the reduced model is fitted beside the full one on every split.
+// cli/tying_flags.h): the reduced model is fitted beside the full one on every split.
 //   - library: a differential drive whose true radii differ by 2.4 %; the full fit finds them
 //     apart, the tied fits ("fit (tied)", "fit (track, tied)") give both radii one value (exactly
 //     equal: p = A q copies it) and leave a held parameter at its nominal. A tie that were ignored
@@ -24,7 +24,7 @@
 #include "odometry/aligned_run.h"
 #include "tests/test_files.h"
 #include "models/diff_drive/diff_drive_trajectories.h"
-#include "tools/sim/model_simulator.h"
+#include "sim/model_simulator.h"
 #include "validation/generalisation.h"
 
 namespace fitcal {

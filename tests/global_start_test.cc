@@ -2,7 +2,7 @@
 // guess ends in a local minimum off every bound: a differential drive whose pose source is a
 // sensor mounted at (1.5 m, -0.2 m, 5 deg), guessed 0.3 m, 0.2 m and 5 deg off, with its wheel
 // separation 20 % off (0.20 for 0.24) and its radii 5-10 % off, simulated as `fitcal simulate`
-// does (tools/sim/model_scenarios.h: squares and circles, encoder and ground-truth noise), fitted
+// does (sim/model_scenarios.h: squares and circles, encoder and ground-truth noise), fitted
 // on the track residuals as `fit` does by default. Measured: from the guess, the fit stops at a
 // separation of 0.18 with the mount 0.8 m off and 59 deg of final heading error, on no bound; its
 // own sigmas are 2.7-3.9x the box's. The global start must find the truth.
@@ -18,7 +18,7 @@
 #include "fit/track_residual.h"
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
-#include "tools/sim/model_scenarios.h"
+#include "sim/model_scenarios.h"
 
 namespace fitcal {
 namespace {

@@ -17,10 +17,10 @@
 #include "models/model_registry.h"
 #include "tests/models/unicycle_test_model.h"
 #include "tests/test_files.h"
-#include "tools/compare_command.h"
-#include "tools/export_ros2_control.h"
-#include "tools/sim/scenario_noise.h"
-#include "tools/simulate_command.h"
+#include "cli/compare_command.h"
+#include "cli/export_ros2_control.h"
+#include "sim/scenario_noise.h"
+#include "cli/simulate_command.h"
 
 namespace fitcal {
 namespace {

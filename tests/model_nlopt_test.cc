@@ -19,7 +19,7 @@
 #include "odometry/aligned_run.h"
 #include "tests/model_support.h"
 #include "tests/test_files.h"
-#include "tools/sim/model_scenarios.h"
+#include "sim/model_scenarios.h"
 
 namespace fitcal {
 namespace {

@@ -21,7 +21,7 @@
 #include "tests/model_support.h"
 #include "tests/test_files.h"
 #include "models/diff_drive/diff_drive_trajectories.h"
-#include "tools/sim/model_simulator.h"
+#include "sim/model_simulator.h"
 
 namespace fitcal {
 namespace {

@@ -27,8 +27,8 @@
 #include "odometry/aligned_run.h"
 #include "tests/model_support.h"
 #include "tests/test_files.h"
-#include "tools/import_optiodom.h"
-#include "tools/sim/model_simulator.h"
+#include "cli/import_optiodom.h"
+#include "sim/model_simulator.h"
 #include "models/omni/omni_trajectories.h"
 
 namespace fitcal {

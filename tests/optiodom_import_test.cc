@@ -14,7 +14,7 @@
 #include "io/log_files.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "odometry/aligned_run.h"
-#include "tools/import_optiodom.h"
+#include "cli/import_optiodom.h"
 #include "tests/test_paths.h"
 
 namespace fitcal {

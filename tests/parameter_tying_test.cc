@@ -28,7 +28,7 @@
 #include "odometry/aligned_run.h"
 #include "tests/test_files.h"
 #include "models/diff_drive/diff_drive_trajectories.h"
-#include "tools/sim/model_simulator.h"
+#include "sim/model_simulator.h"
 
 namespace fitcal {
 namespace {

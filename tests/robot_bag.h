@@ -1,5 +1,5 @@
 #pragma once
-// A simulated differential drive (tools/sim, kDiffDriveExampleYaml's model at kTruth) recorded
+// A simulated differential drive (sim/, kDiffDriveExampleYaml's model at kTruth) recorded
 // as a ROS 2 bag the way a robot records it - sensor_msgs/msg/JointState with cumulative wheel
 // angles (an extra joint, not the robot's order, rest messages between runs) and
 // geometry_msgs/msg/PoseStamped ground truth, header stamps, the recording time a few ms later,
@@ -20,7 +20,7 @@
 #include "io/rosbag2/ros_messages.h"
 #include "models/model_interface.h"
 #include "models/diff_drive/diff_drive_trajectories.h"
-#include "tools/sim/model_simulator.h"
+#include "sim/model_simulator.h"
 
 namespace fitcal::testing::robot_bag {
 

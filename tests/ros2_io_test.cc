@@ -1,6 +1,6 @@
 // ROS 2 in and out: `fitcal import rosbag2` and `fitcal export ros2-control`.
 //
-// Import: a simulated differential drive (tools/sim) is written as a bag the way a robot records
+// Import: a simulated differential drive (sim/) is written as a bag the way a robot records
 // it - sensor_msgs/msg/JointState with cumulative wheel angles (extra joint, another joint order,
 // rest messages between runs) and geometry_msgs/msg/PoseStamped ground truth, header stamps, the
 // recording time a few ms later - in both storage formats, compressed or not, split in two files.
@@ -36,10 +36,10 @@
 #include "tests/robot_bag.h"
 #include "tests/test_files.h"
 #include "io/command_failure.h"
-#include "tools/export_ros2_control.h"
-#include "tools/import_rosbag2.h"
+#include "cli/export_ros2_control.h"
+#include "cli/import_rosbag2.h"
 #include "models/diff_drive/diff_drive_trajectories.h"
-#include "tools/sim/model_simulator.h"
+#include "sim/model_simulator.h"
 #include "models/tricycle/tricycle_trajectories.h"
 
 namespace fitcal {

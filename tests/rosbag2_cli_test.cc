@@ -147,7 +147,7 @@ INSTANTIATE_TEST_SUITE_P(
 // An import over its own previous output is replaced only with --force (the marker is what lets
 // it recognise the data set as its own).
 TEST(ImportThroughTheCommandLine, ReplacesItsOwnDataSetAndRefusesAForeignDirectory) {
-  // The one overwrite rule (tools/output_guard.h): running the import again replaces the data set
+  // The one overwrite rule (io/output_guard.h): running the import again replaces the data set
   // it wrote; a directory holding other files is never replaced, --force or not.
   TempDir tmp;
   WriteBag(tmp, "bag", StorageFormat::kMcap, true);

@@ -92,7 +92,7 @@ INSTANTIATE_TEST_SUITE_P(EveryModel, SimulatedModel,
 
 // The directory appears whole: a data set fitcal wrote is replaced entirely by the next run; a
 // file fitcal did not write there is never deleted, --force or not (the whole directory is
-// refused: tools/output_guard.h); no temporary sibling is left behind.
+// refused: io/output_guard.h); no temporary sibling is left behind.
 TEST(SimulateCommand, WritesTheDataSetDirectoryAtomically) {
   TempDir dir;
   const std::string data = dir.Path("data");
@@ -142,7 +142,7 @@ TEST(SimulateCommand, RefusesWhatTheModelSimulatorDoesNotTake) {
 // data/flower was written by `fitcal simulate --out data/flower --robot data/robots/apr02.yaml
 // --repetitions 10 --seed 1` (docs/simulate.md) with the omni3-only simulator this command no
 // longer has; the generic simulator (the omni3 model through the seam, the flower's stepped
-// physics: tools/sim/flower_scenario.h) regenerates it. Run i draws from its own generator seeded
+// physics: sim/flower_scenario.h) regenerates it. Run i draws from its own generator seeded
 // by (seed, i), so two repetitions with the same seed must reproduce the first 72 runs' files,
 // the robot and the first 72 entries of dataset.yaml exactly.
 TEST(SimulateCommand, RegeneratesTheShippedFlowerByteForByte) {

@@ -22,7 +22,7 @@
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
 #include "models/diff_drive/diff_drive_trajectories.h"
-#include "tools/sim/model_simulator.h"
+#include "sim/model_simulator.h"
 #include "validation/everyday_driving.h"
 #include "validation/time_blocks.h"
 

@@ -23,7 +23,7 @@
 #include "tests/model_support.h"
 #include "tests/test_files.h"
 #include "tests/test_paths.h"
-#include "tools/sim/model_simulator.h"
+#include "sim/model_simulator.h"
 #include "validation/trajectory_family.h"
 
 namespace fitcal {

@@ -14,7 +14,7 @@
 #include "fit/run_split.h"
 #include "models/tricycle/tricycle_model.h"
 #include "tests/diagnose_expectations.h"
-#include "tools/sim/model_simulator.h"
+#include "sim/model_simulator.h"
 #include "models/tricycle/tricycle_trajectories.h"
 
 namespace fitcal {

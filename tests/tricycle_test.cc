@@ -25,9 +25,9 @@
 #include "odometry/aligned_run.h"
 #include "tests/model_support.h"
 #include "tests/test_files.h"
-#include "tools/import_optiodom.h"
-#include "tools/miswired_error.h"
-#include "tools/sim/model_simulator.h"
+#include "cli/import_optiodom.h"
+#include "cli/miswired_error.h"
+#include "sim/model_simulator.h"
 #include "models/tricycle/tricycle_trajectories.h"
 
 namespace fitcal {

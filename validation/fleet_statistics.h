@@ -1,5 +1,5 @@
 #pragma once
-// A fleet's calibrations across robots and time (`fitcal fleet`, tools/fleet_command.h, reads
+// A fleet's calibrations across robots and time (`fitcal fleet`, cli/fleet_command.h, reads
 // them and prints the table): per robot, one series per parameter (and the held-out CF the
 // calibration recorded) in date order, and its flags:
 //   outlier  a calibration more than kOutlierRobustZ robust sigmas (1.4826 x the median absolute

@@ -31,7 +31,7 @@ struct CalibrationInput {
 };
 
 // Everything the report reads, loaded and checked before anything is computed
-// (tools/report_command.cc loads it).
+// (cli/report_command.cc loads it).
 struct ReportInputs {
   io::DatasetIndex index;
   std::vector<std::string> inputs;  // files the output must not overwrite

@@ -55,7 +55,7 @@ class AsocModel : public KinematicModel<AsocKinematics> {
 Robot AsocRobotDescription(const std::string& name,
                            const std::array<std::string, asoc::kNumCastors>& castor_names);
 
-// The simulated one-third-scale prototype (tools/sim/asoc_simulator.h AsocPrototypeVehicle).
+// The simulated one-third-scale prototype (sim/asoc_simulator.h AsocPrototypeVehicle).
 inline constexpr const char* kAsocExampleYaml = R"(model: asoc
 name: example_asoc
 pivot_distance_m: 0.5196152423

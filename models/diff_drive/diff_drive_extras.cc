@@ -42,7 +42,7 @@ std::vector<sim::TrajectorySpec> DiffDriveScenario(const Robot& /*robot*/,
                                                    const std::vector<double>& /*truth*/,
                                                    int repetitions) {
   sim::DiffDriveTrajectoryOptions shapes;
-  shapes.circle_laps = 1.25;  // open arcs: the scale (tools/sim/model_scenarios.h)
+  shapes.circle_laps = 1.25;  // open arcs: the scale (sim/model_scenarios.h)
   return sim::DiffDriveCalibrationTrajectories(repetitions, shapes);
 }
 
@@ -52,7 +52,7 @@ ModelExtras DiffDriveExtras() {
   ModelExtras extras;
   extras.controllers = {{"diff_drive_controller", "humble jazzy rolling", &DiffDriveParameters}};
   // UMBmark-sized: a larger error leaves a 1 m square too far from closing for UMBmark
-  // (tools/sim/model_scenarios.h).
+  // (sim/model_scenarios.h).
   extras.scenario = {&DiffDriveScenario, 0.025};
   return extras;
 }

@@ -61,7 +61,7 @@ using TricycleGainModel = TricycleModelT<true>;
 Robot TricycleRobotDescription(const std::string& name, const std::string& traction_name,
                                bool with_gain = false);
 
-// The OptiOdom tricycle's nominal robot (data sheet values, tools/optiodom_robots.cc).
+// The OptiOdom tricycle's nominal robot (data sheet, interchange/optiodom/optiodom_robots.cc).
 inline constexpr const char* kTricycleExampleYaml = R"(model: tricycle
 name: example_tricycle
 traction_wheel: {radius_m: 0.0325}

@@ -1,6 +1,6 @@
 #pragma once
 // Calibration trajectories for a tricycle (models/tricycle/), as twist segments for the generic
-// simulator (tools/sim/model_simulator.h):
+// simulator (sim/model_simulator.h):
 //
 //   circle_<dir>_<deg>  circle_turns turns (default 1.25) at a constant steering angle
 //                       phi' = deg, counter-clockwise (ccw, phi' > 0) and clockwise (cw), for each

@@ -16,7 +16,7 @@
 #include "io/dataset.h"
 #include "models/model_registry.h"
 #include "tests/bench/bench_support.h"
-#include "tools/import_optiodom.h"
+#include "cli/import_optiodom.h"
 
 namespace fitcal {
 namespace {

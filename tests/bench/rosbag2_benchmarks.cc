@@ -24,7 +24,7 @@
 #include "io/rosbag2/bag_writer.h"
 #include "io/rosbag2/ros_messages.h"
 #include "tests/bench/bench_support.h"
-#include "tools/import_rosbag2.h"
+#include "cli/import_rosbag2.h"
 
 namespace {
 

@@ -22,10 +22,12 @@ set(literal_format "${ws}(\"|[A-Za-z_.]+${ws}\\?${ws}\")")
 set(violations 0)
 file(GLOB_RECURSE sources RELATIVE ${SOURCE_DIR} ${SOURCE_DIR}/odometry/*.cc ${SOURCE_DIR}/io/*.cc
      ${SOURCE_DIR}/models/*.cc ${SOURCE_DIR}/fit/*.cc ${SOURCE_DIR}/validation/*.cc
-     ${SOURCE_DIR}/diagnosis/*.cc ${SOURCE_DIR}/calibrate/*.cc ${SOURCE_DIR}/tools/*.cc
+     ${SOURCE_DIR}/diagnosis/*.cc ${SOURCE_DIR}/calibrate/*.cc ${SOURCE_DIR}/sim/*.cc
+     ${SOURCE_DIR}/interchange/*.cc ${SOURCE_DIR}/cli/*.cc
      ${SOURCE_DIR}/odometry/*.h
      ${SOURCE_DIR}/io/*.h ${SOURCE_DIR}/models/*.h ${SOURCE_DIR}/fit/*.h ${SOURCE_DIR}/validation/*.h
-     ${SOURCE_DIR}/diagnosis/*.h ${SOURCE_DIR}/calibrate/*.h ${SOURCE_DIR}/tools/*.h)
+     ${SOURCE_DIR}/diagnosis/*.h ${SOURCE_DIR}/calibrate/*.h ${SOURCE_DIR}/sim/*.h
+     ${SOURCE_DIR}/interchange/*.h ${SOURCE_DIR}/cli/*.h)
 foreach(source IN LISTS sources)
   if(source STREQUAL FORWARDER)
     continue()

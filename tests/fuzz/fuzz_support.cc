@@ -17,7 +17,7 @@
 #include "models/asoc/asoc_files.h"
 #include "models/diff_drive/diff_drive_model.h"
 #include "models/omni3/omni3_robot_model.h"
-#include "tools/import_rosbag2.h"
+#include "cli/import_rosbag2.h"
 
 namespace fitcal::fuzz {
 

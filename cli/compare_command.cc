@@ -1,0 +1,276 @@
+#include "cli/compare_command.h"
+
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+#include <stdexcept>
+
+#include "fit/run_split.h"
+#include "io/atomic_file.h"
+#include "io/dataset.h"
+#include "io/input_error.h"
+#include "models/model_registry.h"
+#include "cli/cli_validators.h"
+#include "calibrate/fit_methods.h"
+#include "calibrate/method_comparison.h"
+#include "io/output_guard.h"
+
+namespace fitcal::tools {
+
+namespace {
+
+using Row = ComparisonRow;
+
+std::string Fixed(double v, int digits) {
+  if (std::isnan(v)) return "-";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
+  return buf;
+}
+
+// How a row's parameters are shown: as the model registers it (ModelExtras::display: omni3 as
+// the M^-1 of Palacin Eq. 6), else its parameters in display units (m, deg).
+using ParameterColumns = ParameterDisplay;
+
+ParameterColumns ColumnsFor(const Robot& robot) {
+  ParameterColumns c;
+  if (const auto& display = ExtrasOf(robot.model).display) return display(robot);
+  c.markdown_header = "Parameters";
+  for (const ParameterInfo& info : robot.parameters) {
+    c.csv_names.push_back(info.KeyName());
+  }
+  c.csv_values = [robot](const std::vector<double>& p) {
+    std::vector<double> out;
+    for (int k = 0; k < robot.NumParameters(); ++k) {
+      out.push_back(p[k] * robot.parameters[k].DisplayScale());
+    }
+    return out;
+  };
+  c.markdown = [robot](const std::vector<double>& p) {
+    std::string out;
+    char item[96];
+    for (int k = 0; k < robot.NumParameters(); ++k) {
+      const ParameterInfo& info = robot.parameters[k];
+      std::snprintf(item, sizeof item, "%s%s %.6g%s", out.empty() ? "" : ", ", info.name.c_str(),
+                    p[k] * info.DisplayScale(), info.unit == ParameterUnit::kAngle ? " deg" : "");
+      out += item;
+    }
+    return out;
+  };
+  return c;
+}
+
+std::string CsvField(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
+// How each of compare's files starts, whatever the model: how a later run recognises them as its
+// own previous output (io/output_guard.h, rule 1).
+constexpr char kCsvStart[] = "strategy,method,repetitions,";
+constexpr char kMarkdownStart[] = "| Strategy | Method | Reps | ";
+constexpr char kTraceStart[] = "strategy,method,repetitions,evaluation,best_cf,elapsed_s";
+// Each file as <out><suffix> and how it starts.
+constexpr std::pair<const char*, const char*> kOutputFiles[] = {
+    {".csv", kCsvStart}, {".md", kMarkdownStart}, {"_trace.csv", kTraceStart}};
+
+std::string Csv(const std::vector<Row>& rows, const ParameterColumns& columns) {
+  std::ostringstream o;
+  o << "strategy,method,repetitions";
+  for (const std::string& name : columns.csv_names) o << "," << name;
+  o << ",cf_calibration,cf_validation,improvement_percent,evaluations,wall_s,termination,usable\n";
+  for (const Row& row : rows) {
+    o << CsvField(row.strategy) << "," << row.method << "," << row.repetitions;
+    const std::vector<double> values =
+        row.parameters.empty() ? std::vector<double>() : columns.csv_values(row.parameters);
+    for (std::size_t c = 0; c < columns.csv_names.size(); ++c) {
+      o << "," << (values.empty() ? "" : Fixed(values[c], 8));
+    }
+    o << "," << (std::isnan(row.cf_calibration) ? "" : Fixed(row.cf_calibration, 8)) << ","
+      << (std::isnan(row.cf_validation) ? "" : Fixed(row.cf_validation, 8)) << ","
+      << (std::isnan(row.improvement_percent) ? "" : Fixed(row.improvement_percent, 3)) << ","
+      << row.evaluations << "," << Fixed(row.wall_s, 4) << "," << CsvField(row.termination) << ","
+      << (row.usable ? "yes" : "no") << "\n";
+  }
+  return o.str();
+}
+
+std::string Markdown(const std::vector<Row>& rows, const ParameterColumns& columns) {
+  std::ostringstream o;
+  o << kMarkdownStart << columns.markdown_header
+    << " | CF calibration | CF validation | Improvement | "
+       "Evaluations | Wall [s] | Termination |\n"
+    << "|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const Row& row : rows) {
+    o << "| " << row.strategy << " | " << row.method << " | "
+      << (row.repetitions ? std::to_string(row.repetitions) : "-") << " | "
+      << (row.parameters.empty() ? "-" : columns.markdown(row.parameters)) << " | "
+      << Fixed(row.cf_calibration, 4) << " | " << Fixed(row.cf_validation, 4) << " | "
+      << (std::isnan(row.improvement_percent) ? "-" : Fixed(row.improvement_percent, 1) + "%")
+      << " | " << (row.repetitions ? std::to_string(row.evaluations) : "-") << " | "
+      << (row.repetitions ? Fixed(row.wall_s, 2) : "-") << " | " << row.termination
+      << (row.usable ? "" : " (not usable)") << " |\n";
+  }
+  return o.str();
+}
+
+std::string TraceCsv(const std::vector<Row>& rows) {
+  std::ostringstream o;
+  o << kTraceStart << "\n";
+  for (const Row& row : rows) {
+    for (const ConvergencePoint& p : row.trace) {
+      o << CsvField(row.strategy) << "," << row.method << "," << row.repetitions << ","
+        << p.evaluation << "," << Fixed(p.best_cf, 10) << "," << Fixed(p.elapsed_s, 4) << "\n";
+    }
+  }
+  return o.str();
+}
+
+// What the user typed, checked before any data is read or any fit runs: empty when valid, else
+// the one-line reason (exit code 2).
+std::string ParseRequest(const CompareCommandOptions& options, ComparisonRequest* r) {
+  for (const std::string& name : options.methods) {
+    if (name == "all") {
+      for (const FitMethod& m : FitMethods()) r->methods.push_back(&m);
+      continue;
+    }
+    const FitMethod* m = FindFitMethod(name);
+    if (m == nullptr) {
+      return "unknown method '" + name + "' (available: " + FitMethodNames() + ", all)";
+    }
+    r->methods.push_back(m);
+  }
+  r->counts = options.repetitions;
+  std::sort(r->counts.begin(), r->counts.end());
+  r->counts.erase(std::unique(r->counts.begin(), r->counts.end()), r->counts.end());
+  try {
+    for (const std::string& text : options.strategies)
+      r->strategies.push_back(ParseCompareStrategy(text));
+    if (r->methods.empty() || r->strategies.empty() || r->counts.empty() || r->counts.front() < 1) {
+      return "need at least one method, one strategy and repetitions >= 1";
+    }
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  r->data_name = options.logs;
+  r->strategies_given = options.strategies_given;
+  if (!options.validation_reps.empty()) {
+    r->validation_reps = ParseRepetitionList(options.validation_reps);
+  }
+  r->threads = options.threads;
+  std::string error;
+  if (!MakeFitMethodSettings(options, options.threads, &r->settings, &error)) return error;
+  return "";
+}
+
+// Each fit's best CF as it improves, then its result, on one line of stderr.
+ComparisonProgress ProgressOnStderr() {
+  ComparisonProgress p;
+  p.during = [](const std::string& label, const NloptProgress& n) {
+    std::fprintf(stderr, "\r[%s] %d evaluations, best CF %.5f, %.1f s   ", label.c_str(),
+                 n.evaluations, n.best_cf, n.elapsed_s);
+    std::fflush(stderr);
+  };
+  p.done = [](const std::string& label, const Row& row) {
+    std::fprintf(stderr, "\r[%s] CF %.5f -> validation %.5f, %d evaluations, %.2f s%20s\n",
+                 label.c_str(), row.cf_calibration, row.cf_validation, row.evaluations, row.wall_s,
+                 "");
+  };
+  return p;
+}
+
+void PrintAndWrite(const CompareCommandOptions& options, const ComparisonRequest& r,
+                   const MethodComparison& c, const ParameterColumns& columns) {
+  const std::string markdown = Markdown(c.rows, columns);
+  std::string counts;
+  for (int k : r.counts) counts += (counts.empty() ? "" : " or ") + std::to_string(k);
+  std::printf(
+      "Palacin Table 4 on %s: training on the first %s repetition(s) of each strategy's "
+      "trajectories, validation on every trajectory of repetitions %s (%zu runs); CF "
+      "is Eq. 14 (m and rad)\n\n",
+      options.logs.c_str(), counts.c_str(), FormatRepetitionList(c.validation_reps).c_str(),
+      c.num_validation);
+  if (!r.tying.empty()) {  // what the "(tied)" rows fit
+    PrintTying(r.tying);
+    std::printf("\n");
+  }
+  std::printf("%s", markdown.c_str());
+  if (!options.no_output) {
+    io::WriteFilesAtomically({{options.out + ".csv", Csv(c.rows, columns)},
+                              {options.out + ".md", markdown},
+                              {options.out + "_trace.csv", TraceCsv(c.rows)}});
+    std::printf("\nwrote %s.csv, %s.md, %s_trace.csv\n", options.out.c_str(), options.out.c_str(),
+                options.out.c_str());
+  }
+}
+
+}  // namespace
+
+void AddCompareOptions(CLI::App& app, CompareCommandOptions& o) {
+  AddDatasetOptions(app, o);
+  // A data set takes the STA..STE it has unless --strategies names some.
+  app.callback([&app, &o] { o.strategies_given = app.count("--strategies") > 0; });
+  app.add_option("--strategies", o.strategies,
+                 "STA..STE, trajectory lists such as R1,R5,G4 or B1-B12, all, or a label "
+                 "prefix such as circular/* (one per item)")
+      ->capture_default_str();
+  app.add_option("--methods", o.methods, "Methods (" + FitMethodNames() + ") or all")
+      ->capture_default_str();
+  app.add_option("--repetitions", o.repetitions, "Train on the first k repetitions, for each k")
+      ->capture_default_str();
+  app.add_option("--validation-reps", o.validation_reps,
+                 "Validation repetitions (default: those after the largest k)")
+      ->check(RepetitionListValidator());
+  app.add_option("--out", o.out, "Output prefix: <out>.csv, <out>.md, <out>_trace.csv")
+      ->capture_default_str();
+  app.add_flag("--no-output", o.no_output, "Print the table only");
+  app.add_flag("--force", o.force, kForceFileHelp);
+  app.add_flag("--quiet", o.quiet, "No progress on stderr");
+  AddSolverOptions(app, o);
+  AddTyingFlags(app, o);
+}
+
+int RunCompareCommand(const CompareCommandOptions& options) {
+  ComparisonRequest request;
+  if (const std::string error = ParseRequest(options, &request); !error.empty()) {
+    std::cerr << "fitcal compare: " << error << "\n";
+    return 2;
+  }
+  if (!options.quiet && isatty(STDERR_FILENO)) request.progress = ProgressOnStderr();
+  return RunReportingErrors("fitcal compare", [&]() -> int {
+    if (!options.no_output) {  // before the work: the one overwrite rule, io/output_guard.h
+      const std::vector<std::string> inputs = OpenDataset(options).inputs;
+      for (const auto& [suffix, start] : kOutputFiles) {
+        std::string refusal = OutputFileRefusal(options.out + suffix, inputs);
+        if (refusal.empty() && !options.force) {
+          refusal = TextOutputOverwriteRefusal(options.out + suffix, start);
+        }
+        if (!refusal.empty()) return Refuse(refusal);
+      }
+    }
+    const io::DatasetIndex index = OpenDataset(options).index;
+    request.model = ReadRobotModelFile(index.robot_path);
+    request.runs = AlignRuns(LoadRuns(options, index, request.model->robot()).runs);
+    if (const std::string refusal = ReadTying(options, request.model->robot(), &request.tying);
+        !refusal.empty()) {
+      std::cerr << "fitcal compare: " << refusal << "\n";
+      return 2;
+    }
+    const MethodComparison comparison = CompareMethods(request);
+    if (!comparison.refusal.empty()) {
+      std::cerr << "fitcal compare: " << comparison.refusal << "\n";
+      return 2;
+    }
+    PrintAndWrite(options, request, comparison, ColumnsFor(request.model->robot()));
+    return 0;
+  });
+}
+
+}  // namespace fitcal::tools

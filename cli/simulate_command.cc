@@ -1,0 +1,181 @@
+#include "cli/simulate_command.h"
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <iostream>
+#include <stdexcept>
+
+#include "io/input_error.h"
+#include "io/staged_directory.h"
+#include "models/model_registry.h"
+#include "cli/model_simulate_command.h"
+#include "io/output_guard.h"
+#include "sim/flower_scenario.h"
+
+namespace fitcal::tools {
+
+namespace {
+
+// "name=v1[,v2]" -> an effect of the registry with its values, checked against its bounds.
+effects::EffectValue ParseInjectedEffect(const std::string& text) {
+  const std::size_t eq = text.find('=');
+  if (eq == std::string::npos)
+    throw std::invalid_argument("--inject '" + text + "': expected name=value[,value]");
+  effects::EffectValue e;
+  e.id = effects::EffectIdFromName(text.substr(0, eq));
+  const effects::EffectInfo& info = effects::Info(e.id);
+  // The flower robot has three wheel channels: an effect on a steering angle or on a wheel pair
+  // would be written nowhere (a data set that silently lacks the effect asked for).
+  if (effects::NeedsAngleChannel(e.id) || effects::NeedsWheelPair(e.id)) {
+    throw std::invalid_argument(
+        "--inject '" + text + "': " + info.name +
+        " cannot act on the omni3 flower robot (it needs " +
+        (effects::NeedsWheelPair(e.id) ? "a pair of wheels" : "a steering angle") + ")");
+  }
+  std::string rest = text.substr(eq + 1);
+  for (int k = 0; k < info.num_parameters; ++k) {
+    const std::size_t comma = rest.find(',');
+    const std::string item = rest.substr(0, comma);
+    std::size_t used = 0;
+    try {
+      e.value[k] = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size() ||
+        !(e.value[k] >= info.lower[k] && e.value[k] <= info.upper[k])) {
+      throw std::invalid_argument("--inject '" + text + "': " + info.parameter_names[k] +
+                                  " must be a number in [" + std::to_string(info.lower[k]) + ", " +
+                                  std::to_string(info.upper[k]) + "]");
+    }
+    rest = comma == std::string::npos ? "" : rest.substr(comma + 1);
+    if (k + 1 < info.num_parameters && comma == std::string::npos) {
+      throw std::invalid_argument("--inject '" + text + "': " + info.name + " takes " +
+                                  std::to_string(info.num_parameters) + " values");
+    }
+  }
+  if (!rest.empty()) throw std::invalid_argument("--inject '" + text + "': too many values");
+  return e;
+}
+
+// --model: the generic simulator with the flags that apply to it.
+int RunModelSimulate(const SimulateCommandOptions& options) {
+  ModelSimulateOptions o;
+  o.out = options.out;
+  o.model = options.model;
+  o.robot = options.robot_given ? options.robot : "";
+  o.truth = options.truth;
+  o.force = options.force;
+  o.noise.repetitions = options.repetitions;
+  o.noise.seed = options.seed;
+  o.noise.ticks_per_rev = options.encoder_counts_per_rev;
+  o.noise.wheel_rate_sigma_rad_s = options.wheel_rate_sigma_rad_s;
+  o.noise.angle_sigma_rad = options.angle_sigma_deg * M_PI / 180.0;
+  o.noise.gt_position_sigma_m = options.gt_position_sigma_m;
+  o.noise.gt_heading_sigma_rad = options.gt_heading_sigma_deg * M_PI / 180.0;
+  o.flower_only_flags = options.flower_only_flags;
+  return RunModelSimulateCommand(o);
+}
+
+// The flower of the flags: the nominal robot commands, the truth (--truth or Table 5) moves.
+sim::FlowerSimulation FlowerOf(const SimulateCommandOptions& options) {
+  sim::FlowerSimulation flower = sim::PalacinFlower();
+  flower.model = ReadRobotModelFile(options.robot);
+  const Robot& robot = flower.model->robot();
+  if (!ExtrasOf(robot.model).legacy_simulator) {
+    throw std::invalid_argument(options.robot +
+                                ": the flower simulator drives an omni3 robot, not " + robot.model +
+                                " (simulate --model " + robot.model + ")");
+  }
+  if (!options.truth.empty())
+    flower.true_parameters = ReadRobotModelFile(options.truth)->robot().nominal;
+  if (flower.true_parameters.size() != robot.nominal.size()) {
+    throw std::invalid_argument(options.truth + ": the true robot must be an omni3 robot");
+  }
+  flower.repetitions = options.repetitions;
+  sim::SimulationOptions& o = flower.options;
+  o = sim::FlowerSimulationOptions(robot.nominal);
+  o.seed = options.seed;
+  o.ticks_per_rev.assign(robot.channels.size(), options.encoder_counts_per_rev);
+  o.gt_position_sigma_m = options.gt_position_sigma_m;
+  o.gt_heading_sigma_rad = options.gt_heading_sigma_deg * M_PI / 180.0;
+  o.stepped->slip.sigma = options.slip_sigma;
+  for (const std::string& text : options.inject) {
+    o.stepped->injected_effects.push_back(ParseInjectedEffect(text));
+  }
+  return flower;
+}
+
+}  // namespace
+
+void AddSimulateOptions(CLI::App& app, SimulateCommandOptions& o) {
+  app.add_option("--out", o.out, "Output data set directory")->required();
+  app.add_option(
+      "--model", o.model,
+      "Robot model (" + sim::ScenarioModelNames() + "; default: the omni3 flower simulator)");
+  app.add_option("--robot", o.robot, "Nominal robot YAML (commands and fit start)")
+      ->capture_default_str()
+      ->check(CLI::ExistingFile);
+  app.add_option("--truth", o.truth, "Robot YAML of the true robot (default: Palacin Table 5)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--repetitions", o.repetitions, "Repetitions of each trajectory")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_option("--seed", o.seed, "Random seed")->capture_default_str();
+  app.add_option("--encoder-counts-per-rev", o.encoder_counts_per_rev, "Encoder resolution")
+      ->capture_default_str();
+  app.add_option("--gt-position-sigma-m", o.gt_position_sigma_m, "Ground-truth position noise (m)")
+      ->capture_default_str();
+  app.add_option("--gt-heading-sigma-deg", o.gt_heading_sigma_deg,
+                 "Ground-truth heading noise (deg)")
+      ->capture_default_str();
+  app.add_option("--slip-sigma", o.slip_sigma, "Relative wheel slip noise")->capture_default_str();
+  app.add_option("--wheel-rate-sigma-rad-s", o.wheel_rate_sigma_rad_s,
+                 "--model: white noise on each interval's mean wheel rate (rad/s)")
+      ->capture_default_str();
+  app.add_option("--angle-sigma-deg", o.angle_sigma_deg,
+                 "--model: noise of an angle channel's readings, e.g. steering (deg)")
+      ->capture_default_str();
+  app.add_flag("--force", o.force, kForceDirectoryHelp);
+  app.add_option("--inject", o.inject,
+                 "Inject a library effect, name=value[,value] (docs/simulate.md); repeatable; "
+                 "the data set does not name it");
+  app.callback([&app, &o] {
+    o.robot_given = app.count("--robot") > 0;
+    for (const char* flag : {"--slip-sigma", "--inject"}) {
+      if (app.count(flag) > 0) o.flower_only_flags.push_back(flag);
+    }
+  });
+}
+
+int RunSimulateCommand(const SimulateCommandOptions& options) {
+  // A model without a scenario of its own (ModelExtras::legacy_simulator: omni3) takes the flower.
+  if (!options.model.empty() && !ExtrasOf(options.model).legacy_simulator) {
+    return RunModelSimulate(options);
+  }
+  try {
+    const sim::FlowerSimulation flower = FlowerOf(options);
+    if (const std::string refusal =
+            DirectoryOutputRefusal(options.out, kDatasetKind, options.force, {});
+        !refusal.empty()) {
+      std::cerr << "fitcal: " << refusal << "\n";
+      return 2;
+    }
+    const std::vector<sim::ModelSimulatedRun> runs = sim::SimulateFlower(flower);
+    // Written whole or not at all: staged beside --out, renamed over it once complete.
+    io::StagedDirectory staged(options.out);
+    const RobotModelInterface& model = *flower.model;
+    sim::WriteSimulatedDataset(staged.path(), model.RobotYaml(model.robot().nominal, ""), runs,
+                               sim::EncoderCsvDigits::kRecorder);
+    CommitDirectoryOutput(staged, options.out, kDatasetKind, options.force, {});
+    std::printf("wrote %zu runs (%zu trajectories x %d repetitions, seed %llu) to %s\n",
+                runs.size(), flower.trajectories.size(), flower.repetitions,
+                static_cast<unsigned long long>(flower.options.seed), options.out.c_str());
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "fitcal: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace fitcal::tools

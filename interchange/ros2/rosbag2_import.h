@@ -1,0 +1,87 @@
+#pragma once
+// What `fitcal import rosbag2 <bag> --out <data set> --robot <robot.yaml> --ground-truth <topic>`
+// (cli/import_rosbag2.h) reads and decides: a rosbag2 recording (sqlite3 or MCAP, split or not; io/rosbag2/) -> a fitcal data set
+// (README.md "Data set format"): robot.yaml (the robot file as given), dataset.yaml, and per run
+// runs/<id>_encoders.csv and runs/<id>_ground_truth.csv.
+//
+// Encoders. One sensor_msgs/msg/JointState topic; the robot's channels are read from the joints
+// named by --joints (robot channel order; default: the channel names themselves). With positions
+// in the messages (cumulative wheel angles, what joint_state_broadcaster publishes) the CSV holds
+// the mean rate of each interval, (angle(k) - angle(k-1)) / (t(k) - t(k-1)): exact, whatever the
+// spacing. With velocities only, the instantaneous readings at both ends are averaged (the
+// trapezoid rule: second order in the interval, the best a rate sampled at the ends gives). An
+// angle channel (tricycle steering) is the position as read at the row's time.
+//
+// Time. t = 0 is the bag's first recording time; t is in seconds (ns resolution in the CSV). The
+// default stamp is the header stamp: the time the driver measured the sample. The recording
+// time adds the transport latency, which differs between the encoder and the ground-truth topics
+// (a mocap pose crosses a network, joint states do not), so with it the two streams are offset
+// by a few ms and jitter - a pose error of speed x offset at every final pose. --stamp recorded
+// is for drivers that leave the header stamp empty or on another clock.
+//
+// Runs. --runs t0:t1,t2:t3 (s, same clock) cuts the given spans; --split-at-rest S cuts at the
+// middle of every rest (all wheels slower than rest_rate) lasting at least S seconds and keeps the
+// pieces in which the robot moves; neither: the whole bag is one run. Run i (1-based) gets id
+// `<label>-NN`, trajectory label <label> (default: the bag's name) and repetition i, so
+// `fitcal fit --train-reps` chooses runs by number.
+//
+// Real recordings. Messages on the encoder topic that carry none of the robot's joints (another
+// node's JointState) are skipped. Wheel positions wrapped to one turn are unwrapped (or refused
+// when too fast to unwrap). A ground-truth orientation that is not a unit quaternion is refused
+// naming topic and time. With --stamp recorded, a recording clock that steps back (seen as
+// header stamps going back in recorded order) is refused at that instant. The data set is read
+// back with the loader `fit` uses before it is committed: the import never writes a data set
+// `fit` refuses.
+//
+// A pose source on a mount. When the ground truth tracks a frame other than --base-frame (an
+// Odometry's child_frame_id; a PoseStamped's frame named by --ground-truth-frames) and the bag's
+// /tf_static links the two (directly or along a chain), the data set's robot YAML gets that pose
+// as its nominal `ground_truth_frame: {x_m, y_m, yaw_deg}`, said on one line; without /tf_static
+// (or without a link) nothing is written for the frame, said in words. A robot YAML that declares
+// its own ground_truth_frame keeps it.
+
+#include <string>
+#include <vector>
+
+#include "io/rosbag2/bag_streams.h"
+#include "odometry/run_log.h"
+
+namespace fitcal {
+
+struct ImportRosbag2Options {
+  std::string bag;    // bag directory, metadata.yaml, or one .db3 / .mcap file
+  std::string out;    // data set directory to write
+  std::string robot;  // robot YAML (any registered model)
+  std::string encoders = "/joint_states";
+  std::vector<std::string> joints;  // robot channel order; empty: the channel names
+  std::string ground_truth;         // topic
+  std::string ground_truth_frames;  // "parent:child", for a tf2_msgs/msg/TFMessage topic (and a
+                                    // PoseStamped's: the child names the frame it tracks)
+  std::string base_frame = "base_link";  // the robot's base frame in /tf_static
+  std::string stamp = "header";     // header | recorded
+  std::string runs;                 // "t0:t1,t2:t3" (s since the bag's start)
+  double split_at_rest_s = 0.0;     // > 0: cut at rests at least this long
+  double rest_rate_rad_s = 0.02;    // a wheel slower than this is at rest
+  std::string label;                // trajectory label; empty: the bag's name
+  bool force = false;               // replace an existing --out
+  bool quiet = false;
+};
+
+struct Rosbag2Import {
+  io::rosbag2::BagStreams streams;
+  std::vector<RunLog> runs;  // as fitcal will load them
+  // Per run, what the encoder CSV holds: t (s), and row-major one row per stamp of one value per
+  // robot channel (robot channel order).
+  std::vector<std::vector<double>> encoder_t_s;
+  std::vector<std::vector<double>> encoder_values;
+  std::vector<std::string> notes;  // what the import repaired (wrapped joint positions), one line each
+  // Appended to the robot YAML the data set holds: the nominal `ground_truth_frame:` of a ground
+  // truth that tracks a sensor, from the bag's /tf_static (io/rosbag2/static_transforms.h).
+  std::string robot_yaml_addition;
+};
+
+// Reads the bag and cuts the runs, writing nothing. Throws io::InputError for a bad bag or bad
+// runs (file and what), std::invalid_argument for bad options.
+Rosbag2Import ReadRosbag2Import(const ImportRosbag2Options& options);
+
+}  // namespace fitcal

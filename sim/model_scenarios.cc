@@ -1,0 +1,75 @@
+#include "sim/model_scenarios.h"
+
+#include <algorithm>
+#include <functional>
+#include <stdexcept>
+
+#include "models/model_registry.h"
+
+namespace fitcal::sim {
+
+namespace {
+
+// The registered models (sorted by name) whose extras pass `has`, comma-separated.
+std::string ModelNamesWith(const std::function<bool(const ModelExtras&)>& has) {
+  std::vector<std::string> names;
+  for (const ModelRegistration& m : RegisteredModels()) {
+    if (has(m.extras)) names.push_back(m.name);
+  }
+  std::sort(names.begin(), names.end());
+  std::string out;
+  for (const std::string& name : names) out += (out.empty() ? "" : ", ") + name;
+  return out;
+}
+
+}  // namespace
+
+std::string ScenarioModelNames() {
+  return ModelNamesWith([](const ModelExtras& e) { return bool(e.scenario.trajectories); });
+}
+
+ModelScenario MakeModelScenario(const RobotModelInterface& model, const std::vector<double>& truth,
+                                const ScenarioNoise& noise) {
+  const Robot& robot = model.robot();
+  if (noise.repetitions < 1) throw std::invalid_argument("--repetitions must be at least 1");
+  const SimulationScenario& scenario = ExtrasOf(robot.model).scenario;
+  if (!scenario.trajectories) {
+    throw std::invalid_argument(
+        "no calibration trajectories for model '" + robot.model + "' (simulate --model takes " +
+        ScenarioModelNames() + "; " +
+        ModelNamesWith([](const ModelExtras& e) { return e.legacy_simulator; }) +
+        " without --model)");
+  }
+  ModelScenario out;
+  out.trajectories = scenario.trajectories(robot, truth, noise.repetitions);
+  SimulationOptions& o = out.options;
+  o.encoder_period_s = noise.encoder_period_s;
+  o.ground_truth_period_s = noise.ground_truth_period_s;
+  o.ticks_per_rev.assign(robot.channels.size(), 0.0);
+  for (std::size_t i = 0; i < robot.channels.size(); ++i) {
+    if (robot.channels[i].kind == ChannelKind::kWheelRate) o.ticks_per_rev[i] = noise.ticks_per_rev;
+  }
+  o.wheel_rate_sigma_rad_s = noise.wheel_rate_sigma_rad_s;
+  o.angle_sigma_rad = noise.angle_sigma_rad;
+  o.gt_position_sigma_m = noise.gt_position_sigma_m;
+  o.gt_heading_sigma_rad = noise.gt_heading_sigma_rad;
+  o.start_position_range_m = noise.start_position_range_m;
+  o.random_start_heading = true;
+  o.seed = noise.seed;
+  return out;
+}
+
+std::vector<double> DefaultTrueParameters(const Robot& robot) {
+  const double fraction = ExtrasOf(robot.model).scenario.truth_fraction;
+  std::vector<double> p = robot.nominal;
+  int moved = 0;
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    if (robot.IsHeld(k)) continue;
+    const double bound = moved % 2 == 0 ? robot.bounds[k].hi : robot.bounds[k].lo;
+    p[k] += fraction * (bound - robot.nominal[k]);
+    ++moved;
+  }
+  return p;
+}
+
+}  // namespace fitcal::sim
