@@ -1,20 +1,14 @@
 #include "cli/asoc_commands.h"
 
 #include <cstdio>
-#include <filesystem>
 #include <iostream>
 
-#include "io/atomic_file.h"
-#include "io/dataset.h"
 #include "io/staged_directory.h"
-#include "models/asoc/asoc_files.h"
 #include "cli/dataset_command.h"
 #include "io/output_guard.h"
 #include "sim/asoc_scenarios.h"
 
 namespace fitcal::tools {
-
-namespace fs = std::filesystem;
 
 int RunAsocSimulate(const AsocSimulateOptions& options) {
   return RunReportingErrors("fitcal", [&]() -> int {
@@ -26,28 +20,14 @@ int RunAsocSimulate(const AsocSimulateOptions& options) {
     }
     // Written whole or not at all: staged beside --out, renamed over it once complete.
     io::StagedDirectory staged(options.out);
-    const fs::path out(staged.path());
-    fs::create_directories(out / "runs");
     const sim::AsocSimulatedDataset simulated =
         sim::SimulateAsocDataset(options.seed, options.wheel_slip_sigma, options.excursions);
-    const std::vector<asoc::RunLog>& runs = simulated.runs;
-    std::vector<io::DatasetEntry> entries;
-    for (const asoc::RunLog& run : runs) {
-      const std::string enc = "runs/" + run.id + "_encoders.csv";
-      const std::string gt = "runs/" + run.id + "_ground_truth.csv";
-      io::WriteFileAtomically((out / enc).string(), io::AsocEncoderCsv(run.encoders));
-      io::WriteFileAtomically((out / gt).string(), io::GroundTruthCsv(run.ground_truth));
-      entries.push_back({run.id, run.trajectory, run.repetition, enc, gt});
-    }
-    io::WriteFileAtomically((out / "robot.yaml").string(), io::AsocRobotYaml(simulated.nominal));
-    io::WriteFileAtomically((out / "truth.yaml").string(), io::AsocRobotYaml(simulated.truth));
-    io::WriteFileAtomically((out / "dataset.yaml").string(),
-                            io::DatasetYaml("robot.yaml", entries));
+    sim::WriteAsocDataset(simulated, staged.path());
     CommitDirectoryOutput(staged, options.out, kDatasetKind, options.force, {});
     std::printf(
         "wrote %zu ASOC runs (6 calibration holds, 10 UMBmark, %d excursions) to %s; the "
         "true parameters are in truth.yaml\n",
-        runs.size(), options.excursions, options.out.c_str());
+        simulated.runs.size(), options.excursions, options.out.c_str());
     return 0;
   });
 }

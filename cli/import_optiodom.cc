@@ -7,7 +7,6 @@
 #include "io/input_error.h"
 #include "io/input_registry.h"
 #include "io/yaml_scalar.h"
-#include "models/tricycle/tricycle_checks.h"
 #include "odometry/aligned_run.h"
 #include "odometry/parallel_for.h"
 #include "odometry/pose2.h"
@@ -142,7 +141,8 @@ optiodom::RunRows ReadRunRows(const RobotKind& kind, const RunFile& file, int re
       }
     }
   }
-  if (reading_column >= 0) tricycle::CheckSteeringReadings(readings, file.path, run.first_line);
+  if (reading_column >= 0 && kind.check_readings != nullptr)
+    kind.check_readings(readings, file.path, run.first_line);
   return run;
 }
 

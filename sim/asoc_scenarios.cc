@@ -1,8 +1,11 @@
 #include "sim/asoc_scenarios.h"
 
 #include <cmath>
+#include <filesystem>
 #include <random>
 
+#include "io/atomic_file.h"
+#include "io/dataset.h"
 #include "models/asoc/asoc_geometric.h"
 #include "odometry/parallel_for.h"
 #include "sim/stepped_run.h"
@@ -66,6 +69,23 @@ AsocSimulatedDataset SimulateAsocDataset(std::uint64_t seed, double wheel_slip_s
   out.nominal = RobotFromVehicle("asoc-prototype", nominal);
   out.truth = RobotFromVehicle("asoc-truth", truth);
   return out;
+}
+
+void WriteAsocDataset(const AsocSimulatedDataset& dataset, const std::string& directory) {
+  namespace fs = std::filesystem;
+  const fs::path out(directory);
+  fs::create_directories(out / "runs");
+  std::vector<io::DatasetEntry> entries;
+  for (const asoc::RunLog& run : dataset.runs) {
+    const std::string enc = "runs/" + run.id + "_encoders.csv";
+    const std::string gt = "runs/" + run.id + "_ground_truth.csv";
+    io::WriteFileAtomically((out / enc).string(), io::AsocEncoderCsv(run.encoders));
+    io::WriteFileAtomically((out / gt).string(), io::GroundTruthCsv(run.ground_truth));
+    entries.push_back({run.id, run.trajectory, run.repetition, enc, gt});
+  }
+  io::WriteFileAtomically((out / "robot.yaml").string(), io::AsocRobotYaml(dataset.nominal));
+  io::WriteFileAtomically((out / "truth.yaml").string(), io::AsocRobotYaml(dataset.truth));
+  io::WriteFileAtomically((out / "dataset.yaml").string(), io::DatasetYaml("robot.yaml", entries));
 }
 
 DoebblerTables SimulateDoebblerTables(int sets, std::uint64_t seed, double wheel_slip_sigma,

@@ -5,6 +5,7 @@
 // (std::mt19937_64 seeded through SplitMix), drawn in the order written here.
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "models/asoc/asoc_files.h"
@@ -22,6 +23,12 @@ struct AsocSimulatedDataset {
 };
 AsocSimulatedDataset SimulateAsocDataset(std::uint64_t seed, double wheel_slip_sigma,
                                          int excursions);
+
+// Writes `dataset` into `directory` (a staged directory: the caller renames it over --out once
+// complete): runs/<id>_encoders.csv and runs/<id>_ground_truth.csv per run, robot.yaml (the
+// nominal), truth.yaml and dataset.yaml. ASOC's encoder files are the model's own format
+// (models/asoc/asoc_files.h), so the command that calls this names no model.
+void WriteAsocDataset(const AsocSimulatedDataset& dataset, const std::string& directory);
 
 // Means over `sets` random parameter sets (each its own generator, seed ^ SplitMix(set)):
 // Table I, the mean absolute relative error [uncalibrated, calibrated] of r_c, r_w, d and the

@@ -7,6 +7,7 @@
 #include "models/diff_drive/diff_drive_model.h"
 #include "models/omni/omni_model.h"
 #include "models/omni3/omni3_robot_model.h"
+#include "models/tricycle/tricycle_checks.h"
 #include "models/tricycle/tricycle_model.h"
 
 namespace fitcal::tools::optiodom {
@@ -147,21 +148,21 @@ RobotModelPtr TricycleNominal(const Metadata& metadata) {
 const RobotKind kRobots[] = {
     // type    geometry rows (key, count, positive, label, unit)
     //         file columns, tick sign, t decimals, id / trajectory separators, by direction,
-    //         file comment, nominal model
+    //         file comment, nominal model, angle column check
     {"omni3",  {{"Li", 1, true, "R", "m"}, {"Di", 3, true, "D", "m"}},
                "ticks_1, ticks_2, ticks_3", -1.0, 6, '_', '_', false,
-               nullptr, Omni3Nominal},
+               nullptr, Omni3Nominal, nullptr},
     {"omni4",  {{"Li", 2, true, "L", "m"}, {"Di", 4, true, "D", "m"}},
                "enc_1, enc_2, enc_3, enc_4", 1.0, 0, '_', '_', false,
-               nullptr, Omni4Nominal},
+               nullptr, Omni4Nominal, nullptr},
     {"diff",   {{"Li", 1, true, "b", "m"}, {"Di", 2, true, "D", "m"}},
                "ticks_right, ticks_left", 1.0, 9, '-', '/', false,
                "# OptiOdom differential drive (Sousa et al. 2022, MIT licence), "
-               "imported by fitcal\n", DiffNominal},
+               "imported by fitcal\n", DiffNominal, nullptr},
     {"tricyc", {{"Li", 1, true, "L", "m"}, {"Di", 1, true, "D", "m"},
                 {"Thi", 1, false, "offset", "rad"}},
                "ticks, steering", 1.0, 6, '_', '_', true,
-               nullptr, TricycleNominal},
+               nullptr, TricycleNominal, tricycle::CheckSteeringReadings},
 };
 // clang-format on
 

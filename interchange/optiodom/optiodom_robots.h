@@ -2,8 +2,9 @@
 // The robots of the OptiOdom study (Sousa et al., "OptiOdom: a Generic Approach for Odometry
 // Calibration of Wheeled Mobile Robots", J. Intell. Robot. Syst. 105, 39, 2022; MIT licence;
 // ../shared/data/optiodom/README.md) by their metadata `type`: what differs between them, as
-// data and one hook (the nominal model). Everything else is the one import sequence
-// (cli/import_optiodom.h) over the one reader and writer of the format (optiodom_format.h).
+// data and two hooks (the nominal model, the check of an angle column). Everything else is the
+// one import sequence (cli/import_optiodom.h) over the one reader and writer of the format
+// (optiodom_format.h), so that the sequence names no model.
 
 #include <string>
 #include <vector>
@@ -36,6 +37,10 @@ struct RobotKind {
   // The nominal robot of the majority's metadata, with the box the fit may search; a robot with
   // `encoder` set is written as ticks, one without as wheel rates.
   RobotModelPtr (*nominal_model)(const Metadata& metadata);
+  // The model's check of the angle column's readings (radians as the file holds them, row k on
+  // line first_line + k of `path`): io::InputError on a bad one; nullptr without an angle column.
+  void (*check_readings)(const std::vector<double>& readings_rad, const std::string& path,
+                         int first_line);
 };
 
 // The robot of sessions of this `type`; io::InputError naming `session` for any other.
