@@ -13,7 +13,7 @@ namespace fitcal::tools {
 int RunAsocSimulate(const AsocSimulateOptions& options) {
   return RunReportingErrors("fitcal", [&]() -> int {
     if (const std::string refusal =
-            DirectoryOutputRefusal(options.out, kDatasetKind, options.force, {});
+            io::DirectoryOutputRefusal(options.out, io::kDatasetKind, options.force, {});
         !refusal.empty()) {
       std::cerr << "fitcal: " << refusal << "\n";
       return 2;
@@ -23,7 +23,7 @@ int RunAsocSimulate(const AsocSimulateOptions& options) {
     const sim::AsocSimulatedDataset simulated =
         sim::SimulateAsocDataset(options.seed, options.wheel_slip_sigma, options.excursions);
     sim::WriteAsocDataset(simulated, staged.path());
-    CommitDirectoryOutput(staged, options.out, kDatasetKind, options.force, {});
+    io::CommitDirectoryOutput(staged, options.out, io::kDatasetKind, options.force, {});
     std::printf(
         "wrote %zu ASOC runs (6 calibration holds, 10 UMBmark, %d excursions) to %s; the "
         "true parameters are in truth.yaml\n",
@@ -95,7 +95,7 @@ void AddAsocSimulateOptions(CLI::App& app, AsocSimulateOptions& simulate) {
                  "Relative wheel-encoder noise per 20 Hz sample")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
-  app.add_flag("--force", simulate.force, kForceDirectoryHelp);
+  app.add_flag("--force", simulate.force, io::kForceDirectoryHelp);
 }
 
 void AddAsocGeometricOptions(CLI::App& app, FitCommandOptions& geometric) {
@@ -108,7 +108,7 @@ void AddAsocGeometricOptions(CLI::App& app, FitCommandOptions& geometric) {
   app.add_option("--out", geometric.out, "Calibrated robot YAML (atomically)")
       ->capture_default_str();
   app.add_flag("--no-output", geometric.no_output, "Do not write the YAML");
-  app.add_flag("--force", geometric.force, kForceFileHelp);
+  app.add_flag("--force", geometric.force, io::kForceFileHelp);
 }
 
 void AddAsocTablesOptions(CLI::App& app, AsocTablesOptions& tables) {

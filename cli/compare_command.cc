@@ -231,7 +231,7 @@ void AddCompareOptions(CLI::App& app, CompareCommandOptions& o) {
   app.add_option("--out", o.out, "Output prefix: <out>.csv, <out>.md, <out>_trace.csv")
       ->capture_default_str();
   app.add_flag("--no-output", o.no_output, "Print the table only");
-  app.add_flag("--force", o.force, kForceFileHelp);
+  app.add_flag("--force", o.force, io::kForceFileHelp);
   app.add_flag("--quiet", o.quiet, "No progress on stderr");
   AddSolverOptions(app, o);
   AddTyingFlags(app, o);
@@ -248,9 +248,9 @@ int RunCompareCommand(const CompareCommandOptions& options) {
     if (!options.no_output) {  // before the work: the one overwrite rule, io/output_guard.h
       const std::vector<std::string> inputs = OpenDataset(options).inputs;
       for (const auto& [suffix, start] : kOutputFiles) {
-        std::string refusal = OutputFileRefusal(options.out + suffix, inputs);
+        std::string refusal = io::OutputFileRefusal(options.out + suffix, inputs);
         if (refusal.empty() && !options.force) {
-          refusal = TextOutputOverwriteRefusal(options.out + suffix, start);
+          refusal = io::TextOutputOverwriteRefusal(options.out + suffix, start);
         }
         if (!refusal.empty()) return Refuse(refusal);
       }

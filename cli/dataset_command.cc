@@ -31,7 +31,7 @@ void AddDatasetOptions(CLI::App& app, DatasetCommandOptions& options, LogsFlag l
 OpenedDataset OpenDataset(const DatasetCommandOptions& options) {
   OpenedDataset opened;
   opened.index = io::ReadDatasetIndex(options.logs, options.Loading());
-  opened.inputs = DatasetInputs(opened.index);
+  opened.inputs = io::DatasetInputs(opened.index);
   return opened;
 }
 

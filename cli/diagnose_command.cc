@@ -179,7 +179,7 @@ void WriteOutputs(const DiagnoseCommandOptions& options, const std::vector<std::
   io::StopHereForTests("diagnose-staged");
   io::WriteFileAtomically((dir / "metrics.json").string(), io::DiagnoseMetricsJson(page));
   io::WriteFileAtomically((dir / "calibrated.yaml").string(), yaml);
-  CommitOutputDirectory(staged, options.out, inputs, kDiagnoseFiles);
+  io::CommitOutputDirectory(staged, options.out, inputs, kDiagnoseFiles);
 }
 
 }  // namespace
@@ -189,7 +189,7 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
     const OpenedDataset opened = OpenDataset(options);
     const io::DatasetIndex& index = opened.index;
     const std::vector<std::string>& inputs = opened.inputs;
-    if (const std::string refusal = OutputDirectoryRefusal(options.out, inputs, kDiagnoseFiles);
+    if (const std::string refusal = io::OutputDirectoryRefusal(options.out, inputs, kDiagnoseFiles);
         !refusal.empty()) {
       return Refuse(refusal);
     }

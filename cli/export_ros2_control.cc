@@ -75,7 +75,7 @@ void AddExportRos2ControlOptions(CLI::App& app, ExportRos2ControlOptions& o) {
       ->check(CLI::PositiveNumber);
   app.add_option("--calibration-out", o.calibration_out,
                  "With --logs: write the calibration with its odometry covariance here");
-  app.add_flag("--force", o.force, kForceFileHelp);
+  app.add_flag("--force", o.force, io::kForceFileHelp);
 }
 
 namespace {
@@ -85,9 +85,10 @@ namespace {
 // with --force.
 void CheckOut(const ExportRos2ControlOptions& o) {
   if (o.out.empty()) return;
-  std::string refusal = OutputFileRefusal(o.out, {o.calibration, o.logs});
+  std::string refusal = io::OutputFileRefusal(o.out, {o.calibration, o.logs});
   if (!refusal.empty()) throw UsageError(refusal);
-  refusal = ParameterFileOverwriteRefusal(o.out, o.node_name.empty() ? o.controller : o.node_name);
+  refusal =
+      io::ParameterFileOverwriteRefusal(o.out, o.node_name.empty() ? o.controller : o.node_name);
   if (!refusal.empty() && !o.force) throw UsageError(refusal);
 }
 
@@ -99,9 +100,9 @@ void CheckCalibrationOut(const ExportRos2ControlOptions& o, const std::string& r
         "--calibration-out needs --logs (the covariance comes from "
         "the held-out runs)");
   }
-  std::string refusal = OutputFileRefusal(o.calibration_out, {o.calibration, o.logs});
+  std::string refusal = io::OutputFileRefusal(o.calibration_out, {o.calibration, o.logs});
   if (!refusal.empty()) throw UsageError(refusal);
-  refusal = OverwriteRefusal(o.calibration_out, robot_name);
+  refusal = io::OverwriteRefusal(o.calibration_out, robot_name);
   if (!refusal.empty() && !o.force) throw UsageError(refusal);
 }
 

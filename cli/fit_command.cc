@@ -29,7 +29,7 @@ void AddFitOptions(CLI::App& app, FitCommandOptions& o) {
   app.add_option("--out", o.out, "Calibrated robot YAML to write (atomically)")
       ->capture_default_str();
   app.add_flag("--no-output", o.no_output, "Do not write the calibrated YAML");
-  app.add_flag("--force", o.force, kForceFileHelp);
+  app.add_flag("--force", o.force, io::kForceFileHelp);
   app.add_option("--time-blocks", o.time_blocks,
                  "With one or two runs fitted on their tracks and none held out, judge on time: "
                  "cut each into this many blocks of equal path, fit the odd blocks and judge on "
@@ -70,7 +70,7 @@ int RunFitCommand(const FitCommandOptions& options) {
     const OpenedDataset opened = OpenDataset(options);
     if (!options.no_output) {
       // Every model's fit writes one file: never over one of its own inputs (exit 2, usage).
-      const std::string refusal = OutputFileRefusal(options.out, opened.inputs);
+      const std::string refusal = io::OutputFileRefusal(options.out, opened.inputs);
       if (!refusal.empty()) return Refuse(refusal);
     }
     // One path for every model on the seam (models/model_interface.h), omni3 included.

@@ -237,7 +237,7 @@ void AddImportOptiOdomOptions(CLI::App& app, ImportOptiOdomOptions& o) {
       ->required()
       ->check(CLI::ExistingDirectory);
   app.add_option("--out", o.out, "Output data set directory")->required();
-  app.add_flag("--force", o.force, kForceDirectoryHelp);
+  app.add_flag("--force", o.force, io::kForceDirectoryHelp);
   app.add_flag("--skip-mapping-check", o.skip_mapping_check,
                "Write even if another wheel order/sign explains the ground truth better");
 }
@@ -256,8 +256,8 @@ int RunImportOptiOdomCommand(const ImportOptiOdomOptions& options) {
     }
     // The recordings are inputs: no data set may replace, hold or sit inside one.
     for (const std::string& dir : options.sessions) io::RegisterInputDirectory(dir);
-    if (const std::string refusal =
-            DirectoryOutputRefusal(options.out, kDatasetKind, options.force, options.sessions);
+    if (const std::string refusal = io::DirectoryOutputRefusal(options.out, io::kDatasetKind,
+                                                               options.force, options.sessions);
         !refusal.empty()) {
       throw UsageError(refusal);
     }

@@ -21,11 +21,11 @@ namespace CLI {
 class App;
 }
 
-namespace fitcal::tools {
-
-namespace optiodom {
+namespace fitcal::optiodom {
 struct RobotKind;  // interchange/optiodom/optiodom_robots.h
 }
+
+namespace fitcal::tools {
 
 struct ImportOptiOdomOptions {
   std::vector<std::string> sessions;

@@ -168,7 +168,7 @@ void WriteDataset(const ImportRosbag2Options& o, const Robot& robot, const Rosba
                           header + io::DatasetYaml("robot.yaml", entries));
   RefuseWhatFitRefuses(o, staged.path(), robot);
   io::StopHereForTests("import-rosbag2-before-rename");
-  CommitDirectoryOutput(staged, o.out, kDatasetKind, o.force, {o.bag});
+  io::CommitDirectoryOutput(staged, o.out, io::kDatasetKind, o.force, {o.bag});
 }
 
 }  // namespace
@@ -176,7 +176,8 @@ void WriteDataset(const ImportRosbag2Options& o, const Robot& robot, const Rosba
 Rosbag2Import ImportRosbag2(const ImportRosbag2Options& o) {
   if (o.out.empty()) throw UsageError("--out <data set directory> is required");
   io::RegisterInputDirectory(o.bag);  // no data set in, over or holding the bag
-  if (const std::string refusal = DirectoryOutputRefusal(o.out, kDatasetKind, o.force, {o.bag});
+  if (const std::string refusal =
+          io::DirectoryOutputRefusal(o.out, io::kDatasetKind, o.force, {o.bag});
       !refusal.empty()) {
     throw UsageError(refusal);  // exit 2, as every writer refuses its --out
   }
@@ -220,7 +221,7 @@ void AddImportRosbag2Options(CLI::App& app, ImportRosbag2Options& o) {
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   app.add_option("--label", o.label, "Trajectory label of the runs (default: the bag's name)");
-  app.add_flag("--force", o.force, kForceDirectoryHelp);
+  app.add_flag("--force", o.force, io::kForceDirectoryHelp);
 }
 
 int RunImportRosbag2Command(const ImportRosbag2Options& o) {

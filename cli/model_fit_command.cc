@@ -138,7 +138,7 @@ int MakeRequest(const FitCommandOptions& options, const Robot& robot,
     return refused;
   }
   if (!options.no_output && !options.force) {
-    const std::string refusal = OverwriteRefusal(options.out, robot.name);
+    const std::string refusal = io::OverwriteRefusal(options.out, robot.name);
     if (!refusal.empty()) return Refuse(refusal);
   }
   request->dataset = options.logs;

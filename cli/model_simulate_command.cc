@@ -66,7 +66,7 @@ int RunModelSimulateCommand(const ModelSimulateOptions& options) {
                        "--model " + options.model + " (docs/simulate.md)");
     }
     if (const std::string refusal =
-            DirectoryOutputRefusal(options.out, kDatasetKind, options.force, {});
+            io::DirectoryOutputRefusal(options.out, io::kDatasetKind, options.force, {});
         !refusal.empty()) {
       throw UsageError(refusal);
     }
@@ -85,7 +85,7 @@ int RunModelSimulateCommand(const ModelSimulateOptions& options) {
       sim::WriteSimulatedDataset(staged.path(), model->RobotYaml(robot.nominal, ""), runs);
       io::WriteFileAtomically((fs::path(staged.path()) / "true_robot.yaml").string(),
                               model->RobotYaml(truth, ""));
-      CommitDirectoryOutput(staged, options.out, kDatasetKind, options.force, {});
+      io::CommitDirectoryOutput(staged, options.out, io::kDatasetKind, options.force, {});
     }
     std::printf("wrote %zu runs of the %s robot '%s' (%d repetitions, seed %llu) to %s\n",
                 runs.size(), robot.model.c_str(), robot.name.c_str(), noise.repetitions,

@@ -38,7 +38,7 @@ ReportInputs LoadInputs(const ReportCommandOptions& options, std::string* refusa
   in.index = std::move(opened.index);
   in.inputs = std::move(opened.inputs);
   in.inputs.insert(in.inputs.end(), options.calibrations.begin(), options.calibrations.end());
-  *refusal = OutputDirectoryRefusal(options.out, in.inputs, kReportFiles);
+  *refusal = io::OutputDirectoryRefusal(options.out, in.inputs, kReportFiles);
   if (!refusal->empty()) return in;
   in.model = ReadRobotModelFile(in.index.robot_path);
   // Loaded as `fit` loads them, with the robot's channels (their runs' fingerprints must agree).
@@ -81,7 +81,7 @@ void WriteReport(const ReportCommandOptions& options, const ReportInputs& in,
   }
   io::StopHereForTests("report-staged");
   io::WriteFileAtomically((out / "metrics.json").string(), io::MetricsJson(data));
-  CommitOutputDirectory(staged, options.out, in.inputs, kReportFiles);
+  io::CommitOutputDirectory(staged, options.out, in.inputs, kReportFiles);
 }
 
 void PrintReport(const ReportCommandOptions& options, const io::ReportData& data) {

@@ -136,7 +136,7 @@ void AddSimulateOptions(CLI::App& app, SimulateCommandOptions& o) {
   app.add_option("--angle-sigma-deg", o.angle_sigma_deg,
                  "--model: noise of an angle channel's readings, e.g. steering (deg)")
       ->capture_default_str();
-  app.add_flag("--force", o.force, kForceDirectoryHelp);
+  app.add_flag("--force", o.force, io::kForceDirectoryHelp);
   app.add_option("--inject", o.inject,
                  "Inject a library effect, name=value[,value] (docs/simulate.md); repeatable; "
                  "the data set does not name it");
@@ -156,7 +156,7 @@ int RunSimulateCommand(const SimulateCommandOptions& options) {
   try {
     const sim::FlowerSimulation flower = FlowerOf(options);
     if (const std::string refusal =
-            DirectoryOutputRefusal(options.out, kDatasetKind, options.force, {});
+            io::DirectoryOutputRefusal(options.out, io::kDatasetKind, options.force, {});
         !refusal.empty()) {
       std::cerr << "fitcal: " << refusal << "\n";
       return 2;
@@ -167,7 +167,7 @@ int RunSimulateCommand(const SimulateCommandOptions& options) {
     const RobotModelInterface& model = *flower.model;
     sim::WriteSimulatedDataset(staged.path(), model.RobotYaml(model.robot().nominal, ""), runs,
                                sim::EncoderCsvDigits::kRecorder);
-    CommitDirectoryOutput(staged, options.out, kDatasetKind, options.force, {});
+    io::CommitDirectoryOutput(staged, options.out, io::kDatasetKind, options.force, {});
     std::printf("wrote %zu runs (%zu trajectories x %d repetitions, seed %llu) to %s\n",
                 runs.size(), flower.trajectories.size(), flower.repetitions,
                 static_cast<unsigned long long>(flower.options.seed), options.out.c_str());

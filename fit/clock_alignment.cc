@@ -9,7 +9,7 @@
 #include "fit/track_residual.h"
 #include "odometry/aligned_run.h"
 
-namespace fitcal::tools {
+namespace fitcal {
 
 namespace {
 
@@ -104,4 +104,4 @@ std::string AlignGroundTruthClocks(const std::string& mode, const RobotModelInte
   return Summary("estimated per " + mode + how, moved, logs->size(), offsets);
 }
 
-}  // namespace fitcal::tools
+}  // namespace fitcal

@@ -20,7 +20,7 @@
 #include "models/model_interface.h"
 #include "odometry/run_log.h"
 
-namespace fitcal::tools {
+namespace fitcal {
 
 // "recorded, none, session, run, dataset" (with_recorded) or without "recorded".
 std::string ClockOffsetModes(bool with_recorded);
@@ -35,4 +35,4 @@ std::string AlignGroundTruthClocks(const std::string& mode, const RobotModelInte
                                    const std::optional<io::CalibrationProvenance>& recorded,
                                    int threads, std::vector<RunLog>* logs);
 
-}  // namespace fitcal::tools
+}  // namespace fitcal

@@ -13,7 +13,7 @@
 #include "io/input_registry.h"
 #include "io/yaml_reader.h"
 
-namespace fitcal::tools {
+namespace fitcal::io {
 
 namespace fs = std::filesystem;
 
@@ -240,4 +240,4 @@ std::vector<std::string> DatasetInputs(const io::DatasetIndex& index) {
   return inputs;
 }
 
-}  // namespace fitcal::tools
+}  // namespace fitcal::io

@@ -19,7 +19,7 @@
 #include "io/dataset.h"
 #include "io/staged_directory.h"
 
-namespace fitcal::tools {
+namespace fitcal::io {
 
 // The help of every --force flag: one meaning for files and one for directories (the rule above).
 inline constexpr char kForceFileHelp[] =
@@ -84,4 +84,4 @@ void CommitDirectoryOutput(io::StagedDirectory& staged, const std::string& out,
 // Every file a data set run reads: dataset.yaml, the robot YAML, each run's logs.
 std::vector<std::string> DatasetInputs(const io::DatasetIndex& index);
 
-}  // namespace fitcal::tools
+}  // namespace fitcal::io

@@ -15,7 +15,7 @@
 #include "odometry/parallel_for.h"
 #include "io/output_guard.h"
 
-namespace fitcal::tools::optiodom {
+namespace fitcal::optiodom {
 
 namespace fs = std::filesystem;
 using io::InputError;
@@ -373,7 +373,7 @@ void WriteDataset(const std::vector<RunLog>& runs, const RobotModelInterface& mo
                           text.header + model.RobotYaml(model.robot().nominal, ""));
   io::WriteFileAtomically((dir / "dataset.yaml").string(),
                           text.header + io::DatasetYaml("robot.yaml", entries));
-  CommitDirectoryOutput(staged, out, kDatasetKind, force, session_dirs);
+  io::CommitDirectoryOutput(staged, out, io::kDatasetKind, force, session_dirs);
 }
 
-}  // namespace fitcal::tools::optiodom
+}  // namespace fitcal::optiodom

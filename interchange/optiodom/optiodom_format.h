@@ -19,7 +19,7 @@
 #include "models/model_interface.h"
 #include "odometry/run_log.h"
 
-namespace fitcal::tools::optiodom {
+namespace fitcal::optiodom {
 
 // <s>_metadata.csv: the `type` row and every numeric row, key -> (line, values).
 struct Metadata {
@@ -105,4 +105,4 @@ void WriteDataset(const std::vector<RunLog>& runs, const RobotModelInterface& mo
                   const DatasetText& text, const std::string& out, bool force,
                   const std::vector<std::string>& session_dirs);
 
-}  // namespace fitcal::tools::optiodom
+}  // namespace fitcal::optiodom

@@ -10,7 +10,7 @@
 #include "models/tricycle/tricycle_checks.h"
 #include "models/tricycle/tricycle_model.h"
 
-namespace fitcal::tools::optiodom {
+namespace fitcal::optiodom {
 
 namespace {
 
@@ -196,4 +196,4 @@ const char* FlaggedRunReason(const std::string& path_type, const std::string& se
   return nullptr;
 }
 
-}  // namespace fitcal::tools::optiodom
+}  // namespace fitcal::optiodom

@@ -12,7 +12,7 @@
 #include "models/model_interface.h"
 #include "interchange/optiodom/optiodom_format.h"
 
-namespace fitcal::tools::optiodom {
+namespace fitcal::optiodom {
 
 // A metadata row that describes the robot (read after ngear and encRes, in this order). Sessions
 // whose rows differ declare perturbed starting values (the README): the majority's make the robot.
@@ -49,4 +49,4 @@ const RobotKind& RobotKindOf(const std::string& type, const std::string& session
 // A run the authors flagged as bad, or nullptr.
 const char* FlaggedRunReason(const std::string& path_type, const std::string& session, int run);
 
-}  // namespace fitcal::tools::optiodom
+}  // namespace fitcal::optiodom
