@@ -7,6 +7,7 @@
 #include "calibrate/checks_before_fitting.h"
 #include "calibrate/choice_by_transfer.h"
 #include "calibrate/never_worse_gate.h"
+#include "calibrate/reading_resolution_uncertainty.h"
 #include "calibrate/track_residuals.h"
 #include "validation/never_worse.h"
 
@@ -110,6 +111,11 @@ bool SelectCandidate(const CalibrationRequest& r, const RobotModelInterface& mod
   out->selected_fit =
       DescribeSelected(model.robot(), out->candidates, out->gate.selected, r.method->name,
                        out->fit.objective + objective_note, out->fit.fit, out->track_fits);
+  if (out->gate.selected != 0 && out->selected().name == r.method->name) {
+    AddReadingResolutionUncertainty(*r.method, out->settings, model, split.training,
+                                    ReadingResolutionsOf(model.robot(), r.runs),
+                                    out->selected().parameters, &out->selected_fit);
+  }
   if (out->gate.selected == 0 || !r.will_write) return true;
   const std::string refusal =
       AddPropagatedUncertainty(model, out->selected(), split.training, &out->selected_fit);

@@ -191,12 +191,13 @@ std::string FitMethodNames() {
   return out;
 }
 
+bool IsCeresMethod(const std::string& name) { return name == "ceres" || name == "ceres-dogleg"; }
+
 void ResolveAutoResiduals(const std::vector<AlignedRun>& training,
                           const std::vector<const GroundTruthTrack*>& tracks,
                           const std::string& method, FitMethodSettings* settings) {
   if (!settings->residuals_auto) return;
-  const bool ceres = method == "ceres" || method == "ceres-dogleg";
-  settings->residuals = ceres && MeasureTrackDensity(training, tracks).dense
+  settings->residuals = IsCeresMethod(method) && MeasureTrackDensity(training, tracks).dense
                             ? ResidualKind::kTrack
                             : ResidualKind::kFinalPose;
 }

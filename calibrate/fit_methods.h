@@ -83,6 +83,9 @@ struct FitMethod {
 const std::vector<FitMethod>& FitMethods();
 const FitMethod* FindFitMethod(const std::string& name);  // nullptr if unknown
 std::string FitMethodNames();                             // "ceres, ceres-dogleg, crs2lm, ..."
+// Ceres methods (ceres, ceres-dogleg) start where they are told and fit tracks; NLopt's search
+// their box.
+bool IsCeresMethod(const std::string& name);
 
 // --residuals auto (fit/residual_choice.h): kTrack when the training runs' ground truth is a dense
 // track and `method` is a Ceres one, kFinalPose otherwise; nothing without residuals_auto.

@@ -63,7 +63,8 @@ SelectedFit DescribeSelected(const Robot& robot,
                   fit.termination,
                   {},
                   {},
-                  ""};
+                  "",
+                  {}};
   if (const EffectFitResult* track_fit = TrackFitOf(track_fits, selected_index)) {
     out.has_covariance = track_fit->has_covariance;
     out.sigma = track_fit->sigma;

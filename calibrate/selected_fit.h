@@ -28,6 +28,9 @@ struct SelectedFit {
   std::vector<bool> not_determined;
   // Why parameters beyond the robot's own holds are held when no fit chose them ("" for a fit).
   std::string held_reason;
+  // What the sigmas hold beyond the fit's own covariance, one line each (the angle channels'
+  // resolution: calibrate/reading_resolution_uncertainty.h).
+  std::vector<std::string> sigma_notes;
 };
 
 // candidates[selected_index] described by the fit that made it: `fit` (the method's, minimising

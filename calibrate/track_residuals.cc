@@ -14,7 +14,7 @@ std::string PrepareTrackResiduals(const std::string& method, const RunSplit& spl
   const std::vector<const GroundTruthTrack*> tracks = TracksOf(split.training);
   ResolveAutoResiduals(split.training, tracks, method, settings);
   if (settings->residuals == ResidualKind::kFinalPose) return "";
-  if (method != "ceres" && method != "ceres-dogleg") {
+  if (!IsCeresMethod(method)) {
     return std::string("--residuals ") + ToString(settings->residuals) +
            " needs a Ceres method (--method ceres or ceres-dogleg); " + method +
            " fits final poses only";

@@ -223,6 +223,7 @@ EncoderRowConverter::EncoderRowConverter(const Robot& robot, std::vector<int> ch
       previous_(channel_of_column_.size(), 0.0) {
   log_.samples = EncoderSamples(robot.NumChannels());
   angle_encoder_.assign(channel_of_column_.size(), nullptr);
+  reading_grid_.resize(channel_of_column_.size());
   for (std::size_t j = 0; j < channel_of_column_.size(); ++j) {
     if (!ticks_column_[j]) continue;
     const ChannelInfo& channel = robot.channels[channel_of_column_[j]];
@@ -299,8 +300,25 @@ void EncoderRowConverter::Add(double t_s, const double* row) {
     }
     log_.samples.push_back(dt, values);
   }
-  for (std::size_t j = 0; j < n; ++j) previous_[j] = row[j];
+  for (std::size_t j = 0; j < n; ++j) {
+    previous_[j] = row[j];
+    if (robot_.channels[channel_of_column_[j]].kind == ChannelKind::kAngle) {
+      reading_grid_[j].Add(row[j]);
+    }
+  }
   log_.t_s.push_back(t_s);
+}
+
+EncoderLog EncoderRowConverter::Take() {
+  log_.reading_resolution.assign(static_cast<std::size_t>(robot_.NumChannels()), {});
+  for (std::size_t j = 0; j < channel_of_column_.size(); ++j) {
+    if (robot_.channels[channel_of_column_[j]].kind != ChannelKind::kAngle) continue;
+    // Counts: the encoder's count is the step, whatever the readings visited.
+    log_.reading_resolution[static_cast<std::size_t>(channel_of_column_[j])] =
+        reading_grid_[j].Resolution(
+            angle_encoder_[j] ? 2.0 * M_PI / angle_encoder_[j]->ticks_per_rev : 0.0);
+  }
+  return std::move(log_);
 }
 
 namespace {

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "odometry/reading_resolution.h"
 #include "odometry/robot.h"
 #include "odometry/run_log.h"
 
@@ -50,7 +51,8 @@ class EncoderRowConverter {
   // t_s must increase (checked by the caller); row holds one value per column.
   void Add(double t_s, const double* row);
   const EncoderSamples& samples() const { return log_.samples; }
-  EncoderLog Take() { return std::move(log_); }
+  // The log, with each angle channel's reading step (EncoderLog::reading_step_rad).
+  EncoderLog Take();
 
  private:
   const Robot& robot_;
@@ -62,6 +64,7 @@ class EncoderRowConverter {
   bool cumulative_ = false;
   double counter_modulus_ = 0.0;  // 2^counter_bits; 0 when the width is not declared
   std::vector<const AngleEncoder*> angle_encoder_;  // per column: an angle channel's counts
+  std::vector<ReadingGrid> reading_grid_;           // per column: an angle channel's readings
   EncoderLog log_;
 };
 

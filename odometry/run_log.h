@@ -10,6 +10,7 @@
 
 #include "odometry/encoder_samples.h"
 #include "odometry/pose2.h"
+#include "odometry/reading_resolution.h"
 
 namespace fitcal {
 
@@ -26,6 +27,11 @@ struct EncoderLog {
   // Intervals whose counts were glitches of the recorder's counter (io/log_files.h), named on
   // load and bridged by their neighbours instead of replayed.
   int dropped_glitches = 0;
+  // Per channel: the resolution of an angle channel's readings - its absolute encoder's count, or
+  // the grid the recorded readings lie on, and their noise over it (odometry/reading_resolution.h)
+  // - step 0 when none is seen and for wheel rates. Empty: the loader did not look (logs made in
+  // memory).
+  std::vector<ReadingResolution> reading_resolution;
 };
 
 // Ground truth (SLAM, motion capture): poses in the world frame at strictly increasing times.

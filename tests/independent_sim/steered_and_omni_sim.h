@@ -131,9 +131,10 @@ struct TricycleGeometry {
 
 struct SteeringActuator {
   double tau_s = 0.15;
-  // The column's absolute encoder, 14 bits. At 12 bits the straight-ahead reading's rounding (the
-  // same count on every straight) biases the fitted offset beyond its sigma: a resolution limit
-  // of the truth, not noise (docs/everyday_driving.md, "Sigmas that cover").
+  // The column's absolute encoder, 14 bits by default. At 12 bits the straight-ahead reading's
+  // rounding (the same count on every straight) biases the fitted offset by a constant: a
+  // resolution limit, not noise, which fitcal's sigmas hold since the readings' resolution is
+  // measured (docs/everyday_driving.md, "Sigmas that cover").
   int counts_per_rev = 16384;
 };
 
