@@ -296,42 +296,6 @@ std::vector<EffectId> CandidateEffects(const DiagnoseContext& x, const EffectFit
   return candidates;
 }
 
-// The effect parameters that act only through the robot-frame lateral velocity, on a robot that
-// cannot move sideways (its model has no channel values for a sideways twist): held at 0 in the
-// candidates' fits. Such a robot's replay has a lateral velocity only as the chord of each
-// encoder interval (dy = v dt (1 - cos a) / a, a the interval's turn), so the parameter fits a
-// discretisation artefact: on a differential drive translation_yaw_gain's g_y ran to its bound
-// (0.5 s/m) and its fit to the 50-iteration limit, 1-2 s of CPU of a 2-3 s diagnose on the
-// independent simulator's runs, in 23 of 70 diagnoses. Found by probing each parameter's body
-// stage with and without a lateral velocity (a pivot's turn fraction set, so that effects reading
-// it act).
-std::vector<EffectFitOptions::HeldEffectParameter> LateralOnlyParameters(
-    const RobotModelInterface& model, const EffectModel& effects) {
-  Twist sideways;
-  sideways.vy_m_s = 1.0;
-  std::vector<double> w(static_cast<std::size_t>(model.robot().NumChannels()), 0.0);
-  if (model.ChannelsForTwist(model.robot().nominal.data(), sideways, w.data())) return {};
-  std::vector<EffectFitOptions::HeldEffectParameter> held;
-  const auto& table = effects::EffectOpsTable<double>();
-  for (const effects::EffectValue& e : effects) {
-    const auto body = table[static_cast<int>(e.id)].body;
-    if (body == nullptr) continue;
-    effects::SampleContext context;
-    context.turn_fraction = 0.5;
-    context.moving = true;
-    for (int k = 0; k < effects::Info(e.id).num_parameters; ++k) {
-      double q[effects::kMaxEffectParameters] = {};
-      q[k] = 1.0;
-      double forward[3] = {1.0, 0.0, 1.0}, lateral[3] = {1.0, 1.0, 1.0};
-      body(q, context, forward);
-      body(q, context, lateral);
-      const bool acts_forward = forward[0] != 1.0 || forward[1] != 0.0 || forward[2] != 1.0;
-      const bool acts_lateral = lateral[0] != 1.0 || lateral[1] != 1.0 || lateral[2] != 1.0;
-      if (!acts_forward && acts_lateral) held.push_back({e.id, k});
-    }
-  }
-  return held;
-}
 
 // The base of a round: the current model's held-out score and training BIC, and the residual's
 // degrees of freedom (3 per training run, less the fitted parameters; fit/effect_fit.h).
@@ -515,6 +479,34 @@ void Conclude(const DiagnoseContext& x, const EffectFitResult& current, Diagnose
 }
 
 }  // namespace
+
+std::vector<EffectFitOptions::HeldEffectParameter> LateralOnlyParameters(
+    const RobotModelInterface& model, const EffectModel& effects) {
+  Twist sideways;
+  sideways.vy_m_s = 1.0;
+  std::vector<double> w(static_cast<std::size_t>(model.robot().NumChannels()), 0.0);
+  if (model.ChannelsForTwist(model.robot().nominal.data(), sideways, w.data())) return {};
+  std::vector<EffectFitOptions::HeldEffectParameter> held;
+  const auto& table = effects::EffectOpsTable<double>();
+  for (const effects::EffectValue& e : effects) {
+    const auto body = table[static_cast<int>(e.id)].body;
+    if (body == nullptr) continue;
+    effects::SampleContext context;
+    context.turn_fraction = 0.5;
+    context.moving = true;
+    for (int k = 0; k < effects::Info(e.id).num_parameters; ++k) {
+      double q[effects::kMaxEffectParameters] = {};
+      q[k] = 1.0;
+      double forward[3] = {1.0, 0.0, 1.0}, lateral[3] = {1.0, 1.0, 1.0};
+      body(q, context, forward);
+      body(q, context, lateral);
+      const bool acts_forward = forward[0] != 1.0 || forward[1] != 0.0 || forward[2] != 1.0;
+      const bool acts_lateral = lateral[0] != 1.0 || lateral[1] != 1.0 || lateral[2] != 1.0;
+      if (!acts_forward && acts_lateral) held.push_back({e.id, k});
+    }
+  }
+  return held;
+}
 
 DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
                         const std::vector<TrackRun>& validation, const RobotModelInterface& model,

@@ -168,6 +168,18 @@ std::vector<double> WindowObjectives(const RobotModelInterface& model, const std
                                      const EffectModel& effects, const std::vector<TrackRun>& runs,
                                      const ResidualWeights& weights);
 
+// The effect parameters that act only through the robot-frame lateral velocity, on a robot that
+// cannot move sideways (its model has no channel values for a sideways twist): held at 0 in the
+// candidates' fits (Diagnose). Such a robot's replay has a lateral velocity only as the chord of each
+// encoder interval (dy = v dt (1 - cos a) / a, a the interval's turn), so the parameter fits a
+// discretisation artefact: on a differential drive translation_yaw_gain's g_y ran to its bound
+// (0.5 s/m) and its fit to the 50-iteration limit, 1-2 s of CPU of a 2-3 s diagnose on the
+// independent simulator's runs, in 23 of 70 diagnoses. Found by probing each parameter's body
+// stage with and without a lateral velocity (a pivot's turn fraction set, so that effects reading
+// it act).
+std::vector<EffectFitOptions::HeldEffectParameter> LateralOnlyParameters(
+    const RobotModelInterface& model, const EffectModel& effects);
+
 // A fitted candidate's verdict: the held-out test as it came out - "significant (p < threshold)"
 // or "not significant (p >= threshold)", never the one for the other - then the rule that decided,
 // stated ("but explains only 31 % of the lack of fit (rule: >= 50 %)"). accepted_name: the
