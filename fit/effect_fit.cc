@@ -344,16 +344,28 @@ TrackErrors ComputeTrackErrors(const RobotModelInterface& robot_model, const std
 
 namespace {
 
-// The registry's box on every effect's parameters; returns how many there are.
-int BoundEffectParameters(EffectModel* model, ceres::Problem* problem) {
+// The registry's box on every effect's parameters, and the held ones at 0; returns how many are
+// free.
+int BoundEffectParameters(const EffectFitOptions& options, EffectModel* model,
+                          ceres::Problem* problem) {
   int count = 0;
   for (auto& e : *model) {
     const auto& info = effects::Info(e.id);
-    count += info.num_parameters;
+    std::vector<int> held;
+    for (const auto& h : options.held_effect_parameters) {
+      if (h.id == e.id && h.index < info.num_parameters) held.push_back(h.index);
+    }
+    count += info.num_parameters - static_cast<int>(held.size());
     for (int k = 0; k < info.num_parameters; ++k) {
       e.value[k] = std::clamp(e.value[k], info.lower[k], info.upper[k]);
       problem->SetParameterLowerBound(e.value.data(), k, info.lower[k]);
       problem->SetParameterUpperBound(e.value.data(), k, info.upper[k]);
+    }
+    for (int k : held) e.value[k] = 0.0;
+    if (static_cast<int>(held.size()) == info.num_parameters) {
+      problem->SetParameterBlockConstant(e.value.data());
+    } else if (!held.empty()) {
+      problem->SetManifold(e.value.data(), new ceres::SubsetManifold(info.num_parameters, held));
     }
   }
   return count;
@@ -404,7 +416,7 @@ EffectFitResult FitEffectModel(const std::vector<TrackRun>& training,
         blocks));
   }
   BoundModelBlock(robot, HoldAtNominal(robot, p), p, &problem);
-  const int num_effect_parameters = BoundEffectParameters(&result.effects, &problem);
+  const int num_effect_parameters = BoundEffectParameters(options, &result.effects, &problem);
 
   ceres::Solver::Summary summary;
   ceres::Solve(SolverOptionsFor(options), &problem, &summary);
@@ -439,7 +451,7 @@ double SeparableFraction(const std::vector<TrackRun>& training,
                          const RobotModelInterface& robot_model, const std::vector<double>& p,
                          const EffectModel& model, EffectId candidate,
                          const ResidualWeights& weights, double* unexplained_norm,
-                         double* linearized_size) {
+                         double* linearized_size, double* linearized_residual_ss) {
   EffectModel with = model;
   effects::EffectValue c;
   c.id = candidate;
@@ -479,9 +491,11 @@ double SeparableFraction(const std::vector<TrackRun>& training,
   }
   if (unexplained_norm != nullptr) *unexplained_norm = smallest;
   if (linearized_size != nullptr) {
-    const Eigen::VectorXd step = jac.colPivHouseholderQr().solve(
-        -Eigen::Map<const Eigen::VectorXd>(residuals.data(), static_cast<Eigen::Index>(residuals.size())));
+    const Eigen::Map<const Eigen::VectorXd> r(residuals.data(),
+                                              static_cast<Eigen::Index>(residuals.size()));
+    const Eigen::VectorXd step = jac.colPivHouseholderQr().solve(-r);
     *linearized_size = step.tail(m_c).cwiseAbs().maxCoeff();
+    if (linearized_residual_ss != nullptr) *linearized_residual_ss = (r + jac * step).squaredNorm();
   }
   return fraction;
 }

@@ -174,6 +174,13 @@ struct EffectFitOptions : CeresFitOptions {
     function_tolerance = 1e-10;
     parameter_tolerance = 1e-10;
   }
+  // Effect parameters held at 0 (neutral): those the robot's motion cannot excite (diagnose's
+  // LateralOnlyParameters).
+  struct HeldEffectParameter {
+    effects::EffectId id;
+    int index;
+  };
+  std::vector<HeldEffectParameter> held_effect_parameters;
 };
 
 struct EffectFitResult {
@@ -214,11 +221,14 @@ EffectFitResult FitEffectModel(const std::vector<TrackRun>& training,
 // candidate before fitting it. *linearized_size (optional) gets the size the residual itself
 // asks of the candidate: the largest |delta_c| of one Gauss-Newton step of every column from the
 // given solution (min |r + J delta|), so an effect larger than the registry's realistic
-// magnitude is seen as such before it is fitted.
+// magnitude is seen as such before it is fitted; *linearized_residual_ss (optional, with
+// linearized_size) gets |r + J delta|^2 of that step, the residual's sum of squares with the
+// candidate in the model, from which its sigma is predicted (diagnose.h).
 double SeparableFraction(const std::vector<TrackRun>& training,
                          const RobotModelInterface& robot_model, const std::vector<double>& p,
                          const EffectModel& model, effects::EffectId candidate,
                          const ResidualWeights& weights = {}, double* unexplained_norm = nullptr,
-                         double* linearized_size = nullptr);
+                         double* linearized_size = nullptr,
+                         double* linearized_residual_ss = nullptr);
 
 }  // namespace fitcal

@@ -21,6 +21,7 @@
 #include "io/dataset.h"
 #include "models/diff_drive/diff_drive_model.h"
 #include "models/model_registry.h"
+#include "models/omni3/omni3_robot_model.h"
 #include "odometry/effects.h"
 #include "tests/diagnose_expectations.h"
 #include "tests/test_files.h"
@@ -120,6 +121,24 @@ TEST(DiffDriveDiagnose, NamesAPivotYawGainWithItsSize) {
   const Split d = Simulate(*model, injected, 31);
   fitcal::testing::ExpectDiagnoseNamesTheInjectedEffect(d.training, d.validation, *model,
                                                         EffectId::kPivotYawGain, injected);
+}
+
+// A differential drive has no channel values for a sideways twist, so of the effects that act on
+// the body velocity exactly translation_yaw_gain's g_y (omega' = omega (1 + g_x v_x + g_y v_y),
+// index 1) acts on nothing it does: held. The omni3 robot moves sideways: nothing held.
+TEST(DiffDriveDiagnose, HoldsOnlyTheEffectParametersASidewaysMotionWouldShow) {
+  EffectModel body_effects;
+  for (EffectId id : {EffectId::kYawRateSlip, EffectId::kTranslationYawGain,
+                      EffectId::kGroundTruthOffset, EffectId::kPivotYawGain}) {
+    effects::EffectValue e;
+    e.id = id;
+    body_effects.push_back(e);
+  }
+  const auto held = LateralOnlyParameters(*DiffDrive(), body_effects);
+  ASSERT_EQ(held.size(), 1u);
+  EXPECT_EQ(held[0].id, EffectId::kTranslationYawGain);
+  EXPECT_EQ(held[0].index, 1);
+  EXPECT_TRUE(LateralOnlyParameters(DefaultOmni3Model(), body_effects).empty());
 }
 
 TEST(DiffDriveDiagnose, CleanDiffDriveAcceptsNothing) {

@@ -143,7 +143,10 @@ Said DiagnoseSeed(const Case& c, int seed) {
     }
   }
   sim::WriteLabelledDataSet(dir.path() / "data", runs, nominal, sensors);
-  const auto r = RunFitcal(dir, "diagnose --logs " + dir.Path("data") + " --out " +
+  // One thread: ctest already runs two tests at once on the two cores, and diagnose's threads
+  // cost ~14 % more CPU in synchronisation (gear_play seed 3: 2.8 s against 3.25 s user + sys);
+  // the output is the same.
+  const auto r = RunFitcal(dir, "diagnose --threads 1 --logs " + dir.Path("data") + " --out " +
                                     dir.Path("out"));
   Said said;
   said.text = r.out + r.err;
@@ -207,11 +210,13 @@ TEST_P(IndependentDiagnose, SaysWhatThePhysicsIs) {
   std::printf("%-16s %d of %d seeds as expected%s\n", c.name.c_str(), passed, kSeeds,
               c.expect == Expect::kNamed ? (", named in " + std::to_string(named)).c_str() : "");
   EXPECT_EQ(passed, kSeeds) << c.name;
-  // An effect of the library is named in all seeds but one (measured: the eccentric hub's 3 %
-  // sits at three predicted sigmas, and the traction creep's held-out test reached p = 0.034
-  // against 0.0013 on one seed; both said so, neither named another effect).
+  // An effect of the library is named in every seed. (Until the held-out test compared windows,
+  // the eccentric hub and the traction creep were named in 4 of 5: on seed 2, whose trajectories
+  // hold two long fast arcs, the wandering slip accumulated over a run outweighed both effects in
+  // the track error from the start - p = 0.0026 and 0.034 against 0.001 and 0.0013;
+  // docs/diagnose.md.)
   if (c.expect == Expect::kNamed) {
-    EXPECT_GE(named, kSeeds - 1) << c.name;
+    EXPECT_EQ(named, kSeeds) << c.name;
   }
 }
 
