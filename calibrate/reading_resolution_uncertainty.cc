@@ -28,8 +28,9 @@ std::vector<ReadingResolution> ReadingResolutionsOf(const Robot& robot,
 namespace {
 
 // The parameters' move when every training run's channel `c` reads `shift_rad` more: the method's
-// fit warm-started from `parameters` (a judgement fit: only its parameters are read).
-Eigen::VectorXd MoveOfAShiftedChannel(const FitMethod& method, FitMethodSettings settings,
+// fit warm-started from `parameters` (a judgement fit: only its parameters are read); empty when
+// that fit is not usable.
+std::optional<Eigen::VectorXd> MoveOfAShiftedChannel(const FitMethod& method, FitMethodSettings settings,
                                       const RobotModelInterface& model,
                                       const std::vector<AlignedRun>& runs, int c, double shift_rad,
                                       const std::vector<double>& parameters) {
@@ -54,6 +55,7 @@ Eigen::VectorXd MoveOfAShiftedChannel(const FitMethod& method, FitMethodSettings
   settings.start = parameters;
   settings.judgement_fit = true;
   const ModelFitResult refit = method.run_model(training, model, settings).fit;
+  if (!refit.usable) return std::nullopt;
   Eigen::VectorXd move(static_cast<Eigen::Index>(parameters.size()));
   for (std::size_t k = 0; k < parameters.size(); ++k) {
     move[static_cast<Eigen::Index>(k)] = refit.parameters[k] - parameters[k];
@@ -123,10 +125,16 @@ void AddReadingResolutionUncertainty(
                                  "(--method ceres includes it)");
       continue;
     }
-    const Eigen::VectorXd move = MoveOfAShiftedChannel(method, settings, model, training, c,
-                                                       resolution.BiasSigma(), parameters);
+    const std::optional<Eigen::VectorXd> move = MoveOfAShiftedChannel(
+        method, settings, model, training, c, resolution.BiasSigma(), parameters);
+    if (!move) {
+      fit->sigma_notes.push_back("channel '" + robot.channels[c].name +
+                                 "': the fit with its readings shifted did not converge, so the "
+                                 "sigmas leave its resolution out");
+      continue;
+    }
     const std::vector<double> before = SigmasOf(covariance);
-    covariance += move * move.transpose();
+    covariance += *move * move->transpose();
     fit->sigma_notes.push_back(ResolutionLine(robot, c, resolution, before, SigmasOf(covariance)));
   }
   fit->sigma = SigmasOf(covariance);
