@@ -191,7 +191,7 @@ TEST(NewcomerCli, EveryHelpListsTheExitStatusesAndNoArtefacts) {
       commands.push_back(command.empty() ? sub : command + " " + sub);
     }
   }
-  // The 13 commands and 2 groups of fitcal_main.cc, the top level and import's, export's own.
+  // The 13 commands and 2 groups of cli/command_line.cc, the top level and import's, export's own.
   EXPECT_EQ(commands.size(), 16u);
   // The exclusion is said in words (and still refused: InputClassesCli.UsageErrors...).
   for (const std::string command : {"fit", "diagnose"}) {
