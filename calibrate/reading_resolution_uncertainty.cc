@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <optional>
 #include <stdexcept>
 
 #include "fit/correlation.h"
+#include "odometry/text_format.h"
 
 namespace fitcal {
 
@@ -30,10 +30,12 @@ namespace {
 // The parameters' move when every training run's channel `c` reads `shift_rad` more: the method's
 // fit warm-started from `parameters` (a judgement fit: only its parameters are read); empty when
 // that fit is not usable.
-std::optional<Eigen::VectorXd> MoveOfAShiftedChannel(const FitMethod& method, FitMethodSettings settings,
-                                      const RobotModelInterface& model,
-                                      const std::vector<AlignedRun>& runs, int c, double shift_rad,
-                                      const std::vector<double>& parameters) {
+std::optional<Eigen::VectorXd> MoveOfAShiftedChannel(const FitMethod& method,
+                                                     FitMethodSettings settings,
+                                                     const RobotModelInterface& model,
+                                                     const std::vector<AlignedRun>& runs, int c,
+                                                     double shift_rad,
+                                                     const std::vector<double>& parameters) {
   const AlignedRun* original = runs.data();
   std::vector<AlignedRun> training = runs;
   // The track residuals read the runs' samples through their checkpoints: pointed at the copies.
@@ -63,36 +65,32 @@ std::optional<Eigen::VectorXd> MoveOfAShiftedChannel(const FitMethod& method, Fi
   return move;
 }
 
-std::string Number(const char* format, double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, format, value);
-  return text;
-}
-
 // "channel 'steering' reads in steps of 0.45 deg: a held angle's reading is off by a constant
 // (uniform over a step, sigma 0.13 deg), in the sigmas: steering_offset 0.0335 -> 0.134 deg"
 std::string ResolutionLine(const Robot& robot, int c, const ReadingResolution& resolution,
                            const std::vector<double>& sigma_before,
                            const std::vector<double>& sigma_after) {
   const double deg = 180.0 / M_PI;
+  const double uniform_sigma = resolution.step_rad / std::sqrt(12.0);
+  // Said when the readings' noise shrinks the bias by 1 % or more.
   const std::string dither =
-      resolution.NoiseOverStep() > 0.0
-          ? "; its noise, " + Number("%.2g", resolution.NoiseOverStep()) +
-                " of a step, dithers that to sigma " + Number("%.3g", resolution.BiasSigma() * deg) +
-                " deg"
+      resolution.BiasSigma() < 0.99 * uniform_sigma
+          ? "; its noise, " + StrFormat("%.2g", resolution.NoiseOverStep()) +
+                " of a step, dithers that to sigma " +
+                StrFormat("%.3g", resolution.BiasSigma() * deg) + " deg"
           : "";
   std::string line = "channel '" + robot.channels[c].name + "' reads in steps of " +
-                     Number("%.3g", resolution.step_rad * deg) +
+                     StrFormat("%.3g", resolution.step_rad * deg) +
                      " deg: a held angle's reading is off by a constant (uniform over a step, "
-                     "sigma " + Number("%.3g", resolution.step_rad / std::sqrt(12.0) * deg) +
-                     " deg" + dither + "), in the sigmas:";
+                     "sigma " + StrFormat("%.3g", uniform_sigma * deg) + " deg" + dither +
+                     "), in the sigmas:";
   bool any = false;
   for (int k = 0; k < robot.NumParameters(); ++k) {
     const ParameterInfo& info = robot.parameters[k];
     if (!(sigma_after[k] > 1.01 * sigma_before[k])) continue;
     line += std::string(any ? "," : "") + " " + info.name + " " +
-            Number("%.3g", sigma_before[k] * info.DisplayScale()) + " -> " +
-            Number("%.3g", sigma_after[k] * info.DisplayScale()) + " " + info.DisplayUnit();
+            StrFormat("%.3g", sigma_before[k] * info.DisplayScale()) + " -> " +
+            StrFormat("%.3g", sigma_after[k] * info.DisplayScale()) + " " + info.DisplayUnit();
     any = true;
   }
   return any ? line : line + " no parameter's sigma grows by 1 % or more";
@@ -119,7 +117,7 @@ void AddReadingResolutionUncertainty(
     if (!(resolution.step_rad > 0.0)) continue;
     if (!IsCeresMethod(method.name)) {
       fit->sigma_notes.push_back("channel '" + robot.channels[c].name + "' reads in steps of " +
-                                 Number("%.3g", resolution.step_rad * 180.0 / M_PI) + " deg; " +
+                                 StrFormat("%.3g", resolution.step_rad * 180.0 / M_PI) + " deg; " +
                                  method.name +
                                  " takes no start, so the sigmas leave that resolution out "
                                  "(--method ceres includes it)");

@@ -93,7 +93,9 @@ TEST(ReadingGrid, TheFlickerOfHeldAnglesMeasuresTheNoiseOverTheStep) {
     std::vector<double> readings;
     for (int held = 0; held < 40; ++held) {
       const double angle = where(rng);
-      for (int i = 0; i < 500; ++i) readings.push_back(step * std::round((angle + noise(rng)) / step));
+      for (int i = 0; i < 500; ++i) {
+        readings.push_back(step * std::round((angle + noise(rng)) / step));
+      }
     }
     const ReadingResolution r = ResolutionOf(readings);
     EXPECT_NEAR(r.step_rad, step, 1e-12) << s;
@@ -199,7 +201,8 @@ TEST(ReadingResolutionUncertainty, ACoarseSteeringEncoderWidensTheOffsetsSigmaBy
 
   const double step = 2.0 * M_PI / 1024.0;
   QuantiseSteering(data, step);
-  const testing::FitcalRun r = RunFitcal(dir, "fit --logs " + data + " --train-reps 1-2 --out " + cal);
+  const testing::FitcalRun r =
+      RunFitcal(dir, "fit --logs " + data + " --train-reps 1-2 --out " + cal);
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
   double before_deg = 0.0, after_deg = 0.0;
   ASSERT_TRUE(OffsetSigmas(r.out, &before_deg, &after_deg)) << r.out;
@@ -229,7 +232,8 @@ TEST(ReadingResolutionUncertainty, NoiseBeforeTheCountLeavesLessOfItsBias) {
             0);
   const double step = 2.0 * M_PI / 1024.0;
   QuantiseSteering(data, step);
-  const testing::FitcalRun r = RunFitcal(dir, "fit --logs " + data + " --train-reps 1-2 --no-output");
+  const testing::FitcalRun r =
+      RunFitcal(dir, "fit --logs " + data + " --train-reps 1-2 --no-output");
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
   EXPECT_NE(r.out.find("its noise, 0.1"), std::string::npos) << r.out;  // 0.1x of a step
   double before_deg = 0.0, after_deg = 0.0;
