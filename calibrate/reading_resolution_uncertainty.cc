@@ -103,7 +103,11 @@ void AddReadingResolutionUncertainty(
     const std::vector<AlignedRun>& training, const std::vector<ReadingResolution>& resolutions,
     const std::vector<double>& parameters, SelectedFit* fit) {
   const Robot& robot = model.robot();
-  if (!fit->has_covariance) return;
+  const auto quantised = [](const ReadingResolution& r) { return r.step_rad > 0.0; };
+  if (!fit->has_covariance ||
+      std::none_of(resolutions.begin(), resolutions.end(), quantised)) {
+    return;  // the fit's own sigmas and correlation, untouched
+  }
   const Eigen::Index n = robot.NumParameters();
   Eigen::MatrixXd covariance(n, n);
   for (Eigen::Index r = 0; r < n; ++r) {
@@ -114,7 +118,7 @@ void AddReadingResolutionUncertainty(
   for (int c = 0; c < robot.NumChannels(); ++c) {
     const ReadingResolution resolution =
         c < static_cast<int>(resolutions.size()) ? resolutions[c] : ReadingResolution{};
-    if (!(resolution.step_rad > 0.0)) continue;
+    if (!quantised(resolution)) continue;
     if (!IsCeresMethod(method.name)) {
       fit->sigma_notes.push_back("channel '" + robot.channels[c].name + "' reads in steps of " +
                                  StrFormat("%.3g", resolution.step_rad * 180.0 / M_PI) + " deg; " +

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "calibrate/calibrate.h"
+#include "calibrate/fit_methods.h"
 #include "io/atomic_file.h"
 #include "io/calibration_block.h"
 #include "cli/effect_list.h"
@@ -43,7 +44,7 @@ std::optional<EffectModel> EffectsToFit(const FitCommandOptions& options, const 
 // default changes nothing either way).
 std::string FlagThatDoesNotApply(const FitCommandOptions& o) {
   const SolverOptions defaults;
-  const bool ceres = o.method == "ceres" || o.method == "ceres-dogleg";
+  const bool ceres = IsCeresMethod(o.method);
   const bool loss = o.loss != defaults.loss;
   if (!ceres && (loss || o.loss_scale != defaults.loss_scale)) {
     return "--loss and --loss-scale shape the Ceres methods' final-pose residuals; --method " +

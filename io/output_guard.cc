@@ -30,6 +30,21 @@ std::string InputOverlap(const std::string& out, const std::vector<std::string>&
   return why.empty() ? "" : Refusal(out, why);
 }
 
+// The refusal of a directory --out that is an input (or holds or sits in one) or exists as
+// something else than a directory, "" otherwise; *exists says whether anything is there.
+std::string DirectoryOutRefusal(const std::string& out, const std::vector<std::string>& inputs,
+                                bool* exists) {
+  *exists = false;
+  if (const std::string overlap = InputOverlap(out, inputs); !overlap.empty()) return overlap;
+  std::error_code ec;
+  const fs::file_status status = fs::symlink_status(out, ec);
+  *exists = fs::exists(status);
+  if (*exists && !fs::is_directory(status)) {
+    return Refusal(out, "exists and is not a directory; --out must name a directory");
+  }
+  return "";
+}
+
 // Every file below `dir`, relative to it ("runs/a_encoders.csv"); directories are not listed.
 std::set<std::string> FilesUnder(const fs::path& dir) {
   std::set<std::string> files;
@@ -171,13 +186,12 @@ std::string OutputFileRefusal(const std::string& out, const std::vector<std::str
 std::string OutputDirectoryRefusal(const std::string& out, const std::vector<std::string>& inputs,
                                    const std::set<std::string>& own_names) {
   if (out.empty()) return "--out is empty; name the directory to write";
-  if (const std::string overlap = InputOverlap(out, inputs); !overlap.empty()) return overlap;
-  std::error_code ec;
-  const fs::file_status status = fs::symlink_status(out, ec);
-  if (!fs::exists(status)) return "";
-  if (!fs::is_directory(status)) {
-    return Refusal(out, "exists and is not a directory; --out must name a directory");
+  bool exists = false;
+  if (const std::string refusal = DirectoryOutRefusal(out, inputs, &exists);
+      !refusal.empty() || !exists) {
+    return refusal;
   }
+  std::error_code ec;
   for (const auto& entry : fs::directory_iterator(out, ec)) {
     const std::string name = entry.path().filename().string();
     if (own_names.count(name) == 0 && name != kOutputMarker) {
@@ -200,13 +214,12 @@ void CommitOutputDirectory(io::StagedDirectory& staged, const std::string& out,
 std::string DirectoryOutputRefusal(const std::string& out, const std::string& kind, bool force,
                                    const std::vector<std::string>& inputs) {
   if (out.empty()) return "--out is empty; name the directory to write the " + kind + " to";
-  if (const std::string overlap = InputOverlap(out, inputs); !overlap.empty()) return overlap;
-  std::error_code ec;
-  const fs::file_status status = fs::symlink_status(out, ec);
-  if (!fs::exists(status)) return "";
-  if (!fs::is_directory(status)) {
-    return Refusal(out, "exists and is not a directory; --out must name a directory");
+  bool exists = false;
+  if (const std::string refusal = DirectoryOutRefusal(out, inputs, &exists);
+      !refusal.empty() || !exists) {
+    return refusal;
   }
+  std::error_code ec;
   if (fs::is_empty(out, ec)) return "";
   if (ForeignFile(out, kind).empty()) return "";  // its own previous output (rule 1)
   const std::string other_kind = MarkedKind(out);
