@@ -325,7 +325,7 @@ ChannelOrderReport CheckRecordedChannelOrder(const std::vector<AlignedRun>& runs
   // with the straight line between two samples, not with a measured motion, and a sign flip can
   // fit that fiction better than the true wiring (a simulated differential drive's loops with
   // three poses each were refused as miswired, 3.4x). Such runs are judged on final poses only.
-  if (MeasureTrackDensity(runs, tracks).median_sample_spacing_m > kDisjointWindowM) {
+  if (!MeasureTrackDensity(runs, tracks).SamplesThePath()) {
     segments.assign(runs.size(), {});
     total = 0;
   }
