@@ -558,8 +558,8 @@ Neighbourhood NeighbourhoodOf(const EncoderSamples& samples, int c, std::size_t 
 struct Glitch {
   std::size_t row = 0;  // data row (0 = the first after the header) of the wrong count
   std::string what;
-  // The width of a counter whose wrap the count is, when narrower than the declared one (a
-  // 16-bit counter declared as 32 bits wraps as a jump of 2^16 ticks): 0 otherwise.
+  // 16 when the count is the wrap of a 16-bit counter declared as 32 bits (a jump of 2^16
+  // ticks): 0 otherwise.
   int narrower_wrap_bits = 0;
   bool running_total = false;  // a wrong running total, bridged with the travel kept
 };
@@ -586,7 +586,9 @@ class GlitchScreen {
       glitches_.push_back(Bridge(c, k, around.around, what));
       // A flipped bit of a running total jumps by 2^b and back: bridged as a wrong total, not a
       // wrap; a wrap jumps once.
-      if (wrap_bits > 0 && wrap_bits < robot_.encoder->counter_bits &&
+      // Only a width counter_bits may declare (16 under 32): a glitch's count near 2^10 is a
+      // coincidence (the wrapped tricycle's glitches), a jump within 5 % of 2^16 is not.
+      if (wrap_bits == 16 && robot_.encoder->counter_bits == 32 &&
           !glitches_.back().running_total) {
         glitches_.back().narrower_wrap_bits = wrap_bits;
       }
