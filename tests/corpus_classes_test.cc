@@ -601,7 +601,8 @@ TEST(CorpusNeighbours, ClockOffsetsNeedAGroundTruthTrack) {
         dir, command + " --logs " + data + " --clock-offsets session --out " + out);
     EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
     EXPECT_EQ(Lines(r.err), 1) << r.err;
-    EXPECT_TRUE(Has(r.err, "--clock-offsets session is estimated on a ground-truth track")) << r.err;
+    EXPECT_TRUE(Has(r.err, "--clock-offsets session is estimated on a ground-truth track"))
+        << r.err;
     EXPECT_FALSE(fs::exists(out));
   }
 }
@@ -630,6 +631,30 @@ TEST(CorpusNeighbours, OneNameForTwoThingsIsRefused) {
   EXPECT_EQ(fleet.exit_code, 1) << fleet.out << fleet.err;
   EXPECT_EQ(Lines(fleet.err), 1) << fleet.err;
   EXPECT_TRUE(Has(fleet.err, metrics + ":3: parameter 'r_left' is listed twice")) << fleet.err;
+}
+
+// fleet: two robots of one name and one model with other wheels (a mecanum robot of four wheels
+// and an omni robot of three, both model `omni`) were merged into one series per wheel name
+// (R_fl of both in one row, R_rr of one); refused as the different models are.
+TEST(CorpusNeighbours, FleetRefusesOneNameForTwoWheelLayouts) {
+  const TempDir dir;
+  ASSERT_EQ(RunFitcal(dir, "simulate --model omni --repetitions 1 --out " + dir.Path("omni"))
+                .exit_code,
+            0);
+  std::string four = ReadFileBytes(dir.Path("omni/robot.yaml"));
+  const std::size_t name = four.find("name: ");
+  four.replace(name, four.find('\n', name) - name, "name: r1");
+  four += "calibration:\n  training_repetitions: [1]\n";
+  std::string three = four;
+  const std::size_t last = three.find("  - {name: rr");
+  ASSERT_NE(last, std::string::npos) << three;
+  three.erase(last, three.find('\n', last) + 1 - last);
+  const std::string a = dir.Write("fleet/r1/2026-05-01/cal.yaml", four);
+  const std::string b = dir.Write("fleet/r1/2026-05-08/cal.yaml", three);
+  const FitcalRun r = RunFitcal(dir, "fleet " + a + " " + b);
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_EQ(Lines(r.err), 1) << r.err;
+  EXPECT_TRUE(Has(r.err, "robot 'r1' has parameters")) << r.err;
 }
 
 }  // namespace

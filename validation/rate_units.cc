@@ -31,7 +31,8 @@ struct PathLengths {
   double odometry_translation_m = 0.0, truth_translation_m = 0.0;
   void Add(const Pose2d& a, const Pose2d& b, bool is_odometry) {
     (is_odometry ? odometry_m : truth_m) += StepLength(a, b);
-    (is_odometry ? odometry_translation_m : truth_translation_m) += std::hypot(b.x - a.x, b.y - a.y);
+    (is_odometry ? odometry_translation_m : truth_translation_m) +=
+        std::hypot(b.x - a.x, b.y - a.y);
   }
 };
 
