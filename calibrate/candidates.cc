@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "odometry/text_format.h"
 #include "validation/statistics.h"
 #include "validation/trajectory_metrics.h"
 
@@ -48,6 +49,20 @@ CalibrationCandidate WithoutHolds(const Robot& robot, const ModelFitResult& fit,
   return c;
 }
 
+// A closed form measures without the box the robot YAML sets: a value outside it is no
+// calibration the robot accepts (report refuses it), so it does not compete. "" when inside.
+std::string OutsideBounds(const Robot& robot, const std::vector<double>& p) {
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    if (robot.IsHeld(k) || (p[k] >= robot.bounds[k].lo && p[k] <= robot.bounds[k].hi)) continue;
+    const ParameterInfo& info = robot.parameters[k];
+    const double s = info.DisplayScale();
+    return info.name + " " + StrFormat("%.6g", p[k] * s) + " " + info.DisplayUnit() +
+           " outside its bounds [" + StrFormat("%.6g", robot.bounds[k].lo * s) + ", " +
+           StrFormat("%.6g", robot.bounds[k].hi * s) + "]";
+  }
+  return "";
+}
+
 }  // namespace
 
 std::vector<CalibrationCandidate> NominalAndClosedForms(const RobotModelInterface& model,
@@ -57,6 +72,8 @@ std::vector<CalibrationCandidate> NominalAndClosedForms(const RobotModelInterfac
   for (const ClosedFormCalibration& c :
        closed_forms ? model.ClosedForms(split.training) : std::vector<ClosedFormCalibration>{}) {
     out.push_back({c.method, c.parameters, true, {}, c.sigma});
+    out.back().not_usable_because = OutsideBounds(model.robot(), c.parameters);
+    out.back().usable = out.back().not_usable_because.empty();
   }
   return out;
 }

@@ -24,17 +24,26 @@ std::string MiswiredChannels(const CalibrationRequest& request, const RobotModel
 
 }  // namespace
 
+std::string StillTrainingRunsRefusal(const std::string& dataset, const std::vector<RunLog>& runs,
+                                     const std::vector<std::string>& training_ids) {
+  std::vector<RunLog> training_logs;
+  for (const std::string& id : training_ids) {
+    for (const RunLog& log : runs) {
+      if (log.id == id) training_logs.push_back(log);
+    }
+  }
+  const std::string still = StillRunsRefusal(training_logs);
+  return still.empty() ? still : dataset + ": " + still;
+}
+
 int CheckBeforeFitting(const CalibrationRequest& request, const RobotModelInterface& model,
                        const RunSplit& split, std::vector<std::string>* warnings,
                        std::string* reason) {
-  std::vector<RunLog> training_logs;
-  for (const AlignedRun& run : split.training) {
-    for (const RunLog& log : request.runs) {
-      if (log.id == run.id) training_logs.push_back(log);
-    }
-  }
-  if (const std::string still = StillRunsRefusal(training_logs); !still.empty()) {
-    *reason = request.dataset + ": " + still;
+  std::vector<std::string> training_ids;
+  for (const AlignedRun& run : split.training) training_ids.push_back(run.id);
+  if (std::string still = StillTrainingRunsRefusal(request.dataset, request.runs, training_ids);
+      !still.empty()) {
+    *reason = std::move(still);
     return 1;
   }
   if (const RateUnitsFinding units = CheckModelRateUnits(model, request.runs); units.suspicious) {

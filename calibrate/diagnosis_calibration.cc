@@ -1,5 +1,6 @@
 #include "calibrate/diagnosis_calibration.h"
 
+#include "calibrate/checks_before_fitting.h"
 #include "fit/correlation.h"
 #include "fitcal/version.h"
 #include "validation/propagated_uncertainty.h"
@@ -152,6 +153,15 @@ DiagnosisCalibration CalibrateOnDiagnosis(const DiagnosisCalibrationRequest& req
                                           const SplitOf<TrackRun>& split,
                                           const DiagnoseResult& result) {
   DiagnosisCalibration out;
+  // Training runs that stand still teach the diagnosis nothing either: a fit on them picks any
+  // value (on a simulated drive it went to the bounds) and the gate's choice is noise.
+  std::vector<std::string> training_ids;
+  for (const TrackRun& run : split.training) training_ids.push_back(run.aligned.id);
+  if (std::string still = StillTrainingRunsRefusal(request.dataset, *request.runs, training_ids);
+      !still.empty()) {
+    out.refusal = {1, {std::move(still)}};
+    return out;
+  }
   out.gate = Candidates(model, split, result, request.threads);
   out.choice = Select(model, split, request.threads, &out.gate);
   if (out.choice.name == "nominal") {

@@ -12,6 +12,7 @@
 #include <map>
 #include <optional>
 #include <regex>
+#include <set>
 #include <stdexcept>
 
 #include "io/calibration_yaml.h"
@@ -107,7 +108,13 @@ Calibration ReadMetricsJson(const std::string& path) {
                              "); read it with the fitcal that wrote it");
   }
   c.robot = root["robot"].as<std::string>();
+  std::set<std::string> names;  // a parameter listed twice has no one value to chart
   for (const YAML::Node& p : root["parameters"]) {
+    const std::string name = io::YamlString(p["name"], path, "parameters.name");
+    if (!names.insert(name).second) {
+      throw io::InputError(io::InputErrorKind::kBadValue, path, p.Mark().line + 1,
+                           "parameter '" + name + "' is listed twice (which value is it?)");
+    }
     for (const auto& kv : p) {
       const std::string key = kv.first.as<std::string>();
       if (key.rfind("calibrated_", 0) != 0) continue;
@@ -118,8 +125,7 @@ Calibration ReadMetricsJson(const std::string& path) {
       if (p["sigma"] && p["sigma"].IsScalar() && p["sigma"].Scalar() != "null") {
         sigma = io::YamlDouble(p["sigma"], path, "parameters.sigma") / scale;
       }
-      c.values.push_back(
-          {p["name"].as<std::string>(), degrees ? "deg" : "m", v / scale, scale, sigma});
+      c.values.push_back({name, degrees ? "deg" : "m", v / scale, scale, sigma});
     }
   }
   for (const YAML::Node& g : root["summary"]) {

@@ -67,6 +67,13 @@ std::string FlagThatDoesNotApply(const FitCommandOptions& o) {
            " is estimated on track residuals; --residuals final-pose compares final poses, "
            "where no clock offset is estimated (--residuals track or both)";
   }
+  if (o.residuals == "final-pose" && (o.track_heading != defaults.track_heading ||
+                                      o.weight_mode != defaults.weight_mode)) {
+    return std::string(o.track_heading != defaults.track_heading ? "--track-heading"
+                                                                 : "--weights") +
+           " shapes track residuals; --residuals final-pose compares final poses only "
+           "(--residuals track or both)";
+  }
   if (o.residuals == "track" && (loss || !o.objective.empty())) {
     return std::string(loss ? "--loss" : "--objective") +
            " shapes final-pose residuals; the track residual has its own fixed Huber loss "
@@ -78,14 +85,30 @@ std::string FlagThatDoesNotApply(const FitCommandOptions& o) {
 // What --residuals auto's choice leaves unused of the flags given, said beside the residuals:
 // the clock offsets belong to the track, the loss and the objective to the final poses.
 std::vector<std::string> FlagsTheChoiceLeavesUnused(const FitCommandOptions& o,
-                                                    const FitMethodSettings& settings) {
-  if (!settings.residuals_auto) return {};
-  const SolverOptions defaults;
+                                                    const CalibrationOutcome& outcome) {
+  const FitMethodSettings& settings = outcome.settings;
   std::vector<std::string> notes;
+  // --time-blocks: only one or two runs fitted on their tracks with nothing held out are judged
+  // on time; otherwise the count given would change nothing.
+  if (o.time_blocks != FitCommandOptions().time_blocks && !outcome.halves.by_time) {
+    notes.push_back("note: --time-blocks " + std::to_string(o.time_blocks) +
+                    " not applied: the fit was not judged on time blocks (only one or two runs "
+                    "fitted on their tracks with no run held out are)");
+  }
+  if (!settings.residuals_auto) return notes;
+  const SolverOptions defaults;
   if (settings.residuals == ResidualKind::kFinalPose && o.clock_offsets != defaults.clock_offsets) {
     notes.push_back("note: --clock-offsets " + o.clock_offsets +
                     " not applied: final-pose residuals were chosen, on which no clock offset "
                     "is estimated (--residuals track estimates it on dense ground truth)");
+  }
+  if (settings.residuals == ResidualKind::kFinalPose && o.track_heading != defaults.track_heading) {
+    notes.push_back("note: --track-heading " + o.track_heading +
+                    " not applied: final-pose residuals were chosen (it shapes track residuals)");
+  }
+  if (settings.residuals == ResidualKind::kFinalPose && o.weight_mode != defaults.weight_mode) {
+    notes.push_back("note: --weights " + o.weight_mode +
+                    " not applied: final-pose residuals were chosen (it weighs track residuals)");
   }
   if (settings.residuals == ResidualKind::kTrack && o.loss != defaults.loss) {
     notes.push_back("note: --loss " + o.loss +
@@ -179,7 +202,7 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   const double load_s = Seconds(t_total);
   const CalibrationOutcome outcome = Calibrate(request, *model);
   PrintCalibrationOutcome(request, *model, outcome,
-                          FlagsTheChoiceLeavesUnused(options, outcome.settings));
+                          FlagsTheChoiceLeavesUnused(options, outcome));
   if (outcome.refusal.exit_code != 0) return outcome.refusal.exit_code;
   if (outcome.record) WriteCalibration(options, *model, outcome.selected(), *outcome.record);
   std::printf("time: load %.3f s, total %.3f s\n", load_s, Seconds(t_total));

@@ -6,8 +6,11 @@
 #include <utility>
 
 #include "fit/model_fit.h"
+#include "fit/residual_choice.h"
 #include "fit/track_residual.h"
+#include "io/command_failure.h"
 #include "odometry/aligned_run.h"
+#include "odometry/text_format.h"
 
 namespace fitcal {
 
@@ -21,12 +24,20 @@ std::string Summary(const std::string& what, int moved, std::size_t runs,
     lo = g == 0 ? offsets[g].second : std::min(lo, offsets[g].second);
     hi = g == 0 ? offsets[g].second : std::max(hi, offsets[g].second);
   }
-  char line[256];
+  // An offset on the fit's bound is where the solver stopped, not a measured lag: said, so that
+  // a re-stamp by it is not taken for one (the runs then determine no offset of that group).
+  const double bound_s = TrackResidualOptions().max_clock_offset_s;
+  int on_bound = 0;
+  for (const auto& [group, offset_s] : offsets) on_bound += std::abs(offset_s) >= bound_s - 1e-6;
+  char line[320];
   std::snprintf(line, sizeof line,
                 "clock offsets: %s, %zu groups in [%+.3f, %+.3f] s; ground truth of %d of %zu "
                 "runs re-stamped",
                 what.c_str(), offsets.size(), lo, hi, moved, runs);
-  return line;
+  if (on_bound == 0) return line;
+  return std::string(line) + "; " + std::to_string(on_bound) + " of them on the +-" +
+         StrFormat("%g", bound_s) +
+         " s bound: not determined by these runs (--clock-offsets none keeps the stamps)";
 }
 
 // Offsets estimated on the logs' tracks, `parameters` held (or fitted with them when null).
@@ -96,6 +107,19 @@ std::string AlignGroundTruthClocks(const std::string& mode, const RobotModelInte
   if (!ParseClockGrouping(mode, &grouping) || grouping == ClockGrouping::kNone) {
     throw std::invalid_argument("--clock-offsets " + mode + ": expected one of " +
                                 ClockOffsetModes(true));
+  }
+  std::vector<const GroundTruthTrack*> tracks;
+  for (const RunLog& log : *logs) tracks.push_back(&log.ground_truth);
+  // An offset moves a pose along the path by speed x offset; the poses of a ground truth of
+  // start and end only (the robot at rest there) do not move with it: nothing to estimate, and a
+  // fit of it ends on the bound (report re-stamped by +-0.5 s without a word).
+  const TrackDensity density = MeasureTrackDensity(AlignRuns(*logs), tracks);
+  if (!density.SamplesThePath()) {
+    throw UsageError("--clock-offsets " + mode +
+                     " is estimated on a ground-truth track, and these runs' ground truth has " +
+                     StrFormat("%.0f", density.median_intervals) +
+                     " sample intervals between a run's ends (median; start and end poses only?): "
+                     "no offset to estimate (--clock-offsets none)");
   }
   const auto offsets = Estimate(grouping, model, parameters, threads, *logs);
   const int moved = ShiftGroundTruthClocks(offsets, grouping, logs);

@@ -237,8 +237,12 @@ TrackRun PrepareTrackRun(const RunLog& run, unsigned wheel_mask, const TrackOpti
       out.checkpoints.push_back(static_cast<int>(g));
   }
   if (out.checkpoints.empty()) {
+    // Ground truth of the start and end poses only: nothing along the path to fit a track (or
+    // an effect) on - said as what the data lack, since every command that fits tracks meets it.
     throw std::invalid_argument("run " + run.id +
-                                ": no ground-truth sample inside the window for track residuals");
+                                ": no ground-truth sample between the run's ends (the track "
+                                "residuals and effects need poses along the path; ground truth "
+                                "of start and end poses only is fitted on final poses by `fit`)");
   }
   return out;
 }

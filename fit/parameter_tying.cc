@@ -142,6 +142,16 @@ std::string CheckTying(const Robot& robot, const ParameterTying& tying) {
   std::vector<std::vector<int>> groups;
   std::vector<int> held;
   if (std::string e = ResolveNames(robot, tying, &groups, &held); !e.empty()) return e;
+  // Holding every free parameter leaves an empty fit (no solver variable, no covariance to take
+  // the determined directions from): said here, where the names are known, not met as a crash.
+  int free = 0;
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    free += !robot.IsHeld(k) && std::find(held.begin(), held.end(), k) == held.end();
+  }
+  if (free == 0) {
+    return "parameter tying: --hold leaves nothing to fit (every parameter of robot '" +
+           robot.name + "' is held: " + NamesOf(robot) + ")";
+  }
   for (const std::vector<int>& members : groups) {
     const Interval box = Intersection(robot, members);
     if (!(box.lo <= box.hi)) {

@@ -23,7 +23,7 @@ TrackDensity MeasureTrackDensity(const std::vector<AlignedRun>& runs,
   if (runs.size() != tracks.size()) {
     throw std::invalid_argument("MeasureTrackDensity: not one ground truth per run");
   }
-  std::vector<double> paths, spacings;
+  std::vector<double> paths, spacings, counts;
   for (std::size_t i = 0; i < runs.size(); ++i) {
     const GroundTruthTrack& track = *tracks[i];
     double path_m = 0.0;
@@ -36,12 +36,14 @@ TrackDensity MeasureTrackDensity(const std::vector<AlignedRun>& runs,
       ++intervals;
     }
     paths.push_back(path_m);
+    counts.push_back(intervals);
     spacings.push_back(intervals > 0 ? path_m / intervals
                                      : std::numeric_limits<double>::infinity());
   }
   TrackDensity out;
   out.median_path_m = Median(paths);
   out.median_sample_spacing_m = Median(spacings);
+  out.median_intervals = Median(counts);
   const double spacing = options.checkpoint_spacing_m;
   out.dense = out.median_sample_spacing_m <= kMaxSampleSpacingFraction * spacing &&
               out.median_path_m >= kMinCheckpointsPerRun * spacing;

@@ -24,7 +24,18 @@ inline constexpr double kMinCheckpointsPerRun = 4.0;      // 2 m of path for 0.5
 struct TrackDensity {
   double median_path_m = 0.0;            // ground-truth path inside each run's window
   double median_sample_spacing_m = 0.0;  // path per ground-truth sample interval
+  double median_intervals = 0.0;         // ground-truth sample intervals inside each window
   bool dense = false;                    // both above pass the thresholds
+  // Whether the ground truth samples the path between the ends at all (a looser test than
+  // `dense`): what comparing motion along it needs - the wheel-order check's windows, a clock
+  // offset. Start and end poses only fail it even on a closed loop (whose one interval is short),
+  // as does a pose every half loop.
+  bool SamplesThePath() const {
+    return median_intervals >= kMinIntervalsAlongPath &&
+           median_sample_spacing_m <= kMaxSpacingAlongPathM;
+  }
+  static constexpr double kMinIntervalsAlongPath = 4.0;
+  static constexpr double kMaxSpacingAlongPathM = 0.5;  // fit/segment_cost.h kDisjointWindowM
 };
 
 // tracks[i] is runs[i]'s ground truth.

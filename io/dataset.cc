@@ -2,11 +2,13 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
+#include <iomanip>
 #include <map>
 #include <new>
 #include <set>
@@ -207,6 +209,25 @@ void CheckGroundTruthOverlap(const GroundTruthTrack& ground_truth, double enc_be
     std::ostringstream msg;
     msg << "ground truth [" << gt_begin << ", " << gt_end << "] s does not overlap the encoder "
         << "span [" << enc_begin_s << ", " << enc_end_s << "] s (different clocks or wrong file?)";
+    throw InputError(InputErrorKind::kNoOverlap, ground_truth_path, 0, msg.str());
+  }
+  // A ground truth that spans the encoder log many times over and puts at most one sample inside
+  // it is on another time scale (ms or us where s are meant) or another run's: the run's poses
+  // would be interpolated between samples far outside it, and a closed loop's ends would agree by
+  // accident (one run's times in ms fitted without a word). Start and end poses alone, or a sparse
+  // ground truth of about the run's span, are not this.
+  const std::size_t inside = static_cast<std::size_t>(
+      std::count_if(ground_truth.t_s.begin(), ground_truth.t_s.end(),
+                    [&](double t) { return t >= enc_begin_s && t <= enc_end_s; }));
+  constexpr double kMaxSpanRatio = 10.0;
+  if (ground_truth.t_s.size() >= 3 && inside < 2 &&
+      gt_end - gt_begin > kMaxSpanRatio * (enc_end_s - enc_begin_s)) {
+    std::ostringstream msg;
+    msg << "only " << inside << " of the ground truth's " << ground_truth.t_s.size()
+        << " samples lies inside the encoder span [" << enc_begin_s << ", " << enc_end_s
+        << "] s, which the ground truth's [" << gt_begin << ", " << gt_end << "] s spans "
+        << std::setprecision(3) << (gt_end - gt_begin) / (enc_end_s - enc_begin_s)
+        << " times over: times in ms or us instead of s, or another run's file?";
     throw InputError(InputErrorKind::kNoOverlap, ground_truth_path, 0, msg.str());
   }
 }

@@ -558,6 +558,10 @@ Neighbourhood NeighbourhoodOf(const EncoderSamples& samples, int c, std::size_t 
 struct Glitch {
   std::size_t row = 0;  // data row (0 = the first after the header) of the wrong count
   std::string what;
+  // 16 when the count is the wrap of a 16-bit counter declared as 32 bits (a jump of 2^16
+  // ticks): 0 otherwise.
+  int narrower_wrap_bits = 0;
+  bool running_total = false;  // a wrong running total, bridged with the travel kept
 };
 
 class GlitchScreen {
@@ -578,7 +582,16 @@ class GlitchScreen {
       const Neighbourhood around = NeighbourhoodOf(samples_, c, k, bridged_);
       if (what.empty()) what = Backwards(c, k, around);
       if (what.empty()) continue;
+      const int wrap_bits = WrapBitsOf(Ticks(c, k));
       glitches_.push_back(Bridge(c, k, around.around, what));
+      // A flipped bit of a running total jumps by 2^b and back: bridged as a wrong total, not a
+      // wrap; a wrap jumps once.
+      // Only a width counter_bits may declare (16 under 32): a glitch's count near 2^10 is a
+      // coincidence (the wrapped tricycle's glitches), a jump within 5 % of 2^16 is not.
+      if (wrap_bits == 16 && robot_.encoder->counter_bits == 32 &&
+          !glitches_.back().running_total) {
+        glitches_.back().narrower_wrap_bits = wrap_bits;
+      }
     }
   }
   const std::vector<Glitch>& glitches() const { return glitches_; }
@@ -641,9 +654,11 @@ class GlitchScreen {
         if (!(std::abs(merged - around) < 0.25 * off)) continue;
         samples_[a].value[c] = samples_[a + 1].value[c] = merged;
         bridged_[a] = bridged_[a + 1] = true;
-        return {a + 1, what +
-                           "; the running total of this row dropped from the fit (the two "
-                           "intervals it bounds bridged, travel kept)"};
+        return {a + 1,
+                what +
+                    "; the running total of this row dropped from the fit (the two "
+                    "intervals it bounds bridged, travel kept)",
+                0, true};
       }
     }
     samples_[k].value[c] = around;
@@ -693,9 +708,25 @@ void DropCounterGlitches(const std::string& path, const Robot& robot,
   std::vector<std::size_t> rows;
   for (const Glitch& g : all) rows.push_back(g.row);
   const std::vector<int> lines = LinesOfDataRows(path, rows);
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    if (all[i].narrower_wrap_bits == 0) continue;
+    // Not a glitch but the wrap of a narrower counter: bridging each would drop real travel
+    // and warn on every wrap.
+    const std::string b = std::to_string(all[i].narrower_wrap_bits);
+    throw InputError(InputErrorKind::kImplausibleValue, path, lines[i],
+                     "the tick counter jumps by about 2^" + b + " ticks in one interval: a " + b +
+                         "-bit counter that wraps, not the " +
+                         std::to_string(robot.encoder->counter_bits) +
+                         " bits encoder.counter_bits declares; declare counter_bits: " + b);
+  }
   if (static_cast<double>(all.size()) > allowed) {
+    // Intervals, not glitches: two wheels glitching in one interval count once ("6837 of 3568
+    // intervals" said the count of both wheels of a wrong `cumulative:`).
+    std::vector<std::size_t> distinct = rows;
+    distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
     throw InputError(InputErrorKind::kImplausibleValue, path, lines.front(),
-                     std::to_string(all.size()) + " of " + std::to_string(log->samples.size()) +
+                     std::to_string(distinct.size()) + " of " +
+                         std::to_string(log->samples.size()) +
                          " intervals are counter glitches, the first here: " + all.front().what +
                          "; more than 1 % is not a glitch but a wrong encoder block "
                          "(ticks_per_rev, cumulative, counter_bits?)");

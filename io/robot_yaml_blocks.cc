@@ -14,6 +14,13 @@ Interval ReadBoundsPair(YamlMap& map, const std::string& key, double scale) {
         InputErrorKind::kBadValue, map.path(), map.line(map.Required(key)),
         "bounds." + key + " has lo " + std::to_string(lo) + " > hi " + std::to_string(hi));
   }
+  // A box of zero width is no box the solver can search (Ceres fails on it, and the gate then
+  // wrote a closed form's value outside it): fixing a parameter is --hold's job.
+  if (lo == hi) {
+    throw InputError(InputErrorKind::kBadValue, map.path(), map.line(map.Required(key)),
+                     "bounds." + key + " has lo = hi = " + std::to_string(lo) +
+                         ": a box of zero width; widen it, or fix the parameter with --hold");
+  }
   return Interval{lo * scale, hi * scale};
 }
 

@@ -2,7 +2,9 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <set>
 
+#include "io/command_failure.h"
 #include "io/yaml_scalar.h"
 
 namespace fitcal::io {
@@ -23,6 +25,27 @@ std::string Ros2NameList(const std::vector<std::string>& names) {
     out += (i ? ", " : "") + YamlDoubleQuoted(names[i]);
   }
   return out + "]";
+}
+
+std::vector<std::string> ChannelJointNames(const Robot& robot,
+                                           const std::vector<std::string>& joints) {
+  if (joints.empty()) {
+    std::vector<std::string> out;
+    for (const ChannelInfo& c : robot.channels) out.push_back(c.name);
+    return out;
+  }
+  if (joints.size() != robot.channels.size()) {
+    throw UsageError("--joints names " + std::to_string(joints.size()) + " joints; robot '" +
+                     robot.name + "' has " + std::to_string(robot.channels.size()) + " channels");
+  }
+  std::set<std::string> seen;
+  for (const std::string& joint : joints) {
+    if (!seen.insert(joint).second) {
+      throw UsageError("--joints names '" + joint + "' twice; each channel of robot '" +
+                       robot.name + "' has a joint of its own");
+    }
+  }
+  return joints;
 }
 
 }  // namespace fitcal::io

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "odometry/robot.h"
+
 namespace fitcal::io {
 
 // A double with a decimal point (12 significant digits), else rclcpp types it as an integer and a
@@ -18,5 +20,11 @@ double Ros2AsWritten(double v);
 // Joint names as a flow list, each double-quoted and escaped (yaml_scalar.h): a quote in a URDF
 // name stays YAML.
 std::string Ros2NameList(const std::vector<std::string>& names);
+
+// The joint of each of the robot's channels: `joints` (--joints) when given, else the channels'
+// own names. Throws UsageError (exit 2) for a count other than the channels' or a name given
+// twice: one joint for two wheels is no controller's (or bag's) wiring. Import and export share it.
+std::vector<std::string> ChannelJointNames(const Robot& robot,
+                                           const std::vector<std::string>& joints);
 
 }  // namespace fitcal::io

@@ -106,6 +106,23 @@ TEST(EncoderCounts, AnUndeclaredWidthStillRefusesTheWrap) {
   EXPECT_TRUE(Has(error, "counter_bits: 16")) << error;
 }
 
+// A 16-bit counter declared as 32 bits: unwrapped modulo 2^32, each of its wraps is a jump of
+// -2^16 + 10 ticks, which the glitch screen would bridge (dropping real travel, one warning per
+// wrap). Refused at the wrap's line with the width to declare; a flipped bit of a running total
+// (a jump of 2^b and back) stays a glitch (ATornRunningTotalIsBridgedWithItsTravelKept).
+TEST(EncoderCounts, ANarrowerCounterThanDeclaredIsRefusedAtItsWrap) {
+  const Robot robot =
+      RobotWith("encoder: {ticks_per_rev: 4096, cumulative: true, counter_bits: 32}\n");
+  std::string csv = "t,ticks_traction,steering\n";
+  for (int k = 0; k < 20; ++k) {
+    csv += std::to_string(0.1 * k) + "," + std::to_string((65500 + 10 * k) % 65536) + ",0.1\n";
+  }
+  const std::string error = ErrorOf([&] { Load(robot, csv); });
+  EXPECT_TRUE(Has(error, "enc.csv:6: ")) << error;  // 65540 -> 4 is the row of t = 0.4
+  EXPECT_TRUE(Has(error, "16-bit counter")) << error;
+  EXPECT_TRUE(Has(error, "counter_bits: 16")) << error;
+}
+
 TEST(EncoderCounts, CounterBitsOtherThanSixteenOrThirtyTwoAreRefused) {
   const std::string error = ErrorOf(
       [] { RobotWith("encoder: {ticks_per_rev: 4096, cumulative: true, counter_bits: 12}\n"); });

@@ -395,6 +395,35 @@ TEST(BagFilesFromTheBagOnly, AMissingFileIsRefusedNotReadFromTheParentDirectory)
   EXPECT_FALSE(fs::exists(out));
 }
 
+// A file listed twice in metadata.yaml would be read twice (every message repeated): refused
+// naming the list, not as a clock that does not advance in the bag's first file. One joint named
+// for both wheels is refused before the bag is read (exit 2), as export refuses it.
+TEST(BagFilesFromTheBagOnly, AFileListedTwiceOrOneJointForTwoWheelsIsRefused) {
+  TempDir tmp;
+  WriteBag(tmp, "bag", StorageFormat::kSqlite3, true);
+  const fs::path metadata = tmp.path() / "bag" / "metadata.yaml";
+  std::string text = testing::ReadFileBytes(metadata);
+  const std::string second = "- bag_1.db3";
+  ASSERT_NE(text.find(second), std::string::npos) << text;
+  text.replace(text.find(second), second.size(), "- bag_0.db3");
+  testing::WriteFileBytes(metadata, text);
+  const std::string out = tmp.Path("imported");
+  const testing::FitcalRun twice = RunFitcal(tmp, ImportArgs(tmp, tmp.Path("bag"), out));
+  EXPECT_EQ(twice.exit_code, 1) << twice.out;
+  EXPECT_EQ(Lines(twice.err), 1) << twice.err;
+  EXPECT_TRUE(Has(twice.err, "metadata.yaml: lists file \"bag_0.db3\" twice")) << twice.err;
+  EXPECT_FALSE(fs::exists(out));
+
+  std::string args = ImportArgs(tmp, tmp.Path("bag"), out);
+  const std::string joints = "right_wheel_joint,left_wheel_joint";
+  args.replace(args.find(joints), joints.size(), "right_wheel_joint,right_wheel_joint");
+  const testing::FitcalRun one_joint = RunFitcal(tmp, args);
+  EXPECT_EQ(one_joint.exit_code, 2) << one_joint.out;
+  EXPECT_EQ(Lines(one_joint.err), 1) << one_joint.err;
+  EXPECT_TRUE(Has(one_joint.err, "--joints names 'right_wheel_joint' twice")) << one_joint.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 // metadata.yaml as a version 1-3 recorder wrote it: every file as "<bag directory>/<file>".
 void MakeVersion3(const fs::path& bag, const std::string& recorded_name) {
   const fs::path metadata = bag / "metadata.yaml";

@@ -90,20 +90,37 @@ void FlagTrend(FleetSeries* s) {
              std::abs(slope) * span_days > scatter;
 }
 
-// A robot is its name: two calibrations of one name and different models are two robots
-// (a renamed copy, a rebuilt robot), whose parameters must not be merged into one series.
+// The parameter names of a calibration, in its order, without the held-out CF's row.
+std::string ParameterNames(const FleetCalibration& c) {
+  std::string out;
+  for (const FleetValue& v : c.values) {
+    if (v.name != kFleetCfRow) out += (out.empty() ? "" : ", ") + v.name;
+  }
+  return out;
+}
+
+// A robot is its name: two calibrations of one name and different models, or of one model with
+// other parameters (a mecanum robot of four wheels and an omni robot of three, both `omni`), are
+// two robots (a renamed copy, a rebuilt robot), whose parameters must not be merged into one
+// series.
 void RefuseOneNameForTwoModels(const std::vector<FleetCalibration>& all) {
   std::map<std::string, const FleetCalibration*> first_of;
   for (const FleetCalibration& c : all) {
     if (c.model.empty()) continue;
     const auto [it, inserted] = first_of.emplace(c.robot, &c);
-    if (!inserted && it->second->model != c.model) {
-      throw io::InputError(io::InputErrorKind::kBadValue, c.file, 0,
-                           "robot '" + c.robot + "' is a " + c.model + " here and a " +
-                               it->second->model + " in " + it->second->file +
-                               "; fleet keeps one series per robot name: give the robots "
-                               "different names");
+    if (inserted) continue;
+    const FleetCalibration& first = *it->second;
+    std::string differs;
+    if (first.model != c.model) {
+      differs = "is a " + c.model + " here and a " + first.model;
+    } else if (ParameterNames(first) != ParameterNames(c)) {
+      differs = "has parameters " + ParameterNames(c) + " here and " + ParameterNames(first);
     }
+    if (differs.empty()) continue;
+    throw io::InputError(io::InputErrorKind::kBadValue, c.file, 0,
+                         "robot '" + c.robot + "' " + differs + " in " + first.file +
+                             "; fleet keeps one series per robot name: give the robots "
+                             "different names");
   }
 }
 

@@ -24,14 +24,25 @@ double StepLength(const Pose2d& a, const Pose2d& b) {
          kTurnLengthM * std::abs(std::remainder(b.theta - a.theta, 2.0 * M_PI));
 }
 
+// Both paths (translation + kTurnLengthM x rotation) and their translations alone: when the
+// translations agree and the sums do not, the ground truth's heading is the odd one out.
+struct PathLengths {
+  double odometry_m = 0.0, truth_m = 0.0;
+  double odometry_translation_m = 0.0, truth_translation_m = 0.0;
+  void Add(const Pose2d& a, const Pose2d& b, bool is_odometry) {
+    (is_odometry ? odometry_m : truth_m) += StepLength(a, b);
+    (is_odometry ? odometry_translation_m : truth_translation_m) +=
+        std::hypot(b.x - a.x, b.y - a.y);
+  }
+};
+
 // Both paths over the same intervals between consecutive ground-truth instants (the window's
 // start, every sample inside it, its end), and only over those short enough that the ground truth
 // measures the path there (kMaxMeasuredIntervalS): a ground truth of start and end poses only
 // measures the straight line between them, not the path the wheels drove, so it is no evidence
 // of a unit error. The odometry is replayed in steps of kChunk samples inside an interval, so that
 // rates 57x too large (deg/s), which spin the odometry round many times, count in full.
-void AddPathLengths(const RobotModelInterface& model, const RunLog& log, double* odometry_m,
-                    double* truth_m) {
+void AddPathLengths(const RobotModelInterface& model, const RunLog& log, PathLengths* lengths) {
   const std::vector<double>& p = model.robot().nominal;
   const AlignedRun run = AlignRun(log);
   const GroundTruthTrack& gt = log.ground_truth;
@@ -47,10 +58,10 @@ void AddPathLengths(const RobotModelInterface& model, const RunLog& log, double*
         t_s += run.samples[k++].dt_s;
       }
       const Pose2d next = model.Replay(p.data(), run.samples, first, k, odometry);
-      if (measured) *odometry_m += StepLength(odometry, next);
+      if (measured) lengths->Add(odometry, next, true);
       odometry = next;
     }
-    if (measured) *truth_m += StepLength(truth, truth_there);
+    if (measured) lengths->Add(truth, truth_there, false);
     truth = truth_there;
     t_last_s = instant_s;
   };
@@ -67,14 +78,30 @@ void AddPathLengths(const RobotModelInterface& model, const RunLog& log, double*
 RateUnitsFinding CheckModelRateUnits(const RobotModelInterface& model,
                                      const std::vector<RunLog>& runs) {
   RateUnitsFinding finding;
-  double odometry_m = 0.0, truth_m = 0.0;
-  for (const RunLog& log : runs) AddPathLengths(model, log, &odometry_m, &truth_m);
-  if (!(truth_m > kMinEvidenceM) || !std::isfinite(odometry_m)) return finding;
-  finding.scale = odometry_m / truth_m;
-  if (finding.scale >= 1.0 / kMaxPlausibleScale && finding.scale <= kMaxPlausibleScale) {
+  PathLengths lengths;
+  for (const RunLog& log : runs) AddPathLengths(model, log, &lengths);
+  if (!(lengths.truth_m > kMinEvidenceM) || !std::isfinite(lengths.odometry_m)) return finding;
+  finding.scale = lengths.odometry_m / lengths.truth_m;
+  const auto plausible = [](double scale) {
+    return scale >= 1.0 / kMaxPlausibleScale && scale <= kMaxPlausibleScale;
+  };
+  if (plausible(finding.scale)) return finding;
+  finding.suspicious = true;
+  char line[400];
+  // Positions that agree and turns that do not: the ground truth's heading column is in another
+  // unit (degrees read as radians turn 57x as much; wrapped to +-pi between samples, less).
+  const double translation_scale =
+      lengths.odometry_translation_m / lengths.truth_translation_m;
+  if (lengths.truth_translation_m > kMinEvidenceM && plausible(translation_scale)) {
+    finding.likely_unit = "ground-truth heading";
+    std::snprintf(line, sizeof line,
+                  "the ground truth's positions travel as the nominal robot's odometry does "
+                  "(%.3g times) but with its turns the path is %.3g times the odometry's: the "
+                  "ground truth's heading (theta) is not in radians (degrees?); nothing fitted",
+                  1.0 / translation_scale, 1.0 / finding.scale);
+    finding.message = line;
     return finding;
   }
-  finding.suspicious = true;
   struct Unit {
     const char* name;
     double factor;  // logged value / rad/s
@@ -89,7 +116,6 @@ RateUnitsFinding CheckModelRateUnits(const RobotModelInterface& model,
       finding.likely_unit = u.name;
     }
   }
-  char line[400];
   // Ground-truth positions in millimetres scale the other way, by 1/1000 (turns count less there,
   // so the pooled ratio lies a little above it).
   if (std::abs(std::log(finding.scale / 1e-3)) < std::log(3.0)) {

@@ -12,6 +12,7 @@
 #include "fit/model_fit.h"
 #include "fit/run_split.h"
 #include "fitcal/version.h"
+#include "io/command_failure.h"
 #include "odometry/text_format.h"
 #include "validation/never_worse.h"
 #include "validation/relative_pose_error.h"
@@ -57,20 +58,41 @@ struct EvaluatedRuns {
   std::vector<double> cf_parameters_only;  // calibrated parameters without the effects
 };
 
+// --train-reps may choose other training runs than the recorded ones, never validate on a run the
+// calibration recorded (by id and fingerprint) as one it was fitted on: its "held-out" figures
+// would be training figures (--train-reps 2 on a calibration of repetition 1 passed it on its own
+// training runs). Throws UsageError naming the first such run.
+void RefuseValidatingOnTrainingRuns(const std::string& train_reps, const CalibrationInput& cal,
+                                    const TrainingSplit& chosen, const TrainingSplit& recorded) {
+  if (recorded.how != "by id") return;
+  for (const AlignedRun& run : chosen.split.validation) {
+    for (const AlignedRun& trained : recorded.split.training) {
+      if (run.id != trained.id) continue;
+      throw UsageError("--train-reps " + train_reps + " would judge " + cal.path + " on run '" +
+                       run.id + "', one of the " +
+                       std::to_string(recorded.split.training.size()) +
+                       " runs it was fitted on (its calibration block records them): leave "
+                       "--train-reps out to judge it on the others");
+    }
+  }
+}
+
 TrainingSplit SplitForReport(const std::string& train_reps, const ReportInputs& in,
                              const CalibrationInput& cal) {
-  std::vector<AlignedRun> aligned = AlignRuns(in.dataset.runs);
-  if (!train_reps.empty()) {
-    return {SplitByRepetition(std::move(aligned), ParseRepetitionList(train_reps)),
-            "by repetition (--train-reps)"};
-  }
   RecordedTraining recorded;
   if (cal.provenance) {
     recorded.run_ids = cal.provenance->training_run_ids;
     recorded.fingerprint = cal.provenance->training_fingerprint;
     recorded.repetitions = cal.provenance->training_repetitions;
   }
-  return SplitAsRecorded(in.dataset.runs, std::move(aligned), recorded);
+  TrainingSplit as_recorded =
+      SplitAsRecorded(in.dataset.runs, AlignRuns(in.dataset.runs), recorded);
+  if (train_reps.empty()) return as_recorded;
+  TrainingSplit chosen{
+      SplitByRepetition(AlignRuns(in.dataset.runs), ParseRepetitionList(train_reps)),
+      "by repetition (--train-reps)"};
+  RefuseValidatingOnTrainingRuns(train_reps, cal, chosen, as_recorded);
+  return chosen;
 }
 
 std::string TrainingSource(const CalibrationInput& cal, const TrainingSplit& t) {

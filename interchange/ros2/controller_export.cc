@@ -28,13 +28,7 @@ CalibratedRobot WithJoints(RobotModelPtr model, const std::vector<std::string>& 
   CalibratedRobot c;
   c.model = std::move(model);
   const Robot& robot = c.robot();
-  if (!joints.empty() && joints.size() != robot.channels.size()) {
-    throw UsageError("--joints names " + std::to_string(joints.size()) + " joints; robot '" +
-                     robot.name + "' has " + std::to_string(robot.channels.size()) + " channels");
-  }
-  for (std::size_t j = 0; j < robot.channels.size(); ++j) {
-    c.joints.push_back(joints.empty() ? robot.channels[j].name : joints[j]);
-  }
+  c.joints = io::ChannelJointNames(robot, joints);
   return c;
 }
 

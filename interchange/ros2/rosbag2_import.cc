@@ -9,6 +9,7 @@
 #include "io/command_failure.h"
 #include "io/input_error.h"
 #include "io/log_files.h"
+#include "io/ros2_parameter_yaml.h"
 #include "io/rosbag2/static_transforms.h"
 #include "io/text_file.h"
 #include "io/yaml_scalar.h"
@@ -279,13 +280,9 @@ io::rosbag2::BagStreamRequest MakeRequest(const ImportRosbag2Options& o, const R
       if ((*f)[0] == '/') f->erase(0, 1);
     }
   }
-  if (!o.joints.empty() && o.joints.size() != robot.channels.size()) {
-    throw UsageError("--joints names " + std::to_string(o.joints.size()) + " joints; robot '" +
-                     robot.name + "' has " + std::to_string(robot.channels.size()) + " channels");
-  }
-  for (std::size_t j = 0; j < robot.channels.size(); ++j) {
-    r.joints.push_back(o.joints.empty() ? robot.channels[j].name : o.joints[j]);
-    r.needs_position.push_back(robot.channels[j].kind == ChannelKind::kAngle);
+  r.joints = io::ChannelJointNames(robot, o.joints);
+  for (const ChannelInfo& channel : robot.channels) {
+    r.needs_position.push_back(channel.kind == ChannelKind::kAngle);
   }
   return r;
 }

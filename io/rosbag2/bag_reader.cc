@@ -104,6 +104,12 @@ void BagReader::OpenFromMetadata(const std::string& metadata_path) {
   const fs::path bag_dir = fs::path(metadata_path).parent_path();
   for (const std::string& relative : metadata_->relative_file_paths) {
     files_.push_back(ResolveBagFile(bag_dir, relative, metadata_->version, metadata_path));
+    // A file listed twice would be read twice: its messages would repeat (refused later as a
+    // clock that does not advance, which names neither the list nor the file).
+    if (std::find(files_.begin(), files_.end() - 1, files_.back()) != files_.end() - 1) {
+      ThrowBagError(InputErrorKind::kBadValue, metadata_path,
+                    "lists file " + Printable(relative) + " twice (relative_file_paths)");
+    }
   }
 }
 
