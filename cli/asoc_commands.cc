@@ -1,4 +1,5 @@
 #include "cli/asoc_commands.h"
+#include "cli/cli_validators.h"
 
 #include <cstdio>
 #include <iostream>
@@ -90,11 +91,11 @@ void AddAsocSimulateOptions(CLI::App& app, AsocSimulateOptions& simulate) {
   app.add_option("--seed", simulate.seed, "Random seed")->capture_default_str();
   app.add_option("--excursions", simulate.excursions, "Random excursion runs")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegativeNumber());
   app.add_option("--wheel-slip-sigma", simulate.wheel_slip_sigma,
                  "Relative wheel-encoder noise per 20 Hz sample")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegativeNumber());
   app.add_flag("--force", simulate.force, io::kForceDirectoryHelp);
 }
 
@@ -117,7 +118,7 @@ void AddAsocTablesOptions(CLI::App& app, AsocTablesOptions& tables) {
   app.add_option("--wheel-slip-sigma", tables.wheel_slip_sigma,
                  "Relative wheel-encoder noise per 20 Hz sample (non-systematic error)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegativeNumber());
   app.add_option("--threads", tables.threads, "Worker threads (0 = all cores)")
       ->capture_default_str();
 }

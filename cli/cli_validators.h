@@ -3,6 +3,8 @@
 // one line) found while the command line is parsed, before any file is read.
 
 #include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdlib>
 #include <stdexcept>
 #include <string>
 
@@ -57,13 +59,52 @@ inline CLI::Validator NonEmptyPathValidator() {
       "PATH", "non-empty path");
 }
 
-// Adds the validators above to every --threads and --out option of `app` and its subcommands,
-// so that every command refuses these alike.
+// A number option: nan and inf parse as doubles and pass CLI11's PositiveNumber and Range (every
+// comparison with nan is false), then reach the fit as a weight or a bound of nan.
+inline CLI::Validator FiniteNumberValidator() {
+  return CLI::Validator(
+      [](std::string& text) {
+        char* end = nullptr;
+        const double value = std::strtod(text.c_str(), &end);
+        const bool parsed = !text.empty() && end == text.c_str() + text.size();
+        if (parsed && !std::isfinite(value)) {
+          return "must be a finite number, found '" + text.substr(0, 40) + "'";
+        }
+        return std::string();  // not a number at all: CLI11's conversion says so
+      },
+      "", "finite number");
+}
+
+// A number above 0 (or at least 0), said in fitcal's words: CLI11's PositiveNumber prints its
+// range up to the largest double in 300 digits.
+inline CLI::Validator SignValidator(bool zero_allowed) {
+  return CLI::Validator(
+      [zero_allowed](std::string& text) {
+        char* end = nullptr;
+        const double value = std::strtod(text.c_str(), &end);
+        if (text.empty() || end != text.c_str() + text.size()) {
+          return "must be a number, found '" + text.substr(0, 40) + "'";
+        }
+        if (zero_allowed ? value >= 0 : value > 0) return std::string();
+        return std::string(zero_allowed ? "must be 0 or more" : "must be above 0") + ", found '" +
+               text.substr(0, 40) + "'";
+      },
+      zero_allowed ? "NONNEGATIVE" : "POSITIVE", zero_allowed ? "non-negative" : "positive");
+}
+inline CLI::Validator PositiveNumber() { return SignValidator(false); }
+inline CLI::Validator NonNegativeNumber() { return SignValidator(true); }
+
+// Adds the validators above to every --threads and --out option and every floating-point option
+// (CLI11 names their type FLOAT) of `app` and its subcommands, so that every command refuses
+// these alike.
 inline void AddCommonValidators(CLI::App& app) {
   if (CLI::Option* threads = app.get_option_no_throw("--threads")) {
     threads->check(ThreadCountValidator());
   }
   if (CLI::Option* out = app.get_option_no_throw("--out")) out->check(NonEmptyPathValidator());
+  for (CLI::Option* option : app.get_options()) {
+    if (option->get_type_name().rfind("FLOAT", 0) == 0) option->check(FiniteNumberValidator());
+  }
   for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
     AddCommonValidators(*sub);
   }

@@ -61,7 +61,7 @@ void AddDiagnoseOptions(CLI::App& cmd, DiagnoseCommandOptions& o) {
                "Also write residuals.csv and residuals_declared.csv (every ground-truth sample)");
   cmd.add_option("--max-effects", o.max_effects, "Most effects to add")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegativeNumber());
   cmd.add_option("--alpha", o.alpha, "Family-wise significance level of the tracing")
       ->capture_default_str()
       ->check(CLI::Range(1e-9, 0.5));

@@ -1,4 +1,5 @@
 #include "cli/export_ros2_control.h"
+#include "cli/cli_validators.h"
 
 #include <CLI/CLI.hpp>
 #include <cmath>
@@ -72,7 +73,7 @@ void AddExportRos2ControlOptions(CLI::App& app, ExportRos2ControlOptions& o) {
          "--publish-rate", [&o](double hz) { o.publish_period_s = 1.0 / hz; },
          "With --logs: the controller's publish_rate (Hz), the interval its twist covariance is "
          "for (default: the encoder period)")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveNumber());
   app.add_option("--calibration-out", o.calibration_out,
                  "With --logs: write the calibration with its odometry covariance here");
   app.add_flag("--force", o.force, io::kForceFileHelp);

@@ -1,4 +1,5 @@
 #include "cli/import_rosbag2.h"
+#include "cli/cli_validators.h"
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -216,10 +217,10 @@ void AddImportRosbag2Options(CLI::App& app, ImportRosbag2Options& o) {
   app.add_option("--runs", o.runs, "Cut runs at these spans: t0:t1,t2:t3 (s since the bag start)");
   app.add_option("--split-at-rest", o.split_at_rest_s,
                  "Cut runs in the middle of every rest at least this long (s)")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveNumber());
   app.add_option("--rest-rate", o.rest_rate_rad_s, "A wheel slower than this is at rest (rad/s)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveNumber());
   app.add_option("--label", o.label, "Trajectory label of the runs (default: the bag's name)");
   app.add_flag("--force", o.force, io::kForceDirectoryHelp);
 }

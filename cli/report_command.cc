@@ -157,7 +157,7 @@ void AddReportOptions(CLI::App& app, ReportCommandOptions& o) {
   app.add_option("--worst-runs", o.worst_runs,
                  "Draw the error along time of this many of the worst validation runs")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegativeNumber());
 }
 
 int RunReportCommand(const ReportCommandOptions& options) {

@@ -1,4 +1,5 @@
 #include "cli/simulate_command.h"
+#include "cli/cli_validators.h"
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
@@ -120,7 +121,7 @@ void AddSimulateOptions(CLI::App& app, SimulateCommandOptions& o) {
       ->check(CLI::ExistingFile);
   app.add_option("--repetitions", o.repetitions, "Repetitions of each trajectory")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveNumber());
   app.add_option("--seed", o.seed, "Random seed")->capture_default_str();
   app.add_option("--encoder-counts-per-rev", o.encoder_counts_per_rev, "Encoder resolution")
       ->capture_default_str();

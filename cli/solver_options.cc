@@ -1,4 +1,5 @@
 #include "cli/solver_options.h"
+#include "cli/cli_validators.h"
 
 #include <cmath>
 
@@ -26,7 +27,7 @@ void AddSolverOptions(CLI::App& app, SolverOptions& o) {
       ->capture_default_str();
   app.add_option("--max-iterations", o.max_iterations, "Ceres iterations per solve")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveNumber());
   app.add_flag("--polish", o.polish,
                "NLopt global methods: polish the best point with SLSQP (autodiff gradient)");
   const auto given = [&o](const std::string&) { o.sigmas_given = true; };
@@ -35,12 +36,12 @@ void AddSolverOptions(CLI::App& app, SolverOptions& o) {
                  "1 m and 57.3 deg the objective weighs metres and radians as Eq. 14. With "
                  "--weights estimated, giving this or --heading-sigma-deg fixes the weights")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber)
+      ->check(PositiveNumber())
       ->each(given);
   app.add_option("--heading-sigma-deg", o.heading_sigma_deg,
                  "Weight of the heading residual as a standard deviation (deg)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber)
+      ->check(PositiveNumber())
       ->each(given);
 }
 

@@ -246,7 +246,12 @@ TEST(InputClassesCli, UsageErrorsAreOneLineExitTwoBeforeAnyWork) {
         std::string("diagnose --logs . --threads 1.5"), std::string("fit --logs . --out ''"),
         std::string("report --logs . --calibration x --out ''"),
         std::string("diagnose --logs . --train-reps 1-2 --train-trajectories x"),
-        std::string("fit --logs . --train-reps 1-2 --train-trajectories x")}) {
+        std::string("fit --logs . --train-reps 1-2 --train-trajectories x"),
+        // nan and inf pass CLI11's PositiveNumber: every floating-point flag refuses them
+        std::string("fit --logs . --position-sigma-m nan"),
+        std::string("fit --logs . --loss-scale inf"),
+        std::string("diagnose --logs . --alpha nan"),
+        std::string("simulate --out x --gt-position-sigma-m inf")}) {
     const auto r = RunFitcal(dir, args);
     EXPECT_EQ(r.exit_code, 2) << args << ": " << r.err;
     EXPECT_EQ(Lines(r.err), 1) << args << ": " << r.err;
