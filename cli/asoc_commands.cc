@@ -105,7 +105,8 @@ void AddAsocGeometricOptions(CLI::App& app, FitCommandOptions& geometric) {
   app.add_option("--train-reps", geometric.train_reps,
                  "Repetitions the closed form is computed from (its hold_<i>_cw/ccw runs); the "
                  "others judge it against the nominal")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(RepetitionListValidator());
   app.add_option("--out", geometric.out, "Calibrated robot YAML (atomically)")
       ->capture_default_str();
   app.add_flag("--no-output", geometric.no_output, "Do not write the YAML");

@@ -1,4 +1,5 @@
 #include "cli/model_generalise_command.h"
+#include "cli/cli_validators.h"
 
 #include <cstdio>
 #include <iostream>
@@ -275,7 +276,8 @@ void AddGeneraliseOptions(CLI::App& app, GeneraliseCommandOptions& o) {
       ->delimiter(',');
   app.add_option("--train-reps", o.train_reps,
                  "Repetitions of every path type that train the split against the other "
-                 "repetitions (default: the first half present)");
+                 "repetitions (default: the first half present)")
+      ->check(RepetitionListValidator());
   app.add_option("--sessions", o.sessions,
                  "A leave-one-session-out session is a trajectory label (label) or a path "
                  "type + repetition number (repetition)")

@@ -247,6 +247,8 @@ TEST(InputClassesCli, UsageErrorsAreOneLineExitTwoBeforeAnyWork) {
         std::string("report --logs . --calibration x --out ''"),
         std::string("diagnose --logs . --train-reps 1-2 --train-trajectories x"),
         std::string("fit --logs . --train-reps 1-2 --train-trajectories x"),
+        std::string("generalise --logs . --train-reps 5-1"),
+        std::string("asoc-geometric --logs . --train-reps 5-1"),
         // nan and inf pass CLI11's PositiveNumber: every floating-point flag refuses them
         std::string("fit --logs . --position-sigma-m nan"),
         std::string("fit --logs . --loss-scale inf"),
