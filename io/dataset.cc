@@ -23,6 +23,7 @@
 #include "io/yaml_reader.h"
 #include "io/yaml_text.h"
 #include "odometry/parallel_for.h"
+#include "odometry/text_format.h"
 
 namespace fitcal::io {
 
@@ -336,6 +337,35 @@ void RejectDataSetWithoutMotion(const DatasetIndex& index, const std::vector<Run
   }
 }
 
+// A run whose ground truth travels while no wheel turns recorded nothing of its motion (encoders
+// unplugged, a log of another run's idle phase, the robot pushed): fitted, it pulls every
+// parameter towards a robot that does not move; judged, it fails any calibration. 0.2 m is two
+// orders above any motion capture's noise and below every calibration path.
+constexpr double kTravelWithoutWheelsM = 0.2;
+
+double GroundTruthReach(const GroundTruthTrack& track) {
+  double reach_m = 0.0;
+  const Pose2d& first = track.world_T_robot.front();
+  for (const Pose2d& p : track.world_T_robot) {
+    reach_m = std::max(reach_m, std::hypot(p.x - first.x, p.y - first.y));
+  }
+  return reach_m;
+}
+
+void RejectRunsWithoutWheelMotion(const DatasetIndex& index, const std::vector<RunLog>& runs,
+                                  const Robot& robot) {
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    if (WheelsTurn(runs[i].encoders.samples, robot)) continue;
+    const double reach_m = GroundTruthReach(runs[i].ground_truth);
+    if (reach_m <= kTravelWithoutWheelsM) continue;
+    throw InputError(InputErrorKind::kNoMotion, index.runs[i].encoders_path, 0,
+                     "no wheel turns faster than 0.01 rad/s in run '" + runs[i].id +
+                         "', while its ground truth moves " + StrFormat("%.2f m", reach_m) +
+                         " from its start: the encoders recorded none of the motion (unplugged, "
+                         "or the robot pushed); fix or remove the run");
+  }
+}
+
 // A model may record its encoders in a format of its own (Robot::read_own_encoder_file: ASOC's
 // cumulative wheel angles and pivot readings), converted to the model's channels there, so that
 // every command sees the same runs. Any other file goes through the generic reader.
@@ -365,6 +395,7 @@ Dataset LoadDataset(const DatasetIndex& index, const Robot& robot, const Dataset
                             entry.ground_truth_path);
   });
   RejectDataSetWithoutMotion(index, dataset.runs, robot);  // first: still runs are all alike
+  RejectRunsWithoutWheelMotion(index, dataset.runs, robot);
   RejectCopiedRuns(index, dataset.runs);
   return dataset;
 }

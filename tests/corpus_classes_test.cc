@@ -486,6 +486,31 @@ TEST(CorpusNeighbours, DiagnoseRefusesTrainingRunsThatStandStill) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// One run whose wheels stand while its ground truth drives the path (encoders unplugged, the robot
+// pushed): it was fitted among the others, exit 0. Every command that loads the data set refuses
+// it in one line naming the run's encoder file and how far the ground truth went (a square of
+// the simulator: more than 0.2 m).
+TEST(CorpusNeighbours, ARunWhoseWheelsStandWhileItsGroundTruthMovesIsNamed) {
+  const TempDir dir;
+  const std::string data = SimulateDiffDrive(dir, "data");
+  const RunFiles dead = Runs(data).front();
+  Csv encoders = ReadCsv(dead.encoders);
+  for (auto& row : encoders.rows) {
+    for (std::size_t c = 1; c < row.size(); ++c) row[c] = 0.0;
+  }
+  WriteCsv(dead.encoders, encoders);
+  for (const std::string command : {"fit", "diagnose"}) {
+    const std::string out = dir.Path(std::string("out_") + command);
+    const FitcalRun r = RunFitcal(dir, std::string(command) + " --logs " + data + " --out " + out);
+    EXPECT_EQ(r.exit_code, 1) << command << ": " << r.out << r.err;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
+    EXPECT_TRUE(Has(r.err, fs::path(dead.encoders).filename().string() + ": no wheel turns") &&
+                Has(r.err, "ground truth moves"))
+        << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
 // Bounds a robot YAML sets are the box of every calibration: a box of zero width is refused at
 // its line (Ceres failed on it and the gate wrote UMBmark's value outside it, exit 0), and a
 // closed form outside the box does not compete (asoc-geometric on a differential drive, the
