@@ -53,6 +53,23 @@ std::string OptionalString(const YAML::Node& block, const char* key, const std::
   return YamlString(node, path, std::string("calibration.") + key);
 }
 
+// A correlation matrix is symmetric; its two halves are written from one number each, to 4
+// significant digits, so they differ by at most a rounding of the last one.
+void RequireSymmetric(const std::vector<std::vector<double>>& c, const YAML::Node& node,
+                      const std::string& path) {
+  constexpr double kWrittenDigitsTolerance = 1e-3;
+  for (std::size_t r = 0; r < c.size(); ++r) {
+    for (std::size_t k = 0; k < r; ++k) {
+      if (std::abs(c[r][k] - c[k][r]) <= kWrittenDigitsTolerance) continue;
+      throw InputError(InputErrorKind::kBadValue, path, node[r].Mark().line + 1,
+                       "calibration.correlation: row " + std::to_string(r + 1) + ", column " +
+                           std::to_string(k + 1) + " is not the same as row " +
+                           std::to_string(k + 1) + ", column " + std::to_string(r + 1) +
+                           " (a correlation matrix is symmetric)");
+    }
+  }
+}
+
 // `sigma: {name_unit: value, ...}` and `correlation: [[...], ...]`, square and of the same size,
 // or nothing at all when the fit recorded no uncertainty.
 void ReadUncertainty(const YAML::Node& block, const std::string& path, CalibrationProvenance* p) {
@@ -86,6 +103,13 @@ void ReadUncertainty(const YAML::Node& block, const std::string& path, Calibrati
     std::vector<double> values;
     for (const YAML::Node& item : row) {
       values.push_back(YamlDouble(item, path, "calibration.correlation"));
+      // Written to 4 digits, so a correlation reads back within [-1, 1] exactly; anything else
+      // was edited and would make the propagated variances negative.
+      if (!(std::abs(values.back()) <= 1.0)) {
+        throw InputError(InputErrorKind::kBadValue, path, item.Mark().line + 1,
+                         "calibration.correlation: " + item.Scalar() +
+                             " is not a correlation (between -1 and 1)");
+      }
     }
     if (values.size() != p->sigma.size()) {
       throw InputError(InputErrorKind::kBadValue, path, row.Mark().line + 1,
@@ -99,6 +123,7 @@ void ReadUncertainty(const YAML::Node& block, const std::string& path, Calibrati
                      "calibration.correlation: " + std::to_string(p->correlation.size()) +
                          " rows for " + std::to_string(p->sigma.size()) + " sigmas");
   }
+  RequireSymmetric(p->correlation, correlation, path);
 }
 
 // calibration.clock_offsets, when present.

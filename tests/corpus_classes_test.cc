@@ -214,6 +214,39 @@ TEST(CorpusClasses, EditedClockOffsetsAreValidatedWithFileAndLine) {
   }
 }
 
+// An edited correlation block: a value outside [-1, 1], or two halves that disagree, would give
+// negative propagated variances; refused at the line of the row (report, which reads it).
+TEST(CorpusNeighbours, EditedCorrelationsAreValidatedWithFileAndLine) {
+  const TempDir dir;
+  const std::string data = SimulateDiffDrive(dir, "data");
+  const std::string cal = dir.Path("cal.yaml");
+  ASSERT_EQ(RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --out " + cal).exit_code, 0);
+  const std::string text = ReadFileBytes(cal);
+  const std::size_t block = text.find("  correlation:\n");
+  ASSERT_NE(block, std::string::npos) << text;
+  const std::size_t row1 = text.find('\n', block) + 1;
+  const int line = 2 + static_cast<int>(std::count(text.begin(), text.begin() + block, '\n'));
+  struct Case {
+    std::string row, says;
+  };
+  for (const Case& c : std::vector<Case>{{"    - [1, 1.3, 0.5]", "1.3 is not a correlation"},
+                                         {"    - [1, 0.2, 0.5]", "symmetric"}}) {
+    SCOPED_TRACE(c.says);
+    std::string edited_text = text;
+    edited_text.replace(row1, text.find('\n', row1) - row1, c.row);
+    const std::string edited = dir.Write("edited.yaml", edited_text);
+    const std::string rep = dir.Path("rep");
+    const FitcalRun r =
+        RunFitcal(dir, "report --logs " + data + " --calibration " + edited + " --out " + rep);
+    EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
+    const int at = c.says == "symmetric" ? line + 1 : line;  // the later row of the pair
+    EXPECT_TRUE(Has(r.err, edited + ":" + std::to_string(at) + ":")) << r.err << at;
+    EXPECT_TRUE(Has(r.err, c.says)) << r.err;
+    EXPECT_FALSE(fs::exists(rep));
+  }
+}
+
 const char* kDiffYaml = R"(model: diff_drive
 name: r1
 wheels:
