@@ -81,9 +81,20 @@ BagFileInfo ReadFileInfo(const YAML::Node& entry, const std::string& path) {
   return file;
 }
 
+// rosbag2's metadata versions so far: 1-9 (9 from Jazzy, 2024). A version outside them is a
+// layout fitcal was not written for (version 4 moved the file paths, 6 the QoS): refused, not
+// read as if it were known.
+constexpr int kNewestMetadataVersion = 9;
+
 BagMetadata ReadInformation(const YAML::Node& info, const std::string& path) {
   BagMetadata m;
   m.version = Get<int>(info, "version", path);
+  if (m.version < 1 || m.version > kNewestMetadataVersion) {
+    throw InputError(InputErrorKind::kBadValue, path, LineOf(info["version"]),
+                     "version " + std::to_string(m.version) +
+                         " of the bag's metadata is not one fitcal reads (1-" +
+                         std::to_string(kNewestMetadataVersion) + ")");
+  }
   m.storage_identifier = Get<std::string>(info, "storage_identifier", path);
   for (const YAML::Node& p : RequiredList(info, "relative_file_paths", path)) {
     m.relative_file_paths.push_back(Scalar<std::string>(p, "relative_file_paths", path));
