@@ -1,5 +1,5 @@
-// The report files (pages/report_writer.h, pages/svg_plot.h): index.html is well formed, embeds every
-// figure, and references nothing outside itself; the CSV and JSON carry the numbers.
+// The report files (pages/report_writer.h, pages/svg_plot.h): index.html is well formed, embeds
+// every figure, and references nothing outside itself; the CSV and JSON carry the numbers.
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>

@@ -8,7 +8,8 @@
 // (interchange/optiodom/optiodom_format.h), take the robot most sessions declare (others declare
 // perturbed starting values on purpose: a note each), leave out runs the authors flagged, check
 // the channel order against the ground truth (diagnosis/import_channel_order.h: nothing is
-// written when another wheel order or sign explains it far better), write. What differs per robot is data in interchange/optiodom/optiodom_robots.h.
+// written when another wheel order or sign explains it far better), write. What differs per
+// robot is data in interchange/optiodom/optiodom_robots.h.
 
 #include <functional>
 #include <string>
