@@ -142,6 +142,21 @@ TEST(OptiOdomImport, BadSessionIsOneErrorAndWritesNothing) {
   fs::remove_all(tmp);
 }
 
+// Sessions of two robots (an omni3 circle and a diff drive's) make no one robot.yaml: a usage
+// error (exit 2) before anything is read, nothing written.
+TEST(OptiOdomImport, SessionsOfTwoRobotsAreRefused) {
+  SKIP_WITHOUT_DATA();
+  const fs::path diff = kOmni3.parent_path() / "diff" / "circular" / "231220200121";
+  if (!fs::is_directory(diff)) GTEST_SKIP() << "no " << diff;
+  const fs::path tmp = TempDir("two_robots");
+  optiodom::ImportOptiOdomOptions options;
+  options.sessions = {kCircleSession.string(), diff.string()};
+  options.out = (tmp / "out").string();
+  EXPECT_EQ(tools::RunImportOptiOdomCommand(options), 2);
+  EXPECT_FALSE(fs::exists(tmp / "out"));
+  fs::remove_all(tmp);
+}
+
 TEST(EncoderTicks, IncrementsAndCumulativeGiveTheSameRatesAndTicksNeedAResolution) {
   const fs::path tmp = TempDir("ticks");
   WriteText(tmp / "inc.csv", "t,ticks_a,ticks_b,ticks_c\n0,5,5,5\n0.04,100,-50,0\n0.1,30,0,-12\n");
