@@ -17,17 +17,16 @@
 #include "io/atomic_file.h"
 #include "io/calibration_block.h"
 #include "io/dataset.h"
-#include "io/diagnose_page.h"
+#include "pages/diagnose_page.h"
 #include "io/input_error.h"
 #include "io/robot_yaml_blocks.h"
 #include "io/staged_directory.h"
 #include "models/model_registry.h"
-#include "odometry/parallel_for.h"
 #include "odometry/text_format.h"
 #include "cli/cli_validators.h"
 #include "fit/clock_alignment.h"
 #include "cli/diagnose_page_builder.h"
-#include "cli/miswired_error.h"
+#include "diagnosis/miswired_error.h"
 #include "io/output_guard.h"
 #include "cli/report_command.h"
 #include "validation/trajectory_metrics.h"
@@ -123,29 +122,6 @@ std::string WrittenCalibrationText(const Robot& robot, const DiagnoseChoice& cho
   return out;
 }
 
-// Re-stamps each run's ground truth on the encoder clock (the speed-profile match of the
-// model's body velocities at the nominal, fit/segment_cost.h), keeping the map only on the runs
-// whose track error under the final-pose fit it lowers (diagnosis/clock_choice.h): a correctly
-// clocked data set keeps the identity.
-void MapClocks(const RobotModelInterface& model, int threads, std::vector<RunLog>* runs) {
-  const std::vector<double>& nominal = model.robot().nominal;
-  std::vector<RunLog> mapped = *runs;
-  ParallelFor(mapped.size(), threads, [&](std::size_t i) {
-    RunLog& run = mapped[i];
-    const ClockMap map = EstimateClockMap(model, nominal.data(), AlignRun(run), run.ground_truth);
-    run.ground_truth = ApplyClockMap(run.ground_truth, map);
-  });
-  ModelFitOptions fit_options;
-  fit_options.ceres.num_threads = threads;
-  const ModelFitResult fit = FitModel(AlignRuns(*runs), model, fit_options);
-  const std::vector<double>& p = fit.usable ? fit.parameters : model.robot().nominal;
-  const ClockChoice choice =
-      ChooseClocks(model, p, *runs, mapped, WheelChannelMask(model.robot()), threads);
-  std::printf("clock map kept on %d of %zu runs (the identity fits the others better)\n",
-              choice.num_mapped, runs->size());
-  *runs = ApplyClockChoice(choice, std::move(*runs), mapped);
-}
-
 // The one channel-order check (diagnosis/channel_order_check.h), as `fit` and the importers run
 // it: a swapped or sign-flipped column would send the diagnosis after effects that are a wiring
 // fault. True after one line on stderr when another order explains the runs far better.
@@ -205,7 +181,11 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
     const std::string aligned = AlignGroundTruthClocks(options.clock_offsets, *model, nullptr,
                                                        std::nullopt, options.threads, &runs);
     if (!aligned.empty()) std::printf("%s\n", aligned.c_str());
-    if (options.clock_map) MapClocks(*model, options.threads, &runs);
+    if (options.clock_map) {
+      const ClockChoice clocks = MapGroundTruthClocks(*model, options.threads, &runs);
+      std::printf("clock map kept on %d of %zu runs (the identity fits the others better)\n",
+                  clocks.num_mapped, runs.size());
+    }
     if (!options.skip_wheel_order_check && ChannelsLookMiswired(options, *model, runs)) {
       return kMiswiredExitCode;
     }

@@ -2,7 +2,7 @@
 // `fitcal diagnose --logs <dir>`: the declared nine-parameter fit, its residual, the tracing of
 // that residual to library effects (diagnosis/diagnose.h), the error before and after on held-out
 // repetitions. Prints the report and writes, into --out (a directory):
-//   index.html      the page (io/diagnose_page.h): structure tested, effects tried, before and
+//   index.html      the page (pages/diagnose_page.h): structure tested, effects tried, before and
 //                   after on the held-out runs as `report` computes them, what stays unexplained
 //   metrics.json    its numbers (docs/metrics_json.md, kind "diagnose")
 //   diagnose.md     the report (Markdown)

@@ -1,5 +1,5 @@
 #pragma once
-// The data of diagnose's page (io/diagnose_page.h: index.html and metrics.json) from a diagnosis
+// The data of diagnose's page (pages/diagnose_page.h: index.html and metrics.json) from a diagnosis
 // (diagnosis/diagnose.h) and the calibration decided on it (calibrate/diagnosis_calibration.h):
 // the conclusion, the structure tests, the effect candidates, the gate, the held-out runs as
 // `report` computes them, and the written parameters. No decision is made here.
@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "calibrate/diagnosis_calibration.h"
-#include "io/diagnose_page.h"
+#include "pages/diagnose_page.h"
 
 namespace fitcal::tools {
 

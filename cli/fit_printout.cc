@@ -220,7 +220,7 @@ void PrintEncoderGlitches(const std::vector<RunLog>& runs) {
               glitches, glitches == 1 ? "" : "s", runs_with, runs_with == 1 ? "" : "s");
 }
 
-// Drift per 1, 2, 5 m and ATE RMSE (cli/everyday_driving_table.h) of the nominal and the
+// Drift per 1, 2, 5 m and ATE RMSE (validation/never_worse.h) of the nominal and the
 // selected calibration on the held-out runs (the training runs when none is held out).
 void PrintEverydayDriving(const RobotModelInterface& model, const CalibrationOutcome& o,
                           int threads) {
@@ -230,9 +230,8 @@ void PrintEverydayDriving(const RobotModelInterface& model, const CalibrationOut
   const bool held_out = !split.validation.empty();
   const std::vector<AlignedRun>& runs = held_out ? split.validation : split.training;
   PrintEverydayDrivingTable(
-      model, runs, TracksOf(runs),
       held_out ? "everyday driving, validation" : "everyday driving, training",
-      {&nominal.parameters, &nominal.effects}, {&selected.parameters, &selected.effects}, threads);
+      CompareEverydayDriving(model, nominal, selected, runs, TracksOf(runs), threads));
 }
 
 // Each direction held at the nominal, and what to drive to determine it (fit/motion_advice.h).

@@ -17,7 +17,7 @@
 
 #include "io/calibration_yaml.h"
 #include "io/input_error.h"
-#include "io/report_json.h"
+#include "pages/report_json.h"
 #include "io/yaml_reader.h"
 #include "models/model_registry.h"
 #include "odometry/text_format.h"

@@ -1,64 +1,18 @@
 #pragma once
-// `fitcal import optiodom <session-dir>... --out <dataset-dir>`: converts the published OptiOdom
-// recordings (Sousa et al., "OptiOdom: a Generic Approach for Odometry Calibration of Wheeled
-// Mobile Robots", J. Intell. Robot. Syst. 105, 39, 2022; MIT licence) of any robot of the study
-// into a fitcal data set: per-run encoder + ground-truth CSVs, dataset.yaml and the nominal robot
-// YAML. One sequence for every robot: read every session (interchange/optiodom/optiodom_format.h),
-// take the robot most sessions declare (others declare perturbed starting values on purpose: a
-// note each), leave out runs the authors flagged, check the channel order against the ground truth
-// (cli/import_channel_order.h: nothing is written when another wheel order or sign explains it far
-// better), write. What differs per robot is data in interchange/optiodom/optiodom_robots.h.
+// `fitcal import optiodom <session-dir>... --out <dataset-dir>`: its flags, read into the import's
+// options, and the one call (interchange/optiodom/optiodom_import.h) whose lines it prints.
 
-#include <string>
-#include <vector>
-
-#include "fit/final_pose_errors.h"
-#include "models/model_interface.h"
-#include "odometry/run_log.h"
-#include "interchange/optiodom/optiodom_format.h"
+#include "interchange/optiodom/optiodom_import.h"
 
 namespace CLI {
 class App;
 }
 
-namespace fitcal::optiodom {
-struct RobotKind;  // interchange/optiodom/optiodom_robots.h
-}
-
 namespace fitcal::tools {
 
-struct ImportOptiOdomOptions {
-  std::vector<std::string> sessions;
-  std::string out;
-  bool force = false;               // overwrite an existing data set
-  bool skip_mapping_check = false;  // write even if another wheel mapping fits better
-  bool quiet = false;               // print nothing (the result says everything)
-};
-
-// What an import read, checked and wrote.
-struct OptiOdomImport {
-  const optiodom::RobotKind* kind = nullptr;  // the sessions' robot
-  RobotModelPtr model;                        // the nominal robot, as robot.yaml holds it
-  int num_sessions = 0;
-  std::vector<optiodom::RunRows> rows;  // the run files (our signs; empty unless ticks), ...
-  std::vector<RunLog> runs;             // ... and as written: wheel rates, labels
-  std::vector<std::string> notes;       // sessions declaring other values, runs left out
-  std::string channel_order;            // the channel-order check's line
-  FinalPoseErrors nominal;              // Palacin Eq. 14 over the runs at the nominal
-};
-
-// Reads and checks the sessions (one robot), nothing written and no channel-order check: the
-// model, the runs and the notes. Throws io::InputError (file, line, cause).
-OptiOdomImport ReadOptiOdomSessions(const std::vector<std::string>& session_dirs);
-
-// The whole import; prints the notes, the check's line and a summary unless quiet. Throws
-// io::InputError for bad input, MiswiredError (cli/miswired_error.h) when the channel-order
-// check fails and std::runtime_error when `out` may not be written; nothing is written then.
-OptiOdomImport ImportOptiOdom(const ImportOptiOdomOptions& options);
-
 // Declares every flag of `import optiodom` on its subcommand `app`, bound to `options`.
-void AddImportOptiOdomOptions(CLI::App& app, ImportOptiOdomOptions& options);
+void AddImportOptiOdomOptions(CLI::App& app, optiodom::ImportOptiOdomOptions& options);
 
-int RunImportOptiOdomCommand(const ImportOptiOdomOptions& options);
+int RunImportOptiOdomCommand(const optiodom::ImportOptiOdomOptions& options);
 
 }  // namespace fitcal::tools

@@ -2,190 +2,12 @@
 #include "cli/cli_validators.h"
 
 #include <CLI/CLI.hpp>
-#include <algorithm>
-#include <charconv>
 #include <cstdio>
-#include <cstring>
-#include <filesystem>
-#include <memory>
-#include <string_view>
 
-#include "fit/final_pose_errors.h"
-#include "io/atomic_file.h"
-#include "io/command_failure.h"
-#include "io/dataset.h"
-#include "io/input_error.h"
-#include "io/input_registry.h"
-#include "io/staged_directory.h"
-#include "io/text_file.h"
-#include "io/yaml_scalar.h"
-#include "models/model_registry.h"
-#include "odometry/aligned_run.h"
 #include "cli/dataset_command.h"
 #include "io/output_guard.h"
 
 namespace fitcal::tools {
-namespace {
-
-namespace fs = std::filesystem;
-using io::InputError;
-
-// The CSVs are built in one buffer: t with ns resolution (std::to_chars fixed, 9 decimals: the
-// bytes printf's %.9f gives), every other value as the shortest text that reads back to the same
-// double (std::to_chars): exact on read-back (io::ParseDouble uses std::from_chars), and several
-// times faster than printf.
-class CsvBuffer {
- public:
-  // Not zero-filled: the text of a long run is megabytes, and each byte is written once.
-  explicit CsvBuffer(std::size_t expected_bytes)
-      : text_(new char[expected_bytes]), capacity_(expected_bytes) {}
-  void Append(std::string_view s) {
-    Room(s.size());
-    std::memcpy(text_.get() + size_, s.data(), s.size());
-    size_ += s.size();
-  }
-  void Char(char c) {
-    Room(1);
-    text_[size_++] = c;
-  }
-  // %.9f; a fixed-point double needs at most 309 + 1 + 9 + sign characters.
-  void Seconds(double t) {
-    Room(330);
-    End(std::to_chars(Next(), text_.get() + capacity_, t, std::chars_format::fixed, 9));
-  }
-  // Shortest round trip: at most 24 characters ("-2.2250738585072014e-308").
-  void Value(double v) {
-    Room(32);
-    End(std::to_chars(Next(), text_.get() + capacity_, v));
-  }
-  std::string_view view() const { return {text_.get(), size_}; }
-
- private:
-  char* Next() { return text_.get() + size_; }
-  void End(const std::to_chars_result& r) { size_ = static_cast<std::size_t>(r.ptr - text_.get()); }
-  void Room(std::size_t n) {
-    if (capacity_ - size_ >= n) return;
-    const std::size_t capacity = std::max(2 * capacity_, size_ + n);
-    std::unique_ptr<char[]> bigger(new char[capacity]);
-    std::memcpy(bigger.get(), text_.get(), size_);
-    text_ = std::move(bigger);
-    capacity_ = capacity;
-  }
-  std::unique_ptr<char[]> text_;
-  std::size_t capacity_ = 0;
-  std::size_t size_ = 0;
-};
-
-CsvBuffer EncoderCsvText(const Robot& robot, const std::vector<double>& t_s,
-                         const std::vector<double>& rows) {
-  const std::size_t c = robot.channels.size();
-  CsvBuffer out(64 + t_s.size() * (24 + 26 * c));
-  out.Char('t');
-  for (const ChannelInfo& ch : robot.channels) {
-    out.Char(',');
-    out.Append(ch.rate_column);
-  }
-  out.Char('\n');
-  const double* row = rows.data();
-  for (std::size_t k = 0; k < t_s.size(); ++k, row += c) {
-    out.Seconds(t_s[k]);
-    for (std::size_t j = 0; j < c; ++j) {
-      out.Char(',');
-      out.Value(row[j]);
-    }
-    out.Char('\n');
-  }
-  return out;
-}
-
-// io::GroundTruthCsv rounds to 1 um and 1e-7 rad; a bag's poses are kept to the last bit.
-CsvBuffer GroundTruthCsvText(const GroundTruthTrack& track) {
-  CsvBuffer out(16 + track.t_s.size() * 96);
-  out.Append("t,x,y,theta\n");
-  for (std::size_t k = 0; k < track.t_s.size(); ++k) {
-    const Pose2d& p = track.world_T_robot[k];
-    out.Seconds(track.t_s[k]);
-    for (double v : {p.x, p.y, p.theta}) {
-      out.Char(',');
-      out.Value(v);
-    }
-    out.Char('\n');
-  }
-  return out;
-}
-
-// The staged data set read back by the loader `fit` uses (io/dataset.h: physical limits of
-// rates, angles and times, clock steps and gaps while the wheels turn, runs that move): a data
-// set the import writes is one `fit` accepts. A refusal names the bag and the file as it would
-// be under --out.
-void RefuseWhatFitRefuses(const ImportRosbag2Options& o, const std::string& staged_dir,
-                          const Robot& robot) {
-  try {
-    io::LoadDataset(io::ReadDatasetIndex(staged_dir), robot);
-  } catch (const InputError& e) {
-    std::string what = e.what();
-    for (std::size_t at = what.find(staged_dir); at != std::string::npos;
-         at = what.find(staged_dir, at + o.out.size())) {
-      what.replace(at, staged_dir.size(), o.out);
-    }
-    throw InputError(e.kind(), o.bag, 0, "the data set it makes would be refused: " + what);
-  }
-}
-
-void WriteDataset(const ImportRosbag2Options& o, const Robot& robot, const Rosbag2Import& imp) {
-  io::StagedDirectory staged(o.out);
-  const fs::path dir(staged.path());
-  fs::create_directories(dir / "runs");
-  std::vector<io::DatasetEntry> entries;
-  for (std::size_t i = 0; i < imp.runs.size(); ++i) {
-    io::DatasetEntry e;
-    e.id = imp.runs[i].id;
-    e.trajectory = imp.runs[i].trajectory;
-    e.repetition = imp.runs[i].repetition;
-    e.encoders = "runs/" + e.id + "_encoders.csv";
-    e.ground_truth = "runs/" + e.id + "_ground_truth.csv";
-    io::WriteFileAtomically(
-        (dir / e.encoders).string(),
-        EncoderCsvText(robot, imp.encoder_t_s[i], imp.encoder_values[i]).view());
-    io::WriteFileAtomically((dir / e.ground_truth).string(),
-                            GroundTruthCsvText(imp.runs[i].ground_truth).view());
-    entries.push_back(std::move(e));
-  }
-  std::string robot_yaml = io::ReadTextFile(o.robot);
-  if (!imp.robot_yaml_addition.empty()) {
-    if (!robot_yaml.empty() && robot_yaml.back() != '\n') robot_yaml += '\n';
-    robot_yaml += imp.robot_yaml_addition;
-  }
-  io::WriteFileAtomically((dir / "robot.yaml").string(), robot_yaml);
-  ReadRobotModelFile((dir / "robot.yaml").string());  // the robot with its frame reads back
-  const std::string header =
-      "# imported by fitcal import rosbag2 from " + io::YamlCommentText(o.bag) + "\n# encoders " +
-      io::YamlCommentText(o.encoders) + " (" +
-      (imp.streams.joints.positions ? "positions" : "velocities") + "), ground truth " +
-      io::YamlCommentText(o.ground_truth) + " (" + imp.streams.pose_type + "), " + o.stamp +
-      " stamps; t = 0 at " +
-      std::to_string(imp.streams.start_time_ns) + " ns since the epoch\n";
-  io::WriteFileAtomically((dir / "dataset.yaml").string(),
-                          header + io::DatasetYaml("robot.yaml", entries));
-  RefuseWhatFitRefuses(o, staged.path(), robot);
-  io::StopHereForTests("import-rosbag2-before-rename");
-  io::CommitDirectoryOutput(staged, o.out, io::kDatasetKind, o.force, {o.bag});
-}
-
-}  // namespace
-
-Rosbag2Import ImportRosbag2(const ImportRosbag2Options& o) {
-  if (o.out.empty()) throw UsageError("--out <data set directory> is required");
-  io::RegisterInputDirectory(o.bag);  // no data set in, over or holding the bag
-  if (const std::string refusal =
-          io::DirectoryOutputRefusal(o.out, io::kDatasetKind, o.force, {o.bag});
-      !refusal.empty()) {
-    throw UsageError(refusal);  // exit 2, as every writer refuses its --out
-  }
-  Rosbag2Import imp = ReadRosbag2Import(o);
-  WriteDataset(o, ReadRobotModelFile(o.robot)->robot(), imp);
-  return imp;
-}
 
 void AddImportRosbag2Options(CLI::App& app, ImportRosbag2Options& o) {
   app.add_option("bag", o.bag, "Bag directory, its metadata.yaml, or one .db3 / .mcap file")
@@ -230,14 +52,11 @@ int RunImportRosbag2Command(const ImportRosbag2Options& o) {
     const Rosbag2Import imp = ImportRosbag2(o);
     if (!o.quiet) {
       for (const std::string& note : imp.notes) std::printf("%s\n", note.c_str());
-      const RobotModelPtr model = ReadRobotModelFile((fs::path(o.out) / "robot.yaml").string());
-      const FinalPoseErrors nominal =
-          EvaluateFinalPoseErrors(*model, model->robot().nominal, AlignRuns(imp.runs));
       std::printf(
           "wrote %zu run(s) to %s (%.1f MB of bag, %zu encoder and %zu ground-truth "
           "samples); nominal CF (Eq. 14) %.4f\n",
           imp.runs.size(), o.out.c_str(), static_cast<double>(imp.streams.bytes) * 1e-6,
-          imp.streams.joints.t_ns.size(), imp.streams.poses.t_ns.size(), nominal.cf);
+          imp.streams.joints.t_ns.size(), imp.streams.poses.t_ns.size(), imp.nominal.cf);
     }
     return 0;
   });

@@ -19,8 +19,6 @@ namespace fitcal::tools {
 
 // ReadRosbag2Import, then writes the data set atomically. Throws as ReadRosbag2Import, and
 // std::runtime_error when --out exists (without force) or cannot be written.
-Rosbag2Import ImportRosbag2(const ImportRosbag2Options& options);
-
 // The command: one line `fitcal import rosbag2: <file>: <what>` on stderr and exit 1 for bad
 // input or an unwritable output, 2 for bad options; 0 after writing.
 // Declares every flag of `import rosbag2` on its subcommand `app`, bound to `options`.

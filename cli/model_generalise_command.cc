@@ -32,7 +32,7 @@ void PrintSplitTableHeader() {
 void PrintSplitRows(const SplitScores& s) {
   for (const CandidateScore& c : s.candidates) {
     char held[16] = "-", bound[16] = "-";
-    if (c.is_fit && (c.name == "fit" || c.name == kTiedFitName)) {
+    if (c.is_fit && IsWrittenFit(c, /*final_pose_only=*/true)) {
       std::snprintf(held, sizeof held, "%d", c.held_directions);
       std::snprintf(bound, sizeof bound, "%d", c.at_bound);
     }
@@ -194,17 +194,13 @@ void PrintEverydayDrivingOfSplit(const RobotModelInterface& model,
     held_out.push_back(runs[i]);
     tracks.push_back(ground_truth[i]);
   }
-  const EffectModel no_effects;
   const CandidateScore& nominal = scores.candidates.front();
   for (const CandidateScore& c : scores.candidates) {
-    if (c.name != "fit" && c.name != "fit (track)" && c.name != kTiedFitName &&
-        c.name != kTiedTrackFitName) {
-      continue;
-    }
+    if (!IsWrittenFit(c)) continue;
     PrintEverydayDrivingTable(
-        model, held_out, tracks,
         scores.split.train_name + " -> " + scores.split.test_name + ": " + c.name,
-        {&nominal.parameters, &no_effects}, {&c.parameters, &no_effects}, threads,
+        CompareEverydayDriving(model, {nominal.name, nominal.parameters},
+                               {c.name, c.parameters}, held_out, tracks, threads),
         /*judge=*/true);
   }
 }

@@ -6,12 +6,12 @@
 #include <iostream>
 #include <stdexcept>
 
+#include "cli/dataset_command.h"
+#include "io/command_failure.h"
 #include "io/input_error.h"
-#include "io/staged_directory.h"
-#include "models/model_registry.h"
-#include "cli/model_simulate_command.h"
 #include "io/output_guard.h"
-#include "sim/flower_scenario.h"
+#include "models/model_registry.h"
+#include "sim/model_dataset.h"
 
 namespace fitcal::tools {
 
@@ -59,23 +59,45 @@ effects::EffectValue ParseInjectedEffect(const std::string& text) {
   return e;
 }
 
+// The nominal and the true value of each parameter, in display units.
+void PrintTruth(const Robot& robot, const std::vector<double>& truth) {
+  std::printf("  %-22s %12s %12s\n", "parameter", "nominal", "true");
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    const double s = robot.parameters[k].DisplayScale();
+    std::printf("  %-22s %12.6f %12.6f%s\n", robot.LabelOf(k).c_str(), robot.nominal[k] * s,
+                truth[k] * s, robot.IsHeld(k) ? "  held (gauge)" : "");
+  }
+}
+
 // --model: the generic simulator with the flags that apply to it.
 int RunModelSimulate(const SimulateCommandOptions& options) {
-  ModelSimulateOptions o;
-  o.out = options.out;
-  o.model = options.model;
-  o.robot = options.robot_given ? options.robot : "";
-  o.truth = options.truth;
-  o.force = options.force;
-  o.noise.repetitions = options.repetitions;
-  o.noise.seed = options.seed;
-  o.noise.ticks_per_rev = options.encoder_counts_per_rev;
-  o.noise.wheel_rate_sigma_rad_s = options.wheel_rate_sigma_rad_s;
-  o.noise.angle_sigma_rad = options.angle_sigma_deg * M_PI / 180.0;
-  o.noise.gt_position_sigma_m = options.gt_position_sigma_m;
-  o.noise.gt_heading_sigma_rad = options.gt_heading_sigma_deg * M_PI / 180.0;
-  o.flower_only_flags = options.flower_only_flags;
-  return RunModelSimulateCommand(o);
+  return RunReportingErrors("fitcal simulate", [&]() -> int {
+    if (!options.flower_only_flags.empty()) {
+      throw UsageError(options.flower_only_flags.front() +
+                       " belongs to the flower simulation (simulate without --model), not to "
+                       "--model " + options.model + " (docs/simulate.md)");
+    }
+    sim::ModelDatasetRequest r;
+    r.out = options.out;
+    r.model = options.model;
+    r.robot = options.robot_given ? options.robot : "";
+    r.truth = options.truth;
+    r.force = options.force;
+    r.noise.repetitions = options.repetitions;
+    r.noise.seed = options.seed;
+    r.noise.ticks_per_rev = options.encoder_counts_per_rev;
+    r.noise.wheel_rate_sigma_rad_s = options.wheel_rate_sigma_rad_s;
+    r.noise.angle_sigma_rad = options.angle_sigma_deg * M_PI / 180.0;
+    r.noise.gt_position_sigma_m = options.gt_position_sigma_m;
+    r.noise.gt_heading_sigma_rad = options.gt_heading_sigma_deg * M_PI / 180.0;
+    const sim::WrittenModelDataset written = sim::WriteModelDataset(r);
+    const Robot& robot = written.model->robot();
+    std::printf("wrote %zu runs of the %s robot '%s' (%d repetitions, seed %llu) to %s\n",
+                written.num_runs, robot.model.c_str(), robot.name.c_str(), r.noise.repetitions,
+                static_cast<unsigned long long>(r.noise.seed), options.out.c_str());
+    PrintTruth(robot, written.truth);
+    return 0;
+  });
 }
 
 // The flower of the flags: the nominal robot commands, the truth (--truth or Table 5) moves.
@@ -154,29 +176,14 @@ int RunSimulateCommand(const SimulateCommandOptions& options) {
   if (!options.model.empty() && !ExtrasOf(options.model).legacy_simulator) {
     return RunModelSimulate(options);
   }
-  try {
+  return RunReportingErrors("fitcal", [&]() -> int {
     const sim::FlowerSimulation flower = FlowerOf(options);
-    if (const std::string refusal =
-            io::DirectoryOutputRefusal(options.out, io::kDatasetKind, options.force, {});
-        !refusal.empty()) {
-      std::cerr << "fitcal: " << refusal << "\n";
-      return 2;
-    }
-    const std::vector<sim::ModelSimulatedRun> runs = sim::SimulateFlower(flower);
-    // Written whole or not at all: staged beside --out, renamed over it once complete.
-    io::StagedDirectory staged(options.out);
-    const RobotModelInterface& model = *flower.model;
-    sim::WriteSimulatedDataset(staged.path(), model.RobotYaml(model.robot().nominal, ""), runs,
-                               sim::EncoderCsvDigits::kRecorder);
-    io::CommitDirectoryOutput(staged, options.out, io::kDatasetKind, options.force, {});
+    const std::size_t num_runs = sim::WriteFlowerDataset(flower, options.out, options.force);
     std::printf("wrote %zu runs (%zu trajectories x %d repetitions, seed %llu) to %s\n",
-                runs.size(), flower.trajectories.size(), flower.repetitions,
+                num_runs, flower.trajectories.size(), flower.repetitions,
                 static_cast<unsigned long long>(flower.options.seed), options.out.c_str());
     return 0;
-  } catch (const std::exception& e) {
-    std::cerr << "fitcal: " << e.what() << "\n";
-    return 1;
-  }
+  });
 }
 
 }  // namespace fitcal::tools

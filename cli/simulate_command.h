@@ -1,7 +1,7 @@
 #pragma once
 // `fitcal simulate`: writes a simulated flower data set of an omni3 robot (docs/simulate.md;
 // sim/flower_scenario.h on the generic simulator) in the data set format; with --model, a
-// data set of another model (cli/model_simulate_command.h).
+// data set of another model; both written by sim/model_dataset.h.
 
 #include <cstdint>
 #include <string>

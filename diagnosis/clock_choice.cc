@@ -3,6 +3,10 @@
 #include <stdexcept>
 
 #include "fit/effect_fit.h"
+#include "fit/model_fit.h"
+#include "fit/segment_cost.h"
+#include "odometry/aligned_run.h"
+#include "odometry/parallel_for.h"
 
 namespace fitcal {
 
@@ -33,6 +37,25 @@ std::vector<RunLog> ApplyClockChoice(const ClockChoice& choice, std::vector<RunL
     if (choice.mapped[i]) original[i].ground_truth = mapped[i].ground_truth;
   }
   return original;
+}
+
+ClockChoice MapGroundTruthClocks(const RobotModelInterface& model, int num_threads,
+                                 std::vector<RunLog>* runs) {
+  const std::vector<double>& nominal = model.robot().nominal;
+  std::vector<RunLog> mapped = *runs;
+  ParallelFor(mapped.size(), num_threads, [&](std::size_t i) {
+    RunLog& run = mapped[i];
+    const ClockMap map = EstimateClockMap(model, nominal.data(), AlignRun(run), run.ground_truth);
+    run.ground_truth = ApplyClockMap(run.ground_truth, map);
+  });
+  ModelFitOptions fit_options;
+  fit_options.ceres.num_threads = num_threads;
+  const ModelFitResult fit = FitModel(AlignRuns(*runs), model, fit_options);
+  const std::vector<double>& p = fit.usable ? fit.parameters : nominal;
+  ClockChoice choice =
+      ChooseClocks(model, p, *runs, mapped, WheelChannelMask(model.robot()), num_threads);
+  *runs = ApplyClockChoice(choice, std::move(*runs), mapped);
+  return choice;
 }
 
 }  // namespace fitcal

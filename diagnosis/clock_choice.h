@@ -36,4 +36,12 @@ ClockChoice ChooseClocks(const RobotModelInterface& model, const std::vector<dou
 std::vector<RunLog> ApplyClockChoice(const ClockChoice& choice, std::vector<RunLog> original,
                                      const std::vector<RunLog>& mapped);
 
+// `diagnose --clock-map`: re-stamps each run's ground truth on the encoder clock (the speed-profile
+// match of the model's body velocities at the nominal, EstimateClockMap), keeping the map only on
+// the runs whose track error under the final-pose fit of `runs` it lowers (ChooseClocks; that fit
+// falls back to the nominal when it is not usable): a correctly clocked data set keeps the
+// identity. Returns the choice (num_mapped: the runs re-stamped).
+ClockChoice MapGroundTruthClocks(const RobotModelInterface& model, int num_threads,
+                                 std::vector<RunLog>* runs);
+
 }  // namespace fitcal

@@ -14,7 +14,7 @@
 #include "fit/model_fit.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "odometry/aligned_run.h"
-#include "cli/import_optiodom.h"
+#include "interchange/optiodom/optiodom_import.h"
 #include "tests/test_paths.h"
 
 namespace fitcal {
@@ -32,7 +32,7 @@ TEST(BoundedFit, RealOmni3InEq16sBoxConvergesOnTheBoundOnlyWithTheActiveSet) {
     for (const auto& entry : fs::directory_iterator(root / kind)) sessions.push_back(entry.path());
     std::sort(sessions.begin(), sessions.end());
     for (const fs::path& dir : sessions) {
-      const tools::OptiOdomImport session = tools::ReadOptiOdomSessions({dir.string()});
+      const optiodom::OptiOdomImport session = optiodom::ReadOptiOdomSessions({dir.string()});
       robot = Omni3RobotOf(dynamic_cast<const Omni3Model&>(*session.model));
       for (const RunLog& run : session.runs) runs.push_back(AlignRun(run));
     }

@@ -28,7 +28,7 @@
 #include "odometry/aligned_run.h"
 #include "tests/model_support.h"
 #include "tests/test_files.h"
-#include "cli/import_optiodom.h"
+#include "interchange/optiodom/optiodom_import.h"
 #include "models/diff_drive/diff_drive_trajectories.h"
 #include "sim/model_simulator.h"
 #include "validation/generalisation.h"
@@ -493,11 +493,10 @@ TEST(OptiOdomDiffImport, ReproducesTheNominalFinalErrorsOfRealSessions) {
     GTEST_SKIP() << "no " << kDiff;
   }
   testing::TempDir dir;
-  tools::ImportOptiOdomOptions options;
+  optiodom::ImportOptiOdomOptions options;
   options.sessions = {kFlaggedSession.string(), kCircleSession.string()};
   options.out = dir.Path("diff");
-  options.quiet = true;
-  const auto summary = tools::ImportOptiOdom(options);
+  const auto summary = optiodom::ImportOptiOdom(options);
   // 6 + 6 runs, the flagged square run 02 left out and said so.
   EXPECT_EQ(summary.runs.size(), 11u);
   ASSERT_EQ(summary.notes.size(), 1u);
@@ -567,11 +566,10 @@ TEST(OptiOdomDiffImport, EverySessionNominalUmbmarkAndFit) {
     sessions.insert(sessions.end(), names.begin(), names.end());
   }
   testing::TempDir dir;
-  tools::ImportOptiOdomOptions options;
+  optiodom::ImportOptiOdomOptions options;
   options.sessions = sessions;
   options.out = dir.Path("diff");
-  options.quiet = true;
-  const auto summary = tools::ImportOptiOdom(options);
+  const auto summary = optiodom::ImportOptiOdom(options);
   // README: 13 + 8 sessions, 54 + 44 runs, one flagged; four sessions declare perturbed values.
   EXPECT_EQ(summary.num_sessions, 21);
   EXPECT_EQ(summary.runs.size(), 97u);

@@ -27,7 +27,7 @@
 #include "odometry/aligned_run.h"
 #include "tests/model_support.h"
 #include "tests/test_files.h"
-#include "cli/import_optiodom.h"
+#include "interchange/optiodom/optiodom_import.h"
 #include "sim/model_simulator.h"
 #include "models/omni/omni_trajectories.h"
 
@@ -439,16 +439,16 @@ TEST(OptiOdomOmni4, ImportedSessionReproducesTheAuthorsNominalOdometry) {
   if (!fs::is_directory(kSession)) GTEST_SKIP() << "no " << kSession;
   const fs::path out = fs::temp_directory_path() / ("fitcal_omni4_" + std::to_string(::getpid()));
   fs::remove_all(out);
-  tools::ImportOptiOdomOptions options;
+  optiodom::ImportOptiOdomOptions options;
   options.sessions = {kSession.string()};
   options.out = out.string();
-  const tools::OptiOdomImport result = tools::ImportOptiOdom(options);
+  const optiodom::OptiOdomImport result = optiodom::ImportOptiOdom(options);
   EXPECT_EQ(result.runs.size(), 4u);
   // The channel-order check kept the documented layout (it throws otherwise) on the track's
   // windows.
   EXPECT_NE(result.channel_order.find("0.5 m windows"), std::string::npos) << result.channel_order;
 
-  const tools::OptiOdomImport session = tools::ReadOptiOdomSessions({kSession.string()});
+  const optiodom::OptiOdomImport session = optiodom::ReadOptiOdomSessions({kSession.string()});
   const RobotModelPtr model = session.model;
   // The written robot YAML (10 significant digits) is the same robot.
   const RobotModelPtr written = ReadRobotModelFile((out / "robot.yaml").string());

@@ -42,7 +42,7 @@ void WriteText(const fs::path& path, const std::string& text) { std::ofstream(pa
 
 TEST(OptiOdomImport, ReadsMetadataAndMapsTheAuthorsWheelsToOurs) {
   SKIP_WITHOUT_DATA();
-  const tools::OptiOdomImport s = tools::ReadOptiOdomSessions({kCircleSession.string()});
+  const optiodom::OptiOdomImport s = optiodom::ReadOptiOdomSessions({kCircleSession.string()});
   ASSERT_EQ(s.runs.size(), 4u);
   EXPECT_EQ(s.runs[0].trajectory, "circular_221220201643");
   ASSERT_TRUE(s.model->robot().encoder.has_value());
@@ -63,7 +63,7 @@ TEST(OptiOdomImport, ReadsMetadataAndMapsTheAuthorsWheelsToOurs) {
 TEST(OptiOdomImport, DocumentedWheelMappingIsTheOneTheGroundTruthSupports) {
   SKIP_WITHOUT_DATA();
   for (const fs::path& dir : {kCircleSession, kSquareSession}) {
-    const tools::OptiOdomImport s = tools::ReadOptiOdomSessions({dir.string()});
+    const optiodom::OptiOdomImport s = optiodom::ReadOptiOdomSessions({dir.string()});
     const auto& model = s.model;
     const std::vector<RunLog>& logs = s.runs;
     std::vector<const GroundTruthTrack*> tracks;
@@ -89,7 +89,7 @@ TEST(OptiOdomImport, DocumentedWheelMappingIsTheOneTheGroundTruthSupports) {
 TEST(OptiOdomImport, WritesATicksDataSetThatLoadsBackToTheSameRuns) {
   SKIP_WITHOUT_DATA();
   const fs::path out = TempDir("roundtrip");
-  tools::ImportOptiOdomOptions options;
+  optiodom::ImportOptiOdomOptions options;
   options.sessions = {kCircleSession.string()};
   options.out = (out / "ds").string();
   ASSERT_EQ(tools::RunImportOptiOdomCommand(options), 0);
@@ -98,7 +98,7 @@ TEST(OptiOdomImport, WritesATicksDataSetThatLoadsBackToTheSameRuns) {
   ASSERT_TRUE(robot.encoder.has_value());
   EXPECT_EQ(robot.encoder->ticks_per_rev, 12288.0);
   EXPECT_FALSE(robot.encoder->cumulative);
-  const tools::OptiOdomImport s = tools::ReadOptiOdomSessions({kCircleSession.string()});
+  const optiodom::OptiOdomImport s = optiodom::ReadOptiOdomSessions({kCircleSession.string()});
   ASSERT_EQ(ds.runs.size(), 4u);
   for (std::size_t i = 0; i < 4; ++i) {
     const RunLog& direct = s.runs[i];
@@ -129,15 +129,30 @@ TEST(OptiOdomImport, BadSessionIsOneErrorAndWritesNothing) {
                 session / "221220201643_metadata.csv");
   fs::copy_file(kCircleSession / "221220201643_run-01.csv", session / "221220201643_run-01.csv");
   try {
-    tools::ReadOptiOdomSessions({session.string()});
+    optiodom::ReadOptiOdomSessions({session.string()});
     FAIL() << "expected an InputError";
   } catch (const io::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("N = 4"), std::string::npos) << e.what();
   }
-  tools::ImportOptiOdomOptions options;
+  optiodom::ImportOptiOdomOptions options;
   options.sessions = {session.string()};
   options.out = (tmp / "out").string();
   EXPECT_EQ(tools::RunImportOptiOdomCommand(options), 1);
+  EXPECT_FALSE(fs::exists(tmp / "out"));
+  fs::remove_all(tmp);
+}
+
+// Sessions of two robots (an omni3 circle and a diff drive's) make no one robot.yaml: a usage
+// error (exit 2) before anything is read, nothing written.
+TEST(OptiOdomImport, SessionsOfTwoRobotsAreRefused) {
+  SKIP_WITHOUT_DATA();
+  const fs::path diff = kOmni3.parent_path() / "diff" / "circular" / "231220200121";
+  if (!fs::is_directory(diff)) GTEST_SKIP() << "no " << diff;
+  const fs::path tmp = TempDir("two_robots");
+  optiodom::ImportOptiOdomOptions options;
+  options.sessions = {kCircleSession.string(), diff.string()};
+  options.out = (tmp / "out").string();
+  EXPECT_EQ(tools::RunImportOptiOdomCommand(options), 2);
   EXPECT_FALSE(fs::exists(tmp / "out"));
   fs::remove_all(tmp);
 }

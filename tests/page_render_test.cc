@@ -13,8 +13,8 @@
 #include <regex>
 #include <string>
 
-#include "io/diagnose_page.h"
-#include "io/report_writer.h"
+#include "pages/diagnose_page.h"
+#include "pages/report_writer.h"
 #include "tests/test_files.h"
 
 namespace fitcal::io {

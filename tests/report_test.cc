@@ -1,5 +1,5 @@
-// The report files (io/report_writer.h, io/svg_plot.h): index.html is well formed, embeds every
-// figure, and references nothing outside itself; the CSV and JSON carry the numbers.
+// The report files (pages/report_writer.h, pages/svg_plot.h): index.html is well formed, embeds
+// every figure, and references nothing outside itself; the CSV and JSON carry the numbers.
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "io/diagnose_page.h"
-#include "io/report_writer.h"
-#include "io/svg_plot.h"
+#include "pages/diagnose_page.h"
+#include "pages/report_writer.h"
+#include "pages/svg_plot.h"
 #include "validation/trajectory_family.h"
 
 namespace fitcal::io {

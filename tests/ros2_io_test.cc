@@ -108,7 +108,7 @@ TEST_P(ImportEqualsCsv, SameFitAsTheSimulatorsCsv) {
       o.runs += text;
     }
   }
-  const Rosbag2Import in_memory = tools::ImportRosbag2(o);
+  const Rosbag2Import in_memory = ImportRosbag2(o);
   const io::Dataset imported = io::LoadDataset(io::ReadDatasetIndex(o.out),
                                                ReadRobotModelFile(o.out + "/robot.yaml")->robot());
   ASSERT_EQ(imported.runs.size(), sim_runs.size());
@@ -149,7 +149,7 @@ TEST_P(ImportEqualsCsv, SameFitAsTheSimulatorsCsv) {
   // The same bag with the wheels' joints swapped: a different robot, many sigmas away.
   o.joints = {"left_wheel_joint", "right_wheel_joint"};
   o.force = true;
-  tools::ImportRosbag2(o);
+  ImportRosbag2(o);
   const io::Dataset swapped = io::LoadDataset(io::ReadDatasetIndex(o.out), model->robot());
   const ModelFitResult wrong = FitModel(AlignRuns(swapped.runs), *model);
   const double cf_wrong =
@@ -186,7 +186,7 @@ TEST(ImportRosbag2ClockOffset, OneOffsetPerBagRecoversAPoseLatency) {
   WriteRobotBag(tmp.path() / "bag", SimulatedRuns(*model), BagWriterOptions{}, edits);
   ImportRosbag2Options o = ImportOptions(tmp, tmp.path() / "bag");
   o.split_at_rest_s = 2.0;
-  tools::ImportRosbag2(o);
+  ImportRosbag2(o);
   const io::Dataset imported = io::LoadDataset(io::ReadDatasetIndex(o.out), model->robot());
   const std::vector<AlignedRun> runs = AlignRuns(imported.runs);
   std::vector<const GroundTruthTrack*> tracks;
@@ -257,7 +257,7 @@ class MalformedImport : public ::testing::Test {
     ImportRosbag2Options o = ImportOptions(tmp_, bag);
     o.out = tmp_.Path(out);
     o.split_at_rest_s = 2.0;
-    return tools::ImportRosbag2(o);
+    return ImportRosbag2(o);
   }
   testing::TempDir tmp_;
   std::vector<sim::ModelSimulatedRun> runs_;

@@ -25,8 +25,8 @@
 #include "odometry/aligned_run.h"
 #include "tests/model_support.h"
 #include "tests/test_files.h"
-#include "cli/import_optiodom.h"
-#include "cli/miswired_error.h"
+#include "interchange/optiodom/optiodom_import.h"
+#include "diagnosis/miswired_error.h"
 #include "sim/model_simulator.h"
 #include "models/tricycle/tricycle_trajectories.h"
 
@@ -542,14 +542,13 @@ TEST(TricycleSimulation, WrongSteeringSignIsCaughtByTheMiswiringScores) {
 // OptiOdom import: synthetic sessions for bad input, a real session when ../shared has it
 
 // `fitcal import optiodom` of these sessions into `out`, printing nothing.
-tools::OptiOdomImport Import(const std::vector<std::string>& sessions, const std::string& out,
+optiodom::OptiOdomImport Import(const std::vector<std::string>& sessions, const std::string& out,
                              bool skip_mapping_check = false) {
-  tools::ImportOptiOdomOptions options;
+  optiodom::ImportOptiOdomOptions options;
   options.sessions = sessions;
   options.out = out;
   options.skip_mapping_check = skip_mapping_check;
-  options.quiet = true;
-  return tools::ImportOptiOdom(options);
+  return optiodom::ImportOptiOdom(options);
 }
 
 // A session directory <root>/<type>/<name>/ with one run file of the given rows.
@@ -619,7 +618,7 @@ TEST(OptiOdomTricycleImport, SteeringOfTheWrongSignIsRefused) {
   try {
     Import({session}, dir.Path("out"));
     ADD_FAILURE() << "imported";
-  } catch (const tools::MiswiredError& e) {
+  } catch (const MiswiredError& e) {
     EXPECT_NE(std::string(e.what()).find("steering = -steering"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("nothing written"), std::string::npos) << e.what();
   }

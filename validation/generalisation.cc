@@ -190,7 +190,7 @@ SplitScores EvaluateSplit(const RobotModelInterface& model, const std::vector<Al
   }
   ModelFitOptions full = options;
   full.tying = nullptr;
-  AddFinalPoseFits(model, "fit", full, train, test, &out.candidates, fit);
+  AddFinalPoseFits(model, kFitName, full, train, test, &out.candidates, fit);
   ModelFitOptions tied = full;
   tied.tying = &tying;
   if (!tying.empty()) AddFinalPoseFits(model, kTiedFitName, tied, train, test, &out.candidates);
@@ -200,7 +200,7 @@ SplitScores EvaluateSplit(const RobotModelInterface& model, const std::vector<Al
     }
     const TrackFitData data =
         MakeTrackFitData(train, PickEach(*ground_truth, split.train), ClockGrouping::kNone);
-    AddTrackFit(model, "fit (track)", full, data, train, test, &out.candidates);
+    AddTrackFit(model, kTrackFitName, full, data, train, test, &out.candidates);
     if (!tying.empty())
       AddTrackFit(model, kTiedTrackFitName, tied, data, train, test, &out.candidates);
   }
@@ -263,6 +263,12 @@ std::vector<FoldSummary> SummariseFolds(const std::vector<SplitScores>& folds) {
     s.run_heading_rad /= n;
   }
   return out;
+}
+
+bool IsWrittenFit(const CandidateScore& candidate, bool final_pose_only) {
+  const std::string& name = candidate.name;
+  if (name == kFitName || name == kTiedFitName) return true;
+  return !final_pose_only && (name == kTrackFitName || name == kTiedTrackFitName);
 }
 
 }  // namespace fitcal

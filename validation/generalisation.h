@@ -101,9 +101,16 @@ struct TrackCandidates {
   const std::vector<const GroundTruthTrack*>* ground_truth = nullptr;
 };
 
-// The names of the tied fits' candidates (EvaluateSplit with a tying).
+// The names of the fits' candidates, and of the tied fits' (EvaluateSplit with a tying).
+inline constexpr const char* kFitName = "fit";
+inline constexpr const char* kTrackFitName = "fit (track)";
 inline constexpr const char* kTiedFitName = "fit (tied)";
 inline constexpr const char* kTiedTrackFitName = "fit (track, tied)";
+
+// A calibration `fit` writes (the final-pose or the track fit, or a tied twin): the candidates
+// whose everyday driving `generalise` prints. With final_pose_only, the final-pose ones only: the
+// candidates whose held directions and parameters at a bound its table shows.
+bool IsWrittenFit(const CandidateScore& candidate, bool final_pose_only = false);
 
 // Fits on split.train (options.ceres.num_threads also drives the evaluation) and scores every
 // candidate on split.test. With a non-empty `tying` (fit/parameter_tying.h: a reduced model such

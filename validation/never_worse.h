@@ -103,6 +103,21 @@ std::vector<NeverWorseJudgement> JudgeCalibrationNeverWorse(
     const CalibrationCandidate& calibrated, const std::vector<AlignedRun>& runs,
     const std::vector<const GroundTruthTrack*>& tracks, int num_threads = 0);
 
+// A calibration beside the nominal for everyday driving on `runs` (tracks[i] is runs[i]'s ground
+// truth): both replayed once at EverydayDriftLengths(), the never-worse judgements of the
+// calibration and the rows of the table `fit` and `generalise` print (EverydayDrivingRows, a
+// measure that rose noted with the runs' scatter, NeverWorseRowNotes).
+struct EverydayDrivingComparison {
+  std::vector<NeverWorseJudgement> judgements;
+  std::vector<std::string> rows;
+};
+EverydayDrivingComparison CompareEverydayDriving(const RobotModelInterface& model,
+                                                 const CalibrationCandidate& nominal,
+                                                 const CalibrationCandidate& calibrated,
+                                                 const std::vector<AlignedRun>& runs,
+                                                 const std::vector<const GroundTruthTrack*>& tracks,
+                                                 int num_threads = 0);
+
 // The same for a CF per run only (commands that judge final poses: export).
 std::vector<NeverWorseJudgement> JudgeNeverWorseOnCf(const std::vector<AlignedRun>& runs,
                                                      const std::vector<double>& nominal_cf,

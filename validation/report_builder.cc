@@ -502,7 +502,7 @@ std::optional<CrossValidationResult> AddCrossValidation(const ReportBuildOptions
   return cv;
 }
 
-// The world tracks `report --tum` writes (io/report_tum.h): the samples the ATE and drift are
+// The world tracks `report --tum` writes (pages/report_tum.h): the samples the ATE and drift are
 // computed on, the odometry started at the ground truth's start pose.
 void AddWorldTracks(const EvaluatedRuns& e, io::ReportData* data) {
   for (std::size_t i = 0; i < e.before.size(); ++i) {

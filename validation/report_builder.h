@@ -1,7 +1,7 @@
 #pragma once
 // The builder of the validation report (`fitcal report`): from the loaded data set and
-// calibrations, the model every renderer formats (io/report_model.h), built once. Every number is
-// computed here (with fit/, validation/ and diagnosis/): each validation run replayed with the
+// calibrations, the model every renderer formats (pages/report_model.h), built once. Every number
+// is computed here (with fit/, validation/ and diagnosis/): each validation run replayed with the
 // nominal and the calibrated model (Palacin Eq. 8-14), Table 6 per family and trajectory, drift
 // per distance, uncertainty and identifiability of the parameters, effects, optional
 // leave-one-repetition-out cross-validation, the verdict (validation/verdict.h), and the same for
@@ -13,7 +13,7 @@
 
 #include "io/calibration_yaml.h"
 #include "io/dataset.h"
-#include "io/report_model.h"
+#include "pages/report_model.h"
 #include "models/model_registry.h"
 #include "odometry/effects.h"
 #include "odometry/robot.h"

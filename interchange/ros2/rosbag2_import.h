@@ -43,6 +43,7 @@
 #include <string>
 #include <vector>
 
+#include "fit/final_pose_errors.h"
 #include "io/rosbag2/bag_streams.h"
 #include "odometry/run_log.h"
 
@@ -78,10 +79,17 @@ struct Rosbag2Import {
   // Appended to the robot YAML the data set holds: the nominal `ground_truth_frame:` of a ground
   // truth that tracks a sensor, from the bag's /tf_static (io/rosbag2/static_transforms.h).
   std::string robot_yaml_addition;
+  FinalPoseErrors nominal;  // Palacin Eq. 14 over the runs written, at the nominal (ImportRosbag2)
 };
 
 // Reads the bag and cuts the runs, writing nothing. Throws io::InputError for a bad bag or bad
 // runs (file and what), std::invalid_argument for bad options.
 Rosbag2Import ReadRosbag2Import(const ImportRosbag2Options& options);
+
+// The whole import of `fitcal import rosbag2` (rosbag2_dataset.cc): `out` checked against the
+// overwrite rule and the bag (an input), the bag read, the data set written (staged, refused
+// unless the loader `fit` uses accepts it) and the runs' nominal CF. Throws UsageError for an
+// `out` it may not write, io::InputError for a bad bag or data set; nothing is written then.
+Rosbag2Import ImportRosbag2(const ImportRosbag2Options& options);
 
 }  // namespace fitcal

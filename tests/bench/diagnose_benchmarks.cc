@@ -37,7 +37,7 @@ const std::string& ImportedOmni3() {
   static RemovedAtExit cleanup;
   static const std::string directory = [] {
     const fs::path root = fitcal::bench::SharedDir(FITCAL_SHARED_DIR) / "data" / "optiodom" / "omni3";
-    tools::ImportOptiOdomOptions options;
+    optiodom::ImportOptiOdomOptions options;
     for (const char* type : {"circular", "square"}) {
       if (!fs::is_directory(root / type)) return std::string();
       for (const auto& entry : fs::directory_iterator(root / type)) {

@@ -177,7 +177,7 @@ void ImportRosbag2(benchmark::State& state, bool write) {
   const fitcal::ImportRosbag2Options o = ImportOptions();
   for (auto _ : state) {
     const auto imported =
-        write ? fitcal::tools::ImportRosbag2(o) : fitcal::ReadRosbag2Import(o);
+        write ? fitcal::ImportRosbag2(o) : fitcal::ReadRosbag2Import(o);
     benchmark::DoNotOptimize(imported.runs.size());
   }
   state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * ImportBag().file_bytes));

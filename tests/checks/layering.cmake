@@ -4,23 +4,24 @@
 # Each folder is a layer and may include only its own layer and the ones below it:
 #   odometry (0)  replay, poses, encoder samples, the robot description
 #   io (1)        file formats, data sets, atomic writes
-#   models (2)    the kinematic models behind one seam, each reading its own robot YAML through io
-#   sim (3)       the simulators that write data sets, driving the models through the seam
-#   fit (4)       residuals, costs, fitters, the split into training and held-out runs
-#   validation (5) held-out judgement, metrics, statistics
-#   diagnosis (6) what the residual left after a fit says
-#   calibrate (7) one calibration from a request: candidates, choices by transfer, the gate, the
+#   pages (2)     the pages and their renderers: the report's model, HTML, SVG, Markdown, JSON, CSV
+#   models (3)    the kinematic models behind one seam, each reading its own robot YAML through io
+#   sim (4)       the simulators that write data sets, driving the models through the seam
+#   fit (5)       residuals, costs, fitters, the split into training and held-out runs
+#   validation (6) held-out judgement, metrics, statistics
+#   diagnosis (7) what the residual left after a fit says
+#   calibrate (8) one calibration from a request: candidates, choices by transfer, the gate, the
 #                 held-out judgements, the record to write
-#   interchange (8) the formats and tools of other ecosystems: ROS 2 (a bag cut into runs,
+#   interchange (9) the formats and tools of other ecosystems: ROS 2 (a bag cut into runs,
 #                 controller parameters exported, replayed and their covariance), OptiOdom
-#   cli (9)       the commands: load, one library call, print
+#   cli (10)      the commands: load, one library call, print
 # A new include against this order fails the check with the file, the line and the layers.
 cmake_minimum_required(VERSION 3.16)
 if(NOT SOURCE_DIR)
   message(FATAL_ERROR "layering.cmake: pass -DSOURCE_DIR=<checkout>")
 endif()
 
-set(LAYERS odometry io models sim fit validation diagnosis calibrate interchange cli)
+set(LAYERS odometry io pages models sim fit validation diagnosis calibrate interchange cli)
 # No exception: a model that reads files of its own (ASOC's encoder files, models/asoc/asoc_files.h)
 # hands the data-set loader a reader through its Robot (Robot::read_own_encoder_file).
 set(ALLOWED_EXCEPTIONS "")

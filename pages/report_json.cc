@@ -1,8 +1,8 @@
-#include "io/report_json.h"
+#include "pages/report_json.h"
 
 #include <sstream>
 
-#include "io/report_text.h"
+#include "pages/report_text.h"
 
 namespace fitcal::io {
 

@@ -1,4 +1,4 @@
-#include "io/final_error_plot.h"
+#include "pages/final_error_plot.h"
 
 namespace fitcal::io {
 

@@ -1,11 +1,11 @@
-#include "io/report_figures.h"
+#include "pages/report_figures.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "io/final_error_plot.h"
-#include "io/report_text.h"
-#include "io/svg_plot.h"
+#include "pages/final_error_plot.h"
+#include "pages/report_text.h"
+#include "pages/svg_plot.h"
 #include "odometry/text_format.h"
 
 namespace fitcal::io {

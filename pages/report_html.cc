@@ -1,11 +1,11 @@
-#include "io/report_html.h"
+#include "pages/report_html.h"
 
 #include <algorithm>
 #include <sstream>
 
-#include "io/report_figures.h"
-#include "io/report_text.h"
-#include "io/svg_plot.h"
+#include "pages/report_figures.h"
+#include "pages/report_text.h"
+#include "pages/svg_plot.h"
 
 namespace fitcal::io {
 
@@ -64,14 +64,6 @@ const char* const kStyle =
     "margin:0 0 8px;padding:2px 0}table.stack td{border:none;text-align:left;white-space:normal;"
     "min-width:0;overflow-wrap:anywhere}table.stack td::before{content:attr(data-label) \": \";"
     "font-weight:bold;color:#333}}\n";
-
-// A table inside a horizontally scrolling box: wide tables scroll on a phone instead of pushing
-// the page wider than the screen.
-void OpenTable(std::ostringstream& h, const std::string& id = "", bool stacked = false) {
-  h << "<div class=\"scroll\"" << (id.empty() ? "" : " id=\"" + id + "\"") << ">\n<table"
-    << (stacked ? " class=\"stack\"" : "") << ">\n";
-}
-void CloseTable(std::ostringstream& h) { h << "</table>\n</div>\n"; }
 
 void HtmlVerdict(std::ostringstream& h, const ReportData& d) {
   h << "<div class=\"banner " << EscapeXml(d.verdict)
@@ -525,6 +517,12 @@ void HtmlComparison(std::ostringstream& h, const ReportData& d) {
 }
 
 }  // namespace
+
+void OpenTable(std::ostringstream& h, const std::string& id, bool stacked) {
+  h << "<div class=\"scroll\"" << (id.empty() ? "" : " id=\"" + id + "\"") << ">\n<table"
+    << (stacked ? " class=\"stack\"" : "") << ">\n";
+}
+void CloseTable(std::ostringstream& h) { h << "</table>\n</div>\n"; }
 
 std::string PageStyleSheet() { return kStyle; }
 

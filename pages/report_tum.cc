@@ -1,4 +1,4 @@
-#include "io/report_tum.h"
+#include "pages/report_tum.h"
 
 #include "io/tum_file.h"
 

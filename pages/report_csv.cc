@@ -1,8 +1,8 @@
-#include "io/report_csv.h"
+#include "pages/report_csv.h"
 
 #include <sstream>
 
-#include "io/report_text.h"
+#include "pages/report_text.h"
 
 namespace fitcal::io {
 

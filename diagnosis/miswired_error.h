@@ -5,7 +5,7 @@
 
 #include "io/command_failure.h"
 
-namespace fitcal::tools {
+namespace fitcal {
 
 inline constexpr int kMiswiredExitCode = 4;
 
@@ -14,4 +14,4 @@ class MiswiredError : public CommandFailure {
   explicit MiswiredError(const std::string& what) : CommandFailure(kMiswiredExitCode, what) {}
 };
 
-}  // namespace fitcal::tools
+}  // namespace fitcal

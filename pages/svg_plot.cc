@@ -1,4 +1,4 @@
-#include "io/svg_plot.h"
+#include "pages/svg_plot.h"
 
 #include <algorithm>
 #include <atomic>
@@ -237,6 +237,18 @@ XYFrame XYFrameOf(const XYPlotOptions& o, const std::vector<SvgSeries>& series) 
   return f;
 }
 
+// A grid line across the plot (from x = left, pw wide) and its label at each y tick of `yt`.
+template <typename ToPixelY>
+void YGrid(std::ostringstream& out, double left, double pw, const std::vector<double>& yt,
+           const ToPixelY& py) {
+  const double ystep = yt.size() > 1 ? yt[1] - yt[0] : 1.0;
+  for (double t : yt) {
+    out << "<line x1=\"" << Num(left) << "\" y1=\"" << Num(py(t)) << "\" x2=\"" << Num(left + pw)
+        << "\" y2=\"" << Num(py(t)) << "\" stroke=\"#e4e4e4\"/>\n";
+    Text(out, left - 6, py(t) + 4, TickLabel(t, ystep), "end", 11);
+  }
+}
+
 // Title, frame, grid, tick labels and axis labels.
 void XYAxes(std::ostringstream& out, const XYPlotOptions& o, const XYFrame& f) {
   const double left = f.left, top = f.top, pw = f.pw, ph = f.ph;
@@ -248,17 +260,12 @@ void XYAxes(std::ostringstream& out, const XYPlotOptions& o, const XYFrame& f) {
   const auto xt = NiceTicks(f.xr.lo, f.xr.hi, std::max(3, static_cast<int>(pw / 80)));
   const auto yt = NiceTicks(f.yr.lo, f.yr.hi, std::max(3, static_cast<int>(ph / 50)));
   const double xstep = xt.size() > 1 ? xt[1] - xt[0] : 1.0;
-  const double ystep = yt.size() > 1 ? yt[1] - yt[0] : 1.0;
   for (double t : xt) {
     out << "<line x1=\"" << Num(px(t)) << "\" y1=\"" << Num(top) << "\" x2=\"" << Num(px(t))
         << "\" y2=\"" << Num(top + ph) << "\" stroke=\"#e4e4e4\"/>\n";
     Text(out, px(t), top + ph + 16, TickLabel(t, xstep), "middle", 11);
   }
-  for (double t : yt) {
-    out << "<line x1=\"" << Num(left) << "\" y1=\"" << Num(py(t)) << "\" x2=\"" << Num(left + pw)
-        << "\" y2=\"" << Num(py(t)) << "\" stroke=\"#e4e4e4\"/>\n";
-    Text(out, left - 6, py(t) + 4, TickLabel(t, ystep), "end", 11);
-  }
+  YGrid(out, left, pw, yt, py);
   Text(out, left + pw / 2, top + ph + 36, o.x_label, "middle", 13);
   const double ylx = 18, yly = top + ph / 2;
   Text(out, ylx, yly, o.y_label, "middle", 13,
@@ -435,6 +442,17 @@ void Box(std::ostringstream& out, std::vector<double> v, double x0, double w,
   out << "\n";
 }
 
+// The opening of a chart over categories (BarChartSvg, BoxPlotSvg): the <svg> with room for the
+// category labels, the title, and a grid line with its label at each of the y ticks `yt`.
+template <typename ToPixelY>
+void OpenCategoryChart(std::ostringstream& out, const BarChartOptions& o,
+                       const CategoryLabels& labels, double left, double pw,
+                       const std::vector<double>& yt, const ToPixelY& py) {
+  Open(out, o.width, o.height + static_cast<int>(labels.extra_height), o.title);
+  Text(out, o.width / 2.0, 20, o.title, "middle", 15, " font-weight=\"bold\"");
+  YGrid(out, left, pw, yt, py);
+}
+
 }  // namespace
 
 std::string BarChartSvg(const BarChartOptions& o, const std::vector<std::string>& categories,
@@ -453,16 +471,9 @@ std::string BarChartSvg(const BarChartOptions& o, const std::vector<std::string>
   const CategoryLabels labels = LayOutCategoryLabels(categories, group_w);
   const auto yt = NiceTicks(0.0, vmax * 1.05, 6);
   const double ymax = std::max(vmax * 1.05, yt.empty() ? vmax : yt.back());
-  const double ystep = yt.size() > 1 ? yt[1] - yt[0] : 1.0;
   auto py = [&](double y) { return top + ph - y / ymax * ph; };
   std::ostringstream out;
-  Open(out, o.width, o.height + static_cast<int>(labels.extra_height), o.title);
-  Text(out, o.width / 2.0, 20, o.title, "middle", 15, " font-weight=\"bold\"");
-  for (double t : yt) {
-    out << "<line x1=\"" << Num(left) << "\" y1=\"" << Num(py(t)) << "\" x2=\"" << Num(left + pw)
-        << "\" y2=\"" << Num(py(t)) << "\" stroke=\"#e4e4e4\"/>\n";
-    Text(out, left - 6, py(t) + 4, TickLabel(t, ystep), "end", 11);
-  }
+  OpenCategoryChart(out, o, labels, left, pw, yt, py);
   const double bar_w = 0.8 * group_w / std::max<double>(1.0, static_cast<double>(series.size()));
   for (std::size_t c = 0; c < categories.size(); ++c) {
     const double gx = left + static_cast<double>(c) * group_w + 0.1 * group_w;
@@ -500,16 +511,9 @@ std::string BoxPlotSvg(const BarChartOptions& o, const std::vector<std::string>&
   const double group_w = categories.empty() ? pw : pw / static_cast<double>(categories.size());
   const CategoryLabels labels = LayOutCategoryLabels(categories, group_w);
   const auto yt = NiceTicks(yr.lo, yr.hi, 6);
-  const double ystep = yt.size() > 1 ? yt[1] - yt[0] : 1.0;
   auto py = [&](double y) { return top + ph - (y - yr.lo) / (yr.hi - yr.lo) * ph; };
   std::ostringstream out;
-  Open(out, o.width, o.height + static_cast<int>(labels.extra_height), o.title);
-  Text(out, o.width / 2.0, 20, o.title, "middle", 15, " font-weight=\"bold\"");
-  for (double t : yt) {
-    out << "<line x1=\"" << Num(left) << "\" y1=\"" << Num(py(t)) << "\" x2=\"" << Num(left + pw)
-        << "\" y2=\"" << Num(py(t)) << "\" stroke=\"#e4e4e4\"/>\n";
-    Text(out, left - 6, py(t) + 4, TickLabel(t, ystep), "end", 11);
-  }
+  OpenCategoryChart(out, o, labels, left, pw, yt, py);
   const double box_w = 0.7 * group_w / std::max<double>(1.0, static_cast<double>(series.size()));
   for (std::size_t c = 0; c < categories.size(); ++c) {
     for (std::size_t k = 0; k < series.size(); ++k) {

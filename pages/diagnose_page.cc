@@ -1,33 +1,28 @@
-#include "io/diagnose_page.h"
+#include "pages/diagnose_page.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
 
-#include "io/final_error_plot.h"
-#include "io/report_html.h"
-#include "io/report_json.h"
-#include "io/svg_plot.h"
+#include "pages/final_error_plot.h"
+#include "pages/report_html.h"
+#include "pages/report_json.h"
+#include "pages/report_text.h"
+#include "pages/svg_plot.h"
 #include "odometry/text_format.h"
 
 namespace fitcal::io {
 
 namespace {
 
-constexpr double kDeg = 180.0 / M_PI;
-const char* const kAfterColour = "#0072b2";  // calibrated
-
-std::string Fmt(const char* format, double v) { return FormatDouble(format, v); }
+using report_text::kAfterColour;  // the calibration's colour, as on the report's page
+using report_text::kDeg;
+using report_text::Fmt;
 
 std::string ChangeText(double before, double after) {
   return before > 0.0 ? Fmt("%+.1f %%", 100.0 * (after - before) / before) : "-";
 }
-
-void OpenTable(std::ostringstream& h, bool stacked = false) {
-  h << "<div class=\"scroll\">\n<table" << (stacked ? " class=\"stack\"" : "") << ">\n";
-}
-void CloseTable(std::ostringstream& h) { h << "</table>\n</div>\n"; }
 
 // The residual: each held-out run's final position error in its start frame, before and after.
 std::string FinalErrorsSvg(const DiagnosePageData& d) {
@@ -101,7 +96,7 @@ std::string HeldOutSvg(const DiagnosePageData& d) {
 
 void HtmlStructure(std::ostringstream& h, const DiagnosePageData& d) {
   h << "<h2 id=\"structure\">Residual structure tested</h2>\n";
-  OpenTable(h, /*stacked=*/true);
+  OpenTable(h, "", /*stacked=*/true);
   h << "<tr><th>test</th><th>statistic</th><th>p</th><th>result</th><th>what it says</th></tr>\n";
   for (const DiagnoseStructureTest& t : d.structure) {
     h << "<tr><td data-label=\"test\">" << EscapeXml(t.name)
@@ -125,7 +120,7 @@ void HtmlCandidates(std::ostringstream& h, const DiagnosePageData& d) {
     h << "<p>No candidate effect was tried.</p>\n";
     return;
   }
-  OpenTable(h, /*stacked=*/true);
+  OpenTable(h, "", /*stacked=*/true);
   h << "<tr><th>round</th><th>effect</th><th>separable</th><th>fitted</th><th>mean "
        "improvement</th><th>p</th><th>threshold</th><th>&Delta;BIC</th><th>explains</th>"
        "<th>decision</th></tr>\n";

@@ -1,9 +1,9 @@
-#include "io/report_markdown.h"
+#include "pages/report_markdown.h"
 
 #include <sstream>
 #include <vector>
 
-#include "io/report_text.h"
+#include "pages/report_text.h"
 
 namespace fitcal::io {
 

@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "io/report_model.h"
+#include "pages/report_model.h"
 
 namespace fitcal::io {
 

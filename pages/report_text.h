@@ -1,5 +1,5 @@
 #pragma once
-// What the report's renderers share (io/report_html.cc, report_markdown.cc, report_json.cc,
+// What the report's renderers share (pages/report_html.cc, report_markdown.cc, report_json.cc,
 // report_csv.cc, report_figures.cc): number formats, the Table 6 columns, the colours and names
 // of nominal and calibrated, and the display choices derived from the model (which runs to
 // draw, each coloured track's scale). Internal to
@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "io/report_model.h"
-#include "io/svg_plot.h"
+#include "pages/report_model.h"
+#include "pages/svg_plot.h"
 
 namespace fitcal::io::report_text {
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "io/svg_plot.h"
+#include "pages/svg_plot.h"
 
 namespace fitcal::io {
 

@@ -1,4 +1,4 @@
-#include "io/report_text.h"
+#include "pages/report_text.h"
 
 #include <algorithm>
 #include <cstdio>

@@ -1,12 +1,12 @@
 #pragma once
 // The SVG renderer of the report: each figure of index.html drawn from the model
-// (io/report_model.h), a complete inline <svg>.
+// (pages/report_model.h), a complete inline <svg>.
 
 #include <cstddef>
 #include <string>
 #include <vector>
 
-#include "io/report_model.h"
+#include "pages/report_model.h"
 
 namespace fitcal::io {
 

@@ -1,12 +1,12 @@
-#include "cli/import_channel_order.h"
+#include "diagnosis/import_channel_order.h"
 
 #include <cstdio>
 
 #include "diagnosis/channel_order_check.h"
 #include "odometry/aligned_run.h"
-#include "cli/miswired_error.h"
+#include "diagnosis/miswired_error.h"
 
-namespace fitcal::tools {
+namespace fitcal {
 
 std::string CheckImportedChannelOrder(const std::vector<RunLog>& logs,
                                       const RobotModelInterface& model, bool skip) {
@@ -31,4 +31,4 @@ std::string CheckImportedChannelOrder(const std::vector<RunLog>& logs,
   return line;
 }
 
-}  // namespace fitcal::tools
+}  // namespace fitcal

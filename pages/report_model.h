@@ -1,14 +1,14 @@
 #pragma once
 // The model of the validation report (`fitcal report`): plain values, built once from the data
 // by validation/report_builder.h (which computes every number with fit/, validation/ and diagnosis/),
-// then formatted by one renderer per output (io/report_html.h, report_markdown.h, report_json.h,
+// then formatted by one renderer per output (pages/report_html.h, report_markdown.h, report_json.h,
 // report_csv.h, report_tum.h, report_figures.h). Nothing here computes. Angles are radians in
 // the model and degrees in the outputs (columns ending _deg).
 
 #include <string>
 #include <vector>
 
-#include "io/svg_plot.h"
+#include "pages/svg_plot.h"
 #include "odometry/pose2.h"
 
 namespace fitcal::io {

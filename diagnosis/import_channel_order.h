@@ -9,12 +9,12 @@
 #include "models/model_interface.h"
 #include "odometry/run_log.h"
 
-namespace fitcal::tools {
+namespace fitcal {
 
 // The line to print when the documented order stands (its SSR at the nominal and the best other
-// order's). Throws MiswiredError (cli/miswired_error.h) with the check's message when another
+// order's). Throws MiswiredError (diagnosis/miswired_error.h) with the check's message when another
 // order explains the ground truth far better, unless `skip`; with `skip` the line says so.
 std::string CheckImportedChannelOrder(const std::vector<RunLog>& logs,
                                       const RobotModelInterface& model, bool skip);
 
-}  // namespace fitcal::tools
+}  // namespace fitcal

@@ -4,13 +4,13 @@
 
 #include <string>
 
-#include "io/report_model.h"
+#include "pages/report_model.h"
 
 namespace fitcal::io {
 
 std::string MetricsJson(const ReportData& data);
 
-// JSON scalars, shared with the page of `diagnose` (io/diagnose_page.h).
+// JSON scalars, shared with the page of `diagnose` (pages/diagnose_page.h).
 std::string JsonStringOf(const std::string& text);
 std::string JsonNumberOf(double value);  // null when not finite
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "io/report_model.h"
+#include "pages/report_model.h"
 
 namespace fitcal::io {
 

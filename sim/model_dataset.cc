@@ -1,0 +1,90 @@
+#include "sim/model_dataset.h"
+
+#include <filesystem>
+#include <stdexcept>
+
+#include "io/atomic_file.h"
+#include "io/command_failure.h"
+#include "io/output_guard.h"
+#include "io/staged_directory.h"
+#include "models/model_registry.h"
+#include "sim/model_scenarios.h"
+#include "sim/model_simulator.h"
+
+namespace fitcal::sim {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The nominal robot: --robot, or the registry's example robot of the model.
+RobotModelPtr NominalModel(const ModelDatasetRequest& request) {
+  if (!request.robot.empty()) return ReadRobotModelFile(request.robot);
+  const ModelRegistration* registration = FindModel(request.model);
+  if (registration == nullptr) {
+    throw std::invalid_argument("unknown --model '" + request.model +
+                                "' (known: " + RegisteredModelNames() + ")");
+  }
+  return ReadRobotModel(YAML::Load(registration->example_yaml), request.model + " example robot");
+}
+
+// The true parameters: --truth (a robot YAML of the same model and channels), or the default.
+std::vector<double> TrueParameters(const ModelDatasetRequest& request,
+                                   const RobotModelInterface& nominal) {
+  const Robot& robot = nominal.robot();
+  if (request.truth.empty()) return DefaultTrueParameters(robot);
+  const RobotModelPtr truth = ReadRobotModelFile(request.truth);
+  const Robot& t = truth->robot();
+  if (t.model != robot.model || t.NumChannels() != robot.NumChannels() ||
+      t.NumParameters() != robot.NumParameters()) {
+    throw std::invalid_argument(request.truth + ": the true robot must be a " + robot.model +
+                                " robot with the nominal robot's channels and parameters");
+  }
+  return t.nominal;
+}
+
+void RefuseOut(const std::string& out, bool force) {
+  if (const std::string refusal = io::DirectoryOutputRefusal(out, io::kDatasetKind, force, {});
+      !refusal.empty()) {
+    throw UsageError(refusal);
+  }
+}
+
+}  // namespace
+
+WrittenModelDataset WriteModelDataset(const ModelDatasetRequest& request) {
+  RefuseOut(request.out, request.force);
+  WrittenModelDataset written;
+  written.model = NominalModel(request);
+  const RobotModelInterface& model = *written.model;
+  const Robot& robot = model.robot();
+  if (robot.model != request.model) {
+    throw UsageError(request.robot + " is a " + robot.model + " robot, not " + request.model);
+  }
+  written.truth = TrueParameters(request, model);
+  const ModelScenario scenario = MakeModelScenario(model, written.truth, request.noise);
+  const std::vector<ModelSimulatedRun> runs =
+      SimulateRuns(model, written.truth, scenario.trajectories, scenario.options);
+  io::StagedDirectory staged(request.out);
+  WriteSimulatedDataset(staged.path(), model.RobotYaml(robot.nominal, ""), runs);
+  io::WriteFileAtomically((fs::path(staged.path()) / "true_robot.yaml").string(),
+                          model.RobotYaml(written.truth, ""));
+  io::CommitDirectoryOutput(staged, request.out, io::kDatasetKind, request.force, {});
+  written.num_runs = runs.size();
+  return written;
+}
+
+std::size_t WriteFlowerDataset(const FlowerSimulation& flower, const std::string& out,
+                               bool force) {
+  RefuseOut(out, force);
+  const std::vector<ModelSimulatedRun> runs = SimulateFlower(flower);
+  // Written whole or not at all: staged beside `out`, renamed over it once complete.
+  io::StagedDirectory staged(out);
+  const RobotModelInterface& model = *flower.model;
+  WriteSimulatedDataset(staged.path(), model.RobotYaml(model.robot().nominal, ""), runs,
+                        EncoderCsvDigits::kRecorder);
+  io::CommitDirectoryOutput(staged, out, io::kDatasetKind, force, {});
+  return runs.size();
+}
+
+}  // namespace fitcal::sim
