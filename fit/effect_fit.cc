@@ -55,20 +55,24 @@ void TrackPoseErrors(const RobotModelInterface& robot_model, const TrackRun& run
     return Pose2<T>{p0.x + f * (p1.x - p0.x), p0.y + f * (p1.y - p0.y),
                     p0.theta + f * (p1.theta - p0.theta)};
   };
-  // Encoder time (from the window start) that ground-truth sample g shows.
+  // Encoder time (from the window start) that ground-truth sample g shows. Which step a sample
+  // falls in is decided on the scalar part alone (the same double as the Jet's), so the Jet is
+  // made only for the samples interpolated, not for every step's check.
+  const double tau_s = ScalarPart(tau);
+  const auto encoder_time_s = [&](int g) { return run.track.t_s[g] - a.t_start_s - tau_s; };
   const auto encoder_time = [&](int g) { return T(run.track.t_s[g] - a.t_start_s) - tau; };
   const auto visit = [&](std::size_t k, const Pose2<T>& before, const Pose2<T>& after) {
     const double t0 = run.contexts[k].t_s;
     const double t1 = t0 + run.contexts[k].dt_s;
     const bool last = k + 1 == run.contexts.size();
     while (next_anchor < anchors.size()) {
+      if (encoder_time_s(anchors[next_anchor]) > t1 && !last) break;
       const T e = encoder_time(anchors[next_anchor]);
-      if (ScalarPart(e) > t1 && !last) break;
       anchor_pose[next_anchor++] = lerp(before, after, (e - T(t0)) / T(t1 - t0));
     }
     while (next < n) {
+      if (encoder_time_s(indices[next]) > t1 && !last) break;
       const T e = encoder_time(indices[next]);
-      if (ScalarPart(e) > t1 && !last) break;
       replayed[next++] = lerp(before, after, (e - T(t0)) / T(t1 - t0));
     }
   };

@@ -31,6 +31,7 @@
 #include "models/omni/omni_kinematics.h"
 #include "models/omni3/omni3_kinematics.h"
 #include "odometry/aligned_run.h"
+#include "odometry/sin_cos.h"
 
 namespace fitcal {
 namespace final_pose_jacobian_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)
@@ -203,6 +204,46 @@ TEST(FinalPoseJacobian, DiffDriveRightWheelFirst) {
 TEST(FinalPoseJacobian, DiffDriveLeftWheelFirst) {
   CheckModel<DiffDriveKinematicsT<1>>(kDiffDriveLeftFirstYaml,
                                       FinalPoseJacobianKind::kPerSampleStep);
+}
+
+// odometry/sin_cos.h: the steps' sine and cosine from one libm call are ceres' sin(Jet) and
+// cos(Jet) bit for bit (exact equality, no tolerance: the same products in the same order), at
+// zero, tiny, near +-pi, beyond 2 pi and at seeded random angles with random derivative parts; and
+// the diff drive's chord ratios on Jets equal sin(a) / a and (1 - cos(a)) / a written with ceres'
+// functions outside the series' range. Why bitwise: the approval tests pin fits to the last digit.
+TEST(FinalPoseJacobian, SinCosIsCeresOwnBitForBit) {
+  using Jet = ceres::Jet<double, 4>;
+  std::mt19937_64 rng(44);
+  std::uniform_real_distribution<double> angle(-10.0, 10.0), part(-3.0, 3.0);
+  std::vector<double> angles = {0.0, 1e-300, 1e-8, -1e-2, 0.5, M_PI - 1e-12, -M_PI + 1e-9, 7.0};
+  for (int k = 0; k < 200; ++k) angles.push_back(angle(rng));
+  for (double a : angles) {
+    Jet f(a, 0);
+    for (int i = 0; i < 4; ++i) f.v[i] = part(rng);
+    Jet s, c;
+    SinCos(f, &s, &c);
+    const Jet s_ceres = ceres::sin(f), c_ceres = ceres::cos(f);
+    EXPECT_EQ(s.a, s_ceres.a) << a;
+    EXPECT_EQ(c.a, c_ceres.a) << a;
+    for (int i = 0; i < 4; ++i) {
+      EXPECT_EQ(s.v[i], s_ceres.v[i]) << a;
+      EXPECT_EQ(c.v[i], c_ceres.v[i]) << a;
+    }
+    double sd = 0.0, cd = 0.0;
+    SinCos(a, &sd, &cd);
+    EXPECT_EQ(sd, std::sin(a));
+    EXPECT_EQ(cd, std::cos(a));
+    if (std::abs(a) < diff_drive::kChordSeriesMaxAngle) continue;
+    Jet sin_over_a, one_minus_cos_over_a;
+    diff_drive::ChordRatios(f, &sin_over_a, &one_minus_cos_over_a);
+    const Jet expected_sin = ceres::sin(f) / f, expected_cos = (1.0 - ceres::cos(f)) / f;
+    EXPECT_EQ(sin_over_a.a, expected_sin.a) << a;
+    EXPECT_EQ(one_minus_cos_over_a.a, expected_cos.a) << a;
+    for (int i = 0; i < 4; ++i) {
+      EXPECT_EQ(sin_over_a.v[i], expected_sin.v[i]) << a;
+      EXPECT_EQ(one_minus_cos_over_a.v[i], expected_cos.v[i]) << a;
+    }
+  }
 }
 
 }  // namespace

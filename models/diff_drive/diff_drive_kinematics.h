@@ -29,6 +29,7 @@
 
 #include "models/model_interface.h"
 #include "odometry/pose2.h"
+#include "odometry/sin_cos.h"
 
 namespace fitcal {
 
@@ -45,8 +46,6 @@ inline constexpr double kChordSeriesMaxAngle = 1e-2;
 // sin(a) / a and (1 - cos(a)) / a, on double or ceres::Jet.
 template <typename T>
 void ChordRatios(const T& a, T* sin_over_a, T* one_minus_cos_over_a) {
-  using std::cos;
-  using std::sin;
   if (std::abs(ScalarPart(a)) < kChordSeriesMaxAngle) {
     const T a2 = a * a;
     *sin_over_a = 1.0 + a2 * (-1.0 / 6.0 + a2 * (1.0 / 120.0 + a2 * (-1.0 / 5040.0)));
@@ -54,8 +53,10 @@ void ChordRatios(const T& a, T* sin_over_a, T* one_minus_cos_over_a) {
         a * (0.5 + a2 * (-1.0 / 24.0 + a2 * (1.0 / 720.0 + a2 * (-1.0 / 40320.0))));
     return;
   }
-  *sin_over_a = sin(a) / a;
-  *one_minus_cos_over_a = (1.0 - cos(a)) / a;
+  T sin_a, cos_a;
+  SinCos(a, &sin_a, &cos_a);
+  *sin_over_a = sin_a / a;
+  *one_minus_cos_over_a = (1.0 - cos_a) / a;
 }
 
 }  // namespace diff_drive

@@ -38,6 +38,7 @@
 #include <cmath>
 
 #include "models/model_interface.h"
+#include "odometry/sin_cos.h"
 
 namespace fitcal {
 
@@ -79,8 +80,6 @@ struct TricycleKinematicsT {
   // makes the channel values depend on parameters.
   template <typename T, typename C>
   static void BodyStep(const Prepared<T>& k, const C* values, double dt, T* dx, T* dy, T* dtheta) {
-    using std::cos;
-    using std::sin;
     const T distance_m = k.radius_m * values[kTractionChannel] * dt;
     T steering_rad = k.steering_offset_rad;
     if constexpr (kHasGain) {
@@ -88,9 +87,11 @@ struct TricycleKinematicsT {
     } else {
       steering_rad += values[kSteeringChannel];
     }
-    *dx = distance_m * cos(steering_rad);
+    T sin_steering, cos_steering;
+    SinCos(steering_rad, &sin_steering, &cos_steering);
+    *dx = distance_m * cos_steering;
     *dy = T(0.0);
-    *dtheta = distance_m * sin(steering_rad) * k.inverse_wheelbase_per_m;
+    *dtheta = distance_m * sin_steering * k.inverse_wheelbase_per_m;
   }
 
   // Inverse of (T1) per unit time: the traction wheel's velocity in the body frame is

@@ -17,7 +17,6 @@
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
-#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -36,13 +35,14 @@ const std::string& Fitcal() {
   return path;
 }
 
-// The data set's directory, written on first use; "" after `error` when it cannot be made.
+// The data set's directory, written on first use; "" after `error` when it cannot be made. The
+// data sets live in one scratch directory that is removed when the process exits (a static's
+// destructor), so a run leaves nothing in /tmp.
 std::string DataSet(const std::string& name, std::string* error) {
+  static const bench::ScratchDir scratch("fitcal_choice_bench");
   static std::map<std::string, std::string> made;
   if (const auto found = made.find(name); found != made.end()) return found->second;
-  const fs::path dir = fs::temp_directory_path() /
-                       ("fitcal_choice_bench_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
+  const fs::path dir = scratch.path() / name;
   std::string command;
   if (name == "asoc") {
     command = Fitcal() + " asoc-simulate --seed 3 --out " + dir.string();
