@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdlib>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -59,15 +60,22 @@ inline CLI::Validator NonEmptyPathValidator() {
       "PATH", "non-empty path");
 }
 
+// The whole text read as a double (strtod's syntax: "nan" and "inf" too); nothing when any of it
+// is not part of the number.
+inline std::optional<double> WholeTextNumber(const std::string& text) {
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size()) return std::nullopt;
+  return value;
+}
+
 // A number option: nan and inf parse as doubles and pass CLI11's PositiveNumber and Range (every
 // comparison with nan is false), then reach the fit as a weight or a bound of nan.
 inline CLI::Validator FiniteNumberValidator() {
   return CLI::Validator(
       [](std::string& text) {
-        char* end = nullptr;
-        const double value = std::strtod(text.c_str(), &end);
-        const bool parsed = !text.empty() && end == text.c_str() + text.size();
-        if (parsed && !std::isfinite(value)) {
+        const std::optional<double> value = WholeTextNumber(text);
+        if (value && !std::isfinite(*value)) {
           return "must be a finite number, found '" + text.substr(0, 40) + "'";
         }
         return std::string();  // not a number at all: CLI11's conversion says so
@@ -80,12 +88,9 @@ inline CLI::Validator FiniteNumberValidator() {
 inline CLI::Validator SignValidator(bool zero_allowed) {
   return CLI::Validator(
       [zero_allowed](std::string& text) {
-        char* end = nullptr;
-        const double value = std::strtod(text.c_str(), &end);
-        if (text.empty() || end != text.c_str() + text.size()) {
-          return "must be a number, found '" + text.substr(0, 40) + "'";
-        }
-        if (zero_allowed ? value >= 0 : value > 0) return std::string();
+        const std::optional<double> value = WholeTextNumber(text);
+        if (!value) return "must be a number, found '" + text.substr(0, 40) + "'";
+        if (zero_allowed ? *value >= 0 : *value > 0) return std::string();
         return std::string(zero_allowed ? "must be 0 or more" : "must be above 0") + ", found '" +
                text.substr(0, 40) + "'";
       },

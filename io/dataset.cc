@@ -309,13 +309,17 @@ bool WheelsTurn(const EncoderSamples& samples, const Robot& robot) {
   return false;
 }
 
-bool GroundTruthMoves(const GroundTruthTrack& track) {
+// How far the ground truth gets from its first pose (m).
+double GroundTruthReach(const GroundTruthTrack& track) {
+  double reach_m = 0.0;
   const Pose2d& first = track.world_T_robot.front();
   for (const Pose2d& p : track.world_T_robot) {
-    if (std::hypot(p.x - first.x, p.y - first.y) > kMovedM) return true;
+    reach_m = std::max(reach_m, std::hypot(p.x - first.x, p.y - first.y));
   }
-  return false;
+  return reach_m;
 }
+
+bool GroundTruthMoves(const GroundTruthTrack& track) { return GroundTruthReach(track) > kMovedM; }
 
 void RejectDataSetWithoutMotion(const DatasetIndex& index, const std::vector<RunLog>& runs,
                                 const Robot& robot) {
@@ -342,15 +346,6 @@ void RejectDataSetWithoutMotion(const DatasetIndex& index, const std::vector<Run
 // parameter towards a robot that does not move; judged, it fails any calibration. 0.2 m is two
 // orders above any motion capture's noise and below every calibration path.
 constexpr double kTravelWithoutWheelsM = 0.2;
-
-double GroundTruthReach(const GroundTruthTrack& track) {
-  double reach_m = 0.0;
-  const Pose2d& first = track.world_T_robot.front();
-  for (const Pose2d& p : track.world_T_robot) {
-    reach_m = std::max(reach_m, std::hypot(p.x - first.x, p.y - first.y));
-  }
-  return reach_m;
-}
 
 void RejectRunsWithoutWheelMotion(const DatasetIndex& index, const std::vector<RunLog>& runs,
                                   const Robot& robot) {
