@@ -188,4 +188,34 @@ DiagnosisCalibration CalibrateOnDiagnosis(const DiagnosisCalibrationRequest& req
   return out;
 }
 
+DiagnosisSplit SplitForDiagnosis(const std::vector<RunLog>& runs, const Robot& robot,
+                                 const std::string& train_reps,
+                                 const std::string& train_trajectories) {
+  DiagnosisSplit out{
+      SplitForFit(PrepareTrackRuns(runs, WheelChannelMask(robot)), train_reps, train_trajectories),
+      ""};
+  out.text = train_trajectories.empty()
+                 ? "training repetitions " + FormatRepetitionList(out.training_repetitions)
+                 : "training trajectories matching '" + train_trajectories + "'";
+  return out;
+}
+
+Refusal RefusalOfDeclaredEffects(const Robot& robot, const std::string& robot_path) {
+  if (robot.effects.empty()) return {};
+  return {2, {robot_path + ": the robot already declares effects; diagnose starts from a robot "
+                           "YAML without an effects: list"}};
+}
+
+Refusal RefusalOfSplit(const DiagnosisSplit& split) {
+  if (!split.training.empty() && !split.validation.empty()) return {};
+  return {2, {"diagnose needs training and held-out runs; got " +
+              std::to_string(split.training.size()) + " training and " +
+              std::to_string(split.validation.size()) + " validation runs (" + split.text + ")"}};
+}
+
+Refusal RefusalOfUnconvergedFits(const DiagnoseResult& result) {
+  if (result.declared.usable && result.final_fit.usable) return {};
+  return {3, {"the fit did not converge (" + result.declared.termination + "); nothing written"}};
+}
+
 }  // namespace fitcal

@@ -54,6 +54,23 @@ struct DiagnosisCalibration {
   io::CalibrationBlock record;          // when kDone
 };
 
+// The track runs on each side (fit/run_split.h: by train_trajectories, else by train_reps, "auto"
+// the first half of the repetitions present), with the split in words for the report and page.
+struct DiagnosisSplit : SplitOf<TrackRun> {
+  std::string text;
+};
+DiagnosisSplit SplitForDiagnosis(const std::vector<RunLog>& runs, const Robot& robot,
+                                 const std::string& train_reps,
+                                 const std::string& train_trajectories);
+
+// What diagnose refuses, each with exit 2 before any fit or exit 3 after, and the reason: a robot
+// YAML that already declares effects (the diagnosis adds them to a robot without); a split
+// without training or held-out runs (the effects are judged on held-out runs); a declared or final
+// fit that did not converge (nothing it says could be trusted).
+Refusal RefusalOfDeclaredEffects(const Robot& robot, const std::string& robot_path);
+Refusal RefusalOfSplit(const DiagnosisSplit& split);
+Refusal RefusalOfUnconvergedFits(const DiagnoseResult& result);
+
 DiagnosisCalibration CalibrateOnDiagnosis(const DiagnosisCalibrationRequest& request,
                                           const RobotModelInterface& model,
                                           const SplitOf<TrackRun>& split,

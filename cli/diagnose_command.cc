@@ -68,27 +68,15 @@ void AddDiagnoseOptions(CLI::App& cmd, DiagnoseCommandOptions& o) {
 
 namespace {
 
+// Each reason on its own line of stderr; the refusal's exit status.
+int PrintRefusal(const Refusal& refusal) {
+  for (const std::string& reason : refusal.reasons) std::cerr << "fitcal: " << reason << "\n";
+  return refusal.exit_code;
+}
+
 const std::set<std::string> kDiagnoseFiles = {"index.html",    "metrics.json",
                                               "diagnose.md",   "residuals.csv",
                                               "residuals_declared.csv", "calibrated.yaml"};
-
-// The track runs on each side (fit/run_split.h: by --train-trajectories, else by --train-reps,
-// "auto" the first half of the repetitions present), and the split in words for the page.
-struct DiagnoseSplit : SplitOf<TrackRun> {
-  std::string text;
-};
-
-// wheel_mask marks the robot's wheel-rate channels.
-DiagnoseSplit SplitRuns(const DiagnoseCommandOptions& options, const std::vector<RunLog>& runs,
-                        unsigned wheel_mask) {
-  DiagnoseSplit out{SplitForFit(PrepareTrackRuns(runs, wheel_mask), options.train_reps,
-                                options.train_trajectories),
-                    ""};
-  out.text = options.train_trajectories.empty()
-                 ? "training repetitions " + FormatRepetitionList(out.training_repetitions)
-                 : "training trajectories matching '" + options.train_trajectories + "'";
-  return out;
-}
 
 // The gate's table (calibrate/diagnosis_calibration.h), what the never-worse judgement and the
 // uncertainty said, and the refusal's reasons.
@@ -103,7 +91,6 @@ void PrintDecision(const DiagnosisCalibration& c, std::size_t num_held_out) {
     std::printf("uncertainty of '%s': propagated through the training runs' final poses\n",
                 c.choice.name.c_str());
   }
-  for (const std::string& reason : c.refusal.reasons) std::cerr << "fitcal: " << reason << "\n";
 }
 
 // "## Written calibration": the chosen candidate's parameters with the sigma calibrated.yaml
@@ -171,11 +158,8 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
     }
     const RobotModelPtr model = ReadRobotModelFile(index.robot_path);
     const Robot& robot = model->robot();
-    if (!robot.effects.empty()) {
-      std::cerr << "fitcal: " << index.robot_path
-                << ": the robot already declares effects; diagnose starts from a robot YAML "
-                   "without an effects: list\n";
-      return 2;
+    if (const Refusal r = RefusalOfDeclaredEffects(robot, index.robot_path); r.exit_code != 0) {
+      return PrintRefusal(r);
     }
     std::vector<RunLog> runs = LoadRuns(options, index, robot).runs;
     const std::string aligned = AlignGroundTruthClocks(options.clock_offsets, *model, nullptr,
@@ -189,23 +173,17 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
     if (!options.skip_wheel_order_check && ChannelsLookMiswired(options, *model, runs)) {
       return kMiswiredExitCode;
     }
-    const DiagnoseSplit split = SplitRuns(options, runs, WheelChannelMask(robot));
-    if (split.training.empty() || split.validation.empty()) {
-      std::cerr << "fitcal: diagnose needs training and held-out runs; got "
-                << split.training.size() << " training and " << split.validation.size()
-                << " validation runs (" << split.text << ")\n";
-      return 2;
-    }
+    const DiagnosisSplit split =
+        SplitForDiagnosis(runs, robot, options.train_reps, options.train_trajectories);
+    if (const Refusal r = RefusalOfSplit(split); r.exit_code != 0) return PrintRefusal(r);
     DiagnoseOptions diagnose_options;
     diagnose_options.fit.num_threads = options.threads;
     diagnose_options.max_effects = options.max_effects;
     diagnose_options.alpha = options.alpha;
     const DiagnoseResult result =
         Diagnose(split.training, split.validation, *model, diagnose_options);
-    if (!result.declared.usable || !result.final_fit.usable) {
-      std::cerr << "fitcal: the fit did not converge (" << result.declared.termination
-                << "); nothing written\n";
-      return 3;
+    if (const Refusal r = RefusalOfUnconvergedFits(result); r.exit_code != 0) {
+      return PrintRefusal(r);
     }
     const std::string report = "data set: " + options.logs + ", " + split.text +
                                (options.clock_map ? ", ground-truth clocks re-mapped" : "") +
@@ -215,7 +193,7 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
     const DiagnosisCalibration calibration = CalibrateOnDiagnosis(
         {options.logs, options.train_trajectories, &runs, options.threads}, *model, split, result);
     PrintDecision(calibration, split.validation.size());
-    if (calibration.refusal.exit_code != 0) return calibration.refusal.exit_code;
+    if (calibration.refusal.exit_code != 0) return PrintRefusal(calibration.refusal);
     const DiagnoseChoice& choice = calibration.choice;
     const std::string written = WrittenCalibrationText(robot, choice);
     std::printf("%s", written.c_str());

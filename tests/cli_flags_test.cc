@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <regex>
 #include <set>
 #include <string>
@@ -323,6 +324,28 @@ TEST(DiagnoseAlpha, TheThresholdIsAlphaOverTheCandidates) {
     ASSERT_EQ(threshold.size(), 1u) << rows;
     EXPECT_NEAR(threshold[0], alpha / candidates, 0.05 * alpha / candidates) << rows;
   }
+}
+
+// What diagnose refuses before it fits (calibrate/diagnosis_calibration.h), each exit 2 with one
+// line and nothing written: a robot YAML that already declares effects, and a split that leaves
+// no held-out run to judge an effect on.
+TEST(DiagnoseRefusals, DeclaredEffectsAndASplitWithoutHeldOutRunsAreRefusedBeforeAnyFit) {
+  TempDir tmp;
+  const std::string data = SimulateDiffDrive(tmp, "data");
+  const FitcalRun one_sided =
+      RunFitcal(tmp, "diagnose --logs " + data + " --train-reps 1-99 --out " + tmp.Path("a"));
+  EXPECT_EQ(one_sided.exit_code, 2) << one_sided.err;
+  EXPECT_TRUE(Has(one_sided.err, "diagnose needs training and held-out runs; got ")) << one_sided.err;
+  EXPECT_TRUE(Has(one_sided.err, " training and 0 validation runs")) << one_sided.err;
+  EXPECT_FALSE(fs::exists(tmp.Path("a")));
+
+  std::ofstream(data + "/robot.yaml", std::ios::app)
+      << "effects:\n  - {name: acceleration_slip, slip_s2_per_rad: 0.012}\n";
+  const FitcalRun declared = RunFitcal(tmp, "diagnose --logs " + data + " --out " + tmp.Path("b"));
+  EXPECT_EQ(declared.exit_code, 2) << declared.err;
+  EXPECT_TRUE(Has(declared.err, "robot.yaml: the robot already declares effects")) << declared.err;
+  EXPECT_EQ(std::count(declared.err.begin(), declared.err.end(), '\n'), 1) << declared.err;
+  EXPECT_FALSE(fs::exists(tmp.Path("b")));
 }
 
 // ---------------------------------------------------------------------------------------------
