@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "validation/fleet_statistics.h"
+#include "interchange/fleet/fleet_files.h"
 
 namespace CLI {
 class App;
@@ -24,7 +24,7 @@ struct FleetOptions {
   std::vector<std::string> inputs;
 };
 
-std::vector<FleetSeries> ReadFleet(const std::vector<std::string>& inputs);
+using fitcal::ReadFleet;
 
 // The table, one block per robot.
 std::string FleetTable(const std::vector<FleetSeries>& series);
