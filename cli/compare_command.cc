@@ -4,10 +4,8 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <iostream>
-#include <sstream>
 #include <stdexcept>
 
 #include "fit/run_split.h"
@@ -18,120 +16,17 @@
 #include "cli/cli_validators.h"
 #include "calibrate/fit_methods.h"
 #include "calibrate/method_comparison.h"
+#include "calibrate/method_comparison_tables.h"
 #include "io/output_guard.h"
 
 namespace fitcal::tools {
 
 namespace {
 
-using Row = ComparisonRow;
-
-std::string Fixed(double v, int digits) {
-  if (std::isnan(v)) return "-";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
-  return buf;
-}
-
-// How a row's parameters are shown: as the model registers it (ModelExtras::display: omni3 as
-// the M^-1 of Palacin Eq. 6), else its parameters in display units (m, deg).
-using ParameterColumns = ParameterDisplay;
-
-ParameterColumns ColumnsFor(const Robot& robot) {
-  ParameterColumns c;
-  if (const auto& display = ExtrasOf(robot.model).display) return display(robot);
-  c.markdown_header = "Parameters";
-  for (const ParameterInfo& info : robot.parameters) {
-    c.csv_names.push_back(info.KeyName());
-  }
-  c.csv_values = [robot](const std::vector<double>& p) {
-    std::vector<double> out;
-    for (int k = 0; k < robot.NumParameters(); ++k) {
-      out.push_back(p[k] * robot.parameters[k].DisplayScale());
-    }
-    return out;
-  };
-  c.markdown = [robot](const std::vector<double>& p) {
-    std::string out;
-    char item[96];
-    for (int k = 0; k < robot.NumParameters(); ++k) {
-      const ParameterInfo& info = robot.parameters[k];
-      std::snprintf(item, sizeof item, "%s%s %.6g%s", out.empty() ? "" : ", ", info.name.c_str(),
-                    p[k] * info.DisplayScale(), info.unit == ParameterUnit::kAngle ? " deg" : "");
-      out += item;
-    }
-    return out;
-  };
-  return c;
-}
-
-std::string CsvField(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string out = "\"";
-  for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return out + "\"";
-}
-
-// How each of compare's files starts, whatever the model: how a later run recognises them as its
-// own previous output (io/output_guard.h, rule 1).
-constexpr char kCsvStart[] = "strategy,method,repetitions,";
-constexpr char kMarkdownStart[] = "| Strategy | Method | Reps | ";
-constexpr char kTraceStart[] = "strategy,method,repetitions,evaluation,best_cf,elapsed_s";
 // Each file as <out><suffix> and how it starts.
-constexpr std::pair<const char*, const char*> kOutputFiles[] = {
-    {".csv", kCsvStart}, {".md", kMarkdownStart}, {"_trace.csv", kTraceStart}};
-
-std::string Csv(const std::vector<Row>& rows, const ParameterColumns& columns) {
-  std::ostringstream o;
-  o << "strategy,method,repetitions";
-  for (const std::string& name : columns.csv_names) o << "," << name;
-  o << ",cf_calibration,cf_validation,improvement_percent,evaluations,wall_s,termination,usable\n";
-  for (const Row& row : rows) {
-    o << CsvField(row.strategy) << "," << row.method << "," << row.repetitions;
-    const std::vector<double> values =
-        row.parameters.empty() ? std::vector<double>() : columns.csv_values(row.parameters);
-    for (std::size_t c = 0; c < columns.csv_names.size(); ++c) {
-      o << "," << (values.empty() ? "" : Fixed(values[c], 8));
-    }
-    o << "," << (std::isnan(row.cf_calibration) ? "" : Fixed(row.cf_calibration, 8)) << ","
-      << (std::isnan(row.cf_validation) ? "" : Fixed(row.cf_validation, 8)) << ","
-      << (std::isnan(row.improvement_percent) ? "" : Fixed(row.improvement_percent, 3)) << ","
-      << row.evaluations << "," << Fixed(row.wall_s, 4) << "," << CsvField(row.termination) << ","
-      << (row.usable ? "yes" : "no") << "\n";
-  }
-  return o.str();
-}
-
-std::string Markdown(const std::vector<Row>& rows, const ParameterColumns& columns) {
-  std::ostringstream o;
-  o << kMarkdownStart << columns.markdown_header
-    << " | CF calibration | CF validation | Improvement | "
-       "Evaluations | Wall [s] | Termination |\n"
-    << "|---|---|---|---|---|---|---|---|---|---|\n";
-  for (const Row& row : rows) {
-    o << "| " << row.strategy << " | " << row.method << " | "
-      << (row.repetitions ? std::to_string(row.repetitions) : "-") << " | "
-      << (row.parameters.empty() ? "-" : columns.markdown(row.parameters)) << " | "
-      << Fixed(row.cf_calibration, 4) << " | " << Fixed(row.cf_validation, 4) << " | "
-      << (std::isnan(row.improvement_percent) ? "-" : Fixed(row.improvement_percent, 1) + "%")
-      << " | " << (row.repetitions ? std::to_string(row.evaluations) : "-") << " | "
-      << (row.repetitions ? Fixed(row.wall_s, 2) : "-") << " | " << row.termination
-      << (row.usable ? "" : " (not usable)") << " |\n";
-  }
-  return o.str();
-}
-
-std::string TraceCsv(const std::vector<Row>& rows) {
-  std::ostringstream o;
-  o << kTraceStart << "\n";
-  for (const Row& row : rows) {
-    for (const ConvergencePoint& p : row.trace) {
-      o << CsvField(row.strategy) << "," << row.method << "," << row.repetitions << ","
-        << p.evaluation << "," << Fixed(p.best_cf, 10) << "," << Fixed(p.elapsed_s, 4) << "\n";
-    }
-  }
-  return o.str();
-}
+constexpr std::pair<const char*, const char*> kOutputFiles[] = {{".csv", kComparisonCsvStart},
+                                                               {".md", kComparisonMarkdownStart},
+                                                               {"_trace.csv", kComparisonTraceStart}};
 
 // What the user typed, checked before any data is read or any fit runs: empty when valid, else
 // the one-line reason (exit code 2).
@@ -178,7 +73,7 @@ ComparisonProgress ProgressOnStderr() {
                  n.evaluations, n.best_cf, n.elapsed_s);
     std::fflush(stderr);
   };
-  p.done = [](const std::string& label, const Row& row) {
+  p.done = [](const std::string& label, const ComparisonRow& row) {
     std::fprintf(stderr, "\r[%s] CF %.5f -> validation %.5f, %d evaluations, %.2f s%20s\n",
                  label.c_str(), row.cf_calibration, row.cf_validation, row.evaluations, row.wall_s,
                  "");
@@ -187,8 +82,8 @@ ComparisonProgress ProgressOnStderr() {
 }
 
 void PrintAndWrite(const CompareCommandOptions& options, const ComparisonRequest& r,
-                   const MethodComparison& c, const ParameterColumns& columns) {
-  const std::string markdown = Markdown(c.rows, columns);
+                   const MethodComparison& c, const ParameterDisplay& columns) {
+  const std::string markdown = ComparisonMarkdown(c.rows, columns);
   std::string counts;
   for (int k : r.counts) counts += (counts.empty() ? "" : " or ") + std::to_string(k);
   std::printf(
@@ -203,9 +98,9 @@ void PrintAndWrite(const CompareCommandOptions& options, const ComparisonRequest
   }
   std::printf("%s", markdown.c_str());
   if (!options.no_output) {
-    io::WriteFilesAtomically({{options.out + ".csv", Csv(c.rows, columns)},
+    io::WriteFilesAtomically({{options.out + ".csv", ComparisonCsv(c.rows, columns)},
                               {options.out + ".md", markdown},
-                              {options.out + "_trace.csv", TraceCsv(c.rows)}});
+                              {options.out + "_trace.csv", ComparisonTraceCsv(c.rows)}});
     std::printf("\nwrote %s.csv, %s.md, %s_trace.csv\n", options.out.c_str(), options.out.c_str(),
                 options.out.c_str());
   }
@@ -268,7 +163,7 @@ int RunCompareCommand(const CompareCommandOptions& options) {
       std::cerr << "fitcal compare: " << comparison.refusal << "\n";
       return 2;
     }
-    PrintAndWrite(options, request, comparison, ColumnsFor(request.model->robot()));
+    PrintAndWrite(options, request, comparison, ComparisonColumns(request.model->robot()));
     return 0;
   });
 }
