@@ -17,6 +17,7 @@
 #include "io/sample_checks.h"
 #include "io/text_file.h"
 #include "io/warnings.h"
+#include "odometry/text_format.h"
 
 namespace fitcal::io {
 
@@ -332,17 +333,11 @@ constexpr double kMaxAngleRad = 1e4;
 constexpr double kMaxTimeS = 1e10;
 constexpr double kMaxPositionM = 1e7;
 
-std::string Number(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.6g", v);
-  return text;
-}
-
 void CheckTimePlausible(double t_s, const std::string& path, int line_number) {
   if (std::abs(t_s) > kMaxTimeS) {
     throw InputError(InputErrorKind::kImplausibleValue, path, line_number,
-                     "time " + Number(t_s) + " s is not a plausible time (limit " +
-                         Number(kMaxTimeS) + " s; nanoseconds or microseconds instead of s?)");
+                     "time " + MessageNumber(t_s) + " s is not a plausible time (limit " +
+                         MessageNumber(kMaxTimeS) + " s; nanoseconds or microseconds instead of s?)");
   }
 }
 
@@ -392,10 +387,10 @@ void CheckSamplePlausible(const EncoderSamples& samples, const Robot& robot,
     }
     if (screened[static_cast<std::size_t>(c)]) continue;
     throw InputError(InputErrorKind::kImplausibleValue, path, line_number,
-                     "channel '" + robot.channels[c].name + "': " + Number(s.value[c]) +
+                     "channel '" + robot.channels[c].name + "': " + MessageNumber(s.value[c]) +
                          (angle ? " rad is not a physical angle (limit "
                                 : " rad/s is not a physical wheel rate (limit ") +
-                         Number(limit) + "; wrong units or a corrupted field?)");
+                         MessageNumber(limit) + "; wrong units or a corrupted field?)");
   }
 }
 
@@ -834,8 +829,8 @@ EncoderLog ReadEncoderCsv(const std::string& path, const Robot& robot) {
   const std::size_t gap = FindClockGap(log.samples, robot, &median_s);
   if (gap < log.samples.size()) {
     throw InputError(InputErrorKind::kClockGap, path, LineOfDataRow(path, gap + 1),
-                     "the clock jumps " + Number(log.samples[gap].dt_s) +
-                         " s (the log's median interval is " + Number(median_s) +
+                     "the clock jumps " + MessageNumber(log.samples[gap].dt_s) +
+                         " s (the log's median interval is " + MessageNumber(median_s) +
                          " s) while the wheels turn: a clock step or lost rows inside a moving "
                          "stretch; refused (cut the run into two runs there)");
   }
@@ -889,8 +884,8 @@ double YawOfTumRow(const double* row, const std::string& path, int line_number,
   const double error = std::abs(norm - 1.0);
   if (!(error <= kQuaternionNormTolerance)) {
     throw InputError(InputErrorKind::kBadValue, path, line_number,
-                     "quaternion is not a unit quaternion (norm " + Number(norm) +
-                         "; fitcal normalises within " + Number(kQuaternionNormTolerance) +
+                     "quaternion is not a unit quaternion (norm " + MessageNumber(norm) +
+                         "; fitcal normalises within " + MessageNumber(kQuaternionNormTolerance) +
                          " of 1, rounding, and refuses beyond)");
   }
   if (error > kQuaternionNormSilent) {
@@ -908,8 +903,8 @@ void CheckPosePlausible(const double* row, const std::string& path, int line_num
   CheckTimePlausible(row[0], path, line_number);
   if (std::abs(row[1]) > kMaxPositionM || std::abs(row[2]) > kMaxPositionM) {
     throw InputError(InputErrorKind::kImplausibleValue, path, line_number,
-                     "position (" + Number(row[1]) + ", " + Number(row[2]) +
-                         ") m is beyond any map (limit " + Number(kMaxPositionM) +
+                     "position (" + MessageNumber(row[1]) + ", " + MessageNumber(row[2]) +
+                         ") m is beyond any map (limit " + MessageNumber(kMaxPositionM) +
                          " m; wrong units or a corrupted field?)");
   }
 }
@@ -962,8 +957,8 @@ GroundTruthTrack ReadGroundTruthRows(TextFileReader& lines) {
   if (repairs.count > 0) {
     Warn(path, repairs.worst_line,
          std::to_string(repairs.count) + " quaternion(s) normalised, norm up to " +
-             Number(repairs.worst_error) + " from 1 (within the tolerance " +
-             Number(kQuaternionNormTolerance) + ")");
+             MessageNumber(repairs.worst_error) + " from 1 (within the tolerance " +
+             MessageNumber(kQuaternionNormTolerance) + ")");
   }
   return track;
 }

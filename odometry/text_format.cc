@@ -73,4 +73,6 @@ std::string StrFormatFinite(double value, const char* format, ...) {
   return text;
 }
 
+std::string MessageNumber(double value) { return StrFormat("%.6g", value); }
+
 }  // namespace fitcal

@@ -17,6 +17,9 @@ std::string StrFormat(const char* format, ...) __attribute__((format(printf, 1, 
 std::string StrFormatFinite(double value, const char* format, ...)
     __attribute__((format(printf, 2, 3)));
 
+// A number as a message quotes it: six significant digits ("%.6g"), as an input file showed it.
+std::string MessageNumber(double value);
+
 // One number through a format chosen at run time (a table's column format): `format` must hold
 // exactly one conversion of a double (%f, %e, %g, %a with flags, width and precision, no length
 // modifier) besides "%%"; anything else throws std::logic_error, in release builds too, so a

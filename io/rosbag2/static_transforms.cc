@@ -1,4 +1,5 @@
 #include "io/rosbag2/static_transforms.h"
+#include "odometry/text_format.h"
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -37,11 +38,8 @@ std::vector<std::string> Ancestors(const std::map<std::string, Edge>& parent_of,
   return up;
 }
 
-std::string Number(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.6g", std::abs(v) < 5e-13 ? 0.0 : v);
-  return text;
-}
+// A composed transform's rounding (1e-16) shown as 0, not as -2.77556e-17.
+std::string Number(double v) { return MessageNumber(std::abs(v) < 5e-13 ? 0.0 : v); }
 
 }  // namespace
 

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "io/input_error.h"
+#include "odometry/text_format.h"
 
 namespace fitcal::tricycle {
 
@@ -13,12 +14,6 @@ using io::InputError;
 using io::InputErrorKind;
 
 constexpr int kSteeringChannel = 1;
-
-std::string Number(double v) {
-  std::ostringstream out;
-  out << v;
-  return out.str();
-}
 
 bool IsMultipleOf(double v, double step) {
   const double n = v / step;
@@ -47,7 +42,7 @@ void Check(const double* values, std::size_t n, std::size_t stride, double step,
   if (ticks >= 0) {
     throw InputError(InputErrorKind::kBadValue, path, first_line + static_cast<int>(ticks),
                      std::string("the steering ") + what + " are whole numbers up to " +
-                         Number(values[static_cast<std::size_t>(ticks) * stride]) +
+                         MessageNumber(values[static_cast<std::size_t>(ticks) * stride]) +
                          ": encoder ticks, not an angle in rad (counts of an absolute encoder: "
                          "name the column ticks_steering and declare steering_encoder: "
                          "{ticks_per_rev: N, zero_tick: Z} in the robot YAML)");
@@ -57,7 +52,7 @@ void Check(const double* values, std::size_t n, std::size_t stride, double step,
     if (!(std::abs(v) <= M_PI)) {
       throw InputError(
           InputErrorKind::kBadValue, path, first_line + static_cast<int>(k),
-          std::string("steering ") + what + " " + Number(v) + " rad lies outside [-pi, pi]");
+          std::string("steering ") + what + " " + MessageNumber(v) + " rad lies outside [-pi, pi]");
     }
   }
 }
