@@ -20,10 +20,6 @@ using report_text::kAfterColour;  // the calibration's colour, as on the report'
 using report_text::kDeg;
 using report_text::Fmt;
 
-std::string ChangeText(double before, double after) {
-  return before > 0.0 ? Fmt("%+.1f %%", 100.0 * (after - before) / before) : "-";
-}
-
 // The residual: each held-out run's final position error in its start frame, before and after.
 std::string FinalErrorsSvg(const DiagnosePageData& d) {
   FinalErrorScatter s;
@@ -159,9 +155,9 @@ void HtmlHeldOut(std::ostringstream& h, const DiagnosePageData& d) {
   }
   h << "<h2 id=\"heldout\">Before and after on the held-out runs</h2>\n<ul class=\"key\">"
     << "<li>CF (Eq. 14, mean over " << d.held_out.size() << " runs): <b>" << Fmt("%.4f", cf_b)
-    << " &rarr; " << Fmt("%.4f", cf_a) << "</b> (" << ChangeText(cf_b, cf_a) << ")</li>"
+    << " &rarr; " << Fmt("%.4f", cf_a) << "</b> (" << report_text::ChangePercentText(cf_b, cf_a) << ")</li>"
     << "<li>ATE RMSE (no alignment): <b>" << Fmt("%.1f", 1e3 * ate_b) << " &rarr; "
-    << Fmt("%.1f mm", 1e3 * ate_a) << "</b> (" << ChangeText(ate_b, ate_a) << ")</li><li"
+    << Fmt("%.1f mm", 1e3 * ate_a) << "</b> (" << report_text::ChangePercentText(ate_b, ate_a) << ")</li><li"
     << (worse > 0 ? " class=\"worse\"" : "")
     << ">held-out runs that got worse (CF or ATE rose): " << worse << " of " << d.held_out.size()
     << "</li></ul>\n<p>These are computed as <code>fitcal "

@@ -375,7 +375,7 @@ void HtmlParameters(std::ostringstream& h, const ReportData& d) {
     h << "<tr><td>" << EscapeXml(p.name) << "</td><td>" << EscapeXml(p.unit) << "</td><td>"
       << Fmt(fmt, p.nominal * s) << "</td><td>" << Fmt(fmt, p.calibrated * s) << "</td><td>"
       << (p.has_sigma ? Fmt("%.2g", p.sigma * s) : "-") << "</td><td>"
-      << (p.held ? "-" : ChangeText(p)) << "</td><td"
+      << (p.held ? "-" : ParameterChangeText(p)) << "</td><td"
       << (p.held       ? " class=\"held\">held at nominal"
           : p.at_bound ? " class=\"worse\">AT BOUND"
                        : ">fitted")

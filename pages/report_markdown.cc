@@ -165,7 +165,7 @@ void MdParameters(std::ostringstream& m, const ReportData& d) {
                                       Fmt(fmt, p.nominal * s),
                                       Fmt(fmt, p.calibrated * s),
                                       p.has_sigma ? Fmt("%.2g", p.sigma * s) : "-",
-                                      p.held ? "-" : ChangeText(p),
+                                      p.held ? "-" : ParameterChangeText(p),
                                       p.held       ? "held at nominal"
                                       : p.at_bound ? "AT BOUND"
                                                    : "fitted"};

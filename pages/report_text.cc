@@ -20,7 +20,7 @@ double Improvement(double before, double after) {
 }
 
 std::string ChangePercentText(double before, double after) {
-  return Fmt("%+.1f %%", -Improvement(before, after));
+  return before > 0.0 ? Fmt("%+.1f %%", -Improvement(before, after)) : "-";
 }
 
 std::string RunsText(std::size_t n) { return std::to_string(n) + (n == 1 ? " run" : " runs"); }
@@ -79,7 +79,7 @@ std::string JsonNumber(double v) {
 
 double ParamScale(const ReportParameter& p) { return p.is_angle ? kDeg : 1.0; }
 
-std::string ChangeText(const ReportParameter& p) {
+std::string ParameterChangeText(const ReportParameter& p) {
   if (p.is_angle) return Fmt("%+.3f deg", (p.calibrated - p.nominal) * kDeg);
   return Fmt("%+.2f %%", p.nominal != 0.0 ? 100.0 * (p.calibrated - p.nominal) / p.nominal : 0.0);
 }

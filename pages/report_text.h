@@ -31,6 +31,7 @@ double Improvement(double before, double after);
 // Every % change on the page and in summary.md has one sign: 100 (after - before) / before, so
 // an error that shrank is negative (and green), a parameter that grew positive. metrics.json's
 // improvement_percent keeps Palacin Table 6's sign (positive = better) and says so in its name.
+// "-" when nothing was there before (before <= 0).
 std::string ChangePercentText(double before, double after);
 
 // "1 run", "3 runs" (issue 42: "validation: 1 runs").
@@ -57,7 +58,7 @@ std::string JsonNumber(double v);
 // A parameter's display scale (deg for angles) and its change: lengths by percent, angles by
 // degrees (a percentage of an angle means nothing).
 double ParamScale(const ReportParameter& p);
-std::string ChangeText(const ReportParameter& p);
+std::string ParameterChangeText(const ReportParameter& p);
 
 // The runs the error-along-time figures show: largest calibrated CF first, at most `most`.
 std::vector<std::size_t> WorstRuns(const ReportData& data, std::size_t most);
