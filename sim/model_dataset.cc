@@ -58,7 +58,7 @@ WrittenModelDataset WriteModelDataset(const ModelDatasetRequest& request) {
   written.model = NominalModel(request);
   const RobotModelInterface& model = *written.model;
   const Robot& robot = model.robot();
-  if (robot.model != request.model) {
+  if (!request.model.empty() && robot.model != request.model) {
     throw UsageError(request.robot + " is a " + robot.model + " robot, not " + request.model);
   }
   written.truth = TrueParameters(request, model);
@@ -66,25 +66,12 @@ WrittenModelDataset WriteModelDataset(const ModelDatasetRequest& request) {
   const std::vector<ModelSimulatedRun> runs =
       SimulateRuns(model, written.truth, scenario.trajectories, scenario.options);
   io::StagedDirectory staged(request.out);
-  WriteSimulatedDataset(staged.path(), model.RobotYaml(robot.nominal, ""), runs);
+  WriteSimulatedDataset(staged.path(), model.RobotYaml(robot.nominal, ""), runs, scenario.digits);
   io::WriteFileAtomically((fs::path(staged.path()) / "true_robot.yaml").string(),
                           model.RobotYaml(written.truth, ""));
   io::CommitDirectoryOutput(staged, request.out, io::kDatasetKind, request.force, {});
   written.num_runs = runs.size();
   return written;
-}
-
-std::size_t WriteFlowerDataset(const FlowerSimulation& flower, const std::string& out,
-                               bool force) {
-  RefuseOut(out, force);
-  const std::vector<ModelSimulatedRun> runs = SimulateFlower(flower);
-  // Written whole or not at all: staged beside `out`, renamed over it once complete.
-  io::StagedDirectory staged(out);
-  const RobotModelInterface& model = *flower.model;
-  WriteSimulatedDataset(staged.path(), model.RobotYaml(model.robot().nominal, ""), runs,
-                        EncoderCsvDigits::kRecorder);
-  io::CommitDirectoryOutput(staged, out, io::kDatasetKind, force, {});
-  return runs.size();
 }
 
 }  // namespace fitcal::sim
