@@ -16,7 +16,7 @@ int RunAsocSimulate(const AsocSimulateOptions& options) {
         options.out, options.force, options.seed, options.wheel_slip_sigma, options.excursions);
     std::printf(
         "wrote %zu ASOC runs (6 calibration holds, 10 UMBmark, %d excursions) to %s; the "
-        "true parameters are in truth.yaml\n",
+        "true parameters are in true_robot.yaml\n",
         num_runs, options.excursions, options.out.c_str());
     return 0;
   });

@@ -85,7 +85,7 @@ void WriteAsocDataset(const AsocSimulatedDataset& dataset, const std::string& di
     entries.push_back({run.id, run.trajectory, run.repetition, enc, gt});
   }
   io::WriteFileAtomically((out / "robot.yaml").string(), io::AsocRobotYaml(dataset.nominal));
-  io::WriteFileAtomically((out / "truth.yaml").string(), io::AsocRobotYaml(dataset.truth));
+  io::WriteFileAtomically((out / "true_robot.yaml").string(), io::AsocRobotYaml(dataset.truth));
   io::WriteFileAtomically((out / "dataset.yaml").string(), io::DatasetYaml("robot.yaml", entries));
 }
 

@@ -27,7 +27,8 @@ AsocSimulatedDataset SimulateAsocDataset(std::uint64_t seed, double wheel_slip_s
 
 // Writes `dataset` into `directory` (a staged directory: the caller renames it over --out once
 // complete): runs/<id>_encoders.csv and runs/<id>_ground_truth.csv per run, robot.yaml (the
-// nominal), truth.yaml and dataset.yaml. ASOC's encoder files are the model's own format
+// nominal), true_robot.yaml (the truth, named as every simulated data set names it) and
+// dataset.yaml. ASOC's encoder files are the model's own format
 // (models/asoc/asoc_files.h), so the command that calls this names no model.
 void WriteAsocDataset(const AsocSimulatedDataset& dataset, const std::string& directory);
 
