@@ -4,7 +4,6 @@
 #include <cstdio>
 #include <iostream>
 
-#include "io/staged_directory.h"
 #include "cli/dataset_command.h"
 #include "io/output_guard.h"
 #include "sim/asoc_scenarios.h"
@@ -13,22 +12,12 @@ namespace fitcal::tools {
 
 int RunAsocSimulate(const AsocSimulateOptions& options) {
   return RunReportingErrors("fitcal", [&]() -> int {
-    if (const std::string refusal =
-            io::DirectoryOutputRefusal(options.out, io::kDatasetKind, options.force, {});
-        !refusal.empty()) {
-      std::cerr << "fitcal: " << refusal << "\n";
-      return 2;
-    }
-    // Written whole or not at all: staged beside --out, renamed over it once complete.
-    io::StagedDirectory staged(options.out);
-    const sim::AsocSimulatedDataset simulated =
-        sim::SimulateAsocDataset(options.seed, options.wheel_slip_sigma, options.excursions);
-    sim::WriteAsocDataset(simulated, staged.path());
-    io::CommitDirectoryOutput(staged, options.out, io::kDatasetKind, options.force, {});
+    const std::size_t num_runs = sim::WriteSimulatedAsocDataset(
+        options.out, options.force, options.seed, options.wheel_slip_sigma, options.excursions);
     std::printf(
         "wrote %zu ASOC runs (6 calibration holds, 10 UMBmark, %d excursions) to %s; the "
-        "true parameters are in truth.yaml\n",
-        simulated.runs.size(), options.excursions, options.out.c_str());
+        "true parameters are in true_robot.yaml\n",
+        num_runs, options.excursions, options.out.c_str());
     return 0;
   });
 }

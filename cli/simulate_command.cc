@@ -25,14 +25,6 @@ effects::EffectValue ParseInjectedEffect(const std::string& text) {
   effects::EffectValue e;
   e.id = effects::EffectIdFromName(text.substr(0, eq));
   const effects::EffectInfo& info = effects::Info(e.id);
-  // The flower robot has three wheel channels: an effect on a steering angle or on a wheel pair
-  // would be written nowhere (a data set that silently lacks the effect asked for).
-  if (effects::NeedsAngleChannel(e.id) || effects::NeedsWheelPair(e.id)) {
-    throw std::invalid_argument(
-        "--inject '" + text + "': " + info.name +
-        " cannot act on the omni3 flower robot (it needs " +
-        (effects::NeedsWheelPair(e.id) ? "a pair of wheels" : "a steering angle") + ")");
-  }
   std::string rest = text.substr(eq + 1);
   for (int k = 0; k < info.num_parameters; ++k) {
     const std::size_t comma = rest.find(',');
@@ -69,64 +61,26 @@ void PrintTruth(const Robot& robot, const std::vector<double>& truth) {
   }
 }
 
-// --model: the generic simulator with the flags that apply to it.
-int RunModelSimulate(const SimulateCommandOptions& options) {
-  return RunReportingErrors("fitcal simulate", [&]() -> int {
-    if (!options.flower_only_flags.empty()) {
-      throw UsageError(options.flower_only_flags.front() +
-                       " belongs to the flower simulation (simulate without --model), not to "
-                       "--model " + options.model + " (docs/simulate.md)");
-    }
-    sim::ModelDatasetRequest r;
-    r.out = options.out;
-    r.model = options.model;
-    r.robot = options.robot_given ? options.robot : "";
-    r.truth = options.truth;
-    r.force = options.force;
-    r.noise.repetitions = options.repetitions;
-    r.noise.seed = options.seed;
-    r.noise.ticks_per_rev = options.encoder_counts_per_rev;
-    r.noise.wheel_rate_sigma_rad_s = options.wheel_rate_sigma_rad_s;
-    r.noise.angle_sigma_rad = options.angle_sigma_deg * M_PI / 180.0;
-    r.noise.gt_position_sigma_m = options.gt_position_sigma_m;
-    r.noise.gt_heading_sigma_rad = options.gt_heading_sigma_deg * M_PI / 180.0;
-    const sim::WrittenModelDataset written = sim::WriteModelDataset(r);
-    const Robot& robot = written.model->robot();
-    std::printf("wrote %zu runs of the %s robot '%s' (%d repetitions, seed %llu) to %s\n",
-                written.num_runs, robot.model.c_str(), robot.name.c_str(), r.noise.repetitions,
-                static_cast<unsigned long long>(r.noise.seed), options.out.c_str());
-    PrintTruth(robot, written.truth);
-    return 0;
-  });
-}
-
-// The flower of the flags: the nominal robot commands, the truth (--truth or Table 5) moves.
-sim::FlowerSimulation FlowerOf(const SimulateCommandOptions& options) {
-  sim::FlowerSimulation flower = sim::PalacinFlower();
-  flower.model = ReadRobotModelFile(options.robot);
-  const Robot& robot = flower.model->robot();
-  if (!ExtrasOf(robot.model).legacy_simulator) {
-    throw std::invalid_argument(options.robot +
-                                ": the flower simulator drives an omni3 robot, not " + robot.model +
-                                " (simulate --model " + robot.model + ")");
-  }
-  if (!options.truth.empty())
-    flower.true_parameters = ReadRobotModelFile(options.truth)->robot().nominal;
-  if (flower.true_parameters.size() != robot.nominal.size()) {
-    throw std::invalid_argument(options.truth + ": the true robot must be an omni3 robot");
-  }
-  flower.repetitions = options.repetitions;
-  sim::SimulationOptions& o = flower.options;
-  o = sim::FlowerSimulationOptions(robot.nominal);
-  o.seed = options.seed;
-  o.ticks_per_rev.assign(robot.channels.size(), options.encoder_counts_per_rev);
-  o.gt_position_sigma_m = options.gt_position_sigma_m;
-  o.gt_heading_sigma_rad = options.gt_heading_sigma_deg * M_PI / 180.0;
-  o.stepped->slip.sigma = options.slip_sigma;
+// The flags as a request of the library, which decides what the model's scenario takes.
+sim::ModelDatasetRequest RequestOf(const SimulateCommandOptions& options) {
+  sim::ModelDatasetRequest r;
+  r.out = options.out;
+  r.model = options.model;
+  r.robot = options.robot_given || options.model.empty() ? options.robot : "";
+  r.truth = options.truth;
+  r.force = options.force;
+  r.noise.repetitions = options.repetitions;
+  r.noise.seed = options.seed;
+  r.noise.ticks_per_rev = options.encoder_counts_per_rev;
+  r.noise.wheel_rate_sigma_rad_s = options.wheel_rate_sigma_rad_s;
+  r.noise.angle_sigma_rad = options.angle_sigma_deg * M_PI / 180.0;
+  r.noise.gt_position_sigma_m = options.gt_position_sigma_m;
+  r.noise.gt_heading_sigma_rad = options.gt_heading_sigma_deg * M_PI / 180.0;
+  if (options.slip_sigma_given) r.noise.slip_sigma = options.slip_sigma;
   for (const std::string& text : options.inject) {
-    o.stepped->injected_effects.push_back(ParseInjectedEffect(text));
+    r.noise.injected_effects.push_back(ParseInjectedEffect(text));
   }
-  return flower;
+  return r;
 }
 
 }  // namespace
@@ -135,11 +89,11 @@ void AddSimulateOptions(CLI::App& app, SimulateCommandOptions& o) {
   app.add_option("--out", o.out, "Output data set directory")->required();
   app.add_option(
       "--model", o.model,
-      "Robot model (" + sim::ScenarioModelNames() + "; default: the omni3 flower simulator)");
+      "Robot model (" + sim::ScenarioModelNames() + "; default: the --robot's model)");
   app.add_option("--robot", o.robot, "Nominal robot YAML (commands and fit start)")
       ->capture_default_str()
       ->check(CLI::ExistingFile);
-  app.add_option("--truth", o.truth, "Robot YAML of the true robot (default: Palacin Table 5)")
+  app.add_option("--truth", o.truth, "Robot YAML of the true robot (default: the scenario's, docs/simulate.md)")
       ->check(CLI::ExistingFile);
   app.add_option("--repetitions", o.repetitions, "Repetitions of each trajectory")
       ->capture_default_str()
@@ -152,9 +106,10 @@ void AddSimulateOptions(CLI::App& app, SimulateCommandOptions& o) {
   app.add_option("--gt-heading-sigma-deg", o.gt_heading_sigma_deg,
                  "Ground-truth heading noise (deg)")
       ->capture_default_str();
-  app.add_option("--slip-sigma", o.slip_sigma, "Relative wheel slip noise")->capture_default_str();
+  app.add_option("--slip-sigma", o.slip_sigma, "Relative wheel slip noise (stepped physics)")
+      ->capture_default_str();
   app.add_option("--wheel-rate-sigma-rad-s", o.wheel_rate_sigma_rad_s,
-                 "--model: white noise on each interval's mean wheel rate (rad/s)")
+                 "perfect tracking: white noise on each interval's mean wheel rate (rad/s)")
       ->capture_default_str();
   app.add_option("--angle-sigma-deg", o.angle_sigma_deg,
                  "--model: noise of an angle channel's readings, e.g. steering (deg)")
@@ -165,23 +120,19 @@ void AddSimulateOptions(CLI::App& app, SimulateCommandOptions& o) {
                  "the data set does not name it");
   app.callback([&app, &o] {
     o.robot_given = app.count("--robot") > 0;
-    for (const char* flag : {"--slip-sigma", "--inject"}) {
-      if (app.count(flag) > 0) o.flower_only_flags.push_back(flag);
-    }
+    o.slip_sigma_given = app.count("--slip-sigma") > 0;
   });
 }
 
 int RunSimulateCommand(const SimulateCommandOptions& options) {
-  // A model without a scenario of its own (ModelExtras::legacy_simulator: omni3) takes the flower.
-  if (!options.model.empty() && !ExtrasOf(options.model).legacy_simulator) {
-    return RunModelSimulate(options);
-  }
-  return RunReportingErrors("fitcal", [&]() -> int {
-    const sim::FlowerSimulation flower = FlowerOf(options);
-    const std::size_t num_runs = sim::WriteFlowerDataset(flower, options.out, options.force);
-    std::printf("wrote %zu runs (%zu trajectories x %d repetitions, seed %llu) to %s\n",
-                num_runs, flower.trajectories.size(), flower.repetitions,
-                static_cast<unsigned long long>(flower.options.seed), options.out.c_str());
+  return RunReportingErrors("fitcal simulate", [&]() -> int {
+    const sim::ModelDatasetRequest r = RequestOf(options);
+    const sim::WrittenModelDataset written = sim::WriteModelDataset(r);
+    const Robot& robot = written.model->robot();
+    std::printf("wrote %zu runs of the %s robot '%s' (%d repetitions, seed %llu) to %s\n",
+                written.num_runs, robot.model.c_str(), robot.name.c_str(), r.noise.repetitions,
+                static_cast<unsigned long long>(r.noise.seed), options.out.c_str());
+    PrintTruth(robot, written.truth);
     return 0;
   });
 }

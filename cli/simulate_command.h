@@ -1,7 +1,6 @@
 #pragma once
-// `fitcal simulate`: writes a simulated flower data set of an omni3 robot (docs/simulate.md;
-// sim/flower_scenario.h on the generic simulator) in the data set format; with --model, a
-// data set of another model; both written by sim/model_dataset.h.
+// `fitcal simulate`: writes a simulated calibration data set of the --model (default: the --robot's
+// model; omni3's scenario is Palacin's flower) through sim/model_dataset.h (docs/simulate.md).
 
 #include <cstdint>
 #include <string>
@@ -18,11 +17,10 @@ namespace fitcal::tools {
 
 struct SimulateCommandOptions {
   std::string out;
-  std::string
-      model;  // "" (or omni3): the flower (sim/flower_scenario.h); else model_simulate
+  std::string model;  // "": the --robot's model
   std::string robot = "data/robots/apr02.yaml";  // nominal robot: commands + fit start
   bool robot_given = false;  // --model: without --robot the model's registry example is nominal
-  std::string truth;         // robot YAML of the true robot; "" = Table 5
+  std::string truth;         // robot YAML of the true robot; "" = the scenario's default
   bool force = false;
   // Effects to inject, "name=v1[,v2]" with the registry's names and parameter order
   // (odometry/effects.h); the data set written names none of them.
@@ -32,11 +30,10 @@ struct SimulateCommandOptions {
   int encoder_counts_per_rev = 4096;
   double gt_position_sigma_m = 0.002;
   double gt_heading_sigma_deg = 0.2;
-  double slip_sigma = sim::SlipOptions{}.sigma;  // the flower only
-  // --model only (the flower has slip instead): sim/model_scenarios.h.
+  double slip_sigma = sim::SlipOptions{}.sigma;  // the stepped physics only
+  bool slip_sigma_given = false;
   double wheel_rate_sigma_rad_s = sim::ScenarioNoise{}.wheel_rate_sigma_rad_s;
   double angle_sigma_deg = sim::ScenarioNoise{}.angle_sigma_rad * 180.0 / M_PI;
-  std::vector<std::string> flower_only_flags;  // given flags that only the flower takes
 };
 
 // Declares every flag of `simulate` on its subcommand `app`, bound to `options`; once parsed, the

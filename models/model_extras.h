@@ -1,8 +1,8 @@
 #pragma once
 // What a model offers beyond the seam, registered with it (model_registry.h,
 // ModelRegistration::extras) from its own folder: the ROS 2 controllers it can be exported to,
-// the trajectories the simulator calibrates it on, how `compare` shows its parameters, and the
-// older simulator `simulate` still takes for it. Every field is optional. The commands ask the
+// the trajectories the simulator calibrates it on, how `compare` shows its parameters. Every field
+// is optional. The commands ask the
 // registry for these and never compare a model's name (STYLE.md habit 14).
 
 #include <functional>
@@ -62,6 +62,14 @@ struct SimulationScenario {
       const Robot& nominal, const std::vector<double>& truth, int repetitions)>
       trajectories;  // empty: the model has no scenario
   double truth_fraction = 0.25;
+  // The default true robot when a published one exists (omni3: Palacin Table 5); empty: the
+  // nominal moved truth_fraction of the way to its bounds.
+  std::function<std::vector<double>(const Robot& nominal)> default_truth;
+  // Driven through the time-stepped physics of a wheel controller (sim/stepped_run.h: lag, slip,
+  // jittered encoders, irregular ground truth; `--slip-sigma` and `--inject` act there) and the
+  // encoders written as a recorder writes them, instead of perfect tracking: how data/flower was
+  // made, and its bytes are reproduced so.
+  bool stepped_physics = false;
 };
 
 // How `compare` shows a row's parameters (its Markdown column and CSV columns).
@@ -77,9 +85,6 @@ struct ModelExtras {
   SimulationScenario scenario;
   // Empty: the parameters in display units (m, deg).
   std::function<ParameterDisplay(const Robot&)> display;
-  // `simulate` without --model drives it with the stepped flower engine
-  // (sim/flower_scenario.h) instead of a scenario: data/flower's bytes come from there.
-  bool legacy_simulator = false;
 };
 
 // A controller writer's notes, shared by the writers of every model.

@@ -8,6 +8,7 @@
 #include "io/dataset.h"
 #include "models/asoc/asoc_geometric.h"
 #include "odometry/parallel_for.h"
+#include "sim/model_dataset.h"
 #include "sim/stepped_run.h"
 
 namespace fitcal::sim {
@@ -84,8 +85,20 @@ void WriteAsocDataset(const AsocSimulatedDataset& dataset, const std::string& di
     entries.push_back({run.id, run.trajectory, run.repetition, enc, gt});
   }
   io::WriteFileAtomically((out / "robot.yaml").string(), io::AsocRobotYaml(dataset.nominal));
-  io::WriteFileAtomically((out / "truth.yaml").string(), io::AsocRobotYaml(dataset.truth));
+  io::WriteFileAtomically((out / "true_robot.yaml").string(), io::AsocRobotYaml(dataset.truth));
   io::WriteFileAtomically((out / "dataset.yaml").string(), io::DatasetYaml("robot.yaml", entries));
+}
+
+std::size_t WriteSimulatedAsocDataset(const std::string& out, bool force, std::uint64_t seed,
+                                      double wheel_slip_sigma, int excursions) {
+  std::size_t num_runs = 0;
+  WriteDatasetDirectory(out, force, [&](const std::string& directory) {
+    const AsocSimulatedDataset simulated =
+        SimulateAsocDataset(seed, wheel_slip_sigma, excursions);
+    WriteAsocDataset(simulated, directory);
+    num_runs = simulated.runs.size();
+  });
+  return num_runs;
 }
 
 DoebblerTables SimulateDoebblerTables(int sets, std::uint64_t seed, double wheel_slip_sigma,

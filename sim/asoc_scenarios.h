@@ -4,6 +4,7 @@
 // Tables I and II. Both reproduce the commands' outputs bit for bit: one generator per seed
 // (std::mt19937_64 seeded through SplitMix), drawn in the order written here.
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -26,9 +27,16 @@ AsocSimulatedDataset SimulateAsocDataset(std::uint64_t seed, double wheel_slip_s
 
 // Writes `dataset` into `directory` (a staged directory: the caller renames it over --out once
 // complete): runs/<id>_encoders.csv and runs/<id>_ground_truth.csv per run, robot.yaml (the
-// nominal), truth.yaml and dataset.yaml. ASOC's encoder files are the model's own format
+// nominal), true_robot.yaml (the truth, named as every simulated data set names it) and
+// dataset.yaml. ASOC's encoder files are the model's own format
 // (models/asoc/asoc_files.h), so the command that calls this names no model.
 void WriteAsocDataset(const AsocSimulatedDataset& dataset, const std::string& directory);
+
+// What `asoc-simulate` calls once: SimulateAsocDataset written to `out` whole or not at all
+// (sim/model_dataset.h WriteDatasetDirectory: UsageError for an `out` it may not write). Returns
+// the number of runs.
+std::size_t WriteSimulatedAsocDataset(const std::string& out, bool force, std::uint64_t seed,
+                                      double wheel_slip_sigma, int excursions);
 
 // Means over `sets` random parameter sets (each its own generator, seed ^ SplitMix(set)):
 // Table I, the mean absolute relative error [uncalibrated, calibrated] of r_c, r_w, d and the

@@ -43,48 +43,38 @@ std::vector<double> TrueParameters(const ModelDatasetRequest& request,
   return t.nominal;
 }
 
-void RefuseOut(const std::string& out, bool force) {
+}  // namespace
+
+void WriteDatasetDirectory(const std::string& out, bool force,
+                           const std::function<void(const std::string& directory)>& write) {
   if (const std::string refusal = io::DirectoryOutputRefusal(out, io::kDatasetKind, force, {});
       !refusal.empty()) {
     throw UsageError(refusal);
   }
+  io::StagedDirectory staged(out);
+  write(staged.path());
+  io::CommitDirectoryOutput(staged, out, io::kDatasetKind, force, {});
 }
-
-}  // namespace
 
 WrittenModelDataset WriteModelDataset(const ModelDatasetRequest& request) {
-  RefuseOut(request.out, request.force);
   WrittenModelDataset written;
-  written.model = NominalModel(request);
-  const RobotModelInterface& model = *written.model;
-  const Robot& robot = model.robot();
-  if (robot.model != request.model) {
-    throw UsageError(request.robot + " is a " + robot.model + " robot, not " + request.model);
-  }
-  written.truth = TrueParameters(request, model);
-  const ModelScenario scenario = MakeModelScenario(model, written.truth, request.noise);
-  const std::vector<ModelSimulatedRun> runs =
-      SimulateRuns(model, written.truth, scenario.trajectories, scenario.options);
-  io::StagedDirectory staged(request.out);
-  WriteSimulatedDataset(staged.path(), model.RobotYaml(robot.nominal, ""), runs);
-  io::WriteFileAtomically((fs::path(staged.path()) / "true_robot.yaml").string(),
-                          model.RobotYaml(written.truth, ""));
-  io::CommitDirectoryOutput(staged, request.out, io::kDatasetKind, request.force, {});
-  written.num_runs = runs.size();
+  WriteDatasetDirectory(request.out, request.force, [&](const std::string& directory) {
+    written.model = NominalModel(request);
+    const RobotModelInterface& model = *written.model;
+    const Robot& robot = model.robot();
+    if (!request.model.empty() && robot.model != request.model) {
+      throw UsageError(request.robot + " is a " + robot.model + " robot, not " + request.model);
+    }
+    written.truth = TrueParameters(request, model);
+    const ModelScenario scenario = MakeModelScenario(model, written.truth, request.noise);
+    const std::vector<ModelSimulatedRun> runs =
+        SimulateRuns(model, written.truth, scenario.trajectories, scenario.options);
+    WriteSimulatedDataset(directory, model.RobotYaml(robot.nominal, ""), runs, scenario.digits);
+    io::WriteFileAtomically((fs::path(directory) / "true_robot.yaml").string(),
+                            model.RobotYaml(written.truth, ""));
+    written.num_runs = runs.size();
+  });
   return written;
-}
-
-std::size_t WriteFlowerDataset(const FlowerSimulation& flower, const std::string& out,
-                               bool force) {
-  RefuseOut(out, force);
-  const std::vector<ModelSimulatedRun> runs = SimulateFlower(flower);
-  // Written whole or not at all: staged beside `out`, renamed over it once complete.
-  io::StagedDirectory staged(out);
-  const RobotModelInterface& model = *flower.model;
-  WriteSimulatedDataset(staged.path(), model.RobotYaml(model.robot().nominal, ""), runs,
-                        EncoderCsvDigits::kRecorder);
-  io::CommitDirectoryOutput(staged, out, io::kDatasetKind, force, {});
-  return runs.size();
 }
 
 }  // namespace fitcal::sim

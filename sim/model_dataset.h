@@ -1,26 +1,25 @@
 #pragma once
-// The data sets `fitcal simulate` writes (cli/simulate_command.cc reads the flags, calls one of
-// these and prints). `--model <name>`: a simulated calibration data set of any model with
-// calibration trajectories (sim/model_scenarios.h): the nominal robot (--robot, or the model's
-// registry example) commands the trajectories, a true robot (--truth, or the nominal moved part of
-// the way to its bounds) drives them, and the data set - robot.yaml (nominal), true_robot.yaml
-// (the truth, for checking a fit), dataset.yaml and the runs - is built in a temporary sibling
-// directory and renamed into place (io/staged_directory.h). Without --model: Palacin's flower
-// (sim/flower_scenario.h), written the same way.
+// The data set `fitcal simulate` writes (cli/simulate_command.cc reads the flags, calls this and
+// prints): a simulated calibration data set of any model with a scenario (sim/model_scenarios.h;
+// omni3's is Palacin's flower): the nominal robot (--robot, or the model's registry example)
+// commands the trajectories, a true robot (--truth, or the scenario's default) drives them, and the
+// data set - robot.yaml (nominal), true_robot.yaml (the truth, for checking a fit), dataset.yaml and
+// the runs - is built in a temporary sibling directory and renamed into place
+// (io/staged_directory.h).
 
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "models/model_interface.h"
-#include "sim/flower_scenario.h"
 #include "sim/scenario_noise.h"
 
 namespace fitcal::sim {
 
 struct ModelDatasetRequest {
   std::string out;
-  std::string model;
+  std::string model;  // "" = the robot's model
   std::string robot;  // "" = the model's registry example robot
   std::string truth;  // "" = the default true robot (model_scenarios.h)
   bool force = false;
@@ -33,15 +32,15 @@ struct WrittenModelDataset {
   std::size_t num_runs = 0;
 };
 
+// A data set directory written whole or not at all, as every simulated data set is: `out` is
+// refused by the overwrite rule (io/output_guard.h; UsageError) before anything is simulated,
+// `write` fills a staged sibling directory, which is then renamed over `out`.
+void WriteDatasetDirectory(const std::string& out, bool force,
+                           const std::function<void(const std::string& directory)>& write);
+
 // Throws UsageError for an `out` it may not write or a robot of another model,
 // std::invalid_argument for an unknown model or a truth that does not fit the robot; nothing is
 // written then.
 WrittenModelDataset WriteModelDataset(const ModelDatasetRequest& request);
-
-// The flower simulated and written to `out` (the encoders' digits as the recorder wrote them:
-// data/flower's bytes). Returns the number of runs. Throws UsageError for an `out` it may not
-// write; nothing is written then.
-std::size_t WriteFlowerDataset(const FlowerSimulation& flower, const std::string& out,
-                               bool force);
 
 }  // namespace fitcal::sim

@@ -4,6 +4,7 @@
 #include <functional>
 #include <stdexcept>
 
+#include "io/command_failure.h"
 #include "models/model_registry.h"
 
 namespace fitcal::sim {
@@ -22,6 +23,35 @@ std::string ModelNamesWith(const std::function<bool(const ModelExtras&)>& has) {
   return out;
 }
 
+// The stepped physics' own settings (ScenarioNoise: slip, injected effects), refused for a
+// scenario without it: perfect tracking has no slip and no substep the effects act on.
+void SetSteppedPhysics(const Robot& robot, const SimulationScenario& scenario,
+                       const ScenarioNoise& noise, SimulationOptions* o) {
+  if (!scenario.stepped_physics) {
+    if (noise.slip_sigma || !noise.injected_effects.empty()) {
+      throw UsageError(std::string(noise.slip_sigma ? "--slip-sigma" : "--inject") +
+                       " acts on the stepped physics of " +
+                       ModelNamesWith([](const ModelExtras& e) {
+                         return e.scenario.stepped_physics;
+                       }) + ", not on --model " + robot.model + " (docs/simulate.md)");
+    }
+    return;
+  }
+  for (const effects::EffectValue& e : noise.injected_effects) {
+    if (!robot.CanShow(e.id)) {
+      throw UsageError(std::string("--inject ") + effects::Info(e.id).name + ": the " + robot.model +
+                       " robot has no channel it acts on (it needs " +
+                       (effects::NeedsWheelPair(e.id) ? "a pair of wheels" : "a steering angle") +
+                       ")");
+    }
+  }
+  o->rest_after_s = 1.5;  // the controller's lag settles before the run ends
+  o->stepped.emplace();
+  o->stepped->commanded_parameters = robot.nominal;
+  if (noise.slip_sigma) o->stepped->slip.sigma = *noise.slip_sigma;
+  o->stepped->injected_effects = noise.injected_effects;
+}
+
 }  // namespace
 
 std::string ScenarioModelNames() {
@@ -36,9 +66,7 @@ ModelScenario MakeModelScenario(const RobotModelInterface& model, const std::vec
   if (!scenario.trajectories) {
     throw std::invalid_argument(
         "no calibration trajectories for model '" + robot.model + "' (simulate --model takes " +
-        ScenarioModelNames() + "; " +
-        ModelNamesWith([](const ModelExtras& e) { return e.legacy_simulator; }) +
-        " without --model)");
+        ScenarioModelNames() + ")");
   }
   ModelScenario out;
   out.trajectories = scenario.trajectories(robot, truth, noise.repetitions);
@@ -56,11 +84,15 @@ ModelScenario MakeModelScenario(const RobotModelInterface& model, const std::vec
   o.start_position_range_m = noise.start_position_range_m;
   o.random_start_heading = true;
   o.seed = noise.seed;
+  SetSteppedPhysics(robot, scenario, noise, &o);
+  if (scenario.stepped_physics) out.digits = EncoderCsvDigits::kRecorder;
   return out;
 }
 
 std::vector<double> DefaultTrueParameters(const Robot& robot) {
-  const double fraction = ExtrasOf(robot.model).scenario.truth_fraction;
+  const SimulationScenario& scenario = ExtrasOf(robot.model).scenario;
+  if (scenario.default_truth) return scenario.default_truth(robot);
+  const double fraction = scenario.truth_fraction;
   std::vector<double> p = robot.nominal;
   int moved = 0;
   for (int k = 0; k < robot.NumParameters(); ++k) {

@@ -16,10 +16,15 @@
 //   omni        Palacin's flower generalised to any wheel count (models/omni/omni_trajectories.h):
 //               R1..R12, G1..G12, B1..B12 (v = 0.35 m/s, 1 m, |omega| 0.35 rad/s) and one turn
 //               on the spot each way (S-ccw, S-cw), which excites the yaw alone.
+//   omni3       Palacin's flower, Table A1 as printed (models/omni3/omni3_extras.h), under the
+//               stepped physics (SteppedOptions in model_simulator.h: the controller lag's 1.5 s
+//               to settle after the last command, slip, jittered encoders, irregular ground
+//               truth), its encoders written as a recorder writes them: data/flower's bytes.
 //
 // The true robot (DefaultTrueParameters): every free parameter moved from its nominal value a
 // fraction f of the way to its upper bound (1st, 3rd, ... free parameter) or to its lower bound
-// (2nd, 4th, ...); parameters the model holds (gauge) stay nominal, since no data can move them.
+// (2nd, 4th, ...); parameters the model holds (gauge) stay nominal, since no data can move them;
+// a model with a published truth registers it instead (omni3: Palacin Table 5).
 // f = 1/4 for tricycle and omni; 1/40 for diff_drive, whose example robot then has E_d = 1.0048
 // and E_b = 1.0025 (UMBmark-sized: Borenstein & Feng's corrections are of this order, and larger
 // ones leave the nominal odometry of a 1 m square more than a quarter side from closing, which
@@ -46,10 +51,12 @@ namespace fitcal::sim {
 struct ModelScenario {
   std::vector<TrajectorySpec> trajectories;  // ordered by repetition, then trajectory
   SimulationOptions options;
+  EncoderCsvDigits digits = EncoderCsvDigits::kRoundTrip;
 };
 
 // The scenario for the model's robot; std::invalid_argument naming the models that have one when
-// the robot's model has none (omni3 drives the flower: flower_scenario.h).
+// the robot's model has none; UsageError for slip or injected effects outside the stepped physics
+// and for an effect the robot's channels cannot show.
 ModelScenario MakeModelScenario(const RobotModelInterface& model, const std::vector<double>& truth,
                                 const ScenarioNoise& noise);
 

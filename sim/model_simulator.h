@@ -5,7 +5,8 @@
 //
 // Two motion and noise models. With SimulationOptions::stepped, the flower's time-stepped physics
 // (SteppedOptions below: controller lag, slip, jittered encoders, irregular ground truth; the
-// shipped data/flower is made so, sim/flower_scenario.h). Without it, perfect tracking:
+// shipped data/flower is made so: omni3's scenario, sim/model_scenarios.h). Without it, perfect
+// tracking:
 //
 // - Commanded twist. Segments follow each other with raised-cosine ramps of ramp_time_s centred
 //   on every segment boundary (also from rest into the first segment and back to rest after the

@@ -4,7 +4,11 @@
 
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <vector>
+
+#include "odometry/effects.h"
 
 namespace fitcal::sim {
 
@@ -19,6 +23,11 @@ struct ScenarioNoise {
   double gt_position_sigma_m = 0.002;
   double gt_heading_sigma_rad = 0.2 * M_PI / 180.0;
   double start_position_range_m = 2.0;
+  // The stepped physics only (ModelExtras::scenario.stepped_physics; refused elsewhere): the
+  // wheel slip's sigma (unset: SlipOptions' default) and library effects the data set does not
+  // name.
+  std::optional<double> slip_sigma;
+  std::vector<effects::EffectValue> injected_effects;
 };
 
 // The registered models that have calibration trajectories (ModelExtras::scenario), sorted:

@@ -15,7 +15,7 @@
 
 #include "models/omni3/omni3_robot_model.h"
 #include "tests/test_files.h"
-#include "sim/flower_scenario.h"
+#include "tests/flower_scenario.h"
 
 namespace fitcal {
 namespace channel_order_check_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)

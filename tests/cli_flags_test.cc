@@ -78,7 +78,7 @@ std::vector<double> Captured(const std::string& text, const std::string& pattern
 
 // asoc-geometric (fit with the closed form alone, through its gate) writes the closed form with a
 // sigma for every parameter it measures, and each estimate is within 4 sigma of the simulator's
-// truth (truth.yaml; asoc_calibration_test checks the coverage over 90 vehicles: 99 % within 3
+// truth (true_robot.yaml; asoc_calibration_test checks the coverage over 90 vehicles: 99 % within 3
 // sigma, so 4 holds for these 18 on seed 3), and much closer to it than the nominal for the wheel
 // radii (drawn up to 4 % off). `fit` writes the same kind of sigma for r_c and beta when its gate
 // selects the closed form (before: 0).
@@ -91,7 +91,7 @@ TEST(AsocCommands, GeometricWritesEstimatesWithinTheirSigmasOfTheTruth) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(Has(r.out, "no fit: the robot's closed forms alone against the nominal")) << r.out;
   EXPECT_TRUE(Has(r.out, "result gate, CF on held-out runs (10):")) << r.out;
-  const io::AsocRobot truth = io::ReadAsocRobot(data + "/truth.yaml");
+  const io::AsocRobot truth = io::ReadAsocRobot(data + "/true_robot.yaml");
   const io::AsocRobot nominal = io::ReadAsocRobot(data + "/robot.yaml");
   const io::AsocRobot calibrated = io::ReadAsocRobot(out);
   const YAML::Node sigma = YAML::LoadFile(out)["calibration"]["sigma"];
@@ -142,7 +142,7 @@ TEST(AsocCommands, GeometricWritesEstimatesWithinTheirSigmasOfTheTruth) {
 }
 
 // asoc-geometric goes through fit's gate: a closed form that does not beat the nominal on the
-// held-out runs is not written. The nominal here is the simulator's truth (truth.yaml as
+// held-out runs is not written. The nominal here is the simulator's truth (true_robot.yaml as
 // robot.yaml), which no estimate from quantised hold runs can beat on the UMBmark circuits held
 // out (CF 0.0014 against the closed form's 0.0021 on seed 3); before the gate it was written.
 TEST(AsocCommands, GeometricRefusesAClosedFormThatDoesNotBeatTheNominal) {
@@ -150,7 +150,7 @@ TEST(AsocCommands, GeometricRefusesAClosedFormThatDoesNotBeatTheNominal) {
   const std::string data = tmp.Path("asoc"), out = tmp.Path("geo.yaml");
   ASSERT_EQ(RunFitcal(tmp, "asoc-simulate --out " + data + " --excursions 0 --seed 3").exit_code,
             0);
-  std::filesystem::copy_file(data + "/truth.yaml", data + "/robot.yaml",
+  std::filesystem::copy_file(data + "/true_robot.yaml", data + "/robot.yaml",
                              std::filesystem::copy_options::overwrite_existing);
   const FitcalRun r = RunFitcal(tmp, "asoc-geometric --logs " + data + " --out " + out);
   EXPECT_EQ(r.exit_code, 5) << r.out << r.err;

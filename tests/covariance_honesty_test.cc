@@ -13,7 +13,7 @@
 #include <cmath>
 
 #include "tests/omni3_fit_support.h"
-#include "sim/flower_scenario.h"
+#include "tests/flower_scenario.h"
 
 namespace fitcal {
 namespace {

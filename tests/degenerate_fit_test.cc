@@ -12,7 +12,7 @@
 #include "fit/run_split.h"
 #include "tests/omni3_fit_support.h"
 #include "tests/omni3_reference_replay.h"
-#include "sim/flower_scenario.h"
+#include "tests/flower_scenario.h"
 
 namespace fitcal {
 namespace {

@@ -13,7 +13,7 @@
 #include "fit/run_split.h"
 #include "fit/segment_cost.h"
 #include "models/omni3/omni3_robot_model.h"
-#include "sim/flower_scenario.h"
+#include "tests/flower_scenario.h"
 #include "tests/test_paths.h"
 
 namespace fitcal {

@@ -11,7 +11,7 @@
 #include "diagnosis/diagnose.h"
 #include "fit/run_split.h"
 #include "models/omni3/omni3_robot_model.h"
-#include "sim/flower_scenario.h"
+#include "tests/flower_scenario.h"
 #include "tests/test_paths.h"
 
 namespace fitcal {

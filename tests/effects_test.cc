@@ -16,7 +16,7 @@
 #include "models/omni3/omni3_kinematics.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "tests/omni3_reference_replay.h"
-#include "sim/flower_scenario.h"
+#include "tests/flower_scenario.h"
 #include "validation/statistics.h"
 #include "tests/test_paths.h"
 

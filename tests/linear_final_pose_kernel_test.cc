@@ -14,7 +14,7 @@
 
 #include "models/model_registry.h"
 #include "models/omni3/omni3_robot_model.h"
-#include "sim/flower_scenario.h"
+#include "tests/flower_scenario.h"
 
 namespace fitcal {
 namespace {

@@ -11,7 +11,7 @@
 #include "models/omni3/omni3_kinematics.h"
 #include "odometry/effects.h"
 #include "tests/omni3_reference_replay.h"
-#include "sim/flower_scenario.h"
+#include "tests/flower_scenario.h"
 
 namespace fitcal {
 namespace {

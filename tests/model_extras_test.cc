@@ -66,7 +66,8 @@ ParameterDisplay ToyColumns(const Robot&) {
 void RegisterToyWithExtras() {
   ModelRegistration toy = *FindModel(kToy);
   toy.extras.controllers = {{kController, "jazzy rolling", &ToyControllerParameters}};
-  toy.extras.scenario = {&ToyScenario, kTruthFraction};
+  toy.extras.scenario.trajectories = &ToyScenario;
+  toy.extras.scenario.truth_fraction = kTruthFraction;
   toy.extras.display = &ToyColumns;
   RegisterModel(toy);
 }

@@ -1,5 +1,5 @@
 // End-to-end recovery of known parameters by the Ceres fit (fit/model_fit.h) on data from
-// the flower simulation (sim/flower_scenario.h), with tolerances derived from the noise.
+// the flower simulation (tests/flower_scenario.h), with tolerances derived from the noise.
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 #include "fit/run_split.h"
 #include "tests/omni3_fit_support.h"
 #include "tests/omni3_reference_replay.h"
-#include "sim/flower_scenario.h"
+#include "tests/flower_scenario.h"
 
 namespace fitcal {
 namespace {

@@ -13,7 +13,7 @@
 
 #include "odometry/pose2.h"
 #include "models/omni/flower_trajectories.h"
-#include "sim/flower_scenario.h"
+#include "tests/flower_scenario.h"
 
 namespace fitcal::omni3 {
 namespace {

@@ -11,7 +11,7 @@
 #include "fit/final_pose_errors.h"
 #include "fit/strategies.h"
 #include "tests/omni3_fit_support.h"
-#include "sim/flower_scenario.h"
+#include "tests/flower_scenario.h"
 
 namespace fitcal {
 namespace {

@@ -10,7 +10,7 @@
 #include <complex>
 #include <random>
 
-#include "sim/flower_scenario.h"
+#include "tests/flower_scenario.h"
 
 namespace fitcal::omni3 {
 namespace omni3_replay_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)

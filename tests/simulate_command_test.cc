@@ -120,29 +120,86 @@ TEST(SimulateCommand, WritesTheDataSetDirectoryAtomically) {
   }
 }
 
+// Usage errors (exit 2, one line, nothing written): slip and injected effects outside the
+// stepped physics (perfect tracking has neither), effects the robot's channels cannot show, a
+// robot of another model than --model.
 TEST(SimulateCommand, RefusesWhatTheModelSimulatorDoesNotTake) {
   TempDir dir;
   const std::string data = dir.Path("data");
   for (const std::string& args :
-       {std::string("--model diff_drive --slip-sigma 0.01"), std::string("--model asoc"),
+       {std::string("--model diff_drive --slip-sigma 0.01"),
+        std::string("--model tricycle --inject yaw_rate_slip=0.1"),
         std::string("--model omni --robot ") + FITCAL_SOURCE_DIR + "/data/robots/apr02.yaml",
         // Effects the three-wheeled flower robot has no channel for.
-        std::string("--robot ") + FITCAL_SOURCE_DIR + "/data/robots/apr02.yaml --inject " +
-            "pivot_yaw_gain=0.01",
+        std::string("--model omni3 --inject pivot_yaw_gain=0.01"),
         std::string("--robot ") + FITCAL_SOURCE_DIR + "/data/robots/apr02.yaml --inject " +
             "steering_scale=0.01"}) {
     SCOPED_TRACE(args);
     const Result r = RunFitcal(dir, "simulate " + args + " --out " + data);
-    EXPECT_NE(r.exit_code, 0);
+    EXPECT_EQ(r.exit_code, 2) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
     EXPECT_FALSE(fs::exists(data));
   }
+  const Result r = RunFitcal(dir, "simulate --model asoc --out " + data);
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(fs::exists(data));
+}
+
+// The ground-truth stamps of a run, from its CSV's first column.
+std::vector<double> GroundTruthTimes(const std::string& path) {
+  std::vector<double> t;
+  const std::string text = ReadFileBytes(path);
+  for (std::size_t at = text.find('\n'); at != std::string::npos && at + 1 < text.size();
+       at = text.find('\n', at + 1)) {
+    t.push_back(std::strtod(text.c_str() + at + 1, nullptr));
+  }
+  return t;
+}
+
+// --inject and --slip-sigma reach omni3's stepped physics through --model as without it. A
+// time_offset of tau stamps each ground-truth pose tau late (odometry/effects.h) and draws nothing,
+// so every stamp moves by exactly tau; the stamps are written with 6 decimals, hence 1e-6.
+// --slip-sigma 0 takes the slip out: the wheels roll as counted, so the ground truth moves.
+TEST(SimulateCommand, TheFlowerTakesInjectedEffectsAndSlipThroughModel) {
+  TempDir dir;
+  const std::string plain = dir.Path("plain"), late = dir.Path("late"), grip = dir.Path("grip");
+  const std::string common = " --repetitions 1 --seed 4 --out ";
+  ASSERT_EQ(RunFitcal(dir, "simulate --model omni3" + common + plain).exit_code, 0);
+  ASSERT_EQ(RunFitcal(dir, "simulate --model omni3 --inject time_offset=0.05" + common + late)
+                .exit_code,
+            0);
+  ASSERT_EQ(RunFitcal(dir, "simulate --model omni3 --slip-sigma 0" + common + grip).exit_code, 0);
+  const std::vector<double> t0 = GroundTruthTimes(plain + "/runs/R1-rep01_ground_truth.csv");
+  const std::vector<double> t1 = GroundTruthTimes(late + "/runs/R1-rep01_ground_truth.csv");
+  ASSERT_EQ(t0.size(), t1.size());
+  ASSERT_GT(t0.size(), 10u);
+  for (std::size_t i = 0; i < t0.size(); ++i) EXPECT_NEAR(t1[i] - t0[i], 0.05, 1e-6) << i;
+  EXPECT_TRUE(ReadFileBytes(late + "/runs/R1-rep01_encoders.csv") ==
+              ReadFileBytes(plain + "/runs/R1-rep01_encoders.csv"));
+  EXPECT_TRUE(ReadFileBytes(grip + "/runs/R1-rep01_ground_truth.csv") !=
+              ReadFileBytes(plain + "/runs/R1-rep01_ground_truth.csv"));
+}
+
+// Without --model the --robot's model is simulated: a differential drive's robot YAML gives its
+// own scenario's data set (UMBmark squares and circles), the robot written as given.
+TEST(SimulateCommand, WithoutModelTheRobotFileChoosesIt) {
+  TempDir dir;
+  const std::string example = dir.Path("example"), data = dir.Path("data");
+  ASSERT_EQ(RunFitcal(dir, "simulate --model diff_drive --repetitions 1 --out " + example)
+                .exit_code,
+            0);
+  const Result r =
+      RunFitcal(dir, "simulate --robot " + example + "/robot.yaml --repetitions 1 --out " + data);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(ReadFileBytes(data + "/robot.yaml"), ReadFileBytes(example + "/robot.yaml"));
+  EXPECT_TRUE(fs::exists(data + "/runs/square-cw-rep01_encoders.csv"));
 }
 
 // data/flower was written by `fitcal simulate --out data/flower --robot data/robots/apr02.yaml
 // --repetitions 10 --seed 1` (docs/simulate.md) with the omni3-only simulator this command no
 // longer has; the generic simulator (the omni3 model through the seam, the flower's stepped
-// physics: sim/flower_scenario.h) regenerates it. Run i draws from its own generator seeded
+// physics: tests/flower_scenario.h) regenerates it. Run i draws from its own generator seeded
 // by (seed, i), so two repetitions with the same seed must reproduce the first 72 runs' files,
 // the robot and the first 72 entries of dataset.yaml exactly.
 TEST(SimulateCommand, RegeneratesTheShippedFlowerByteForByte) {
@@ -165,6 +222,15 @@ TEST(SimulateCommand, RegeneratesTheShippedFlowerByteForByte) {
   const std::string index = ReadFileBytes(data + "/dataset.yaml");
   EXPECT_EQ(std::count(index.begin(), index.end(), '\n'), 2 + 72);
   EXPECT_EQ(index, ReadFileBytes(source + "flower/dataset.yaml").substr(0, index.size()));
+  // The truth beside it (data/flower predates true_robot.yaml and is kept as shipped): Palacin
+  // Table 5, as printed (R m, r m, delta deg).
+  const Robot truth = ReadRobotModelFile(data + "/true_robot.yaml")->robot();
+  const double table5[9] = {0.218643, 0.215735, 0.216287, 0.155068, 0.151534,
+                            0.152728, 59.7397,  179.6820, 301.5735};
+  ASSERT_EQ(truth.NumParameters(), 9);
+  for (int k = 0; k < 9; ++k) {
+    EXPECT_NEAR(truth.nominal[k] * truth.parameters[k].DisplayScale(), table5[k], 1e-9) << k;
+  }
 }
 
 }  // namespace

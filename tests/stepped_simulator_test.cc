@@ -15,7 +15,7 @@
 
 #include "models/model_registry.h"
 #include "tests/model_support.h"
-#include "sim/flower_scenario.h"
+#include "tests/flower_scenario.h"
 #include "sim/model_scenarios.h"
 #include "sim/model_simulator.h"
 

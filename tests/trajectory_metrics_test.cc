@@ -9,7 +9,7 @@
 
 #include "fit/effect_fit.h"
 #include "models/omni3/omni3_robot_model.h"
-#include "sim/flower_scenario.h"
+#include "tests/flower_scenario.h"
 
 namespace fitcal {
 namespace {

@@ -157,24 +157,6 @@ BodyStep<T> CastStep(const std::array<PivotPosition, kNumCastors>& pivots, Casto
   return step;
 }
 
-// CAST replay of a whole log from `start` with the flat castor parameters p (templated: the Ceres
-// fit differentiates through it). Returns the final pose of the body origin.
-template <typename T>
-Pose2<T> ReplayCastFinalPose(const T* p, const std::array<PivotPosition, kNumCastors>& pivots,
-                             CastorMask mask, bool midpoint_linearisation,
-                             const EncoderSample* samples, std::size_t n, const Pose2<T>& start) {
-  Pose2<T> pose = start;
-  T dx[kNumCastors], dy[kNumCastors];
-  for (std::size_t k = 1; k < n; ++k) {
-    PivotDisplacements(p, samples[k - 1], samples[k], pose.theta, dx, dy);
-    const BodyStep<T> step = CastStep(pivots, mask, midpoint_linearisation, pose.theta, dx, dy);
-    pose.x += step.dx_m;
-    pose.y += step.dy_m;
-    pose.theta += step.dpsi_rad;
-  }
-  return pose;
-}
-
 // The redundancy check (Doebbler Sec. III-B, end; header above): the castor whose displacement
 // (dx_i, dy_i) disagrees with the CAST prediction of the other two by more than
 // tolerance_m + tolerance_fraction * (the step length), or -1. psi: the heading the displacements
@@ -250,8 +232,8 @@ struct OdometryOptions {
   }
 };
 
-// Incremental odometry over a stream of encoder samples (double). For the Ceres fit use
-// ReplayCastFinalPose, which runs the same CAST arithmetic on any scalar.
+// Incremental odometry over a stream of encoder samples (double): the paper's replay, which the
+// simulator's UMBmark (Tables I-II) runs; fits replay through the seam (asoc_kinematics.h).
 class Odometry {
  public:
   Odometry(const Vehicle& vehicle, const OdometryOptions& options, const Pose2d& start,

@@ -53,7 +53,8 @@ ModelExtras DiffDriveExtras() {
   extras.controllers = {{"diff_drive_controller", "humble jazzy rolling", &DiffDriveParameters}};
   // UMBmark-sized: a larger error leaves a 1 m square too far from closing for UMBmark
   // (sim/model_scenarios.h).
-  extras.scenario = {&DiffDriveScenario, 0.025};
+  extras.scenario.trajectories = &DiffDriveScenario;
+  extras.scenario.truth_fraction = 0.025;
   return extras;
 }
 

@@ -269,7 +269,7 @@ ModelExtras OmniExtras() {
   ModelExtras extras;
   extras.controllers = {{"mecanum_drive_controller", "humble jazzy rolling", &MecanumParameters},
                         OmniWheelController(OmniWheelReplay::kControllerGeometry)};
-  extras.scenario = {&OmniScenario, 0.25};
+  extras.scenario.trajectories = &OmniScenario;
   return extras;
 }
 

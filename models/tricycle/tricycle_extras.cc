@@ -101,7 +101,7 @@ std::vector<sim::TrajectorySpec> TricycleScenario(const Robot& robot,
 ModelExtras TricycleExtras() {
   ModelExtras extras;
   extras.controllers = {{"tricycle_controller", "humble jazzy rolling", &TricycleParameters}};
-  extras.scenario = {&TricycleScenario, 0.25};
+  extras.scenario.trajectories = &TricycleScenario;
   return extras;
 }
 

@@ -14,7 +14,7 @@
 #include "fit/model_nlopt_fit.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "odometry/aligned_run.h"
-#include "sim/flower_scenario.h"
+#include "tests/flower_scenario.h"
 
 namespace fitcal {
 namespace {
