@@ -247,6 +247,104 @@ TEST(CorpusNeighbours, EditedCorrelationsAreValidatedWithFileAndLine) {
   }
 }
 
+// probe45: a key of an edited calibration block that no fitcal writer writes is a typo whose
+// value would be ignored in silence (`at_bounds: [r_left]` leaves the bound unsaid); a
+// before/after map without one of its keys read as yaml-cpp's "invalid node" with no file or
+// line. Each is refused at its line by every reader of the block (report, export), nothing
+// written; the file as fit wrote it reads.
+TEST(CorpusNeighbours, EditedCalibrationKeysNoWriterWritesAreRefusedAtTheirLine) {
+  const TempDir dir;
+  const std::string data = SimulateDiffDrive(dir, "data");
+  const std::string cal = dir.Path("cal.yaml");
+  ASSERT_EQ(RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --out " + cal).exit_code, 0);
+  const std::string text = ReadFileBytes(cal);
+  struct Case {
+    std::string from, to, says;
+  };
+  for (const Case& c : std::vector<Case>{
+           {"  at_bound: []", "  at_bounds: [r_left]", "unknown key 'at_bounds' in calibration"},
+           {"  method: ceres", "  methd: ceres", "misspelt 'method'"},
+           {"cf_training: {before:", "cf_training: {befor:", "in calibration.cf_training"}}) {
+    SCOPED_TRACE(c.to);
+    std::string edited_text = text;
+    const std::size_t at = text.find(c.from);
+    ASSERT_NE(at, std::string::npos) << text;
+    edited_text.replace(at, c.from.size(), c.to);
+    const int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + at, '\n'));
+    const std::string edited = dir.Write("edited.yaml", edited_text);
+    const std::string rep = dir.Path("rep");
+    const std::string ctl = dir.Path("ctl.yaml");
+    for (const std::string& command :
+         {"report --logs " + data + " --calibration " + edited + " --out " + rep,
+          "export ros2-control --controller diff_drive_controller --calibration " + edited +
+              " --logs " + data + " --out " + ctl}) {
+      const FitcalRun r = RunFitcal(dir, command);
+      EXPECT_EQ(r.exit_code, 1) << command << r.out << r.err;
+      EXPECT_EQ(Lines(r.err), 1) << r.err;
+      EXPECT_TRUE(Has(r.err, edited + ":" + std::to_string(line) + ":")) << r.err << line;
+      EXPECT_TRUE(Has(r.err, c.says)) << r.err;
+    }
+    EXPECT_FALSE(fs::exists(rep));
+    EXPECT_FALSE(fs::exists(ctl));
+  }
+  // Every key a writer adds reads back: fit's block, and export's odometry_covariance in it.
+  const std::string with_covariance = dir.Path("cal_cov.yaml");
+  ASSERT_EQ(RunFitcal(dir, "export ros2-control --controller diff_drive_controller --calibration " +
+                               cal + " --logs " + data + " --out " + dir.Path("ctl.yaml") +
+                               " --calibration-out " + with_covariance)
+                .exit_code,
+            0);
+  for (const std::string& written : {cal, with_covariance}) {
+    const FitcalRun r = RunFitcal(dir, "report --logs " + data + " --calibration " + written +
+                                           " --out " + dir.Path("rep"));
+    EXPECT_EQ(r.exit_code, 0) << written << r.err;
+  }
+}
+
+// probe45: options a command would drop, or refuse as bad data rather than as a usage error.
+// generalise --train-reps naming no repetition of the data set (or every one) printed the tables
+// without the repetition split asked for, exit 0; export --publish-rate and --allow-worse without
+// --logs (no replay to apply them to) wrote the file, exit 0; a --train-trajectories that is not
+// a regular expression was exit 1; --tie of the ground truth's mount with a wheel's geometry
+// (both in metres) fitted one value for both. Each: exit 2, one line, nothing written.
+TEST(CorpusNeighbours, OptionsThatWouldBeDroppedAreUsageErrors) {
+  const TempDir dir;
+  const std::string data = SimulateDiffDrive(dir, "data");
+  const std::string cal = dir.Path("cal.yaml");
+  ASSERT_EQ(RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --out " + cal).exit_code, 0);
+  std::string robot = ReadFileBytes(data + "/robot.yaml");
+  const std::size_t bounds = robot.find("bounds:");
+  ASSERT_NE(bounds, std::string::npos) << robot;
+  robot.insert(bounds, "ground_truth_frame: {x_m: 0.0, y_m: 0.0, yaw_deg: 0.0}\n");
+  WriteFileBytes(data + "/robot.yaml", robot);
+  const std::string out = dir.Path("out.yaml");
+  struct Case {
+    std::string command, says;
+  };
+  for (const Case& c : std::vector<Case>{
+           {"generalise --logs " + data + " --train-reps 7",
+            "--train-reps 7: no run of the data set is of repetition 7"},
+           {"generalise --logs " + data + " --train-reps 1-2", "none left to test on"},
+           {"export ros2-control --controller diff_drive_controller --calibration " + cal +
+                " --publish-rate 50 --out " + out,
+            "--publish-rate requires --logs"},
+           {"export ros2-control --controller diff_drive_controller --calibration " + cal +
+                " --allow-worse --out " + out,
+            "--allow-worse requires --logs"},
+           {"fit --logs " + data + " --train-trajectories '([' --out " + out,
+            "nor a valid regular expression"},
+           {"fit --logs " + data + " --train-reps 1 --tie ground_truth_x,wheel_separation --out " +
+                out,
+            "mixes the ground truth's mount with the robot's geometry"}}) {
+    SCOPED_TRACE(c.command);
+    const FitcalRun r = RunFitcal(dir, c.command);
+    EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
+    EXPECT_TRUE(Has(r.err, c.says)) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
 const char* kDiffYaml = R"(model: diff_drive
 name: r1
 wheels:
