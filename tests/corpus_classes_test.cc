@@ -850,5 +850,35 @@ TEST(CorpusNeighbours, FleetRefusesOneNameForTwoWheelLayouts) {
   EXPECT_TRUE(Has(r.err, "robot 'r1' has parameters")) << r.err;
 }
 
+// probe45: fleet kept the first of two calibrations of one robot and date and dropped the other
+// unsaid (r_right 0.042 charted, 0.043 gone, n = 1, exit 0); a metrics.json without parameters
+// ended in "basic_string::substr" with no file. Now two results of one date must agree (a file
+// found twice, a calibration and its report count once), else both files are named, exit 1.
+TEST(CorpusNeighbours, FleetKeepsOneResultPerRobotAndDateOrSaysWhy) {
+  const TempDir dir;
+  std::string other = kDiffYaml;
+  other.replace(other.find("radius_m: 0.042"), 15, "radius_m: 0.043");
+  const std::string a = dir.Write("fleet/r1/2026-05-01/a/cal.yaml", kDiffYaml);
+  const std::string b = dir.Write("fleet/r1/2026-05-01/b/cal.yaml", other);
+  const FitcalRun two = RunFitcal(dir, "fleet " + a + " " + b);
+  EXPECT_EQ(two.exit_code, 1) << two.out << two.err;
+  EXPECT_EQ(Lines(two.err), 1) << two.err;
+  EXPECT_TRUE(Has(two.err, b + ": robot 'r1' has two results dated 2026-05-01: r_right 0.043"))
+      << two.err;
+  EXPECT_TRUE(Has(two.err, "0.042 in " + a)) << two.err;
+
+  const FitcalRun twice = RunFitcal(dir, "fleet " + a + " " + a);
+  EXPECT_EQ(twice.exit_code, 0) << twice.err;
+  EXPECT_TRUE(Has(twice.out, "  r_right                m        1  2026-05-01")) << twice.out;
+
+  const std::string empty = dir.Write("fleet/r2/2026-05-01/report/metrics.json",
+                                      "{\"version\": 2, \"robot\": \"r2\", \"parameters\": []}\n");
+  const FitcalRun nothing = RunFitcal(dir, "fleet " + empty);
+  EXPECT_EQ(nothing.exit_code, 1) << nothing.out << nothing.err;
+  EXPECT_EQ(Lines(nothing.err), 1) << nothing.err;
+  EXPECT_TRUE(Has(nothing.err, empty + ":1: a metrics.json without a calibrated parameter"))
+      << nothing.err;
+}
+
 }  // namespace
 }  // namespace fitcal
