@@ -1,5 +1,6 @@
 #include "io/calibration_yaml.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "io/input_error.h"
@@ -83,6 +84,7 @@ void ReadUncertainty(const YAML::Node& block, const std::string& path, Calibrati
                        "calibration.sigma." + key + ": not a finite non-negative number");
     }
     p->sigma.emplace_back(key, value);
+    p->sigma_lines.push_back(node.Mark().line + 1);
   };
   for (const auto& entry : sigma) {
     const std::string key = YamlString(entry.first, path, "calibration.sigma");
@@ -225,6 +227,7 @@ std::optional<CalibrationProvenance> ReadCalibrationProvenance(const std::string
   if (!block || block.IsNull()) return std::nullopt;
   RejectKeysNoWriterWrites(block, path);
   CalibrationProvenance p;
+  p.path = path;
   if (const std::optional<std::vector<int>> reps = ReadCalibrationTrainingRepetitions(path)) {
     p.training_repetitions = *reps;
   }
@@ -263,6 +266,19 @@ bool RecordedKeyMatches(const std::string& key, const ParameterInfo& info) {
 std::vector<double> RecordedSigmas(const CalibrationProvenance& provenance,
                                    const std::vector<ParameterInfo>& parameters) {
   const auto& recorded = provenance.sigma;
+  for (std::size_t r = 0; r < recorded.size(); ++r) {
+    if (std::any_of(parameters.begin(), parameters.end(), [&](const ParameterInfo& info) {
+          return RecordedKeyMatches(recorded[r].first, info);
+        })) {
+      continue;
+    }
+    std::string keys;
+    for (const ParameterInfo& info : parameters) keys += (keys.empty() ? "" : ", ") + info.KeyName();
+    throw InputError(InputErrorKind::kUnknownKey, provenance.path,
+                     r < provenance.sigma_lines.size() ? provenance.sigma_lines[r] : 0,
+                     "calibration.sigma: '" + recorded[r].first +
+                         "' names no parameter of this robot (its keys: " + keys + ")");
+  }
   if (recorded.size() != parameters.size()) return {};
   std::vector<double> sigma(parameters.size());
   for (std::size_t k = 0; k < parameters.size(); ++k) {
