@@ -25,14 +25,15 @@ std::string MiswiredChannels(const CalibrationRequest& request, const RobotModel
 }  // namespace
 
 std::string StillTrainingRunsRefusal(const std::string& dataset, const std::vector<RunLog>& runs,
-                                     const std::vector<std::string>& training_ids) {
+                                     const std::vector<std::string>& training_ids,
+                                     const Robot& robot) {
   std::vector<RunLog> training_logs;
   for (const std::string& id : training_ids) {
     for (const RunLog& log : runs) {
       if (log.id == id) training_logs.push_back(log);
     }
   }
-  const std::string still = StillRunsRefusal(training_logs);
+  const std::string still = StillRunsRefusal(training_logs, robot);
   return still.empty() ? still : dataset + ": " + still;
 }
 
@@ -41,7 +42,8 @@ int CheckBeforeFitting(const CalibrationRequest& request, const RobotModelInterf
                        std::string* reason) {
   std::vector<std::string> training_ids;
   for (const AlignedRun& run : split.training) training_ids.push_back(run.id);
-  if (std::string still = StillTrainingRunsRefusal(request.dataset, request.runs, training_ids);
+  if (std::string still =
+          StillTrainingRunsRefusal(request.dataset, request.runs, training_ids, model.robot());
       !still.empty()) {
     *reason = std::move(still);
     return 1;

@@ -15,7 +15,8 @@ namespace fitcal {
 // (diagnosis/degenerate_data.h StillRunsRefusal): "" or the refusal's one line, `dataset: ...`
 // (exit 1). Every command that fits training runs asks it: fit and diagnose.
 std::string StillTrainingRunsRefusal(const std::string& dataset, const std::vector<RunLog>& runs,
-                                     const std::vector<std::string>& training_ids);
+                                     const std::vector<std::string>& training_ids,
+                                     const Robot& robot);
 
 // 0 to go on (with the data's warnings appended to *warnings); else the exit code, with the
 // refusal's reason in *reason.

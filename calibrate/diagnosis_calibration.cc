@@ -157,7 +157,8 @@ DiagnosisCalibration CalibrateOnDiagnosis(const DiagnosisCalibrationRequest& req
   // value (on a simulated drive it went to the bounds) and the gate's choice is noise.
   std::vector<std::string> training_ids;
   for (const TrackRun& run : split.training) training_ids.push_back(run.aligned.id);
-  if (std::string still = StillTrainingRunsRefusal(request.dataset, *request.runs, training_ids);
+  if (std::string still =
+          StillTrainingRunsRefusal(request.dataset, *request.runs, training_ids, model.robot());
       !still.empty()) {
     out.refusal = {1, {std::move(still)}};
     return out;

@@ -28,6 +28,21 @@ constexpr std::pair<const char*, const char*> kOutputFiles[] = {{".csv", kCompar
                                                                {".md", kComparisonMarkdownStart},
                                                                {"_trace.csv", kComparisonTraceStart}};
 
+// A solver flag none of the methods asked for uses (--seed with Ceres methods only, --loss with
+// NLopt ones only): refused as fit refuses it, since each fit would run without it.
+std::string SolverFlagOfNoMethodAsked(const CompareCommandOptions& options,
+                                      const std::vector<const FitMethod*>& methods) {
+  bool ceres = false;
+  bool nlopt = false;
+  std::string names;
+  for (const FitMethod* m : methods) {
+    (IsCeresMethod(m->name) ? ceres : nlopt) = true;
+    names += (names.empty() ? "" : " ") + m->name;
+  }
+  return SolverFlagThatDoesNotApply(options, CompareCommandOptions(), ceres, nlopt,
+                                    "--methods " + names);
+}
+
 // What the user typed, checked before any data is read or any fit runs: empty when valid, else
 // the one-line reason (exit code 2).
 std::string ParseRequest(const CompareCommandOptions& options, ComparisonRequest* r) {
@@ -60,6 +75,7 @@ std::string ParseRequest(const CompareCommandOptions& options, ComparisonRequest
     r->validation_reps = ParseRepetitionList(options.validation_reps);
   }
   r->threads = options.threads;
+  if (std::string e = SolverFlagOfNoMethodAsked(options, r->methods); !e.empty()) return e;
   std::string error;
   if (!MakeFitMethodSettings(options, options.threads, &r->settings, &error)) return error;
   return "";
@@ -123,9 +139,11 @@ void AddCompareOptions(CLI::App& app, CompareCommandOptions& o) {
   app.add_option("--validation-reps", o.validation_reps,
                  "Validation repetitions (default: those after the largest k)")
       ->check(RepetitionListValidator());
-  app.add_option("--out", o.out, "Output prefix: <out>.csv, <out>.md, <out>_trace.csv")
-      ->capture_default_str();
-  app.add_flag("--no-output", o.no_output, "Print the table only");
+  CLI::Option* out =
+      app.add_option("--out", o.out, "Output prefix: <out>.csv, <out>.md, <out>_trace.csv")
+          ->capture_default_str();
+  // An --out given with --no-output would be dropped: one of them is a mistake.
+  app.add_flag("--no-output", o.no_output, "Print the table only")->excludes(out);
   app.add_flag("--force", o.force, io::kForceFileHelp);
   app.add_flag("--quiet", o.quiet, "No progress on stderr");
   AddSolverOptions(app, o);

@@ -58,7 +58,7 @@ void AddExportRos2ControlOptions(CLI::App& app, ExportRos2ControlOptions& o) {
                  "URDF joint names in the robot's channel order (default: the channel names)")
       ->delimiter(',');
   app.add_option("--out", o.out, "File to write (atomically; default: stdout)");
-  app.add_option("--logs", o.logs,
+  CLI::Option* logs = app.add_option("--logs", o.logs,
                  "Data set: replay the exported parameters on its held-out runs beside the "
                  "nominal robot and the exact calibration; refuse them if worse than nominal")
       ->check(CLI::ExistingDirectory);
@@ -67,13 +67,17 @@ void AddExportRos2ControlOptions(CLI::App& app, ExportRos2ControlOptions& o) {
   app.add_option("--ros-distro", o.ros_distro,
                  "ROS 2 distribution (" + distros + "): only the keys it declares are written")
       ->capture_default_str();
+  // Both act on the replay of --logs; without it they would be dropped in silence.
   app.add_flag("--allow-worse", o.allow_worse,
-               "Write the parameters even when they replay worse than the nominal robot");
+               "With --logs: write the parameters even when they replay worse than the nominal "
+               "robot")
+      ->needs(logs);
   app.add_option_function<double>(
          "--publish-rate", [&o](double hz) { o.publish_period_s = 1.0 / hz; },
          "With --logs: the controller's publish_rate (Hz), the interval its twist covariance is "
          "for (default: the encoder period)")
-      ->check(PositiveNumber());
+      ->check(PositiveNumber())
+      ->needs(logs);
   app.add_option("--calibration-out", o.calibration_out,
                  "With --logs: write the calibration with its odometry covariance here");
   app.add_flag("--force", o.force, io::kForceFileHelp);

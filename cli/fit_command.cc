@@ -26,9 +26,10 @@ void AddFitOptions(CLI::App& app, FitCommandOptions& o) {
                  "Fit on the runs whose trajectory label matches (list or regular expression); "
                  "the others validate")
       ->excludes(reps);
-  app.add_option("--out", o.out, "Calibrated robot YAML to write (atomically)")
-      ->capture_default_str();
-  app.add_flag("--no-output", o.no_output, "Do not write the calibrated YAML");
+  CLI::Option* out = app.add_option("--out", o.out, "Calibrated robot YAML to write (atomically)")
+                         ->capture_default_str();
+  // An --out given with --no-output would be dropped: one of them is a mistake.
+  app.add_flag("--no-output", o.no_output, "Do not write the calibrated YAML")->excludes(out);
   app.add_flag("--force", o.force, io::kForceFileHelp);
   app.add_option("--time-blocks", o.time_blocks,
                  "With one or two runs fitted on their tracks and none held out, judge on time: "

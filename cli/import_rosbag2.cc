@@ -45,6 +45,9 @@ void AddImportRosbag2Options(CLI::App& app, ImportRosbag2Options& o) {
       ->check(PositiveNumber());
   app.add_option("--label", o.label, "Trajectory label of the runs (default: the bag's name)");
   app.add_flag("--force", o.force, io::kForceDirectoryHelp);
+  app.add_flag("--skip-mapping-check", o.skip_mapping_check,
+               "Write even when another order or sign of the joints explains the ground truth "
+               "far better (exit 4 otherwise)");
 }
 
 int RunImportRosbag2Command(const ImportRosbag2Options& o) {

@@ -45,23 +45,11 @@ std::optional<EffectModel> EffectsToFit(const FitCommandOptions& options, const 
 std::string FlagThatDoesNotApply(const FitCommandOptions& o) {
   const SolverOptions defaults;
   const bool ceres = IsCeresMethod(o.method);
+  const std::string methods = "--method " + o.method;
+  if (std::string e = SolverFlagThatDoesNotApply(o, defaults, ceres, !ceres, methods); !e.empty()) {
+    return e;
+  }
   const bool loss = o.loss != defaults.loss;
-  if (!ceres && (loss || o.loss_scale != defaults.loss_scale)) {
-    return "--loss and --loss-scale shape the Ceres methods' final-pose residuals; --method " +
-           o.method + " does not use them";
-  }
-  if (!ceres && o.max_iterations != defaults.max_iterations) {
-    return "--max-iterations bounds the Ceres methods; --method " + o.method +
-           " has --max-evaluations";
-  }
-  if (ceres && (o.seed != defaults.seed || o.max_evaluations != defaults.max_evaluations ||
-                o.polish)) {
-    return "--seed, --max-evaluations and --polish apply to the NLopt methods; --method " +
-           o.method + " does not use them";
-  }
-  if (!loss && o.loss_scale != defaults.loss_scale) {
-    return "--loss-scale without --loss (huber or cauchy) has no loss to scale";
-  }
   if (o.residuals == "final-pose" && o.clock_offsets != defaults.clock_offsets) {
     return "--clock-offsets " + o.clock_offsets +
            " is estimated on track residuals; --residuals final-pose compares final poses, "

@@ -168,15 +168,8 @@ std::optional<std::vector<GeneralisationSplit>> TableSplits(const GeneraliseComm
   } else {
     splits = PathTypeSplits(runs);
   }
-  std::set<int> present;
-  for (const AlignedRun& run : runs) present.insert(run.repetition);
-  const std::vector<int> reps = ResolveRepetitionList(options.train_reps, present);
-  const std::set<int> rep_set(reps.begin(), reps.end());
-  for (GeneralisationSplit& s : PredicateSplits(
-           runs, [&](const AlignedRun& run) { return rep_set.count(run.repetition) > 0; },
-           "every path type, reps " + FormatRepetitionList(reps), "the other reps")) {
-    splits.push_back(std::move(s));
-    break;  // the other direction would train on what was meant to be held out
+  if (std::optional<GeneralisationSplit> s = RepetitionSplit(runs, options.train_reps)) {
+    splits.push_back(std::move(*s));
   }
   return splits;
 }

@@ -74,6 +74,27 @@ void AddTrackResidualOptions(CLI::App& app, SolverOptions& o) {
       ->check(CLI::IsMember({"fixed", "estimated", "auto"}));
 }
 
+std::string SolverFlagThatDoesNotApply(const SolverOptions& o, const SolverOptions& defaults,
+                                       bool ceres, bool nlopt, const std::string& methods) {
+  const bool loss = o.loss != defaults.loss;
+  if (!ceres && (loss || o.loss_scale != defaults.loss_scale)) {
+    return "--loss and --loss-scale shape the Ceres methods' final-pose residuals; " + methods +
+           " does not use them";
+  }
+  if (!ceres && o.max_iterations != defaults.max_iterations) {
+    return "--max-iterations bounds the Ceres methods; " + methods + " has --max-evaluations";
+  }
+  if (!nlopt && (o.seed != defaults.seed || o.max_evaluations != defaults.max_evaluations ||
+                 o.polish)) {
+    return "--seed, --max-evaluations and --polish apply to the NLopt methods; " + methods +
+           " does not use them";
+  }
+  if (!loss && o.loss_scale != defaults.loss_scale) {
+    return "--loss-scale without --loss (huber or cauchy) has no loss to scale";
+  }
+  return "";
+}
+
 bool MakeFitMethodSettings(const SolverOptions& o, int threads, FitMethodSettings* s,
                            std::string* error) {
   s->threads = threads;

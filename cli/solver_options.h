@@ -54,6 +54,13 @@ void AddSolverOptions(CLI::App& app, SolverOptions& options);
 // fits final poses) refuses them as flags it does not take (exit 2) instead of ignoring them.
 void AddTrackResidualOptions(CLI::App& app, SolverOptions& options);
 
+// A solver flag none of the methods would use, as the flags alone show it: "" or the refusal's one
+// line (exit 2), so that nothing the user set is dropped without a word. `ceres` and `nlopt` say
+// whether the methods asked for (`methods`, e.g. "--method ceres") include a Ceres and an NLopt
+// one; `defaults` are the command's (a flag given at its default changes nothing either way).
+std::string SolverFlagThatDoesNotApply(const SolverOptions& o, const SolverOptions& defaults,
+                                       bool ceres, bool nlopt, const std::string& methods);
+
 // The solver flags (cli/solver_options.h) checked and turned into settings; false with a
 // one-line message when a name is unknown or a value out of range.
 bool MakeFitMethodSettings(const SolverOptions& options, int threads, FitMethodSettings* settings,

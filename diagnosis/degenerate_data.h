@@ -36,10 +36,14 @@ std::vector<std::string> FindDegenerateData(const std::vector<AlignedRun>& runs,
 // of its ground truth's distance from its median position exceeds kStillPositionM, or that of its
 // heading's difference from its median heading exceeds kStillHeadingRad (far above motion-capture
 // noise, far below any calibration drive). One line naming why when no run moves ("" otherwise):
-// the caller refuses to fit (exit 1).
+// the caller refuses to fit (exit 1). A run whose ground truth holds only its start and end poses
+// (a closed loop ends where it began) moves when one of its wheels turned more than
+// kStillWheelTurnRad (one turn: far above an encoder's jitter at rest, far below a calibration
+// drive); `robot` names its wheel-rate channels.
 inline constexpr double kStillPositionM = 0.05;
 inline constexpr double kStillHeadingRad = 0.05;
-std::string StillRunsRefusal(const std::vector<RunLog>& runs);
+inline constexpr double kStillWheelTurnRad = 2.0 * 3.14159265358979323846;
+std::string StillRunsRefusal(const std::vector<RunLog>& runs, const Robot& robot);
 
 struct OutlierRun {
   std::string id;

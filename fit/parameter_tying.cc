@@ -7,6 +7,8 @@
 #include <map>
 #include <stdexcept>
 
+#include "models/mounted_model.h"
+
 namespace fitcal {
 
 namespace {
@@ -75,6 +77,13 @@ class TiedPrepared final : public PreparedKinematics<T> {
   std::unique_ptr<const PreparedKinematics<T>> inner_;
 };
 
+// ground_truth_x, _y, _yaw (models/mounted_model.h): the pose of the frame the ground truth
+// tracks, which no wheel's size or place can share a value with.
+bool IsMount(const Robot& robot, int k) {
+  const std::vector<int> mount = MountParameterIndices(robot);
+  return std::find(mount.begin(), mount.end(), k) != mount.end();
+}
+
 // Every name in `tying` resolved to its index; "" or the first problem.
 std::string ResolveNames(const Robot& robot, const ParameterTying& tying,
                          std::vector<std::vector<int>>* groups, std::vector<int>* held) {
@@ -104,6 +113,11 @@ std::string ResolveNames(const Robot& robot, const ParameterTying& tying,
       if (!groups->back().empty() &&
           robot.parameters[k].unit != robot.parameters[groups->back()[0]].unit) {
         return "parameter tying: a group mixes lengths and angles ('" + name + "')";
+      }
+      if (!groups->back().empty() && IsMount(robot, k) != IsMount(robot, groups->back()[0])) {
+        return "parameter tying: a group mixes the ground truth's mount with the robot's "
+               "geometry ('" + robot.parameters[groups->back()[0]].name + "', '" + name +
+               "'): the mount is where the sensor sits, not a wheel's size or place";
       }
       groups->back().push_back(k);
     }

@@ -5,6 +5,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "io/command_failure.h"
+
 namespace fitcal {
 
 TrajectorySelector::TrajectorySelector(const std::string& text,
@@ -25,7 +27,8 @@ TrajectorySelector::TrajectorySelector(const std::string& text,
     const std::regex check(text, std::regex::ECMAScript);
     (void)check;
   } catch (const std::regex_error& e) {
-    throw std::invalid_argument("trajectory selector '" + text +
+    // A usage error (exit 2), as a malformed --train-reps is: the flag's text, not the data.
+    throw UsageError("trajectory selector '" + text +
                                 "' is neither a list of labels in the data nor a valid regular "
                                 "expression (" +
                                 e.what() + ")");

@@ -1,5 +1,6 @@
 #include "io/calibration_yaml.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "io/input_error.h"
@@ -83,6 +84,7 @@ void ReadUncertainty(const YAML::Node& block, const std::string& path, Calibrati
                        "calibration.sigma." + key + ": not a finite non-negative number");
     }
     p->sigma.emplace_back(key, value);
+    p->sigma_lines.push_back(node.Mark().line + 1);
   };
   for (const auto& entry : sigma) {
     const std::string key = YamlString(entry.first, path, "calibration.sigma");
@@ -126,21 +128,63 @@ void ReadUncertainty(const YAML::Node& block, const std::string& path, Calibrati
   RequireSymmetric(p->correlation, correlation, path);
 }
 
+// Every key a fitcal writer puts in the block (io/calibration_block.cc; omni3's
+// inverse_kinematic_matrix, models/omni3/omni3_robot_model.cc, and the omni and mecanum robots'
+// forward_kinematic_matrix, models/omni/omni_model_n.h; export's odometry_covariance,
+// interchange/ros2/controller_export.cc). An edited block is read back by
+// report, export and fleet: a key none of them wrote is a typo whose value would be ignored in
+// silence (`at_bounds: [r_left]` would leave the bound unsaid), so it is refused at its line.
+void RejectKeysNoWriterWrites(const YAML::Node& block, const std::string& path) {
+  static const char* const kWritten[] = {
+      "method", "objective", "dataset", "tool_version", "termination", "selected", "selected_on",
+      "training_repetitions", "validation_repetitions", "training_runs", "validation_runs",
+      "training_trajectories", "training_run_ids", "training_fingerprint", "cf_training",
+      "cf_validation", "held", "at_bound", "not_determined", "sigma", "correlation",
+      "clock_offsets", "inverse_kinematic_matrix", "forward_kinematic_matrix",
+      "odometry_covariance"};
+  YamlMap map(block, path, "calibration");
+  for (const char* key : kWritten) (void)map.Optional(key);
+  map.RejectUnread();
+}
+
+struct BeforeAfter {
+  double before = 0.0;
+  double after = 0.0;
+};
+
+// `<key>: {before: x, after: y}` (the CF before and after the calibration), when present.
+std::optional<BeforeAfter> ReadBeforeAfter(const YAML::Node& block, const std::string& key,
+                                           const std::string& path) {
+  const YAML::Node node = block[key];
+  if (!node || node.IsNull()) return std::nullopt;
+  YamlMap map(node, path, "calibration." + key);
+  const BeforeAfter out{map.Double("before"), map.Double("after")};
+  map.RejectUnread();
+  return out;
+}
+
 // calibration.clock_offsets, when present.
 void ReadClockOffsets(const YAML::Node& block, const std::string& path, CalibrationProvenance* p) {
   const YAML::Node node = block["clock_offsets"];
   if (!node || node.IsNull()) return;
   ExpectYamlType(node, YAML::NodeType::Map, path, "calibration.clock_offsets");
-  p->clock_offset_grouping = OptionalString(node, "grouping", path);
-  const YAML::Node groups = node["groups"];
+  YamlMap offsets(node, path, "calibration.clock_offsets");
+  (void)offsets.Optional("meaning");  // the writer's explanation for a reader, not data
+  const YAML::Node grouping = offsets.Optional("grouping");
+  if (grouping && !grouping.IsNull()) {
+    p->clock_offset_grouping = YamlString(grouping, path, "calibration.clock_offsets.grouping");
+  }
+  const YAML::Node groups = offsets.Optional("groups");
+  offsets.RejectUnread();
   if (!groups) return;
   ExpectYamlType(groups, YAML::NodeType::Sequence, path, "calibration.clock_offsets.groups");
   for (const YAML::Node& g : groups) {
-    ExpectYamlType(g, YAML::NodeType::Map, path, "calibration.clock_offsets.groups");
+    YamlMap entry(g, path, "calibration.clock_offsets.groups");
     CalibrationProvenance::ClockOffset c;
-    c.group = YamlString(g["group"], path, "calibration.clock_offsets.groups.group");
-    c.offset_s = YamlDouble(g["offset_s"], path, "calibration.clock_offsets.groups.offset_s");
-    c.sigma_s = YamlDouble(g["sigma_s"], path, "calibration.clock_offsets.groups.sigma_s");
+    c.group = entry.String("group");
+    c.offset_s = entry.Double("offset_s");
+    c.sigma_s = entry.Double("sigma_s");
+    entry.RejectUnread();
     if (!std::isfinite(c.offset_s) || !std::isfinite(c.sigma_s) || c.sigma_s < 0.0) {
       throw InputError(InputErrorKind::kBadValue, path, g.Mark().line + 1,
                        "calibration.clock_offsets: offset_s and sigma_s must be finite, sigma_s "
@@ -181,7 +225,9 @@ std::optional<std::vector<int>> ReadCalibrationTrainingRepetitions(const std::st
 std::optional<CalibrationProvenance> ReadCalibrationProvenance(const std::string& path) {
   const YAML::Node block = CalibrationNode(path);
   if (!block || block.IsNull()) return std::nullopt;
+  RejectKeysNoWriterWrites(block, path);
   CalibrationProvenance p;
+  p.path = path;
   if (const std::optional<std::vector<int>> reps = ReadCalibrationTrainingRepetitions(path)) {
     p.training_repetitions = *reps;
   }
@@ -192,13 +238,13 @@ std::optional<CalibrationProvenance> ReadCalibrationProvenance(const std::string
   p.training_fingerprint = OptionalString(block, "training_fingerprint", path);
   p.training_run_ids = Strings(block["training_run_ids"], path, "calibration.training_run_ids");
   p.at_bound = Strings(block["at_bound"], path, "calibration.at_bound");
-  const YAML::Node cf = block["cf_training"];
-  if (cf && !cf.IsNull()) {
-    ExpectYamlType(cf, YAML::NodeType::Map, path, "calibration.cf_training");
-    p.cf_training_before = YamlDouble(cf["before"], path, "calibration.cf_training.before");
-    p.cf_training_after = YamlDouble(cf["after"], path, "calibration.cf_training.after");
+  if (const std::optional<BeforeAfter> cf = ReadBeforeAfter(block, "cf_training", path)) {
+    p.cf_training_before = cf->before;
+    p.cf_training_after = cf->after;
     p.has_training_cf = true;
   }
+  // Read for its check only: a hand-edited block is validated whole, not just what is used.
+  (void)ReadBeforeAfter(block, "cf_validation", path);
   ReadUncertainty(block, path, &p);
   ReadClockOffsets(block, path, &p);
   return p;
@@ -220,6 +266,19 @@ bool RecordedKeyMatches(const std::string& key, const ParameterInfo& info) {
 std::vector<double> RecordedSigmas(const CalibrationProvenance& provenance,
                                    const std::vector<ParameterInfo>& parameters) {
   const auto& recorded = provenance.sigma;
+  for (std::size_t r = 0; r < recorded.size(); ++r) {
+    if (std::any_of(parameters.begin(), parameters.end(), [&](const ParameterInfo& info) {
+          return RecordedKeyMatches(recorded[r].first, info);
+        })) {
+      continue;
+    }
+    std::string keys;
+    for (const ParameterInfo& info : parameters) keys += (keys.empty() ? "" : ", ") + info.KeyName();
+    throw InputError(InputErrorKind::kUnknownKey, provenance.path,
+                     r < provenance.sigma_lines.size() ? provenance.sigma_lines[r] : 0,
+                     "calibration.sigma: '" + recorded[r].first +
+                         "' names no parameter of this robot (its keys: " + keys + ")");
+  }
   if (recorded.size() != parameters.size()) return {};
   std::vector<double> sigma(parameters.size());
   for (std::size_t k = 0; k < parameters.size(); ++k) {

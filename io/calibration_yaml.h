@@ -33,6 +33,8 @@ struct CalibrationProvenance {
   // units (degrees for angles), with the correlation matrix in the same order; empty when the
   // file records `sigma: ~`.
   std::vector<std::pair<std::string, double>> sigma;
+  std::vector<int> sigma_lines;  // the line of each sigma's key, for RecordedSigmas's refusal
+  std::string path;              // the file it was read from
   std::vector<std::vector<double>> correlation;
   // `clock_offsets:` (io/calibration_block.h): how runs were grouped, and each group's offset
   // (seconds; the ground truth stamped t + offset belongs to encoder time t) and sigma.
@@ -51,7 +53,9 @@ std::optional<CalibrationProvenance> ReadCalibrationProvenance(const std::string
 // The recorded sigmas matched to `parameters` by their written key, in SI units and rad: a
 // recorded key names its parameter and display unit, "<name>_<unit>", or for the omni3 file,
 // which writes one list per quantity in the parameters' order, "<quantity>_<unit>[i]". Empty
-// unless every parameter has one.
+// unless every parameter has one (a file from before a parameter was added to its model). A
+// recorded key that names none of `parameters` (an edited `r_rigth_m`) is an InputError at its
+// line: its uncertainty would otherwise vanish from every page unsaid.
 std::vector<double> RecordedSigmas(const CalibrationProvenance& provenance,
                                    const std::vector<ParameterInfo>& parameters);
 

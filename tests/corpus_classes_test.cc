@@ -247,6 +247,110 @@ TEST(CorpusNeighbours, EditedCorrelationsAreValidatedWithFileAndLine) {
   }
 }
 
+// probe45: a key of an edited calibration block that no fitcal writer writes is a typo whose
+// value would be ignored in silence (`at_bounds: [r_left]` leaves the bound unsaid, a sigma under
+// `r_rigth_m` left every sigma out of the report); a before/after map without one of its keys read
+// as yaml-cpp's "invalid node" with no file or line. Each is refused at its line by every reader of the block (report, export), nothing
+// written; the file as fit wrote it reads.
+TEST(CorpusNeighbours, EditedCalibrationKeysNoWriterWritesAreRefusedAtTheirLine) {
+  const TempDir dir;
+  const std::string data = SimulateDiffDrive(dir, "data");
+  const std::string cal = dir.Path("cal.yaml");
+  ASSERT_EQ(RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --out " + cal).exit_code, 0);
+  const std::string text = ReadFileBytes(cal);
+  struct Case {
+    std::string from, to, says;
+  };
+  for (const Case& c : std::vector<Case>{
+           {"  at_bound: []", "  at_bounds: [r_left]", "unknown key 'at_bounds' in calibration"},
+           {"  method: ceres", "  methd: ceres", "misspelt 'method'"},
+           {"cf_training: {before:", "cf_training: {befor:", "in calibration.cf_training"},
+           // A sigma's key that names no parameter: its uncertainty vanished from every page.
+           {"    r_right_m: ", "    r_rigth_m: ", "'r_rigth_m' names no parameter of this robot"}}) {
+    SCOPED_TRACE(c.to);
+    std::string edited_text = text;
+    const std::size_t at = text.find(c.from);
+    ASSERT_NE(at, std::string::npos) << text;
+    edited_text.replace(at, c.from.size(), c.to);
+    const int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + at, '\n'));
+    const std::string edited = dir.Write("edited.yaml", edited_text);
+    const std::string rep = dir.Path("rep");
+    const std::string ctl = dir.Path("ctl.yaml");
+    std::vector<std::string> commands = {"report --logs " + data + " --calibration " + edited +
+                                         " --out " + rep};
+    // export reads the block's keys but not the sigmas (its covariance is from the runs).
+    if (!Has(c.to, "rigth")) {
+      commands.push_back("export ros2-control --controller diff_drive_controller --calibration " +
+                         edited + " --logs " + data + " --out " + ctl);
+    }
+    for (const std::string& command : commands) {
+      const FitcalRun r = RunFitcal(dir, command);
+      EXPECT_EQ(r.exit_code, 1) << command << r.out << r.err;
+      EXPECT_EQ(Lines(r.err), 1) << r.err;
+      EXPECT_TRUE(Has(r.err, edited + ":" + std::to_string(line) + ":")) << r.err << line;
+      EXPECT_TRUE(Has(r.err, c.says)) << r.err;
+    }
+    EXPECT_FALSE(fs::exists(rep));
+    EXPECT_FALSE(fs::exists(ctl));
+  }
+  // Every key a writer adds reads back: fit's block, and export's odometry_covariance in it.
+  const std::string with_covariance = dir.Path("cal_cov.yaml");
+  ASSERT_EQ(RunFitcal(dir, "export ros2-control --controller diff_drive_controller --calibration " +
+                               cal + " --logs " + data + " --out " + dir.Path("ctl.yaml") +
+                               " --calibration-out " + with_covariance)
+                .exit_code,
+            0);
+  for (const std::string& written : {cal, with_covariance}) {
+    const FitcalRun r = RunFitcal(dir, "report --logs " + data + " --calibration " + written +
+                                           " --out " + dir.Path("rep"));
+    EXPECT_EQ(r.exit_code, 0) << written << r.err;
+  }
+}
+
+// probe45: options a command would drop, or refuse as bad data rather than as a usage error.
+// generalise --train-reps naming no repetition of the data set (or every one) printed the tables
+// without the repetition split asked for, exit 0; export --publish-rate and --allow-worse without
+// --logs (no replay to apply them to) wrote the file, exit 0; a --train-trajectories that is not
+// a regular expression was exit 1; --tie of the ground truth's mount with a wheel's geometry
+// (both in metres) fitted one value for both. Each: exit 2, one line, nothing written.
+TEST(CorpusNeighbours, OptionsThatWouldBeDroppedAreUsageErrors) {
+  const TempDir dir;
+  const std::string data = SimulateDiffDrive(dir, "data");
+  const std::string cal = dir.Path("cal.yaml");
+  ASSERT_EQ(RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --out " + cal).exit_code, 0);
+  std::string robot = ReadFileBytes(data + "/robot.yaml");
+  const std::size_t bounds = robot.find("bounds:");
+  ASSERT_NE(bounds, std::string::npos) << robot;
+  robot.insert(bounds, "ground_truth_frame: {x_m: 0.0, y_m: 0.0, yaw_deg: 0.0}\n");
+  WriteFileBytes(data + "/robot.yaml", robot);
+  const std::string out = dir.Path("out.yaml");
+  struct Case {
+    std::string command, says;
+  };
+  for (const Case& c : std::vector<Case>{
+           {"generalise --logs " + data + " --train-reps 7",
+            "--train-reps 7: no run of the data set is of repetition 7"},
+           {"generalise --logs " + data + " --train-reps 1-2", "none left to test on"},
+           {"export ros2-control --controller diff_drive_controller --calibration " + cal +
+                " --publish-rate 50 --out " + out,
+            "--publish-rate requires --logs"},
+           {"export ros2-control --controller diff_drive_controller --calibration " + cal +
+                " --allow-worse --out " + out,
+            "--allow-worse requires --logs"},
+           {"fit --logs " + data + " --train-trajectories '([' --out " + out,
+            "nor a valid regular expression"},
+           {"fit --logs " + data + " --train-reps 1 --tie ground_truth_x,wheel_separation --out " +
+                out,
+            "mixes the ground truth's mount with the robot's geometry"}}) {
+    SCOPED_TRACE(c.command);
+    const FitcalRun r = RunFitcal(dir, c.command);
+    EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
+    EXPECT_TRUE(Has(r.err, c.says)) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
 const char* kDiffYaml = R"(model: diff_drive
 name: r1
 wheels:
@@ -519,6 +623,43 @@ TEST(CorpusNeighbours, DiagnoseRefusesTrainingRunsThatStandStill) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// probe45: UMBmark's squares with ground truth of their start and end poses only - the textbook
+// calibration, the robot measured where it stops - were refused as "the training runs stand
+// still" (a closed loop ends where it began). Such a run moves when its wheels turned; fitted on
+// the squares alone, the wheels' ratio and the track against the radius come back as the
+// simulator's true robot has them (a closed loop judged at its end cannot see the common scale,
+// held at the nominal and said). Tolerance 0.1 %: the held-out runs' mean final heading error
+// after the fit, ~0.45 deg per 360-deg loop, is 0.12 % of the turn the ratio scales. Runs that
+// stand still with such ground truth (wheels at rest) are still refused.
+TEST(CorpusNeighbours, ClosedLoopsJudgedAtTheirEndsAreNotStill) {
+  const TempDir dir;
+  const std::string data = SimulateDiffDrive(dir, "data");
+  KeepGroundTruthPoses(data, 2);
+  const std::string cal = dir.Path("cal.yaml");
+  const FitcalRun r =
+      RunFitcal(dir, "fit --logs " + data + " --train-trajectories '^square' --out " + cal);
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_TRUE(Has(r.out, "residuals: final-pose")) << r.out;
+  const YAML::Node fitted = YAML::LoadFile(cal);
+  const YAML::Node truth = YAML::LoadFile(data + "/true_robot.yaml");
+  const auto ratios = [](const YAML::Node& robot) {
+    const double right = robot["wheels"][0]["radius_m"].as<double>();
+    const double left = robot["wheels"][1]["radius_m"].as<double>();
+    const double track = robot["wheel_separation_m"].as<double>();
+    return std::array<double, 2>{right / left, track / (0.5 * (right + left))};
+  };
+  const std::array<double, 2> got = ratios(fitted), want = ratios(truth);
+  for (int k = 0; k < 2; ++k) EXPECT_NEAR(got[k] / want[k], 1.0, 1e-3) << k;
+
+  MakeRepetitionOneStandStill(data);
+  const std::string still = dir.Path("still.yaml");
+  const FitcalRun refused =
+      RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --out " + still);
+  EXPECT_EQ(refused.exit_code, 1) << refused.out << refused.err;
+  EXPECT_TRUE(Has(refused.err, "the training runs stand still")) << refused.err;
+  EXPECT_FALSE(fs::exists(still));
+}
+
 // One run whose wheels stand while its ground truth drives the path (encoders unplugged, the robot
 // pushed): it was fitted among the others, exit 0. Every command that loads the data set refuses
 // it in one line naming the run's encoder file and how far the ground truth went (a square of
@@ -713,6 +854,36 @@ TEST(CorpusNeighbours, FleetRefusesOneNameForTwoWheelLayouts) {
   EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
   EXPECT_EQ(Lines(r.err), 1) << r.err;
   EXPECT_TRUE(Has(r.err, "robot 'r1' has parameters")) << r.err;
+}
+
+// probe45: fleet kept the first of two calibrations of one robot and date and dropped the other
+// unsaid (r_right 0.042 charted, 0.043 gone, n = 1, exit 0); a metrics.json without parameters
+// ended in "basic_string::substr" with no file. Now two results of one date must agree (a file
+// found twice, a calibration and its report count once), else both files are named, exit 1.
+TEST(CorpusNeighbours, FleetKeepsOneResultPerRobotAndDateOrSaysWhy) {
+  const TempDir dir;
+  std::string other = kDiffYaml;
+  other.replace(other.find("radius_m: 0.042"), 15, "radius_m: 0.043");
+  const std::string a = dir.Write("fleet/r1/2026-05-01/a/cal.yaml", kDiffYaml);
+  const std::string b = dir.Write("fleet/r1/2026-05-01/b/cal.yaml", other);
+  const FitcalRun two = RunFitcal(dir, "fleet " + a + " " + b);
+  EXPECT_EQ(two.exit_code, 1) << two.out << two.err;
+  EXPECT_EQ(Lines(two.err), 1) << two.err;
+  EXPECT_TRUE(Has(two.err, b + ": robot 'r1' has two results dated 2026-05-01: r_right 0.043"))
+      << two.err;
+  EXPECT_TRUE(Has(two.err, "0.042 in " + a)) << two.err;
+
+  const FitcalRun twice = RunFitcal(dir, "fleet " + a + " " + a);
+  EXPECT_EQ(twice.exit_code, 0) << twice.err;
+  EXPECT_TRUE(Has(twice.out, "  r_right                m        1  2026-05-01")) << twice.out;
+
+  const std::string empty = dir.Write("fleet/r2/2026-05-01/report/metrics.json",
+                                      "{\"version\": 2, \"robot\": \"r2\", \"parameters\": []}\n");
+  const FitcalRun nothing = RunFitcal(dir, "fleet " + empty);
+  EXPECT_EQ(nothing.exit_code, 1) << nothing.out << nothing.err;
+  EXPECT_EQ(Lines(nothing.err), 1) << nothing.err;
+  EXPECT_TRUE(Has(nothing.err, empty + ":1: a metrics.json without a calibrated parameter"))
+      << nothing.err;
 }
 
 }  // namespace

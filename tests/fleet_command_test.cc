@@ -76,11 +76,16 @@ TEST(Fleet, FlagsTrendsAndOutliers) {
   EXPECT_NE(table.find("OUTLIER 2026-04-08"), std::string::npos) << table;
   EXPECT_NE(table.find("cf_validation_after"), std::string::npos) << table;
 
-  // A report's metrics.json is read too; beside its calibration of the same date it counts once.
-  tmp.Write("fleet/r1/2026-04-22/report/metrics.json",
-            R"({"robot": "r1", "parameters": [{"name": "r_left", "calibrated_m": 0.0412},
-                {"name": "wheel_separation", "calibrated_m": 0.2}],
-               "summary": [{"group": "all validation runs", "after": {"cf": 0.01}}]})");
+  // A report's metrics.json is read too; beside its calibration of the same date it counts once
+  // (it holds that calibration's values: a report of another one is a second result, refused,
+  // CorpusNeighbours.FleetKeepsOneResultPerRobotAndDateOrSaysWhy).
+  char report[512];
+  std::snprintf(report, sizeof report,
+                R"({"robot": "r1", "parameters": [{"name": "r_left", "calibrated_m": %.17g},
+                {"name": "wheel_separation", "calibrated_m": %.17g}],
+               "summary": [{"group": "all validation runs", "after": {"cf": 0.01}}]})",
+                worn.values.back(), Find(all, "r1", "wheel_separation").values.back());
+  tmp.Write("fleet/r1/2026-04-22/report/metrics.json", report);
   tmp.Write("fleet/r1/2026-04-29/report/metrics.json",
             R"({"robot": "r1", "parameters": [{"name": "r_left", "calibrated_m": 0.0411}]})");
   const std::vector<FleetSeries> with_reports = tools::ReadFleet({tmp.Path("fleet")});

@@ -120,6 +120,27 @@ TEST(MountedFit, AnOmniRobotsXAndYAreHeldWithTheReason) {
   EXPECT_EQ(frame["y_m"].as<double>(), -0.2);
 }
 
+// probe45: an omni robot whose mount guess is 0.1 m off (the ground truth tracks the centre, the
+// YAML says x 0.1 m): x and y are held, the error moves into the wheel distances, and the fit
+// ends on their bounds, refused (exit 5) naming only the wheels. The refusal now also names the
+// held mount and its guess, the one number the user can fix.
+TEST(MountedFit, ABoundHitWithTheMountHeldNamesTheMount) {
+  TempDir dir;
+  const std::string data = dir.Path("data"), cal = dir.Path("calibrated.yaml");
+  auto r = RunFitcal(dir, "simulate --model omni --out " + data + " --seed 4 --repetitions 2");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::string robot = fitcal::testing::ReadFileBytes(data + "/robot.yaml");
+  robot = Replace(robot, "bounds:", "ground_truth_frame: {x_m: 0.1, y_m: 0.0, yaw_deg: 0.0}\nbounds:");
+  WriteFileBytes(data + "/robot.yaml", robot);
+  r = RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --out " + cal);
+  EXPECT_EQ(r.exit_code, 5) << r.err << r.out;
+  EXPECT_TRUE(Has(r.err, "leaves a parameter on its bound (R_")) << r.err;
+  EXPECT_TRUE(Has(r.err, "the ground truth's mount is held at its guess (ground_truth_x 0.1 m, "
+                         "ground_truth_y 0 m)"))
+      << r.err;
+  EXPECT_FALSE(std::filesystem::exists(cal));
+}
+
 // A closed form measures the base only (MountedModel::ClosedForms hands it the nominal frame): an
 // ASOC robot whose frame is declared (here at its true place, the origin), calibrated by its
 // closed form (Doebbler's, selected by the gate on these runs), is written with the frame held

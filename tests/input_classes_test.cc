@@ -261,5 +261,35 @@ TEST(InputClassesCli, UsageErrorsAreOneLineExitTwoBeforeAnyWork) {
   }
 }
 
+// probe45: flags the command would drop. compare ran every fit without --seed (Ceres methods
+// only), --loss (NLopt methods only), --polish or --max-iterations where no method asked for uses
+// them, exit 0, where fit refuses the same flags; fit and compare with --no-output dropped an
+// --out given beside it. Each: exit 2, one line naming the flag, before any data is read.
+TEST(InputClassesCli, FlagsNoMethodAskedWouldUseAreRefused) {
+  const TempDir dir;
+  struct Case {
+    std::string args, says;
+  };
+  const std::string compare = "compare --logs . --strategies all --repetitions 1 --quiet ";
+  for (const Case& c : std::vector<Case>{
+           {compare + "--methods ceres --seed 5", "--methods ceres does not use them"},
+           {compare + "--methods ceres ceres-dogleg --polish", "apply to the NLopt methods"},
+           {compare + "--methods crs2lm --loss huber", "--methods crs2lm does not use them"},
+           {compare + "--methods crs2lm --max-iterations 5", "bounds the Ceres methods"},
+           {compare + "--methods ceres --loss-scale 0.1", "--loss-scale without --loss"},
+           {compare + "--methods ceres --no-output --out " + dir.Path("table"),
+            "--out excludes --no-output"},
+           {"fit --logs . --no-output --out " + dir.Path("cal.yaml"),
+            "--out excludes --no-output"}}) {
+    const auto r = RunFitcal(dir, c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.args << ": " << r.out << r.err;
+    EXPECT_EQ(Lines(r.err), 1) << c.args << ": " << r.err;
+    EXPECT_TRUE(Has(r.err, c.says)) << c.args << ": " << r.err;
+  }
+  for (const char* written : {"table.csv", "table.md", "cal.yaml"}) {
+    EXPECT_FALSE(std::filesystem::exists(dir.Path(written))) << written;
+  }
+}
+
 }  // namespace
 }  // namespace fitcal

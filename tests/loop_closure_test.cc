@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "fit/trajectory_split.h"
+#include "io/command_failure.h"
 #include "models/omni3/omni3_kinematics.h"
 #include "odometry/effects.h"
 #include "tests/omni3_reference_replay.h"
@@ -36,7 +37,8 @@ TEST(TrajectorySelector, RegularExpressionIsSearched) {
 
 TEST(TrajectorySelector, BadSelectorThrows) {
   EXPECT_THROW(TrajectorySelector("", {"a"}), std::invalid_argument);
-  EXPECT_THROW(TrajectorySelector("(unclosed", {"a"}), std::invalid_argument);
+  // Not a regular expression: a usage error (exit 2), as a malformed --train-reps is.
+  EXPECT_THROW(TrajectorySelector("(unclosed", {"a"}), UsageError);
 }
 
 // omega' = omega (1 + g_x v_x + g_y v_y); translation untouched. Values chosen so that a swapped

@@ -425,6 +425,32 @@ TEST(BagFilesFromTheBagOnly, AFileListedTwiceOrOneJointForTwoWheelsIsRefused) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// probe45: the wheels' joints given to --joints in the other order (left for right) wrote a data
+// set, exit 0, that `fit` then refused as miswired (exit 4) naming the robot YAML. Now the import
+// runs the channel-order check every import runs: exit 4, one line naming the bag and the
+// --joints order, nothing written; --skip-mapping-check writes it and says so.
+TEST(ImportThroughTheCommandLine, JointsInTheOtherOrderAreRefusedAsMiswired) {
+  TempDir tmp;
+  WriteBag(tmp, "bag", StorageFormat::kMcap, false);
+  const std::string out = tmp.Path("imported");
+  std::string args = ImportArgs(tmp, tmp.Path("bag"), out);
+  const std::string joints = "right_wheel_joint,left_wheel_joint";
+  args.replace(args.find(joints), joints.size(), "left_wheel_joint,right_wheel_joint");
+  const testing::FitcalRun swapped = RunFitcal(tmp, args);
+  EXPECT_EQ(swapped.exit_code, 4) << swapped.out << swapped.err;
+  EXPECT_EQ(Lines(swapped.err), 1) << swapped.err;
+  EXPECT_TRUE(Has(swapped.err, "read as --joints left_wheel_joint,right_wheel_joint")) << swapped.err;
+  EXPECT_TRUE(Has(swapped.err, "columns w_right and w_left swapped")) << swapped.err;
+  EXPECT_FALSE(fs::exists(out));
+  ExpectNoStagingLeft(out);
+
+  const testing::FitcalRun anyway = RunFitcal(tmp, args + " --skip-mapping-check");
+  EXPECT_EQ(anyway.exit_code, 0) << anyway.err;
+  EXPECT_TRUE(Has(anyway.out, "channel order check: ")) << anyway.out;
+  EXPECT_TRUE(Has(anyway.out, "written anyway")) << anyway.out;
+  EXPECT_TRUE(fs::exists(fs::path(out) / "dataset.yaml"));
+}
+
 // A metadata version rosbag2 has not written (1-9 so far) is a layout fitcal does not know:
 // refused at its line, not read as if it were version 5.
 TEST(BagFilesFromTheBagOnly, AnUnknownMetadataVersionIsRefusedAtItsLine) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <sstream>
 #include <string>
 #include <tuple>
 
@@ -124,6 +125,27 @@ void RefuseOneNameForTwoModels(const std::vector<FleetCalibration>& all) {
   }
 }
 
+// A second file of the robot and date (its report, the same file found twice) must hold the
+// value the first did: two calibrations of one date with different values are two results of
+// which the series could keep only one, and the other would vanish unsaid. The report's CF is
+// not compared: `report` may judge the calibration on other runs (a free run) than fit did.
+void RequireOneResultPerDate(const FleetSeries& s, const FleetValue& v, const FleetCalibration& c) {
+  if (v.name == kFleetCfRow) return;
+  // The YAML writes 10 significant digits, metrics.json more: equal to the YAML's last digit.
+  constexpr double kWrittenDigits = 1e-9;
+  const double kept = s.values.back();
+  if (std::abs(v.value - kept) <= kWrittenDigits * std::max(std::abs(v.value), std::abs(kept))) {
+    return;
+  }
+  std::ostringstream why;
+  why.precision(10);
+  why << "robot '" << c.robot << "' has two results dated " << c.date << ": " << v.name << " "
+      << v.value * v.display_scale << " here and " << kept * s.display_scale << " in "
+      << s.files.back() << "; fleet keeps one result per robot and date (a calibration and its "
+      << "report count once): keep one, or date them apart";
+  throw io::InputError(io::InputErrorKind::kBadValue, c.file, 0, why.str());
+}
+
 }  // namespace
 
 std::vector<FleetSeries> FleetSeriesOf(std::vector<FleetCalibration> all) {
@@ -148,7 +170,10 @@ std::vector<FleetSeries> FleetSeriesOf(std::vector<FleetCalibration> all) {
       }
       FleetSeries& s = out[it->second];
       // A calibration and its report (metrics.json) on the same date are one result.
-      if (!s.dates.empty() && s.dates.back() == c.date) continue;
+      if (!s.dates.empty() && s.dates.back() == c.date) {
+        RequireOneResultPerDate(s, v, c);
+        continue;
+      }
       s.dates.push_back(c.date);
       s.values.push_back(v.value);
       s.sigmas.push_back(v.sigma);

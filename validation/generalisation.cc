@@ -1,9 +1,13 @@
 #include "validation/generalisation.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <set>
 #include <stdexcept>
+
+#include "fit/run_split.h"
+#include "io/command_failure.h"
 
 namespace fitcal {
 
@@ -148,6 +152,29 @@ std::vector<GeneralisationSplit> PredicateSplits(
   if (a.train.empty() || a.test.empty()) return {};
   GeneralisationSplit b{test_name, train_name, a.test, a.train};
   return {a, b};
+}
+
+std::optional<GeneralisationSplit> RepetitionSplit(const std::vector<AlignedRun>& runs,
+                                                   const std::string& train_reps) {
+  std::set<int> present;
+  for (const AlignedRun& run : runs) present.insert(run.repetition);
+  const std::vector<int> reps = ResolveRepetitionList(train_reps, present);
+  const std::set<int> rep_set(reps.begin(), reps.end());
+  const std::string named = FormatRepetitionList(reps);
+  std::vector<GeneralisationSplit> both = PredicateSplits(
+      runs, [&](const AlignedRun& run) { return rep_set.count(run.repetition) > 0; },
+      "every path type, reps " + named, "the other reps");
+  if (!both.empty()) return std::move(both.front());
+  if (train_reps == "auto") return std::nullopt;
+  const bool none = std::none_of(runs.begin(), runs.end(), [&](const AlignedRun& run) {
+    return rep_set.count(run.repetition) > 0;
+  });
+  throw UsageError("--train-reps " + train_reps + ": " +
+                   (none ? "no run of the data set is of repetition " + named
+                         : "every run of the data set is of repetition " + named +
+                               ", none left to test on") +
+                   " (repetitions present: " +
+                   FormatRepetitionList(std::vector<int>(present.begin(), present.end())) + ")");
 }
 
 std::string SessionOf(const AlignedRun& run, SessionKey key) {

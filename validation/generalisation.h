@@ -20,6 +20,7 @@
 //   - leave-one-session-out: every session held out once, the others train.
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,6 +50,14 @@ std::vector<GeneralisationSplit> PathTypeSplits(const std::vector<AlignedRun>& r
 std::vector<GeneralisationSplit> PredicateSplits(
     const std::vector<AlignedRun>& runs, const std::function<bool(const AlignedRun&)>& trains,
     const std::string& train_name, const std::string& test_name);
+
+// The runs of the repetitions `train_reps` names (fit/run_split.h: "auto", the first half present)
+// of every path type against the other repetitions, one direction only: the other would train on
+// what was meant to be held out. nullopt when "auto" leaves a side empty (one repetition in the
+// data set); a UsageError (exit 2) when repetitions the user named do - none of them in the data
+// set, or every repetition - since the split asked for would otherwise be left out unsaid.
+std::optional<GeneralisationSplit> RepetitionSplit(const std::vector<AlignedRun>& runs,
+                                                   const std::string& train_reps);
 
 // What a session is in a data set. OptiOdom's omni3, omni4 and diff_drive imports give every
 // recording session its own trajectory label; its tricycle import labels runs by path type and

@@ -131,6 +131,11 @@ Calibration ReadMetricsJson(const std::string& path) {
                         : path;
     }
   }
+  if (c.values.empty()) {
+    throw io::InputError(io::InputErrorKind::kMissingKey, path, 1,
+                         "a metrics.json without a calibrated parameter or a held-out CF: "
+                         "nothing of it to chart");
+  }
   return c;
 }
 

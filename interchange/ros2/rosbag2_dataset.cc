@@ -6,6 +6,8 @@
 #include <string_view>
 
 #include "interchange/ros2/rosbag2_import.h"
+#include "diagnosis/import_channel_order.h"
+#include "diagnosis/miswired_error.h"
 #include "io/atomic_file.h"
 #include "io/command_failure.h"
 #include "io/dataset.h"
@@ -129,10 +131,32 @@ void RefuseWhatFitRefuses(const ImportRosbag2Options& o, const std::string& stag
   }
 }
 
+// The channel-order check of every import (diagnosis/import_channel_order.h), on the runs as
+// written and the robot as it reads back: joints given to --joints in another order (left for
+// right) or a wheel whose joint axis is reversed wrote a data set that `fit` then refused as
+// miswired (exit 4), naming the robot YAML rather than the import's --joints.
+// With --skip-mapping-check, the line that says it was written anyway (else "").
+std::string RefuseJointsInAnotherOrder(const ImportRosbag2Options& o,
+                                       const std::vector<RunLog>& runs,
+                                       const RobotModelInterface& model) {
+  try {
+    const std::string line = CheckImportedChannelOrder(runs, model, o.skip_mapping_check);
+    return line.find("written anyway") != std::string::npos ? line : "";
+  } catch (const MiswiredError& e) {
+    std::string joints;
+    for (std::size_t c = 0; c < model.robot().channels.size(); ++c) {
+      joints += (c == 0 ? "" : ",") +
+                (o.joints.empty() ? model.robot().channels[c].name : o.joints.at(c));
+    }
+    throw MiswiredError(o.bag + ": read as --joints " + joints + " in the robot's channel order: " +
+                        e.what());
+  }
+}
+
 // Writes the data set staged and renamed over --out; returns the robot as it reads back (with the
 // ground-truth frame the bag added).
 RobotModelPtr WriteDataset(const ImportRosbag2Options& o, const Robot& robot,
-                           const Rosbag2Import& imp) {
+                           Rosbag2Import& imp) {
   io::StagedDirectory staged(o.out);
   const fs::path dir(staged.path());
   fs::create_directories(dir / "runs");
@@ -168,6 +192,9 @@ RobotModelPtr WriteDataset(const ImportRosbag2Options& o, const Robot& robot,
   io::WriteFileAtomically((dir / "dataset.yaml").string(),
                           header + io::DatasetYaml("robot.yaml", entries));
   RefuseWhatFitRefuses(o, staged.path(), robot);
+  if (std::string said = RefuseJointsInAnotherOrder(o, imp.runs, *written); !said.empty()) {
+    imp.notes.push_back(std::move(said));
+  }
   io::StopHereForTests("import-rosbag2-before-rename");
   io::CommitDirectoryOutput(staged, o.out, io::kDatasetKind, o.force, {o.bag});
   return written;

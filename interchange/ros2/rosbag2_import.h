@@ -66,6 +66,9 @@ struct ImportRosbag2Options {
   std::string label;                // trajectory label; empty: the bag's name
   bool force = false;               // replace an existing --out
   bool quiet = false;
+  // Write even when another channel order or sign explains the ground truth far better than the
+  // one --joints gives (diagnosis/import_channel_order.h; exit 4 otherwise, as every import).
+  bool skip_mapping_check = false;
 };
 
 struct Rosbag2Import {
