@@ -246,5 +246,50 @@ TEST(FinalPoseJacobian, SinCosIsCeresOwnBitForBit) {
   }
 }
 
+// The diff drive's chord ratios written out on Jets (diff_drive_kinematics.h) against the same
+// formulas in ceres' Jet operators, both branches: exact equality of the value and every
+// derivative (no tolerance: the fits pinned by the approval tests replay through them), for Jets of
+// 3 (the final-pose and segment fits) and 4 (the effect fits) at zero, tiny, near the series'
+// bound on both sides, and seeded random angles with random derivative parts.
+template <int N>
+void ExpectChordRatiosAreJetOperators() {
+  using Jet = ceres::Jet<double, N>;
+  std::mt19937_64 rng(45 + N);
+  std::uniform_real_distribution<double> small(-0.012, 0.012), large(-10.0, 10.0), part(-3.0, 3.0);
+  std::vector<double> angles = {0.0, 1e-300, -1e-8, 1e-4, std::nextafter(1e-2, 0.0), 1e-2,
+                                -1e-2, 0.5, M_PI, 7.0};
+  for (int k = 0; k < 300; ++k) angles.push_back(small(rng));
+  for (int k = 0; k < 100; ++k) angles.push_back(large(rng));
+  int series = 0;
+  for (double a : angles) {
+    Jet f(a, 0);
+    for (int i = 0; i < N; ++i) f.v[i] = part(rng);
+    Jet expected_sin, expected_cos;
+    if (std::abs(a) < diff_drive::kChordSeriesMaxAngle) {
+      ++series;
+      const Jet a2 = f * f;
+      expected_sin = 1.0 + a2 * (-1.0 / 6.0 + a2 * (1.0 / 120.0 + a2 * (-1.0 / 5040.0)));
+      expected_cos = f * (0.5 + a2 * (-1.0 / 24.0 + a2 * (1.0 / 720.0 + a2 * (-1.0 / 40320.0))));
+    } else {
+      expected_sin = ceres::sin(f) / f;
+      expected_cos = (1.0 - ceres::cos(f)) / f;
+    }
+    Jet sin_over_a, one_minus_cos_over_a;
+    diff_drive::ChordRatios(f, &sin_over_a, &one_minus_cos_over_a);
+    EXPECT_EQ(sin_over_a.a, expected_sin.a) << a;
+    EXPECT_EQ(one_minus_cos_over_a.a, expected_cos.a) << a;
+    for (int i = 0; i < N; ++i) {
+      EXPECT_EQ(sin_over_a.v[i], expected_sin.v[i]) << a << " d" << i;
+      EXPECT_EQ(one_minus_cos_over_a.v[i], expected_cos.v[i]) << a << " d" << i;
+    }
+  }
+  EXPECT_GT(series, 200);  // the series branch is exercised (~250 of the 300 small angles)
+}
+
+TEST(FinalPoseJacobian, ChordRatiosAreTheJetOperatorsBitForBit) {
+  ExpectChordRatiosAreJetOperators<3>();
+  ExpectChordRatiosAreJetOperators<4>();
+}
+
 }  // namespace
 }  // namespace fitcal
