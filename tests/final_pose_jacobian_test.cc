@@ -20,9 +20,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "models/diff_drive/diff_drive_kinematics.h"
@@ -289,6 +291,54 @@ void ExpectChordRatiosAreJetOperators() {
 TEST(FinalPoseJacobian, ChordRatiosAreTheJetOperatorsBitForBit) {
   ExpectChordRatiosAreJetOperators<3>();
   ExpectChordRatiosAreJetOperators<4>();
+}
+
+// odometry/sin_cos.h's SinCosOfRepeatedAngle (the tricycle's steering): every result is libm's
+// (and ceres' for Jets) bit for bit, whatever came before on the thread - a repeated angle, +0
+// after -0 (their sines differ in sign), a NaN, another thread's angles in between.
+TEST(FinalPoseJacobian, SinCosOfARepeatedAngleIsLibmsBitForBit) {
+  std::mt19937_64 rng(46);
+  std::uniform_real_distribution<double> angle(-4.0, 4.0), part(-3.0, 3.0);
+  std::vector<double> angles = {0.0, -0.0, -0.0, 0.0, 0.0, 1.5, 1.5, std::nan(""), 1.5, -1.5};
+  for (int k = 0; k < 200; ++k) {
+    const double a = angle(rng);
+    for (int r = k % 4; r >= 0; --r) angles.push_back(a);  // runs of 1-4 equal angles
+  }
+  const auto check_all = [&angles](int* mismatches) {
+    for (double a : angles) {
+      double s = 0.0, c = 0.0;
+      SinCosOfRepeatedAngle(a, &s, &c);
+      const double s_libm = std::sin(a), c_libm = std::cos(a);
+      if (std::memcmp(&s, &s_libm, sizeof s) != 0 || std::memcmp(&c, &c_libm, sizeof c) != 0) {
+        ++*mismatches;
+      }
+    }
+  };
+  int mismatches = 0;
+  check_all(&mismatches);
+  int other_thread = 0;
+  std::thread other([&] { check_all(&other_thread); });
+  check_all(&mismatches);  // the two threads interleave on the same sequence
+  other.join();
+  EXPECT_EQ(mismatches, 0);
+  EXPECT_EQ(other_thread, 0);
+
+  using Jet = ceres::Jet<double, 4>;
+  for (double a : angles) {
+    if (std::isnan(a)) continue;
+    Jet f(a, 0);
+    for (int i = 0; i < 4; ++i) f.v[i] = part(rng);
+    Jet s, c;
+    SinCosOfRepeatedAngle(f, &s, &c);
+    const Jet s_ceres = ceres::sin(f), c_ceres = ceres::cos(f);
+    EXPECT_EQ(std::signbit(s.a), std::signbit(s_ceres.a)) << a;
+    EXPECT_EQ(s.a, s_ceres.a) << a;
+    EXPECT_EQ(c.a, c_ceres.a) << a;
+    for (int i = 0; i < 4; ++i) {
+      EXPECT_EQ(s.v[i], s_ceres.v[i]) << a;
+      EXPECT_EQ(c.v[i], c_ceres.v[i]) << a;
+    }
+  }
 }
 
 }  // namespace
