@@ -20,9 +20,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "models/diff_drive/diff_drive_kinematics.h"
@@ -242,6 +244,99 @@ TEST(FinalPoseJacobian, SinCosIsCeresOwnBitForBit) {
     for (int i = 0; i < 4; ++i) {
       EXPECT_EQ(sin_over_a.v[i], expected_sin.v[i]) << a;
       EXPECT_EQ(one_minus_cos_over_a.v[i], expected_cos.v[i]) << a;
+    }
+  }
+}
+
+// The diff drive's chord ratios written out on Jets (diff_drive_kinematics.h) against the same
+// formulas in ceres' Jet operators, both branches: exact equality of the value and every
+// derivative (no tolerance: the fits pinned by the approval tests replay through them), for Jets of
+// 3 (the final-pose and segment fits) and 4 (the effect fits) at zero, tiny, near the series'
+// bound on both sides, and seeded random angles with random derivative parts.
+template <int N>
+void ExpectChordRatiosAreJetOperators() {
+  using Jet = ceres::Jet<double, N>;
+  std::mt19937_64 rng(45 + N);
+  std::uniform_real_distribution<double> small(-0.012, 0.012), large(-10.0, 10.0), part(-3.0, 3.0);
+  std::vector<double> angles = {0.0, 1e-300, -1e-8, 1e-4, std::nextafter(1e-2, 0.0), 1e-2,
+                                -1e-2, 0.5, M_PI, 7.0};
+  for (int k = 0; k < 300; ++k) angles.push_back(small(rng));
+  for (int k = 0; k < 100; ++k) angles.push_back(large(rng));
+  int series = 0;
+  for (double a : angles) {
+    Jet f(a, 0);
+    for (int i = 0; i < N; ++i) f.v[i] = part(rng);
+    Jet expected_sin, expected_cos;
+    if (std::abs(a) < diff_drive::kChordSeriesMaxAngle) {
+      ++series;
+      const Jet a2 = f * f;
+      expected_sin = 1.0 + a2 * (-1.0 / 6.0 + a2 * (1.0 / 120.0 + a2 * (-1.0 / 5040.0)));
+      expected_cos = f * (0.5 + a2 * (-1.0 / 24.0 + a2 * (1.0 / 720.0 + a2 * (-1.0 / 40320.0))));
+    } else {
+      expected_sin = ceres::sin(f) / f;
+      expected_cos = (1.0 - ceres::cos(f)) / f;
+    }
+    Jet sin_over_a, one_minus_cos_over_a;
+    diff_drive::ChordRatios(f, &sin_over_a, &one_minus_cos_over_a);
+    EXPECT_EQ(sin_over_a.a, expected_sin.a) << a;
+    EXPECT_EQ(one_minus_cos_over_a.a, expected_cos.a) << a;
+    for (int i = 0; i < N; ++i) {
+      EXPECT_EQ(sin_over_a.v[i], expected_sin.v[i]) << a << " d" << i;
+      EXPECT_EQ(one_minus_cos_over_a.v[i], expected_cos.v[i]) << a << " d" << i;
+    }
+  }
+  EXPECT_GT(series, 200);  // the series branch is exercised (~250 of the 300 small angles)
+}
+
+TEST(FinalPoseJacobian, ChordRatiosAreTheJetOperatorsBitForBit) {
+  ExpectChordRatiosAreJetOperators<3>();
+  ExpectChordRatiosAreJetOperators<4>();
+}
+
+// odometry/sin_cos.h's SinCosOfRepeatedAngle (the tricycle's steering): every result is libm's
+// (and ceres' for Jets) bit for bit, whatever came before on the thread - a repeated angle, +0
+// after -0 (their sines differ in sign), a NaN, another thread's angles in between.
+TEST(FinalPoseJacobian, SinCosOfARepeatedAngleIsLibmsBitForBit) {
+  std::mt19937_64 rng(46);
+  std::uniform_real_distribution<double> angle(-4.0, 4.0), part(-3.0, 3.0);
+  std::vector<double> angles = {0.0, -0.0, -0.0, 0.0, 0.0, 1.5, 1.5, std::nan(""), 1.5, -1.5};
+  for (int k = 0; k < 200; ++k) {
+    const double a = angle(rng);
+    for (int r = k % 4; r >= 0; --r) angles.push_back(a);  // runs of 1-4 equal angles
+  }
+  const auto check_all = [&angles](int* mismatches) {
+    for (double a : angles) {
+      double s = 0.0, c = 0.0;
+      SinCosOfRepeatedAngle(a, &s, &c);
+      const double s_libm = std::sin(a), c_libm = std::cos(a);
+      if (std::memcmp(&s, &s_libm, sizeof s) != 0 || std::memcmp(&c, &c_libm, sizeof c) != 0) {
+        ++*mismatches;
+      }
+    }
+  };
+  int mismatches = 0;
+  check_all(&mismatches);
+  int other_thread = 0;
+  std::thread other([&] { check_all(&other_thread); });
+  check_all(&mismatches);  // the two threads interleave on the same sequence
+  other.join();
+  EXPECT_EQ(mismatches, 0);
+  EXPECT_EQ(other_thread, 0);
+
+  using Jet = ceres::Jet<double, 4>;
+  for (double a : angles) {
+    if (std::isnan(a)) continue;
+    Jet f(a, 0);
+    for (int i = 0; i < 4; ++i) f.v[i] = part(rng);
+    Jet s, c;
+    SinCosOfRepeatedAngle(f, &s, &c);
+    const Jet s_ceres = ceres::sin(f), c_ceres = ceres::cos(f);
+    EXPECT_EQ(std::signbit(s.a), std::signbit(s_ceres.a)) << a;
+    EXPECT_EQ(s.a, s_ceres.a) << a;
+    EXPECT_EQ(c.a, c_ceres.a) << a;
+    for (int i = 0; i < 4; ++i) {
+      EXPECT_EQ(s.v[i], s_ceres.v[i]) << a;
+      EXPECT_EQ(c.v[i], c_ceres.v[i]) << a;
     }
   }
 }

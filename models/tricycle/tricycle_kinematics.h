@@ -88,7 +88,8 @@ struct TricycleKinematicsT {
       steering_rad += values[kSteeringChannel];
     }
     T sin_steering, cos_steering;
-    SinCos(steering_rad, &sin_steering, &cos_steering);
+    // The steering reading holds for most samples (sin_cos.h): libm once per new angle.
+    SinCosOfRepeatedAngle(steering_rad, &sin_steering, &cos_steering);
     *dx = distance_m * cos_steering;
     *dy = T(0.0);
     *dtheta = distance_m * sin_steering * k.inverse_wheelbase_per_m;
