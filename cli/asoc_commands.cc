@@ -96,9 +96,10 @@ void AddAsocGeometricOptions(CLI::App& app, FitCommandOptions& geometric) {
                  "others judge it against the nominal")
       ->capture_default_str()
       ->check(RepetitionListValidator());
-  app.add_option("--out", geometric.out, "Calibrated robot YAML (atomically)")
-      ->capture_default_str();
-  app.add_flag("--no-output", geometric.no_output, "Do not write the YAML");
+  CLI::Option* out = app.add_option("--out", geometric.out, "Calibrated robot YAML (atomically)")
+                         ->capture_default_str();
+  // An --out given with --no-output would be dropped: one of them is a mistake (as fit).
+  app.add_flag("--no-output", geometric.no_output, "Do not write the YAML")->excludes(out);
   app.add_flag("--force", geometric.force, io::kForceFileHelp);
 }
 

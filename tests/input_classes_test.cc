@@ -263,8 +263,8 @@ TEST(InputClassesCli, UsageErrorsAreOneLineExitTwoBeforeAnyWork) {
 
 // probe45: flags the command would drop. compare ran every fit without --seed (Ceres methods
 // only), --loss (NLopt methods only), --polish or --max-iterations where no method asked for uses
-// them, exit 0, where fit refuses the same flags; fit and compare with --no-output dropped an
-// --out given beside it. Each: exit 2, one line naming the flag, before any data is read.
+// them, exit 0, where fit refuses the same flags; fit, compare and asoc-geometric with
+// --no-output dropped an --out given beside it. Each: exit 2, one line naming the flag, before any data is read.
 TEST(InputClassesCli, FlagsNoMethodAskedWouldUseAreRefused) {
   const TempDir dir;
   struct Case {
@@ -280,6 +280,8 @@ TEST(InputClassesCli, FlagsNoMethodAskedWouldUseAreRefused) {
            {compare + "--methods ceres --no-output --out " + dir.Path("table"),
             "--out excludes --no-output"},
            {"fit --logs . --no-output --out " + dir.Path("cal.yaml"),
+            "--out excludes --no-output"},
+           {"asoc-geometric --logs . --no-output --out " + dir.Path("cal.yaml"),
             "--out excludes --no-output"}}) {
     const auto r = RunFitcal(dir, c.args);
     EXPECT_EQ(r.exit_code, 2) << c.args << ": " << r.out << r.err;
