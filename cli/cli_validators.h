@@ -60,6 +60,22 @@ inline CLI::Validator NonEmptyPathValidator() {
       "PATH", "non-empty path");
 }
 
+// --joints: each comma-separated item a joint name. An empty item (`--joints ,`) made CLI11 take
+// the flags that followed as joint names (`--out` written into the controller's wheel names,
+// exit 0): an item that is empty or starts with "--" (a long flag; one dash may begin a name) is
+// refused.
+inline CLI::Validator JointNameValidator() {
+  return CLI::Validator(
+      [](std::string& text) {
+        if (text.empty()) return std::string("holds an empty joint name (a stray comma?)");
+        if (text.rfind("--", 0) == 0) {
+          return "takes joint names, not '" + text + "' (a flag? give the names, comma-separated)";
+        }
+        return std::string();
+      },
+      "NAME,...", "joint names");
+}
+
 // The whole text read as a double (strtod's syntax: "nan" and "inf" too); nothing when any of it
 // is not part of the number.
 inline std::optional<double> WholeTextNumber(const std::string& text) {

@@ -56,7 +56,8 @@ void AddExportRos2ControlOptions(CLI::App& app, ExportRos2ControlOptions& o) {
   app.add_option("--node-name", o.node_name, "Top-level key (default: the controller's name)");
   app.add_option("--joints", o.joints,
                  "URDF joint names in the robot's channel order (default: the channel names)")
-      ->delimiter(',');
+      ->delimiter(',')
+      ->check(JointNameValidator());
   app.add_option("--out", o.out, "File to write (atomically; default: stdout)");
   CLI::Option* logs = app.add_option("--logs", o.logs,
                  "Data set: replay the exported parameters on its held-out runs beside the "

@@ -20,7 +20,8 @@ void AddImportRosbag2Options(CLI::App& app, ImportRosbag2Options& o) {
       ->capture_default_str();
   app.add_option("--joints", o.joints,
                  "Joint names in the robot's channel order (default: the channel names)")
-      ->delimiter(',');
+      ->delimiter(',')
+      ->check(JointNameValidator());
   app.add_option("--ground-truth", o.ground_truth,
                  "Ground-truth topic: geometry_msgs/msg/PoseStamped, nav_msgs/msg/Odometry or "
                  "tf2_msgs/msg/TFMessage")

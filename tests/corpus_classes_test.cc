@@ -832,6 +832,30 @@ TEST(CorpusNeighbours, OneNameForTwoThingsIsRefused) {
   EXPECT_TRUE(Has(fleet.err, metrics + ":3: parameter 'r_left' is listed twice")) << fleet.err;
 }
 
+// `--joints ,` (a stray comma): CLI11 took the flags after it as joint names, so `--out x` was
+// written into the controller's wheel names and the parameters went to stdout, exit 0. export
+// and import rosbag2 take joint names only: exit 2, one line, nothing written.
+TEST(CorpusNeighbours, AFlagAfterAStrayCommaIsNotAJointName) {
+  const TempDir dir;
+  const std::string data = SimulateDiffDrive(dir, "data");
+  const std::string cal = dir.Path("cal.yaml");
+  ASSERT_EQ(RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --out " + cal).exit_code, 0);
+  const std::string out = dir.Path("params.yaml");
+  for (const std::string& args :
+       {"export ros2-control --controller diff_drive_controller --calibration " + cal +
+            " --joints , --out " + out,
+        "export ros2-control --controller diff_drive_controller --calibration " + cal +
+            " --joints '' --out " + out,
+        "import rosbag2 " + dir.Path("no_bag") + " --ground-truth /gt --joints , --out " + out}) {
+    const FitcalRun r = RunFitcal(dir, args);
+    EXPECT_EQ(r.exit_code, 2) << args << ": " << r.out << r.err;
+    EXPECT_EQ(Lines(r.err), 1) << r.err;
+    EXPECT_TRUE(Has(r.err, "--joints: ")) << r.err;
+    EXPECT_EQ(r.out.find("wheel_names"), std::string::npos) << r.out;
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
 // fleet: two robots of one name and one model with other wheels (a mecanum robot of four wheels
 // and an omni robot of three, both model `omni`) were merged into one series per wheel name
 // (R_fl of both in one row, R_rr of one); refused as the different models are.
