@@ -11,7 +11,6 @@
 #include "diagnosis/channel_order_check.h"
 #include "diagnosis/clock_choice.h"
 #include "diagnosis/diagnose.h"
-#include "fit/run_split.h"
 #include "fit/segment_cost.h"
 #include "fitcal/version.h"
 #include "io/atomic_file.h"

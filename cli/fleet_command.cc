@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "cli/dataset_command.h"
+#include "interchange/fleet/fleet_files.h"
 #include "io/command_failure.h"
 #include "odometry/text_format.h"
 

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "interchange/fleet/fleet_files.h"
+#include "validation/fleet_statistics.h"
 
 namespace CLI {
 class App;
@@ -23,8 +23,6 @@ namespace fitcal::tools {
 struct FleetOptions {
   std::vector<std::string> inputs;
 };
-
-using fitcal::ReadFleet;
 
 // The table, one block per robot.
 std::string FleetTable(const std::vector<FleetSeries>& series);

@@ -4,6 +4,7 @@
 // (radius 2 mm off): an outlier, and not a trend.
 
 #include "cli/fleet_command.h"
+#include "interchange/fleet/fleet_files.h"
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
@@ -58,7 +59,7 @@ TEST(Fleet, FlagsTrendsAndOutliers) {
     }
   }
   tmp.Write("fleet/notes.yaml", "just: notes\n");  // found by the search, not a calibration
-  const std::vector<FleetSeries> all = tools::ReadFleet({tmp.Path("fleet")});
+  const std::vector<FleetSeries> all = ReadFleet({tmp.Path("fleet")});
   const FleetSeries& worn = Find(all, "r1", "r_left");
   EXPECT_EQ(worn.values.size(), 8u);
   EXPECT_TRUE(worn.trend);
@@ -88,12 +89,12 @@ TEST(Fleet, FlagsTrendsAndOutliers) {
   tmp.Write("fleet/r1/2026-04-22/report/metrics.json", report);
   tmp.Write("fleet/r1/2026-04-29/report/metrics.json",
             R"({"robot": "r1", "parameters": [{"name": "r_left", "calibrated_m": 0.0411}]})");
-  const std::vector<FleetSeries> with_reports = tools::ReadFleet({tmp.Path("fleet")});
+  const std::vector<FleetSeries> with_reports = ReadFleet({tmp.Path("fleet")});
   EXPECT_EQ(Find(with_reports, "r1", "r_left").values.size(), 9u);  // + 2026-04-29 only
   EXPECT_EQ(Find(with_reports, "r1", "r_left").values.back(), 0.0411);
 
   tmp.Write("undated/cal.yaml", testing::ReadFileBytes(worn.files[0]));
-  EXPECT_THROW(tools::ReadFleet({tmp.Path("undated/cal.yaml")}), io::InputError);
+  EXPECT_THROW(ReadFleet({tmp.Path("undated/cal.yaml")}), io::InputError);
 }
 
 // Issue 42: fleet printed angles in rad where fit prints degrees, no sigma, and compared held-out
@@ -121,7 +122,7 @@ TEST(Fleet, PrintsUnitsAndSigmasAndNotesCfsJudgedOnDifferentRuns) {
         "fleet/" + std::string(data == "/data/week1" ? "2026-05-01" : "2026-05-08") + "/cal.yaml",
         model->RobotYaml(robot.nominal, block));
   }
-  const std::vector<FleetSeries> all = tools::ReadFleet({tmp.Path("fleet")});
+  const std::vector<FleetSeries> all = ReadFleet({tmp.Path("fleet")});
   const std::string table = tools::FleetTable(all);
   const std::string& name = robot.parameters[angle].name;
   const FleetSeries& steering = Find(all, robot.name, name);
@@ -145,7 +146,7 @@ TEST(Fleet, PrintsUnitsAndSigmasAndNotesCfsJudgedOnDifferentRuns) {
                                 "calibration:\n  dataset: /data/one\n  training_repetitions: [1]\n"
                                 "  cf_validation: {before: 0.05, after: 0.01}\n"));
   }
-  EXPECT_EQ(tools::FleetTable(tools::ReadFleet({same.Path("fleet")})).find("note:"),
+  EXPECT_EQ(tools::FleetTable(ReadFleet({same.Path("fleet")})).find("note:"),
             std::string::npos);
 }
 
