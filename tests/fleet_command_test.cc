@@ -15,6 +15,7 @@
 #include <random>
 
 #include "io/input_error.h"
+#include "io/warnings.h"
 #include "models/model_registry.h"
 #include "tests/model_support.h"
 #include "tests/test_files.h"
@@ -92,6 +93,20 @@ TEST(Fleet, FlagsTrendsAndOutliers) {
   const std::vector<FleetSeries> with_reports = ReadFleet({tmp.Path("fleet")});
   EXPECT_EQ(Find(with_reports, "r1", "r_left").values.size(), 9u);  // + 2026-04-29 only
   EXPECT_EQ(Find(with_reports, "r1", "r_left").values.back(), 0.0411);
+
+  // A calibration a write cut short (an unclosed flow map) is skipped by the search, not refused
+  // (other YAML may sit there), but said with its file and line: a lost night is not silent.
+  const std::string whole = testing::ReadFileBytes(worn.files[0]);
+  tmp.Write("fleet/r1/2026-05-06/cal.yaml",
+            whole.substr(0, whole.find("bounds:")) + "bounds: {r: [");
+  std::vector<std::string> warnings;
+  io::SetWarningSinkForTests([&](const std::string& w) { warnings.push_back(w); });
+  const std::vector<FleetSeries> with_cut = ReadFleet({tmp.Path("fleet")});
+  io::SetWarningSinkForTests(nullptr);
+  EXPECT_EQ(Find(with_cut, "r1", "r_left").values.size(), 9u);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("2026-05-06/cal.yaml:"), std::string::npos) << warnings[0];
+  EXPECT_NE(warnings[0].find("does not parse as YAML"), std::string::npos) << warnings[0];
 
   tmp.Write("undated/cal.yaml", testing::ReadFileBytes(worn.files[0]));
   EXPECT_THROW(ReadFleet({tmp.Path("undated/cal.yaml")}), io::InputError);

@@ -13,6 +13,7 @@
 #include "io/calibration_yaml.h"
 #include "io/command_failure.h"
 #include "io/input_error.h"
+#include "io/warnings.h"
 #include "io/yaml_reader.h"
 #include "models/model_registry.h"
 #include "pages/report_json.h"
@@ -145,8 +146,12 @@ bool IsCalibrationYaml(const fs::path& p) {
   if (p.extension() != ".yaml" && p.extension() != ".yml") return false;
   try {
     return static_cast<bool>(YAML::LoadFile(p.string())["calibration"]);
-  } catch (const YAML::Exception&) {
-    return false;  // not ours to judge when found by searching
+  } catch (const YAML::Exception& e) {
+    // Not ours to refuse when found by searching (a directory may hold other YAML), but a
+    // calibration a write cut short looks just like this: said, so that no night is lost unseen.
+    io::Warn(p.string(), e.mark.is_null() ? 0 : e.mark.line + 1,
+             "does not parse as YAML (" + e.msg + "); skipped by the search");
+    return false;
   }
 }
 
