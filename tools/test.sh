@@ -25,6 +25,12 @@ if command -v ccache > /dev/null; then
   # The sanitizer build's instrumented objects carry debug lines (-g1), and ccache then hashes the
   # build directory too: without this another clone compiles them again (282 s on a warm machine).
   export CCACHE_NOHASHDIR=1
+  # Depend mode: on a miss ccache takes the included files from the compiler's own -MD output
+  # instead of running the preprocessor first (by default it preprocesses every missed file once
+  # more, to look it up by its preprocessed text). A cold build misses everything: the 100 Release
+  # translation units' preprocessing is ~38 s of CPU, the instrumented ones' ~4 s (docs/tests.md);
+  # hits are direct either way.
+  export CCACHE_DEPEND=1
   launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 fi
 
