@@ -1,40 +1,35 @@
 #include "cli/fit_printout.h"
 
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <iostream>
 
-#include "diagnosis/degenerate_data.h"
+#include "calibrate/outcome_figures.h"
 #include "fit/motion_advice.h"
 #include "fitcal/version.h"
 #include "models/mounted_model.h"
 #include "cli/everyday_driving_table.h"
 #include "cli/tying_flags.h"
 #include "validation/trajectory_family.h"
-#include "validation/trajectory_metrics.h"
 
 namespace fitcal::tools {
 
 namespace {
 
-void PrintCfTable(const CalibrationCandidate& nominal, const CalibrationCandidate& selected,
-                  const RunSplit& split, const CandidateErrors& errors) {
-  const auto row = [&](const char* name, const std::vector<AlignedRun>& runs) {
-    const FinalPoseErrors before = errors(nominal, runs);
-    const FinalPoseErrors after = errors(selected, runs);
+void PrintCfTable(const std::vector<CfRow>& rows) {
+  std::printf("  %-30s %10s %10s %9s\n", "CF (Eq. 14, m and rad)", "nominal", "calibrated",
+              "change");
+  for (const CfRow& r : rows) {
+    const FinalPoseErrors& before = r.nominal;
+    const FinalPoseErrors& after = r.selected;
     const double change = before.cf > 0.0 ? 100.0 * (after.cf - before.cf) / before.cf : 0.0;
-    std::printf("  %-30s %10.4f %10.4f %+8.1f%%\n", name, before.cf, after.cf, change);
+    std::printf("  %-30s %10.4f %10.4f %+8.1f%%\n", r.side, before.cf, after.cf, change);
     std::printf("  %-30s %10.4f %10.4f\n", "  mean final position error [m]",
                 before.mean_position_error_m, after.mean_position_error_m);
     std::printf("  %-30s %10.3f %10.3f\n", "  mean final heading error [deg]",
                 RadToDeg(before.mean_abs_heading_error_rad),
                 RadToDeg(after.mean_abs_heading_error_rad));
-  };
-  std::printf("  %-30s %10s %10s %9s\n", "CF (Eq. 14, m and rad)", "nominal", "calibrated",
-              "change");
-  row("training", split.training);
-  if (!split.validation.empty()) row("validation", split.validation);
+  }
 }
 
 void PrintParameters(const Robot& robot, const std::vector<double>& p, const SelectedFit& fit) {
@@ -125,10 +120,10 @@ void PrintSolver(const CalibrationRequest& request, const CalibrationOutcome& o)
 
 // The header, the CF table, the parameters and the solvers' stop reasons.
 void PrintFit(const CalibrationRequest& request, const RobotModelInterface& model,
-              const CalibrationOutcome& o, const CandidateErrors& errors) {
+              const CalibrationOutcome& o) {
   PrintHeader(request, model.robot(), o.split);
   const CalibrationCandidate& selected = o.selected();
-  PrintCfTable(o.candidates[0], selected, o.split, errors);
+  PrintCfTable(CfRows(model, o, request.threads));
   PrintParameters(model.robot(), selected.parameters, o.selected_fit);
   for (const effects::EffectValue& e : selected.effects) {
     const effects::EffectInfo& info = effects::Info(e.id);
@@ -145,51 +140,32 @@ void PrintFit(const CalibrationRequest& request, const RobotModelInterface& mode
 void PrintClockOffsets(const ModelFitResult& fit, const TrackFitData& track) {
   if (!track.estimate_clock_offsets || track.clock_groups.empty()) return;
   const std::size_t n = track.clock_groups.size();
-  const auto sigma = [&](std::size_t g) {
-    return g < fit.clock_offset_sigma_s.size() ? fit.clock_offset_sigma_s[g] : 0.0;
-  };
-  std::printf("clock offsets (ground truth at encoder time + dt, |dt| <= %.2g s), %zu %s:\n",
-              track.options.max_clock_offset_s, n, n == 1 ? "group" : "groups");
-  constexpr std::size_t kMaxListed = 12;
-  // An offset on its bound is where the fit was stopped, not a measured lag: said, with the
-  // groups, so that it is not read as one.
   const double bound = track.options.max_clock_offset_s;
-  std::string on_bound;
-  std::size_t num_on_bound = 0;
-  for (std::size_t g = 0; g < n; ++g) {
-    if (std::abs(fit.clock_offsets_s[g]) < bound * (1.0 - 1e-3)) continue;
-    ++num_on_bound;
-    if (num_on_bound <= 3) on_bound += (on_bound.empty() ? "" : ", ") + track.clock_groups[g];
-  }
-  const auto warn_on_bound = [&] {
-    if (num_on_bound == 0) return;
-    std::printf("warning: %zu clock offset%s rest%s on the +-%.2g s bound (%s%s): not a measured "
-                "lag; the clocks differ by more, or the offset absorbs a mismatch of the runs "
-                "(--clock-offsets none, or check the ground truth's time stamps)\n",
-                num_on_bound, num_on_bound == 1 ? "" : "s", num_on_bound == 1 ? "s" : "", bound,
-                on_bound.c_str(), num_on_bound > 3 ? ", ..." : "");
-  };
-  if (n <= kMaxListed) {
-    for (std::size_t g = 0; g < n; ++g) {
-      // A sigma of exactly 0 is the covariance that could not be computed, not a sure offset.
-      if (sigma(g) > 0.0) {
-        std::printf("  %-36s %+8.3f s +- %.3f\n", track.clock_groups[g].c_str(),
-                    fit.clock_offsets_s[g], sigma(g));
-      } else {
-        std::printf("  %-36s %+8.3f s +- ? (no covariance)\n", track.clock_groups[g].c_str(),
-                    fit.clock_offsets_s[g]);
-      }
+  const ClockOffsetSummary s = SummariseClockOffsets(fit, track);
+  std::printf("clock offsets (ground truth at encoder time + dt, |dt| <= %.2g s), %zu %s:\n",
+              bound, n, n == 1 ? "group" : "groups");
+  constexpr std::size_t kMaxListed = 12;
+  for (std::size_t g = 0; g < n && n <= kMaxListed; ++g) {
+    // A sigma of exactly 0 is the covariance that could not be computed, not a sure offset.
+    if (s.sigma_s[g] > 0.0) {
+      std::printf("  %-36s %+8.3f s +- %.3f\n", track.clock_groups[g].c_str(),
+                  fit.clock_offsets_s[g], s.sigma_s[g]);
+    } else {
+      std::printf("  %-36s %+8.3f s +- ? (no covariance)\n", track.clock_groups[g].c_str(),
+                  fit.clock_offsets_s[g]);
     }
-    warn_on_bound();
-    return;
   }
-  std::vector<double> sorted(fit.clock_offsets_s.begin(), fit.clock_offsets_s.begin() + n);
-  std::sort(sorted.begin(), sorted.end());
-  double mean_sigma = 0.0;
-  for (std::size_t g = 0; g < n; ++g) mean_sigma += sigma(g) / n;
-  std::printf("  median %+.3f s, range [%+.3f, %+.3f] s, mean sigma %.3f s\n", sorted[n / 2],
-              sorted.front(), sorted.back(), mean_sigma);
-  warn_on_bound();
+  if (n > kMaxListed) {
+    std::printf("  median %+.3f s, range [%+.3f, %+.3f] s, mean sigma %.3f s\n", s.median_s,
+                s.lo_s, s.hi_s, s.mean_sigma_s);
+  }
+  // An offset on its bound is where the fit was stopped: said, so that it is not read as a lag.
+  if (s.num_on_bound == 0) return;
+  std::printf("warning: %zu clock offset%s rest%s on the +-%.2g s bound (%s%s): not a measured "
+              "lag; the clocks differ by more, or the offset absorbs a mismatch of the runs "
+              "(--clock-offsets none, or check the ground truth's time stamps)\n",
+              s.num_on_bound, s.num_on_bound == 1 ? "" : "s", s.num_on_bound == 1 ? "s" : "",
+              bound, s.first_on_bound.c_str(), s.num_on_bound > 3 ? ", ..." : "");
 }
 
 // The residuals fitted, how they were chosen, and the clock offsets fitted with them.
@@ -209,29 +185,21 @@ void PrintResiduals(const CalibrationOutcome& o, const std::vector<std::string>&
 
 // The counter glitches the loader dropped (io/log_files.h), each named above with its line.
 void PrintEncoderGlitches(const std::vector<RunLog>& runs) {
-  int glitches = 0, runs_with = 0;
-  for (const RunLog& run : runs) {
-    glitches += run.encoders.dropped_glitches;
-    runs_with += run.encoders.dropped_glitches > 0;
-  }
-  if (glitches == 0) return;
+  const DroppedGlitches g = CountDroppedGlitches(runs);
+  if (g.intervals == 0) return;
   std::printf("encoder glitches: %d interval%s in %d run%s dropped from the fit (each named with "
               "its file:line in the warnings)\n",
-              glitches, glitches == 1 ? "" : "s", runs_with, runs_with == 1 ? "" : "s");
+              g.intervals, g.intervals == 1 ? "" : "s", g.runs, g.runs == 1 ? "" : "s");
 }
 
 // Drift per 1, 2, 5 m and ATE RMSE (validation/never_worse.h) of the nominal and the
 // selected calibration on the held-out runs (the training runs when none is held out).
 void PrintEverydayDriving(const RobotModelInterface& model, const CalibrationOutcome& o,
                           int threads) {
-  const RunSplit& split = o.split;
-  const CalibrationCandidate& nominal = o.candidates[0];
-  const CalibrationCandidate& selected = o.selected();
-  const bool held_out = !split.validation.empty();
-  const std::vector<AlignedRun>& runs = held_out ? split.validation : split.training;
+  const OutcomeEverydayDriving driving = CompareOutcomeEverydayDriving(model, o, threads);
   PrintEverydayDrivingTable(
-      held_out ? "everyday driving, validation" : "everyday driving, training",
-      CompareEverydayDriving(model, nominal, selected, runs, TracksOf(runs), threads));
+      driving.held_out ? "everyday driving, validation" : "everyday driving, training",
+      driving.table);
 }
 
 // Each direction held at the nominal, and what to drive to determine it (fit/motion_advice.h).
@@ -251,17 +219,10 @@ void PrintHeldDirections(const RobotModelInterface& model, const ModelFitResult&
 // another run), and parameters that stopped on their bounds.
 void PrintFitWarnings(const RobotModelInterface& model, const RunSplit& split,
                       const ModelFitResult& fit, int threads) {
-  if (fit.usable || fit.stopped_early) {
-    std::vector<std::string> ids;
-    for (const AlignedRun& run : split.training) ids.push_back(run.id);
-    const FinalPoseErrors errors =
-        EvaluateFinalPoseErrors(model, fit.parameters, split.training, threads);
-    for (const OutlierRun& o : FindOutlierRuns(ids, errors.per_run_cf)) {
-      std::printf(
-          "warning: run %s: final-pose error %.1fx the median run's (gross wheel slip or a "
-          "ground truth of another run?); a robust loss limits its pull\n",
-          o.id.c_str(), o.error_ratio);
-    }
+  for (const OutlierRun& o : OutlierTrainingRuns(model, split, fit, threads)) {
+    std::printf("warning: run %s: final-pose error %.1fx the median run's (gross wheel slip or a "
+                "ground truth of another run?); a robust loss limits its pull\n",
+                o.id.c_str(), o.error_ratio);
   }
   if (std::find(fit.at_bound.begin(), fit.at_bound.end(), true) != fit.at_bound.end()) {
     std::printf(
@@ -291,8 +252,7 @@ void PrintGate(const CalibrationOutcome& o) {
 // Everything up to the gate's table: the fit, the residuals, everyday driving, the warnings.
 void PrintReport(const CalibrationRequest& request, const RobotModelInterface& model,
                  const CalibrationOutcome& o, const std::vector<std::string>& flag_notes) {
-  const CandidateErrors errors(model, request.threads);
-  PrintFit(request, model, o, errors);
+  PrintFit(request, model, o);
   PrintTying(o.settings.tying);
   if (!request.closed_forms_only) PrintResiduals(o, flag_notes);
   PrintEncoderGlitches(request.runs);

@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <stdexcept>
 
 #include "cli/dataset_command.h"
@@ -28,15 +29,9 @@ effects::EffectValue ParseInjectedEffect(const std::string& text) {
   std::string rest = text.substr(eq + 1);
   for (int k = 0; k < info.num_parameters; ++k) {
     const std::size_t comma = rest.find(',');
-    const std::string item = rest.substr(0, comma);
-    std::size_t used = 0;
-    try {
-      e.value[k] = std::stod(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != item.size() ||
-        !(e.value[k] >= info.lower[k] && e.value[k] <= info.upper[k])) {
+    const std::optional<double> value = WholeTextNumber(rest.substr(0, comma));
+    e.value[k] = value.value_or(0.0);
+    if (!value || !(e.value[k] >= info.lower[k] && e.value[k] <= info.upper[k])) {
       throw std::invalid_argument("--inject '" + text + "': " + info.parameter_names[k] +
                                   " must be a number in [" + std::to_string(info.lower[k]) + ", " +
                                   std::to_string(info.upper[k]) + "]");

@@ -13,6 +13,44 @@
 namespace fitcal::asoc {
 namespace {
 
+// True when the used pivots' centroid is the body origin (b = c = 0 in Eq. 18), to 1e-9 m.
+bool PivotsCentred(const std::array<PivotPosition, kNumCastors>& pivots, CastorMask mask) {
+  double mx = 0.0, my = 0.0;
+  for (int i = 0; i < kNumCastors; ++i) {
+    if ((mask >> i) & 1u) {
+      mx += pivots[i].x_m();
+      my += pivots[i].y_m();
+    }
+  }
+  return std::hypot(mx, my) < 1e-9;
+}
+
+// CAST centred solution, Eq. 22: translation = the mean pivot displacement, and
+//   dpsi = sum R_i (dy_i cos(psi+phi_i) - dx_i sin(psi+phi_i)) / sum R_i^2,
+// which is Eq. 22's (1/n) sum (1/R)(...) when all R_i equal R. Only valid for centred pivots.
+template <typename T>
+BodyStep<T> SolveCastCentred(const std::array<PivotPosition, kNumCastors>& pivots, CastorMask mask,
+                             const T& psi, const T* dx, const T* dy) {
+  using std::cos;
+  using std::sin;
+  const T cp = cos(psi), sp = sin(psi);
+  double n = 0.0, d = 0.0;
+  BodyStep<T> out{T(0.0), T(0.0), T(0.0)};
+  for (int i = 0; i < kNumCastors; ++i) {
+    if (!((mask >> i) & 1u)) continue;
+    const double px = pivots[i].x_m(), py = pivots[i].y_m();
+    n += 1.0;
+    d += px * px + py * py;
+    out.dx_m += dx[i];
+    out.dy_m += dy[i];
+    out.dpsi_rad += (px * cp - py * sp) * dy[i] - (py * cp + px * sp) * dx[i];
+  }
+  out.dx_m /= n;
+  out.dy_m /= n;
+  out.dpsi_rad /= d;
+  return out;
+}
+
 CastorParameters TestCastor() {
   CastorParameters c;
   c.offset_m = 0.08;

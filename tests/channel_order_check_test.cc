@@ -16,6 +16,7 @@
 #include "models/omni3/omni3_robot_model.h"
 #include "tests/test_files.h"
 #include "tests/flower_scenario.h"
+#include "tests/omni3_robot.h"
 
 namespace fitcal {
 namespace channel_order_check_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)

@@ -15,6 +15,7 @@
 #include "models/omni3/omni3_robot_model.h"
 #include "tests/flower_scenario.h"
 #include "tests/test_paths.h"
+#include "tests/omni3_robot.h"
 
 namespace fitcal {
 namespace diagnose_hidden_structure_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)

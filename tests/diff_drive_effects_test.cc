@@ -28,6 +28,7 @@
 #include "models/diff_drive/diff_drive_trajectories.h"
 #include "sim/model_simulator.h"
 #include "validation/trajectory_metrics.h"
+#include "tests/omni3_robot.h"
 
 namespace fitcal {
 namespace diff_drive_effects_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)

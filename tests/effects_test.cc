@@ -19,6 +19,7 @@
 #include "tests/flower_scenario.h"
 #include "validation/statistics.h"
 #include "tests/test_paths.h"
+#include "tests/omni3_robot.h"
 
 namespace fitcal {
 namespace {

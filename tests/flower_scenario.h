@@ -13,6 +13,7 @@
 #include "models/omni3/omni3_robot_model.h"
 #include "sim/model_scenarios.h"
 #include "sim/model_simulator.h"
+#include "tests/omni3_robot.h"
 
 namespace fitcal::sim {
 

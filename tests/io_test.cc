@@ -15,6 +15,7 @@
 #include "models/model_registry.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "tests/test_files.h"
+#include "tests/omni3_robot.h"
 
 namespace fitcal::io {
 namespace {

@@ -109,7 +109,7 @@ TEST(ModelExtras, ExportFindsTheToysControllerWriterThroughTheRegistry) {
                 {"--calibration", diff_drive, "--controller", kController}),
             2);
   try {
-    ExportRos2Control(diff_drive, kController, "", {});
+    ExportRos2Control(ReadRobotModelFile(diff_drive), diff_drive, kController, "", {});
     ADD_FAILURE() << "a diff_drive was exported as the toy's controller";
   } catch (const std::exception& e) {
     EXPECT_TRUE(testing::Has(e.what(), "(it takes model test_unicycle)")) << e.what();

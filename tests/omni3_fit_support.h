@@ -9,6 +9,7 @@
 #include "fit/model_fit.h"
 #include "fit/model_nlopt_fit.h"
 #include "models/omni3/omni3_robot_model.h"
+#include "tests/omni3_robot.h"
 
 namespace fitcal::testing {
 

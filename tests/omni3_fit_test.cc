@@ -10,6 +10,7 @@
 #include "tests/omni3_fit_support.h"
 #include "tests/omni3_reference_replay.h"
 #include "tests/flower_scenario.h"
+#include "tests/omni3_robot.h"
 
 namespace fitcal {
 namespace {

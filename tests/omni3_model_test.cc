@@ -14,6 +14,7 @@
 #include "odometry/pose2.h"
 #include "models/omni/flower_trajectories.h"
 #include "tests/flower_scenario.h"
+#include "tests/omni3_robot.h"
 
 namespace fitcal::omni3 {
 namespace {

@@ -12,6 +12,7 @@
 #include "fit/strategies.h"
 #include "tests/omni3_fit_support.h"
 #include "tests/flower_scenario.h"
+#include "tests/omni3_robot.h"
 
 namespace fitcal {
 namespace {

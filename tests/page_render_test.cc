@@ -14,7 +14,13 @@
 #include <string>
 
 #include "pages/diagnose_page.h"
-#include "pages/report_writer.h"
+#include "pages/report_csv.h"
+#include "pages/report_figures.h"
+#include "pages/report_html.h"
+#include "pages/report_json.h"
+#include "pages/report_markdown.h"
+#include "pages/report_model.h"
+#include "pages/report_tum.h"
 #include "tests/test_files.h"
 
 namespace fitcal::io {

@@ -29,6 +29,7 @@
 #include "tests/test_files.h"
 #include "models/diff_drive/diff_drive_trajectories.h"
 #include "sim/model_simulator.h"
+#include "tests/omni3_robot.h"
 
 namespace fitcal {
 namespace {

@@ -1,4 +1,4 @@
-// The report files (pages/report_writer.h, pages/svg_plot.h): index.html is well formed, embeds
+// The report files (pages/report_*.h, pages/svg_plot.h): index.html is well formed, embeds
 // every figure, and references nothing outside itself; the CSV and JSON carry the numbers.
 
 #include <gtest/gtest.h>
@@ -12,7 +12,13 @@
 #include <vector>
 
 #include "pages/diagnose_page.h"
-#include "pages/report_writer.h"
+#include "pages/report_csv.h"
+#include "pages/report_figures.h"
+#include "pages/report_html.h"
+#include "pages/report_json.h"
+#include "pages/report_markdown.h"
+#include "pages/report_model.h"
+#include "pages/report_tum.h"
 #include "pages/svg_plot.h"
 #include "validation/trajectory_family.h"
 

@@ -50,6 +50,17 @@ using namespace io::rosbag2;
 
 using namespace testing::robot_bag;  // the simulated robot and its bag (tests/robot_bag.h)
 
+// The export of a calibration file, as `fitcal export ros2-control` reads it: the controller and
+// distribution checked before the file is read.
+Ros2ControlExport ExportRos2Control(const std::string& calibration_path,
+                                    const std::string& controller, const std::string& node_name,
+                                    const std::vector<std::string>& joints,
+                                    const std::string& ros_distro = RosDistros().back()) {
+  CheckControllerDistro(controller, ros_distro);
+  return fitcal::ExportRos2Control(ReadRobotModelFile(calibration_path), calibration_path,
+                                   controller, node_name, joints, ros_distro);
+}
+
 ImportRosbag2Options ImportOptions(const testing::TempDir& tmp, const fs::path& bag) {
   ImportRosbag2Options o;
   o.bag = bag.string();

@@ -14,8 +14,8 @@
 #include <random>
 
 #include "fit/model_fit.h"
-#include "models/omni3/omni3_robot.h"
 #include "models/omni3/omni3_robot_model.h"
+#include "tests/omni3_robot.h"
 
 namespace fitcal {
 namespace segment_cost_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)

@@ -10,6 +10,7 @@
 #include "fit/effect_fit.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "tests/flower_scenario.h"
+#include "tests/omni3_robot.h"
 
 namespace fitcal {
 namespace {

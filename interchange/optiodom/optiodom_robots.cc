@@ -24,28 +24,25 @@ RobotModelPtr Omni3Nominal(const Metadata& metadata) {
   constexpr double kWheelAngleDeg[3] = {300.0, 60.0, 180.0};
   const double distance_m = metadata.Value("Li", true);
   const std::vector<double> diameter_m = metadata.Values("Di", 3, true);
-  Omni3Robot robot;
-  robot.name = "optiodom_omni3";
-  robot.wheel_names = {"a", "b", "c"};
-  for (int i = 0; i < 3; ++i) {
-    robot.nominal.distance_m[i] = distance_m;
-    robot.nominal.radius_m[i] = 0.5 * diameter_m[i];
-    robot.nominal.angle_rad[i] = DegToRad(kWheelAngleDeg[i]);
-  }
+  Robot robot = Omni3RobotDescription("optiodom_omni3", {"a", "b", "c"});
+  robot.nominal.assign(3, distance_m);
+  for (double d : diameter_m) robot.nominal.push_back(0.5 * d);
+  for (double deg : kWheelAngleDeg) robot.nominal.push_back(DegToRad(deg));
   // Palacin Eq. 16 gives R +- 0.025 m, r +- 0.010 m on r = 0.148 m (6.8 %), delta +- 2 deg: the
   // same physical box scaled to this robot's wheels, with R widened by kTrackedPointOffset_m: the
   // ground truth tracks the marker centroid, not the kinematic centre, and an offset e shifts
   // every fitted R_i by up to |e| (README, "Why the distances run into their bounds"; ~3 cm on
   // this robot, which left a distance on Eq. 16's bound and the fit without convergence).
   constexpr double kTrackedPointOffset_m = 0.025;
-  const auto [r_min, r_max] =
-      std::minmax_element(robot.nominal.radius_m.begin(), robot.nominal.radius_m.end());
-  robot.bounds.distance_m = {distance_m - 0.025 - kTrackedPointOffset_m,
-                             distance_m + 0.025 + kTrackedPointOffset_m};
-  robot.bounds.radius_m = {*r_min * (1.0 - 0.01 / 0.148), *r_max * (1.0 + 0.01 / 0.148)};
-  robot.bounds.angle_offset_rad = {DegToRad(-2.0), DegToRad(2.0)};
+  const auto [d_min, d_max] = std::minmax_element(diameter_m.begin(), diameter_m.end());
+  OmniBounds box;
+  box.distance_m = {distance_m - 0.025 - kTrackedPointOffset_m,
+                    distance_m + 0.025 + kTrackedPointOffset_m};
+  box.radius_m = {0.5 * *d_min * (1.0 - 0.01 / 0.148), 0.5 * *d_max * (1.0 + 0.01 / 0.148)};
+  box.angle_offset_rad = {DegToRad(-2.0), DegToRad(2.0)};
+  robot.bounds = Omni3ParameterBounds(robot.nominal, box);
   robot.encoder = EncoderTicks{metadata.TicksPerWheelRev(), false};
-  return Omni3ModelOf(robot);
+  return std::make_shared<Omni3Model>(std::move(robot), box.angle_offset_rad);
 }
 
 // omni4: `t, x, y, theta, enc_1..enc_4`, wheel revolutions over the 10 ms cycle ending at t

@@ -157,15 +157,6 @@ Ros2ControlExport ExportRos2Control(const RobotModelPtr& calibrated,
   return out;
 }
 
-Ros2ControlExport ExportRos2Control(const std::string& calibration_path,
-                                    const std::string& controller, const std::string& node_name,
-                                    const std::vector<std::string>& joints,
-                                    const std::string& ros_distro) {
-  CheckControllerDistro(controller, ros_distro);
-  return ExportRos2Control(ReadRobotModelFile(calibration_path), calibration_path, controller,
-                           node_name, joints, ros_distro);
-}
-
 namespace {
 
 // The held-out runs of a loaded data set (ExportHeldOutRuns); `held_out_logs` takes theirs.

@@ -95,11 +95,6 @@ Ros2ControlExport ExportRos2Control(const RobotModelPtr& calibrated,
                                     const std::string& controller, const std::string& node_name,
                                     const std::vector<std::string>& joints,
                                     const std::string& ros_distro = RosDistros().back());
-// The same from the calibration file; io::InputError for a bad one.
-Ros2ControlExport ExportRos2Control(const std::string& calibration_path,
-                                    const std::string& controller, const std::string& node_name,
-                                    const std::vector<std::string>& joints,
-                                    const std::string& ros_distro = RosDistros().back());
 
 // The covariance keys of `controller` (ros__parameters lines, 4-space indent) holding `c`.
 std::string Ros2CovarianceParameters(const std::string& controller, const OdometryCovariance& c);

@@ -5,8 +5,8 @@
 //   - CAST-n: the linear least squares of Eq. 13-17 over any subset of >= 2 castors,
 //       dx_i = dx_c - dpsi R_i sin(psi + phi_i)   (Eq. 13)
 //       dy_i = dy_c + dpsi R_i cos(psi + phi_i)   (Eq. 14)
-//     solved with the closed-form (H^T H)^-1 of Eq. 18-21 for pivots anywhere on the body, or with
-//     Eq. 22 when the used pivots are centred on the body origin;
+//     solved with the closed-form (H^T H)^-1 of Eq. 18-21 for pivots anywhere on the body (Eq. 22,
+//     for pivots centred on the body origin, is its special case: tests/asoc_odometry_test.cc);
 //   - IPEC (Borenstein, Eq. 10) on two castors as the baseline;
 //   - the final step both share: each castor's heading is updated from the new vehicle heading and
 //     its measured castor angle (chi_i = psi+ + gamma_i+ - beta_i).
@@ -91,44 +91,6 @@ BodyStep<T> SolveCastGeneral(const std::array<PivotPosition, kNumCastors>& pivot
   out.dx_m = inv * ((c * c - n * d) * sum_dx - b * c * sum_dy + n * b * sum_rot);
   out.dy_m = inv * (-b * c * sum_dx + (b * b - n * d) * sum_dy + n * c * sum_rot);
   out.dpsi_rad = inv * (n * b * sum_dx + n * c * sum_dy - n * n * sum_rot);
-  return out;
-}
-
-// True when the used pivots' centroid is the body origin (b = c = 0 in Eq. 18), to 1e-9 m.
-inline bool PivotsCentred(const std::array<PivotPosition, kNumCastors>& pivots, CastorMask mask) {
-  double mx = 0.0, my = 0.0;
-  for (int i = 0; i < kNumCastors; ++i) {
-    if ((mask >> i) & 1u) {
-      mx += pivots[i].x_m();
-      my += pivots[i].y_m();
-    }
-  }
-  return std::hypot(mx, my) < 1e-9;
-}
-
-// CAST centred solution, Eq. 22: translation = the mean pivot displacement, and
-//   dpsi = sum R_i (dy_i cos(psi+phi_i) - dx_i sin(psi+phi_i)) / sum R_i^2,
-// which is Eq. 22's (1/n) sum (1/R)(...) when all R_i equal R. Only valid for centred pivots.
-template <typename T>
-BodyStep<T> SolveCastCentred(const std::array<PivotPosition, kNumCastors>& pivots, CastorMask mask,
-                             const T& psi, const T* dx, const T* dy) {
-  using std::cos;
-  using std::sin;
-  const T cp = cos(psi), sp = sin(psi);
-  double n = 0.0, d = 0.0;
-  BodyStep<T> out{T(0.0), T(0.0), T(0.0)};
-  for (int i = 0; i < kNumCastors; ++i) {
-    if (!((mask >> i) & 1u)) continue;
-    const double px = pivots[i].x_m(), py = pivots[i].y_m();
-    n += 1.0;
-    d += px * px + py * py;
-    out.dx_m += dx[i];
-    out.dy_m += dy[i];
-    out.dpsi_rad += (px * cp - py * sp) * dy[i] - (py * cp + px * sp) * dx[i];
-  }
-  out.dx_m /= n;
-  out.dy_m /= n;
-  out.dpsi_rad /= d;
   return out;
 }
 

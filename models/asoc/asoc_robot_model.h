@@ -31,8 +31,6 @@ class AsocModel : public KinematicModel<AsocKinematics> {
   AsocModel(Robot robot, io::AsocRobot asoc, AsocKinematics kinematics)
       : KinematicModel(std::move(robot), std::move(kinematics)), asoc_(std::move(asoc)) {}
 
-  const io::AsocRobot& asoc_robot() const { return asoc_; }
-
   using RobotModelInterface::RobotYaml;
   std::string RobotYaml(const std::vector<double>& p,
                         const std::vector<effects::EffectValue>& effects,

@@ -53,36 +53,16 @@ std::vector<sim::TrajectorySpec> FlowerScenario(const Robot& /*nominal*/,
   return sim::FlowerSpecs(sim::FlowerTrajectories(), repetitions);
 }
 
-omni3::Parameters Make(double r_a, double r_b, double r_c, double wr_a, double wr_b, double wr_c,
-                       double d_a_deg, double d_b_deg, double d_c_deg) {
-  omni3::Parameters p;
-  p.distance_m = {r_a, r_b, r_c};
-  p.radius_m = {wr_a, wr_b, wr_c};
-  p.angle_rad = {d_a_deg * M_PI / 180.0, d_b_deg * M_PI / 180.0, d_c_deg * M_PI / 180.0};
-  return p;
-}
-
 }  // namespace
 
 namespace sim {
 
 omni3::Parameters PalacinTable5Parameters() {
-  return Make(0.218643, 0.215735, 0.216287, 0.155068, 0.151534, 0.152728, 59.7397, 179.6820,
-              301.5735);
-}
-
-omni3::Parameters PalacinNominalParameters() {
-  return Make(0.195, 0.195, 0.195, 0.148, 0.148, 0.148, 60.0, 180.0, 300.0);
-}
-
-Omni3Robot PalacinApr02Robot() {
-  Omni3Robot robot;
-  robot.name = "apr02";
-  robot.nominal = PalacinNominalParameters();
-  robot.bounds.distance_m = {0.170, 0.220};  // Palacin Eq. 16
-  robot.bounds.radius_m = {0.138, 0.158};
-  robot.bounds.angle_offset_rad = {-2.0 * M_PI / 180.0, 2.0 * M_PI / 180.0};
-  return robot;
+  omni3::Parameters p;
+  p.distance_m = {0.218643, 0.215735, 0.216287};
+  p.radius_m = {0.155068, 0.151534, 0.152728};
+  p.angle_rad = {59.7397 * M_PI / 180.0, 179.6820 * M_PI / 180.0, 301.5735 * M_PI / 180.0};
+  return p;
 }
 
 std::vector<double> ParameterVector(const omni3::Parameters& p) {

@@ -8,7 +8,6 @@
 
 #include "models/model_extras.h"
 #include "models/omni3/omni3_parameters.h"
-#include "models/omni3/omni3_robot.h"
 
 namespace fitcal {
 
@@ -18,10 +17,6 @@ ModelExtras Omni3Extras();
 namespace sim {
 // Palacin Table 5: the STE-GA5 calibrated parameters of APR-02, the flower's default truth.
 omni3::Parameters PalacinTable5Parameters();
-// Palacin Eq. 15: the nominal parameters.
-omni3::Parameters PalacinNominalParameters();
-// APR-02 as data/robots/apr02.yaml describes it: Eq. 15 nominal, Eq. 16 bounds.
-Omni3Robot PalacinApr02Robot();
 // The nine parameters in the seam's order (Eq. 15: R_i, r_i, delta_i).
 std::vector<double> ParameterVector(const omni3::Parameters& p);
 }  // namespace sim

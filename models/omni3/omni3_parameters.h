@@ -103,36 +103,4 @@ Matrix3<T> InverseKinematicMatrix(const T* p) {
   return m * inv_den;
 }
 
-// Inverts Eq. 3: from the rows of M back to the nine parameters. Row i is
-// [-sin d_i, cos d_i, R_i] / r_i, so r_i = 1 / |(M_i0, M_i1)|, d_i = atan2(-M_i0, M_i1) and
-// R_i = M_i2 r_i. Each angle is returned in the turn nearest to reference_angle_rad[i] (the
-// nominal), since the matrix only knows angles modulo 2 pi.
-inline Parameters ParametersFromKinematicMatrix(
-    const Matrix3<double>& m, const std::array<double, kNumWheels>& reference_angle_rad) {
-  Parameters out;
-  for (int i = 0; i < kNumWheels; ++i) {
-    const double radius = 1.0 / std::hypot(m(i, 0), m(i, 1));
-    double angle = std::atan2(-m(i, 0), m(i, 1));
-    angle += 2.0 * M_PI * std::round((reference_angle_rad[i] - angle) / (2.0 * M_PI));
-    out.radius_m[i] = radius;
-    out.angle_rad[i] = angle;
-    out.distance_m[i] = m(i, 2) * radius;
-  }
-  return out;
-}
-
-inline Parameters ParametersFromInverseKinematicMatrix(
-    const Matrix3<double>& m_inv, const std::array<double, kNumWheels>& reference_angle_rad) {
-  return ParametersFromKinematicMatrix(m_inv.inverse(), reference_angle_rad);
-}
-
-// Wheel rates that realise a robot-frame motion command, Palacin Eq. 1 and Table A1:
-// speed v (m/s) in direction alpha (rad, robot frame) while turning at omega (rad/s).
-inline Eigen::Vector3d WheelRatesForCommand(const double* p, double speed_m_s, double alpha_rad,
-                                            double omega_rad_s) {
-  const Eigen::Vector3d v_robot(speed_m_s * std::cos(alpha_rad), speed_m_s * std::sin(alpha_rad),
-                                omega_rad_s);
-  return KinematicMatrix(p) * v_robot;
-}
-
 }  // namespace fitcal::omni3

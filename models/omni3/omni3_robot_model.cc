@@ -8,8 +8,6 @@
 #include "io/robot_yaml_blocks.h"
 #include "io/yaml_reader.h"
 #include "io/yaml_text.h"
-#include "models/model_registry.h"
-#include "models/omni/omni_model.h"
 
 namespace fitcal {
 
@@ -73,12 +71,7 @@ RobotModelPtr ReadOmni3Model(const YAML::Node& root, const std::string& path) {
   const OmniBounds box = ReadOmniBounds(robot_map, path);
   Robot robot = Omni3RobotDescription(name, names);
   robot.nominal.assign(p.begin(), p.end());
-  for (int i = 0; i < omni3::kNumWheels; ++i) robot.bounds.push_back(box.distance_m);
-  for (int i = 0; i < omni3::kNumWheels; ++i) robot.bounds.push_back(box.radius_m);
-  for (int i = 0; i < omni3::kNumWheels; ++i) {
-    const double delta = p[omni3::kAngleIndex + i];
-    robot.bounds.push_back({delta + box.angle_offset_rad.lo, delta + box.angle_offset_rad.hi});
-  }
+  robot.bounds = Omni3ParameterBounds(robot.nominal, box);
   for (int k = 0; k < robot.NumParameters(); ++k) {
     // Named at the line of its wheel (parameters are grouped by kind, three wheels each).
     if (!robot.bounds[k].Contains(robot.nominal[k])) {
@@ -96,51 +89,15 @@ RobotModelPtr ReadOmni3Model(const YAML::Node& root, const std::string& path) {
   return std::make_shared<Omni3Model>(std::move(robot), box.angle_offset_rad);
 }
 
-std::shared_ptr<const Omni3Model> Omni3ModelOf(const Omni3Robot& omni3_robot) {
-  Robot robot = Omni3RobotDescription(
-      omni3_robot.name, {omni3_robot.wheel_names.begin(), omni3_robot.wheel_names.end()});
-  const auto p = omni3_robot.nominal.ToArray();
-  robot.nominal.assign(p.begin(), p.end());
-  const auto box = omni3_robot.ParameterBounds();
-  robot.bounds.assign(box.begin(), box.end());
-  robot.encoder = omni3_robot.encoder;
-  robot.effects = omni3_robot.effects;
-  return std::make_shared<Omni3Model>(std::move(robot), omni3_robot.bounds.angle_offset_rad);
-}
-
-Omni3Robot Omni3RobotOf(const Omni3Model& model) {
-  const Robot& robot = model.robot();
-  Omni3Robot out;
-  out.name = robot.name;
-  for (int i = 0; i < omni3::kNumWheels; ++i) out.wheel_names[i] = robot.channels[i].name;
-  out.nominal = omni3::Parameters::FromArray(robot.nominal.data());
-  // One box per group (the YAML's schema; both constructors above fill every wheel alike).
-  out.bounds.distance_m = robot.bounds[omni3::kDistanceIndex];
-  out.bounds.radius_m = robot.bounds[omni3::kRadiusIndex];
-  out.bounds.angle_offset_rad = model.angle_offset_rad();
-  out.encoder = robot.encoder;
-  out.effects = robot.effects;
-  return out;
-}
-
-Omni3Robot ReadOmni3Robot(const std::string& path) {
-  const YAML::Node root = io::LoadYamlFile(path);
-  io::ExpectYamlType(root, YAML::NodeType::Map, path, "robot file");
-  // Another model's schema would fail on its first key; name the model instead.
-  if (root["model"]) {
-    const std::string model = io::YamlString(root["model"], path, "robot.model");
-    if (model != "omni3") {
-      throw InputError(InputErrorKind::kUnknownModel, path, LineOf(root["model"]),
-                       "model '" + model + "' is not omni3 (an omni3 robot is expected here)");
-    }
+std::vector<Interval> Omni3ParameterBounds(const std::vector<double>& nominal,
+                                           const OmniBounds& box) {
+  std::vector<Interval> bounds(omni3::kNumWheels, box.distance_m);
+  bounds.insert(bounds.end(), omni3::kNumWheels, box.radius_m);
+  for (int i = 0; i < omni3::kNumWheels; ++i) {
+    const double delta = nominal[omni3::kAngleIndex + i];
+    bounds.push_back({delta + box.angle_offset_rad.lo, delta + box.angle_offset_rad.hi});
   }
-  const RobotModelPtr model = ReadRobotModel(root, path);
-  return Omni3RobotOf(dynamic_cast<const Omni3Model&>(*model));
-}
-
-const Omni3Model& DefaultOmni3Model() {
-  static const std::shared_ptr<const Omni3Model> model = Omni3ModelOf(Omni3Robot{});
-  return *model;
+  return bounds;
 }
 
 std::string Omni3Model::RobotYaml(const std::vector<double>& p,

@@ -8,8 +8,8 @@
 #include <string>
 
 #include "models/kinematic_model.h"
+#include "models/omni/omni_model.h"
 #include "models/omni3/omni3_kinematics.h"
-#include "models/omni3/omni3_robot.h"
 
 namespace fitcal {
 
@@ -49,17 +49,10 @@ bounds:
 
 RobotModelPtr ReadOmni3Model(const YAML::Node& root, const std::string& path);
 
-// The seam's view of an omni3 robot held in named fields (models/omni3/omni3_robot.h), for the
-// paper-reproduction code and the OptiOdom importer, and its inverse.
-std::shared_ptr<const Omni3Model> Omni3ModelOf(const Omni3Robot& robot);
-Omni3Robot Omni3RobotOf(const Omni3Model& model);
-
-// An omni3 robot YAML read as the registry reads every robot (ReadOmni3Model and the registry's
-// checks), in named fields. InputError, at the `model:` line, for a robot of another model.
-Omni3Robot ReadOmni3Robot(const std::string& path);
-
-// The omni3 model of the default Omni3Robot, made once: the kinematics for callers that hold omni3
-// parameters without a robot (the parameters come with each call, the robot's values are not used).
-const Omni3Model& DefaultOmni3Model();
+// The bounds of the nine parameters (Eq. 15 order) in the box of the YAML's `bounds:`: one
+// interval for every R_i, one for every r_i, the angle bounds relative to each nominal delta_i
+// (Eq. 16).
+std::vector<Interval> Omni3ParameterBounds(const std::vector<double>& nominal,
+                                           const OmniBounds& box);
 
 }  // namespace fitcal

@@ -9,7 +9,6 @@
 #include "io/robot_yaml_blocks.h"
 #include "io/yaml_reader.h"
 #include "io/yaml_text.h"
-#include "models/tricycle/tricycle_checks.h"
 
 namespace fitcal {
 
@@ -176,11 +175,6 @@ std::string TricycleRobotYaml(const Robot& robot, const std::vector<double>& p,
   io::EmitEncoderAndEffects(out, robot, effects);
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n" + calibration_block;
-}
-
-template <bool kHasGain>
-void TricycleModelT<kHasGain>::CheckSamples(const EncoderLog& log, const std::string& path) const {
-  tricycle::CheckSteeringSamples(log, path);
 }
 
 template class TricycleModelT<false>;

@@ -23,7 +23,6 @@
 
 #include "models/kinematic_model.h"
 #include "models/tricycle/tricycle_kinematics.h"
-#include "odometry/run_log.h"
 
 namespace fitcal {
 
@@ -45,11 +44,6 @@ class TricycleModelT : public KinematicModel<TricycleKinematicsT<kHasGain>> {
                         const std::string& calibration_block) const override {
     return TricycleRobotYaml(this->robot_, p, effects, calibration_block);
   }
-
-  // The loader's hook for model-specific checks of a log (proposed as a virtual of
-  // RobotModelInterface): the steering channel is present, in [-pi, pi] and not ticks
-  // (tricycle_checks.h). Throws io::InputError.
-  void CheckSamples(const EncoderLog& log, const std::string& path) const;
 };
 
 using TricycleModel = TricycleModelT<false>;

@@ -18,6 +18,7 @@
 #include "tests/omni3_reference_replay.h"
 #include "tests/flower_scenario.h"
 #include "tests/test_paths.h"
+#include "tests/omni3_robot.h"
 
 namespace fitcal {
 namespace {

@@ -15,6 +15,7 @@
 #include "models/omni3/omni3_robot_model.h"
 #include "odometry/aligned_run.h"
 #include "tests/flower_scenario.h"
+#include "tests/omni3_robot.h"
 
 namespace fitcal {
 namespace {

@@ -18,6 +18,7 @@
 #include "models/diff_drive/diff_drive_model.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "cli/import_rosbag2.h"
+#include "tests/omni3_robot.h"
 
 namespace fitcal::fuzz {
 
