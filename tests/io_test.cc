@@ -15,6 +15,7 @@
 #include "models/model_registry.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "tests/test_files.h"
+#include "tests/three_wheel_files.h"
 
 namespace fitcal::io {
 namespace {

@@ -19,6 +19,7 @@
 #include "io/text_file.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "tests/test_files.h"
+#include "tests/three_wheel_files.h"
 
 namespace fitcal {
 namespace {

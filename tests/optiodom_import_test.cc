@@ -16,6 +16,7 @@
 #include "odometry/aligned_run.h"
 #include "cli/import_optiodom.h"
 #include "tests/test_paths.h"
+#include "tests/three_wheel_files.h"
 
 namespace fitcal {
 namespace {

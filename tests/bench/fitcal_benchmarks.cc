@@ -18,6 +18,7 @@
 #include "tests/omni3_reference_replay.h"
 #include "tests/flower_scenario.h"
 #include "tests/test_paths.h"
+#include "tests/three_wheel_files.h"
 
 namespace fitcal {
 namespace {
