@@ -89,6 +89,9 @@ std::vector<CalibrationCandidate> Candidates(const RobotModelInterface& model,
   return out;
 }
 
+namespace {
+
+// "name, name" of the effects.
 std::string EffectNames(const EffectModel& effects) {
   std::string out;
   for (const effects::EffectValue& e : effects) {
@@ -96,8 +99,6 @@ std::string EffectNames(const EffectModel& effects) {
   }
   return out;
 }
-
-namespace {
 
 // The model's parameters and `effects` fitted on the training tracks (fit/effect_fit.h),
 // from the nominal, as `diagnose` and `generalise --effects` fit them.
@@ -108,6 +109,17 @@ EffectFitResult FitEffects(const ResidualWeights& weights, int threads,
   o.weights = weights;
   o.num_threads = threads;
   return FitEffectModel(training, model, model.robot().nominal, effects, o);
+}
+
+// The candidate without effects with the lowest CF on the runs that judged (-1: none usable).
+int BestWithoutEffects(const std::vector<CalibrationCandidate>& candidates,
+                       const GateDecision& gate) {
+  int best = -1;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    if (!candidates[i].effects.empty() || !std::isfinite(gate.cf[i])) continue;
+    if (best < 0 || gate.cf[i] < gate.cf[best]) best = static_cast<int>(i);
+  }
+  return best;
 }
 
 }  // namespace
@@ -126,16 +138,6 @@ TrackFits AddTrackFitCandidates(const ResidualWeights& weights, int threads,
   candidates->push_back({"track fit + " + EffectNames(effects_to_fit), t.with_effects.parameters,
                          t.with_effects.usable, t.with_effects.effects});
   return t;
-}
-
-int BestWithoutEffects(const std::vector<CalibrationCandidate>& candidates,
-                       const GateDecision& gate) {
-  int best = -1;
-  for (std::size_t i = 0; i < candidates.size(); ++i) {
-    if (!candidates[i].effects.empty() || !std::isfinite(gate.cf[i])) continue;
-    if (best < 0 || gate.cf[i] < gate.cf[best]) best = static_cast<int>(i);
-  }
-  return best;
 }
 
 std::string RequireEffectsToEarnTheirPlace(const std::vector<CalibrationCandidate>& candidates,

@@ -62,13 +62,6 @@ TrackFits AddTrackFitCandidates(const ResidualWeights& weights, int threads,
                                 const EffectModel& effects_to_fit,
                                 std::vector<CalibrationCandidate>* candidates);
 
-// "name, name" of the effects.
-std::string EffectNames(const EffectModel& effects);
-
-// The candidate without effects with the lowest CF on the runs that judged (-1: none usable).
-int BestWithoutEffects(const std::vector<CalibrationCandidate>& candidates,
-                       const GateDecision& gate);
-
 // An effect earns its place as a calibration earns it against the nominal: the gate's choice,
 // when it carries effects, must have lower per-run CFs than the same track fit without them
 // (like for like: the track objective alone must not be credited to the effects), by the

@@ -68,16 +68,12 @@ std::vector<std::pair<std::string, double>> Estimate(ClockGrouping grouping,
   return out;
 }
 
-}  // namespace
-
+// "recorded, none, session, run, dataset" (with_recorded) or without "recorded".
 std::string ClockOffsetModes(bool with_recorded) {
   return with_recorded ? "recorded, none, session, run, dataset" : "none, session, run, dataset";
 }
 
-bool IsClockOffsetMode(const std::string& mode, bool with_recorded) {
-  ClockGrouping grouping;
-  return (with_recorded && mode == "recorded") || ParseClockGrouping(mode, &grouping);
-}
+}  // namespace
 
 std::string AlignGroundTruthClocks(const std::string& mode, const RobotModelInterface& model,
                                    const std::vector<double>* parameters,

@@ -22,10 +22,6 @@
 
 namespace fitcal {
 
-// "recorded, none, session, run, dataset" (with_recorded) or without "recorded".
-std::string ClockOffsetModes(bool with_recorded);
-bool IsClockOffsetMode(const std::string& mode, bool with_recorded);
-
 // Re-stamps logs' ground truth by the offsets `mode` names and returns one line saying what was
 // done (printed by the caller). `parameters`: held while estimating (nullptr: estimated jointly
 // with the model's parameters from its nominal). `recorded`: the calibration's provenance (for

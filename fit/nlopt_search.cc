@@ -336,13 +336,6 @@ const std::vector<NloptMethodInfo>& NloptMethods() {
   return kMethods;
 }
 
-const NloptMethodInfo* FindNloptMethod(const std::string& name) {
-  for (const NloptMethodInfo& info : NloptMethods()) {
-    if (name == info.name) return &info;
-  }
-  return nullptr;
-}
-
 const NloptMethodInfo& Info(NloptMethod method) {
   for (const NloptMethodInfo& info : NloptMethods()) {
     if (info.method == method) return info;

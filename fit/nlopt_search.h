@@ -55,8 +55,6 @@ struct NloptMethodInfo {
 
 // Every method, in the order above.
 const std::vector<NloptMethodInfo>& NloptMethods();
-// nullptr when no method has that name.
-const NloptMethodInfo* FindNloptMethod(const std::string& name);
 const NloptMethodInfo& Info(NloptMethod method);
 
 // One point of a convergence trace: the best CF (Eq. 14, on the training runs) after

@@ -16,14 +16,7 @@ Pose2d Between(const Pose2d& a, const Pose2d& b) {
 
 Pose2d Inverse(const Pose2d& p) { return Between(p, Pose2d{}); }
 
-// Ad(dQ_k^-1): carries an error in the frame at checkpoint k-1 to the frame at k.
-Eigen::Matrix3d StepAdjoint(const TrackErrorChain& run, std::size_t k) {
-  const Pose2d previous = k == 0 ? Pose2d{} : run.ground_truth_from_start[k - 1];
-  return Adjoint(Inverse(Between(previous, run.ground_truth_from_start[k])));
-}
-
-}  // namespace
-
+// The SE(2) adjoint of `pose` in (x, y, theta) coordinates (header).
 Eigen::Matrix3d Adjoint(const Pose2d& pose) {
   const double c = std::cos(pose.theta), s = std::sin(pose.theta);
   Eigen::Matrix3d ad;
@@ -31,6 +24,13 @@ Eigen::Matrix3d Adjoint(const Pose2d& pose) {
   return ad;
 }
 
+// Ad(dQ_k^-1): carries an error in the frame at checkpoint k-1 to the frame at k.
+Eigen::Matrix3d StepAdjoint(const TrackErrorChain& run, std::size_t k) {
+  const Pose2d previous = k == 0 ? Pose2d{} : run.ground_truth_from_start[k - 1];
+  return Adjoint(Inverse(Between(previous, run.ground_truth_from_start[k])));
+}
+
+// The innovations eps_k^ = e_k - Ad(dQ_k^-1) e_{k-1} of one run (e_0 = 0).
 std::vector<Eigen::Vector3d> Innovations(const TrackErrorChain& run) {
   std::vector<Eigen::Vector3d> out;
   Eigen::Vector3d previous = Eigen::Vector3d::Zero();
@@ -40,6 +40,8 @@ std::vector<Eigen::Vector3d> Innovations(const TrackErrorChain& run) {
   }
   return out;
 }
+
+}  // namespace
 
 Eigen::MatrixXd RandomWalkScoreCovariance(const std::vector<TrackErrorChain>& runs, int m) {
   // Sigma and Gamma pooled over every run's innovations (header).
@@ -88,12 +90,6 @@ Eigen::MatrixXd InverseInformation(const Eigen::MatrixXd& information) {
   const Eigen::VectorXd& s = svd.singularValues();
   if (s.size() == 0 || !(s(s.size() - 1) > 1e-14 * s(0))) return {};
   return svd.matrixV() * s.cwiseInverse().asDiagonal() * svd.matrixU().transpose();
-}
-
-Eigen::MatrixXd SandwichCovariance(const Eigen::MatrixXd& information, const Eigen::MatrixXd& meat) {
-  const Eigen::MatrixXd inverse = InverseInformation(information);
-  if (inverse.size() == 0) return {};
-  return inverse * meat * inverse.transpose();
 }
 
 }  // namespace fitcal

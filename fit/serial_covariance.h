@@ -45,20 +45,11 @@ struct TrackErrorChain {
   std::vector<Pose2d> ground_truth_from_start;   // Q_k
 };
 
-// The SE(2) adjoint of `pose` in (x, y, theta) coordinates (header).
-Eigen::Matrix3d Adjoint(const Pose2d& pose);
-
-// The innovations eps_k^ = e_k - Ad(dQ_k^-1) e_{k-1} of one run (e_0 = 0).
-std::vector<Eigen::Vector3d> Innovations(const TrackErrorChain& run);
-
 // M of the header (m x m) over `runs`; empty runs are skipped.
 Eigen::MatrixXd RandomWalkScoreCovariance(const std::vector<TrackErrorChain>& runs, int m);
 
 // H^-1 for a symmetric positive definite H (m x m), by SVD; empty when H is singular to within a
 // reciprocal condition number of 1e-14 (Ceres' DENSE_SVD default).
 Eigen::MatrixXd InverseInformation(const Eigen::MatrixXd& information);
-
-// H^-1 M H^-1 (InverseInformation's H^-1); empty when H is singular.
-Eigen::MatrixXd SandwichCovariance(const Eigen::MatrixXd& information, const Eigen::MatrixXd& meat);
 
 }  // namespace fitcal

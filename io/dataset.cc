@@ -19,7 +19,6 @@
 #include "io/input_error.h"
 #include "io/input_registry.h"
 #include "io/log_files.h"
-#include "io/robot_yaml.h"
 #include "io/yaml_reader.h"
 #include "io/yaml_text.h"
 #include "odometry/parallel_for.h"
@@ -203,6 +202,9 @@ DatasetIndex ReadDatasetIndex(const std::string& directory, const DatasetOptions
   return index;
 }
 
+namespace {
+
+// Throws kNoOverlap when the ground truth does not share time with [enc_begin_s, enc_end_s].
 void CheckGroundTruthOverlap(const GroundTruthTrack& ground_truth, double enc_begin_s,
                              double enc_end_s, const std::string& ground_truth_path) {
   const double gt_begin = ground_truth.t_s.front(), gt_end = ground_truth.t_s.back();
@@ -232,16 +234,6 @@ void CheckGroundTruthOverlap(const GroundTruthTrack& ground_truth, double enc_be
     throw InputError(InputErrorKind::kNoOverlap, ground_truth_path, 0, msg.str());
   }
 }
-
-Dataset LoadDataset(const std::string& directory, const DatasetOptions& options) {
-  return LoadDataset(ReadDatasetIndex(directory, options), options);
-}
-
-Dataset LoadDataset(const DatasetIndex& index, const DatasetOptions& options) {
-  return LoadDataset(index, LegacyThreeWheelRobot(ReadEncoderTicks(index.robot_path)), options);
-}
-
-namespace {
 
 // Bytes of a vector of doubles, for hashing and comparing logs exactly.
 template <typename T>
@@ -411,36 +403,6 @@ std::string DatasetYaml(const std::string& robot_path, const std::vector<Dataset
   }
   out << YAML::EndSeq << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
-}
-
-std::string EncoderCsv(const EncoderLog& log) {
-  std::string out = "t,w_a,w_b,w_c\n";
-  out.reserve(log.t_s.size() * 40);
-  char line[160];
-  for (std::size_t k = 0; k < log.t_s.size(); ++k) {
-    const double* w = k == 0 ? nullptr : log.samples[k - 1].value;
-    const int n = w == nullptr ? std::snprintf(line, sizeof line, "%.6f,0,0,0\n", log.t_s[k])
-                               : std::snprintf(line, sizeof line, "%.6f,%.9g,%.9g,%.9g\n",
-                                               log.t_s[k], w[0], w[1], w[2]);
-    out.append(line, static_cast<std::size_t>(n));
-  }
-  return out;
-}
-
-std::string EncoderCsv(const Robot& robot, const std::vector<double>& t_s,
-                       const std::vector<std::vector<double>>& rows) {
-  std::string out = "t";
-  for (const ChannelInfo& c : robot.channels) out += "," + c.rate_column;
-  out += "\n";
-  char field[64];
-  for (std::size_t k = 0; k < t_s.size(); ++k) {
-    out.append(field, static_cast<std::size_t>(std::snprintf(field, sizeof field, "%.6f", t_s[k])));
-    for (double v : rows[k]) {
-      out.append(field, static_cast<std::size_t>(std::snprintf(field, sizeof field, ",%.9g", v)));
-    }
-    out += "\n";
-  }
-  return out;
 }
 
 void AppendFixed(std::string* out, double v, int precision) {

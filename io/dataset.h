@@ -39,24 +39,15 @@ struct DatasetIndex {
 
 DatasetIndex ReadDatasetIndex(const std::string& directory, const DatasetOptions& options = {});
 
-// Throws kNoOverlap when the ground truth does not share time with [enc_begin_s, enc_end_s].
-void CheckGroundTruthOverlap(const GroundTruthTrack& ground_truth, double enc_begin_s,
-                             double enc_end_s, const std::string& ground_truth_path);
-
 struct Dataset {
   std::string directory;
   std::string robot_path;  // resolved path of the robot YAML
   std::vector<RunLog> runs;
 };
 
-// Loads dataset.yaml and every run it lists as three wheel columns w_a, w_b, w_c (the shipped
-// flower's layout), whatever the robot YAML says: a shortcut for tests and benchmarks on such
-// files. Every command reads a data set with its robot's own channels (the overload below, through
-// the model registry: io, below it, names no model). Throws InputError naming the file and line.
-Dataset LoadDataset(const std::string& directory, const DatasetOptions& options = {});
-// The same from an index already read (dataset.yaml is then parsed once).
-Dataset LoadDataset(const DatasetIndex& index, const DatasetOptions& options = {});
-// Any robot model: every run's encoder CSV read with the robot's channels (log_files.h).
+// Every run's encoder CSV read with the robot's channels (log_files.h); every command reads a data
+// set so, the robot from the model registry (io, below it, names no model). Throws InputError
+// naming the file and line.
 Dataset LoadDataset(const DatasetIndex& index, const Robot& robot,
                     const DatasetOptions& options = {});
 
@@ -70,12 +61,6 @@ struct DatasetEntry {
 };
 
 std::string DatasetYaml(const std::string& robot_path, const std::vector<DatasetEntry>& runs);
-std::string EncoderCsv(const EncoderLog& log);
-// Any robot: header `t,<rate column per channel>`, then one row per time with what the CSV
-// holds per channel (rates over the interval ending at the row, angle readings at the row time;
-// row 0 sets the start, its rates are ignored).
-std::string EncoderCsv(const Robot& robot, const std::vector<double>& t_s,
-                       const std::vector<std::vector<double>>& rows);
 std::string GroundTruthCsv(const GroundTruthTrack& track);
 
 // Appends v as printf("%.<precision>f") / printf("%.<precision>g") would write it, byte for byte,

@@ -846,20 +846,6 @@ EncoderLog ReadEncoderCsv(const std::string& path, const Robot& robot) {
   return log;
 }
 
-Robot LegacyThreeWheelRobot(const std::optional<EncoderTicks>& ticks) {
-  Robot robot;
-  for (const char* w : {"a", "b", "c"}) {
-    robot.channels.push_back(
-        {w, ChannelKind::kWheelRate, std::string("w_") + w, std::string("ticks_") + w});
-  }
-  robot.encoder = ticks;
-  return robot;
-}
-
-EncoderLog ReadEncoderCsv(const std::string& path, const std::optional<EncoderTicks>& ticks) {
-  return ReadEncoderCsv(path, LegacyThreeWheelRobot(ticks));
-}
-
 namespace {
 
 // TUM quaternions are written with a few decimals: four components rounded to 1e-4 put the norm

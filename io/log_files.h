@@ -29,10 +29,6 @@ namespace fitcal::io {
 // the row time and become the mean over each interval. A three-channel robot also accepts the
 // positional legacy header above whatever its wheel names.
 EncoderLog ReadEncoderCsv(const std::string& path, const Robot& robot);
-// The legacy three-wheel form: channels a, b, c.
-EncoderLog ReadEncoderCsv(const std::string& path,
-                          const std::optional<EncoderTicks>& ticks = std::nullopt);
-Robot LegacyThreeWheelRobot(const std::optional<EncoderTicks>& ticks);
 
 // Turns encoder CSV rows (as written: per channel a rate, an angle reading at the row time, or
 // ticks) into the interval samples of an EncoderLog, one row at a time; shared by the reader and

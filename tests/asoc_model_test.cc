@@ -21,6 +21,7 @@
 #include "odometry/aligned_run.h"
 #include "tests/test_files.h"
 #include "sim/asoc_simulator.h"
+#include "tests/three_wheel_files.h"
 
 namespace fitcal {
 namespace {

@@ -18,7 +18,8 @@
 #include <random>
 #include <string>
 
-#include "io/rosbag2/bag_writer.h"
+#include "tests/bags/bag_writer.h"
+#include "tests/bags/ros_message_encoders.h"
 #include "io/rosbag2/ros_messages.h"
 #include "tests/fuzz/fuzz_support.h"
 #include "tests/test_files.h"

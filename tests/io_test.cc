@@ -16,6 +16,7 @@
 #include "models/omni3/omni3_robot_model.h"
 #include "tests/test_files.h"
 #include "tests/omni3_robot.h"
+#include "tests/three_wheel_files.h"
 
 namespace fitcal::io {
 namespace {

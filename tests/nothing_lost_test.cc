@@ -21,6 +21,7 @@
 #include "models/omni3/omni3_robot_model.h"
 #include "tests/test_files.h"
 #include "tests/omni3_robot.h"
+#include "tests/three_wheel_files.h"
 
 namespace fitcal {
 namespace nothing_lost_test {  // named, not anonymous: tests compile in batches (tests/CMakeLists.txt)

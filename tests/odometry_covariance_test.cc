@@ -39,15 +39,5 @@ TEST(OdometryCovariance, StructureFunctionKeepsEveryTermNonNegative) {
   EXPECT_GT(f[0], 0.0);
 }
 
-TEST(OdometryCovariance, PoseLawGrowsAsItsExponent) {
-  OdometryCovariance c;
-  c.pose_variance_1m = {1e-6, 4e-6, 1e-5};
-  c.pose_growth_exponent = {1.0, 3.0, 2.0};
-  const std::array<double, 3> at2 = PoseVarianceAfter(c, 2.0);
-  EXPECT_DOUBLE_EQ(at2[0], 2e-6);
-  EXPECT_DOUBLE_EQ(at2[1], 32e-6);
-  EXPECT_DOUBLE_EQ(at2[2], 4e-5);
-}
-
 }  // namespace
 }  // namespace fitcal

@@ -30,6 +30,7 @@
 #include "interchange/optiodom/optiodom_import.h"
 #include "sim/model_simulator.h"
 #include "models/omni/omni_trajectories.h"
+#include "tests/three_wheel_files.h"
 
 namespace fitcal {
 namespace {

@@ -17,6 +17,7 @@
 #include "cli/import_optiodom.h"
 #include "tests/test_paths.h"
 #include "tests/omni3_robot.h"
+#include "tests/three_wheel_files.h"
 
 namespace fitcal {
 namespace {

@@ -26,6 +26,7 @@
 #include "io/warnings.h"
 #include "io/yaml_reader.h"
 #include "tests/test_files.h"
+#include "tests/three_wheel_files.h"
 
 namespace fitcal {
 namespace {

@@ -16,7 +16,8 @@
 #include <utility>
 #include <vector>
 
-#include "io/rosbag2/bag_writer.h"
+#include "tests/bags/bag_writer.h"
+#include "tests/bags/ros_message_encoders.h"
 #include "io/rosbag2/ros_messages.h"
 #include "models/model_interface.h"
 #include "models/diff_drive/diff_drive_trajectories.h"

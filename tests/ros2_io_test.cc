@@ -25,7 +25,7 @@
 #include "io/calibration_yaml.h"
 #include "io/dataset.h"
 #include "io/rosbag2/bag_reader.h"
-#include "io/rosbag2/bag_writer.h"
+#include "tests/bags/bag_writer.h"
 #include "io/rosbag2/ros_messages.h"
 #include "models/diff_drive/diff_drive_model.h"
 #include "models/model_registry.h"

@@ -16,7 +16,8 @@
 
 #include "io/input_error.h"
 #include "io/rosbag2/bag_reader.h"
-#include "io/rosbag2/bag_writer.h"
+#include "tests/bags/bag_writer.h"
+#include "tests/bags/ros_message_encoders.h"
 #include "io/rosbag2/cdr_reader.h"
 #include "io/rosbag2/crc32.h"
 #include "io/rosbag2/ros_messages.h"

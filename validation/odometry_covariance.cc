@@ -326,11 +326,4 @@ OdometryCovariance EstimateOdometryCovariance(const RobotModelInterface& model,
   return out;
 }
 
-std::array<double, 3> PoseVarianceAfter(const OdometryCovariance& c, double distance_m) {
-  std::array<double, 3> out{};
-  for (int a = 0; a < 3; ++a)
-    out[a] = c.pose_variance_1m[a] * std::pow(distance_m, c.pose_growth_exponent[a]);
-  return out;
-}
-
 }  // namespace fitcal

@@ -55,9 +55,6 @@ OdometryCovariance EstimateOdometryCovariance(const RobotModelInterface& model,
                                               const std::vector<double>& p,
                                               const std::vector<RunLog>& runs, double interval_s);
 
-// The pose variance the law gives after d metres (m^2, m^2, rad^2).
-std::array<double, 3> PoseVarianceAfter(const OdometryCovariance& c, double distance_m);
-
 // V(T) = c + beta T + alpha T^2 fitted to mean squares `v` at durations `t` with weights `w`,
 // every coefficient >= 0 (the best of the non-negative subsets): {c, beta, alpha}.
 std::array<double, 3> FitStructureFunction(const std::vector<double>& t,

@@ -2,7 +2,7 @@
 // metadata.yaml, the file rosbag2 writes beside a bag's storage files: which storage plugin, which
 // files (in split order), when the recording started, how long it lasted, and the topics with
 // their message counts. Read for any version 1-9 that rosbag2 has written (the keys read here
-// are common to all of them); written as version 5 (the first with the per-file `files` list).
+// are common to all of them).
 
 #include <cstdint>
 #include <string>
@@ -35,8 +35,5 @@ struct BagMetadata {
 // Reads `path` (a metadata.yaml). Throws InputError (kMissingFile, kYamlSyntax, kMissingKey,
 // kWrongYamlType, kBadValue) with the file and line.
 BagMetadata ReadBagMetadata(const std::string& path);
-
-// The YAML text rosbag2 would write for `metadata` (version 5 layout).
-std::string BagMetadataToYaml(const BagMetadata& metadata);
 
 }  // namespace fitcal::io::rosbag2

@@ -158,23 +158,4 @@ bool Decompressor::CheckDeclaredSize(Compression compression, ByteView input,
   return true;
 }
 
-std::vector<std::uint8_t> Compress(Compression compression, ByteView input) {
-  std::vector<std::uint8_t> out;
-  if (compression == Compression::kNone) return input.ToVector();
-  if (compression == Compression::kZstd) {
-    out.resize(ZSTD_compressBound(input.size));
-    const std::size_t n = ZSTD_compress(out.data(), out.size(), input.data, input.size, 1);
-    if (ZSTD_isError(n)) throw std::runtime_error(std::string("zstd: ") + ZSTD_getErrorName(n));
-    out.resize(n);
-    return out;
-  }
-  LZ4F_preferences_t prefs{};
-  prefs.frameInfo.contentSize = input.size;
-  out.resize(LZ4F_compressFrameBound(input.size, &prefs));
-  const std::size_t n = LZ4F_compressFrame(out.data(), out.size(), input.data, input.size, &prefs);
-  if (LZ4F_isError(n)) throw std::runtime_error(std::string("lz4: ") + LZ4F_getErrorName(n));
-  out.resize(n);
-  return out;
-}
-
 }  // namespace fitcal::io::rosbag2

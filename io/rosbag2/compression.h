@@ -47,8 +47,4 @@ class Decompressor {
   std::unique_ptr<Contexts> contexts_;
 };
 
-// Compresses `input` (used by the writer). zstd at level 1 (fast, as rosbag2's default preset
-// favours write speed); lz4 as one LZ4 frame with the content size recorded.
-std::vector<std::uint8_t> Compress(Compression compression, ByteView input);
-
 }  // namespace fitcal::io::rosbag2

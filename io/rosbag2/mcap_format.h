@@ -1,6 +1,7 @@
 #pragma once
 // The MCAP container format, version 0 (mcap.dev/spec): magic, record opcodes and a bounds-checked
-// reader of record fields. Shared by the reader (mcap_storage.cc) and the writer (mcap_writer.cc).
+// reader of record fields. Shared by the reader (mcap_storage.cc) and the tests' writer
+// (tests/bags/mcap_writer.cc).
 
 #include <cstddef>
 #include <cstdint>

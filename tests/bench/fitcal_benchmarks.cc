@@ -19,6 +19,7 @@
 #include "tests/flower_scenario.h"
 #include "tests/test_paths.h"
 #include "tests/omni3_robot.h"
+#include "tests/three_wheel_files.h"
 
 namespace fitcal {
 namespace {

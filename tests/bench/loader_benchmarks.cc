@@ -19,6 +19,7 @@
 #include "io/log_files.h"
 #include "io/text_file.h"
 #include "tests/bench/bench_support.h"
+#include "tests/three_wheel_files.h"
 
 namespace {
 

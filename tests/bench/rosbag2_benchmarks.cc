@@ -21,7 +21,8 @@
 #include <string>
 
 #include "io/rosbag2/bag_reader.h"
-#include "io/rosbag2/bag_writer.h"
+#include "tests/bags/bag_writer.h"
+#include "tests/bags/ros_message_encoders.h"
 #include "io/rosbag2/ros_messages.h"
 #include "tests/bench/bench_support.h"
 #include "cli/import_rosbag2.h"

@@ -13,12 +13,12 @@
 #include "io/dataset.h"
 #include "io/input_error.h"
 #include "io/log_files.h"
-#include "io/robot_yaml.h"
 #include "models/asoc/asoc_files.h"
 #include "models/diff_drive/diff_drive_model.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "cli/import_rosbag2.h"
 #include "tests/omni3_robot.h"
+#include "tests/three_wheel_files.h"
 
 namespace fitcal::fuzz {
 

@@ -1,8 +1,8 @@
 // CDR encoders of the message types in ros_messages.h, field for field the mirror of
 // ros_message_decoders.cc.
 
-#include "io/rosbag2/cdr_writer.h"
-#include "io/rosbag2/ros_messages.h"
+#include "tests/bags/cdr_writer.h"
+#include "tests/bags/ros_message_encoders.h"
 
 namespace fitcal::io::rosbag2 {
 namespace {

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "io/rosbag2/bag_metadata.h"
-#include "io/rosbag2/storage_writer.h"
+#include "tests/bags/storage_writer.h"
 
 namespace fitcal::io::rosbag2 {
 

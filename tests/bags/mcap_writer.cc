@@ -3,13 +3,16 @@
 // End, then (optionally) a summary with Schemas, Channels, Statistics and Chunk Indexes, the
 // Summary Offsets and the Footer.
 
+#include <lz4frame.h>
+#include <zstd.h>
+
 #include <cstdio>
 #include <map>
 #include <stdexcept>
 
 #include "io/rosbag2/crc32.h"
 #include "io/rosbag2/mcap_format.h"
-#include "io/rosbag2/storage_writer.h"
+#include "tests/bags/storage_writer.h"
 
 namespace fitcal::io::rosbag2 {
 namespace {
@@ -20,6 +23,27 @@ using Bytes = std::vector<std::uint8_t>;
 void AppendString(Bytes* out, const std::string& text) {
   AppendLe(out, static_cast<std::uint32_t>(text.size()));
   AppendBytes(out, text.data(), text.size());
+}
+
+// zstd at level 1 (fast, as rosbag2's default preset favours write speed); lz4 as one LZ4 frame
+// with the content size recorded.
+std::vector<std::uint8_t> Compress(Compression compression, ByteView input) {
+  std::vector<std::uint8_t> out;
+  if (compression == Compression::kNone) return input.ToVector();
+  if (compression == Compression::kZstd) {
+    out.resize(ZSTD_compressBound(input.size));
+    const std::size_t n = ZSTD_compress(out.data(), out.size(), input.data, input.size, 1);
+    if (ZSTD_isError(n)) throw std::runtime_error(std::string("zstd: ") + ZSTD_getErrorName(n));
+    out.resize(n);
+    return out;
+  }
+  LZ4F_preferences_t prefs{};
+  prefs.frameInfo.contentSize = input.size;
+  out.resize(LZ4F_compressFrameBound(input.size, &prefs));
+  const std::size_t n = LZ4F_compressFrame(out.data(), out.size(), input.data, input.size, &prefs);
+  if (LZ4F_isError(n)) throw std::runtime_error(std::string("lz4: ") + LZ4F_getErrorName(n));
+  out.resize(n);
+  return out;
 }
 
 // <opcode><uint64 length><content> (spec "Records").

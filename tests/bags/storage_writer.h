@@ -5,12 +5,26 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "io/rosbag2/bytes.h"
 #include "io/rosbag2/compression.h"
 #include "io/rosbag2/storage.h"
 
 namespace fitcal::io::rosbag2 {
+
+// Appends `value` as sizeof(T) little-endian bytes.
+template <typename T>
+void AppendLe(std::vector<std::uint8_t>* out, T value) {
+  for (std::size_t i = 0; i < sizeof(T); ++i) {
+    out->push_back(static_cast<std::uint8_t>(static_cast<std::uint64_t>(value) >> (8 * i)));
+  }
+}
+
+inline void AppendBytes(std::vector<std::uint8_t>* out, const void* data, std::size_t size) {
+  const auto* bytes = static_cast<const std::uint8_t*>(data);
+  out->insert(out->end(), bytes, bytes + size);
+}
 
 class StorageWriter {
  public:

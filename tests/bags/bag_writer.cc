@@ -1,4 +1,6 @@
-#include "io/rosbag2/bag_writer.h"
+#include "tests/bags/bag_writer.h"
+
+#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -8,6 +10,55 @@
 namespace fitcal::io::rosbag2 {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+void EmitTopic(YAML::Emitter& out, const TopicInfo& topic) {
+  out << YAML::BeginMap << YAML::Key << "topic_metadata" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "name" << YAML::Value << topic.name;
+  out << YAML::Key << "type" << YAML::Value << topic.type;
+  out << YAML::Key << "serialization_format" << YAML::Value << topic.serialization_format;
+  out << YAML::Key << "offered_qos_profiles" << YAML::Value << YAML::DoubleQuoted << "";
+  out << YAML::EndMap;
+  out << YAML::Key << "message_count" << YAML::Value << topic.message_count << YAML::EndMap;
+}
+
+void EmitTime(YAML::Emitter& out, const char* key, const char* inner, std::int64_t value_ns) {
+  out << YAML::Key << key << YAML::Value << YAML::BeginMap << YAML::Key << inner << YAML::Value
+      << value_ns << YAML::EndMap;
+}
+
+void EmitFile(YAML::Emitter& out, const BagFileInfo& file) {
+  out << YAML::BeginMap << YAML::Key << "path" << YAML::Value << file.path;
+  EmitTime(out, "starting_time", "nanoseconds_since_epoch", file.starting_time_ns);
+  EmitTime(out, "duration", "nanoseconds", file.duration_ns);
+  out << YAML::Key << "message_count" << YAML::Value << file.message_count << YAML::EndMap;
+}
+
+// The YAML text rosbag2 would write for `metadata` (version 5 layout).
+std::string BagMetadataToYaml(const BagMetadata& m) {
+  YAML::Emitter out;
+  out << YAML::BeginMap << YAML::Key << "rosbag2_bagfile_information" << YAML::Value
+      << YAML::BeginMap;
+  out << YAML::Key << "version" << YAML::Value << m.version;
+  out << YAML::Key << "storage_identifier" << YAML::Value << m.storage_identifier;
+  EmitTime(out, "duration", "nanoseconds", m.duration_ns);
+  EmitTime(out, "starting_time", "nanoseconds_since_epoch", m.starting_time_ns);
+  out << YAML::Key << "message_count" << YAML::Value << m.message_count;
+  out << YAML::Key << "topics_with_message_count" << YAML::Value << YAML::BeginSeq;
+  for (const TopicInfo& topic : m.topics) EmitTopic(out, topic);
+  out << YAML::EndSeq;
+  out << YAML::Key << "compression_format" << YAML::Value << YAML::DoubleQuoted
+      << m.compression_format;
+  out << YAML::Key << "compression_mode" << YAML::Value << YAML::DoubleQuoted << m.compression_mode;
+  out << YAML::Key << "relative_file_paths" << YAML::Value << m.relative_file_paths;
+  out << YAML::Key << "files" << YAML::Value << YAML::BeginSeq;
+  for (const BagFileInfo& file : m.files) EmitFile(out, file);
+  out << YAML::EndSeq << YAML::EndMap << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+}  // namespace
 
 BagWriter::BagWriter(const std::string& directory, BagWriterOptions options)
     : directory_(directory), options_(options) {

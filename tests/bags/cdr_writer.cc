@@ -1,4 +1,4 @@
-#include "io/rosbag2/cdr_writer.h"
+#include "tests/bags/cdr_writer.h"
 
 #include <fastcdr/Cdr.h>
 #include <fastcdr/FastBuffer.h>

@@ -2,7 +2,7 @@
 
 #include <stdexcept>
 
-#include "io/rosbag2/storage_writer.h"
+#include "tests/bags/storage_writer.h"
 
 namespace fitcal::io::rosbag2 {
 namespace {
