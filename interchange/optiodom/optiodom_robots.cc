@@ -42,7 +42,7 @@ RobotModelPtr Omni3Nominal(const Metadata& metadata) {
   box.angle_offset_rad = {DegToRad(-2.0), DegToRad(2.0)};
   robot.bounds = Omni3ParameterBounds(robot.nominal, box);
   robot.encoder = EncoderTicks{metadata.TicksPerWheelRev(), false};
-  return std::make_shared<Omni3Model>(std::move(robot), box.angle_offset_rad);
+  return MakeOmni3Model(std::move(robot), box.angle_offset_rad);
 }
 
 // omni4: `t, x, y, theta, enc_1..enc_4`, wheel revolutions over the 10 ms cycle ending at t

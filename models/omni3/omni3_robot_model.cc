@@ -89,6 +89,10 @@ RobotModelPtr ReadOmni3Model(const YAML::Node& root, const std::string& path) {
   return std::make_shared<Omni3Model>(std::move(robot), box.angle_offset_rad);
 }
 
+RobotModelPtr MakeOmni3Model(Robot robot, Interval angle_offset_rad) {
+  return std::make_shared<Omni3Model>(std::move(robot), angle_offset_rad);
+}
+
 std::vector<Interval> Omni3ParameterBounds(const std::vector<double>& nominal,
                                            const OmniBounds& box) {
   std::vector<Interval> bounds(omni3::kNumWheels, box.distance_m);

@@ -49,6 +49,11 @@ bounds:
 
 RobotModelPtr ReadOmni3Model(const YAML::Node& root, const std::string& path);
 
+// An omni3 model made in the models library, so that its replay on Ceres Jets is compiled here
+// and not in an instrumented caller (models/diff_drive/diff_drive_model.h, MakeDiffDriveModel,
+// says why; tests/checks/instrumented_templates.cmake keeps it so).
+RobotModelPtr MakeOmni3Model(Robot robot, Interval angle_offset_rad);
+
 // The bounds of the nine parameters (Eq. 15 order) in the box of the YAML's `bounds:`: one
 // interval for every R_i, one for every r_i, the angle bounds relative to each nominal delta_i
 // (Eq. 16).
