@@ -7,9 +7,6 @@
 
 #include <glog/logging.h>
 #include <signal.h>
-#if defined(__GLIBC__)
-#include <malloc.h>
-#endif
 
 #include <CLI/CLI.hpp>
 #include <cstdlib>
@@ -26,6 +23,7 @@
 #include "io/atomic_file.h"
 #include "io/input_error.h"
 #include "io/input_registry.h"
+#include "odometry/memory_reuse.h"
 #include "cli/asoc_commands.h"
 #include "cli/command_line.h"
 #include "cli/cli_validators.h"
@@ -231,26 +229,11 @@ void SilenceLibraryLogging(const char* argv0) {
   }
 }
 
-// A fit allocates and frees the same large buffers (Jacobians, replays, residual vectors) again
-// and again. With glibc's defaults each one above 128 KiB is its own mmap, and the heap's top is
-// given back to the kernel whenever 128 KiB of it is free, so every reallocation costs fresh,
-// zeroed pages: on an IndependentDiagnose data set (diagnose --threads 1, 32 runs) 57-90 thousand
-// page faults, 0.44-0.77 s of system time beside 1.6-2.2 s of user. Memory freed is kept for the
-// next allocation instead (up to 32 MiB a block, glibc's upper bound, and nothing trimmed below
-// 1 GiB): 10 thousand faults, 0.1 s system, 1.2 s user; the peak resident size the same (50 MB).
-// The results do not depend on where memory lies.
-void KeepFreedMemoryForReuse() {
-#if defined(__GLIBC__)
-  mallopt(M_MMAP_THRESHOLD, 32 * 1024 * 1024);
-  mallopt(M_TRIM_THRESHOLD, 1024 * 1024 * 1024);
-#endif
-}
-
 }  // namespace command_line
 
 int RunCommandLine(int argc, char** argv) {
   using namespace command_line;
-  KeepFreedMemoryForReuse();
+  fitcal::KeepFreedMemoryForReuse();  // odometry/memory_reuse.h says why
   SilenceLibraryLogging(argv[0]);
   // Ctrl-C or a scheduler's SIGTERM while an output is being written leaves no temporary behind.
   fitcal::io::RemoveTemporaryFilesOnSignals();
