@@ -23,6 +23,7 @@
 #include "io/atomic_file.h"
 #include "io/input_error.h"
 #include "io/input_registry.h"
+#include "odometry/memory_reuse.h"
 #include "cli/asoc_commands.h"
 #include "cli/command_line.h"
 #include "cli/cli_validators.h"
@@ -232,6 +233,7 @@ void SilenceLibraryLogging(const char* argv0) {
 
 int RunCommandLine(int argc, char** argv) {
   using namespace command_line;
+  fitcal::KeepFreedMemoryForReuse();  // odometry/memory_reuse.h says why
   SilenceLibraryLogging(argv[0]);
   // Ctrl-C or a scheduler's SIGTERM while an output is being written leaves no temporary behind.
   fitcal::io::RemoveTemporaryFilesOnSignals();
