@@ -12,6 +12,7 @@
 #include "models/asoc/asoc_geometric.h"
 #include "sim/asoc_scenarios.h"
 #include "sim/asoc_simulator.h"
+#include "tests/asoc_robot_file.h"
 #include "tests/test_paths.h"
 
 namespace fitcal::asoc {

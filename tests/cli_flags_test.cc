@@ -17,6 +17,7 @@
 #include "models/asoc/asoc_files.h"
 #include "models/model_registry.h"
 #include "odometry/pose2.h"
+#include "tests/asoc_robot_file.h"
 #include "tests/dataset_edit.h"
 #include "tests/test_files.h"
 

@@ -38,6 +38,7 @@
 #include "io/yaml_reader.h"
 #include "io/yaml_text.h"
 #include "models/model_registry.h"
+#include "tests/asoc_robot_file.h"
 #include "tests/test_files.h"
 
 namespace fitcal {

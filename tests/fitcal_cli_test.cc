@@ -14,6 +14,7 @@
 
 #include "models/asoc/asoc_files.h"
 #include "models/omni3/omni3_robot_model.h"
+#include "tests/asoc_robot_file.h"
 #include "tests/test_files.h"
 #include "tests/omni3_robot.h"
 

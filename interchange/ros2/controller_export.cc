@@ -159,7 +159,10 @@ Ros2ControlExport ExportRos2Control(const RobotModelPtr& calibrated,
 
 namespace {
 
-// The held-out runs of a loaded data set (ExportHeldOutRuns); `held_out_logs` takes theirs.
+// The runs of a loaded data set that validate `calibration_path`: those it did not train on (by
+// recorded run id, as `report` splits; every run when it records none); `*which` says which.
+// Throws UsageError (exit 2, as `report`) when it trained on every run. `held_out_logs`, when
+// given, receives the same runs as loaded (ground-truth tracks included).
 std::vector<AlignedRun> HeldOutRuns(const std::string& calibration_path, io::Dataset data,
                                     std::string* which, std::vector<RunLog>* held_out_logs) {
   // The rule `report` uses (cli/report_command.cc, SplitForReport): the recorded training run
@@ -191,18 +194,6 @@ std::vector<AlignedRun> HeldOutRuns(const std::string& calibration_path, io::Dat
   }
   return runs;
 }
-
-}  // namespace
-
-std::vector<AlignedRun> ExportHeldOutRuns(const std::string& calibration_path,
-                                          const std::string& logs, const Robot& robot,
-                                          std::string* which,
-                                          std::vector<RunLog>* held_out_logs) {
-  return HeldOutRuns(calibration_path, io::LoadDataset(io::ReadDatasetIndex(logs), robot), which,
-                     held_out_logs);
-}
-
-namespace {
 
 // The never-worse judgement of the exported parameters against the nominal robot on `runs`.
 NeverWorseSaid ExportNeverWorse(const RobotModelInterface& nominal,

@@ -99,16 +99,6 @@ Ros2ControlExport ExportRos2Control(const RobotModelPtr& calibrated,
 // The covariance keys of `controller` (ros__parameters lines, 4-space indent) holding `c`.
 std::string Ros2CovarianceParameters(const std::string& controller, const OdometryCovariance& c);
 
-// The runs of `logs` that validate `calibration_path`: those it did not train on (by recorded run
-// id, as `report` splits; every run when it records none); `*which` says which. Throws
-// io::InputError for a bad data set or calibration block, and UsageError (exit 2, as `report`)
-// when it trained on every run.
-// `held_out_logs`, when given, receives the same runs as loaded (ground-truth tracks included).
-std::vector<AlignedRun> ExportHeldOutRuns(const std::string& calibration_path,
-                                          const std::string& logs, const Robot& robot,
-                                          std::string* which,
-                                          std::vector<RunLog>* held_out_logs = nullptr);
-
 // The exported parameters replayed on the held-out runs beside the nominal robot and the exact
 // calibration: CF (Palacin Eq. 14) of each, and the odometry covariance of both calibrations.
 struct ExportReplay {

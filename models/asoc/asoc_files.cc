@@ -227,10 +227,6 @@ void ReadAsocOptionalBlocks(YamlMap& map, const std::string& path, AsocRobot* ro
 
 }  // namespace
 
-AsocRobot ReadAsocRobot(const std::string& path) {
-  return ReadAsocRobotNode(LoadYamlFile(path), path);
-}
-
 AsocRobot ReadAsocRobotNode(const YAML::Node& root, const std::string& path) {
   YamlMap map(root, path, "robot");
   const std::string model = map.String("model");

@@ -72,9 +72,8 @@ struct AsocRobot {
   double pivot_resolution_rad = 0.0;
 };
 
-// Throws InputError (file, line, cause) on anything malformed or physically impossible.
-AsocRobot ReadAsocRobot(const std::string& path);
-// The same from a parsed YAML (`path` names it in messages); the model registry's reader.
+// From a parsed YAML (`path` names it in messages); the model registry's reader. Throws
+// InputError (file, line, cause) on anything malformed or physically impossible.
 AsocRobot ReadAsocRobotNode(const YAML::Node& root, const std::string& path);
 // The YAML text; `calibration_yaml`, when not empty, is emitted verbatim under `calibration:`
 // (a flow map written by the caller). Optional keys are written when set (odometry when not the

@@ -17,6 +17,7 @@
 #include "models/diff_drive/diff_drive_model.h"
 #include "models/omni3/omni3_robot_model.h"
 #include "cli/import_rosbag2.h"
+#include "tests/asoc_robot_file.h"
 #include "tests/omni3_robot.h"
 #include "tests/three_wheel_files.h"
 
