@@ -23,7 +23,7 @@ struct CalibrationRequest {
   std::string train_reps = "1-5";
   std::string train_trajectories;  // non-empty: replaces train_reps (fit/trajectory_split.h)
   // Non-empty: exactly these runs train and the others judge, replacing both (generalise's
-  // splits, calibrate/generalise_split.h).
+  // splits, calibrate/generalise.h).
   std::vector<std::string> training_ids;
   int threads = 0;
   int time_blocks = 4;  // with nothing held out: the time blocks of validation/held_out_halves.h

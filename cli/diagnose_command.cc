@@ -24,7 +24,7 @@
 #include "odometry/text_format.h"
 #include "cli/cli_validators.h"
 #include "fit/clock_alignment.h"
-#include "cli/diagnose_page_builder.h"
+#include "calibrate/diagnose_page_builder.h"
 #include "diagnosis/miswired_error.h"
 #include "io/output_guard.h"
 #include "cli/report_command.h"

@@ -1,7 +1,6 @@
 #include "cli/fleet_command.h"
 
 #include <CLI/CLI.hpp>
-#include <algorithm>
 #include <iostream>
 
 #include "cli/dataset_command.h"
@@ -19,10 +18,7 @@ constexpr const char* kCfRow = kFleetCfRow;
 // The note under a robot's table when its held-out CFs were judged on different runs: a change
 // in CF may then be the runs', not the robot's.
 std::string DifferentJudgesNote(const FleetSeries& s) {
-  std::vector<std::string> distinct;
-  for (const std::string& j : s.judged_on) {
-    if (std::find(distinct.begin(), distinct.end(), j) == distinct.end()) distinct.push_back(j);
-  }
+  const std::vector<std::string>& distinct = s.distinct_judges;
   if (distinct.size() < 2) return "";
   std::string note = "  note: " + std::string(kCfRow) + " was judged on " +
                      std::to_string(distinct.size()) +
@@ -54,7 +50,7 @@ std::string FleetTable(const std::vector<FleetSeries>& series) {
     out += StrFormat("  %-22s %-6s %3zu  %-10s %12.6g  %-10s %12.6g %10s %12.6g %14s  %s\n",
                      s.parameter.c_str(), s.unit.c_str(), s.values.size(), s.dates.front().c_str(),
                      k * s.values.front(), s.dates.back().c_str(), k * s.values.back(),
-                     sigma.c_str(), k * Median(s.values), slope.c_str(), flags.c_str());
+                     sigma.c_str(), k * s.median, slope.c_str(), flags.c_str());
     if (s.parameter == kCfRow) note += DifferentJudgesNote(s);
   }
   close_robot();

@@ -153,7 +153,7 @@ GateChoice SelectedByFit(const std::string& fit_out) {
 }
 
 // generalise judges a split as `fit --residuals final-pose` judges the same runs
-// (calibrate/generalise_split.h: one Calibrate): `fit --train-trajectories X` trains on X and
+// (calibrate/generalise.h: one Calibrate): `fit --train-trajectories X` trains on X and
 // validates on every other run, which is generalise's "'X' -> others" split. The expected line is
 // built from fit's own printout (its gate's table, or its refusal on stderr), so it fails when
 // generalise's fit, gate, never-worse rule or bound check departs from fit's. '^R': fit writes its

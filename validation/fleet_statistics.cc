@@ -35,19 +35,15 @@ long Days(const std::string& date) {
                        std::stoi(date.substr(8, 2)));
 }
 
-}  // namespace
-
 double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t n = v.size();
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-namespace {
-
 void FlagOutliers(FleetSeries* s) {
   if (s->values.size() < kMinForOutlier) return;
-  const double median = Median(s->values);
+  const double median = s->median;
   std::vector<double> deviation;
   for (double v : s->values) deviation.push_back(std::abs(v - median));
   const double sigma = 1.4826 * Median(deviation);
@@ -182,6 +178,11 @@ std::vector<FleetSeries> FleetSeriesOf(std::vector<FleetCalibration> all) {
     }
   }
   for (FleetSeries& s : out) {
+    s.median = Median(s.values);
+    for (const std::string& j : s.judged_on) {
+      const auto& d = s.distinct_judges;
+      if (std::find(d.begin(), d.end(), j) == d.end()) s.distinct_judges.push_back(j);
+    }
     FlagOutliers(&s);
     FlagTrend(&s);
   }

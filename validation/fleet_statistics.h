@@ -46,6 +46,8 @@ struct FleetSeries {
   std::vector<std::string> files;
   // The held-out CF's row only: the data set and split that judged each calibration.
   std::vector<std::string> judged_on;
+  std::vector<std::string> distinct_judges;  // judged_on without repeats, first seen first
+  double median = 0.0;                       // of values
   std::vector<std::string> outliers;  // dates of the flagged calibrations
   bool trend = false;
   bool has_slope = false;  // enough calibrations (kMinForTrend) for a line
@@ -58,7 +60,5 @@ struct FleetSeries {
 // The series of every robot (sorted by robot, then date) with their flags. Throws io::InputError
 // when one robot name is two models (a renamed copy, a rebuilt robot: never one series).
 std::vector<FleetSeries> FleetSeriesOf(std::vector<FleetCalibration> calibrations);
-
-double Median(std::vector<double> v);
 
 }  // namespace fitcal

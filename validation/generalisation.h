@@ -128,7 +128,7 @@ bool IsWrittenFit(const CandidateScore& candidate, bool final_pose_only = false)
 // held directions) after "fit", "fit (track, tied)" after "fit (track)". options.tying is
 // ignored: the full fits stay full. Throws std::invalid_argument when either side is empty.
 // `fit`, when given, is the final-pose fit of split.train already made (by calibrate/
-// generalise_split.h, the fit `fit` makes and gates), scored as "fit" instead of fitting again.
+// generalise.h, the fit `fit` makes and gates), scored as "fit" instead of fitting again.
 SplitScores EvaluateSplit(const RobotModelInterface& model, const std::vector<AlignedRun>& runs,
                           const GeneralisationSplit& split, const ModelFitOptions& options,
                           const TrackCandidates& track_candidates = {},

@@ -1,4 +1,4 @@
-#include "cli/diagnose_page_builder.h"
+#include "calibrate/diagnose_page_builder.h"
 
 #include <cmath>
 
@@ -7,7 +7,7 @@
 #include "validation/report_builder.h"
 #include "validation/trajectory_metrics.h"
 
-namespace fitcal::tools {
+namespace fitcal {
 
 namespace {
 
@@ -138,4 +138,4 @@ io::DiagnosePageData MakeDiagnosePage(const DiagnosePageSource& source,
   return page;
 }
 
-}  // namespace fitcal::tools
+}  // namespace fitcal

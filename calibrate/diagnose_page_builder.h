@@ -10,7 +10,7 @@
 #include "calibrate/diagnosis_calibration.h"
 #include "pages/diagnose_page.h"
 
-namespace fitcal::tools {
+namespace fitcal {
 
 // What the page says of where the runs came from.
 struct DiagnosePageSource {
@@ -27,4 +27,4 @@ io::DiagnosePageData MakeDiagnosePage(const DiagnosePageSource& source,
                                       const DiagnosisCalibration& calibration,
                                       const std::string& report);
 
-}  // namespace fitcal::tools
+}  // namespace fitcal
