@@ -75,8 +75,11 @@ void PrintLeaveOneSessionOut(const GeneraliseOutcome& outcome) {
     for (const FoldSummary& s : outcome.fold_summary) {
       const auto c = std::find_if(fold.candidates.begin(), fold.candidates.end(),
                                   [&s](const CandidateScore& a) { return a.name == s.name; });
-      if (c == fold.candidates.end()) std::printf(" - |");
-      if (c != fold.candidates.end()) std::printf(" %.4f |", c->test.cf);
+      if (c == fold.candidates.end()) {
+        std::printf(" - |");  // not among this fold's candidates
+      } else {
+        std::printf(" %.4f |", c->test.cf);
+      }
     }
     std::printf("\n");
   }
