@@ -88,18 +88,14 @@ std::vector<GeneralisationSplit> TableSplits(const GeneraliseOptions& options,
 void AddEverydayDriving(const GeneraliseRequest& request, const RobotModelInterface& model,
                         const SplitScores& scores, GeneraliseOutcome* out) {
   std::vector<AlignedRun> held_out;
-  std::vector<const GroundTruthTrack*> tracks;
-  for (std::size_t i : scores.split.test) {
-    held_out.push_back(request.runs[i]);
-    tracks.push_back(&request.logs[i].ground_truth);
-  }
+  for (std::size_t i : scores.split.test) held_out.push_back(request.runs[i]);
   const CandidateScore& nominal = scores.candidates.front();
   for (const CandidateScore& c : scores.candidates) {
     if (!IsWrittenFit(c)) continue;
     out->everyday_driving.emplace_back(
         scores.split.train_name + " -> " + scores.split.test_name + ": " + c.name,
         CompareEverydayDriving(model, {nominal.name, nominal.parameters}, {c.name, c.parameters},
-                               held_out, tracks, request.threads));
+                               held_out, TracksOf(held_out), request.threads));
   }
 }
 
@@ -146,9 +142,7 @@ GeneraliseRequest MakeGeneraliseRequest(GeneraliseRequest r, const Robot& robot)
         MakeCheckpointsFromStart(r.runs[i], r.logs[i].ground_truth, /*spacing_m=*/0.5));
   }
   if (!r.effects.empty()) r.tracks = PrepareTrackRuns(r.logs, WheelChannelMask(robot));
-  std::vector<const GroundTruthTrack*> ground_truth;
-  for (const RunLog& log : r.logs) ground_truth.push_back(&log.ground_truth);
-  r.dense_tracks = MeasureTrackDensity(r.runs, ground_truth).dense;
+  r.dense_tracks = MeasureTrackDensity(r.runs, TracksOf(r.runs)).dense;
   r.table_splits = TableSplits(r.options, r.runs);
   if (r.options.leave_one_session_out) r.folds = LeaveOneSessionOutSplits(r.runs, r.sessions);
   return r;
@@ -156,8 +150,7 @@ GeneraliseRequest MakeGeneraliseRequest(GeneraliseRequest r, const Robot& robot)
 
 GeneraliseOutcome Generalise(const GeneraliseRequest& request, const RobotModelInterface& model,
                              const std::function<void(const SplitCalibration&)>& on_table_split) {
-  std::vector<const GroundTruthTrack*> ground_truth;
-  for (const RunLog& log : request.logs) ground_truth.push_back(&log.ground_truth);
+  const std::vector<const GroundTruthTrack*> ground_truth = TracksOf(request.runs);
   TrackCandidates candidates;
   if (request.options.optiodom) candidates.optiodom_checkpoints = &request.optiodom_checkpoints;
   if (!request.effects.empty()) {
