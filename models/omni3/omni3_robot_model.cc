@@ -86,7 +86,7 @@ RobotModelPtr ReadOmni3Model(const YAML::Node& root, const std::string& path) {
   robot.effects = io::ReadEffectsNode(robot_map.Optional("effects"), path);
   robot_map.Optional("calibration");  // written by fitcal; informational when read back
   robot_map.RejectUnread();
-  return std::make_shared<Omni3Model>(std::move(robot), box.angle_offset_rad);
+  return MakeOmni3Model(std::move(robot), box.angle_offset_rad);
 }
 
 RobotModelPtr MakeOmni3Model(Robot robot, Interval angle_offset_rad) {
