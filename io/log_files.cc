@@ -8,6 +8,7 @@
 #include <cstring>
 #include <limits>
 #include <new>
+#include <optional>
 #include <stdexcept>
 #include <string_view>
 #include <utility>
@@ -688,6 +689,38 @@ std::vector<int> LinesOfDataRows(const std::string& path, const std::vector<std:
   return out;
 }
 
+// The lines of the glitches' rows, sorted by row.
+std::vector<int> SortedGlitchLines(const std::string& path, std::vector<Glitch>* all) {
+  std::sort(all->begin(), all->end(),
+            [](const Glitch& a, const Glitch& b) { return a.row < b.row; });
+  std::vector<std::size_t> rows;
+  for (const Glitch& g : *all) rows.push_back(g.row);
+  return LinesOfDataRows(path, rows);
+}
+
+// More than kMaxGlitchShare of a log's intervals is not a glitch but a wrong block (`hint`):
+// refused. Else each is warned, `file:line: <kind> glitch: <what>`, and counted.
+void WarnAndCountGlitches(const std::string& path, const std::string& kind,
+                          const std::string& hint, const std::vector<Glitch>& all,
+                          const std::vector<int>& lines, EncoderLog* log) {
+  const double allowed = std::max(1.0, kMaxGlitchShare * static_cast<double>(log->samples.size()));
+  if (static_cast<double>(all.size()) > allowed) {
+    // Intervals, not glitches: two wheels glitching in one interval count once ("6837 of 3568
+    // intervals" said the count of both wheels of a wrong `cumulative:`).
+    std::vector<std::size_t> distinct;
+    for (const Glitch& g : all) distinct.push_back(g.row);
+    distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+    throw InputError(InputErrorKind::kImplausibleValue, path, lines.front(),
+                     std::to_string(distinct.size()) + " of " +
+                         std::to_string(log->samples.size()) + " intervals are " + kind +
+                         " glitches, the first here: " + all.front().what +
+                         "; more than 1 % is not a glitch but " + hint);
+  }
+  for (std::size_t i = 0; i < all.size(); ++i)
+    Warn(path, lines[i], kind + " glitch: " + all[i].what);
+  log->dropped_glitches += static_cast<int>(all.size());
+}
+
 // Screens every wheel channel read as counts, names each glitch with its line (a warning) and
 // counts them in log->dropped_glitches.
 void DropCounterGlitches(const std::string& path, const Robot& robot,
@@ -698,11 +731,7 @@ void DropCounterGlitches(const std::string& path, const Robot& robot,
   }
   std::vector<Glitch> all = screen.glitches();
   if (all.empty()) return;
-  const double allowed = std::max(1.0, kMaxGlitchShare * static_cast<double>(log->samples.size()));
-  std::sort(all.begin(), all.end(), [](const Glitch& a, const Glitch& b) { return a.row < b.row; });
-  std::vector<std::size_t> rows;
-  for (const Glitch& g : all) rows.push_back(g.row);
-  const std::vector<int> lines = LinesOfDataRows(path, rows);
+  const std::vector<int> lines = SortedGlitchLines(path, &all);
   for (std::size_t i = 0; i < all.size(); ++i) {
     if (all[i].narrower_wrap_bits == 0) continue;
     // Not a glitch but the wrap of a narrower counter: bridging each would drop real travel
@@ -714,21 +743,61 @@ void DropCounterGlitches(const std::string& path, const Robot& robot,
                          std::to_string(robot.encoder->counter_bits) +
                          " bits encoder.counter_bits declares; declare counter_bits: " + b);
   }
-  if (static_cast<double>(all.size()) > allowed) {
-    // Intervals, not glitches: two wheels glitching in one interval count once ("6837 of 3568
-    // intervals" said the count of both wheels of a wrong `cumulative:`).
-    std::vector<std::size_t> distinct = rows;
-    distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
-    throw InputError(InputErrorKind::kImplausibleValue, path, lines.front(),
-                     std::to_string(distinct.size()) + " of " +
-                         std::to_string(log->samples.size()) +
-                         " intervals are counter glitches, the first here: " + all.front().what +
-                         "; more than 1 % is not a glitch but a wrong encoder block "
-                         "(ticks_per_rev, cumulative, counter_bits?)");
+  WarnAndCountGlitches(path, "counter", "a wrong encoder block (ticks_per_rev, cumulative, "
+                       "counter_bits?)", all, lines, log);
+}
+
+// Angle glitches. An absolute encoder sometimes delivers one wrong angle (a torn read, a bit
+// flip): the steering or castor angle jumps out and back in one reading. Replayed, the robot
+// turns sharply for two intervals. An interval's angle is the mean of its two readings (robot.h),
+// so one wrong reading moves the two intervals it bounds by half its error each, the same way.
+// It is named when those two intervals depart from the intervals on each side, both the same way,
+// by a reading error of more than kMaxAngleRateRadPerS over the longer of them (and at least
+// kMinAngleGlitchRad), while the two outer intervals agree, and the two inner ones, to a quarter
+// of it. 20 rad/s is twice a fast steering servo (60 deg in 0.1 s) and turns a castor through
+// half a turn in 0.16 s; a real swing that fast does not come back within one reading. The
+// OptiOdom tricycle's largest out-and-back step is one 0.45 deg count (0.008 rad) at 20 Hz, where
+// the limit is 1 rad. Differences are taken the short way round (a castor near +-pi). The two
+// intervals take the angle between their outer neighbours.
+constexpr double kMaxAngleRateRadPerS = 20.0;
+constexpr double kMinAngleGlitchRad = 0.1;
+
+// The glitch of the reading that bounds intervals k and k + 1 (data row k + 1), bridged.
+std::optional<Glitch> AngleGlitchAt(const Robot& robot, int c, std::size_t k,
+                                    EncoderSamples& samples) {
+  const double before = samples[k - 1].value[c], after = samples[k + 2].value[c];
+  const double out = WrapAngle(samples[k].value[c] - before);
+  const double back = WrapAngle(samples[k + 1].value[c] - after);
+  const double error = 2.0 * std::min(std::abs(out), std::abs(back));  // of the reading
+  const double limit = std::max(kMinAngleGlitchRad,
+                                kMaxAngleRateRadPerS * std::max(samples[k].dt_s,
+                                                                samples[k + 1].dt_s));
+  if (!(out * back > 0.0 && error > limit)) return std::nullopt;
+  const double between = WrapAngle(after - before);
+  const double inner = WrapAngle(samples[k + 1].value[c] - samples[k].value[c]);
+  if (!(std::abs(between) < 0.25 * error && std::abs(inner) < 0.25 * error)) return std::nullopt;
+  // In the column's own range, not wrapped.
+  samples[k].value[c] = samples[k + 1].value[c] = before + 0.5 * between;
+  return Glitch{k + 1, StrFormat("channel '%s' reads about %.4g rad off the angle around it "
+                                 "(%.4g rad) and comes back at the next reading, faster than "
+                                 "%.0f rad/s; dropped from the fit (the two intervals it bounds "
+                                 "take the angle around it)",
+                                 robot.channels[c].name.c_str(), std::copysign(error, out),
+                                 samples[k].value[c], kMaxAngleRateRadPerS)};
+}
+
+void DropAngleGlitches(const std::string& path, const Robot& robot, EncoderLog* log) {
+  std::vector<Glitch> all;
+  for (int c = 0; c < robot.NumChannels(); ++c) {
+    if (robot.channels[c].kind != ChannelKind::kAngle) continue;
+    for (std::size_t k = 1; k + 2 < log->samples.size(); ++k) {
+      if (std::optional<Glitch> g = AngleGlitchAt(robot, c, k, log->samples)) all.push_back(*g);
+    }
   }
-  for (std::size_t i = 0; i < all.size(); ++i)
-    Warn(path, lines[i], "counter glitch: " + all[i].what);
-  log->dropped_glitches = static_cast<int>(all.size());
+  if (all.empty()) return;
+  const std::vector<int> lines = SortedGlitchLines(path, &all);
+  WarnAndCountGlitches(path, "angle", "a wrong angle column (degrees or counts read as "
+                       "radians, a swapped column?)", all, lines, log);
 }
 
 EncoderLog ReadEncoderRows(TextFileReader& lines, const Robot& robot, std::vector<bool>* screened) {
@@ -841,6 +910,7 @@ EncoderLog ReadEncoderCsv(const std::string& path, const Robot& robot) {
                      CounterWrapMessage(bits));
   }
   DropCounterGlitches(path, robot, screened, &log);
+  DropAngleGlitches(path, robot, &log);
   // The model's own checks of what its channels hold (a steering angle in degrees or ticks, ...).
   RunSampleCheck(robot.model, log, path);
   return log;

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <sstream>
 #include <string>
@@ -269,6 +270,57 @@ TEST(EncoderCounts, ManyGlitchesAreAWrongEncoderBlock) {
     Load(robot, TractionCsv(false, 10, [](std::vector<double>* c) { (*c)[10] = (*c)[25] = 1e8; }));
   });
   EXPECT_TRUE(Has(error, "enc.csv:12: 2 of 39 intervals are counter glitches")) << error;
+}
+
+// A tricycle's steering log at 100 Hz (rates, radians): the steering ramps by 1 mrad a row,
+// `edit` changes it.
+std::string SteeringCsv(const std::function<void(std::vector<double>*)>& edit) {
+  std::vector<double> steering;
+  for (int k = 0; k < 40; ++k) steering.push_back(0.2 + 0.001 * k);
+  edit(&steering);
+  std::ostringstream csv;
+  csv.precision(12);
+  csv << "t,w_traction,steering\n";
+  for (std::size_t k = 0; k < steering.size(); ++k)
+    csv << 0.01 * k << ",5.0," << steering[k] << "\n";
+  return csv.str();
+}
+
+// One steering reading of 4 rad among a slow ramp (row 20, line 22): the two intervals it bounds
+// are each half-way to it. Named, counted, and both intervals take the angle between their outer
+// neighbours, which on a ramp is the true reading 0.22 rad exactly (the mean of rows 18, 19, 21,
+// 22).
+TEST(AngleGlitches, OneWrongSteeringReadingIsNamedAndBridged) {
+  CapturedWarnings warnings;
+  const EncoderLog log =
+      Load(RobotWith(""), SteeringCsv([](std::vector<double>* a) { (*a)[20] = 4.0; }));
+  EXPECT_EQ(log.dropped_glitches, 1);
+  ASSERT_EQ(warnings.lines.size(), 1u);
+  EXPECT_TRUE(Has(warnings.lines[0], "enc.csv:22: angle glitch: channel 'steering'"))
+      << warnings.lines[0];
+  EXPECT_NEAR(log.samples[19].value[1], 0.22, 1e-12);
+  EXPECT_NEAR(log.samples[20].value[1], 0.22, 1e-12);
+  EXPECT_NEAR(log.samples[21].value[1], 0.2215, 1e-12);  // untouched
+}
+
+// What a steering or castor does: a step that stays (1 rad in one reading), an out-and-back of
+// 0.15 rad (under the 0.2 rad that 20 rad/s makes of 10 ms), and a castor swinging across +-pi
+// (3.13, -3.13: 0.02 rad apart the short way) are readings, not glitches.
+TEST(AngleGlitches, AStepASmallBlipAndTheSeamAreNotGlitches) {
+  const std::vector<std::function<void(std::vector<double>*)>> edits = {
+      [](std::vector<double>* a) {
+        for (std::size_t k = 20; k < a->size(); ++k) (*a)[k] = 1.2;
+      },
+      [](std::vector<double>* a) { (*a)[20] += 0.15; },
+      [](std::vector<double>* a) {
+        for (std::size_t k = 0; k < a->size(); ++k) (*a)[k] = k % 2 == 0 ? 3.13 : -3.13;
+      }};
+  for (std::size_t i = 0; i < edits.size(); ++i) {
+    CapturedWarnings warnings;
+    const EncoderLog log = Load(RobotWith(""), SteeringCsv(edits[i]));
+    EXPECT_EQ(log.dropped_glitches, 0) << i;
+    EXPECT_TRUE(warnings.lines.empty()) << i << ": " << warnings.lines.front();
+  }
 }
 
 // ---- through the command line --------------------------------------------------------------
