@@ -6,11 +6,8 @@
 #include <iostream>
 #include <set>
 
-#include "fit/run_split.h"
 #include "io/atomic_file.h"
-#include "io/calibration_yaml.h"
 #include "io/dataset.h"
-#include "io/input_error.h"
 #include "pages/report_csv.h"
 #include "pages/report_html.h"
 #include "pages/report_json.h"
@@ -44,15 +41,7 @@ ReportInputs LoadInputs(const ReportCommandOptions& options, std::string* refusa
   // Loaded as `fit` loads them, with the robot's channels (their runs' fingerprints must agree).
   in.dataset = LoadRuns(options, in.index, in.model->robot());
   for (const std::string& path : options.calibrations) {
-    Robot calibrated = ReadRobotModelFile(path)->robot();
-    if (calibrated.model != in.model->robot().model ||
-        calibrated.NumParameters() != in.model->robot().NumParameters()) {
-      throw io::InputError(
-          io::InputErrorKind::kBadValue, path, 0,
-          "a " + calibrated.model + " robot with " + std::to_string(calibrated.NumParameters()) +
-              " parameters cannot calibrate the data set's " + in.model->robot().model + " robot");
-    }
-    in.calibrations.push_back({path, std::move(calibrated), io::ReadCalibrationProvenance(path)});
+    in.calibrations.push_back(ReadCalibrationFor(path, in.model->robot()));
   }
   const CalibrationInput& first = in.calibrations.front();
   const std::string aligned =
@@ -178,13 +167,9 @@ int RunReportCommand(const ReportCommandOptions& options) {
       return Refuse(refusal);
     }
     std::vector<TrainingSplit> splits = CommonSplits(options.train_reps, in);
-    if (splits.front().split.validation.empty()) {
-      std::cerr << "fitcal report: every run of " << options.logs
-                << (splits.size() > 1
-                        ? " trained at least one of the calibrations"
-                        : " trained the calibration (repetitions " +
-                              FormatRepetitionList(splits.front().split.training_repetitions) + ")")
-                << "; nothing to validate on\n";
+    if (const std::string nothing = NothingToValidateRefusal(splits, options.logs);
+        !nothing.empty()) {
+      std::cerr << "fitcal report: " << nothing << "\n";
       return 2;
     }
     ReportBuildOptions build;

@@ -13,6 +13,7 @@
 #include "fit/run_split.h"
 #include "fitcal/version.h"
 #include "io/command_failure.h"
+#include "io/input_error.h"
 #include "odometry/text_format.h"
 #include "validation/never_worse.h"
 #include "validation/relative_pose_error.h"
@@ -628,6 +629,30 @@ io::ReportComparisonRow ComparisonRowOf(const io::ReportData& d) {
 }
 
 }  // namespace
+
+CalibrationInput ReadCalibrationFor(const std::string& path, const Robot& dataset_robot) {
+  Robot calibrated = ReadRobotModelFile(path)->robot();
+  if (calibrated.model != dataset_robot.model ||
+      calibrated.NumParameters() != dataset_robot.NumParameters()) {
+    throw io::InputError(io::InputErrorKind::kBadValue, path, 0,
+                         "a " + calibrated.model + " robot with " +
+                             std::to_string(calibrated.NumParameters()) +
+                             " parameters cannot calibrate the data set's " +
+                             dataset_robot.model + " robot");
+  }
+  return {path, std::move(calibrated), io::ReadCalibrationProvenance(path)};
+}
+
+std::string NothingToValidateRefusal(const std::vector<TrainingSplit>& splits,
+                                     const std::string& dataset) {
+  if (!splits.front().split.validation.empty()) return "";
+  return "every run of " + dataset +
+         (splits.size() > 1
+              ? " trained at least one of the calibrations"
+              : " trained the calibration (repetitions " +
+                    FormatRepetitionList(splits.front().split.training_repetitions) + ")") +
+         "; nothing to validate on";
+}
 
 std::vector<TrainingSplit> CommonSplits(const std::string& train_reps, const ReportInputs& in) {
   std::vector<TrainingSplit> splits;

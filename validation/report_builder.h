@@ -30,6 +30,10 @@ struct CalibrationInput {
   std::optional<io::CalibrationProvenance> provenance;
 };
 
+// The calibration at `path`, read for a data set of `dataset_robot`: refused (io::InputError,
+// the file named) when it is another model or has another number of parameters.
+CalibrationInput ReadCalibrationFor(const std::string& path, const Robot& dataset_robot);
+
 // Everything the report reads, loaded and checked before anything is computed
 // (cli/report_command.cc loads it).
 struct ReportInputs {
@@ -52,6 +56,11 @@ struct ReportBuildOptions {
 // Each calibration's split, the validation runs restricted to those every calibration left out:
 // several calibrations are compared on the same runs, the ones none of them trained on.
 std::vector<TrainingSplit> CommonSplits(const std::string& train_reps, const ReportInputs& in);
+
+// Why there is nothing to report on `dataset` (--logs) with these splits, or "": every run
+// trained the calibration (or at least one of several).
+std::string NothingToValidateRefusal(const std::vector<TrainingSplit>& splits,
+                                     const std::string& dataset);
 
 // The report of in.calibrations[0] on its validation runs, with the others compared
 // (ReportData::comparison); `splits` from CommonSplits, the first with validation runs.
