@@ -243,7 +243,9 @@ TrackRun PrepareTrackRun(const RunLog& run, unsigned wheel_mask, const TrackOpti
   if (out.checkpoints.empty()) {
     // Ground truth of the start and end poses only: nothing along the path to fit a track (or
     // an effect) on - said as what the data lack, since every command that fits tracks meets it.
-    throw std::invalid_argument("run " + run.id +
+    const std::string where =
+        run.ground_truth_path.empty() ? "run " + run.id : run.ground_truth_path;
+    throw std::invalid_argument(where +
                                 ": no ground-truth sample between the run's ends (the track "
                                 "residuals and effects need poses along the path; ground truth "
                                 "of start and end poses only is fitted on final poses by `fit`)");

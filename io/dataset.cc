@@ -378,6 +378,7 @@ Dataset LoadDataset(const DatasetIndex& index, const Robot& robot, const Dataset
     log.start_pose = entry.start_pose;
     log.encoders = ReadRunEncoders(entry.encoders_path, robot);
     log.ground_truth = ReadGroundTruth(entry.ground_truth_path);
+    log.ground_truth_path = entry.ground_truth_path;
     CheckGroundTruthOverlap(log.ground_truth, log.encoders.t_s.front(), log.encoders.t_s.back(),
                             entry.ground_truth_path);
   });

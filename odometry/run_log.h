@@ -47,6 +47,9 @@ struct RunLog {
   EncoderLog encoders;
   GroundTruthTrack ground_truth;
   std::optional<Pose2d> start_pose;  // the pose at the first encoder time, when the user knows it
+  // The file the ground truth was read from, named when the data lack something the fit needs
+  // ("" for runs made in memory).
+  std::string ground_truth_path;
 };
 
 // Ground truth at time t_s by linear interpolation (heading along the shorter arc); clamps to the

@@ -14,6 +14,8 @@
 #include "fitcal/version.h"
 #include "io/command_failure.h"
 #include "io/input_error.h"
+#include "models/mounted_model.h"
+#include "io/warnings.h"
 #include "odometry/text_format.h"
 #include "validation/never_worse.h"
 #include "validation/relative_pose_error.h"
@@ -630,8 +632,43 @@ io::ReportComparisonRow ComparisonRowOf(const io::ReportData& d) {
 
 }  // namespace
 
+namespace {
+
+// The recorded sigmas and correlation of a mounted calibration's base parameters alone: they
+// come first (models/mounted_model.h), so their block of the correlation.
+void KeepTheBasesUncertainty(const Robot& base, io::CalibrationProvenance* provenance) {
+  std::set<std::string> keys;
+  for (const ParameterInfo& info : base.parameters) keys.insert(info.KeyName());
+  std::vector<std::pair<std::string, double>> sigma;
+  std::vector<int> lines;
+  for (std::size_t i = 0; i < provenance->sigma.size(); ++i) {
+    if (keys.count(provenance->sigma[i].first) == 0) continue;
+    sigma.push_back(provenance->sigma[i]);
+    if (i < provenance->sigma_lines.size()) lines.push_back(provenance->sigma_lines[i]);
+  }
+  provenance->sigma = std::move(sigma);
+  provenance->sigma_lines = std::move(lines);
+  std::vector<std::vector<double>>& correlation = provenance->correlation;
+  const std::size_t n = static_cast<std::size_t>(base.NumParameters());
+  if (correlation.size() > n) correlation.resize(n);
+  for (std::vector<double>& row : correlation) row.resize(std::min(row.size(), n));
+}
+
+}  // namespace
+
 CalibrationInput ReadCalibrationFor(const std::string& path, const Robot& dataset_robot) {
-  Robot calibrated = ReadRobotModelFile(path)->robot();
+  const RobotModelPtr model = ReadRobotModelFile(path);
+  const bool mounted = !MountParameterIndices(model->robot()).empty();
+  const bool dataset_mounted = !MountParameterIndices(dataset_robot).empty();
+  if (model->robot().model == dataset_robot.model && !mounted && dataset_mounted) {
+    throw io::InputError(io::InputErrorKind::kBadValue, path, 0,
+                         "calibrated without a ground_truth_frame, but the data set's ground "
+                         "truth is a mounted sensor's (its robot YAML declares one): calibrate "
+                         "on runs of that sensor to report on them");
+  }
+  // A calibration made from a mounted sensor, judged on ground truth of the base: its wheels are
+  // the base model's parameters (models/mounted_model.h); the frame does not apply.
+  Robot calibrated = mounted && !dataset_mounted ? BaseModel(*model).robot() : model->robot();
   if (calibrated.model != dataset_robot.model ||
       calibrated.NumParameters() != dataset_robot.NumParameters()) {
     throw io::InputError(io::InputErrorKind::kBadValue, path, 0,
@@ -640,7 +677,14 @@ CalibrationInput ReadCalibrationFor(const std::string& path, const Robot& datase
                              " parameters cannot calibrate the data set's " +
                              dataset_robot.model + " robot");
   }
-  return {path, std::move(calibrated), io::ReadCalibrationProvenance(path)};
+  std::optional<io::CalibrationProvenance> provenance = io::ReadCalibrationProvenance(path);
+  if (mounted && !dataset_mounted) {
+    io::Warn(path, 0,
+             "its ground_truth_frame is not used: the data set's robot YAML declares none, so "
+             "its ground truth is the base's; the wheels are judged alone");
+    if (provenance) KeepTheBasesUncertainty(calibrated, &*provenance);
+  }
+  return {path, std::move(calibrated), std::move(provenance)};
 }
 
 std::string NothingToValidateRefusal(const std::vector<TrainingSplit>& splits,
