@@ -67,7 +67,8 @@ void PrintParameters(const Robot& robot, const std::vector<double>& p, const Sel
     std::printf("  held: %s (%s)\n", robot.parameters[h.index].name.c_str(), h.reason.c_str());
   }
   for (const std::string& note : fit.sigma_notes) std::printf("  resolution: %s\n", note.c_str());
-  if (const std::string frame = GroundTruthFrameLine(robot, fit.held, fit.held_reason);
+  if (const std::string frame =
+          GroundTruthFrameLine(robot, fit.held, fit.held_reason, fit.not_determined);
       !frame.empty()) {
     std::printf("  %s\n", frame.c_str());
   }

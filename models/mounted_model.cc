@@ -286,26 +286,34 @@ std::vector<int> MountParameterIndices(const Robot& robot) {
 }
 
 std::string GroundTruthFrameLine(const Robot& robot, const std::vector<bool>& held,
-                                 const std::string& held_reason) {
+                                 const std::string& held_reason,
+                                 const std::vector<bool>& not_determined) {
   const std::vector<int> mount = MountParameterIndices(robot);
   if (mount.empty()) return "";
   const char* const names[] = {"x", "y", "yaw"};
-  std::vector<std::string> determined, fixed;
+  std::vector<std::string> determined, open, fixed;
   std::string reason = "--hold, or a direction the runs do not determine";
   for (int i = 0; i < MountedModel::kNumMountParameters; ++i) {
     const int k = mount[i];
-    (held[k] ? fixed : determined).push_back(names[i]);
+    // A fitted number on a direction the runs leave open (an omni robot's yaw turning with a
+    // common offset of its wheel angles) moves with the nominal there: not "determined".
+    const bool on_open_direction =
+        k < static_cast<int>(not_determined.size()) && not_determined[k];
+    (held[k] ? fixed : on_open_direction ? open : determined).push_back(names[i]);
     for (const HeldParameter& h : robot.held) {
       if (h.index == k) reason = h.reason;
     }
   }
   if (!held_reason.empty()) reason = held_reason;
   std::string line = "ground_truth_frame: ";
-  if (!determined.empty()) line += Enumerate(determined) + " determined by the runs";
-  if (!fixed.empty()) {
-    line += std::string(determined.empty() ? "" : "; ") + Enumerate(fixed) + " held (" + reason +
-            ")";
+  std::vector<std::string> parts;
+  if (!determined.empty()) parts.push_back(Enumerate(determined) + " determined by the runs");
+  if (!open.empty()) {
+    parts.push_back(Enumerate(open) + " not determined (on a direction the runs leave open, " +
+                    "with the parameters marked NOT DETERMINED)");
   }
+  if (!fixed.empty()) parts.push_back(Enumerate(fixed) + " held (" + reason + ")");
+  for (std::size_t i = 0; i < parts.size(); ++i) line += (i == 0 ? "" : "; ") + parts[i];
   return line;
 }
 

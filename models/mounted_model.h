@@ -107,11 +107,14 @@ const RobotModelInterface& BaseModel(const RobotModelInterface& model);
 // without the frame.
 std::vector<int> MountParameterIndices(const Robot& robot);
 
-// One line saying which of the frame's numbers the fit determined and which it held (held: per
-// parameter, the fit's holds), with `held_reason` (a closed form's), else the model's reason
-// (--hold or a held direction without one); "" for a robot without the frame.
+// One line saying which of the frame's numbers the fit determined, which it fitted but the runs
+// leave along an open direction (not_determined: per parameter, fit/determined_directions.h; may
+// be empty), and which it held (held: per parameter, the fit's holds), with `held_reason` (a
+// closed form's), else the model's reason (--hold or a held direction without one); "" for a
+// robot without the frame.
 std::string GroundTruthFrameLine(const Robot& robot, const std::vector<bool>& held,
-                                 const std::string& held_reason = "");
+                                 const std::string& held_reason = "",
+                                 const std::vector<bool>& not_determined = {});
 
 // The robot YAML's `ground_truth_frame:` (and its bounds under `bounds:`), read from `root` and
 // removed from it, so that the model's own reader sees its schema only. Returns `inner` itself

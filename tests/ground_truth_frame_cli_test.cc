@@ -115,7 +115,12 @@ TEST(MountedFit, AnOmniRobotsXAndYAreHeldWithTheReason) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   r = RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --residuals final-pose --out " + cal);
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
-  EXPECT_TRUE(Has(r.out, "ground_truth_frame: yaw determined by the runs; x and y held")) << r.out;
+  // Its yaw turns with a common offset of the wheel angles, a direction these runs leave open
+  // (the table marks it NOT DETERMINED; -17.3 deg fitted for 5): said so, not "determined by the
+  // runs" as before (tests/mounted_realdata_test.cc checks the two agree on the real omni3).
+  EXPECT_TRUE(Has(r.out, "ground_truth_frame: yaw not determined (on a direction the runs leave "
+                         "open, with the parameters marked NOT DETERMINED); x and y held"))
+      << r.out;
   EXPECT_TRUE(Has(r.out, "wheel distances")) << r.out;
   const YAML::Node frame = YAML::LoadFile(cal)["ground_truth_frame"];
   EXPECT_EQ(frame["x_m"].as<double>(), 1.5);
