@@ -46,6 +46,22 @@ std::optional<std::vector<double>> FoldFits::Fit(const FitMethod& method,
   return out;
 }
 
+ScoreOnRuns FoldFits::ScoredOnce(ScoreOnRuns score) {
+  return [this, score = std::move(score)](const std::vector<double>& p,
+                                          const std::vector<AlignedRun>& runs) {
+    // The parameters' bytes: the same fit, not merely equal numbers.
+    std::string key(reinterpret_cast<const char*>(p.data()), p.size() * sizeof(double));
+    for (const AlignedRun& run : runs) key += " " + run.id;
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      if (const auto found = scored_.find(key); found != scored_.end()) return found->second;
+    }
+    EverydayDrivingMetrics metrics = score(p, runs);
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return scored_.emplace(std::move(key), std::move(metrics)).first->second;
+  };
+}
+
 namespace {
 
 // The fit of all the training runs with `settings` into *full; the folds' fits start from it.
@@ -91,7 +107,8 @@ std::vector<std::string> ChooseResidualsByTransfer(const FitMethod& method, int 
     s.residuals = kind;
     return fold_fits->Fit(method, model, s, training);
   };
-  const ScoreOnRuns score = EverydayDrivingScore(model, threads, {kTransferDriftLength_m});
+  const ScoreOnRuns score =
+      fold_fits->ScoredOnce(EverydayDrivingScore(model, threads, {kTransferDriftLength_m}));
   const ResidualKindJudgement judgement = JudgeResidualKindsByTransfer(
       ResidualKind::kTrack, ResidualKind::kFinalPose, split, fit_on, score);
   if (judgement.chosen != settings->residuals) {
@@ -119,7 +136,8 @@ std::vector<std::string> ChooseTrackObjectiveByTransfer(
     s.track_heading = objective.heading;
     return fold_fits->Fit(method, model, s, training);
   };
-  const ScoreOnRuns score = EverydayDrivingScore(model, threads, {kTransferDriftLength_m});
+  const ScoreOnRuns score =
+      fold_fits->ScoredOnce(EverydayDrivingScore(model, threads, {kTransferDriftLength_m}));
   const TrackObjectiveJudgement judgement = JudgeTrackObjectivesByTransfer(
       TrackObjectiveCandidates(*settings), split, fit_on, score);
   *note = TrackObjectiveChoiceText(judgement);
