@@ -32,12 +32,10 @@ std::optional<std::vector<double>> FoldFits::Fit(const FitMethod& method,
   if (s.estimate_weights && seed_levels.estimated) {
     s.track_weights = WeightsFromNoiseLevels(seed_levels).track;
   }
-  RunSplit part;
-  part.training = training;
   std::optional<TrackFitData> data;
   std::optional<std::vector<double>> out;
   // The whole data's method fits this kind (checked before the choice): no refusal here.
-  if (PrepareTrackResiduals(method.name, part, &s, &data).empty()) {
+  if (PrepareTrackResiduals(method.name, training, &s, &data).empty()) {
     const ModelFitResult fit = method.run_model(training, model, s).fit;
     if (fit.usable || fit.stopped_early) out = fit.parameters;
   }
