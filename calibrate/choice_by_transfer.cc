@@ -32,18 +32,32 @@ std::optional<std::vector<double>> FoldFits::Fit(const FitMethod& method,
   if (s.estimate_weights && seed_levels.estimated) {
     s.track_weights = WeightsFromNoiseLevels(seed_levels).track;
   }
-  RunSplit part;
-  part.training = training;
   std::optional<TrackFitData> data;
   std::optional<std::vector<double>> out;
   // The whole data's method fits this kind (checked before the choice): no refusal here.
-  if (PrepareTrackResiduals(method.name, part, &s, &data).empty()) {
+  if (PrepareTrackResiduals(method.name, training, &s, &data).empty()) {
     const ModelFitResult fit = method.run_model(training, model, s).fit;
     if (fit.usable || fit.stopped_early) out = fit.parameters;
   }
   const std::lock_guard<std::mutex> lock(mutex_);
   done_[key] = out;
   return out;
+}
+
+ScoreOnRuns FoldFits::ScoredOnce(ScoreOnRuns score) {
+  return [this, score = std::move(score)](const std::vector<double>& p,
+                                          const std::vector<AlignedRun>& runs) {
+    // The parameters' bytes: the same fit, not merely equal numbers.
+    std::string key(reinterpret_cast<const char*>(p.data()), p.size() * sizeof(double));
+    for (const AlignedRun& run : runs) key += " " + run.id;
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      if (const auto found = scored_.find(key); found != scored_.end()) return found->second;
+    }
+    EverydayDrivingMetrics metrics = score(p, runs);
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return scored_.emplace(std::move(key), std::move(metrics)).first->second;
+  };
 }
 
 namespace {
@@ -91,7 +105,8 @@ std::vector<std::string> ChooseResidualsByTransfer(const FitMethod& method, int 
     s.residuals = kind;
     return fold_fits->Fit(method, model, s, training);
   };
-  const ScoreOnRuns score = EverydayDrivingScore(model, threads, {kTransferDriftLength_m});
+  const ScoreOnRuns score =
+      fold_fits->ScoredOnce(EverydayDrivingScore(model, threads, {kTransferDriftLength_m}));
   const ResidualKindJudgement judgement = JudgeResidualKindsByTransfer(
       ResidualKind::kTrack, ResidualKind::kFinalPose, split, fit_on, score);
   if (judgement.chosen != settings->residuals) {
@@ -119,7 +134,8 @@ std::vector<std::string> ChooseTrackObjectiveByTransfer(
     s.track_heading = objective.heading;
     return fold_fits->Fit(method, model, s, training);
   };
-  const ScoreOnRuns score = EverydayDrivingScore(model, threads, {kTransferDriftLength_m});
+  const ScoreOnRuns score =
+      fold_fits->ScoredOnce(EverydayDrivingScore(model, threads, {kTransferDriftLength_m}));
   const TrackObjectiveJudgement judgement = JudgeTrackObjectivesByTransfer(
       TrackObjectiveCandidates(*settings), split, fit_on, score);
   *note = TrackObjectiveChoiceText(judgement);

@@ -33,12 +33,18 @@ class FoldFits {
                                          FitMethodSettings s,
                                          const std::vector<AlignedRun>& training);
 
+  // `score`, each fit scored once on each set of runs: the two choices judge the default
+  // candidate's fits (one fit per fold, above) on the same runs, and the score is a function of
+  // the parameters and the runs alone.
+  ScoreOnRuns ScoredOnce(ScoreOnRuns score);
+
   std::vector<double> start;  // empty: the nominal
   NoiseLevels seed_levels;
 
  private:
   std::mutex mutex_;
   std::map<std::string, std::optional<std::vector<double>>> done_;
+  std::map<std::string, EverydayDrivingMetrics> scored_;
 };
 
 // --residuals auto proposing the track: the track and the final pose are fitted and judged on

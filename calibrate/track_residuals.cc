@@ -9,10 +9,11 @@
 
 namespace fitcal {
 
-std::string PrepareTrackResiduals(const std::string& method, const RunSplit& split,
+std::string PrepareTrackResiduals(const std::string& method,
+                                  const std::vector<AlignedRun>& training,
                                   FitMethodSettings* settings, std::optional<TrackFitData>* data) {
-  const std::vector<const GroundTruthTrack*> tracks = TracksOf(split.training);
-  ResolveAutoResiduals(split.training, tracks, method, settings);
+  const std::vector<const GroundTruthTrack*> tracks = TracksOf(training);
+  ResolveAutoResiduals(training, tracks, method, settings);
   if (settings->residuals == ResidualKind::kFinalPose) return "";
   if (!IsCeresMethod(method)) {
     return std::string("--residuals ") + ToString(settings->residuals) +
@@ -21,9 +22,14 @@ std::string PrepareTrackResiduals(const std::string& method, const RunSplit& spl
   }
   TrackResidualOptions track_options;
   track_options.heading = settings->track_heading;
-  data->emplace(MakeTrackFitData(split.training, tracks, settings->clock_grouping, track_options));
+  data->emplace(MakeTrackFitData(training, tracks, settings->clock_grouping, track_options));
   settings->track = &**data;
   return "";
+}
+
+std::string PrepareTrackResiduals(const std::string& method, const RunSplit& split,
+                                  FitMethodSettings* settings, std::optional<TrackFitData>* data) {
+  return PrepareTrackResiduals(method, split.training, settings, data);
 }
 
 std::string DegreesOfFreedomRefusal(const RunSplit& split, const FitMethodSettings& settings,

@@ -18,6 +18,10 @@ namespace fitcal {
 // into *data): "" when done, else why `method` cannot fit them (the caller refuses, exit 2).
 std::string PrepareTrackResiduals(const std::string& method, const RunSplit& split,
                                   FitMethodSettings* settings, std::optional<TrackFitData>* data);
+// The same for the runs `training` (a fold's), without copying them into a split.
+std::string PrepareTrackResiduals(const std::string& method,
+                                  const std::vector<AlignedRun>& training,
+                                  FitMethodSettings* settings, std::optional<TrackFitData>* data);
 
 // The fit's residual degrees of freedom (validation/residual_dof.h), counted for the residuals
 // it will minimise: three final-pose residuals per training run, three per track checkpoint

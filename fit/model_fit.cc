@@ -15,6 +15,7 @@
 #include "fit/ceres_problem.h"
 #include "fit/correlation.h"
 #include "fit/determined_directions.h"
+#include "fit/last_evaluation_memo.h"
 #include "fit/segment_cost.h"
 #include "fit/serial_covariance.h"
 
@@ -84,6 +85,10 @@ class HoldDirectionsCost : public ceres::CostFunction {
   Eigen::MatrixXd rows_;
 };
 
+// A run's residual block, its repeated evaluations at one point answered from a memo
+// (fit/last_evaluation_memo.h: Ceres' bounded line search evaluates the step's end twice).
+ceres::CostFunction* Memo(ceres::CostFunction* cost) { return new LastEvaluationMemo(cost); }
+
 // One Ceres problem over the training runs with the parameters in `fixed` held constant.
 class FitProblem {
  public:
@@ -101,19 +106,20 @@ class FitProblem {
       if (fit_options.segments != nullptr) {
         if ((*fit_options.segments)[i].empty()) continue;
         data_blocks_.push_back(problem_->AddResidualBlock(
-            model.SegmentCost(run, (*fit_options.segments)[i], options.weights), nullptr, p));
+            Memo(model.SegmentCost(run, (*fit_options.segments)[i], options.weights)), nullptr,
+            p));
         continue;
       }
       if (final_poses) {
-        data_blocks_.push_back(problem_->AddResidualBlock(model.FinalPoseCost(run, options.weights),
-                                                          MakeLoss(options), p));
+        data_blocks_.push_back(problem_->AddResidualBlock(
+            Memo(model.FinalPoseCost(run, options.weights)), MakeLoss(options), p));
       }
       if (!tracks) continue;
       const TrackCheckpoints& track = fit_options.track->runs[i];
       if (!track.segments.empty()) {
         data_blocks_.push_back(problem_->AddResidualBlock(
-            TrackResidual::Create(track, model, TrackWeightsOf(fit_options),
-                                  fit_options.track->options),
+            Memo(TrackResidual::Create(track, model, TrackWeightsOf(fit_options),
+                                       fit_options.track->options)),
             nullptr, p, clock_offsets + track.clock_group));
       }
     }

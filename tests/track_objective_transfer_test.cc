@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <map>
 #include <random>
@@ -142,6 +143,41 @@ TEST(TrackObjectiveTransfer, NotJudgedWithoutCandidatesKindsOrUsableFits) {
 }
 
 // Held-out free driving judges alone (one fold, all training runs fitted).
+// The two choices by transfer judge the default candidate's fold fits on the same runs: through
+// FoldFits::ScoredOnce each fit is scored once per set of runs, the second judgement reads the
+// first one's measures (the same numbers: a score is a function of the parameters and the runs).
+TEST(TrackObjectiveTransfer, FoldFitsScoreEachFitOnceOnEachSetOfRuns) {
+  const RunSplit split = CirclesAndSquares();
+  int scored = 0;
+  FoldFits fold_fits;
+  const ScoreOnRuns score = fold_fits.ScoredOnce(
+      [&](const std::vector<double>& p, const std::vector<AlignedRun>& runs) {
+        ++scored;
+        EverydayDrivingMetrics e;
+        e.runs = static_cast<int>(runs.size());
+        e.cf = p[0] + 0.5 * scored;  // differs per call: a second scoring would show
+        return e;
+      });
+  const double first = score({1.0}, split.training).cf;
+  EXPECT_EQ(score({1.0}, split.training).cf, first);
+  EXPECT_EQ(scored, 1);
+  score({1.0}, {split.training.front()});  // other runs
+  score({std::nextafter(1.0, 2.0)}, split.training);  // another fit, one ulp away
+  EXPECT_EQ(scored, 3);
+  // Both judgements on these folds (2 kinds of run): the default's two fold fits scored once.
+  const FitCandidate fit_on = [](int c, const std::vector<AlignedRun>& training) {
+    return std::optional<std::vector<double>>(
+        std::vector<double>{10.0 * c + static_cast<double>(training.size())});
+  };
+  const std::vector<TransferFold> folds = MakeTransferFolds(split).folds;
+  ASSERT_EQ(folds.size(), 2u);
+  scored = 0;
+  ASSERT_TRUE(FitAndScoreFolds(folds, 2, fit_on, score));
+  EXPECT_EQ(scored, 4);
+  ASSERT_TRUE(FitAndScoreFolds(folds, 3, fit_on, score));  // candidates 0 and 1 again, and 2
+  EXPECT_EQ(scored, 6);
+}
+
 TEST(TrackObjectiveTransfer, HeldOutFreeDrivingIsTheOneFold) {
   RunSplit split = CirclesAndSquares();
   split.validation.push_back(testing::LabelledRun("free_1", 1));
