@@ -6,18 +6,49 @@
 
 #include "cli/dataset_command.h"
 #include "io/output_guard.h"
-#include "sim/asoc_scenarios.h"
+#include "models/asoc/asoc_extras.h"
+#include "models/asoc/asoc_tables.h"
+#include "models/model_registry.h"
+#include "sim/model_dataset.h"
+#include "sim/model_scenarios.h"
 
 namespace fitcal::tools {
 
+namespace {
+
+// The simulated prototype's encoders (Doebbler Sec. IV-B, V; models/asoc/asoc_extras.h): 20 Hz,
+// wheels counted in 0.3 deg, ground truth noise-free at every encoder time from the origin, and
+// the relative wheel-encoder noise of --wheel-slip-sigma on each 20 Hz increment.
+sim::ScenarioNoise PrototypeEncoders(std::uint64_t seed, double wheel_slip_sigma, int excursions) {
+  sim::ScenarioNoise noise;
+  noise.repetitions = excursions;
+  noise.seed = seed;
+  noise.encoder_period_s = asoc::kPrototypeSamplePeriodS;
+  noise.ground_truth_period_s = asoc::kPrototypeSamplePeriodS;
+  noise.ticks_per_rev = asoc::kPrototypeWheelTicksPerRev;
+  noise.wheel_rate_sigma_rad_s = 0.0;
+  noise.wheel_relative_sigma = wheel_slip_sigma;
+  noise.angle_sigma_rad = 0.0;
+  noise.gt_position_sigma_m = 0.0;
+  noise.gt_heading_sigma_rad = 0.0;
+  noise.start_position_range_m = 0.0;
+  return noise;
+}
+
+}  // namespace
+
 int RunAsocSimulate(const AsocSimulateOptions& options) {
   return RunReportingErrors("fitcal", [&]() -> int {
-    const std::size_t num_runs = sim::WriteSimulatedAsocDataset(
-        options.out, options.force, options.seed, options.wheel_slip_sigma, options.excursions);
+    sim::ModelDatasetRequest request;
+    request.out = options.out;
+    request.model = "asoc";
+    request.force = options.force;
+    request.noise = PrototypeEncoders(options.seed, options.wheel_slip_sigma, options.excursions);
+    const sim::WrittenModelDataset written = sim::WriteModelDataset(request);
     std::printf(
         "wrote %zu ASOC runs (6 calibration holds, 10 UMBmark, %d excursions) to %s; the "
         "true parameters are in true_robot.yaml\n",
-        num_runs, options.excursions, options.out.c_str());
+        written.num_runs, options.excursions, options.out.c_str());
     return 0;
   });
 }
@@ -33,8 +64,29 @@ int RunAsocTables(const AsocTablesOptions& options) {
     std::cerr << "fitcal: --sets must be at least 1\n";
     return 2;
   }
-  const sim::DoebblerTables mean = sim::SimulateDoebblerTables(
-      options.sets, options.seed, options.wheel_slip_sigma, options.threads);
+  const RobotModelPtr model = ReadRobotModel(YAML::Load(kAsocExampleYaml), "asoc example robot");
+  const auto& nominal = dynamic_cast<const AsocModel&>(*model);
+  sim::SimulationOptions simulation =
+      sim::MakeModelScenario(nominal, nominal.robot().nominal,
+                             PrototypeEncoders(options.seed, options.wheel_slip_sigma, 0))
+          .options;
+  // UMBmark averages the runs' error vectors in the world frame: every run starts at the origin,
+  // heading +x. The castors integrated at a tenth of the 20 Hz sample, as the paper's runs need.
+  simulation.random_start_heading = false;
+  simulation.substep_s = asoc::kPrototypeSamplePeriodS / 10.0;
+  const asoc::SimulateFn simulate = [&](const std::vector<double>& truth,
+                                        const std::vector<sim::TrajectorySpec>& specs,
+                                        std::uint64_t seed) {
+    sim::SimulationOptions o = simulation;
+    o.seed = seed;
+    std::vector<RunLog> logs;
+    for (sim::ModelSimulatedRun& run : sim::SimulateRuns(nominal, truth, specs, o)) {
+      logs.push_back(std::move(run.log));
+    }
+    return logs;
+  };
+  const asoc::DoebblerTables mean = asoc::SimulateDoebblerTables(
+      nominal, options.sets, options.seed, simulate, options.threads);
   std::printf(
       "Doebbler et al. Tables I and II, %d random parameter sets (seed %llu, wheel slip "
       "sigma %g per 20 Hz sample)\n\n",

@@ -5,7 +5,9 @@
 // is optional. The commands ask the
 // registry for these and never compare a model's name (STYLE.md habit 14).
 
+#include <cstdint>
 #include <functional>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -57,14 +59,34 @@ struct ControllerWriter {
 // how far its default true robot is from the nominal one (a fraction of the way to the bounds).
 // The commands are the nominal robot's; the true parameters may only limit what the machine can
 // drive (a tricycle's readable steering range).
+// A channel that is a state of the machine, not a function of the body twist (an ASOC castor's
+// angle follows its pivot's motion: asoc_extras.h). The simulator's perfect tracking asks the
+// model's dynamics for every fine step in place of ChannelsForTwist.
+class ChannelDynamics {
+ public:
+  virtual ~ChannelDynamics() = default;
+  // Advances the state by dt_s under the body twist v (held over the step) and writes the step's
+  // channel values as the seam's replay reads them: wheel rates as the step's mean, angles at its
+  // middle.
+  virtual void Step(const Twist& v, double dt_s, double* values) = 0;
+  // The angle channels' encoder readings now (wheel channels are left as they are).
+  virtual void Read(double* values) const = 0;
+};
+using ChannelDynamicsFactory = std::function<std::unique_ptr<ChannelDynamics>(
+    const RobotModelInterface& model, const std::vector<double>& truth,
+    const sim::TrajectorySpec& spec)>;
+
 struct SimulationScenario {
   std::function<std::vector<sim::TrajectorySpec>(
-      const Robot& nominal, const std::vector<double>& truth, int repetitions)>
+      const RobotModelInterface& nominal, const std::vector<double>& truth, int repetitions)>
       trajectories;  // empty: the model has no scenario
   double truth_fraction = 0.25;
-  // The default true robot when a published one exists (omni3: Palacin Table 5); empty: the
-  // nominal moved truth_fraction of the way to its bounds.
-  std::function<std::vector<double>(const Robot& nominal)> default_truth;
+  // The default true robot when the model has its own (omni3: Palacin Table 5, any seed; asoc:
+  // drawn from `seed` as Doebbler Table I); empty: the nominal moved truth_fraction of the way to
+  // its bounds.
+  std::function<std::vector<double>(const Robot& nominal, std::uint64_t seed)> default_truth;
+  // Empty: every channel follows the twist (ChannelsForTwist).
+  ChannelDynamicsFactory dynamics;
   // Driven through the time-stepped physics of a wheel controller (sim/stepped_run.h: lag, slip,
   // jittered encoders, irregular ground truth; `--slip-sigma` and `--inject` act there) and the
   // encoders written as a recorder writes them, instead of perfect tracking: how data/flower was

@@ -4,6 +4,7 @@
 #include "io/sample_checks.h"
 #include "io/yaml_reader.h"
 #include "io/yaml_units_check.h"
+#include "models/asoc/asoc_extras.h"
 #include "models/asoc/asoc_robot_model.h"
 #include "models/diff_drive/diff_drive_extras.h"
 #include "models/diff_drive/diff_drive_model.h"
@@ -32,7 +33,7 @@ std::vector<ModelRegistration>& Registry() {
       {"diff_drive", "differential drive, Borenstein & Feng 1996 (3 parameters)",
        &ReadDiffDriveModel, kDiffDriveExampleYaml, DiffDriveExtras()},
       {"asoc", "three active split offset castors, Doebbler et al. (18 parameters)", &ReadAsocModel,
-       kAsocExampleYaml, {}},
+       kAsocExampleYaml, AsocExtras()},
   };
   // What each model's channels must hold, checked by the loader on every log (io/sample_checks.h).
   static const bool sample_checks_registered = [] {

@@ -32,7 +32,7 @@ RobotModelPtr NominalModel(const ModelDatasetRequest& request) {
 std::vector<double> TrueParameters(const ModelDatasetRequest& request,
                                    const RobotModelInterface& nominal) {
   const Robot& robot = nominal.robot();
-  if (request.truth.empty()) return DefaultTrueParameters(robot);
+  if (request.truth.empty()) return DefaultTrueParameters(robot, request.noise.seed);
   const RobotModelPtr truth = ReadRobotModelFile(request.truth);
   const Robot& t = truth->robot();
   if (t.model != robot.model || t.NumChannels() != robot.NumChannels() ||

@@ -61,7 +61,7 @@ std::string ScenarioModelNames() {
 ModelScenario MakeModelScenario(const RobotModelInterface& model, const std::vector<double>& truth,
                                 const ScenarioNoise& noise) {
   const Robot& robot = model.robot();
-  if (noise.repetitions < 1) throw std::invalid_argument("--repetitions must be at least 1");
+  if (noise.repetitions < 0) throw std::invalid_argument("--repetitions must be at least 0");
   const SimulationScenario& scenario = ExtrasOf(robot.model).scenario;
   if (!scenario.trajectories) {
     throw std::invalid_argument(
@@ -69,7 +69,7 @@ ModelScenario MakeModelScenario(const RobotModelInterface& model, const std::vec
         ScenarioModelNames() + ")");
   }
   ModelScenario out;
-  out.trajectories = scenario.trajectories(robot, truth, noise.repetitions);
+  out.trajectories = scenario.trajectories(model, truth, noise.repetitions);
   SimulationOptions& o = out.options;
   o.encoder_period_s = noise.encoder_period_s;
   o.ground_truth_period_s = noise.ground_truth_period_s;
@@ -78,20 +78,22 @@ ModelScenario MakeModelScenario(const RobotModelInterface& model, const std::vec
     if (robot.channels[i].kind == ChannelKind::kWheelRate) o.ticks_per_rev[i] = noise.ticks_per_rev;
   }
   o.wheel_rate_sigma_rad_s = noise.wheel_rate_sigma_rad_s;
+  o.wheel_relative_sigma = noise.wheel_relative_sigma;
   o.angle_sigma_rad = noise.angle_sigma_rad;
   o.gt_position_sigma_m = noise.gt_position_sigma_m;
   o.gt_heading_sigma_rad = noise.gt_heading_sigma_rad;
   o.start_position_range_m = noise.start_position_range_m;
   o.random_start_heading = true;
   o.seed = noise.seed;
+  o.dynamics = scenario.dynamics;
   SetSteppedPhysics(robot, scenario, noise, &o);
   if (scenario.stepped_physics) out.digits = EncoderCsvDigits::kRecorder;
   return out;
 }
 
-std::vector<double> DefaultTrueParameters(const Robot& robot) {
+std::vector<double> DefaultTrueParameters(const Robot& robot, std::uint64_t seed) {
   const SimulationScenario& scenario = ExtrasOf(robot.model).scenario;
-  if (scenario.default_truth) return scenario.default_truth(robot);
+  if (scenario.default_truth) return scenario.default_truth(robot, seed);
   const double fraction = scenario.truth_fraction;
   std::vector<double> p = robot.nominal;
   int moved = 0;

@@ -60,7 +60,8 @@ struct ModelScenario {
 ModelScenario MakeModelScenario(const RobotModelInterface& model, const std::vector<double>& truth,
                                 const ScenarioNoise& noise);
 
-// The default true robot of the header: nominal moved a fraction of the way to a bound.
-std::vector<double> DefaultTrueParameters(const Robot& robot);
+// The default true robot of the header: nominal moved a fraction of the way to a bound, or the
+// model's own (drawn from `seed` where the model draws it).
+std::vector<double> DefaultTrueParameters(const Robot& robot, std::uint64_t seed = 1);
 
 }  // namespace fitcal::sim

@@ -156,9 +156,29 @@ EncoderSamples FineChannels(const RobotModelInterface& model, const double* p,
   return fine;
 }
 
-// The encoder log and the recorded rows from the fine channel values (header: noise model).
+// Channel values of every fine step from the model's own dynamics, and the angle readings at
+// every grid time (readings[k], grid time k).
+EncoderSamples DynamicChannels(ChannelDynamics& dynamics, int c, const TwistProfile& profile,
+                               const FineGrid& grid, std::vector<std::vector<double>>* readings) {
+  EncoderSamples fine(c);
+  std::vector<double> values(c, 0.0);
+  dynamics.Read(values.data());
+  readings->push_back(values);
+  for (std::size_t k = 1; k < grid.t_s.size(); ++k) {
+    const double dt = grid.t_s[k] - grid.t_s[k - 1];
+    dynamics.Step(profile.At(grid.t_s[k - 1] + 0.5 * dt), dt, values.data());
+    fine.push_back(dt, values.data());
+    dynamics.Read(values.data());
+    readings->push_back(values);
+  }
+  return fine;
+}
+
+// The encoder log and the recorded rows from the fine channel values (header: noise model);
+// `readings` per grid time when the model's dynamics read the angles, else empty.
 void RecordEncoders(const RobotModelInterface& model, const double* p, const TwistProfile& profile,
-                    const FineGrid& grid, const EncoderSamples& fine, const SimulationOptions& o,
+                    const FineGrid& grid, const EncoderSamples& fine,
+                    const std::vector<std::vector<double>>& readings, const SimulationOptions& o,
                     Rng& rng, ModelSimulatedRun* run) {
   const Robot& robot = model.robot();
   const int c = robot.NumChannels();
@@ -166,11 +186,12 @@ void RecordEncoders(const RobotModelInterface& model, const double* p, const Twi
   const auto ticks_of = [&o](int i) {
     return o.ticks_per_rev.empty() ? 0.0 : o.ticks_per_rev[static_cast<std::size_t>(i)];
   };
-  const auto read_angles = [&](double t, std::vector<double>* out) {
-    model.ChannelsForTwist(p, profile.At(t), tmp.data());
+  const auto read_angles = [&](std::size_t k, std::vector<double>* out) {
+    if (readings.empty()) model.ChannelsForTwist(p, profile.At(grid.t_s[k]), tmp.data());
+    const std::vector<double>& read = readings.empty() ? tmp : readings[k];
     for (int i = 0; i < c; ++i) {
       if (robot.channels[i].kind == ChannelKind::kAngle)
-        (*out)[i] = tmp[i] + rng.Normal(o.angle_sigma_rad);
+        (*out)[i] = read[i] + rng.Normal(o.angle_sigma_rad);
     }
   };
   for (int i = 0; i < c; ++i) {
@@ -178,7 +199,7 @@ void RecordEncoders(const RobotModelInterface& model, const double* p, const Twi
     if (ticks_of(i) > 0.0) angle[i] = rng.Uniform() * 2.0 * M_PI / ticks_of(i);
     counted[i] = ticks_of(i) > 0.0 ? std::floor(angle[i] * ticks_of(i) / (2.0 * M_PI)) : angle[i];
   }
-  read_angles(0.0, &previous);
+  read_angles(0, &previous);
   run->log.encoders.samples = EncoderSamples(c);
   run->log.encoders.t_s.push_back(0.0);
   run->recorded.push_back(std::vector<double>(c, 0.0));
@@ -188,7 +209,7 @@ void RecordEncoders(const RobotModelInterface& model, const double* p, const Twi
   for (std::size_t k = 1; k < grid.encoder_index.size(); ++k) {
     const std::size_t a = grid.encoder_index[k - 1], b = grid.encoder_index[k];
     const double dt = grid.t_s[b] - grid.t_s[a];
-    read_angles(grid.t_s[b], &reading);
+    read_angles(b, &reading);
     std::vector<double> row(c);
     for (int i = 0; i < c; ++i) {
       if (robot.channels[i].kind == ChannelKind::kAngle) {
@@ -198,6 +219,7 @@ void RecordEncoders(const RobotModelInterface& model, const double* p, const Twi
       }
       double advance = 0.0;
       for (std::size_t j = a; j < b; ++j) advance += fine[j].value[i] * fine[j].dt_s;
+      advance *= 1.0 + rng.Normal(o.wheel_relative_sigma);
       angle[i] += advance + rng.Normal(o.wheel_rate_sigma_rad_s * dt);
       const double ticks = ticks_of(i);
       const double now = ticks > 0.0 ? std::floor(angle[i] * ticks / (2.0 * M_PI)) : angle[i];
@@ -217,7 +239,11 @@ ModelSimulatedRun SimulateRun(const RobotModelInterface& model, const std::vecto
                               const TrajectorySpec& spec, const SimulationOptions& o, Rng& rng) {
   const TwistProfile profile(spec.segments, o);
   const FineGrid grid = MakeGrid(profile.end_s(), o);
-  const EncoderSamples fine = FineChannels(model, p.data(), profile, grid);
+  std::vector<std::vector<double>> readings;
+  const EncoderSamples fine =
+      o.dynamics ? DynamicChannels(*o.dynamics(model, p, spec), model.robot().NumChannels(), profile,
+                                   grid, &readings)
+                 : FineChannels(model, p.data(), profile, grid);
   ModelSimulatedRun run;
   run.true_start_pose = StartPose(o, rng);
   // The truth: the true model replayed on the fine grid.
@@ -232,7 +258,7 @@ ModelSimulatedRun SimulateRun(const RobotModelInterface& model, const std::vecto
   run.log.repetition = spec.repetition;
   for (const ChannelInfo& ch : model.robot().channels)
     run.encoder_columns.push_back(ch.rate_column);
-  RecordEncoders(model, p.data(), profile, grid, fine, o, rng, &run);
+  RecordEncoders(model, p.data(), profile, grid, fine, readings, o, rng, &run);
   for (std::size_t j : grid.gt_index) {
     const Pose2d& t = truth[j];
     run.log.ground_truth.t_s.push_back(grid.t_s[j]);
@@ -267,7 +293,9 @@ std::string SimulationOptions::Check(int num_channels) const {
     const std::string problem = CheckSteppedOptions(*stepped, encoder_period_s, num_channels);
     if (!problem.empty()) return problem;
   }
-  if (!(wheel_rate_sigma_rad_s >= 0.0) || !(angle_sigma_rad >= 0.0) ||
+  if (stepped && dynamics) return "a model's own channel dynamics need perfect tracking";
+  if (!(wheel_rate_sigma_rad_s >= 0.0) || !(wheel_relative_sigma >= 0.0) ||
+      !(angle_sigma_rad >= 0.0) ||
       !(gt_position_sigma_m >= 0.0) || !(gt_heading_sigma_rad >= 0.0) ||
       !(start_position_range_m >= 0.0)) {
     return "noise sigmas and the start range must be >= 0";

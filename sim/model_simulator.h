@@ -31,7 +31,8 @@
 //       (floor), so the quantisation error stays below one tick and does not accumulate; the log
 //       holds the mean rate over the interval (counted angle advance / dt).
 //     angle channels: the reading at each row time plus white Gaussian noise angle_sigma_rad; the
-//       interval value is the mean of the two readings (as the loader makes it, robot.h).
+//       interval value is the mean of the two readings (as the loader makes it, robot.h). With
+//       `dynamics` the model's own state gives the channels step by step and its encoders' readings.
 // - Start pose: start_pose, moved by a uniform offset in +-start_position_range_m per axis and a
 //   uniform heading in [-pi, pi) when random_start_heading; recorded in RunLog::start_pose only
 //   when record_start_pose (otherwise the fit takes it from the noisy ground truth).
@@ -44,6 +45,7 @@
 #include <string>
 #include <vector>
 
+#include "models/model_extras.h"
 #include "models/model_interface.h"
 #include "models/trajectory_spec.h"
 #include "odometry/effects.h"
@@ -129,6 +131,9 @@ struct SimulationOptions {
   // Per channel (robot order): ticks per wheel revolution, 0 = no quantisation. Empty = none.
   std::vector<double> ticks_per_rev;
   double wheel_rate_sigma_rad_s = 0.0;
+  // Each wheel channel's counted advance over an encoder interval scaled by (1 + N(0, sigma)):
+  // floor roughness, small slips (Doebbler's non-systematic error, asoc-tables).
+  double wheel_relative_sigma = 0.0;
   double angle_sigma_rad = 0.0;
   double gt_position_sigma_m = 0.0;
   double gt_heading_sigma_rad = 0.0;
@@ -143,6 +148,9 @@ struct SimulationOptions {
   // Set: the flower's time-stepped physics (above) in place of perfect tracking; ramp_time_s,
   // ground_truth_period_s and wheel_rate_sigma_rad_s are then unused.
   std::optional<SteppedOptions> stepped;
+  // Set: the model integrates channels of its own state (ModelExtras::scenario.dynamics: an
+  // ASOC castor's angle) in place of ChannelsForTwist; perfect tracking only.
+  ChannelDynamicsFactory dynamics;
 
   // Empty when valid, else what is wrong.
   std::string Check(int num_channels) const;

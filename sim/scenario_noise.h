@@ -18,6 +18,7 @@ struct ScenarioNoise {
   double encoder_period_s = 0.010;
   double ticks_per_rev = 4096.0;  // wheel channels; 0 = no quantisation
   double wheel_rate_sigma_rad_s = 0.02;
+  double wheel_relative_sigma = 0.0;  // SimulationOptions::wheel_relative_sigma
   double angle_sigma_rad = 0.1 * M_PI / 180.0;
   double ground_truth_period_s = 0.2;
   double gt_position_sigma_m = 0.002;

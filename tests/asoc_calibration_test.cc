@@ -10,8 +10,8 @@
 #include "io/input_error.h"
 #include "models/asoc/asoc_files.h"
 #include "models/asoc/asoc_geometric.h"
-#include "sim/asoc_scenarios.h"
-#include "sim/asoc_simulator.h"
+#include "models/asoc/asoc_extras.h"
+#include "tests/asoc_simulation.h"
 #include "tests/asoc_robot_file.h"
 #include "tests/test_paths.h"
 
@@ -54,11 +54,11 @@ TEST(AsocGeometricTest, HoldPairInvertsEq4To7) {
 // The drawn errors are up to 4 % (r_w) and 16 deg (beta): a wrong sign or a swapped wheel in
 // Eq. 1-9 would miss by that much.
 TEST(AsocGeometricTest, RecoversSimulatedParametersToQuantisation) {
-  const Vehicle nominal = sim::AsocPrototypeVehicle();
+  const Vehicle nominal = PrototypeVehicle();
   std::mt19937_64 rng(21);
   for (int set = 0; set < 4; ++set) {
-    const Vehicle truth = sim::DrawVehicle(nominal, sim::ParameterSpread{}, rng);
-    const auto runs = sim::SimulateCalibrationManoeuvre(truth, sim::AsocSimulationOptions{}, rng);
+    const Vehicle truth = DrawVehicle(nominal, ParameterSpread{}, rng);
+    const auto runs = SimulateAsoc(truth, HoldTrajectories(nominal), set);
     const GeometricResult result = CalibrateGeometric(runs, nominal);
     ASSERT_TRUE(result.usable) << result.message;
     for (int i = 0; i < kNumCastors; ++i) {
@@ -76,9 +76,8 @@ TEST(AsocGeometricTest, RecoversSimulatedParametersToQuantisation) {
 }
 
 TEST(AsocGeometricTest, MissingHoldRunsMakeTheResultUnusable) {
-  const Vehicle nominal = sim::AsocPrototypeVehicle();
-  std::mt19937_64 rng(2);
-  auto runs = sim::SimulateCalibrationManoeuvre(nominal, sim::AsocSimulationOptions{}, rng);
+  const Vehicle nominal = PrototypeVehicle();
+  auto runs = SimulateAsoc(nominal, HoldTrajectories(nominal));
   runs.resize(2);  // only castor 1 held: castors 2 and 3 get one estimate, castor 1 none
   const GeometricResult result = CalibrateGeometric(runs, nominal);
   EXPECT_FALSE(result.usable);
@@ -94,7 +93,7 @@ TEST(AsocFilesTest, RobotYamlRoundTrip) {
   std::mt19937_64 rng(8);
   io::AsocRobot robot;
   robot.name = "proto";
-  robot.nominal = sim::DrawVehicle(sim::AsocPrototypeVehicle(), sim::ParameterSpread{}, rng);
+  robot.nominal = DrawVehicle(PrototypeVehicle(), ParameterSpread{}, rng);
   robot.pivot_distance_m = robot.nominal.PivotDistance(0, 1);
   robot.castor_names = {"front", "left", "right"};
   const std::string path = TempPath("robot.yaml");
@@ -111,7 +110,7 @@ TEST(AsocFilesTest, RobotYamlRoundTrip) {
 TEST(AsocFilesTest, PivotResolutionRoundTripAndBadValues) {
   io::AsocRobot robot;
   robot.name = "proto";
-  robot.nominal = sim::AsocPrototypeVehicle();
+  robot.nominal = PrototypeVehicle();
   robot.pivot_distance_m = robot.nominal.PivotDistance(0, 1);
   robot.pivot_resolution_rad = 0.07 * M_PI / 180.0;
   const std::string path = TempPath("resolution.yaml");
@@ -137,15 +136,23 @@ TEST(AsocFilesTest, PivotResolutionRoundTripAndBadValues) {
 }
 
 TEST(AsocFilesTest, EncoderCsvRoundTripAndBadInput) {
-  std::mt19937_64 rng(9);
-  const RunLog run = sim::SimulateUmbmark(sim::AsocPrototypeVehicle(), {}, rng, 1)[0];
+  EncoderLog log;
+  for (int k = 0; k < 200; ++k) {  // wheels and pivots turning at incommensurate rates
+    EncoderSample s;
+    for (int i = 0; i < kNumCastors; ++i) {
+      s.wheel_rad[i][0] = 0.37 * k * (i + 1);
+      s.wheel_rad[i][1] = -0.29 * k / (i + 1);
+      s.pivot_rad[i] = std::sin(0.013 * k * (i + 2));
+    }
+    log.t_s.push_back(0.05 * k);
+    log.samples.push_back(s);
+  }
   const std::string path = TempPath("enc.csv");
-  io::WriteFileAtomically(path, io::AsocEncoderCsv(run.encoders));
+  io::WriteFileAtomically(path, io::AsocEncoderCsv(log));
   const EncoderLog back = io::ReadAsocEncoderCsv(path);
-  ASSERT_EQ(back.samples.size(), run.encoders.samples.size());
-  EXPECT_NEAR(back.samples.back().wheel_rad[2][1], run.encoders.samples.back().wheel_rad[2][1],
-              1e-9);
-  EXPECT_NEAR(back.samples[100].pivot_rad[1], run.encoders.samples[100].pivot_rad[1], 1e-11);
+  ASSERT_EQ(back.samples.size(), log.samples.size());
+  EXPECT_NEAR(back.samples.back().wheel_rad[2][1], log.samples.back().wheel_rad[2][1], 1e-9);
+  EXPECT_NEAR(back.samples[100].pivot_rad[1], log.samples[100].pivot_rad[1], 1e-11);
 
   const auto expect_error = [&](const std::string& text, io::InputErrorKind kind, int line) {
     io::WriteFileAtomically(path, text);
@@ -177,8 +184,8 @@ namespace {
 
 // The closed form's sigmas (GeometricResult::sigma: the spread of each castor's two estimates,
 // pooled over the castors, widened by Student's t for 3 degrees of freedom) against the truth of
-// the ASOC simulator (sim/asoc_simulator.h: castor dynamics integrated with RK4 and
-// quantised encoders; it shares the castor kinematics of asoc_model.h with the library, not
+// the one simulator (sim/model_simulator.h with the castor dynamics of asoc_extras.h, integrated
+// with RK4, and quantised encoders; it shares the castor kinematics of asoc_model.h with the library, not
 // Eq. 1-9 nor the replay), over 30 random vehicles per noise level: quantisation only, and 2 % and
 // 5 % random error on each wheel increment (the sigmas add the pivot step, 0.07 deg, propagated
 // through Eq. 1-9, as robot.yaml of asoc-simulate states it). Each of the 18 parameters' error
@@ -195,16 +202,16 @@ struct Coverage {
 };
 
 Coverage ClosedFormCoverage(double wheel_slip_sigma, std::uint64_t seed, int sets) {
-  const Vehicle nominal = sim::AsocPrototypeVehicle();
-  sim::AsocSimulationOptions options;
-  options.wheel_slip_sigma = wheel_slip_sigma;
+  const Vehicle nominal = PrototypeVehicle();
   std::mt19937_64 rng(seed);
   Coverage c;
   const int kind_of[kParametersPerCastor] = {0, 1, 1, 2, 2, 3};  // ToArray's order
   for (int set = 0; set < sets; ++set) {
-    const Vehicle truth = sim::DrawVehicle(nominal, sim::ParameterSpread{}, rng);
-    const GeometricResult r = CalibrateGeometric(
-        sim::SimulateCalibrationManoeuvre(truth, options, rng), nominal, options.pivot_quantum_rad);
+    const Vehicle truth = DrawVehicle(nominal, ParameterSpread{}, rng);
+    const GeometricResult r =
+        CalibrateGeometric(SimulateAsoc(truth, HoldTrajectories(nominal), seed + set,
+                                        wheel_slip_sigma),
+                           nominal, kPrototypePivotQuantumRad);
     EXPECT_TRUE(r.usable) << r.message;
     EXPECT_EQ(r.sigma_dof, 3);
     for (int i = 0; i < kNumCastors; ++i) {
@@ -247,35 +254,35 @@ TEST(AsocGeometricTest, SigmasCoverTheErrorOnSimulatedVehicles) {
   }
 }
 
-// asoc-simulate's data set (sim/asoc_scenarios.h): 6 holds, 10 UMBmark circuits as
-// repetitions 6-10 and the excursions as 1..N, every id distinct; the closed form on its holds
-// lands nearer the drawn truth than the prototype is (noise-free encoders but the pivot step),
-// so the truth it writes is the one that drove the runs. The same seed gives the same runs.
+// asoc-simulate's data set (the asoc model's scenario, asoc_extras.h): 6 holds, 10 UMBmark
+// circuits as repetitions 6-10 and the excursions as 1..N, every id distinct; the closed form on
+// its holds lands nearer the drawn truth than the prototype is (noise-free encoders but the pivot
+// step), so the truth the scenario draws is the one that drove the runs.
 TEST(AsocScenarios, TheSimulatedDataSetIsDrivenByTheTruthItWrites) {
-  const sim::AsocSimulatedDataset d = sim::SimulateAsocDataset(3, 0.0, 2);
-  ASSERT_EQ(d.runs.size(), 6u + 10u + 2u);
-  std::vector<RunLog> holds;
-  std::vector<std::string> ids;
-  for (const RunLog& run : d.runs) {
-    ids.push_back(run.id);
-    if (run.trajectory.rfind("hold_", 0) == 0) holds.push_back(run);
-    if (run.trajectory.rfind("umbmark_", 0) == 0) {
-      EXPECT_GE(run.repetition, 6);
-      EXPECT_LE(run.repetition, 10);
+  const AsocModel& model = ExampleAsocModel();
+  const SimulationScenario& scenario = ExtrasOf("asoc").scenario;
+  const std::vector<double> p = scenario.default_truth(model.robot(), 3);
+  const auto specs = scenario.trajectories(model, p, 2);
+  ASSERT_EQ(specs.size(), 6u + 10u + 2u);
+  Vehicle truth = model.asoc().nominal;
+  truth.SetFromArray(p.data());
+  std::vector<sim::TrajectorySpec> holds;
+  for (const sim::TrajectorySpec& spec : specs) {
+    if (spec.label.rfind("hold_", 0) == 0) holds.push_back(spec);
+    if (spec.label.rfind("umbmark_", 0) == 0) {
+      EXPECT_GE(spec.repetition, 6);
+      EXPECT_LE(spec.repetition, 10);
     }
   }
-  std::sort(ids.begin(), ids.end());
-  EXPECT_EQ(std::unique(ids.begin(), ids.end()), ids.end());
   ASSERT_EQ(holds.size(), 6u);
-  const GeometricResult cal = CalibrateGeometric(holds, d.nominal.nominal);
+  const GeometricResult cal = CalibrateGeometric(SimulateAsoc(truth, holds), model.asoc().nominal);
   ASSERT_TRUE(cal.usable) << cal.message;
   for (int i = 0; i < kNumCastors; ++i) {
-    const double truth = d.truth.nominal.castors[i].wheel_radius_m[0];
-    EXPECT_LT(std::abs(cal.estimate.castors[i].wheel_radius_m[0] - truth),
-              std::abs(d.nominal.nominal.castors[i].wheel_radius_m[0] - truth))
+    const double t = truth.castors[i].wheel_radius_m[0];
+    EXPECT_LT(std::abs(cal.estimate.castors[i].wheel_radius_m[0] - t),
+              std::abs(model.asoc().nominal.castors[i].wheel_radius_m[0] - t))
         << "castor " << i;
   }
-  EXPECT_EQ(sim::SimulateAsocDataset(3, 0.0, 2).runs[7].encoders.t_s, d.runs[7].encoders.t_s);
 }
 
 }  // namespace

@@ -1,7 +1,7 @@
-// The ASOC vehicle on the model seam (models/asoc/asoc_robot_model.h): its body step against the
-// paper's odometry (asoc_odometry.h, which Tables I and II use), its closed form (Doebbler Eq. 1-9)
-// from the generic runs against the silo's from the native logs, every hold run used, the odometry
-// variants of the robot YAML, and ASOC's own encoder files converted on load.
+// The ASOC vehicle on the model seam (models/asoc/asoc_robot_model.h): its body step on simulated
+// UMBmark circuits, every hold run used by the closed form (Doebbler Eq. 1-9), the odometry
+// variants of the robot YAML, ASOC's own encoder files converted on load, the generic CSV, and the
+// generic fit. Runs from the one simulator with the castor dynamics (tests/asoc_simulation.h).
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
@@ -20,7 +20,7 @@
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
 #include "tests/test_files.h"
-#include "sim/asoc_simulator.h"
+#include "tests/asoc_simulation.h"
 #include "tests/three_wheel_files.h"
 
 namespace fitcal {
@@ -43,42 +43,29 @@ RobotModelPtr ModelOf(const asoc::Vehicle& v, const std::string& odometry = "CAS
                         "test robot");
 }
 
-// A native ASOC run as the generic commands see it (io/dataset.cc converts on load).
-AlignedRun Generic(const asoc::RunLog& run) {
-  RunLog log;
-  log.id = run.id;
-  log.trajectory = run.trajectory;
-  log.repetition = run.repetition;
-  log.encoders = io::AsocEncoderLogAsChannels(run.encoders);
-  log.ground_truth = run.ground_truth;
-  log.start_pose = run.start_pose;
-  return AlignRun(log);
-}
+std::vector<AlignedRun> Aligned(const std::vector<RunLog>& runs) { return AlignRuns(runs); }
 
 double PositionError(const Pose2d& a, const Pose2d& b) { return std::hypot(a.x - b.x, a.y - b.y); }
 
 // UMBmark circuits of a drawn vehicle (6 m each, encoders quantised as the prototype's), replayed
-// with the true parameters. The paper's CAST-0 linearises about the heading before each 20 Hz
-// update; the seam's body step solves Eq. 13-14 about the interval's middle (exact for a rigid
-// step) from the pivot angles at the intervals' middles (models/asoc/asoc_files.h). Both leave only the
-// update and quantisation error of a few mm after 6 m (measured: seam 0.03 / 3.3 mm, silo 0.5 /
-// 2.8 mm for CW / CCW, 0.5 mm apart; heading within 3e-3 rad); bounds with margin: 5 mm and
-// 4e-3 rad from the truth, 1 mm between the two.
-TEST(AsocModelTest, BodyStepReplaysUmbmarkAsThePapersOdometry) {
-  const asoc::Vehicle nominal = sim::AsocPrototypeVehicle();
+// with the true parameters: the seam's body step solves Eq. 13-14 about the interval's middle
+// (exact for a rigid step) from the pivot angles as the mean of an interval's two readings. Only
+// the 20 Hz update and quantisation error remains after 6 m: bounds 5 mm and 4e-3 rad (before the
+// one simulator: 0.03 / 3.3 mm for CW / CCW, from the native files' cubic midpoint).
+TEST(AsocModelTest, BodyStepReplaysUmbmarkToTheUpdateError) {
+  const asoc::Vehicle nominal = asoc::PrototypeVehicle();
   std::mt19937_64 rng(7);
-  const asoc::Vehicle truth = sim::DrawVehicle(nominal, sim::ParameterSpread{}, rng);
+  const asoc::Vehicle truth = asoc::DrawVehicle(nominal, asoc::ParameterSpread{}, rng);
   const RobotModelPtr model = ModelOf(truth);
   const std::vector<double> p = model->robot().nominal;
-  for (const asoc::RunLog& run : sim::SimulateUmbmark(truth, {}, rng, 1)) {
+  for (const AlignedRun& run :
+       Aligned(asoc::SimulateAsoc(truth, asoc::UmbmarkTrajectories(1, 1), 7))) {
     SCOPED_TRACE(run.trajectory);
-    const AlignedRun generic = Generic(run);
-    const Pose2d seam = model->ReplayFinalPose(p.data(), generic.samples, generic.start);
-    const Pose2d silo = asoc::RunOdometry(truth, {}, run.encoders, *run.start_pose);
-    const Pose2d& gt = generic.final_ground_truth;
+    const Pose2d seam = model->ReplayFinalPose(p.data(), run.samples, run.start);
+    const Pose2d& gt = run.final_ground_truth;
+    std::printf("%s: %.2f mm, %.2e rad\n", run.trajectory.c_str(), 1e3 * PositionError(seam, gt),
+                seam.theta - gt.theta);
     EXPECT_LT(PositionError(seam, gt), 5e-3);
-    EXPECT_LT(PositionError(silo, gt), 5e-3);
-    EXPECT_LT(PositionError(seam, silo), 1e-3);
     EXPECT_NEAR(seam.theta, gt.theta, 4e-3);
   }
 }
@@ -87,23 +74,22 @@ TEST(AsocModelTest, BodyStepReplaysUmbmarkAsThePapersOdometry) {
 // of the two castors that can hold it (2 x 3 x 3 = 18 estimates), and the message counts them all
 // (before, a second repetition silently replaced the first: "from 6 hold runs").
 TEST(AsocModelTest, EveryHoldRunIsUsed) {
-  const asoc::Vehicle nominal = sim::AsocPrototypeVehicle();
+  const asoc::Vehicle nominal = asoc::PrototypeVehicle();
   std::mt19937_64 rng(5);
-  const asoc::Vehicle truth = sim::DrawVehicle(nominal, sim::ParameterSpread{}, rng);
-  std::vector<asoc::RunLog> runs;
+  const asoc::Vehicle truth = asoc::DrawVehicle(nominal, asoc::ParameterSpread{}, rng);
+  std::vector<sim::TrajectorySpec> specs;
   for (int rep = 1; rep <= 3; ++rep) {
-    for (asoc::RunLog run : sim::SimulateCalibrationManoeuvre(truth, {}, rng)) {
-      run.repetition = rep;
-      runs.push_back(std::move(run));
+    for (sim::TrajectorySpec spec : asoc::HoldTrajectories(nominal)) {
+      spec.repetition = rep;
+      specs.push_back(std::move(spec));
     }
   }
+  const std::vector<RunLog> runs = asoc::SimulateAsoc(truth, specs, 5);
   const asoc::GeometricResult result = asoc::CalibrateGeometric(runs, nominal);
   ASSERT_TRUE(result.usable) << result.message;
   EXPECT_NE(result.message.find("from 18 of 18 hold runs"), std::string::npos) << result.message;
   for (int i = 0; i < asoc::kNumCastors; ++i) EXPECT_EQ(result.num_estimates[i], 18);
-  std::vector<AlignedRun> generic;
-  for (const asoc::RunLog& run : runs) generic.push_back(Generic(run));
-  const auto closed = ModelOf(nominal)->ClosedForms(generic);
+  const auto closed = ModelOf(nominal)->ClosedForms(Aligned(runs));
   ASSERT_EQ(closed.size(), 1u);
   EXPECT_NE(closed[0].note.find("from 18 of 18 hold runs"), std::string::npos) << closed[0].note;
 }
@@ -112,11 +98,13 @@ TEST(AsocModelTest, EveryHoldRunIsUsed) {
 // castor 2 that over-counts by 30 % for 3 s throws CAST-0 off; the redundancy check drops that
 // castor while it slips, and CAST-2 / IPEC-2 (castor 2 left out) never see it.
 TEST(AsocModelTest, OdometryVariantsFromTheRobotYaml) {
-  const asoc::Vehicle truth = sim::AsocPrototypeVehicle();
-  sim::AsocSimulationOptions options;
-  options.slip_events.push_back({1, 0, 2.0, 5.0, 0.3});
-  std::mt19937_64 rng(3);
-  const AlignedRun run = Generic(sim::SimulateUmbmark(truth, options, rng, 1).front());
+  const asoc::Vehicle truth = asoc::PrototypeVehicle();
+  RunLog log = asoc::SimulateAsoc(truth, asoc::UmbmarkTrajectories(1, 1), 3).front();
+  for (std::size_t k = 0; k < log.encoders.samples.size(); ++k) {
+    const double t = log.encoders.t_s[k + 1];
+    if (t > 2.0 && t <= 5.0) log.encoders.samples[k].value[asoc::kChannelsPerCastor] *= 1.3;
+  }
+  const AlignedRun run = AlignRun(log);
   const auto error = [&](const std::string& algorithm, bool check) {
     const RobotModelPtr model = ModelOf(truth, algorithm, check);
     const Pose2d f = model->ReplayFinalPose(model->robot().nominal.data(), run.samples, run.start);
@@ -178,43 +166,27 @@ TEST(AsocModelTest, NativeEncoderLogBecomesTheModelsChannels) {
 }
 
 // A user's own logs in the generic CSV (columns w_<castor>_a, w_<castor>_b, pivot_<castor>, named
-// from the robot YAML) are read by the generic reader with the asoc model's channels: the same
-// wheel rates as the native file, the pivot as every angle channel (mean of the two readings, not
-// the native files' cubic midpoint), so a UMBmark circuit replays 1.4 mm from the native file's
-// (measured; bound 3 mm).
+// from the robot YAML) are read by the generic reader with the asoc model's channels: the CSV the
+// simulator writes reads back as the run it simulated.
 TEST(AsocModelTest, GenericCsvWithTheCastorsColumnNames) {
-  const asoc::Vehicle truth = sim::AsocPrototypeVehicle();
-  std::mt19937_64 rng(4);
-  const asoc::RunLog run = sim::SimulateUmbmark(truth, {}, rng, 1).back();
+  const asoc::Vehicle truth = asoc::PrototypeVehicle();
+  const auto p = truth.ToArray();
+  const sim::ModelSimulatedRun run =
+      sim::SimulateRuns(asoc::ExampleAsocModel(), {p.begin(), p.end()},
+                        asoc::UmbmarkTrajectories(1, 1), asoc::PrototypeSimulation(4, 0.0))
+          .back();
   const RobotModelPtr model = ModelOf(truth);
-  const Robot& robot = model->robot();
-  std::vector<std::vector<double>> rows;
-  for (std::size_t k = 0; k < run.encoders.t_s.size(); ++k) {
-    const asoc::EncoderSample& now = run.encoders.samples[k];
-    const asoc::EncoderSample& before = run.encoders.samples[k == 0 ? 0 : k - 1];
-    const double dt = k == 0 ? 1.0 : run.encoders.t_s[k] - run.encoders.t_s[k - 1];
-    std::vector<double> row;
-    for (int i = 0; i < asoc::kNumCastors; ++i) {
-      row.push_back((now.wheel_rad[i][0] - before.wheel_rad[i][0]) / dt);
-      row.push_back((now.wheel_rad[i][1] - before.wheel_rad[i][1]) / dt);
-      row.push_back(now.pivot_rad[i]);
-    }
-    rows.push_back(row);
-  }
-  const std::string csv = io::EncoderCsv(robot, run.encoders.t_s, rows);
+  const std::string csv = sim::SimulatedEncoderCsv(run);
   EXPECT_EQ(csv.substr(0, csv.find('\n')),
             "t,w_1_a,w_1_b,pivot_1,w_2_a,w_2_b,pivot_2,w_3_a,w_3_b,pivot_3");
   const testing::TempDir dir;
-  const EncoderLog generic = io::ReadEncoderCsv(dir.Write("enc.csv", csv), robot);
-  const EncoderLog native = io::AsocEncoderLogAsChannels(run.encoders);
-  ASSERT_EQ(generic.samples.size(), native.samples.size());
-  for (std::size_t k = 0; k < native.samples.size(); k += 50) {
-    EXPECT_NEAR(generic.samples[k].value[0], native.samples[k].value[0], 1e-6);
+  const EncoderLog generic = io::ReadEncoderCsv(dir.Write("enc.csv", csv), model->robot());
+  ASSERT_EQ(generic.samples.size(), run.log.encoders.samples.size());
+  for (std::size_t k = 0; k < generic.samples.size(); k += 50) {
+    for (int c = 0; c < asoc::kNumChannels; ++c) {
+      EXPECT_NEAR(generic.samples[k].value[c], run.log.encoders.samples[k].value[c], 1e-12);
+    }
   }
-  const Pose2d start = *run.start_pose;
-  const Pose2d a = model->ReplayFinalPose(robot.nominal.data(), generic.samples, start);
-  const Pose2d b = model->ReplayFinalPose(robot.nominal.data(), native.samples, start);
-  EXPECT_LT(PositionError(a, b), 3e-3);
 }
 
 // The seam's generic final-pose fit (fit/model_fit.h) on random excursions (ground truth exact,
@@ -223,18 +195,16 @@ TEST(AsocModelTest, GenericCsvWithTheCastorsColumnNames) {
 // uncalibrated decimetres to the level of the true parameters (limited by quantisation and the
 // 20 Hz discretisation, ~mm): below 5 % of the nominal's and within 1 cm of the truth's.
 TEST(AsocModelTest, GenericFitRecoversOdometry) {
-  const asoc::Vehicle nominal = sim::AsocPrototypeVehicle();
-  sim::ParameterSpread spread;
+  const asoc::Vehicle nominal = asoc::PrototypeVehicle();
+  asoc::ParameterSpread spread;
   spread.bias_range_rad = 5.0 * M_PI / 180.0;
   std::mt19937_64 rng(31);
-  const asoc::Vehicle truth = sim::DrawVehicle(nominal, spread, rng);
+  const asoc::Vehicle truth = asoc::DrawVehicle(nominal, spread, rng);
   std::vector<AlignedRun> training, validation;
-  for (int k = 0; k < 12; ++k) {
-    training.push_back(Generic(sim::SimulateRandomExcursion(truth, {}, rng, 4)));
-  }
-  for (const asoc::RunLog& run : sim::SimulateUmbmark(truth, {}, rng, 1)) {
-    validation.push_back(Generic(run));
-  }
+  std::vector<sim::TrajectorySpec> excursions;
+  for (int k = 0; k < 12; ++k) excursions.push_back(asoc::ExcursionTrajectory(k + 1, 4));
+  training = Aligned(asoc::SimulateAsoc(truth, excursions, 31));
+  validation = Aligned(asoc::SimulateAsoc(truth, asoc::UmbmarkTrajectories(1, 1), 32));
   const RobotModelPtr model = ModelOf(nominal);
   ModelFitOptions options;
   options.ceres.compute_covariance = false;
@@ -258,20 +228,19 @@ TEST(AsocModelTest, GenericFitRecoversOdometry) {
 // (measured; above 1 because quantisation errors are not white). The bounds below (rms in
 // [0.75, 2.2], worst < 6) fail when sigma is off by 2x either way (rms then ~0.68 or ~2.7).
 TEST(AsocModelTest, GenericFitSigmaDescribesTheEstimationError) {
-  const asoc::Vehicle nominal = sim::AsocPrototypeVehicle();
+  const asoc::Vehicle nominal = asoc::PrototypeVehicle();
   const RobotModelPtr model = ModelOf(nominal);
-  sim::ParameterSpread spread;
+  asoc::ParameterSpread spread;
   spread.offset_fraction = 0.0;
   spread.bias_range_rad = 0.0;
   double worst_z = 0.0, sum_z2 = 0.0;
   int with_covariance = 0, count = 0;
   for (unsigned seed = 1; seed <= 6; ++seed) {
     std::mt19937_64 rng(100 + seed);
-    const asoc::Vehicle truth = sim::DrawVehicle(nominal, spread, rng);
-    std::vector<AlignedRun> training;
-    for (int k = 0; k < 16; ++k) {
-      training.push_back(Generic(sim::SimulateRandomExcursion(truth, {}, rng, 4)));
-    }
+    const asoc::Vehicle truth = asoc::DrawVehicle(nominal, spread, rng);
+    std::vector<sim::TrajectorySpec> excursions;
+    for (int k = 0; k < 16; ++k) excursions.push_back(asoc::ExcursionTrajectory(16 * seed + k, 4));
+    const std::vector<AlignedRun> training = Aligned(asoc::SimulateAsoc(truth, excursions, seed));
     const ModelFitResult fit = FitModel(training, *model);
     ASSERT_TRUE(fit.usable) << fit.message;
     EXPECT_TRUE(fit.held_directions.empty());

@@ -7,8 +7,10 @@
 #include <cmath>
 #include <random>
 
+#include "models/asoc/asoc_extras.h"
 #include "models/asoc/asoc_model.h"
-#include "sim/asoc_simulator.h"
+#include "models/asoc/asoc_tables.h"
+#include "tests/asoc_simulation.h"
 
 namespace fitcal::asoc {
 namespace {
@@ -123,31 +125,79 @@ TEST(AsocModelTest, RotationAboutStationaryCastorReproducesEq4To7) {
   }
 }
 
+// The total angle each wheel turned over a run: the sum of its interval rates times the intervals.
+double WheelTotal(const RunLog& run, int castor, int wheel) {
+  const EncoderSamples& samples = run.encoders.samples;
+  double total = 0.0;
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    total += samples[k].value[castor * kChannelsPerCastor + kWheelAChannel + wheel] *
+             samples[k].dt_s;
+  }
+  return total;
+}
+
 // The simulated calibration manoeuvre (no quantisation) obeys Eq. 4-7 on the integrated angles.
 TEST(AsocModelTest, SimulatedHoldRunObeysEq4To7) {
-  Vehicle truth = sim::AsocPrototypeVehicle();
+  Vehicle truth = PrototypeVehicle();
   truth.castors[1] = TestCastor();
-  sim::AsocSimulationOptions options;
-  options.wheel_quantum_rad = 0.0;
-  options.pivot_quantum_rad = 0.0;
-  std::mt19937_64 rng(1);
   const double D = truth.PivotDistance(0, 1);
   const double cg = D * std::cos(std::asin(truth.castors[1].offset_m / D));
+  const double dtheta = 2.0;  // the segment's rotation: the ramps keep its integral
+  std::vector<sim::TrajectorySpec> specs;
   for (int direction : {-1, 1}) {
-    const auto segments = sim::RotationAboutPivot(truth, 0, direction, 2.0);
-    const RunLog run = sim::SimulateAsocRun(
-        truth, segments, Pose2d{}, sim::SteadyCastorAngles(truth, segments[0]), options, rng);
-    const double dtheta = std::abs(run.ground_truth.world_T_robot.back().theta);
-    EXPECT_NEAR(dtheta, 2.0, 1e-9);
-    const double c1 = run.encoders.samples.back().wheel_rad[1][0];
-    const double c2 = run.encoders.samples.back().wheel_rad[1][1];
+    const double w = direction * 0.4;
+    const PivotPosition& p = truth.pivots[0];
+    specs.push_back({"hold_1", 1, {{{w * p.y_m(), -w * p.x_m(), w}, dtheta / 0.4}}});
+  }
+  const auto runs = SimulateAsoc(truth, specs, PrototypeSimulation(1, 0.0, 0.0, 0.0));
+  for (int k = 0; k < 2; ++k) {
+    const int direction = k == 0 ? -1 : 1;
+    const RunLog& run = runs[k];
+    EXPECT_NEAR(std::abs(WrapAngle(run.ground_truth.world_T_robot.back().theta -
+                                   run.ground_truth.world_T_robot.front().theta)),
+                dtheta, 1e-9);
+    const double c1 = WheelTotal(run, 1, 0), c2 = WheelTotal(run, 1, 1);
     const double d1 = truth.castors[1].wheel_offset_m[0], d2 = truth.castors[1].wheel_offset_m[1];
-    // RK4 at 200 Hz on a steady rotation: the integration error is far below 1e-9.
+    // RK4 at 400 Hz on a steady rotation: the integration error is far below 1e-9.
     EXPECT_NEAR(c1 * truth.castors[1].wheel_radius_m[0], dtheta * (cg - direction * d1), 1e-9);
     EXPECT_NEAR(c2 * truth.castors[1].wheel_radius_m[1], dtheta * (cg + direction * d2), 1e-9);
     // The held castor's wheels stay still.
-    EXPECT_NEAR(run.encoders.samples.back().wheel_rad[0][0], 0.0, 1e-12);
+    EXPECT_NEAR(WheelTotal(run, 0, 0), 0.0, 1e-12);
   }
+}
+
+// Castor dynamics checked against the closed form of a trailing castor towed in a straight line
+// (the tractrix), from physics, not from the code under test: a pivot moving at speed v along
+// the body's x (no body rotation) with the castor at angle theta to it has lateral velocity
+// -v sin theta, so r_c theta_dot = -v sin theta, i.e. tan(theta / 2) = tan(theta0 / 2) e^(-s/r_c),
+// s = v t. The wheels roll the pivot's along-track motion v cos theta less (wheel 1) or plus
+// (wheel 2) d_k times the castor's turn: r_w1 c_1 = C - d_1 (theta - theta0),
+// r_w2 c_2 = C + d_2 (theta - theta0), with C = int cos theta ds
+// = s - r_c ln((1 + A^2) / (1 + A^2 e^(-2 s / r_c))), A = tan(theta0 / 2).
+TEST(AsocModelTest, CastorDynamicsFollowTheTractrix) {
+  Vehicle truth = PrototypeVehicle();
+  truth.castors[0] = TestCastor();
+  truth.castors[0].encoder_bias_rad = 0.2;
+  const double theta0 = 2.5, v = 0.3, dt = 0.004;
+  const auto dynamics = MakeCastorDynamics(truth, {theta0, 0.0, 0.0}, 0.0);
+  double values[kNumChannels], wheel[2] = {0.0, 0.0};
+  const CastorParameters& c = truth.castors[0];
+  const double a = std::tan(theta0 / 2.0);
+  for (int k = 1; k <= 500; ++k) {
+    dynamics->Step(Twist{v, 0.0, 0.0}, dt, values);
+    for (int j = 0; j < 2; ++j) wheel[j] += values[kWheelAChannel + j] * dt;
+    dynamics->Read(values);
+    const double s = v * dt * k;
+    const double theta = 2.0 * std::atan(a * std::exp(-s / c.offset_m));
+    ASSERT_NEAR(values[kPivotChannel] - c.encoder_bias_rad, theta, 1e-8) << "t " << k * dt;
+    const double along =
+        s - c.offset_m * std::log((1.0 + a * a) / (1.0 + a * a * std::exp(-2.0 * s / c.offset_m)));
+    ASSERT_NEAR(wheel[0] * c.wheel_radius_m[0], along - c.wheel_offset_m[0] * (theta - theta0),
+                1e-8);
+    ASSERT_NEAR(wheel[1] * c.wheel_radius_m[1], along + c.wheel_offset_m[1] * (theta - theta0),
+                1e-8);
+  }
+  EXPECT_LT(std::abs(values[kPivotChannel] - c.encoder_bias_rad), 0.01);  // it has trailed
 }
 
 // Least squares of Eq. 15-17 solved by QR, as the reference for the closed forms.
@@ -198,7 +248,7 @@ TEST(AsocOdometryTest, CentredEq22MatchesGeneralSolution) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   // Centred layouts: the prototype (equal R, Eq. 22 verbatim) and an unequal-R triangle whose
   // centroid is the origin.
-  std::array<PivotPosition, kNumCastors> equal = sim::AsocPrototypeVehicle().pivots;
+  std::array<PivotPosition, kNumCastors> equal = PrototypeVehicle().pivots;
   const Eigen::Vector2d a(0.35, 0.05), b(-0.10, 0.30);
   const Eigen::Vector2d c = -a - b;
   std::array<PivotPosition, kNumCastors> unequal;
@@ -223,49 +273,54 @@ TEST(AsocOdometryTest, CentredEq22MatchesGeneralSolution) {
   EXPECT_FALSE(PivotsCentred(equal, MaskExcluding(1)));
 }
 
+// The seam's replay with one of Doebbler's algorithms ("CAST-0", "IPEC-1", ...).
+RobotModelPtr Algorithm(const std::string& name, bool redundancy_check = false) {
+  AsocOdometryOptions o;
+  EXPECT_TRUE(AsocOdometryOptions::Parse(name, &o)) << name;
+  o.redundancy_check = redundancy_check;
+  return ExampleAsocModel().WithOdometry(o);
+}
+
+std::vector<double> Parameters(const Vehicle& v) {
+  const auto p = v.ToArray();
+  return {p.begin(), p.end()};
+}
+
 // With the true parameters and no quantisation the odometry closes the UMBmark square up to the
-// discretisation of the updates only (castor rates vary within an update; Eq. 13-14 linearise).
-// That error is second order in the update period: 0.7-5 mm over 6 m at 20 Hz, so at 200 Hz
-// it must be near 5e-3 m / 100 = 5e-5 m; the bound is twice that. Every CAST-i and IPEC-i.
+// discretisation of the updates only (castor rates vary within an update). That error is second
+// order in the update period: 0.7-5 mm over 6 m at 20 Hz, so at 200 Hz it must be near
+// 5e-3 m / 100 = 5e-5 m; the bound is twice that. Every CAST-i and IPEC-i.
 TEST(AsocOdometryTest, TrueParametersCloseTheSquare) {
-  const Vehicle truth = sim::AsocPrototypeVehicle();
-  sim::AsocSimulationOptions options;
-  options.wheel_quantum_rad = 0.0;
-  options.pivot_quantum_rad = 0.0;
-  options.sample_period_s = 0.005;
-  options.substeps = 2;
-  std::mt19937_64 rng(5);
-  const auto runs = sim::SimulateUmbmark(truth, options, rng, 1);
+  const Vehicle truth = PrototypeVehicle();
+  sim::SimulationOptions options = PrototypeSimulation(5, 0.0, 0.0, 0.0);
+  options.encoder_period_s = options.ground_truth_period_s = 0.005;
+  options.substep_s = 0.0025;
+  const auto runs = SimulateAsoc(truth, UmbmarkTrajectories(1, 1), options);
   for (int excluded = 0; excluded <= 3; ++excluded) {
-    OdometryOptions o;
-    o.castors = MaskExcluding(excluded);
-    EXPECT_LT(sim::EvaluateUmbmark(runs, truth, o).e_max_m, 1e-4) << "CAST-" << excluded;
+    const std::string i = std::to_string(excluded);
+    EXPECT_LT(UmbmarkEmax(*Algorithm("CAST-" + i), Parameters(truth), runs), 1e-4) << i;
     if (excluded > 0) {
-      o.method = Method::kIpec;
-      EXPECT_LT(sim::EvaluateUmbmark(runs, truth, o).e_max_m, 1e-4) << "IPEC-" << excluded;
+      EXPECT_LT(UmbmarkEmax(*Algorithm("IPEC-" + i), Parameters(truth), runs), 1e-4) << i;
     }
   }
 }
 
 // Doebbler Table II: two-castor least squares and IPEC give nearly the same answer (394.6 vs
 // 394.1 mm, 0.13 %). On random uncalibrated vehicles with quantised encoders the mean E_max of
-// IPEC-1 and CAST-1 must agree within 2 %, while CAST-0 must differ from both by more (it uses a
-// third castor); a swapped wheel or a wrong sign in either would break the agreement.
+// IPEC-1 and CAST-1 must agree within 2 %; a swapped wheel or a wrong sign in either would break
+// the agreement.
 TEST(AsocOdometryTest, TwoCastorCastAgreesWithIpec) {
-  const Vehicle nominal = sim::AsocPrototypeVehicle();
-  sim::ParameterSpread spread;
+  const Vehicle nominal = PrototypeVehicle();
+  ParameterSpread spread;
   spread.bias_range_rad = 0.0;  // Table II: beta = 0
   std::mt19937_64 rng(11);
   double ipec = 0.0, cast1 = 0.0;
   const int kSets = 6;
   for (int s = 0; s < kSets; ++s) {
-    const Vehicle truth = sim::DrawVehicle(nominal, spread, rng);
-    const auto runs = sim::SimulateUmbmark(truth, sim::AsocSimulationOptions{}, rng, 1);
-    OdometryOptions o;
-    o.castors = MaskExcluding(1);
-    cast1 += sim::EvaluateUmbmark(runs, nominal, o).e_max_m / kSets;
-    o.method = Method::kIpec;
-    ipec += sim::EvaluateUmbmark(runs, nominal, o).e_max_m / kSets;
+    const Vehicle truth = DrawVehicle(nominal, spread, rng);
+    const auto runs = SimulateAsoc(truth, UmbmarkTrajectories(1, 1), s);
+    cast1 += UmbmarkEmax(*Algorithm("CAST-1"), Parameters(nominal), runs) / kSets;
+    ipec += UmbmarkEmax(*Algorithm("IPEC-1"), Parameters(nominal), runs) / kSets;
   }
   EXPECT_GT(cast1, 0.05);  // the uncalibrated error is large (Table II: ~0.4 m)
   EXPECT_NEAR(ipec / cast1, 1.0, 0.02);
@@ -274,39 +329,30 @@ TEST(AsocOdometryTest, TwoCastorCastAgreesWithIpec) {
 // The redundancy check: a wheel of castor 2 whose encoder over-counts by 30 % for 3 s (a spinning
 // wheel) ruins CAST-0; dropping the inconsistent castor while it slips restores the accuracy.
 TEST(AsocOdometryTest, RedundancyCheckDropsSlippingCastor) {
-  const Vehicle truth = sim::AsocPrototypeVehicle();
-  sim::AsocSimulationOptions options;
-  options.slip_events.push_back({1, 0, 2.0, 5.0, 0.3});
-  std::mt19937_64 rng(6);
-  const auto runs = sim::SimulateUmbmark(truth, options, rng, 1);
-  OdometryOptions plain;
-  OdometryOptions checked;
-  checked.drop_inconsistent_castor = true;
-  const double e_plain = sim::EvaluateUmbmark(runs, truth, plain).e_max_m;
-  const double e_checked = sim::EvaluateUmbmark(runs, truth, checked).e_max_m;
+  const Vehicle truth = PrototypeVehicle();
+  const auto clean = SimulateAsoc(truth, UmbmarkTrajectories(1, 1), 6);
+  std::vector<RunLog> slipping = clean;
+  for (RunLog& run : slipping) {
+    EncoderSamples& samples = run.encoders.samples;
+    for (std::size_t k = 0; k < samples.size(); ++k) {
+      const double t = run.encoders.t_s[k + 1];
+      if (t > 2.0 && t <= 5.0) samples[k].value[1 * kChannelsPerCastor + kWheelAChannel] *= 1.3;
+    }
+  }
+  const double e_plain = UmbmarkEmax(*Algorithm("CAST-0"), Parameters(truth), slipping);
+  const double e_checked = UmbmarkEmax(*Algorithm("CAST-0", true), Parameters(truth), slipping);
   // 30 % of ~0.5 m of rolling, split over three castors: centimetres of error without the check.
   EXPECT_GT(e_plain, 0.02);
   EXPECT_LT(e_checked, 0.2 * e_plain);
-  // Without slip the check must not drop anything with the true parameters.
-  std::mt19937_64 rng2(6);
-  const auto clean = sim::SimulateUmbmark(truth, sim::AsocSimulationOptions{}, rng2, 1);
-  Odometry odo(truth, checked, Pose2d{}, clean[0].encoders.samples.front());
-  for (std::size_t k = 1; k < clean[0].encoders.samples.size(); ++k)
-    odo.Step(clean[0].encoders.samples[k]);
-  EXPECT_EQ(odo.dropped()[0] + odo.dropped()[1] + odo.dropped()[2], 0);
-}
-
-TEST(AsocOdometryTest, OptionsValidation) {
-  std::string error;
-  OdometryOptions o;
-  EXPECT_TRUE(o.IsValid(&error));
-  o.castors = 0b001;
-  EXPECT_FALSE(o.IsValid(&error));
-  o.method = Method::kIpec;
-  o.castors = kAllCastors;
-  EXPECT_FALSE(o.IsValid(&error));
-  o.castors = MaskExcluding(2);
-  EXPECT_TRUE(o.IsValid(&error));
+  // Without slip the check must not drop anything with the true parameters: the same replay.
+  for (const RunLog& run : clean) {
+    const Pose2d a = Algorithm("CAST-0")->ReplayFinalPose(Parameters(truth).data(),
+                                                          run.encoders.samples, Pose2d{});
+    const Pose2d b = Algorithm("CAST-0", true)
+                         ->ReplayFinalPose(Parameters(truth).data(), run.encoders.samples, Pose2d{});
+    EXPECT_EQ(a.x, b.x);
+    EXPECT_EQ(a.y, b.y);
+  }
 }
 
 }  // namespace

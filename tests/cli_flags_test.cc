@@ -82,11 +82,12 @@ std::vector<double> Captured(const std::string& text, const std::string& pattern
 // truth (true_robot.yaml; asoc_calibration_test checks the coverage over 90 vehicles: 99 % within 3
 // sigma, so 4 holds for these 18 on seed 3), and much closer to it than the nominal for the wheel
 // radii (drawn up to 4 % off). `fit` writes the same kind of sigma for r_c and beta when its gate
-// selects the closed form (before: 0).
+// selects the closed form (before: 0). Seed 1: on seed 3 the Ceres fit of the six holds beats the
+// closed form on the UMBmark circuits (CF 0.0046 against 0.0056) and the gate selects it.
 TEST(AsocCommands, GeometricWritesEstimatesWithinTheirSigmasOfTheTruth) {
   TempDir tmp;
   const std::string data = tmp.Path("asoc"), out = tmp.Path("geo.yaml");
-  ASSERT_EQ(RunFitcal(tmp, "asoc-simulate --out " + data + " --excursions 0 --seed 3").exit_code,
+  ASSERT_EQ(RunFitcal(tmp, "asoc-simulate --out " + data + " --excursions 0 --seed 1").exit_code,
             0);
   const FitcalRun r = RunFitcal(tmp, "asoc-geometric --logs " + data + " --out " + out);
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -144,12 +145,13 @@ TEST(AsocCommands, GeometricWritesEstimatesWithinTheirSigmasOfTheTruth) {
 
 // asoc-geometric goes through fit's gate: a closed form that does not beat the nominal on the
 // held-out runs is not written. The nominal here is the simulator's truth (true_robot.yaml as
-// robot.yaml), which no estimate from quantised hold runs can beat on the UMBmark circuits held
-// out (CF 0.0014 against the closed form's 0.0021 on seed 3); before the gate it was written.
+// robot.yaml), which the estimate from quantised hold runs does not beat on the UMBmark circuits
+// held out on seed 5 (CF 0.0033 against the closed form's 0.0054; on seeds 1-3 the closed form's
+// errors happen to offset the truth's 20 Hz update error); before the gate it was written.
 TEST(AsocCommands, GeometricRefusesAClosedFormThatDoesNotBeatTheNominal) {
   TempDir tmp;
   const std::string data = tmp.Path("asoc"), out = tmp.Path("geo.yaml");
-  ASSERT_EQ(RunFitcal(tmp, "asoc-simulate --out " + data + " --excursions 0 --seed 3").exit_code,
+  ASSERT_EQ(RunFitcal(tmp, "asoc-simulate --out " + data + " --excursions 0 --seed 5").exit_code,
             0);
   std::filesystem::copy_file(data + "/true_robot.yaml", data + "/robot.yaml",
                              std::filesystem::copy_options::overwrite_existing);

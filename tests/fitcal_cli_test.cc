@@ -345,7 +345,7 @@ TEST(FitcalCli, DiagnoseRecordsTheWrittenFitsSigmasAndTheReportShowsThem) {
               block["sigma"]["wheel_separation_m"].as<double>(), 1e-12);
 }
 
-// An ASOC data set (asoc-simulate's own encoder files, converted on load) goes through the
+// An ASOC data set (asoc-simulate on the one simulator, the generic CSV) goes through the
 // generic commands like any model: `fit` with the closed form of Doebbler Eq. 1-9 (from the hold
 // runs) in the result gate, every --method on the seam (crs2lm runs NLopt, not Ceres), `compare`.
 TEST(FitcalCli, AsocDataSetGoesThroughTheGenericCommands) {
@@ -356,11 +356,11 @@ TEST(FitcalCli, AsocDataSetGoesThroughTheGenericCommands) {
   const std::string out = dir.Path("asoc_calibrated.yaml");
   r = RunFitcal(dir, "fit --logs " + data + " --train-reps 1-2 --out " + out);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.out.find("asoc robot 'asoc-prototype'"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("asoc robot 'example_asoc'"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("asoc-geometric"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("result gate"), std::string::npos) << r.out;
-  const io::AsocRobot calibrated = io::ReadAsocRobot(out);  // the silo's commands still read it
-  EXPECT_EQ(calibrated.name, "asoc-prototype");
+  const io::AsocRobot calibrated = io::ReadAsocRobot(out);
+  EXPECT_EQ(calibrated.name, "example_asoc");
   const YAML::Node record = YAML::LoadFile(out)["calibration"];
   ASSERT_TRUE(record.IsMap()) << ReadFileBytes(out);
   EXPECT_TRUE(record["selected"]) << ReadFileBytes(out);

@@ -48,7 +48,7 @@ void ToyControllerParameters(const CalibratedRobot& c, const std::string&, Contr
 }
 
 // Two trajectories the unicycle can drive (it has no sideways motion): 1 m ahead, a turn.
-std::vector<sim::TrajectorySpec> ToyScenario(const Robot&, const std::vector<double>&,
+std::vector<sim::TrajectorySpec> ToyScenario(const RobotModelInterface&, const std::vector<double>&,
                                               int repetitions) {
   std::vector<sim::TrajectorySpec> out;
   for (int rep = 1; rep <= repetitions; ++rep) {

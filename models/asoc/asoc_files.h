@@ -33,7 +33,23 @@
 
 #include "io/dataset.h"
 #include "models/asoc/asoc_model.h"
-#include "models/asoc/asoc_run_log.h"
+
+namespace fitcal::asoc {
+
+// One row of ASOC's encoder CSV: wheel_rad[i][k] the cumulative angle of wheel k (0 = "a" =
+// wheel 1, 1 = "b" = wheel 2) of castor i; pivot_rad[i] the pivot encoder reading gamma_i.
+struct EncoderSample {
+  double wheel_rad[kNumCastors][2] = {{0.0, 0.0}, {0.0, 0.0}, {0.0, 0.0}};
+  double pivot_rad[kNumCastors] = {0.0, 0.0, 0.0};
+};
+
+// Samples at strictly increasing times t_s (same length).
+struct EncoderLog {
+  std::vector<double> t_s;
+  std::vector<EncoderSample> samples;
+};
+
+}  // namespace fitcal::asoc
 
 namespace fitcal::io {
 

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <limits>
 
-#include "models/asoc/asoc_files.h"
 #include "odometry/pose2.h"
 
 namespace fitcal::asoc {
@@ -310,12 +309,13 @@ GeometricResult CalibrateFromHoldRuns(const std::vector<HoldRun>& runs, const Ve
   return result;
 }
 
-GeometricResult CalibrateGeometric(const std::vector<RunLog>& runs, const Vehicle& nominal,
+GeometricResult CalibrateGeometric(const std::vector<fitcal::RunLog>& runs, const Vehicle& nominal,
                                    double pivot_resolution_rad) {
   std::vector<HoldRun> holds;
-  for (const RunLog& run : runs) {
-    const fitcal::EncoderLog channels = io::AsocEncoderLogAsChannels(run.encoders);
-    if (const auto hold = MeasureHoldRun(run.trajectory, channels.samples)) holds.push_back(*hold);
+  for (const fitcal::RunLog& run : runs) {
+    if (const auto hold = MeasureHoldRun(run.trajectory, run.encoders.samples)) {
+      holds.push_back(*hold);
+    }
   }
   return CalibrateFromHoldRuns(holds, nominal, pivot_resolution_rad);
 }

@@ -36,8 +36,8 @@
 #include <vector>
 
 #include "models/asoc/asoc_model.h"
-#include "models/asoc/asoc_run_log.h"
 #include "odometry/encoder_samples.h"
+#include "odometry/run_log.h"
 
 namespace fitcal::asoc {
 
@@ -100,9 +100,9 @@ double OneSigmaStudentFactor(int dof);
 GeometricResult CalibrateFromHoldRuns(const std::vector<HoldRun>& runs, const Vehicle& nominal,
                                       double pivot_resolution_rad = 0.0);
 
-// The hold runs among `runs` (MeasureHoldRun on the model's channels,
-// io::AsocEncoderLogAsChannels) through CalibrateFromHoldRuns.
-GeometricResult CalibrateGeometric(const std::vector<RunLog>& runs, const Vehicle& nominal,
+// The hold runs among `runs` (MeasureHoldRun on the model's channels) through
+// CalibrateFromHoldRuns.
+GeometricResult CalibrateGeometric(const std::vector<fitcal::RunLog>& runs, const Vehicle& nominal,
                                    double pivot_resolution_rad = 0.0);
 
 }  // namespace fitcal::asoc

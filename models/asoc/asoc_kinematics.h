@@ -23,8 +23,8 @@
 //      the middle, Eq. 13-14 hold without the small-angle assumption, with s = 2 sin(dpsi/2);
 //   3. dpsi = 2 asin(s / 2), and (dx_c, dy_c) turned by dpsi/2 back into the start frame, which the
 //      generic replay (odometry/replay.h) rotates by the heading before the interval.
-// The paper linearises about psi- (the silo's asoc::Odometry, kept for Tables I and II); the two
-// agree to second order in dpsi per interval, and this one replays a constant twist exactly.
+// The paper linearises about psi- (asoc-tables replayed so until asoc41); the two agree to second
+// order in dpsi per interval, and this one replays a constant twist exactly.
 //
 // Variants (robot YAML `odometry:`, Doebbler Table II naming): CAST-i leaves castor i out (CAST-0
 // uses all three); IPEC-i uses the other two castors, heading from the line through their pivots

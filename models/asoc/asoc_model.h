@@ -171,13 +171,4 @@ void PivotChord(const CastorMotion<T>& m, const T& mid_heading_rad, T* dx_m, T* 
   *dy_m = s * m.along + c * m.lateral;
 }
 
-// The pivot's world displacement over one interval, from the wheel angle increments and the
-// castor's absolute heading chi at the interval's start (mid heading chi + omega_c / 2).
-template <typename T>
-void PivotDisplacement(const T* p, const T& wheel_1_delta_rad, const T& wheel_2_delta_rad,
-                       const T& castor_heading_rad, T* dx_m, T* dy_m) {
-  const CastorMotion<T> m = PivotMotionFromWheels(p, wheel_1_delta_rad, wheel_2_delta_rad);
-  PivotChord(m, T(castor_heading_rad + m.turn * 0.5), dx_m, dy_m);
-}
-
 }  // namespace fitcal::asoc

@@ -1,20 +1,13 @@
 #pragma once
-// Multi-castor odometry of an ASOC vehicle, Doebbler Sec. III-B:
-//   - every update, each castor's pivot displacement (dx_i, dy_i) in the world frame comes from its
-//     wheel increments and its heading chi_i = psi + gamma_i - beta_i (asoc_model.h);
+// The pieces of Doebbler's multi-castor odometry (Sec. III-B) that the seam's body step
+// (asoc_kinematics.h) is built from:
 //   - CAST-n: the linear least squares of Eq. 13-17 over any subset of >= 2 castors,
 //       dx_i = dx_c - dpsi R_i sin(psi + phi_i)   (Eq. 13)
 //       dy_i = dy_c + dpsi R_i cos(psi + phi_i)   (Eq. 14)
 //     solved with the closed-form (H^T H)^-1 of Eq. 18-21 for pivots anywhere on the body (Eq. 22,
 //     for pivots centred on the body origin, is its special case: tests/asoc_odometry_test.cc);
-//   - IPEC (Borenstein, Eq. 10) on two castors as the baseline;
-//   - the final step both share: each castor's heading is updated from the new vehicle heading and
-//     its measured castor angle (chi_i = psi+ + gamma_i+ - beta_i).
+//   - IPEC (Borenstein, Eq. 10) on two castors as the baseline (Method);
 // Naming as in Doebbler Table II: CAST-i / IPEC-i leave castor i out (1-based), CAST-0 uses all.
-//
-// Linearisation heading: Eq. 13-14 linearise about psi- (the paper). With
-// `midpoint_linearisation` the solve is repeated about psi- + dpsi/2, which makes Eq. 13-14 exact
-// to second order in dpsi (2 sin(dpsi/2) R about the mid heading); default off (the paper).
 //
 // Redundancy check (the paper's future work, Sec. III-B end): with three castors, each castor's
 // displacement is predicted from the other two (CAST on the pair). The pair whose own two
@@ -22,16 +15,11 @@
 // castor; it is dropped for this update when its measured displacement differs from the
 // prediction by more than tolerance_m + tolerance_fraction * (the step length).
 
-#include <Eigen/Core>
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <stdexcept>
-#include <string>
 
 #include "models/asoc/asoc_model.h"
-#include "models/asoc/asoc_run_log.h"
-#include "odometry/pose2.h"
 
 namespace fitcal::asoc {
 
@@ -94,31 +82,6 @@ BodyStep<T> SolveCastGeneral(const std::array<PivotPosition, kNumCastors>& pivot
   return out;
 }
 
-// Pivot displacements of all castors over one update, castor headings from psi- (the shared final
-// step of the previous update) and the pivot encoders at the update's start.
-template <typename T>
-void PivotDisplacements(const T* p, const EncoderSample& before, const EncoderSample& after,
-                        const T& psi, T* dx, T* dy) {
-  for (int i = 0; i < kNumCastors; ++i) {
-    const T* castor = p + i * kParametersPerCastor;
-    const T heading = psi + (before.pivot_rad[i] - castor[kBiasIndex]);
-    PivotDisplacement(castor, T(after.wheel_rad[i][0] - before.wheel_rad[i][0]),
-                      T(after.wheel_rad[i][1] - before.wheel_rad[i][1]), heading, &dx[i], &dy[i]);
-  }
-}
-
-// One CAST update of the body pose (general solution; the centred one is the same number when the
-// pivots are centred, tests/asoc_odometry_test.cc).
-template <typename T>
-BodyStep<T> CastStep(const std::array<PivotPosition, kNumCastors>& pivots, CastorMask mask,
-                     bool midpoint_linearisation, const T& psi, const T* dx, const T* dy) {
-  BodyStep<T> step = SolveCastGeneral(pivots, mask, psi, dx, dy);
-  if (midpoint_linearisation) {
-    step = SolveCastGeneral(pivots, mask, T(psi + step.dpsi_rad * 0.5), dx, dy);
-  }
-  return step;
-}
-
 // The redundancy check (Doebbler Sec. III-B, end; header above): the castor whose displacement
 // (dx_i, dy_i) disagrees with the CAST prediction of the other two by more than
 // tolerance_m + tolerance_fraction * (the step length), or -1. psi: the heading the displacements
@@ -155,144 +118,5 @@ inline int InconsistentCastor(const std::array<PivotPosition, kNumCastors>& pivo
 }
 
 enum class Method { kCast, kIpec };
-
-struct OdometryOptions {
-  Method method = Method::kCast;
-  // CAST: castors used (>= 2). IPEC: exactly two; the lower-numbered one is the anchor whose
-  // position the other is re-placed from (Doebbler: "the position of the second castor is
-  // updated to be consistent with the pose of the first castor").
-  CastorMask castors = kAllCastors;
-  bool midpoint_linearisation = false;
-  // Redundancy check (CAST with all three castors only).
-  bool drop_inconsistent_castor = false;
-  double consistency_tolerance_m = 0.5e-3;
-  double consistency_tolerance_fraction = 0.1;
-
-  bool IsValid(std::string* error) const {
-    const int n = MaskCount(castors);
-    if (castors & ~kAllCastors) {
-      *error = "castor mask names a castor that does not exist";
-      return false;
-    }
-    if (method == Method::kCast && n < 2) {
-      *error = "CAST needs at least two castors";
-      return false;
-    }
-    if (method == Method::kIpec && n != 2) {
-      *error = "IPEC uses exactly two castors";
-      return false;
-    }
-    if (drop_inconsistent_castor && (method != Method::kCast || n != 3)) {
-      *error = "the redundancy check needs CAST with all three castors";
-      return false;
-    }
-    if (!(consistency_tolerance_m >= 0.0) || !(consistency_tolerance_fraction >= 0.0)) {
-      *error = "consistency tolerances must be >= 0";
-      return false;
-    }
-    return true;
-  }
-};
-
-// Incremental odometry over a stream of encoder samples (double): the paper's replay, which the
-// simulator's UMBmark (Tables I-II) runs; fits replay through the seam (asoc_kinematics.h).
-class Odometry {
- public:
-  Odometry(const Vehicle& vehicle, const OdometryOptions& options, const Pose2d& start,
-           const EncoderSample& first)
-      : vehicle_(vehicle),
-        options_(options),
-        params_(vehicle.ToArray()),
-        pose_(start),
-        last_(first) {
-    std::string error;
-    if (!options.IsValid(&error)) throw std::invalid_argument("asoc::OdometryOptions: " + error);
-    if (options.method == Method::kIpec) {
-      for (int i = 0; i < kNumCastors; ++i) {
-        if ((options.castors >> i) & 1u) (anchor_ < 0 ? anchor_ : other_) = i;
-      }
-      anchor_pos_ = PivotWorld(anchor_);
-      other_pos_ = PivotWorld(other_);
-    }
-  }
-
-  void Step(const EncoderSample& next) {
-    double dx[kNumCastors], dy[kNumCastors];
-    PivotDisplacements(params_.data(), last_, next, pose_.theta, dx, dy);
-    if (options_.method == Method::kIpec) {
-      IpecStep(dx, dy);
-    } else {
-      CastorMask mask = options_.castors;
-      if (options_.drop_inconsistent_castor) {
-        const int suspect = InconsistentCastor(dx, dy);
-        if (suspect >= 0) {
-          mask &= ~(1u << suspect);
-          ++dropped_[suspect];
-        }
-      }
-      const BodyStep<double> step =
-          CastStep(vehicle_.pivots, mask, options_.midpoint_linearisation, pose_.theta, dx, dy);
-      pose_.x += step.dx_m;
-      pose_.y += step.dy_m;
-      pose_.theta += step.dpsi_rad;
-    }
-    last_ = next;  // final step: castor headings follow from pose_.theta and the new gamma_i
-  }
-
-  const Pose2d& pose() const { return pose_; }
-  // Updates in which castor i was dropped by the redundancy check.
-  const std::array<int, kNumCastors>& dropped() const { return dropped_; }
-
-  // The castor the redundancy check would drop for these displacements, or -1.
-  int InconsistentCastor(const double* dx, const double* dy) const {
-    return asoc::InconsistentCastor(vehicle_.pivots, pose_.theta, dx, dy,
-                                    options_.consistency_tolerance_m,
-                                    options_.consistency_tolerance_fraction);
-  }
-
- private:
-  Eigen::Vector2d PivotWorld(int i) const {
-    const double c = std::cos(pose_.theta), s = std::sin(pose_.theta);
-    const PivotPosition& q = vehicle_.pivots[i];
-    return {pose_.x + c * q.x_m() - s * q.y_m(), pose_.y + s * q.x_m() + c * q.y_m()};
-  }
-
-  // IPEC, Doebbler Eq. 10 on the pivots: move both pivots, take the heading from the line through
-  // them, re-place the second pivot at its known distance from the first along that line.
-  void IpecStep(const double* dx, const double* dy) {
-    anchor_pos_ += Eigen::Vector2d(dx[anchor_], dy[anchor_]);
-    other_pos_ += Eigen::Vector2d(dx[other_], dy[other_]);
-    const PivotPosition& a = vehicle_.pivots[anchor_];
-    const PivotPosition& b = vehicle_.pivots[other_];
-    const double body_angle = std::atan2(b.y_m() - a.y_m(), b.x_m() - a.x_m());
-    const Eigen::Vector2d line = other_pos_ - anchor_pos_;
-    const double psi = std::atan2(line.y(), line.x()) - body_angle;  // Eq. 10
-    pose_.theta += WrapAngle(psi - pose_.theta);
-    other_pos_ = anchor_pos_ + vehicle_.PivotDistance(anchor_, other_) * line.normalized();
-    const double c = std::cos(pose_.theta), s = std::sin(pose_.theta);
-    pose_.x = anchor_pos_.x() - (c * a.x_m() - s * a.y_m());
-    pose_.y = anchor_pos_.y() - (s * a.x_m() + c * a.y_m());
-  }
-
-  Vehicle vehicle_;
-  OdometryOptions options_;
-  std::array<double, kNumParameters> params_;
-  Pose2d pose_;
-  EncoderSample last_;
-  std::array<int, kNumCastors> dropped_{};
-  int anchor_ = -1;
-  int other_ = -1;
-  Eigen::Vector2d anchor_pos_ = Eigen::Vector2d::Zero();
-  Eigen::Vector2d other_pos_ = Eigen::Vector2d::Zero();
-};
-
-// Runs the odometry over a whole log; returns the final pose.
-inline Pose2d RunOdometry(const Vehicle& vehicle, const OdometryOptions& options,
-                          const EncoderLog& log, const Pose2d& start) {
-  if (log.samples.empty()) return start;
-  Odometry odometry(vehicle, options, start, log.samples.front());
-  for (std::size_t k = 1; k < log.samples.size(); ++k) odometry.Step(log.samples[k]);
-  return odometry.pose();
-}
 
 }  // namespace fitcal::asoc

@@ -148,6 +148,12 @@ std::string AsocModel::RobotYaml(const std::vector<double>& p,
   return io::AsocRobotYaml(out) + calibration_block;
 }
 
+RobotModelPtr AsocModel::WithOdometry(const AsocOdometryOptions& odometry) const {
+  AsocKinematics k = kinematics();
+  k.odometry = odometry;
+  return std::make_shared<AsocModel>(robot(), asoc_, std::move(k));
+}
+
 std::vector<ClosedFormCalibration> AsocModel::ClosedForms(
     const std::vector<AlignedRun>& training) const {
   std::vector<asoc::HoldRun> holds;

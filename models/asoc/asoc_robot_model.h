@@ -45,6 +45,10 @@ class AsocModel : public KinematicModel<AsocKinematics> {
   // castor cables swapped, the pivot encoders alone swapped. The identity first.
   std::vector<ChannelMapping> CandidateMiswirings() const override;
 
+  const io::AsocRobot& asoc() const { return asoc_; }
+  // The same robot replayed by another of Doebbler's odometry algorithms (asoc_kinematics.h).
+  RobotModelPtr WithOdometry(const AsocOdometryOptions& odometry) const;
+
  private:
   io::AsocRobot asoc_;
 };
@@ -53,10 +57,11 @@ class AsocModel : public KinematicModel<AsocKinematics> {
 Robot AsocRobotDescription(const std::string& name,
                            const std::array<std::string, asoc::kNumCastors>& castor_names);
 
-// The simulated one-third-scale prototype (sim/asoc_simulator.h AsocPrototypeVehicle).
+// The simulated one-third-scale prototype (asoc_extras.h PrototypeVehicle).
 inline constexpr const char* kAsocExampleYaml = R"(model: asoc
 name: example_asoc
 pivot_distance_m: 0.5196152423
+pivot_resolution_deg: 0.07
 castors:
   - {name: "1", pivot_radius_m: 0.3, pivot_angle_deg: 0, offset_m: 0.08,
      wheel_radius_m: [0.04, 0.04], wheel_offset_m: [0.06, 0.06], encoder_bias_deg: 0}

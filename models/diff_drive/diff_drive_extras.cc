@@ -38,7 +38,7 @@ void DiffDriveParameters(const CalibratedRobot& c, const std::string& distro,
   out->parameters[k_separation] = Ros2AsWritten(p[k_separation]);
 }
 
-std::vector<sim::TrajectorySpec> DiffDriveScenario(const Robot& /*robot*/,
+std::vector<sim::TrajectorySpec> DiffDriveScenario(const RobotModelInterface& /*model*/,
                                                    const std::vector<double>& /*truth*/,
                                                    int repetitions) {
   sim::DiffDriveTrajectoryOptions shapes;

@@ -248,7 +248,7 @@ void OmniWheelParameters(const CalibratedRobot& c, OmniWheelReplay replay, Contr
   OmniWheelKinematics(c, order, offset, MeanValue(distances), MeanValue(radii), sense, replay, out);
 }
 
-std::vector<sim::TrajectorySpec> OmniScenario(const Robot& /*robot*/,
+std::vector<sim::TrajectorySpec> OmniScenario(const RobotModelInterface& /*model*/,
                                               const std::vector<double>& /*truth*/,
                                               int repetitions) {
   sim::OmniTrajectoryOptions shapes;

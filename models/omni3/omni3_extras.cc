@@ -47,7 +47,7 @@ ParameterDisplay InverseKinematicMatrixColumns(const Robot& /*robot*/) {
 }
 
 // Table A1 as printed: the commands are the nominal robot's, whatever the truth.
-std::vector<sim::TrajectorySpec> FlowerScenario(const Robot& /*nominal*/,
+std::vector<sim::TrajectorySpec> FlowerScenario(const RobotModelInterface& /*nominal*/,
                                                 const std::vector<double>& /*truth*/,
                                                 int repetitions) {
   return sim::FlowerSpecs(sim::FlowerTrajectories(), repetitions);
@@ -78,7 +78,7 @@ ModelExtras Omni3Extras() {
   extras.controllers = {OmniWheelController(OmniWheelReplay::kOwnModelByName)};
   extras.display = &InverseKinematicMatrixColumns;
   extras.scenario.trajectories = &FlowerScenario;
-  extras.scenario.default_truth = [](const Robot& /*nominal*/) {
+  extras.scenario.default_truth = [](const Robot& /*nominal*/, std::uint64_t /*seed*/) {
     return sim::ParameterVector(sim::PalacinTable5Parameters());
   };
   extras.scenario.stepped_physics = true;

@@ -71,9 +71,10 @@ void TricycleParameters(const CalibratedRobot& c, const std::string&, Controller
 // how far the wheel can steer is the true robot's: its column, read through the true gain, must
 // stay readable (sim::TricycleReadableSteeringDeg), so circles beyond that are left out and the
 // squares turn on arcs at that steering instead of in place.
-std::vector<sim::TrajectorySpec> TricycleScenario(const Robot& robot,
+std::vector<sim::TrajectorySpec> TricycleScenario(const RobotModelInterface& model,
                                                   const std::vector<double>& truth,
                                                   int repetitions) {
+  const Robot& robot = model.robot();
   sim::TricycleTrajectoryOptions shapes;
   for (int k = 0; k < robot.NumParameters(); ++k) {
     if (robot.parameters[k].group == "wheelbase_m") shapes.wheelbase_m = robot.nominal[k];

@@ -1,0 +1,39 @@
+#pragma once
+// Doebbler et al. Tables I and II by Monte Carlo (`asoc-tables`, docs/asoc.md): random true
+// vehicles about the nominal, each driven through the calibration manoeuvre and the UMBmark square
+// on the one simulator (the caller's `simulate`: sim/model_simulator.h with the castor dynamics of
+// asoc_extras.h), calibrated by the closed form of Eq. 1-9 and judged by the odometry of the seam.
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "models/asoc/asoc_robot_model.h"
+#include "models/trajectory_spec.h"
+#include "odometry/run_log.h"
+
+namespace fitcal::asoc {
+
+// Runs of the true parameters (asoc::Vehicle::ToArray order) along the trajectories; `seed` the
+// noise's. Ground truth noise-free, its last sample at the last encoder time.
+using SimulateFn = std::function<std::vector<RunLog>(const std::vector<double>& truth,
+                                                     const std::vector<sim::TrajectorySpec>& specs,
+                                                     std::uint64_t seed)>;
+
+// UMBmark E_max (Borenstein; Doebbler Sec. IV-B): for each direction the distance of the mean of
+// the runs' final position errors (odometry - truth) from zero; E_max the larger of the two.
+double UmbmarkEmax(const RobotModelInterface& odometry, const std::vector<double>& p,
+                   const std::vector<RunLog>& runs);
+
+// Means over `sets` random parameter sets (set s draws from std::mt19937_64 seeded by
+// seed ^ Mix(s)): Table I, the mean absolute relative error [uncalibrated, calibrated] of r_c, r_w,
+// d and the absolute error of beta (rad); Table II, UMBmark E_max (m) [uncalibrated, calibrated] of
+// IPEC-1, CAST-1 and CAST-0 on a truth with beta = 0 (Doebbler Sec. IV-B), 5 circuits each way.
+struct DoebblerTables {
+  double param[2][4] = {{0, 0, 0, 0}, {0, 0, 0, 0}};
+  double emax[2][3] = {{0, 0, 0}, {0, 0, 0}};
+};
+DoebblerTables SimulateDoebblerTables(const AsocModel& nominal, int sets, std::uint64_t seed,
+                                      const SimulateFn& simulate, int threads);
+
+}  // namespace fitcal::asoc
