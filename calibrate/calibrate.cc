@@ -117,9 +117,11 @@ bool SelectCandidate(const CalibrationRequest& r, const RobotModelInterface& mod
                                     ReadingResolutionsOf(model.robot(), r.runs),
                                     out->selected().parameters, &out->selected_fit);
   }
-  if (out->gate.selected == 0 || !r.will_write) return true;
-  const std::string refusal =
-      AddPropagatedUncertainty(model, out->selected(), split.training, &out->selected_fit);
+  std::string refusal;
+  if (out->gate.selected != 0 && r.will_write) {
+    refusal = AddPropagatedUncertainty(model, out->selected(), split.training, &out->selected_fit);
+  }
+  MarkWiderThanTheBounds(model.robot(), &out->selected_fit);
   return refusal.empty() || Refuse(out, 1, {refusal});
 }
 

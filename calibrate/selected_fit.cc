@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "fit/correlation.h"
+#include "fit/determined_directions.h"
 #include "models/mounted_model.h"
 #include "validation/propagated_uncertainty.h"
 
@@ -113,6 +114,17 @@ std::string AddPropagatedUncertainty(const RobotModelInterface& model,
   fit->correlation = CorrelationOf(u.covariance);
   UseOwnSigmas(selected.sigma, fit);
   return "";
+}
+
+void MarkWiderThanTheBounds(const Robot& robot, SelectedFit* fit) {
+  const Eigen::VectorXd prior = PriorSigma(robot);
+  const std::size_t n = static_cast<std::size_t>(robot.NumParameters());
+  if (fit->sigma.size() != n) return;
+  fit->not_determined.resize(n, false);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double bounds_sigma = prior[static_cast<Eigen::Index>(k)];
+    if (bounds_sigma > 0.0 && fit->sigma[k] > bounds_sigma) fit->not_determined[k] = true;
+  }
 }
 
 }  // namespace fitcal

@@ -24,7 +24,8 @@ struct SelectedFit {
   // The weights' noise levels when the fit estimated them (fit/noise_levels.h); else not estimated.
   NoiseLevels noise_levels;
   // Per parameter: not determined by the training runs, its sigma the bounds' along a held
-  // direction (NotDeterminedParameters, fit/model_fit.h).
+  // direction (NotDeterminedParameters, fit/model_fit.h) or wider than the bounds allow
+  // (MarkWiderThanTheBounds).
   std::vector<bool> not_determined;
   // Why parameters beyond the robot's own holds are held when no fit chose them ("" for a fit).
   std::string held_reason;
@@ -49,5 +50,13 @@ SelectedFit DescribeSelected(const Robot& robot,
 std::string AddPropagatedUncertainty(const RobotModelInterface& model,
                                      const CalibrationCandidate& selected,
                                      const std::vector<AlignedRun>& training, SelectedFit* fit);
+
+// Marks NOT DETERMINED every parameter whose sigma is wider than its bounds read as a uniform
+// prior (width / sqrt(12), PriorSigma in fit/determined_directions.h), whichever fit made it: the
+// bounds say more about it than the runs do. A held direction marks its parameters already
+// (NotDeterminedParameters); this catches a direction left free, as by a fit without its holds
+// whose sigma was propagated (the real omni3's mount yaw and wheel angles on its circles alone,
+// sigma 2.3e3 deg within bounds of +-90 deg, said "determined").
+void MarkWiderThanTheBounds(const Robot& robot, SelectedFit* fit);
 
 }  // namespace fitcal

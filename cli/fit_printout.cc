@@ -60,8 +60,9 @@ void PrintParameters(const Robot& robot, const std::vector<double>& p, const Sel
   if (std::find(fit.not_determined.begin(), fit.not_determined.end(), true) !=
       fit.not_determined.end()) {
     std::printf("  NOT DETERMINED: the training runs leave a direction these parameters move along "
-                "(held at the nominal, below); their sigma is what the bounds allow along it, "
-                "read as a uniform prior: the value is as good as your nominal there\n");
+                "(held at the nominal, below: their sigma is what the bounds allow along it, "
+                "read as a uniform prior; or fitted, with a sigma wider than the bounds allow): "
+                "the value is as good as your nominal there\n");
   }
   for (const HeldParameter& h : robot.held) {
     std::printf("  held: %s (%s)\n", robot.parameters[h.index].name.c_str(), h.reason.c_str());
