@@ -8,13 +8,6 @@
 
 namespace fitcal::sim {
 
-std::uint64_t SplitMix(std::uint64_t x) {
-  x += 0x9E3779B97F4A7C15ull;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-  return x ^ (x >> 31);
-}
-
 namespace {
 
 // Portable random numbers: mt19937_64 is fully specified by the standard, the distributions on

@@ -22,12 +22,10 @@
 #include <vector>
 
 #include "models/model_interface.h"
+#include "odometry/split_mix.h"
 #include "sim/model_simulator.h"
 
 namespace fitcal::sim {
-
-// SplitMix64 (Steele, Lea, Flood 2014): a seed and a stream index mixed into one generator seed.
-std::uint64_t SplitMix(std::uint64_t x);
 
 // Empty when the stepped options are valid for a robot of num_channels channels, else what is
 // wrong.

@@ -62,8 +62,7 @@ class CastorDynamics : public ChannelDynamics {
   State Derivative(const State& s, const Twist& v) const {
     State d{};
     for (int i = 0; i < kNumCastors; ++i) {
-      const double bx = v.vx_m_s - v.omega_rad_s * truth_.pivots[i].y_m();
-      const double by = v.vy_m_s + v.omega_rad_s * truth_.pivots[i].x_m();
+      const auto [bx, by] = PivotVelocity(v, truth_.pivots[i]);
       const double c = std::cos(s[i]), sn = std::sin(s[i]);
       const double along = c * bx + sn * by;
       const double lateral = -sn * bx + c * by;
@@ -145,18 +144,13 @@ std::array<double, kNumCastors> SteadyCastorAngles(const Vehicle& truth, const T
                                                    double rest_angle_rad) {
   std::array<double, kNumCastors> theta{};
   for (int i = 0; i < kNumCastors; ++i) {
-    const double bx = twist.vx_m_s - twist.omega_rad_s * truth.pivots[i].y_m();
-    const double by = twist.vy_m_s + twist.omega_rad_s * truth.pivots[i].x_m();
-    const double speed = std::hypot(bx, by);
-    const double lateral = truth.castors[i].offset_m * twist.omega_rad_s;  // chi_dot = omega
-    if (speed < 1e-12 || std::abs(lateral) >= speed) {
+    const std::array<double, 2> pivot_velocity = PivotVelocity(twist, truth.pivots[i]);
+    double along = 0.0;
+    if (std::hypot(pivot_velocity[0], pivot_velocity[1]) < 1e-12 ||
+        !TrailingCastorAngle(pivot_velocity, truth.castors[i].offset_m, twist.omega_rad_s,
+                             &theta[i], &along)) {
       theta[i] = rest_angle_rad;
-      continue;
     }
-    // In the castor frame the pivot velocity is (u, w) = (sqrt(speed^2 - w^2), r_c omega):
-    // c1 = the velocity direction turned back by atan2(w, u).
-    theta[i] =
-        std::atan2(by, bx) - std::atan2(lateral, std::sqrt(speed * speed - lateral * lateral));
   }
   return theta;
 }
@@ -230,7 +224,7 @@ ModelExtras AsocExtras() {
   extras.scenario.default_truth = [](const Robot& nominal, std::uint64_t seed) {
     asoc::Vehicle v;
     v.SetFromArray(nominal.nominal.data());
-    std::mt19937_64 rng(asoc::Mix(seed));
+    std::mt19937_64 rng(SplitMix(seed));
     const auto p = asoc::DrawVehicle(v, asoc::ParameterSpread{}, rng).ToArray();
     return std::vector<double>(p.begin(), p.end());
   };

@@ -17,7 +17,7 @@
 // first segment before a run starts.
 //
 // The true robot (default_truth): drawn about the nominal as Doebbler Table I (ParameterSpread)
-// from std::mt19937_64(Mix(seed)), the draw of asoc-simulate before the one simulator.
+// from std::mt19937_64(SplitMix(seed)), the draw of asoc-simulate before the one simulator.
 
 #include <array>
 #include <cstdint>
@@ -26,6 +26,7 @@
 
 #include "models/asoc/asoc_model.h"
 #include "models/model_extras.h"
+#include "odometry/split_mix.h"
 
 namespace fitcal {
 
@@ -42,15 +43,6 @@ inline constexpr double kPrototypePivotQuantumRad = 0.07 * M_PI / 180.0;
 // The simulated prototype (kAsocExampleYaml): pivots on a 0.30 m circle, r_c 0.08 m, r_w 0.04 m,
 // d 0.06 m; Doebbler do not print their dimensions.
 Vehicle PrototypeVehicle();
-
-// SplitMix64 (Steele, Lea, Flood 2014): a seed (and a stream) mixed into a generator's seed, as
-// the simulator's stepped physics mixes them (sim/stepped_run.h SplitMix).
-inline std::uint64_t Mix(std::uint64_t x) {
-  x += 0x9E3779B97F4A7C15ull;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-  return x ^ (x >> 31);
-}
 
 // Draws a vehicle around `nominal` as Doebbler Table I: every r_c, r_w, d scaled by
 // (1 + U(-f, f)) with its own f, beta uniform in +-beta_range_rad. Pivot layout unchanged.

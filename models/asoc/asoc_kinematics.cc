@@ -43,19 +43,16 @@ bool AsocKinematics::ChannelsForTwist(const double* p, const Twist& twist, doubl
     const asoc::CastorParameters c =
         asoc::CastorParameters::FromArray(p + i * asoc::kParametersPerCastor);
     double* v = values + i * asoc::kChannelsPerCastor;
-    // The pivot's body-frame velocity v + omega x p_i.
-    const double bx = twist.vx_m_s - twist.omega_rad_s * pivots[i].y_m();
-    const double by = twist.vy_m_s + twist.omega_rad_s * pivots[i].x_m();
-    const double speed = std::hypot(bx, by);
-    const double lateral = c.offset_m * twist.omega_rad_s;  // w = r_c chi_dot, chi_dot = omega
-    if (speed < 1e-12 && twist.omega_rad_s == 0.0) {        // at rest: the castor keeps theta = 0
-      v[asoc::kWheelAChannel] = v[asoc::kWheelBChannel] = 0.0;
-      v[asoc::kPivotChannel] = c.encoder_bias_rad;
+    const std::array<double, 2> pivot_velocity = asoc::PivotVelocity(twist, pivots[i]);
+    if (std::hypot(pivot_velocity[0], pivot_velocity[1]) < 1e-12 && twist.omega_rad_s == 0.0) {
+      v[asoc::kWheelAChannel] = v[asoc::kWheelBChannel] = 0.0;  // at rest: the castor keeps
+      v[asoc::kPivotChannel] = c.encoder_bias_rad;                // theta = 0
       continue;
     }
-    if (!(std::abs(lateral) < speed)) return false;
-    const double along = std::sqrt(speed * speed - lateral * lateral);  // u > 0: trailing
-    const double theta = std::atan2(by, bx) - std::atan2(lateral, along);
+    double theta = 0.0, along = 0.0;
+    if (!asoc::TrailingCastorAngle(pivot_velocity, c.offset_m, twist.omega_rad_s, &theta, &along))
+      return false;
+    const double lateral = c.offset_m * twist.omega_rad_s;  // w = r_c chi_dot, chi_dot = omega
     const auto rates = asoc::WheelRatesFromPivotMotion(c, along, lateral);
     v[asoc::kWheelAChannel] = rates[0];
     v[asoc::kWheelBChannel] = rates[1];

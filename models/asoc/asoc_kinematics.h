@@ -44,6 +44,32 @@
 
 namespace fitcal {
 
+namespace asoc {
+
+// A pivot's body-frame velocity v + omega x p for a body twist.
+inline std::array<double, 2> PivotVelocity(const Twist& twist, const PivotPosition& pivot) {
+  return {twist.vx_m_s - twist.omega_rad_s * pivot.y_m(),
+          twist.vy_m_s + twist.omega_rad_s * pivot.x_m()};
+}
+
+// The body-relative angle theta of a castor trailing its pivot in steady state, whose pivot moves
+// at `pivot_velocity` (body frame) while the body turns at omega: the castor turns with the body
+// (chi_dot = omega), so in its own frame the pivot moves at (u, w) = (sqrt(|v_p|^2 - w^2),
+// r_c omega) (asoc_model.h), and c1 is v_p's direction turned back by atan2(w, u). *along = u.
+// False when the pivot moves no faster than r_c |omega| (no steady angle exists).
+inline bool TrailingCastorAngle(const std::array<double, 2>& pivot_velocity, double offset_m,
+                                double omega_rad_s, double* theta_rad, double* along_m_s) {
+  const double speed = std::hypot(pivot_velocity[0], pivot_velocity[1]);
+  const double lateral = offset_m * omega_rad_s;
+  if (!(std::abs(lateral) < speed)) return false;
+  *along_m_s = std::sqrt(speed * speed - lateral * lateral);
+  *theta_rad =
+      std::atan2(pivot_velocity[1], pivot_velocity[0]) - std::atan2(lateral, *along_m_s);
+  return true;
+}
+
+}  // namespace asoc
+
 // Which of Doebbler's odometry algorithms the body step runs.
 struct AsocOdometryOptions {
   asoc::Method method = asoc::Method::kCast;

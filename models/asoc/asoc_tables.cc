@@ -70,7 +70,7 @@ DoebblerTables SimulateDoebblerTables(const AsocModel& nominal_model, int sets,
   const std::size_t n = static_cast<std::size_t>(sets);
   std::vector<DoebblerTables> results(n);
   ParallelFor(n, threads, [&](std::size_t s) {
-    const std::uint64_t set_seed = Mix(seed ^ Mix(s));
+    const std::uint64_t set_seed = SplitMix(seed ^ SplitMix(s));
     std::mt19937_64 rng(set_seed);
     DoebblerTables& r = results[s];
     // Table I: a random parameter set through the calibration.

@@ -26,9 +26,10 @@ double UmbmarkEmax(const RobotModelInterface& odometry, const std::vector<double
                    const std::vector<RunLog>& runs);
 
 // Means over `sets` random parameter sets (set s draws from std::mt19937_64 seeded by
-// seed ^ Mix(s)): Table I, the mean absolute relative error [uncalibrated, calibrated] of r_c, r_w,
-// d and the absolute error of beta (rad); Table II, UMBmark E_max (m) [uncalibrated, calibrated] of
-// IPEC-1, CAST-1 and CAST-0 on a truth with beta = 0 (Doebbler Sec. IV-B), 5 circuits each way.
+// SplitMix(seed ^ SplitMix(s)), odometry/split_mix.h): Table I, the mean absolute relative error
+// [uncalibrated, calibrated] of r_c, r_w, d and the absolute error of beta (rad); Table II,
+// UMBmark E_max (m) [uncalibrated, calibrated] of IPEC-1, CAST-1 and CAST-0 on a truth with
+// beta = 0 (Doebbler Sec. IV-B), 5 circuits each way.
 struct DoebblerTables {
   double param[2][4] = {{0, 0, 0, 0}, {0, 0, 0, 0}};
   double emax[2][3] = {{0, 0, 0}, {0, 0, 0}};
