@@ -5,8 +5,8 @@
 #include <cstdio>
 #include <sstream>
 
+#include "fit/statistics.h"
 #include "odometry/text_format.h"
-#include "validation/statistics.h"
 #include "validation/trajectory_metrics.h"
 
 namespace fitcal {

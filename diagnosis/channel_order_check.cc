@@ -10,9 +10,9 @@
 #include "fit/model_fit.h"
 #include "fit/residual_choice.h"
 #include "fit/segment_cost.h"
+#include "fit/statistics.h"
 #include "models/pose_errors.h"
 #include "odometry/parallel_for.h"
-#include "validation/statistics.h"
 
 namespace fitcal {
 

@@ -7,8 +7,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "fit/statistics.h"
 #include "odometry/text_format.h"
-#include "validation/statistics.h"
 
 namespace fitcal {
 

@@ -6,8 +6,8 @@
 #include <cstdio>
 #include <map>
 
+#include "fit/statistics.h"
 #include "odometry/parallel_for.h"
-#include "validation/statistics.h"
 #include "validation/trajectory_family.h"
 
 namespace fitcal {

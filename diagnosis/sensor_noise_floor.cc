@@ -7,8 +7,8 @@
 #include <cstdio>
 #include <map>
 
+#include "fit/statistics.h"
 #include "odometry/pose2.h"
-#include "validation/statistics.h"
 
 namespace fitcal {
 namespace {

@@ -38,6 +38,16 @@ ResidualWeights TrackWeightsOf(const ModelFitOptions& options) {
   return options.track_weights.value_or(options.ceres.weights);
 }
 
+// Run i's track and final-pose weights: its session's (weights_per_run) or the data set's.
+ResidualWeights TrackWeightsOf(const ModelFitOptions& options, std::size_t i) {
+  if (i < options.weights_per_run.size()) return options.weights_per_run[i].track;
+  return TrackWeightsOf(options);
+}
+ResidualWeights FinalPoseWeightsOf(const ModelFitOptions& options, std::size_t i) {
+  if (i < options.weights_per_run.size()) return options.weights_per_run[i].final_pose;
+  return options.ceres.weights;
+}
+
 // Rounds of the active set: one per parameter that comes to rest on a bound, and releases.
 constexpr int kMaxActiveSetRounds = 16;
 
@@ -112,13 +122,14 @@ class FitProblem {
       }
       if (final_poses) {
         data_blocks_.push_back(problem_->AddResidualBlock(
-            Memo(model.FinalPoseCost(run, options.weights)), MakeLoss(options), p));
+            Memo(model.FinalPoseCost(run, FinalPoseWeightsOf(fit_options, i))), MakeLoss(options),
+            p));
       }
       if (!tracks) continue;
       const TrackCheckpoints& track = fit_options.track->runs[i];
       if (!track.segments.empty()) {
         data_blocks_.push_back(problem_->AddResidualBlock(
-            Memo(TrackResidual::Create(track, model, TrackWeightsOf(fit_options),
+            Memo(TrackResidual::Create(track, model, TrackWeightsOf(fit_options, i),
                                        fit_options.track->options)),
             nullptr, p, clock_offsets + track.clock_group));
       }
@@ -560,10 +571,11 @@ void SolveClockOffsetsAt(const RobotModelInterface& model, const ModelFitOptions
   for (std::size_t g = 0; g < track.clock_groups.size(); ++g) {
     // Each run's odometry from its start, replayed once: it does not depend on dt.
     std::vector<std::pair<std::unique_ptr<TrackResidual>, std::vector<double>>> runs;
-    for (const TrackCheckpoints& run : track.runs) {
+    for (std::size_t i = 0; i < track.runs.size(); ++i) {
+      const TrackCheckpoints& run = track.runs[i];
       if (run.clock_group != static_cast<int>(g) || run.segments.empty()) continue;
       std::unique_ptr<TrackResidual> cost(static_cast<TrackResidual*>(
-          TrackResidual::Create(run, model, TrackWeightsOf(options), track.options)));
+          TrackResidual::Create(run, model, TrackWeightsOf(options, i), track.options)));
       std::vector<double> poses = cost->OdometryFromStart(p.data());
       runs.emplace_back(std::move(cost), std::move(poses));
     }
@@ -773,9 +785,9 @@ ModelFitResult FitWithNoiseLevels(const std::vector<AlignedRun>& training,
                             : 0;
     const int estimated = model.robot().NumParameters() - held -
                           static_cast<int>(fit.held_directions.size()) + offsets;
-    NoiseLevels next =
-        EstimateNoiseLevels(training, model, fit.parameters, fit.clock_offsets_s, *options.track,
-                            options.residuals == ResidualKind::kBoth, estimated);
+    NoiseLevels next = EstimateNoiseLevels(training, model, fit.parameters, fit.clock_offsets_s,
+                                           *options.track, options.residuals == ResidualKind::kBoth,
+                                           estimated, options.noise_levels_per_session);
     if (!next.estimated) break;
     next.iterations = round;
     next.settled = NoiseLevelsAgree(levels, next);
@@ -784,6 +796,7 @@ ModelFitResult FitWithNoiseLevels(const std::vector<AlignedRun>& training,
     const FitWeights w = WeightsFromNoiseLevels(levels);
     weighted.track_weights = w.track;
     if (levels.with_final_poses) weighted.ceres.weights = w.final_pose;
+    weighted.weights_per_run = WeightsPerRun(levels);
     from = fit.parameters;
   }
   fit.noise_levels = levels;
@@ -911,10 +924,11 @@ ClockOffsetEstimate EstimateClockOffsets(const RobotModelInterface& model,
   SolveClockOffsetsAt(model, options, p, &out.offsets_s, &counts);
   std::vector<double> sum_squares(out.offsets_s.size(), 0.0), information(out.offsets_s.size(), 0.0);
   std::vector<int> residuals(out.offsets_s.size(), 0);
-  for (const TrackCheckpoints& run : track.runs) {
+  for (std::size_t run_index = 0; run_index < track.runs.size(); ++run_index) {
+    const TrackCheckpoints& run = track.runs[run_index];
     if (run.segments.empty()) continue;
     const std::unique_ptr<ceres::CostFunction> cost(
-        TrackResidual::Create(run, model, TrackWeightsOf(options), track.options));
+        TrackResidual::Create(run, model, TrackWeightsOf(options, run_index), track.options));
     const int m = cost->num_residuals();
     std::vector<double> r(m), j_dt(m);
     const double* parameters[] = {p.data(), &out.offsets_s[run.clock_group]};

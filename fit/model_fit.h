@@ -117,6 +117,12 @@ struct ModelFitOptions {
   // warm-started from the last, until they settle); ceres.weights and track_weights are then
   // only the first fit's. Final poses alone keep ceres.weights (Palacin Eq. 14's 1 m : 1 rad).
   bool estimate_weights = false;
+  // With estimate_weights: each session's own levels where sessions differ (fit/noise_levels.h);
+  // false: one level per component for the data set.
+  bool noise_levels_per_session = true;
+  // When not empty, one per training run, replacing track_weights and ceres.weights for that
+  // run's residuals (the per-session levels, WeightsPerRun).
+  std::vector<FitWeights> weights_per_run;
   // Use the active set above (false: one plain bounded Ceres solve, as before; kept for tests
   // that show the difference).
   bool active_set_bounds = true;

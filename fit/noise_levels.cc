@@ -9,7 +9,9 @@
 #include <memory>
 #include <string>
 
+#include "fit/statistics.h"
 #include "odometry/pose2.h"
+#include "odometry/text_format.h"
 
 namespace fitcal {
 
@@ -20,6 +22,7 @@ struct ComponentSums {
   double position = 0.0;
   double heading = 0.0;
   int runs = 0;
+  double inverse_checkpoints = 0.0;  // sum over the runs of 1 / K
 };
 
 // Adds the residuals of `cost` at `parameters` to `sums`; false when the replay fails.
@@ -32,6 +35,7 @@ bool AddResiduals(const ceres::CostFunction& cost, const double* const* paramete
     sums->heading += r[i + 2] * r[i + 2];
   }
   ++sums->runs;
+  sums->inverse_checkpoints += 3.0 / static_cast<double>(std::max<std::size_t>(3, r.size()));
   return true;
 }
 
@@ -44,13 +48,129 @@ double SigmaOf(double sum, double count) {
 
 double Ratio(double a, double b) { return a / std::max(b, kSmallestSigma); }
 
+// One session's residuals of one component: the weighted sum of squares, the count the estimate
+// divides it by, and the degrees of freedom of its variance (header).
+struct SessionSum {
+  double squares = 0.0;
+  double count = 0.0;
+  double degrees = 0.0;
+  double Variance() const { return squares / count; }
+};
+
+SessionSum SumOf(const ComponentSums& sums, bool heading, double redundancy) {
+  const double dimension = heading ? 1.0 : 2.0;
+  const double runs = sums.runs;
+  return {heading ? sums.heading : sums.position, dimension * runs * redundancy,
+          dimension * runs * runs / std::max(sums.inverse_checkpoints, 1e-300) * redundancy};
+}
+
+// Bartlett's test that the sessions in `pool` share one variance (header): its p.
+double BartlettP(const std::vector<SessionSum>& s, const std::vector<int>& pool) {
+  double n = 0.0, weighted = 0.0, logs = 0.0, inverse = 0.0;
+  for (int i : pool) {
+    n += s[i].degrees;
+    weighted += s[i].degrees * s[i].Variance();
+    logs += s[i].degrees * std::log(std::max(s[i].Variance(), 1e-300));
+    inverse += 1.0 / s[i].degrees;
+  }
+  const double k = static_cast<double>(pool.size());
+  const double t = n * std::log(std::max(weighted / n, 1e-300)) - logs;
+  const double correction = 1.0 + (inverse - 1.0 / n) / (3.0 * (k - 1.0));
+  return stats::ChiSquareUpperTail(t / correction, k - 1.0);
+}
+
+// The session in `pool` farthest from the pool's variance: the largest nu_s (ln v_s - ln v_p)^2.
+std::size_t Farthest(const std::vector<SessionSum>& s, const std::vector<int>& pool) {
+  double n = 0.0, weighted = 0.0;
+  for (int i : pool) n += s[i].degrees, weighted += s[i].degrees * s[i].Variance();
+  std::size_t out = 0;
+  double largest = -1.0;
+  for (std::size_t j = 0; j < pool.size(); ++j) {
+    const double d = std::log(std::max(s[pool[j]].Variance(), 1e-300) / (weighted / n));
+    if (s[pool[j]].degrees * d * d > largest) largest = s[pool[j]].degrees * d * d, out = j;
+  }
+  return out;
+}
+
+// One component's levels per session (header): the sessions that differ split off one by one;
+// the rest share their pooled level, `data_set_sigma` when none split.
+void SplitSessions(const std::vector<SessionSum>& s, double data_set_sigma, double alpha,
+                   std::vector<double>* sigma, std::vector<double>* split_p) {
+  sigma->assign(s.size(), data_set_sigma);
+  split_p->assign(s.size(), -1.0);
+  std::vector<int> pool;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s[i].degrees >= kMinSessionDegrees) pool.push_back(static_cast<int>(i));
+  }
+  bool split = false;
+  while (pool.size() >= 2) {
+    const double p = BartlettP(s, pool);
+    if (!(p < alpha)) break;
+    const std::size_t j = Farthest(s, pool);
+    (*split_p)[pool[j]] = p;
+    (*sigma)[pool[j]] = SigmaOf(s[pool[j]].squares, s[pool[j]].count);
+    pool.erase(pool.begin() + static_cast<std::ptrdiff_t>(j));
+    split = true;
+  }
+  if (!split) return;
+  double squares = 0.0, count = 0.0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if ((*split_p)[i] < 0.0) squares += s[i].squares, count += s[i].count;
+  }
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if ((*split_p)[i] < 0.0) (*sigma)[i] = SigmaOf(squares, count);
+  }
+}
+
+// The sessions' levels of every component from their sums (header).
+SessionNoise SessionLevels(const NoiseLevels& data_set, const std::vector<ComponentSums>& tracks,
+                           const std::vector<ComponentSums>& finals, double redundancy) {
+  SessionNoise out;
+  const double data_set_sigma[] = {data_set.track_position_m, data_set.track_heading_rad,
+                                   data_set.final_position_m, data_set.final_heading_rad};
+  const int components = data_set.with_final_poses ? 4 : 2;
+  for (int c = 0; c < kNumNoiseComponents; ++c) {
+    const std::vector<ComponentSums>& sums = c < 2 ? tracks : finals;
+    std::vector<SessionSum> s;
+    for (const ComponentSums& session : sums) s.push_back(SumOf(session, c % 2 == 1, redundancy));
+    if (c >= components) s.assign(sums.size(), SessionSum{});  // not a component of this fit
+    SplitSessions(s, data_set_sigma[c], kSessionAlpha / components, &out.sigma[c],
+                  &out.split_p[c]);
+  }
+  return out;
+}
+
 }  // namespace
+
+bool SessionNoise::Differs(int component) const {
+  for (double p : split_p[component]) {
+    if (p >= 0.0) return true;
+  }
+  return false;
+}
+
+bool SessionNoise::AnyDiffers() const {
+  for (int c = 0; c < kNumNoiseComponents; ++c) {
+    if (Differs(c)) return true;
+  }
+  return false;
+}
 
 NoiseLevels EstimateNoiseLevels(const std::vector<AlignedRun>& training,
                                 const RobotModelInterface& model, const std::vector<double>& p,
                                 const std::vector<double>& clock_offsets_s,
-                                const TrackFitData& track, bool final_poses, int num_estimated) {
+                                const TrackFitData& track, bool final_poses, int num_estimated,
+                                bool per_session) {
   NoiseLevels out;
+  SessionNoise& sessions = out.sessions;
+  for (const AlignedRun& run : training) {
+    const std::string name = ClockGroupOf(run.id, run.trajectory, ClockGrouping::kPerSession);
+    const auto found = std::find(sessions.names.begin(), sessions.names.end(), name);
+    sessions.of_run.push_back(static_cast<int>(found - sessions.names.begin()));
+    if (found == sessions.names.end()) sessions.names.push_back(name);
+  }
+  std::vector<ComponentSums> session_tracks(sessions.names.size());
+  std::vector<ComponentSums> session_finals(sessions.names.size());
   out.with_final_poses = final_poses;
   // Unit weights and no Huber: the residuals in metres and radians, each run's checkpoints
   // weighed 1/sqrt(K) as in the fit.
@@ -65,6 +185,7 @@ NoiseLevels EstimateNoiseLevels(const std::vector<AlignedRun>& training,
           TrackResidual::Create(run, model, ResidualWeights{}, plain));
       const double* parameters[] = {p.data(), &clock_offsets_s[run.clock_group]};
       if (!AddResiduals(*cost, parameters, &tracks)) return out;
+      AddResiduals(*cost, parameters, &session_tracks[sessions.of_run[i]]);
       residuals += cost->num_residuals();
     }
     if (!final_poses) continue;
@@ -72,6 +193,7 @@ NoiseLevels EstimateNoiseLevels(const std::vector<AlignedRun>& training,
         model.FinalPoseCost(training[i], ResidualWeights{}));
     const double* parameters[] = {p.data()};
     if (!AddResiduals(*cost, parameters, &finals)) return out;
+    AddResiduals(*cost, parameters, &session_finals[sessions.of_run[i]]);
     residuals += cost->num_residuals();
   }
   const double redundancy = 1.0 - static_cast<double>(num_estimated) / std::max(1, residuals);
@@ -83,6 +205,12 @@ NoiseLevels EstimateNoiseLevels(const std::vector<AlignedRun>& training,
     out.final_heading_rad = SigmaOf(finals.heading, finals.runs * redundancy);
   }
   out.estimated = true;
+  if (per_session) {
+    SessionNoise levels = SessionLevels(out, session_tracks, session_finals, redundancy);
+    levels.names = std::move(sessions.names);
+    levels.of_run = std::move(sessions.of_run);
+    sessions = std::move(levels);
+  }
   return out;
 }
 
@@ -98,18 +226,93 @@ FitWeights WeightsFromNoiseLevels(const NoiseLevels& levels) {
   return w;
 }
 
+std::vector<FitWeights> WeightsPerRun(const NoiseLevels& levels) {
+  const SessionNoise& s = levels.sessions;
+  if (!levels.estimated || !s.AnyDiffers()) return {};
+  std::vector<FitWeights> out;
+  const double reference = levels.track_position_m;
+  for (int session : s.of_run) {
+    FitWeights w;
+    w.track = {Ratio(s.sigma[kTrackPosition][session], reference),
+               Ratio(s.sigma[kTrackHeading][session], reference)};
+    if (levels.with_final_poses) {
+      w.final_pose = {Ratio(s.sigma[kFinalPosition][session], reference),
+                      Ratio(s.sigma[kFinalHeading][session], reference)};
+    }
+    out.push_back(w);
+  }
+  return out;
+}
+
 bool NoiseLevelsAgree(const NoiseLevels& a, const NoiseLevels& b) {
   if (!a.estimated || !b.estimated) return false;
   const FitWeights wa = WeightsFromNoiseLevels(a), wb = WeightsFromNoiseLevels(b);
   const auto close = [](double x, double y) {
     return std::abs(x - y) <= kNoiseLevelTolerance * std::max(std::abs(x), std::abs(y));
   };
+  const std::vector<FitWeights> ra = WeightsPerRun(a), rb = WeightsPerRun(b);
+  if (ra.size() != rb.size()) return false;
+  for (std::size_t i = 0; i < ra.size(); ++i) {
+    if (!close(ra[i].track.position_sigma_m, rb[i].track.position_sigma_m) ||
+        !close(ra[i].track.heading_sigma_rad, rb[i].track.heading_sigma_rad) ||
+        !close(ra[i].final_pose.position_sigma_m, rb[i].final_pose.position_sigma_m) ||
+        !close(ra[i].final_pose.heading_sigma_rad, rb[i].final_pose.heading_sigma_rad))
+      return false;
+  }
   return close(wa.track.heading_sigma_rad, wb.track.heading_sigma_rad) &&
          close(wa.final_pose.position_sigma_m, wb.final_pose.position_sigma_m) &&
          close(wa.final_pose.heading_sigma_rad, wb.final_pose.heading_sigma_rad);
 }
 
-std::string NoiseLevelsText(const NoiseLevels& levels) {
+namespace {
+
+// One component's levels by session: "0.012 m (sessions A, B), 0.031 m (session C: differs,
+// Bartlett p = 2e-06)".
+std::string SessionLevelsText(const SessionNoise& s, int component, double unit_scale,
+                              const char* unit) {
+  std::string pooled_names, out;
+  int pooled_count = 0;
+  for (std::size_t i = 0; i < s.names.size(); ++i) {
+    if (s.split_p[component][i] < 0.0) pooled_names += (pooled_count++ ? ", " : "") + s.names[i];
+  }
+  bool pooled_said = false;
+  for (std::size_t i = 0; i < s.names.size(); ++i) {
+    const double sigma = s.sigma[component][i] * unit_scale;
+    if (s.split_p[component][i] >= 0.0) {
+      out += (out.empty() ? "" : ", ") +
+             StrFormat("%.3g %s (session %s: differs, Bartlett p = %.2g)", sigma, unit,
+                       s.names[i].c_str(), s.split_p[component][i]);
+    } else if (!pooled_said) {
+      pooled_said = true;
+      out += (out.empty() ? "" : ", ") + StrFormat("%.3g %s (session%s %s)", sigma, unit,
+                                                   pooled_count > 1 ? "s" : "",
+                                                   pooled_names.c_str());
+    }
+  }
+  return out;
+}
+
+std::string PerSessionText(const NoiseLevels& levels, const std::string& separator) {
+  const SessionNoise& s = levels.sessions;
+  std::string out = "track position " + SessionLevelsText(s, kTrackPosition, 1.0, "m") +
+                    separator + "track heading " +
+                    SessionLevelsText(s, kTrackHeading, RadToDeg(1.0), "deg") + " per checkpoint";
+  if (levels.with_final_poses) {
+    out += separator + "final pose position " + SessionLevelsText(s, kFinalPosition, 1.0, "m") +
+           separator + "final pose heading " +
+           SessionLevelsText(s, kFinalHeading, RadToDeg(1.0), "deg");
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string NoiseLevelsText(const NoiseLevels& levels, const std::string& separator) {
+  if (levels.sessions.AnyDiffers()) {
+    return PerSessionText(levels, separator) +
+           StrFormat(" (%d fits, %s)", levels.iterations,
+                     levels.settled ? "settled" : "not settled");
+  }
   char text[300];
   std::snprintf(text, sizeof text, "track position %.3g m, heading %.3g deg per checkpoint",
                 levels.track_position_m, RadToDeg(levels.track_heading_rad));

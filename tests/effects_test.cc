@@ -1,5 +1,5 @@
 // Tests of the effect library (odometry/effects.h), the effect fit's building blocks
-// (fit/effect_fit.h), the tail probabilities (validation/statistics.h) and the robot YAML's
+// (fit/effect_fit.h), the tail probabilities (fit/statistics.h) and the robot YAML's
 // `effects:` list.
 #include <ceres/jet.h>
 #include <gtest/gtest.h>
@@ -17,7 +17,7 @@
 #include "models/omni3/omni3_robot_model.h"
 #include "tests/omni3_reference_replay.h"
 #include "tests/flower_scenario.h"
-#include "validation/statistics.h"
+#include "fit/statistics.h"
 #include "tests/test_paths.h"
 #include "tests/omni3_robot.h"
 

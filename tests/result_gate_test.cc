@@ -13,9 +13,9 @@
 #include <random>
 
 #include "fit/result_gate.h"
+#include "fit/statistics.h"
 #include "tests/model_support.h"
 #include "validation/never_worse.h"
-#include "validation/statistics.h"
 
 namespace fitcal {
 namespace {

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <random>
 
-#include "validation/statistics.h"
+#include "fit/statistics.h"
 
 namespace fitcal {
 namespace {

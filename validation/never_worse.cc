@@ -6,7 +6,7 @@
 #include <map>
 #include <utility>
 
-#include "validation/statistics.h"
+#include "fit/statistics.h"
 #include "validation/trajectory_family.h"
 
 namespace fitcal {

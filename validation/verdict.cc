@@ -4,8 +4,8 @@
 #include <cmath>
 #include <map>
 
+#include "fit/statistics.h"
 #include "odometry/text_format.h"
-#include "validation/statistics.h"
 
 namespace fitcal {
 

@@ -1,4 +1,4 @@
-#include "validation/statistics.h"
+#include "fit/statistics.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,6 @@
 #pragma once
-// Tail probabilities for the tests of the effect tracing (diagnosis/diagnose.h): Student t and
+// Tail probabilities for the tests of the effect tracing (diagnosis/diagnose.h), the verdicts
+// (validation/) and the noise levels' session test (fit/noise_levels.h): Student t and
 // Fisher F, through the regularised incomplete beta function I_x(a, b) (continued fraction of
 // Numerical Recipes 3rd ed. Sec. 6.4, Lentz's method); chi-square through the regularised
 // incomplete gamma function Q(a, x) (series and continued fraction, Sec. 6.2).
