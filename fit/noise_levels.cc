@@ -25,17 +25,20 @@ struct ComponentSums {
   double inverse_checkpoints = 0.0;  // sum over the runs of 1 / K
 };
 
-// Adds the residuals of `cost` at `parameters` to `sums`; false when the replay fails.
+// Adds the residuals of `cost` at `parameters` to `sums` and to the run's session's; false when
+// the replay fails.
 bool AddResiduals(const ceres::CostFunction& cost, const double* const* parameters,
-                  ComponentSums* sums) {
+                  ComponentSums* sums, ComponentSums* session) {
   std::vector<double> r(cost.num_residuals());
   if (!cost.Evaluate(parameters, r.data(), nullptr)) return false;
-  for (std::size_t i = 0; i + 2 < r.size(); i += 3) {
-    sums->position += r[i] * r[i] + r[i + 1] * r[i + 1];
-    sums->heading += r[i + 2] * r[i + 2];
+  for (ComponentSums* to : {sums, session}) {
+    for (std::size_t i = 0; i + 2 < r.size(); i += 3) {
+      to->position += r[i] * r[i] + r[i + 1] * r[i + 1];
+      to->heading += r[i + 2] * r[i + 2];
+    }
+    ++to->runs;
+    to->inverse_checkpoints += 3.0 / static_cast<double>(std::max<std::size_t>(3, r.size()));
   }
-  ++sums->runs;
-  sums->inverse_checkpoints += 3.0 / static_cast<double>(std::max<std::size_t>(3, r.size()));
   return true;
 }
 
@@ -184,16 +187,16 @@ NoiseLevels EstimateNoiseLevels(const std::vector<AlignedRun>& training,
       const std::unique_ptr<ceres::CostFunction> cost(
           TrackResidual::Create(run, model, ResidualWeights{}, plain));
       const double* parameters[] = {p.data(), &clock_offsets_s[run.clock_group]};
-      if (!AddResiduals(*cost, parameters, &tracks)) return out;
-      AddResiduals(*cost, parameters, &session_tracks[sessions.of_run[i]]);
+      if (!AddResiduals(*cost, parameters, &tracks, &session_tracks[sessions.of_run[i]]))
+        return out;
       residuals += cost->num_residuals();
     }
     if (!final_poses) continue;
     const std::unique_ptr<ceres::CostFunction> cost(
         model.FinalPoseCost(training[i], ResidualWeights{}));
     const double* parameters[] = {p.data()};
-    if (!AddResiduals(*cost, parameters, &finals)) return out;
-    AddResiduals(*cost, parameters, &session_finals[sessions.of_run[i]]);
+    if (!AddResiduals(*cost, parameters, &finals, &session_finals[sessions.of_run[i]]))
+      return out;
     residuals += cost->num_residuals();
   }
   const double redundancy = 1.0 - static_cast<double>(num_estimated) / std::max(1, residuals);
