@@ -67,7 +67,8 @@ void AddTrackResidualOptions(CLI::App& app, SolverOptions& o) {
       ->capture_default_str();
   app.add_option("--weights", o.weight_mode,
                  "Track residuals: fixed (--position-sigma-m, --heading-sigma-deg) or estimated (noise levels of "
-                 "position and heading estimated from the fit itself, printed and written into "
+                 "position and heading estimated from the fit itself, per session where the "
+                 "sessions differ, printed and written into "
                  "the calibration's objective; docs/everyday_driving.md), or auto: the one that "
                  "transfers better to runs of a kind it was not fitted on")
       ->capture_default_str()
