@@ -3,7 +3,6 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
-#include <cstdio>
 #include <fstream>
 #include <set>
 
@@ -106,20 +105,6 @@ asoc::EncoderLog ReadAsocEncoderCsv(const std::string& path) {
                      "an encoder log needs at least two rows");
   }
   return log;
-}
-
-std::string AsocEncoderCsv(const asoc::EncoderLog& log) {
-  std::string out = ExpectedHeader() + "\n";
-  char line[400];
-  for (std::size_t k = 0; k < log.t_s.size(); ++k) {
-    const asoc::EncoderSample& s = log.samples[k];
-    const int n = std::snprintf(
-        line, sizeof line, "%.6f,%.12g,%.12g,%.12g,%.12g,%.12g,%.12g,%.12g,%.12g,%.12g\n",
-        log.t_s[k], s.wheel_rad[0][0], s.wheel_rad[0][1], s.wheel_rad[1][0], s.wheel_rad[1][1],
-        s.wheel_rad[2][0], s.wheel_rad[2][1], s.pivot_rad[0], s.pivot_rad[1], s.pivot_rad[2]);
-    out.append(line, static_cast<std::size_t>(n));
-  }
-  return out;
 }
 
 bool IsAsocEncoderCsv(const std::string& path) {
