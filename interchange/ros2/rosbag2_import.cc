@@ -12,7 +12,6 @@
 #include "io/ros2_parameter_yaml.h"
 #include "io/rosbag2/static_transforms.h"
 #include "io/text_file.h"
-#include "io/yaml_scalar.h"
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
 
