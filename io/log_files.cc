@@ -92,18 +92,12 @@ void ParseRow(std::string_view line, char separator, int n, const std::string& p
 
 void ExpectHeader(std::string_view line, const std::array<std::string_view, 4>& names,
                   const std::string& path, int line_number) {
-  std::string expected;
-  for (const auto& name : names) expected += (expected.empty() ? "" : ",") + std::string(name);
-  std::size_t pos = 0;
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    std::size_t end = line.find(',', pos);
-    if (end == std::string_view::npos) end = line.size();
-    const bool last = i + 1 == names.size();
-    if (Trim(line.substr(pos, end - pos)) != names[i] || (last != (end == line.size()))) {
-      throw InputError(InputErrorKind::kBadHeader, path, line_number,
-                       "header must be '" + expected + "', found '" + std::string(line) + "'");
-    }
-    pos = end + 1;
+  const std::vector<std::string> fields = SplitCsvFields(line);
+  if (!std::equal(fields.begin(), fields.end(), names.begin(), names.end())) {
+    std::string expected;
+    for (const auto& name : names) expected += (expected.empty() ? "" : ",") + std::string(name);
+    throw InputError(InputErrorKind::kBadHeader, path, line_number,
+                     "header must be '" + expected + "', found '" + std::string(line) + "'");
   }
 }
 
@@ -134,18 +128,6 @@ struct ColumnPlan {
   bool any_ticks = false;
 };
 
-std::vector<std::string> SplitHeader(std::string_view line) {
-  std::vector<std::string> out;
-  std::size_t pos = 0;
-  while (pos <= line.size()) {
-    std::size_t end = line.find(',', pos);
-    if (end == std::string_view::npos) end = line.size();
-    out.emplace_back(Trim(line.substr(pos, end - pos)));
-    pos = end + 1;
-  }
-  return out;
-}
-
 std::string ExpectedHeader(const Robot& robot) {
   std::string out = "t";
   for (const ChannelInfo& c : robot.channels) {
@@ -172,7 +154,7 @@ bool MatchLegacyHeader(const std::vector<std::string>& names, const Robot& robot
 }
 
 ColumnPlan PlanColumns(std::string_view header, const Robot& robot, const std::string& path) {
-  const std::vector<std::string> names = SplitHeader(header);
+  const std::vector<std::string> names = SplitCsvFields(header);
   const auto bad_header = [&](const std::string& why) {
     return InputError(InputErrorKind::kBadHeader, path, 1,
                       why + "; header must be '" + ExpectedHeader(robot) + "'");

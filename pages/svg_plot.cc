@@ -85,14 +85,6 @@ void ColouredLine(std::ostringstream& out, const std::vector<Point2>& line,
   }
 }
 
-double Quantile(std::vector<double> sorted, double q) {
-  if (sorted.empty()) return 0.0;
-  const double at = q * static_cast<double>(sorted.size() - 1);
-  const std::size_t lo = static_cast<std::size_t>(std::floor(at));
-  const std::size_t hi = std::min(sorted.size() - 1, lo + 1);
-  return sorted[lo] + (at - static_cast<double>(lo)) * (sorted[hi] - sorted[lo]);
-}
-
 }  // namespace
 
 double TextWidthPx(const std::string& text, double font_px) {

@@ -37,20 +37,10 @@ asoc::EncoderLog ReadAsocEncoderCsv(const std::string& path) {
   while (scanner.Next(&line) && Trim(line).empty()) {
   }
   if (Trim(line).empty()) throw InputError(InputErrorKind::kEmptyFile, path, 0, "file is empty");
-  {
-    std::string header;
-    std::size_t pos = 0;
-    while (pos <= line.size()) {
-      std::size_t end = line.find(',', pos);
-      if (end == std::string_view::npos) end = line.size();
-      header += (header.empty() ? "" : ",") + std::string(Trim(line.substr(pos, end - pos)));
-      pos = end + 1;
-    }
-    if (header != ExpectedHeader()) {
-      throw InputError(
-          InputErrorKind::kBadHeader, path, scanner.line_number(),
-          "header must be '" + ExpectedHeader() + "', found '" + std::string(line) + "'");
-    }
+  if (SplitCsvFields(line) != SplitCsvFields(ExpectedHeader())) {
+    throw InputError(
+        InputErrorKind::kBadHeader, path, scanner.line_number(),
+        "header must be '" + ExpectedHeader() + "', found '" + std::string(line) + "'");
   }
   asoc::EncoderLog log;
   while (scanner.Next(&line)) {
@@ -112,15 +102,7 @@ bool IsAsocEncoderCsv(const std::string& path) {
   std::string line;
   if (!std::getline(in, line)) return false;
   if (line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 byte order mark
-  std::string header;
-  std::size_t pos = 0;
-  while (pos <= line.size()) {
-    std::size_t end = line.find(',', pos);
-    if (end == std::string::npos) end = line.size();
-    header += (header.empty() ? "" : ",") + std::string(Trim(line.substr(pos, end - pos)));
-    pos = end + 1;
-  }
-  return header == ExpectedHeader();
+  return SplitCsvFields(line) == SplitCsvFields(ExpectedHeader());
 }
 
 namespace {
