@@ -579,19 +579,16 @@ class GlitchScreen {
     return samples_[k].value[c] * samples_[k].dt_s / rad_per_tick_;
   }
   std::string Prefix(int c, std::size_t k) const {
-    char text[160];
-    std::snprintf(text, sizeof text, "channel '%s' counts %.0f ticks in %.4g s",
-                  robot_.channels[c].name.c_str(), Ticks(c, k), samples_[k].dt_s);
-    return text;
+    return StrFormat("channel '%s' counts %.0f ticks in %.4g s", robot_.channels[c].name.c_str(),
+                     Ticks(c, k), samples_[k].dt_s);
   }
   std::string TooFast(int c, std::size_t k) const {
     if (!(std::abs(samples_[k].value[c]) > rate_limit_)) return "";
-    char text[200];
-    std::snprintf(text, sizeof text,
-                  " (%.4g rad/s): beyond %.4g rad/s, a rim speed of %.0f m/s that no robot with "
-                  "wheels of its size reaches",
-                  samples_[k].value[c], rate_limit_, kMaxRimSpeedMps);
-    return Prefix(c, k) + text;
+    return Prefix(c, k) +
+           StrFormat(
+               " (%.4g rad/s): beyond %.4g rad/s, a rim speed of %.0f m/s that no robot with "
+               "wheels of its size reaches",
+               samples_[k].value[c], rate_limit_, kMaxRimSpeedMps);
   }
   // Cheap first look: a count beyond the jitter whose sign differs from a neighbour's (most
   // intervals turn as their neighbours do and are not looked at further).
@@ -610,12 +607,11 @@ class GlitchScreen {
     if (!(v * (n.before > 0.0 ? 1.0 : -1.0) < -jitter)) return "";
     if (!(std::abs(v - n.around) > kSpreadFactor * (n.scatter + jitter))) return "";
     const double to_ticks = dt / rad_per_tick_;
-    char text[200];
-    std::snprintf(text, sizeof text,
-                  ": backwards against the wheel's motion around it (%.1f and %.1f ticks per "
-                  "interval before and after, scattered by %.1f)",
-                  n.before * to_ticks, n.after * to_ticks, n.scatter * to_ticks);
-    return Prefix(c, k) + text;
+    return Prefix(c, k) +
+           StrFormat(
+               ": backwards against the wheel's motion around it (%.1f and %.1f ticks per "
+               "interval before and after, scattered by %.1f)",
+               n.before * to_ticks, n.after * to_ticks, n.scatter * to_ticks);
   }
   // A wrong running total first (the pair of intervals it bounds, after then before k), else the
   // interval alone.
