@@ -5,15 +5,14 @@
 #include <sstream>
 
 #include "models/model_registry.h"
+#include "odometry/text_format.h"
 
 namespace fitcal {
 namespace {
 
 std::string Fixed(double v, int digits) {
   if (std::isnan(v)) return "-";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
-  return buf;
+  return StrFormat("%.*f", digits, v);
 }
 
 std::string CsvField(const std::string& s) {

@@ -1,30 +1,29 @@
 #include "cli/export_ros2_control.h"
-#include "cli/cli_validators.h"
 
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
 
+#include "cli/cli_validators.h"
+#include "cli/dataset_command.h"
+#include "interchange/ros2/controller_export.h"
 #include "io/atomic_file.h"
 #include "io/command_failure.h"
+#include "io/output_guard.h"
 #include "io/yaml_scalar.h"
 #include "models/model_registry.h"
-#include "interchange/ros2/controller_export.h"
-#include "cli/dataset_command.h"
-#include "io/output_guard.h"
+#include "odometry/text_format.h"
 
 namespace fitcal::tools {
 namespace {
 
 std::string ReplayLine(const ExportRos2ControlOptions& o, const ExportReplay& r) {
-  char text[400];
-  std::snprintf(text, sizeof text,
-                "CF (Palacin Eq. 14, m and rad) over %zu runs of %s %s: nominal robot %.6f, "
-                "exact calibration %.6f, these parameters %.6f (%+.1f %% vs exact)",
-                r.runs, o.logs.c_str(), r.which.c_str(), r.cf_nominal, r.cf_exact, r.cf_exported,
-                100.0 * (r.cf_exported / r.cf_exact - 1.0));
-  return text;
+  return StrFormat(
+      "CF (Palacin Eq. 14, m and rad) over %zu runs of %s %s: nominal robot %.6f, "
+      "exact calibration %.6f, these parameters %.6f (%+.1f %% vs exact)",
+      r.runs, o.logs.c_str(), r.which.c_str(), r.cf_nominal, r.cf_exact, r.cf_exported,
+      100.0 * (r.cf_exported / r.cf_exact - 1.0));
 }
 
 std::string CovarianceLine(const OdometryCovariance& c) {

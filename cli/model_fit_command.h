@@ -10,8 +10,6 @@
 #include <string>
 
 #include "fit/result_gate.h"
-#include "fit/run_split.h"
-#include "io/calibration_block.h"
 #include "io/dataset.h"
 #include "models/model_interface.h"
 #include "cli/fit_command.h"

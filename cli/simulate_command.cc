@@ -8,7 +8,6 @@
 #include <stdexcept>
 
 #include "cli/dataset_command.h"
-#include "io/command_failure.h"
 #include "io/input_error.h"
 #include "io/output_guard.h"
 #include "models/model_registry.h"

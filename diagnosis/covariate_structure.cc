@@ -9,6 +9,7 @@
 #include <random>
 
 #include "fit/statistics.h"
+#include "odometry/text_format.h"
 
 namespace fitcal {
 
@@ -349,13 +350,11 @@ CovariateStructure AnalyzeCovariates(const ResidualAnalysis& analysis, double al
 }
 
 std::string CovariateFinding(const CovariateTest& t) {
-  char line[320];
-  std::snprintf(line, sizeof line,
-                "unexplained: the residual %s %s (F = %.2f on (%.0f, %.0f) df, p = %.2g, Holm "
-                "threshold %.2g)",
-                t.direction ? "depends on the" : "drifts with", t.name.c_str(), t.f, t.df1, t.df2,
-                t.p_value, t.holm_threshold);
-  return line;
+  return StrFormat(
+      "unexplained: the residual %s %s (F = %.2f on (%.0f, %.0f) df, p = %.2g, Holm "
+      "threshold %.2g)",
+      t.direction ? "depends on the" : "drifts with", t.name.c_str(), t.f, t.df1, t.df2, t.p_value,
+      t.holm_threshold);
 }
 
 std::string FormatCovariateStructure(const CovariateStructure& s) {

@@ -6,20 +6,14 @@
 #include <sstream>
 #include <utility>
 
+#include "validation/statistics.h"
+
 namespace fitcal {
 
 namespace {
 
 // Two runs are copies when their samples are equal.
 bool SameSamples(const EncoderSamples& a, const EncoderSamples& b) { return a == b; }
-
-double Median(std::vector<double> v) {
-  const std::size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
-  if (v.size() % 2 == 1) return v[mid];
-  const double upper = v[mid];
-  return 0.5 * (upper + *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid)));
-}
 
 }  // namespace
 
@@ -36,7 +30,7 @@ std::pair<double, double> GroundTruthSpread(const GroundTruthTrack& track) {
     y.push_back(pose.y);
     heading.push_back(std::remainder(pose.theta - poses.front().theta, 2.0 * M_PI));
   }
-  const double mx = Median(x), my = Median(y), mh = Median(heading);
+  const double mx = stats::Median(x), my = stats::Median(y), mh = stats::Median(heading);
   std::vector<double> distance_m, turn_rad;
   for (std::size_t k = 0; k < poses.size(); ++k) {
     distance_m.push_back(std::hypot(x[k] - mx, y[k] - my));
@@ -155,7 +149,7 @@ std::vector<OutlierRun> FindOutlierRuns(const std::vector<std::string>& run_ids,
   if (n < 3 || run_ids.size() != n) return out;  // no robust scale from fewer runs
   std::vector<double> squared(n);
   for (std::size_t i = 0; i < n; ++i) squared[i] = per_run_norm[i] * per_run_norm[i];
-  const double median_squared = Median(squared);
+  const double median_squared = stats::Median(squared);
   if (!(median_squared > 0.0)) return out;
   const double s2 = median_squared / ChiSquare1Quantile(0.5);
   const double limit = ChiSquare1Quantile(1.0 - alpha / static_cast<double>(n));

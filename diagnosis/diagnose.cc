@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <stdexcept>
 
@@ -38,10 +37,7 @@ std::string EffectValueText(const effects::EffectValue& e) {
   const auto& info = effects::Info(e.id);
   std::string out = info.name;
   for (int k = 0; k < info.num_parameters; ++k) {
-    char buf[160];
-    std::snprintf(buf, sizeof buf, " %s = %.4g +- %.2g", info.parameter_names[k], e.value[k],
-                  e.sigma[k]);
-    out += buf;
+    out += StrFormat(" %s = %.4g +- %.2g", info.parameter_names[k], e.value[k], e.sigma[k]);
   }
   return out;
 }
@@ -557,13 +553,10 @@ std::string TracingText(const DiagnoseResult& r) {
           }
         }
       }
-      char line[512];
-      std::snprintf(line, sizeof line,
-                    "| %s | %.2g | %.2g | %s | %.4g | %.3g | %.2f | %.2g | %.1f | %s |\n",
-                    effects::Info(c.id).name, c.separable_fraction, c.predicted_sigma,
-                    value.c_str(), c.validation_objective, c.mean_improvement, c.t_statistic,
-                    c.p_value, c.delta_bic, c.verdict.c_str());
-      out += line;
+      out += StrFormat("| %s | %.2g | %.2g | %s | %.4g | %.3g | %.2f | %.2g | %.1f | %s |\n",
+                       effects::Info(c.id).name, c.separable_fraction, c.predicted_sigma,
+                       value.c_str(), c.validation_objective, c.mean_improvement, c.t_statistic,
+                       c.p_value, c.delta_bic, c.verdict.c_str());
     }
     out += "\n";
   }

@@ -1,10 +1,9 @@
 #include "diagnosis/import_channel_order.h"
 
-#include <cstdio>
-
 #include "diagnosis/channel_order_check.h"
-#include "odometry/aligned_run.h"
 #include "diagnosis/miswired_error.h"
+#include "odometry/aligned_run.h"
+#include "odometry/text_format.h"
 
 namespace fitcal {
 
@@ -20,15 +19,12 @@ std::string CheckImportedChannelOrder(const std::vector<RunLog>& logs,
   }
   if (report.likely_miswired) return "channel order check: " + report.message + "; written anyway";
   if (report.best.column.empty()) return "channel order check: the model has no other order";
-  char line[300];
-  std::snprintf(line, sizeof line,
-                "channel order check (%zu runs, %s at the nominal): documented order %.4g, best "
-                "other (%s) %.4g",
-                runs.size(), report.on_windows ? "SSR over 0.5 m windows" : "final-pose SSR",
-                report.recorded_nominal_ssr,
-                DescribeChannelMapping(model.robot(), report.best).c_str(),
-                report.best_nominal_ssr);
-  return line;
+  return StrFormat(
+      "channel order check (%zu runs, %s at the nominal): documented order %.4g, best "
+      "other (%s) %.4g",
+      runs.size(), report.on_windows ? "SSR over 0.5 m windows" : "final-pose SSR",
+      report.recorded_nominal_ssr, DescribeChannelMapping(model.robot(), report.best).c_str(),
+      report.best_nominal_ssr);
 }
 
 }  // namespace fitcal

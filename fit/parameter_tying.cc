@@ -7,6 +7,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "io/text_file.h"
 #include "models/mounted_model.h"
 
 namespace fitcal {
@@ -14,12 +15,6 @@ namespace fitcal {
 namespace {
 
 constexpr const char* kHeldReason = "held at its nominal value by the parameter tying";
-
-std::string Trim(const std::string& s) {
-  const std::size_t b = s.find_first_not_of(" \t");
-  if (b == std::string::npos) return "";
-  return s.substr(b, s.find_last_not_of(" \t") - b + 1);
-}
 
 std::string NamesOf(const Robot& robot) {
   std::string out;
@@ -146,7 +141,7 @@ std::vector<std::string> SplitParameterNames(const std::string& text) {
   std::size_t begin = 0;
   while (true) {
     const std::size_t comma = text.find(',', begin);
-    out.push_back(Trim(text.substr(begin, comma - begin)));
+    out.emplace_back(io::Trim(text.substr(begin, comma - begin)));
     if (comma == std::string::npos) return out;
     begin = comma + 1;
   }

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "fit/final_pose_errors.h"
+#include "odometry/text_format.h"
 
 namespace fitcal {
 
@@ -53,11 +54,9 @@ std::string AtBoundRefusal(const Robot& robot, const std::string& name,
     if (!at_bound[k]) continue;
     const ParameterInfo& info = robot.parameters[k];
     const double s = info.DisplayScale();
-    char text[200];
-    std::snprintf(text, sizeof text, "%s%s %.6g %s in [%.6g, %.6g]", which.empty() ? "" : ", ",
-                  info.name.c_str(), s * parameters[k], info.DisplayUnit(), s * robot.bounds[k].lo,
-                  s * robot.bounds[k].hi);
-    which += text;
+    which += StrFormat("%s%s %.6g %s in [%.6g, %.6g]", which.empty() ? "" : ", ", info.name.c_str(),
+                       s * parameters[k], info.DisplayUnit(), s * robot.bounds[k].lo,
+                       s * robot.bounds[k].hi);
   }
   if (which.empty()) return "";
   return "'" + name + "' leaves a parameter on its bound (" + which +

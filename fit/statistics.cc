@@ -122,6 +122,14 @@ double ChiSquareUpperTail(double chi2, double df) {
   return RegularizedUpperGamma(0.5 * df, 0.5 * std::max(chi2, 0.0));
 }
 
+double Median(std::vector<double> v) {
+  const std::size_t mid = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
+  if (v.size() % 2 == 1) return v[mid];
+  const double upper = v[mid];
+  return 0.5 * (upper + *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid)));
+}
+
 PairedTest PairedLogRatioTest(const std::vector<double>& base,
                               const std::vector<double>& candidate) {
   const std::size_t n = std::min(base.size(), candidate.size());

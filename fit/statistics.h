@@ -21,6 +21,8 @@ double FUpperTail(double f, double d1, double d2);
 double RegularizedUpperGamma(double a, double x);
 // P(X > chi2) for X chi-square with df degrees of freedom.
 double ChiSquareUpperTail(double chi2, double df);
+// The middle value of `v` (not empty), the mean of the two middle ones for an even count.
+double Median(std::vector<double> v);
 
 // The one-sided paired t test that `candidate`'s per-run errors are lower than `base`'s, on the
 // log ratios l_i = ln(base_i / candidate_i): an effect scales each run's error by that run's

@@ -5,6 +5,8 @@
 #include <set>
 #include <stdexcept>
 
+#include "io/text_file.h"
+
 namespace fitcal {
 
 namespace {
@@ -31,13 +33,6 @@ bool SplitLabel(const std::string& label, std::string* prefix, int* number) {
   return true;
 }
 
-std::string Trim(const std::string& s) {
-  const std::size_t b = s.find_first_not_of(" \t");
-  if (b == std::string::npos) return "";
-  const std::size_t e = s.find_last_not_of(" \t");
-  return s.substr(b, e - b + 1);
-}
-
 }  // namespace
 
 const std::vector<TrajectoryStrategy>& PalacinStrategies() {
@@ -53,20 +48,20 @@ const std::vector<TrajectoryStrategy>& PalacinStrategies() {
 }
 
 TrajectoryStrategy ParseStrategy(const std::string& text) {
-  std::string upper = Trim(text);
+  std::string upper(io::Trim(text));
   std::transform(upper.begin(), upper.end(), upper.begin(),
                  [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
   for (const TrajectoryStrategy& s : PalacinStrategies()) {
     if (upper == s.name) return s;
   }
   TrajectoryStrategy out;
-  out.name = Trim(text);
+  out.name = io::Trim(text);
   std::set<std::string> seen;
   std::size_t pos = 0;
   while (pos <= text.size()) {
     std::size_t end = text.find(',', pos);
     if (end == std::string::npos) end = text.size();
-    const std::string item = Trim(text.substr(pos, end - pos));
+    const std::string item(io::Trim(text.substr(pos, end - pos)));
     pos = end + 1;
     if (item.empty()) {
       throw std::invalid_argument("strategy '" + text + "': empty trajectory label");
@@ -78,8 +73,9 @@ TrajectoryStrategy ParseStrategy(const std::string& text) {
     } else {
       std::string p0, p1;
       int n0 = 0, n1 = 0;
-      if (!SplitLabel(Trim(item.substr(0, dash)), &p0, &n0) ||
-          !SplitLabel(Trim(item.substr(dash + 1)), &p1, &n1) || p0 != p1 || n0 > n1) {
+      if (!SplitLabel(std::string(io::Trim(item.substr(0, dash))), &p0, &n0) ||
+          !SplitLabel(std::string(io::Trim(item.substr(dash + 1))), &p1, &n1) || p0 != p1 ||
+          n0 > n1) {
         throw std::invalid_argument("strategy '" + text + "': '" + item +
                                     "' is not a range like B1-B12 (same prefix, increasing)");
       }

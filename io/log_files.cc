@@ -92,18 +92,12 @@ void ParseRow(std::string_view line, char separator, int n, const std::string& p
 
 void ExpectHeader(std::string_view line, const std::array<std::string_view, 4>& names,
                   const std::string& path, int line_number) {
-  std::string expected;
-  for (const auto& name : names) expected += (expected.empty() ? "" : ",") + std::string(name);
-  std::size_t pos = 0;
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    std::size_t end = line.find(',', pos);
-    if (end == std::string_view::npos) end = line.size();
-    const bool last = i + 1 == names.size();
-    if (Trim(line.substr(pos, end - pos)) != names[i] || (last != (end == line.size()))) {
-      throw InputError(InputErrorKind::kBadHeader, path, line_number,
-                       "header must be '" + expected + "', found '" + std::string(line) + "'");
-    }
-    pos = end + 1;
+  const std::vector<std::string> fields = SplitCsvFields(line);
+  if (!std::equal(fields.begin(), fields.end(), names.begin(), names.end())) {
+    std::string expected;
+    for (const auto& name : names) expected += (expected.empty() ? "" : ",") + std::string(name);
+    throw InputError(InputErrorKind::kBadHeader, path, line_number,
+                     "header must be '" + expected + "', found '" + std::string(line) + "'");
   }
 }
 
@@ -134,18 +128,6 @@ struct ColumnPlan {
   bool any_ticks = false;
 };
 
-std::vector<std::string> SplitHeader(std::string_view line) {
-  std::vector<std::string> out;
-  std::size_t pos = 0;
-  while (pos <= line.size()) {
-    std::size_t end = line.find(',', pos);
-    if (end == std::string_view::npos) end = line.size();
-    out.emplace_back(Trim(line.substr(pos, end - pos)));
-    pos = end + 1;
-  }
-  return out;
-}
-
 std::string ExpectedHeader(const Robot& robot) {
   std::string out = "t";
   for (const ChannelInfo& c : robot.channels) {
@@ -172,7 +154,7 @@ bool MatchLegacyHeader(const std::vector<std::string>& names, const Robot& robot
 }
 
 ColumnPlan PlanColumns(std::string_view header, const Robot& robot, const std::string& path) {
-  const std::vector<std::string> names = SplitHeader(header);
+  const std::vector<std::string> names = SplitCsvFields(header);
   const auto bad_header = [&](const std::string& why) {
     return InputError(InputErrorKind::kBadHeader, path, 1,
                       why + "; header must be '" + ExpectedHeader(robot) + "'");
@@ -597,19 +579,16 @@ class GlitchScreen {
     return samples_[k].value[c] * samples_[k].dt_s / rad_per_tick_;
   }
   std::string Prefix(int c, std::size_t k) const {
-    char text[160];
-    std::snprintf(text, sizeof text, "channel '%s' counts %.0f ticks in %.4g s",
-                  robot_.channels[c].name.c_str(), Ticks(c, k), samples_[k].dt_s);
-    return text;
+    return StrFormat("channel '%s' counts %.0f ticks in %.4g s", robot_.channels[c].name.c_str(),
+                     Ticks(c, k), samples_[k].dt_s);
   }
   std::string TooFast(int c, std::size_t k) const {
     if (!(std::abs(samples_[k].value[c]) > rate_limit_)) return "";
-    char text[200];
-    std::snprintf(text, sizeof text,
-                  " (%.4g rad/s): beyond %.4g rad/s, a rim speed of %.0f m/s that no robot with "
-                  "wheels of its size reaches",
-                  samples_[k].value[c], rate_limit_, kMaxRimSpeedMps);
-    return Prefix(c, k) + text;
+    return Prefix(c, k) +
+           StrFormat(
+               " (%.4g rad/s): beyond %.4g rad/s, a rim speed of %.0f m/s that no robot with "
+               "wheels of its size reaches",
+               samples_[k].value[c], rate_limit_, kMaxRimSpeedMps);
   }
   // Cheap first look: a count beyond the jitter whose sign differs from a neighbour's (most
   // intervals turn as their neighbours do and are not looked at further).
@@ -628,12 +607,11 @@ class GlitchScreen {
     if (!(v * (n.before > 0.0 ? 1.0 : -1.0) < -jitter)) return "";
     if (!(std::abs(v - n.around) > kSpreadFactor * (n.scatter + jitter))) return "";
     const double to_ticks = dt / rad_per_tick_;
-    char text[200];
-    std::snprintf(text, sizeof text,
-                  ": backwards against the wheel's motion around it (%.1f and %.1f ticks per "
-                  "interval before and after, scattered by %.1f)",
-                  n.before * to_ticks, n.after * to_ticks, n.scatter * to_ticks);
-    return Prefix(c, k) + text;
+    return Prefix(c, k) +
+           StrFormat(
+               ": backwards against the wheel's motion around it (%.1f and %.1f ticks per "
+               "interval before and after, scattered by %.1f)",
+               n.before * to_ticks, n.after * to_ticks, n.scatter * to_ticks);
   }
   // A wrong running total first (the pair of intervals it bounds, after then before k), else the
   // interval alone.

@@ -1,18 +1,16 @@
 #include "io/ros2_parameter_yaml.h"
 
-#include <cstdio>
 #include <cstdlib>
 #include <set>
 
 #include "io/command_failure.h"
 #include "io/yaml_scalar.h"
+#include "odometry/text_format.h"
 
 namespace fitcal::io {
 
 std::string Ros2Double(double v) {
-  char text[40];
-  std::snprintf(text, sizeof text, "%.12g", v);
-  std::string s = text;
+  std::string s = StrFormat("%.12g", v);
   if (s.find_first_of(".en") == std::string::npos) s += ".0";
   return s;
 }

@@ -213,6 +213,18 @@ std::string_view Trim(std::string_view s) {
   return s.substr(b, e - b);
 }
 
+std::vector<std::string> SplitCsvFields(std::string_view line) {
+  std::vector<std::string> out;
+  std::size_t pos = 0;
+  while (pos <= line.size()) {
+    std::size_t end = line.find(',', pos);
+    if (end == std::string_view::npos) end = line.size();
+    out.emplace_back(Trim(line.substr(pos, end - pos)));
+    pos = end + 1;
+  }
+  return out;
+}
+
 bool ParseDouble(std::string_view field, double* value, bool* finite) {
   field = Trim(field);
   if (!field.empty() && field.front() == '+') field.remove_prefix(1);

@@ -75,5 +75,7 @@ class LineScanner {
 bool ParseDouble(std::string_view field, double* value, bool* finite);
 
 std::string_view Trim(std::string_view s);
+// The comma-separated fields of one line, each trimmed ("a, b," -> "a", "b", "").
+std::vector<std::string> SplitCsvFields(std::string_view line);
 
 }  // namespace fitcal::io

@@ -2,13 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <map>
 #include <vector>
 
 #include "io/input_error.h"
 #include "io/text_file.h"
 #include "io/yaml_reader.h"
+#include "odometry/text_format.h"
 
 namespace fitcal::io {
 namespace {
@@ -36,11 +36,7 @@ std::vector<std::pair<double, int>> Numbers(const YAML::Node& node) {
   return out;
 }
 
-std::string Text(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", v);
-  return text;
-}
+std::string Text(double v) { return StrFormat("%g", v); }
 
 void CheckLengths(const std::string& key, const YAML::Node& value, const std::string& path) {
   for (const auto& [v, line] : Numbers(value)) {

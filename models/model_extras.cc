@@ -2,8 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <numeric>
+
+#include "odometry/text_format.h"
 
 namespace fitcal {
 
@@ -15,13 +16,10 @@ void NoteSpread(const std::vector<double>& v, const std::string& what, const std
                 double scale, const char* unit, std::vector<std::string>* notes) {
   const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
   if (*hi - *lo <= 1e-12 * std::abs(*hi)) return;
-  char text[256];
-  std::snprintf(text, sizeof text,
-                "%s takes one %s: the calibrated %.6g..%.6g %s are written as "
-                "their mean %.6g %s",
-                key.c_str(), what.c_str(), *lo * scale, *hi * scale, unit, MeanValue(v) * scale,
-                unit);
-  notes->push_back(text);
+  notes->push_back(StrFormat(
+      "%s takes one %s: the calibrated %.6g..%.6g %s are written as "
+      "their mean %.6g %s",
+      key.c_str(), what.c_str(), *lo * scale, *hi * scale, unit, MeanValue(v) * scale, unit));
 }
 
 }  // namespace fitcal

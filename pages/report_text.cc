@@ -1,7 +1,6 @@
 #include "pages/report_text.h"
 
 #include <algorithm>
-#include <cstdio>
 
 #include "odometry/text_format.h"
 
@@ -59,9 +58,7 @@ std::string JsonString(const std::string& s) {
         break;
       default:
         if (static_cast<unsigned char>(c) < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", c);
-          out += buf;
+          out += StrFormat("\\u%04x", c);
         } else {
           out += c;
         }
@@ -72,9 +69,7 @@ std::string JsonString(const std::string& s) {
 
 std::string JsonNumber(double v) {
   if (!std::isfinite(v)) return "null";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.10g", v);
-  return buf;
+  return StrFormat("%.10g", v);
 }
 
 double ParamScale(const ReportParameter& p) { return p.is_angle ? kDeg : 1.0; }

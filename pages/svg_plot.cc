@@ -7,15 +7,13 @@
 #include <limits>
 #include <sstream>
 
+#include "odometry/text_format.h"
+
 namespace fitcal::io {
 
 namespace {
 
-std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.2f", v);
-  return buf;
-}
+std::string Num(double v) { return StrFormat("%.2f", v); }
 
 std::string TickLabel(double v, double step) {
   char buf[32];
@@ -83,14 +81,6 @@ void ColouredLine(std::ostringstream& out, const std::vector<Point2>& line,
     out << "\"/>";
     i = j;
   }
-}
-
-double Quantile(std::vector<double> sorted, double q) {
-  if (sorted.empty()) return 0.0;
-  const double at = q * static_cast<double>(sorted.size() - 1);
-  const std::size_t lo = static_cast<std::size_t>(std::floor(at));
-  const std::size_t hi = std::min(sorted.size() - 1, lo + 1);
-  return sorted[lo] + (at - static_cast<double>(lo)) * (sorted[hi] - sorted[lo]);
 }
 
 }  // namespace
@@ -559,9 +549,7 @@ std::string HeatMapSvg(const std::string& title, const std::vector<std::string>&
     const int full = 255;
     const int r = u >= 0.5 ? full : fade, b = u >= 0.5 ? fade : full;
     const int g = fade;
-    char buf[16];
-    std::snprintf(buf, sizeof buf, "#%02x%02x%02x", r, g, b);
-    return std::string(buf);
+    return StrFormat("#%02x%02x%02x", r, g, b);
   };
   std::ostringstream out;
   Open(out, width, height, title);

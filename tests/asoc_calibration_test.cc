@@ -11,6 +11,7 @@
 #include "models/asoc/asoc_files.h"
 #include "models/asoc/asoc_geometric.h"
 #include "models/asoc/asoc_extras.h"
+#include "odometry/text_format.h"
 #include "tests/asoc_simulation.h"
 #include "tests/asoc_robot_file.h"
 #include "tests/test_paths.h"
@@ -135,6 +136,21 @@ TEST(AsocFilesTest, PivotResolutionRoundTripAndBadValues) {
   }
 }
 
+// The ASOC encoder file of `log` (the reader's format; fitcal writes none): the round trip's
+// first half.
+std::string AsocEncoderCsv(const EncoderLog& log) {
+  std::string out =
+      "t,wheel_1a,wheel_1b,wheel_2a,wheel_2b,wheel_3a,wheel_3b,pivot_1,pivot_2,pivot_3\n";
+  for (std::size_t k = 0; k < log.t_s.size(); ++k) {
+    const EncoderSample& s = log.samples[k];
+    out += StrFormat("%.6f,%.12g,%.12g,%.12g,%.12g,%.12g,%.12g,%.12g,%.12g,%.12g\n", log.t_s[k],
+                     s.wheel_rad[0][0], s.wheel_rad[0][1], s.wheel_rad[1][0], s.wheel_rad[1][1],
+                     s.wheel_rad[2][0], s.wheel_rad[2][1], s.pivot_rad[0], s.pivot_rad[1],
+                     s.pivot_rad[2]);
+  }
+  return out;
+}
+
 TEST(AsocFilesTest, EncoderCsvRoundTripAndBadInput) {
   EncoderLog log;
   for (int k = 0; k < 200; ++k) {  // wheels and pivots turning at incommensurate rates
@@ -148,7 +164,7 @@ TEST(AsocFilesTest, EncoderCsvRoundTripAndBadInput) {
     log.samples.push_back(s);
   }
   const std::string path = TempPath("enc.csv");
-  io::WriteFileAtomically(path, io::AsocEncoderCsv(log));
+  io::WriteFileAtomically(path, AsocEncoderCsv(log));
   const EncoderLog back = io::ReadAsocEncoderCsv(path);
   ASSERT_EQ(back.samples.size(), log.samples.size());
   EXPECT_NEAR(back.samples.back().wheel_rad[2][1], log.samples.back().wheel_rad[2][1], 1e-9);

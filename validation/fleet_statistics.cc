@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "io/input_error.h"
+#include "validation/statistics.h"
 
 namespace fitcal {
 namespace {
@@ -35,18 +36,12 @@ long Days(const std::string& date) {
                        std::stoi(date.substr(8, 2)));
 }
 
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 void FlagOutliers(FleetSeries* s) {
   if (s->values.size() < kMinForOutlier) return;
   const double median = s->median;
   std::vector<double> deviation;
   for (double v : s->values) deviation.push_back(std::abs(v - median));
-  const double sigma = 1.4826 * Median(deviation);
+  const double sigma = 1.4826 * stats::Median(deviation);
   if (!(sigma > 0.0)) return;
   for (std::size_t i = 0; i < s->values.size(); ++i) {
     if (std::abs(s->values[i] - median) > kOutlierRobustZ * sigma) {
@@ -178,7 +173,7 @@ std::vector<FleetSeries> FleetSeriesOf(std::vector<FleetCalibration> all) {
     }
   }
   for (FleetSeries& s : out) {
-    s.median = Median(s.values);
+    s.median = stats::Median(s.values);
     for (const std::string& j : s.judged_on) {
       const auto& d = s.distinct_judges;
       if (std::find(d.begin(), d.end(), j) == d.end()) s.distinct_judges.push_back(j);

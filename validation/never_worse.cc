@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "fit/statistics.h"
+#include "odometry/text_format.h"
 #include "validation/trajectory_family.h"
 
 namespace fitcal {
@@ -267,10 +268,9 @@ std::map<std::string, std::string> NeverWorseRowNotes(
   std::map<std::string, std::string> notes;
   for (const NeverWorseJudgement& j : judgements) {
     if (!j.all_runs || !(j.calibrated > j.nominal)) continue;
-    char note[96];
-    std::snprintf(note, sizeof note, "worse%s: margin %.3g",
+    notes[j.measure] =
+        StrFormat("worse%s: margin %.3g",
                   j.Worse() ? " beyond the scatter" : ", within the scatter", j.margin);
-    notes[j.measure] = note;
   }
   return notes;
 }

@@ -2,10 +2,11 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <cstdio>
 #include <cstring>
 #include <map>
 #include <set>
+
+#include "odometry/text_format.h"
 
 namespace fitcal {
 
@@ -51,9 +52,7 @@ std::string TrainingFingerprint(const std::vector<RunLog>& runs,
     h.Add(e.t_s.data(), e.t_s.size() * sizeof(double));
     h.Add(e.samples.data(), e.samples.size() * e.samples.stride() * sizeof(double));
   }
-  char text[17];
-  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h.hash));
-  return text;
+  return StrFormat("%016llx", static_cast<unsigned long long>(h.hash));
 }
 
 TrainingSplit SplitAsRecorded(const std::vector<RunLog>& logs, std::vector<AlignedRun> aligned,

@@ -28,19 +28,6 @@ const std::set<std::string> kMetadataKeys = {"type",  "ngear",  "encRes", "Li", 
                                              "Thi",   "N",      "L",      "imarkers", "gt_ti",
                                              "gt_tf", "odo_ti", "odo_tf"};
 
-// The comma-separated fields of one line, each trimmed.
-std::vector<std::string> SplitCsv(std::string_view line) {
-  std::vector<std::string> out;
-  std::size_t pos = 0;
-  while (true) {
-    const std::size_t end = line.find(',', pos);
-    out.emplace_back(io::Trim(line.substr(pos, end == std::string_view::npos ? end : end - pos)));
-    if (end == std::string_view::npos) break;
-    pos = end + 1;
-  }
-  return out;
-}
-
 // A finite number, or InputError(path:line: `what` is not a finite number: '<field>').
 double ParseNumber(const std::string& field, const std::string& path, int line,
                    const std::string& what) {
@@ -92,7 +79,7 @@ Metadata ReadMetadata(const std::string& path, const std::string& expected_type)
   meta.path = path;
   while (lines.Next(&line)) {
     if (io::Trim(line).empty()) continue;
-    const std::vector<std::string> fields = SplitCsv(line);
+    const std::vector<std::string> fields = io::SplitCsvFields(line);
     const std::string& key = fields[0];
     if (kMetadataKeys.count(key) == 0) {
       throw InputError(InputErrorKind::kUnknownKey, path, lines.line_number(),
@@ -228,7 +215,7 @@ RunRows ReadRun(const std::string& path, int number, const std::string& column_n
   std::vector<double> v(num_fields);
   while (lines.Next(&line)) {
     if (io::Trim(line).empty()) continue;
-    const std::vector<std::string> fields = SplitCsv(line);
+    const std::vector<std::string> fields = io::SplitCsvFields(line);
     if (fields.size() != num_fields) {
       throw InputError(InputErrorKind::kWrongColumnCount, path, lines.line_number(),
                        "expected " + std::to_string(num_fields) + " fields (t, x, y, theta, " +

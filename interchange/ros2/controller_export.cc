@@ -1,7 +1,6 @@
 #include "interchange/ros2/controller_export.h"
 
 #include <algorithm>
-#include <cstdio>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -16,6 +15,7 @@
 #include "models/model_registry.h"
 #include "models/mounted_model.h"
 #include "odometry/effects.h"
+#include "odometry/text_format.h"
 #include "validation/everyday_driving.h"
 #include "validation/training_runs.h"
 
@@ -242,11 +242,9 @@ ExportReplay ReplayExport(const std::string& logs, const std::string& calibratio
 
 std::string ExportReplay::WorseRefusal(bool has_notes) const {
   if (!Worse()) return "";
-  char text_worse[300];
-  std::snprintf(text_worse, sizeof text_worse, "CF %.6f > %.6f on %zu runs", cf_exported,
-                cf_nominal, runs);
-  const std::string what =
-      cf_exported > cf_nominal ? std::string(text_worse) : never_worse.refusals.front();
+  const std::string what = cf_exported > cf_nominal ? StrFormat("CF %.6f > %.6f on %zu runs",
+                                                                cf_exported, cf_nominal, runs)
+                                                    : never_worse.refusals.front();
   return "these parameters replay worse than the nominal robot (" + what +
          "); nothing written (--allow-worse writes them" +
          (has_notes ? ", with notes on what the controller leaves out: apply that first, e.g. a "

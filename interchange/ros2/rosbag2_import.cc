@@ -12,9 +12,9 @@
 #include "io/ros2_parameter_yaml.h"
 #include "io/rosbag2/static_transforms.h"
 #include "io/text_file.h"
-#include "io/yaml_scalar.h"
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
+#include "odometry/text_format.h"
 
 namespace fitcal {
 namespace {
@@ -130,12 +130,11 @@ std::vector<std::string> UnwrapWrappedWheels(const Robot& robot,
       const double raw = v[k * c + j];
       const double step = WrapAngle(raw - previous_raw);
       if (std::abs(step) > kMaxUnwrappedStepRad) {
-        char what[240];
-        std::snprintf(what, sizeof what,
-                      "joint \"%s\": positions wrapped to one turn with a step of %.3f rad "
+        throw InputError(
+            InputErrorKind::kBadValue, s->bag, 0,
+            StrFormat("joint \"%s\": positions wrapped to one turn with a step of %.3f rad "
                       "between messages at %.9f s: too fast to unwrap unambiguously",
-                      joint_names[j].c_str(), step, SecondsSinceStart(*s, s->joints.t_ns[k]));
-        throw InputError(InputErrorKind::kBadValue, s->bag, 0, what);
+                      joint_names[j].c_str(), step, SecondsSinceStart(*s, s->joints.t_ns[k])));
       }
       wraps += std::abs(raw - previous_raw) > M_PI;
       previous_raw = raw;
@@ -207,11 +206,10 @@ std::vector<IndexSpan> SpansFromTimes(const BagStreams& s, const ImportRosbag2Op
       span.last = k;
     }
     if (span.first >= span.last) {
-      char what[160];
-      std::snprintf(what, sizeof what,
-                    "run %g:%g s holds fewer than 2 encoder messages (the bag spans 0:%.3f s)", t0,
-                    t1, SecondsSinceStart(s, s.joints.t_ns.back()));
-      throw InputError(InputErrorKind::kTooFewSamples, s.bag, 0, what);
+      throw InputError(
+          InputErrorKind::kTooFewSamples, s.bag, 0,
+          StrFormat("run %g:%g s holds fewer than 2 encoder messages (the bag spans 0:%.3f s)", t0,
+                    t1, SecondsSinceStart(s, s.joints.t_ns.back())));
     }
     spans.push_back(span);
   }
@@ -306,12 +304,12 @@ void AddGroundTruthFrame(const ImportRosbag2Options& o, const Robot& robot, Rosb
   if (!mount.base_T_sensor) return;
   // Rounding of the 3-D composition (1e-17 m where a chain cancels) printed as the 0 it is.
   const auto clean = [](double v) { return std::abs(v) < 5e-13 ? 0.0 : v; };
-  char line[200];
-  std::snprintf(line, sizeof line, "ground_truth_frame: {x_m: %.9g, y_m: %.9g, yaw_deg: %.9g}\n",
+  imp->robot_yaml_addition =
+      "# the ground truth's frame in " + o.base_frame +
+      ", from the bag's /tf_static (fitcal import rosbag2)\n" +
+      StrFormat("ground_truth_frame: {x_m: %.9g, y_m: %.9g, yaw_deg: %.9g}\n",
                 clean(mount.base_T_sensor->x), clean(mount.base_T_sensor->y),
                 clean(mount.base_T_sensor->theta * 180.0 / M_PI));
-  imp->robot_yaml_addition = "# the ground truth's frame in " + o.base_frame +
-                             ", from the bag's /tf_static (fitcal import rosbag2)\n" + line;
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include "io/rosbag2/bag_reader.h"
 #include "io/rosbag2/errors.h"
 #include "io/rosbag2/ros_messages.h"
+#include "odometry/text_format.h"
 
 namespace fitcal::io::rosbag2 {
 namespace {
@@ -23,9 +24,7 @@ constexpr const char* kTfType = "tf2_msgs/msg/TFMessage";
 constexpr const char* kTfStaticTopic = "/tf_static";
 
 std::string Seconds(std::int64_t t_ns) {
-  char text[48];
-  std::snprintf(text, sizeof text, "%.9f s", static_cast<double>(t_ns) * 1e-9);
-  return text;
+  return StrFormat("%.9f s", static_cast<double>(t_ns) * 1e-9);
 }
 
 // tf2 ignores a leading '/' in frame ids (ROS 1 habit); so does the matching here.

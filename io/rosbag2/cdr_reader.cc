@@ -76,7 +76,6 @@ void CdrReader::ReadArray(T* out, std::size_t count) {
 bool CdrReader::Bool() { return Read<bool>(); }
 std::uint8_t CdrReader::Uint8() { return Read<std::uint8_t>(); }
 std::int8_t CdrReader::Int8() { return Read<std::int8_t>(); }
-char CdrReader::Char() { return Read<char>(); }
 std::int16_t CdrReader::Int16() { return Read<std::int16_t>(); }
 std::uint16_t CdrReader::Uint16() { return Read<std::uint16_t>(); }
 std::int32_t CdrReader::Int32() { return Read<std::int32_t>(); }

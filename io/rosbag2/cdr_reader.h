@@ -37,7 +37,6 @@ class CdrReader {
   bool Bool();
   std::uint8_t Uint8();
   std::int8_t Int8();
-  char Char();
   std::int16_t Int16();
   std::uint16_t Uint16();
   std::int32_t Int32();

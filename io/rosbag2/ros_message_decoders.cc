@@ -20,16 +20,10 @@ Header ReadHeader(CdrReader& cdr) {
   return header;
 }
 
-Point ReadPoint(CdrReader& cdr) {
-  Point p;
-  p.x = cdr.Float64();
-  p.y = cdr.Float64();
-  p.z = cdr.Float64();
-  return p;
-}
-
-Vector3 ReadVector3(CdrReader& cdr) {
-  Vector3 v;
+// geometry_msgs Point and Vector3: three float64 x, y, z.
+template <typename Xyz>
+Xyz ReadXyz(CdrReader& cdr) {
+  Xyz v;
   v.x = cdr.Float64();
   v.y = cdr.Float64();
   v.z = cdr.Float64();
@@ -47,7 +41,7 @@ Quaternion ReadQuaternion(CdrReader& cdr) {
 
 Pose ReadPose(CdrReader& cdr) {
   Pose pose;
-  pose.position = ReadPoint(cdr);
+  pose.position = ReadXyz<Point>(cdr);
   pose.orientation = ReadQuaternion(cdr);
   return pose;
 }
@@ -56,7 +50,7 @@ TransformStamped ReadTransformStamped(CdrReader& cdr) {
   TransformStamped t;
   t.header = ReadHeader(cdr);
   t.child_frame_id = cdr.String();
-  t.transform.translation = ReadVector3(cdr);
+  t.transform.translation = ReadXyz<Vector3>(cdr);
   t.transform.rotation = ReadQuaternion(cdr);
   return t;
 }
@@ -89,8 +83,8 @@ Odometry DecodeOdometry(ByteView payload, const std::string& what) {
   msg.child_frame_id = cdr.String();
   msg.pose.pose = ReadPose(cdr);
   cdr.Array(msg.pose.covariance.data(), msg.pose.covariance.size());
-  msg.twist.twist.linear = ReadVector3(cdr);
-  msg.twist.twist.angular = ReadVector3(cdr);
+  msg.twist.twist.linear = ReadXyz<Vector3>(cdr);
+  msg.twist.twist.angular = ReadXyz<Vector3>(cdr);
   cdr.Array(msg.twist.covariance.data(), msg.twist.covariance.size());
   return msg;
 }

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -12,6 +11,7 @@
 #include <map>
 
 #include "io/rosbag2/errors.h"
+#include "odometry/text_format.h"
 
 namespace fitcal::io::rosbag2 {
 namespace {
@@ -58,9 +58,7 @@ std::string ImmutableUri(const std::string& path) {
     if (std::isalnum(u) || std::strchr("/-._~", c) != nullptr) {
       uri += c;
     } else {
-      char hex[4];
-      std::snprintf(hex, sizeof hex, "%%%02X", u);
-      uri += hex;
+      uri += StrFormat("%%%02X", u);
     }
   }
   return uri + "?immutable=1";

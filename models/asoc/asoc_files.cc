@@ -3,7 +3,6 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
-#include <cstdio>
 #include <fstream>
 #include <set>
 
@@ -38,20 +37,10 @@ asoc::EncoderLog ReadAsocEncoderCsv(const std::string& path) {
   while (scanner.Next(&line) && Trim(line).empty()) {
   }
   if (Trim(line).empty()) throw InputError(InputErrorKind::kEmptyFile, path, 0, "file is empty");
-  {
-    std::string header;
-    std::size_t pos = 0;
-    while (pos <= line.size()) {
-      std::size_t end = line.find(',', pos);
-      if (end == std::string_view::npos) end = line.size();
-      header += (header.empty() ? "" : ",") + std::string(Trim(line.substr(pos, end - pos)));
-      pos = end + 1;
-    }
-    if (header != ExpectedHeader()) {
-      throw InputError(
-          InputErrorKind::kBadHeader, path, scanner.line_number(),
-          "header must be '" + ExpectedHeader() + "', found '" + std::string(line) + "'");
-    }
+  if (SplitCsvFields(line) != SplitCsvFields(ExpectedHeader())) {
+    throw InputError(
+        InputErrorKind::kBadHeader, path, scanner.line_number(),
+        "header must be '" + ExpectedHeader() + "', found '" + std::string(line) + "'");
   }
   asoc::EncoderLog log;
   while (scanner.Next(&line)) {
@@ -108,34 +97,12 @@ asoc::EncoderLog ReadAsocEncoderCsv(const std::string& path) {
   return log;
 }
 
-std::string AsocEncoderCsv(const asoc::EncoderLog& log) {
-  std::string out = ExpectedHeader() + "\n";
-  char line[400];
-  for (std::size_t k = 0; k < log.t_s.size(); ++k) {
-    const asoc::EncoderSample& s = log.samples[k];
-    const int n = std::snprintf(
-        line, sizeof line, "%.6f,%.12g,%.12g,%.12g,%.12g,%.12g,%.12g,%.12g,%.12g,%.12g\n",
-        log.t_s[k], s.wheel_rad[0][0], s.wheel_rad[0][1], s.wheel_rad[1][0], s.wheel_rad[1][1],
-        s.wheel_rad[2][0], s.wheel_rad[2][1], s.pivot_rad[0], s.pivot_rad[1], s.pivot_rad[2]);
-    out.append(line, static_cast<std::size_t>(n));
-  }
-  return out;
-}
-
 bool IsAsocEncoderCsv(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::string line;
   if (!std::getline(in, line)) return false;
   if (line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 byte order mark
-  std::string header;
-  std::size_t pos = 0;
-  while (pos <= line.size()) {
-    std::size_t end = line.find(',', pos);
-    if (end == std::string::npos) end = line.size();
-    header += (header.empty() ? "" : ",") + std::string(Trim(line.substr(pos, end - pos)));
-    pos = end + 1;
-  }
-  return header == ExpectedHeader();
+  return SplitCsvFields(line) == SplitCsvFields(ExpectedHeader());
 }
 
 namespace {

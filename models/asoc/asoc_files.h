@@ -54,7 +54,6 @@ struct EncoderLog {
 namespace fitcal::io {
 
 asoc::EncoderLog ReadAsocEncoderCsv(const std::string& path);
-std::string AsocEncoderCsv(const asoc::EncoderLog& log);
 // True when the file's first line is the ASOC encoder header above (read no further).
 bool IsAsocEncoderCsv(const std::string& path);
 // The log as the asoc model's channels (asoc::kChannelsPerCastor order), one sample per interval:

@@ -4,11 +4,6 @@
 
 namespace fitcal {
 
-std::string AsocOdometryOptions::Name() const {
-  return std::string(method == asoc::Method::kIpec ? "IPEC-" : "CAST-") +
-         std::to_string(excluded_castor);
-}
-
 bool AsocOdometryOptions::Parse(const std::string& name, AsocOdometryOptions* out) {
   if (name.size() != 6 || name[4] != '-' || name[5] < '0' || name[5] > '3') return false;
   const std::string kind = name.substr(0, 4);

@@ -79,7 +79,6 @@ struct AsocOdometryOptions {
   double consistency_tolerance_fraction = 0.1;
 
   asoc::CastorMask castors() const { return asoc::MaskExcluding(excluded_castor); }
-  std::string Name() const;  // "CAST-0", "IPEC-1"
   // Parses "CAST-i" (i = 0..3) or "IPEC-i" (i = 1..3); false otherwise.
   static bool Parse(const std::string& name, AsocOdometryOptions* out);
   bool IsValid(std::string* error) const;

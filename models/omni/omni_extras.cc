@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <numeric>
 #include <optional>
 #include <stdexcept>
@@ -12,6 +11,7 @@
 #include "models/omni/omni_model.h"
 #include "models/omni/omni_trajectories.h"
 #include "odometry/pose2.h"
+#include "odometry/text_format.h"
 
 namespace fitcal {
 
@@ -113,12 +113,10 @@ void MecanumParameters(const CalibratedRobot& c, const std::string&, ControllerE
              &out->notes);
   const double worst_drive = *std::max_element(drives.begin(), drives.end());
   if (worst_drive > kSameAngleRad) {
-    char text[200];
-    std::snprintf(text, sizeof text,
-                  "mecanum_drive_controller drives every wheel straight ahead: "
+    out->notes.push_back(
+        StrFormat("mecanum_drive_controller drives every wheel straight ahead: "
                   "calibrated drive directions up to %.4g deg off it are written as 0",
-                  worst_drive / kDeg);
-    out->notes.push_back(text);
+                  worst_drive / kDeg));
   }
   for (int k = 0; k < 4; ++k) {
     out->parameters_yaml += std::string("    ") + kCorners[k].key + "_wheel_command_joint_name: " +
@@ -228,12 +226,10 @@ void OmniWheelParameters(const CalibratedRobot& c, OmniWheelReplay replay, Contr
   NoteSpread(radii, "radius", "wheel_radius", 1.0, "m", &out->notes);
   NoteSpread(distances, "distance", "robot_radius", 1.0, "m", &out->notes);
   if (worst > kSameAngleRad) {
-    char text[200];
-    std::snprintf(text, sizeof text,
-                  "omni_wheel_drive_controller spaces the wheels equally (%.4g "
+    out->notes.push_back(
+        StrFormat("omni_wheel_drive_controller spaces the wheels equally (%.4g "
                   "deg apart): the calibrated wheel angles are up to %.4g deg off that",
-                  360.0 / n, worst / kDeg);
-    out->notes.push_back(text);
+                  360.0 / n, worst / kDeg));
   }
   if (sense > 0) {
     out->notes.push_back(

@@ -1,7 +1,6 @@
 #include "models/tricycle/tricycle_extras.h"
 
 #include <cmath>
-#include <cstdio>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -11,6 +10,7 @@
 #include "io/yaml_scalar.h"
 #include "models/tricycle/tricycle_kinematics.h"
 #include "models/tricycle/tricycle_trajectories.h"
+#include "odometry/text_format.h"
 
 namespace fitcal {
 
@@ -33,14 +33,12 @@ void TricycleParameters(const CalibratedRobot& c, const std::string&, Controller
     // reads the steering joint's state as the true angle, so the joint must report phi_0 more:
     // ros2_control's SimpleTransmission computes joint = actuator / reduction + offset, which
     // also shifts the commands the same way.
-    char text[400];
-    std::snprintf(text, sizeof text,
-                  "tricycle_controller has no steering offset: add %+.9g rad (%+.6f deg) to "
+    out->notes.push_back(
+        StrFormat("tricycle_controller has no steering offset: add %+.9g rad (%+.6f deg) to "
                   "the steering joint '%s' position (true steering = measured %+.6f deg), e.g. "
                   "<offset>%.9g</offset> in its SimpleTransmission <joint> in the URDF "
                   "(joint = actuator / reduction + offset), or zero the steering encoder there",
-                  offset_rad, offset_rad / kDeg, steering.c_str(), offset_rad / kDeg, offset_rad);
-    out->notes.push_back(text);
+                  offset_rad, offset_rad / kDeg, steering.c_str(), offset_rad / kDeg, offset_rad));
   }
   out->parameters_yaml += "    traction_joint_name: " + io::YamlDoubleQuoted(traction) +
                           "\n    steering_joint_name: " + io::YamlDoubleQuoted(steering) +
@@ -55,14 +53,12 @@ void TricycleParameters(const CalibratedRobot& c, const std::string&, Controller
   if (const std::optional<int> k_gain = ParameterIndex(c.robot(), "steering_gain")) {
     // Wheel angle = k x measured + phi_0 (tricycle_kinematics.h T3). The controller reads the
     // steering joint as the wheel's angle; a SimpleTransmission's joint = actuator / reduction.
-    char text[400];
-    std::snprintf(text, sizeof text,
-                  "tricycle_controller has no steering gain: the steering joint '%s' must report "
+    out->notes.push_back(
+        StrFormat("tricycle_controller has no steering gain: the steering joint '%s' must report "
                   "%.9g times the measured angle, e.g. <mechanicalReduction>%.9g"
                   "</mechanicalReduction> in its SimpleTransmission (joint = actuator / "
                   "reduction), before the offset above",
-                  steering.c_str(), p[*k_gain], 1.0 / p[*k_gain]);
-    out->notes.push_back(text);
+                  steering.c_str(), p[*k_gain], 1.0 / p[*k_gain]));
     out->parameters[*k_gain] = 1.0;
   }
 }
