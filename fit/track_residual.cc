@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <stdexcept>
+#include <type_traits>
 #include <utility>
 
 #include "fit/segment_cost.h"
@@ -178,35 +179,54 @@ ceres::CostFunction* TrackResidual::Create(const TrackCheckpoints& track,
   return new TrackResidual(track, model, weights, options);
 }
 
-Pose2<TrackResidual::ErrorJet> TrackResidual::GroundTruthAtStart(double dt_s) const {
-  return InterpolateGroundTruth(*track_.ground_truth, ErrorJet(track_.t_start_s + dt_s, 3));
+namespace {
+
+// A variable of the checkpoint residual: a Jet with derivative 1 in dimension `dimension`, or
+// the plain value on double.
+template <typename T>
+T Variable(double value, int dimension) {
+  if constexpr (std::is_same_v<T, double>) {
+    return value;
+  } else {
+    return T(value, dimension);
+  }
 }
 
-// r_k of the header for the odometry poses `pose` (3 per checkpoint), as Jets in (P_k, dt).
-std::array<TrackResidual::ErrorJet, 3> TrackResidual::CheckpointResidual(
-    const std::vector<double>& pose, int k, const Pose2<ErrorJet>& q0, double dt_s) const {
+}  // namespace
+
+template <typename T>
+Pose2<T> TrackResidual::GroundTruthAtStart(double dt_s) const {
+  return InterpolateGroundTruth(*track_.ground_truth, Variable<T>(track_.t_start_s + dt_s, 3));
+}
+
+// r_k of the header for the odometry poses `pose` (3 per checkpoint), as Jets in (P_k, dt), or
+// its value on double (the Jets' value parts: the same operations on the same numbers).
+template <typename T>
+std::array<T, 3> TrackResidual::CheckpointResidual(const std::vector<double>& pose, int k,
+                                                   const Pose2<T>& q0, double dt_s) const {
   using std::cos;
   using std::sin;
-  const Pose2<ErrorJet> p{ErrorJet(pose[3 * k], 0), ErrorJet(pose[3 * k + 1], 1),
-                          ErrorJet(pose[3 * k + 2], 2)};
-  const Pose2<ErrorJet> q =
-      Between(q0, InterpolateGroundTruth(*track_.ground_truth, ErrorJet(track_.t_s[k] + dt_s, 3)));
+  const Pose2<T> p{Variable<T>(pose[3 * k], 0), Variable<T>(pose[3 * k + 1], 1),
+                   Variable<T>(pose[3 * k + 2], 2)};
+  const Pose2<T> q = Between(
+      q0, InterpolateGroundTruth(*track_.ground_truth, Variable<T>(track_.t_s[k] + dt_s, 3)));
   const double inv_xy = 1.0 / weights_.position_sigma_m;
   const double inv_th = 1.0 / weights_.heading_sigma_rad;
-  const ErrorJet cq = cos(q.theta), sq = sin(q.theta);
-  const ErrorJet ex = p.x - q.x, ey = p.y - q.y;
-  ErrorJet heading_error = p.theta - q.theta;
+  const T cq = cos(q.theta), sq = sin(q.theta);
+  const T ex = p.x - q.x, ey = p.y - q.y;
+  T heading_error = p.theta - q.theta;
   if (heading_ == TrackHeading::kIncrements && k > 0) {
     // Minus the same error at checkpoint k - 1: the odometry's heading there (Jet dimension 4)
     // against the ground truth's.
-    const ErrorJet p_before(pose[3 * (k - 1) + 2], 4);
-    const Pose2<ErrorJet> q_before = Between(
-        q0, InterpolateGroundTruth(*track_.ground_truth, ErrorJet(track_.t_s[k - 1] + dt_s, 3)));
+    const T p_before = Variable<T>(pose[3 * (k - 1) + 2], 4);
+    const Pose2<T> q_before = Between(
+        q0,
+        InterpolateGroundTruth(*track_.ground_truth, Variable<T>(track_.t_s[k - 1] + dt_s, 3)));
     heading_error = heading_error - (p_before - q_before.theta);
   }
-  const ErrorJet e[3] = {(cq * ex + sq * ey) * inv_xy, (-sq * ex + cq * ey) * inv_xy,
-                         WrapAngle(heading_error) * inv_th};
-  const ErrorJet factor =
+  const T e[3] = {(cq * ex + sq * ey) * inv_xy, (-sq * ex + cq * ey) * inv_xy,
+                  WrapAngle(heading_error) * inv_th};
+  const T factor =
       run_weight_ * HuberFactor(e[0] * e[0] + e[1] * e[1] + e[2] * e[2], huber_scale_);
   return {factor * e[0], factor * e[1], factor * e[2]};
 }
@@ -219,10 +239,10 @@ std::vector<double> TrackResidual::OdometryFromStart(const double* p) const {
 }
 
 double TrackResidual::SquaredNormAt(const std::vector<double>& pose, double dt_s) const {
-  const Pose2<ErrorJet> q0 = GroundTruthAtStart(dt_s);
+  const Pose2d q0 = GroundTruthAtStart<double>(dt_s);
   double sum = 0.0;
   for (int k = 0; k < num_residuals() / 3; ++k) {
-    for (const ErrorJet& r : CheckpointResidual(pose, k, q0, dt_s)) sum += r.a * r.a;
+    for (const double r : CheckpointResidual(pose, k, q0, dt_s)) sum += r * r;
   }
   return sum;
 }
@@ -240,7 +260,7 @@ bool TrackResidual::Evaluate(double const* const* parameters, double* residuals,
     return false;
   }
   const double dt_s = parameters[1][0];
-  const Pose2<ErrorJet> q0 = GroundTruthAtStart(dt_s);
+  const Pose2<ErrorJet> q0 = GroundTruthAtStart<ErrorJet>(dt_s);
   for (int k = 0; k < m / 3; ++k) {
     const std::array<ErrorJet, 3> rk = CheckpointResidual(pose, k, q0, dt_s);
     for (int i = 0; i < 3; ++i) {

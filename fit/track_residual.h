@@ -135,10 +135,13 @@ class TrackResidual : public ceres::CostFunction {
  private:
   // Jet dimensions: the odometry pose (x, y, theta), the clock offset, and the odometry's heading
   // at the checkpoint before (TrackHeading::kIncrements).
+  // On double where no derivative is wanted (the search over dt): the same values.
   using ErrorJet = ceres::Jet<double, 5>;
-  Pose2<ErrorJet> GroundTruthAtStart(double dt_s) const;
-  std::array<ErrorJet, 3> CheckpointResidual(const std::vector<double>& pose, int k,
-                                             const Pose2<ErrorJet>& q0, double dt_s) const;
+  template <typename T>
+  Pose2<T> GroundTruthAtStart(double dt_s) const;
+  template <typename T>
+  std::array<T, 3> CheckpointResidual(const std::vector<double>& pose, int k, const Pose2<T>& q0,
+                                      double dt_s) const;
 
   TrackResidual(const TrackCheckpoints& track, const RobotModelInterface& model,
                 const ResidualWeights& weights, const TrackResidualOptions& options);

@@ -59,39 +59,67 @@ namespace final_pose_jacobian_internal {
 template <int P>
 using Row = std::array<double, P>;
 
-// Accumulates dx_N/dp, dy_N/dp, dtheta_N/dp with a Jet of each body step (kPerSampleStep).
+// Whether K writes its body step's Jacobian by hand:
+// K::StepJacobian(p, values, dt, dx, dy, g[3][P]), (dx, dy) the step BodyStep made.
+template <class K, class = void>
+struct HasStepJacobian : std::false_type {};
+template <class K>
+struct HasStepJacobian<
+    K, std::void_t<decltype(K::StepJacobian(static_cast<const double*>(nullptr),
+                                            static_cast<const double*>(nullptr), 0.0, 0.0, 0.0,
+                                            static_cast<double (*)[K::kNumParameters]>(nullptr)))>>
+    : std::true_type {};
+
+// Accumulates dx_N/dp, dy_N/dp, dtheta_N/dp with each body step's Jacobian G_k (kPerSampleStep):
+// K's StepJacobian where it has one, else a Jet of the body step.
 template <class K, typename Prepared>
 class PerSampleSums : public StepVisitor {
  public:
   static constexpr int P = K::kNumParameters;
   using JetP = ceres::Jet<double, P>;
 
-  PerSampleSums(const K& kinematics, const Prepared& prepared_jet, const EncoderSamples& samples)
+  PerSampleSums(const K& kinematics, const double* p, const Prepared& prepared_jet,
+                const EncoderSamples& samples)
       : kinematics_(kinematics),
+        p_(p),
         prepared_jet_(prepared_jet),
         rows_(samples.data()),
         stride_(static_cast<std::size_t>(samples.stride())) {}
 
+  // The sums run in local copies, as ChannelSums' (members would stay in memory).
   void Steps(std::size_t k0, std::size_t m, const double* c, const double* s, const double* dx,
              const double* dy, const double* /*dtheta*/) {
+    Row<P> l_d_x = d_x, l_d_y = d_y, l_d_theta = d_theta;
     for (std::size_t j = 0; j < m; ++j) {
       const double* row = rows_ + (k0 + j) * stride_;
-      JetP gx, gy, gt;
-      kinematics_.BodyStep(prepared_jet_, row + 1, row[0], &gx, &gy, &gt);
+      double g[3][P];
+      StepJacobian(row, dx[j], dy[j], g);
       const double world_dx = c[j] * dx[j] - s[j] * dy[j];
       const double world_dy = s[j] * dx[j] + c[j] * dy[j];
       for (int i = 0; i < P; ++i) {
-        d_x[i] += c[j] * gx.v[i] - s[j] * gy.v[i] - world_dy * d_theta[i];
-        d_y[i] += s[j] * gx.v[i] + c[j] * gy.v[i] + world_dx * d_theta[i];
-        d_theta[i] += gt.v[i];
+        l_d_x[i] += c[j] * g[0][i] - s[j] * g[1][i] - world_dy * l_d_theta[i];
+        l_d_y[i] += s[j] * g[0][i] + c[j] * g[1][i] + world_dx * l_d_theta[i];
+        l_d_theta[i] += g[2][i];
       }
     }
+    d_x = l_d_x, d_y = l_d_y, d_theta = l_d_theta;
   }
 
   Row<P> d_x{}, d_y{}, d_theta{};  // derivatives of the pose after the last visited step
 
  private:
+  void StepJacobian(const double* row, double dx, double dy, double g[3][P]) const {
+    if constexpr (HasStepJacobian<K>::value) {
+      kinematics_.StepJacobian(p_, row + 1, row[0], dx, dy, g);
+    } else {
+      JetP gx, gy, gt;
+      kinematics_.BodyStep(prepared_jet_, row + 1, row[0], &gx, &gy, &gt);
+      for (int i = 0; i < P; ++i) g[0][i] = gx.v[i], g[1][i] = gy.v[i], g[2][i] = gt.v[i];
+    }
+  }
+
   const K& kinematics_;
+  const double* p_;
   const Prepared& prepared_jet_;
   const double* rows_;
   std::size_t stride_;
@@ -132,6 +160,41 @@ class ChannelSums : public StepVisitor {
   const double* rows_;
   std::size_t stride_;
 };
+
+// Column i of M and of dM/dp (kLinearInChannels): the step of a unit rate on channel i over 1 s
+// (the step is linear in the rates, so this is exact).
+template <int N, class K, typename Prepared>
+auto StepMatrixJets(const K& kinematics, const Prepared& prepared_jet) {
+  using JetP = ceres::Jet<double, K::kNumParameters>;
+  std::array<std::array<JetP, 3>, N> m;
+  for (int i = 0; i < N; ++i) {
+    std::array<double, N> unit{};
+    unit[i] = 1.0;
+    kinematics.BodyStep(prepared_jet, unit.data(), 1.0, &m[i][0], &m[i][1], &m[i][2]);
+  }
+  return m;
+}
+
+// dx/dp, dy/dp, dtheta/dp of the pose after the samples `sums` visited (kLinearInChannels, the
+// header's sums over the channels).
+// m is StepMatrixJets' result.
+template <int P, int N, typename StepMatrix>
+std::array<Row<P>, 3> PoseDerivatives(const StepMatrix& m, const ChannelSums<N>& sums) {
+  std::array<Row<P>, 3> d;
+  for (int j = 0; j < P; ++j) {
+    double dx = 0.0, dy = 0.0, dtheta = 0.0;
+    for (int i = 0; i < N; ++i) {
+      const double mx = m[i][0].v[j], my = m[i][1].v[j], mt = m[i][2].v[j];
+      dx += mx * sums.a_c[i] - my * sums.a_s[i] - mt * sums.b_y[i];
+      dy += mx * sums.a_s[i] + my * sums.a_c[i] + mt * sums.b_x[i];
+      dtheta += mt * sums.w[i];
+    }
+    d[0][j] = dx;
+    d[1][j] = dy;
+    d[2][j] = dtheta;
+  }
+  return d;
+}
 
 }  // namespace final_pose_jacobian_internal
 
@@ -176,36 +239,18 @@ class FinalPoseJacobianCost final : public ceres::SizedCostFunction<3, K::kNumPa
     const std::size_t n = run_.samples.size();
     if constexpr (kKind == FinalPoseJacobianKind::kPerSampleStep) {
       final_pose_jacobian_internal::PerSampleSums<K, decltype(prepared_jet)> sums(
-          kinematics_, prepared_jet, run_.samples);
+          kinematics_, p, prepared_jet, run_.samples);
       const Pose2d final_pose =
           ReplayKinematics(kinematics_, p, run_.samples, 0, n, run_.start, sums);
       *d = {sums.d_x, sums.d_y, sums.d_theta};
       return final_pose;
     } else {
       constexpr int N = K::kNumChannels;
-      // Column i of M and of dM/dp: the step of a unit rate on channel i over 1 s (the step is
-      // linear in the rates, so this is exact).
-      std::array<std::array<JetP, 3>, N> m;
-      for (int i = 0; i < N; ++i) {
-        std::array<double, N> unit{};
-        unit[i] = 1.0;
-        kinematics_.BodyStep(prepared_jet, unit.data(), 1.0, &m[i][0], &m[i][1], &m[i][2]);
-      }
+      const auto m = final_pose_jacobian_internal::StepMatrixJets<N>(kinematics_, prepared_jet);
       final_pose_jacobian_internal::ChannelSums<N> sums(run_.samples);
       const Pose2d final_pose =
           ReplayKinematics(kinematics_, p, run_.samples, 0, n, run_.start, sums);
-      for (int j = 0; j < P; ++j) {
-        double dx = 0.0, dy = 0.0, dtheta = 0.0;
-        for (int i = 0; i < N; ++i) {
-          const double mx = m[i][0].v[j], my = m[i][1].v[j], mt = m[i][2].v[j];
-          dx += mx * sums.a_c[i] - my * sums.a_s[i] - mt * sums.b_y[i];
-          dy += mx * sums.a_s[i] + my * sums.a_c[i] + mt * sums.b_x[i];
-          dtheta += mt * sums.w[i];
-        }
-        (*d)[0][j] = dx;
-        (*d)[1][j] = dy;
-        (*d)[2][j] = dtheta;
-      }
+      *d = final_pose_jacobian_internal::PoseDerivatives<P>(m, sums);
       return final_pose;
     }
   }

@@ -40,6 +40,7 @@
 #include "models/model_interface.h"
 #include "models/pose_errors.h"
 #include "models/replay_kinematics.h"
+#include "models/segment_jacobian.h"
 #include "odometry/aligned_run.h"
 #include "odometry/replay.h"
 
@@ -75,20 +76,19 @@ class ModelFinalPoseResidual {
 };
 
 // Segment residuals (models/pose_errors.h) of one run for the kinematics K: the run is replayed once
-// from the identity, keeping the pose at every window start and end.
+// from the identity, keeping the pose at every window start and end. Autodiff through the whole
+// replay: SegmentCost's for kinematics without an analytic Jacobian, and the reference the
+// analytic SegmentJacobianCost (segment_jacobian.h) is tested against.
 template <class K>
 class ModelSegmentResidual {
  public:
   ModelSegmentResidual(const AlignedRun& run, const std::vector<Segment>& segments,
                        const ResidualWeights& weights, const K& kinematics = K())
-      : run_(run), segments_(segments), weights_(weights), kinematics_(kinematics) {
-    for (const Segment& s : segments_) {
-      marks_.push_back(s.begin);
-      marks_.push_back(s.end);
-    }
-    std::sort(marks_.begin(), marks_.end());
-    marks_.erase(std::unique(marks_.begin(), marks_.end()), marks_.end());
-  }
+      : run_(run),
+        segments_(segments),
+        weights_(weights),
+        kinematics_(kinematics),
+        marks_(SegmentMarks(segments)) {}
 
   int NumResiduals() const { return 3 * static_cast<int>(segments_.size()); }
 
@@ -179,7 +179,11 @@ class KinematicModel : public RobotModelInterface {
   ceres::CostFunction* SegmentCost(const AlignedRun& run, const std::vector<Segment>& segments,
                                    const ResidualWeights& weights) const override {
     CheckChannels(run.samples);
-    return ModelSegmentResidual<K>::Create(run, segments, weights, kinematics_);
+    if constexpr (FinalPoseJacobianKindOf<K>::value == FinalPoseJacobianKind::kAutodiff) {
+      return ModelSegmentResidual<K>::Create(run, segments, weights, kinematics_);
+    } else {
+      return new SegmentJacobianCost<K>(run, segments, weights, kinematics_);
+    }
   }
 
   // The body step reads robot().NumChannels() values per row: samples of another width would be

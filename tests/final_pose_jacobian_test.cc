@@ -32,6 +32,7 @@
 #include "models/model_registry.h"
 #include "models/omni/omni_kinematics.h"
 #include "models/omni3/omni3_kinematics.h"
+#include "models/segment_jacobian.h"
 #include "odometry/aligned_run.h"
 #include "odometry/sin_cos.h"
 
@@ -206,6 +207,129 @@ TEST(FinalPoseJacobian, DiffDriveRightWheelFirst) {
 TEST(FinalPoseJacobian, DiffDriveLeftWheelFirst) {
   CheckModel<DiffDriveKinematicsT<1>>(kDiffDriveLeftFirstYaml,
                                       FinalPoseJacobianKind::kPerSampleStep);
+}
+
+// The analytic segment cost (models/segment_jacobian.h) against the autodiff ModelSegmentResidual
+// it replaces in SegmentCost, on the same runs, at the nominal and at seeded random parameters
+// inside the bounds: the track residual's windows [0, k] every 300 samples and at the end (the
+// first at 0, an empty window), and overlapping windows that do not start at 0 (the segment
+// fit's). Same tolerance as above: the poses are the plain replay's (paired samples) against the
+// Jets' one at a time, so residuals agree to rounding, Jacobians to 1e-9 of the row's largest entry.
+double ExpectSameSegmentCost(const ceres::CostFunction& analytic,
+                             const ceres::CostFunction& autodiff, const std::vector<double>& p) {
+  const int m = analytic.num_residuals();
+  const int np = static_cast<int>(p.size());
+  EXPECT_EQ(m, autodiff.num_residuals());
+  std::vector<double> r_a(m), r_d(m), r_plain(m), j_a(m * np), j_d(m * np);
+  const double* params[] = {p.data()};
+  double* jac_a[] = {j_a.data()};
+  double* jac_d[] = {j_d.data()};
+  EXPECT_TRUE(analytic.Evaluate(params, r_a.data(), jac_a));
+  EXPECT_TRUE(autodiff.Evaluate(params, r_d.data(), jac_d));
+  EXPECT_TRUE(analytic.Evaluate(params, r_plain.data(), nullptr));
+  double worst = 0.0;
+  for (int r = 0; r < m; ++r) {
+    EXPECT_EQ(r_a[r], r_plain[r]) << "row " << r;  // both the plain replay's poses
+    EXPECT_NEAR(r_a[r], r_d[r], kRelativeTolerance * std::max(1.0, std::abs(r_d[r])));
+    double row_max = 0.0;
+    for (int j = 0; j < np; ++j) row_max = std::max(row_max, std::abs(j_d[r * np + j]));
+    if (row_max == 0.0) {  // an empty window: no derivative on either path
+      for (int j = 0; j < np; ++j) EXPECT_EQ(j_a[r * np + j], 0.0) << "row " << r;
+      continue;
+    }
+    for (int j = 0; j < np; ++j) {
+      const double diff = std::abs(j_a[r * np + j] - j_d[r * np + j]) / row_max;
+      worst = std::max(worst, diff);
+      EXPECT_LT(diff, kRelativeTolerance) << "d r" << r << " / d p" << j << ": analytic "
+                                          << j_a[r * np + j] << ", autodiff " << j_d[r * np + j];
+    }
+  }
+  return worst;
+}
+
+// Windows [0, k] every `step` samples and at the end, ground truth the replay at `p_truth` moved
+// a little; and windows [k, k + 2 step] every step.
+std::vector<std::vector<Segment>> SegmentSets(const RobotModelInterface& model,
+                                              const AlignedRun& run,
+                                              const std::vector<double>& p_truth) {
+  const std::size_t n = run.samples.size();
+  const std::size_t step = 300;
+  std::vector<Pose2d> pose_at(n + 1);
+  pose_at[0] = Pose2d{0.0, 0.0, 0.0};
+  model.Replay(p_truth.data(), run.samples, 0, n, pose_at[0],
+               [&pose_at](std::size_t k, const Pose2d& pose) { pose_at[k + 1] = pose; });
+  const auto window = [&](std::size_t begin, std::size_t end) {
+    const Pose2d& a = pose_at[begin];
+    const Pose2d& b = pose_at[end];
+    const double c = std::cos(a.theta), s = std::sin(a.theta);
+    const double dx = b.x - a.x, dy = b.y - a.y;
+    return Segment{begin, end, Pose2d{c * dx + s * dy + 0.01, -s * dx + c * dy - 0.005,
+                                      b.theta - a.theta + 0.02}};
+  };
+  std::vector<Segment> from_start, overlapping;
+  for (std::size_t k = 0; k < n; k += step) from_start.push_back(window(0, k));
+  from_start.push_back(window(0, n));
+  for (std::size_t k = step / 2; k + 2 * step <= n; k += step) {
+    overlapping.push_back(window(k, k + 2 * step));
+  }
+  return {from_start, overlapping};
+}
+
+template <class K>
+void CheckSegmentCost(const std::string& yaml) {
+  const RobotModelPtr model = ReadRobotModel(YAML::Load(yaml), "test robot");
+  const auto* kinematic = dynamic_cast<const KinematicModel<K>*>(model.get());
+  ASSERT_NE(kinematic, nullptr) << "unexpected kinematics for " << model->robot().name;
+  const Robot& robot = model->robot();
+  std::mt19937_64 rng(47);
+  std::vector<std::vector<double>> points = {robot.nominal};
+  for (int t = 0; t < 3; ++t) {
+    std::vector<double> p = robot.nominal;
+    for (int k = 0; k < robot.NumParameters(); ++k) {
+      std::uniform_real_distribution<double> inside(robot.bounds[k].lo, robot.bounds[k].hi);
+      p[k] = inside(rng);
+    }
+    points.push_back(p);
+  }
+  std::vector<AlignedRun> runs = SimulatedRuns(*model);
+  runs.push_back(RealLikeRun(*model, 9, 4000));
+  runs.push_back(RealLikeRun(*model, 10, 11500));
+  double worst = 0.0;
+  for (const AlignedRun& run : runs) {
+    SCOPED_TRACE(run.id);
+    for (const std::vector<Segment>& segments : SegmentSets(*model, run, points.back())) {
+      for (const ResidualWeights& weights : {ResidualWeights{}, ResidualWeights{0.02, 0.05}}) {
+        std::unique_ptr<ceres::CostFunction> analytic(model->SegmentCost(run, segments, weights));
+        ASSERT_NE(dynamic_cast<const SegmentJacobianCost<K>*>(analytic.get()), nullptr);
+        std::unique_ptr<ceres::CostFunction> autodiff(
+            ModelSegmentResidual<K>::Create(run, segments, weights, kinematic->kinematics()));
+        for (const std::vector<double>& p : points) {
+          worst = std::max(worst, ExpectSameSegmentCost(*analytic, *autodiff, p));
+        }
+      }
+    }
+  }
+  char worst_text[32];
+  std::snprintf(worst_text, sizeof(worst_text), "%.3g", worst);
+  ::testing::Test::RecordProperty("worst_relative_jacobian_difference", worst_text);
+}
+
+TEST(SegmentJacobian, Omni3PalacinModel) {
+  CheckSegmentCost<Omni3Kinematics>(FindModel("omni3")->example_yaml);
+}
+
+TEST(SegmentJacobian, OmniThreeWheels) { CheckSegmentCost<OmniKinematics<3>>(kOmni3WheelYaml); }
+
+TEST(SegmentJacobian, OmniFourMecanumWheels) {
+  CheckSegmentCost<OmniKinematics<4>>(kMecanumYaml);
+}
+
+TEST(SegmentJacobian, DiffDriveRightWheelFirst) {
+  CheckSegmentCost<DiffDriveKinematicsT<0>>(FindModel("diff_drive")->example_yaml);
+}
+
+TEST(SegmentJacobian, DiffDriveLeftWheelFirst) {
+  CheckSegmentCost<DiffDriveKinematicsT<1>>(kDiffDriveLeftFirstYaml);
 }
 
 // odometry/sin_cos.h: the steps' sine and cosine from one libm call are ceres' sin(Jet) and

@@ -101,6 +101,10 @@ FITCAL_FIT_BENCHMARK(tricyc_auto, "tricyc", "");
 FITCAL_FIT_BENCHMARK(tricyc_single, "tricyc", "--residuals track --track-heading from-start");
 FITCAL_FIT_BENCHMARK(omni3_auto, "omni3", "");
 FITCAL_FIT_BENCHMARK(omni3_single, "omni3", "--residuals track --track-heading from-start");
+// Issue 40's other speed target: the 97-run diff drive fit with clock offsets, every run trained
+// (judged on held-out halves), <= 1 s CPU.
+FITCAL_FIT_BENCHMARK(diff_reps_1_99_clock_offsets, "diff",
+                     "--train-reps 1-99 --clock-offsets session");
 
 }  // namespace
 }  // namespace fitcal
