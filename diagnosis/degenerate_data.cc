@@ -6,7 +6,7 @@
 #include <sstream>
 #include <utility>
 
-#include "validation/statistics.h"
+#include "fit/statistics.h"
 
 namespace fitcal {
 

@@ -7,8 +7,8 @@
 #include <string>
 #include <tuple>
 
+#include "fit/statistics.h"
 #include "io/input_error.h"
-#include "validation/statistics.h"
 
 namespace fitcal {
 namespace {
