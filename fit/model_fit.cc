@@ -355,20 +355,22 @@ void AddHeldDirectionsCovariance(const Robot& robot, const HeldDirections& holds
   result->covariance += result->held_directions_covariance;
 }
 
-// One run's track errors at the solution for the random-walk covariance (fit/serial_covariance.h).
+// One run's track errors at the solution for the random-walk covariance (fit/serial_covariance.h),
+// weighed as the fit weighed them (`weights`: TrackWeightsOf), so that the sandwich's bread and
+// meat are those of the objective that was minimised.
 TrackErrorChain TrackChainOf(const TrackCheckpoints& track, const RobotModelInterface& model,
-                             const ModelFitOptions& options, const std::vector<double>& p,
-                             double offset_s, int offset_column, int m) {
+                             const ModelFitOptions& options, const ResidualWeights& weights,
+                             const std::vector<double>& p, double offset_s, int offset_column,
+                             int m) {
   const std::unique_ptr<TrackResidual> cost(static_cast<TrackResidual*>(
-      TrackResidual::Create(track, model, options.ceres.weights, options.track->options)));
+      TrackResidual::Create(track, model, weights, options.track->options)));
   const EvaluatedBlock block =
       EvaluateBlock(*cost, {p.data(), &offset_s}, {0, offset_column}, m);
   TrackErrorChain chain;
   if (block.jacobian.size() == 0) return chain;
   const std::vector<double> pose = cost->OdometryFromStart(p.data());
-  const Eigen::Vector3d w(1.0 / options.ceres.weights.position_sigma_m,
-                          1.0 / options.ceres.weights.position_sigma_m,
-                          1.0 / options.ceres.weights.heading_sigma_rad);
+  const Eigen::Vector3d w(1.0 / weights.position_sigma_m, 1.0 / weights.position_sigma_m,
+                          1.0 / weights.heading_sigma_rad);
   for (std::size_t k = 0; k < track.segments.size(); ++k) {
     const Pose2d q = GroundTruthFromStart(track, k, offset_s);
     const double c = std::cos(q.theta), s = std::sin(q.theta);
@@ -407,7 +409,7 @@ void TrackSandwichCovariance(const std::vector<AlignedRun>& training,
     const TrackCheckpoints& track = options.track->runs[i];
     if (options.residuals == ResidualKind::kBoth) {
       const std::unique_ptr<ceres::CostFunction> cost(
-          model.FinalPoseCost(training[i], options.ceres.weights));
+          model.FinalPoseCost(training[i], FinalPoseWeightsOf(options, i)));
       const EvaluatedBlock block = EvaluateBlock(*cost, {p.data()}, {0}, m);
       if (block.jacobian.size() > 0) {
         final_pose_information += block.jacobian.transpose() * block.jacobian;
@@ -417,7 +419,7 @@ void TrackSandwichCovariance(const std::vector<AlignedRun>& training,
     }
     if (track.segments.empty()) continue;
     const int column = num_offsets > 0 ? n + track.clock_group : -1;
-    chains.push_back(TrackChainOf(track, model, options, p,
+    chains.push_back(TrackChainOf(track, model, options, TrackWeightsOf(options, i), p,
                                   result->clock_offsets_s[track.clock_group], column, m));
     for (const Eigen::MatrixXd& j : chains.back().jacobian) information += j.transpose() * j;
   }
