@@ -106,8 +106,8 @@ class ModelSegmentResidual {
     }
     for (std::size_t k = 0; k < segments_.size(); ++k) {
       const Segment& s = segments_[k];
-      SegmentError(at_mark[IndexOf(s.begin)], at_mark[IndexOf(s.end)], s.ground_truth_start_T_end,
-                   weights_, residual + 3 * k);
+      SegmentError(at_mark[MarkIndex(marks_, s.begin)], at_mark[MarkIndex(marks_, s.end)],
+                   s.ground_truth_start_T_end, weights_, residual + 3 * k);
     }
     return true;
   }
@@ -120,11 +120,6 @@ class ModelSegmentResidual {
   }
 
  private:
-  std::size_t IndexOf(std::size_t mark) const {
-    return static_cast<std::size_t>(std::lower_bound(marks_.begin(), marks_.end(), mark) -
-                                    marks_.begin());
-  }
-
   const AlignedRun& run_;
   const std::vector<Segment>& segments_;
   ResidualWeights weights_;

@@ -46,6 +46,12 @@ inline std::vector<std::size_t> SegmentMarks(const std::vector<Segment>& segment
   return marks;
 }
 
+// Where `mark` (a window start or end) stands in SegmentMarks' list.
+inline std::size_t MarkIndex(const std::vector<std::size_t>& marks, std::size_t mark) {
+  return static_cast<std::size_t>(std::lower_bound(marks.begin(), marks.end(), mark) -
+                                  marks.begin());
+}
+
 template <class K>
 class SegmentJacobianCost final : public ceres::CostFunction {
  public:
@@ -80,7 +86,7 @@ class SegmentJacobianCost final : public ceres::CostFunction {
     }
     for (std::size_t k = 0; k < segments_.size(); ++k) {
       const Segment& s = segments_[k];
-      const std::size_t a = IndexOf(s.begin), b = IndexOf(s.end);
+      const std::size_t a = MarkIndex(marks_, s.begin), b = MarkIndex(marks_, s.end);
       SegmentError(at_mark[a], at_mark[b], s.ground_truth_start_T_end, weights_, residuals + 3 * k);
       if (!want_jacobian) continue;
       JetP r[3];
@@ -139,11 +145,6 @@ class SegmentJacobianCost final : public ceres::CostFunction {
       out.theta.v[j] = d[2][j];
     }
     return out;
-  }
-
-  std::size_t IndexOf(std::size_t mark) const {
-    return static_cast<std::size_t>(std::lower_bound(marks_.begin(), marks_.end(), mark) -
-                                    marks_.begin());
   }
 
   const AlignedRun& run_;
