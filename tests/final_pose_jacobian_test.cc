@@ -115,6 +115,29 @@ AlignedRun RealLikeRun(const RobotModelInterface& model, unsigned seed, std::siz
   return run;
 }
 
+// Row r of the analytic Jacobian j_a against autodiff's j_d (np columns), each entry within
+// kRelativeTolerance of the row's largest; returns the largest relative difference. A row autodiff
+// gives as zero (an empty window) must be zero on the analytic path too, and is allowed only when
+// `row_may_be_empty`.
+double ExpectSameJacobianRow(const std::vector<double>& j_a, const std::vector<double>& j_d, int r,
+                             int np, bool row_may_be_empty) {
+  double row_max = 0.0;
+  for (int j = 0; j < np; ++j) row_max = std::max(row_max, std::abs(j_d[r * np + j]));
+  if (row_max == 0.0) {
+    EXPECT_TRUE(row_may_be_empty) << "row " << r;
+    for (int j = 0; j < np; ++j) EXPECT_EQ(j_a[r * np + j], 0.0) << "row " << r;
+    return 0.0;
+  }
+  double worst = 0.0;
+  for (int j = 0; j < np; ++j) {
+    const double diff = std::abs(j_a[r * np + j] - j_d[r * np + j]) / row_max;
+    worst = std::max(worst, diff);
+    EXPECT_LT(diff, kRelativeTolerance) << "d r" << r << " / d p" << j << ": analytic "
+                                        << j_a[r * np + j] << ", autodiff " << j_d[r * np + j];
+  }
+  return worst;
+}
+
 // Every residual and Jacobian entry of `analytic` equals `autodiff`'s within kRelativeTolerance of
 // the row's largest entry; returns the largest relative difference seen.
 double ExpectSameCost(const ceres::CostFunction& analytic, const ceres::CostFunction& autodiff,
@@ -134,15 +157,7 @@ double ExpectSameCost(const ceres::CostFunction& analytic, const ceres::CostFunc
     // the plain replay pairs samples, equal to rounding.
     EXPECT_NEAR(r_a[r], r_d[r], kRelativeTolerance * std::max(1.0, std::abs(r_d[r])));
     EXPECT_NEAR(r_plain[r], r_d[r], kRelativeTolerance * std::max(1.0, std::abs(r_d[r])));
-    double row_max = 0.0;
-    for (int j = 0; j < np; ++j) row_max = std::max(row_max, std::abs(j_d[r * np + j]));
-    EXPECT_GT(row_max, 0.0) << "row " << r;
-    for (int j = 0; j < np; ++j) {
-      const double diff = std::abs(j_a[r * np + j] - j_d[r * np + j]) / row_max;
-      worst = std::max(worst, diff);
-      EXPECT_LT(diff, kRelativeTolerance) << "d r" << r << " / d p" << j << ": analytic "
-                                          << j_a[r * np + j] << ", autodiff " << j_d[r * np + j];
-    }
+    worst = std::max(worst, ExpectSameJacobianRow(j_a, j_d, r, np, /*row_may_be_empty=*/false));
   }
   return worst;
 }
@@ -231,18 +246,8 @@ double ExpectSameSegmentCost(const ceres::CostFunction& analytic,
   for (int r = 0; r < m; ++r) {
     EXPECT_EQ(r_a[r], r_plain[r]) << "row " << r;  // both the plain replay's poses
     EXPECT_NEAR(r_a[r], r_d[r], kRelativeTolerance * std::max(1.0, std::abs(r_d[r])));
-    double row_max = 0.0;
-    for (int j = 0; j < np; ++j) row_max = std::max(row_max, std::abs(j_d[r * np + j]));
-    if (row_max == 0.0) {  // an empty window: no derivative on either path
-      for (int j = 0; j < np; ++j) EXPECT_EQ(j_a[r * np + j], 0.0) << "row " << r;
-      continue;
-    }
-    for (int j = 0; j < np; ++j) {
-      const double diff = std::abs(j_a[r * np + j] - j_d[r * np + j]) / row_max;
-      worst = std::max(worst, diff);
-      EXPECT_LT(diff, kRelativeTolerance) << "d r" << r << " / d p" << j << ": analytic "
-                                          << j_a[r * np + j] << ", autodiff " << j_d[r * np + j];
-    }
+    // An empty window: no derivative on either path.
+    worst = std::max(worst, ExpectSameJacobianRow(j_a, j_d, r, np, /*row_may_be_empty=*/true));
   }
   return worst;
 }

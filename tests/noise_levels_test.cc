@@ -57,6 +57,24 @@ std::vector<sim::ModelSimulatedRun> Simulate(const RobotModelInterface& model, i
   return runs;
 }
 
+// The simulated runs, aligned, and their track checkpoints, which point into `logs` and `runs`:
+// built in place and never copied.
+struct SimulatedTracks {
+  SimulatedTracks(const RobotModelInterface& model, int repetitions) {
+    for (const sim::ModelSimulatedRun& run : Simulate(model, repetitions)) logs.push_back(run.log);
+    runs = AlignRuns(logs);
+    std::vector<const GroundTruthTrack*> tracks;
+    for (const RunLog& log : logs) tracks.push_back(&log.ground_truth);
+    data = MakeTrackFitData(runs, tracks, ClockGrouping::kNone);
+  }
+  SimulatedTracks(const SimulatedTracks&) = delete;
+  SimulatedTracks& operator=(const SimulatedTracks&) = delete;
+
+  std::vector<RunLog> logs;
+  std::vector<AlignedRun> runs;
+  TrackFitData data;
+};
+
 // Relative standard error of a sigma estimated from runs whose checkpoints weigh 1/K each:
 // each run adds mean_k(e^2) over its K checkpoints, a chi-square of `dimension` K degrees of
 // freedom over K, variance 2 / (dimension K) relative; the N runs' mean has variance
@@ -70,13 +88,9 @@ double RelativeStandardError(const std::vector<int>& checkpoints, int dimension)
 
 TEST(NoiseLevels, TrackFitRecoversKnownPositionAndHeadingNoise) {
   const RobotModelPtr model = testing::ExampleModel("diff_drive");
-  const std::vector<sim::ModelSimulatedRun> simulated = Simulate(*model, 3);
-  std::vector<RunLog> logs;
-  for (const auto& run : simulated) logs.push_back(run.log);
-  const std::vector<AlignedRun> runs = AlignRuns(logs);
-  std::vector<const GroundTruthTrack*> tracks;
-  for (const RunLog& log : logs) tracks.push_back(&log.ground_truth);
-  const TrackFitData data = MakeTrackFitData(runs, tracks, ClockGrouping::kNone);
+  const SimulatedTracks simulated(*model, 3);
+  const std::vector<AlignedRun>& runs = simulated.runs;
+  const TrackFitData& data = simulated.data;
   std::vector<int> checkpoints;
   for (const TrackCheckpoints& t : data.runs)
     checkpoints.push_back(static_cast<int>(t.segments.size()));
@@ -119,13 +133,9 @@ TEST(NoiseLevels, TrackFitRecoversKnownPositionAndHeadingNoise) {
 // fit's own.
 TEST(NoiseLevels, TrackSigmasAreOfTheWeightsTheFitUsed) {
   const RobotModelPtr model = testing::ExampleModel("diff_drive");
-  const std::vector<sim::ModelSimulatedRun> simulated = Simulate(*model, 2);
-  std::vector<RunLog> logs;
-  for (const auto& run : simulated) logs.push_back(run.log);
-  const std::vector<AlignedRun> runs = AlignRuns(logs);
-  std::vector<const GroundTruthTrack*> tracks;
-  for (const RunLog& log : logs) tracks.push_back(&log.ground_truth);
-  const TrackFitData data = MakeTrackFitData(runs, tracks, ClockGrouping::kNone);
+  const SimulatedTracks simulated(*model, 2);
+  const std::vector<AlignedRun>& runs = simulated.runs;
+  const TrackFitData& data = simulated.data;
   const ResidualWeights weights{1.0, kPositionSigmaM / 4.0};  // heading weighed 250x 1 m : 1 rad
   ModelFitOptions as_ceres;
   as_ceres.residuals = ResidualKind::kTrack;
