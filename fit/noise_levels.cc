@@ -166,12 +166,9 @@ NoiseLevels EstimateNoiseLevels(const std::vector<AlignedRun>& training,
                                 bool per_session) {
   NoiseLevels out;
   SessionNoise& sessions = out.sessions;
-  for (const AlignedRun& run : training) {
-    const std::string name = ClockGroupOf(run.id, run.trajectory, ClockGrouping::kPerSession);
-    const auto found = std::find(sessions.names.begin(), sessions.names.end(), name);
-    sessions.of_run.push_back(static_cast<int>(found - sessions.names.begin()));
-    if (found == sessions.names.end()) sessions.names.push_back(name);
-  }
+  RunGroups groups = GroupRuns(training, ClockGrouping::kPerSession);
+  sessions.names = std::move(groups.names);
+  sessions.of_run = std::move(groups.of_run);
   std::vector<ComponentSums> session_tracks(sessions.names.size());
   std::vector<ComponentSums> session_finals(sessions.names.size());
   out.with_final_poses = final_poses;

@@ -83,6 +83,17 @@ std::string ClockGroupOf(const std::string& run_id, const std::string& trajector
   return "all";
 }
 
+RunGroups GroupRuns(const std::vector<AlignedRun>& runs, ClockGrouping grouping) {
+  RunGroups out;
+  for (const AlignedRun& run : runs) {
+    const std::string group = ClockGroupOf(run.id, run.trajectory, grouping);
+    const auto found = std::find(out.names.begin(), out.names.end(), group);
+    out.of_run.push_back(static_cast<int>(found - out.names.begin()));
+    if (found == out.names.end()) out.names.push_back(group);
+  }
+  return out;
+}
+
 int ShiftGroundTruthClocks(const std::vector<std::pair<std::string, double>>& offset_of_group,
                            ClockGrouping grouping, std::vector<RunLog>* logs) {
   int moved = 0;
@@ -107,14 +118,13 @@ TrackFitData MakeTrackFitData(const std::vector<AlignedRun>& runs,
   TrackFitData out;
   out.options = options;
   out.estimate_clock_offsets = grouping != ClockGrouping::kNone;
+  RunGroups groups = GroupRuns(runs, grouping);
   for (std::size_t i = 0; i < runs.size(); ++i) {
     TrackCheckpoints t = MakeTrackCheckpoints(runs[i], *ground_truth[i], options);
-    const std::string group = ClockGroupOf(runs[i].id, runs[i].trajectory, grouping);
-    const auto found = std::find(out.clock_groups.begin(), out.clock_groups.end(), group);
-    t.clock_group = static_cast<int>(found - out.clock_groups.begin());
-    if (found == out.clock_groups.end()) out.clock_groups.push_back(group);
+    t.clock_group = groups.of_run[i];
     out.runs.push_back(std::move(t));
   }
+  out.clock_groups = std::move(groups.names);
   return out;
 }
 

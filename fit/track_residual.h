@@ -86,6 +86,14 @@ bool ParseClockGrouping(const std::string& text, ClockGrouping* out);
 std::string ClockGroupOf(const std::string& run_id, const std::string& trajectory,
                          ClockGrouping grouping);
 
+// The runs' clock groups under `grouping`: the groups' names in the order of their first run, and
+// each run's index into them.
+struct RunGroups {
+  std::vector<std::string> names;
+  std::vector<int> of_run;
+};
+RunGroups GroupRuns(const std::vector<AlignedRun>& runs, ClockGrouping grouping);
+
 // Applies clock offsets to recorded runs: every ground-truth stamp of a run whose clock group
 // (ClockGroupOf) has an offset dt moves to t - dt, so that the ground truth read at encoder time
 // t is the one stamped t + dt (the offsets' meaning, header): the values the track residual
