@@ -43,7 +43,8 @@ RunJacobian EvaluateRun(const ceres::CostFunction& cost, const std::vector<doubl
 
 std::vector<RunJacobian> EvaluateRuns(const std::vector<AlignedRun>& training,
                                       const RobotModelInterface& model,
-                                      const std::vector<double>& p, const ResidualWeights& weights,
+                                      const std::vector<double>& p,
+                                      const std::vector<ResidualWeights>& weights,
                                       const std::vector<std::vector<Segment>>* segments,
                                       int num_threads) {
   std::vector<RunJacobian> out(training.size());
@@ -59,9 +60,9 @@ std::vector<RunJacobian> EvaluateRuns(const std::vector<AlignedRun>& training,
     const std::vector<Segment> stretches =
         segments == nullptr ? std::vector<Segment>{} : StretchesBetweenCheckpoints((*segments)[i]);
     std::unique_ptr<ceres::CostFunction> cost(
-        segments == nullptr ? model.FinalPoseCost(training[i], weights)
-        : stretches.empty() ? model.SegmentCost(training[i], (*segments)[i], weights)
-                            : model.SegmentCost(training[i], stretches, weights));
+        segments == nullptr ? model.FinalPoseCost(training[i], weights[i])
+        : stretches.empty() ? model.SegmentCost(training[i], (*segments)[i], weights[i])
+                            : model.SegmentCost(training[i], stretches, weights[i]));
     out[i] = EvaluateRun(*cost, p);
     out[i].finite = out[i].finite || out[i].residuals.size() == 0;
     out[i].innovations = !stretches.empty();
@@ -205,7 +206,7 @@ Eigen::VectorXd PriorSigma(const Robot& robot) {
 DirectionAnalysis AnalyseDeterminedDirections(const std::vector<AlignedRun>& training,
                                               const RobotModelInterface& model,
                                               const std::vector<double>& p,
-                                              const ResidualWeights& weights,
+                                              const std::vector<ResidualWeights>& weights,
                                               const std::vector<std::vector<Segment>>* segments,
                                               int num_threads) {
   const Robot& robot = model.robot();
@@ -295,7 +296,8 @@ double PosteriorFractionWith(const UndeterminedDirection& d, const std::vector<A
       d.one_sigma_step / std::max(std::min(d.posterior_fraction, 1.0), 1e-300);
   const double s2 = std::max(d.residual_sigma * d.residual_sigma, 1e-300);
   double information = 1.0 / std::max(d.posterior_fraction * d.posterior_fraction, 1e-300);
-  for (const RunJacobian& run : EvaluateRuns(extra, model, p, weights, nullptr, 1)) {
+  const std::vector<ResidualWeights> alike(extra.size(), weights);
+  for (const RunJacobian& run : EvaluateRuns(extra, model, p, alike, nullptr, 1)) {
     if (run.finite && run.jacobian.size() > 0)
       information += (run.jacobian * prior_step).squaredNorm() / s2;
   }

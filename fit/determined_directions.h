@@ -68,12 +68,12 @@ inline constexpr double kMaxAbsCorrelation = 0.99;
 Eigen::VectorXd PriorSigma(const Robot& robot);
 
 // The analysis at `p` over the training runs (final poses, or `segments` when given: one window
-// list per run). `trajectory_of_run` names each run's trajectory for the description (may be
-// empty).
+// list per run), each run weighed as the fit weighs it (`weights`: one per run; with per-session
+// noise levels a noisy session determines less, fit/noise_levels.h).
 DirectionAnalysis AnalyseDeterminedDirections(const std::vector<AlignedRun>& training,
                                               const RobotModelInterface& model,
                                               const std::vector<double>& p,
-                                              const ResidualWeights& weights,
+                                              const std::vector<ResidualWeights>& weights,
                                               const std::vector<std::vector<Segment>>* segments,
                                               int num_threads);
 

@@ -48,6 +48,16 @@ ResidualWeights FinalPoseWeightsOf(const ModelFitOptions& options, std::size_t i
   return options.ceres.weights;
 }
 
+// Each run's weights as the fit weighs its residuals (tracks or final poses).
+std::vector<ResidualWeights> WeightsOfRuns(const ModelFitOptions& options, std::size_t num_runs) {
+  std::vector<ResidualWeights> out;
+  for (std::size_t i = 0; i < num_runs; ++i) {
+    out.push_back(UsesTracks(options) ? TrackWeightsOf(options, i)
+                                      : FinalPoseWeightsOf(options, i));
+  }
+  return out;
+}
+
 // Rounds of the active set: one per parameter that comes to rest on a bound, and releases.
 constexpr int kMaxActiveSetRounds = 16;
 
@@ -853,10 +863,10 @@ ModelFitResult FitModelFrom(const std::vector<AlignedRun>& training,
   if (options.hold_undetermined) {
     bool finite = true;
     for (double v : result.parameters) finite = finite && std::isfinite(v);
-    const DirectionAnalysis analysis = AnalyseDeterminedDirections(
-        training, model, finite ? result.parameters : start,
-        UsesTracks(options) ? TrackWeightsOf(options) : options.ceres.weights, analysed,
-        options.ceres.num_threads);
+    const DirectionAnalysis analysis =
+        AnalyseDeterminedDirections(training, model, finite ? result.parameters : start,
+                                    WeightsOfRuns(options, training.size()), analysed,
+                                    options.ceres.num_threads);
     if (analysis.ok && !analysis.undetermined.empty()) {
       holds.directions = analysis.undetermined;
       holds.weight = HoldWeight(analysis);

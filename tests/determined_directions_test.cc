@@ -230,7 +230,7 @@ TEST(DeterminedDirections, DenserCheckpointsOfOneTrackAddNoInformation) {
         MakeTrackFitData(runs, {&logs[0].ground_truth}, ClockGrouping::kNone, track_options);
     const std::vector<std::vector<Segment>> segments = {data.runs[0].segments};
     const DirectionAnalysis a =
-        AnalyseDeterminedDirections(runs, *model, truth, ResidualWeights{}, &segments, 1);
+        AnalyseDeterminedDirections(runs, *model, truth, testing::Unweighted(runs), &segments, 1);
     EXPECT_TRUE(a.ok);
     return a.posterior_fractions;
   };
@@ -257,7 +257,7 @@ TEST(DeterminedDirections, TheWholeFlowerDeterminesEveryDirection) {
   plain.hold_undetermined = false;
   const ModelFitResult unconstrained = FitModel(runs, *model, plain);
   const DirectionAnalysis analysis = AnalyseDeterminedDirections(
-      runs, *model, unconstrained.parameters, ResidualWeights{}, nullptr, 0);
+      runs, *model, unconstrained.parameters, testing::Unweighted(runs), nullptr, 0);
   ASSERT_TRUE(analysis.ok);
   EXPECT_TRUE(analysis.undetermined.empty());
   EXPECT_EQ(static_cast<int>(analysis.posterior_fractions.size()), model->robot().NumFree());
@@ -284,8 +284,8 @@ TEST(DeterminedDirections, ConditioningAgreesWithTheFitsCovariance) {
   plain.hold_undetermined = false;
   const ModelFitResult fit = FitModel(runs, *model, plain);
   ASSERT_TRUE(fit.has_covariance);
-  const DirectionAnalysis analysis =
-      AnalyseDeterminedDirections(runs, *model, fit.parameters, ResidualWeights{}, nullptr, 0);
+  const DirectionAnalysis analysis = AnalyseDeterminedDirections(
+      runs, *model, fit.parameters, testing::Unweighted(runs), nullptr, 0);
   ASSERT_TRUE(analysis.ok);
   std::vector<int> free;
   for (int k = 0; k < robot.NumParameters(); ++k) {

@@ -29,6 +29,11 @@ inline AlignedRun LabelledRun(const std::string& trajectory, int repetition) {
   return run;
 }
 
+// Every run weighed 1 m : 1 rad (the weights AnalyseDeterminedDirections takes, one per run).
+inline std::vector<ResidualWeights> Unweighted(const std::vector<AlignedRun>& runs) {
+  return std::vector<ResidualWeights>(runs.size());
+}
+
 // The registry's example robot of model `name` (models/model_registry.h).
 inline RobotModelPtr ExampleModel(const std::string& name) {
   return ReadRobotModel(YAML::Load(FindModel(name)->example_yaml), name + " example");

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "fit/model_fit.h"
 #include "models/model_registry.h"
 #include "tests/model_support.h"
 
@@ -51,7 +52,7 @@ TEST(MotionAdvice, ClosedCirclesOfADiffDriveAreAdvisedAStraightRun) {
   std::vector<AlignedRun> circles;
   for (int i = 0; i < 6; ++i) circles.push_back(NoisyRun(*model, Circle(i % 2 ? -1.0 : 1.0), i));
   const DirectionAnalysis analysis =
-      AnalyseDeterminedDirections(circles, *model, p, ResidualWeights{}, nullptr, 1);
+      AnalyseDeterminedDirections(circles, *model, p, testing::Unweighted(circles), nullptr, 1);
   ASSERT_TRUE(analysis.ok);
   const UndeterminedDirection* scale = CommonScale(analysis);
   ASSERT_NE(scale, nullptr) << "closed circles must leave the common scale undetermined";
@@ -76,10 +77,34 @@ TEST(MotionAdvice, ClosedCirclesOfADiffDriveAreAdvisedAStraightRun) {
   std::vector<AlignedRun> with_straight = circles;
   for (int i = 0; i < straight_runs; ++i)
     with_straight.push_back(NoisyRun(*model, StandardMotions()[0], 100 + i));
-  const DirectionAnalysis after =
-      AnalyseDeterminedDirections(with_straight, *model, p, ResidualWeights{}, nullptr, 1);
+  const DirectionAnalysis after = AnalyseDeterminedDirections(
+      with_straight, *model, p, testing::Unweighted(with_straight), nullptr, 1);
   ASSERT_TRUE(after.ok);
   EXPECT_EQ(CommonScale(after), nullptr);
+}
+
+// The fit's own analysis weighs each run as the fit does (ModelFitOptions::weights_per_run, as
+// per-session noise levels set them): straight runs weighed 1000 times noisier than the circles
+// bring 1e-6 of their information, so the common scale the circles leave open is held at the
+// nominal; weighed alike they determine it. The analysis read the data set's weights for every
+// run before, and then held nothing here.
+TEST(MotionAdvice, RunsTheFitHardlyWeighsDetermineNothing) {
+  const RobotModelPtr model = testing::ExampleModel("diff_drive");
+  std::vector<AlignedRun> runs;
+  for (int i = 0; i < 6; ++i) runs.push_back(NoisyRun(*model, Circle(i % 2 ? -1.0 : 1.0), i));
+  for (int i = 0; i < 4; ++i) runs.push_back(NoisyRun(*model, StandardMotions()[0], 100 + i));
+  const auto held_with_straight_sigma = [&](double sigma) {
+    ModelFitOptions options;
+    options.weights_per_run.resize(runs.size());
+    for (std::size_t i = 6; i < runs.size(); ++i)
+      options.weights_per_run[i].final_pose = ResidualWeights{sigma, sigma};
+    return FitModel(runs, *model, options).held_directions;
+  };
+  EXPECT_TRUE(held_with_straight_sigma(1.0).empty());
+  const std::vector<UndeterminedDirection> held = held_with_straight_sigma(1000.0);
+  DirectionAnalysis as_held;
+  as_held.undetermined = held;
+  EXPECT_NE(CommonScale(as_held), nullptr) << held.size() << " directions held";
 }
 
 TEST(MotionAdvice, MotionsAModelCannotDriveAreSkipped) {

@@ -341,7 +341,8 @@ void AddModelIdentifiability(const ReportInputs& in, const CalibrationInput& cal
                              const std::vector<AlignedRun>& training, int threads,
                              io::ReportData* data) {
   const DirectionAnalysis d = AnalyseDeterminedDirections(
-      training, *in.model, cal.calibrated.nominal, ResidualWeights{}, nullptr, threads);
+      training, *in.model, cal.calibrated.nominal,
+      std::vector<ResidualWeights>(training.size()), nullptr, threads);
   data->condition_number = d.condition_number;
   for (const UndeterminedDirection& u : d.undetermined) {
     data->identifiability_lines.push_back("not determined by the training runs: " + u.description);
