@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <sstream>
 
 #include "fit/statistics.h"
@@ -150,22 +149,19 @@ std::string RequireEffectsToEarnTheirPlace(const std::vector<CalibrationCandidat
       gate->judged_on_held_out ? split.validation : split.training;
   const stats::PairedTest test =
       stats::PairedLogRatioTest(errors(without, runs).per_run_cf, errors(chosen, runs).per_run_cf);
-  char line[400];
   if (test.p < kEffectAlpha) {
-    std::snprintf(line, sizeof line,
-                  "effects: '%s' beats '%s' run by run (paired log-ratio t = %.2f, p = %.2g < %g)",
-                  chosen.name.c_str(), without.name.c_str(), test.t, test.p, kEffectAlpha);
-    return line;
+    return StrFormat(
+        "effects: '%s' beats '%s' run by run (paired log-ratio t = %.2f, p = %.2g < %g)",
+        chosen.name.c_str(), without.name.c_str(), test.t, test.p, kEffectAlpha);
   }
   // The nominal carries effects only when the robot declares them; then some fit must stand in.
   const int best = std::max(0, BestWithoutEffects(candidates, *gate));
-  std::snprintf(line, sizeof line,
-                "effects: '%s' is not significantly better than '%s' run by run (paired "
-                "log-ratio t = %.2f, p = %.2g >= %g): '%s' is selected",
-                chosen.name.c_str(), without.name.c_str(), test.t, test.p, kEffectAlpha,
-                candidates[best].name.c_str());
   gate->selected = best;
-  return line;
+  return StrFormat(
+      "effects: '%s' is not significantly better than '%s' run by run (paired log-ratio t = "
+      "%.2f, p = %.2g >= %g): '%s' is selected",
+      chosen.name.c_str(), without.name.c_str(), test.t, test.p, kEffectAlpha,
+      candidates[best].name.c_str());
 }
 
 std::string EffectsNote(const std::vector<CalibrationCandidate>& candidates,

@@ -2,12 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <tuple>
 
 #include "fit/final_pose_errors.h"
 #include "fit/model_nlopt_fit.h"
 #include "fit/residual_choice.h"
+#include "odometry/text_format.h"
 
 namespace fitcal {
 
@@ -57,16 +57,14 @@ NloptFitOptions NloptOptionsFor(NloptMethod method, const FitMethodSettings& set
 std::string ResidualsText(const FitMethodSettings& settings) {
   if (settings.residuals == ResidualKind::kFinalPose || settings.track == nullptr) return "";
   const TrackResidualOptions& t = settings.track->options;
-  char text[300];
-  std::snprintf(text, sizeof text,
-                "track residuals (pose from the run's start every %.2g m of ground-truth path and "
-                "at the end, heading %s, Huber %.2g, runs weighed alike; clock offsets: %s)%s",
-                t.checkpoint_spacing_m, ToString(t.heading), t.huber_scale,
-                settings.clock_grouping == ClockGrouping::kNone
-                    ? "none"
-                    : (std::string("one per ") + ToString(settings.clock_grouping)).c_str(),
-                settings.residuals == ResidualKind::kBoth ? " and final poses: " : "");
-  return text;
+  return StrFormat(
+      "track residuals (pose from the run's start every %.2g m of ground-truth path and at the "
+      "end, heading %s, Huber %.2g, runs weighed alike; clock offsets: %s)%s",
+      t.checkpoint_spacing_m, ToString(t.heading), t.huber_scale,
+      settings.clock_grouping == ClockGrouping::kNone
+          ? "none"
+          : (std::string("one per ") + ToString(settings.clock_grouping)).c_str(),
+      settings.residuals == ResidualKind::kBoth ? " and final poses: " : "");
 }
 
 ModelFitMethodOutcome RunModelCeres(CeresTrustRegion trust_region,

@@ -1,12 +1,12 @@
 #include "calibrate/generalise.h"
 
-#include <cstdio>
 #include <map>
 #include <set>
 
 #include "fit/residual_choice.h"
 #include "fit/trajectory_split.h"
 #include "io/command_failure.h"
+#include "odometry/text_format.h"
 
 namespace fitcal {
 
@@ -110,9 +110,8 @@ std::string DecisionLine(const CalibrationOutcome& outcome) {
     return line;
   }
   const GateDecision& gate = outcome.gate;
-  char cf[80];
-  std::snprintf(cf, sizeof cf, "CF %.4f -> %.4f", gate.cf.front(), gate.cf.at(gate.selected));
-  return "writes " + TableName(outcome.selected().name) + " (" + gate.judged_on + ": " + cf + ")";
+  return "writes " + TableName(outcome.selected().name) + " (" + gate.judged_on + ": " +
+         StrFormat("CF %.4f -> %.4f", gate.cf.front(), gate.cf.at(gate.selected)) + ")";
 }
 
 std::string FoldDecisionsLine(const std::vector<SplitCalibration>& folds) {

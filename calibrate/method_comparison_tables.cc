@@ -1,7 +1,6 @@
 #include "calibrate/method_comparison_tables.h"
 
 #include <cmath>
-#include <cstdio>
 #include <sstream>
 
 #include "models/model_registry.h"
@@ -40,12 +39,11 @@ ParameterDisplay ComparisonColumns(const Robot& robot) {
   };
   c.markdown = [robot](const std::vector<double>& p) {
     std::string out;
-    char item[96];
     for (int k = 0; k < robot.NumParameters(); ++k) {
       const ParameterInfo& info = robot.parameters[k];
-      std::snprintf(item, sizeof item, "%s%s %.6g%s", out.empty() ? "" : ", ", info.name.c_str(),
-                    p[k] * info.DisplayScale(), info.unit == ParameterUnit::kAngle ? " deg" : "");
-      out += item;
+      out += StrFormat("%s%s %.6g%s", out.empty() ? "" : ", ", info.name.c_str(),
+                       p[k] * info.DisplayScale(),
+                       info.unit == ParameterUnit::kAngle ? " deg" : "");
     }
     return out;
   };
@@ -77,8 +75,7 @@ std::string ComparisonMarkdown(const std::vector<ComparisonRow>& rows,
                                const ParameterDisplay& columns) {
   std::ostringstream o;
   o << kComparisonMarkdownStart << columns.markdown_header
-    << " | CF calibration | CF validation | Improvement | "
-       "Evaluations | Wall [s] | Termination |\n"
+    << " | CF calibration | CF validation | Improvement | Evaluations | Wall [s] | Termination |\n"
     << "|---|---|---|---|---|---|---|---|---|---|\n";
   for (const ComparisonRow& row : rows) {
     o << "| " << row.strategy << " | " << row.method << " | "

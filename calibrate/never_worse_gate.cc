@@ -10,8 +10,9 @@ NeverWorseVerdict JudgeNeverWorseThanNominal(const RobotModelInterface& model,
                                              const std::vector<AlignedRun>& runs,
                                              const std::vector<const GroundTruthTrack*>& tracks,
                                              int threads) {
-  const NeverWorseSaid said = SayNeverWorse(
-      chosen.name, JudgeCalibrationNeverWorse(model, nominal, chosen, runs, tracks, threads));
+  const std::vector<NeverWorseJudgement> judged =
+      CompareEverydayDriving(model, nominal, chosen, runs, tracks, threads).judgements;
+  const NeverWorseSaid said = SayNeverWorse(chosen.name, judged);
   NeverWorseVerdict out{said.warnings, said.refusals};
   for (std::string& line : out.refusals) line += "; nothing written";
   return out;

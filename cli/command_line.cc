@@ -107,8 +107,7 @@ std::vector<Command> Commands() {
                   "(docs/diagnose.md)",
                   &AddDiagnoseOptions, &RunDiagnoseCommand),
       MakeCommand("", "generalise",
-                  "Train on one path type / session, test on the others "
-                  "(docs/optiodom.md)",
+                  "Train on one path type / session, test on the others (docs/optiodom.md)",
                   &AddGeneraliseOptions, &RunGeneraliseCommand),
       MakeCommand("", "simulate",
                   "Write a simulated data set: omni3 flower, or --model's trajectories "

@@ -27,20 +27,18 @@ std::string ReplayLine(const ExportRos2ControlOptions& o, const ExportReplay& r)
 }
 
 std::string CovarianceLine(const OdometryCovariance& c) {
-  char text[600];
-  std::snprintf(text, sizeof text,
-                "odometry covariance from %zu held-out runs (%zu windows; twist per message of %.4g s): twist sigma "
-                "vx %.4g m/s, vy %.4g m/s, omega %.4g rad/s; pose sigma after 1 m x %.4g m, "
-                "y %.4g m, theta %.4g rad, growing as d^%.2f, d^%.2f, d^%.2f; ground truth's own "
-                "noise removed: %.3g m, %.3g m, %.3g rad",
-                c.runs, c.windows, c.interval_s, std::sqrt(c.twist_variance[0]),
-                std::sqrt(c.twist_variance[1]), std::sqrt(c.twist_variance[2]),
-                std::sqrt(c.pose_variance_1m[0]), std::sqrt(c.pose_variance_1m[1]),
-                std::sqrt(c.pose_variance_1m[2]), 0.5 * c.pose_growth_exponent[0],
-                0.5 * c.pose_growth_exponent[1], 0.5 * c.pose_growth_exponent[2],
-                std::sqrt(c.ground_truth_variance[0]), std::sqrt(c.ground_truth_variance[1]),
-                std::sqrt(c.ground_truth_variance[2]));
-  return text;
+  return StrFormat(
+      "odometry covariance from %zu held-out runs (%zu windows; twist per message of %.4g s): "
+      "twist sigma vx %.4g m/s, vy %.4g m/s, omega %.4g rad/s; pose sigma after 1 m x %.4g m, "
+      "y %.4g m, theta %.4g rad, growing as d^%.2f, d^%.2f, d^%.2f; ground truth's own noise "
+      "removed: %.3g m, %.3g m, %.3g rad",
+      c.runs, c.windows, c.interval_s, std::sqrt(c.twist_variance[0]),
+      std::sqrt(c.twist_variance[1]), std::sqrt(c.twist_variance[2]),
+      std::sqrt(c.pose_variance_1m[0]), std::sqrt(c.pose_variance_1m[1]),
+      std::sqrt(c.pose_variance_1m[2]), 0.5 * c.pose_growth_exponent[0],
+      0.5 * c.pose_growth_exponent[1], 0.5 * c.pose_growth_exponent[2],
+      std::sqrt(c.ground_truth_variance[0]), std::sqrt(c.ground_truth_variance[1]),
+      std::sqrt(c.ground_truth_variance[2]));
 }
 
 }  // namespace
@@ -102,8 +100,7 @@ void CheckCalibrationOut(const ExportRos2ControlOptions& o, const std::string& r
   if (o.calibration_out.empty()) return;
   if (o.logs.empty()) {
     throw UsageError(
-        "--calibration-out needs --logs (the covariance comes from "
-        "the held-out runs)");
+        "--calibration-out needs --logs (the covariance comes from the held-out runs)");
   }
   std::string refusal = io::OutputFileRefusal(o.calibration_out, {o.calibration, o.logs});
   if (!refusal.empty()) throw UsageError(refusal);

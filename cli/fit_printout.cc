@@ -5,11 +5,12 @@
 #include <iostream>
 
 #include "calibrate/outcome_figures.h"
+#include "cli/everyday_driving_table.h"
+#include "cli/tying_flags.h"
 #include "fit/motion_advice.h"
 #include "fitcal/version.h"
 #include "models/mounted_model.h"
-#include "cli/everyday_driving_table.h"
-#include "cli/tying_flags.h"
+#include "odometry/text_format.h"
 #include "validation/trajectory_family.h"
 
 namespace fitcal::tools {
@@ -38,24 +39,21 @@ void PrintParameters(const Robot& robot, const std::vector<double>& p, const Sel
   for (int k = 0; k < robot.NumParameters(); ++k) {
     const ParameterInfo& info = robot.parameters[k];
     const double s = info.DisplayScale();
-    char sigma[32] = "-";
-    if (fit.has_covariance && !fit.held[k])
-      std::snprintf(sigma, sizeof sigma, "%.2g", fit.sigma[k] * s);
+    const std::string sigma =
+        fit.has_covariance && !fit.held[k] ? StrFormat("%.2g", fit.sigma[k] * s) : "-";
     // Angles change by degrees, lengths by percent (a percentage of an angle means nothing).
-    char change[32];
-    if (info.unit == ParameterUnit::kAngle) {
-      std::snprintf(change, sizeof change, "%+.3f deg", (p[k] - robot.nominal[k]) * s);
-    } else if (robot.nominal[k] == 0.0) {  // no percentage of nothing (a frame's y of 0)
-      std::snprintf(change, sizeof change, "%+.4g m", p[k] - robot.nominal[k]);
-    } else {
-      std::snprintf(change, sizeof change, "%+.2f%%",
-                    100.0 * (p[k] - robot.nominal[k]) / robot.nominal[k]);
-    }
+    const double change = p[k] - robot.nominal[k];
+    const std::string change_text =
+        info.unit == ParameterUnit::kAngle ? StrFormat("%+.3f deg", change * s)
+        : robot.nominal[k] == 0.0  // no percentage of nothing (a frame's y of 0)
+            ? StrFormat("%+.4g m", change)
+            : StrFormat("%+.2f%%", 100.0 * change / robot.nominal[k]);
     const bool not_determined =
         k < static_cast<int>(fit.not_determined.size()) && fit.not_determined[k];
     std::printf("  %-22s %12.6f %12.6f %12s %12s%s%s%s\n", robot.LabelOf(k).c_str(),
-                robot.nominal[k] * s, p[k] * s, sigma, change, fit.at_bound[k] ? "  AT BOUND" : "",
-                fit.held[k] ? "  HELD" : "", not_determined ? "  NOT DETERMINED" : "");
+                robot.nominal[k] * s, p[k] * s, sigma.c_str(), change_text.c_str(),
+                fit.at_bound[k] ? "  AT BOUND" : "", fit.held[k] ? "  HELD" : "",
+                not_determined ? "  NOT DETERMINED" : "");
   }
   if (std::find(fit.not_determined.begin(), fit.not_determined.end(), true) !=
       fit.not_determined.end()) {

@@ -7,9 +7,10 @@
 #include <optional>
 #include <string>
 
-#include "models/model_registry.h"
 #include "cli/effect_list.h"
 #include "cli/everyday_driving_table.h"
+#include "models/model_registry.h"
+#include "odometry/text_format.h"
 
 namespace fitcal::tools {
 
@@ -24,16 +25,14 @@ void PrintSplitTableHeader() {
 
 void PrintSplitRows(const SplitScores& s) {
   for (const CandidateScore& c : s.candidates) {
-    char held[16] = "-", bound[16] = "-";
-    if (c.is_fit && IsWrittenFit(c, /*final_pose_only=*/true)) {
-      std::snprintf(held, sizeof held, "%d", c.held_directions);
-      std::snprintf(bound, sizeof bound, "%d", c.at_bound);
-    }
+    const bool written = c.is_fit && IsWrittenFit(c, /*final_pose_only=*/true);
+    const std::string held = written ? std::to_string(c.held_directions) : "-";
+    const std::string bound = written ? std::to_string(c.at_bound) : "-";
     std::printf("| %s -> %s | %s%s | %zu | %zu | %.4f | %.4f | %.3f | %.2f | %s | %s |\n",
                 s.split.train_name.c_str(), s.split.test_name.c_str(), c.name.c_str(),
                 c.usable ? "" : " (not converged)", s.split.train.size(), s.split.test.size(),
                 c.train.cf, c.test.cf, c.test.mean_position_error_m,
-                RadToDeg(c.test.mean_abs_heading_error_rad), held, bound);
+                RadToDeg(c.test.mean_abs_heading_error_rad), held.c_str(), bound.c_str());
   }
 }
 
@@ -128,8 +127,7 @@ int RunGeneralise(const GeneraliseCommandOptions& flags) {
   PrintDecisions(outcome.table);
   std::printf(
       "\neveryday driving on each split's held-out runs (ATE RMSE: each run's start pose "
-      "aligned, no scale; drift per window of ground-truth path, validation/everyday_driving.h)"
-      "\n");
+      "aligned, no scale; drift per window of ground-truth path, validation/everyday_driving.h)\n");
   for (const auto& [title, comparison] : outcome.everyday_driving) {
     PrintEverydayDrivingTable(title, comparison, /*judge=*/true);
   }

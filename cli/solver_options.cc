@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "fit/residual_choice.h"
+#include "odometry/invalid.h"
 
 namespace fitcal::tools {
 
@@ -104,10 +105,8 @@ bool MakeFitMethodSettings(const SolverOptions& o, int threads, FitMethodSetting
   s->estimate_weights = o.weight_mode == "estimated" && !o.sigmas_given;
   s->weights_auto = o.weight_mode == "auto" && !o.sigmas_given;  // a sigma given fixes them
   s->objective_set = !o.objective.empty();
-  if (s->objective_set && !ParseFinalPoseObjective(o.objective, &s->objective)) {
-    *error = "unknown --objective '" + o.objective + "' (available: squares, eq14)";
-    return false;
-  }
+  if (s->objective_set && !ParseFinalPoseObjective(o.objective, &s->objective))
+    return Invalid(error, "unknown --objective '" + o.objective + "' (available: squares, eq14)");
   s->residuals_auto = o.residuals == "auto";
   if (!s->residuals_auto && !ParseResidualKind(o.residuals, &s->residuals)) {
     *error =
@@ -124,18 +123,14 @@ bool MakeFitMethodSettings(const SolverOptions& o, int threads, FitMethodSetting
              "' (available: from-start, increments, auto)";
     return false;
   }
-  if (!ParseCeresRobustLoss(o.loss, &s->loss)) {
-    *error = "unknown --loss '" + o.loss + "' (available: none, huber, cauchy)";
-    return false;
-  }
+  if (!ParseCeresRobustLoss(o.loss, &s->loss))
+    return Invalid(error, "unknown --loss '" + o.loss + "' (available: none, huber, cauchy)");
   s->loss_scale = o.loss_scale;
   s->seed = o.seed;
   s->max_evaluations = o.max_evaluations;
   s->local_polish = o.polish;
-  if (o.max_evaluations < 1 || !(o.loss_scale > 0.0)) {
-    *error = "--max-evaluations and --loss-scale must be positive";
-    return false;
-  }
+  if (o.max_evaluations < 1 || !(o.loss_scale > 0.0))
+    return Invalid(error, "--max-evaluations and --loss-scale must be positive");
   return true;
 }
 

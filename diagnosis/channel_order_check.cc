@@ -12,6 +12,7 @@
 #include "fit/segment_cost.h"
 #include "fit/statistics.h"
 #include "models/pose_errors.h"
+#include "odometry/invalid.h"
 #include "odometry/parallel_for.h"
 
 namespace fitcal {
@@ -204,14 +205,10 @@ void DecideMiswiring(const MiswiringTest& test, MiswiringScores* scores) {
 
 bool IsValidMiswiringOptions(double false_alarm_probability, const ResidualWeights& weights,
                              std::string* error) {
-  if (!(false_alarm_probability > 0.0 && false_alarm_probability < 1.0)) {
-    *error = "false_alarm_probability must be in (0, 1)";
-    return false;
-  }
-  if (!(weights.position_sigma_m > 0.0) || !(weights.heading_sigma_rad > 0.0)) {
-    *error = "weights must be positive";
-    return false;
-  }
+  if (!(false_alarm_probability > 0.0 && false_alarm_probability < 1.0))
+    return Invalid(error, "false_alarm_probability must be in (0, 1)");
+  if (!(weights.position_sigma_m > 0.0) || !(weights.heading_sigma_rad > 0.0))
+    return Invalid(error, "weights must be positive");
   return true;
 }
 

@@ -3,7 +3,6 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <map>
 #include <numeric>
 #include <random>
@@ -358,25 +357,20 @@ std::string CovariateFinding(const CovariateTest& t) {
 }
 
 std::string FormatCovariateStructure(const CovariateStructure& s) {
-  char line[320];
-  std::snprintf(line, sizeof line,
-                "Residual against covariates (%s; p from 1999 permutations of the covariate "
-                "within each set of repetitions; family-wise alpha %.2g, Holm step-down over the "
-                "covariates tested):\n\n",
-                s.within_repetitions ? "deviations between repetitions of each trajectory"
-                                     : "all runs, no repetitions",
-                s.alpha);
-  std::string out = line;
+  std::string out = StrFormat(
+      "Residual against covariates (%s; p from 1999 permutations of the covariate within each "
+      "set of repetitions; family-wise alpha %.2g, Holm step-down over the covariates tested):\n\n",
+      s.within_repetitions ? "deviations between repetitions of each trajectory"
+                           : "all runs, no repetitions",
+      s.alpha);
   out += "| covariate | F | df | p | Holm threshold | verdict |\n|---|---|---|---|---|---|\n";
   for (const CovariateTest& t : s.tests) {
     if (!t.tested) {
       out += "| " + t.name + " | - | - | - | - | not tested: " + t.why_not + " |\n";
       continue;
     }
-    std::snprintf(line, sizeof line, "| %s | %.2f | (%.0f, %.0f) | %.2g | %.2g | %s |\n",
-                  t.name.c_str(), t.f, t.df1, t.df2, t.p_value, t.holm_threshold,
-                  t.significant ? "STRUCTURE" : "-");
-    out += line;
+    out += StrFormat("| %s | %.2f | (%.0f, %.0f) | %.2g | %.2g | %s |\n", t.name.c_str(), t.f,
+                     t.df1, t.df2, t.p_value, t.holm_threshold, t.significant ? "STRUCTURE" : "-");
   }
   return out;
 }

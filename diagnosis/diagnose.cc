@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "fit/statistics.h"
+#include "odometry/invalid.h"
 #include "odometry/text_format.h"
 
 namespace fitcal {
@@ -197,19 +198,14 @@ void JudgeAgainstSensorFloor(const SensorFloorTest& floor, double lof_alpha, Dia
 
 bool DiagnoseOptions::IsValid(std::string* error) const {
   if (!fit.IsValid(error)) return false;
-  if (!(alpha > 0.0 && alpha < 1.0) || !(lof_alpha > 0.0 && lof_alpha < 1.0)) {
-    *error = "alpha and lof_alpha must be in (0, 1)";
-    return false;
-  }
+  if (!(alpha > 0.0 && alpha < 1.0) || !(lof_alpha > 0.0 && lof_alpha < 1.0))
+    return Invalid(error, "alpha and lof_alpha must be in (0, 1)");
   if (!(min_explained_fraction >= 0.0 && min_explained_fraction <= 1.0) ||
       !(min_separable_fraction >= 0.0 && min_separable_fraction < 1.0)) {
     *error = "fractions must be in [0, 1]";
     return false;
   }
-  if (max_effects < 0) {
-    *error = "max_effects must be >= 0";
-    return false;
-  }
+  if (max_effects < 0) return Invalid(error, "max_effects must be >= 0");
   return true;
 }
 
@@ -630,8 +626,7 @@ std::string HeldOutText(const DiagnoseResult& r) {
                 r.declared_validation.track_rmse_m, RadToDeg(r.declared_validation.track_rmse_rad));
   // The second row is the track fit; "+ accepted effects" only when there are some.
   out += StrFormat(r.final_fit.effects.empty()
-                       ? "| parameters, track fit (no effect accepted) | %.5f | "
-                         "%.5f | %.4f |\n"
+                       ? "| parameters, track fit (no effect accepted) | %.5f | %.5f | %.4f |\n"
                        : "| parameters + accepted effects | %.5f | %.5f | %.4f |\n",
                    r.final_validation.cf, r.final_validation.track_rmse_m,
                    RadToDeg(r.final_validation.track_rmse_rad));

@@ -8,6 +8,7 @@
 
 #include "fit/statistics.h"
 #include "odometry/parallel_for.h"
+#include "odometry/text_format.h"
 #include "validation/trajectory_family.h"
 
 namespace fitcal {
@@ -444,14 +445,12 @@ void AccumulateByFeatures(const RunFeatures& f, const Pose2d& e,
                           std::map<std::string, GroupStat>& groups) {
   const double v[3] = {e.x, e.y, e.theta};
   Accumulate(groups, "family", f.family, v);
-  char bin[32];
   const double alpha_deg = std::fmod(RadToDeg(f.alpha_rad) + 360.0 + 15.0, 360.0) - 15.0;
-  std::snprintf(bin, sizeof bin, "%+04.0f", 30.0 * std::round(alpha_deg / 30.0) + 0.0);
-  Accumulate(groups, "alpha_deg", bin, v);
+  Accumulate(groups, "alpha_deg", StrFormat("%+04.0f", 30.0 * std::round(alpha_deg / 30.0) + 0.0),
+             v);
   Accumulate(groups, "rotation",
              f.rotation_sign > 0 ? "ccw" : (f.rotation_sign < 0 ? "cw" : "none"), v);
-  std::snprintf(bin, sizeof bin, "%.2f", 0.05 * std::round(f.speed_m_s / 0.05));
-  Accumulate(groups, "speed_m_s", bin, v);
+  Accumulate(groups, "speed_m_s", StrFormat("%.2f", 0.05 * std::round(f.speed_m_s / 0.05)), v);
 }
 
 // The phase of the motion at `mid` (s since the window's start), from the sample context:
@@ -534,21 +533,17 @@ ResidualAnalysis AnalyzeResiduals(const RobotModelInterface& robot_model,
 }
 
 std::string FormatResidualAnalysis(const ResidualAnalysis& a) {
-  std::string out;
-  char line[256];
-  std::snprintf(line, sizeof line,
-                "final-pose residual (start frame): systematic %.4f m / %.3f deg, "
-                "non-systematic (noise floor) %.4f m / %.3f deg\n",
-                a.systematic_rms_m, RadToDeg(a.systematic_rms_rad), a.nonsystematic_rms_m,
-                RadToDeg(a.nonsystematic_rms_rad));
-  out += line;
+  std::string out = StrFormat(
+      "final-pose residual (start frame): systematic %.4f m / %.3f deg, non-systematic (noise "
+      "floor) %.4f m / %.3f deg\n",
+      a.systematic_rms_m, RadToDeg(a.systematic_rms_rad), a.nonsystematic_rms_m,
+      RadToDeg(a.nonsystematic_rms_rad));
   if (a.lack_of_fit.available) {
-    std::snprintf(line, sizeof line,
-                  "lack of fit vs pure error (%d trajectories with repetitions): F = %.2f on "
-                  "(%.0f, %.0f) df, p = %.2g\n",
-                  a.lack_of_fit.trajectories_with_repetitions, a.lack_of_fit.f,
-                  a.lack_of_fit.df_lof, a.lack_of_fit.df_pe, a.lack_of_fit.p_value);
-    out += line;
+    out += StrFormat(
+        "lack of fit vs pure error (%d trajectories with repetitions): F = %.2f on (%.0f, %.0f) "
+        "df, p = %.2g\n",
+        a.lack_of_fit.trajectories_with_repetitions, a.lack_of_fit.f, a.lack_of_fit.df_lof,
+        a.lack_of_fit.df_pe, a.lack_of_fit.p_value);
   } else {
     out += "lack of fit: not available (no trajectory has two repetitions)\n";
   }
@@ -558,11 +553,9 @@ std::string FormatResidualAnalysis(const ResidualAnalysis& a) {
   out += "|---|---|---|---|---|---|---|---|---|\n";
   for (const GroupStat& g : a.groups) {
     const bool rate = g.by == "phase" || g.by == "time_in_run";
-    std::snprintf(line, sizeof line,
-                  "| %s%s | %s | %d | %+.4f | %+.4f | %+.3f | %.4f | %.4f | %.3f |\n", g.by.c_str(),
-                  rate ? " (rate /s)" : "", g.bin.c_str(), g.count, g.mean[0], g.mean[1],
-                  RadToDeg(g.mean[2]), g.rms[0], g.rms[1], RadToDeg(g.rms[2]));
-    out += line;
+    out += StrFormat("| %s%s | %s | %d | %+.4f | %+.4f | %+.3f | %.4f | %.4f | %.3f |\n",
+                     g.by.c_str(), rate ? " (rate /s)" : "", g.bin.c_str(), g.count, g.mean[0],
+                     g.mean[1], RadToDeg(g.mean[2]), g.rms[0], g.rms[1], RadToDeg(g.rms[2]));
   }
   return out;
 }

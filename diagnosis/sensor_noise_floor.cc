@@ -4,11 +4,11 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <map>
 
 #include "fit/statistics.h"
 #include "odometry/pose2.h"
+#include "odometry/text_format.h"
 
 namespace fitcal {
 namespace {
@@ -308,18 +308,15 @@ SensorFloorTest TestAgainstSensorFloor(const std::vector<Eigen::VectorXd>& e,
 }
 
 std::string SensorFloorFinding(const SensorFloorTest& test) {
-  char line[512];
-  std::snprintf(line, sizeof line,
-                "UNEXPLAINED: the residual is %.2f times what the sensors' noise explains "
-                "(chi2 = %.1f on %.0f df, p = %.2g)",
-                test.ratio, test.chi2, test.df, test.p_value);
-  std::string out = line;
+  std::string out = StrFormat(
+      "UNEXPLAINED: the residual is %.2f times what the sensors' noise explains (chi2 = %.1f on "
+      "%.0f df, p = %.2g)",
+      test.ratio, test.chi2, test.df, test.p_value);
   if (test.has_repetition_check && test.repetition_p_above < 0.01) {
-    std::snprintf(line, sizeof line,
-                  "; the repetitions scatter %.2f times it (p = %.2g): something changes from "
-                  "run to run beyond the sensors' noise",
-                  test.repetition_ratio, test.repetition_p_above);
-    out += line;
+    out += StrFormat(
+        "; the repetitions scatter %.2f times it (p = %.2g): something changes from run to run "
+        "beyond the sensors' noise",
+        test.repetition_ratio, test.repetition_p_above);
   }
   return out;
 }
@@ -329,30 +326,25 @@ std::string FormatSensorFloor(const SensorNoise& noise, const SensorFloorTest& t
     return "sensor noise floor: not available (fewer than " + std::to_string(kMinIntervals) +
            " ground-truth intervals)\n";
   }
-  char line[512];
-  std::snprintf(line, sizeof line,
-                "sensor noise floor (from the residual track's high frequencies, %d intervals): "
-                "ground truth %.2f mm / %.2f mm / %.3f deg, odometry walk %.2f mm / %.2f mm / "
-                "%.3f deg per interval of >= 0.2 s (x / y body / heading, one sigma)\n",
-                noise.num_intervals, 1e3 * std::sqrt(noise.ground_truth_var[0]),
-                1e3 * std::sqrt(noise.ground_truth_var[1]),
-                RadToDeg(std::sqrt(noise.ground_truth_var[2])),
-                1e3 * std::sqrt(noise.walk_var_per_interval[0]),
-                1e3 * std::sqrt(noise.walk_var_per_interval[1]),
-                RadToDeg(std::sqrt(noise.walk_var_per_interval[2])));
-  std::string out = line;
+  std::string out = StrFormat(
+      "sensor noise floor (from the residual track's high frequencies, %d intervals): ground "
+      "truth %.2f mm / %.2f mm / %.3f deg, odometry walk %.2f mm / %.2f mm / %.3f deg per "
+      "interval of >= 0.2 s (x / y body / heading, one sigma)\n",
+      noise.num_intervals, 1e3 * std::sqrt(noise.ground_truth_var[0]),
+      1e3 * std::sqrt(noise.ground_truth_var[1]), RadToDeg(std::sqrt(noise.ground_truth_var[2])),
+      1e3 * std::sqrt(noise.walk_var_per_interval[0]),
+      1e3 * std::sqrt(noise.walk_var_per_interval[1]),
+      RadToDeg(std::sqrt(noise.walk_var_per_interval[2])));
   if (!test.available) return out + "residual against the sensor noise floor: not available\n";
-  std::snprintf(line, sizeof line,
-                "residual against the sensor noise floor (every run, no repetitions needed): "
-                "%.2f times it, chi2 = %.1f on %.0f df, p = %.2g\n",
-                test.ratio, test.chi2, test.df, test.p_value);
-  out += line;
+  out += StrFormat(
+      "residual against the sensor noise floor (every run, no repetitions needed): %.2f times "
+      "it, chi2 = %.1f on %.0f df, p = %.2g\n",
+      test.ratio, test.chi2, test.df, test.p_value);
   if (test.has_repetition_check) {
-    std::snprintf(line, sizeof line,
-                  "repetitions against the sensor noise floor: they scatter %.2f times it "
-                  "(%.0f df, p = %.2g that they scatter this much by the sensors' noise alone)\n",
-                  test.repetition_ratio, test.repetition_df, test.repetition_p_above);
-    out += line;
+    out += StrFormat(
+        "repetitions against the sensor noise floor: they scatter %.2f times it (%.0f df, p = "
+        "%.2g that they scatter this much by the sensors' noise alone)\n",
+        test.repetition_ratio, test.repetition_df, test.repetition_p_above);
     if (test.repetition_ratio < 0.5 && test.repetition_p_above > 0.999) {
       out +=
           "  (the floor is well above what the repetitions show: here the odometry's errors do not "

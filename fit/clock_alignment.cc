@@ -1,7 +1,6 @@
 #include "fit/clock_alignment.h"
 
 #include <cmath>
-#include <cstdio>
 #include <stdexcept>
 #include <utility>
 
@@ -29,13 +28,12 @@ std::string Summary(const std::string& what, int moved, std::size_t runs,
   const double bound_s = TrackResidualOptions().max_clock_offset_s;
   int on_bound = 0;
   for (const auto& [group, offset_s] : offsets) on_bound += std::abs(offset_s) >= bound_s - 1e-6;
-  char line[320];
-  std::snprintf(line, sizeof line,
-                "clock offsets: %s, %zu groups in [%+.3f, %+.3f] s; ground truth of %d of %zu "
-                "runs re-stamped",
-                what.c_str(), offsets.size(), lo, hi, moved, runs);
+  const std::string line = StrFormat(
+      "clock offsets: %s, %zu groups in [%+.3f, %+.3f] s; ground truth of %d of %zu runs "
+      "re-stamped",
+      what.c_str(), offsets.size(), lo, hi, moved, runs);
   if (on_bound == 0) return line;
-  return std::string(line) + "; " + std::to_string(on_bound) + " of them on the +-" +
+  return line + "; " + std::to_string(on_bound) + " of them on the +-" +
          StrFormat("%g", bound_s) +
          " s bound: not determined by these runs (--clock-offsets none keeps the stamps)";
 }

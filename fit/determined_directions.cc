@@ -7,13 +7,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <map>
 #include <memory>
 
 #include "fit/correlation.h"
 #include "fit/segment_cost.h"
 #include "odometry/parallel_for.h"
+#include "odometry/text_format.h"
 
 namespace fitcal {
 
@@ -78,15 +78,14 @@ std::string DescribeStep(const Robot& robot, const Eigen::VectorXd& prior_units,
   for (int k = 0; k < robot.NumParameters(); ++k) {
     if (std::abs(prior_units[k]) < 0.1 * largest) continue;
     const ParameterInfo& info = robot.parameters[k];
-    char text[96];
+    out += out.empty() ? "" : ", ";
     if (info.unit == ParameterUnit::kAngle) {
-      std::snprintf(text, sizeof text, "%s %+.2g deg", info.name.c_str(), step[k] * 180.0 / M_PI);
+      out += StrFormat("%s %+.2g deg", info.name.c_str(), step[k] * 180.0 / M_PI);
     } else if (info.unit == ParameterUnit::kRatio) {
-      std::snprintf(text, sizeof text, "%s %+.2g", info.name.c_str(), step[k]);
+      out += StrFormat("%s %+.2g", info.name.c_str(), step[k]);
     } else {
-      std::snprintf(text, sizeof text, "%s %+.2g mm", info.name.c_str(), step[k] * 1e3);
+      out += StrFormat("%s %+.2g mm", info.name.c_str(), step[k] * 1e3);
     }
-    out += (out.empty() ? "" : ", ") + std::string(text);
   }
   return out;
 }
@@ -136,18 +135,16 @@ std::string DescribeDirection(const std::vector<AlignedRun>& training,
                               const std::vector<RunJacobian>& runs, const Robot& robot,
                               const Eigen::VectorXd& v, const Eigen::VectorXd& prior_sigma,
                               double fraction, const Eigen::VectorXd& one_sigma_step) {
-  char percent[32];
-  std::snprintf(percent, sizeof percent, "%.0f%%", 100.0 * std::min(fraction, 1.0));
   std::string out = DescribeStep(robot, v, one_sigma_step) +
-                    " together move the training residuals by only one sigma (" + percent +
+                    " together move the training residuals by only one sigma (" +
+                    StrFormat("%.0f%%", 100.0 * std::min(fraction, 1.0)) +
                     " of what the bounds allow)";
   double share = 0.0;
   const std::string trajectory =
       MostInformativeTrajectory(training, runs, prior_sigma.cwiseProduct(v), &share);
   if (!trajectory.empty() && share > 0.0) {
-    std::snprintf(percent, sizeof percent, "%.0f%%", 100.0 * share);
-    out += "; more runs like '" + trajectory + "', which sees it most (" + percent +
-           " of its information), would determine it";
+    out += "; more runs like '" + trajectory + "', which sees it most (" +
+           StrFormat("%.0f%%", 100.0 * share) + " of its information), would determine it";
   }
   return out;
 }

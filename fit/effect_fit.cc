@@ -13,6 +13,7 @@
 #include "fit/ceres_problem.h"
 #include "fit/correlation.h"
 #include "fit/model_fit.h"
+#include "odometry/invalid.h"
 #include "odometry/parallel_for.h"
 
 namespace fitcal {
@@ -204,10 +205,7 @@ std::vector<int> StartAnchorIndices(const AlignedRun& run,
 }
 
 bool TrackOptions::IsValid(std::string* error) const {
-  if (!(edge_margin_s >= 0.0)) {
-    *error = "edge_margin_s must be >= 0";
-    return false;
-  }
+  if (!(edge_margin_s >= 0.0)) return Invalid(error, "edge_margin_s must be >= 0");
   return true;
 }
 

@@ -18,6 +18,7 @@
 #include "fit/last_evaluation_memo.h"
 #include "fit/segment_cost.h"
 #include "fit/serial_covariance.h"
+#include "odometry/text_format.h"
 
 namespace fitcal {
 
@@ -1027,11 +1028,8 @@ std::string ReasonToStartAcrossTheBox(const Robot& robot, const ModelFitResult& 
   }
   const WiderThanItsBox wide = SigmaWiderThanItsBox(robot, fit, options);
   if (wide.parameter < 0) return "";
-  char text[200];
-  std::snprintf(text, sizeof text,
-                "left residuals far above the noise (%s's sigma %.3gx its box's)",
-                robot.parameters[wide.parameter].name.c_str(), wide.ratio);
-  return text;
+  return StrFormat("left residuals far above the noise (%s's sigma %.3gx its box's)",
+                   robot.parameters[wide.parameter].name.c_str(), wide.ratio);
 }
 
 // A point `fraction` of the way across a parameter's box. A ratio's box is a factor either way of
@@ -1123,18 +1121,13 @@ ModelFitResult WithGlobalStart(const std::vector<AlignedRun>& training,
     }
   }
   const std::string tried = fractions + " of the way across the box" + windows;
-  char text[700];
-  if (best_start.empty()) {
-    std::snprintf(text, sizeof text,
-                  "the fit from the guess %s; fits from %s found no lower cost: kept",
-                  reason.c_str(), tried.c_str());
-  } else {
-    std::snprintf(text, sizeof text,
-                  "the fit from the guess %s, cost %.6g; fits from %s: the one from %s found cost "
-                  "%.6g, kept",
-                  reason.c_str(), local_cost, tried.c_str(), best_start.c_str(), best_cost);
-  }
-  best.global_start = text;
+  best.global_start =
+      best_start.empty()
+          ? StrFormat("the fit from the guess %s; fits from %s found no lower cost: kept",
+                      reason.c_str(), tried.c_str())
+          : StrFormat("the fit from the guess %s, cost %.6g; fits from %s: the one from %s found "
+                      "cost %.6g, kept",
+                      reason.c_str(), local_cost, tried.c_str(), best_start.c_str(), best_cost);
   return best;
 }
 

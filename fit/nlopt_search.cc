@@ -14,6 +14,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "odometry/invalid.h"
 #include "odometry/parallel_for.h"
 
 namespace fitcal {
@@ -344,30 +345,19 @@ const NloptMethodInfo& Info(NloptMethod method) {
 }
 
 bool NloptFitOptions::IsValid(std::string* error) const {
-  if (!(weights.position_sigma_m > 0.0) || !(weights.heading_sigma_rad > 0.0)) {
-    *error = "residual sigmas must be positive";
-    return false;
-  }
-  if (max_evaluations < 1) {
-    *error = "max_evaluations must be at least 1";
-    return false;
-  }
+  if (!(weights.position_sigma_m > 0.0) || !(weights.heading_sigma_rad > 0.0))
+    return Invalid(error, "residual sigmas must be positive");
+  if (max_evaluations < 1) return Invalid(error, "max_evaluations must be at least 1");
   if (local_polish && Info(method).global && local_polish_evaluations >= max_evaluations) {
     *error = "local_polish_evaluations must leave part of max_evaluations to the search";
     return false;
   }
-  if (local_polish && local_polish_evaluations < 1) {
-    *error = "local_polish_evaluations must be at least 1";
-    return false;
-  }
-  if (max_time_s < 0.0 || ftol_rel < 0.0 || xtol_rel < 0.0 || progress_interval_s < 0.0) {
-    *error = "max_time_s, tolerances and progress_interval_s must be >= 0";
-    return false;
-  }
-  if (population < 0 || num_threads < 0) {
-    *error = "population and num_threads must be >= 0";
-    return false;
-  }
+  if (local_polish && local_polish_evaluations < 1)
+    return Invalid(error, "local_polish_evaluations must be at least 1");
+  if (max_time_s < 0.0 || ftol_rel < 0.0 || xtol_rel < 0.0 || progress_interval_s < 0.0)
+    return Invalid(error, "max_time_s, tolerances and progress_interval_s must be >= 0");
+  if (population < 0 || num_threads < 0)
+    return Invalid(error, "population and num_threads must be >= 0");
   return true;
 }
 

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <memory>
 #include <string>
@@ -313,18 +312,14 @@ std::string NoiseLevelsText(const NoiseLevels& levels, const std::string& separa
            StrFormat(" (%d fits, %s)", levels.iterations,
                      levels.settled ? "settled" : "not settled");
   }
-  char text[300];
-  std::snprintf(text, sizeof text, "track position %.3g m, heading %.3g deg per checkpoint",
-                levels.track_position_m, RadToDeg(levels.track_heading_rad));
-  std::string out = text;
+  std::string out = StrFormat("track position %.3g m, heading %.3g deg per checkpoint",
+                              levels.track_position_m, RadToDeg(levels.track_heading_rad));
   if (levels.with_final_poses) {
-    std::snprintf(text, sizeof text, "; final pose position %.3g m, heading %.3g deg",
-                  levels.final_position_m, RadToDeg(levels.final_heading_rad));
-    out += text;
+    out += StrFormat("; final pose position %.3g m, heading %.3g deg", levels.final_position_m,
+                     RadToDeg(levels.final_heading_rad));
   }
-  std::snprintf(text, sizeof text, " (%d fits, %s)", levels.iterations,
-                levels.settled ? "settled" : "not settled");
-  return out + text;
+  return out + StrFormat(" (%d fits, %s)", levels.iterations,
+                         levels.settled ? "settled" : "not settled");
 }
 
 }  // namespace fitcal

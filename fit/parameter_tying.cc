@@ -165,8 +165,7 @@ std::string CheckTying(const Robot& robot, const ParameterTying& tying) {
     const Interval box = Intersection(robot, members);
     if (!(box.lo <= box.hi)) {
       return "parameter tying: the bounds of " + robot.parameters[members[0]].name +
-             " and the "
-             "parameters tied to it do not overlap";
+             " and the parameters tied to it do not overlap";
     }
   }
   return "";

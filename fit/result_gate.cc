@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <stdexcept>
 
@@ -74,17 +73,15 @@ std::vector<std::string> GateLines(const std::vector<CalibrationCandidate>& cand
     width = std::max(width, static_cast<int>(c.name.size()));
   }
   for (std::size_t i = 0; i < candidates.size(); ++i) {
-    char line[512];
     if (!candidates[i].usable) {
-      std::snprintf(line, sizeof line, "  %-*s %10s   (not usable: %s)", width,
-                    candidates[i].name.c_str(), "-", candidates[i].not_usable_because.c_str());
-    } else {
-      const double change = nominal > 0.0 ? 100.0 * (decision.cf[i] - nominal) / nominal : 0.0;
-      std::snprintf(line, sizeof line, "  %-*s %10.4f %+8.1f%%%s", width,
-                    candidates[i].name.c_str(), decision.cf[i], change,
-                    static_cast<int>(i) == decision.selected ? "   <- selected" : "");
+      out.push_back(StrFormat("  %-*s %10s   (not usable: %s)", width, candidates[i].name.c_str(),
+                              "-", candidates[i].not_usable_because.c_str()));
+      continue;
     }
-    out.push_back(line);
+    const double change = nominal > 0.0 ? 100.0 * (decision.cf[i] - nominal) / nominal : 0.0;
+    out.push_back(StrFormat("  %-*s %10.4f %+8.1f%%%s", width, candidates[i].name.c_str(),
+                            decision.cf[i], change,
+                            static_cast<int>(i) == decision.selected ? "   <- selected" : ""));
   }
   return out;
 }

@@ -6,17 +6,14 @@
 #include <memory>
 #include <stdexcept>
 
+#include "odometry/invalid.h"
+
 namespace fitcal {
 
 bool SegmentOptions::IsValid(std::string* error) const {
-  if (!(length_m > 0.0)) {
-    *error = "segment length must be positive";
-    return false;
-  }
-  if (!(stride_fraction > 0.0 && stride_fraction <= 1.0)) {
-    *error = "segment stride fraction must be in (0, 1]";
-    return false;
-  }
+  if (!(length_m > 0.0)) return Invalid(error, "segment length must be positive");
+  if (!(stride_fraction > 0.0 && stride_fraction <= 1.0))
+    return Invalid(error, "segment stride fraction must be in (0, 1]");
   return true;
 }
 

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "odometry/invalid.h"
+
 namespace fitcal {
 
 namespace {
@@ -82,22 +84,12 @@ bool ParseFinalPoseObjective(const std::string& text, FinalPoseObjective* out) {
 }
 
 bool CeresFitOptions::IsValid(std::string* error) const {
-  if (!(weights.position_sigma_m > 0.0) || !(weights.heading_sigma_rad > 0.0)) {
-    *error = "residual sigmas must be positive";
-    return false;
-  }
-  if (max_num_iterations < 1) {
-    *error = "max_num_iterations must be at least 1";
-    return false;
-  }
-  if (num_threads < 0) {
-    *error = "num_threads must be >= 0";
-    return false;
-  }
-  if (loss != CeresRobustLoss::kNone && !(loss_scale > 0.0)) {
-    *error = "loss_scale must be positive";
-    return false;
-  }
+  if (!(weights.position_sigma_m > 0.0) || !(weights.heading_sigma_rad > 0.0))
+    return Invalid(error, "residual sigmas must be positive");
+  if (max_num_iterations < 1) return Invalid(error, "max_num_iterations must be at least 1");
+  if (num_threads < 0) return Invalid(error, "num_threads must be >= 0");
+  if (loss != CeresRobustLoss::kNone && !(loss_scale > 0.0))
+    return Invalid(error, "loss_scale must be positive");
   if (loss != CeresRobustLoss::kNone && objective == FinalPoseObjective::kSumOfNorms) {
     *error =
         "a robust loss applies to the sum-of-squares objective; the Eq. 14 sum of norms "

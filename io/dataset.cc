@@ -55,8 +55,7 @@ std::string NoDatasetHint(const fs::path& dir) {
   }
   if (HoldsFileEndingIn(dir, ".db3", 0) || HoldsFileEndingIn(dir, ".mcap", 0)) {
     return "this looks like a ROS 2 bag: import it first (fitcal import rosbag2 <bag> --robot "
-           "<robot YAML> "
-           "--out <data set>) and pass the data set as --logs";
+           "<robot YAML> --out <data set>) and pass the data set as --logs";
   }
   return "--logs takes a data set directory: dataset.yaml, a robot YAML and the runs' logs "
          "(docs/dataset-format.md)";
@@ -71,16 +70,14 @@ std::string ResolvePath(const std::string& directory, const std::string& relativ
   if (!options.allow_paths_outside) {
     if (p.is_absolute()) {
       throw InputError(InputErrorKind::kBadPath, yaml_path, LineOf(node),
-                       "path '" + relative +
-                           "' is absolute; paths are relative to the data set "
-                           "directory (--allow-outside-paths to permit)");
+                       "path '" + relative + "' is absolute; paths are relative to the data set "
+                                             "directory (--allow-outside-paths to permit)");
     }
     for (const auto& part : p) {
       if (part == "..") {
         throw InputError(InputErrorKind::kBadPath, yaml_path, LineOf(node),
                          "path '" + relative +
-                             "' leaves the data set directory "
-                             "(--allow-outside-paths to permit)");
+                             "' leaves the data set directory (--allow-outside-paths to permit)");
       }
     }
   }

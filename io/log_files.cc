@@ -4,7 +4,6 @@
 #include <array>
 #include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <new>
@@ -339,8 +338,7 @@ std::string CounterWrapMessage(int bits) {
   const std::string b = std::to_string(bits);
   const std::string fix =
       bits == 16 || bits == 32
-          ? "declare its width in the robot YAML (encoder: {..., "
-            "counter_bits: " +
+          ? "declare its width in the robot YAML (encoder: {..., counter_bits: " +
                 b + "}) and fitcal unwraps it"
           : "unwrap the counts (add 2^" + b + " after each wrap) before importing";
   return "the tick counter jumps by about 2^" + b + " ticks in one interval: a " + b +
@@ -637,10 +635,8 @@ class GlitchScreen {
     }
     samples_[k].value[c] = around;
     bridged_[k] = true;
-    char text[96];
-    std::snprintf(text, sizeof text, "%.4g rad/s", around);
     return {k + 1, what + "; dropped from the fit (the interval takes the rate around it, " +
-                       std::string(text) + ")"};
+                       StrFormat("%.4g rad/s", around) + ")"};
   }
 
   const Robot& robot_;

@@ -72,8 +72,7 @@ void CheckDocument(const YAML::Node& root, const std::string& path) {
           if (!fresh) {
             throw InputError(InputErrorKind::kDuplicateKey, path, LineOf(entry.first),
                              "key '" + entry.first.Scalar() +
-                                 "' appears twice in one map (first "
-                                 "at line " +
+                                 "' appears twice in one map (first at line " +
                                  std::to_string(it->second) + "); remove one");
           }
         } else {

@@ -43,8 +43,7 @@ void CheckLengths(const std::string& key, const YAML::Node& value, const std::st
     if (std::abs(v) <= kMaxRobotLengthM) continue;
     throw InputError(InputErrorKind::kImplausibleValue, path, line,
                      key + " = " + Text(v) +
-                         " is not a plausible length in metres for a wheeled "
-                         "robot (limit " +
+                         " is not a plausible length in metres for a wheeled robot (limit " +
                          Text(kMaxRobotLengthM) + " m): millimetres? write " + Text(v / 1000.0));
   }
 }
@@ -92,8 +91,7 @@ void CheckListAngles(const YAML::Node& list, const std::string& list_key, const 
     throw InputError(InputErrorKind::kImplausibleValue, path, values.front().second,
                      list_key + ": " + key + " values lie within 2 pi of each other (" + Text(lo) +
                          " to " + Text(hi) +
-                         "): radians where the key says degrees? in degrees "
-                         "they would be " +
+                         "): radians where the key says degrees? in degrees they would be " +
                          as_degrees);
   }
 }

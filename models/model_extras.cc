@@ -17,8 +17,7 @@ void NoteSpread(const std::vector<double>& v, const std::string& what, const std
   const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
   if (*hi - *lo <= 1e-12 * std::abs(*hi)) return;
   notes->push_back(StrFormat(
-      "%s takes one %s: the calibrated %.6g..%.6g %s are written as "
-      "their mean %.6g %s",
+      "%s takes one %s: the calibrated %.6g..%.6g %s are written as their mean %.6g %s",
       key.c_str(), what.c_str(), *lo * scale, *hi * scale, unit, MeanValue(v) * scale, unit));
 }
 

@@ -21,17 +21,26 @@ SvgSeries Series(const std::string& name, const std::string& colour) {
   return s;
 }
 
-// At most `most` points of a polyline for drawing, evenly strided, first and last kept: a run
-// logged at 100 Hz has far more points than a 600-pixel figure can show, and the real-data report
-// must stay small (README: under 2 MB for the OptiOdom omni3 set).
-std::vector<Point2> Thinned(const std::vector<Point2>& line, std::size_t most) {
-  if (line.size() <= most || most < 2) return line;
-  std::vector<Point2> out;
-  out.reserve(most);
-  const double step = static_cast<double>(line.size() - 1) / static_cast<double>(most - 1);
-  for (std::size_t i = 0; i < most; ++i) {
-    out.push_back(line[static_cast<std::size_t>(std::lround(step * static_cast<double>(i)))]);
+// Indices 0..n-1 thinned to at most `most`, evenly strided, first and last kept.
+std::vector<std::size_t> ThinnedIndices(std::size_t n, std::size_t most) {
+  std::vector<std::size_t> out;
+  if (n <= most || most < 2) {
+    for (std::size_t i = 0; i < n; ++i) out.push_back(i);
+    return out;
   }
+  const double step = static_cast<double>(n - 1) / static_cast<double>(most - 1);
+  for (std::size_t i = 0; i < most; ++i) {
+    out.push_back(static_cast<std::size_t>(std::lround(step * static_cast<double>(i))));
+  }
+  return out;
+}
+
+// At most `most` points of a polyline for drawing (ThinnedIndices): a run logged at 100 Hz has
+// far more points than a 600-pixel figure can show, and the real-data report must stay small
+// (README: under 2 MB for the OptiOdom omni3 set).
+std::vector<Point2> Thinned(const std::vector<Point2>& line, std::size_t most) {
+  std::vector<Point2> out;
+  for (std::size_t i : ThinnedIndices(line.size(), most)) out.push_back(line[i]);
   return out;
 }
 
@@ -107,20 +116,6 @@ std::string ResidualHistogramSvg(const ReportData& data) {
 // around them when the track is longer than t_s (MakeReportRun), else the samples alone.
 std::size_t SampleOffset(const std::vector<Point2>& xy, const std::vector<double>& t_s) {
   return xy.size() >= t_s.size() + 2 ? 1 : 0;
-}
-
-// Indices 0..n-1 thinned to at most `most`, first and last kept (as Thinned).
-std::vector<std::size_t> ThinnedIndices(std::size_t n, std::size_t most) {
-  std::vector<std::size_t> out;
-  if (n <= most || most < 2) {
-    for (std::size_t i = 0; i < n; ++i) out.push_back(i);
-    return out;
-  }
-  const double step = static_cast<double>(n - 1) / static_cast<double>(most - 1);
-  for (std::size_t i = 0; i < most; ++i) {
-    out.push_back(static_cast<std::size_t>(std::lround(step * static_cast<double>(i))));
-  }
-  return out;
 }
 
 // Which error of a run a distance figure shows, and how it is scaled for display.

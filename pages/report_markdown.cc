@@ -16,13 +16,8 @@ using namespace report_text;
 std::string MdCell(const std::string& text) {
   std::string out;
   for (char c : text) {
-    if (c == '|') {
-      out += "\\|";
-    } else if (c == '\n') {
-      out += ' ';
-    } else {
-      out += c;
-    }
+    if (c == '|') out += '\\';
+    out += c == '\n' ? ' ' : c;
   }
   return out;
 }
@@ -34,10 +29,11 @@ std::string MdRow(const std::vector<std::string>& cells) {
   return out + "\n";
 }
 
-// The separator row: the first `left` columns left-aligned, the rest right-aligned.
-std::string MdRule(std::size_t columns, std::size_t left) {
-  std::string out = "|";
-  for (std::size_t i = 0; i < columns; ++i) out += i < left ? "---|" : "---:|";
+// The header row and the separator row: the first `left` columns left-aligned, the rest
+// right-aligned.
+std::string MdHeader(const std::vector<std::string>& names, std::size_t left) {
+  std::string out = MdRow(names) + "|";
+  for (std::size_t i = 0; i < names.size(); ++i) out += i < left ? "---|" : "---:|";
   return out + "\n";
 }
 
@@ -71,7 +67,7 @@ void MdSummary(std::ostringstream& m, const ReportData& d) {
        "smaller error, as in every table here.\n\n";
   std::vector<std::string> header = {"group", "runs", ""};
   for (const Column& c : kColumns) header.push_back(c.label);
-  m << MdRow(header) << MdRule(header.size(), 3);
+  m << MdHeader(header, 3);
   for (const ReportSummaryRow& row : d.summary) {
     for (int part = 0; part < 3; ++part) {
       std::vector<std::string> cells = {part == 0 ? row.group : "",
@@ -87,9 +83,9 @@ void MdSummary(std::ostringstream& m, const ReportData& d) {
     }
   }
   m << "\n## Per trajectory\n\n";
-  const std::vector<std::string> per = {
-      "trajectory", "runs", "CF before", "CF after", "final position before [mm]", "after [mm]"};
-  m << MdRow(per) << MdRule(per.size(), 1);
+  m << MdHeader({"trajectory", "runs", "CF before", "CF after", "final position before [mm]",
+                 "after [mm]"},
+                1);
   for (const ReportSummaryRow& row : d.trajectories) {
     m << MdRow({row.group, std::to_string(row.runs), Fmt("%.4f", row.before.cf),
                 Fmt("%.4f", row.after.cf), Fmt("%.1f", 1e3 * row.before.final_distance_m),
@@ -100,10 +96,9 @@ void MdSummary(std::ostringstream& m, const ReportData& d) {
 
 void MdDrift(std::ostringstream& m, const ReportData& d) {
   m << "\n## Drift per distance (relative pose error) and bias\n\n";
-  const std::vector<std::string> header = {"path length [m]",         "windows",
-                                           "translation before [%]",  "after [%]",
-                                           "rotation before [deg/m]", "after [deg/m]"};
-  m << MdRow(header) << MdRule(header.size(), 0);
+  m << MdHeader({"path length [m]", "windows", "translation before [%]", "after [%]",
+                 "rotation before [deg/m]", "after [deg/m]"},
+                0);
   for (const ReportDriftRow& r : d.drift) {
     // A drift that rose is flagged like a run that got worse: short windows show a wrong
     // calibration first (issue 42: 0.5 m, 0.71 -> 0.86 %, went unmarked).
@@ -122,9 +117,7 @@ void MdDrift(std::ostringstream& m, const ReportData& d) {
                         "%.3f")});
   }
   m << "\n";
-  const std::vector<std::string> bias = {"signed mean final error", "x [mm]", "y [mm]",
-                                         "heading [deg]"};
-  m << MdRow(bias) << MdRule(bias.size(), 1);
+  m << MdHeader({"signed mean final error", "x [mm]", "y [mm]", "heading [deg]"}, 1);
   for (bool after : {false, true}) {
     const ReportBias& b = after ? d.bias_after : d.bias_before;
     m << MdRow({after ? "after" : "before", Fmt("%+.1f", 1e3 * b.x_m), Fmt("%+.1f", 1e3 * b.y_m),
@@ -134,9 +127,7 @@ void MdDrift(std::ostringstream& m, const ReportData& d) {
 
 void MdStatistics(std::ostringstream& m, const ReportData& d) {
   m << "\n## Statistics over validation runs (evo names)\n\n";
-  const std::vector<std::string> header = {"metric", "",    "rmse", "mean",
-                                           "median", "std", "min",  "max"};
-  m << MdRow(header) << MdRule(header.size(), 2);
+  m << MdHeader({"metric", "", "rmse", "mean", "median", "std", "min", "max"}, 2);
   for (const ReportStatisticsRow& s : d.statistics) {
     const double scale = s.is_angle ? kDeg : 1.0;
     for (int part = 0; part < 2; ++part) {
@@ -156,7 +147,7 @@ void MdParameters(std::ostringstream& m, const ReportData& d) {
   std::vector<std::string> header = {"parameter", "unit",   "nominal", "calibrated",
                                      "+-1 sigma", "change", "status"};
   if (d.has_cv) header.insert(header.end(), {"CV std", "CV min", "CV max"});
-  m << MdRow(header) << MdRule(header.size(), 2);
+  m << MdHeader(header, 2);
   for (const ReportParameter& p : d.parameters) {
     const double s = ParamScale(p);
     const char* fmt = p.is_angle ? "%.4f" : "%.6f";
@@ -177,14 +168,11 @@ void MdParameters(std::ostringstream& m, const ReportData& d) {
   }
   if (d.effects.empty()) return;
   m << "\n## Effects\n\n";
-  const std::vector<std::string> header_cf = {"", "nominal", "calibrated parameters alone",
-                                              "parameters + effects"};
-  m << MdRow(header_cf) << MdRule(header_cf.size(), 1)
+  m << MdHeader({"", "nominal", "calibrated parameters alone", "parameters + effects"}, 1)
     << MdRow({"held-out CF", Fmt("%.4f", d.summary.back().before.cf),
               Fmt("%.4f", d.cf_parameters_only), Fmt("%.4f", d.summary.back().after.cf)})
     << "\n";
-  const std::vector<std::string> header_e = {"effect", "parameter", "value", "+-1 sigma"};
-  m << MdRow(header_e) << MdRule(header_e.size(), 2);
+  m << MdHeader({"effect", "parameter", "value", "+-1 sigma"}, 2);
   for (const ReportEffect& e : d.effects) {
     for (std::size_t k = 0; k < e.values.size(); ++k) {
       m << MdRow(
@@ -196,10 +184,9 @@ void MdParameters(std::ostringstream& m, const ReportData& d) {
 void MdComparison(std::ostringstream& m, const ReportData& d) {
   if (d.comparison.empty()) return;
   m << "## Calibrations compared (same validation runs)\n\n";
-  const std::vector<std::string> header = {"calibration", "verdict", "held-out CF",
-                                           "final position error [mm]",
-                                           "final |heading error| [deg]"};
-  m << MdRow(header) << MdRule(header.size(), 2);
+  m << MdHeader({"calibration", "verdict", "held-out CF", "final position error [mm]",
+                 "final |heading error| [deg]"},
+                2);
   const ReportSummaryRow& nominal = d.comparison[0].all;
   m << MdRow({"nominal", "", Fmt("%.4f", nominal.before.cf),
               Fmt("%.1f", 1e3 * nominal.before.final_distance_m),

@@ -3,9 +3,10 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <cstdio>
 #include <limits>
+#include <iterator>
 #include <sstream>
+#include <utility>
 
 #include "odometry/text_format.h"
 
@@ -16,10 +17,8 @@ namespace {
 std::string Num(double v) { return StrFormat("%.2f", v); }
 
 std::string TickLabel(double v, double step) {
-  char buf[32];
   const int decimals = step >= 1.0 ? 0 : static_cast<int>(std::ceil(-std::log10(step) - 1e-9));
-  std::snprintf(buf, sizeof buf, "%.*f", std::min(decimals, 6), std::abs(v) < 1e-12 ? 0.0 : v);
-  return buf;
+  return StrFormat("%.*f", std::min(decimals, 6), std::abs(v) < 1e-12 ? 0.0 : v);
 }
 
 struct Range {
@@ -98,12 +97,10 @@ std::string SequentialColour(double u) {
   u = std::clamp(std::isfinite(u) ? u : 0.0, 0.0, 1.0);
   const int k = std::min(3, static_cast<int>(u * 4.0));
   const double f = u * 4.0 - k;
-  char buf[16];
   const auto c = [&](int i) {
     return static_cast<int>(std::lround(kStops[k][i] + f * (kStops[k + 1][i] - kStops[k][i])));
   };
-  std::snprintf(buf, sizeof buf, "#%02x%02x%02x", c(0), c(1), c(2));
-  return buf;
+  return StrFormat("#%02x%02x%02x", c(0), c(1), c(2));
 }
 
 std::string ColourBarSvg(const std::string& label, double lo, double hi, int width) {
@@ -126,27 +123,17 @@ std::string ColourBarSvg(const std::string& label, double lo, double hi, int wid
 }
 
 std::string EscapeXml(const std::string& text) {
+  static const std::pair<char, const char*> kEntities[] = {
+      {'&', "&amp;"}, {'<', "&lt;"}, {'>', "&gt;"}, {'"', "&quot;"}, {'\'', "&#39;"}};
   std::string out;
   out.reserve(text.size());
   for (char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\'':
-        out += "&#39;";
-        break;
-      default:
-        out += c;
+    const auto* entity = std::find_if(std::begin(kEntities), std::end(kEntities),
+                                      [c](const auto& e) { return e.first == c; });
+    if (entity == std::end(kEntities)) {
+      out += c;
+    } else {
+      out += entity->second;
     }
   }
   return out;
@@ -432,15 +419,32 @@ void Box(std::ostringstream& out, std::vector<double> v, double x0, double w,
   out << "\n";
 }
 
-// The opening of a chart over categories (BarChartSvg, BoxPlotSvg): the <svg> with room for the
-// category labels, the title, and a grid line with its label at each of the y ticks `yt`.
-template <typename ToPixelY>
-void OpenCategoryChart(std::ostringstream& out, const BarChartOptions& o,
-                       const CategoryLabels& labels, double left, double pw,
-                       const std::vector<double>& yt, const ToPixelY& py) {
+// A chart over categories (BarChartSvg, BoxPlotSvg), y from lo to hi with a grid line at each
+// tick of `yt`: the frame, the category labels, the axis titles and the legend around what
+// draw_group(out, c, group_x, group_w, py) draws for category c.
+template <typename DrawGroup>
+std::string CategoryChartSvg(const BarChartOptions& o, const std::vector<std::string>& categories,
+                             const std::vector<BarSeries>& legend, double lo, double hi,
+                             const std::vector<double>& yt, const DrawGroup& draw_group) {
+  const double left = 70, right = 20, top = 34, bottom = 74;
+  const double pw = o.width - left - right, ph = o.height - top - bottom;
+  const double group_w = categories.empty() ? pw : pw / static_cast<double>(categories.size());
+  const CategoryLabels labels = LayOutCategoryLabels(categories, group_w);
+  const auto py = [&](double y) { return top + ph - (y - lo) / (hi - lo) * ph; };
+  std::ostringstream out;
   Open(out, o.width, o.height + static_cast<int>(labels.extra_height), o.title);
   Text(out, o.width / 2.0, 20, o.title, "middle", 15, " font-weight=\"bold\"");
   YGrid(out, left, pw, yt, py);
+  for (std::size_t c = 0; c < categories.size(); ++c) {
+    draw_group(out, c, left + static_cast<double>(c) * group_w, group_w, py);
+    CategoryLabel(out, labels, left + (static_cast<double>(c) + 0.5) * group_w, top + ph,
+                  categories[c]);
+  }
+  out << "<rect x=\"" << Num(left) << "\" y=\"" << Num(top) << "\" width=\"" << Num(pw)
+      << "\" height=\"" << Num(ph) << "\" fill=\"none\" stroke=\"#333\"/>\n";
+  AxisLabelsAndLegend(out, left, top, pw, ph, labels.extra_height, o, legend);
+  out << "</svg>\n";
+  return out.str();
 }
 
 }  // namespace
@@ -454,35 +458,23 @@ std::string BarChartSvg(const BarChartOptions& o, const std::vector<std::string>
     }
   }
   if (!(vmax > 0.0)) vmax = 1.0;
-  const double left = 70, right = 20, top = 34, bottom = 74;
-  const double pw = o.width - left - right;
-  const double ph = o.height - top - bottom;
-  const double group_w = categories.empty() ? pw : pw / static_cast<double>(categories.size());
-  const CategoryLabels labels = LayOutCategoryLabels(categories, group_w);
   const auto yt = NiceTicks(0.0, vmax * 1.05, 6);
   const double ymax = std::max(vmax * 1.05, yt.empty() ? vmax : yt.back());
-  auto py = [&](double y) { return top + ph - y / ymax * ph; };
-  std::ostringstream out;
-  OpenCategoryChart(out, o, labels, left, pw, yt, py);
-  const double bar_w = 0.8 * group_w / std::max<double>(1.0, static_cast<double>(series.size()));
-  for (std::size_t c = 0; c < categories.size(); ++c) {
-    const double gx = left + static_cast<double>(c) * group_w + 0.1 * group_w;
+  const double bars = std::max<double>(1.0, static_cast<double>(series.size()));
+  const auto draw_bars = [&](std::ostringstream& out, std::size_t c, double group_x,
+                             double group_w, const auto& py) {
+    const double bar_w = 0.8 * group_w / bars;
     for (std::size_t s = 0; s < series.size(); ++s) {
       const double v = c < series[s].values.size() ? series[s].values[c] : 0.0;
       if (!std::isfinite(v)) continue;
-      out << "<rect x=\"" << Num(gx + static_cast<double>(s) * bar_w) << "\" y=\"" << Num(py(v))
-          << "\" width=\"" << Num(bar_w) << "\" height=\"" << Num(py(0.0) - py(v)) << "\" fill=\""
-          << series[s].color << "\"><title>" << EscapeXml(categories[c]) << " "
-          << EscapeXml(series[s].name) << ": " << v << "</title></rect>";
+      out << "<rect x=\"" << Num(group_x + 0.1 * group_w + static_cast<double>(s) * bar_w)
+          << "\" y=\"" << Num(py(v)) << "\" width=\"" << Num(bar_w) << "\" height=\""
+          << Num(py(0.0) - py(v)) << "\" fill=\"" << series[s].color << "\"><title>"
+          << EscapeXml(categories[c]) << " " << EscapeXml(series[s].name) << ": " << v
+          << "</title></rect>";
     }
-    CategoryLabel(out, labels, left + (static_cast<double>(c) + 0.5) * group_w, top + ph,
-                  categories[c]);
-  }
-  out << "<rect x=\"" << Num(left) << "\" y=\"" << Num(top) << "\" width=\"" << Num(pw)
-      << "\" height=\"" << Num(ph) << "\" fill=\"none\" stroke=\"#333\"/>\n";
-  AxisLabelsAndLegend(out, left, top, pw, ph, labels.extra_height, o, series);
-  out << "</svg>\n";
-  return out.str();
+  };
+  return CategoryChartSvg(o, categories, series, 0.0, ymax, yt, draw_bars);
 }
 
 std::string BoxPlotSvg(const BarChartOptions& o, const std::vector<std::string>& categories,
@@ -496,32 +488,20 @@ std::string BoxPlotSvg(const BarChartOptions& o, const std::vector<std::string>&
   }
   yr.Pad(0.05);
   yr.lo = std::max(yr.lo, 0.0);  // errors: never below zero
-  const double left = 70, right = 20, top = 34, bottom = 74;
-  const double pw = o.width - left - right, ph = o.height - top - bottom;
-  const double group_w = categories.empty() ? pw : pw / static_cast<double>(categories.size());
-  const CategoryLabels labels = LayOutCategoryLabels(categories, group_w);
-  const auto yt = NiceTicks(yr.lo, yr.hi, 6);
-  auto py = [&](double y) { return top + ph - (y - yr.lo) / (yr.hi - yr.lo) * ph; };
-  std::ostringstream out;
-  OpenCategoryChart(out, o, labels, left, pw, yt, py);
-  const double box_w = 0.7 * group_w / std::max<double>(1.0, static_cast<double>(series.size()));
-  for (std::size_t c = 0; c < categories.size(); ++c) {
+  const double boxes = std::max<double>(1.0, static_cast<double>(series.size()));
+  const auto draw_boxes = [&](std::ostringstream& out, std::size_t c, double group_x,
+                              double group_w, const auto& py) {
+    const double box_w = 0.7 * group_w / boxes;
     for (std::size_t k = 0; k < series.size(); ++k) {
       if (c >= series[k].samples.size() || series[k].samples[c].empty()) continue;
-      const double x0 =
-          left + static_cast<double>(c) * group_w + 0.15 * group_w + static_cast<double>(k) * box_w;
+      const double x0 = group_x + 0.15 * group_w + static_cast<double>(k) * box_w;
       Box(out, series[k].samples[c], x0 + 0.1 * box_w, 0.8 * box_w, series[k].color, py);
     }
-    CategoryLabel(out, labels, left + (static_cast<double>(c) + 0.5) * group_w, top + ph,
-                  categories[c]);
-  }
-  out << "<rect x=\"" << Num(left) << "\" y=\"" << Num(top) << "\" width=\"" << Num(pw)
-      << "\" height=\"" << Num(ph) << "\" fill=\"none\" stroke=\"#333\"/>\n";
+  };
   std::vector<BarSeries> legend;
   for (const BoxSeries& s : series) legend.push_back({s.name, s.color, {}});
-  AxisLabelsAndLegend(out, left, top, pw, ph, labels.extra_height, o, legend);
-  out << "</svg>\n";
-  return out.str();
+  return CategoryChartSvg(o, categories, legend, yr.lo, yr.hi, NiceTicks(yr.lo, yr.hi, 6),
+                          draw_boxes);
 }
 
 std::string HeatMapSvg(const std::string& title, const std::vector<std::string>& labels,
@@ -546,10 +526,7 @@ std::string HeatMapSvg(const std::string& title, const std::vector<std::string>&
     u = std::clamp(std::isfinite(u) ? u : 0.5, 0.0, 1.0);
     const double a = std::abs(2.0 * u - 1.0);
     const int fade = static_cast<int>(std::lround(255.0 * (1.0 - a)));
-    const int full = 255;
-    const int r = u >= 0.5 ? full : fade, b = u >= 0.5 ? fade : full;
-    const int g = fade;
-    return StrFormat("#%02x%02x%02x", r, g, b);
+    return u >= 0.5 ? StrFormat("#ff%02x%02x", fade, fade) : StrFormat("#%02x%02xff", fade, fade);
   };
   std::ostringstream out;
   Open(out, width, height, title);
@@ -567,11 +544,10 @@ std::string HeatMapSvg(const std::string& title, const std::vector<std::string>&
       // Two decimals, four (smaller) where two would round a correlation that is not exactly 1
       // to 1.00: a strongly correlated pair (0.9993 on a differential drive's circles) must not
       // read as the diagonal.
-      char buf[16];
       const bool near_one = i != j && std::abs(v) >= 0.995 && std::abs(v) < 1.0;
-      std::snprintf(buf, sizeof buf, near_one ? "%.4f" : "%.2f", v);
       const bool dark = std::abs((v - lo) / (hi - lo) * 2.0 - 1.0) > 0.6;
-      Text(out, x + cell_px / 2.0, y + cell_px / 2.0 + 4, buf, "middle", near_one ? 10 : 11,
+      Text(out, x + cell_px / 2.0, y + cell_px / 2.0 + 4,
+           StrFormat(near_one ? "%.4f" : "%.2f", v), "middle", near_one ? 10 : 11,
            dark ? " fill=\"#fff\"" : "");
     }
   }

@@ -9,6 +9,7 @@
 #include "io/atomic_file.h"
 #include "io/dataset.h"
 #include "odometry/parallel_for.h"
+#include "odometry/text_format.h"
 #include "sim/stepped_run.h"
 
 namespace fitcal::sim {
@@ -251,9 +252,7 @@ ModelSimulatedRun SimulateRun(const RobotModelInterface& model, const std::vecto
   truth[0] = run.true_start_pose;
   model.Replay(p.data(), fine, 0, fine.size(), run.true_start_pose,
                [&truth](std::size_t k, const Pose2d& pose) { truth[k + 1] = pose; });
-  char id[160];
-  std::snprintf(id, sizeof id, "%s-rep%02d", spec.label.c_str(), spec.repetition);
-  run.log.id = id;
+  run.log.id = StrFormat("%s-rep%02d", spec.label.c_str(), spec.repetition);
   run.log.trajectory = spec.label;
   run.log.repetition = spec.repetition;
   for (const ChannelInfo& ch : model.robot().channels)

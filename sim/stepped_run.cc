@@ -1,10 +1,11 @@
 #include "sim/stepped_run.h"
 
 #include <cmath>
-#include <cstdio>
 #include <memory>
 #include <random>
 #include <stdexcept>
+
+#include "odometry/text_format.h"
 
 namespace fitcal::sim {
 
@@ -158,9 +159,7 @@ void SteppedRun::Start() {
 }
 
 ModelSimulatedRun SteppedRun::Run() {
-  char id[160];
-  std::snprintf(id, sizeof id, "%s-rep%02d", spec_.label.c_str(), spec_.repetition);
-  out_.log.id = id;
+  out_.log.id = StrFormat("%s-rep%02d", spec_.label.c_str(), spec_.repetition);
   out_.log.trajectory = spec_.label;
   out_.log.repetition = spec_.repetition;
   out_.log.encoders.samples = EncoderSamples(c_);

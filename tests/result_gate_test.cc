@@ -31,6 +31,16 @@ std::vector<AlignedRun> Family(const std::string& family, int labels, int reps) 
   return runs;
 }
 
+// The never-worse judgement of a CF per run alone (JudgeNeverWorse without ATE or drift).
+std::vector<NeverWorseJudgement> JudgeNeverWorseOnCf(const std::vector<AlignedRun>& runs,
+                                                     const std::vector<double>& nominal_cf,
+                                                     const std::vector<double>& calibrated_cf) {
+  EverydayDrivingMetrics nominal, calibrated;
+  nominal.per_run_cf = nominal_cf;
+  calibrated.per_run_cf = calibrated_cf;
+  return JudgeNeverWorse(runs, nominal, calibrated);
+}
+
 // The generator: one value per run, level_of_label * (1 + shift) * (1 + sigma * N(0, 1)).
 std::vector<double> Draw(const std::vector<AlignedRun>& runs, double sigma, double shift,
                          std::mt19937_64* rng) {

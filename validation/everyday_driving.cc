@@ -1,6 +1,5 @@
 #include "validation/everyday_driving.h"
 
-#include <cstdio>
 #include <stdexcept>
 #include <utility>
 
@@ -77,13 +76,11 @@ std::vector<std::string> EverydayDrivingRows(const EverydayDrivingMetrics& befor
     const DriftAtLength& a = before.drift[k];
     const DriftAtLength& b = after.drift[k];
     if (a.windows == 0) continue;
-    char name[64];
-    std::snprintf(name, sizeof name, "drift %g m [%%] (%d windows)", a.length_m, a.windows);
-    row(name, a.translation_percent, b.translation_percent,
+    row(StrFormat("drift %g m [%%] (%d windows)", a.length_m, a.windows), a.translation_percent,
+        b.translation_percent,
         StrFormat("%10.3f %10.3f", a.translation_percent, b.translation_percent),
         StrFormat("drift %g m [%%]", a.length_m));
-    std::snprintf(name, sizeof name, "drift %g m [deg/m]", a.length_m);
-    row(name, a.rotation_deg_per_m, b.rotation_deg_per_m,
+    row(StrFormat("drift %g m [deg/m]", a.length_m), a.rotation_deg_per_m, b.rotation_deg_per_m,
         StrFormat("%10.3f %10.3f", a.rotation_deg_per_m, b.rotation_deg_per_m));
   }
   return rows;

@@ -1,10 +1,10 @@
 #include "validation/held_out_halves.h"
 
 #include <algorithm>
-#include <cstdio>
 #include <set>
 #include <utility>
 
+#include "odometry/text_format.h"
 #include "validation/time_blocks.h"
 
 namespace fitcal {
@@ -140,11 +140,10 @@ HalvesJudgement JudgeOnHeldOutHalves(const RunSplit& split, ResidualKind residua
 }
 
 std::string HalvesDescription(const HalvesJudgement& j) {
-  char cf[64];
-  std::snprintf(cf, sizeof(cf), "CF %.4f -> %.4f", j.nominal_cf, j.calibrated_cf);
+  const std::string cf = StrFormat("CF %.4f -> %.4f", j.nominal_cf, j.calibrated_cf);
   if (!j.by_time) {
     return "held-out halves of the training runs (two folds, every other run against the rest; " +
-           std::string(cf) + ")";
+           cf + ")";
   }
   std::string counts;
   for (int c : j.block_counts) counts += (counts.empty() ? "" : ", ") + std::to_string(c);

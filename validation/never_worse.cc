@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <map>
 #include <utility>
 
@@ -83,14 +82,13 @@ std::vector<Measure> Measures(const EverydayDrivingMetrics& nominal,
   for (std::size_t k = 0; k < nominal.drift.size() && k < calibrated.drift.size(); ++k) {
     const DriftAtLength& a = nominal.drift[k];
     if (a.windows == 0 || a.per_run_windows.size() != ones.size()) continue;
-    char name[48];
-    std::snprintf(name, sizeof name, "drift %g m [%%]", a.length_m);
     // Drift per family and over 0.5 m warns only (docs/never_worse.md): on the real diff drive
     // the default track fit, better on all held-out runs at 1-5 m, drifts more on the squares at
     // 1 m (0.52 -> 0.89 %) and on all runs at 0.5 m (0.71 -> 0.86 %), windows the ground truth's
     // own noise (2-3 mm) and the encoder-to-ground-truth clock offset dominate.
     const bool short_window = a.length_m < 1.0;
-    out.push_back({name, std::vector<double>(a.per_run_windows.begin(), a.per_run_windows.end()),
+    out.push_back({StrFormat("drift %g m [%%]", a.length_m),
+                   std::vector<double>(a.per_run_windows.begin(), a.per_run_windows.end()),
                    a.per_run_translation_percent, calibrated.drift[k].per_run_translation_percent,
                    !short_window, false});
   }
@@ -170,33 +168,22 @@ NeverWorseJudgement JudgeMeasure(const std::string& measure, const std::string& 
 }
 
 std::string NeverWorseJudgement::Description() const {
-  char text[320];
   if (spread.dof == 0) {
-    std::snprintf(text, sizeof text,
-                  "%s %.6g -> %.6g (margin 0: no trajectory repeats, the noise is not measured)",
-                  measure.c_str(), nominal, calibrated);
-  } else {
-    std::snprintf(text, sizeof text,
-                  "%s %.6g -> %.6g, %s the margin %.3g (t %.2f x spread %.3g %% of a "
-                  "run's value between repetitions, %d dof)",
-                  measure.c_str(), nominal, calibrated, Worse() ? "more than" : "within", margin,
-                  t, 100.0 * spread.relative_sd,
-                  spread.dof);
+    return StrFormat(
+        "%s %.6g -> %.6g (margin 0: no trajectory repeats, the noise is not measured)",
+        measure.c_str(), nominal, calibrated);
   }
-  return text;
+  return StrFormat(
+      "%s %.6g -> %.6g, %s the margin %.3g (t %.2f x spread %.3g %% of a run's value between "
+      "repetitions, %d dof)",
+      measure.c_str(), nominal, calibrated, Worse() ? "more than" : "within", margin, t,
+      100.0 * spread.relative_sd, spread.dof);
 }
 
 std::vector<NeverWorseJudgement> JudgeNeverWorse(const std::vector<AlignedRun>& runs,
                                                  const EverydayDrivingMetrics& nominal,
                                                  const EverydayDrivingMetrics& calibrated) {
   return JudgeAll(runs, Measures(nominal, calibrated));
-}
-
-std::vector<NeverWorseJudgement> JudgeCalibrationNeverWorse(
-    const RobotModelInterface& model, const CalibrationCandidate& nominal,
-    const CalibrationCandidate& calibrated, const std::vector<AlignedRun>& runs,
-    const std::vector<const GroundTruthTrack*>& tracks, int num_threads) {
-  return CompareEverydayDriving(model, nominal, calibrated, runs, tracks, num_threads).judgements;
 }
 
 EverydayDrivingComparison CompareEverydayDriving(const RobotModelInterface& model,
@@ -217,12 +204,6 @@ EverydayDrivingComparison CompareEverydayDriving(const RobotModelInterface& mode
   return c;
 }
 
-std::vector<NeverWorseJudgement> JudgeNeverWorseOnCf(const std::vector<AlignedRun>& runs,
-                                                     const std::vector<double>& nominal_cf,
-                                                     const std::vector<double>& calibrated_cf) {
-  const std::vector<double> ones(runs.size(), 1.0);
-  return JudgeAll(runs, {{"CF", ones, nominal_cf, calibrated_cf}});
-}
 
 std::vector<std::string> NeverWorseRefusals(const std::string& name,
                                             const std::vector<NeverWorseJudgement>& judgements,
@@ -242,10 +223,9 @@ std::vector<std::string> NeverWorseWithinScatter(const std::string& name,
   std::vector<std::string> out;
   for (const NeverWorseJudgement& j : judgements) {
     if (!j.WorseWithinScatter()) continue;
-    char change[32];
-    std::snprintf(change, sizeof change, " (%+.1f %%)", 100.0 * (j.calibrated / j.nominal - 1.0));
     std::string text = j.Description();
-    text.insert(text.find(','), change);
+    const double change_percent = 100.0 * (j.calibrated / j.nominal - 1.0);
+    text.insert(text.find(','), StrFormat(" (%+.1f %%)", change_percent));
     out.push_back("'" + name + "' is worse than the nominal on the " + j.runs +
                   ", within the runs' scatter: " + text);
   }

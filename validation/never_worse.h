@@ -96,13 +96,6 @@ std::vector<NeverWorseJudgement> JudgeNeverWorse(const std::vector<AlignedRun>& 
                                                  const EverydayDrivingMetrics& nominal,
                                                  const EverydayDrivingMetrics& calibrated);
 
-// Both calibrations replayed on `runs` (tracks[i] is runs[i]'s ground truth) at
-// EverydayDriftLengths(), then judged as above.
-std::vector<NeverWorseJudgement> JudgeCalibrationNeverWorse(
-    const RobotModelInterface& model, const CalibrationCandidate& nominal,
-    const CalibrationCandidate& calibrated, const std::vector<AlignedRun>& runs,
-    const std::vector<const GroundTruthTrack*>& tracks, int num_threads = 0);
-
 // A calibration beside the nominal for everyday driving on `runs` (tracks[i] is runs[i]'s ground
 // truth): both replayed once at EverydayDriftLengths(), the never-worse judgements of the
 // calibration and the rows of the table `fit` and `generalise` print (EverydayDrivingRows, a
@@ -117,11 +110,6 @@ EverydayDrivingComparison CompareEverydayDriving(const RobotModelInterface& mode
                                                  const std::vector<AlignedRun>& runs,
                                                  const std::vector<const GroundTruthTrack*>& tracks,
                                                  int num_threads = 0);
-
-// The same for a CF per run only (commands that judge final poses: export).
-std::vector<NeverWorseJudgement> JudgeNeverWorseOnCf(const std::vector<AlignedRun>& runs,
-                                                     const std::vector<double>& nominal_cf,
-                                                     const std::vector<double>& calibrated_cf);
 
 // The judgements that refuse (refusing = false: those worse that only warn), as lines "'<name>'
 // is worse than the nominal on the <runs>: ...".

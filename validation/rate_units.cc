@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 
 #include "odometry/aligned_run.h"
+#include "odometry/text_format.h"
 
 namespace fitcal {
 namespace {
@@ -87,19 +87,17 @@ RateUnitsFinding CheckModelRateUnits(const RobotModelInterface& model,
   };
   if (plausible(finding.scale)) return finding;
   finding.suspicious = true;
-  char line[400];
   // Positions that agree and turns that do not: the ground truth's heading column is in another
   // unit (degrees read as radians turn 57x as much; wrapped to +-pi between samples, less).
   const double translation_scale =
       lengths.odometry_translation_m / lengths.truth_translation_m;
   if (lengths.truth_translation_m > kMinEvidenceM && plausible(translation_scale)) {
     finding.likely_unit = "ground-truth heading";
-    std::snprintf(line, sizeof line,
-                  "the ground truth's positions travel as the nominal robot's odometry does "
-                  "(%.3g times) but with its turns the path is %.3g times the odometry's: the "
-                  "ground truth's heading (theta) is not in radians (degrees?); nothing fitted",
-                  1.0 / translation_scale, 1.0 / finding.scale);
-    finding.message = line;
+    finding.message = StrFormat(
+        "the ground truth's positions travel as the nominal robot's odometry does (%.3g times) "
+        "but with its turns the path is %.3g times the odometry's: the ground truth's heading "
+        "(theta) is not in radians (degrees?); nothing fitted",
+        1.0 / translation_scale, 1.0 / finding.scale);
     return finding;
   }
   struct Unit {
@@ -120,21 +118,18 @@ RateUnitsFinding CheckModelRateUnits(const RobotModelInterface& model,
   // so the pooled ratio lies a little above it).
   if (std::abs(std::log(finding.scale / 1e-3)) < std::log(3.0)) {
     finding.likely_unit = "ground truth in mm";
-    std::snprintf(
-        line, sizeof line,
+    finding.message = StrFormat(
         "the ground truth's path is %.3g times the nominal robot's odometry: ground-truth "
         "positions in millimetres, not metres?; nothing fitted",
         1.0 / finding.scale);
-    finding.message = line;
     return finding;
   }
-  std::snprintf(line, sizeof line,
-                "the nominal robot's odometry travels %.3g times the ground truth's path: the "
-                "encoder rates are not in rad/s%s%s%s (or the robot file's wheel sizes or "
-                "encoder.ticks_per_rev are off by that factor); nothing fitted",
-                finding.scale, finding.likely_unit.empty() ? "" : " (they look like ",
-                finding.likely_unit.c_str(), finding.likely_unit.empty() ? "" : ")");
-  finding.message = line;
+  finding.message = StrFormat(
+      "the nominal robot's odometry travels %.3g times the ground truth's path: the encoder "
+      "rates are not in rad/s%s%s%s (or the robot file's wheel sizes or encoder.ticks_per_rev "
+      "are off by that factor); nothing fitted",
+      finding.scale, finding.likely_unit.empty() ? "" : " (they look like ",
+      finding.likely_unit.c_str(), finding.likely_unit.empty() ? "" : ")");
   return finding;
 }
 

@@ -29,15 +29,8 @@ namespace {
 // TrajectoryErrors (one run) and Table6Averages (a group) carry the same Eq. 8-14 fields.
 template <typename Metrics>
 io::ReportMetrics MetricsOf(const Metrics& e) {
-  io::ReportMetrics m;
-  m.rms_distance_m = e.rms_distance_m;
-  m.rms_angle_rad = e.rms_angle_rad;
-  m.max_distance_m = e.max_distance_m;
-  m.max_angle_rad = e.max_angle_rad;
-  m.final_distance_m = e.final_distance_m;
-  m.final_angle_rad = e.final_angle_rad;
-  m.cf = e.cf;
-  return m;
+  return {e.rms_distance_m,   e.rms_angle_rad,   e.max_distance_m, e.max_angle_rad,
+          e.final_distance_m, e.final_angle_rad, e.cf};  // io::ReportMetrics' order
 }
 
 io::ReportStatistics StatsOf(const SummaryStatistics& s) {

@@ -1,7 +1,6 @@
 #include "validation/residual_kind_transfer.h"
 
 #include <cmath>
-#include <cstdio>
 #include <future>
 #include <map>
 
@@ -122,27 +121,24 @@ ResidualKindJudgement JudgeResidualKindsByTransfer(ResidualKind proposed, Residu
 std::vector<std::string> ResidualKindJudgementLines(const ResidualKindJudgement& j) {
   std::vector<std::string> lines;
   if (!j.judged) return lines;
-  char line[256];
-  std::snprintf(line, sizeof(line),
-                "residual kinds judged on runs of a kind they were not fitted on (%s | %s):",
-                ToString(j.proposed), ToString(j.alternative));
-  lines.push_back(line);
-  std::snprintf(line, sizeof(line), "  %-22s %-22s %21s %21s %21s", "judged on (runs)", "fitted on",
-                "CF", "drift 2 m [%]", "ATE RMSE [m]");
-  lines.push_back(line);
+  lines.push_back(
+      StrFormat("residual kinds judged on runs of a kind they were not fitted on (%s | %s):",
+                ToString(j.proposed), ToString(j.alternative)));
+  lines.push_back(StrFormat("  %-22s %-22s %21s %21s %21s", "judged on (runs)", "fitted on", "CF",
+                            "drift 2 m [%]", "ATE RMSE [m]"));
   for (const KindComparison& c : j.comparisons) {
     const DriftAtLength* p = DriftAt(c.proposed, kTransferDriftLength_m);
     const DriftAtLength* a = DriftAt(c.alternative, kTransferDriftLength_m);
-    char drift[64] = "-";
-    if (p != nullptr && a != nullptr)
-      std::snprintf(drift, sizeof(drift), "%.3f | %.3f", p->translation_percent,
-                    a->translation_percent);
+    const std::string drift =
+        p != nullptr && a != nullptr
+            ? StrFormat("%.3f | %.3f", p->translation_percent, a->translation_percent)
+            : "-";
     const std::string judged = c.judged_on + " (" + std::to_string(c.runs) + ")";
-    std::snprintf(line, sizeof(line), "  %-22s %-22s %10.4f | %-8.4f %21s %10.4f | %-8.4f",
-                  judged.c_str(), c.fitted_on.c_str(), c.proposed.cf, c.alternative.cf, drift,
-                  c.proposed.mean_ate_rmse_m, c.alternative.mean_ate_rmse_m);
     // The last column is left-aligned: its padding would end the line in spaces (issue 42).
-    std::string row = line;
+    std::string row = StrFormat("  %-22s %-22s %10.4f | %-8.4f %21s %10.4f | %-8.4f",
+                                judged.c_str(), c.fitted_on.c_str(), c.proposed.cf,
+                                c.alternative.cf, drift.c_str(), c.proposed.mean_ate_rmse_m,
+                                c.alternative.mean_ate_rmse_m);
     row.erase(row.find_last_not_of(' ') + 1);
     lines.push_back(row);
   }

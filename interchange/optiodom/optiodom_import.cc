@@ -1,6 +1,5 @@
 #include "interchange/optiodom/optiodom_import.h"
 
-#include <cstdio>
 #include <stdexcept>
 
 #include "diagnosis/import_channel_order.h"
@@ -52,12 +51,10 @@ std::size_t MajoritySession(const std::vector<SessionHead>& sessions) {
 // "b = 0.205 m, D = 0.084 / 0.084 m".
 std::string DescribeGeometry(const RobotKind& kind, const SessionHead& s) {
   std::string out;
-  char value[40];
   for (std::size_t r = 0; r < s.geometry.size(); ++r) {
     out += (r == 0 ? "" : ", ") + std::string(kind.geometry[r].label) + " =";
     for (std::size_t i = 0; i < s.geometry[r].size(); ++i) {
-      std::snprintf(value, sizeof value, "%s%g", i == 0 ? " " : " / ", s.geometry[r][i]);
-      out += value;
+      out += StrFormat("%s%g", i == 0 ? " " : " / ", s.geometry[r][i]);
     }
     out += " " + std::string(kind.geometry[r].unit);
   }
@@ -66,9 +63,8 @@ std::string DescribeGeometry(const RobotKind& kind, const SessionHead& s) {
 
 // <path><sep><session><sep>runNN.
 std::string RunId(const RobotKind& kind, const SessionHead& s, int number) {
-  char run[16];
-  std::snprintf(run, sizeof run, "run%02d", number);
-  return s.files.path_type + kind.id_separator + s.files.name + kind.id_separator + run;
+  return s.files.path_type + kind.id_separator + s.files.name + kind.id_separator +
+         StrFormat("run%02d", number);
 }
 
 // A run file to read: its session (index), its number and its path.

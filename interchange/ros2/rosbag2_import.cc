@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <stdexcept>
 
@@ -220,9 +219,7 @@ RunLog MakeRun(const Robot& robot, const BagStreams& s, const std::vector<double
                const IndexSpan& span, int number, const std::string& label,
                std::vector<double>* t_out, std::vector<double>* rows_out) {
   RunLog run;
-  char id[32];
-  std::snprintf(id, sizeof id, "-%02d", number);
-  run.id = label + id;
+  run.id = label + StrFormat("-%02d", number);
   run.trajectory = label;
   run.repetition = number;
   const std::size_t c = robot.channels.size(), count = span.last - span.first + 1;
@@ -248,12 +245,10 @@ RunLog MakeRun(const Robot& robot, const BagStreams& s, const std::vector<double
     run.ground_truth.world_T_robot.push_back(s.poses.world_T_robot[k]);
   }
   if (run.ground_truth.t_s.size() < 2) {
-    char what[160];
-    std::snprintf(what, sizeof what,
-                  "run %s (%.3f:%.3f s) holds %zu ground-truth pose(s); at "
-                  "least 2 needed",
-                  run.id.c_str(), t0, t1, run.ground_truth.t_s.size());
-    throw InputError(InputErrorKind::kNoOverlap, s.bag, 0, what);
+    throw InputError(InputErrorKind::kNoOverlap, s.bag, 0,
+                     StrFormat("run %s (%.3f:%.3f s) holds %zu ground-truth pose(s); at least 2 "
+                               "needed",
+                               run.id.c_str(), t0, t1, run.ground_truth.t_s.size()));
   }
   return run;
 }

@@ -64,21 +64,17 @@ std::int64_t Nanoseconds(const YAML::Node& map, const std::string& key, const st
 
 TopicInfo ReadTopic(const YAML::Node& entry, const std::string& path) {
   const YAML::Node topic = Required(entry, "topic_metadata", path);
-  TopicInfo info;
-  info.name = Get<std::string>(topic, "name", path);
-  info.type = Get<std::string>(topic, "type", path);
-  info.serialization_format = Get<std::string>(topic, "serialization_format", path);
-  info.message_count = Get<std::uint64_t>(entry, "message_count", path);
-  return info;
+  // A braced list reads the keys in order, so the first missing one is the one reported.
+  return {Get<std::string>(topic, "name", path), Get<std::string>(topic, "type", path),
+          Get<std::string>(topic, "serialization_format", path),
+          Get<std::uint64_t>(entry, "message_count", path)};
 }
 
 BagFileInfo ReadFileInfo(const YAML::Node& entry, const std::string& path) {
-  BagFileInfo file;
-  file.path = Get<std::string>(entry, "path", path);
-  file.starting_time_ns = Nanoseconds(entry, "starting_time", "nanoseconds_since_epoch", path);
-  file.duration_ns = Nanoseconds(entry, "duration", "nanoseconds", path);
-  file.message_count = Get<std::uint64_t>(entry, "message_count", path);
-  return file;
+  return {Get<std::string>(entry, "path", path),
+          Nanoseconds(entry, "starting_time", "nanoseconds_since_epoch", path),
+          Nanoseconds(entry, "duration", "nanoseconds", path),
+          Get<std::uint64_t>(entry, "message_count", path)};
 }
 
 // rosbag2's metadata versions so far: 1-9 (9 from Jazzy, 2024). A version outside them is a

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <optional>
 
@@ -136,8 +135,7 @@ class JointCollector {
                     std::string("has ") + std::to_string(field.size()) +
                         (out_->positions ? " positions" : " velocities") + " for " +
                         std::to_string(js.name.size()) +
-                        " joint names (earlier messages had one "
-                        "per joint)");
+                        " joint names (earlier messages had one per joint)");
     }
     for (std::size_t j = 0; j < index_.size(); ++j) {
       const double v = field[index_[j]];
@@ -237,13 +235,11 @@ constexpr double kUnitQuaternionTolerance = 1e-3;
 Pose2d PlanarPose(const Point& p, const Quaternion& q, const Header& header, const BagMessage& m) {
   const double norm = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
   if (!(std::abs(norm - 1.0) <= kUnitQuaternionTolerance)) {
-    char what[200];
-    std::snprintf(what, sizeof what,
-                  "orientation (x %.6g, y %.6g, z %.6g, w %.6g) is %s quaternion (norm %.6g), "
-                  "not a rotation; header stamp ",
-                  q.x, q.y, q.z, q.w, norm == 0.0 ? "a zero" : "not a unit", norm);
     ThrowBagError(InputErrorKind::kBadValue, Describe(m),
-                  what + Seconds(header.stamp.ToNanoseconds()));
+                  StrFormat("orientation (x %.6g, y %.6g, z %.6g, w %.6g) is %s quaternion (norm "
+                            "%.6g), not a rotation; header stamp ",
+                            q.x, q.y, q.z, q.w, norm == 0.0 ? "a zero" : "not a unit", norm) +
+                      Seconds(header.stamp.ToNanoseconds()));
   }
   return {p.x, p.y, YawOfQuaternion(q.x, q.y, q.z, q.w)};
 }

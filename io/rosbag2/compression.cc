@@ -5,6 +5,8 @@
 
 #include <stdexcept>
 
+#include "odometry/invalid.h"
+
 namespace fitcal::io::rosbag2 {
 
 std::optional<Compression> ParseCompression(std::string_view name) {
@@ -51,10 +53,8 @@ namespace {
 bool DecompressZstd(ZSTD_DCtx* ctx, ByteView input, std::uint8_t* out, std::size_t expected,
                     std::string* error) {
   const std::size_t written = ZSTD_decompressDCtx(ctx, out, expected, input.data, input.size);
-  if (ZSTD_isError(written)) {
-    *error = std::string("zstd: ") + ZSTD_getErrorName(written);
-    return false;
-  }
+  if (ZSTD_isError(written))
+    return Invalid(error, std::string("zstd: ") + ZSTD_getErrorName(written));
   if (written != expected) {
     *error = "zstd data decompresses to " + std::to_string(written) + " bytes, not the declared " +
              std::to_string(expected);
@@ -76,10 +76,7 @@ bool DecompressLz4(LZ4F_dctx* ctx, ByteView input, std::uint8_t* out, std::size_
     std::size_t out_size = expected - out_pos;
     std::size_t in_size = input.size - in_pos;
     hint = LZ4F_decompress(ctx, out + out_pos, &out_size, input.data + in_pos, &in_size, nullptr);
-    if (LZ4F_isError(hint)) {
-      *error = std::string("lz4: ") + LZ4F_getErrorName(hint);
-      return false;
-    }
+    if (LZ4F_isError(hint)) return Invalid(error, std::string("lz4: ") + LZ4F_getErrorName(hint));
     in_pos += in_size;
     out_pos += out_size;
     if (in_size == 0 && out_size == 0) {
@@ -88,10 +85,7 @@ bool DecompressLz4(LZ4F_dctx* ctx, ByteView input, std::uint8_t* out, std::size_
       return false;
     }
   }
-  if (hint != 0) {
-    *error = "lz4 frame is truncated";
-    return false;
-  }
+  if (hint != 0) return Invalid(error, "lz4 frame is truncated");
   if (out_pos != expected) {
     *error = "lz4 data decompresses to " + std::to_string(out_pos) + " bytes, not the declared " +
              std::to_string(expected);
@@ -127,15 +121,10 @@ bool Decompressor::CheckDeclaredSize(Compression compression, ByteView input,
   const std::string declared = "declared uncompressed size " + std::to_string(declared_size);
   if (compression == Compression::kZstd) {
     const unsigned long long content = ZSTD_getFrameContentSize(input.data, input.size);
-    if (content == ZSTD_CONTENTSIZE_ERROR) {
-      *error = "not a zstd frame";
-      return false;
-    }
+    if (content == ZSTD_CONTENTSIZE_ERROR) return Invalid(error, "not a zstd frame");
     const bool one_frame = ZSTD_findFrameCompressedSize(input.data, input.size) == input.size;
-    if (content != ZSTD_CONTENTSIZE_UNKNOWN && one_frame && content != declared_size) {
-      *error = declared + " differs from the zstd frame's " + std::to_string(content);
-      return false;
-    }
+    if (content != ZSTD_CONTENTSIZE_UNKNOWN && one_frame && content != declared_size)
+      return Invalid(error, declared + " differs from the zstd frame's " + std::to_string(content));
   } else if (compression == Compression::kLz4) {
     constexpr std::uint64_t kMaxLz4Ratio = 255;
     if (declared_size > input.size * kMaxLz4Ratio + 65536) {
@@ -146,10 +135,8 @@ bool Decompressor::CheckDeclaredSize(Compression compression, ByteView input,
     LZ4F_resetDecompressionContext(contexts_->lz4);
     LZ4F_frameInfo_t info{};
     std::size_t consumed = input.size;
-    if (LZ4F_isError(LZ4F_getFrameInfo(contexts_->lz4, &info, input.data, &consumed))) {
-      *error = "not an lz4 frame";
-      return false;
-    }
+    if (LZ4F_isError(LZ4F_getFrameInfo(contexts_->lz4, &info, input.data, &consumed)))
+      return Invalid(error, "not an lz4 frame");
     if (info.contentSize != 0 && info.contentSize > declared_size) {
       *error = declared + " is less than the lz4 frame's " + std::to_string(info.contentSize);
       return false;

@@ -1,5 +1,7 @@
 // CDR decoders of the message types in ros_messages.h: fields in .msg order, nested messages
-// inline (CDR has no per-struct framing in XCDR1), so each helper reads one nested type.
+// inline (CDR has no per-struct framing in XCDR1), so each helper reads one nested type. The
+// helpers fill a message as a braced list, whose elements are evaluated in order ([dcl.init.list]):
+// the fields are read in the order they are declared, which is their .msg order.
 
 #include "io/rosbag2/cdr_reader.h"
 #include "io/rosbag2/errors.h"
@@ -12,68 +14,35 @@ namespace {
 // then 7 doubles; used to bound a transforms[] length before allocating.
 constexpr std::size_t kMinTransformStampedBytes = 8 + 4 + 4 + 7 * 8;
 
-Header ReadHeader(CdrReader& cdr) {
-  Header header;
-  header.stamp.sec = cdr.Int32();
-  header.stamp.nanosec = cdr.Uint32();
-  header.frame_id = cdr.String();
-  return header;
-}
+Header ReadHeader(CdrReader& cdr) { return {{cdr.Int32(), cdr.Uint32()}, cdr.String()}; }
 
 // geometry_msgs Point and Vector3: three float64 x, y, z.
 template <typename Xyz>
 Xyz ReadXyz(CdrReader& cdr) {
-  Xyz v;
-  v.x = cdr.Float64();
-  v.y = cdr.Float64();
-  v.z = cdr.Float64();
-  return v;
+  return {cdr.Float64(), cdr.Float64(), cdr.Float64()};
 }
 
 Quaternion ReadQuaternion(CdrReader& cdr) {
-  Quaternion q;
-  q.x = cdr.Float64();
-  q.y = cdr.Float64();
-  q.z = cdr.Float64();
-  q.w = cdr.Float64();
-  return q;
+  return {cdr.Float64(), cdr.Float64(), cdr.Float64(), cdr.Float64()};
 }
 
-Pose ReadPose(CdrReader& cdr) {
-  Pose pose;
-  pose.position = ReadXyz<Point>(cdr);
-  pose.orientation = ReadQuaternion(cdr);
-  return pose;
-}
+Pose ReadPose(CdrReader& cdr) { return {ReadXyz<Point>(cdr), ReadQuaternion(cdr)}; }
 
 TransformStamped ReadTransformStamped(CdrReader& cdr) {
-  TransformStamped t;
-  t.header = ReadHeader(cdr);
-  t.child_frame_id = cdr.String();
-  t.transform.translation = ReadXyz<Vector3>(cdr);
-  t.transform.rotation = ReadQuaternion(cdr);
-  return t;
+  return {ReadHeader(cdr), cdr.String(), {ReadXyz<Vector3>(cdr), ReadQuaternion(cdr)}};
 }
 
 }  // namespace
 
 JointState DecodeJointState(ByteView payload, const std::string& what) {
   CdrReader cdr(payload, what);
-  JointState msg;
-  msg.header = ReadHeader(cdr);
-  msg.name = cdr.Sequence<std::string>();
-  msg.position = cdr.Sequence<double>();
-  msg.velocity = cdr.Sequence<double>();
-  msg.effort = cdr.Sequence<double>();
-  return msg;
+  return {ReadHeader(cdr), cdr.Sequence<std::string>(), cdr.Sequence<double>(),
+          cdr.Sequence<double>(), cdr.Sequence<double>()};
 }
 
 PoseStamped DecodePoseStamped(ByteView payload, const std::string& what) {
   CdrReader cdr(payload, what);
-  PoseStamped msg;
-  msg.header = ReadHeader(cdr);
-  msg.pose = ReadPose(cdr);
-  return msg;
+  return {ReadHeader(cdr), ReadPose(cdr)};
 }
 
 Odometry DecodeOdometry(ByteView payload, const std::string& what) {

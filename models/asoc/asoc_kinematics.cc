@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "odometry/invalid.h"
+
 namespace fitcal {
 
 bool AsocOdometryOptions::Parse(const std::string& name, AsocOdometryOptions* out) {
@@ -14,22 +16,14 @@ bool AsocOdometryOptions::Parse(const std::string& name, AsocOdometryOptions* ou
 }
 
 bool AsocOdometryOptions::IsValid(std::string* error) const {
-  if (excluded_castor < 0 || excluded_castor > asoc::kNumCastors) {
-    *error = "the castor left out must be 1, 2 or 3 (0: none)";
-    return false;
-  }
-  if (method == asoc::Method::kIpec && excluded_castor == 0) {
-    *error = "IPEC uses two castors: IPEC-1, IPEC-2 or IPEC-3";
-    return false;
-  }
-  if (redundancy_check && (method != asoc::Method::kCast || excluded_castor != 0)) {
-    *error = "the redundancy check needs all three castors (CAST-0)";
-    return false;
-  }
-  if (!(consistency_tolerance_m >= 0.0) || !(consistency_tolerance_fraction >= 0.0)) {
-    *error = "consistency tolerances must be >= 0";
-    return false;
-  }
+  if (excluded_castor < 0 || excluded_castor > asoc::kNumCastors)
+    return Invalid(error, "the castor left out must be 1, 2 or 3 (0: none)");
+  if (method == asoc::Method::kIpec && excluded_castor == 0)
+    return Invalid(error, "IPEC uses two castors: IPEC-1, IPEC-2 or IPEC-3");
+  if (redundancy_check && (method != asoc::Method::kCast || excluded_castor != 0))
+    return Invalid(error, "the redundancy check needs all three castors (CAST-0)");
+  if (!(consistency_tolerance_m >= 0.0) || !(consistency_tolerance_fraction >= 0.0))
+    return Invalid(error, "consistency tolerances must be >= 0");
   return true;
 }
 

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cstdio>
 
 #include "io/input_error.h"
 #include "io/robot_yaml_blocks.h"
@@ -10,6 +9,7 @@
 #include "io/yaml_text.h"
 #include "models/diff_drive/umbmark.h"
 #include "models/mounted_model.h"
+#include "odometry/text_format.h"
 
 namespace fitcal {
 
@@ -213,16 +213,13 @@ std::vector<ClosedFormCalibration> DiffDriveClosedForms(const RobotModelInterfac
   calibration.parameters[right_channel] = c->corrected.r_right_m;
   calibration.parameters[left_channel] = c->corrected.r_left_m;
   calibration.parameters[diff_drive::kSeparationIndex] = c->corrected.separation_m;
-  char note[256];
-  std::snprintf(note, sizeof note,
-                "Borenstein & Feng 1996 from %d CW + %d CCW squares (side %.3f m%s): alpha %.4f "
-                "deg, beta %.4f deg, E_d %.6f, E_b %.6f",
-                c->num_cw, c->num_ccw, c->side_m,
-                skipped > 0
-                    ? (", " + std::to_string(skipped) + " 'square' runs not one closed lap").c_str()
-                    : "",
-                c->alpha_rad * 180.0 / M_PI, c->beta_rad * 180.0 / M_PI, c->e_d, c->e_b);
-  calibration.note = note;
+  calibration.note = StrFormat(
+      "Borenstein & Feng 1996 from %d CW + %d CCW squares (side %.3f m%s): alpha %.4f deg, beta "
+      "%.4f deg, E_d %.6f, E_b %.6f",
+      c->num_cw, c->num_ccw, c->side_m,
+      skipped > 0 ? (", " + std::to_string(skipped) + " 'square' runs not one closed lap").c_str()
+                  : "",
+      c->alpha_rad * 180.0 / M_PI, c->beta_rad * 180.0 / M_PI, c->e_d, c->e_b);
   return {calibration};
 }
 

@@ -1,7 +1,8 @@
 #include "models/diff_drive/diff_drive_trajectories.h"
 
 #include <cmath>
-#include <cstdio>
+
+#include "odometry/text_format.h"
 
 namespace fitcal::sim {
 
@@ -25,9 +26,7 @@ TrajectorySpec UmbmarkSquare(bool clockwise, int repetition,
 TrajectorySpec CircleTrajectory(double radius_m, bool clockwise, int repetition,
                                 const DiffDriveTrajectoryOptions& options) {
   TrajectorySpec spec;
-  char label[64];
-  std::snprintf(label, sizeof label, "circle-%s-r%.2f", clockwise ? "cw" : "ccw", radius_m);
-  spec.label = label;
+  spec.label = StrFormat("circle-%s-r%.2f", clockwise ? "cw" : "ccw", radius_m);
   spec.repetition = repetition;
   const double omega = (clockwise ? -1.0 : 1.0) * options.speed_m_s / radius_m;
   const double duration_s = options.circle_laps * 2.0 * M_PI * radius_m / options.speed_m_s;

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -13,8 +12,9 @@
 #include "io/input_error.h"
 #include "io/robot_yaml_blocks.h"
 #include "io/yaml_reader.h"
-#include "models/omni/omni_model_build.h"
 #include "models/mounted_model.h"
+#include "models/omni/omni_model_build.h"
+#include "odometry/text_format.h"
 
 namespace fitcal {
 
@@ -25,14 +25,12 @@ namespace {
 std::string GaugeReason(const Robot& robot, int held, const Eigen::VectorXd& direction) {
   const ParameterInfo& h = robot.parameters[held];
   std::string with;
-  char item[96];
   for (int k = 0; k < robot.NumParameters(); ++k) {
     if (k == held || std::abs(direction(k)) < 1e-9) continue;
     const ParameterInfo& q = robot.parameters[k];
-    std::snprintf(item, sizeof item, "%s%s %+.3g %s/%s", with.empty() ? "" : ", ", q.name.c_str(),
-                  direction(k) * q.DisplayScale() / h.DisplayScale(), q.DisplayUnit(),
-                  h.DisplayUnit());
-    with += item;
+    with += StrFormat("%s%s %+.3g %s/%s", with.empty() ? "" : ", ", q.name.c_str(),
+                      direction(k) * q.DisplayScale() / h.DisplayScale(), q.DisplayUnit(),
+                      h.DisplayUnit());
   }
   return "wheels that agree replay the same when " + h.name + " changes together with " +
          (with.empty() ? std::string("nothing else") : with) +

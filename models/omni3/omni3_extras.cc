@@ -1,11 +1,11 @@
 #include "models/omni3/omni3_extras.h"
 
 #include <cmath>
-#include <cstdio>
 
 #include "models/omni/flower_trajectories.h"
 #include "models/omni/omni_extras.h"
 #include "models/omni3/omni3_parameters.h"
+#include "odometry/text_format.h"
 
 namespace fitcal {
 
@@ -13,11 +13,9 @@ namespace {
 
 std::string MatrixText(const Eigen::Matrix3d& m) {
   std::string out = "[";
-  char value[64];
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c) {
-      std::snprintf(value, sizeof value, "%.4f", m(r, c));
-      out += std::string(std::isnan(m(r, c)) ? "-" : value) + (c < 2 ? " " : "");
+      out += (std::isnan(m(r, c)) ? "-" : StrFormat("%.4f", m(r, c))) + (c < 2 ? " " : "");
     }
     out += r < 2 ? "; " : "]";
   }

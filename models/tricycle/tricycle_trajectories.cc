@@ -2,8 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <stdexcept>
+
+#include "odometry/text_format.h"
 
 namespace fitcal::sim {
 
@@ -62,10 +63,9 @@ std::vector<TrajectorySpec> TricycleTrajectories(const TricycleTrajectoryOptions
   if (!error.empty()) throw std::invalid_argument("tricycle trajectories: " + error);
   std::vector<TrajectorySpec> shapes;
   for (double deg : options.steering_deg) {
-    char label[32];
     for (double sign : {1.0, -1.0}) {
-      std::snprintf(label, sizeof label, "circle_%s_%g", sign > 0.0 ? "ccw" : "cw", deg);
-      shapes.push_back({label, 1, {Circle(options, sign * deg * M_PI / 180.0)}});
+      shapes.push_back({StrFormat("circle_%s_%g", sign > 0.0 ? "ccw" : "cw", deg), 1,
+                        {Circle(options, sign * deg * M_PI / 180.0)}});
     }
   }
   shapes.push_back({"square_ccw", 1, Square(options, 1.0)});
