@@ -159,9 +159,6 @@ HalvesJudgement JudgeMethodOnHeldOutHalves(const FitMethod& method, int threads,
   const FitOnFold fit_on = [&](const HalvesFold& fold) -> std::optional<std::vector<double>> {
     FitMethodSettings fold_settings = settings;
     fold_settings.residuals_auto = false;  // the whole data's choice holds for its halves
-    // Only the parameters are read: no covariance, no CF trace (a judgement fit, as the choices'
-    // folds; from the nominal, as before).
-    fold_settings.judgement_fit = true;
     std::optional<TrackFitData> track_data;
     if (!PrepareTrackResiduals(method.name, fold.split, &fold_settings, &track_data).empty()) {
       return std::nullopt;
