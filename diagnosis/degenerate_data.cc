@@ -58,9 +58,10 @@ double MostWheelTurnRad(const RunLog& run, const Robot& robot) {
 
 }  // namespace
 
-std::string StillRunsRefusal(const std::vector<RunLog>& runs, const Robot& robot) {
+std::string StillRunsRefusal(const std::vector<const RunLog*>& runs, const Robot& robot) {
   double most_m = 0.0, most_rad = 0.0;
-  for (const RunLog& run : runs) {
+  for (const RunLog* run_pointer : runs) {
+    const RunLog& run = *run_pointer;
     if (run.ground_truth.world_T_robot.empty()) continue;
     // Ground truth of the start and end poses only cannot show a run standing still: a closed
     // loop (UMBmark's squares) ends where it started. Its wheels say whether it moved.

@@ -43,7 +43,7 @@ std::vector<std::string> FindDegenerateData(const std::vector<AlignedRun>& runs,
 inline constexpr double kStillPositionM = 0.05;
 inline constexpr double kStillHeadingRad = 0.05;
 inline constexpr double kStillWheelTurnRad = 2.0 * 3.14159265358979323846;
-std::string StillRunsRefusal(const std::vector<RunLog>& runs, const Robot& robot);
+std::string StillRunsRefusal(const std::vector<const RunLog*>& runs, const Robot& robot);
 
 struct OutlierRun {
   std::string id;

@@ -115,7 +115,8 @@ class FitProblem {
  public:
   FitProblem(const std::vector<AlignedRun>& training, const RobotModelInterface& model,
              const ModelFitOptions& fit_options, const std::vector<bool>& fixed, double* p,
-             double* clock_offsets, const HeldDirections& holds = {}) {
+             double* clock_offsets, const HeldDirections& holds = {},
+             std::vector<OdometryMemo>* memos = nullptr) {
     const CeresFitOptions& options = fit_options.ceres;
     ceres::Problem::Options problem_options;
     problem_options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
@@ -141,7 +142,8 @@ class FitProblem {
       if (!track.segments.empty()) {
         data_blocks_.push_back(problem_->AddResidualBlock(
             Memo(TrackResidual::Create(track, model, TrackWeightsOf(fit_options, i),
-                                       fit_options.track->options)),
+                                       fit_options.track->options,
+                                       memos != nullptr ? &(*memos)[i] : nullptr)),
             nullptr, p, clock_offsets + track.clock_group));
       }
     }
@@ -262,7 +264,8 @@ ceres::Solver::Summary RefineWithActiveSet(const std::vector<AlignedRun>& traini
                                            const RobotModelInterface& model,
                                            const ModelFitOptions& options,
                                            const HeldDirections& holds,
-                                           ceres::Solver::Summary summary, ModelFitResult* result) {
+                                           ceres::Solver::Summary summary, ModelFitResult* result,
+                                           std::vector<OdometryMemo>* memos) {
   const Robot& robot = model.robot();
   const int n = robot.NumParameters();
   std::vector<double>& p = result->parameters;
@@ -271,7 +274,7 @@ ceres::Solver::Summary RefineWithActiveSet(const std::vector<AlignedRun>& traini
   for (int round = 0; round < kMaxActiveSetRounds; ++round) {
     ++result->active_set_rounds;
     FitProblem fit(training, model, options, fixed, p.data(), result->clock_offsets_s.data(),
-                   holds);
+                   holds, memos);
     const bool contact =
         SolveUntilBoundContact(robot, options, fixed, p.data(), &fit.problem(), &summary);
     Accumulate(summary, result);
@@ -282,7 +285,7 @@ ceres::Solver::Summary RefineWithActiveSet(const std::vector<AlignedRun>& traini
     if (summary.termination_type != ceres::CONVERGENCE) break;
     // Release a bound parameter whose descent direction points into the box.
     FitProblem all_free(training, model, options, result->held, p.data(),
-                        result->clock_offsets_s.data(), holds);
+                        result->clock_offsets_s.data(), holds, memos);
     const std::vector<double> g = all_free.FullGradient();
     bool released = false;
     for (int k = 0; k < n; ++k) {
@@ -578,7 +581,8 @@ constexpr int kLocalScanSteps = 3;
 
 void SolveClockOffsetsAt(const RobotModelInterface& model, const ModelFitOptions& options,
                          const std::vector<double>& p, std::vector<double>* offsets_s,
-                         ModelFitResult* result, bool scan = true) {
+                         ModelFitResult* result, bool scan = true,
+                         std::vector<OdometryMemo>* memos = nullptr) {
   const TrackFitData& track = *options.track;
   const double bound = track.options.max_clock_offset_s;
   for (std::size_t g = 0; g < track.clock_groups.size(); ++g) {
@@ -588,7 +592,8 @@ void SolveClockOffsetsAt(const RobotModelInterface& model, const ModelFitOptions
       const TrackCheckpoints& run = track.runs[i];
       if (run.clock_group != static_cast<int>(g) || run.segments.empty()) continue;
       std::unique_ptr<TrackResidual> cost(static_cast<TrackResidual*>(
-          TrackResidual::Create(run, model, TrackWeightsOf(options, i), track.options)));
+          TrackResidual::Create(run, model, TrackWeightsOf(options, i), track.options,
+                                memos != nullptr ? &(*memos)[i] : nullptr)));
       std::vector<double> poses = cost->OdometryFromStart(p.data());
       runs.emplace_back(std::move(cost), std::move(poses));
     }
@@ -662,18 +667,18 @@ constexpr int kParameterStepsPerRound = 2;       // the parameters' steps betwee
 void AlternateWithClockOffsets(const std::vector<AlignedRun>& training,
                                const RobotModelInterface& model, const ModelFitOptions& options,
                                const ModelFitOptions& offsets_held, const HeldDirections& holds,
-                               ModelFitResult* result) {
+                               ModelFitResult* result, std::vector<OdometryMemo>* memos) {
   ModelFitOptions few_steps = offsets_held;
   few_steps.ceres.max_num_iterations = kParameterStepsPerRound;
   for (int round = 0; round < kMaxClockOffsetRounds; ++round) {
     const std::vector<double> before = result->clock_offsets_s;
     SolveClockOffsetsAt(model, options, result->parameters, &result->clock_offsets_s, result,
-                        /*scan=*/round == 0);
+                        /*scan=*/round == 0, memos);
     if (round > 0 && LargestChange(before, result->clock_offsets_s) < kClockOffsetToleranceS) {
       return;
     }
     FitProblem fit(training, model, few_steps, result->held, result->parameters.data(),
-                   result->clock_offsets_s.data(), holds);
+                   result->clock_offsets_s.data(), holds, memos);
     ceres::Solver::Summary summary;
     ceres::Solve(SolverOptionsFor(few_steps.ceres), &fit.problem(), &summary);
     result->iterations += static_cast<int>(summary.iterations.size());
@@ -696,17 +701,19 @@ ModelFitResult SolveFrom(const std::vector<AlignedRun>& training, const RobotMod
   const bool offsets = UsesTracks(options) && options.track->estimate_clock_offsets;
   TrackFitData track_offsets_held;
   ModelFitOptions solve_options = options;
+  // The runs' odometry at the last parameters, kept across this fit's problems (OdometryMemo).
+  std::vector<OdometryMemo> memos(UsesTracks(options) ? options.track->runs.size() : 0);
   if (offsets) {
     track_offsets_held = *options.track;
     track_offsets_held.estimate_clock_offsets = false;
     solve_options.track = &track_offsets_held;
-    AlternateWithClockOffsets(training, model, options, solve_options, holds, &result);
+    AlternateWithClockOffsets(training, model, options, solve_options, holds, &result, &memos);
   }
   ceres::Solver::Summary summary;
   for (int round = 0; round < kMaxClockOffsetRounds; ++round) {
     {
       FitProblem fit(training, model, solve_options, result.held, result.parameters.data(),
-                     result.clock_offsets_s.data(), holds);
+                     result.clock_offsets_s.data(), holds, &memos);
       SolveUntilBoundContact(robot, solve_options, result.held, result.parameters.data(),
                              &fit.problem(), &summary);
     }
@@ -714,13 +721,14 @@ ModelFitResult SolveFrom(const std::vector<AlignedRun>& training, const RobotMod
     Accumulate(summary, &result);
     const bool converged = summary.termination_type == ceres::CONVERGENCE;
     if (!converged && options.active_set_bounds) {
-      summary = RefineWithActiveSet(training, model, solve_options, holds, summary, &result);
+      summary =
+          RefineWithActiveSet(training, model, solve_options, holds, summary, &result, &memos);
     }
     if (!offsets) break;
     // The offsets for the parameters found; done when they stay (the joint minimum).
     const std::vector<double> before = result.clock_offsets_s;
     SolveClockOffsetsAt(model, options, result.parameters, &result.clock_offsets_s, &result,
-                        /*scan=*/false);
+                        /*scan=*/false, &memos);
     result.clock_offsets_settled =
         LargestChange(before, result.clock_offsets_s) < kClockOffsetToleranceS;
     if (result.clock_offsets_settled) break;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <type_traits>
 #include <utility>
@@ -156,15 +157,43 @@ Pose2d GroundTruthFromStart(const TrackCheckpoints& track, std::size_t k, double
                  InterpolateGroundTruth(*track.ground_truth, track.t_s[k] + dt_s));
 }
 
+bool OdometryMemo::Recall(const double* p, int num_parameters, double* pose, int num_poses,
+                          double* jacobian) const {
+  const std::optional<Kept>& kept = jacobian != nullptr ? with_jacobian_ : values_;
+  // Bitwise: the same doubles, not merely equal ones (as LastEvaluationMemo).
+  if (!kept || kept->pose.size() != static_cast<std::size_t>(num_poses) ||
+      kept->p.size() != static_cast<std::size_t>(num_parameters) ||
+      std::memcmp(kept->p.data(), p, num_parameters * sizeof(double)) != 0) {
+    return false;
+  }
+  std::copy(kept->pose.begin(), kept->pose.end(), pose);
+  if (jacobian != nullptr) std::copy(kept->jacobian.begin(), kept->jacobian.end(), jacobian);
+  return true;
+}
+
+void OdometryMemo::Keep(const double* p, int num_parameters, const double* pose, int num_poses,
+                        const double* jacobian) {
+  std::optional<Kept>& kept = jacobian != nullptr ? with_jacobian_ : values_;
+  if (!kept) kept.emplace();
+  kept->p.assign(p, p + num_parameters);
+  kept->pose.assign(pose, pose + num_poses);
+  if (jacobian != nullptr) {
+    kept->jacobian.assign(jacobian,
+                          jacobian + static_cast<std::size_t>(num_poses) * num_parameters);
+  }
+}
+
 TrackResidual::TrackResidual(const TrackCheckpoints& track, const RobotModelInterface& model,
-                             const ResidualWeights& weights, const TrackResidualOptions& options)
+                             const ResidualWeights& weights, const TrackResidualOptions& options,
+                             OdometryMemo* memo)
     : track_(track),
       weights_(weights),
       huber_scale_(options.huber_scale),
       heading_(options.heading),
       run_weight_(1.0 /
                   std::sqrt(static_cast<double>(std::max<std::size_t>(1, track.segments.size())))),
-      num_parameters_(model.robot().NumParameters()) {
+      num_parameters_(model.robot().NumParameters()),
+      memo_(memo) {
   for (const Segment& s : track.segments) {
     Segment identity = s;
     identity.ground_truth_start_T_end = Pose2d{0.0, 0.0, 0.0};
@@ -180,13 +209,14 @@ TrackResidual::TrackResidual(const TrackCheckpoints& track, const RobotModelInte
 ceres::CostFunction* TrackResidual::Create(const TrackCheckpoints& track,
                                            const RobotModelInterface& model,
                                            const ResidualWeights& weights,
-                                           const TrackResidualOptions& options) {
+                                           const TrackResidualOptions& options,
+                                           OdometryMemo* memo) {
   std::string error;
   if (!options.IsValid(&error)) throw std::invalid_argument(error);
   if (track.segments.empty() || track.t_s.size() != track.segments.size()) {
     throw std::invalid_argument("TrackResidual: run " + track.run->id + " has no checkpoints");
   }
-  return new TrackResidual(track, model, weights, options);
+  return new TrackResidual(track, model, weights, options, memo);
 }
 
 namespace {
@@ -241,10 +271,21 @@ std::array<T, 3> TrackResidual::CheckpointResidual(const std::vector<double>& po
   return {factor * e[0], factor * e[1], factor * e[2]};
 }
 
+bool TrackResidual::EvaluateOdometry(const double* p, double* pose, double* jacobian) const {
+  const int m = num_residuals();
+  if (memo_ != nullptr && memo_->Recall(p, num_parameters_, pose, m, jacobian)) return true;
+  const double* parameters[] = {p};
+  double* inner_jacobians[1] = {jacobian};
+  if (!odometry_->Evaluate(parameters, pose, jacobian != nullptr ? inner_jacobians : nullptr)) {
+    return false;
+  }
+  if (memo_ != nullptr) memo_->Keep(p, num_parameters_, pose, m, jacobian);
+  return true;
+}
+
 std::vector<double> TrackResidual::OdometryFromStart(const double* p) const {
   std::vector<double> pose(num_residuals());
-  const double* parameters[] = {p};
-  if (!odometry_->Evaluate(parameters, pose.data(), nullptr)) pose.assign(pose.size(), HUGE_VAL);
+  if (!EvaluateOdometry(p, pose.data(), nullptr)) pose.assign(pose.size(), HUGE_VAL);
   return pose;
 }
 
@@ -265,8 +306,7 @@ bool TrackResidual::Evaluate(double const* const* parameters, double* residuals,
   std::vector<double> pose_jacobian;  // m x n, row-major: dP/dp
   const bool want_p = jacobians != nullptr && jacobians[0] != nullptr;
   if (want_p) pose_jacobian.assign(static_cast<std::size_t>(m) * n, 0.0);
-  double* inner_jacobians[1] = {want_p ? pose_jacobian.data() : nullptr};
-  if (!odometry_->Evaluate(parameters, pose.data(), want_p ? inner_jacobians : nullptr)) {
+  if (!EvaluateOdometry(parameters[0], pose.data(), want_p ? pose_jacobian.data() : nullptr)) {
     return false;
   }
   const double dt_s = parameters[1][0];

@@ -38,6 +38,7 @@
 #include <array>
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -123,13 +124,38 @@ TrackCheckpoints MakeTrackCheckpoints(const AlignedRun& run, const GroundTruthTr
 // double: for metrics and tests.
 Pose2d GroundTruthFromStart(const TrackCheckpoints& track, std::size_t k, double dt_s);
 
+// The odometry's poses from one run's start (TrackResidual's inner cost: the replay, most of a
+// track fit's CPU) at the last parameters they were computed for, with and without dP/dp, kept
+// across the Ceres problems of one fit. Why: a fit with clock offsets solves by turns
+// (fit/model_fit.cc), and each turn starts a new problem at the parameters the last one ended
+// at with only the offsets moved, which the odometry does not depend on; the offsets' search
+// replays the same runs at those parameters again. A request of the same kind (with or without
+// the Jacobian) at bitwise the same parameters is answered with a copy of what the cost computed
+// there, so every fit takes the same steps to the bit. One per run, used by one thread at a time.
+class OdometryMemo {
+ public:
+  // Copies the poses (and dP/dp when `jacobian` is not null) kept for `p` of this kind.
+  bool Recall(const double* p, int num_parameters, double* pose, int num_poses,
+              double* jacobian) const;
+  void Keep(const double* p, int num_parameters, const double* pose, int num_poses,
+            const double* jacobian);
+
+ private:
+  struct Kept {
+    std::vector<double> p, pose, jacobian;
+  };
+  std::optional<Kept> values_, with_jacobian_;
+};
+
 class TrackResidual : public ceres::CostFunction {
  public:
   // Parameter blocks: the model's parameters, then the run's clock offset dt (1 value, seconds).
+  // `memo` (may be null) answers the odometry's repeated evaluations; it must outlive the cost.
   static ceres::CostFunction* Create(const TrackCheckpoints& track,
                                      const RobotModelInterface& model,
                                      const ResidualWeights& weights,
-                                     const TrackResidualOptions& options);
+                                     const TrackResidualOptions& options,
+                                     OdometryMemo* memo = nullptr);
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
@@ -152,7 +178,12 @@ class TrackResidual : public ceres::CostFunction {
                                       double dt_s) const;
 
   TrackResidual(const TrackCheckpoints& track, const RobotModelInterface& model,
-                const ResidualWeights& weights, const TrackResidualOptions& options);
+                const ResidualWeights& weights, const TrackResidualOptions& options,
+                OdometryMemo* memo);
+
+  // The odometry's poses (and dP/dp into `jacobian` when not null), from the memo when it has
+  // them; false when the replay fails.
+  bool EvaluateOdometry(const double* p, double* pose, double* jacobian) const;
 
   const TrackCheckpoints& track_;
   std::unique_ptr<ceres::CostFunction> odometry_;  // P_k and dP_k/dp: 3 values per checkpoint
@@ -162,6 +193,7 @@ class TrackResidual : public ceres::CostFunction {
   TrackHeading heading_;
   double run_weight_;  // 1 / sqrt(K)
   int num_parameters_;
+  OdometryMemo* memo_;
 };
 
 }  // namespace fitcal

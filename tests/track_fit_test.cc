@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <vector>
 
@@ -127,6 +128,54 @@ TEST(TrackResidual, JacobiansMatchCentralDifferences) {
         }
       }
     }
+  }
+}
+
+// A fit with clock offsets solves by turns, each a new problem at the parameters the last one
+// ended at with only the offsets moved (fit/model_fit.cc): the OdometryMemo answers those
+// requests. Its answers must be the cost's own to the bit, for a moved offset, for each kind of
+// request, and never a stale replay when the parameters move.
+TEST(TrackResidual, OdometryMemoAnswersTheCostsOwnNumbersBitForBit) {
+  const RobotModelPtr model = Model();
+  const Simulated s = SimulateLoops(*model, 1);
+  TrackResidualOptions track_options;
+  track_options.heading = TrackHeading::kIncrements;
+  const TrackFitData data =
+      MakeTrackFitData(s.aligned, s.tracks, ClockGrouping::kPerRun, track_options);
+  for (const TrackCheckpoints& track : data.runs) {
+    OdometryMemo memo;
+    std::unique_ptr<ceres::CostFunction> plain(
+        TrackResidual::Create(track, *model, ResidualWeights{}, data.options));
+    std::unique_ptr<ceres::CostFunction> memoised(
+        TrackResidual::Create(track, *model, ResidualWeights{}, data.options, &memo));
+    const int m = plain->num_residuals();
+    const auto same_bits = [&](std::vector<double> p, double dt, bool with_jacobians) {
+      std::vector<double> r[2], j_p[2], j_dt[2];
+      const ceres::CostFunction* costs[2] = {plain.get(), memoised.get()};
+      for (int c = 0; c < 2; ++c) {
+        r[c].assign(m, 0.0), j_p[c].assign(m * 3, 0.0), j_dt[c].assign(m, 0.0);
+        const double* parameters[] = {p.data(), &dt};
+        double* jacobians[] = {j_p[c].data(), j_dt[c].data()};
+        EXPECT_TRUE(costs[c]->Evaluate(parameters, r[c].data(),
+                                       with_jacobians ? jacobians : nullptr));
+      }
+      return std::memcmp(r[0].data(), r[1].data(), m * sizeof(double)) == 0 &&
+             std::memcmp(j_p[0].data(), j_p[1].data(), 3 * m * sizeof(double)) == 0 &&
+             std::memcmp(j_dt[0].data(), j_dt[1].data(), m * sizeof(double)) == 0;
+    };
+    const std::vector<double> p = {0.0425, 0.0418, 0.203};
+    std::vector<double> p_next = p;  // a Levenberg-Marquardt step's last digits
+    p_next[2] *= 1.0 + 1e-9;
+    for (bool with_jacobians : {true, false}) {
+      EXPECT_TRUE(same_bits(p, 0.1234, with_jacobians)) << track.run->id;  // kept
+      EXPECT_TRUE(same_bits(p, -0.05, with_jacobians)) << track.run->id;   // from the memo
+      EXPECT_TRUE(same_bits(p_next, -0.05, with_jacobians)) << track.run->id;  // replayed
+      EXPECT_TRUE(same_bits(p, -0.05, with_jacobians)) << track.run->id;       // replayed
+    }
+    // The search's odometry (OdometryFromStart) shares the memo of the residual-only requests.
+    const auto* residual = static_cast<const TrackResidual*>(memoised.get());
+    const auto* reference = static_cast<const TrackResidual*>(plain.get());
+    EXPECT_EQ(residual->OdometryFromStart(p.data()), reference->OdometryFromStart(p.data()));
   }
 }
 

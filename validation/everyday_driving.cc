@@ -38,12 +38,16 @@ EverydayDrivingMetrics EvaluateEverydayDriving(const RobotModelInterface& model,
     out.cf /= out.runs;
     out.mean_ate_rmse_m /= out.runs;
   }
+  // Each run's path lengths and headings once for every length.
+  std::vector<RelativePoseErrorRun> drift_runs;
+  drift_runs.reserve(per_run.size());
+  for (const TrajectoryErrors& e : per_run) drift_runs.emplace_back(e.ground_truth, e.odometry);
   for (double length : lengths_m) {
     RelativePoseErrorSum sum;
     DriftAtLength drift;
-    for (const TrajectoryErrors& e : per_run) {
+    for (const RelativePoseErrorRun& drift_run : drift_runs) {
       RelativePoseErrorSum run;
-      AddRelativePoseErrors(e.ground_truth, e.odometry, length, &run);
+      drift_run.Add(length, &run);
       drift.per_run_translation_percent.push_back(run.MeanTranslationPercent());
       drift.per_run_windows.push_back(run.windows);
       sum.windows += run.windows;

@@ -7,47 +7,75 @@ namespace fitcal {
 
 namespace {
 
-// a^-1 b for planar poses.
-Pose2d BetweenWrapped(const Pose2d& a, const Pose2d& b) {
-  const double c = std::cos(a.theta), s = std::sin(a.theta);
+// a^-1 b for planar poses, with a's heading as (cos, sin).
+Pose2d BetweenWrapped(const Pose2d& a, double c, double s, const Pose2d& b) {
   const double dx = b.x - a.x, dy = b.y - a.y;
   return {c * dx + s * dy, -s * dx + c * dy, WrapAngle(b.theta - a.theta)};
 }
 
 }  // namespace
 
+RelativePoseErrorRun::RelativePoseErrorRun(const std::vector<Pose2d>& ground_truth,
+                                           const std::vector<Pose2d>& odometry)
+    : ground_truth_(ground_truth),
+      odometry_(odometry),
+      n_(std::min(ground_truth.size(), odometry.size())) {
+  if (n_ < 2) return;
+  path_m_.assign(n_, 0.0);
+  for (std::size_t k = 1; k < n_; ++k) {
+    path_m_[k] = path_m_[k - 1] + std::hypot(ground_truth[k].x - ground_truth[k - 1].x,
+                                             ground_truth[k].y - ground_truth[k - 1].y);
+  }
+  ground_truth_heading_.resize(n_);
+  odometry_heading_.resize(n_);
+  for (std::size_t k = 0; k < n_; ++k) {
+    ground_truth_heading_[k] = {std::cos(ground_truth[k].theta), std::sin(ground_truth[k].theta)};
+    odometry_heading_[k] = {std::cos(odometry[k].theta), std::sin(odometry[k].theta)};
+  }
+}
+
+template <typename Visit>
+void RelativePoseErrorRun::ForEachWindow(double length_m, Visit&& window) const {
+  if (n_ < 2 || !(length_m > 0.0)) return;
+  const std::vector<double>& s = path_m_;
+  std::size_t j = 0;
+  for (std::size_t i = 0; i < n_; ++i) {
+    if (j < i) j = i;
+    while (j < n_ && s[j] - s[i] < length_m) ++j;
+    if (j == n_) break;  // no later start reaches the length either
+    const Heading& g = ground_truth_heading_[i];
+    const Heading& o = odometry_heading_[i];
+    const Pose2d truth = BetweenWrapped(ground_truth_[i], g.c, g.s, ground_truth_[j]);
+    const Pose2d odo = BetweenWrapped(odometry_[i], o.c, o.s, odometry_[j]);
+    const Pose2d e = BetweenWrapped(truth, std::cos(truth.theta), std::sin(truth.theta), odo);
+    window(RelativePoseErrorWindow{i, j, std::hypot(e.x, e.y) / length_m,
+                                   std::abs(e.theta) / length_m});
+  }
+}
+
+std::vector<RelativePoseErrorWindow> RelativePoseErrorRun::Windows(double length_m) const {
+  std::vector<RelativePoseErrorWindow> out;
+  ForEachWindow(length_m, [&out](const RelativePoseErrorWindow& w) { out.push_back(w); });
+  return out;
+}
+
+void RelativePoseErrorRun::Add(double length_m, RelativePoseErrorSum* sum) const {
+  ForEachWindow(length_m, [sum](const RelativePoseErrorWindow& w) {
+    sum->translation_ratio_sum += w.translation_ratio;
+    sum->rotation_rad_per_m_sum += w.rotation_rad_per_m;
+    ++sum->windows;
+  });
+}
+
 std::vector<RelativePoseErrorWindow> RelativePoseErrorWindows(
     const std::vector<Pose2d>& ground_truth, const std::vector<Pose2d>& odometry, double length_m) {
-  std::vector<RelativePoseErrorWindow> out;
-  const std::size_t n = std::min(ground_truth.size(), odometry.size());
-  if (n < 2 || !(length_m > 0.0)) return out;
-  std::vector<double> s(n, 0.0);  // ground-truth path length from sample 0
-  for (std::size_t k = 1; k < n; ++k) {
-    s[k] = s[k - 1] + std::hypot(ground_truth[k].x - ground_truth[k - 1].x,
-                                 ground_truth[k].y - ground_truth[k - 1].y);
-  }
-  std::size_t j = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (j < i) j = i;
-    while (j < n && s[j] - s[i] < length_m) ++j;
-    if (j == n) break;  // no later start reaches the length either
-    const Pose2d truth = BetweenWrapped(ground_truth[i], ground_truth[j]);
-    const Pose2d odo = BetweenWrapped(odometry[i], odometry[j]);
-    const Pose2d e = BetweenWrapped(truth, odo);
-    out.push_back({i, j, std::hypot(e.x, e.y) / length_m, std::abs(e.theta) / length_m});
-  }
-  return out;
+  return RelativePoseErrorRun(ground_truth, odometry).Windows(length_m);
 }
 
 void AddRelativePoseErrors(const std::vector<Pose2d>& ground_truth,
                            const std::vector<Pose2d>& odometry, double length_m,
                            RelativePoseErrorSum* sum) {
-  for (const RelativePoseErrorWindow& w :
-       RelativePoseErrorWindows(ground_truth, odometry, length_m)) {
-    sum->translation_ratio_sum += w.translation_ratio;
-    sum->rotation_rad_per_m_sum += w.rotation_rad_per_m;
-    ++sum->windows;
-  }
+  RelativePoseErrorRun(ground_truth, odometry).Add(length_m, sum);
 }
 
 std::vector<double> RelativePoseErrorLengths(double median_path_length_m) {

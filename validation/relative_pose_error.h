@@ -35,6 +35,34 @@ struct RelativePoseErrorWindow {
   double rotation_rad_per_m = 0.0;  // |wrap(theta(E))| / length
 };
 
+// One run's poses prepared for windows of any length: the ground truth's path length from its
+// first sample and each pose's heading as (cos, sin), computed once for every length (a window
+// needs them at its start; each length's windows start at most samples). The windows' numbers are
+// those of the functions below bit for bit: the same operations on the same values.
+class RelativePoseErrorRun {
+ public:
+  // The poses must outlive this; the run is the first min(sizes) samples of both.
+  RelativePoseErrorRun(const std::vector<Pose2d>& ground_truth,
+                       const std::vector<Pose2d>& odometry);
+
+  std::vector<RelativePoseErrorWindow> Windows(double length_m) const;
+  void Add(double length_m, RelativePoseErrorSum* sum) const;
+
+ private:
+  // Calls window(w) for each window of `length_m`, in the order of their start.
+  template <typename Visit>
+  void ForEachWindow(double length_m, Visit&& window) const;
+
+  struct Heading {
+    double c, s;
+  };
+  const std::vector<Pose2d>& ground_truth_;
+  const std::vector<Pose2d>& odometry_;
+  std::size_t n_;
+  std::vector<double> path_m_;  // ground-truth path length from sample 0
+  std::vector<Heading> ground_truth_heading_, odometry_heading_;
+};
+
 // Every window of one run (the pictures draw them one by one; the sum below is their mean).
 std::vector<RelativePoseErrorWindow> RelativePoseErrorWindows(
     const std::vector<Pose2d>& ground_truth, const std::vector<Pose2d>& odometry, double length_m);

@@ -130,6 +130,13 @@ TrajectoryErrors ErrorsAlongTrack(const AlignedRun& run, const GroundTruthTrack&
   const Pose2d& final_pose = replayed.final_pose;
   const Pose2d& final_ground_truth = replayed.final_ground_truth;
   TrajectoryErrors out;
+  // At most every ground-truth sample: one allocation each instead of the doublings.
+  const std::size_t most = track.t_s.size();
+  out.t_s.reserve(most);
+  out.ground_truth.reserve(most);
+  out.odometry.reserve(most);
+  out.distance_error_m.reserve(most);
+  out.angle_error_rad.reserve(most);
   for (std::size_t i = 0; i < track.t_s.size(); ++i) {
     const double t_gt = track.t_s[i];
     if (t_gt < run.t_start_s || t_gt > run.t_final_s) continue;
