@@ -105,24 +105,16 @@ ModelFitMethodOutcome RunModelCeres(CeresTrustRegion trust_region,
 
 ModelFitMethodOutcome RunModelNlopt(NloptMethod method, const std::vector<AlignedRun>& training,
                                     const RobotModelInterface& model,
-                                    const FitMethodSettings& settings);
-
-// The NLopt search of the tied model (fit/parameter_tying.h), mapped back to the parameters.
-ModelFitMethodOutcome RunTiedModelNlopt(NloptMethod method, const std::vector<AlignedRun>& training,
-                                        const RobotModelInterface& model,
-                                        const FitMethodSettings& settings) {
-  const TiedModel tied(model, settings.tying);
-  FitMethodSettings untied = settings;
-  untied.tying = {};
-  ModelFitMethodOutcome out = RunModelNlopt(method, training, tied, untied);
-  out.fit = ExpandTiedResult(tied, out.fit);
-  return out;
-}
-
-ModelFitMethodOutcome RunModelNlopt(NloptMethod method, const std::vector<AlignedRun>& training,
-                                    const RobotModelInterface& model,
                                     const FitMethodSettings& settings) {
-  if (!settings.tying.empty()) return RunTiedModelNlopt(method, training, model, settings);
+  if (!settings.tying.empty()) {
+    // The NLopt search of the tied model (fit/parameter_tying.h), mapped back to the parameters.
+    const TiedModel tied(model, settings.tying);
+    FitMethodSettings untied = settings;
+    untied.tying = {};
+    ModelFitMethodOutcome out = RunModelNlopt(method, training, tied, untied);
+    out.fit = ExpandTiedResult(tied, out.fit);
+    return out;
+  }
   const NloptFitOptions options = NloptOptionsFor(method, settings);
   const NloptSearchResult r = FitModelNlopt(training, model, options);
   const Robot& robot = model.robot();

@@ -55,17 +55,11 @@ SelectedFit DescribeSelected(const Robot& robot,
                              const std::optional<TrackFits>& track_fits) {
   const CalibrationCandidate& selected = candidates[selected_index];
   const std::size_t n = robot.nominal.size();
-  SelectedFit out{false,
-                  {},
-                  {},
-                  std::vector<bool>(n, false),
-                  std::vector<bool>(n, false),
-                  method_objective,
-                  fit.termination,
-                  {},
-                  {},
-                  "",
-                  {}};
+  SelectedFit out;
+  out.at_bound.assign(n, false);
+  out.held.assign(n, false);
+  out.objective = method_objective;
+  out.termination = fit.termination;
   if (const EffectFitResult* track_fit = TrackFitOf(track_fits, selected_index)) {
     out.has_covariance = track_fit->has_covariance;
     out.sigma = track_fit->sigma;

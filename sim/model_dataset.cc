@@ -1,6 +1,7 @@
 #include "sim/model_dataset.h"
 
 #include <filesystem>
+#include <functional>
 #include <stdexcept>
 
 #include "io/atomic_file.h"
@@ -43,8 +44,8 @@ std::vector<double> TrueParameters(const ModelDatasetRequest& request,
   return t.nominal;
 }
 
-}  // namespace
-
+// `out` refused by the overwrite rule (io/output_guard.h; UsageError) before anything is
+// simulated; `write` fills a staged sibling directory, then renamed over `out`.
 void WriteDatasetDirectory(const std::string& out, bool force,
                            const std::function<void(const std::string& directory)>& write) {
   if (const std::string refusal = io::DirectoryOutputRefusal(out, io::kDatasetKind, force, {});
@@ -55,6 +56,8 @@ void WriteDatasetDirectory(const std::string& out, bool force,
   write(staged.path());
   io::CommitDirectoryOutput(staged, out, io::kDatasetKind, force, {});
 }
+
+}  // namespace
 
 WrittenModelDataset WriteModelDataset(const ModelDatasetRequest& request) {
   WrittenModelDataset written;

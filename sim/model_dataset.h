@@ -8,7 +8,6 @@
 // (io/staged_directory.h).
 
 #include <cstddef>
-#include <functional>
 #include <string>
 #include <vector>
 
@@ -31,12 +30,6 @@ struct WrittenModelDataset {
   std::vector<double> truth;   // the true parameters, as true_robot.yaml holds them
   std::size_t num_runs = 0;
 };
-
-// A data set directory written whole or not at all, as every simulated data set is: `out` is
-// refused by the overwrite rule (io/output_guard.h; UsageError) before anything is simulated,
-// `write` fills a staged sibling directory, which is then renamed over `out`.
-void WriteDatasetDirectory(const std::string& out, bool force,
-                           const std::function<void(const std::string& directory)>& write);
 
 // Throws UsageError for an `out` it may not write or a robot of another model,
 // std::invalid_argument for an unknown model or a truth that does not fit the robot; nothing is

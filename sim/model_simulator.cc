@@ -148,9 +148,9 @@ EncoderSamples FineChannels(const RobotModelInterface& model, const double* p,
   for (std::size_t k = 1; k < grid.t_s.size(); ++k) {
     const Twist v = profile.At(0.5 * (grid.t_s[k - 1] + grid.t_s[k]));
     if (!model.ChannelsForTwist(p, v, values.data())) {
-      throw std::invalid_argument("the " + model.robot().model + " model cannot drive the twist (" +
-                                  std::to_string(v.vx_m_s) + ", " + std::to_string(v.vy_m_s) +
-                                  ", " + std::to_string(v.omega_rad_s) + ")");
+      throw std::invalid_argument(StrFormat("the %s model cannot drive the twist (%f, %f, %f)",
+                                            model.robot().model.c_str(), v.vx_m_s, v.vy_m_s,
+                                            v.omega_rad_s));  // std::to_string's %f
     }
     fine.push_back(grid.t_s[k] - grid.t_s[k - 1], values.data());
   }
@@ -354,12 +354,9 @@ void WriteSimulatedDataset(const std::string& dir, const std::string& robot_yaml
   fs::create_directories(out / "runs");
   std::vector<io::DatasetEntry> entries;
   for (const ModelSimulatedRun& run : runs) {
-    io::DatasetEntry e;
-    e.id = run.log.id;
-    e.trajectory = run.log.trajectory;
-    e.repetition = run.log.repetition;
-    e.encoders = "runs/" + e.id + "_encoders.csv";
-    e.ground_truth = "runs/" + e.id + "_ground_truth.csv";
+    const RunLog& log = run.log;
+    io::DatasetEntry e{log.id, log.trajectory, log.repetition, "runs/" + log.id + "_encoders.csv",
+                       "runs/" + log.id + "_ground_truth.csv"};
     io::WriteFileAtomically((out / e.encoders).string(), SimulatedEncoderCsv(run, digits));
     io::WriteFileAtomically((out / e.ground_truth).string(),
                             io::GroundTruthCsv(run.log.ground_truth));

@@ -1,41 +1,25 @@
 #pragma once
 // Simulated calibration runs of any robot model (models/model_interface.h): a trajectory is a
 // list of body twists held for given durations; the simulator turns it into what a recorder
-// would log (encoder channels, ground truth) for a robot whose true parameters are known.
-//
-// Two motion and noise models. With SimulationOptions::stepped, the flower's time-stepped physics
-// (SteppedOptions below: controller lag, slip, jittered encoders, irregular ground truth; the
-// shipped data/flower is made so: omni3's scenario, sim/model_scenarios.h). Without it, perfect
-// tracking:
-//
-// - Commanded twist. Segments follow each other with raised-cosine ramps of ramp_time_s centred
-//   on every segment boundary (also from rest into the first segment and back to rest after the
-//   last): v(t) = v_prev + (v_next - v_prev) (1 - cos(pi u)) / 2, u = (t - t_b + ramp/2) / ramp.
-//   Velocity and acceleration are continuous, and because the ramp is antisymmetric about the
-//   boundary every segment keeps the integral it was given: a segment of (v, omega) for T seconds
-//   still covers v T metres and omega T radians. Segments must last at least ramp_time_s. The
-//   run starts with rest_before_s and ends with rest_after_s at rest.
-// - The true robot follows the commanded twist exactly (as under a perfect tracking controller):
-//   its channel values are the model's inverse kinematics with the TRUE parameters,
-//   ChannelsForTwist(p_true, v(t)), evaluated on a fine time grid (steps of at most substep_s,
-//   refined so that every encoder and ground-truth time is a grid point) at each step's middle.
-//   A twist the model cannot drive (ChannelsForTwist false) is an error.
-// - Ground truth: the true model replayed on that fine grid (RobotModelInterface::Replay with
-//   p_true, piecewise-constant channel values), sampled every ground_truth_period_s, plus white
-//   Gaussian noise: gt_position_sigma_m per axis and gt_heading_sigma_rad.
-// - Encoders, every encoder_period_s (row 0 only sets the start time):
-//     wheel-rate channels: the true wheel angle advance over the interval (exact integral of the
-//       fine rates) plus white Gaussian noise of wheel_rate_sigma_rad_s * dt per interval (an
-//       encoder rate noise, independent per interval: the odometry's random walk); with
-//       ticks_per_rev[i] > 0 the accumulated measured angle is then counted in whole ticks
-//       (floor), so the quantisation error stays below one tick and does not accumulate; the log
-//       holds the mean rate over the interval (counted angle advance / dt).
-//     angle channels: the reading at each row time plus white Gaussian noise angle_sigma_rad; the
-//       interval value is the mean of the two readings (as the loader makes it, robot.h). With
-//       `dynamics` the model's own state gives the channels step by step and its encoders' readings.
-// - Start pose: start_pose, moved by a uniform offset in +-start_position_range_m per axis and a
-//   uniform heading in [-pi, pi) when random_start_heading; recorded in RunLog::start_pose only
-//   when record_start_pose (otherwise the fit takes it from the noisy ground truth).
+// would log (encoder channels, ground truth) for a robot whose true parameters are known. Two
+// motion and noise models (docs/simulate.md: their tables of effects and defaults): with
+// SimulationOptions::stepped the flower's time-stepped physics (SteppedOptions below), without it
+// perfect tracking:
+// - Commanded twist: raised-cosine ramps of ramp_time_s centred on every segment boundary (from
+//   and back to rest too), v(t) = v_prev + (v_next - v_prev) (1 - cos(pi u)) / 2,
+//   u = (t - t_b + ramp/2) / ramp. The ramp is antisymmetric about the boundary, so every segment
+//   keeps its integral (v T metres, omega T radians); segments must last at least ramp_time_s.
+// - The true robot follows it exactly: ChannelsForTwist(p_true, v(t)) at the middle of each step
+//   of a fine grid (steps <= substep_s, every encoder and ground-truth time a grid point; a twist
+//   the model cannot drive is an error), replayed with p_true for the ground truth, sampled every
+//   ground_truth_period_s with white noise gt_position_sigma_m per axis, gt_heading_sigma_rad.
+// - Encoders every encoder_period_s: a wheel channel's exact angle advance plus white noise of
+//   wheel_rate_sigma_rad_s * dt per interval (a random walk), counted in whole ticks of the
+//   accumulated angle (floor: the quantisation error stays below one tick), logged as the mean
+//   rate; an angle channel read at each row with white noise angle_sigma_rad, the interval's value
+//   the mean of its two readings (robot.h). With `dynamics` the model's own state gives both.
+// - Start pose: start_pose, moved uniformly by +-start_position_range_m per axis and to a uniform
+//   heading when random_start_heading; recorded only when record_start_pose.
 // Reproducible: run i draws from its own generator seeded by (seed, i) with a hand-written
 // Box-Muller normal, so the output does not depend on the standard library or thread count.
 
@@ -53,27 +37,21 @@
 
 namespace fitcal::sim {
 
-// The flower simulator's physics (Palacin's APR-02 as data/flower was made; stepped_run.h): a
-// time-stepped run in which a wheel controller follows the NOMINAL robot's inverse kinematics
-// with a first-order lag, the wheels slip, the encoders latch with jitter and the ground truth
-// comes at irregular times. Selected by SimulationOptions::stepped; the defaults are the
-// flower's (docs/simulate.md).
+// The flower simulator's physics, selected by SimulationOptions::stepped: the per-substep
+// equations and the order of the draws in stepped_run.h, the defaults (the flower's) in
+// docs/simulate.md. The controller follows the NOMINAL robot's inverse kinematics.
 struct ControllerLagOptions {
-  // Each channel follows its target through a first-order lag, rest to rest (start/stop
-  // transients): x += (1 - exp(-h / tau)) (target - x) per substep h.
-  double time_constant_s = 0.12;
+  double time_constant_s = 0.12;  // tau of each channel's first-order lag, rest to rest
 };
 struct SlipOptions {
-  // Contact rate = wheel rate (1 + s), s a per-wheel Ornstein-Uhlenbeck process of stationary
-  // sigma `sigma` and correlation time `correlation_time_s`: the non-systematic error that makes
-  // repetitions scatter. Wheel-rate channels only.
+  // Contact rate = wheel rate (1 + s), s a per-wheel Ornstein-Uhlenbeck process: the
+  // non-systematic error that makes repetitions scatter. Wheel-rate channels only.
   double sigma = 0.003;
   double correlation_time_s = 0.5;
 };
 struct EncoderLatchOptions {
-  // Counts latched every encoder period (SimulationOptions::encoder_period_s) plus a uniform
-  // jitter in [-jitter_s, jitter_s] (APR-02's 10 ms PID period), at the first substep end at or
-  // after the scheduled time; quantised by SimulationOptions::ticks_per_rev.
+  // Counts latched every encoder period plus a uniform jitter in [-jitter_s, jitter_s] (APR-02's
+  // 10 ms PID period), at the first substep end at or after the scheduled time.
   double jitter_s = 0.0005;
 };
 struct IrregularGroundTruthOptions {

@@ -93,10 +93,9 @@ SteppedRun::SteppedRun(const RobotModelInterface& model, const std::vector<doubl
   for (const TwistSegment& segment : spec.segments) {
     std::vector<double> target(c_);
     if (!model.ChannelsForTwist(commanded.data(), segment.twist, target.data())) {
-      throw std::invalid_argument("the " + robot_.model + " model cannot drive the twist (" +
-                                  std::to_string(segment.twist.vx_m_s) + ", " +
-                                  std::to_string(segment.twist.vy_m_s) + ", " +
-                                  std::to_string(segment.twist.omega_rad_s) + ")");
+      throw std::invalid_argument(StrFormat("the %s model cannot drive the twist (%f, %f, %f)",
+                                            robot_.model.c_str(), segment.twist.vx_m_s,
+                                            segment.twist.vy_m_s, segment.twist.omega_rad_s));
     }
     boundaries_.push_back(t);
     targets_.push_back(std::move(target));

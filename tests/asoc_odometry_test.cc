@@ -200,6 +200,12 @@ TEST(AsocModelTest, CastorDynamicsFollowTheTractrix) {
   EXPECT_LT(std::abs(values[kPivotChannel] - c.encoder_bias_rad), 0.01);  // it has trailed
 }
 
+int MaskCount(CastorMask mask) {
+  int n = 0;
+  for (int i = 0; i < kNumCastors; ++i) n += (mask >> i) & 1u;
+  return n;
+}
+
 // Least squares of Eq. 15-17 solved by QR, as the reference for the closed forms.
 BodyStep<double> SolveByQr(const std::array<PivotPosition, kNumCastors>& pivots, CastorMask mask,
                            double psi, const double* dx, const double* dy) {

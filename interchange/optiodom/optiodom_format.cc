@@ -185,9 +185,7 @@ void CheckRunCount(const SessionFiles& files, int num_runs) {
 std::string SessionType(const std::string& directory) {
   if (fs::is_directory(directory)) RequireSessionFolder(directory);
   const fs::path dir(directory);
-  const std::string name =
-      dir.filename().empty() ? dir.parent_path().filename().string() : dir.filename().string();
-  const std::string path = (dir / (name + "_metadata.csv")).string();
+  const std::string path = (dir / (SessionName(dir) + "_metadata.csv")).string();
   const std::string text = io::ReadTextFile(path);
   io::LineScanner lines(text);
   std::string_view line;

@@ -1,15 +1,9 @@
 #pragma once
-// The import of `fitcal import optiodom <session-dir>... --out <dataset-dir>`
-// (cli/import_optiodom.h only reads its flags, calls ImportOptiOdom and prints): converts the
-// published OptiOdom recordings (Sousa et al., "OptiOdom: a Generic Approach for Odometry
-// Calibration of Wheeled Mobile Robots", J. Intell. Robot. Syst. 105, 39, 2022; MIT licence) of
-// any robot of the study into a fitcal data set: per-run encoder + ground-truth CSVs, dataset.yaml
-// and the nominal robot YAML. One sequence for every robot: read every session
-// (interchange/optiodom/optiodom_format.h), take the robot most sessions declare (others declare
-// perturbed starting values on purpose: a note each), leave out runs the authors flagged, check
-// the channel order against the ground truth (diagnosis/import_channel_order.h: nothing is
-// written when another wheel order or sign explains it far better), write. What differs per
-// robot is data in interchange/optiodom/optiodom_robots.h.
+// The import of `fitcal import optiodom <session-dir>... --out <dataset-dir>` (the command only
+// reads its flags, calls ImportOptiOdom and prints): the published OptiOdom recordings (Sousa et
+// al., J. Intell. Robot. Syst. 105, 39, 2022; MIT licence; optiodom_format.h) of any robot of the
+// study into a fitcal data set, by one sequence for every robot (ImportOptiOdom below); what
+// differs per robot is data in interchange/optiodom/optiodom_robots.h.
 
 #include <functional>
 #include <string>

@@ -210,8 +210,6 @@ NeverWorseSaid ExportNeverWorse(const RobotModelInterface& nominal,
                                               tracks, lengths)));
 }
 
-// `exact` is the calibration as read, `exported` what the controller computes from the export;
-// the data set is read once.
 }  // namespace
 
 ExportReplay ReplayExport(const std::string& logs, const std::string& calibration_path,

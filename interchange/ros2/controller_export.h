@@ -1,63 +1,26 @@
 #pragma once
 // The parameter YAML a ros2_controllers controller reads, from a calibrated robot YAML (what
-// `fitcal export ros2-control`, cli/export_ros2_control.h, calls). Each model registers the
-// controllers it can be written for, with their writers, from its own folder
-// (ModelExtras::controllers, models/model_extras.h; e.g. models/diff_drive/diff_drive_extras.cc);
-// the export finds them through the registry:
+// `fitcal export ros2-control` calls; docs/ros2.md). Each model registers the controllers it can
+// be written for, with writers reading its parameters by name, from its own folder
+// (ModelExtras::controllers, models/model_extras.h); the export finds them through the registry:
+// diff_drive_controller (diff_drive), mecanum_drive_controller (omni, 4 mecanum wheels),
+// omni_wheel_drive_controller (omni3, omni wheels), tricycle_controller (tricycle). Key names and
+// nesting are each controller's generate_parameter_library file in ros2_controllers
+// (tricycle_controller's radius is `wheel_radius`; `traction_wheel_radius` is
+// bicycle_steering_controller's); only the keys the --ros-distro's controller declares are
+// written (tests/data/ros2_controllers/, checked by ros2_io_test).
 //
-//   controller                   fitcal model               keys written (ros__parameters)
-//   diff_drive_controller        diff_drive                 wheel_separation, wheel_radius,
-//                                                           {left,right}_wheel_radius_multiplier,
-//                                                           wheel_separation_multiplier (1.0),
-//                                                           {left,right}_wheel_names,
-//                                                           wheels_per_side (humble only)
-//   mecanum_drive_controller     omni, 4 mecanum wheels     kinematics.wheels_radius,
-//                                                           kinematics.sum_of_robot_center_
-//                                                           projection_on_X_Y_axis, the four
-//                                                           <corner>_wheel_command_joint_name
-//   omni_wheel_drive_controller  omni3, omni (omni wheels)  wheel_radius, robot_radius,
-//                                                           wheel_offset, wheel_names
-//   tricycle_controller          tricycle                   wheelbase, wheel_radius,
-//                                                           traction_joint_name,
-//                                                           steering_joint_name
-// (key names and nesting: each controller's generate_parameter_library file in
-// ros-controls/ros2_controllers, src/*_parameter(s).yaml; tricycle_controller's radius key is
-// `wheel_radius` - `traction_wheel_radius` belongs to bicycle_steering_controller.)
+// Only diff_drive_controller represents its calibration exactly (a radius multiplier per side).
+// The others get the best representable values (means over the wheels; the tricycle's steering
+// offset left out), every approximation named in one line with the exact value, its sign and
+// where it goes. The replay runs what the controller computes from the values as written
+// (Ros2ControlExport::model, ::parameters): no YAML is written to be read back.
 //
-// Per ROS 2 distribution (--ros-distro humble|jazzy|rolling, default the newest): only the keys
-// that distribution's controller declares are written (tests/data/ros2_controllers/ keeps the
-// declared names and types of each; ros2_io_test checks every export against them). humble has
-// no omni_wheel_drive_controller; jazzy and rolling no longer declare wheels_per_side.
-//
-// diff_drive_controller represents a diff_drive calibration exactly (a radius multiplier per
-// side). The others cannot: mecanum_drive_controller has one radius and one lx + ly for all
-// wheels and assumes drive directions straight ahead; omni_wheel_drive_controller has one radius,
-// one distance and equally spaced wheels; tricycle_controller has no steering offset. The export
-// writes the best representable values (means over the wheels; the offset left out) and names
-// every approximation in one line, with the exact value, its sign and where it goes.
-//
-// Covariance (validation/odometry_covariance.h, docs/ros2.md): with a data set, the errors of
-// the exported parameters on the held-out runs give twist_covariance_diagonal (the twist's
-// variance per message of --publish-rate, default the encoder period, the ground truth's own
-// noise removed) and pose_covariance_diagonal (the variance after 1 m, with its growth law in
-// --calibration-out), written where the controller declares them (diagonal_covariance.twist /
-// .pose for omni_wheel_drive_controller); axes a planar robot does not measure (z, roll, pitch)
-// get kUnmeasuredVariance. --calibration-out writes the exact calibration's own covariance into
-// a copy of the calibration file (calibration.odometry_covariance).
-//
-// The calibrated parameters are taken from the model by name (its parameter table,
-// models/model_interface.h: ParameterIndex), and the replay runs what the controller computes
-// from the values as written (Ros2ControlExport::model, ::parameters): no YAML is written to be
-// read back.
-//
-// With a data set (--logs) the exported parameters are replayed on its held-out runs - the runs
-// the calibration did not train on, found as `report` finds them (validation/training_runs.h:
-// by run id and fingerprint) - beside the nominal robot (the data set's robot.yaml) and the exact
-// calibration (CF, Palacin Eq. 14). Parameters that replay worse than the nominal robot are not
-// written (exit 5) unless --allow-worse.
-//
-// Joint names: in the robot's channel order (default: the channel names); they must be the
-// URDF's joint names for the controller to load.
+// With a data set (--logs) the export is replayed on the held-out runs (found as `report` finds
+// them, validation/training_runs.h) beside the nominal and the exact calibration, judged
+// never-worse, and gives the odometry covariance (validation/odometry_covariance.h): its
+// unmeasured axes (z, roll, pitch) get kUnmeasuredVariance. Joint names, in the robot's channel
+// order, must be the URDF's for the controller to load.
 
 #include <string>
 #include <vector>
@@ -85,8 +48,7 @@ const std::vector<std::string>& RosDistros();
 void CheckControllerDistro(const std::string& controller, const std::string& ros_distro);
 
 // The export of a calibrated robot (read through the model registry; its values are the
-// calibration; calibration_path names it in errors). The parameters are taken from the model by
-// name (its parameter table, models/model_interface.h), never by position. Throws UsageError
+// calibration; calibration_path names it in errors). Throws UsageError
 // (one line) for an unknown controller, a model/controller mismatch, a geometry the controller
 // cannot describe at all (e.g. mecanum rollers the wrong way), joints of the wrong length, an
 // unknown distribution or a controller it does not ship.

@@ -162,17 +162,14 @@ RobotModelPtr WriteDataset(const ImportRosbag2Options& o, const Robot& robot,
   fs::create_directories(dir / "runs");
   std::vector<io::DatasetEntry> entries;
   for (std::size_t i = 0; i < imp.runs.size(); ++i) {
-    io::DatasetEntry e;
-    e.id = imp.runs[i].id;
-    e.trajectory = imp.runs[i].trajectory;
-    e.repetition = imp.runs[i].repetition;
-    e.encoders = "runs/" + e.id + "_encoders.csv";
-    e.ground_truth = "runs/" + e.id + "_ground_truth.csv";
+    const RunLog& run = imp.runs[i];
+    io::DatasetEntry e{run.id, run.trajectory, run.repetition, "runs/" + run.id + "_encoders.csv",
+                       "runs/" + run.id + "_ground_truth.csv"};
     io::WriteFileAtomically(
         (dir / e.encoders).string(),
         EncoderCsvText(robot, imp.encoder_t_s[i], imp.encoder_values[i]).view());
     io::WriteFileAtomically((dir / e.ground_truth).string(),
-                            GroundTruthCsvText(imp.runs[i].ground_truth).view());
+                            GroundTruthCsvText(run.ground_truth).view());
     entries.push_back(std::move(e));
   }
   std::string robot_yaml = io::ReadTextFile(o.robot);

@@ -25,20 +25,10 @@
 // `<label>-NN`, trajectory label <label> (default: the bag's name) and repetition i, so
 // `fitcal fit --train-reps` chooses runs by number.
 //
-// Real recordings. Messages on the encoder topic that carry none of the robot's joints (another
-// node's JointState) are skipped. Wheel positions wrapped to one turn are unwrapped (or refused
-// when too fast to unwrap). A ground-truth orientation that is not a unit quaternion is refused
-// naming topic and time. With --stamp recorded, a recording clock that steps back (seen as
-// header stamps going back in recorded order) is refused at that instant. The data set is read
-// back with the loader `fit` uses before it is committed: the import never writes a data set
-// `fit` refuses.
-//
-// A pose source on a mount. When the ground truth tracks a frame other than --base-frame (an
-// Odometry's child_frame_id; a PoseStamped's frame named by --ground-truth-frames) and the bag's
-// /tf_static links the two (directly or along a chain), the data set's robot YAML gets that pose
-// as its nominal `ground_truth_frame: {x_m, y_m, yaw_deg}`, said on one line; without /tf_static
-// (or without a link) nothing is written for the frame, said in words. A robot YAML that declares
-// its own ground_truth_frame keeps it.
+// Real recordings (docs/ros2.md, "Import"): other nodes' JointStates skipped, wrapped positions
+// unwrapped, non-unit quaternions and (with --stamp recorded) a clock stepping back refused, and
+// the data set read back by `fit`'s loader before it is committed. A ground truth tracking
+// another frame than --base-frame gets its nominal `ground_truth_frame` from /tf_static.
 
 #include <string>
 #include <vector>

@@ -94,11 +94,6 @@ class CastorDynamics : public ChannelDynamics {
   State state_{};
 };
 
-sim::TrajectorySpec Spec(const std::string& label, int repetition,
-                         std::vector<sim::TwistSegment> segments) {
-  return {label, repetition, std::move(segments)};
-}
-
 const AsocModel& AsAsoc(const RobotModelInterface& model) {
   const auto* asoc = dynamic_cast<const AsocModel*>(&model);
   if (asoc == nullptr) throw std::invalid_argument("not an asoc robot: " + model.robot().model);
@@ -171,7 +166,7 @@ sim::TrajectorySpec ExcursionTrajectory(int repetition, int num_segments) {
     const Twist twist{speed * std::cos(direction), speed * std::sin(direction), omega};
     segments.push_back({twist, Uniform(rng, 2.0, 5.0)});
   }
-  return Spec("excursion", repetition, std::move(segments));
+  return {"excursion", repetition, std::move(segments)};
 }
 
 std::vector<sim::TrajectorySpec> HoldTrajectories(const Vehicle& nominal) {
@@ -182,8 +177,8 @@ std::vector<sim::TrajectorySpec> HoldTrajectories(const Vehicle& nominal) {
       // The held pivot stays still: v_origin + omega x p_held = 0.
       const double w = direction * kRateRadS;
       const PivotPosition& p = nominal.pivots[held];
-      out.push_back(Spec("hold_" + std::to_string(held + 1) + (direction < 0 ? "_cw" : "_ccw"), 1,
-                         {{{w * p.y_m(), -w * p.x_m(), w}, kAngleRad / kRateRadS}}));
+      out.push_back({"hold_" + std::to_string(held + 1) + (direction < 0 ? "_cw" : "_ccw"), 1,
+                     {{{w * p.y_m(), -w * p.x_m(), w}, kAngleRad / kRateRadS}}});
     }
   }
   return out;
@@ -203,8 +198,8 @@ std::vector<sim::TrajectorySpec> UmbmarkTrajectories(int per_direction, int firs
         square.push_back({{0.0, 0.0, direction * kTurnRateRadS}, 0.5 * M_PI / kTurnRateRadS});
         if (leg < 3) square.push_back({{}, kStopS});
       }
-      out.push_back(Spec(direction < 0 ? "umbmark_cw" : "umbmark_ccw", first_repetition + k,
-                         std::move(square)));
+      out.push_back({direction < 0 ? "umbmark_cw" : "umbmark_ccw", first_repetition + k,
+                     std::move(square)});
     }
   }
   return out;

@@ -9,12 +9,10 @@
 // encoders read gamma_i = theta_i + beta_i in steps of the robot's pivot_resolution_deg (an
 // absolute encoder; the recorded readings are unwrapped, as ASOC's own files are on load).
 //
-// Scenario, per data set: the calibration manoeuvre of Sec. III-A (hold castor 1, 2, 3, rotate the
-// body 270 deg about its pivot CW then CCW: `hold_<i>_cw` / `hold_<i>_ccw`, repetition 1), the
-// UMBmark square (Borenstein; Sec. IV-B) 5 x CW and CCW as repetitions 6-10 (each at its own
-// speed, 0.30, 0.306, ... m/s, so no two are one recording copied) and `repetitions` random
-// holonomic excursions (repetitions 1..N, the fit's training data). Castors are aligned for the
-// first segment before a run starts.
+// Scenario, per data set: the calibration manoeuvre of Sec. III-A (repetition 1), the UMBmark
+// square (Sec. IV-B) as repetitions 6-10, each at its own speed so that no two are one recording
+// copied, and `repetitions` random excursions (1..N, the fit's training data); below. Castors are
+// aligned for the first segment before a run starts.
 //
 // The true robot (default_truth): drawn about the nominal as Doebbler Table I (ParameterSpread)
 // from std::mt19937_64(SplitMix(seed)), the draw of asoc-simulate before the one simulator.

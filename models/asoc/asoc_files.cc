@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <set>
@@ -46,35 +47,23 @@ asoc::EncoderLog ReadAsocEncoderCsv(const std::string& path) {
   while (scanner.Next(&line)) {
     if (Trim(line).empty()) continue;
     const int n = scanner.line_number();
+    const std::vector<std::string> fields = SplitCsvFields(line);
     double v[kColumns];
-    int count = 0;
-    std::size_t pos = 0;
-    while (pos <= line.size()) {
-      std::size_t end = line.find(',', pos);
-      if (end == std::string_view::npos) end = line.size();
-      if (count >= kColumns) {
-        throw InputError(InputErrorKind::kWrongColumnCount, path, n,
-                         "expected " + std::to_string(kColumns) + " fields, found more");
-      }
-      const std::string_view field = line.substr(pos, end - pos);
+    for (std::size_t i = 0; i < std::min<std::size_t>(fields.size(), kColumns); ++i) {
       bool finite = true;
-      if (!ParseDouble(field, &v[count], &finite)) {
-        throw InputError(
-            InputErrorKind::kNonNumeric, path, n,
-            std::string(kHeader[count]) + " is not a number: '" + std::string(Trim(field)) + "'");
+      if (!ParseDouble(fields[i], &v[i], &finite)) {
+        throw InputError(InputErrorKind::kNonNumeric, path, n,
+                         std::string(kHeader[i]) + " is not a number: '" + fields[i] + "'");
       }
       if (!finite) {
-        throw InputError(
-            InputErrorKind::kNonFinite, path, n,
-            std::string(kHeader[count]) + " is not finite: '" + std::string(Trim(field)) + "'");
+        throw InputError(InputErrorKind::kNonFinite, path, n,
+                         std::string(kHeader[i]) + " is not finite: '" + fields[i] + "'");
       }
-      ++count;
-      pos = end + 1;
     }
-    if (count != kColumns) {
-      throw InputError(
-          InputErrorKind::kWrongColumnCount, path, n,
-          "expected " + std::to_string(kColumns) + " fields, found " + std::to_string(count));
+    if (fields.size() != kColumns) {  // a longer row is "found more"
+      throw InputError(InputErrorKind::kWrongColumnCount, path, n,
+                       "expected " + std::to_string(kColumns) + " fields, found " +
+                           (fields.size() > kColumns ? "more" : std::to_string(fields.size())));
     }
     if (!log.t_s.empty() && !(v[0] > log.t_s.back())) {
       throw InputError(InputErrorKind::kNonIncreasingTime, path, n,

@@ -1,29 +1,13 @@
 #pragma once
-// Files of ASOC data sets (Doebbler's active split offset castor vehicles):
-//
-// Encoder CSV, header exactly
+// Files of ASOC data sets (Doebbler's active split offset castor vehicles; docs/asoc.md, "Data",
+// shows both). Encoder CSV, header exactly
 //   t,wheel_1a,wheel_1b,wheel_2a,wheel_2b,wheel_3a,wheel_3b,pivot_1,pivot_2,pivot_3
 // t in s (strictly increasing); wheel_<i><a|b> the cumulative angle of wheel 1 / 2 of castor i
-// (rad); pivot_<i> the pivot encoder reading gamma_i (rad, any turn). At least two rows.
-//
-// Robot YAML, `model: asoc`:
-//   model: asoc
-//   name: proto
-//   pivot_distance_m: 0.5196      # Doebbler's D: every pair of pivots is this far apart
-//   castors:
-//     - {name: c1, pivot_radius_m: 0.3, pivot_angle_deg: 0, offset_m: 0.08,
-//        wheel_radius_m: [0.04, 0.04], wheel_offset_m: [0.06, 0.06], encoder_bias_deg: 0}
-//     - ... (three castors)
-//   bounds: {offset_m: [lo, hi], wheel_radius_m: [lo, hi], wheel_offset_m: [lo, hi],
-//            encoder_bias_deg: [lo, hi]}   # optional, absolute; default: a box around each
-//                                          # value (models/asoc/asoc_robot_model.cc)
-//   odometry: {algorithm: CAST-0, redundancy_check: false}   # optional (Doebbler Table II names:
-//                                          # CAST-0..3, IPEC-1..3; models/asoc/asoc_kinematics.h)
-//   encoder: {...}, effects: [...]         # optional, as for every model (io/robot_yaml_blocks.h)
-//   calibration: {...}            # optional, written by fitcal, informational when read
-// Ground truth and dataset.yaml are as for omni3 (io/dataset.h, io/log_files.h). The generic
-// commands read these encoder files through AsocEncoderLogAsChannels (io/dataset.cc); a user's own
-// logs may instead use the generic CSV with the asoc model's channel columns (README, ASOC).
+// (rad); pivot_<i> the pivot encoder reading gamma_i (rad, any turn). At least two rows. The
+// robot YAML, `model: asoc`: pivot_distance_m (Doebbler's D: every pair of pivots this far
+// apart), three castors, and optional bounds (absolute), odometry (Doebbler Table II's names,
+// asoc_kinematics.h), encoder, effects and calibration (informational when read). The generic
+// commands read these encoder files through AsocEncoderLogAsChannels (io/dataset.cc).
 
 #include <yaml-cpp/yaml.h>
 

@@ -29,6 +29,9 @@ CastorParameters SolveHoldPair(const HoldMeasurement& m, double pivot_distance_m
   return out;
 }
 
+namespace {
+
+// "hold_<j>_cw" / "hold_<j>_ccw" (j = 1..3): the held castor (0-based) and the direction.
 bool ParseHoldLabel(const std::string& trajectory, int* held, int* direction) {
   for (int j = 0; j < kNumCastors; ++j) {
     const std::string prefix = "hold_" + std::to_string(j + 1);
@@ -40,6 +43,8 @@ bool ParseHoldLabel(const std::string& trajectory, int* held, int* direction) {
   }
   return false;
 }
+
+}  // namespace
 
 std::optional<HoldRun> MeasureHoldRun(const std::string& trajectory,
                                       const EncoderSamples& samples) {
@@ -196,19 +201,17 @@ CastorParameters HalfSpread(const std::vector<CastorParameters>& e, const Castor
   return CastorParameters::FromArray(h);
 }
 
-}  // namespace
-
+// t with P(|T| < t) = 68.27 % (the normal's 1 sigma) for Student's t with dof degrees of freedom:
+// a standard error from dof degrees of freedom times t covers the error as often as one normal
+// sigma does. dof 1..10 from a table (computed by integrating the density); beyond,
+// 1 + 1/(2 dof) to 0.3 %; infinity for dof < 1.
 double OneSigmaStudentFactor(int dof) {
-  // t with P(|T| < t) = 68.27 % (the normal's 1 sigma) for Student's t with dof degrees of
-  // freedom, dof 1..10 (computed by integrating the density); beyond, 1 + 1/(2 dof) to 0.3 %.
   static constexpr double kTable[] = {1.8373, 1.3213, 1.1969, 1.1416, 1.1105,
                                       1.0906, 1.0767, 1.0665, 1.0587, 1.0526};
   if (dof < 1) return std::numeric_limits<double>::infinity();
   if (dof <= 10) return kTable[dof - 1];
   return 1.0 + 0.5 / dof;
 }
-
-namespace {
 
 // The sigmas of the castor estimates from the spread of their independent estimates (one per
 // held castor: different runs); the pair estimates of one held castor share runs, so they are

@@ -15,11 +15,9 @@
 // (p_i - p_j) minus 90 deg (the CW velocity of pivot i). Holding each of the three castors in turn
 // gives two estimates per castor; they are averaged (beta on the circle).
 //
-// Runs are found by trajectory label "hold_<j>_cw" / "hold_<j>_ccw" (j 1-based). The steady
-// castor angle is the circular mean of the readings over the middle half of the run
-// (kSteadyFraction), which skips start/stop transients when the castors were not pre-aligned. Every hold run
-// is used: each CW run of castor j is paired with each CCW run of castor j; a castor's estimate is
-// the mean over its held castors of the mean of their pair estimates.
+// Runs are found by trajectory label "hold_<j>_cw" / "hold_<j>_ccw" (j 1-based); the steady
+// castor angle is read over the middle of the run (kSteadyFraction), which skips start/stop
+// transients when the castors were not pre-aligned.
 //
 // Uncertainty: the estimates of castor i with castor j held and with castor k held come from
 // different runs, so their spread measures what the encoders' quantisation and noise do to
@@ -64,8 +62,6 @@ struct HoldRun {
   std::array<std::array<double, 2>, kNumCastors> wheel_rad{};  // angle each wheel turned
 };
 
-// "hold_<j>_cw" / "hold_<j>_ccw" (j = 1..3): the held castor (0-based) and the direction.
-bool ParseHoldLabel(const std::string& trajectory, int* held, int* direction);
 inline constexpr double kSteadyFraction = 0.5;
 // A hold run's Eq. 1-9 measurements from the model's channels, when `trajectory` names one and it
 // has at least 4 intervals: steady angles as the circular mean over the middle kSteadyFraction of
@@ -73,7 +69,6 @@ inline constexpr double kSteadyFraction = 0.5;
 // and each wheel's angle over the same span.
 std::optional<HoldRun> MeasureHoldRun(const std::string& trajectory,
                                       const EncoderSamples& samples);
-
 
 struct GeometricResult {
   bool usable = false;
@@ -89,11 +84,6 @@ struct GeometricResult {
   std::array<CastorParameters, kNumCastors> sigma{};
   int sigma_dof = 0;
 };
-
-// The factor t with P(|T| < t) = 68.27 % for Student's t with `dof` degrees of freedom: a
-// standard error from dof degrees of freedom times t covers the error as often as one normal
-// sigma does. Infinity for dof < 1.
-double OneSigmaStudentFactor(int dof);
 
 // Eq. 1-9 on every CW x CCW pair of hold runs of each held castor, averaged per castor. Castors
 // without any usable hold pair keep their nominal parameters and make the result unusable.

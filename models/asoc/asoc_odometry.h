@@ -29,11 +29,6 @@ inline constexpr CastorMask kAllCastors = 0b111;
 inline CastorMask MaskExcluding(int castor_one_based) {
   return castor_one_based == 0 ? kAllCastors : (kAllCastors & ~(1u << (castor_one_based - 1)));
 }
-inline int MaskCount(CastorMask mask) {
-  int n = 0;
-  for (int i = 0; i < kNumCastors; ++i) n += (mask >> i) & 1u;
-  return n;
-}
 
 template <typename T>
 struct BodyStep {

@@ -79,8 +79,7 @@ AsocOdometryOptions OdometryOf(const io::AsocRobot& robot, const std::string& pa
   return o;
 }
 
-}  // namespace
-
+// The generic description (channels, parameters; no nominal) of castors with these names.
 Robot AsocRobotDescription(const std::string& name,
                            const std::array<std::string, asoc::kNumCastors>& castor_names) {
   Robot robot;
@@ -111,6 +110,8 @@ Robot AsocRobotDescription(const std::string& name,
   }
   return robot;
 }
+
+}  // namespace
 
 RobotModelPtr ReadAsocModel(const YAML::Node& root, const std::string& path) {
   io::AsocRobot asoc = io::ReadAsocRobotNode(root, path);

@@ -53,10 +53,6 @@ class AsocModel : public KinematicModel<AsocKinematics> {
   io::AsocRobot asoc_;
 };
 
-// The generic description (channels, parameters; no nominal) of castors with these names.
-Robot AsocRobotDescription(const std::string& name,
-                           const std::array<std::string, asoc::kNumCastors>& castor_names);
-
 // The simulated one-third-scale prototype (asoc_extras.h PrototypeVehicle).
 inline constexpr const char* kAsocExampleYaml = R"(model: asoc
 name: example_asoc

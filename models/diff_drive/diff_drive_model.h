@@ -2,17 +2,8 @@
 // A differential-drive robot on the model seam: the kinematics of diff_drive_kinematics.h, the
 // robot YAML schema below and UMBmark (umbmark.h) as its classical calibration.
 //
-// Robot YAML:
-//
-//   model: diff_drive
-//   name: turtle
-//   wheels:                          # order = encoder channels
-//     - {name: right, radius_m: 0.042}
-//     - {name: left, radius_m: 0.042}
-//   wheel_separation_m: 0.200
-//   bounds: {radius_m: [0.038, 0.046], wheel_separation_m: [0.18, 0.22]}
-//   encoder: {ticks_per_rev: 2796.8, cumulative: false}   # optional (io/robot_yaml_blocks.h)
-//   effects: [...]                                        # optional
+// Robot YAML: kDiffDriveExampleYaml below (wheels in encoder channel order, bounds absolute),
+// with optional `encoder:` and `effects:` blocks (io/robot_yaml_blocks.h).
 //
 // Which wheel is which: a wheel named `right` or `left` is on that side; a wheel with any other
 // name needs `side: right` or `side: left` (e.g. `{name: a, side: left, radius_m: 0.05}`). One

@@ -2,15 +2,11 @@
 // A holonomic robot on 3 to 8 omni or mecanum wheels on the model seam: the kinematics of
 // omni_kinematics.h, the robot YAML schema below, and the gauge the fit holds.
 //
-// Robot YAML (`model: omni`):
-//   name: <robot>
-//   wheels:                      # 3..8 entries, in the encoder CSV's column order
-//     - {name: fl, distance_m: 0.1414, angle_deg: 45, radius_m: 0.03,
-//        drive_angle_deg: 0,      # optional: drive direction in the robot frame, default
-//                                 #   angle_deg + 90 (tangential, counter-clockwise)
-//        roller_angle_deg: -45}   # optional: 0 (omni wheel) by default, +-45 mecanum
-//   bounds: {distance_m: [lo, hi], radius_m: [lo, hi], angle_offset_deg: [lo, hi]}
-//   encoder: ..., effects: ...    # optional, as for every model (io/robot_yaml_blocks.h)
+// Robot YAML (`model: omni`), kOmniExampleYaml below: 3..8 wheels in the encoder CSV's column
+// order, each with distance_m, angle_deg, radius_m, an optional drive_angle_deg (drive direction
+// in the robot frame; default angle_deg + 90, tangential counter-clockwise) and roller_angle_deg
+// (default 0, an omni wheel; +-45 mecanum); bounds; optional `encoder:` and `effects:`
+// (io/robot_yaml_blocks.h).
 // Distance and radius bounds are absolute for every wheel, angle bounds relative to each wheel's
 // nominal angle (Palacin Eq. 16). Channels are "w_<name>" (rad/s) or "ticks_<name>".
 //

@@ -1,16 +1,10 @@
 #pragma once
-// A tricycle robot on the model seam: the kinematics of tricycle_kinematics.h and its robot YAML
-//
-//   model: tricycle
-//   name: forklift_3
-//   traction_wheel: {radius_m: 0.0325}      # optional `name:` (default "traction")
-//   wheelbase_m: 0.15                        # traction wheel to the rear axle's centre
-//   steering_offset_deg: 0.0                 # true steering = gain x measured + offset
-//   steering_gain: 1.0                       # optional: a fourth parameter (bounds key
-//                                            # steering_gain, default [gain / 10, gain x 10])
-//   bounds: {radius_m: [lo, hi], wheelbase_m: [lo, hi], steering_offset_deg: [lo, hi]}
-//   encoder: {ticks_per_rev: 1600, cumulative: false}   # optional, for the traction ticks
-//   effects: [...]                           # optional (io/robot_yaml_blocks.h)
+// A tricycle robot on the model seam: the kinematics of tricycle_kinematics.h and its robot YAML,
+// kTricycleExampleYaml below: traction_wheel takes an optional `name:` (default "traction"),
+// wheelbase_m runs from the traction wheel to the rear axle's centre, true steering = gain x
+// measured + offset with an optional steering_gain (a fourth parameter; bounds key
+// steering_gain, default [gain / 10, gain x 10]); optional `encoder:` (the traction ticks) and
+// `effects:` (io/robot_yaml_blocks.h).
 //
 // Bounds are absolute (the steering offset is itself an offset). Encoder channels: the traction
 // wheel (`w_<name>` rad/s or `ticks_<name>`) and the steering angle (`steering`, rad, one reading
