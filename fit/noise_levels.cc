@@ -66,29 +66,39 @@ SessionSum SumOf(const ComponentSums& sums, bool heading, double redundancy) {
           dimension * runs * runs / std::max(sums.inverse_checkpoints, 1e-300) * redundancy};
 }
 
+// The sessions in `pool` together: N = sum nu_s and v_p = sum nu_s v_s / N (header).
+struct Pool {
+  double degrees = 0.0;
+  double variance = 0.0;
+};
+Pool PoolOf(const std::vector<SessionSum>& s, const std::vector<int>& pool) {
+  double n = 0.0, weighted = 0.0;
+  for (int i : pool) n += s[i].degrees, weighted += s[i].degrees * s[i].Variance();
+  return {n, weighted / n};
+}
+
 // Bartlett's test that the sessions in `pool` share one variance (header): its p.
 double BartlettP(const std::vector<SessionSum>& s, const std::vector<int>& pool) {
-  double n = 0.0, weighted = 0.0, logs = 0.0, inverse = 0.0;
+  const Pool pooled = PoolOf(s, pool);
+  const double n = pooled.degrees;
+  double logs = 0.0, inverse = 0.0;
   for (int i : pool) {
-    n += s[i].degrees;
-    weighted += s[i].degrees * s[i].Variance();
     logs += s[i].degrees * std::log(std::max(s[i].Variance(), 1e-300));
     inverse += 1.0 / s[i].degrees;
   }
   const double k = static_cast<double>(pool.size());
-  const double t = n * std::log(std::max(weighted / n, 1e-300)) - logs;
+  const double t = n * std::log(std::max(pooled.variance, 1e-300)) - logs;
   const double correction = 1.0 + (inverse - 1.0 / n) / (3.0 * (k - 1.0));
   return stats::ChiSquareUpperTail(t / correction, k - 1.0);
 }
 
 // The session in `pool` farthest from the pool's variance: the largest nu_s (ln v_s - ln v_p)^2.
 std::size_t Farthest(const std::vector<SessionSum>& s, const std::vector<int>& pool) {
-  double n = 0.0, weighted = 0.0;
-  for (int i : pool) n += s[i].degrees, weighted += s[i].degrees * s[i].Variance();
+  const double pooled_variance = PoolOf(s, pool).variance;
   std::size_t out = 0;
   double largest = -1.0;
   for (std::size_t j = 0; j < pool.size(); ++j) {
-    const double d = std::log(std::max(s[pool[j]].Variance(), 1e-300) / (weighted / n));
+    const double d = std::log(std::max(s[pool[j]].Variance(), 1e-300) / pooled_variance);
     if (s[pool[j]].degrees * d * d > largest) largest = s[pool[j]].degrees * d * d, out = j;
   }
   return out;
@@ -304,22 +314,24 @@ std::string PerSessionText(const NoiseLevels& levels, const std::string& separat
   return out;
 }
 
-}  // namespace
-
-std::string NoiseLevelsText(const NoiseLevels& levels, const std::string& separator) {
-  if (levels.sessions.AnyDiffers()) {
-    return PerSessionText(levels, separator) +
-           StrFormat(" (%d fits, %s)", levels.iterations,
-                     levels.settled ? "settled" : "not settled");
-  }
+// The data set's levels, one per component.
+std::string DataSetText(const NoiseLevels& levels) {
   std::string out = StrFormat("track position %.3g m, heading %.3g deg per checkpoint",
                               levels.track_position_m, RadToDeg(levels.track_heading_rad));
   if (levels.with_final_poses) {
     out += StrFormat("; final pose position %.3g m, heading %.3g deg", levels.final_position_m,
                      RadToDeg(levels.final_heading_rad));
   }
-  return out + StrFormat(" (%d fits, %s)", levels.iterations,
-                         levels.settled ? "settled" : "not settled");
+  return out;
+}
+
+}  // namespace
+
+std::string NoiseLevelsText(const NoiseLevels& levels, const std::string& separator) {
+  const std::string text = levels.sessions.AnyDiffers() ? PerSessionText(levels, separator)
+                                                        : DataSetText(levels);
+  return text + StrFormat(" (%d fits, %s)", levels.iterations,
+                          levels.settled ? "settled" : "not settled");
 }
 
 }  // namespace fitcal
