@@ -7,7 +7,7 @@
 set -euo pipefail
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-PACKAGES=(build-essential cmake ninja-build pkg-config mold ccache
+PACKAGES=(build-essential cmake ninja-build pkg-config lld ccache
           libceres-dev libeigen3-dev libnlopt-cxx-dev libnlopt-dev libyaml-cpp-dev libcli11-dev
           libgtest-dev libgmock-dev libbenchmark-dev
           libsqlite3-dev libzstd-dev liblz4-dev libfastcdr-dev)
