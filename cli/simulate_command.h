@@ -30,7 +30,7 @@ struct SimulateCommandOptions {
   int encoder_counts_per_rev = 4096;
   double gt_position_sigma_m = 0.002;
   double gt_heading_sigma_deg = 0.2;
-  double slip_sigma = sim::SlipOptions{}.sigma;  // the stepped physics only
+  double slip_sigma = sim::SteppedOptions{}.slip_sigma;  // the stepped physics only
   bool slip_sigma_given = false;
   double wheel_rate_sigma_rad_s = sim::ScenarioNoise{}.wheel_rate_sigma_rad_s;
   double angle_sigma_deg = sim::ScenarioNoise{}.angle_sigma_rad * 180.0 / M_PI;

@@ -129,7 +129,7 @@ DatasetIndex ReadDatasetIndex(const std::string& directory, const DatasetOptions
   if (!fs::is_directory(directory, fs_error)) {
     throw InputError(InputErrorKind::kMissingFile, directory, 0, "not a directory");
   }
-  RegisterInputDirectory(directory);  // no output inside the data set (io/input_registry.h)
+  RegisterInput(directory);  // no output inside the data set (io/input_registry.h)
   if (!fs::exists(yaml_path, fs_error)) {
     throw InputError(InputErrorKind::kMissingFile, yaml_path, 0,
                      "no such file: not a data set; " + NoDatasetHint(directory));

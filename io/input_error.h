@@ -35,13 +35,15 @@ enum class InputErrorKind {
   kNoMotion,           // no run of the data set moves: nothing to calibrate
 };
 
-const char* ToString(InputErrorKind kind);
-
 // `text` made fit for one line of a message: control characters (a newline in a YAML scalar,
 // binary junk) shown as '?', and at most max_chars characters, the middle elided with the number
 // of bytes left out (a 2 MB field is never echoed whole). Keeps the head and the tail, where a
 // path's file name is.
 std::string OneLine(const std::string& text, std::size_t max_chars = 240);
+
+// `file:line: message` (`file: message` for line 0) in one line of at most ~500 characters
+// whatever the loaders echo: what() of an InputError, and a warning (io/warnings.h).
+std::string FileLineText(const std::string& file, int line, const std::string& message);
 
 class InputError : public std::runtime_error {
  public:

@@ -100,7 +100,7 @@ void EnableInputGuard() { g_enabled = true; }
 NotAnInput::NotAnInput() : previous_(t_probing) { t_probing = true; }
 NotAnInput::~NotAnInput() { t_probing = previous_; }
 
-void RegisterInputFile(const std::string& path) {
+void RegisterInput(const std::string& path) {
   if (!g_enabled || t_probing || path.empty()) return;
   {
     const std::lock_guard<std::mutex> lock(g_mutex);
@@ -127,8 +127,6 @@ void EndStagedOutput(const std::string& staging_dir) {
     g_staged_outputs.erase(it);
   }
 }
-
-void RegisterInputDirectory(const std::string& path) { RegisterInputFile(path); }
 
 std::string OutputOverlapsInputs(const std::string& out, const std::vector<std::string>& inputs) {
   std::vector<Input> described;

@@ -18,8 +18,7 @@ void EnableInputGuard();
 
 // Record an input file or directory (no effect unless the guard is enabled; thread-safe). A path
 // inside a staged output of this process (BeginStagedOutput) is not recorded.
-void RegisterInputFile(const std::string& path);
-void RegisterInputDirectory(const std::string& path);
+void RegisterInput(const std::string& path);
 
 // What the process is writing is not what it read: between these two calls, files read inside
 // `staging_dir` (a staged directory before its rename, io/staged_directory.h) are not inputs. A
@@ -35,10 +34,6 @@ std::string OutputOverlapsInput(const std::string& out);
 // The same against an explicit list (a command's inputs before it has read them). An input that
 // is a directory counts as a directory: an output inside it is refused.
 std::string OutputOverlapsInputs(const std::string& out, const std::vector<std::string>& inputs);
-
-}  // namespace fitcal::io
-
-namespace fitcal::io {
 
 // While one lives, files this thread opens are not recorded as inputs: reading an existing output
 // to decide whether it may be replaced (a previous calibration's robot name, a data set's file

@@ -113,10 +113,6 @@ bool IsBlank(std::string_view line) { return Trim(line).empty(); }
 // An angle in (-pi, pi] (WrapAngle's interval mirrored: a reading of exactly half a turn is +pi).
 double WrapToPi(double angle_rad) { return -WrapAngle(-angle_rad); }
 
-}  // namespace
-
-namespace {
-
 // Which channel each CSV column (after t) carries, and whether it holds ticks. Columns are
 // matched by name (ChannelInfo::rate_column / ticks_column); a header of the legacy positional
 // form `t,w_a,w_b,w_c` (or ticks_a..) is accepted for three-channel robots whatever their wheel
@@ -196,6 +192,13 @@ ColumnPlan PlanColumns(std::string_view header, const Robot& robot, const std::s
   return plan;
 }
 
+// 0, 1, ..., n - 1: the columns of a row in the robot's channel order.
+std::vector<int> Identity(int n) {
+  std::vector<int> out(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) out[static_cast<std::size_t>(i)] = i;
+  return out;
+}
+
 }  // namespace
 
 EncoderRowConverter::EncoderRowConverter(const Robot& robot, std::vector<int> channel_of_column,
@@ -230,14 +233,6 @@ EncoderRowConverter::EncoderRowConverter(const Robot& robot, std::vector<int> ch
 double AngleOfCount(const AngleEncoder& encoder, double count) {
   return WrapToPi(2.0 * M_PI * (count - encoder.zero_tick) / encoder.ticks_per_rev);
 }
-
-namespace {
-std::vector<int> Identity(int n) {
-  std::vector<int> out(static_cast<std::size_t>(n));
-  for (int i = 0; i < n; ++i) out[static_cast<std::size_t>(i)] = i;
-  return out;
-}
-}  // namespace
 
 EncoderRowConverter::EncoderRowConverter(const Robot& robot)
     : EncoderRowConverter(robot, Identity(robot.NumChannels()),
@@ -417,18 +412,22 @@ std::size_t FindClockGap(const EncoderSamples& samples, const Robot& robot, doub
   return samples.size();
 }
 
-// The file line of data row `row` (row 0 is the first after the header); blank lines skipped as
-// the reader skips them. Only on the error path: the file is read again.
-int LineOfDataRow(const std::string& path, std::size_t row) {
+// The file lines of sorted data rows (row 0 is the first after the header; 0 for a row past the
+// end), in one pass, blank lines skipped as the reader skips them. Only on the error path: the
+// file is read again.
+std::vector<int> LinesOfDataRows(const std::string& path, const std::vector<std::size_t>& rows) {
+  std::vector<int> out;
   TextFileReader lines(path);
   std::string_view line;
   lines.Next(&line);  // header
   std::size_t seen = 0;
-  while (lines.Next(&line)) {
+  while (out.size() < rows.size() && lines.Next(&line)) {
     if (IsBlank(line)) continue;
-    if (seen++ == row) return lines.line_number();
+    while (out.size() < rows.size() && rows[out.size()] == seen) out.push_back(lines.line_number());
+    ++seen;
   }
-  return 0;
+  out.resize(rows.size(), 0);
+  return out;
 }
 
 // Memory that runs out while a file is read is reported with the file (the loaders' boundary).
@@ -647,22 +646,6 @@ class GlitchScreen {
   std::vector<Glitch> glitches_;
 };
 
-// The file lines of sorted data rows, in one pass (blank lines skipped as the reader skips them).
-std::vector<int> LinesOfDataRows(const std::string& path, const std::vector<std::size_t>& rows) {
-  std::vector<int> out;
-  TextFileReader lines(path);
-  std::string_view line;
-  lines.Next(&line);  // header
-  std::size_t seen = 0;
-  while (out.size() < rows.size() && lines.Next(&line)) {
-    if (IsBlank(line)) continue;
-    while (out.size() < rows.size() && rows[out.size()] == seen) out.push_back(lines.line_number());
-    ++seen;
-  }
-  out.resize(rows.size(), 0);
-  return out;
-}
-
 // The lines of the glitches' rows, sorted by row.
 std::vector<int> SortedGlitchLines(const std::string& path, std::vector<Glitch>* all) {
   std::sort(all->begin(), all->end(),
@@ -816,10 +799,6 @@ EncoderLog ReadEncoderRows(TextFileReader& lines, const Robot& robot, std::vecto
   return converter.Take();
 }
 
-}  // namespace
-
-namespace {
-
 // A running tick counter that wraps inside a run (a 16-bit count passing 65535 -> 0) turns one
 // interval into a jump of about -2^bits ticks: a rate thousands of times its neighbours'. Such an
 // interval, whose tick count lies within 5 % of a power of two from 2^8 to 2^32 and is over a
@@ -871,7 +850,7 @@ EncoderLog ReadEncoderCsv(const std::string& path, const Robot& robot) {
   double median_s = 0.0;
   const std::size_t gap = FindClockGap(log.samples, robot, &median_s);
   if (gap < log.samples.size()) {
-    throw InputError(InputErrorKind::kClockGap, path, LineOfDataRow(path, gap + 1),
+    throw InputError(InputErrorKind::kClockGap, path, LinesOfDataRows(path, {gap + 1})[0],
                      "the clock jumps " + MessageNumber(log.samples[gap].dt_s) +
                          " s (the log's median interval is " + MessageNumber(median_s) +
                          " s) while the wheels turn: a clock step or lost rows inside a moving "
@@ -880,8 +859,8 @@ EncoderLog ReadEncoderCsv(const std::string& path, const Robot& robot) {
   int bits = 0;
   const std::size_t wrap = FindCounterWrap(log, robot, &bits);
   if (wrap < log.samples.size()) {
-    throw InputError(InputErrorKind::kImplausibleValue, path, LineOfDataRow(path, wrap + 1),
-                     CounterWrapMessage(bits));
+    const int line = LinesOfDataRows(path, {wrap + 1})[0];
+    throw InputError(InputErrorKind::kImplausibleValue, path, line, CounterWrapMessage(bits));
   }
   DropCounterGlitches(path, robot, screened, &log);
   DropAngleGlitches(path, robot, &log);

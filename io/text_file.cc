@@ -69,7 +69,7 @@ int OpenRegularFile(const std::string& path, std::uint64_t* size_bytes) {
                          " bytes is larger than half of the free memory; split the log");
   }
   *size_bytes = size;
-  RegisterInputFile(path);  // an output must never replace what was read (io/input_registry.h)
+  RegisterInput(path);  // an output must never replace what was read (io/input_registry.h)
   return fd;
 }
 

@@ -20,9 +20,7 @@ std::function<void(const std::string&)>& Sink() {
 }  // namespace
 
 void Warn(const std::string& file, int line, const std::string& message) {
-  std::string text = OneLine(file, 200);
-  if (line > 0) text += ":" + std::to_string(line);
-  text += ": " + OneLine(message, 300);
+  const std::string text = FileLineText(file, line, message);
   std::lock_guard<std::mutex> lock(SinkMutex());
   if (Sink()) {
     Sink()(text);

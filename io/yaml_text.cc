@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cctype>
 
+#include "io/input_error.h"
+#include "io/yaml_scalar.h"
+
 namespace fitcal::io {
 
 bool IsSafePlainYaml(const std::string& s) {
@@ -25,11 +28,6 @@ bool IsSafePlainYaml(const std::string& s) {
   return true;
 }
 
-}  // namespace fitcal::io
-
-#include "io/yaml_scalar.h"
-
-namespace fitcal::io {
 
 std::string YamlScalar(const std::string& s) {
   YAML::Emitter out;
@@ -43,12 +41,6 @@ std::string YamlDoubleQuoted(const std::string& s) {
   return out.c_str();
 }
 
-std::string YamlCommentText(const std::string& s) {
-  std::string out = s;
-  for (char& c : out) {
-    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
-  }
-  return out;
-}
+std::string YamlCommentText(const std::string& s) { return OneLine(s, std::string::npos); }
 
 }  // namespace fitcal::io

@@ -213,11 +213,7 @@ double HeldOutMean(const std::vector<DiagnoseHeldOutRun>& runs, double DiagnoseH
 
 std::string DiagnoseHtml(const DiagnosePageData& d) {
   std::ostringstream h;
-  h << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
-    << "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
-    << "<title>fitcal diagnose: " << EscapeXml(d.level) << "</title>\n<style>\n"
-    << PageStyleSheet() << "</style>\n</head>\n<body>\n<h1>fitcal diagnose</h1>\n"
-    << "<div class=\"banner " << (d.level == "EFFECTS_NAMED" ? "PASS" : "WARN")
+  h << PageHead("fitcal diagnose: " + d.level, "fitcal diagnose") << "<div class=\"banner " << (d.level == "EFFECTS_NAMED" ? "PASS" : "WARN")
     << "\" id=\"verdict\">\n<h2>" << EscapeXml(d.level) << "</h2>\n<p>" << EscapeXml(d.conclusion)
     << "</p>\n</div>\n<p>Robot <b>" << EscapeXml(d.robot_name) << "</b> (" << EscapeXml(d.model)
     << "), data set <code>" << EscapeXml(d.dataset) << "</code>, " << EscapeXml(d.split)
@@ -242,64 +238,48 @@ std::string DiagnoseHtml(const DiagnosePageData& d) {
 }
 
 std::string DiagnoseMetricsJson(const DiagnosePageData& d) {
-  const auto pair = [](double b, double a) {
-    return "{\"before\": " + JsonNumberOf(b) + ", \"after\": " + JsonNumberOf(a) + "}";
-  };
   std::ostringstream j;
   j << "{\n  \"version\": " << kMetricsJsonVersion << ",\n  \"kind\": \"diagnose\""
-    << ",\n  \"tool_version\": " << JsonStringOf(d.tool_version)
-    << ",\n  \"dataset\": " << JsonStringOf(d.dataset)
-    << ",\n  \"split\": " << JsonStringOf(d.split)
-    << ",\n  \"robot\": " << JsonStringOf(d.robot_name)
-    << ",\n  \"verdict\": {\"level\": " << JsonStringOf(d.level)
-    << ", \"message\": " << JsonStringOf(d.conclusion) << "}"
-    << ",\n  \"selected\": " << JsonStringOf(d.selected)
+    << ",\n  \"tool_version\": " << JsonString(d.tool_version)
+    << ",\n  \"dataset\": " << JsonString(d.dataset)
+    << ",\n  \"split\": " << JsonString(d.split)
+    << ",\n  \"robot\": " << JsonString(d.robot_name)
+    << ",\n  \"verdict\": {\"level\": " << JsonString(d.level)
+    << ", \"message\": " << JsonString(d.conclusion) << "}"
+    << ",\n  \"selected\": " << JsonString(d.selected)
     << ",\n  \"held_out_runs\": " << d.held_out.size() << ",\n  \"cf\": "
-    << pair(HeldOutMean(d.held_out, &DiagnoseHeldOutRun::cf_before),
-            HeldOutMean(d.held_out, &DiagnoseHeldOutRun::cf_after))
+    << JsonBeforeAfter(HeldOutMean(d.held_out, &DiagnoseHeldOutRun::cf_before),
+                       HeldOutMean(d.held_out, &DiagnoseHeldOutRun::cf_after))
     << ",\n  \"ate_rmse_m\": "
-    << pair(HeldOutMean(d.held_out, &DiagnoseHeldOutRun::ate_before_m),
-            HeldOutMean(d.held_out, &DiagnoseHeldOutRun::ate_after_m))
-    << ",\n  \"gate_cf\": [";
-  for (std::size_t i = 0; i < d.gate.size(); ++i) {
-    j << (i ? ", " : "") << "{\"name\": " << JsonStringOf(d.gate[i].name)
-      << ", \"cf\": " << JsonNumberOf(d.gate[i].cf_held_out)
-      << ", \"selected\": " << (d.gate[i].selected ? "true" : "false") << "}";
-  }
-  j << "],\n  \"parameters\": [";
-  for (std::size_t i = 0; i < d.parameters.size(); ++i) {
-    const ReportParameter& p = d.parameters[i];
-    const double s = p.is_angle ? kDeg : 1.0;
-    j << (i ? "," : "") << "\n    {\"name\": " << JsonStringOf(p.name)
-      << ", \"unit\": " << JsonStringOf(p.unit) << ", \"value\": " << JsonNumberOf(p.calibrated * s)
-      << ", \"sigma\": " << (p.has_sigma ? JsonNumberOf(p.sigma * s) : "null")
-      << ", \"held\": " << (p.held ? "true" : "false") << "}";
-  }
-  j << "\n  ],\n  \"effects\": [";
-  for (std::size_t i = 0; i < d.effects.size(); ++i) {
-    j << (i ? ", " : "") << "{\"name\": " << JsonStringOf(d.effects[i].name) << ", \"values\": [";
-    for (std::size_t k = 0; k < d.effects[i].values.size(); ++k) {
-      j << (k ? ", " : "") << JsonNumberOf(d.effects[i].values[k]);
-    }
-    j << "]}";
-  }
-  j << "],\n  \"candidates\": [";
-  for (std::size_t i = 0; i < d.candidates.size(); ++i) {
-    const DiagnoseCandidate& c = d.candidates[i];
-    j << (i ? "," : "") << "\n    {\"round\": " << c.round
-      << ", \"effect\": " << JsonStringOf(c.effect)
-      << ", \"fitted\": " << (c.fitted ? "true" : "false")
-      << ", \"p_value\": " << (c.fitted ? JsonNumberOf(c.p_value) : "null")
-      << ", \"accepted\": " << (c.accepted ? "true" : "false") << "}";
-  }
-  j << "\n  ],\n  \"runs\": [";
-  for (std::size_t i = 0; i < d.held_out.size(); ++i) {
-    const DiagnoseHeldOutRun& r = d.held_out[i];
-    j << (i ? "," : "") << "\n    {\"run\": " << JsonStringOf(r.id)
-      << ", \"cf\": " << pair(r.cf_before, r.cf_after)
-      << ", \"ate_rmse_m\": " << pair(r.ate_before_m, r.ate_after_m) << "}";
-  }
-  j << "\n  ]\n}\n";
+    << JsonBeforeAfter(HeldOutMean(d.held_out, &DiagnoseHeldOutRun::ate_before_m),
+                       HeldOutMean(d.held_out, &DiagnoseHeldOutRun::ate_after_m))
+    << ",\n  \"gate_cf\": [" << Joined(d.gate, ", ", [](const DiagnoseGateRow& g) {
+         return "{\"name\": " + JsonString(g.name) + ", \"cf\": " + JsonNumber(g.cf_held_out) +
+                ", \"selected\": " + JsonBool(g.selected) + "}";
+       })
+    << "],\n  \"parameters\": [" << Joined(d.parameters, ",", [](const ReportParameter& p) {
+         const double s = p.is_angle ? kDeg : 1.0;
+         return "\n    {\"name\": " + JsonString(p.name) + ", \"unit\": " + JsonString(p.unit) +
+                ", \"value\": " + JsonNumber(p.calibrated * s) +
+                ", \"sigma\": " + (p.has_sigma ? JsonNumber(p.sigma * s) : "null") +
+                ", \"held\": " + JsonBool(p.held) + "}";
+       })
+    << "\n  ],\n  \"effects\": [" << Joined(d.effects, ", ", [](const ReportEffect& e) {
+         return "{\"name\": " + JsonString(e.name) + ", \"values\": [" +
+                Joined(e.values, ", ", JsonNumber) + "]}";
+       })
+    << "],\n  \"candidates\": [" << Joined(d.candidates, ",", [](const DiagnoseCandidate& c) {
+         return "\n    {\"round\": " + std::to_string(c.round) +
+                ", \"effect\": " + JsonString(c.effect) + ", \"fitted\": " + JsonBool(c.fitted) +
+                ", \"p_value\": " + (c.fitted ? JsonNumber(c.p_value) : "null") +
+                ", \"accepted\": " + JsonBool(c.accepted) + "}";
+       })
+    << "\n  ],\n  \"runs\": [" << Joined(d.held_out, ",", [](const DiagnoseHeldOutRun& r) {
+         return "\n    {\"run\": " + JsonString(r.id) +
+                ", \"cf\": " + JsonBeforeAfter(r.cf_before, r.cf_after) +
+                ", \"ate_rmse_m\": " + JsonBeforeAfter(r.ate_before_m, r.ate_after_m) + "}";
+       })
+    << "\n  ]\n}\n";
   return j.str();
 }
 

@@ -2,6 +2,7 @@
 
 #include <sstream>
 
+#include "pages/report_json.h"
 #include "pages/report_text.h"
 
 namespace fitcal::io {

@@ -524,15 +524,17 @@ void OpenTable(std::ostringstream& h, const std::string& id, bool stacked) {
 }
 void CloseTable(std::ostringstream& h) { h << "</table>\n</div>\n"; }
 
-std::string PageStyleSheet() { return kStyle; }
+std::string PageHead(const std::string& title, const std::string& heading) {
+  return "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+         "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n<title>" +
+         EscapeXml(title) + "</title>\n<style>\n" + kStyle + "</style>\n</head>\n<body>\n<h1>" +
+         EscapeXml(heading) + "</h1>\n";
+}
 
 std::string ReportHtml(const ReportData& d) {
   const ReportFigures f = MakeReportFigures(d);
   std::ostringstream h;
-  h << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
-    << "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
-    << "<title>fitcal validation report: " << EscapeXml(d.verdict) << "</title>\n<style>\n"
-    << kStyle << "</style>\n</head>\n<body>\n<h1>fitcal validation report</h1>\n";
+  h << PageHead("fitcal validation report: " + d.verdict, "fitcal validation report");
   HtmlVerdict(h, d);
   HtmlKeyNumbers(h, d);
   HtmlHeader(h, d);

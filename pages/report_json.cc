@@ -2,6 +2,7 @@
 
 #include <sstream>
 
+#include "odometry/text_format.h"
 #include "pages/report_text.h"
 
 namespace fitcal::io {
@@ -10,14 +11,16 @@ namespace {
 
 using namespace report_text;
 
+// {"key": value, ...} of the Table 6 columns, `value_of` giving each column's number.
+template <typename ValueOf>
+std::string JsonColumns(const ValueOf& value_of) {
+  return "{" + Joined(kColumns, ", ", [&](const Column& c) {
+           return JsonString(KeyOf(c)) + ": " + JsonNumber(value_of(c));
+         }) + "}";
+}
+
 std::string JsonMetrics(const ReportMetrics& m) {
-  std::string out = "{";
-  bool first = true;
-  for (const Column& c : kColumns) {
-    out += (first ? "" : ", ") + JsonString(KeyOf(c)) + ": " + JsonNumber(ValueOf(c, m));
-    first = false;
-  }
-  return out + "}";
+  return JsonColumns([&](const Column& c) { return ValueOf(c, m); });
 }
 
 std::string JsonStats(const ReportStatistics& s, double scale) {
@@ -29,47 +32,37 @@ std::string JsonStats(const ReportStatistics& s, double scale) {
 
 // {"level": "WARN", "reasons": [{"level", "check", "section", "message"}, ...]}
 std::string JsonVerdict(const ReportData& d) {
-  std::string out = "{\"level\": " + JsonString(d.verdict) + ", \"reasons\": [";
-  for (std::size_t i = 0; i < d.verdict_reasons.size(); ++i) {
-    const ReportVerdictReason& r = d.verdict_reasons[i];
-    out += std::string(i ? "," : "") + "\n    {\"level\": " + JsonString(r.level) +
-           ", \"check\": " + JsonString(r.check) + ", \"section\": " + JsonString(r.section) +
-           ", \"message\": " + JsonString(r.message) + "}";
-  }
-  return out + "]}";
+  return "{\"level\": " + JsonString(d.verdict) + ", \"reasons\": [" +
+         Joined(d.verdict_reasons, ",", [](const ReportVerdictReason& r) {
+           return "\n    {\"level\": " + JsonString(r.level) + ", \"check\": " +
+                  JsonString(r.check) + ", \"section\": " + JsonString(r.section) +
+                  ", \"message\": " + JsonString(r.message) + "}";
+         }) + "]}";
 }
 
 // {"cf_parameters_only": x, "list": [{"name", "parameters": [{"name", "value", "sigma"}]}]}
 std::string JsonEffects(const ReportData& d) {
-  std::string out = "{\"cf_parameters_only\": " +
-                    (d.effects.empty() ? std::string("null") : JsonNumber(d.cf_parameters_only)) +
-                    ", \"list\": [";
-  for (std::size_t i = 0; i < d.effects.size(); ++i) {
-    const ReportEffect& e = d.effects[i];
-    out += std::string(i ? ", " : "") + "{\"name\": " + JsonString(e.name) + ", \"parameters\": [";
+  const auto effect = [](const ReportEffect& e) {
+    std::string out = "{\"name\": " + JsonString(e.name) + ", \"parameters\": [";
     for (std::size_t k = 0; k < e.values.size(); ++k) {
       out += std::string(k ? ", " : "") + "{\"name\": " + JsonString(e.parameter_names[k]) +
              ", \"value\": " + JsonNumber(e.values[k]) + ", \"sigma\": " + JsonNumber(e.sigmas[k]) +
              "}";
     }
-    out += "]}";
-  }
-  return out + "]}";
+    return out + "]}";
+  };
+  return "{\"cf_parameters_only\": " +
+         (d.effects.empty() ? std::string("null") : JsonNumber(d.cf_parameters_only)) +
+         ", \"list\": [" + Joined(d.effects, ", ", effect) + "]}";
 }
 
 std::string JsonTrajectories(const ReportData& d) {
-  std::string out = "[";
-  for (std::size_t i = 0; i < d.trajectories.size(); ++i) {
-    const ReportSummaryRow& row = d.trajectories[i];
-    out += std::string(i ? "," : "") + "\n    {\"trajectory\": " + JsonString(row.group) +
-           ", \"runs\": " + std::to_string(row.runs) + ", \"before\": " + JsonMetrics(row.before) +
-           ", \"after\": " + JsonMetrics(row.after) + "}";
-  }
-  return out + "]";
-}
-
-std::string JsonBeforeAfter(double before, double after) {
-  return "{\"before\": " + JsonNumber(before) + ", \"after\": " + JsonNumber(after) + "}";
+  return "[" + Joined(d.trajectories, ",", [](const ReportSummaryRow& row) {
+           return "\n    {\"trajectory\": " + JsonString(row.group) +
+                  ", \"runs\": " + std::to_string(row.runs) +
+                  ", \"before\": " + JsonMetrics(row.before) +
+                  ", \"after\": " + JsonMetrics(row.after) + "}";
+         }) + "]";
 }
 
 int WorseCount(const ReportData& d) {
@@ -79,19 +72,15 @@ int WorseCount(const ReportData& d) {
 }
 
 std::string JsonDrift(const ReportData& d) {
-  std::string out = "[";
-  for (std::size_t i = 0; i < d.drift.size(); ++i) {
-    const ReportDriftRow& r = d.drift[i];
-    out += std::string(i ? ", " : "") + "{\"length_m\": " + JsonNumber(r.length_m) +
-           ", \"windows\": " + std::to_string(r.windows) +
-           ", \"translation_percent\": {\"before\": " + JsonNumber(r.before_translation_percent) +
-           ", \"after\": " + JsonNumber(r.after_translation_percent) +
-           "}, \"rotation_deg_per_m\": {\"before\": " +
-           JsonNumber(kDeg * r.before_rotation_rad_per_m) +
-           ", \"after\": " + JsonNumber(kDeg * r.after_rotation_rad_per_m) +
-           "}, \"windows_worse\": " + std::to_string(r.windows_worse) + "}";
-  }
-  return out + "]";
+  return "[" + Joined(d.drift, ", ", [](const ReportDriftRow& r) {
+           return "{\"length_m\": " + JsonNumber(r.length_m) +
+                  ", \"windows\": " + std::to_string(r.windows) + ", \"translation_percent\": " +
+                  JsonBeforeAfter(r.before_translation_percent, r.after_translation_percent) +
+                  ", \"rotation_deg_per_m\": " +
+                  JsonBeforeAfter(kDeg * r.before_rotation_rad_per_m,
+                                  kDeg * r.after_rotation_rad_per_m) +
+                  ", \"windows_worse\": " + std::to_string(r.windows_worse) + "}";
+         }) + "]";
 }
 
 std::string JsonBias(const ReportData& d) {
@@ -115,48 +104,37 @@ std::string JsonNoiseFloor(const ReportData& d) {
 }
 
 std::string JsonComparison(const ReportData& d) {
-  std::string out = "[";
-  for (std::size_t i = 0; i < d.comparison.size(); ++i) {
-    const ReportComparisonRow& c = d.comparison[i];
-    out += std::string(i ? "," : "") + "\n    {\"calibration\": " + JsonString(c.calibration) +
-           ", \"verdict\": " + JsonString(c.verdict) +
-           ", \"training_source\": " + JsonString(c.training_source) +
-           ", \"before\": " + JsonMetrics(c.all.before) +
-           ", \"after\": " + JsonMetrics(c.all.after) + ", \"per_trajectory_cf_after\": [";
-    for (std::size_t t = 0; t < c.trajectory_cf_after.size(); ++t) {
-      out += std::string(t ? ", " : "") + JsonNumber(c.trajectory_cf_after[t]);
-    }
-    out += "]}";
-  }
-  return out + "]";
+  return "[" + Joined(d.comparison, ",", [](const ReportComparisonRow& c) {
+           return "\n    {\"calibration\": " + JsonString(c.calibration) +
+                  ", \"verdict\": " + JsonString(c.verdict) +
+                  ", \"training_source\": " + JsonString(c.training_source) +
+                  ", \"before\": " + JsonMetrics(c.all.before) +
+                  ", \"after\": " + JsonMetrics(c.all.after) + ", \"per_trajectory_cf_after\": [" +
+                  Joined(c.trajectory_cf_after, ", ", JsonNumber) + "]}";
+         }) + "]";
 }
 
 // "summary": Table 6 rows with Palacin's improvement (positive = better).
-void JsonSummary(std::ostringstream& j, const ReportData& d) {
-  for (std::size_t i = 0; i < d.summary.size(); ++i) {
-    const ReportSummaryRow& row = d.summary[i];
-    j << (i ? "," : "") << "\n    {\"group\": " << JsonString(row.group)
-      << ", \"runs\": " << row.runs << ",\n     \"before\": " << JsonMetrics(row.before)
-      << ",\n     \"after\": " << JsonMetrics(row.after) << ",\n     \"improvement_percent\": {";
-    bool first = true;
-    for (const Column& c : kColumns) {
-      j << (first ? "" : ", ") << JsonString(KeyOf(c)) << ": "
-        << JsonNumber(Improvement(ValueOf(c, row.before), ValueOf(c, row.after)));
-      first = false;
-    }
-    j << "}}";
-  }
+std::string JsonSummary(const ReportData& d) {
+  return Joined(d.summary, ",", [](const ReportSummaryRow& row) {
+    return "\n    {\"group\": " + JsonString(row.group) + ", \"runs\": " +
+           std::to_string(row.runs) + ",\n     \"before\": " + JsonMetrics(row.before) +
+           ",\n     \"after\": " + JsonMetrics(row.after) + ",\n     \"improvement_percent\": " +
+           JsonColumns([&](const Column& c) {
+             return Improvement(ValueOf(c, row.before), ValueOf(c, row.after));
+           }) +
+           "}";
+  });
 }
 
 // "statistics": evo-style statistics of the per-run quantities.
-void JsonStatistics(std::ostringstream& j, const ReportData& d) {
-  for (std::size_t i = 0; i < d.statistics.size(); ++i) {
-    const ReportStatisticsRow& s = d.statistics[i];
+std::string JsonStatistics(const ReportData& d) {
+  return Joined(d.statistics, ",", [](const ReportStatisticsRow& s) {
     const double scale = s.is_angle ? kDeg : 1.0;
-    j << (i ? "," : "") << "\n    " << JsonString(s.metric + (s.is_angle ? "_deg" : ""))
-      << ": {\"before\": " << JsonStats(s.before, scale)
-      << ", \"after\": " << JsonStats(s.after, scale) << "}";
-  }
+    return "\n    " + JsonString(s.metric + (s.is_angle ? "_deg" : "")) +
+           ": {\"before\": " + JsonStats(s.before, scale) +
+           ", \"after\": " + JsonStats(s.after, scale) + "}";
+  });
 }
 
 // "parameters": nominal, calibrated and sigma in display units (_m or _deg).
@@ -182,65 +160,84 @@ void JsonParameters(std::ostringstream& j, const ReportData& d) {
   }
 }
 
-void JsonCorrelation(std::ostringstream& j, const ReportData& d) {
-  if (d.has_correlation) {
-    j << "[";
-    for (std::size_t r = 0; r < d.correlation.size(); ++r) {
-      j << (r ? ", " : "") << "[";
-      for (std::size_t c = 0; c < d.correlation[r].size(); ++c) {
-        j << (c ? ", " : "") << JsonNumber(d.correlation[r][c]);
-      }
-      j << "]";
-    }
-    j << "]";
-  } else {
-    j << "null";
-  }
+std::string JsonCorrelation(const ReportData& d) {
+  if (!d.has_correlation) return "null";
+  return "[" + Joined(d.correlation, ", ", [](const std::vector<double>& row) {
+           return "[" + Joined(row, ", ", JsonNumber) + "]";
+         }) + "]";
 }
 
 void JsonIdentifiability(std::ostringstream& j, const ReportData& d) {
   j << ",\n  \"identifiability\": {\"checked\": " << (d.identifiability_checked ? "true" : "false")
     << ", \"identifiable\": " << (d.identifiable ? "true" : "false")
-    << ", \"condition_number\": " << JsonNumber(d.condition_number) << ", \"warnings\": [";
-  for (std::size_t i = 0; i < d.identifiability_lines.size(); ++i) {
-    j << (i ? ", " : "") << JsonString(d.identifiability_lines[i]);
-  }
-  j << "]}";
+    << ", \"condition_number\": " << JsonNumber(d.condition_number)
+    << ", \"warnings\": [" << Joined(d.identifiability_lines, ", ", JsonString) << "]}";
 }
 
 void JsonCrossValidation(std::ostringstream& j, const ReportData& d) {
   if (d.has_cv) {
     j << ",\n  \"cross_validation\": {\"cf_validation_after\": " << JsonStats(d.cv_cf_after, 1.0)
-      << ", \"cf_validation_before\": " << JsonStats(d.cv_cf_before, 1.0) << ", \"folds\": [";
-    for (std::size_t i = 0; i < d.folds.size(); ++i) {
-      const ReportFold& f = d.folds[i];
-      j << (i ? ", " : "") << "{\"held_out_repetition\": " << f.held_out_repetition
-        << ", \"usable\": " << (f.usable ? "true" : "false")
-        << ", \"cf_training\": " << JsonNumber(f.cf_training)
-        << ", \"cf_validation_before\": " << JsonNumber(f.cf_validation_before)
-        << ", \"cf_validation_after\": " << JsonNumber(f.cf_validation_after) << "}";
-    }
-    j << "]}";
+      << ", \"cf_validation_before\": " << JsonStats(d.cv_cf_before, 1.0) << ", \"folds\": ["
+      << Joined(d.folds, ", ", [](const ReportFold& f) {
+           return "{\"held_out_repetition\": " + std::to_string(f.held_out_repetition) +
+                  ", \"usable\": " + JsonBool(f.usable) +
+                  ", \"cf_training\": " + JsonNumber(f.cf_training) +
+                  ", \"cf_validation_before\": " + JsonNumber(f.cf_validation_before) +
+                  ", \"cf_validation_after\": " + JsonNumber(f.cf_validation_after) + "}";
+         })
+      << "]}";
   }
 }
 
 // "runs": every validation run before and after.
-void JsonRuns(std::ostringstream& j, const ReportData& d) {
-  j << ",\n  \"runs\": [";
-  for (std::size_t i = 0; i < d.runs.size(); ++i) {
-    const ReportRun& r = d.runs[i];
-    j << (i ? "," : "") << "\n    {\"run\": " << JsonString(r.id)
-      << ", \"trajectory\": " << JsonString(r.trajectory) << ", \"repetition\": " << r.repetition
-      << ", \"before\": " << JsonMetrics(r.before) << ", \"after\": " << JsonMetrics(r.after)
-      << ", \"ate_rmse_m\": " << JsonBeforeAfter(r.before.rms_distance_m, r.after.rms_distance_m)
-      << ", \"got_worse\": " << (GotWorse(r) ? "true" : "false") << "}";
-  }
+std::string JsonRuns(const ReportData& d) {
+  return Joined(d.runs, ",", [](const ReportRun& r) {
+    return "\n    {\"run\": " + JsonString(r.id) + ", \"trajectory\": " + JsonString(r.trajectory) +
+           ", \"repetition\": " + std::to_string(r.repetition) +
+           ", \"before\": " + JsonMetrics(r.before) + ", \"after\": " + JsonMetrics(r.after) +
+           ", \"ate_rmse_m\": " +
+           JsonBeforeAfter(r.before.rms_distance_m, r.after.rms_distance_m) +
+           ", \"got_worse\": " + JsonBool(GotWorse(r)) + "}";
+  });
 }
 
 }  // namespace
 
-std::string JsonStringOf(const std::string& text) { return JsonString(text); }
-std::string JsonNumberOf(double value) { return JsonNumber(value); }
+std::string JsonString(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    switch (c) {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          out += StrFormat("\\u%04x", c);
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+std::string JsonNumber(double v) {
+  if (!std::isfinite(v)) return "null";
+  return StrFormat("%.10g", v);
+}
+
+std::string JsonBeforeAfter(double before, double after) {
+  return "{\"before\": " + JsonNumber(before) + ", \"after\": " + JsonNumber(after) + "}";
+}
 
 std::string MetricsJson(const ReportData& d) {
   std::ostringstream j;
@@ -262,18 +259,13 @@ std::string MetricsJson(const ReportData& d) {
     << ",\n  \"bias\": " << JsonBias(d) << ",\n  \"noise_floor\": " << JsonNoiseFloor(d)
     << ",\n  \"training_repetitions\": " << JsonString(d.training_repetitions)
     << ",\n  \"validation_repetitions\": " << JsonString(d.validation_repetitions)
-    << ",\n  \"summary\": [";
-  JsonSummary(j, d);
-  j << "\n  ],\n  \"statistics\": {";
-  JsonStatistics(j, d);
-  j << "\n  },\n  \"parameters\": [";
+    << ",\n  \"summary\": [" << JsonSummary(d) << "\n  ],\n  \"statistics\": {"
+    << JsonStatistics(d) << "\n  },\n  \"parameters\": [";
   JsonParameters(j, d);
-  j << "\n  ],\n  \"correlation\": ";
-  JsonCorrelation(j, d);
+  j << "\n  ],\n  \"correlation\": " << JsonCorrelation(d);
   JsonIdentifiability(j, d);
   JsonCrossValidation(j, d);
-  JsonRuns(j, d);
-  j << "\n  ]\n}\n";
+  j << ",\n  \"runs\": [" << JsonRuns(d) << "\n  ]\n}\n";
   return j.str();
 }
 

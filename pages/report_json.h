@@ -10,9 +10,24 @@ namespace fitcal::io {
 
 std::string MetricsJson(const ReportData& data);
 
-// JSON scalars, shared with the page of `diagnose` (pages/diagnose_page.h).
-std::string JsonStringOf(const std::string& text);
-std::string JsonNumberOf(double value);  // null when not finite
+// JSON text, shared with the page of `diagnose` (pages/diagnose_page.h) and metrics.csv's numbers:
+// a quoted, escaped string; a number as %.10g, or null when not finite; {"before": b, "after": a}.
+std::string JsonString(const std::string& s);
+std::string JsonNumber(double v);
+inline std::string JsonBool(bool b) { return b ? "true" : "false"; }
+std::string JsonBeforeAfter(double before, double after);
+
+// The text of each item, `separator` between them (the elements of a JSON list or map).
+template <typename Items, typename Text>
+std::string Joined(const Items& items, const char* separator, const Text& text) {
+  std::string out;
+  bool first = true;
+  for (const auto& item : items) {
+    out += (first ? "" : separator) + text(item);
+    first = false;
+  }
+  return out;
+}
 
 // The layout version of metrics.json (docs/metrics_json.md): raised when a key changes meaning
 // or disappears; keys may be added within a version.

@@ -40,38 +40,6 @@ double ValueOf(const Column& c, const ReportMetrics& m) {
 }
 const char* FormatOf(const Column& c) { return c.is_angle ? "%.3f" : "%.4f"; }
 
-std::string JsonString(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          out += StrFormat("\\u%04x", c);
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out + "\"";
-}
-
-std::string JsonNumber(double v) {
-  if (!std::isfinite(v)) return "null";
-  return StrFormat("%.10g", v);
-}
-
 double ParamScale(const ReportParameter& p) { return p.is_angle ? kDeg : 1.0; }
 
 std::string ParameterChangeText(const ReportParameter& p) {

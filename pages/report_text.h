@@ -51,10 +51,6 @@ std::string KeyOf(const Column& c);
 double ValueOf(const Column& c, const ReportMetrics& m);
 const char* FormatOf(const Column& c);
 
-// JSON scalars (also the CSV's numbers): a quoted, escaped string; %.10g or null.
-std::string JsonString(const std::string& s);
-std::string JsonNumber(double v);
-
 // A parameter's display scale (deg for angles) and its change: lengths by percent, angles by
 // degrees (a percentage of an angle means nothing).
 double ParamScale(const ReportParameter& p);

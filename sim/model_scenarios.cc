@@ -48,7 +48,7 @@ void SetSteppedPhysics(const Robot& robot, const SimulationScenario& scenario,
   o->rest_after_s = 1.5;  // the controller's lag settles before the run ends
   o->stepped.emplace();
   o->stepped->commanded_parameters = robot.nominal;
-  if (noise.slip_sigma) o->stepped->slip.sigma = *noise.slip_sigma;
+  if (noise.slip_sigma) o->stepped->slip_sigma = *noise.slip_sigma;
   o->stepped->injected_effects = noise.injected_effects;
 }
 

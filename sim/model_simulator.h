@@ -37,50 +37,36 @@
 
 namespace fitcal::sim {
 
-// The flower simulator's physics, selected by SimulationOptions::stepped: the per-substep
-// equations and the order of the draws in stepped_run.h, the defaults (the flower's) in
-// docs/simulate.md. The controller follows the NOMINAL robot's inverse kinematics.
-struct ControllerLagOptions {
-  double time_constant_s = 0.12;  // tau of each channel's first-order lag, rest to rest
-};
-struct SlipOptions {
-  // Contact rate = wheel rate (1 + s), s a per-wheel Ornstein-Uhlenbeck process: the
-  // non-systematic error that makes repetitions scatter. Wheel-rate channels only.
-  double sigma = 0.003;
-  double correlation_time_s = 0.5;
-};
-struct EncoderLatchOptions {
-  // Counts latched every encoder period plus a uniform jitter in [-jitter_s, jitter_s] (APR-02's
-  // 10 ms PID period), at the first substep end at or after the scheduled time.
-  double jitter_s = 0.0005;
-};
-struct IrregularGroundTruthOptions {
-  // Samples at intervals uniform in [period_min_s, period_max_s] (Palacin Sec. 2.5: SLAM every
-  // 200-300 ms), the first within period_max_s of the start.
-  double period_min_s = 0.2;
-  double period_max_s = 0.3;
-};
-
 // What a test may change at every substep of a stepped run, after the library effects: the
 // channels' contact rates (rad/s, robot order; angle channels as they are), the body twist and
 // an additive world velocity (m/s).
 struct SteppedState {
-  double t_s = 0.0;                         // since the run's start
-  double time_since_motion_s = -1.0;        // < 0 before the first segment starts
-  const double* channel_value = nullptr;    // the controller's state, robot order
-  const double* wheel_angle_rad = nullptr;  // integrated channel values since the start
+  double t_s = 0.0;                       // since the run's start
+  double time_since_motion_s = -1.0;      // < 0 before the first segment starts
+  const double* channel_value = nullptr;  // the controller's state, robot order
   Pose2d pose;
 };
 using SteppedHook = std::function<void(const SteppedState&, double* contact_rate, Twist* v_body,
                                        double* v_world_xy)>;
 
+// The flower simulator's physics, selected by SimulationOptions::stepped: the per-substep
+// equations and the order of the draws in stepped_run.h, the defaults (the flower's) in
+// docs/simulate.md. The controller follows the NOMINAL robot's inverse kinematics.
 struct SteppedOptions {
   // The robot the controller commands with (ChannelsForTwist); empty = the true robot.
   std::vector<double> commanded_parameters;
-  ControllerLagOptions controller;
-  SlipOptions slip;
-  EncoderLatchOptions encoder;
-  IrregularGroundTruthOptions ground_truth;
+  double controller_time_constant_s = 0.12;  // tau of each channel's first-order lag
+  // Contact rate = wheel rate (1 + s), s a per-wheel Ornstein-Uhlenbeck process: the
+  // non-systematic error that makes repetitions scatter. Wheel-rate channels only.
+  double slip_sigma = 0.003;
+  double slip_correlation_time_s = 0.5;
+  // Counts latched every encoder period plus a uniform jitter in [-jitter_s, jitter_s] (APR-02's
+  // 10 ms PID period), at the first substep end at or after the scheduled time.
+  double encoder_jitter_s = 0.0005;
+  // Ground truth sampled at intervals uniform in [min, max] (Palacin Sec. 2.5: SLAM every
+  // 200-300 ms), the first within the max of the start.
+  double gt_period_min_s = 0.2;
+  double gt_period_max_s = 0.3;
   double substep_s = 0.0005;  // integration step of the true motion (midpoint heading)
 
   // Wheels' absolute angles: with random_wheel_start_angle each run starts at uniformly random

@@ -25,7 +25,7 @@ struct ScenarioNoise {
   double gt_heading_sigma_rad = 0.2 * M_PI / 180.0;
   double start_position_range_m = 2.0;
   // The stepped physics only (ModelExtras::scenario.stepped_physics; refused elsewhere): the
-  // wheel slip's sigma (unset: SlipOptions' default) and library effects the data set does not
+  // wheel slip's sigma (unset: SteppedOptions' default) and library effects the data set does not
   // name.
   std::optional<double> slip_sigma;
   std::vector<effects::EffectValue> injected_effects;

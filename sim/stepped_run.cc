@@ -104,9 +104,9 @@ SteppedRun::SteppedRun(const RobotModelInterface& model, const std::vector<doubl
   boundaries_.push_back(t);
   targets_.push_back(std::vector<double>(c_, 0.0));  // at rest
   t_end_ = t + o.rest_after_s;
-  lag_ = 1.0 - std::exp(-h_ / s_.controller.time_constant_s);
-  slip_decay_ = std::exp(-h_ / s_.slip.correlation_time_s);
-  slip_kick_ = s_.slip.sigma * std::sqrt(1.0 - slip_decay_ * slip_decay_);
+  lag_ = 1.0 - std::exp(-h_ / s_.controller_time_constant_s);
+  slip_decay_ = std::exp(-h_ / s_.slip_correlation_time_s);
+  slip_kick_ = s_.slip_sigma * std::sqrt(1.0 - slip_decay_ * slip_decay_);
   for (const auto& e : s_.injected_effects) active_.push_back({e.id, e.value.data()});
   latency_s_ = effects::TotalLatency(active_);
   injecting_ = !active_.empty() || static_cast<bool>(s_.hook);
@@ -123,7 +123,7 @@ const std::vector<double>& SteppedRun::TargetAt(double t_mid) const {
 
 double SteppedRun::EncoderTime(int k) {
   return k * o_.encoder_period_s +
-         (k == 0 ? 0.0 : rng_.Uniform(-s_.encoder.jitter_s, s_.encoder.jitter_s));
+         (k == 0 ? 0.0 : rng_.Uniform(-s_.encoder_jitter_s, s_.encoder_jitter_s));
 }
 
 // The run's initial state, drawing in the flower's order (header).
@@ -141,7 +141,7 @@ void SteppedRun::Start() {
   // call, which GCC evaluates right to left.
   for (int i = c_ - 1; i >= 0; --i) {
     if (robot_.channels[i].kind == ChannelKind::kWheelRate) {
-      slip_[i] = s_.slip.sigma * rng_.Gaussian();
+      slip_[i] = s_.slip_sigma * rng_.Gaussian();
     }
   }
   wheel_start_.assign(c_, 0.0);
@@ -151,7 +151,7 @@ void SteppedRun::Start() {
     out_.log.encoders.start_angle_rad = wheel_start_;
   }
   next_encoder_t_ = EncoderTime(0);
-  next_gt_t_ = rng_.Uniform(0.0, s_.ground_truth.period_max_s);
+  next_gt_t_ = rng_.Uniform(0.0, s_.gt_period_max_s);
   counts_.assign(c_, 0.0);
   last_counts_.assign(c_, 0.0);
   last_reading_.assign(c_, 0.0);
@@ -250,7 +250,6 @@ void SteppedRun::ApplyEffects(double t, double t_mid, const std::vector<double>&
     state.t_s = t;
     state.time_since_motion_s = t_mid >= boundaries_.front() ? t - boundaries_.front() : -1.0;
     state.channel_value = x_.data();
-    state.wheel_angle_rad = angle_.data();
     state.pose = pose_;
     s_.hook(state, contact_.data(), v, v_world);
   }
@@ -272,7 +271,7 @@ void SteppedRun::Latch(double t) {
     const double y = pose_.y + sigma * rng_.Gaussian();
     gt.world_T_robot.push_back(
         Pose2d{x, y, WrapAngle(pose_.theta + o_.gt_heading_sigma_rad * rng_.Gaussian())});
-    next_gt_t_ += rng_.Uniform(s_.ground_truth.period_min_s, s_.ground_truth.period_max_s);
+    next_gt_t_ += rng_.Uniform(s_.gt_period_min_s, s_.gt_period_max_s);
   }
 }
 
@@ -306,18 +305,17 @@ void SteppedRun::LatchEncoder(double t) {
 
 std::string CheckSteppedOptions(const SteppedOptions& s, double encoder_period_s,
                                 int num_channels) {
-  if (!(s.encoder.jitter_s >= 0.0 && s.encoder.jitter_s < 0.5 * encoder_period_s)) {
+  if (!(s.encoder_jitter_s >= 0.0 && s.encoder_jitter_s < 0.5 * encoder_period_s)) {
     return "the encoder jitter must be in [0, period/2)";
   }
-  if (!(s.substep_s > 0.0 && s.substep_s <= s.encoder.jitter_s + encoder_period_s)) {
+  if (!(s.substep_s > 0.0 && s.substep_s <= s.encoder_jitter_s + encoder_period_s)) {
     return "substep_s must be > 0 and not longer than an encoder period";
   }
-  if (!(s.controller.time_constant_s > 0.0)) return "the controller time constant must be > 0";
-  if (!(s.ground_truth.period_min_s > 0.0 &&
-        s.ground_truth.period_max_s >= s.ground_truth.period_min_s)) {
+  if (!(s.controller_time_constant_s > 0.0)) return "the controller time constant must be > 0";
+  if (!(s.gt_period_min_s > 0.0 && s.gt_period_max_s >= s.gt_period_min_s)) {
     return "the ground-truth period must satisfy 0 < min <= max";
   }
-  if (!(s.slip.sigma >= 0.0 && s.slip.correlation_time_s > 0.0)) {
+  if (!(s.slip_sigma >= 0.0 && s.slip_correlation_time_s > 0.0)) {
     return "the slip needs sigma >= 0 and a correlation time > 0";
   }
   if (!s.wheel_eccentricity.empty() &&

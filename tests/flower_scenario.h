@@ -45,8 +45,8 @@ inline FlowerSimulation NoiseFreePalacinFlower() {
   f.options.gt_position_sigma_m = 0.0;
   f.options.gt_heading_sigma_rad = 0.0;
   f.options.ticks_per_rev.assign(omni3::kNumWheels, static_cast<double>(1 << 22));
-  f.options.stepped->slip.sigma = 0.0;
-  f.options.stepped->encoder.jitter_s = 0.0;
+  f.options.stepped->slip_sigma = 0.0;
+  f.options.stepped->encoder_jitter_s = 0.0;
   return f;
 }
 

@@ -31,7 +31,7 @@ template <typename Fn>
 void ExpectInputError(Fn fn, InputErrorKind kind, const std::string& file, int line) {
   try {
     fn();
-    ADD_FAILURE() << "no error; expected " << ToString(kind);
+    ADD_FAILURE() << "no error; expected kind " << static_cast<int>(kind);
   } catch (const InputError& e) {
     EXPECT_EQ(e.kind(), kind) << e.what();
     EXPECT_EQ(e.file(), file) << e.what();

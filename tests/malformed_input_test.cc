@@ -164,7 +164,7 @@ TEST(MalformedInputTest, LoadersReportTheExactErrorKindFileAndLine) {
       LoadForFit(data.dir());
       ADD_FAILURE() << "accepted";
     } catch (const io::InputError& e) {
-      EXPECT_EQ(e.kind(), c.kind) << "got '" << io::ToString(e.kind()) << "': " << e.what();
+      EXPECT_EQ(e.kind(), c.kind) << e.what();
       const std::string suffix = c.error_file;
       EXPECT_TRUE(e.file().size() >= suffix.size() &&
                   e.file().compare(e.file().size() - suffix.size(), suffix.size(), suffix) == 0)

@@ -37,8 +37,8 @@ sim::ModelScenario NoiseFreeStepped(const RobotModelInterface& model,
   o.gt_position_sigma_m = o.gt_heading_sigma_rad = 0.0;
   o.rest_after_s = 1.5;  // ten time constants: the lagging wheels have stopped
   o.stepped.emplace();
-  o.stepped->slip.sigma = 0.0;
-  o.stepped->encoder.jitter_s = 0.0;
+  o.stepped->slip_sigma = 0.0;
+  o.stepped->encoder_jitter_s = 0.0;
   return scenario;
 }
 
@@ -100,14 +100,14 @@ TEST(SteppedSimulator, NoiseFreeLogsReplayToTheTruthForEveryModel) {
   }
 }
 
-// The slip is an Ornstein-Uhlenbeck process of stationary sigma SlipOptions::sigma, seen through
+// The slip is an Ornstein-Uhlenbeck process of stationary sigma SteppedOptions::slip_sigma, seen through
 // the hook as contact rate / channel value - 1 on a moving wheel. Over the 36 flower runs (3
 // wheels, ~3 s of motion each, 0.5 s correlation: ~600 independent values) the sample standard
 // deviation has a relative standard error of ~1/sqrt(2 * 600) = 3 %; the test allows 12 %.
 TEST(SteppedSimulator, SlipHasTheStatedSigma) {
   sim::FlowerSimulation flower = sim::PalacinFlower();
   flower.repetitions = 1;
-  flower.options.stepped->slip.sigma = 0.01;
+  flower.options.stepped->slip_sigma = 0.01;
   std::mutex mutex;  // runs are simulated in parallel
   double sum_sq = 0.0;
   long count = 0;
@@ -133,7 +133,7 @@ TEST(SteppedSimulator, LagJitterAndGroundTruthIntervalsAreAsStated) {
   sim::FlowerSimulation flower = sim::PalacinFlower();
   flower.repetitions = 1;
   flower.trajectories.resize(1);  // R1: one run, one target
-  const double tau = flower.options.stepped->controller.time_constant_s;
+  const double tau = flower.options.stepped->controller_time_constant_s;
   const std::vector<double> target = [&] {
     std::vector<double> w(3);
     const sim::MotionCommand& c = flower.trajectories[0];
@@ -179,10 +179,10 @@ TEST(SteppedSimulator, RejectsInconsistentOptions) {
     spoil(&f);
     EXPECT_THROW(sim::SimulateFlower(f), std::invalid_argument);
   };
-  expect_throw([](auto* f) { f->options.stepped->encoder.jitter_s = 0.006; });
-  expect_throw([](auto* f) { f->options.stepped->controller.time_constant_s = 0.0; });
-  expect_throw([](auto* f) { f->options.stepped->ground_truth.period_min_s = 0.4; });
-  expect_throw([](auto* f) { f->options.stepped->slip.correlation_time_s = 0.0; });
+  expect_throw([](auto* f) { f->options.stepped->encoder_jitter_s = 0.006; });
+  expect_throw([](auto* f) { f->options.stepped->controller_time_constant_s = 0.0; });
+  expect_throw([](auto* f) { f->options.stepped->gt_period_min_s = 0.4; });
+  expect_throw([](auto* f) { f->options.stepped->slip_correlation_time_s = 0.0; });
   expect_throw([](auto* f) { f->options.stepped->wheel_eccentricity = {0.1}; });
   expect_throw([](auto* f) { f->options.stepped->commanded_parameters = {0.2}; });
   expect_throw([](auto* f) { f->repetitions = 0; });

@@ -212,7 +212,7 @@ void CheckSessionsAndOut(const ImportOptiOdomOptions& options) {
                        " sessions; import one robot at a time");
     }
   }
-  for (const std::string& dir : options.sessions) io::RegisterInputDirectory(dir);
+  for (const std::string& dir : options.sessions) io::RegisterInput(dir);
   if (const std::string refusal = io::DirectoryOutputRefusal(options.out, io::kDatasetKind,
                                                              options.force, options.sessions);
       !refusal.empty()) {

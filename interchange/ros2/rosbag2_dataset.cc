@@ -201,7 +201,7 @@ RobotModelPtr WriteDataset(const ImportRosbag2Options& o, const Robot& robot,
 
 Rosbag2Import ImportRosbag2(const ImportRosbag2Options& o) {
   if (o.out.empty()) throw UsageError("--out <data set directory> is required");
-  io::RegisterInputDirectory(o.bag);  // no data set in, over or holding the bag
+  io::RegisterInput(o.bag);  // no data set in, over or holding the bag
   if (const std::string refusal =
           io::DirectoryOutputRefusal(o.out, io::kDatasetKind, o.force, {o.bag});
       !refusal.empty()) {

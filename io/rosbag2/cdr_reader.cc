@@ -62,7 +62,7 @@ T CdrReader::Read() {
 }
 
 template <typename T>
-void CdrReader::ReadArray(T* out, std::size_t count) {
+void CdrReader::Array(T* out, std::size_t count) {
   const std::size_t at = impl_->cdr.getSerializedDataLength();
   try {
     impl_->cdr.deserializeArray(out, count);
@@ -73,22 +73,10 @@ void CdrReader::ReadArray(T* out, std::size_t count) {
   }
 }
 
-bool CdrReader::Bool() { return Read<bool>(); }
-std::uint8_t CdrReader::Uint8() { return Read<std::uint8_t>(); }
-std::int8_t CdrReader::Int8() { return Read<std::int8_t>(); }
-std::int16_t CdrReader::Int16() { return Read<std::int16_t>(); }
-std::uint16_t CdrReader::Uint16() { return Read<std::uint16_t>(); }
-std::int32_t CdrReader::Int32() { return Read<std::int32_t>(); }
-std::uint32_t CdrReader::Uint32() { return Read<std::uint32_t>(); }
-std::int64_t CdrReader::Int64() { return Read<std::int64_t>(); }
-std::uint64_t CdrReader::Uint64() { return Read<std::uint64_t>(); }
-float CdrReader::Float32() { return Read<float>(); }
-double CdrReader::Float64() { return Read<double>(); }
-
 // A string: uint32 length counting the terminating NUL, the bytes, the NUL. A length of 0 (no
 // NUL at all) is accepted as "", as some serializers write it for the empty string.
 std::string CdrReader::String() {
-  const std::uint32_t length = Uint32();
+  const std::uint32_t length = Read<std::uint32_t>();
   if (length == 0) return std::string();
   const std::size_t at = impl_->cdr.getSerializedDataLength();
   if (length > remaining()) {
@@ -108,24 +96,38 @@ std::string CdrReader::String() {
   return out;
 }
 
-void CdrReader::Array(bool* out, std::size_t count) { ReadArray(out, count); }
-void CdrReader::Array(std::uint8_t* out, std::size_t count) { ReadArray(out, count); }
-void CdrReader::Array(std::int8_t* out, std::size_t count) { ReadArray(out, count); }
-void CdrReader::Array(char* out, std::size_t count) { ReadArray(out, count); }
-void CdrReader::Array(std::int16_t* out, std::size_t count) { ReadArray(out, count); }
-void CdrReader::Array(std::uint16_t* out, std::size_t count) { ReadArray(out, count); }
-void CdrReader::Array(std::int32_t* out, std::size_t count) { ReadArray(out, count); }
-void CdrReader::Array(std::uint32_t* out, std::size_t count) { ReadArray(out, count); }
-void CdrReader::Array(std::int64_t* out, std::size_t count) { ReadArray(out, count); }
-void CdrReader::Array(std::uint64_t* out, std::size_t count) { ReadArray(out, count); }
-void CdrReader::Array(float* out, std::size_t count) { ReadArray(out, count); }
-void CdrReader::Array(double* out, std::size_t count) { ReadArray(out, count); }
-void CdrReader::Array(std::string* out, std::size_t count) {
+template <>
+void CdrReader::Array<std::string>(std::string* out, std::size_t count) {
   for (std::size_t i = 0; i < count; ++i) out[i] = String();
 }
 
+// The types a message may hold (the template definitions stay here, beside fastcdr).
+template bool CdrReader::Read<bool>();
+template std::uint8_t CdrReader::Read<std::uint8_t>();
+template std::int8_t CdrReader::Read<std::int8_t>();
+template std::int16_t CdrReader::Read<std::int16_t>();
+template std::uint16_t CdrReader::Read<std::uint16_t>();
+template std::int32_t CdrReader::Read<std::int32_t>();
+template std::uint32_t CdrReader::Read<std::uint32_t>();
+template std::int64_t CdrReader::Read<std::int64_t>();
+template std::uint64_t CdrReader::Read<std::uint64_t>();
+template float CdrReader::Read<float>();
+template double CdrReader::Read<double>();
+template void CdrReader::Array<bool>(bool*, std::size_t);
+template void CdrReader::Array<std::uint8_t>(std::uint8_t*, std::size_t);
+template void CdrReader::Array<char>(char*, std::size_t);
+template void CdrReader::Array<std::int8_t>(std::int8_t*, std::size_t);
+template void CdrReader::Array<std::int16_t>(std::int16_t*, std::size_t);
+template void CdrReader::Array<std::uint16_t>(std::uint16_t*, std::size_t);
+template void CdrReader::Array<std::int32_t>(std::int32_t*, std::size_t);
+template void CdrReader::Array<std::uint32_t>(std::uint32_t*, std::size_t);
+template void CdrReader::Array<std::int64_t>(std::int64_t*, std::size_t);
+template void CdrReader::Array<std::uint64_t>(std::uint64_t*, std::size_t);
+template void CdrReader::Array<float>(float*, std::size_t);
+template void CdrReader::Array<double>(double*, std::size_t);
+
 std::uint32_t CdrReader::SequenceLength(std::size_t min_element_bytes, std::size_t alignment) {
-  const std::uint32_t count = Uint32();
+  const std::uint32_t count = Read<std::uint32_t>();
   // Alignment counts from the end of the encapsulation header (see the file comment).
   const std::size_t position = impl_->cdr.getSerializedDataLength() - kEncapsulationBytes;
   const std::size_t padding = (alignment - position % alignment) % alignment;

@@ -34,33 +34,14 @@ class CdrReader {
   // Bytes not yet read (trailing alignment padding included).
   std::size_t remaining() const;
 
-  bool Bool();
-  std::uint8_t Uint8();
-  std::int8_t Int8();
-  std::int16_t Int16();
-  std::uint16_t Uint16();
-  std::int32_t Int32();
-  std::uint32_t Uint32();
-  std::int64_t Int64();
-  std::uint64_t Uint64();
-  float Float32();
-  double Float64();
+  // A primitive field: bool, std::(u)int8_t .. std::(u)int64_t, float or double.
+  template <typename T>
+  T Read();
   std::string String();
 
-  // Fixed-size arrays of primitives (`T name[N]` in a .msg file).
-  void Array(bool* out, std::size_t count);
-  void Array(std::uint8_t* out, std::size_t count);
-  void Array(std::int8_t* out, std::size_t count);
-  void Array(char* out, std::size_t count);
-  void Array(std::int16_t* out, std::size_t count);
-  void Array(std::uint16_t* out, std::size_t count);
-  void Array(std::int32_t* out, std::size_t count);
-  void Array(std::uint32_t* out, std::size_t count);
-  void Array(std::int64_t* out, std::size_t count);
-  void Array(std::uint64_t* out, std::size_t count);
-  void Array(float* out, std::size_t count);
-  void Array(double* out, std::size_t count);
-  void Array(std::string* out, std::size_t count);
+  // A fixed-size array (`T name[N]` in a .msg file) of one of those, of char or of strings.
+  template <typename T>
+  void Array(T* out, std::size_t count);
 
   // The uint32 element count of a sequence, checked: `count * min_element_bytes` (after the
   // first element's alignment to `alignment`) must fit in the bytes left.
@@ -78,15 +59,14 @@ class CdrReader {
  private:
   struct Impl;
   [[noreturn]] void Fail(const std::string& why) const;
-  template <typename T>
-  T Read();
-  template <typename T>
-  void ReadArray(T* out, std::size_t count);
 
   std::unique_ptr<Impl> impl_;
   std::string what_;
   std::size_t size_;
   bool big_endian_ = false;
 };
+
+template <>
+void CdrReader::Array<std::string>(std::string* out, std::size_t count);
 
 }  // namespace fitcal::io::rosbag2

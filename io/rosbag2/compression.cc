@@ -55,11 +55,9 @@ bool DecompressZstd(ZSTD_DCtx* ctx, ByteView input, std::uint8_t* out, std::size
   const std::size_t written = ZSTD_decompressDCtx(ctx, out, expected, input.data, input.size);
   if (ZSTD_isError(written))
     return Invalid(error, std::string("zstd: ") + ZSTD_getErrorName(written));
-  if (written != expected) {
-    *error = "zstd data decompresses to " + std::to_string(written) + " bytes, not the declared " +
-             std::to_string(expected);
-    return false;
-  }
+  if (written != expected)
+    return Invalid(error, "zstd data decompresses to " + std::to_string(written) +
+                              " bytes, not the declared " + std::to_string(expected));
   return true;
 }
 
@@ -79,18 +77,14 @@ bool DecompressLz4(LZ4F_dctx* ctx, ByteView input, std::uint8_t* out, std::size_
     if (LZ4F_isError(hint)) return Invalid(error, std::string("lz4: ") + LZ4F_getErrorName(hint));
     in_pos += in_size;
     out_pos += out_size;
-    if (in_size == 0 && out_size == 0) {
-      *error =
-          "lz4 data decompresses to more than the declared " + std::to_string(expected) + " bytes";
-      return false;
-    }
+    if (in_size == 0 && out_size == 0)
+      return Invalid(error, "lz4 data decompresses to more than the declared " +
+                                std::to_string(expected) + " bytes");
   }
   if (hint != 0) return Invalid(error, "lz4 frame is truncated");
-  if (out_pos != expected) {
-    *error = "lz4 data decompresses to " + std::to_string(out_pos) + " bytes, not the declared " +
-             std::to_string(expected);
-    return false;
-  }
+  if (out_pos != expected)
+    return Invalid(error, "lz4 data decompresses to " + std::to_string(out_pos) +
+                              " bytes, not the declared " + std::to_string(expected));
   return true;
 }
 
@@ -100,11 +94,10 @@ bool Decompressor::Decompress(Compression compression, ByteView input, std::uint
                               std::size_t expected_size, std::string* error) {
   switch (compression) {
     case Compression::kNone:
-      if (input.size != expected_size) {
-        *error = "uncompressed size " + std::to_string(expected_size) + " differs from the " +
-                 std::to_string(input.size) + " bytes stored";
-        return false;
-      }
+      if (input.size != expected_size)
+        return Invalid(error, "uncompressed size " + std::to_string(expected_size) +
+                                  " differs from the " + std::to_string(input.size) +
+                                  " bytes stored");
       if (expected_size > 0) std::memcpy(out, input.data, expected_size);
       return true;
     case Compression::kZstd:
@@ -112,8 +105,7 @@ bool Decompressor::Decompress(Compression compression, ByteView input, std::uint
     case Compression::kLz4:
       return DecompressLz4(contexts_->lz4, input, out, expected_size, error);
   }
-  *error = "unknown compression";
-  return false;
+  return Invalid(error, "unknown compression");
 }
 
 bool Decompressor::CheckDeclaredSize(Compression compression, ByteView input,
@@ -127,20 +119,17 @@ bool Decompressor::CheckDeclaredSize(Compression compression, ByteView input,
       return Invalid(error, declared + " differs from the zstd frame's " + std::to_string(content));
   } else if (compression == Compression::kLz4) {
     constexpr std::uint64_t kMaxLz4Ratio = 255;
-    if (declared_size > input.size * kMaxLz4Ratio + 65536) {
-      *error =
-          declared + " is more than lz4 can expand " + std::to_string(input.size) + " bytes to";
-      return false;
-    }
+    if (declared_size > input.size * kMaxLz4Ratio + 65536)
+      return Invalid(error, declared + " is more than lz4 can expand " +
+                                std::to_string(input.size) + " bytes to");
     LZ4F_resetDecompressionContext(contexts_->lz4);
     LZ4F_frameInfo_t info{};
     std::size_t consumed = input.size;
     if (LZ4F_isError(LZ4F_getFrameInfo(contexts_->lz4, &info, input.data, &consumed)))
       return Invalid(error, "not an lz4 frame");
-    if (info.contentSize != 0 && info.contentSize > declared_size) {
-      *error = declared + " is less than the lz4 frame's " + std::to_string(info.contentSize);
-      return false;
-    }
+    if (info.contentSize != 0 && info.contentSize > declared_size)
+      return Invalid(
+          error, declared + " is less than the lz4 frame's " + std::to_string(info.contentSize));
   }
   return true;
 }

@@ -14,16 +14,18 @@ namespace {
 // then 7 doubles; used to bound a transforms[] length before allocating.
 constexpr std::size_t kMinTransformStampedBytes = 8 + 4 + 4 + 7 * 8;
 
-Header ReadHeader(CdrReader& cdr) { return {{cdr.Int32(), cdr.Uint32()}, cdr.String()}; }
+Header ReadHeader(CdrReader& cdr) {
+  return {{cdr.Read<std::int32_t>(), cdr.Read<std::uint32_t>()}, cdr.String()};
+}
 
 // geometry_msgs Point and Vector3: three float64 x, y, z.
 template <typename Xyz>
 Xyz ReadXyz(CdrReader& cdr) {
-  return {cdr.Float64(), cdr.Float64(), cdr.Float64()};
+  return {cdr.Read<double>(), cdr.Read<double>(), cdr.Read<double>()};
 }
 
 Quaternion ReadQuaternion(CdrReader& cdr) {
-  return {cdr.Float64(), cdr.Float64(), cdr.Float64(), cdr.Float64()};
+  return {cdr.Read<double>(), cdr.Read<double>(), cdr.Read<double>(), cdr.Read<double>()};
 }
 
 Pose ReadPose(CdrReader& cdr) { return {ReadXyz<Point>(cdr), ReadQuaternion(cdr)}; }

@@ -15,19 +15,19 @@ namespace {
 
 BasicTypes ReadBasicTypes(CdrReader& cdr) {
   BasicTypes b;
-  b.bool_value = cdr.Bool();
-  b.byte_value = cdr.Uint8();
-  b.char_value = cdr.Uint8();
-  b.float32_value = cdr.Float32();
-  b.float64_value = cdr.Float64();
-  b.int8_value = cdr.Int8();
-  b.uint8_value = cdr.Uint8();
-  b.int16_value = cdr.Int16();
-  b.uint16_value = cdr.Uint16();
-  b.int32_value = cdr.Int32();
-  b.uint32_value = cdr.Uint32();
-  b.int64_value = cdr.Int64();
-  b.uint64_value = cdr.Uint64();
+  b.bool_value = cdr.Read<bool>();
+  b.byte_value = cdr.Read<std::uint8_t>();
+  b.char_value = cdr.Read<std::uint8_t>();
+  b.float32_value = cdr.Read<float>();
+  b.float64_value = cdr.Read<double>();
+  b.int8_value = cdr.Read<std::int8_t>();
+  b.uint8_value = cdr.Read<std::uint8_t>();
+  b.int16_value = cdr.Read<std::int16_t>();
+  b.uint16_value = cdr.Read<std::uint16_t>();
+  b.int32_value = cdr.Read<std::int32_t>();
+  b.uint32_value = cdr.Read<std::uint32_t>();
+  b.int64_value = cdr.Read<std::int64_t>();
+  b.uint64_value = cdr.Read<std::uint64_t>();
   return b;
 }
 
@@ -75,7 +75,7 @@ Arrays DecodeArrays(ByteView payload, const std::string& what) {
   ReadArray(cdr, &msg.constants_values);
   for (BasicTypes& b : msg.defaults_values) b = ReadBasicTypes(cdr);
   msg.defaults = ReadArrayValues(cdr);
-  msg.alignment_check = cdr.Int32();
+  msg.alignment_check = cdr.Read<std::int32_t>();
   return msg;
 }
 
