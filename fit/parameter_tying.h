@@ -65,6 +65,10 @@ class TiedModel final : public RobotModelInterface {
       const double* q) const override;
   std::unique_ptr<const PreparedKinematics<EffectJet>> PrepareKinematics(
       const EffectJet* q) const override;
+  // The tied cost passes the inner cost's residuals through (TiedCost).
+  bool SegmentResidualsAlikeWithJacobians() const override {
+    return inner_.SegmentResidualsAlikeWithJacobians();
+  }
   bool StepMatrix(const double* q, double* m) const override;
   bool ChannelsForTwist(const double* q, const Twist& twist, double* values) const override;
   using RobotModelInterface::RobotYaml;

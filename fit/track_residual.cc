@@ -157,17 +157,31 @@ Pose2d GroundTruthFromStart(const TrackCheckpoints& track, std::size_t k, double
                  InterpolateGroundTruth(*track.ground_truth, track.t_s[k] + dt_s));
 }
 
+namespace {
+
+// Whether `kept` holds `num_poses` poses for bitwise the same parameters `p` (the same doubles,
+// not merely equal ones, as LastEvaluationMemo).
+template <typename Kept>
+bool KeptFor(const std::optional<Kept>& kept, const double* p, int num_parameters,
+             int num_poses) {
+  return kept && kept->pose.size() == static_cast<std::size_t>(num_poses) &&
+         kept->p.size() == static_cast<std::size_t>(num_parameters) &&
+         std::memcmp(kept->p.data(), p, num_parameters * sizeof(double)) == 0;
+}
+
+}  // namespace
+
 bool OdometryMemo::Recall(const double* p, int num_parameters, double* pose, int num_poses,
-                          double* jacobian) const {
-  const std::optional<Kept>& kept = jacobian != nullptr ? with_jacobian_ : values_;
-  // Bitwise: the same doubles, not merely equal ones (as LastEvaluationMemo).
-  if (!kept || kept->pose.size() != static_cast<std::size_t>(num_poses) ||
-      kept->p.size() != static_cast<std::size_t>(num_parameters) ||
-      std::memcmp(kept->p.data(), p, num_parameters * sizeof(double)) != 0) {
-    return false;
+                          double* jacobian, bool values_alike) {
+  const std::optional<Kept>* kept = jacobian != nullptr ? &with_jacobian_ : &values_;
+  if (!KeptFor(*kept, p, num_parameters, num_poses)) {
+    if (jacobian != nullptr || !values_alike) return false;
+    kept = &with_jacobian_;
+    if (!KeptFor(*kept, p, num_parameters, num_poses)) return false;
   }
-  std::copy(kept->pose.begin(), kept->pose.end(), pose);
-  if (jacobian != nullptr) std::copy(kept->jacobian.begin(), kept->jacobian.end(), jacobian);
+  ++recalled_;
+  std::copy((*kept)->pose.begin(), (*kept)->pose.end(), pose);
+  if (jacobian != nullptr) std::copy((*kept)->jacobian.begin(), (*kept)->jacobian.end(), jacobian);
   return true;
 }
 
@@ -193,6 +207,7 @@ TrackResidual::TrackResidual(const TrackCheckpoints& track, const RobotModelInte
       run_weight_(1.0 /
                   std::sqrt(static_cast<double>(std::max<std::size_t>(1, track.segments.size())))),
       num_parameters_(model.robot().NumParameters()),
+      values_alike_(model.SegmentResidualsAlikeWithJacobians()),
       memo_(memo) {
   for (const Segment& s : track.segments) {
     Segment identity = s;
@@ -273,7 +288,9 @@ std::array<T, 3> TrackResidual::CheckpointResidual(const std::vector<double>& po
 
 bool TrackResidual::EvaluateOdometry(const double* p, double* pose, double* jacobian) const {
   const int m = num_residuals();
-  if (memo_ != nullptr && memo_->Recall(p, num_parameters_, pose, m, jacobian)) return true;
+  if (memo_ != nullptr && memo_->Recall(p, num_parameters_, pose, m, jacobian, values_alike_)) {
+    return true;
+  }
   const double* parameters[] = {p};
   double* inner_jacobians[1] = {jacobian};
   if (!odometry_->Evaluate(parameters, pose, jacobian != nullptr ? inner_jacobians : nullptr)) {

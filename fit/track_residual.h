@@ -131,20 +131,29 @@ Pose2d GroundTruthFromStart(const TrackCheckpoints& track, std::size_t k, double
 // at with only the offsets moved, which the odometry does not depend on; the offsets' search
 // replays the same runs at those parameters again. A request of the same kind (with or without
 // the Jacobian) at bitwise the same parameters is answered with a copy of what the cost computed
-// there, so every fit takes the same steps to the bit. One per run, used by one thread at a time.
+// there, so every fit takes the same steps to the bit. A request without the Jacobian is also
+// answered from one with it where the model's poses are the same either way
+// (RobotModelInterface::SegmentResidualsAlikeWithJacobians): Ceres' bounded trust region
+// evaluates the Jacobian at each candidate point in its line search, then the cost alone at the
+// same point (2.1, trust_region_minimizer.cc), and the offsets' search replays the point a solve
+// ended at. One per run, used by one thread at a time.
 class OdometryMemo {
  public:
-  // Copies the poses (and dP/dp when `jacobian` is not null) kept for `p` of this kind.
+  // Copies the poses (and dP/dp when `jacobian` is not null) kept for `p` of this kind, or, with
+  // `values_alike` and no `jacobian`, the poses of an evaluation with dP/dp there.
   bool Recall(const double* p, int num_parameters, double* pose, int num_poses,
-              double* jacobian) const;
+              double* jacobian, bool values_alike = false);
   void Keep(const double* p, int num_parameters, const double* pose, int num_poses,
             const double* jacobian);
+  // How many requests were answered from the memo (tests).
+  int recalled() const { return recalled_; }
 
  private:
   struct Kept {
     std::vector<double> p, pose, jacobian;
   };
   std::optional<Kept> values_, with_jacobian_;
+  int recalled_ = 0;
 };
 
 class TrackResidual : public ceres::CostFunction {
@@ -193,6 +202,7 @@ class TrackResidual : public ceres::CostFunction {
   TrackHeading heading_;
   double run_weight_;  // 1 / sqrt(K)
   int num_parameters_;
+  bool values_alike_;  // model.SegmentResidualsAlikeWithJacobians()
   OdometryMemo* memo_;
 };
 

@@ -181,6 +181,10 @@ class KinematicModel : public RobotModelInterface {
     }
   }
 
+  bool SegmentResidualsAlikeWithJacobians() const override {
+    return FinalPoseJacobianKindOf<K>::value != FinalPoseJacobianKind::kAutodiff;
+  }
+
   // The body step reads robot().NumChannels() values per row: samples of another width would be
   // read out of bounds. A check that fires in release builds too (STYLE.md habit 7).
   void CheckChannels(const EncoderSamples& samples) const {

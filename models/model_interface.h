@@ -127,6 +127,13 @@ class RobotModelInterface {
                                            const std::vector<Segment>& segments,
                                            const ResidualWeights& weights) const = 0;
 
+  // Whether SegmentCost's residuals are the same to the bit with and without Jacobians (an
+  // analytic Jacobian whose poses are the plain replay's, models/segment_jacobian.h; not Ceres'
+  // autodiff, whose Jets replay one sample at a time where the plain replay pairs them), so that
+  // a residual-only request may be answered from an evaluation with Jacobians at the same point
+  // (fit/track_residual.h OdometryMemo). False unless the model says so.
+  virtual bool SegmentResidualsAlikeWithJacobians() const { return false; }
+
   // The kinematics at parameters p for the effect replay (PreparedKinematics above).
   virtual std::unique_ptr<const PreparedKinematics<double>> PrepareKinematics(
       const double* p) const = 0;

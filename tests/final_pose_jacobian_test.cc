@@ -296,6 +296,9 @@ void CheckSegmentCost(const std::string& yaml) {
     }
     points.push_back(p);
   }
+  // Its residuals are the same to the bit with and without Jacobians (ExpectSameSegmentCost),
+  // which the model says, so that the track residual's memo may rely on it.
+  EXPECT_TRUE(model->SegmentResidualsAlikeWithJacobians());
   std::vector<AlignedRun> runs = SimulatedRuns(*model);
   runs.push_back(RealLikeRun(*model, 9, 4000));
   runs.push_back(RealLikeRun(*model, 10, 11500));

@@ -179,6 +179,42 @@ TEST(TrackResidual, OdometryMemoAnswersTheCostsOwnNumbersBitForBit) {
   }
 }
 
+// Ceres' bounded trust region evaluates the Jacobian at each candidate point in its line search,
+// then the cost alone at the same point; the offsets' search replays the point a solve ended at.
+// Where the model's poses are the same with and without Jacobians (the diff drive's analytic
+// segment cost), the memo answers those from the evaluation with Jacobians, with the cost's own
+// numbers to the bit.
+TEST(TrackResidual, OdometryMemoAnswersTheCostAloneFromAnEvaluationWithJacobians) {
+  const RobotModelPtr model = Model();
+  ASSERT_TRUE(model->SegmentResidualsAlikeWithJacobians());
+  const Simulated s = SimulateLoops(*model, 1);
+  const TrackFitData data = MakeTrackFitData(s.aligned, s.tracks, ClockGrouping::kPerRun);
+  for (const TrackCheckpoints& track : data.runs) {
+    OdometryMemo memo;
+    std::unique_ptr<ceres::CostFunction> plain(
+        TrackResidual::Create(track, *model, ResidualWeights{}, data.options));
+    std::unique_ptr<ceres::CostFunction> memoised(
+        TrackResidual::Create(track, *model, ResidualWeights{}, data.options, &memo));
+    const int m = plain->num_residuals();
+    std::vector<double> p = {0.0425, 0.0418, 0.203};
+    double dt = 0.1234;
+    std::vector<double> r(m), j_p(3 * m), j_dt(m), r_memo(m), r_plain(m);
+    const double* parameters[] = {p.data(), &dt};
+    double* jacobians[] = {j_p.data(), j_dt.data()};
+    ASSERT_TRUE(memoised->Evaluate(parameters, r.data(), jacobians));
+    ASSERT_EQ(memo.recalled(), 0);
+    dt = -0.05;  // the offsets' search moves dt only
+    ASSERT_TRUE(memoised->Evaluate(parameters, r_memo.data(), nullptr));
+    EXPECT_EQ(memo.recalled(), 1) << track.run->id << ": the replay ran again";
+    ASSERT_TRUE(plain->Evaluate(parameters, r_plain.data(), nullptr));
+    EXPECT_EQ(std::memcmp(r_memo.data(), r_plain.data(), m * sizeof(double)), 0) << track.run->id;
+    const auto* residual = static_cast<const TrackResidual*>(memoised.get());
+    const auto* reference = static_cast<const TrackResidual*>(plain.get());
+    EXPECT_EQ(residual->OdometryFromStart(p.data()), reference->OdometryFromStart(p.data()));
+    EXPECT_EQ(memo.recalled(), 2) << track.run->id;
+  }
+}
+
 // The common scale s multiplies every distance the odometry replays and leaves every heading as
 // it is, so a closed loop ends where it started whatever s: the final-pose fit holds that
 // direction at the nominal. The track sees it at every checkpoint (1 % of the path from the start,
