@@ -11,7 +11,6 @@
 #include "fit/run_split.h"
 #include "io/atomic_file.h"
 #include "io/dataset.h"
-#include "io/input_error.h"
 #include "models/model_registry.h"
 #include "cli/cli_validators.h"
 #include "calibrate/fit_methods.h"

@@ -13,7 +13,6 @@
 #include "io/staged_directory.h"
 #include "models/model_registry.h"
 #include "pages/diagnose_page.h"
-#include "validation/trajectory_metrics.h"
 
 namespace fitcal::tools {
 

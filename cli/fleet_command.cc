@@ -5,22 +5,16 @@
 
 #include "cli/dataset_command.h"
 #include "interchange/fleet/fleet_files.h"
-#include "io/command_failure.h"
 #include "odometry/text_format.h"
 
 namespace fitcal::tools {
-namespace {
-
-constexpr const char* kCfRow = kFleetCfRow;
-
-}  // namespace
 
 // The note under a robot's table when its held-out CFs were judged on different runs: a change
 // in CF may then be the runs', not the robot's.
 std::string DifferentJudgesNote(const FleetSeries& s) {
   const std::vector<std::string>& distinct = s.distinct_judges;
   if (distinct.size() < 2) return "";
-  std::string note = "  note: " + std::string(kCfRow) + " was judged on " +
+  std::string note = "  note: " + std::string(kFleetCfRow) + " was judged on " +
                      std::to_string(distinct.size()) +
                      " different sets of held-out runs, so its values do not compare like for "
                      "like:";
@@ -51,7 +45,7 @@ std::string FleetTable(const std::vector<FleetSeries>& series) {
                      s.parameter.c_str(), s.unit.c_str(), s.values.size(), s.dates.front().c_str(),
                      k * s.values.front(), s.dates.back().c_str(), k * s.values.back(),
                      sigma.c_str(), k * s.median, slope.c_str(), flags.c_str());
-    if (s.parameter == kCfRow) note += DifferentJudgesNote(s);
+    if (s.parameter == kFleetCfRow) note += DifferentJudgesNote(s);
   }
   close_robot();
   return out;

@@ -10,7 +10,6 @@
 #include "cli/effect_list.h"
 #include "cli/everyday_driving_table.h"
 #include "models/model_registry.h"
-#include "odometry/text_format.h"
 
 namespace fitcal::tools {
 

@@ -7,7 +7,6 @@
 #include <set>
 
 #include "io/atomic_file.h"
-#include "io/dataset.h"
 #include "pages/report_csv.h"
 #include "pages/report_html.h"
 #include "pages/report_json.h"

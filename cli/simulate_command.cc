@@ -8,9 +8,7 @@
 #include <stdexcept>
 
 #include "cli/dataset_command.h"
-#include "io/input_error.h"
 #include "io/output_guard.h"
-#include "models/model_registry.h"
 #include "sim/model_dataset.h"
 
 namespace fitcal::tools {

@@ -3,7 +3,6 @@
 
 #include <cmath>
 
-#include "fit/residual_choice.h"
 #include "odometry/invalid.h"
 
 namespace fitcal::tools {

@@ -7,7 +7,6 @@
 #include <numeric>
 #include <random>
 
-#include "fit/statistics.h"
 #include "odometry/text_format.h"
 
 namespace fitcal {

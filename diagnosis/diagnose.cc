@@ -1,13 +1,13 @@
 #include "diagnosis/diagnose.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 
 #include "fit/statistics.h"
 #include "odometry/invalid.h"
+#include "odometry/pose_between.h"
 #include "odometry/text_format.h"
 
 namespace fitcal {
@@ -67,14 +67,9 @@ double WindowError(const TrackErrors& e, std::size_t j0, std::size_t j1,
   const Pose2d& g1 = e.ground_truth[j1];
   const Pose2d p0{g0.x + e.error[j0].x, g0.y + e.error[j0].y, g0.theta + e.error[j0].theta};
   const Pose2d p1{g1.x + e.error[j1].x, g1.y + e.error[j1].y, g1.theta + e.error[j1].theta};
-  const auto relative = [](const Pose2d& a, const Pose2d& b) {
-    const double c = std::cos(a.theta), s = std::sin(a.theta);
-    const double dx = b.x - a.x, dy = b.y - a.y;
-    return std::array<double, 2>{c * dx + s * dy, -s * dx + c * dy};
-  };
-  const std::array<double, 2> moved = relative(p0, p1), truth = relative(g0, g1);
-  const double ex = (moved[0] - truth[0]) / weights.position_sigma_m;
-  const double ey = (moved[1] - truth[1]) / weights.position_sigma_m;
+  const Pose2d moved = Between(p0, p1), truth = Between(g0, g1);
+  const double ex = (moved.x - truth.x) / weights.position_sigma_m;
+  const double ey = (moved.y - truth.y) / weights.position_sigma_m;
   const double et = WrapAngle(e.error[j1].theta - e.error[j0].theta) / weights.heading_sigma_rad;
   return ex * ex + ey * ey + et * et;
 }

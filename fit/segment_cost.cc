@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "odometry/invalid.h"
+#include "odometry/pose_between.h"
 
 namespace fitcal {
 
@@ -34,12 +35,6 @@ std::vector<double> BoundaryTimes(const AlignedRun& run) {
   t[0] = run.t_start_s;
   for (std::size_t k = 0; k < run.samples.size(); ++k) t[k + 1] = t[k] + run.samples[k].dt_s;
   return t;
-}
-
-Pose2d Between(const Pose2d& a, const Pose2d& b) {
-  const double c = std::cos(a.theta), s = std::sin(a.theta);
-  const double dx = b.x - a.x, dy = b.y - a.y;
-  return Pose2d{c * dx + s * dy, -s * dx + c * dy, b.theta - a.theta};
 }
 
 }  // namespace

@@ -4,15 +4,10 @@
 #include <Eigen/SVD>
 #include <cmath>
 
+#include "odometry/pose_between.h"
+
 namespace fitcal {
 namespace {
-
-// a^-1 b
-Pose2d Between(const Pose2d& a, const Pose2d& b) {
-  const double c = std::cos(a.theta), s = std::sin(a.theta);
-  const double dx = b.x - a.x, dy = b.y - a.y;
-  return {c * dx + s * dy, -s * dx + c * dy, b.theta - a.theta};
-}
 
 Pose2d Inverse(const Pose2d& p) { return Between(p, Pose2d{}); }
 

@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "fit/segment_cost.h"
+#include "odometry/pose_between.h"
 
 namespace fitcal {
 
@@ -131,16 +132,6 @@ TrackFitData MakeTrackFitData(const std::vector<AlignedRun>& runs,
 
 namespace {
 
-// a^-1 b
-template <typename T>
-Pose2<T> Between(const Pose2<T>& a, const Pose2<T>& b) {
-  using std::cos;
-  using std::sin;
-  const T c = cos(a.theta), s = sin(a.theta);
-  const T dx = b.x - a.x, dy = b.y - a.y;
-  return {c * dx + s * dy, -s * dx + c * dy, b.theta - a.theta};
-}
-
 // sqrt(rho(s) / s) for Huber's rho of scale c (header): 1 in the quadratic zone.
 template <typename T>
 T HuberFactor(const T& s, double c) {
@@ -148,7 +139,6 @@ T HuberFactor(const T& s, double c) {
   if (ScalarPart(s) <= c * c) return T(1.0);
   return sqrt((2.0 * c * sqrt(s) - c * c) / s);
 }
-
 
 }  // namespace
 

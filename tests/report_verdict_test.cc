@@ -239,14 +239,14 @@ TEST(RelativePoseErrorTest, StraightDriveClosedForms) {
     turning.push_back({s, 0.0, 0.3 + s * M_PI / 180.0});
   }
   RelativePoseErrorSum a, b;
-  AddRelativePoseErrors(truth, long_odometry, 1.0, &a);
+  RelativePoseErrorRun(truth, long_odometry).Add(1.0, &a);
   EXPECT_EQ(a.windows, 41 - 4);
   EXPECT_NEAR(a.MeanTranslationPercent(), 2.0, 1e-9);
   EXPECT_NEAR(a.MeanRotationRadPerM(), 0.0, 1e-12);
-  AddRelativePoseErrors(truth, turning, 1.0, &b);
+  RelativePoseErrorRun(truth, turning).Add(1.0, &b);
   EXPECT_NEAR(b.MeanRotationRadPerM(), M_PI / 180.0, 1e-9);
   RelativePoseErrorSum none;
-  AddRelativePoseErrors(truth, long_odometry, 20.0, &none);  // longer than the run
+  RelativePoseErrorRun(truth, long_odometry).Add(20.0, &none);  // longer than the run
   EXPECT_EQ(none.windows, 0);
   EXPECT_EQ(RelativePoseErrorLengths(5.0), (std::vector<double>{0.5, 1.0, 2.0}));
   EXPECT_EQ(RelativePoseErrorLengths(0.4), (std::vector<double>{}));

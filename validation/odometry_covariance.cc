@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "odometry/aligned_run.h"
+#include "odometry/pose_between.h"
 
 namespace fitcal {
 namespace {
@@ -18,12 +19,6 @@ constexpr int kLags[] = {1, 2, 4, 8, 16, 32, 64, 128, 256};
 constexpr double kPathWindowsM[] = {0.25, 0.5, 1.0, 2.0, 4.0};
 // A mean square over fewer windows than this does not enter a fit.
 constexpr std::size_t kMinWindows = 10;
-
-Pose2d Between(const Pose2d& a, const Pose2d& b) {
-  const double c = std::cos(a.theta), s = std::sin(a.theta);
-  const double dx = b.x - a.x, dy = b.y - a.y;
-  return {c * dx + s * dy, -s * dx + c * dy, b.theta - a.theta};
-}
 
 // One run replayed once from the identity: the pose, time and odometry path at every sample
 // boundary (index k: after k samples).

@@ -7,7 +7,6 @@
 #include <cmath>
 #include <memory>
 
-#include "models/pose_errors.h"
 
 namespace fitcal {
 namespace {

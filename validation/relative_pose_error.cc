@@ -60,22 +60,7 @@ std::vector<RelativePoseErrorWindow> RelativePoseErrorRun::Windows(double length
 }
 
 void RelativePoseErrorRun::Add(double length_m, RelativePoseErrorSum* sum) const {
-  ForEachWindow(length_m, [sum](const RelativePoseErrorWindow& w) {
-    sum->translation_ratio_sum += w.translation_ratio;
-    sum->rotation_rad_per_m_sum += w.rotation_rad_per_m;
-    ++sum->windows;
-  });
-}
-
-std::vector<RelativePoseErrorWindow> RelativePoseErrorWindows(
-    const std::vector<Pose2d>& ground_truth, const std::vector<Pose2d>& odometry, double length_m) {
-  return RelativePoseErrorRun(ground_truth, odometry).Windows(length_m);
-}
-
-void AddRelativePoseErrors(const std::vector<Pose2d>& ground_truth,
-                           const std::vector<Pose2d>& odometry, double length_m,
-                           RelativePoseErrorSum* sum) {
-  RelativePoseErrorRun(ground_truth, odometry).Add(length_m, sum);
+  ForEachWindow(length_m, [sum](const RelativePoseErrorWindow& w) { sum->Add(w); });
 }
 
 std::vector<double> RelativePoseErrorLengths(double median_path_length_m) {

@@ -16,10 +16,22 @@
 
 namespace fitcal {
 
+// One window of one run: samples start..end of the run, the errors of E above.
+struct RelativePoseErrorWindow {
+  std::size_t start = 0, end = 0;
+  double translation_ratio = 0.0;  // |t(E)| / length (unitless; x 100 for %)
+  double rotation_rad_per_m = 0.0;  // |wrap(theta(E))| / length
+};
+
 struct RelativePoseErrorSum {
   int windows = 0;
   double translation_ratio_sum = 0.0;  // sum of |t(E)| / length (unitless)
   double rotation_rad_per_m_sum = 0.0;
+  void Add(const RelativePoseErrorWindow& w) {
+    translation_ratio_sum += w.translation_ratio;
+    rotation_rad_per_m_sum += w.rotation_rad_per_m;
+    ++windows;
+  }
   double MeanTranslationPercent() const {
     return windows > 0 ? 100.0 * translation_ratio_sum / windows : 0.0;
   }
@@ -28,23 +40,18 @@ struct RelativePoseErrorSum {
   }
 };
 
-// One window of one run: samples start..end of the run, the errors of E above.
-struct RelativePoseErrorWindow {
-  std::size_t start = 0, end = 0;
-  double translation_ratio = 0.0;  // |t(E)| / length (unitless; x 100 for %)
-  double rotation_rad_per_m = 0.0;  // |wrap(theta(E))| / length
-};
-
 // One run's poses prepared for windows of any length: the ground truth's path length from its
 // first sample and each pose's heading as (cos, sin), computed once for every length (a window
-// needs them at its start; each length's windows start at most samples). The windows' numbers are
-// those of the functions below bit for bit: the same operations on the same values.
+// needs them at its start; each length's windows start at most samples).
 class RelativePoseErrorRun {
  public:
-  // The poses must outlive this; the run is the first min(sizes) samples of both.
+  // Poses at the same times, in any one world frame each; they must outlive this. The run is the
+  // first min(sizes) samples of both.
   RelativePoseErrorRun(const std::vector<Pose2d>& ground_truth,
                        const std::vector<Pose2d>& odometry);
 
+  // Every window (the pictures draw them one by one; their sum is the mean). Runs shorter than
+  // length_m have none.
   std::vector<RelativePoseErrorWindow> Windows(double length_m) const;
   void Add(double length_m, RelativePoseErrorSum* sum) const;
 
@@ -62,16 +69,6 @@ class RelativePoseErrorRun {
   std::vector<double> path_m_;  // ground-truth path length from sample 0
   std::vector<Heading> ground_truth_heading_, odometry_heading_;
 };
-
-// Every window of one run (the pictures draw them one by one; the sum below is their mean).
-std::vector<RelativePoseErrorWindow> RelativePoseErrorWindows(
-    const std::vector<Pose2d>& ground_truth, const std::vector<Pose2d>& odometry, double length_m);
-
-// Adds the windows of one run: `ground_truth` and `odometry` are poses at the same times, in any
-// one world frame each. Runs shorter than length_m add nothing.
-void AddRelativePoseErrors(const std::vector<Pose2d>& ground_truth,
-                           const std::vector<Pose2d>& odometry, double length_m,
-                           RelativePoseErrorSum* sum);
 
 // Window lengths for runs of this median path length: the largest three of 0.25, 0.5, 1, 2, 5,
 // 10, 20, 50, 100 m that fit twice into it (so that every run holds windows of each).

@@ -233,38 +233,53 @@ void AddStatistics(const EvaluatedRuns& e, io::ReportData* data) {
   }
 }
 
-// The drift lengths of the report: those suited to these runs (RelativePoseErrorLengths of the
-// median path length) and the everyday 1, 2 and 5 m wherever some run is long enough for them.
-std::vector<double> DriftLengths(const EvaluatedRuns& e, const io::ReportData& data) {
-  std::vector<double> lengths;
-  for (const io::ReportRun& r : data.runs) lengths.push_back(r.path_length_m);
-  std::set<double> out;
-  for (double l : RelativePoseErrorLengths(Summarize(lengths).median)) out.insert(l);
-  for (double l : {1.0, 2.0, 5.0}) {
-    for (const TrajectoryErrors& b : e.before) {
-      if (!RelativePoseErrorWindows(b.ground_truth, b.odometry, l).empty()) {
-        out.insert(l);
-        break;
-      }
-    }
+// One drift length's windows of every validation run (validation/relative_pose_error.h), before
+// and after calibration: computed once, read by the drift table and the never-worse judgement.
+struct DriftWindows {
+  double length_m = 0.0;
+  std::vector<std::vector<RelativePoseErrorWindow>> before, after;  // per run
+};
+
+// The report's drift lengths: those suited to these runs (RelativePoseErrorLengths of the median
+// path length) and the everyday 1, 2 and 5 m wherever some run is long enough for them.
+std::vector<DriftWindows> DriftWindowsOf(const EvaluatedRuns& e, const io::ReportData& data) {
+  std::vector<double> path_lengths;
+  for (const io::ReportRun& r : data.runs) path_lengths.push_back(r.path_length_m);
+  const std::vector<double> suited = RelativePoseErrorLengths(Summarize(path_lengths).median);
+  std::set<double> lengths(suited.begin(), suited.end());
+  lengths.insert({1.0, 2.0, 5.0});
+  std::vector<RelativePoseErrorRun> before, after;
+  for (std::size_t i = 0; i < e.before.size(); ++i) {
+    before.emplace_back(e.before[i].ground_truth, e.before[i].odometry);
+    after.emplace_back(e.after[i].ground_truth, e.after[i].odometry);
   }
-  return {out.begin(), out.end()};
+  std::vector<DriftWindows> out;
+  for (double length : lengths) {
+    DriftWindows d{length, {}, {}};
+    bool some_run_long_enough = false;
+    for (std::size_t i = 0; i < before.size(); ++i) {
+      d.before.push_back(before[i].Windows(length));
+      d.after.push_back(after[i].Windows(length));
+      some_run_long_enough = some_run_long_enough || !d.before.back().empty();
+    }
+    const bool is_suited = std::find(suited.begin(), suited.end(), length) != suited.end();
+    if (is_suited || some_run_long_enough) out.push_back(std::move(d));
+  }
+  return out;
 }
 
-// Relative pose error (validation/relative_pose_error.h): the mean over every window of every
-// validation run, and each window for the box plots.
-void AddDrift(const EvaluatedRuns& e, io::ReportData* data) {
-  for (double length : DriftLengths(e, *data)) {
+// Relative pose error: the mean over every window of every validation run, and each window for
+// the box plots.
+void AddDrift(const std::vector<DriftWindows>& drift, io::ReportData* data) {
+  for (const DriftWindows& d : drift) {
     io::ReportDriftRow row;
-    row.length_m = length;
+    row.length_m = d.length_m;
     RelativePoseErrorSum before, after;
-    for (std::size_t i = 0; i < e.before.size(); ++i) {
-      AddRelativePoseErrors(e.before[i].ground_truth, e.before[i].odometry, length, &before);
-      AddRelativePoseErrors(e.after[i].ground_truth, e.after[i].odometry, length, &after);
-      const auto wb =
-          RelativePoseErrorWindows(e.before[i].ground_truth, e.before[i].odometry, length);
-      const auto wa =
-          RelativePoseErrorWindows(e.after[i].ground_truth, e.after[i].odometry, length);
+    for (std::size_t i = 0; i < d.before.size(); ++i) {
+      const std::vector<RelativePoseErrorWindow>& wb = d.before[i];
+      const std::vector<RelativePoseErrorWindow>& wa = d.after[i];
+      for (const RelativePoseErrorWindow& w : wb) before.Add(w);
+      for (const RelativePoseErrorWindow& w : wa) after.Add(w);
       for (std::size_t k = 0; k < std::min(wb.size(), wa.size()); ++k) {
         row.before_translation_percent_windows.push_back(100.0 * wb[k].translation_ratio);
         row.after_translation_percent_windows.push_back(100.0 * wa[k].translation_ratio);
@@ -282,11 +297,21 @@ void AddDrift(const EvaluatedRuns& e, io::ReportData* data) {
   }
 }
 
+// One run's drift at one length, as the never-worse judgement reads it.
+void AddRunDrift(const std::vector<RelativePoseErrorWindow>& windows, DriftAtLength* drift) {
+  RelativePoseErrorSum sum;
+  for (const RelativePoseErrorWindow& w : windows) sum.Add(w);
+  drift->per_run_translation_percent.push_back(sum.MeanTranslationPercent());
+  drift->per_run_windows.push_back(sum.windows);
+  drift->windows += sum.windows;
+}
+
 // fit's never-worse judgement (validation/never_worse.h) on the report's runs and drift lengths:
 // the drift rows that rose say whether the runs' scatter explains it, and every measure and
 // family worse than the nominal, beyond the scatter or by more than 5 % within it, is one line
 // (issue 42: a circles-only fit's squares drifted 13 % more at 1 m, unsaid).
-void AddNeverWorse(const EvaluatedRuns& e, io::ReportData* data) {
+void AddNeverWorse(const EvaluatedRuns& e, const std::vector<DriftWindows>& drift,
+                   io::ReportData* data) {
   EverydayDrivingMetrics before, after;
   for (std::size_t i = 0; i < e.before.size(); ++i) {
     before.per_run_cf.push_back(e.before[i].cf);
@@ -294,18 +319,11 @@ void AddNeverWorse(const EvaluatedRuns& e, io::ReportData* data) {
     before.per_run_ate_m.push_back(e.before[i].rms_distance_m);
     after.per_run_ate_m.push_back(e.after[i].rms_distance_m);
   }
-  for (const io::ReportDriftRow& row : data->drift) {
-    DriftAtLength b{row.length_m}, a{row.length_m};
-    for (std::size_t i = 0; i < e.before.size(); ++i) {
-      RelativePoseErrorSum sb, sa;
-      AddRelativePoseErrors(e.before[i].ground_truth, e.before[i].odometry, row.length_m, &sb);
-      AddRelativePoseErrors(e.after[i].ground_truth, e.after[i].odometry, row.length_m, &sa);
-      b.per_run_translation_percent.push_back(sb.MeanTranslationPercent());
-      a.per_run_translation_percent.push_back(sa.MeanTranslationPercent());
-      b.per_run_windows.push_back(sb.windows);
-      a.per_run_windows.push_back(sa.windows);
-      b.windows += sb.windows;
-      a.windows += sa.windows;
+  for (const DriftWindows& d : drift) {
+    DriftAtLength b{d.length_m}, a{d.length_m};
+    for (std::size_t i = 0; i < d.before.size(); ++i) {
+      AddRunDrift(d.before[i], &b);
+      AddRunDrift(d.after[i], &a);
     }
     before.drift.push_back(std::move(b));
     after.drift.push_back(std::move(a));
@@ -599,8 +617,9 @@ io::ReportData BuildReportData(const ReportBuildOptions& options, const ReportIn
   AddBiasAndErrorBands(&data);
   AddGroupRows(e, &data);
   AddStatistics(e, &data);
-  AddDrift(e, &data);
-  AddNeverWorse(e, &data);
+  const std::vector<DriftWindows> drift = DriftWindowsOf(e, data);
+  AddDrift(drift, &data);
+  AddNeverWorse(e, drift, &data);
   std::vector<double> sigma;
   bool has_sigma = false;
   AddUncertainty(in, cal, training, options.threads, &data, &sigma, &has_sigma);
