@@ -15,9 +15,8 @@ namespace {
 // not written by fit. The last digit of a written value may round past it.
 constexpr double kMaxRecordedClockOffsetS = 0.5 + 1e-9;
 
-// The block, or a null node for a plain robot YAML.
-YAML::Node CalibrationNode(const std::string& path) {
-  const YAML::Node root = LoadYamlFile(path);
+// The block of a parsed file, or a null node for a plain robot YAML.
+YAML::Node CalibrationNode(const YAML::Node& root, const std::string& path) {
   ExpectYamlType(root, YAML::NodeType::Map, path, "robot");
   const YAML::Node block = root["calibration"];
   if (!block || block.IsNull()) return YAML::Node();
@@ -209,11 +208,7 @@ void ReadClockOffsets(const YAML::Node& block, const std::string& path, Calibrat
   }
 }
 
-}  // namespace
-
-std::optional<std::vector<int>> ReadCalibrationTrainingRepetitions(const std::string& path) {
-  const YAML::Node block = CalibrationNode(path);
-  if (!block || block.IsNull()) return std::nullopt;
+std::vector<int> TrainingRepetitions(const YAML::Node& block, const std::string& path) {
   const YAML::Node reps = block["training_repetitions"];
   if (!reps) {
     throw InputError(InputErrorKind::kMissingKey, path, block.Mark().line + 1,
@@ -222,15 +217,26 @@ std::optional<std::vector<int>> ReadCalibrationTrainingRepetitions(const std::st
   return Repetitions(reps, path);
 }
 
+}  // namespace
+
+std::optional<std::vector<int>> ReadCalibrationTrainingRepetitions(const std::string& path) {
+  const YAML::Node block = CalibrationNode(LoadYamlFile(path), path);
+  if (!block || block.IsNull()) return std::nullopt;
+  return TrainingRepetitions(block, path);
+}
+
 std::optional<CalibrationProvenance> ReadCalibrationProvenance(const std::string& path) {
-  const YAML::Node block = CalibrationNode(path);
+  return ReadCalibrationProvenance(LoadYamlFile(path), path);
+}
+
+std::optional<CalibrationProvenance> ReadCalibrationProvenance(const YAML::Node& root,
+                                                               const std::string& path) {
+  const YAML::Node block = CalibrationNode(root, path);
   if (!block || block.IsNull()) return std::nullopt;
   RejectKeysNoWriterWrites(block, path);
   CalibrationProvenance p;
   p.path = path;
-  if (const std::optional<std::vector<int>> reps = ReadCalibrationTrainingRepetitions(path)) {
-    p.training_repetitions = *reps;
-  }
+  p.training_repetitions = TrainingRepetitions(block, path);
   p.method = OptionalString(block, "method", path);
   p.dataset = OptionalString(block, "dataset", path);
   p.termination = OptionalString(block, "termination", path);

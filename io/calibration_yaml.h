@@ -10,6 +10,10 @@
 
 #include "odometry/robot.h"
 
+namespace YAML {
+class Node;
+}  // namespace YAML
+
 namespace fitcal::io {
 
 // The recorded training repetitions, or nullopt when the file has no calibration block (a plain
@@ -49,6 +53,9 @@ struct CalibrationProvenance {
 
 // nullopt for a plain robot YAML; InputError (file, line) for a malformed block.
 std::optional<CalibrationProvenance> ReadCalibrationProvenance(const std::string& path);
+// The same from the file's parsed `root` (a reader that has it need not parse it again).
+std::optional<CalibrationProvenance> ReadCalibrationProvenance(const YAML::Node& root,
+                                                               const std::string& path);
 
 // The recorded sigmas matched to `parameters` by their written key, in SI units and rad: a
 // recorded key names its parameter and display unit, "<name>_<unit>", or for the omni3 file,
