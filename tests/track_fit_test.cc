@@ -70,6 +70,27 @@ Simulated SimulateLoops(const RobotModelInterface& model, int repetitions) {
   return s;
 }
 
+// One run's track cost twice, without and with an OdometryMemo: the memo's answers must be the
+// plain cost's own. Built in place: `memoised` keeps the memo's address.
+struct PlainAndMemoisedCosts {
+  PlainAndMemoisedCosts(const TrackCheckpoints& track, const RobotModelInterface& model,
+                        const TrackResidualOptions& options)
+      : plain(TrackResidual::Create(track, model, ResidualWeights{}, options)),
+        memoised(TrackResidual::Create(track, model, ResidualWeights{}, options, &memo)) {}
+  PlainAndMemoisedCosts(const PlainAndMemoisedCosts&) = delete;
+  PlainAndMemoisedCosts& operator=(const PlainAndMemoisedCosts&) = delete;
+
+  const TrackResidual& PlainResidual() const {
+    return static_cast<const TrackResidual&>(*plain);
+  }
+  const TrackResidual& MemoisedResidual() const {
+    return static_cast<const TrackResidual&>(*memoised);
+  }
+
+  OdometryMemo memo;
+  std::unique_ptr<ceres::CostFunction> plain, memoised;
+};
+
 ModelFitOptions FitOptions(ResidualKind kind, const TrackFitData* track) {
   ModelFitOptions o;
   o.residuals = kind;
@@ -143,20 +164,16 @@ TEST(TrackResidual, OdometryMemoAnswersTheCostsOwnNumbersBitForBit) {
   const TrackFitData data =
       MakeTrackFitData(s.aligned, s.tracks, ClockGrouping::kPerRun, track_options);
   for (const TrackCheckpoints& track : data.runs) {
-    OdometryMemo memo;
-    std::unique_ptr<ceres::CostFunction> plain(
-        TrackResidual::Create(track, *model, ResidualWeights{}, data.options));
-    std::unique_ptr<ceres::CostFunction> memoised(
-        TrackResidual::Create(track, *model, ResidualWeights{}, data.options, &memo));
-    const int m = plain->num_residuals();
+    const PlainAndMemoisedCosts costs(track, *model, data.options);
+    const int m = costs.plain->num_residuals();
     const auto same_bits = [&](std::vector<double> p, double dt, bool with_jacobians) {
       std::vector<double> r[2], j_p[2], j_dt[2];
-      const ceres::CostFunction* costs[2] = {plain.get(), memoised.get()};
+      const ceres::CostFunction* both[2] = {costs.plain.get(), costs.memoised.get()};
       for (int c = 0; c < 2; ++c) {
         r[c].assign(m, 0.0), j_p[c].assign(m * 3, 0.0), j_dt[c].assign(m, 0.0);
         const double* parameters[] = {p.data(), &dt};
         double* jacobians[] = {j_p[c].data(), j_dt[c].data()};
-        EXPECT_TRUE(costs[c]->Evaluate(parameters, r[c].data(),
+        EXPECT_TRUE(both[c]->Evaluate(parameters, r[c].data(),
                                        with_jacobians ? jacobians : nullptr));
       }
       return std::memcmp(r[0].data(), r[1].data(), m * sizeof(double)) == 0 &&
@@ -173,9 +190,8 @@ TEST(TrackResidual, OdometryMemoAnswersTheCostsOwnNumbersBitForBit) {
       EXPECT_TRUE(same_bits(p, -0.05, with_jacobians)) << track.run->id;       // replayed
     }
     // The search's odometry (OdometryFromStart) shares the memo of the residual-only requests.
-    const auto* residual = static_cast<const TrackResidual*>(memoised.get());
-    const auto* reference = static_cast<const TrackResidual*>(plain.get());
-    EXPECT_EQ(residual->OdometryFromStart(p.data()), reference->OdometryFromStart(p.data()));
+    EXPECT_EQ(costs.MemoisedResidual().OdometryFromStart(p.data()),
+              costs.PlainResidual().OdometryFromStart(p.data()));
   }
 }
 
@@ -190,27 +206,23 @@ TEST(TrackResidual, OdometryMemoAnswersTheCostAloneFromAnEvaluationWithJacobians
   const Simulated s = SimulateLoops(*model, 1);
   const TrackFitData data = MakeTrackFitData(s.aligned, s.tracks, ClockGrouping::kPerRun);
   for (const TrackCheckpoints& track : data.runs) {
-    OdometryMemo memo;
-    std::unique_ptr<ceres::CostFunction> plain(
-        TrackResidual::Create(track, *model, ResidualWeights{}, data.options));
-    std::unique_ptr<ceres::CostFunction> memoised(
-        TrackResidual::Create(track, *model, ResidualWeights{}, data.options, &memo));
-    const int m = plain->num_residuals();
+    const PlainAndMemoisedCosts costs(track, *model, data.options);
+    const OdometryMemo& memo = costs.memo;
+    const int m = costs.plain->num_residuals();
     std::vector<double> p = {0.0425, 0.0418, 0.203};
     double dt = 0.1234;
     std::vector<double> r(m), j_p(3 * m), j_dt(m), r_memo(m), r_plain(m);
     const double* parameters[] = {p.data(), &dt};
     double* jacobians[] = {j_p.data(), j_dt.data()};
-    ASSERT_TRUE(memoised->Evaluate(parameters, r.data(), jacobians));
+    ASSERT_TRUE(costs.memoised->Evaluate(parameters, r.data(), jacobians));
     ASSERT_EQ(memo.recalled(), 0);
     dt = -0.05;  // the offsets' search moves dt only
-    ASSERT_TRUE(memoised->Evaluate(parameters, r_memo.data(), nullptr));
+    ASSERT_TRUE(costs.memoised->Evaluate(parameters, r_memo.data(), nullptr));
     EXPECT_EQ(memo.recalled(), 1) << track.run->id << ": the replay ran again";
-    ASSERT_TRUE(plain->Evaluate(parameters, r_plain.data(), nullptr));
+    ASSERT_TRUE(costs.plain->Evaluate(parameters, r_plain.data(), nullptr));
     EXPECT_EQ(std::memcmp(r_memo.data(), r_plain.data(), m * sizeof(double)), 0) << track.run->id;
-    const auto* residual = static_cast<const TrackResidual*>(memoised.get());
-    const auto* reference = static_cast<const TrackResidual*>(plain.get());
-    EXPECT_EQ(residual->OdometryFromStart(p.data()), reference->OdometryFromStart(p.data()));
+    EXPECT_EQ(costs.MemoisedResidual().OdometryFromStart(p.data()),
+              costs.PlainResidual().OdometryFromStart(p.data()));
     EXPECT_EQ(memo.recalled(), 2) << track.run->id;
   }
 }
