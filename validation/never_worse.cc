@@ -204,7 +204,6 @@ EverydayDrivingComparison CompareEverydayDriving(const RobotModelInterface& mode
   return c;
 }
 
-
 std::vector<std::string> NeverWorseRefusals(const std::string& name,
                                             const std::vector<NeverWorseJudgement>& judgements,
                                             bool refusing) {
