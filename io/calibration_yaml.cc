@@ -219,12 +219,6 @@ std::vector<int> TrainingRepetitions(const YAML::Node& block, const std::string&
 
 }  // namespace
 
-std::optional<std::vector<int>> ReadCalibrationTrainingRepetitions(const std::string& path) {
-  const YAML::Node block = CalibrationNode(LoadYamlFile(path), path);
-  if (!block || block.IsNull()) return std::nullopt;
-  return TrainingRepetitions(block, path);
-}
-
 std::optional<CalibrationProvenance> ReadCalibrationProvenance(const std::string& path) {
   return ReadCalibrationProvenance(LoadYamlFile(path), path);
 }

@@ -16,10 +16,6 @@ class Node;
 
 namespace fitcal::io {
 
-// The recorded training repetitions, or nullopt when the file has no calibration block (a plain
-// robot YAML). Throws InputError (file, line) when the block is present but malformed.
-std::optional<std::vector<int>> ReadCalibrationTrainingRepetitions(const std::string& path);
-
 // What trained a calibration and how it ended. Keys a file written by an older fitcal lacks stay
 // empty (training_run_ids, training_trajectories, training_fingerprint, at_bound).
 struct CalibrationProvenance {

@@ -99,7 +99,8 @@ std::string ReadTextFile(const std::string& path) {
 }
 
 TextFileReader::TextFileReader(const std::string& path) : path_(path) {
-  fd_ = OpenRegularFile(path, &size_bytes_);
+  std::uint64_t size_bytes = 0;
+  fd_ = OpenRegularFile(path, &size_bytes);
   try {
     buffer_.resize(kBufferBytes);
   } catch (...) {

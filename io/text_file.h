@@ -35,7 +35,6 @@ class TextFileReader {
   // Next line (without its terminator), valid until the next call; false at the end.
   bool Next(std::string_view* line);
   int line_number() const { return line_number_; }
-  std::uint64_t size_bytes() const { return size_bytes_; }
   const std::string& path() const { return path_; }
   // Lines in the file (one pass over it, memchr speed), to reserve sample storage exactly; then
   // reading starts again at line 1.
@@ -47,7 +46,6 @@ class TextFileReader {
 
   std::string path_;
   int fd_ = -1;
-  std::uint64_t size_bytes_ = 0;
   std::vector<char> buffer_;
   std::size_t begin_ = 0;  // unread bytes are [begin_, end_)
   std::size_t end_ = 0;

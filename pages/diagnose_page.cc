@@ -16,6 +16,7 @@ namespace fitcal::io {
 
 namespace {
 
+using report_text::ChangePercentText;
 using report_text::kAfterColour;  // the calibration's colour, as on the report's page
 using report_text::kDeg;
 using report_text::Fmt;
@@ -155,9 +156,9 @@ void HtmlHeldOut(std::ostringstream& h, const DiagnosePageData& d) {
   }
   h << "<h2 id=\"heldout\">Before and after on the held-out runs</h2>\n<ul class=\"key\">"
     << "<li>CF (Eq. 14, mean over " << d.held_out.size() << " runs): <b>" << Fmt("%.4f", cf_b)
-    << " &rarr; " << Fmt("%.4f", cf_a) << "</b> (" << report_text::ChangePercentText(cf_b, cf_a) << ")</li>"
+    << " &rarr; " << Fmt("%.4f", cf_a) << "</b> (" << ChangePercentText(cf_b, cf_a) << ")</li>"
     << "<li>ATE RMSE (no alignment): <b>" << Fmt("%.1f", 1e3 * ate_b) << " &rarr; "
-    << Fmt("%.1f mm", 1e3 * ate_a) << "</b> (" << report_text::ChangePercentText(ate_b, ate_a) << ")</li><li"
+    << Fmt("%.1f mm", 1e3 * ate_a) << "</b> (" << ChangePercentText(ate_b, ate_a) << ")</li><li"
     << (worse > 0 ? " class=\"worse\"" : "")
     << ">held-out runs that got worse (CF or ATE rose): " << worse << " of " << d.held_out.size()
     << "</li></ul>\n<p>These are computed as <code>fitcal "
@@ -213,7 +214,8 @@ double HeldOutMean(const std::vector<DiagnoseHeldOutRun>& runs, double DiagnoseH
 
 std::string DiagnoseHtml(const DiagnosePageData& d) {
   std::ostringstream h;
-  h << PageHead("fitcal diagnose: " + d.level, "fitcal diagnose") << "<div class=\"banner " << (d.level == "EFFECTS_NAMED" ? "PASS" : "WARN")
+  h << PageHead("fitcal diagnose: " + d.level, "fitcal diagnose") << "<div class=\"banner "
+    << (d.level == "EFFECTS_NAMED" ? "PASS" : "WARN")
     << "\" id=\"verdict\">\n<h2>" << EscapeXml(d.level) << "</h2>\n<p>" << EscapeXml(d.conclusion)
     << "</p>\n</div>\n<p>Robot <b>" << EscapeXml(d.robot_name) << "</b> (" << EscapeXml(d.model)
     << "), data set <code>" << EscapeXml(d.dataset) << "</code>, " << EscapeXml(d.split)

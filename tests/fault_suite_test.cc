@@ -158,7 +158,6 @@ TEST(FaultSuiteTest, TruncatedAndGarbledCalibrationsAndAsocFilesFailInOneLine) {
        [&] {
          ReadRobotModelFile(cal.string());
          io::ReadCalibrationProvenance(cal.string());
-         io::ReadCalibrationTrainingRepetitions(cal.string());
        }},
       {asoc_index.robot_path, [&] { io::ReadAsocRobot(asoc_index.robot_path); }},
       {asoc_index.runs.front().encoders_path, [&] { LoadEverything(asoc); }},

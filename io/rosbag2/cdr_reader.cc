@@ -33,7 +33,6 @@ CdrReader::CdrReader(ByteView payload, std::string what)
     Fail("unsupported CDR encapsulation " + std::to_string(payload.data[0]) + "," +
          std::to_string(payload.data[1]) + " (only plain CDR big/little endian)");
   }
-  big_endian_ = payload.data[1] == 0x00;
   impl_ = std::make_unique<Impl>(payload);
   // Reads the header, switches endianness and restarts alignment after it.
   impl_->cdr.read_encapsulation();

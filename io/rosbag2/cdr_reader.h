@@ -30,7 +30,6 @@ class CdrReader {
   CdrReader(const CdrReader&) = delete;
   CdrReader& operator=(const CdrReader&) = delete;
 
-  bool big_endian() const { return big_endian_; }
   // Bytes not yet read (trailing alignment padding included).
   std::size_t remaining() const;
 
@@ -63,7 +62,6 @@ class CdrReader {
   std::unique_ptr<Impl> impl_;
   std::string what_;
   std::size_t size_;
-  bool big_endian_ = false;
 };
 
 template <>

@@ -98,7 +98,6 @@ class McapStorage : public StorageReader {
   const std::vector<TopicInfo>& topics() const override { return topics_; }
   std::int64_t start_time_ns() const override { return start_ns_; }
   std::int64_t end_time_ns() const override { return end_ns_; }
-  const std::string& path() const override { return file_.path(); }
   bool Next(StoredMessage* message) override;
   // The blocks in file order, each one's messages in file order (before LoadBlock sorts them).
   std::optional<ClockStepBack> RecordingClockStepBack(

@@ -128,7 +128,6 @@ class Sqlite3Storage : public StorageReader {
   const std::vector<TopicInfo>& topics() const override { return topics_; }
   std::int64_t start_time_ns() const override { return start_ns_; }
   std::int64_t end_time_ns() const override { return end_ns_; }
-  const std::string& path() const override { return path_; }
   bool Next(StoredMessage* message) override;
   // Write order is the messages table's id order (rosbag2 inserts them as they arrive).
   std::optional<ClockStepBack> RecordingClockStepBack(

@@ -53,8 +53,6 @@ class StorageReader {
   virtual std::int64_t end_time_ns() const = 0;
   // The next message by time (ties: file order); false after the last one.
   virtual bool Next(StoredMessage* message) = 0;
-  // The file this storage reads, for messages.
-  virtual const std::string& path() const = 0;
   // The first step back of a topic's recording time by more than kClockStepBackToleranceNs in
   // the file's own (write) order, if any; `latest_ns` (by topic name) carries each topic's
   // latest time from the files before it and is updated. Reads the file once more.
