@@ -93,10 +93,9 @@ void ExpectHeader(std::string_view line, const std::array<std::string_view, 4>& 
                   const std::string& path, int line_number) {
   const std::vector<std::string> fields = SplitCsvFields(line);
   if (!std::equal(fields.begin(), fields.end(), names.begin(), names.end())) {
-    std::string expected;
-    for (const auto& name : names) expected += (expected.empty() ? "" : ",") + std::string(name);
-    throw InputError(InputErrorKind::kBadHeader, path, line_number,
-                     "header must be '" + expected + "', found '" + std::string(line) + "'");
+    throw InputError(
+        InputErrorKind::kBadHeader, path, line_number,
+        "header must be '" + Joined(names, ",") + "', found '" + std::string(line) + "'");
   }
 }
 

@@ -1,7 +1,7 @@
 #pragma once
 // Reading text files: whole (small files: YAML), or line by line as they stream (logs, which can
-// be larger than the memory their samples need twice), and the line/field scanning shared by the
-// CSV and TUM loaders.
+// be larger than the memory their samples need twice), the line/field scanning shared by the
+// CSV and TUM loaders, and its inverse: items joined into one text.
 
 #include <cstddef>
 #include <cstdint>
@@ -75,5 +75,23 @@ bool ParseDouble(std::string_view field, double* value, bool* finite);
 std::string_view Trim(std::string_view s);
 // The comma-separated fields of one line, each trimmed ("a, b," -> "a", "b", "").
 std::vector<std::string> SplitCsvFields(std::string_view line);
+
+// The text of each item, `separator` between them: a message's list of names ("a, b, c"), the
+// elements of a JSON list or map.
+template <typename Items, typename Text>
+std::string Joined(const Items& items, const char* separator, const Text& text) {
+  std::string out;
+  bool first = true;
+  for (const auto& item : items) {
+    out += (first ? "" : separator) + text(item);
+    first = false;
+  }
+  return out;
+}
+// Items that are text already (strings, string views, C strings).
+template <typename Items>
+std::string Joined(const Items& items, const char* separator) {
+  return Joined(items, separator, [](const auto& item) { return std::string(item); });
+}
 
 }  // namespace fitcal::io

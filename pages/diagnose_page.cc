@@ -5,12 +5,13 @@
 #include <cstdio>
 #include <sstream>
 
+#include "io/text_file.h"
+#include "odometry/text_format.h"
 #include "pages/final_error_plot.h"
 #include "pages/report_html.h"
 #include "pages/report_json.h"
 #include "pages/report_text.h"
 #include "pages/svg_plot.h"
-#include "odometry/text_format.h"
 
 namespace fitcal::io {
 

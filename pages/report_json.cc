@@ -2,6 +2,7 @@
 
 #include <sstream>
 
+#include "io/text_file.h"
 #include "odometry/text_format.h"
 #include "pages/report_text.h"
 

@@ -17,18 +17,6 @@ std::string JsonNumber(double v);
 inline std::string JsonBool(bool b) { return b ? "true" : "false"; }
 std::string JsonBeforeAfter(double before, double after);
 
-// The text of each item, `separator` between them (the elements of a JSON list or map).
-template <typename Items, typename Text>
-std::string Joined(const Items& items, const char* separator, const Text& text) {
-  std::string out;
-  bool first = true;
-  for (const auto& item : items) {
-    out += (first ? "" : separator) + text(item);
-    first = false;
-  }
-  return out;
-}
-
 // The layout version of metrics.json (docs/metrics_json.md): raised when a key changes meaning
 // or disappears; keys may be added within a version.
 constexpr int kMetricsJsonVersion = 2;

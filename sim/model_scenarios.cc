@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "io/command_failure.h"
+#include "io/text_file.h"
 #include "models/model_registry.h"
 
 namespace fitcal::sim {
@@ -18,9 +19,7 @@ std::string ModelNamesWith(const std::function<bool(const ModelExtras&)>& has) {
     if (has(m.extras)) names.push_back(m.name);
   }
   std::sort(names.begin(), names.end());
-  std::string out;
-  for (const std::string& name : names) out += (out.empty() ? "" : ", ") + name;
-  return out;
+  return io::Joined(names, ", ");
 }
 
 // The stepped physics' own settings (ScenarioNoise: slip, injected effects), refused for a

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "io/input_error.h"
+#include "io/text_file.h"
 #include "models/diff_drive/diff_drive_model.h"
 #include "models/omni/omni_model.h"
 #include "models/omni3/omni3_robot_model.h"
@@ -176,11 +177,11 @@ constexpr struct {
 }  // namespace
 
 const RobotKind& RobotKindOf(const std::string& type, const std::string& session) {
-  std::string known;
   for (const RobotKind& robot : kRobots) {
     if (type == robot.type) return robot;
-    known += (known.empty() ? "" : ", ") + std::string(robot.type);
   }
+  const std::string known =
+      io::Joined(kRobots, ", ", [](const RobotKind& r) { return std::string(r.type); });
   throw io::InputError(
       io::InputErrorKind::kUnknownModel, session, 0,
       "type '" + type + "' is not an OptiOdom robot fitcal imports (" + known + ")");

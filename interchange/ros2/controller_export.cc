@@ -50,9 +50,8 @@ ControllerEntry FindController(const std::string& name) {
     }
   }
   if (entry.writers.empty()) {
-    std::string known;
-    for (const std::string& c : Ros2Controllers()) known += (known.empty() ? "" : ", ") + c;
-    throw UsageError("unknown controller '" + name + "' (fitcal writes " + known + ")");
+    throw UsageError("unknown controller '" + name + "' (fitcal writes " +
+                     io::Joined(Ros2Controllers(), ", ") + ")");
   }
   return entry;
 }
@@ -71,17 +70,13 @@ const ControllerWriteFn* WriterFor(const ControllerEntry& e, const std::string& 
 
 // "omni3 omni": the models that take the controller, for the mismatch message.
 std::string ModelsTaking(const ControllerEntry& e) {
-  std::string out;
-  for (const auto& writer : e.writers) out += (out.empty() ? "" : " ") + writer.first;
-  return out;
+  return io::Joined(e.writers, " ", [](const auto& writer) { return writer.first; });
 }
 
 void CheckDistro(const ControllerEntry& e, const std::string& distro) {
   const std::vector<std::string>& all = RosDistros();
   if (std::find(all.begin(), all.end(), distro) == all.end()) {
-    std::string known;
-    for (const std::string& d : all) known += (known.empty() ? "" : ", ") + d;
-    throw UsageError("--ros-distro '" + distro + "' is not one of " + known);
+    throw UsageError("--ros-distro '" + distro + "' is not one of " + io::Joined(all, ", "));
   }
   if (!InList(e.distros, distro)) {
     throw UsageError(e.name + " is not in ROS 2 " + distro + " (it ships in " +
@@ -138,10 +133,9 @@ Ros2ControlExport ExportRos2Control(const RobotModelPtr& calibrated,
   if (!c.robot().effects.empty()) {
     // Its parameters were fitted together with the effects, which the controller cannot apply:
     // alone they are worse than a calibration fitted without effects.
-    std::string names;
-    for (const effects::EffectValue& e : c.robot().effects) {
-      names += (names.empty() ? "" : ", ") + std::string(effects::Info(e.id).name);
-    }
+    const std::string names = io::Joined(
+        c.robot().effects, ", ",
+        [](const effects::EffectValue& e) { return std::string(effects::Info(e.id).name); });
     throw UsageError(calibration_path + ": the calibration carries effects (" + names + ") that " +
                      controller + " cannot apply; export a calibration fitted without effects");
   }

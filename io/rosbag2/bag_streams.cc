@@ -9,6 +9,7 @@
 #include "io/rosbag2/bag_reader.h"
 #include "io/rosbag2/errors.h"
 #include "io/rosbag2/ros_messages.h"
+#include "io/text_file.h"
 #include "odometry/text_format.h"
 
 namespace fitcal::io::rosbag2 {
@@ -35,8 +36,7 @@ const TopicInfo& RequireTopic(const BagReader& bag, const std::string& bag_path,
                               const std::string& name, const std::string& role) {
   const TopicInfo* topic = bag.FindTopic(name);
   if (topic == nullptr) {
-    std::string have;
-    for (const TopicInfo& t : bag.topics()) have += (have.empty() ? "" : ", ") + t.name;
+    const std::string have = Joined(bag.topics(), ", ", [](const TopicInfo& t) { return t.name; });
     ThrowBagError(InputErrorKind::kMissingKey, bag_path,
                   role + " topic " + Printable(name) +
                       " is not in the bag (topics: " + Printable(have, 160) + ")");
@@ -155,12 +155,12 @@ class JointCollector {
   // After the last message: a topic on which no message carried the robot's joints.
   void Finish(const std::string& bag_path) const {
     if (!out_->t_ns.empty() || skipped_ == 0) return;
-    std::string have;
-    for (const std::string& n : first_skipped_names_) have += (have.empty() ? "" : ", ") + n;
     ThrowBagError(InputErrorKind::kMissingKey, bag_path,
-                  "joint " + Printable(request_.joints[0]) + " is not in the message (none of the " +
-                      std::to_string(skipped_) + " messages on " + Printable(request_.joint_topic) +
-                      " carries the robot's joints; names: " + Printable(have, 160) +
+                  "joint " + Printable(request_.joints[0]) +
+                      " is not in the message (none of the " + std::to_string(skipped_) +
+                      " messages on " + Printable(request_.joint_topic) +
+                      " carries the robot's joints; names: " +
+                      Printable(Joined(first_skipped_names_, ", "), 160) +
                       "); --joints names them in the robot's order");
   }
 
@@ -184,11 +184,10 @@ class JointCollector {
       std::size_t k = 0;
       while (k < js.name.size() && js.name[k] != request_.joints[j]) ++k;
       if (k == js.name.size()) {
-        std::string have;
-        for (const std::string& n : js.name) have += (have.empty() ? "" : ", ") + n;
         ThrowBagError(InputErrorKind::kMissingKey, Describe(m),
                       "joint " + Printable(request_.joints[j]) + " is not in the message (names: " +
-                          Printable(have, 160) + "); --joints names them in the robot's order");
+                          Printable(Joined(js.name, ", "), 160) +
+                          "); --joints names them in the robot's order");
       }
       index_[j] = k;
     }
