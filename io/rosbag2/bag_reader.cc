@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <iterator>
 #include <limits>
+#include <map>
 #include <string>
 
 #include "io/rosbag2/errors.h"
@@ -171,14 +172,17 @@ bool BagReader::Advance(std::size_t file_index) {
 
 std::optional<ClockStepBack> BagReader::RecordingClockStepBack(std::string* file) {
   std::map<std::string, std::int64_t> latest_ns;  // by topic, over the files in split order
-  for (std::size_t i = 0; i < storages_.size(); ++i) {
+  std::optional<ClockStepBack> step;
+  for (std::size_t i = 0; i < storages_.size() && !step; ++i) {
     *file = files_[i];
-    if (const std::optional<ClockStepBack> step =
-            storages_[i]->RecordingClockStepBack(&latest_ns)) {
-      return step;
-    }
+    storages_[i]->VisitInWriteOrder([&](std::size_t topic_index, std::int64_t t) {
+      const auto [it, first] = latest_ns.emplace(topics_[topic_map_[i][topic_index]].name, t);
+      if (!first && t < it->second - kClockStepBackToleranceNs) step = ClockStepBack{it->second, t};
+      it->second = std::max(it->second, t);
+      return !step;
+    });
   }
-  return std::nullopt;
+  return step;
 }
 
 // A k-way merge of the files, each already in time order. Only the file whose message went out

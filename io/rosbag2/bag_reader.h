@@ -14,6 +14,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,18 @@
 #include "io/rosbag2/storage.h"
 
 namespace fitcal::io::rosbag2 {
+
+// Where the recording time goes back in the order the recorder wrote the messages (a clock
+// stepped back while it recorded): the latest time written before and the time written after.
+struct ClockStepBack {
+  std::int64_t before_ns = 0;
+  std::int64_t after_ns = 0;
+};
+
+// A recorder writes each topic's messages in the order it received them (a converter may write
+// one topic after another, so only a topic's own order counts); several threads can swap two by
+// a fraction of a millisecond. A step back by more than this is the clock's.
+constexpr std::int64_t kClockStepBackToleranceNs = 10000000;  // 10 ms
 
 struct BagMessage {
   const TopicInfo* topic = nullptr;   // into BagReader::topics()

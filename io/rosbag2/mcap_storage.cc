@@ -100,21 +100,15 @@ class McapStorage : public StorageReader {
   std::int64_t end_time_ns() const override { return end_ns_; }
   bool Next(StoredMessage* message) override;
   // The blocks in file order, each one's messages in file order (before LoadBlock sorts them).
-  std::optional<ClockStepBack> RecordingClockStepBack(
-      std::map<std::string, std::int64_t>* latest_ns) override {
+  void VisitInWriteOrder(const std::function<bool(std::size_t, std::int64_t)>& visit) override {
     for (std::size_t seq = 0; seq < blocks_.size(); ++seq) {
       if (blocks_[seq].message_count == 0) continue;
       // Held here: a range-for over a member of the temporary would outlive the block.
       const auto block = LoadBlock(seq, /*sorted=*/false);
       for (const Entry& e : block->entries) {
-        const auto [it, first] = latest_ns->emplace(topics_[e.topic_index].name, e.time_ns);
-        if (!first && e.time_ns < it->second - kClockStepBackToleranceNs) {
-          return ClockStepBack{it->second, e.time_ns};
-        }
-        it->second = std::max(it->second, e.time_ns);
+        if (!visit(e.topic_index, e.time_ns)) return;
       }
     }
-    return std::nullopt;
   }
 
  private:

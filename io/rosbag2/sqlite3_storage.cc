@@ -130,19 +130,13 @@ class Sqlite3Storage : public StorageReader {
   std::int64_t end_time_ns() const override { return end_ns_; }
   bool Next(StoredMessage* message) override;
   // Write order is the messages table's id order (rosbag2 inserts them as they arrive).
-  std::optional<ClockStepBack> RecordingClockStepBack(
-      std::map<std::string, std::int64_t>* latest_ns) override {
+  void VisitInWriteOrder(const std::function<bool(std::size_t, std::int64_t)>& visit) override {
     Statement in_write_order(db_.get(), "SELECT topic_id, timestamp FROM messages ORDER BY id",
                              path_);
     while (in_write_order.Step()) {
-      const std::string& topic =
-          topics_[TopicIndex(sqlite3_column_int64(in_write_order.get(), 0))].name;
-      const std::int64_t t = sqlite3_column_int64(in_write_order.get(), 1);
-      const auto [it, first] = latest_ns->emplace(topic, t);
-      if (!first && t < it->second - kClockStepBackToleranceNs) return ClockStepBack{it->second, t};
-      it->second = std::max(it->second, t);
+      const std::size_t topic = TopicIndex(sqlite3_column_int64(in_write_order.get(), 0));
+      if (!visit(topic, sqlite3_column_int64(in_write_order.get(), 1))) return;
     }
-    return std::nullopt;
   }
 
  private:

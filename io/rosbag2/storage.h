@@ -4,9 +4,8 @@
 // OpenSqlite3Storage (sqlite3_storage.h) and OpenMcapStorage (mcap_storage.h).
 
 #include <cstdint>
-#include <map>
+#include <functional>
 #include <memory>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,18 +29,6 @@ struct StoredMessage {
   ByteView payload;             // serialized message (CDR for rosbag2's default)
 };
 
-// Where the recording time goes back in the order the recorder wrote the messages (a clock
-// stepped back while it recorded): the latest time written before and the time written after.
-struct ClockStepBack {
-  std::int64_t before_ns = 0;
-  std::int64_t after_ns = 0;
-};
-
-// A recorder writes each topic's messages in the order it received them (a converter may write
-// one topic after another, so only a topic's own order counts); several threads can swap two by
-// a fraction of a millisecond. A step back by more than this is the clock's.
-constexpr std::int64_t kClockStepBackToleranceNs = 10000000;  // 10 ms
-
 class StorageReader {
  public:
   virtual ~StorageReader() = default;
@@ -53,11 +40,10 @@ class StorageReader {
   virtual std::int64_t end_time_ns() const = 0;
   // The next message by time (ties: file order); false after the last one.
   virtual bool Next(StoredMessage* message) = 0;
-  // The first step back of a topic's recording time by more than kClockStepBackToleranceNs in
-  // the file's own (write) order, if any; `latest_ns` (by topic name) carries each topic's
-  // latest time from the files before it and is updated. Reads the file once more.
-  virtual std::optional<ClockStepBack> RecordingClockStepBack(
-      std::map<std::string, std::int64_t>* latest_ns) = 0;
+  // Each message's topic (index into topics()) and recording time in the file's own (write)
+  // order, until `visit` returns false. Reads the file once more.
+  virtual void VisitInWriteOrder(
+      const std::function<bool(std::size_t topic_index, std::int64_t time_ns)>& visit) = 0;
 };
 
 }  // namespace fitcal::io::rosbag2
