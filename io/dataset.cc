@@ -284,16 +284,11 @@ void RejectCopiedRuns(const DatasetIndex& index, const std::vector<RunLog>& runs
 
 // A calibration needs motion: when no wheel turns in any run (or no ground truth moves), every
 // parameter is undetermined and a fit would return the nominal with sigma 0.
-constexpr double kTurningRadPerS = 0.01;  // the log reader's own threshold for "turning"
 constexpr double kMovedM = 1e-4;          // below any ground truth's noise
 
-bool WheelsTurn(const EncoderSamples& samples, const Robot& robot) {
-  for (const auto& s : samples) {
-    for (int c = 0; c < robot.NumChannels(); ++c) {
-      if (robot.channels[c].kind == ChannelKind::kWheelRate &&
-          std::abs(s.value[c]) > kTurningRadPerS)
-        return true;
-    }
+bool AnyWheelTurns(const EncoderSamples& samples, const Robot& robot) {
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    if (WheelsTurn(samples, k, robot)) return true;
   }
   return false;
 }
@@ -314,7 +309,7 @@ void RejectDataSetWithoutMotion(const DatasetIndex& index, const std::vector<Run
                                 const Robot& robot) {
   bool wheels = false, ground_truth = false;
   for (const RunLog& run : runs) {
-    wheels = wheels || WheelsTurn(run.encoders.samples, robot);
+    wheels = wheels || AnyWheelTurns(run.encoders.samples, robot);
     ground_truth = ground_truth || GroundTruthMoves(run.ground_truth);
   }
   const std::string n = std::to_string(runs.size());
@@ -339,7 +334,7 @@ constexpr double kTravelWithoutWheelsM = 0.2;
 void RejectRunsWithoutWheelMotion(const DatasetIndex& index, const std::vector<RunLog>& runs,
                                   const Robot& robot) {
   for (std::size_t i = 0; i < runs.size(); ++i) {
-    if (WheelsTurn(runs[i].encoders.samples, robot)) continue;
+    if (AnyWheelTurns(runs[i].encoders.samples, robot)) continue;
     const double reach_m = GroundTruthReach(runs[i].ground_truth);
     if (reach_m <= kTravelWithoutWheelsM) continue;
     throw InputError(InputErrorKind::kNoMotion, index.runs[i].encoders_path, 0,

@@ -387,16 +387,6 @@ double MedianIntervalS(const EncoderSamples& samples) {
   return dt[dt.size() / 2];
 }
 
-bool WheelsTurn(const EncoderSamples& samples, std::size_t k, const Robot& robot) {
-  if (k >= samples.size()) return false;
-  for (int c = 0; c < robot.NumChannels(); ++c) {
-    if (robot.channels[c].kind == ChannelKind::kWheelRate &&
-        std::abs(samples[k].value[c]) > kTurningRadPerS)
-      return true;
-  }
-  return false;
-}
-
 // Index of the first sample that is a gap while moving, or samples.size().
 std::size_t FindClockGap(const EncoderSamples& samples, const Robot& robot, double* median_s) {
   if (samples.size() < 3) return samples.size();
@@ -834,6 +824,16 @@ std::size_t FindCounterWrap(const EncoderLog& log, const Robot& robot, int* bits
 }
 
 }  // namespace
+
+bool WheelsTurn(const EncoderSamples& samples, std::size_t k, const Robot& robot) {
+  if (k >= samples.size()) return false;
+  for (int c = 0; c < robot.NumChannels(); ++c) {
+    if (robot.channels[c].kind == ChannelKind::kWheelRate &&
+        std::abs(samples[k].value[c]) > kTurningRadPerS)
+      return true;
+  }
+  return false;
+}
 
 EncoderLog ReadEncoderCsv(const std::string& path, const Robot& robot) {
   std::vector<bool> screened;

@@ -67,6 +67,10 @@ class EncoderRowConverter {
 // An absolute encoder's count as an angle (odometry/robot.h AngleEncoder), in (-pi, pi].
 double AngleOfCount(const AngleEncoder& encoder, double count);
 
+// Whether a wheel (a rate channel) turns faster than 0.01 rad/s in sample k (false past the end):
+// what the loaders call moving.
+bool WheelsTurn(const EncoderSamples& samples, std::size_t k, const Robot& robot);
+
 // Ground truth: CSV with header `t,x,y,theta` (s, m, m, rad), or a TUM trajectory
 // (`t x y z qx qy qz qw`, blank-separated, '#' comments) whose yaw is taken from the quaternion.
 GroundTruthTrack ReadGroundTruth(const std::string& path);
