@@ -44,7 +44,8 @@ bool PrepareData(const CalibrationRequest& r, const RobotModelInterface& model,
     *training_tracks = TrainingTracks(r.dataset, model.robot(), r.runs, out->split, &reason);
     if (!*training_tracks) return Refuse(out, 2, {reason});
   }
-  reason = PrepareTrackResiduals(r.method->name, out->split, &out->settings, &out->track_data);
+  reason = PrepareTrackResiduals(r.method->name, out->split.training, &out->settings,
+                                 &out->track_data);
   if (!reason.empty()) return Refuse(out, 2, {reason});
   return true;
 }

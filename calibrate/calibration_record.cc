@@ -2,9 +2,6 @@
 
 #include <string>
 
-#include "fitcal/version.h"
-#include "validation/training_runs.h"
-
 namespace fitcal {
 
 namespace {
@@ -14,24 +11,6 @@ std::string WeightsText(const CalibrationRequest& request, const NoiseLevels& le
   if (levels.estimated) return "weights from the data: " + NoiseLevelsText(levels);
   return "sigma_xy " + std::to_string(request.position_sigma_m) + " m, sigma_theta " +
          std::to_string(request.heading_sigma_deg) + " deg";
-}
-
-void RecordFitSource(const CalibrationRequest& request, const RunSplit& split,
-                     const std::string& method, const SelectedFit& fit,
-                     io::CalibrationSource* source) {
-  io::CalibrationSource& s = *source;
-  s.method = method;
-  s.objective = fit.objective + " (" + WeightsText(request, fit.noise_levels) + ")";
-  s.dataset = request.dataset;
-  s.tool_version = kVersion;
-  s.termination = fit.termination;
-  s.training_repetitions = split.training_repetitions;
-  s.validation_repetitions = split.validation_repetitions;
-  for (const AlignedRun& run : split.training) s.training_run_ids.push_back(run.id);
-  s.training_trajectories = request.train_trajectories;
-  s.training_fingerprint = TrainingFingerprint(request.runs, s.training_run_ids);
-  s.training_runs = static_cast<int>(split.training.size());
-  s.validation_runs = static_cast<int>(split.validation.size());
 }
 
 }  // namespace
@@ -45,7 +24,11 @@ io::CalibrationBlock MakeRecord(const CalibrationRequest& request, const RobotMo
   const CalibrationCandidate& nominal = candidates[0];
   const CalibrationCandidate& selected = candidates[gate.selected];
   io::CalibrationBlock r;
-  RecordFitSource(request, split, selected.name, selected_fit, &r);
+  r.method = selected.name;
+  r.objective =
+      selected_fit.objective + " (" + WeightsText(request, selected_fit.noise_levels) + ")";
+  r.termination = selected_fit.termination;
+  RecordTrainingRuns(request.dataset, request.runs, request.train_trajectories, split, &r);
   r.cf_training_before = errors(nominal, split.training).cf;
   r.cf_training_after = errors(selected, split.training).cf;
   r.cf_validation_before = errors(nominal, split.validation).cf;

@@ -147,7 +147,9 @@ std::vector<std::string> ChooseTrackObjectiveByTransfer(
     track_data->reset();
     full->reset();
     // The method fits tracks (this choice is made on track residuals only): no refusal here.
-    if (!PrepareTrackResiduals(method.name, split, settings, track_data).empty()) return {};
+    if (!PrepareTrackResiduals(method.name, split.training, settings, track_data).empty()) {
+      return {};
+    }
   }
   return TrackObjectiveJudgementLines(judgement);
 }
@@ -160,7 +162,8 @@ HalvesJudgement JudgeMethodOnHeldOutHalves(const FitMethod& method, int threads,
     FitMethodSettings fold_settings = settings;
     fold_settings.residuals_auto = false;  // the whole data's choice holds for its halves
     std::optional<TrackFitData> track_data;
-    if (!PrepareTrackResiduals(method.name, fold.split, &fold_settings, &track_data).empty()) {
+    if (!PrepareTrackResiduals(method.name, fold.split.training, &fold_settings, &track_data)
+             .empty()) {
       return std::nullopt;
     }
     const ModelFitResult fit = method.run_model(fold.split.training, model, fold_settings).fit;

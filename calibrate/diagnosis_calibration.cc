@@ -1,10 +1,9 @@
 #include "calibrate/diagnosis_calibration.h"
 
+#include "calibrate/calibration_record.h"
 #include "calibrate/checks_before_fitting.h"
 #include "fit/correlation.h"
-#include "fitcal/version.h"
 #include "validation/propagated_uncertainty.h"
-#include "validation/training_runs.h"
 
 namespace fitcal {
 
@@ -108,33 +107,18 @@ std::string ObjectiveOf(const DiagnoseChoice& choice) {
 
 // What the calibrated YAML records of the diagnosis: the chosen candidate, its objective, the
 // training and held-out runs, and the CF before and after on both.
-void RecordSource(const DiagnosisCalibrationRequest& request, const SplitOf<TrackRun>& split,
-                  const DiagnoseResult& result, const DiagnoseChoice& choice,
-                  io::CalibrationSource* source) {
-  io::CalibrationSource& s = *source;
-  s.method = "diagnose: " + choice.name;
-  s.objective = ObjectiveOf(choice);
-  s.dataset = request.dataset;
-  s.tool_version = kVersion;
-  s.termination = result.final_fit.termination;
-  s.training_repetitions = split.training_repetitions;
-  s.validation_repetitions = split.validation_repetitions;
-  for (const TrackRun& r : split.training) s.training_run_ids.push_back(r.aligned.id);
-  s.training_trajectories = request.train_trajectories;
-  s.training_fingerprint = TrainingFingerprint(*request.runs, s.training_run_ids);
-  s.training_runs = static_cast<int>(split.training.size());
-  s.validation_runs = static_cast<int>(split.validation.size());
-  s.cf_training_before = choice.cf_training_before;
-  s.cf_training_after = choice.cf_training_after;
-  s.cf_validation_before = choice.cf_before;
-  s.cf_validation_after = choice.cf_after;
-}
-
 io::CalibrationBlock MakeRecord(const DiagnosisCalibrationRequest& request, const Robot& robot,
                                 const SplitOf<TrackRun>& split, const DiagnoseResult& result,
                                 const DiagnoseChoice& choice) {
   io::CalibrationBlock block;
-  RecordSource(request, split, result, choice, &block);
+  block.method = "diagnose: " + choice.name;
+  block.objective = ObjectiveOf(choice);
+  block.termination = result.final_fit.termination;
+  RecordTrainingRuns(request.dataset, *request.runs, request.train_trajectories, split, &block);
+  block.cf_training_before = choice.cf_training_before;
+  block.cf_training_after = choice.cf_training_after;
+  block.cf_validation_before = choice.cf_before;
+  block.cf_validation_after = choice.cf_after;
   block.selected = choice.name;
   block.selected_on = "held-out runs (" + std::to_string(split.validation.size()) + ")";
   for (const HeldParameter& h : robot.held) block.held.push_back(robot.parameters[h.index].name);

@@ -27,11 +27,6 @@ std::string PrepareTrackResiduals(const std::string& method,
   return "";
 }
 
-std::string PrepareTrackResiduals(const std::string& method, const RunSplit& split,
-                                  FitMethodSettings* settings, std::optional<TrackFitData>* data) {
-  return PrepareTrackResiduals(method, split.training, settings, data);
-}
-
 std::string DegreesOfFreedomRefusal(const RunSplit& split, const FitMethodSettings& settings,
                                     const std::optional<TrackFitData>& track,
                                     std::size_t num_parameters) {

@@ -16,9 +16,6 @@ namespace fitcal {
 
 // The training runs' tracks for --residuals track/both, and auto resolved (settings->track points
 // into *data): "" when done, else why `method` cannot fit them (the caller refuses, exit 2).
-std::string PrepareTrackResiduals(const std::string& method, const RunSplit& split,
-                                  FitMethodSettings* settings, std::optional<TrackFitData>* data);
-// The same for the runs `training` (a fold's), without copying them into a split.
 std::string PrepareTrackResiduals(const std::string& method,
                                   const std::vector<AlignedRun>& training,
                                   FitMethodSettings* settings, std::optional<TrackFitData>* data);

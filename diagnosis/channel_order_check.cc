@@ -199,17 +199,8 @@ void DecideMiswiring(const MiswiringTest& test, MiswiringScores* scores) {
   msg << "the encoder columns look miswired: with " << test.describe_best()
       << " the runs are explained " << ratio << "x better (" << test.evidence << " " << s.best_ssr
       << " vs " << s.recorded_ssr << " as recorded; threshold " << s.threshold << " for "
-      << test.sample << "); fix the log or the robot YAML's " << test.order;
+      << test.sample << "); fix the log or the robot YAML's channel order";
   s.message = msg.str();
-}
-
-bool IsValidMiswiringOptions(double false_alarm_probability, const ResidualWeights& weights,
-                             std::string* error) {
-  if (!(false_alarm_probability > 0.0 && false_alarm_probability < 1.0))
-    return Invalid(error, "false_alarm_probability must be in (0, 1)");
-  if (!(weights.position_sigma_m > 0.0) || !(weights.heading_sigma_rad > 0.0))
-    return Invalid(error, "weights must be positive");
-  return true;
 }
 
 std::vector<AlignedRun> ApplyChannelMapping(const std::vector<AlignedRun>& runs,
@@ -249,7 +240,11 @@ std::string DescribeChannelMapping(const Robot& robot, const ChannelMapping& m) 
 }
 
 bool ChannelOrderOptions::IsValid(std::string* error) const {
-  return IsValidMiswiringOptions(false_alarm_probability, weights, error);
+  if (!(false_alarm_probability > 0.0 && false_alarm_probability < 1.0))
+    return Invalid(error, "false_alarm_probability must be in (0, 1)");
+  if (!(weights.position_sigma_m > 0.0) || !(weights.heading_sigma_rad > 0.0))
+    return Invalid(error, "weights must be positive");
+  return true;
 }
 
 namespace {
@@ -294,7 +289,6 @@ ChannelOrderReport CheckOrder(const std::vector<AlignedRun>& runs,
   test.describe_best = [&] { return DescribeChannelMapping(robot, report.best); };
   test.evidence = segments.empty() ? "final-pose SSR" : "segment SSR";
   test.sample = std::to_string(runs.size()) + " runs";
-  test.order = "channel order";
   DecideMiswiring(test, &report);
   return report;
 }

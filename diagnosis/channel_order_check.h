@@ -58,12 +58,7 @@ struct MiswiringTest {
   std::function<std::string()> describe_best;  // the best other mapping in words
   std::string evidence;                        // e.g. "final-pose SSR"
   std::string sample;                          // e.g. "36 runs"
-  std::string order;                           // what to fix in the robot YAML, e.g. "wheel order"
 };
-
-// The options this check and the channel-order check share: alpha in (0, 1), positive weights.
-bool IsValidMiswiringOptions(double false_alarm_probability, const ResidualWeights& weights,
-                             std::string* error);
 
 // The decision of the header on scores whose recorded_nominal_ssr and best_nominal_ssr are set:
 // fills the rest of *scores (both hypotheses fitted when the other beats the recorded one at the
@@ -96,7 +91,7 @@ struct ChannelOrderOptions {
   ResidualWeights weights;
   double false_alarm_probability = 1e-6;  // alpha above
   int num_threads = 0;
-  bool IsValid(std::string* error) const;
+  bool IsValid(std::string* error) const;  // alpha in (0, 1), positive weights
 };
 
 struct ChannelOrderReport : MiswiringScores {

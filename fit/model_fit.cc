@@ -34,15 +34,11 @@ bool UsesTracks(const ModelFitOptions& options) {
   return options.segments == nullptr && options.residuals != ResidualKind::kFinalPose;
 }
 
-// The weights of the track residuals (ModelFitOptions::track_weights, else the final poses').
-ResidualWeights TrackWeightsOf(const ModelFitOptions& options) {
-  return options.track_weights.value_or(options.ceres.weights);
-}
-
-// Run i's track and final-pose weights: its session's (weights_per_run) or the data set's.
+// Run i's track and final-pose weights: its session's (weights_per_run) or the data set's (for
+// the tracks ModelFitOptions::track_weights, else the final poses').
 ResidualWeights TrackWeightsOf(const ModelFitOptions& options, std::size_t i) {
   if (i < options.weights_per_run.size()) return options.weights_per_run[i].track;
-  return TrackWeightsOf(options);
+  return options.track_weights.value_or(options.ceres.weights);
 }
 ResidualWeights FinalPoseWeightsOf(const ModelFitOptions& options, std::size_t i) {
   if (i < options.weights_per_run.size()) return options.weights_per_run[i].final_pose;

@@ -74,6 +74,11 @@ class MountedModel final : public RobotModelInterface {
                                      const ResidualWeights& weights) const override;
   ceres::CostFunction* SegmentCost(const AlignedRun& run, const std::vector<Segment>& segments,
                                    const ResidualWeights& weights) const override;
+  // MountedCost maps the inner segment cost's residuals through the same Jets with and without
+  // Jacobians, so its residuals are alike exactly where the inner model's are.
+  bool SegmentResidualsAlikeWithJacobians() const override {
+    return inner_->SegmentResidualsAlikeWithJacobians();
+  }
   std::unique_ptr<const PreparedKinematics<double>> PrepareKinematics(
       const double* p) const override;
   std::unique_ptr<const PreparedKinematics<EffectJet>> PrepareKinematics(

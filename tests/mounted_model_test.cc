@@ -10,6 +10,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <string>
 #include <vector>
@@ -186,6 +187,33 @@ TEST(MountedModel, ResidualJacobiansMatchCentralDifferences) {
       model->SegmentCost(run, segments, ResidualWeights{0.01, 0.02}));
   ExpectJacobianMatchesDifferences(*final_pose, model->robot().nominal);
   ExpectJacobianMatchesDifferences(*segment, model->robot().nominal);
+}
+
+// A mounted diff drive keeps its analytic segment cost's promise (residuals the same to the bit
+// with and without Jacobians), so the track residual's memo (fit/track_residual.h) serves it too.
+TEST(MountedModel, SaysItsResidualsAreAlikeWhereTheInnerModelsAre) {
+  const RobotModelPtr model = Read(std::string(kDiffDriveExampleYaml) + kFrame);
+  ASSERT_TRUE(BaseModel(*model).SegmentResidualsAlikeWithJacobians());
+  EXPECT_TRUE(model->SegmentResidualsAlikeWithJacobians());
+  AlignedRun run;
+  run.samples = EncoderSamples(2);
+  for (int k = 0; k < 80; ++k) {
+    const double values[2] = {5.0 + std::sin(0.1 * k), 3.0};
+    run.samples.push_back(0.05, values);
+  }
+  const std::vector<Segment> segments = {{0, 40, Pose2d{0.5, 0.1, 0.2}, 0.5},
+                                         {20, 80, Pose2d{1.0, -0.3, -0.4}, 1.0}};
+  std::unique_ptr<ceres::CostFunction> cost(
+      model->SegmentCost(run, segments, ResidualWeights{0.01, 0.02}));
+  const int m = cost->num_residuals();
+  std::vector<double> p = model->robot().nominal;
+  p[0] *= 1.01;
+  std::vector<double> plain(m), with(m), jacobian(static_cast<std::size_t>(m) * p.size());
+  const double* blocks[] = {p.data()};
+  double* jacobians[] = {jacobian.data()};
+  ASSERT_TRUE(cost->Evaluate(blocks, plain.data(), nullptr));
+  ASSERT_TRUE(cost->Evaluate(blocks, with.data(), jacobians));
+  EXPECT_EQ(std::memcmp(plain.data(), with.data(), m * sizeof(double)), 0);
 }
 
 // The final-pose residual is the sensor's replayed final pose minus the ground truth's.

@@ -241,7 +241,7 @@ TEST(TrackObjectiveTransfer, JudgementFitsChooseWhatConvergedRefitsChooseWhereTh
   settings.estimate_weights = false;
   settings.residuals_auto = true;
   std::optional<TrackFitData> data;
-  ASSERT_EQ(PrepareTrackResiduals(method.name, split, &settings, &data), "");
+  ASSERT_EQ(PrepareTrackResiduals(method.name, split.training, &settings, &data), "");
   ASSERT_EQ(settings.residuals, ResidualKind::kTrack);
   const FitMethodSettings proposed = settings;
   std::optional<ModelFitMethodOutcome> full;
@@ -261,10 +261,8 @@ TEST(TrackObjectiveTransfer, JudgementFitsChooseWhatConvergedRefitsChooseWhereTh
     s.residuals = kind;
     s.residuals_auto = false;
     s.start = full->fit.parameters;
-    RunSplit part;
-    part.training = training;
     std::optional<TrackFitData> part_data;
-    EXPECT_EQ(PrepareTrackResiduals(method.name, part, &s, &part_data), "");
+    EXPECT_EQ(PrepareTrackResiduals(method.name, training, &s, &part_data), "");
     const ModelFitResult fit = method.run_model(training, *model, s).fit;
     EXPECT_TRUE(fit.usable) << fit.message;
     if (kind == ResidualKind::kFinalPose) held_a_direction.push_back(!fit.held_directions.empty());

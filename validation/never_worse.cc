@@ -95,32 +95,6 @@ std::vector<Measure> Measures(const EverydayDrivingMetrics& nominal,
   return out;
 }
 
-std::vector<NeverWorseJudgement> JudgeAll(const std::vector<AlignedRun>& runs,
-                                          const std::vector<Measure>& measures) {
-  std::vector<std::string> labels, families;
-  for (const AlignedRun& run : runs) {
-    labels.push_back(run.trajectory);
-    families.push_back(TrajectoryFamily(run.trajectory));
-  }
-  const std::vector<RunSet> sets = RunSets(runs);
-  const int k = static_cast<int>(sets.size() * measures.size());
-  std::vector<NeverWorseJudgement> out;
-  for (const Measure& m : measures) {
-    RepetitionSpread all = SpreadBetweenRepetitions(labels, m.weights, {m.nominal, m.calibrated});
-    // No trajectory repeats: the runs of a family (the flower's G1-G12) stand in for repetitions;
-    // their scatter holds the paths' differences too, so the margin is wider, never narrower.
-    if (all.dof == 0) all = SpreadBetweenRepetitions(families, m.weights, {m.nominal, m.calibrated});
-    for (const RunSet& set : sets) {
-      out.push_back(JudgeMeasure(m.name, set.name, Pick(labels, set.index),
-                                 Pick(m.weights, set.index), Pick(m.nominal, set.index),
-                                 Pick(m.calibrated, set.index), all, k));
-      out.back().all_runs = &set == &sets.front();
-      out.back().refuses = out.back().all_runs ? m.refuses_on_all : m.refuses_per_family;
-    }
-  }
-  return out;
-}
-
 }  // namespace
 
 RepetitionSpread SpreadBetweenRepetitions(const std::vector<std::string>& labels,
@@ -183,7 +157,29 @@ std::string NeverWorseJudgement::Description() const {
 std::vector<NeverWorseJudgement> JudgeNeverWorse(const std::vector<AlignedRun>& runs,
                                                  const EverydayDrivingMetrics& nominal,
                                                  const EverydayDrivingMetrics& calibrated) {
-  return JudgeAll(runs, Measures(nominal, calibrated));
+  const std::vector<Measure> measures = Measures(nominal, calibrated);
+  std::vector<std::string> labels, families;
+  for (const AlignedRun& run : runs) {
+    labels.push_back(run.trajectory);
+    families.push_back(TrajectoryFamily(run.trajectory));
+  }
+  const std::vector<RunSet> sets = RunSets(runs);
+  const int k = static_cast<int>(sets.size() * measures.size());
+  std::vector<NeverWorseJudgement> out;
+  for (const Measure& m : measures) {
+    RepetitionSpread all = SpreadBetweenRepetitions(labels, m.weights, {m.nominal, m.calibrated});
+    // No trajectory repeats: the runs of a family (the flower's G1-G12) stand in for repetitions;
+    // their scatter holds the paths' differences too, so the margin is wider, never narrower.
+    if (all.dof == 0) all = SpreadBetweenRepetitions(families, m.weights, {m.nominal, m.calibrated});
+    for (const RunSet& set : sets) {
+      out.push_back(JudgeMeasure(m.name, set.name, Pick(labels, set.index),
+                                 Pick(m.weights, set.index), Pick(m.nominal, set.index),
+                                 Pick(m.calibrated, set.index), all, k));
+      out.back().all_runs = &set == &sets.front();
+      out.back().refuses = out.back().all_runs ? m.refuses_on_all : m.refuses_per_family;
+    }
+  }
+  return out;
 }
 
 EverydayDrivingComparison CompareEverydayDriving(const RobotModelInterface& model,
