@@ -88,7 +88,8 @@ std::string AddUncertainty(const RobotModelInterface& model, const SplitOf<Track
   if (choice->sigma.size() == n) return "";
   std::vector<AlignedRun> training;
   for (const TrackRun& r : split.training) training.push_back(r.aligned);
-  const PropagatedUncertainty u = PropagateFinalPoseUncertainty(model, choice->parameters, training);
+  const PropagatedUncertainty u =
+      PropagateFinalPoseUncertainty(model, choice->parameters, training);
   if (!u.ok || u.sigma.size() != n) {
     return "the chosen calibration ('" + choice->name + "') has no uncertainty: " + u.message +
            "; nothing written";

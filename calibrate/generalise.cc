@@ -45,7 +45,8 @@ CalibrationRequest SplitRequest(const Robot& robot, const std::vector<RunLog>& l
 // The split calibrated as `fit` calibrates it (Ceres, final poses; no channel-order check: the
 // data set's wiring does not change between splits), then every candidate scored on it.
 SplitCalibration CalibrateSplit(const GeneraliseRequest& request, const RobotModelInterface& model,
-                                const TrackCandidates& candidates, const GeneralisationSplit& split) {
+                                const TrackCandidates& candidates,
+                                const GeneralisationSplit& split) {
   ModelFitOptions options;
   options.ceres.num_threads = request.threads;
   SplitCalibration out;

@@ -23,9 +23,10 @@ namespace fitcal::tools {
 namespace {
 
 // Each file as <out><suffix> and how it starts.
-constexpr std::pair<const char*, const char*> kOutputFiles[] = {{".csv", kComparisonCsvStart},
-                                                               {".md", kComparisonMarkdownStart},
-                                                               {"_trace.csv", kComparisonTraceStart}};
+constexpr std::pair<const char*, const char*> kOutputFiles[] = {
+    {".csv", kComparisonCsvStart},
+    {".md", kComparisonMarkdownStart},
+    {"_trace.csv", kComparisonTraceStart}};
 
 // A solver flag none of the methods asked for uses (--seed with Ceres methods only, --loss with
 // NLopt ones only): refused as fit refuses it, since each fit would run without it.

@@ -1,15 +1,15 @@
 #pragma once
 // `fitcal compare --logs <dir>`: Palacin Table 4 regenerated on the user's data, for any robot
-// model (the comparison itself is calibrate/method_comparison.h's CompareMethods) - every strategy (STA..STE or explicit trajectory lists, fit/strategies.h; "all" or a
-// label prefix) x every method (calibrate/fit_methods.h) x training on the first 1 or 5 repetitions,
-// validated on every trajectory of the held-out repetitions (Palacin Sec. 3.2: "five additional"
-// repetitions of the whole flower). The model's closed forms (UMBmark for a differential drive)
-// are rows beside the fits, computed from the same training runs. Prints the
-// table as Markdown and writes <out>.csv, <out>.md and <out>_trace.csv (best CF vs evaluations
-// per fit), each atomically, after every fit has finished; a file there that is not compare's
-// previous output is refused (exit 2) unless --force (io/output_guard.h). With --tie/--hold
-// (fit/parameter_tying.h, read as `fit` reads them) every method also fits the reduced model, a
-// "<method> (tied)" row beside its full fit.
+// model (the comparison itself is calibrate/method_comparison.h's CompareMethods) - every strategy
+// (STA..STE or explicit trajectory lists, fit/strategies.h; "all" or a label prefix) x every method
+// (calibrate/fit_methods.h) x training on the first 1 or 5 repetitions, validated on every
+// trajectory of the held-out repetitions (Palacin Sec. 3.2: "five additional" repetitions of the
+// whole flower). The model's closed forms (UMBmark for a differential drive) are rows beside the
+// fits, computed from the same training runs. Prints the table as Markdown and writes <out>.csv,
+// <out>.md and <out>_trace.csv (best CF vs evaluations per fit), each atomically, after every fit
+// has finished; a file there that is not compare's previous output is refused (exit 2) unless
+// --force (io/output_guard.h). With --tie/--hold (fit/parameter_tying.h, read as `fit` reads them)
+// every method also fits the reduced model, a "<method> (tied)" row beside its full fit.
 
 #include <string>
 #include <vector>

@@ -271,7 +271,8 @@ void PrintJudgements(const CalibrationOutcome& o) {
         HalvesDescription(o.halves).c_str());
   }
   if (o.reached >= CalibrationStage::kNeverWorse) {
-    for (const std::string& line : o.never_worse_warnings) std::printf("warning: %s\n", line.c_str());
+    for (const std::string& line : o.never_worse_warnings)
+      std::printf("warning: %s\n", line.c_str());
   }
   if (o.reached >= CalibrationStage::kAtBound && !o.at_bound_warning.empty()) {
     std::printf("warning: %s; written as --bounds-widened asks\n", o.at_bound_warning.c_str());

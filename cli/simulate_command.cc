@@ -85,7 +85,8 @@ void AddSimulateOptions(CLI::App& app, SimulateCommandOptions& o) {
   app.add_option("--robot", o.robot, "Nominal robot YAML (commands and fit start)")
       ->capture_default_str()
       ->check(CLI::ExistingFile);
-  app.add_option("--truth", o.truth, "Robot YAML of the true robot (default: the scenario's, docs/simulate.md)")
+  app.add_option("--truth", o.truth,
+                 "Robot YAML of the true robot (default: the scenario's, docs/simulate.md)")
       ->check(CLI::ExistingFile);
   app.add_option("--repetitions", o.repetitions, "Repetitions of each trajectory")
       ->capture_default_str()

@@ -66,11 +66,11 @@ void AddTrackResidualOptions(CLI::App& app, SolverOptions& o) {
                  "(docs/everyday_driving.md)")
       ->capture_default_str();
   app.add_option("--weights", o.weight_mode,
-                 "Track residuals: fixed (--position-sigma-m, --heading-sigma-deg) or estimated (noise levels of "
-                 "position and heading estimated from the fit itself, per session where the "
-                 "sessions differ, printed and written into "
-                 "the calibration's objective; docs/everyday_driving.md), or auto: the one that "
-                 "transfers better to runs of a kind it was not fitted on")
+                 "Track residuals: fixed (--position-sigma-m, --heading-sigma-deg) or estimated "
+                 "(noise levels of position and heading estimated from the fit itself, per "
+                 "session where the sessions differ, printed and written into the calibration's "
+                 "objective; docs/everyday_driving.md), or auto: the one that transfers better "
+                 "to runs of a kind it was not fitted on")
       ->capture_default_str()
       ->check(CLI::IsMember({"fixed", "estimated", "auto"}));
 }
@@ -113,7 +113,8 @@ bool MakeFitMethodSettings(const SolverOptions& o, int threads, FitMethodSetting
     return false;
   }
   if (!ParseClockGrouping(o.clock_offsets, &s->clock_grouping)) {
-    *error = "unknown --clock-offsets '" + o.clock_offsets + "' (available: session, run, dataset, none)";
+    *error = "unknown --clock-offsets '" + o.clock_offsets +
+             "' (available: session, run, dataset, none)";
     return false;
   }
   s->track_heading_auto = o.track_heading == "auto";

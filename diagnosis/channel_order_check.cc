@@ -253,7 +253,8 @@ namespace {
 ChannelOrderReport CheckOrder(const std::vector<AlignedRun>& runs,
                               const std::vector<std::vector<Segment>>& segments,
                               const std::vector<std::vector<Segment>>* start_windows,
-                              const RobotModelInterface& model, const ChannelOrderOptions& options) {
+                              const RobotModelInterface& model,
+                              const ChannelOrderOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) throw std::invalid_argument("ChannelOrderOptions: " + error);
   if (runs.empty()) throw std::invalid_argument("CheckChannelOrder: no runs");

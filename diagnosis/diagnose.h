@@ -170,8 +170,8 @@ std::vector<double> WindowObjectives(const RobotModelInterface& model, const std
 
 // The effect parameters that act only through the robot-frame lateral velocity, on a robot that
 // cannot move sideways (its model has no channel values for a sideways twist): held at 0 in the
-// candidates' fits (Diagnose). Such a robot's replay has a lateral velocity only as the chord of each
-// encoder interval (dy = v dt (1 - cos a) / a, a the interval's turn), so the parameter fits a
+// candidates' fits (Diagnose). Such a robot's replay has a lateral velocity only as the chord of
+// each encoder interval (dy = v dt (1 - cos a) / a, a the interval's turn), so the parameter fits a
 // discretisation artefact: on a differential drive translation_yaw_gain's g_y ran to its bound
 // (0.5 s/m) and its fit to the 50-iteration limit, 1-2 s of CPU of a 2-3 s diagnose on the
 // independent simulator's runs, in 23 of 70 diagnoses. Found by probing each parameter's body

@@ -57,7 +57,8 @@ std::vector<std::pair<std::string, double>> Estimate(ClockGrouping grouping,
     offsets_s = EstimateClockOffsets(model, *parameters, options).offsets_s;
   } else {
     const ModelFitResult fit = FitModel(runs, model, options);
-    if (!fit.usable) throw std::runtime_error("the track fit for the clock offsets did not converge");
+    if (!fit.usable)
+      throw std::runtime_error("the track fit for the clock offsets did not converge");
     offsets_s = fit.clock_offsets_s;
   }
   std::vector<std::pair<std::string, double>> out;

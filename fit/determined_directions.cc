@@ -50,13 +50,13 @@ std::vector<RunJacobian> EvaluateRuns(const std::vector<AlignedRun>& training,
   std::vector<RunJacobian> out(training.size());
   ParallelFor(training.size(), num_threads, [&](std::size_t i) {
     if (segments != nullptr && (*segments)[i].empty()) return;
-    // A track's checkpoints are windows from the run's start: each carries every error made
-    // before it, so their errors are a random walk along the run (fit/serial_covariance.h), and
-    // counting them as independent counts one stretch's error once per later checkpoint - the
-    // information of a track then grows with its checkpoint count along the same path, and
-    // directions only noise moves look determined (issue 40: the fit of half the omni3 joystick run moved R_a by
-    // 24 % and lost to the nominal on the other half). Such windows are analysed as the stretches
-    // between the checkpoints, whose errors are independent.
+    // A track's checkpoints are windows from the run's start: each carries every error made before
+    // it, so their errors are a random walk along the run (fit/serial_covariance.h), and counting
+    // them as independent counts one stretch's error once per later checkpoint - the information of
+    // a track then grows with its checkpoint count along the same path, and directions only noise
+    // moves look determined (issue 40: the fit of half the omni3 joystick run moved R_a by 24 % and
+    // lost to the nominal on the other half). Such windows are analysed as the stretches between
+    // the checkpoints, whose errors are independent.
     const std::vector<Segment> stretches =
         segments == nullptr ? std::vector<Segment>{} : StretchesBetweenCheckpoints((*segments)[i]);
     std::unique_ptr<ceres::CostFunction> cost(

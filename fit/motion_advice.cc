@@ -54,7 +54,8 @@ std::vector<MotionThatDetermines> MotionsThatDetermine(const UndeterminedDirecti
                                                        const std::vector<double>& p,
                                                        const ResidualWeights& weights) {
   // Information adds over runs: 1 / f_k^2 = 1 / f^2 + k g with g one run's own.
-  const double data_information = 1.0 / std::max(d.posterior_fraction * d.posterior_fraction, 1e-300);
+  const double data_information =
+      1.0 / std::max(d.posterior_fraction * d.posterior_fraction, 1e-300);
   const double needed = 1.0 / (kMaxPosteriorFraction * kMaxPosteriorFraction) - data_information;
   std::vector<MotionThatDetermines> out;
   for (const StandardMotion& motion : StandardMotions()) {
@@ -66,7 +67,8 @@ std::vector<MotionThatDetermines> MotionsThatDetermine(const UndeterminedDirecti
     const double runs = std::ceil(std::max(needed, 0.0) / per_run);
     if (runs <= kMaxAdvisedRuns) out.push_back({motion.words, std::max(1, static_cast<int>(runs))});
   }
-  std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.runs < b.runs; });
+  std::stable_sort(out.begin(), out.end(),
+                   [](const auto& a, const auto& b) { return a.runs < b.runs; });
   return out;
 }
 

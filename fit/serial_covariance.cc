@@ -81,7 +81,8 @@ Eigen::MatrixXd RandomWalkScoreCovariance(const std::vector<TrackErrorChain>& ru
 }
 
 Eigen::MatrixXd InverseInformation(const Eigen::MatrixXd& information) {
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(information, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(information,
+                                              Eigen::ComputeFullU | Eigen::ComputeFullV);
   const Eigen::VectorXd& s = svd.singularValues();
   if (s.size() == 0 || !(s(s.size() - 1) > 1e-14 * s(0))) return {};
   return svd.matrixV() * s.cwiseInverse().asDiagonal() * svd.matrixU().transpose();

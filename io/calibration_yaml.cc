@@ -273,7 +273,8 @@ std::vector<double> RecordedSigmas(const CalibrationProvenance& provenance,
       continue;
     }
     std::string keys;
-    for (const ParameterInfo& info : parameters) keys += (keys.empty() ? "" : ", ") + info.KeyName();
+    for (const ParameterInfo& info : parameters)
+      keys += (keys.empty() ? "" : ", ") + info.KeyName();
     throw InputError(InputErrorKind::kUnknownKey, provenance.path,
                      r < provenance.sigma_lines.size() ? provenance.sigma_lines[r] : 0,
                      "calibration.sigma: '" + recorded[r].first +

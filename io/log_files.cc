@@ -313,7 +313,8 @@ void CheckTimePlausible(double t_s, const std::string& path, int line_number) {
   if (std::abs(t_s) > kMaxTimeS) {
     throw InputError(InputErrorKind::kImplausibleValue, path, line_number,
                      "time " + MessageNumber(t_s) + " s is not a plausible time (limit " +
-                         MessageNumber(kMaxTimeS) + " s; nanoseconds or microseconds instead of s?)");
+                         MessageNumber(kMaxTimeS) +
+                         " s; nanoseconds or microseconds instead of s?)");
   }
 }
 

@@ -75,9 +75,9 @@ class ModelFinalPoseResidual {
   K kinematics_;
 };
 
-// Segment residuals (models/pose_errors.h) of one run for the kinematics K: the run is replayed once
-// from the identity, keeping the pose at every window start and end. Autodiff through the whole
-// replay: SegmentCost's for kinematics without an analytic Jacobian, and the reference the
+// Segment residuals (models/pose_errors.h) of one run for the kinematics K: the run is replayed
+// once from the identity, keeping the pose at every window start and end. Autodiff through the
+// whole replay: SegmentCost's for kinematics without an analytic Jacobian, and the reference the
 // analytic SegmentJacobianCost (segment_jacobian.h) is tested against.
 template <class K>
 class ModelSegmentResidual {

@@ -1,9 +1,9 @@
 #pragma once
-// The model of the validation report (`fitcal report`): plain values, built once from the data
-// by validation/report_builder.h (which computes every number with fit/, validation/ and diagnosis/),
+// The model of the validation report (`fitcal report`): plain values, built once from the data by
+// validation/report_builder.h (which computes every number with fit/, validation/ and diagnosis/),
 // then formatted by one renderer per output (pages/report_html.h, report_markdown.h, report_json.h,
-// report_csv.h, report_tum.h, report_figures.h). Nothing here computes. Angles are radians in
-// the model and degrees in the outputs (columns ending _deg).
+// report_csv.h, report_tum.h, report_figures.h). Nothing here computes. Angles are radians in the
+// model and degrees in the outputs (columns ending _deg).
 
 #include <string>
 #include <vector>

@@ -3,8 +3,8 @@
 // prints): a simulated calibration data set of any model with a scenario (sim/model_scenarios.h;
 // omni3's is Palacin's flower): the nominal robot (--robot, or the model's registry example)
 // commands the trajectories, a true robot (--truth, or the scenario's default) drives them, and the
-// data set - robot.yaml (nominal), true_robot.yaml (the truth, for checking a fit), dataset.yaml and
-// the runs - is built in a temporary sibling directory and renamed into place
+// data set - robot.yaml (nominal), true_robot.yaml (the truth, for checking a fit), dataset.yaml
+// and the runs - is built in a temporary sibling directory and renamed into place
 // (io/staged_directory.h).
 
 #include <cstddef>

@@ -38,8 +38,8 @@ void SetSteppedPhysics(const Robot& robot, const SimulationScenario& scenario,
   }
   for (const effects::EffectValue& e : noise.injected_effects) {
     if (!robot.CanShow(e.id)) {
-      throw UsageError(std::string("--inject ") + effects::Info(e.id).name + ": the " + robot.model +
-                       " robot has no channel it acts on (it needs " +
+      throw UsageError(std::string("--inject ") + effects::Info(e.id).name + ": the " +
+                       robot.model + " robot has no channel it acts on (it needs " +
                        (effects::NeedsWheelPair(e.id) ? "a pair of wheels" : "a steering angle") +
                        ")");
     }

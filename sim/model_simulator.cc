@@ -242,8 +242,8 @@ ModelSimulatedRun SimulateRun(const RobotModelInterface& model, const std::vecto
   const FineGrid grid = MakeGrid(profile.end_s(), o);
   std::vector<std::vector<double>> readings;
   const EncoderSamples fine =
-      o.dynamics ? DynamicChannels(*o.dynamics(model, p, spec), model.robot().NumChannels(), profile,
-                                   grid, &readings)
+      o.dynamics ? DynamicChannels(*o.dynamics(model, p, spec), model.robot().NumChannels(),
+                                   profile, grid, &readings)
                  : FineChannels(model, p.data(), profile, grid);
   ModelSimulatedRun run;
   run.true_start_pose = StartPose(o, rng);

@@ -65,7 +65,8 @@ void FlagTrend(FleetSeries* s) {
   double mx = 0, my = 0;
   for (std::size_t i = 0; i < n; ++i) mx += x[i] / n, my += y[i] / n;
   double sxx = 0, sxy = 0;
-  for (std::size_t i = 0; i < n; ++i) sxx += (x[i] - mx) * (x[i] - mx), sxy += (x[i] - mx) * (y[i] - my);
+  for (std::size_t i = 0; i < n; ++i)
+    sxx += (x[i] - mx) * (x[i] - mx), sxy += (x[i] - mx) * (y[i] - my);
   if (!(sxx > 0)) return;
   const double slope = sxy / sxx;
   double rss = 0;
@@ -75,7 +76,8 @@ void FlagTrend(FleetSeries* s) {
   }
   const double scatter = std::sqrt(rss / static_cast<double>(n - 2));
   const double standard_error = scatter / std::sqrt(sxx);
-  const double span_days = *std::max_element(x.begin(), x.end()) - *std::min_element(x.begin(), x.end());
+  const double span_days =
+      *std::max_element(x.begin(), x.end()) - *std::min_element(x.begin(), x.end());
   s->slope_per_30_days = 30.0 * slope;
   s->has_slope = true;
   s->trend = std::abs(slope) > kTrendT * standard_error &&
@@ -141,9 +143,10 @@ void RequireOneResultPerDate(const FleetSeries& s, const FleetValue& v, const Fl
 
 std::vector<FleetSeries> FleetSeriesOf(std::vector<FleetCalibration> all) {
   RefuseOneNameForTwoModels(all);
-  std::stable_sort(all.begin(), all.end(), [](const FleetCalibration& a, const FleetCalibration& b) {
-    return std::tie(a.robot, a.date) < std::tie(b.robot, b.date);
-  });
+  std::stable_sort(all.begin(), all.end(),
+                   [](const FleetCalibration& a, const FleetCalibration& b) {
+                     return std::tie(a.robot, a.date) < std::tie(b.robot, b.date);
+                   });
   std::vector<FleetSeries> out;
   std::map<std::pair<std::string, std::string>, std::size_t> index;
   for (const FleetCalibration& c : all) {

@@ -170,7 +170,8 @@ std::vector<NeverWorseJudgement> JudgeNeverWorse(const std::vector<AlignedRun>& 
     RepetitionSpread all = SpreadBetweenRepetitions(labels, m.weights, {m.nominal, m.calibrated});
     // No trajectory repeats: the runs of a family (the flower's G1-G12) stand in for repetitions;
     // their scatter holds the paths' differences too, so the margin is wider, never narrower.
-    if (all.dof == 0) all = SpreadBetweenRepetitions(families, m.weights, {m.nominal, m.calibrated});
+    if (all.dof == 0)
+      all = SpreadBetweenRepetitions(families, m.weights, {m.nominal, m.calibrated});
     for (const RunSet& set : sets) {
       out.push_back(JudgeMeasure(m.name, set.name, Pick(labels, set.index),
                                  Pick(m.weights, set.index), Pick(m.nominal, set.index),
@@ -213,8 +214,8 @@ std::vector<std::string> NeverWorseRefusals(const std::string& name,
   return out;
 }
 
-std::vector<std::string> NeverWorseWithinScatter(const std::string& name,
-                                                 const std::vector<NeverWorseJudgement>& judgements) {
+std::vector<std::string> NeverWorseWithinScatter(
+    const std::string& name, const std::vector<NeverWorseJudgement>& judgements) {
   std::vector<std::string> out;
   for (const NeverWorseJudgement& j : judgements) {
     if (!j.WorseWithinScatter()) continue;

@@ -119,8 +119,8 @@ std::vector<std::string> NeverWorseRefusals(const std::string& name,
 
 // The judgements WorseWithinScatter(), as lines "'<name>' is worse than the nominal on the
 // <runs>, within the runs' scatter: drift 1 m [%] 0.74 -> 0.836 (+13.0 %), within the margin ...".
-std::vector<std::string> NeverWorseWithinScatter(const std::string& name,
-                                                 const std::vector<NeverWorseJudgement>& judgements);
+std::vector<std::string> NeverWorseWithinScatter(
+    const std::string& name, const std::vector<NeverWorseJudgement>& judgements);
 
 // What a command that writes a calibration says of its never-worse judgements, one rule for fit,
 // diagnose and export: `warnings` (worse where worse only warns, then risen by more than 5 %

@@ -129,7 +129,8 @@ std::array<double, 3> GroundTruthNoise(const std::vector<RunLog>& runs) {
     for (std::size_t k = 1; k + 1 < q.size(); ++k) {
       const double dx = q[k - 1].x - 2.0 * q[k].x + q[k + 1].x;
       const double dy = q[k - 1].y - 2.0 * q[k].y + q[k + 1].y;
-      const double dth = WrapAngle(q[k - 1].theta - q[k].theta) + WrapAngle(q[k + 1].theta - q[k].theta);
+      const double dth =
+          WrapAngle(q[k - 1].theta - q[k].theta) + WrapAngle(q[k + 1].theta - q[k].theta);
       // Position noise is isotropic: either world axis serves for both body axes.
       sum[0] += 0.5 * (dx * dx + dy * dy);
       sum[2] += dth * dth;
@@ -193,7 +194,7 @@ std::pair<double, double> PowerLaw(const std::vector<double>& d, const std::vect
 
 namespace {
 
-// The best non-negative fit of V(T) = sum of the terms c, beta T, alpha T^2 in `allowed` (bits 0-2).
+// Best non-negative fit of V(T) = c + beta T + alpha T^2 with the terms in `allowed` (bits 0-2).
 std::array<double, 3> FitTerms(const std::vector<double>& t, const std::vector<double>& v,
                                const std::vector<double>& w, int allowed) {
   std::array<double, 3> best{};

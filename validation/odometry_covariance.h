@@ -9,10 +9,11 @@
 //
 // Structure function. Each held-out run is cut into non-overlapping windows of L encoder samples
 // for L = 1, 2, 4, ..., 256, of at least two ground-truth intervals (shorter ones read the ground
-// truth between the same samples at both ends, where its noise cancels). In a window [t0, t1] the odometry's displacement, replayed from the
-// identity, is compared with the ground truth's, expressed in its frame at t0 (its heading there
-// averaged over +-kHeadingSmoothingS, so the ground truth's heading noise does not rotate the
-// displacement); the mean square error per axis against the window's duration T is fitted by
+// truth between the same samples at both ends, where its noise cancels). In a window [t0, t1] the
+// odometry's displacement, replayed from the identity, is compared with the ground truth's,
+// expressed in its frame at t0 (its heading there averaged over +-kHeadingSmoothingS, so the ground
+// truth's heading noise does not rotate the displacement); the mean square error per axis against
+// the window's duration T is fitted by
 //   V(T) = c + beta T + alpha T^2,   c, beta, alpha >= 0,
 // where c is what does not grow with T: twice the ground truth's noise variance plus the encoder
 // quantisation (a tick's uncertainty at either end, known from the robot's encoder ticks; zero for

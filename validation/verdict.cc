@@ -198,12 +198,12 @@ Verdict JudgeCalibration(const VerdictInputs& in) {
   }
   v.reasons.push_back(NoiseFloorReason(in.noise_floor));
   if (in.identifiability_checked) {
-    v.reasons.push_back(in.identifiable
-                            ? Reason(VerdictLevel::kPass, "identifiability", "identifiability",
-                                     "the training runs determine every parameter")
-                            : Reason(VerdictLevel::kWarn, "identifiability", "identifiability",
-                                     "the training runs do not determine every parameter on its own "
-                                     "(undetermined, correlated or ill-conditioned)"));
+    v.reasons.push_back(
+        in.identifiable ? Reason(VerdictLevel::kPass, "identifiability", "identifiability",
+                                 "the training runs determine every parameter")
+                        : Reason(VerdictLevel::kWarn, "identifiability", "identifiability",
+                                 "the training runs do not determine every parameter on its own "
+                                 "(undetermined, correlated or ill-conditioned)"));
   }
   std::stable_sort(
       v.reasons.begin(), v.reasons.end(),

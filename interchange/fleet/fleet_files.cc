@@ -58,7 +58,8 @@ Calibration ReadCalibration(const std::string& path) {
   c.model = model->robot().model;
   c.date = DateOf(path);
   const Robot& robot = model->robot();
-  const std::optional<io::CalibrationProvenance> provenance = io::ReadCalibrationProvenance(root, path);
+  const std::optional<io::CalibrationProvenance> provenance =
+      io::ReadCalibrationProvenance(root, path);
   const std::vector<double> sigma =
       provenance ? io::RecordedSigmas(*provenance, robot.parameters) : std::vector<double>{};
   for (std::size_t k = 0; k < robot.parameters.size(); ++k) {

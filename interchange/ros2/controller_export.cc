@@ -93,8 +93,8 @@ void KeepGroundTruthFrame(const CalibratedRobot& c, Ros2ControlExport* out) {
   const int k = mounted->MountIndex();
   const std::vector<double>& p = c.robot().nominal;
   const std::vector<Interval> bounds(c.robot().bounds.begin() + k, c.robot().bounds.end());
-  out->model = std::make_shared<MountedModel>(out->model, GroundTruthFrame{p[k], p[k + 1], p[k + 2]},
-                                              bounds);
+  out->model = std::make_shared<MountedModel>(out->model,
+                                              GroundTruthFrame{p[k], p[k + 1], p[k + 2]}, bounds);
   out->parameters.insert(out->parameters.end(), p.begin() + k, p.end());
 }
 
@@ -253,8 +253,9 @@ namespace {
 constexpr double kUnmeasuredVariance = 1e6;
 
 std::string Diagonal(const std::array<double, 3>& planar) {
-  return "[" + Ros2Double(planar[0]) + ", " + Ros2Double(planar[1]) + ", " + Ros2Double(kUnmeasuredVariance) + ", " +
-         Ros2Double(kUnmeasuredVariance) + ", " + Ros2Double(kUnmeasuredVariance) + ", " + Ros2Double(planar[2]) + "]";
+  return "[" + Ros2Double(planar[0]) + ", " + Ros2Double(planar[1]) + ", " +
+         Ros2Double(kUnmeasuredVariance) + ", " + Ros2Double(kUnmeasuredVariance) + ", " +
+         Ros2Double(kUnmeasuredVariance) + ", " + Ros2Double(planar[2]) + "]";
 }
 
 }  // namespace

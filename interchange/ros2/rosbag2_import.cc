@@ -101,9 +101,10 @@ std::vector<double> ChannelRows(const Robot& robot, const BagStreams& s) {
 
 // Joint positions wrapped to one turn (a driver that reports a wheel's angle modulo a turn, in
 // [-pi, pi) or [0, 2 pi), not cumulatively): every reading of the wheel within one turn of the
-// others and some step between two messages longer than pi. Each step is then taken as the shortest rotation, WrapAngle(step) - right
-// while the wheel turns less than half a turn between messages. A wrapped step longer than
-// kMaxUnwrappedStepRad leaves too little margin to tell the direction: refused, naming the joint.
+// others and some step between two messages longer than pi. Each step is then taken as the shortest
+// rotation, WrapAngle(step) - right while the wheel turns less than half a turn between messages. A
+// wrapped step longer than kMaxUnwrappedStepRad leaves too little margin to tell the direction:
+// refused, naming the joint.
 constexpr double kMaxUnwrappedStepRad = 0.5 * M_PI;
 
 std::vector<std::string> UnwrapWrappedWheels(const Robot& robot,

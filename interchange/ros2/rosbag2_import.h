@@ -1,8 +1,8 @@
 #pragma once
 // What `fitcal import rosbag2 <bag> --out <data set> --robot <robot.yaml> --ground-truth <topic>`
-// (cli/import_rosbag2.h) reads and decides: a rosbag2 recording (sqlite3 or MCAP, split or not; io/rosbag2/) -> a fitcal data set
-// (README.md "Data set format"): robot.yaml (the robot file as given), dataset.yaml, and per run
-// runs/<id>_encoders.csv and runs/<id>_ground_truth.csv.
+// (cli/import_rosbag2.h) reads and decides: a rosbag2 recording (sqlite3 or MCAP, split or not;
+// io/rosbag2/) -> a fitcal data set (README.md "Data set format"): robot.yaml (the robot file as
+// given), dataset.yaml, and per run runs/<id>_encoders.csv and runs/<id>_ground_truth.csv.
 //
 // Encoders. One sensor_msgs/msg/JointState topic; the robot's channels are read from the joints
 // named by --joints (robot channel order; default: the channel names themselves). With positions
@@ -68,7 +68,8 @@ struct Rosbag2Import {
   // robot channel (robot channel order).
   std::vector<std::vector<double>> encoder_t_s;
   std::vector<std::vector<double>> encoder_values;
-  std::vector<std::string> notes;  // what the import repaired (wrapped joint positions), one line each
+  // What the import repaired (wrapped joint positions), one line each.
+  std::vector<std::string> notes;
   // Appended to the robot YAML the data set holds: the nominal `ground_truth_frame:` of a ground
   // truth that tracks a sensor, from the bag's /tf_static (io/rosbag2/static_transforms.h).
   std::string robot_yaml_addition;

@@ -211,7 +211,8 @@ ModelExtras AsocExtras() {
   ModelExtras extras;
   extras.scenario.trajectories = [](const RobotModelInterface& nominal, const std::vector<double>&,
                                     int repetitions) {
-    std::vector<sim::TrajectorySpec> out = asoc::HoldTrajectories(asoc::AsAsoc(nominal).asoc().nominal);
+    std::vector<sim::TrajectorySpec> out =
+        asoc::HoldTrajectories(asoc::AsAsoc(nominal).asoc().nominal);
     for (sim::TrajectorySpec& spec : asoc::UmbmarkTrajectories(5, 6)) out.push_back(spec);
     for (int k = 1; k <= repetitions; ++k) out.push_back(asoc::ExcursionTrajectory(k));
     return out;

@@ -65,10 +65,14 @@ OmniBounds ReadOmniBounds(io::YamlMap& robot_map, const std::string& path);
 inline constexpr const char* kOmniExampleYaml = R"(model: omni
 name: example_mecanum
 wheels:
-  - {name: fl, distance_m: 0.25, angle_deg: 36.86989765, radius_m: 0.05, drive_angle_deg: 0, roller_angle_deg: -45}
-  - {name: fr, distance_m: 0.25, angle_deg: -36.86989765, radius_m: 0.05, drive_angle_deg: 0, roller_angle_deg: 45}
-  - {name: rl, distance_m: 0.25, angle_deg: 143.13010235, radius_m: 0.05, drive_angle_deg: 0, roller_angle_deg: 45}
-  - {name: rr, distance_m: 0.25, angle_deg: -143.13010235, radius_m: 0.05, drive_angle_deg: 0, roller_angle_deg: -45}
+  - {name: fl, distance_m: 0.25, angle_deg: 36.86989765, radius_m: 0.05, drive_angle_deg: 0,
+     roller_angle_deg: -45}
+  - {name: fr, distance_m: 0.25, angle_deg: -36.86989765, radius_m: 0.05, drive_angle_deg: 0,
+     roller_angle_deg: 45}
+  - {name: rl, distance_m: 0.25, angle_deg: 143.13010235, radius_m: 0.05, drive_angle_deg: 0,
+     roller_angle_deg: 45}
+  - {name: rr, distance_m: 0.25, angle_deg: -143.13010235, radius_m: 0.05, drive_angle_deg: 0,
+     roller_angle_deg: -45}
 bounds:
   distance_m: [0.22, 0.28]
   radius_m: [0.045, 0.055]
