@@ -155,7 +155,8 @@ std::vector<std::string> HalvesRefusalReasons(const HalvesJudgement& j) {
            << " -> " << g.calibrated_cf << ")";
       reasons.push_back(line.str());
     }
-    for (const std::string& line : NeverWorseRefusals("the fit of one half" + which, g.never_worse)) {
+    for (const std::string& line :
+         NeverWorseRefusals("the fit of one half" + which, g.never_worse)) {
       reasons.push_back(line);
     }
   }

@@ -23,8 +23,8 @@ struct FitMethodSettings {
   int threads = 0;
   int max_iterations = 100;  // Ceres iterations per solve
   ResidualWeights weights;
-  // Ceres with track residuals: weights from noise levels estimated by the fit (fit/noise_levels.h);
-  // `weights` start it. Off when the user gave a sigma.
+  // Ceres with track residuals: weights from noise levels estimated by the fit
+  // (fit/noise_levels.h); `weights` start it. Off when the user gave a sigma.
   bool estimate_weights = true;
   // --weights auto / --track-heading auto: the track objective chosen by transfer among those the
   // flags allow (validation/track_objective_transfer.h); estimate_weights and track_heading hold

@@ -305,7 +305,8 @@ int NumDataResiduals(const std::vector<AlignedRun>& training, const ModelFitOpti
       num_residuals += 3 * static_cast<int>(windows.size());
     return num_residuals;
   }
-  if (options.residuals != ResidualKind::kTrack) num_residuals += 3 * static_cast<int>(training.size());
+  if (options.residuals != ResidualKind::kTrack)
+    num_residuals += 3 * static_cast<int>(training.size());
   if (UsesTracks(options)) {
     for (const TrackCheckpoints& t : options.track->runs)
       num_residuals += 3 * static_cast<int>(t.segments.size());
@@ -385,7 +386,8 @@ TrackErrorChain TrackChainOf(const TrackCheckpoints& track, const RobotModelInte
     const Pose2d q = GroundTruthFromStart(track, k, offset_s);
     const double c = std::cos(q.theta), s = std::sin(q.theta);
     const double ex = pose[3 * k] - q.x, ey = pose[3 * k + 1] - q.y;
-    const Eigen::Vector3d e(c * ex + s * ey, -s * ex + c * ey, WrapAngle(pose[3 * k + 2] - q.theta));
+    const Eigen::Vector3d e(c * ex + s * ey, -s * ex + c * ey,
+                            WrapAngle(pose[3 * k + 2] - q.theta));
     // r_k = factor W e_k: the factor (run weight, loss) from the residual itself.
     const Eigen::Vector3d r = block.residuals.segment<3>(3 * static_cast<Eigen::Index>(k));
     const double weighted = w.cwiseProduct(e).norm();
@@ -561,16 +563,17 @@ std::vector<bool> ParametersAtBound(const Robot& robot, const std::vector<double
 namespace {
 
 // The clock offsets of every group with the parameters `p` held, each the minimum of its group's
-// exact track cost (the ground truth interpolated linearly at t + dt, TrackResidual): a scan of
-// the bounded interval every kOffsetScanStepS, then a golden-section search of the best step's
+// exact track cost (the ground truth interpolated linearly at t + dt, TrackResidual): a scan of the
+// bounded interval every kOffsetScanStepS, then a golden-section search of the best step's
 // neighbourhood to kOffsetSearchToleranceS (without `scan`, the scan covers kLocalScanSteps steps
-// either side of the current offset: after the first round the parameters move little). Why a search and not Gauss-Newton: the cost is
-// piecewise smooth with kinks at sample crossings (fit/track_residual.h), and on circles an
-// offset is seen mostly through the start and stop transients, where the cost's curvature in dt
-// is up to 10 times Gauss-Newton's model of it (the OptiOdom diff circles): the joint
-// Levenberg-Marquardt solve zigzagged for 46-118 iterations. The scan also keeps a weakly
-// determined offset from a local minimum. The group's runs are replayed once per call (the
-// odometry does not depend on dt); each evaluation interpolates the ground truth only.
+// either side of the current offset: after the first round the parameters move little). Why a
+// search and not Gauss-Newton: the cost is piecewise smooth with kinks at sample crossings
+// (fit/track_residual.h), and on circles an offset is seen mostly through the start and stop
+// transients, where the cost's curvature in dt is up to 10 times Gauss-Newton's model of it (the
+// OptiOdom diff circles): the joint Levenberg-Marquardt solve zigzagged for 46-118 iterations. The
+// scan also keeps a weakly determined offset from a local minimum. The group's runs are replayed
+// once per call (the odometry does not depend on dt); an evaluation only interpolates the ground
+// truth.
 constexpr double kOffsetScanStepS = 0.025;
 constexpr double kOffsetSearchToleranceS = 1e-5;
 constexpr int kLocalScanSteps = 3;
@@ -601,7 +604,8 @@ void SolveClockOffsetsAt(const RobotModelInterface& model, const ModelFitOptions
       return sum;
     };
     // The whole interval, or kLocalScanSteps either side of the current offset.
-    const int steps = scan ? static_cast<int>(std::ceil(bound / kOffsetScanStepS)) : kLocalScanSteps;
+    const int steps =
+        scan ? static_cast<int>(std::ceil(bound / kOffsetScanStepS)) : kLocalScanSteps;
     const double centre = scan ? 0.0 : (*offsets_s)[g];
     double best = centre, best_cost = HUGE_VAL;
     for (int i = -steps; i <= steps; ++i) {
@@ -847,7 +851,8 @@ ModelFitResult FitModelFrom(const std::vector<AlignedRun>& training,
     }
     if (!options.track->options.IsValid(&error)) throw std::invalid_argument(error);
     for (const TrackCheckpoints& t : options.track->runs) {
-      if (t.clock_group < 0 || t.clock_group >= static_cast<int>(options.track->clock_groups.size()))
+      if (t.clock_group < 0 ||
+          t.clock_group >= static_cast<int>(options.track->clock_groups.size()))
         throw std::invalid_argument("FitModel: a track's clock group is out of range");
     }
   }
@@ -939,7 +944,8 @@ ClockOffsetEstimate EstimateClockOffsets(const RobotModelInterface& model,
   out.sigma_s.assign(track.clock_groups.size(), 0.0);
   ModelFitResult counts;
   SolveClockOffsetsAt(model, options, p, &out.offsets_s, &counts);
-  std::vector<double> sum_squares(out.offsets_s.size(), 0.0), information(out.offsets_s.size(), 0.0);
+  std::vector<double> sum_squares(out.offsets_s.size(), 0.0);
+  std::vector<double> information(out.offsets_s.size(), 0.0);
   std::vector<int> residuals(out.offsets_s.size(), 0);
   for (std::size_t run_index = 0; run_index < track.runs.size(); ++run_index) {
     const TrackCheckpoints& run = track.runs[run_index];

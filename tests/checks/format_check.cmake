@@ -8,6 +8,9 @@
 # FormatDouble (one double, the format checked when it runs). Only odometry/text_format.cc
 # forwards a format; a call elsewhere whose format is not a literal (or a choice between two
 # literals) fails the check with the file and the line.
+#
+# Lines: at most 100 characters (.clang-format's ColumnLimit; UTF-8 counted as characters), so
+# that the code reads whole in a side-by-side diff.
 cmake_minimum_required(VERSION 3.16)
 if(NOT SOURCE_DIR)
   message(FATAL_ERROR "format_check.cmake: pass -DSOURCE_DIR=<checkout>")
@@ -19,12 +22,19 @@ set(ws "[ \t\r\n]*")
 set(before_format "(snprintf${ws}\\([^,]*,[^,]*,|fprintf${ws}\\([^,]*,|[^a-z_]printf${ws}\\()")
 set(literal_format "${ws}(\"|[A-Za-z_.]+${ws}\\?${ws}\")")
 
+set(kMaxColumns 100)
+set(utf8_continuation_bytes "")
+foreach(byte RANGE 128 191)
+  string(ASCII ${byte} c)
+  string(APPEND utf8_continuation_bytes "${c}")
+endforeach()
+
 set(violations 0)
 file(GLOB_RECURSE sources RELATIVE ${SOURCE_DIR} ${SOURCE_DIR}/odometry/*.cc ${SOURCE_DIR}/io/*.cc
      ${SOURCE_DIR}/models/*.cc ${SOURCE_DIR}/fit/*.cc ${SOURCE_DIR}/validation/*.cc
      ${SOURCE_DIR}/diagnosis/*.cc ${SOURCE_DIR}/calibrate/*.cc ${SOURCE_DIR}/sim/*.cc
-     ${SOURCE_DIR}/interchange/*.cc ${SOURCE_DIR}/cli/*.cc
-     ${SOURCE_DIR}/odometry/*.h
+     ${SOURCE_DIR}/interchange/*.cc ${SOURCE_DIR}/cli/*.cc ${SOURCE_DIR}/pages/*.cc
+     ${SOURCE_DIR}/odometry/*.h ${SOURCE_DIR}/pages/*.h
      ${SOURCE_DIR}/io/*.h ${SOURCE_DIR}/models/*.h ${SOURCE_DIR}/fit/*.h ${SOURCE_DIR}/validation/*.h
      ${SOURCE_DIR}/diagnosis/*.h ${SOURCE_DIR}/calibrate/*.h ${SOURCE_DIR}/sim/*.h
      ${SOURCE_DIR}/interchange/*.h ${SOURCE_DIR}/cli/*.h)
@@ -34,6 +44,20 @@ foreach(source IN LISTS sources)
   endif()
   file(READ ${SOURCE_DIR}/${source} text)
   string(REGEX REPLACE "[][;\\]" "_" text "${text}")
+  string(REPLACE "\n" ";" lines "${text}")
+  set(line_number 0)
+  foreach(line IN LISTS lines)
+    math(EXPR line_number "${line_number} + 1")
+    string(LENGTH "${line}" bytes)
+    if(bytes GREATER kMaxColumns)
+      string(REGEX REPLACE "[${utf8_continuation_bytes}]" "" characters "${line}")
+      string(LENGTH "${characters}" columns)
+      if(columns GREATER kMaxColumns)
+        message(SEND_ERROR "${source}:${line_number}: ${columns} characters, over ${kMaxColumns}")
+        math(EXPR violations "${violations} + 1")
+      endif()
+    endif()
+  endforeach()
   string(REGEX MATCHALL "${before_format}[^,)]*" calls "${text}")
   foreach(call IN LISTS calls)
     string(REGEX REPLACE "^${before_format}" "" format_argument "${call}")
@@ -50,6 +74,6 @@ foreach(source IN LISTS sources)
   endforeach()
 endforeach()
 if(violations GREATER 0)
-  message(FATAL_ERROR "${violations} printf-family call(s) with a format that is not a literal "
-                      "(tests/checks/format_check.cmake)")
+  message(FATAL_ERROR "${violations} line(s) over ${kMaxColumns} characters or printf-family "
+                      "call(s) with a format that is not a literal (tests/checks/format_check.cmake)")
 endif()
