@@ -180,7 +180,7 @@ std::string OutputFileRefusal(const std::string& out, const std::vector<std::str
                    "exists and is not a regular file (a directory, FIFO or device); "
                    "--out must name a file to write");
   }
-  return InputOverlap(out, inputs);
+  return "";
 }
 
 std::string OutputDirectoryRefusal(const std::string& out, const std::vector<std::string>& inputs,
