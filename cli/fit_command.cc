@@ -60,7 +60,6 @@ void AddFitOptions(CLI::App& app, FitCommandOptions& o) {
   AddTyingFlags(app, o);
 }
 
-
 namespace {
 
 double Seconds(std::chrono::steady_clock::time_point since) {

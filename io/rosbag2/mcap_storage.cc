@@ -159,7 +159,6 @@ class McapStorage : public StorageReader {
   std::int64_t end_ns_ = 0;
   std::vector<std::uint8_t> scratch_;
 
-
   // Iteration state: blocks in order of their first message time, the next one to open, and a
   // heap of open blocks by their next message. `retired_` keeps the block of the message last
   // returned alive until the following call (StoredMessage::payload points into it).
