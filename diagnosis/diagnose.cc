@@ -283,7 +283,6 @@ std::vector<EffectId> CandidateEffects(const DiagnoseContext& x, const EffectFit
   return candidates;
 }
 
-
 // The base of a round: the current model's held-out score and training BIC, and the residual's
 // degrees of freedom (3 per training run, less the fitted parameters; fit/effect_fit.h).
 struct RoundBase {

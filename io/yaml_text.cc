@@ -28,7 +28,6 @@ bool IsSafePlainYaml(const std::string& s) {
   return true;
 }
 
-
 std::string YamlScalar(const std::string& s) {
   YAML::Emitter out;
   out << YamlText(s);

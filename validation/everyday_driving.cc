@@ -48,14 +48,12 @@ EverydayDrivingMetrics EvaluateEverydayDriving(const RobotModelInterface& model,
     for (const RelativePoseErrorRun& drift_run : drift_runs) {
       RelativePoseErrorSum run;
       drift_run.Add(length, &run);
-      drift.per_run_translation_percent.push_back(run.MeanTranslationPercent());
-      drift.per_run_windows.push_back(run.windows);
+      drift.AddRun(run.MeanTranslationPercent(), run.windows);
       sum.windows += run.windows;
       sum.translation_ratio_sum += run.translation_ratio_sum;
       sum.rotation_rad_per_m_sum += run.rotation_rad_per_m_sum;
     }
     drift.length_m = length;
-    drift.windows = sum.windows;
     drift.translation_percent = sum.MeanTranslationPercent();
     drift.rotation_deg_per_m = RadToDeg(sum.MeanRotationRadPerM());
     out.drift.push_back(std::move(drift));

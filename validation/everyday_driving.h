@@ -30,6 +30,12 @@ struct DriftAtLength {
   // (validation/never_worse.h); translation_percent is their mean weighted by the windows.
   std::vector<double> per_run_translation_percent = {};
   std::vector<int> per_run_windows = {};
+  // Appends one run's mean over its windows and their number, and counts them in `windows`.
+  void AddRun(double run_translation_percent, int run_windows) {
+    per_run_translation_percent.push_back(run_translation_percent);
+    per_run_windows.push_back(run_windows);
+    windows += run_windows;
+  }
 };
 
 struct EverydayDrivingMetrics {

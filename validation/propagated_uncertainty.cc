@@ -7,7 +7,6 @@
 #include <cmath>
 #include <memory>
 
-
 namespace fitcal {
 namespace {
 

@@ -301,9 +301,7 @@ void AddDrift(const std::vector<DriftWindows>& drift, io::ReportData* data) {
 void AddRunDrift(const std::vector<RelativePoseErrorWindow>& windows, DriftAtLength* drift) {
   RelativePoseErrorSum sum;
   for (const RelativePoseErrorWindow& w : windows) sum.Add(w);
-  drift->per_run_translation_percent.push_back(sum.MeanTranslationPercent());
-  drift->per_run_windows.push_back(sum.windows);
-  drift->windows += sum.windows;
+  drift->AddRun(sum.MeanTranslationPercent(), sum.windows);
 }
 
 // fit's never-worse judgement (validation/never_worse.h) on the report's runs and drift lengths:
