@@ -34,8 +34,8 @@ struct CalibrationRequest {
   bool check_channel_order = true;
   bool will_write = true;  // a record is made (and an uncertainty must exist) only then
   bool bounds_widened = false;  // a parameter on its bound is written, with a warning
-  // The model's closed forms alone against the nominal (asoc-geometric): no method fit, no choice
-  // by transfer, no halves; the same gate, never-worse rule, bound check and record.
+  // The model's closed forms alone against the nominal (--closed-form-only): no method fit, no
+  // choice by transfer, no halves; the same gate, never-worse rule, bound check and record.
   bool closed_forms_only = false;
 };
 

@@ -24,7 +24,6 @@
 #include "io/input_error.h"
 #include "io/input_registry.h"
 #include "odometry/memory_reuse.h"
-#include "cli/asoc_commands.h"
 #include "cli/command_line.h"
 #include "cli/cli_validators.h"
 #include "io/command_failure.h"
@@ -36,6 +35,7 @@
 #include "cli/import_optiodom.h"
 #include "cli/import_rosbag2.h"
 #include "cli/model_generalise_command.h"
+#include "cli/paper_tables_command.h"
 #include "cli/report_command.h"
 #include "cli/simulate_command.h"
 
@@ -126,14 +126,9 @@ std::vector<Command> Commands() {
       MakeCommand("", "fleet",
                   "Calibrations across robots and dates: a table per robot, outliers and trends",
                   &AddFleetOptions, &RunFleetCommand),
-      MakeCommand("", "asoc-simulate",
-                  "Write a simulated ASOC data set (calibration holds, UMBmark, excursions)",
-                  &AddAsocSimulateOptions, &RunAsocSimulate),
-      MakeCommand("", "asoc-geometric",
-                  "Closed-form ASOC calibration (Doebbler Eq. 1-9) from hold runs",
-                  &AddAsocGeometricOptions, &RunAsocGeometric),
-      MakeCommand("", "asoc-tables", "Reproduce Doebbler et al. Tables I and II in simulation",
-                  &AddAsocTablesOptions, &RunAsocTables),
+      MakeCommand("", "paper-tables",
+                  "A paper's tables reproduced in simulation by --model (docs/asoc.md)",
+                  &AddPaperTablesOptions, &RunPaperTablesCommand),
   };
 }
 

@@ -17,9 +17,22 @@
 #include "io/atomic_file.h"
 #include "io/calibration_block.h"
 #include "io/output_guard.h"
+#include "io/text_file.h"
 #include "models/model_registry.h"
 
 namespace fitcal::tools {
+
+// The models that register closed forms, each with its methods: "<model>: <method>; ...".
+std::string ClosedFormsOfModels() {
+  std::vector<std::string> models;
+  for (const ModelRegistration& m : RegisteredModels()) {
+    if (!m.extras.closed_forms.empty()) {
+      models.push_back(m.name + ": " + io::Joined(m.extras.closed_forms, ", "));
+    }
+  }
+  std::sort(models.begin(), models.end());
+  return io::Joined(models, "; ");
+}
 
 void AddFitOptions(CLI::App& app, FitCommandOptions& o) {
   AddDatasetOptions(app, o, LogsFlag::kCheckedByCommand);
@@ -28,7 +41,8 @@ void AddFitOptions(CLI::App& app, FitCommandOptions& o) {
   AddTrackResidualOptions(app, o);
   CLI::Option* reps =
       app.add_option("--train-reps", o.train_reps,
-                     "Repetitions used for fitting, e.g. 1-5 or 1,3,5; the others validate")
+                     "Repetitions used for fitting (or the closed forms), e.g. 1-5 or 1,3,5; the "
+                     "others validate")
           ->capture_default_str()
           ->check(RepetitionListValidator());
   app.add_option("--train-trajectories", o.train_trajectories,
@@ -58,6 +72,14 @@ void AddFitOptions(CLI::App& app, FitCommandOptions& o) {
                  "YAML declares is refitted without naming it")
       ->delimiter(',');
   AddTyingFlags(app, o);
+  app.add_flag("--closed-form-only", o.closed_forms_only,
+               "No fit: the model's closed-form calibrations alone against the nominal, through "
+               "the same gate (" + ClosedFormsOfModels() + ")");
+  app.callback([&app, &o] {
+    for (const CLI::Option* option : app.get_options()) {
+      if (option->count() > 0) o.given.insert(option->get_name());
+    }
+  });
 }
 
 namespace {
@@ -83,6 +105,19 @@ std::optional<EffectModel> EffectsToFit(const FitCommandOptions& options, const 
 // A flag the fit asked for would not use: "" or the refusal's one line (exit 2), so that nothing
 // the user set is dropped without a word. Defaults are those of SolverOptions (a flag given at its
 // default changes nothing either way).
+// --closed-form-only runs no fit: "" or the one line refusing a flag only a fit uses.
+std::string FitFlagBesideClosedForms(const FitCommandOptions& o) {
+  for (const char* flag : {"--method", "--effects", "--tie", "--hold", "--time-blocks",
+                           "--residuals", "--clock-offsets", "--track-heading", "--weights",
+                           "--objective", "--loss", "--loss-scale", "--seed", "--max-evaluations",
+                           "--max-iterations", "--polish"}) {
+    if (o.given.count(flag) > 0) {
+      return std::string("--closed-form-only runs no fit, so it cannot take ") + flag;
+    }
+  }
+  return "";
+}
+
 std::string FlagThatDoesNotApply(const FitCommandOptions& o) {
   const SolverOptions defaults;
   const bool ceres = IsCeresMethod(o.method);
@@ -180,6 +215,12 @@ int MakeRequest(const FitCommandOptions& options, const Robot& robot,
   if (const int refused = ReadTyingAndEffects(options, robot, request); refused != 0) {
     return refused;
   }
+  if (options.closed_forms_only && ExtrasOf(robot.model).closed_forms.empty()) {
+    std::cerr << "fitcal: --closed-form-only: the " << robot.model
+              << " model computes no closed form (models that do: " << ClosedFormsOfModels()
+              << ")\n";
+    return 2;
+  }
   if (!options.no_output && !options.force) {
     const std::string refusal = io::OverwriteRefusal(options.out, robot.name);
     if (!refusal.empty()) return Refuse(refusal);
@@ -247,6 +288,11 @@ int RunFitCommand(const FitCommandOptions& options) {
   std::string settings_error;
   if (!MakeFitMethodSettings(options, options.threads, &request.settings, &settings_error)) {
     std::cerr << "fitcal: " << settings_error << "\n";
+    return 2;
+  }
+  if (const std::string e = options.closed_forms_only ? FitFlagBesideClosedForms(options) : "";
+      !e.empty()) {
+    std::cerr << "fitcal: " << e << "\n";
     return 2;
   }
   return RunReportingErrors("fitcal", [&]() -> int {

@@ -2,6 +2,7 @@
 // `fitcal fit` (and plain `fitcal --logs ... --method ceres`): load a data set, fit on the
 // training repetitions, validate on the rest, print the table and write the calibrated YAML.
 
+#include <set>
 #include <string>
 #include <vector>
 
@@ -34,9 +35,11 @@ struct FitCommandOptions : DatasetCommandOptions, SolverOptions, TyingFlags {
   // Write a calibration with a parameter on its bound (fit/result_gate.h AtBoundRefusal): the user
   // widened the bounds on purpose and accepts a value that still ends on one.
   bool bounds_widened = false;
-  // Not a flag of `fit`: asoc-geometric's request, the robot's closed forms alone against the
-  // nominal (CalibrationRequest::closed_forms_only).
+  // --closed-form-only: the robot's closed forms alone against the nominal, no fit
+  // (CalibrationRequest::closed_forms_only); refused before the runs are read for a model that
+  // registers none (ModelExtras::closed_forms) and beside a flag only a fit uses.
   bool closed_forms_only = false;
+  std::set<std::string> given;  // the flags given on the command line, e.g. "--method"
 };
 
 // Declares every flag of `fit` on `app` (the `fit` subcommand, and the top level: `fitcal --logs

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <iostream>
 #include <optional>
+#include <utility>
 #include <stdexcept>
 
 #include "cli/dataset_command.h"
@@ -53,22 +54,34 @@ void PrintTruth(const Robot& robot, const std::vector<double>& truth) {
   }
 }
 
-// The flags as a request of the library, which decides what the model's scenario takes.
+// The flags as a request of the library, which decides what the model's scenario takes: a noise
+// flag not given leaves the model recorder's value.
 sim::ModelDatasetRequest RequestOf(const SimulateCommandOptions& options) {
+  const auto given = [&](const char* flag) { return options.given.count(flag) > 0; };
+  const std::pair<const char*, std::pair<double ScenarioRecorder::*, double>> recorder_flags[] = {
+      {"--encoder-counts-per-rev",
+       {&ScenarioRecorder::ticks_per_rev, options.encoder_counts_per_rev}},
+      {"--wheel-rate-sigma-rad-s",
+       {&ScenarioRecorder::wheel_rate_sigma_rad_s, options.wheel_rate_sigma_rad_s}},
+      {"--wheel-slip-sigma", {&ScenarioRecorder::wheel_relative_sigma, options.wheel_slip_sigma}},
+      {"--angle-sigma-deg",
+       {&ScenarioRecorder::angle_sigma_rad, options.angle_sigma_deg * M_PI / 180.0}},
+      {"--gt-position-sigma-m",
+       {&ScenarioRecorder::gt_position_sigma_m, options.gt_position_sigma_m}},
+      {"--gt-heading-sigma-deg",
+       {&ScenarioRecorder::gt_heading_sigma_rad, options.gt_heading_sigma_deg * M_PI / 180.0}}};
   sim::ModelDatasetRequest r;
   r.out = options.out;
   r.model = options.model;
-  r.robot = options.robot_given || options.model.empty() ? options.robot : "";
+  r.robot = given("--robot") || options.model.empty() ? options.robot : "";
   r.truth = options.truth;
   r.force = options.force;
-  r.noise.repetitions = options.repetitions;
+  if (given("--repetitions")) r.noise.repetitions = options.repetitions;
   r.noise.seed = options.seed;
-  r.noise.ticks_per_rev = options.encoder_counts_per_rev;
-  r.noise.wheel_rate_sigma_rad_s = options.wheel_rate_sigma_rad_s;
-  r.noise.angle_sigma_rad = options.angle_sigma_deg * M_PI / 180.0;
-  r.noise.gt_position_sigma_m = options.gt_position_sigma_m;
-  r.noise.gt_heading_sigma_rad = options.gt_heading_sigma_deg * M_PI / 180.0;
-  if (options.slip_sigma_given) r.noise.slip_sigma = options.slip_sigma;
+  for (const auto& [flag, value] : recorder_flags) {
+    if (given(flag)) r.noise.recorder_values.push_back(value);
+  }
+  if (given("--slip-sigma")) r.noise.slip_sigma = options.slip_sigma;
   for (const std::string& text : options.inject) {
     r.noise.injected_effects.push_back(ParseInjectedEffect(text));
   }
@@ -88,32 +101,37 @@ void AddSimulateOptions(CLI::App& app, SimulateCommandOptions& o) {
   app.add_option("--truth", o.truth,
                  "Robot YAML of the true robot (default: the scenario's, docs/simulate.md)")
       ->check(CLI::ExistingFile);
-  app.add_option("--repetitions", o.repetitions, "Repetitions of each trajectory")
-      ->capture_default_str()
-      ->check(PositiveNumber());
+  // The recorder's values below are the model's unless given (docs/simulate.md).
+  app.add_option("--repetitions", o.repetitions,
+                 "Repetitions of each trajectory (default: the model's scenario, docs/simulate.md)")
+      ->check(NonNegativeNumber());
   app.add_option("--seed", o.seed, "Random seed")->capture_default_str();
-  app.add_option("--encoder-counts-per-rev", o.encoder_counts_per_rev, "Encoder resolution")
-      ->capture_default_str();
-  app.add_option("--gt-position-sigma-m", o.gt_position_sigma_m, "Ground-truth position noise (m)")
-      ->capture_default_str();
+  app.add_option("--encoder-counts-per-rev", o.encoder_counts_per_rev,
+                 "Encoder resolution (default: the model's recorder)");
+  app.add_option("--gt-position-sigma-m", o.gt_position_sigma_m,
+                 "Ground-truth position noise (m; default: the model's recorder)");
   app.add_option("--gt-heading-sigma-deg", o.gt_heading_sigma_deg,
-                 "Ground-truth heading noise (deg)")
-      ->capture_default_str();
+                 "Ground-truth heading noise (deg; default: the model's recorder)");
   app.add_option("--slip-sigma", o.slip_sigma, "Relative wheel slip noise (stepped physics)")
       ->capture_default_str();
+  app.add_option("--wheel-slip-sigma", o.wheel_slip_sigma,
+                 "perfect tracking: relative noise on each wheel's advance per encoder interval "
+                 "(default: the model's recorder)")
+      ->check(NonNegativeNumber());
   app.add_option("--wheel-rate-sigma-rad-s", o.wheel_rate_sigma_rad_s,
-                 "perfect tracking: white noise on each interval's mean wheel rate (rad/s)")
-      ->capture_default_str();
+                 "perfect tracking: white noise on each interval's mean wheel rate (rad/s; "
+                 "default: the model's recorder)");
   app.add_option("--angle-sigma-deg", o.angle_sigma_deg,
-                 "--model: noise of an angle channel's readings, e.g. steering (deg)")
-      ->capture_default_str();
+                 "--model: noise of an angle channel's readings, e.g. steering (deg; default: "
+                 "the model's recorder)");
   app.add_flag("--force", o.force, io::kForceDirectoryHelp);
   app.add_option("--inject", o.inject,
                  "Inject a library effect, name=value[,value] (docs/simulate.md); repeatable; "
                  "the data set does not name it");
   app.callback([&app, &o] {
-    o.robot_given = app.count("--robot") > 0;
-    o.slip_sigma_given = app.count("--slip-sigma") > 0;
+    for (const CLI::Option* option : app.get_options()) {
+      if (option->count() > 0) o.given.insert(option->get_name());
+    }
   });
 }
 
@@ -123,7 +141,7 @@ int RunSimulateCommand(const SimulateCommandOptions& options) {
     const sim::WrittenModelDataset written = sim::WriteModelDataset(r);
     const Robot& robot = written.model->robot();
     std::printf("wrote %zu runs of the %s robot '%s' (%d repetitions, seed %llu) to %s\n",
-                written.num_runs, robot.model.c_str(), robot.name.c_str(), r.noise.repetitions,
+                written.num_runs, robot.model.c_str(), robot.name.c_str(), written.repetitions,
                 static_cast<unsigned long long>(r.noise.seed), options.out.c_str());
     PrintTruth(robot, written.truth);
     return 0;

@@ -3,6 +3,7 @@
 // model; omni3's scenario is Palacin's flower) through sim/model_dataset.h (docs/simulate.md).
 
 #include <cstdint>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -15,12 +16,13 @@ class App;
 
 namespace fitcal::tools {
 
+// The noise flags replace the model's recorder's values (ModelExtras::scenario.recorder) only when
+// given: each is read into the request from `given` (its flag names).
 struct SimulateCommandOptions {
   std::string out;
   std::string model;  // "": the --robot's model
   std::string robot = "data/robots/apr02.yaml";  // nominal robot: commands + fit start
-  bool robot_given = false;  // --model: without --robot the model's registry example is nominal
-  std::string truth;         // robot YAML of the true robot; "" = the scenario's default
+  std::string truth;  // robot YAML of the true robot; "" = the scenario's default
   bool force = false;
   // Effects to inject, "name=v1[,v2]" with the registry's names and parameter order
   // (odometry/effects.h); the data set written names none of them.
@@ -31,9 +33,10 @@ struct SimulateCommandOptions {
   double gt_position_sigma_m = 0.002;
   double gt_heading_sigma_deg = 0.2;
   double slip_sigma = sim::SteppedOptions{}.slip_sigma;  // the stepped physics only
-  bool slip_sigma_given = false;
-  double wheel_rate_sigma_rad_s = sim::ScenarioNoise{}.wheel_rate_sigma_rad_s;
-  double angle_sigma_deg = sim::ScenarioNoise{}.angle_sigma_rad * 180.0 / M_PI;
+  double wheel_slip_sigma = 0.0;                          // perfect tracking only
+  double wheel_rate_sigma_rad_s = 0.02;
+  double angle_sigma_deg = 0.1;
+  std::set<std::string> given;  // the flags given, e.g. "--robot"
 };
 
 // Declares every flag of `simulate` on its subcommand `app`, bound to `options`; once parsed, the

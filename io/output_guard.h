@@ -1,7 +1,7 @@
 #pragma once
 // What an output may replace: the one rule of every command that writes (README, "Outputs").
 //   1. Running a command again replaces its own previous output at --out: a calibration of the
-//      same robot (fit, diagnose, asoc-geometric, export --calibration-out), the parameter file of
+//      same robot (fit, diagnose, export --calibration-out), the parameter file of
 //      the same controller node (export), compare's tables, a data set fitcal wrote (import,
 //      simulate), a report or page directory holding only the files the command writes. Each is
 //      recreated from inputs that still exist (an output never overlaps an input), so replacing it

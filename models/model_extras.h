@@ -1,10 +1,12 @@
 #pragma once
 // What a model offers beyond the seam, registered with it (model_registry.h,
 // ModelRegistration::extras) from its own folder: the ROS 2 controllers it can be exported to,
-// the trajectories the simulator calibrates it on, how `compare` shows its parameters. Every field
-// is optional. The commands ask the
-// registry for these and never compare a model's name (STYLE.md habit 14).
+// the trajectories the simulator calibrates it on and how they are recorded, the closed forms it
+// computes, a published table it reproduces, how `compare` shows its parameters. Every field is
+// optional. The commands ask the registry for these and never compare a model's name (STYLE.md
+// habit 14).
 
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -14,6 +16,7 @@
 
 #include "models/model_interface.h"
 #include "models/trajectory_spec.h"
+#include "odometry/run_log.h"
 
 namespace fitcal {
 
@@ -55,10 +58,6 @@ struct ControllerWriter {
   ControllerWriteFn write;
 };
 
-// The trajectories `simulate --model` drives the model on (sim/model_scenarios.h), and
-// how far its default true robot is from the nominal one (a fraction of the way to the bounds).
-// The commands are the nominal robot's; the true parameters may only limit what the machine can
-// drive (a tricycle's readable steering range).
 // A channel that is a state of the machine, not a function of the body twist (an ASOC castor's
 // angle follows its pivot's motion: asoc_extras.h). The simulator's perfect tracking asks the
 // model's dynamics for every fine step in place of ChannelsForTwist.
@@ -76,10 +75,36 @@ using ChannelDynamicsFactory = std::function<std::unique_ptr<ChannelDynamics>(
     const RobotModelInterface& model, const std::vector<double>& truth,
     const sim::TrajectorySpec& spec)>;
 
+// How a simulated data set is recorded (sim/model_scenarios.h turns it into the simulator's
+// options; `simulate`'s noise flags replace single values). The defaults are a generic robot's
+// (docs/simulate.md: 100 Hz encoders of 4096 counts with rate noise, 5 Hz ground truth with 2 mm
+// and 0.2 deg of noise, runs started anywhere within +-2 m); a model whose paper recorded
+// otherwise registers its own (asoc: Doebbler's 20 Hz prototype, asoc_extras.h).
+struct ScenarioRecorder {
+  double encoder_period_s = 0.010;
+  double ticks_per_rev = 4096.0;         // wheel channels; 0 = no quantisation
+  double wheel_rate_sigma_rad_s = 0.02;  // white noise on each interval's mean wheel rate
+  // Each wheel's counted advance over an interval scaled by (1 + N(0, sigma)): a slip per sample.
+  double wheel_relative_sigma = 0.0;
+  double angle_sigma_rad = 0.1 * M_PI / 180.0;  // white noise on an angle channel's readings
+  double ground_truth_period_s = 0.2;
+  double gt_position_sigma_m = 0.002;
+  double gt_heading_sigma_rad = 0.2 * M_PI / 180.0;
+  double start_position_range_m = 2.0;  // each axis uniform in +-range about the origin
+  bool random_start_heading = true;
+  double substep_s = 0.0;  // the true motion's longest step; 0: the simulator's default
+};
+
+// The trajectories `simulate --model` drives the model on (sim/model_scenarios.h), how they are
+// recorded, and how far its default true robot is from the nominal one (a fraction of the way to
+// the bounds). The commands are the nominal robot's; the true parameters may only limit what the
+// machine can drive (a tricycle's readable steering range).
 struct SimulationScenario {
   std::function<std::vector<sim::TrajectorySpec>(
       const RobotModelInterface& nominal, const std::vector<double>& truth, int repetitions)>
       trajectories;  // empty: the model has no scenario
+  int default_repetitions = 10;  // `simulate` without --repetitions
+  ScenarioRecorder recorder;
   double truth_fraction = 0.25;
   // The default true robot when the model has its own (omni3: Palacin Table 5, any seed; asoc:
   // drawn from `seed` as Doebbler Table I); empty: the nominal moved truth_fraction of the way to
@@ -102,9 +127,38 @@ struct ParameterDisplay {
   std::function<std::string(const std::vector<double>&)> markdown;
 };
 
+// Runs of the true parameters `truth` (robot().parameters order) along the trajectories, as the
+// model's recorder records them; `seed` the noise's (sim/model_scenarios.h ScenarioSimulator).
+using SimulateFn = std::function<std::vector<RunLog>(const std::vector<double>& truth,
+                                                     const std::vector<sim::TrajectorySpec>& specs,
+                                                     std::uint64_t seed)>;
+
+// What `fitcal paper-tables --model <name>` asks of a model that reproduces a paper's tables by
+// Monte Carlo: `sets` random vehicles, drawn from `seed`, with the relative wheel noise of the
+// recorder set to wheel_slip_sigma.
+struct PaperTablesRequest {
+  int sets = 1000;
+  std::uint64_t seed = 1;
+  double wheel_slip_sigma = 0.0;
+  int threads = 0;  // 0 = all cores
+};
+
+// A paper's tables reproduced in simulation (asoc: Doebbler et al. Tables I and II,
+// asoc_tables.h): the runs recorded as `recorder` says, the tables as printed, paper values beside.
+struct PaperTables {
+  ScenarioRecorder recorder;
+  std::function<std::string(const RobotModelInterface& nominal, const PaperTablesRequest& request,
+                            const SimulateFn& simulate)>
+      reproduce;  // empty: the model reproduces no table
+};
+
 struct ModelExtras {
   std::vector<ControllerWriter> controllers;
   SimulationScenario scenario;
+  // The methods of the closed forms RobotModelInterface::ClosedForms computes ("umbmark"); empty:
+  // none, and `fit --closed-form-only` is refused before any run is read.
+  std::vector<std::string> closed_forms;
+  PaperTables paper_tables;
   // Empty: the parameters in display units (m, deg).
   std::function<ParameterDisplay(const Robot&)> display;
 };

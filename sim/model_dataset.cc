@@ -76,6 +76,7 @@ WrittenModelDataset WriteModelDataset(const ModelDatasetRequest& request) {
     io::WriteFileAtomically((fs::path(directory) / "true_robot.yaml").string(),
                             model.RobotYaml(written.truth, ""));
     written.num_runs = runs.size();
+    written.repetitions = scenario.repetitions;
   });
   return written;
 }

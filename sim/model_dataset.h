@@ -29,6 +29,7 @@ struct WrittenModelDataset {
   RobotModelPtr model;         // the nominal robot, as robot.yaml holds it
   std::vector<double> truth;   // the true parameters, as true_robot.yaml holds them
   std::size_t num_runs = 0;
+  int repetitions = 0;         // as asked, or the scenario's default
 };
 
 // Throws UsageError for an `out` it may not write or a robot of another model,

@@ -26,6 +26,14 @@ std::string ModelNamesWith(const std::function<bool(const ModelExtras&)>& has) {
 // scenario without it: perfect tracking has no slip and no substep the effects act on.
 void SetSteppedPhysics(const Robot& robot, const SimulationScenario& scenario,
                        const ScenarioNoise& noise, SimulationOptions* o) {
+  const auto replaces = [&](double ScenarioRecorder::*value) {
+    return std::any_of(noise.recorder_values.begin(), noise.recorder_values.end(),
+                       [&](const auto& replaced) { return replaced.first == value; });
+  };
+  if (scenario.stepped_physics && replaces(&ScenarioRecorder::wheel_relative_sigma)) {
+    throw UsageError("--wheel-slip-sigma acts on perfect tracking; the stepped physics of "
+                     "--model " + robot.model + " slips as --slip-sigma says (docs/simulate.md)");
+  }
   if (!scenario.stepped_physics) {
     if (noise.slip_sigma || !noise.injected_effects.empty()) {
       throw UsageError(std::string(noise.slip_sigma ? "--slip-sigma" : "--inject") +
@@ -57,10 +65,39 @@ std::string ScenarioModelNames() {
   return ModelNamesWith([](const ModelExtras& e) { return bool(e.scenario.trajectories); });
 }
 
+ScenarioRecorder WithReplacements(ScenarioRecorder recorder, const ScenarioNoise& noise) {
+  for (const auto& [value, replacement] : noise.recorder_values) recorder.*value = replacement;
+  return recorder;
+}
+
+SimulationOptions RecordedAs(const RobotModelInterface& model, const ScenarioRecorder& recorder,
+                             std::uint64_t seed) {
+  const Robot& robot = model.robot();
+  SimulationOptions o;
+  o.encoder_period_s = recorder.encoder_period_s;
+  o.ground_truth_period_s = recorder.ground_truth_period_s;
+  if (recorder.substep_s > 0.0) o.substep_s = recorder.substep_s;
+  o.ticks_per_rev.assign(robot.channels.size(), 0.0);
+  for (std::size_t i = 0; i < robot.channels.size(); ++i) {
+    if (robot.channels[i].kind == ChannelKind::kWheelRate) {
+      o.ticks_per_rev[i] = recorder.ticks_per_rev;
+    }
+  }
+  o.wheel_rate_sigma_rad_s = recorder.wheel_rate_sigma_rad_s;
+  o.wheel_relative_sigma = recorder.wheel_relative_sigma;
+  o.angle_sigma_rad = recorder.angle_sigma_rad;
+  o.gt_position_sigma_m = recorder.gt_position_sigma_m;
+  o.gt_heading_sigma_rad = recorder.gt_heading_sigma_rad;
+  o.start_position_range_m = recorder.start_position_range_m;
+  o.random_start_heading = recorder.random_start_heading;
+  o.seed = seed;
+  o.dynamics = ExtrasOf(robot.model).scenario.dynamics;
+  return o;
+}
+
 ModelScenario MakeModelScenario(const RobotModelInterface& model, const std::vector<double>& truth,
                                 const ScenarioNoise& noise) {
   const Robot& robot = model.robot();
-  if (noise.repetitions < 0) throw std::invalid_argument("--repetitions must be at least 0");
   const SimulationScenario& scenario = ExtrasOf(robot.model).scenario;
   if (!scenario.trajectories) {
     throw std::invalid_argument(
@@ -68,26 +105,45 @@ ModelScenario MakeModelScenario(const RobotModelInterface& model, const std::vec
         ScenarioModelNames() + ")");
   }
   ModelScenario out;
-  out.trajectories = scenario.trajectories(model, truth, noise.repetitions);
-  SimulationOptions& o = out.options;
-  o.encoder_period_s = noise.encoder_period_s;
-  o.ground_truth_period_s = noise.ground_truth_period_s;
-  o.ticks_per_rev.assign(robot.channels.size(), 0.0);
-  for (std::size_t i = 0; i < robot.channels.size(); ++i) {
-    if (robot.channels[i].kind == ChannelKind::kWheelRate) o.ticks_per_rev[i] = noise.ticks_per_rev;
+  out.repetitions = noise.repetitions.value_or(scenario.default_repetitions);
+  if (out.repetitions < 0) throw std::invalid_argument("--repetitions must be at least 0");
+  out.trajectories = scenario.trajectories(model, truth, out.repetitions);
+  if (out.trajectories.empty()) {
+    throw UsageError("--repetitions 0: the " + robot.model +
+                     " scenario drives no run without repetitions");
   }
-  o.wheel_rate_sigma_rad_s = noise.wheel_rate_sigma_rad_s;
-  o.wheel_relative_sigma = noise.wheel_relative_sigma;
-  o.angle_sigma_rad = noise.angle_sigma_rad;
-  o.gt_position_sigma_m = noise.gt_position_sigma_m;
-  o.gt_heading_sigma_rad = noise.gt_heading_sigma_rad;
-  o.start_position_range_m = noise.start_position_range_m;
-  o.random_start_heading = true;
-  o.seed = noise.seed;
-  o.dynamics = scenario.dynamics;
-  SetSteppedPhysics(robot, scenario, noise, &o);
+  out.options = RecordedAs(model, WithReplacements(scenario.recorder, noise), noise.seed);
+  SetSteppedPhysics(robot, scenario, noise, &out.options);
   if (scenario.stepped_physics) out.digits = EncoderCsvDigits::kRecorder;
   return out;
+}
+
+SimulateFn ScenarioSimulator(const RobotModelInterface& model, const ScenarioRecorder& recorder) {
+  return [&model, recorder](const std::vector<double>& truth,
+                            const std::vector<TrajectorySpec>& specs, std::uint64_t seed) {
+    std::vector<RunLog> logs;
+    const SimulationOptions options = RecordedAs(model, recorder, seed);
+    for (ModelSimulatedRun& run : SimulateRuns(model, truth, specs, options)) {
+      logs.push_back(std::move(run.log));
+    }
+    return logs;
+  };
+}
+
+std::string ReproducePaperTables(const std::string& model, const PaperTablesRequest& request) {
+  const ModelRegistration* registration = FindModel(model);
+  if (registration == nullptr || !registration->extras.paper_tables.reproduce) {
+    throw UsageError("--model " + model + " reproduces no paper's tables (models that do: " +
+                     ModelNamesWith([](const ModelExtras& e) {
+                       return bool(e.paper_tables.reproduce);
+                     }) + ")");
+  }
+  const PaperTables& tables = registration->extras.paper_tables;
+  const RobotModelPtr nominal =
+      ReadRobotModel(YAML::Load(registration->example_yaml), model + " example robot");
+  ScenarioRecorder recorder = tables.recorder;
+  recorder.wheel_relative_sigma = request.wheel_slip_sigma;
+  return tables.reproduce(*nominal, request, ScenarioSimulator(*nominal, recorder));
 }
 
 std::vector<double> DefaultTrueParameters(const Robot& robot, std::uint64_t seed) {

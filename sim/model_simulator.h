@@ -96,7 +96,7 @@ struct SimulationOptions {
   std::vector<double> ticks_per_rev;
   double wheel_rate_sigma_rad_s = 0.0;
   // Each wheel channel's counted advance over an encoder interval scaled by (1 + N(0, sigma)):
-  // floor roughness, small slips (Doebbler's non-systematic error, asoc-tables).
+  // floor roughness, small slips (Doebbler's non-systematic error, paper-tables --model asoc).
   double wheel_relative_sigma = 0.0;
   double angle_sigma_rad = 0.0;
   double gt_position_sigma_m = 0.0;

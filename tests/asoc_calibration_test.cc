@@ -204,8 +204,8 @@ namespace {
 // with RK4, and quantised encoders; it shares the castor kinematics of asoc_model.h with the library, not
 // Eq. 1-9 nor the replay), over 30 random vehicles per noise level: quantisation only, and 2 % and
 // 5 % random error on each wheel increment (the sigmas add the pivot step, 0.07 deg, propagated
-// through Eq. 1-9, as robot.yaml of asoc-simulate states it). Each of the 18 parameters' error
-// over its sigma, z:
+// through Eq. 1-9, as robot.yaml of `simulate --model asoc` states it). Each of the 18
+// parameters' error over its sigma, z:
 //   - |z| <= 3 for at least 95 % of the 540 (a t with 3 dof widened to 1 sigma gives 96 %);
 //   - |z| <= 1 for 50-90 % (68 % expected), so the sigmas are neither too narrow nor too wide;
 //   - per parameter kind (r_c, r_w, d, beta: 90 or 180 z's) RMS z in 0.4-2.5: a sigma 10x too
@@ -270,10 +270,10 @@ TEST(AsocGeometricTest, SigmasCoverTheErrorOnSimulatedVehicles) {
   }
 }
 
-// asoc-simulate's data set (the asoc model's scenario, asoc_extras.h): 6 holds, 10 UMBmark
-// circuits as repetitions 6-10 and the excursions as 1..N, every id distinct; the closed form on
-// its holds lands nearer the drawn truth than the prototype is (noise-free encoders but the pivot
-// step), so the truth the scenario draws is the one that drove the runs.
+// `simulate --model asoc`'s data set (the asoc model's scenario, asoc_extras.h): 6 holds, 10
+// UMBmark circuits as repetitions 6-10 and the excursions as 1..N, every id distinct; the closed
+// form on its holds lands nearer the drawn truth than the prototype is (noise-free encoders but
+// the pivot step), so the truth the scenario draws is the one that drove the runs.
 TEST(AsocScenarios, TheSimulatedDataSetIsDrivenByTheTruthItWrites) {
   const AsocModel& model = ExampleAsocModel();
   const SimulationScenario& scenario = ExtrasOf("asoc").scenario;

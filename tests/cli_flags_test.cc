@@ -75,9 +75,9 @@ std::vector<double> Captured(const std::string& text, const std::string& pattern
 }
 
 // ---------------------------------------------------------------------------------------------
-// asoc-geometric and asoc-tables.
+// fit --closed-form-only (asoc-geometric until asoc41) and paper-tables --model asoc (asoc-tables).
 
-// asoc-geometric (fit with the closed form alone, through its gate) writes the closed form with a
+// fit --closed-form-only (the closed form alone, through fit's gate) writes the closed form with a
 // sigma for every parameter it measures, and each estimate is within 4 sigma of the simulator's
 // truth (true_robot.yaml; asoc_calibration_test checks the coverage over 90 vehicles: 99 % within 3
 // sigma, so 4 holds for these 18 on seed 3), and much closer to it than the nominal for the wheel
@@ -87,9 +87,10 @@ std::vector<double> Captured(const std::string& text, const std::string& pattern
 TEST(AsocCommands, GeometricWritesEstimatesWithinTheirSigmasOfTheTruth) {
   TempDir tmp;
   const std::string data = tmp.Path("asoc"), out = tmp.Path("geo.yaml");
-  ASSERT_EQ(RunFitcal(tmp, "asoc-simulate --out " + data + " --excursions 0 --seed 1").exit_code,
-            0);
-  const FitcalRun r = RunFitcal(tmp, "asoc-geometric --logs " + data + " --out " + out);
+  ASSERT_EQ(
+      RunFitcal(tmp, "simulate --model asoc --out " + data + " --repetitions 0 --seed 1").exit_code,
+      0);
+  const FitcalRun r = RunFitcal(tmp, "fit --closed-form-only --logs " + data + " --out " + out);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(Has(r.out, "no fit: the robot's closed forms alone against the nominal")) << r.out;
   EXPECT_TRUE(Has(r.out, "result gate, CF on held-out runs (10):")) << r.out;
@@ -143,7 +144,7 @@ TEST(AsocCommands, GeometricWritesEstimatesWithinTheirSigmasOfTheTruth) {
   }
 }
 
-// asoc-geometric goes through fit's gate: a closed form that does not beat the nominal on the
+// fit --closed-form-only goes through fit's gate: a closed form that does not beat the nominal on the
 // held-out runs is not written. The nominal here is the simulator's truth (true_robot.yaml as
 // robot.yaml), which the estimate from quantised hold runs does not beat on the UMBmark circuits
 // held out on seed 5 (CF 0.0033 against the closed form's 0.0054; on seeds 1-3 the closed form's
@@ -151,11 +152,12 @@ TEST(AsocCommands, GeometricWritesEstimatesWithinTheirSigmasOfTheTruth) {
 TEST(AsocCommands, GeometricRefusesAClosedFormThatDoesNotBeatTheNominal) {
   TempDir tmp;
   const std::string data = tmp.Path("asoc"), out = tmp.Path("geo.yaml");
-  ASSERT_EQ(RunFitcal(tmp, "asoc-simulate --out " + data + " --excursions 0 --seed 5").exit_code,
-            0);
+  ASSERT_EQ(
+      RunFitcal(tmp, "simulate --model asoc --out " + data + " --repetitions 0 --seed 5").exit_code,
+      0);
   std::filesystem::copy_file(data + "/true_robot.yaml", data + "/robot.yaml",
                              std::filesystem::copy_options::overwrite_existing);
-  const FitcalRun r = RunFitcal(tmp, "asoc-geometric --logs " + data + " --out " + out);
+  const FitcalRun r = RunFitcal(tmp, "fit --closed-form-only --logs " + data + " --out " + out);
   EXPECT_EQ(r.exit_code, 5) << r.out << r.err;
   EXPECT_EQ(r.err,
             "fitcal: no calibration beats the nominal robot on the held-out runs (10); nothing "
@@ -163,26 +165,38 @@ TEST(AsocCommands, GeometricRefusesAClosedFormThatDoesNotBeatTheNominal) {
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
-// A robot whose model computes no closed form (the omni3 flower) has nothing for asoc-geometric to
-// judge: one line, exit 1, nothing written.
-TEST(AsocCommands, GeometricRefusesARobotWithoutAClosedForm) {
+// A robot whose model registers no closed form (the omni3 flower) has nothing for
+// --closed-form-only to judge: one line naming the model and those that have one, exit 2, before
+// any run is read (here the runs are missing) and nothing written. A flag only a fit uses is
+// refused beside it the same way. Before (asoc-geometric), the runs were read and fitcal exited 1.
+TEST(AsocCommands, ClosedFormOnlyRefusesAModelWithoutOneBeforeReadingRuns) {
   TempDir tmp;
-  const std::string out = tmp.Path("geo.yaml");
-  const FitcalRun r = RunFitcal(tmp, "asoc-geometric --logs " + kFlower + " --out " + out);
-  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
-  EXPECT_EQ(r.err, "fitcal: " + kFlower +
-                       ": the robot's model computes no closed form from the training runs "
-                       "(repetitions 1-5); nothing written\n");
+  const std::string data = tmp.Path("flower"), out = tmp.Path("cal.yaml");
+  std::filesystem::create_directories(data);
+  for (const char* file : {"/dataset.yaml", "/robot.yaml"}) {
+    std::filesystem::copy_file(kFlower + file, data + file);
+  }
+  const FitcalRun without = RunFitcal(tmp, "fit --logs " + data + " --out " + out);
+  EXPECT_EQ(without.exit_code, 1) << without.err;  // the runs are missing
+  const FitcalRun r = RunFitcal(tmp, "fit --closed-form-only --logs " + data + " --out " + out);
+  EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+  EXPECT_EQ(r.err,
+            "fitcal: --closed-form-only: the omni3 model computes no closed form (models that "
+            "do: asoc: asoc-geometric; diff_drive: umbmark)\n");
+  const FitcalRun method =
+      RunFitcal(tmp, "fit --closed-form-only --method crs2lm --logs " + kFlower + " --no-output");
+  EXPECT_EQ(method.exit_code, 2) << method.err;
+  EXPECT_EQ(method.err, "fitcal: --closed-form-only runs no fit, so it cannot take --method\n");
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
-// asoc-tables: Table I's calibrated errors far below the uncalibrated ones (the drawn errors are
+// paper-tables --model asoc (Doebbler's Tables I and II): Table I's calibrated errors far below the uncalibrated ones (the drawn errors are
 // 2 % for r_w and 8 deg for beta; the closed form's are set by the 0.07 deg pivot step: beta
 // within q/2 = 0.035 deg), Table II's calibrated E_max 10x below the uncalibrated for every
-// algorithm, over the --sets asked for; --sets 0 refused.
+// algorithm, over the --sets asked for; --sets 0 and a model without tables refused.
 TEST(AsocCommands, TablesCalibrateEveryDrawnSet) {
   TempDir tmp;
-  const FitcalRun r = RunFitcal(tmp, "asoc-tables --sets 4 --seed 1 --threads 2");
+  const FitcalRun r = RunFitcal(tmp, "paper-tables --model asoc --sets 4 --seed 1 --threads 2");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(Has(r.out, "Tables I and II, 4 random parameter sets (seed 1")) << r.out;
   const std::vector<double> rw = Captured(r.out, R"(\| r_w \| ([0-9.]+)% \| ([0-9.]+)% \|)");
@@ -199,9 +213,13 @@ TEST(AsocCommands, TablesCalibrateEveryDrawnSet) {
     ASSERT_EQ(e.size(), 2u) << algorithm << r.out;
     EXPECT_LT(e[1], 0.1 * e[0]) << algorithm;
   }
-  const FitcalRun none = RunFitcal(tmp, "asoc-tables --sets 0");
+  const FitcalRun none = RunFitcal(tmp, "paper-tables --model asoc --sets 0");
   EXPECT_EQ(none.exit_code, 2);
-  EXPECT_TRUE(Has(none.err, "--sets must be at least 1")) << none.err;
+  EXPECT_TRUE(Has(none.err, "--sets")) << none.err;
+  const FitcalRun omni3 = RunFitcal(tmp, "paper-tables --model omni3 --sets 1");
+  EXPECT_EQ(omni3.exit_code, 2);
+  EXPECT_EQ(omni3.err,
+            "fitcal: --model omni3 reproduces no paper's tables (models that do: asoc)\n");
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -687,8 +687,8 @@ TEST(CorpusNeighbours, ARunWhoseWheelsStandWhileItsGroundTruthMovesIsNamed) {
 
 // Bounds a robot YAML sets are the box of every calibration: a box of zero width is refused at
 // its line (Ceres failed on it and the gate wrote UMBmark's value outside it, exit 0), and a
-// closed form outside the box does not compete (asoc-geometric on a differential drive, the
-// closed forms alone, wrote wheel_separation 0.200285 m against bounds [0.19, 0.2001]).
+// closed form outside the box does not compete (fit --closed-form-only on a differential drive,
+// asoc-geometric until asoc41, wrote wheel_separation 0.200285 m against bounds [0.19, 0.2001]).
 TEST(CorpusNeighbours, NoCalibrationOutsideTheRobotsBounds) {
   const TempDir dir;
   const std::string data = SimulateDiffDrive(dir, "data");
@@ -713,7 +713,7 @@ TEST(CorpusNeighbours, NoCalibrationOutsideTheRobotsBounds) {
 
   with_box("wheel_separation_m: [0.19, 0.2001]");
   const FitcalRun closed =
-      RunFitcal(dir, "asoc-geometric --logs " + data + " --train-reps 1 --out " + out);
+      RunFitcal(dir, "fit --closed-form-only --logs " + data + " --train-reps 1 --out " + out);
   if (fs::exists(out)) {
     const double written = YAML::LoadFile(out)["wheel_separation_m"].as<double>();
     EXPECT_LE(written, 0.2001) << "written outside its bounds";

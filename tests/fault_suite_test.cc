@@ -142,7 +142,7 @@ TEST(FaultSuiteTest, TruncatedAndGarbledCalibrationsAndAsocFilesFailInOneLine) {
   const fs::path cal = dir.path() / "cal.yaml";
   ASSERT_EQ(RunFitcal(dir, "fit --logs " + data.string() + " --out " + cal.string()).exit_code, 0);
   const fs::path asoc = dir.path() / "asoc";
-  ASSERT_EQ(RunFitcal(dir, "asoc-simulate --out " + asoc.string()).exit_code, 0);
+  ASSERT_EQ(RunFitcal(dir, "simulate --model asoc --out " + asoc.string()).exit_code, 0);
   const io::DatasetIndex asoc_index = io::ReadDatasetIndex(asoc.string(), {});
   const auto expect_one_line = [](const std::function<void()>& read) {
     try {
@@ -259,7 +259,8 @@ TEST(FaultSuiteTest, ForceReplacesOnlyWhatFitcalWroteAsTheSameKind) {
   WriteFileBytes(user / "runs" / "x.csv", "mine too\n");
   const auto before = Snapshot(user);
   for (const std::string& command :
-       {std::string("simulate --model diff_drive --repetitions 2"), std::string("asoc-simulate"),
+       {std::string("simulate --model diff_drive --repetitions 2"),
+        std::string("simulate --model asoc"),
         std::string("simulate --repetitions 1 --robot ") + FITCAL_SOURCE_DIR + "/data/robots/apr02.yaml"}) {
     for (const char* force : {"", " --force"}) {
       const auto r = RunFitcal(dir, command + force + " --out '" + user.string() + "'");

@@ -345,13 +345,13 @@ TEST(FitcalCli, DiagnoseRecordsTheWrittenFitsSigmasAndTheReportShowsThem) {
               block["sigma"]["wheel_separation_m"].as<double>(), 1e-12);
 }
 
-// An ASOC data set (asoc-simulate on the one simulator, the generic CSV) goes through the
+// An ASOC data set (`simulate --model asoc` on the one simulator, the generic CSV) goes through the
 // generic commands like any model: `fit` with the closed form of Doebbler Eq. 1-9 (from the hold
 // runs) in the result gate, every --method on the seam (crs2lm runs NLopt, not Ceres), `compare`.
 TEST(FitcalCli, AsocDataSetGoesThroughTheGenericCommands) {
   TempDir dir;
   const std::string data = dir.Path("asoc");
-  Result r = RunFitcal(dir, "asoc-simulate --out " + data + " --excursions 2 --seed 3");
+  Result r = RunFitcal(dir, "simulate --model asoc --out " + data + " --repetitions 2 --seed 3");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string out = dir.Path("asoc_calibrated.yaml");
   r = RunFitcal(dir, "fit --logs " + data + " --train-reps 1-2 --out " + out);

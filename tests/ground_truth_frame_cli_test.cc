@@ -158,7 +158,7 @@ TEST(MountedFit, ABoundHitWithTheMountHeldNamesTheMount) {
 TEST(MountedFit, AClosedFormKeepsTheFrameItWasGivenAndSaysSo) {
   TempDir dir;
   const std::string data = dir.Path("data"), cal = dir.Path("calibrated.yaml");
-  auto r = RunFitcal(dir, "asoc-simulate --out " + data + " --seed 3");
+  auto r = RunFitcal(dir, "simulate --model asoc --out " + data + " --seed 3");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string robot = data + "/robot.yaml";
   WriteFileBytes(robot, testing::ReadFileBytes(robot) +

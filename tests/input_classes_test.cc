@@ -248,7 +248,8 @@ TEST(InputClassesCli, UsageErrorsAreOneLineExitTwoBeforeAnyWork) {
         std::string("diagnose --logs . --train-reps 1-2 --train-trajectories x"),
         std::string("fit --logs . --train-reps 1-2 --train-trajectories x"),
         std::string("generalise --logs . --train-reps 5-1"),
-        std::string("asoc-geometric --logs . --train-reps 5-1"),
+        std::string("fit --logs . --closed-form-only --train-reps 5-1"),
+        std::string("fit --logs . --closed-form-only --method crs2lm"),
         // nan and inf pass CLI11's PositiveNumber: every floating-point flag refuses them
         std::string("fit --logs . --position-sigma-m nan"),
         std::string("fit --logs . --loss-scale inf"),
@@ -263,8 +264,9 @@ TEST(InputClassesCli, UsageErrorsAreOneLineExitTwoBeforeAnyWork) {
 
 // probe45: flags the command would drop. compare ran every fit without --seed (Ceres methods
 // only), --loss (NLopt methods only), --polish or --max-iterations where no method asked for uses
-// them, exit 0, where fit refuses the same flags; fit, compare and asoc-geometric with
-// --no-output dropped an --out given beside it. Each: exit 2, one line naming the flag, before any data is read.
+// them, exit 0, where fit refuses the same flags; fit, compare and asoc-geometric (now
+// fit --closed-form-only, which refuses a fit's flags beside it) with --no-output dropped an
+// --out given beside it. Each: exit 2, one line naming the flag, before any data is read.
 TEST(InputClassesCli, FlagsNoMethodAskedWouldUseAreRefused) {
   const TempDir dir;
   struct Case {
@@ -281,8 +283,8 @@ TEST(InputClassesCli, FlagsNoMethodAskedWouldUseAreRefused) {
             "--out excludes --no-output"},
            {"fit --logs . --no-output --out " + dir.Path("cal.yaml"),
             "--out excludes --no-output"},
-           {"asoc-geometric --logs . --no-output --out " + dir.Path("cal.yaml"),
-            "--out excludes --no-output"}}) {
+           {"fit --logs . --closed-form-only --effects pivot_yaw_gain",
+            "--closed-form-only runs no fit, so it cannot take --effects"}}) {
     const auto r = RunFitcal(dir, c.args);
     EXPECT_EQ(r.exit_code, 2) << c.args << ": " << r.out << r.err;
     EXPECT_EQ(Lines(r.err), 1) << c.args << ": " << r.err;

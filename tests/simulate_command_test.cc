@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <sstream>
 
 #include "models/model_registry.h"
 #include "tests/test_files.h"
@@ -159,6 +160,75 @@ TEST(SimulateCommand, AsocRunsOnTheOneEngine) {
   EXPECT_NE(ReadFileBytes(data + "/true_robot.yaml"), ReadFileBytes(data + "/robot.yaml"));
   const Result fit = RunFitcal(dir, "fit --logs " + data + " --no-output");
   EXPECT_EQ(fit.exit_code, 0) << fit.err;
+}
+
+// The rows of a CSV after its header, as numbers.
+std::vector<std::vector<double>> CsvRows(const std::string& path) {
+  std::vector<std::vector<double>> rows;
+  std::istringstream text(ReadFileBytes(path));
+  std::string line;
+  std::getline(text, line);
+  while (std::getline(text, line)) {
+    std::vector<double> row;
+    std::istringstream cells(line);
+    for (std::string cell; std::getline(cells, cell, ',');) row.push_back(std::stod(cell));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+// `simulate --model asoc` records as Doebbler's prototype, the recorder the asoc model registers
+// (models/asoc/asoc_extras.h; asoc-simulate's until it was retired): 5 excursions by default
+// beside the 6 holds and 10 UMBmark circuits, encoders every 0.05 s with every wheel rate a whole
+// number of 0.3 deg counts per 0.05 s, noise-free ground truth at every encoder time, each run
+// from the origin; --wheel-slip-sigma reaches its wheels and --encoder-counts-per-rev replaces
+// its count. Before, the generic recorder: 10 ms, 4096 counts, ground truth every 0.2 s, 10
+// excursions.
+TEST(SimulateCommand, AsocRecordsAsThePrototype) {
+  TempDir dir;
+  const auto wheel_counts = [&](const std::string& data, double counts_per_rev) {
+    const double count_rate = 2.0 * M_PI / counts_per_rev / 0.05;
+    double worst = 0.0;
+    for (const auto& row : CsvRows(data + "/runs/umbmark_cw-rep06_encoders.csv")) {
+      for (int column : {1, 2, 4, 5, 7, 8}) {
+        worst = std::max(worst, std::abs(row[column] / count_rate -
+                                         std::round(row[column] / count_rate)));
+      }
+    }
+    return worst;
+  };
+  const std::string data = dir.Path("asoc");
+  const Result r = RunFitcal(dir, "simulate --model asoc --out " + data);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.out.find("wrote 21 runs") == 0) << r.out;
+  const std::string index = ReadFileBytes(data + "/dataset.yaml");
+  EXPECT_NE(index.find("excursion-rep05"), std::string::npos) << index;
+  EXPECT_EQ(index.find("excursion-rep06"), std::string::npos) << index;
+  const auto encoders = CsvRows(data + "/runs/umbmark_cw-rep06_encoders.csv");
+  const auto truth = CsvRows(data + "/runs/umbmark_cw-rep06_ground_truth.csv");
+  ASSERT_GT(encoders.size(), 100u);
+  ASSERT_EQ(truth.size(), encoders.size());
+  for (std::size_t k = 0; k < encoders.size(); ++k) {
+    EXPECT_NEAR(encoders[k][0], 0.05 * static_cast<double>(k), 1e-9) << k;
+    EXPECT_NEAR(truth[k][0], encoders[k][0], 1e-6) << k;
+  }
+  EXPECT_EQ(truth[0][1], 0.0);
+  EXPECT_EQ(truth[0][2], 0.0);
+  EXPECT_LT(wheel_counts(data, 1200.0), 1e-6);
+
+  const std::string slipping = dir.Path("slipping"), fine = dir.Path("fine");
+  ASSERT_EQ(RunFitcal(dir, "simulate --model asoc --wheel-slip-sigma 0.05 --out " + slipping)
+                .exit_code,
+            0);
+  EXPECT_NE(ReadFileBytes(slipping + "/runs/umbmark_cw-rep06_encoders.csv"),
+            ReadFileBytes(data + "/runs/umbmark_cw-rep06_encoders.csv"));
+  EXPECT_EQ(ReadFileBytes(slipping + "/runs/umbmark_cw-rep06_ground_truth.csv"),
+            ReadFileBytes(data + "/runs/umbmark_cw-rep06_ground_truth.csv"));
+  ASSERT_EQ(RunFitcal(dir, "simulate --model asoc --encoder-counts-per-rev 4096 --out " + fine)
+                .exit_code,
+            0);
+  EXPECT_LT(wheel_counts(fine, 4096.0), 1e-6);
+  EXPECT_GT(wheel_counts(fine, 1200.0), 0.1);
 }
 
 // The ground-truth stamps of a run, from its CSV's first column.

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "models/asoc/asoc_robot_model.h"
+#include "models/asoc/asoc_tables.h"
 
 namespace fitcal {
 
@@ -108,6 +109,19 @@ Vehicle VehicleOf(const RobotModelInterface& model, const std::vector<double>& p
 }
 
 }  // namespace
+
+ScenarioRecorder PrototypeRecorder() {
+  ScenarioRecorder r;
+  r.encoder_period_s = kPrototypeSamplePeriodS;
+  r.ground_truth_period_s = kPrototypeSamplePeriodS;
+  r.ticks_per_rev = kPrototypeWheelTicksPerRev;
+  r.wheel_rate_sigma_rad_s = 0.0;
+  r.angle_sigma_rad = 0.0;  // the pivots' own step (pivot_resolution_deg) is their error
+  r.gt_position_sigma_m = 0.0;
+  r.gt_heading_sigma_rad = 0.0;
+  r.start_position_range_m = 0.0;
+  return r;
+}
 
 Vehicle PrototypeVehicle() {
   Vehicle v;
@@ -217,6 +231,10 @@ ModelExtras AsocExtras() {
     for (int k = 1; k <= repetitions; ++k) out.push_back(asoc::ExcursionTrajectory(k));
     return out;
   };
+  extras.closed_forms = {"asoc-geometric"};  // Doebbler Eq. 1-9 (AsocModel::ClosedForms)
+  extras.paper_tables = asoc::DoebblerPaperTables();
+  extras.scenario.default_repetitions = 5;
+  extras.scenario.recorder = asoc::PrototypeRecorder();
   extras.scenario.default_truth = [](const Robot& nominal, std::uint64_t seed) {
     asoc::Vehicle v;
     v.SetFromArray(nominal.nominal.data());

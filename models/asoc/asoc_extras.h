@@ -1,6 +1,8 @@
 #pragma once
 // What an ASOC vehicle offers beyond the seam (models/model_extras.h): its calibration scenario on
-// the one simulator (sim/model_simulator.h) and the castor dynamics the simulator integrates.
+// the one simulator (sim/model_simulator.h), recorded as the paper's prototype, the castor
+// dynamics the simulator integrates, the closed form of Eq. 1-9 and the reproduction of Tables I
+// and II (asoc_tables.h).
 //
 // Castor dynamics (Doebbler Sec. II, no lateral slip): each castor turns so that its pivot moves
 // with no lateral slip of its wheels, chi_dot_i = (v_pivot_i . c2_i) / r_c (asoc_model.h), i.e.
@@ -11,11 +13,12 @@
 //
 // Scenario, per data set: the calibration manoeuvre of Sec. III-A (repetition 1), the UMBmark
 // square (Sec. IV-B) as repetitions 6-10, each at its own speed so that no two are one recording
-// copied, and `repetitions` random excursions (1..N, the fit's training data); below. Castors are
-// aligned for the first segment before a run starts.
+// copied, and `repetitions` random excursions (1..N, the fit's training data; 5 by default);
+// below. Castors are aligned for the first segment before a run starts. Recorded as the
+// prototype (PrototypeRecorder).
 //
 // The true robot (default_truth): drawn about the nominal as Doebbler Table I (ParameterSpread)
-// from std::mt19937_64(SplitMix(seed)), the draw of asoc-simulate before the one simulator.
+// from std::mt19937_64(SplitMix(seed)), the draw of ASOC's own simulator before the one simulator.
 
 #include <array>
 #include <cstdint>
@@ -37,6 +40,11 @@ namespace asoc {
 inline constexpr double kPrototypeSamplePeriodS = 0.05;
 inline constexpr double kPrototypeWheelTicksPerRev = 1200.0;
 inline constexpr double kPrototypePivotQuantumRad = 0.07 * M_PI / 180.0;
+
+// The prototype's recorder: the encoders above, noise-free ground truth at every encoder time,
+// every run from the origin at a random heading, no wheel noise unless a caller sets
+// wheel_relative_sigma (a relative error on each 20 Hz wheel increment).
+ScenarioRecorder PrototypeRecorder();
 
 // The simulated prototype (kAsocExampleYaml): pivots on a 0.30 m circle, r_c 0.08 m, r_w 0.04 m,
 // d 0.06 m; Doebbler do not print their dimensions.

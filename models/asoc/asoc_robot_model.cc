@@ -18,8 +18,8 @@ using io::InputErrorKind;
 // box of the ASOC-only Ceres fit that preceded the seam), wheel radii +-30 % and wheel
 // offsets +-50 %: with beta held, the wheel parameters absorb the pivot bias (Gauge below), and a
 // bias of 15 deg (Table I's spread) moves the d_k by ~40 % and the r_wk by ~25 %. Measured on
-// `asoc-simulate --seed 3`: with +-15 % everywhere the fit stopped on bounds (validation CF 0.026
-// after 188 iterations), with this box it converges in 7 (0.0037).
+// `simulate --model asoc --seed 3`: with +-15 % everywhere the fit stopped on bounds (validation
+// CF 0.026 after 188 iterations), with this box it converges in 7 (0.0037).
 constexpr double kDefaultOffsetBound = 0.15;
 constexpr double kDefaultWheelRadiusBound = 0.30;
 constexpr double kDefaultWheelOffsetBound = 0.50;

@@ -6,6 +6,7 @@
 
 #include "models/asoc/asoc_extras.h"
 #include "odometry/parallel_for.h"
+#include "odometry/text_format.h"
 
 namespace fitcal::asoc {
 
@@ -30,7 +31,72 @@ void AddParameterErrors(const Vehicle& truth, const Vehicle& estimate, double* o
   }
 }
 
+// Table I: the mean absolute errors against the paper's (Doebbler Table I).
+std::string TableOne(const DoebblerTables& mean) {
+  std::string out = "Table I: mean absolute parameter error\n\n";
+  out += "| parameter | uncalibrated | calibrated | paper uncal. | paper cal. |\n";
+  out += "|---|---|---|---|---|\n";
+  const char* names[4] = {"r_c", "r_w", "d", "beta"};
+  const char* paper[4][2] = {
+      {"0.21%", "0.09%"}, {"2.07%", "0.04%"}, {"0.89%", "0.04%"}, {"7.98 deg", "0.01 deg"}};
+  for (int k = 0; k < 4; ++k) {
+    out += k < 3 ? StrFormat("| %s | %.3f%% | %.3f%% | %s | %s |\n", names[k],
+                             100 * mean.param[0][k], 100 * mean.param[1][k], paper[k][0],
+                             paper[k][1])
+                 : StrFormat("| %s | %.3f deg | %.4f deg | %s | %s |\n", names[k],
+                             RadToDeg(mean.param[0][k]), RadToDeg(mean.param[1][k]), paper[k][0],
+                             paper[k][1]);
+  }
+  return out;
+}
+
+// Table II: UMBmark E_max of the three algorithms against the paper's (Doebbler Table II; the
+// percentage of the 6 m circuit), and the ratios the paper draws its conclusions from.
+std::string TableTwo(const DoebblerTables& mean) {
+  std::string out = "\nTable II: UMBmark E_max (1.5 m square, 5 x CW and CCW, 6 m per circuit)\n\n";
+  out += "| algorithm | uncalibrated | calibrated | ratio | paper uncal. | paper cal. |\n";
+  out += "|---|---|---|---|---|---|\n";
+  const char* algorithm[3] = {"IPEC-1", "CAST-1", "CAST-0"};
+  const char* paper[3][2] = {{"394.6 mm 6.89%", "71.7 mm 1.25%"},
+                             {"394.1 mm 6.88%", "71.6 mm 1.25%"},
+                             {"311.0 mm 5.43%", "39.0 mm 0.68%"}};
+  for (int a = 0; a < 3; ++a) {
+    out += StrFormat("| %s | %.1f mm %.2f%% | %.2f mm %.3f%% | %.0fx | %s | %s |\n", algorithm[a],
+                     1000 * mean.emax[0][a], 100 * mean.emax[0][a] / 6.0, 1000 * mean.emax[1][a],
+                     100 * mean.emax[1][a] / 6.0, mean.emax[0][a] / mean.emax[1][a], paper[a][0],
+                     paper[a][1]);
+  }
+  return out + StrFormat(
+                   "\nratios: CAST-0 / two-castor uncalibrated %.3f (paper 0.79), calibrated %.3f "
+                   "(paper 0.54); IPEC-1 / CAST-1 uncalibrated %.4f (paper 1.0013)\n",
+                   mean.emax[0][2] / mean.emax[0][1], mean.emax[1][2] / mean.emax[1][1],
+                   mean.emax[0][0] / mean.emax[0][1]);
+}
+
+std::string ReproduceDoebblerTables(const RobotModelInterface& nominal,
+                                    const PaperTablesRequest& request,
+                                    const SimulateFn& simulate) {
+  const auto* asoc = dynamic_cast<const AsocModel*>(&nominal);
+  if (asoc == nullptr) throw std::invalid_argument("not an asoc robot: " + nominal.robot().model);
+  const DoebblerTables mean = SimulateDoebblerTables(*asoc, request.sets, request.seed, simulate,
+                                                     request.threads);
+  return StrFormat("Doebbler et al. Tables I and II, %d random parameter sets (seed %llu, wheel "
+                   "slip sigma %g per 20 Hz sample)\n\n",
+                   request.sets, static_cast<unsigned long long>(request.seed),
+                   request.wheel_slip_sigma) +
+         TableOne(mean) + TableTwo(mean);
+}
+
 }  // namespace
+
+PaperTables DoebblerPaperTables() {
+  PaperTables tables;
+  tables.recorder = PrototypeRecorder();
+  tables.recorder.random_start_heading = false;
+  tables.recorder.substep_s = kPrototypeSamplePeriodS / 10.0;
+  tables.reproduce = &ReproduceDoebblerTables;
+  return tables;
+}
 
 double UmbmarkEmax(const RobotModelInterface& odometry, const std::vector<double>& p,
                    const std::vector<RunLog>& runs) {

@@ -1,24 +1,20 @@
 #pragma once
-// Doebbler et al. Tables I and II by Monte Carlo (`asoc-tables`, docs/asoc.md): random true
-// vehicles about the nominal, each driven through the calibration manoeuvre and the UMBmark square
-// on the one simulator (the caller's `simulate`: sim/model_simulator.h with the castor dynamics of
-// asoc_extras.h), calibrated by the closed form of Eq. 1-9 and judged by the odometry of the seam.
+// Doebbler et al. Tables I and II by Monte Carlo (`fitcal paper-tables --model asoc`,
+// docs/asoc.md): random true vehicles about the nominal, each driven through the calibration
+// manoeuvre and the UMBmark square on the one simulator (the caller's `simulate`:
+// sim/model_scenarios.h ScenarioSimulator with the castor dynamics of asoc_extras.h), calibrated by
+// the closed form of Eq. 1-9 and judged by the odometry of the seam.
 
 #include <cstdint>
 #include <functional>
 #include <vector>
 
 #include "models/asoc/asoc_robot_model.h"
+#include "models/model_extras.h"
 #include "models/trajectory_spec.h"
 #include "odometry/run_log.h"
 
 namespace fitcal::asoc {
-
-// Runs of the true parameters (asoc::Vehicle::ToArray order) along the trajectories; `seed` the
-// noise's. Ground truth noise-free, its last sample at the last encoder time.
-using SimulateFn = std::function<std::vector<RunLog>(const std::vector<double>& truth,
-                                                     const std::vector<sim::TrajectorySpec>& specs,
-                                                     std::uint64_t seed)>;
 
 // UMBmark E_max (Borenstein; Doebbler Sec. IV-B): for each direction the distance of the mean of
 // the runs' final position errors (odometry - truth) from zero; E_max the larger of the two.
@@ -36,5 +32,11 @@ struct DoebblerTables {
 };
 DoebblerTables SimulateDoebblerTables(const AsocModel& nominal, int sets, std::uint64_t seed,
                                       const SimulateFn& simulate, int threads);
+
+// The reproduction the asoc model registers (ModelExtras::paper_tables): the prototype's recorder
+// with every run from the origin heading +x (UMBmark averages the runs' error vectors in the world
+// frame) and the castors integrated at a tenth of the 20 Hz sample, as the paper's runs need; the
+// tables printed in Markdown beside the paper's values.
+PaperTables DoebblerPaperTables();
 
 }  // namespace fitcal::asoc

@@ -4,7 +4,7 @@
 // (validation/residual_kind_transfer.h), then the track's heading likewise
 // (validation/track_objective_transfer.h); the benchmark runs the fit command as a user does, once
 // with the defaults and once with the flags of what they select, on
-//   - asoc: the ASOC example of `fitcal asoc-simulate --seed 3` (simulated, always here; its
+//   - asoc: the ASOC example of `fitcal simulate --model asoc --seed 3` (simulated, always here; its
 //     ground truth is not dense enough for the track, so auto fits final poses at once);
 //   - diff, tricyc, omni3: the OptiOdom robots' circles + squares (needs ../shared, skipped
 //     without it; FITCAL_SHARED_DIR points elsewhere); on these the defaults keep the track, with
@@ -45,7 +45,7 @@ std::string DataSet(const std::string& name, std::string* error) {
   const fs::path dir = scratch.path() / name;
   std::string command;
   if (name == "asoc") {
-    command = Fitcal() + " asoc-simulate --seed 3 --out " + dir.string();
+    command = Fitcal() + " simulate --model asoc --seed 3 --out " + dir.string();
   } else {
     const char* shared = std::getenv("FITCAL_SHARED_DIR");
     const fs::path source =
