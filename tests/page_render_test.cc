@@ -3,15 +3,19 @@
 // than the screen (they scroll in their own box), every SVG laid out and its text at least 10 px
 // as drawn. Skipped when no chromium is
 // installed (apt-get install chromium). A probe script is added to a copy of the page (the pages
-// themselves carry none); it writes what it measured into the DOM that --dump-dom prints.
+// themselves carry none); it writes what it measured into the DOM that --dump-dom prints. One
+// Chromium renders every page of a test at both widths, each in a frame of its own.
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <regex>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "pages/diagnose_page.h"
 #include "pages/report_csv.h"
@@ -66,22 +70,29 @@ window.addEventListener('load', function () {
   });
   var out = document.createElement('pre');
   out.id = 'probe';
-  out.textContent = 'PROBE min_font=' + min + ' scroll_width=' +
+  out.textContent = 'PROBE frame=' + window.frameElement.id + ' min_font=' + min + ' scroll_width=' +
       document.documentElement.scrollWidth + ' window=' + window.innerWidth + ' zero_svgs=' + zero +
       ' svg_font=' + svg_min + ' verdict_cells=' + verdicts + ' cut=' + cut;
   window.parent.document.body.appendChild(out);  // the host page's DOM is the one printed
 });
 </script>)";
 
+// Each frame's height: the pages scroll inside it.
+constexpr int kFrameHeight = 2000;
+
 struct Probe {
   double min_font = 0, scroll_width = 0, window = 0, zero_svgs = -1, svg_font = 0;
   double verdict_cells = 0, cut = -1;
 };
 
-// Headless Chromium lays a window out at least 500 px wide whatever --window-size says, so the
-// page is rendered in an iframe of exactly `width` px (srcdoc: same origin as its host, whose DOM
-// --dump-dom prints).
-std::string HostPage(const std::string& page, int width) {
+// One page at one width: what the probe measures, rendered in its own iframe.
+struct Frame {
+  std::string what;  // names the page in a failure
+  std::string html;
+  int width = 0;
+};
+
+std::string EscapedForAttribute(const std::string& page) {
   std::string escaped;
   for (char c : page) {
     if (c == '&') {
@@ -92,36 +103,58 @@ std::string HostPage(const std::string& page, int width) {
       escaped += c;
     }
   }
-  return "<!DOCTYPE html><html><body style=\"margin:0\"><iframe style=\"border:0;width:" +
-         std::to_string(width) + "px;height:2000px\" srcdoc=\"" + escaped +
-         "\"></iframe></body></html>";
+  return escaped;
 }
 
-Probe Render(const TempDir& dir, const std::string& html, int width) {
-  std::string page = html;
-  page.insert(page.rfind("</body>"), kProbe);
-  const std::string path = dir.Write("page.html", HostPage(page, width));
-  const std::string out = dir.Path("dom.txt");
-  const std::string cmd = Chromium() +
-                          " --headless --no-sandbox --disable-gpu --disable-background-networking"
-                          " --disable-component-update --disable-sync --no-first-run"
-                          " --user-data-dir=" +
-                          dir.Path("profile") + " --window-size=" + std::to_string(width + 40) +
-                          ",2100 --virtual-time-budget=5000 --dump-dom"
-                          " file://" +
-                          path + " > " + out + " 2>/dev/null";
-  Probe p;
-  if (std::system(cmd.c_str()) != 0) return p;
-  std::smatch m;
-  const std::string dom = ReadFileBytes(out);
-  if (std::regex_search(dom, m,
-                        std::regex("PROBE min_font=([0-9.e+]+) scroll_width=([0-9.]+) "
-                                   "window=([0-9.]+) zero_svgs=([0-9]+) svg_font=([0-9.e+]+) "
-                                   "verdict_cells=([0-9]+) cut=([0-9]+)"))) {
-    p = {std::stod(m[1]), std::stod(m[2]), std::stod(m[3]), std::stod(m[4]),
-         std::stod(m[5]), std::stod(m[6]), std::stod(m[7])};
+// Headless Chromium lays a window out at least 500 px wide whatever --window-size says, so each
+// page is rendered in an iframe of exactly its width in px (srcdoc: same origin as its host,
+// whose DOM --dump-dom prints). The frames stand one below the other in a window tall enough to
+// show them all, so that every page is laid out on the screen as if it were the only one; the
+// host's load event waits for every frame's, so every probe has written before the dump.
+std::string HostPage(const std::vector<Frame>& frames) {
+  std::string host = "<!DOCTYPE html><html><body style=\"margin:0\">";
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    std::string page = frames[i].html;
+    page.insert(page.rfind("</body>"), kProbe);
+    host += "<iframe id=\"f" + std::to_string(i) + "\" style=\"border:0;display:block;width:" +
+            std::to_string(frames[i].width) + "px;height:" + std::to_string(kFrameHeight) +
+            "px\" srcdoc=\"" + EscapedForAttribute(page) + "\"></iframe>";
   }
-  return p;
+  return host + "</body></html>";
+}
+
+// Every frame rendered by one Chromium (a launch costs ~2 s of CPU; docs/tests.md), each frame's
+// probe read by its iframe's id. A frame that printed no probe keeps window = 0.
+std::vector<Probe> Render(const TempDir& dir, const std::vector<Frame>& frames) {
+  int widest = 0;
+  for (const Frame& f : frames) widest = std::max(widest, f.width);
+  const std::string path = dir.Write("page.html", HostPage(frames));
+  const std::string out = dir.Path("dom.txt");
+  const std::string cmd =
+      Chromium() +
+      " --headless --no-sandbox --disable-gpu --disable-background-networking"
+      " --disable-component-update --disable-sync --no-first-run"
+      " --user-data-dir=" +
+      dir.Path("profile") + " --window-size=" + std::to_string(widest + 40) + "," +
+      std::to_string(kFrameHeight * static_cast<int>(frames.size()) + 100) +
+      " --virtual-time-budget=5000 --dump-dom"
+      " file://" +
+      path + " > " + out + " 2>/dev/null";
+  std::vector<Probe> probes(frames.size());
+  if (std::system(cmd.c_str()) != 0) return probes;
+  const std::string dom = ReadFileBytes(out);
+  const std::regex probe_line(
+      "PROBE frame=f([0-9]+) min_font=([0-9.e+]+) scroll_width=([0-9.]+) "
+      "window=([0-9.]+) zero_svgs=([0-9]+) svg_font=([0-9.e+]+) "
+      "verdict_cells=([0-9]+) cut=([0-9]+)");
+  for (std::sregex_iterator m(dom.begin(), dom.end(), probe_line), end; m != end; ++m) {
+    const std::size_t i = std::stoul((*m)[1]);
+    if (i >= probes.size()) continue;
+    probes[i] = {std::stod((*m)[2]), std::stod((*m)[3]), std::stod((*m)[4]),
+                 std::stod((*m)[5]), std::stod((*m)[6]), std::stod((*m)[7]),
+                 std::stod((*m)[8])};
+  }
+  return probes;
 }
 
 ReportData SmallReport() {
@@ -177,11 +210,20 @@ ReportData SmallReport() {
   return d;
 }
 
-void ExpectReadable(const TempDir& dir, const std::string& html, const std::string& what) {
-  for (int width : {390, 1400}) {
-    const Probe p = Render(dir, html, width);
-    SCOPED_TRACE(what + " at " + std::to_string(width) + " px");
-    ASSERT_GT(p.window, 0) << "chromium printed no probe";
+// Every page at a phone's width and a desktop's, all in one Chromium.
+void ExpectReadable(const TempDir& dir, const std::vector<std::pair<std::string, std::string>>&
+                                            pages) {  // (what, html)
+  std::vector<Frame> frames;
+  for (const auto& [what, html] : pages) {
+    for (int width : {390, 1400}) frames.push_back({what, html, width});
+  }
+  const std::vector<Probe> probes = Render(dir, frames);
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    const Probe& p = probes[i];
+    const int width = frames[i].width;
+    SCOPED_TRACE(frames[i].what + " at " + std::to_string(width) + " px");
+    EXPECT_GT(p.window, 0) << "chromium printed no probe";
+    if (p.window <= 0) continue;
     EXPECT_GE(p.min_font, 12.0);
     EXPECT_EQ(p.window, width);
     EXPECT_LE(p.scroll_width, p.window);  // the page never scrolls sideways as a whole
@@ -211,7 +253,6 @@ TEST(PageRender, AnExtremeBeyondTheScaleIsMarked) {
 TEST(PageRender, ReportAndDiagnoseReadableOnPhoneAndDesktop) {
   if (Chromium().empty()) GTEST_SKIP() << "no chromium";
   TempDir dir;
-  ExpectReadable(dir, ReportHtml(SmallReport()), "report");
   DiagnosePageData d;
   d.level = "EFFECTS_NAMED";
   d.conclusion = "One effect.";
@@ -222,7 +263,7 @@ TEST(PageRender, ReportAndDiagnoseReadableOnPhoneAndDesktop) {
   d.gate = {{"nominal", 0.05, false}, {"track fit + effects", 0.01, true}};
   d.held_out = {{"run1", 0.05, 0.01, 0.02, 0.004, {0.01, 0.02}, {0.001, 0.002}}};
   d.text_report = std::string(300, 'x');
-  ExpectReadable(dir, DiagnoseHtml(d), "diagnose");
+  ExpectReadable(dir, {{"report", ReportHtml(SmallReport())}, {"diagnose", DiagnoseHtml(d)}});
 }
 
 // The report of the worked example on the real differential drive (README: 20 held-out runs, 4
@@ -247,7 +288,7 @@ TEST(PageRender, RealDiffDriveReportReadableOnPhoneAndDesktop) {
       0);
   const std::string html = ReadFileBytes(rep + "/index.html");
   EXPECT_NE(html.find("beyond the top: "), std::string::npos);
-  ExpectReadable(dir, html, "real report");
+  ExpectReadable(dir, {{"real report", html}});
 }
 
 }  // namespace
