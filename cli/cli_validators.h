@@ -6,12 +6,23 @@
 #include <cmath>
 #include <cstdlib>
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <string>
 
 #include "fit/run_split.h"
 
 namespace fitcal::tools {
+
+// Once `app` is parsed, the long names of the flags given on its command line ("--method") into
+// *given: what a command reads later to tell a flag given from its default.
+inline void RecordGivenFlags(CLI::App& app, std::set<std::string>* given) {
+  app.callback([&app, given] {
+    for (const CLI::Option* option : app.get_options()) {
+      if (option->count() > 0) given->insert(option->get_name());
+    }
+  });
+}
 
 // A repetition list such as "1-5" or "1,3,7" (fit/run_split.h); "auto" too when allowed.
 inline CLI::Validator RepetitionListValidator(bool allow_auto = false) {

@@ -75,11 +75,7 @@ void AddFitOptions(CLI::App& app, FitCommandOptions& o) {
   app.add_flag("--closed-form-only", o.closed_forms_only,
                "No fit: the model's closed-form calibrations alone against the nominal, through "
                "the same gate (" + ClosedFormsOfModels() + ")");
-  app.callback([&app, &o] {
-    for (const CLI::Option* option : app.get_options()) {
-      if (option->count() > 0) o.given.insert(option->get_name());
-    }
-  });
+  RecordGivenFlags(app, &o.given);
 }
 
 namespace {

@@ -128,11 +128,7 @@ void AddSimulateOptions(CLI::App& app, SimulateCommandOptions& o) {
   app.add_option("--inject", o.inject,
                  "Inject a library effect, name=value[,value] (docs/simulate.md); repeatable; "
                  "the data set does not name it");
-  app.callback([&app, &o] {
-    for (const CLI::Option* option : app.get_options()) {
-      if (option->count() > 0) o.given.insert(option->get_name());
-    }
-  });
+  RecordGivenFlags(app, &o.given);
 }
 
 int RunSimulateCommand(const SimulateCommandOptions& options) {

@@ -59,17 +59,14 @@ void SetSteppedPhysics(const Robot& robot, const SimulationScenario& scenario,
   o->stepped->injected_effects = noise.injected_effects;
 }
 
-}  // namespace
-
-std::string ScenarioModelNames() {
-  return ModelNamesWith([](const ModelExtras& e) { return bool(e.scenario.trajectories); });
-}
-
+// The model's recorder with the values `simulate` was given in place of its own.
 ScenarioRecorder WithReplacements(ScenarioRecorder recorder, const ScenarioNoise& noise) {
   for (const auto& [value, replacement] : noise.recorder_values) recorder.*value = replacement;
   return recorder;
 }
 
+// The simulator's options for runs of `model` recorded as `recorder` says (counts on the wheel
+// channels only), with the model's channel dynamics.
 SimulationOptions RecordedAs(const RobotModelInterface& model, const ScenarioRecorder& recorder,
                              std::uint64_t seed) {
   const Robot& robot = model.robot();
@@ -93,6 +90,12 @@ SimulationOptions RecordedAs(const RobotModelInterface& model, const ScenarioRec
   o.seed = seed;
   o.dynamics = ExtrasOf(robot.model).scenario.dynamics;
   return o;
+}
+
+}  // namespace
+
+std::string ScenarioModelNames() {
+  return ModelNamesWith([](const ModelExtras& e) { return bool(e.scenario.trajectories); });
 }
 
 ModelScenario MakeModelScenario(const RobotModelInterface& model, const std::vector<double>& truth,
