@@ -50,8 +50,9 @@ bool PrepareData(const CalibrationRequest& r, const RobotModelInterface& model,
   return true;
 }
 
-// The fit of all the training runs, with the residual kind and the track objective chosen by
-// transfer first when the request leaves them to the data (not with effects to fit).
+// The fit of all the training runs, with the residual kind and the track's heading chosen by
+// transfer and its weights on the held-out runs first, when the request leaves them to the data
+// (not with effects to fit).
 void FitTrainingRuns(const CalibrationRequest& r, const RobotModelInterface& model,
                      CalibrationOutcome* out, std::string* objective_note) {
   if (r.closed_forms_only) {
@@ -68,6 +69,11 @@ void FitTrainingRuns(const CalibrationRequest& r, const RobotModelInterface& mod
     for (const std::string& line : ChooseTrackObjectiveByTransfer(
              *r.method, r.threads, model, out->split, &out->settings, &out->track_data,
              &chosen_fit, &fold_fits, objective_note)) {
+      out->choice_lines.push_back(line);
+    }
+    for (const std::string& line : ChooseWeightsOnHeldOutRuns(
+             *r.method, r.threads, model, out->split, &out->settings, &chosen_fit,
+             objective_note)) {
       out->choice_lines.push_back(line);
     }
   }

@@ -72,21 +72,12 @@ void FitAllTrainingRuns(const FitMethod& method, const RobotModelInterface& mode
   fold_fits->seed_levels = whole.noise_levels;
 }
 
-// The track objectives --weights auto / --track-heading auto allow, the default first (weights
-// fixed unless --weights estimated, heading from the start unless given).
-std::vector<TrackObjective> TrackObjectiveCandidates(const FitMethodSettings& settings) {
-  const std::vector<bool> weights =
-      settings.weights_auto ? std::vector<bool>{false, true}
-                            : std::vector<bool>{settings.estimate_weights};
-  const std::vector<TrackHeading> headings =
-      settings.track_heading_auto
-          ? std::vector<TrackHeading>{TrackHeading::kFromStart, TrackHeading::kIncrements}
-          : std::vector<TrackHeading>{settings.track_heading};
-  std::vector<TrackObjective> out;
-  for (TrackHeading heading : headings) {
-    for (bool estimate : weights) out.push_back({estimate, heading});
-  }
-  return out;
+// The track objectives --track-heading auto allows, the default first (heading from the start),
+// with the request's weights (fixed under --weights auto: judged after, on the held-out runs).
+std::vector<TrackObjective> HeadingCandidates(const FitMethodSettings& settings) {
+  if (!settings.track_heading_auto) return {{settings.estimate_weights, settings.track_heading}};
+  return {{settings.estimate_weights, TrackHeading::kFromStart},
+          {settings.estimate_weights, TrackHeading::kIncrements}};
 }
 
 }  // namespace
@@ -122,8 +113,7 @@ std::vector<std::string> ChooseTrackObjectiveByTransfer(
     const FitMethod& method, int threads, const RobotModelInterface& model, const RunSplit& split,
     FitMethodSettings* settings, std::optional<TrackFitData>* track_data,
     std::optional<ModelFitMethodOutcome>* full, FoldFits* fold_fits, std::string* note) {
-  if (!settings->weights_auto && !settings->track_heading_auto) return {};
-  if (settings->residuals == ResidualKind::kFinalPose) return {};
+  if (!settings->track_heading_auto || settings->residuals == ResidualKind::kFinalPose) return {};
   // The default candidate's fit of all the runs (unless the residual choice made it): the folds'
   // start, and the fit written when the default is kept.
   if (!*full) FitAllTrainingRuns(method, model, split, *settings, full, fold_fits);
@@ -137,7 +127,7 @@ std::vector<std::string> ChooseTrackObjectiveByTransfer(
   const ScoreOnRuns score =
       fold_fits->ScoredOnce(EverydayDrivingScore(model, threads, {kTransferDriftLength_m}));
   const TrackObjectiveJudgement judgement = JudgeTrackObjectivesByTransfer(
-      TrackObjectiveCandidates(*settings), split, fit_on, score);
+      HeadingCandidates(*settings), split, fit_on, score);
   *note = TrackObjectiveChoiceText(judgement);
   if (judgement.chosen != 0) {
     const TrackObjective& chosen = judgement.candidates[judgement.chosen];
@@ -150,6 +140,49 @@ std::vector<std::string> ChooseTrackObjectiveByTransfer(
     if (!PrepareTrackResiduals(method.name, split.training, settings, track_data).empty()) {
       return {};
     }
+  }
+  return TrackObjectiveJudgementLines(judgement);
+}
+
+std::vector<std::string> ChooseWeightsOnHeldOutRuns(const FitMethod& method, int threads,
+                                                    const RobotModelInterface& model,
+                                                    const RunSplit& split,
+                                                    FitMethodSettings* settings,
+                                                    std::optional<ModelFitMethodOutcome>* full,
+                                                    std::string* note) {
+  if (!settings->weights_auto || settings->residuals == ResidualKind::kFinalPose) return {};
+  if (split.validation.empty()) {
+    return {"track weights fixed: no held-out run to judge weights estimated from the data on "
+            "(--weights estimated fits them)"};
+  }
+  if (!*full) full->emplace(method.run_model(split.training, model, *settings));
+  if (!(*full)->fit.usable && !(*full)->fit.stopped_early) return {};
+  // The estimated weights' fit starts where the fixed weights' ended: the same track data (it
+  // does not depend on the weights), a few steps per reweighting.
+  FitMethodSettings estimated = *settings;
+  estimated.estimate_weights = true;
+  estimated.start = (*full)->fit.parameters;
+  std::optional<ModelFitMethodOutcome> estimated_fit;
+  const FitByTrackObjective fit_on =
+      [&](const TrackObjective& objective,
+          const std::vector<AlignedRun>& training) -> std::optional<std::vector<double>> {
+    if (!objective.estimate_weights) return (*full)->fit.parameters;
+    estimated_fit.emplace(method.run_model(training, model, estimated));
+    const ModelFitResult& fit = estimated_fit->fit;
+    if (!fit.usable && !fit.stopped_early) return std::nullopt;
+    return fit.parameters;
+  };
+  const TrackObjectiveJudgement judgement = JudgeTrackWeightsOnHeldOutRuns(
+      {{false, settings->track_heading}, {true, settings->track_heading}}, split, fit_on,
+      EverydayDrivingScore(model, threads, {kTransferDriftLength_m}));
+  *note += TrackObjectiveChoiceText(judgement);
+  if (judgement.chosen != 0) {
+    // It started where the fixed weights' fit ended: how that one left the guess is its history.
+    if (estimated_fit->fit.global_start.empty()) {
+      estimated_fit->fit.global_start = (*full)->fit.global_start;
+    }
+    settings->estimate_weights = true;
+    *full = std::move(estimated_fit);
   }
   return TrackObjectiveJudgementLines(judgement);
 }

@@ -1,8 +1,8 @@
 #pragma once
 // The fit's choices made by transfer, each fold fitted by the request's method: the residual kind
-// (validation/residual_kind_transfer.h), the track's heading and weights
-// (validation/track_objective_transfer.h), and, with nothing held out, the two-fold judgement of
-// the method (validation/held_out_halves.h).
+// (validation/residual_kind_transfer.h), the track's heading and, on the held-out runs, its
+// weights (validation/track_objective_transfer.h), and, with nothing held out, the two-fold
+// judgement of the method (validation/held_out_halves.h).
 
 #include <map>
 #include <mutex>
@@ -61,7 +61,7 @@ std::vector<std::string> ChooseResidualsByTransfer(const FitMethod& method, int 
                                                    std::optional<ModelFitMethodOutcome>* full,
                                                    FoldFits* fold_fits);
 
-// --weights auto / --track-heading auto on track residuals: the candidates fitted and judged by
+// --track-heading auto on track residuals: the candidates fitted and judged by
 // transfer (validation/track_objective_transfer.h), each fold's fit started from the fit of all
 // the training runs when the residual choice made one; settings, *track_data and *full follow the
 // choice. The lines for the terminal, and in *note what the calibration's objective records.
@@ -69,6 +69,19 @@ std::vector<std::string> ChooseTrackObjectiveByTransfer(
     const FitMethod& method, int threads, const RobotModelInterface& model, const RunSplit& split,
     FitMethodSettings* settings, std::optional<TrackFitData>* track_data,
     std::optional<ModelFitMethodOutcome>* full, FoldFits* fold_fits, std::string* note);
+
+// --weights auto on track residuals: the fit with weights estimated from the data
+// (fit/noise_levels.h), started from the fixed weights' fit of all the training runs (*full, made
+// here unless a choice before made it), replaces it when lower on the held-out runs in CF, drift
+// and ATE (validation/track_objective_transfer.h); settings and *full follow the choice. Without
+// held-out runs the weights stay fixed, said in one line. The lines for the terminal, and in
+// *note (appended) what the calibration's objective records.
+std::vector<std::string> ChooseWeightsOnHeldOutRuns(const FitMethod& method, int threads,
+                                                    const RobotModelInterface& model,
+                                                    const RunSplit& split,
+                                                    FitMethodSettings* settings,
+                                                    std::optional<ModelFitMethodOutcome>* full,
+                                                    std::string* note);
 
 // With nothing held out, the two-fold judgement of validation/held_out_halves.h, each fold fitted
 // by `method` with the whole data's settings and scored on the everyday-driving measures.

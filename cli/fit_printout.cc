@@ -179,8 +179,8 @@ void PrintResiduals(const CalibrationOutcome& o, const std::vector<std::string>&
     // Where sessions differ, one line per component (fit/noise_levels.h).
     const bool per_session = fit.noise_levels.sessions.AnyDiffers();
     std::printf("weights from the data (variance components at the solution; "
-                "--position-sigma-m/--heading-sigma-deg override): %s%s\n",
-                per_session ? "\n  " : "", NoiseLevelsText(fit.noise_levels, "\n  ").c_str());
+                "--position-sigma-m/--heading-sigma-deg override):%s%s\n",
+                per_session ? "\n  " : " ", NoiseLevelsText(fit.noise_levels, "\n  ").c_str());
   }
   if (o.track_data) PrintClockOffsets(fit, *o.track_data);
 }

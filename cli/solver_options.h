@@ -34,11 +34,9 @@ struct SolverOptions {
   // The residual's weights as standard deviations; 1 m and 1 rad weigh metres and radians as
   // Palacin Eq. 14's CF does. With weight_mode = "estimated", track residuals (and `both`) are
   // weighed by noise levels estimated from the fit (fit/noise_levels.h) unless a sigma is given
-  // (sigmas_given). Default "fixed": on the shared OptiOdom free runs the estimate helped the
-  // differential drive and cost omni3 more (docs/everyday_driving.md); "auto" chooses by
-  // transfer as --track-heading auto does, opt-in (on the shared OptiOdom loops it chose the fixed
-  // weights on every robot, at twice the candidate fits).
-  std::string weight_mode = "fixed";
+  // (sigmas_given). Default "auto": the estimated weights replace the fixed ones when their fit
+  // is lower on the held-out runs in CF, drift and ATE (calibrate/choice_by_transfer.h).
+  std::string weight_mode = "auto";
   double position_sigma_m = 1.0;
   double heading_sigma_deg = 180.0 / 3.14159265358979323846;
   // Set when either sigma is given: the weights are then these, not estimated from the data.

@@ -43,8 +43,11 @@ TEST(NeverWorseRealData, ACirclesOnlyFitSaysItsSquaresDriftMoreWithinTheScatter)
   const auto import = RunFitcal(dir, "import optiodom " + kDiff + "/circular/* " + kDiff +
                                          "/square/* --out " + data);
   ASSERT_EQ(import.exit_code, 0) << import.err;
-  const auto fit =
-      RunFitcal(dir, "fit --logs " + data + " --train-trajectories '^circular' --out " + cal);
+  // Fixed weights: with weights from the data (chosen on these held-out squares since issue 40)
+  // the squares drift less than with the nominal, and this test is about the warning.
+  const auto fit = RunFitcal(dir, "fit --logs " + data +
+                                      " --train-trajectories '^circular' --weights fixed --out " +
+                                      cal);
   ASSERT_EQ(fit.exit_code, 0) << fit.out << fit.err;  // written: not refused on noise
   ASSERT_TRUE(fs::exists(cal));
 

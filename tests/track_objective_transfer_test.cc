@@ -51,9 +51,12 @@ const std::vector<TrackObjective> kFourCandidates = {
     {false, TrackHeading::kIncrements},
     {true, TrackHeading::kIncrements}};
 
+// `table` judged by `judge` (by transfer unless given), the fits a marker per candidate.
 TrackObjectiveJudgement Judge(const Table& table, const RunSplit& split,
                               const std::vector<TrackObjective>& candidates = kFourCandidates,
-                              bool usable = true) {
+                              bool usable = true,
+                              decltype(&JudgeTrackObjectivesByTransfer) judge =
+                                  &JudgeTrackObjectivesByTransfer) {
   const FitByTrackObjective fit_on =
       [&](const TrackObjective& o, const std::vector<AlignedRun>&)
       -> std::optional<std::vector<double>> {
@@ -74,7 +77,7 @@ TrackObjectiveJudgement Judge(const Table& table, const RunSplit& split,
     e.mean_ate_rmse_m = m[2];
     return e;
   };
-  return JudgeTrackObjectivesByTransfer(candidates, split, fit_on, score);
+  return judge(candidates, split, fit_on, score);
 }
 
 // Candidate 2 is worse than the default on the square (1 run) and better on the circles (3 runs):
@@ -187,6 +190,38 @@ TEST(TrackObjectiveTransfer, HeldOutFreeDrivingIsTheOneFold) {
   EXPECT_TRUE(j.on_free_driving);
   EXPECT_EQ(j.judged_on, "free (1)");
   EXPECT_EQ(j.chosen, 2);
+}
+
+// --weights auto: the weights are judged on the held-out runs (one fold: every training run
+// fitted, every held-out run judged, whatever its kind), by the same pooled rule; nothing to judge
+// without held-out runs.
+TEST(TrackObjectiveTransfer, WeightsAreJudgedOnTheHeldOutRunsByThePooledRule) {
+  RunSplit split = CirclesAndSquares();
+  split.validation = {testing::LabelledRun("circular_1", 4), testing::LabelledRun("circular_1", 5)};
+  const std::vector<TrackObjective> weights = {{false, TrackHeading::kIncrements},
+                                               {true, TrackHeading::kIncrements}};
+  // Lower on all three on the held-out circles: chosen; higher drift (below): kept.
+  const Table better = {{"circular", {{0.10, 1.0, 0.050}, {0.09, 0.9, 0.040}}}};
+  const TrackObjectiveJudgement j =
+      Judge(better, split, weights, true, &JudgeTrackWeightsOnHeldOutRuns);
+  ASSERT_TRUE(j.judged);
+  EXPECT_TRUE(j.on_held_out_runs);
+  EXPECT_EQ(j.pooled[1].runs, 2);  // the held-out runs, not the training runs' kinds
+  EXPECT_EQ(j.chosen, 1);
+  const std::string text = TrackObjectiveChoiceText(j);
+  EXPECT_TRUE(testing::Has(text, "; weights estimated, heading increments chosen on the held-out "
+                                 "runs (2: CF 0.1000 -> 0.0900, drift 2 m 1.000 -> 0.900 %"))
+      << text;
+  const std::vector<std::string> lines = TrackObjectiveJudgementLines(j);
+  ASSERT_FALSE(lines.empty());
+  EXPECT_EQ(lines[0], "track weights fitted on every training run, judged on the held-out runs (2):");
+  const Table drift_worse = {{"circular", {{0.10, 1.0, 0.050}, {0.09, 1.1, 0.040}}}};
+  const TrackObjectiveJudgement kept =
+      Judge(drift_worse, split, weights, true, &JudgeTrackWeightsOnHeldOutRuns);
+  EXPECT_EQ(kept.chosen, 0);
+  EXPECT_TRUE(testing::Has(TrackObjectiveChoiceText(kept), "increments kept on the held-out runs (2"));
+  EXPECT_FALSE(
+      Judge(better, CirclesAndSquares(), weights, true, &JudgeTrackWeightsOnHeldOutRuns).judged);
 }
 
 // A simulated differential drive (every length 2 % large, circles and squares, the ground truth
@@ -333,10 +368,17 @@ TEST(TrackObjectiveTransfer, FitCommandChoosesRecordsAndWritesTheChosenObjective
   EXPECT_FALSE(testing::Has(given.out, "track objectives judged")) << given.out;
   EXPECT_EQ(WithoutObjective(a), WithoutObjective(testing::ReadFileBytes(tmp.Path("b.yaml"))));
 
-  const testing::FitcalRun both = testing::RunFitcal(
-      tmp, fit + " --weights auto --no-output");
-  ASSERT_EQ(both.exit_code, 0) << both.out << both.err;
-  EXPECT_TRUE(testing::Has(both.out, "weights estimated, heading increments")) << both.out;
+  // --weights auto (the default): nothing held out here, so the weights stay fixed, said; with
+  // the second repetitions held out they are judged there.
+  EXPECT_TRUE(testing::Has(automatic.out, "track weights fixed: no held-out run")) << automatic.out;
+  const testing::FitcalRun held_out = testing::RunFitcal(
+      tmp, "fit --logs " + tmp.Path("loops") + " --residuals track --threads 1 --train-reps 1 "
+           "--no-output");
+  ASSERT_EQ(held_out.exit_code, 0) << held_out.out << held_out.err;
+  EXPECT_TRUE(testing::Has(held_out.out, "track weights fitted on every training run, judged on "
+                                         "the held-out runs (6):\n"))
+      << held_out.out;
+  EXPECT_TRUE(testing::Has(held_out.out, "  weights estimated, heading ")) << held_out.out;
 
   const testing::FitcalRun sigma = testing::RunFitcal(
       tmp, fit + " --weights auto --position-sigma-m 1 --track-heading from-start --no-output");

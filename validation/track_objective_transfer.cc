@@ -34,21 +34,15 @@ bool BetterOnEveryMeasure(const PooledTransfer& a, const PooledTransfer& b) {
   return a.cf < b.cf && a.ate_rmse_m < b.ate_rmse_m && drift;
 }
 
-}  // namespace
 
-std::string ToString(const TrackObjective& objective) {
-  return std::string("weights ") + (objective.estimate_weights ? "estimated" : "fixed") +
-         ", heading " + ToString(objective.heading);
-}
-
-TrackObjectiveJudgement JudgeTrackObjectivesByTransfer(
-    const std::vector<TrackObjective>& candidates, const RunSplit& split,
-    const FitByTrackObjective& fit_on, const ScoreOnRuns& score) {
+// The rule of the header on `folds`: every candidate fitted on each fold's training runs, scored
+// on its judged runs, pooled.
+TrackObjectiveJudgement JudgeOnFolds(const std::vector<TrackObjective>& candidates,
+                                     const TransferFolds& folds,
+                                     const FitByTrackObjective& fit_on, const ScoreOnRuns& score) {
   TrackObjectiveJudgement j;
   j.candidates = candidates;
-  if (candidates.size() < 2) return j;
-  const TransferFolds folds = MakeTransferFolds(split);
-  if (folds.folds.empty()) return j;
+  if (candidates.size() < 2 || folds.folds.empty()) return j;
   const FitCandidate fit_candidate = [&](int c, const std::vector<AlignedRun>& training) {
     return fit_on(candidates[c], training);
   };
@@ -71,28 +65,63 @@ TrackObjectiveJudgement JudgeTrackObjectivesByTransfer(
   return j;
 }
 
+// "by transfer (pooled over circular (44), square (33)" or "on the held-out runs (20"
+std::string WhereJudged(const TrackObjectiveJudgement& j) {
+  if (j.on_held_out_runs) return "on the held-out runs (" + std::to_string(j.pooled[0].runs);
+  return "by transfer (pooled over " + j.judged_on;
+}
+
+}  // namespace
+
+std::string ToString(const TrackObjective& objective) {
+  return std::string("weights ") + (objective.estimate_weights ? "estimated" : "fixed") +
+         ", heading " + ToString(objective.heading);
+}
+
+TrackObjectiveJudgement JudgeTrackObjectivesByTransfer(
+    const std::vector<TrackObjective>& candidates, const RunSplit& split,
+    const FitByTrackObjective& fit_on, const ScoreOnRuns& score) {
+  return JudgeOnFolds(candidates, MakeTransferFolds(split), fit_on, score);
+}
+
+TrackObjectiveJudgement JudgeTrackWeightsOnHeldOutRuns(
+    const std::vector<TrackObjective>& candidates, const RunSplit& split,
+    const FitByTrackObjective& fit_on, const ScoreOnRuns& score) {
+  TransferFolds held_out;
+  if (!split.validation.empty()) {
+    held_out.folds.push_back({"held-out", "every training run", split.training, split.validation});
+  }
+  TrackObjectiveJudgement j = JudgeOnFolds(candidates, held_out, fit_on, score);
+  j.on_held_out_runs = true;
+  return j;
+}
+
 std::string TrackObjectiveChoiceText(const TrackObjectiveJudgement& j) {
   if (!j.judged) return "";
   const PooledTransfer& d = j.pooled[0];
   const PooledTransfer& c = j.pooled[j.chosen];
   if (j.chosen == 0) {
-    return StrFormat("; %s kept by transfer (pooled over %s: CF %.4f, drift 2 m %.3f %%, ATE "
-                     "%.4f m; no other lower on all three)",
-                     ToString(j.candidates[0]).c_str(), j.judged_on.c_str(), d.cf, d.drift_percent,
-                     d.ate_rmse_m);
+    return StrFormat("; %s kept %s: CF %.4f, drift 2 m %.3f %%, ATE %.4f m; no other lower on "
+                     "all three)",
+                     ToString(j.candidates[0]).c_str(), WhereJudged(j).c_str(), d.cf,
+                     d.drift_percent, d.ate_rmse_m);
   }
-  return StrFormat("; %s chosen by transfer (pooled over %s: CF %.4f -> %.4f, drift 2 m %.3f -> "
-                   "%.3f %%, ATE %.4f -> %.4f m against the default)",
-                   ToString(j.candidates[j.chosen]).c_str(), j.judged_on.c_str(), d.cf, c.cf,
+  return StrFormat("; %s chosen %s: CF %.4f -> %.4f, drift 2 m %.3f -> %.3f %%, ATE %.4f -> "
+                   "%.4f m against the default)",
+                   ToString(j.candidates[j.chosen]).c_str(), WhereJudged(j).c_str(), d.cf, c.cf,
                    d.drift_percent, c.drift_percent, d.ate_rmse_m, c.ate_rmse_m);
 }
 
 std::vector<std::string> TrackObjectiveJudgementLines(const TrackObjectiveJudgement& j) {
   std::vector<std::string> lines;
   if (!j.judged) return lines;
-  lines.push_back(StrFormat("track objectives judged on runs of a kind they were not fitted on, "
-                            "pooled over %s:",
-                            j.judged_on.c_str()));
+  lines.push_back(j.on_held_out_runs
+                      ? StrFormat("track weights fitted on every training run, judged on the "
+                                  "held-out runs (%d):",
+                                  j.pooled[0].runs)
+                      : StrFormat("track objectives judged on runs of a kind they were not "
+                                  "fitted on, pooled over %s:",
+                                  j.judged_on.c_str()));
   lines.push_back(StrFormat("  %-44s %10s %16s %14s", "weights, heading", "CF", "drift 2 m [%]",
                             "ATE RMSE [m]"));
   for (std::size_t c = 0; c < j.candidates.size(); ++c) {

@@ -1,10 +1,10 @@
 #pragma once
-// `fit --weights auto` / `--track-heading auto`: how the track residual weighs its checkpoints,
-// judged by transfer as the residual kind is (validation/residual_kind_transfer.h, same folds:
-// held-out free driving, else leave one kind of training run out). The candidates are the
-// track objectives the flags allow - weights fixed (1 m : 1 rad, Eq. 14) or estimated from the fit
-// (fit/noise_levels.h), heading from the run's start or as increments (fit/track_residual.h) -
-// the first of them the default.
+// `fit --track-heading auto` / `--weights auto`: how the track residual weighs its checkpoints.
+// The candidates are the track objectives the flags allow - heading from the run's start or as
+// increments (fit/track_residual.h), weights fixed (1 m : 1 rad, Eq. 14) or estimated from the fit
+// (fit/noise_levels.h) - the first of them the default. The heading is judged by transfer as the
+// residual kind is (validation/residual_kind_transfer.h, same folds: held-out free driving, else
+// leave one kind of training run out); the weights on the held-out runs (below).
 //
 // Rule: every held-out run counts once, whatever kind it is: the CF and the ATE pooled as means
 // over all the judged runs, the drift per 2 m as the mean over all the judged windows. A candidate
@@ -49,6 +49,7 @@ struct PooledTransfer {
 struct TrackObjectiveJudgement {
   bool judged = false;
   bool on_free_driving = false;
+  bool on_held_out_runs = false;  // JudgeTrackWeightsOnHeldOutRuns
   std::vector<TrackObjective> candidates;  // [0] the default
   std::vector<PooledTransfer> pooled;      // per candidate
   std::string judged_on;                   // the folds in words: "circular (44), square (33)"
@@ -57,6 +58,16 @@ struct TrackObjectiveJudgement {
 
 // Not judged (chosen = 0) with one candidate, nothing to judge on, or a fit not usable.
 TrackObjectiveJudgement JudgeTrackObjectivesByTransfer(
+    const std::vector<TrackObjective>& candidates, const RunSplit& split,
+    const FitByTrackObjective& fit_on, const ScoreOnRuns& score);
+
+// --weights auto: the weights judged by the same rule on the held-out runs (the gate's: held-out
+// repetitions, free runs) of the candidates fitted on every training run. Not by transfer between
+// kinds of loop: the weights model the noise of these runs' ground truth and odometry, which a
+// fit on circles judged on squares confounds with what circles cannot determine (on the real
+// loops the transfer folds rejected estimated weights that the held-out repetitions and the free
+// runs preferred, docs/everyday_driving.md). Not judged without held-out runs.
+TrackObjectiveJudgement JudgeTrackWeightsOnHeldOutRuns(
     const std::vector<TrackObjective>& candidates, const RunSplit& split,
     const FitByTrackObjective& fit_on, const ScoreOnRuns& score);
 

@@ -1,14 +1,16 @@
-// What `fitcal fit` with its defaults (`--residuals auto`, `--track-heading auto`) costs against
-// the single fit it selects (issue 40: auto must cost at most twice that fit). `auto` proposes the
-// track on dense ground truth and judges it against the final pose by leave-one-kind-out fits
-// (validation/residual_kind_transfer.h), then the track's heading likewise
-// (validation/track_objective_transfer.h); the benchmark runs the fit command as a user does, once
-// with the defaults and once with the flags of what they select, on
+// What `fitcal fit` with its defaults (`--residuals auto`, `--track-heading auto`, `--weights
+// auto`) costs against the single fit it selects (issue 40: auto must cost at most twice that
+// fit). `auto` proposes the track on dense ground truth and judges it against the final pose by
+// leave-one-kind-out fits (validation/residual_kind_transfer.h), then the track's heading likewise
+// (validation/track_objective_transfer.h), then its weights on the held-out runs; the benchmark
+// runs the fit command as a user does, once with the defaults and once with the flags of what
+// they select, on
 //   - asoc: the ASOC example of `fitcal simulate --model asoc --seed 3` (simulated, always here; its
 //     ground truth is not dense enough for the track, so auto fits final poses at once);
 //   - diff, tricyc, omni3: the OptiOdom robots' circles + squares (needs ../shared, skipped
 //     without it; FITCAL_SHARED_DIR points elsewhere); on these the defaults keep the track, with
-//     the heading increments on diff and from the start on tricyc and omni3.
+//     the heading increments and the estimated weights on diff, the heading from the start and the
+//     fixed weights on tricyc and omni3.
 // Both commands run as child processes on the machine's cores (the folds run in parallel): the
 // benchmark reports wall time (UseRealTime) and the children's CPU time per iteration
 // (child_cpu_s), the measure of the issue's 2x. Data sets are written once per process, outside
@@ -96,11 +98,14 @@ void BM_Fit(benchmark::State& state, const std::string& data, const std::string&
 FITCAL_FIT_BENCHMARK(asoc_auto, "asoc", "");
 FITCAL_FIT_BENCHMARK(asoc_single, "asoc", "--residuals final-pose");
 FITCAL_FIT_BENCHMARK(diff_auto, "diff", "");
-FITCAL_FIT_BENCHMARK(diff_single, "diff", "--residuals track --track-heading increments");
+FITCAL_FIT_BENCHMARK(diff_single, "diff",
+                     "--residuals track --track-heading increments --weights estimated");
 FITCAL_FIT_BENCHMARK(tricyc_auto, "tricyc", "");
-FITCAL_FIT_BENCHMARK(tricyc_single, "tricyc", "--residuals track --track-heading from-start");
+FITCAL_FIT_BENCHMARK(tricyc_single, "tricyc",
+                     "--residuals track --track-heading from-start --weights fixed");
 FITCAL_FIT_BENCHMARK(omni3_auto, "omni3", "");
-FITCAL_FIT_BENCHMARK(omni3_single, "omni3", "--residuals track --track-heading from-start");
+FITCAL_FIT_BENCHMARK(omni3_single, "omni3",
+                     "--residuals track --track-heading from-start --weights fixed");
 // Issue 40's other speed target: the 97-run diff drive fit with clock offsets, every run trained
 // (judged on held-out halves), <= 1 s CPU.
 FITCAL_FIT_BENCHMARK(diff_reps_1_99_clock_offsets, "diff",
