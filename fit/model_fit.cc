@@ -781,9 +781,52 @@ std::vector<double> ProjectOntoHold(const Robot& robot,
   return out;
 }
 
+// The fit from `start` with the directions the runs do not determine held
+// (ModelFitOptions::hold_undetermined; *holds says which), without its covariance.
+ModelFitResult SolveHoldingUndetermined(const std::vector<AlignedRun>& training,
+                                        const RobotModelInterface& model,
+                                        const std::vector<double>& start,
+                                        const ModelFitOptions& options, HeldDirections* holds) {
+  // What the direction analysis sees: with tracks, their checkpoints at the start's clock offsets
+  // (the last checkpoint is the final pose relative to the start, so "both" adds nothing to it).
+  std::vector<std::vector<Segment>> checkpoints;
+  if (UsesTracks(options)) {
+    for (const TrackCheckpoints& t : options.track->runs) checkpoints.push_back(t.segments);
+  }
+  const std::vector<std::vector<Segment>>* analysed =
+      UsesTracks(options) ? &checkpoints : options.segments;
+
+  ModelFitResult result = SolveFrom(training, model, start, options, {});
+  if (options.hold_undetermined) {
+    bool finite = true;
+    for (double v : result.parameters) finite = finite && std::isfinite(v);
+    const DirectionAnalysis analysis =
+        AnalyseDeterminedDirections(training, model, finite ? result.parameters : start,
+                                    WeightsOfRuns(options, training.size()), analysed,
+                                    options.ceres.num_threads);
+    if (analysis.ok && !analysis.undetermined.empty()) {
+      holds->directions = analysis.undetermined;
+      holds->weight = HoldWeight(analysis);
+      const bool project = options.held_fit_from_projection && result.usable;
+      ModelFitResult held = SolveFrom(
+          training, model,
+          project ? ProjectOntoHold(model.robot(), holds->directions, result.parameters) : start,
+          options, *holds);
+      held.held_directions = analysis.undetermined;
+      held.unconstrained_parameters = result.parameters;
+      held.unconstrained_usable = result.usable;
+      held.iterations += result.iterations;
+      held.solve_time_s += result.solve_time_s;
+      result = std::move(held);
+    }
+  }
+  return result;
+}
+
 // ModelFitOptions::estimate_weights (fit/noise_levels.h): fit, estimate the noise levels at the
 // solution, reweight, refit from there, until two estimates agree. The fit returned is the last
-// one, made with weights that agree with the estimate at its solution.
+// one, made with weights that agree with the estimate at its solution; its covariance is the only
+// one computed (the rounds before are discarded).
 ModelFitResult FitWithNoiseLevels(const std::vector<AlignedRun>& training,
                                   const RobotModelInterface& model,
                                   const std::vector<double>& start,
@@ -793,10 +836,14 @@ ModelFitResult FitWithNoiseLevels(const std::vector<AlignedRun>& training,
   std::vector<double> from = start;
   NoiseLevels levels;
   ModelFitResult fit;
+  ModelFitOptions fitted_with;  // the returned fit's options and holds
+  HeldDirections holds;
   int iterations = 0;
   double solve_time_s = 0.0;
   for (int round = 1; round <= kMaxNoiseLevelIterations; ++round) {
-    fit = FitModelFrom(training, model, from, weighted);
+    holds = {};
+    fit = SolveHoldingUndetermined(training, model, from, weighted, &holds);
+    fitted_with = weighted;
     iterations += fit.iterations;
     solve_time_s += fit.solve_time_s;
     if (!(fit.usable || fit.stopped_early)) break;
@@ -819,6 +866,9 @@ ModelFitResult FitWithNoiseLevels(const std::vector<AlignedRun>& training,
     if (levels.with_final_poses) weighted.ceres.weights = w.final_pose;
     weighted.weights_per_run = WeightsPerRun(levels);
     from = fit.parameters;
+  }
+  if (options.ceres.compute_covariance) {
+    ComputeCovariance(training, model, fitted_with, holds, &fit);
   }
   fit.noise_levels = levels;
   fit.iterations = iterations;
@@ -859,40 +909,8 @@ ModelFitResult FitModelFrom(const std::vector<AlignedRun>& training,
   if (options.estimate_weights && UsesTracks(options)) {
     return FitWithNoiseLevels(training, model, start, options);
   }
-  // What the direction analysis sees: with tracks, their checkpoints at the start's clock offsets
-  // (the last checkpoint is the final pose relative to the start, so "both" adds nothing to it).
-  std::vector<std::vector<Segment>> checkpoints;
-  if (UsesTracks(options)) {
-    for (const TrackCheckpoints& t : options.track->runs) checkpoints.push_back(t.segments);
-  }
-  const std::vector<std::vector<Segment>>* analysed =
-      UsesTracks(options) ? &checkpoints : options.segments;
-
-  ModelFitResult result = SolveFrom(training, model, start, options, {});
   HeldDirections holds;
-  if (options.hold_undetermined) {
-    bool finite = true;
-    for (double v : result.parameters) finite = finite && std::isfinite(v);
-    const DirectionAnalysis analysis =
-        AnalyseDeterminedDirections(training, model, finite ? result.parameters : start,
-                                    WeightsOfRuns(options, training.size()), analysed,
-                                    options.ceres.num_threads);
-    if (analysis.ok && !analysis.undetermined.empty()) {
-      holds.directions = analysis.undetermined;
-      holds.weight = HoldWeight(analysis);
-      const bool project = options.held_fit_from_projection && result.usable;
-      ModelFitResult held = SolveFrom(
-          training, model,
-          project ? ProjectOntoHold(model.robot(), holds.directions, result.parameters) : start,
-          options, holds);
-      held.held_directions = analysis.undetermined;
-      held.unconstrained_parameters = result.parameters;
-      held.unconstrained_usable = result.usable;
-      held.iterations += result.iterations;
-      held.solve_time_s += result.solve_time_s;
-      result = std::move(held);
-    }
-  }
+  ModelFitResult result = SolveHoldingUndetermined(training, model, start, options, &holds);
   if (options.ceres.compute_covariance) ComputeCovariance(training, model, options, holds, &result);
   return result;
 }
