@@ -34,7 +34,6 @@ bool BetterOnEveryMeasure(const PooledTransfer& a, const PooledTransfer& b) {
   return a.cf < b.cf && a.ate_rmse_m < b.ate_rmse_m && drift;
 }
 
-
 // The rule of the header on `folds`: every candidate fitted on each fold's training runs, scored
 // on its judged runs, pooled.
 TrackObjectiveJudgement JudgeOnFolds(const std::vector<TrackObjective>& candidates,
