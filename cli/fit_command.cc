@@ -26,9 +26,9 @@ namespace fitcal::tools {
 std::string ClosedFormsOfModels() {
   std::vector<std::string> models;
   for (const ModelRegistration& m : RegisteredModels()) {
-    if (!m.extras.closed_forms.empty()) {
-      models.push_back(m.name + ": " + io::Joined(m.extras.closed_forms, ", "));
-    }
+    std::vector<std::string> methods;
+    for (const ClosedForm& form : m.extras.closed_forms) methods.push_back(form.method);
+    if (!methods.empty()) models.push_back(m.name + ": " + io::Joined(methods, ", "));
   }
   std::sort(models.begin(), models.end());
   return io::Joined(models, "; ");

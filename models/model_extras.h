@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -152,12 +153,22 @@ struct PaperTables {
       reproduce;  // empty: the model reproduces no table
 };
 
+// A classical calibration computed from the training runs: its method's name (written as
+// ClosedFormCalibration::method, so the name is given once) and the computation, nullopt when the
+// runs hold nothing it can use.
+struct ClosedForm {
+  std::string method;  // "umbmark"
+  std::function<std::optional<ClosedFormCalibration>(const RobotModelInterface& model,
+                                                     const std::vector<AlignedRun>& training)>
+      compute;
+};
+
 struct ModelExtras {
   std::vector<ControllerWriter> controllers;
   SimulationScenario scenario;
-  // The methods of the closed forms RobotModelInterface::ClosedForms computes ("umbmark"); empty:
-  // none, and `fit --closed-form-only` is refused before any run is read.
-  std::vector<std::string> closed_forms;
+  // What RobotModelInterface::ClosedForms computes; empty: none, and `fit --closed-form-only` is
+  // refused before any run is read.
+  std::vector<ClosedForm> closed_forms;
   PaperTables paper_tables;
   // Empty: the parameters in display units (m, deg).
   std::function<ParameterDisplay(const Robot&)> display;
