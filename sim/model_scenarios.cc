@@ -66,8 +66,8 @@ ScenarioRecorder WithReplacements(ScenarioRecorder r, const ScenarioNoise& noise
   return r;
 }
 
-// The simulator's options for runs of `model` recorded as `recorder` says (counts on the wheel
-// channels only), with the model's channel dynamics.
+}  // namespace
+
 SimulationOptions RecordedAs(const RobotModelInterface& model, const ScenarioRecorder& recorder,
                              std::uint64_t seed) {
   const Robot& robot = model.robot();
@@ -92,8 +92,6 @@ SimulationOptions RecordedAs(const RobotModelInterface& model, const ScenarioRec
   o.dynamics = ExtrasOf(robot.model).scenario.dynamics;
   return o;
 }
-
-}  // namespace
 
 std::string ScenarioModelNames() {
   return ModelNamesWith([](const ModelExtras& e) { return bool(e.scenario.trajectories); });

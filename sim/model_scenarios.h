@@ -41,6 +41,11 @@ struct ModelScenario {
 ModelScenario MakeModelScenario(const RobotModelInterface& model, const std::vector<double>& truth,
                                 const ScenarioNoise& noise);
 
+// The simulator's options for runs of `model` recorded as `recorder` says (counts on the wheel
+// channels only), with the model's channel dynamics.
+SimulationOptions RecordedAs(const RobotModelInterface& model, const ScenarioRecorder& recorder,
+                             std::uint64_t seed);
+
 // The simulator of a published experiment (ModelExtras::paper_tables): runs of the model with its
 // own channel dynamics, recorded as `recorder` says; `model` must outlive the function.
 SimulateFn ScenarioSimulator(const RobotModelInterface& model, const ScenarioRecorder& recorder);
