@@ -132,9 +132,10 @@ int RunSimulateCommand(const SimulateCommandOptions& options) {
     const sim::ModelDatasetRequest r = RequestOf(options);
     const sim::WrittenModelDataset written = sim::WriteModelDataset(r);
     const Robot& robot = written.model->robot();
-    std::printf("wrote %zu runs of the %s robot '%s' (%d repetitions, seed %llu) to %s\n",
+    std::printf("wrote %zu runs of the %s robot '%s' (%d %s, seed %llu) to %s\n",
                 written.num_runs, robot.model.c_str(), robot.name.c_str(), written.repetitions,
-                static_cast<unsigned long long>(r.noise.seed), options.out.c_str());
+                written.repetition_unit.c_str(), static_cast<unsigned long long>(r.noise.seed),
+                options.out.c_str());
     PrintTruth(robot, written.truth);
     return 0;
   });

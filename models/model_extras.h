@@ -105,6 +105,8 @@ struct SimulationScenario {
       const RobotModelInterface& nominal, const std::vector<double>& truth, int repetitions)>
       trajectories;  // empty: the model has no scenario
   int default_repetitions = 10;  // `simulate` without --repetitions
+  // What a repetition is, as `simulate` counts them ("5 repetitions, seed 1"; asoc: excursions).
+  std::string repetition_unit = "repetitions";
   ScenarioRecorder recorder;
   double truth_fraction = 0.25;
   // The default true robot when the model has its own (omni3: Palacin Table 5, any seed; asoc:

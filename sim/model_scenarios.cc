@@ -108,6 +108,7 @@ ModelScenario MakeModelScenario(const RobotModelInterface& model, const std::vec
   }
   ModelScenario out;
   out.repetitions = noise.repetitions.value_or(scenario.default_repetitions);
+  out.repetition_unit = scenario.repetition_unit;
   if (out.repetitions < 0) throw std::invalid_argument("--repetitions must be at least 0");
   out.trajectories = scenario.trajectories(model, truth, out.repetitions);
   if (out.trajectories.empty()) {

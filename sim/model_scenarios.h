@@ -29,6 +29,7 @@ namespace fitcal::sim {
 
 struct ModelScenario {
   int repetitions = 0;  // --repetitions, or the scenario's default
+  std::string repetition_unit;  // SimulationScenario::repetition_unit
   std::vector<TrajectorySpec> trajectories;  // ordered by repetition, then trajectory
   SimulationOptions options;
   EncoderCsvDigits digits = EncoderCsvDigits::kRoundTrip;

@@ -237,6 +237,7 @@ ModelExtras AsocExtras() {
                           }}};
   extras.paper_tables = asoc::DoebblerPaperTables();
   extras.scenario.default_repetitions = 5;
+  extras.scenario.repetition_unit = "excursions";  // the holds and squares are always driven
   extras.scenario.recorder = asoc::PrototypeRecorder();
   extras.scenario.default_truth = [](const Robot& nominal, std::uint64_t seed) {
     asoc::Vehicle v;
