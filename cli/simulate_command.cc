@@ -58,30 +58,26 @@ void PrintTruth(const Robot& robot, const std::vector<double>& truth) {
 // flag not given leaves the model recorder's value.
 sim::ModelDatasetRequest RequestOf(const SimulateCommandOptions& options) {
   const auto given = [&](const char* flag) { return options.given.count(flag) > 0; };
-  const std::pair<const char*, std::pair<double ScenarioRecorder::*, double>> recorder_flags[] = {
-      {"--encoder-counts-per-rev",
-       {&ScenarioRecorder::ticks_per_rev, options.encoder_counts_per_rev}},
-      {"--wheel-rate-sigma-rad-s",
-       {&ScenarioRecorder::wheel_rate_sigma_rad_s, options.wheel_rate_sigma_rad_s}},
-      {"--wheel-slip-sigma", {&ScenarioRecorder::wheel_relative_sigma, options.wheel_slip_sigma}},
-      {"--angle-sigma-deg",
-       {&ScenarioRecorder::angle_sigma_rad, options.angle_sigma_deg * M_PI / 180.0}},
-      {"--gt-position-sigma-m",
-       {&ScenarioRecorder::gt_position_sigma_m, options.gt_position_sigma_m}},
-      {"--gt-heading-sigma-deg",
-       {&ScenarioRecorder::gt_heading_sigma_rad, options.gt_heading_sigma_deg * M_PI / 180.0}}};
+  const auto if_given = [&](const char* flag, auto value) {
+    return given(flag) ? std::optional(value) : std::nullopt;
+  };
   sim::ModelDatasetRequest r;
   r.out = options.out;
   r.model = options.model;
   r.robot = given("--robot") || options.model.empty() ? options.robot : "";
   r.truth = options.truth;
   r.force = options.force;
-  if (given("--repetitions")) r.noise.repetitions = options.repetitions;
+  r.noise.repetitions = if_given("--repetitions", options.repetitions);
   r.noise.seed = options.seed;
-  for (const auto& [flag, value] : recorder_flags) {
-    if (given(flag)) r.noise.recorder_values.push_back(value);
-  }
-  if (given("--slip-sigma")) r.noise.slip_sigma = options.slip_sigma;
+  r.noise.ticks_per_rev = if_given("--encoder-counts-per-rev", options.encoder_counts_per_rev);
+  r.noise.wheel_rate_sigma_rad_s =
+      if_given("--wheel-rate-sigma-rad-s", options.wheel_rate_sigma_rad_s);
+  r.noise.wheel_relative_sigma = if_given("--wheel-slip-sigma", options.wheel_slip_sigma);
+  r.noise.angle_sigma_rad = if_given("--angle-sigma-deg", options.angle_sigma_deg * M_PI / 180.0);
+  r.noise.gt_position_sigma_m = if_given("--gt-position-sigma-m", options.gt_position_sigma_m);
+  r.noise.gt_heading_sigma_rad =
+      if_given("--gt-heading-sigma-deg", options.gt_heading_sigma_deg * M_PI / 180.0);
+  r.noise.slip_sigma = if_given("--slip-sigma", options.slip_sigma);
   for (const std::string& text : options.inject) {
     r.noise.injected_effects.push_back(ParseInjectedEffect(text));
   }
@@ -136,9 +132,10 @@ int RunSimulateCommand(const SimulateCommandOptions& options) {
     const sim::ModelDatasetRequest r = RequestOf(options);
     const sim::WrittenModelDataset written = sim::WriteModelDataset(r);
     const Robot& robot = written.model->robot();
-    std::printf("wrote %zu runs of the %s robot '%s' (%d repetitions, seed %llu) to %s\n",
+    std::printf("wrote %zu runs of the %s robot '%s' (%d %s, seed %llu) to %s\n",
                 written.num_runs, robot.model.c_str(), robot.name.c_str(), written.repetitions,
-                static_cast<unsigned long long>(r.noise.seed), options.out.c_str());
+                written.repetition_unit.c_str(), static_cast<unsigned long long>(r.noise.seed),
+                options.out.c_str());
     PrintTruth(robot, written.truth);
     return 0;
   });

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -104,6 +105,8 @@ struct SimulationScenario {
       const RobotModelInterface& nominal, const std::vector<double>& truth, int repetitions)>
       trajectories;  // empty: the model has no scenario
   int default_repetitions = 10;  // `simulate` without --repetitions
+  // What a repetition is, as `simulate` counts them ("5 repetitions, seed 1"; asoc: excursions).
+  std::string repetition_unit = "repetitions";
   ScenarioRecorder recorder;
   double truth_fraction = 0.25;
   // The default true robot when the model has its own (omni3: Palacin Table 5, any seed; asoc:
@@ -152,12 +155,22 @@ struct PaperTables {
       reproduce;  // empty: the model reproduces no table
 };
 
+// A classical calibration computed from the training runs: its method's name (written as
+// ClosedFormCalibration::method, so the name is given once) and the computation, nullopt when the
+// runs hold nothing it can use.
+struct ClosedForm {
+  std::string method;  // "umbmark"
+  std::function<std::optional<ClosedFormCalibration>(const RobotModelInterface& model,
+                                                     const std::vector<AlignedRun>& training)>
+      compute;
+};
+
 struct ModelExtras {
   std::vector<ControllerWriter> controllers;
   SimulationScenario scenario;
-  // The methods of the closed forms RobotModelInterface::ClosedForms computes ("umbmark"); empty:
-  // none, and `fit --closed-form-only` is refused before any run is read.
-  std::vector<std::string> closed_forms;
+  // What RobotModelInterface::ClosedForms computes; empty: none, and `fit --closed-form-only` is
+  // refused before any run is read.
+  std::vector<ClosedForm> closed_forms;
   PaperTables paper_tables;
   // Empty: the parameters in display units (m, deg).
   std::function<ParameterDisplay(const Robot&)> display;

@@ -4,6 +4,8 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "models/model_registry.h"
+
 namespace fitcal {
 
 namespace {
@@ -89,6 +91,18 @@ int RequireParameterIndex(const Robot& robot, const std::string& name) {
                            ") has no parameter '" + name + "'");
   }
   return *k;
+}
+
+std::vector<ClosedFormCalibration> RobotModelInterface::ClosedForms(
+    const std::vector<AlignedRun>& training) const {
+  std::vector<ClosedFormCalibration> out;
+  for (const ClosedForm& form : ExtrasOf(robot().model).closed_forms) {
+    if (std::optional<ClosedFormCalibration> c = form.compute(*this, training)) {
+      c->method = form.method;
+      out.push_back(std::move(*c));
+    }
+  }
+  return out;
 }
 
 }  // namespace fitcal

@@ -165,11 +165,10 @@ class RobotModelInterface {
   // capped to keep the check fast for many wheels.
   virtual std::vector<ChannelMapping> CandidateMiswirings() const;
 
-  // Classical calibrations computed from the training runs, when the model has one.
+  // Classical calibrations computed from the training runs: the closed forms the model registers
+  // (model_extras.h ModelExtras::closed_forms), those the runs allow.
   virtual std::vector<ClosedFormCalibration> ClosedForms(
-      const std::vector<AlignedRun>& /*training*/) const {
-    return {};
-  }
+      const std::vector<AlignedRun>& training) const;
 };
 
 using RobotModelPtr = std::shared_ptr<const RobotModelInterface>;

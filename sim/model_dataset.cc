@@ -77,6 +77,7 @@ WrittenModelDataset WriteModelDataset(const ModelDatasetRequest& request) {
                             model.RobotYaml(written.truth, ""));
     written.num_runs = runs.size();
     written.repetitions = scenario.repetitions;
+    written.repetition_unit = scenario.repetition_unit;
   });
   return written;
 }

@@ -30,6 +30,7 @@ struct WrittenModelDataset {
   std::vector<double> truth;   // the true parameters, as true_robot.yaml holds them
   std::size_t num_runs = 0;
   int repetitions = 0;         // as asked, or the scenario's default
+  std::string repetition_unit;  // the scenario's: "repetitions", asoc's "excursions"
 };
 
 // Throws UsageError for an `out` it may not write or a robot of another model,

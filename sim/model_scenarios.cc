@@ -26,11 +26,7 @@ std::string ModelNamesWith(const std::function<bool(const ModelExtras&)>& has) {
 // scenario without it: perfect tracking has no slip and no substep the effects act on.
 void SetSteppedPhysics(const Robot& robot, const SimulationScenario& scenario,
                        const ScenarioNoise& noise, SimulationOptions* o) {
-  const auto replaces = [&](double ScenarioRecorder::*value) {
-    return std::any_of(noise.recorder_values.begin(), noise.recorder_values.end(),
-                       [&](const auto& replaced) { return replaced.first == value; });
-  };
-  if (scenario.stepped_physics && replaces(&ScenarioRecorder::wheel_relative_sigma)) {
+  if (scenario.stepped_physics && noise.wheel_relative_sigma) {
     throw UsageError("--wheel-slip-sigma acts on perfect tracking; the stepped physics of "
                      "--model " + robot.model + " slips as --slip-sigma says (docs/simulate.md)");
   }
@@ -60,13 +56,18 @@ void SetSteppedPhysics(const Robot& robot, const SimulationScenario& scenario,
 }
 
 // The model's recorder with the values `simulate` was given in place of its own.
-ScenarioRecorder WithReplacements(ScenarioRecorder recorder, const ScenarioNoise& noise) {
-  for (const auto& [value, replacement] : noise.recorder_values) recorder.*value = replacement;
-  return recorder;
+ScenarioRecorder WithReplacements(ScenarioRecorder r, const ScenarioNoise& noise) {
+  r.ticks_per_rev = noise.ticks_per_rev.value_or(r.ticks_per_rev);
+  r.wheel_rate_sigma_rad_s = noise.wheel_rate_sigma_rad_s.value_or(r.wheel_rate_sigma_rad_s);
+  r.wheel_relative_sigma = noise.wheel_relative_sigma.value_or(r.wheel_relative_sigma);
+  r.angle_sigma_rad = noise.angle_sigma_rad.value_or(r.angle_sigma_rad);
+  r.gt_position_sigma_m = noise.gt_position_sigma_m.value_or(r.gt_position_sigma_m);
+  r.gt_heading_sigma_rad = noise.gt_heading_sigma_rad.value_or(r.gt_heading_sigma_rad);
+  return r;
 }
 
-// The simulator's options for runs of `model` recorded as `recorder` says (counts on the wheel
-// channels only), with the model's channel dynamics.
+}  // namespace
+
 SimulationOptions RecordedAs(const RobotModelInterface& model, const ScenarioRecorder& recorder,
                              std::uint64_t seed) {
   const Robot& robot = model.robot();
@@ -92,8 +93,6 @@ SimulationOptions RecordedAs(const RobotModelInterface& model, const ScenarioRec
   return o;
 }
 
-}  // namespace
-
 std::string ScenarioModelNames() {
   return ModelNamesWith([](const ModelExtras& e) { return bool(e.scenario.trajectories); });
 }
@@ -109,6 +108,7 @@ ModelScenario MakeModelScenario(const RobotModelInterface& model, const std::vec
   }
   ModelScenario out;
   out.repetitions = noise.repetitions.value_or(scenario.default_repetitions);
+  out.repetition_unit = scenario.repetition_unit;
   if (out.repetitions < 0) throw std::invalid_argument("--repetitions must be at least 0");
   out.trajectories = scenario.trajectories(model, truth, out.repetitions);
   if (out.trajectories.empty()) {

@@ -29,6 +29,7 @@ namespace fitcal::sim {
 
 struct ModelScenario {
   int repetitions = 0;  // --repetitions, or the scenario's default
+  std::string repetition_unit;  // SimulationScenario::repetition_unit
   std::vector<TrajectorySpec> trajectories;  // ordered by repetition, then trajectory
   SimulationOptions options;
   EncoderCsvDigits digits = EncoderCsvDigits::kRoundTrip;
@@ -40,6 +41,11 @@ struct ModelScenario {
 // per-sample wheel slip inside it and for an effect the robot's channels cannot show.
 ModelScenario MakeModelScenario(const RobotModelInterface& model, const std::vector<double>& truth,
                                 const ScenarioNoise& noise);
+
+// The simulator's options for runs of `model` recorded as `recorder` says (counts on the wheel
+// channels only), with the model's channel dynamics.
+SimulationOptions RecordedAs(const RobotModelInterface& model, const ScenarioRecorder& recorder,
+                             std::uint64_t seed);
 
 // The simulator of a published experiment (ModelExtras::paper_tables): runs of the model with its
 // own channel dynamics, recorded as `recorder` says; `model` must outlive the function.

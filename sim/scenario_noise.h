@@ -7,7 +7,6 @@
 #include <cstdint>
 #include <optional>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "models/model_extras.h"
@@ -18,8 +17,13 @@ namespace fitcal::sim {
 struct ScenarioNoise {
   std::optional<int> repetitions;  // unset: the scenario's default_repetitions
   std::uint64_t seed = 1;
-  // The recorder's values replaced, e.g. {&ScenarioRecorder::ticks_per_rev, 1024.0}.
-  std::vector<std::pair<double ScenarioRecorder::*, double>> recorder_values;
+  // The recorder's values given; unset: the model recorder's (ScenarioRecorder's fields).
+  std::optional<double> ticks_per_rev;
+  std::optional<double> wheel_rate_sigma_rad_s;
+  std::optional<double> wheel_relative_sigma;  // perfect tracking only (refused elsewhere)
+  std::optional<double> angle_sigma_rad;
+  std::optional<double> gt_position_sigma_m;
+  std::optional<double> gt_heading_sigma_rad;
   // The stepped physics only (ModelExtras::scenario.stepped_physics; refused elsewhere): the
   // wheel slip's sigma (unset: SteppedOptions' default) and library effects the data set does not
   // name.

@@ -1,8 +1,8 @@
 #pragma once
 // ASOC runs for the tests on the one simulator (sim/model_simulator.h) with the castor dynamics
-// the asoc model registers (models/asoc/asoc_extras.h), the prototype's encoders as asoc-tables
-// simulates them: 20 Hz, wheels counted in 0.3 deg, pivots read in 0.07 deg, noise-free ground
-// truth at every encoder time, each run from the origin heading +x.
+// the asoc model registers (models/asoc/asoc_extras.h), the prototype's encoders as
+// `paper-tables --model asoc` records them: 20 Hz, wheels counted in 0.3 deg, pivots read in
+// 0.07 deg, noise-free ground truth at every encoder time, each run from the origin heading +x.
 
 #include <yaml-cpp/yaml.h>
 
@@ -12,6 +12,7 @@
 #include "models/asoc/asoc_extras.h"
 #include "models/asoc/asoc_robot_model.h"
 #include "models/model_registry.h"
+#include "sim/model_scenarios.h"
 #include "sim/model_simulator.h"
 
 namespace fitcal::asoc {
@@ -21,23 +22,18 @@ inline const AsocModel& ExampleAsocModel() {
   return dynamic_cast<const AsocModel&>(*model);
 }
 
-// pivot_quantum_rad < 0: the example robot's pivot_resolution_deg; wheel_ticks_per_rev 0: exact.
+// The prototype's recorder as the asoc model registers it for Doebbler's tables
+// (ModelExtras::paper_tables.recorder, models/asoc/asoc_tables.cc), with the wheel slip and the
+// wheels' counts given. pivot_quantum_rad < 0: the example robot's pivot_resolution_deg;
+// wheel_ticks_per_rev 0: exact.
 inline sim::SimulationOptions PrototypeSimulation(std::uint64_t seed, double wheel_slip_sigma,
                                                   double pivot_quantum_rad = -1.0,
                                                   double wheel_ticks_per_rev =
                                                       kPrototypeWheelTicksPerRev) {
-  sim::SimulationOptions o;
-  o.encoder_period_s = kPrototypeSamplePeriodS;
-  o.ground_truth_period_s = kPrototypeSamplePeriodS;
-  o.substep_s = kPrototypeSamplePeriodS / 10.0;
-  o.ticks_per_rev.assign(kNumChannels, 0.0);
-  for (int i = 0; i < kNumCastors; ++i) {
-    o.ticks_per_rev[i * kChannelsPerCastor + kWheelAChannel] = wheel_ticks_per_rev;
-    o.ticks_per_rev[i * kChannelsPerCastor + kWheelBChannel] = wheel_ticks_per_rev;
-  }
-  o.wheel_relative_sigma = wheel_slip_sigma;
-  o.seed = seed;
-  o.dynamics = ExtrasOf("asoc").scenario.dynamics;
+  ScenarioRecorder recorder = ExtrasOf("asoc").paper_tables.recorder;
+  recorder.wheel_relative_sigma = wheel_slip_sigma;
+  recorder.ticks_per_rev = wheel_ticks_per_rev;
+  sim::SimulationOptions o = sim::RecordedAs(ExampleAsocModel(), recorder, seed);
   if (pivot_quantum_rad >= 0.0) {
     o.dynamics = [pivot_quantum_rad](const RobotModelInterface&, const std::vector<double>& p,
                                      const sim::TrajectorySpec& spec) {

@@ -231,9 +231,13 @@ ModelExtras AsocExtras() {
     for (int k = 1; k <= repetitions; ++k) out.push_back(asoc::ExcursionTrajectory(k));
     return out;
   };
-  extras.closed_forms = {"asoc-geometric"};  // Doebbler Eq. 1-9 (AsocModel::ClosedForms)
+  extras.closed_forms = {{"asoc-geometric", [](const RobotModelInterface& model,
+                                                const std::vector<AlignedRun>& training) {
+                            return asoc::AsAsoc(model).Geometric(training);
+                          }}};
   extras.paper_tables = asoc::DoebblerPaperTables();
   extras.scenario.default_repetitions = 5;
+  extras.scenario.repetition_unit = "excursions";  // the holds and squares are always driven
   extras.scenario.recorder = asoc::PrototypeRecorder();
   extras.scenario.default_truth = [](const Robot& nominal, std::uint64_t seed) {
     asoc::Vehicle v;

@@ -155,26 +155,25 @@ RobotModelPtr AsocModel::WithOdometry(const AsocOdometryOptions& odometry) const
   return std::make_shared<AsocModel>(robot(), asoc_, std::move(k));
 }
 
-std::vector<ClosedFormCalibration> AsocModel::ClosedForms(
+std::optional<ClosedFormCalibration> AsocModel::Geometric(
     const std::vector<AlignedRun>& training) const {
   std::vector<asoc::HoldRun> holds;
   for (const AlignedRun& run : training) {
     if (const auto hold = asoc::MeasureHoldRun(run.trajectory, run.samples)) holds.push_back(*hold);
   }
-  if (holds.empty()) return {};
+  if (holds.empty()) return std::nullopt;
   const asoc::GeometricResult result =
       asoc::CalibrateFromHoldRuns(holds, asoc_.nominal, asoc_.pivot_resolution_rad);
-  if (!result.usable) return {};
+  if (!result.usable) return std::nullopt;
   const auto p = result.estimate.ToArray();
-  ClosedFormCalibration out{"asoc-geometric", std::vector<double>(p.begin(), p.end()),
-                            result.message};
+  ClosedFormCalibration out{"", std::vector<double>(p.begin(), p.end()), result.message};
   if (result.sigma_dof >= 1) {  // every parameter is measured (Eq. 1-9): all 18 get a sigma
     asoc::Vehicle sigma = result.estimate;
     sigma.castors = result.sigma;
     const auto s = sigma.ToArray();
     out.sigma.assign(s.begin(), s.end());
   }
-  return {out};
+  return out;
 }
 
 std::vector<ChannelMapping> AsocModel::CandidateMiswirings() const {

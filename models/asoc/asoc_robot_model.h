@@ -36,9 +36,9 @@ class AsocModel : public KinematicModel<AsocKinematics> {
                         const std::vector<effects::EffectValue>& effects,
                         const std::string& calibration_block) const override;
 
-  // Doebbler Eq. 1-9 from every hold run (`hold_<j>_cw` / `hold_<j>_ccw`) among the training runs.
-  std::vector<ClosedFormCalibration> ClosedForms(
-      const std::vector<AlignedRun>& training) const override;
+  // Doebbler Eq. 1-9 from every hold run (`hold_<j>_cw` / `hold_<j>_ccw`) among the training
+  // runs: the method of asoc's closed form (asoc_extras.cc).
+  std::optional<ClosedFormCalibration> Geometric(const std::vector<AlignedRun>& training) const;
 
   // Per castor: wheels a and b swapped, both wheels' signs flipped (a module's motor polarity),
   // each wheel's sign flipped, the pivot encoder's sign flipped; per pair of castors: the whole

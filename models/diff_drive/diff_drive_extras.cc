@@ -55,7 +55,7 @@ ModelExtras DiffDriveExtras() {
   // (sim/model_scenarios.h).
   extras.scenario.trajectories = &DiffDriveScenario;
   extras.scenario.truth_fraction = 0.025;
-  extras.closed_forms = {"umbmark"};  // Borenstein & Feng (DiffDriveClosedForms)
+  extras.closed_forms = {{"umbmark", &DiffDriveUmbmark}};
   return extras;
 }
 

@@ -183,10 +183,10 @@ std::string DiffDriveRobotYaml(const Robot& robot, int right_channel, const std:
   return std::string(out.c_str()) + "\n" + calibration_block;
 }
 
-std::vector<ClosedFormCalibration> DiffDriveClosedForms(const RobotModelInterface& model,
-                                                        int right_channel,
-                                                        const std::vector<AlignedRun>& training) {
+std::optional<ClosedFormCalibration> DiffDriveUmbmark(const RobotModelInterface& model,
+                                                      const std::vector<AlignedRun>& training) {
   const Robot& robot = model.robot();
+  const int right_channel = DiffDriveRightChannel(model);
   std::vector<umbmark::SquareReturnError> squares;
   int skipped = 0;
   for (const AlignedRun& run : training) {
@@ -206,9 +206,8 @@ std::vector<ClosedFormCalibration> DiffDriveClosedForms(const RobotModelInterfac
                                            robot.nominal[left_channel],
                                            robot.nominal[diff_drive::kSeparationIndex]};
   const auto c = umbmark::Correct(squares, nominal);
-  if (!c) return {};
+  if (!c) return std::nullopt;
   ClosedFormCalibration calibration;
-  calibration.method = "umbmark";
   calibration.parameters.resize(diff_drive::kNumParameters);
   calibration.parameters[right_channel] = c->corrected.r_right_m;
   calibration.parameters[left_channel] = c->corrected.r_left_m;
@@ -220,7 +219,7 @@ std::vector<ClosedFormCalibration> DiffDriveClosedForms(const RobotModelInterfac
       skipped > 0 ? (", " + std::to_string(skipped) + " 'square' runs not one closed lap").c_str()
                   : "",
       c->alpha_rad * 180.0 / M_PI, c->beta_rad * 180.0 / M_PI, c->e_d, c->e_b);
-  return {calibration};
+  return calibration;
 }
 
 }  // namespace fitcal

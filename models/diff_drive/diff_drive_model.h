@@ -35,10 +35,11 @@ std::string DiffDriveRobotYaml(const Robot& robot, int right_channel, const std:
                                const std::vector<effects::EffectValue>& effects,
                                const std::string& calibration_block);
 
-// UMBmark (umbmark.h) from the training runs whose trajectory label contains "square".
-std::vector<ClosedFormCalibration> DiffDriveClosedForms(const RobotModelInterface& model,
-                                                        int right_channel,
-                                                        const std::vector<AlignedRun>& training);
+// UMBmark (Borenstein & Feng 1996, umbmark.h) from the CW and CCW squares among the training runs
+// (trajectory label containing "square"); nullopt without at least one of each. The method of
+// diff_drive's closed form (diff_drive_extras.cc).
+std::optional<ClosedFormCalibration> DiffDriveUmbmark(const RobotModelInterface& model,
+                                                      const std::vector<AlignedRun>& training);
 
 template <int kRightChannel>
 class DiffDriveModelT : public KinematicModel<DiffDriveKinematicsT<kRightChannel>> {
@@ -54,13 +55,6 @@ class DiffDriveModelT : public KinematicModel<DiffDriveKinematicsT<kRightChannel
                         const std::vector<effects::EffectValue>& effects,
                         const std::string& calibration_block) const override {
     return DiffDriveRobotYaml(this->robot_, kRightChannel, p, effects, calibration_block);
-  }
-
-  // UMBmark (Borenstein & Feng 1996) from the CW and CCW squares among the training runs; empty
-  // without at least one of each.
-  std::vector<ClosedFormCalibration> ClosedForms(
-      const std::vector<AlignedRun>& training) const override {
-    return DiffDriveClosedForms(*this, kRightChannel, training);
   }
 };
 
