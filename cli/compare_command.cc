@@ -39,7 +39,8 @@ std::string SolverFlagOfNoMethodAsked(const CompareCommandOptions& options,
     (IsCeresMethod(m->name) ? ceres : nlopt) = true;
     names += (names.empty() ? "" : " ") + m->name;
   }
-  return SolverFlagThatDoesNotApply(options, ceres, nlopt, "--methods " + names);
+  return SolverFlagThatDoesNotApply(options, CompareCommandOptions(), ceres, nlopt,
+                                    "--methods " + names);
 }
 
 // What the user typed, checked before any data is read or any fit runs: empty when valid, else
@@ -69,7 +70,7 @@ std::string ParseRequest(const CompareCommandOptions& options, ComparisonRequest
     return e.what();
   }
   r->data_name = options.logs;
-  r->strategies_given = options.Given("--strategies");
+  r->strategies_given = options.strategies_given;
   if (!options.validation_reps.empty()) {
     r->validation_reps = ParseRepetitionList(options.validation_reps);
   }
@@ -125,6 +126,8 @@ void PrintAndWrite(const CompareCommandOptions& options, const ComparisonRequest
 
 void AddCompareOptions(CLI::App& app, CompareCommandOptions& o) {
   AddDatasetOptions(app, o);
+  // A data set takes the STA..STE it has unless --strategies names some.
+  app.callback([&app, &o] { o.strategies_given = app.count("--strategies") > 0; });
   app.add_option("--strategies", o.strategies,
                  "STA..STE, trajectory lists such as R1,R5,G4 or B1-B12, all, or a label "
                  "prefix such as circular/* (one per item)")
@@ -145,9 +148,6 @@ void AddCompareOptions(CLI::App& app, CompareCommandOptions& o) {
   app.add_flag("--quiet", o.quiet, "No progress on stderr");
   AddSolverOptions(app, o);
   AddTyingFlags(app, o);
-  // The solver flags given (SolverFlagThatDoesNotApply), and --strategies: without it a data set
-  // takes the STA..STE it has.
-  RecordGivenFlags(app, &o.given);
 }
 
 int RunCompareCommand(const CompareCommandOptions& options) {

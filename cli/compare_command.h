@@ -24,8 +24,9 @@ namespace fitcal::tools {
 // from SolverOptions and --tie/--hold from TyingFlags (the same as fit's).
 struct CompareCommandOptions : DatasetCommandOptions, SolverOptions, TyingFlags {
   // Palacin's STA..STE, trajectory lists, "all" or "<prefix>*" (calibrate/method_comparison.h).
-  // Without --strategies given: those of STA..STE the data set has, else "all".
+  // Without strategies_given: those of STA..STE the data set has, else "all".
   std::vector<std::string> strategies = {"STA", "STB", "STC", "STD", "STE"};
+  bool strategies_given = false;
   std::vector<std::string> methods = {"ceres", "crs2lm", "esch", "slsqp"};  // or "all"
   std::vector<int> repetitions = {1, 5};  // train on the first k repetitions of the data set
   std::string validation_reps;            // "" = every repetition after the largest k

@@ -2,6 +2,7 @@
 // `fitcal fit` (and plain `fitcal --logs ... --method ceres`): load a data set, fit on the
 // training repetitions, validate on the rest, print the table and write the calibrated YAML.
 
+#include <set>
 #include <string>
 #include <vector>
 
@@ -12,8 +13,7 @@
 namespace fitcal::tools {
 
 // --logs, --threads and --allow-outside-paths come from DatasetCommandOptions, the solver flags
-// and the set of flags given from SolverOptions, --tie and --hold (fit/parameter_tying.h) from
-// TyingFlags.
+// from SolverOptions, --tie and --hold (fit/parameter_tying.h) from TyingFlags.
 struct FitCommandOptions : DatasetCommandOptions, SolverOptions, TyingFlags {
   std::string method = "ceres";
   std::string train_reps = "1-5";
@@ -39,6 +39,7 @@ struct FitCommandOptions : DatasetCommandOptions, SolverOptions, TyingFlags {
   // (CalibrationRequest::closed_forms_only); refused before the runs are read for a model that
   // registers none (ModelExtras::closed_forms) and beside a flag only a fit uses.
   bool closed_forms_only = false;
+  std::set<std::string> given;  // the flags given on the command line, e.g. "--method"
 };
 
 // Declares every flag of `fit` on `app` (the `fit` subcommand, and the top level: `fitcal --logs

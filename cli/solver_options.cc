@@ -30,16 +30,19 @@ void AddSolverOptions(CLI::App& app, SolverOptions& o) {
       ->check(PositiveNumber());
   app.add_flag("--polish", o.polish,
                "NLopt global methods: polish the best point with SLSQP (autodiff gradient)");
+  const auto given = [&o](const std::string&) { o.sigmas_given = true; };
   app.add_option("--position-sigma-m", o.position_sigma_m,
                  "Weight of the position residual as a standard deviation (m); with the default "
                  "1 m and 57.3 deg the objective weighs metres and radians as Eq. 14. With "
                  "--weights estimated, giving this or --heading-sigma-deg fixes the weights")
       ->capture_default_str()
-      ->check(PositiveNumber());
+      ->check(PositiveNumber())
+      ->each(given);
   app.add_option("--heading-sigma-deg", o.heading_sigma_deg,
                  "Weight of the heading residual as a standard deviation (deg)")
       ->capture_default_str()
-      ->check(PositiveNumber());
+      ->check(PositiveNumber())
+      ->each(given);
 }
 
 void AddTrackResidualOptions(CLI::App& app, SolverOptions& o) {
@@ -72,20 +75,22 @@ void AddTrackResidualOptions(CLI::App& app, SolverOptions& o) {
       ->check(CLI::IsMember({"fixed", "estimated", "auto"}));
 }
 
-std::string SolverFlagThatDoesNotApply(const SolverOptions& o, bool ceres, bool nlopt,
-                                       const std::string& methods) {
-  if (!ceres && (o.Given("--loss") || o.Given("--loss-scale"))) {
+std::string SolverFlagThatDoesNotApply(const SolverOptions& o, const SolverOptions& defaults,
+                                       bool ceres, bool nlopt, const std::string& methods) {
+  const bool loss = o.loss != defaults.loss;
+  if (!ceres && (loss || o.loss_scale != defaults.loss_scale)) {
     return "--loss and --loss-scale shape the Ceres methods' final-pose residuals; " + methods +
            " does not use them";
   }
-  if (!ceres && o.Given("--max-iterations")) {
+  if (!ceres && o.max_iterations != defaults.max_iterations) {
     return "--max-iterations bounds the Ceres methods; " + methods + " has --max-evaluations";
   }
-  if (!nlopt && (o.Given("--seed") || o.Given("--max-evaluations") || o.Given("--polish"))) {
+  if (!nlopt && (o.seed != defaults.seed || o.max_evaluations != defaults.max_evaluations ||
+                 o.polish)) {
     return "--seed, --max-evaluations and --polish apply to the NLopt methods; " + methods +
            " does not use them";
   }
-  if (o.loss == "none" && o.Given("--loss-scale")) {
+  if (!loss && o.loss_scale != defaults.loss_scale) {
     return "--loss-scale without --loss (huber or cauchy) has no loss to scale";
   }
   return "";
@@ -96,8 +101,8 @@ bool MakeFitMethodSettings(const SolverOptions& o, int threads, FitMethodSetting
   s->threads = threads;
   s->max_iterations = o.max_iterations;
   s->weights = o.Weights();
-  s->estimate_weights = o.weight_mode == "estimated" && !o.SigmasGiven();
-  s->weights_auto = o.weight_mode == "auto" && !o.SigmasGiven();  // a sigma given fixes them
+  s->estimate_weights = o.weight_mode == "estimated" && !o.sigmas_given;
+  s->weights_auto = o.weight_mode == "auto" && !o.sigmas_given;  // a sigma given fixes them
   s->objective_set = !o.objective.empty();
   if (s->objective_set && !ParseFinalPoseObjective(o.objective, &s->objective))
     return Invalid(error, "unknown --objective '" + o.objective + "' (available: squares, eq14)");

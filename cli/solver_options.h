@@ -6,7 +6,6 @@
 // budget and polish; both the residual weights.
 
 #include <CLI/CLI.hpp>
-#include <set>
 #include <string>
 
 #include "calibrate/fit_methods.h"
@@ -35,18 +34,14 @@ struct SolverOptions {
   // The residual's weights as standard deviations; 1 m and 1 rad weigh metres and radians as
   // Palacin Eq. 14's CF does. With weight_mode = "estimated", track residuals (and `both`) are
   // weighed by noise levels estimated from the fit (fit/noise_levels.h) unless a sigma is given
-  // (SigmasGiven). Default "auto": the estimated weights replace the fixed ones when their fit
+  // (sigmas_given). Default "auto": the estimated weights replace the fixed ones when their fit
   // is lower on the held-out runs in CF, drift and ATE (calibrate/choice_by_transfer.h).
   std::string weight_mode = "auto";
   double position_sigma_m = 1.0;
   double heading_sigma_deg = 180.0 / 3.14159265358979323846;
-  // The flags given on the command line, e.g. "--loss" (cli_validators.h RecordGivenFlags): a
-  // flag given at its default value is given all the same.
-  std::set<std::string> given;
+  // Set when either sigma is given: the weights are then these, not estimated from the data.
+  bool sigmas_given = false;
 
-  bool Given(const std::string& flag) const { return given.count(flag) > 0; }
-  // Either sigma given: the weights are then these, not estimated from the data.
-  bool SigmasGiven() const { return Given("--position-sigma-m") || Given("--heading-sigma-deg"); }
   ResidualWeights Weights() const;  // the sigmas in SI units (the heading's in radians)
 };
 
@@ -57,12 +52,12 @@ void AddSolverOptions(CLI::App& app, SolverOptions& options);
 // fits final poses) refuses them as flags it does not take (exit 2) instead of ignoring them.
 void AddTrackResidualOptions(CLI::App& app, SolverOptions& options);
 
-// A solver flag given (SolverOptions::given) that none of the methods would use: "" or the
-// refusal's one line (exit 2), so that nothing the user set is dropped without a word. `ceres` and
-// `nlopt` say whether the methods asked for (`methods`, e.g. "--method ceres") include a Ceres and
-// an NLopt one.
-std::string SolverFlagThatDoesNotApply(const SolverOptions& o, bool ceres, bool nlopt,
-                                       const std::string& methods);
+// A solver flag none of the methods would use, as the flags alone show it: "" or the refusal's one
+// line (exit 2), so that nothing the user set is dropped without a word. `ceres` and `nlopt` say
+// whether the methods asked for (`methods`, e.g. "--method ceres") include a Ceres and an NLopt
+// one; `defaults` are the command's (a flag given at its default changes nothing either way).
+std::string SolverFlagThatDoesNotApply(const SolverOptions& o, const SolverOptions& defaults,
+                                       bool ceres, bool nlopt, const std::string& methods);
 
 // The solver flags (cli/solver_options.h) checked and turned into settings; false with a
 // one-line message when a name is unknown or a value out of range.

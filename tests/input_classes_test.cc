@@ -295,33 +295,5 @@ TEST(InputClassesCli, FlagsNoMethodAskedWouldUseAreRefused) {
   }
 }
 
-// tidy41: a flag given at its default value is given (SolverOptions::given). fit and compare
-// decided "given" by comparing with the default, so `--method slsqp --loss none` or
-// `--residuals final-pose --clock-offsets none` ran (exit 0) with a flag the fit does not use;
-// now each is refused as the same flag at another value is: exit 2, one line, before a run is
-// read (the flower's data set is opened, not loaded).
-TEST(InputClassesCli, AFlagGivenAtItsDefaultIsGiven) {
-  const TempDir dir;
-  struct Case {
-    std::string args, says;
-  };
-  const std::string compare = "compare --logs . --strategies all --repetitions 1 --quiet ";
-  const std::string fit = "fit --no-output --logs " + FITCAL_SOURCE_DIR + "/data/flower ";
-  for (const Case& c : std::vector<Case>{
-           {compare + "--methods ceres --seed 1", "--methods ceres does not use them"},
-           {compare + "--methods crs2lm --loss none", "--methods crs2lm does not use them"},
-           {compare + "--methods crs2lm --max-iterations 100", "bounds the Ceres methods"},
-           {compare + "--methods ceres --loss-scale 0.05", "--loss-scale without --loss"},
-           {fit + "--method slsqp --loss none", "--method slsqp does not use them"},
-           {fit + "--residuals final-pose --clock-offsets none", "estimated on track residuals"},
-           {fit + "--residuals final-pose --weights auto", "--weights shapes track residuals"},
-           {fit + "--residuals track --loss none", "--loss shapes final-pose residuals"}}) {
-    const auto r = RunFitcal(dir, c.args);
-    EXPECT_EQ(r.exit_code, 2) << c.args << ": " << r.out << r.err;
-    EXPECT_EQ(Lines(r.err), 1) << c.args << ": " << r.err;
-    EXPECT_TRUE(Has(r.err, c.says)) << c.args << ": " << r.err;
-  }
-}
-
 }  // namespace
 }  // namespace fitcal
