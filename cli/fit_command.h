@@ -27,10 +27,10 @@ struct FitCommandOptions : DatasetCommandOptions, SolverOptions, TyingFlags {
   // Library effects (odometry/effects.h) to fit with the parameters on the training tracks, as
   // one more candidate of the result gate; the effects a robot YAML declares are refitted too.
   std::vector<std::string> effects;
-  // One or two runs fitted on their tracks and nothing held out: cut each into this many blocks
-  // of equal path, the odd ones train and the even ones validate (0, the default: fit the whole
-  // runs; measured on the OptiOdom free runs, half a run calibrates worse,
-  // docs/everyday_driving.md).
+  // One or two runs fitted on their tracks and nothing held out: the procedure is judged on
+  // held-out time blocks of equal path, 2, 4, 8 and this many per run, the fit of the odd blocks
+  // on the even ones and back (validation/held_out_halves.h); the whole runs' fit is what is
+  // written (on the OptiOdom free runs half a run calibrates worse, docs/everyday_driving.md).
   int time_blocks = 4;
   // Write a calibration with a parameter on its bound (fit/result_gate.h AtBoundRefusal): the user
   // widened the bounds on purpose and accepts a value that still ends on one.
