@@ -72,10 +72,9 @@ void FitAllTrainingRuns(const FitMethod& method, const RobotModelInterface& mode
   fold_fits->seed_levels = whole.noise_levels;
 }
 
-// The track objectives --track-heading auto allows, the default first (heading from the start),
+// The track objectives --track-heading auto judges, the default first (heading from the start),
 // with the request's weights (fixed under --weights auto: judged after, on the held-out runs).
 std::vector<TrackObjective> HeadingCandidates(const FitMethodSettings& settings) {
-  if (!settings.track_heading_auto) return {{settings.estimate_weights, settings.track_heading}};
   return {{settings.estimate_weights, TrackHeading::kFromStart},
           {settings.estimate_weights, TrackHeading::kIncrements}};
 }
