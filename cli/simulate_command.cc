@@ -16,6 +16,12 @@ namespace fitcal::tools {
 
 namespace {
 
+// "repetitions" / "excursions" for one: the unit without its plural s.
+std::string Singular(const std::string& unit, int count) {
+  const bool plural_s = count == 1 && !unit.empty() && unit.back() == 's';
+  return plural_s ? unit.substr(0, unit.size() - 1) : unit;
+}
+
 // "name=v1[,v2]" -> an effect of the registry with its values, checked against its bounds.
 effects::EffectValue ParseInjectedEffect(const std::string& text) {
   const std::size_t eq = text.find('=');
@@ -132,10 +138,10 @@ int RunSimulateCommand(const SimulateCommandOptions& options) {
     const sim::ModelDatasetRequest r = RequestOf(options);
     const sim::WrittenModelDataset written = sim::WriteModelDataset(r);
     const Robot& robot = written.model->robot();
+    const std::string unit = Singular(written.repetition_unit, written.repetitions);
     std::printf("wrote %zu runs of the %s robot '%s' (%d %s, seed %llu) to %s\n",
                 written.num_runs, robot.model.c_str(), robot.name.c_str(), written.repetitions,
-                written.repetition_unit.c_str(), static_cast<unsigned long long>(r.noise.seed),
-                options.out.c_str());
+                unit.c_str(), static_cast<unsigned long long>(r.noise.seed), options.out.c_str());
     PrintTruth(robot, written.truth);
     return 0;
   });

@@ -33,8 +33,7 @@ void AddSolverOptions(CLI::App& app, SolverOptions& o) {
   const auto given = [&o](const std::string&) { o.sigmas_given = true; };
   app.add_option("--position-sigma-m", o.position_sigma_m,
                  "Weight of the position residual as a standard deviation (m); with the default "
-                 "1 m and 57.3 deg the objective weighs metres and radians as Eq. 14. With "
-                 "--weights estimated, giving this or --heading-sigma-deg fixes the weights")
+                 "1 m and 57.3 deg the objective weighs metres and radians as Eq. 14")
       ->capture_default_str()
       ->check(PositiveNumber())
       ->each(given);
@@ -70,7 +69,8 @@ void AddTrackResidualOptions(CLI::App& app, SolverOptions& o) {
                  "(noise levels of position and heading estimated from the fit itself, per "
                  "session where the sessions differ, printed and written into the calibration's "
                  "objective; docs/everyday_driving.md), or auto: estimated when their fit is "
-                 "lower than the fixed weights' on the held-out runs in CF, drift and ATE")
+                 "lower than the fixed weights' on the held-out runs in CF, drift and ATE; "
+                 "--position-sigma-m or --heading-sigma-deg given fixes them")
       ->capture_default_str()
       ->check(CLI::IsMember({"fixed", "estimated", "auto"}));
 }

@@ -153,6 +153,7 @@ TEST(SimulateCommand, AsocRunsOnTheOneEngine) {
   const std::string data = dir.Path("data");
   const Result r = RunFitcal(dir, "simulate --model asoc --repetitions 1 --seed 4 --out " + data);
   ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("(1 excursion, seed 4)"), std::string::npos) << r.out;  // not "excursions"
   const std::string index = ReadFileBytes(data + "/dataset.yaml");
   for (const char* id : {"hold_3_ccw-rep01", "umbmark_cw-rep10", "excursion-rep01"}) {
     EXPECT_NE(index.find(id), std::string::npos) << id << "\n" << index;
