@@ -8,8 +8,7 @@
 #include <string>
 
 #include "io/rosbag2/errors.h"
-#include "io/rosbag2/mcap_storage.h"
-#include "io/rosbag2/sqlite3_storage.h"
+#include "io/rosbag2/storage.h"
 
 namespace fitcal::io::rosbag2 {
 namespace {
