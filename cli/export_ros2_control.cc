@@ -7,7 +7,6 @@
 
 #include "cli/cli_validators.h"
 #include "cli/dataset_command.h"
-#include "interchange/ros2/controller_export.h"
 #include "io/atomic_file.h"
 #include "io/command_failure.h"
 #include "io/output_guard.h"

@@ -10,7 +10,6 @@
 #include <stdexcept>
 #include <string_view>
 #include <utility>
-#include <vector>
 
 #include "io/input_error.h"
 #include "io/sample_checks.h"

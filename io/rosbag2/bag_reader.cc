@@ -5,10 +5,8 @@
 #include <iterator>
 #include <limits>
 #include <map>
-#include <string>
 
 #include "io/rosbag2/errors.h"
-#include "io/rosbag2/storage.h"
 
 namespace fitcal::io::rosbag2 {
 namespace {
