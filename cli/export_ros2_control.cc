@@ -7,10 +7,10 @@
 
 #include "cli/cli_validators.h"
 #include "cli/dataset_command.h"
-#include "interchange/ros2/controller_export.h"
 #include "io/atomic_file.h"
 #include "io/command_failure.h"
 #include "io/output_guard.h"
+#include "io/text_file.h"
 #include "io/yaml_scalar.h"
 #include "models/model_registry.h"
 #include "odometry/text_format.h"
@@ -47,9 +47,8 @@ void AddExportRos2ControlOptions(CLI::App& app, ExportRos2ControlOptions& o) {
   app.add_option("--calibration", o.calibration, "Calibrated robot YAML (from fit)")
       ->required()
       ->check(CLI::ExistingFile);
-  std::string names;
-  for (const std::string& c : Ros2Controllers()) names += (names.empty() ? "" : ", ") + c;
-  app.add_option("--controller", o.controller, "One of " + names)->required();
+  app.add_option("--controller", o.controller, "One of " + io::Joined(Ros2Controllers(), ", "))
+      ->required();
   app.add_option("--node-name", o.node_name, "Top-level key (default: the controller's name)");
   app.add_option("--joints", o.joints,
                  "URDF joint names in the robot's channel order (default: the channel names)")
@@ -60,10 +59,9 @@ void AddExportRos2ControlOptions(CLI::App& app, ExportRos2ControlOptions& o) {
                  "Data set: replay the exported parameters on its held-out runs beside the "
                  "nominal robot and the exact calibration; refuse them if worse than nominal")
       ->check(CLI::ExistingDirectory);
-  std::string distros;
-  for (const std::string& d : RosDistros()) distros += (distros.empty() ? "" : "|") + d;
   app.add_option("--ros-distro", o.ros_distro,
-                 "ROS 2 distribution (" + distros + "): only the keys it declares are written")
+                 "ROS 2 distribution (" + io::Joined(RosDistros(), "|") +
+                     "): only the keys it declares are written")
       ->capture_default_str();
   // Both act on the replay of --logs; without it they would be dropped in silence.
   app.add_flag("--allow-worse", o.allow_worse,

@@ -6,8 +6,6 @@
 #include <cstdio>
 #include <iostream>
 #include <optional>
-#include <string>
-#include <vector>
 
 #include "calibrate/calibrate.h"
 #include "calibrate/fit_methods.h"

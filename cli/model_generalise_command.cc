@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <iostream>
 #include <optional>
-#include <string>
 
 #include "cli/effect_list.h"
 #include "cli/everyday_driving_table.h"

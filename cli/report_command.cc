@@ -18,7 +18,6 @@
 #include "cli/cli_validators.h"
 #include "fit/clock_alignment.h"
 #include "io/output_guard.h"
-#include "validation/report_builder.h"
 #include "validation/trajectory_metrics.h"
 
 namespace fitcal::tools {

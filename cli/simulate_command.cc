@@ -3,9 +3,7 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
-#include <iostream>
 #include <optional>
-#include <utility>
 #include <stdexcept>
 
 #include "cli/dataset_command.h"

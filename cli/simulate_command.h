@@ -8,7 +8,6 @@
 #include <vector>
 
 #include "sim/model_simulator.h"
-#include "sim/scenario_noise.h"
 
 namespace CLI {
 class App;

@@ -15,8 +15,6 @@
 #include <cstring>
 #include <filesystem>
 #include <stdexcept>
-#include <string>
-#include <vector>
 
 #include "io/input_registry.h"
 

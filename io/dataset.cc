@@ -5,16 +5,13 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <functional>
 #include <iomanip>
 #include <map>
-#include <new>
 #include <set>
 #include <sstream>
 #include <string_view>
-#include <unordered_map>
 
 #include "io/input_error.h"
 #include "io/input_registry.h"

@@ -4,14 +4,12 @@
 #include <array>
 #include <charconv>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <new>
 #include <optional>
 #include <stdexcept>
 #include <string_view>
 #include <utility>
-#include <vector>
 
 #include "io/input_error.h"
 #include "io/sample_checks.h"

@@ -1,7 +1,6 @@
 #pragma once
 // Loaders for the per-run log files of a data set (format: README.md, "Data set format").
 
-#include <optional>
 #include <string>
 #include <vector>
 

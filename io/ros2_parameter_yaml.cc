@@ -4,6 +4,7 @@
 #include <set>
 
 #include "io/command_failure.h"
+#include "io/text_file.h"
 #include "io/yaml_scalar.h"
 #include "odometry/text_format.h"
 
@@ -18,11 +19,7 @@ std::string Ros2Double(double v) {
 double Ros2AsWritten(double v) { return std::strtod(Ros2Double(v).c_str(), nullptr); }
 
 std::string Ros2NameList(const std::vector<std::string>& names) {
-  std::string out = "[";
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    out += (i ? ", " : "") + YamlDoubleQuoted(names[i]);
-  }
-  return out + "]";
+  return "[" + Joined(names, ", ", YamlDoubleQuoted) + "]";
 }
 
 std::vector<std::string> ChannelJointNames(const Robot& robot,

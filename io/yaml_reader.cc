@@ -4,7 +4,6 @@
 #include <cmath>
 #include <map>
 #include <new>
-#include <vector>
 
 #include "io/input_error.h"
 #include "io/text_file.h"

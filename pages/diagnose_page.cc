@@ -2,11 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <sstream>
 
 #include "io/text_file.h"
-#include "odometry/text_format.h"
 #include "pages/final_error_plot.h"
 #include "pages/report_html.h"
 #include "pages/report_json.h"

@@ -1,7 +1,6 @@
 #include "pages/report_html.h"
 
 #include <algorithm>
-#include <sstream>
 
 #include "pages/report_figures.h"
 #include "pages/report_text.h"

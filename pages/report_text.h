@@ -10,7 +10,6 @@
 #include <vector>
 
 #include "pages/report_model.h"
-#include "pages/svg_plot.h"
 
 namespace fitcal::io::report_text {
 

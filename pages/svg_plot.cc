@@ -54,6 +54,21 @@ void Open(std::ostringstream& out, int width, int height, const std::string& tit
       << EscapeXml(title) << "</title>\n";
 }
 
+// A colour-blind-safe sequential scale (viridis stops) at u in [0, 1], clamped: dark blue for
+// small values, yellow for large ones.
+std::string SequentialColour(double u) {
+  // Viridis at u = 0, 0.25, 0.5, 0.75, 1 (matplotlib), linearly between.
+  static const double kStops[5][3] = {
+      {68, 1, 84}, {59, 82, 139}, {33, 145, 140}, {94, 201, 98}, {253, 231, 37}};
+  u = std::clamp(std::isfinite(u) ? u : 0.0, 0.0, 1.0);
+  const int k = std::min(3, static_cast<int>(u * 4.0));
+  const double f = u * 4.0 - k;
+  const auto c = [&](int i) {
+    return static_cast<int>(std::lround(kStops[k][i] + f * (kStops[k + 1][i] - kStops[k][i])));
+  };
+  return StrFormat("#%02x%02x%02x", c(0), c(1), c(2));
+}
+
 // Number of colours of an error-coloured line: pieces of one colour are one polyline, so the
 // file grows with the colour changes, not with the points.
 constexpr int kColourSteps = 10;
@@ -88,19 +103,6 @@ double TextWidthPx(const std::string& text, double font_px) {
   std::size_t chars = 0;
   for (char c : text) chars += (static_cast<unsigned char>(c) & 0xC0) != 0x80;
   return 0.6 * font_px * static_cast<double>(chars);
-}
-
-std::string SequentialColour(double u) {
-  // Viridis at u = 0, 0.25, 0.5, 0.75, 1 (matplotlib), linearly between.
-  static const double kStops[5][3] = {
-      {68, 1, 84}, {59, 82, 139}, {33, 145, 140}, {94, 201, 98}, {253, 231, 37}};
-  u = std::clamp(std::isfinite(u) ? u : 0.0, 0.0, 1.0);
-  const int k = std::min(3, static_cast<int>(u * 4.0));
-  const double f = u * 4.0 - k;
-  const auto c = [&](int i) {
-    return static_cast<int>(std::lround(kStops[k][i] + f * (kStops[k + 1][i] - kStops[k][i])));
-  };
-  return StrFormat("#%02x%02x%02x", c(0), c(1), c(2));
 }
 
 std::string ColourBarSvg(const std::string& label, double lo, double hi, int width) {

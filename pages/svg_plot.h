@@ -39,16 +39,12 @@ struct SvgSeries {
   // band between two quantiles; no stroke.
   std::string fill;
   // Non-empty (one value per point of each line): the line is drawn in pieces coloured by the
-  // value on SequentialColour's scale from value_lo to value_hi (evo's error-coloured track).
+  // value on a viridis scale from value_lo to value_hi (evo's error-coloured track; svg_plot.cc).
   std::vector<std::vector<double>> values;
   double value_lo = 0.0, value_hi = 1.0;
 };
 
-// A colour-blind-safe sequential scale (viridis stops) at u in [0, 1], clamped: dark blue for
-// small values, yellow for large ones.
-std::string SequentialColour(double u);
-
-// A horizontal colour bar of SequentialColour from lo to hi, labelled, `width` pixels wide.
+// A horizontal colour bar of that viridis scale from lo to hi, labelled, `width` pixels wide.
 std::string ColourBarSvg(const std::string& label, double lo, double hi, int width = 360);
 
 struct XYPlotOptions {

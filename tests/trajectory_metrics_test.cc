@@ -166,7 +166,7 @@ TEST(TrajectoryMetricsTest, AveragesAndImprovementReproducePalacinTable6) {
   b.rms_distance_m = 0.04;
   a.cf = 0.1;
   b.cf = 0.3;
-  const Table6Averages avg = AverageOf({&a, &b});
+  const TrajectoryErrors avg = AverageOf({&a, &b});
   EXPECT_DOUBLE_EQ(avg.rms_distance_m, 0.03);
   EXPECT_DOUBLE_EQ(avg.cf, 0.2);
 }

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <map>
 #include <sstream>
-#include <string>
 #include <tuple>
 
 #include "fit/statistics.h"

@@ -119,6 +119,11 @@ std::vector<T> PickEach(const std::vector<T>& all, const std::vector<std::size_t
   return out;
 }
 
+std::string SessionOf(const AlignedRun& run, SessionKey key) {
+  if (key == SessionKey::kLabel) return run.trajectory;
+  return PathTypeOf(run.trajectory) + " " + std::to_string(run.repetition);
+}
+
 }  // namespace
 
 std::string PathTypeOf(const std::string& trajectory_label) {
@@ -175,11 +180,6 @@ std::optional<GeneralisationSplit> RepetitionSplit(const std::vector<AlignedRun>
                                ", none left to test on") +
                    " (repetitions present: " +
                    FormatRepetitionList(std::vector<int>(present.begin(), present.end())) + ")");
-}
-
-std::string SessionOf(const AlignedRun& run, SessionKey key) {
-  if (key == SessionKey::kLabel) return run.trajectory;
-  return PathTypeOf(run.trajectory) + " " + std::to_string(run.repetition);
 }
 
 std::vector<GeneralisationSplit> LeaveOneSessionOutSplits(const std::vector<AlignedRun>& runs,

@@ -67,8 +67,6 @@ enum class SessionKey {
   kPathTypeAndRepetition,  // path type + repetition number
 };
 
-std::string SessionOf(const AlignedRun& run, SessionKey key);
-
 // One split per session (sorted), holding it out; the others train. Empty with fewer than two
 // sessions.
 std::vector<GeneralisationSplit> LeaveOneSessionOutSplits(const std::vector<AlignedRun>& runs,

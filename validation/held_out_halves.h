@@ -29,8 +29,6 @@
 
 #include "fit/model_fit.h"
 #include "fit/run_split.h"
-#include "odometry/aligned_run.h"
-#include "odometry/run_log.h"
 #include "validation/everyday_driving.h"
 #include "validation/never_worse.h"
 

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <utility>
 
 #include "fit/statistics.h"
@@ -95,8 +94,8 @@ std::vector<Measure> Measures(const EverydayDrivingMetrics& nominal,
   return out;
 }
 
-}  // namespace
-
+// Pooled over the labels that repeat, over both value lists (runs in the order of `labels`,
+// weights as above; a run of weight 0 is skipped).
 RepetitionSpread SpreadBetweenRepetitions(const std::vector<std::string>& labels,
                                           const std::vector<double>& weights,
                                           const std::vector<std::vector<double>>& values) {
@@ -120,6 +119,8 @@ RepetitionSpread SpreadBetweenRepetitions(const std::vector<std::string>& labels
   if (s.dof > 0) s.relative_sd = std::sqrt(sum_sq / s.dof);
   return s;
 }
+
+}  // namespace
 
 NeverWorseJudgement JudgeMeasure(const std::string& measure, const std::string& runs,
                                  const std::vector<std::string>& labels,

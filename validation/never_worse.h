@@ -25,7 +25,6 @@
 // two runs the spread is not measured, the margin is 0 and the line says so (the strict
 // comparison of before).
 
-#include <cstddef>
 #include <map>
 #include <string>
 #include <vector>
@@ -47,12 +46,6 @@ struct RepetitionSpread {
   double relative_sd = 0.0;
   int dof = 0;
 };
-
-// Pooled over the labels that repeat, over both value lists (runs in the order of `labels`,
-// weights as above; a run of weight 0 is skipped).
-RepetitionSpread SpreadBetweenRepetitions(const std::vector<std::string>& labels,
-                                          const std::vector<double>& weights,
-                                          const std::vector<std::vector<double>>& values);
 
 struct NeverWorseJudgement {
   std::string measure;  // "CF", "ATE RMSE [m]", "drift 1 m [%]"

@@ -26,9 +26,8 @@ namespace fitcal {
 
 namespace {
 
-// TrajectoryErrors (one run) and Table6Averages (a group) carry the same Eq. 8-14 fields.
-template <typename Metrics>
-io::ReportMetrics MetricsOf(const Metrics& e) {
+// The Eq. 8-14 fields of one run or of a group's averages (AverageOf).
+io::ReportMetrics MetricsOf(const TrajectoryErrors& e) {
   return {e.rms_distance_m,   e.rms_angle_rad,   e.max_distance_m, e.max_angle_rad,
           e.final_distance_m, e.final_angle_rad, e.cf};  // io::ReportMetrics' order
 }
@@ -640,10 +639,6 @@ io::ReportComparisonRow ComparisonRowOf(const io::ReportData& d) {
   if (!d.drift.empty()) row.drift = d.drift.back();
   return row;
 }
-
-}  // namespace
-
-namespace {
 
 // The recorded sigmas and correlation of a mounted calibration's base parameters alone: they
 // come first (models/mounted_model.h), so their block of the correlation.

@@ -245,26 +245,17 @@ SummaryStatistics Summarize(std::vector<double> values) {
   return s;
 }
 
-Table6Averages AverageOf(const std::vector<const TrajectoryErrors*>& runs) {
-  Table6Averages a;
+TrajectoryErrors AverageOf(const std::vector<const TrajectoryErrors*>& runs) {
+  TrajectoryErrors a;
   if (runs.empty()) return a;
-  for (const TrajectoryErrors* r : runs) {
-    a.rms_distance_m += r->rms_distance_m;
-    a.rms_angle_rad += r->rms_angle_rad;
-    a.max_distance_m += r->max_distance_m;
-    a.max_angle_rad += r->max_angle_rad;
-    a.final_distance_m += r->final_distance_m;
-    a.final_angle_rad += r->final_angle_rad;
-    a.cf += r->cf;
+  for (double TrajectoryErrors::*field :
+       {&TrajectoryErrors::rms_distance_m, &TrajectoryErrors::rms_angle_rad,
+        &TrajectoryErrors::max_distance_m, &TrajectoryErrors::max_angle_rad,
+        &TrajectoryErrors::final_distance_m, &TrajectoryErrors::final_angle_rad,
+        &TrajectoryErrors::cf}) {
+    for (const TrajectoryErrors* r : runs) a.*field += r->*field;
+    a.*field /= static_cast<double>(runs.size());
   }
-  const double n = static_cast<double>(runs.size());
-  a.rms_distance_m /= n;
-  a.rms_angle_rad /= n;
-  a.max_distance_m /= n;
-  a.max_angle_rad /= n;
-  a.final_distance_m /= n;
-  a.final_angle_rad /= n;
-  a.cf /= n;
   return a;
 }
 

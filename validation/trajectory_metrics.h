@@ -89,18 +89,10 @@ struct SummaryStatistics {
 };
 SummaryStatistics Summarize(std::vector<double> values);
 
-// Palacin Table 6, one row pair: averages over runs of each per-run metric, with the nominal
-// ("before") and with the calibrated ("after") parameters.
-struct Table6Averages {
-  double rms_distance_m = 0.0;
-  double rms_angle_rad = 0.0;
-  double max_distance_m = 0.0;
-  double max_angle_rad = 0.0;
-  double final_distance_m = 0.0;
-  double final_angle_rad = 0.0;
-  double cf = 0.0;
-};
-Table6Averages AverageOf(const std::vector<const TrajectoryErrors*>& runs);
+// Palacin Table 6, one row pair: averages over runs of each per-run metric (Eq. 10-14 and the
+// final errors; the per-sample vectors and final poses stay empty), with the nominal ("before")
+// or with the calibrated ("after") parameters.
+TrajectoryErrors AverageOf(const std::vector<const TrajectoryErrors*>& runs);
 
 // Improvement in percent as the paper's Table 6: 100 (before - after) / before (positive = better).
 double ImprovementPercent(double before, double after);

@@ -27,7 +27,6 @@
 
 #include "models/model_extras.h"
 #include "models/model_interface.h"
-#include "odometry/aligned_run.h"
 #include "odometry/run_log.h"
 #include "validation/never_worse.h"
 #include "validation/odometry_covariance.h"

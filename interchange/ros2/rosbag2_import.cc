@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <stdexcept>
 
 #include "io/command_failure.h"
 #include "io/input_error.h"
@@ -12,7 +11,6 @@
 #include "io/rosbag2/static_transforms.h"
 #include "io/text_file.h"
 #include "models/model_registry.h"
-#include "odometry/aligned_run.h"
 #include "odometry/text_format.h"
 
 namespace fitcal {

@@ -2,8 +2,6 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include <sstream>
-
 #include "io/input_error.h"
 #include "io/yaml_reader.h"
 

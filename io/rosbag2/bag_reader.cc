@@ -5,11 +5,8 @@
 #include <iterator>
 #include <limits>
 #include <map>
-#include <string>
 
 #include "io/rosbag2/errors.h"
-#include "io/rosbag2/mcap_storage.h"
-#include "io/rosbag2/sqlite3_storage.h"
 
 namespace fitcal::io::rosbag2 {
 namespace {

@@ -8,7 +8,6 @@
 #include "io/input_error.h"
 #include "io/rosbag2/bag_reader.h"
 #include "io/rosbag2/errors.h"
-#include "io/rosbag2/ros_messages.h"
 #include "io/text_file.h"
 #include "odometry/text_format.h"
 

@@ -3,7 +3,7 @@
 #include <lz4frame.h>
 #include <zstd.h>
 
-#include <stdexcept>
+#include <cstring>
 
 #include "odometry/invalid.h"
 

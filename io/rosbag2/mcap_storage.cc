@@ -1,24 +1,129 @@
-#include "io/rosbag2/mcap_storage.h"
+// rosbag2's MCAP storage (.mcap), read from the specification (mcap.dev/spec) without the mcap
+// library. The file is read front to back from the leading magic: the Summary section is not
+// needed (a recorder killed before writing it still leaves a Data section we can use, as long
+// as the Footer is there). Opening scans every record once: it checks the structure, decompresses
+// each Chunk ("", "zstd", "lz4" frame), verifies every CRC the writer filled in (Chunk
+// uncompressed_crc, Attachment crc, Data End data_section_crc, Footer summary_crc), learns the
+// Schemas and Channels (rosbag2 writes them inside chunks) and counts messages per topic.
+// Iteration then reads one chunk at a time again and yields messages by log_time across
+// overlapping chunks (a k-way merge over the chunks whose time ranges overlap).
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstring>
 #include <limits>
 #include <map>
-#include <optional>
 #include <queue>
 
-#include "io/rosbag2/binary_file.h"
 #include "io/rosbag2/compression.h"
 #include "io/rosbag2/crc32.h"
 #include "io/rosbag2/errors.h"
 #include "io/rosbag2/mcap_format.h"
+#include "io/rosbag2/storage.h"
 
 namespace fitcal::io::rosbag2 {
 namespace {
 
+// Reading a binary file by offset (pread) and front to back through a growing buffer. Every read
+// says whether the bytes were there, so a truncated file is an error the caller can name.
+class RandomAccessFile {
+ public:
+  // Throws InputError(kMissingFile) when the file cannot be opened.
+  explicit RandomAccessFile(const std::string& path);
+  ~RandomAccessFile();
+  RandomAccessFile(const RandomAccessFile&) = delete;
+  RandomAccessFile& operator=(const RandomAccessFile&) = delete;
+
+  std::uint64_t size() const { return size_; }
+  const std::string& path() const { return path_; }
+  // Reads exactly `count` bytes at `offset` into `out`; false if the file is shorter or fails.
+  bool ReadAt(std::uint64_t offset, std::size_t count, std::uint8_t* out) const;
+
+ private:
+  std::string path_;
+  int fd_ = -1;
+  std::uint64_t size_ = 0;
+};
+
+// Front-to-back reading in large blocks: Read(n) hands out n contiguous bytes that stay valid
+// until the next Read.
+class SequentialReader {
+ public:
+  explicit SequentialReader(const RandomAccessFile& file, std::size_t block_bytes = 1 << 20);
+
+  // The next `count` bytes, or nullptr when fewer are left in the file.
+  const std::uint8_t* Read(std::size_t count);
+  // Offset in the file of the next byte Read returns.
+  std::uint64_t offset() const { return buffer_offset_ + pos_; }
+  std::uint64_t remaining() const { return file_.size() - offset(); }
+
+ private:
+  const RandomAccessFile& file_;
+  std::vector<std::uint8_t> buffer_;
+  std::uint64_t buffer_offset_ = 0;  // file offset of buffer_[0]
+  std::size_t pos_ = 0;              // next unread byte in buffer_
+  std::size_t filled_ = 0;           // valid bytes in buffer_
+};
+
+RandomAccessFile::RandomAccessFile(const std::string& path) : path_(path) {
+  fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  struct stat st {};
+  if (fd_ < 0 || ::fstat(fd_, &st) != 0 || !S_ISREG(st.st_mode)) {
+    const std::string why = fd_ < 0 ? std::strerror(errno) : "not a regular file";
+    if (fd_ >= 0) ::close(fd_);
+    ThrowBagError(InputErrorKind::kMissingFile, path, "cannot open the bag file: " + why);
+  }
+  size_ = static_cast<std::uint64_t>(st.st_size);
+}
+
+RandomAccessFile::~RandomAccessFile() { ::close(fd_); }
+
+bool RandomAccessFile::ReadAt(std::uint64_t offset, std::size_t count, std::uint8_t* out) const {
+  if (offset > size_ || count > size_ - offset) return false;
+  while (count > 0) {
+    const ssize_t n = ::pread(fd_, out, count, static_cast<off_t>(offset));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    out += n;
+    offset += static_cast<std::uint64_t>(n);
+    count -= static_cast<std::size_t>(n);
+  }
+  return true;
+}
+
+SequentialReader::SequentialReader(const RandomAccessFile& file, std::size_t block_bytes)
+    : file_(file), buffer_(block_bytes) {}
+
+const std::uint8_t* SequentialReader::Read(std::size_t count) {
+  if (count > remaining()) return nullptr;
+  if (filled_ - pos_ < count) {
+    // Keep the unread tail, grow for a record larger than the buffer, refill behind it.
+    std::memmove(buffer_.data(), buffer_.data() + pos_, filled_ - pos_);
+    buffer_offset_ += pos_;
+    filled_ -= pos_;
+    pos_ = 0;
+    if (buffer_.size() < count) buffer_.resize(count);
+    const std::uint64_t in_file = file_.size() - (buffer_offset_ + filled_);
+    const std::size_t want =
+        static_cast<std::size_t>(std::min<std::uint64_t>(buffer_.size() - filled_, in_file));
+    if (!file_.ReadAt(buffer_offset_ + filled_, want, buffer_.data() + filled_)) return nullptr;
+    filled_ += want;
+  }
+  const std::uint8_t* p = buffer_.data() + pos_;
+  pos_ += count;
+  return p;
+}
+
 using mcap::FieldReader;
 using mcap::Opcode;
 
+// The largest record (and decompressed chunk) the reader will hold in memory. rosbag2 writes
+// chunks of about 768 KiB to a few MiB; a larger length in a file is corruption or an attack.
+constexpr std::uint64_t kMaxMcapRecordBytes = std::uint64_t{1} << 30;
 // Messages outside chunks are grouped into blocks of about this size, read back as one unit.
 constexpr std::uint64_t kLooseBlockBytes = 4 << 20;
 constexpr std::int64_t kNoTime = std::numeric_limits<std::int64_t>::max();

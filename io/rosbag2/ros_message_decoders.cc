@@ -4,7 +4,6 @@
 // the fields are read in the order they are declared, which is their .msg order.
 
 #include "io/rosbag2/cdr_reader.h"
-#include "io/rosbag2/errors.h"
 #include "io/rosbag2/ros_messages.h"
 
 namespace fitcal::io::rosbag2 {

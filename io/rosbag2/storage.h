@@ -1,7 +1,7 @@
 #pragma once
 // What every storage back end (one .db3 or one .mcap file) gives the bag reader: the topics it
 // holds and its messages one at a time in recording-time order. The back ends are created by
-// OpenSqlite3Storage (sqlite3_storage.h) and OpenMcapStorage (mcap_storage.h).
+// OpenSqlite3Storage (sqlite3_storage.cc) and OpenMcapStorage (mcap_storage.cc).
 
 #include <cstdint>
 #include <functional>
@@ -45,5 +45,12 @@ class StorageReader {
   virtual void VisitInWriteOrder(
       const std::function<bool(std::size_t topic_index, std::int64_t time_ns)>& visit) = 0;
 };
+
+// Opens one .db3 file read-only. Throws InputError when it is missing, not an SQLite database,
+// or lacks the rosbag2 tables.
+std::unique_ptr<StorageReader> OpenSqlite3Storage(const std::string& path);
+
+// Opens one .mcap file. Throws InputError for a missing, truncated or corrupt file.
+std::unique_ptr<StorageReader> OpenMcapStorage(const std::string& path);
 
 }  // namespace fitcal::io::rosbag2

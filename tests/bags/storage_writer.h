@@ -35,7 +35,7 @@ class StorageWriter {
   virtual void Close() = 0;
 };
 
-// sqlite3_writer.cc: the schema version 4 layout of rosbag2 (see sqlite3_storage.h).
+// sqlite3_writer.cc: the schema version 4 layout of rosbag2 (see io/rosbag2/sqlite3_storage.cc).
 std::unique_ptr<StorageWriter> CreateSqlite3Writer(const std::string& path);
 
 struct McapWriterOptions {
