@@ -1,6 +1,7 @@
 #include "interchange/ros2/rosbag2_import.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 
