@@ -345,10 +345,9 @@ bool NloptFitOptions::IsValid(std::string* error) const {
   if (!(weights.position_sigma_m > 0.0) || !(weights.heading_sigma_rad > 0.0))
     return Invalid(error, "residual sigmas must be positive");
   if (max_evaluations < 1) return Invalid(error, "max_evaluations must be at least 1");
-  if (local_polish && Info(method).global && local_polish_evaluations >= max_evaluations) {
-    *error = "local_polish_evaluations must leave part of max_evaluations to the search";
-    return false;
-  }
+  if (local_polish && Info(method).global && local_polish_evaluations >= max_evaluations)
+    return Invalid(error,
+                   "local_polish_evaluations must leave part of max_evaluations to the search");
   if (local_polish && local_polish_evaluations < 1)
     return Invalid(error, "local_polish_evaluations must be at least 1");
   if (max_time_s < 0.0 || ftol_rel < 0.0 || xtol_rel < 0.0 || progress_interval_s < 0.0)
