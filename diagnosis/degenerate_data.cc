@@ -12,13 +12,6 @@ namespace fitcal {
 
 namespace {
 
-// Two runs are copies when their samples are equal.
-bool SameSamples(const EncoderSamples& a, const EncoderSamples& b) { return a == b; }
-
-}  // namespace
-
-namespace {
-
 // How far a run's ground truth spreads about its median pose: the 90th percentile of the
 // distances and of the heading differences, so that a motion capture's noise (a few of its
 // samples far out) does not count as motion, and a run that moves for a tenth of its time does.
@@ -121,7 +114,7 @@ std::vector<std::string> FindDegenerateData(const std::vector<AlignedRun>& runs,
     ++distinct;
     std::vector<std::string> copies;
     for (std::size_t j = i + 1; j < runs.size(); ++j) {
-      if (!seen[j] && SameSamples(runs[i].samples, runs[j].samples)) {
+      if (!seen[j] && runs[i].samples == runs[j].samples) {
         seen[j] = true;
         copies.push_back(runs[j].id);
       }
