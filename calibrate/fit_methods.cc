@@ -7,6 +7,7 @@
 #include "fit/final_pose_errors.h"
 #include "fit/model_nlopt_fit.h"
 #include "fit/residual_choice.h"
+#include "io/text_file.h"
 #include "odometry/text_format.h"
 
 namespace fitcal {
@@ -174,9 +175,7 @@ const FitMethod* FindFitMethod(const std::string& name) {
 }
 
 std::string FitMethodNames() {
-  std::string out;
-  for (const FitMethod& method : FitMethods()) out += (out.empty() ? "" : ", ") + method.name;
-  return out;
+  return io::Joined(FitMethods(), ", ", [](const FitMethod& method) { return method.name; });
 }
 
 bool IsCeresMethod(const std::string& name) { return name == "ceres" || name == "ceres-dogleg"; }

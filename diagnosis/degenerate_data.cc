@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "fit/statistics.h"
+#include "io/text_file.h"
 
 namespace fitcal {
 
@@ -120,9 +121,7 @@ std::vector<std::string> FindDegenerateData(const std::vector<AlignedRun>& runs,
       }
     }
     if (!copies.empty() && copies.size() + 1 < runs.size()) {
-      std::string list;
-      for (const std::string& id : copies) list += (list.empty() ? "" : ", ") + id;
-      problems.push_back("runs " + runs[i].id + " and " + list +
+      problems.push_back("runs " + runs[i].id + " and " + io::Joined(copies, ", ") +
                          " have identical encoder logs (a copied file?): they count as one run");
     }
   }

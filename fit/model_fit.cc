@@ -18,6 +18,7 @@
 #include "fit/last_evaluation_memo.h"
 #include "fit/segment_cost.h"
 #include "fit/serial_covariance.h"
+#include "io/text_file.h"
 #include "odometry/text_format.h"
 
 namespace fitcal {
@@ -1015,11 +1016,7 @@ WiderThanItsBox SigmaWiderThanItsBox(const Robot& robot, const ModelFitResult& f
 std::string ReasonToStartAcrossTheBox(const Robot& robot, const ModelFitResult& fit,
                                       const ModelFitOptions& options) {
   const std::vector<std::string> on_bound = FreeParametersOnABound(robot, fit, options);
-  if (!on_bound.empty()) {
-    std::string names;
-    for (const std::string& n : on_bound) names += (names.empty() ? "" : ", ") + n;
-    return "ended on a bound (" + names + ")";
-  }
+  if (!on_bound.empty()) return "ended on a bound (" + io::Joined(on_bound, ", ") + ")";
   // No covariance although the runs are enough for one: the fit stopped where the runs, at its
   // residual level, leave a direction flat (measured: the diff drive 20 % off fitted on final poses
   // stopped at a separation of 0.166 for 0.24 with a rank-deficient covariance, docs/fit.md).

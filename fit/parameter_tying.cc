@@ -17,9 +17,7 @@ namespace {
 constexpr const char* kHeldReason = "held at its nominal value by the parameter tying";
 
 std::string NamesOf(const Robot& robot) {
-  std::string out;
-  for (const ParameterInfo& info : robot.parameters) out += (out.empty() ? "" : ", ") + info.name;
-  return out;
+  return io::Joined(robot.parameters, ", ", [](const ParameterInfo& info) { return info.name; });
 }
 
 // The chain rule through p = A q: J_q = J_p A, i.e. column j of J_q sums the columns of J_p of
