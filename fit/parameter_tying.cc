@@ -135,14 +135,7 @@ Interval Intersection(const Robot& robot, const std::vector<int>& members) {
 }  // namespace
 
 std::vector<std::string> SplitParameterNames(const std::string& text) {
-  std::vector<std::string> out;
-  std::size_t begin = 0;
-  while (true) {
-    const std::size_t comma = text.find(',', begin);
-    out.emplace_back(io::Trim(text.substr(begin, comma - begin)));
-    if (comma == std::string::npos) return out;
-    begin = comma + 1;
-  }
+  return io::SplitCsvFields(text);
 }
 
 std::string CheckTying(const Robot& robot, const ParameterTying& tying) {
