@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "fit/statistics.h"
+#include "io/text_file.h"
 #include "odometry/text_format.h"
 #include "validation/trajectory_metrics.h"
 
@@ -92,11 +93,9 @@ namespace {
 
 // "name, name" of the effects.
 std::string EffectNames(const EffectModel& effects) {
-  std::string out;
-  for (const effects::EffectValue& e : effects) {
-    out += std::string(out.empty() ? "" : ", ") + effects::Info(e.id).name;
-  }
-  return out;
+  return io::Joined(effects, ", ", [](const effects::EffectValue& e) {
+    return std::string(effects::Info(e.id).name);
+  });
 }
 
 // The model's parameters and `effects` fitted on the training tracks (fit/effect_fit.h),

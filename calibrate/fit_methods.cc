@@ -7,6 +7,7 @@
 #include "fit/final_pose_errors.h"
 #include "fit/model_nlopt_fit.h"
 #include "fit/residual_choice.h"
+#include "io/text_file.h"
 #include "odometry/text_format.h"
 
 namespace fitcal {
@@ -85,7 +86,7 @@ ModelFitMethodOutcome RunModelCeres(CeresTrustRegion trust_region,
   // point (a fold's, from the fit of all the training runs) starts from no guess and keeps it.
   out.fit = settings.start.empty() ? FitModel(training, model, options)
                                    : FitModelFrom(training, model, settings.start, options);
-  out.evaluations = out.fit.num_residual_evaluations + out.fit.num_jacobian_evaluations;
+  out.evaluations = out.fit.evaluations;
   out.objective = ResidualsText(settings);
   if (options.residuals != ResidualKind::kTrack) {
     out.objective +=
@@ -124,8 +125,6 @@ ModelFitMethodOutcome RunModelNlopt(NloptMethod method, const std::vector<Aligne
   fit.termination = r.termination;
   fit.message = r.message;
   fit.iterations = r.evaluations;
-  fit.num_residual_evaluations = r.evaluations - r.gradient_evaluations;
-  fit.num_jacobian_evaluations = r.gradient_evaluations;
   fit.solve_time_s = r.solve_time_s;
   fit.parameters = r.parameters;
   fit.at_bound = r.at_bound;
@@ -176,9 +175,7 @@ const FitMethod* FindFitMethod(const std::string& name) {
 }
 
 std::string FitMethodNames() {
-  std::string out;
-  for (const FitMethod& method : FitMethods()) out += (out.empty() ? "" : ", ") + method.name;
-  return out;
+  return io::Joined(FitMethods(), ", ", [](const FitMethod& method) { return method.name; });
 }
 
 bool IsCeresMethod(const std::string& name) { return name == "ceres" || name == "ceres-dogleg"; }

@@ -8,6 +8,7 @@
 
 #include "fit/final_pose_errors.h"
 #include "fit/run_split.h"
+#include "io/text_file.h"
 
 namespace fitcal {
 
@@ -80,10 +81,9 @@ std::string SplitRepetitions(const ComparisonRequest& r, std::vector<int>* prese
   for (const TrajectoryStrategy& s : r.strategies) {
     const std::vector<std::string> missing = MissingTrajectories(r.runs, s);
     if (missing.empty()) continue;
-    std::string list;
-    for (const std::string& label : missing) list += (list.empty() ? "" : ", ") + label;
     return "strategy " + s.name + " needs trajectories the data set " + r.data_name +
-           " lacks: " + list + " (choose --strategies from its trajectory labels)";
+           " lacks: " + io::Joined(missing, ", ") +
+           " (choose --strategies from its trajectory labels)";
   }
   if (r.validation_reps.empty()) {
     validation_reps->assign(present->begin() + r.counts.back(), present->end());

@@ -96,7 +96,7 @@ std::string ComparisonTraceCsv(const std::vector<ComparisonRow>& rows) {
   for (const ComparisonRow& row : rows) {
     for (const ConvergencePoint& p : row.trace) {
       o << CsvField(row.strategy) << "," << row.method << "," << row.repetitions << ","
-        << p.evaluation << "," << Fixed(p.best_cf, 10) << "," << Fixed(p.elapsed_s, 4) << "\n";
+        << p.evaluations << "," << Fixed(p.best_cf, 10) << "," << Fixed(p.elapsed_s, 4) << "\n";
     }
   }
   return o.str();

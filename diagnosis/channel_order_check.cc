@@ -154,8 +154,6 @@ double FittedSumOfSquares(const RobotModelInterface& model, const std::vector<Al
   return SumOfSquares(model, result.parameters, runs, segments, options);
 }
 
-std::string ColumnName(const ChannelInfo& c) { return c.rate_column; }
-
 }  // namespace
 
 double FDistributionQuantile(double p, double d1, double d2) {
@@ -225,15 +223,15 @@ std::string DescribeChannelMapping(const Robot& robot, const ChannelMapping& m) 
     all_positive = all_positive && m.sign[i] > 0;
   }
   if (all_positive && moved.size() == 2) {
-    return "columns " + ColumnName(robot.channels[moved[0]]) + " and " +
-           ColumnName(robot.channels[moved[1]]) + " swapped";
+    return "columns " + robot.channels[moved[0]].rate_column + " and " +
+           robot.channels[moved[1]].rate_column + " swapped";
   }
   std::string out;
   for (int i = 0; i < robot.NumChannels(); ++i) {
     if (m.column[i] == i && m.sign[i] > 0) continue;
     if (!out.empty()) out += ", ";
     out += robot.channels[i].name + " = " + (m.sign[i] < 0 ? "-" : "") +
-           ColumnName(robot.channels[m.column[i]]);
+           robot.channels[m.column[i]].rate_column;
     if (m.column[i] == i) out += " (sign flipped)";
   }
   return out.empty() ? "recorded order" : out;

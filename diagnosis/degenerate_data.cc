@@ -7,15 +7,9 @@
 #include <utility>
 
 #include "fit/statistics.h"
+#include "io/text_file.h"
 
 namespace fitcal {
-
-namespace {
-
-// Two runs are copies when their samples are equal.
-bool SameSamples(const EncoderSamples& a, const EncoderSamples& b) { return a == b; }
-
-}  // namespace
 
 namespace {
 
@@ -121,15 +115,13 @@ std::vector<std::string> FindDegenerateData(const std::vector<AlignedRun>& runs,
     ++distinct;
     std::vector<std::string> copies;
     for (std::size_t j = i + 1; j < runs.size(); ++j) {
-      if (!seen[j] && SameSamples(runs[i].samples, runs[j].samples)) {
+      if (!seen[j] && runs[i].samples == runs[j].samples) {
         seen[j] = true;
         copies.push_back(runs[j].id);
       }
     }
     if (!copies.empty() && copies.size() + 1 < runs.size()) {
-      std::string list;
-      for (const std::string& id : copies) list += (list.empty() ? "" : ", ") + id;
-      problems.push_back("runs " + runs[i].id + " and " + list +
+      problems.push_back("runs " + runs[i].id + " and " + io::Joined(copies, ", ") +
                          " have identical encoder logs (a copied file?): they count as one run");
     }
   }

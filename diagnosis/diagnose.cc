@@ -196,10 +196,8 @@ bool DiagnoseOptions::IsValid(std::string* error) const {
   if (!(alpha > 0.0 && alpha < 1.0) || !(lof_alpha > 0.0 && lof_alpha < 1.0))
     return Invalid(error, "alpha and lof_alpha must be in (0, 1)");
   if (!(min_explained_fraction >= 0.0 && min_explained_fraction <= 1.0) ||
-      !(min_separable_fraction >= 0.0 && min_separable_fraction < 1.0)) {
-    *error = "fractions must be in [0, 1]";
-    return false;
-  }
+      !(min_separable_fraction >= 0.0 && min_separable_fraction < 1.0))
+    return Invalid(error, "fractions must be in [0, 1]");
   if (max_effects < 0) return Invalid(error, "max_effects must be >= 0");
   return true;
 }

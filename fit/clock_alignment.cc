@@ -54,7 +54,7 @@ std::vector<std::pair<std::string, double>> Estimate(ClockGrouping grouping,
   options.ceres.compute_covariance = false;
   std::vector<double> offsets_s;
   if (parameters != nullptr) {
-    offsets_s = EstimateClockOffsets(model, *parameters, options).offsets_s;
+    offsets_s = EstimateClockOffsets(model, *parameters, options);
   } else {
     const ModelFitResult fit = FitModel(runs, model, options);
     if (!fit.usable)

@@ -13,7 +13,6 @@
 #include "fit/ceres_problem.h"
 #include "fit/correlation.h"
 #include "fit/model_fit.h"
-#include "odometry/invalid.h"
 #include "odometry/parallel_for.h"
 
 namespace fitcal {
@@ -204,11 +203,6 @@ std::vector<int> StartAnchorIndices(const AlignedRun& run,
   return {static_cast<int>(first - track.t_s.begin())};
 }
 
-bool TrackOptions::IsValid(std::string* error) const {
-  if (!(edge_margin_s >= 0.0)) return Invalid(error, "edge_margin_s must be >= 0");
-  return true;
-}
-
 namespace {
 
 // The absolute wheel angles at t_start: the log's start angles advanced by each channel's rate
@@ -224,16 +218,17 @@ std::vector<double> WindowStartWheelAngles(const EncoderLog& log, double t_start
   return angle;
 }
 
-TrackRun PrepareTrackRun(const RunLog& run, unsigned wheel_mask, const TrackOptions& options) {
-  std::string error;
-  if (!options.IsValid(&error)) throw std::invalid_argument("TrackOptions: " + error);
+TrackRun PrepareTrackRun(const RunLog& run, unsigned wheel_mask) {
   TrackRun out;
   out.aligned = AlignRun(run);
   out.track = run.ground_truth;
   out.contexts = effects::MakeSampleContexts(out.aligned.samples, wheel_mask);
   out.start_wheel_angle_rad = WindowStartWheelAngles(run.encoders, out.aligned.t_start_s);
-  const double lo = out.aligned.t_start_s + options.edge_margin_s;
-  const double hi = out.aligned.t_final_s - options.edge_margin_s;
+  // Checkpoints keep the largest latency the time-offset effect admits (its registry bound) from
+  // the window's ends, so that no admissible latency moves them outside the replay.
+  const double margin_s = effects::Info(EffectId::kTimeOffset).upper[0];
+  const double lo = out.aligned.t_start_s + margin_s;
+  const double hi = out.aligned.t_final_s - margin_s;
   for (std::size_t g = 0; g < out.track.t_s.size(); ++g) {
     if (out.track.t_s[g] >= lo && out.track.t_s[g] <= hi)
       out.checkpoints.push_back(static_cast<int>(g));
@@ -253,11 +248,10 @@ TrackRun PrepareTrackRun(const RunLog& run, unsigned wheel_mask, const TrackOpti
 
 }  // namespace
 
-std::vector<TrackRun> PrepareTrackRuns(const std::vector<RunLog>& runs, unsigned wheel_mask,
-                                       const TrackOptions& options) {
+std::vector<TrackRun> PrepareTrackRuns(const std::vector<RunLog>& runs, unsigned wheel_mask) {
   std::vector<TrackRun> out(runs.size());
   ParallelFor(runs.size(), 0,
-              [&](std::size_t i) { out[i] = PrepareTrackRun(runs[i], wheel_mask, options); });
+              [&](std::size_t i) { out[i] = PrepareTrackRun(runs[i], wheel_mask); });
   return out;
 }
 

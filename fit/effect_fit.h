@@ -111,17 +111,9 @@ AnchorCarry<T> FitAnchorCarry(const GroundTruthTrack& track, const std::vector<i
   return carry;
 }
 
-struct TrackOptions {
-  // Checkpoints keep this far from the window's ends so a latency within the effect's bounds
-  // never moves them outside the replay.
-  double edge_margin_s = 0.3;
-  bool IsValid(std::string* error) const;
-};
-
 // wheel_mask: bit i set when channel i is a wheel rate (WheelChannelMask); the default, every
 // channel, suits a robot whose channels are all wheels (omni3's three).
-std::vector<TrackRun> PrepareTrackRuns(const std::vector<RunLog>& runs, unsigned wheel_mask = ~0u,
-                                       const TrackOptions& options = {});
+std::vector<TrackRun> PrepareTrackRuns(const std::vector<RunLog>& runs, unsigned wheel_mask = ~0u);
 // Bit i set when the robot's channel i is a wheel rate (effects::SampleContext::wheel_mask).
 unsigned WheelChannelMask(const Robot& robot);
 // The split of track runs (fit/run_split.h) reads each run's aligned part.

@@ -18,6 +18,7 @@
 #include "fit/last_evaluation_memo.h"
 #include "fit/segment_cost.h"
 #include "fit/serial_covariance.h"
+#include "io/text_file.h"
 #include "odometry/text_format.h"
 
 namespace fitcal {
@@ -219,8 +220,7 @@ void Accumulate(const ceres::Solver::Summary& summary, ModelFitResult* result) {
   result->termination = ceres::TerminationTypeToString(summary.termination_type);
   result->message = summary.message;
   result->iterations += static_cast<int>(summary.iterations.size());
-  result->num_residual_evaluations += summary.num_residual_evaluations;
-  result->num_jacobian_evaluations += summary.num_jacobian_evaluations;
+  result->evaluations += summary.num_residual_evaluations + summary.num_jacobian_evaluations;
   result->final_cost = summary.final_cost;
 }
 
@@ -717,7 +717,6 @@ ModelFitResult SolveFrom(const std::vector<AlignedRun>& training, const RobotMod
       SolveUntilBoundContact(robot, solve_options, result.held, result.parameters.data(),
                              &fit.problem(), &summary);
     }
-    if (round == 0) result.initial_cost = summary.initial_cost;
     Accumulate(summary, &result);
     const bool converged = summary.termination_type == ceres::CONVERGENCE;
     if (!converged && options.active_set_bounds) {
@@ -952,40 +951,14 @@ ModelFitResult ExpandTiedResult(const TiedModel& tied, const ModelFitResult& fit
   return out;
 }
 
-ClockOffsetEstimate EstimateClockOffsets(const RobotModelInterface& model,
+std::vector<double> EstimateClockOffsets(const RobotModelInterface& model,
                                          const std::vector<double>& p,
                                          const ModelFitOptions& options) {
   if (options.track == nullptr) throw std::invalid_argument("EstimateClockOffsets: no tracks");
-  const TrackFitData& track = *options.track;
-  ClockOffsetEstimate out;
-  out.offsets_s.assign(track.clock_groups.size(), 0.0);
-  out.sigma_s.assign(track.clock_groups.size(), 0.0);
+  std::vector<double> offsets_s(options.track->clock_groups.size(), 0.0);
   ModelFitResult counts;
-  SolveClockOffsetsAt(model, options, p, &out.offsets_s, &counts);
-  std::vector<double> sum_squares(out.offsets_s.size(), 0.0);
-  std::vector<double> information(out.offsets_s.size(), 0.0);
-  std::vector<int> residuals(out.offsets_s.size(), 0);
-  for (std::size_t run_index = 0; run_index < track.runs.size(); ++run_index) {
-    const TrackCheckpoints& run = track.runs[run_index];
-    if (run.segments.empty()) continue;
-    const std::unique_ptr<ceres::CostFunction> cost(
-        TrackResidual::Create(run, model, TrackWeightsOf(options, run_index), track.options));
-    const int m = cost->num_residuals();
-    std::vector<double> r(m), j_dt(m);
-    const double* parameters[] = {p.data(), &out.offsets_s[run.clock_group]};
-    double* jacobians[] = {nullptr, j_dt.data()};
-    if (!cost->Evaluate(parameters, r.data(), jacobians)) continue;
-    for (int i = 0; i < m; ++i) {
-      sum_squares[run.clock_group] += r[i] * r[i];
-      information[run.clock_group] += j_dt[i] * j_dt[i];
-    }
-    residuals[run.clock_group] += m;
-  }
-  for (std::size_t g = 0; g < out.sigma_s.size(); ++g) {
-    if (residuals[g] < 2 || !(information[g] > 0.0)) continue;
-    out.sigma_s[g] = std::sqrt(sum_squares[g] / (residuals[g] - 1) / information[g]);
-  }
-  return out;
+  SolveClockOffsetsAt(model, options, p, &offsets_s, &counts);
+  return offsets_s;
 }
 
 namespace {
@@ -1043,11 +1016,7 @@ WiderThanItsBox SigmaWiderThanItsBox(const Robot& robot, const ModelFitResult& f
 std::string ReasonToStartAcrossTheBox(const Robot& robot, const ModelFitResult& fit,
                                       const ModelFitOptions& options) {
   const std::vector<std::string> on_bound = FreeParametersOnABound(robot, fit, options);
-  if (!on_bound.empty()) {
-    std::string names;
-    for (const std::string& n : on_bound) names += (names.empty() ? "" : ", ") + n;
-    return "ended on a bound (" + names + ")";
-  }
+  if (!on_bound.empty()) return "ended on a bound (" + io::Joined(on_bound, ", ") + ")";
   // No covariance although the runs are enough for one: the fit stopped where the runs, at its
   // residual level, leave a direction flat (measured: the diff drive 20 % off fitted on final poses
   // stopped at a separation of 0.166 for 0.24 with a rank-deficient covariance, docs/fit.md).

@@ -51,11 +51,9 @@ struct ModelFitResult {
   std::string termination;  // Ceres termination type of the last solve, e.g. CONVERGENCE
   std::string message;      // Ceres' reason for stopping
   int iterations = 0;       // over all active-set rounds
-  int num_residual_evaluations = 0;
-  int num_jacobian_evaluations = 0;
+  int evaluations = 0;      // Ceres' residual and Jacobian evaluations, over all solves
   int active_set_rounds = 0;  // solves after the first (0: the plain bounded solve converged)
   double solve_time_s = 0.0;
-  double initial_cost = 0.0;  // Ceres cost: 0.5 sum |r|^2 (under the objective's loss)
   double final_cost = 0.0;
   std::vector<double> parameters;
   std::vector<bool> at_bound;
@@ -165,14 +163,9 @@ bool AtBound(double value, const Interval& box);
 std::vector<bool> ParametersAtBound(const Robot& robot, const std::vector<double>& p);
 
 // The clock offsets of `options.track`'s groups with the parameters held at `p` (each group's
-// own bounded problem, as FitModel solves them), with each offset's sigma from its group's
-// residual scatter, s^2 / sum (dr/ddt)^2, s^2 = |r|^2 / (residuals - 1). For `report` and
-// `diagnose`, which replay given parameters against a ground truth on another clock.
-struct ClockOffsetEstimate {
-  std::vector<double> offsets_s;
-  std::vector<double> sigma_s;
-};
-ClockOffsetEstimate EstimateClockOffsets(const RobotModelInterface& model,
+// own bounded problem, as FitModel solves them). For `report` and `diagnose`, which replay given
+// parameters against a ground truth on another clock.
+std::vector<double> EstimateClockOffsets(const RobotModelInterface& model,
                                          const std::vector<double>& p,
                                          const ModelFitOptions& options);
 

@@ -197,7 +197,6 @@ class Objective {
       for (std::size_t j = 0; j < free_.size(); ++j) {
         grad[j] = dp[free_[j]] * inv_n * width_[free_[j]];
       }
-      ++gradient_evaluations_;
     }
     // The CF of Eq. 14 is reported with sigmas of 1; with other weights it is the weighted one.
     *cf = sum_norm * inv_n;
@@ -239,7 +238,6 @@ class Objective {
   }
 
   int evaluations() const { return evaluations_; }
-  int gradient_evaluations() const { return gradient_evaluations_; }
   double best_f() const { return best_f_; }
   double best_cf() const { return best_cf_; }
   const std::vector<double>& best_u() const { return best_u_; }
@@ -258,7 +256,6 @@ class Objective {
   std::vector<int> free_;  // the searched parameters, in parameter order
   std::vector<double> r_, jacobians_;
   int evaluations_ = 0;
-  int gradient_evaluations_ = 0;
   double best_f_ = std::numeric_limits<double>::infinity();
   double best_cf_ = std::numeric_limits<double>::infinity();
   std::vector<double> best_u_;
@@ -348,10 +345,9 @@ bool NloptFitOptions::IsValid(std::string* error) const {
   if (!(weights.position_sigma_m > 0.0) || !(weights.heading_sigma_rad > 0.0))
     return Invalid(error, "residual sigmas must be positive");
   if (max_evaluations < 1) return Invalid(error, "max_evaluations must be at least 1");
-  if (local_polish && Info(method).global && local_polish_evaluations >= max_evaluations) {
-    *error = "local_polish_evaluations must leave part of max_evaluations to the search";
-    return false;
-  }
+  if (local_polish && Info(method).global && local_polish_evaluations >= max_evaluations)
+    return Invalid(error,
+                   "local_polish_evaluations must leave part of max_evaluations to the search");
   if (local_polish && local_polish_evaluations < 1)
     return Invalid(error, "local_polish_evaluations must be at least 1");
   if (max_time_s < 0.0 || ftol_rel < 0.0 || xtol_rel < 0.0 || progress_interval_s < 0.0)
@@ -438,7 +434,6 @@ NloptSearchResult RunNloptSearch(RunResiduals& residuals, const std::vector<doub
   const bool ok = objective.dimension() > 0 && Search(options, objective, u, &result);
 
   result.evaluations = objective.evaluations();
-  result.gradient_evaluations = objective.gradient_evaluations();
   result.solve_time_s = objective.elapsed_s();
   result.trace = objective.TakeTrace();
   // The best point seen (NLopt's x is the same for these methods, but ISRES/ESCH may return

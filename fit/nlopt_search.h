@@ -57,19 +57,14 @@ struct NloptMethodInfo {
 const std::vector<NloptMethodInfo>& NloptMethods();
 const NloptMethodInfo& Info(NloptMethod method);
 
-// One point of a convergence trace: the best CF (Eq. 14, on the training runs) after
-// `evaluation` objective evaluations.
+// One point of a convergence trace, or of the progress reported while the search runs: the best
+// CF (Eq. 14, on the training runs) after `evaluations` objective evaluations.
 struct ConvergencePoint {
-  int evaluation = 0;
-  double best_cf = 0.0;
-  double elapsed_s = 0.0;
-};
-
-struct NloptProgress {
   int evaluations = 0;
   double best_cf = 0.0;
   double elapsed_s = 0.0;
 };
+using NloptProgress = ConvergencePoint;
 
 struct NloptFitOptions {
   NloptMethod method = NloptMethod::kCrs2Lm;
@@ -113,24 +108,20 @@ class RunResiduals {
                                    double* jacobian) const = 0;
 };
 
-// How a search went (NloptSearchResult adds the parameters).
-struct NloptSearchSummary {
-  bool usable = false;           // finite parameters and NLopt stopped on a success code
-  std::string termination;       // NLopt's result, e.g. "NLOPT_MAXEVAL_REACHED"
-  std::string message;           // the method, polish and stop reason in words
-  int evaluations = 0;           // objective evaluations (each one replays every training run)
-  int gradient_evaluations = 0;  // of them, evaluations with the gradient
+// How a search went, and the parameters it found.
+struct NloptSearchResult {
+  bool usable = false;      // finite parameters and NLopt stopped on a success code
+  std::string termination;  // NLopt's result, e.g. "NLOPT_MAXEVAL_REACHED"
+  std::string message;      // the method, polish and stop reason in words
+  int evaluations = 0;      // objective evaluations (each one replays every training run)
   double solve_time_s = 0.0;
   double initial_objective = 0.0;
   double final_objective = 0.0;
   double initial_cf = 0.0;  // Eq. 14 (weighted as the residuals) at the start
   double final_cf = 0.0;
   std::vector<ConvergencePoint> trace;  // one point per improvement of the best CF
-};
-
-struct NloptSearchResult : NloptSearchSummary {
-  std::vector<double> parameters;  // all of them, held ones at their start value
-  std::vector<bool> at_bound;      // within 1e-6 of the box width of a bound
+  std::vector<double> parameters;       // all of them, held ones at their start value
+  std::vector<bool> at_bound;           // within 1e-6 of the box width of a bound
 };
 
 // Searches the box `bounds` (one interval per parameter, start inside it) from `start`; held[k]

@@ -155,10 +155,8 @@ SessionNoise SessionLevels(const NoiseLevels& data_set, const std::vector<Compon
 }  // namespace
 
 bool SessionNoise::Differs(int component) const {
-  for (double p : split_p[component]) {
-    if (p >= 0.0) return true;
-  }
-  return false;
+  const std::vector<double>& p = split_p[component];
+  return std::any_of(p.begin(), p.end(), [](double split) { return split >= 0.0; });
 }
 
 bool SessionNoise::AnyDiffers() const {

@@ -17,9 +17,7 @@ namespace {
 constexpr const char* kHeldReason = "held at its nominal value by the parameter tying";
 
 std::string NamesOf(const Robot& robot) {
-  std::string out;
-  for (const ParameterInfo& info : robot.parameters) out += (out.empty() ? "" : ", ") + info.name;
-  return out;
+  return io::Joined(robot.parameters, ", ", [](const ParameterInfo& info) { return info.name; });
 }
 
 // The chain rule through p = A q: J_q = J_p A, i.e. column j of J_q sums the columns of J_p of
@@ -137,14 +135,7 @@ Interval Intersection(const Robot& robot, const std::vector<int>& members) {
 }  // namespace
 
 std::vector<std::string> SplitParameterNames(const std::string& text) {
-  std::vector<std::string> out;
-  std::size_t begin = 0;
-  while (true) {
-    const std::size_t comma = text.find(',', begin);
-    out.emplace_back(io::Trim(text.substr(begin, comma - begin)));
-    if (comma == std::string::npos) return out;
-    begin = comma + 1;
-  }
+  return io::SplitCsvFields(text);
 }
 
 std::string CheckTying(const Robot& robot, const ParameterTying& tying) {

@@ -20,10 +20,8 @@ bool SegmentOptions::IsValid(std::string* error) const {
 
 bool ClockMapOptions::IsValid(std::string* error) const {
   if (!(max_offset_s >= 0.0) || !(offset_step_s > 0.0) || !(max_rate >= 0.0 && max_rate < 0.5) ||
-      !(rate_step > 0.0)) {
-    *error = "clock map search: ranges must be >= 0 (rate < 0.5) and steps positive";
-    return false;
-  }
+      !(rate_step > 0.0))
+    return Invalid(error, "clock map search: ranges must be >= 0 (rate < 0.5) and steps positive");
   return true;
 }
 

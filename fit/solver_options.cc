@@ -90,12 +90,10 @@ bool CeresFitOptions::IsValid(std::string* error) const {
   if (num_threads < 0) return Invalid(error, "num_threads must be >= 0");
   if (loss != CeresRobustLoss::kNone && !(loss_scale > 0.0))
     return Invalid(error, "loss_scale must be positive");
-  if (loss != CeresRobustLoss::kNone && objective == FinalPoseObjective::kSumOfNorms) {
-    *error =
-        "a robust loss applies to the sum-of-squares objective; the Eq. 14 sum of norms "
-        "already weighs each run linearly";
-    return false;
-  }
+  if (loss != CeresRobustLoss::kNone && objective == FinalPoseObjective::kSumOfNorms)
+    return Invalid(error,
+                   "a robust loss applies to the sum-of-squares objective; the Eq. 14 sum of "
+                   "norms already weighs each run linearly");
   return true;
 }
 

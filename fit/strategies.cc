@@ -57,12 +57,7 @@ TrajectoryStrategy ParseStrategy(const std::string& text) {
   TrajectoryStrategy out;
   out.name = io::Trim(text);
   std::set<std::string> seen;
-  std::size_t pos = 0;
-  while (pos <= text.size()) {
-    std::size_t end = text.find(',', pos);
-    if (end == std::string::npos) end = text.size();
-    const std::string item(io::Trim(text.substr(pos, end - pos)));
-    pos = end + 1;
+  for (const std::string& item : io::SplitCsvFields(text)) {
     if (item.empty()) {
       throw std::invalid_argument("strategy '" + text + "': empty trajectory label");
     }

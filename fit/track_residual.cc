@@ -11,15 +11,15 @@
 #include <utility>
 
 #include "fit/segment_cost.h"
+#include "odometry/invalid.h"
 #include "odometry/pose_between.h"
 
 namespace fitcal {
 
 bool TrackResidualOptions::IsValid(std::string* error) const {
-  if (!(checkpoint_spacing_m > 0.0) || !(huber_scale > 0.0) || !(max_clock_offset_s >= 0.0)) {
-    *error = "track: checkpoint spacing and loss scale must be positive, the offset bound >= 0";
-    return false;
-  }
+  if (!(checkpoint_spacing_m > 0.0) || !(huber_scale > 0.0) || !(max_clock_offset_s >= 0.0))
+    return Invalid(
+        error, "track: checkpoint spacing and loss scale must be positive, the offset bound >= 0");
   return true;
 }
 

@@ -2,6 +2,7 @@
 
 #include "io/input_error.h"
 #include "io/sample_checks.h"
+#include "io/text_file.h"
 #include "io/yaml_reader.h"
 #include "io/yaml_units_check.h"
 #include "models/asoc/asoc_extras.h"
@@ -68,9 +69,7 @@ const ModelRegistration* FindModel(const std::string& name) {
 }
 
 std::string RegisteredModelNames() {
-  std::string out;
-  for (const ModelRegistration& m : Registry()) out += (out.empty() ? "" : ", ") + m.name;
-  return out;
+  return io::Joined(Registry(), ", ", [](const ModelRegistration& m) { return m.name; });
 }
 
 const ModelExtras& ExtrasOf(const std::string& name) {

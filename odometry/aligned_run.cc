@@ -9,10 +9,7 @@ namespace {
 // Every channel of the sample reads zero (wheel rates and angles alike: an interval with a
 // non-zero angle channel is kept as it is, whatever the model makes of it).
 bool IsRest(const double* values, int num_channels) {
-  for (int i = 0; i < num_channels; ++i) {
-    if (values[i] != 0.0) return false;
-  }
-  return true;
+  return std::all_of(values, values + num_channels, [](double v) { return v == 0.0; });
 }
 }  // namespace
 

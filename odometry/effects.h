@@ -25,7 +25,6 @@
 #include <cstddef>
 #include <stdexcept>
 #include <string>
-#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -146,22 +145,6 @@ struct EffectValue {
 // ---------------------------------------------------------------------------------------------
 // The transforms. Every function is pure.
 
-// The value of a double or of a Ceres Jet (its scalar part), for decisions that do not depend on
-// the parameters being differentiated.
-template <typename T>
-double ScalarOf(const T& x) {
-  if constexpr (std::is_same_v<T, double>) {
-    return x;
-  } else {
-    return x.a;
-  }
-}
-
-template <typename T>
-inline T Sign(double x) {
-  return T(x > 0.0 ? 1.0 : (x < 0.0 ? -1.0 : 0.0));
-}
-
 // Ground-truth latency tau (s): the ground-truth sample stamped t shows the pose of encoder time
 // t - tau. Invisible in the final pose when runs end at rest: needs the track.
 struct TimeOffset {
@@ -212,7 +195,7 @@ struct AccelerationSlip {
     for (int i = 0; i < c.num_channels; ++i) {
       if (!c.IsWheel(i)) continue;
       const double a = c.accel_rad_s2(i);
-      const double along = ScalarOf(w[i]) >= 0.0 ? a : -a;
+      const double along = ScalarPart(w[i]) >= 0.0 ? a : -a;
       w[i] = w[i] * (T(1.0) - q[0] * T(std::abs(a)) - q[1] * T(along));
     }
   }
@@ -283,7 +266,7 @@ struct OncePerRevolution {
   static void Rates(const T* q, const SampleContext& c, T* w) {
     for (int i = 0; i < c.num_channels; ++i) {
       if (!c.IsWheel(i)) continue;
-      const double a = c.angle_rad[i] + 0.5 * ScalarOf(w[i]) * c.dt_s;
+      const double a = c.angle_rad[i] + 0.5 * ScalarPart(w[i]) * c.dt_s;
       w[i] = w[i] * (T(1.0) + q[0] * T(std::cos(a)) + q[1] * T(std::sin(a)));
     }
   }

@@ -9,6 +9,7 @@
 #include "io/atomic_file.h"
 #include "io/dataset.h"
 #include "odometry/parallel_for.h"
+#include "odometry/split_mix.h"
 #include "odometry/text_format.h"
 #include "sim/stepped_run.h"
 
@@ -24,10 +25,9 @@ class Rng {
     Next();
   }
   std::uint64_t Next() {
-    std::uint64_t z = (state_ += 0x9E3779B97F4A7C15ULL);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
-    return z ^ (z >> 31);
+    const std::uint64_t z = SplitMix(state_);
+    state_ += 0x9E3779B97F4A7C15ULL;
+    return z;
   }
   double Uniform() { return static_cast<double>(Next() >> 11) * 0x1.0p-53; }  // [0, 1)
   // Box-Muller; sigma 0 draws nothing, so noise-free runs do not depend on the stream.

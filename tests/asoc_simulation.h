@@ -17,6 +17,19 @@
 
 namespace fitcal::asoc {
 
+// The simulated prototype (kAsocExampleYaml): pivots on a 0.30 m circle, r_c 0.08 m, r_w 0.04 m,
+// d 0.06 m; Doebbler do not print their dimensions.
+inline Vehicle PrototypeVehicle() {
+  Vehicle v;
+  for (int i = 0; i < kNumCastors; ++i) {
+    v.pivots[i] = {0.30, 2.0 * M_PI * i / 3.0};  // phi_1 = 0 (Doebbler Sec. II-C)
+    v.castors[i].offset_m = 0.08;
+    v.castors[i].wheel_radius_m = {0.04, 0.04};
+    v.castors[i].wheel_offset_m = {0.06, 0.06};
+  }
+  return v;
+}
+
 inline const AsocModel& ExampleAsocModel() {
   static const RobotModelPtr model = ReadRobotModel(YAML::Load(kAsocExampleYaml), "asoc example");
   return dynamic_cast<const AsocModel&>(*model);

@@ -121,7 +121,7 @@ TEST_P(EveryMethod, ReachesTheCeresOptimumOnCleanData) {
   ASSERT_FALSE(fit.trace.empty());
   for (std::size_t i = 1; i < fit.trace.size(); ++i) {
     EXPECT_LT(fit.trace[i].best_cf, fit.trace[i - 1].best_cf);
-    EXPECT_GT(fit.trace[i].evaluation, fit.trace[i - 1].evaluation);
+    EXPECT_GT(fit.trace[i].evaluations, fit.trace[i - 1].evaluations);
   }
   const double ratio = cf / CeresOptimumCf(runs);
   std::printf("%-9s %5d evaluations: CF %.6g = %.4f x Ceres optimum (%s)\n", info.name,
@@ -154,7 +154,7 @@ TEST(NloptSeeds, SameSeedSameBitsOnAnyThreadCountOtherSeedOtherPath) {
   EXPECT_EQ(a.evaluations, b.evaluations);
   ASSERT_EQ(a.trace.size(), b.trace.size());
   for (std::size_t i = 0; i < a.trace.size(); ++i) {
-    EXPECT_EQ(a.trace[i].evaluation, b.trace[i].evaluation);
+    EXPECT_EQ(a.trace[i].evaluations, b.trace[i].evaluations);
     EXPECT_EQ(a.trace[i].best_cf, b.trace[i].best_cf);
   }
   EXPECT_NE(a.parameters, c.parameters)

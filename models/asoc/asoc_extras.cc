@@ -123,17 +123,6 @@ ScenarioRecorder PrototypeRecorder() {
   return r;
 }
 
-Vehicle PrototypeVehicle() {
-  Vehicle v;
-  for (int i = 0; i < kNumCastors; ++i) {
-    v.pivots[i] = {0.30, 2.0 * M_PI * i / 3.0};  // phi_1 = 0 (Doebbler Sec. II-C)
-    v.castors[i].offset_m = 0.08;
-    v.castors[i].wheel_radius_m = {0.04, 0.04};
-    v.castors[i].wheel_offset_m = {0.06, 0.06};
-  }
-  return v;
-}
-
 Vehicle DrawVehicle(const Vehicle& nominal, const ParameterSpread& spread, std::mt19937_64& rng) {
   Vehicle v = nominal;
   for (CastorParameters& c : v.castors) {

@@ -46,10 +46,6 @@ inline constexpr double kPrototypePivotQuantumRad = 0.07 * M_PI / 180.0;
 // wheel_relative_sigma (a relative error on each 20 Hz wheel increment).
 ScenarioRecorder PrototypeRecorder();
 
-// The simulated prototype (kAsocExampleYaml): pivots on a 0.30 m circle, r_c 0.08 m, r_w 0.04 m,
-// d 0.06 m; Doebbler do not print their dimensions.
-Vehicle PrototypeVehicle();
-
 // Draws a vehicle around `nominal` as Doebbler Table I: every r_c, r_w, d scaled by
 // (1 + U(-f, f)) with its own f, beta uniform in +-beta_range_rad. Pivot layout unchanged.
 struct ParameterSpread {

@@ -182,25 +182,6 @@ void DeviationFrom(const CastorParameters& q, const CastorParameters& mean, doub
   d[kBiasIndex] = WrapAngle(d[kBiasIndex]);
 }
 
-// Half the range of a castor's pair estimates per parameter (beta: the largest distance from the
-// mean on the circle), printed as their repeatability.
-CastorParameters HalfSpread(const std::vector<CastorParameters>& e, const CastorParameters& mean) {
-  double lo[kParametersPerCastor] = {0, 0, 0, 0, 0, 0},
-         hi[kParametersPerCastor] = {0, 0, 0, 0, 0, 0};
-  for (const CastorParameters& c : e) {
-    double d[kParametersPerCastor];
-    DeviationFrom(c, mean, d);
-    for (int k = 0; k < kParametersPerCastor; ++k) {
-      lo[k] = std::min(lo[k], d[k]);
-      hi[k] = std::max(hi[k], d[k]);
-    }
-  }
-  double h[kParametersPerCastor];
-  for (int k = 0; k < kParametersPerCastor; ++k) h[k] = 0.5 * (hi[k] - lo[k]);
-  h[kBiasIndex] = std::max(-lo[kBiasIndex], hi[kBiasIndex]);
-  return CastorParameters::FromArray(h);
-}
-
 // t with P(|T| < t) = 68.27 % (the normal's 1 sigma) for Student's t with dof degrees of freedom:
 // a standard error from dof degrees of freedom times t covers the error as often as one normal
 // sigma does. dof 1..10 from a table (computed by integrating the density); beyond,
@@ -297,7 +278,6 @@ GeometricResult CalibrateFromHoldRuns(const std::vector<HoldRun>& runs, const Ve
       continue;
     }
     result.estimate.castors[i] = MeanOf(group_means[i]);
-    result.half_spread[i] = HalfSpread(all, result.estimate.castors[i]);
     if (!Physical(result.estimate.castors[i])) {
       result.usable = false;
       result.message += "castor " + std::to_string(i + 1) + " gives a non-physical estimate; ";

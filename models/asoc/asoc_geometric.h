@@ -74,13 +74,12 @@ struct GeometricResult {
   bool usable = false;
   std::string message;  // why not usable, or a summary
   Vehicle estimate;     // nominal pivot layout + the calibrated castors
-  // Per castor: how many pair estimates were averaged and their half-difference (a direct look at
-  // the repeatability: the two estimates of one castor should agree to quantisation level).
+  // Per castor: how many pair estimates were averaged.
   std::array<int, kNumCastors> num_estimates{};
-  std::array<CastorParameters, kNumCastors> half_spread{};
-  // Per castor, the 1-sigma uncertainty of every estimated parameter from the spread over runs
-  // (above), with sigma_dof degrees of freedom; sigma_dof 0: no castor has two independent
-  // estimates, and the sigmas are 0 (unknown, not exact).
+  // Per castor, the 1-sigma uncertainty of every estimated parameter from the spread of its pair
+  // estimates over runs (the two estimates of one castor should agree to quantisation level), with
+  // sigma_dof degrees of freedom; sigma_dof 0: no castor has two independent estimates, and the
+  // sigmas are 0 (unknown, not exact).
   std::array<CastorParameters, kNumCastors> sigma{};
   int sigma_dof = 0;
 };

@@ -1,5 +1,6 @@
 #include "models/asoc/asoc_robot_model.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 
@@ -41,11 +42,9 @@ constexpr const char* kBiasHeldReason =
     "it (Eq. 2)";
 
 bool IsColumnSafe(const std::string& name) {
-  if (name.empty()) return false;
-  for (char c : name) {
-    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_') return false;
-  }
-  return true;
+  return !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+  });
 }
 
 // The box of parameter k (castor block order) for the robot's bounds or the default above.

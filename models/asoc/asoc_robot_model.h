@@ -53,7 +53,7 @@ class AsocModel : public KinematicModel<AsocKinematics> {
   io::AsocRobot asoc_;
 };
 
-// The simulated one-third-scale prototype (asoc_extras.h PrototypeVehicle).
+// The simulated one-third-scale prototype (tests/asoc_simulation.h PrototypeVehicle).
 inline constexpr const char* kAsocExampleYaml = R"(model: asoc
 name: example_asoc
 pivot_distance_m: 0.5196152423

@@ -5,8 +5,6 @@
 // sim/model_scenarios.h ScenarioSimulator with the castor dynamics of asoc_extras.h), calibrated by
 // the closed form of Eq. 1-9 and judged by the odometry of the seam.
 
-#include <cstdint>
-#include <functional>
 #include <vector>
 
 #include "models/asoc/asoc_robot_model.h"
@@ -20,18 +18,6 @@ namespace fitcal::asoc {
 // the runs' final position errors (odometry - truth) from zero; E_max the larger of the two.
 double UmbmarkEmax(const RobotModelInterface& odometry, const std::vector<double>& p,
                    const std::vector<RunLog>& runs);
-
-// Means over `sets` random parameter sets (set s draws from std::mt19937_64 seeded by
-// SplitMix(seed ^ SplitMix(s)), odometry/split_mix.h): Table I, the mean absolute relative error
-// [uncalibrated, calibrated] of r_c, r_w, d and the absolute error of beta (rad); Table II,
-// UMBmark E_max (m) [uncalibrated, calibrated] of IPEC-1, CAST-1 and CAST-0 on a truth with
-// beta = 0 (Doebbler Sec. IV-B), 5 circuits each way.
-struct DoebblerTables {
-  double param[2][4] = {{0, 0, 0, 0}, {0, 0, 0, 0}};
-  double emax[2][3] = {{0, 0, 0}, {0, 0, 0}};
-};
-DoebblerTables SimulateDoebblerTables(const AsocModel& nominal, int sets, std::uint64_t seed,
-                                      const SimulateFn& simulate, int threads);
 
 // The reproduction the asoc model registers (ModelExtras::paper_tables): the prototype's recorder
 // with every run from the origin heading +x (UMBmark averages the runs' error vectors in the world

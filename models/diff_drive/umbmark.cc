@@ -65,13 +65,9 @@ std::optional<Correction> Correct(const std::vector<SquareReturnError>& runs,
 }
 
 std::optional<SquareReturnError> MeasureSquare(const RobotModelInterface& model,
-                                               const std::vector<double>& p, const AlignedRun& run,
-                                               std::string* why_not) {
-  const auto refuse = [why_not](const std::string& reason) {
-    if (why_not != nullptr) *why_not = reason;
-    return std::nullopt;
-  };
-  if (run.samples.empty()) return refuse("no samples");
+                                               const std::vector<double>& p,
+                                               const AlignedRun& run) {
+  if (run.samples.empty()) return std::nullopt;
   // The odometry path in the start frame: x along the start heading.
   const double c0 = std::cos(run.start.theta), s0 = std::sin(run.start.theta);
   const auto to_start_frame = [&run, c0, s0](double wx, double wy, double* x, double* y) {
@@ -89,20 +85,15 @@ std::optional<SquareReturnError> MeasureSquare(const RobotModelInterface& model,
                                          previous = pose;
                                        });
   const double turn_rad = odometry.theta - run.start.theta;
-  if (!(std::abs(turn_rad) >= 1.25 * M_PI && std::abs(turn_rad) <= 2.5 * M_PI)) {
-    return refuse("turns " + std::to_string(turn_rad * 180.0 / M_PI) +
-                  " deg, not one lap of a square");
-  }
+  // Not one lap of a square.
+  if (!(std::abs(turn_rad) >= 1.25 * M_PI && std::abs(turn_rad) <= 2.5 * M_PI)) return std::nullopt;
   SquareReturnError e;
   e.clockwise = turn_rad < 0.0;
   e.side_m = 0.25 * path_m;
   double end_x, end_y;
   to_start_frame(odometry.x, odometry.y, &end_x, &end_y);
-  if (!(e.side_m > 0.0) || std::hypot(end_x, end_y) > 0.25 * e.side_m) {
-    return refuse("the odometry path does not close (ends " +
-                  std::to_string(std::hypot(end_x, end_y)) + " m from its start, side " +
-                  std::to_string(e.side_m) + " m)");
-  }
+  // The odometry path does not close.
+  if (!(e.side_m > 0.0) || std::hypot(end_x, end_y) > 0.25 * e.side_m) return std::nullopt;
   double gt_x, gt_y;
   to_start_frame(run.final_ground_truth.x, run.final_ground_truth.y, &gt_x, &gt_y);
   e.x_m = gt_x - end_x;

@@ -45,7 +45,6 @@
 // and equal counts per direction this is exactly the formulas above on the centres of gravity.
 
 #include <optional>
-#include <string>
 #include <vector>
 
 #include "models/model_interface.h"
@@ -87,10 +86,9 @@ std::optional<Correction> Correct(const std::vector<SquareReturnError>& runs,
 // Measures one run as a UMBmark square from its odometry with parameters p: the turning
 // direction from the sign of the total heading change, which must be one lap (|change| in
 // [1.25 pi, 2.5 pi]: three or four corners); the side L from the odometry's path length (a
-// quarter of it); the path must close (odometry ends within L / 4 of its start). nullopt, with the
-// reason in *why_not, for a run that is not such a square.
+// quarter of it); the path must close (odometry ends within L / 4 of its start). nullopt for a
+// run that is not such a square.
 std::optional<SquareReturnError> MeasureSquare(const RobotModelInterface& model,
-                                               const std::vector<double>& p, const AlignedRun& run,
-                                               std::string* why_not = nullptr);
+                                               const std::vector<double>& p, const AlignedRun& run);
 
 }  // namespace fitcal::umbmark

@@ -149,22 +149,6 @@ Robot OmniRobotDescription(const std::string& name, const std::vector<OmniWheel>
   return robot;
 }
 
-RobotModelPtr MakeOmniModelWithEffects(const std::string& name,
-                                       const std::vector<OmniWheel>& wheels,
-                                       const OmniBounds& bounds,
-                                       const std::optional<EncoderTicks>& encoder,
-                                       const std::vector<effects::EffectValue>& effect_values) {
-  CheckWheels(wheels);
-  Robot robot = OmniRobotDescription(name, wheels, bounds);
-  robot.encoder = encoder;
-  robot.effects = effect_values;
-  using Builder = RobotModelPtr (*)(Robot, const std::vector<OmniWheel>&, const OmniBounds&);
-  static constexpr Builder kBuilders[] = {&BuildOmniModel<3>, &BuildOmniModel<4>,
-                                          &BuildOmniModel<5>, &BuildOmniModel<6>,
-                                          &BuildOmniModel<7>, &BuildOmniModel<8>};
-  return kBuilders[wheels.size() - kOmniMinWheels](std::move(robot), wheels, bounds);
-}
-
 OmniWheel ReadWheel(const YAML::Node& node, const std::string& path, int index) {
   io::YamlMap map(node, path, "wheel " + std::to_string(index + 1));
   OmniWheel w;
@@ -196,8 +180,17 @@ OmniBounds ReadOmniBounds(io::YamlMap& robot_map, const std::string& path) {
 }
 
 RobotModelPtr MakeOmniModel(const std::string& name, const std::vector<OmniWheel>& wheels,
-                            const OmniBounds& bounds, const std::optional<EncoderTicks>& encoder) {
-  return MakeOmniModelWithEffects(name, wheels, bounds, encoder, {});
+                            const OmniBounds& bounds, const std::optional<EncoderTicks>& encoder,
+                            const std::vector<effects::EffectValue>& effect_values) {
+  CheckWheels(wheels);
+  Robot robot = OmniRobotDescription(name, wheels, bounds);
+  robot.encoder = encoder;
+  robot.effects = effect_values;
+  using Builder = RobotModelPtr (*)(Robot, const std::vector<OmniWheel>&, const OmniBounds&);
+  static constexpr Builder kBuilders[] = {&BuildOmniModel<3>, &BuildOmniModel<4>,
+                                          &BuildOmniModel<5>, &BuildOmniModel<6>,
+                                          &BuildOmniModel<7>, &BuildOmniModel<8>};
+  return kBuilders[wheels.size() - kOmniMinWheels](std::move(robot), wheels, bounds);
 }
 
 RobotModelPtr ReadOmniModel(const YAML::Node& root, const std::string& path) {
@@ -218,7 +211,7 @@ RobotModelPtr ReadOmniModel(const YAML::Node& root, const std::string& path) {
   robot_map.Optional("calibration");  // written by fitcal; informational when read back
   robot_map.RejectUnread();
   try {
-    return MakeOmniModelWithEffects(name, wheels, box, encoder, effect_values);
+    return MakeOmniModel(name, wheels, box, encoder, effect_values);
   } catch (const std::invalid_argument& e) {
     throw InputError(InputErrorKind::kBadValue, path, LineOf(wheel_list), e.what());
   }

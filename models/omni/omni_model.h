@@ -85,7 +85,8 @@ bounds:
 // full rank (naming the wheels and the motion they cannot sense).
 RobotModelPtr MakeOmniModel(const std::string& name, const std::vector<OmniWheel>& wheels,
                             const OmniBounds& bounds,
-                            const std::optional<EncoderTicks>& encoder = std::nullopt);
+                            const std::optional<EncoderTicks>& encoder = std::nullopt,
+                            const std::vector<effects::EffectValue>& effect_values = {});
 
 // The wheels of an omni-wheeled robot at parameters p: distance, angle and radius found in p by
 // the parameter table (R_<wheel>, delta_<wheel>, r_<wheel>), drive and roller directions from an

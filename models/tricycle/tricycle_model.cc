@@ -29,11 +29,9 @@ constexpr double kDefaultGainFactor = 10.0;
 
 // A CSV column name is built from the traction wheel's name: letters, digits, '_' only.
 bool IsColumnSafe(const std::string& name) {
-  if (name.empty()) return false;
-  for (char c : name) {
-    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_') return false;
-  }
-  return true;
+  return !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+  });
 }
 
 void RequirePositive(double v, const YAML::Node& node, const std::string& path,
