@@ -41,7 +41,7 @@ void AddStructureTests(const DiagnoseResult& r, io::DiagnosePageData* page) {
     page->structure.push_back(
         {name, "F = " + Format("%.2f", l.f) + " on (" + Format("%.0f", l.df_lof) + ", " +
                    Format("%.0f", l.df_pe) + ") dof",
-         l.p_value, l.p_value < DiagnoseOptions{}.lof_alpha,
+         l.p_value, l.p_value < kLofAlpha,
          "the repetitions of a trajectory agree with each other better than with the model"});
   };
   lof("lack of fit, declared fit", r.before.lack_of_fit);

@@ -27,7 +27,7 @@ OutcomeEverydayDriving CompareOutcomeEverydayDriving(const RobotModelInterface& 
 ClockOffsetSummary SummariseClockOffsets(const ModelFitResult& fit, const TrackFitData& track) {
   ClockOffsetSummary s;
   const std::size_t n = track.clock_groups.size();
-  const double bound = track.options.max_clock_offset_s;
+  const double bound = kMaxClockOffsetS;
   for (std::size_t g = 0; g < n; ++g) {
     s.sigma_s.push_back(g < fit.clock_offset_sigma_s.size() ? fit.clock_offset_sigma_s[g] : 0.0);
     s.mean_sigma_s += s.sigma_s.back() / n;

@@ -140,7 +140,7 @@ void PrintFit(const CalibrationRequest& request, const RobotModelInterface& mode
 void PrintClockOffsets(const ModelFitResult& fit, const TrackFitData& track) {
   if (!track.estimate_clock_offsets || track.clock_groups.empty()) return;
   const std::size_t n = track.clock_groups.size();
-  const double bound = track.options.max_clock_offset_s;
+  const double bound = kMaxClockOffsetS;
   const ClockOffsetSummary s = SummariseClockOffsets(fit, track);
   std::printf("clock offsets (ground truth at encoder time + dt, |dt| <= %.2g s), %zu %s:\n",
               bound, n, n == 1 ? "group" : "groups");

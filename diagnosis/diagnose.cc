@@ -123,7 +123,7 @@ std::vector<EffectId> DefaultCandidates(const Robot& robot) {
 // of fit); the first candidate passing all is accepted. Sets every fitted candidate's rule flags
 // and verdict; returns the accepted candidate's index, or -1.
 int DecideRound(const RobotModelInterface& model, const std::vector<TrackRun>& all, bool base_lof,
-                const DiagnoseOptions& options, int threads, DiagnoseRound* round) {
+                int threads, DiagnoseRound* round) {
   std::vector<int> order;
   for (int i = 0; i < static_cast<int>(round->candidates.size()); ++i) {
     CandidateResult& c = round->candidates[i];
@@ -146,9 +146,8 @@ int DecideRound(const RobotModelInterface& model, const std::vector<TrackRun>& a
       c.lof_f = with.lack_of_fit.f;
       c.lof_p = with.lack_of_fit.p_value;
       c.explained_fraction = ExplainedFraction(round->base_lof_f, c.lof_f);
-      c.leaves_no_lack_of_fit = !(with.lack_of_fit.available && c.lof_p < options.lof_alpha);
-      c.explains =
-          c.explained_fraction >= options.min_explained_fraction || c.leaves_no_lack_of_fit;
+      c.leaves_no_lack_of_fit = !(with.lack_of_fit.available && c.lof_p < kLofAlpha);
+      c.explains = c.explained_fraction >= kMinExplainedFraction || c.leaves_no_lack_of_fit;
     }
     if (c.explains) {
       best = i;
@@ -159,8 +158,7 @@ int DecideRound(const RobotModelInterface& model, const std::vector<TrackRun>& a
   const std::string accepted_name = best >= 0 ? effects::Info(round->candidates[best].id).name : "";
   for (CandidateResult& c : round->candidates) {
     if (c.fitted) {
-      c.verdict =
-          CandidateVerdict(c, round->threshold, options.min_explained_fraction, accepted_name);
+      c.verdict = CandidateVerdict(c, round->threshold, kMinExplainedFraction, accepted_name);
     }
   }
   return best;
@@ -173,11 +171,11 @@ int DecideRound(const RobotModelInterface& model, const std::vector<TrackRun>& a
 // and covariate tests (their noise is the repetitions' scatter) judge; the simulated backlash and
 // acceleration slip, fitted within two sigmas, were "partial" for a residual 1.15 times the floor
 // whose repetitions scattered 1.15 times it. So the residual must then also exceed the measured
-// scatter: F = ratio / repetition_ratio, compared with F(df, repetition_df) at lof_alpha. Without
+// scatter: F = ratio / repetition_ratio, compared with F(df, repetition_df) at kLofAlpha. Without
 // repetitions, or when they scatter within the floor, the floor's own chi-square test decides, as
 // before.
-void JudgeAgainstSensorFloor(const SensorFloorTest& floor, double lof_alpha, DiagnoseResult* out) {
-  out->above_sensor_floor = floor.available && floor.p_value < lof_alpha;
+void JudgeAgainstSensorFloor(const SensorFloorTest& floor, DiagnoseResult* out) {
+  out->above_sensor_floor = floor.available && floor.p_value < kLofAlpha;
   out->floor_below_repetitions = floor.available && floor.has_repetition_check &&
                                  floor.repetition_ratio > 1.0 && floor.repetition_df > 0.0;
   out->floor_shows_structure = out->above_sensor_floor;
@@ -185,7 +183,7 @@ void JudgeAgainstSensorFloor(const SensorFloorTest& floor, double lof_alpha, Dia
   out->floor_vs_repetitions_f = floor.ratio / floor.repetition_ratio;
   out->floor_vs_repetitions_p =
       stats::FUpperTail(out->floor_vs_repetitions_f, floor.df, floor.repetition_df);
-  out->floor_shows_structure = out->above_sensor_floor && out->floor_vs_repetitions_p < lof_alpha;
+  out->floor_shows_structure = out->above_sensor_floor && out->floor_vs_repetitions_p < kLofAlpha;
   out->floor_excess_is_run_to_run_noise = out->above_sensor_floor && !out->floor_shows_structure;
 }
 
@@ -193,11 +191,7 @@ void JudgeAgainstSensorFloor(const SensorFloorTest& floor, double lof_alpha, Dia
 
 bool DiagnoseOptions::IsValid(std::string* error) const {
   if (!fit.IsValid(error)) return false;
-  if (!(alpha > 0.0 && alpha < 1.0) || !(lof_alpha > 0.0 && lof_alpha < 1.0))
-    return Invalid(error, "alpha and lof_alpha must be in (0, 1)");
-  if (!(min_explained_fraction >= 0.0 && min_explained_fraction <= 1.0) ||
-      !(min_separable_fraction >= 0.0 && min_separable_fraction < 1.0))
-    return Invalid(error, "fractions must be in [0, 1]");
+  if (!(alpha > 0.0 && alpha < 1.0)) return Invalid(error, "alpha must be in (0, 1)");
   if (max_effects < 0) return Invalid(error, "max_effects must be >= 0");
   return true;
 }
@@ -261,7 +255,7 @@ void FitDeclared(const DiagnoseContext& x, DiagnoseResult* out) {
 // identifiable" holds for omni3 (e.g. a tracked-point offset is exactly a change of its wheel
 // distances); another model may separate the effect (a differential drive cannot move sideways,
 // so the same offset shows). Checked numerically here: an effect whose separable fraction reaches
-// min_separable_fraction becomes a candidate like the others; the rest are reported.
+// kMinSeparableFraction becomes a candidate like the others; the rest are reported.
 std::vector<EffectId> CandidateEffects(const DiagnoseContext& x, const EffectFitResult& base,
                                        std::vector<std::string>* not_identifiable) {
   std::vector<EffectId> candidates =
@@ -270,7 +264,7 @@ std::vector<EffectId> CandidateEffects(const DiagnoseContext& x, const EffectFit
     if (info.identifiable) continue;
     const double sep =
         SeparableFraction(x.training, x.model, base.parameters, {}, info.id, x.options.fit.weights);
-    if (x.options.candidates.empty() && sep >= x.options.min_separable_fraction) {
+    if (x.options.candidates.empty() && sep >= kMinSeparableFraction) {
       candidates.push_back(info.id);
       continue;
     }
@@ -326,8 +320,8 @@ CandidateResult TryCandidate(const DiagnoseContext& x, const EffectFitResult& cu
   // decides whether it is accepted.
   double size = asked;
   for (int j = 0; j < info.num_parameters; ++j) size = std::max(size, std::abs(info.typical[j]));
-  c.resolvable = c.separable_fraction >= x.options.min_separable_fraction &&
-                 size >= x.options.min_resolvable_sigmas * c.predicted_sigma;
+  c.resolvable = c.separable_fraction >= kMinSeparableFraction &&
+                 size >= kMinResolvableSigmas * c.predicted_sigma;
   *tried = c.resolvable;
   if (!c.resolvable) {
     c.verdict = "cannot be told apart from the model on these runs";
@@ -376,7 +370,7 @@ DiagnoseRound RunRound(const DiagnoseContext& x, const EffectFitResult& current,
   round.base_lof_f = base_all.lack_of_fit.f;
   round.base_lof_p = base_all.lack_of_fit.p_value;
   const bool base_lof =
-      base_all.lack_of_fit.available && base_all.lack_of_fit.p_value < x.options.lof_alpha;
+      base_all.lack_of_fit.available && base_all.lack_of_fit.p_value < kLofAlpha;
   base.bic = Bic(2.0 * current.final_cost, static_cast<int>(x.training.size()),
                  NumParameters(robot, current.effects));
   base.dof = 3 * static_cast<int>(x.training.size()) - NumParameters(robot, current.effects);
@@ -390,7 +384,7 @@ DiagnoseRound RunRound(const DiagnoseContext& x, const EffectFitResult& current,
     num_tried += tried ? 1 : 0;
   }
   round.threshold = x.options.alpha / std::max(1, num_tried);
-  *best = DecideRound(x.model, x.all, base_lof, x.options, x.threads, &round);
+  *best = DecideRound(x.model, x.all, base_lof, x.threads, &round);
   return round;
 }
 
@@ -436,10 +430,10 @@ void Conclude(const DiagnoseContext& x, const EffectFitResult& current, Diagnose
   out->final_validation = ScoreModel(x.model, current.parameters, current.effects, x.validation,
                                      x.options.fit.weights, x.threads);
   out->after = AnalyzeResiduals(x.model, current.parameters, current.effects, x.all, x.threads);
-  out->covariates = AnalyzeCovariates(out->after, x.options.covariate_alpha);
+  out->covariates = AnalyzeCovariates(out->after, kCovariateAlpha);
   out->lack_of_fit =
-      out->after.lack_of_fit.available && out->after.lack_of_fit.p_value < x.options.lof_alpha;
-  JudgeAgainstSensorFloor(out->after.sensor_floor, x.options.lof_alpha, out);
+      out->after.lack_of_fit.available && out->after.lack_of_fit.p_value < kLofAlpha;
+  JudgeAgainstSensorFloor(out->after.sensor_floor, out);
   out->unexplained_structure =
       out->lack_of_fit || out->covariates.any_significant || out->floor_shows_structure;
   out->effects_named = !out->unexplained_structure && !current.effects.empty();

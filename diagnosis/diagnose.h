@@ -12,8 +12,8 @@
 //       - separability: the part of its Jacobian column outside the span of the others
 //         (SeparableFraction) and the sigma it predicts, sigma_c = s / |(I - P) J_c| with s the
 //         base's residual RMS (one run = three residuals, as the fit's covariance). When the
-//         fraction is below min_separable_fraction, or the registry's realistic magnitude is
-//         less than min_resolvable_sigmas predicted sigmas, the runs cannot tell it from the
+//         fraction is below kMinSeparableFraction, or the registry's realistic magnitude is
+//         less than kMinResolvableSigmas predicted sigmas, the runs cannot tell it from the
 //         model: it is not fitted, and the runs that would separate it are named;
 //       - refit nine + accepted effects + candidate on the training runs;
 //       - validation: per held-out run, d_i = J_base,i - J_cand,i (J the run's mean squared track
@@ -24,8 +24,8 @@
 //       - information criterion on the training runs, one observation per run (a run's
 //         checkpoints are correlated): BIC = N ln(S / N) + k ln N, S = sum of run objectives,
 //         k the number of fitted parameters; required: BIC falls;
-//       - explanation: where the base leaves significant lack of fit (p < lof_alpha), the
-//         candidate must remove at least min_explained_fraction of its excess (F - 1), or leave
+//       - explanation: where the base leaves significant lack of fit (p < kLofAlpha), the
+//         candidate must remove at least kMinExplainedFraction of its excess (F - 1), or leave
 //         no significant lack of fit, so a candidate that merely nibbles at an effect outside the
 //         library is not named. (Why the second way: the verdict names effects only when nothing
 //         significant remains, and a base just past the threshold - an eccentric hub on the
@@ -36,7 +36,7 @@
 //  4. After: lack of fit of the final model, its residual against the sensors' own noise
 //     (sensor_noise_floor.h: no repetitions needed) and against covariates of the runs
 //     (covariate_structure.h: what differs between repetitions, which the lack of fit takes as
-//     noise). If any is significant (p < lof_alpha; Holm at covariate_alpha), the residual is
+//     noise). If any is significant (p < kLofAlpha; Holm at kCovariateAlpha), the residual is
 //     reported as structure that no candidate explains, with its pattern and the covariates it
 //     follows, and the accepted effects (if any) are a partial description, not the cause.
 // Structurally non-identifiable effects (registry: identifiable = false, e.g. the encoder clock
@@ -54,17 +54,21 @@
 
 namespace fitcal {
 
+// The procedure's thresholds (steps 3 and 4 above), fixed: no caller sets them.
+inline constexpr double kLofAlpha = 0.001;  // lack-of-fit threshold (approximate F, see above)
+inline constexpr double kMinExplainedFraction = 0.5;  // of the lack-of-fit excess, if significant
+// Below: not separable from the nine on these runs.
+inline constexpr double kMinSeparableFraction = 0.02;
+// Realistic magnitude / predicted sigma, at least.
+inline constexpr double kMinResolvableSigmas = 3.0;
+// Residual against covariates of the runs (covariate_structure.h), family-wise over the
+// covariates (Holm): a significant one is unexplained structure, as a significant lack of fit.
+inline constexpr double kCovariateAlpha = 0.01;
+
 struct DiagnoseOptions {
   EffectFitOptions fit;
-  double alpha = 0.01;                   // family-wise, split over the candidates (Bonferroni)
-  double lof_alpha = 0.001;              // lack-of-fit threshold (approximate F, see above)
-  double min_explained_fraction = 0.5;   // of the lack-of-fit excess, when it is significant
-  double min_separable_fraction = 0.02;  // below: not separable from the nine on these runs
-  double min_resolvable_sigmas = 3.0;    // realistic magnitude / predicted sigma, at least
+  double alpha = 0.01;  // family-wise, split over the candidates (Bonferroni)
   int max_effects = 3;
-  // Residual against covariates of the runs (covariate_structure.h), family-wise over the
-  // covariates (Holm): a significant one is unexplained structure, as a significant lack of fit.
-  double covariate_alpha = 0.01;
   // Candidates (default, empty: every identifiable effect of the registry).
   std::vector<effects::EffectId> candidates;
   bool IsValid(std::string* error) const;
@@ -92,7 +96,7 @@ struct CandidateResult {
   // Fraction of the base's lack-of-fit excess F - 1 the candidate removes, in [0, 1]; NaN when
   // not evaluated (no significant lack of fit, or the candidate failed an earlier rule).
   double explained_fraction = std::numeric_limits<double>::quiet_NaN();
-  // With the candidate no significant lack of fit remains (p >= lof_alpha): it explains what the
+  // With the candidate no significant lack of fit remains (p >= kLofAlpha): it explains what the
   // test can see, whatever the fraction.
   bool leaves_no_lack_of_fit = false;
   bool explains = false;
@@ -119,14 +123,14 @@ struct DiagnoseResult {
   ModelScore final_validation;
   ResidualAnalysis after;
   CovariateStructure covariates;  // of `after`
-  bool lack_of_fit = false;       // significant lack of fit of `after` (p < lof_alpha)
-  // `after` significantly above the sensors' own noise (sensor_noise_floor.h, p < lof_alpha):
+  bool lack_of_fit = false;       // significant lack of fit of `after` (p < kLofAlpha)
+  // `after` significantly above the sensors' own noise (sensor_noise_floor.h, p < kLofAlpha):
   // seen without repetitions, and when what differs between repetitions hides in their scatter.
   bool above_sensor_floor = false;
   // The floor's excess counts as structure (floor_shows_structure) unless the repetitions
   // themselves scatter above the floor (ratio > 1: noise the floor's model lacks, e.g. random slip
   // that changes from run to run) and the residual does not exceed that measured scatter:
-  // F = residual ratio / repetition ratio on (df, repetition df), p < lof_alpha.
+  // F = residual ratio / repetition ratio on (df, repetition df), p < kLofAlpha.
   bool floor_below_repetitions = false;  // the repetitions scatter above the floor (ratio > 1)
   double floor_vs_repetitions_f = 0.0;
   double floor_vs_repetitions_p = 1.0;

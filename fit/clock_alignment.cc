@@ -25,7 +25,7 @@ std::string Summary(const std::string& what, int moved, std::size_t runs,
   }
   // An offset on the fit's bound is where the solver stopped, not a measured lag: said, so that
   // a re-stamp by it is not taken for one (the runs then determine no offset of that group).
-  const double bound_s = TrackResidualOptions().max_clock_offset_s;
+  const double bound_s = kMaxClockOffsetS;
   int on_bound = 0;
   for (const auto& [group, offset_s] : offsets) on_bound += std::abs(offset_s) >= bound_s - 1e-6;
   const std::string line = StrFormat(

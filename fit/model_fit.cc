@@ -155,16 +155,15 @@ class FitProblem {
   // Each clock offset in [-max, max], or held at its value when not estimated.
   void BoundClockOffsets(const ModelFitOptions& fit_options, double* clock_offsets) {
     const TrackFitData& track = *fit_options.track;
-    const double bound = track.options.max_clock_offset_s;
     for (std::size_t g = 0; g < track.clock_groups.size(); ++g) {
       double* offset = clock_offsets + g;
       if (!problem_->HasParameterBlock(offset)) continue;
-      if (!track.estimate_clock_offsets || bound == 0.0) {
+      if (!track.estimate_clock_offsets) {
         problem_->SetParameterBlockConstant(offset);
         continue;
       }
-      problem_->SetParameterLowerBound(offset, 0, -bound);
-      problem_->SetParameterUpperBound(offset, 0, bound);
+      problem_->SetParameterLowerBound(offset, 0, -kMaxClockOffsetS);
+      problem_->SetParameterUpperBound(offset, 0, kMaxClockOffsetS);
     }
   }
 
@@ -583,7 +582,7 @@ void SolveClockOffsetsAt(const RobotModelInterface& model, const ModelFitOptions
                          ModelFitResult* result, bool scan = true,
                          std::vector<OdometryMemo>* memos = nullptr) {
   const TrackFitData& track = *options.track;
-  const double bound = track.options.max_clock_offset_s;
+  const double bound = kMaxClockOffsetS;
   for (std::size_t g = 0; g < track.clock_groups.size(); ++g) {
     // Each run's odometry from its start, replayed once: it does not depend on dt.
     std::vector<std::pair<std::unique_ptr<TrackResidual>, std::vector<double>>> runs;
@@ -596,7 +595,7 @@ void SolveClockOffsetsAt(const RobotModelInterface& model, const ModelFitOptions
       std::vector<double> poses = cost->OdometryFromStart(p.data());
       runs.emplace_back(std::move(cost), std::move(poses));
     }
-    if (runs.empty() || bound == 0.0) continue;
+    if (runs.empty()) continue;
     const auto cost_at = [&](double dt) {
       ++result->clock_offset_iterations;
       double sum = 0.0;

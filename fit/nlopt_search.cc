@@ -226,7 +226,7 @@ class Objective {
       std::copy(u, u + dim, best_u_.begin());
       if (options_.record_trace) trace_.push_back({evaluations_, cf, SecondsSince(t0_)});
     }
-    if (options_.progress && SecondsSince(last_progress_) >= options_.progress_interval_s) {
+    if (options_.progress && SecondsSince(last_progress_) >= kNloptProgressIntervalS) {
       last_progress_ = Clock::now();
       options_.progress({evaluations_, best_cf_, SecondsSince(t0_)});
     }
@@ -350,10 +350,8 @@ bool NloptFitOptions::IsValid(std::string* error) const {
                    "local_polish_evaluations must leave part of max_evaluations to the search");
   if (local_polish && local_polish_evaluations < 1)
     return Invalid(error, "local_polish_evaluations must be at least 1");
-  if (max_time_s < 0.0 || ftol_rel < 0.0 || xtol_rel < 0.0 || progress_interval_s < 0.0)
-    return Invalid(error, "max_time_s, tolerances and progress_interval_s must be >= 0");
-  if (population < 0 || num_threads < 0)
-    return Invalid(error, "population and num_threads must be >= 0");
+  if (ftol_rel < 0.0 || xtol_rel < 0.0) return Invalid(error, "tolerances must be >= 0");
+  if (num_threads < 0) return Invalid(error, "num_threads must be >= 0");
   return true;
 }
 
@@ -369,8 +367,6 @@ bool Search(const NloptFitOptions& options, Objective& objective, std::vector<do
       polish ? options.max_evaluations - options.local_polish_evaluations : options.max_evaluations;
   OptPtr opt = MakeOpt(Algorithm(options.method), &objective, options.ftol_rel, options.xtol_rel,
                        search_budget);
-  if (options.max_time_s > 0.0) nlopt_set_maxtime(opt.get(), options.max_time_s);
-  if (options.population > 0) nlopt_set_population(opt.get(), options.population);
   OptPtr local;
   if (options.method == NloptMethod::kMlslLds) {
     // MLSL's local searches: BOBYQA to a moderate tolerance; the budget is MLSL's.

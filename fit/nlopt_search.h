@@ -66,28 +66,29 @@ struct ConvergencePoint {
 };
 using NloptProgress = ConvergencePoint;
 
+// No time limit (it would make results timing-dependent) and NLopt's default population for
+// each method: neither is an option. How often `progress` is called, at most:
+inline constexpr double kNloptProgressIntervalS = 0.5;
+
 struct NloptFitOptions {
   NloptMethod method = NloptMethod::kCrs2Lm;
   FinalPoseObjective objective = FinalPoseObjective::kSumOfNorms;
   ResidualWeights weights;
   std::uint64_t seed = 1;
   int max_evaluations = 20000;  // the whole fit, polish included
-  double max_time_s = 0.0;      // 0 = no limit (a time limit makes results timing-dependent)
   // Relative tolerances in the normalised box / on the objective; 0 disables a test. Global
   // methods stop on them too (CRS2, ISRES and MLSL check them), so set both to 0 to spend the
   // whole budget.
   double ftol_rel = 1e-10;
   double xtol_rel = 1e-8;
-  int population = 0;  // 0 = NLopt's default for the method
   // Global methods only: the search gets max_evaluations - local_polish_evaluations, then SLSQP
   // with the autodiff gradient polishes its best point with the rest.
   bool local_polish = false;
   int local_polish_evaluations = 2000;
   int num_threads = 0;  // 0 = all cores
   bool record_trace = true;
-  // Called on the fitting thread at most every progress_interval_s with the state of the search.
+  // Called on the fitting thread at most every kNloptProgressIntervalS with the search's state.
   std::function<void(const NloptProgress&)> progress;
-  double progress_interval_s = 0.5;
 
   bool IsValid(std::string* error) const;
 };

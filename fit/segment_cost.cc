@@ -18,13 +18,6 @@ bool SegmentOptions::IsValid(std::string* error) const {
   return true;
 }
 
-bool ClockMapOptions::IsValid(std::string* error) const {
-  if (!(max_offset_s >= 0.0) || !(offset_step_s > 0.0) || !(max_rate >= 0.0 && max_rate < 0.5) ||
-      !(rate_step > 0.0))
-    return Invalid(error, "clock map search: ranges must be >= 0 (rate < 0.5) and steps positive");
-  return true;
-}
-
 namespace {
 
 // Sample boundary times of an aligned run: boundary b lies after b samples.
@@ -151,9 +144,7 @@ double ClockMapLeverArm(const RobotModelInterface& model, const double* p) {
 }
 
 ClockMap EstimateClockMap(const RobotModelInterface& model, const double* p, const AlignedRun& run,
-                          const GroundTruthTrack& ground_truth, const ClockMapOptions& options) {
-  std::string error;
-  if (!options.IsValid(&error)) throw std::invalid_argument("ClockMapOptions: " + error);
+                          const GroundTruthTrack& ground_truth) {
   const std::vector<double> t = BoundaryTimes(run);
   const std::unique_ptr<const PreparedKinematics<double>> kinematics = model.PrepareKinematics(p);
   const double lever_m = ClockMapLeverArm(model, p);  // weighs omega like a wheel's speed
@@ -171,14 +162,14 @@ ClockMap EstimateClockMap(const RobotModelInterface& model, const double* p, con
   best.t_mid_s = 0.5 * (t.front() + t.back());
   double best_cost = std::numeric_limits<double>::infinity();
   std::vector<Pose2d> q(t.size());
-  const int num_rates = static_cast<int>(std::floor(options.max_rate / options.rate_step + 1e-9));
+  const int num_rates = static_cast<int>(std::floor(kClockMapMaxRate / kClockMapRateStep + 1e-9));
   const int num_offsets =
-      static_cast<int>(std::floor(options.max_offset_s / options.offset_step_s + 1e-9));
+      static_cast<int>(std::floor(kClockMapMaxOffsetS / kClockMapOffsetStepS + 1e-9));
   for (int ir = -num_rates; ir <= num_rates; ++ir) {
     for (int io = -num_offsets; io <= num_offsets; ++io) {
       ClockMap map = best;
-      map.rate = ir * options.rate_step;
-      map.offset_s = io * options.offset_step_s;
+      map.rate = ir * kClockMapRateStep;
+      map.offset_s = io * kClockMapOffsetStepS;
       for (std::size_t b = 0; b < t.size(); ++b)
         q[b] = InterpolateGroundTruth(ground_truth, map.Map(t[b]));
       double cost = 0.0;

@@ -65,18 +65,17 @@ struct ClockMap {
   double t_mid_s = 0.0;
   double Map(double t_s) const { return t_s + offset_s + rate * (t_s - t_mid_s); }
 };
-struct ClockMapOptions {
-  double max_offset_s = 0.5;
-  double offset_step_s = 0.01;
-  double max_rate = 0.03;  // 3 %: the OptiOdom spans differ by ~2 %
-  double rate_step = 0.0025;
-  bool IsValid(std::string* error) const;
-};
+// The grid EstimateClockMap searches: offsets a in [-max, max] by the step, rates b likewise.
+inline constexpr double kClockMapMaxOffsetS = 0.5;
+inline constexpr double kClockMapOffsetStepS = 0.01;
+inline constexpr double kClockMapMaxRate = 0.03;  // 3 %: the OptiOdom spans differ by ~2 %
+inline constexpr double kClockMapRateStep = 0.0025;
+static_assert(kClockMapOffsetStepS > 0.0 && kClockMapRateStep > 0.0 && kClockMapMaxRate < 0.5,
+              "clock map search: steps positive, rate < 0.5");
 // The map that makes the ground truth's speed profile match the odometry's: the body velocities
 // of `model` at p (its body step of each sample over dt), any model.
 ClockMap EstimateClockMap(const RobotModelInterface& model, const double* p, const AlignedRun& run,
-                          const GroundTruthTrack& ground_truth,
-                          const ClockMapOptions& options = {});
+                          const GroundTruthTrack& ground_truth);
 // How EstimateClockMap weighs a yaw-rate mismatch against a speed mismatch: the distance from the
 // centre at which a turn moves the wheels as fast as a translation of the same speed,
 // |w(rotation 1 rad/s)| / |w(translation 1 m/s)| with w the channel values (ChannelsForTwist; the

@@ -17,9 +17,8 @@
 namespace fitcal {
 
 bool TrackResidualOptions::IsValid(std::string* error) const {
-  if (!(checkpoint_spacing_m > 0.0) || !(huber_scale > 0.0) || !(max_clock_offset_s >= 0.0))
-    return Invalid(
-        error, "track: checkpoint spacing and loss scale must be positive, the offset bound >= 0");
+  if (!(checkpoint_spacing_m > 0.0) || !(huber_scale > 0.0))
+    return Invalid(error, "track: checkpoint spacing and loss scale must be positive");
   return true;
 }
 

@@ -57,11 +57,12 @@ enum class TrackHeading { kFromStart, kIncrements };
 const char* ToString(TrackHeading heading);  // "from-start", "increments"
 bool ParseTrackHeading(const std::string& text, TrackHeading* out);
 
+inline constexpr double kMaxClockOffsetS = 0.5;  // |dt| bound of the clock offsets
+
 struct TrackResidualOptions {
   double checkpoint_spacing_m = 0.5;  // OptiOdom's
   TrackHeading heading = TrackHeading::kFromStart;
   double huber_scale = 0.1;           // c, residual units (m and rad): a few times a clean error
-  double max_clock_offset_s = 0.5;    // |dt| bound
   bool IsValid(std::string* error) const;
 };
 

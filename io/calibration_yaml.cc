@@ -10,8 +10,8 @@ namespace fitcal::io {
 
 namespace {
 
-// The bound of the track fit's clock offsets (fit/track_residual.h, TrackResidualOptions::
-// max_clock_offset_s; io/ sits below fit/ and cannot include it): a recorded offset beyond it was
+// The bound of the track fit's clock offsets (fit/track_residual.h, kMaxClockOffsetS; io/ sits
+// below fit/ and cannot include it): a recorded offset beyond it was
 // not written by fit. The last digit of a written value may round past it.
 constexpr double kMaxRecordedClockOffsetS = 0.5 + 1e-9;
 

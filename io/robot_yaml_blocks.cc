@@ -1,5 +1,7 @@
 #include "io/robot_yaml_blocks.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <stdexcept>
 
@@ -22,6 +24,12 @@ Interval ReadBoundsPair(YamlMap& map, const std::string& key, double scale) {
                          ": a box of zero width; widen it, or fix the parameter with --hold");
   }
   return Interval{lo * scale, hi * scale};
+}
+
+bool IsColumnSafe(const std::string& name) {
+  return !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+  });
 }
 
 std::optional<EncoderTicks> ReadEncoderTicksNode(const YAML::Node& node, const std::string& path) {

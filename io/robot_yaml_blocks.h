@@ -32,6 +32,10 @@ void ReadAngleEncoders(YamlMap& map, Robot* robot);
 // `sigma_<parameter>` keys carry the fitted uncertainty.
 std::vector<effects::EffectValue> ReadEffectsNode(const YAML::Node& node, const std::string& path);
 
+// A name that a model builds CSV columns from (a castor's, a traction wheel's): letters, digits
+// and '_' only, not empty.
+bool IsColumnSafe(const std::string& name);
+
 // The nominal must lie inside the box the fit may search: InputError naming the parameter.
 void CheckNominalInsideBounds(const Robot& robot, const std::string& path, int line);
 

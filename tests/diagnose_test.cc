@@ -239,7 +239,7 @@ TEST(Diagnose, LackOfFitIsCalibratedOnCleanDataWithManyRepetitions) {
   options.max_effects = 0;  // the residual of the nine parameters alone
   const DiagnoseResult r = Diagnose(d.training, d.validation, *NominalModel(), options);
   ASSERT_TRUE(r.after.lack_of_fit.available);
-  EXPECT_GT(r.after.lack_of_fit.p_value, options.lof_alpha) << "F = " << r.after.lack_of_fit.f;
+  EXPECT_GT(r.after.lack_of_fit.p_value, kLofAlpha) << "F = " << r.after.lack_of_fit.f;
   EXPECT_FALSE(r.unexplained_structure);
 }
 

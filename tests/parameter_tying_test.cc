@@ -227,7 +227,6 @@ TEST(ClockMap, FindsAGroundTruthOffsetOfADiffDrive) {
   const RobotModelPtr omni3 = ReadRobotModel(YAML::Load(kOmni3ExampleYaml), "robot.yaml");
   EXPECT_NEAR(ClockMapLeverArm(*omni3, omni3->robot().nominal.data()), 0.195, 1e-12);
   constexpr double kLateS = 0.15;
-  const ClockMapOptions options;
   sim::SimulationOptions o = NoisyOptions();
   o.gt_position_sigma_m = 0.0;
   o.gt_heading_sigma_rad = 0.0;
@@ -237,8 +236,8 @@ TEST(ClockMap, FindsAGroundTruthOffsetOfADiffDrive) {
     RunLog log = run.log;
     for (double& t : log.ground_truth.t_s) t += kLateS;
     const ClockMap map = EstimateClockMap(*model, p.data(), AlignRun(run.log), log.ground_truth);
-    EXPECT_NEAR(map.offset_s, kLateS, options.offset_step_s + 1e-9) << log.id;
-    EXPECT_NEAR(map.rate, 0.0, options.rate_step + 1e-12) << log.id;
+    EXPECT_NEAR(map.offset_s, kLateS, kClockMapOffsetStepS + 1e-9) << log.id;
+    EXPECT_NEAR(map.rate, 0.0, kClockMapRateStep + 1e-12) << log.id;
   }
 }
 

@@ -29,7 +29,7 @@ double PoseChangeAround(const GroundTruthTrack& track, double t_s, double lag_s)
 std::size_t SteadiestBoundary(const GroundTruthTrack& track, const std::vector<double>& t,
                               const std::vector<double>& s, std::size_t at, std::size_t first,
                               double reach_m) {
-  const double lag_s = TrackResidualOptions{}.max_clock_offset_s;
+  const double lag_s = kMaxClockOffsetS;
   const std::size_t n = s.size() - 1;
   if (at >= n) return at;
   std::size_t best = at;

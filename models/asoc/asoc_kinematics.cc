@@ -22,8 +22,6 @@ bool AsocOdometryOptions::IsValid(std::string* error) const {
     return Invalid(error, "IPEC uses two castors: IPEC-1, IPEC-2 or IPEC-3");
   if (redundancy_check && (method != asoc::Method::kCast || excluded_castor != 0))
     return Invalid(error, "the redundancy check needs all three castors (CAST-0)");
-  if (!(consistency_tolerance_m >= 0.0) || !(consistency_tolerance_fraction >= 0.0))
-    return Invalid(error, "consistency tolerances must be >= 0");
   return true;
 }
 

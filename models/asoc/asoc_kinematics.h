@@ -75,8 +75,6 @@ struct AsocOdometryOptions {
   asoc::Method method = asoc::Method::kCast;
   int excluded_castor = 0;  // 1-based castor left out (CAST-i / IPEC-i); 0 = none (CAST-0)
   bool redundancy_check = false;
-  double consistency_tolerance_m = 0.5e-3;
-  double consistency_tolerance_fraction = 0.1;
 
   asoc::CastorMask castors() const { return asoc::MaskExcluding(excluded_castor); }
   // Parses "CAST-i" (i = 0..3) or "IPEC-i" (i = 1..3); false otherwise.
@@ -146,9 +144,7 @@ struct AsocKinematics {
       x[i] = ScalarPart(px[i]);
       y[i] = ScalarPart(py[i]);
     }
-    const int suspect =
-        asoc::InconsistentCastor(pivots, 0.0, x, y, odometry.consistency_tolerance_m,
-                                 odometry.consistency_tolerance_fraction);
+    const int suspect = asoc::InconsistentCastor(pivots, 0.0, x, y);
     return suspect < 0 ? mask : mask & ~(1u << suspect);
   }
   static int AnchorCastor(asoc::CastorMask mask) {

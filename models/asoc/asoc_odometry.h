@@ -81,9 +81,10 @@ BodyStep<T> SolveCastGeneral(const std::array<PivotPosition, kNumCastors>& pivot
 // (dx_i, dy_i) disagrees with the CAST prediction of the other two by more than
 // tolerance_m + tolerance_fraction * (the step length), or -1. psi: the heading the displacements
 // are expressed at (the body frame's, Eq. 13-14).
+inline constexpr double kConsistencyToleranceM = 0.5e-3;      // tolerance_m
+inline constexpr double kConsistencyToleranceFraction = 0.1;  // tolerance_fraction
 inline int InconsistentCastor(const std::array<PivotPosition, kNumCastors>& pivots, double psi,
-                              const double* dx, const double* dy, double tolerance_m,
-                              double tolerance_fraction) {
+                              const double* dx, const double* dy) {
   int suspect = -1;
   double best_pair_residual = 0.0;
   double step_length = 0.0;
@@ -109,7 +110,7 @@ inline int InconsistentCastor(const std::array<PivotPosition, kNumCastors>& pivo
   const double pred_x = pair.dx_m - pair.dpsi_rad * (q.y_m() * c + q.x_m() * s);  // Eq. 13
   const double pred_y = pair.dy_m + pair.dpsi_rad * (q.x_m() * c - q.y_m() * s);  // Eq. 14
   const double miss = std::hypot(dx[suspect] - pred_x, dy[suspect] - pred_y);
-  return miss > tolerance_m + tolerance_fraction * step_length ? suspect : -1;
+  return miss > kConsistencyToleranceM + kConsistencyToleranceFraction * step_length ? suspect : -1;
 }
 
 enum class Method { kCast, kIpec };

@@ -1,7 +1,6 @@
 #include "models/asoc/asoc_robot_model.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 
 #include "io/input_error.h"
@@ -40,12 +39,6 @@ constexpr const char* kOffsetHeldReason =
 constexpr const char* kBiasHeldReason =
     "a pivot bias is absorbed by the wheel parameters (Doebbler Fig. 3); the closed form measures "
     "it (Eq. 2)";
-
-bool IsColumnSafe(const std::string& name) {
-  return !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
-  });
-}
 
 // The box of parameter k (castor block order) for the robot's bounds or the default above.
 Interval BoundOf(const io::AsocRobot& robot, int k, double value) {
@@ -116,7 +109,7 @@ RobotModelPtr ReadAsocModel(const YAML::Node& root, const std::string& path) {
   io::AsocRobot asoc = io::ReadAsocRobotNode(root, path);
   const YAML::Node castors = root["castors"];
   for (int i = 0; i < asoc::kNumCastors; ++i) {
-    if (!IsColumnSafe(asoc.castor_names[i])) {
+    if (!io::IsColumnSafe(asoc.castor_names[i])) {
       throw InputError(InputErrorKind::kBadValue, path, castors[i].Mark().line + 1,
                        "castor name '" + asoc.castor_names[i] +
                            "' must be letters, digits and '_' (it names CSV columns)");

@@ -1,7 +1,6 @@
 #include "models/tricycle/tricycle_model.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <optional>
 
@@ -26,13 +25,6 @@ constexpr const char* kSteeringColumn = "steering";
 constexpr double kMaxSteeringOffsetDeg = 90.0;
 constexpr const char* kGainKey = "steering_gain";
 constexpr double kDefaultGainFactor = 10.0;
-
-// A CSV column name is built from the traction wheel's name: letters, digits, '_' only.
-bool IsColumnSafe(const std::string& name) {
-  return !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
-  });
-}
 
 void RequirePositive(double v, const YAML::Node& node, const std::string& path,
                      const std::string& what) {
@@ -104,7 +96,8 @@ RobotModelPtr ReadTricycleModel(const YAML::Node& root, const std::string& path)
   io::YamlMap wheel(wheel_node, path, "traction_wheel");
   const std::string traction_name =
       wheel.Has("name") ? wheel.Name("name") : std::string(kDefaultTractionName);
-  if (!IsColumnSafe(traction_name) || traction_name == kSteeringColumn) {
+  // A CSV column name is built from the traction wheel's name.
+  if (!io::IsColumnSafe(traction_name) || traction_name == kSteeringColumn) {
     throw InputError(InputErrorKind::kBadValue, path, LineOf(wheel_node),
                      "traction_wheel.name '" + traction_name +
                          "' must be letters, digits and '_' and not 'steering'");
