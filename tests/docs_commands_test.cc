@@ -29,7 +29,7 @@ namespace fs = std::filesystem;
 
 const fs::path kSource = FITCAL_SOURCE_DIR;
 const fs::path kBuild = FITCAL_BINARY_DIR;
-const fs::path kShared = bench::SharedDir(FITCAL_SHARED_DIR);  // what the docs call ../shared
+const fs::path kShared = FITCAL_SHARED_DIR;  // what the docs call ../shared
 
 // The doc files to run: FITCAL_DOC (relative to the repository), or README.md and docs/*.md.
 std::vector<std::string> DocFiles() {

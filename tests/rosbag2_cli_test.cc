@@ -359,7 +359,7 @@ TEST(StaticTransforms, ComposeAlongTheTreeInThreeDimensions) {
 // topic, so each is refused in one line naming the topic, exit 1, nothing written - read through
 // the same path as a robot's bag, both storage formats.
 TEST(ImportThroughTheCommandLine, TheRecordersOwnBagsHoldNoWheelsAndAreRefusedInOneLine) {
-  const fs::path root = bench::SharedDir(FITCAL_SHARED_DIR) / "data" / "rosbag2";
+  const fs::path root = fs::path(FITCAL_SHARED_DIR) / "data" / "rosbag2";
   if (!fs::is_directory(root)) GTEST_SKIP() << root << " is absent (a clone without ../shared)";
   TempDir tmp;
   tmp.Write("robot.yaml", kDiffDriveExampleYaml);

@@ -34,13 +34,6 @@ inline std::uint64_t EnvBytes(const char* name, long fallback_mb) {
   return static_cast<std::uint64_t>(EnvOr(name, fallback_mb)) << 20;
 }
 
-// The shared data (../shared beside the checkout, `built_in`), or $FITCAL_SHARED_DIR where the
-// checkout has none beside it (a git worktree elsewhere).
-inline std::filesystem::path SharedDir(const std::string& built_in) {
-  const char* env = std::getenv("FITCAL_SHARED_DIR");
-  return env != nullptr && *env != '\0' ? std::filesystem::path(env) : std::filesystem::path(built_in);
-}
-
 // A fresh directory under the system's temporary directory, removed with everything in it.
 class ScratchDir {
  public:

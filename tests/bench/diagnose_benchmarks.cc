@@ -36,7 +36,7 @@ struct RemovedAtExit {
 const std::string& ImportedOmni3() {
   static RemovedAtExit cleanup;
   static const std::string directory = [] {
-    const fs::path root = fitcal::bench::SharedDir(FITCAL_SHARED_DIR) / "data" / "optiodom" / "omni3";
+    const fs::path root = fs::path(FITCAL_SHARED_DIR) / "data" / "optiodom" / "omni3";
     optiodom::ImportOptiOdomOptions options;
     for (const char* type : {"circular", "square"}) {
       if (!fs::is_directory(root / type)) return std::string();

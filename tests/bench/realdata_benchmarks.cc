@@ -26,7 +26,7 @@ namespace fs = std::filesystem;
 // robot: a folder of ../shared/data/optiodom; fit_flags: what `fit` gets besides the data set.
 void BM_ImportAndFit(benchmark::State& state, const std::string& robot,
                      const std::string& fit_flags) {
-  const fs::path source = fitcal::bench::SharedDir(FITCAL_SHARED_DIR) / "data" / "optiodom" / robot;
+  const fs::path source = fs::path(FITCAL_SHARED_DIR) / "data" / "optiodom" / robot;
   if (!fs::is_directory(source / "circular") || !fs::is_directory(source / "square")) {
     state.SkipWithError(("no shared data at " + source.string()).c_str());
     return;

@@ -49,9 +49,7 @@ std::string DataSet(const std::string& name, std::string* error) {
   if (name == "asoc") {
     command = Fitcal() + " simulate --model asoc --seed 3 --out " + dir.string();
   } else {
-    const char* shared = std::getenv("FITCAL_SHARED_DIR");
-    const fs::path source =
-        fs::path(shared != nullptr ? shared : FITCAL_SHARED_DIR) / "data" / "optiodom" / name;
+    const fs::path source = fs::path(FITCAL_SHARED_DIR) / "data" / "optiodom" / name;
     if (!fs::is_directory(source / "circular")) {
       *error = "no shared data at " + source.string();
       return "";

@@ -42,7 +42,7 @@ struct ImportedLoops {
 
 ImportedLoops ImportLoops(const std::string& robot) {
   ImportedLoops out;
-  const fs::path source = bench::SharedDir(FITCAL_SHARED_DIR) / "data" / "optiodom" / robot;
+  const fs::path source = fs::path(FITCAL_SHARED_DIR) / "data" / "optiodom" / robot;
   if (!fs::is_directory(source / "circular") || !fs::is_directory(source / "square")) {
     out.error = "no shared data at " + source.string();
     return out;
