@@ -12,6 +12,7 @@
 
 #include "fit/ceres_problem.h"
 #include "fit/correlation.h"
+#include "fit/last_evaluation_memo.h"
 #include "fit/model_fit.h"
 #include "odometry/parallel_for.h"
 
@@ -412,10 +413,13 @@ EffectFitResult FitEffectModel(const std::vector<TrackRun>& training,
   std::vector<double*> blocks = {p};
   for (auto& e : result.effects) blocks.push_back(e.value.data());
   std::vector<ceres::ResidualBlockId> runs;
+  // Each run's block behind a memo: Ceres' bounded line search evaluates a step's end with
+  // Jacobians and the successful step evaluates it again (fit/last_evaluation_memo.h).
   for (const TrackRun& run : training) {
     runs.push_back(problem.AddResidualBlock(
-        EffectTrackResidual::Create(robot_model, run, ids, options.weights), MakeLoss(options),
-        blocks));
+        new LastEvaluationMemo(
+            EffectTrackResidual::Create(robot_model, run, ids, options.weights)),
+        MakeLoss(options), blocks));
   }
   BoundModelBlock(robot, HoldAtNominal(robot, p), p, &problem);
   const int num_effect_parameters = BoundEffectParameters(options, &result.effects, &problem);
