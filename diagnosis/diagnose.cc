@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 
 #include "fit/statistics.h"
@@ -121,9 +122,11 @@ std::vector<EffectId> DefaultCandidates(const Robot& robot) {
 // test at round->threshold, a mean improvement, a falling BIC; then, in order of mean
 // improvement, the explanation of the lack of fit (only where the base leaves significant lack
 // of fit); the first candidate passing all is accepted. Sets every fitted candidate's rule flags
-// and verdict; returns the accepted candidate's index, or -1.
+// and verdict; returns the accepted candidate's index, or -1. *accepted_analysis gets the
+// accepted candidate's residual analysis of every run when the rule computed it.
 int DecideRound(const RobotModelInterface& model, const std::vector<TrackRun>& all, bool base_lof,
-                int threads, DiagnoseRound* round) {
+                int threads, DiagnoseRound* round,
+                std::optional<ResidualAnalysis>* accepted_analysis) {
   std::vector<int> order;
   for (int i = 0; i < static_cast<int>(round->candidates.size()); ++i) {
     CandidateResult& c = round->candidates[i];
@@ -140,17 +143,18 @@ int DecideRound(const RobotModelInterface& model, const std::vector<TrackRun>& a
   for (int i : order) {
     CandidateResult& c = round->candidates[i];
     c.explains = true;
+    std::optional<ResidualAnalysis> with;
     if (base_lof) {
-      const ResidualAnalysis with =
-          AnalyzeResiduals(model, c.fit.parameters, c.fit.effects, all, threads);
-      c.lof_f = with.lack_of_fit.f;
-      c.lof_p = with.lack_of_fit.p_value;
+      with = AnalyzeResiduals(model, c.fit.parameters, c.fit.effects, all, threads);
+      c.lof_f = with->lack_of_fit.f;
+      c.lof_p = with->lack_of_fit.p_value;
       c.explained_fraction = ExplainedFraction(round->base_lof_f, c.lof_f);
-      c.leaves_no_lack_of_fit = !(with.lack_of_fit.available && c.lof_p < kLofAlpha);
+      c.leaves_no_lack_of_fit = !(with->lack_of_fit.available && c.lof_p < kLofAlpha);
       c.explains = c.explained_fraction >= kMinExplainedFraction || c.leaves_no_lack_of_fit;
     }
     if (c.explains) {
       best = i;
+      *accepted_analysis = std::move(with);
       break;
     }
   }
@@ -275,11 +279,35 @@ std::vector<EffectId> CandidateEffects(const DiagnoseContext& x, const EffectFit
   return candidates;
 }
 
-// The base of a round: the current model's held-out score and training BIC, and the residual's
+// What the tracing computes of one model (a fit's parameters and effects), computed once and
+// handed on: a candidate's score is, when it is accepted, the next round's base, and the last
+// round's base (or accepted candidate) is the final model that Conclude reports - the same
+// numbers from the same inputs, so each is computed only where it is first needed.
+struct ModelEvaluation {
+  ModelScore validation;                   // ScoreModel on the held-out runs
+  std::vector<double> validation_windows;  // WindowObjectives of the held-out runs
+  std::optional<ResidualAnalysis> all;     // AnalyzeResiduals on every run, once computed
+};
+
+ModelEvaluation EvaluateOnHeldOut(const DiagnoseContext& x, const EffectFitResult& fit) {
+  ModelEvaluation e;
+  e.validation = ScoreModel(x.model, fit.parameters, fit.effects, x.validation,
+                            x.options.fit.weights, x.threads);
+  e.validation_windows =
+      WindowObjectives(x.model, fit.parameters, fit.effects, x.validation, x.options.fit.weights);
+  return e;
+}
+
+const ResidualAnalysis& AnalysisOfAll(const DiagnoseContext& x, const EffectFitResult& fit,
+                                      ModelEvaluation* e) {
+  if (!e->all) e->all = AnalyzeResiduals(x.model, fit.parameters, fit.effects, x.all, x.threads);
+  return *e->all;
+}
+
+// The base of a round: the current model's evaluation and training BIC, and the residual's
 // degrees of freedom (3 per training run, less the fitted parameters; fit/effect_fit.h).
 struct RoundBase {
-  ModelScore validation;
-  std::vector<double> validation_windows;  // WindowObjectives of the held-out runs
+  const ModelEvaluation& evaluation;
   double bic = 0.0;
   int dof = 1;
 };
@@ -301,7 +329,8 @@ double PredictedSigma(double unexplained_norm, double residual_ss_with, int dof_
 // held-out paired improvement and BIC change. *tried: it was resolvable, so it counts in the
 // round's Bonferroni threshold.
 CandidateResult TryCandidate(const DiagnoseContext& x, const EffectFitResult& current,
-                             const RoundBase& base, EffectId id, bool* tried) {
+                             const RoundBase& base, EffectId id, bool* tried,
+                             ModelEvaluation* evaluation) {
   const Robot& robot = x.model.robot();
   CandidateResult c;
   c.id = id;
@@ -339,33 +368,26 @@ CandidateResult TryCandidate(const DiagnoseContext& x, const EffectFitResult& cu
     c.verdict = "fit failed: " + c.fit.termination;
     return c;
   }
-  const ModelScore val = ScoreModel(x.model, c.fit.parameters, c.fit.effects, x.validation,
-                                    x.options.fit.weights, x.threads);
-  c.validation_objective = val.objective;
-  PairedImprovement(base.validation_windows,
-                    WindowObjectives(x.model, c.fit.parameters, c.fit.effects, x.validation,
-                                     x.options.fit.weights),
-                    &c);
+  *evaluation = EvaluateOnHeldOut(x, c.fit);
+  c.validation_objective = evaluation->validation.objective;
+  PairedImprovement(base.evaluation.validation_windows, evaluation->validation_windows, &c);
   c.delta_bic = Bic(2.0 * c.fit.final_cost, static_cast<int>(x.training.size()),
                     NumParameters(robot, c.fit.effects)) -
                 base.bic;
   return c;
 }
 
-// One round of the tracing: every candidate not yet in the model tried on top of `current`, then
-// decided (DecideRound); *best is the accepted candidate's index, or -1.
+// One round of the tracing: every candidate not yet in the model tried on top of `current` (its
+// evaluation completed here), then decided (DecideRound); *best is the accepted candidate's
+// index, or -1, and *accepted its evaluation.
 DiagnoseRound RunRound(const DiagnoseContext& x, const EffectFitResult& current,
-                       const std::vector<EffectId>& candidates, int* best) {
+                       ModelEvaluation* evaluation, const std::vector<EffectId>& candidates,
+                       int* best, ModelEvaluation* accepted) {
   const Robot& robot = x.model.robot();
   DiagnoseRound round;
-  RoundBase base;
-  base.validation = ScoreModel(x.model, current.parameters, current.effects, x.validation,
-                               x.options.fit.weights, x.threads);
-  round.base_validation_objective = base.validation.objective;
-  base.validation_windows = WindowObjectives(x.model, current.parameters, current.effects,
-                                             x.validation, x.options.fit.weights);
-  const ResidualAnalysis base_all =
-      AnalyzeResiduals(x.model, current.parameters, current.effects, x.all, x.threads);
+  RoundBase base{*evaluation};
+  round.base_validation_objective = evaluation->validation.objective;
+  const ResidualAnalysis& base_all = AnalysisOfAll(x, current, evaluation);
   round.base_lof_available = base_all.lack_of_fit.available;
   round.base_lof_f = base_all.lack_of_fit.f;
   round.base_lof_p = base_all.lack_of_fit.p_value;
@@ -375,16 +397,23 @@ DiagnoseRound RunRound(const DiagnoseContext& x, const EffectFitResult& current,
                  NumParameters(robot, current.effects));
   base.dof = 3 * static_cast<int>(x.training.size()) - NumParameters(robot, current.effects);
   int num_tried = 0;
+  std::vector<ModelEvaluation> evaluations;  // one per entry of round.candidates
   for (EffectId id : candidates) {
     const bool in_model = std::any_of(current.effects.begin(), current.effects.end(),
                                       [&](const effects::EffectValue& e) { return e.id == id; });
     if (in_model) continue;
     bool tried = false;
-    round.candidates.push_back(TryCandidate(x, current, base, id, &tried));
+    evaluations.emplace_back();
+    round.candidates.push_back(TryCandidate(x, current, base, id, &tried, &evaluations.back()));
     num_tried += tried ? 1 : 0;
   }
   round.threshold = x.options.alpha / std::max(1, num_tried);
-  *best = DecideRound(x.model, x.all, base_lof, x.threads, &round);
+  std::optional<ResidualAnalysis> accepted_analysis;
+  *best = DecideRound(x.model, x.all, base_lof, x.threads, &round, &accepted_analysis);
+  if (*best >= 0) {
+    *accepted = std::move(evaluations[*best]);
+    accepted->all = std::move(accepted_analysis);
+  }
   return round;
 }
 
@@ -403,17 +432,22 @@ void NoteUnresolvable(const DiagnoseRound& round, std::vector<std::string>* prac
 }
 
 // 3. Tracing: rounds until no candidate is accepted or max_effects are in the model; returns the
-// final model.
+// final model, and *evaluation its evaluation (what the rounds computed of it).
 EffectFitResult Trace(const DiagnoseContext& x, const std::vector<EffectId>& candidates,
-                      DiagnoseResult* out) {
+                      DiagnoseResult* out, ModelEvaluation* evaluation) {
   EffectFitResult current = out->base;
+  *evaluation = EvaluateOnHeldOut(x, current);
   std::vector<std::string> practically_aliased;
   const bool have_validation = !x.validation.empty();
   while (have_validation && static_cast<int>(current.effects.size()) < x.options.max_effects) {
     int best = -1;
-    DiagnoseRound round = RunRound(x, current, candidates, &best);
+    ModelEvaluation accepted;
+    DiagnoseRound round = RunRound(x, current, evaluation, candidates, &best, &accepted);
     NoteUnresolvable(round, &practically_aliased);
-    if (best >= 0) current = round.candidates[best].fit;
+    if (best >= 0) {
+      current = round.candidates[best].fit;
+      *evaluation = std::move(accepted);
+    }
     out->rounds.push_back(std::move(round));
     if (best < 0) break;
   }
@@ -425,11 +459,12 @@ EffectFitResult Trace(const DiagnoseContext& x, const std::vector<EffectId>& can
 }
 
 // 4. After: the final model's residual, its tests, and what to record next.
-void Conclude(const DiagnoseContext& x, const EffectFitResult& current, DiagnoseResult* out) {
+void Conclude(const DiagnoseContext& x, const EffectFitResult& current,
+              ModelEvaluation* evaluation, DiagnoseResult* out) {
   out->final_fit = current;
-  out->final_validation = ScoreModel(x.model, current.parameters, current.effects, x.validation,
-                                     x.options.fit.weights, x.threads);
-  out->after = AnalyzeResiduals(x.model, current.parameters, current.effects, x.all, x.threads);
+  out->final_validation = evaluation->validation;
+  AnalysisOfAll(x, current, evaluation);
+  out->after = std::move(*evaluation->all);
   out->covariates = AnalyzeCovariates(out->after, kCovariateAlpha);
   out->lack_of_fit =
       out->after.lack_of_fit.available && out->after.lack_of_fit.p_value < kLofAlpha;
@@ -501,8 +536,9 @@ DiagnoseResult Diagnose(const std::vector<TrackRun>& training,
   // 2. The base: the model's parameters on the tracks.
   out.base = FitEffectModel(training, model, out.declared.parameters, {}, options.fit);
   const std::vector<EffectId> candidates = CandidateEffects(x, out.base, &out.not_identifiable);
-  const EffectFitResult final_fit = Trace(x, candidates, &out);
-  Conclude(x, final_fit, &out);
+  ModelEvaluation evaluation;
+  const EffectFitResult final_fit = Trace(x, candidates, &out, &evaluation);
+  Conclude(x, final_fit, &evaluation, &out);
   return out;
 }
 
