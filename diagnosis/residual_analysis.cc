@@ -456,8 +456,13 @@ void AccumulateByFeatures(const RunFeatures& f, const Pose2d& e,
 // The phase of the motion at `mid` (s since the window's start), from the sample context:
 // rest, cruise, accelerate or decelerate by the largest wheel acceleration.
 const char* PhaseAt(const TrackRun& run, double mid) {
-  std::size_t k = 0;
-  while (k + 1 < run.contexts.size() && run.contexts[k + 1].t_s <= mid) ++k;
+  // The last sample starting at or before `mid` (the first when none does); the samples are in
+  // time order, so a binary search finds it (a scan from the first, per ground-truth sample, made
+  // the error-growth table quadratic in a run's length).
+  const auto after = std::upper_bound(
+      run.contexts.begin() + 1, run.contexts.end(), mid,
+      [](double t, const effects::SampleContext& context) { return t < context.t_s; });
+  const std::size_t k = static_cast<std::size_t>(after - run.contexts.begin()) - 1;
   const auto& c = run.contexts[k];
   double accel = 0.0, dir = 0.0;
   for (int w = 0; w < c.num_channels; ++w) {
