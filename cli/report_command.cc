@@ -83,8 +83,7 @@ void PrintReport(const ReportCommandOptions& options, const io::ReportData& data
   std::printf("  ATE RMSE [m] (Eq. 12)  %.4f -> %.4f  (change %+.1f %%)\n",
               all.before.rms_distance_m, all.after.rms_distance_m,
               -ImprovementPercent(all.before.rms_distance_m, all.after.rms_distance_m));
-  int worse = 0;
-  for (const io::ReportRun& r : data.runs) worse += io::GotWorse(r) ? 1 : 0;
+  const int worse = io::WorseRunCount(data);
   if (worse > 0)
     std::printf("  held-out runs that got worse: %d of %zu\n", worse, data.runs.size());
   for (const std::string& line : data.identifiability_lines) std::printf("%s\n", line.c_str());

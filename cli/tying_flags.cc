@@ -2,6 +2,8 @@
 
 #include <cstdio>
 
+#include "io/text_file.h"
+
 namespace fitcal::tools {
 
 void AddTyingFlags(CLI::App& app, TyingFlags& flags) {
@@ -15,9 +17,10 @@ void AddTyingFlags(CLI::App& app, TyingFlags& flags) {
 
 std::string ReadTying(const TyingFlags& flags, const Robot& robot, ParameterTying* tying) {
   *tying = {};
-  for (const std::string& group : flags.tie) tying->groups.push_back(SplitParameterNames(group));
+  // "R_a, R_b,R_c" -> {"R_a", "R_b", "R_c"}; empty names are kept, so that CheckTying refuses them.
+  for (const std::string& group : flags.tie) tying->groups.push_back(io::SplitCsvFields(group));
   for (const std::string& name : flags.hold) {
-    for (const std::string& n : SplitParameterNames(name)) tying->held.push_back(n);
+    for (const std::string& n : io::SplitCsvFields(name)) tying->held.push_back(n);
   }
   return CheckTying(robot, *tying);
 }

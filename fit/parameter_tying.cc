@@ -134,10 +134,6 @@ Interval Intersection(const Robot& robot, const std::vector<int>& members) {
 
 }  // namespace
 
-std::vector<std::string> SplitParameterNames(const std::string& text) {
-  return io::SplitCsvFields(text);
-}
-
 std::string CheckTying(const Robot& robot, const ParameterTying& tying) {
   std::vector<std::vector<int>> groups;
   std::vector<int> held;

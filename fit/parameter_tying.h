@@ -31,10 +31,6 @@ struct ParameterTying {
   bool empty() const { return groups.empty() && held.empty(); }
 };
 
-// "R_a,R_b,R_c" -> {"R_a", "R_b", "R_c"} (spaces around names dropped; empty names kept, so that
-// CheckTying refuses them).
-std::vector<std::string> SplitParameterNames(const std::string& text);
-
 // "" when `tying` can be applied to `robot`, otherwise one line saying what is wrong: an unknown
 // name (with the robot's names), a name used twice, a group of fewer than two, a tied parameter
 // the model holds, or tied parameters whose bounds do not overlap.

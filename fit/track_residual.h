@@ -57,8 +57,6 @@ enum class TrackHeading { kFromStart, kIncrements };
 const char* ToString(TrackHeading heading);  // "from-start", "increments"
 bool ParseTrackHeading(const std::string& text, TrackHeading* out);
 
-inline constexpr double kMaxClockOffsetS = 0.5;  // |dt| bound of the clock offsets
-
 struct TrackResidualOptions {
   double checkpoint_spacing_m = 0.5;  // OptiOdom's
   TrackHeading heading = TrackHeading::kFromStart;

@@ -5,15 +5,15 @@
 
 #include "io/input_error.h"
 #include "io/yaml_reader.h"
+#include "odometry/aligned_run.h"
 
 namespace fitcal::io {
 
 namespace {
 
-// The bound of the track fit's clock offsets (fit/track_residual.h, kMaxClockOffsetS; io/ sits
-// below fit/ and cannot include it): a recorded offset beyond it was
+// The bound of the track fit's clock offsets (kMaxClockOffsetS): a recorded offset beyond it was
 // not written by fit. The last digit of a written value may round past it.
-constexpr double kMaxRecordedClockOffsetS = 0.5 + 1e-9;
+constexpr double kMaxRecordedClockOffsetS = kMaxClockOffsetS + 1e-9;
 
 // The block of a parsed file, or a null node for a plain robot YAML.
 YAML::Node CalibrationNode(const YAML::Node& root, const std::string& path) {

@@ -300,14 +300,12 @@ double GroundTruthReach(const GroundTruthTrack& track) {
   return reach_m;
 }
 
-bool GroundTruthMoves(const GroundTruthTrack& track) { return GroundTruthReach(track) > kMovedM; }
-
 void RejectDataSetWithoutMotion(const DatasetIndex& index, const std::vector<RunLog>& runs,
                                 const Robot& robot) {
   bool wheels = false, ground_truth = false;
   for (const RunLog& run : runs) {
     wheels = wheels || AnyWheelTurns(run.encoders.samples, robot);
-    ground_truth = ground_truth || GroundTruthMoves(run.ground_truth);
+    ground_truth = ground_truth || GroundTruthReach(run.ground_truth) > kMovedM;
   }
   const std::string n = std::to_string(runs.size());
   if (!wheels) {

@@ -17,6 +17,9 @@
 
 namespace fitcal {
 
+// Here, below fit/ (whose track fit estimates the offsets) and io/ (which reads them recorded).
+inline constexpr double kMaxClockOffsetS = 0.5;  // |dt| bound of the clock offsets
+
 struct AlignedRun {
   std::string id;
   std::string trajectory;

@@ -79,8 +79,7 @@ void HtmlVerdict(std::ostringstream& h, const ReportData& d) {
 void HtmlKeyNumbers(std::ostringstream& h, const ReportData& d) {
   if (d.summary.empty()) return;
   const ReportSummaryRow& all = d.summary.back();
-  int worse = 0;
-  for (const ReportRun& r : d.runs) worse += GotWorse(r) ? 1 : 0;
+  const int worse = WorseRunCount(d);
   h << "<ul class=\"key\" id=\"key\">\n<li>ATE RMSE (mean over " << all.runs
     << " held-out runs, no alignment): <b>" << Fmt("%.1f", 1e3 * all.before.rms_distance_m)
     << " &rarr; " << Fmt("%.1f mm", 1e3 * all.after.rms_distance_m) << "</b> ("

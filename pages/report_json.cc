@@ -66,12 +66,6 @@ std::string JsonTrajectories(const ReportData& d) {
          }) + "]";
 }
 
-int WorseCount(const ReportData& d) {
-  int n = 0;
-  for (const ReportRun& r : d.runs) n += GotWorse(r) ? 1 : 0;
-  return n;
-}
-
 std::string JsonDrift(const ReportData& d) {
   return "[" + Joined(d.drift, ", ", [](const ReportDriftRow& r) {
            return "{\"length_m\": " + JsonNumber(r.length_m) +
@@ -253,7 +247,7 @@ std::string MetricsJson(const ReportData& d) {
     << ",\n  \"training_source\": " << JsonString(d.training_source)
     << ",\n  \"effects\": " << JsonEffects(d) << ",\n  \"per_trajectory\": " << JsonTrajectories(d)
     << ",\n  \"held_out_runs\": " << d.runs.size()
-    << ",\n  \"held_out_runs_worse\": " << WorseCount(d) << ",\n  \"ate_rmse_m\": "
+    << ",\n  \"held_out_runs_worse\": " << WorseRunCount(d) << ",\n  \"ate_rmse_m\": "
     << (all ? JsonBeforeAfter(all->before.rms_distance_m, all->after.rms_distance_m) : "null")
     << ",\n  \"cf\": " << (all ? JsonBeforeAfter(all->before.cf, all->after.cf) : "null")
     << ",\n  \"drift\": " << JsonDrift(d) << ",\n  \"comparison\": " << JsonComparison(d)

@@ -5,6 +5,7 @@
 // report_csv.h, report_tum.h, report_figures.h). Nothing here computes. Angles are radians in the
 // model and degrees in the outputs (columns ending _deg).
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -219,5 +220,10 @@ struct ReportData {
   ReportStatistics cv_cf_after, cv_cf_before;
   std::vector<ReportWorldTrack> world_tracks;  // one per validation run, in the order of runs
 };
+
+// The held-out runs that got worse (GotWorse): the page's key numbers, metrics.json, `report`.
+inline int WorseRunCount(const ReportData& data) {
+  return static_cast<int>(std::count_if(data.runs.begin(), data.runs.end(), GotWorse));
+}
 
 }  // namespace fitcal::io

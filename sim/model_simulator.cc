@@ -46,14 +46,13 @@ class Rng {
 // boundary (header).
 class TwistProfile {
  public:
-  TwistProfile(const std::vector<TwistSegment>& segments, const SimulationOptions& options)
-      : ramp_s_(options.ramp_time_s) {
+  TwistProfile(const std::vector<TwistSegment>& segments, const SimulationOptions& options) {
     levels_.push_back(Twist{});
     double t = options.rest_before_s;
     for (const TwistSegment& s : segments) {
-      if (!(s.duration_s >= ramp_s_)) {
+      if (!(s.duration_s >= kRampTimeS)) {
         throw std::invalid_argument("a trajectory segment of " + std::to_string(s.duration_s) +
-                                    " s is shorter than the ramp (" + std::to_string(ramp_s_) +
+                                    " s is shorter than the ramp (" + std::to_string(kRampTimeS) +
                                     " s)");
       }
       boundaries_.push_back(t);
@@ -71,14 +70,14 @@ class TwistProfile {
     const std::size_t j = static_cast<std::size_t>(
         std::upper_bound(boundaries_.begin(), boundaries_.end(), t) - boundaries_.begin());
     // The ramps of boundary j-1 (ending) and j (starting); at most one covers t.
-    if (j > 0 && t - boundaries_[j - 1] < 0.5 * ramp_s_) return Blend(j - 1, t);
-    if (j < boundaries_.size() && boundaries_[j] - t < 0.5 * ramp_s_) return Blend(j, t);
+    if (j > 0 && t - boundaries_[j - 1] < 0.5 * kRampTimeS) return Blend(j - 1, t);
+    if (j < boundaries_.size() && boundaries_[j] - t < 0.5 * kRampTimeS) return Blend(j, t);
     return levels_[j];
   }
 
  private:
   Twist Blend(std::size_t boundary, double t) const {
-    const double u = (t - boundaries_[boundary] + 0.5 * ramp_s_) / ramp_s_;
+    const double u = (t - boundaries_[boundary] + 0.5 * kRampTimeS) / kRampTimeS;
     const double s = 0.5 * (1.0 - std::cos(M_PI * std::clamp(u, 0.0, 1.0)));
     const Twist& a = levels_[boundary];
     const Twist& b = levels_[boundary + 1];
@@ -86,7 +85,6 @@ class TwistProfile {
             a.omega_rad_s + s * (b.omega_rad_s - a.omega_rad_s)};
   }
 
-  double ramp_s_;
   double end_s_ = 0.0;
   std::vector<double> boundaries_;
   std::vector<Twist> levels_;  // levels_[j] holds before boundaries_[j]
@@ -276,9 +274,8 @@ std::string SimulationOptions::Check(int num_channels) const {
   if (!(encoder_period_s > 0.0) || !(ground_truth_period_s > 0.0) || !(substep_s > 0.0)) {
     return "encoder_period_s, ground_truth_period_s and substep_s must be positive";
   }
-  if (!(ramp_time_s > 0.0)) return "ramp_time_s must be positive";
   // The stepped physics has no ramps (the controller lag smooths the commands).
-  const double half_ramp_s = stepped ? 0.0 : 0.5 * ramp_time_s;
+  const double half_ramp_s = stepped ? 0.0 : 0.5 * kRampTimeS;
   if (!(rest_before_s >= half_ramp_s) || !(rest_after_s >= half_ramp_s)) {
     return "rest_before_s and rest_after_s must hold half a ramp";
   }

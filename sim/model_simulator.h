@@ -5,10 +5,10 @@
 // motion and noise models (docs/simulate.md: their tables of effects and defaults): with
 // SimulationOptions::stepped the flower's time-stepped physics (SteppedOptions below), without it
 // perfect tracking:
-// - Commanded twist: raised-cosine ramps of ramp_time_s centred on every segment boundary (from
+// - Commanded twist: raised-cosine ramps of kRampTimeS centred on every segment boundary (from
 //   and back to rest too), v(t) = v_prev + (v_next - v_prev) (1 - cos(pi u)) / 2,
 //   u = (t - t_b + ramp/2) / ramp. The ramp is antisymmetric about the boundary, so every segment
-//   keeps its integral (v T metres, omega T radians); segments must last at least ramp_time_s.
+//   keeps its integral (v T metres, omega T radians); segments must last at least kRampTimeS.
 // - The true robot follows it exactly: ChannelsForTwist(p_true, v(t)) at the middle of each step
 //   of a fine grid (steps <= substep_s, every encoder and ground-truth time a grid point; a twist
 //   the model cannot drive is an error), replayed with p_true for the ground truth, sampled every
@@ -84,11 +84,12 @@ struct SteppedOptions {
   SteppedHook hook;  // anything else, after the library effects
 };
 
+inline constexpr double kRampTimeS = 0.4;  // the commanded twist's ramps (above)
+
 struct SimulationOptions {
   double encoder_period_s = 0.05;
   double ground_truth_period_s = 0.1;
   double substep_s = 0.002;  // longest step of the fine truth grid
-  double ramp_time_s = 0.4;
   double rest_before_s = 0.5;
   double rest_after_s = 0.5;
 
@@ -109,7 +110,7 @@ struct SimulationOptions {
 
   std::uint64_t seed = 1;
 
-  // Set: the flower's time-stepped physics (above) in place of perfect tracking; ramp_time_s,
+  // Set: the flower's time-stepped physics (above) in place of perfect tracking; the ramps,
   // ground_truth_period_s and wheel_rate_sigma_rad_s are then unused.
   std::optional<SteppedOptions> stepped;
   // Set: the model integrates channels of its own state (ModelExtras::scenario.dynamics: an

@@ -22,6 +22,7 @@
 #include "fit/model_fit.h"
 #include "fit/segment_cost.h"
 #include "fit/track_residual.h"
+#include "io/text_file.h"
 #include "models/diff_drive/diff_drive_model.h"
 #include "models/model_registry.h"
 #include "models/omni3/omni3_robot_model.h"
@@ -186,7 +187,7 @@ TEST(ParameterTying, WrongNamesAreRefused) {
   ParameterTying alone;
   alone.groups = {{"R_a"}};
   EXPECT_FALSE(CheckTying(robot, alone).empty());
-  EXPECT_EQ(SplitParameterNames(" R_a, R_b ,R_c"), (std::vector<std::string>{"R_a", "R_b", "R_c"}));
+  EXPECT_EQ(io::SplitCsvFields(" R_a, R_b ,R_c"), (std::vector<std::string>{"R_a", "R_b", "R_c"}));
 }
 
 TEST(ParameterTying, FitCommandTiesAndRefusesUnknownNames) {

@@ -313,7 +313,7 @@ TEST_F(MalformedImport, TopicTypeJointAndStamps) {
     std::vector<std::pair<std::string, std::vector<std::uint8_t>>> all;
     std::vector<std::int64_t> times;
     while (once.ReadNext(&m)) {
-      all.emplace_back(m.topic->name, m.payload.ToVector());
+      all.push_back({m.topic->name, {m.payload.data, m.payload.data + m.payload.size}});
       times.push_back(m.time_ns);
     }
     for (int pass = 0; pass < 2; ++pass) {

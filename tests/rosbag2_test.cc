@@ -46,7 +46,8 @@ std::vector<ReadMessage> ReadAll(BagReader& bag) {
   std::vector<ReadMessage> out;
   BagMessage m;
   while (bag.ReadNext(&m)) {
-    out.push_back({m.topic->name, m.topic->type, m.time_ns, m.payload.ToVector(), Describe(m)});
+    std::vector<std::uint8_t> payload(m.payload.data, m.payload.data + m.payload.size);
+    out.push_back({m.topic->name, m.topic->type, m.time_ns, std::move(payload), Describe(m)});
   }
   return out;
 }

@@ -10,7 +10,7 @@
 // while the robot moves starts and ends on a ground-truth pose that is off by the motion over the
 // lag, and its start heading error turns its whole path. A run starts and ends at rest; its
 // blocks do not. Each boundary therefore moves, within a quarter of a block's path of its
-// equal-path place, to where a clock error of up to kMaxClockOffsetS (fit/track_residual.h)
+// equal-path place, to where a clock error of up to kMaxClockOffsetS (odometry/aligned_run.h)
 // moves the ground truth's pose least. Measured (issue 40): the nominal's mean CF on the held-out
 // blocks of the omni3 joystick run 0.133 -> 0.080; the first half of the diff drive's free run,
 // refused before (its fit takes the other half's CF 0.057 -> 0.013), is written.

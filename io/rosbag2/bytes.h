@@ -4,7 +4,6 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <string>
 #include <vector>
 
 namespace fitcal::io::rosbag2 {
@@ -20,7 +19,6 @@ struct ByteView {
       : data(bytes.data()), size(bytes.size()) {}
 
   ByteView Sub(std::size_t offset, std::size_t count) const { return {data + offset, count}; }
-  std::vector<std::uint8_t> ToVector() const { return {data, data + size}; }
 };
 
 // Loads an unsigned integer of sizeof(T) bytes stored little-endian at `p`.

@@ -15,9 +15,9 @@ TrajectorySpec UmbmarkSquare(bool clockwise, int repetition,
   for (int corner = 0; corner < 4; ++corner) {
     spec.segments.push_back(
         {{options.speed_m_s, 0.0, 0.0}, options.square_side_m / options.speed_m_s});
-    spec.segments.push_back({{}, options.pause_s});
+    spec.segments.push_back({{}, kUmbmarkPauseS});
     spec.segments.push_back({{0.0, 0.0, turn}, 0.5 * M_PI / options.turn_rate_rad_s});
-    spec.segments.push_back({{}, options.pause_s});
+    spec.segments.push_back({{}, kUmbmarkPauseS});
   }
   spec.segments.pop_back();  // the run's rest_after_s ends it
   return spec;

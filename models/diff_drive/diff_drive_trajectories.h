@@ -10,11 +10,13 @@
 
 namespace fitcal::sim {
 
+// At rest before and after every corner of a square (as UMBmark stops).
+inline constexpr double kUmbmarkPauseS = 0.6;
+
 struct DiffDriveTrajectoryOptions {
   double square_side_m = 1.0;  // Borenstein & Feng used 4 m; OptiOdom 0.75 and 1.7 m
   double speed_m_s = 0.2;
   double turn_rate_rad_s = 0.6;  // on the spot, at the square's corners
-  double pause_s = 0.6;          // at rest before and after every corner (as UMBmark stops)
   std::vector<double> circle_radii_m = {0.5, 1.0};
   double circle_laps = 1.0;  // < 1 or non-integer: an open arc (its end pose sees the scale)
 };

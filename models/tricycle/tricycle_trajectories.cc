@@ -14,7 +14,7 @@ namespace {
 // 2 pi turns in 2 pi turns / |omega|.
 TwistSegment Circle(const TricycleTrajectoryOptions& o, double steering_rad) {
   const double omega = o.speed_m_s * std::tan(steering_rad) / o.wheelbase_m;
-  return {Twist{o.speed_m_s, 0.0, omega}, 2.0 * M_PI * o.circle_turns / std::abs(omega)};
+  return {Twist{o.speed_m_s, 0.0, omega}, 2.0 * M_PI * kCircleTurns / std::abs(omega)};
 }
 
 // A quarter turn (sign +1 = ccw): in place, or an arc at the largest steering the robot reads.
@@ -44,7 +44,6 @@ std::vector<TwistSegment> Square(const TricycleTrajectoryOptions& o, double sign
 std::string TricycleTrajectoryOptions::Check() const {
   if (!(wheelbase_m > 0.0)) return "wheelbase_m must be positive";
   if (!(speed_m_s > 0.0)) return "speed_m_s must be positive";
-  if (!(circle_turns > 0.0)) return "circle_turns must be positive";
   if (!(square_side_m > 0.0)) return "square_side_m must be positive";
   if (!(turn_rate_rad_s > 0.0)) return "turn_rate_rad_s must be positive";
   if (repetitions < 1) return "repetitions must be at least 1";

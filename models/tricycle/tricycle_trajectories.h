@@ -2,7 +2,7 @@
 // Calibration trajectories for a tricycle (models/tricycle/), as twist segments for the generic
 // simulator (sim/model_simulator.h):
 //
-//   circle_<dir>_<deg>  circle_turns turns (default 1.25) at a constant steering angle
+//   circle_<dir>_<deg>  kCircleTurns turns (1.25) at a constant steering angle
 //                       phi' = deg, counter-clockwise (ccw, phi' > 0) and clockwise (cw), for each
 //                       angle of steering_deg: forward speed v and yaw rate
 //                       omega = v tan(phi') / L, so the rear axle's centre traces the arc of
@@ -29,11 +29,12 @@
 
 namespace fitcal::sim {
 
+inline constexpr double kCircleTurns = 1.25;  // not a whole number: see "open on purpose" above
+
 struct TricycleTrajectoryOptions {
   double wheelbase_m = 0.15;  // the L used to turn steering angles into yaw rates (nominal)
   double speed_m_s = 0.1;     // forward speed of the rear axle's centre
   std::vector<double> steering_deg = {10.0, 20.0, 30.0, 45.0};  // circles, each both ways
-  double circle_turns = 1.25;  // not a whole number: see "open on purpose" above
   double square_side_m = 1.0;
   double turn_rate_rad_s = 0.4;  // in-place turns at the square's corners
   // The largest steering angle the robot can drive and read (0, 90] deg. Below 90 the square's

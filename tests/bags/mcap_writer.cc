@@ -29,7 +29,7 @@ void AppendString(Bytes* out, const std::string& text) {
 // with the content size recorded.
 std::vector<std::uint8_t> Compress(Compression compression, ByteView input) {
   std::vector<std::uint8_t> out;
-  if (compression == Compression::kNone) return input.ToVector();
+  if (compression == Compression::kNone) return {input.data, input.data + input.size};
   if (compression == Compression::kZstd) {
     out.resize(ZSTD_compressBound(input.size));
     const std::size_t n = ZSTD_compress(out.data(), out.size(), input.data, input.size, 1);
