@@ -334,16 +334,10 @@ CandidateResult TryCandidate(const DiagnoseContext& x, const EffectFitResult& cu
   const Robot& robot = x.model.robot();
   CandidateResult c;
   c.id = id;
-  EffectModel start = current.effects;
-  effects::EffectValue neutral;
-  neutral.id = id;
-  start.push_back(neutral);
-  // One set of residuals for the separability and the fit: the fit starts where it was evaluated.
-  const EffectTrackCosts costs(x.training, x.model, start, x.options.fit.weights);
   double unexplained = 0.0, asked = 0.0, residual_ss_with = 0.0;
   c.separable_fraction =
       SeparableFraction(x.training, x.model, current.parameters, current.effects, id,
-                        x.options.fit.weights, &unexplained, &asked, &residual_ss_with, &costs);
+                        x.options.fit.weights, &unexplained, &asked, &residual_ss_with);
   const auto& info = effects::Info(id);
   c.predicted_sigma =
       PredictedSigma(unexplained, residual_ss_with, base.dof - info.num_parameters);
@@ -362,9 +356,13 @@ CandidateResult TryCandidate(const DiagnoseContext& x, const EffectFitResult& cu
     c.verdict = "cannot be told apart from the model on these runs";
     return c;
   }
+  EffectModel start = current.effects;
+  effects::EffectValue neutral;
+  neutral.id = id;
+  start.push_back(neutral);
   EffectFitOptions fit_options = x.options.fit;
   fit_options.held_effect_parameters = LateralOnlyParameters(x.model, start);
-  c.fit = FitEffectModel(x.training, x.model, current.parameters, start, fit_options, &costs);
+  c.fit = FitEffectModel(x.training, x.model, current.parameters, start, fit_options);
   c.fitted = c.fit.usable;
   if (!c.fitted) {
     c.verdict = "fit failed: " + c.fit.termination;

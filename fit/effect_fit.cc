@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <memory>
 #include <stdexcept>
 
 #include "fit/ceres_problem.h"
@@ -162,50 +161,7 @@ std::vector<EffectId> IdsOf(const EffectModel& model) {
   return ids;
 }
 
-// The costs to use: the caller's, checked to be these runs' with these effects and weights, or
-// built here into *own.
-const EffectTrackCosts& CostsFor(const std::vector<TrackRun>& training,
-                                 const RobotModelInterface& robot_model,
-                                 const EffectModel& effects, const ResidualWeights& weights,
-                                 const EffectTrackCosts* given,
-                                 std::unique_ptr<EffectTrackCosts>* own) {
-  if (given == nullptr) {
-    *own = std::make_unique<EffectTrackCosts>(training, robot_model, effects, weights);
-    return **own;
-  }
-  if (!given->Serves(training, effects, weights)) {
-    throw std::invalid_argument("EffectTrackCosts: built for other runs, effects or weights");
-  }
-  return *given;
-}
-
-// A problem that uses the costs without owning them (EffectTrackCosts does).
-ceres::Problem::Options BorrowingCosts() {
-  ceres::Problem::Options o;
-  o.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  return o;
-}
-
 }  // namespace
-
-EffectTrackCosts::EffectTrackCosts(const std::vector<TrackRun>& training,
-                                   const RobotModelInterface& robot_model,
-                                   const EffectModel& effects, const ResidualWeights& weights)
-    : training_(training), ids_(IdsOf(effects)), weights_(weights) {
-  for (const TrackRun& run : training) {
-    runs_.emplace_back(new LastEvaluationMemo(
-        EffectTrackResidual::Create(robot_model, run, ids_, weights)));
-  }
-}
-
-EffectTrackCosts::~EffectTrackCosts() = default;
-
-bool EffectTrackCosts::Serves(const std::vector<TrackRun>& training, const EffectModel& effects,
-                              const ResidualWeights& weights) const {
-  return &training == &training_ && IdsOf(effects) == ids_ &&
-         weights.position_sigma_m == weights_.position_sigma_m &&
-         weights.heading_sigma_rad == weights_.heading_sigma_rad;
-}
 
 unsigned WheelChannelMask(const Robot& robot) {
   unsigned mask = 0;
@@ -439,7 +395,7 @@ bool CheckEffectValues(const std::vector<double>& p, EffectFitResult* result) {
 EffectFitResult FitEffectModel(const std::vector<TrackRun>& training,
                                const RobotModelInterface& robot_model,
                                const std::vector<double>& start_p, const EffectModel& start,
-                               const EffectFitOptions& options, const EffectTrackCosts* costs) {
+                               const EffectFitOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) throw std::invalid_argument("EffectFitOptions: " + error);
   if (training.empty()) throw std::invalid_argument("FitEffectModel: no training runs");
@@ -451,18 +407,19 @@ EffectFitResult FitEffectModel(const std::vector<TrackRun>& training,
   result.parameters = start_p;
   result.effects = start;
   double* p = result.parameters.data();
-  std::unique_ptr<EffectTrackCosts> own;
-  const EffectTrackCosts& track_costs =
-      CostsFor(training, robot_model, start, options.weights, costs, &own);
+  const std::vector<EffectId> ids = IdsOf(start);
 
-  ceres::Problem problem(BorrowingCosts());
+  ceres::Problem problem;
   std::vector<double*> blocks = {p};
   for (auto& e : result.effects) blocks.push_back(e.value.data());
   std::vector<ceres::ResidualBlockId> runs;
   // Each run's block behind a memo: Ceres' bounded line search evaluates a step's end with
   // Jacobians and the successful step evaluates it again (fit/last_evaluation_memo.h).
-  for (std::size_t i = 0; i < training.size(); ++i) {
-    runs.push_back(problem.AddResidualBlock(track_costs.run(i), MakeLoss(options), blocks));
+  for (const TrackRun& run : training) {
+    runs.push_back(problem.AddResidualBlock(
+        new LastEvaluationMemo(
+            EffectTrackResidual::Create(robot_model, run, ids, options.weights)),
+        MakeLoss(options), blocks));
   }
   BoundModelBlock(robot, HoldAtNominal(robot, p), p, &problem);
   const int num_effect_parameters = BoundEffectParameters(options, &result.effects, &problem);
@@ -500,22 +457,21 @@ double SeparableFraction(const std::vector<TrackRun>& training,
                          const RobotModelInterface& robot_model, const std::vector<double>& p,
                          const EffectModel& model, EffectId candidate,
                          const ResidualWeights& weights, double* unexplained_norm,
-                         double* linearized_size, double* linearized_residual_ss,
-                         const EffectTrackCosts* costs) {
+                         double* linearized_size, double* linearized_residual_ss) {
   EffectModel with = model;
   effects::EffectValue c;
   c.id = candidate;
   with.push_back(c);
-  std::unique_ptr<EffectTrackCosts> own;
-  const EffectTrackCosts& track_costs = CostsFor(training, robot_model, with, weights, costs, &own);
+  const std::vector<EffectId> ids = IdsOf(with);
   const int m_c = effects::Info(candidate).num_parameters;
   // The runs' residuals stacked, their Jacobian's columns in block order (model, then effects).
   std::vector<double> p_at = p;
   std::vector<double*> blocks = {p_at.data()};
   for (auto& e : with) blocks.push_back(e.value.data());
-  ceres::Problem problem(BorrowingCosts());
-  for (std::size_t i = 0; i < training.size(); ++i) {
-    problem.AddResidualBlock(track_costs.run(i), nullptr, blocks);
+  ceres::Problem problem;
+  for (const TrackRun& run : training) {
+    problem.AddResidualBlock(EffectTrackResidual::Create(robot_model, run, ids, weights), nullptr,
+                             blocks);
   }
   ceres::Problem::EvaluateOptions evaluate;
   evaluate.parameter_blocks = blocks;

@@ -16,7 +16,6 @@
 // double-valued scoring.
 
 #include <Eigen/Core>
-#include <memory>
 #include <string>
 #include <vector>
 
@@ -26,10 +25,6 @@
 #include "odometry/aligned_run.h"
 #include "odometry/effects.h"
 #include "odometry/run_log.h"
-
-namespace ceres {
-class CostFunction;
-}  // namespace ceres
 
 namespace fitcal {
 
@@ -196,29 +191,6 @@ struct EffectFitResult {
   bool any_at_bound = false;
 };
 
-// The training runs' track residuals (header) of one list of effects, each run's behind a
-// LastEvaluationMemo (fit/last_evaluation_memo.h), for SeparableFraction and FitEffectModel to
-// share: a candidate's fit starts at the very point where SeparableFraction evaluated it, so the
-// fit's first residuals and Jacobians are answered from that evaluation, bit for bit, instead of
-// replaying every run again (diagnose's TryCandidate). It refers to the runs and the model, which
-// outlive it.
-class EffectTrackCosts {
- public:
-  EffectTrackCosts(const std::vector<TrackRun>& training, const RobotModelInterface& robot_model,
-                   const EffectModel& effects, const ResidualWeights& weights);
-  ~EffectTrackCosts();
-  // Whether these are the residuals of these runs, effects (by id, in order) and weights.
-  bool Serves(const std::vector<TrackRun>& training, const EffectModel& effects,
-              const ResidualWeights& weights) const;
-  ceres::CostFunction* run(std::size_t i) const { return runs_[i].get(); }
-
- private:
-  const std::vector<TrackRun>& training_;
-  std::vector<effects::EffectId> ids_;
-  ResidualWeights weights_;
-  std::vector<std::unique_ptr<ceres::CostFunction>> runs_;
-};
-
 // Fits the model's parameters (started at start_p, bounded by the robot's box, held parameters
 // at their nominal) and the effects' parameters (started at the values in `start`, bounded by
 // the registry) to the training runs.
@@ -226,13 +198,10 @@ class EffectTrackCosts {
 // Covariance: Ceres' covariance scaled by s^2 = sum of run objectives (without the loss) /
 // (3 N_runs - k), i.e. each run counts as three independent residuals (a run's checkpoints are
 // correlated through the drift, so counting them all would understate the uncertainty).
-// `costs` (optional): the residuals to use, built for these runs, `start`'s effects and the
-// options' weights (std::invalid_argument otherwise); without them the fit builds its own.
 EffectFitResult FitEffectModel(const std::vector<TrackRun>& training,
                                const RobotModelInterface& robot_model,
                                const std::vector<double>& start_p, const EffectModel& start,
-                               const EffectFitOptions& options = {},
-                               const EffectTrackCosts* costs = nullptr);
+                               const EffectFitOptions& options = {});
 
 // How much of a candidate's influence on the training residuals lies outside what the model's
 // parameters (and the effects already in `model`) can produce: |(I - P) J_c| / |J_c| for the
@@ -246,14 +215,12 @@ EffectFitResult FitEffectModel(const std::vector<TrackRun>& training,
 // given solution (min |r + J delta|), so an effect larger than the registry's realistic
 // magnitude is seen as such before it is fitted; *linearized_residual_ss (optional, with
 // linearized_size) gets |r + J delta|^2 of that step, the residual's sum of squares with the
-// candidate in the model, from which its sigma is predicted (diagnose.h). `costs` (optional): as
-// FitEffectModel's, built for `model` with the candidate appended (neutral).
+// candidate in the model, from which its sigma is predicted (diagnose.h).
 double SeparableFraction(const std::vector<TrackRun>& training,
                          const RobotModelInterface& robot_model, const std::vector<double>& p,
                          const EffectModel& model, effects::EffectId candidate,
                          const ResidualWeights& weights = {}, double* unexplained_norm = nullptr,
                          double* linearized_size = nullptr,
-                         double* linearized_residual_ss = nullptr,
-                         const EffectTrackCosts* costs = nullptr);
+                         double* linearized_residual_ss = nullptr);
 
 }  // namespace fitcal
