@@ -77,12 +77,15 @@ BodyStep<T> SolveCastGeneral(const std::array<PivotPosition, kNumCastors>& pivot
   return out;
 }
 
+// How far a castor's displacement may miss the other two's CAST prediction before the redundancy
+// check below names it: an absolute part and a fraction of the step's length.
+inline constexpr double kConsistencyToleranceM = 0.5e-3;
+inline constexpr double kConsistencyToleranceFraction = 0.1;
+
 // The redundancy check (Doebbler Sec. III-B, end; header above): the castor whose displacement
 // (dx_i, dy_i) disagrees with the CAST prediction of the other two by more than
-// tolerance_m + tolerance_fraction * (the step length), or -1. psi: the heading the displacements
-// are expressed at (the body frame's, Eq. 13-14).
-inline constexpr double kConsistencyToleranceM = 0.5e-3;      // tolerance_m
-inline constexpr double kConsistencyToleranceFraction = 0.1;  // tolerance_fraction
+// kConsistencyToleranceM + kConsistencyToleranceFraction * (the step length), or -1. psi: the
+// heading the displacements are expressed at (the body frame's, Eq. 13-14).
 inline int InconsistentCastor(const std::array<PivotPosition, kNumCastors>& pivots, double psi,
                               const double* dx, const double* dy) {
   int suspect = -1;
