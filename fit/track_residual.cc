@@ -238,22 +238,37 @@ T Variable(double value, int dimension) {
 
 }  // namespace
 
+// The ground truth's pose at every checkpoint from the run's start, the ground truth read at
+// t + dt_s (the clock offset is Jet dimension 3): the start's rotation is formed once and each
+// checkpoint's pose once, where one Between per checkpoint, and another for the checkpoint before
+// it (kIncrements), formed them again - the same operations on the same numbers.
 template <typename T>
-Pose2<T> TrackResidual::GroundTruthAtStart(double dt_s) const {
-  return InterpolateGroundTruth(*track_.ground_truth, Variable<T>(track_.t_start_s + dt_s, 3));
+std::vector<Pose2<T>> TrackResidual::GroundTruthFromStartAt(double dt_s) const {
+  using std::cos;
+  using std::sin;
+  const GroundTruthTrack& ground_truth = *track_.ground_truth;
+  const Pose2<T> q0 = InterpolateGroundTruth(ground_truth, Variable<T>(track_.t_start_s + dt_s, 3));
+  const T c = cos(q0.theta), s = sin(q0.theta);
+  std::vector<Pose2<T>> out;
+  out.reserve(from_start_.size());
+  for (std::size_t k = 0; k < from_start_.size(); ++k) {
+    const Pose2<T> q = InterpolateGroundTruth(ground_truth, Variable<T>(track_.t_s[k] + dt_s, 3));
+    out.push_back(BetweenRotated(q0, c, s, q));
+  }
+  return out;
 }
 
-// r_k of the header for the odometry poses `pose` (3 per checkpoint), as Jets in (P_k, dt), or
-// its value on double (the Jets' value parts: the same operations on the same numbers).
+// r_k of the header for the odometry poses `pose` (3 per checkpoint) and the ground truth's from
+// GroundTruthFromStartAt, as Jets in (P_k, dt), or its value on double (the Jets' value parts:
+// the same operations on the same numbers).
 template <typename T>
-std::array<T, 3> TrackResidual::CheckpointResidual(const std::vector<double>& pose, int k,
-                                                   const Pose2<T>& q0, double dt_s) const {
+std::array<T, 3> TrackResidual::CheckpointResidual(
+    const std::vector<double>& pose, int k, const std::vector<Pose2<T>>& ground_truth) const {
   using std::cos;
   using std::sin;
   const Pose2<T> p{Variable<T>(pose[3 * k], 0), Variable<T>(pose[3 * k + 1], 1),
                    Variable<T>(pose[3 * k + 2], 2)};
-  const Pose2<T> q = Between(
-      q0, InterpolateGroundTruth(*track_.ground_truth, Variable<T>(track_.t_s[k] + dt_s, 3)));
+  const Pose2<T>& q = ground_truth[k];
   const double inv_xy = 1.0 / weights_.position_sigma_m;
   const double inv_th = 1.0 / weights_.heading_sigma_rad;
   const T cq = cos(q.theta), sq = sin(q.theta);
@@ -263,10 +278,7 @@ std::array<T, 3> TrackResidual::CheckpointResidual(const std::vector<double>& po
     // Minus the same error at checkpoint k - 1: the odometry's heading there (Jet dimension 4)
     // against the ground truth's.
     const T p_before = Variable<T>(pose[3 * (k - 1) + 2], 4);
-    const Pose2<T> q_before = Between(
-        q0,
-        InterpolateGroundTruth(*track_.ground_truth, Variable<T>(track_.t_s[k - 1] + dt_s, 3)));
-    heading_error = heading_error - (p_before - q_before.theta);
+    heading_error = heading_error - (p_before - ground_truth[k - 1].theta);
   }
   const T e[3] = {(cq * ex + sq * ey) * inv_xy, (-sq * ex + cq * ey) * inv_xy,
                   WrapAngle(heading_error) * inv_th};
@@ -296,10 +308,10 @@ std::vector<double> TrackResidual::OdometryFromStart(const double* p) const {
 }
 
 double TrackResidual::SquaredNormAt(const std::vector<double>& pose, double dt_s) const {
-  const Pose2d q0 = GroundTruthAtStart<double>(dt_s);
+  const std::vector<Pose2d> ground_truth = GroundTruthFromStartAt<double>(dt_s);
   double sum = 0.0;
   for (int k = 0; k < num_residuals() / 3; ++k) {
-    for (const double r : CheckpointResidual(pose, k, q0, dt_s)) sum += r * r;
+    for (const double r : CheckpointResidual(pose, k, ground_truth)) sum += r * r;
   }
   return sum;
 }
@@ -316,9 +328,9 @@ bool TrackResidual::Evaluate(double const* const* parameters, double* residuals,
     return false;
   }
   const double dt_s = parameters[1][0];
-  const Pose2<ErrorJet> q0 = GroundTruthAtStart<ErrorJet>(dt_s);
+  const std::vector<Pose2<ErrorJet>> ground_truth = GroundTruthFromStartAt<ErrorJet>(dt_s);
   for (int k = 0; k < m / 3; ++k) {
-    const std::array<ErrorJet, 3> rk = CheckpointResidual(pose, k, q0, dt_s);
+    const std::array<ErrorJet, 3> rk = CheckpointResidual(pose, k, ground_truth);
     for (int i = 0; i < 3; ++i) {
       const ErrorJet& r = rk[i];
       const int row = 3 * k + i;

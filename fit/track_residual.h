@@ -180,10 +180,10 @@ class TrackResidual : public ceres::CostFunction {
   // On double where no derivative is wanted (the search over dt): the same values.
   using ErrorJet = ceres::Jet<double, 5>;
   template <typename T>
-  Pose2<T> GroundTruthAtStart(double dt_s) const;
+  std::vector<Pose2<T>> GroundTruthFromStartAt(double dt_s) const;
   template <typename T>
-  std::array<T, 3> CheckpointResidual(const std::vector<double>& pose, int k, const Pose2<T>& q0,
-                                      double dt_s) const;
+  std::array<T, 3> CheckpointResidual(const std::vector<double>& pose, int k,
+                                      const std::vector<Pose2<T>>& ground_truth) const;
 
   TrackResidual(const TrackCheckpoints& track, const RobotModelInterface& model,
                 const ResidualWeights& weights, const TrackResidualOptions& options,
