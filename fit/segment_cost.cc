@@ -52,8 +52,9 @@ std::vector<Segment> MakeSegments(const AlignedRun& run, const GroundTruthTrack&
   const std::vector<double> t = BoundaryTimes(run);
   std::vector<Pose2d> q(t.size());
   std::vector<double> s(t.size(), 0.0);
+  std::size_t bracket = 0;
   for (std::size_t b = 0; b < t.size(); ++b) {
-    q[b] = InterpolateGroundTruth(ground_truth, t[b]);
+    q[b] = InterpolateGroundTruth(ground_truth, t[b], &bracket);
     if (b > 0) s[b] = s[b - 1] + std::hypot(q[b].x - q[b - 1].x, q[b].y - q[b - 1].y);
   }
   std::vector<Segment> out;
@@ -83,11 +84,12 @@ std::vector<Segment> MakeCheckpointsFromStart(const AlignedRun& run,
   const std::vector<double> t = BoundaryTimes(run);
   std::vector<Segment> out;
   if (t.size() < 2) return out;
-  const Pose2d start = InterpolateGroundTruth(ground_truth, t[0]);
+  std::size_t bracket = 0;
+  const Pose2d start = InterpolateGroundTruth(ground_truth, t[0], &bracket);
   Pose2d previous = start;
   double path_m = 0.0, next_checkpoint_m = spacing_m;
   for (std::size_t j = 1; j < t.size(); ++j) {
-    const Pose2d q = InterpolateGroundTruth(ground_truth, t[j]);
+    const Pose2d q = InterpolateGroundTruth(ground_truth, t[j], &bracket);
     path_m += std::hypot(q.x - previous.x, q.y - previous.y);
     previous = q;
     const bool last = j + 1 == t.size();

@@ -247,12 +247,15 @@ std::vector<Pose2<T>> TrackResidual::GroundTruthFromStartAt(double dt_s) const {
   using std::cos;
   using std::sin;
   const GroundTruthTrack& ground_truth = *track_.ground_truth;
-  const Pose2<T> q0 = InterpolateGroundTruth(ground_truth, Variable<T>(track_.t_start_s + dt_s, 3));
+  std::size_t bracket = 0;  // the checkpoints follow the start in time
+  const Pose2<T> q0 =
+      InterpolateGroundTruth(ground_truth, Variable<T>(track_.t_start_s + dt_s, 3), &bracket);
   const T c = cos(q0.theta), s = sin(q0.theta);
   std::vector<Pose2<T>> out;
   out.reserve(from_start_.size());
   for (std::size_t k = 0; k < from_start_.size(); ++k) {
-    const Pose2<T> q = InterpolateGroundTruth(ground_truth, Variable<T>(track_.t_s[k] + dt_s, 3));
+    const Pose2<T> q =
+        InterpolateGroundTruth(ground_truth, Variable<T>(track_.t_s[k] + dt_s, 3), &bracket);
     out.push_back(BetweenRotated(q0, c, s, q));
   }
   return out;

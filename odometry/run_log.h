@@ -52,19 +52,40 @@ struct RunLog {
   std::string ground_truth_path;
 };
 
+// The index of the first sample after v in the times t (t.front() <= v < t.back()), as
+// std::upper_bound. With `from` (the bracket an earlier, not later, time found: times asked in
+// order, as a run's samples and checkpoints are) the search starts there and doubles its step -
+// a few comparisons where the samples are dense, not a bisection of the whole track - and
+// leaves the new bracket's start there. The same index either way.
+inline std::size_t FirstSampleAfter(const std::vector<double>& t, double v, std::size_t* from) {
+  auto begin = t.begin(), end = t.end();
+  if (from != nullptr && *from < t.size() && t[*from] <= v) {
+    std::size_t lo = *from, step = 1;
+    while (lo + step < t.size() && t[lo + step] <= v) {
+      lo += step;
+      step *= 2;
+    }
+    begin = t.begin() + static_cast<std::ptrdiff_t>(lo + 1);  // t[lo] <= v
+    end = t.begin() + static_cast<std::ptrdiff_t>(std::min(lo + step + 1, t.size()));
+  }
+  const std::size_t hi = static_cast<std::size_t>(std::upper_bound(begin, end, v) - t.begin());
+  if (from != nullptr) *from = hi - 1;
+  return hi;
+}
+
 // Ground truth at time t_s by linear interpolation (heading along the shorter arc); clamps to the
 // first/last sample outside the track. The track must hold at least one sample. T is double or a
 // ceres::Jet (a time differentiated in a clock offset or a latency): the bracket is chosen on the
-// value, the fraction keeps the derivatives.
+// value, the fraction keeps the derivatives. `from`: FirstSampleAfter's, for times asked in order.
 template <typename T>
-Pose2<T> InterpolateGroundTruth(const GroundTruthTrack& track, const T& t_s) {
+Pose2<T> InterpolateGroundTruth(const GroundTruthTrack& track, const T& t_s,
+                                std::size_t* from = nullptr) {
   const std::vector<double>& t = track.t_s;
   const double v = ScalarPart(t_s);
   const auto sample = [](const Pose2d& q) { return Pose2<T>{T(q.x), T(q.y), T(q.theta)}; };
   if (v <= t.front()) return sample(track.world_T_robot.front());
   if (v >= t.back()) return sample(track.world_T_robot.back());
-  const std::size_t hi =
-      static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), v) - t.begin());
+  const std::size_t hi = FirstSampleAfter(t, v, from);
   const std::size_t lo = hi - 1;
   const T u = (t_s - t[lo]) / (t[hi] - t[lo]);
   const Pose2d& a = track.world_T_robot[lo];
