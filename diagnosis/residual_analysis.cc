@@ -145,15 +145,15 @@ void Accumulate(std::map<std::string, GroupStat>& groups, const std::string& by,
 
 // Wheel channels with a known absolute start angle, the same in every run; empty when a run
 // lacks one.
-std::vector<int> WheelsWithAbsoluteAngle(const std::vector<TrackRun>& runs) {
+std::vector<int> WheelsWithAbsoluteAngle(const std::vector<const TrackRun*>& runs) {
   std::vector<int> out;
-  if (runs.empty() || runs.front().contexts.empty()) return out;
-  const effects::SampleContext& c0 = runs.front().contexts.front();
+  if (runs.empty() || runs.front()->contexts.empty()) return out;
+  const effects::SampleContext& c0 = runs.front()->contexts.front();
   for (int i = 0; i < c0.num_channels; ++i) {
     bool known = c0.IsWheel(i);
-    for (const TrackRun& r : runs) {
-      known = known && static_cast<int>(r.start_wheel_angle_rad.size()) > i &&
-              std::isfinite(r.start_wheel_angle_rad[i]);
+    for (const TrackRun* r : runs) {
+      known = known && static_cast<int>(r->start_wheel_angle_rad.size()) > i &&
+              std::isfinite(r->start_wheel_angle_rad[i]);
     }
     if (known) out.push_back(i);
   }
@@ -197,7 +197,7 @@ Eigen::MatrixXd WheelAngleJacobian(const RobotModelInterface& robot_model,
 
 // The residual against the sensors' own noise (sensor_noise_floor.h), on the lack-of-fit
 // components: the three checkpoints and the window's end.
-void AddSensorFloor(const std::vector<TrackRun>& runs, const std::vector<Lof>& lof,
+void AddSensorFloor(const std::vector<const TrackRun*>& runs, const std::vector<Lof>& lof,
                     const std::vector<std::vector<Lof>>& lof_jacobian,
                     const std::vector<std::array<double, 3>>& checkpoint_times, int num_threads,
                     ResidualAnalysis* out) {
@@ -213,7 +213,7 @@ void AddSensorFloor(const std::vector<TrackRun>& runs, const std::vector<Lof>& l
     const std::vector<double> times = {checkpoint_times[i][0], checkpoint_times[i][1],
                                        checkpoint_times[i][2], track.t_s.back()};
     covariance[i] =
-        PropagateSensorNoise(out->sensor_noise, track, times, runs[i].aligned.start.theta);
+        PropagateSensorNoise(out->sensor_noise, track, times, runs[i]->aligned.start.theta);
     e[i] = Eigen::Map<const Eigen::VectorXd>(lof[i].data(), kLofComponents);
     jacobian[i].resize(kLofComponents, static_cast<int>(lof_jacobian.size()));
     for (std::size_t k = 0; k < lof_jacobian.size(); ++k) {
@@ -242,7 +242,7 @@ struct RunComponents {
   std::vector<std::array<double, 3>> checkpoint_times;
 };
 RunComponents AddRunResiduals(const RobotModelInterface& robot_model, const std::vector<double>& p,
-                              const EffectModel& model, const std::vector<TrackRun>& runs,
+                              const EffectModel& model, const std::vector<const TrackRun*>& runs,
                               int num_threads, ResidualAnalysis* out) {
   const std::size_t n = runs.size();
   out->runs.resize(n);
@@ -252,7 +252,7 @@ RunComponents AddRunResiduals(const RobotModelInterface& robot_model, const std:
   rc.lof.resize(n);
   rc.checkpoint_times.resize(n);
   ParallelFor(n, num_threads, [&](std::size_t i) {
-    const TrackRun& run = runs[i];
+    const TrackRun& run = *runs[i];
     out->runs[i] = Features(robot_model, p, run);
     out->track[i] = ComputeTrackErrors(robot_model, p, model, run, /*all_samples=*/true);
     const double theta0 = run.aligned.start.theta;
@@ -272,7 +272,7 @@ RunComponents AddRunResiduals(const RobotModelInterface& robot_model, const std:
 // the model's free parameters, then every parameter of every effect.
 std::vector<std::vector<Lof>> LofJacobian(const RobotModelInterface& robot_model,
                                           const std::vector<double>& p, const EffectModel& model,
-                                          const std::vector<TrackRun>& runs,
+                                          const std::vector<const TrackRun*>& runs,
                                           const RunComponents& rc, int num_threads) {
   const std::size_t n = runs.size();
   std::vector<std::vector<Lof>> lof_jacobian;
@@ -281,8 +281,8 @@ std::vector<std::vector<Lof>> LofJacobian(const RobotModelInterface& robot_model
                               double h) {
     std::vector<Lof> column(n);
     ParallelFor(n, num_threads, [&](std::size_t i) {
-      const TrackErrors moved = ComputeTrackErrors(robot_model, p_k, model_k, runs[i], true);
-      const Lof x = LofComponents(moved, rc.checkpoint_times[i], runs[i].aligned.start.theta);
+      const TrackErrors moved = ComputeTrackErrors(robot_model, p_k, model_k, *runs[i], true);
+      const Lof x = LofComponents(moved, rc.checkpoint_times[i], runs[i]->aligned.start.theta);
       for (int c = 0; c < kLofComponents; ++c) column[i][c] = (x[c] - rc.lof[i][c]) / h;
     });
     lof_jacobian.push_back(std::move(column));
@@ -321,13 +321,14 @@ void AddFinalJacobian(const std::vector<std::vector<Lof>>& lof_jacobian, std::si
 }
 
 void AddWheelAngleJacobians(const RobotModelInterface& robot_model, const std::vector<double>& p,
-                            const EffectModel& model, const std::vector<TrackRun>& runs,
+                            const EffectModel& model, const std::vector<const TrackRun*>& runs,
                             int num_threads, ResidualAnalysis* out) {
   const std::vector<int> angle_wheels = WheelsWithAbsoluteAngle(runs);
   if (angle_wheels.empty()) return;
   out->wheel_angle_jacobian.resize(runs.size());
   ParallelFor(runs.size(), num_threads, [&](std::size_t i) {
-    out->wheel_angle_jacobian[i] = WheelAngleJacobian(robot_model, p, model, runs[i], angle_wheels);
+    out->wheel_angle_jacobian[i] =
+        WheelAngleJacobian(robot_model, p, model, *runs[i], angle_wheels);
   });
 }
 
@@ -503,11 +504,11 @@ void AccumulateErrorGrowth(const TrackRun& run, const TrackErrors& t, const RunF
 }
 
 // Group statistics: mean and RMS of each bin.
-void AddGroupStatistics(const std::vector<TrackRun>& runs, ResidualAnalysis* out) {
+void AddGroupStatistics(const std::vector<const TrackRun*>& runs, ResidualAnalysis* out) {
   std::map<std::string, GroupStat> groups;
   for (std::size_t i = 0; i < runs.size(); ++i) {
     AccumulateByFeatures(out->runs[i], out->final_start_frame[i], groups);
-    AccumulateErrorGrowth(runs[i], out->track[i], out->runs[i], groups);
+    AccumulateErrorGrowth(*runs[i], out->track[i], out->runs[i], groups);
   }
   for (auto& [key, g] : groups) {
     for (int c = 0; c < 3; ++c) {
@@ -522,7 +523,7 @@ void AddGroupStatistics(const std::vector<TrackRun>& runs, ResidualAnalysis* out
 
 ResidualAnalysis AnalyzeResiduals(const RobotModelInterface& robot_model,
                                   const std::vector<double>& p, const EffectModel& model,
-                                  const std::vector<TrackRun>& runs, int num_threads) {
+                                  const std::vector<const TrackRun*>& runs, int num_threads) {
   ResidualAnalysis out;
   const RunComponents rc = AddRunResiduals(robot_model, p, model, runs, num_threads, &out);
   const std::vector<std::vector<Lof>> lof_jacobian =

@@ -100,10 +100,11 @@ struct ResidualAnalysis {
 };
 
 // The lack-of-fit test counts as fitted every parameter of p and of the model's effects (it
-// subtracts their linearised refit on all runs).
+// subtracts their linearised refit on all runs). `runs` by address: Diagnose's training and
+// validation runs in one list without copying them.
 ResidualAnalysis AnalyzeResiduals(const RobotModelInterface& robot_model,
                                   const std::vector<double>& p, const EffectModel& model,
-                                  const std::vector<TrackRun>& runs, int num_threads = 0);
+                                  const std::vector<const TrackRun*>& runs, int num_threads = 0);
 
 // Human-readable tables (Markdown).
 std::string FormatResidualAnalysis(const ResidualAnalysis& analysis);

@@ -8,15 +8,16 @@ namespace fitcal {
 LastEvaluationMemo::LastEvaluationMemo(ceres::CostFunction* cost) : cost_(cost) {
   set_num_residuals(cost_->num_residuals());
   *mutable_parameter_block_sizes() = cost_->parameter_block_sizes();
-  jacobians_.resize(parameter_block_sizes().size());
+  for (Evaluation& e : remembered_) e.jacobians.resize(parameter_block_sizes().size());
 }
 
-bool LastEvaluationMemo::Remembers(double const* const* parameters, double** jacobians) const {
-  if (!valid_ || residuals_.empty()) return false;
+bool LastEvaluationMemo::Remembers(const Evaluation& e, double const* const* parameters,
+                                   double** jacobians) const {
+  if (!e.valid || e.residuals.empty()) return false;
   const std::vector<int32_t>& sizes = parameter_block_sizes();
-  const double* point = point_.data();
+  const double* point = e.point.data();
   for (std::size_t b = 0; b < sizes.size(); ++b) {
-    if ((jacobians[b] != nullptr) != with_jacobian_[b]) return false;
+    if ((jacobians[b] != nullptr) != e.with_jacobian[b]) return false;
     // Bitwise: the same doubles, not merely equal ones (0.0 and -0.0 differ in a sign that a
     // cost may carry into its result).
     if (std::memcmp(point, parameters[b], sizes[b] * sizeof(double)) != 0) return false;
@@ -27,18 +28,20 @@ bool LastEvaluationMemo::Remembers(double const* const* parameters, double** jac
 
 void LastEvaluationMemo::Remember(double const* const* parameters, const double* residuals,
                                   double** jacobians) const {
+  Evaluation& e = remembered_[older_];
+  older_ = 1 - older_;
   const std::vector<int32_t>& sizes = parameter_block_sizes();
-  point_.clear();
-  with_jacobian_.assign(sizes.size(), false);
+  e.point.clear();
+  e.with_jacobian.assign(sizes.size(), false);
   for (std::size_t b = 0; b < sizes.size(); ++b) {
-    point_.insert(point_.end(), parameters[b], parameters[b] + sizes[b]);
-    with_jacobian_[b] = jacobians[b] != nullptr;
+    e.point.insert(e.point.end(), parameters[b], parameters[b] + sizes[b]);
+    e.with_jacobian[b] = jacobians[b] != nullptr;
     if (jacobians[b] != nullptr) {
-      jacobians_[b].assign(jacobians[b], jacobians[b] + num_residuals() * sizes[b]);
+      e.jacobians[b].assign(jacobians[b], jacobians[b] + num_residuals() * sizes[b]);
     }
   }
-  residuals_.assign(residuals, residuals + num_residuals());
-  valid_ = true;
+  e.residuals.assign(residuals, residuals + num_residuals());
+  e.valid = true;
 }
 
 bool LastEvaluationMemo::Evaluate(double const* const* parameters, double* residuals,
@@ -47,17 +50,18 @@ bool LastEvaluationMemo::Evaluate(double const* const* parameters, double* resid
     ++evaluations_;
     return cost_->Evaluate(parameters, residuals, jacobians);
   }
-  if (Remembers(parameters, jacobians)) {
+  for (const Evaluation& e : remembered_) {
+    if (!Remembers(e, parameters, jacobians)) continue;
     ++answered_from_memo_;
-    std::copy(residuals_.begin(), residuals_.end(), residuals);
-    for (std::size_t b = 0; b < jacobians_.size(); ++b) {
+    std::copy(e.residuals.begin(), e.residuals.end(), residuals);
+    for (std::size_t b = 0; b < e.jacobians.size(); ++b) {
       if (jacobians[b] == nullptr) continue;
-      std::copy(jacobians_[b].begin(), jacobians_[b].end(), jacobians[b]);
+      std::copy(e.jacobians[b].begin(), e.jacobians[b].end(), jacobians[b]);
     }
     return true;
   }
   ++evaluations_;
-  valid_ = false;
+  // A failed evaluation leaves nothing behind; the slots hold what the cost gave at their points.
   if (!cost_->Evaluate(parameters, residuals, jacobians)) return false;
   Remember(parameters, residuals, jacobians);
   return true;

@@ -1,6 +1,6 @@
 #pragma once
-// A residual block's cost function that remembers its last evaluation with Jacobians and answers
-// a repeated request at the same point from it, bit for bit.
+// A residual block's cost function that remembers its last two evaluations with Jacobians and
+// answers a repeated request at either point from them, bit for bit.
 //
 // Why: on a bounded problem Ceres' trust-region minimizer (2.1, trust_region_minimizer.cc) runs a
 // projected Armijo line search before every step, which evaluates the cost and gradient at the
@@ -8,6 +8,10 @@
 // and succeeds, HandleSuccessfulStep evaluates residuals and Jacobians at that same point again.
 // Every successful iteration of fitcal's fits thus replayed each run twice with Jacobians at one
 // point (Solver::Summary: 10 Jacobian evaluations for 5 iterations). The second is now a copy.
+// Why two: a solve usually ends on a step it does not take (its line search evaluated the
+// candidate with Jacobians, then the function tolerance stopped it), so the evaluation at the
+// solution is the one before the last; the covariance's Jacobian there (fit/ceres_problem.h
+// ScaledCovariance on the solved problem) is then a copy too (not after two rejected steps).
 //
 // Only a request of the same kind is answered from the memo (residuals and the same Jacobian
 // blocks; a residual-only request is always evaluated): the residual-only path of a cost may
@@ -17,6 +21,7 @@
 
 #include <ceres/cost_function.h>
 
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -35,17 +40,20 @@ class LastEvaluationMemo : public ceres::CostFunction {
   int answered_from_memo() const { return answered_from_memo_; }
 
  private:
-  bool Remembers(double const* const* parameters, double** jacobians) const;
-  void Remember(double const* const* parameters, const double* residuals,
-                double** jacobians) const;
+  // One evaluation with Jacobians: the point, which blocks had Jacobians, the values.
+  struct Evaluation {
+    bool valid = false;
+    std::vector<double> point;
+    std::vector<bool> with_jacobian;
+    std::vector<double> residuals;
+    std::vector<std::vector<double>> jacobians;
+  };
+  bool Remembers(const Evaluation& e, double const* const* parameters, double** jacobians) const;
+  void Remember(double const* const* parameters, const double* residuals, double** jacobians) const;
 
   std::unique_ptr<ceres::CostFunction> cost_;
-  // The last evaluation with Jacobians: the point, which blocks had Jacobians, the values.
-  mutable bool valid_ = false;
-  mutable std::vector<double> point_;
-  mutable std::vector<bool> with_jacobian_;
-  mutable std::vector<double> residuals_;
-  mutable std::vector<std::vector<double>> jacobians_;
+  mutable std::array<Evaluation, 2> remembered_;
+  mutable int older_ = 0;  // the slot the next evaluation replaces
   mutable int evaluations_ = 0;
   mutable int answered_from_memo_ = 0;
 };

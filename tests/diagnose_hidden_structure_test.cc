@@ -230,8 +230,10 @@ TEST(HiddenStructure, WithoutRepetitionsTheSensorFloorSeesAnUndeclaredEffect) {
     const std::vector<RunLog> logs = SimulateLogs(o);
     const ModelFitResult declared = FitModel(AlignRuns(logs), *model);
     ASSERT_TRUE(declared.usable) << declared.message;
-    const ResidualAnalysis a =
-        AnalyzeResiduals(*model, declared.parameters, {}, PrepareTrackRuns(logs));
+    const std::vector<TrackRun> runs = PrepareTrackRuns(logs);
+    std::vector<const TrackRun*> by_address;
+    for (const TrackRun& run : runs) by_address.push_back(&run);
+    const ResidualAnalysis a = AnalyzeResiduals(*model, declared.parameters, {}, by_address);
     EXPECT_FALSE(a.lack_of_fit.available);
     ASSERT_TRUE(a.sensor_floor.available);
     std::printf("%s: %.2f times the sensor floor, p = %.2g\n", inject ? "slip" : "clean",

@@ -1,14 +1,16 @@
-// The memo of a residual block's last evaluation (fit/last_evaluation_memo.h): a repeated request
-// at the same point is answered from it bit for bit, any other request is evaluated; and on a
-// bounded Ceres solve, where the trust-region minimizer's projected line search evaluates the
+// The memo of a residual block's last two evaluations (fit/last_evaluation_memo.h): a repeated
+// request at either point is answered from it bit for bit, any other request is evaluated; and on
+// a bounded Ceres solve, where the trust-region minimizer's projected line search evaluates the
 // step's end with Jacobians before HandleSuccessfulStep evaluates it again, the memo answers those
-// second requests and the solve ends at the same parameters, bit for bit, after the same steps.
+// second requests and the solve ends at the same parameters, bit for bit, after the same steps;
+// the Jacobian at the solution afterwards (the covariance's) is answered from the older slot.
 
 #include "fit/last_evaluation_memo.h"
 
 #include <ceres/ceres.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <memory>
@@ -36,6 +38,26 @@ struct ExponentialResidual {
   const double y;
 };
 
+// Passes requests on to `cost`, and keeps the point of the last one with Jacobians in `last`:
+// what a memo of one evaluation would hold (every block of the solve has the same point).
+class LastJacobianPoint : public ceres::CostFunction {
+ public:
+  LastJacobianPoint(ceres::CostFunction* cost, std::vector<double>* last)
+      : cost_(cost), last_(last) {
+    set_num_residuals(cost_->num_residuals());
+    *mutable_parameter_block_sizes() = cost_->parameter_block_sizes();
+  }
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    if (jacobians != nullptr) last_->assign(parameters[0], parameters[0] + 3);
+    return cost_->Evaluate(parameters, residuals, jacobians);
+  }
+
+ private:
+  std::unique_ptr<ceres::CostFunction> cost_;
+  std::vector<double>* last_;
+};
+
 struct Samples {
   std::vector<double> x, y;
 };
@@ -58,17 +80,21 @@ struct Solved {
   ceres::Solver::Summary summary;
   int evaluations = 0;  // of the wrapped costs (memo only)
   int answered_from_memo = 0;
+  std::vector<double> last_jacobian_point;  // of the solve (memo only)
+  ceres::CRSMatrix jacobian_at_solution;    // asked for after the solve, as a covariance does
+  int answered_at_solution = 0;
 };
 
 Solved SolveBounded(const Samples& s, bool memo) {
   Solved out;
   out.p = {1.0, 0.1, 0.0};
+  std::vector<double> last_jacobian_point;
   ceres::Problem problem;
   std::vector<const LastEvaluationMemo*> memos;
   for (std::size_t i = 0; i < s.x.size(); ++i) {
     ceres::CostFunction* cost = ExponentialResidual::Create(s.x[i], s.y[i]);
     if (memo) {
-      auto* wrapped = new LastEvaluationMemo(cost);
+      auto* wrapped = new LastEvaluationMemo(new LastJacobianPoint(cost, &last_jacobian_point));
       memos.push_back(wrapped);
       cost = wrapped;
     }
@@ -87,6 +113,11 @@ Solved SolveBounded(const Samples& s, bool memo) {
     out.evaluations += m->evaluations();
     out.answered_from_memo += m->answered_from_memo();
   }
+  out.last_jacobian_point = last_jacobian_point;
+  problem.Evaluate(ceres::Problem::EvaluateOptions(), nullptr, nullptr, nullptr,
+                   &out.jacobian_at_solution);
+  for (const LastEvaluationMemo* m : memos) out.answered_at_solution += m->answered_from_memo();
+  out.answered_at_solution -= out.answered_from_memo;
   return out;
 }
 
@@ -110,13 +141,22 @@ TEST(LastEvaluationMemo, ARepeatedRequestIsAnsweredBitForBitAndAnyOtherIsEvaluat
   double* no_block_jacobian[] = {nullptr};  // another pattern of Jacobians: evaluated
   ASSERT_TRUE(memo.Evaluate(parameters, &r3, no_block_jacobian));
   EXPECT_EQ(memo.evaluations(), 3);
-  ASSERT_TRUE(memo.Evaluate(parameters, &r3, jacobians2));  // that pattern is the memo's now
-  EXPECT_EQ(memo.evaluations(), 4);
+  // The first request is still in the older slot (a one-slot memo held only the last pattern).
+  std::fill(j2, j2 + 3, 0.0);
+  ASSERT_TRUE(memo.Evaluate(parameters, &r2, jacobians2));
+  EXPECT_EQ(memo.evaluations(), 3);
+  EXPECT_EQ(memo.answered_from_memo(), 2);
+  EXPECT_EQ(std::memcmp(&r1, &r2, sizeof r1), 0);
+  EXPECT_EQ(std::memcmp(j1, j2, sizeof j1), 0);
 
-  p[1] = std::nextafter(p[1], 1.0);  // one ulp away: another point
+  p[1] = std::nextafter(p[1], 1.0);  // one ulp away: another point, in place of the older slot
+  ASSERT_TRUE(memo.Evaluate(parameters, &r2, jacobians2));
+  EXPECT_EQ(memo.evaluations(), 4);
+  EXPECT_NE(j1[0], j2[0]);
+  p[1] = std::nextafter(p[1], 0.0);  // back: the first point is gone from the memo
   ASSERT_TRUE(memo.Evaluate(parameters, &r2, jacobians2));
   EXPECT_EQ(memo.evaluations(), 5);
-  EXPECT_NE(j1[0], j2[0]);
+  EXPECT_EQ(memo.answered_from_memo(), 2);
 }
 
 TEST(LastEvaluationMemo, BoundedSolveEndsBitForBitWhereItDidWithoutTheMemoWithFewerEvaluations) {
@@ -143,6 +183,13 @@ TEST(LastEvaluationMemo, BoundedSolveEndsBitForBitWhereItDidWithoutTheMemoWithFe
   }
   ASSERT_GT(successful, 2);
   EXPECT_GE(memo.answered_from_memo, blocks * successful);
+  // The solve ended on a step it did not take (the function tolerance stopped it after its line
+  // search evaluated the candidate with Jacobians): a memo of one evaluation held the candidate,
+  // and the solution's Jacobian, asked for as a covariance does, is the older slot's, bit for bit.
+  ASSERT_EQ(memo.last_jacobian_point.size(), 3u);
+  ASSERT_NE(std::memcmp(memo.last_jacobian_point.data(), memo.p.data(), 3 * sizeof(double)), 0);
+  EXPECT_EQ(memo.answered_at_solution, blocks);
+  EXPECT_EQ(memo.jacobian_at_solution.values, plain.jacobian_at_solution.values);
 }
 
 }  // namespace
