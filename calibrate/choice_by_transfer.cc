@@ -1,5 +1,7 @@
 #include "calibrate/choice_by_transfer.h"
 
+#include <memory>
+
 #include "calibrate/track_residuals.h"
 #include "validation/everyday_driving.h"
 #include "validation/track_objective_transfer.h"
@@ -8,9 +10,13 @@ namespace fitcal {
 
 ScoreOnRuns EverydayDrivingScore(const RobotModelInterface& model, int threads,
                                  std::vector<double> lengths_m) {
-  return [&model, threads, lengths_m = std::move(lengths_m)](const std::vector<double>& p,
-                                                             const std::vector<AlignedRun>& runs) {
-    return EvaluateEverydayDriving(model, p, {}, runs, TracksOf(runs), lengths_m, threads);
+  // The runs' ground-truth side made once for every candidate and fold scored here, and owned by
+  // the score (its copies share it).
+  auto truths = std::make_shared<EverydayDrivingTruths>();
+  return [&model, threads, lengths_m = std::move(lengths_m), truths](
+             const std::vector<double>& p, const std::vector<AlignedRun>& runs) {
+    return EvaluateEverydayDriving(model, p, {}, runs, TracksOf(runs), lengths_m, threads,
+                                   truths.get());
   };
 }
 

@@ -936,9 +936,13 @@ bool DetectTum(TextFileReader& lines, std::string_view* line) {
 
 GroundTruthTrack ReadGroundTruthRows(TextFileReader& lines) {
   const std::string& path = lines.path();
+  GroundTruthTrack track;
+  // At most a row per line: reserved once (as the encoder log) instead of copied while growing.
+  const std::size_t most_rows = lines.CountLinesAndRewind();
+  track.t_s.reserve(most_rows);
+  track.world_T_robot.reserve(most_rows);
   std::string_view line;
   const bool tum = DetectTum(lines, &line);
-  GroundTruthTrack track;
   double row[kMaxColumns];
   QuaternionRepairs repairs;
   auto add = [&](const Pose2d& pose) {

@@ -238,15 +238,16 @@ TEST(RelativePoseErrorTest, StraightDriveClosedForms) {
     long_odometry.push_back({1.02 * s, 0.0, 0.3});
     turning.push_back({s, 0.0, 0.3 + s * M_PI / 180.0});
   }
+  const RelativePoseErrorTruth truth_side(truth);
   RelativePoseErrorSum a, b;
-  RelativePoseErrorRun(truth, long_odometry).Add(1.0, &a);
+  RelativePoseErrorRun(truth_side, long_odometry).Add(1.0, &a);
   EXPECT_EQ(a.windows, 41 - 4);
   EXPECT_NEAR(a.MeanTranslationPercent(), 2.0, 1e-9);
   EXPECT_NEAR(a.MeanRotationRadPerM(), 0.0, 1e-12);
-  RelativePoseErrorRun(truth, turning).Add(1.0, &b);
+  RelativePoseErrorRun(truth_side, turning).Add(1.0, &b);
   EXPECT_NEAR(b.MeanRotationRadPerM(), M_PI / 180.0, 1e-9);
   RelativePoseErrorSum none;
-  RelativePoseErrorRun(truth, long_odometry).Add(20.0, &none);  // longer than the run
+  RelativePoseErrorRun(truth_side, long_odometry).Add(20.0, &none);  // longer than the run
   EXPECT_EQ(none.windows, 0);
   EXPECT_EQ(RelativePoseErrorLengths(5.0), (std::vector<double>{0.5, 1.0, 2.0}));
   EXPECT_EQ(RelativePoseErrorLengths(0.4), (std::vector<double>{}));

@@ -10,13 +10,18 @@
 //     over runs.
 
 #include <map>
+#include <memory>
+#include <mutex>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "models/model_interface.h"
 #include "odometry/aligned_run.h"
 #include "odometry/effects.h"
 #include "odometry/run_log.h"
+#include "validation/relative_pose_error.h"
+#include "validation/trajectory_metrics.h"
 
 namespace fitcal {
 
@@ -51,14 +56,37 @@ struct EverydayDrivingMetrics {
 // drift shows first), 1, 2 and 5 m.
 std::vector<double> EverydayDriftLengths();
 
-// tracks[i] is runs[i]'s ground truth. Runs shorter than a window add nothing to its drift.
-EverydayDrivingMetrics EvaluateEverydayDriving(const RobotModelInterface& model,
-                                               const std::vector<double>& p,
-                                               const std::vector<effects::EffectValue>& effects,
-                                               const std::vector<AlignedRun>& runs,
-                                               const std::vector<const GroundTruthTrack*>& tracks,
-                                               const std::vector<double>& lengths_m,
-                                               int num_threads = 0);
+// What scoring a run takes from the run and its ground truth alone, whatever the parameters: the
+// replay's time line with the track's samples inside its window (trajectory_metrics.h) and the
+// ground-truth side of its drift windows (relative_pose_error.h).
+struct EverydayDrivingTruth {
+  EverydayDrivingTruth(const AlignedRun& run, const GroundTruthTrack& track);
+  RunTimeLine time_line;
+  RelativePoseErrorTruth drift;
+};
+
+// Each run's EverydayDrivingTruth, made when the run is first scored and kept for the scores of
+// other parameters after it (calibrate/choice_by_transfer.h: EverydayDrivingScore owns one for the
+// candidates and folds it scores). A run is known by its id, unique in a data set, and its time
+// window: the time blocks of a run (validation/time_blocks.h) share an id across block counts.
+// Safe to call from several threads.
+class EverydayDrivingTruths {
+ public:
+  const EverydayDrivingTruth& Of(const AlignedRun& run, const GroundTruthTrack& track);
+
+ private:
+  using Key = std::tuple<std::string, double, double>;  // id, t_start_s, t_final_s
+  std::mutex mutex_;
+  std::map<Key, std::unique_ptr<const EverydayDrivingTruth>> by_run_;
+};
+
+// tracks[i] is runs[i]'s ground truth. Runs shorter than a window add nothing to its drift. Each
+// run's truth is taken from `truths` when given, else made for this call.
+EverydayDrivingMetrics EvaluateEverydayDriving(
+    const RobotModelInterface& model, const std::vector<double>& p,
+    const std::vector<effects::EffectValue>& effects, const std::vector<AlignedRun>& runs,
+    const std::vector<const GroundTruthTrack*>& tracks, const std::vector<double>& lengths_m,
+    int num_threads = 0, EverydayDrivingTruths* truths = nullptr);
 
 // Table rows "  drift 1 m [%]  nominal  calibrated  change" etc. for two calibrations on the same
 // runs; a measure named in `notes` ("ATE RMSE [m]", "drift 1 m [%]") has its note after the

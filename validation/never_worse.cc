@@ -191,10 +191,12 @@ EverydayDrivingComparison CompareEverydayDriving(const RobotModelInterface& mode
                                                  const std::vector<const GroundTruthTrack*>& tracks,
                                                  int num_threads) {
   const std::vector<double> lengths = EverydayDriftLengths();
+  EverydayDrivingTruths truths;  // the runs' ground-truth side, once for both
   const EverydayDrivingMetrics before = EvaluateEverydayDriving(
-      model, nominal.parameters, nominal.effects, runs, tracks, lengths, num_threads);
-  const EverydayDrivingMetrics after = EvaluateEverydayDriving(
-      model, calibrated.parameters, calibrated.effects, runs, tracks, lengths, num_threads);
+      model, nominal.parameters, nominal.effects, runs, tracks, lengths, num_threads, &truths);
+  const EverydayDrivingMetrics after =
+      EvaluateEverydayDriving(model, calibrated.parameters, calibrated.effects, runs, tracks,
+                              lengths, num_threads, &truths);
   EverydayDrivingComparison c;
   c.judgements = JudgeNeverWorse(runs, before, after);
   // A row that rose says whether the runs' scatter explains it (issue 42: +13 % went unmarked).

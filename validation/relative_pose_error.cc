@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace fitcal {
 
@@ -15,45 +16,47 @@ Pose2d BetweenWrapped(const Pose2d& a, double c, double s, const Pose2d& b) {
 
 }  // namespace
 
-RelativePoseErrorRun::RelativePoseErrorRun(const std::vector<Pose2d>& ground_truth,
-                                           const std::vector<Pose2d>& odometry)
-    : ground_truth_(ground_truth),
-      odometry_(odometry),
-      n_(std::min(ground_truth.size(), odometry.size())) {
-  if (n_ < 2) return;
-  path_m_.assign(n_, 0.0);
-  for (std::size_t k = 1; k < n_; ++k) {
+RelativePoseErrorTruth::RelativePoseErrorTruth(std::vector<Pose2d> ground_truth)
+    : poses_(std::move(ground_truth)), path_m_(poses_.size(), 0.0) {
+  const std::vector<Pose2d>& g = poses_;
+  for (std::size_t k = 1; k < g.size(); ++k) {
     // sqrt(dx^2 + dy^2), not std::hypot: steps in metres cannot overflow, so hypot's scaling
     // against it is not needed (speed; every fit scores this; equal up to rounding).
-    const double dx = ground_truth[k].x - ground_truth[k - 1].x;
-    const double dy = ground_truth[k].y - ground_truth[k - 1].y;
+    const double dx = g[k].x - g[k - 1].x, dy = g[k].y - g[k - 1].y;
     path_m_[k] = path_m_[k - 1] + std::sqrt(dx * dx + dy * dy);
   }
-  ground_truth_heading_.resize(n_);
-  odometry_heading_.resize(n_);
+  heading_.reserve(g.size());
+  for (const Pose2d& q : g) heading_.push_back({std::cos(q.theta), std::sin(q.theta)});
+}
+
+RelativePoseErrorRun::RelativePoseErrorRun(const RelativePoseErrorTruth& truth,
+                                           const std::vector<Pose2d>& odometry)
+    : truth_(truth), odometry_(odometry), n_(std::min(truth.poses_.size(), odometry.size())) {
+  if (n_ < 2) return;
+  odometry_heading_.reserve(n_);
   for (std::size_t k = 0; k < n_; ++k) {
-    ground_truth_heading_[k] = {std::cos(ground_truth[k].theta), std::sin(ground_truth[k].theta)};
-    odometry_heading_[k] = {std::cos(odometry[k].theta), std::sin(odometry[k].theta)};
+    odometry_heading_.push_back({std::cos(odometry[k].theta), std::sin(odometry[k].theta)});
   }
 }
 
 template <typename Visit>
 void RelativePoseErrorRun::ForEachWindow(double length_m, Visit&& window) const {
   if (n_ < 2 || !(length_m > 0.0)) return;
-  const std::vector<double>& s = path_m_;
+  const std::vector<double>& s = truth_.path_m_;
+  const std::vector<Pose2d>& ground_truth = truth_.poses_;
   std::size_t j = 0;
   for (std::size_t i = 0; i < n_; ++i) {
     if (j < i) j = i;
     while (j < n_ && s[j] - s[i] < length_m) ++j;
     if (j == n_) break;  // no later start reaches the length either
-    const Heading& g = ground_truth_heading_[i];
-    const Heading& o = odometry_heading_[i];
-    const Pose2d truth = BetweenWrapped(ground_truth_[i], g.c, g.s, ground_truth_[j]);
+    const RelativePoseErrorTruth::Heading& g = truth_.heading_[i];
+    const RelativePoseErrorTruth::Heading& o = odometry_heading_[i];
+    const Pose2d truth = BetweenWrapped(ground_truth[i], g.c, g.s, ground_truth[j]);
     const Pose2d odo = BetweenWrapped(odometry_[i], o.c, o.s, odometry_[j]);
     // truth's heading t_j - t_i as (cos, sin) from the stored ones by the difference formulas,
     // cos(t_j - t_i) = c_j c_i + s_j s_i, sin(t_j - t_i) = s_j c_i - c_j s_i: no libm call per
     // window (speed; the wrap by 2 pi changes neither; equal to cos/sin up to rounding).
-    const Heading& gj = ground_truth_heading_[j];
+    const RelativePoseErrorTruth::Heading& gj = truth_.heading_[j];
     const Pose2d e = BetweenWrapped(truth, gj.c * g.c + gj.s * g.s, gj.s * g.c - gj.c * g.s, odo);
     // |t(E)| as sqrt(x^2 + y^2): metres cannot overflow, so hypot's scaling is not needed (speed).
     window(RelativePoseErrorWindow{i, j, std::sqrt(e.x * e.x + e.y * e.y) / length_m,

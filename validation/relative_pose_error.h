@@ -40,15 +40,29 @@ struct RelativePoseErrorSum {
   }
 };
 
-// One run's poses prepared for windows of any length: the ground truth's path length from its
-// first sample and each pose's heading as (cos, sin), computed once for every length (a window
-// needs them at its start; each length's windows start at most samples).
+// The ground-truth side of one run's windows, for windows of any length: its poses, its path
+// length from its first sample and each pose's heading as (cos, sin). It depends on the ground
+// truth alone: made once per run, it serves every odometry replayed against it (a window needs
+// the heading at its start; each length's windows start at most samples).
+class RelativePoseErrorTruth {
+ public:
+  explicit RelativePoseErrorTruth(std::vector<Pose2d> ground_truth);
+
+ private:
+  friend class RelativePoseErrorRun;
+  struct Heading {
+    double c, s;
+  };
+  std::vector<Pose2d> poses_;
+  std::vector<double> path_m_;  // path length from sample 0
+  std::vector<Heading> heading_;
+};
+
+// One run's odometry against its ground truth's side, at the same times in any one world frame
+// each; both must outlive this. The run is the first min(sizes) samples of both.
 class RelativePoseErrorRun {
  public:
-  // Poses at the same times, in any one world frame each; they must outlive this. The run is the
-  // first min(sizes) samples of both.
-  RelativePoseErrorRun(const std::vector<Pose2d>& ground_truth,
-                       const std::vector<Pose2d>& odometry);
+  RelativePoseErrorRun(const RelativePoseErrorTruth& truth, const std::vector<Pose2d>& odometry);
 
   // Every window (the pictures draw them one by one; their sum is the mean). Runs shorter than
   // length_m have none.
@@ -60,14 +74,10 @@ class RelativePoseErrorRun {
   template <typename Visit>
   void ForEachWindow(double length_m, Visit&& window) const;
 
-  struct Heading {
-    double c, s;
-  };
-  const std::vector<Pose2d>& ground_truth_;
+  const RelativePoseErrorTruth& truth_;
   const std::vector<Pose2d>& odometry_;
   std::size_t n_;
-  std::vector<double> path_m_;  // ground-truth path length from sample 0
-  std::vector<Heading> ground_truth_heading_, odometry_heading_;
+  std::vector<RelativePoseErrorTruth::Heading> odometry_heading_;
 };
 
 // Window lengths for runs of this median path length: the largest three of 0.25, 0.5, 1, 2, 5,

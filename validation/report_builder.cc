@@ -247,10 +247,14 @@ std::vector<DriftWindows> DriftWindowsOf(const EvaluatedRuns& e, const io::Repor
   const std::vector<double> suited = RelativePoseErrorLengths(Summarize(path_lengths).median);
   std::set<double> lengths(suited.begin(), suited.end());
   lengths.insert({1.0, 2.0, 5.0});
+  // Both calibrations are compared with the same ground truth samples of a run.
+  std::vector<RelativePoseErrorTruth> truths;
+  truths.reserve(e.before.size());  // the runs below keep references into it
   std::vector<RelativePoseErrorRun> before, after;
   for (std::size_t i = 0; i < e.before.size(); ++i) {
-    before.emplace_back(e.before[i].ground_truth, e.before[i].odometry);
-    after.emplace_back(e.after[i].ground_truth, e.after[i].odometry);
+    truths.emplace_back(e.before[i].ground_truth);
+    before.emplace_back(truths.back(), e.before[i].odometry);
+    after.emplace_back(truths.back(), e.after[i].odometry);
   }
   std::vector<DriftWindows> out;
   for (double length : lengths) {

@@ -51,30 +51,15 @@ Pose2d CarryThroughAnchors(const AlignedRun& run,
   return carried(final_pose);
 }
 
-// The odometry at every encoder time of a run's window: times[0] = t_start with the start pose,
-// times[k + 1] after sample k. Heading stays unwrapped here; only errors are wrapped.
+// The odometry at every encoder time of a run's window: poses[k] at the time line's
+// encoder_times[k], poses[0] the start pose. Heading stays unwrapped here; only errors are wrapped.
 struct ReplayedRun {
-  std::vector<double> times;
+  const std::vector<double>& times;
   std::vector<Pose2d> poses;
   Pose2d final_pose;
   Pose2d final_ground_truth;
   double latency_s = 0.0;  // a ground-truth latency effect: the sample stamped t shows t - tau
 };
-
-ReplayedRun PrepareReplay(const AlignedRun& run) {
-  const std::size_t n = run.samples.size();
-  ReplayedRun r;
-  r.times.resize(n + 1);
-  r.poses.resize(n + 1);
-  r.times[0] = run.t_start_s;
-  double t = run.t_start_s;
-  for (std::size_t k = 0; k < n; ++k) {
-    t += run.samples[k].dt_s;
-    r.times[k + 1] = t;
-  }
-  r.final_ground_truth = run.final_ground_truth;
-  return r;
-}
 
 // The effect replay of any model's body step (odometry/effects.h), started where the effect fit
 // starts it (TrackStartPose) and compared with the ground truth at t_final + latency.
@@ -97,18 +82,48 @@ void ReplayWithEffectList(const Step& step, const AlignedRun& run, const GroundT
 }
 
 TrajectoryErrors ErrorsAlongTrack(const AlignedRun& run, const GroundTruthTrack& track,
-                                  const ReplayedRun& replayed, OdometrySampling sampling);
+                                  const RunTimeLine& time_line, const ReplayedRun& replayed,
+                                  OdometrySampling sampling);
 
 }  // namespace
+
+RunTimeLine::RunTimeLine(const AlignedRun& run, const GroundTruthTrack& track) {
+  const std::size_t n = run.samples.size();
+  encoder_times.resize(n + 1);
+  encoder_times[0] = run.t_start_s;
+  double t = run.t_start_s;
+  for (std::size_t k = 0; k < n; ++k) {
+    t += run.samples[k].dt_s;
+    encoder_times[k + 1] = t;
+  }
+  // The track's times increase strictly (run_log.h): the samples inside are one stretch.
+  const std::vector<double>& t_s = track.t_s;
+  first = std::lower_bound(t_s.begin(), t_s.end(), run.t_start_s) - t_s.begin();
+  end = std::max(first, static_cast<std::size_t>(
+                            std::upper_bound(t_s.begin(), t_s.end(), run.t_final_s) - t_s.begin()));
+}
 
 TrajectoryErrors EvaluateTrajectory(const RobotModelInterface& model, const AlignedRun& run,
                                     const GroundTruthTrack& track, const std::vector<double>& p,
                                     const std::vector<effects::EffectValue>& effects,
                                     OdometrySampling sampling) {
-  ReplayedRun r = PrepareReplay(run);
+  return EvaluateTrajectory(model, run, track, RunTimeLine(run, track), p, effects, sampling);
+}
+
+TrajectoryErrors EvaluateTrajectory(const RobotModelInterface& model, const AlignedRun& run,
+                                    const GroundTruthTrack& track, const RunTimeLine& time_line,
+                                    const std::vector<double>& p,
+                                    const std::vector<effects::EffectValue>& effects,
+                                    OdometrySampling sampling) {
+  const std::size_t n = run.samples.size();
+  if (time_line.encoder_times.size() != n + 1) {
+    throw std::invalid_argument("run " + run.id +
+                                ": EvaluateTrajectory given another run's time line");
+  }
+  ReplayedRun r{time_line.encoder_times, std::vector<Pose2d>(n + 1), {}, run.final_ground_truth};
   if (effects.empty()) {
     r.poses[0] = run.start;
-    r.final_pose = model.Replay(p.data(), run.samples, 0, run.samples.size(), run.start,
+    r.final_pose = model.Replay(p.data(), run.samples, 0, n, run.start,
                                 [&r](std::size_t k, const Pose2d& pose) { r.poses[k + 1] = pose; });
   } else {
     const auto kinematics = model.PrepareKinematics(p.data());
@@ -116,13 +131,14 @@ TrajectoryErrors EvaluateTrajectory(const RobotModelInterface& model, const Alig
                                     double* dtheta) { kinematics->Step(w, dt, dx, dy, dtheta); };
     ReplayWithEffectList(step, run, track, effects, WheelChannelMask(model.robot()), &r);
   }
-  return ErrorsAlongTrack(run, track, r, sampling);
+  return ErrorsAlongTrack(run, track, time_line, r, sampling);
 }
 
 namespace {
 
 TrajectoryErrors ErrorsAlongTrack(const AlignedRun& run, const GroundTruthTrack& track,
-                                  const ReplayedRun& replayed, OdometrySampling sampling) {
+                                  const RunTimeLine& time_line, const ReplayedRun& replayed,
+                                  OdometrySampling sampling) {
   const std::vector<double>& times = replayed.times;
   const std::vector<Pose2d>& poses = replayed.poses;
   const std::size_t n = run.samples.size();
@@ -130,21 +146,19 @@ TrajectoryErrors ErrorsAlongTrack(const AlignedRun& run, const GroundTruthTrack&
   const Pose2d& final_pose = replayed.final_pose;
   const Pose2d& final_ground_truth = replayed.final_ground_truth;
   TrajectoryErrors out;
-  // At most every ground-truth sample: one allocation each instead of the doublings.
-  const std::size_t most = track.t_s.size();
-  out.t_s.reserve(most);
-  out.ground_truth.reserve(most);
-  out.odometry.reserve(most);
-  out.distance_error_m.reserve(most);
-  out.angle_error_rad.reserve(most);
-  for (std::size_t i = 0; i < track.t_s.size(); ++i) {
-    const double t_gt = track.t_s[i];
-    if (t_gt < run.t_start_s || t_gt > run.t_final_s) continue;
-    const double t_enc = t_gt - latency_s;  // the encoder time this sample shows
-    const std::size_t hi = std::min<std::size_t>(
-        static_cast<std::size_t>(std::lower_bound(times.begin(), times.end(), t_enc) -
-                                 times.begin()),
-        n);
+  // The track's samples inside the window, one allocation each.
+  const std::size_t first = time_line.first, end = time_line.end;
+  out.t_s.assign(track.t_s.begin() + first, track.t_s.begin() + end);
+  out.ground_truth.assign(track.world_T_robot.begin() + first, track.world_T_robot.begin() + end);
+  out.odometry.reserve(end - first);
+  out.distance_error_m.reserve(end - first);
+  out.angle_error_rad.reserve(end - first);
+  std::size_t hi = 0;
+  for (std::size_t i = first; i < end; ++i) {
+    const double t_enc = track.t_s[i] - latency_s;  // the encoder time this sample shows
+    // The first encoder time at or after t_enc (std::lower_bound's, capped at n): both time lines
+    // increase, so it only moves forward, one pass for the whole track (speed).
+    while (hi < n && times[hi] < t_enc) ++hi;
     const std::size_t lo = hi == 0 ? 0 : hi - 1;
     Pose2d odom;
     if (hi == lo || times[hi] <= times[lo]) {
@@ -158,8 +172,6 @@ TrajectoryErrors ErrorsAlongTrack(const AlignedRun& run, const GroundTruthTrack&
                     poses[lo].theta + u * (poses[hi].theta - poses[lo].theta)};
     }
     const Pose2d& gt = track.world_T_robot[i];
-    out.t_s.push_back(t_gt);
-    out.ground_truth.push_back(gt);
     out.odometry.push_back(odom);
     // Eq. 8 as sqrt(dx^2 + dy^2), not std::hypot: errors in metres cannot overflow, so hypot's
     // scaling against it is not needed (speed; every fit scores this; equal up to rounding).

@@ -15,6 +15,7 @@
 // those of Eq. 14 (replay to t_final against the ground truth interpolated at t_final), so the
 // per-run CF here equals EvaluateFinalPoseErrors' (fit/final_pose_errors.h).
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -51,15 +52,31 @@ struct TrajectoryErrors {
   double cf = 0.0;                       // Eq. 14 of this run (m and rad)
 };
 
+// What replaying a run against its ground truth takes from the run and the track alone, whatever
+// the parameters and effects: the encoder time of every replayed pose and the track's samples
+// inside the run's window. Made once per run where many parameter sets are scored on it
+// (everyday_driving.h: EverydayDrivingTruth).
+struct RunTimeLine {
+  RunTimeLine(const AlignedRun& run, const GroundTruthTrack& track);
+  std::vector<double> encoder_times;  // [0] = t_start_s, [k + 1] after sample k
+  std::size_t first = 0, end = 0;     // track samples first .. end - 1 lie in [t_start, t_final]
+};
+
 // Any model through the seam (models/model_interface.h), replayed with its own kinematics at
 // parameters p (robot().parameters order). `track` is the run's ground truth
-// (RunLog::ground_truth); `run` its AlignRun(). Throws std::invalid_argument if no ground-truth
-// sample lies inside the window.
+// (RunLog::ground_truth); `run` its AlignRun(); `time_line` theirs, when made once for many
+// calls (the overload below makes it). Throws std::invalid_argument if no ground-truth sample
+// lies inside the window.
 // With effects (odometry/effects.h, as a calibrated robot YAML carries them after `fitcal
 // diagnose`) the semantics are the effect fit's (fit/effect_fit.h): the replay applies every
 // effect, and a ground-truth latency tau makes the ground-truth sample stamped t show the odometry
 // at encoder time t - tau (the replay is carried through the anchor samples of
 // StartAnchorIndices, the final pose is compared with the ground truth at t_final + tau).
+TrajectoryErrors EvaluateTrajectory(const RobotModelInterface& model, const AlignedRun& run,
+                                    const GroundTruthTrack& track, const RunTimeLine& time_line,
+                                    const std::vector<double>& p,
+                                    const std::vector<effects::EffectValue>& effects,
+                                    OdometrySampling sampling = OdometrySampling::kNearestTime);
 TrajectoryErrors EvaluateTrajectory(const RobotModelInterface& model, const AlignedRun& run,
                                     const GroundTruthTrack& track, const std::vector<double>& p,
                                     const std::vector<effects::EffectValue>& effects,
