@@ -18,18 +18,6 @@ bool SegmentOptions::IsValid(std::string* error) const {
   return true;
 }
 
-namespace {
-
-// Sample boundary times of an aligned run: boundary b lies after b samples.
-std::vector<double> BoundaryTimes(const AlignedRun& run) {
-  std::vector<double> t(run.samples.size() + 1);
-  t[0] = run.t_start_s;
-  for (std::size_t k = 0; k < run.samples.size(); ++k) t[k + 1] = t[k] + run.samples[k].dt_s;
-  return t;
-}
-
-}  // namespace
-
 std::vector<std::vector<Segment>> MakeDisjointWindows(
     const std::vector<AlignedRun>& runs, const std::vector<const GroundTruthTrack*>& tracks,
     std::size_t* total) {

@@ -74,4 +74,11 @@ std::vector<const GroundTruthTrack*> TracksOf(const std::vector<AlignedRun>& run
   return tracks;
 }
 
+std::vector<double> BoundaryTimes(const AlignedRun& run) {
+  std::vector<double> t(run.samples.size() + 1);
+  t[0] = run.t_start_s;
+  for (std::size_t k = 0; k < run.samples.size(); ++k) t[k + 1] = t[k] + run.samples[k].dt_s;
+  return t;
+}
+
 }  // namespace fitcal

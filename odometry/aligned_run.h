@@ -39,6 +39,9 @@ struct AlignedRun {
 AlignedRun AlignRun(const RunLog& run);
 std::vector<AlignedRun> AlignRuns(const std::vector<RunLog>& runs);
 
+// The encoder time of each sample boundary of a run: [0] = t_start_s, [k + 1] after sample k.
+std::vector<double> BoundaryTimes(const AlignedRun& run);
+
 // Each run's ground-truth track (AlignedRun::track), in the runs' order; throws
 // std::invalid_argument naming a run aligned without its log.
 std::vector<const GroundTruthTrack*> TracksOf(const std::vector<AlignedRun>& runs);

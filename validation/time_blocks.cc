@@ -58,11 +58,10 @@ std::vector<AlignedRun> CutIntoTimeBlocks(const AlignedRun& run, int num_blocks)
   }
   const GroundTruthTrack& track = *run.track;
   // Boundary b lies after b samples; its ground-truth path length from the start.
-  std::vector<double> t(n + 1), s(n + 1, 0.0);
-  t[0] = run.t_start_s;
+  const std::vector<double> t = BoundaryTimes(run);
+  std::vector<double> s(n + 1, 0.0);
   Pose2d previous = InterpolateGroundTruth(track, t[0]);
   for (std::size_t k = 0; k < n; ++k) {
-    t[k + 1] = t[k] + run.samples[k].dt_s;
     const Pose2d q = InterpolateGroundTruth(track, t[k + 1]);
     s[k + 1] = s[k] + std::hypot(q.x - previous.x, q.y - previous.y);
     previous = q;

@@ -87,15 +87,8 @@ TrajectoryErrors ErrorsAlongTrack(const AlignedRun& run, const GroundTruthTrack&
 
 }  // namespace
 
-RunTimeLine::RunTimeLine(const AlignedRun& run, const GroundTruthTrack& track) {
-  const std::size_t n = run.samples.size();
-  encoder_times.resize(n + 1);
-  encoder_times[0] = run.t_start_s;
-  double t = run.t_start_s;
-  for (std::size_t k = 0; k < n; ++k) {
-    t += run.samples[k].dt_s;
-    encoder_times[k + 1] = t;
-  }
+RunTimeLine::RunTimeLine(const AlignedRun& run, const GroundTruthTrack& track)
+    : encoder_times(BoundaryTimes(run)) {
   // The track's times increase strictly (run_log.h): the samples inside are one stretch.
   const std::vector<double>& t_s = track.t_s;
   first = std::lower_bound(t_s.begin(), t_s.end(), run.t_start_s) - t_s.begin();
