@@ -20,13 +20,28 @@ ScoreOnRuns EverydayDrivingScore(const RobotModelInterface& model, int threads,
   };
 }
 
+namespace {
+
+// The runs in a key: each by its id and its time window, since a run cut into time blocks keeps
+// its id in every block (validation/time_blocks.h), as EverydayDrivingTruths keys them.
+void AppendRunKeys(const std::vector<AlignedRun>& runs, std::string* key) {
+  for (const AlignedRun& run : runs) {
+    *key += " " + run.id;
+    for (const double t : {run.t_start_s, run.t_final_s}) {
+      key->append(reinterpret_cast<const char*>(&t), sizeof t);
+    }
+  }
+}
+
+}  // namespace
+
 std::optional<std::vector<double>> FoldFits::Fit(const FitMethod& method,
                                                  const RobotModelInterface& model,
                                                  FitMethodSettings s,
                                                  const std::vector<AlignedRun>& training) {
   std::string key = std::string(ToString(s.residuals)) + (s.estimate_weights ? " est " : " fix ") +
                     ToString(s.track_heading);
-  for (const AlignedRun& run : training) key += " " + run.id;
+  AppendRunKeys(training, &key);
   {
     const std::lock_guard<std::mutex> lock(mutex_);
     if (const auto found = done_.find(key); found != done_.end()) return found->second;
@@ -55,7 +70,7 @@ ScoreOnRuns FoldFits::ScoredOnce(ScoreOnRuns score) {
                                           const std::vector<AlignedRun>& runs) {
     // The parameters' bytes: the same fit, not merely equal numbers.
     std::string key(reinterpret_cast<const char*>(p.data()), p.size() * sizeof(double));
-    for (const AlignedRun& run : runs) key += " " + run.id;
+    AppendRunKeys(runs, &key);
     {
       const std::lock_guard<std::mutex> lock(mutex_);
       if (const auto found = scored_.find(key); found != scored_.end()) return found->second;

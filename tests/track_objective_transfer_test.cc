@@ -167,6 +167,11 @@ TEST(TrackObjectiveTransfer, FoldFitsScoreEachFitOnceOnEachSetOfRuns) {
   score({1.0}, {split.training.front()});  // other runs
   score({std::nextafter(1.0, 2.0)}, split.training);  // another fit, one ulp away
   EXPECT_EQ(scored, 3);
+  // A run's later time block keeps its id (validation/time_blocks.h): other runs all the same.
+  std::vector<AlignedRun> later_blocks = split.training;
+  for (AlignedRun& run : later_blocks) run.t_start_s += 1.0;
+  score({1.0}, later_blocks);
+  EXPECT_EQ(scored, 4);
   // Both judgements on these folds (2 kinds of run): the default's two fold fits scored once.
   const FitCandidate fit_on = [](int c, const std::vector<AlignedRun>& training) {
     return std::optional<std::vector<double>>(
