@@ -33,14 +33,13 @@ ReplayedRun ReplayRun(const RobotModelInterface& model, const std::vector<double
   ReplayedRun out;
   out.log = &log;
   out.pose.push_back(Pose2d{});
-  out.t_s.push_back(run.t_start_s);
+  out.t_s = BoundaryTimes(run);
   out.path_m.push_back(0.0);
   model.Replay(p.data(), run.samples, 0, run.samples.size(), Pose2d{},
-               [&](std::size_t k, const Pose2d& pose) {
+               [&](std::size_t, const Pose2d& pose) {
                  out.path_m.push_back(out.path_m.back() + std::hypot(pose.x - out.pose.back().x,
                                                                      pose.y - out.pose.back().y));
                  out.pose.push_back(pose);
-                 out.t_s.push_back(out.t_s.back() + run.samples[k].dt_s);
                });
   return out;
 }
