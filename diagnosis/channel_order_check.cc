@@ -287,10 +287,11 @@ ChannelOrderReport CheckOrder(const std::vector<AlignedRun>& runs,
   // The other mapping's fit of windows goes without the global start. In the common case it is
   // the wrong mapping: its fit stays far above the noise, so the global start always tried three
   // more starts (`fit` of a simulated tricycle guessed with half its steering gain: 7.1 -> 4.8 s
-  // of CPU without them). Without them its SSR can only be higher, so the check can only be less
-  // ready to call a robot miswired, never more; and windows have none of the far-guess minima of
-  // final poses (FittedSumOfSquares). The recorded order keeps its global start: a correctly
-  // wired robot is not called miswired for a fit that stopped short.
+  // of CPU without them). Its windows' SSR can then only be higher (least squares: FitModel keeps
+  // the lowest cost), which makes the check less ready to call a robot miswired, not more; and
+  // windows have none of the far-guess minima of final poses (FittedSumOfSquares). The recorded
+  // order keeps its global start: a correctly wired robot is not called miswired for a fit that
+  // stopped short.
   test.fitted_ssr = [&](bool other) {
     if (!other) return FittedSumOfSquares(model, runs, segments, start_windows, options, true);
     return FittedSumOfSquares(model, ApplyChannelMapping(runs, report.best), segments,
