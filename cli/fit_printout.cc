@@ -266,9 +266,10 @@ void PrintReport(const CalibrationRequest& request, const RobotModelInterface& m
 // The judgements after the gate, as far as they went.
 void PrintJudgements(const CalibrationOutcome& o) {
   if (o.reached >= CalibrationStage::kHalves && o.halves.judged) {
-    std::printf(
-        "no held-out runs: judged on %s; the calibration written is fitted on all of them\n",
-        HalvesDescription(o.halves).c_str());
+    // What is written follows only when the halves beat the nominal (the refusal says why not).
+    std::printf("no held-out runs: judged on %s; %s\n", HalvesDescription(o.halves).c_str(),
+                o.halves.Beats() ? "the calibration written is fitted on all of them"
+                                 : "they do not beat the nominal");
   }
   if (o.reached >= CalibrationStage::kNeverWorse) {
     for (const std::string& line : o.never_worse_warnings)

@@ -114,5 +114,22 @@ TEST(GateCli, TheTimeBlockVerdictDoesNotFlipWithTheCount) {
   EXPECT_TRUE(Has(six.out, "of 4 counts")) << six.out;
 }
 
+// A real session of two runs the time blocks refuse (OptiOdom's diff drive, square 231220200048:
+// the fits beat the nominal for 1 of the 3 block counts): the judgement's line says that they do
+// not beat it, not what a written calibration would be fitted on, and nothing is written.
+TEST(GateCli, RefusedTimeBlocksDoNotDescribeACalibrationWritten) {
+  const std::string session = FITCAL_SHARED_DIR + "/data/optiodom/diff/square/231220200048";
+  if (!fs::is_directory(session)) GTEST_SKIP() << "no " << session;
+  TempDir dir;
+  const std::string data = dir.Path("data"), out = dir.Path("cal.yaml");
+  ASSERT_EQ(RunFitcal(dir, "import optiodom " + session + " --out " + data).exit_code, 0);
+  const auto r = RunFitcal(dir, "fit --logs " + data + " --out " + out);
+  EXPECT_EQ(r.exit_code, 5) << r.out << r.err;
+  EXPECT_TRUE(Has(r.out, "judged on held-out time blocks")) << r.out;
+  EXPECT_TRUE(Has(r.out, "they do not beat the nominal")) << r.out;
+  EXPECT_FALSE(Has(r.out, "the calibration written is fitted on all of them")) << r.out;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 }  // namespace
 }  // namespace fitcal
