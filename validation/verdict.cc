@@ -72,7 +72,9 @@ VerdictReason RegressionReason(const VerdictInputs& in) {
   return Reason(
       VerdictLevel::kWarn, "regressions", "groups",
       std::to_string(worse.size()) +
-          " held-out group(s) more than 5 % worse than with the nominal: " + NameList(worse, 4));
+          " held-out group(s) more than 5 % worse than with the nominal in mean CF or final "
+          "position error: " +
+          NameList(worse, 4));
 }
 
 VerdictReason NoiseFloorReason(const NoiseFloorTest& t) {
