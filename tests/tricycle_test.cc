@@ -353,6 +353,24 @@ TEST(TricycleTrajectories, SquaresTurnOnArcsWithinTheReadableSteering) {
   EXPECT_THROW(sim::TricycleTrajectories(o), std::invalid_argument);  // a circle beyond the cap
 }
 
+// Read at most 88 deg (a steering gain of ~0.55), the corners' arc would turn a quarter in 0.06 s,
+// shorter than the simulator's 0.4 s ramp, and `simulate` exited 1 (stop 65's sweep): the corner
+// steers less and lasts min_corner_s, the squares simulate and still turn a whole turn.
+TEST(TricycleTrajectories, ACornerNearNinetyDegreesLastsTwoRamps) {
+  const auto model = ExampleModel();
+  sim::TricycleTrajectoryOptions o;
+  o.max_steering_deg = 88.0;
+  const auto specs = sim::TricycleTrajectories(o);
+  ASSERT_EQ(specs.size(), 10u);
+  for (const sim::TwistSegment& segment : specs[8].segments) {
+    EXPECT_GE(segment.duration_s, o.min_corner_s);
+  }
+  const auto runs =
+      sim::SimulateRuns(*model, model->robot().nominal, specs, sim::SimulationOptions{});
+  EXPECT_NEAR(runs[8].true_final_pose.theta, 2.0 * M_PI, 1e-6);
+  EXPECT_NEAR(runs[9].true_final_pose.theta, -2.0 * M_PI, 1e-6);
+}
+
 // Noisy simulated calibration: ground-truth noise of sigma_xy = 2 mm and sigma_theta = 2 mrad at
 // the final pose (start pose recorded), traction ticks of 1600 per revolution (< 0.13 mm, not
 // accumulating), 3 repetitions of the 10 trajectories. Encoders at 100 Hz: the midpoint rule

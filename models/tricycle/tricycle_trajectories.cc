@@ -17,13 +17,21 @@ TwistSegment Circle(const TricycleTrajectoryOptions& o, double steering_rad) {
   return {Twist{o.speed_m_s, 0.0, omega}, 2.0 * M_PI * kCircleTurns / std::abs(omega)};
 }
 
-// A quarter turn (sign +1 = ccw): in place, or an arc at the largest steering the robot reads.
+// A quarter turn (sign +1 = ccw): in place, or an arc at the largest steering the robot reads,
+// or less where that arc would be over in under min_corner_s (a steering gain of 0.52-0.55 reads
+// at most 86-88 deg: a quarter turn of 0.08 s, and `simulate` exited 1; found by a randomized
+// sweep, stop 65).
 TwistSegment Corner(const TricycleTrajectoryOptions& o, double sign) {
   if (o.max_steering_deg >= 90.0) {
     return {Twist{0.0, 0.0, sign * o.turn_rate_rad_s}, 0.5 * M_PI / o.turn_rate_rad_s};
   }
-  const TwistSegment arc = Circle(o, sign * o.max_steering_deg * M_PI / 180.0);
-  return {arc.twist, 0.5 * M_PI / std::abs(arc.twist.omega_rad_s)};
+  TwistSegment arc = Circle(o, sign * o.max_steering_deg * M_PI / 180.0);
+  arc.duration_s = 0.5 * M_PI / std::abs(arc.twist.omega_rad_s);
+  if (arc.duration_s < o.min_corner_s) {
+    arc.duration_s = o.min_corner_s;
+    arc.twist.omega_rad_s = sign * 0.5 * M_PI / o.min_corner_s;
+  }
+  return arc;
 }
 
 // Four straight sides, each followed by a quarter turn (sign +1 = ccw), and the first side again.
@@ -46,6 +54,7 @@ std::string TricycleTrajectoryOptions::Check() const {
   if (!(speed_m_s > 0.0)) return "speed_m_s must be positive";
   if (!(square_side_m > 0.0)) return "square_side_m must be positive";
   if (!(turn_rate_rad_s > 0.0)) return "turn_rate_rad_s must be positive";
+  if (!(min_corner_s > 0.0)) return "min_corner_s must be positive";
   if (repetitions < 1) return "repetitions must be at least 1";
   if (!(max_steering_deg > 0.0 && max_steering_deg <= 90.0)) {
     return "max_steering_deg must lie in (0, 90]";

@@ -41,6 +41,10 @@ struct TricycleTrajectoryOptions {
   // corners are quarter arcs at this steering instead of turns in place (a column read through a
   // gain below 1 cannot report 90 deg: TricycleReadableSteeringDeg).
   double max_steering_deg = 90.0;
+  // A corner's arc lasts at least this long: two of the simulator's 0.4 s ramps of the commanded
+  // twist (sim/model_simulator.cc refuses a segment shorter than one). Near 90 deg the arc turns
+  // faster, so such a corner steers less than max_steering_deg.
+  double min_corner_s = 0.8;
   int repetitions = 1;           // each trajectory this many times (repetition 1..n)
 
   // Empty when valid, else what is wrong.
