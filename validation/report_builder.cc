@@ -705,7 +705,9 @@ std::string NothingToValidateRefusal(const std::vector<TrainingSplit>& splits,
               ? " trained at least one of the calibrations"
               : " trained the calibration (repetitions " +
                     FormatRepetitionList(splits.front().split.training_repetitions) + ")") +
-         "; nothing to validate on";
+         "; nothing to validate on: pass runs it did not train on as --logs (another session's "
+         "import, say); with nothing held out `fit` judged it on halves of its runs (the "
+         "calibration's selected_on)";
 }
 
 std::vector<TrainingSplit> CommonSplits(const std::string& train_reps, const ReportInputs& in) {
