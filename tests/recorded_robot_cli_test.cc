@@ -277,6 +277,22 @@ TEST_P(RecordedRobot, DefaultFitRecoversWheelsAndMountFromCountsFarFromTheGuess)
 INSTANTIATE_TEST_SUITE_P(Models, RecordedRobot, ::testing::ValuesIn(kCases),
                          [](const auto& test) { return std::string(test.param.name); });
 
+// A diff drive guessed with radii of 0.042 m and a separation of 0.2 m (nominal.yaml in `dir`)
+// and its truth (truth.yaml), both in the sweep's box.
+void WriteGuessAndTruth(const TempDir& dir, double r_right, double r_left, double separation) {
+  const auto yaml = [](double right, double left, double sep) {
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "model: diff_drive\nname: d\nwheels:\n  - {name: right, radius_m: %.10g}\n"
+                  "  - {name: left, radius_m: %.10g}\nwheel_separation_m: %.10g\n"
+                  "bounds: {radius_m: [0.025, 0.060], wheel_separation_m: [0.120, 0.300]}\n",
+                  right, left, sep);
+    return std::string(text);
+  };
+  WriteFileBytes(dir.Path("nominal.yaml"), yaml(0.042, 0.042, 0.2));
+  WriteFileBytes(dir.Path("truth.yaml"), yaml(r_right, r_left, separation));
+}
+
 // Two noisy squares (the first two runs of one repetition, 3.8x simulate's default noise) of a
 // diff drive guessed 9-18 % off: the track fit from the guess ended in a local minimum that held
 // the common scale of wheels and track (and one more direction) as undetermined, training CF 1.95
@@ -285,16 +301,7 @@ INSTANTIATE_TEST_SUITE_P(Models, RecordedRobot, ::testing::ValuesIn(kCases),
 // ReasonToStartAcrossTheBox). Every parameter determined and within 3 of its sigmas of the truth.
 TEST(FarFromTheGuessOnTracks, AHeldDirectionOfATrackFitTriesTheGlobalStart) {
   TempDir dir;
-  const std::string box =
-      "bounds: {radius_m: [0.025, 0.060], wheel_separation_m: [0.120, 0.300]}\n";
-  WriteFileBytes(dir.Path("nominal.yaml"),
-                 "model: diff_drive\nname: d\nwheels:\n  - {name: right, radius_m: 0.042}\n"
-                 "  - {name: left, radius_m: 0.042}\nwheel_separation_m: 0.200\n" + box);
-  WriteFileBytes(dir.Path("truth.yaml"),
-                 "model: diff_drive\nname: d\nwheels:\n"
-                 "  - {name: right, radius_m: 0.0483777644}\n"
-                 "  - {name: left, radius_m: 0.0343787927}\nwheel_separation_m: 0.181986811\n" +
-                     box);
+  WriteGuessAndTruth(dir, 0.0483777644, 0.0343787927, 0.181986811);
   const std::string data = dir.Path("data"), cal = dir.Path("cal.yaml");
   const auto sim = RunFitcal(
       dir, "simulate --model diff_drive --robot " + dir.Path("nominal.yaml") + " --truth " +
@@ -342,16 +349,7 @@ void CutCsvAt(const std::string& file, double t_max) {
 // reaches within 0.01 %, from that minimum (and from swapped wheels: 0.032 against 0.045).
 TEST(ResidualKindChoice, AChosenFinalPoseIsFittedFromTheTracksFit) {
   TempDir dir;
-  const std::string box =
-      "bounds: {radius_m: [0.025, 0.060], wheel_separation_m: [0.120, 0.300]}\n";
-  WriteFileBytes(dir.Path("nominal.yaml"),
-                 "model: diff_drive\nname: d\nwheels:\n  - {name: right, radius_m: 0.042}\n"
-                 "  - {name: left, radius_m: 0.042}\nwheel_separation_m: 0.200\n" + box);
-  WriteFileBytes(dir.Path("truth.yaml"),
-                 "model: diff_drive\nname: d\nwheels:\n"
-                 "  - {name: right, radius_m: 0.0319256392}\n"
-                 "  - {name: left, radius_m: 0.0449456803}\nwheel_separation_m: 0.224940094\n" +
-                     box);
+  WriteGuessAndTruth(dir, 0.0319256392, 0.0449456803, 0.224940094);
   const std::string data = dir.Path("data"), cal = dir.Path("cal.yaml");
   const auto sim = RunFitcal(dir, "simulate --model diff_drive --robot " +
                                      dir.Path("nominal.yaml") + " --truth " +
