@@ -96,9 +96,10 @@ void FitAllTrainingRuns(const FitMethod& method, const RobotModelInterface& mode
 // The final pose's fit of all the training runs when it replaces the track: from the guess (with
 // FitModel's global start) and from the track's fit of the same runs, `track_fit`, the lower cost
 // kept. The folds that chose the final pose started from the track's fit; from the guess alone
-// the fit written could end elsewhere (a randomized sweep, stop 65: a diff drive guessed 9-18 %
-// off, two squares, ended in a local minimum at CF 1.95 against 0.033 at the truth and was
-// written; its flat direction held, so no reason to start across the box showed).
+// the fit written could end elsewhere (a randomized sweep, stop 65: a diff drive with a radius
+// guessed 24 % off, its runs cut to 56 %, ended in a local minimum at training CF 1.64 against
+// 0.007 at the truth and was written; its flat direction held, so no reason to start across the
+// box showed).
 void FitFinalPoseOfAllTrainingRuns(const FitMethod& method, const RobotModelInterface& model,
                                    const RunSplit& split, const FitMethodSettings& settings,
                                    const std::vector<double>& track_fit,
