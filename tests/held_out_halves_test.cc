@@ -6,7 +6,6 @@
 
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <map>
 #include <memory>
 #include <set>
@@ -52,50 +51,6 @@ TEST(HeldOutHalves, FoldsOfFourRunsAlternate) {
   EXPECT_EQ(Ids(fold0.validation), (std::vector<std::string>{"free-2", "free-4"}));
   EXPECT_EQ(Ids(fold1.training), Ids(fold0.validation));
   EXPECT_EQ(Ids(fold1.validation), Ids(fold0.training));
-}
-
-// A run of one session turning `turns` full turns (negative: clockwise) over 10 s, its ground
-// truth a pose every 0.1 s (a step of 36 deg per turn per second).
-AlignedRun Turning(int repetition, double turns) {
-  AlignedRun run = testing::LabelledRun("session", repetition);
-  GroundTruthTrack track;
-  for (int i = 0; i <= 100; ++i) {
-    track.t_s.push_back(0.1 * i);
-    track.world_T_robot.push_back({0.0, 0.0, WrapAngle(2.0 * M_PI * turns * i / 100.0)});
-  }
-  run.t_final_s = 10.0;
-  run.track = std::make_shared<const GroundTruthTrack>(track);
-  return run;
-}
-
-TEST(HeldOutHalves, TurningSenseFollowsTheGroundTruth) {
-  EXPECT_EQ(TurningSense(Turning(1, 3.0)), 1);
-  EXPECT_EQ(TurningSense(Turning(1, -3.0)), -1);
-  EXPECT_EQ(TurningSense(Turning(1, 0.4)), 0);  // less than half a turn
-  EXPECT_EQ(TurningSense(Turning(1, 30.0)), 0);  // 108 deg between poses: not followed
-  AlignedRun later = Turning(1, 3.0);            // only its last 2 s in the window: 0.6 turns
-  later.t_start_s = 8.0;
-  EXPECT_EQ(TurningSense(later), 1);
-  later.t_start_s = 9.0;  // 0.3 turns
-  EXPECT_EQ(TurningSense(later), 0);
-  EXPECT_EQ(TurningSense(testing::LabelledRun("session", 1)), 0);  // no track
-}
-
-// A session alternating clockwise and counter-clockwise runs (OptiOdom's 4-run sessions): each
-// half trains on one run turning each way, where every other run in data-set order trained on the
-// clockwise runs alone and judged on the others. Runs whose kinds stand together are halved as
-// before, every other run in data-set order.
-TEST(HeldOutHalves, EachHalfDrivesEveryKindOfMotion) {
-  RunSplit alternating;
-  for (int i = 1; i <= 4; ++i) alternating.training.push_back(Turning(i, i % 2 ? -3.0 : 3.0));
-  const RunSplit fold0 = RunsFold(alternating, 0), fold1 = RunsFold(alternating, 1);
-  EXPECT_EQ(Ids(fold0.training), (std::vector<std::string>{"session-1", "session-4"}));
-  EXPECT_EQ(Ids(fold0.validation), (std::vector<std::string>{"session-2", "session-3"}));
-  EXPECT_EQ(Ids(fold1.training), Ids(fold0.validation));
-  RunSplit together;
-  for (int i = 1; i <= 6; ++i) together.training.push_back(Turning(i, i <= 3 ? -3.0 : 3.0));
-  EXPECT_EQ(Ids(RunsFold(together, 0).training),
-            (std::vector<std::string>{"session-1", "session-3", "session-5"}));
 }
 
 // A straight run of 4 m over 4 s (40 encoder intervals of 0.1 s) cut into 4 blocks of 1 m: fold 0

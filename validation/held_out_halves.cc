@@ -1,13 +1,9 @@
 #include "validation/held_out_halves.h"
 
 #include <algorithm>
-#include <cmath>
-#include <map>
 #include <set>
-#include <string>
 #include <utility>
 
-#include "odometry/pose2.h"
 #include "odometry/text_format.h"
 #include "validation/time_blocks.h"
 
@@ -25,32 +21,12 @@ HalvesFold TimeBlockFold(const RunSplit& whole, int num_blocks, int fold) {
 }
 
 RunSplit RunsFold(const RunSplit& whole, int fold) {
-  // Data sets interleave clockwise and counter-clockwise runs (OptiOdom's tricycle import, its
-  // 4-run sessions): every other run in data-set order trained each half on one way of turning
-  // and judged it on the other (the tricycle's --train-reps 1-99: CF 1.1757 -> 0.3504 on the
-  // halves, 0.1052 by kind).
-  std::map<std::pair<std::string, int>, std::size_t> first_at, seen;
   RunSplit half;
   for (std::size_t i = 0; i < whole.training.size(); ++i) {
-    const AlignedRun& run = whole.training[i];
-    const std::pair<std::string, int> kind(run.trajectory, TurningSense(run));
-    const std::size_t place = first_at.emplace(kind, i).first->second + seen[kind]++;
-    (static_cast<int>(place % 2) == fold ? half.training : half.validation).push_back(run);
+    (static_cast<int>(i % 2) == fold ? half.training : half.validation)
+        .push_back(whole.training[i]);
   }
   return half;
-}
-
-int TurningSense(const AlignedRun& run) {
-  if (run.track == nullptr) return 0;
-  const GroundTruthTrack& g = *run.track;
-  double turned_rad = 0.0;
-  for (std::size_t i = 1; i < g.t_s.size(); ++i) {
-    if (g.t_s[i] <= run.t_start_s || g.t_s[i - 1] >= run.t_final_s) continue;
-    const double step = WrapAngle(g.world_T_robot[i].theta - g.world_T_robot[i - 1].theta);
-    if (std::abs(step) > 0.5 * M_PI) return 0;
-    turned_rad += step;
-  }
-  return turned_rad > M_PI ? 1 : turned_rad < -M_PI ? -1 : 0;
 }
 
 std::vector<int> TimeBlockCounts(int num_blocks) {
@@ -166,8 +142,7 @@ HalvesJudgement JudgeOnHeldOutHalves(const RunSplit& split, ResidualKind residua
 std::string HalvesDescription(const HalvesJudgement& j) {
   const std::string cf = StrFormat("CF %.4f -> %.4f", j.nominal_cf, j.calibrated_cf);
   if (!j.by_time) {
-    return "held-out halves of the training runs (two folds, every other run of each trajectory "
-           "and turning sense against the rest; " +
+    return "held-out halves of the training runs (two folds, every other run against the rest; " +
            cf + ")";
   }
   std::string counts;

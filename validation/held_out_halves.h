@@ -3,8 +3,7 @@
 // driving), the calibration procedure is judged by two folds before the fit of all the training
 // runs is written: a fit of one half is judged on the other half and back, against the nominal
 // (two-fold cross-validation).
-// - More than two runs: every other run of each kind of motion trains (RunsFold), the rest is
-//   held out.
+// - More than two runs: every other run trains, the rest is held out.
 // - One or two long runs fitted on their tracks (--residuals track/both, or auto resolving to
 //   track): each is cut into blocks of equal ground-truth path (validation/time_blocks.h), odd
 //   blocks against even ones, for 2, 4 and 8 blocks (and `num_blocks` when it is another count),
@@ -46,17 +45,9 @@ struct HalvesFold {
 // The time blocks of the training runs, fold 0 training on the odd blocks and fold 1 on the even.
 HalvesFold TimeBlockFold(const RunSplit& whole, int num_blocks, int fold);
 
-// Every other training run of each kind of motion - the runs of one trajectory label that turn
-// the same way (TurningSense) - so that both halves drive every kind: fold 0 trains on a kind's
-// 1st, 3rd, ... run and fold 1 on its 2nd, 4th, ..., or the other way round when the kind's first
-// run stands at an odd place in the data set. Where each kind's runs stand together this is every
-// other run in data-set order, so each session gives to both halves.
+// Every other training run (in data-set order, so each session gives to both halves): fold 0
+// trains on runs 0, 2, 4, ..., fold 1 on runs 1, 3, 5, ...
 RunSplit RunsFold(const RunSplit& whole, int fold);
-
-// The way a run turns on its ground truth: +1 counter-clockwise, -1 clockwise, 0 when it turns
-// less than half a turn in all, or its track is missing or too sparse to follow (a step of over
-// 90 deg between two poses).
-int TurningSense(const AlignedRun& run);
 
 // The parameters fitted on a fold's training runs; nullopt when that fit cannot be made or is not
 // usable (the judgement is then not made).
