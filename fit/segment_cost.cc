@@ -37,14 +37,10 @@ std::vector<Segment> MakeSegments(const AlignedRun& run, const GroundTruthTrack&
                                   const SegmentOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) throw std::invalid_argument("SegmentOptions: " + error);
-  const std::vector<double> t = BoundaryTimes(run);
-  std::vector<Pose2d> q(t.size());
-  std::vector<double> s(t.size(), 0.0);
-  std::size_t bracket = 0;
-  for (std::size_t b = 0; b < t.size(); ++b) {
-    q[b] = InterpolateGroundTruth(ground_truth, t[b], &bracket);
-    if (b > 0) s[b] = s[b - 1] + std::hypot(q[b].x - q[b - 1].x, q[b].y - q[b - 1].y);
-  }
+  const BoundaryGroundTruth boundaries = GroundTruthAtBoundaries(run, ground_truth);
+  const std::vector<double>& t = boundaries.t_s;
+  const std::vector<Pose2d>& q = boundaries.pose;
+  const std::vector<double>& s = boundaries.path_m;
   std::vector<Segment> out;
   const double stride = options.stride_fraction * options.length_m;
   double next_start = 0.0;
@@ -69,26 +65,21 @@ std::vector<Segment> MakeCheckpointsFromStart(const AlignedRun& run,
                                               const GroundTruthTrack& ground_truth,
                                               double spacing_m) {
   if (!(spacing_m > 0.0)) throw std::invalid_argument("checkpoint spacing must be positive");
-  const std::vector<double> t = BoundaryTimes(run);
+  const BoundaryGroundTruth boundaries = GroundTruthAtBoundaries(run, ground_truth);
+  const std::vector<Pose2d>& q = boundaries.pose;
+  const std::vector<double>& path_m = boundaries.path_m;
   std::vector<Segment> out;
-  if (t.size() < 2) return out;
-  std::size_t bracket = 0;
-  const Pose2d start = InterpolateGroundTruth(ground_truth, t[0], &bracket);
-  Pose2d previous = start;
-  double path_m = 0.0, next_checkpoint_m = spacing_m;
-  for (std::size_t j = 1; j < t.size(); ++j) {
-    const Pose2d q = InterpolateGroundTruth(ground_truth, t[j], &bracket);
-    path_m += std::hypot(q.x - previous.x, q.y - previous.y);
-    previous = q;
-    const bool last = j + 1 == t.size();
-    if (path_m < next_checkpoint_m && !last) continue;
+  double next_checkpoint_m = spacing_m;
+  for (std::size_t j = 1; j < q.size(); ++j) {
+    const bool last = j + 1 == q.size();
+    if (path_m[j] < next_checkpoint_m && !last) continue;
     Segment seg;
     seg.begin = 0;
     seg.end = j;
-    seg.ground_truth_start_T_end = Between(start, q);
-    seg.path_length_m = path_m;
+    seg.ground_truth_start_T_end = Between(q[0], q[j]);
+    seg.path_length_m = path_m[j];
     out.push_back(seg);
-    next_checkpoint_m = path_m + spacing_m;  // the count restarts at each, as the authors'
+    next_checkpoint_m = path_m[j] + spacing_m;  // the count restarts at each, as the authors'
   }
   return out;
 }

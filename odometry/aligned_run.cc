@@ -1,6 +1,7 @@
 #include "odometry/aligned_run.h"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 namespace fitcal {
@@ -79,6 +80,21 @@ std::vector<double> BoundaryTimes(const AlignedRun& run) {
   t[0] = run.t_start_s;
   for (std::size_t k = 0; k < run.samples.size(); ++k) t[k + 1] = t[k] + run.samples[k].dt_s;
   return t;
+}
+
+BoundaryGroundTruth GroundTruthAtBoundaries(const AlignedRun& run, const GroundTruthTrack& track) {
+  BoundaryGroundTruth out;
+  out.t_s = BoundaryTimes(run);
+  out.pose.resize(out.t_s.size());
+  out.path_m.assign(out.t_s.size(), 0.0);
+  std::size_t bracket = 0;  // the times rise: each search starts where the last one ended
+  for (std::size_t b = 0; b < out.t_s.size(); ++b) {
+    out.pose[b] = InterpolateGroundTruth(track, out.t_s[b], &bracket);
+    if (b == 0) continue;
+    const Pose2d& from = out.pose[b - 1];
+    out.path_m[b] = out.path_m[b - 1] + std::hypot(out.pose[b].x - from.x, out.pose[b].y - from.y);
+  }
+  return out;
 }
 
 }  // namespace fitcal

@@ -42,6 +42,15 @@ std::vector<AlignedRun> AlignRuns(const std::vector<RunLog>& runs);
 // The encoder time of each sample boundary of a run: [0] = t_start_s, [k + 1] after sample k.
 std::vector<double> BoundaryTimes(const AlignedRun& run);
 
+// The ground truth at each sample boundary: the pose there and the path length from the start,
+// summed chord by chord in boundary order - where segments, checkpoints and time blocks cut.
+struct BoundaryGroundTruth {
+  std::vector<double> t_s;   // BoundaryTimes(run)
+  std::vector<Pose2d> pose;  // world_T_robot at t_s[b]
+  std::vector<double> path_m;
+};
+BoundaryGroundTruth GroundTruthAtBoundaries(const AlignedRun& run, const GroundTruthTrack& track);
+
 // Each run's ground-truth track (AlignedRun::track), in the runs' order; throws
 // std::invalid_argument naming a run aligned without its log.
 std::vector<const GroundTruthTrack*> TracksOf(const std::vector<AlignedRun>& runs);

@@ -58,14 +58,9 @@ std::vector<AlignedRun> CutIntoTimeBlocks(const AlignedRun& run, int num_blocks)
   }
   const GroundTruthTrack& track = *run.track;
   // Boundary b lies after b samples; its ground-truth path length from the start.
-  const std::vector<double> t = BoundaryTimes(run);
-  std::vector<double> s(n + 1, 0.0);
-  Pose2d previous = InterpolateGroundTruth(track, t[0]);
-  for (std::size_t k = 0; k < n; ++k) {
-    const Pose2d q = InterpolateGroundTruth(track, t[k + 1]);
-    s[k + 1] = s[k] + std::hypot(q.x - previous.x, q.y - previous.y);
-    previous = q;
-  }
+  const BoundaryGroundTruth boundaries = GroundTruthAtBoundaries(run, track);
+  const std::vector<double>& t = boundaries.t_s;
+  const std::vector<double>& s = boundaries.path_m;
   std::vector<std::size_t> cut = {0};
   const double reach_m = s[n] / num_blocks * kBoundaryReach;
   for (int b = 1; b < num_blocks; ++b) {
@@ -85,8 +80,8 @@ std::vector<AlignedRun> CutIntoTimeBlocks(const AlignedRun& run, int num_blocks)
     block.repetition = b + 1;
     block.t_start_s = t[begin];
     block.t_final_s = t[end];
-    block.start = InterpolateGroundTruth(track, t[begin]);
-    block.final_ground_truth = InterpolateGroundTruth(track, t[end]);
+    block.start = boundaries.pose[begin];
+    block.final_ground_truth = boundaries.pose[end];
     block.track = run.track;  // a block replays against its run's track
     block.samples = EncoderSamples(run.samples.num_channels());
     for (std::size_t k = begin; k < end; ++k) block.samples.push_back(run.samples[k]);
