@@ -85,10 +85,13 @@ void FitTrainingRuns(const CalibrationRequest& r, const RobotModelInterface& mod
     Refuse(out, 1, {r.dataset + ": " + refusal});
     return;
   }
-  out->halves = JudgeMethodOnHeldOutHalves(*r.method, r.threads, r.time_blocks, out->settings,
-                                           model, out->split);
   out->fit = chosen_fit ? std::move(*chosen_fit)
                         : r.method->run_model(out->split.training, model, out->settings);
+  const ModelFitResult& whole = out->fit.fit;
+  out->halves = JudgeMethodOnHeldOutHalves(
+      *r.method, r.threads, r.time_blocks, out->settings,
+      whole.usable || whole.stopped_early ? whole.parameters : std::vector<double>{}, model,
+      out->split);
 }
 
 // The candidates fitted and judged by the gate, the effects' paired test, and what the selected

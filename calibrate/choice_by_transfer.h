@@ -84,9 +84,13 @@ std::vector<std::string> ChooseWeightsOnHeldOutRuns(const FitMethod& method, int
                                                     std::string* note);
 
 // With nothing held out, the two-fold judgement of validation/held_out_halves.h, each fold fitted
-// by `method` with the whole data's settings and scored on the everyday-driving measures.
+// by `method` with the whole data's settings and scored on the everyday-driving measures. A fold
+// is fitted from the guess and from `whole_fit` (the fit of all the training runs; empty: the
+// guess only), the lower cost on the fold's own runs kept: judged is the best fit the fold's runs
+// give, not where one start of the search ended.
 HalvesJudgement JudgeMethodOnHeldOutHalves(const FitMethod& method, int threads, int time_blocks,
                                            const FitMethodSettings& settings,
+                                           const std::vector<double>& whole_fit,
                                            const RobotModelInterface& model,
                                            const RunSplit& split);
 

@@ -343,7 +343,7 @@ void CutCsvAt(const std::string& file, double t_max) {
 // --residuals auto choosing the final pose writes a fit from where the choice judged it: the folds
 // that chose it start from the track's fit of all the training runs, and so does the fit written
 // (the lower cost of that start and of the guess's). From the guess alone this diff drive (a
-// radius guessed 24 % off, every run cut to 56 % of its encoder time) ended in a local minimum -
+// radius guessed 24 % off, every run cut to 55.6 % of its encoder time) ended in a local minimum -
 // training CF 1.64 against 0.007, r_left -34 % - and was written with exit 0 (found by a
 // randomized sweep of `simulate` and `fit`, stop 65). 1 % separates the truth, which the fit
 // reaches within 0.05 %, from that minimum (and from swapped wheels: 0.032 against 0.045).
@@ -360,18 +360,27 @@ TEST(ResidualKindChoice, AChosenFinalPoseIsFittedFromTheTracksFit) {
     std::istringstream rows(ReadFileBytes(encoders));
     std::string row, last;
     while (std::getline(rows, row)) last = row;
-    const double t_max = 0.56 * std::stod(last.substr(0, last.find(',')));
+    const double t_max = 0.5559 * std::stod(last.substr(0, last.find(',')));
     CutCsvAt(encoders, t_max);
     CutCsvAt(data + "/" + run["ground_truth"].as<std::string>(), t_max);
   }
-  const auto r = RunFitcal(dir, "fit --logs " + data + " --train-reps 1-9 --out " + cal);
-  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
-  EXPECT_TRUE(Has(r.out, "final-pose chosen")) << r.out;
-  const Robot fitted = ReadRobotModelFile(cal)->robot();
+  // 1-99: nothing held out, the halves judge; each half is fitted from the guess and from the
+  // whole fit (of the track or the final pose, as the choice goes). From the guess alone they
+  // ended in local minima (halves' CF 3.06 -> 2.4) and the calibration was refused as "the runs
+  // do not determine the parameters".
   const Robot truth = ReadRobotModelFile(dir.Path("truth.yaml"))->robot();
-  for (int k = 0; k < truth.NumParameters(); ++k) {
-    EXPECT_NEAR(fitted.nominal[k], truth.nominal[k], 0.01 * truth.nominal[k])
-        << truth.parameters[k].name;
+  for (const std::string training : {"1-9", "1-99"}) {
+    const auto r = RunFitcal(dir, "fit --logs " + data + " --train-reps " + training + " --out " +
+                                      cal);
+    ASSERT_EQ(r.exit_code, 0) << training << r.out << r.err;
+    if (training == "1-9") {
+      EXPECT_TRUE(Has(r.out, "final-pose chosen")) << r.out;
+    }
+    const Robot fitted = ReadRobotModelFile(cal)->robot();
+    for (int k = 0; k < truth.NumParameters(); ++k) {
+      EXPECT_NEAR(fitted.nominal[k], truth.nominal[k], 0.01 * truth.nominal[k])
+          << training << " " << truth.parameters[k].name;
+    }
   }
 }
 
