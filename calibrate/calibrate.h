@@ -53,6 +53,7 @@ struct CalibrationOutcome {
   GateDecision gate;                              // judged_on: what the record says
   std::string gate_judged_on;                     // what the gate's table says
   std::string effects_line;                       // the effects' paired test, or empty
+  std::string gave_way_line;  // the gate's pick on a bound gave way to the next best, or empty
   SelectedFit selected_fit;
   HalvesJudgement halves;
   std::vector<std::string> never_worse_warnings;

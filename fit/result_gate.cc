@@ -64,6 +64,20 @@ std::string AtBoundRefusal(const Robot& robot, const std::string& name,
          "writes a calibration that still ends on a widened bound)";
 }
 
+int BestCandidateInsideTheBounds(const std::vector<CalibrationCandidate>& candidates,
+                                 const GateDecision& decision,
+                                 const std::function<std::vector<bool>(int)>& at_bound) {
+  int best = 0;
+  for (int i = 1; i < static_cast<int>(candidates.size()); ++i) {
+    const CalibrationCandidate& c = candidates[i];
+    if (i == decision.selected || !c.usable || !c.effects.empty()) continue;
+    if (!(decision.cf[i] < decision.cf[best])) continue;  // the nominal and earlier win ties
+    const std::vector<bool> on = at_bound(i);
+    if (std::find(on.begin(), on.end(), true) == on.end()) best = i;
+  }
+  return best;
+}
+
 std::vector<std::string> GateLines(const std::vector<CalibrationCandidate>& candidates,
                                    const GateDecision& decision) {
   std::vector<std::string> out;

@@ -60,6 +60,13 @@ std::string AtBoundRefusal(const Robot& robot, const std::string& name,
                            const std::vector<double>& parameters,
                            const std::vector<bool>& at_bound);
 
+// The gate's pick when its selected candidate is on a bound (AtBoundRefusal) and the bounds were
+// not widened: the best other candidate without effects that beats the nominal with no parameter
+// on its bound (`at_bound(i)`, robot().parameters order); 0 when none does.
+int BestCandidateInsideTheBounds(const std::vector<CalibrationCandidate>& candidates,
+                                 const GateDecision& decision,
+                                 const std::function<std::vector<bool>(int)>& at_bound);
+
 // One line per candidate for the terminal: name, CF, change against nominal, and which won.
 std::vector<std::string> GateLines(const std::vector<CalibrationCandidate>& candidates,
                                    const GateDecision& decision);

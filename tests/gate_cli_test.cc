@@ -131,5 +131,26 @@ TEST(GateCli, RefusedTimeBlocksDoNotDescribeACalibrationWritten) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// A real 12-run session (OptiOdom's omni3, circular 221220201701) drives four paths, three runs
+// each: repetitions 1-5 train on the first two and leave directions undetermined, and the fit
+// loses to the nominal on the held-out paths. The refusal says what to try; --train-reps 1-99
+// writes (its calibration beats the nominal on the robot's other sessions: stop 65's sweep).
+TEST(GateCli, ARefusedSplitByRepetitionSaysWhatToTry) {
+  const std::string session = FITCAL_SHARED_DIR + "/data/optiodom/omni3/circular/221220201701";
+  if (!fs::is_directory(session)) GTEST_SKIP() << "no " << session;
+  TempDir dir;
+  const std::string data = dir.Path("data"), out = dir.Path("cal.yaml");
+  ASSERT_EQ(RunFitcal(dir, "import optiodom " + session + " --out " + data).exit_code, 0);
+  const auto refused = RunFitcal(dir, "fit --logs " + data + " --out " + out);
+  EXPECT_EQ(refused.exit_code, 5) << refused.out << refused.err;
+  EXPECT_TRUE(Has(refused.err, "(repetitions 1-5) leave directions undetermined")) << refused.err;
+  EXPECT_TRUE(Has(refused.err, "--train-reps 1-99 fits every run")) << refused.err;
+  EXPECT_FALSE(fs::exists(out));
+  const auto every_run = RunFitcal(dir, "fit --logs " + data + " --train-reps 1-99 --out " + out);
+  EXPECT_EQ(every_run.exit_code, 0) << every_run.out << every_run.err;
+  EXPECT_FALSE(Has(every_run.err, "leave directions undetermined")) << every_run.err;
+  EXPECT_TRUE(fs::exists(out));
+}
+
 }  // namespace
 }  // namespace fitcal

@@ -100,6 +100,28 @@ TEST(ResultGate, AtBoundRefusalNamesTheParameter) {
   EXPECT_NE(refusal.find("--bounds-widened"), std::string::npos) << refusal;
 }
 
+// A pick on a bound gives way to the best other candidate that beats the nominal with nothing on
+// a bound; a candidate with effects (their own test chose among them), one on a bound itself, one
+// not usable and one that only ties the nominal do not take its place.
+TEST(ResultGate, APickOnABoundGivesWayToTheBestInsideTheBounds) {
+  std::vector<CalibrationCandidate> candidates = {
+      {"nominal", {0.0}}, {"closed form", {1.0}}, {"other fit", {2.0}}, {"ceres", {3.0}},
+      {"with effects", {4.0}, true, {effects::EffectValue{}}}};
+  GateDecision decision;
+  decision.selected = 3;
+  decision.cf = {1.0, 0.5, 0.4, 0.3, 0.2};
+  std::vector<bool> on_a_bound = {false, false, false, true, false};
+  const auto at_bound = [&](int i) { return std::vector<bool>{false, on_a_bound[i]}; };
+  EXPECT_EQ(BestCandidateInsideTheBounds(candidates, decision, at_bound), 2);
+  on_a_bound[2] = true;
+  EXPECT_EQ(BestCandidateInsideTheBounds(candidates, decision, at_bound), 1);
+  candidates[1].usable = false;
+  EXPECT_EQ(BestCandidateInsideTheBounds(candidates, decision, at_bound), 0);
+  candidates[1].usable = true;
+  decision.cf[1] = 1.0;  // a tie with the nominal earns no place
+  EXPECT_EQ(BestCandidateInsideTheBounds(candidates, decision, at_bound), 0);
+}
+
 // The t quantile the margins use, against two table values (Student t, one-sided: t_{0.95, 2} =
 // 2.920, t_{0.995, 10} = 3.169; any statistics table).
 TEST(NeverWorse, StudentQuantileMatchesTheTable) {
