@@ -33,7 +33,10 @@ void EmitCalibrationCf(YAML::Emitter& out, const CalibrationSource& c) {
         << YAML::Value << before << YAML::Key << "after" << YAML::Value << after << YAML::EndMap;
   };
   before_after("cf_training", c.cf_training_before, c.cf_training_after);
-  before_after("cf_validation", c.cf_validation_before, c.cf_validation_after);
+  // With every run trained there is nothing it was validated on: no figures, not zeros.
+  if (c.validation_runs > 0) {
+    before_after("cf_validation", c.cf_validation_before, c.cf_validation_after);
+  }
 }
 
 void EmitRuns(YAML::Emitter& out, const CalibrationBlock& c) {
