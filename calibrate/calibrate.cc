@@ -163,7 +163,7 @@ bool SelectCandidate(const CalibrationRequest& r, const RobotModelInterface& mod
     refusal = AddPropagatedUncertainty(model, out->selected(), split.training, &out->selected_fit);
   }
   MarkWiderThanTheBounds(model.robot(), &out->selected_fit);
-  return refusal.empty() || Refuse(out, 1, {refusal});
+  return refusal.empty() || Refuse(out, 1, {r.dataset + ": " + refusal});
 }
 
 // What to try when the training runs, chosen by repetition, leave directions undetermined that
