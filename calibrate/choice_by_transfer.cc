@@ -238,6 +238,7 @@ HalvesJudgement JudgeMethodOnHeldOutHalves(const FitMethod& method, int threads,
   const FitOnFold fit_on = [&](const HalvesFold& fold) -> std::optional<std::vector<double>> {
     FitMethodSettings fold_settings = settings;
     fold_settings.residuals_auto = false;  // the whole data's choice holds for its halves
+    fold_settings.judgement_fit = true;  // the parameters alone are read: no covariance
     std::optional<TrackFitData> track_data;
     if (!PrepareTrackResiduals(method.name, fold.split.training, &fold_settings, &track_data)
              .empty()) {
