@@ -150,6 +150,7 @@ class FitProblem {
           new HoldDirectionsCost(holds.directions, model.robot(), holds.weight), nullptr, p);
     }
     BoundModelBlock(model.robot(), fixed, p, problem_.get());
+    p_ = p;
   }
 
   // Each clock offset in [-max, max], or held at its value when not estimated.
@@ -171,17 +172,22 @@ class FitProblem {
   // The runs' residual blocks (not the hold), for the residual variance.
   const std::vector<ceres::ResidualBlockId>& data_blocks() const { return data_blocks_; }
 
-  // Gradient of the (loss-shaped) cost with respect to every parameter.
-  std::vector<double> FullGradient() {
+  // Gradient of the (loss-shaped) cost in the model's parameters (robot().parameters order) - in
+  // all of them only when none is fixed: Ceres gives a block with fixed entries (SubsetManifold)
+  // the gradient of its free ones alone.
+  std::vector<double> ModelGradient() {
+    ceres::Problem::EvaluateOptions options;
+    options.parameter_blocks = {p_};
     double cost = 0.0;
     std::vector<double> gradient;
-    problem_->Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, &gradient, nullptr);
+    problem_->Evaluate(options, &cost, nullptr, &gradient, nullptr);
     return gradient;
   }
 
  private:
   std::unique_ptr<ceres::Problem> problem_;
   std::vector<ceres::ResidualBlockId> data_blocks_;
+  double* p_ = nullptr;  // the model's parameter block
 };
 
 // Ends a bounded solve once a free parameter has rested on its bound (AtBound) for
@@ -278,10 +284,14 @@ ceres::Solver::Summary RefineWithActiveSet(const std::vector<AlignedRun>& traini
       continue;
     }
     if (summary.termination_type != ceres::CONVERGENCE) break;
-    // Release a bound parameter whose descent direction points into the box.
-    FitProblem all_free(training, model, options, result->held, p.data(),
+    // Release a bound parameter whose descent direction points into the box. Nothing is fixed in
+    // the problem that measures it, so the gradient has every parameter's entry: with the held
+    // ones fixed it had fewer, g[k] read another parameter's entry or past the end, and fits
+    // with a held parameter on a bound released parameters by chance (valgrind; a simulated
+    // ASOC's --train-reps 1-99 fit differed from run to run, stop 66).
+    FitProblem all_free(training, model, options, std::vector<bool>(n, false), p.data(),
                         result->clock_offsets_s.data(), holds, memos);
-    const std::vector<double> g = all_free.FullGradient();
+    const std::vector<double> g = all_free.ModelGradient();
     bool released = false;
     for (int k = 0; k < n; ++k) {
       if (!fixed[k] || result->held[k]) continue;
