@@ -366,7 +366,7 @@ TEST(ResidualKindChoice, AChosenFinalPoseIsFittedFromTheTracksFit) {
   }
   // 1-99: nothing held out, the halves judge; each half is fitted from the guess and from the
   // whole fit (of the track or the final pose, as the choice goes). From the guess alone they
-  // ended in local minima (halves' CF 3.06 -> 2.4) and the calibration was refused as "the runs
+  // ended in local minima (halves' CF 3.08 -> 2.46) and the calibration was refused as "the runs
   // do not determine the parameters".
   const Robot truth = ReadRobotModelFile(dir.Path("truth.yaml"))->robot();
   for (const std::string training : {"1-9", "1-99"}) {
