@@ -259,6 +259,21 @@ void FixParametersAtBound(const Robot& robot, std::vector<double>* p, std::vecto
   }
 }
 
+// The cost's gradient in every model parameter at p (FitCostGradient): measured on a problem with
+// nothing fixed. With the held parameters fixed it had fewer entries, g[k] was another
+// parameter's entry or lay past the end, and fits with a held parameter on a bound released
+// parameters by chance (valgrind; a simulated ASOC's fits differed from run to run, stop 66).
+std::vector<double> GradientInEveryParameter(const std::vector<AlignedRun>& training,
+                                             const RobotModelInterface& model,
+                                             const ModelFitOptions& options, double* p,
+                                             double* clock_offsets, const HeldDirections& holds,
+                                             std::vector<OdometryMemo>* memos) {
+  FitProblem all_free(training, model, options,
+                      std::vector<bool>(model.robot().NumParameters(), false), p, clock_offsets,
+                      holds, memos);
+  return all_free.ModelGradient();
+}
+
 // Active-set rounds after a bounded solve that did not converge (header comment). Returns the
 // last solve's summary.
 ceres::Solver::Summary RefineWithActiveSet(const std::vector<AlignedRun>& training,
@@ -284,14 +299,9 @@ ceres::Solver::Summary RefineWithActiveSet(const std::vector<AlignedRun>& traini
       continue;
     }
     if (summary.termination_type != ceres::CONVERGENCE) break;
-    // Release a bound parameter whose descent direction points into the box. Nothing is fixed in
-    // the problem that measures it, so the gradient has every parameter's entry: with the held
-    // ones fixed it had fewer, g[k] read another parameter's entry or past the end, and fits
-    // with a held parameter on a bound released parameters by chance (valgrind; a simulated
-    // ASOC's --train-reps 1-99 fit differed from run to run, stop 66).
-    FitProblem all_free(training, model, options, std::vector<bool>(n, false), p.data(),
-                        result->clock_offsets_s.data(), holds, memos);
-    const std::vector<double> g = all_free.ModelGradient();
+    // Release a bound parameter whose descent direction points into the box.
+    const std::vector<double> g = GradientInEveryParameter(
+        training, model, options, p.data(), result->clock_offsets_s.data(), holds, memos);
     bool released = false;
     for (int k = 0; k < n; ++k) {
       if (!fixed[k] || result->held[k]) continue;
@@ -1157,6 +1167,15 @@ ModelFitResult FitModel(const std::vector<AlignedRun>& training, const RobotMode
   ModelFitResult local = FitModelFrom(training, model, model.robot().nominal, options);
   if (!options.global_start) return local;
   return WithGlobalStart(training, model, options, std::move(local));
+}
+
+std::vector<double> FitCostGradient(const std::vector<AlignedRun>& training,
+                                    const RobotModelInterface& model, std::vector<double> p,
+                                    const ModelFitOptions& options) {
+  std::vector<double> offsets(
+      UsesTracks(options) ? std::max<std::size_t>(1, options.track->clock_groups.size()) : 1, 0.0);
+  return GradientInEveryParameter(training, model, options, p.data(), offsets.data(), {},
+                                  nullptr);
 }
 
 }  // namespace fitcal

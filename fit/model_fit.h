@@ -188,4 +188,11 @@ ModelFitResult FitModelFrom(const std::vector<AlignedRun>& training,
                             const RobotModelInterface& model, const std::vector<double>& start,
                             const ModelFitOptions& options = {});
 
+// The gradient of the fit's cost (the runs' residuals as FitModel weighs them) at `p`, one entry
+// per parameter of `model`, held ones included: what the active set's release test reads. (From a
+// problem with the held parameters fixed, Ceres gives the free entries alone.)
+std::vector<double> FitCostGradient(const std::vector<AlignedRun>& training,
+                                    const RobotModelInterface& model, std::vector<double> p,
+                                    const ModelFitOptions& options = {});
+
 }  // namespace fitcal
