@@ -97,20 +97,18 @@ void FitTrainingRuns(const CalibrationRequest& r, const RobotModelInterface& mod
 }
 
 // The bounds' rule (JudgeBounds) applied among the candidates: a selected candidate with a
-// parameter on its bound gives way to the best candidate inside its bounds that beats the nominal
-// too (stop 65's sweep: an ASOC fit with --train-reps 1-99 ended with d_2_3 on its bound and was
-// refused while its geometric closed form, inside its bounds, beat the nominal by 98 %). With
-// none, the selection stands and JudgeBounds refuses it with the reason.
-void GiveWayOnABound(const Robot& robot, const std::string& method, CalibrationOutcome* out) {
+// parameter on its bound (its description's at_bound, out->selected_fit) gives way to the best
+// candidate inside its bounds that beats the nominal too (stop 65's sweep: an ASOC fit with
+// --train-reps 1-99 ended with d_2_3 on its bound and was refused while its geometric closed form,
+// inside its bounds, beat the nominal by 98 %); true when it did. With none, the selection stands
+// and JudgeBounds refuses it with the reason.
+bool GiveWayOnABound(const Robot& robot, const std::string& method, CalibrationOutcome* out) {
   const int selected = out->gate.selected;
-  if (selected == 0) return;
+  if (selected == 0) return false;
   const CalibrationCandidate& c = out->candidates[selected];
-  const std::string refusal = AtBoundRefusal(
-      robot, c.name, c.parameters,
-      DescribeSelected(robot, out->candidates, selected, method, "", out->fit.fit,
-                       out->track_fits)
-          .at_bound);
-  if (refusal.empty()) return;
+  const std::string refusal =
+      AtBoundRefusal(robot, c.name, c.parameters, out->selected_fit.at_bound);
+  if (refusal.empty()) return false;
   // The other candidates by the parameters' own values (a closed form's too; the method's fit
   // by its own rule, which leaves out what it held).
   const int next = BestCandidateInsideTheBounds(out->candidates, out->gate, [&](int i) {
@@ -118,10 +116,11 @@ void GiveWayOnABound(const Robot& robot, const std::string& method, CalibrationO
     return other.name == method ? out->fit.fit.at_bound
                                 : ParametersAtBound(robot, other.parameters);
   });
-  if (next == 0) return;
+  if (next == 0) return false;
   out->gate.selected = next;
   out->gave_way_line = refusal + "; selected instead: '" + out->candidates[next].name +
                        "', inside its bounds (--bounds-widened would write '" + c.name + "')";
+  return true;
 }
 
 // The candidates fitted and judged by the gate, the effects' paired test, and what the selected
@@ -149,10 +148,15 @@ bool SelectCandidate(const CalibrationRequest& r, const RobotModelInterface& mod
     out->effects_line = RequireEffectsToEarnTheirPlace(out->candidates, split, errors,
                                                        *out->track_fits, &out->gate);
   }
-  if (!r.bounds_widened) GiveWayOnABound(model.robot(), r.method->name, out);
-  out->selected_fit =
-      DescribeSelected(model.robot(), out->candidates, out->gate.selected, r.method->name,
-                       out->fit.objective + objective_note, out->fit.fit, out->track_fits);
+  const auto describe_selected = [&] {
+    out->selected_fit =
+        DescribeSelected(model.robot(), out->candidates, out->gate.selected, r.method->name,
+                         out->fit.objective + objective_note, out->fit.fit, out->track_fits);
+  };
+  describe_selected();
+  if (!r.bounds_widened && GiveWayOnABound(model.robot(), r.method->name, out)) {
+    describe_selected();
+  }
   if (out->gate.selected != 0 && out->selected().name == r.method->name) {
     AddReadingResolutionUncertainty(*r.method, out->settings, model, split.training,
                                     ReadingResolutionsOf(model.robot(), r.runs),

@@ -93,27 +93,23 @@ void FitAllTrainingRuns(const FitMethod& method, const RobotModelInterface& mode
   fold_fits->seed_levels = whole.noise_levels;
 }
 
-// The final pose's fit of all the training runs when it replaces the track: from the guess (with
-// FitModel's global start) and from the track's fit of the same runs, `track_fit`, the lower cost
-// kept. The folds that chose the final pose started from the track's fit; from the guess alone
-// the fit written could end elsewhere (a randomized sweep, stop 65: a diff drive with a radius
-// guessed 24 % off, its runs cut to 56 %, ended in a local minimum at training CF 1.64 against
-// 0.007 at the truth and was written; its flat direction held, so no reason to start across the
-// box showed).
-void FitFinalPoseOfAllTrainingRuns(const FitMethod& method, const RobotModelInterface& model,
-                                   const RunSplit& split, const FitMethodSettings& settings,
-                                   const std::vector<double>& track_fit,
-                                   std::optional<ModelFitMethodOutcome>* full) {
-  full->emplace(method.run_model(split.training, model, settings));
-  if (track_fit.empty()) return;
-  FitMethodSettings from_track = settings;
-  from_track.start = track_fit;
-  ModelFitMethodOutcome warm = method.run_model(split.training, model, from_track);
+// `settings`' fit of `training` from the guess (FitModel's global start) and, unless `start` is
+// empty, from `start`, the lower cost of the usable ones kept: either start can end in a local
+// minimum the other leaves.
+ModelFitMethodOutcome FitFromGuessAndFrom(const FitMethod& method,
+                                          const std::vector<AlignedRun>& training,
+                                          const RobotModelInterface& model,
+                                          const FitMethodSettings& settings,
+                                          const std::vector<double>& start) {
+  ModelFitMethodOutcome guess = method.run_model(training, model, settings);
+  if (start.empty()) return guess;
+  FitMethodSettings from_start = settings;
+  from_start.start = start;
+  ModelFitMethodOutcome warm = method.run_model(training, model, from_start);
   const auto usable = [](const ModelFitResult& f) { return f.usable || f.stopped_early; };
-  const ModelFitResult& guess = (*full)->fit;
-  if (usable(warm.fit) && (!usable(guess) || warm.fit.final_cost < guess.final_cost)) {
-    *full = std::move(warm);
-  }
+  const bool warm_is_lower =
+      usable(warm.fit) && (!usable(guess.fit) || warm.fit.final_cost < guess.fit.final_cost);
+  return warm_is_lower ? std::move(warm) : std::move(guess);
 }
 
 // The track objectives --track-heading auto judges, the default first (heading from the start),
@@ -147,7 +143,13 @@ std::vector<std::string> ChooseResidualsByTransfer(const FitMethod& method, int 
     settings->residuals = judgement.chosen;
     settings->track = nullptr;
     track_data->reset();
-    FitFinalPoseOfAllTrainingRuns(method, model, split, *settings, fold_fits->start, full);
+    // The final pose's fit of all the training runs, from the guess and from the track's fit of
+    // the same runs, where the folds that chose it started. From the guess alone the fit written
+    // could end elsewhere (a randomized sweep, stop 65: a diff drive with a radius guessed 24 %
+    // off, its runs cut to 56 %, ended in a local minimum at training CF 1.64 against 0.007 at
+    // the truth and was written; its flat direction held, so no reason to start across the box
+    // showed).
+    full->emplace(FitFromGuessAndFrom(method, split.training, model, *settings, fold_fits->start));
   }
   return ResidualKindJudgementLines(judgement);
 }
@@ -244,20 +246,13 @@ HalvesJudgement JudgeMethodOnHeldOutHalves(const FitMethod& method, int threads,
              .empty()) {
       return std::nullopt;
     }
-    const auto usable = [](const ModelFitResult& f) { return f.usable || f.stopped_early; };
-    ModelFitResult fit = method.run_model(fold.split.training, model, fold_settings).fit;
-    if (!whole_fit.empty()) {
-      // From the guess alone a fold's fit can end in a local minimum the whole data's fit left
-      // (a randomized sweep, stop 65: a diff drive guessed 24 % off, halves' CF 3.08 -> 2.46,
-      // refused as "the runs do not determine the parameters" while every half fitted from the
-      // whole fit lands at the truth's level).
-      fold_settings.start = whole_fit;
-      ModelFitResult warm = method.run_model(fold.split.training, model, fold_settings).fit;
-      if (usable(warm) && (!usable(fit) || warm.final_cost < fit.final_cost)) {
-        fit = std::move(warm);
-      }
-    }
-    if (!usable(fit)) return std::nullopt;
+    // From the guess alone a fold's fit can end in a local minimum the whole data's fit left (a
+    // randomized sweep, stop 65: a diff drive guessed 24 % off, halves' CF 3.08 -> 2.46, refused
+    // as "the runs do not determine the parameters" while every half fitted from the whole fit
+    // lands at the truth's level).
+    const ModelFitResult fit =
+        FitFromGuessAndFrom(method, fold.split.training, model, fold_settings, whole_fit).fit;
+    if (!(fit.usable || fit.stopped_early)) return std::nullopt;
     return fit.parameters;
   };
   const ScoreOnRuns on_runs = EverydayDrivingScore(model, threads, EverydayDriftLengths());

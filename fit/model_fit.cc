@@ -708,6 +708,12 @@ void AlternateWithClockOffsets(const std::vector<AlignedRun>& training,
   }
 }
 
+// The clock offsets a problem points into: one per clock group, and one slot even without tracks
+// (the problem takes a pointer it never uses then).
+std::size_t ClockOffsetSlots(const ModelFitOptions& options) {
+  return UsesTracks(options) ? std::max<std::size_t>(1, options.track->clock_groups.size()) : 1;
+}
+
 // One bounded solve from `start` with `holds`, refined by the active set when it did not converge.
 ModelFitResult SolveFrom(const std::vector<AlignedRun>& training, const RobotModelInterface& model,
                          const std::vector<double>& start, const ModelFitOptions& options,
@@ -716,9 +722,7 @@ ModelFitResult SolveFrom(const std::vector<AlignedRun>& training, const RobotMod
   ModelFitResult result;
   result.parameters = start;
   result.held = HoldAtNominal(robot, result.parameters.data());
-  // One slot even without tracks: the problem takes a pointer it never uses then.
-  result.clock_offsets_s.assign(
-      UsesTracks(options) ? std::max<std::size_t>(1, options.track->clock_groups.size()) : 1, 0.0);
+  result.clock_offsets_s.assign(ClockOffsetSlots(options), 0.0);
   const auto t0 = std::chrono::steady_clock::now();
   // With estimated offsets, the parameters' solves below hold them (AlternateWithClockOffsets).
   const bool offsets = UsesTracks(options) && options.track->estimate_clock_offsets;
@@ -1172,8 +1176,7 @@ ModelFitResult FitModel(const std::vector<AlignedRun>& training, const RobotMode
 std::vector<double> FitCostGradient(const std::vector<AlignedRun>& training,
                                     const RobotModelInterface& model, std::vector<double> p,
                                     const ModelFitOptions& options) {
-  std::vector<double> offsets(
-      UsesTracks(options) ? std::max<std::size_t>(1, options.track->clock_groups.size()) : 1, 0.0);
+  std::vector<double> offsets(ClockOffsetSlots(options), 0.0);
   return GradientInEveryParameter(training, model, options, p.data(), offsets.data(), {},
                                   nullptr);
 }
