@@ -15,6 +15,7 @@
 #include "calibrate/candidates.h"
 #include "calibrate/selected_fit.h"
 #include "io/calibration_block.h"
+#include "models/model_interface.h"
 #include "validation/held_out_halves.h"
 
 namespace fitcal {
@@ -61,6 +62,15 @@ struct CalibrationOutcome {
   std::string effects_note;      // the selected calibration's effects and a plain controller
   std::optional<io::CalibrationBlock> record;  // when the request writes and nothing refused
   std::string stopped_early;  // the written calibration is the solver's last point (exit 6)
+  // The mount's x and y fitted, not held at a guess the wheel distances could not take up
+  // (calibrate.cc, FitAMountTheWheelsCannotAbsorb): what was compared, or empty.
+  std::string mount_freed_line;
+  RobotModelPtr mount_freed_model;  // with mount_freed_line: the model the outcome is of
+
+  // The model the outcome is of: `requested` (the one Calibrate was given), or its mount freed.
+  const RobotModelInterface& CalibratedModel(const RobotModelInterface& requested) const {
+    return mount_freed_model ? *mount_freed_model : requested;
+  }
 
   const CalibrationCandidate& selected() const { return candidates[gate.selected]; }
   int exit_code() const;

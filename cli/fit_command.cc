@@ -173,10 +173,11 @@ int RunModelFitCommand(const FitCommandOptions& options, const io::DatasetIndex&
   io::StopHereForTests("loaded");
   const double load_s = Seconds(t_total);
   const CalibrationOutcome outcome = Calibrate(request, *model);
-  PrintCalibrationOutcome(request, *model, outcome,
+  const RobotModelInterface& calibrated = outcome.CalibratedModel(*model);
+  PrintCalibrationOutcome(request, calibrated, outcome,
                           FlagsTheChoiceLeavesUnused(options, outcome));
   if (outcome.refusal.exit_code != 0) return outcome.refusal.exit_code;
-  if (outcome.record) WriteCalibration(options, *model, outcome.selected(), *outcome.record);
+  if (outcome.record) WriteCalibration(options, calibrated, outcome.selected(), *outcome.record);
   std::printf("time: load %.3f s, total %.3f s\n", load_s, Seconds(t_total));
   if (!outcome.stopped_early.empty()) std::cerr << "fitcal: " << outcome.stopped_early << "\n";
   return outcome.exit_code();

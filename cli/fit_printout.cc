@@ -250,6 +250,7 @@ void PrintGate(const CalibrationOutcome& o) {
   for (const std::string& line : GateLines(o.candidates, gate)) std::printf("%s\n", line.c_str());
   if (!o.effects_line.empty()) std::printf("%s\n", o.effects_line.c_str());
   if (!o.gave_way_line.empty()) std::printf("%s\n", o.gave_way_line.c_str());
+  if (!o.mount_freed_line.empty()) std::printf("warning: %s\n", o.mount_freed_line.c_str());
 }
 
 // Everything up to the gate's table: the fit, the residuals, everyday driving, the warnings.

@@ -139,9 +139,19 @@ bool MovesSideways(const RobotModelInterface& model) {
 }  // namespace
 
 MountedModel::MountedModel(RobotModelPtr inner, const GroundTruthFrame& frame,
-                           const std::vector<Interval>& bounds)
+                           const std::vector<Interval>& bounds, bool hold_sideways)
     : inner_(std::move(inner)),
-      robot_(MountedRobot(inner_->robot(), frame, bounds, MovesSideways(*inner_))) {}
+      robot_(MountedRobot(inner_->robot(), frame, bounds,
+                          hold_sideways && MovesSideways(*inner_))) {}
+
+RobotModelPtr MountedModel::WithSidewaysMountFreed() const {
+  const int n = MountIndex();
+  if (!robot_.IsHeld(n)) return nullptr;
+  const std::vector<double>& nominal = robot_.nominal;
+  const GroundTruthFrame frame{nominal[n], nominal[n + 1], nominal[n + 2]};
+  const std::vector<Interval> bounds(robot_.bounds.begin() + n, robot_.bounds.end());
+  return std::make_shared<MountedModel>(inner_, frame, bounds, false);
+}
 
 Pose2d MountedModel::Replay(const double* p, const EncoderSamples& samples, std::size_t begin,
                             std::size_t end, const Pose2d& start, const PoseVisitor& visit) const {

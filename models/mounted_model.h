@@ -23,7 +23,8 @@
 // its reference point is wherever its wheel distances put it, and a shift of the pose source is a
 // change of them (omni3: R_i' = R_i - e_x cos delta_i - e_y sin delta_i). Its x and y are held at
 // the nominal, with that reason (Robot::held); what remains is left to the direction analysis
-// (fit/determined_directions.h) like any parameter.
+// (fit/determined_directions.h) like any parameter. A guess the wheel distances cannot absorb
+// within their bounds is the exception: WithSidewaysMountFreed, and calibrate/calibrate.cc.
 
 #include <yaml-cpp/yaml.h>
 
@@ -59,9 +60,15 @@ class MountedModel final : public RobotModelInterface {
  public:
   static constexpr int kNumMountParameters = 3;  // x, y, yaw
 
-  // `bounds` (3 intervals, SI and rad) around the nominal `frame`.
+  // `bounds` (3 intervals, SI and rad) around the nominal `frame`. `hold_sideways` holds x and y
+  // of a robot that moves sideways (the header's gauge).
   MountedModel(RobotModelPtr inner, const GroundTruthFrame& frame,
-               const std::vector<Interval>& bounds);
+               const std::vector<Interval>& bounds, bool hold_sideways = true);
+
+  // The same model with x and y free where they are held as the gauge (then the direction
+  // analysis holds the gauge's direction at the nominal, wheel distances and mount together);
+  // nullptr where nothing is held that way.
+  RobotModelPtr WithSidewaysMountFreed() const;
 
   const Robot& robot() const override { return robot_; }
   const RobotModelInterface& inner() const { return *inner_; }

@@ -128,10 +128,13 @@ TEST(MountedFit, AnOmniRobotsXAndYAreHeldWithTheReason) {
 }
 
 // probe45: an omni robot whose mount guess is 0.1 m off (the ground truth tracks the centre, the
-// YAML says x 0.1 m): x and y are held, the error moves into the wheel distances, and the fit
-// ends on their bounds, refused (exit 5) naming only the wheels. The refusal now also names the
-// held mount and its guess, the one number the user can fix.
-TEST(MountedFit, ABoundHitWithTheMountHeldNamesTheMount) {
+// YAML says x 0.1 m). Held at the guess, the error moves into the wheel distances, which end on
+// their bounds (refused, exit 5, before). The fit with x and y free predicts the runs far better
+// (training CF 0.050 held, 0.0062 fitted), so the calibration is made with them fitted, and says
+// so: the written mount is within 3 of its printed sigmas (0.01 m, what the bounds allow along the
+// direction the mount shares with the distances) of the truth; a guess kept, or moved the wrong
+// way, is 10 sigmas off.
+TEST(MountedFit, AGuessTheWheelDistancesCannotTakeUpIsFitted) {
   TempDir dir;
   const std::string data = dir.Path("data"), cal = dir.Path("calibrated.yaml");
   auto r = RunFitcal(dir, "simulate --model omni --out " + data + " --seed 4 --repetitions 2");
@@ -140,12 +143,26 @@ TEST(MountedFit, ABoundHitWithTheMountHeldNamesTheMount) {
   robot = Replace(robot, "bounds:", "ground_truth_frame: {x_m: 0.1, y_m: 0.0, yaw_deg: 0.0}\nbounds:");
   WriteFileBytes(data + "/robot.yaml", robot);
   r = RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --out " + cal);
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  EXPECT_TRUE(Has(r.out, "warning: ground_truth_frame: x and y fitted, not held at the guess (0.1, "
+                         "0 m): held, the wheel distances could not take up its error"))
+      << r.out;
+  const YAML::Node frame = YAML::LoadFile(cal)["ground_truth_frame"];
+  EXPECT_NEAR(frame["x_m"].as<double>(), 0.0, 0.03);
+  EXPECT_NEAR(frame["y_m"].as<double>(), 0.0, 0.03);
+
+  // With the mount's bounds narrowed around the guess, the fit with it free ends on them too:
+  // the fit with it held is refused, and the refusal names the held mount and its guess, the one
+  // number the user can fix.
+  robot = Replace(robot, "bounds:", "bounds:\n  ground_truth_x_m: [0.09, 0.11]");
+  WriteFileBytes(data + "/robot.yaml", robot);
+  r = RunFitcal(dir, "fit --logs " + data + " --train-reps 1 --out " + dir.Path("narrow.yaml"));
   EXPECT_EQ(r.exit_code, 5) << r.err << r.out;
   EXPECT_TRUE(Has(r.err, "leaves a parameter on its bound (R_")) << r.err;
   EXPECT_TRUE(Has(r.err, "the ground truth's mount is held at its guess (ground_truth_x 0.1 m, "
                          "ground_truth_y 0 m)"))
       << r.err;
-  EXPECT_FALSE(std::filesystem::exists(cal));
+  EXPECT_FALSE(std::filesystem::exists(dir.Path("narrow.yaml")));
 }
 
 // A closed form measures the base only (MountedModel::ClosedForms hands it the nominal frame): an
