@@ -93,7 +93,7 @@ void FitTrainingRuns(const CalibrationRequest& r, const RobotModelInterface& mod
   const ModelFitResult& whole = out->fit.fit;
   out->halves = JudgeMethodOnHeldOutHalves(
       *r.method, r.threads, r.time_blocks, out->settings,
-      whole.usable || whole.stopped_early ? whole.parameters : std::vector<double>{}, model,
+      whole.HasFinitePoint() ? whole.parameters : std::vector<double>{}, model,
       out->split);
 }
 

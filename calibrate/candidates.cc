@@ -82,7 +82,7 @@ std::vector<CalibrationCandidate> Candidates(const RobotModelInterface& model,
                                              const RunSplit& split, const ModelFitResult& fit,
                                              const std::string& method, bool closed_forms) {
   std::vector<CalibrationCandidate> out = NominalAndClosedForms(model, split, closed_forms);
-  out.push_back({method, fit.parameters, fit.usable || fit.stopped_early});
+  out.push_back({method, fit.parameters, fit.HasFinitePoint()});
   if (!fit.held_directions.empty() && !split.validation.empty()) {
     out.push_back(WithoutHolds(model.robot(), fit, method));
   }

@@ -58,7 +58,7 @@ std::optional<std::vector<double>> FoldFits::Fit(const FitMethod& method,
   // The whole data's method fits this kind (checked before the choice): no refusal here.
   if (PrepareTrackResiduals(method.name, training, &s, &data).empty()) {
     const ModelFitResult fit = method.run_model(training, model, s).fit;
-    if (fit.usable || fit.stopped_early) out = fit.parameters;
+    if (fit.HasFinitePoint()) out = fit.parameters;
   }
   const std::lock_guard<std::mutex> lock(mutex_);
   done_[key] = out;
@@ -89,7 +89,7 @@ void FitAllTrainingRuns(const FitMethod& method, const RobotModelInterface& mode
                         std::optional<ModelFitMethodOutcome>* full, FoldFits* fold_fits) {
   full->emplace(method.run_model(split.training, model, settings));
   const ModelFitResult& whole = (*full)->fit;
-  if (whole.usable || whole.stopped_early) fold_fits->start = whole.parameters;
+  if (whole.HasFinitePoint()) fold_fits->start = whole.parameters;
   fold_fits->seed_levels = whole.noise_levels;
 }
 
@@ -106,9 +106,9 @@ ModelFitMethodOutcome FitFromGuessAndFrom(const FitMethod& method,
   FitMethodSettings from_start = settings;
   from_start.start = start;
   ModelFitMethodOutcome warm = method.run_model(training, model, from_start);
-  const auto usable = [](const ModelFitResult& f) { return f.usable || f.stopped_early; };
   const bool warm_is_lower =
-      usable(warm.fit) && (!usable(guess.fit) || warm.fit.final_cost < guess.fit.final_cost);
+      warm.fit.HasFinitePoint() &&
+      (!guess.fit.HasFinitePoint() || warm.fit.final_cost < guess.fit.final_cost);
   return warm_is_lower ? std::move(warm) : std::move(guess);
 }
 
@@ -201,7 +201,7 @@ std::vector<std::string> ChooseWeightsOnHeldOutRuns(const FitMethod& method, int
             "(--weights estimated fits them)"};
   }
   if (!*full) full->emplace(method.run_model(split.training, model, *settings));
-  if (!(*full)->fit.usable && !(*full)->fit.stopped_early) return {};
+  if (!(*full)->fit.HasFinitePoint()) return {};
   // The estimated weights' fit starts where the fixed weights' ended: the same track data (it
   // does not depend on the weights), a few steps per reweighting.
   FitMethodSettings estimated = *settings;
@@ -214,7 +214,7 @@ std::vector<std::string> ChooseWeightsOnHeldOutRuns(const FitMethod& method, int
     if (!objective.estimate_weights) return (*full)->fit.parameters;
     estimated_fit.emplace(method.run_model(training, model, estimated));
     const ModelFitResult& fit = estimated_fit->fit;
-    if (!fit.usable && !fit.stopped_early) return std::nullopt;
+    if (!fit.HasFinitePoint()) return std::nullopt;
     return fit.parameters;
   };
   const TrackObjectiveJudgement judgement = JudgeTrackWeightsOnHeldOutRuns(
@@ -252,7 +252,7 @@ HalvesJudgement JudgeMethodOnHeldOutHalves(const FitMethod& method, int threads,
     // lands at the truth's level).
     const ModelFitResult fit =
         FitFromGuessAndFrom(method, fold.split.training, model, fold_settings, whole_fit).fit;
-    if (!(fit.usable || fit.stopped_early)) return std::nullopt;
+    if (!fit.HasFinitePoint()) return std::nullopt;
     return fit.parameters;
   };
   const ScoreOnRuns on_runs = EverydayDrivingScore(model, threads, EverydayDriftLengths());

@@ -48,7 +48,7 @@ ClockOffsetSummary SummariseClockOffsets(const ModelFitResult& fit, const TrackF
 std::vector<OutlierRun> OutlierTrainingRuns(const RobotModelInterface& model,
                                             const RunSplit& split, const ModelFitResult& fit,
                                             int threads) {
-  if (!fit.usable && !fit.stopped_early) return {};
+  if (!fit.HasFinitePoint()) return {};
   std::vector<std::string> ids;
   for (const AlignedRun& run : split.training) ids.push_back(run.id);
   const FinalPoseErrors errors =

@@ -149,7 +149,7 @@ double FittedSumOfSquares(const RobotModelInterface& model, const std::vector<Al
     on_windows.segments = start_windows;
     on_windows.global_start = windows_global_start;
     const ModelFitResult windows = FitModel(runs, model, on_windows);
-    if (windows.usable || windows.stopped_early) {
+    if (windows.HasFinitePoint()) {
       const ModelFitResult from_windows = FitModelFrom(runs, model, windows.parameters, fit);
       return SumOfSquares(model, from_windows.parameters, runs, segments, options);
     }

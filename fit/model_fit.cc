@@ -872,7 +872,7 @@ ModelFitResult FitWithNoiseLevels(const std::vector<AlignedRun>& training,
     fitted_with = weighted;
     iterations += fit.iterations;
     solve_time_s += fit.solve_time_s;
-    if (!(fit.usable || fit.stopped_early)) break;
+    if (!fit.HasFinitePoint()) break;
     const int held = static_cast<int>(std::count(fit.held.begin(), fit.held.end(), true));
     const int offsets = options.track->estimate_clock_offsets
                             ? static_cast<int>(options.track->clock_groups.size())
@@ -1101,7 +1101,7 @@ std::optional<std::vector<double>> WindowsStart(const std::vector<AlignedRun>& t
   on_windows.segments = &segments;
   on_windows.global_start = false;
   const ModelFitResult fit = FitModelFrom(training, model, model.robot().nominal, on_windows);
-  if (!fit.usable && !fit.stopped_early) return std::nullopt;
+  if (!fit.HasFinitePoint()) return std::nullopt;
   return fit.parameters;
 }
 

@@ -48,6 +48,8 @@ struct ModelFitResult {
   // Stopped at the iteration limit (NO_CONVERGENCE) with finite parameters: a point that may
   // still be good; commands let it compete in the result gate and flag it when it wins.
   bool stopped_early = false;
+  // Parameters a gate may judge: converged, or stopped at the iteration limit.
+  bool HasFinitePoint() const { return usable || stopped_early; }
   std::string termination;  // Ceres termination type of the last solve, e.g. CONVERGENCE
   std::string message;      // Ceres' reason for stopping
   int iterations = 0;       // over all active-set rounds
