@@ -251,24 +251,6 @@ bool JudgeNeverWorse(const RobotModelInterface& model, int threads, CalibrationO
   return verdict.refusals.empty() || Refuse(out, 5, std::move(verdict.refusals));
 }
 
-// The ground truth's mount held at its guess because the runs cannot tell it from the wheels'
-// geometry (an omni robot's x and y, models/mounted_model.h): a guess that is off moves into the
-// wheel distances, which may be what ended on a bound - said beside the bound, with the values.
-std::string HeldMountNote(const Robot& robot, const std::vector<double>& parameters,
-                          const std::vector<bool>& held) {
-  std::ostringstream names;
-  for (int k : MountParameterIndices(robot)) {
-    if (k >= static_cast<int>(held.size()) || !held[k]) continue;
-    const ParameterInfo& info = robot.parameters[k];
-    names << (names.tellp() > 0 ? ", " : "") << info.name << " "
-          << info.DisplayScale() * parameters[k] << " " << info.DisplayUnit();
-  }
-  if (names.tellp() == 0) return "";
-  return "; the ground truth's mount is held at its guess (" + names.str() +
-         "), which these runs cannot tell from the wheels' geometry: an error in the guess moves "
-         "into the wheels' parameters - measure the mount and set ground_truth_frame";
-}
-
 // A parameter on its bound refuses the calibration, unless the bounds were widened on purpose.
 bool JudgeBounds(const CalibrationRequest& r, const Robot& robot, CalibrationOutcome* out) {
   out->reached = CalibrationStage::kAtBound;

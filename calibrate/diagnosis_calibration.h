@@ -2,8 +2,9 @@
 // The calibration `diagnose` writes, decided from its diagnosis (diagnosis/diagnose.h): the
 // candidates judged like the fit's result gate on the held-out runs by the track replay's
 // final-pose CF (the nominal, the declared final-pose fit, the track fit, and the track fit with
-// its effects when they were named), the never-worse judgement against the nominal, the
-// uncertainty (the fit's, or propagated through the training runs' final poses), and the record.
+// its effects when they were named; none with a parameter on its bound, as fit's bounds' rule),
+// the never-worse judgement against the nominal, the uncertainty (the fit's, or propagated
+// through the training runs' final poses), and the record.
 // A track fit with effects that were not named is not a candidate: the file would claim a CF its
 // parameters reach only together with effects it does not carry.
 
@@ -50,6 +51,8 @@ struct DiagnosisCalibration {
   std::vector<DiagnoseChoice> gate;  // the candidates, [0] the nominal
   DiagnoseChoice choice;             // the selected one, with its uncertainty when kDone
   std::vector<std::string> never_worse_warnings;
+  // The lowest held-out CF had a parameter on its bound and gave way to `choice`; or empty.
+  std::string gave_way_line;
   bool uncertainty_propagated = false;  // the fit that made `choice` had none of its own
   io::CalibrationBlock record;          // when kDone
 };

@@ -69,6 +69,7 @@ void PrintDecision(const DiagnosisCalibration& c, std::size_t num_held_out) {
     std::printf("  %-28s %10.5f%s\n", d.name.c_str(), d.cf_after,
                 d.name == c.choice.name ? "   <- selected" : "");
   }
+  if (!c.gave_way_line.empty()) std::printf("%s\n", c.gave_way_line.c_str());
   for (const std::string& line : c.never_worse_warnings) std::printf("warning: %s\n", line.c_str());
   if (c.uncertainty_propagated) {
     std::printf("uncertainty of '%s': propagated through the training runs' final poses\n",

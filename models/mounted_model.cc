@@ -295,6 +295,21 @@ std::vector<int> MountParameterIndices(const Robot& robot) {
   return {*first, *first + 1, *first + 2};
 }
 
+std::string HeldMountNote(const Robot& robot, const std::vector<double>& parameters,
+                          const std::vector<bool>& held) {
+  std::ostringstream names;
+  for (int k : MountParameterIndices(robot)) {
+    if (k >= static_cast<int>(held.size()) || !held[k]) continue;
+    const ParameterInfo& info = robot.parameters[k];
+    names << (names.tellp() > 0 ? ", " : "") << info.name << " "
+          << info.DisplayScale() * parameters[k] << " " << info.DisplayUnit();
+  }
+  if (names.tellp() == 0) return "";
+  return "; the ground truth's mount is held at its guess (" + names.str() +
+         "), which these runs cannot tell from the wheels' geometry: an error in the guess moves "
+         "into the wheels' parameters - measure the mount and set ground_truth_frame";
+}
+
 std::string GroundTruthFrameLine(const Robot& robot, const std::vector<bool>& held,
                                  const std::string& held_reason,
                                  const std::vector<bool>& not_determined) {

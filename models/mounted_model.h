@@ -128,6 +128,13 @@ std::string GroundTruthFrameLine(const Robot& robot, const std::vector<bool>& he
                                  const std::string& held_reason = "",
                                  const std::vector<bool>& not_determined = {});
 
+// The ground truth's mount held at its guess because the runs cannot tell it from the wheels'
+// geometry (held: per parameter; an omni robot's x and y): a guess that is off moves into the
+// wheel distances, which may be what ended on a bound - "; the ground truth's mount is held at
+// its guess (...)", said beside the bound with the values; "" when no number of the frame is held.
+std::string HeldMountNote(const Robot& robot, const std::vector<double>& parameters,
+                          const std::vector<bool>& held);
+
 // The robot YAML's `ground_truth_frame:` (and its bounds under `bounds:`), read from `root` and
 // removed from it, so that the model's own reader sees its schema only. Returns `inner` itself
 // when the key is absent. InputError (file:line) for a malformed frame or bounds.
