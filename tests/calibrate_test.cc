@@ -171,6 +171,38 @@ TEST(CalibrateOnDiagnosis, ATrackFitWithoutCovarianceGetsThePropagatedUncertaint
   EXPECT_EQ(d.record.cf_validation_after, d.choice.cf_after);
 }
 
+// fit's bounds' rule in diagnose: the declared fit, said to be the lowest on the held-out runs
+// but with its first parameter on its upper bound, gives way to the track fit (the flower's fit,
+// inside its bounds, beating the nominal), and a line says why; with the track fit on its bound
+// too, nothing beats the nominal inside its bounds: exit 5, the bound named.
+TEST(CalibrateOnDiagnosis, ACandidateOnItsBoundGivesWayOrIsRefused) {
+  DiagnosisCase c;
+  const CalibrationOutcome fit = Calibrate(c.loaded.request, *c.loaded.model);
+  ASSERT_EQ(fit.exit_code(), 0);
+  const Robot& robot = c.loaded.model->robot();
+  std::vector<double> on_bound = fit.selected().parameters;
+  on_bound[0] = robot.bounds[0].hi;
+  c.result.declared.parameters = on_bound;
+  c.result.declared_validation.cf = 0.0;  // the lowest of all
+  c.result.base.parameters = fit.selected().parameters;
+  const DiagnosisCalibration gave_way = c.Run();
+  ASSERT_EQ(gave_way.refusal.exit_code, 0) << gave_way.refusal.reasons.front();
+  EXPECT_EQ(gave_way.choice.name, "track fit");
+  EXPECT_EQ(gave_way.gave_way_line.rfind("'declared final-pose fit' leaves a parameter on its "
+                                         "bound (" + robot.parameters[0].name + " ", 0),
+            0u)
+      << gave_way.gave_way_line;
+
+  c.result.base.parameters = on_bound;
+  const DiagnosisCalibration refused = c.Run();
+  EXPECT_EQ(refused.refusal.exit_code, 5);
+  EXPECT_EQ(refused.choice.name, "nominal");
+  ASSERT_EQ(refused.refusal.reasons.size(), 1u);
+  EXPECT_EQ(refused.refusal.reasons[0].rfind("'declared final-pose fit' leaves a parameter on", 0),
+            0u)
+      << refused.refusal.reasons[0];
+}
+
 // CompareMethods (calibrate/method_comparison.h, `fitcal compare` without the command): one
 // strategy (STB: curves both ways; STA's three straight runs do not determine the wheels'
 // angles, and their fit is worse held out, as in Palacin Table 4), Ceres on the first repetition
