@@ -1,5 +1,6 @@
 #include "calibrate/calibrate.h"
 
+#include <iomanip>
 #include <sstream>
 #include <utility>
 
@@ -333,10 +334,12 @@ void FitAMountTheWheelsCannotAbsorb(const CalibrationRequest& r, const RobotMode
   Run(r, *freed, &again);
   if (again.refusal.exit_code != 0) return;  // the held one's refusal names the guess
   const int x = mounted->MountIndex();
+  const std::vector<double>& written = again.selected().parameters;
   std::ostringstream line;
-  line << "ground_truth_frame: x and y fitted, not held at the guess (" << held.parameters[x]
-       << ", " << held.parameters[x + 1] << " m): held, the wheel distances could not take up "
-       << "its error within their bounds (training CF " << held_cf << " held, " << free_cf
+  line << std::setprecision(4) << "ground_truth_frame: x and y fitted (x " << written[x]
+       << " m, y " << written[x + 1] << " m), not held at the guess (x " << held.parameters[x]
+       << " m, y " << held.parameters[x + 1] << " m): held, the wheel distances could not take "
+       << "up its error within their bounds (training CF " << held_cf << " held, " << free_cf
        << " fitted); the runs tell the mount from the distances only through those bounds, so "
        << "measure the mount to check the fitted one";
   *out = std::move(again);

@@ -139,7 +139,7 @@ TEST_P(FreeDriveFarGuess, Omni3AndItsSensorsMountFromTwoRuns) {
   const auto r =
       RunFitcal(dir, "fit --logs " + dir.Path("data") + " --out " + dir.Path("cal.yaml"));
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
-  EXPECT_TRUE(Has(r.out, "x and y fitted, not held at the guess")) << r.out;
+  EXPECT_TRUE(Has(r.out, "not held at the guess (x 1.2 m, y 0 m)")) << r.out;
   const fitcal::Robot fitted = fitcal::ReadRobotModelFile(dir.Path("cal.yaml"))->robot();
   const fitcal::Robot expected = fitcal::ReadRobotModelFile(dir.Path("truth.yaml"))->robot();
   const YAML::Node sigma = YAML::LoadFile(dir.Path("cal.yaml"))["calibration"]["sigma"];
