@@ -321,11 +321,11 @@ void FitAMountTheWheelsCannotAbsorb(const CalibrationRequest& r, const RobotMode
                                     CalibrationOutcome* out) {
   const auto* mounted = dynamic_cast<const MountedModel*>(&model);
   const ModelFitResult& held = out->fit.fit;
-  if (mounted == nullptr || r.closed_forms_only || !held.usable) return;
+  if (mounted == nullptr || r.closed_forms_only || !held.HasFinitePoint()) return;
   const RobotModelPtr freed = mounted->WithSidewaysMountFreed();
   if (!freed) return;
   const ModelFitResult fitted = r.method->run_model(out->split.training, *freed, out->settings).fit;
-  if (!fitted.usable) return;
+  if (!fitted.HasFinitePoint()) return;
   const std::vector<AlignedRun>& training = out->split.training;
   const double held_cf = EvaluateFinalPoseErrors(model, held.parameters, training, r.threads).cf;
   const double free_cf = EvaluateFinalPoseErrors(*freed, fitted.parameters, training, r.threads).cf;

@@ -64,7 +64,7 @@ bool AnyOf(const std::vector<bool>& flags) {
 // The lowest held-out CF (the nominal first wins ties) among the candidates with no parameter on
 // a bound - the bounds' rule of fit (fit/result_gate.h AtBoundRefusal): a value the data pushed
 // as far as the box allows is not written (before, diagnose wrote a simulated omni3, its mount
-// guessed 0.3 m off, with its wheel distances and angles on their bounds, sigmas 4.9 m and 220
+// guessed 0.37 m off, with its wheel distances and angles on their bounds, sigmas 4.9 m and 220
 // deg). *on_bound: why the lowest of all gave way, or empty. With the CFs the record carries.
 DiagnoseChoice Select(const RobotModelInterface& model, const SplitOf<TrackRun>& split,
                       int threads, std::vector<DiagnoseChoice>* candidates,
