@@ -1077,32 +1077,15 @@ double AcrossTheBox(const ParameterInfo& info, const Interval& box, double fract
   return box.lo + fraction * box.Width();
 }
 
-// The fit of the runs' relative motion over disjoint 0.5 m windows of their ground truth, from the
-// nominal: a window's error does not accumulate along a run, so a guess far off meets none of the
-// minima a whole run's final pose or track has (diagnosis/channel_order_check.h measured a
-// tricycle's 2.5x gain: final poses fitted from the guess SSR 177, from the windows' fit 0.0056).
-// Only for a fit of tracks, which see all the windows see: a final-pose fit holds what its runs
-// leave undetermined at its start, and from the windows' fit that would be a value its own
-// residuals never measured (GeneralisationOptiOdom.CheckpointsSeeWhatAClosedPathHidesFromItsFinal-
-// Pose, generalisation_test).
-// Empty otherwise, when a run was aligned without its track, or with fewer than 4 windows in all.
+// A start from the windows' fit (FitOfDisjointWindows) only for a fit of tracks, which see all the
+// windows see: a final-pose fit holds what its runs leave undetermined at its start, and from the
+// windows' fit that would be a value its own residuals never measured
+// (GeneralisationOptiOdom.CheckpointsSeeWhatAClosedPathHidesFromItsFinalPose, generalisation_test).
 std::optional<std::vector<double>> WindowsStart(const std::vector<AlignedRun>& training,
                                                 const RobotModelInterface& model,
                                                 const ModelFitOptions& options) {
   if (!UsesTracks(options)) return std::nullopt;
-  for (const AlignedRun& run : training) {
-    if (run.track == nullptr) return std::nullopt;
-  }
-  std::size_t total = 0;
-  const std::vector<std::vector<Segment>> segments =
-      MakeDisjointWindows(training, TracksOf(training), &total);
-  if (total < 4) return std::nullopt;
-  ModelFitOptions on_windows = options;
-  on_windows.segments = &segments;
-  on_windows.global_start = false;
-  const ModelFitResult fit = FitModelFrom(training, model, model.robot().nominal, on_windows);
-  if (!fit.HasFinitePoint()) return std::nullopt;
-  return fit.parameters;
+  return FitOfDisjointWindows(training, model, options);
 }
 
 // A point `fraction` of the way across every free parameter's box (AcrossTheBox).
@@ -1179,6 +1162,27 @@ std::vector<double> FitCostGradient(const std::vector<AlignedRun>& training,
   std::vector<double> offsets(ClockOffsetSlots(options), 0.0);
   return GradientInEveryParameter(training, model, options, p.data(), offsets.data(), {},
                                   nullptr);
+}
+
+// A window's error does not accumulate along a run, so a guess far off meets none of the minima a
+// whole run's final pose or track has (diagnosis/channel_order_check.h measured a tricycle's 2.5x
+// gain: final poses fitted from the guess SSR 177, from the windows' fit 0.0056).
+std::optional<std::vector<double>> FitOfDisjointWindows(const std::vector<AlignedRun>& training,
+                                                        const RobotModelInterface& model,
+                                                        const ModelFitOptions& options) {
+  for (const AlignedRun& run : training) {
+    if (run.track == nullptr) return std::nullopt;
+  }
+  std::size_t total = 0;
+  const std::vector<std::vector<Segment>> segments =
+      MakeDisjointWindows(training, TracksOf(training), &total);
+  if (total < 4) return std::nullopt;
+  ModelFitOptions on_windows = options;
+  on_windows.segments = &segments;
+  on_windows.global_start = false;
+  const ModelFitResult fit = FitModelFrom(training, model, model.robot().nominal, on_windows);
+  if (!fit.HasFinitePoint()) return std::nullopt;
+  return fit.parameters;
 }
 
 }  // namespace fitcal

@@ -190,6 +190,14 @@ ModelFitResult FitModelFrom(const std::vector<AlignedRun>& training,
                             const RobotModelInterface& model, const std::vector<double>& start,
                             const ModelFitOptions& options = {});
 
+// The parameters of the fit of the runs' relative motion over disjoint 0.5 m windows of their
+// ground truth, from the nominal (`options` otherwise as given, no global start): a start for a fit
+// of tracks from a guess far off. nullopt when a run was aligned without its track, with fewer
+// than 4 windows in all, or when the fit has no finite point.
+std::optional<std::vector<double>> FitOfDisjointWindows(const std::vector<AlignedRun>& training,
+                                                        const RobotModelInterface& model,
+                                                        const ModelFitOptions& options);
+
 // The gradient of the fit's cost (the runs' residuals as FitModel weighs them) at `p`, one entry
 // per parameter of `model`, held ones included: what the active set's release test reads. (From a
 // problem with the held parameters fixed, Ceres gives the free entries alone.)
