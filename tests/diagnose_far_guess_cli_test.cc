@@ -16,6 +16,7 @@
 
 #include "models/model_registry.h"
 #include "tests/test_files.h"
+#include "tests/written_calibration_checks.h"
 
 namespace diagnose_far_guess_cli_test {  // named, not anonymous: tests compile in batches
 
@@ -50,19 +51,8 @@ TEST(DiagnoseFarGuess, ATrackFitFromTheWindowsFindsTheTruth) {
   ASSERT_NE(selected, std::string::npos) << r.out;
   const std::size_t line = r.out.rfind('\n', selected);
   EXPECT_TRUE(Has(r.out.substr(line, selected - line), "track fit")) << r.out;
-  const fitcal::Robot fitted =
-      fitcal::ReadRobotModelFile(dir.Path("diag") + "/calibrated.yaml")->robot();
-  const fitcal::Robot truth = fitcal::ReadRobotModelFile(dir.Path("truth.yaml"))->robot();
-  const YAML::Node sigma =
-      YAML::LoadFile(dir.Path("diag") + "/calibrated.yaml")["calibration"]["sigma"];
-  ASSERT_TRUE(sigma.IsMap()) << r.out;
-  for (int k = 0; k < fitted.NumParameters(); ++k) {
-    const fitcal::ParameterInfo& info = fitted.parameters[k];
-    const double s = sigma[info.KeyName()].as<double>() / info.DisplayScale();
-    const double error = fitted.nominal[k] - truth.nominal[k];
-    ASSERT_GT(s, 0.0) << info.name;
-    EXPECT_LT(std::abs(error), 3.0 * s) << info.name << " error " << error << " sigma " << s;
-  }
+  fitcal::testing::ExpectEveryParameterWithin3WrittenSigmas(dir.Path("diag") + "/calibrated.yaml",
+                                                           dir.Path("truth.yaml"));
 }
 
 }  // namespace diagnose_far_guess_cli_test

@@ -16,6 +16,7 @@
 #include "models/omni/omni_model.h"
 #include "models/tricycle/tricycle_model.h"
 #include "tests/test_files.h"
+#include "tests/written_calibration_checks.h"
 
 namespace fitcal {
 namespace {
@@ -86,13 +87,7 @@ TEST_P(MountedFit, RecoversTheSensorsMountWithinThreeSigma) {
     EXPECT_GT(std::abs(e.guess - e.truth), 3.0 * s);
   }
   // The wheels too, and the calibrated robot reads back as a mounted robot of its model.
-  const Robot fitted = ReadRobotModelFile(cal)->robot();
-  const Robot truth = ReadRobotModelFile(dir.Path("truth.yaml"))->robot();
-  for (int k = 0; k < fitted.NumParameters(); ++k) {
-    const ParameterInfo& info = fitted.parameters[k];
-    const double s = sigma[info.KeyName()].as<double>() / info.DisplayScale();
-    EXPECT_LT(std::abs(fitted.nominal[k] - truth.nominal[k]), 3.0 * s) << info.name;
-  }
+  fitcal::testing::ExpectEveryParameterWithin3WrittenSigmas(cal, dir.Path("truth.yaml"));
 }
 
 INSTANTIATE_TEST_SUITE_P(
