@@ -25,6 +25,18 @@ ceres::Solver::Options SolverOptionsFor(const CeresFitOptions& options) {
   return o;
 }
 
+ceres::Context* SharedCeresContext() {
+  // Made once and never destroyed: a fit may still run on another thread while statics go.
+  static ceres::Context* const context = ceres::Context::Create();
+  return context;
+}
+
+ceres::Problem::Options ProblemOptionsOnSharedContext() {
+  ceres::Problem::Options options;
+  options.context = SharedCeresContext();
+  return options;
+}
+
 std::vector<bool> HoldAtNominal(const Robot& robot, double* p) {
   std::vector<bool> held(robot.NumParameters(), false);
   for (const HeldParameter& h : robot.held) {

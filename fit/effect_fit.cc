@@ -409,7 +409,7 @@ EffectFitResult FitEffectModel(const std::vector<TrackRun>& training,
   double* p = result.parameters.data();
   const std::vector<EffectId> ids = IdsOf(start);
 
-  ceres::Problem problem;
+  ceres::Problem problem(ProblemOptionsOnSharedContext());
   std::vector<double*> blocks = {p};
   for (auto& e : result.effects) blocks.push_back(e.value.data());
   std::vector<ceres::ResidualBlockId> runs;
@@ -468,7 +468,7 @@ double SeparableFraction(const std::vector<TrackRun>& training,
   std::vector<double> p_at = p;
   std::vector<double*> blocks = {p_at.data()};
   for (auto& e : with) blocks.push_back(e.value.data());
-  ceres::Problem problem;
+  ceres::Problem problem(ProblemOptionsOnSharedContext());
   for (const TrackRun& run : training) {
     problem.AddResidualBlock(EffectTrackResidual::Create(robot_model, run, ids, weights), nullptr,
                              blocks);

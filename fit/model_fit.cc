@@ -115,7 +115,7 @@ class FitProblem {
              double* clock_offsets, const HeldDirections& holds = {},
              std::vector<OdometryMemo>* memos = nullptr) {
     const CeresFitOptions& options = fit_options.ceres;
-    ceres::Problem::Options problem_options;
+    ceres::Problem::Options problem_options = ProblemOptionsOnSharedContext();
     problem_options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
     problem_ = std::make_unique<ceres::Problem>(problem_options);
     const bool final_poses = fit_options.residuals != ResidualKind::kTrack;

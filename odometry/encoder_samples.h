@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <initializer_list>
 #include <iterator>
+#include <memory>
 #include <vector>
 
 namespace fitcal {
@@ -34,20 +35,25 @@ class EncoderSamples {
   int num_channels() const { return num_channels_; }
   // Doubles per row: the interval length, then the channel values.
   int stride() const { return num_channels_ + 1; }
-  std::size_t size() const { return data_.size() / static_cast<std::size_t>(stride()); }
-  bool empty() const { return data_.empty(); }
-  void reserve(std::size_t rows) { data_.reserve(rows * static_cast<std::size_t>(stride())); }
-  std::size_t capacity_rows() const {
-    return data_.capacity() / static_cast<std::size_t>(stride());
+  std::size_t size() const { return Rows().size() / static_cast<std::size_t>(stride()); }
+  bool empty() const { return Rows().empty(); }
+  void reserve(std::size_t rows) {
+    MutableRows().reserve(rows * static_cast<std::size_t>(stride()));
   }
-  void clear() { data_.clear(); }
+  std::size_t capacity_rows() const {
+    return Rows().capacity() / static_cast<std::size_t>(stride());
+  }
+  void clear() { MutableRows().clear(); }
   // Rows k >= n are dropped; new rows are zero.
-  void resize(std::size_t rows) { data_.resize(rows * static_cast<std::size_t>(stride()), 0.0); }
+  void resize(std::size_t rows) {
+    MutableRows().resize(rows * static_cast<std::size_t>(stride()), 0.0);
+  }
 
   // Appends a row; `values` holds num_channels() numbers.
   void push_back(double dt_s, const double* values) {
-    data_.push_back(dt_s);
-    data_.insert(data_.end(), values, values + num_channels_);
+    std::vector<double>& rows = MutableRows();
+    rows.push_back(dt_s);
+    rows.insert(rows.end(), values, values + num_channels_);
   }
   void push_back(double dt_s, std::initializer_list<double> values) {
     assert(static_cast<int>(values.size()) == num_channels_);
@@ -61,11 +67,11 @@ class EncoderSamples {
   ConstSampleView back() const { return (*this)[size() - 1]; }
 
   // The flat rows, for kernels that walk them with stride().
-  const double* data() const { return data_.data(); }
-  double* data() { return data_.data(); }
+  const double* data() const { return Rows().data(); }
+  double* data() { return MutableRows().data(); }
 
   bool operator==(const EncoderSamples& o) const {
-    return num_channels_ == o.num_channels_ && data_ == o.data_;
+    return num_channels_ == o.num_channels_ && Rows() == o.Rows();
   }
 
   // Iteration yields row views (`for (auto&& s : samples) s.value[0] *= 2;`).
@@ -98,13 +104,29 @@ class EncoderSamples {
   const_iterator end() const { return {this, size()}; }
 
  private:
-  double* Row(std::size_t k) { return data_.data() + k * static_cast<std::size_t>(stride()); }
+  // The rows are shared by copies until one of them is changed (copy on write): a run's samples
+  // are copied into every fold and half of the choices by transfer, and read only there.
+  const std::vector<double>& Rows() const {
+    static const std::vector<double> kNoRows;
+    return rows_ ? *rows_ : kNoRows;
+  }
+  std::vector<double>& MutableRows() {
+    if (!rows_) {
+      rows_ = std::make_shared<std::vector<double>>();
+    } else if (rows_.use_count() > 1) {
+      rows_ = std::make_shared<std::vector<double>>(*rows_);
+    }
+    return *rows_;
+  }
+  double* Row(std::size_t k) {
+    return MutableRows().data() + k * static_cast<std::size_t>(stride());
+  }
   const double* Row(std::size_t k) const {
-    return data_.data() + k * static_cast<std::size_t>(stride());
+    return Rows().data() + k * static_cast<std::size_t>(stride());
   }
 
   int num_channels_;
-  std::vector<double> data_;
+  std::shared_ptr<std::vector<double>> rows_;
 };
 
 }  // namespace fitcal
