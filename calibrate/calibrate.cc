@@ -1,12 +1,12 @@
 #include "calibrate/calibrate.h"
 
-#include <iomanip>
 #include <sstream>
 #include <utility>
 
 #include "calibrate/calibration_record.h"
 #include "calibrate/checks_before_fitting.h"
 #include "calibrate/choice_by_transfer.h"
+#include "calibrate/mount_freed.h"
 #include "calibrate/never_worse_gate.h"
 #include "calibrate/reading_resolution_uncertainty.h"
 #include "calibrate/track_residuals.h"
@@ -305,13 +305,6 @@ void Run(const CalibrationRequest& r, const RobotModelInterface& model, Calibrat
   Conclude(r, model, errors, out);
 }
 
-// The fit with the mount freed replaces the one with it held when its training CF is below this
-// fraction of the held fit's. Where the wheel distances take up the guess's error the two fits
-// predict alike (the gauge is exact, models/mounted_model.h: CF equal to the solver's tolerance),
-// so a fifth lower is far above that; a guess they cannot take up costs far more (a simulated
-// omni3 with the mount 0.29 m off: CF 0.154 held, 0.030 freed).
-constexpr double kMountFreedCfRatio = 0.8;
-
 // A robot that moves sideways holds its mount's x and y at the guess: the wheel distances take
 // up an error in it, as far as their bounds let them. Where they cannot, the fit with x and y
 // free (the direction analysis then holds the gauge at the nominal, distances and mount
@@ -333,17 +326,10 @@ void FitAMountTheWheelsCannotAbsorb(const CalibrationRequest& r, const RobotMode
   CalibrationOutcome again;
   Run(r, *freed, &again);
   if (again.refusal.exit_code != 0) return;  // the held one's refusal names the guess
-  const int x = mounted->MountIndex();
-  const std::vector<double>& written = again.selected().parameters;
-  std::ostringstream line;
-  line << std::setprecision(4) << "ground_truth_frame: x and y fitted (x " << written[x]
-       << " m, y " << written[x + 1] << " m), not held at the guess (x " << held.parameters[x]
-       << " m, y " << held.parameters[x + 1] << " m): held, the wheel distances could not take "
-       << "up its error within their bounds (training CF " << held_cf << " held, " << free_cf
-       << " fitted); the runs tell the mount from the distances only through those bounds, so "
-       << "measure the mount to check the fitted one";
+  const std::string line =
+      MountFreedLine(*mounted, again.selected().parameters, held.parameters, held_cf, free_cf);
   *out = std::move(again);
-  out->mount_freed_line = line.str();
+  out->mount_freed_line = line;
   out->mount_freed_model = freed;
 }
 

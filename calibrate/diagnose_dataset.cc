@@ -1,10 +1,12 @@
 #include "calibrate/diagnose_dataset.h"
 
 #include "calibrate/diagnose_page_builder.h"
+#include "calibrate/mount_freed.h"
 #include "diagnosis/channel_order_check.h"
 #include "diagnosis/clock_choice.h"
 #include "diagnosis/miswired_error.h"
 #include "fit/clock_alignment.h"
+#include "fit/final_pose_errors.h"
 #include "fitcal/version.h"
 #include "io/calibration_block.h"
 #include "odometry/text_format.h"
@@ -78,6 +80,53 @@ void DiagnoseSplit(const DiagnoseDatasetRequest& request, const RobotModelInterf
                 kVersion + "\n\n" + FormatDiagnoseReport(out->result, model);
 }
 
+// The diagnosis of the split (DiagnoseSplit) and the calibration decided on it.
+void DiagnoseAndCalibrate(const DiagnoseDatasetRequest& request, const RobotModelInterface& model,
+                          const std::vector<RunLog>& runs, DiagnoseDatasetOutcome* out) {
+  DiagnoseSplit(request, model, out);
+  if (out->refusal.exit_code != 0) return;
+  out->calibration =
+      CalibrateOnDiagnosis({request.dataset, request.train_trajectories, &runs, request.threads},
+                           model, out->split, out->result);
+  out->refusal = out->calibration.refusal;
+}
+
+// fit's check (calibrate/mount_freed.h) on the diagnosis' base, the track fit: the same fit with
+// the mount's x and y free, from the held one's point; when it predicts the training runs far
+// better, the whole diagnosis is made again with them free and replaces the held one unless
+// refused (stop 67's diagnose sweep: omni_040 and omni3_057, refused with the distances on their
+// bounds, where `fit` frees the mount and calibrates them).
+void DiagnoseAMountTheWheelsCannotAbsorb(const DiagnoseDatasetRequest& request,
+                                         const RobotModelInterface& model,
+                                         const std::vector<RunLog>& runs,
+                                         DiagnoseDatasetOutcome* out) {
+  const auto* mounted = dynamic_cast<const MountedModel*>(&model);
+  const EffectFitResult& held = out->result.base;
+  if (mounted == nullptr || !held.usable || out->refusal.exit_code == 3) return;
+  const RobotModelPtr freed = mounted->WithSidewaysMountFreed();
+  if (!freed) return;
+  DiagnoseOptions options;
+  options.fit.num_threads = request.threads;
+  const EffectFitResult fitted =
+      FitEffectModel(out->split.training, *freed, held.parameters, {}, options.fit);
+  if (!fitted.usable) return;
+  const std::vector<AlignedRun> training = AlignedOf(out->split.training);
+  const double held_cf =
+      EvaluateFinalPoseErrors(model, held.parameters, training, request.threads).cf;
+  const double free_cf =
+      EvaluateFinalPoseErrors(*freed, fitted.parameters, training, request.threads).cf;
+  if (!(free_cf < kMountFreedCfRatio * held_cf)) return;
+  DiagnoseDatasetOutcome again;
+  again.clock_notes = out->clock_notes;
+  again.split = out->split;
+  DiagnoseAndCalibrate(request, *freed, runs, &again);
+  if (again.refusal.exit_code != 0) return;  // the held one's refusal names the guess
+  again.mount_freed_line = MountFreedLine(*mounted, again.calibration.choice.parameters,
+                                          held.parameters, held_cf, free_cf);
+  again.mount_freed_model = freed;
+  *out = std::move(again);
+}
+
 }  // namespace
 
 DiagnoseDatasetOutcome DiagnoseDataset(const DiagnoseDatasetRequest& request,
@@ -92,19 +141,17 @@ DiagnoseDatasetOutcome DiagnoseDataset(const DiagnoseDatasetRequest& request,
   out.split = SplitForDiagnosis(runs, robot, request.train_reps, request.train_trajectories);
   out.refusal = RefusalOfSplit(out.split);
   if (out.refusal.exit_code != 0) return out;
-  DiagnoseSplit(request, model, &out);
-  if (out.refusal.exit_code != 0) return out;
-  out.calibration = CalibrateOnDiagnosis(
-      {request.dataset, request.train_trajectories, &runs, request.threads}, model, out.split,
-      out.result);
-  out.refusal = out.calibration.refusal;
+  DiagnoseAndCalibrate(request, model, runs, &out);
+  DiagnoseAMountTheWheelsCannotAbsorb(request, model, runs, &out);
   if (out.refusal.exit_code != 0) return out;
   const DiagnoseChoice& choice = out.calibration.choice;
-  out.written_text = WrittenCalibrationText(robot, choice);
+  const RobotModelInterface& diagnosed = out.mount_freed_model ? *out.mount_freed_model : model;
+  out.written_text = WrittenCalibrationText(diagnosed.robot(), choice);
   // The model's own YAML with the accepted effects and the calibration block, as `fit` writes.
-  out.yaml = model.RobotYaml(choice.parameters, choice.effects,
-                             io::CalibrationBlockYaml(out.calibration.record, robot));
-  out.page = MakeDiagnosePage({request.dataset, out.split.text, request.csv_written}, model,
+  out.yaml =
+      diagnosed.RobotYaml(choice.parameters, choice.effects,
+                          io::CalibrationBlockYaml(out.calibration.record, diagnosed.robot()));
+  out.page = MakeDiagnosePage({request.dataset, out.split.text, request.csv_written}, diagnosed,
                               out.split.validation, out.result, out.calibration, out.report);
   return out;
 }

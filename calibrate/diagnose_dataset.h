@@ -39,6 +39,9 @@ struct DiagnoseDatasetOutcome {
   std::string written_text;          // "## Written calibration": the parameters with sigmas
   std::string yaml;                  // calibrated.yaml
   io::DiagnosePageData page;
+  // The mount's x and y were freed (calibrate/mount_freed.h): why, and the model diagnosed.
+  std::string mount_freed_line;
+  RobotModelPtr mount_freed_model;
 };
 
 DiagnoseDatasetOutcome DiagnoseDataset(const DiagnoseDatasetRequest& request,

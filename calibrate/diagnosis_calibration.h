@@ -8,10 +8,9 @@
 // A track fit with effects that were not named is not a candidate: the file would claim a CF its
 // parameters reach only together with effects it does not carry.
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "calibrate/calibrate.h"
 #include "calibrate/never_worse_gate.h"
@@ -53,6 +52,8 @@ struct DiagnosisCalibration {
   std::vector<std::string> never_worse_warnings;
   // The lowest held-out CF had a parameter on its bound and gave way to `choice`; or empty.
   std::string gave_way_line;
+  // The declared final-pose fit did not converge and is no candidate; or empty.
+  std::string left_out_line;
   bool uncertainty_propagated = false;  // the fit that made `choice` had none of its own
   io::CalibrationBlock record;          // when kDone
 };
@@ -68,8 +69,10 @@ DiagnosisSplit SplitForDiagnosis(const std::vector<RunLog>& runs, const Robot& r
 
 // What diagnose refuses, each with exit 2 before any fit or exit 3 after, and the reason: a robot
 // YAML that already declares effects (the diagnosis adds them to a robot without); a split
-// without training or held-out runs (the effects are judged on held-out runs); a declared or final
-// fit that did not converge (nothing it says could be trusted).
+// without training or held-out runs (the effects are judged on held-out runs); a track fit (the
+// diagnosis' base and final fit) that did not converge, or a declared fit without a finite point
+// (nothing they say could be trusted). A declared fit that stopped short of converging is only
+// left out of the gate (DiagnosisCalibration::left_out_line): the tracks are the diagnosis.
 Refusal RefusalOfDeclaredEffects(const Robot& robot, const std::string& robot_path);
 Refusal RefusalOfSplit(const DiagnosisSplit& split);
 Refusal RefusalOfUnconvergedFits(const DiagnoseResult& result);

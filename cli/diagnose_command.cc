@@ -69,6 +69,7 @@ void PrintDecision(const DiagnosisCalibration& c, std::size_t num_held_out) {
     std::printf("  %-28s %10.5f%s\n", d.name.c_str(), d.cf_after,
                 d.name == c.choice.name ? "   <- selected" : "");
   }
+  if (!c.left_out_line.empty()) std::printf("%s\n", c.left_out_line.c_str());
   if (!c.gave_way_line.empty()) std::printf("%s\n", c.gave_way_line.c_str());
   for (const std::string& line : c.never_worse_warnings) std::printf("warning: %s\n", line.c_str());
   if (c.uncertainty_propagated) {
@@ -132,6 +133,9 @@ int RunDiagnoseCommand(const DiagnoseCommandOptions& options) {
     std::printf("%s", outcome.report.c_str());
     if (!outcome.calibration.gate.empty()) {
       PrintDecision(outcome.calibration, outcome.split.validation.size());
+    }
+    if (!outcome.mount_freed_line.empty()) {
+      std::printf("warning: %s\n", outcome.mount_freed_line.c_str());
     }
     if (outcome.refusal.exit_code != 0) return PrintRefusal(outcome.refusal);
     std::printf("%s", outcome.written_text.c_str());

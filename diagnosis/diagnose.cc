@@ -28,13 +28,6 @@ double Bic(double sum_objective, int num_runs, int k) {
   return n * std::log(std::max(sum_objective, 1e-300) / n) + k * std::log(n);
 }
 
-std::vector<AlignedRun> AlignedOf(const std::vector<TrackRun>& runs) {
-  std::vector<AlignedRun> out;
-  out.reserve(runs.size());
-  for (const TrackRun& r : runs) out.push_back(r.aligned);
-  return out;
-}
-
 std::string EffectValueText(const effects::EffectValue& e) {
   const auto& info = effects::Info(e.id);
   std::string out = info.name;
@@ -709,6 +702,10 @@ std::string FormatDiagnoseReport(const DiagnoseResult& r, const RobotModelInterf
   const Robot& robot = model.robot();
   std::string out = "# fitcal diagnose\n\n## Residual of the declared fit of the " +
                     std::to_string(robot.NumFree()) + " free parameters\n\n";
+  if (!r.declared.usable) {
+    out += "The declared fit did not converge (" + r.declared.termination +
+           "): below is its residual where it stopped; the diagnosis starts from the tracks.\n\n";
+  }
   out += FormatResidualAnalysis(r.before);
   out += "\n## Tracing\n\n";
   out += TracingText(r);

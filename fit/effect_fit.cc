@@ -163,6 +163,13 @@ std::vector<EffectId> IdsOf(const EffectModel& model) {
 
 }  // namespace
 
+std::vector<AlignedRun> AlignedOf(const std::vector<TrackRun>& runs) {
+  std::vector<AlignedRun> out;
+  out.reserve(runs.size());
+  for (const TrackRun& r : runs) out.push_back(r.aligned);
+  return out;
+}
+
 unsigned WheelChannelMask(const Robot& robot) {
   unsigned mask = 0;
   for (int i = 0; i < robot.NumChannels(); ++i) {

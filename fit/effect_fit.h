@@ -118,6 +118,8 @@ std::vector<TrackRun> PrepareTrackRuns(const std::vector<RunLog>& runs, unsigned
 unsigned WheelChannelMask(const Robot& robot);
 // The split of track runs (fit/run_split.h) reads each run's aligned part.
 inline const AlignedRun& AlignedOf(const TrackRun& run) { return run.aligned; }
+// Copies of the runs' aligned parts, for the fits and scores of aligned runs.
+std::vector<AlignedRun> AlignedOf(const std::vector<TrackRun>& runs);
 
 using EffectModel = std::vector<effects::EffectValue>;
 

@@ -3,13 +3,14 @@
 // the caller to decide, and the selected candidate is the gate's on the runs it says it judged
 // on. The CFs the outcome reports are checked against a replay of the selected parameters made
 // here (fit/final_pose_errors.h), not against the outcome's own numbers.
+#include "calibrate/calibrate.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <string>
 
-#include "calibrate/calibrate.h"
 #include "calibrate/diagnosis_calibration.h"
 #include "calibrate/method_comparison.h"
 #include "fit/final_pose_errors.h"
@@ -134,6 +135,7 @@ struct DiagnosisCase {
     const Robot& robot = loaded.model->robot();
     split = SplitForFit(PrepareTrackRuns(loaded.request.runs, WheelChannelMask(robot)), "1-5", "");
     result.declared.parameters = robot.nominal;
+    result.declared.usable = true;
     result.declared_validation.cf = 1e9;  // worse than anything: never selected
     result.base.parameters = robot.nominal;
   }
@@ -205,6 +207,39 @@ TEST(CalibrateOnDiagnosis, ACandidateOnItsBoundGivesWayOrIsRefused) {
 
 // CompareMethods (calibrate/method_comparison.h, `fitcal compare` without the command): one
 // strategy (STB: curves both ways; STA's three straight runs do not determine the wheels'
+// A declared fit that stopped short of converging (a finite point, not usable) is no candidate,
+// however low its held-out CF, and a line says so; the track fit is written. Without even a
+// finite point, or with a track fit that did not converge, the diagnosis is refused (exit 3).
+TEST(CalibrateOnDiagnosis, ADeclaredFitThatDidNotConvergeIsNoCandidate) {
+  DiagnosisCase c;
+  const CalibrationOutcome fit = Calibrate(c.loaded.request, *c.loaded.model);
+  ASSERT_EQ(fit.exit_code(), 0);
+  c.result.declared.usable = false;
+  c.result.declared.stopped_early = true;
+  c.result.declared.termination = "NO_CONVERGENCE";
+  c.result.declared_validation.cf = 0.0;  // the lowest of all, were it a candidate
+  c.result.base.parameters = fit.selected().parameters;
+  c.result.final_fit.usable = true;
+  const DiagnosisCalibration d = c.Run();
+  ASSERT_EQ(d.refusal.exit_code, 0) << d.refusal.reasons.front();
+  ASSERT_EQ(d.gate.size(), 2u);
+  EXPECT_EQ(d.gate[1].name, "track fit");
+  EXPECT_EQ(d.choice.name, "track fit");
+  EXPECT_EQ(d.left_out_line,
+            "declared final-pose fit: not a candidate, it did not converge (NO_CONVERGENCE)");
+  EXPECT_EQ(RefusalOfUnconvergedFits(c.result).exit_code, 0);
+
+  c.result.declared.stopped_early = false;
+  EXPECT_EQ(RefusalOfUnconvergedFits(c.result).exit_code, 3);
+  c.result.declared.usable = true;
+  c.result.final_fit.usable = false;
+  c.result.final_fit.termination = "NO_CONVERGENCE";
+  const Refusal track = RefusalOfUnconvergedFits(c.result);
+  EXPECT_EQ(track.exit_code, 3);
+  EXPECT_EQ(track.reasons.at(0),
+            "the track fit did not converge (NO_CONVERGENCE); nothing written");
+}
+
 // angles, and their fit is worse held out, as in Palacin Table 4), Ceres on the first repetition
 // of the flower.
 ComparisonRequest FlowerComparison() {

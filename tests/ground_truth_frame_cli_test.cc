@@ -6,10 +6,10 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <filesystem>
 #include <set>
 #include <string>
 #include <tuple>
-#include <filesystem>
 
 #include "models/diff_drive/diff_drive_model.h"
 #include "models/model_registry.h"
@@ -169,22 +169,32 @@ TEST(MountedFit, AGuessTheWheelDistancesCannotTakeUpIsFitted) {
   EXPECT_FALSE(std::filesystem::exists(dir.Path("narrow.yaml")));
 }
 
-// diagnose keeps the mount at its guess: on probe45 its lowest held-out CF, the track fit's
-// (0.0467 against the nominal's 0.0884), has two wheel distances and an angle on their bounds.
-// fit's bounds' rule holds there too: no other candidate beats the nominal inside its bounds, so
-// nothing is written (exit 5, no page either) and the reason names the parameters and the held
-// mount's guess, as fit's does (before, the track fit was written).
-TEST(MountedFit, DiagnoseWritesNoCalibrationOnItsBounds) {
+// diagnose makes fit's check (calibrate/mount_freed.h) on its track fit: on probe45 the track fit
+// with the mount held had its lowest held-out CF (0.0467 against the nominal's 0.0884) with two
+// wheel distances and an angle on their bounds, and nothing was written (exit 5). With x and y
+// freed the diagnosis is made again and written, the mount within 0.03 m of the truth as fit's
+// (above), with the same warning. With the mount's bounds narrowed around the guess, the freed
+// diagnosis is refused too: the held one's refusal stands, naming the held mount and its guess.
+TEST(MountedFit, DiagnoseFitsAMountTheWheelsCannotAbsorb) {
   TempDir dir;
-  Probe45(dir);
-  const auto r = RunFitcal(dir, "diagnose --logs " + dir.Path("data") + " --out " +
-                                    dir.Path("diagnosis") + " --threads 2");
+  const std::string data = dir.Path("data"), out = dir.Path("diagnosis");
+  std::string robot = Probe45(dir);
+  auto r = RunFitcal(dir, "diagnose --logs " + data + " --out " + out + " --threads 2");
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  EXPECT_TRUE(Has(r.out, "warning: ground_truth_frame: x and y fitted (x ")) << r.out;
+  const YAML::Node frame = YAML::LoadFile(out + "/calibrated.yaml")["ground_truth_frame"];
+  EXPECT_NEAR(frame["x_m"].as<double>(), 0.0, 0.03);
+  EXPECT_NEAR(frame["y_m"].as<double>(), 0.0, 0.03);
+
+  robot = Replace(robot, "bounds:", "bounds:\n  ground_truth_x_m: [0.09, 0.11]");
+  WriteFileBytes(data + "/robot.yaml", robot);
+  r = RunFitcal(dir, "diagnose --logs " + data + " --out " + dir.Path("narrow") + " --threads 2");
   EXPECT_EQ(r.exit_code, 5) << r.err << r.out;
   EXPECT_TRUE(Has(r.err, "'track fit' leaves a parameter on its bound (R_")) << r.err;
   EXPECT_TRUE(Has(r.err, "the ground truth's mount is held at its guess (ground_truth_x 0.1 m, "
                          "ground_truth_y 0 m)"))
       << r.err;
-  EXPECT_FALSE(std::filesystem::exists(dir.Path("diagnosis")));
+  EXPECT_FALSE(std::filesystem::exists(dir.Path("narrow")));
 }
 
 // A closed form measures the base only (MountedModel::ClosedForms hands it the nominal frame): an
