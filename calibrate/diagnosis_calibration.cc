@@ -79,11 +79,9 @@ DiagnoseChoice Select(const RobotModelInterface& model, const SplitOf<TrackRun>&
     if (c[i].cf_after < c[best].cf_after && !AnyOf(OnItsBounds(robot, i, c[i]))) best = i;
   }
   if (lowest != best) {
-    std::vector<bool> held(robot.parameters.size(), false);
-    for (const HeldParameter& h : robot.held) held[h.index] = true;
     *on_bound = AtBoundRefusal(robot, c[lowest].name, c[lowest].parameters,
                                OnItsBounds(robot, lowest, c[lowest])) +
-                HeldMountNote(robot, c[lowest].parameters, held);
+                HeldMountNote(robot, c[lowest].parameters, robot.HeldFlags());
   }
   c[best].cf_before = c[0].cf_after;
   const auto cf_training = [&](const DiagnoseChoice& d) {

@@ -128,8 +128,7 @@ ModelFitMethodOutcome RunModelNlopt(NloptMethod method, const std::vector<Aligne
   fit.solve_time_s = r.solve_time_s;
   fit.parameters = r.parameters;
   fit.at_bound = r.at_bound;
-  fit.held.assign(robot.NumParameters(), false);
-  for (const HeldParameter& h : robot.held) fit.held[h.index] = true;
+  fit.held = robot.HeldFlags();
   fit.sigma.assign(robot.NumParameters(), 0.0);
   fit.covariance_message = "no covariance from NLopt methods (the ceres method computes one)";
   out.evaluations = r.evaluations;

@@ -67,7 +67,7 @@ SelectedFit DescribeSelected(const Robot& robot,
     // The effect fit reports only whether some parameter ended on a bound: which ones, by the
     // fit's own rule.
     out.at_bound = ParametersAtBound(robot, selected.parameters);
-    for (const HeldParameter& h : robot.held) out.held[h.index] = true;
+    out.held = robot.HeldFlags();
     out.objective = kTrackObjective;
     out.termination = track_fit->termination;
   } else if (selected.name == method) {

@@ -38,12 +38,8 @@ ceres::Problem::Options ProblemOptionsOnSharedContext() {
 }
 
 std::vector<bool> HoldAtNominal(const Robot& robot, double* p) {
-  std::vector<bool> held(robot.NumParameters(), false);
-  for (const HeldParameter& h : robot.held) {
-    held[h.index] = true;
-    p[h.index] = robot.nominal[h.index];
-  }
-  return held;
+  for (const HeldParameter& h : robot.held) p[h.index] = robot.nominal[h.index];
+  return robot.HeldFlags();
 }
 
 void BoundModelBlock(const Robot& robot, const std::vector<bool>& fixed, double* p,

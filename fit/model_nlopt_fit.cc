@@ -81,9 +81,7 @@ NloptSearchResult FitModelNlopt(const std::vector<AlignedRun>& training,
   const bool needs_gradient = info.gradient || (options.local_polish && info.global);
   ModelRunResiduals residuals(training, model, options.weights, needs_gradient);
   const Robot& robot = model.robot();
-  std::vector<bool> held(robot.NumParameters(), false);
-  for (const HeldParameter& h : robot.held) held[h.index] = true;
-  return RunNloptSearch(residuals, robot.nominal, robot.bounds, held, options);
+  return RunNloptSearch(residuals, robot.nominal, robot.bounds, robot.HeldFlags(), options);
 }
 
 }  // namespace fitcal

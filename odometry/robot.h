@@ -120,6 +120,12 @@ struct Robot {
     return false;
   }
   int NumFree() const { return NumParameters() - static_cast<int>(held.size()); }
+  // One flag per parameter: whether it is held (the fits' and the gate's `held` vectors).
+  std::vector<bool> HeldFlags() const {
+    std::vector<bool> flags(parameters.size(), false);
+    for (const HeldParameter& h : held) flags[h.index] = true;
+    return flags;
+  }
   // Whether these channels let the effect act (effects::ChannelsCanCarry).
   bool CanShow(effects::EffectId id) const {
     bool has_angle = false;

@@ -12,8 +12,7 @@ namespace {
 
 // The free parameters: not held by the caller nor by the robot's gauge.
 std::vector<int> FreeParameters(const Robot& robot, const std::vector<bool>& held) {
-  std::vector<bool> fixed(robot.nominal.size(), false);
-  for (const HeldParameter& h : robot.held) fixed[h.index] = true;
+  std::vector<bool> fixed = robot.HeldFlags();
   for (std::size_t k = 0; k < held.size() && k < fixed.size(); ++k) fixed[k] = fixed[k] || held[k];
   std::vector<int> free;
   for (std::size_t k = 0; k < fixed.size(); ++k) {
