@@ -8,9 +8,10 @@
 // A track fit with effects that were not named is not a candidate: the file would claim a CF its
 // parameters reach only together with effects it does not carry.
 
-#include <Eigen/Core>
 #include <string>
 #include <vector>
+
+#include <Eigen/Core>
 
 #include "calibrate/calibrate.h"
 #include "calibrate/never_worse_gate.h"

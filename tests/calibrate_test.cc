@@ -3,14 +3,13 @@
 // the caller to decide, and the selected candidate is the gate's on the runs it says it judged
 // on. The CFs the outcome reports are checked against a replay of the selected parameters made
 // here (fit/final_pose_errors.h), not against the outcome's own numbers.
-#include "calibrate/calibrate.h"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <string>
 
+#include "calibrate/calibrate.h"
 #include "calibrate/diagnosis_calibration.h"
 #include "calibrate/method_comparison.h"
 #include "fit/final_pose_errors.h"
@@ -205,8 +204,6 @@ TEST(CalibrateOnDiagnosis, ACandidateOnItsBoundGivesWayOrIsRefused) {
       << refused.refusal.reasons[0];
 }
 
-// CompareMethods (calibrate/method_comparison.h, `fitcal compare` without the command): one
-// strategy (STB: curves both ways; STA's three straight runs do not determine the wheels'
 // A declared fit that stopped short of converging (a finite point, not usable) is no candidate,
 // however low its held-out CF, and a line says so; the track fit is written. Without even a
 // finite point, or with a track fit that did not converge, the diagnosis is refused (exit 3).
@@ -240,6 +237,8 @@ TEST(CalibrateOnDiagnosis, ADeclaredFitThatDidNotConvergeIsNoCandidate) {
             "the track fit did not converge (NO_CONVERGENCE); nothing written");
 }
 
+// CompareMethods (calibrate/method_comparison.h, `fitcal compare` without the command): one
+// strategy (STB: curves both ways; STA's three straight runs do not determine the wheels'
 // angles, and their fit is worse held out, as in Palacin Table 4), Ceres on the first repetition
 // of the flower.
 ComparisonRequest FlowerComparison() {

@@ -6,10 +6,10 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
-#include <filesystem>
 #include <set>
 #include <string>
 #include <tuple>
+#include <filesystem>
 
 #include "models/diff_drive/diff_drive_model.h"
 #include "models/model_registry.h"
