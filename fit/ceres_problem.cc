@@ -2,6 +2,10 @@
 
 #include <ceres/covariance.h>
 #include <ceres/manifold.h>
+#include <ceres/sized_cost_function.h>
+
+#include <pthread.h>
+#include <signal.h>
 
 #include <algorithm>
 #include <utility>
@@ -25,9 +29,48 @@ ceres::Solver::Options SolverOptionsFor(const CeresFitOptions& options) {
   return o;
 }
 
+namespace {
+
+// A residual with nothing to fit, solved once to make Ceres start its pool.
+class ZeroResidual final : public ceres::SizedCostFunction<1, 1> {
+ public:
+  bool Evaluate(double const* const* /*x*/, double* r, double** jacobians) const override {
+    r[0] = 0.0;
+    if (jacobians != nullptr && jacobians[0] != nullptr) jacobians[0][0] = 1.0;
+    return true;
+  }
+};
+
+// The context with its pool's threads started, all of them, and with every signal blocked. They
+// live as long as the process, and a signal delivered to one of them runs its handler beside the
+// main thread, which goes on: io/atomic_file.h's cleanup then raced the rename it must come
+// before (NothingLostTest.SignalAtEveryStageLeavesThePreviousOutputUntouched). Ceres sizes its
+// pool at a solve's num_threads - 1, capped at the hardware's threads, so a solve on one thread
+// more than the hardware has starts every thread it will ever have.
+ceres::Context* ContextWithItsThreadsStarted() {
+  ceres::Context* context = ceres::Context::Create();
+  sigset_t all, previous;
+  sigfillset(&all);
+  pthread_sigmask(SIG_BLOCK, &all, &previous);
+  double x = 0.0;
+  ceres::Problem::Options problem_options;
+  problem_options.context = context;
+  ceres::Problem problem(problem_options);
+  problem.AddResidualBlock(new ZeroResidual, nullptr, &x);
+  ceres::Solver::Options options;
+  options.logging_type = ceres::SILENT;
+  options.num_threads = ResolveThreadCount(0) + 1;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  pthread_sigmask(SIG_SETMASK, &previous, nullptr);
+  return context;
+}
+
+}  // namespace
+
 ceres::Context* SharedCeresContext() {
   // Made once and never destroyed: a fit may still run on another thread while statics go.
-  static ceres::Context* const context = ceres::Context::Create();
+  static ceres::Context* const context = ContextWithItsThreadsStarted();
   return context;
 }
 
