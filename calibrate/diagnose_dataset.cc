@@ -65,14 +65,19 @@ std::string WrittenCalibrationText(const Robot& robot, const DiagnoseChoice& cho
   return out;
 }
 
-// The diagnosis of the split's training runs, judged on its held-out runs; the report from it.
-void DiagnoseSplit(const DiagnoseDatasetRequest& request, const RobotModelInterface& model,
-                   DiagnoseDatasetOutcome* out) {
+// The diagnosis' options from the request: its fits' and its tracing's.
+DiagnoseOptions OptionsOf(const DiagnoseDatasetRequest& request) {
   DiagnoseOptions options;
   options.fit.num_threads = request.threads;
   options.max_effects = request.max_effects;
   options.alpha = request.alpha;
-  out->result = Diagnose(out->split.training, out->split.validation, model, options);
+  return options;
+}
+
+// The diagnosis of the split's training runs, judged on its held-out runs; the report from it.
+void DiagnoseSplit(const DiagnoseDatasetRequest& request, const RobotModelInterface& model,
+                   DiagnoseDatasetOutcome* out) {
+  out->result = Diagnose(out->split.training, out->split.validation, model, OptionsOf(request));
   out->refusal = RefusalOfUnconvergedFits(out->result);
   if (out->refusal.exit_code != 0) return;
   out->report = "data set: " + request.dataset + ", " + out->split.text +
@@ -105,10 +110,8 @@ void DiagnoseAMountTheWheelsCannotAbsorb(const DiagnoseDatasetRequest& request,
   if (mounted == nullptr || !held.usable || out->refusal.exit_code == 3) return;
   const RobotModelPtr freed = mounted->WithSidewaysMountFreed();
   if (!freed) return;
-  DiagnoseOptions options;
-  options.fit.num_threads = request.threads;
   const EffectFitResult fitted =
-      FitEffectModel(out->split.training, *freed, held.parameters, {}, options.fit);
+      FitEffectModel(out->split.training, *freed, held.parameters, {}, OptionsOf(request).fit);
   if (!fitted.usable) return;
   const std::vector<AlignedRun> training = AlignedOf(out->split.training);
   const double held_cf =

@@ -68,15 +68,11 @@ ceres::Context* ContextWithItsThreadsStarted() {
 
 }  // namespace
 
-ceres::Context* SharedCeresContext() {
+ceres::Problem::Options ProblemOptionsOnSharedContext() {
   // Made once and never destroyed: a fit may still run on another thread while statics go.
   static ceres::Context* const context = ContextWithItsThreadsStarted();
-  return context;
-}
-
-ceres::Problem::Options ProblemOptionsOnSharedContext() {
   ceres::Problem::Options options;
-  options.context = SharedCeresContext();
+  options.context = context;
   return options;
 }
 

@@ -20,11 +20,11 @@ namespace fitcal {
 // and the covariance is taken at the end point.
 ceres::Solver::Options SolverOptionsFor(const CeresFitOptions& options);
 
-// The Ceres context every fit's problem shares (Problem::Options::context): without one, each
-// problem made its own, and each solve on more than one thread started and joined a new thread
-// pool (62 pools in the 97-run differential drive fit with clock offsets). Ceres' ParallelFor lets
-// the calling thread take the work a pool thread has not, so problems solved at once share it.
-ceres::Context* SharedCeresContext();
+// Problem options on the Ceres context every fit's problem shares (Problem::Options::context):
+// without one, each problem made its own, and each solve on more than one thread started and
+// joined a new thread pool (62 pools in the 97-run differential drive fit with clock offsets).
+// Ceres' ParallelFor lets the calling thread take the work a pool thread has not, so problems
+// solved at once share it.
 ceres::Problem::Options ProblemOptionsOnSharedContext();
 
 // Sets the robot's held parameters (Robot::held, the gauge) in p to their nominal values and
