@@ -19,7 +19,8 @@
 #include "tests/written_calibration_checks.h"
 
 namespace fitcal {
-namespace {
+// Named, not anonymous: tests compile in batches (tests/CMakeLists.txt).
+namespace ground_truth_frame_cli_test {
 
 using fitcal::testing::Has;
 using fitcal::testing::RunFitcal;
@@ -278,5 +279,5 @@ TEST(MountedFit, ReportJudgesAMountedCalibrationsWheelsOnGroundTruthOfTheBase) {
   EXPECT_FALSE(std::filesystem::exists(dir.Path("report2")));
 }
 
-}  // namespace
+}  // namespace ground_truth_frame_cli_test
 }  // namespace fitcal
