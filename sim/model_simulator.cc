@@ -104,6 +104,7 @@ FineGrid MakeGrid(double end_s, const SimulationOptions& o) {
   const std::size_t num_encoder = num(end_s, o.encoder_period_s);
   const double last_s = static_cast<double>(num_encoder) * o.encoder_period_s;
   std::vector<std::pair<double, int>> anchors;  // time, 0 encoder / 1 ground truth
+  anchors.reserve(num_encoder + num(last_s, o.ground_truth_period_s) + 2);
   for (std::size_t k = 0; k <= num_encoder; ++k) {
     anchors.push_back({static_cast<double>(k) * o.encoder_period_s, 0});
   }
@@ -111,7 +112,13 @@ FineGrid MakeGrid(double end_s, const SimulationOptions& o) {
     anchors.push_back({std::min(static_cast<double>(j) * o.ground_truth_period_s, last_s), 1});
   }
   std::sort(anchors.begin(), anchors.end());
+  // Sized once: every gap between anchors is split into at most gap / substep + 1 steps. A
+  // vector grown row by row is copied at every doubling (most of a simulation's page faults
+  // under the sanitizers).
   FineGrid grid;
+  grid.t_s.reserve(num(last_s, o.substep_s) + anchors.size() + 1);
+  grid.encoder_index.reserve(num_encoder + 1);
+  grid.gt_index.reserve(anchors.size() - num_encoder - 1);
   grid.t_s.push_back(0.0);
   for (const auto& [t, kind] : anchors) {
     const double gap = t - grid.t_s.back();
@@ -160,6 +167,8 @@ EncoderSamples FineChannels(const RobotModelInterface& model, const double* p,
 EncoderSamples DynamicChannels(ChannelDynamics& dynamics, int c, const TwistProfile& profile,
                                const FineGrid& grid, std::vector<std::vector<double>>* readings) {
   EncoderSamples fine(c);
+  fine.reserve(grid.t_s.size());
+  readings->reserve(grid.t_s.size());
   std::vector<double> values(c, 0.0);
   dynamics.Read(values.data());
   readings->push_back(values);
@@ -200,6 +209,9 @@ void RecordEncoders(const RobotModelInterface& model, const double* p, const Twi
   }
   read_angles(0, &previous);
   run->log.encoders.samples = EncoderSamples(c);
+  run->log.encoders.samples.reserve(grid.encoder_index.size());
+  run->log.encoders.t_s.reserve(grid.encoder_index.size());
+  run->recorded.reserve(grid.encoder_index.size());
   run->log.encoders.t_s.push_back(0.0);
   run->recorded.push_back(std::vector<double>(c, 0.0));
   for (int i = 0; i < c; ++i) {
@@ -256,6 +268,8 @@ ModelSimulatedRun SimulateRun(const RobotModelInterface& model, const std::vecto
   for (const ChannelInfo& ch : model.robot().channels)
     run.encoder_columns.push_back(ch.rate_column);
   RecordEncoders(model, p.data(), profile, grid, fine, readings, o, rng, &run);
+  run.log.ground_truth.t_s.reserve(grid.gt_index.size());
+  run.log.ground_truth.world_T_robot.reserve(grid.gt_index.size());
   for (std::size_t j : grid.gt_index) {
     const Pose2d& t = truth[j];
     run.log.ground_truth.t_s.push_back(grid.t_s[j]);
@@ -331,6 +345,10 @@ std::string SimulatedEncoderCsv(const ModelSimulatedRun& run, EncoderCsvDigits d
   std::string out = "t";
   for (const std::string& column : run.encoder_columns) out += "," + column;
   out += "\n";
+  // At most 25 characters a field with its comma ("%.17g" of a negative number with a
+  // three-digit exponent), 17 for "%.9g"; sized once, as the grid above.
+  const std::size_t fields = run.recorded.size() * (1 + run.encoder_columns.size());
+  out.reserve(out.size() + fields * (round_trip ? 25 : 17) + run.recorded.size());
   char field[64];
   for (std::size_t k = 0; k < run.recorded.size(); ++k) {
     std::snprintf(field, sizeof field, round_trip ? "%.17g" : "%.6f", run.log.encoders.t_s[k]);
