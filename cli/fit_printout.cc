@@ -147,13 +147,10 @@ void PrintClockOffsets(const ModelFitResult& fit, const TrackFitData& track) {
   constexpr std::size_t kMaxListed = 12;
   for (std::size_t g = 0; g < n && n <= kMaxListed; ++g) {
     // A sigma of exactly 0 is the covariance that could not be computed, not a sure offset.
-    if (s.sigma_s[g] > 0.0) {
-      std::printf("  %-36s %+8.3f s +- %.3f\n", track.clock_groups[g].c_str(),
-                  fit.clock_offsets_s[g], s.sigma_s[g]);
-    } else {
-      std::printf("  %-36s %+8.3f s +- ? (no covariance)\n", track.clock_groups[g].c_str(),
-                  fit.clock_offsets_s[g]);
-    }
+    const std::string sigma =
+        s.sigma_s[g] > 0.0 ? StrFormat("%.3f", s.sigma_s[g]) : "? (no covariance)";
+    std::printf("  %-36s %+8.3f s +- %s\n", track.clock_groups[g].c_str(),
+                fit.clock_offsets_s[g], sigma.c_str());
   }
   if (n > kMaxListed) {
     std::printf("  median %+.3f s, range [%+.3f, %+.3f] s, mean sigma %.3f s\n", s.median_s,
@@ -192,16 +189,6 @@ void PrintEncoderGlitches(const std::vector<RunLog>& runs) {
   std::printf("encoder glitches: %d interval%s in %d run%s dropped from the fit (each named with "
               "its file:line in the warnings)\n",
               g.intervals, g.intervals == 1 ? "" : "s", g.runs, g.runs == 1 ? "" : "s");
-}
-
-// Drift per 1, 2, 5 m and ATE RMSE (validation/never_worse.h) of the nominal and the
-// selected calibration on the held-out runs (the training runs when none is held out).
-void PrintEverydayDriving(const RobotModelInterface& model, const CalibrationOutcome& o,
-                          int threads) {
-  const OutcomeEverydayDriving driving = CompareOutcomeEverydayDriving(model, o, threads);
-  PrintEverydayDrivingTable(
-      driving.held_out ? "everyday driving, validation" : "everyday driving, training",
-      driving.table);
 }
 
 // Each direction held at the nominal, and what to drive to determine it (fit/motion_advice.h).
@@ -260,7 +247,12 @@ void PrintReport(const CalibrationRequest& request, const RobotModelInterface& m
   PrintTying(o.settings.tying);
   if (!request.closed_forms_only) PrintResiduals(o, flag_notes);
   PrintEncoderGlitches(request.runs);
-  PrintEverydayDriving(model, o, request.threads);
+  // Drift per 1, 2, 5 m and ATE RMSE (validation/never_worse.h) of the nominal and the selected
+  // calibration on the held-out runs (the training runs when none is held out).
+  const OutcomeEverydayDriving driving = CompareOutcomeEverydayDriving(model, o, request.threads);
+  PrintEverydayDrivingTable(
+      driving.held_out ? "everyday driving, validation" : "everyday driving, training",
+      driving.table);
   if (!request.closed_forms_only) PrintUncertaintyAndWarnings(model, o, request.threads);
   PrintGate(o);
 }
