@@ -705,6 +705,7 @@ void AlternateWithClockOffsets(const std::vector<AlignedRun>& training,
     ceres::Solver::Summary summary;
     ceres::Solve(SolverOptionsFor(few_steps.ceres), &fit.problem(), &summary);
     result->iterations += static_cast<int>(summary.iterations.size());
+    result->evaluations += summary.num_residual_evaluations + summary.num_jacobian_evaluations;
   }
 }
 
@@ -842,6 +843,7 @@ ModelFitResult SolveHoldingUndetermined(const std::vector<AlignedRun>& training,
       held.unconstrained_parameters = result.parameters;
       held.unconstrained_usable = result.usable;
       held.iterations += result.iterations;
+      held.evaluations += result.evaluations;
       held.solve_time_s += result.solve_time_s;
       result = std::move(held);
     }
@@ -864,13 +866,15 @@ ModelFitResult FitWithNoiseLevels(const std::vector<AlignedRun>& training,
   ModelFitResult fit;
   ModelFitOptions fitted_with;  // the returned fit's options and holds
   HeldDirections holds;
-  int iterations = 0;
+  int iterations = 0;  // summed over the rounds, as the evaluations and the solve time
+  int evaluations = 0;
   double solve_time_s = 0.0;
   for (int round = 1; round <= kMaxNoiseLevelIterations; ++round) {
     holds = {};
     fit = SolveHoldingUndetermined(training, model, from, weighted, &holds);
     fitted_with = weighted;
     iterations += fit.iterations;
+    evaluations += fit.evaluations;
     solve_time_s += fit.solve_time_s;
     if (!fit.HasFinitePoint()) break;
     const int held = static_cast<int>(std::count(fit.held.begin(), fit.held.end(), true));
@@ -898,6 +902,7 @@ ModelFitResult FitWithNoiseLevels(const std::vector<AlignedRun>& training,
   }
   fit.noise_levels = levels;
   fit.iterations = iterations;
+  fit.evaluations = evaluations;
   fit.solve_time_s = solve_time_s;
   return fit;
 }

@@ -52,8 +52,10 @@ struct ModelFitResult {
   bool HasFinitePoint() const { return usable || stopped_early; }
   std::string termination;  // Ceres termination type of the last solve, e.g. CONVERGENCE
   std::string message;      // Ceres' reason for stopping
-  int iterations = 0;       // over all active-set rounds
-  int evaluations = 0;      // Ceres' residual and Jacobian evaluations, over all solves
+  // Summed over every solve: active-set rounds, held directions, clock-offset and noise-level
+  // rounds (the evaluations are Ceres' residual and Jacobian evaluations).
+  int iterations = 0;
+  int evaluations = 0;
   int active_set_rounds = 0;  // solves after the first (0: the plain bounded solve converged)
   double solve_time_s = 0.0;
   double final_cost = 0.0;

@@ -106,6 +106,11 @@ TEST(NoiseLevels, TrackFitRecoversKnownPositionAndHeadingNoise) {
     const NoiseLevels& levels = fit.noise_levels;
     ASSERT_TRUE(levels.estimated) << ToString(kind);
     EXPECT_TRUE(levels.settled) << NoiseLevelsText(levels);
+    // The counts fit prints add up every round's solves: a Ceres iteration evaluates at least once
+    // (iteration 0 the Jacobian, each step the residuals), so evaluations >= iterations. Before
+    // the mend the evaluations were the last round's alone (the diff drive: 18 iterations, 9).
+    EXPECT_GT(levels.iterations, 1) << NoiseLevelsText(levels);
+    EXPECT_GE(fit.evaluations, fit.iterations) << ToString(kind);
     EXPECT_NEAR(levels.track_position_m / kPositionSigmaM, 1.0,
                 4.0 * RelativeStandardError(checkpoints, 2))
         << ToString(kind) << ": " << NoiseLevelsText(levels);
