@@ -12,7 +12,9 @@ std::string CheckImportedChannelOrder(const std::vector<RunLog>& logs,
   const std::vector<AlignedRun> runs = AlignRuns(logs);
   std::vector<const GroundTruthTrack*> tracks;
   for (const RunLog& log : logs) tracks.push_back(&log.ground_truth);
-  const ChannelOrderReport report = CheckRecordedChannelOrder(runs, tracks, model);
+  ChannelOrderOptions options;
+  options.score_every_mapping = true;  // the best other order's SSR is printed below
+  const ChannelOrderReport report = CheckRecordedChannelOrder(runs, tracks, model, options);
   if (report.likely_miswired && !skip) {
     throw MiswiredError(report.message +
                         "; nothing written (--skip-mapping-check to write anyway)");
