@@ -27,18 +27,27 @@ std::string ReplayLine(const ExportRos2ControlOptions& o, const ExportReplay& r)
 }
 
 std::string CovarianceLine(const OdometryCovariance& c) {
+  std::string unresolved;
+  for (int a = 0; a < 3; ++a) {
+    if (c.twist_unresolved[a]) unresolved += std::string(unresolved.empty() ? "" : ", ") +
+                                             (a == 0 ? "vx" : a == 1 ? "vy" : "omega");
+  }
+  if (!unresolved.empty()) {
+    unresolved = "; twist " + unresolved +
+                 ": no growth resolved above the ground truth's noise, the bound its windows set";
+  }
   return StrFormat(
       "odometry covariance from %zu held-out runs (%zu windows; twist per message of %.4g s): "
       "twist sigma vx %.4g m/s, vy %.4g m/s, omega %.4g rad/s; pose sigma after 1 m x %.4g m, "
       "y %.4g m, theta %.4g rad, growing as d^%.2f, d^%.2f, d^%.2f; ground truth's own noise "
-      "removed: %.3g m, %.3g m, %.3g rad",
+      "removed: %.3g m, %.3g m, %.3g rad%s",
       c.runs, c.windows, c.interval_s, std::sqrt(c.twist_variance[0]),
       std::sqrt(c.twist_variance[1]), std::sqrt(c.twist_variance[2]),
       std::sqrt(c.pose_variance_1m[0]), std::sqrt(c.pose_variance_1m[1]),
       std::sqrt(c.pose_variance_1m[2]), 0.5 * c.pose_growth_exponent[0],
       0.5 * c.pose_growth_exponent[1], 0.5 * c.pose_growth_exponent[2],
       std::sqrt(c.ground_truth_variance[0]), std::sqrt(c.ground_truth_variance[1]),
-      std::sqrt(c.ground_truth_variance[2]));
+      std::sqrt(c.ground_truth_variance[2]), unresolved.c_str());
 }
 
 }  // namespace

@@ -231,6 +231,21 @@ std::array<double, 3> FitGrowth(const std::vector<double>& t, const std::vector<
   return FitTerms(t, v, w, ticks ? 0b100 : 0b110);
 }
 
+// The white growth (per second) that the windows could hide where they resolve none: two
+// standard errors of a lag's mean square (n Gaussian errors: V sqrt(2 / n); n = w V^2, the
+// weights above) over its duration, the tightest over the lags. Zero growth is not zero error: an
+// EKF given a twist variance of 0 trusts the twist exactly.
+double UnresolvedGrowthBound(const std::vector<double>& t, const std::vector<double>& v,
+                             const std::vector<double>& w) {
+  double bound = HUGE_VAL;
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    if (!(w[i] > 0.0 && v[i] > 0.0 && t[i] > 0.0)) continue;
+    const double n = w[i] * v[i] * v[i];
+    bound = std::min(bound, 2.0 * v[i] * std::sqrt(2.0 / n) / t[i]);
+  }
+  return std::isfinite(bound) ? bound : 0.0;
+}
+
 }  // namespace
 
 std::array<double, 3> FitStructureFunction(const std::vector<double>& t,
@@ -290,6 +305,10 @@ OdometryCovariance EstimateOdometryCovariance(const RobotModelInterface& model,
     for (double x : v) remaining.push_back(x - c);
     const std::array<double, 3> f = FitGrowth(t, remaining, w, ticks);
     out.twist_variance[a] = (f[1] * dt + f[2] * dt * dt + out.quantisation_variance[a]) / (dt * dt);
+    if (!(out.twist_variance[a] > 0.0)) {  // a simulated bag's omega: 0 (export, stop 70)
+      out.twist_variance[a] = UnresolvedGrowthBound(t, v, w) / dt;
+      out.twist_unresolved[a] = true;
+    }
   }
   // The pose law over path windows, the ground truth's noise removed.
   std::vector<double> d;
@@ -316,7 +335,9 @@ OdometryCovariance EstimateOdometryCovariance(const RobotModelInterface& model,
   for (int a = 0; a < 3; ++a) {
     const auto [at_1m, exponent] = PowerLaw(d, v[a]);
     if (!measured_at_1m || !(out.pose_variance_1m[a] > 0.0)) out.pose_variance_1m[a] = at_1m;
-    out.pose_growth_exponent[a] = exponent;
+    // A variance does not shrink with the path: a negative slope is growth the windows do not
+    // resolve beside the ground truth's noise (a simulated bag's heading: -0.33). Flat, then.
+    out.pose_growth_exponent[a] = std::max(0.0, exponent);
   }
   return out;
 }

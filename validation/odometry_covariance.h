@@ -27,7 +27,9 @@
 //   V(d) = a d^p   (least squares in log V against log d),
 // and the controller's constant is V(1 m) = a. Dead reckoning's heading error is a random walk in
 // distance (p near 1), its position error grows faster (the heading error rotates what follows:
-// p up to 3): a per-metre law would make position too wide at 1 m.
+// p up to 3): a per-metre law would make position too wide at 1 m. A negative p is taken as 0.
+// A twist axis with no growth resolved gets the growth its windows could hide (an upper bound,
+// `twist_unresolved`), never 0.
 
 #include <array>
 #include <cstddef>
@@ -47,6 +49,9 @@ struct OdometryCovariance {
   // quantisation's part of a window's error (same units).
   std::array<double, 3> ground_truth_variance{};
   std::array<double, 3> quantisation_variance{};
+  // Axes whose twist error the windows did not resolve above the ground truth's noise: their
+  // twist variance is the bound the windows set (what they could hide), not a measurement.
+  std::array<bool, 3> twist_unresolved{};
   std::size_t windows = 0, runs = 0;
 };
 
