@@ -214,6 +214,36 @@ TEST(OptiOdomImport, BadSessionIsOneErrorAndWritesNothing) {
   fs::remove_all(tmp);
 }
 
+// A time that does not advance is named with the previous row's, as the file writes both.
+TEST(OptiOdomImport, ATimeThatDoesNotAdvanceNamesBothTimes) {
+  SKIP_WITHOUT_DATA();
+  const fs::path tmp = TempDir("time");
+  const fs::path session = tmp / "circular" / "221220201643";
+  fs::create_directories(session);
+  for (const auto& entry : fs::directory_iterator(kCircleSession)) {
+    fs::copy_file(entry.path(), session / entry.path().filename());
+  }
+  const fs::path run = session / "221220201643_run-01.csv";
+  std::ifstream in(run);
+  std::string text, line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    if (n == 3) line.replace(0, line.find(','), "0.0399999999999636");  // row 2's time again
+    text += line + "\n";
+  }
+  in.close();
+  WriteText(run, text);
+  try {
+    optiodom::ReadOptiOdomSessions({session.string()});
+    FAIL() << "expected an InputError";
+  } catch (const io::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(":3: time 0.0399999999999636 s is not after the "
+                                         "previous row's 0.0399999999999636 s"),
+              std::string::npos)
+        << e.what();
+  }
+  fs::remove_all(tmp);
+}
+
 // Sessions of two robots (an omni3 circle and a diff drive's) make no one robot.yaml: a usage
 // error (exit 2) before anything is read, nothing written.
 TEST(OptiOdomImport, SessionsOfTwoRobotsAreRefused) {

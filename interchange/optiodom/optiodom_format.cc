@@ -211,6 +211,7 @@ RunRows ReadRun(const std::string& path, int number, const std::string& column_n
   run.number = number;
   const std::size_t num_fields = 4 + static_cast<std::size_t>(encoder_columns);
   std::vector<double> v(num_fields);
+  std::string previous_time;  // as the file writes it, for the message below
   while (lines.Next(&line)) {
     if (io::Trim(line).empty()) continue;
     const std::vector<std::string> fields = io::SplitCsvFields(line);
@@ -225,8 +226,10 @@ RunRows ReadRun(const std::string& path, int number, const std::string& column_n
     }
     if (!run.t_s.empty() && !(v[0] > run.t_s.back())) {
       throw InputError(InputErrorKind::kNonIncreasingTime, path, lines.line_number(),
-                       "time " + fields[0] + " s is not after the previous row's");
+                       "time " + fields[0] + " s is not after the previous row's " +
+                           previous_time + " s");
     }
+    previous_time = fields[0];
     if (run.first_line == 0) run.first_line = lines.line_number();
     run.t_s.push_back(v[0]);
     run.ground_truth.t_s.push_back(v[0]);
