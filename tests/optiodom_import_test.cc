@@ -259,6 +259,36 @@ TEST(OptiOdomImport, SessionsOfTwoRobotsAreRefused) {
   fs::remove_all(tmp);
 }
 
+// A session whose metadata names no OptiOdom robot is refused by name (exit 1), listed first or
+// not: listed first it set the type the other sessions were held to, and the good one was blamed.
+TEST(OptiOdomImport, AnUnknownRobotTypeIsBlamedOnItsOwnSession) {
+  SKIP_WITHOUT_DATA();
+  const fs::path tmp = TempDir("type");
+  const fs::path bad = tmp / "circular" / "221220201643";
+  fs::create_directories(bad);
+  for (const auto& entry : fs::directory_iterator(kCircleSession)) {
+    fs::copy_file(entry.path(), bad / entry.path().filename());
+  }
+  WriteText(bad / "221220201643_metadata.csv", "type,omni33,,,\n");
+  const std::string good = kSquareSession.string();
+  for (const std::vector<std::string>& order : {std::vector<std::string>{bad.string(), good},
+                                                std::vector<std::string>{good, bad.string()}}) {
+    optiodom::ImportOptiOdomOptions options;
+    options.sessions = order;
+    options.out = (tmp / "out").string();
+    try {
+      optiodom::ImportOptiOdom(options, [](const std::string&) {});
+      ADD_FAILURE() << "expected an InputError";
+    } catch (const io::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(bad.string() + ": type 'omni33'"), std::string::npos)
+          << e.what();
+    }
+    EXPECT_EQ(tools::RunImportOptiOdomCommand(options), 1);
+    EXPECT_FALSE(fs::exists(tmp / "out"));
+  }
+  fs::remove_all(tmp);
+}
+
 TEST(EncoderTicks, IncrementsAndCumulativeGiveTheSameRatesAndTicksNeedAResolution) {
   const fs::path tmp = TempDir("ticks");
   WriteText(tmp / "inc.csv", "t,ticks_a,ticks_b,ticks_c\n0,5,5,5\n0.04,100,-50,0\n0.1,30,0,-12\n");

@@ -205,6 +205,8 @@ void CheckSessionsAndOut(const ImportOptiOdomOptions& options) {
   if (options.sessions.empty()) {
     throw UsageError("import optiodom needs at least one session directory");
   }
+  // A type no OptiOdom robot has is that session's error, whichever session comes first.
+  for (const std::string& dir : options.sessions) RobotKindOf(SessionType(dir), dir);
   const std::string type = SessionType(options.sessions.front());
   for (const std::string& dir : options.sessions) {
     if (const std::string other = SessionType(dir); other != type) {
