@@ -14,11 +14,12 @@ std::string OneLine(const std::string& text, std::size_t max_chars) {
 }
 
 // The path and the message are each clamped (a path near PATH_MAX, a header line of a binary
-// file).
+// file). The message's clamp is above fitcal's own longest sentences (~400 characters: an angle
+// glitch's with its hint was cut mid-word at 300), so that only what a message echoes is cut.
 std::string FileLineText(const std::string& file, int line, const std::string& message) {
   std::string out = OneLine(file, 200);
   if (line > 0) out += ":" + std::to_string(line);
-  return out + ": " + OneLine(message, 300);
+  return out + ": " + OneLine(message, 600);
 }
 
 InputError::InputError(InputErrorKind kind, std::string file, int line, const std::string& message)

@@ -239,6 +239,18 @@ bounds: {distance_m: [0.18, 0.22], radius_m: [0.045, 0.055], angle_offset_deg: [
       << r.err;
 }
 
+// An error line cuts what it echoes, not fitcal's own sentence: an angle glitch's message with
+// its hint (~400 characters) was cut mid-word at 300. A field a megabyte long is still cut.
+TEST(InputClassesCli, AnErrorLineKeepsItsOwnSentenceAndCutsWhatItEchoes) {
+  const std::string sentence(450, 's');
+  const std::string own = io::InputError(io::InputErrorKind::kBadValue, "f.csv", 3, sentence).what();
+  EXPECT_EQ(own, "f.csv:3: " + sentence);
+  const std::string echoed =
+      io::InputError(io::InputErrorKind::kBadValue, "f.csv", 3, std::string(1 << 20, 'x')).what();
+  EXPECT_LT(echoed.size(), 700u);
+  EXPECT_NE(echoed.find("bytes]..."), std::string::npos);
+}
+
 TEST(InputClassesCli, UsageErrorsAreOneLineExitTwoBeforeAnyWork) {
   const TempDir dir;
   for (const std::string& args :
