@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "io/ros2_parameter_yaml.h"
+#include "io/text_file.h"
 #include "io/yaml_scalar.h"
 #include "models/omni/omni_model.h"
 #include "models/omni/omni_trajectories.h"
@@ -41,6 +42,19 @@ constexpr MecanumCorner kCorners[] = {{"front_left", 1, 1, -45},
                                       {"rear_left", -1, 1, 45},
                                       {"rear_right", -1, -1, -45}};
 
+// How far a wheel drives off the x axis, forwards or backwards (rad).
+double OffTheXAxis(const OmniWheel& wheel) {
+  const double drive = std::abs(WrapAngle(wheel.drive_angle_rad));
+  return std::min(drive, M_PI - drive);
+}
+
+// A wheel driven straight backwards: the controller's wheel with its rate's sign turned. Its
+// roller line is the same (axis at drive + roller angle, a line either way), so the corner's
+// roller angle holds for it too (OptiOdom's omni4: the right wheels at 180 deg).
+bool DrivesBackwards(const OmniWheel& wheel) {
+  return std::abs(WrapAngle(wheel.drive_angle_rad)) > M_PI / 2;
+}
+
 // The channel at each corner (kCorners order); std::invalid_argument when the layout differs.
 std::vector<int> MecanumCorners(const std::vector<OmniWheel>& wheels, const Robot& robot) {
   std::vector<int> at(4, -1);
@@ -50,12 +64,12 @@ std::vector<int> MecanumCorners(const std::vector<OmniWheel>& wheels, const Robo
     for (int k = 0; k < 4; ++k) {
       if (x * kCorners[k].sign_x > 0 && y * kCorners[k].sign_y > 0) {
         const bool layout =
-            std::abs(WrapAngle(wheels[i].drive_angle_rad)) < 15.0 * kDeg &&
+            OffTheXAxis(wheels[i]) < 15.0 * kDeg &&
             std::abs(wheels[i].roller_angle_rad - kCorners[k].roller_deg * kDeg) < kSameAngleRad;
         if (!layout || at[k] >= 0) {
           throw ControllerCannotDescribe(
               "wheel '" + robot.channels[i].name + "' (" + kCorners[k].key +
-              ") is not in mecanum_drive_controller's layout (driven straight ahead, rollers -45 "
+              ") is not in mecanum_drive_controller's layout (driven along x, rollers -45 "
               "deg front-left/rear-right, +45 deg front-right/rear-left, one wheel per corner)");
         }
         at[k] = static_cast<int>(i);
@@ -80,15 +94,17 @@ OmniBounds ControllerBounds(double distance_m, double radius_m) {
 }
 
 // What mecanum_drive_controller computes: its layout with one radius and lx = ly (any point with
-// |x| + |y| = lx + ly gives the controller's yaw row).
-RobotModelPtr MecanumKinematics(const CalibratedRobot& c, const std::vector<int>& corner,
-                                double radius_m, double sum_m) {
+// |x| + |y| = lx + ly gives the controller's yaw row), each wheel driven as the calibrated one
+// (backwards: the joint the note asks to invert, replayed as the data record it).
+RobotModelPtr MecanumKinematics(const CalibratedRobot& c, const std::vector<OmniWheel>& calibrated,
+                                const std::vector<int>& corner, double radius_m, double sum_m) {
   const double distance_m = io::Ros2AsWritten(sum_m) / std::sqrt(2.0);
   std::vector<OmniWheel> wheels(4);
   for (int k = 0; k < 4; ++k) {
+    const double drive = DrivesBackwards(calibrated[corner[k]]) ? M_PI : 0.0;
     wheels[corner[k]] = {
         c.ChannelName(corner[k]),    distance_m, std::atan2(kCorners[k].sign_y, kCorners[k].sign_x),
-        io::Ros2AsWritten(radius_m), 0.0,        DegToRad(kCorners[k].roller_deg)};
+        io::Ros2AsWritten(radius_m), drive,      DegToRad(kCorners[k].roller_deg)};
   }
   return MakeOmniModel(c.robot().name, wheels,
                        ControllerBounds(distance_m, io::Ros2AsWritten(radius_m)));
@@ -102,11 +118,20 @@ void MecanumParameters(const CalibratedRobot& c, const std::string&, ControllerE
   const std::vector<OmniWheel> wheels = OmniGeometry(c);
   const std::vector<int> corner = MecanumCorners(wheels, c.robot());
   std::vector<double> radii, sums, drives;
-  for (const OmniWheel& w : wheels) {
+  std::vector<std::string> backwards;
+  for (std::size_t i = 0; i < wheels.size(); ++i) {
+    const OmniWheel& w = wheels[i];
     radii.push_back(w.radius_m);
     sums.push_back(std::abs(w.distance_m * std::cos(w.angle_rad)) +
                    std::abs(w.distance_m * std::sin(w.angle_rad)));
-    drives.push_back(std::abs(WrapAngle(w.drive_angle_rad)));
+    drives.push_back(OffTheXAxis(w));
+    if (DrivesBackwards(w)) backwards.push_back(c.joints[i]);
+  }
+  if (!backwards.empty()) {
+    out->notes.push_back("mecanum_drive_controller counts a wheel positive when it drives the "
+                         "robot forwards, and joints " + io::Joined(backwards, ", ") +
+                         " turn the other way: invert their axes in the URDF (or their sign in "
+                         "the hardware interface)");
   }
   NoteSpread(radii, "radius", "kinematics.wheels_radius", 1.0, "m", &out->notes);
   NoteSpread(sums, "lx + ly", "kinematics.sum_of_robot_center_projection_on_X_Y_axis", 1.0, "m",
@@ -126,7 +151,7 @@ void MecanumParameters(const CalibratedRobot& c, const std::string&, ControllerE
       "    kinematics:\n      wheels_radius: " + io::Ros2Double(MeanValue(radii)) +
       "\n      sum_of_robot_center_projection_on_X_Y_axis: " + io::Ros2Double(MeanValue(sums)) +
       "\n";
-  out->model = MecanumKinematics(c, corner, MeanValue(radii), MeanValue(sums));
+  out->model = MecanumKinematics(c, wheels, corner, MeanValue(radii), MeanValue(sums));
   out->parameters = out->model->robot().nominal;
 }
 
