@@ -363,8 +363,9 @@ void AddModelIdentifiability(const ReportInputs& in, const CalibrationInput& cal
   const std::vector<ParameterInfo>& names = in.model->robot().parameters;
   if (d.ok && d.max_abs_correlation > kMaxAbsCorrelation) {
     data->identifiability_lines.push_back(StrFormat(
-        "%s and %s correlate %.4f on the training runs (above %.2f): the runs see mostly their "
-        "combination, each alone is less certain than its sigma suggests",
+        "%s and %s correlate %.4f in the training runs' final poses (1 m against 1 rad; above "
+        "%.2f; the fit's correlation comes from the residuals it fitted): the runs see mostly "
+        "their combination, each alone is less certain than its sigma suggests",
         names[d.correlated_a].name.c_str(), names[d.correlated_b].name.c_str(),
         d.max_abs_correlation, kMaxAbsCorrelation));
   }
