@@ -14,10 +14,10 @@ namespace fitcal {
 inline constexpr char kExitStatusHelp[] =
     "Exit status: 0 success; 1 bad input (one line: file:line: what is wrong); 2 usage error, or\n"
     "an output refused (README, Outputs: what may be replaced, with --force where a command has\n"
-    "it); 3 the fit did not converge; 4 the encoder columns look miswired; 5 no calibration\n"
-    "beats the nominal robot on the held-out runs; 6 written with a warning (stopped at the\n"
-    "iteration limit); 7 and 8 report --strict judged FAIL and WARN. On any failure nothing is\n"
-    "written.";
+    "it); 3 the fit did not converge; 4 the encoder columns look miswired;\n"
+    "5 no calibration beats the nominal robot on the held-out runs; 6 written with a warning\n"
+    "(stopped at the iteration limit); 7 and 8 report --strict judged FAIL and WARN. On any\n"
+    "failure nothing is written.";
 
 class CommandFailure : public std::runtime_error {
  public:
