@@ -402,9 +402,8 @@ ChannelOrderReport CheckEachSession(const std::vector<AlignedRun>& runs,
     ChannelOrderReport report = CheckChannelOrder(session_runs, session_windows, model, each);
     report.on_windows = on_windows;
     if (!report.likely_miswired) continue;
-    report.message = "session '" + session + "' (" + std::to_string(session_runs.size()) + " of " +
-                     std::to_string(runs.size()) + " runs): " +
-                     report.message;
+    report.message = "session '" + session + "' (" + std::to_string(session_runs.size()) +
+                     " of " + std::to_string(runs.size()) + " runs): " + report.message;
     return report;
   }
   return pooled;
