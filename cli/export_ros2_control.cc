@@ -27,10 +27,11 @@ std::string ReplayLine(const ExportRos2ControlOptions& o, const ExportReplay& r)
 }
 
 std::string CovarianceLine(const OdometryCovariance& c) {
+  constexpr const char* kAxes[] = {"vx", "vy", "omega"};
   std::string unresolved;
   for (int a = 0; a < 3; ++a) {
-    if (c.twist_unresolved[a]) unresolved += std::string(unresolved.empty() ? "" : ", ") +
-                                             (a == 0 ? "vx" : a == 1 ? "vy" : "omega");
+    if (!c.twist_unresolved[a]) continue;
+    unresolved += (unresolved.empty() ? "" : ", ") + std::string(kAxes[a]);
   }
   if (!unresolved.empty()) {
     unresolved = "; twist " + unresolved +

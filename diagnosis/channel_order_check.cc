@@ -11,6 +11,7 @@
 #include "fit/residual_choice.h"
 #include "fit/segment_cost.h"
 #include "fit/statistics.h"
+#include "fit/track_residual.h"
 #include "models/pose_errors.h"
 #include "odometry/invalid.h"
 #include "odometry/parallel_for.h"
@@ -375,22 +376,19 @@ ChannelOrderReport CheckEachSession(const std::vector<AlignedRun>& runs,
                                     const RobotModelInterface& model,
                                     const ChannelOrderOptions& options,
                                     ChannelOrderReport pooled) {
-  std::vector<std::string> sessions;
-  for (const AlignedRun& run : runs) {
-    if (std::find(sessions.begin(), sessions.end(), run.trajectory) == sessions.end()) {
-      sessions.push_back(run.trajectory);
-    }
-  }
-  if (sessions.size() < 2) return pooled;
+  // The sessions as `--clock-offsets session` and the per-session noise levels group them.
+  const RunGroups sessions = GroupRuns(runs, ClockGrouping::kPerSession);
+  if (sessions.names.size() < 2) return pooled;
   ChannelOrderOptions each = options;
-  each.false_alarm_probability /= static_cast<double>(sessions.size());
+  each.false_alarm_probability /= static_cast<double>(sessions.names.size());
   each.score_every_mapping = false;  // the pool's scores are the ones printed
-  for (const std::string& session : sessions) {
+  for (std::size_t g = 0; g < sessions.names.size(); ++g) {
+    const std::string& session = sessions.names[g];
     std::vector<AlignedRun> session_runs;
     std::vector<std::vector<Segment>> session_windows;
     std::size_t total = 0;
     for (std::size_t i = 0; i < runs.size(); ++i) {
-      if (runs[i].trajectory != session) continue;
+      if (sessions.of_run[i] != static_cast<int>(g)) continue;
       session_runs.push_back(runs[i]);
       session_windows.push_back(segments[i]);
       total += segments[i].size();

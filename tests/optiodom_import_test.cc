@@ -43,6 +43,17 @@ fs::path TempDir(const std::string& name) {
 
 void WriteText(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
 
+// A copy of the circle session under `tmp` (circular/<session>, as the recordings lay it out),
+// for a test to spoil one of its files.
+fs::path CopyOfCircleSession(const fs::path& tmp) {
+  const fs::path session = tmp / "circular" / kCircleSession.filename();
+  fs::create_directories(session);
+  for (const auto& entry : fs::directory_iterator(kCircleSession)) {
+    fs::copy_file(entry.path(), session / entry.path().filename());
+  }
+  return session;
+}
+
 TEST(OptiOdomImport, ReadsMetadataAndMapsTheAuthorsWheelsToOurs) {
   SKIP_WITHOUT_DATA();
   const optiodom::OptiOdomImport s = optiodom::ReadOptiOdomSessions({kCircleSession.string()});
@@ -218,11 +229,7 @@ TEST(OptiOdomImport, BadSessionIsOneErrorAndWritesNothing) {
 TEST(OptiOdomImport, ATimeThatDoesNotAdvanceNamesBothTimes) {
   SKIP_WITHOUT_DATA();
   const fs::path tmp = TempDir("time");
-  const fs::path session = tmp / "circular" / "221220201643";
-  fs::create_directories(session);
-  for (const auto& entry : fs::directory_iterator(kCircleSession)) {
-    fs::copy_file(entry.path(), session / entry.path().filename());
-  }
+  const fs::path session = CopyOfCircleSession(tmp);
   const fs::path run = session / "221220201643_run-01.csv";
   std::ifstream in(run);
   std::string text, line;
@@ -264,11 +271,7 @@ TEST(OptiOdomImport, SessionsOfTwoRobotsAreRefused) {
 TEST(OptiOdomImport, AnUnknownRobotTypeIsBlamedOnItsOwnSession) {
   SKIP_WITHOUT_DATA();
   const fs::path tmp = TempDir("type");
-  const fs::path bad = tmp / "circular" / "221220201643";
-  fs::create_directories(bad);
-  for (const auto& entry : fs::directory_iterator(kCircleSession)) {
-    fs::copy_file(entry.path(), bad / entry.path().filename());
-  }
+  const fs::path bad = CopyOfCircleSession(tmp);
   WriteText(bad / "221220201643_metadata.csv", "type,omni33,,,\n");
   const std::string good = kSquareSession.string();
   for (const std::vector<std::string>& order : {std::vector<std::string>{bad.string(), good},

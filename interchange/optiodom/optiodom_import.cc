@@ -205,12 +205,14 @@ void CheckSessionsAndOut(const ImportOptiOdomOptions& options) {
   if (options.sessions.empty()) {
     throw UsageError("import optiodom needs at least one session directory");
   }
-  // A type no OptiOdom robot has is that session's error, whichever session comes first.
-  for (const std::string& dir : options.sessions) RobotKindOf(SessionType(dir), dir);
-  const std::string type = SessionType(options.sessions.front());
+  // A type no OptiOdom robot has is that session's own error (RobotKindOf throws naming it), not
+  // a mismatch blamed on the sessions after it.
+  const RobotKind* first = nullptr;
   for (const std::string& dir : options.sessions) {
-    if (const std::string other = SessionType(dir); other != type) {
-      throw UsageError(dir + ": a " + other + " session among " + type +
+    const RobotKind& kind = RobotKindOf(SessionType(dir), dir);
+    if (first == nullptr) first = &kind;
+    if (&kind != first) {
+      throw UsageError(dir + ": a " + kind.type + " session among " + first->type +
                        " sessions; import one robot at a time");
     }
   }
