@@ -183,9 +183,12 @@ std::string SplitHint(const CalibrationRequest& r, const CalibrationOutcome& out
       out.fit.fit.held_directions.empty()) {
     return "";
   }
+  int last = 1;
+  for (const RunLog& run : r.runs) last = std::max(last, run.repetition);
   return "the training runs (" + TrainingSelection(r) + ") leave directions undetermined (held "
-         "at nominal, above) that the held-out runs may drive: --train-reps 1-99 fits every run "
-         "and judges on held-out halves of them";
+         "at nominal, above) that the held-out runs may drive: --train-reps 1-" +
+         std::to_string(std::max(last, 99)) +
+         " fits every run and judges on held-out halves of them";
 }
 
 // The gate's verdict; its table says it judged on the training runs when the halves judge.

@@ -28,13 +28,16 @@ std::string ReplayLine(const ExportRos2ControlOptions& o, const ExportReplay& r)
 
 std::string CovarianceLine(const OdometryCovariance& c) {
   constexpr const char* kAxes[] = {"vx", "vy", "omega"};
+  constexpr const char* kPoseAxes[] = {"x", "y", "theta"};
   std::string unresolved;
-  for (int a = 0; a < 3; ++a) {
-    if (!c.twist_unresolved[a]) continue;
-    unresolved += (unresolved.empty() ? "" : ", ") + std::string(kAxes[a]);
+  for (int a = 0; a < 6; ++a) {
+    const bool twist = a < 3;
+    if (!(twist ? c.twist_unresolved[a] : c.pose_unresolved[a - 3])) continue;
+    unresolved += (unresolved.empty() ? "" : ", ") +
+                  std::string(twist ? "twist " : "pose ") + (twist ? kAxes[a] : kPoseAxes[a - 3]);
   }
   if (!unresolved.empty()) {
-    unresolved = "; twist " + unresolved +
+    unresolved = "; " + unresolved +
                  ": no growth resolved above the ground truth's noise, the bound its windows set";
   }
   return StrFormat(

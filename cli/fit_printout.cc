@@ -41,11 +41,13 @@ void PrintParameters(const Robot& robot, const std::vector<double>& p, const Sel
     const double s = info.DisplayScale();
     const std::string sigma =
         fit.has_covariance && !fit.held[k] ? StrFormat("%.2g", fit.sigma[k] * s) : "-";
-    // Angles change by degrees, lengths by percent (a percentage of an angle means nothing).
+    // Angles change by degrees, sizes by percent (a percentage of an angle means nothing), a
+    // frame's position by metres (a percentage of where it sits depends on the origin: a mount
+    // guessed at x 0.05 m and found at 0.35 m is +0.3 m, not +600 %).
     const double change = p[k] - robot.nominal[k];
     const std::string change_text =
         info.unit == ParameterUnit::kAngle ? StrFormat("%+.3f deg", change * s)
-        : robot.nominal[k] == 0.0  // no percentage of nothing (a frame's y of 0)
+        : robot.nominal[k] == 0.0 || IsMountPosition(robot, k)
             ? StrFormat("%+.4g m", change)
             : StrFormat("%+.2f%%", 100.0 * change / robot.nominal[k]);
     const bool not_determined =

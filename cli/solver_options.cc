@@ -129,8 +129,8 @@ bool MakeFitMethodSettings(const SolverOptions& o, int threads, FitMethodSetting
   s->seed = o.seed;
   s->max_evaluations = o.max_evaluations;
   s->local_polish = o.polish;
-  if (o.max_evaluations < 1 || !(o.loss_scale > 0.0))
-    return Invalid(error, "--max-evaluations and --loss-scale must be positive");
+  if (o.max_evaluations < 1) return Invalid(error, "--max-evaluations must be positive");
+  if (!(o.loss_scale > 0.0)) return Invalid(error, "--loss-scale must be positive");
   return true;
 }
 

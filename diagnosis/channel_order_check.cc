@@ -12,6 +12,7 @@
 #include "fit/segment_cost.h"
 #include "fit/statistics.h"
 #include "fit/track_residual.h"
+#include "models/mounted_model.h"
 #include "models/pose_errors.h"
 #include "odometry/invalid.h"
 #include "odometry/parallel_for.h"
@@ -409,6 +410,29 @@ ChannelOrderReport CheckEachSession(const std::vector<AlignedRun>& runs,
 
 }  // namespace
 
+bool TurnsTheBodyHalfway(const RobotModelInterface& model, const ChannelMapping& mapping,
+                         const std::vector<AlignedRun>& runs) {
+  const RobotModelInterface& body = BaseModel(model);
+  const std::unique_ptr<const PreparedKinematics<double>> kinematics =
+      body.PrepareKinematics(body.robot().nominal.data());
+  double mismatch = 0.0, size = 0.0;
+  for (const AlignedRun& run : runs) {
+    const int n = run.samples.num_channels();
+    for (auto&& s : run.samples) {
+      double mapped[kMaxChannels];
+      for (int i = 0; i < n; ++i) mapped[i] = mapping.sign[i] * s.value[mapping.column[i]];
+      double x, y, theta, xm, ym, thetam;
+      kinematics->Step(s.value, s.dt_s, &x, &y, &theta);
+      kinematics->Step(mapped, s.dt_s, &xm, &ym, &thetam);
+      mismatch += (xm + x) * (xm + x) + (ym + y) * (ym + y) + (thetam - theta) * (thetam - theta);
+      size += x * x + y * y + theta * theta;
+    }
+  }
+  // A relative 1e-3 in the steps: the same motion but for rounding and nominal wheels that differ
+  // a little from side to side; any other miswiring differs by the steps' own size.
+  return size > 0.0 && mismatch <= 1e-6 * size;
+}
+
 ChannelOrderReport CheckRecordedChannelOrder(const std::vector<AlignedRun>& runs,
                                              const std::vector<const GroundTruthTrack*>& tracks,
                                              const RobotModelInterface& model,
@@ -418,9 +442,18 @@ ChannelOrderReport CheckRecordedChannelOrder(const std::vector<AlignedRun>& runs
   }
   std::size_t total = 0;
   const std::vector<std::vector<Segment>> segments = WindowsToCheckOn(runs, tracks, &total);
-  ChannelOrderReport pooled = CheckPooledChannelOrder(runs, segments, total, model, options);
-  if (pooled.likely_miswired) return pooled;
-  return CheckEachSession(runs, segments, model, options, std::move(pooled));
+  ChannelOrderReport report = CheckPooledChannelOrder(runs, segments, total, model, options);
+  if (!report.likely_miswired) {
+    report = CheckEachSession(runs, segments, model, options, std::move(report));
+  }
+  // The data cannot tell such a mapping from a ground truth whose frame faces backwards (a pose
+  // sensor mounted turned around, its yaw guessed 180 deg off): the message names both.
+  if (report.likely_miswired && TurnsTheBodyHalfway(model, report.best, runs)) {
+    report.message +=
+        "; or the ground truth's frame faces backwards, which no run tells from this wiring (a "
+        "sensor turned around: declare its ground_truth_frame yaw_deg)";
+  }
+  return report;
 }
 
 }  // namespace fitcal

@@ -105,6 +105,13 @@ struct ChannelOrderReport : MiswiringScores {
   bool on_windows = false;  // scored on windows of the ground-truth track, not final poses
 };
 
+// Whether `mapping` drives the body at the nominal as the recorded order does with the body turned
+// 180 deg: every step (dx, dy, dtheta) of the runs becomes (-dx, -dy, dtheta) (a differential
+// drive's wheels swapped and both negated, a tricycle's traction and steering negated). Such a
+// mapping explains a ground truth whose frame faces backwards exactly as well as the true wiring.
+bool TurnsTheBodyHalfway(const RobotModelInterface& model, const ChannelMapping& mapping,
+                         const std::vector<AlignedRun>& runs);
+
 // segments: empty for the final-pose test, else one window list per run (segment test).
 ChannelOrderReport CheckChannelOrder(const std::vector<AlignedRun>& runs,
                                      const std::vector<std::vector<Segment>>& segments,

@@ -1146,9 +1146,12 @@ ModelFitResult WithGlobalStart(const std::vector<AlignedRun>& training,
       best_start.empty()
           ? StrFormat("the fit from the guess %s; fits from %s found no lower cost: kept",
                       reason.c_str(), tried.c_str())
-          : StrFormat("the fit from the guess %s, cost %.6g; fits from %s: the one from %s found "
+          : StrFormat("the fit from the guess %s, %s; fits from %s: the one from %s found "
                       "cost %.6g, kept",
-                      reason.c_str(), local_cost, tried.c_str(), best_start.c_str(), best_cost);
+                      reason.c_str(),
+                      std::isfinite(local_cost) ? StrFormat("cost %.6g", local_cost).c_str()
+                                                : "no usable cost",
+                      tried.c_str(), best_start.c_str(), best_cost);
   return best;
 }
 

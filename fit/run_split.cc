@@ -7,9 +7,13 @@ namespace fitcal {
 
 namespace {
 int ParseInt(const std::string& s, const std::string& whole) {
-  if (s.empty() || s.size() > 6 || s.find_first_not_of("0123456789") != std::string::npos) {
+  if (s.empty() || s.find_first_not_of("0123456789") != std::string::npos) {
     throw std::invalid_argument("repetition list '" + whole + "': '" + s +
                                 "' is not a whole number");
+  }
+  if (s.size() > 6) {  // a range of them is expanded: a million at most
+    throw std::invalid_argument("repetition list '" + whole + "': " + s +
+                                " is beyond the last repetition a list may name, 999999");
   }
   return std::stoi(s);
 }

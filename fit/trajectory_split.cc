@@ -1,7 +1,7 @@
 #include "fit/trajectory_split.h"
 
 #include <algorithm>
-#include <regex>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 
@@ -23,21 +23,24 @@ TrajectorySelector::TrajectorySelector(const std::string& text,
     list_ = items;
     return;
   }
-  try {
-    const std::regex check(text, std::regex::ECMAScript);
-    (void)check;
-  } catch (const std::regex_error& e) {
+  auto compiled = std::make_unique<regex_t>();  // a failed regcomp frees what it made
+  if (const int code = regcomp(compiled.get(), text.c_str(), REG_EXTENDED | REG_NOSUB)) {
+    char why[256];
+    regerror(code, compiled.get(), why, sizeof why);
     // A usage error (exit 2), as a malformed --train-reps is: the flag's text, not the data.
     throw UsageError("trajectory selector '" + text +
-                                "' is neither a list of labels in the data nor a valid regular "
-                                "expression (" +
-                                e.what() + ")");
+                     "' is neither a list of labels in the data nor a valid regular expression (" +
+                     why + ")");
   }
+  regex_ = std::shared_ptr<regex_t>(compiled.release(), [](regex_t* r) {
+    regfree(r);
+    delete r;
+  });
 }
 
 bool TrajectorySelector::Matches(const std::string& label) const {
   if (is_list_) return std::find(list_.begin(), list_.end(), label) != list_.end();
-  return std::regex_search(label, std::regex(text_, std::regex::ECMAScript));
+  return regexec(regex_.get(), label.c_str(), 0, nullptr, 0) == 0;
 }
 
 }  // namespace fitcal

@@ -184,6 +184,12 @@ DatasetIndex ReadDatasetIndex(const std::string& directory, const DatasetOptions
       entry.start_pose = Pose2d{YamlDouble(start[0], yaml_path, "start_pose x"),
                                 YamlDouble(start[1], yaml_path, "start_pose y"),
                                 YamlDouble(start[2], yaml_path, "start_pose theta")};
+      // As a ground-truth sample's (io/log_files.cc): no map is larger.
+      if (!(std::hypot(entry.start_pose->x, entry.start_pose->y) <= 1e7)) {
+        throw InputError(InputErrorKind::kImplausibleValue, yaml_path, LineOf(start),
+                         "start_pose position is beyond any map (limit 1e7 m; wrong units or a "
+                         "corrupted field?)");
+      }
       // A heading beyond a full turn is degrees written where radians are meant.
       if (std::abs(entry.start_pose->theta) > 2.0 * M_PI + 1e-9) {
         throw InputError(InputErrorKind::kImplausibleValue, yaml_path, LineOf(start[2]),
@@ -309,9 +315,15 @@ void RejectDataSetWithoutMotion(const DatasetIndex& index, const std::vector<Run
   }
   const std::string n = std::to_string(runs.size());
   if (!wheels) {
+    // Counts over intervals 1000x too long turn 1000x too slowly (times in ms read as s).
+    const double interval_s = TypicalEncoderInterval(runs);
+    const std::string slow_clock =
+        interval_s > 1.0 ? StrFormat(" (its samples lie %.3g s apart: times in ms or us, not s?)",
+                                     interval_s)
+                         : "";
     throw InputError(InputErrorKind::kNoMotion, index.yaml_path, 0,
                      "no run moves: no wheel turns faster than 0.01 rad/s in any of the " + n +
-                         " runs; nothing to calibrate");
+                         " runs" + slow_clock + "; nothing to calibrate");
   }
   if (!ground_truth) {
     throw InputError(InputErrorKind::kNoMotion, index.yaml_path, 0,

@@ -462,12 +462,8 @@ constexpr double kMaxGlitchShare = 0.01;
 // radius (parameters of a `..radius_m` bounds group); the loader's own limit when none is named.
 double GlitchRateLimit(const Robot& robot) {
   double r_min = std::numeric_limits<double>::infinity();
-  const std::string suffix = "radius_m";
   for (int k = 0; k < robot.NumParameters(); ++k) {
-    const std::string& group = robot.parameters[k].group;
-    if (group.size() >= suffix.size() &&
-        group.compare(group.size() - suffix.size(), suffix.size(), suffix) == 0 &&
-        robot.nominal[k] > 0.0)
+    if (robot.parameters[k].IsWheelRadius() && robot.nominal[k] > 0.0)
       r_min = std::min(r_min, robot.nominal[k]);
   }
   if (!std::isfinite(r_min)) return kMaxWheelRateRadPerS;
@@ -934,6 +930,93 @@ bool DetectTum(TextFileReader& lines, std::string_view* line) {
                    "empty file (expected header 't,x,y,theta' or TUM rows)");
 }
 
+// A ground-truth pose that leaves both neighbours faster than any robot drives or turns and lands
+// far from them while they lie close together: a motion-capture marker swapped for one sample, a
+// second body's pose on the track. Replayed, every window across it would fit the jump (a 2 m
+// sample in each of six runs: the sigmas 120x wider). Dropped with a warning naming its line;
+// more than kMaxGlitchShare of the samples is not a glitch but two bodies or frames on one track:
+// refused.
+struct PoseJump {
+  double away, apart, rate;  // to the nearer neighbour, between the neighbours, the slower leg's
+};
+
+double Distance(const Pose2d& a, const Pose2d& b) { return std::hypot(b.x - a.x, b.y - a.y); }
+double Turn(const Pose2d& a, const Pose2d& b) { return std::abs(WrapAngle(b.theta - a.theta)); }
+
+// The lower quartile over the track of how far a sample's two neighbours lie apart, by
+// `measure`: the track's own step or its noise where it stands, in its own units (positions in
+// mm: 1000x, where a stop's noise passed for glitches of metres). A second body's samples
+// interleaved leave it small: where one in two or three samples is the other body's, the
+// neighbours of the others' samples are of one body.
+template <typename Measure>
+double TypicalApart(const GroundTruthTrack& track, Measure measure) {
+  std::vector<double> apart;
+  for (std::size_t i = 1; i + 1 < track.t_s.size(); ++i)
+    apart.push_back(measure(track.world_T_robot[i - 1], track.world_T_robot[i + 1]));
+  if (apart.empty()) return 0.0;
+  std::nth_element(apart.begin(), apart.begin() + apart.size() / 4, apart.end());
+  return apart[apart.size() / 4];
+}
+
+struct TrackSteps {
+  double moved = 0.0, turned = 0.0;  // TypicalApart of positions (track units) and headings
+};
+
+std::optional<std::string> GroundTruthGlitchAt(const GroundTruthTrack& track, std::size_t i,
+                                               const TrackSteps& typical) {
+  const Pose2d& before = track.world_T_robot[i - 1];
+  const Pose2d& p = track.world_T_robot[i];
+  const Pose2d& after = track.world_T_robot[i + 1];
+  const double dt_in = track.t_s[i] - track.t_s[i - 1], dt_out = track.t_s[i + 1] - track.t_s[i];
+  const auto jump = [&](auto measure) {
+    const double in = measure(before, p), out = measure(p, after);
+    return PoseJump{std::min(in, out), measure(before, after), std::min(in / dt_in, out / dt_out)};
+  };
+  const PoseJump moved = jump(Distance), turned = jump(Turn);
+  // Out and back 10x as far as the neighbours lie apart and as the track's typical step, at least
+  // 0.1 m or 0.5 rad: no robot drives so (a stop's noise in a track of millimetres is 1000x, as
+  // its steps are); faster than 5 m/s and 10 rad/s both ways: a sparse track (a pose every half
+  // loop) moves slowly between its samples.
+  if (moved.rate > 5.0 &&
+      moved.away > std::max({0.1, 10.0 * moved.apart, 10.0 * typical.moved})) {
+    return "the pose jumps " + MessageNumber(moved.away) + " m from both neighbours (" +
+           MessageNumber(moved.apart) + " m apart) and back";
+  }
+  if (turned.rate > 10.0 &&
+      turned.away > std::max({0.5, 10.0 * turned.apart, 10.0 * typical.turned})) {
+    return "the heading jumps " + MessageNumber(turned.away) + " rad from both neighbours (" +
+           MessageNumber(turned.apart) + " rad apart) and back";
+  }
+  return std::nullopt;
+}
+
+void DropGroundTruthGlitches(const std::string& path, const std::vector<int>& line_of_row,
+                             GroundTruthTrack* track) {
+  std::vector<std::size_t> rows;
+  std::vector<std::string> what;
+  const TrackSteps typical{TypicalApart(*track, Distance), TypicalApart(*track, Turn)};
+  for (std::size_t i = 1; i + 1 < track->t_s.size(); ++i) {
+    if (std::optional<std::string> glitch = GroundTruthGlitchAt(*track, i, typical)) {
+      rows.push_back(i);
+      what.push_back(std::move(*glitch));
+      ++i;  // its neighbour leaves it as fast: not a second glitch
+    }
+  }
+  if (rows.empty()) return;
+  const double allowed = std::max(1.0, kMaxGlitchShare * static_cast<double>(track->t_s.size()));
+  if (static_cast<double>(rows.size()) > allowed) {
+    throw InputError(InputErrorKind::kImplausibleValue, path, line_of_row[rows.front()],
+                     std::to_string(rows.size()) + " of " + std::to_string(track->t_s.size()) +
+                         " ground-truth samples are glitches, the first here: " + what.front() +
+                         "; more than 1 % is not a glitch but two bodies or frames on one track");
+  }
+  for (std::size_t g = rows.size(); g-- > 0;) {
+    Warn(path, line_of_row[rows[g]], "ground-truth glitch: " + what[g] + "; dropped");
+    track->t_s.erase(track->t_s.begin() + static_cast<std::ptrdiff_t>(rows[g]));
+    track->world_T_robot.erase(track->world_T_robot.begin() + static_cast<std::ptrdiff_t>(rows[g]));
+  }
+}
+
 GroundTruthTrack ReadGroundTruthRows(TextFileReader& lines) {
   const std::string& path = lines.path();
   GroundTruthTrack track;
@@ -945,11 +1028,20 @@ GroundTruthTrack ReadGroundTruthRows(TextFileReader& lines) {
   const bool tum = DetectTum(lines, &line);
   double row[kMaxColumns];
   QuaternionRepairs repairs;
+  std::vector<int> line_of_row;
+  line_of_row.reserve(most_rows);
   auto add = [&](const Pose2d& pose) {
     CheckPosePlausible(row, path, lines.line_number());
+    if (!(std::abs(pose.theta) <= kMaxAngleRad)) {  // a heading, unwrapped, of 1600 turns at most
+      throw InputError(InputErrorKind::kImplausibleValue, path, lines.line_number(),
+                       "heading " + MessageNumber(pose.theta) + " rad is beyond any run (limit " +
+                           MessageNumber(kMaxAngleRad) +
+                           " rad; wrong units or a corrupted field?)");
+    }
     if (!track.t_s.empty()) CheckIncreasing(track.t_s.back(), row[0], path, lines.line_number());
     track.t_s.push_back(row[0]);
     track.world_T_robot.push_back(pose);
+    line_of_row.push_back(lines.line_number());
   };
   if (tum) {
     do {  // the line that decided the format is a data row
@@ -971,6 +1063,7 @@ GroundTruthTrack ReadGroundTruthRows(TextFileReader& lines) {
              MessageNumber(repairs.worst_error) + " from 1 (within the tolerance " +
              MessageNumber(kQuaternionNormTolerance) + ")");
   }
+  DropGroundTruthGlitches(path, line_of_row, &track);
   return track;
 }
 

@@ -295,6 +295,11 @@ std::vector<int> MountParameterIndices(const Robot& robot) {
   return {*first, *first + 1, *first + 2};
 }
 
+bool IsMountPosition(const Robot& robot, int k) {
+  const std::vector<int> mount = MountParameterIndices(robot);
+  return !mount.empty() && (k == mount[0] || k == mount[1]);
+}
+
 std::string HeldMountNote(const Robot& robot, const std::vector<double>& parameters,
                           const std::vector<bool>& held) {
   std::ostringstream names;

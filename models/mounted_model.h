@@ -118,6 +118,8 @@ const RobotModelInterface& BaseModel(const RobotModelInterface& model);
 // The indices of the frame's three numbers (ground_truth_x, _y, _yaw); empty for a robot
 // without the frame.
 std::vector<int> MountParameterIndices(const Robot& robot);
+// Whether parameter k is the ground-truth frame's x or y.
+bool IsMountPosition(const Robot& robot, int k);
 
 // One line saying which of the frame's numbers the fit determined, which it fitted but the runs
 // leave along an open direction (not_determined: per parameter, fit/determined_directions.h; may

@@ -79,6 +79,10 @@ struct ParameterInfo {
     return unit == ParameterUnit::kRatio ? name : name + "_" + DisplayUnit();
   }
   double DisplayScale() const { return unit == ParameterUnit::kAngle ? 180.0 / M_PI : 1.0; }
+  // A wheel's radius: a parameter of a `..radius_m` bounds group.
+  bool IsWheelRadius() const {
+    return group.size() >= 8 && group.compare(group.size() - 8, 8, "radius_m") == 0;
+  }
   // Identifiability measures lengths as relative changes and angles in radians, so that one
   // number means the same for every parameter (a 1 % radius change ~ a 0.01 rad turn).
   double RelativeScale(double value) const {

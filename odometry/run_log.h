@@ -52,6 +52,24 @@ struct RunLog {
   std::string ground_truth_path;
 };
 
+// The typical interval between encoder samples: the median over the runs of each run's median
+// (s; 0 without intervals), blind to a logger's pauses. No calibration log is slower than 1 Hz:
+// beyond a second, the times are in ms or us.
+inline double TypicalEncoderInterval(const std::vector<RunLog>& runs) {
+  std::vector<double> medians;
+  for (const RunLog& log : runs) {
+    std::vector<double> dt;
+    for (std::size_t k = 1; k < log.encoders.t_s.size(); ++k)
+      dt.push_back(log.encoders.t_s[k] - log.encoders.t_s[k - 1]);
+    if (dt.empty()) continue;
+    std::nth_element(dt.begin(), dt.begin() + dt.size() / 2, dt.end());
+    medians.push_back(dt[dt.size() / 2]);
+  }
+  if (medians.empty()) return 0.0;
+  std::nth_element(medians.begin(), medians.begin() + medians.size() / 2, medians.end());
+  return medians[medians.size() / 2];
+}
+
 // The index of the first sample after v in the times t (t.front() <= v < t.back()), as
 // std::upper_bound. With `from` (the bracket an earlier, not later, time found: times asked in
 // order, as a run's samples and checkpoints are) the search starts there and doubles its step -

@@ -75,6 +75,7 @@ struct ReportParameter {
   bool at_bound = false;  // resting on a bound of the robot's box
   std::string unit;       // "m" or "deg" (display unit; values below are in SI + rad)
   bool is_angle = false;
+  bool is_position = false;  // a frame's x or y: where, not how big, so it changes by metres
   bool held = false;  // held at its nominal value by the robot YAML: not fitted, no sigma
   double nominal = 0.0;
   double calibrated = 0.0;

@@ -44,7 +44,8 @@ double ParamScale(const ReportParameter& p) { return p.is_angle ? kDeg : 1.0; }
 
 std::string ParameterChangeText(const ReportParameter& p) {
   if (p.is_angle) return Fmt("%+.3f deg", (p.calibrated - p.nominal) * kDeg);
-  return Fmt("%+.2f %%", p.nominal != 0.0 ? 100.0 * (p.calibrated - p.nominal) / p.nominal : 0.0);
+  if (p.is_position || p.nominal == 0.0) return Fmt("%+.4g m", p.calibrated - p.nominal);
+  return Fmt("%+.2f %%", 100.0 * (p.calibrated - p.nominal) / p.nominal);
 }
 
 std::vector<std::size_t> WorstRuns(const ReportData& data, std::size_t most) {

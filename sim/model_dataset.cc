@@ -1,8 +1,10 @@
 #include "sim/model_dataset.h"
 
+#include <cmath>
 #include <filesystem>
 #include <functional>
 #include <stdexcept>
+#include <vector>
 
 #include "io/atomic_file.h"
 #include "io/command_failure.h"
@@ -30,6 +32,26 @@ RobotModelPtr NominalModel(const ModelDatasetRequest& request) {
 }
 
 // The true parameters: --truth (a robot YAML of the same model and channels), or the default.
+// Whether two models of one kind step alike at parameters p: each channel alone and all together
+// (their fixed geometry, what is not a parameter, is the same).
+bool StepAlike(const RobotModelInterface& a, const RobotModelInterface& b,
+               const std::vector<double>& p) {
+  const auto step_a = a.PrepareKinematics(p.data());
+  const auto step_b = b.PrepareKinematics(p.data());
+  const int n = a.robot().NumChannels();
+  for (int k = 0; k <= n; ++k) {
+    std::vector<double> values(n, 0.0);
+    for (int i = 0; i < n; ++i) values[i] = k == n ? 0.3 + 0.1 * i : i == k ? 1.0 : 0.0;
+    double da[3], db[3];
+    step_a->Step(values.data(), 0.01, &da[0], &da[1], &da[2]);
+    step_b->Step(values.data(), 0.01, &db[0], &db[1], &db[2]);
+    for (int c = 0; c < 3; ++c) {
+      if (!(std::abs(da[c] - db[c]) <= 1e-12 + 1e-9 * std::abs(da[c]))) return false;
+    }
+  }
+  return true;
+}
+
 std::vector<double> TrueParameters(const ModelDatasetRequest& request,
                                    const RobotModelInterface& nominal) {
   const Robot& robot = nominal.robot();
@@ -40,6 +62,12 @@ std::vector<double> TrueParameters(const ModelDatasetRequest& request,
       t.NumParameters() != robot.NumParameters()) {
     throw std::invalid_argument(request.truth + ": the true robot must be a " + robot.model +
                                 " robot with the nominal robot's channels and parameters");
+  }
+  if (!StepAlike(nominal, *truth, t.nominal)) {
+    throw std::invalid_argument(
+        request.truth + ": the true robot differs from the nominal robot in more than its "
+        "parameters (geometry the model does not fit, such as an omni wheel's drive or roller "
+        "angle); the simulation would drive the nominal's: make it the same in both files");
   }
   return t.nominal;
 }

@@ -31,6 +31,8 @@
 #include "interchange/optiodom/optiodom_import.h"
 #include "models/diff_drive/diff_drive_trajectories.h"
 #include "sim/model_simulator.h"
+#include "diagnosis/channel_order_check.h"
+#include "validation/rate_units.h"
 #include "validation/generalisation.h"
 
 namespace fitcal {
@@ -655,6 +657,109 @@ TEST(OptiOdomDiffImport, EverySessionNominalUmbmarkAndFit) {
   ASSERT_GT(optiodom_cf, 0.0);
   EXPECT_LT(optiodom_cf, 0.5 * before.cf);  // a real calibration ...
   EXPECT_LT(fit_cf, optiodom_cf);           // ... which the fit beats
+}
+
+// ---------------------------------------------------------------------------------------------
+// What a recording in the wrong conventions looks like to the checks before fitting
+
+RobotModelPtr EvenWheelsModel(const std::string& radius_bounds) {
+  return ModelFromYaml(
+      "model: diff_drive\nname: even\nwheels:\n  - {name: right, side: right, radius_m: 0.05}\n"
+      "  - {name: left, side: left, radius_m: 0.05}\nwheel_separation_m: 0.3\nbounds: {radius_m: " +
+      radius_bounds + ", wheel_separation_m: [0.27, 0.33]}\n");
+}
+
+// Three 40 s slaloms at 100 Hz whose ground truth is the model's own odometry, sampled at every
+// encoder instant; `heading_offset` turns the ground truth's frame (pi: a sensor facing backwards).
+std::vector<RunLog> ExactSlaloms(const RobotModelInterface& model, double heading_offset = 0.0) {
+  std::vector<RunLog> logs(3);
+  for (int r = 0; r < 3; ++r) {
+    RunLog& log = logs[r];
+    log.id = "slalom-" + std::to_string(r + 1);
+    log.trajectory = "slalom";
+    log.repetition = r + 1;
+    log.encoders.samples = EncoderSamples(2);
+    log.encoders.t_s = {0.0};
+    for (int k = 1; k <= 4000; ++k) {
+      const double t = 0.01 * k;
+      log.encoders.samples.push_back(0.01, {4.0 + 2.0 * std::sin(0.3 * t + r), 4.0 + 2.0 * std::cos(0.2 * t)});
+      log.encoders.t_s.push_back(t);
+    }
+    log.ground_truth.t_s = {0.0};
+    log.ground_truth.world_T_robot = {Pose2d{0.0, 0.0, heading_offset}};
+    model.Replay(model.robot().nominal.data(), log.encoders.samples, 0, 4000, Pose2d{},
+                 [&](std::size_t k, const Pose2d& pose) {
+                   log.ground_truth.t_s.push_back(log.encoders.t_s[k + 1]);
+                   log.ground_truth.world_T_robot.push_back(
+                       Pose2d{pose.x, pose.y, pose.theta + heading_offset});
+                 });
+  }
+  return logs;
+}
+
+ChannelMapping Mapping(std::vector<int> column, std::vector<int> sign) {
+  ChannelMapping m;
+  m.column = std::move(column);
+  m.sign = std::move(sign);
+  return m;
+}
+
+// Wheels swapped and both negated drive the body backwards: every step (dx, dy, dtheta) becomes
+// (-dx, -dy, dtheta), the motion a ground truth facing backwards records. One wheel negated, or
+// the two swapped, is another motion.
+TEST(DiffDriveMiswiring, SwappedAndNegatedWheelsAreTheBodyTurnedHalfway) {
+  const RobotModelPtr model = EvenWheelsModel("[0.045, 0.055]");
+  const std::vector<AlignedRun> runs = AlignRuns(ExactSlaloms(*model));
+  EXPECT_TRUE(TurnsTheBodyHalfway(*model, Mapping({1, 0}, {-1, -1}), runs));
+  EXPECT_FALSE(TurnsTheBodyHalfway(*model, Mapping({0, 1}, {1, -1}), runs));
+  EXPECT_FALSE(TurnsTheBodyHalfway(*model, Mapping({1, 0}, {1, 1}), runs));
+}
+
+// A pose sensor facing backwards (its frame 180 deg from the robot's forward) is explained
+// exactly by the wheels swapped and negated: the refusal names both, so that a user with a rear
+// camera declares its yaw instead of rewiring the robot (it named the wiring alone, and exported
+// swapped, inverted joints when followed).
+TEST(DiffDriveMiswiring, AGroundTruthFacingBackwardsIsNamedBesideTheWiring) {
+  const RobotModelPtr model = EvenWheelsModel("[0.045, 0.055]");
+  const std::vector<RunLog> logs = ExactSlaloms(*model, M_PI);
+  std::vector<const GroundTruthTrack*> tracks;
+  for (const RunLog& log : logs) tracks.push_back(&log.ground_truth);
+  const ChannelOrderReport report = CheckRecordedChannelOrder(AlignRuns(logs), tracks, *model);
+  ASSERT_TRUE(report.likely_miswired);
+  EXPECT_NE(report.message.find("ground truth's frame faces backwards"), std::string::npos)
+      << report.message;
+  const std::vector<RunLog> forwards = ExactSlaloms(*model);
+  tracks.clear();
+  for (const RunLog& log : forwards) tracks.push_back(&log.ground_truth);
+  EXPECT_FALSE(CheckRecordedChannelOrder(AlignRuns(forwards), tracks, *model).likely_miswired);
+}
+
+// Odometry that travels twice (or half) the ground truth's path, where the bounds let a radius
+// change 10 % (ticks_per_rev declared for x2 decoding of an x4 encoder), is named before fitting
+// (it was blamed on the wiring, or fitted to nothing); with bounds of 2x either way it is the
+// fit's to find. Times in ms where s are meant are named as that.
+TEST(DiffDriveUnits, TravelBeyondTheRadiusBoundsAndTimesInMillisecondsAreNamed) {
+  const RobotModelPtr tight = EvenWheelsModel("[0.045, 0.055]");
+  const std::vector<RunLog> exact = ExactSlaloms(*tight);
+  EXPECT_FALSE(CheckModelRateUnits(*tight, exact).suspicious);
+  for (const double factor : {2.0, 0.5}) {
+    std::vector<RunLog> scaled = exact;
+    for (RunLog& log : scaled) {
+      for (auto&& s : log.encoders.samples) s.value[0] *= factor, s.value[1] *= factor;
+    }
+    const RateUnitsFinding finding = CheckModelRateUnits(*tight, scaled);
+    EXPECT_TRUE(finding.suspicious) << factor;
+    EXPECT_NE(finding.message.find("encoder.ticks_per_rev"), std::string::npos) << finding.message;
+    EXPECT_FALSE(CheckModelRateUnits(*EvenWheelsModel("[0.025, 0.1]"), scaled).suspicious);
+  }
+  std::vector<RunLog> in_ms = exact;
+  for (RunLog& log : in_ms) {
+    for (double& t : log.encoders.t_s) t *= 1000.0;
+    for (auto&& s : log.encoders.samples) s.dt_s *= 1000.0;
+    for (double& t : log.ground_truth.t_s) t *= 1000.0;
+  }
+  const RateUnitsFinding ms = CheckModelRateUnits(*tight, in_ms);
+  EXPECT_EQ(ms.likely_unit, "ms") << ms.message;
 }
 
 }  // namespace

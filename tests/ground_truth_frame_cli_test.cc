@@ -152,6 +152,13 @@ TEST(MountedFit, AGuessTheWheelDistancesCannotTakeUpIsFitted) {
   EXPECT_TRUE(Has(r.out, "not held at the guess (x 0.1 m, y 0 m): held, the wheel distances could "
                          "not take up its error"))
       << r.out;
+  // Where a frame sits changes by metres: a percentage of a position depends on the origin (this
+  // guess of 0.1 m found near 0 printed about -100 %, one of 0.05 m found at 0.35 m +600 %).
+  const std::size_t row = r.out.find("\n  ground_truth_x");
+  ASSERT_NE(row, std::string::npos) << r.out;
+  const std::string x_row = r.out.substr(row + 1, r.out.find('\n', row + 1) - row - 1);
+  EXPECT_EQ(x_row.find('%'), std::string::npos) << x_row;
+  EXPECT_NE(x_row.find(" m"), std::string::npos) << x_row;
   const YAML::Node frame = YAML::LoadFile(cal)["ground_truth_frame"];
   EXPECT_NEAR(frame["x_m"].as<double>(), 0.0, 0.03);
   EXPECT_NEAR(frame["y_m"].as<double>(), 0.0, 0.03);

@@ -12,6 +12,7 @@
 #include <functional>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "io/input_error.h"
@@ -271,6 +272,20 @@ TEST(InputClassesCli, UsageErrorsAreOneLineExitTwoBeforeAnyWork) {
     EXPECT_EQ(r.exit_code, 2) << args << ": " << r.err;
     EXPECT_EQ(Lines(r.err), 1) << args << ": " << r.err;
     EXPECT_FALSE(Has(r.err, "could not be converted")) << r.err;
+  }
+}
+
+// Each refusal names the flag that is wrong and why: one message for two flags left the user to
+// guess, and a repetition list of a number too large to expand said it was no whole number.
+TEST(InputClassesCli, EachFlagIsNamedWithWhatIsWrong) {
+  const TempDir dir;
+  for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
+           {"fit --logs . --max-evaluations 0", "--max-evaluations must be positive"},
+           {"fit --logs . --loss huber --loss-scale -1", "--loss-scale must be positive"},
+           {"fit --logs . --train-reps 1-2000000000", "2000000000 is beyond the last repetition"}}) {
+    const auto r = RunFitcal(dir, args);
+    EXPECT_EQ(r.exit_code, 2) << args << ": " << r.err;
+    EXPECT_TRUE(Has(r.err, says)) << args << ": " << r.err;
   }
 }
 

@@ -121,6 +121,44 @@ TEST(GroundTruth, BadInputs) {
   check("t,x,y,theta\n0,0,0,0\n0,0,0,0\n", InputErrorKind::kNonIncreasingTime, 3);
   check("t,x,y,theta\n0,0,0,0\n", InputErrorKind::kTooFewSamples, 0);
   check("0 1 2 0 0 0 0 1\n1 1 2 0 0 0\n", InputErrorKind::kWrongColumnCount, 2);
+  check("t,x,y,theta\n0,0,0,0\n1,0,0,1e300\n", InputErrorKind::kImplausibleValue, 3);
+}
+
+// A track of a robot at 0.5 m/s sampled at 10 Hz, n samples, one pose moved by `jump` (m, rad).
+std::string TrackText(int n, int moved, double jump_m, double jump_rad) {
+  std::string text = "t,x,y,theta\n";
+  for (int k = 0; k < n; ++k) {
+    const double x = 0.05 * k + (k == moved ? jump_m : 0.0);
+    const double theta = 0.01 * k + (k == moved ? jump_rad : 0.0);
+    text += std::to_string(0.1 * k) + "," + std::to_string(x) + ",0," + std::to_string(theta) +
+            "\n";
+  }
+  return text;
+}
+
+// One pose of a motion capture 2 m off (a marker swapped for a sample) is dropped with a warning
+// naming its line, and so is a heading flipped by pi; the track is otherwise the file's. More
+// than 1 % of them is two bodies on one track: refused. A sparse track whose samples lie far apart
+// in time is no glitch (a pose every half loop).
+TEST(GroundTruth, AGlitchIsDroppedAndNamedAndManyAreRefused) {
+  TempDir dir;
+  for (const auto& [jump_m, jump_rad] : {std::pair{2.0, 0.0}, std::pair{0.0, M_PI}}) {
+    const GroundTruthTrack t = ReadGroundTruth(dir.Write("one.csv", TrackText(200, 50, jump_m, jump_rad)));
+    ASSERT_EQ(t.t_s.size(), 199u);
+    EXPECT_EQ(t.t_s[50], 5.1);  // the sample of line 52 is gone
+    const GroundTruthTrack clean = ReadGroundTruth(dir.Write("clean.csv", TrackText(200, -1, 0, 0)));
+    EXPECT_EQ(clean.t_s.size(), 200u);
+  }
+  std::string two_bodies = "t,x,y,theta\n";
+  for (int k = 0; k < 200; ++k) {
+    two_bodies += std::to_string(0.01 * k) + "," + std::to_string(0.005 * k + (k % 2) * 3.0) +
+                  ",0,0\n";
+  }
+  const std::string path = dir.Write("two.csv", two_bodies);
+  ExpectInputError([&] { ReadGroundTruth(path); }, InputErrorKind::kImplausibleValue, path, 3);
+  const GroundTruthTrack sparse =
+      ReadGroundTruth(dir.Write("sparse.csv", "t,x,y,theta\n0,0,0,0\n10,2,0,3\n20,0.01,0,6.2\n"));
+  EXPECT_EQ(sparse.t_s.size(), 3u);
 }
 
 // The calibrated YAML an omni3 model writes (its schema + the generic calibration block) reads back
@@ -308,6 +346,10 @@ TEST(Dataset, BadInputs) {
       "robot: robot.yaml\nruns:\n  - {id: r1, trajectory: R1, repetition: 1, encoders: runs/e.csv, "
       "ground_truth: runs/g.csv, start_pose: [1, 2]}\n",
       InputErrorKind::kBadValue, 3);
+  check(
+      "robot: robot.yaml\nruns:\n  - {id: r1, trajectory: R1, repetition: 1, encoders: runs/e.csv, "
+      "ground_truth: runs/g.csv, start_pose: [1e308, 0, 0]}\n",
+      InputErrorKind::kImplausibleValue, 3);
   {
     TempDir dir;
     WriteDataset(dir, std::string(kDatasetYaml)

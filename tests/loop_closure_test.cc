@@ -35,6 +35,15 @@ TEST(TrajectorySelector, RegularExpressionIsSearched) {
   EXPECT_FALSE(s.Matches("x_circular"));  // anchored
 }
 
+// A pattern that makes a backtracking matcher take time exponential in the label (std::regex:
+// 28 s on 30 characters, doubling with each more) is matched in one pass: this test ends.
+TEST(TrajectorySelector, NoPatternBacktracks) {
+  const std::string label = std::string(200, 'a') + "X";
+  const TrajectorySelector s("(a+)+$", {label});
+  EXPECT_FALSE(s.Matches(label));
+  EXPECT_TRUE(s.Matches("aaa"));
+}
+
 TEST(TrajectorySelector, BadSelectorThrows) {
   EXPECT_THROW(TrajectorySelector("", {"a"}), std::invalid_argument);
   // Not a regular expression: a usage error (exit 2), as a malformed --train-reps is.

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <random>
 
 #include "tests/model_support.h"
@@ -44,8 +45,9 @@ TEST(OdometryCovariance, StructureFunctionKeepsEveryTermNonNegative) {
 
 // Runs whose odometry is exact (the example diff drive's own replay at its nominal, circles at
 // 50 Hz) and whose ground truth carries white noise only (1 mm, 0.2 deg): no growth to resolve.
-std::vector<RunLog> ExactOdometryNoisyGroundTruth(const RobotModelInterface& model) {
-  std::mt19937_64 random(7);
+std::vector<RunLog> ExactOdometryNoisyGroundTruth(const RobotModelInterface& model,
+                                                  std::uint64_t seed = 7) {
+  std::mt19937_64 random(seed);
   std::normal_distribution<double> xy(0.0, 1e-3), yaw(0.0, DegToRad(0.2));
   std::vector<RunLog> runs(4);
   for (std::size_t i = 0; i < runs.size(); ++i) {
@@ -75,7 +77,8 @@ std::vector<RunLog> ExactOdometryNoisyGroundTruth(const RobotModelInterface& mod
 
 // Where the windows resolve no growth above the ground truth's noise, the twist variance is the
 // bound the windows set, flagged, and never 0 (an EKF given 0 trusts that axis exactly: a
-// simulated bag's omega was exported as 0 before); a pose variance never shrinks with the path.
+// simulated bag's omega was exported as 0 before), and so is a pose variance, which never shrinks
+// with the path.
 TEST(OdometryCovariance, UnresolvedGrowthIsABoundNotZero) {
   const RobotModelPtr model = testing::ExampleModel("diff_drive");
   const OdometryCovariance c = EstimateOdometryCovariance(
@@ -84,10 +87,23 @@ TEST(OdometryCovariance, UnresolvedGrowthIsABoundNotZero) {
   int unresolved = 0;
   for (int a = 0; a < 3; ++a) {
     EXPECT_GT(c.twist_variance[a], 0.0) << a;
+    EXPECT_GT(c.pose_variance_1m[a], 0.0) << a;
     EXPECT_GE(c.pose_growth_exponent[a], 0.0) << a;
     unresolved += c.twist_unresolved[a];
   }
   EXPECT_GT(unresolved, 0);  // the odometry is exact: at least one axis resolves nothing
+  // Over seeds, where a pose axis resolves nothing above the ground truth's noise it is the
+  // bound, never 0 (a simulated bag's x and theta were exported as 0).
+  int pose_unresolved_over_seeds = 0;
+  for (std::uint64_t seed = 1; seed <= 12; ++seed) {
+    const OdometryCovariance s = EstimateOdometryCovariance(
+        *model, model->robot().nominal, ExactOdometryNoisyGroundTruth(*model, seed), 0.0);
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_GT(s.pose_variance_1m[a], 0.0) << "seed " << seed << ", axis " << a;
+      pose_unresolved_over_seeds += s.pose_unresolved[a];
+    }
+  }
+  EXPECT_GT(pose_unresolved_over_seeds, 0);
 }
 
 }  // namespace

@@ -422,6 +422,66 @@ TEST_F(MalformedImport, RecordingClockSteppingBack) {
   }
 }
 
+// A ground truth whose frame changes mid-bag (a localisation restarted in `map`) holds poses of
+// two frames: refused naming the message, where it was imported without a word.
+TEST_F(MalformedImport, GroundTruthFrameChangingMidBagIsRefused) {
+  BagEdits edits;
+  edits.pose = [](std::size_t i, PoseStamped* p) { p->header.frame_id = i < 40 ? "world" : "map"; };
+  ExpectRefused(ImportOptions(tmp_, Bag("frames", StorageFormat::kMcap, edits)),
+                "header.frame_id \"map\" differs from \"world\" of the topic's first message");
+}
+
+// A second tracked body's poses interleaved on the ground-truth topic: every other sample jumps
+// 4 m away and back. Refused as that (the loader's ground-truth glitches), where it was written
+// and `fit` then blamed millimetres.
+TEST_F(MalformedImport, TwoBodiesOnTheGroundTruthTopicAreRefused) {
+  BagEdits edits;
+  edits.pose = [](std::size_t i, PoseStamped* p) {
+    if (i % 2 == 1) p->pose.position.x += 4.0;
+  };
+  ExpectRefused(ImportOptions(tmp_, Bag("bodies", StorageFormat::kMcap, edits)),
+                "ground-truth samples are glitches");
+}
+
+// Header stamps on another clock than the recorder's (simulated time from near 0): the data set's
+// t = 0 is the first stamp, said in a note, not the recording's start 1.7e9 s later (times of
+// -1.7e9 s that --runs could not name). The runs and their rows are the clean bag's.
+TEST_F(MalformedImport, HeaderStampsOnAnotherClockStartAtTheFirstStamp) {
+  const Rosbag2Import clean = Import(Bag("clean", StorageFormat::kSqlite3), "clean_out");
+  constexpr std::int32_t kBehindS = 1'600'000'000;
+  BagEdits edits;
+  edits.joint = [](std::size_t, JointState* js) { js->header.stamp.sec -= kBehindS; };
+  edits.pose = [](std::size_t, PoseStamped* p) { p->header.stamp.sec -= kBehindS; };
+  const Rosbag2Import shifted = Import(Bag("sim_time", StorageFormat::kSqlite3, edits), "s");
+  ASSERT_EQ(shifted.runs.size(), clean.runs.size());
+  ASSERT_EQ(shifted.notes.size(), 1u);
+  EXPECT_NE(shifted.notes[0].find("another clock than the recorder's"), std::string::npos);
+  EXPECT_GE(shifted.encoder_t_s[0].front(), 0.0);
+  EXPECT_LT(shifted.encoder_t_s[0].front(), 60.0);
+}
+
+// A bag given as `.` (the user inside its folder) is named after the folder: its runs were
+// `.-01`, files the shell hides.
+TEST_F(MalformedImport, ABagGivenAsDotIsNamedAfterItsFolder) {
+  const fs::path bag = Bag("named", StorageFormat::kMcap);
+  const fs::path before = fs::current_path();
+  fs::current_path(bag);
+  ImportRosbag2Options o = ImportOptions(tmp_, ".");
+  o.out = tmp_.Path("dot_out");
+  o.split_at_rest_s = 2.0;
+  const Rosbag2Import imported = ImportRosbag2(o);
+  fs::current_path(before);
+  ASSERT_FALSE(imported.runs.empty());
+  EXPECT_EQ(imported.runs[0].id.rfind("named-", 0), 0u) << imported.runs[0].id;
+}
+
+// Spans that share samples would put one motion into a training and a held-out run.
+TEST_F(MalformedImport, OverlappingRunSpansAreAUsageError) {
+  ImportRosbag2Options o = ImportOptions(tmp_, Bag("spans", StorageFormat::kMcap));
+  o.runs = "0:10,5:20";
+  EXPECT_THROW(ImportRosbag2(o), UsageError);
+}
+
 // A reader must not write next to its input: the recorder's own sqlite3 bag (WAL mode), copied
 // and made read-only, is read without a byte or a file changing around it.
 TEST(Rosbag2ReadOnly, BagDirectoryUnchanged) {

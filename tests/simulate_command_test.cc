@@ -17,6 +17,7 @@
 #include <sstream>
 
 #include "models/model_registry.h"
+#include "models/omni/omni_model.h"
 #include "tests/test_files.h"
 
 namespace fitcal {
@@ -143,6 +144,34 @@ TEST(SimulateCommand, RefusesWhatTheModelSimulatorDoesNotTake) {
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
     EXPECT_FALSE(fs::exists(data));
   }
+}
+
+// A truth file is its parameters: one whose fixed geometry differs (a mecanum wheel's rollers at
+// -30 deg where the nominal has -45) was simulated with the nominal's and written as
+// true_robot.yaml stating another robot. Refused in one line, nothing written; and a repetition
+// count no memory holds (2e9 grew by 140 MB/s) is a usage error.
+TEST(SimulateCommand, RefusesATruthOfAnotherGeometryAndRepetitionsBeyondMemory) {
+  TempDir dir;
+  const std::string data = dir.Path("data");
+  std::string truth = kOmniExampleYaml;
+  truth.replace(truth.find("roller_angle_deg: -45"), 21, "roller_angle_deg: -30");
+  const std::string nominal_path = dir.Write("nominal.yaml", kOmniExampleYaml);
+  const std::string truth_path = dir.Write("truth.yaml", truth);
+  const Result other = RunFitcal(dir, "simulate --model omni --robot " + nominal_path +
+                                          " --truth " + truth_path + " --out " + data);
+  EXPECT_NE(other.exit_code, 0);
+  EXPECT_EQ(std::count(other.err.begin(), other.err.end(), '\n'), 1) << other.err;
+  EXPECT_NE(other.err.find("differs from the nominal robot in more than its parameters"),
+            std::string::npos) << other.err;
+  EXPECT_FALSE(fs::exists(data));
+  const Result same = RunFitcal(dir, "simulate --model omni --robot " + nominal_path +
+                                         " --truth " + nominal_path + " --out " + data);
+  EXPECT_EQ(same.exit_code, 0) << same.err;
+  const Result many = RunFitcal(dir, "simulate --model diff_drive --repetitions 2000000000 --out " +
+                                         dir.Path("many"));
+  EXPECT_EQ(many.exit_code, 2) << many.err;
+  EXPECT_NE(many.err.find("at most 1000"), std::string::npos) << many.err;
+  EXPECT_FALSE(fs::exists(dir.Path("many")));
 }
 
 // ASOC simulates on the one engine (its castor dynamics registered by the model, asoc41; before,

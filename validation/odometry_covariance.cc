@@ -313,6 +313,7 @@ OdometryCovariance EstimateOdometryCovariance(const RobotModelInterface& model,
   // The pose law over path windows, the ground truth's noise removed.
   std::vector<double> d;
   std::array<std::vector<double>, 3> v;
+  std::array<double, 3> hidden_at_1m{HUGE_VAL, HUGE_VAL, HUGE_VAL};
   bool measured_at_1m = false;
   for (double length : kPathWindowsM) {
     MeanSquares m;
@@ -326,7 +327,13 @@ OdometryCovariance EstimateOdometryCovariance(const RobotModelInterface& model,
     }
     if (m.count < kMinWindows) continue;
     d.push_back(m.extent / m.count);  // the windows' mean path
-    for (int a = 0; a < 3; ++a) v[a].push_back(m.Mean(a) - 2.0 * out.ground_truth_variance[a]);
+    for (int a = 0; a < 3; ++a) {
+      v[a].push_back(m.Mean(a) - 2.0 * out.ground_truth_variance[a]);
+      // What the windows could hide (two standard errors of their mean square, which has variance
+      // 2 V^2 / n), taken to 1 m as a random walk: the bound of an axis they resolve nothing on.
+      const double hidden = 2.0 * m.Mean(a) * std::sqrt(2.0 / m.count) / d.back();
+      hidden_at_1m[a] = length == 1.0 ? hidden : std::min(hidden_at_1m[a], hidden);
+    }
     if (length == 1.0) {  // the controller's constant, where the data measure it directly
       measured_at_1m = true;
       for (int a = 0; a < 3; ++a) out.pose_variance_1m[a] = v[a].back();
@@ -338,6 +345,12 @@ OdometryCovariance EstimateOdometryCovariance(const RobotModelInterface& model,
     // A variance does not shrink with the path: a negative slope is growth the windows do not
     // resolve beside the ground truth's noise (a simulated bag's heading: -0.33). Flat, then.
     out.pose_growth_exponent[a] = std::max(0.0, exponent);
+    // Zero error is not what the windows showed: an EKF given a pose variance of 0 trusts it
+    // exactly (a simulated bag's noise-free encoders: x and theta 0).
+    if (!(out.pose_variance_1m[a] > 0.0) && std::isfinite(hidden_at_1m[a])) {
+      out.pose_variance_1m[a] = hidden_at_1m[a];
+      out.pose_unresolved[a] = true;
+    }
   }
   return out;
 }

@@ -29,7 +29,7 @@
 // distance (p near 1), its position error grows faster (the heading error rotates what follows:
 // p up to 3): a per-metre law would make position too wide at 1 m. A negative p is taken as 0.
 // A twist axis with no growth resolved gets the growth its windows could hide (an upper bound,
-// `twist_unresolved`), never 0.
+// `twist_unresolved`), never 0; so does a pose axis (`pose_unresolved`).
 
 #include <array>
 #include <cstddef>
@@ -52,6 +52,8 @@ struct OdometryCovariance {
   // Axes whose twist error the windows did not resolve above the ground truth's noise: their
   // twist variance is the bound the windows set (what they could hide), not a measurement.
   std::array<bool, 3> twist_unresolved{};
+  // The same for the pose after 1 m: the bound the path windows set.
+  std::array<bool, 3> pose_unresolved{};
   std::size_t windows = 0, runs = 0;
 };
 

@@ -15,6 +15,9 @@ constexpr double kTurnLengthM = 0.2;
 // Ground-truth intervals longer than this are not a measured path (a robot drives far and turns
 // much in a second); shorter ones are, at any speed a calibration drive has.
 constexpr double kMaxMeasuredIntervalS = 1.0;
+// A ground truth sampled fast measures its own noise as path (5 mm of noise at 100 Hz on a robot
+// at 0.1 m/s lengthens it ~7x); samples at least this far apart step 2 cm there, ~6 % longer.
+constexpr double kMinMeasuredIntervalS = 0.2;
 constexpr std::size_t kChunk = 10;  // samples per replayed step of the odometry's path
 // Below this much ground-truth travel there is no evidence either way.
 constexpr double kMinEvidenceM = 0.5;
@@ -37,8 +40,9 @@ struct PathLengths {
 };
 
 // Both paths over the same intervals between consecutive ground-truth instants (the window's
-// start, every sample inside it, its end), and only over those short enough that the ground truth
-// measures the path there (kMaxMeasuredIntervalS): a ground truth of start and end poses only
+// start, every sample inside it kMinMeasuredIntervalS after the last, its end), and only over
+// those short enough that the ground truth measures the path there (kMaxMeasuredIntervalS, or
+// kChunk encoder samples at most): a ground truth of start and end poses only
 // measures the straight line between them, not the path the wheels drove, so it is no evidence
 // of a unit error. The odometry is replayed in steps of kChunk samples inside an interval, so that
 // rates 57x too large (deg/s), which spin the odometry round many times, count in full.
@@ -50,27 +54,49 @@ void AddPathLengths(const RobotModelInterface& model, const RunLog& log, PathLen
   double t_s = run.t_start_s, t_last_s = run.t_start_s;
   std::size_t k = 0;
   const auto interval_to = [&](double instant_s, const Pose2d& truth_there) {
-    const bool measured = instant_s - t_last_s <= kMaxMeasuredIntervalS;
+    PathLengths odometry_path;
     Pose2d odometry;
+    const std::size_t interval_begin = k;
     while (k < run.samples.size() && t_s < instant_s) {
       const std::size_t first = k;
       while (k < run.samples.size() && t_s < instant_s && k - first < kChunk) {
         t_s += run.samples[k++].dt_s;
       }
       const Pose2d next = model.Replay(p.data(), run.samples, first, k, odometry);
-      if (measured) lengths->Add(odometry, next, true);
+      odometry_path.Add(odometry, next, true);
       odometry = next;
     }
-    if (measured) lengths->Add(truth, truth_there, false);
+    // Or kChunk encoder samples at most, whatever the clock says (both logs' times in ms: every
+    // interval 1000x long, and the path was not measured at all).
+    const bool measured =
+        instant_s - t_last_s <= kMaxMeasuredIntervalS || k - interval_begin <= kChunk;
+    if (measured) {
+      lengths->odometry_m += odometry_path.odometry_m;
+      lengths->odometry_translation_m += odometry_path.odometry_translation_m;
+      lengths->Add(truth, truth_there, false);
+    }
     truth = truth_there;
     t_last_s = instant_s;
   };
   for (std::size_t g = 0; g < gt.t_s.size(); ++g) {
-    if (gt.t_s[g] > run.t_start_s && gt.t_s[g] < run.t_final_s) {
+    if (gt.t_s[g] > run.t_start_s && gt.t_s[g] < run.t_final_s &&
+        gt.t_s[g] - t_last_s >= kMinMeasuredIntervalS) {
       interval_to(gt.t_s[g], gt.world_T_robot[g]);
     }
   }
   interval_to(run.t_final_s, run.final_ground_truth);
+}
+
+// The largest factor the bounds let a wheel radius move from its nominal, either way (infinite
+// without wheel radii).
+double WheelRadiusBoundsScale(const Robot& robot) {
+  double scale = 0.0;
+  for (int k = 0; k < robot.NumParameters(); ++k) {
+    const double r = robot.nominal[k];
+    if (!robot.parameters[k].IsWheelRadius() || !(r > 0.0)) continue;
+    scale = std::max({scale, robot.bounds[k].hi / r, r / robot.bounds[k].lo});
+  }
+  return scale > 0.0 ? scale : std::numeric_limits<double>::infinity();
 }
 
 }  // namespace
@@ -78,13 +104,29 @@ void AddPathLengths(const RobotModelInterface& model, const RunLog& log, PathLen
 RateUnitsFinding CheckModelRateUnits(const RobotModelInterface& model,
                                      const std::vector<RunLog>& runs) {
   RateUnitsFinding finding;
+  // Times in ms or us where s are meant: every encoder interval 1e3 (1e6) times as long, and the
+  // rates integrate over it to as much more travel - where the ground truth, as slow in count,
+  // measures no path at all (rates and ground truth in ms were blamed on the wiring).
+  if (const double interval_s = TypicalEncoderInterval(runs); interval_s > 1.0) {
+    finding.suspicious = true;
+    finding.likely_unit = interval_s > 1e3 ? "us" : "ms";
+    finding.message = StrFormat(
+        "the encoder samples lie %.3g s apart, where a calibration log records every 0.001-0.1 s: "
+        "times in %s, not s?; nothing fitted",
+        interval_s, finding.likely_unit.c_str());
+    return finding;
+  }
   PathLengths lengths;
   for (const RunLog& log : runs) AddPathLengths(model, log, &lengths);
   if (!(lengths.truth_m > kMinEvidenceM) || !std::isfinite(lengths.odometry_m)) return finding;
   finding.scale = lengths.odometry_m / lengths.truth_m;
-  const auto plausible = [](double scale) {
-    return scale >= 1.0 / kMaxPlausibleScale && scale <= kMaxPlausibleScale;
-  };
+  // The wheels' travel scales with their radii, which the fit keeps inside their bounds: a scale
+  // half again beyond what the bounds allow no fit can undo (encoder.ticks_per_rev declared 2x
+  // off, x2 against x4 quadrature decoding, was blamed on the wiring). Robots without wheel radii
+  // in their bounds keep kMaxPlausibleScale.
+  const double bounds_scale = WheelRadiusBoundsScale(model.robot());
+  const double most = std::min(kMaxPlausibleScale, 1.5 * bounds_scale);
+  const auto plausible = [most](double scale) { return scale >= 1.0 / most && scale <= most; };
   if (plausible(finding.scale)) return finding;
   finding.suspicious = true;
   // Positions that agree and turns that do not: the ground truth's heading column is in another
@@ -122,6 +164,16 @@ RateUnitsFinding CheckModelRateUnits(const RobotModelInterface& model,
         "the ground truth's path is %.3g times the nominal robot's odometry: ground-truth "
         "positions in millimetres, not metres?; nothing fitted",
         1.0 / finding.scale);
+    return finding;
+  }
+  if (finding.likely_unit.empty() && finding.scale >= 1.0 / kMaxPlausibleScale &&
+      finding.scale <= kMaxPlausibleScale) {
+    finding.message = StrFormat(
+        "the nominal robot's odometry travels %.3g times the ground truth's path, where the "
+        "bounds let a wheel radius change %.3gx at most: encoder.ticks_per_rev (x2 against x4 "
+        "quadrature?) or the wheel sizes are off by that factor, or the rates are not in rad/s; "
+        "nothing fitted",
+        finding.scale, bounds_scale);
     return finding;
   }
   finding.message = StrFormat(

@@ -738,6 +738,7 @@ io::ReportParameter ReportParameterOf(const Robot& robot, int k, double calibrat
   io::ReportParameter p;
   p.name = robot.parameters[k].name;
   p.is_angle = robot.parameters[k].unit == ParameterUnit::kAngle;
+  p.is_position = IsMountPosition(robot, k);
   p.unit = robot.parameters[k].DisplayUnit();
   p.held = robot.IsHeld(k);
   p.nominal = robot.nominal[k];

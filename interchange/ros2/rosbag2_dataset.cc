@@ -19,6 +19,7 @@
 #include "io/yaml_scalar.h"
 #include "models/model_registry.h"
 #include "odometry/aligned_run.h"
+#include "validation/rate_units.h"
 
 // The data set `import rosbag2` writes from a bag read and cut into runs (rosbag2_import.cc):
 // the CSVs exact to the last bit, robot.yaml with the frame the bag adds, dataset.yaml with
@@ -118,9 +119,9 @@ CsvBuffer GroundTruthCsvText(const GroundTruthTrack& track) {
 // set the import writes is one `fit` accepts. A refusal names the bag and the file as it would
 // be under --out.
 void RefuseWhatFitRefuses(const ImportRosbag2Options& o, const std::string& staged_dir,
-                          const Robot& robot) {
+                          const RobotModelInterface& model, const std::vector<RunLog>& runs) {
   try {
-    io::LoadDataset(io::ReadDatasetIndex(staged_dir), robot);
+    io::LoadDataset(io::ReadDatasetIndex(staged_dir), model.robot());
   } catch (const InputError& e) {
     std::string what = e.what();
     for (std::size_t at = what.find(staged_dir); at != std::string::npos;
@@ -128,6 +129,13 @@ void RefuseWhatFitRefuses(const ImportRosbag2Options& o, const std::string& stag
       what.replace(at, staged_dir.size(), o.out);
     }
     throw InputError(e.kind(), o.bag, 0, "the data set it makes would be refused: " + what);
+  }
+  // The units check `fit` runs before fitting (calibrate/checks_before_fitting.h): odometry and
+  // ground truth that travel paths of lengths no unit explains (a second body's poses interleaved
+  // on the ground-truth topic made a data set `fit` refused as millimetres).
+  if (const RateUnitsFinding units = CheckModelRateUnits(model, runs); units.suspicious) {
+    throw InputError(InputErrorKind::kBadValue, o.bag, 0,
+                     "the data set it makes would be refused: " + units.message);
   }
 }
 
@@ -188,7 +196,7 @@ RobotModelPtr WriteDataset(const ImportRosbag2Options& o, const Robot& robot,
       std::to_string(imp.streams.start_time_ns) + " ns since the epoch\n";
   io::WriteFileAtomically((dir / "dataset.yaml").string(),
                           header + io::DatasetYaml("robot.yaml", entries));
-  RefuseWhatFitRefuses(o, staged.path(), robot);
+  RefuseWhatFitRefuses(o, staged.path(), *written, imp.runs);
   if (std::string said = RefuseJointsInAnotherOrder(o, imp.runs, *written); !said.empty()) {
     imp.notes.push_back(std::move(said));
   }

@@ -50,6 +50,10 @@ std::vector<std::pair<double, double>> ParseRunSpans(const std::string& text) {
     const double t0 = ParseSeconds(item.substr(0, colon), "--runs");
     const double t1 = ParseSeconds(item.substr(colon + 1), "--runs");
     if (!(t1 > t0)) throw UsageError("--runs: '" + item + "' does not end after it starts");
+    // Runs that share samples would put the same motion in training and held-out runs.
+    for (const auto& [b0, b1] : spans) {
+      if (t0 < b1 && b0 < t1) throw UsageError("--runs: '" + item + "' overlaps an earlier span");
+    }
     spans.emplace_back(t0, t1);
     pos = end + 1;
   }
@@ -59,7 +63,8 @@ std::vector<std::pair<double, double>> ParseRunSpans(const std::string& text) {
 std::string RunLabel(const ImportRosbag2Options& o) {
   std::string label = o.label;
   if (label.empty()) {
-    fs::path p = fs::path(o.bag).lexically_normal();
+    // absolute: a bag given as `.` or `..` is named after its folder, not the dots
+    fs::path p = fs::absolute(o.bag).lexically_normal();
     if (!p.has_filename()) p = p.parent_path();
     label =
         p.filename() == "metadata.yaml" ? p.parent_path().filename().string() : p.stem().string();

@@ -133,12 +133,19 @@ void BagReader::OpenStorages() {
   has_pending_.assign(storages_.size(), false);
 }
 
-// Topics are matched across the files of a split bag by name.
+// Topics are matched across the files of a split bag by name, and must agree on their type.
 void BagReader::MergeTopics(std::size_t file_index) {
   std::vector<std::size_t> map;
   for (const TopicInfo& topic : storages_[file_index]->topics()) {
     std::size_t i = 0;
     while (i < topics_.size() && topics_[i].name != topic.name) ++i;
+    // One name, one type: the messages of a topic are decoded with its type.
+    if (i < topics_.size() && topics_[i].type != topic.type) {
+      ThrowBagError(InputErrorKind::kBadValue, files_[file_index],
+                    "topic " + Printable(topic.name) + " has type " + Printable(topic.type) +
+                        " here and " + Printable(topics_[i].type) +
+                        " in an earlier file of the bag");
+    }
     if (i == topics_.size()) {
       topics_.push_back(topic);
       topics_.back().message_count = 0;

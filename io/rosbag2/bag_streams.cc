@@ -4,6 +4,8 @@
 #include <cmath>
 #include <filesystem>
 #include <optional>
+#include <string>
+#include <tuple>
 
 #include "io/input_error.h"
 #include "io/rosbag2/bag_reader.h"
@@ -35,10 +37,10 @@ const TopicInfo& RequireTopic(const BagReader& bag, const std::string& bag_path,
                               const std::string& name, const std::string& role) {
   const TopicInfo* topic = bag.FindTopic(name);
   if (topic == nullptr) {
-    const std::string have = Joined(bag.topics(), ", ", [](const TopicInfo& t) { return t.name; });
+    const std::string have =
+        Joined(bag.topics(), ", ", [](const TopicInfo& t) { return Printable(t.name); });
     ThrowBagError(InputErrorKind::kMissingKey, bag_path,
-                  role + " topic " + Printable(name) +
-                      " is not in the bag (topics: " + Printable(have, 160) + ")");
+                  role + " topic " + Printable(name) + " is not in the bag (topics: " + have + ")");
   }
   return *topic;
 }
@@ -250,10 +252,11 @@ class PoseCollector {
   void Add(const BagMessage& m) {
     if (type_ == kPoseStampedType) {
       const PoseStamped p = DecodePoseStamped(m.payload, Describe(m));
+      KeepFrames(m, p.header.frame_id, "");
       Push(m, p.header, PlanarPose(p.pose.position, p.pose.orientation, p.header, m));
     } else if (type_ == kOdometryType) {
       const Odometry o = DecodeOdometry(m.payload, Describe(m));
-      if (out_->t_ns.empty()) child_frame = StripSlash(o.child_frame_id);
+      KeepFrames(m, o.header.frame_id, o.child_frame_id);
       Push(m, o.header, PlanarPose(o.pose.pose.position, o.pose.pose.orientation, o.header, m));
     } else {
       for (const TransformStamped& t : DecodeTfMessage(m.payload, Describe(m)).transforms) {
@@ -268,6 +271,27 @@ class PoseCollector {
   }
 
  private:
+  // One frame and one child frame for the whole topic, those of its first message. A ground truth
+  // whose frame changes mid-bag (a localisation restarted in `map` after `world`, an Odometry's
+  // child switched to another sensor) holds poses of two frames on one track, which no odometry
+  // follows; refused naming the message.
+  void KeepFrames(const BagMessage& m, const std::string& frame, const std::string& child) {
+    if (out_->t_ns.empty()) {
+      frame_ = StripSlash(frame);
+      child_frame = StripSlash(child);
+      return;
+    }
+    for (const auto& [field, first, now] :
+         {std::tuple{"header.frame_id", frame_, StripSlash(frame)},
+          std::tuple{"child_frame_id", child_frame, StripSlash(child)}}) {
+      if (now == first) continue;
+      ThrowBagError(InputErrorKind::kBadValue, Describe(m),
+                    std::string(field) + " " + Printable(now) + " differs from " +
+                        Printable(first) + " of the topic's first message: poses in two frames "
+                        "are not one ground truth");
+    }
+  }
+
   void Push(const BagMessage& m, const Header& header, Pose2d pose) {
     if (!std::isfinite(pose.x) || !std::isfinite(pose.y) || !std::isfinite(pose.theta)) {
       ThrowBagError(InputErrorKind::kNonFinite, Describe(m), "pose is not finite");
@@ -288,6 +312,7 @@ class PoseCollector {
   std::string child_frame;  // an Odometry's child_frame_id, from its first message
 
  private:
+  std::string frame_;  // header.frame_id of the first message
   const BagStreamRequest& request_;
   std::string type_;
   PoseStream* out_;
@@ -351,6 +376,20 @@ void OrderByHeaderStamps(BagReader* bag, const BagStreamRequest& request, BagStr
                        " into the bag: the messages are put in the order of their header stamps");
 }
 
+// Header stamps on a clock other than the recorder's (simulated time from 0, a robot clock never
+// synchronised) lie far from the recording times, and t = 0 at the recording's start put the
+// data set's times at -1.7e9 s, where --runs cannot name them. Then t = 0 is the first stamp.
+// A minute apart: a synchronised clock and a recorder's queue differ by far less.
+void StartAtFirstStampOnAnotherClock(std::int64_t first_recorded_ns, BagStreams* out) {
+  constexpr std::int64_t kAnotherClockNs = 60'000'000'000;
+  const std::int64_t first_stamp_ns = out->joints.t_ns.front();
+  if (std::abs(first_stamp_ns - first_recorded_ns) <= kAnotherClockNs) return;
+  out->start_time_ns = std::min(first_stamp_ns, out->poses.t_ns.front());
+  out->notes.push_back("the header stamps run on another clock than the recorder's (the first "
+                       "encoder message stamped " + Seconds(first_stamp_ns - first_recorded_ns) +
+                       " from its recording time): t = 0 at the first header stamp");
+}
+
 }  // namespace
 
 double YawOfQuaternion(double x, double y, double z, double w) {
@@ -379,8 +418,10 @@ BagStreams ReadBagStreams(const std::string& bag_path, const BagStreamRequest& r
   if (tf_static != nullptr && tf_static->type != kTfType) tf_static = nullptr;
   out.has_tf_static = tf_static != nullptr;
   BagMessage m;
+  std::optional<std::int64_t> first_recorded_ns;  // the first encoder message's recording time
   while (bag.ReadNext(&m)) {
     if (m.topic == joint_topic) {
+      if (!first_recorded_ns) first_recorded_ns = m.time_ns;
       joints.Add(m);
     } else if (m.topic == pose_topic) {
       poses.Add(m);
@@ -409,6 +450,9 @@ BagStreams ReadBagStreams(const std::string& bag_path, const BagStreamRequest& r
                       (out.pose_type == kTfType ? " of the transform " + request.parent_frame +
                                                       " -> " + request.child_frame
                                                 : std::string()));
+  }
+  if (request.stamp == StampSource::kHeader) {
+    StartAtFirstStampOnAnotherClock(*first_recorded_ns, &out);
   }
   return out;
 }

@@ -15,6 +15,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -72,9 +73,16 @@ Bag WriteBag(const std::string& name, const rb::BagWriterOptions& options, bool 
     writer.Write("/joint_states", t_ns, rb::ByteView(payload));
     written += payload.size() + 31;  // + MCAP Message record prefix and fields
     if (ground_truth && i % 10 == 0) {
+      // Where ImportBag's diff drive goes on wheel_0 (right, 0.1 rad/s) and wheel_1 (left,
+      // 0.2 rad/s): an arc at v = 0.0075 m/s, omega = -1/60 rad/s (the import refuses a ground
+      // truth no unit relates to the odometry).
+      const double t_s = 0.01 * static_cast<double>(i), v = 0.0075, omega = -1.0 / 60.0;
       rb::PoseStamped p;
       p.header = js.header;
-      p.pose.position.x = 0.001 * static_cast<double>(i);
+      p.pose.position.x = v / omega * std::sin(omega * t_s);
+      p.pose.position.y = v / omega * (1.0 - std::cos(omega * t_s));
+      p.pose.orientation.z = std::sin(0.5 * omega * t_s);
+      p.pose.orientation.w = std::cos(0.5 * omega * t_s);
       const std::vector<std::uint8_t> pose = rb::EncodePoseStamped(p);
       writer.Write("/mocap/pose", t_ns + 1000, rb::ByteView(pose));
       written += pose.size() + 31;
