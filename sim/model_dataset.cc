@@ -31,7 +31,6 @@ RobotModelPtr NominalModel(const ModelDatasetRequest& request) {
   return ReadRobotModel(YAML::Load(registration->example_yaml), request.model + " example robot");
 }
 
-// The true parameters: --truth (a robot YAML of the same model and channels), or the default.
 // Whether two models of one kind step alike at parameters p: each channel alone and all together
 // (their fixed geometry, what is not a parameter, is the same).
 bool StepAlike(const RobotModelInterface& a, const RobotModelInterface& b,
@@ -52,6 +51,7 @@ bool StepAlike(const RobotModelInterface& a, const RobotModelInterface& b,
   return true;
 }
 
+// The true parameters: --truth (a robot YAML of the same model and channels), or the default.
 std::vector<double> TrueParameters(const ModelDatasetRequest& request,
                                    const RobotModelInterface& nominal) {
   const Robot& robot = nominal.robot();

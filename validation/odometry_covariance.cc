@@ -331,8 +331,10 @@ OdometryCovariance EstimateOdometryCovariance(const RobotModelInterface& model,
       v[a].push_back(m.Mean(a) - 2.0 * out.ground_truth_variance[a]);
       // What the windows could hide (two standard errors of their mean square, which has variance
       // 2 V^2 / n), taken to 1 m as a random walk: the bound of an axis they resolve nothing on.
+      // The 1 m windows' where there are, else the tightest length's.
       const double hidden = 2.0 * m.Mean(a) * std::sqrt(2.0 / m.count) / d.back();
-      hidden_at_1m[a] = length == 1.0 ? hidden : std::min(hidden_at_1m[a], hidden);
+      if (length == 1.0) hidden_at_1m[a] = hidden;
+      if (!measured_at_1m) hidden_at_1m[a] = std::min(hidden_at_1m[a], hidden);
     }
     if (length == 1.0) {  // the controller's constant, where the data measure it directly
       measured_at_1m = true;

@@ -5,7 +5,6 @@
 #include <filesystem>
 #include <optional>
 #include <string>
-#include <tuple>
 
 #include "io/input_error.h"
 #include "io/rosbag2/bag_reader.h"
@@ -281,15 +280,15 @@ class PoseCollector {
       child_frame = StripSlash(child);
       return;
     }
-    for (const auto& [field, first, now] :
-         {std::tuple{"header.frame_id", frame_, StripSlash(frame)},
-          std::tuple{"child_frame_id", child_frame, StripSlash(child)}}) {
-      if (now == first) continue;
+    const auto same = [&m](const char* field, const std::string& first, const std::string& now) {
+      if (now == first) return;
       ThrowBagError(InputErrorKind::kBadValue, Describe(m),
                     std::string(field) + " " + Printable(now) + " differs from " +
                         Printable(first) + " of the topic's first message: poses in two frames "
                         "are not one ground truth");
-    }
+    };
+    same("header.frame_id", frame_, StripSlash(frame));
+    same("child_frame_id", child_frame, StripSlash(child));
   }
 
   void Push(const BagMessage& m, const Header& header, Pose2d pose) {
