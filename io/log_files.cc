@@ -521,6 +521,10 @@ struct Glitch {
   // ticks): 0 otherwise.
   int narrower_wrap_bits = 0;
   bool running_total = false;  // a wrong running total, bridged with the travel kept
+  // 16 or 32 when an increment of an undeclared counter is within 5 % of 2^bits: a negative
+  // count stored unsigned (-1 as 65535); 0 otherwise.
+  int unsigned_negative_bits = 0;
+  std::string count = "";  // with unsigned_negative_bits: "channel 'right' counts 65535 ..."
 };
 
 class GlitchScreen {
@@ -541,7 +545,9 @@ class GlitchScreen {
       const Neighbourhood around = NeighbourhoodOf(samples_, c, k, bridged_);
       if (what.empty()) what = Backwards(c, k, around);
       if (what.empty()) continue;
-      const int wrap_bits = WrapBitsOf(Ticks(c, k));
+      const double ticks = Ticks(c, k);  // before the bridge replaces it
+      const int wrap_bits = WrapBitsOf(ticks);
+      const std::string count = Prefix(c, k);
       glitches_.push_back(Bridge(c, k, around.around, what));
       // A flipped bit of a running total jumps by 2^b and back: bridged as a wrong total, not a
       // wrap; a wrap jumps once.
@@ -550,6 +556,11 @@ class GlitchScreen {
       if (wrap_bits == 16 && robot_.encoder->counter_bits == 32 &&
           !glitches_.back().running_total) {
         glitches_.back().narrower_wrap_bits = wrap_bits;
+      }
+      if ((wrap_bits == 16 || wrap_bits == 32) && !robot_.encoder->cumulative &&
+          robot_.encoder->counter_bits == 0 && ticks > 0.0) {
+        glitches_.back().unsigned_negative_bits = wrap_bits;
+        glitches_.back().count = count;
       }
     }
   }
@@ -683,6 +694,16 @@ void DropCounterGlitches(const std::string& path, const Robot& robot,
                          "-bit counter that wraps, not the " +
                          std::to_string(robot.encoder->counter_bits) +
                          " bits encoder.counter_bits declares; declare counter_bits: " + b);
+  }
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    if (all[i].unsigned_negative_bits == 0) continue;
+    // Every backwards interval of such a log is one: a warning each flooded the terminal (97
+    // lines) before the share refused the log.
+    const std::string b = std::to_string(all[i].unsigned_negative_bits);
+    throw InputError(InputErrorKind::kImplausibleValue, path, lines[i],
+                     all[i].count + ": an increment of about 2^" + b + " is a negative count "
+                     "stored as an unsigned " + b + "-bit number; declare counter_bits: " + b +
+                     " in the robot YAML's encoder block and fitcal reads the counts signed");
   }
   WarnAndCountGlitches(path, "counter", "a wrong encoder block (ticks_per_rev, cumulative, "
                        "counter_bits?)", all, lines, log);

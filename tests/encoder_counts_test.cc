@@ -197,6 +197,21 @@ std::string TractionCsv(bool cumulative, double forward,
   return csv.str();
 }
 
+// The same counts without the width: -5 recorded as 2^16 - 5 in a 40-row log going backwards
+// now and then. Refused at its line in one message that names the cause and the width to
+// declare, where each such interval was warned as a glitch (97 lines) before the share refused.
+TEST(EncoderCounts, UnsignedNegativeIncrementsOfAnUndeclaredWidthAreNamedOnce) {
+  const Robot robot = RobotWith("encoder: {ticks_per_rev: 4096, cumulative: false}\n");
+  CapturedWarnings warnings;
+  const std::string error = ErrorOf([&] {
+    Load(robot, TractionCsv(false, 10, [](std::vector<double>* c) { (*c)[20] = 65531; }));
+  });
+  EXPECT_TRUE(Has(error, "enc.csv:22: channel 'traction' counts 65531 ticks")) << error;
+  EXPECT_TRUE(Has(error, "negative count stored as an unsigned 16-bit number")) << error;
+  EXPECT_TRUE(Has(error, "counter_bits: 16")) << error;
+  EXPECT_TRUE(warnings.lines.empty());
+}
+
 // A running total torn for one row (row 20 on line 22 reads 0x5A5A5A5A): its two intervals move
 // 10^9 ticks each way, a rim speed far beyond 20 m/s; the reading is dropped, the two intervals
 // bridged with their sum (20 ticks over 0.02 s: exact), the line named and counted.
