@@ -682,7 +682,8 @@ std::vector<RunLog> ExactSlaloms(const RobotModelInterface& model, double headin
     log.encoders.t_s = {0.0};
     for (int k = 1; k <= 4000; ++k) {
       const double t = 0.01 * k;
-      log.encoders.samples.push_back(0.01, {4.0 + 2.0 * std::sin(0.3 * t + r), 4.0 + 2.0 * std::cos(0.2 * t)});
+      log.encoders.samples.push_back(
+          0.01, {4.0 + 2.0 * std::sin(0.3 * t + r), 4.0 + 2.0 * std::cos(0.2 * t)});
       log.encoders.t_s.push_back(t);
     }
     log.ground_truth.t_s = {0.0};

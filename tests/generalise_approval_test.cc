@@ -188,9 +188,9 @@ TEST(GeneraliseApproval, DecisionOnASplitIsFits) {
 // Leave-one-session-out's closing line counts fit's decisions on the folds. On the real OptiOdom
 // tricycle (circles and squares; each path and direction one session label: four folds), the fold
 // holding out label L is `fit --residuals final-pose --train-trajectories <the other labels>`,
-// run here four times; the line built from those runs must be generalise's. On dense tracks `fit`'s default
-// fits the track, which is not the table's "fit": hence --residuals final-pose. Needs
-// ../shared/data/optiodom (skipped without it).
+// run here four times; the line built from those runs must be generalise's. On dense tracks
+// `fit`'s default fits the track, which is not the table's "fit": hence --residuals final-pose.
+// Needs ../shared/data/optiodom (skipped without it).
 TEST(GeneraliseApproval, FoldDecisionsAreFitsOnTheRealTricycle) {
   const fs::path root = fs::path(FITCAL_SHARED_DIR) / "data" / "optiodom" / "tricyc";
   if (!fs::is_directory(root)) GTEST_SKIP() << "no " << root;

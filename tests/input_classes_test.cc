@@ -282,7 +282,8 @@ TEST(InputClassesCli, EachFlagIsNamedWithWhatIsWrong) {
   for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
            {"fit --logs . --max-evaluations 0", "--max-evaluations must be positive"},
            {"fit --logs . --loss huber --loss-scale -1", "--loss-scale must be positive"},
-           {"fit --logs . --train-reps 1-2000000000", "2000000000 is beyond the last repetition"}}) {
+           {"fit --logs . --train-reps 1-2000000000",
+            "2000000000 is beyond the last repetition"}}) {
     const auto r = RunFitcal(dir, args);
     EXPECT_EQ(r.exit_code, 2) << args << ": " << r.err;
     EXPECT_TRUE(Has(r.err, says)) << args << ": " << r.err;

@@ -143,10 +143,12 @@ std::string TrackText(int n, int moved, double jump_m, double jump_rad) {
 TEST(GroundTruth, AGlitchIsDroppedAndNamedAndManyAreRefused) {
   TempDir dir;
   for (const auto& [jump_m, jump_rad] : {std::pair{2.0, 0.0}, std::pair{0.0, M_PI}}) {
-    const GroundTruthTrack t = ReadGroundTruth(dir.Write("one.csv", TrackText(200, 50, jump_m, jump_rad)));
+    const GroundTruthTrack t =
+        ReadGroundTruth(dir.Write("one.csv", TrackText(200, 50, jump_m, jump_rad)));
     ASSERT_EQ(t.t_s.size(), 199u);
     EXPECT_EQ(t.t_s[50], 5.1);  // the sample of line 52 is gone
-    const GroundTruthTrack clean = ReadGroundTruth(dir.Write("clean.csv", TrackText(200, -1, 0, 0)));
+    const GroundTruthTrack clean =
+        ReadGroundTruth(dir.Write("clean.csv", TrackText(200, -1, 0, 0)));
     EXPECT_EQ(clean.t_s.size(), 200u);
   }
   std::string two_bodies = "t,x,y,theta\n";
