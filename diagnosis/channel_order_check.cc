@@ -415,15 +415,14 @@ bool TurnsTheBodyHalfway(const RobotModelInterface& model, const ChannelMapping&
   const RobotModelInterface& body = BaseModel(model);
   const std::unique_ptr<const PreparedKinematics<double>> kinematics =
       body.PrepareKinematics(body.robot().nominal.data());
+  const std::vector<AlignedRun> mapped = ApplyChannelMapping(runs, mapping);
   double mismatch = 0.0, size = 0.0;
-  for (const AlignedRun& run : runs) {
-    const int n = run.samples.num_channels();
-    for (auto&& s : run.samples) {
-      double mapped[kMaxChannels];
-      for (int i = 0; i < n; ++i) mapped[i] = mapping.sign[i] * s.value[mapping.column[i]];
+  for (std::size_t r = 0; r < runs.size(); ++r) {
+    for (std::size_t k = 0; k < runs[r].samples.size(); ++k) {
+      const auto s = runs[r].samples[k], m = mapped[r].samples[k];
       double x, y, theta, xm, ym, thetam;
       kinematics->Step(s.value, s.dt_s, &x, &y, &theta);
-      kinematics->Step(mapped, s.dt_s, &xm, &ym, &thetam);
+      kinematics->Step(m.value, m.dt_s, &xm, &ym, &thetam);
       mismatch += (xm + x) * (xm + x) + (ym + y) * (ym + y) + (thetam - theta) * (thetam - theta);
       size += x * x + y * y + theta * theta;
     }

@@ -650,12 +650,13 @@ std::vector<int> SortedGlitchLines(const std::string& path, std::vector<Glitch>*
   return LinesOfDataRows(path, rows);
 }
 
-// More than kMaxGlitchShare of a log's intervals is not a glitch but a wrong block (`hint`):
-// refused. Else each is warned, `file:line: <kind> glitch: <what>`, and counted.
-void WarnAndCountGlitches(const std::string& path, const std::string& kind,
-                          const std::string& hint, const std::vector<Glitch>& all,
-                          const std::vector<int>& lines, EncoderLog* log) {
-  const double allowed = std::max(1.0, kMaxGlitchShare * static_cast<double>(log->samples.size()));
+// More than kMaxGlitchShare of the `total` intervals of a log (samples of a track: `counted`)
+// is not a glitch but `hint`: refused. Else each is warned, `file:line: <kind> glitch: <what>`.
+void WarnGlitchesOrRefuse(const std::string& path, const std::string& kind,
+                          const std::string& counted, const std::string& hint,
+                          const std::vector<Glitch>& all, const std::vector<int>& lines,
+                          std::size_t total) {
+  const double allowed = std::max(1.0, kMaxGlitchShare * static_cast<double>(total));
   if (static_cast<double>(all.size()) > allowed) {
     // Intervals, not glitches: two wheels glitching in one interval count once ("6837 of 3568
     // intervals" said the count of both wheels of a wrong `cumulative:`).
@@ -663,13 +664,19 @@ void WarnAndCountGlitches(const std::string& path, const std::string& kind,
     for (const Glitch& g : all) distinct.push_back(g.row);
     distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
     throw InputError(InputErrorKind::kImplausibleValue, path, lines.front(),
-                     std::to_string(distinct.size()) + " of " +
-                         std::to_string(log->samples.size()) + " intervals are " + kind +
-                         " glitches, the first here: " + all.front().what +
-                         "; more than 1 % is not a glitch but " + hint);
+                     std::to_string(distinct.size()) + " of " + std::to_string(total) + " " +
+                         counted + " are " + kind + " glitches, the first here: " +
+                         all.front().what + "; more than 1 % is not a glitch but " + hint);
   }
   for (std::size_t i = 0; i < all.size(); ++i)
     Warn(path, lines[i], kind + " glitch: " + all[i].what);
+}
+
+// The same for a log's intervals (a wrong block: `hint`), each glitch counted in the log.
+void WarnAndCountGlitches(const std::string& path, const std::string& kind,
+                          const std::string& hint, const std::vector<Glitch>& all,
+                          const std::vector<int>& lines, EncoderLog* log) {
+  WarnGlitchesOrRefuse(path, kind, "intervals", hint, all, lines, log->samples.size());
   log->dropped_glitches += static_cast<int>(all.size());
 }
 
@@ -1013,28 +1020,23 @@ std::optional<std::string> GroundTruthGlitchAt(const GroundTruthTrack& track, st
 
 void DropGroundTruthGlitches(const std::string& path, const std::vector<int>& line_of_row,
                              GroundTruthTrack* track) {
-  std::vector<std::size_t> rows;
-  std::vector<std::string> what;
+  std::vector<Glitch> all;
+  std::vector<int> lines;
   const TrackSteps typical{TypicalApart(*track, Distance), TypicalApart(*track, Turn)};
   for (std::size_t i = 1; i + 1 < track->t_s.size(); ++i) {
     if (std::optional<std::string> glitch = GroundTruthGlitchAt(*track, i, typical)) {
-      rows.push_back(i);
-      what.push_back(std::move(*glitch));
+      all.push_back({i, *glitch + "; dropped"});
+      lines.push_back(line_of_row[i]);
       ++i;  // its neighbour leaves it as fast: not a second glitch
     }
   }
-  if (rows.empty()) return;
-  const double allowed = std::max(1.0, kMaxGlitchShare * static_cast<double>(track->t_s.size()));
-  if (static_cast<double>(rows.size()) > allowed) {
-    throw InputError(InputErrorKind::kImplausibleValue, path, line_of_row[rows.front()],
-                     std::to_string(rows.size()) + " of " + std::to_string(track->t_s.size()) +
-                         " ground-truth samples are glitches, the first here: " + what.front() +
-                         "; more than 1 % is not a glitch but two bodies or frames on one track");
-  }
-  for (std::size_t g = rows.size(); g-- > 0;) {
-    Warn(path, line_of_row[rows[g]], "ground-truth glitch: " + what[g] + "; dropped");
-    track->t_s.erase(track->t_s.begin() + static_cast<std::ptrdiff_t>(rows[g]));
-    track->world_T_robot.erase(track->world_T_robot.begin() + static_cast<std::ptrdiff_t>(rows[g]));
+  if (all.empty()) return;
+  WarnGlitchesOrRefuse(path, "ground-truth", "samples", "two bodies or frames on one track", all,
+                       lines, track->t_s.size());
+  for (std::size_t g = all.size(); g-- > 0;) {
+    const auto row = static_cast<std::ptrdiff_t>(all[g].row);
+    track->t_s.erase(track->t_s.begin() + row);
+    track->world_T_robot.erase(track->world_T_robot.begin() + row);
   }
 }
 

@@ -440,7 +440,7 @@ TEST_F(MalformedImport, TwoBodiesOnTheGroundTruthTopicAreRefused) {
     if (i % 2 == 1) p->pose.position.x += 4.0;
   };
   ExpectRefused(ImportOptions(tmp_, Bag("bodies", StorageFormat::kMcap, edits)),
-                "ground-truth samples are glitches");
+                "samples are ground-truth glitches");
 }
 
 // Header stamps on another clock than the recorder's (simulated time from near 0): the data set's

@@ -231,17 +231,21 @@ std::array<double, 3> FitGrowth(const std::vector<double>& t, const std::vector<
   return FitTerms(t, v, w, ticks ? 0b100 : 0b110);
 }
 
+// What a mean square V of n Gaussian errors could hide: two of its standard errors, V sqrt(2 / n).
+double TwoStandardErrors(double mean_square, double n) {
+  return 2.0 * mean_square * std::sqrt(2.0 / n);
+}
+
 // The white growth (per second) that the windows could hide where they resolve none: two
-// standard errors of a lag's mean square (n Gaussian errors: V sqrt(2 / n); n = w V^2, the
-// weights above) over its duration, the tightest over the lags. Zero growth is not zero error: an
-// EKF given a twist variance of 0 trusts the twist exactly.
+// standard errors of a lag's mean square (n = w V^2, the weights above) over its duration, the
+// tightest over the lags. Zero growth is not zero error: an EKF given a twist variance of 0
+// trusts the twist exactly.
 double UnresolvedGrowthBound(const std::vector<double>& t, const std::vector<double>& v,
                              const std::vector<double>& w) {
   double bound = HUGE_VAL;
   for (std::size_t i = 0; i < t.size(); ++i) {
     if (!(w[i] > 0.0 && v[i] > 0.0 && t[i] > 0.0)) continue;
-    const double n = w[i] * v[i] * v[i];
-    bound = std::min(bound, 2.0 * v[i] * std::sqrt(2.0 / n) / t[i]);
+    bound = std::min(bound, TwoStandardErrors(v[i], w[i] * v[i] * v[i]) / t[i]);
   }
   return std::isfinite(bound) ? bound : 0.0;
 }
@@ -329,12 +333,14 @@ OdometryCovariance EstimateOdometryCovariance(const RobotModelInterface& model,
     d.push_back(m.extent / m.count);  // the windows' mean path
     for (int a = 0; a < 3; ++a) {
       v[a].push_back(m.Mean(a) - 2.0 * out.ground_truth_variance[a]);
-      // What the windows could hide (two standard errors of their mean square, which has variance
-      // 2 V^2 / n), taken to 1 m as a random walk: the bound of an axis they resolve nothing on.
-      // The 1 m windows' where there are, else the tightest length's.
-      const double hidden = 2.0 * m.Mean(a) * std::sqrt(2.0 / m.count) / d.back();
-      if (length == 1.0) hidden_at_1m[a] = hidden;
-      if (!measured_at_1m) hidden_at_1m[a] = std::min(hidden_at_1m[a], hidden);
+      // What the windows could hide, taken to 1 m as a random walk: the bound of an axis they
+      // resolve nothing on. The 1 m windows' where there are, else the tightest length's.
+      const double hidden = TwoStandardErrors(m.Mean(a), m.count) / d.back();
+      if (length == 1.0) {
+        hidden_at_1m[a] = hidden;
+      } else if (!measured_at_1m) {
+        hidden_at_1m[a] = std::min(hidden_at_1m[a], hidden);
+      }
     }
     if (length == 1.0) {  // the controller's constant, where the data measure it directly
       measured_at_1m = true;
