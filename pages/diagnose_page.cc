@@ -259,10 +259,7 @@ std::string DiagnoseMetricsJson(const DiagnosePageData& d) {
                 ", \"selected\": " + JsonBool(g.selected) + "}";
        })
     << "],\n  \"parameters\": [" << Joined(d.parameters, ",", [](const ReportParameter& p) {
-         const double s = p.is_angle ? kDeg : 1.0;
-         return "\n    {\"name\": " + JsonString(p.name) + ", \"unit\": " + JsonString(p.unit) +
-                ", \"value\": " + JsonNumber(p.calibrated * s) +
-                ", \"sigma\": " + (p.has_sigma ? JsonNumber(p.sigma * s) : "null") +
+         return "\n    {\"name\": " + JsonString(p.name) + ", " + JsonSiValue(p) +
                 ", \"held\": " + JsonBool(p.held) + "}";
        })
     << "\n  ],\n  \"effects\": [" << Joined(d.effects, ", ", [](const ReportEffect& e) {

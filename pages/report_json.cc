@@ -132,7 +132,7 @@ std::string JsonStatistics(const ReportData& d) {
   });
 }
 
-// "parameters": nominal, calibrated and sigma in display units (_m or _deg).
+// "parameters": nominal, calibrated and sigma in display units (_m or _deg), and in SI.
 void JsonParameters(std::ostringstream& j, const ReportData& d) {
   for (std::size_t i = 0; i < d.parameters.size(); ++i) {
     const ReportParameter& p = d.parameters[i];
@@ -143,9 +143,7 @@ void JsonParameters(std::ostringstream& j, const ReportData& d) {
       << "\": " << JsonNumber(p.calibrated * s) << ", \"sigma" << u
       << "\": " << (p.has_sigma ? JsonNumber(p.sigma * s) : "null")
       << ", \"at_bound\": " << (p.at_bound ? "true" : "false")
-      << ", \"unit\": " << JsonString(p.unit) << ", \"value\": " << JsonNumber(p.calibrated * s)
-      << ", \"sigma\": " << (p.has_sigma ? JsonNumber(p.sigma * s) : "null")
-      << ", \"held\": " << (p.held ? "true" : "false");
+      << ", " << JsonSiValue(p) << ", \"held\": " << (p.held ? "true" : "false");
     if (p.has_cv) {
       j << ", \"cv_std" << u << "\": " << JsonNumber(p.cv_std * s) << ", \"cv_min" << u
         << "\": " << JsonNumber(p.cv_min * s) << ", \"cv_max" << u
@@ -228,6 +226,12 @@ std::string JsonString(const std::string& s) {
 std::string JsonNumber(double v) {
   if (!std::isfinite(v)) return "null";
   return StrFormat("%.10g", v);
+}
+
+std::string JsonSiValue(const ReportParameter& p) {
+  return "\"unit\": " + JsonString(p.is_angle ? "rad" : p.unit) +
+         ", \"value\": " + JsonNumber(p.calibrated) +
+         ", \"sigma\": " + (p.has_sigma ? JsonNumber(p.sigma) : "null");
 }
 
 std::string JsonBeforeAfter(double before, double after) {

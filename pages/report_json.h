@@ -17,8 +17,14 @@ std::string JsonNumber(double v);
 inline std::string JsonBool(bool b) { return b ? "true" : "false"; }
 std::string JsonBeforeAfter(double before, double after);
 
+// A parameter's `"unit": ..., "value": ..., "sigma": ...` in SI (m or rad; null sigma when none):
+// the generic keys carry no unit in their names, so they carry no degrees.
+std::string JsonSiValue(const ReportParameter& p);
+
 // The layout version of metrics.json (docs/metrics_json.md): raised when a key changes meaning
 // or disappears; keys may be added within a version.
-constexpr int kMetricsJsonVersion = 2;
+// Version 3: a parameter's generic `value` and `sigma` are SI (m, rad) as its `unit` says; degrees
+// stay under the keys that end in _deg.
+constexpr int kMetricsJsonVersion = 3;
 
 }  // namespace fitcal::io

@@ -165,6 +165,22 @@ TEST(Fleet, PrintsUnitsAndSigmasAndNotesCfsJudgedOnDifferentRuns) {
             std::string::npos);
 }
 
+// A version-3 report's angle: value and sigma in rad under "value"/"sigma", degrees under the
+// _deg keys; the fleet holds rad either way (reading "sigma" as degrees, as version 2 wrote it,
+// would make the 0.5 deg sigma 0.0087 deg).
+TEST(Fleet, ReadsAnAngleFromAVersionThreeReport) {
+  testing::TempDir tmp;
+  tmp.Write("fleet/r1/2026-06-01/report/metrics.json",
+            R"({"version": 3, "robot": "r1", "parameters": [{"name": "steering_offset",
+            "calibrated_deg": 2, "sigma_deg": 0.5, "unit": "rad", "value": 0.0349066,
+            "sigma": 0.00872665}]})");
+  const std::vector<FleetSeries> all = ReadFleet({tmp.Path("fleet")});
+  const FleetSeries& steering = Find(all, "r1", "steering_offset");
+  EXPECT_EQ(steering.unit, "deg");
+  EXPECT_NEAR(steering.values.at(0), 2.0 * M_PI / 180.0, 1e-15);
+  EXPECT_NEAR(steering.sigmas.at(0), 0.5 * M_PI / 180.0, 1e-15);
+}
+
 // FleetSeriesOf (validation/fleet_statistics.h) without files: a radius shrinking by exactly
 // 0.1 mm a week, dates a week apart, has the slope 30/7 x 0.1 mm per 30 days to rounding and is a
 // trend (no scatter about the line); one value 2 mm off among six that alternate +-1 um is the

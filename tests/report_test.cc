@@ -471,6 +471,17 @@ TEST(ReportTest, HeldParametersAreMarkedHeld) {
   EXPECT_NEAR(j["parameters"][0]["sigma"].as<double>(), 1e-4, 1e-15);
 }
 
+// An angle's generic value and sigma are radians, as its unit says; degrees only under _deg keys
+// (version 2 wrote degrees under "value": 57.9 here for 1.01 rad).
+TEST(ReportTest, AngleParametersAreRadiansUnlessTheKeySaysDeg) {
+  const YAML::Node angle = YAML::Load(MetricsJson(SmallReport()))["parameters"][6];
+  EXPECT_EQ(angle["unit"].as<std::string>(), "rad");
+  EXPECT_NEAR(angle["value"].as<double>(), 1.01, 1e-12);
+  EXPECT_NEAR(angle["sigma"].as<double>(), 1e-4, 1e-15);
+  EXPECT_NEAR(angle["calibrated_deg"].as<double>(), 1.01 * 180.0 / M_PI, 1e-9);
+  EXPECT_NEAR(angle["sigma_deg"].as<double>(), 1e-4 * 180.0 / M_PI, 1e-12);
+}
+
 // A held-out run whose error rose is flagged by name on the page, counted in the key numbers and
 // marked in metrics.json; with none, the page says none.
 TEST(ReportTest, HeldOutRunsThatGotWorseAreFlagged) {

@@ -93,8 +93,8 @@ Calibration ReadMetricsJson(const std::string& path) {
   // read only the versions whose keys this fleet knows, never a file it would half-read.
   const YAML::Node version = root["version"];
   const std::string current = std::to_string(io::kMetricsJsonVersion);
-  const bool known =
-      !version || (version.IsScalar() && (version.Scalar() == "1" || version.Scalar() == current));
+  const std::set<std::string> readable = {"1", "2", current};  // 3 moved `sigma` to SI, see below
+  const bool known = !version || (version.IsScalar() && readable.count(version.Scalar()) == 1);
   if (!known) {
     throw io::InputError(io::InputErrorKind::kBadValue, path, version.Mark().line + 1,
                          "metrics.json version " + (version.IsScalar() ? version.Scalar() : "?") +
@@ -115,9 +115,11 @@ Calibration ReadMetricsJson(const std::string& path) {
       const double v = io::YamlDouble(kv.second, path, "parameters." + key);
       const bool degrees = key.size() > 4 && key.compare(key.size() - 4, 4, "_deg") == 0;
       const double scale = degrees ? 180.0 / M_PI : 1.0;
+      // sigma_<unit> beside calibrated_<unit>, in every version (the generic `sigma` turned SI in 3).
+      const std::string sigma_key = "sigma_" + key.substr(std::string("calibrated_").size());
       double sigma = std::numeric_limits<double>::quiet_NaN();
-      if (p["sigma"] && p["sigma"].IsScalar() && p["sigma"].Scalar() != "null") {
-        sigma = io::YamlDouble(p["sigma"], path, "parameters.sigma") / scale;
+      if (p[sigma_key] && p[sigma_key].IsScalar() && p[sigma_key].Scalar() != "null") {
+        sigma = io::YamlDouble(p[sigma_key], path, "parameters." + sigma_key) / scale;
       }
       c.values.push_back({name, degrees ? "deg" : "m", v / scale, scale, sigma});
     }
