@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <optional>
 #include <set>
@@ -124,6 +125,22 @@ inline CLI::Validator SignValidator(bool zero_allowed) {
       zero_allowed ? "NONNEGATIVE" : "POSITIVE", zero_allowed ? "non-negative" : "positive");
 }
 inline CLI::Validator PositiveNumber() { return SignValidator(false); }
+
+// A residual's sigma no finer than `floor` (1e-9 m, a nanometre): 1e-300 weighed a metre as 1e300,
+// the squared cost overflowed, the solve failed and its tables printed nan.
+inline CLI::Validator SigmaAtLeast(double floor, const std::string& unit) {
+  return CLI::Validator(
+      [floor, unit](std::string& text) {
+        const std::optional<double> value = WholeTextNumber(text);
+        if (!value) return "must be a number, found '" + text.substr(0, 40) + "'";
+        if (*value >= floor) return std::string();
+        char line[160];
+        std::snprintf(line, sizeof line, "must be at least %g %s (finer than any ground truth), "
+                      "found '%s'", floor, unit.c_str(), text.substr(0, 40).c_str());
+        return std::string(line);
+      },
+      "SIGMA", "sigma");
+}
 inline CLI::Validator NonNegativeNumber() { return SignValidator(true); }
 
 // Adds the validators above to every --threads and --out option and every floating-point option

@@ -109,21 +109,26 @@ void AddSimulateOptions(CLI::App& app, SimulateCommandOptions& o) {
   app.add_option("--encoder-counts-per-rev", o.encoder_counts_per_rev,
                  "Encoder resolution (default: the model's recorder)");
   app.add_option("--gt-position-sigma-m", o.gt_position_sigma_m,
-                 "Ground-truth position noise (m; default: the model's recorder)");
+                 "Ground-truth position noise (m; default: the model's recorder)")
+      ->check(NonNegativeNumber());
   app.add_option("--gt-heading-sigma-deg", o.gt_heading_sigma_deg,
-                 "Ground-truth heading noise (deg; default: the model's recorder)");
+                 "Ground-truth heading noise (deg; default: the model's recorder)")
+      ->check(NonNegativeNumber());
   app.add_option("--slip-sigma", o.slip_sigma, "Relative wheel slip noise (stepped physics)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(NonNegativeNumber());
   app.add_option("--wheel-slip-sigma", o.wheel_slip_sigma,
                  "perfect tracking: relative noise on each wheel's advance per encoder interval "
                  "(default: the model's recorder)")
       ->check(NonNegativeNumber());
   app.add_option("--wheel-rate-sigma-rad-s", o.wheel_rate_sigma_rad_s,
                  "perfect tracking: white noise on each interval's mean wheel rate (rad/s; "
-                 "default: the model's recorder)");
+                 "default: the model's recorder)")
+      ->check(NonNegativeNumber());
   app.add_option("--angle-sigma-deg", o.angle_sigma_deg,
                  "--model: noise of an angle channel's readings, e.g. steering (deg; default: "
-                 "the model's recorder)");
+                 "the model's recorder)")
+      ->check(NonNegativeNumber());
   app.add_flag("--force", o.force, io::kForceDirectoryHelp);
   app.add_option("--inject", o.inject,
                  "Inject a library effect, name=value[,value] (docs/simulate.md); repeatable; "

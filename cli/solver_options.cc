@@ -35,12 +35,12 @@ void AddSolverOptions(CLI::App& app, SolverOptions& o) {
                  "Weight of the position residual as a standard deviation (m); with the default "
                  "1 m and 57.3 deg the objective weighs metres and radians as Eq. 14")
       ->capture_default_str()
-      ->check(PositiveNumber())
+      ->check(SigmaAtLeast(1e-9, "m"))
       ->each(given);
   app.add_option("--heading-sigma-deg", o.heading_sigma_deg,
                  "Weight of the heading residual as a standard deviation (deg)")
       ->capture_default_str()
-      ->check(PositiveNumber())
+      ->check(SigmaAtLeast(1e-7, "deg"))
       ->each(given);
 }
 

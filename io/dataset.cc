@@ -387,6 +387,25 @@ Dataset LoadDataset(const DatasetIndex& index, const Robot& robot, const Dataset
   return dataset;
 }
 
+void ReadBackStagedDataset(const std::string& staged_dir, const std::string& out,
+                           const Robot& robot) {
+  try {
+    LoadDataset(ReadDatasetIndex(staged_dir), robot);
+  } catch (const InputError& e) {
+    const auto as_out = [&](std::string text) {
+      for (std::size_t at = text.find(staged_dir); at != std::string::npos;
+           at = text.find(staged_dir, at + out.size())) {
+        text.replace(at, staged_dir.size(), out);
+      }
+      return text;
+    };
+    const std::string what = e.what();
+    const std::size_t prefix = FileLineText(e.file(), e.line(), "").size();
+    throw InputError(e.kind(), as_out(e.file()), e.line(),
+                     as_out(what.substr(std::min(prefix, what.size()))));
+  }
+}
+
 std::string DatasetYaml(const std::string& robot_path, const std::vector<DatasetEntry>& runs) {
   YAML::Emitter out;
   out << YAML::BeginMap;

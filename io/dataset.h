@@ -51,6 +51,11 @@ struct Dataset {
 Dataset LoadDataset(const DatasetIndex& index, const Robot& robot,
                     const DatasetOptions& options = {});
 
+// A writer's staged data set read back as every command reads it, so that what a writer makes is
+// what `fit` accepts; a refusal (InputError) names the file as it will be under `out`.
+void ReadBackStagedDataset(const std::string& staged_dir, const std::string& out,
+                           const Robot& robot);
+
 // One run as dataset.yaml lists it; used by writers (the simulator, importers).
 struct DatasetEntry {
   std::string id;

@@ -8,6 +8,8 @@
 
 #include "io/atomic_file.h"
 #include "io/command_failure.h"
+#include "io/dataset.h"
+#include "io/input_error.h"
 #include "io/output_guard.h"
 #include "io/staged_directory.h"
 #include "models/model_registry.h"
@@ -72,6 +74,18 @@ std::vector<double> TrueParameters(const ModelDatasetRequest& request,
   return t.nominal;
 }
 
+// Noise beyond the loader's physical limits (a ground truth beyond any map, a wheel rate no wheel
+// turns: sigmas of 1e300 were written, then refused by `fit`) is refused here, nothing written.
+void RefuseWhatFitRefuses(const std::string& staged_dir, const std::string& out,
+                          const Robot& robot) {
+  try {
+    io::ReadBackStagedDataset(staged_dir, out, robot);
+  } catch (const io::InputError& e) {
+    throw UsageError(std::string("the noise asked for makes a data set fit would refuse: ") +
+                     e.what());
+  }
+}
+
 // `out` refused by the overwrite rule (io/output_guard.h; UsageError) before anything is
 // simulated; `write` fills a staged sibling directory, then renamed over `out`.
 void WriteDatasetDirectory(const std::string& out, bool force,
@@ -101,6 +115,7 @@ WrittenModelDataset WriteModelDataset(const ModelDatasetRequest& request) {
     const std::vector<ModelSimulatedRun> runs =
         SimulateRuns(model, written.truth, scenario.trajectories, scenario.options);
     WriteSimulatedDataset(directory, model.RobotYaml(robot.nominal, ""), runs, scenario.digits);
+    RefuseWhatFitRefuses(directory, request.out, robot);
     io::WriteFileAtomically((fs::path(directory) / "true_robot.yaml").string(),
                             model.RobotYaml(written.truth, ""));
     written.num_runs = runs.size();

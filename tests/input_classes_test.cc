@@ -283,7 +283,11 @@ TEST(InputClassesCli, EachFlagIsNamedWithWhatIsWrong) {
            {"fit --logs . --max-evaluations 0", "--max-evaluations must be positive"},
            {"fit --logs . --loss huber --loss-scale -1", "--loss-scale must be positive"},
            {"fit --logs . --train-reps 1-2000000000",
-            "2000000000 is beyond the last repetition"}}) {
+            "2000000000 is beyond the last repetition"},
+           // 1e-300 weighed a metre as 1e300: the solve failed, its tables printed nan, and
+           // UMBmark was written, exit 0.
+           {"fit --logs . --position-sigma-m 1e-300", "must be at least 1e-09 m"},
+           {"compare --logs . --heading-sigma-deg 1e-300", "must be at least 1e-07 deg"}}) {
     const auto r = RunFitcal(dir, args);
     EXPECT_EQ(r.exit_code, 2) << args << ": " << r.err;
     EXPECT_TRUE(Has(r.err, says)) << args << ": " << r.err;

@@ -478,7 +478,7 @@ TEST(ReportTest, AngleParametersAreRadiansUnlessTheKeySaysDeg) {
   EXPECT_EQ(angle["unit"].as<std::string>(), "rad");
   EXPECT_NEAR(angle["value"].as<double>(), 1.01, 1e-12);
   EXPECT_NEAR(angle["sigma"].as<double>(), 1e-4, 1e-15);
-  EXPECT_NEAR(angle["calibrated_deg"].as<double>(), 1.01 * 180.0 / M_PI, 1e-9);
+  EXPECT_NEAR(angle["calibrated_deg"].as<double>(), 1.01 * 180.0 / M_PI, 1e-7);  // %.10g
   EXPECT_NEAR(angle["sigma_deg"].as<double>(), 1e-4 * 180.0 / M_PI, 1e-12);
 }
 

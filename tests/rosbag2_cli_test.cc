@@ -164,6 +164,27 @@ TEST(ImportThroughTheCommandLine, ReplacesItsOwnDataSetAndRefusesAForeignDirecto
   EXPECT_EQ(testing::ReadFileBytes(tmp.Path("foreign/notes.txt")), "not a data set");
 }
 
+// One file of a split bag given alone is read alone (a user may want only that part), but said:
+// before, its half of the recording became the whole data set without a word.
+TEST(ImportThroughTheCommandLine, OneFileOfASplitBagIsReadAloneAndSaidSo) {
+  TempDir tmp;
+  WriteBag(tmp, "bag", StorageFormat::kSqlite3, true);
+  std::vector<std::string> files;
+  for (const auto& entry : fs::directory_iterator(tmp.path() / "bag")) {
+    if (entry.path().extension() == ".db3") files.push_back(entry.path().string());
+  }
+  ASSERT_EQ(files.size(), 2u);
+  std::sort(files.begin(), files.end());
+  const testing::FitcalRun part = RunFitcal(tmp, ImportArgs(tmp, files[0], tmp.Path("part")));
+  EXPECT_EQ(part.exit_code, 0) << part.err;
+  EXPECT_TRUE(Has(part.out, files[0] + ": one of the 2 files of the split bag")) << part.out;
+  EXPECT_TRUE(Has(part.out, "the other is left out; give the directory")) << part.out;
+  const testing::FitcalRun whole =
+      RunFitcal(tmp, ImportArgs(tmp, tmp.Path("bag"), tmp.Path("all")));
+  EXPECT_EQ(whole.exit_code, 0) << whole.err;
+  EXPECT_FALSE(Has(whole.out, "files of the split bag")) << whole.out;
+}
+
 // ---- a ground truth on a mount (issue 39 item 6) ---------------------------------------------
 
 TransformStamped StaticTransform(const char* parent, const char* child, double x, double y,

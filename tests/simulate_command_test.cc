@@ -137,12 +137,21 @@ TEST(SimulateCommand, RefusesWhatTheModelSimulatorDoesNotTake) {
         std::string("--robot ") + FITCAL_SOURCE_DIR + "/data/robots/apr02.yaml --inject " +
             "steering_scale=0.01",
         // ASOC's castors run on perfect tracking with their own dynamics: no stepped slip.
-        std::string("--model asoc --slip-sigma 0.01")}) {
+        std::string("--model asoc --slip-sigma 0.01"),
+        // A negative sigma (exit 1 before), and noise whose samples the loader refuses: a
+        // ground truth 1e300 m away was written, and `fit` then refused the data set.
+        std::string("--model tricycle --gt-position-sigma-m -1"),
+        std::string("--model tricycle --gt-position-sigma-m 1e300"),
+        std::string("--model diff_drive --wheel-rate-sigma-rad-s 1e300")}) {
     SCOPED_TRACE(args);
     const Result r = RunFitcal(dir, "simulate " + args + " --out " + data);
     EXPECT_EQ(r.exit_code, 2) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
     EXPECT_FALSE(fs::exists(data));
+    if (args.find("1e300") != std::string::npos) {
+      EXPECT_NE(r.err.find("a data set fit would refuse: " + data + "/runs/"), std::string::npos)
+          << r.err;  // the file named as it would have been written, not the staging directory
+    }
   }
 }
 

@@ -115,7 +115,7 @@ Calibration ReadMetricsJson(const std::string& path) {
       const double v = io::YamlDouble(kv.second, path, "parameters." + key);
       const bool degrees = key.size() > 4 && key.compare(key.size() - 4, 4, "_deg") == 0;
       const double scale = degrees ? 180.0 / M_PI : 1.0;
-      // sigma_<unit> beside calibrated_<unit>, in every version (the generic `sigma` turned SI in 3).
+      // sigma_<unit> beside calibrated_<unit>, in every version (`sigma` turned SI in 3).
       const std::string sigma_key = "sigma_" + key.substr(std::string("calibrated_").size());
       double sigma = std::numeric_limits<double>::quiet_NaN();
       if (p[sigma_key] && p[sigma_key].IsScalar() && p[sigma_key].Scalar() != "null") {

@@ -121,14 +121,10 @@ CsvBuffer GroundTruthCsvText(const GroundTruthTrack& track) {
 void RefuseWhatFitRefuses(const ImportRosbag2Options& o, const std::string& staged_dir,
                           const RobotModelInterface& model, const std::vector<RunLog>& runs) {
   try {
-    io::LoadDataset(io::ReadDatasetIndex(staged_dir), model.robot());
+    io::ReadBackStagedDataset(staged_dir, o.out, model.robot());
   } catch (const InputError& e) {
-    std::string what = e.what();
-    for (std::size_t at = what.find(staged_dir); at != std::string::npos;
-         at = what.find(staged_dir, at + o.out.size())) {
-      what.replace(at, staged_dir.size(), o.out);
-    }
-    throw InputError(e.kind(), o.bag, 0, "the data set it makes would be refused: " + what);
+    throw InputError(e.kind(), o.bag, 0, std::string("the data set it makes would be refused: ") +
+                                             e.what());
   }
   // The units check `fit` runs before fitting (calibrate/checks_before_fitting.h): odometry and
   // ground truth that travel paths of lengths no unit explains (a second body's poses interleaved
