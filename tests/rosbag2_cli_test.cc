@@ -185,6 +185,29 @@ TEST(ImportThroughTheCommandLine, OneFileOfASplitBagIsReadAloneAndSaidSo) {
   EXPECT_FALSE(Has(whole.out, "files of the split bag")) << whole.out;
 }
 
+// A bag given by its one storage file is the bag: its runs carry the directory's label, so that a
+// calibration fitted on one import knows its training runs in the other (they were labelled
+// "bag_0" and "bag", and the training runs were judged as held out).
+TEST(ImportThroughTheCommandLine, ABagByItsOneFileLabelsItsRunsAsByItsDirectory) {
+  TempDir tmp;
+  WriteBag(tmp, "bag", StorageFormat::kMcap, false);
+  std::string file;
+  for (const auto& entry : fs::directory_iterator(tmp.path() / "bag")) {
+    if (entry.path().extension() == ".mcap") file = entry.path().string();
+  }
+  ASSERT_FALSE(file.empty());
+  ASSERT_EQ(RunFitcal(tmp, ImportArgs(tmp, tmp.Path("bag"), tmp.Path("by_dir"))).exit_code, 0);
+  const testing::FitcalRun by_file = RunFitcal(tmp, ImportArgs(tmp, file, tmp.Path("by_file")));
+  ASSERT_EQ(by_file.exit_code, 0) << by_file.err;
+  EXPECT_FALSE(Has(by_file.out, "files of the split bag")) << by_file.out;
+  const auto runs_of = [&](const char* out) {  // the runs, not the header naming the path given
+    const std::string yaml = testing::ReadFileBytes(tmp.path() / out / "dataset.yaml");
+    return yaml.substr(yaml.find("\nrobot:"));
+  };
+  EXPECT_TRUE(Has(runs_of("by_dir"), "{id: bag-01, trajectory: bag,")) << runs_of("by_dir");
+  EXPECT_EQ(runs_of("by_file"), runs_of("by_dir"));
+}
+
 // ---- a ground truth on a mount (issue 39 item 6) ---------------------------------------------
 
 TransformStamped StaticTransform(const char* parent, const char* child, double x, double y,

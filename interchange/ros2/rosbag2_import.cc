@@ -9,6 +9,7 @@
 #include "io/input_error.h"
 #include "io/log_files.h"
 #include "io/ros2_parameter_yaml.h"
+#include "io/rosbag2/bag_metadata.h"
 #include "io/rosbag2/static_transforms.h"
 #include "io/text_file.h"
 #include "models/model_registry.h"
@@ -66,8 +67,11 @@ std::string RunLabel(const ImportRosbag2Options& o) {
     // absolute: a bag given as `.` or `..` is named after its folder, not the dots
     fs::path p = fs::absolute(o.bag).lexically_normal();
     if (!p.has_filename()) p = p.parent_path();
-    label =
-        p.filename() == "metadata.yaml" ? p.parent_path().filename().string() : p.stem().string();
+    // A bag's one storage file names its runs as the bag's directory does: the same recording
+    // under two labels had its training runs judged as held out by another run id.
+    const bool whole_bag_file = io::rosbag2::OwningBagOfFile(p.string()).files == 1;
+    label = p.filename() == "metadata.yaml" || whole_bag_file ? p.parent_path().filename().string()
+                                                               : p.stem().string();
   }
   for (char& c : label) {
     if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_' && c != '.') c = '_';

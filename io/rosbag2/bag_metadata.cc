@@ -2,10 +2,16 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
+#include <filesystem>
+
 #include "io/input_error.h"
 #include "io/yaml_reader.h"
 
 namespace fitcal::io::rosbag2 {
+
+namespace fs = std::filesystem;
+
 namespace {
 
 YAML::Node Required(const YAML::Node& map, const std::string& key, const std::string& path) {
@@ -115,6 +121,23 @@ BagMetadata ReadBagMetadata(const std::string& path) {
   // The shared reader: regular files only (a FIFO does not block), duplicate keys refused.
   const YAML::Node root = LoadYamlFile(path);
   return ReadInformation(Required(root, "rosbag2_bagfile_information", path), path);
+}
+
+OwningBag OwningBagOfFile(const std::string& file) {
+  const fs::path metadata_path = fs::path(file).parent_path() / "metadata.yaml";
+  std::error_code ec;
+  if (!fs::is_regular_file(metadata_path, ec)) return {};
+  try {
+    const BagMetadata metadata = ReadBagMetadata(metadata_path.string());
+    // Versions before 5 listed each file with the bag's folder in front: compare file names.
+    const fs::path name = fs::path(file).filename();
+    const auto is_this = [&](const std::string& p) { return fs::path(p).filename() == name; };
+    const std::vector<std::string>& parts = metadata.relative_file_paths;
+    if (std::none_of(parts.begin(), parts.end(), is_this)) return {};
+    return {metadata_path.parent_path().string(), parts.size()};
+  } catch (const InputError&) {
+    return {};  // a metadata.yaml that does not read is no bag this file belongs to
+  }
 }
 
 }  // namespace fitcal::io::rosbag2

@@ -36,4 +36,12 @@ struct BagMetadata {
 // kWrongYamlType, kBadValue) with the file and line.
 BagMetadata ReadBagMetadata(const std::string& path);
 
+// The bag a storage file given alone belongs to: the directory whose metadata.yaml lists it, and
+// how many files that lists (0 when no metadata.yaml beside it reads or lists this file).
+struct OwningBag {
+  std::string directory;
+  std::size_t files = 0;
+};
+OwningBag OwningBagOfFile(const std::string& file);
+
 }  // namespace fitcal::io::rosbag2

@@ -390,30 +390,16 @@ void StartAtFirstStampOnAnotherClock(std::int64_t first_recorded_ns, BagStreams*
                        " from its recording time): t = 0 at the first header stamp");
 }
 
-// A storage file opened alone whose directory's metadata.yaml lists it among others: one part
-// of a split bag, read as if it were the whole (the others' messages left out, unsaid before).
-// A metadata.yaml that does not read is no bag this file belongs to: nothing said.
+// A storage file opened alone that its directory's metadata.yaml lists among others: one part of
+// a split bag, read as if it were the whole (the others' messages left out, unsaid before).
 std::optional<std::string> PartOfSplitBagNote(const std::string& file) {
-  const fs::path metadata_path = fs::path(file).parent_path() / "metadata.yaml";
-  std::error_code ec;
-  if (!fs::is_regular_file(metadata_path, ec)) return std::nullopt;
-  try {
-    const BagMetadata metadata = ReadBagMetadata(metadata_path.string());
-    const std::vector<std::string>& parts = metadata.relative_file_paths;
-    const std::string name = fs::path(file).filename().string();
-    // Versions before 5 listed each file with the bag's folder in front: compare file names.
-    const auto is_this = [&](const std::string& p) { return fs::path(p).filename() == name; };
-    if (parts.size() < 2 || std::none_of(parts.begin(), parts.end(), is_this)) {
-      return std::nullopt;
-    }
-    return file + ": one of the " + std::to_string(parts.size()) + " files of the split bag " +
-           metadata_path.parent_path().string() + " (its metadata.yaml), read alone: " +
-           (parts.size() == 2 ? std::string("the other is")
-                              : "the other " + std::to_string(parts.size() - 1) + " are") +
-           " left out; give the directory to read the whole bag";
-  } catch (const InputError&) {
-    return std::nullopt;
-  }
+  const OwningBag bag = OwningBagOfFile(file);
+  if (bag.files < 2) return std::nullopt;
+  return file + ": one of the " + std::to_string(bag.files) + " files of the split bag " +
+         bag.directory + " (its metadata.yaml), read alone: " +
+         (bag.files == 2 ? std::string("the other is")
+                         : "the other " + std::to_string(bag.files - 1) + " are") +
+         " left out; give the directory to read the whole bag";
 }
 
 }  // namespace
