@@ -278,6 +278,42 @@ TEST(FitcalCli, ReportServesADifferentialDrive) {
             0.2 * j["summary"][0]["before"]["cf"].as<double>());
 }
 
+// A calibration listing its wheels in another order than the data set's robot YAML was applied by
+// position: with wheel b listed before a, the flower's report and the export's replay drove each
+// wheel with the other's encoder (a hand-edited omni3 calibration read CF 3.4 for 0.036). Refused
+// in one line, nothing written, by both.
+TEST(FitcalCli, ACalibrationListingTheWheelsInAnotherOrderIsRefused) {
+  TempDir dir;
+  const std::string data = std::string(FITCAL_SOURCE_DIR) + "/data/flower";
+  const std::string cal = dir.Path("cal.yaml");
+  ASSERT_EQ(RunFitcal(dir, "fit --logs " + data + " --out " + cal).exit_code, 0);
+  std::string yaml = ReadFileBytes(cal);
+  const std::size_t a = yaml.find("  - {name: a,"), b = yaml.find("  - {name: b,");
+  ASSERT_TRUE(a != std::string::npos && b != std::string::npos) << yaml;
+  const std::string line_a = yaml.substr(a, b - a);
+  const std::string line_b = yaml.substr(b, yaml.find('\n', b) + 1 - b);
+  yaml.replace(a, line_a.size() + line_b.size(), line_b + line_a);
+  const std::string swapped = dir.Write("swapped.yaml", yaml);
+  const std::string says = "swapped.yaml: lists its channels as b, a, c, the data set's robot "
+                           "YAML as a, b, c";
+  const Result report = RunFitcal(dir, "report --logs " + data + " --calibration " + swapped +
+                                           " --out " + dir.Path("rep"));
+  EXPECT_EQ(report.exit_code, 1) << report.err;
+  EXPECT_EQ(Lines(report.err), 1) << report.err;
+  EXPECT_NE(report.err.find(says), std::string::npos) << report.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.Path("rep")));
+  const Result exported = RunFitcal(dir, "export ros2-control --calibration " + swapped +
+                                             " --controller omni_wheel_drive_controller --logs " +
+                                             data + " --out " + dir.Path("c.yaml"));
+  EXPECT_EQ(exported.exit_code, 1) << exported.err;
+  EXPECT_NE(exported.err.find(says), std::string::npos) << exported.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.Path("c.yaml")));
+  // In the data set's order it reports and exports.
+  EXPECT_EQ(RunFitcal(dir, "report --logs " + data + " --calibration " + cal + " --out " +
+                               dir.Path("rep")).exit_code,
+            0);
+}
+
 // `report --cv` refits any model on the seam, one fold per repetition (three here), and shows
 // the spread of each of the model's own parameters across the folds.
 TEST(FitcalCli, ReportCrossValidatesAnyModel) {

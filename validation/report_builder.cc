@@ -17,6 +17,7 @@
 #include "io/warnings.h"
 #include "models/mounted_model.h"
 #include "odometry/text_format.h"
+#include "validation/calibration_match.h"
 #include "validation/never_worse.h"
 #include "validation/relative_pose_error.h"
 #include "validation/trajectory_family.h"
@@ -687,6 +688,10 @@ CalibrationInput ReadCalibrationFor(const std::string& path, const Robot& datase
                              std::to_string(calibrated.NumParameters()) +
                              " parameters cannot calibrate the data set's " +
                              dataset_robot.model + " robot");
+  }
+  if (const std::string refusal = ChannelOrderRefusal(calibrated, dataset_robot);
+      !refusal.empty()) {
+    throw io::InputError(io::InputErrorKind::kBadValue, path, 0, refusal);
   }
   std::optional<io::CalibrationProvenance> provenance = io::ReadCalibrationProvenance(path);
   if (mounted && !dataset_mounted) {

@@ -9,6 +9,7 @@
 #include "io/calibration_yaml.h"
 #include "io/command_failure.h"
 #include "io/dataset.h"
+#include "io/input_error.h"
 #include "io/ros2_parameter_yaml.h"
 #include "io/text_file.h"
 #include "io/yaml_scalar.h"
@@ -16,6 +17,7 @@
 #include "models/mounted_model.h"
 #include "odometry/effects.h"
 #include "odometry/text_format.h"
+#include "validation/calibration_match.h"
 #include "validation/everyday_driving.h"
 #include "validation/training_runs.h"
 
@@ -214,6 +216,10 @@ ExportReplay ReplayExport(const std::string& logs, const std::string& calibratio
   if (nominal->robot().model != exact->robot().model) {
     throw UsageError(logs + ": its robot is a " + nominal->robot().model +
                      ", the calibration a " + exact->robot().model);
+  }
+  if (const std::string refusal = ChannelOrderRefusal(exact->robot(), nominal->robot());
+      !refusal.empty()) {
+    throw io::InputError(io::InputErrorKind::kBadValue, calibration_path, 0, refusal);
   }
   ExportReplay r;
   std::vector<RunLog> held_out_logs;
