@@ -193,6 +193,16 @@ std::string UnexpectedArgumentHint(const CLI::ParseError& e) {
 // Usage errors exit 2 in one line, as the README says; CLI11's own codes (105 for a validation,
 // 106 for a missing option, ...) and its second "Run with --help" line would say otherwise.
 // Help and version requests keep CLI11's output and exit 0. Returns -1 when parsing succeeded.
+// The first of fit's flags given on the top level (`fitcal --train-reps 1-3 generalise`): bound
+// to fit's options, another subcommand never read it, and the command ran without it, exit 0.
+std::string TopLevelFitFlagGiven(const CLI::App& app) {
+  for (const CLI::Option* option : app.get_options()) {
+    const std::string name = option->get_name();
+    if (option->count() > 0 && name != "--help" && name != "--version") return name;
+  }
+  return "";
+}
+
 int ParseCommandLine(CLI::App& app, int argc, char** argv) {
   try {
     app.parse(argc, argv);
@@ -257,7 +267,18 @@ int RunCommandLine(int argc, char** argv) {
   AddCommonValidators(app);
   if (const int usage_rc = ParseCommandLine(app, argc, argv); usage_rc >= 0) return usage_rc;
   for (std::size_t i = 0; i < commands.size(); ++i) {
-    if (parsers[i]->parsed()) return commands[i].run();
+    if (!parsers[i]->parsed()) continue;
+    if (i > 0) {
+      if (const std::string flag = TopLevelFitFlagGiven(app); !flag.empty()) {
+        const std::string name =
+            (commands[i].group.empty() ? "" : commands[i].group + " ") + commands[i].name;
+        std::cerr << "fitcal: " << flag << " is given before '" << name
+                  << "': there it is fit's flag, which '" << name
+                  << "' does not read; write it after '" << name << "' (see fitcal --help)\n";
+        return 2;
+      }
+    }
+    return commands[i].run();
   }
   return commands.front().run();
 }

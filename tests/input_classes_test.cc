@@ -287,7 +287,13 @@ TEST(InputClassesCli, EachFlagIsNamedWithWhatIsWrong) {
            // 1e-300 weighed a metre as 1e300: the solve failed, its tables printed nan, and
            // UMBmark was written, exit 0.
            {"fit --logs . --position-sigma-m 1e-300", "must be at least 1e-09 m"},
-           {"compare --logs . --heading-sigma-deg 1e-300", "must be at least 1e-07 deg"}}) {
+           {"compare --logs . --heading-sigma-deg 1e-300", "must be at least 1e-07 deg"},
+           // fit's flags on the top level, before another subcommand, were read by nothing:
+           // generalise ran on its default split, exit 0.
+           {"--train-reps 1-3 generalise --logs .",
+            "--train-reps is given before 'generalise': there it is fit's flag"},
+           {"--residuals track export ros2-control --calibration /dev/null --controller y",
+            "write it after 'export ros2-control'"}}) {
     const auto r = RunFitcal(dir, args);
     EXPECT_EQ(r.exit_code, 2) << args << ": " << r.err;
     EXPECT_TRUE(Has(r.err, says)) << args << ": " << r.err;
