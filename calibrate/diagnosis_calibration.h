@@ -56,6 +56,9 @@ struct DiagnosisCalibration {
   // The declared final-pose fit did not converge and is no candidate; or empty.
   std::string left_out_line;
   bool uncertainty_propagated = false;  // the fit that made `choice` had none of its own
+  // What the sigmas hold beyond the fit's covariance, one line each (the angle channels'
+  // resolution, as fit's SelectedFit::sigma_notes).
+  std::vector<std::string> sigma_notes;
   io::CalibrationBlock record;          // when kDone
 };
 

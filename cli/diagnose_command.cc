@@ -76,6 +76,7 @@ void PrintDecision(const DiagnosisCalibration& c, std::size_t num_held_out) {
     std::printf("uncertainty of '%s': propagated through the training runs' final poses\n",
                 c.choice.name.c_str());
   }
+  for (const std::string& line : c.sigma_notes) std::printf("resolution: %s\n", line.c_str());
 }
 
 // The library's request from the flags.

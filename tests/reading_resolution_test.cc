@@ -216,6 +216,18 @@ TEST(ReadingResolutionUncertainty, ACoarseSteeringEncoderWidensTheOffsetsSigmaBy
   const double truth = ReadRobotModelFile(data + "/true_robot.yaml")->robot().nominal[2];
   const double fitted = ReadRobotModelFile(cal)->robot().nominal[2];
   EXPECT_LT(std::abs(fitted - truth) * 180.0 / M_PI, 3.0 * written_deg);
+
+  // diagnose's calibration holds the count too (it wrote the fit's own 0.012 deg, 9x below fit's
+  // 0.13 on the OptiOdom tricycle): the same line, and the variance grown by count^2 / 12 to 1 %.
+  const testing::FitcalRun d =
+      RunFitcal(dir, "diagnose --logs " + data + " --train-reps 1-2 --out " + dir.Path("d"));
+  ASSERT_EQ(d.exit_code, 0) << d.err << d.out;
+  ASSERT_TRUE(OffsetSigmas(d.out, &before_deg, &after_deg)) << d.out;
+  EXPECT_NEAR(after_deg * after_deg - before_deg * before_deg, count_sigma_deg * count_sigma_deg,
+              0.02 * count_sigma_deg * count_sigma_deg);
+  const double diagnosed_deg = YAML::LoadFile(dir.Path("d/calibrated.yaml"))["calibration"]
+                                   ["sigma"]["steering_offset_deg"].as<double>();
+  EXPECT_NEAR(diagnosed_deg, after_deg, 0.005 * after_deg);
 }
 
 // The simulator's default steering noise, 0.1 deg before the same count (0.28 of a step), dithers
