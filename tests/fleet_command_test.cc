@@ -163,6 +163,18 @@ TEST(Fleet, PrintsUnitsAndSigmasAndNotesCfsJudgedOnDifferentRuns) {
   }
   EXPECT_EQ(tools::FleetTable(ReadFleet({same.Path("fleet")})).find("note:"),
             std::string::npos);
+
+  // A report a week later of the 2026-05-01 calibration on its own data set found its training
+  // runs by id: the same held-out runs (it said "2 different sets": "/data/one (report)").
+  const std::string key = std::string("calibrated_") + robot.parameters[0].DisplayUnit();
+  same.Write("fleet/2026-05-15/rep/metrics.json",
+             "{\"version\": 3, \"robot\": \"" + robot.name + "\", \"dataset\": \"/data/one\", "
+             "\"training_source\": \"20 runs of this data set, recorded by id (repetitions 1)\", "
+             "\"training_repetitions\": \"1\", \"parameters\": [{\"name\": \"" +
+                 robot.parameters[0].name + "\", \"" + key + "\": 0.5}], \"summary\": "
+             "[{\"group\": \"all validation runs\", \"after\": {\"cf\": 0.01}}]}");
+  EXPECT_EQ(tools::FleetTable(ReadFleet({same.Path("fleet")})).find("note:"),
+            std::string::npos);
 }
 
 // A version-3 report's angle: value and sigma in rad under "value"/"sigma", degrees under the

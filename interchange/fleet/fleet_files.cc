@@ -10,6 +10,7 @@
 #include <regex>
 #include <set>
 
+#include "fit/run_split.h"
 #include "io/calibration_yaml.h"
 #include "io/command_failure.h"
 #include "io/input_error.h"
@@ -28,14 +29,36 @@ constexpr const char* kCfRow = kFleetCfRow;
 constexpr const char* kCfUnit = "Eq. 14";
 
 // The data set and the training split a calibration's provenance records; "" without one.
-std::string JudgedOn(const std::optional<io::CalibrationProvenance>& p) {
-  if (!p) return "";
+std::string JudgedOn(const std::string& dataset, const std::vector<int>& training_repetitions,
+                     const std::string& training_trajectories) {
   std::string reps;
-  for (int r : p->training_repetitions) reps += (reps.empty() ? "" : ",") + std::to_string(r);
-  return p->dataset + " (training " +
-         (p->training_trajectories.empty() ? "repetitions " + reps
-                                           : "trajectories " + p->training_trajectories) +
+  for (int r : training_repetitions) reps += (reps.empty() ? "" : ",") + std::to_string(r);
+  return dataset + " (training " +
+         (training_trajectories.empty() ? "repetitions " + reps
+                                        : "trajectories " + training_trajectories) +
          ")";
+}
+
+std::string JudgedOn(const std::optional<io::CalibrationProvenance>& p) {
+  return p ? JudgedOn(p->dataset, p->training_repetitions, p->training_trajectories) : "";
+}
+
+// A report that found the calibration's training runs in its data set by id (training_source "...
+// recorded by id (repetitions 1-5)") judged the runs the calibration's record names as held out:
+// said as the calibration says it, so that the two are one set of runs, not "2 different sets".
+std::string JudgedOnOfReport(const YAML::Node& root, const std::string& path) {
+  const std::string dataset = root["dataset"] && root["dataset"].IsScalar()
+                                  ? root["dataset"].Scalar() : path;
+  const YAML::Node source = root["training_source"], reps = root["training_repetitions"];
+  if (source && source.IsScalar() && source.Scalar().find("recorded by id") != std::string::npos &&
+      reps && reps.IsScalar()) {
+    try {
+      return JudgedOn(dataset, ParseRepetitionList(reps.Scalar()), "");
+    } catch (const std::exception&) {
+      // not a list fitcal wrote: the report's own words below
+    }
+  }
+  return dataset + " (report)";
 }
 
 std::string DateOf(const std::string& path) {
@@ -129,10 +152,7 @@ Calibration ReadMetricsJson(const std::string& path) {
       c.values.push_back(
           {kCfRow, kCfUnit, io::YamlDouble(g["after"]["cf"], path, "summary.after.cf"), 1.0,
            std::numeric_limits<double>::quiet_NaN()});
-      // A report judges on the runs of the data set it was given.
-      c.judged_on = root["dataset"] && root["dataset"].IsScalar()
-                        ? root["dataset"].Scalar() + " (report)"
-                        : path;
+      c.judged_on = JudgedOnOfReport(root, path);
     }
   }
   if (c.values.empty()) {
