@@ -154,6 +154,25 @@ TEST(VerdictTest, NoiseFloorNotMeasuredIsSkippedNotPassed) {
   EXPECT_EQ(v.reasons.back().check, "noise_floor");  // after every check that ran
 }
 
+// Held-out runs too short for any drift window left an empty table and "drift": [] without a
+// word; the verdict says so as a SKIP with the longest run's path, and only then.
+TEST(VerdictTest, DriftNotMeasuredIsSkippedWithTheLongestPath) {
+  VerdictInputs in = GoodCase();
+  EXPECT_EQ(Find(JudgeCalibration(in), "drift"), nullptr);
+  in.drift_measured = false;
+  in.longest_path_m = 0.31;
+  const Verdict v = JudgeCalibration(in);
+  const VerdictReason* r = Find(v, "drift");
+  ASSERT_NE(r, nullptr);
+  EXPECT_EQ(r->level, VerdictLevel::kSkip);
+  EXPECT_EQ(r->section, "drift");
+  EXPECT_NE(r->message.find("not measured: the held-out runs are too short for its windows (the "
+                            "longest travels 0.31 m of ground-truth path)"),
+            std::string::npos)
+      << r->message;
+  EXPECT_EQ(v.level, VerdictLevel::kPass);
+}
+
 TEST(VerdictTest, ConvergenceGapAndIdentifiability) {
   VerdictInputs in = GoodCase();
   in.termination = "NO_CONVERGENCE";

@@ -486,6 +486,10 @@ void AddVerdict(const CalibrationInput& cal, io::ReportData* data) {
                        v.noise_floor.p_value};
   v.identifiability_checked = data->identifiability_checked;
   v.identifiable = data->identifiable;
+  v.drift_measured = !data->drift.empty();
+  for (const io::ReportRun& r : data->runs) {
+    v.longest_path_m = std::max(v.longest_path_m, r.path_length_m);
+  }
   const Verdict verdict = JudgeCalibration(v);
   data->verdict = ToString(verdict.level);
   for (const VerdictReason& r : verdict.reasons) {

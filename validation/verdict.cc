@@ -199,6 +199,13 @@ Verdict JudgeCalibration(const VerdictInputs& in) {
                             : Reason(VerdictLevel::kPass, "generalisation", "summary", numbers));
   }
   v.reasons.push_back(NoiseFloorReason(in.noise_floor));
+  if (!in.drift_measured) {
+    v.reasons.push_back(Reason(VerdictLevel::kSkip, "drift", "drift",
+                               StrFormat("not measured: the held-out runs are too short for its "
+                                         "windows (the longest travels %.2f m of ground-truth "
+                                         "path)",
+                                         in.longest_path_m)));
+  }
   if (in.identifiability_checked) {
     v.reasons.push_back(
         in.identifiable ? Reason(VerdictLevel::kPass, "identifiability", "identifiability",

@@ -71,6 +71,10 @@ struct VerdictInputs {
   NoiseFloorTest noise_floor;
   bool identifiability_checked = false;  // training runs in this data set
   bool identifiable = true;
+  // No drift window fits in any held-out run (an empty table said nothing): the longest run's
+  // ground-truth path, said in the SKIP.
+  bool drift_measured = true;
+  double longest_path_m = 0.0;
 };
 
 struct VerdictReason {
