@@ -91,6 +91,7 @@ void PrintReport(const ReportCommandOptions& options, const io::ReportData& data
     std::printf("cross-validation: %zu folds, validation CF %.4f +- %.4f (min %.4f, max %.4f)\n",
                 data.folds.size(), data.cv_cf_after.mean, data.cv_cf_after.std,
                 data.cv_cf_after.min, data.cv_cf_after.max);
+    std::printf("  %s\n", data.cv_objective.c_str());
   }
   for (const io::ReportComparisonRow& c : data.comparison) {
     std::printf("  compared: %-40s %s  held-out CF %.4f -> %.4f\n", c.calibration.c_str(),

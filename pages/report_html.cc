@@ -432,7 +432,8 @@ void HtmlIdentifiability(std::ostringstream& h, const ReportData& d) {
 void HtmlCrossValidation(std::ostringstream& h, const ReportData& d) {
   if (!d.has_cv) return;
   h << "<h2>Leave-one-repetition-out cross-validation</h2>\n<p>Each fold fits on all "
-       "repetitions but one and validates on the one left out. Validation CF (calibrated): mean "
+       "repetitions but one and validates on the one left out; "
+    << EscapeXml(d.cv_objective) << ". Validation CF (calibrated): mean "
     << Fmt("%.4f", d.cv_cf_after.mean) << ", std " << Fmt("%.4f", d.cv_cf_after.std) << ", min "
     << Fmt("%.4f", d.cv_cf_after.min) << ", max " << Fmt("%.4f", d.cv_cf_after.max)
     << " (nominal: mean " << Fmt("%.4f", d.cv_cf_before.mean)

@@ -169,7 +169,8 @@ void JsonIdentifiability(std::ostringstream& j, const ReportData& d) {
 
 void JsonCrossValidation(std::ostringstream& j, const ReportData& d) {
   if (d.has_cv) {
-    j << ",\n  \"cross_validation\": {\"cf_validation_after\": " << JsonStats(d.cv_cf_after, 1.0)
+    j << ",\n  \"cross_validation\": {\"objective\": " << JsonString(d.cv_objective)
+      << ", \"cf_validation_after\": " << JsonStats(d.cv_cf_after, 1.0)
       << ", \"cf_validation_before\": " << JsonStats(d.cv_cf_before, 1.0) << ", \"folds\": ["
       << Joined(d.folds, ", ", [](const ReportFold& f) {
            return "{\"held_out_repetition\": " + std::to_string(f.held_out_repetition) +

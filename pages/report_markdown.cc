@@ -233,7 +233,7 @@ std::string ReportMarkdown(const ReportData& d) {
       << d.folds.size() << " folds: mean " << Fmt("%.4f", d.cv_cf_after.mean) << ", std "
       << Fmt("%.4f", d.cv_cf_after.std) << ", min " << Fmt("%.4f", d.cv_cf_after.min) << ", max "
       << Fmt("%.4f", d.cv_cf_after.max) << "; nominal mean " << Fmt("%.4f", d.cv_cf_before.mean)
-      << ".\n";
+      << ". Fits: " << d.cv_objective << ".\n";
   }
   return m.str();
 }

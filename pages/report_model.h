@@ -217,6 +217,7 @@ struct ReportData {
   double condition_number = 0.0;
   std::vector<std::string> identifiability_lines;
   bool has_cv = false;
+  std::string cv_objective;  // what each fold minimises, in words (the calibration's may differ)
   std::vector<ReportFold> folds;
   ReportStatistics cv_cf_after, cv_cf_before;
   std::vector<ReportWorldTrack> world_tracks;  // one per validation run, in the order of runs

@@ -341,6 +341,14 @@ TEST(FitcalCli, ReportCrossValidatesAnyModel) {
   }
   ASSERT_EQ(j["parameters"].size(), 3u);
   EXPECT_GT(j["parameters"][2]["cv_std_m"].as<double>(), 0.0);
+  // The folds are final-pose fits whatever made the calibration (fit's default here: the track
+  // fit), said where the spread is shown: a track-fitted wheelbase 13 CV std from the folds read
+  // as an outlier of its own cross-validation.
+  const std::string says = "each fold is a bounded Ceres fit of the final poses";
+  EXPECT_NE(j["cross_validation"]["objective"].as<std::string>().find(says), std::string::npos);
+  EXPECT_NE(r.out.find(says), std::string::npos) << r.out;
+  EXPECT_NE(ReadFileBytes(out + "/summary.md").find(says), std::string::npos);
+  EXPECT_NE(ReadFileBytes(out + "/index.html").find(says), std::string::npos);
 }
 
 // `diagnose` records the uncertainty of the fit it wrote (the model actually used, with its
