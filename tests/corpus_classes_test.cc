@@ -375,15 +375,17 @@ TEST(CorpusClasses, FleetRefusesUnknownVersionsAndOneNameForTwoModels) {
     text.replace(text.find("VERSION"), 7, version);
     return dir.Write("fleet/r1/2026-05-08/report/metrics.json", text);
   };
-  metrics("2");
-  const FitcalRun known = RunFitcal(dir, "fleet " + dir.Path("fleet"));
-  EXPECT_EQ(known.exit_code, 0) << known.err;
-  const std::string unknown = metrics("3");
+  for (const char* version : {"2", "3"}) {  // 3 moved the generic sigma to SI; both read
+    metrics(version);
+    const FitcalRun known = RunFitcal(dir, "fleet " + dir.Path("fleet"));
+    EXPECT_EQ(known.exit_code, 0) << version << ": " << known.err;
+  }
+  const std::string unknown = metrics("4");
   const FitcalRun refused = RunFitcal(dir, "fleet " + dir.Path("fleet"));
   EXPECT_EQ(refused.exit_code, 1) << refused.out << refused.err;
   EXPECT_EQ(Lines(refused.err), 1) << refused.err;
   EXPECT_TRUE(Has(refused.err, unknown + ":1:")) << refused.err;
-  EXPECT_TRUE(Has(refused.err, "version 3")) << refused.err;
+  EXPECT_TRUE(Has(refused.err, "version 4")) << refused.err;
   fs::remove(unknown);
 
   std::string omni3 = ReadFileBytes(std::string(FITCAL_SOURCE_DIR) + "/data/robots/apr02.yaml");
