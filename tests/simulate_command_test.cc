@@ -141,8 +141,8 @@ TEST(SimulateCommand, RefusesWhatTheModelSimulatorDoesNotTake) {
         // A negative sigma (exit 1 before), and noise whose samples the loader refuses: a
         // ground truth 1e300 m away was written, and `fit` then refused the data set.
         std::string("--model tricycle --gt-position-sigma-m -1"),
-        std::string("--model tricycle --gt-position-sigma-m 1e300"),
-        std::string("--model diff_drive --wheel-rate-sigma-rad-s 1e300")}) {
+        std::string("--model tricycle --repetitions 1 --gt-position-sigma-m 1e300"),
+        std::string("--model diff_drive --repetitions 1 --wheel-rate-sigma-rad-s 1e300")}) {
     SCOPED_TRACE(args);
     const Result r = RunFitcal(dir, "simulate " + args + " --out " + data);
     EXPECT_EQ(r.exit_code, 2) << r.err;
