@@ -125,6 +125,7 @@ inline CLI::Validator SignValidator(bool zero_allowed) {
       zero_allowed ? "NONNEGATIVE" : "POSITIVE", zero_allowed ? "non-negative" : "positive");
 }
 inline CLI::Validator PositiveNumber() { return SignValidator(false); }
+inline CLI::Validator NonNegativeNumber() { return SignValidator(true); }
 
 // A residual's sigma no finer than `floor` (1e-9 m, a nanometre): 1e-300 weighed a metre as 1e300,
 // the squared cost overflowed, the solve failed and its tables printed nan.
@@ -141,7 +142,6 @@ inline CLI::Validator SigmaAtLeast(double floor, const std::string& unit) {
       },
       "SIGMA", "sigma");
 }
-inline CLI::Validator NonNegativeNumber() { return SignValidator(true); }
 
 // Adds the validators above to every --threads and --out option and every floating-point option
 // (CLI11 names their type FLOAT) of `app` and its subcommands, so that every command refuses

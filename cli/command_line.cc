@@ -190,9 +190,6 @@ std::string UnexpectedArgumentHint(const CLI::ParseError& e) {
   return "";
 }
 
-// Usage errors exit 2 in one line, as the README says; CLI11's own codes (105 for a validation,
-// 106 for a missing option, ...) and its second "Run with --help" line would say otherwise.
-// Help and version requests keep CLI11's output and exit 0. Returns -1 when parsing succeeded.
 // The first of fit's flags given on the top level (`fitcal --train-reps 1-3 generalise`): bound
 // to fit's options, another subcommand never read it, and the command ran without it, exit 0.
 std::string TopLevelFitFlagGiven(const CLI::App& app) {
@@ -203,6 +200,9 @@ std::string TopLevelFitFlagGiven(const CLI::App& app) {
   return "";
 }
 
+// Usage errors exit 2 in one line, as the README says; CLI11's own codes (105 for a validation,
+// 106 for a missing option, ...) and its second "Run with --help" line would say otherwise.
+// Help and version requests keep CLI11's output and exit 0. Returns -1 when parsing succeeded.
 int ParseCommandLine(CLI::App& app, int argc, char** argv) {
   try {
     app.parse(argc, argv);

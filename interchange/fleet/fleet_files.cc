@@ -28,7 +28,7 @@ using Calibration = FleetCalibration;
 constexpr const char* kCfRow = kFleetCfRow;
 constexpr const char* kCfUnit = "Eq. 14";
 
-// The data set and the training split a calibration's provenance records; "" without one.
+// The data set and the training split that chose a calibration's held-out runs, in words.
 std::string JudgedOn(const std::string& dataset, const std::vector<int>& training_repetitions,
                      const std::string& training_trajectories) {
   std::string reps;
@@ -39,6 +39,7 @@ std::string JudgedOn(const std::string& dataset, const std::vector<int>& trainin
          ")";
 }
 
+// As a calibration's provenance records them; "" without one.
 std::string JudgedOn(const std::optional<io::CalibrationProvenance>& p) {
   return p ? JudgedOn(p->dataset, p->training_repetitions, p->training_trajectories) : "";
 }
