@@ -11,6 +11,7 @@
 #include "fitcal/version.h"
 #include "models/mounted_model.h"
 #include "odometry/text_format.h"
+#include "pages/report_text.h"
 #include "validation/trajectory_family.h"
 
 namespace fitcal::tools {
@@ -41,15 +42,14 @@ void PrintParameters(const Robot& robot, const std::vector<double>& p, const Sel
     const double s = info.DisplayScale();
     const std::string sigma =
         fit.has_covariance && !fit.held[k] ? StrFormat("%.2g", fit.sigma[k] * s) : "-";
-    // Angles change by degrees, sizes by percent (a percentage of an angle means nothing), a
-    // frame's position by metres (a percentage of where it sits depends on the origin: a mount
-    // guessed at x 0.05 m and found at 0.35 m is +0.3 m, not +600 %).
     const double change = p[k] - robot.nominal[k];
+    using io::report_text::ChangeTerms;
+    const ChangeTerms terms = io::report_text::ChangeTermsOf(
+        info.unit == ParameterUnit::kAngle, IsMountPosition(robot, k), robot.nominal[k]);
     const std::string change_text =
-        info.unit == ParameterUnit::kAngle ? StrFormat("%+.3f deg", change * s)
-        : robot.nominal[k] == 0.0 || IsMountPosition(robot, k)
-            ? StrFormat("%+.4g m", change)
-            : StrFormat("%+.2f%%", 100.0 * change / robot.nominal[k]);
+        terms == ChangeTerms::kDegrees  ? StrFormat("%+.3f deg", change * s)
+        : terms == ChangeTerms::kMetres ? StrFormat("%+.4g m", change)
+                                        : StrFormat("%+.2f%%", 100.0 * change / robot.nominal[k]);
     const bool not_determined =
         k < static_cast<int>(fit.not_determined.size()) && fit.not_determined[k];
     std::printf("  %-22s %12.6f %12.6f %12s %12s%s%s%s\n", robot.LabelOf(k).c_str(),

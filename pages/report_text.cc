@@ -42,10 +42,22 @@ const char* FormatOf(const Column& c) { return c.is_angle ? "%.3f" : "%.4f"; }
 
 double ParamScale(const ReportParameter& p) { return p.is_angle ? kDeg : 1.0; }
 
+ChangeTerms ChangeTermsOf(bool is_angle, bool is_position, double nominal) {
+  if (is_angle) return ChangeTerms::kDegrees;
+  return is_position || nominal == 0.0 ? ChangeTerms::kMetres : ChangeTerms::kPercent;
+}
+
 std::string ParameterChangeText(const ReportParameter& p) {
-  if (p.is_angle) return Fmt("%+.3f deg", (p.calibrated - p.nominal) * kDeg);
-  if (p.is_position || p.nominal == 0.0) return Fmt("%+.4g m", p.calibrated - p.nominal);
-  return Fmt("%+.2f %%", 100.0 * (p.calibrated - p.nominal) / p.nominal);
+  const double change = p.calibrated - p.nominal;
+  switch (ChangeTermsOf(p.is_angle, p.is_position, p.nominal)) {
+    case ChangeTerms::kDegrees:
+      return Fmt("%+.3f deg", change * kDeg);
+    case ChangeTerms::kMetres:
+      return Fmt("%+.4g m", change);
+    case ChangeTerms::kPercent:
+      break;
+  }
+  return Fmt("%+.2f %%", 100.0 * change / p.nominal);
 }
 
 std::vector<std::size_t> WorstRuns(const ReportData& data, std::size_t most) {

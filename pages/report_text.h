@@ -50,8 +50,14 @@ std::string KeyOf(const Column& c);
 double ValueOf(const Column& c, const ReportMetrics& m);
 const char* FormatOf(const Column& c);
 
-// A parameter's display scale (deg for angles) and its change: lengths by percent, angles by
-// degrees (a percentage of an angle means nothing).
+// How a parameter's change from its nominal is said, in fit's printout and on the pages alike:
+// angles by degrees (a percentage of an angle means nothing), a frame's position and a zero
+// nominal by metres (a percentage of where a mount sits depends on the origin: guessed at x 0.05 m
+// and found at 0.35 m is +0.3 m, not +600 %), sizes by percent.
+enum class ChangeTerms { kDegrees, kMetres, kPercent };
+ChangeTerms ChangeTermsOf(bool is_angle, bool is_position, double nominal);
+
+// A parameter's display scale (deg for angles) and its change in those terms.
 double ParamScale(const ReportParameter& p);
 std::string ParameterChangeText(const ReportParameter& p);
 
