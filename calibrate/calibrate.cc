@@ -285,10 +285,11 @@ void Conclude(const CalibrationRequest& r, const RobotModelInterface& model,
     }
   }
   if (fit.stopped_early && selected_is_fit) {
+    const bool ceres = IsCeresMethod(r.method->name);
     out->stopped_early = "warning: the written calibration is the solver's last point (" +
-                         fit.termination +
-                         " at the iteration limit): it beats the nominal, but check it or raise "
-                         "--max-iterations";
+                         fit.termination + (ceres ? " at the iteration" : " at the evaluation") +
+                         " limit): it beats the nominal, but check it or raise " +
+                         (ceres ? "--max-iterations" : "--max-evaluations");
   }
 }
 

@@ -122,6 +122,11 @@ ModelFitMethodOutcome RunModelNlopt(NloptMethod method, const std::vector<Aligne
   ModelFitMethodOutcome out;
   ModelFitResult& fit = out.fit;
   fit.usable = r.usable;
+  // A local method out of its evaluation budget stopped short of converging, as Ceres at its
+  // iteration limit: flagged when written (exit 6; SBPLX on the example differential drive spent
+  // its 20000 and wrote, exit 0). A global method always ends on its budget: its way to stop.
+  fit.stopped_early = r.usable && !Info(method).global &&
+                      r.termination.find("MAXEVAL_REACHED") != std::string::npos;
   fit.termination = r.termination;
   fit.message = r.message;
   fit.iterations = r.evaluations;

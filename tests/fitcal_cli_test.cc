@@ -88,6 +88,19 @@ TEST(FitcalCli, FitStoppedAtTheIterationLimitIsWrittenAndFlagged) {
   const Result d = RunFitcal(dir, "fit --logs " + diff + " --max-iterations 1 --out " + diff_out);
   EXPECT_EQ(d.exit_code, 6) << d.out << d.err;
   EXPECT_NE(ReadFileBytes(diff_out).find("NO_CONVERGENCE"), std::string::npos);
+
+  // A local NLopt method out of its evaluation budget is flagged alike (it wrote, exit 0); a
+  // global one always ends on its budget and is not.
+  const Result bobyqa = RunFitcal(dir, "fit --logs " + diff + " --method bobyqa "
+                                       "--max-evaluations 20 --out " + dir.Path("bobyqa.yaml"));
+  EXPECT_EQ(bobyqa.exit_code, 6) << bobyqa.out << bobyqa.err;
+  EXPECT_EQ(Lines(bobyqa.err), 1) << bobyqa.err;
+  EXPECT_NE(bobyqa.err.find("MAXEVAL_REACHED at the evaluation limit"), std::string::npos)
+      << bobyqa.err;
+  EXPECT_NE(bobyqa.err.find("raise --max-evaluations"), std::string::npos) << bobyqa.err;
+  const Result crs2lm = RunFitcal(dir, "fit --logs " + diff + " --method crs2lm --max-evaluations "
+                                       "200 --no-output");
+  EXPECT_EQ(crs2lm.exit_code, 0) << crs2lm.out << crs2lm.err;
 }
 
 // The real OptiOdom three-wheel robot (skipped without ../shared): every split a user would try
