@@ -36,6 +36,9 @@ bool Refuse(CalibrationOutcome* out, int exit_code, std::vector<std::string> rea
 bool PrepareData(const CalibrationRequest& r, const RobotModelInterface& model,
                  CalibrationOutcome* out, std::optional<std::vector<TrackRun>>* training_tracks) {
   out->split = SplitOfRequest(r);
+  if (const std::string absent = AbsentRepetitionRefusal(r); !absent.empty()) {
+    return Refuse(out, 2, {absent});
+  }
   if (out->split.training.empty()) {
     return Refuse(out, 2, {"no run of " + r.dataset + " is a training run (" +
                            TrainingSelection(r) + ")"});

@@ -46,4 +46,8 @@ std::string TrainingSelection(const CalibrationRequest& request);
 // The request's runs split into training and validation (training_ids, else SplitForFit).
 RunSplit SplitOfRequest(const CalibrationRequest& request);
 
+// Why a repetition --train-reps names on its own (not in a range: "1-99" spans what there is) is
+// no run's, or "": "1,11" on repetitions 1-10 trained on 1 alone without a word.
+std::string AbsentRepetitionRefusal(const CalibrationRequest& request);
+
 }  // namespace fitcal

@@ -600,6 +600,17 @@ TEST(FitcalCli, UsageErrors) {
   for (const char* flag : {"--logs", "--method", "--train-reps", "--out"}) {
     EXPECT_NE(help.out.find(flag), std::string::npos) << flag;
   }
+  // A repetition named on its own that no run has is a usage error ("1,11" on repetitions 1-10
+  // trained on 1 alone, exit 0); a range spans what there is.
+  const std::string flower = std::string(FITCAL_SOURCE_DIR) + "/data/flower";
+  const Result absent = RunFitcal(dir, "fit --logs " + flower + " --train-reps 1,11 --no-output");
+  EXPECT_EQ(absent.exit_code, 2) << absent.err;
+  EXPECT_EQ(Lines(absent.err), 1) << absent.err;
+  EXPECT_NE(absent.err.find("--train-reps names repetition 11, which no run of " + flower +
+                            " has (repetitions 1-10)"),
+            std::string::npos)
+      << absent.err;
+  EXPECT_EQ(RunFitcal(dir, "fit --logs " + flower + " --train-reps 1-99 --no-output").exit_code, 0);
 }
 
 }  // namespace
