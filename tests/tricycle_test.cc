@@ -237,6 +237,18 @@ TEST(TricycleYaml, MalformedRobotsGiveOneLine) {
       EXPECT_NE(message.find("bad.yaml"), std::string::npos) << what << ": " << message;
     }
   }
+  // A negative wheelbase, a steered wheel behind the axle, says how that robot fits this model.
+  try {
+    ReadTricycleModel(YAML::Load(replace("wheelbase_m: 0.15\n", "wheelbase_m: -0.15\n")),
+                      "bad.yaml");
+    ADD_FAILURE() << "a negative wheelbase accepted";
+  } catch (const io::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("must be positive (the steered wheel ahead of the fixed "
+                                         "axle; one behind it is this model with the steering "
+                                         "angle's sign flipped in the logs)"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 // ---------------------------------------------------------------------------------------------

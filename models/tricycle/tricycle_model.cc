@@ -27,11 +27,20 @@ constexpr const char* kGainKey = "steering_gain";
 constexpr double kDefaultGainFactor = 10.0;
 
 void RequirePositive(double v, const YAML::Node& node, const std::string& path,
-                     const std::string& what) {
+                     const std::string& what, const std::string& hint = "") {
   if (!(v > 0.0)) {
-    throw InputError(InputErrorKind::kBadValue, path, LineOf(node), what + " must be positive");
+    throw InputError(InputErrorKind::kBadValue, path, LineOf(node),
+                     what + " must be positive" + hint);
   }
 }
+
+// A steered wheel behind the fixed axle (a forklift's) turns the body the other way for the same
+// reading (w = -v sin(delta) / L about the fixed axle): this model with the steering reading
+// negated. Said where a negative wheelbase or gain is refused; "must be positive" alone left a
+// user no way on.
+constexpr const char* kRearSteeredHint =
+    " (the steered wheel ahead of the fixed axle; one behind it is this model with the steering "
+    "angle's sign flipped in the logs)";
 
 // `bounds:` - absolute boxes, lengths positive, the offset within +-90 deg.
 // With a steering gain (`gain`), its box too: bounds.steering_gain, or by default a factor of
@@ -107,12 +116,13 @@ RobotModelPtr ReadTricycleModel(const YAML::Node& root, const std::string& path)
   RequirePositive(p[K::kRadiusIndex], wheel.Required("radius_m"), path, "traction_wheel.radius_m");
   wheel.RejectUnread();
   p[K::kWheelbaseIndex] = robot_map.Double("wheelbase_m");
-  RequirePositive(p[K::kWheelbaseIndex], robot_map.Required("wheelbase_m"), path, "wheelbase_m");
+  RequirePositive(p[K::kWheelbaseIndex], robot_map.Required("wheelbase_m"), path, "wheelbase_m",
+                  kRearSteeredHint);
   p[K::kSteeringOffsetIndex] = DegToRad(robot_map.Double("steering_offset_deg"));
   std::optional<double> gain;
   if (robot_map.Has(kGainKey)) {
     gain = robot_map.Double(kGainKey);
-    RequirePositive(*gain, robot_map.Required(kGainKey), path, kGainKey);
+    RequirePositive(*gain, robot_map.Required(kGainKey), path, kGainKey, kRearSteeredHint);
     p.push_back(*gain);
   }
 
