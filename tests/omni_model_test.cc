@@ -306,6 +306,35 @@ bounds: {distance_m: [0.1, 0.3], radius_m: [0.04, 0.06], angle_offset_deg: [-2, 
   EXPECT_THROW(Read(FourWheels("roller_angle_deg: 90", "roller_angle_deg: 0")), io::InputError);
 }
 
+// A wheel's own problem is refused at its line (line 4, the `wheels:` list's, named the third
+// wheel's duplicate name and the fourth's zero radius).
+TEST(OmniModel, AWheelsProblemIsRefusedAtItsLine) {
+  const std::string head = "model: omni\nname: bad\nwheels:\n";
+  const auto wheel = [](const char* name, int angle, const char* radius) {
+    char line[128];
+    std::snprintf(line, sizeof line,
+                  "  - {name: %s, distance_m: 0.2, angle_deg: %d, radius_m: %s}\n", name, angle,
+                  radius);
+    return std::string(line);
+  };
+  const std::string bounds =
+      "bounds: {distance_m: [0.1, 0.3], radius_m: [0.04, 0.06], angle_offset_deg: [-2, 2]}\n";
+  for (const auto& [yaml, says] : std::vector<std::pair<std::string, std::string>>{
+           {head + wheel("a", 0, "0.05") + wheel("b", 120, "0.05") + wheel("a", 240, "0.05") +
+                bounds,
+            "bad.yaml:6: wheel name 'a' is used twice"},
+           {head + wheel("a", 0, "0.05") + wheel("b", 90, "0.05") + wheel("c", 180, "0.05") +
+                wheel("d", 270, "0") + bounds,
+            "bad.yaml:7: wheel d: distance_m and radius_m must be positive"}}) {
+    try {
+      ReadOmniModel(YAML::Load(yaml), "bad.yaml");
+      ADD_FAILURE() << says << ": accepted";
+    } catch (const io::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+    }
+  }
+}
+
 // Symmetric mecanum: J's columns are (1,1,1,1), (-1,1,1,-1) and 0.35 (-1,1,-1,1) / r, so the
 // wheel-disagreement direction is n = (1, 1, -1, -1) and the 3 x 4 = 12 parameters hold 9
 // determinable combinations. The yaw entries are x tan(gamma) - y = -/+0.35 = R_i s_i with

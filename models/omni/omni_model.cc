@@ -92,24 +92,29 @@ using io::InputError;
 using io::InputErrorKind;
 using io::LineOf;
 
+// What is wrong with wheels[i] among those before it, or "".
+std::string WheelProblem(const std::vector<OmniWheel>& wheels, std::size_t i) {
+  const OmniWheel& w = wheels[i];
+  for (std::size_t k = 0; k < i; ++k) {
+    if (wheels[k].name == w.name) return "wheel name '" + w.name + "' is used twice";
+  }
+  if (!(w.distance_m > 0.0) || !(w.radius_m > 0.0)) {
+    return "wheel " + w.name + ": distance_m and radius_m must be positive";
+  }
+  if (!(std::abs(w.roller_angle_rad) < DegToRad(89.0))) {
+    return "wheel " + w.name + ": roller_angle_deg must lie inside (-89, 89) deg";
+  }
+  return "";
+}
+
 void CheckWheels(const std::vector<OmniWheel>& wheels) {
   if (wheels.size() < kOmniMinWheels || wheels.size() > kOmniMaxWheels) {
     throw std::invalid_argument("an omni robot has 3 to 8 wheels, found " +
                                 std::to_string(wheels.size()));
   }
   for (std::size_t i = 0; i < wheels.size(); ++i) {
-    const OmniWheel& w = wheels[i];
-    for (std::size_t k = 0; k < i; ++k) {
-      if (wheels[k].name == w.name) {
-        throw std::invalid_argument("wheel name '" + w.name + "' is used twice");
-      }
-    }
-    if (!(w.distance_m > 0.0) || !(w.radius_m > 0.0)) {
-      throw std::invalid_argument("wheel " + w.name + ": distance_m and radius_m must be positive");
-    }
-    if (!(std::abs(w.roller_angle_rad) < DegToRad(89.0))) {
-      throw std::invalid_argument("wheel " + w.name +
-                                  ": roller_angle_deg must lie inside (-89, 89) deg");
+    if (const std::string problem = WheelProblem(wheels, i); !problem.empty()) {
+      throw std::invalid_argument(problem);
     }
   }
 }
@@ -202,6 +207,10 @@ RobotModelPtr ReadOmniModel(const YAML::Node& root, const std::string& path) {
   std::vector<OmniWheel> wheels;
   for (std::size_t i = 0; i < wheel_list.size(); ++i) {
     wheels.push_back(ReadWheel(wheel_list[i], path, static_cast<int>(i)));
+    // At the wheel's own line (the list's line named another wheel's problem).
+    if (const std::string problem = WheelProblem(wheels, i); !problem.empty()) {
+      throw InputError(InputErrorKind::kBadValue, path, LineOf(wheel_list[i]), problem);
+    }
   }
   const OmniBounds box = ReadOmniBounds(robot_map, path);
   const std::optional<EncoderTicks> encoder =
