@@ -93,12 +93,6 @@ std::string SolverFlagThatDoesNotApply(const SolverOptions& o, const SolverOptio
   if (!loss && o.loss_scale != defaults.loss_scale) {
     return "--loss-scale without --loss (huber or cauchy) has no loss to scale";
   }
-  // Under the default auto a sigma given fixes the weights, as documented; asked for by name,
-  // estimated weights were replaced by the sigma in silence.
-  if (o.weight_mode == "estimated" && o.sigmas_given) {
-    return "--weights estimated estimates the noise levels that --position-sigma-m and "
-           "--heading-sigma-deg fix: give one or the other";
-  }
   return "";
 }
 

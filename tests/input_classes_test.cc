@@ -288,10 +288,6 @@ TEST(InputClassesCli, EachFlagIsNamedWithWhatIsWrong) {
            // UMBmark was written, exit 0.
            {"fit --logs . --position-sigma-m 1e-300", "must be at least 1e-09 m"},
            {"compare --logs . --heading-sigma-deg 1e-300", "must be at least 1e-07 deg"},
-           // estimated weights asked for by name were replaced by the sigma's, exit 0
-           {"fit --logs " + std::string(FITCAL_SOURCE_DIR) +
-                "/data/flower --weights estimated --position-sigma-m 0.01",
-            "--weights estimated estimates the noise levels that --position-sigma-m"},
            // fit's flags on the top level, before another subcommand, were read by nothing:
            // generalise ran on its default split, exit 0.
            {"--train-reps 1-3 generalise --logs .",
