@@ -183,6 +183,9 @@ TEST(NoiseLevels, FitCommandEstimatesWeightsUnlessASigmaIsGiven) {
       tmp, fit + " --position-sigma-m 0.004 --heading-sigma-deg 1.15 --out " + tmp.Path("b.yaml"));
   ASSERT_EQ(given.exit_code, 0) << given.out << given.err;
   EXPECT_FALSE(testing::Has(given.out, "weights from the data")) << given.out;
+  // The override said: an explicit --weights estimated was dropped without a word.
+  EXPECT_TRUE(testing::Has(given.out + given.err, "note: --weights estimated not applied"))
+      << given.out << given.err;
   const std::string b = testing::ReadFileBytes(tmp.Path("b.yaml"));
   EXPECT_TRUE(testing::Has(b, "sigma_xy 0.004000 m, sigma_theta 1.150000 deg")) << b;
 
