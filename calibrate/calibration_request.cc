@@ -1,6 +1,5 @@
 #include "calibrate/calibration_request.h"
 
-#include <algorithm>
 #include <set>
 
 namespace fitcal {
@@ -29,16 +28,10 @@ std::string AbsentRepetitionRefusal(const CalibrationRequest& request) {
   }
   std::set<int> present;
   for (const RunLog& run : request.runs) present.insert(run.repetition);
-  const std::string& text = request.train_reps;
-  for (std::size_t start = 0; start <= text.size();) {
-    const std::size_t comma = std::min(text.find(',', start), text.size());
-    const std::string item = text.substr(start, comma - start);
-    start = comma + 1;
-    if (item.empty() || item.find('-') != std::string::npos) continue;
-    const std::vector<int> named = ParseRepetitionList(item);
-    if (named.size() == 1 && present.count(named[0]) == 0) {
-      return "--train-reps names repetition " + item + ", which no run of " + request.dataset +
-             " has (repetitions " +
+  for (const int named : RepetitionsNamedAlone(request.train_reps)) {
+    if (present.count(named) == 0) {
+      return "--train-reps names repetition " + std::to_string(named) + ", which no run of " +
+             request.dataset + " has (repetitions " +
              FormatRepetitionList(std::vector<int>(present.begin(), present.end())) + ")";
     }
   }

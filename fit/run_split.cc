@@ -19,26 +19,44 @@ int ParseInt(const std::string& s, const std::string& whole) {
 }
 }  // namespace
 
-std::vector<int> ParseRepetitionList(const std::string& text) {
-  std::set<int> out;
+// Calls item(text of one comma-separated item, its repetitions) for each item of `text`.
+template <typename Item>
+void ForEachRepetitionItem(const std::string& text, Item&& item) {
   std::size_t pos = 0;
   while (pos <= text.size()) {
     std::size_t end = text.find(',', pos);
     if (end == std::string::npos) end = text.size();
-    const std::string item = text.substr(pos, end - pos);
-    const std::size_t dash = item.find('-');
+    const std::string part = text.substr(pos, end - pos);
+    const std::size_t dash = part.find('-');
     if (dash == std::string::npos) {
-      out.insert(ParseInt(item, text));
+      item(part, std::vector<int>{ParseInt(part, text)});
     } else {
-      const int lo = ParseInt(item.substr(0, dash), text);
-      const int hi = ParseInt(item.substr(dash + 1), text);
+      const int lo = ParseInt(part.substr(0, dash), text);
+      const int hi = ParseInt(part.substr(dash + 1), text);
       if (lo > hi)
-        throw std::invalid_argument("repetition list '" + text + "': range " + item +
+        throw std::invalid_argument("repetition list '" + text + "': range " + part +
                                     " is reversed");
-      for (int r = lo; r <= hi; ++r) out.insert(r);
+      std::vector<int> range;
+      for (int r = lo; r <= hi; ++r) range.push_back(r);
+      item(part, range);
     }
     pos = end + 1;
   }
+}
+
+std::vector<int> ParseRepetitionList(const std::string& text) {
+  std::set<int> out;
+  ForEachRepetitionItem(text, [&](const std::string&, const std::vector<int>& reps) {
+    out.insert(reps.begin(), reps.end());
+  });
+  return {out.begin(), out.end()};
+}
+
+std::vector<int> RepetitionsNamedAlone(const std::string& text) {
+  std::set<int> out;
+  ForEachRepetitionItem(text, [&](const std::string& part, const std::vector<int>& reps) {
+    if (part.find('-') == std::string::npos) out.insert(reps.front());
+  });
   return {out.begin(), out.end()};
 }
 

@@ -16,6 +16,8 @@ namespace fitcal {
 
 // Parses "1-5", "1,3,5" or "1-3,7": sorted, unique; throws std::invalid_argument otherwise.
 std::vector<int> ParseRepetitionList(const std::string& text);
+// The repetitions `text` names on their own, not in a range ("1,11,3-5": 1 and 11).
+std::vector<int> RepetitionsNamedAlone(const std::string& text);
 // "1-5" style text of a sorted list.
 std::string FormatRepetitionList(const std::vector<int>& repetitions);
 // "auto": the first half of the repetitions present (rounded up), how `diagnose` and `generalise`
