@@ -275,9 +275,14 @@ DirectionAnalysis AnalyseDeterminedDirections(const std::vector<AlignedRun>& tra
     d.description =
         DescribeDirection(training, runs, robot, v, prior_sigma, fraction, d.one_sigma_step);
     if (AlongCommonScale(robot, prior_sigma, v) > kCommonScaleCosine) {
-      d.description = "the common scale of wheels and track (" + d.description +
-                      "): closed loops judged at their end cannot see it; add a straight run of "
-                      "known length, or fit the track (--residuals track)";
+      // Closed loops judged at their end cannot see it; a track can, unless its residuals are
+      // too large for it (a tie or a hold the robot does not obey: stop 72's D-F7).
+      d.description = "the common scale of wheels and track (" + d.description + "): " +
+                      (segments == nullptr
+                           ? "closed loops judged at their end cannot see it; add a straight run "
+                             "of known length, or fit the track (--residuals track)"
+                           : "the tracks' residuals are too large to see it (does the model as "
+                             "asked fit these runs?); add a straight run of known length");
     }
     out.undetermined.push_back(d);
   }

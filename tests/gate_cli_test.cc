@@ -152,5 +152,30 @@ TEST(GateCli, ARefusedSplitByRepetitionSaysWhatToTry) {
   EXPECT_TRUE(fs::exists(out));
 }
 
+// A tie the robot does not obey (wheels of 30 and 90 mm tied to one radius): the tied fit loses to
+// the nominal on its own training runs (CF 0.98 -> 1.78), so the refusal names the model as asked,
+// not the split, and a track fit is not told to fit the track (stop 72's D-F7).
+TEST(GateCli, ATieTheRobotDoesNotObeyIsNamedAsTheCause) {
+  TempDir dir;
+  const std::string robot = dir.Path("robot.yaml"), data = dir.Path("sim");
+  WriteFileBytes(robot,
+                 "model: diff_drive\nname: unequal\nwheels:\n"
+                 "  - {name: port, side: left, radius_m: 0.03}\n"
+                 "  - {name: starboard, side: right, radius_m: 0.09}\n"
+                 "wheel_separation_m: 0.5\nbounds:\n  radius_m: [0.02, 0.1]\n"
+                 "  wheel_separation_m: [0.4, 0.6]\n");
+  ASSERT_EQ(RunFitcal(dir, "simulate --robot " + robot + " --out " + data + " --repetitions 10")
+                .exit_code,
+            0);
+  const auto r = RunFitcal(dir, "fit --logs " + data + " --tie r_port,r_starboard --out " +
+                                    dir.Path("cal.yaml"));
+  EXPECT_EQ(r.exit_code, 5) << r.out << r.err;
+  EXPECT_TRUE(Has(r.err, "no calibration beats the nominal even on the training runs")) << r.err;
+  EXPECT_FALSE(Has(r.err, "leave directions undetermined")) << r.err;
+  ASSERT_TRUE(Has(r.out, "residuals: track")) << r.out;
+  EXPECT_FALSE(Has(r.out, "(--residuals track)")) << r.out;
+  EXPECT_FALSE(fs::exists(dir.Path("cal.yaml")));
+}
+
 }  // namespace
 }  // namespace fitcal
