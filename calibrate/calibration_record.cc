@@ -40,6 +40,11 @@ io::CalibrationBlock MakeRecord(const CalibrationRequest& request, const RobotMo
     // Held by --hold (fit/parameter_tying.h) beside the model's own holds.
     if (selected_fit.held[k] && !robot.IsHeld(k)) r.held.push_back(robot.parameters[k].name);
   }
+  for (const std::vector<std::string>& group : request.settings.tying.groups) {
+    std::string names;
+    for (const std::string& name : group) names += (names.empty() ? "" : "=") + name;
+    r.tied.push_back(names);
+  }
   for (int k = 0; k < robot.NumParameters(); ++k) {
     if (selected_fit.at_bound[k]) r.at_bound.push_back(robot.parameters[k].name);
   }

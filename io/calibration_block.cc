@@ -108,6 +108,7 @@ std::string CalibrationBlockYaml(const CalibrationBlock& c, const Robot& robot) 
   }
   EmitRuns(out, c);
   out << YAML::Key << "held" << YAML::Value << YAML::Flow << c.held;
+  if (!c.tied.empty()) out << YAML::Key << "tied" << YAML::Value << YAML::Flow << c.tied;
   out << YAML::Key << "at_bound" << YAML::Value << YAML::Flow << c.at_bound;
   if (!c.not_determined.empty()) {
     out << YAML::Key << "not_determined" << YAML::Value << YAML::Flow << c.not_determined;

@@ -51,6 +51,9 @@ struct CalibrationBlock : CalibrationSource {
   std::string selected;
   std::string selected_on;
   std::vector<std::string> held;  // parameter names held at nominal, with why
+  // Groups fitted as one value (--tie, fit/parameter_tying.h), "r_left=r_right" each (`tied:`,
+  // written only when there are some): a reader of the values sees why they are equal.
+  std::vector<std::string> tied;
   // Parameters the runs did not determine: their sigma is what the bounds allow along a direction
   // held at the nominal (`not_determined:`, written only when there are some).
   std::vector<std::string> not_determined;

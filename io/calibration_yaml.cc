@@ -138,7 +138,7 @@ void RejectKeysNoWriterWrites(const YAML::Node& block, const std::string& path) 
       "method", "objective", "dataset", "tool_version", "termination", "selected", "selected_on",
       "training_repetitions", "validation_repetitions", "training_runs", "validation_runs",
       "training_trajectories", "training_run_ids", "training_fingerprint", "cf_training",
-      "cf_validation", "held", "at_bound", "not_determined", "sigma", "correlation",
+      "cf_validation", "held", "tied", "at_bound", "not_determined", "sigma", "correlation",
       "clock_offsets", "inverse_kinematic_matrix", "forward_kinematic_matrix",
       "odometry_covariance"};
   YamlMap map(block, path, "calibration");

@@ -196,10 +196,17 @@ TEST(ParameterTying, FitCommandTiesAndRefusesUnknownNames) {
   ASSERT_EQ(
       testing::RunFitcal(dir, "simulate --model diff_drive --out " + data + " --seed 3").exit_code,
       0);
+  const std::string cal = dir.Path("cal.yaml");
   const auto tied =
-      testing::RunFitcal(dir, "fit --logs " + data + " --tie r_left,r_right --no-output");
-  EXPECT_NE(tied.exit_code, 2) << tied.err;
+      testing::RunFitcal(dir, "fit --logs " + data + " --tie r_left,r_right --out " + cal);
+  ASSERT_EQ(tied.exit_code, 0) << tied.err;
   EXPECT_NE(tied.out.find("tied (one value): r_left=r_right"), std::string::npos) << tied.out;
+  // The calibration says why its two radii are equal (stop 72's D-F4), and reads back.
+  EXPECT_NE(testing::ReadFileBytes(cal).find("\n  tied: [r_left=r_right]\n"), std::string::npos);
+  EXPECT_EQ(testing::RunFitcal(dir, "report --logs " + data + " --calibration " + cal +
+                                        " --out " + dir.Path("r"))
+                .exit_code,
+            0);
   const auto wrong =
       testing::RunFitcal(dir, "fit --logs " + data + " --tie r_left,r_nope --no-output");
   EXPECT_EQ(wrong.exit_code, 2);
