@@ -48,6 +48,9 @@ std::vector<std::vector<Segment>> MakeDisjointWindows(
 // The authors count 0.5 m of nominal odometry distance; the ground truth's path length is counted
 // here, which does not move with the parameters being fitted. With a heading weight near zero the
 // segment residual's squared norm is their cost, the squared position error in the start frame.
+// A checkpoint sits at the encoder boundary nearest the ground truth's first sample at or past the
+// crossing (OnAGroundTruthSample, segment_cost.cc): where every boundary has a sample, as in
+// OptiOdom's logs, that is the crossing itself.
 std::vector<Segment> MakeCheckpointsFromStart(const AlignedRun& run,
                                               const GroundTruthTrack& ground_truth,
                                               double spacing_m);

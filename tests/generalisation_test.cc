@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -220,6 +221,34 @@ TEST(GeneralisationOptiOdom, CheckpointsFollowTheGroundTruthPath) {
   EXPECT_EQ(c.back().end, aligned.samples.size());
   EXPECT_NEAR(c.back().ground_truth_start_T_end.x, 1.4, 1e-9);
   EXPECT_THROW(MakeCheckpointsFromStart(aligned, run.log.ground_truth, 0.0), std::invalid_argument);
+}
+
+// A ground truth sparser than the encoders (every 0.25 s, encoders every 0.05 s) is a straight
+// line between its samples, which lags a robot slowing down: each checkpoint sits on a sample
+// (stop 72's D-F1: between samples the flower's checkpoints read the stop 5-6 mm short and track
+// fits wrote radii 0.27 % small), past its spacing by less than one sample's travel.
+TEST(GeneralisationOptiOdom, CheckpointsSitOnASparseGroundTruthsSamples) {
+  const RobotModelPtr model = testing::ExampleModel("test_unicycle");
+  sim::SimulationOptions sim_options;
+  sim_options.ground_truth_period_s = 5 * sim_options.encoder_period_s;
+  const sim::ModelSimulatedRun run =
+      sim::SimulateRuns(*model, {kTrueRadius, kTrueGain}, {Spec(kShapes[1])}, sim_options)[0];
+  const AlignedRun aligned = AlignRun(run.log);
+  const std::vector<double> t = BoundaryTimes(aligned);
+  const std::vector<double>& samples = run.log.ground_truth.t_s;
+  const std::vector<Segment> c = MakeCheckpointsFromStart(aligned, run.log.ground_truth, 0.33);
+  ASSERT_EQ(c.size(), 5u);  // 1.4 m: four checkpoints 0.33 m apart or a little more, the end
+  double previous_m = 0.0;
+  for (std::size_t k = 0; k + 1 < c.size(); ++k) {
+    const double at = t[c[k].end];
+    const auto sample = std::lower_bound(samples.begin(), samples.end(), at - 1e-9);
+    ASSERT_NE(sample, samples.end());
+    EXPECT_NEAR(*sample, at, 1e-9) << "checkpoint " << k << " between samples";
+    EXPECT_GE(c[k].path_length_m - previous_m, 0.33 - 1e-12);
+    EXPECT_LT(c[k].path_length_m - previous_m,
+              0.33 + kSpeed * sim_options.ground_truth_period_s + 1e-9);
+    previous_m = c[k].path_length_m;
+  }
 }
 
 TEST(GeneralisationSplits, PredicateSplitsGoBothWaysAndNeedBothSides) {
