@@ -153,7 +153,7 @@ TEST(GateCli, ARefusedSplitByRepetitionSaysWhatToTry) {
 }
 
 // A tie the robot does not obey (wheels of 30 and 90 mm tied to one radius): the tied fit loses to
-// the nominal on its own training runs (CF 0.98 -> 1.78), so the refusal names the model as asked,
+// the nominal on its own training runs (CF 0.98 -> 1.78), so the refusal names the tie,
 // not the split, and a track fit is not told to fit the track (stop 72's D-F7).
 TEST(GateCli, ATieTheRobotDoesNotObeyIsNamedAsTheCause) {
   TempDir dir;
