@@ -322,6 +322,12 @@ void Conclude(const CalibrationRequest& r, const RobotModelInterface& model,
                          " limit): it beats the nominal, but check it or raise " +
                          (ceres ? "--max-iterations" : "--max-evaluations");
   }
+  if (!fit.not_at_a_minimum.empty() && selected_is_fit) {
+    out->stopped_early = "warning: the written calibration is " + r.method->name +
+                         "'s last point, and " + fit.not_at_a_minimum +
+                         ": it beats the nominal, but --polish finishes the search with a local "
+                         "method (or fit with --method ceres)";
+  }
 }
 
 void Run(const CalibrationRequest& r, const RobotModelInterface& model, CalibrationOutcome* out) {

@@ -50,6 +50,9 @@ struct ModelFitResult {
   bool stopped_early = false;
   // Parameters a gate may judge: converged, or stopped at the iteration limit.
   bool HasFinitePoint() const { return usable || stopped_early; }
+  // A global NLopt search that ended where its cost still falls (calibrate/fit_methods.cc,
+  // NotAtAMinimum), in words; "" otherwise. Written with a warning, as stopped_early.
+  std::string not_at_a_minimum;
   std::string termination;  // Ceres termination type of the last solve, e.g. CONVERGENCE
   std::string message;      // Ceres' reason for stopping
   // Summed over every solve: active-set rounds, held directions, clock-offset and noise-level

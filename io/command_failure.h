@@ -16,8 +16,8 @@ inline constexpr char kExitStatusHelp[] =
     "an output refused (README, Outputs: what may be replaced, with --force where a command has\n"
     "it); 3 the fit did not converge; 4 the encoder columns look miswired;\n"
     "5 no calibration beats the nominal robot on the held-out runs; 6 written with a warning\n"
-    "(stopped at the iteration limit); 7 and 8 report --strict judged FAIL and WARN. On any\n"
-    "failure nothing is written.";
+    "(stopped at the iteration limit, or a global search short of a minimum); 7 and 8 report\n"
+    "--strict judged FAIL and WARN. On any failure nothing is written.";
 
 class CommandFailure : public std::runtime_error {
  public:

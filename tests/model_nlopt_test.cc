@@ -5,12 +5,14 @@
 // model's closed form (UMBmark) as a row.
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 
 #include "fit/final_pose_errors.h"
 #include "fit/model_fit.h"
@@ -158,4 +160,30 @@ TEST(ModelNloptCli, FitAndCompareWorkForADifferentialDrive) {
 }
 
 }  // namespace
+
+// A global search that ends where its objective still falls is written with a warning (exit 6),
+// as a solver stopped at its limit: DIRECT-L on OptiOdom's tricycle squares stops on its function
+// tolerance at a point of its box's grid (stop 72's D-F11: held-out CF 0.54 where the polished
+// search reaches 0.14, exit 0, its parameters "NOT DETERMINED"). The check is the polish itself:
+// from that point a local method lowers the training CF by more than the tenth the warning needs.
+TEST(ModelNloptCli, AGlobalSearchEndingShortOfAMinimumIsFlagged) {
+  const std::string squares = FITCAL_SHARED_DIR + "/data/optiodom/tricyc/square";
+  if (!std::filesystem::is_directory(squares)) GTEST_SKIP() << "no " << squares;
+  TempDir dir;
+  const std::string data = dir.Path("sq"), raw = dir.Path("raw.yaml"), polished = dir.Path("p.yaml");
+  ASSERT_EQ(RunFitcal(dir, "import optiodom " + squares + "/* --out " + data).exit_code, 0);
+  const auto short_of = RunFitcal(dir, "fit --logs " + data + " --method direct-l --out " + raw);
+  EXPECT_EQ(short_of.exit_code, 6) << short_of.out << short_of.err;
+  EXPECT_EQ(testing::Lines(short_of.err), 1) << short_of.err;
+  EXPECT_NE(short_of.err.find("is not a minimum"), std::string::npos) << short_of.err;
+  EXPECT_NE(short_of.err.find("--polish"), std::string::npos) << short_of.err;
+  const auto finished =
+      RunFitcal(dir, "fit --logs " + data + " --method direct-l --polish --out " + polished);
+  ASSERT_EQ(finished.exit_code, 0) << finished.out << finished.err;
+  const auto training_cf = [](const std::string& cal) {
+    return YAML::LoadFile(cal)["calibration"]["cf_training"]["after"].as<double>();
+  };
+  EXPECT_LT(training_cf(polished), 0.9 * training_cf(raw));
+}
+
 }  // namespace fitcal
