@@ -159,8 +159,6 @@ TEST(ModelNloptCli, FitAndCompareWorkForADifferentialDrive) {
   EXPECT_EQ(testing::Lines(refused.err), 1) << refused.err;
 }
 
-}  // namespace
-
 // A global search that ends where its objective still falls is written with a warning (exit 6),
 // as a solver stopped at its limit: DIRECT-L on OptiOdom's tricycle squares stops on its function
 // tolerance at a point of its box's grid (stop 72's D-F11: held-out CF 0.54 where the polished
@@ -186,4 +184,5 @@ TEST(ModelNloptCli, AGlobalSearchEndingShortOfAMinimumIsFlagged) {
   EXPECT_LT(training_cf(polished), 0.9 * training_cf(raw));
 }
 
+}  // namespace
 }  // namespace fitcal
