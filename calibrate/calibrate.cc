@@ -95,6 +95,10 @@ void FitTrainingRuns(const CalibrationRequest& r, const RobotModelInterface& mod
     Refuse(out, 1, {r.dataset + ": " + refusal});
     return;
   }
+  if (!chosen_fit && r.effects_to_fit.empty()) {
+    chosen_fit = FitAskedFinalPoseFromTheTrackToo(*r.method, model, out->split.training,
+                                                  out->settings);
+  }
   out->fit = chosen_fit ? std::move(*chosen_fit)
                         : r.method->run_model(out->split.training, model, out->settings);
   const ModelFitResult& whole = out->fit.fit;

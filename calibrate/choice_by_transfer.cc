@@ -95,12 +95,14 @@ void FitAllTrainingRuns(const FitMethod& method, const RobotModelInterface& mode
 
 // `settings`' fit of `training` from the guess (FitModel's global start) and, unless `start` is
 // empty, from `start`, the lower cost of the usable ones kept: either start can end in a local
-// minimum the other leaves.
+// minimum the other leaves. The fit from `start` must be lower by more than `relative_margin` of
+// the guess's cost: with a margin, two ends of one minimum keep the guess's.
 ModelFitMethodOutcome FitFromGuessAndFrom(const FitMethod& method,
                                           const std::vector<AlignedRun>& training,
                                           const RobotModelInterface& model,
                                           const FitMethodSettings& settings,
-                                          const std::vector<double>& start) {
+                                          const std::vector<double>& start,
+                                          double relative_margin = 0.0) {
   ModelFitMethodOutcome guess = method.run_model(training, model, settings);
   if (start.empty()) return guess;
   FitMethodSettings from_start = settings;
@@ -108,7 +110,8 @@ ModelFitMethodOutcome FitFromGuessAndFrom(const FitMethod& method,
   ModelFitMethodOutcome warm = method.run_model(training, model, from_start);
   const bool warm_is_lower =
       warm.fit.HasFinitePoint() &&
-      (!guess.fit.HasFinitePoint() || warm.fit.final_cost < guess.fit.final_cost);
+      (!guess.fit.HasFinitePoint() ||
+       warm.fit.final_cost < (1.0 - relative_margin) * guess.fit.final_cost);
   return warm_is_lower ? std::move(warm) : std::move(guess);
 }
 
@@ -152,6 +155,30 @@ std::vector<std::string> ChooseResidualsByTransfer(const FitMethod& method, int 
     full->emplace(FitFromGuessAndFrom(method, split.training, model, *settings, fold_fits->start));
   }
   return ResidualKindJudgementLines(judgement);
+}
+
+std::optional<ModelFitMethodOutcome> FitAskedFinalPoseFromTheTrackToo(
+    const FitMethod& method, const RobotModelInterface& model,
+    const std::vector<AlignedRun>& training, const FitMethodSettings& settings) {
+  if (settings.residuals_auto || settings.residuals != ResidualKind::kFinalPose ||
+      !settings.start.empty()) {
+    return std::nullopt;
+  }
+  FitMethodSettings track = settings;
+  track.residuals_auto = true;  // the track where the ground truth is dense (ResolveAutoResiduals)
+  track.weights_auto = track.track_heading_auto = false;
+  track.judgement_fit = true;  // its parameters alone are read: no covariance
+  std::optional<TrackFitData> data;
+  if (!PrepareTrackResiduals(method.name, training, &track, &data).empty() ||
+      track.residuals != ResidualKind::kTrack) {
+    return std::nullopt;
+  }
+  const ModelFitResult track_fit = method.run_model(training, model, track).fit;
+  if (!track_fit.HasFinitePoint()) return std::nullopt;
+  // The margin keeps the guess's fit, and the bytes an explicit final pose wrote before, where
+  // both starts end in one minimum (without it the OptiOdom diff drive's radii moved by 1e-10 m);
+  // the local minimum above has 200 times the truth's training CF.
+  return FitFromGuessAndFrom(method, training, model, settings, track_fit.parameters, 1e-6);
 }
 
 std::vector<std::string> ChooseTrackObjectiveByTransfer(

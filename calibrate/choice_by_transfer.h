@@ -61,6 +61,18 @@ std::vector<std::string> ChooseResidualsByTransfer(const FitMethod& method, int 
                                                    std::optional<ModelFitMethodOutcome>* full,
                                                    FoldFits* fold_fits);
 
+// An explicit --residuals final-pose fitted by a Ceres method on training runs whose ground truth
+// is a dense track: the final pose's fit from the guess and from the track's fit of the same runs,
+// the lower cost kept, as a final pose chosen by transfer is fitted. From the guess alone a fit
+// far from the truth can end in a local minimum of the final poses that holds its flat direction,
+// so no reason to start across the box shows (a diff drive with a radius guessed 24 % off, its
+// runs cut to 56 %: radii 0.0445 / 0.0276 m against 0.0319 / 0.0449, exit 0). nullopt where this
+// does not apply (another kind, another method, sparse ground truth, a start given): the fit
+// from the guess is the caller's.
+std::optional<ModelFitMethodOutcome> FitAskedFinalPoseFromTheTrackToo(
+    const FitMethod& method, const RobotModelInterface& model,
+    const std::vector<AlignedRun>& training, const FitMethodSettings& settings);
+
 // --track-heading auto on track residuals: the candidates fitted and judged by
 // transfer (validation/track_objective_transfer.h), each fold's fit started from the fit of all
 // the training runs when the residual choice made one; settings, *track_data and *full follow the

@@ -371,7 +371,10 @@ TEST(ResidualKindChoice, AFitFarFromTheGuessOnCutRunsIsWrittenAtTheTruth) {
   // ended in local minima (halves' CF 3.08 -> 2.46) and the calibration was refused as "the runs
   // do not determine the parameters".
   const Robot truth = ReadRobotModelFile(dir.Path("truth.yaml"))->robot();
-  for (const std::string training : {"1-9", "1-99"}) {
+  // An explicit final pose, fitted from the guess alone, ended in that minimum too (radii 0.0445
+  // and 0.0276 m, exit 0): it is fitted from the track's fit as well now
+  // (FitAskedFinalPoseFromTheTrackToo, calibrate/choice_by_transfer.cc).
+  for (const std::string training : {"1-9", "1-99", "1-9 --residuals final-pose"}) {
     const auto r = RunFitcal(dir, "fit --logs " + data + " --train-reps " + training + " --out " +
                                       cal);
     ASSERT_EQ(r.exit_code, 0) << training << r.out << r.err;
@@ -381,7 +384,7 @@ TEST(ResidualKindChoice, AFitFarFromTheGuessOnCutRunsIsWrittenAtTheTruth) {
           << training << " " << truth.parameters[k].name;
     }
     // Validated on nothing, it records no validation figures (it wrote zeros).
-    EXPECT_EQ(YAML::LoadFile(cal)["calibration"]["cf_validation"].IsDefined(), training == "1-9");
+    EXPECT_EQ(YAML::LoadFile(cal)["calibration"]["cf_validation"].IsDefined(), training != "1-99");
   }
 }
 
