@@ -177,7 +177,7 @@ std::optional<ModelFitMethodOutcome> FitAskedFinalPoseFromTheTrackToo(
   if (!track_fit.HasFinitePoint()) return std::nullopt;
   // The margin keeps the guess's fit, and the bytes an explicit final pose wrote before, where
   // both starts end in one minimum (without it the OptiOdom diff drive's radii moved by 1e-10 m);
-  // the local minimum above has 200 times the truth's training CF.
+  // the local minimum above has over 200 times the truth's training CF.
   return FitFromGuessAndFrom(method, training, model, settings, track_fit.parameters, 1e-6);
 }
 

@@ -1105,11 +1105,14 @@ std::vector<double> StartAcrossTheBox(const Robot& robot, const ModelFitOptions&
   return start;
 }
 
-// A fit of tracks whose only reason to start across the box is a flat direction (held, or a
-// rank-deficient covariance), inside its bounds: the runs may truly leave that direction open,
-// and then every start ends flat again. Such a fit tries the windows' fit first
-// (WithGlobalStart): its short windows' minima do not depend on the guess, so a fit from there
-// that ends at the guess's cost says the guess's minimum is the runs' own, and the search ends.
+// A fit of tracks, on no bound, with a flat direction (held, or a rank-deficient covariance): the
+// runs may truly leave that direction open, and then every start ends flat again. Such a fit
+// tries the windows' fit first (WithGlobalStart): short windows reach the truth from guesses a
+// whole run's fit does not (the tricycle below), so a fit from there that ends at the guess's
+// cost says the guess's minimum is the runs' own, and the search ends. A start across the box
+// that meets the guess's cost says less: letting it end the search failed three far-guess tests
+// (FarFromTheGuessOnTracks, RecordedRobot, ResidualKindChoice), where the 50 % start fell into
+// the guess's local minimum and a later start found the truth.
 // Without this a robot whose runs leave directions open tried every start (a simulated ASOC robot
 // with a mounted pose source, `fit --residuals track`: the probe with the mount freed,
 // calibrate/calibrate.cc, held two directions with a rank-deficient covariance at cost
